@@ -1,0 +1,306 @@
+"""Contacts and contact frames (numpy only).
+
+A :class:`Contact` is a point on the object's surface with the unit normal that
+points **into the object** (the direction in which the finger pushes), a friction
+coefficient and a contact model.  Two-dimensional position and normal make a planar
+contact.  See ``shared/CONVENTIONS.md`` for every sign and ordering used here.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from drakegrasp.errors import InvalidContactError
+
+__all__ = ["Contact", "ContactModel", "contact_frame", "contact_frames"]
+
+
+class ContactModel(str, enum.Enum):
+    """How a contact transmits force and moment to the object.
+
+    ``FRICTIONLESS``: normal force only, ``f = [f_n]``.
+    ``HARD_FINGER``: point contact with Coulomb friction, ``f = [f_n, f_t1, f_t2]``
+    (planar ``[f_n, f_t]``).
+    ``SOFT_FINGER``: hard finger plus a moment about the normal,
+    ``f = [f_n, f_t1, f_t2, m_n]`` (spatial only).
+    """
+
+    FRICTIONLESS = "frictionless"
+    HARD_FINGER = "hard_finger"
+    SOFT_FINGER = "soft_finger"
+
+    @classmethod
+    def parse(cls, value: ContactModel | str) -> ContactModel:
+        """Return the model named by ``value`` (an enum member or its string)."""
+        if isinstance(value, cls):
+            return value
+        try:
+            return cls(str(value).strip().lower().replace("-", "_"))
+        except ValueError:
+            valid = ", ".join(repr(m.value) for m in cls)
+            raise InvalidContactError(
+                f"unknown contact model {value!r}; valid models are {valid}"
+            ) from None
+
+    def __str__(self) -> str:
+        return self.value
+
+
+def contact_frames(normals: np.ndarray) -> np.ndarray:
+    """Contact frames ``R = [n, t1, t2]`` (or ``[n, t]``) for many unit normals.
+
+    Parameters
+    ----------
+    normals : (..., 3) or (..., 2) float
+        Unit contact normals, pointing into the object.  They are not
+        re-normalised here.
+
+    Returns
+    -------
+    R : (..., 3, 3) or (..., 2, 2) float
+        Rotation matrices whose columns are ``n, t1, t2`` (spatial) or ``n, t``
+        (planar), in the frame the normals are expressed in.
+
+    Notes
+    -----
+    Spatial: ``t1`` is the unit projection, onto the plane normal to ``n``, of the
+    coordinate axis along which ``|n|`` has its smallest component (the first such
+    axis on ties), and ``t2 = n × t1``.  This depends on ``n`` alone, so equal
+    normals always get equal frames.  Planar: ``t = (-n_y, n_x)``.
+    """
+    n = np.asarray(normals, dtype=float)
+    if n.shape[-1] == 2:
+        t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
+        return np.stack([n, t], axis=-1)
+    if n.shape[-1] != 3:
+        raise InvalidContactError(
+            f"normals must have 2 or 3 components, got shape {n.shape}"
+        )
+    axis = np.argmin(np.abs(n), axis=-1)
+    e = np.zeros_like(n)
+    np.put_along_axis(e, axis[..., None], 1.0, axis=-1)
+    t1 = e - np.sum(e * n, axis=-1, keepdims=True) * n
+    t1 /= np.linalg.norm(t1, axis=-1, keepdims=True)
+    t2 = np.cross(n, t1)
+    return np.stack([n, t1, t2], axis=-1)
+
+
+def contact_frame(normal: np.ndarray) -> np.ndarray:
+    """Contact frame ``R_i`` of one unit normal; see :func:`contact_frames`.
+
+    Parameters
+    ----------
+    normal : (3,) or (2,) float
+        Contact normal pointing into the object.  It is normalised here; a zero
+        or non-finite normal raises :class:`~drakegrasp.InvalidContactError`.
+
+    Returns
+    -------
+    R : (3, 3) or (2, 2) float
+        Columns ``[n, t1, t2]`` (spatial) or ``[n, t]`` (planar); right-handed.
+    """
+    return contact_frames(_unit_normal(normal))
+
+
+def _unit_normal(normal: np.ndarray) -> np.ndarray:
+    n = np.array(normal, dtype=float).reshape(-1)
+    if n.shape not in ((2,), (3,)):
+        raise InvalidContactError(
+            f"a normal must have 2 or 3 components, got {np.asarray(normal).tolist()}"
+        )
+    if not np.all(np.isfinite(n)):
+        raise InvalidContactError(f"normal {n.tolist()} is not finite")
+    norm = float(np.linalg.norm(n))
+    if norm < 1e-12:
+        raise InvalidContactError(
+            f"normal {n.tolist()} has zero length; a contact normal must be a "
+            "non-zero vector pointing into the object"
+        )
+    return n / norm
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.flags.writeable = False
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class Contact:
+    """One contact between a finger and the object.
+
+    Parameters
+    ----------
+    position : (3,) or (2,) float
+        Contact point ``c`` on the object's surface, metres, in the grasp frame.
+    normal : (3,) or (2,) float
+        Contact normal pointing into the object, in the grasp frame; it is
+        normalised.  Its dimension must match ``position``.
+    mu : float, optional
+        Coulomb friction coefficient, ``>= 0``.  Ignored by frictionless contacts.
+    model : ContactModel or str, optional
+        ``"frictionless"``, ``"hard_finger"`` (default) or ``"soft_finger"``.
+        A soft finger is spatial only.
+    torsional_friction : float, optional
+        Torsional friction coefficient ``ν >= 0`` of a soft finger: the moment
+        about the normal is bounded by ``b ν f_n`` with ``b`` the grasp's
+        characteristic length.
+
+    Notes
+    -----
+    Contacts are immutable; their arrays are read-only.  A hard finger with
+    ``mu = 0`` has a cone that is a single ray: every program treats it exactly
+    as a frictionless contact (see :meth:`effective_model`).
+    """
+
+    position: np.ndarray
+    normal: np.ndarray
+    mu: float = 0.0
+    model: ContactModel = ContactModel.HARD_FINGER
+    torsional_friction: float = 0.0
+    _frame: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __init__(
+        self,
+        position: np.ndarray,
+        normal: np.ndarray,
+        *,
+        mu: float = 0.0,
+        model: ContactModel | str = ContactModel.HARD_FINGER,
+        torsional_friction: float = 0.0,
+    ) -> None:
+        p = np.array(position, dtype=float).reshape(-1)
+        if p.shape not in ((2,), (3,)):
+            raise InvalidContactError(
+                "a contact position must have 2 (planar) or 3 (spatial) "
+                f"components, got {np.asarray(position).tolist()}"
+            )
+        if not np.all(np.isfinite(p)):
+            raise InvalidContactError(f"contact position {p.tolist()} is not finite")
+        n = _unit_normal(normal)
+        if n.shape != p.shape:
+            raise InvalidContactError(
+                f"position {p.tolist()} has {p.size} components but normal "
+                f"{n.tolist()} has {n.size}; both must be 2-D or both 3-D"
+            )
+        mu_value = _nonnegative("mu", mu)
+        nu_value = _nonnegative("torsional_friction", torsional_friction)
+        contact_model = ContactModel.parse(model)
+        if contact_model is ContactModel.SOFT_FINGER and p.size == 2:
+            raise InvalidContactError(
+                "a soft-finger contact is spatial only; planar contacts are "
+                "'frictionless' or 'hard_finger'"
+            )
+        object.__setattr__(self, "position", _frozen(p))
+        object.__setattr__(self, "normal", _frozen(n))
+        object.__setattr__(self, "mu", mu_value)
+        object.__setattr__(self, "model", contact_model)
+        object.__setattr__(self, "torsional_friction", nu_value)
+        object.__setattr__(self, "_frame", _frozen(contact_frames(n)))
+
+    @property
+    def dim(self) -> int:
+        """Dimension of the contact: 2 (planar) or 3 (spatial)."""
+        return int(self.position.size)
+
+    @property
+    def planar(self) -> bool:
+        """True for a 2-D contact."""
+        return self.dim == 2
+
+    @property
+    def frame(self) -> np.ndarray:
+        """Contact frame ``R_i``, (3, 3) ``[n, t1, t2]`` or (2, 2) ``[n, t]``."""
+        return self._frame
+
+    @property
+    def num_components(self) -> int:
+        """Number of force components of the model (1, 2, 3 or 4)."""
+        return len(self.component_names)
+
+    @property
+    def component_names(self) -> tuple[str, ...]:
+        """Names of the force components in order, normal component first."""
+        if self.model is ContactModel.FRICTIONLESS:
+            return ("f_n",)
+        if self.planar:
+            return ("f_n", "f_t")
+        if self.model is ContactModel.HARD_FINGER:
+            return ("f_n", "f_t1", "f_t2")
+        return ("f_n", "f_t1", "f_t2", "m_n")
+
+    def effective_components(self) -> tuple[int, ...]:
+        """Indices of the force components that the friction cone lets be non-zero.
+
+        A hard finger with ``mu = 0`` keeps only ``f_n``; a soft finger drops its
+        tangential components when ``mu = 0`` and its moment when
+        ``torsional_friction = 0``.  The programs use only these components, so a
+        degenerate cone never changes a verdict.
+        """
+        keep = [0]
+        if self.model is not ContactModel.FRICTIONLESS and self.mu > 0.0:
+            keep += [1] if self.planar else [1, 2]
+        if self.model is ContactModel.SOFT_FINGER and self.torsional_friction > 0:
+            keep.append(3)
+        return tuple(keep)
+
+    def effective_model(self) -> ContactModel:
+        """The model this contact behaves as once degenerate cones are removed."""
+        comps = self.effective_components()
+        if comps == (0,):
+            return ContactModel.FRICTIONLESS
+        if 3 in comps:
+            return ContactModel.SOFT_FINGER
+        return ContactModel.HARD_FINGER
+
+    def with_(self, **changes) -> Contact:
+        """Return a copy with some fields replaced (``mu``, ``model``, ...)."""
+        kwargs = {
+            "position": self.position,
+            "normal": self.normal,
+            "mu": self.mu,
+            "model": self.model,
+            "torsional_friction": self.torsional_friction,
+        }
+        unknown = set(changes) - set(kwargs)
+        if unknown:
+            raise InvalidContactError(
+                f"Contact has no field(s) {sorted(unknown)}; "
+                f"fields are {sorted(kwargs)}"
+            )
+        kwargs.update(changes)
+        position = kwargs.pop("position")
+        normal = kwargs.pop("normal")
+        return Contact(position, normal, **kwargs)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary of the contact."""
+        return {
+            "position": self.position.tolist(),
+            "normal": self.normal.tolist(),
+            "mu": self.mu,
+            "model": self.model.value,
+            "torsional_friction": self.torsional_friction,
+        }
+
+    def __repr__(self) -> str:
+        extra = f", nu={self.torsional_friction:g}" if self.torsional_friction else ""
+        return (
+            f"Contact(position={np.round(self.position, 6).tolist()}, "
+            f"normal={np.round(self.normal, 6).tolist()}, mu={self.mu:g}, "
+            f"model={self.model.value!r}{extra})"
+        )
+
+
+def _nonnegative(name: str, value: float) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InvalidContactError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(x) or x < 0.0:
+        raise InvalidContactError(f"{name} must be finite and >= 0, got {value!r}")
+    return x

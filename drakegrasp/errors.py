@@ -1,0 +1,59 @@
+"""The one tree of errors that drakegrasp raises.
+
+Every error is a :class:`GraspError`, so ``except drakegrasp.GraspError`` catches
+all of them.  Messages name the offending value and what would be valid.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class GraspError(Exception):
+    """Base class of every error raised by drakegrasp."""
+
+
+class InvalidContactError(GraspError, ValueError):
+    """A contact, or a set of contacts, is not well formed.
+
+    Raised for a zero or non-finite normal, a negative friction coefficient, an
+    unknown contact model, mixed planar and spatial contacts, a soft finger in
+    the plane, and the like.
+    """
+
+
+class InvalidGraspError(GraspError, ValueError):
+    """A grasp-level input is not well formed (reference point, length, Jacobian)."""
+
+
+class InvalidOptionError(GraspError, ValueError):
+    """Options passed to a function conflict or are out of range."""
+
+
+class NoContactsError(GraspError):
+    """The hand does not touch the object (or a grasp has no contacts)."""
+
+
+class PenetrationError(GraspError):
+    """A finger penetrates the object deeper than the distance tolerance."""
+
+
+class ModelError(GraspError):
+    """A model, scene file or body could not be found or loaded."""
+
+
+class SolverError(GraspError):
+    """A solver failed for a reason other than infeasibility.
+
+    Attributes
+    ----------
+    program : pydrake.solvers.MathematicalProgram or None
+        The program that was being solved.
+    result : pydrake.solvers.MathematicalProgramResult or None
+        What the solver returned.
+    """
+
+    def __init__(self, message: str, *, program: Any = None, result: Any = None):
+        super().__init__(message)
+        self.program = program
+        self.result = result

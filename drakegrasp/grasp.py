@@ -1,0 +1,262 @@
+r"""A grasp (a set of contacts on one object) and its grasp matrices (numpy only).
+
+.. math::
+
+    G_i = \begin{bmatrix} R_i \\ S(c_i - p)\, R_i \end{bmatrix}, \qquad
+    G = [G_1 \; \cdots \; G_N]
+
+restricted to the force components of each contact model (a soft finger adds
+the column :math:`[0; n_i]`).  Wrenches are ``[f; m]`` with moments about the
+reference point ``p``; planar wrenches are ``[f_x, f_y, m_z]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from drakegrasp.contact import Contact, ContactModel
+from drakegrasp.errors import InvalidContactError, InvalidGraspError
+
+__all__ = ["Grasp", "grasp_matrix", "normal_grasp_matrix", "wrench_columns"]
+
+
+@dataclass(frozen=True, eq=False)
+class Grasp:
+    """Contacts on one object, all expressed in one frame.
+
+    Parameters
+    ----------
+    contacts : sequence of Contact
+        At least one contact; all planar or all spatial.
+    reference_point : (3,) or (2,) float, optional
+        Point ``p`` about which moments are taken, metres, in the grasp frame.
+        Default: the frame's origin.
+    characteristic_length : float, optional
+        Length ``b`` > 0 (metres) that turns moments into forces in soft-finger
+        cones and quality metrics.  Default: the largest distance from ``p`` to a
+        contact (1 m if every contact is at ``p``).
+    """
+
+    contacts: tuple[Contact, ...]
+    reference_point: np.ndarray
+    characteristic_length: float
+
+    def __init__(
+        self,
+        contacts: Iterable[Contact],
+        *,
+        reference_point: np.ndarray | None = None,
+        characteristic_length: float | None = None,
+    ) -> None:
+        contacts = tuple(contacts)
+        if not contacts:
+            raise InvalidGraspError("a grasp needs at least one contact, got none")
+        for i, c in enumerate(contacts):
+            if not isinstance(c, Contact):
+                raise InvalidContactError(
+                    f"contact {i} is a {type(c).__name__}, not a drakegrasp.Contact"
+                )
+        dims = {c.dim for c in contacts}
+        if len(dims) > 1:
+            planar = [i for i, c in enumerate(contacts) if c.planar]
+            raise InvalidContactError(
+                "a grasp's contacts must be all planar or all spatial; contacts "
+                f"{planar} are planar and the others spatial"
+            )
+        dim = dims.pop()
+        if reference_point is None:
+            p = np.zeros(dim)
+        else:
+            p = np.array(reference_point, dtype=float).reshape(-1)
+            if p.shape != (dim,) or not np.all(np.isfinite(p)):
+                raise InvalidGraspError(
+                    f"reference_point must be a finite {dim}-vector like the "
+                    f"contacts, got {np.asarray(reference_point).tolist()}"
+                )
+        p.flags.writeable = False
+        if characteristic_length is None:
+            b = max(float(np.linalg.norm(c.position - p)) for c in contacts)
+            b = b if b > 1e-12 else 1.0
+        else:
+            b = float(characteristic_length)
+            if not np.isfinite(b) or b <= 0.0:
+                raise InvalidGraspError(
+                    "characteristic_length must be finite and > 0, got "
+                    f"{characteristic_length!r}"
+                )
+        object.__setattr__(self, "contacts", contacts)
+        object.__setattr__(self, "reference_point", p)
+        object.__setattr__(self, "characteristic_length", b)
+
+    @property
+    def dim(self) -> int:
+        """Dimension of the contacts: 2 (planar) or 3 (spatial)."""
+        return self.contacts[0].dim
+
+    @property
+    def planar(self) -> bool:
+        """True when the contacts are 2-D (wrenches have 3 rows)."""
+        return self.dim == 2
+
+    @property
+    def num_contacts(self) -> int:
+        """Number of contacts ``N``."""
+        return len(self.contacts)
+
+    @property
+    def wrench_dim(self) -> int:
+        """Rows of a wrench: 3 (planar) or 6 (spatial)."""
+        return 3 if self.planar else 6
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Contact positions, (N, d), metres."""
+        return np.array([c.position for c in self.contacts])
+
+    @property
+    def normals(self) -> np.ndarray:
+        """Inward unit normals, (N, d)."""
+        return np.array([c.normal for c in self.contacts])
+
+    @property
+    def num_components(self) -> int:
+        """Total number of contact-force components (columns of ``G``)."""
+        return sum(c.num_components for c in self.contacts)
+
+    def component_slices(self) -> list[slice]:
+        """Slice of each contact's components in the stacked force vector."""
+        slices, start = [], 0
+        for c in self.contacts:
+            slices.append(slice(start, start + c.num_components))
+            start += c.num_components
+        return slices
+
+    def normal_indices(self) -> np.ndarray:
+        """Index of each contact's ``f_n`` in the stacked force vector, (N,) int."""
+        return np.array([s.start for s in self.component_slices()], dtype=int)
+
+    def with_contacts(self, contacts: Sequence[Contact]) -> Grasp:
+        """Same reference point and characteristic length, other contacts."""
+        return Grasp(
+            contacts,
+            reference_point=self.reference_point,
+            characteristic_length=self.characteristic_length,
+        )
+
+    def with_friction(
+        self,
+        mu: float | None = None,
+        *,
+        model: ContactModel | str | None = None,
+        torsional_friction: float | None = None,
+    ) -> Grasp:
+        """Copy with every contact's ``mu``/``model``/``torsional_friction`` set."""
+        changes = {}
+        if mu is not None:
+            changes["mu"] = mu
+        if model is not None:
+            changes["model"] = model
+        if torsional_friction is not None:
+            changes["torsional_friction"] = torsional_friction
+        return self.with_contacts([c.with_(**changes) for c in self.contacts])
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary of the grasp."""
+        return {
+            "contacts": [c.to_dict() for c in self.contacts],
+            "reference_point": self.reference_point.tolist(),
+            "characteristic_length": self.characteristic_length,
+        }
+
+    def __repr__(self) -> str:
+        kind = "planar" if self.planar else "spatial"
+        return (
+            f"Grasp({self.num_contacts} {kind} contacts, "
+            f"p={self.reference_point.tolist()}, b={self.characteristic_length:g})"
+        )
+
+
+def wrench_columns(
+    position: np.ndarray, directions: np.ndarray, reference_point: np.ndarray
+) -> np.ndarray:
+    """Wrenches of unit forces applied at one point.
+
+    Parameters
+    ----------
+    position : (d,) float
+        Point of application ``c``, metres.
+    directions : (d, k) float
+        Force directions as columns.
+    reference_point : (d,) float
+        Point ``p`` about which moments are taken.
+
+    Returns
+    -------
+    W : (6, k) or (3, k) float
+        ``[u; (c - p) × u]`` for each column ``u`` (planar: ``m_z`` only).
+    """
+    r = np.asarray(position, dtype=float) - np.asarray(reference_point, dtype=float)
+    u = np.asarray(directions, dtype=float)
+    if r.size == 2:
+        moment = r[0] * u[1] - r[1] * u[0]
+        return np.vstack([u, moment[None, :]])
+    return np.vstack([u, np.cross(r, u.T).T])
+
+
+def _contact_block(contact: Contact, p: np.ndarray) -> np.ndarray:
+    R = contact.frame
+    k = contact.num_components
+    if contact.model is ContactModel.FRICTIONLESS:
+        return wrench_columns(contact.position, R[:, :1], p)
+    block = wrench_columns(contact.position, R, p)
+    if k == 4:  # soft finger: a pure moment about the normal
+        block = np.hstack([block, np.concatenate([np.zeros(3), R[:, 0]])[:, None]])
+    return block
+
+
+def grasp_matrix(grasp: Grasp) -> np.ndarray:
+    r"""Grasp matrix ``G`` mapping contact forces to the object wrench.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        The contacts, in the grasp frame.
+
+    Returns
+    -------
+    G : (6, M) or (3, M) float
+        ``w = G f`` with ``f`` the stacked contact forces in their contact frames
+        (normal component first; ``M`` = total number of components) and ``w``
+        the wrench ``[f; m]`` about the reference point, in the grasp frame.
+
+    Notes
+    -----
+    .. math:: G_i = \begin{bmatrix} R_i \\ S(c_i - p) R_i \end{bmatrix}
+
+    restricted to the components of the contact model; column order follows
+    contact order.
+    """
+    p = grasp.reference_point
+    return np.hstack([_contact_block(c, p) for c in grasp.contacts])
+
+
+def normal_grasp_matrix(grasp: Grasp) -> np.ndarray:
+    """Grasp matrix ``G_n`` of the normal components only.
+
+    Parameters
+    ----------
+    grasp : Grasp
+
+    Returns
+    -------
+    G_n : (6, N) or (3, N) float
+        Column ``i`` is the wrench ``[n_i; (c_i - p) × n_i]`` of a unit normal
+        push at contact ``i``.
+    """
+    p = grasp.reference_point
+    return np.hstack(
+        [wrench_columns(c.position, c.normal[:, None], p) for c in grasp.contacts]
+    )
