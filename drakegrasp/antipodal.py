@@ -1,0 +1,103 @@
+r"""Antipodal two-contact grasps (numpy only).
+
+Two contacts are antipodal when the segment between the contact points lies inside
+both friction cones:
+
+.. math:: \angle(c_2 - c_1, n_1) \le \arctan \mu_1, \qquad
+          \angle(c_1 - c_2, n_2) \le \arctan \mu_2
+
+with the normals pointing into the object.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from drakegrasp.contact import Contact, ContactModel
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError
+from drakegrasp.grasp import Grasp
+from drakegrasp.results import AntipodalResult
+
+__all__ = ["DEFAULT_ANGLE_TOL", "is_antipodal"]
+
+DEFAULT_ANGLE_TOL = 1e-9
+"""Angles may exceed ``atan μ`` by this much (rad) and still count as inside."""
+
+
+def _two_contacts(grasp_or_contacts: Grasp | Sequence[Contact]) -> tuple[Contact, ...]:
+    contacts = (
+        grasp_or_contacts.contacts
+        if isinstance(grasp_or_contacts, Grasp)
+        else tuple(grasp_or_contacts)
+    )
+    if len(contacts) != 2 or not all(isinstance(c, Contact) for c in contacts):
+        raise InvalidGraspError(
+            "the antipodal check takes exactly two contacts (a Grasp or a pair of "
+            f"Contact), got {len(contacts)} item(s)"
+        )
+    if contacts[0].dim != contacts[1].dim:
+        raise InvalidGraspError("the two contacts must both be planar or both spatial")
+    return contacts
+
+
+def _friction(contact: Contact) -> float:
+    return 0.0 if contact.model is ContactModel.FRICTIONLESS else contact.mu
+
+
+def _angle(u: np.ndarray, v: np.ndarray) -> float:
+    """Angle between two vectors, accurate near 0 and π (atan2 of |u×v|, u·v)."""
+    cross = np.cross(u, v) if u.size == 3 else u[0] * v[1] - u[1] * v[0]
+    return float(np.arctan2(np.linalg.norm(cross), np.dot(u, v)))
+
+
+def is_antipodal(
+    grasp_or_contacts: Grasp | Sequence[Contact],
+    *,
+    mu: float | None = None,
+    angle_tol: float = DEFAULT_ANGLE_TOL,
+) -> AntipodalResult:
+    """Check whether two contacts are antipodal.
+
+    Parameters
+    ----------
+    grasp_or_contacts : Grasp or sequence of two Contact
+        Planar or spatial; normals point into the object.
+    mu : float, optional
+        Friction coefficient to use at both contacts.  Default: each contact's own
+        ``mu`` (0 for a frictionless contact).
+    angle_tol : float, optional
+        Slack (rad) on the angle test, for contacts that are exactly collinear.
+
+    Returns
+    -------
+    AntipodalResult
+        Verdict, the two angles (rad), the margins ``atan μ_i - angle_i`` (rad)
+        and the smallest ``μ`` that makes the pair antipodal.
+    """
+    c1, c2 = _two_contacts(grasp_or_contacts)
+    if mu is None:
+        mus = np.array([_friction(c1), _friction(c2)])
+    else:
+        m = float(mu)
+        if not np.isfinite(m) or m < 0:
+            raise InvalidOptionError(f"mu must be finite and >= 0, got {mu!r}")
+        mus = np.array([m, m])
+    line = c2.position - c1.position
+    if np.linalg.norm(line) < 1e-12:
+        raise InvalidGraspError(
+            f"the two contacts coincide at {c1.position.tolist()}; the antipodal "
+            "line between them is undefined"
+        )
+    angles = np.array([_angle(line, c1.normal), _angle(-line, c2.normal)])
+    margins = np.arctan(mus) - angles
+    worst = float(angles.max())
+    min_mu = float(np.tan(worst)) if worst < np.pi / 2 else float("inf")
+    return AntipodalResult(
+        is_antipodal=bool(np.all(margins >= -angle_tol)),
+        angles=angles,
+        mu=mus,
+        margins=margins,
+        min_mu=min_mu,
+    )

@@ -1,0 +1,648 @@
+r"""Form closure, force closure and the hand's internal forces as Drake programs.
+
+Every program is built by a ``build_*_program`` function that returns the
+``MathematicalProgram`` and its decision variables, so a user can inspect or
+extend it, and solved by the function of the same name without ``build_``:
+
+* LP1 (first-order form closure), over the normal forces ``f_n``:
+
+  .. math:: \max d \;\; \text{s.t.}\;\; G_n f_n = 0,\; f_n - \mathbf 1 d \ge 0,\;
+            d \ge 0,\; \mathbf 1^T f_n \le N
+
+* LP2 (frictional force closure), over the stacked contact forces ``f``:
+
+  .. math:: \max d \;\; \text{s.t.}\;\; G f = 0,\; F f - \mathbf 1 d \ge 0,\;
+            d \ge 0,\; \textstyle\sum_i f_{n,i} \le N
+
+* LP3 (internal forces the hand cannot control; ``d^* = 0`` passes):
+
+  .. math:: \max d \;\; \text{s.t.}\;\; G f = 0,\; J^T f = 0,\; E f - \mathbf 1 d
+            \ge 0,\; d \ge 0,\; \textstyle\sum_i f_{n,i} \le N
+
+* The exact-cone program: LP2 with each Coulomb cone as a second-order cone, ``d``
+  being the distance of each contact force to its cone's boundary (so the
+  polyhedral ``d*``, inscribed, never exceeds the exact one).
+
+Components that a degenerate cone forbids (the tangential force of a hard finger
+with ``mu = 0``) are not variables at all: such a contact behaves exactly as a
+frictionless one.  This module imports ``pydrake.solvers`` only, never the plant.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.solvers import (
+    ClarabelSolver,
+    ClpSolver,
+    MathematicalProgram,
+    MathematicalProgramResult,
+    ScsSolver,
+    SolutionResult,
+)
+
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
+from drakegrasp.friction_cone import (
+    DEFAULT_NUM_GENERATORS,
+    EffectiveCone,
+    effective_cone,
+)
+from drakegrasp.grasp import Grasp, grasp_matrix, normal_grasp_matrix
+from drakegrasp.results import ClosureResult, InternalForceResult, _relative_margin
+
+__all__ = [
+    "DEFAULT_TOL",
+    "ProgramVariables",
+    "build_exact_force_closure_program",
+    "build_force_closure_program",
+    "build_form_closure_program",
+    "build_internal_force_program",
+    "force_closure",
+    "force_closure_exact",
+    "form_closure",
+    "internal_forces",
+    "matrix_rank",
+]
+
+DEFAULT_TOL = 1e-6
+"""Default threshold on ``d*``: closure needs ``d* > tol`` (LP3 passes at ``<= tol``).
+
+LP1–LP3 normalise the normal forces to ``Σ f_n <= N``, so ``d*`` is of order 0.1
+for a good grasp; Clp solves these LPs to about 1e-9, well below this threshold.
+"""
+
+DEFAULT_RANK_TOL = 1e-9
+"""Singular values below ``rank_tol * σ_max`` count as zero in rank tests."""
+
+_FORMULATIONS = ("facets", "generators")
+
+
+@dataclass(frozen=True)
+class ProgramVariables:
+    """Decision variables of a closure program.
+
+    Attributes
+    ----------
+    d : pydrake.symbolic.Variable
+        The margin variable that the program maximises.
+    forces : ndarray of Variable or Expression, (m,)
+        The contact-force components that are free in the program (for the
+        generator formulation, linear expressions of ``weights``).
+    columns : (m,) int
+        Where each entry of ``forces`` sits in the grasp's stacked force vector
+        (columns of :func:`~drakegrasp.grasp_matrix`; for LP1, the contact index).
+    weights : ndarray of Variable or None
+        Generator weights ``λ >= 0`` (generator formulation only).
+    generators : (m, len(weights)) float or None
+        Block-diagonal generator matrix ``S`` with ``forces = S @ weights``
+        (generator formulation only).
+    """
+
+    d: object
+    forces: np.ndarray
+    columns: np.ndarray
+    weights: np.ndarray | None = None
+    generators: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """The force components a grasp's cones allow, and their cones."""
+
+    columns: np.ndarray  # (m,) indices into the full stacked force vector
+    cones: tuple[EffectiveCone, ...]
+    normal_positions: np.ndarray  # (N,) index of each f_n within `columns`
+    G: np.ndarray  # (w, m) grasp matrix restricted to `columns`
+
+    @staticmethod
+    def of(grasp: Grasp, num_generators: int) -> _Layout:
+        b = grasp.characteristic_length
+        cones = tuple(
+            effective_cone(c, num_generators, characteristic_length=b)
+            for c in grasp.contacts
+        )
+        columns, normals = [], []
+        for s, cone in zip(grasp.component_slices(), cones, strict=True):
+            normals.append(len(columns))
+            columns.extend(s.start + j for j in cone.components)
+        columns = np.array(columns, dtype=int)
+        G = grasp_matrix(grasp)[:, columns]
+        return _Layout(columns, cones, np.array(normals, dtype=int), G)
+
+    def facet_matrix(self) -> np.ndarray:
+        return _block_diag([cone.facets for cone in self.cones])
+
+    def generator_matrix(self) -> np.ndarray:
+        return _block_diag([cone.generators for cone in self.cones])
+
+
+def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
+    rows = sum(b.shape[0] for b in blocks)
+    cols = sum(b.shape[1] for b in blocks)
+    out = np.zeros((rows, cols))
+    r = c = 0
+    for b in blocks:
+        out[r : r + b.shape[0], c : c + b.shape[1]] = b
+        r, c = r + b.shape[0], c + b.shape[1]
+    return out
+
+
+def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
+    """Numerical rank: singular values above ``rank_tol * σ_max``.
+
+    Parameters
+    ----------
+    A : (m, n) float
+    rank_tol : float, optional
+        Relative threshold on the singular values.
+
+    Returns
+    -------
+    int
+    """
+    A = np.asarray(A, dtype=float)
+    if A.size == 0:
+        return 0
+    s = np.linalg.svd(A, compute_uv=False)
+    if s[0] == 0.0:
+        return 0
+    return int(np.sum(s > rank_tol * s[0]))
+
+
+def _check_tol(tol: float) -> float:
+    t = float(tol)
+    if not np.isfinite(t) or t <= 0:
+        raise InvalidOptionError(f"tol must be finite and > 0, got {tol!r}")
+    return t
+
+
+def _check_formulation(formulation: str) -> str:
+    if formulation not in _FORMULATIONS:
+        raise InvalidOptionError(
+            f"formulation must be one of {_FORMULATIONS}, got {formulation!r}"
+        )
+    return formulation
+
+
+def _margin_program(
+    num_forces: int, num_contacts: int
+) -> tuple[MathematicalProgram, np.ndarray, object]:
+    """Program with forces ``f`` (m,), ``d >= 0``, cost ``-d``."""
+    prog = MathematicalProgram()
+    f = prog.NewContinuousVariables(num_forces, "f")
+    d = prog.NewContinuousVariables(1, "d")[0]
+    prog.AddBoundingBoxConstraint(0.0, np.inf, d)
+    prog.AddLinearCost(-1.0 * d)
+    return prog, f, d
+
+
+def _add_normal_budget(prog, normal_forces, num_contacts: int) -> None:
+    """``Σ f_n <= N`` (the normalisation of LP1–LP3)."""
+    prog.AddLinearConstraint(
+        np.ones((1, len(normal_forces))),
+        [-np.inf],
+        [float(num_contacts)],
+        normal_forces,
+    )
+
+
+def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
+    """``A x - 1 d >= 0``."""
+    A = np.atleast_2d(A)
+    prog.AddLinearConstraint(
+        np.hstack([A, -np.ones((A.shape[0], 1))]),
+        np.zeros(A.shape[0]),
+        np.full(A.shape[0], np.inf),
+        np.append(x, d),
+    )
+
+
+def build_form_closure_program(
+    grasp: Grasp,
+) -> tuple[MathematicalProgram, ProgramVariables]:
+    """Build LP1, the first-order form-closure program, over normal forces.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        Every contact is treated as frictionless (form closure ignores friction).
+
+    Returns
+    -------
+    prog : MathematicalProgram
+        ``max d`` s.t. ``G_n f_n = 0``, ``f_n - 1 d >= 0``, ``d >= 0``,
+        ``1ᵀ f_n <= N``.
+    variables : ProgramVariables
+        ``forces`` are the normal forces ``f_n`` (N,); ``columns`` the contact
+        indices.
+    """
+    N = grasp.num_contacts
+    prog, f, d = _margin_program(N, N)
+    prog.AddLinearEqualityConstraint(
+        normal_grasp_matrix(grasp), np.zeros(grasp.wrench_dim), f
+    )
+    _add_margin_rows(prog, np.eye(N), f, d)
+    _add_normal_budget(prog, f, N)
+    return prog, ProgramVariables(d, f, np.arange(N))
+
+
+def build_force_closure_program(
+    grasp: Grasp,
+    *,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    formulation: str = "facets",
+) -> tuple[MathematicalProgram, ProgramVariables]:
+    """Build LP2, the frictional force-closure program on polyhedral cones.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    num_generators : int, optional
+        Generators ``n_g`` of each spatial Coulomb cone (default 8).
+    formulation : {"facets", "generators"}, optional
+        ``"facets"`` (H-form, default): ``max d`` s.t. ``G f = 0``,
+        ``F f - 1 d >= 0``, ``d >= 0``, ``Σ f_n <= N``.  ``"generators"``
+        (V-form): ``f = S λ`` and ``max d`` s.t. ``G S λ = 0``, ``λ - 1 d >= 0``,
+        ``d >= 0``, ``Σ f_n <= N``; its ``d*`` has another scale, but the
+        verdict (``d* > 0`` with full rank) is the same.
+
+    Returns
+    -------
+    prog : MathematicalProgram
+    variables : ProgramVariables
+        ``forces`` cover the components the cones allow (see ``columns``).
+    """
+    _check_formulation(formulation)
+    layout = _Layout.of(grasp, num_generators)
+    N = grasp.num_contacts
+    w = grasp.wrench_dim
+    if formulation == "facets":
+        prog, f, d = _margin_program(len(layout.columns), N)
+        prog.AddLinearEqualityConstraint(layout.G, np.zeros(w), f)
+        _add_margin_rows(prog, layout.facet_matrix(), f, d)
+        _add_normal_budget(prog, f[layout.normal_positions], N)
+        return prog, ProgramVariables(d, f, layout.columns)
+    S = layout.generator_matrix()
+    prog, lam, d = _margin_program(S.shape[1], N)
+    prog.AddLinearEqualityConstraint(layout.G @ S, np.zeros(w), lam)
+    _add_margin_rows(prog, np.eye(S.shape[1]), lam, d)
+    # Every generator has unit normal component, so Σ f_n = Σ λ.
+    _add_normal_budget(prog, lam, N)
+    return prog, ProgramVariables(d, S @ lam, layout.columns, weights=lam, generators=S)
+
+
+def build_exact_force_closure_program(
+    grasp: Grasp,
+) -> tuple[MathematicalProgram, ProgramVariables]:
+    """Build the force-closure program on exact Coulomb cones (an SOCP).
+
+    Parameters
+    ----------
+    grasp : Grasp
+
+    Returns
+    -------
+    prog : MathematicalProgram
+        ``max d`` s.t. ``G f = 0``, ``d >= 0``, ``Σ f_n <= N`` and, per contact,
+        the ball of radius ``d`` around ``f_i`` inside its cone:
+        hard finger ``‖f_t‖ <= μ f_n - sqrt(1 + μ²) d``; soft finger, for both
+        signs ``σ``, ``‖f_t‖ <= μ f_n - σ μ m_n / (b ν) - sqrt(1 + μ² +
+        μ²/(b ν)²) d``; frictionless ``f_n >= d``; planar cones (exact
+        polyhedra) as facets.
+    variables : ProgramVariables
+    """
+    layout = _Layout.of(grasp, DEFAULT_NUM_GENERATORS)
+    N = grasp.num_contacts
+    prog, f, d = _margin_program(len(layout.columns), N)
+    prog.AddLinearEqualityConstraint(layout.G, np.zeros(grasp.wrench_dim), f)
+    _add_normal_budget(prog, f[layout.normal_positions], N)
+    b = grasp.characteristic_length
+    starts = list(layout.normal_positions) + [len(layout.columns)]
+    for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
+        fi = f[starts[i] : starts[i + 1]]
+        if cone.components not in ((0, 1, 2), (0, 1, 2, 3)):
+            _add_margin_rows(prog, cone.facets, fi, d)  # exact already
+            continue
+        mu = contact.mu
+        signs_and_slopes = [(0.0, 0.0)]
+        if cone.components == (0, 1, 2, 3):
+            k = mu / (b * contact.torsional_friction)
+            signs_and_slopes = [(1.0, k), (-1.0, k)]
+        for sign, k in signs_and_slopes:
+            # z = A [fi; d]: z0 = μ f_n - σ k m_n - sqrt(1+μ²+k²) d, z1:3 = f_t.
+            A = np.zeros((3, len(fi) + 1))
+            A[0, 0] = mu
+            if len(fi) == 4:
+                A[0, 3] = -sign * k
+            A[0, -1] = -np.sqrt(1.0 + mu * mu + k * k)
+            A[1, 1] = A[2, 2] = 1.0
+            prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(fi, d))
+    return prog, ProgramVariables(d, f, layout.columns)
+
+
+def build_internal_force_program(
+    grasp: Grasp, hand_jacobian: np.ndarray
+) -> tuple[MathematicalProgram, ProgramVariables]:
+    """Build LP3: an internal force with positive normals that the hand cannot feel.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    hand_jacobian : (M, n_q) float
+        Hand Jacobian ``J``: rows in the order of the columns of
+        :func:`~drakegrasp.grasp_matrix` (contact-frame components), columns the
+        hand's generalized velocities.
+
+    Returns
+    -------
+    prog : MathematicalProgram
+        ``max d`` s.t. ``G f = 0``, ``Jᵀ f = 0``, ``E f - 1 d >= 0``, ``d >= 0``,
+        ``Σ f_n <= N``.  ``d* = 0`` passes.
+    variables : ProgramVariables
+    """
+    J = _check_hand_jacobian(grasp, hand_jacobian)
+    layout = _Layout.of(grasp, DEFAULT_NUM_GENERATORS)
+    N = grasp.num_contacts
+    prog, f, d = _margin_program(len(layout.columns), N)
+    A = np.vstack([layout.G, J[layout.columns].T])
+    prog.AddLinearEqualityConstraint(A, np.zeros(A.shape[0]), f)
+    _add_margin_rows(prog, np.eye(len(f))[layout.normal_positions], f, d)
+    _add_normal_budget(prog, f[layout.normal_positions], N)
+    return prog, ProgramVariables(d, f, layout.columns)
+
+
+def _check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
+    J = np.asarray(hand_jacobian, dtype=float)
+    M = grasp.num_components
+    if J.ndim != 2 or J.shape[0] != M or J.shape[1] < 1:
+        raise InvalidGraspError(
+            f"hand_jacobian must have shape ({M}, n_q) — one row per column of G "
+            f"(contact-frame components) and one column per hand velocity — got "
+            f"shape {J.shape}"
+        )
+    if not np.all(np.isfinite(J)):
+        raise InvalidGraspError("hand_jacobian has non-finite entries")
+    return J
+
+
+# ---------------------------------------------------------------- solving
+
+
+def _solve(prog: MathematicalProgram, *, conic: bool) -> MathematicalProgramResult:
+    solvers = (ClarabelSolver(), ScsSolver()) if conic else (ClpSolver(),)
+    for solver in solvers:
+        if solver.available() and solver.enabled():
+            return solver.Solve(prog)
+    raise SolverError(
+        "no solver available for this program: need "
+        + ("Clarabel or SCS" if conic else "Clp")
+        + " (they ship with Drake's wheel)",
+        program=prog,
+    )
+
+
+def _solve_margin(prog, variables: ProgramVariables, *, conic: bool):
+    """Solve; return (d*, full-vector forces or None, solver, status)."""
+    result = _solve(prog, conic=conic)
+    status = result.get_solution_result()
+    solver = result.get_solver_id().name()
+    if status == SolutionResult.kSolutionFound:
+        d_star = float(result.GetSolution(variables.d))
+        if variables.weights is None:
+            forces = result.GetSolution(variables.forces)
+        else:
+            forces = variables.generators @ result.GetSolution(variables.weights)
+        return d_star, np.asarray(forces, dtype=float), solver, status.name
+    if status in (SolutionResult.kInfeasibleConstraints,):
+        return float("nan"), None, solver, status.name
+    raise SolverError(
+        f"{solver} failed with status {status.name} (the program is always "
+        "feasible, so this is a numerical failure, not a verdict)",
+        program=prog,
+        result=result,
+    )
+
+
+def _split_forces(
+    grasp: Grasp, columns: np.ndarray, values: np.ndarray | None
+) -> tuple[np.ndarray, ...]:
+    full = np.zeros(grasp.num_components)
+    if values is not None:
+        full[columns] = values
+    return tuple(full[s].copy() for s in grasp.component_slices())
+
+
+def form_closure(
+    grasp: Grasp,
+    *,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+) -> ClosureResult:
+    """Decide first-order form closure: ``rank(G_n)`` full and LP1 ``d* > tol``.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        Friction and contact models are ignored: form closure is frictionless.
+    tol : float, optional
+        Threshold on ``d*`` (dimensionless, see :data:`DEFAULT_TOL`).
+    rank_tol : float, optional
+        Relative singular-value threshold of the rank test.
+
+    Returns
+    -------
+    ClosureResult
+        ``contact_forces`` holds ``[f_n]`` per contact.
+    """
+    tol = _check_tol(tol)
+    required = grasp.wrench_dim
+    rank = matrix_rank(normal_grasp_matrix(grasp), rank_tol=rank_tol)
+    prog, variables = build_form_closure_program(grasp)
+    d_star, forces, solver, status = _solve_margin(prog, variables, conic=False)
+    if forces is None:
+        forces = np.zeros(grasp.num_contacts)
+    ok = rank == required and d_star > tol
+    return ClosureResult(
+        kind="form closure",
+        is_closure=bool(ok),
+        d_star=d_star,
+        rank=rank,
+        required_rank=required,
+        margin=_relative_margin(d_star, tol),
+        contact_forces=tuple(np.array([x]) for x in forces),
+        solver=solver,
+        status=status,
+        tol=tol,
+        formulation="normals",
+        frictional_closure=bool(ok),
+    )
+
+
+def internal_forces(
+    grasp: Grasp,
+    hand_jacobian: np.ndarray,
+    *,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+) -> InternalForceResult:
+    """Solve LP3, which asks whether the hand controls every internal force.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    hand_jacobian : (M, n_q) float
+        Rows in the order of the columns of ``G``; columns the hand's velocities.
+    tol : float, optional
+        LP3 passes when ``d* <= tol``.
+    rank_tol : float, optional
+        Relative singular-value threshold for ``dim(N(G) ∩ N(Jᵀ))``.
+
+    Returns
+    -------
+    InternalForceResult
+    """
+    tol = _check_tol(tol)
+    prog, variables = build_internal_force_program(grasp, hand_jacobian)
+    d_star, forces, solver, status = _solve_margin(prog, variables, conic=False)
+    J = np.asarray(hand_jacobian, dtype=float)[variables.columns]
+    G = grasp_matrix(grasp)[:, variables.columns]
+    null_dim = len(variables.columns) - matrix_rank(
+        np.vstack([G, J.T]), rank_tol=rank_tol
+    )
+    passes = not (d_star > tol)  # NaN (infeasible) passes: no such force exists
+    return InternalForceResult(
+        passes=bool(passes),
+        d_star=d_star,
+        margin=-_relative_margin(d_star, tol) if np.isfinite(d_star) else np.inf,
+        null_space_dim=int(null_dim),
+        contact_forces=_split_forces(grasp, variables.columns, forces),
+        solver=solver,
+        status=status,
+        tol=tol,
+    )
+
+
+def _force_closure_result(
+    grasp: Grasp,
+    prog: MathematicalProgram,
+    variables: ProgramVariables,
+    *,
+    kind: str,
+    formulation: str,
+    conic: bool,
+    hand_jacobian: np.ndarray | None,
+    tol: float,
+    rank_tol: float,
+) -> ClosureResult:
+    required = grasp.wrench_dim
+    G = grasp_matrix(grasp)[:, variables.columns]
+    rank = matrix_rank(G, rank_tol=rank_tol)
+    d_star, forces, solver, status = _solve_margin(prog, variables, conic=conic)
+    frictional = bool(rank == required and d_star > tol)
+    lp3 = None
+    if hand_jacobian is not None:
+        lp3 = internal_forces(grasp, hand_jacobian, tol=tol, rank_tol=rank_tol)
+    return ClosureResult(
+        kind=kind,
+        is_closure=frictional and (lp3 is None or lp3.passes),
+        d_star=d_star,
+        rank=rank,
+        required_rank=required,
+        margin=_relative_margin(d_star, tol),
+        contact_forces=_split_forces(grasp, variables.columns, forces),
+        solver=solver,
+        status=status,
+        tol=tol,
+        formulation=formulation,
+        frictional_closure=frictional,
+        internal_forces=lp3,
+    )
+
+
+def force_closure(
+    grasp: Grasp,
+    *,
+    hand_jacobian: np.ndarray | None = None,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+    formulation: str = "facets",
+) -> ClosureResult:
+    """Decide force closure on polyhedral friction cones (LP2, and LP3 with a hand).
+
+    Parameters
+    ----------
+    grasp : Grasp
+    hand_jacobian : (M, n_q) float, optional
+        Hand Jacobian ``J`` (rows in ``G``'s column order).  When given, the
+        verdict also needs LP3 to pass.
+    num_generators : int, optional
+        Generators of each spatial Coulomb cone (default 8; the cone is
+        inscribed, so a polyhedral closure implies an exact one).
+    tol : float, optional
+        Closure needs ``d* > tol``.
+    rank_tol : float, optional
+        Relative singular-value threshold of the rank test.
+    formulation : {"facets", "generators"}, optional
+        H-form (default, ``d*`` as in CONVENTIONS.md) or V-form.
+
+    Returns
+    -------
+    ClosureResult
+    """
+    tol = _check_tol(tol)
+    prog, variables = build_force_closure_program(
+        grasp, num_generators=num_generators, formulation=formulation
+    )
+    return _force_closure_result(
+        grasp,
+        prog,
+        variables,
+        kind="force closure",
+        formulation=formulation,
+        conic=False,
+        hand_jacobian=hand_jacobian,
+        tol=tol,
+        rank_tol=rank_tol,
+    )
+
+
+def force_closure_exact(
+    grasp: Grasp,
+    *,
+    hand_jacobian: np.ndarray | None = None,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+) -> ClosureResult:
+    """Decide force closure with exact Coulomb cones (an SOCP, Clarabel or SCS).
+
+    Parameters
+    ----------
+    grasp : Grasp
+    hand_jacobian : (M, n_q) float, optional
+        When given, the verdict also needs LP3 to pass.
+    tol : float, optional
+        Closure needs ``d* > tol``; ``d*`` is each contact force's distance to
+        its exact cone's boundary.
+    rank_tol : float, optional
+        Relative singular-value threshold of the rank test.
+
+    Returns
+    -------
+    ClosureResult
+    """
+    tol = _check_tol(tol)
+    prog, variables = build_exact_force_closure_program(grasp)
+    conic = bool(prog.lorentz_cone_constraints())
+    return _force_closure_result(
+        grasp,
+        prog,
+        variables,
+        kind="force closure (exact cones)",
+        formulation="exact",
+        conic=conic,
+        hand_jacobian=hand_jacobian,
+        tol=tol,
+        rank_tol=rank_tol,
+    )
