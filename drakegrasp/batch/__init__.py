@@ -1,0 +1,29 @@
+"""Closure of many grasps at once: arrays in, arrays out, streamed in chunks.
+
+:func:`batch_force_closure` (LP2) and :func:`batch_form_closure` (LP1) decide
+closure for ``K`` grasps with ``N`` contacts each, with the conventions and
+verdicts of :mod:`drakegrasp.closure`; :func:`evaluate_file` runs them on a
+``.npz`` file (the ``drakegrasp batch`` command).
+
+Modules: :mod:`~drakegrasp.batch.construction` (vectorised frames, grasp
+matrices and cone facets), :mod:`~drakegrasp.batch.reduction` (null-space
+reduction of LP1/LP2), :mod:`~drakegrasp.batch.ipm` (batched interior-point
+method), :mod:`~drakegrasp.batch.engine` (chunked drivers),
+:mod:`~drakegrasp.batch.io` (files).
+"""
+
+from drakegrasp.batch.engine import (
+    DEFAULT_CHUNK_SIZE,
+    METRICS,
+    BatchClosureResult,
+    batch_force_closure,
+    batch_form_closure,
+)
+
+__all__ = [
+    "DEFAULT_CHUNK_SIZE",
+    "METRICS",
+    "BatchClosureResult",
+    "batch_force_closure",
+    "batch_form_closure",
+]

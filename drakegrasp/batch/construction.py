@@ -1,0 +1,259 @@
+r"""Vectorised contact frames, grasp matrices and friction-cone facets (numpy only).
+
+The single-grasp path builds one :class:`~drakegrasp.Grasp` at a time; here the
+same objects are built for a stack of ``K`` grasps with ``N`` contacts each, with
+exactly the conventions of :mod:`drakegrasp.contact`, :mod:`drakegrasp.grasp` and
+:mod:`drakegrasp.friction_cone` (``shared/CONVENTIONS.md``):
+
+* contact frames come from :func:`drakegrasp.contact_frames` (same ``t1``);
+* ``G_i = [R_i; S(c_i - p) R_i]`` restricted to the contact's *effective*
+  components, a soft finger adding the column ``[0; n_i]``;
+* facet rows are unit rows positive on the cone axis, ``∝ s_k × s_{k+1}`` for a
+  spatial hard finger with the generators
+  ``s_k = [1, μ cos(2πk/n_g), μ sin(2πk/n_g)]``.
+
+Every contact gets a *kind*, the set of force components its cone lets be
+non-zero (a hard finger with ``μ = 0`` is frictionless, exactly as
+:meth:`drakegrasp.Contact.effective_components`).  Grasps whose contacts have the
+same kinds share one *layout* and are processed together.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drakegrasp.contact import contact_frames
+
+__all__ = [
+    "KIND_COMPONENTS",
+    "batched_characteristic_lengths",
+    "batched_grasp_matrix",
+    "batched_normal_grasp_matrix",
+    "contact_kinds",
+    "kind_facets",
+]
+
+# Kind code -> effective components (indices into the contact's force vector).
+FRICTIONLESS, PLANAR_HARD, SPATIAL_HARD, SOFT_TORSION, SOFT_FULL = range(5)
+KIND_COMPONENTS: dict[int, tuple[int, ...]] = {
+    FRICTIONLESS: (0,),
+    PLANAR_HARD: (0, 1),
+    SPATIAL_HARD: (0, 1, 2),
+    SOFT_TORSION: (0, 3),
+    SOFT_FULL: (0, 1, 2, 3),
+}
+
+
+def contact_kinds(
+    mu: np.ndarray, torsional_friction: np.ndarray, *, model: str, dim: int
+) -> np.ndarray:
+    """Kind code of every contact from its model and coefficients.
+
+    Parameters
+    ----------
+    mu, torsional_friction : (K, N) float
+        Friction coefficients ``μ >= 0`` and ``ν >= 0``.
+    model : {"frictionless", "hard_finger", "soft_finger"}
+    dim : {2, 3}
+
+    Returns
+    -------
+    kinds : (K, N) int8
+        Codes ``FRICTIONLESS`` … ``SOFT_FULL``; see :data:`KIND_COMPONENTS`.
+    """
+    shape = np.shape(mu)
+    if model == "frictionless":
+        return np.full(shape, FRICTIONLESS, dtype=np.int8)
+    friction = mu > 0.0
+    if dim == 2:  # soft fingers are rejected upstream in the plane
+        return np.where(friction, PLANAR_HARD, FRICTIONLESS).astype(np.int8)
+    kinds = np.where(friction, SPATIAL_HARD, FRICTIONLESS).astype(np.int8)
+    if model == "soft_finger":
+        torsion = torsional_friction > 0.0
+        kinds[torsion & friction] = SOFT_FULL
+        kinds[torsion & ~friction] = SOFT_TORSION
+    return kinds
+
+
+def batched_characteristic_lengths(
+    positions: np.ndarray, reference_points: np.ndarray
+) -> np.ndarray:
+    """Default characteristic length ``b`` of each grasp, as :class:`Grasp` does.
+
+    Parameters
+    ----------
+    positions : (K, N, d) float
+        Contact points, metres.
+    reference_points : (K, d) float
+        Reference points ``p``, metres.
+
+    Returns
+    -------
+    b : (K,) float
+        Largest ``‖c_i - p‖``; 1 m when every contact sits at ``p``.
+    """
+    b = np.linalg.norm(positions - reference_points[:, None, :], axis=-1).max(axis=1)
+    return np.where(b > 1e-12, b, 1.0)
+
+
+def _wrench_columns(r: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Wrenches ``[u; r × u]`` (planar ``[u; r_x u_y - r_y u_x]``).
+
+    ``r`` (..., d) lever arms and ``u`` (..., d) force directions; returns
+    (..., 6) or (..., 3).
+    """
+    if r.shape[-1] == 2:
+        m = r[..., 0] * u[..., 1] - r[..., 1] * u[..., 0]
+        return np.concatenate([u, m[..., None]], axis=-1)
+    return np.concatenate([u, np.cross(r, u)], axis=-1)
+
+
+def batched_grasp_matrix(
+    positions: np.ndarray,
+    normals: np.ndarray,
+    reference_points: np.ndarray,
+    layout: tuple[int, ...],
+) -> tuple[np.ndarray, np.ndarray]:
+    """Effective grasp matrices of a stack of grasps sharing one layout.
+
+    Parameters
+    ----------
+    positions : (K, N, d) float
+        Contact points ``c_i``, metres, in the grasp frame.
+    normals : (K, N, d) float
+        Unit inward normals, in the grasp frame.
+    reference_points : (K, d) float
+        Points ``p`` about which moments are taken.
+    layout : tuple of N kind codes
+        Kind of each contact (see :func:`contact_kinds`).
+
+    Returns
+    -------
+    G : (K, w, M) float
+        ``w = 6`` (spatial) or 3 (planar); columns are the effective components
+        of each contact in contact order (normal first), as in the single-grasp
+        programs' restricted ``G``.
+    normal_columns : (N,) int
+        Column of each contact's ``f_n`` in ``G``.
+    """
+    R = contact_frames(normals)  # (K, N, d, d), columns n, t1, t2
+    r = positions - reference_points[:, None, :]
+    cols, normal_columns = [], []
+    for i, kind in enumerate(layout):
+        normal_columns.append(len(cols))
+        ri = r[:, i, None, :]
+        for comp in KIND_COMPONENTS[kind]:
+            if comp < positions.shape[-1]:
+                cols.append(_wrench_columns(ri[:, 0], R[:, i, :, comp]))
+            else:  # soft finger: pure moment about the normal
+                n = R[:, i, :, 0]
+                cols.append(np.concatenate([np.zeros_like(n), n], axis=-1))
+    G = np.stack(cols, axis=-1)
+    return G, np.array(normal_columns, dtype=int)
+
+
+def batched_normal_grasp_matrix(
+    positions: np.ndarray, normals: np.ndarray, reference_points: np.ndarray
+) -> np.ndarray:
+    """Normal grasp matrices ``G_n`` of a stack of grasps.
+
+    Parameters
+    ----------
+    positions, normals : (K, N, d) float
+        Contact points (metres) and unit inward normals, in the grasp frame.
+    reference_points : (K, d) float
+
+    Returns
+    -------
+    G_n : (K, w, N) float
+        Column ``i`` is ``[n_i; (c_i - p) × n_i]``.
+    """
+    r = positions - reference_points[:, None, :]
+    return np.swapaxes(_wrench_columns(r, normals), -1, -2)
+
+
+def _two_sided(slope: np.ndarray) -> np.ndarray:
+    """Facets ``[[a, 1], [a, -1]] / sqrt(1 + a²)`` of ``|x| <= a f_n``, (K, 2, 2)."""
+    F = np.empty(slope.shape + (2, 2))
+    F[..., 0] = slope[..., None]
+    F[..., 0, 1] = 1.0
+    F[..., 1, 1] = -1.0
+    return F / np.sqrt(1.0 + slope**2)[..., None, None]
+
+
+def _ring(mu: np.ndarray, num_generators: int) -> np.ndarray:
+    """Generators ``[1, μ cos θ_k, μ sin θ_k]``, θ_k = 2πk/n_g, k = 1…n_g: (K, n_g, 3)."""
+    theta = 2.0 * np.pi * np.arange(1, num_generators + 1) / num_generators
+    S = np.empty(mu.shape + (num_generators, 3))
+    S[..., 0] = 1.0
+    S[..., 1] = mu[..., None] * np.cos(theta)
+    S[..., 2] = mu[..., None] * np.sin(theta)
+    return S
+
+
+def _unit_rows(F: np.ndarray) -> np.ndarray:
+    return F / np.linalg.norm(F, axis=-1, keepdims=True)
+
+
+def _det3(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    return np.einsum("...i,...i->...", a, np.cross(b, c))
+
+
+def _normal_to_three(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """A vector orthogonal to three 4-vectors (their generalised cross product)."""
+    M = np.stack([a, b, c], axis=-2)  # (..., 3, 4)
+    out = np.empty(a.shape)
+    for j in range(4):
+        keep = [i for i in range(4) if i != j]
+        minor = M[..., keep]
+        out[..., j] = (-1) ** j * _det3(
+            minor[..., 0, :], minor[..., 1, :], minor[..., 2, :]
+        )
+    return out
+
+
+def kind_facets(
+    kind: int, mu: np.ndarray, torsion: np.ndarray, num_generators: int
+) -> np.ndarray:
+    """Unit facet rows of one contact's effective cone, for a stack of grasps.
+
+    Parameters
+    ----------
+    kind : int
+        Kind code of the contact.
+    mu : (K,) float
+        Friction coefficients.
+    torsion : (K,) float
+        ``b ν`` (metres), the soft-finger moment slope; ignored otherwise.
+    num_generators : int
+        ``n_g`` of the spatial ring.
+
+    Returns
+    -------
+    F : (K, r_i, k_i) float
+        Rows over the kind's effective components, as
+        :func:`drakegrasp.friction_cone.effective_cone` builds them.
+    """
+    K = mu.shape[0]
+    if kind == FRICTIONLESS:
+        return np.ones((K, 1, 1))
+    if kind == PLANAR_HARD:
+        return _two_sided(mu)
+    if kind == SOFT_TORSION:
+        return _two_sided(torsion)
+    S = _ring(mu, num_generators)
+    S_next = np.roll(S, -1, axis=-2)
+    if kind == SPATIAL_HARD:
+        return _unit_rows(np.cross(S, S_next))
+    # SOFT_FULL: triangles (s_k, s_{k+1}, apex) of the bipyramid, +bν apex first.
+    zeros = np.zeros(S.shape[:-1] + (1,))
+    s0 = np.concatenate([S, zeros], axis=-1)
+    s1 = np.concatenate([S_next, zeros], axis=-1)
+    rows = []
+    for sign in (1.0, -1.0):
+        apex = np.zeros_like(s0)
+        apex[..., 0] = 1.0
+        apex[..., 3] = sign * torsion[:, None]
+        row = _normal_to_three(s0, s1, apex)
+        rows.append(np.where(row[..., :1] > 0, row, -row))
+    return _unit_rows(np.concatenate(rows, axis=-2))
