@@ -1,0 +1,62 @@
+"""Pictures of grasps: Meshcat drawings and matplotlib plots.
+
+- :func:`draw_grasp` / :func:`clear_grasp`: contacts, contact frames, friction
+  cones and contact forces in Drake's Meshcat.
+- :func:`plot_planar_grasp`: a planar grasp with its outline, normals, exact
+  cones and forces (matplotlib).
+- :func:`plot_wrench_space`: the primitive wrenches of a planar grasp and their
+  convex hull, with the origin marked (matplotlib, scipy).
+
+matplotlib and scipy are imported only when a plot is made, so importing this
+package needs neither.
+"""
+
+from drakegrasp.visualization.geometry import (
+    cone_edge_directions,
+    contact_forces_in_grasp_frame,
+    contact_pose_3d,
+    exact_cone_mesh,
+    normalize_contact_forces,
+    pyramid_mesh,
+)
+from drakegrasp.visualization.meshcat import (
+    DEFAULT_PREFIX,
+    MESHCAT_COLORS,
+    GraspDrawing,
+    clear_grasp,
+    draw_grasp,
+)
+from drakegrasp.visualization.plots import (
+    PLOT_COLORS,
+    PlanarGraspPlot,
+    plot_planar_grasp,
+)
+from drakegrasp.visualization.wrench_space import (
+    WrenchHull,
+    WrenchSpacePlot,
+    plot_wrench_space,
+    primitive_wrenches,
+    wrench_hull,
+)
+
+__all__ = [
+    "DEFAULT_PREFIX",
+    "MESHCAT_COLORS",
+    "PLOT_COLORS",
+    "GraspDrawing",
+    "PlanarGraspPlot",
+    "WrenchHull",
+    "WrenchSpacePlot",
+    "clear_grasp",
+    "cone_edge_directions",
+    "contact_forces_in_grasp_frame",
+    "contact_pose_3d",
+    "draw_grasp",
+    "exact_cone_mesh",
+    "normalize_contact_forces",
+    "plot_planar_grasp",
+    "plot_wrench_space",
+    "primitive_wrenches",
+    "pyramid_mesh",
+    "wrench_hull",
+]

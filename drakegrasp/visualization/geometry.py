@@ -1,0 +1,297 @@
+"""What the pictures draw, as plain arrays (numpy only).
+
+The Meshcat and matplotlib drawings share these helpers, so the geometry of a
+picture (where a cone edge points, where a force arrow starts) can be checked
+without a renderer.
+
+Drawing side
+------------
+A contact's normal points **into the object**, so its friction cone
+``{f : ‖f_t‖ ≤ μ f_n}`` (placed with its apex at the contact point) lies inside
+the object, where an object's mesh would hide it.  Every drawing therefore takes
+``side``:
+
+``"outside"`` (default)
+    the cone is reflected through the contact point (apex at ``c``, opening away
+    from the object, on the finger's side) and a force ``f`` is an arrow that
+    **ends** at ``c``: it starts at ``c - s f`` (``s`` = force scale), i.e. the
+    finger pushes.  Every drawn force lies inside the drawn cone.
+``"inside"``
+    the cone opens along ``+n`` into the object and arrows **start** at ``c``.
+
+Either way an arrow's direction is the force ``f`` itself (in the grasp frame).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from drakegrasp.contact import Contact
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.friction_cone import friction_cone_generators
+from drakegrasp.grasp import Grasp
+
+__all__ = [
+    "contact_forces_in_grasp_frame",
+    "contact_pose_3d",
+    "cone_edge_directions",
+    "exact_cone_mesh",
+    "normalize_contact_forces",
+    "pyramid_mesh",
+    "side_sign",
+]
+
+SIDES = ("outside", "inside")
+
+
+def side_sign(side: str) -> float:
+    """``-1.0`` for ``side="outside"`` and ``+1.0`` for ``side="inside"``.
+
+    Raises
+    ------
+    InvalidOptionError
+        If ``side`` is neither.
+    """
+    if side not in SIDES:
+        raise InvalidOptionError(f"side must be 'outside' or 'inside', got {side!r}")
+    return -1.0 if side == "outside" else 1.0
+
+
+def positive_length(name: str, value: Any) -> float:
+    """Return ``value`` as a finite positive float or raise InvalidOptionError."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InvalidOptionError(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(x) or x <= 0.0:
+        raise InvalidOptionError(f"{name} must be finite and > 0, got {value!r}")
+    return x
+
+
+def contact_pose_3d(contact: Contact) -> tuple[np.ndarray, np.ndarray]:
+    """Contact frame and position of a contact, lifted to 3-D.
+
+    Parameters
+    ----------
+    contact : Contact
+        Planar or spatial.
+
+    Returns
+    -------
+    R_GC : (3, 3) float
+        Columns ``[n, t1, t2]`` of the contact frame in the grasp frame G.  A
+        planar contact ``R = [n, t]`` in the z = 0 plane becomes
+        ``[[n, t, 0], [0, 0, 1]]`` (right-handed, since ``n × t = +z``).
+    p_GC : (3,) float
+        Contact point, metres, in G (``z = 0`` for a planar contact).
+    """
+    R = np.asarray(contact.frame, dtype=float)
+    c = np.asarray(contact.position, dtype=float)
+    if contact.planar:
+        R3 = np.eye(3)
+        R3[:2, :2] = R
+        return R3, np.array([c[0], c[1], 0.0])
+    return R.copy(), c.copy()
+
+
+def normalize_contact_forces(grasp: Grasp, forces: Any) -> list[np.ndarray] | None:
+    """Per-contact force arrays from a closure result or a sequence of arrays.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        The grasp the forces belong to.
+    forces : ClosureResult, sequence of array_like, or None
+        An object with a ``contact_forces`` attribute (a
+        :class:`~drakegrasp.ClosureResult`) or one array per contact, each the
+        force in that contact's frame, normal component first.  An array may
+        hold fewer components than the contact's model (form closure reports
+        ``[f_n]`` only): the missing ones are zero.
+
+    Returns
+    -------
+    list of ndarray or None
+        One array per contact with exactly ``contact.num_components`` entries
+        (newtons; a soft finger's last entry is a moment, N·m); None when
+        ``forces`` is None or the result holds no forces.
+
+    Raises
+    ------
+    InvalidOptionError
+        If the number of arrays differs from the number of contacts, or an
+        array has too many components or non-finite entries.
+    """
+    if forces is None:
+        return None
+    if hasattr(forces, "contact_forces"):
+        forces = forces.contact_forces
+        if forces is None:
+            return None
+    forces = list(forces)
+    if not forces:
+        return None
+    if len(forces) != grasp.num_contacts:
+        raise InvalidOptionError(
+            f"got {len(forces)} contact forces for a grasp with "
+            f"{grasp.num_contacts} contacts; pass one array per contact"
+        )
+    out = []
+    for i, (f, contact) in enumerate(zip(forces, grasp.contacts, strict=True)):
+        a = np.asarray(f, dtype=float).reshape(-1)
+        k = contact.num_components
+        if a.size > k or a.size == 0:
+            raise InvalidOptionError(
+                f"contact {i} ({contact.model.value}) has {k} force components "
+                f"({', '.join(contact.component_names)}), got {a.tolist()}"
+            )
+        if not np.all(np.isfinite(a)):
+            raise InvalidOptionError(
+                f"force of contact {i} is not finite: {a.tolist()}"
+            )
+        full = np.zeros(k)
+        full[: a.size] = a
+        out.append(full)
+    return out
+
+
+def contact_forces_in_grasp_frame(
+    grasp: Grasp, forces: Sequence[np.ndarray]
+) -> np.ndarray:
+    """Contact forces mapped from contact frames to the grasp frame.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    forces : sequence of ndarray
+        As returned by :func:`normalize_contact_forces`.
+
+    Returns
+    -------
+    f_G : (N, d) float
+        ``R_i [f_n, f_t…]`` for each contact (the soft-finger moment ``m_n`` is
+        not a force and is left out), newtons, in the grasp frame; ``d`` is 2 for
+        a planar grasp and 3 otherwise.
+    """
+    rows = []
+    for contact, f in zip(grasp.contacts, forces, strict=True):
+        R = np.asarray(contact.frame, dtype=float)
+        d = contact.dim
+        local = np.zeros(d)
+        m = min(d, f.size)
+        local[:m] = f[:m]
+        rows.append(R @ local)
+    return np.array(rows, dtype=float).reshape(grasp.num_contacts, grasp.dim)
+
+
+def cone_edge_directions(contact: Contact) -> np.ndarray:
+    """Unit edge rays of a planar contact's (exact) friction cone.
+
+    Parameters
+    ----------
+    contact : Contact
+        A planar contact.
+
+    Returns
+    -------
+    U : (2, 2) float
+        Rows are the unit vectors along ``R [1, +μ]`` and ``R [1, -μ]`` in the
+        grasp frame (both equal ``n`` for a frictionless contact or ``μ = 0``).
+    """
+    if not contact.planar:
+        raise InvalidOptionError(
+            "cone_edge_directions is for planar contacts; got a spatial contact "
+            f"{contact!r}"
+        )
+    mu = contact.mu if 1 in contact.effective_components() else 0.0
+    local = np.array([[1.0, mu], [1.0, -mu]]) / np.hypot(1.0, mu)
+    return local @ np.asarray(contact.frame, dtype=float).T
+
+
+def exact_cone_mesh(
+    mu: float, height: float, *, num_segments: int = 32, sign: float = 1.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Lateral surface of the Coulomb cone ``‖f_t‖ ≤ μ f_n`` as triangles.
+
+    Parameters
+    ----------
+    mu : float
+        Friction coefficient, ``> 0``.
+    height : float
+        Extent along the cone's axis, metres.
+    num_segments : int, optional
+        Triangles around the axis (>= 3).
+    sign : float, optional
+        ``+1`` opens the cone along ``+x``, ``-1`` reflects it through the apex
+        (see the module notes on ``side``).
+
+    Returns
+    -------
+    vertices : (num_segments + 1, 3) float
+        In the contact frame (x = normal, y = t1, z = t2): the apex (row 0) at
+        the origin, then the rim points ``sign · h [1, μ cos θ_k, μ sin θ_k]``.
+    faces : (num_segments, 3) int
+        Triangles ``(apex, k, k+1)`` indexing ``vertices``.
+    """
+    n = int(num_segments)
+    if n < 3:
+        raise InvalidOptionError(f"num_segments must be >= 3, got {num_segments!r}")
+    theta = 2.0 * np.pi * np.arange(n) / n
+    rim = np.column_stack([np.full(n, 1.0), mu * np.cos(theta), mu * np.sin(theta)]) * (
+        sign * height
+    )
+    vertices = np.vstack([np.zeros(3), rim])
+    k = np.arange(n)
+    faces = np.column_stack([np.zeros(n, dtype=int), 1 + k, 1 + (k + 1) % n])
+    return vertices, faces
+
+
+def pyramid_generators(
+    contact: Contact, num_generators: int, *, characteristic_length: float
+) -> np.ndarray:
+    """Force generators ``[1, μ cos, μ sin]`` of the linearised cone, (3, n_g).
+
+    The soft finger's pure-moment generators ``[1, 0, 0, ±bν]`` are left out (a
+    moment about the normal has no arrow in the picture).  Empty (3, 0) when
+    the contact has no friction.
+    """
+    S = friction_cone_generators(
+        contact, num_generators, characteristic_length=characteristic_length
+    )
+    if contact.num_components < 3 or 1 not in contact.effective_components():
+        return np.zeros((3, 0))
+    S = S[:3]
+    keep = np.linalg.norm(S[1:3], axis=0) > 0.0
+    return S[:, keep]
+
+
+def pyramid_mesh(
+    generators: np.ndarray, height: float, *, sign: float = 1.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Side faces of the polyhedral cone spanned by ``generators``.
+
+    Parameters
+    ----------
+    generators : (3, m) float
+        Generators ``s_k`` in the contact frame, ordered around the axis, each
+        with first component 1.
+    height : float
+        Extent along the axis, metres: edge ``k`` ends at ``sign · h s_k``.
+    sign : float, optional
+        ``+1`` or ``-1`` (reflection through the apex).
+
+    Returns
+    -------
+    vertices : (m + 1, 3) float
+        Apex (row 0) then the edge ends, in the contact frame.
+    faces : (m, 3) int
+        Triangles ``(apex, k, k+1)``.
+    """
+    S = np.asarray(generators, dtype=float)
+    m = S.shape[1]
+    vertices = np.vstack([np.zeros(3), (sign * height) * (S / S[0]).T])
+    k = np.arange(m)
+    faces = np.column_stack([np.zeros(m, dtype=int), 1 + k, 1 + (k + 1) % m])
+    return vertices, faces

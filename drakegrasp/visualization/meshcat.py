@@ -1,0 +1,393 @@
+"""Draw a grasp in Drake's Meshcat: contacts, contact frames, cones and forces.
+
+Everything one call draws lives under one Meshcat path (``prefix``), so a second
+call with the same prefix replaces the drawing and :func:`clear_grasp` deletes it.
+Meshcat accepts drawings without any browser connected.
+
+Scene tree (``{prefix}`` carries ``X_WG``; each contact path carries ``X_GC_i``,
+the contact frame ``R_i`` at the contact point, so everything below it is drawn in
+contact-frame coordinates: x = normal, y = t1, z = t2)::
+
+    {prefix}/contact_{i}/point          sphere at the contact point
+    {prefix}/contact_{i}/frame/n|t1|t2  triad (red, green, blue)
+    {prefix}/contact_{i}/cone/exact     Coulomb cone (translucent triangle mesh)
+    {prefix}/contact_{i}/cone/pyramid   linearised cone (wireframe)
+    {prefix}/contact_{i}/cone/ray       a frictionless contact's cone (a ray)
+    {prefix}/contact_{i}/force          arrow: shaft and head
+
+Planar grasps are drawn in the z = 0 plane of the grasp frame.  By default cones
+open away from the object and force arrows end at the contact point (the finger
+pushes); see :mod:`drakegrasp.visualization.geometry` on ``side``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from pydrake.geometry import Cylinder, Meshcat, Rgba, Sphere
+from pydrake.math import RigidTransform, RotationMatrix
+
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.grasp import Grasp
+from drakegrasp.visualization.geometry import (
+    contact_pose_3d,
+    exact_cone_mesh,
+    normalize_contact_forces,
+    positive_length,
+    pyramid_generators,
+    pyramid_mesh,
+    side_sign,
+)
+
+__all__ = [
+    "DEFAULT_PREFIX",
+    "GraspDrawing",
+    "MESHCAT_COLORS",
+    "clear_grasp",
+    "draw_grasp",
+]
+
+DEFAULT_PREFIX = "drakegrasp/grasp"
+
+MESHCAT_COLORS: dict[str, tuple[float, float, float, float]] = {
+    "point": (0.1, 0.1, 0.1, 1.0),
+    "n": (0.85, 0.1, 0.1, 1.0),
+    "t1": (0.1, 0.7, 0.1, 1.0),
+    "t2": (0.1, 0.2, 0.9, 1.0),
+    "cone": (0.1, 0.55, 1.0, 0.35),
+    "pyramid": (0.0, 0.25, 0.6, 1.0),
+    "ray": (0.0, 0.25, 0.6, 1.0),
+    "force": (0.95, 0.05, 0.75, 1.0),
+}
+"""Default RGBA of each drawn part; override entries with ``colors=``."""
+
+_CONE_CHOICES = ("exact", "pyramid", "both", None)
+
+
+@dataclass(frozen=True)
+class GraspDrawing:
+    """What :func:`draw_grasp` put in the scene.
+
+    Attributes
+    ----------
+    prefix : str
+        Meshcat path that holds the whole drawing.
+    paths : tuple of str
+        Every object path drawn (under ``prefix``).
+    cone_height : float
+        Extent of each drawn cone along its normal, metres.
+    force_scale : float
+        Arrow length per newton, metres/N (0 when no forces were drawn).
+    forces_G : (N, 3) ndarray or None
+        Drawn contact forces in the grasp frame, newtons (planar: ``z = 0``).
+    """
+
+    prefix: str
+    paths: tuple[str, ...]
+    cone_height: float
+    force_scale: float
+    forces_G: np.ndarray | None
+
+
+def _rgba(colors: Mapping[str, Any], key: str) -> Rgba:
+    value = colors[key]
+    if isinstance(value, Rgba):
+        return value
+    v = [float(x) for x in value]
+    if len(v) == 3:
+        v.append(1.0)
+    if len(v) != 4:
+        raise InvalidOptionError(f"colour {key!r} must be RGB or RGBA, got {value!r}")
+    return Rgba(*v)
+
+
+def _merge_colors(colors: Mapping[str, Any] | None) -> dict[str, Any]:
+    merged = dict(MESHCAT_COLORS)
+    if colors:
+        unknown = set(colors) - set(merged)
+        if unknown:
+            raise InvalidOptionError(
+                f"unknown colour key(s) {sorted(unknown)}; valid keys are "
+                f"{sorted(merged)}"
+            )
+        merged.update(colors)
+    return merged
+
+
+def _set_mesh(meshcat: Meshcat, path: str, vertices, faces, rgba: Rgba, **kw) -> None:
+    meshcat.SetTriangleMesh(
+        path,
+        np.asfortranarray(np.asarray(vertices, dtype=float).T),
+        np.asfortranarray(np.asarray(faces, dtype=np.int32).T),
+        rgba,
+        **kw,
+    )
+
+
+def _draw_arrow(
+    meshcat: Meshcat,
+    path: str,
+    tail: np.ndarray,
+    vector: np.ndarray,
+    *,
+    radius: float,
+    rgba: Rgba,
+) -> None:
+    """Arrow from ``tail`` along ``vector`` (parent-frame coordinates)."""
+    length = float(np.linalg.norm(vector))
+    head = min(0.35 * length, 5.0 * radius)
+    shaft = length - head
+    R = RotationMatrix.MakeFromOneVector(vector, 2)
+    meshcat.SetTransform(path, RigidTransform(R, tail))
+    if shaft > 0:
+        meshcat.SetObject(f"{path}/shaft", Cylinder(radius, shaft), rgba)
+        meshcat.SetTransform(f"{path}/shaft", RigidTransform([0.0, 0.0, shaft / 2]))
+    # Head: a cone with its apex at the tip, opening back along -z (the mesh
+    # opens along +x; a rotation by π/2 about y takes +x to -z).
+    v, f = exact_cone_mesh(2.0 * radius / head, head, num_segments=16)
+    _set_mesh(meshcat, f"{path}/head", v, f, rgba)
+    meshcat.SetTransform(
+        f"{path}/head",
+        RigidTransform(RotationMatrix.MakeYRotation(np.pi / 2), [0.0, 0.0, length]),
+    )
+
+
+def draw_grasp(
+    meshcat: Meshcat,
+    grasp: Grasp,
+    *,
+    X_WG: RigidTransform | None = None,
+    result: Any = None,
+    prefix: str = DEFAULT_PREFIX,
+    cone: str | None = "exact",
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    cone_height: float | None = None,
+    force_scale: float | None = None,
+    point_radius: float | None = None,
+    frame_length: float | None = None,
+    show_frames: bool = True,
+    side: str = "outside",
+    colors: Mapping[str, Any] | None = None,
+) -> GraspDrawing:
+    """Draw a grasp (and optionally the forces of a closure result) in Meshcat.
+
+    Parameters
+    ----------
+    meshcat : pydrake.geometry.Meshcat
+        The visualizer; no browser needs to be connected.
+    grasp : Grasp
+        Contacts expressed in the grasp frame G.  Planar grasps are drawn in G's
+        z = 0 plane.
+    X_WG : RigidTransform, optional
+        Pose of G in world (for a grasp from a plant: the object body's pose
+        ``X_WO``).  Default identity.  It is set on ``prefix``, so
+        ``meshcat.SetTransform(prefix, X_WG)`` later moves the whole drawing.
+    result : ClosureResult or sequence of array_like, optional
+        Contact forces to draw as arrows: a result with ``contact_forces``, or
+        one array per contact in that contact's frame, normal first (newtons).
+    prefix : str, optional
+        Meshcat path holding the drawing; an existing drawing there is deleted
+        first.
+    cone : {"exact", "pyramid", "both", None}, optional
+        Which friction cones to draw: the exact Coulomb cone (translucent
+        surface), the inscribed pyramid with ``num_generators`` edges
+        (wireframe, from :func:`~drakegrasp.friction_cone_generators`), both,
+        or none.  Planar cones are exact wedges in the plane either way; a
+        frictionless contact's cone is the ray along its normal.
+    num_generators : int, optional
+        Edges of the pyramid (spatial contacts).
+    cone_height : float, optional
+        Extent of each cone along its normal, metres.  Default: 0.4 b, with b
+        the grasp's characteristic length.
+    force_scale : float, optional
+        Arrow length per newton (m/N).  Default: the largest force is drawn
+        0.6 b long.
+    point_radius : float, optional
+        Radius of the contact spheres, metres.  Default 0.04 b.
+    frame_length : float, optional
+        Length of the triad axes, metres.  Default 0.2 b.
+    show_frames : bool, optional
+        Draw the contact frames ``R_i = [n, t1, t2]`` as red, green and blue
+        axes.
+    side : {"outside", "inside"}, optional
+        ``"outside"``: cones open away from the object and arrows end at the
+        contact point; ``"inside"``: cones open along ``n`` and arrows start at
+        the contact point.
+    colors : mapping, optional
+        RGB(A) overrides of :data:`MESHCAT_COLORS` (keys ``point``, ``n``,
+        ``t1``, ``t2``, ``cone``, ``pyramid``, ``ray``, ``force``).
+
+    Returns
+    -------
+    GraspDrawing
+        The prefix, every path drawn, and the sizes used.
+
+    Raises
+    ------
+    InvalidOptionError
+        For an unknown ``cone``, ``side`` or colour key, a non-positive size, or
+        forces that do not match the grasp's contacts.
+    """
+    if not isinstance(grasp, Grasp):
+        raise InvalidOptionError(
+            f"draw_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
+        )
+    if cone not in _CONE_CHOICES:
+        raise InvalidOptionError(
+            f"cone must be 'exact', 'pyramid', 'both' or None, got {cone!r}"
+        )
+    if not isinstance(prefix, str) or not prefix.strip("/"):
+        raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
+    sign = side_sign(side)
+    palette = _merge_colors(colors)
+    b = grasp.characteristic_length
+    h = positive_length("cone_height", 0.4 * b if cone_height is None else cone_height)
+    r = positive_length(
+        "point_radius", 0.04 * b if point_radius is None else point_radius
+    )
+    axis_len = positive_length(
+        "frame_length", 0.2 * b if frame_length is None else frame_length
+    )
+    if X_WG is None:
+        X_WG = RigidTransform()
+    elif not isinstance(X_WG, RigidTransform):
+        raise InvalidOptionError(
+            f"X_WG must be a pydrake RigidTransform, got {type(X_WG).__name__}"
+        )
+
+    forces = normalize_contact_forces(grasp, result)
+    forces_G = None
+    scale = 0.0
+    if forces is not None:
+        forces_G = np.zeros((grasp.num_contacts, 3))
+        for i, (contact, f) in enumerate(zip(grasp.contacts, forces, strict=True)):
+            R3, _ = contact_pose_3d(contact)
+            local = np.zeros(3)
+            m = min(contact.dim, f.size)
+            local[:m] = f[:m]
+            forces_G[i] = R3 @ local
+        largest = float(np.max(np.linalg.norm(forces_G, axis=1)))
+        if force_scale is not None:
+            scale = positive_length("force_scale", force_scale)
+        elif largest > 0:
+            scale = 0.6 * b / largest
+
+    meshcat.Delete(prefix)
+    meshcat.SetTransform(prefix, X_WG)
+    paths: list[str] = []
+    axis_radius = 0.2 * r
+    for i, contact in enumerate(grasp.contacts):
+        base = f"{prefix}/contact_{i}"
+        R3, p3 = contact_pose_3d(contact)
+        meshcat.SetTransform(base, RigidTransform(RotationMatrix(R3), p3))
+
+        meshcat.SetObject(f"{base}/point", Sphere(r), _rgba(palette, "point"))
+        paths.append(f"{base}/point")
+
+        if show_frames:
+            axes = {
+                "n": RotationMatrix.MakeYRotation(np.pi / 2),
+                "t1": RotationMatrix.MakeXRotation(-np.pi / 2),
+                "t2": RotationMatrix(),
+            }
+            for k, (name, R_axis) in enumerate(axes.items()):
+                path = f"{base}/frame/{name}"
+                meshcat.SetObject(
+                    path, Cylinder(axis_radius, axis_len), _rgba(palette, name)
+                )
+                offset = np.zeros(3)
+                offset[k] = axis_len / 2
+                meshcat.SetTransform(path, RigidTransform(R_axis, offset))
+                paths.append(path)
+
+        if cone is not None:
+            paths += _draw_cone(
+                meshcat,
+                f"{base}/cone",
+                grasp,
+                i,
+                cone=cone,
+                num_generators=num_generators,
+                height=h,
+                sign=sign,
+                palette=palette,
+            )
+
+        if forces_G is not None and scale > 0:
+            f_C = R3.T @ forces_G[i]
+            if np.linalg.norm(f_C) * scale > 1e-9 * b:
+                vec = scale * f_C
+                tail = np.zeros(3) if sign > 0 else -vec
+                _draw_arrow(
+                    meshcat,
+                    f"{base}/force",
+                    tail,
+                    vec,
+                    radius=0.4 * r,
+                    rgba=_rgba(palette, "force"),
+                )
+                paths.append(f"{base}/force")
+    return GraspDrawing(prefix, tuple(paths), h, scale, forces_G)
+
+
+def _draw_cone(
+    meshcat: Meshcat,
+    path: str,
+    grasp: Grasp,
+    i: int,
+    *,
+    cone: str,
+    num_generators: int,
+    height: float,
+    sign: float,
+    palette: Mapping[str, Any],
+) -> list[str]:
+    contact = grasp.contacts[i]
+    drawn = []
+    if 1 not in contact.effective_components():
+        ray = np.array([[0.0, 0.0, 0.0], [sign * height, 0.0, 0.0]]).T
+        meshcat.SetLine(f"{path}/ray", ray, 3.0, _rgba(palette, "ray"))
+        return [f"{path}/ray"]
+    mu = contact.mu
+    if contact.planar:
+        # The planar cone is exact: the wedge between R[1, ±μ], in the plane.
+        v = sign * height * np.array([[0, 0, 0], [1, mu, 0], [1, -mu, 0]], float)
+        if cone in ("exact", "both"):
+            _set_mesh(meshcat, f"{path}/exact", v, [[0, 1, 2]], _rgba(palette, "cone"))
+            drawn.append(f"{path}/exact")
+        if cone in ("pyramid", "both"):
+            edges = np.array([v[1], v[0], v[2]]).T
+            meshcat.SetLine(f"{path}/pyramid", edges, 2.0, _rgba(palette, "pyramid"))
+            drawn.append(f"{path}/pyramid")
+        return drawn
+    if cone in ("exact", "both"):
+        v, f = exact_cone_mesh(mu, height, num_segments=48, sign=sign)
+        _set_mesh(meshcat, f"{path}/exact", v, f, _rgba(palette, "cone"))
+        drawn.append(f"{path}/exact")
+    if cone in ("pyramid", "both"):
+        S = pyramid_generators(
+            contact, num_generators, characteristic_length=grasp.characteristic_length
+        )
+        v, f = pyramid_mesh(S, height, sign=sign)
+        _set_mesh(
+            meshcat,
+            f"{path}/pyramid",
+            v,
+            f,
+            _rgba(palette, "pyramid"),
+            wireframe=True,
+            wireframe_line_width=2.0,
+        )
+        drawn.append(f"{path}/pyramid")
+    return drawn
+
+
+def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
+    """Delete a drawing made by :func:`draw_grasp` (everything under ``prefix``)."""
+    if not isinstance(prefix, str) or not prefix.strip("/"):
+        raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
+    meshcat.Delete(prefix)

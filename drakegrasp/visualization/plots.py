@@ -1,0 +1,327 @@
+"""matplotlib pictures of planar grasps: outline, contacts, normals, cones, forces.
+
+matplotlib is an optional dependency (the ``viz`` extra): it is imported only
+when a function here is called, and its absence raises an ImportError that says
+how to install it.  Headless use works with the Agg backend.
+
+By default cones open away from the object and force arrows end at the contact
+point (the finger pushes); see :mod:`drakegrasp.visualization.geometry` on
+``side``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.grasp import Grasp
+from drakegrasp.visualization.geometry import (
+    cone_edge_directions,
+    contact_forces_in_grasp_frame,
+    normalize_contact_forces,
+    positive_length,
+    side_sign,
+)
+
+__all__ = ["PLOT_COLORS", "PlanarGraspPlot", "import_pyplot", "plot_planar_grasp"]
+
+PLOT_COLORS: dict[str, Any] = {
+    "outline": (0.85, 0.85, 0.85, 1.0),
+    "outline_edge": (0.3, 0.3, 0.3, 1.0),
+    "contact": "black",
+    "normal": "tab:red",
+    "cone": (0.12, 0.47, 0.71, 0.3),
+    "cone_edge": (0.12, 0.47, 0.71, 1.0),
+    "force": "tab:purple",
+}
+"""Default colours of :func:`plot_planar_grasp`; override entries with ``colors=``."""
+
+
+def import_pyplot():
+    """Import ``matplotlib.pyplot``, or explain how to install matplotlib.
+
+    Raises
+    ------
+    ImportError
+        When matplotlib is not installed.
+    """
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ImportError(
+            "drakegrasp's plots need matplotlib, an optional dependency: "
+            "pip install 'drakegrasp[viz]' (or pip install matplotlib)"
+        ) from exc
+    return plt
+
+
+@dataclass(frozen=True)
+class PlanarGraspPlot:
+    """Artists of :func:`plot_planar_grasp`, for inspection or restyling.
+
+    Attributes
+    ----------
+    ax : matplotlib.axes.Axes
+    outline : matplotlib.patches.Patch or None
+        The object outline.
+    contacts : matplotlib.collections.PathCollection
+        Contact points (one marker per contact, in contact order).
+    normals : matplotlib.quiver.Quiver or None
+        One arrow per contact along its inward normal ``n``.
+    cones : tuple of (matplotlib.patches.Polygon or None)
+        Per contact, the exact friction cone as a wedge ``[apex, edge+, edge-]``
+        (None for a contact without friction, whose cone is its normal ray).
+    forces : matplotlib.quiver.Quiver or None
+        One arrow per contact with the contact force (in the grasp frame).
+    labels : tuple of matplotlib.text.Text
+        Contact numbers.
+    cone_length : float
+        Length of each drawn cone edge, metres.
+    force_scale : float
+        Arrow length per newton (m/N); 0 when no forces were drawn.
+    """
+
+    ax: Any
+    outline: Any
+    contacts: Any
+    normals: Any
+    cones: tuple[Any, ...]
+    forces: Any
+    labels: tuple[Any, ...]
+    cone_length: float
+    force_scale: float
+
+
+def _outline_patch(outline: Any, colors: Mapping[str, Any]):
+    from matplotlib.patches import Circle, Patch, Polygon
+
+    style = {"facecolor": colors["outline"], "edgecolor": colors["outline_edge"]}
+    if isinstance(outline, Patch):
+        return outline
+    if isinstance(outline, Mapping):
+        if set(outline) != {"center", "radius"}:
+            raise InvalidOptionError(
+                "a circle outline is a mapping with keys 'center' and 'radius', "
+                f"got keys {sorted(outline)}"
+            )
+        center = np.asarray(outline["center"], dtype=float).reshape(-1)
+        radius = positive_length("outline radius", outline["radius"])
+        if center.shape != (2,) or not np.all(np.isfinite(center)):
+            raise InvalidOptionError(
+                f"circle center must be a finite 2-vector, got {outline['center']!r}"
+            )
+        return Circle(tuple(center), radius, **style)
+    pts = np.asarray(outline, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 3:
+        raise InvalidOptionError(
+            "outline must be an (M, 2) polygon with M >= 3, a mapping "
+            "{'center': (x, y), 'radius': r}, or a matplotlib Patch; got an "
+            f"array of shape {pts.shape}"
+        )
+    if not np.all(np.isfinite(pts)):
+        raise InvalidOptionError("outline vertices must be finite")
+    return Polygon(pts, closed=True, **style)
+
+
+def plot_planar_grasp(
+    grasp: Grasp,
+    *,
+    ax: Any = None,
+    outline: Any = None,
+    result: Any = None,
+    cone_length: float | None = None,
+    force_scale: float | None = None,
+    side: str = "outside",
+    show_normals: bool = True,
+    show_labels: bool = True,
+    colors: Mapping[str, Any] | None = None,
+) -> PlanarGraspPlot:
+    """Draw a planar grasp: outline, contacts, normals, exact cones and forces.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        A planar grasp; coordinates are the grasp frame's, metres.
+    ax : matplotlib.axes.Axes, optional
+        2-D axes to draw on; a new figure when omitted.  Its aspect is set
+        equal and its limits fit the drawing.
+    outline : (M, 2) array_like, mapping or Patch, optional
+        The object: a polygon's vertices, ``{"center": (x, y), "radius": r}``
+        for a disc, or any matplotlib patch (added as given).
+    result : ClosureResult or sequence of array_like, optional
+        Contact forces to draw: a result with ``contact_forces`` or one array
+        per contact in its contact frame, ``[f_n, f_t]`` (newtons).
+    cone_length : float, optional
+        Length of the drawn cone edges and normal arrows, metres.  Default
+        0.3 b (b: the grasp's characteristic length).
+    force_scale : float, optional
+        Arrow length per newton (m/N).  Default: the largest force is 0.6 b
+        long.
+    side : {"outside", "inside"}, optional
+        ``"outside"``: cones open away from the object (apex at the contact,
+        edges along ``-R[1, ±μ]``) and normal and force arrows end at the
+        contact point; ``"inside"``: cones open along ``R[1, ±μ]`` and arrows
+        start at the contact point.
+    show_normals, show_labels : bool, optional
+        Draw the normal arrows / the contact numbers.
+    colors : mapping, optional
+        Overrides of :data:`PLOT_COLORS`.
+
+    Returns
+    -------
+    PlanarGraspPlot
+        The axes and every artist drawn.
+
+    Raises
+    ------
+    InvalidOptionError
+        For a spatial grasp, a bad outline, size, side, colour key, or forces
+        that do not match the contacts.
+    ImportError
+        When matplotlib is not installed.
+    """
+    if not isinstance(grasp, Grasp):
+        raise InvalidOptionError(
+            f"plot_planar_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
+        )
+    if not grasp.planar:
+        raise InvalidOptionError(
+            "plot_planar_grasp draws planar grasps; this grasp is spatial "
+            "(use drakegrasp.visualization.draw_grasp with Meshcat)"
+        )
+    sign = side_sign(side)
+    palette = dict(PLOT_COLORS)
+    if colors:
+        unknown = set(colors) - set(palette)
+        if unknown:
+            raise InvalidOptionError(
+                f"unknown colour key(s) {sorted(unknown)}; valid keys are "
+                f"{sorted(palette)}"
+            )
+        palette.update(colors)
+    b = grasp.characteristic_length
+    L = positive_length("cone_length", 0.3 * b if cone_length is None else cone_length)
+    forces = normalize_contact_forces(grasp, result)
+    f_G = None if forces is None else contact_forces_in_grasp_frame(grasp, forces)
+    scale = 0.0
+    if f_G is not None:
+        largest = float(np.max(np.linalg.norm(f_G, axis=1)))
+        if force_scale is not None:
+            scale = positive_length("force_scale", force_scale)
+        elif largest > 0:
+            scale = 0.6 * b / largest
+    patch = None if outline is None else _outline_patch(outline, palette)
+
+    plt = import_pyplot()
+    from matplotlib.patches import Polygon
+
+    if ax is None:
+        _, ax = plt.subplots()
+    elif getattr(ax, "name", None) != "rectilinear":
+        raise InvalidOptionError(
+            "ax must be a 2-D axes, got a "
+            f"{getattr(ax, 'name', type(ax).__name__)!r} axes"
+        )
+    C = grasp.positions
+    Nrm = grasp.normals
+    extent = [C]
+    if patch is not None:
+        ax.add_patch(patch)
+        patch.set_zorder(0)
+        # Vertices in data coordinates (a Circle's path is the unit circle).
+        verts = patch.get_patch_transform().transform(patch.get_path().vertices)
+        if len(verts):
+            extent.append(np.asarray(verts))
+
+    cones = []
+    for contact in grasp.contacts:
+        if 1 not in contact.effective_components():
+            cones.append(None)
+            continue
+        U = cone_edge_directions(contact)
+        c = contact.position
+        wedge = np.vstack([c, c + sign * L * U[0], c + sign * L * U[1]])
+        poly = Polygon(
+            wedge,
+            closed=True,
+            facecolor=palette["cone"],
+            edgecolor=palette["cone_edge"],
+            linewidth=1.2,
+            zorder=1,
+        )
+        ax.add_patch(poly)
+        cones.append(poly)
+        extent.append(wedge)
+
+    normals = None
+    if show_normals:
+        tails = C if sign > 0 else C - L * Nrm
+        normals = ax.quiver(
+            tails[:, 0],
+            tails[:, 1],
+            L * Nrm[:, 0],
+            L * Nrm[:, 1],
+            angles="xy",
+            scale_units="xy",
+            scale=1.0,
+            color=palette["normal"],
+            width=0.006,
+            minlength=0.0,
+            zorder=3,
+        )
+        extent.append(tails)
+
+    force_artist = None
+    if f_G is not None and scale > 0:
+        vec = scale * f_G
+        tails = C if sign > 0 else C - vec
+        force_artist = ax.quiver(
+            tails[:, 0],
+            tails[:, 1],
+            vec[:, 0],
+            vec[:, 1],
+            angles="xy",
+            scale_units="xy",
+            scale=1.0,
+            color=palette["force"],
+            width=0.009,
+            minlength=0.0,
+            zorder=4,
+        )
+        extent += [tails, tails + vec]
+
+    points = ax.scatter(C[:, 0], C[:, 1], color=palette["contact"], s=25, zorder=5)
+    labels = []
+    if show_labels:
+        offset = 0.06 * b
+        for i, (c, n) in enumerate(zip(C, Nrm, strict=True)):
+            # Put the number beside the contact, off the normal's line.
+            t = np.array([-n[1], n[0]])
+            x, y = c + offset * t
+            labels.append(
+                ax.text(x, y, str(i), fontsize=9, ha="center", va="center", zorder=6)
+            )
+
+    pts = np.vstack(extent)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pad = 0.1 * max(float(np.max(hi - lo)), b)
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    return PlanarGraspPlot(
+        ax,
+        patch,
+        points,
+        normals,
+        tuple(cones),
+        force_artist,
+        tuple(labels),
+        L,
+        scale,
+    )

@@ -1,0 +1,271 @@
+r"""The wrench space of a planar grasp: primitive wrenches and their convex hull.
+
+Each contact's friction cone is spanned by its generators ``s_k`` (planar: the
+exact edge rays ``[1, ±μ]``; frictionless: ``[1]``), all with unit normal
+component.  Their wrenches ``w = G_i s_k`` are the *primitive wrenches*; the grasp
+is force closure exactly when they positively span the wrench space, i.e. when
+the origin lies strictly inside their convex hull.  Moments are divided by the
+characteristic length ``b`` so the three axes share units (newtons).
+
+.. math:: w_{ik} = \begin{bmatrix} R_i s_k \\ (c_i - p) \times R_i s_k / b
+          \end{bmatrix}
+
+matplotlib and scipy are imported only when a function here needs them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, friction_cone_generators
+from drakegrasp.grasp import Grasp, wrench_columns
+from drakegrasp.visualization.plots import import_pyplot
+
+__all__ = [
+    "WrenchHull",
+    "WrenchSpacePlot",
+    "plot_wrench_space",
+    "primitive_wrenches",
+    "wrench_hull",
+]
+
+
+def primitive_wrenches(
+    grasp: Grasp,
+    *,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    scale_moments: bool = True,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Wrenches of the friction-cone generators of every contact.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        Planar or spatial.
+    num_generators : int, optional
+        Generators of a spatial Coulomb cone (planar cones are exact with 2).
+    scale_moments : bool, optional
+        Divide the moment rows by the characteristic length ``b`` (default).
+
+    Returns
+    -------
+    W : (3, K) or (6, K) float
+        Primitive wrenches ``[f; m]`` (or ``[f; m / b]``) as columns, about the
+        grasp's reference point, in the grasp frame; forces have unit normal
+        component (newtons per newton of normal force).
+    contact_index : (K,) int
+        Contact that each column comes from.
+
+    Notes
+    -----
+    Only force generators enter: a soft finger's moment generators
+    ``[1, 0, 0, ±bν]`` add the wrench ``[n; (c - p) × n ± bν n]``.
+    """
+    b = grasp.characteristic_length
+    p = grasp.reference_point
+    cols, owner = [], []
+    for i, contact in enumerate(grasp.contacts):
+        S = friction_cone_generators(contact, num_generators, characteristic_length=b)
+        d = contact.dim
+        forces = np.zeros((d, S.shape[1]))
+        k = min(d, S.shape[0])
+        forces[:k] = S[:k]
+        W = wrench_columns(contact.position, contact.frame @ forces, p)
+        if S.shape[0] == 4:  # soft finger: the moment about the normal
+            W[3:] += np.outer(contact.normal, S[3])
+        cols.append(W)
+        owner += [i] * S.shape[1]
+    W = np.hstack(cols)
+    if scale_moments:
+        W[grasp.dim :] /= b  # moment rows: 2: (planar) or 3: (spatial)
+    return W, np.array(owner, dtype=int)
+
+
+@dataclass(frozen=True)
+class WrenchHull:
+    """Convex hull of a set of wrenches and where the origin lies.
+
+    Attributes
+    ----------
+    hull : scipy.spatial.ConvexHull or None
+        None when the wrenches do not span the space (no interior).
+    origin_inside : bool
+        True when the origin is strictly inside, by more than ``tol``.
+    margin : float
+        Smallest signed distance from the origin to a facet plane, positive
+        inside: when positive, the radius of the largest ball about the origin
+        inside the hull (units of the wrenches).  0.0 when ``hull`` is None.
+    rank : int
+        Rank of the wrench matrix.
+    """
+
+    hull: Any
+    origin_inside: bool
+    margin: float
+    rank: int
+
+
+def wrench_hull(W: np.ndarray, *, tol: float = 1e-9) -> WrenchHull:
+    """Convex hull of the columns of ``W`` and whether it contains the origin.
+
+    Parameters
+    ----------
+    W : (m, K) float
+        Wrenches as columns.
+    tol : float, optional
+        The origin counts as inside only when every facet is farther than
+        ``tol``.
+
+    Returns
+    -------
+    WrenchHull
+    """
+    from scipy.spatial import ConvexHull, QhullError
+
+    W = np.asarray(W, dtype=float)
+    m, K = W.shape
+    rank = int(np.linalg.matrix_rank(W)) if K else 0
+    # The hull has an interior only if the points' affine hull is m-dimensional.
+    affine_rank = int(np.linalg.matrix_rank(W[:, 1:] - W[:, :1])) if K > 1 else 0
+    if K < m + 1 or affine_rank < m:
+        return WrenchHull(None, False, 0.0, rank)
+    try:
+        hull = ConvexHull(W.T)
+    except QhullError:
+        return WrenchHull(None, False, 0.0, rank)
+    # equations: [normal, offset] with unit outward normals; inside: n·x + o <= 0.
+    margin = float(-np.max(hull.equations[:, -1]))
+    return WrenchHull(hull, margin > tol, margin, rank)
+
+
+@dataclass(frozen=True)
+class WrenchSpacePlot:
+    """Artists and data of :func:`plot_wrench_space`.
+
+    Attributes
+    ----------
+    ax : mpl_toolkits.mplot3d.axes3d.Axes3D
+    wrenches : (3, K) ndarray
+        Primitive wrenches ``[fx, fy, mz / b]`` that were drawn.
+    contact_index : (K,) ndarray of int
+        Contact of each wrench.
+    points : matplotlib collection
+        The wrenches as points.
+    rays : Line3DCollection or None
+        Segments from the origin to each wrench.
+    hull : WrenchHull
+        Hull data, including ``origin_inside`` and ``margin``.
+    hull_artist : Poly3DCollection or None
+        Hull facets (None when ``hull=False`` or the hull is degenerate).
+    origin : matplotlib collection
+        The origin marker (green when inside, red when not).
+    """
+
+    ax: Any
+    wrenches: np.ndarray
+    contact_index: np.ndarray
+    points: Any
+    rays: Any
+    hull: WrenchHull
+    hull_artist: Any
+    origin: Any
+
+    @property
+    def origin_inside(self) -> bool:
+        """True when the origin is strictly inside the hull (force closure)."""
+        return self.hull.origin_inside
+
+
+def plot_wrench_space(
+    grasp: Grasp,
+    *,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    ax: Any = None,
+    hull: bool = True,
+    rays: bool = True,
+    tol: float = 1e-9,
+) -> WrenchSpacePlot:
+    """Plot the primitive wrenches of a planar grasp and their convex hull.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        A planar grasp (its wrench space ``(fx, fy, mz / b)`` is 3-D).
+    num_generators : int, optional
+        Passed to :func:`primitive_wrenches` (planar cones are exact, so it
+        only matters for the validation of the value).
+    ax : Axes3D, optional
+        A 3-D axes (``fig.add_subplot(projection="3d")``); a new figure when
+        omitted.
+    hull : bool, optional
+        Draw the convex hull's facets (translucent).
+    rays : bool, optional
+        Draw a segment from the origin to each primitive wrench.
+    tol : float, optional
+        Margin the origin needs to count as inside (see :func:`wrench_hull`).
+
+    Returns
+    -------
+    WrenchSpacePlot
+
+    Raises
+    ------
+    InvalidOptionError
+        For a spatial grasp (6-D wrench space) or an ``ax`` that is not 3-D.
+    ImportError
+        When matplotlib (or scipy) is not installed.
+    """
+    if not isinstance(grasp, Grasp):
+        raise InvalidOptionError(
+            f"plot_wrench_space needs a drakegrasp.Grasp, got {type(grasp).__name__}"
+        )
+    if not grasp.planar:
+        raise InvalidOptionError(
+            "plot_wrench_space draws planar grasps, whose wrench space is 3-D; "
+            "this grasp is spatial (6-D wrenches)"
+        )
+    plt = import_pyplot()
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    if ax is None:
+        fig = plt.figure()
+        ax = fig.add_subplot(projection="3d")
+    elif getattr(ax, "name", None) != "3d":
+        raise InvalidOptionError(
+            "ax must be a 3-D axes (fig.add_subplot(projection='3d')), got "
+            f"a {getattr(ax, 'name', type(ax).__name__)!r} axes"
+        )
+    W, owner = primitive_wrenches(grasp, num_generators=num_generators)
+    info = wrench_hull(W, tol=tol)
+    cmap = plt.get_cmap("tab10")
+    colors = [cmap(i % 10) for i in owner]
+    points = ax.scatter(W[0], W[1], W[2], c=colors, s=30, depthshade=False)
+    ray_artist = None
+    if rays:
+        segments = [[(0.0, 0.0, 0.0), tuple(w)] for w in W.T]
+        ray_artist = Line3DCollection(segments, colors=colors, linewidths=1.0)
+        ax.add_collection3d(ray_artist)
+    hull_artist = None
+    if hull and info.hull is not None:
+        faces = [W.T[s] for s in info.hull.simplices]
+        hull_artist = Poly3DCollection(
+            faces, facecolors=(0.3, 0.5, 0.9, 0.18), edgecolors=(0.2, 0.3, 0.6, 0.6)
+        )
+        ax.add_collection3d(hull_artist)
+    origin_color = "tab:green" if info.origin_inside else "tab:red"
+    origin = ax.scatter(
+        [0.0], [0.0], [0.0], c=origin_color, marker="X", s=80, depthshade=False
+    )
+    extent = float(np.max(np.abs(W))) * 1.1 if W.size else 1.0
+    for setter in (ax.set_xlim, ax.set_ylim, ax.set_zlim):
+        setter(-extent, extent)
+    ax.set_xlabel("$f_x$ [N]")
+    ax.set_ylabel("$f_y$ [N]")
+    ax.set_zlabel("$m_z / b$ [N]")
+    where = "inside" if info.origin_inside else "NOT inside"
+    ax.set_title(f"origin {where} the hull (margin {info.margin:.3g})")
+    return WrenchSpacePlot(ax, W, owner, points, ray_artist, info, hull_artist, origin)
