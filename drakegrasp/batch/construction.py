@@ -182,7 +182,7 @@ def _two_sided(slope: np.ndarray) -> np.ndarray:
 
 
 def _ring(mu: np.ndarray, num_generators: int) -> np.ndarray:
-    """Generators ``[1, μ cos θ_k, μ sin θ_k]``, θ_k = 2πk/n_g, k = 1…n_g: (K, n_g, 3)."""
+    """Ring generators ``[1, μ cos θ_k, μ sin θ_k]``, θ_k = 2πk/n_g: (K, n_g, 3)."""
     theta = 2.0 * np.pi * np.arange(1, num_generators + 1) / num_generators
     S = np.empty(mu.shape + (num_generators, 3))
     S[..., 0] = 1.0

@@ -16,7 +16,8 @@ The feasible set without the budget is a cone, so :math:`d^* = N \max(0, t^*)` w
 
 (``e`` sums the normal components): a positive margin is attained with the whole
 budget spent, and ``d* = 0`` otherwise.  With an orthonormal basis ``Z`` (M, m) of
-``N(G)`` (from the SVD, the same relative rank threshold as the single path),
+``N(G)`` (the same relative rank threshold as the single path, see
+:func:`null_spaces`),
 ``f = Z y`` and ``c = Zᵀ e``; the equality is eliminated with a Householder
 reflection of ``c``: ``y = c/‖c‖² + W u`` with ``W`` (m, m−1) orthonormal and
 ``Wᵀ c = 0``.  What is left is, per grasp,
@@ -42,7 +43,7 @@ import numpy as np
 
 from drakegrasp.batch.ipm import solve_max_last
 
-__all__ = ["MarginSolution", "solve_margin_lp"]
+__all__ = ["MarginSolution", "null_spaces", "solve_margin_lp"]
 
 _PUSH_TOL = 1e-10  # ‖Zᵀe‖ below this: no balanced force has a normal component
 
@@ -57,15 +58,12 @@ class MarginSolution:
         Optimal margin of the LP, ``>= 0``.
     rank : (K,) int
         Numerical rank of ``G``.
-    singular_values : (K, min(w, M)) float
-        Singular values of ``G``, descending.
     converged : (K,) bool
         False where the interior-point method stopped at its iteration cap.
     """
 
     d_star: np.ndarray
     rank: np.ndarray
-    singular_values: np.ndarray
     converged: np.ndarray
 
 
@@ -84,6 +82,107 @@ def _householder_complement(c: np.ndarray) -> np.ndarray:
         v[:, :, None] * v[:, None, :]
     )
     return H[:, :, 1:]
+
+
+def _householder_qr(A: np.ndarray):
+    """Vectorised Householder QR of a stack stored (M, w, K), M >= w.
+
+    Returns the upper triangles ``R`` (w, w, K) and the last ``M - w`` columns of
+    the complete ``Q`` (M, M - w, K), an orthonormal basis of the complement of
+    ``A``'s columns.
+    """
+    M, w, K = A.shape
+    A = A.copy()
+    vs, betas = [], []
+    for j in range(w):
+        x = A[j:, j]
+        norm = np.sqrt(np.einsum("ik,ik->k", x, x))
+        alpha = np.where(x[0] >= 0.0, -norm, norm)
+        v = x.copy()
+        v[0] -= alpha
+        vv = np.einsum("ik,ik->k", v, v)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            beta = np.where(vv > 0.0, 2.0 / vv, 0.0)
+        sub = A[j:, j:]
+        sub -= v[:, None, :] * (beta * np.einsum("ik,ijk->jk", v, sub))[None]
+        vs.append(v)
+        betas.append(beta)
+    Q = np.zeros((M, M - w, K))
+    Q[w:] = np.eye(M - w)[:, :, None]
+    for j in reversed(range(w)):
+        v, sub = vs[j], Q[j:]
+        sub -= v[:, None, :] * (betas[j] * np.einsum("ik,ijk->jk", v, sub))[None]
+    return A[:w], Q
+
+
+def _inverse_frobenius(R: np.ndarray) -> np.ndarray:
+    """``‖R⁻¹‖_F`` of upper-triangular (w, w, K) stacks (inf when singular)."""
+    w = R.shape[0]
+    X = np.zeros_like(R)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for j in range(w):
+            X[j, j] = 1.0 / R[j, j]
+            for i in reversed(range(j)):
+                X[i, j] = -np.einsum(
+                    "ik,ik->k", R[i, i + 1 : j + 1], X[i + 1 : j + 1, j]
+                )
+                X[i, j] /= R[i, i]
+        out = np.sqrt(np.einsum("ijk,ijk->k", X, X))
+    return np.where(np.isfinite(out), out, np.inf)
+
+
+def null_spaces(G: np.ndarray, *, rank_tol: float):
+    """Numerical ranks and orthonormal null-space bases of a stack of matrices.
+
+    Parameters
+    ----------
+    G : (K, w, M) float
+    rank_tol : float
+        Singular values ``<= rank_tol * σ_max`` count as zero (as
+        :func:`drakegrasp.closure.matrix_rank`).
+
+    Returns
+    -------
+    rank : (K,) int
+    groups : list of (rows, Z)
+        For each nullity ``m > 0`` present: the grasp indices (k,) and bases
+        ``Z`` (k, M, m) with orthonormal columns spanning ``N(G)``.
+
+    Notes
+    -----
+    Fast path: a Householder QR of ``Gᵀ`` vectorised over the stack.  When it
+    certifies full row rank, ``1/‖R⁻¹‖_F <= σ_min`` and ``σ_max <= ‖G‖_F``
+    give ``σ_min > rank_tol σ_max`` and the trailing columns of ``Q`` span
+    ``N(G)``.  The uncertain rest (rank-deficient or nearly so) takes a full SVD,
+    which applies the threshold exactly.
+    """
+    K, w, M = G.shape
+    rank = np.zeros(K, dtype=int)
+    groups = []
+    svd_rows = np.arange(K)
+    if M > w and K > 0:
+        R, Q = _householder_qr(np.transpose(G, (2, 1, 0)))
+        gnorm = np.sqrt(np.einsum("kij,kij->k", G, G))
+        # 1/‖R⁻¹‖_F > rank_tol ‖G‖_F, written without dividing by inf.
+        certain = _inverse_frobenius(R) * rank_tol * gnorm < 1.0
+        rows = np.flatnonzero(certain)
+        if rows.size:
+            rank[rows] = w
+            groups.append(
+                (rows, np.ascontiguousarray(np.transpose(Q[:, :, rows], (2, 0, 1))))
+            )
+        svd_rows = np.flatnonzero(~certain)
+    if svd_rows.size:
+        _, sv, Vh = np.linalg.svd(G[svd_rows], full_matrices=True)
+        r = np.sum(sv > rank_tol * sv[:, :1], axis=1)
+        rank[svd_rows] = r
+        for nullity in np.unique(M - r):
+            m = int(nullity)
+            if m > 0:
+                sel = np.flatnonzero(M - r == m)
+                Z = np.swapaxes(Vh[sel, M - m :, :], 1, 2)
+                groups.append((svd_rows[sel], Z))
+    return rank, groups
 
 
 def solve_margin_lp(
@@ -118,16 +217,11 @@ def solve_margin_lp(
     """
     K, _, M = G.shape
     N = len(normal_columns)
-    _, sv, Vh = np.linalg.svd(G, full_matrices=True)
-    rank = np.sum(sv > rank_tol * sv[:, :1], axis=1)
+    rank, groups = null_spaces(G, rank_tol=rank_tol)
     d_star = np.zeros(K)
     converged = np.ones(K, dtype=bool)
-    for nullity in np.unique(M - rank):
-        m = int(nullity)
-        if m == 0:
-            continue
-        sel = np.flatnonzero(M - rank == m)
-        Z = np.swapaxes(Vh[sel, M - m :, :], 1, 2)  # (k, M, m)
+    for sel, Z in groups:
+        m = Z.shape[2]
         c = Z[:, normal_columns, :].sum(axis=1)  # (k, m)
         cnorm2 = np.einsum("ki,ki->k", c, c)
         push = cnorm2 > _PUSH_TOL**2
@@ -153,4 +247,4 @@ def solve_margin_lp(
             t = sol.value
             converged[sel] = sol.converged
         d_star[sel] = N * np.maximum(t, 0.0)
-    return MarginSolution(d_star, rank, sv, converged)
+    return MarginSolution(d_star, rank, converged)
