@@ -35,8 +35,8 @@ from drakegrasp.visualization.wrench_space import (
     WrenchHull,
     WrenchSpacePlot,
     plot_wrench_space,
-    primitive_wrenches,
     wrench_hull,
+    wrench_space_points,
 )
 
 __all__ = [
@@ -56,7 +56,7 @@ __all__ = [
     "normalize_contact_forces",
     "plot_planar_grasp",
     "plot_wrench_space",
-    "primitive_wrenches",
     "pyramid_mesh",
     "wrench_hull",
+    "wrench_space_points",
 ]

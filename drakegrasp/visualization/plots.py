@@ -214,10 +214,10 @@ def plot_planar_grasp(
             scale = positive_length("force_scale", force_scale)
         elif largest > 0:
             scale = 0.6 * b / largest
-    patch = None if outline is None else _outline_patch(outline, palette)
-
     plt = import_pyplot()
     from matplotlib.patches import Polygon
+
+    patch = None if outline is None else _outline_patch(outline, palette)
 
     if ax is None:
         _, ax = plt.subplots()

@@ -29,18 +29,21 @@ __all__ = [
     "WrenchHull",
     "WrenchSpacePlot",
     "plot_wrench_space",
-    "primitive_wrenches",
+    "wrench_space_points",
     "wrench_hull",
 ]
 
 
-def primitive_wrenches(
+def wrench_space_points(
     grasp: Grasp,
     *,
     num_generators: int = DEFAULT_NUM_GENERATORS,
     scale_moments: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Wrenches of the friction-cone generators of every contact.
+    """Wrenches of the friction-cone generators of every contact, as columns.
+
+    (:func:`drakegrasp.quality.primitive_wrenches` returns the same wrenches
+    grouped per contact, as rows; this flat form is what a plot needs.)
 
     Parameters
     ----------
@@ -196,7 +199,7 @@ def plot_wrench_space(
     grasp : Grasp
         A planar grasp (its wrench space ``(fx, fy, mz / b)`` is 3-D).
     num_generators : int, optional
-        Passed to :func:`primitive_wrenches` (planar cones are exact, so it
+        Passed to :func:`wrench_space_points` (planar cones are exact, so it
         only matters for the validation of the value).
     ax : Axes3D, optional
         A 3-D axes (``fig.add_subplot(projection="3d")``); a new figure when
@@ -239,7 +242,7 @@ def plot_wrench_space(
             "ax must be a 3-D axes (fig.add_subplot(projection='3d')), got "
             f"a {getattr(ax, 'name', type(ax).__name__)!r} axes"
         )
-    W, owner = primitive_wrenches(grasp, num_generators=num_generators)
+    W, owner = wrench_space_points(grasp, num_generators=num_generators)
     info = wrench_hull(W, tol=tol)
     cmap = plt.get_cmap("tab10")
     colors = [cmap(i % 10) for i in owner]
