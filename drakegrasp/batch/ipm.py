@@ -137,7 +137,7 @@ def _starting_point(B: np.ndarray, h: np.ndarray):
     sl = np.einsum("rk,rk->k", s, lam)
     s = s + 0.5 * sl / np.maximum(lam.sum(axis=0), 1e-300) + 1e-12
     lam = lam + 0.5 * sl / np.maximum(s.sum(axis=0), 1e-300) + 1e-12
-    return x, s, lam
+    return x, s, lam, L
 
 
 def solve_max_last(
@@ -146,6 +146,7 @@ def solve_max_last(
     *,
     tol: float = 1e-10,
     max_iter: int = 60,
+    stop_below: float | None = None,
 ) -> MaxLPSolution:
     r"""Maximise the last variable subject to ``B x <= h``, for a stack of LPs.
 
@@ -161,6 +162,10 @@ def solve_max_last(
         optimal value once the residuals vanish).
     max_iter : int, optional
         Iteration cap per problem.
+    stop_below : float, optional
+        Stop a problem as soon as a dual certificate proves its optimum lies
+        below this value; its ``value`` is then that certified upper bound, not
+        the optimum.  (The closure LPs only need ``max(0, t*)``.)
 
     Returns
     -------
@@ -169,7 +174,10 @@ def solve_max_last(
     Notes
     -----
     Mehrotra's predictor–corrector method with separate primal and dual step
-    lengths.  Both directions of an iteration share one ``n × n`` normal matrix
+    lengths.  The certificate of ``stop_below``: the multipliers projected onto
+    ``Bᵀ λ = e``, ``λ' = λ + B (BᵀB)⁻¹ (e - Bᵀλ)``; when ``λ' >= 0``, weak
+    duality gives ``x*_{n-1} <= hᵀλ'``.  Both directions of an iteration share
+    one ``n × n`` normal matrix
     :math:`B^T \operatorname{diag}(\lambda/s) B` and its Cholesky factor.
     Converged problems are dropped from the stack, so late iterations cost only
     what the slow problems need.
@@ -184,7 +192,7 @@ def solve_max_last(
     B = np.ascontiguousarray(np.transpose(B, (2, 1, 0)), dtype=float)  # (n, r, K)
     h = np.ascontiguousarray(np.transpose(h), dtype=float)  # (r, K)
 
-    x, s, lam = _starting_point(B, h)
+    x, s, lam, L0 = _starting_point(B, h)
     idx = np.arange(K)
     hscale = 1.0 + np.abs(h).max(axis=0)
     for it in range(1, max_iter + 1):
@@ -199,11 +207,21 @@ def solve_max_last(
         err_d = np.abs(rd).max(axis=0) / hscale
         err_g = gap / (1.0 + np.abs(obj))
         done = (err_p <= tol) & (err_d <= tol) & (err_g <= tol)
+        below = np.zeros_like(done)
+        if stop_below is not None:
+            lam_f = lam + _mul(B, _cho_solve(L0, rp))
+            bound = np.einsum("rk,rk->k", h, lam_f)
+            below = (bound < stop_below) & (lam_f.min(axis=0) >= 0.0) & ~done
+            if below.any():
+                done |= below
+                x = x.copy()
+                x[-1, below] = bound[below]
         last = it == max_iter
         if last or done.any():
             if last:  # accept a last iterate that is close enough, flag the rest
                 loose = 1e3 * tol
                 ok = (err_p <= loose) & (err_d <= loose) & (err_g <= loose)
+                ok |= below
                 done[:] = True
             else:
                 ok = done
@@ -216,6 +234,7 @@ def solve_max_last(
             if not keep.any():
                 break
             idx, B, h, hscale = idx[keep], B[:, :, keep], h[:, keep], hscale[keep]
+            L0 = L0[:, :, keep]
             x, s, lam = x[:, keep], s[:, keep], lam[:, keep]
             rp, rd, sl, gap = rp[:, keep], rd[:, keep], sl[:, keep], gap[keep]
         mu = gap / r

@@ -243,7 +243,7 @@ def solve_margin_lp(
         else:
             W = _householder_complement(c)
             B = np.concatenate([-(A @ W), np.ones(h.shape + (1,))], axis=2)
-            sol = solve_max_last(B, h, tol=ipm_tol)
+            sol = solve_max_last(B, h, tol=ipm_tol, stop_below=0.0)
             t = sol.value
             converged[sel] = sol.converged
         d_star[sel] = N * np.maximum(t, 0.0)
