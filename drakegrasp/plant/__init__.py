@@ -1,0 +1,53 @@
+"""The Drake plant layer: models, scenes, contacts, Jacobians and grasp analysis.
+
+Everything here takes ``(plant, plant_context, ...)`` as Drake users expect and
+builds on the numpy core (:mod:`drakegrasp.contact`, :mod:`drakegrasp.grasp`,
+:mod:`drakegrasp.closure`); the core never imports this package.
+"""
+
+from drakegrasp.plant.analysis import (
+    GraspFromPlant,
+    GraspReport,
+    analyze_grasp,
+    grasp_from_plant,
+)
+from drakegrasp.plant.contacts import (
+    DEFAULT_DISTANCE_TOLERANCE,
+    PlantContact,
+    find_contacts,
+    hand_bodies,
+)
+from drakegrasp.plant.jacobians import (
+    hand_jacobian,
+    hand_velocity_indices,
+    signed_distance_jacobian,
+)
+from drakegrasp.plant.models import models_dir, register_models
+from drakegrasp.plant.scene import (
+    DEFAULT_SCENE,
+    Scene,
+    SceneInfo,
+    list_scenes,
+    load_scene,
+)
+
+__all__ = [
+    "DEFAULT_DISTANCE_TOLERANCE",
+    "DEFAULT_SCENE",
+    "GraspFromPlant",
+    "GraspReport",
+    "PlantContact",
+    "Scene",
+    "SceneInfo",
+    "analyze_grasp",
+    "find_contacts",
+    "grasp_from_plant",
+    "hand_bodies",
+    "hand_jacobian",
+    "hand_velocity_indices",
+    "list_scenes",
+    "load_scene",
+    "models_dir",
+    "register_models",
+    "signed_distance_jacobian",
+]

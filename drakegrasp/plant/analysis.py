@@ -1,0 +1,417 @@
+"""From a plant's configuration to a grasp and its full analysis.
+
+:func:`grasp_from_plant` turns the contacts that :func:`find_contacts` reads into
+the core's :class:`~drakegrasp.Grasp` (object frame O, reference point = the
+object body's origin) with the hand Jacobian ``J``, ``ψ`` and ``∂ψ/∂v``.
+:func:`analyze_grasp` adds the verdicts of the core: form closure (LP1), force
+closure on polyhedral cones with the hand check LP3, force closure on exact
+cones, and the antipodal test for two contacts.  The verdicts are the core's;
+nothing here re-decides them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import Context
+
+from drakegrasp.antipodal import is_antipodal
+from drakegrasp.closure import (
+    DEFAULT_TOL,
+    force_closure,
+    force_closure_exact,
+    form_closure,
+)
+from drakegrasp.contact import Contact, ContactModel
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.grasp import Grasp, grasp_matrix
+from drakegrasp.plant.contacts import (
+    DEFAULT_DISTANCE_TOLERANCE,
+    HandSpec,
+    PlantContact,
+    _scoped_name,
+    find_contacts,
+    hand_bodies,
+    resolve_object_body,
+)
+from drakegrasp.plant.jacobians import (
+    PLANES,
+    hand_jacobian,
+    hand_velocity_indices,
+    signed_distance_jacobian,
+)
+from drakegrasp.results import AntipodalResult, ClosureResult, _jsonable
+
+__all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
+
+PLANE_NORMAL_TOL = 1e-6
+"""A planar analysis needs every normal's out-of-plane component below this."""
+
+
+@dataclass(frozen=True, eq=False)
+class GraspFromPlant:
+    """A grasp read from a plant, with its Jacobians.
+
+    Attributes
+    ----------
+    grasp : Grasp
+        Contacts in the object body frame O; reference point = O's origin
+        (planar: the two in-plane coordinates).
+    contacts : tuple of PlantContact
+        The plant contacts, in the order of ``grasp.contacts``.
+    hand_jacobian : (M, n_h) float
+        ``J``: rows in the contact-frame components of ``G``'s columns, columns
+        the hand velocities ``hand_velocity_indices``.
+    hand_velocity_indices : (n_h,) int
+        Which plant velocities are the hand's.
+    psi : (N,) float
+        Signed distance of each contact, metres.
+    dpsi_dv : (N, nv) float
+        ``∂ψ/∂v`` over all plant velocities (``JacobianWrtVariable.kV``).
+    object_body : str
+        Scoped name of the object body (the frame O).
+    hand_bodies : tuple of str
+        Scoped names of the hand's bodies.
+    plane : str or None
+        Object-frame plane of a planar analysis (``"yz"``...), or None.
+    """
+
+    grasp: Grasp
+    contacts: tuple[PlantContact, ...]
+    hand_jacobian: np.ndarray
+    hand_velocity_indices: np.ndarray
+    psi: np.ndarray
+    dpsi_dv: np.ndarray
+    object_body: str
+    hand_bodies: tuple[str, ...]
+    plane: str | None
+
+    @property
+    def G(self) -> np.ndarray:
+        """Grasp matrix of :attr:`grasp`, (6, M) or (3, M)."""
+        return grasp_matrix(self.grasp)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {
+            "object_body": self.object_body,
+            "hand_bodies": list(self.hand_bodies),
+            "plane": self.plane,
+            "grasp": self.grasp.to_dict(),
+            "contacts": [c.to_dict() for c in self.contacts],
+            "psi": _jsonable(self.psi),
+            "hand_velocity_indices": self.hand_velocity_indices.tolist(),
+            "hand_jacobian": _jsonable(self.hand_jacobian),
+            "dpsi_dv": _jsonable(self.dpsi_dv),
+        }
+
+
+def _check_plane(plane: str | None) -> str | None:
+    if plane is None or plane in PLANES:
+        return plane
+    raise InvalidOptionError(
+        f"plane must be one of {sorted(PLANES)} (object-frame axes) or None, "
+        f"got {plane!r}"
+    )
+
+
+def _core_contact(
+    pc: PlantContact,
+    *,
+    plane: str | None,
+    mu: float,
+    model: ContactModel,
+    torsional_friction: float,
+) -> Contact:
+    position, normal = pc.p_OC, pc.nhat_O
+    if plane is not None:
+        axes = list(PLANES[plane])
+        off = ({0, 1, 2} - set(axes)).pop()
+        if abs(normal[off]) > PLANE_NORMAL_TOL:
+            raise InvalidOptionError(
+                f"contact of {pc.finger_body} at {np.round(position, 6).tolist()} has "
+                f"normal {np.round(normal, 6).tolist()}, which leaves the {plane} "
+                f"plane (component {normal[off]:.3g} along the plane's normal); the "
+                "grasp is not planar in that plane"
+            )
+        position, normal = position[axes], normal[axes]
+    return Contact(
+        position,
+        normal,
+        mu=mu,
+        model=model,
+        torsional_friction=torsional_friction,
+    )
+
+
+def grasp_from_plant(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    *,
+    object_body,
+    hand: HandSpec = None,
+    mu: float,
+    contact_model: ContactModel | str = ContactModel.HARD_FINGER,
+    torsional_friction: float | None = None,
+    distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
+    plane: str | None = None,
+    characteristic_length: float | None = None,
+    allow_penetration: bool = False,
+    patches: str = "vertices",
+) -> GraspFromPlant:
+    """The grasp that the plant's configuration makes, with ``J``, ``ψ``, ``∂ψ/∂v``.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized, registered with a ``SceneGraph``.
+    plant_context : Context
+        The plant's context (validated).
+    object_body : RigidBody, BodyIndex or str
+        The grasped object; its body frame O is the grasp frame and its origin
+        the reference point.
+    hand : ModelInstanceIndex, iterable of RigidBody, or None, optional
+        See :func:`drakegrasp.plant.hand_bodies`.
+    mu : float
+        Friction coefficient of every contact.
+    contact_model : ContactModel or str, optional
+        ``"frictionless"``, ``"hard_finger"`` (default) or ``"soft_finger"``.
+    torsional_friction : float, optional
+        ``ν`` of soft fingers; required (> 0) with ``"soft_finger"``.
+    distance_tolerance : float, optional
+        Contact when ``|ψ| <=`` this (metres, default 1e-4).
+    plane : {"xy", "yz", "zx"}, optional
+        Analyse a planar grasp in this plane of frame O (wrenches
+        ``[f_a, f_b, m]``); every contact normal must lie in the plane.
+    characteristic_length : float, optional
+        ``b`` of the grasp (default: farthest contact from O's origin).
+    allow_penetration, patches
+        Passed to :func:`drakegrasp.find_contacts`.
+
+    Returns
+    -------
+    GraspFromPlant
+
+    Raises
+    ------
+    NoContactsError, PenetrationError, ModelError, InvalidOptionError
+    """
+    plant.ValidateContext(plant_context)
+    plane = _check_plane(plane)
+    model = ContactModel.parse(contact_model)
+    if torsional_friction is None:
+        if model is ContactModel.SOFT_FINGER:
+            raise InvalidOptionError(
+                "contact_model='soft_finger' needs torsional_friction > 0 (the "
+                "moment about the normal is bounded by b * nu * f_n)"
+            )
+        torsional_friction = 0.0
+    if plane is not None and model is ContactModel.SOFT_FINGER:
+        raise InvalidOptionError(
+            "a planar analysis has no soft fingers (no moment about an in-plane "
+            "normal); use 'hard_finger' or 'frictionless'"
+        )
+    body = resolve_object_body(plant, object_body)
+    bodies = hand_bodies(plant, body, hand)
+    contacts = find_contacts(
+        plant,
+        plant_context,
+        object_body=body,
+        hand=bodies,
+        distance_tolerance=distance_tolerance,
+        allow_penetration=allow_penetration,
+        patches=patches,
+    )
+    core = [
+        _core_contact(
+            c, plane=plane, mu=mu, model=model, torsional_friction=torsional_friction
+        )
+        for c in contacts
+    ]
+    dim = 2 if plane is not None else 3
+    grasp = Grasp(
+        core,
+        reference_point=np.zeros(dim),
+        characteristic_length=characteristic_length,
+    )
+    indices = hand_velocity_indices(plant, bodies)
+    J = hand_jacobian(
+        plant,
+        plant_context,
+        contacts,
+        grasp,
+        object_body=body,
+        velocity_indices=indices,
+        plane=plane,
+    )
+    dpsi = signed_distance_jacobian(plant, plant_context, contacts, object_body=body)
+    return GraspFromPlant(
+        grasp=grasp,
+        contacts=tuple(contacts),
+        hand_jacobian=J,
+        hand_velocity_indices=indices,
+        psi=np.array([c.psi for c in contacts]),
+        dpsi_dv=dpsi,
+        object_body=_scoped_name(plant, body),
+        hand_bodies=tuple(_scoped_name(plant, b) for b in bodies),
+        plane=plane,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class GraspReport:
+    """Everything drakegrasp says about the grasp in a plant's configuration.
+
+    Attributes
+    ----------
+    data : GraspFromPlant
+        Grasp, contacts, ``J``, ``ψ`` and ``∂ψ/∂v``.
+    G : (6, M) or (3, M) float
+        Grasp matrix (object frame, moments about O's origin).
+    form_closure : ClosureResult
+        First-order form closure (LP1, frictionless).
+    force_closure : ClosureResult
+        Force closure on polyhedral cones (LP2) with the hand check LP3 on ``J``
+        (``force_closure.internal_forces``).
+    force_closure_exact : ClosureResult
+        Force closure on exact (second-order / planar) cones, with LP3.
+    antipodal : AntipodalResult or None
+        The antipodal test when there are exactly two contacts.
+    """
+
+    data: GraspFromPlant
+    G: np.ndarray
+    form_closure: ClosureResult
+    force_closure: ClosureResult
+    force_closure_exact: ClosureResult
+    antipodal: AntipodalResult | None
+
+    @property
+    def grasp(self) -> Grasp:
+        """The core grasp (object frame)."""
+        return self.data.grasp
+
+    @property
+    def contacts(self) -> tuple[PlantContact, ...]:
+        """The plant contacts, in grasp order."""
+        return self.data.contacts
+
+    @property
+    def J(self) -> np.ndarray:
+        """The hand Jacobian, (M, n_h)."""
+        return self.data.hand_jacobian
+
+    @property
+    def is_force_closure(self) -> bool:
+        """Polyhedral force closure with LP3 passing."""
+        return self.force_closure.is_closure
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary of the whole report."""
+        return {
+            **self.data.to_dict(),
+            "G": _jsonable(self.G),
+            "form_closure": self.form_closure.to_dict(),
+            "force_closure": self.force_closure.to_dict(),
+            "force_closure_exact": self.force_closure_exact.to_dict(),
+            "antipodal": None if self.antipodal is None else self.antipodal.to_dict(),
+        }
+
+    def __str__(self) -> str:
+        g = self.grasp
+        c0 = g.contacts[0]
+        kind = f"planar ({self.data.plane} plane of O)" if g.planar else "spatial"
+        friction = f"mu = {c0.mu:g}"
+        if c0.model is ContactModel.SOFT_FINGER:
+            friction += f", nu = {c0.torsional_friction:g}"
+        lines = [
+            f"Grasp of {self.data.object_body} — {g.num_contacts} contacts, {kind}, "
+            f"{c0.model.value}, {friction}",
+            "  frame O = the object body frame; moments about its origin; "
+            f"b = {g.characteristic_length * 1e3:.4g} mm",
+            f"  {'#':>2}  {'finger':<28} {'p_OC [mm]':<27} {'nhat_O':<25} psi [mm]",
+        ]
+        for i, pc in enumerate(self.contacts):
+            p = ", ".join(f"{x * 1e3:7.2f}" for x in pc.p_OC)
+            n = ", ".join(f"{x:6.3f}" for x in pc.nhat_O)
+            patch = (
+                "" if pc.patch_vertex is None else f"  (patch vertex {pc.patch_vertex})"
+            )
+            psi = f"{pc.psi * 1e3:+.1e}"
+            lines.append(f"  {i:>2}  {pc.finger_body:<28} ({p})  ({n})  {psi}{patch}")
+        rows, cols = self.G.shape
+        lines.append(
+            f"  G: {rows} x {cols}, rank {self.force_closure.rank}; "
+            f"J: {self.J.shape[0]} x {self.J.shape[1]} (hand velocities "
+            f"{self.data.hand_velocity_indices.tolist()})"
+        )
+        for result in (self.form_closure, self.force_closure, self.force_closure_exact):
+            lines += ["  " + line for line in str(result).splitlines()]
+        if self.antipodal is not None:
+            lines.append("  " + str(self.antipodal))
+        return "\n".join(lines)
+
+
+def analyze_grasp(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    *,
+    object_body,
+    hand: HandSpec = None,
+    mu: float,
+    contact_model: ContactModel | str = ContactModel.HARD_FINGER,
+    torsional_friction: float | None = None,
+    distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
+    plane: str | None = None,
+    characteristic_length: float | None = None,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    tol: float = DEFAULT_TOL,
+    allow_penetration: bool = False,
+    patches: str = "vertices",
+) -> GraspReport:
+    """Read the grasp from the plant and decide every closure property.
+
+    Parameters
+    ----------
+    plant, plant_context, object_body, hand, mu, contact_model,
+    torsional_friction, distance_tolerance, plane, characteristic_length,
+    allow_penetration, patches
+        As in :func:`grasp_from_plant`.
+    num_generators : int, optional
+        Generators of each polyhedral Coulomb cone (default 8).
+    tol : float, optional
+        Threshold on ``d*`` of every program (see :mod:`drakegrasp.closure`).
+
+    Returns
+    -------
+    GraspReport
+    """
+    data = grasp_from_plant(
+        plant,
+        plant_context,
+        object_body=object_body,
+        hand=hand,
+        mu=mu,
+        contact_model=contact_model,
+        torsional_friction=torsional_friction,
+        distance_tolerance=distance_tolerance,
+        plane=plane,
+        characteristic_length=characteristic_length,
+        allow_penetration=allow_penetration,
+        patches=patches,
+    )
+    grasp, J = data.grasp, data.hand_jacobian
+    antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
+    return GraspReport(
+        data=data,
+        G=grasp_matrix(grasp),
+        form_closure=form_closure(grasp, tol=tol),
+        force_closure=force_closure(
+            grasp, hand_jacobian=J, num_generators=num_generators, tol=tol
+        ),
+        force_closure_exact=force_closure_exact(grasp, hand_jacobian=J, tol=tol),
+        antipodal=antipodal,
+    )

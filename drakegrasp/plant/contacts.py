@@ -1,0 +1,554 @@
+r"""Contacts between a hand and an object, read from a ``MultibodyPlant``.
+
+For every pair (object collision geometry, hand collision geometry) the plant's
+scene-graph query port gives the signed distance ``ψ`` and the witness points
+``Ca`` (on the object) and ``Cb`` (on the finger), with
+``p_Ca − p_Cb = ψ n̂`` and ``n̂`` pointing from the finger into the object.  A
+pair is a contact when ``|ψ| <= distance_tolerance``.
+
+**Normals.**  Drake guarantees the witness normal at ``ψ = 0`` only for a few
+shape pairs, so the normal is derived from the shapes themselves: the object's
+outward face normal at ``Ca`` (negated) when the object is smooth or on a face
+there; else the finger's outward normal at ``Cb`` when the finger is smooth
+there (a rounded fingertip on a box edge); else the direction ``Ca − Cb`` when
+``ψ`` is clearly non-zero; else Drake's ``nhat_BA_W``.  ``PlantContact.normal_source``
+says which.
+
+**Flat patches.**  A flat pad on a flat face touches along an area, for which
+Drake reports a single witness point somewhere in the patch.  When both surfaces
+are flat faces of boxes or convex meshes with opposite normals (within
+:data:`PATCH_ANGLE_TOL`), drakegrasp intersects the two face polygons in the
+contact plane, keeps the part where the gap between the faces is within the
+distance tolerance, and reports one contact at **each vertex** of that patch
+polygon (same normal; ``ψ`` the gap at the vertex).  A square pad on a box face
+thus gives four contacts, so the pad's resistance to torsion and tilt appears in
+the analysis, as a user would expect.  Patches on a cylinder's flat cap (a disc)
+are reported as the single witness point.  ``patches="witness"`` turns patch
+handling off.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.geometry import GeometryId, QueryObject, SceneGraphInspector
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
+from pydrake.systems.framework import Context
+
+from drakegrasp.errors import (
+    InvalidOptionError,
+    ModelError,
+    NoContactsError,
+    PenetrationError,
+)
+from drakegrasp.plant._shapes import (
+    ON_SURFACE_TOL,
+    SurfacePiece,
+    plane_basis,
+    surface_pieces,
+)
+
+__all__ = [
+    "DEFAULT_DISTANCE_TOLERANCE",
+    "PATCH_ANGLE_TOL",
+    "PlantContact",
+    "find_contacts",
+    "hand_bodies",
+    "resolve_object_body",
+]
+
+DEFAULT_DISTANCE_TOLERANCE = 1e-4
+"""Default ``|ψ|`` (metres) below which a geometry pair counts as a contact."""
+
+PATCH_ANGLE_TOL = np.radians(2.0)
+"""Two flat faces whose normals are opposite within this angle (rad) form a patch."""
+
+HandSpec = ModelInstanceIndex | Iterable[RigidBody] | None
+
+
+@dataclass(frozen=True, eq=False)
+class PlantContact:
+    """One contact between a finger geometry and the object.
+
+    Attributes
+    ----------
+    p_OC : (3,) float
+        Contact point on the object's surface, metres, in the object body frame O.
+    nhat_O : (3,) float
+        Unit contact normal pointing into the object, in frame O.
+    psi : float
+        Signed distance ``ψ`` (metres): > 0 separated, < 0 penetrating.
+    p_FC : (3,) float
+        The finger's witness point (``p_OC − ψ nhat``) in the finger body's frame
+        F: the material point of the finger that touches the object.
+    finger_body : str
+        Scoped name ``model::body`` of the finger body.
+    finger_body_index : BodyIndex
+    object_geometry, finger_geometry : GeometryId
+        The geometry pair.
+    object_geometry_name, finger_geometry_name : str
+        Their names in the scene graph.
+    normal_source : str
+        Where the normal came from: ``"object"``, ``"finger"``, ``"patch"``,
+        ``"witness points"`` or ``"drake"`` (see the module docstring).
+    patch_vertex : int or None
+        Index of this contact among the vertices of a flat patch, or None for a
+        point contact.
+    """
+
+    p_OC: np.ndarray
+    nhat_O: np.ndarray
+    psi: float
+    p_FC: np.ndarray
+    finger_body: str
+    finger_body_index: BodyIndex
+    object_geometry: GeometryId
+    finger_geometry: GeometryId
+    object_geometry_name: str
+    finger_geometry_name: str
+    normal_source: str
+    patch_vertex: int | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (geometry ids as their integer values)."""
+        return {
+            "p_OC": self.p_OC.tolist(),
+            "nhat_O": self.nhat_O.tolist(),
+            "psi": self.psi,
+            "p_FC": self.p_FC.tolist(),
+            "finger_body": self.finger_body,
+            "object_geometry": self.object_geometry_name,
+            "finger_geometry": self.finger_geometry_name,
+            "normal_source": self.normal_source,
+            "patch_vertex": self.patch_vertex,
+        }
+
+    def __repr__(self) -> str:
+        patch = (
+            "" if self.patch_vertex is None else f", patch vertex {self.patch_vertex}"
+        )
+        return (
+            f"PlantContact({self.finger_body}: p_OC={np.round(self.p_OC, 6).tolist()}, "
+            f"nhat_O={np.round(self.nhat_O, 6).tolist()}, psi={self.psi:.3g}{patch})"
+        )
+
+
+def _scoped_name(plant: MultibodyPlant, body: RigidBody) -> str:
+    return f"{plant.GetModelInstanceName(body.model_instance())}::{body.name()}"
+
+
+def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
+    """The object body given as a ``RigidBody``, a ``BodyIndex`` or a scoped name."""
+    if isinstance(object_body, RigidBody):
+        return object_body
+    if isinstance(object_body, BodyIndex):
+        return plant.get_body(object_body)
+    if isinstance(object_body, str):
+        from drakegrasp.plant.scene import resolve_body
+
+        return resolve_body(plant, object_body)
+    raise InvalidOptionError(
+        "object_body must be a RigidBody, a BodyIndex or a 'model::body' name, "
+        f"got {type(object_body).__name__}"
+    )
+
+
+def hand_bodies(
+    plant: MultibodyPlant, object_body: RigidBody, hand: HandSpec = None
+) -> list[RigidBody]:
+    """The bodies that make up the hand.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    object_body : RigidBody
+    hand : ModelInstanceIndex, iterable of RigidBody (or scoped names), or None
+        A model instance (all its bodies that are not welded to the world), an
+        explicit list of bodies, or None: every body that is not the object,
+        not welded to the world and not in the object's model instance.
+
+    Returns
+    -------
+    list of RigidBody
+        In body-index order.
+    """
+    welded_to_world = {b.index() for b in plant.GetBodiesWeldedTo(plant.world_body())}
+    if isinstance(hand, ModelInstanceIndex):
+        bodies = [plant.get_body(i) for i in plant.GetBodyIndices(hand)]
+        bodies = [b for b in bodies if b.index() not in welded_to_world]
+    elif hand is None:
+        bodies = [
+            plant.get_body(BodyIndex(i))
+            for i in range(plant.num_bodies())
+            if BodyIndex(i) not in welded_to_world
+        ]
+        bodies = [
+            b for b in bodies if b.model_instance() != object_body.model_instance()
+        ]
+    else:
+        bodies = [resolve_object_body(plant, b) for b in hand]
+    bodies = [b for b in bodies if b.index() != object_body.index()]
+    if not bodies:
+        raise ModelError(
+            f"the hand has no bodies that can move (hand={hand!r}); name its model "
+            "instance or list its bodies"
+        )
+    return sorted(bodies, key=lambda b: int(b.index()))
+
+
+def _rotation(X) -> np.ndarray:
+    return X.rotation().matrix()
+
+
+def _pieces_in(
+    inspector: SceneGraphInspector, gid: GeometryId, p_GC: np.ndarray
+) -> list[SurfacePiece]:
+    return surface_pieces(inspector.GetShape(gid), p_GC)
+
+
+def _clip(poly: np.ndarray, a: np.ndarray, b: float) -> np.ndarray:
+    """Clip a 2-D polygon (k, 2) to the half-plane ``a·x <= b``."""
+    if len(poly) == 0:
+        return poly
+    out = []
+    for i in range(len(poly)):
+        p, q = poly[i], poly[(i + 1) % len(poly)]
+        fp, fq = a @ p - b, a @ q - b
+        if fp <= 0:
+            out.append(p)
+        if fp * fq < 0:
+            t = fp / (fp - fq)
+            out.append(p + t * (q - p))
+    return np.array(out).reshape(-1, 2)
+
+
+def _ccw(poly: np.ndarray) -> np.ndarray:
+    area = 0.5 * np.sum(
+        poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1]
+    )
+    return poly if area >= 0 else poly[::-1]
+
+
+def _clip_convex(subject: np.ndarray, clipper: np.ndarray) -> np.ndarray:
+    """Intersection of two convex 2-D polygons (Sutherland–Hodgman)."""
+    clipper = _ccw(clipper)
+    out = _ccw(subject)
+    for i in range(len(clipper)):
+        p, q = clipper[i], clipper[(i + 1) % len(clipper)]
+        edge = q - p
+        outward = np.array([edge[1], -edge[0]])  # right of a CCW edge is outside
+        out = _clip(out, outward, outward @ p)
+    return out
+
+
+def _dedupe(points: np.ndarray, tol: float) -> np.ndarray:
+    keep: list[np.ndarray] = []
+    for p in points:
+        if all(np.linalg.norm(p - k) > tol for k in keep):
+            keep.append(p)
+    return np.array(keep).reshape(-1, points.shape[1])
+
+
+def _patch(
+    *,
+    n_O: np.ndarray,
+    poly_obj_O: np.ndarray,
+    poly_fin_O: np.ndarray,
+    plane_point_obj_O: np.ndarray,
+    finger_normal_O: np.ndarray,
+    plane_point_fin_O: np.ndarray,
+    tol: float,
+) -> list[tuple[np.ndarray, float]]:
+    """Vertices (on the object face, frame O) of a flat patch and their gaps ψ.
+
+    ``n_O`` is the inward contact normal (minus the object face's normal).  The
+    gap at a point x of the object face is the distance along ``-n`` to the
+    finger face's plane.
+    """
+    u, w = plane_basis(n_O)
+    origin = plane_point_obj_O
+
+    def to2(P):
+        d = P - origin
+        return np.column_stack([d @ u, d @ w])
+
+    inter = _clip_convex(to2(poly_fin_O), to2(poly_obj_O))
+    # gap(x) = (x - p_fin) · m / (-n · m), with m the finger face's outward
+    # normal; it is affine in the 2-D coordinates: g0 + g · x2.
+    denom = float(-(n_O @ finger_normal_O))
+    g0 = float((origin - plane_point_fin_O) @ finger_normal_O) / denom
+    g = np.array([u @ finger_normal_O, w @ finger_normal_O]) / denom
+    inter = _clip(inter, g, tol - g0)
+    inter = _dedupe(inter, 1e-9)
+    return [(origin + x[0] * u + x[1] * w, g0 + float(g @ x)) for x in inter]
+
+
+def find_contacts(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    *,
+    object_body,
+    hand: HandSpec = None,
+    distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
+    allow_penetration: bool = False,
+    patches: str = "vertices",
+) -> list[PlantContact]:
+    """Contacts between the hand and the object in the plant's configuration.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        A finalized plant registered with a ``SceneGraph``.
+    plant_context : Context
+        The plant's context (validated).
+    object_body : RigidBody, BodyIndex or str
+        The grasped object (a ``"model::body"`` name is accepted).
+    hand : ModelInstanceIndex, iterable of RigidBody, or None, optional
+        See :func:`hand_bodies`.
+    distance_tolerance : float, optional
+        A pair is a contact when ``|ψ| <= distance_tolerance`` (metres, default
+        1e-4).
+    allow_penetration : bool, optional
+        If False (default), a pair with ``ψ < -distance_tolerance`` raises
+        :class:`~drakegrasp.PenetrationError`; if True it is reported as a contact.
+    patches : {"vertices", "witness"}, optional
+        How a flat-on-flat patch is reported: one contact per patch vertex
+        (default) or Drake's single witness point.
+
+    Returns
+    -------
+    list of PlantContact
+        Ordered by finger body index, then by geometry registration order, then
+        by patch vertex.  Positions and normals are in the object body frame.
+
+    Raises
+    ------
+    NoContactsError
+        If no pair is within the tolerance; names the object, the closest
+        finger geometry and its distance.
+    PenetrationError
+        If a pair penetrates deeper than the tolerance (unless allowed); names
+        the pair and its depth.
+    ModelError
+        If the plant has no scene graph, or a geometry's shape is unsupported.
+    """
+    plant.ValidateContext(plant_context)
+    tol = float(distance_tolerance)
+    if not np.isfinite(tol) or tol <= 0:
+        raise InvalidOptionError(
+            "distance_tolerance must be finite and > 0 (metres), got "
+            f"{distance_tolerance!r}"
+        )
+    if patches not in ("vertices", "witness"):
+        raise InvalidOptionError(
+            f"patches must be 'vertices' or 'witness', got {patches!r}"
+        )
+    body = resolve_object_body(plant, object_body)
+    fingers = hand_bodies(plant, body, hand)
+    if not plant.geometry_source_is_registered():
+        raise ModelError("the plant is not registered with a SceneGraph; no geometry")
+    query: QueryObject = plant.get_geometry_query_input_port().Eval(plant_context)
+    inspector = query.inspector()
+    object_geometries = plant.GetCollisionGeometriesForBody(body)
+    object_name = _scoped_name(plant, body)
+    if not object_geometries:
+        raise ModelError(f"the object body {object_name!r} has no collision geometry")
+    X_WO = plant.EvalBodyPoseInWorld(plant_context, body)
+    X_OW = X_WO.inverse()
+    R_OW = _rotation(X_OW)
+
+    def to_O(p_W):
+        return np.asarray(X_OW.multiply(p_W))
+
+    contacts: list[PlantContact] = []
+    penetrations: list[str] = []
+    closest: tuple[float, str] | None = None
+    for finger in fingers:
+        finger_name = _scoped_name(plant, finger)
+        X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
+        for gf in plant.GetCollisionGeometriesForBody(finger):
+            for go in object_geometries:
+                if inspector.CollisionFiltered(go, gf):
+                    continue
+                try:
+                    r = query.ComputeSignedDistancePairClosestPoints(go, gf)
+                except RuntimeError as e:
+                    shapes = [type(inspector.GetShape(g)).__name__ for g in (go, gf)]
+                    raise ModelError(
+                        "Drake cannot compute the signed distance between "
+                        f"{inspector.GetName(go)!r} ({shapes[0]}) and "
+                        f"{inspector.GetName(gf)!r} ({shapes[1]}): {e}"
+                    ) from None
+                if r.id_A == go:
+                    p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
+                else:  # Drake swapped the pair: normal now points into the finger
+                    p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
+                psi = float(r.distance)
+                finger_geom = f"{finger_name} ({inspector.GetName(gf)})"
+                pair = f"{object_name} ({inspector.GetName(go)}) and {finger_geom}"
+                if closest is None or psi < closest[0]:
+                    closest = (psi, finger_geom)
+                if psi < -tol and not allow_penetration:
+                    penetrations.append(f"{pair} penetrate by {-psi * 1e3:.4g} mm")
+                    continue
+                if abs(psi) > tol and not (allow_penetration and psi < 0):
+                    continue
+                contacts += _pair_contacts(
+                    query=query,
+                    inspector=inspector,
+                    go=go,
+                    gf=gf,
+                    p_GaCa=np.asarray(p_GaCa),
+                    p_GbCb=np.asarray(p_GbCb),
+                    nhat_W=np.asarray(nhat_W),
+                    psi=psi,
+                    to_O=to_O,
+                    R_OW=R_OW,
+                    X_FO=X_WF.inverse().multiply(X_WO),
+                    finger=finger,
+                    finger_name=finger_name,
+                    tol=tol,
+                    patches=patches,
+                )
+    if penetrations:
+        raise PenetrationError(
+            f"penetration deeper than distance_tolerance = {tol:g} m: "
+            + "; ".join(penetrations)
+        )
+    if not contacts:
+        if closest is None:
+            raise NoContactsError(
+                f"the hand has no collision geometry that can touch {object_name!r}"
+            )
+        raise NoContactsError(
+            f"the hand does not touch {object_name!r}: the closest finger geometry "
+            f"is {closest[1]} at {closest[0] * 1e3:.4g} mm (distance_tolerance "
+            f"{tol * 1e3:g} mm)"
+        )
+    return _dedupe_contacts(contacts)
+
+
+def _dedupe_contacts(contacts: list[PlantContact]) -> list[PlantContact]:
+    out: list[PlantContact] = []
+    for c in contacts:
+        if any(
+            c.finger_body_index == k.finger_body_index
+            and np.linalg.norm(c.p_OC - k.p_OC) < ON_SURFACE_TOL
+            and c.nhat_O @ k.nhat_O > 1 - 1e-9
+            for k in out
+        ):
+            continue
+        out.append(c)
+    return out
+
+
+def _pair_contacts(
+    *,
+    query,
+    inspector,
+    go,
+    gf,
+    p_GaCa,
+    p_GbCb,
+    nhat_W,
+    psi,
+    to_O,
+    R_OW,
+    X_FO,
+    finger,
+    finger_name,
+    tol,
+    patches,
+) -> list[PlantContact]:
+    X_WGa = query.GetPoseInWorld(go)
+    X_WGb = query.GetPoseInWorld(gf)
+    R_OGa = R_OW @ _rotation(X_WGa)
+    R_OGb = R_OW @ _rotation(X_WGb)
+    p_OCa = to_O(X_WGa.multiply(p_GaCa))
+    p_OCb = to_O(X_WGb.multiply(p_GbCb))
+    obj_pieces = _pieces_in(inspector, go, p_GaCa)
+    fin_pieces = _pieces_in(inspector, gf, p_GbCb)
+
+    def finger_point(p_O):
+        return np.asarray(X_FO.multiply(p_O))
+
+    common = {
+        "finger_body": finger_name,
+        "finger_body_index": finger.index(),
+        "object_geometry": go,
+        "finger_geometry": gf,
+        "object_geometry_name": inspector.GetName(go),
+        "finger_geometry_name": inspector.GetName(gf),
+    }
+    if patches == "vertices":
+        for po in obj_pieces:
+            if po.polygon_G is None:
+                continue
+            m_O = R_OGa @ po.normal_G  # object's outward face normal
+            for pf in fin_pieces:
+                if pf.polygon_G is None:
+                    continue
+                f_O = R_OGb @ pf.normal_G  # finger's outward face normal
+                if m_O @ f_O > -np.cos(PATCH_ANGLE_TOL):
+                    continue
+                poly_obj = to_O_points(po.polygon_G, X_WGa, to_O)
+                poly_fin = to_O_points(pf.polygon_G, X_WGb, to_O)
+                n_O = -m_O
+                verts = _patch(
+                    n_O=n_O,
+                    poly_obj_O=poly_obj,
+                    poly_fin_O=poly_fin,
+                    plane_point_obj_O=poly_obj[0],
+                    finger_normal_O=f_O,
+                    plane_point_fin_O=poly_fin[0],
+                    tol=tol,
+                )
+                if len(verts) >= 2:
+                    return [
+                        PlantContact(
+                            p_OC=p,
+                            nhat_O=n_O,
+                            psi=gap,
+                            p_FC=finger_point(p - gap * n_O),
+                            normal_source="patch",
+                            patch_vertex=k,
+                            **common,
+                        )
+                        for k, (p, gap) in enumerate(verts)
+                    ]
+    if len(obj_pieces) == 1:
+        n_O, source = -(R_OGa @ obj_pieces[0].normal_G), "object"
+    elif len(fin_pieces) == 1:
+        n_O, source = R_OGb @ fin_pieces[0].normal_G, "finger"
+    elif abs(psi) > 1e-9:
+        d = p_OCa - p_OCb
+        n_O, source = d / np.linalg.norm(d) * np.sign(psi), "witness points"
+    else:
+        n_O, source = R_OW @ nhat_W, "drake"
+    n_O = n_O / np.linalg.norm(n_O)
+    return [
+        PlantContact(
+            p_OC=p_OCa,
+            nhat_O=n_O,
+            psi=psi,
+            p_FC=finger_point(p_OCb),
+            normal_source=source,
+            **common,
+        )
+    ]
+
+
+def to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
+    """Polygon vertices from a geometry frame to the object frame."""
+    return np.array([to_O(X_WG.multiply(p)) for p in poly_G])
+
+
+def contacts_by_finger(contacts: Sequence[PlantContact]) -> dict[str, list[int]]:
+    """Indices of the contacts of each finger body, by scoped body name."""
+    out: dict[str, list[int]] = {}
+    for i, c in enumerate(contacts):
+        out.setdefault(c.finger_body, []).append(i)
+    return out

@@ -1,0 +1,198 @@
+r"""Jacobians of a grasp read from a plant: ``∂ψ/∂v`` and the hand Jacobian ``J``.
+
+With ``n̂`` the contact normal (into the object), ``Ca`` the object's witness
+point and ``Cb`` the finger's, the signed distance changes as
+
+.. math:: \dot\psi_i = \hat n_i^T \big(v_{W\,Ca} - v_{W\,Cb}\big)
+          = \frac{\partial \psi_i}{\partial v}\, v,
+
+with ``v`` the plant's generalized velocities (Drake's ``JacobianWrtVariable.kV``;
+a floating object has 7 positions and 6 velocities, so ``∂ψ/∂v`` is not
+``∂ψ/∂q``).  The hand Jacobian maps the hand's velocities to the velocities of
+the finger points ``Cb`` in each contact frame, component by component in the
+order of the grasp matrix's columns (a soft finger adds the finger's angular
+velocity about ``n̂``):
+
+.. math:: J_i = \begin{bmatrix} R_i^T J_{v,Cb} \\ \hat n_i^T J_{\omega,F}
+          \end{bmatrix}_{\text{model components}}, \qquad G^T \nu = J \dot q_h
+
+All vectors are expressed in the object body frame O.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import JacobianWrtVariable, JointIndex, RigidBody
+from pydrake.systems.framework import Context
+
+from drakegrasp.contact import ContactModel
+from drakegrasp.grasp import Grasp
+from drakegrasp.plant.contacts import PlantContact
+
+__all__ = [
+    "PLANES",
+    "hand_jacobian",
+    "hand_velocity_indices",
+    "signed_distance_jacobian",
+]
+
+PLANES = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
+"""Planes of the object frame for a planar analysis: name -> the two axes.
+
+Each pair is ordered so that the plane's normal (the moment axis) is the third
+axis of a right-handed frame: ``"yz"`` gives wrenches ``[f_y, f_z, m_x]``.
+"""
+
+
+def hand_velocity_indices(
+    plant: MultibodyPlant, bodies: Iterable[RigidBody]
+) -> np.ndarray:
+    """Plant velocity indices of the joints that move the given bodies.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    bodies : iterable of RigidBody
+        The hand's bodies (see :func:`drakegrasp.plant.hand_bodies`).
+
+    Returns
+    -------
+    (n_h,) int
+        Sorted indices into ``v`` of every joint whose child is one of the bodies.
+    """
+    wanted = {int(b.index()) for b in bodies}
+    out: list[int] = []
+    for i in range(plant.num_joints()):
+        joint = plant.get_joint(JointIndex(i))
+        if int(joint.child_body().index()) in wanted:
+            start = joint.velocity_start()
+            out += range(start, start + joint.num_velocities())
+    return np.array(sorted(out), dtype=int)
+
+
+def _translational(plant, context, body: RigidBody, points_B: np.ndarray, frame_O):
+    """(3k, nv) Jacobian of points fixed in ``body``, world velocity, in O."""
+    return plant.CalcJacobianTranslationalVelocity(
+        context,
+        JacobianWrtVariable.kV,
+        body.body_frame(),
+        np.asarray(points_B, dtype=float).T.reshape(3, -1),
+        plant.world_frame(),
+        frame_O,
+    )
+
+
+def _finger_jacobians(plant, context, contacts, frame_O):
+    """Per contact: (3, nv) translational Jacobian of its finger point, in O."""
+    out: list[np.ndarray | None] = [None] * len(contacts)
+    groups: dict[int, list[int]] = {}
+    for i, c in enumerate(contacts):
+        groups.setdefault(int(c.finger_body_index), []).append(i)
+    for idx in groups.values():
+        body = plant.get_body(contacts[idx[0]].finger_body_index)
+        points = np.array([contacts[i].p_FC for i in idx])
+        Jv = _translational(plant, context, body, points, frame_O)
+        for k, i in enumerate(idx):
+            out[i] = Jv[3 * k : 3 * k + 3]
+    return out
+
+
+def signed_distance_jacobian(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    contacts: Sequence[PlantContact],
+    *,
+    object_body: RigidBody,
+) -> np.ndarray:
+    """``∂ψ/∂v``: one row per contact, one column per plant velocity.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    plant_context : Context
+        Validated; the configuration the contacts were found in.
+    contacts : sequence of PlantContact
+        From :func:`drakegrasp.find_contacts` (object frame O).
+    object_body : RigidBody
+
+    Returns
+    -------
+    (N, nv) float
+        ``ψ̇ = (∂ψ/∂v) v`` (metres per unit velocity; ``JacobianWrtVariable.kV``).
+    """
+    plant.ValidateContext(plant_context)
+    frame_O = object_body.body_frame()
+    points_O = np.array([c.p_OC for c in contacts])
+    J_obj = _translational(plant, plant_context, object_body, points_O, frame_O)
+    J_fin = _finger_jacobians(plant, plant_context, contacts, frame_O)
+    rows = []
+    for i, c in enumerate(contacts):
+        rows.append(c.nhat_O @ (J_obj[3 * i : 3 * i + 3] - J_fin[i]))
+    return np.array(rows).reshape(len(contacts), plant.num_velocities())
+
+
+def hand_jacobian(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    contacts: Sequence[PlantContact],
+    grasp: Grasp,
+    *,
+    object_body: RigidBody,
+    velocity_indices: np.ndarray,
+    plane: str | None = None,
+) -> np.ndarray:
+    """The hand Jacobian ``J`` in the grasp's contact frames.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    plant_context : Context
+    contacts : sequence of PlantContact
+        The plant contacts, in the order of ``grasp.contacts``.
+    grasp : Grasp
+        The grasp built from them (its contact frames and models set the rows).
+    object_body : RigidBody
+        Frame O in which everything is expressed.
+    velocity_indices : (n_h,) int
+        Plant velocities that are the hand's (the columns of ``J``).
+    plane : {"xy", "yz", "zx"} or None, optional
+        For a planar grasp: the object-frame plane the contacts live in.
+
+    Returns
+    -------
+    J : (M, n_h) float
+        ``M`` = the number of columns of ``G``; row blocks follow the contact
+        order, each in the contact's components ``[n, t1, t2(, m_n)]`` (planar
+        ``[n, t]``; frictionless ``[n]``).  Velocities in m/s (rad/s for the
+        soft-finger row) per unit hand velocity.
+    """
+    plant.ValidateContext(plant_context)
+    frame_O = object_body.body_frame()
+    cols = np.asarray(velocity_indices, dtype=int)
+    J_fin = _finger_jacobians(plant, plant_context, contacts, frame_O)
+    blocks = []
+    for i, (pc, c) in enumerate(zip(contacts, grasp.contacts, strict=True)):
+        Jv = J_fin[i][:, cols]
+        if plane is not None:
+            Jv = Jv[list(PLANES[plane]), :]
+        R = c.frame
+        k = c.num_components
+        if c.model is ContactModel.FRICTIONLESS:
+            blocks.append(R[:, :1].T @ Jv)
+            continue
+        block = R.T @ Jv
+        if k == 4:
+            body = plant.get_body(pc.finger_body_index)
+            Jw = plant.CalcJacobianAngularVelocity(
+                plant_context,
+                JacobianWrtVariable.kV,
+                body.body_frame(),
+                plant.world_frame(),
+                frame_O,
+            )[:, cols]
+            block = np.vstack([block, pc.nhat_O @ Jw])
+        blocks.append(block)
+    return np.vstack(blocks).reshape(grasp.num_components, cols.size)
