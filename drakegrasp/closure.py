@@ -289,7 +289,11 @@ def build_force_closure_program(
     _add_margin_rows(prog, np.eye(S.shape[1]), lam, d)
     # Every generator has unit normal component, so Σ f_n = Σ λ.
     _add_normal_budget(prog, lam, N)
-    return prog, ProgramVariables(d, S @ lam, layout.columns, weights=lam, generators=S)
+    # Object-dtype matmul can re-raise a floating-point flag left set by a
+    # previous native solve; symbolic products themselves cannot be invalid.
+    with np.errstate(invalid="ignore"):
+        forces = S @ lam
+    return prog, ProgramVariables(d, forces, layout.columns, weights=lam, generators=S)
 
 
 def build_exact_force_closure_program(
@@ -539,7 +543,18 @@ def _force_closure_result(
     G = grasp_matrix(grasp)[:, variables.columns]
     rank = matrix_rank(G, rank_tol=rank_tol)
     d_star, forces, solver, status = _solve_margin(prog, variables, conic=conic)
+    contact_forces = _split_forces(grasp, variables.columns, forces)
+    margin = _relative_margin(d_star, tol)
     frictional = bool(rank == required and d_star > tol)
+    certificate = "d*"
+    if rank == required and not frictional:
+        # d is a distance to the cone boundaries, so it vanishes with μ.  Normal
+        # forces alone (f_t = 0) lie inside every cone with μ > 0: if they
+        # balance with f_n > tol, the grasp is in force closure for any μ.
+        normal = _normal_force_certificate(grasp, variables.columns, tol=tol)
+        if normal is not None:
+            frictional, certificate = True, "normal forces"
+            margin, contact_forces = normal
     lp3 = None
     if hand_jacobian is not None:
         lp3 = internal_forces(grasp, hand_jacobian, tol=tol, rank_tol=rank_tol)
@@ -549,15 +564,34 @@ def _force_closure_result(
         d_star=d_star,
         rank=rank,
         required_rank=required,
-        margin=_relative_margin(d_star, tol),
-        contact_forces=_split_forces(grasp, variables.columns, forces),
+        margin=margin,
+        contact_forces=contact_forces,
         solver=solver,
         status=status,
         tol=tol,
         formulation=formulation,
         frictional_closure=frictional,
         internal_forces=lp3,
+        certificate=certificate,
     )
+
+
+def _normal_force_certificate(
+    grasp: Grasp, columns: np.ndarray, *, tol: float
+) -> tuple[float, tuple[np.ndarray, ...]] | None:
+    """LP1 on the contacts' normals, when some contact has friction.
+
+    Returns the margin of LP1's ``d*`` and its forces (tangential parts zero) when
+    ``d* > tol``, else None.
+    """
+    normals = grasp.normal_indices()
+    if len(columns) == len(normals):  # every contact is frictionless already
+        return None
+    prog, variables = build_form_closure_program(grasp)
+    d_star, f_n, _, _ = _solve_margin(prog, variables, conic=False)
+    if not d_star > tol:
+        return None
+    return _relative_margin(d_star, tol), _split_forces(grasp, normals, f_n)
 
 
 def force_closure(

@@ -81,23 +81,44 @@ def _circle_generators(mu: float, n_g: int) -> np.ndarray:
     return np.vstack([np.ones(n_g), mu * np.cos(angles), mu * np.sin(angles)])
 
 
-def _pyramid_facets(S: np.ndarray) -> np.ndarray:
-    rows = np.cross(S.T, np.roll(S, -1, axis=1).T)
-    return rows / np.linalg.norm(rows, axis=1, keepdims=True)
+def _facet_directions(n_g: int) -> np.ndarray:
+    """Unit tangent directions ``u_k`` bisecting generators ``k`` and ``k + 1``."""
+    phi = 2.0 * np.pi * (np.arange(1, n_g + 1) + 0.5) / n_g
+    return np.column_stack([np.cos(phi), np.sin(phi)])
 
 
-def _bipyramid_facets(S: np.ndarray, torsion: float) -> np.ndarray:
-    """Facets of the soft-finger cone: triangles (s_k, s_{k+1}, apex±)."""
-    rows = []
-    for apex in (torsion, -torsion):
-        a = np.array([1.0, 0.0, 0.0, apex])
-        for k in range(S.shape[1]):
-            s0 = np.append(S[:, k], 0.0)
-            s1 = np.append(S[:, (k + 1) % S.shape[1]], 0.0)
-            _, _, vt = np.linalg.svd(np.vstack([s0, s1, a]))
-            row = vt[-1]
-            rows.append(row if row[0] > 0 else -row)
-    F = np.array(rows)
+def _pyramid_facets(mu: float, n_g: int) -> np.ndarray:
+    """Rows ``∝ s_k × s_{k+1}``: ``[μ cos(π/n_g), -u_k] / norm``.
+
+    Written in closed form rather than as cross products so that it stays exact
+    for any ``μ > 0`` (the cross product underflows for tiny ``μ``).
+    """
+    a = mu * np.cos(np.pi / n_g)
+    F = np.column_stack([np.full(n_g, a), -_facet_directions(n_g)])
+    return F / np.hypot(1.0, a)
+
+
+def _bipyramid_facets(mu: float, n_g: int, torsion: float) -> np.ndarray:
+    """Facets of the soft-finger cone: triangles (s_k, s_{k+1}, [1, 0, 0, ±τ]).
+
+    The facet through the ring edge ``k`` and the apex ``±τ`` is
+    ``μ c τ f_n - τ u_k·f_t ∓ μ c m_n >= 0`` with ``c = cos(π/n_g)``.
+    """
+    a = mu * np.cos(np.pi / n_g)
+    u = _facet_directions(n_g)
+    # Divided by max(a, τ) so that tiny μ or τ cannot underflow the products.
+    m = max(a, torsion)
+    rows = [
+        np.column_stack(
+            [
+                np.full(n_g, min(a, torsion)),
+                -(torsion / m) * u,
+                np.full(n_g, -s * a / m),
+            ]
+        )
+        for s in (1.0, -1.0)
+    ]
+    F = np.vstack(rows)
     return F / np.linalg.norm(F, axis=1, keepdims=True)
 
 
@@ -135,11 +156,11 @@ def effective_cone(
         S, F = _two_sided(_torsion_scale(contact, characteristic_length))
     elif comps == (0, 1, 2):
         S = _circle_generators(contact.mu, n_g)
-        F = _pyramid_facets(S)
+        F = _pyramid_facets(contact.mu, n_g)
     else:  # (0, 1, 2, 3)
         torsion = _torsion_scale(contact, characteristic_length)
         ring = _circle_generators(contact.mu, n_g)
-        F = _bipyramid_facets(ring, torsion)
+        F = _bipyramid_facets(contact.mu, n_g, torsion)
         apexes = np.array([[1.0, 1.0], [0, 0], [0, 0], [torsion, -torsion]])
         S = np.hstack([np.vstack([ring, np.zeros(n_g)]), apexes])
     return EffectiveCone(comps, S, F)

@@ -146,6 +146,14 @@ class ClosureResult:
         ``is_closure`` when no hand Jacobian was given).
     internal_forces : InternalForceResult or None
         LP3, when a hand Jacobian was given.
+    certificate : str
+        What proved the verdict: ``"d*"`` (the program's own ``d* > tol``, or
+        the lack of it) or ``"normal forces"``.  ``d`` is a distance to the cone
+        boundaries, so it vanishes as ``μ -> 0`` even for a grasp in form
+        closure; when ``G`` has full rank and ``d* <= tol``, force closure is
+        also proved by balancing normal forces with ``f_n > tol`` (LP1), which
+        lie inside every cone with ``μ > 0``.  Then ``margin`` and
+        ``contact_forces`` are LP1's, and ``d_star`` stays the program's.
     """
 
     kind: str
@@ -161,6 +169,7 @@ class ClosureResult:
     formulation: str
     frictional_closure: bool
     internal_forces: InternalForceResult | None = field(default=None)
+    certificate: str = "d*"
 
     @property
     def near_boundary(self) -> bool:
@@ -189,6 +198,8 @@ class ClosureResult:
             + ("  [within tol of the boundary]" if self.near_boundary else ""),
             f"  solver {self.solver} ({self.status}), {self.formulation}",
         ]
+        if self.certificate != "d*":
+            lines.insert(2, f"  proved by {self.certificate} (LP1), margin as LP1's")
         if self.internal_forces is not None:
             lines.append("  " + str(self.internal_forces))
         return "\n".join(lines)

@@ -1,0 +1,208 @@
+"""Textbook grasps with known answers, for demos, tutorials and tests (numpy only).
+
+Every function returns a :class:`~drakegrasp.Grasp` whose verdicts are known in
+closed form; the docstrings say what they are and why.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drakegrasp.contact import Contact, ContactModel
+from drakegrasp.grasp import Grasp
+
+__all__ = [
+    "cube_seven_contacts",
+    "equator_fingers",
+    "planar_square_four_contacts",
+    "planar_two_finger_square",
+    "spatial_two_fingers",
+]
+
+
+def planar_two_finger_square(
+    mu: float, *, half_width: float = 1.0, offset: float = 0.5
+) -> Grasp:
+    """Two planar hard fingers on opposite faces of a square, offset vertically.
+
+    The left finger touches ``(-h, -offset)`` and the right ``(h, offset)``, so
+    the line between them makes the angle ``atan(offset / h)`` with the normals
+    (``atan(1/2)`` by default).  Force closure and antipodality hold exactly when
+    ``mu > offset / h``.
+
+    Parameters
+    ----------
+    mu : float
+        Friction coefficient of both fingers.
+    half_width : float, optional
+        Half the side of the square ``h``, metres.
+    offset : float, optional
+        Vertical offset of each finger from the centre, metres.
+
+    Returns
+    -------
+    Grasp
+        Planar, reference point at the square's centre.
+    """
+    h = half_width
+    return Grasp(
+        [
+            Contact([-h, -offset], [1.0, 0.0], mu=mu),
+            Contact([h, offset], [-1.0, 0.0], mu=mu),
+        ]
+    )
+
+
+def planar_square_four_contacts(half_width: float = 1.0) -> Grasp:
+    """Four frictionless contacts in first-order form closure on a square.
+
+    Two contacts on the left/right faces at heights ``±h/2`` and two on the
+    top/bottom faces: the normal-force wrenches positively span the plane's
+    wrench space, the fewest contacts that can (Somov: 4 in the plane).
+
+    Parameters
+    ----------
+    half_width : float, optional
+        Half the side of the square, metres.
+
+    Returns
+    -------
+    Grasp
+        Planar, frictionless, reference point at the centre.
+    """
+    h = half_width
+    return Grasp(
+        [
+            Contact([h, h / 2], [-1, 0], model=ContactModel.FRICTIONLESS),
+            Contact([-h, -h / 2], [1, 0], model=ContactModel.FRICTIONLESS),
+            Contact([-h / 2, -h], [0, 1], model=ContactModel.FRICTIONLESS),
+            Contact([h / 2, h], [0, -1], model=ContactModel.FRICTIONLESS),
+        ]
+    )
+
+
+_CUBE_CONTACTS = (  # (position on the cube [-1, 1]^3, inward normal)
+    ((1.0, -0.5, 0.0), (-1, 0, 0)),
+    ((-1.0, 0.0, 0.0), (1, 0, 0)),
+    ((0.0, 1.0, 0.5), (0, -1, 0)),
+    ((0.5, -1.0, 0.0), (0, 1, 0)),
+    ((0.0, 0.0, 1.0), (0, 0, -1)),
+    ((-0.5, 0.0, -1.0), (0, 0, 1)),
+    ((0.5, -0.5, -1.0), (0, 0, 1)),
+)
+
+
+def cube_seven_contacts(half_width: float = 1.0) -> Grasp:
+    """Seven frictionless contacts in first-order form closure on a cube.
+
+    One contact on each face and a second one on the bottom face, placed so that
+    ``G_n`` has rank 6 and its one-dimensional null space is spanned by a
+    strictly positive vector: the fewest contacts that can immobilise a body in
+    space (Somov: 7).
+
+    Parameters
+    ----------
+    half_width : float, optional
+        Half the side of the cube, metres.
+
+    Returns
+    -------
+    Grasp
+        Spatial, frictionless, reference point at the centre.
+    """
+    return Grasp(
+        [
+            Contact(np.array(p) * half_width, n, model=ContactModel.FRICTIONLESS)
+            for p, n in _CUBE_CONTACTS
+        ]
+    )
+
+
+def equator_fingers(
+    mu: float,
+    *,
+    num_fingers: int = 3,
+    radius: float = 1.0,
+    model: ContactModel | str = ContactModel.HARD_FINGER,
+    torsional_friction: float = 0.0,
+) -> Grasp:
+    """Fingers evenly spaced on a sphere's equator, pushing towards the centre.
+
+    With three hard fingers 120° apart, any ``mu > 0`` gives force closure
+    (the three tangential planes contain the vertical; friction resists
+    vertical forces and moments); with ``mu = 0`` the normals all pass through
+    the centre and no moment can be resisted.
+
+    Parameters
+    ----------
+    mu : float
+    num_fingers : int, optional
+    radius : float, optional
+        Sphere radius, metres.
+    model : ContactModel or str, optional
+    torsional_friction : float, optional
+
+    Returns
+    -------
+    Grasp
+        Spatial, reference point at the sphere's centre.
+    """
+    angles = 2.0 * np.pi * np.arange(num_fingers) / num_fingers
+    contacts = []
+    for a in angles:
+        outward = np.array([np.cos(a), np.sin(a), 0.0])
+        contacts.append(
+            Contact(
+                radius * outward,
+                -outward,
+                mu=mu,
+                model=model,
+                torsional_friction=torsional_friction,
+            )
+        )
+    return Grasp(contacts)
+
+
+def spatial_two_fingers(
+    mu: float,
+    *,
+    half_width: float = 0.05,
+    model: ContactModel | str = ContactModel.HARD_FINGER,
+    torsional_friction: float = 0.0,
+) -> Grasp:
+    """Two fingers squeezing a box along x, as a parallel-jaw gripper does.
+
+    Hard fingers never give force closure (``rank G = 5``: nothing resists a
+    moment about the line between them); soft fingers with torsional friction
+    do.
+
+    Parameters
+    ----------
+    mu : float
+    half_width : float, optional
+        Half the box's width along x, metres.
+    model : ContactModel or str, optional
+    torsional_friction : float, optional
+
+    Returns
+    -------
+    Grasp
+    """
+    return Grasp(
+        [
+            Contact(
+                [-half_width, 0, 0],
+                [1, 0, 0],
+                mu=mu,
+                model=model,
+                torsional_friction=torsional_friction,
+            ),
+            Contact(
+                [half_width, 0, 0],
+                [-1, 0, 0],
+                mu=mu,
+                model=model,
+                torsional_friction=torsional_friction,
+            ),
+        ]
+    )

@@ -1,0 +1,74 @@
+import dataclasses
+
+import numpy as np
+import pytest
+
+import drakegrasp as dg
+
+
+def test_frame_is_a_right_handed_rotation_with_normal_first(rng):
+    normals = rng.normal(size=(200, 3))
+    normals = np.vstack([normals, np.eye(3), -np.eye(3), [[1, 1, 0], [1, 1, 1]]])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    R = dg.contact_frames(normals)
+    assert np.allclose(R @ np.swapaxes(R, 1, 2), np.eye(3), atol=1e-12)
+    assert np.allclose(np.linalg.det(R), 1.0)
+    assert np.allclose(R[:, :, 0], normals)
+    assert np.allclose(R[:, :, 2], np.cross(R[:, :, 0], R[:, :, 1]))
+
+
+def test_single_and_vectorised_frames_agree_and_depend_on_n_alone(rng):
+    for n in rng.normal(size=(20, 3)):
+        R = dg.contact_frame(n)
+        assert np.allclose(R, dg.contact_frame(3.0 * n), rtol=0, atol=1e-15)
+        unit = n / np.linalg.norm(n)
+        assert np.allclose(R, dg.contact_frames(unit[None])[0], rtol=0, atol=1e-15)
+
+
+def test_documented_tangent_choice():
+    # t1: projection of the axis where |n| is smallest (first on ties).
+    R = dg.contact_frame([0, 0, 1])
+    assert np.allclose(R[:, 1], [1, 0, 0]) and np.allclose(R[:, 2], [0, 1, 0])
+    n = np.array([-np.cos(0.3), -np.sin(0.3), 0.0])
+    assert np.allclose(dg.contact_frame(n)[:, 1], [0, 0, 1])
+
+
+def test_planar_frame():
+    n = np.array([0.6, 0.8])
+    R = dg.contact_frame(n)
+    assert np.allclose(R, [[0.6, -0.8], [0.8, 0.6]])
+    assert np.isclose(np.linalg.det(R), 1.0)
+
+
+def test_contact_normalises_and_is_immutable():
+    c = dg.Contact([1, 2, 3], [0, 0, -2], mu=0.4)
+    assert np.allclose(c.normal, [0, 0, -1])
+    with pytest.raises(ValueError):
+        c.position[0] = 5.0
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        c.mu = 1.0
+    assert c.component_names == ("f_n", "f_t1", "f_t2")
+    assert c.with_(mu=0.7).mu == 0.7 and c.mu == 0.4
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "expected"),
+    [
+        ({"model": "frictionless", "mu": 0.5}, (0,)),
+        ({"model": "hard_finger", "mu": 0.0}, (0,)),
+        ({"model": "hard_finger", "mu": 0.5}, (0, 1, 2)),
+        ({"model": "soft_finger", "mu": 0.5, "torsional_friction": 0.1}, (0, 1, 2, 3)),
+        ({"model": "soft_finger", "mu": 0.5}, (0, 1, 2)),
+        ({"model": "soft_finger", "mu": 0.0, "torsional_friction": 0.1}, (0, 3)),
+    ],
+)
+def test_effective_components(kwargs, expected):
+    c = dg.Contact([0, 0, 1], [0, 0, -1], **kwargs)
+    assert c.effective_components() == expected
+
+
+def test_model_enum_and_strings_are_interchangeable():
+    a = dg.Contact([0, 0], [1, 0], model=dg.ContactModel.FRICTIONLESS)
+    b = dg.Contact([0, 0], [1, 0], model="Frictionless")
+    assert a.model is b.model is dg.ContactModel.FRICTIONLESS
+    assert a.to_dict()["model"] == "frictionless"

@@ -1,0 +1,72 @@
+"""LP3: internal forces the hand can or cannot control."""
+
+import numpy as np
+import pytest
+
+import drakegrasp as dg
+from drakegrasp import examples as ex
+
+
+def _jacobian(grasp, rows_per_contact):
+    """J with one hand joint per contact, moving it along the given local rows."""
+    J = np.zeros((grasp.num_components, grasp.num_contacts))
+    for i, s in enumerate(grasp.component_slices()):
+        J[s, i] = rows_per_contact
+    return J
+
+
+def test_fingers_that_push_along_their_normals_control_the_squeeze():
+    grasp = ex.equator_fingers(0.5)
+    J = _jacobian(grasp, [1.0, 0.0, 0.0])
+    r = dg.force_closure(grasp, hand_jacobian=J)
+    assert r.is_closure and r.internal_forces.passes
+    assert r.internal_forces.null_space_dim == 0
+
+
+def test_fingers_that_only_slide_tangentially_cannot_squeeze():
+    grasp = ex.equator_fingers(0.5)
+    J = _jacobian(grasp, [0.0, 1.0, 0.0])  # joints move the tips along t1
+    r = dg.force_closure(grasp, hand_jacobian=J)
+    assert r.frictional_closure and not r.is_closure
+    lp3 = r.internal_forces
+    assert not lp3.passes and lp3.d_star > 0.1 and lp3.null_space_dim > 0
+    # The reported force is an uncontrollable internal force with f_n >= d*.
+    f = np.concatenate(lp3.contact_forces)
+    assert np.allclose(dg.grasp_matrix(grasp) @ f, 0, atol=1e-8)
+    assert np.allclose(J.T @ f, 0, atol=1e-8)
+    assert min(fi[0] for fi in lp3.contact_forces) >= lp3.d_star - 1e-9
+
+
+def test_one_actuator_closing_both_jaws_controls_the_squeeze():
+    grasp = ex.spatial_two_fingers(0.5, model="soft_finger", torsional_friction=0.3)
+    closing = np.zeros((8, 1))
+    closing[[0, 4], 0] = 1.0  # both fingers move along their normals together
+    assert dg.force_closure(grasp, hand_jacobian=closing).is_closure
+    # A joint that translates both jaws sideways together cannot squeeze.
+    sideways = np.zeros((8, 1))
+    sideways[[0, 4], 0] = [1.0, -1.0]
+    r = dg.force_closure(grasp, hand_jacobian=sideways)
+    assert r.frictional_closure and not r.is_closure
+
+
+def test_exact_cones_with_a_hand_jacobian():
+    grasp = ex.equator_fingers(0.5)
+    good = dg.force_closure_exact(grasp, hand_jacobian=_jacobian(grasp, [1, 0, 0]))
+    bad = dg.force_closure_exact(grasp, hand_jacobian=_jacobian(grasp, [0, 1, 0]))
+    assert good.is_closure and not bad.is_closure
+
+
+def test_null_space_dimension_matches_an_independent_count():
+    grasp = ex.equator_fingers(0.5)
+    J = _jacobian(grasp, [0.0, 1.0, 0.0])
+    G = dg.grasp_matrix(grasp)
+    # dim(N(G) ∩ N(J^T)) = dim N([G; J^T]) by SVD of the stacked matrix.
+    s = np.linalg.svd(np.vstack([G, J.T]), compute_uv=False)
+    expected = G.shape[1] - np.sum(s > 1e-9 * s[0])
+    assert dg.internal_forces(grasp, J).null_space_dim == expected
+
+
+def test_wrong_jacobian_shape_names_the_expected_shape():
+    grasp = ex.equator_fingers(0.5)
+    with pytest.raises(dg.InvalidGraspError, match=r"\(9, n_q\).*\(6, 3\)"):
+        dg.force_closure(grasp, hand_jacobian=np.zeros((6, 3)))

@@ -1,0 +1,49 @@
+"""The build_* functions return programs a user can inspect and extend."""
+
+import numpy as np
+from pydrake.solvers import ClpSolver
+
+import drakegrasp as dg
+from drakegrasp import examples as ex
+
+
+def test_lp2_program_shape_follows_the_conventions():
+    grasp = ex.equator_fingers(0.5)
+    prog, v = dg.build_force_closure_program(grasp, num_generators=8)
+    assert prog.num_vars() == 9 + 1 and len(v.forces) == 9
+    assert np.array_equal(v.columns, np.arange(9))
+    eq = prog.linear_equality_constraints()[0].evaluator()
+    assert np.allclose(eq.GetDenseA(), dg.grasp_matrix(grasp))
+    ineq = [c.evaluator() for c in prog.linear_constraints()]
+    assert sum(c.num_constraints() for c in ineq) == 3 * 8 + 1
+
+
+def test_mu_zero_contacts_have_no_tangential_variables():
+    grasp = ex.equator_fingers(0.0)
+    prog, v = dg.build_force_closure_program(grasp)
+    assert len(v.forces) == 3 and np.array_equal(v.columns, [0, 3, 6])
+
+
+def test_a_user_can_extend_and_solve_the_program():
+    grasp = ex.equator_fingers(0.5)
+    prog, v = dg.build_force_closure_program(grasp)
+    base = ClpSolver().Solve(prog)
+    prog.AddBoundingBoxConstraint(0, 0.2, v.forces[0])  # limit finger 0's push
+    limited = ClpSolver().Solve(prog)
+    assert limited.is_success()
+    assert limited.GetSolution(v.d) < base.GetSolution(v.d)
+    assert limited.GetSolution(v.forces[0]) <= 0.2 + 1e-9
+
+
+def test_lp1_lp3_and_socp_builders():
+    cube = ex.cube_seven_contacts()
+    prog, v = dg.build_form_closure_program(cube)
+    assert prog.num_vars() == 8 and len(v.forces) == 7
+    grasp = ex.equator_fingers(0.5)
+    prog, v = dg.build_internal_force_program(grasp, np.eye(9)[:, :3])
+    assert len(prog.linear_equality_constraints()) == 1
+    prog, v = dg.build_exact_force_closure_program(grasp)
+    assert len(prog.lorentz_cone_constraints()) == 3
+    soft = ex.spatial_two_fingers(0.5, model="soft_finger", torsional_friction=0.2)
+    prog, v = dg.build_exact_force_closure_program(soft)
+    assert len(prog.lorentz_cone_constraints()) == 4  # two per soft finger
