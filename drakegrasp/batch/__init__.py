@@ -19,6 +19,7 @@ from drakegrasp.batch.engine import (
     batch_force_closure,
     batch_form_closure,
 )
+from drakegrasp.batch.io import evaluate_file, read_grasps, write_result
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -26,4 +27,7 @@ __all__ = [
     "BatchClosureResult",
     "batch_force_closure",
     "batch_form_closure",
+    "evaluate_file",
+    "read_grasps",
+    "write_result",
 ]

@@ -347,7 +347,9 @@ def _singular_value_metrics(
     if "sigma_min" in wanted:
         out["sigma_min"][sl] = sv[:, -1]
     if "isotropy" in wanted:
-        out["isotropy"][sl] = sv[:, -1] / sv[:, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = sv[:, -1] / sv[:, 0]
+        out["isotropy"][sl] = np.where(sv[:, 0] > 0.0, ratio, 0.0)
     if "ellipsoid_volume" in wanted:
         out["ellipsoid_volume"][sl] = np.prod(sv, axis=1)
 

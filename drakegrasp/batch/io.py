@@ -1,0 +1,200 @@
+"""Files of grasps in, files of verdicts out (the ``drakegrasp batch`` command).
+
+Input: a ``.npz`` archive with arrays
+
+* ``positions`` (K, N, d) float, metres;
+* ``normals`` (K, N, d) float, pointing into the object;
+* optional ``mu`` (scalar, (K,) or (K, N)), ``torsional_friction`` (same
+  shapes), ``reference_points`` ((d,) or (K, d)) and ``characteristic_lengths``
+  (scalar or (K,)).
+
+Output: ``.npz`` with the per-grasp arrays of :class:`BatchClosureResult`
+(``is_closure``, ``d_star``, ``rank``, ``margin``, ``converged`` and the metrics)
+plus 0-d arrays ``kind``, ``tol`` and ``required_rank``; or ``.parquet`` (one row
+per grasp, the same columns) when the optional package ``pyarrow`` is installed.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from drakegrasp.batch.engine import (
+    DEFAULT_CHUNK_SIZE,
+    DEFAULT_RANK_TOL,
+    DEFAULT_TOL,
+    BatchClosureResult,
+    batch_force_closure,
+    batch_form_closure,
+)
+from drakegrasp.contact import ContactModel
+from drakegrasp.errors import InvalidOptionError
+
+__all__ = ["evaluate_file", "read_grasps", "write_result"]
+
+_OPTIONAL = ("mu", "torsional_friction", "reference_points", "characteristic_lengths")
+
+
+def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
+    """Read a ``.npz`` file of grasps.
+
+    Parameters
+    ----------
+    path : str or path-like
+        ``.npz`` archive with ``positions`` and ``normals`` and the optional
+        arrays listed in the module docstring.
+
+    Returns
+    -------
+    dict of str to ndarray
+        The arrays present, by name.
+    """
+    path = Path(path)
+    if path.suffix.lower() != ".npz":
+        raise InvalidOptionError(
+            f"input file {str(path)!r} must be a .npz archive (arrays positions, "
+            "normals and optionally mu, torsional_friction, reference_points, "
+            "characteristic_lengths)"
+        )
+    with np.load(path, allow_pickle=False) as data:
+        missing = [k for k in ("positions", "normals") if k not in data.files]
+        if missing:
+            raise InvalidOptionError(
+                f"input file {str(path)!r} has no array(s) {missing}; it holds "
+                f"{sorted(data.files)}"
+            )
+        unknown = set(data.files) - {"positions", "normals", *_OPTIONAL}
+        if unknown:
+            raise InvalidOptionError(
+                f"input file {str(path)!r} has unknown array(s) {sorted(unknown)}; "
+                f"valid names are positions, normals, {', '.join(_OPTIONAL)}"
+            )
+        return {k: data[k] for k in data.files}
+
+
+def write_result(result: BatchClosureResult, path: str | os.PathLike) -> Path:
+    """Write a batch result to ``.npz`` (or ``.parquet`` if pyarrow is present).
+
+    Parameters
+    ----------
+    result : BatchClosureResult
+    path : str or path-like
+        Output file; its suffix picks the format.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    path = Path(path)
+    arrays = result.to_arrays()
+    suffix = path.suffix.lower()
+    if suffix == ".npz":
+        np.savez(
+            path,
+            kind=np.array(result.kind),
+            tol=np.array(result.tol),
+            required_rank=np.array(result.required_rank),
+            **arrays,
+        )
+        return path
+    if suffix == ".parquet":
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ImportError as exc:
+            raise InvalidOptionError(
+                "writing .parquet needs the optional package pyarrow "
+                "(pip install pyarrow); write .npz instead"
+            ) from exc
+        table = pa.table(dict(arrays))
+        table = table.replace_schema_metadata(
+            {
+                "kind": result.kind,
+                "tol": repr(result.tol),
+                "required_rank": str(result.required_rank),
+            }
+        )
+        pq.write_table(table, path)
+        return path
+    raise InvalidOptionError(
+        f"output file {str(path)!r} must end in .npz (or .parquet with pyarrow)"
+    )
+
+
+def evaluate_file(
+    input_path: str | os.PathLike,
+    output_path: str | os.PathLike,
+    *,
+    kind: str = "force",
+    mu: float | None = None,
+    model: ContactModel | str = "hard_finger",
+    num_generators: int = 8,
+    torsional_friction: float | None = None,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    progress: bool = False,
+    metrics: Sequence[str] = (),
+) -> BatchClosureResult:
+    """Decide closure for every grasp of a file and write the verdicts.
+
+    Parameters
+    ----------
+    input_path : str or path-like
+        ``.npz`` archive of grasps (see the module docstring).
+    output_path : str or path-like
+        ``.npz`` (or ``.parquet`` with pyarrow) file to write.
+    kind : {"force", "form"}, optional
+        LP2 (:func:`batch_force_closure`) or LP1 (:func:`batch_form_closure`).
+    mu : float, optional
+        Friction coefficient for every contact; overrides the file's ``mu``.
+        Force closure needs one or the other.
+    model, num_generators, tol, rank_tol, chunk_size, progress, metrics : optional
+        As in :func:`batch_force_closure`.
+    torsional_friction : float, optional
+        Overrides the file's ``torsional_friction`` (default 0).
+
+    Returns
+    -------
+    BatchClosureResult
+        What was written.
+    """
+    data = read_grasps(input_path)
+    common = {
+        "reference_points": data.get("reference_points"),
+        "characteristic_lengths": data.get("characteristic_lengths"),
+        "tol": tol,
+        "rank_tol": rank_tol,
+        "chunk_size": chunk_size,
+        "progress": progress,
+        "metrics": metrics,
+    }
+    if kind == "force":
+        mu_value = mu if mu is not None else data.get("mu")
+        if mu_value is None:
+            raise InvalidOptionError(
+                f"force closure needs friction: {str(input_path)!r} has no array "
+                "'mu' and no mu was given"
+            )
+        nu = torsional_friction
+        if nu is None:
+            nu = data.get("torsional_friction", 0.0)
+        result = batch_force_closure(
+            data["positions"],
+            data["normals"],
+            mu_value,
+            model=model,
+            num_generators=num_generators,
+            torsional_friction=nu,
+            **common,
+        )
+    elif kind == "form":
+        result = batch_form_closure(data["positions"], data["normals"], **common)
+    else:
+        raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
+    write_result(result, output_path)
+    return result
