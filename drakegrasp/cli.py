@@ -1,0 +1,164 @@
+"""The ``drakegrasp`` command.
+
+    drakegrasp analyze [SCENE] [--mu M] [--contact-model MODEL]
+                       [--torsional-friction NU] [--json]
+    drakegrasp scenes
+
+``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
+default scene), finds the contacts and prints the full report: contacts, ranks,
+form closure, force closure with the hand check, exact-cone verdict, antipodal
+test.  Errors print one line on stderr and exit with status 1 (2 for a bad
+command line).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable, Sequence
+
+from drakegrasp.contact import ContactModel
+from drakegrasp.errors import GraspError
+
+__all__ = ["build_parser", "main"]
+
+EXIT_ERROR = 1
+
+
+def _cmd_analyze(args: argparse.Namespace) -> int:
+    from drakegrasp.plant.analysis import analyze_grasp
+    from drakegrasp.plant.scene import load_scene
+
+    scene = load_scene(args.scene)
+    options = scene.analysis_options()
+    if args.mu is not None:
+        options["mu"] = args.mu
+    if args.contact_model is not None:
+        options["contact_model"] = ContactModel.parse(args.contact_model)
+    if args.torsional_friction is not None:
+        options["torsional_friction"] = args.torsional_friction
+    if (
+        options["contact_model"] is ContactModel.SOFT_FINGER
+        and not options["torsional_friction"]
+    ):
+        options["torsional_friction"] = None  # analyze_grasp explains what is missing
+    report = analyze_grasp(scene.plant, scene.plant_context, **options)
+    if args.json:
+        out = {"scene": scene.name, "scene_file": str(scene.info.path)}
+        out.update(report.to_dict())
+        json.dump(out, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        print(f"scene {scene.name}: {scene.info.description}")
+        print(report)
+    return 0
+
+
+def _cmd_scenes(args: argparse.Namespace) -> int:
+    from drakegrasp.plant.scene import DEFAULT_SCENE, list_scenes
+
+    infos = list_scenes()
+    width = max(len(i.name) for i in infos)
+    for info in infos:
+        mark = "*" if info.name == DEFAULT_SCENE else " "
+        print(f"{mark} {info.name:<{width}}  {info.description}")
+    print("(* = default scene; run `drakegrasp analyze NAME`)")
+    return 0
+
+
+def _positive_float(text: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (x >= 0.0) or x == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be finite and >= 0, got {text!r}")
+    return x
+
+
+def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
+    """The argument parser and its subparsers (other subcommands add themselves).
+
+    Returns
+    -------
+    parser : argparse.ArgumentParser
+    subparsers : argparse._SubParsersAction
+        Add a subcommand with ``subparsers.add_parser(name)`` and
+        ``set_defaults(func=handler)``; the handler takes the parsed namespace
+        and returns the exit status.
+    """
+    parser = argparse.ArgumentParser(
+        prog="drakegrasp",
+        description="Grasp analysis on top of Drake: contacts, grasp matrix, "
+        "form and force closure.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+
+    analyze = sub.add_parser(
+        "analyze",
+        help="analyse the grasp of a scene (default: the default scene)",
+        description="Load a scene and print its grasp analysis.",
+    )
+    analyze.add_argument(
+        "scene",
+        nargs="?",
+        default=None,
+        help="shipped scene name (see `drakegrasp scenes`) or scene YAML file",
+    )
+    analyze.add_argument(
+        "--mu", type=_positive_float, help="friction coefficient (default: scene's)"
+    )
+    analyze.add_argument(
+        "--contact-model",
+        choices=[m.value for m in ContactModel],
+        help="contact model (default: scene's)",
+    )
+    analyze.add_argument(
+        "--torsional-friction",
+        type=_positive_float,
+        help="torsional friction coefficient of soft fingers (default: scene's)",
+    )
+    analyze.add_argument("--json", action="store_true", help="print JSON")
+    analyze.set_defaults(func=_cmd_analyze)
+
+    scenes = sub.add_parser("scenes", help="list the shipped scenes")
+    scenes.set_defaults(func=_cmd_scenes)
+    return parser, sub
+
+
+_EXTENSIONS: list[Callable[[argparse._SubParsersAction], None]] = []
+
+
+def register_subcommand(add: Callable[[argparse._SubParsersAction], None]) -> None:
+    """Register a function that adds a subcommand to the parser's subparsers."""
+    _EXTENSIONS.append(add)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Arguments without the program name (default: ``sys.argv[1:]``).
+    """
+    parser, sub = build_parser()
+    for add in _EXTENSIONS:
+        add(sub)
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args))
+    except BrokenPipeError:  # e.g. `drakegrasp analyze | head`
+        return 0
+    except (GraspError, OSError, ValueError, RuntimeError) as e:
+        # GraspError covers bad scenes, bodies, contacts; the others are file or
+        # Drake errors that were not already wrapped.  One line, no traceback.
+        message = " ".join(str(e).split())
+        print(f"drakegrasp: error: {message}", file=sys.stderr)
+        return EXIT_ERROR
+
+
+if __name__ == "__main__":
+    sys.exit(main())
