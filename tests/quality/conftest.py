@@ -1,0 +1,100 @@
+"""Shared builders and independent reference routes for the quality-metric tests."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+import drakegrasp as dg
+
+
+def equator_grasp(mu=0.5, *, radius=1.0, model="hard_finger", **kwargs):
+    """Three contacts 120° apart on a sphere's equator, normals to the centre."""
+    contacts = []
+    for t in np.deg2rad([0.0, 120.0, 240.0]):
+        c = radius * np.array([np.cos(t), np.sin(t), 0.0])
+        contacts.append(dg.Contact(c, -c, mu=mu, model=model, **kwargs))
+    return dg.Grasp(contacts)
+
+
+def random_grasp(rng, num, dim=3, *, mu=0.5, spread=0.5, model="hard_finger"):
+    """Contacts on the unit sphere/circle, normals tilted from the inward radial."""
+    contacts = []
+    for _ in range(num):
+        p = rng.normal(size=dim)
+        p /= np.linalg.norm(p)
+        n = -p + spread * rng.normal(size=dim)
+        contacts.append(dg.Contact(p, n, mu=mu, model=model))
+    return dg.Grasp(contacts)
+
+
+def brute_force_ball_radius(points, tol=1e-9):
+    """ε of conv(points) by enumerating every hyperplane through D points.
+
+    A hyperplane through D affinely independent points with every point on one
+    side is a facet's; ε is the smallest distance from the origin to such a
+    hyperplane (0 if the origin is not strictly inside).  Exponential, exact,
+    and shares no code with Qhull.
+    """
+    P = np.asarray(points, dtype=float)
+    K, D = P.shape
+    idx = np.array(list(itertools.combinations(range(K), D)))
+    diffs = P[idx[:, 1:]] - P[idx[:, :1]]  # (S, D-1, D)
+    _, s, vt = np.linalg.svd(diffs)
+    ok = s[:, -1] > 1e-9 * max(1.0, s[:, 0].max())
+    normals = vt[ok, -1, :]  # unit, orthogonal to the D-1 differences
+    offsets = np.einsum("sd,sd->s", normals, P[idx[ok, 0]])
+    values = P @ normals.T - offsets  # (K, S)
+    scale = np.abs(P).max()
+    below = np.all(values <= tol * scale, axis=0)
+    above = np.all(values >= -tol * scale, axis=0)
+    dists = np.concatenate([offsets[below], -offsets[above]])
+    if dists.size == 0:
+        return 0.0
+    return max(0.0, float(dists.min()))
+
+
+def signed_permutation_rotations():
+    """The 24 rotations that map coordinate axes onto coordinate axes."""
+    out = []
+    for perm in itertools.permutations(range(3)):
+        for signs in itertools.product([1.0, -1.0], repeat=3):
+            R = np.zeros((3, 3))
+            R[np.arange(3), perm] = signs
+            if np.linalg.det(R) > 0:
+                out.append(R)
+    return out
+
+
+def moved_grasp(grasp, R, t):
+    """The grasp rigidly moved by x -> R x + t, reference point moved along."""
+    contacts = [
+        c.with_(position=R @ c.position + t, normal=R @ c.normal)
+        for c in grasp.contacts
+    ]
+    return dg.Grasp(
+        contacts,
+        reference_point=R @ grasp.reference_point + t,
+        characteristic_length=grasp.characteristic_length,
+    )
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(20261122)
+
+
+@pytest.fixture
+def helpers():
+    """The builders above (fixtures are how test files share them)."""
+
+    class H:
+        pass
+
+    h = H()
+    h.equator_grasp = equator_grasp
+    h.random_grasp = random_grasp
+    h.brute_force_ball_radius = brute_force_ball_radius
+    h.signed_permutation_rotations = signed_permutation_rotations
+    h.moved_grasp = moved_grasp
+    return h
