@@ -297,7 +297,7 @@ def plot_planar_grasp(
     points = ax.scatter(C[:, 0], C[:, 1], color=palette["contact"], s=25, zorder=5)
     labels = []
     if show_labels:
-        offset = 0.06 * b
+        offset = 0.1 * b
         for i, (c, n) in enumerate(zip(C, Nrm, strict=True)):
             # Put the number beside the contact, off the normal's line.
             t = np.array([-n[1], n[0]])
