@@ -504,6 +504,10 @@ def objects() -> dict[str, str]:
 # Scenes.  Model directives (Drake's own format) plus a ``drakegrasp:`` section.
 
 
+TORSIONAL_FRICTION = 0.1
+"""Torsional friction coefficient written into the spatial scenes (soft fingers)."""
+
+
 def yaml_vec(v) -> str:
     """A YAML flow sequence of floats."""
     return "[" + ", ".join(fmt(x) for x in v) + "]"
@@ -517,7 +521,7 @@ def scene(
     hand: str,
     mu: float,
     contact_model: str = "hard_finger",
-    torsional_friction: float | None = None,
+    torsional_friction: float | None = TORSIONAL_FRICTION,
     plane: str | None = None,
     expected: dict | None = None,
 ) -> str:
@@ -640,7 +644,6 @@ def scenes() -> dict[str, str]:
         object_body="box::box",
         hand="gripper",
         mu=0.5,
-        torsional_friction=0.1,
     )
     out["scenes/parallel_jaw_flat_box.yaml"] = scene(
         "Parallel-jaw gripper with flat 20 x 20 mm pads on the box: each pad "
@@ -673,7 +676,6 @@ def scenes() -> dict[str, str]:
         object_body="cylinder::cylinder",
         hand="gripper",
         mu=0.5,
-        torsional_friction=0.1,
     )
     hand = "package://drakegrasp/hands/three_finger_hand.sdf"
     q2, q3 = 0.35, 0.30
@@ -745,6 +747,7 @@ def scenes() -> dict[str, str]:
         "analysed in the y-z plane.",
         directives,
         object_body="brick::brick_link",
+        torsional_friction=None,
         hand="gripper",
         mu=0.5,
         plane="yz",
