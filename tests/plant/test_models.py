@@ -123,9 +123,9 @@ def test_hex_prism_inertia_closed_form():
     h = 0.08
     volume = 1.5 * math.sqrt(3) * s * s * h
     assert m == pytest.approx(900.0 * volume, rel=1e-12)
-    I = M.CalcRotationalInertia().CopyToFullMatrix3()
+    inertia = M.CalcRotationalInertia().CopyToFullMatrix3()
     expected = m * np.diag([5 * s * s / 24 + h * h / 12] * 2 + [5 * s * s / 12])
-    np.testing.assert_allclose(I, expected, rtol=1e-12)
+    np.testing.assert_allclose(inertia, expected, rtol=1e-12)
 
 
 def test_hex_prism_mesh_is_convex_and_closed():
