@@ -587,6 +587,8 @@ def _normal_force_certificate(
     normals = grasp.normal_indices()
     if len(columns) == len(normals):  # every contact is frictionless already
         return None
+    if matrix_rank(normal_grasp_matrix(grasp)) == grasp.num_contacts:
+        return None  # N(G_n) = {0}: no non-zero normal forces balance
     prog, variables = build_form_closure_program(grasp)
     d_star, f_n, _, _ = _solve_margin(prog, variables, conic=False)
     if not d_star > tol:

@@ -8,6 +8,7 @@ cone's axis ``[1, 0, 0, …]``.  See ``shared/CONVENTIONS.md``.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -148,21 +149,35 @@ def effective_cone(
     """
     n_g = _check_num_generators(num_generators)
     comps = contact.effective_components()
+    torsion = 0.0
+    if 3 in comps:
+        torsion = _torsion_scale(contact, characteristic_length)
+    return _cone(comps, contact.mu if 1 in comps else 0.0, n_g, torsion)
+
+
+@functools.lru_cache(maxsize=1024)
+def _cone(comps: tuple[int, ...], mu: float, n_g: int, torsion: float) -> EffectiveCone:
+    """The cone of given components, μ, n_g and torsion bound ``b ν``; cached.
+
+    Grasps repeat the same few cones, so each is computed once; its arrays are
+    read-only.
+    """
     if comps == (0,):
         S, F = np.ones((1, 1)), np.ones((1, 1))
     elif comps == (0, 1):  # planar hard finger
-        S, F = _two_sided(contact.mu)
+        S, F = _two_sided(mu)
     elif comps == (0, 3):  # soft finger without tangential friction
-        S, F = _two_sided(_torsion_scale(contact, characteristic_length))
+        S, F = _two_sided(torsion)
     elif comps == (0, 1, 2):
-        S = _circle_generators(contact.mu, n_g)
-        F = _pyramid_facets(contact.mu, n_g)
+        S = _circle_generators(mu, n_g)
+        F = _pyramid_facets(mu, n_g)
     else:  # (0, 1, 2, 3)
-        torsion = _torsion_scale(contact, characteristic_length)
-        ring = _circle_generators(contact.mu, n_g)
-        F = _bipyramid_facets(contact.mu, n_g, torsion)
+        ring = _circle_generators(mu, n_g)
+        F = _bipyramid_facets(mu, n_g, torsion)
         apexes = np.array([[1.0, 1.0], [0, 0], [0, 0], [torsion, -torsion]])
         S = np.hstack([np.vstack([ring, np.zeros(n_g)]), apexes])
+    S.flags.writeable = False
+    F.flags.writeable = False
     return EffectiveCone(comps, S, F)
 
 

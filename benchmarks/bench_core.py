@@ -1,0 +1,79 @@
+"""Time the single-grasp programs (MathematicalProgram path) on seeded grasps.
+
+Prints the median and 90th-percentile wall time of one call of each program, for
+3-contact spatial hard-finger grasps with 8 generators, and the share of that time
+spent building the program versus solving it.
+
+Run: ``python benchmarks/bench_core.py [--grasps 200]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+from pydrake.solvers import ClpSolver  # noqa: E402
+
+import drakegrasp as dg  # noqa: E402
+
+
+def random_grasps(count: int, num_contacts: int, seed: int = 7) -> list[dg.Grasp]:
+    rng = np.random.default_rng(seed)
+    grasps = []
+    for _ in range(count):
+        p = rng.normal(size=(num_contacts, 3))
+        p /= np.linalg.norm(p, axis=1, keepdims=True)
+        n = -p + 0.5 * rng.normal(size=p.shape)
+        grasps.append(dg.Grasp([dg.Contact(p[i], n[i], mu=0.5) for i in range(len(p))]))
+    return grasps
+
+
+def timed(fn, items) -> np.ndarray:
+    times = np.empty(len(items))
+    for i, item in enumerate(items):
+        t0 = time.perf_counter()
+        fn(item)
+        times[i] = time.perf_counter() - t0
+    return times
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--grasps", type=int, default=200)
+    args = parser.parse_args()
+    grasps = random_grasps(args.grasps, 3)
+    closures = sum(dg.force_closure(g).is_closure for g in grasps[:50])
+    print(
+        f"{args.grasps} seeded 3-contact spatial hard-finger grasps, mu = 0.5, "
+        f"n_g = 8 ({closures}/50 of the first 50 in force closure)"
+    )
+    print(f"{'call':<44}{'median':>10}{'p90':>10}")
+    rows = [
+        ("force_closure (LP2, facets)", dg.force_closure),
+        (
+            "force_closure (LP2, generators)",
+            lambda g: dg.force_closure(g, formulation="generators"),
+        ),
+        ("force_closure_exact (SOCP)", dg.force_closure_exact),
+        ("form_closure (LP1)", dg.form_closure),
+        ("build_force_closure_program only", dg.build_force_closure_program),
+        ("Clp solve of a prebuilt LP2 only", None),
+    ]
+    prebuilt = [dg.build_force_closure_program(g)[0] for g in grasps]
+    solver = ClpSolver()
+    for name, fn in rows:
+        if fn is None:
+            t = timed(solver.Solve, prebuilt)
+        else:
+            t = timed(fn, grasps)
+        median, p90 = np.median(t) * 1e3, np.percentile(t, 90) * 1e3
+        print(f"{name:<44}{median:>8.3f}ms{p90:>8.3f}ms")
+
+
+if __name__ == "__main__":
+    main()
