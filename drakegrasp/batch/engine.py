@@ -208,7 +208,7 @@ def _check_coefficients(name: str, x: np.ndarray, start: int) -> None:
     if bad.any():
         k, i = np.argwhere(bad)[0]
         raise InvalidContactError(
-            f"{name} of grasp {start + k}, contact {i} is {x[k, i]!r}; it must be "
+            f"{name} of grasp {start + k}, contact {i} is {float(x[k, i])}; it must be "
             "finite and >= 0"
         )
 
@@ -284,7 +284,7 @@ def _characteristic_lengths(value, K: int):
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
             raise InvalidGraspError(
-                f"characteristic length of grasp {sl.start + k} is {b[k]!r}; it "
+                f"characteristic length of grasp {sl.start + k} is {float(b[k])}; it "
                 "must be finite and > 0"
             )
         return b
