@@ -28,8 +28,14 @@ from pydrake.geometry import (
 
 from drakegrasp.errors import ModelError
 
-ON_SURFACE_TOL = 1e-6
-"""A point within this distance (m) of a face's plane lies on that face."""
+ON_SURFACE_TOL = 1e-5
+"""A point within this distance (m) of a face's plane lies on that face.
+
+Generous because Drake's GJK-based witness points (convex meshes, cylinders)
+are accurate to about 1e-5 m only: a witness that close to an edge is taken to
+be on the edge, where :func:`drakegrasp.plant.contacts.find_contacts` then uses
+the other surface's normal.
+"""
 
 
 @dataclass(frozen=True)

@@ -276,9 +276,10 @@ def _patch(
         return np.column_stack([d @ u, d @ w])
 
     inter = _clip_convex(to2(poly_fin_O), to2(poly_obj_O))
-    # gap(x) = (x - p_fin) · m / (-n · m), with m the finger face's outward
-    # normal; it is affine in the 2-D coordinates: g0 + g · x2.
-    denom = float(-(n_O @ finger_normal_O))
+    # The finger point above x is x - gap n, on the finger's plane
+    # m · (y - p_fin) = 0 (m: the finger face's outward normal, m ≈ n), so
+    # gap(x) = m · (x - p_fin) / (m · n), affine in the 2-D coordinates.
+    denom = float(n_O @ finger_normal_O)
     g0 = float((origin - plane_point_fin_O) @ finger_normal_O) / denom
     g = np.array([u @ finger_normal_O, w @ finger_normal_O]) / denom
     inter = _clip(inter, g, tol - g0)
@@ -396,7 +397,7 @@ def find_contacts(
                     continue
                 if abs(psi) > tol and not (allow_penetration and psi < 0):
                     continue
-                contacts += _pair_contacts(
+                found = _pair_contacts(
                     query=query,
                     inspector=inspector,
                     go=go,
@@ -413,6 +414,13 @@ def find_contacts(
                     tol=tol,
                     patches=patches,
                 )
+                deepest = min(c.psi for c in found)
+                if deepest < -tol and not allow_penetration:  # a tilted patch
+                    penetrations.append(
+                        f"{pair} penetrate by {-deepest * 1e3:.4g} mm at a patch corner"
+                    )
+                    continue
+                contacts += found
     if penetrations:
         raise PenetrationError(
             f"penetration deeper than distance_tolerance = {tol:g} m: "
@@ -519,15 +527,15 @@ def _pair_contacts(
                         )
                         for k, (p, gap) in enumerate(verts)
                     ]
-    if len(obj_pieces) == 1:
-        n_O, source = -(R_OGa @ obj_pieces[0].normal_G), "object"
-    elif len(fin_pieces) == 1:
-        n_O, source = R_OGb @ fin_pieces[0].normal_G, "finger"
-    elif abs(psi) > 1e-9:
-        d = p_OCa - p_OCb
-        n_O, source = d / np.linalg.norm(d) * np.sign(psi), "witness points"
-    else:
-        n_O, source = R_OW @ nhat_W, "drake"
+    n_O, source = _choose_normal(
+        obj=[-(R_OGa @ p.normal_G) for p in obj_pieces],
+        obj_flat=all(p.polygon_G is not None for p in obj_pieces),
+        fin=[R_OGb @ p.normal_G for p in fin_pieces],
+        fin_flat=all(p.polygon_G is not None for p in fin_pieces),
+        witness=p_OCa - p_OCb,
+        psi=psi,
+        drake=R_OW @ nhat_W,
+    )
     n_O = n_O / np.linalg.norm(n_O)
     return [
         PlantContact(
@@ -539,6 +547,37 @@ def _pair_contacts(
             **common,
         )
     ]
+
+
+NORMAL_AGREEMENT = np.cos(np.radians(5.0))
+"""Object and finger normals within 5 degrees of each other agree."""
+
+
+def _choose_normal(*, obj, obj_flat, fin, fin_flat, witness, psi, drake):
+    """Pick the inward normal (frame O) from the candidates of both surfaces.
+
+    ``obj`` and ``fin`` hold the candidate inward normals from the object's and
+    the finger's surface pieces at the witness points (several at an edge or a
+    corner).  A unique normal of one surface is used when the other agrees
+    with it or has no unique normal; when both are unique but disagree, one
+    witness point sits numerically next to an edge it should be on (Drake's GJK
+    witnesses are accurate to ~1e-5 m), and the curved surface wins over the
+    flat face, whose normal jumps there.
+    """
+    if len(obj) == 1 and len(fin) == 1:
+        if obj[0] @ fin[0] >= NORMAL_AGREEMENT:
+            return obj[0], "object"
+        if obj_flat and not fin_flat:
+            return fin[0], "finger"
+        if fin_flat and not obj_flat:
+            return obj[0], "object"
+    elif len(obj) == 1:
+        return obj[0], "object"
+    elif len(fin) == 1:
+        return fin[0], "finger"
+    if abs(psi) > 1e-9:
+        return witness / np.linalg.norm(witness) * np.sign(psi), "witness points"
+    return drake, "drake"
 
 
 def to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
