@@ -552,7 +552,10 @@ def batch_force_closure(
             facets, slices, start = [], [], 0
             for i, kind in enumerate(layout):
                 k_i = len(KIND_COMPONENTS[kind])
-                facets.append(kind_facets(kind, mu_c[sub, i], torsion[:, i], n_g))
+                mu_i, tor_i = mu_c[sub, i], torsion[:, i]
+                if (mu_i == mu_i[0]).all() and (tor_i == tor_i[0]).all():
+                    mu_i, tor_i = mu_i[:1], tor_i[:1]  # one cone for all grasps
+                facets.append(kind_facets(kind, mu_i, tor_i, n_g))
                 slices.append(slice(start, start + k_i))
                 start += k_i
             sol = solve_margin_lp(G, facets, slices, normal_cols, rank_tol=rank_tol)

@@ -200,8 +200,9 @@ def solve_margin_lp(
     ----------
     G : (K, w, M) float
         Effective grasp matrices.
-    facets : list of (K, r_i, k_i) float
-        Unit facet rows of each contact's effective cone.
+    facets : list of (K, r_i, k_i) or (1, r_i, k_i) float
+        Unit facet rows of each contact's effective cone (leading 1: the same
+        cone for every grasp).
     component_slices : list of slice
         Columns of ``G`` that belong to each contact (``k_i`` of them).
     normal_columns : (N,) int
@@ -231,7 +232,7 @@ def solve_margin_lp(
             continue
         A = np.concatenate(
             [
-                F[sel] @ Z[:, s, :]
+                (F if F.shape[0] == 1 else F[sel]) @ Z[:, s, :]
                 for F, s in zip(facets, component_slices, strict=True)
             ],
             axis=1,
