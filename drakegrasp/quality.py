@@ -35,6 +35,7 @@ The hull-based ε imports ``scipy.spatial`` (Qhull); the LP imports
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
@@ -83,8 +84,8 @@ RANK_TOL = 1e-9
 HULL_TOL = 1e-9
 """Relative tolerance (times the largest coordinate) of the hull checks."""
 
-LINF_MAX_POINTS = 2_000_000
-"""Largest point set the L∞ Minkowski sum may form in one step (memory guard)."""
+LINF_MAX_CANDIDATES = 5_000_000
+"""Most candidate facet normals the L∞ ε may test (about a second per million)."""
 
 _NORMS = ("L1", "Linf")
 
@@ -228,18 +229,6 @@ def _hard_finger_wrenches(
 # ------------------------------------------------------------- convex hulls
 
 
-def _affine_basis(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, float]:
-    """Centroid, orthonormal basis rows and dimension of the points' affine hull."""
-    centre = points.mean(axis=0)
-    centred = points - centre
-    scale = float(np.max(np.abs(points))) if points.size else 0.0
-    if points.shape[0] < 2 or scale == 0.0:
-        return centre, np.zeros((0, points.shape[1])), 0, scale
-    _, s, vt = np.linalg.svd(centred, full_matrices=False)
-    r = int(np.sum(s > RANK_TOL * max(s[0], scale)))
-    return centre, vt[:r], r, scale
-
-
 def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
     """Convex hull of full-dimensional points, fast when the input allows it.
 
@@ -249,8 +238,10 @@ def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
     ``HULL_TOL * scale``).  Qhull keeps the facets a closed surface, so facets
     that all support the point set are the hull's boundary.  Otherwise (or if
     Qhull reports a precision error) it runs again with its default merging
-    options, and as a last resort with joggled input ``QJ`` (which perturbs the
-    points by about 1e-11 relative, far below any quality we report).
+    for 5-D and up, ``Qx``, plus ``Qs`` (search every point for the initial
+    simplex, which symmetric wrench sets need), and as a last resort with
+    joggled input ``QJ`` (which perturbs the points by about 1e-11 relative,
+    far below any quality we report).
     """
     tol = HULL_TOL * max(scale, 1e-300)
     try:
@@ -261,7 +252,7 @@ def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
     except QhullError:
         pass
     try:
-        return ConvexHull(points)
+        return ConvexHull(points, qhull_options="Qx Qs")
     except QhullError:
         pass
     try:
@@ -315,31 +306,168 @@ def _ball_radius(points: np.ndarray) -> float:
     return radius if radius > 0.0 else 0.0
 
 
-def _hull_vertices(points: np.ndarray) -> np.ndarray:
-    """The vertices of ``conv(points)`` (any affine dimension), as rows."""
-    centre, basis, r, scale = _affine_basis(points)
-    if r == 0:
-        return points[:1]
-    coords = (points - centre) @ basis.T
-    if r == 1:
-        return points[[int(np.argmin(coords[:, 0])), int(np.argmax(coords[:, 0]))]]
-    hull = _qhull(coords, float(np.max(np.abs(coords))))
-    return points[np.sort(hull.vertices)]
+def _face_directions(points: np.ndarray) -> dict[int, np.ndarray]:
+    """Direction spaces of the faces of ``conv(points)``, grouped by dimension.
+
+    ``points`` must contain the origin (a per-contact set ``{0} ∪ {w_ik}``), so
+    the polytope's affine span is the linear span of its points.
+
+    Returns
+    -------
+    dict
+        ``j -> (n_j, j, D)``: an orthonormal basis (rows) of the direction space
+        of each ``j``-dimensional face, ``1 <= j <= m`` (``m`` the polytope's
+        dimension; the one ``m``-face is the polytope itself).  Vertices
+        (``j = 0``) have no direction and are left out.
+
+    Notes
+    -----
+    Facets come from Qhull (default merging options, so coplanar triangles of a
+    facet share one hyperplane) in ``m``-D coordinates; every face of a polytope
+    is an intersection of facets, so the faces are the closure of the facets'
+    vertex sets under intersection.
+    """
+    scale = float(np.max(np.abs(points)))
+    _, s, vt = np.linalg.svd(points, full_matrices=False)
+    m = int(np.sum(s > RANK_TOL * max(s[0], scale)))
+    out = {m: vt[None, :m]}
+    if m < 2:
+        return out
+    coords = points @ vt[:m].T
+    hull = ConvexHull(coords)
+    verts = hull.vertices
+    tol = HULL_TOL * float(np.max(np.abs(coords)))
+    facets = set()
+    for eq in hull.equations:
+        on = verts[np.abs(coords[verts] @ eq[:-1] + eq[-1]) <= tol]
+        facets.add(frozenset(on.tolist()))
+    faces, frontier = set(facets), set(facets)
+    while frontier:
+        frontier = {a & f for a in frontier for f in facets if a & f} - faces
+        faces |= frontier
+    by_dim: dict[int, list[np.ndarray]] = {}
+    for face in faces:
+        idx = sorted(face)
+        if len(idx) < 2:
+            continue
+        _, sf, vtf = np.linalg.svd(points[idx[1:]] - points[idx[0]])
+        j = int(np.sum(sf > RANK_TOL * max(sf[0], scale)))
+        if 0 < j < m:
+            by_dim.setdefault(j, []).append(vtf[:j])
+    out.update({j: np.array(bases) for j, bases in by_dim.items()})
+    return out
 
 
-def _minkowski_sum_vertices(sets: Sequence[np.ndarray]) -> np.ndarray:
-    """Vertices of ``conv(P_1) ⊕ … ⊕ conv(P_N)``, pruning after each sum."""
-    acc = _hull_vertices(sets[0])
-    for P in sets[1:]:
-        total = acc.shape[0] * P.shape[0]
-        if total > LINF_MAX_POINTS:
-            raise InvalidOptionError(
-                f"the L∞ Minkowski sum needs {total} points in one step (more than "
-                f"LINF_MAX_POINTS = {LINF_MAX_POINTS}); use norm='L1', fewer "
-                "contacts or fewer generators"
-            )
-        acc = _hull_vertices((acc[:, None, :] + P[None, :, :]).reshape(-1, P.shape[1]))
-    return acc
+def _cofactor_normals(M: np.ndarray) -> np.ndarray:
+    """Normals of the hyperplanes spanned by the rows of ``M`` (n, D-1, D).
+
+    ``u_j = (-1)^j det(M without column j)`` is orthogonal to every row, and
+    ``‖u‖ = sqrt(det(M Mᵀ))`` (0 when the rows are dependent).
+    """
+    D = M.shape[2]
+    u = np.empty((M.shape[0], D))
+    for j in range(D):
+        cols = [k for k in range(D) if k != j]
+        u[:, j] = (-1.0) ** j * np.linalg.det(M[:, :, cols])
+    return u
+
+
+def _support_min(U: np.ndarray, wrenches: Sequence[np.ndarray]) -> float:
+    """``min over rows u of U (unit) and ±u`` of ``h(u) = Σ_i max(0, max_k u·w_ik)``."""
+    hp = np.zeros(U.shape[0])
+    hm = np.zeros(U.shape[0])
+    for W in wrenches:
+        V = U @ W.T
+        hp += np.maximum(V.max(axis=1), 0.0)
+        hm += np.maximum(-V.min(axis=1), 0.0)
+    return float(min(hp.min(), hm.min()))
+
+
+def _face_tuples(families, dim_test):
+    """Yield ``(parts, shape)`` for every choice of one face per contact.
+
+    ``families[i]`` maps a face dimension to bases (see
+    :func:`_face_directions`); a contact may also contribute a vertex (no
+    direction).  ``dim_test(total)`` selects the total dimensions to keep.
+    """
+    choices = [[0, *sorted(f)] for f in families]
+    for combo in itertools.product(*choices):
+        if not dim_test(sum(combo)):
+            continue
+        parts = [(i, j) for i, j in enumerate(combo) if j > 0]
+        shape = [families[i][j].shape[0] for i, j in parts]
+        yield parts, shape
+
+
+def _stacked_bases(families, parts, shape, lo, hi) -> np.ndarray:
+    idx = np.unravel_index(np.arange(lo, hi), shape)
+    return np.concatenate(
+        [families[i][j][k] for (i, j), k in zip(parts, idx, strict=True)], axis=1
+    )
+
+
+def _check_candidate_count(families, dim_test) -> None:
+    total = sum(int(np.prod(s)) for _, s in _face_tuples(families, dim_test))
+    if total > LINF_MAX_CANDIDATES:
+        raise InvalidOptionError(
+            f"the L∞ Ferrari–Canny metric of this grasp needs {total} candidate "
+            f"facet normals (more than LINF_MAX_CANDIDATES = {LINF_MAX_CANDIDATES});"
+            " use norm='L1', fewer contacts or fewer generators"
+        )
+
+
+def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
+    r"""ε of the Minkowski sum ``⊕_i conv({0} ∪ {w_ik})`` through its normal fan.
+
+    Call only when the origin is strictly inside (ε_1 > 0).  Every facet of a
+    Minkowski sum is a sum of faces ``F_i`` of the summands, and its normal is
+    orthogonal to every ``dir(F_i)``.  Any unit ``u`` bounds
+    ``ε = min_{‖u‖=1} h(u)`` from above, so the minimum of ``h`` over a set of
+    directions that contains every facet normal is ε exactly:
+
+    1. every choice of faces with ``Σ dim F_i = D - 1`` whose directions are
+       independent gives one normal (by cofactors).  If no such choice is
+       dependent, every facet normal is among them (a facet's faces can be
+       shrunk to sub-faces with dimensions adding up to ``D - 1``, and their
+       directions then still span the facet's).
+    2. otherwise (symmetric grasps) every choice with ``Σ dim F_i >= D - 1``
+       whose directions span exactly ``D - 1`` dimensions gives one normal (by
+       SVD); a facet is such a choice with its own faces.
+    """
+    D = wrenches[0].shape[1]
+    sets = [np.vstack([np.zeros((1, D)), W]) for W in wrenches]
+    families = [_face_directions(P) for P in sets]
+    chunk = 100_000
+    exact_dim = (lambda t: t == D - 1), (lambda t: t >= D - 1)
+    _check_candidate_count(families, exact_dim[0])
+    best, degenerate = math.inf, False
+    for parts, shape in _face_tuples(families, exact_dim[0]):
+        count = int(np.prod(shape))
+        for lo in range(0, count, chunk):
+            M = _stacked_bases(families, parts, shape, lo, min(count, lo + chunk))
+            u = _cofactor_normals(M)
+            norms = np.linalg.norm(u, axis=1)
+            if np.any(norms <= RANK_TOL):
+                degenerate = True
+                break
+            best = min(best, _support_min(u / norms[:, None], wrenches))
+        if degenerate:
+            break
+    if not degenerate:
+        return best
+    _check_candidate_count(families, exact_dim[1])
+    best = math.inf
+    for parts, shape in _face_tuples(families, exact_dim[1]):
+        count = int(np.prod(shape))
+        for lo in range(0, count, chunk):
+            M = _stacked_bases(families, parts, shape, lo, min(count, lo + chunk))
+            _, s, vt = np.linalg.svd(M)
+            keep = s[:, D - 2] > RANK_TOL * s[:, 0]
+            if M.shape[1] >= D:
+                keep &= s[:, D - 1] <= RANK_TOL * s[:, 0]
+            if np.any(keep):
+                best = min(best, _support_min(vt[keep, D - 1, :], wrenches))
+    return best
 
 
 # ------------------------------------------------------------ Ferrari–Canny
@@ -392,14 +520,21 @@ def ferrari_canny(
 
     where Qhull gives each facet as ``n_j·x + o_j <= 0`` with unit ``n_j``.
     Since every ``w_{i,k}`` lies in ``W_∞``, ``ε_1 <= ε_∞``, and
-    ``ε_∞ <= N ε_1``.  The cones are inscribed in the Coulomb cones, so ε
-    underestimates the exact-cone value; it grows with ``n_g``.
+    ``ε_∞ <= N ε_1``; the origin is strictly inside one exactly when it is
+    strictly inside the other.  The cones are inscribed in the Coulomb cones, so
+    ε underestimates the exact-cone value.
 
-    Cost: the L1 hull of ``N n_g`` points in 6-D is about a millisecond for
-    three hard fingers.  The L∞ set is formed by adding one contact at a time
-    and keeping only the vertices of each partial sum, instead of all
-    ``(n_g + 1)^N`` sums; it stays practical for a handful of contacts (see
-    ``LINF_MAX_POINTS``).
+    Cost.  L1: one Qhull hull of ``Σ_i m_i`` points (24 for three hard fingers
+    with 8 generators: about a millisecond in 6-D); a grasp that is not in force
+    closure is settled before Qhull by an NNLS test.  L∞: the Minkowski sum of
+    ``N`` sets of ``n_g + 1`` points has up to ``(n_g + 1)^N`` vertices and tens
+    of thousands of facets in 6-D (about a second in Qhull for three hard
+    fingers), so ε_∞ is computed through the sum's normal fan instead: every
+    facet normal of ``W_∞`` is orthogonal to the directions of one face of each
+    summand, so the minimum of the support function over those normals is ε_∞
+    (exact; see ``_linf_radius``).  About 40 ms for three spatial hard fingers
+    with 8 generators and about 1.5 s for four; more candidates than
+    ``LINF_MAX_CANDIDATES`` raise :class:`~drakegrasp.InvalidOptionError`.
     """
     if norm not in _NORMS:
         raise InvalidOptionError(f"norm must be one of {_NORMS}, got {norm!r}")
@@ -413,9 +548,7 @@ def ferrari_canny(
     # so the cheap L1 test settles ε_∞ = 0 first.
     if _ball_radius(np.vstack(wrenches)) == 0.0:
         return 0.0
-    dim = wrenches[0].shape[1]
-    sets = [np.vstack([np.zeros((1, dim)), W]) for W in wrenches]
-    return _ball_radius(_minkowski_sum_vertices(sets))
+    return _linf_radius(wrenches)
 
 
 # -------------------------------------------------------------- LP2 margin

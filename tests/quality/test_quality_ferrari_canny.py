@@ -4,7 +4,7 @@ import itertools
 
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull
+from scipy.spatial import ConvexHull, QhullError
 
 import drakegrasp as dg
 from drakegrasp.quality import ferrari_canny, primitive_wrenches
@@ -86,11 +86,16 @@ def _minkowski_all_sums(wrenches):
 
 
 def _ball_radius_scipy(points):
-    eq = ConvexHull(points).equations
+    # Qs: search all points for the initial simplex (symmetric sets need it);
+    # zonotopes (sums of segments) may need joggling, QJ (about 1e-11 relative).
+    try:
+        eq = ConvexHull(points, qhull_options="Qx Qs").equations
+    except QhullError:
+        eq = ConvexHull(points, qhull_options="QJ").equations
     return max(0.0, float(np.min(-eq[:, -1])))
 
 
-@pytest.mark.parametrize("dim,num,n_g", [(2, 3, 8), (2, 4, 8), (3, 3, 4)])
+@pytest.mark.parametrize("dim,num,n_g", [(2, 3, 8), (2, 4, 8), (3, 3, 4), (3, 4, 3)])
 def test_linf_against_full_minkowski_sum(helpers, rng, dim, num, n_g):
     # All (n_g+1)^N sums (no pruning) into scipy's hull with default options.
     done = 0
@@ -283,26 +288,28 @@ def test_soft_and_frictionless_contacts(helpers):
     assert ferrari_canny(soft, num_generators=4) == pytest.approx(
         helpers.brute_force_ball_radius(W), abs=1e-9
     )
-    # Seven frictionless contacts can be in form closure: eps > 0.
-    fl = dg.Grasp(
-        [
-            dg.Contact(p, n, model="frictionless")
-            for p, n in [
-                ([1, 0, 0], [-1, 0, 0]),
-                ([-1, 0, 0], [1, 0, 0]),
-                ([0, 1, 0.2], [0, -1, 0]),
-                ([0, -1, -0.2], [0, 1, 0]),
-                ([0.2, 0, 1], [0, 0, -1]),
-                ([-0.2, 0.1, -1], [0, 0, 1]),
-                ([0.3, 0.4, 0.2], -np.array([0.3, 0.4, 0.2])),
-            ]
-        ]
-    )
+    # Seven frictionless contacts on the faces of a cube, in form closure.
+    fl = _seven_frictionless()
     W = np.vstack(primitive_wrenches(fl))
     assert W.shape == (7, 6)
-    assert ferrari_canny(fl) == pytest.approx(
-        helpers.brute_force_ball_radius(W), abs=1e-9
-    )
+    eps = ferrari_canny(fl)
+    assert eps > 0
+    assert eps == pytest.approx(helpers.brute_force_ball_radius(W), abs=1e-9)
+
+
+def _seven_frictionless():
+    """Seven frictionless contacts on the cube [-1, 1]³ in first-order form closure
+    (found by a seeded search; form_closure gives d* ≈ 0.45)."""
+    spec = [
+        ([1.0, 0.4, 0.6], [-1.0, 0.0, 0.0]),
+        ([-1.0, 0.6, -0.2], [1.0, 0.0, 0.0]),
+        ([0.0, 1.0, 0.3], [0.0, -1.0, 0.0]),
+        ([-0.3, -1.0, -0.4], [0.0, 1.0, 0.0]),
+        ([0.1, -0.2, 1.0], [0.0, 0.0, -1.0]),
+        ([-0.5, -0.5, -1.0], [0.0, 0.0, 1.0]),
+        ([-1.0, 0.1, 0.7], [1.0, 0.0, 0.0]),
+    ]
+    return dg.Grasp([dg.Contact(p, n, model="frictionless") for p, n in spec])
 
 
 def test_primitive_wrenches_fast_path_matches_generic(helpers, rng):
@@ -329,3 +336,53 @@ def test_bad_inputs(helpers):
         ferrari_canny(g, num_generators=4.5)
     with pytest.raises(dg.InvalidGraspError, match="Grasp"):
         ferrari_canny(list(g.contacts))
+
+
+def _first_pass_is_degenerate(wrenches):
+    """Whether some choice of faces with Σ dim = D - 1 has dependent directions."""
+    from drakegrasp import quality as q
+
+    D = wrenches[0].shape[1]
+    fams = [q._face_directions(np.vstack([np.zeros((1, D)), W])) for W in wrenches]
+    for parts, shape in q._face_tuples(fams, lambda t: t == D - 1):
+        M = q._stacked_bases(fams, parts, shape, 0, int(np.prod(shape)))
+        if np.any(np.linalg.norm(q._cofactor_normals(M), axis=1) <= 1e-9):
+            return True
+    return False
+
+
+def test_linf_both_normal_fan_passes_against_full_sum(helpers, rng):
+    # The symmetric equator grasp has dependent face directions (second pass);
+    # a random grasp does not (first pass only).  Both against all 9^3 sums.
+    cases = [helpers.equator_grasp(0.5)]
+    while len(cases) < 2:
+        g = helpers.random_grasp(rng, 3, 3, mu=0.6, spread=0.3)
+        if ferrari_canny(g) > 0:
+            cases.append(g)
+    for g, degenerate in zip(cases, (True, False), strict=True):
+        wrenches = primitive_wrenches(g)
+        assert _first_pass_is_degenerate(wrenches) == degenerate
+        ref = _ball_radius_scipy(_minkowski_all_sums(wrenches))
+        assert ferrari_canny(g, norm="Linf") == pytest.approx(ref, abs=1e-9)
+
+
+def test_linf_soft_and_frictionless_against_full_sum(helpers):
+    soft = helpers.equator_grasp(0.5, model="soft_finger", torsional_friction=0.3)
+    wrenches = primitive_wrenches(soft, num_generators=4)
+    ref = _ball_radius_scipy(_minkowski_all_sums(wrenches))
+    assert ferrari_canny(soft, norm="Linf", num_generators=4) == pytest.approx(
+        ref, abs=1e-9
+    )
+    fl = _seven_frictionless()
+    ref = _ball_radius_scipy(_minkowski_all_sums(primitive_wrenches(fl)))
+    assert ref > 0
+    assert ferrari_canny(fl, norm="Linf") == pytest.approx(ref, abs=1e-9)
+
+
+def test_linf_refuses_huge_candidate_sets(helpers, rng, monkeypatch):
+    from drakegrasp import quality as q
+
+    g = helpers.equator_grasp(0.5)
+    monkeypatch.setattr(q, "LINF_MAX_CANDIDATES", 100)
+    with pytest.raises(dg.InvalidOptionError, match="LINF_MAX_CANDIDATES"):
+        ferrari_canny(g, norm="Linf")
