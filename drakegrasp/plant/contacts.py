@@ -33,7 +33,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import GeometryId, QueryObject, SceneGraphInspector
+from pydrake.geometry import GeometryId, QueryObject, SceneGraphInspector, Sphere
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context
@@ -504,7 +504,7 @@ def _pair_contacts(
                     continue
                 poly_obj = to_O_points(po.polygon_G, X_WGa, to_O)
                 poly_fin = to_O_points(pf.polygon_G, X_WGb, to_O)
-                n_O = -m_O
+                n_O = _clean_unit(-m_O)
                 verts = _patch(
                     n_O=n_O,
                     poly_obj_O=poly_obj,
@@ -536,7 +536,22 @@ def _pair_contacts(
         psi=psi,
         drake=R_OW @ nhat_W,
     )
-    n_O = n_O / np.linalg.norm(n_O)
+    n_O = _clean_unit(n_O)
+    finger_shape = inspector.GetShape(gf)
+    if isinstance(finger_shape, Sphere):
+        # A spherical fingertip touches at centre + r n: recompute the witness
+        # points from the sphere's centre (exact), and ψ exactly on a flat face.
+        r = finger_shape.radius()
+        centre_O = to_O(X_WGb.translation())
+        p_OCb = centre_O + r * n_O
+        if (
+            len(obj_pieces) == 1
+            and obj_pieces[0].polygon_G is not None
+            and source == "object"
+        ):
+            face_point_O = to_O(X_WGa.multiply(obj_pieces[0].polygon_G[0]))
+            psi = float(-n_O @ (centre_O - face_point_O)) - r
+        p_OCa = p_OCb + psi * n_O
     return [
         PlantContact(
             p_OC=p_OCa,
@@ -547,6 +562,18 @@ def _pair_contacts(
             **common,
         )
     ]
+
+
+def _clean_unit(n: np.ndarray) -> np.ndarray:
+    """Unit vector with round-off components (< 1e-12) set to exactly zero.
+
+    The core picks each contact frame's ``t1`` from the smallest component of
+    ``n``; zeroing round-off keeps that choice, hence ``G``, the same wherever
+    the object sits in the world.
+    """
+    n = np.array(n, dtype=float)
+    n[np.abs(n) < 1e-12] = 0.0
+    return n / np.linalg.norm(n)
 
 
 NORMAL_AGREEMENT = np.cos(np.radians(5.0))

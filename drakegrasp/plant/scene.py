@@ -25,8 +25,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
-from pydrake.common.yaml import yaml_load_typed
-from pydrake.multibody.parsing import ModelDirectives, Parser, ProcessModelDirectives
+from pydrake.multibody.parsing import (
+    LoadModelDirectivesFromString,
+    Parser,
+    ProcessModelDirectives,
+)
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
@@ -338,6 +341,23 @@ def _resolve_hand(plant: MultibodyPlant, hand) -> ModelInstanceIndex | tuple | N
     return tuple(resolve_body(plant, h) for h in hand)
 
 
+def _without_drakegrasp_section(text: str) -> str:
+    """The scene text without its top-level ``drakegrasp:`` block.
+
+    Drake's directive loader rejects unknown keys (so typos in the directives
+    are caught); the block-style ``drakegrasp:`` mapping is cut out first: from
+    its line to the next line that starts in column 0 with a key.
+    """
+    out, skipping = [], False
+    for line in text.splitlines(keepends=True):
+        starts_key = bool(line) and not line[0].isspace() and not line.startswith("#")
+        if starts_key:
+            skipping = line.startswith("drakegrasp:")
+        if not skipping:
+            out.append(line)
+    return "".join(out)
+
+
 def load_scene(path_or_name: str | Path | None = None) -> Scene:
     """Build the plant of a scene file and set the configuration it describes.
 
@@ -362,9 +382,7 @@ def load_scene(path_or_name: str | Path | None = None) -> Scene:
     info = read_scene_info(path)
     text, _ = _read_yaml(path)
     try:
-        directives = yaml_load_typed(
-            schema=ModelDirectives, data=text, allow_yaml_with_no_schema=True
-        )
+        directives = LoadModelDirectivesFromString(_without_drakegrasp_section(text))
     except Exception as e:  # Drake raises RuntimeError/ValueError on bad schema
         msg = " ".join(str(e).split())
         raise ModelError(f"scene {str(path)!r}: bad model directives: {msg}") from None
