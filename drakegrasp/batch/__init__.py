@@ -2,8 +2,9 @@
 
 :func:`batch_force_closure` (LP2) and :func:`batch_form_closure` (LP1) decide
 closure for ``K`` grasps with ``N`` contacts each, with the conventions and
-verdicts of :mod:`drakegrasp.closure`; :func:`evaluate_file` runs them on a
-``.npz`` file (the ``drakegrasp batch`` command).
+verdicts of :mod:`drakegrasp.closure`; :func:`iter_batch_closure` consumes a
+stream of chunks lazily; :func:`evaluate_file` runs them on a ``.npz`` file (the
+``drakegrasp batch`` command).
 
 Modules: :mod:`~drakegrasp.batch.construction` (vectorised frames, grasp
 matrices and cone facets), :mod:`~drakegrasp.batch.reduction` (null-space
@@ -18,6 +19,7 @@ from drakegrasp.batch.engine import (
     BatchClosureResult,
     batch_force_closure,
     batch_form_closure,
+    iter_batch_closure,
 )
 from drakegrasp.batch.io import evaluate_file, read_grasps, write_result
 
@@ -28,6 +30,7 @@ __all__ = [
     "batch_force_closure",
     "batch_form_closure",
     "evaluate_file",
+    "iter_batch_closure",
     "read_grasps",
     "write_result",
 ]

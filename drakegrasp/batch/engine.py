@@ -17,7 +17,7 @@ matrices exist at any moment, and inputs may be memory-mapped arrays.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -44,6 +44,7 @@ __all__ = [
     "BatchClosureResult",
     "batch_force_closure",
     "batch_form_closure",
+    "iter_batch_closure",
 ]
 
 DEFAULT_CHUNK_SIZE = 4096
@@ -677,3 +678,58 @@ def batch_form_closure(
         progress=progress,
         metrics=names,
     )
+
+
+def iter_batch_closure(
+    chunks: Iterable[Mapping[str, np.ndarray] | tuple],
+    *,
+    kind: str = "force",
+    **options,
+) -> Iterator[BatchClosureResult]:
+    """Closure of a stream of grasp chunks, one result per chunk, lazily.
+
+    For inputs that do not fit in memory at once (a generator reading a large
+    file, a grasp sampler): only the current chunk and its result are held.
+
+    Parameters
+    ----------
+    chunks : iterable
+        Each item is a tuple ``(positions, normals)`` or ``(positions, normals,
+        mu)``, or a mapping with those keys (and optionally ``mu``,
+        ``torsional_friction``, ``reference_points``,
+        ``characteristic_lengths``), with the shapes of
+        :func:`batch_force_closure` for that chunk.
+    kind : {"force", "form"}, optional
+        :func:`batch_force_closure` (needs ``mu``) or :func:`batch_form_closure`.
+    **options
+        Keyword options of that function, applied to every chunk.
+
+    Yields
+    ------
+    BatchClosureResult
+        The result of each chunk, in order.  Error messages index grasps within
+        their chunk.
+    """
+    if kind not in ("force", "form"):
+        raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
+    for item in chunks:
+        if isinstance(item, Mapping):
+            arrays = dict(item)
+        else:
+            names = ("positions", "normals", "mu")[: len(item)]
+            arrays = dict(zip(names, item, strict=True))
+        try:
+            P, Nrm = arrays.pop("positions"), arrays.pop("normals")
+        except KeyError as exc:
+            raise InvalidOptionError(
+                f"each chunk needs positions and normals; got {sorted(arrays)}"
+            ) from exc
+        if kind == "form":
+            arrays.pop("mu", None)
+            arrays.pop("torsional_friction", None)
+            yield batch_form_closure(P, Nrm, **arrays, **options)
+        else:
+            if "mu" not in arrays:
+                raise InvalidOptionError("force closure chunks need mu")
+            mu = arrays.pop("mu")
+            yield batch_force_closure(P, Nrm, mu, **arrays, **options)

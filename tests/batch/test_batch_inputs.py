@@ -9,7 +9,7 @@ import pytest
 from batch_support import random_grasps
 
 import drakegrasp.batch.engine as engine
-from drakegrasp.batch import batch_force_closure, batch_form_closure
+from drakegrasp.batch import batch_force_closure, batch_form_closure, iter_batch_closure
 from drakegrasp.errors import (
     GraspError,
     InvalidContactError,
@@ -187,3 +187,36 @@ def test_result_accessors_and_text():
     np.testing.assert_allclose(res.margin, (res.d_star - res.tol) / res.tol)
     with pytest.raises(AttributeError):
         res.tol = 1.0
+
+
+def test_iter_batch_closure_is_lazy_and_matches_one_call():
+    rng = np.random.default_rng(16)
+    P, Nrm = random_grasps(rng, 90, 3, 3)
+    mu = rng.uniform(0.2, 0.8, (90, 3))
+    produced = []
+
+    def chunks():
+        for start in range(0, 90, 30):
+            produced.append(start)
+            sl = slice(start, start + 30)
+            yield {"positions": P[sl], "normals": Nrm[sl], "mu": mu[sl]}
+
+    stream = iter_batch_closure(chunks(), chunk_size=16)
+    first = next(stream)
+    assert produced == [0] and len(first) == 30
+    parts = [first, *stream]
+    assert produced == [0, 30, 60]
+    whole = batch_force_closure(P, Nrm, mu)
+    np.testing.assert_allclose(
+        np.concatenate([r.d_star for r in parts]), whole.d_star, atol=1e-12
+    )
+    form = list(
+        iter_batch_closure([(P[:50], Nrm[:50]), (P[50:], Nrm[50:])], kind="form")
+    )
+    np.testing.assert_allclose(
+        np.concatenate([r.d_star for r in form]),
+        batch_form_closure(P, Nrm).d_star,
+        atol=1e-12,
+    )
+    with pytest.raises(InvalidOptionError, match="need mu"):
+        next(iter_batch_closure([(P, Nrm)]))
