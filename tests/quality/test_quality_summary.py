@@ -79,7 +79,11 @@ def test_summary_matches_individual_metrics(helpers):
     assert q.wrench_ellipsoid_volume == pytest.approx(13.5)
     assert q.torque_scale == g.characteristic_length
     assert q.hand_singular_values is None and q.distance_to_singularity is None
-    assert grasp_quality(g).ferrari_canny_linf is None  # L∞ only on request
+    # L∞ by default only when cheap (planar, or at most three spatial contacts).
+    assert grasp_quality(g).ferrari_canny_linf == q.ferrari_canny_linf
+    assert grasp_quality(g, linf=False).ferrari_canny_linf is None
+    four = dg.Grasp([*g.contacts, dg.Contact([0, 0, 1.0], [0, 0, -1.0], mu=0.5)])
+    assert grasp_quality(four).ferrari_canny_linf is None
 
 
 def test_summary_with_hand_and_json(helpers, rng):
