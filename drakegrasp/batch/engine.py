@@ -62,6 +62,8 @@ METRICS = ("sigma_min", "isotropy", "ellipsoid_volume", "epsilon_l1")
 class BatchClosureResult:
     """Closure verdicts of ``K`` grasps, as arrays.
 
+    The arrays are read-only.
+
     Attributes
     ----------
     kind : str
@@ -430,13 +432,20 @@ def _run(
         Nrm = _unit_normals(np.asarray(normals[sl], dtype=float), sl.start)
         chunk_fn(P, Nrm, sl, d_star, rank, converged, out_metrics)
     required = 3 if d == 2 else 6
+    is_closure = (rank == required) & (d_star > tol)
+    if tol > 0:
+        margin = (d_star - tol) / tol
+    else:
+        margin = np.where(d_star > 0, np.inf, -1.0)
+    for a in (is_closure, d_star, rank, margin, converged, *out_metrics.values()):
+        a.flags.writeable = False
     return BatchClosureResult(
         kind=kind,
-        is_closure=(rank == required) & (d_star > tol),
+        is_closure=is_closure,
         d_star=d_star,
         rank=rank,
         required_rank=required,
-        margin=(d_star - tol) / tol if tol > 0 else np.where(d_star > 0, np.inf, -1.0),
+        margin=margin,
         converged=converged,
         tol=tol,
         metrics=out_metrics,

@@ -187,6 +187,8 @@ def test_result_accessors_and_text():
     np.testing.assert_allclose(res.margin, (res.d_star - res.tol) / res.tol)
     with pytest.raises(AttributeError):
         res.tol = 1.0
+    with pytest.raises(ValueError, match="read-only"):
+        res.d_star[0] = 1.0
 
 
 def test_iter_batch_closure_is_lazy_and_matches_one_call():
