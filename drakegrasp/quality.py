@@ -16,7 +16,8 @@ is computed with ``S G`` instead of ``G``, where ``S = diag(I, I / b_s)``.
 
 The metrics:
 
-* :func:`ferrari_canny`: the Ferrari–Canny ε (L1 and L∞ forms), with Qhull;
+* :func:`ferrari_canny`: the Ferrari–Canny ε (L1 form with a Qhull hull, L∞
+  form through the normal fan of a Minkowski sum);
 * :func:`lp2_margin`: the ``d*`` of the force-closure program LP2;
 * :func:`grasp_singular_values` and the indices of ``G`` built from them
   (:func:`min_singular_value`, :func:`isotropy`,
@@ -334,7 +335,10 @@ def _face_directions(points: np.ndarray) -> dict[int, np.ndarray]:
     if m < 2:
         return out
     coords = points @ vt[:m].T
-    hull = ConvexHull(coords)
+    try:
+        hull = ConvexHull(coords)
+    except QhullError:  # symmetric sets may need a search for the first simplex
+        hull = ConvexHull(coords, qhull_options="Qx Qs")
     verts = hull.vertices
     tol = HULL_TOL * float(np.max(np.abs(coords)))
     facets = set()
@@ -425,14 +429,16 @@ def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
     ``ε = min_{‖u‖=1} h(u)`` from above, so the minimum of ``h`` over a set of
     directions that contains every facet normal is ε exactly:
 
-    1. every choice of faces with ``Σ dim F_i = D - 1`` whose directions are
-       independent gives one normal (by cofactors).  If no such choice is
-       dependent, every facet normal is among them (a facet's faces can be
-       shrunk to sub-faces with dimensions adding up to ``D - 1``, and their
-       directions then still span the facet's).
+    1. every choice of one face per summand (a vertex counts as dimension 0)
+       with ``Σ dim F_i = D - 1`` and independent directions gives one normal
+       (by cofactors).  If no such choice has dependent directions, every facet
+       normal is among them: shrinking a facet's faces to sub-faces whose
+       dimensions add up to ``D - 1`` gives a choice whose directions lie in the
+       facet's hyperplane, so they either span it (its normal is found) or are
+       dependent (which this step detects).
     2. otherwise (symmetric grasps) every choice with ``Σ dim F_i >= D - 1``
        whose directions span exactly ``D - 1`` dimensions gives one normal (by
-       SVD); a facet is such a choice with its own faces.
+       SVD); each facet is such a choice, with its own faces.
     """
     D = wrenches[0].shape[1]
     sets = [np.vstack([np.zeros((1, D)), W]) for W in wrenches]
@@ -522,7 +528,8 @@ def ferrari_canny(
     Since every ``w_{i,k}`` lies in ``W_∞``, ``ε_1 <= ε_∞``, and
     ``ε_∞ <= N ε_1``; the origin is strictly inside one exactly when it is
     strictly inside the other.  The cones are inscribed in the Coulomb cones, so
-    ε underestimates the exact-cone value.
+    ε underestimates the exact-cone value.  (Ferrari & Canny, *Planning optimal
+    grasps*, ICRA 1992; the L1/L∞ names follow the bound on the normal forces.)
 
     Cost.  L1: one Qhull hull of ``Σ_i m_i`` points (24 for three hard fingers
     with 8 generators: about a millisecond in 6-D); a grasp that is not in force
