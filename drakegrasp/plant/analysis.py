@@ -202,6 +202,11 @@ def grasp_from_plant(
     plant.ValidateContext(plant_context)
     plane = _check_plane(plane)
     model = ContactModel.parse(contact_model)
+    if plane is not None and model is ContactModel.SOFT_FINGER:
+        raise InvalidOptionError(
+            "a planar analysis has no soft fingers (no moment about an in-plane "
+            "normal); use 'hard_finger' or 'frictionless'"
+        )
     if torsional_friction is None:
         if model is ContactModel.SOFT_FINGER:
             raise InvalidOptionError(
@@ -209,11 +214,6 @@ def grasp_from_plant(
                 "moment about the normal is bounded by b * nu * f_n)"
             )
         torsional_friction = 0.0
-    if plane is not None and model is ContactModel.SOFT_FINGER:
-        raise InvalidOptionError(
-            "a planar analysis has no soft fingers (no moment about an in-plane "
-            "normal); use 'hard_finger' or 'frictionless'"
-        )
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
     contacts = find_contacts(
