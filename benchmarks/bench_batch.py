@@ -109,7 +109,7 @@ def bench_case(name, N, d, kind, mu, *, n_batch, n_scipy, n_mp, chunk_size, seed
     rng = np.random.default_rng(seed)
     P, Nrm = random_grasps(rng, n_batch, N, d, spread=0.4 if kind == "force" else 0.3)
 
-    run_batch(P[:1000], Nrm[:1000], mu, kind, chunk_size)  # warm-up
+    run_batch(P[:1000], Nrm[:1000], mu, kind, chunk_size)  # warm-up (imports, caches)
     best = np.inf
     for _ in range(3):
         t0 = time.perf_counter()
@@ -121,6 +121,8 @@ def bench_case(name, N, d, kind, mu, *, n_batch, n_scipy, n_mp, chunk_size, seed
     grasps = [make_grasp(P[k], Nrm[k], mu, kind) for k in range(n_slow)]
     lps = [lp_matrices(g, kind) for g in grasps[:n_scipy]]
     d_scipy = np.empty(n_scipy)
+    c, A_ub, b_ub, A_eq, b_eq, bounds = lps[0]
+    linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=b_eq, bounds=bounds)  # warm-up
     t0 = time.perf_counter()
     for k, (c, A_ub, b_ub, A_eq, b_eq, bounds) in enumerate(lps):
         out = linprog(
@@ -140,6 +142,7 @@ def bench_case(name, N, d, kind, mu, *, n_batch, n_scipy, n_mp, chunk_size, seed
     if force_closure is not None and n_mp > 0:
         single = form_closure if kind == "form" else force_closure
         d_mp, v_mp = np.empty(n_mp), np.empty(n_mp, dtype=bool)
+        single(grasps[0])  # warm-up
         t0 = time.perf_counter()
         for k in range(n_mp):
             r = single(grasps[k])
