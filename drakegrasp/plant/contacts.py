@@ -66,7 +66,7 @@ DEFAULT_DISTANCE_TOLERANCE = 1e-4
 PATCH_ANGLE_TOL = np.radians(2.0)
 """Two flat faces whose normals are opposite within this angle (rad) form a patch."""
 
-HandSpec = ModelInstanceIndex | Iterable[RigidBody] | None
+HandSpec = ModelInstanceIndex | str | Iterable[RigidBody] | None
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,10 +165,11 @@ def hand_bodies(
     ----------
     plant : MultibodyPlant
     object_body : RigidBody
-    hand : ModelInstanceIndex, iterable of RigidBody (or scoped names), or None
-        A model instance (all its bodies that are not welded to the world), an
-        explicit list of bodies, or None: every body that is not the object,
-        not welded to the world and not in the object's model instance.
+    hand : ModelInstanceIndex, str, iterable of RigidBody (or scoped names), or None
+        A model instance, given by index or name (all its bodies that are not
+        welded to the world), an explicit list of bodies, or None: every body
+        that is not the object, not welded to the world and not in the object's
+        model instance.
 
     Returns
     -------
@@ -176,6 +177,14 @@ def hand_bodies(
         In body-index order.
     """
     welded_to_world = {b.index() for b in plant.GetBodiesWeldedTo(plant.world_body())}
+    if isinstance(hand, str):  # a model instance's name
+        if not plant.HasModelInstanceNamed(hand):
+            names = [
+                plant.GetModelInstanceName(ModelInstanceIndex(i))
+                for i in range(plant.num_model_instances())
+            ]
+            raise ModelError(f"no model instance named {hand!r}; instances are {names}")
+        hand = plant.GetModelInstanceByName(hand)
     if isinstance(hand, ModelInstanceIndex):
         bodies = [plant.get_body(i) for i in plant.GetBodyIndices(hand)]
         bodies = [b for b in bodies if b.index() not in welded_to_world]

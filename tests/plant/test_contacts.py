@@ -349,6 +349,10 @@ def test_hand_selection():
     assert [c.finger_body for c in only] == ["hand::finger1"]
     instance = rig.plant.GetModelInstanceByName("hand")
     assert len(rig.contacts(hand=instance)) == 2
+    assert len(rig.contacts(hand="hand")) == 2
+    assert len(rig.contacts(hand=["hand::finger0"])) == 1
+    with pytest.raises(ModelError, match="no model instance named 'claw'"):
+        rig.contacts(hand="claw")
 
 
 def test_object_without_collision_geometry():
