@@ -335,8 +335,9 @@ class GraspReport:
             f"  {'#':>2}  {'finger':<28} {'p_OC [mm]':<27} {'nhat_O':<25} psi [mm]",
         ]
         for i, pc in enumerate(self.contacts):
-            p = ", ".join(f"{x * 1e3:7.2f}" for x in pc.p_OC)
-            n = ", ".join(f"{x:6.3f}" for x in pc.nhat_O)
+            # round first so that -0.0001 does not print as "-0.000"
+            p = ", ".join(f"{x:7.2f}" for x in np.round(pc.p_OC * 1e3, 2) + 0.0)
+            n = ", ".join(f"{x:6.3f}" for x in np.round(pc.nhat_O, 3) + 0.0)
             patch = (
                 "" if pc.patch_vertex is None else f"  (patch vertex {pc.patch_vertex})"
             )

@@ -14,6 +14,13 @@ there (a rounded fingertip on a box edge); else the direction ``Ca − Cb`` when
 ``ψ`` is clearly non-zero; else Drake's ``nhat_BA_W``.  ``PlantContact.normal_source``
 says which.
 
+**Accuracy.**  Drake computes some pairs in closed form (sphere–sphere,
+sphere–box, sphere–cylinder...) and the others with GJK/EPA, whose witness
+points are accurate to about 1e-5 m (convex meshes, ellipsoids).  For a
+spherical fingertip drakegrasp recomputes the finger's contact point as
+``centre + r n̂`` and, on a flat face, ``ψ`` exactly as the centre's distance to
+the face plane minus ``r``; other pairs keep Drake's values.
+
 **Flat patches.**  A flat pad on a flat face touches along an area, for which
 Drake reports a single witness point somewhere in the patch.  When both surfaces
 are flat faces of boxes or convex meshes with opposite normals (within
