@@ -4,6 +4,8 @@ import itertools
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from scipy.spatial import ConvexHull, QhullError
 
 import drakegrasp as dg
@@ -386,3 +388,41 @@ def test_linf_refuses_huge_candidate_sets(helpers, rng, monkeypatch):
     monkeypatch.setattr(q, "LINF_MAX_CANDIDATES", 100)
     with pytest.raises(dg.InvalidOptionError, match="LINF_MAX_CANDIDATES"):
         ferrari_canny(g, norm="Linf")
+
+
+@settings(
+    derandomize=True,
+    max_examples=15,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],  # stateless
+)
+@given(
+    angles=st.lists(
+        st.tuples(
+            st.floats(0.0, 2 * np.pi),
+            st.floats(-1.2, 1.2),
+            st.floats(-0.4, 0.4),
+            st.floats(-0.4, 0.4),
+        ),
+        min_size=3,
+        max_size=4,
+    ),
+    mu=st.floats(0.2, 1.2),
+)
+def test_property_l1_matches_facet_enumeration(helpers, angles, mu):
+    # Contacts at longitude/latitude (θ, φ) on the unit sphere, normals tilted
+    # from the inward radial by (a, b); eps (4 generators) against brute force,
+    # and eps_1 <= eps_∞ <= N eps_1.
+    contacts = []
+    for theta, phi, a, b in angles:
+        c = np.array(
+            [np.cos(phi) * np.cos(theta), np.cos(phi) * np.sin(theta), np.sin(phi)]
+        )
+        n = -c + np.array([a, b, 0.5 * (a - b)])
+        contacts.append(dg.Contact(c, n, mu=mu))
+    g = dg.Grasp(contacts)
+    W = np.vstack(primitive_wrenches(g, num_generators=4))
+    e1 = ferrari_canny(g, num_generators=4)
+    assert e1 == pytest.approx(helpers.brute_force_ball_radius(W), abs=1e-9)
+    einf = ferrari_canny(g, norm="Linf", num_generators=4)
+    assert e1 - 1e-12 <= einf <= len(contacts) * e1 + 1e-12
