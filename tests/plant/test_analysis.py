@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform, RollPitchYaw
@@ -403,3 +405,50 @@ def test_bad_analysis_options(scene_cache):
         )
     with pytest.raises(RuntimeError):  # a context that is not the plant's
         analyze_grasp(plant, scene.context, **base)
+
+
+@settings(derandomize=True, max_examples=6, deadline=None)
+@given(
+    rpy=st.tuples(*[st.floats(-math.pi, math.pi)] * 3),
+    xyz=st.tuples(*[st.floats(-2.0, 2.0)] * 3),
+)
+def test_default_scene_invariance_property(rpy, xyz):
+    scene = load_scene(DEFAULT_SCENE)
+    reference = _report(scene)
+    X = RigidTransform(RollPitchYaw(rpy), np.array(xyz))
+    diagram, plant, root, ctx = _moved_scene(DEFAULT_SCENE, X)
+    moved = analyze_grasp(
+        plant,
+        ctx,
+        object_body="box::box",
+        hand="gripper",
+        mu=0.5,
+        torsional_friction=0.1,
+    )
+    np.testing.assert_allclose(moved.G, reference.G, atol=1e-9)
+    np.testing.assert_allclose(moved.data.psi, reference.data.psi, atol=1e-9)
+    assert moved.force_closure.is_closure == reference.force_closure.is_closure
+    assert moved.antipodal.is_antipodal
+
+
+def test_public_signatures_follow_the_issue():
+    import inspect
+
+    from drakegrasp.plant import find_contacts
+
+    for fn, required in (
+        (find_contacts, ["object_body"]),
+        (grasp_from_plant, ["object_body", "mu"]),
+        (analyze_grasp, ["object_body", "mu"]),
+    ):
+        params = inspect.signature(fn).parameters
+        names = list(params)
+        assert names[:2] == ["plant", "plant_context"]
+        for name in names[2:]:
+            assert params[name].kind is inspect.Parameter.KEYWORD_ONLY, name
+        for name in required:
+            assert params[name].default is inspect.Parameter.empty
+        assert params["hand"].default is None
+        assert params["distance_tolerance"].default == 1e-4
+    params = inspect.signature(grasp_from_plant).parameters
+    assert params["contact_model"].default == "hard_finger"
