@@ -36,7 +36,7 @@ handling off.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -518,8 +518,8 @@ def _pair_contacts(
                 f_O = R_OGb @ pf.normal_G  # finger's outward face normal
                 if m_O @ f_O > -np.cos(PATCH_ANGLE_TOL):
                     continue
-                poly_obj = to_O_points(po.polygon_G, X_WGa, to_O)
-                poly_fin = to_O_points(pf.polygon_G, X_WGb, to_O)
+                poly_obj = _to_O_points(po.polygon_G, X_WGa, to_O)
+                poly_fin = _to_O_points(pf.polygon_G, X_WGb, to_O)
                 n_O = _clean_unit(-m_O)
                 verts = _patch(
                     n_O=n_O,
@@ -623,14 +623,6 @@ def _choose_normal(*, obj, obj_flat, fin, fin_flat, witness, psi, drake):
     return drake, "drake"
 
 
-def to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
+def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
     """Polygon vertices from a geometry frame to the object frame."""
     return np.array([to_O(X_WG.multiply(p)) for p in poly_G])
-
-
-def contacts_by_finger(contacts: Sequence[PlantContact]) -> dict[str, list[int]]:
-    """Indices of the contacts of each finger body, by scoped body name."""
-    out: dict[str, list[int]] = {}
-    for i, c in enumerate(contacts):
-        out.setdefault(c.finger_body, []).append(i)
-    return out
