@@ -37,7 +37,9 @@ import numpy as np
 
 __all__ = ["MaxLPSolution", "solve_max_last"]
 
-_STEP = 0.995  # fraction of the distance to the boundary taken per step
+_STEP = 0.9995
+"""Fraction of the distance to the boundary taken per step (0.995 costs about one
+more iteration on the closure LPs; both pass the same agreement tests)."""
 
 
 @dataclass(frozen=True)
