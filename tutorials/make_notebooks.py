@@ -591,8 +591,9 @@ assert all(rates["plane (square)"][k] == 0 for k in (2, 3))
 assert all(rates["space (cube)"][k] == 0 for k in (5, 6))
 """),
         md(r"""
-The minimal examples reach the bound exactly: four contacts in the plane, seven in
-space.  For the cube, $G_n$ is $6\times 7$ with rank 6 and a one-dimensional null
+Random sets at the bound pass rarely (seven random contacts on a cube almost never:
+they would need one on every face and moment balance besides), but careful
+placements reach it exactly: four contacts in the plane, seven in space.  For the cube, $G_n$ is $6\times 7$ with rank 6 and a one-dimensional null
 space spanned by a strictly positive vector; drop any contact and closure is lost.
 """),
         code("""
