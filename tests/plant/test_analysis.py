@@ -452,3 +452,19 @@ def test_public_signatures_follow_the_issue():
         assert params["distance_tolerance"].default == 1e-4
     params = inspect.signature(grasp_from_plant).parameters
     assert params["contact_model"].default == "hard_finger"
+
+
+def test_scene_hand_as_body_list_and_tolerance(tmp_path):
+    text = _default_text().replace(
+        "  hand: gripper",
+        "  hand: [gripper::left_finger]\n  distance_tolerance: 2.0e-4",
+    )
+    scene = load_scene(_write(tmp_path, text))
+    assert scene.info.hand == ("gripper::left_finger",)
+    assert scene.info.distance_tolerance == 2e-4
+    assert [b.name() for b in scene.hand] == ["left_finger"]
+    report = analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
+    assert [c.finger_body for c in report.contacts] == ["gripper::left_finger"]
+    assert report.data.hand_velocity_indices.tolist() == [
+        scene.plant.GetJointByName("left_finger_joint").velocity_start()
+    ]
