@@ -188,9 +188,9 @@ def test_scene_fingers_touch_exactly_and_nothing_else_touches(scene_cache, name)
     plant, ctx = scene.plant, scene.plant_context
     contacts = find_contacts(plant, ctx, object_body=scene.object_body, hand=scene.hand)
     assert len(contacts) == EXPECTED_CONTACTS[name]
-    # The analytic joint values put the fingertips on the surface (GJK on the
-    # convex mesh is the least accurate query, ~2e-7 m).
-    assert max(abs(c.psi) for c in contacts) < 1e-6
+    # The closed-form joint values put the fingertips on the surface to
+    # round-off.
+    assert max(abs(c.psi) for c in contacts) < 1e-12
     touching = {(c.object_geometry, c.finger_geometry) for c in contacts}
     query = plant.get_geometry_query_input_port().Eval(ctx)
     for finger in hand_bodies(plant, scene.object_body, scene.hand):
