@@ -20,6 +20,7 @@ from scipy.spatial import ConvexHull
 
 import drakegrasp as dg
 from drakegrasp import quality as q
+from drakegrasp.quality import epsilon
 
 
 def random_grasps(rng, count, num_contacts=3, *, mu=0.5, spread=0.3):
@@ -85,7 +86,7 @@ def main() -> None:
     row("  primitive wrenches (24 x 6)", per_grasp(q.primitive_wrenches, fc))
     row(
         "  NNLS origin-in-hull test",
-        per_grasp(lambda W: q._origin_distance_residual(W, np.abs(W).max()), Ws),
+        per_grasp(lambda W: epsilon._origin_distance_residual(W, np.abs(W).max()), Ws),
     )
     row(
         "  rank test (SVD of centred points)",

@@ -342,7 +342,7 @@ def test_bad_inputs(helpers):
 
 def _first_pass_is_degenerate(wrenches):
     """Whether some choice of faces with Σ dim = D - 1 has dependent directions."""
-    from drakegrasp import quality as q
+    from drakegrasp.quality import epsilon as q
 
     D = wrenches[0].shape[1]
     fams = [q._face_directions(np.vstack([np.zeros((1, D)), W])) for W in wrenches]
@@ -382,7 +382,7 @@ def test_linf_soft_and_frictionless_against_full_sum(helpers):
 
 
 def test_linf_refuses_huge_candidate_sets(helpers, rng, monkeypatch):
-    from drakegrasp import quality as q
+    from drakegrasp.quality import epsilon as q
 
     g = helpers.equator_grasp(0.5)
     monkeypatch.setattr(q, "LINF_MAX_CANDIDATES", 100)

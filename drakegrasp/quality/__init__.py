@@ -1,0 +1,88 @@
+r"""Grasp quality metrics.
+
+Every metric takes a :class:`~drakegrasp.Grasp` (its contacts, reference point
+``p`` and characteristic length ``b``, all in one grasp frame) and follows
+``shared/CONVENTIONS.md``: wrenches ``[f; m]`` with moments about ``p``, planar
+wrenches ``[f_x, f_y, m_z]``, contact forces in contact frames with the normal
+component first, inscribed polyhedral cones with ``n_g`` generators.
+
+**Torque scaling.**  Metrics that compare forces with moments divide every
+moment by a length ``b_s`` (the option ``torque_scale``; default the grasp's
+characteristic length ``b``, an explicit ``1.0`` means no scaling).  A scaled
+wrench ``[f; m / b_s]`` has the units of a force in every row, so balls and
+singular values in wrench space are measured in newtons (per newton of normal
+contact force: the metrics below are dimensionless).  Equivalently the metric
+is computed with ``S G`` instead of ``G``, where ``S = diag(I, I / b_s)``.
+
+The metrics:
+
+* :func:`ferrari_canny`: the Ferrari–Canny ε (L1 form with a Qhull hull, L∞
+  form through the normal fan of a Minkowski sum);
+* :func:`lp2_margin`: the ``d*`` of the force-closure program LP2;
+* :func:`grasp_singular_values` and the indices of ``G`` built from them
+  (:func:`min_singular_value`, :func:`isotropy`,
+  :func:`wrench_ellipsoid_volume`);
+* :func:`hand_object_matrix` ``H = (G^+)^T J`` and its indices
+  (:func:`distance_to_singularity`, :func:`uniformity_of_transformation`,
+  :func:`manipulability_volume`);
+* :func:`max_resistible_wrench`: the largest multiple of a given external
+  wrench that bounded contact forces can resist (an LP solved with Clp);
+* :func:`grasp_quality`: all of them at once, as a :class:`GraspQuality`.
+
+Submodules: :mod:`~drakegrasp.quality.epsilon` (primitive wrenches and ε),
+:mod:`~drakegrasp.quality.indices` (singular values of ``G`` and ``H``),
+:mod:`~drakegrasp.quality.resistible` (the LP) and
+:mod:`~drakegrasp.quality.summary` (LP2 margin and :class:`GraspQuality`).
+The ε module imports ``scipy`` (Qhull, NNLS); the LPs import
+``pydrake.solvers``.  Nothing here touches a plant.
+"""
+
+from drakegrasp.quality._common import RANK_TOL
+from drakegrasp.quality.epsilon import (
+    HULL_TOL,
+    LINF_MAX_CANDIDATES,
+    ferrari_canny,
+    primitive_wrenches,
+)
+from drakegrasp.quality.indices import (
+    distance_to_singularity,
+    grasp_singular_values,
+    hand_object_matrix,
+    hand_object_singular_values,
+    isotropy,
+    manipulability_volume,
+    min_singular_value,
+    uniformity_of_transformation,
+    wrench_ellipsoid_volume,
+)
+from drakegrasp.quality.resistible import (
+    MaxWrenchResult,
+    MaxWrenchVariables,
+    build_max_resistible_wrench_program,
+    max_resistible_wrench,
+)
+from drakegrasp.quality.summary import GraspQuality, grasp_quality, lp2_margin
+
+__all__ = [
+    "HULL_TOL",
+    "LINF_MAX_CANDIDATES",
+    "RANK_TOL",
+    "GraspQuality",
+    "MaxWrenchResult",
+    "MaxWrenchVariables",
+    "build_max_resistible_wrench_program",
+    "distance_to_singularity",
+    "ferrari_canny",
+    "grasp_quality",
+    "grasp_singular_values",
+    "hand_object_matrix",
+    "hand_object_singular_values",
+    "isotropy",
+    "lp2_margin",
+    "manipulability_volume",
+    "max_resistible_wrench",
+    "min_singular_value",
+    "primitive_wrenches",
+    "uniformity_of_transformation",
+    "wrench_ellipsoid_volume",
+]

@@ -1,0 +1,453 @@
+r"""Ferrari–Canny ε: primitive wrenches, convex hulls and the L∞ normal fan.
+
+See :func:`ferrari_canny`.  The L1 form is one Qhull hull; the L∞ form uses
+the normal fan of a Minkowski sum (see ``_linf_radius``).
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from scipy.optimize import nnls
+from scipy.spatial import ConvexHull, QhullError
+
+from drakegrasp.errors import InvalidOptionError, SolverError
+from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, friction_cone_generators
+from drakegrasp.grasp import Grasp
+from drakegrasp.quality._common import (
+    RANK_TOL,
+    _check_grasp,
+    _scaled_grasp_matrix,
+    _torque_scale,
+)
+
+__all__ = [
+    "HULL_TOL",
+    "LINF_MAX_CANDIDATES",
+    "ferrari_canny",
+    "primitive_wrenches",
+]
+
+HULL_TOL = 1e-9
+"""Relative tolerance (times the largest coordinate) of the hull checks."""
+
+LINF_MAX_CANDIDATES = 2_000_000
+"""Most candidate facet normals the L∞ ε may test (about 6 s per million)."""
+
+_NORMS = ("L1", "Linf")
+
+
+def primitive_wrenches(
+    grasp: Grasp,
+    *,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    torque_scale: float | None = None,
+) -> tuple[np.ndarray, ...]:
+    r"""Wrenches of the friction-cone generators of each contact.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    num_generators : int, optional
+        Generators ``n_g`` of each spatial Coulomb cone (default 8).
+    torque_scale : float, optional
+        Length ``b_s`` (metres) by which moments are divided; default the
+        grasp's characteristic length, ``1.0`` for unscaled moments.
+
+    Returns
+    -------
+    wrenches : tuple of (m_i, 6) or (m_i, 3) float
+        For contact ``i``, row ``k`` is the scaled wrench ``S G_i s_k`` of its
+        ``k``-th generator ``s_k`` (contact frame), in the grasp frame about
+        ``p``.  Every generator has unit normal component, so these are the
+        wrenches of contact forces with ``f_n = 1``.  A frictionless contact
+        (or a hard finger with ``mu = 0``) has one row, a planar hard finger
+        two, a spatial hard finger ``n_g``, a soft finger ``n_g + 2``.
+
+    Notes
+    -----
+    .. math:: w_{i,k} = S\, G_i\, s_k, \qquad S = \operatorname{diag}(I, I / b_s)
+    """
+    _check_grasp(grasp)
+    b = _torque_scale(grasp, torque_scale)
+    if not grasp.planar and all(
+        c.effective_components() == (0, 1, 2) for c in grasp.contacts
+    ):
+        return _hard_finger_wrenches(grasp, num_generators, b)
+    G = _scaled_grasp_matrix(grasp, b)
+    out = []
+    for contact, sl in zip(grasp.contacts, grasp.component_slices(), strict=True):
+        S = friction_cone_generators(
+            contact, num_generators, characteristic_length=grasp.characteristic_length
+        )
+        out.append((G[:, sl] @ S).T.copy())
+    return tuple(out)
+
+
+@functools.lru_cache(maxsize=16)
+def _unit_circle(n_g: int) -> tuple[np.ndarray, np.ndarray]:
+    angles = 2.0 * np.pi * np.arange(1, n_g + 1) / n_g
+    return np.cos(angles), np.sin(angles)
+
+
+def _hard_finger_wrenches(
+    grasp: Grasp, num_generators: int, b: float
+) -> tuple[np.ndarray, ...]:
+    """Vectorised :func:`primitive_wrenches` for spatial hard fingers (mu > 0).
+
+    The generators are those of CONVENTIONS.md (``s_k = [1, μ cos(2πk/n_g),
+    μ sin(2πk/n_g)]`` in the contact frame); a test checks that they equal
+    :func:`~drakegrasp.friction_cone_generators`.
+    """
+    n_g = int(num_generators)
+    if n_g != num_generators or n_g < 3:
+        raise InvalidOptionError(
+            f"num_generators must be an integer >= 3, got {num_generators!r}"
+        )
+    R = np.array([c.frame for c in grasp.contacts])  # (N, 3, 3) columns n, t1, t2
+    mu = np.array([c.mu for c in grasp.contacts])
+    r = np.array([c.position for c in grasp.contacts]) - grasp.reference_point
+    cos, sin = _unit_circle(n_g)
+    # Force directions R_i s_k, (N, n_g, 3).
+    forces = R[:, None, :, 0] + mu[:, None, None] * (
+        cos[None, :, None] * R[:, None, :, 1] + sin[None, :, None] * R[:, None, :, 2]
+    )
+    W = np.empty(forces.shape[:2] + (6,))
+    W[:, :, :3] = forces
+    rx, ry, rz = (r[:, i, None] / b for i in range(3))
+    fx, fy, fz = forces[:, :, 0], forces[:, :, 1], forces[:, :, 2]
+    W[:, :, 3] = ry * fz - rz * fy
+    W[:, :, 4] = rz * fx - rx * fz
+    W[:, :, 5] = rx * fy - ry * fx
+    return tuple(W)
+
+
+def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
+    """Convex hull of full-dimensional points, fast when the input allows it.
+
+    First Qhull runs with ``Q0`` (no facet merging), about three times faster
+    than the default merging options in 5-D and 6-D; its answer is accepted
+    only if every point lies below every facet hyperplane (within
+    ``HULL_TOL * scale``).  Qhull keeps the facets a closed surface, so facets
+    that all support the point set are the hull's boundary.  Otherwise (or if
+    Qhull reports a precision error) it runs again with its default merging
+    for 5-D and up, ``Qx``, plus ``Qs`` (search every point for the initial
+    simplex, which symmetric wrench sets need), and as a last resort with
+    joggled input ``QJ`` (which perturbs the points by about 1e-11 relative,
+    far below any quality we report).
+    """
+    tol = HULL_TOL * max(scale, 1e-300)
+    try:
+        hull = ConvexHull(points, qhull_options="Q0")
+        eq = hull.equations
+        if np.max(points @ eq[:, :-1].T + eq[:, -1]) <= tol:
+            return hull
+    except QhullError:
+        pass
+    try:
+        return ConvexHull(points, qhull_options="Qx Qs")
+    except QhullError:
+        pass
+    try:
+        return ConvexHull(points, qhull_options="QJ")
+    except QhullError as err:  # pragma: no cover - Qhull's last resort failed
+        raise SolverError(
+            f"Qhull could not build the convex hull of {points.shape[0]} points in "
+            f"{points.shape[1]}-D: {err}"
+        ) from err
+
+
+def _origin_distance_residual(points: np.ndarray, scale: float) -> float:
+    r"""Residual of ``min ‖Pᵀλ‖² + ρ²(1ᵀλ - 1)²`` over ``λ >= 0`` (NNLS).
+
+    Zero (to round-off) exactly when some convex combination of the points is
+    the origin, i.e. when the origin lies in their hull; positive otherwise.
+    Lawson–Hanson NNLS on ``K`` points costs tens of microseconds, so it lets
+    :func:`_ball_radius` skip Qhull for grasps that are not in force closure.
+    A residual at round-off level is never trusted: Qhull then decides.
+    """
+    rho = max(scale, 1e-300)
+    A = np.vstack([points.T, np.full((1, points.shape[0]), rho)])
+    rhs = np.zeros(points.shape[1] + 1)
+    rhs[-1] = rho
+    try:
+        return float(nnls(A, rhs)[1])
+    except RuntimeError:  # iteration limit: let Qhull decide
+        return 0.0
+
+
+def _ball_radius(points: np.ndarray) -> float:
+    """Radius of the largest origin-centred ball in ``conv(points)``; 0 if none.
+
+    Qhull is called only when needed: a hull that does not contain the origin
+    (NNLS residual above round-off) or whose affine hull is lower-dimensional
+    than the space (no interior) has radius 0 without it.
+    """
+    num, dim = points.shape
+    scale = float(np.max(np.abs(points))) if points.size else 0.0
+    if num <= dim or scale == 0.0:
+        return 0.0
+    if _origin_distance_residual(points, scale) > HULL_TOL * scale:
+        return 0.0  # the origin is outside the hull: no hull needed
+    s = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    if s[-1] <= RANK_TOL * max(s[0], scale):
+        return 0.0  # flat hull: no interior
+    eq = _qhull(points, scale).equations
+    # Unit outward normals n and offsets o: the hull is {x : n·x + o <= 0}, so
+    # the distance from the origin to each facet's hyperplane is -o.
+    radius = float(np.min(-eq[:, -1]))
+    return radius if radius > 0.0 else 0.0
+
+
+def _face_directions(points: np.ndarray) -> dict[int, np.ndarray]:
+    """Direction spaces of the faces of ``conv(points)``, grouped by dimension.
+
+    ``points`` must contain the origin (a per-contact set ``{0} ∪ {w_ik}``), so
+    the polytope's affine span is the linear span of its points.
+
+    Returns
+    -------
+    dict
+        ``j -> (n_j, j, D)``: an orthonormal basis (rows) of the direction space
+        of each ``j``-dimensional face, ``1 <= j <= m`` (``m`` the polytope's
+        dimension; the one ``m``-face is the polytope itself).  Vertices
+        (``j = 0``) have no direction and are left out.
+
+    Notes
+    -----
+    Facets come from Qhull (default merging options, so coplanar triangles of a
+    facet share one hyperplane) in ``m``-D coordinates; every face of a polytope
+    is an intersection of facets, so the faces are the closure of the facets'
+    vertex sets under intersection.
+    """
+    scale = float(np.max(np.abs(points)))
+    _, s, vt = np.linalg.svd(points, full_matrices=False)
+    m = int(np.sum(s > RANK_TOL * max(s[0], scale)))
+    out = {m: vt[None, :m]}
+    if m < 2:
+        return out
+    coords = points @ vt[:m].T
+    try:
+        hull = ConvexHull(coords)
+    except QhullError:  # symmetric sets may need a search for the first simplex
+        hull = ConvexHull(coords, qhull_options="Qx Qs")
+    verts = hull.vertices
+    tol = HULL_TOL * float(np.max(np.abs(coords)))
+    facets = set()
+    for eq in hull.equations:
+        on = verts[np.abs(coords[verts] @ eq[:-1] + eq[-1]) <= tol]
+        facets.add(frozenset(on.tolist()))
+    faces, frontier = set(facets), set(facets)
+    while frontier:
+        frontier = {a & f for a in frontier for f in facets if a & f} - faces
+        faces |= frontier
+    by_dim: dict[int, list[np.ndarray]] = {}
+    for face in faces:
+        idx = sorted(face)
+        if len(idx) < 2:
+            continue
+        _, sf, vtf = np.linalg.svd(points[idx[1:]] - points[idx[0]])
+        j = int(np.sum(sf > RANK_TOL * max(sf[0], scale)))
+        if 0 < j < m:
+            by_dim.setdefault(j, []).append(vtf[:j])
+    out.update({j: np.array(bases) for j, bases in by_dim.items()})
+    return out
+
+
+def _cofactor_normals(M: np.ndarray) -> np.ndarray:
+    """Normals of the hyperplanes spanned by the rows of ``M`` (n, D-1, D).
+
+    ``u_j = (-1)^j det(M without column j)`` is orthogonal to every row, and
+    ``‖u‖ = sqrt(det(M Mᵀ))`` (0 when the rows are dependent).
+    """
+    D = M.shape[2]
+    u = np.empty((M.shape[0], D))
+    for j in range(D):
+        cols = [k for k in range(D) if k != j]
+        u[:, j] = (-1.0) ** j * np.linalg.det(M[:, :, cols])
+    return u
+
+
+def _support_min(U: np.ndarray, wrenches: Sequence[np.ndarray]) -> float:
+    """``min over rows u of U (unit) and ±u`` of ``h(u) = Σ_i max(0, max_k u·w_ik)``."""
+    hp = np.zeros(U.shape[0])
+    hm = np.zeros(U.shape[0])
+    for W in wrenches:
+        V = U @ W.T
+        hp += np.maximum(V.max(axis=1), 0.0)
+        hm += np.maximum(-V.min(axis=1), 0.0)
+    return float(min(hp.min(), hm.min()))
+
+
+def _face_tuples(families, dim_test):
+    """Yield ``(parts, shape)`` for every choice of one face per contact.
+
+    ``families[i]`` maps a face dimension to bases (see
+    :func:`_face_directions`); a contact may also contribute a vertex (no
+    direction).  ``dim_test(total)`` selects the total dimensions to keep.
+    """
+    choices = [[0, *sorted(f)] for f in families]
+    for combo in itertools.product(*choices):
+        if not dim_test(sum(combo)):
+            continue
+        parts = [(i, j) for i, j in enumerate(combo) if j > 0]
+        shape = [families[i][j].shape[0] for i, j in parts]
+        yield parts, shape
+
+
+def _stacked_bases(families, parts, shape, lo, hi) -> np.ndarray:
+    idx = np.unravel_index(np.arange(lo, hi), shape)
+    return np.concatenate(
+        [families[i][j][k] for (i, j), k in zip(parts, idx, strict=True)], axis=1
+    )
+
+
+def _check_candidate_count(families, dim_test) -> None:
+    total = sum(int(np.prod(s)) for _, s in _face_tuples(families, dim_test))
+    if total > LINF_MAX_CANDIDATES:
+        raise InvalidOptionError(
+            f"the L∞ Ferrari–Canny metric of this grasp needs {total} candidate "
+            f"facet normals (more than LINF_MAX_CANDIDATES = {LINF_MAX_CANDIDATES});"
+            " use norm='L1', fewer contacts or fewer generators"
+        )
+
+
+def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
+    r"""ε of the Minkowski sum ``⊕_i conv({0} ∪ {w_ik})`` through its normal fan.
+
+    Call only when the origin is strictly inside (ε_1 > 0).  Every facet of a
+    Minkowski sum is a sum of faces ``F_i`` of the summands, and its normal is
+    orthogonal to every ``dir(F_i)``.  Any unit ``u`` bounds
+    ``ε = min_{‖u‖=1} h(u)`` from above, so the minimum of ``h`` over a set of
+    directions that contains every facet normal is ε exactly:
+
+    1. every choice of one face per summand (a vertex counts as dimension 0)
+       with ``Σ dim F_i = D - 1`` and independent directions gives one normal
+       (by cofactors).  If no such choice has dependent directions, every facet
+       normal is among them: shrinking a facet's faces to sub-faces whose
+       dimensions add up to ``D - 1`` gives a choice whose directions lie in the
+       facet's hyperplane, so they either span it (its normal is found) or are
+       dependent (which this step detects).
+    2. otherwise (symmetric grasps) every choice with ``Σ dim F_i >= D - 1``
+       whose directions span exactly ``D - 1`` dimensions gives one normal (by
+       SVD); each facet is such a choice, with its own faces.
+    """
+    D = wrenches[0].shape[1]
+    sets = [np.vstack([np.zeros((1, D)), W]) for W in wrenches]
+    families = [_face_directions(P) for P in sets]
+    chunk = 100_000
+    exact_dim = (lambda t: t == D - 1), (lambda t: t >= D - 1)
+    _check_candidate_count(families, exact_dim[0])
+    best, degenerate = math.inf, False
+    for parts, shape in _face_tuples(families, exact_dim[0]):
+        count = int(np.prod(shape))
+        for lo in range(0, count, chunk):
+            M = _stacked_bases(families, parts, shape, lo, min(count, lo + chunk))
+            u = _cofactor_normals(M)
+            norms = np.linalg.norm(u, axis=1)
+            if np.any(norms <= RANK_TOL):
+                degenerate = True
+                break
+            best = min(best, _support_min(u / norms[:, None], wrenches))
+        if degenerate:
+            break
+    if not degenerate:
+        return best
+    _check_candidate_count(families, exact_dim[1])
+    best = math.inf
+    for parts, shape in _face_tuples(families, exact_dim[1]):
+        count = int(np.prod(shape))
+        for lo in range(0, count, chunk):
+            M = _stacked_bases(families, parts, shape, lo, min(count, lo + chunk))
+            _, s, vt = np.linalg.svd(M)
+            keep = s[:, D - 2] > RANK_TOL * s[:, 0]
+            if M.shape[1] >= D:
+                keep &= s[:, D - 1] <= RANK_TOL * s[:, 0]
+            if np.any(keep):
+                best = min(best, _support_min(vt[keep, D - 1, :], wrenches))
+    return best
+
+
+def ferrari_canny(
+    grasp: Grasp,
+    *,
+    norm: str = "L1",
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    torque_scale: float | None = None,
+) -> float:
+    r"""Ferrari–Canny ε: the largest origin-centred ball in the grasp wrench set.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    norm : {"L1", "Linf"}, optional
+        ``"L1"`` (default): the contact forces are bounded by ``Σ_i f_{n,i} <= 1``
+        and the wrench set is the convex hull of all primitive wrenches.
+        ``"Linf"``: each ``f_{n,i} <= 1`` and the wrench set is the Minkowski sum
+        of the per-contact sets ``conv({0} ∪ {w_{i,k}})``.
+    num_generators : int, optional
+        Generators ``n_g`` of each spatial Coulomb cone (default 8).
+    torque_scale : float, optional
+        Length ``b_s`` (metres) dividing the moments; default the grasp's
+        characteristic length ``b``; ``1.0`` means no scaling.
+
+    Returns
+    -------
+    float
+        ε ≥ 0, the radius of the largest ball centred at the origin inside the
+        wrench set, in newtons of scaled wrench per newton of normal force
+        (dimensionless).  0 when the origin is not strictly inside the set (no
+        force closure on the polyhedral cones), including wrench sets of lower
+        dimension than the wrench space (e.g. two hard fingers in 3-D).
+
+    Notes
+    -----
+    With the primitive wrenches ``w_{i,k} = S G_i s_k`` (see
+    :func:`primitive_wrenches`; every generator has ``f_n = 1``):
+
+    .. math::
+
+        W_1 = \operatorname{conv}\bigcup_i \{w_{i,k}\}_k, \qquad
+        W_\infty = \bigoplus_i \operatorname{conv}(\{0\} \cup \{w_{i,k}\}_k),
+
+        \varepsilon = \min_{\|u\| = 1} \max_{w \in W} u^T w
+                    = \min_{\text{facets } (n_j, o_j)} (-o_j)
+
+    where Qhull gives each facet as ``n_j·x + o_j <= 0`` with unit ``n_j``.
+    Since every ``w_{i,k}`` lies in ``W_∞``, ``ε_1 <= ε_∞``, and
+    ``ε_∞ <= N ε_1``; the origin is strictly inside one exactly when it is
+    strictly inside the other.  The cones are inscribed in the Coulomb cones, so
+    ε underestimates the exact-cone value.  (Ferrari & Canny, *Planning optimal
+    grasps*, ICRA 1992; the L1/L∞ names follow the bound on the normal forces.)
+
+    Cost.  L1: one Qhull hull of ``Σ_i m_i`` points (24 for three hard fingers
+    with 8 generators: about a millisecond in 6-D); a grasp that is not in force
+    closure is settled before Qhull by an NNLS test.  L∞: the Minkowski sum of
+    ``N`` sets of ``n_g + 1`` points has up to ``(n_g + 1)^N`` vertices and tens
+    of thousands of facets in 6-D (about a second in Qhull for three hard
+    fingers), so ε_∞ is computed through the sum's normal fan instead: every
+    facet normal of ``W_∞`` is orthogonal to the directions of one face of each
+    summand, so the minimum of the support function over those normals is ε_∞
+    (exact; see ``_linf_radius``).  About 20–60 ms for three spatial hard
+    fingers with 8 generators (4,710 candidate normals) and about 1 s for four
+    (166,188); five need 1.8 million candidates (about 15 s).  Grasps that
+    need more than ``LINF_MAX_CANDIDATES`` (six hard fingers do) raise
+    :class:`~drakegrasp.InvalidOptionError`.
+    """
+    if norm not in _NORMS:
+        raise InvalidOptionError(f"norm must be one of {_NORMS}, got {norm!r}")
+    wrenches = primitive_wrenches(
+        grasp, num_generators=num_generators, torque_scale=torque_scale
+    )
+    if norm == "L1":
+        return _ball_radius(np.vstack(wrenches))
+    # The origin is strictly inside W_∞ exactly when it is strictly inside W_1
+    # (both hold iff the primitive wrenches positively span the wrench space),
+    # so the cheap L1 test settles ε_∞ = 0 first.
+    if _ball_radius(np.vstack(wrenches)) == 0.0:
+        return 0.0
+    return _linf_radius(wrenches)

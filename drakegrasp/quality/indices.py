@@ -1,0 +1,209 @@
+r"""Singular-value indices of the grasp matrix ``G`` and of ``H = (G^+)^T J``."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from drakegrasp.errors import InvalidGraspError
+from drakegrasp.grasp import Grasp
+from drakegrasp.quality._common import (
+    RANK_TOL,
+    _check_grasp,
+    _padded_singular_values,
+    _scaled_grasp_matrix,
+    _torque_scale,
+)
+
+__all__ = [
+    "distance_to_singularity",
+    "grasp_singular_values",
+    "hand_object_matrix",
+    "hand_object_singular_values",
+    "isotropy",
+    "manipulability_volume",
+    "min_singular_value",
+    "uniformity_of_transformation",
+    "wrench_ellipsoid_volume",
+]
+
+
+def grasp_singular_values(
+    grasp: Grasp, *, torque_scale: float | None = None
+) -> np.ndarray:
+    r"""Singular values of the torque-scaled grasp matrix ``S G``.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    torque_scale : float, optional
+        Length ``b_s`` (metres) dividing the moment rows; default the grasp's
+        characteristic length, ``1.0`` for the unscaled ``G``.
+
+    Returns
+    -------
+    sigma : (6,) or (3,) float
+        ``σ_1 >= … >= σ_D`` of ``S G`` (``D`` = wrench dimension), zero-padded
+        when ``G`` has fewer than ``D`` columns.  Dimensionless (newtons of
+        scaled wrench per newton of contact force).
+
+    Notes
+    -----
+    ``G`` is :func:`~drakegrasp.grasp_matrix` with every component of each
+    contact model (a hard finger with ``mu = 0`` keeps its tangential columns:
+    these indices describe the contact geometry, not friction).  The columns of
+    ``G`` map orthonormal contact-frame components, so ``σ_i`` are the semi-axes
+    of the wrench ellipsoid ``{S G f : ‖f‖ <= 1}``.
+    """
+    _check_grasp(grasp)
+    b = _torque_scale(grasp, torque_scale)
+    return _padded_singular_values(_scaled_grasp_matrix(grasp, b))
+
+
+def min_singular_value(grasp: Grasp, *, torque_scale: float | None = None) -> float:
+    """Smallest singular value ``σ_min(S G)``: the worst-direction wrench gain.
+
+    The smallest wrench norm that a unit contact-force vector can produce in
+    the least favourable direction; 0 when ``G`` is rank-deficient.  See
+    :func:`grasp_singular_values` for ``S``, units and conventions.
+    """
+    return float(grasp_singular_values(grasp, torque_scale=torque_scale)[-1])
+
+
+def isotropy(grasp: Grasp, *, torque_scale: float | None = None) -> float:
+    """Grasp isotropy index ``σ_min(S G) / σ_max(S G)`` in ``[0, 1]``.
+
+    1 when every wrench direction is produced equally well; 0 when ``G`` is
+    rank-deficient.  Depends on the torque scale; see
+    :func:`grasp_singular_values`.
+    """
+    s = grasp_singular_values(grasp, torque_scale=torque_scale)
+    return float(s[-1] / s[0]) if s[0] > 0 else 0.0
+
+
+def wrench_ellipsoid_volume(
+    grasp: Grasp, *, torque_scale: float | None = None
+) -> float:
+    r"""Volume index of the wrench ellipsoid: ``σ_1 σ_2 … σ_D = sqrt(det(S G Gᵀ S))``.
+
+    The ellipsoid ``{S G f : ‖f‖ <= 1}`` has semi-axes ``σ_i``, so its volume is
+    ``V_D σ_1 … σ_D`` with ``V_D`` the volume of the unit ball (``π³/6`` in 6-D,
+    ``4π/3`` in 3-D).  As in the grasp-quality literature the constant ``V_D``
+    is left out: the index is the product of the singular values
+    (dimensionless; 0 when ``G`` is rank-deficient).  See
+    :func:`grasp_singular_values` for the scaling.
+    """
+    return float(np.prod(grasp_singular_values(grasp, torque_scale=torque_scale)))
+
+
+def _check_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
+    J = np.asarray(hand_jacobian, dtype=float)
+    M = grasp.num_components
+    if J.ndim != 2 or J.shape[0] != M or J.shape[1] < 1:
+        raise InvalidGraspError(
+            f"hand_jacobian must have shape ({M}, n_q): one row per column of G "
+            f"(contact-frame components, in contact order) and one column per hand "
+            f"velocity; got shape {J.shape}"
+        )
+    if not np.all(np.isfinite(J)):
+        raise InvalidGraspError("hand_jacobian has non-finite entries")
+    return J
+
+
+def hand_object_matrix(
+    grasp: Grasp,
+    hand_jacobian: np.ndarray,
+    *,
+    torque_scale: float | None = None,
+) -> np.ndarray:
+    r"""Hand-object matrix ``H = ((S G)^+)^T J``: hand velocities to object twist.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    hand_jacobian : (M, n_q) float
+        Hand Jacobian ``J``: rows in the column order of ``G`` (contact-frame
+        components, contact by contact), columns the hand's generalized
+        velocities ``q̇``.
+    torque_scale : float, optional
+        Length ``b_s`` (metres); default the grasp's characteristic length,
+        ``1.0`` for no scaling.
+
+    Returns
+    -------
+    H : (6, n_q) or (3, n_q) float
+        Maps ``q̇`` to the object twist ``[v; b_s ω]`` (planar
+        ``[v_x, v_y, b_s ω]``) about ``p`` in the grasp frame: every row in
+        metres per second per unit of ``q̇``.
+
+    Notes
+    -----
+    The contact constraint (Prattichizzo & Trinkle, *Grasping*, Springer
+    Handbook of Robotics) equates the contact velocities seen by the hand and
+    by the object: ``J q̇ = Gᵀ ν``.  Its least-squares solution for the twist
+    is ``ν = (Gᵀ)^+ J q̇ = (G^+)ᵀ J q̇``, and ``H = (G^+)ᵀ J`` is the matrix whose
+    singular values give the hand-configuration indices of Roa & Suárez,
+    *Grasp quality measures: review and performance* (Auton. Robots, 2015).
+    With scaling, ``Gᵀ ν = (S G)ᵀ (S^{-1} ν)``, so the twist becomes
+    ``S^{-1} ν = [v; b_s ω]``.  The pseudo-inverse drops singular values below
+    ``RANK_TOL σ_max``.
+    """
+    _check_grasp(grasp)
+    J = _check_jacobian(grasp, hand_jacobian)
+    b = _torque_scale(grasp, torque_scale)
+    G = _scaled_grasp_matrix(grasp, b)
+    G_pinv = np.linalg.pinv(G, rcond=RANK_TOL)
+    return G_pinv.T @ J
+
+
+def hand_object_singular_values(
+    grasp: Grasp, hand_jacobian: np.ndarray, *, torque_scale: float | None = None
+) -> np.ndarray:
+    """Singular values ``σ_1 >= … >= σ_D`` of ``H`` (zero-padded to ``D`` rows).
+
+    See :func:`hand_object_matrix`.  Units: metres per second of (scaled)
+    object twist per unit of hand velocity.
+    """
+    return _padded_singular_values(
+        hand_object_matrix(grasp, hand_jacobian, torque_scale=torque_scale)
+    )
+
+
+def distance_to_singularity(
+    grasp: Grasp, hand_jacobian: np.ndarray, *, torque_scale: float | None = None
+) -> float:
+    """Distance from singular configurations: ``σ_min(H)`` (0 at a singularity).
+
+    ``σ_min`` is the smallest of the ``D`` singular values of ``H``, so it is 0
+    whenever the hand cannot move the object in some direction (including
+    ``n_q < D``).  See :func:`hand_object_matrix`.
+    """
+    s = hand_object_singular_values(grasp, hand_jacobian, torque_scale=torque_scale)
+    return float(s[-1])
+
+
+def uniformity_of_transformation(
+    grasp: Grasp, hand_jacobian: np.ndarray, *, torque_scale: float | None = None
+) -> float:
+    """Uniformity of transformation: ``σ_max(H) / σ_min(H) >= 1``; 1 is best.
+
+    The condition number of ``H``; ``inf`` at a singular configuration.  See
+    :func:`hand_object_matrix`.
+    """
+    s = hand_object_singular_values(grasp, hand_jacobian, torque_scale=torque_scale)
+    return float(s[0] / s[-1]) if s[-1] > 0 else math.inf
+
+
+def manipulability_volume(
+    grasp: Grasp, hand_jacobian: np.ndarray, *, torque_scale: float | None = None
+) -> float:
+    r"""Manipulability-ellipsoid volume index ``σ_1 … σ_D = sqrt(det(H Hᵀ))``.
+
+    The ellipsoid ``{H q̇ : ‖q̇‖ <= 1}`` of object twists has volume
+    ``V_D σ_1 … σ_D``; the unit-ball constant ``V_D`` is left out (as in
+    :func:`wrench_ellipsoid_volume`).  0 at a singular configuration.  See
+    :func:`hand_object_matrix`.
+    """
+    s = hand_object_singular_values(grasp, hand_jacobian, torque_scale=torque_scale)
+    return float(np.prod(s))
