@@ -195,6 +195,7 @@ def solve_max_last(
     h = np.ascontiguousarray(np.transpose(h), dtype=float)  # (r, K)
 
     x, s, lam, L0 = _starting_point(B, h)
+    hB = _tmul(B, h) if stop_below is not None else None
     idx = np.arange(K)
     hscale = 1.0 + np.abs(h).max(axis=0)
     for it in range(1, max_iter + 1):
@@ -211,13 +212,17 @@ def solve_max_last(
         done = (err_p <= tol) & (err_d <= tol) & (err_g <= tol)
         below = np.zeros_like(done)
         if stop_below is not None:
-            lam_f = lam + _mul(B, _cho_solve(L0, rp))
-            bound = np.einsum("rk,rk->k", h, lam_f)
-            below = (bound < stop_below) & (lam_f.min(axis=0) >= 0.0) & ~done
-            if below.any():
+            # hᵀλ' = hᵀλ + (Bᵀh)ᵀ z costs O(n); form λ' only where it would stop.
+            z = _cho_solve(L0, rp)
+            bound = np.einsum("rk,rk->k", h, lam) + np.einsum("ik,ik->k", hB, z)
+            cand = np.flatnonzero((bound < stop_below) & ~done)
+            if cand.size:
+                lam_f = lam[:, cand] + _mul(B[:, :, cand], z[:, cand])
+                cand = cand[lam_f.min(axis=0) >= 0.0]
+                below[cand] = True
                 done |= below
                 x = x.copy()
-                x[-1, below] = bound[below]
+                x[-1, cand] = bound[cand]
         last = it == max_iter
         if last or done.any():
             if last:  # accept a last iterate that is close enough, flag the rest
@@ -237,6 +242,8 @@ def solve_max_last(
                 break
             idx, B, h, hscale = idx[keep], B[:, :, keep], h[:, keep], hscale[keep]
             L0 = L0[:, :, keep]
+            if hB is not None:
+                hB = hB[:, keep]
             x, s, lam = x[:, keep], s[:, keep], lam[:, keep]
             rp, rd, sl, gap = rp[:, keep], rd[:, keep], sl[:, keep], gap[keep]
         mu = gap / r
