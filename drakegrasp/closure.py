@@ -346,7 +346,10 @@ def build_exact_force_closure_program(
 
 
 def build_internal_force_program(
-    grasp: Grasp, hand_jacobian: np.ndarray
+    grasp: Grasp,
+    hand_jacobian: np.ndarray,
+    *,
+    rank_tol: float = DEFAULT_RANK_TOL,
 ) -> tuple[MathematicalProgram, ProgramVariables]:
     """Build LP3: an internal force with positive normals that the hand cannot feel.
 
@@ -357,6 +360,8 @@ def build_internal_force_program(
         Hand Jacobian ``J``: rows in the order of the columns of
         :func:`~drakegrasp.grasp_matrix` (contact-frame components), columns the
         hand's generalized velocities.
+    rank_tol : float, optional
+        Relative singular-value threshold that defines the numerical null space.
 
     Returns
     -------
@@ -364,16 +369,34 @@ def build_internal_force_program(
         ``max d`` s.t. ``G f = 0``, ``Jᵀ f = 0``, ``E f - 1 d >= 0``, ``d >= 0``,
         ``Σ f_n <= N``.  ``d* = 0`` passes.
     variables : ProgramVariables
+
+    Notes
+    -----
+    The two equalities are imposed as ``V_rᵀ f = 0``, with ``V_r`` the right
+    singular vectors of ``A = [G; Jᵀ]`` whose singular values exceed
+    ``rank_tol σ_max``: ``f`` ranges over the same numerical null space
+    ``N(G) ∩ N(Jᵀ)`` whose dimension the result reports.  Imposing ``A f = 0``
+    literally would let a singular value of 1e-12 (contacts measured to 1e-7 m)
+    exclude an internal force that the rank count says exists.
     """
     J = _check_hand_jacobian(grasp, hand_jacobian)
     layout = _Layout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
-    A = np.vstack([layout.G, J[layout.columns].T])
-    prog.AddLinearEqualityConstraint(A, np.zeros(A.shape[0]), f)
+    row_space = _row_space(np.vstack([layout.G, J[layout.columns].T]), rank_tol)
+    if row_space.shape[0]:
+        prog.AddLinearEqualityConstraint(row_space, np.zeros(row_space.shape[0]), f)
     _add_margin_rows(prog, np.eye(len(f))[layout.normal_positions], f, d)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     return prog, ProgramVariables(d, f, layout.columns)
+
+
+def _row_space(A: np.ndarray, rank_tol: float) -> np.ndarray:
+    """Orthonormal basis (rows) of the numerical row space of ``A``."""
+    _, s, vt = np.linalg.svd(A)
+    if s.size == 0 or s[0] == 0.0:
+        return np.zeros((0, A.shape[1]))
+    return vt[: int(np.sum(s > rank_tol * s[0]))]
 
 
 def _check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
@@ -507,13 +530,13 @@ def internal_forces(
     InternalForceResult
     """
     tol = _check_tol(tol)
-    prog, variables = build_internal_force_program(grasp, hand_jacobian)
-    d_star, forces, solver, status = _solve_margin(prog, variables, conic=False)
-    J = np.asarray(hand_jacobian, dtype=float)[variables.columns]
-    G = grasp_matrix(grasp)[:, variables.columns]
-    null_dim = len(variables.columns) - matrix_rank(
-        np.vstack([G, J.T]), rank_tol=rank_tol
+    prog, variables = build_internal_force_program(
+        grasp, hand_jacobian, rank_tol=rank_tol
     )
+    d_star, forces, solver, status = _solve_margin(prog, variables, conic=False)
+    (equalities,) = prog.linear_equality_constraints() or (None,)
+    rank = 0 if equalities is None else equalities.evaluator().num_constraints()
+    null_dim = len(variables.columns) - rank
     passes = not (d_star > tol)  # NaN (infeasible) passes: no such force exists
     return InternalForceResult(
         passes=bool(passes),

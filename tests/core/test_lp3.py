@@ -70,3 +70,21 @@ def test_wrong_jacobian_shape_names_the_expected_shape():
     grasp = ex.equator_fingers(0.5)
     with pytest.raises(dg.InvalidGraspError, match=r"\(9, n_q\).*\(6, 3\)"):
         dg.force_closure(grasp, hand_jacobian=np.zeros((6, 3)))
+
+
+def test_lp3_and_the_null_space_count_agree_on_noisy_jacobians(rng):
+    # Contacts measured to ~1e-7 make [G; J^T] full rank only by round-off.  LP3
+    # must then see the same numerical null space that null_space_dim counts.
+    grasp = ex.equator_fingers(0.5)
+    J = _jacobian(grasp, [0.0, 1.0, 0.0])
+    clean = dg.internal_forces(grasp, J)
+    for scale in (1e-12, 1e-11, 3e-10):
+        noisy = J + scale * rng.normal(size=J.shape)
+        s = np.linalg.svd(np.vstack([dg.grasp_matrix(grasp), noisy.T]), compute_uv=0)
+        assert s[-1] < 1e-9 * s[0]  # still rank deficient at the default rank_tol
+        r = dg.internal_forces(grasp, noisy)
+        assert r.null_space_dim == clean.null_space_dim > 0
+        assert not r.passes and r.d_star == pytest.approx(clean.d_star, abs=1e-6)
+    # Above rank_tol the noise is a real change of J: the squeeze is controlled.
+    r = dg.internal_forces(grasp, J + 1e-3 * rng.normal(size=J.shape))
+    assert r.null_space_dim == 0 and r.passes
