@@ -147,3 +147,14 @@ def test_normals_are_normalised():
     a = batch_force_closure(P, Nrm, 0.4)
     b = batch_force_closure(P, Nrm * scale, 0.4)
     np.testing.assert_allclose(a.d_star, b.d_star, atol=1e-9)
+
+
+def test_balanced_forces_that_do_not_push_give_zero():
+    # Two equal pushes on one line of action: N(G_n) is spanned by (1, -1), whose
+    # normal forces sum to zero, so no balanced force pushes (d* = 0 exactly).
+    P = np.array([[[0.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [2.0, 0.0]]])
+    Nrm = np.array([[[1.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [1.0, 0.0]]])
+    res = batch_form_closure(P, Nrm)
+    np.testing.assert_array_equal(res.d_star, [0.0, 0.0])
+    np.testing.assert_array_equal(res.rank, [1, 1])  # same line of action
+    assert res.converged.all() and not res.is_closure.any()
