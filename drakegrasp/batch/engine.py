@@ -357,9 +357,7 @@ def _singular_value_metrics(
         out["ellipsoid_volume"][sl] = np.prod(sv, axis=1)
 
 
-def _epsilon_l1(
-    P, Nrm, mu, nu, p, b, *, model, num_generators, out, sl
-) -> None:  # pragma: no cover - exercised only once drakegrasp.quality exists
+def _epsilon_l1(P, Nrm, mu, nu, p, b, *, model, num_generators, out, sl) -> None:
     try:
         from drakegrasp.quality import ferrari_canny
     except ImportError as exc:
@@ -569,7 +567,7 @@ def batch_force_closure(
                 slices.append(slice(start, start + k_i))
                 start += k_i
             sol = solve_margin_lp(G, facets, slices, normal_cols, rank_tol=rank_tol)
-            idx = sl.start + (rows if rows.size < P.shape[0] else np.arange(len(rows)))
+            idx = sl.start + rows
             d_star[idx] = sol.d_star
             rank[idx] = sol.rank
             converged[idx] = sol.converged
