@@ -19,7 +19,9 @@ sphere–box, sphere–cylinder...) and the others with GJK/EPA, whose witness
 points are accurate to about 1e-5 m (convex meshes, ellipsoids).  For a
 spherical fingertip drakegrasp recomputes the finger's contact point as
 ``centre + r n̂`` and, on a flat face, ``ψ`` exactly as the centre's distance to
-the face plane minus ``r``; other pairs keep Drake's values.
+the face plane minus ``r``; on an edge or a corner of flat faces (boxes, convex
+meshes) the normal runs from the centre to the closest point of that edge or
+corner.  Other pairs keep Drake's values.
 
 **Flat patches.**  A flat pad on a flat face touches along an area, for which
 Drake reports a single witness point somewhere in the patch.  When both surfaces
@@ -100,7 +102,8 @@ class PlantContact:
         Their names in the scene graph.
     normal_source : str
         Where the normal came from: ``"object"``, ``"finger"``, ``"patch"``,
-        ``"witness points"`` or ``"drake"`` (see the module docstring).
+        ``"edge"`` or ``"corner"`` (a spherical tip on an edge or corner of flat
+        faces), ``"witness points"`` or ``"drake"`` (see the module docstring).
     patch_vertex : int or None
         Index of this contact among the vertices of a flat patch, or None for a
         point contact.
@@ -555,18 +558,27 @@ def _pair_contacts(
     n_O = _clean_unit(n_O)
     finger_shape = inspector.GetShape(gf)
     if isinstance(finger_shape, Sphere):
-        # A spherical fingertip touches at centre + r n: recompute the witness
-        # points from the sphere's centre (exact), and ψ exactly on a flat face.
+        # A spherical fingertip touches at centre + r n.  Recompute the witness
+        # points from the sphere's centre: on a flat face ψ is the centre's
+        # distance to the face's plane minus r; on an edge or a corner of flat
+        # faces, the normal runs from the centre to the closest point of that
+        # edge or corner.  All exact, whatever the accuracy of Drake's witnesses.
         r = finger_shape.radius()
         centre_O = to_O(X_WGb.translation())
-        p_OCb = centre_O + r * n_O
-        if (
-            len(obj_pieces) == 1
-            and obj_pieces[0].polygon_G is not None
-            and source == "object"
-        ):
-            face_point_O = to_O(X_WGa.multiply(obj_pieces[0].polygon_G[0]))
+        flat = [p.polygon_G for p in obj_pieces if p.polygon_G is not None]
+        feature = _shared_feature(flat) if len(flat) == len(obj_pieces) else None
+        if len(obj_pieces) == 1 and flat and source == "object":
+            face_point_O = to_O(X_WGa.multiply(flat[0][0]))
             psi = float(-n_O @ (centre_O - face_point_O)) - r
+        elif feature is not None and len(obj_pieces) > 1:
+            closest_O = _closest_on_segment(
+                centre_O, *(to_O(X_WGa.multiply(v)) for v in feature)
+            )
+            d = closest_O - centre_O
+            if np.linalg.norm(d) > r / 2:  # the centre is outside the object
+                n_O, source = _clean_unit(d), "edge" if len(feature) == 2 else "corner"
+                psi = float(np.linalg.norm(d)) - r
+        p_OCb = centre_O + r * n_O
         p_OCa = p_OCb + psi * n_O
     return [
         PlantContact(
@@ -578,6 +590,27 @@ def _pair_contacts(
             **common,
         )
     ]
+
+
+def _shared_feature(polygons: list[np.ndarray]) -> tuple[np.ndarray, ...] | None:
+    """The edge (two vertices) or corner (one) that several faces share."""
+    if len(polygons) < 2:
+        return None
+    shared = [
+        v
+        for v in polygons[0]
+        if all(np.min(np.linalg.norm(P - v, axis=1)) < 1e-9 for P in polygons[1:])
+    ]
+    return tuple(shared) if len(shared) in (1, 2) else None
+
+
+def _closest_on_segment(x: np.ndarray, a: np.ndarray, b: np.ndarray | None = None):
+    """Closest point to ``x`` on the segment ``ab`` (or the point ``a``)."""
+    if b is None:
+        return np.asarray(a)
+    ab = b - a
+    s = float(np.clip((x - a) @ ab / (ab @ ab), 0.0, 1.0))
+    return a + s * ab
 
 
 def _clean_unit(n: np.ndarray) -> np.ndarray:
