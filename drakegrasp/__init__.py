@@ -2,10 +2,23 @@
 
 Contacts, contact frames and grasp matrices; form closure, force closure and
 antipodal grasps decided with Drake's ``MathematicalProgram``; grasps read from a
-``MultibodyPlant``.  Conventions: ``shared/CONVENTIONS.md``.
+``MultibodyPlant``; quality metrics; pictures; a batch engine for many grasps.
+Conventions: ``shared/CONVENTIONS.md``.
+
+Layers, inner to outer (an import never points outwards): the numpy core
+(``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
+programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
+(``plant``), and the outside ring (``visualization``, ``batch``, ``cli``).
 """
 
+from drakegrasp import examples
 from drakegrasp.antipodal import is_antipodal
+from drakegrasp.batch import (
+    BatchClosureResult,
+    batch_force_closure,
+    batch_form_closure,
+    evaluate_file,
+)
 from drakegrasp.closure import (
     DEFAULT_TOL,
     ProgramVariables,
@@ -35,41 +48,116 @@ from drakegrasp.friction_cone import (
     friction_cone_generators,
 )
 from drakegrasp.grasp import Grasp, grasp_matrix, normal_grasp_matrix
+from drakegrasp.plant import (
+    GraspFromPlant,
+    GraspReport,
+    PlantContact,
+    Scene,
+    analyze_grasp,
+    find_contacts,
+    grasp_from_plant,
+    hand_jacobian,
+    list_scenes,
+    load_scene,
+    register_models,
+    signed_distance_jacobian,
+)
+from drakegrasp.quality import (
+    GraspQuality,
+    MaxWrenchResult,
+    build_max_resistible_wrench_program,
+    distance_to_singularity,
+    ferrari_canny,
+    grasp_quality,
+    grasp_singular_values,
+    hand_object_matrix,
+    isotropy,
+    lp2_margin,
+    manipulability_volume,
+    max_resistible_wrench,
+    min_singular_value,
+    primitive_wrenches,
+    uniformity_of_transformation,
+    wrench_ellipsoid_volume,
+)
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.visualization import (
+    clear_grasp,
+    draw_grasp,
+    plot_planar_grasp,
+    plot_wrench_space,
+)
 
 __version__ = "0.1.0"
 
 __all__ = [
     "DEFAULT_TOL",
     "AntipodalResult",
+    "BatchClosureResult",
     "ClosureResult",
     "Contact",
     "ContactModel",
     "Grasp",
     "GraspError",
+    "GraspFromPlant",
+    "GraspQuality",
+    "GraspReport",
     "InternalForceResult",
     "InvalidContactError",
     "InvalidGraspError",
     "InvalidOptionError",
+    "MaxWrenchResult",
     "ModelError",
     "NoContactsError",
     "PenetrationError",
+    "PlantContact",
     "ProgramVariables",
+    "Scene",
     "SolverError",
+    "analyze_grasp",
+    "batch_force_closure",
+    "batch_form_closure",
     "build_exact_force_closure_program",
     "build_force_closure_program",
     "build_form_closure_program",
     "build_internal_force_program",
+    "build_max_resistible_wrench_program",
+    "clear_grasp",
     "contact_frame",
     "contact_frames",
+    "distance_to_singularity",
+    "draw_grasp",
+    "evaluate_file",
+    "examples",
+    "ferrari_canny",
+    "find_contacts",
     "force_closure",
     "force_closure_exact",
     "form_closure",
     "friction_cone_facets",
     "friction_cone_generators",
+    "grasp_from_plant",
     "grasp_matrix",
+    "grasp_quality",
+    "grasp_singular_values",
+    "hand_jacobian",
+    "hand_object_matrix",
     "internal_forces",
     "is_antipodal",
+    "isotropy",
+    "list_scenes",
+    "load_scene",
+    "lp2_margin",
+    "manipulability_volume",
     "matrix_rank",
+    "max_resistible_wrench",
+    "min_singular_value",
     "normal_grasp_matrix",
+    "plot_planar_grasp",
+    "plot_wrench_space",
+    "primitive_wrenches",
+    "register_models",
+    "signed_distance_jacobian",
+    "uniformity_of_transformation",
+    "wrench_ellipsoid_volume",
 ]

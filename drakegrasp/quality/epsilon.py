@@ -10,10 +10,9 @@ import functools
 import itertools
 import math
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.optimize import nnls
-from scipy.spatial import ConvexHull, QhullError
 
 from drakegrasp.errors import InvalidOptionError, SolverError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, friction_cone_generators
@@ -24,6 +23,9 @@ from drakegrasp.quality._common import (
     _scaled_grasp_matrix,
     _torque_scale,
 )
+
+if TYPE_CHECKING:
+    from scipy.spatial import ConvexHull
 
 __all__ = [
     "HULL_TOL",
@@ -140,6 +142,9 @@ def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
     joggled input ``QJ`` (which perturbs the points by about 1e-11 relative,
     far below any quality we report).
     """
+    # scipy.spatial is imported on first use: it costs 0.4 s of `import drakegrasp`.
+    from scipy.spatial import ConvexHull, QhullError
+
     tol = HULL_TOL * max(scale, 1e-300)
     try:
         hull = ConvexHull(points, qhull_options="Q0")
@@ -175,6 +180,9 @@ def _origin_distance_residual(points: np.ndarray, scale: float) -> float:
     rhs = np.zeros(points.shape[1] + 1)
     rhs[-1] = rho
     try:
+        # Imported here: scipy.optimize alone doubles `import drakegrasp`'s time.
+        from scipy.optimize import nnls
+
         return float(nnls(A, rhs)[1])
     except RuntimeError:  # iteration limit: let Qhull decide
         return 0.0
@@ -224,6 +232,9 @@ def _face_directions(points: np.ndarray) -> dict[int, np.ndarray]:
     is an intersection of facets, so the faces are the closure of the facets'
     vertex sets under intersection.
     """
+    # scipy.spatial is imported on first use: it costs 0.4 s of `import drakegrasp`.
+    from scipy.spatial import ConvexHull, QhullError
+
     scale = float(np.max(np.abs(points)))
     _, s, vt = np.linalg.svd(points, full_matrices=False)
     m = int(np.sum(s > RANK_TOL * max(s[0], scale)))
