@@ -42,13 +42,14 @@ from pydrake.solvers import (
     SolutionResult,
 )
 
-from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
-from drakegrasp.friction_cone import (
-    DEFAULT_NUM_GENERATORS,
-    EffectiveCone,
-    effective_cone,
+from drakegrasp.errors import InvalidOptionError, SolverError
+from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
+from drakegrasp.grasp import (
+    Grasp,
+    check_hand_jacobian,
+    grasp_matrix,
+    normal_grasp_matrix,
 )
-from drakegrasp.grasp import Grasp, grasp_matrix, normal_grasp_matrix
 from drakegrasp.results import ClosureResult, InternalForceResult, _relative_margin
 
 __all__ = [
@@ -104,48 +105,6 @@ class ProgramVariables:
     columns: np.ndarray
     weights: np.ndarray | None = None
     generators: np.ndarray | None = None
-
-
-@dataclass(frozen=True)
-class _Layout:
-    """The force components a grasp's cones allow, and their cones."""
-
-    columns: np.ndarray  # (m,) indices into the full stacked force vector
-    cones: tuple[EffectiveCone, ...]
-    normal_positions: np.ndarray  # (N,) index of each f_n within `columns`
-    G: np.ndarray  # (w, m) grasp matrix restricted to `columns`
-
-    @staticmethod
-    def of(grasp: Grasp, num_generators: int) -> _Layout:
-        b = grasp.characteristic_length
-        cones = tuple(
-            effective_cone(c, num_generators, characteristic_length=b)
-            for c in grasp.contacts
-        )
-        columns, normals = [], []
-        for s, cone in zip(grasp.component_slices(), cones, strict=True):
-            normals.append(len(columns))
-            columns.extend(s.start + j for j in cone.components)
-        columns = np.array(columns, dtype=int)
-        G = grasp_matrix(grasp)[:, columns]
-        return _Layout(columns, cones, np.array(normals, dtype=int), G)
-
-    def facet_matrix(self) -> np.ndarray:
-        return _block_diag([cone.facets for cone in self.cones])
-
-    def generator_matrix(self) -> np.ndarray:
-        return _block_diag([cone.generators for cone in self.cones])
-
-
-def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
-    rows = sum(b.shape[0] for b in blocks)
-    cols = sum(b.shape[1] for b in blocks)
-    out = np.zeros((rows, cols))
-    r = c = 0
-    for b in blocks:
-        out[r : r + b.shape[0], c : c + b.shape[1]] = b
-        r, c = r + b.shape[0], c + b.shape[1]
-    return out
 
 
 def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
@@ -274,7 +233,7 @@ def build_force_closure_program(
         ``forces`` cover the components the cones allow (see ``columns``).
     """
     _check_formulation(formulation)
-    layout = _Layout.of(grasp, num_generators)
+    layout = ConeLayout.of(grasp, num_generators)
     N = grasp.num_contacts
     w = grasp.wrench_dim
     if formulation == "facets":
@@ -316,7 +275,7 @@ def build_exact_force_closure_program(
         polyhedra) as facets.
     variables : ProgramVariables
     """
-    layout = _Layout.of(grasp, DEFAULT_NUM_GENERATORS)
+    layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
     prog.AddLinearEqualityConstraint(layout.G, np.zeros(grasp.wrench_dim), f)
@@ -379,8 +338,8 @@ def build_internal_force_program(
     literally would let a singular value of 1e-12 (contacts measured to 1e-7 m)
     exclude an internal force that the rank count says exists.
     """
-    J = _check_hand_jacobian(grasp, hand_jacobian)
-    layout = _Layout.of(grasp, DEFAULT_NUM_GENERATORS)
+    J = check_hand_jacobian(grasp, hand_jacobian)
+    layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
     row_space = _row_space(np.vstack([layout.G, J[layout.columns].T]), rank_tol)
@@ -397,20 +356,6 @@ def _row_space(A: np.ndarray, rank_tol: float) -> np.ndarray:
     if s.size == 0 or s[0] == 0.0:
         return np.zeros((0, A.shape[1]))
     return vt[: int(np.sum(s > rank_tol * s[0]))]
-
-
-def _check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
-    J = np.asarray(hand_jacobian, dtype=float)
-    M = grasp.num_components
-    if J.ndim != 2 or J.shape[0] != M or J.shape[1] < 1:
-        raise InvalidGraspError(
-            f"hand_jacobian must have shape ({M}, n_q) — one row per column of G "
-            f"(contact-frame components) and one column per hand velocity — got "
-            f"shape {J.shape}"
-        )
-    if not np.all(np.isfinite(J)):
-        raise InvalidGraspError("hand_jacobian has non-finite entries")
-    return J
 
 
 # ---------------------------------------------------------------- solving

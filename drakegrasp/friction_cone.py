@@ -15,9 +15,11 @@ import numpy as np
 
 from drakegrasp.contact import Contact
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.grasp import Grasp, grasp_matrix
 
 __all__ = [
     "DEFAULT_NUM_GENERATORS",
+    "ConeLayout",
     "EffectiveCone",
     "effective_cone",
     "friction_cone_facets",
@@ -258,3 +260,63 @@ def friction_cone_facets(
         eye = np.eye(k)[dropped]
         F = np.vstack([F, eye, -eye])
     return F
+
+
+@dataclass(frozen=True)
+class ConeLayout:
+    """The force components a grasp's cones allow, their cones, and ``G`` on them.
+
+    Programs use only these components, so a degenerate cone (``mu = 0``) never
+    brings a tangential variable or a facet row without interior.
+
+    Attributes
+    ----------
+    columns : (m,) int
+        Indices of the kept components in the grasp's stacked force vector.
+    cones : tuple of EffectiveCone
+        Each contact's cone over its kept components.
+    normal_positions : (N,) int
+        Position of each contact's ``f_n`` within ``columns``.
+    G : (w, m) float
+        The grasp matrix restricted to ``columns``.
+    """
+
+    columns: np.ndarray
+    cones: tuple[EffectiveCone, ...]
+    normal_positions: np.ndarray
+    G: np.ndarray
+
+    @staticmethod
+    def of(grasp: Grasp, num_generators: int = DEFAULT_NUM_GENERATORS) -> ConeLayout:
+        """Layout of ``grasp`` with ``num_generators`` per spatial Coulomb cone."""
+        b = grasp.characteristic_length
+        cones = tuple(
+            effective_cone(c, num_generators, characteristic_length=b)
+            for c in grasp.contacts
+        )
+        columns, normals = [], []
+        for s, cone in zip(grasp.component_slices(), cones, strict=True):
+            normals.append(len(columns))
+            columns.extend(s.start + j for j in cone.components)
+        columns = np.array(columns, dtype=int)
+        G = grasp_matrix(grasp)[:, columns]
+        return ConeLayout(columns, cones, np.array(normals, dtype=int), G)
+
+    def facet_matrix(self) -> np.ndarray:
+        """``F``: block-diagonal unit facet rows over ``columns``."""
+        return _block_diag([cone.facets for cone in self.cones])
+
+    def generator_matrix(self) -> np.ndarray:
+        """``S``: block-diagonal generators (columns) over ``columns``."""
+        return _block_diag([cone.generators for cone in self.cones])
+
+
+def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
+    rows = sum(b.shape[0] for b in blocks)
+    cols = sum(b.shape[1] for b in blocks)
+    out = np.zeros((rows, cols))
+    r = c = 0
+    for b in blocks:
+        out[r : r + b.shape[0], c : c + b.shape[1]] = b
+        r, c = r + b.shape[0], c + b.shape[1]
+    return out

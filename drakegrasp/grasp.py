@@ -21,7 +21,13 @@ import numpy as np
 from drakegrasp.contact import Contact, ContactModel
 from drakegrasp.errors import InvalidContactError, InvalidGraspError
 
-__all__ = ["Grasp", "grasp_matrix", "normal_grasp_matrix", "wrench_columns"]
+__all__ = [
+    "Grasp",
+    "check_hand_jacobian",
+    "grasp_matrix",
+    "normal_grasp_matrix",
+    "wrench_columns",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -276,3 +282,36 @@ def normal_grasp_matrix(grasp: Grasp) -> np.ndarray:
         push at contact ``i``.
     """
     return grasp._grasp_matrix[:, grasp.normal_indices()]
+
+
+def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
+    """Validate a hand Jacobian against a grasp.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    hand_jacobian : (M, n_q) float
+        One row per column of ``G`` (contact-frame components, contact order),
+        one column per hand velocity.
+
+    Returns
+    -------
+    J : (M, n_q) float
+        The Jacobian as a float array.
+
+    Raises
+    ------
+    InvalidGraspError
+        On a wrong shape (naming the expected one) or non-finite entries.
+    """
+    J = np.asarray(hand_jacobian, dtype=float)
+    M = grasp.num_components
+    if J.ndim != 2 or J.shape[0] != M or J.shape[1] < 1:
+        raise InvalidGraspError(
+            f"hand_jacobian must have shape ({M}, n_q) — one row per column of G "
+            f"(contact-frame components) and one column per hand velocity — got "
+            f"shape {J.shape}"
+        )
+    if not np.all(np.isfinite(J)):
+        raise InvalidGraspError("hand_jacobian has non-finite entries")
+    return J

@@ -6,8 +6,7 @@ import math
 
 import numpy as np
 
-from drakegrasp.errors import InvalidGraspError
-from drakegrasp.grasp import Grasp
+from drakegrasp.grasp import Grasp, check_hand_jacobian
 from drakegrasp.quality._common import (
     RANK_TOL,
     _check_grasp,
@@ -97,20 +96,6 @@ def wrench_ellipsoid_volume(
     return float(np.prod(grasp_singular_values(grasp, torque_scale=torque_scale)))
 
 
-def _check_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
-    J = np.asarray(hand_jacobian, dtype=float)
-    M = grasp.num_components
-    if J.ndim != 2 or J.shape[0] != M or J.shape[1] < 1:
-        raise InvalidGraspError(
-            f"hand_jacobian must have shape ({M}, n_q): one row per column of G "
-            f"(contact-frame components, in contact order) and one column per hand "
-            f"velocity; got shape {J.shape}"
-        )
-    if not np.all(np.isfinite(J)):
-        raise InvalidGraspError("hand_jacobian has non-finite entries")
-    return J
-
-
 def hand_object_matrix(
     grasp: Grasp,
     hand_jacobian: np.ndarray,
@@ -150,7 +135,7 @@ def hand_object_matrix(
     ``RANK_TOL σ_max``.
     """
     _check_grasp(grasp)
-    J = _check_jacobian(grasp, hand_jacobian)
+    J = check_hand_jacobian(grasp, hand_jacobian)
     b = _torque_scale(grasp, torque_scale)
     G = _scaled_grasp_matrix(grasp, b)
     G_pinv = np.linalg.pinv(G, rcond=RANK_TOL)

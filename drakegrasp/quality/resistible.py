@@ -8,8 +8,8 @@ import numpy as np
 from pydrake.solvers import ClpSolver, MathematicalProgram, SolutionResult
 
 from drakegrasp.errors import InvalidOptionError, SolverError
-from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, effective_cone
-from drakegrasp.grasp import Grasp, grasp_matrix
+from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
+from drakegrasp.grasp import Grasp
 from drakegrasp.quality._common import _check_grasp, _jsonable
 
 __all__ = [
@@ -164,18 +164,9 @@ def build_max_resistible_wrench_program(
     _check_grasp(grasp)
     d = _check_direction(grasp, direction)
     fmax = _check_max_normal_force(grasp, max_normal_force)
-    b = grasp.characteristic_length
-    cones = [
-        effective_cone(c, num_generators, characteristic_length=b)
-        for c in grasp.contacts
-    ]
-    columns, normals = [], []
-    for sl, cone in zip(grasp.component_slices(), cones, strict=True):
-        normals.append(len(columns))
-        columns.extend(sl.start + j for j in cone.components)
-    columns = np.array(columns, dtype=int)
-    normals = np.array(normals, dtype=int)
-    G = grasp_matrix(grasp)[:, columns]
+    layout = ConeLayout.of(grasp, num_generators)
+    columns, normals, G = layout.columns, layout.normal_positions, layout.G
+    cones = layout.cones
 
     prog = MathematicalProgram()
     f = prog.NewContinuousVariables(len(columns), "f")

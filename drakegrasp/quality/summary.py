@@ -8,11 +8,10 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.grasp import Grasp
+from drakegrasp.grasp import Grasp, check_hand_jacobian
 from drakegrasp.quality._common import _check_grasp, _jsonable, _torque_scale
 from drakegrasp.quality.epsilon import ferrari_canny
 from drakegrasp.quality.indices import (
-    _check_jacobian,
     grasp_singular_values,
     hand_object_singular_values,
 )
@@ -174,7 +173,7 @@ def grasp_quality(
 
     _check_grasp(grasp)
     b = _torque_scale(grasp, torque_scale)
-    J = None if hand_jacobian is None else _check_jacobian(grasp, hand_jacobian)
+    J = None if hand_jacobian is None else check_hand_jacobian(grasp, hand_jacobian)
     closure = force_closure(
         grasp, hand_jacobian=J, num_generators=num_generators, tol=tol
     )
