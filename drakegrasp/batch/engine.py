@@ -81,8 +81,10 @@ class BatchClosureResult:
         ``(d_star - tol) / tol``, as :class:`drakegrasp.ClosureResult.margin`:
         ``|margin| < 1`` means the verdict lies within ``tol`` of the boundary.
     converged : (K,) bool
-        False where the interior-point method hit its iteration cap (the verdict
-        then rests on its last iterate).
+        False where neither the batched interior-point method (within its
+        iteration cap) nor the per-grasp HiGHS fallback solved the LP; the
+        verdict then rests on the last iterate.  True for every grasp in all
+        the tests and benchmarks so far.
     tol : float
         Threshold on ``d*``.
     metrics : dict of str to (K,) float

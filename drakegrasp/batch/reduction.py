@@ -59,7 +59,7 @@ class MarginSolution:
     rank : (K,) int
         Numerical rank of ``G``.
     converged : (K,) bool
-        False where the interior-point method stopped at its iteration cap.
+        False where neither the interior-point method nor HiGHS solved the LP.
     """
 
     d_star: np.ndarray
@@ -185,6 +185,18 @@ def null_spaces(G: np.ndarray, *, rank_tol: float):
     return rank, groups
 
 
+def _highs_max_last(B: np.ndarray, h: np.ndarray, fallback: float):
+    """``max x_{n-1} s.t. B x <= h`` for one LP with HiGHS: (value, success)."""
+    from scipy.optimize import linprog
+
+    c = np.zeros(B.shape[1])
+    c[-1] = -1.0
+    res = linprog(c, A_ub=B, b_ub=h, bounds=[(None, None)] * B.shape[1], method="highs")
+    if res.status != 0:
+        return fallback, False
+    return -float(res.fun), True
+
+
 def solve_margin_lp(
     G: np.ndarray,
     facets: list[np.ndarray],
@@ -193,6 +205,7 @@ def solve_margin_lp(
     *,
     rank_tol: float,
     ipm_tol: float = 1e-10,
+    ipm_max_iter: int = 60,
 ) -> MarginSolution:
     """Solve LP1/LP2 for a stack of grasps that share one layout.
 
@@ -211,6 +224,10 @@ def solve_margin_lp(
         Singular values ``<= rank_tol * σ_max`` count as zero.
     ipm_tol : float, optional
         Tolerance of the interior-point method on ``t*`` (relative to 1 + |t*|).
+    ipm_max_iter : int, optional
+        Iteration cap of the interior-point method.  The rare LPs that reach it
+        are solved again one by one with HiGHS (``scipy.optimize.linprog``);
+        ``converged`` is False only if that fails too.
 
     Returns
     -------
@@ -244,8 +261,14 @@ def solve_margin_lp(
         else:
             W = _householder_complement(c)
             B = np.concatenate([-(A @ W), np.ones(h.shape + (1,))], axis=2)
-            sol = solve_max_last(B, h, tol=ipm_tol, stop_below=0.0)
-            t = sol.value
-            converged[sel] = sol.converged
+            sol = solve_max_last(
+                B, h, tol=ipm_tol, max_iter=ipm_max_iter, stop_below=0.0
+            )
+            t, ok = sol.value, sol.converged
+            if not ok.all():
+                t, ok = t.copy(), ok.copy()
+                for j in np.flatnonzero(~ok):
+                    t[j], ok[j] = _highs_max_last(B[j], h[j], t[j])
+            converged[sel] = ok
         d_star[sel] = N * np.maximum(t, 0.0)
     return MarginSolution(d_star, rank, converged)

@@ -204,3 +204,29 @@ def test_ipm_matches_highs_and_certificates_are_sound():
     assert (early.value[~pos] < 1e-9).all() and (early.value >= want - 1e-8).all()
     assert early.iterations[~pos].mean() < exact.iterations[~pos].mean()
     assert 0 < pos.sum() < K
+
+
+def test_lps_that_hit_the_iteration_cap_are_finished_by_highs(monkeypatch):
+    import drakegrasp.batch.engine as engine
+    import drakegrasp.batch.reduction as reduction
+
+    rng = np.random.default_rng(28)
+    P, Nrm = random_grasps(rng, 150, 4, 3)
+    ref = batch_force_closure(P, Nrm, 0.5)
+    calls = []
+    real_highs = reduction._highs_max_last
+
+    def counting(*args):
+        calls.append(1)
+        return real_highs(*args)
+
+    def capped(*args, **kwargs):
+        return reduction.solve_margin_lp(*args, ipm_max_iter=2, **kwargs)
+
+    monkeypatch.setattr(reduction, "_highs_max_last", counting)
+    monkeypatch.setattr(engine, "solve_margin_lp", capped)
+    res = batch_force_closure(P, Nrm, 0.5)
+    assert len(calls) > 50  # most LPs need more than two iterations
+    assert res.converged.all()
+    np.testing.assert_allclose(res.d_star, ref.d_star, atol=1e-8)
+    np.testing.assert_array_equal(res.is_closure, ref.is_closure)
