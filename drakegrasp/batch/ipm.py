@@ -118,7 +118,7 @@ def _max_step(v: np.ndarray, dv: np.ndarray, fraction: float = 1.0) -> np.ndarra
 
     ``v`` (r, K) is positive; the result is (K,).
     """
-    q = (-dv / v).max(axis=0)  # 1 / α_max where positive
+    q = -(dv / v).min(axis=0)  # 1 / α_max where positive
     with np.errstate(divide="ignore"):
         return np.where(q > 0.0, np.minimum(1.0, fraction / q), 1.0)
 
@@ -248,20 +248,22 @@ def solve_max_last(
             rp, rd, sl, gap = rp[:, keep], rd[:, keep], sl[:, keep], gap[keep]
         mu = gap / r
 
-        L = _cholesky(_normal_matrix(B, lam / s))
-        # Predictor (affine scaling) direction: rc = -λ∘s.
-        dx = _cho_solve(L, rp - _tmul(B, (-sl - lam * rd) / s))
+        D = lam / s
+        L = _cholesky(_normal_matrix(B, D))
+        # Predictor (affine scaling) direction, rc = -λ∘s; with D = λ/s,
+        # (rc - λ∘rd)/s = -D (s + rd) and Δλ = (rc - λ∘Δs)/s = -λ - D Δs.
+        dx = _cho_solve(L, rp + _tmul(B, D * (s + rd)))
         ds = rd - _mul(B, dx)
-        dlam = (-sl - lam * ds) / s
+        dlam = -lam - D * ds
         a_p = _max_step(s, ds)
         a_d = _max_step(lam, dlam)
         mu_aff = np.einsum("rk,rk->k", s + a_p * ds, lam + a_d * dlam) / r
         sigma = (mu_aff / np.maximum(mu, 1e-300)) ** 3
-        # Corrector: rc = σμ - λ∘s - Δλ_aff∘Δs_aff.
-        rc = sigma * mu - sl - dlam * ds
-        dx = _cho_solve(L, rp - _tmul(B, (rc - lam * rd) / s))
+        # Corrector: rc = σμ - λ∘s - Δλ_aff∘Δs_aff, used as rc/s.
+        rcs = (sigma * mu - dlam * ds) / s - lam
+        dx = _cho_solve(L, rp - _tmul(B, rcs - D * rd))
         ds = rd - _mul(B, dx)
-        dlam = (rc - lam * ds) / s
+        dlam = rcs - D * ds
         a_p = _max_step(s, ds, _STEP)
         a_d = _max_step(lam, dlam, _STEP)
         x = x + a_p * dx
