@@ -37,6 +37,7 @@ from drakegrasp.batch.construction import (
 from drakegrasp.batch.reduction import solve_margin_lp
 from drakegrasp.contact import ContactModel
 from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOptionError
+from drakegrasp.results import ZERO_FRACTION
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -69,7 +70,8 @@ class BatchClosureResult:
     kind : str
         ``"form"`` (LP1 on ``G_n``) or ``"force"`` (LP2 on ``G``).
     is_closure : (K,) bool
-        ``rank == required_rank`` and ``d_star > tol``.
+        ``rank == required_rank`` and (``d_star > tol`` or a normal-force
+        certificate), as :func:`drakegrasp.force_closure` decides.
     d_star : (K,) float
         Optimal margin of the LP (dimensionless; normal forces normalised by
         ``Σ f_n <= N``).  Reported whatever the rank.
@@ -78,8 +80,9 @@ class BatchClosureResult:
     required_rank : int
         6 (spatial) or 3 (planar).
     margin : (K,) float
-        ``(d_star - tol) / tol``, as :class:`drakegrasp.ClosureResult.margin`:
-        ``|margin| < 1`` means the verdict lies within ``tol`` of the boundary.
+        ``(d* - tol) / tol`` as :class:`drakegrasp.ClosureResult.margin`, with
+        LP1's ``d*`` where the normal-force certificate decided.  The verdict
+        is uncertain where ``tol/1000 < d* < 2 tol``.
     converged : (K,) bool
         False where neither the batched interior-point method (within its
         iteration cap) nor the per-grasp HiGHS fallback solved the LP; the
@@ -89,6 +92,12 @@ class BatchClosureResult:
         Threshold on ``d*``.
     metrics : dict of str to (K,) float
         The requested metrics, see :func:`batch_force_closure`.
+    normal_certificate : (K,) bool
+        True where force closure was proved by balancing normal forces (LP1
+        with ``d* > tol``) although the LP2 ``d*`` was at most ``tol``: ``d`` is a
+        distance to the cone boundaries and vanishes as ``μ -> 0``, while such
+        forces lie inside every cone with ``μ > 0`` (see
+        :attr:`drakegrasp.ClosureResult.certificate`).
     """
 
     kind: str
@@ -100,6 +109,7 @@ class BatchClosureResult:
     converged: np.ndarray
     tol: float
     metrics: dict[str, np.ndarray] = field(default_factory=dict)
+    normal_certificate: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.is_closure.shape[0])
@@ -120,6 +130,8 @@ class BatchClosureResult:
             "margin": self.margin,
             "converged": self.converged,
         }
+        if self.normal_certificate is not None:
+            out["normal_certificate"] = self.normal_certificate
         out.update(self.metrics)
         return out
 
@@ -137,7 +149,7 @@ class BatchClosureResult:
     def __str__(self) -> str:
         K = len(self)
         n = int(self.is_closure.sum())
-        near = int(np.sum(np.abs(self.margin) < 1.0))
+        near = int(np.sum((self.margin > ZERO_FRACTION - 1.0) & (self.margin < 1.0)))
         lines = [
             f"{self.kind} closure of {K} grasps: {n} closed, {K - n} not "
             f"(tol {self.tol:g}, {near} within tol of the boundary)"
@@ -425,19 +437,22 @@ def _run(
     d_star = np.zeros(K)
     rank = np.zeros(K, dtype=int)
     converged = np.ones(K, dtype=bool)
+    normal_d_star = np.full(K, np.nan)  # LP1's d* where a certificate was sought
     out_metrics = {name: np.full(K, np.nan) for name in metrics}
     for sl in _chunks(K, chunk_size, progress, f"{kind} closure"):
         P = np.asarray(positions[sl], dtype=float)
         _check_positions(P, sl.start)
         Nrm = _unit_normals(np.asarray(normals[sl], dtype=float), sl.start)
-        chunk_fn(P, Nrm, sl, d_star, rank, converged, out_metrics)
+        chunk_fn(P, Nrm, sl, d_star, rank, converged, out_metrics, normal_d_star)
     required = 3 if d == 2 else 6
-    is_closure = (rank == required) & (d_star > tol)
+    certified = (rank == required) & ~(d_star > tol) & (normal_d_star > tol)
+    is_closure = (rank == required) & (d_star > tol) | certified
     if tol > 0:
-        margin = (d_star - tol) / tol
+        margin = (np.where(certified, normal_d_star, d_star) - tol) / tol
     else:
         margin = np.where(d_star > 0, np.inf, -1.0)
-    for a in (is_closure, d_star, rank, margin, converged, *out_metrics.values()):
+    arrays = (is_closure, d_star, rank, margin, converged, certified)
+    for a in (*arrays, *out_metrics.values()):
         a.flags.writeable = False
     return BatchClosureResult(
         kind=kind,
@@ -449,7 +464,46 @@ def _run(
         converged=converged,
         tol=tol,
         metrics=out_metrics,
+        normal_certificate=certified if kind == "force" else None,
     )
+
+
+def _lp1(Gn: np.ndarray, rank_tol: float):
+    """LP1 on stacked normal grasp matrices ``G_n`` (k, w, N)."""
+    N = Gn.shape[2]
+    slices = [slice(i, i + 1) for i in range(N)]
+    ones = np.ones((Gn.shape[0], 1, 1))
+    return solve_margin_lp(Gn, [ones] * N, slices, np.arange(N), rank_tol=rank_tol)
+
+
+def _normal_certificates(
+    P, Nrm, p, kinds, sl, d_star, rank, normal_d_star, *, tol: float
+) -> None:
+    """LP1 for the grasps whose force closure only normal forces could prove.
+
+    Those are the grasps with full rank, ``d* <= tol`` and some friction, the
+    same that :func:`drakegrasp.force_closure` checks; LP1's ``d*`` is stored
+    in ``normal_d_star`` (NaN elsewhere).
+    """
+    required = 3 if P.shape[2] == 2 else 6
+    local = np.arange(P.shape[0])
+    full_rank = rank[sl] == required
+    frictional = (kinds != FRICTIONLESS).any(axis=1)
+    rows = local[full_rank & frictional & ~(d_star[sl] > tol)]
+    if rows.size == 0:
+        return
+    Gn = batched_normal_grasp_matrix(P[rows], Nrm[rows], p[rows])
+    N = Gn.shape[2]
+    if N <= Gn.shape[1]:
+        # Balancing normal forces need N(G_n) != {0}.  With no more contacts than
+        # wrench rows that is rare, and an N x N Gram eigenvalue test (the same
+        # σ_min <= rank_tol σ_max rule) rules it out at ~1 µs a grasp.
+        lam = np.linalg.eigvalsh(np.einsum("kwi,kwj->kij", Gn, Gn))
+        deficient = lam[:, 0] <= DEFAULT_RANK_TOL**2 * lam[:, -1]
+        rows, Gn = rows[deficient], Gn[deficient]
+        if rows.size == 0:
+            return
+    normal_d_star[sl.start + rows] = _lp1(Gn, DEFAULT_RANK_TOL).d_star
 
 
 def batch_force_closure(
@@ -546,7 +600,7 @@ def batch_force_closure(
     get_b = _characteristic_lengths(characteristic_lengths, K)
     soft = model == "soft_finger"
 
-    def chunk(P, Nrm, sl, d_star, rank, converged, out_metrics):
+    def chunk(P, Nrm, sl, d_star, rank, converged, out_metrics, normal_d_star):
         mu_c = get_mu(sl)
         _check_coefficients("mu", mu_c, sl.start)
         nu_c = get_nu(sl)
@@ -573,6 +627,7 @@ def batch_force_closure(
             d_star[idx] = sol.d_star
             rank[idx] = sol.rank
             converged[idx] = sol.converged
+        _normal_certificates(P, Nrm, p, kinds, sl, d_star, rank, normal_d_star, tol=tol)
         if names:
             full = {
                 "frictionless": FRICTIONLESS,
@@ -662,14 +717,11 @@ def batch_form_closure(
         )
     get_p = _reference_points(reference_points, K, d)
     get_b = _characteristic_lengths(characteristic_lengths, K)
-    slices = [slice(i, i + 1) for i in range(N)]
-    normal_cols = np.arange(N)
 
-    def chunk(P, Nrm, sl, d_star, rank, converged, out_metrics):
+    def chunk(P, Nrm, sl, d_star, rank, converged, out_metrics, normal_d_star):
         p = get_p(sl)
         Gn = batched_normal_grasp_matrix(P, Nrm, p)
-        ones = np.ones((P.shape[0], 1, 1))
-        sol = solve_margin_lp(Gn, [ones] * N, slices, normal_cols, rank_tol=rank_tol)
+        sol = _lp1(Gn, rank_tol)
         d_star[sl] = sol.d_star
         rank[sl] = sol.rank
         converged[sl] = sol.converged
