@@ -3,11 +3,16 @@
     drakegrasp analyze [SCENE] [--mu M] [--contact-model MODEL]
                        [--torsional-friction NU] [--json]
     drakegrasp scenes
+    drakegrasp batch IN.npz OUT.npz [--kind force|form] [--mu M] [--model MODEL]
+                     [--num-generators NG] [--metrics NAME ...] [--progress]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
 form closure, force closure with the hand check, exact-cone verdict, antipodal
-test.  Errors print one line on stderr and exit with status 1 (2 for a bad
+test.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
+``positions`` and ``normals`` of shape (K, N, d), optionally ``mu``, ...) with
+the vectorised batch engine and writes the verdicts to another file.  Errors
+print one line on stderr and exit with status 1 (2 for a bad
 command line).
 """
 
@@ -16,7 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 from drakegrasp.contact import ContactModel
 from drakegrasp.errors import GraspError
@@ -64,6 +69,26 @@ def _cmd_scenes(args: argparse.Namespace) -> int:
         mark = "*" if info.name == DEFAULT_SCENE else " "
         print(f"{mark} {info.name:<{width}}  {info.description}")
     print("(* = default scene; run `drakegrasp analyze NAME`)")
+    return 0
+
+
+def _cmd_batch(args: argparse.Namespace) -> int:
+    from drakegrasp.batch import evaluate_file
+
+    result = evaluate_file(
+        args.input,
+        args.output,
+        kind=args.kind,
+        mu=args.mu,
+        model=args.model,
+        num_generators=args.num_generators,
+        torsional_friction=args.torsional_friction,
+        tol=args.tol,
+        progress=args.progress,
+        metrics=tuple(args.metrics),
+    )
+    print(result)
+    print(f"wrote {args.output}")
     return 0
 
 
@@ -125,15 +150,57 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
 
     scenes = sub.add_parser("scenes", help="list the shipped scenes")
     scenes.set_defaults(func=_cmd_scenes)
+    _add_batch_parser(sub)
     return parser, sub
 
 
-_EXTENSIONS: list[Callable[[argparse._SubParsersAction], None]] = []
+def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
+    from drakegrasp.batch import METRICS
 
-
-def register_subcommand(add: Callable[[argparse._SubParsersAction], None]) -> None:
-    """Register a function that adds a subcommand to the parser's subparsers."""
-    _EXTENSIONS.append(add)
+    batch = sub.add_parser(
+        "batch",
+        help="decide closure for every grasp of an .npz file",
+        description="Decide form or force closure for K grasps of N contacts "
+        "stored as arrays positions (K, N, d) and normals (K, N, d) [, mu, "
+        "torsional_friction, reference_points, characteristic_lengths] in an "
+        ".npz file, and write is_closure, d_star, rank, margin, converged and "
+        "the requested metrics to OUT (.npz, or .parquet with pyarrow).",
+    )
+    batch.add_argument("input", help="input .npz file")
+    batch.add_argument("output", help="output .npz (or .parquet) file")
+    batch.add_argument(
+        "--kind", choices=["force", "form"], default="force", help="default: force"
+    )
+    batch.add_argument(
+        "--mu", type=_positive_float, help="friction for every contact (else file's)"
+    )
+    batch.add_argument(
+        "--model",
+        choices=[m.value for m in ContactModel],
+        default="hard_finger",
+        help="contact model (default: hard_finger)",
+    )
+    batch.add_argument(
+        "--num-generators", type=int, default=8, help="cone generators (default 8)"
+    )
+    batch.add_argument(
+        "--torsional-friction",
+        type=_positive_float,
+        help="soft-finger torsional friction (else the file's, or 0)",
+    )
+    batch.add_argument(
+        "--tol", type=_positive_float, default=1e-6, help="threshold on d*"
+    )
+    batch.add_argument(
+        "--metrics",
+        nargs="*",
+        default=[],
+        choices=METRICS,
+        metavar="NAME",
+        help=f"metrics to add: {', '.join(METRICS)}",
+    )
+    batch.add_argument("--progress", action="store_true", help="show a progress bar")
+    batch.set_defaults(func=_cmd_batch)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -144,9 +211,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv : sequence of str, optional
         Arguments without the program name (default: ``sys.argv[1:]``).
     """
-    parser, sub = build_parser()
-    for add in _EXTENSIONS:
-        add(sub)
+    parser, _ = build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))

@@ -59,7 +59,18 @@ def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
             "normals and optionally mu, torsional_friction, reference_points, "
             "characteristic_lengths)"
         )
-    with np.load(path, allow_pickle=False) as data:
+    try:
+        archive = np.load(path, allow_pickle=False)
+    except (ValueError, EOFError) as err:  # not .npy/.npz data at all
+        raise InvalidOptionError(
+            f"input file {str(path)!r} is not a readable .npz archive ({err})"
+        ) from None
+    if not hasattr(archive, "files"):  # a lone .npy array renamed .npz
+        raise InvalidOptionError(
+            f"input file {str(path)!r} holds one array, not a .npz archive of "
+            "named arrays (positions, normals, ...)"
+        )
+    with archive as data:
         missing = [k for k in ("positions", "normals") if k not in data.files]
         if missing:
             raise InvalidOptionError(

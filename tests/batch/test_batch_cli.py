@@ -1,0 +1,63 @@
+"""`drakegrasp batch IN OUT`: same verdicts as the API, one-line errors."""
+
+import numpy as np
+import pytest
+
+import drakegrasp as dg
+from drakegrasp.cli import main
+
+
+@pytest.fixture
+def grasp_file(tmp_path):
+    rng = np.random.default_rng(3)
+    p = rng.normal(size=(300, 3, 3))
+    p /= np.linalg.norm(p, axis=2, keepdims=True)
+    n = -p + 0.5 * rng.normal(size=p.shape)
+    path = tmp_path / "grasps.npz"
+    np.savez(path, positions=p, normals=n, mu=np.full((300, 3), 0.5))
+    return path, p, n
+
+
+def test_batch_command_writes_the_api_verdicts(grasp_file, tmp_path, capsys):
+    path, p, n = grasp_file
+    out = tmp_path / "out.npz"
+    assert main(["batch", str(path), str(out), "--metrics", "sigma_min"]) == 0
+    written = np.load(out)
+    expected = dg.batch_force_closure(p, n, 0.5, metrics=("sigma_min",))
+    assert np.array_equal(written["is_closure"], expected.is_closure)
+    assert np.allclose(written["d_star"], expected.d_star)
+    assert np.allclose(written["sigma_min"], expected.metrics["sigma_min"])
+    assert 0 < expected.is_closure.sum() < 300
+    assert "force closure of 300 grasps" in capsys.readouterr().out
+
+
+def test_mu_on_the_command_line_overrides_the_file(grasp_file, tmp_path):
+    path, p, n = grasp_file
+    out = tmp_path / "out.npz"
+    assert main(["batch", str(path), str(out), "--mu", "0"]) == 0
+    assert np.array_equal(
+        np.load(out)["is_closure"], dg.batch_force_closure(p, n, 0.0).is_closure
+    )
+
+
+def test_form_closure_kind(grasp_file, tmp_path):
+    path, p, n = grasp_file
+    out = tmp_path / "out.npz"
+    assert main(["batch", str(path), str(out), "--kind", "form"]) == 0
+    assert not np.load(out)["is_closure"].any()  # three contacts never suffice
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda d: np.savez(d / "in.npz", positions=np.zeros((2, 3, 3))), "normals"),
+        (lambda d: (d / "in.npz").write_text("not an archive"), "in.npz"),
+        (lambda d: None, "No such file"),
+    ],
+)
+def test_bad_input_prints_one_line_and_fails(tmp_path, capsys, make, message):
+    make(tmp_path)
+    code = main(["batch", str(tmp_path / "in.npz"), str(tmp_path / "out.npz")])
+    err = capsys.readouterr().err
+    assert code == 1 and message in err
+    assert err.count("\n") == 1 and "Traceback" not in err
