@@ -42,3 +42,12 @@ def test_ruff_is_clean():
             text=True,
         )
         assert run.returncode == 0, run.stdout + run.stderr
+
+
+def test_readme_python_examples_run(capsys):
+    text = (ROOT / "README.md").read_text()
+    namespace: dict = {}
+    for block in re.findall(r"```python\n(.*?)```", text, re.S):
+        exec(compile(block, "README.md", "exec"), namespace)
+    out = capsys.readouterr().out
+    assert "force closure: YES" in out and "form closure: no" in out
