@@ -54,6 +54,7 @@ from drakegrasp.results import ClosureResult, InternalForceResult, _relative_mar
 
 __all__ = [
     "DEFAULT_TOL",
+    "OBJECTIVE_SCALE",
     "ProgramVariables",
     "build_exact_force_closure_program",
     "build_force_closure_program",
@@ -70,7 +71,17 @@ DEFAULT_TOL = 1e-6
 """Default threshold on ``d*``: closure needs ``d* > tol`` (LP3 passes at ``<= tol``).
 
 LP1–LP3 normalise the normal forces to ``Σ f_n <= N``, so ``d*`` is of order 0.1
-for a good grasp; Clp solves these LPs to about 1e-9, well below this threshold.
+for a good grasp; with :data:`OBJECTIVE_SCALE`, Clp reports ``d*`` to about 1e-11
+(checked against closed forms), far below this threshold.
+"""
+
+OBJECTIVE_SCALE = 1e4
+"""The programs minimise ``-OBJECTIVE_SCALE * d`` rather than ``-d``.
+
+Clp's optimality test has an absolute dual tolerance of 1e-7, so with cost
+``-d`` it stops as soon as ``d`` cannot grow by more than about 1e-7 and can
+report ``d* = 1e-12`` where the true value is 9e-8.  Scaling the objective
+moves that error to about 1e-11 without changing the optimum.
 """
 
 DEFAULT_RANK_TOL = 1e-9
@@ -147,12 +158,12 @@ def _check_formulation(formulation: str) -> str:
 def _margin_program(
     num_forces: int, num_contacts: int
 ) -> tuple[MathematicalProgram, np.ndarray, object]:
-    """Program with forces ``f`` (m,), ``d >= 0``, cost ``-d``."""
+    """Program with forces ``f`` (m,), ``d >= 0``, cost ``-OBJECTIVE_SCALE d``."""
     prog = MathematicalProgram()
     f = prog.NewContinuousVariables(num_forces, "f")
     d = prog.NewContinuousVariables(1, "d")[0]
     prog.AddBoundingBoxConstraint(0.0, np.inf, d)
-    prog.AddLinearCost(-1.0 * d)
+    prog.AddLinearCost(-OBJECTIVE_SCALE * d)
     return prog, f, d
 
 
@@ -315,7 +326,7 @@ def build_internal_force_program(
     Parameters
     ----------
     grasp : Grasp
-    hand_jacobian : (M, n_q) float
+    hand_jacobian : (M, n_v) float
         Hand Jacobian ``J``: rows in the order of the columns of
         :func:`~drakegrasp.grasp_matrix` (contact-frame components), columns the
         hand's generalized velocities.
@@ -463,7 +474,7 @@ def internal_forces(
     Parameters
     ----------
     grasp : Grasp
-    hand_jacobian : (M, n_q) float
+    hand_jacobian : (M, n_v) float
         Rows in the order of the columns of ``G``; columns the hand's velocities.
     tol : float, optional
         LP3 passes when ``d* <= tol``.
@@ -519,7 +530,9 @@ def _force_closure_result(
         # d is a distance to the cone boundaries, so it vanishes with μ.  Normal
         # forces alone (f_t = 0) lie inside every cone with μ > 0: if they
         # balance with f_n > tol, the grasp is in force closure for any μ.
-        normal = _normal_force_certificate(grasp, variables.columns, tol=tol)
+        normal = _normal_force_certificate(
+            grasp, variables.columns, tol=tol, rank_tol=rank_tol
+        )
         if normal is not None:
             frictional, certificate = True, "normal forces"
             margin, contact_forces = normal
@@ -545,7 +558,7 @@ def _force_closure_result(
 
 
 def _normal_force_certificate(
-    grasp: Grasp, columns: np.ndarray, *, tol: float
+    grasp: Grasp, columns: np.ndarray, *, tol: float, rank_tol: float
 ) -> tuple[float, tuple[np.ndarray, ...]] | None:
     """LP1 on the contacts' normals, when some contact has friction.
 
@@ -555,7 +568,7 @@ def _normal_force_certificate(
     normals = grasp.normal_indices()
     if len(columns) == len(normals):  # every contact is frictionless already
         return None
-    if matrix_rank(normal_grasp_matrix(grasp)) == grasp.num_contacts:
+    if matrix_rank(normal_grasp_matrix(grasp), rank_tol=rank_tol) == len(normals):
         return None  # N(G_n) = {0}: no non-zero normal forces balance
     prog, variables = build_form_closure_program(grasp)
     d_star, f_n, _, _ = _solve_margin(prog, variables, conic=False)
@@ -578,7 +591,7 @@ def force_closure(
     Parameters
     ----------
     grasp : Grasp
-    hand_jacobian : (M, n_q) float, optional
+    hand_jacobian : (M, n_v) float, optional
         Hand Jacobian ``J`` (rows in ``G``'s column order).  When given, the
         verdict also needs LP3 to pass.
     num_generators : int, optional
@@ -624,7 +637,7 @@ def force_closure_exact(
     Parameters
     ----------
     grasp : Grasp
-    hand_jacobian : (M, n_q) float, optional
+    hand_jacobian : (M, n_v) float, optional
         When given, the verdict also needs LP3 to pass.
     tol : float, optional
         Closure needs ``d* > tol``; ``d*`` is each contact force's distance to

@@ -290,13 +290,13 @@ def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
     Parameters
     ----------
     grasp : Grasp
-    hand_jacobian : (M, n_q) float
+    hand_jacobian : (M, n_v) float
         One row per column of ``G`` (contact-frame components, contact order),
         one column per hand velocity.
 
     Returns
     -------
-    J : (M, n_q) float
+    J : (M, n_v) float
         The Jacobian as a float array.
 
     Raises
@@ -308,7 +308,7 @@ def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
     M = grasp.num_components
     if J.ndim != 2 or J.shape[0] != M or J.shape[1] < 1:
         raise InvalidGraspError(
-            f"hand_jacobian must have shape ({M}, n_q) — one row per column of G "
+            f"hand_jacobian must have shape ({M}, n_v) — one row per column of G "
             f"(contact-frame components) and one column per hand velocity — got "
             f"shape {J.shape}"
         )

@@ -117,8 +117,9 @@ class ClosureResult:
     kind : str
         ``"form closure"``, ``"force closure"`` or ``"force closure (exact cones)"``.
     is_closure : bool
-        The verdict: ``rank == required_rank`` and ``d* > tol`` (and, with a hand
-        Jacobian, LP3 passes).
+        The verdict: ``rank == required_rank`` and either ``d* > tol`` or the
+        normal-force certificate (see :attr:`certificate`); with a hand
+        Jacobian, LP3 must pass too.
     d_star : float
         Optimal ``d`` of LP1/LP2/SOCP: how far the best internal force lies inside
         the cones (the distance of each contact force to its cone's facets), with
@@ -142,8 +143,9 @@ class ClosureResult:
     formulation : str
         ``"normals"`` (LP1), ``"facets"``, ``"generators"`` or ``"exact"``.
     frictional_closure : bool
-        ``rank`` full and ``d* > tol``, ignoring the hand (equal to
-        ``is_closure`` when no hand Jacobian was given).
+        The verdict ignoring the hand: ``rank`` full and ``d* > tol`` or the
+        normal-force certificate (equal to ``is_closure`` when no hand Jacobian
+        was given).
     internal_forces : InternalForceResult or None
         LP3, when a hand Jacobian was given.
     certificate : str

@@ -107,27 +107,27 @@ def hand_object_matrix(
     Parameters
     ----------
     grasp : Grasp
-    hand_jacobian : (M, n_q) float
+    hand_jacobian : (M, n_v) float
         Hand Jacobian ``J``: rows in the column order of ``G`` (contact-frame
         components, contact by contact), columns the hand's generalized
-        velocities ``q̇``.
+        velocities ``v``.
     torque_scale : float, optional
         Length ``b_s`` (metres); default the grasp's characteristic length,
         ``1.0`` for no scaling.
 
     Returns
     -------
-    H : (6, n_q) or (3, n_q) float
-        Maps ``q̇`` to the object twist ``[v; b_s ω]`` (planar
+    H : (6, n_v) or (3, n_v) float
+        Maps ``v`` to the object twist ``[v; b_s ω]`` (planar
         ``[v_x, v_y, b_s ω]``) about ``p`` in the grasp frame: every row in
-        metres per second per unit of ``q̇``.
+        metres per second per unit of ``v``.
 
     Notes
     -----
     The contact constraint (Prattichizzo & Trinkle, *Grasping*, Springer
     Handbook of Robotics) equates the contact velocities seen by the hand and
-    by the object: ``J q̇ = Gᵀ ν``.  Its least-squares solution for the twist
-    is ``ν = (Gᵀ)^+ J q̇ = (G^+)ᵀ J q̇``, and ``H = (G^+)ᵀ J`` is the matrix whose
+    by the object: ``J v = Gᵀ ν``.  Its least-squares solution for the twist
+    is ``ν = (Gᵀ)^+ J v = (G^+)ᵀ J v``, and ``H = (G^+)ᵀ J`` is the matrix whose
     singular values give the hand-configuration indices of Roa & Suárez,
     *Grasp quality measures: review and performance* (Auton. Robots, 2015).
     With scaling, ``Gᵀ ν = (S G)ᵀ (S^{-1} ν)``, so the twist becomes
@@ -162,7 +162,7 @@ def distance_to_singularity(
 
     ``σ_min`` is the smallest of the ``D`` singular values of ``H``, so it is 0
     whenever the hand cannot move the object in some direction (including
-    ``n_q < D``).  See :func:`hand_object_matrix`.
+    ``n_v < D``).  See :func:`hand_object_matrix`.
     """
     s = hand_object_singular_values(grasp, hand_jacobian, torque_scale=torque_scale)
     return float(s[-1])
@@ -185,7 +185,7 @@ def manipulability_volume(
 ) -> float:
     r"""Manipulability-ellipsoid volume index ``σ_1 … σ_D = sqrt(det(H Hᵀ))``.
 
-    The ellipsoid ``{H q̇ : ‖q̇‖ <= 1}`` of object twists has volume
+    The ellipsoid ``{H v : ‖v‖ <= 1}`` of object twists has volume
     ``V_D σ_1 … σ_D``; the unit-ball constant ``V_D`` is left out (as in
     :func:`wrench_ellipsoid_volume`).  0 at a singular configuration.  See
     :func:`hand_object_matrix`.

@@ -149,7 +149,7 @@ def grasp_quality(
     Parameters
     ----------
     grasp : Grasp
-    hand_jacobian : (M, n_q) float, optional
+    hand_jacobian : (M, n_v) float, optional
         Hand Jacobian ``J`` (rows in ``G``'s column order); enables the indices
         of ``H = (G^+)ᵀ J`` and the LP3 part of the force-closure verdict.
     num_generators : int, optional

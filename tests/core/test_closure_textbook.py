@@ -154,3 +154,16 @@ def test_thin_cones_keep_the_frictionless_verdict(mu):
     # Without such a certificate, a thin cone is an honest "no".
     r = dg.force_closure(ex.equator_fingers(mu))
     assert not r.is_closure and r.certificate == "d*"
+
+
+@pytest.mark.parametrize("eps", [1e-8, 3e-8, 1e-7, 1e-6, 1e-3, 0.2])
+def test_d_star_matches_the_closed_form_down_to_the_boundary(eps):
+    # Square, fingers offset at atan(1/2): the best internal force is the squeeze
+    # along the line between the contacts, whose distance to the nearer cone
+    # facet is (μ - 1/2) / sqrt(1 + μ²) per unit normal force.
+    mu = 0.5 + eps
+    expected = (mu - 0.5) / np.hypot(1.0, mu)
+    for solve in (dg.force_closure, dg.force_closure_exact):
+        r = solve(ex.planar_two_finger_square(mu))
+        assert r.d_star == pytest.approx(expected, rel=1e-3, abs=2e-12)
+        assert r.near_boundary == (expected < 2 * r.tol)

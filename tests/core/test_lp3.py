@@ -68,7 +68,7 @@ def test_null_space_dimension_matches_an_independent_count():
 
 def test_wrong_jacobian_shape_names_the_expected_shape():
     grasp = ex.equator_fingers(0.5)
-    with pytest.raises(dg.InvalidGraspError, match=r"\(9, n_q\).*\(6, 3\)"):
+    with pytest.raises(dg.InvalidGraspError, match=r"\(9, n_v\).*\(6, 3\)"):
         dg.force_closure(grasp, hand_jacobian=np.zeros((6, 3)))
 
 

@@ -176,9 +176,9 @@ def test_h_recovers_a_chosen_twist_map(helpers, rng):
 
 def test_bad_jacobian(helpers):
     g, J = _planar_gripper()
-    with pytest.raises(dg.InvalidGraspError, match=r"shape \(4, n_q\)"):
+    with pytest.raises(dg.InvalidGraspError, match=r"shape \(4, n_v\)"):
         hand_object_matrix(g, J[:3])
-    with pytest.raises(dg.InvalidGraspError, match=r"shape \(4, n_q\)"):
+    with pytest.raises(dg.InvalidGraspError, match=r"shape \(4, n_v\)"):
         hand_object_matrix(g, J.ravel())
     bad = J.copy()
     bad[0, 0] = np.nan
