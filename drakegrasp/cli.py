@@ -84,6 +84,7 @@ def _cmd_batch(args: argparse.Namespace) -> int:
         num_generators=args.num_generators,
         torsional_friction=args.torsional_friction,
         tol=args.tol,
+        chunk_size=args.chunk_size,
         progress=args.progress,
         metrics=tuple(args.metrics),
     )
@@ -163,10 +164,13 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         description="Decide form or force closure for K grasps of N contacts "
         "stored as arrays positions (K, N, d) and normals (K, N, d) [, mu, "
         "torsional_friction, reference_points, characteristic_lengths] in an "
-        ".npz file, and write is_closure, d_star, rank, margin, converged and "
+        ".npz file or a directory of .npy files (read chunk by chunk), and "
+        "write is_closure, d_star, rank, margin, converged and "
         "the requested metrics to OUT (.npz, or .parquet with pyarrow).",
     )
-    batch.add_argument("input", help="input .npz file")
+    batch.add_argument(
+        "input", help="input .npz file, or a directory of .npy files (memory-mapped)"
+    )
     batch.add_argument("output", help="output .npz (or .parquet) file")
     batch.add_argument(
         "--kind", choices=["force", "form"], default="force", help="default: force"
@@ -198,6 +202,9 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         choices=METRICS,
         metavar="NAME",
         help=f"metrics to add: {', '.join(METRICS)}",
+    )
+    batch.add_argument(
+        "--chunk-size", type=int, default=4096, help="grasps per chunk (default 4096)"
     )
     batch.add_argument("--progress", action="store_true", help="show a progress bar")
     batch.set_defaults(func=_cmd_batch)

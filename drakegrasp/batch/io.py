@@ -1,12 +1,18 @@
 """Files of grasps in, files of verdicts out (the ``drakegrasp batch`` command).
 
-Input: a ``.npz`` archive with arrays
+Input: a ``.npz`` archive, or a directory of ``.npy`` files named after them
+(``positions.npy``, ``normals.npy``, ...), with arrays
 
 * ``positions`` (K, N, d) float, metres;
 * ``normals`` (K, N, d) float, pointing into the object;
 * optional ``mu`` (scalar, (K,) or (K, N)), ``torsional_friction`` (same
   shapes), ``reference_points`` ((d,) or (K, d)) and ``characteristic_lengths``
   (scalar or (K,)).
+
+A ``.npz`` archive is read whole (numpy cannot map a member of a zip file); a
+directory's ``.npy`` files are memory-mapped, so the engine reads one chunk of
+grasps at a time and a file of millions of grasps is analysed in bounded memory
+(only the per-grasp results, a few numbers each, are held).
 
 Output: ``.npz`` with the per-grasp arrays of :class:`BatchClosureResult`
 (``is_closure``, ``d_star``, ``rank``, ``margin``, ``converged`` and the metrics)
@@ -39,20 +45,22 @@ _OPTIONAL = ("mu", "torsional_friction", "reference_points", "characteristic_len
 
 
 def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
-    """Read a ``.npz`` file of grasps.
+    """Read grasps from a ``.npz`` archive or a directory of ``.npy`` files.
 
     Parameters
     ----------
     path : str or path-like
-        ``.npz`` archive with ``positions`` and ``normals`` and the optional
-        arrays listed in the module docstring.
+        ``.npz`` archive, or directory of ``.npy`` files, holding ``positions``
+        and ``normals`` and the optional arrays listed in the module docstring.
 
     Returns
     -------
     dict of str to ndarray
-        The arrays present, by name.
+        The arrays present, by name (memory-mapped for a directory).
     """
     path = Path(path)
+    if path.is_dir():
+        return _read_npy_directory(path)
     if path.suffix.lower() != ".npz":
         raise InvalidOptionError(
             f"input file {str(path)!r} must be a .npz archive (arrays positions, "
@@ -84,6 +92,31 @@ def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
                 f"valid names are positions, normals, {', '.join(_OPTIONAL)}"
             )
         return {k: data[k] for k in data.files}
+
+
+def _read_npy_directory(path: Path) -> dict[str, np.ndarray]:
+    names = {f.stem: f for f in sorted(path.glob("*.npy"))}
+    missing = [k for k in ("positions", "normals") if k not in names]
+    if missing:
+        raise InvalidOptionError(
+            f"input directory {str(path)!r} has no "
+            f"{', '.join(m + '.npy' for m in missing)}; it holds "
+            f"{sorted(f.name for f in names.values())}"
+        )
+    unknown = set(names) - {"positions", "normals", *_OPTIONAL}
+    if unknown:
+        raise InvalidOptionError(
+            f"input directory {str(path)!r} has unknown array(s) {sorted(unknown)}; "
+            f"valid names are positions, normals, {', '.join(_OPTIONAL)}"
+        )
+    try:
+        return {
+            k: np.load(f, mmap_mode="r", allow_pickle=False) for k, f in names.items()
+        }
+    except ValueError as err:
+        raise InvalidOptionError(
+            f"input directory {str(path)!r} holds an unreadable .npy file ({err})"
+        ) from None
 
 
 def write_result(result: BatchClosureResult, path: str | os.PathLike) -> Path:
@@ -156,7 +189,9 @@ def evaluate_file(
     Parameters
     ----------
     input_path : str or path-like
-        ``.npz`` archive of grasps (see the module docstring).
+        ``.npz`` archive of grasps, or a directory of ``.npy`` files (memory-
+        mapped: bounded memory for any number of grasps); see the module
+        docstring.
     output_path : str or path-like
         ``.npz`` (or ``.parquet`` with pyarrow) file to write.
     kind : {"force", "form"}, optional

@@ -61,3 +61,30 @@ def test_bad_input_prints_one_line_and_fails(tmp_path, capsys, make, message):
     err = capsys.readouterr().err
     assert code == 1 and message in err
     assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_a_directory_of_npy_files_is_read_chunk_by_chunk(grasp_file, tmp_path):
+    from drakegrasp.batch import read_grasps
+
+    _, p, n = grasp_file
+    folder = tmp_path / "grasps"
+    folder.mkdir()
+    np.save(folder / "positions.npy", p)
+    np.save(folder / "normals.npy", n)
+    arrays = read_grasps(folder)
+    assert isinstance(arrays["positions"], np.memmap)  # nothing loaded yet
+    out = tmp_path / "out.npz"
+    assert (
+        main(["batch", str(folder), str(out), "--mu", "0.5", "--chunk-size", "64"]) == 0
+    )
+    expected = dg.batch_force_closure(p, n, 0.5)
+    assert np.array_equal(np.load(out)["is_closure"], expected.is_closure)
+
+
+def test_a_directory_without_normals_is_named(tmp_path, capsys):
+    (tmp_path / "g").mkdir()
+    np.save(tmp_path / "g" / "positions.npy", np.zeros((2, 3, 3)))
+    assert (
+        main(["batch", str(tmp_path / "g"), str(tmp_path / "o.npz"), "--mu", "1"]) == 1
+    )
+    assert "has no normals.npy" in capsys.readouterr().err
