@@ -651,9 +651,17 @@ def _choose_normal(*, obj, obj_flat, fin, fin_flat, witness, psi, drake):
         return obj[0], "object"
     elif len(fin) == 1:
         return fin[0], "finger"
-    if abs(psi) > 1e-9:
+    if abs(psi) > _WITNESS_DIRECTION_MIN_DISTANCE:
         return witness / np.linalg.norm(witness) * np.sign(psi), "witness points"
     return drake, "drake"
+
+
+_WITNESS_DIRECTION_MIN_DISTANCE = 1e-3
+"""|ψ| (m) above which the line between witness points gives the normal.
+
+GJK witnesses are accurate to ~1e-5 m, so nearer than this their direction is
+mostly noise; Drake's own normal is then used (exact for the shape pairs that
+Drake computes analytically)."""
 
 
 def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
