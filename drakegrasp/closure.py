@@ -71,7 +71,7 @@ DEFAULT_TOL = 1e-6
 """Default threshold on ``d*``: closure needs ``d* > tol`` (LP3 passes at ``<= tol``).
 
 LP1–LP3 normalise the normal forces to ``Σ f_n <= N``, so ``d*`` is of order 0.1
-for a good grasp; with :data:`OBJECTIVE_SCALE`, Clp reports ``d*`` to about 1e-11
+for a good grasp; with :data:`OBJECTIVE_SCALE`, Clp reports ``d*`` to about 1e-10
 (checked against closed forms), far below this threshold.
 """
 
@@ -81,7 +81,7 @@ OBJECTIVE_SCALE = 1e4
 Clp's optimality test has an absolute dual tolerance of 1e-7, so with cost
 ``-d`` it stops as soon as ``d`` cannot grow by more than about 1e-7 and can
 report ``d* = 1e-12`` where the true value is 9e-8.  Scaling the objective
-moves that error to about 1e-11 without changing the optimum.
+moves that error to about 1e-10 without changing the optimum.
 """
 
 DEFAULT_RANK_TOL = 1e-9
@@ -188,8 +188,25 @@ def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
     )
 
 
+def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
+    """``A x = 0``, imposed on the numerical row space of ``A`` (see below).
+
+    The rows added are ``V_rᵀ``: the right singular vectors of ``A`` whose
+    singular values exceed ``rank_tol σ_max``.  They span ``A``'s row space when
+    ``A`` has full rank (the same constraint, orthonormal rows), and otherwise
+    leave ``x`` free in exactly the numerical null space that the reported rank
+    counts.  Imposing a nearly rank-deficient ``A x = 0`` literally (contacts
+    measured to 1e-8 m) made Clp declare an always-feasible LP infeasible.
+    """
+    rows = _row_space(A, rank_tol)
+    if rows.shape[0]:
+        prog.AddLinearEqualityConstraint(rows, np.zeros(rows.shape[0]), x)
+
+
 def build_form_closure_program(
     grasp: Grasp,
+    *,
+    rank_tol: float = DEFAULT_RANK_TOL,
 ) -> tuple[MathematicalProgram, ProgramVariables]:
     """Build LP1, the first-order form-closure program, over normal forces.
 
@@ -197,6 +214,10 @@ def build_form_closure_program(
     ----------
     grasp : Grasp
         Every contact is treated as frictionless (form closure ignores friction).
+    rank_tol : float, optional
+        ``G_n f_n = 0`` is imposed on ``G_n``'s numerical row space at this
+        relative singular-value threshold (``V_rᵀ f_n = 0``; the same constraint
+        when ``G_n`` has full rank).
 
     Returns
     -------
@@ -209,9 +230,7 @@ def build_form_closure_program(
     """
     N = grasp.num_contacts
     prog, f, d = _margin_program(N, N)
-    prog.AddLinearEqualityConstraint(
-        normal_grasp_matrix(grasp), np.zeros(grasp.wrench_dim), f
-    )
+    _add_balance(prog, normal_grasp_matrix(grasp), f, rank_tol)
     _add_margin_rows(prog, np.eye(N), f, d)
     _add_normal_budget(prog, f, N)
     return prog, ProgramVariables(d, f, np.arange(N))
@@ -222,6 +241,7 @@ def build_force_closure_program(
     *,
     num_generators: int = DEFAULT_NUM_GENERATORS,
     formulation: str = "facets",
+    rank_tol: float = DEFAULT_RANK_TOL,
 ) -> tuple[MathematicalProgram, ProgramVariables]:
     """Build LP2, the frictional force-closure program on polyhedral cones.
 
@@ -236,6 +256,9 @@ def build_force_closure_program(
         (V-form): ``f = S λ`` and ``max d`` s.t. ``G S λ = 0``, ``λ - 1 d >= 0``,
         ``d >= 0``, ``Σ f_n <= N``; its ``d*`` has another scale, but the
         verdict (``d* > 0`` with full rank) is the same.
+    rank_tol : float, optional
+        ``G f = 0`` is imposed on ``G``'s numerical row space at this threshold
+        (the same constraint when ``G`` has full rank).
 
     Returns
     -------
@@ -246,16 +269,15 @@ def build_force_closure_program(
     _check_formulation(formulation)
     layout = ConeLayout.of(grasp, num_generators)
     N = grasp.num_contacts
-    w = grasp.wrench_dim
     if formulation == "facets":
         prog, f, d = _margin_program(len(layout.columns), N)
-        prog.AddLinearEqualityConstraint(layout.G, np.zeros(w), f)
+        _add_balance(prog, layout.G, f, rank_tol)
         _add_margin_rows(prog, layout.facet_matrix(), f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
         return prog, ProgramVariables(d, f, layout.columns)
     S = layout.generator_matrix()
     prog, lam, d = _margin_program(S.shape[1], N)
-    prog.AddLinearEqualityConstraint(layout.G @ S, np.zeros(w), lam)
+    _add_balance(prog, layout.G @ S, lam, rank_tol)
     _add_margin_rows(prog, np.eye(S.shape[1]), lam, d)
     # Every generator has unit normal component, so Σ f_n = Σ λ.
     _add_normal_budget(prog, lam, N)
@@ -268,12 +290,16 @@ def build_force_closure_program(
 
 def build_exact_force_closure_program(
     grasp: Grasp,
+    *,
+    rank_tol: float = DEFAULT_RANK_TOL,
 ) -> tuple[MathematicalProgram, ProgramVariables]:
     """Build the force-closure program on exact Coulomb cones (an SOCP).
 
     Parameters
     ----------
     grasp : Grasp
+    rank_tol : float, optional
+        ``G f = 0`` is imposed on ``G``'s numerical row space at this threshold.
 
     Returns
     -------
@@ -289,7 +315,7 @@ def build_exact_force_closure_program(
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
-    prog.AddLinearEqualityConstraint(layout.G, np.zeros(grasp.wrench_dim), f)
+    _add_balance(prog, layout.G, f, rank_tol)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     b = grasp.characteristic_length
     starts = list(layout.normal_positions) + [len(layout.columns)]
@@ -353,9 +379,7 @@ def build_internal_force_program(
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
-    row_space = _row_space(np.vstack([layout.G, J[layout.columns].T]), rank_tol)
-    if row_space.shape[0]:
-        prog.AddLinearEqualityConstraint(row_space, np.zeros(row_space.shape[0]), f)
+    _add_balance(prog, np.vstack([layout.G, J[layout.columns].T]), f, rank_tol)
     _add_margin_rows(prog, np.eye(len(f))[layout.normal_positions], f, d)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     return prog, ProgramVariables(d, f, layout.columns)
@@ -441,7 +465,7 @@ def form_closure(
     tol = _check_tol(tol)
     required = grasp.wrench_dim
     rank = matrix_rank(normal_grasp_matrix(grasp), rank_tol=rank_tol)
-    prog, variables = build_form_closure_program(grasp)
+    prog, variables = build_form_closure_program(grasp, rank_tol=rank_tol)
     d_star, forces, solver, status = _solve_margin(prog, variables, conic=False)
     if forces is None:
         forces = np.zeros(grasp.num_contacts)
@@ -570,7 +594,7 @@ def _normal_force_certificate(
         return None
     if matrix_rank(normal_grasp_matrix(grasp), rank_tol=rank_tol) == len(normals):
         return None  # N(G_n) = {0}: no non-zero normal forces balance
-    prog, variables = build_form_closure_program(grasp)
+    prog, variables = build_form_closure_program(grasp, rank_tol=rank_tol)
     d_star, f_n, _, _ = _solve_margin(prog, variables, conic=False)
     if not d_star > tol:
         return None
@@ -610,7 +634,7 @@ def force_closure(
     """
     tol = _check_tol(tol)
     prog, variables = build_force_closure_program(
-        grasp, num_generators=num_generators, formulation=formulation
+        grasp, num_generators=num_generators, formulation=formulation, rank_tol=rank_tol
     )
     return _force_closure_result(
         grasp,
@@ -650,7 +674,7 @@ def force_closure_exact(
     ClosureResult
     """
     tol = _check_tol(tol)
-    prog, variables = build_exact_force_closure_program(grasp)
+    prog, variables = build_exact_force_closure_program(grasp, rank_tol=rank_tol)
     conic = bool(prog.lorentz_cone_constraints())
     return _force_closure_result(
         grasp,

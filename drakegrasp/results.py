@@ -177,8 +177,8 @@ class ClosureResult:
     def near_boundary(self) -> bool:
         """True when ``tol/1000 < d* < 2 tol``: the verdict is not certain.
 
-        ``d*`` at or below ``tol/1000`` is the solver's zero (Clp solves to about
-        1e-9): a certain "no".
+        ``d*`` at or below ``tol/1000`` is the solver's zero (Clp reports ``d*``
+        to about 1e-10): a certain "no".
         """
         return _near(self.margin)
 

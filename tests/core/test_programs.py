@@ -12,8 +12,11 @@ def test_lp2_program_shape_follows_the_conventions():
     prog, v = dg.build_force_closure_program(grasp, num_generators=8)
     assert prog.num_vars() == 9 + 1 and len(v.forces) == 9
     assert np.array_equal(v.columns, np.arange(9))
-    eq = prog.linear_equality_constraints()[0].evaluator()
-    assert np.allclose(eq.GetDenseA(), dg.grasp_matrix(grasp))
+    # G f = 0 is imposed as V_r^T f = 0: orthonormal rows spanning G's rows.
+    A = prog.linear_equality_constraints()[0].evaluator().GetDenseA()
+    G = dg.grasp_matrix(grasp)
+    assert A.shape == (6, 9) and np.allclose(A @ A.T, np.eye(6))
+    assert np.allclose(np.linalg.pinv(A) @ A, np.linalg.pinv(G) @ G)
     ineq = [c.evaluator() for c in prog.linear_constraints()]
     assert sum(c.num_constraints() for c in ineq) == 3 * 8 + 1
 

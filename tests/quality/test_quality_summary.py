@@ -61,8 +61,11 @@ def test_lp2_margin_against_scipy(helpers, rng):
 def test_lp2_margin_grows_with_mu(helpers):
     g = helpers.equator_grasp(0.5)
     values = [lp2_margin(g.with_friction(mu)) for mu in (0.0, 0.2, 0.5, 1.0)]
-    assert values[0] == pytest.approx(0.0, abs=1e-9)
-    assert np.all(np.diff(values) > 0)
+    # μ = 0: frictionless, LP2 is LP1, and the three normals balance with
+    # f_n = 1 each, so d* = 1.  For μ > 0, d* is the distance to the cone
+    # boundaries (0 at μ -> 0+) and grows with μ.
+    assert values[0] == pytest.approx(1.0, abs=1e-9)
+    assert np.all(np.diff(values[1:]) > 0)
 
 
 def test_summary_matches_individual_metrics(helpers):
