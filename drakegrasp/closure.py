@@ -30,6 +30,7 @@ frictionless one.  This module imports ``pydrake.solvers`` only, never the plant
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +66,7 @@ __all__ = [
     "form_closure",
     "internal_forces",
     "matrix_rank",
+    "with_internal_forces",
 ]
 
 DEFAULT_TOL = 1e-6
@@ -560,12 +562,9 @@ def _force_closure_result(
         if normal is not None:
             frictional, certificate = True, "normal forces"
             margin, contact_forces = normal
-    lp3 = None
-    if hand_jacobian is not None:
-        lp3 = internal_forces(grasp, hand_jacobian, tol=tol, rank_tol=rank_tol)
-    return ClosureResult(
+    result = ClosureResult(
         kind=kind,
-        is_closure=frictional and (lp3 is None or lp3.passes),
+        is_closure=frictional,
         d_star=d_star,
         rank=rank,
         required_rank=required,
@@ -576,8 +575,37 @@ def _force_closure_result(
         tol=tol,
         formulation=formulation,
         frictional_closure=frictional,
-        internal_forces=lp3,
         certificate=certificate,
+    )
+    if hand_jacobian is None:
+        return result
+    lp3 = internal_forces(grasp, hand_jacobian, tol=tol, rank_tol=rank_tol)
+    return with_internal_forces(result, lp3)
+
+
+def with_internal_forces(
+    result: ClosureResult, lp3: InternalForceResult
+) -> ClosureResult:
+    """The verdict with a hand: frictional closure and LP3 passing.
+
+    Parameters
+    ----------
+    result : ClosureResult
+        A force-closure result computed without the hand Jacobian.
+    lp3 : InternalForceResult
+        :func:`internal_forces` of the same grasp and hand Jacobian; one LP3
+        can serve the polyhedral and the exact-cone verdicts alike.
+
+    Returns
+    -------
+    ClosureResult
+        ``result`` with ``internal_forces = lp3`` and
+        ``is_closure = frictional_closure and lp3.passes``.
+    """
+    return dataclasses.replace(
+        result,
+        internal_forces=lp3,
+        is_closure=result.frictional_closure and lp3.passes,
     )
 
 

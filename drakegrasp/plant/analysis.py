@@ -23,6 +23,8 @@ from drakegrasp.closure import (
     force_closure,
     force_closure_exact,
     form_closure,
+    internal_forces,
+    with_internal_forces,
 )
 from drakegrasp.contact import Contact, ContactModel
 from drakegrasp.errors import InvalidOptionError
@@ -406,13 +408,17 @@ def analyze_grasp(
     )
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
+    lp3 = internal_forces(grasp, J, tol=tol)
     return GraspReport(
         data=data,
         G=grasp_matrix(grasp),
         form_closure=form_closure(grasp, tol=tol),
-        force_closure=force_closure(
-            grasp, hand_jacobian=J, num_generators=num_generators, tol=tol
+        # One LP3 serves both verdicts: it depends on G and J, not on the cones.
+        force_closure=with_internal_forces(
+            force_closure(grasp, num_generators=num_generators, tol=tol), lp3
         ),
-        force_closure_exact=force_closure_exact(grasp, hand_jacobian=J, tol=tol),
+        force_closure_exact=with_internal_forces(
+            force_closure_exact(grasp, tol=tol), lp3
+        ),
         antipodal=antipodal,
     )
