@@ -620,6 +620,35 @@ def planar_gripper_joints() -> tuple[dict, list[tuple[float, tuple]]]:
 PLANAR_BASE_DISTANCE = 0.19
 
 
+def _three_finger_scene(name: str, rho: float, description: str) -> str:
+    """The three-finger hand closed on an object, tips at radius ``rho`` (m)."""
+    q2, q3 = 0.35, 0.30
+    q1 = proximal_for_radius(q2, q3, rho)
+    _, z_tip = finger_tip((q1, q2, q3))
+    joints = {}
+    for k in (1, 2, 3):
+        joints.update(
+            {
+                f"finger{k}_proximal_joint": q1,
+                f"finger{k}_middle_joint": q2,
+                f"finger{k}_distal_joint": q3,
+            }
+        )
+    return scene(
+        description,
+        add_model("hand", "package://drakegrasp/hands/three_finger_hand.sdf", joints)
+        + add_weld("world", "hand::palm")
+        + add_model(
+            name,
+            f"package://drakegrasp/objects/{name}.sdf",
+            pose=(name, (0, 0, z_tip), (0, 0, 0)),
+        ),
+        object_body=f"{name}::{name}",
+        hand="hand",
+        mu=0.5,
+    )
+
+
 def scenes() -> dict[str, str]:
     """Relative path -> text of every scene file."""
     out = {}
@@ -677,60 +706,23 @@ def scenes() -> dict[str, str]:
         hand="gripper",
         mu=0.5,
     )
-    hand = "package://drakegrasp/hands/three_finger_hand.sdf"
-    q2, q3 = 0.35, 0.30
-    # Sphere: tip centres on the sphere's equator, at radius R + r_tip.
-    rho = SPHERE["radius"] + HAND_TIP_RADIUS
-    q1 = proximal_for_radius(q2, q3, rho)
-    _, z_tip = finger_tip((q1, q2, q3))
-    joints = {}
-    for k in (1, 2, 3):
-        joints.update(
-            {
-                f"finger{k}_proximal_joint": q1,
-                f"finger{k}_middle_joint": q2,
-                f"finger{k}_distal_joint": q3,
-            }
-        )
-    out["scenes/three_finger_sphere.yaml"] = scene(
-        "Three-finger hand holding a 35 mm-radius sphere at its equator.",
-        add_model("hand", hand, joints)
-        + add_weld("world", "hand::palm")
-        + add_model(
+    # Tip centres on the object's circle of radius rho, at the height z_tip.
+    for name, rho, description in (
+        (
             "sphere",
-            "package://drakegrasp/objects/sphere.sdf",
-            pose=("sphere", (0, 0, z_tip), (0, 0, 0)),
+            SPHERE["radius"] + HAND_TIP_RADIUS,
+            "Three-finger hand holding a 35 mm-radius sphere at its equator.",
         ),
-        object_body="sphere::sphere",
-        hand="hand",
-        mu=0.5,
-    )
-    # Hexagonal prism: tip centres at radius apothem + r_tip, facing three flats.
-    rho = HEX["apothem"] + HAND_TIP_RADIUS
-    q1 = proximal_for_radius(q2, q3, rho)
-    _, z_tip = finger_tip((q1, q2, q3))
-    joints = {}
-    for k in (1, 2, 3):
-        joints.update(
-            {
-                f"finger{k}_proximal_joint": q1,
-                f"finger{k}_middle_joint": q2,
-                f"finger{k}_distal_joint": q3,
-            }
-        )
-    out["scenes/three_finger_hex_prism.yaml"] = scene(
-        "Three-finger hand on three side faces of the hexagonal prism (convex mesh).",
-        add_model("hand", hand, joints)
-        + add_weld("world", "hand::palm")
-        + add_model(
+        (
             "hex_prism",
-            "package://drakegrasp/objects/hex_prism.sdf",
-            pose=("hex_prism", (0, 0, z_tip), (0, 0, 0)),
+            HEX["apothem"] + HAND_TIP_RADIUS,
+            "Three-finger hand on three side faces of the hexagonal prism "
+            "(convex mesh).",
         ),
-        object_body="hex_prism::hex_prism",
-        hand="hand",
-        mu=0.5,
-    )
+    ):
+        out[f"scenes/three_finger_{name}.yaml"] = _three_finger_scene(
+            name, rho, description
+        )
     joints, welds = planar_gripper_joints()
     directives = add_model(
         "gripper", "package://drake/examples/planar_gripper/planar_gripper.sdf", joints

@@ -24,7 +24,7 @@ Either way an arrow's direction is the force ``f`` itself (in the grasp frame).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -45,6 +45,32 @@ __all__ = [
 ]
 
 SIDES = ("outside", "inside")
+
+
+def merge_palette(
+    defaults: Mapping[str, Any], overrides: Mapping[str, Any] | None
+) -> dict[str, Any]:
+    """Default colours with the caller's overrides; unknown keys are an error.
+
+    Parameters
+    ----------
+    defaults : mapping of str to colour
+    overrides : mapping of str to colour, optional
+
+    Returns
+    -------
+    dict of str to colour
+    """
+    merged = dict(defaults)
+    if overrides:
+        unknown = set(overrides) - set(merged)
+        if unknown:
+            raise InvalidOptionError(
+                f"unknown colour key(s) {sorted(unknown)}; valid keys are "
+                f"{sorted(merged)}"
+            )
+        merged.update(overrides)
+    return merged
 
 
 def side_sign(side: str) -> float:

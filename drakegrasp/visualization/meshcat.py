@@ -36,6 +36,7 @@ from drakegrasp.grasp import Grasp
 from drakegrasp.visualization.geometry import (
     contact_pose_3d,
     exact_cone_mesh,
+    merge_palette,
     normalize_contact_forces,
     positive_length,
     pyramid_generators,
@@ -103,19 +104,6 @@ def _rgba(colors: Mapping[str, Any], key: str) -> Rgba:
     if len(v) != 4:
         raise InvalidOptionError(f"colour {key!r} must be RGB or RGBA, got {value!r}")
     return Rgba(*v)
-
-
-def _merge_colors(colors: Mapping[str, Any] | None) -> dict[str, Any]:
-    merged = dict(MESHCAT_COLORS)
-    if colors:
-        unknown = set(colors) - set(merged)
-        if unknown:
-            raise InvalidOptionError(
-                f"unknown colour key(s) {sorted(unknown)}; valid keys are "
-                f"{sorted(merged)}"
-            )
-        merged.update(colors)
-    return merged
 
 
 def _set_mesh(meshcat: Meshcat, path: str, vertices, faces, rgba: Rgba, **kw) -> None:
@@ -243,7 +231,7 @@ def draw_grasp(
     if not isinstance(prefix, str) or not prefix.strip("/"):
         raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
     sign = side_sign(side)
-    palette = _merge_colors(colors)
+    palette = merge_palette(MESHCAT_COLORS, colors)
     b = grasp.characteristic_length
     h = positive_length("cone_height", 0.4 * b if cone_height is None else cone_height)
     r = positive_length(

@@ -22,6 +22,7 @@ from drakegrasp.grasp import Grasp
 from drakegrasp.visualization.geometry import (
     cone_edge_directions,
     contact_forces_in_grasp_frame,
+    merge_palette,
     normalize_contact_forces,
     positive_length,
     side_sign,
@@ -194,15 +195,7 @@ def plot_planar_grasp(
             "(use drakegrasp.visualization.draw_grasp with Meshcat)"
         )
     sign = side_sign(side)
-    palette = dict(PLOT_COLORS)
-    if colors:
-        unknown = set(colors) - set(palette)
-        if unknown:
-            raise InvalidOptionError(
-                f"unknown colour key(s) {sorted(unknown)}; valid keys are "
-                f"{sorted(palette)}"
-            )
-        palette.update(colors)
+    palette = merge_palette(PLOT_COLORS, colors)
     b = grasp.characteristic_length
     L = positive_length("cone_length", 0.3 * b if cone_length is None else cone_length)
     forces = normalize_contact_forces(grasp, result)
