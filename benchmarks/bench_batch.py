@@ -33,9 +33,9 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.optimize import linprog  # noqa: E402
 
-from drakegrasp import Contact, Grasp, grasp_matrix, normal_grasp_matrix  # noqa: E402
+from drakegrasp import Contact, Grasp, normal_grasp_matrix  # noqa: E402
 from drakegrasp.batch import batch_force_closure, batch_form_closure  # noqa: E402
-from drakegrasp.friction_cone import effective_cone  # noqa: E402
+from drakegrasp.friction_cone import ConeLayout  # noqa: E402
 
 try:  # the single-grasp MathematicalProgram path
     from drakegrasp.closure import force_closure, form_closure  # noqa: E402
@@ -70,18 +70,9 @@ def lp_matrices(grasp, kind):
     if kind == "form":
         G, F, normal_cols = normal_grasp_matrix(grasp), np.eye(N), list(range(N))
     else:
-        cones = [effective_cone(c, 8) for c in grasp.contacts]
-        cols, normal_cols, blocks = [], [], []
-        for s, cone in zip(grasp.component_slices(), cones, strict=True):
-            normal_cols.append(len(cols))
-            cols.extend(s.start + j for j in cone.components)
-            blocks.append(cone.facets)
-        G = grasp_matrix(grasp)[:, cols]
-        F = np.zeros((sum(b.shape[0] for b in blocks), len(cols)))
-        r = c = 0
-        for b in blocks:
-            F[r : r + b.shape[0], c : c + b.shape[1]] = b
-            r, c = r + b.shape[0], c + b.shape[1]
+        layout = ConeLayout.of(grasp, 8)
+        G, F = layout.G, layout.facet_matrix()
+        normal_cols = list(layout.normal_positions)
     w, M = G.shape
     cost = np.zeros(M + 1)
     cost[-1] = -1.0

@@ -656,42 +656,37 @@ def scenes() -> dict[str, str]:
     pjf = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
     half_box = BOX["size"][1] / 2
     box_z = 0.065
-    out["scenes/parallel_jaw_box.yaml"] = scene(
-        "Parallel-jaw gripper with rounded pads squeezing a 50 x 50 x 100 mm box "
-        "(default scene).",
-        add_model(
-            "gripper",
+    for name, hand, description in (
+        (
+            "parallel_jaw_box",
             pj,
-            {"left_finger_joint": half_box, "right_finger_joint": half_box},
-        )
-        + add_weld("world", "gripper::palm")
-        + add_model(
-            "box",
-            "package://drakegrasp/objects/box.sdf",
-            pose=("box", (0, 0, box_z), (0, 0, 0)),
+            "Parallel-jaw gripper with rounded pads squeezing a 50 x 50 x 100 mm "
+            "box (default scene).",
         ),
-        object_body="box::box",
-        hand="gripper",
-        mu=0.5,
-    )
-    out["scenes/parallel_jaw_flat_box.yaml"] = scene(
-        "Parallel-jaw gripper with flat 20 x 20 mm pads on the box: each pad "
-        "touches along a square patch.",
-        add_model(
-            "gripper",
+        (
+            "parallel_jaw_flat_box",
             pjf,
-            {"left_finger_joint": half_box, "right_finger_joint": half_box},
-        )
-        + add_weld("world", "gripper::palm")
-        + add_model(
-            "box",
-            "package://drakegrasp/objects/box.sdf",
-            pose=("box", (0, 0, box_z), (0, 0, 0)),
+            "Parallel-jaw gripper with flat 20 x 20 mm pads on the box: each pad "
+            "touches along a square patch.",
         ),
-        object_body="box::box",
-        hand="gripper",
-        mu=0.5,
-    )
+    ):
+        out[f"scenes/{name}.yaml"] = scene(
+            description,
+            add_model(
+                "gripper",
+                hand,
+                {"left_finger_joint": half_box, "right_finger_joint": half_box},
+            )
+            + add_weld("world", "gripper::palm")
+            + add_model(
+                "box",
+                "package://drakegrasp/objects/box.sdf",
+                pose=("box", (0, 0, box_z), (0, 0, 0)),
+            ),
+            object_body="box::box",
+            hand="gripper",
+            mu=0.5,
+        )
     r = CYLINDER["radius"]
     out["scenes/parallel_jaw_cylinder.yaml"] = scene(
         "Parallel-jaw gripper with rounded pads on an upright cylinder.",

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import linprog
 
-from drakegrasp import Contact, Grasp, grasp_matrix, normal_grasp_matrix
-from drakegrasp.friction_cone import effective_cone
+from drakegrasp import Contact, Grasp, normal_grasp_matrix
+from drakegrasp.friction_cone import ConeLayout
 
 
 def random_grasps(rng, K, N, d, *, spread=0.4, radius=1.0):
@@ -63,23 +63,8 @@ def _rank(A, rank_tol=1e-9):
 
 def scipy_force_closure(grasp, num_generators=8):
     """(d*, rank) of LP2 built per grasp from the single-grasp building blocks."""
-    b = grasp.characteristic_length
-    cones = [
-        effective_cone(c, num_generators, characteristic_length=b)
-        for c in grasp.contacts
-    ]
-    cols, normal_cols = [], []
-    blocks = []
-    for s, cone in zip(grasp.component_slices(), cones, strict=True):
-        normal_cols.append(len(cols))
-        cols.extend(s.start + j for j in cone.components)
-        blocks.append(cone.facets)
-    G = grasp_matrix(grasp)[:, cols]
-    F = np.zeros((sum(f.shape[0] for f in blocks), len(cols)))
-    r = c = 0
-    for f in blocks:
-        F[r : r + f.shape[0], c : c + f.shape[1]] = f
-        r, c = r + f.shape[0], c + f.shape[1]
+    layout = ConeLayout.of(grasp, num_generators)
+    G, F, normal_cols = layout.G, layout.facet_matrix(), list(layout.normal_positions)
     return _lp_margin(G, F, normal_cols, grasp.num_contacts), _rank(G)
 
 
