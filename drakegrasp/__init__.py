@@ -61,6 +61,7 @@ from drakegrasp.plant import (
     load_scene,
     register_models,
     signed_distance_jacobian,
+    use_local_drake_models,
 )
 from drakegrasp.quality import (
     GraspQuality,
@@ -157,6 +158,7 @@ __all__ = [
     "plot_wrench_space",
     "primitive_wrenches",
     "register_models",
+    "use_local_drake_models",
     "signed_distance_jacobian",
     "uniformity_of_transformation",
     "wrench_ellipsoid_volume",

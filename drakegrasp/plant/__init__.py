@@ -22,7 +22,7 @@ from drakegrasp.plant.jacobians import (
     hand_velocity_indices,
     signed_distance_jacobian,
 )
-from drakegrasp.plant.models import models_dir, register_models
+from drakegrasp.plant.models import models_dir, register_models, use_local_drake_models
 from drakegrasp.plant.scene import (
     DEFAULT_SCENE,
     Scene,
@@ -49,5 +49,6 @@ __all__ = [
     "load_scene",
     "models_dir",
     "register_models",
+    "use_local_drake_models",
     "signed_distance_jacobian",
 ]

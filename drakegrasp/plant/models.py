@@ -10,15 +10,30 @@ from __future__ import annotations
 
 import functools
 import importlib.util
+import os
 from pathlib import Path
 
 from pydrake.multibody.parsing import PackageMap, Parser
 
 from drakegrasp.errors import ModelError
 
-__all__ = ["PACKAGE_NAME", "models_dir", "register_models"]
+__all__ = [
+    "DRAKE_MODELS_ENV",
+    "PACKAGE_NAME",
+    "models_dir",
+    "register_models",
+    "use_local_drake_models",
+]
 
 PACKAGE_NAME = "drakegrasp"
+
+DRAKE_MODELS_ENV = "DRAKEGRASP_DRAKE_MODELS"
+"""Environment variable naming a local copy of Drake's ``drake_models`` package.
+
+Drake's wheel downloads ``package://drake_models/...`` on demand; offline
+machines (CI, a laptop on a plane) set this variable to a folder holding the
+package and call :func:`use_local_drake_models` on their parser.
+"""
 
 
 @functools.cache
@@ -72,15 +87,7 @@ def register_models(parser_or_package_map: Parser | PackageMap) -> PackageMap:
     >>> parser.AddModelsFromUrl(
     ...     "package://drakegrasp/objects/box.sdf")  # doctest: +SKIP
     """
-    if isinstance(parser_or_package_map, Parser):
-        package_map = parser_or_package_map.package_map()
-    elif isinstance(parser_or_package_map, PackageMap):
-        package_map = parser_or_package_map
-    else:
-        raise TypeError(
-            "register_models expects a pydrake Parser or PackageMap, got "
-            f"{type(parser_or_package_map).__name__}"
-        )
+    package_map = _package_map_of(parser_or_package_map, "register_models")
     path = str(models_dir())
     if package_map.Contains(PACKAGE_NAME):
         if package_map.GetPath(PACKAGE_NAME) == path:
@@ -88,3 +95,56 @@ def register_models(parser_or_package_map: Parser | PackageMap) -> PackageMap:
         package_map.Remove(PACKAGE_NAME)
     package_map.Add(PACKAGE_NAME, path)
     return package_map
+
+
+def use_local_drake_models(
+    parser_or_package_map: Parser | PackageMap, path: str | os.PathLike | None = None
+) -> PackageMap:
+    """Point ``package://drake_models/...`` at a local folder instead of a download.
+
+    Parameters
+    ----------
+    parser_or_package_map : pydrake.multibody.parsing.Parser or PackageMap
+        The parser (its ``package_map()`` is updated) or package map to change.
+    path : str or os.PathLike, optional
+        Folder that holds the ``drake_models`` package (``wsg_50_description/``,
+        ``allegro_hand_description/``, ...).  Default: the folder named by the
+        environment variable :data:`DRAKE_MODELS_ENV`; when that is unset too,
+        nothing changes and Drake downloads the package as usual.
+
+    Returns
+    -------
+    PackageMap
+        The package map, now resolving ``drake_models`` to ``path``.
+
+    Raises
+    ------
+    ModelError
+        If ``path`` (or the variable's value) is not a directory.
+    """
+    package_map = _package_map_of(parser_or_package_map, "use_local_drake_models")
+    if path is None:
+        path = os.environ.get(DRAKE_MODELS_ENV)
+        if not path:
+            return package_map
+    folder = Path(path).expanduser().resolve()
+    if not folder.is_dir():
+        raise ModelError(
+            f"drake_models folder {str(path)!r} is not a directory (set "
+            f"{DRAKE_MODELS_ENV} or pass path= to a local copy of drake_models)"
+        )
+    if package_map.Contains("drake_models"):
+        package_map.Remove("drake_models")
+    package_map.Add("drake_models", str(folder))
+    return package_map
+
+
+def _package_map_of(parser_or_package_map, caller: str) -> PackageMap:
+    if isinstance(parser_or_package_map, Parser):
+        return parser_or_package_map.package_map()
+    if isinstance(parser_or_package_map, PackageMap):
+        return parser_or_package_map
+    raise TypeError(
+        f"{caller} expects a pydrake Parser or PackageMap, got "
+        f"{type(parser_or_package_map).__name__}"
+    )

@@ -1,0 +1,36 @@
+"""Fixtures shared by every test folder: where Drake's real models are."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from drakegrasp.plant.models import DRAKE_MODELS_ENV
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def local_drake_models() -> Path | None:
+    """The local ``drake_models`` copy: ``$DRAKEGRASP_DRAKE_MODELS``, else
+    ``<repo>/../shared/drake_models``; None when neither is a directory."""
+    for candidate in (
+        os.environ.get(DRAKE_MODELS_ENV),
+        ROOT.parent / "shared" / "drake_models",
+    ):
+        if candidate and Path(candidate).is_dir():
+            return Path(candidate).resolve()
+    return None
+
+
+@pytest.fixture(scope="session")
+def drake_models_dir() -> Path:
+    """Folder of Drake's ``drake_models`` package; skips the test when absent."""
+    path = local_drake_models()
+    if path is None:
+        pytest.skip(
+            f"drake_models not found: set {DRAKE_MODELS_ENV} or put a copy at "
+            "../shared/drake_models"
+        )
+    return path
