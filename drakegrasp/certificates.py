@@ -59,6 +59,7 @@ __all__ = [
     "Certificate",
     "CertificateCheck",
     "cone_support",
+    "support_of",
 ]
 
 ESCAPE_TWIST = "escape twist"
@@ -290,17 +291,23 @@ def cone_support(
         a_full = G[:, s].T @ w
         if cones == "normals":
             out[i] = a_full[0]
-            continue
-        a = a_full[list(cone.components)]
-        exact_round = cones == "exact" and cone.components in ((0, 1, 2), (0, 1, 2, 3))
-        if not exact_round:
-            out[i] = float(np.max(cone.generators.T @ a))
-            continue
-        value = c.mu * np.linalg.norm(a[1:3])
-        if c.model is ContactModel.SOFT_FINGER and len(a) == 4:
-            value = max(value, b * c.torsional_friction * abs(a[3]))
-        out[i] = a[0] + value
+        else:
+            out[i] = support_of(a_full[list(cone.components)], cone, c, cones, b)
     return out
+
+
+def support_of(a: np.ndarray, cone, contact, cones: str, b: float) -> float:
+    """``max aᵀ f`` over one contact's cone with ``f_n = 1``.
+
+    ``a`` is over the cone's components (``cone.components``); see
+    :func:`cone_support` for the formulas.
+    """
+    if not (cones == "exact" and cone.components in ((0, 1, 2), (0, 1, 2, 3))):
+        return float(np.max(cone.generators.T @ a))
+    value = contact.mu * np.linalg.norm(a[1:3])
+    if contact.model is ContactModel.SOFT_FINGER and len(a) == 4:
+        value = max(value, b * contact.torsional_friction * abs(a[3]))
+    return float(a[0] + value)
 
 
 def _check_jacobian(grasp, hand_jacobian):

@@ -39,7 +39,7 @@ from drakegrasp.certificates import (
     UNCONTROLLABLE,
     UNRESISTED_WRENCH,
     Certificate,
-    cone_support,
+    support_of,
 )
 from drakegrasp.friction_cone import ConeLayout
 from drakegrasp.grasp import Grasp, grasp_matrix, normalised_grasp_matrix
@@ -157,14 +157,14 @@ def escape_twist(grasp: Grasp, rank: int) -> Certificate | None:
 
 
 def _finish(prog, x, grasp, *, conic, kind, G=None, cones="normals", ng=8):
+    """Solve a witness program; the certificate, or None if there is none."""
     result = _solve(prog, conic)
     if result is None or result.get_solution_result() != SolutionResult.kSolutionFound:
         return None
     sol = result.GetSolution(x)
     if not sol[-1] > _ACCEPT:
         return None
-    T = normalising_transform(grasp)
-    u = T.T @ sol[:-1]
+    u = normalising_transform(grasp).T @ sol[:-1]
     if kind == "twist":
         v = _scale_twist(grasp, u)
         return Certificate(
@@ -176,7 +176,18 @@ def _finish(prog, x, grasp, *, conic, kind, G=None, cones="normals", ng=8):
             **_where(grasp),
         )
     w = _scale_wrench(grasp, u)
-    support = cone_support(grasp, w, cones=cones, num_generators=ng)
+    # a_i(w) = A_iᵀ ū / c with the same scale c that took u to w
+    blocks, layout = G
+    c = np.linalg.norm(u) / np.linalg.norm(w)
+    b = grasp.characteristic_length
+    support = np.array(
+        [
+            support_of(Ai @ sol[:-1] / c, cone, contact, cones, b)
+            for Ai, cone, contact in zip(
+                blocks, layout.cones, grasp.contacts, strict=True
+            )
+        ]
+    )
     return Certificate(
         UNRESISTED_WRENCH,
         cones,
@@ -227,25 +238,34 @@ def unresisted_wrench(
     x = prog.NewContinuousVariables(k + 1, "u")
     starts = list(layout.normal_positions) + [len(layout.columns)]
     normal_sum = np.zeros(k + 1)
+    blocks, linear = [], []
     for i, (cone, c) in enumerate(zip(layout.cones, grasp.contacts, strict=True)):
         Ai = A[:, starts[i] : starts[i + 1]].T  # a_i = Ai u, contact components
+        blocks.append(Ai)
         normal_sum[:k] -= Ai[0]
         round_cone = cone.components in ((0, 1, 2), (0, 1, 2, 3))
         if cones == "exact" and round_cone:
             _add_exact_support(prog, x, Ai, c, grasp.characteristic_length)
-        else:
-            # generatorsᵀ a + s <= 0
-            rows = np.hstack(
-                [cone.generators.T @ Ai, np.ones((cone.generators.shape[1], 1))]
-            )
-            prog.AddLinearConstraint(
-                rows, np.full(len(rows), -np.inf), np.zeros(len(rows)), x
-            )
+        else:  # generatorsᵀ a + s <= 0
+            S = cone.generators
+            linear.append(np.hstack([S.T @ Ai, np.ones((S.shape[1], 1))]))
+    if linear:
+        rows = np.vstack(linear)
+        prog.AddLinearConstraint(
+            rows, np.full(len(rows), -np.inf), np.zeros(len(rows)), x
+        )
     prog.AddLinearEqualityConstraint(normal_sum[None, :], [1.0], x)
     prog.AddLinearCost(np.append(np.zeros(k), -1.0), x)
     conic = bool(prog.lorentz_cone_constraints())
     return _finish(
-        prog, x, grasp, conic=conic, kind="wrench", cones=cones, ng=num_generators
+        prog,
+        x,
+        grasp,
+        conic=conic,
+        kind="wrench",
+        G=(blocks, layout),
+        cones=cones,
+        ng=num_generators,
     )
 
 
