@@ -85,13 +85,20 @@ def _check_twist(cert: Certificate, grasp: Grasp):
 def _check_wrench(cert: Certificate, grasp: Grasp):
     G = grasp_matrix(grasp)
     scale = np.linalg.norm(G, 2)
+    ys = [np.asarray(cert.separating_twist, dtype=float)]
+    ws = [np.asarray(cert.direction, dtype=float)]
+    if cert.two_sided:
+        ys += list(np.asarray(cert.separating_basis, dtype=float).T)
+        ws += list(np.asarray(cert.null_basis, dtype=float).T)
     violation, slack = 0.0, np.inf
-    for w in _directions(cert):
-        size = np.linalg.norm(w)
-        if not size > 0.0:
-            return np.inf, 0.0, "the wrench is zero"
-        signs = (w, -w) if cert.two_sided else (w,)
-        for x in signs:
+    for y, w in zip(ys, ws, strict=True):
+        size = np.linalg.norm(y)
+        if not (size > 0.0 and np.linalg.norm(w) > 0.0):
+            return np.inf, 0.0, "the wrench or its hyperplane normal is zero"
+        # the unresisted wrench lies strictly on the other side of the plane
+        side = float(y @ w) / (size * np.linalg.norm(w))
+        violation = max(violation, max(0.0, -side))
+        for x in (y, -y) if cert.two_sided else (y,):
             sigma = cone_support(
                 grasp, x, cones=cert.cones, num_generators=cert.num_generators
             )
@@ -101,7 +108,7 @@ def _check_wrench(cert: Certificate, grasp: Grasp):
     return (
         violation,
         slack,
-        f"max over the {cert.cones} cones of wᵀ G f (f_n = 1) evaluated",
+        f"max over the {cert.cones} cones of yᵀ G f (f_n = 1), and yᵀ w > 0",
     )
 
 

@@ -69,9 +69,9 @@ def _line_point(p: np.ndarray, f: np.ndarray, m: np.ndarray) -> np.ndarray:
     return p + float(m[0]) * np.array([f[1], -f[0]]) / float(f @ f)
 
 
-def _more(cert: Certificate) -> str:
+def _more(cert: Certificate, what: str) -> str:
     k = cert.null_basis.shape[-1] if cert.two_sided else 1
-    return f" ({k - 1} more independent ones too)" if k > 1 else ""
+    return f" (and {k - 1} more independent {what})" if k > 1 else ""
 
 
 def _contacts_text(cert: Certificate) -> str:
@@ -91,11 +91,11 @@ def _twist_text(cert: Certificate) -> str:
     v = np.asarray(cert.direction, dtype=float)
     lin, ang = v[:d], v[d:]
     two = cert.two_sided
-    sides = " in either direction" if two else ""
     if b * np.linalg.norm(ang) <= _SMALL * np.linalg.norm(lin):
         motion = f"translate along {axis_name(lin, both_signs=two)}"
     elif d == 2:
         sense = "counter-clockwise" if ang[0] > 0 else "clockwise"
+        sense = "either way" if two else sense
         motion = f"rotate {sense} about {_vector(screw_point(p, lin, ang), b)} m"
     else:
         r = screw_point(p, lin, ang)
@@ -106,8 +106,8 @@ def _twist_text(cert: Certificate) -> str:
         if abs(pitch) > _SMALL * b:
             motion = motion.replace("rotate", "screw") + f" (pitch {pitch:.3g} m/rad)"
     return (
-        f"the object can {motion}{sides} without penetrating any finger"
-        f"{_more(cert)}: {_contacts_text(cert)}"
+        f"the object can {motion} without penetrating any finger"
+        f"{_more(cert, 'motions')}: {_contacts_text(cert)}"
     )
 
 
@@ -117,11 +117,10 @@ def _wrench_text(cert: Certificate) -> str:
     e = -np.asarray(cert.direction, dtype=float)  # the external wrench
     f, m = e[:d], e[d:]
     two = cert.two_sided
-    sides = " (either sign)" if two else ""
     if np.linalg.norm(f) * b <= _SMALL * np.linalg.norm(m):
         if d == 2:
             sense = "counter-clockwise" if m[0] > 0 else "clockwise"
-            what = f"a {sense} moment"
+            what = "a moment of either sign" if two else f"a {sense} moment"
         else:
             what = f"a moment about {axis_name(m, both_signs=two)}"
     else:
@@ -131,7 +130,7 @@ def _wrench_text(cert: Certificate) -> str:
             pitch = float(f @ m) / float(f @ f)
             if abs(pitch) > _SMALL * b:
                 what += f" with a moment about it (pitch {pitch:.3g} m)"
-    return f"cannot resist {what}{sides}{_more(cert)}"
+    return f"cannot resist {what}{_more(cert, 'wrenches')}"
 
 
 def describe_certificate(cert: Certificate) -> str:

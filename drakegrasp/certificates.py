@@ -23,10 +23,17 @@ The four kinds:
     ``G_n`` is rank deficient, ``v`` lies in ``N(G_nᵀ)`` and both ``±v``
     escape (``two_sided``).
 ``"unresisted wrench"`` (force closure "no")
-    ``w ≠ 0`` with ``wᵀ G f <= 0`` for every ``f`` in the contact cones
-    (polyhedral or exact): every wrench the fingers can apply lies in a closed
-    half-space, so the grasp cannot resist an external wrench along ``−w``.
-    Rank deficient: ``w`` spans ``N(Gᵀ)`` and both signs are unresisted.
+    ``y ≠ 0`` (``separating_twist``, the ``w`` of CONVENTIONS.md) with
+    ``yᵀ G f <= 0`` for every ``f`` in the contact cones (polyhedral or
+    exact): every wrench the fingers can apply lies in a closed half-space, a
+    hyperplane through the origin separates them from ``direction``
+    (``yᵀ direction > 0``), so the grasp cannot resist an external wrench
+    along ``−direction``.  ``y`` pairs with wrenches by power, so it is a
+    twist; ``direction`` is the wrench that ``y`` names in the wrench metric
+    about the contacts' centroid (``‖[f; m/L]‖``), which does not depend on
+    the reference point: a moment about the line between two fingers reads as
+    a moment, not as a force far away.  Rank deficient: ``y`` spans
+    ``N(Gᵀ)`` and both signs are unresisted.
 ``"uncontrollable internal force"`` (LP3 fails)
     ``f ∈ N(G) ∩ N(Jᵀ)`` with every normal component positive: a squeeze that
     no joint torque can change.
@@ -138,10 +145,15 @@ class Certificate:
         Rank-deficient case: a basis of ``N(G_nᵀ)`` (twists) or ``N(Gᵀ)``
         (wrenches), each column scaled like ``direction``; both signs of every
         column are witnesses.  ``k = 0`` when the rank is full.
+    separating_twist : (6,) or (3,) float or None
+        Unresisted wrench: ``y`` with ``yᵀ G f <= 0`` on the cones (the normal
+        of the separating hyperplane in wrench space), scaled like a twist.
+    separating_basis : (6, k) or (3, k) float
+        Rank-deficient case: ``y`` for each column of ``null_basis``.
     contact_rates : (N,) float or None
         Escape twist: ``(G_nᵀ v)_i``, the separation speed of each contact
-        (m/s).  Unresisted wrench: ``max wᵀ G_i f_i`` over the cone with
-        ``f_n = 1`` (N·m/s per N: ``<= 0`` everywhere).
+        (m/s).  Unresisted wrench: ``max yᵀ G_i f_i`` over the cone with
+        ``f_n = 1`` (W per N: ``<= 0`` everywhere).
     contact_forces : tuple of ndarray or None
         Internal forces (LP3's or the verdict's optimal forces), per contact in
         its contact frame, normal first, over the full components of its model.
@@ -160,6 +172,8 @@ class Certificate:
     cones: str
     direction: np.ndarray | None = None
     null_basis: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    separating_twist: np.ndarray | None = None
+    separating_basis: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     contact_rates: np.ndarray | None = None
     contact_forces: tuple[np.ndarray, ...] | None = None
     internal_basis: np.ndarray | None = None

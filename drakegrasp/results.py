@@ -240,10 +240,26 @@ class ClosureResult:
         return self.is_closure
 
     def to_dict(self) -> dict:
-        """JSON-ready dictionary (non-finite numbers become ``None``)."""
+        """JSON-ready dictionary (non-finite numbers become ``None``).
+
+        ``certificate`` is the witness's own dictionary; ``why`` is its one-line
+        reading for a "no" (None for a "yes").
+        """
         d = {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
         d["near_boundary"] = self.near_boundary
+        d["why"] = self.why()
         return d
+
+    def why(self) -> str | None:
+        """One line that says why the verdict is "no" (None for a "yes")."""
+        if self.is_closure:
+            return None
+        if self.certificate is None:
+            return (
+                "no witness exists at this tol (the verdict lies within tol of "
+                "the boundary)"
+            )
+        return self.certificate.describe()
 
     def __str__(self) -> str:
         return "\n".join(self.report_lines())
@@ -274,23 +290,17 @@ class ClosureResult:
             )
         return f"decided by d* = {_zero_text(d, tol)} <= tol {tol:g}, {rank}"
 
-    def report_lines(self) -> list[str]:
-        """The report: verdict and what decided it, why, solver, LP3."""
+    def report_lines(self, *, internal_forces: bool = True) -> list[str]:
+        """The report: verdict and what decided it, why, solver (and LP3)."""
         verdict = "YES" if self.is_closure else "no"
         lines = [f"{self.kind}: {verdict}, {self._decision_text()}"]
         if self.near_boundary and self.decided_by == "d*":
             lines[0] += "  [within tol of the boundary]"
-        cert = self.certificate
-        if not self.is_closure:
-            if cert is None:
-                lines.append(
-                    "  why: no witness exists at this tol (the verdict lies "
-                    "within tol of the boundary)"
-                )
-            else:
-                lines.append("  why: " + cert.describe())
+        why = self.why()
+        if why is not None:
+            lines.append("  why: " + why)
         lines.append(f"  solver {self.solver} ({self.status}), {self.formulation}")
-        if self.internal_forces is not None:
+        if internal_forces and self.internal_forces is not None:
             lines += ["  " + line for line in self.internal_forces.report_lines()]
         return lines
 

@@ -3,7 +3,11 @@ r"""Compute the certificates of the closure verdicts (``pydrake.solvers`` only).
 The witness of a "no" comes from the normalised balance matrix ``Ḡ = T G``
 (:func:`~drakegrasp.grasp.normalised_grasp_matrix`) on which every rank is
 decided, then is mapped to the grasp frame: ``Ḡᵀ u = Gᵀ (Tᵀ u)``, so a dual
-vector ``u`` of ``Ḡ`` is the physical twist or wrench direction ``Tᵀ u``.
+vector ``u`` of ``Ḡ`` is the physical twist ``Tᵀ u`` (an escape twist, or the
+normal of a separating hyperplane in wrench space), and the wrench that
+``u`` names in the normalised wrench space (moments about the contacts'
+centroid over their spread) is ``T⁻¹ u``: the unresisted wrench, free of the
+choice of reference point.
 
 * Rank deficient: ``u`` spans the left null space of ``Ḡ`` (from its SVD).
 * Full rank: a small program over ``u`` (6 or 3 unknowns and a slack ``s``),
@@ -107,10 +111,35 @@ def _left_null_space(A: np.ndarray, rank: int) -> np.ndarray:
     return U[:, rank:]
 
 
-def _physical_basis(grasp, A, rank, scale) -> np.ndarray:
+def _readable(N: np.ndarray) -> np.ndarray:
+    """The same span as the orthonormal ``N``, axis directions first.
+
+    In the normalised coordinates the unit vectors are translations (forces)
+    along the frame's axes and rotations (moments) about axes through the
+    contacts' centroid; those that lie in the span come first, so a report
+    reads "translate along y" rather than a mixture.
+    """
+    picked = []
+    rest = N
+    for j in range(N.shape[0]):
+        e = np.zeros(N.shape[0])
+        e[j] = 1.0
+        if rest.shape[1] and np.linalg.norm(rest.T @ e) > 1.0 - 1e-9:
+            picked.append(e)
+            U, sv, _ = np.linalg.svd(rest - np.outer(e, e @ rest), full_matrices=False)
+            rest = U[:, sv > 1e-9]
+    return np.column_stack(picked + [rest]) if picked else N
+
+
+def _physical_basis(grasp, A, rank, *, wrench: bool):
+    """Twists ``Tᵀ u`` (and wrenches ``T⁻¹ u``) for ``u`` spanning ``N(Aᵀ)``."""
     T = normalising_transform(grasp)
-    basis = T.T @ _left_null_space(A, rank)
-    return np.column_stack([scale(grasp, x) for x in basis.T])
+    U = _readable(_left_null_space(A, rank))
+    twists = np.column_stack([_scale_twist(grasp, x) for x in (T.T @ U).T])
+    if not wrench:
+        return twists, None
+    wrenches = np.linalg.solve(T, U)
+    return twists, np.column_stack([_scale_wrench(grasp, x) for x in wrenches.T])
 
 
 def _solve(prog, conic: bool):
@@ -139,7 +168,7 @@ def escape_twist(grasp: Grasp, rank: int) -> Certificate | None:
     A = normalised_grasp_matrix(grasp)[:, grasp.normal_indices()]
     G_n = grasp_matrix(grasp)[:, grasp.normal_indices()]
     if rank < grasp.wrench_dim:
-        basis = _physical_basis(grasp, A, rank, _scale_twist)
+        basis, _ = _physical_basis(grasp, A, rank, wrench=False)
         v = basis[:, 0]
         return Certificate(
             ESCAPE_TWIST, "normals", v, basis, contact_rates=G_n.T @ v, **_where(grasp)
@@ -164,7 +193,8 @@ def _finish(prog, x, grasp, *, conic, kind, G=None, cones="normals", ng=8):
     sol = result.GetSolution(x)
     if not sol[-1] > _ACCEPT:
         return None
-    u = normalising_transform(grasp).T @ sol[:-1]
+    T = normalising_transform(grasp)
+    u = T.T @ sol[:-1]
     if kind == "twist":
         v = _scale_twist(grasp, u)
         return Certificate(
@@ -175,10 +205,11 @@ def _finish(prog, x, grasp, *, conic, kind, G=None, cones="normals", ng=8):
             contact_rates=G.T @ v,
             **_where(grasp),
         )
-    w = _scale_wrench(grasp, u)
-    # a_i(w) = A_iᵀ ū / c with the same scale c that took u to w
+    y = _scale_twist(grasp, u)  # the hyperplane's normal: yᵀ G f <= 0
+    w = _scale_wrench(grasp, np.linalg.solve(T, sol[:-1]))
+    # a_i(y) = A_iᵀ ū / c with the same scale c that took u to y
     blocks, layout = G
-    c = np.linalg.norm(u) / np.linalg.norm(w)
+    c = np.linalg.norm(u) / np.linalg.norm(y)
     b = grasp.characteristic_length
     support = np.array(
         [
@@ -193,6 +224,8 @@ def _finish(prog, x, grasp, *, conic, kind, G=None, cones="normals", ng=8):
         cones,
         w,
         np.zeros((len(w), 0)),
+        separating_twist=y,
+        separating_basis=np.zeros((len(w), 0)),
         contact_rates=support,
         num_generators=ng,
         **_where(grasp),
@@ -222,13 +255,14 @@ def unresisted_wrench(
     layout = ConeLayout.of(grasp, num_generators)
     A = normalised_grasp_matrix(grasp)[:, layout.columns]
     if rank < grasp.wrench_dim:
-        basis = _physical_basis(grasp, A, rank, _scale_wrench)
-        w = basis[:, 0]
+        twists, wrenches = _physical_basis(grasp, A, rank, wrench=True)
         return Certificate(
             UNRESISTED_WRENCH,
             cones,
-            w,
-            basis,
+            wrenches[:, 0],
+            wrenches,
+            separating_twist=twists[:, 0],
+            separating_basis=twists,
             contact_rates=np.zeros(grasp.num_contacts),
             num_generators=num_generators,
             **_where(grasp),

@@ -86,6 +86,13 @@ def _exact_support(grasp, w):
     return np.array(out)
 
 
+def _pairs(cert):
+    """(hyperplane normal, unresisted wrench) pairs of a wrench certificate."""
+    ys = [cert.separating_twist, *cert.separating_basis.T]
+    ws = [cert.direction, *cert.null_basis.T]
+    return list(zip(ys, ws, strict=True))
+
+
 def _scale(grasp, w):
     return np.linalg.norm(dg.grasp_matrix(grasp), 2) * np.linalg.norm(w)
 
@@ -116,8 +123,9 @@ def test_every_no_carries_a_witness_that_an_independent_route_confirms(
                 continue
             cert = r.certificate
             assert cert is not None and cert.kind == UNRESISTED_WRENCH
-            for w in [cert.direction, *cert.null_basis.T]:
-                signs = (w, -w) if cert.two_sided else (w,)
+            for y, w in _pairs(cert):
+                assert y @ w > 0  # the unresisted wrench is beyond the plane
+                signs = (y, -y) if cert.two_sided else (y,)
                 for x in signs:
                     worst = max(worst, _lp_max_power(g, x) / _scale(g, x))
             assert cert.check(g).holds
@@ -126,8 +134,9 @@ def test_every_no_carries_a_witness_that_an_independent_route_confirms(
         if not r.is_closure:
             cert = r.certificate
             assert cert is not None and cert.cones == "exact"
-            for w in [cert.direction, *cert.null_basis.T]:
-                signs = (w, -w) if cert.two_sided else (w,)
+            for y, w in _pairs(cert):
+                assert y @ w > 0
+                signs = (y, -y) if cert.two_sided else (y,)
                 for x in signs:
                     worst = max(worst, _exact_support(g, x).max() / _scale(g, x))
             assert cert.check(g).holds
@@ -170,6 +179,8 @@ def test_a_wrong_witness_fails_the_check():
 
     flipped = dataclasses.replace(cert, direction=-cert.direction)
     assert cert.check(g).holds and not flipped.check(g).holds
+    tilted = dataclasses.replace(cert, separating_twist=-cert.separating_twist)
+    assert not tilted.check(g).holds
     fc = dg.form_closure(g).certificate
     # a twist that pushes the object into the left finger
     bad = dataclasses.replace(
@@ -225,6 +236,7 @@ def test_a_box_between_two_frictionless_fingers_slides_in_their_face_plane():
     for t in ([0, 1, 0, 0, 0, 0], [0, 0, 1, 0, 0, 0]):  # slide along y and z
         coef = np.linalg.lstsq(B, np.array(t, float), rcond=None)[0]
         assert np.allclose(B @ coef, t, atol=1e-9)
+    assert "translate along ±y" in cert.describe()  # axis directions come first
     # pushing along x is not an escape: it penetrates a finger
     coef = np.linalg.lstsq(B, np.eye(6)[0], rcond=None)[0]
     assert not np.allclose(B @ coef, np.eye(6)[0], atol=1e-3)
@@ -265,6 +277,16 @@ def test_lp3_failure_carries_the_uncontrollable_squeeze():
         cert.check(g)
     with pytest.raises(TypeError, match="decided_by"):
         _ = cert == "normal forces"
+
+
+def test_two_hard_fingers_cannot_resist_a_moment_about_their_line():
+    g = dg.Grasp(ex.spatial_two_fingers(0.5).contacts, reference_point=[0.3, -0.2, 0.1])
+    r = dg.force_closure(g)
+    assert r.decided_by == "rank" and r.certificate.two_sided
+    w = r.certificate.direction
+    assert np.allclose(w[:3], 0, atol=1e-12)  # a pure moment, wherever p is
+    assert abs(abs(w[3]) - np.linalg.norm(w[3:])) < 1e-12  # about x
+    assert "cannot resist a moment about ±x" in r.certificate.describe()
 
 
 def test_certificates_are_invariant_to_units_and_reference_point(rng, make_contacts):
