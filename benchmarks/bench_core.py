@@ -23,6 +23,7 @@ from pydrake.solvers import ClpSolver  # noqa: E402
 
 import drakegrasp as dg  # noqa: E402
 from drakegrasp import closure  # noqa: E402
+from drakegrasp.batch.certificates import batch_certificates  # noqa: E402
 from drakegrasp.witness import escape_twist, unresisted_wrench  # noqa: E402
 
 
@@ -82,11 +83,20 @@ def main() -> None:
         "cert_form": lambda g: escape_twist(g, 6),
     }
     rows += [
+        ("batch_certificates, per failing grasp", "batch"),
         ("force_closure without its certificate", "bare_poly"),
         ("force_closure_exact without its certificate", "bare_exact"),
     ]
+    P = np.array([g.positions for g in grasps])
+    n = np.array([g.normals for g in grasps])
     for name, fn in rows:
-        if fn in ("bare_poly", "bare_exact"):
+        if fn == "batch":
+            batch = dg.batch_force_closure(P, n, 0.5)
+            t0 = time.perf_counter()
+            batch_certificates(P, n, batch, mu=0.5)
+            per = (time.perf_counter() - t0) / max(1, int((~batch.is_closure).sum()))
+            t = np.array([per])
+        elif fn in ("bare_poly", "bare_exact"):
             real = closure.unresisted_wrench
             closure.unresisted_wrench = lambda *a, **k: None
             try:
