@@ -582,7 +582,10 @@ def _refuse_penetration(plant, context, body, bodies, query, tol) -> None:
 def _user_direction(direction, n: int, coupled) -> np.ndarray | None:
     if direction is None:
         return None
-    d = np.asarray(direction, dtype=float)
+    try:
+        d = np.asarray(direction, dtype=float)
+    except (TypeError, ValueError):
+        d = np.full(0, np.nan)
     if d.shape != (n,) or not np.all(np.isfinite(d)):
         raise InvalidOptionError(
             f"direction must be {n} finite numbers (one per closing joint, in "
@@ -621,7 +624,8 @@ class _Search:
             f.d = self._direction(f, query, user_d)
             alpha_end = _path_end(f.q_good, f.d, self.lower, self.upper)
             if alpha_end <= 1e-12:
-                f.status = "at limit" if np.any(f.d) or user_d is None else "fixed"
+                unmoved = user_d is not None and not np.any(user_d[f.joints])
+                f.status = "fixed" if unmoved else "at limit"
                 return
             slope = float(self._dpsi(n_W, body, p_BC) @ self.coupled.tangent(f.d))
             newton = (psi - self.target) / -slope if slope < 0 else np.inf
