@@ -45,6 +45,9 @@ from drakegrasp.plant.jacobians import (
     hand_velocity_indices,
     signed_distance_jacobian,
 )
+from drakegrasp.plant.pose import PoseCheck
+from drakegrasp.plant.pose import check_pose as _check_pose
+from drakegrasp.plant.validation import hand_model_instances, plant_context_of
 from drakegrasp.results import AntipodalResult, ClosureResult, _jsonable
 
 __all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
@@ -79,6 +82,10 @@ class GraspFromPlant:
         Scoped names of the hand's bodies.
     plane : str or None
         Object-frame plane of a planar analysis (``"yz"``...), or None.
+    pose : PoseCheck or None
+        Penetrations and joint-limit violations of the hand's model instances
+        (``pose.valid`` is False only when the caller opted out of the refusal
+        with ``check_pose=False`` or ``allow_penetration=True``).
     """
 
     grasp: Grasp
@@ -90,6 +97,7 @@ class GraspFromPlant:
     object_body: str
     hand_bodies: tuple[str, ...]
     plane: str | None
+    pose: PoseCheck | None = None
 
     @property
     def G(self) -> np.ndarray:
@@ -108,6 +116,7 @@ class GraspFromPlant:
             "hand_velocity_indices": self.hand_velocity_indices.tolist(),
             "hand_jacobian": _jsonable(self.hand_jacobian),
             "dpsi_dv": _jsonable(self.dpsi_dv),
+            "pose": None if self.pose is None else self.pose.to_dict(),
         }
 
 
@@ -152,8 +161,8 @@ def _core_contact(
 def grasp_from_plant(
     plant: MultibodyPlant,
     plant_context: Context,
-    *,
     object_body,
+    *,
     hand: HandSpec = None,
     mu: float,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
@@ -163,6 +172,7 @@ def grasp_from_plant(
     characteristic_length: float | None = None,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    check_pose: bool = True,
 ) -> GraspFromPlant:
     """The grasp that the plant's configuration makes, with ``J``, ``ψ``, ``∂ψ/∂v``.
 
@@ -171,11 +181,11 @@ def grasp_from_plant(
     plant : MultibodyPlant
         Finalized, registered with a ``SceneGraph``.
     plant_context : Context
-        The plant's context (validated).
+        The plant's context, or the root context of the diagram holding it.
     object_body : RigidBody, BodyIndex or str
         The grasped object; its body frame O is the grasp frame and its origin
-        the reference point.
-    hand : ModelInstanceIndex, iterable of RigidBody, or None, optional
+        the reference point.  Positional or keyword.
+    hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
         See :func:`drakegrasp.plant.hand_bodies`.
     mu : float
         Friction coefficient of every contact.
@@ -191,7 +201,14 @@ def grasp_from_plant(
     characteristic_length : float, optional
         ``b`` of the grasp (default: farthest contact from O's origin).
     allow_penetration, patches
-        Passed to :func:`drakegrasp.find_contacts`.
+        Passed to :func:`drakegrasp.find_contacts`.  ``allow_penetration=True``
+        also stops the pose check from refusing penetration (it is still
+        recorded in ``pose``).
+    check_pose : bool, optional
+        True (default): refuse an impossible pose, i.e. any body of the hand's
+        model instances (the welded palm too) penetrating the object, or a
+        joint of the hand outside its limits.  False: analyse it anyway; the
+        result's ``pose.valid`` is then False and the report says so.
 
     Returns
     -------
@@ -199,9 +216,12 @@ def grasp_from_plant(
 
     Raises
     ------
-    NoContactsError, PenetrationError, ModelError, InvalidOptionError
+    PenetrationError, JointLimitError
+        Both :class:`~drakegrasp.InvalidPoseError`: the pose is impossible
+        (names the bodies and the depth, or the joint, its value and limits).
+    NoContactsError, ModelError, InvalidOptionError, InvalidContextError
     """
-    plant.ValidateContext(plant_context)
+    plant_context = plant_context_of(plant, plant_context)
     plane = _check_plane(plane)
     model = ContactModel.parse(contact_model)
     if plane is not None and model is ContactModel.SOFT_FINGER:
@@ -218,13 +238,22 @@ def grasp_from_plant(
         torsional_friction = 0.0
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
+    pose = _pose_of(
+        plant,
+        plant_context,
+        body,
+        bodies,
+        distance_tolerance=distance_tolerance,
+        refuse=check_pose,
+        allow_penetration=allow_penetration,
+    )
     contacts = find_contacts(
         plant,
         plant_context,
         object_body=body,
         hand=bodies,
         distance_tolerance=distance_tolerance,
-        allow_penetration=allow_penetration,
+        allow_penetration=allow_penetration or not check_pose,
         patches=patches,
     )
     core = [
@@ -260,7 +289,33 @@ def grasp_from_plant(
         object_body=_scoped_name(plant, body),
         hand_bodies=tuple(_scoped_name(plant, b) for b in bodies),
         plane=plane,
+        pose=pose,
     )
+
+
+def _pose_of(
+    plant, plant_context, body, bodies, *, distance_tolerance, refuse, allow_penetration
+) -> PoseCheck:
+    """Check the pose; raise unless the caller opted out."""
+    tol = float(distance_tolerance)
+    if not np.isfinite(tol) or tol <= 0:
+        raise InvalidOptionError(
+            "distance_tolerance must be finite and > 0 (metres), got "
+            f"{distance_tolerance!r}"
+        )
+    found = _check_pose(
+        plant,
+        plant_context,
+        body,
+        hand_model_instances(plant, bodies, body),
+        distance_tolerance=tol,
+    )
+    if refuse:
+        if allow_penetration:
+            PoseCheck((), found.joint_limit_violations).raise_if_invalid()
+        else:
+            found.raise_if_invalid()
+    return PoseCheck(found.penetrations, found.joint_limit_violations, refuse)
 
 
 @dataclass(frozen=True, eq=False)
@@ -282,6 +337,9 @@ class GraspReport:
         Force closure on exact (second-order / planar) cones, with LP3.
     antipodal : AntipodalResult or None
         The antipodal test when there are exactly two contacts.
+    pose : PoseCheck or None
+        Whether the pose is possible (``pose.valid``); an invalid pose is only
+        analysed with ``check_pose=False`` (or ``allow_penetration=True``).
     """
 
     data: GraspFromPlant
@@ -290,6 +348,7 @@ class GraspReport:
     force_closure: ClosureResult
     force_closure_exact: ClosureResult
     antipodal: AntipodalResult | None
+    pose: PoseCheck | None = None
 
     @property
     def grasp(self) -> Grasp:
@@ -320,6 +379,7 @@ class GraspReport:
             "force_closure": self.force_closure.to_dict(),
             "force_closure_exact": self.force_closure_exact.to_dict(),
             "antipodal": None if self.antipodal is None else self.antipodal.to_dict(),
+            "pose": None if self.pose is None else self.pose.to_dict(),
         }
 
     def __str__(self) -> str:
@@ -334,6 +394,7 @@ class GraspReport:
             f"{c0.model.value}, {friction}",
             "  frame O = the object body frame; moments about its origin; "
             f"b = {g.characteristic_length * 1e3:.4g} mm",
+            *([] if self.pose is None else ["  " + self.pose.summary()]),
             f"  {'#':>2}  {'finger':<28} {'p_OC [mm]':<27} {'nhat_O':<25} psi [mm]",
         ]
         for i, pc in enumerate(self.contacts):
@@ -361,8 +422,8 @@ class GraspReport:
 def analyze_grasp(
     plant: MultibodyPlant,
     plant_context: Context,
-    *,
     object_body,
+    *,
     hand: HandSpec = None,
     mu: float,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
@@ -374,6 +435,7 @@ def analyze_grasp(
     tol: float = DEFAULT_TOL,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    check_pose: bool = True,
 ) -> GraspReport:
     """Read the grasp from the plant and decide every closure property.
 
@@ -381,8 +443,9 @@ def analyze_grasp(
     ----------
     plant, plant_context, object_body, hand, mu, contact_model,
     torsional_friction, distance_tolerance, plane, characteristic_length,
-    allow_penetration, patches
-        As in :func:`grasp_from_plant`.
+    allow_penetration, patches, check_pose
+        As in :func:`grasp_from_plant` (``plant_context`` may be the diagram's
+        root context; ``object_body`` may be positional).
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
     tol : float, optional
@@ -405,6 +468,7 @@ def analyze_grasp(
         characteristic_length=characteristic_length,
         allow_penetration=allow_penetration,
         patches=patches,
+        check_pose=check_pose,
     )
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
@@ -421,4 +485,5 @@ def analyze_grasp(
             force_closure_exact(grasp, tol=tol), lp3
         ),
         antipodal=antipodal,
+        pose=data.pose,
     )
