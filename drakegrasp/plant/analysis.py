@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
@@ -163,6 +164,7 @@ def grasp_from_plant(
     characteristic_length: float | None = None,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    query_object: QueryObject | None = None,
 ) -> GraspFromPlant:
     """The grasp that the plant's configuration makes, with ``J``, ``ψ``, ``∂ψ/∂v``.
 
@@ -190,8 +192,10 @@ def grasp_from_plant(
         ``[f_a, f_b, m]``); every contact normal must lie in the plane.
     characteristic_length : float, optional
         ``b`` of the grasp (default: farthest contact from O's origin).
-    allow_penetration, patches
-        Passed to :func:`drakegrasp.find_contacts`.
+    allow_penetration, patches, query_object
+        Passed to :func:`drakegrasp.find_contacts` (``query_object``: read the
+        geometry from this scene-graph query object instead of the plant's
+        query input port in ``plant_context``).
 
     Returns
     -------
@@ -226,6 +230,7 @@ def grasp_from_plant(
         distance_tolerance=distance_tolerance,
         allow_penetration=allow_penetration,
         patches=patches,
+        query_object=query_object,
     )
     core = [
         _core_contact(
@@ -374,6 +379,7 @@ def analyze_grasp(
     tol: float = DEFAULT_TOL,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    query_object: QueryObject | None = None,
 ) -> GraspReport:
     """Read the grasp from the plant and decide every closure property.
 
@@ -381,7 +387,7 @@ def analyze_grasp(
     ----------
     plant, plant_context, object_body, hand, mu, contact_model,
     torsional_friction, distance_tolerance, plane, characteristic_length,
-    allow_penetration, patches
+    allow_penetration, patches, query_object
         As in :func:`grasp_from_plant`.
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
@@ -405,6 +411,7 @@ def analyze_grasp(
         characteristic_length=characteristic_length,
         allow_penetration=allow_penetration,
         patches=patches,
+        query_object=query_object,
     )
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
