@@ -11,6 +11,7 @@ from drakegrasp.plant.analysis import (
     analyze_grasp,
     grasp_from_plant,
 )
+from drakegrasp.plant.contact_results import contacts_from_results
 from drakegrasp.plant.contacts import (
     DEFAULT_DISTANCE_TOLERANCE,
     PlantContact,
@@ -40,6 +41,7 @@ __all__ = [
     "Scene",
     "SceneInfo",
     "analyze_grasp",
+    "contacts_from_results",
     "find_contacts",
     "grasp_from_plant",
     "hand_bodies",

@@ -28,7 +28,7 @@ from drakegrasp.closure import (
     with_internal_forces,
 )
 from drakegrasp.contact import Contact, ContactModel
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidOptionError, NoContactsError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.grasp import Grasp, grasp_matrix
 from drakegrasp.plant.contacts import (
@@ -165,6 +165,7 @@ def grasp_from_plant(
     allow_penetration: bool = False,
     patches: str = "vertices",
     query_object: QueryObject | None = None,
+    contacts: list[PlantContact] | None = None,
 ) -> GraspFromPlant:
     """The grasp that the plant's configuration makes, with ``J``, ``ψ``, ``∂ψ/∂v``.
 
@@ -196,6 +197,10 @@ def grasp_from_plant(
         Passed to :func:`drakegrasp.find_contacts` (``query_object``: read the
         geometry from this scene-graph query object instead of the plant's
         query input port in ``plant_context``).
+    contacts : list of PlantContact, optional
+        Analyse these contacts (frame O of ``object_body``) instead of finding
+        them from signed distances: e.g. the patches of hydroelastic contact
+        surfaces read by :func:`drakegrasp.plant.contacts_from_results`.
 
     Returns
     -------
@@ -222,16 +227,19 @@ def grasp_from_plant(
         torsional_friction = 0.0
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
-    contacts = find_contacts(
-        plant,
-        plant_context,
-        object_body=body,
-        hand=bodies,
-        distance_tolerance=distance_tolerance,
-        allow_penetration=allow_penetration,
-        patches=patches,
-        query_object=query_object,
-    )
+    if contacts is None:
+        contacts = find_contacts(
+            plant,
+            plant_context,
+            object_body=body,
+            hand=bodies,
+            distance_tolerance=distance_tolerance,
+            allow_penetration=allow_penetration,
+            patches=patches,
+            query_object=query_object,
+        )
+    elif not contacts:
+        raise NoContactsError(f"no contacts given for {_scoped_name(plant, body)!r}")
     core = [
         _core_contact(
             c, plane=plane, mu=mu, model=model, torsional_friction=torsional_friction
@@ -380,6 +388,7 @@ def analyze_grasp(
     allow_penetration: bool = False,
     patches: str = "vertices",
     query_object: QueryObject | None = None,
+    contacts: list[PlantContact] | None = None,
 ) -> GraspReport:
     """Read the grasp from the plant and decide every closure property.
 
@@ -387,7 +396,7 @@ def analyze_grasp(
     ----------
     plant, plant_context, object_body, hand, mu, contact_model,
     torsional_friction, distance_tolerance, plane, characteristic_length,
-    allow_penetration, patches, query_object
+    allow_penetration, patches, query_object, contacts
         As in :func:`grasp_from_plant`.
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
@@ -412,6 +421,7 @@ def analyze_grasp(
         allow_penetration=allow_penetration,
         patches=patches,
         query_object=query_object,
+        contacts=contacts,
     )
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
