@@ -42,6 +42,7 @@ from drakegrasp.errors import (
     ModelError,
     NoContactsError,
     PenetrationError,
+    SceneError,
     SolverError,
 )
 from drakegrasp.friction_cone import (
@@ -118,6 +119,7 @@ __all__ = [
     "PlantContact",
     "ProgramVariables",
     "Scene",
+    "SceneError",
     "SolverError",
     "add_grasp_monitor",
     "analyze_grasp",
