@@ -8,7 +8,8 @@ Conventions: ``shared/CONVENTIONS.md``.
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
 programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
-(``plant``), and the outside ring (``visualization``, ``batch``, ``cli``).
+(``plant``), and the outside ring (``visualization``, ``batch``, ``systems``,
+``cli``).
 """
 
 from drakegrasp import examples
@@ -44,6 +45,7 @@ from drakegrasp.errors import (
     ModelError,
     NoContactsError,
     PenetrationError,
+    SceneError,
     SolverError,
     UnreachableError,
 )
@@ -94,6 +96,7 @@ from drakegrasp.quality import (
     wrench_ellipsoid_volume,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
 from drakegrasp.visualization import (
     clear_grasp,
     draw_grasp,
@@ -114,9 +117,11 @@ __all__ = [
     "FingerClosure",
     "GraspError",
     "GraspFromPlant",
+    "GraspMonitor",
     "GraspQuality",
     "GraspReport",
     "HandClosure",
+    "GraspSample",
     "InternalForceResult",
     "InvalidContactError",
     "InvalidContextError",
@@ -131,8 +136,10 @@ __all__ = [
     "PlantContact",
     "ProgramVariables",
     "Scene",
+    "SceneError",
     "SolverError",
     "UnreachableError",
+    "add_grasp_monitor",
     "analyze_grasp",
     "batch_force_closure",
     "batch_form_closure",
