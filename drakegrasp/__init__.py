@@ -33,6 +33,7 @@ from drakegrasp.closure import (
     matrix_rank,
 )
 from drakegrasp.contact import Contact, ContactModel, contact_frame, contact_frames
+from drakegrasp.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import (
     GraspError,
     InvalidContactError,
@@ -82,6 +83,7 @@ from drakegrasp.quality import (
     wrench_ellipsoid_volume,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
 from drakegrasp.visualization import (
     clear_grasp,
     draw_grasp,
@@ -97,6 +99,7 @@ __all__ = [
     "BatchClosureResult",
     "ClosureResult",
     "Contact",
+    "ContactCurvature",
     "ContactModel",
     "Grasp",
     "GraspError",
@@ -114,7 +117,9 @@ __all__ = [
     "PlantContact",
     "ProgramVariables",
     "Scene",
+    "SecondOrderResult",
     "SolverError",
+    "SurfaceCurvature",
     "analyze_grasp",
     "batch_force_closure",
     "batch_form_closure",
@@ -158,6 +163,7 @@ __all__ = [
     "plot_wrench_space",
     "primitive_wrenches",
     "register_models",
+    "second_order_form_closure",
     "use_local_drake_models",
     "signed_distance_jacobian",
     "uniformity_of_transformation",
