@@ -136,9 +136,7 @@ class SurfaceCurvature:
         return cls((curvature, math.inf), direction)
 
     @classmethod
-    def from_shape_form(
-        cls, form: np.ndarray, normal: np.ndarray
-    ) -> SurfaceCurvature:
+    def from_shape_form(cls, form: np.ndarray, normal: np.ndarray) -> SurfaceCurvature:
         """Principal curvatures of the form ``II(x, x) = xᵀ form x`` on the tangents.
 
         Parameters
