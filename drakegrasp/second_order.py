@@ -284,6 +284,29 @@ class SecondOrderResult:
     status: str
     reason: str
 
+    @classmethod
+    def undecided(
+        cls, num_contacts: int, reason: str, *, tol: float = DEFAULT_SECOND_ORDER_TOL
+    ) -> SecondOrderResult:
+        """A result that decides nothing, for contacts without a curvature model."""
+        return cls(
+            is_closure=False,
+            order=None,
+            t_star=math.nan,
+            multipliers=np.zeros(num_contacts),
+            dim_w=-1,
+            support=(),
+            escape_twist=None,
+            escape_acceleration=None,
+            escape_margin=math.nan,
+            escape_verified=False,
+            margin=math.nan,
+            tol=tol,
+            solver="",
+            status="not solved",
+            reason=f"not decided: {reason}",
+        )
+
     @property
     def near_boundary(self) -> bool:
         """True when ``t*`` is within ``tol`` of 0: higher orders decide."""

@@ -17,6 +17,7 @@ from drakegrasp.plant.contacts import (
     find_contacts,
     hand_bodies,
 )
+from drakegrasp.plant.curvature import contact_curvatures
 from drakegrasp.plant.jacobians import (
     hand_jacobian,
     hand_velocity_indices,
@@ -40,6 +41,7 @@ __all__ = [
     "Scene",
     "SceneInfo",
     "analyze_grasp",
+    "contact_curvatures",
     "find_contacts",
     "grasp_from_plant",
     "hand_bodies",

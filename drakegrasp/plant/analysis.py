@@ -27,7 +27,7 @@ from drakegrasp.closure import (
     with_internal_forces,
 )
 from drakegrasp.contact import Contact, ContactModel
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import GraspError, InvalidOptionError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.grasp import Grasp, grasp_matrix
 from drakegrasp.plant.contacts import (
@@ -46,6 +46,7 @@ from drakegrasp.plant.jacobians import (
     signed_distance_jacobian,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, _jsonable
+from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
 
 __all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
 
@@ -282,6 +283,9 @@ class GraspReport:
         Force closure on exact (second-order / planar) cones, with LP3.
     antipodal : AntipodalResult or None
         The antipodal test when there are exactly two contacts.
+    second_order : SecondOrderResult or None
+        Second-order form closure (curvatures read off the shapes) when
+        first-order form closure fails; None when it holds.
     """
 
     data: GraspFromPlant
@@ -290,6 +294,7 @@ class GraspReport:
     force_closure: ClosureResult
     force_closure_exact: ClosureResult
     antipodal: AntipodalResult | None
+    second_order: SecondOrderResult | None = None
 
     @property
     def grasp(self) -> Grasp:
@@ -320,6 +325,7 @@ class GraspReport:
             "force_closure": self.force_closure.to_dict(),
             "force_closure_exact": self.force_closure_exact.to_dict(),
             "antipodal": None if self.antipodal is None else self.antipodal.to_dict(),
+            "second_order": _jsonable(self.second_order),
         }
 
     def __str__(self) -> str:
@@ -355,6 +361,8 @@ class GraspReport:
             lines += ["  " + line for line in str(result).splitlines()]
         if self.antipodal is not None:
             lines.append("  " + str(self.antipodal))
+        if self.second_order is not None:
+            lines += ["  " + line for line in str(self.second_order).splitlines()]
         return "\n".join(lines)
 
 
@@ -409,10 +417,11 @@ def analyze_grasp(
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
     lp3 = internal_forces(grasp, J, tol=tol)
+    first_order = form_closure(grasp, tol=tol)
     return GraspReport(
         data=data,
         G=grasp_matrix(grasp),
-        form_closure=form_closure(grasp, tol=tol),
+        form_closure=first_order,
         # One LP3 serves both verdicts: it depends on G and J, not on the cones.
         force_closure=with_internal_forces(
             force_closure(grasp, num_generators=num_generators, tol=tol), lp3
@@ -421,4 +430,26 @@ def analyze_grasp(
             force_closure_exact(grasp, tol=tol), lp3
         ),
         antipodal=antipodal,
+        second_order=None
+        if first_order.is_closure
+        else _second_order(plant, plant_context, data, first_order),
     )
+
+
+def _second_order(plant, plant_context, data, first_order) -> SecondOrderResult:
+    """Second-order form closure with the shapes' curvatures (or why not)."""
+    from drakegrasp.plant.curvature import contact_curvatures
+
+    try:
+        curvatures = contact_curvatures(
+            plant,
+            plant_context,
+            data.contacts,
+            object_body=data.object_body,
+            plane=data.plane,
+        )
+        return second_order_form_closure(
+            data.grasp, curvatures, first_order=first_order
+        )
+    except GraspError as e:  # a contact without a second-order model
+        return SecondOrderResult.undecided(data.grasp.num_contacts, str(e))
