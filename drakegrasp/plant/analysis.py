@@ -39,6 +39,7 @@ from drakegrasp.plant.contacts import (
     hand_bodies,
     resolve_object_body,
 )
+from drakegrasp.plant.curvature import contact_curvatures
 from drakegrasp.plant.jacobians import (
     PLANES,
     hand_jacobian,
@@ -438,8 +439,6 @@ def analyze_grasp(
 
 def _second_order(plant, plant_context, data, first_order) -> SecondOrderResult:
     """Second-order form closure with the shapes' curvatures (or why not)."""
-    from drakegrasp.plant.curvature import contact_curvatures
-
     try:
         curvatures = contact_curvatures(
             plant,
