@@ -39,7 +39,7 @@ from drakegrasp.plant.contacts import (
     hand_bodies,
     resolve_object_body,
 )
-from drakegrasp.plant.curvature import contact_curvatures
+from drakegrasp.plant.curvature import SECOND_ORDER_RANK_TOL, contact_curvatures
 from drakegrasp.plant.jacobians import (
     PLANES,
     hand_jacobian,
@@ -448,7 +448,10 @@ def _second_order(plant, plant_context, data, first_order) -> SecondOrderResult:
             plane=data.plane,
         )
         return second_order_form_closure(
-            data.grasp, curvatures, first_order=first_order
+            data.grasp,
+            curvatures,
+            first_order=first_order,
+            rank_tol=SECOND_ORDER_RANK_TOL,
         )
     except GraspError as e:  # a contact without a second-order model
         return SecondOrderResult.undecided(data.grasp.num_contacts, str(e))

@@ -47,7 +47,17 @@ from drakegrasp.plant._shapes import flat_faces, surface_pieces
 from drakegrasp.plant.contacts import PlantContact, resolve_object_body
 from drakegrasp.plant.jacobians import PLANES
 
-__all__ = ["contact_curvatures", "shape_curvature"]
+__all__ = ["SECOND_ORDER_RANK_TOL", "contact_curvatures", "shape_curvature"]
+
+SECOND_ORDER_RANK_TOL = 1e-4
+"""Relative singular-value threshold of the second-order test on plant grasps.
+
+Equilibrium (``G_n λ = 0`` with ``W ≠ {0}``) is a measure-zero condition, and
+contacts read with GJK (ellipsoids, meshes) carry errors of ~1e-6 m in their
+points and normals: six fingers at an ellipsoid's axis ends give singular
+values of ``G_n`` of ~1e-6 relative where they are exactly 0.  The test treats
+singular values below this fraction of the largest as zero.
+"""
 
 VERTEX_TOL = 1e-8
 """A patch vertex this close (m) to a face polygon's corner is that corner."""
