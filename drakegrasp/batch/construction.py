@@ -59,7 +59,7 @@ def contact_kinds(
     Returns
     -------
     kinds : (K, N) int8
-        Codes ``FRICTIONLESS`` … ``SOFT_FULL``; see :data:`KIND_COMPONENTS`.
+        Codes ``FRICTIONLESS`` … ``SOFT_FULL``; see ``KIND_COMPONENTS``.
     """
     shape = np.shape(mu)
     if model == "frictionless":

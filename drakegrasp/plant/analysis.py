@@ -379,9 +379,11 @@ def analyze_grasp(
 
     Parameters
     ----------
-    plant, plant_context, object_body, hand, mu, contact_model,
-    torsional_friction, distance_tolerance, plane, characteristic_length,
-    allow_penetration, patches
+    plant, plant_context, object_body, hand, mu
+        As in :func:`grasp_from_plant`.
+    contact_model, torsional_friction, distance_tolerance, plane
+        As in :func:`grasp_from_plant`.
+    characteristic_length, allow_penetration, patches
         As in :func:`grasp_from_plant`.
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
