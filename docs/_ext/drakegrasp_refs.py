@@ -41,7 +41,8 @@ def _import(dotted: str) -> object | None:
 def _canonical(obj: object) -> str | None:
     if inspect.ismodule(obj):
         return obj.__name__
-    module, qualname = getattr(obj, "__module__", None), getattr(obj, "__qualname__", None)
+    module = getattr(obj, "__module__", None)
+    qualname = getattr(obj, "__qualname__", None)
     if module and qualname and module.startswith("drakegrasp"):
         return f"{module}.{qualname}"
     return None
@@ -73,11 +74,17 @@ def _resolve(
         if entry is None:
             continue
         return make_refnode(
-            app.builder, node["refdoc"], entry.docname, entry.node_id, contnode, canonical
+            app.builder,
+            node["refdoc"],
+            entry.docname,
+            entry.node_id,
+            contnode,
+            canonical,
         )
     return None
 
 
 def setup(app: Sphinx) -> dict:
+    """Register the resolver (a Sphinx extension's entry point)."""
     app.connect("missing-reference", _resolve)
     return {"parallel_read_safe": True, "parallel_write_safe": True}

@@ -120,5 +120,6 @@ def _resolve(
 
 
 def setup(app: Sphinx) -> dict:
+    """Register the resolver (a Sphinx extension's entry point)."""
     app.connect("missing-reference", _resolve)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
