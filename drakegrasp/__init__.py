@@ -47,7 +47,12 @@ from drakegrasp.friction_cone import (
     friction_cone_facets,
     friction_cone_generators,
 )
-from drakegrasp.grasp import Grasp, grasp_matrix, normal_grasp_matrix
+from drakegrasp.grasp import (
+    Grasp,
+    grasp_matrix,
+    normal_grasp_matrix,
+    normalised_grasp_matrix,
+)
 from drakegrasp.plant import (
     GraspFromPlant,
     GraspReport,
@@ -154,6 +159,7 @@ __all__ = [
     "max_resistible_wrench",
     "min_singular_value",
     "normal_grasp_matrix",
+    "normalised_grasp_matrix",
     "plot_planar_grasp",
     "plot_wrench_space",
     "primitive_wrenches",
