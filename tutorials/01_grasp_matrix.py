@@ -23,9 +23,9 @@
 # matrix appears a second time: as the object part of $\partial\psi/\partial v$, the
 # derivative of the signed distances.
 #
-# Conventions (`shared/CONVENTIONS.md`): normals point **into** the object, wrenches
-# are $w = [f;\, m]$ with moments about a reference point $p$, contact forces are
-# ordered normal component first.
+# Conventions (the documentation's *Conventions* page, `docs/conventions.md`):
+# normals point **into** the object, wrenches are $w = [f;\, m]$ with moments about a
+# reference point $p$, contact forces are ordered normal component first.
 
 # %%
 import os

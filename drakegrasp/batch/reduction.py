@@ -1,6 +1,6 @@
 r"""Null-space reduction of the closure LPs to tiny max–min problems.
 
-LP1/LP2 (``shared/CONVENTIONS.md``) read
+LP1/LP2 (``docs/conventions.md``) read
 
 .. math::
 
