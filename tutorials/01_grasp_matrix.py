@@ -80,7 +80,10 @@ for c in grasp.contacts:
         ax.quiver(*c.position, *(0.6 * axis), color=color)
     ax.scatter(*c.position, color="k", s=30)
 ax.set_box_aspect((1, 1, 1))
-ax.set_title("contact frames R = [n, t1, t2]")
+for set_ticks in (ax.set_xticks, ax.set_yticks, ax.set_zticks):
+    set_ticks([-1, 0, 1])
+ax.set(xlabel="x", ylabel="y", zlabel="z")
+ax.set_title("contact frames $R = [n, t_1, t_2]$")
 plt.show()
 
 # %% [markdown]
@@ -275,11 +278,15 @@ print("max |finite differences - G_n^T| =", np.abs(fd - Gn.T).max())
 # Rotation columns are in metres per radian: divide them by b to compare shapes.
 b = data.grasp.characteristic_length
 scale = np.r_[1, 1, 1, 1 / b, 1 / b, 1 / b]
-fig, axes = plt.subplots(1, 3, figsize=(10, 2.6))
+fig, axes = plt.subplots(1, 3, figsize=(11, 2.6))
 for ax, M, title in zip(
     axes,
     (Gn.T * scale, dpsi_dxi * scale, fd * scale),
-    ("$G_n^T$", "Drake $\\partial\\psi/\\partial v\\;T$", "finite differences"),
+    (
+        "$G_n^T$",
+        "Drake: $\\partial\\psi/\\partial v_{obj}$ times $T$",
+        "finite differences",
+    ),
     strict=True,
 ):
     im = ax.imshow(M, cmap="coolwarm", vmin=-1, vmax=1)
@@ -289,6 +296,7 @@ for ax, M, title in zip(
         ["$v_x$", "$v_y$", "$v_z$", "$b\\omega_x$", "$b\\omega_y$", "$b\\omega_z$"],
     )
     ax.set_yticks(range(Gn.shape[1]))
+axes[0].set_ylabel("contact")
 fig.colorbar(im, ax=axes, shrink=0.8)
 plt.show()
 

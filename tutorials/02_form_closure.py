@@ -81,14 +81,15 @@ plt.show()
 # **What $d^*$ says.**  $d^*$ is the smallest normal force of the best balancing set,
 # with the budget $\sum f_n \le N$.  Slide the top contact to the left, from
 # $x=+h/2$ towards $-h/2$: the moment it balances shrinks, the left/right pair must
-# carry less, and at $x_4 = -h/2$ their forces reach zero: $d^* \to 0$ and form
+# carry less, and with the top contact (contact 3) at $x = -h/2$ their forces reach zero: $d^* \to 0$ and form
 # closure is lost (the four normals no longer resist a rotation).
 
 
 # %%
-def square_with_top_at(x4):
+def square_with_top_at(x):
+    """The square grasp with its top contact (contact 3) moved to ``(x, 1)``."""
     c = square4.contacts
-    return square4.with_contacts([*c[:3], c[3].with_(position=[x4, 1.0])])
+    return square4.with_contacts([*c[:3], c[3].with_(position=[x, 1.0])])
 
 
 xs = np.linspace(0.5, -0.7, 13 if TEST_MODE else 49)
@@ -104,11 +105,13 @@ plot_planar_grasp(
     square_with_top_at(-0.25), ax=ax1, outline=SQUARE,
     result=dg.form_closure(square_with_top_at(-0.25)),
 )  # fmt: skip
-ax1.set_title("x4 = -0.25: the left/right pair carries less")
+ax1.set_title("contact 3 at x = -0.25: the left/right pair carries less")
 plt.show()
 for x, r in zip(xs[::4], runs[::4], strict=True):
     f = np.concatenate(r.contact_forces)
-    print(f"x4 = {x:+.2f}: closure {r.is_closure!s:5}, d* = {r.d_star:.3f}, f_n = {f}")
+    print(
+        f"contact 3 at x = {x:+.2f}: closure {r.is_closure!s:5}, d* = {r.d_star:.3f}, f_n = {f}"
+    )
 
 # %% [markdown]
 # ## Rank matters as much as $d^*$: first order can be inconclusive
@@ -160,6 +163,8 @@ def psi_point_to_ellipse(point, phi, a, b):
     """Signed distance of a fixed point to the ellipse rotated by phi (< 0 inside)."""
     c, s = np.cos(-phi), np.sin(-phi)
     x, y = c * point[0] - s * point[1], s * point[0] + c * point[1]  # in body frame
+    if a == b:  # a disc: closed form, exact (a minimiser would add 1e-8 noise)
+        return np.hypot(x, y) - a
     dist = lambda u: np.hypot(a * np.cos(u) - x, b * np.sin(u) - y)  # noqa: E731
     u0 = t[np.argmin(dist(t))]  # coarse search, then refine the parameter
     step = t[1] - t[0]
@@ -171,6 +176,7 @@ def psi_point_to_ellipse(point, phi, a, b):
 phis = np.linspace(-0.3, 0.3, 31 if TEST_MODE else 61)
 fingers = ellipse4.positions
 fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+axes[1].sharey(axes[0])  # same ψ scale: the disc's ψ ≡ 0 shows as flat
 for ax, (name, semi) in zip(
     axes[:2], (("ellipse", (a, b)), ("disc", (1.0, 1.0))), strict=True
 ):
@@ -183,23 +189,28 @@ for ax, (name, semi) in zip(
         ax.plot(
             phis,
             [psi_point_to_ellipse(finger, p, *semi) for p in phis],
+            ls="--" if i % 2 else "-",  # 1 and 3 retrace 0 and 2 (symmetry)
             label=f"contact {i}",
         )
     ax.axhline(0, color="k", lw=0.5)
     ax.set_xlabel("rotation $\\phi$ [rad]")
-    ax.set_ylabel("$\\psi_i$")
+    ax.set_ylabel("$\\psi_i$ [m]" if name == "ellipse" else "")
     ax.set_title(f"{name}: rotating about the centre")
     ax.legend(fontsize=8)
 phi_demo = 0.25
-outline = np.c_[a * np.cos(t[::200]), b * np.sin(t[::200])]
+outline = np.c_[a * np.cos(t), b * np.sin(t)]
 rot = np.array(
     [[np.cos(phi_demo), -np.sin(phi_demo)], [np.sin(phi_demo), np.cos(phi_demo)]]
 )
 axes[2].fill(*outline.T, alpha=0.2, label="ellipse")
 axes[2].fill(*(outline @ rot.T).T, alpha=0.2, label=f"rotated by {phi_demo} rad")
 axes[2].scatter(*fingers.T, color="k", zorder=3, label="fingers")
+for i, finger in enumerate(fingers):
+    axes[2].annotate(str(i), finger, xytext=(6, 4), textcoords="offset points")
 axes[2].set_aspect("equal")
-axes[2].legend(fontsize=8, loc="lower left")
+axes[2].set_xlim(-1.9, 1.9)
+axes[2].set_ylim(-1.4, 1.4)
+axes[2].legend(fontsize=8, loc="center left", bbox_to_anchor=(1.02, 0.5))
 axes[2].set_title("rotated: it runs into fingers 2, 3")
 plt.show()
 print(

@@ -106,6 +106,8 @@ for name, g in cases.items():
 # \frac{\pi^2}{2 n_g^2}$.
 
 # %%
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
+
 equator = examples.equator_fingers(0.5)
 exact = dg.force_closure_exact(equator)
 n_gs = np.arange(3, 17 if TEST_MODE else 65)
@@ -125,6 +127,12 @@ ax1.loglog(
 )
 ax1.loglog(n_gs, np.pi**2 / (2 * n_gs**2), "k:", label="$\\pi^2 / (2 n_g^2)$")
 ax1.set_xlabel("$n_g$")
+# Plain numbers at a few ticks; no labels on the minor ticks (they ran together).
+ax1.set_xticks([n for n in (3, 4, 8, 16, 32, 64) if n <= n_gs[-1]])
+ax1.yaxis.set_major_locator(LogLocator(subs=(1, 2, 5)))
+for axis in (ax1.xaxis, ax1.yaxis):
+    axis.set_major_formatter(FormatStrFormatter("%g"))
+    axis.set_minor_formatter(NullFormatter())
 ax1.legend()
 ax1.set_title("the error falls like $1/n_g^2$")
 plt.show()

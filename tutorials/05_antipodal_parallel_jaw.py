@@ -146,7 +146,11 @@ for mu in mus:
     )
 margins = np.array(margins)
 
-fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(11, 3.8))
+fig = plt.figure(figsize=(11, 4.2))
+grid = fig.add_gridspec(2, 2, height_ratios=[3, 1], hspace=0.08, wspace=0.3)
+ax0 = fig.add_subplot(grid[:, 0])
+ax1 = fig.add_subplot(grid[0, 1])
+strip = fig.add_subplot(grid[1, 1], sharex=ax1)
 ax0.plot(mus, margins[:, 0], "o-", label="margin of contact 0")
 ax0.plot(mus, margins[:, 1], "x--", label="margin of contact 1")
 ax0.axhline(0, color="k", lw=0.5)
@@ -155,16 +159,22 @@ ax0.set_xlabel("$\\mu$")
 ax0.set_ylabel("antipodal margin [deg]")
 ax0.legend()
 ax1.plot(mus, d_soft, "o-", label="$d^*$, soft fingers (exact cones)")
-ax1.axvline(antipodal.min_mu, color="C3", ls=":")
-ax1.set_xlabel("$\\mu$")
+ax1.axvline(antipodal.min_mu, color="C3", ls=":", label="$\\mu_{min}$")
 ax1.set_ylabel("$d^*$")
 ax1.legend(fontsize=8, loc="upper left")
-verdicts = ax1.twinx()
-verdicts.plot(mus, fc_soft, "s", mfc="none", color="C1", label="soft fingers")
-verdicts.plot(mus, fc_hard, "kx", label="hard fingers")
-verdicts.set_yticks([0, 1], ["no", "force closure"])
-verdicts.legend(fontsize=8, loc="center right")
-fig.tight_layout()
+ax1.tick_params(labelbottom=False)
+# The verdicts in a strip of their own: one row per contact model.
+for row, verdict in enumerate((fc_hard, fc_soft)):
+    verdict = np.array(verdict)
+    strip.plot(mus[verdict], np.full(verdict.sum(), row), "s", color="C2",
+               label="force closure" if row else None)  # fmt: skip
+    strip.plot(mus[~verdict], np.full((~verdict).sum(), row), "x", color="C3",
+               label="no" if row else None)  # fmt: skip
+strip.axvline(antipodal.min_mu, color="C3", ls=":")
+strip.set_yticks([0, 1], ["hard", "soft"])
+strip.set_ylim(-0.6, 1.6)
+strip.set_xlabel("$\\mu$")
+strip.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
 plt.show()
 
 first = mus[np.argmax(fc_soft)]
