@@ -8,7 +8,8 @@ Conventions: ``docs/conventions.md``.
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
 programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
-(``plant``), and the outside ring (``visualization``, ``batch``, ``cli``).
+(``plant``), and the outside ring (``visualization``, ``batch``, ``systems``,
+``cli``).
 """
 
 from drakegrasp import examples
@@ -36,12 +37,17 @@ from drakegrasp.contact import Contact, ContactModel, contact_frame, contact_fra
 from drakegrasp.errors import (
     GraspError,
     InvalidContactError,
+    InvalidContextError,
     InvalidGraspError,
     InvalidOptionError,
+    InvalidPoseError,
+    JointLimitError,
     ModelError,
     NoContactsError,
     PenetrationError,
+    SceneError,
     SolverError,
+    UnreachableError,
 )
 from drakegrasp.friction_cone import (
     friction_cone_facets,
@@ -54,11 +60,14 @@ from drakegrasp.grasp import (
     normalised_grasp_matrix,
 )
 from drakegrasp.plant import (
+    FingerClosure,
     GraspFromPlant,
     GraspReport,
+    HandClosure,
     PlantContact,
     Scene,
     analyze_grasp,
+    close_hand,
     find_contacts,
     grasp_from_plant,
     hand_jacobian,
@@ -87,6 +96,7 @@ from drakegrasp.quality import (
     wrench_ellipsoid_volume,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
 from drakegrasp.visualization import (
     clear_grasp,
     draw_grasp,
@@ -104,14 +114,21 @@ __all__ = [
     "Contact",
     "ContactModel",
     "Grasp",
+    "FingerClosure",
     "GraspError",
     "GraspFromPlant",
+    "GraspMonitor",
     "GraspQuality",
     "GraspReport",
+    "HandClosure",
+    "GraspSample",
     "InternalForceResult",
     "InvalidContactError",
+    "InvalidContextError",
     "InvalidGraspError",
     "InvalidOptionError",
+    "InvalidPoseError",
+    "JointLimitError",
     "MaxWrenchResult",
     "ModelError",
     "NoContactsError",
@@ -119,7 +136,10 @@ __all__ = [
     "PlantContact",
     "ProgramVariables",
     "Scene",
+    "SceneError",
     "SolverError",
+    "UnreachableError",
+    "add_grasp_monitor",
     "analyze_grasp",
     "batch_force_closure",
     "batch_form_closure",
@@ -129,6 +149,7 @@ __all__ = [
     "build_internal_force_program",
     "build_max_resistible_wrench_program",
     "clear_grasp",
+    "close_hand",
     "contact_frame",
     "contact_frames",
     "distance_to_singularity",
