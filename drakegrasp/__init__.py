@@ -3,7 +3,7 @@
 Contacts, contact frames and grasp matrices; form closure, force closure and
 antipodal grasps decided with Drake's ``MathematicalProgram``; grasps read from a
 ``MultibodyPlant``; quality metrics; pictures; a batch engine for many grasps.
-Conventions: ``shared/CONVENTIONS.md``.
+Conventions: ``docs/conventions.md``.
 
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
