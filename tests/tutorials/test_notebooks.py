@@ -38,6 +38,7 @@ EXPECTED = [
     "03_force_closure.ipynb",
     "04_hand_jacobian_lp3.ipynb",
     "05_antipodal_parallel_jaw.ipynb",
+    "08_why_not.ipynb",
 ]
 
 WARNINGS_AS_ERRORS = """\
