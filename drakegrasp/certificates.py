@@ -70,9 +70,13 @@ __all__ = [
 ]
 
 ESCAPE_TWIST = "escape twist"
+"""Kind of the witness of a form-closure "no"."""
 UNRESISTED_WRENCH = "unresisted wrench"
+"""Kind of the witness of a force-closure "no"."""
 UNCONTROLLABLE = "uncontrollable internal force"
+"""Kind of the witness of an LP3 failure."""
 BALANCE = "balancing internal force"
+"""Kind of the witness of a "yes"."""
 _KINDS = (ESCAPE_TWIST, UNRESISTED_WRENCH, UNCONTROLLABLE, BALANCE)
 _CONES = ("normals", "polyhedral", "exact")
 
