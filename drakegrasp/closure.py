@@ -52,6 +52,7 @@ from drakegrasp.grasp import (
     normal_grasp_matrix,
 )
 from drakegrasp.results import ClosureResult, InternalForceResult, _relative_margin
+from drakegrasp.validation import check_grasp, check_rank_tol, check_tol, real_array
 
 __all__ = [
     "DEFAULT_TOL",
@@ -132,8 +133,20 @@ def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
     Returns
     -------
     int
+
+    Raises
+    ------
+    InvalidOptionError
+        ``A`` not a real finite 2-D array (LAPACK's SVD can loop forever on
+        ``inf``/``NaN``), or ``rank_tol`` outside its valid range.
     """
-    A = np.asarray(A, dtype=float)
+    A = real_array("A", A, error=InvalidOptionError)
+    if A.ndim != 2 or not np.all(np.isfinite(A)):
+        raise InvalidOptionError(
+            f"matrix_rank needs a finite 2-D array, got shape {A.shape}"
+            + ("" if A.ndim != 2 else " with non-finite entries")
+        )
+    rank_tol = check_rank_tol(rank_tol)
     if A.size == 0:
         return 0
     s = np.linalg.svd(A, compute_uv=False)
@@ -143,14 +156,17 @@ def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
 
 
 def _check_tol(tol: float) -> float:
-    t = float(tol)
-    if not np.isfinite(t) or t <= 0:
-        raise InvalidOptionError(f"tol must be finite and > 0, got {tol!r}")
-    return t
+    return check_tol(tol)
+
+
+def _check_options(grasp: Grasp, rank_tol: float) -> float:
+    """Validate the grasp and ``rank_tol`` of a public program (see validation)."""
+    check_grasp(grasp)
+    return check_rank_tol(rank_tol)
 
 
 def _check_formulation(formulation: str) -> str:
-    if formulation not in _FORMULATIONS:
+    if not isinstance(formulation, str) or formulation not in _FORMULATIONS:
         raise InvalidOptionError(
             f"formulation must be one of {_FORMULATIONS}, got {formulation!r}"
         )
@@ -230,6 +246,7 @@ def build_form_closure_program(
         ``forces`` are the normal forces ``f_n`` (N,); ``columns`` the contact
         indices.
     """
+    rank_tol = _check_options(grasp, rank_tol)
     N = grasp.num_contacts
     prog, f, d = _margin_program(N, N)
     _add_balance(prog, normal_grasp_matrix(grasp), f, rank_tol)
@@ -268,6 +285,7 @@ def build_force_closure_program(
     variables : ProgramVariables
         ``forces`` cover the components the cones allow (see ``columns``).
     """
+    rank_tol = _check_options(grasp, rank_tol)
     _check_formulation(formulation)
     layout = ConeLayout.of(grasp, num_generators)
     N = grasp.num_contacts
@@ -314,6 +332,7 @@ def build_exact_force_closure_program(
         polyhedra) as facets.
     variables : ProgramVariables
     """
+    rank_tol = _check_options(grasp, rank_tol)
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
@@ -377,6 +396,7 @@ def build_internal_force_program(
     literally would let a singular value of 1e-12 (contacts measured to 1e-7 m)
     exclude an internal force that the rank count says exists.
     """
+    rank_tol = _check_options(grasp, rank_tol)
     J = check_hand_jacobian(grasp, hand_jacobian)
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
@@ -464,6 +484,7 @@ def form_closure(
     ClosureResult
         ``contact_forces`` holds ``[f_n]`` per contact.
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     required = grasp.wrench_dim
     rank = matrix_rank(normal_grasp_matrix(grasp), rank_tol=rank_tol)
@@ -511,6 +532,7 @@ def internal_forces(
     -------
     InternalForceResult
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_internal_force_program(
         grasp, hand_jacobian, rank_tol=rank_tol
@@ -660,6 +682,7 @@ def force_closure(
     -------
     ClosureResult
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_force_closure_program(
         grasp, num_generators=num_generators, formulation=formulation, rank_tol=rank_tol
@@ -701,6 +724,7 @@ def force_closure_exact(
     -------
     ClosureResult
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_exact_force_closure_program(grasp, rank_tol=rank_tol)
     conic = bool(prog.lorentz_cone_constraints())

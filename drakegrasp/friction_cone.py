@@ -14,8 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.contact import Contact
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidContactError, InvalidOptionError
 from drakegrasp.grasp import Grasp, grasp_matrix
+from drakegrasp.validation import check_grasp, check_length, check_num_generators
 
 __all__ = [
     "DEFAULT_NUM_GENERATORS",
@@ -49,12 +50,7 @@ class EffectiveCone:
 
 
 def _check_num_generators(num_generators: int) -> int:
-    n = int(num_generators)
-    if n != num_generators or n < 3:
-        raise InvalidOptionError(
-            f"num_generators must be an integer >= 3, got {num_generators!r}"
-        )
-    return n
+    return check_num_generators(num_generators)
 
 
 def _torsion_scale(contact: Contact, characteristic_length: float | None) -> float:
@@ -63,12 +59,9 @@ def _torsion_scale(contact: Contact, characteristic_length: float | None) -> flo
             "a soft finger with torsional_friction > 0 needs the grasp's "
             "characteristic_length b (its moment bound is b * nu * f_n)"
         )
-    b = float(characteristic_length)
-    if not np.isfinite(b) or b <= 0:
-        raise InvalidOptionError(
-            "characteristic_length must be finite and > 0, got "
-            f"{characteristic_length!r}"
-        )
+    b = check_length(
+        "characteristic_length", characteristic_length, error=InvalidOptionError
+    )
     return b * contact.torsional_friction
 
 
@@ -149,6 +142,10 @@ def effective_cone(
     -------
     EffectiveCone
     """
+    if not isinstance(contact, Contact):
+        raise InvalidContactError(
+            f"contact must be a drakegrasp.Contact, got {type(contact).__name__}"
+        )
     n_g = _check_num_generators(num_generators)
     comps = contact.effective_components()
     torsion = 0.0
@@ -289,6 +286,7 @@ class ConeLayout:
     @staticmethod
     def of(grasp: Grasp, num_generators: int = DEFAULT_NUM_GENERATORS) -> ConeLayout:
         """Layout of ``grasp`` with ``num_generators`` per spatial Coulomb cone."""
+        check_grasp(grasp)
         b = grasp.characteristic_length
         cones = tuple(
             effective_cone(c, num_generators, characteristic_length=b)
