@@ -34,6 +34,7 @@ from drakegrasp.closure import (
 )
 from drakegrasp.contact import Contact, ContactModel, contact_frame, contact_frames
 from drakegrasp.errors import (
+    BatchFileError,
     GraspError,
     InvalidContactError,
     InvalidGraspError,
@@ -95,6 +96,7 @@ __all__ = [
     "DEFAULT_TOL",
     "AntipodalResult",
     "BatchClosureResult",
+    "BatchFileError",
     "ClosureResult",
     "Contact",
     "ContactModel",

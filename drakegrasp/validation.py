@@ -69,6 +69,7 @@ __all__ = [
     "check_angle_tol",
     "check_coefficient",
     "check_coefficient_array",
+    "check_flag",
     "check_grasp",
     "check_length",
     "check_num_generators",
@@ -283,8 +284,8 @@ def check_coefficient(name: str, value, *, error: type = InvalidContactError) ->
 
 def _coefficient_message(name: str, x: float) -> str:
     return (
-        f"{name} must be 0 or in [{COEFFICIENT_MIN:g}, {COEFFICIENT_MAX:g}] "
-        f"(drakegrasp.validation.COEFFICIENT_MIN/MAX), got {x!r}"
+        f"{name} must be finite and 0 or in [{COEFFICIENT_MIN:g}, "
+        f"{COEFFICIENT_MAX:g}] (drakegrasp.validation.COEFFICIENT_MIN/MAX), got {x!r}"
     )
 
 
@@ -301,7 +302,8 @@ def check_coefficient_array(
     if not np.all(ok):
         k, *rest = (int(i) for i in np.argwhere(~ok)[0])
         where = f" of grasp {start + k}" + (f", contact {rest[0]}" if rest else "")
-        raise error(_coefficient_message(f"{name}{where}", float(x[(k, *rest)])))
+        value = float(x[(k, *rest)])
+        raise error(f"{name}{where} is {value!r}; " + _coefficient_message(name, value))
     return x
 
 
@@ -310,8 +312,8 @@ def check_tol(value, name: str = "tol") -> float:
     x = real_scalar(name, value)
     if not (TOL_MIN <= x <= 1.0):
         raise InvalidOptionError(
-            f"{name} must be a real number in [{TOL_MIN:g}, 1] (d* is at most 1 "
-            f"and resolved to about 1e-10), got {_describe(value)}"
+            f"{name} must be finite and > 0, a real number in [{TOL_MIN:g}, 1] "
+            f"(d* is at most 1 and resolved to about 1e-10), got {_describe(value)}"
         )
     return x
 
@@ -341,7 +343,7 @@ def check_num_generators(value, name: str = "num_generators") -> int:
                 n = int(value)
     if n is None or not (3 <= n <= MAX_NUM_GENERATORS):
         raise InvalidOptionError(
-            f"{name} must be an integer in [3, {MAX_NUM_GENERATORS}] "
+            f"{name} must be an integer >= 3 and <= {MAX_NUM_GENERATORS} "
             f"(drakegrasp.validation.MAX_NUM_GENERATORS), got {_describe(value)}"
         )
     return int(n)
