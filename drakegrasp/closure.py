@@ -108,10 +108,13 @@ class ProgramVariables:
         Where each entry of ``forces`` sits in the grasp's stacked force vector
         (columns of :func:`~drakegrasp.grasp_matrix`; for LP1, the contact index).
     weights : ndarray of Variable or None
-        Generator weights ``λ >= 0`` (generator formulation only).
+        The program's own variables when ``forces`` are linear expressions of
+        them: generator weights ``λ >= 0`` (generator formulation), or the
+        scaled components of a grasp with soft-finger torsion (``m_n / (b ν)``,
+        see :class:`~drakegrasp.friction_cone.ConeLayout`).
     generators : (m, len(weights)) float or None
-        Block-diagonal generator matrix ``S`` with ``forces = S @ weights``
-        (generator formulation only).
+        The matrix with ``forces = generators @ weights``: the block-diagonal
+        generators ``S``, or ``diag(ConeLayout.scales)``.
     """
 
     d: object
@@ -206,7 +209,23 @@ def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
     )
 
 
-def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
+def _scaled_variables(d, x, layout: ConeLayout) -> ProgramVariables:
+    """Variables whose forces are ``scales * x`` (see ``ConeLayout.scales``).
+
+    Without a soft finger's torsion every scale is 1 and ``forces`` are the
+    program's variables; otherwise ``forces = diag(scales) @ weights``.
+    """
+    if np.all(layout.scales == 1.0):
+        return ProgramVariables(d, x, layout.columns)
+    D = np.diag(layout.scales)
+    with np.errstate(invalid="ignore"):  # see build_force_closure_program
+        forces = D @ x
+    return ProgramVariables(d, forces, layout.columns, weights=x, generators=D)
+
+
+def _add_balance(
+    prog, A: np.ndarray, x, rank_tol: float, *, scales: np.ndarray | None = None
+) -> None:
     """``A x = 0``, imposed on the numerical row space of ``A`` (see below).
 
     The rows added are ``V_rᵀ``: the right singular vectors of ``A`` whose
@@ -217,6 +236,8 @@ def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
     measured to 1e-8 m) made Clp declare an always-feasible LP infeasible.
     """
     rows = _row_space(A, rank_tol)
+    if scales is not None:  # x holds scaled components: A f = A diag(scales) x
+        rows = rows * scales
     if rows.shape[0]:
         prog.AddLinearEqualityConstraint(rows, np.zeros(rows.shape[0]), x)
 
@@ -291,10 +312,11 @@ def build_force_closure_program(
     N = grasp.num_contacts
     if formulation == "facets":
         prog, f, d = _margin_program(len(layout.columns), N)
-        _add_balance(prog, layout.G, f, rank_tol)
-        _add_margin_rows(prog, layout.facet_matrix(), f, d)
+        scales = layout.scales
+        _add_balance(prog, layout.G, f, rank_tol, scales=scales)
+        _add_margin_rows(prog, layout.facet_matrix() * scales, f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
-        return prog, ProgramVariables(d, f, layout.columns)
+        return prog, _scaled_variables(d, f, layout)
     S = layout.generator_matrix()
     prog, lam, d = _margin_program(S.shape[1], N)
     _add_balance(prog, layout.G @ S, lam, rank_tol)
@@ -327,39 +349,43 @@ def build_exact_force_closure_program(
         ``max d`` s.t. ``G f = 0``, ``d >= 0``, ``Σ f_n <= N`` and, per contact,
         the ball of radius ``d`` around ``f_i`` inside its cone:
         hard finger ``‖f_t‖ <= μ f_n - sqrt(1 + μ²) d``; soft finger, for both
-        signs ``σ``, ``‖f_t‖ <= μ f_n - σ μ m_n / (b ν) - sqrt(1 + μ² +
-        μ²/(b ν)²) d``; frictionless ``f_n >= d``; planar cones (exact
-        polyhedra) as facets.
+        signs ``σ``, ``‖f_t‖ <= μ f_n - σ μ m_n / (b ν) - sqrt(1 + μ²) d``
+        (the hard-finger margin of the normal force left after torsion, so a
+        soft finger never scores below a hard one); frictionless
+        ``f_n >= d``; planar cones (exact polyhedra) as facets.
     variables : ProgramVariables
     """
     rank_tol = _check_options(grasp, rank_tol)
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
-    _add_balance(prog, layout.G, f, rank_tol)
+    # f holds scaled components (a soft finger's m_n / (b ν)): ConeLayout.scales.
+    _add_balance(prog, layout.G, f, rank_tol, scales=layout.scales)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     b = grasp.characteristic_length
     starts = list(layout.normal_positions) + [len(layout.columns)]
     for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
         fi = f[starts[i] : starts[i + 1]]
         if cone.components not in ((0, 1, 2), (0, 1, 2, 3)):
-            _add_margin_rows(prog, cone.facets, fi, d)  # exact already
+            scale = layout.scales[starts[i] : starts[i + 1]]
+            _add_margin_rows(prog, cone.facets * scale, fi, d)  # exact already
             continue
         mu = contact.mu
-        signs_and_slopes = [(0.0, 0.0)]
-        if cone.components == (0, 1, 2, 3):
-            k = mu / (b * contact.torsional_friction)
-            signs_and_slopes = [(1.0, k), (-1.0, k)]
-        for sign, k in signs_and_slopes:
-            # z = A [fi; d]: z0 = μ f_n - σ k m_n - sqrt(1+μ²+k²) d, z1:3 = f_t.
+        signs = [0.0] if cone.components == (0, 1, 2) else [1.0, -1.0]
+        for sign in signs:
+            # z = A [fi; d]: z0 = μ f_n - σ μ m_n/(b ν) - sqrt(1+μ²) d,
+            # z1:3 = f_t, with m_n = s m̃ (s = ConeLayout.scales): d is the
+            # hard-cone margin of (f_n - |m_n| / (b ν), f_t), as the polyhedral
+            # soft rows (friction_cone.soft_finger_facets).
             A = np.zeros((3, len(fi) + 1))
             A[0, 0] = mu
             if len(fi) == 4:
-                A[0, 3] = -sign * k
-            A[0, -1] = -np.sqrt(1.0 + mu * mu + k * k)
+                s = layout.scales[starts[i] + 3]
+                A[0, 3] = -sign * mu * s / (b * contact.torsional_friction)
+            A[0, -1] = -np.sqrt(1.0 + mu * mu)
             A[1, 1] = A[2, 2] = 1.0
             prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(fi, d))
-    return prog, ProgramVariables(d, f, layout.columns)
+    return prog, _scaled_variables(d, f, layout)
 
 
 def build_internal_force_program(
@@ -431,10 +457,18 @@ def _solve(prog: MathematicalProgram, *, conic: bool) -> MathematicalProgramResu
     )
 
 
+_VERDICTS = (SolutionResult.kSolutionFound, SolutionResult.kInfeasibleConstraints)
+
+
 def _solve_margin(prog, variables: ProgramVariables, *, conic: bool):
     """Solve; return (d*, full-vector forces or None, solver, status)."""
     result = _solve(prog, conic=conic)
     status = result.get_solution_result()
+    if conic and status not in _VERDICTS and ScsSolver().available():
+        # Clarabel can stall on degenerate SOCPs (d* = 0 with no interior, e.g.
+        # soft fingers with nu = 1e12); SCS, a first-order method, does not.
+        result = ScsSolver().Solve(prog)
+        status = result.get_solution_result()
     solver = result.get_solver_id().name()
     if status == SolutionResult.kSolutionFound:
         d_star = float(result.GetSolution(variables.d))

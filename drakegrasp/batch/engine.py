@@ -262,8 +262,8 @@ def _check_positions(P: np.ndarray, start: int) -> None:
         k, i = np.argwhere(bad)[0]
         raise InvalidContactError(
             f"position of grasp {start + k}, contact {i} is {P[k, i].tolist()}: "
-            f"not finite or out of range; it must be finite with |x| <= {POSITION_BOUND:g} m "
-            "(drakegrasp.validation.POSITION_BOUND)"
+            "not finite or out of range; it must be finite with "
+            f"|x| <= {POSITION_BOUND:g} m (drakegrasp.validation.POSITION_BOUND)"
         )
 
 
