@@ -8,7 +8,8 @@ Conventions: ``shared/CONVENTIONS.md``.
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
 programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
-(``plant``), and the outside ring (``visualization``, ``batch``, ``cli``).
+(``plant``), and the outside ring (``visualization``, ``batch``, ``systems``,
+``cli``).
 """
 
 from drakegrasp import examples
@@ -37,24 +38,37 @@ from drakegrasp.errors import (
     BatchFileError,
     GraspError,
     InvalidContactError,
+    InvalidContextError,
     InvalidGraspError,
     InvalidOptionError,
+    InvalidPoseError,
+    JointLimitError,
     ModelError,
     NoContactsError,
     PenetrationError,
+    SceneError,
     SolverError,
+    UnreachableError,
 )
 from drakegrasp.friction_cone import (
     friction_cone_facets,
     friction_cone_generators,
 )
-from drakegrasp.grasp import Grasp, grasp_matrix, normal_grasp_matrix
+from drakegrasp.grasp import (
+    Grasp,
+    grasp_matrix,
+    normal_grasp_matrix,
+    normalised_grasp_matrix,
+)
 from drakegrasp.plant import (
+    FingerClosure,
     GraspFromPlant,
     GraspReport,
+    HandClosure,
     PlantContact,
     Scene,
     analyze_grasp,
+    close_hand,
     find_contacts,
     grasp_from_plant,
     hand_jacobian,
@@ -83,6 +97,7 @@ from drakegrasp.quality import (
     wrench_ellipsoid_volume,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
 from drakegrasp.visualization import (
     clear_grasp,
     draw_grasp,
@@ -101,14 +116,21 @@ __all__ = [
     "Contact",
     "ContactModel",
     "Grasp",
+    "FingerClosure",
     "GraspError",
     "GraspFromPlant",
+    "GraspMonitor",
     "GraspQuality",
     "GraspReport",
+    "HandClosure",
+    "GraspSample",
     "InternalForceResult",
     "InvalidContactError",
+    "InvalidContextError",
     "InvalidGraspError",
     "InvalidOptionError",
+    "InvalidPoseError",
+    "JointLimitError",
     "MaxWrenchResult",
     "ModelError",
     "NoContactsError",
@@ -116,7 +138,10 @@ __all__ = [
     "PlantContact",
     "ProgramVariables",
     "Scene",
+    "SceneError",
     "SolverError",
+    "UnreachableError",
+    "add_grasp_monitor",
     "analyze_grasp",
     "batch_force_closure",
     "batch_form_closure",
@@ -126,6 +151,7 @@ __all__ = [
     "build_internal_force_program",
     "build_max_resistible_wrench_program",
     "clear_grasp",
+    "close_hand",
     "contact_frame",
     "contact_frames",
     "distance_to_singularity",
@@ -156,6 +182,7 @@ __all__ = [
     "max_resistible_wrench",
     "min_singular_value",
     "normal_grasp_matrix",
+    "normalised_grasp_matrix",
     "plot_planar_grasp",
     "plot_wrench_space",
     "primitive_wrenches",
