@@ -176,6 +176,17 @@ def test_every_yes_certificate_balances_inside_the_cones(rng, make_contacts):
     assert count > 50
 
 
+def test_the_normal_force_route_certificate_holds_where_g_n_is_short():
+    # equator fingers with almost no friction: the normals balance, G has full
+    # rank through the (tiny) friction, G_n has rank 2
+    g = ex.equator_fingers(1e-8)
+    for fn in (dg.force_closure, dg.force_closure_exact):
+        r = fn(g)
+        assert r.is_closure and r.decided_by == "normal forces"
+        chk = r.certificate.check(g)
+        assert chk.holds and chk.slack > 0, chk
+
+
 def test_a_wrong_witness_fails_the_check():
     g = ex.planar_two_finger_square(0.2)
     cert = dg.force_closure(g).certificate
