@@ -24,6 +24,7 @@ SPATIAL_MODELS = [
     ("hard_finger", 0.0, 0.0),
     ("hard_finger", 0.3, 0.0),
     ("soft_finger", 0.3, 0.2),
+    ("soft_finger", 0.0, 0.2),
 ]
 PLANAR_MODELS = [("frictionless", 0.5, 0.0), ("hard_finger", 0.2, 0.0)]
 
