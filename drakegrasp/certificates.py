@@ -126,7 +126,7 @@ class CertificateCheck:
         verdict = "holds" if self.holds else "FAILS"
         return (
             f"witness {verdict}: violation {self.violation:.2g}, "
-            f"slack {self.slack:.3g} (tol {self.tol:g}); {self.detail}"
+            f"slack {self.slack + 0.0:.3g} (tol {self.tol:g}); {self.detail}"
         )
 
 
