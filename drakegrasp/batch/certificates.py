@@ -92,6 +92,14 @@ def _per_contact(value, K: int, N: int, name: str) -> np.ndarray:
         ) from None
 
 
+def _witness(grasp: Grasp, rank: int, form: bool, num_generators: int):
+    if form:
+        return escape_twist(grasp, rank)
+    return unresisted_wrench(
+        grasp, rank, cones="polyhedral", num_generators=num_generators
+    )
+
+
 def _core_rank(grasp: Grasp, form: bool, num_generators: int) -> int:
     if form:
         cols = grasp.normal_indices()
@@ -191,14 +199,13 @@ def batch_certificates(
             reference_points=reference_points,
             characteristic_lengths=characteristic_lengths,
         )
-        # the witness's rank is the core's, on the normalised G (the batch's
-        # own rank decided the verdict; they agree in the agreement tests)
-        rank = _core_rank(g, form, num_generators)
-        if form:
-            cert = escape_twist(g, rank)
-        else:
-            cert = unresisted_wrench(
-                g, rank, cones="polyhedral", num_generators=num_generators
+        # The batch's rank decided the verdict; it agrees with the core's on
+        # the normalised G in the agreement tests.  A witness that does not
+        # check out at that rank is recomputed at the core's rank.
+        cert = _witness(g, int(result.rank[k]), form, num_generators)
+        if cert is None or not cert.check(g).holds:
+            cert = _witness(
+                g, _core_rank(g, form, num_generators), form, num_generators
             )
         certs[k] = cert
         if cert is None:
