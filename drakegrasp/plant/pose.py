@@ -32,6 +32,7 @@ __all__ = [
     "Penetration",
     "PoseCheck",
     "check_pose",
+    "find_penetrations",
 ]
 
 JOINT_LIMIT_TOL = 1e-8
@@ -140,13 +141,14 @@ class PoseCheck:
         }
 
 
-def _penetrations(
+def find_penetrations(
     plant: MultibodyPlant,
     plant_context: Context,
     object_body: RigidBody,
     bodies: Sequence[RigidBody],
     tol: float,
 ) -> list[Penetration]:
+    """Every (body geometry, object geometry) pair with ``ψ < −tol``, unfiltered."""
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     query = plant.get_geometry_query_input_port().Eval(plant_context)
@@ -224,7 +226,7 @@ def check_pose(
     -------
     PoseCheck
     """
-    pens = _penetrations(
+    pens = find_penetrations(
         plant, plant_context, object_body, hand_instance_bodies, distance_tolerance
     )
     joints = _joint_violations(plant, plant_context, hand_instance_bodies)
