@@ -8,7 +8,8 @@ Conventions: ``shared/CONVENTIONS.md``.
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
 programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
-(``plant``), and the outside ring (``visualization``, ``batch``, ``cli``).
+(``plant``), and the outside ring (``visualization``, ``batch``, ``systems``,
+``cli``).
 """
 
 from drakegrasp import examples
@@ -44,6 +45,7 @@ from drakegrasp.errors import (
     ModelError,
     NoContactsError,
     PenetrationError,
+    SceneError,
     SolverError,
     UnreachableError,
 )
@@ -51,7 +53,12 @@ from drakegrasp.friction_cone import (
     friction_cone_facets,
     friction_cone_generators,
 )
-from drakegrasp.grasp import Grasp, grasp_matrix, normal_grasp_matrix
+from drakegrasp.grasp import (
+    Grasp,
+    grasp_matrix,
+    normal_grasp_matrix,
+    normalised_grasp_matrix,
+)
 from drakegrasp.plant import (
     FingerClosure,
     GraspFromPlant,
@@ -89,6 +96,7 @@ from drakegrasp.quality import (
     wrench_ellipsoid_volume,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
 from drakegrasp.visualization import (
     clear_grasp,
     draw_grasp,
@@ -109,9 +117,11 @@ __all__ = [
     "FingerClosure",
     "GraspError",
     "GraspFromPlant",
+    "GraspMonitor",
     "GraspQuality",
     "GraspReport",
     "HandClosure",
+    "GraspSample",
     "InternalForceResult",
     "InvalidContactError",
     "InvalidContextError",
@@ -126,8 +136,10 @@ __all__ = [
     "PlantContact",
     "ProgramVariables",
     "Scene",
+    "SceneError",
     "SolverError",
     "UnreachableError",
+    "add_grasp_monitor",
     "analyze_grasp",
     "batch_force_closure",
     "batch_form_closure",
@@ -168,6 +180,7 @@ __all__ = [
     "max_resistible_wrench",
     "min_singular_value",
     "normal_grasp_matrix",
+    "normalised_grasp_matrix",
     "plot_planar_grasp",
     "plot_wrench_space",
     "primitive_wrenches",

@@ -55,6 +55,16 @@ class ModelError(GraspError):
     """A model, scene file or body could not be found or loaded."""
 
 
+class SceneError(ModelError, ValueError):
+    """A scene file is malformed, or references a file it may not.
+
+    Raised for YAML that is not valid, too large or uses anchors and aliases,
+    a ``drakegrasp:`` key or value of the wrong type, an unknown package, and a
+    model file outside the scene's directory and its packages (see
+    :mod:`drakegrasp.plant.scene`).
+    """
+
+
 class SolverError(GraspError):
     """A solver failed for a reason other than infeasibility.
 

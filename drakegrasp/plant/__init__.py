@@ -12,6 +12,7 @@ from drakegrasp.plant.analysis import (
     grasp_from_plant,
 )
 from drakegrasp.plant.closing import FingerClosure, HandClosure, close_hand
+from drakegrasp.plant.contact_results import contacts_from_results
 from drakegrasp.plant.contacts import (
     DEFAULT_DISTANCE_TOLERANCE,
     PlantContact,
@@ -46,6 +47,7 @@ __all__ = [
     "SceneInfo",
     "analyze_grasp",
     "close_hand",
+    "contacts_from_results",
     "find_contacts",
     "grasp_from_plant",
     "hand_bodies",

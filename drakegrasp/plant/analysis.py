@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
@@ -27,7 +28,7 @@ from drakegrasp.closure import (
     with_internal_forces,
 )
 from drakegrasp.contact import Contact, ContactModel
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidOptionError, NoContactsError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.grasp import Grasp, grasp_matrix
 from drakegrasp.plant.contacts import (
@@ -173,6 +174,8 @@ def grasp_from_plant(
     allow_penetration: bool = False,
     patches: str = "vertices",
     check_pose: bool = True,
+    query_object: QueryObject | None = None,
+    contacts: list[PlantContact] | None = None,
 ) -> GraspFromPlant:
     """The grasp that the plant's configuration makes, with ``J``, ``ψ``, ``∂ψ/∂v``.
 
@@ -200,8 +203,10 @@ def grasp_from_plant(
         ``[f_a, f_b, m]``); every contact normal must lie in the plane.
     characteristic_length : float, optional
         ``b`` of the grasp (default: farthest contact from O's origin).
-    allow_penetration, patches
-        Passed to :func:`drakegrasp.find_contacts`.  ``allow_penetration=True``
+    allow_penetration, patches, query_object
+        Passed to :func:`drakegrasp.find_contacts` (``query_object``: read the
+        geometry from this scene-graph query object instead of the plant's
+        query input port in ``plant_context``).  ``allow_penetration=True``
         also stops the pose check from refusing penetration (it is still
         recorded in ``pose``).
     check_pose : bool, optional
@@ -209,6 +214,10 @@ def grasp_from_plant(
         model instances (the welded palm too) penetrating the object, or a
         joint of the hand outside its limits.  False: analyse it anyway; the
         result's ``pose.valid`` is then False and the report says so.
+    contacts : list of PlantContact, optional
+        Analyse these contacts (frame O of ``object_body``) instead of finding
+        them from signed distances: e.g. the patches of hydroelastic contact
+        surfaces read by :func:`drakegrasp.plant.contacts_from_results`.
 
     Returns
     -------
@@ -246,16 +255,21 @@ def grasp_from_plant(
         distance_tolerance=distance_tolerance,
         refuse=check_pose,
         allow_penetration=allow_penetration,
+        query_object=query_object,
     )
-    contacts = find_contacts(
-        plant,
-        plant_context,
-        object_body=body,
-        hand=bodies,
-        distance_tolerance=distance_tolerance,
-        allow_penetration=allow_penetration or not check_pose,
-        patches=patches,
-    )
+    if contacts is None:
+        contacts = find_contacts(
+            plant,
+            plant_context,
+            object_body=body,
+            hand=bodies,
+            distance_tolerance=distance_tolerance,
+            allow_penetration=allow_penetration or not check_pose,
+            patches=patches,
+            query_object=query_object,
+        )
+    elif not contacts:
+        raise NoContactsError(f"no contacts given for {_scoped_name(plant, body)!r}")
     core = [
         _core_contact(
             c, plane=plane, mu=mu, model=model, torsional_friction=torsional_friction
@@ -294,7 +308,15 @@ def grasp_from_plant(
 
 
 def _pose_of(
-    plant, plant_context, body, bodies, *, distance_tolerance, refuse, allow_penetration
+    plant,
+    plant_context,
+    body,
+    bodies,
+    *,
+    distance_tolerance,
+    refuse,
+    allow_penetration,
+    query_object=None,
 ) -> PoseCheck:
     """Check the pose; raise unless the caller opted out."""
     tol = float(distance_tolerance)
@@ -309,6 +331,7 @@ def _pose_of(
         body,
         hand_model_instances(plant, bodies, body),
         distance_tolerance=tol,
+        query_object=query_object,
     )
     if refuse:
         if allow_penetration:
@@ -436,6 +459,8 @@ def analyze_grasp(
     allow_penetration: bool = False,
     patches: str = "vertices",
     check_pose: bool = True,
+    query_object: QueryObject | None = None,
+    contacts: list[PlantContact] | None = None,
 ) -> GraspReport:
     """Read the grasp from the plant and decide every closure property.
 
@@ -443,7 +468,7 @@ def analyze_grasp(
     ----------
     plant, plant_context, object_body, hand, mu, contact_model,
     torsional_friction, distance_tolerance, plane, characteristic_length,
-    allow_penetration, patches, check_pose
+    allow_penetration, patches, check_pose, query_object, contacts
         As in :func:`grasp_from_plant` (``plant_context`` may be the diagram's
         root context; ``object_body`` may be positional).
     num_generators : int, optional
@@ -469,6 +494,8 @@ def analyze_grasp(
         allow_penetration=allow_penetration,
         patches=patches,
         check_pose=check_pose,
+        query_object=query_object,
+        contacts=contacts,
     )
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None

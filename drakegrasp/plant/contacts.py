@@ -249,6 +249,7 @@ def find_contacts(
     distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    query_object: QueryObject | None = None,
 ) -> list[PlantContact]:
     """Contacts between the hand and the object in the plant's configuration.
 
@@ -273,6 +274,13 @@ def find_contacts(
     patches : {"vertices", "witness"}, optional
         How a flat-on-flat patch is reported: one contact per patch vertex
         (default) or Drake's single witness point.
+    query_object : pydrake.geometry.QueryObject, optional
+        The scene-graph query object to read distances and geometry poses
+        from.  Default: evaluate the plant's geometry query input port in
+        ``plant_context``.  Pass one when ``plant_context`` is not connected to
+        a scene graph (e.g. a private context inside a Drake ``System`` such as
+        :class:`drakegrasp.GraspMonitor`, fed by a query-object input port); it
+        must describe the same configuration as ``plant_context``.
 
     Returns
     -------
@@ -306,7 +314,15 @@ def find_contacts(
     fingers = hand_bodies(plant, body, hand)
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
-    query: QueryObject = plant.get_geometry_query_input_port().Eval(plant_context)
+    if query_object is None:
+        query = plant.get_geometry_query_input_port().Eval(plant_context)
+    elif isinstance(query_object, QueryObject):
+        query = query_object
+    else:
+        raise InvalidOptionError(
+            "query_object must be a pydrake.geometry.QueryObject or None, got "
+            f"{type(query_object).__name__}"
+        )
     inspector = query.inspector()
     object_geometries = plant.GetCollisionGeometriesForBody(body)
     object_name = _scoped_name(plant, body)

@@ -147,11 +147,14 @@ def find_penetrations(
     object_body: RigidBody,
     bodies: Sequence[RigidBody],
     tol: float,
+    query_object=None,
 ) -> list[Penetration]:
     """Every (body geometry, object geometry) pair with ``ψ < −tol``, unfiltered."""
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
-    query = plant.get_geometry_query_input_port().Eval(plant_context)
+    query = query_object
+    if query is None:
+        query = plant.get_geometry_query_input_port().Eval(plant_context)
     inspector = query.inspector()
     object_geometries = plant.GetCollisionGeometriesForBody(object_body)
     out = []
@@ -207,6 +210,7 @@ def check_pose(
     hand_instance_bodies: Sequence[RigidBody],
     *,
     distance_tolerance: float,
+    query_object=None,
 ) -> PoseCheck:
     """Penetrations and joint-limit violations of the hand in this pose.
 
@@ -221,13 +225,21 @@ def check_pose(
         :func:`~drakegrasp.plant.validation.hand_model_instances`).
     distance_tolerance : float
         Penetration deeper than this (metres) is reported.
+    query_object : pydrake.geometry.QueryObject, optional
+        Read distances from this query object instead of the plant's query
+        input port in ``plant_context`` (a System's private plant context).
 
     Returns
     -------
     PoseCheck
     """
     pens = find_penetrations(
-        plant, plant_context, object_body, hand_instance_bodies, distance_tolerance
+        plant,
+        plant_context,
+        object_body,
+        hand_instance_bodies,
+        distance_tolerance,
+        query_object,
     )
     joints = _joint_violations(plant, plant_context, hand_instance_bodies)
     return PoseCheck(tuple(pens), tuple(joints))
