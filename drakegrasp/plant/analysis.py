@@ -191,7 +191,7 @@ def grasp_from_plant(
         The grasped object; its body frame O is the grasp frame and its origin
         the reference point.  Positional or keyword.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
-        See :func:`drakegrasp.plant.hand_bodies`.
+        See :func:`~drakegrasp.plant.validation.hand_bodies`.
     mu : float
         Friction coefficient of every contact.
     contact_model : ContactModel or str, optional

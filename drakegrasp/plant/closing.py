@@ -241,7 +241,7 @@ def close_hand(
     object_body : RigidBody, BodyIndex or str
         The object; positional or keyword.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None
-        The hand (see :func:`drakegrasp.plant.hand_bodies`).
+        The hand (see :func:`~drakegrasp.plant.validation.hand_bodies`).
     direction : (n_h,) float, optional
         Closing direction over the closing joints (order of
         ``HandClosure.joints``; followers of couplings are ignored): each
@@ -255,7 +255,8 @@ def close_hand(
         plant has constraints, which Drake does not let us read.
     distance_tolerance : float, optional
         A finger touches when ``0 <= ψ <= distance_tolerance`` (metres,
-        default 1e-4, the contact tolerance of :func:`find_contacts`).
+        default 1e-4, the contact tolerance of
+        :func:`~drakegrasp.plant.contacts.find_contacts`).
     min_fingers : int, optional
         Fewest fingers that must touch (default 1).
     max_iterations : int, optional
@@ -431,6 +432,13 @@ class _Search:
                 if not st.status:
                     self.advance(st, query)
             steps += 1
+        # Where each finger stopped (a finger that ran out of steps goes back
+        # to its last point clear of the object).
+        q = q0.copy()
+        for st in states:
+            q[list(st.finger.joints)] = st.q_trial[list(st.finger.joints)]
+        q_all[hand.position_indices] = hand.coupling.apply(q)
+        self.plant.SetPositions(self.context, q_all)
         return steps
 
     def advance(self, st: _State, query) -> None:
@@ -444,9 +452,9 @@ class _Search:
             st.status = "fixed"
         elif 0.0 <= psi <= self.tol or (first and -self.tol <= psi <= self.tol):
             st.status = "touching"
-        elif st.iterations >= self.max_iterations:
+        elif st.iterations >= self.max_iterations:  # back to the last clear point
             st.status = "not converged"
-            st.q_trial = st.q_good.copy()
+            st.q_trial, st.psi = st.q_good.copy(), st.psi_good
         elif psi < 0.0:  # the step went in: regula falsi back to the surface
             alpha = st.alpha * (st.psi_good - self.target) / (st.psi_good - psi)
             st.alpha = float(np.clip(alpha, 0.1 * st.alpha, 0.9 * st.alpha))

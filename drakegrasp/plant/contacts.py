@@ -264,7 +264,7 @@ def find_contacts(
         The grasped object (a ``"model::body"`` name is accepted); positional
         or keyword, like every option-free argument of the plant layer.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
-        See :func:`hand_bodies`.
+        See :func:`~drakegrasp.plant.validation.hand_bodies`.
     distance_tolerance : float, optional
         A pair is a contact when ``|ψ| <= distance_tolerance`` (metres, default
         1e-4).

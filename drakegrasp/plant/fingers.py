@@ -49,7 +49,7 @@ class Finger:
     name : str
         ``model::root_joint`` (roots joined by ``+`` for coupled fingers).
     joints : tuple of int
-        Positions of its joints in :attr:`HandStructure.joints`.
+        Positions of its joints in ``HandStructure.joints``.
     bodies : tuple of RigidBody
     pairs : tuple of (GeometryId, GeometryId, RigidBody)
         (object geometry, finger geometry, finger body) for every pair that
@@ -280,7 +280,7 @@ def hand_structure(
     object_body : RigidBody
         The object the fingers close on (its geometries make the pairs).
     bodies : sequence of RigidBody
-        The hand's movable bodies (:func:`drakegrasp.plant.hand_bodies`).
+        The hand's movable bodies (:func:`~drakegrasp.plant.validation.hand_bodies`).
     couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
     inspector : SceneGraphInspector
         For the collision filters (``query_object.inspector()``).
