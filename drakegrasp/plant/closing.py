@@ -52,6 +52,7 @@ from drakegrasp.plant.fingers import Finger, HandStructure, hand_structure
 from drakegrasp.plant.pose import find_penetrations
 from drakegrasp.plant.validation import (
     HandSpec,
+    check_distance_tolerance,
     hand_bodies,
     hand_model_instances,
     plant_context_of,
@@ -280,7 +281,7 @@ def close_hand(
     """
     t0 = time.perf_counter()
     plant_context = plant_context_of(plant, plant_context)
-    tol = _positive(distance_tolerance, "distance_tolerance")
+    tol = check_distance_tolerance(distance_tolerance)
     for name, value in (
         ("max_iterations", max_iterations),
         ("min_fingers", min_fingers),
@@ -352,16 +353,6 @@ def _couplings(plant, couplings):
             "offset)], or couplings=() to close without them"
         )
     return ()
-
-
-def _positive(value, name: str) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        x = np.nan
-    if not np.isfinite(x) or x <= 0:
-        raise InvalidOptionError(f"{name} must be finite and > 0, got {value!r}")
-    return x
 
 
 def _check_coupled(hand: HandStructure, q0: np.ndarray) -> None:

@@ -182,3 +182,16 @@ def test_hand_of_only_welded_bodies(real_hands):
     palm = scene.plant.GetBodyByName("body", scene.hand)
     with pytest.raises(ModelError, match="welded to the world.*Schunk_Gripper::body"):
         analyze_grasp(scene.plant, scene.ctx, scene.object, hand=[palm], mu=0.5)
+
+
+def test_distance_tolerance_is_one_rule_for_every_plant_function(real_hands):
+    scene = real_hands.wsg()
+    plant, ctx, box, hand = scene.plant, scene.ctx, scene.object, scene.hand
+    for bad in (0.0, -1e-4, np.inf, np.nan, "abc", None):
+        for call in (
+            lambda t: find_contacts(plant, ctx, box, distance_tolerance=t),
+            lambda t: analyze_grasp(plant, ctx, box, mu=0.5, distance_tolerance=t),
+            lambda t: close_hand(plant, ctx, box, hand=hand, distance_tolerance=t),
+        ):
+            with pytest.raises(GraspError, match="distance_tolerance must be finite"):
+                call(bad)
