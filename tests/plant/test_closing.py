@@ -304,3 +304,56 @@ def test_pre_shape_penetration_is_refused(real_hands):
     scene = real_hands.wsg(X_WO=X)
     with pytest.raises(PenetrationError, match=r"Schunk_Gripper::body .* 20\.6"):
         close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+
+
+def test_shipped_gripper_closes_back_onto_its_closed_form_pose(scene_cache, tools):
+    # The shipped scenes come from closed-form kinematics (|psi| < 1e-15 m):
+    # opened and closed again, the gripper must come back to them.
+    scene = scene_cache("parallel_jaw_box")
+    root, ctx = tools.fresh_context(scene)
+    q_star = scene.plant.GetPositions(ctx).copy()
+    for name in ("left_finger_joint", "right_finger_joint"):
+        scene.plant.GetJointByName(name).set_translation(ctx, 0.04)
+    closure = close_hand(scene.plant, root, scene.object_body, hand=scene.hand)
+    assert len(closure.touching_fingers) == 2
+    # 0 <= psi <= tol of a pad moving along its normal: q* + psi, psi ~ tol / 2.
+    np.testing.assert_allclose(scene.plant.GetPositions(ctx), q_star, atol=TOL)
+
+
+def test_shipped_three_finger_hand_closes_along_a_synergy(scene_cache, tools):
+    scene = scene_cache("three_finger_sphere")
+    plant = scene.plant
+    root, ctx = tools.fresh_context(scene)
+    q_star = plant.GetPositions(ctx).copy()
+    q = q_star.copy()
+    proximal = [
+        plant.GetJointByName(f"finger{k}_proximal_joint").position_start()
+        for k in (1, 2, 3)
+    ]
+    q[proximal] -= 0.25  # open the proximal joints only
+    plant.SetPositions(ctx, q)
+    names = [n.split("::")[1] for n in _closing_names(plant, scene)]
+    synergy = [1.0 if n.endswith("proximal_joint") else 0.0 for n in names]
+    plant.SetPositions(ctx, q)
+    closure = close_hand(
+        plant, root, scene.object_body, hand=scene.hand, direction=synergy
+    )
+    assert len(closure.touching_fingers) == 3
+    assert {f.touching_body for f in closure.fingers} == {
+        f"hand::finger{k}_distal" for k in (1, 2, 3)
+    }
+    # Only the proximal joints moved, back to the closed-form pose (a 0.05 mm
+    # gap on a ~0.1 m lever is well under 2 mrad).
+    np.testing.assert_allclose(plant.GetPositions(ctx), q_star, atol=2e-3)
+    moved = np.flatnonzero(plant.GetPositions(ctx) != q)
+    assert set(moved) == set(proximal)
+
+
+def _closing_names(plant, scene):
+    from drakegrasp.plant.fingers import hand_structure
+    from drakegrasp.plant.validation import hand_bodies
+
+    ctx = scene.plant_context
+    inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
+    bodies = hand_bodies(plant, scene.object_body, scene.hand)
+    return hand_structure(plant, scene.object_body, bodies, inspector=inspector).names
