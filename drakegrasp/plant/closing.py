@@ -382,7 +382,7 @@ def _user_direction(direction, n: int, hand: HandStructure) -> np.ndarray | None
 
 def _path_end(q, d, lower, upper) -> float:
     """Largest α at which a joint with d != 0 still moves (capped at 1e3)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         t = np.where(d > 0, (upper - q) / d, np.where(d < 0, (lower - q) / d, 0.0))
     t = np.where(np.isfinite(t), t, 1e3)
     return float(max(np.max(t, initial=0.0), 0.0))
@@ -498,4 +498,7 @@ class _Search:
         blocked = ((d > 0) & (q >= hand.upper)) | ((d < 0) & (q <= hand.lower))
         d = np.where(blocked, 0.0, d)
         scale = np.max(np.abs(d), initial=0.0)
-        return d / scale if scale > 1e-12 else np.zeros_like(d)
+        if scale <= 1e-12:
+            return np.zeros_like(d)
+        d = d / scale
+        return np.where(np.abs(d) < 1e-9, 0.0, d)  # round-off, not a motion

@@ -12,6 +12,8 @@ import json
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from pydrake.multibody.tree import BodyIndex
 from scipy.optimize import linprog
 
@@ -357,3 +359,59 @@ def _closing_names(plant, scene):
     inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
     bodies = hand_bodies(plant, scene.object_body, scene.hand)
     return hand_structure(plant, scene.object_body, bodies, inspector=inspector).names
+
+
+@settings(
+    derandomize=True,
+    max_examples=8,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    x=st.floats(-0.04, 0.04),
+    y=st.floats(0.05, 0.16),
+    yaw=st.floats(-0.6, 0.6),
+)
+def test_wsg_anywhere_either_closes_truthfully_or_says_why(real_hands, x, y, yaw):
+    from pydrake.math import RigidTransform, RollPitchYaw
+
+    R = RollPitchYaw(np.pi / 2, yaw, np.pi / 2).ToRotationMatrix()
+    scene = real_hands.wsg(X_WO=RigidTransform(R, [x, y, 0.0]))
+    q0 = scene.plant.GetPositions(scene.ctx).copy()
+    try:
+        closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    except PenetrationError:
+        assert min(all_pair_distances(scene).values()) < -TOL
+        return
+    except UnreachableError as e:
+        np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
+        assert all(f.status != "touching" for f in e.closure.fingers)
+        return
+    assert all(f.status in ("touching", "at limit") for f in closure.fingers)
+    check_closed(scene, closure)
+
+
+@settings(
+    derandomize=True,
+    max_examples=8,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    x=st.floats(0.06, 0.12),
+    y=st.floats(-0.03, 0.03),
+    z=st.floats(0.06, 0.16),
+)
+def test_allegro_anywhere_either_closes_truthfully_or_says_why(real_hands, x, y, z):
+    scene = real_hands.allegro(p_ball=(x, y, z))
+    q0 = scene.plant.GetPositions(scene.ctx).copy()
+    try:
+        closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    except PenetrationError:
+        assert min(all_pair_distances(scene).values()) < -TOL
+        return
+    except UnreachableError as e:
+        np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
+        assert all(f.status != "touching" for f in e.closure.fingers)
+        return
+    check_closed(scene, closure)
