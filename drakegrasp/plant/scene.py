@@ -76,15 +76,16 @@ naming the file, the key and what is valid (:mod:`drakegrasp.plant.scene_file`).
 
 Example: Drake's WSG-50 from ``drake_models``
 --------------------------------------------
-::
+Its tip spheres touch the box's faces at finger values of ±22.5 mm, with the
+box's centre between the tips::
 
     directives:
     - add_model:
         name: wsg
         file: package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf
         default_joint_positions:
-          left_finger_sliding_joint: [-0.025]
-          right_finger_sliding_joint: [0.025]
+          left_finger_sliding_joint: [-0.0225]
+          right_finger_sliding_joint: [0.0225]
     - add_weld:
         parent: world
         child: wsg::body
@@ -93,8 +94,9 @@ Example: Drake's WSG-50 from ``drake_models``
         file: package://drakegrasp/objects/box.sdf
         default_free_body_pose:
           box:
-            translation: [0.0, 0.108, 0.0]   # between the tips
+            translation: [0.0, 0.108, 0.0]
     drakegrasp:
+      description: Drake's WSG-50 squeezing a 50 x 50 x 100 mm box
       object_body: box::box
       hand: wsg
       mu: 0.5
