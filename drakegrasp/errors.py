@@ -34,8 +34,21 @@ class NoContactsError(GraspError):
     """The hand does not touch the object (or a grasp has no contacts)."""
 
 
-class PenetrationError(GraspError):
-    """A finger penetrates the object deeper than the distance tolerance."""
+class InvalidPoseError(GraspError):
+    """The plant's configuration is physically impossible for a grasp.
+
+    The common base of :class:`PenetrationError` and :class:`JointLimitError`;
+    ``analyze_grasp(..., check_pose=False)`` analyses such a pose anyway and
+    marks the report invalid.
+    """
+
+
+class PenetrationError(InvalidPoseError):
+    """A hand body penetrates the object deeper than the distance tolerance."""
+
+
+class JointLimitError(InvalidPoseError):
+    """A joint of the hand is outside its position limits."""
 
 
 class ModelError(GraspError):
@@ -67,3 +80,21 @@ class SolverError(GraspError):
         super().__init__(message)
         self.program = program
         self.result = result
+
+
+class InvalidContextError(GraspError, ValueError):
+    """A context that belongs neither to the plant nor to the diagram holding it."""
+
+
+class UnreachableError(GraspError):
+    """Closing the hand left too few fingers touching the object.
+
+    Attributes
+    ----------
+    closure : HandClosure or None
+        Where every finger stopped (the context is left unchanged).
+    """
+
+    def __init__(self, message: str, *, closure: Any = None):
+        super().__init__(message)
+        self.closure = closure

@@ -46,6 +46,9 @@ from drakegrasp.plant.jacobians import (
     hand_velocity_indices,
     signed_distance_jacobian,
 )
+from drakegrasp.plant.pose import PoseCheck
+from drakegrasp.plant.pose import check_pose as _check_pose
+from drakegrasp.plant.validation import hand_model_instances, plant_context_of
 from drakegrasp.results import AntipodalResult, ClosureResult, _jsonable
 
 __all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
@@ -80,6 +83,10 @@ class GraspFromPlant:
         Scoped names of the hand's bodies.
     plane : str or None
         Object-frame plane of a planar analysis (``"yz"``...), or None.
+    pose : PoseCheck or None
+        Penetrations and joint-limit violations of the hand's model instances
+        (``pose.valid`` is False only when the caller opted out of the refusal
+        with ``check_pose=False`` or ``allow_penetration=True``).
     """
 
     grasp: Grasp
@@ -91,6 +98,7 @@ class GraspFromPlant:
     object_body: str
     hand_bodies: tuple[str, ...]
     plane: str | None
+    pose: PoseCheck | None = None
 
     @property
     def G(self) -> np.ndarray:
@@ -109,6 +117,7 @@ class GraspFromPlant:
             "hand_velocity_indices": self.hand_velocity_indices.tolist(),
             "hand_jacobian": _jsonable(self.hand_jacobian),
             "dpsi_dv": _jsonable(self.dpsi_dv),
+            "pose": None if self.pose is None else self.pose.to_dict(),
         }
 
 
@@ -153,8 +162,8 @@ def _core_contact(
 def grasp_from_plant(
     plant: MultibodyPlant,
     plant_context: Context,
-    *,
     object_body,
+    *,
     hand: HandSpec = None,
     mu: float,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
@@ -164,6 +173,7 @@ def grasp_from_plant(
     characteristic_length: float | None = None,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    check_pose: bool = True,
     query_object: QueryObject | None = None,
     contacts: list[PlantContact] | None = None,
 ) -> GraspFromPlant:
@@ -174,11 +184,11 @@ def grasp_from_plant(
     plant : MultibodyPlant
         Finalized, registered with a ``SceneGraph``.
     plant_context : Context
-        The plant's context (validated).
+        The plant's context, or the root context of the diagram holding it.
     object_body : RigidBody, BodyIndex or str
         The grasped object; its body frame O is the grasp frame and its origin
-        the reference point.
-    hand : ModelInstanceIndex, iterable of RigidBody, or None, optional
+        the reference point.  Positional or keyword.
+    hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
         See :func:`drakegrasp.plant.hand_bodies`.
     mu : float
         Friction coefficient of every contact.
@@ -196,7 +206,14 @@ def grasp_from_plant(
     allow_penetration, patches, query_object
         Passed to :func:`drakegrasp.find_contacts` (``query_object``: read the
         geometry from this scene-graph query object instead of the plant's
-        query input port in ``plant_context``).
+        query input port in ``plant_context``).  ``allow_penetration=True``
+        also stops the pose check from refusing penetration (it is still
+        recorded in ``pose``).
+    check_pose : bool, optional
+        True (default): refuse an impossible pose, i.e. any body of the hand's
+        model instances (the welded palm too) penetrating the object, or a
+        joint of the hand outside its limits.  False: analyse it anyway; the
+        result's ``pose.valid`` is then False and the report says so.
     contacts : list of PlantContact, optional
         Analyse these contacts (frame O of ``object_body``) instead of finding
         them from signed distances: e.g. the patches of hydroelastic contact
@@ -208,9 +225,12 @@ def grasp_from_plant(
 
     Raises
     ------
-    NoContactsError, PenetrationError, ModelError, InvalidOptionError
+    PenetrationError, JointLimitError
+        Both :class:`~drakegrasp.InvalidPoseError`: the pose is impossible
+        (names the bodies and the depth, or the joint, its value and limits).
+    NoContactsError, ModelError, InvalidOptionError, InvalidContextError
     """
-    plant.ValidateContext(plant_context)
+    plant_context = plant_context_of(plant, plant_context)
     plane = _check_plane(plane)
     model = ContactModel.parse(contact_model)
     if plane is not None and model is ContactModel.SOFT_FINGER:
@@ -227,6 +247,16 @@ def grasp_from_plant(
         torsional_friction = 0.0
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
+    pose = _pose_of(
+        plant,
+        plant_context,
+        body,
+        bodies,
+        distance_tolerance=distance_tolerance,
+        refuse=check_pose,
+        allow_penetration=allow_penetration,
+        query_object=query_object,
+    )
     if contacts is None:
         contacts = find_contacts(
             plant,
@@ -234,7 +264,7 @@ def grasp_from_plant(
             object_body=body,
             hand=bodies,
             distance_tolerance=distance_tolerance,
-            allow_penetration=allow_penetration,
+            allow_penetration=allow_penetration or not check_pose,
             patches=patches,
             query_object=query_object,
         )
@@ -273,7 +303,42 @@ def grasp_from_plant(
         object_body=_scoped_name(plant, body),
         hand_bodies=tuple(_scoped_name(plant, b) for b in bodies),
         plane=plane,
+        pose=pose,
     )
+
+
+def _pose_of(
+    plant,
+    plant_context,
+    body,
+    bodies,
+    *,
+    distance_tolerance,
+    refuse,
+    allow_penetration,
+    query_object=None,
+) -> PoseCheck:
+    """Check the pose; raise unless the caller opted out."""
+    tol = float(distance_tolerance)
+    if not np.isfinite(tol) or tol <= 0:
+        raise InvalidOptionError(
+            "distance_tolerance must be finite and > 0 (metres), got "
+            f"{distance_tolerance!r}"
+        )
+    found = _check_pose(
+        plant,
+        plant_context,
+        body,
+        hand_model_instances(plant, bodies, body),
+        distance_tolerance=tol,
+        query_object=query_object,
+    )
+    if refuse:
+        if allow_penetration:
+            PoseCheck((), found.joint_limit_violations).raise_if_invalid()
+        else:
+            found.raise_if_invalid()
+    return PoseCheck(found.penetrations, found.joint_limit_violations, refuse)
 
 
 @dataclass(frozen=True, eq=False)
@@ -295,6 +360,9 @@ class GraspReport:
         Force closure on exact (second-order / planar) cones, with LP3.
     antipodal : AntipodalResult or None
         The antipodal test when there are exactly two contacts.
+    pose : PoseCheck or None
+        Whether the pose is possible (``pose.valid``); an invalid pose is only
+        analysed with ``check_pose=False`` (or ``allow_penetration=True``).
     """
 
     data: GraspFromPlant
@@ -303,6 +371,7 @@ class GraspReport:
     force_closure: ClosureResult
     force_closure_exact: ClosureResult
     antipodal: AntipodalResult | None
+    pose: PoseCheck | None = None
 
     @property
     def grasp(self) -> Grasp:
@@ -333,6 +402,7 @@ class GraspReport:
             "force_closure": self.force_closure.to_dict(),
             "force_closure_exact": self.force_closure_exact.to_dict(),
             "antipodal": None if self.antipodal is None else self.antipodal.to_dict(),
+            "pose": None if self.pose is None else self.pose.to_dict(),
         }
 
     def __str__(self) -> str:
@@ -347,6 +417,7 @@ class GraspReport:
             f"{c0.model.value}, {friction}",
             "  frame O = the object body frame; moments about its origin; "
             f"b = {g.characteristic_length * 1e3:.4g} mm",
+            *([] if self.pose is None else ["  " + self.pose.summary()]),
             f"  {'#':>2}  {'finger':<28} {'p_OC [mm]':<27} {'nhat_O':<25} psi [mm]",
         ]
         for i, pc in enumerate(self.contacts):
@@ -374,8 +445,8 @@ class GraspReport:
 def analyze_grasp(
     plant: MultibodyPlant,
     plant_context: Context,
-    *,
     object_body,
+    *,
     hand: HandSpec = None,
     mu: float,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
@@ -387,6 +458,7 @@ def analyze_grasp(
     tol: float = DEFAULT_TOL,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    check_pose: bool = True,
     query_object: QueryObject | None = None,
     contacts: list[PlantContact] | None = None,
 ) -> GraspReport:
@@ -396,8 +468,9 @@ def analyze_grasp(
     ----------
     plant, plant_context, object_body, hand, mu, contact_model,
     torsional_friction, distance_tolerance, plane, characteristic_length,
-    allow_penetration, patches, query_object, contacts
-        As in :func:`grasp_from_plant`.
+    allow_penetration, patches, check_pose, query_object, contacts
+        As in :func:`grasp_from_plant` (``plant_context`` may be the diagram's
+        root context; ``object_body`` may be positional).
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
     tol : float, optional
@@ -420,6 +493,7 @@ def analyze_grasp(
         characteristic_length=characteristic_length,
         allow_penetration=allow_penetration,
         patches=patches,
+        check_pose=check_pose,
         query_object=query_object,
         contacts=contacts,
     )
@@ -438,4 +512,5 @@ def analyze_grasp(
             force_closure_exact(grasp, tol=tol), lp3
         ),
         antipodal=antipodal,
+        pose=data.pose,
     )

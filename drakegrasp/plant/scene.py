@@ -116,7 +116,7 @@ from pydrake.multibody.parsing import (
     ProcessModelDirectives,
 )
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
-from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
+from pydrake.multibody.tree import ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.contact import ContactModel
@@ -124,6 +124,7 @@ from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.models import models_dir
 from drakegrasp.plant.scene_file import check_section, read_yaml
 from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
+from drakegrasp.plant.validation import resolve_body
 
 __all__ = [
     "DEFAULT_SCENE",
@@ -272,36 +273,6 @@ def read_scene_info(path: str | Path) -> SceneInfo:
     _, data = read_yaml(path)
     section = check_section(path, data)
     return SceneInfo(name=path.stem, path=path.resolve(), **section)
-
-
-def resolve_body(plant: MultibodyPlant, name: str) -> RigidBody:
-    """The body called ``"model::body"`` (or an unscoped name used once).
-
-    Raises
-    ------
-    ModelError
-        If no (or more than one) body has that name; the message lists the
-        plant's bodies.
-    """
-    try:
-        if "::" in name:
-            model, body = name.rsplit("::", 1)
-            if plant.HasModelInstanceNamed(model):
-                instance = plant.GetModelInstanceByName(model)
-                if plant.HasBodyNamed(body, instance):
-                    return plant.GetBodyByName(body, instance)
-        elif plant.HasBodyNamed(name):
-            return plant.GetBodyByName(name)
-    except RuntimeError as e:  # the name is used by several model instances
-        raise ModelError(f"body name {name!r} is ambiguous: {e}") from None
-    bodies = []
-    for i in range(plant.num_bodies()):
-        b = plant.get_body(BodyIndex(i))
-        if b.index() != plant.world_body().index():
-            bodies.append(
-                f"{plant.GetModelInstanceName(b.model_instance())}::{b.name()}"
-            )
-    raise ModelError(f"no body named {name!r} in the plant; bodies are {bodies}")
 
 
 def _resolve_hand(plant: MultibodyPlant, hand) -> ModelInstanceIndex | tuple | None:
