@@ -203,8 +203,10 @@ class GraspMonitor(LeafSystem):
         The finalized plant of the simulation (registered with a SceneGraph).
     object_body, hand, mu, contact_model, torsional_friction,
     distance_tolerance, plane, characteristic_length, num_generators, tol,
-    allow_penetration, patches
-        As in :func:`drakegrasp.analyze_grasp`.
+    allow_penetration, patches, check_pose
+        As in :func:`drakegrasp.analyze_grasp`.  A pose that the check refuses
+        (penetration deeper than ``distance_tolerance`` by any hand body, a
+        joint off its limits) gives an ``"invalid"`` sample, not an exception.
     contacts : {"geometry", "contact_results"}, optional
         Signed distances (default), or the plant's contact results (then the
         ``contact_results`` input port exists and must be connected).
@@ -250,6 +252,7 @@ class GraspMonitor(LeafSystem):
         tol: float = DEFAULT_TOL,
         allow_penetration: bool = False,
         patches: str = "vertices",
+        check_pose: bool = True,
         contacts: str = "geometry",
         period: float = 0.05,
         offset: float = 0.0,
@@ -293,6 +296,7 @@ class GraspMonitor(LeafSystem):
             "tol": tol,
             "allow_penetration": allow_penetration,
             "patches": patches,
+            "check_pose": bool(check_pose),
         }
         self._plant_context = plant.CreateDefaultContext()
         nx = plant.num_multibody_states()

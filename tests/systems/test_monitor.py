@@ -230,3 +230,38 @@ def test_bad_options_fail_at_construction(point_pick):
     geometric = GraspMonitor(plant, object_body=box, mu=0.5)
     with pytest.raises(InvalidOptionError, match="contact_results"):
         geometric.get_contact_results_input_port()
+
+
+def test_joint_off_its_limits_is_an_invalid_sample(point_pick):
+    context = point_pick.diagram.CreateDefaultContext()
+    plant = point_pick.plant
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    plant.GetJointByName("left_finger_joint", point_pick.gripper).set_translation(
+        plant_context,
+        0.05,  # upper limit 0.0425
+    )
+    monitor_context = point_pick.monitor.GetMyContextFromRoot(context)
+    sample = point_pick.monitor.evaluate(monitor_context)
+    assert sample.status == "invalid"
+    assert "left_finger_joint" in sample.message
+    # With check_pose=False the same pose is analysed, and marked invalid.
+    unchecked = GraspMonitor(
+        plant,
+        object_body="box::box",
+        hand=point_pick.gripper,
+        mu=0.5,
+        check_pose=False,
+    )
+    own = unchecked.CreateDefaultContext()
+    unchecked.get_plant_state_input_port().FixValue(
+        own, plant.GetPositionsAndVelocities(plant_context)
+    )
+    scene_graph = point_pick.scene_graph
+    query = scene_graph.get_query_output_port().Eval(
+        scene_graph.GetMyContextFromRoot(context)
+    )
+    unchecked.get_query_object_input_port().FixValue(own, query)
+    analysed = unchecked.evaluate(own)
+    assert analysed.status == "ok"
+    assert not analysed.report.pose.valid
+    assert "left_finger_joint" in str(analysed.report)
