@@ -38,6 +38,7 @@ EXPECTED = [
     "03_force_closure.ipynb",
     "04_hand_jacobian_lp3.ipynb",
     "05_antipodal_parallel_jaw.ipynb",
+    "07_grasp_in_simulation.ipynb",
 ]
 
 WARNINGS_AS_ERRORS = """\
