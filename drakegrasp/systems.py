@@ -162,6 +162,21 @@ class GraspSample:
         """Force closure (with LP3) in this sample."""
         return self.report is not None and self.report.is_force_closure
 
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (the report's own ``to_dict`` nested)."""
+        return {
+            "time": self.time,
+            "status": self.status,
+            "message": self.message,
+            "verdicts": dict(
+                zip(VERDICT_NAMES, (float(x) for x in self.verdicts), strict=True)
+            ),
+            "epsilon": self.epsilon,
+            "state": self.state.tolist(),
+            "seconds": self.seconds,
+            "report": None if self.report is None else self.report.to_dict(),
+        }
+
     def __str__(self) -> str:
         v = dict(zip(VERDICT_NAMES, self.verdicts, strict=True))
         if self.report is None:

@@ -12,6 +12,8 @@ before the update at t_k, so the verdict logged at t_{k+1} is the sample of
 the state logged at t_k.
 """
 
+import json
+
 import numpy as np
 import pytest
 from pick import DURATION, LIFT, build_pick
@@ -136,6 +138,7 @@ def test_report_port_holds_the_last_sample(point_pick):
     assert sample.time == pytest.approx(DURATION - period)
     assert sample.status == "no contact" and sample.report is None
     assert "does not touch" in sample.message
+    assert json.loads(json.dumps(sample.to_dict()))["status"] == "no contact"
     np.testing.assert_array_equal(
         sample.verdicts,
         point_pick.monitor.get_verdicts_output_port().Eval(monitor_context),
@@ -185,6 +188,10 @@ def test_hydroelastic_patches_match_the_geometry(hydro_pick):
     np.testing.assert_allclose(np.abs(p[:, 1]), 0.025, atol=1e-3)  # box faces
     assert np.all(np.abs(p[:, 0]) <= 0.0101)  # inside the 20 x 20 mm pads
     assert {c.normal_source for c in report.contacts} == {"hydroelastic"}
+    as_json = json.loads(json.dumps(sample.to_dict()))
+    assert as_json["verdicts"]["num_contacts"] == 8
+    assert len(as_json["report"]["contacts"]) == 8
+    assert "8 contacts, force closure YES" in str(sample)
     # Signed distances on the same state find the same two patches.
     geometric = _second_route(pick, sample.state, **OPTIONS)
     assert geometric[GraspMonitor.FORCE_CLOSURE] == 1.0
