@@ -201,6 +201,8 @@ def draw_grasp(
     result : ClosureResult or sequence of array_like, optional
         Contact forces to draw as arrows: a result with ``contact_forces``, or
         one array per contact in that contact's frame, normal first (newtons).
+        A "no" result's certificate is drawn too (the unresisted wrench or
+        the escape axis, see :mod:`drakegrasp.visualization.certificates`).
     prefix : str, optional
         Meshcat path holding the drawing; an existing drawing there is deleted
         first.
@@ -364,8 +366,21 @@ def draw_grasp(
                     rgba=_rgba(palette, "force"),
                 )
                 paths.append(f"{base}/force")
+    from drakegrasp.visualization.certificates import draw_result_certificate
+
+    certificate = draw_result_certificate(meshcat, grasp, result, prefix)  # why "no"
+    paths += certificate
     if on_top:
-        for path in [p for p in paths if not p.endswith("/force")] + leaves:
+        # Arrows are groups (shaft, head): their parts carry the materials.
+        arrows = {p for p in paths if p.endswith("/force")}
+        arrows |= {p for p in certificate if not p.endswith("/point")}
+        parts = [
+            f"{p}/{part}"
+            for p in certificate
+            if p in arrows
+            for part in ("shaft", "head")
+        ]
+        for path in [p for p in paths if p not in arrows] + leaves + parts:
             _draw_on_top(meshcat, path)
     if translucent:
         set_translucent(meshcat, translucent, translucent_opacity)
