@@ -91,6 +91,26 @@ def _arrow_segments(drawing, report, X_WO, camera, target):
     return segments
 
 
+def _hidden_then_on_top(meshcat, tmp_path, name, report, X_WO, camera, target, options):
+    """Draw plainly, then on top; the arrows on top are where the camera puts them.
+
+    Returns the force-coloured pixels of the plain drawing.
+    """
+    dg.draw_grasp(meshcat, report.grasp, **options)
+    _, plain = _force_pixels(meshcat, tmp_path, f"{name}_plain")
+    drawing = dg.draw_grasp(meshcat, report.grasp, on_top=True, **options)
+    _, on_top = _force_pixels(meshcat, tmp_path, f"{name}_on_top")
+    print(f"{name} force pixels: hidden {plain.sum()}, on top {on_top.sum()}")
+    assert on_top.sum() > 2 * plain.sum() + 50
+    segments = _arrow_segments(drawing, report, X_WO, camera, target)
+    ys, xs = np.nonzero(on_top)
+    pixels = np.column_stack([xs, ys]).astype(float)
+    near = np.array([distance_to_segment(pixels, a, b) < 8.0 for a, b in segments])
+    assert near.any(axis=0).mean() > 0.9
+    assert all(row.sum() >= 3 for row in near), "an arrow is not visible"
+    return plain
+
+
 def test_shipped_hand_on_top_and_translucent(meshcat, tmp_path):
     plant, scene_graph, hand, report, X_WO = _scene(
         meshcat,
@@ -105,20 +125,9 @@ def test_shipped_hand_on_top_and_translucent(meshcat, tmp_path):
 
     hand_only, _ = _force_pixels(meshcat, tmp_path, "hand")
     assert colour_mask(hand_only, FORCE).sum() == 0
-    dg.draw_grasp(meshcat, report.grasp, **options)
-    _, plain = _force_pixels(meshcat, tmp_path, "plain")
-    drawing = dg.draw_grasp(meshcat, report.grasp, on_top=True, **options)
-    _, on_top = _force_pixels(meshcat, tmp_path, "on_top")
-    print(f"force pixels: hidden {plain.sum()}, on top {on_top.sum()}")
-    assert on_top.sum() > 2 * plain.sum() + 60
-
-    # The arrows on top are where the camera model puts them.
-    segments = _arrow_segments(drawing, report, X_WO, camera, target)
-    ys, xs = np.nonzero(on_top)
-    pixels = np.column_stack([xs, ys]).astype(float)
-    near = np.array([distance_to_segment(pixels, a, b) < 8.0 for a, b in segments])
-    assert near.any(axis=0).mean() > 0.9
-    assert all(row.sum() >= 3 for row in near), "an arrow is not visible"
+    plain = _hidden_then_on_top(
+        meshcat, tmp_path, "parallel_jaw", report, X_WO, camera, target, options
+    )
 
     # A translucent hand shows the (not on-top) drawing through the fingers.
     paths = visualizer_paths(plant, scene_graph, hand)
@@ -147,14 +156,6 @@ def test_wsg50_meshes_do_not_hide_an_on_top_drawing(
     camera, target = np.array([0.0, 0.05, 0.07]), np.array([0.0, 0.108, 0.0])
     meshcat.SetCameraPose(camera, target)
     options = {"X_WG": X_WO, "result": report.force_closure, "cone": "exact"}
-    dg.draw_grasp(meshcat, report.grasp, **options)
-    _, plain = _force_pixels(meshcat, tmp_path, "wsg_plain")
-    drawing = dg.draw_grasp(meshcat, report.grasp, on_top=True, **options)
-    _, on_top = _force_pixels(meshcat, tmp_path, "wsg_on_top")
-    print(f"WSG-50 force pixels: hidden {plain.sum()}, on top {on_top.sum()}")
-    assert on_top.sum() > 2 * plain.sum() + 50
-    segments = _arrow_segments(drawing, report, X_WO, camera, target)
-    ys, xs = np.nonzero(on_top)
-    pixels = np.column_stack([xs, ys]).astype(float)
-    near = np.array([distance_to_segment(pixels, a, b) < 8.0 for a, b in segments])
-    assert near.any(axis=0).mean() > 0.9
+    _hidden_then_on_top(
+        meshcat, tmp_path, "wsg50", report, X_WO, camera, target, options
+    )
