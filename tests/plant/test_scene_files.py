@@ -240,3 +240,16 @@ def test_cli_package_option(user_package, monkeypatch, capsys):
         main(["analyze", str(scene), "--package", "mypkg"])
     assert info.value.code == 2
     assert "NAME=DIR" in capsys.readouterr().err
+
+
+def test_cli_allow_any_file(tmp_path, capsys):
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    shutil.copy(models_dir() / "objects" / "box.sdf", outside / "evil.sdf")
+    rel = os.path.relpath(outside / "evil.sdf", models_dir())
+    path = _write(tmp_path, _box_scene(f"package://drakegrasp/{rel}"))
+    assert main(["analyze", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "leaves the package 'drakegrasp'" in err and err.count("\n") == 1
+    assert main(["analyze", str(path), "--allow-any-file"]) == 0
+    assert "box::box" in capsys.readouterr().out
