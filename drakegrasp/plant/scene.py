@@ -61,7 +61,9 @@ list of directories holding a ``package.xml``, or a Drake ``PackageMap``),
 or ``ROS_PACKAGE_PATH``, crawled as Drake does.  Details:
 :mod:`drakegrasp.plant.scene_refs`.
 
-A scene may reference only files inside its packages and its own directory:
+A ``file:`` without a URL scheme is a path relative to the scene file
+(``file: models/my_object.sdf``).  A scene may reference only files inside its
+packages and its own directory:
 ``package://drakegrasp/../../outside/evil.sdf``, ``file:///etc/...`` or a
 path that climbs out of the scene's directory is a :class:`SceneError`
 unless ``allow_any_file=True`` says the scene is trusted.
@@ -306,6 +308,22 @@ def _without_drakegrasp_section(text: str) -> str:
     return "".join(out)
 
 
+def _anchor_relative_files(directives, path: Path) -> None:
+    """Turn ``file:`` paths without a URL scheme into ``file://`` URLs.
+
+    A relative path is relative to the scene file's directory (Drake, reading
+    the directives from a string, would refuse it).
+    """
+    for directive in directives.directives:
+        for kind in (directive.add_model, directive.add_directives):
+            if kind is None or "://" in kind.file:
+                continue
+            local = Path(kind.file)
+            if not local.is_absolute():
+                local = path.resolve().parent / local
+            kind.file = f"file://{local}"
+
+
 def load_scene(
     path_or_name: str | Path | None = None,
     *,
@@ -356,6 +374,7 @@ def load_scene(
     except Exception as e:  # Drake raises RuntimeError/ValueError on bad schema
         msg = " ".join(str(e).split())
         raise SceneError(f"scene {str(path)!r}: bad model directives: {msg}") from None
+    _anchor_relative_files(directives, path)
     try:
         ProcessModelDirectives(directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError
