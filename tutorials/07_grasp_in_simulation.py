@@ -40,6 +40,9 @@ from pydrake.geometry import (
     AddContactMaterial,
     AddRigidHydroelasticProperties,
     Box,
+    Meshcat,
+    MeshcatParams,
+    MeshcatVisualizer,
     ProximityProperties,
     SceneGraphConfig,
 )
@@ -94,7 +97,7 @@ SCHEDULE = [  # (time s, finger joint m, lift m)
 ]
 
 
-def build_pick(*, flat=False, plant_contact="point", **monitor_options):
+def build_pick(*, flat=False, plant_contact="point", meshcat=None, **monitor_options):
     """Gripper, box, ground, PD schedule and a GraspMonitor, ready to simulate."""
     builder = DiagramBuilder()
     plant_config = MultibodyPlantConfig(
@@ -175,6 +178,8 @@ def build_pick(*, flat=False, plant_contact="point", **monitor_options):
         ),
         "state": LogVectorOutput(plant.get_state_output_port(), builder, PERIOD),
     }
+    if meshcat is not None:
+        MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat)
     diagram = builder.Build()
     simulator = Simulator(diagram)
     plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
@@ -203,7 +208,10 @@ def build_pick(*, flat=False, plant_contact="point", **monitor_options):
 
 # %%
 SOFT = dict(mu=0.5, contact_model="soft_finger", torsional_friction=0.1)
-pick = build_pick(distance_tolerance=1e-3, **SOFT)
+params = MeshcatParams()
+params.show_stats_plot = False
+meshcat = Meshcat(params)  # open meshcat.web_url() in a browser to watch
+pick = build_pick(distance_tolerance=1e-3, meshcat=meshcat, **SOFT)
 
 # Time every evaluation of the monitor (it stores its own wall time per sample).
 costs = []
@@ -314,6 +322,22 @@ report = dg.analyze_grasp(
 )
 print(report)
 assert np.isclose(report.force_closure.d_star, V[GraspMonitor.D_STAR, k + 1], rtol=1e-9)
+
+# %% [markdown]
+# ## The grasp in the air, drawn on the hand
+#
+# Drawn where the hand is, the contacts, cones and forces would sit inside the
+# finger pads; `on_top=True` draws them over the robot that `MeshcatVisualizer`
+# shows.  The pose is the logged one at 1.6 s.
+
+# %%
+pick["diagram"].ForcedPublish(fresh)  # the robot and the box at t = 1.6 s
+X_WO = plant.EvalBodyPoseInWorld(fresh_plant, plant.GetBodyByName("box", box))
+drawing = dg.draw_grasp(
+    meshcat, report.grasp, X_WG=X_WO, result=report.force_closure, on_top=True
+)
+meshcat.SetCameraPose([0.1, -0.1, 0.2], X_WO.translation())
+print(f"open {meshcat.web_url()}: {len(drawing.paths)} objects drawn on top")
 
 # %% [markdown]
 # The full report of the latest sample is on the monitor's abstract output port,
