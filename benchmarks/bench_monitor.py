@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_monitor.py [--period 0.05]
 
-Runs the pick of ``tests/systems/pick.py`` (the shipped parallel-jaw gripper
+Runs the pick of ``tests/systems/pick_support.py`` (the shipped parallel-jaw gripper
 closes on a 0.2 kg box, lifts it 5 cm, lowers it, opens; 3 s simulated, 1 ms
 SAP steps) in three set-ups: point contact with distances from geometry (soft
 fingers), hydroelastic contact with patches from the contact results (flat
@@ -30,7 +30,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "systems"))
-from pick import DURATION, build_pick  # noqa: E402
+from pick_support import DURATION, build_pick  # noqa: E402
 
 from drakegrasp.systems import GraspMonitor  # noqa: E402
 

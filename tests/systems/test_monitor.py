@@ -1,6 +1,6 @@
 """GraspMonitor in a running simulation, checked against a second route.
 
-The pick of ``pick.py`` (the shipped parallel-jaw gripper closes on a free box
+The pick of ``pick_support.py`` (the shipped parallel-jaw gripper closes on a free box
 under gravity, lifts it 5 cm, lowers it and opens) runs in a ``Simulator``.
 The monitor's logged verdicts must go "no contact" -> "force closure" ->
 "no contact", and every sample must equal what ``analyze_grasp`` says on the
@@ -16,7 +16,7 @@ import json
 
 import numpy as np
 import pytest
-from pick import DURATION, LIFT, build_pick
+from pick_support import DURATION, LIFT, build_pick
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 
