@@ -39,6 +39,7 @@ EXPECTED = [
     "04_hand_jacobian_lp3.ipynb",
     "05_antipodal_parallel_jaw.ipynb",
     "06_real_hand.ipynb",
+    "07_grasp_in_simulation.ipynb",
 ]
 NEEDS_DRAKE_MODELS = {"06_real_hand.ipynb"}  # Drake's real hands and YCB objects
 
