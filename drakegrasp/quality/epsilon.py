@@ -22,6 +22,7 @@ from drakegrasp.quality._common import (
     _scaled_grasp_matrix,
     _torque_scale,
 )
+from drakegrasp.validation import check_num_generators
 
 if TYPE_CHECKING:
     from scipy.spatial import ConvexHull
@@ -74,6 +75,7 @@ def primitive_wrenches(
     .. math:: w_{i,k} = S\, G_i\, s_k, \qquad S = \operatorname{diag}(I, I / b_s)
     """
     _check_grasp(grasp)
+    num_generators = check_num_generators(num_generators)
     b = _torque_scale(grasp, torque_scale)
     if not grasp.planar and all(
         c.effective_components() == (0, 1, 2) for c in grasp.contacts
@@ -104,11 +106,7 @@ def _hard_finger_wrenches(
     μ sin(2πk/n_g)]`` in the contact frame); a test checks that they equal
     :func:`~drakegrasp.friction_cone_generators`.
     """
-    n_g = int(num_generators)
-    if n_g != num_generators or n_g < 3:
-        raise InvalidOptionError(
-            f"num_generators must be an integer >= 3, got {num_generators!r}"
-        )
+    n_g = check_num_generators(num_generators)
     R = np.array([c.frame for c in grasp.contacts])  # (N, 3, 3) columns n, t1, t2
     mu = np.array([c.mu for c in grasp.contacts])
     r = np.array([c.position for c in grasp.contacts]) - grasp.reference_point
@@ -533,7 +531,7 @@ def ferrari_canny(
     need more than ``LINF_MAX_CANDIDATES`` (six hard fingers do) raise
     :class:`~drakegrasp.InvalidOptionError`.
     """
-    if norm not in _NORMS:
+    if not isinstance(norm, str) or norm not in _NORMS:
         raise InvalidOptionError(f"norm must be one of {_NORMS}, got {norm!r}")
     wrenches = primitive_wrenches(
         grasp, num_generators=num_generators, torque_scale=torque_scale

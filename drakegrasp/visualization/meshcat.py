@@ -220,11 +220,12 @@ def draw_grasp(
         For an unknown ``cone``, ``side`` or colour key, a non-positive size, or
         forces that do not match the grasp's contacts.
     """
+    _check_meshcat(meshcat)
     if not isinstance(grasp, Grasp):
         raise InvalidOptionError(
             f"draw_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
-    if cone not in _CONE_CHOICES:
+    if not isinstance(cone, (str, type(None))) or cone not in _CONE_CHOICES:
         raise InvalidOptionError(
             f"cone must be 'exact', 'pyramid', 'both' or None, got {cone!r}"
         )
@@ -376,6 +377,14 @@ def _draw_cone(
 
 def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
     """Delete a drawing made by :func:`draw_grasp` (everything under ``prefix``)."""
+    _check_meshcat(meshcat)
     if not isinstance(prefix, str) or not prefix.strip("/"):
         raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
     meshcat.Delete(prefix)
+
+
+def _check_meshcat(meshcat) -> None:
+    if not isinstance(meshcat, Meshcat):
+        raise InvalidOptionError(
+            f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
+        )
