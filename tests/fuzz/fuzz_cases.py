@@ -703,7 +703,7 @@ def geometry_cases(seed: int = 0, count: int = 120) -> Iterator[Case]:
         if k % 4 == 0:
             Pb, Nb = P[None], n[None]
             yield Case(
-                "geometry",
+                "geometry batch",
                 f"batch#{k}",
                 lambda Pb=Pb, Nb=Nb, r=ref * unit, mu=mu: dg.batch_force_closure(
                     Pb, Nb, mu, reference_points=r
