@@ -3,7 +3,7 @@
 Contacts, contact frames and grasp matrices; form closure, force closure and
 antipodal grasps decided with Drake's ``MathematicalProgram``; grasps read from a
 ``MultibodyPlant``; quality metrics; pictures; a batch engine for many grasps.
-Conventions: ``shared/CONVENTIONS.md``.
+Conventions: ``docs/conventions.md``.
 
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
@@ -34,6 +34,7 @@ from drakegrasp.closure import (
     matrix_rank,
 )
 from drakegrasp.contact import Contact, ContactModel, contact_frame, contact_frames
+from drakegrasp.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import (
     BatchFileError,
     GraspError,
@@ -97,6 +98,7 @@ from drakegrasp.quality import (
     wrench_ellipsoid_volume,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
 from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
 from drakegrasp.visualization import (
     clear_grasp,
@@ -108,22 +110,23 @@ from drakegrasp.visualization import (
 __version__ = "0.1.0"
 
 __all__ = [
-    "DEFAULT_TOL",
     "AntipodalResult",
     "BatchClosureResult",
     "BatchFileError",
     "ClosureResult",
     "Contact",
+    "ContactCurvature",
     "ContactModel",
-    "Grasp",
+    "DEFAULT_TOL",
     "FingerClosure",
+    "Grasp",
     "GraspError",
     "GraspFromPlant",
     "GraspMonitor",
     "GraspQuality",
     "GraspReport",
-    "HandClosure",
     "GraspSample",
+    "HandClosure",
     "InternalForceResult",
     "InvalidContactError",
     "InvalidContextError",
@@ -139,7 +142,9 @@ __all__ = [
     "ProgramVariables",
     "Scene",
     "SceneError",
+    "SecondOrderResult",
     "SolverError",
+    "SurfaceCurvature",
     "UnreachableError",
     "add_grasp_monitor",
     "analyze_grasp",
@@ -187,8 +192,9 @@ __all__ = [
     "plot_wrench_space",
     "primitive_wrenches",
     "register_models",
-    "use_local_drake_models",
+    "second_order_form_closure",
     "signed_distance_jacobian",
     "uniformity_of_transformation",
+    "use_local_drake_models",
     "wrench_ellipsoid_volume",
 ]

@@ -6,7 +6,7 @@ Generators are inscribed in the exact Coulomb cone:
 ``[1, 0, 0, …]``; they have unit length except a soft finger's, whose rows are
 the hard-finger rows applied to the normal force left after torsion (see
 :func:`soft_finger_facets`: so a soft finger never scores below a hard one).
-See ``shared/CONVENTIONS.md``.
+See ``docs/conventions.md``.
 """
 
 from __future__ import annotations

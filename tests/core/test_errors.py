@@ -20,7 +20,11 @@ from drakegrasp import examples as ex
             {"mu": -0.1},
             r"mu must be finite and 0 or in \[1e-12, 1e\+12\].*got -0\.1",
         ),
-        (([0, 0, 1], [0, 0, -1]), {"mu": "high"}, "mu must be a real number, got 'high'"),
+        (
+            ([0, 0, 1], [0, 0, -1]),
+            {"mu": "high"},
+            "mu must be a real number, got 'high'",
+        ),
         (
             ([0, 0, 1], [0, 0, -1]),
             {"model": "sticky"},
@@ -69,7 +73,10 @@ def test_invalid_options():
     grasp = ex.equator_fingers(0.5)
     with pytest.raises(dg.InvalidOptionError, match="num_generators .* got 2"):
         dg.force_closure(grasp, num_generators=2)
-    with pytest.raises(dg.InvalidOptionError, match=r"tol must be finite and > 0, a real number in \[1e-10, 0.5\]"):
+    with pytest.raises(
+        dg.InvalidOptionError,
+        match=r"tol must be finite and > 0, a real number in \[1e-10, 0.5\]",
+    ):
         dg.form_closure(grasp, tol=0)
     with pytest.raises(dg.InvalidOptionError, match="formulation .* 'vertices'"):
         dg.force_closure(grasp, formulation="vertices")

@@ -17,9 +17,7 @@ def equator_grasp(mu=0.5, *, radius=1.0, model="hard_finger", **kwargs):
     return dg.Grasp(contacts)
 
 
-def random_grasp(
-    rng, num, dim=3, *, mu=0.5, spread=0.5, model="hard_finger", nu=None
-):
+def random_grasp(rng, num, dim=3, *, mu=0.5, spread=0.5, model="hard_finger", nu=None):
     """Contacts on the unit sphere/circle, normals tilted from the inward radial.
 
     A soft finger without ``nu`` gets ``nu = 0`` (it acts as a hard finger).
