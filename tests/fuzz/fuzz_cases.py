@@ -240,6 +240,25 @@ def contact_cases() -> Iterator[Case]:
             lambda m=m, kw=kw: dg.Contact([0, 0, 1], [0, 0, -1], model=m, **kw),
             expect,
         )
+    # A perpendicular normal of length 1e200 is not antipodal (its squared norm
+    # overflowed, the normal became 0 and the pair passed).
+    a = dg.Contact([0, 0, 0], [1, 0, 0], mu=0.1)
+    for i, n in enumerate(([0, 1e200, 0], [0, 1e-300, 0], [1e300, 1e300, 0])):
+        b = dg.Contact([1, 0, 0], n, mu=0.1)
+        yield Case(
+            "Contact",
+            f"antipodal-huge#{i}",
+            lambda b=b: dg.is_antipodal([a, b]),
+            "answer",
+            lambda r: not r.is_antipodal,
+        )
+    yield Case(
+        "Contact",
+        "antipodal-huge-opposed",
+        lambda: dg.is_antipodal([a, dg.Contact([1, 0, 0], [-1e300, 0, 0], mu=0.1)]),
+        "answer",
+        lambda r: r.is_antipodal,
+    )
     yield Case(
         "Contact",
         "soft-without-nu",
@@ -1013,8 +1032,50 @@ def _cli(cli, *argv):
     raise dg.InvalidOptionError(lines[0])
 
 
+WALK_VALUES = (object(), 1j, None, "x", np.full(3, np.nan))
+
+
+def api_walk_cases(names=None) -> Iterator[Case]:
+    """Every callable of ``drakegrasp.__all__`` with wrong-typed required arguments.
+
+    Each required parameter (positional or keyword-only) gets the same wrong
+    value; functions without required parameters (``list_scenes``) are left
+    out, as are exceptions and result dataclasses (plain records).
+    """
+    import dataclasses
+    import inspect
+
+    for name in sorted(dg.__all__ if names is None else names):
+        obj = getattr(dg, name)
+        if inspect.ismodule(obj) or not callable(obj) or name == "ContactModel":
+            continue
+        if isinstance(obj, type) and (
+            issubclass(obj, BaseException)
+            or (dataclasses.is_dataclass(obj) and name not in ("Contact", "Grasp"))
+        ):
+            continue
+        params = inspect.signature(obj).parameters.values()
+        required = [
+            p
+            for p in params
+            if p.default is p.empty and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+        ]
+        if not required:
+            continue
+        for i, wrong in enumerate(WALK_VALUES):
+            args = [wrong for p in required if p.kind != p.KEYWORD_ONLY]
+            kwargs = {p.name: wrong for p in required if p.kind == p.KEYWORD_ONLY}
+            yield Case(
+                "api walk",
+                f"{name}#{i}",
+                lambda obj=obj, a=args, k=kwargs: obj(*a, **k),
+                "refuse",
+            )
+
+
 def all_cases(root: Path | None = None) -> Iterator[Case]:
     """Every family, in a fixed order."""
+    yield from api_walk_cases()
     yield from contact_cases()
     yield from grasp_cases()
     yield from wrong_type_cases()

@@ -282,3 +282,24 @@ def test_soft_finger_d_star_with_small_torsion_is_at_least_hard():
             soft = hard.with_friction(model="soft_finger", torsional_friction=nu)
             assert dg.force_closure(soft).d_star >= d_hard - 1e-8
             assert math.isfinite(dg.force_closure_exact(soft).d_star)
+
+
+@pytest.mark.parametrize("mu", [1e-12, 1e-6, 1e-3, 0.3, 1.0, 10.0, 1e3, 1e6, 1e12])
+def test_batch_agrees_with_the_single_path_across_the_mu_range(mu):
+    # Issue 9: mu >= 1e78 gave 0/60 closed with converged=True in batch; now mu
+    # is refused outside [1e-12, 1e12] and agrees with the single path inside.
+    rng = np.random.default_rng(int(mu * 1e3) % 2**32)
+    K, N = 25, 4
+    p = rng.normal(size=(K, N, 3))
+    p /= np.linalg.norm(p, axis=2, keepdims=True)
+    n = -p + 0.4 * rng.normal(size=(K, N, 3))
+    batch = dg.batch_force_closure(p, n, mu)
+    single = [
+        dg.force_closure(
+            dg.Grasp([dg.Contact(p[k, i], n[k, i], mu=mu) for i in range(N)])
+        )
+        for k in range(K)
+    ]
+    assert batch.converged.all()
+    np.testing.assert_array_equal(batch.is_closure, [r.is_closure for r in single])
+    np.testing.assert_allclose(batch.d_star, [r.d_star for r in single], atol=1e-6)
