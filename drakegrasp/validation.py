@@ -131,7 +131,8 @@ def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
     ----------
     name : str
         Name of the input, for the message.
-    value : int, float, numpy real scalar or 0-d real array
+    value : int or float
+        Also a numpy real scalar or a 0-d real array.
     error : type, optional
         The :class:`~drakegrasp.GraspError` subclass to raise.
 
