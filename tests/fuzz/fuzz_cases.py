@@ -507,6 +507,28 @@ def option_cases() -> Iterator[Case]:
                     lambda fn=fn, o=option, v=value: fn(g, **{o: v}),
                     "refuse",
                 )
+    hostile = ["abc", None, [1j, 0, 0, 0, 0, 0], [NAN] * 6, np.zeros(6), [1, 0, 0], {}]
+    for i, d in enumerate(hostile):
+        yield Case(
+            "options",
+            f"max_resistible_wrench(direction#{i})",
+            lambda d=d: dg.max_resistible_wrench(g, d, max_normal_force=1.0),
+            "refuse",
+        )
+    for i, f in enumerate(["abc", None, 1j, -1.0, NAN, [1.0, 2.0], INF]):
+        yield Case(
+            "options",
+            f"max_resistible_wrench(max_normal_force#{i})",
+            lambda f=f: dg.max_resistible_wrench(g, np.eye(6)[0], max_normal_force=f),
+            "refuse",
+        )
+    for i, flag in enumerate(["yes", 1, [True]]):
+        yield Case(
+            "options",
+            f"grasp_quality(linf#{i})",
+            lambda f=flag: dg.grasp_quality(g, linf=f),
+            "refuse",
+        )
     # Valid extremes are answered (and agree with the default where they should).
     ref = dg.force_closure(g)
     # Equator fingers: LP2's d* = 0.4194 and LP1's d* = 1 (three unit normal
