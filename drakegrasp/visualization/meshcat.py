@@ -227,6 +227,7 @@ def draw_grasp(
         raise InvalidOptionError(
             f"draw_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
+    _check_rgba_colors(colors)
     if not isinstance(cone, (str, type(None))) or cone not in _CONE_CHOICES:
         raise InvalidOptionError(
             f"cone must be 'exact', 'pyramid', 'both' or None, got {cone!r}"
@@ -393,3 +394,29 @@ def _check_meshcat(meshcat) -> None:
         raise InvalidOptionError(
             f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
         )
+
+
+def _check_rgba_colors(colors) -> None:
+    """Refuse colours that are not Rgba or 3/4 numbers in [0, 1]."""
+    if colors is None:
+        return
+    if not isinstance(colors, Mapping):
+        raise InvalidOptionError(
+            f"colors must be a mapping of names to RGB(A) colours, got {colors!r}"
+        )
+    for key, value in colors.items():
+        if isinstance(value, Rgba):
+            continue
+        try:
+            v = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            v = None
+        if (
+            v is None
+            or v.shape not in ((3,), (4,))
+            or not np.all((v >= 0.0) & (v <= 1.0))
+        ):
+            raise InvalidOptionError(
+                f"colour {key!r} must be an Rgba or 3 or 4 numbers in [0, 1], got "
+                f"{value!r}"
+            )

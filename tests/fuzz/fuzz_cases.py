@@ -1095,6 +1095,81 @@ def api_walk_cases(names=None) -> Iterator[Case]:
             )
 
 
+def picture_cases() -> Iterator[Case]:
+    """Pictures with bad colours, sizes and outlines (matplotlib and Meshcat)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from drakegrasp import examples
+
+    g = examples.planar_square_four_contacts()
+    bad = [
+        {"colors": {"contact": "notacolor"}},
+        {"colors": {"contact": (2.0, 0, 0)}},
+        {"colors": {"bogus": "red"}},
+        {"colors": "red"},
+        {"force_scale": NAN},
+        {"force_scale": -1.0},
+        {"cone_length": INF},
+        {"outline": "abc"},
+        {"side": None},
+        {"result": "abc"},
+    ]
+    for i, kw in enumerate(bad):
+        yield Case(
+            "pictures",
+            f"plot_planar_grasp#{i}",
+            lambda kw=kw: dg.plot_planar_grasp(g, **kw),
+            "refuse",
+        )
+    for i, kw in enumerate(
+        [{"tol": NAN}, {"tol": "abc"}, {"num_generators": 10**9}, {"tol": 2.0}]
+    ):
+        yield Case(
+            "pictures",
+            f"plot_wrench_space#{i}",
+            lambda kw=kw: dg.plot_wrench_space(g, **kw),
+            "refuse",
+        )
+    from pydrake.geometry import Meshcat
+
+    meshcat = _meshcat(Meshcat)
+    if meshcat is None:
+        return
+    g3 = _valid_grasp()
+    for i, kw in enumerate(
+        [
+            {"colors": {"point": "notacolor"}},
+            {"colors": {"point": (2.0, 0, 0)}},
+            {"colors": {"point": (1, 0)}},
+            {"colors": "red"},
+            {"cone": "wide"},
+            {"cone_height": NAN},
+            {"prefix": ""},
+            {"side": 3},
+        ]
+    ):
+        yield Case(
+            "pictures",
+            f"draw_grasp#{i}",
+            lambda kw=kw: dg.draw_grasp(meshcat, g3, **kw),
+            "refuse",
+        )
+
+
+_MESHCAT = []
+
+
+def _meshcat(cls):
+    """One Meshcat for all cases (each opens a server); None if none can open."""
+    if not _MESHCAT:
+        try:
+            _MESHCAT.append(cls())
+        except RuntimeError:
+            _MESHCAT.append(None)
+    return _MESHCAT[0]
+
+
 def all_cases(root: Path | None = None) -> Iterator[Case]:
     """Every family, in a fixed order."""
     yield from api_walk_cases()
@@ -1105,6 +1180,7 @@ def all_cases(root: Path | None = None) -> Iterator[Case]:
     yield from batch_cases()
     yield from geometry_cases()
     yield from monotonicity_cases()
+    yield from picture_cases()
     if root is None:
         root = Path(tempfile.mkdtemp(prefix="drakegrasp-fuzz-"))
     yield from file_cases(root)

@@ -20,6 +20,7 @@ FAMILIES = {
     "options": fuzz_cases.option_cases,
     "batch": fuzz_cases.batch_cases,
     "monotone": fuzz_cases.monotonicity_cases,
+    "pictures": fuzz_cases.picture_cases,
 }
 
 
