@@ -529,6 +529,28 @@ def option_cases() -> Iterator[Case]:
             lambda f=flag: dg.grasp_quality(g, linf=f),
             "refuse",
         )
+    # Unbounded work is refused up front: L∞ with 40 contacts (4^40 face
+    # choices), any ε of 300 contacts (a 2,400-point hull in 6-D).
+    rng = np.random.default_rng(2)
+    for num in (40, 300):
+        P = rng.normal(size=(num, 3))
+        P /= np.linalg.norm(P, axis=1, keepdims=True)
+        big = dg.Grasp(
+            [dg.Contact(p, -p + 0.2 * rng.normal(size=3), mu=0.5) for p in P]
+        )
+        yield Case(
+            "options",
+            f"ferrari_canny_linf(N={num})",
+            lambda g=big: dg.ferrari_canny(g, norm="Linf"),
+            "refuse",
+        )
+        if num == 300:
+            yield Case(
+                "options",
+                f"ferrari_canny(N={num})",
+                lambda g=big: dg.ferrari_canny(g),
+                "refuse",
+            )
     # Valid extremes are answered (and agree with the default where they should).
     ref = dg.force_closure(g)
     # Equator fingers: LP2's d* = 0.4194 and LP1's d* = 1 (three unit normal
