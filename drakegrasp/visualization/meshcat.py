@@ -266,11 +266,13 @@ def draw_grasp(
         For an unknown ``cone``, ``side`` or colour key, a non-positive size, or
         forces that do not match the grasp's contacts.
     """
+    _check_meshcat(meshcat)
     if not isinstance(grasp, Grasp):
         raise InvalidOptionError(
             f"draw_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
-    if cone not in _CONE_CHOICES:
+    _check_rgba_colors(colors)
+    if not isinstance(cone, (str, type(None))) or cone not in _CONE_CHOICES:
         raise InvalidOptionError(
             f"cone must be 'exact', 'pyramid', 'both' or None, got {cone!r}"
         )
@@ -441,6 +443,40 @@ def _draw_cone(
 
 def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
     """Delete a drawing made by :func:`draw_grasp` (everything under ``prefix``)."""
+    _check_meshcat(meshcat)
     if not isinstance(prefix, str) or not prefix.strip("/"):
         raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
     meshcat.Delete(prefix)
+
+
+def _check_meshcat(meshcat) -> None:
+    if not isinstance(meshcat, Meshcat):
+        raise InvalidOptionError(
+            f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
+        )
+
+
+def _check_rgba_colors(colors) -> None:
+    """Refuse colours that are not Rgba or 3/4 numbers in [0, 1]."""
+    if colors is None:
+        return
+    if not isinstance(colors, Mapping):
+        raise InvalidOptionError(
+            f"colors must be a mapping of names to RGB(A) colours, got {colors!r}"
+        )
+    for key, value in colors.items():
+        if isinstance(value, Rgba):
+            continue
+        try:
+            v = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            v = None
+        if (
+            v is None
+            or v.shape not in ((3,), (4,))
+            or not np.all((v >= 0.0) & (v <= 1.0))
+        ):
+            raise InvalidOptionError(
+                f"colour {key!r} must be an Rgba or 3 or 4 numbers in [0, 1], got "
+                f"{value!r}"
+            )
