@@ -441,7 +441,11 @@ class GraspReport:
             f"J: {self.J.shape[0]} x {self.J.shape[1]} (hand velocities "
             f"{self.data.hand_velocity_indices.tolist()})"
         )
-        lines.append("  (points below are in frame O, metres)")
+        if g.planar and self.data.plane is not None:
+            axes = ", ".join("xyz"[i] for i in PLANES[self.data.plane])
+            lines.append(f"  (points below are ({axes}) of frame O, metres)")
+        else:
+            lines.append("  (points below are in frame O, metres)")
         for result in (self.form_closure, self.force_closure, self.force_closure_exact):
             lines += ["  " + x for x in result.report_lines(internal_forces=False)]
             if result.certificate is not None:

@@ -40,6 +40,7 @@ EXPECTED = [
     "05_antipodal_parallel_jaw.ipynb",
     "06_real_hand.ipynb",
     "07_grasp_in_simulation.ipynb",
+    "08_why_not.ipynb",
 ]
 NEEDS_DRAKE_MODELS = {"06_real_hand.ipynb"}  # Drake's real hands and YCB objects
 
