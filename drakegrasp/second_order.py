@@ -509,21 +509,36 @@ def _find_escape(grasp, var: SecondOrderVariables, H, lam, dual, tol):
 
 
 def _escape_acceleration(Gt, closed, H, T, nu, b):
-    """LP: ``max s`` s.t. ``G̃_iᵀ ã + b νᵀ H̃_i ν >= s`` on the closed contacts."""
+    """LP: ``max s - ε |ã|₁`` s.t. ``G̃_iᵀ ã + b νᵀ H̃_i ν >= s`` on closed contacts.
+
+    The small ``ε`` picks the least acceleration among the near-optimal ones
+    (an LP vertex at the box's corner would make third-order terms large).
+    Returns ``ã`` and ``min_i (G̃_iᵀ ã + b νᵀ H̃_i ν)``.
+    """
     idx = np.flatnonzero(closed)
     h = np.array([b * nu @ T.T @ H[i] @ T @ nu for i in idx])
+    n = Gt.shape[0]
     prog = MathematicalProgram()
-    a = prog.NewContinuousVariables(Gt.shape[0], "a")
+    a = prog.NewContinuousVariables(n, "a")
+    z = prog.NewContinuousVariables(n, "abs_a")
     s = prog.NewContinuousVariables(1, "s")[0]
     prog.AddBoundingBoxConstraint(-_ESCAPE_BOX, _ESCAPE_BOX, a)
     prog.AddBoundingBoxConstraint(-np.inf, 1.0, s)
+    eye = np.eye(n)
+    prog.AddLinearConstraint(
+        np.block([[eye, eye], [-eye, eye]]),
+        np.zeros(2 * n),
+        np.full(2 * n, np.inf),
+        np.append(a, z),
+    )
     A = np.hstack([Gt[:, idx].T, -np.ones((len(idx), 1))])
     prog.AddLinearConstraint(A, -h, np.full(len(idx), np.inf), np.append(a, s))
-    prog.AddLinearCost(-s)
+    prog.AddLinearCost(np.append(np.full(n, 1e-3), -1.0), 0.0, np.append(z, s))
     result = _solve(prog, (ClpSolver(), ClarabelSolver()))
     if result.get_solution_result() != SolutionResult.kSolutionFound:
         return None
-    return np.asarray(result.GetSolution(a)), float(result.GetSolution(s))
+    acc = np.asarray(result.GetSolution(a))
+    return acc, float(np.min(Gt[:, idx].T @ acc + h)) if len(idx) else 1.0
 
 
 def _no_equilibrium(grasp: Grasp, tol: float) -> SecondOrderResult:
