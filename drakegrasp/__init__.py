@@ -8,7 +8,8 @@ Conventions: ``shared/CONVENTIONS.md``.
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
 programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
-(``plant``), and the outside ring (``visualization``, ``batch``, ``cli``).
+(``plant``), and the outside ring (``visualization``, ``batch``, ``systems``,
+``cli``).
 """
 
 from drakegrasp import examples
@@ -37,24 +38,37 @@ from drakegrasp.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import (
     GraspError,
     InvalidContactError,
+    InvalidContextError,
     InvalidGraspError,
     InvalidOptionError,
+    InvalidPoseError,
+    JointLimitError,
     ModelError,
     NoContactsError,
     PenetrationError,
+    SceneError,
     SolverError,
+    UnreachableError,
 )
 from drakegrasp.friction_cone import (
     friction_cone_facets,
     friction_cone_generators,
 )
-from drakegrasp.grasp import Grasp, grasp_matrix, normal_grasp_matrix
+from drakegrasp.grasp import (
+    Grasp,
+    grasp_matrix,
+    normal_grasp_matrix,
+    normalised_grasp_matrix,
+)
 from drakegrasp.plant import (
+    FingerClosure,
     GraspFromPlant,
     GraspReport,
+    HandClosure,
     PlantContact,
     Scene,
     analyze_grasp,
+    close_hand,
     find_contacts,
     grasp_from_plant,
     hand_jacobian,
@@ -84,6 +98,7 @@ from drakegrasp.quality import (
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
 from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
+from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
 from drakegrasp.visualization import (
     clear_grasp,
     draw_grasp,
@@ -102,14 +117,21 @@ __all__ = [
     "ContactCurvature",
     "ContactModel",
     "Grasp",
+    "FingerClosure",
     "GraspError",
     "GraspFromPlant",
+    "GraspMonitor",
     "GraspQuality",
     "GraspReport",
+    "HandClosure",
+    "GraspSample",
     "InternalForceResult",
     "InvalidContactError",
+    "InvalidContextError",
     "InvalidGraspError",
     "InvalidOptionError",
+    "InvalidPoseError",
+    "JointLimitError",
     "MaxWrenchResult",
     "ModelError",
     "NoContactsError",
@@ -117,9 +139,12 @@ __all__ = [
     "PlantContact",
     "ProgramVariables",
     "Scene",
+    "SceneError",
     "SecondOrderResult",
     "SolverError",
     "SurfaceCurvature",
+    "UnreachableError",
+    "add_grasp_monitor",
     "analyze_grasp",
     "batch_force_closure",
     "batch_form_closure",
@@ -129,6 +154,7 @@ __all__ = [
     "build_internal_force_program",
     "build_max_resistible_wrench_program",
     "clear_grasp",
+    "close_hand",
     "contact_frame",
     "contact_frames",
     "distance_to_singularity",
@@ -159,6 +185,7 @@ __all__ = [
     "max_resistible_wrench",
     "min_singular_value",
     "normal_grasp_matrix",
+    "normalised_grasp_matrix",
     "plot_planar_grasp",
     "plot_wrench_space",
     "primitive_wrenches",

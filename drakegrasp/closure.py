@@ -48,8 +48,7 @@ from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.grasp import (
     Grasp,
     check_hand_jacobian,
-    grasp_matrix,
-    normal_grasp_matrix,
+    normalised_grasp_matrix,
 )
 from drakegrasp.results import ClosureResult, InternalForceResult, _relative_margin
 
@@ -193,15 +192,20 @@ def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
 def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
     """``A x = 0``, imposed on the numerical row space of ``A`` (see below).
 
-    The rows added are ``V_rᵀ``: the right singular vectors of ``A`` whose
-    singular values exceed ``rank_tol σ_max``.  They span ``A``'s row space when
-    ``A`` has full rank (the same constraint, orthonormal rows), and otherwise
+    ``A`` is a normalised balance matrix (:func:`_balance_matrix`), whose columns
+    are first scaled to unit length (``A_s = A D``).  The rows added are an
+    orthonormal basis of ``V_rᵀ D⁻¹``, with ``V_r`` the right singular vectors of
+    ``A_s`` whose singular values exceed ``rank_tol σ_max``.  They span ``A``'s
+    row space when ``A`` has full rank (the same constraint), and otherwise
     leave ``x`` free in exactly the numerical null space that the reported rank
     counts.  Imposing a nearly rank-deficient ``A x = 0`` literally (contacts
     measured to 1e-8 m) made Clp declare an always-feasible LP infeasible.
     """
-    rows = _row_space(A, rank_tol)
+    A_s, scale = _equilibrated(A)
+    # A x = A_s (D⁻¹ x) with D = diag(scale): impose V_rᵀ D⁻¹ x = 0.
+    rows = _row_space(A_s, rank_tol) / scale
     if rows.shape[0]:
+        rows = np.linalg.qr(rows.T)[0].T
         prog.AddLinearEqualityConstraint(rows, np.zeros(rows.shape[0]), x)
 
 
@@ -232,7 +236,7 @@ def build_form_closure_program(
     """
     N = grasp.num_contacts
     prog, f, d = _margin_program(N, N)
-    _add_balance(prog, normal_grasp_matrix(grasp), f, rank_tol)
+    _add_balance(prog, _normal_balance_matrix(grasp), f, rank_tol)
     _add_margin_rows(prog, np.eye(N), f, d)
     _add_normal_budget(prog, f, N)
     return prog, ProgramVariables(d, f, np.arange(N))
@@ -273,13 +277,13 @@ def build_force_closure_program(
     N = grasp.num_contacts
     if formulation == "facets":
         prog, f, d = _margin_program(len(layout.columns), N)
-        _add_balance(prog, layout.G, f, rank_tol)
+        _add_balance(prog, _balance_matrix(grasp, layout.columns), f, rank_tol)
         _add_margin_rows(prog, layout.facet_matrix(), f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
         return prog, ProgramVariables(d, f, layout.columns)
     S = layout.generator_matrix()
     prog, lam, d = _margin_program(S.shape[1], N)
-    _add_balance(prog, layout.G @ S, lam, rank_tol)
+    _add_balance(prog, _balance_matrix(grasp, layout.columns) @ S, lam, rank_tol)
     _add_margin_rows(prog, np.eye(S.shape[1]), lam, d)
     # Every generator has unit normal component, so Σ f_n = Σ λ.
     _add_normal_budget(prog, lam, N)
@@ -317,7 +321,7 @@ def build_exact_force_closure_program(
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
-    _add_balance(prog, layout.G, f, rank_tol)
+    _add_balance(prog, _balance_matrix(grasp, layout.columns), f, rank_tol)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     b = grasp.characteristic_length
     starts = list(layout.normal_positions) + [len(layout.columns)]
@@ -381,10 +385,67 @@ def build_internal_force_program(
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
-    _add_balance(prog, np.vstack([layout.G, J[layout.columns].T]), f, rank_tol)
+    A = np.vstack(
+        [_balance_matrix(grasp, layout.columns), _unit_columns(J[layout.columns]).T]
+    )
+    _add_balance(prog, A, f, rank_tol)
     _add_margin_rows(prog, np.eye(len(f))[layout.normal_positions], f, d)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     return prog, ProgramVariables(d, f, layout.columns)
+
+
+def _balance_matrix(grasp: Grasp, columns: np.ndarray) -> np.ndarray:
+    """Columns ``columns`` of the normalised ``G`` (same null space as ``G``).
+
+    Every rank, row space and null space below is computed on
+    :func:`~drakegrasp.grasp.normalised_grasp_matrix`, so no verdict depends on
+    units, on the reference point or on where the grasp sits in its frame.
+    """
+    return normalised_grasp_matrix(grasp)[:, columns]
+
+
+def _normal_balance_matrix(grasp: Grasp) -> np.ndarray:
+    """The normalised ``G_n``: one column per contact normal."""
+    return _balance_matrix(grasp, grasp.normal_indices())
+
+
+def _equilibrated(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``A diag(scale)`` with unit columns, and ``scale`` (zero columns kept).
+
+    Scaling columns changes neither the rank nor, pulled back, the null space,
+    but it makes a relative singular-value threshold blind to the units of each
+    variable: a soft finger's torsional moment (N·m) beside forces (N), or a
+    generator with a large torsion component.
+    """
+    norms = np.linalg.norm(A, axis=0)
+    scale = np.ones_like(norms)
+    np.divide(1.0, norms, out=scale, where=norms > 0.0)
+    return A * scale, scale
+
+
+def _balance_rank(A: np.ndarray, rank_tol: float) -> int:
+    """Numerical rank of a balance matrix, on equilibrated columns."""
+    return matrix_rank(_equilibrated(A)[0], rank_tol=rank_tol)
+
+
+def _unit_columns(J: np.ndarray) -> np.ndarray:
+    """``J`` with its columns scaled to unit length, numerically zero ones dropped.
+
+    ``N(Jᵀ)`` is unchanged (each row of ``Jᵀ`` is only rescaled), but a joint
+    measured in other units, or a Jacobian scaled by 1e9, no longer decides which
+    singular values of ``[G; Jᵀ]`` count as zero.  A column below
+    :data:`_ZERO_COLUMN` times the largest (a joint that moves no contact, up to
+    round-off) is dropped rather than blown up to a spurious constraint.
+    """
+    norms = np.linalg.norm(J, axis=0)
+    if norms.size == 0 or not norms.max() > 0.0:
+        return J[:, :0]
+    keep = norms > _ZERO_COLUMN * norms.max()
+    return J[:, keep] / norms[keep]
+
+
+_ZERO_COLUMN = 1e-12
+"""Relative norm below which a column of ``J`` counts as zero in LP3."""
 
 
 def _row_space(A: np.ndarray, rank_tol: float) -> np.ndarray:
@@ -466,7 +527,7 @@ def form_closure(
     """
     tol = _check_tol(tol)
     required = grasp.wrench_dim
-    rank = matrix_rank(normal_grasp_matrix(grasp), rank_tol=rank_tol)
+    rank = _balance_rank(_normal_balance_matrix(grasp), rank_tol)
     prog, variables = build_form_closure_program(grasp, rank_tol=rank_tol)
     d_star, forces, solver, status = _solve_margin(prog, variables, conic=False)
     if forces is None:
@@ -545,8 +606,7 @@ def _force_closure_result(
     rank_tol: float,
 ) -> ClosureResult:
     required = grasp.wrench_dim
-    G = grasp_matrix(grasp)[:, variables.columns]
-    rank = matrix_rank(G, rank_tol=rank_tol)
+    rank = _balance_rank(_balance_matrix(grasp, variables.columns), rank_tol)
     d_star, forces, solver, status = _solve_margin(prog, variables, conic=conic)
     contact_forces = _split_forces(grasp, variables.columns, forces)
     margin = _relative_margin(d_star, tol)
@@ -620,7 +680,7 @@ def _normal_force_certificate(
     normals = grasp.normal_indices()
     if len(columns) == len(normals):  # every contact is frictionless already
         return None
-    if matrix_rank(normal_grasp_matrix(grasp), rank_tol=rank_tol) == len(normals):
+    if _balance_rank(_normal_balance_matrix(grasp), rank_tol) == len(normals):
         return None  # N(G_n) = {0}: no non-zero normal forces balance
     prog, variables = build_form_closure_program(grasp, rank_tol=rank_tol)
     d_star, f_n, _, _ = _solve_margin(prog, variables, conic=False)

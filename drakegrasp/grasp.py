@@ -26,6 +26,7 @@ __all__ = [
     "check_hand_jacobian",
     "grasp_matrix",
     "normal_grasp_matrix",
+    "normalised_grasp_matrix",
     "wrench_columns",
 ]
 
@@ -182,6 +183,19 @@ class Grasp:
         G.flags.writeable = False
         return G
 
+    @functools.cached_property
+    def _normalised_grasp_matrix(self) -> np.ndarray:
+        """``T G`` with moments about the centroid over the spread; read-only."""
+        positions = self.positions
+        centroid = positions.mean(axis=0)
+        spread = float(np.max(np.linalg.norm(positions - centroid, axis=1)))
+        if not (np.isfinite(spread) and spread > 0.0):
+            spread = 1.0  # every contact at one point: all moments vanish anyway
+        G = np.hstack([_contact_block(c, centroid) for c in self.contacts])
+        G[self.dim :] /= spread
+        G.flags.writeable = False
+        return G
+
     def to_dict(self) -> dict:
         """JSON-ready dictionary of the grasp."""
         return {
@@ -282,6 +296,40 @@ def normal_grasp_matrix(grasp: Grasp) -> np.ndarray:
         push at contact ``i``.
     """
     return grasp._grasp_matrix[:, grasp.normal_indices()]
+
+
+def normalised_grasp_matrix(grasp: Grasp) -> np.ndarray:
+    r"""``G`` made invariant to units and to the reference point, for rank tests.
+
+    Parameters
+    ----------
+    grasp : Grasp
+
+    Returns
+    -------
+    G_bar : (6, M) or (3, M) float
+        The columns of :func:`grasp_matrix`, in the same order, with moments
+        taken about the contacts' centroid :math:`\bar c` and divided by their
+        spread :math:`L = \max_i \lVert c_i - \bar c \rVert` (``L = 1`` when
+        every contact is at one point).
+
+    Notes
+    -----
+    .. math::
+
+        \bar G = T G, \qquad
+        T = \begin{bmatrix} I & 0 \\ 0 & I / L \end{bmatrix}
+            \begin{bmatrix} I & 0 \\ S(p - \bar c) & I \end{bmatrix}
+
+    ``T`` is invertible, so ``Ḡ`` has the null space, the rank and the row
+    space of ``G``: every program's ``G f = 0`` and every rank verdict can use
+    it.  Unlike ``G``, it does not change when the reference point moves, when
+    the whole grasp moves rigidly, or when lengths change units (mm, m, km), so
+    a relative singular-value threshold means the same thing for every grasp:
+    moments about a point ``10⁶ b`` away, or in nanometres, no longer swamp or
+    vanish beside the forces.
+    """
+    return grasp._normalised_grasp_matrix.copy()
 
 
 def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:

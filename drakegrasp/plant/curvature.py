@@ -46,6 +46,7 @@ from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import flat_faces, surface_pieces
 from drakegrasp.plant.contacts import PlantContact, resolve_object_body
 from drakegrasp.plant.jacobians import PLANES
+from drakegrasp.plant.validation import plant_context_of
 
 __all__ = ["SECOND_ORDER_RANK_TOL", "contact_curvatures", "shape_curvature"]
 
@@ -222,7 +223,8 @@ def contact_curvatures(
     plant : MultibodyPlant
         Finalized, with a ``SceneGraph``.
     plant_context : Context
-        The configuration in which ``contacts`` were found.
+        The configuration in which ``contacts`` were found (the plant's
+        context or its diagram's root context).
     contacts : sequence of PlantContact
         From :func:`~drakegrasp.find_contacts` (or ``grasp_from_plant``).
     object_body : RigidBody, BodyIndex or str
@@ -240,7 +242,7 @@ def contact_curvatures(
     ModelError
         For a shape without a curvature model.
     """
-    plant.ValidateContext(plant_context)
+    plant_context = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
     query = plant.get_geometry_query_input_port().Eval(plant_context)
     inspector = query.inspector()
