@@ -246,7 +246,7 @@ class SecondOrderResult:
     multipliers : (N,) float
         ``λ*`` (``Σ λ = 1``; zero outside ``support``).
     dim_w : int
-        ``dim W`` (0 for first-order closure).
+        ``dim W`` (0 for first-order closure, -1 when not decided).
     support : tuple of int
         Contacts that carry force in some equilibrium.
     escape_twist : (3,) or (6,) float or None
@@ -503,6 +503,8 @@ def _find_escape(grasp, var: SecondOrderVariables, H, lam, dual, tol):
             found = _escape_acceleration(Gt, np.abs(g) <= 1e-9, H, T, nu, b)
             if found is not None and (best is None or found[1] > best[2]):
                 best = (T @ nu, T @ found[0], found[1])
+            if best is not None and best[2] >= -tol:
+                return best  # an escape that holds: no need to try the others
     if best is None or best[2] < -tol:
         return None
     return best

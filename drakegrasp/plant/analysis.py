@@ -525,19 +525,20 @@ def analyze_grasp(
         pose=data.pose,
         second_order=None
         if first_order.is_closure
-        else _second_order(plant, plant_context, data, first_order),
+        else _second_order(plant, plant_context, data, first_order, query_object),
     )
 
 
-def _second_order(plant, plant_context, data, first_order) -> SecondOrderResult:
+def _second_order(plant, context, data, first_order, query) -> SecondOrderResult:
     """Second-order form closure with the shapes' curvatures (or why not)."""
     try:
         curvatures = contact_curvatures(
             plant,
-            plant_context,
+            context,
             data.contacts,
             object_body=data.object_body,
             plane=data.plane,
+            query_object=query,
         )
         return second_order_form_closure(
             data.grasp,

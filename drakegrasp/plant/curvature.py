@@ -35,6 +35,7 @@ from pydrake.geometry import (
     Ellipsoid,
     HalfSpace,
     Mesh,
+    QueryObject,
     Shape,
     Sphere,
 )
@@ -215,6 +216,7 @@ def contact_curvatures(
     *,
     object_body,
     plane: str | None = None,
+    query_object: QueryObject | None = None,
 ) -> tuple[ContactCurvature, ...]:
     """Curvatures of object and finger at each contact, in the object frame O.
 
@@ -231,6 +233,9 @@ def contact_curvatures(
         The object; O is its body frame.
     plane : {"xy", "yz", "zx"}, optional
         For a planar analysis: one curvature per surface, in that plane.
+    query_object : pydrake.geometry.QueryObject, optional
+        Geometry poses to use instead of evaluating the plant's query port
+        (as in :func:`~drakegrasp.find_contacts`).
 
     Returns
     -------
@@ -244,7 +249,9 @@ def contact_curvatures(
     """
     plant_context = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
-    query = plant.get_geometry_query_input_port().Eval(plant_context)
+    if query_object is None:
+        query_object = plant.get_geometry_query_input_port().Eval(plant_context)
+    query = query_object
     inspector = query.inspector()
     X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
     out = []
