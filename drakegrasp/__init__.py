@@ -3,7 +3,7 @@
 Contacts, contact frames and grasp matrices; form closure, force closure and
 antipodal grasps decided with Drake's ``MathematicalProgram``; grasps read from a
 ``MultibodyPlant``; quality metrics; pictures; a batch engine for many grasps.
-Conventions: ``shared/CONVENTIONS.md``.
+Conventions: ``docs/conventions.md``.
 
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
@@ -109,22 +109,22 @@ from drakegrasp.visualization import (
 __version__ = "0.1.0"
 
 __all__ = [
-    "DEFAULT_TOL",
     "AntipodalResult",
     "BatchClosureResult",
     "ClosureResult",
     "Contact",
     "ContactCurvature",
     "ContactModel",
-    "Grasp",
+    "DEFAULT_TOL",
     "FingerClosure",
+    "Grasp",
     "GraspError",
     "GraspFromPlant",
     "GraspMonitor",
     "GraspQuality",
     "GraspReport",
-    "HandClosure",
     "GraspSample",
+    "HandClosure",
     "InternalForceResult",
     "InvalidContactError",
     "InvalidContextError",
@@ -191,8 +191,8 @@ __all__ = [
     "primitive_wrenches",
     "register_models",
     "second_order_form_closure",
-    "use_local_drake_models",
     "signed_distance_jacobian",
     "uniformity_of_transformation",
+    "use_local_drake_models",
     "wrench_ellipsoid_volume",
 ]

@@ -1,5 +1,7 @@
 """The ``drakegrasp`` command.
 
+Usage::
+
     drakegrasp analyze [SCENE] [--mu M] [--contact-model MODEL]
                        [--torsional-friction NU] [--package NAME=DIR ...]
                        [--allow-any-file] [--json]

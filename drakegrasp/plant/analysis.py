@@ -475,11 +475,15 @@ def analyze_grasp(
 
     Parameters
     ----------
-    plant, plant_context, object_body, hand, mu, contact_model,
-    torsional_friction, distance_tolerance, plane, characteristic_length,
-    allow_penetration, patches, check_pose, query_object, contacts
+    plant, plant_context, object_body, hand, mu
         As in :func:`grasp_from_plant` (``plant_context`` may be the diagram's
         root context; ``object_body`` may be positional).
+    contact_model, torsional_friction, distance_tolerance, plane
+        As in :func:`grasp_from_plant`.
+    characteristic_length, allow_penetration, patches
+        As in :func:`grasp_from_plant`.
+    check_pose, query_object, contacts
+        As in :func:`grasp_from_plant`.
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
     tol : float, optional
@@ -529,16 +533,18 @@ def analyze_grasp(
     )
 
 
-def _second_order(plant, context, data, first_order, query) -> SecondOrderResult:
+def _second_order(
+    plant, plant_context, data, first_order, query_object
+) -> SecondOrderResult:
     """Second-order form closure with the shapes' curvatures (or why not)."""
     try:
         curvatures = contact_curvatures(
             plant,
-            context,
+            plant_context,
             data.contacts,
             object_body=data.object_body,
             plane=data.plane,
-            query_object=query,
+            query_object=query_object,
         )
         return second_order_form_closure(
             data.grasp,

@@ -225,8 +225,7 @@ def contact_curvatures(
     plant : MultibodyPlant
         Finalized, with a ``SceneGraph``.
     plant_context : Context
-        The configuration in which ``contacts`` were found (the plant's
-        context or its diagram's root context).
+        The configuration in which ``contacts`` were found.
     contacts : sequence of PlantContact
         From :func:`~drakegrasp.find_contacts` (or ``grasp_from_plant``).
     object_body : RigidBody, BodyIndex or str
@@ -234,8 +233,8 @@ def contact_curvatures(
     plane : {"xy", "yz", "zx"}, optional
         For a planar analysis: one curvature per surface, in that plane.
     query_object : pydrake.geometry.QueryObject, optional
-        Geometry poses to use instead of evaluating the plant's query port
-        (as in :func:`~drakegrasp.find_contacts`).
+        Read geometry poses from this query object instead of the plant's query
+        input port (a System's private plant context).
 
     Returns
     -------
@@ -249,9 +248,9 @@ def contact_curvatures(
     """
     plant_context = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
-    if query_object is None:
-        query_object = plant.get_geometry_query_input_port().Eval(plant_context)
     query = query_object
+    if query is None:
+        query = plant.get_geometry_query_input_port().Eval(plant_context)
     inspector = query.inspector()
     X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
     out = []
