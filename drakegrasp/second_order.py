@@ -173,6 +173,7 @@ def build_second_order_program(
     *,
     support: Sequence[int] | None = None,
     rank_tol: float = DEFAULT_RANK_TOL,
+    hessians: np.ndarray | None = None,
 ) -> tuple[MathematicalProgram, SecondOrderVariables]:
     """Build the SDP of second-order form closure.
 
@@ -186,6 +187,9 @@ def build_second_order_program(
         :func:`equilibrium_support` (which solves one LP).
     rank_tol : float, optional
         Relative singular-value threshold for ``W`` and ``G_n λ = 0``.
+    hessians : (N, 3 or 6, 3 or 6) float, optional
+        :func:`~drakegrasp.curvature.contact_hessians` of ``grasp`` and
+        ``curvatures``, when already computed.
 
     Returns
     -------
@@ -199,7 +203,7 @@ def build_second_order_program(
     InvalidGraspError
         When the support is empty (no equilibrium) or ``W = {0}``.
     """
-    H = contact_hessians(grasp, curvatures)
+    H = contact_hessians(grasp, curvatures) if hessians is None else hessians
     if support is None:
         support = equilibrium_support(grasp, rank_tol=rank_tol)
     S = np.array(sorted(set(int(i) for i in support)), dtype=int)
@@ -399,7 +403,7 @@ def second_order_form_closure(
     if not support:
         return _no_equilibrium(grasp, tol)
     prog, var = build_second_order_program(
-        grasp, curvatures, support=support, rank_tol=rank_tol
+        grasp, curvatures, support=support, rank_tol=rank_tol, hessians=H
     )
     result = _solve(prog, (ClarabelSolver(), ScsSolver()))
     status = result.get_solution_result()
