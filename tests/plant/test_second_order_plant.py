@@ -200,3 +200,16 @@ def test_report_line_and_json(scene_cache):
     d = json.loads(json.dumps(report.to_dict()))
     assert d["second_order"]["is_closure"] is False
     assert d["second_order"]["escape_verified"] is True
+
+
+def test_flat_on_flat_witness_contact_is_reported_undecided(scene_cache):
+    """With patches="witness" a pad on a face is one flat-on-flat point, which
+    has no second-order model: the report says so instead of failing."""
+    scene = scene_cache("parallel_jaw_flat_box")
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    options = {**scene.analysis_options(), "patches": "witness"}
+    report = analyze_grasp(scene.plant, ctx, **options)
+    so = report.second_order
+    assert not so.is_closure and so.order is None and so.dim_w == -1
+    assert "not decided" in so.reason and "not positive" in so.reason
+    assert "not decided" in str(report)
