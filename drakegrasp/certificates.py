@@ -70,9 +70,13 @@ __all__ = [
 ]
 
 ESCAPE_TWIST = "escape twist"
+"""Kind of the witness of a form-closure "no"."""
 UNRESISTED_WRENCH = "unresisted wrench"
+"""Kind of the witness of a force-closure "no"."""
 UNCONTROLLABLE = "uncontrollable internal force"
+"""Kind of the witness of an LP3 failure."""
 BALANCE = "balancing internal force"
+"""Kind of the witness of a "yes"."""
 _KINDS = (ESCAPE_TWIST, UNRESISTED_WRENCH, UNCONTROLLABLE, BALANCE)
 _CONES = ("normals", "polyhedral", "exact")
 
@@ -122,7 +126,7 @@ class CertificateCheck:
         verdict = "holds" if self.holds else "FAILS"
         return (
             f"witness {verdict}: violation {self.violation:.2g}, "
-            f"slack {self.slack:.3g} (tol {self.tol:g}); {self.detail}"
+            f"slack {self.slack + 0.0:.3g} (tol {self.tol:g}); {self.detail}"
         )
 
 

@@ -48,6 +48,7 @@ from __future__ import annotations
 import math
 import numbers
 import operator
+import sys
 
 import numpy as np
 
@@ -381,9 +382,10 @@ def check_length(name: str, value, *, error: type = InvalidGraspError) -> float:
 
 def check_grasp(value, name: str = "grasp"):
     """``value`` if it is a :class:`~drakegrasp.Grasp`, else InvalidGraspError."""
-    from drakegrasp.grasp import Grasp  # grasp imports this module
-
-    if not isinstance(value, Grasp):
+    # No import of drakegrasp.grasp (it imports this module: a cycle): a Grasp
+    # can only exist once that module is loaded, so look it up there.
+    grasp_module = sys.modules.get("drakegrasp.grasp")
+    if grasp_module is None or not isinstance(value, grasp_module.Grasp):
         raise InvalidGraspError(
             f"{name} must be a drakegrasp.Grasp, got {_describe(value)} "
             f"({type(value).__name__})"
