@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from batch_support import random_grasps
 
-import drakegrasp.batch.engine as engine
+import drakegrasp.batch.chunks as chunks
 from drakegrasp.batch import batch_force_closure, batch_form_closure, iter_batch_closure
 from drakegrasp.errors import (
     GraspError,
@@ -144,13 +144,13 @@ def test_driver_reads_and_builds_one_chunk_at_a_time(monkeypatch):
     P, Nrm = random_grasps(rng, K, 3, 3)
     mu = rng.uniform(0.2, 0.8, (K, 3))
     sizes = []
-    real = engine.solve_margin_lp
+    real = chunks.solve_margin_blocks
 
     def spy(G, *args, **kwargs):
         sizes.append(G.shape[0])
         return real(G, *args, **kwargs)
 
-    monkeypatch.setattr(engine, "solve_margin_lp", spy)
+    monkeypatch.setattr(chunks, "solve_margin_blocks", spy)
     arrays = [_RecordingArray(a) for a in (P, Nrm, mu)]
     res = batch_force_closure(*arrays, chunk_size=cs)
     assert max(sizes) <= cs and sum(sizes) == K
