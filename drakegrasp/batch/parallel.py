@@ -62,7 +62,7 @@ def map_ordered(tasks: Iterable[Task], workers: int) -> Iterator:
         Picklable top-level functions and their arguments; consumed lazily.
     workers : int
         1 runs every task here; more starts that many worker processes
-        (``forkserver`` where available, else ``spawn``).
+        (``fork`` where available, else ``spawn``).
 
     Yields
     ------
@@ -73,10 +73,11 @@ def map_ordered(tasks: Iterable[Task], workers: int) -> Iterator:
         for fn, args, kwargs in tasks:
             yield fn(*args, **kwargs)
         return
+    # fork where the OS has it: workers start in milliseconds with the parent's
+    # modules loaded, and scripts need no ``if __name__ == "__main__"`` guard
+    # (forkserver and spawn re-run the main module in every worker).
     methods = multiprocessing.get_all_start_methods()
-    ctx = multiprocessing.get_context(
-        "forkserver" if "forkserver" in methods else "spawn"
-    )
+    ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
         pending: deque = deque()
         try:
