@@ -3,12 +3,13 @@
 Contacts, contact frames and grasp matrices; form closure, force closure and
 antipodal grasps decided with Drake's ``MathematicalProgram``; grasps read from a
 ``MultibodyPlant``; quality metrics; pictures; a batch engine for many grasps.
-Conventions: ``shared/CONVENTIONS.md``.
+Conventions: ``docs/conventions.md``.
 
 Layers, inner to outer (an import never points outwards): the numpy core
 (``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
 programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
-(``plant``), and the outside ring (``visualization``, ``batch``, ``cli``).
+(``plant``), and the outside ring (``visualization``, ``batch``, ``systems``,
+``cli``).
 """
 
 from drakegrasp import examples
@@ -33,15 +34,21 @@ from drakegrasp.closure import (
     matrix_rank,
 )
 from drakegrasp.contact import Contact, ContactModel, contact_frame, contact_frames
+from drakegrasp.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import (
     GraspError,
     InvalidContactError,
+    InvalidContextError,
     InvalidGraspError,
     InvalidOptionError,
+    InvalidPoseError,
+    JointLimitError,
     ModelError,
     NoContactsError,
     PenetrationError,
+    SceneError,
     SolverError,
+    UnreachableError,
 )
 from drakegrasp.friction_cone import (
     friction_cone_facets,
@@ -54,11 +61,14 @@ from drakegrasp.grasp import (
     normalised_grasp_matrix,
 )
 from drakegrasp.plant import (
+    FingerClosure,
     GraspFromPlant,
     GraspReport,
+    HandClosure,
     PlantContact,
     Scene,
     analyze_grasp,
+    close_hand,
     find_contacts,
     grasp_from_plant,
     hand_jacobian,
@@ -87,6 +97,8 @@ from drakegrasp.quality import (
     wrench_ellipsoid_volume,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
+from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
 from drakegrasp.visualization import (
     clear_grasp,
     draw_grasp,
@@ -97,21 +109,29 @@ from drakegrasp.visualization import (
 __version__ = "0.1.0"
 
 __all__ = [
-    "DEFAULT_TOL",
     "AntipodalResult",
     "BatchClosureResult",
     "ClosureResult",
     "Contact",
+    "ContactCurvature",
     "ContactModel",
+    "DEFAULT_TOL",
+    "FingerClosure",
     "Grasp",
     "GraspError",
     "GraspFromPlant",
+    "GraspMonitor",
     "GraspQuality",
     "GraspReport",
+    "GraspSample",
+    "HandClosure",
     "InternalForceResult",
     "InvalidContactError",
+    "InvalidContextError",
     "InvalidGraspError",
     "InvalidOptionError",
+    "InvalidPoseError",
+    "JointLimitError",
     "MaxWrenchResult",
     "ModelError",
     "NoContactsError",
@@ -119,7 +139,12 @@ __all__ = [
     "PlantContact",
     "ProgramVariables",
     "Scene",
+    "SceneError",
+    "SecondOrderResult",
     "SolverError",
+    "SurfaceCurvature",
+    "UnreachableError",
+    "add_grasp_monitor",
     "analyze_grasp",
     "batch_force_closure",
     "batch_form_closure",
@@ -129,6 +154,7 @@ __all__ = [
     "build_internal_force_program",
     "build_max_resistible_wrench_program",
     "clear_grasp",
+    "close_hand",
     "contact_frame",
     "contact_frames",
     "distance_to_singularity",
@@ -164,8 +190,9 @@ __all__ = [
     "plot_wrench_space",
     "primitive_wrenches",
     "register_models",
-    "use_local_drake_models",
+    "second_order_form_closure",
     "signed_distance_jacobian",
     "uniformity_of_transformation",
+    "use_local_drake_models",
     "wrench_ellipsoid_volume",
 ]

@@ -75,6 +75,18 @@ def is_antipodal(
     AntipodalResult
         Verdict, the two angles (rad), the margins ``atan μ_i - angle_i`` (rad)
         and the smallest ``μ`` that makes the pair antipodal.
+
+    Examples
+    --------
+    Two fingers squeezing along a line tilted by 10° from both normals:
+
+    >>> import numpy as np
+    >>> import drakegrasp as dg
+    >>> t = np.tan(np.radians(10.0))
+    >>> pair = [dg.Contact([-1, -t, 0], [1, 0, 0]), dg.Contact([1, t, 0], [-1, 0, 0])]
+    >>> result = dg.is_antipodal(pair, mu=0.2)
+    >>> bool(result.is_antipodal), round(float(result.min_mu), 4)
+    (True, 0.1763)
     """
     c1, c2 = _two_contacts(grasp_or_contacts)
     if mu is None:

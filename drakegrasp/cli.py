@@ -1,7 +1,10 @@
 """The ``drakegrasp`` command.
 
+Usage::
+
     drakegrasp analyze [SCENE] [--mu M] [--contact-model MODEL]
-                       [--torsional-friction NU] [--json]
+                       [--torsional-friction NU] [--package NAME=DIR ...]
+                       [--allow-any-file] [--json]
     drakegrasp scenes
     drakegrasp batch IN.npz OUT.npz [--kind force|form] [--mu M] [--model MODEL]
                      [--num-generators NG] [--metrics NAME ...] [--progress]
@@ -35,7 +38,11 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     from drakegrasp.plant.analysis import analyze_grasp
     from drakegrasp.plant.scene import load_scene
 
-    scene = load_scene(args.scene)
+    scene = load_scene(
+        args.scene,
+        package_map=dict(args.package) or None,
+        allow_any_file=args.allow_any_file,
+    )
     options = scene.analysis_options()
     if args.mu is not None:
         options["mu"] = args.mu
@@ -121,6 +128,15 @@ def _positive_float(text: str) -> float:
     return x
 
 
+def _package(text: str) -> tuple[str, str]:
+    name, sep, folder = text.partition("=")
+    if not sep or not name or not folder or "/" in name:
+        raise argparse.ArgumentTypeError(
+            f"expected NAME=DIR (a package name, '=', its directory), got {text!r}"
+        )
+    return name, folder
+
+
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
     """The argument parser and its subparsers (other subcommands add themselves).
 
@@ -163,6 +179,21 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
         "--torsional-friction",
         type=_positive_float,
         help="torsional friction coefficient of soft fingers (default: scene's)",
+    )
+    analyze.add_argument(
+        "--package",
+        action="append",
+        type=_package,
+        default=[],
+        metavar="NAME=DIR",
+        help="resolve package://NAME/... to DIR (repeatable; ROS_PACKAGE_PATH "
+        "is honoured too)",
+    )
+    analyze.add_argument(
+        "--allow-any-file",
+        action="store_true",
+        help="trust the scene: let it reference files outside its packages and "
+        "its own directory",
     )
     analyze.add_argument("--json", action="store_true", help="print JSON")
     analyze.set_defaults(func=_cmd_analyze)

@@ -524,6 +524,15 @@ def form_closure(
     -------
     ClosureResult
         ``contact_forces`` holds ``[f_n]`` per contact.
+
+    Examples
+    --------
+    Four frictionless contacts on a square's sides hold it in the plane:
+
+    >>> import drakegrasp as dg
+    >>> result = dg.form_closure(dg.examples.planar_square_four_contacts())
+    >>> result.is_closure, result.rank
+    (True, 3)
     """
     tol = _check_tol(tol)
     required = grasp.wrench_dim
@@ -714,11 +723,20 @@ def force_closure(
     rank_tol : float, optional
         Relative singular-value threshold of the rank test.
     formulation : {"facets", "generators"}, optional
-        H-form (default, ``d*`` as in CONVENTIONS.md) or V-form.
+        H-form (default, ``d*`` as in the conventions) or V-form.
 
     Returns
     -------
     ClosureResult
+
+    Examples
+    --------
+    The equator grasp of three hard fingers is in force closure:
+
+    >>> import drakegrasp as dg
+    >>> result = dg.force_closure(dg.examples.equator_fingers(0.5, num_fingers=3))
+    >>> result.is_closure, result.rank, round(result.d_star, 4)
+    (True, 6, 0.4194)
     """
     tol = _check_tol(tol)
     prog, variables = build_force_closure_program(

@@ -3,7 +3,7 @@
 A :class:`Contact` is a point on the object's surface with the unit normal that
 points **into the object** (the direction in which the finger pushes), a friction
 coefficient and a contact model.  Two-dimensional position and normal make a planar
-contact.  See ``shared/CONVENTIONS.md`` for every sign and ordering used here.
+contact.  See ``docs/conventions.md`` for every sign and ordering used here.
 """
 
 from __future__ import annotations

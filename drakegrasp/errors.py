@@ -34,12 +34,35 @@ class NoContactsError(GraspError):
     """The hand does not touch the object (or a grasp has no contacts)."""
 
 
-class PenetrationError(GraspError):
-    """A finger penetrates the object deeper than the distance tolerance."""
+class InvalidPoseError(GraspError):
+    """The plant's configuration is physically impossible for a grasp.
+
+    The common base of :class:`PenetrationError` and :class:`JointLimitError`;
+    ``analyze_grasp(..., check_pose=False)`` analyses such a pose anyway and
+    marks the report invalid.
+    """
+
+
+class PenetrationError(InvalidPoseError):
+    """A hand body penetrates the object deeper than the distance tolerance."""
+
+
+class JointLimitError(InvalidPoseError):
+    """A joint of the hand is outside its position limits."""
 
 
 class ModelError(GraspError):
     """A model, scene file or body could not be found or loaded."""
+
+
+class SceneError(ModelError, ValueError):
+    """A scene file is malformed, or references a file it may not.
+
+    Raised for YAML that is not valid, too large or uses anchors and aliases,
+    a ``drakegrasp:`` key or value of the wrong type, an unknown package, and a
+    model file outside the scene's directory and its packages (see
+    :mod:`drakegrasp.plant.scene`).
+    """
 
 
 class SolverError(GraspError):
@@ -57,3 +80,21 @@ class SolverError(GraspError):
         super().__init__(message)
         self.program = program
         self.result = result
+
+
+class InvalidContextError(GraspError, ValueError):
+    """A context that belongs neither to the plant nor to the diagram holding it."""
+
+
+class UnreachableError(GraspError):
+    """Closing the hand left too few fingers touching the object.
+
+    Attributes
+    ----------
+    closure : HandClosure or None
+        Where every finger stopped (the context is left unchanged).
+    """
+
+    def __init__(self, message: str, *, closure: Any = None):
+        super().__init__(message)
+        self.closure = closure

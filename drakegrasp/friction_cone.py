@@ -3,7 +3,7 @@
 Generators are inscribed in the exact Coulomb cone:
 ``s_k = [1, μ cos(2πk/n_g), μ sin(2πk/n_g)]``, ``k = 1 … n_g``; a soft finger adds
 ``[1, 0, 0, ±b ν]``.  Facet rows have unit length and give a positive value on the
-cone's axis ``[1, 0, 0, …]``.  See ``shared/CONVENTIONS.md``.
+cone's axis ``[1, 0, 0, …]``.  See ``docs/conventions.md``.
 """
 
 from __future__ import annotations

@@ -278,6 +278,18 @@ def grasp_matrix(grasp: Grasp) -> np.ndarray:
 
     restricted to the components of the contact model; column order follows
     contact order.
+
+    Examples
+    --------
+    Three hard fingers on a unit circle's equator: three columns each.
+
+    >>> import numpy as np
+    >>> import drakegrasp as dg
+    >>> a = 2 * np.pi * np.arange(3) / 3
+    >>> c = np.c_[np.cos(a), np.sin(a), np.zeros(3)]
+    >>> grasp = dg.Grasp([dg.Contact(ci, -ci, mu=0.5) for ci in c])
+    >>> dg.grasp_matrix(grasp).shape
+    (6, 9)
     """
     return grasp._grasp_matrix.copy()
 

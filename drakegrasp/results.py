@@ -118,7 +118,7 @@ class ClosureResult:
         ``"form closure"``, ``"force closure"`` or ``"force closure (exact cones)"``.
     is_closure : bool
         The verdict: ``rank == required_rank`` and either ``d* > tol`` or the
-        normal-force certificate (see :attr:`certificate`); with a hand
+        normal-force certificate (see ``certificate``); with a hand
         Jacobian, LP3 must pass too.
     d_star : float
         Optimal ``d`` of LP1/LP2/SOCP: how far the best internal force lies inside

@@ -3,7 +3,7 @@ r"""Vectorised contact frames, grasp matrices and friction-cone facets (numpy on
 The single-grasp path builds one :class:`~drakegrasp.Grasp` at a time; here the
 same objects are built for a stack of ``K`` grasps with ``N`` contacts each, with
 exactly the conventions of :mod:`drakegrasp.contact`, :mod:`drakegrasp.grasp` and
-:mod:`drakegrasp.friction_cone` (``shared/CONVENTIONS.md``):
+:mod:`drakegrasp.friction_cone` (``docs/conventions.md``):
 
 * contact frames come from :func:`drakegrasp.contact_frames` (same ``t1``);
 * ``G_i = [R_i; S(c_i - p) R_i]`` restricted to the contact's *effective*
@@ -59,7 +59,7 @@ def contact_kinds(
     Returns
     -------
     kinds : (K, N) int8
-        Codes ``FRICTIONLESS`` … ``SOFT_FULL``; see :data:`KIND_COMPONENTS`.
+        Codes ``FRICTIONLESS`` … ``SOFT_FULL``; see ``KIND_COMPONENTS``.
     """
     shape = np.shape(mu)
     if model == "frictionless":

@@ -78,7 +78,7 @@ class BatchClosureResult:
     required_rank : int
         6 (spatial) or 3 (planar).
     margin : (K,) float
-        ``(d* - tol) / tol`` as :class:`drakegrasp.ClosureResult.margin`, with
+        ``(d* - tol) / tol`` as ``margin`` of :class:`~drakegrasp.ClosureResult`, with
         LP1's ``d*`` where the normal-force certificate decided.  The verdict
         is uncertain where ``tol/1000 < d* < 2 tol``.
     converged : (K,) bool
@@ -95,7 +95,7 @@ class BatchClosureResult:
         with ``d* > tol``) although the LP2 ``d*`` was at most ``tol``: ``d`` is a
         distance to the cone boundaries and vanishes as ``μ -> 0``, while such
         forces lie inside every cone with ``μ > 0`` (see
-        :attr:`drakegrasp.ClosureResult.certificate`).
+        ``certificate`` of :class:`~drakegrasp.ClosureResult`).
     """
 
     kind: str

@@ -1,6 +1,6 @@
 r"""Null-space reduction of the closure LPs to tiny max–min problems.
 
-LP1/LP2 (``shared/CONVENTIONS.md``) read
+LP1/LP2 (``docs/conventions.md``) read
 
 .. math::
 
@@ -223,7 +223,7 @@ def solve_margin_lp(
     rank_tol : float
         Singular values ``<= rank_tol * σ_max`` count as zero.
     ipm_tol : float, optional
-        Tolerance of the interior-point method on ``t*`` (relative to 1 + |t*|).
+        Tolerance of the interior-point method on ``t*`` (relative to ``1 + |t*|``).
     ipm_max_iter : int, optional
         Iteration cap of the interior-point method.  The rare LPs that reach it
         are solved again one by one with HiGHS (``scipy.optimize.linprog``);

@@ -11,18 +11,22 @@ from drakegrasp.plant.analysis import (
     analyze_grasp,
     grasp_from_plant,
 )
+from drakegrasp.plant.closing import FingerClosure, HandClosure, close_hand
+from drakegrasp.plant.contact_results import contacts_from_results
 from drakegrasp.plant.contacts import (
     DEFAULT_DISTANCE_TOLERANCE,
     PlantContact,
     find_contacts,
     hand_bodies,
 )
+from drakegrasp.plant.curvature import contact_curvatures
 from drakegrasp.plant.jacobians import (
     hand_jacobian,
     hand_velocity_indices,
     signed_distance_jacobian,
 )
 from drakegrasp.plant.models import models_dir, register_models, use_local_drake_models
+from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.scene import (
     DEFAULT_SCENE,
     Scene,
@@ -34,12 +38,18 @@ from drakegrasp.plant.scene import (
 __all__ = [
     "DEFAULT_DISTANCE_TOLERANCE",
     "DEFAULT_SCENE",
+    "FingerClosure",
     "GraspFromPlant",
     "GraspReport",
+    "HandClosure",
     "PlantContact",
+    "PoseCheck",
     "Scene",
     "SceneInfo",
     "analyze_grasp",
+    "close_hand",
+    "contacts_from_results",
+    "contact_curvatures",
     "find_contacts",
     "grasp_from_plant",
     "hand_bodies",

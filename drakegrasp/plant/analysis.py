@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
@@ -27,7 +28,7 @@ from drakegrasp.closure import (
     with_internal_forces,
 )
 from drakegrasp.contact import Contact, ContactModel
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import GraspError, InvalidOptionError, NoContactsError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.grasp import Grasp, grasp_matrix
 from drakegrasp.plant.contacts import (
@@ -39,13 +40,18 @@ from drakegrasp.plant.contacts import (
     hand_bodies,
     resolve_object_body,
 )
+from drakegrasp.plant.curvature import SECOND_ORDER_RANK_TOL, contact_curvatures
 from drakegrasp.plant.jacobians import (
     PLANES,
     hand_jacobian,
     hand_velocity_indices,
     signed_distance_jacobian,
 )
+from drakegrasp.plant.pose import PoseCheck
+from drakegrasp.plant.pose import check_pose as _check_pose
+from drakegrasp.plant.validation import hand_model_instances, plant_context_of
 from drakegrasp.results import AntipodalResult, ClosureResult, _jsonable
+from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
 
 __all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
 
@@ -79,6 +85,10 @@ class GraspFromPlant:
         Scoped names of the hand's bodies.
     plane : str or None
         Object-frame plane of a planar analysis (``"yz"``...), or None.
+    pose : PoseCheck or None
+        Penetrations and joint-limit violations of the hand's model instances
+        (``pose.valid`` is False only when the caller opted out of the refusal
+        with ``check_pose=False`` or ``allow_penetration=True``).
     """
 
     grasp: Grasp
@@ -90,6 +100,7 @@ class GraspFromPlant:
     object_body: str
     hand_bodies: tuple[str, ...]
     plane: str | None
+    pose: PoseCheck | None = None
 
     @property
     def G(self) -> np.ndarray:
@@ -108,6 +119,7 @@ class GraspFromPlant:
             "hand_velocity_indices": self.hand_velocity_indices.tolist(),
             "hand_jacobian": _jsonable(self.hand_jacobian),
             "dpsi_dv": _jsonable(self.dpsi_dv),
+            "pose": None if self.pose is None else self.pose.to_dict(),
         }
 
 
@@ -152,8 +164,8 @@ def _core_contact(
 def grasp_from_plant(
     plant: MultibodyPlant,
     plant_context: Context,
-    *,
     object_body,
+    *,
     hand: HandSpec = None,
     mu: float,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
@@ -163,6 +175,9 @@ def grasp_from_plant(
     characteristic_length: float | None = None,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    check_pose: bool = True,
+    query_object: QueryObject | None = None,
+    contacts: list[PlantContact] | None = None,
 ) -> GraspFromPlant:
     """The grasp that the plant's configuration makes, with ``J``, ``ψ``, ``∂ψ/∂v``.
 
@@ -171,11 +186,11 @@ def grasp_from_plant(
     plant : MultibodyPlant
         Finalized, registered with a ``SceneGraph``.
     plant_context : Context
-        The plant's context (validated).
+        The plant's context, or the root context of the diagram holding it.
     object_body : RigidBody, BodyIndex or str
         The grasped object; its body frame O is the grasp frame and its origin
-        the reference point.
-    hand : ModelInstanceIndex, iterable of RigidBody, or None, optional
+        the reference point.  Positional or keyword.
+    hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
         See :func:`drakegrasp.plant.hand_bodies`.
     mu : float
         Friction coefficient of every contact.
@@ -190,8 +205,21 @@ def grasp_from_plant(
         ``[f_a, f_b, m]``); every contact normal must lie in the plane.
     characteristic_length : float, optional
         ``b`` of the grasp (default: farthest contact from O's origin).
-    allow_penetration, patches
-        Passed to :func:`drakegrasp.find_contacts`.
+    allow_penetration, patches, query_object
+        Passed to :func:`drakegrasp.find_contacts` (``query_object``: read the
+        geometry from this scene-graph query object instead of the plant's
+        query input port in ``plant_context``).  ``allow_penetration=True``
+        also stops the pose check from refusing penetration (it is still
+        recorded in ``pose``).
+    check_pose : bool, optional
+        True (default): refuse an impossible pose, i.e. any body of the hand's
+        model instances (the welded palm too) penetrating the object, or a
+        joint of the hand outside its limits.  False: analyse it anyway; the
+        result's ``pose.valid`` is then False and the report says so.
+    contacts : list of PlantContact, optional
+        Analyse these contacts (frame O of ``object_body``) instead of finding
+        them from signed distances: e.g. the patches of hydroelastic contact
+        surfaces read by :func:`drakegrasp.plant.contacts_from_results`.
 
     Returns
     -------
@@ -199,9 +227,12 @@ def grasp_from_plant(
 
     Raises
     ------
-    NoContactsError, PenetrationError, ModelError, InvalidOptionError
+    PenetrationError, JointLimitError
+        Both :class:`~drakegrasp.InvalidPoseError`: the pose is impossible
+        (names the bodies and the depth, or the joint, its value and limits).
+    NoContactsError, ModelError, InvalidOptionError, InvalidContextError
     """
-    plant.ValidateContext(plant_context)
+    plant_context = plant_context_of(plant, plant_context)
     plane = _check_plane(plane)
     model = ContactModel.parse(contact_model)
     if plane is not None and model is ContactModel.SOFT_FINGER:
@@ -218,15 +249,29 @@ def grasp_from_plant(
         torsional_friction = 0.0
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
-    contacts = find_contacts(
+    pose = _pose_of(
         plant,
         plant_context,
-        object_body=body,
-        hand=bodies,
+        body,
+        bodies,
         distance_tolerance=distance_tolerance,
+        refuse=check_pose,
         allow_penetration=allow_penetration,
-        patches=patches,
+        query_object=query_object,
     )
+    if contacts is None:
+        contacts = find_contacts(
+            plant,
+            plant_context,
+            object_body=body,
+            hand=bodies,
+            distance_tolerance=distance_tolerance,
+            allow_penetration=allow_penetration or not check_pose,
+            patches=patches,
+            query_object=query_object,
+        )
+    elif not contacts:
+        raise NoContactsError(f"no contacts given for {_scoped_name(plant, body)!r}")
     core = [
         _core_contact(
             c, plane=plane, mu=mu, model=model, torsional_friction=torsional_friction
@@ -260,7 +305,42 @@ def grasp_from_plant(
         object_body=_scoped_name(plant, body),
         hand_bodies=tuple(_scoped_name(plant, b) for b in bodies),
         plane=plane,
+        pose=pose,
     )
+
+
+def _pose_of(
+    plant,
+    plant_context,
+    body,
+    bodies,
+    *,
+    distance_tolerance,
+    refuse,
+    allow_penetration,
+    query_object=None,
+) -> PoseCheck:
+    """Check the pose; raise unless the caller opted out."""
+    tol = float(distance_tolerance)
+    if not np.isfinite(tol) or tol <= 0:
+        raise InvalidOptionError(
+            "distance_tolerance must be finite and > 0 (metres), got "
+            f"{distance_tolerance!r}"
+        )
+    found = _check_pose(
+        plant,
+        plant_context,
+        body,
+        hand_model_instances(plant, bodies, body),
+        distance_tolerance=tol,
+        query_object=query_object,
+    )
+    if refuse:
+        if allow_penetration:
+            PoseCheck((), found.joint_limit_violations).raise_if_invalid()
+        else:
+            found.raise_if_invalid()
+    return PoseCheck(found.penetrations, found.joint_limit_violations, refuse)
 
 
 @dataclass(frozen=True, eq=False)
@@ -282,6 +362,12 @@ class GraspReport:
         Force closure on exact (second-order / planar) cones, with LP3.
     antipodal : AntipodalResult or None
         The antipodal test when there are exactly two contacts.
+    pose : PoseCheck or None
+        Whether the pose is possible (``pose.valid``); an invalid pose is only
+        analysed with ``check_pose=False`` (or ``allow_penetration=True``).
+    second_order : SecondOrderResult or None
+        Second-order form closure (curvatures read off the shapes) when
+        first-order form closure fails; None when it holds.
     """
 
     data: GraspFromPlant
@@ -290,6 +376,8 @@ class GraspReport:
     force_closure: ClosureResult
     force_closure_exact: ClosureResult
     antipodal: AntipodalResult | None
+    pose: PoseCheck | None = None
+    second_order: SecondOrderResult | None = None
 
     @property
     def grasp(self) -> Grasp:
@@ -320,6 +408,8 @@ class GraspReport:
             "force_closure": self.force_closure.to_dict(),
             "force_closure_exact": self.force_closure_exact.to_dict(),
             "antipodal": None if self.antipodal is None else self.antipodal.to_dict(),
+            "pose": None if self.pose is None else self.pose.to_dict(),
+            "second_order": _jsonable(self.second_order),
         }
 
     def __str__(self) -> str:
@@ -334,6 +424,7 @@ class GraspReport:
             f"{c0.model.value}, {friction}",
             "  frame O = the object body frame; moments about its origin; "
             f"b = {g.characteristic_length * 1e3:.4g} mm",
+            *([] if self.pose is None else ["  " + self.pose.summary()]),
             f"  {'#':>2}  {'finger':<28} {'p_OC [mm]':<27} {'nhat_O':<25} psi [mm]",
         ]
         for i, pc in enumerate(self.contacts):
@@ -355,14 +446,16 @@ class GraspReport:
             lines += ["  " + line for line in str(result).splitlines()]
         if self.antipodal is not None:
             lines.append("  " + str(self.antipodal))
+        if self.second_order is not None:
+            lines += ["  " + line for line in str(self.second_order).splitlines()]
         return "\n".join(lines)
 
 
 def analyze_grasp(
     plant: MultibodyPlant,
     plant_context: Context,
-    *,
     object_body,
+    *,
     hand: HandSpec = None,
     mu: float,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
@@ -374,14 +467,22 @@ def analyze_grasp(
     tol: float = DEFAULT_TOL,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    check_pose: bool = True,
+    query_object: QueryObject | None = None,
+    contacts: list[PlantContact] | None = None,
 ) -> GraspReport:
     """Read the grasp from the plant and decide every closure property.
 
     Parameters
     ----------
-    plant, plant_context, object_body, hand, mu, contact_model,
-    torsional_friction, distance_tolerance, plane, characteristic_length,
-    allow_penetration, patches
+    plant, plant_context, object_body, hand, mu
+        As in :func:`grasp_from_plant` (``plant_context`` may be the diagram's
+        root context; ``object_body`` may be positional).
+    contact_model, torsional_friction, distance_tolerance, plane
+        As in :func:`grasp_from_plant`.
+    characteristic_length, allow_penetration, patches
+        As in :func:`grasp_from_plant`.
+    check_pose, query_object, contacts
         As in :func:`grasp_from_plant`.
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
@@ -405,14 +506,18 @@ def analyze_grasp(
         characteristic_length=characteristic_length,
         allow_penetration=allow_penetration,
         patches=patches,
+        check_pose=check_pose,
+        query_object=query_object,
+        contacts=contacts,
     )
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
     lp3 = internal_forces(grasp, J, tol=tol)
+    first_order = form_closure(grasp, tol=tol)
     return GraspReport(
         data=data,
         G=grasp_matrix(grasp),
-        form_closure=form_closure(grasp, tol=tol),
+        form_closure=first_order,
         # One LP3 serves both verdicts: it depends on G and J, not on the cones.
         force_closure=with_internal_forces(
             force_closure(grasp, num_generators=num_generators, tol=tol), lp3
@@ -421,4 +526,31 @@ def analyze_grasp(
             force_closure_exact(grasp, tol=tol), lp3
         ),
         antipodal=antipodal,
+        pose=data.pose,
+        second_order=None
+        if first_order.is_closure
+        else _second_order(plant, plant_context, data, first_order, query_object),
     )
+
+
+def _second_order(
+    plant, plant_context, data, first_order, query_object
+) -> SecondOrderResult:
+    """Second-order form closure with the shapes' curvatures (or why not)."""
+    try:
+        curvatures = contact_curvatures(
+            plant,
+            plant_context,
+            data.contacts,
+            object_body=data.object_body,
+            plane=data.plane,
+            query_object=query_object,
+        )
+        return second_order_form_closure(
+            data.grasp,
+            curvatures,
+            first_order=first_order,
+            rank_tol=SECOND_ORDER_RANK_TOL,
+        )
+    except GraspError as e:  # a contact without a second-order model
+        return SecondOrderResult.undecided(data.grasp.num_contacts, str(e))

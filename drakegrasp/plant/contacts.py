@@ -38,13 +38,12 @@ handling off.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 from pydrake.geometry import GeometryId, QueryObject, SceneGraphInspector, Sphere
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
+from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context
 
 from drakegrasp.errors import (
@@ -58,6 +57,13 @@ from drakegrasp.plant._shapes import (
     SurfacePiece,
     plane_basis,
     surface_pieces,
+)
+from drakegrasp.plant.validation import (
+    HandSpec,
+    hand_bodies,
+    plant_context_of,
+    resolve_object_body,
+    scoped_name,
 )
 
 __all__ = [
@@ -75,7 +81,7 @@ DEFAULT_DISTANCE_TOLERANCE = 1e-4
 PATCH_ANGLE_TOL = np.radians(2.0)
 """Two flat faces whose normals are opposite within this angle (rad) form a patch."""
 
-HandSpec = ModelInstanceIndex | str | Iterable[RigidBody] | None
+_scoped_name = scoped_name  # the name other modules of the plant layer import
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,78 +150,6 @@ class PlantContact:
             f"PlantContact({self.finger_body}: p_OC={np.round(self.p_OC, 6).tolist()}, "
             f"nhat_O={np.round(self.nhat_O, 6).tolist()}, psi={self.psi:.3g}{patch})"
         )
-
-
-def _scoped_name(plant: MultibodyPlant, body: RigidBody) -> str:
-    return f"{plant.GetModelInstanceName(body.model_instance())}::{body.name()}"
-
-
-def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
-    """The object body given as a ``RigidBody``, a ``BodyIndex`` or a scoped name."""
-    if isinstance(object_body, RigidBody):
-        return object_body
-    if isinstance(object_body, BodyIndex):
-        return plant.get_body(object_body)
-    if isinstance(object_body, str):
-        from drakegrasp.plant.scene import resolve_body
-
-        return resolve_body(plant, object_body)
-    raise InvalidOptionError(
-        "object_body must be a RigidBody, a BodyIndex or a 'model::body' name, "
-        f"got {type(object_body).__name__}"
-    )
-
-
-def hand_bodies(
-    plant: MultibodyPlant, object_body: RigidBody, hand: HandSpec = None
-) -> list[RigidBody]:
-    """The bodies that make up the hand.
-
-    Parameters
-    ----------
-    plant : MultibodyPlant
-    object_body : RigidBody
-    hand : ModelInstanceIndex, str, iterable of RigidBody (or scoped names), or None
-        A model instance, given by index or name (all its bodies that are not
-        welded to the world), an explicit list of bodies, or None: every body
-        that is not the object, not welded to the world and not in the object's
-        model instance.
-
-    Returns
-    -------
-    list of RigidBody
-        In body-index order.
-    """
-    welded_to_world = {b.index() for b in plant.GetBodiesWeldedTo(plant.world_body())}
-    if isinstance(hand, str):  # a model instance's name
-        if not plant.HasModelInstanceNamed(hand):
-            names = [
-                plant.GetModelInstanceName(ModelInstanceIndex(i))
-                for i in range(plant.num_model_instances())
-            ]
-            raise ModelError(f"no model instance named {hand!r}; instances are {names}")
-        hand = plant.GetModelInstanceByName(hand)
-    if isinstance(hand, ModelInstanceIndex):
-        bodies = [plant.get_body(i) for i in plant.GetBodyIndices(hand)]
-        bodies = [b for b in bodies if b.index() not in welded_to_world]
-    elif hand is None:
-        bodies = [
-            plant.get_body(BodyIndex(i))
-            for i in range(plant.num_bodies())
-            if BodyIndex(i) not in welded_to_world
-        ]
-        bodies = [
-            b for b in bodies if b.model_instance() != object_body.model_instance()
-        ]
-    else:
-        bodies = [resolve_object_body(plant, b) for b in hand]
-    bodies = [b for b in bodies if b.index() != object_body.index()]
-    if not bodies:
-        raise ModelError(
-            f"the hand has no bodies that can move (hand={hand!r}); name its model "
-            "instance or list its bodies"
-        )
-    return sorted(bodies, key=lambda b: int(b.index()))
 
 
 def _rotation(X) -> np.ndarray:
@@ -309,12 +243,13 @@ def _patch(
 def find_contacts(
     plant: MultibodyPlant,
     plant_context: Context,
-    *,
     object_body,
+    *,
     hand: HandSpec = None,
     distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    query_object: QueryObject | None = None,
 ) -> list[PlantContact]:
     """Contacts between the hand and the object in the plant's configuration.
 
@@ -323,10 +258,12 @@ def find_contacts(
     plant : MultibodyPlant
         A finalized plant registered with a ``SceneGraph``.
     plant_context : Context
-        The plant's context (validated).
+        The plant's context, or the root context of the diagram holding the
+        plant (see :func:`~drakegrasp.plant.validation.plant_context_of`).
     object_body : RigidBody, BodyIndex or str
-        The grasped object (a ``"model::body"`` name is accepted).
-    hand : ModelInstanceIndex, iterable of RigidBody, or None, optional
+        The grasped object (a ``"model::body"`` name is accepted); positional
+        or keyword, like every option-free argument of the plant layer.
+    hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
         See :func:`hand_bodies`.
     distance_tolerance : float, optional
         A pair is a contact when ``|ψ| <= distance_tolerance`` (metres, default
@@ -337,6 +274,13 @@ def find_contacts(
     patches : {"vertices", "witness"}, optional
         How a flat-on-flat patch is reported: one contact per patch vertex
         (default) or Drake's single witness point.
+    query_object : pydrake.geometry.QueryObject, optional
+        The scene-graph query object to read distances and geometry poses
+        from.  Default: evaluate the plant's geometry query input port in
+        ``plant_context``.  Pass one when ``plant_context`` is not connected to
+        a scene graph (e.g. a private context inside a Drake ``System`` such as
+        :class:`drakegrasp.GraspMonitor`, fed by a query-object input port); it
+        must describe the same configuration as ``plant_context``.
 
     Returns
     -------
@@ -355,7 +299,7 @@ def find_contacts(
     ModelError
         If the plant has no scene graph, or a geometry's shape is unsupported.
     """
-    plant.ValidateContext(plant_context)
+    plant_context = plant_context_of(plant, plant_context)
     tol = float(distance_tolerance)
     if not np.isfinite(tol) or tol <= 0:
         raise InvalidOptionError(
@@ -370,7 +314,15 @@ def find_contacts(
     fingers = hand_bodies(plant, body, hand)
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
-    query: QueryObject = plant.get_geometry_query_input_port().Eval(plant_context)
+    if query_object is None:
+        query = plant.get_geometry_query_input_port().Eval(plant_context)
+    elif isinstance(query_object, QueryObject):
+        query = query_object
+    else:
+        raise InvalidOptionError(
+            "query_object must be a pydrake.geometry.QueryObject or None, got "
+            f"{type(query_object).__name__}"
+        )
     inspector = query.inspector()
     object_geometries = plant.GetCollisionGeometriesForBody(body)
     object_name = _scoped_name(plant, body)

@@ -31,6 +31,7 @@ from pydrake.systems.framework import Context
 from drakegrasp.contact import ContactModel
 from drakegrasp.grasp import Grasp
 from drakegrasp.plant.contacts import PlantContact
+from drakegrasp.plant.validation import plant_context_of, resolve_object_body
 
 __all__ = [
     "PLANES",
@@ -104,8 +105,7 @@ def signed_distance_jacobian(
     plant: MultibodyPlant,
     plant_context: Context,
     contacts: Sequence[PlantContact],
-    *,
-    object_body: RigidBody,
+    object_body,
 ) -> np.ndarray:
     """``∂ψ/∂v``: one row per contact, one column per plant velocity.
 
@@ -113,17 +113,20 @@ def signed_distance_jacobian(
     ----------
     plant : MultibodyPlant
     plant_context : Context
-        Validated; the configuration the contacts were found in.
+        The plant's context or the diagram's root context; the configuration
+        the contacts were found in.
     contacts : sequence of PlantContact
         From :func:`drakegrasp.find_contacts` (object frame O).
-    object_body : RigidBody
+    object_body : RigidBody, BodyIndex or str
+        The object (frame O); positional or keyword.
 
     Returns
     -------
     (N, nv) float
         ``ψ̇ = (∂ψ/∂v) v`` (metres per unit velocity; ``JacobianWrtVariable.kV``).
     """
-    plant.ValidateContext(plant_context)
+    plant_context = plant_context_of(plant, plant_context)
+    object_body = resolve_object_body(plant, object_body)
     frame_O = object_body.body_frame()
     points_O = np.array([c.p_OC for c in contacts])
     J_obj = _translational(plant, plant_context, object_body, points_O, frame_O)
@@ -139,8 +142,8 @@ def hand_jacobian(
     plant_context: Context,
     contacts: Sequence[PlantContact],
     grasp: Grasp,
+    object_body,
     *,
-    object_body: RigidBody,
     velocity_indices: np.ndarray,
     plane: str | None = None,
 ) -> np.ndarray:
@@ -154,8 +157,8 @@ def hand_jacobian(
         The plant contacts, in the order of ``grasp.contacts``.
     grasp : Grasp
         The grasp built from them (its contact frames and models set the rows).
-    object_body : RigidBody
-        Frame O in which everything is expressed.
+    object_body : RigidBody, BodyIndex or str
+        Frame O in which everything is expressed; positional or keyword.
     velocity_indices : (n_h,) int
         Plant velocities that are the hand's (the columns of ``J``).
     plane : {"xy", "yz", "zx"} or None, optional
@@ -169,7 +172,8 @@ def hand_jacobian(
         ``[n, t]``; frictionless ``[n]``).  Velocities in m/s (rad/s for the
         soft-finger row) per unit hand velocity.
     """
-    plant.ValidateContext(plant_context)
+    plant_context = plant_context_of(plant, plant_context)
+    object_body = resolve_object_body(plant, object_body)
     frame_O = object_body.body_frame()
     cols = np.asarray(velocity_indices, dtype=int)
     J_fin = _finger_jacobians(plant, plant_context, contacts, frame_O)

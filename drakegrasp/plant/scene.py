@@ -1,22 +1,106 @@
-"""Scene files: Drake model directives plus a small ``drakegrasp:`` section.
+r"""Scene files: Drake model directives plus a small ``drakegrasp:`` section.
 
-A scene is a YAML file that Drake itself can read (its ``directives:`` list is
-ordinary :class:`~pydrake.multibody.parsing.ModelDirectives`, with the hand's
-joint values in ``default_joint_positions`` and the object's pose in
-``default_free_body_pose``), plus a ``drakegrasp:`` mapping::
+A scene is a YAML file that Drake itself can read, plus one mapping that tells
+drakegrasp what to analyse.  ``drakegrasp analyze FILE`` and
+:func:`load_scene` take it; ``drakegrasp scenes`` lists the shipped ones.
 
+The format
+----------
+::
+
+    directives:                      # Drake's ModelDirectives, unchanged
+    - add_model:
+        name: gripper                # model instance name
+        file: package://drakegrasp/hands/parallel_jaw.sdf
+        default_joint_positions:     # the hand's configuration
+          left_finger_joint: [0.025]
+          right_finger_joint: [0.025]
+    - add_weld:
+        parent: world
+        child: gripper::palm
+    - add_model:
+        name: box
+        file: package://drakegrasp/objects/box.sdf
+        default_free_body_pose:      # the object's pose
+          box:
+            translation: [0.0, 0.0, 0.065]
+            rotation: !Rpy { deg: [0.0, 0.0, 0.0] }
     drakegrasp:
       description: one line shown by `drakegrasp scenes`
-      object_body: box::box          # scoped body name (model::body)
+      object_body: box::box          # required: scoped body name (model::body)
       hand: gripper                  # model instance name, or a list of bodies
-      mu: 0.5                        # friction coefficient
+      mu: 0.5                        # required: friction coefficient, >= 0
       contact_model: hard_finger     # frictionless | hard_finger | soft_finger
-      torsional_friction: 0.1        # optional, for soft fingers
-      plane: yz                      # optional: analyse in this object-frame plane
-      distance_tolerance: 1.0e-4     # optional, metres
+      torsional_friction: 0.1        # soft fingers: nu >= 0
+      plane: yz                      # optional: planar analysis (xy | yz | zx)
+      distance_tolerance: 1.0e-4     # optional, metres, > 0
 
-``package://drakegrasp/...`` URIs resolve to the models shipped with
-drakegrasp.
+``directives`` is any list that Drake's ``LoadModelDirectives`` accepts
+(``add_model``, ``add_weld``, ``add_frame``, ``add_directives``,
+``add_collision_filter_group``...): Drake checks its schema and reports
+unknown keys.  ``drakegrasp:`` keys (see :data:`drakegrasp.plant.scene_file.KEYS`):
+
+- ``object_body`` (required): the grasped body, ``"model::body"``;
+- ``mu`` (required): friction coefficient of every contact;
+- ``hand``: a model-instance name (all its bodies not welded to the world) or
+  a list of ``"model::body"`` names; absent: every body that is not the
+  object, not welded to the world and not in the object's model instance;
+- ``contact_model`` (default ``hard_finger``), ``torsional_friction``
+  (default 0; needed > 0 by ``soft_finger``), ``plane`` (absent: spatial),
+  ``distance_tolerance`` (default 1e-4 m), ``description`` (default empty).
+
+Packages and files
+------------------
+``package://drakegrasp/...`` resolves to the models shipped with drakegrasp,
+``package://drake/...`` to Drake's own resources and
+``package://drake_models/...`` to Drake's model collection (downloaded on
+demand, or the local copy named by ``DRAKEGRASP_DRAKE_MODELS``).  Your own
+packages: ``load_scene(path, package_map={"mypkg": "/path/to/mypkg"})`` (or a
+list of directories holding a ``package.xml``, or a Drake ``PackageMap``),
+``drakegrasp analyze scene.yaml --package mypkg=/path/to/mypkg`` (repeatable),
+or ``ROS_PACKAGE_PATH``, crawled as Drake does.  Details:
+:mod:`drakegrasp.plant.scene_refs`.
+
+A scene may reference only files inside its packages and its own directory:
+``package://drakegrasp/../../outside/evil.sdf``, ``file:///etc/...`` or a
+path that climbs out of the scene's directory is a :class:`SceneError`
+unless ``allow_any_file=True`` says the scene is trusted.
+
+Safety
+------
+A scene file is read with a safe YAML loader, at most 1 MiB, without YAML
+anchors or aliases (which can expand without bound) and at most 64 levels
+deep; every key and value of ``drakegrasp:`` is type-checked.  Every problem is
+a :class:`~drakegrasp.errors.SceneError` (a :class:`~drakegrasp.ModelError`)
+naming the file, the key and what is valid (:mod:`drakegrasp.plant.scene_file`).
+
+Example: Drake's WSG-50 from ``drake_models``
+--------------------------------------------
+::
+
+    directives:
+    - add_model:
+        name: wsg
+        file: package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf
+        default_joint_positions:
+          left_finger_sliding_joint: [-0.025]
+          right_finger_sliding_joint: [0.025]
+    - add_weld:
+        parent: world
+        child: wsg::body
+    - add_model:
+        name: box
+        file: package://drakegrasp/objects/box.sdf
+        default_free_body_pose:
+          box:
+            translation: [0.0, 0.108, 0.0]   # between the tips
+    drakegrasp:
+      object_body: box::box
+      hand: wsg
+      mu: 0.5
+
+(``docs/scene_format.md`` walks through it with the joint values that make the
+tips touch.)
 """
 
 from __future__ import annotations
@@ -24,20 +108,21 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-import yaml
 from pydrake.multibody.parsing import (
     LoadModelDirectivesFromString,
     Parser,
     ProcessModelDirectives,
 )
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
-from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
+from pydrake.multibody.tree import ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.contact import ContactModel
-from drakegrasp.errors import GraspError, ModelError
-from drakegrasp.plant.jacobians import PLANES
-from drakegrasp.plant.models import models_dir, register_models
+from drakegrasp.errors import ModelError, SceneError
+from drakegrasp.plant.models import models_dir
+from drakegrasp.plant.scene_file import check_section, read_yaml
+from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
+from drakegrasp.plant.validation import resolve_body
 
 __all__ = [
     "DEFAULT_SCENE",
@@ -51,17 +136,6 @@ __all__ = [
 
 DEFAULT_SCENE = "parallel_jaw_box"
 """Name of the scene that ``drakegrasp analyze`` uses without an argument."""
-
-_KEYS = {
-    "description",
-    "object_body",
-    "hand",
-    "mu",
-    "contact_model",
-    "torsional_friction",
-    "plane",
-    "distance_tolerance",
-}
 
 
 @dataclass(frozen=True)
@@ -184,147 +258,19 @@ def scene_path(path_or_name: str | Path) -> Path:
     )
 
 
-class _TolerantLoader(yaml.SafeLoader):
-    """Safe YAML loader that accepts Drake's tags (``!Rpy``...) as plain data."""
-
-
-def _construct_tagged(loader, suffix, node):
-    if isinstance(node, yaml.MappingNode):
-        return loader.construct_mapping(node, deep=True)
-    if isinstance(node, yaml.SequenceNode):
-        return loader.construct_sequence(node, deep=True)
-    return loader.construct_scalar(node)
-
-
-_TolerantLoader.add_multi_constructor("!", _construct_tagged)
-
-
-def _read_yaml(path: Path) -> tuple[str, dict]:
-    try:
-        text = path.read_text()
-    except OSError as e:
-        raise ModelError(f"cannot read scene file {str(path)!r}: {e}") from None
-    try:
-        data = yaml.load(text, Loader=_TolerantLoader)
-    except yaml.YAMLError as e:
-        first = " ".join(str(e).split())
-        raise ModelError(
-            f"scene file {str(path)!r} is not valid YAML: {first}"
-        ) from None
-    if not isinstance(data, dict):
-        raise ModelError(
-            f"scene file {str(path)!r} must be a YAML mapping with 'directives' "
-            f"and 'drakegrasp' keys, got {type(data).__name__}"
-        )
-    return text, data
-
-
-def _number(path: Path, key: str, value, *, positive: bool = False) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ModelError(
-            f"scene {str(path)!r}: drakegrasp.{key} must be a number, got {value!r}"
-        ) from None
-    if not (x >= 0.0) or (positive and x == 0.0) or x == float("inf"):
-        bound = "> 0" if positive else ">= 0"
-        raise ModelError(
-            f"scene {str(path)!r}: drakegrasp.{key} must be finite and {bound}, "
-            f"got {value!r}"
-        )
-    return x
-
-
 def read_scene_info(path: str | Path) -> SceneInfo:
     """Read and check the ``drakegrasp:`` section of a scene file.
 
     Raises
     ------
-    ModelError
-        On an unreadable file, invalid YAML, a missing or unknown key, or a bad
-        value; the message names the file and the key.
+    SceneError
+        On an unreadable, oversized or invalid YAML file, a missing or unknown
+        key, or a bad value; the message names the file and the key.
     """
     path = Path(path)
-    _, data = _read_yaml(path)
-    section = data.get("drakegrasp")
-    if not isinstance(section, dict):
-        raise ModelError(
-            f"scene {str(path)!r} has no 'drakegrasp:' mapping (it needs at least "
-            "object_body and mu)"
-        )
-    unknown = set(section) - _KEYS
-    if unknown:
-        raise ModelError(
-            f"scene {str(path)!r}: unknown key(s) {sorted(unknown)} in 'drakegrasp:'; "
-            f"valid keys are {sorted(_KEYS)}"
-        )
-    for key in ("object_body", "mu"):
-        if key not in section:
-            raise ModelError(f"scene {str(path)!r}: 'drakegrasp:' needs {key!r}")
-    hand = section.get("hand")
-    if isinstance(hand, list):
-        hand = tuple(str(h) for h in hand)
-    elif hand is not None:
-        hand = str(hand)
-    try:
-        model = ContactModel.parse(section.get("contact_model", "hard_finger"))
-    except GraspError as e:
-        raise ModelError(f"scene {str(path)!r}: {e}") from None
-    plane = section.get("plane")
-    if plane is not None and plane not in PLANES:
-        raise ModelError(
-            f"scene {str(path)!r}: drakegrasp.plane must be one of "
-            f"{sorted(PLANES)} or absent, got {plane!r}"
-        )
-    return SceneInfo(
-        name=path.stem,
-        path=path.resolve(),
-        description=str(section.get("description", "")),
-        object_body=str(section["object_body"]),
-        hand=hand,
-        mu=_number(path, "mu", section["mu"]),
-        contact_model=model,
-        torsional_friction=_number(
-            path, "torsional_friction", section.get("torsional_friction", 0.0)
-        ),
-        plane=plane,
-        distance_tolerance=_number(
-            path,
-            "distance_tolerance",
-            section.get("distance_tolerance", 1e-4),
-            positive=True,
-        ),
-    )
-
-
-def resolve_body(plant: MultibodyPlant, name: str) -> RigidBody:
-    """The body called ``"model::body"`` (or an unscoped name used once).
-
-    Raises
-    ------
-    ModelError
-        If no (or more than one) body has that name; the message lists the
-        plant's bodies.
-    """
-    try:
-        if "::" in name:
-            model, body = name.rsplit("::", 1)
-            if plant.HasModelInstanceNamed(model):
-                instance = plant.GetModelInstanceByName(model)
-                if plant.HasBodyNamed(body, instance):
-                    return plant.GetBodyByName(body, instance)
-        elif plant.HasBodyNamed(name):
-            return plant.GetBodyByName(name)
-    except RuntimeError as e:  # the name is used by several model instances
-        raise ModelError(f"body name {name!r} is ambiguous: {e}") from None
-    bodies = []
-    for i in range(plant.num_bodies()):
-        b = plant.get_body(BodyIndex(i))
-        if b.index() != plant.world_body().index():
-            bodies.append(
-                f"{plant.GetModelInstanceName(b.model_instance())}::{b.name()}"
-            )
-    raise ModelError(f"no body named {name!r} in the plant; bodies are {bodies}")
+    _, data = read_yaml(path)
+    section = check_section(path, data)
+    return SceneInfo(name=path.stem, path=path.resolve(), **section)
 
 
 def _resolve_hand(plant: MultibodyPlant, hand) -> ModelInstanceIndex | tuple | None:
@@ -358,7 +304,13 @@ def _without_drakegrasp_section(text: str) -> str:
     return "".join(out)
 
 
-def load_scene(path_or_name: str | Path | None = None) -> Scene:
+def load_scene(
+    path_or_name: str | Path | None = None,
+    *,
+    package_map: PackagesSpec = None,
+    ros_package_path: bool = True,
+    allow_any_file: bool = False,
+) -> Scene:
     """Build the plant of a scene file and set the configuration it describes.
 
     Parameters
@@ -366,6 +318,15 @@ def load_scene(path_or_name: str | Path | None = None) -> Scene:
     path_or_name : str or pathlib.Path, optional
         A scene file, or the name of a shipped scene (see :func:`list_scenes`).
         Default: :data:`DEFAULT_SCENE`.
+    package_map : PackageMap, mapping or iterable, optional
+        The user's packages: a Drake ``PackageMap``, ``{name: directory}``, or
+        directories that hold a ``package.xml`` (see
+        :func:`drakegrasp.plant.scene_refs.add_packages`).
+    ros_package_path : bool, optional
+        Also register the packages under ``$ROS_PACKAGE_PATH`` (default True).
+    allow_any_file : bool, optional
+        Trust the scene: let it reference files outside its packages and its
+        own directory (default False: refused).
 
     Returns
     -------
@@ -374,22 +335,25 @@ def load_scene(path_or_name: str | Path | None = None) -> Scene:
 
     Raises
     ------
+    SceneError
+        For a malformed file or a reference the policy refuses.
     ModelError
-        For a missing or malformed file, a model that does not parse, or an
-        unknown body or model instance.
+        For a model that does not parse, or an unknown body or model instance.
     """
     path = scene_path(DEFAULT_SCENE if path_or_name is None else path_or_name)
-    info = read_scene_info(path)
-    text, _ = _read_yaml(path)
+    text, data = read_yaml(path)
+    info = SceneInfo(name=path.stem, path=path.resolve(), **check_section(path, data))
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    parser = Parser(plant)
+    packages = add_packages(parser, package_map, ros_package_path=ros_package_path)
+    if not allow_any_file:
+        check_references(path, data, packages, read_yaml=read_yaml)
     try:
         directives = LoadModelDirectivesFromString(_without_drakegrasp_section(text))
     except Exception as e:  # Drake raises RuntimeError/ValueError on bad schema
         msg = " ".join(str(e).split())
-        raise ModelError(f"scene {str(path)!r}: bad model directives: {msg}") from None
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    parser = Parser(plant)
-    register_models(parser)
+        raise SceneError(f"scene {str(path)!r}: bad model directives: {msg}") from None
     try:
         ProcessModelDirectives(directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError

@@ -2,7 +2,7 @@ r"""Grasp quality metrics.
 
 Every metric takes a :class:`~drakegrasp.Grasp` (its contacts, reference point
 ``p`` and characteristic length ``b``, all in one grasp frame) and follows
-``shared/CONVENTIONS.md``: wrenches ``[f; m]`` with moments about ``p``, planar
+``docs/conventions.md``: wrenches ``[f; m]`` with moments about ``p``, planar
 wrenches ``[f_x, f_y, m_z]``, contact forces in contact frames with the normal
 component first, inscribed polyhedral cones with ``n_g`` generators.
 

@@ -101,7 +101,7 @@ def _hard_finger_wrenches(
 ) -> tuple[np.ndarray, ...]:
     """Vectorised :func:`primitive_wrenches` for spatial hard fingers (mu > 0).
 
-    The generators are those of CONVENTIONS.md (``s_k = [1, μ cos(2πk/n_g),
+    The generators are those of ``docs/conventions.md`` (``s_k = [1, μ cos(2πk/n_g),
     μ sin(2πk/n_g)]`` in the contact frame); a test checks that they equal
     :func:`~drakegrasp.friction_cone_generators`.
     """

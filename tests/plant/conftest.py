@@ -58,3 +58,98 @@ def tools():
     return types.SimpleNamespace(
         fresh_context=fresh_context, step_q=step_q, make_plant=make_plant
     )
+
+
+# --- Real hands from drake_models (tests skip with a reason where it is absent) ---
+
+WSG_URL = "package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf"
+ALLEGRO_URL = (
+    "package://drake_models/allegro_hand_description/sdf/"
+    "allegro_hand_description_right.sdf"
+)
+FRANKA_URL = "package://drake_models/franka_description/urdf/hand.urdf"
+
+
+class RealScene:
+    """A welded hand and a free object in a diagram; contexts ready to use."""
+
+    def __init__(
+        self, models_dir, hand_url, hand_frame, object_url, X_WO, *, edit=None
+    ):
+        from pydrake.multibody.parsing import Parser
+
+        from drakegrasp.plant.models import register_models, use_local_drake_models
+
+        builder, plant, self.scene_graph = make_plant()
+        parser = Parser(plant)
+        use_local_drake_models(parser, models_dir)
+        register_models(parser)
+        if edit is not None:  # a model file written by the test
+            self.hand = parser.AddModels(str(edit))[0]
+        else:
+            self.hand = parser.AddModels(url=hand_url)[0]
+        plant.WeldFrames(
+            plant.world_frame(), plant.GetFrameByName(hand_frame, self.hand)
+        )
+        self.object_instance = parser.AddModels(url=object_url)[0]
+        plant.Finalize()
+        self.plant = plant
+        self.diagram = builder.Build()
+        self.root = self.diagram.CreateDefaultContext()
+        self.ctx = plant.GetMyContextFromRoot(self.root)
+        self.object = plant.get_body(plant.GetBodyIndices(self.object_instance)[0])
+        plant.SetFreeBodyPose(self.ctx, self.object, X_WO)
+
+    def set_hand(self, q):
+        self.plant.SetPositions(self.ctx, self.hand, np.asarray(q, dtype=float))
+
+
+def _rt(R, p):
+    from pydrake.math import RigidTransform, RotationMatrix
+
+    return RigidTransform(RotationMatrix(np.array(R, dtype=float)), p)
+
+
+@pytest.fixture
+def real_hands(drake_models_dir):
+    """Builders of real-hand scenes: the WSG-50, the Allegro hand, the Franka hand."""
+    import types
+
+    def wsg(
+        object_url="package://drake_models/ycb/004_sugar_box.sdf", X_WO=None, q=0.05
+    ):
+        # Sugar box 39.1 mm thick between the pads (its z along the world x,
+        # the fingers' motion), clear of the palm (which ends at y = 36 mm).
+        X_WO = X_WO or _rt([[0, 0, 1], [1, 0, 0], [0, 1, 0]], [0, 0.09, 0])
+        s = RealScene(drake_models_dir, WSG_URL, "body", object_url, X_WO)
+        s.set_hand([-q, q])
+        return s
+
+    def allegro(p_ball=(0.08, 0.0, 0.1)):
+        from pydrake.math import RigidTransform
+
+        s = RealScene(
+            drake_models_dir,
+            ALLEGRO_URL,
+            "hand_root",
+            "package://drakegrasp/objects/sphere.sdf",
+            RigidTransform(list(p_ball)),
+        )
+        s.plant.GetJointByName("joint_12").set_angle(s.ctx, 1.0)  # thumb opposed
+        return s
+
+    def franka(edit=None, y=0.005):
+        from pydrake.math import RigidTransform
+
+        s = RealScene(
+            drake_models_dir,
+            FRANKA_URL,
+            "panda_hand",
+            "package://drakegrasp/objects/box.sdf",
+            RigidTransform([0.0, y, 0.135]),
+            edit=edit,
+        )
+        s.set_hand([0.04, 0.04])
+        return s
+
+    return types.SimpleNamespace(wsg=wsg, allegro=allegro, franka=franka, rt=_rt)

@@ -91,7 +91,7 @@ def _bad_scene(tmp_path, old, new):
         ),
         (
             lambda tmp: ["analyze", _bad_scene(tmp, "joint: [0.025]", "joint: [0.02]")],
-            "penetrate by",
+            "penetrates the object",
         ),
         (
             lambda tmp: [

@@ -330,9 +330,9 @@ def test_bad_options_and_bodies():
     assert find_contacts(rig.plant, rig.ctx, object_body="object::object")
     with pytest.raises(ModelError, match="hand has no bodies"):
         rig.contacts(hand=[rig.object])
-    # The context must be the plant's.
-    with pytest.raises(RuntimeError):
-        find_contacts(rig.plant, rig.root, object_body=rig.object)
+    # The diagram's root context resolves to the plant's; object_body positional.
+    from_root = find_contacts(rig.plant, rig.root, rig.object)
+    assert [c.psi for c in from_root] == [c.psi for c in rig.contacts()]
 
 
 def test_hand_selection():

@@ -19,7 +19,7 @@ from drakegrasp.quality import (
 
 
 def _lp2_by_linprog(grasp, n_g=8):
-    """LP2 (CONVENTIONS.md) written out for scipy/HiGHS, facets form."""
+    """LP2 (docs/conventions.md) written out for scipy/HiGHS, facets form."""
     G = dg.grasp_matrix(grasp)
     blocks = [dg.friction_cone_facets(c, n_g) for c in grasp.contacts]
     F = np.zeros((sum(b.shape[0] for b in blocks), G.shape[1]))

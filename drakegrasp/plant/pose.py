@@ -1,0 +1,243 @@
+"""Pose validity: is the configuration one a real hand could be in.
+
+Two facts make a pose impossible for a grasp analysis:
+
+- **penetration**: a collision geometry of any body of the hand's model
+  instances (the moving fingers *and* the palm, welded to the world or not)
+  overlaps the object by more than the distance tolerance (``ψ < −tol``);
+- **joint limits**: a joint of the hand's model instances sits outside its
+  position limits by more than :data:`JOINT_LIMIT_TOL`.
+
+:func:`check_pose` collects both into a :class:`PoseCheck`;
+:meth:`PoseCheck.raise_if_invalid` turns the first kind found into a
+:class:`~drakegrasp.PenetrationError` or :class:`~drakegrasp.JointLimitError`
+(both :class:`~drakegrasp.InvalidPoseError`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import JointIndex, RigidBody
+from pydrake.systems.framework import Context
+
+from drakegrasp.errors import JointLimitError, ModelError, PenetrationError
+from drakegrasp.plant.validation import scoped_name
+
+__all__ = [
+    "JOINT_LIMIT_TOL",
+    "JointLimitViolation",
+    "Penetration",
+    "PoseCheck",
+    "check_pose",
+]
+
+JOINT_LIMIT_TOL = 1e-8
+"""A joint this far (metres or radians) outside a limit violates it."""
+
+
+@dataclass(frozen=True)
+class Penetration:
+    """A hand geometry that overlaps the object.
+
+    Attributes
+    ----------
+    hand_body, hand_geometry, object_geometry : str
+        Scoped body name and the two geometries' names.
+    depth : float
+        ``−ψ`` in metres (> the distance tolerance).
+    """
+
+    hand_body: str
+    hand_geometry: str
+    object_geometry: str
+    depth: float
+
+    def __str__(self) -> str:
+        return (
+            f"{self.hand_body} ({self.hand_geometry}) penetrates the object "
+            f"({self.object_geometry}) by {self.depth * 1e3:.4g} mm"
+        )
+
+
+@dataclass(frozen=True)
+class JointLimitViolation:
+    """A joint position outside its limits.
+
+    Attributes
+    ----------
+    joint : str
+        Scoped joint name ``model::joint`` (with ``[k]`` for multi-dof joints).
+    value, lower, upper : float
+        The position and its limits (metres or radians).
+    """
+
+    joint: str
+    value: float
+    lower: float
+    upper: float
+
+    def __str__(self) -> str:
+        return (
+            f"{self.joint} = {self.value:.6g} is outside its limits "
+            f"[{self.lower:.6g}, {self.upper:.6g}]"
+        )
+
+
+@dataclass(frozen=True)
+class PoseCheck:
+    """What :func:`check_pose` found.
+
+    Attributes
+    ----------
+    penetrations : tuple of Penetration
+    joint_limit_violations : tuple of JointLimitViolation
+    checked : bool
+        False when the caller skipped the refusal (``check_pose=False``); the
+        findings are still listed.
+    """
+
+    penetrations: tuple[Penetration, ...] = ()
+    joint_limit_violations: tuple[JointLimitViolation, ...] = ()
+    checked: bool = True
+
+    @property
+    def valid(self) -> bool:
+        """True when the pose has neither penetration nor a joint off limits."""
+        return not self.penetrations and not self.joint_limit_violations
+
+    def raise_if_invalid(self) -> None:
+        """Raise :class:`PenetrationError` or :class:`JointLimitError` if invalid."""
+        opt_out = " (pass check_pose=False to analyse it anyway)"
+        if self.penetrations:
+            raise PenetrationError(
+                "impossible pose: " + "; ".join(map(str, self.penetrations)) + opt_out
+            )
+        if self.joint_limit_violations:
+            raise JointLimitError(
+                "impossible pose: "
+                + "; ".join(map(str, self.joint_limit_violations))
+                + opt_out
+            )
+
+    def summary(self) -> str:
+        """One line for a report."""
+        if self.valid:
+            return "pose: valid (no penetration, joints within limits)"
+        found = [str(p) for p in self.penetrations]
+        found += [str(v) for v in self.joint_limit_violations]
+        return "pose: INVALID (analysed with check_pose=False): " + "; ".join(found)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {
+            "valid": self.valid,
+            "checked": self.checked,
+            "penetrations": [vars(p) for p in self.penetrations],
+            "joint_limit_violations": [vars(v) for v in self.joint_limit_violations],
+        }
+
+
+def _penetrations(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    object_body: RigidBody,
+    bodies: Sequence[RigidBody],
+    tol: float,
+    query_object=None,
+) -> list[Penetration]:
+    if not plant.geometry_source_is_registered():
+        raise ModelError("the plant is not registered with a SceneGraph; no geometry")
+    query = query_object
+    if query is None:
+        query = plant.get_geometry_query_input_port().Eval(plant_context)
+    inspector = query.inspector()
+    object_geometries = plant.GetCollisionGeometriesForBody(object_body)
+    out = []
+    for body in bodies:
+        for gh in plant.GetCollisionGeometriesForBody(body):
+            for go in object_geometries:
+                if inspector.CollisionFiltered(go, gh):
+                    continue
+                try:
+                    psi = query.ComputeSignedDistancePairClosestPoints(go, gh).distance
+                except RuntimeError as e:
+                    raise ModelError(
+                        "Drake cannot compute the signed distance between "
+                        f"{inspector.GetName(go)!r} and {inspector.GetName(gh)!r}: {e}"
+                    ) from None
+                if psi < -tol:
+                    out.append(
+                        Penetration(
+                            hand_body=scoped_name(plant, body),
+                            hand_geometry=inspector.GetName(gh),
+                            object_geometry=inspector.GetName(go),
+                            depth=float(-psi),
+                        )
+                    )
+    return out
+
+
+def _joint_violations(
+    plant: MultibodyPlant, plant_context: Context, bodies: Sequence[RigidBody]
+) -> list[JointLimitViolation]:
+    instances = {int(b.model_instance()) for b in bodies}
+    q = plant.GetPositions(plant_context)
+    out = []
+    for i in range(plant.num_joints()):
+        joint = plant.get_joint(JointIndex(i))
+        if int(joint.model_instance()) not in instances or joint.num_positions() == 0:
+            continue
+        lo, hi = joint.position_lower_limits(), joint.position_upper_limits()
+        start = joint.position_start()
+        for k in range(joint.num_positions()):
+            value = float(q[start + k])
+            if value < lo[k] - JOINT_LIMIT_TOL or value > hi[k] + JOINT_LIMIT_TOL:
+                name = f"{plant.GetModelInstanceName(joint.model_instance())}::"
+                name += joint.name() + (f"[{k}]" if joint.num_positions() > 1 else "")
+                out.append(JointLimitViolation(name, value, float(lo[k]), float(hi[k])))
+    return out
+
+
+def check_pose(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    object_body: RigidBody,
+    hand_instance_bodies: Sequence[RigidBody],
+    *,
+    distance_tolerance: float,
+    query_object=None,
+) -> PoseCheck:
+    """Penetrations and joint-limit violations of the hand in this pose.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    plant_context : Context
+        The plant's own context (already resolved).
+    object_body : RigidBody
+    hand_instance_bodies : sequence of RigidBody
+        Every body of the hand's model instances, welded ones included (see
+        :func:`~drakegrasp.plant.validation.hand_model_instances`).
+    distance_tolerance : float
+        Penetration deeper than this (metres) is reported.
+    query_object : pydrake.geometry.QueryObject, optional
+        Read distances from this query object instead of the plant's query
+        input port in ``plant_context`` (a System's private plant context).
+
+    Returns
+    -------
+    PoseCheck
+    """
+    pens = _penetrations(
+        plant,
+        plant_context,
+        object_body,
+        hand_instance_bodies,
+        distance_tolerance,
+        query_object,
+    )
+    joints = _joint_violations(plant, plant_context, hand_instance_bodies)
+    return PoseCheck(tuple(pens), tuple(joints))

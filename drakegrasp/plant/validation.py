@@ -1,0 +1,294 @@
+"""One validator for every plant-layer function: plant, context, bodies, hand.
+
+Every function of :mod:`drakegrasp.plant` that takes ``(plant, plant_context)``
+accepts either the plant's own context or the **root context** of the diagram
+that holds the plant (what a simulation hands its user), and resolves it with
+:func:`plant_context_of`.  Indices and names are checked here, before Drake
+sees them: Drake aborts the interpreter (``SystemExit``) on an out-of-range
+``ModelInstanceIndex``.
+
+**Argument order.**  Everywhere in the plant layer ``object_body`` may be given
+positionally, right after the essential arguments
+(``find_contacts(plant, plant_context, object_body)``,
+``signed_distance_jacobian(plant, plant_context, contacts, object_body)``) or
+by keyword; every option after it is keyword-only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
+from pydrake.systems.framework import Context
+
+from drakegrasp.errors import InvalidContextError, InvalidOptionError, ModelError
+
+__all__ = [
+    "HandSpec",
+    "check_plant",
+    "hand_bodies",
+    "hand_model_instances",
+    "model_instance",
+    "plant_context_of",
+    "resolve_body",
+    "resolve_object_body",
+    "scoped_name",
+]
+
+HandSpec = ModelInstanceIndex | str | Iterable[RigidBody] | None
+
+
+def check_plant(plant) -> MultibodyPlant:
+    """``plant`` itself, once it is known to be a finalized ``MultibodyPlant``.
+
+    Raises
+    ------
+    ModelError
+        If ``plant`` is not a ``MultibodyPlant`` or is not finalized.
+    """
+    if not isinstance(plant, MultibodyPlant):
+        raise ModelError(
+            f"plant must be a pydrake MultibodyPlant, got {type(plant).__name__}"
+        )
+    if not plant.is_finalized():
+        raise ModelError(
+            "the plant is not finalized; call plant.Finalize() before analysing it"
+        )
+    return plant
+
+
+def plant_context_of(plant, context) -> Context:
+    """The plant's context, given the plant's own context or the diagram's root.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized.
+    context : Context
+        The plant's context, or the root context of the diagram that contains
+        the plant (resolved with ``plant.GetMyContextFromRoot``).
+
+    Returns
+    -------
+    Context
+        The plant's context (the same object the caller holds, or the
+        subcontext inside the root context: writes go to the caller's state).
+
+    Raises
+    ------
+    ModelError
+        If the plant is not a finalized ``MultibodyPlant``.
+    InvalidContextError
+        If ``context`` is not a Context, or belongs to another system.
+    """
+    check_plant(plant)
+    if not isinstance(context, Context):
+        raise InvalidContextError(
+            "plant_context must be a pydrake Context (the plant's or the root "
+            f"context of its diagram), got {type(context).__name__}"
+        )
+    try:
+        plant.ValidateContext(context)
+        return context
+    except RuntimeError:
+        pass
+    try:
+        sub = plant.GetMyContextFromRoot(context)
+        plant.ValidateContext(sub)
+        return sub
+    except RuntimeError as e:
+        msg = " ".join(str(e).split())
+        raise InvalidContextError(
+            "plant_context belongs neither to this plant nor to the diagram that "
+            f"holds it (pass plant.GetMyContextFromRoot(root) or the root); "
+            f"Drake says: {msg}"
+        ) from None
+
+
+def scoped_name(plant: MultibodyPlant, body: RigidBody) -> str:
+    """``"model::body"`` of a body."""
+    return f"{plant.GetModelInstanceName(body.model_instance())}::{body.name()}"
+
+
+def _instance_names(plant: MultibodyPlant) -> list[str]:
+    return [
+        plant.GetModelInstanceName(ModelInstanceIndex(i))
+        for i in range(plant.num_model_instances())
+    ]
+
+
+def model_instance(plant: MultibodyPlant, spec) -> ModelInstanceIndex:
+    """A model instance given by index or name, checked before Drake sees it.
+
+    Raises
+    ------
+    ModelError
+        For an unknown name or an index outside ``[0, num_model_instances)``;
+        the message lists the plant's instances.
+    """
+    if isinstance(spec, str):
+        if not plant.HasModelInstanceNamed(spec):
+            raise ModelError(
+                f"no model instance named {spec!r}; instances are "
+                f"{_instance_names(plant)}"
+            )
+        return plant.GetModelInstanceByName(spec)
+    if isinstance(spec, ModelInstanceIndex):
+        n = plant.num_model_instances()
+        if not spec.is_valid() or not 0 <= int(spec) < n:
+            shown = int(spec) if spec.is_valid() else "an invalid index"
+            raise ModelError(
+                f"hand=ModelInstanceIndex({shown}) is not a model instance of the "
+                f"plant: valid indices are 0..{n - 1} ({_instance_names(plant)})"
+            )
+        return spec
+    raise InvalidOptionError(
+        "a model instance must be a ModelInstanceIndex or a name, got "
+        f"{type(spec).__name__}"
+    )
+
+
+def resolve_body(plant: MultibodyPlant, name: str) -> RigidBody:
+    """The body called ``"model::body"`` (or an unscoped name used once).
+
+    Raises
+    ------
+    ModelError
+        If no (or more than one) body has that name; the message lists the
+        plant's bodies.
+    """
+    try:
+        if "::" in name:
+            model, body = name.rsplit("::", 1)
+            if plant.HasModelInstanceNamed(model):
+                instance = plant.GetModelInstanceByName(model)
+                if plant.HasBodyNamed(body, instance):
+                    return plant.GetBodyByName(body, instance)
+        elif plant.HasBodyNamed(name):
+            return plant.GetBodyByName(name)
+    except RuntimeError as e:  # the name is used by several model instances
+        raise ModelError(f"body name {name!r} is ambiguous: {e}") from None
+    bodies = [
+        scoped_name(plant, plant.get_body(BodyIndex(i)))
+        for i in range(1, plant.num_bodies())
+    ]
+    raise ModelError(f"no body named {name!r} in the plant; bodies are {bodies}")
+
+
+def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
+    """A body given as a ``RigidBody`` (of this plant), a ``BodyIndex`` or a name.
+
+    Raises
+    ------
+    ModelError
+        For an unknown name, a ``BodyIndex`` out of range, or a body of
+        another plant.
+    InvalidOptionError
+        For any other type.
+    """
+    if isinstance(object_body, RigidBody):
+        if object_body.GetParentPlant() is not plant:
+            raise ModelError(
+                f"body {object_body.name()!r} does not belong to this plant"
+            )
+        return object_body
+    if isinstance(object_body, BodyIndex):
+        n = plant.num_bodies()
+        if not object_body.is_valid() or not 0 <= int(object_body) < n:
+            raise ModelError(
+                f"BodyIndex({int(object_body) if object_body.is_valid() else '?'}) "
+                f"is not a body of the plant: valid indices are 0..{n - 1}"
+            )
+        return plant.get_body(object_body)
+    if isinstance(object_body, str):
+        return resolve_body(plant, object_body)
+    raise InvalidOptionError(
+        "object_body must be a RigidBody, a BodyIndex or a 'model::body' name, "
+        f"got {type(object_body).__name__}"
+    )
+
+
+def _welded_to_world(plant: MultibodyPlant) -> set[int]:
+    return {int(b.index()) for b in plant.GetBodiesWeldedTo(plant.world_body())}
+
+
+def hand_bodies(
+    plant: MultibodyPlant, object_body: RigidBody, hand: HandSpec = None
+) -> list[RigidBody]:
+    """The bodies of the hand that can move.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    object_body : RigidBody
+    hand : ModelInstanceIndex, str, iterable of RigidBody (or scoped names), or None
+        A model instance, given by index or name (all its bodies that are not
+        welded to the world), an explicit list of bodies, or None: every body
+        that is not the object, not welded to the world and not in the object's
+        model instance.
+
+    Returns
+    -------
+    list of RigidBody
+        In body-index order.
+
+    Raises
+    ------
+    ModelError
+        For an unknown instance or body, or a hand left with no body that can
+        move (for instance a list of bodies all welded to the world).
+    """
+    welded = _welded_to_world(plant)
+    if isinstance(hand, str | ModelInstanceIndex):
+        instance = model_instance(plant, hand)
+        bodies = [plant.get_body(i) for i in plant.GetBodyIndices(instance)]
+        bodies = [b for b in bodies if int(b.index()) not in welded]
+    elif hand is None:
+        bodies = [
+            plant.get_body(BodyIndex(i))
+            for i in range(plant.num_bodies())
+            if i not in welded
+        ]
+        bodies = [
+            b for b in bodies if b.model_instance() != object_body.model_instance()
+        ]
+    else:
+        listed = [resolve_object_body(plant, b) for b in hand]
+        bodies = [b for b in listed if int(b.index()) not in welded]
+        if listed and not bodies:
+            raise ModelError(
+                "every body listed as the hand is welded to the world, so none can "
+                f"move: {[scoped_name(plant, b) for b in listed]}; list the "
+                "fingers' bodies or name the hand's model instance"
+            )
+    bodies = [b for b in bodies if b.index() != object_body.index()]
+    if not bodies:
+        raise ModelError(
+            f"the hand has no bodies that can move (hand={hand!r}); name its model "
+            "instance or list its bodies"
+        )
+    return sorted(bodies, key=lambda b: int(b.index()))
+
+
+def hand_model_instances(
+    plant: MultibodyPlant, bodies: Iterable[RigidBody], object_body: RigidBody
+) -> list[RigidBody]:
+    """Every body of the model instances the hand's bodies belong to.
+
+    This is what a pose check looks at: the moving fingers *and* the palm,
+    even when the palm is welded to the world.  The object and the world
+    body are left out.
+
+    Returns
+    -------
+    list of RigidBody
+        In body-index order.
+    """
+    instances = {int(b.model_instance()) for b in bodies}
+    out = []
+    for i in range(1, plant.num_bodies()):
+        b = plant.get_body(BodyIndex(i))
+        if int(b.model_instance()) in instances and b.index() != object_body.index():
+            out.append(b)
+    return out

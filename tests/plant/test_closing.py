@@ -1,0 +1,298 @@
+"""close_hand on real hands (WSG-50, Allegro, Franka) from drake_models.
+
+Every closed pose is checked by routes of its own: Drake's signed distances
+over every hand/object geometry pair, the joint limits read from the plant,
+a force-closure LP written here with scipy (not the library's programs), and
+central finite differences of ψ for ∂ψ/∂v.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from pydrake.multibody.tree import BodyIndex
+from scipy.optimize import linprog
+
+from drakegrasp import (
+    InvalidOptionError,
+    PenetrationError,
+    UnreachableError,
+    analyze_grasp,
+    close_hand,
+    grasp_from_plant,
+)
+from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
+
+
+def all_pair_distances(scene):
+    """ψ of every (hand-instance body geometry, object geometry) pair."""
+    plant, ctx = scene.plant, scene.ctx
+    query = plant.get_geometry_query_input_port().Eval(ctx)
+    inspector = query.inspector()
+    out = {}
+    for i in range(plant.num_bodies()):
+        body = plant.get_body(BodyIndex(i))
+        if body.model_instance() != scene.hand:
+            continue
+        for gh in plant.GetCollisionGeometriesForBody(body):
+            for go in plant.GetCollisionGeometriesForBody(scene.object):
+                if not inspector.CollisionFiltered(go, gh):
+                    r = query.ComputeSignedDistancePairClosestPoints(go, gh)
+                    out[(body.name(), inspector.GetName(gh), go)] = r.distance
+    return out
+
+
+def check_closed(scene, closure):
+    """The closure's claims, each checked against the plant directly."""
+    plant, ctx = scene.plant, scene.ctx
+    q = plant.GetPositions(ctx)
+    np.testing.assert_array_equal(q[closure.position_indices], closure.q)
+    for name, qi in zip(closure.joints, closure.q, strict=True):
+        joint = plant.GetJointByName(name.split("::")[-1], scene.hand)
+        assert (
+            joint.position_lower_limits()[0] <= qi <= joint.position_upper_limits()[0]
+        )
+    distances = all_pair_distances(scene)
+    assert min(distances.values()) >= -TOL  # no hand body penetrates the object
+    for finger in closure.fingers:
+        mine = [
+            d
+            for (body, _, _), d in distances.items()
+            if f"{plant.GetModelInstanceName(scene.hand)}::{body}" in finger.bodies
+        ]
+        if finger.status == "touching":
+            assert 0.0 <= finger.psi <= TOL
+            assert abs(min(mine) - finger.psi) < 1e-12
+        else:
+            assert min(mine) > TOL
+
+
+def independent_force_closure(contacts, mu: float, n_g: int = 8) -> bool:
+    """Force closure on inscribed pyramids: 0 strictly inside the wrench hull.
+
+    Written here from the definition (not the library's LP2): with primitive
+    wrenches ``w_k = [s_k; c × s_k]`` of every generator of every cone, the grasp
+    is in force closure iff rank W = 6 and ``W λ = 0`` has a solution with every
+    ``λ_k >= t > 0`` (``Σ λ = 1``).
+    """
+    W = []
+    for c in contacts:
+        n = c.nhat_O
+        a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+        t1 = np.cross(n, a)
+        t1 /= np.linalg.norm(t1)
+        t2 = np.cross(n, t1)
+        for k in range(n_g):
+            th = 2 * np.pi * k / n_g
+            s = n + mu * (np.cos(th) * t1 + np.sin(th) * t2)
+            W.append(np.concatenate([s, np.cross(c.p_OC, s)]))
+    W = np.array(W).T
+    if np.linalg.matrix_rank(W, tol=1e-9 * np.abs(W).max()) < 6:
+        return False
+    m = W.shape[1]
+    # variables [λ (m), t]; maximise t
+    cost = np.zeros(m + 1)
+    cost[-1] = -1.0
+    A_eq = np.vstack([np.hstack([W, np.zeros((6, 1))]), np.r_[np.ones(m), 0.0]])
+    b_eq = np.r_[np.zeros(6), 1.0]
+    A_ub = np.hstack([-np.eye(m), np.ones((m, 1))])  # t - λ_k <= 0
+    res = linprog(cost, A_ub=A_ub, b_ub=np.zeros(m), A_eq=A_eq, b_eq=b_eq,
+                  bounds=[(0, None)] * (m + 1), method="highs")  # fmt: skip
+    if res.status == 2:  # no λ >= 0 with W λ = 0, Σ λ = 1: 0 is outside the hull
+        return False
+    assert res.status == 0
+    return -res.fun > 1e-9
+
+
+def test_wsg_closes_on_the_sugar_box(real_hands):
+    scene = real_hands.wsg()
+    X_WO = scene.plant.EvalBodyPoseInWorld(scene.ctx, scene.object)
+    closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    assert [f.status for f in closure.fingers] == ["touching", "touching"]
+    assert closure.iterations < 20
+    check_closed(scene, closure)
+    # Symmetric: each pad at 39.1 / 2 mm from the box's mid-plane.
+    np.testing.assert_allclose(closure.q, [-0.01705, 0.01705], atol=TOL)
+    assert scene.plant.EvalBodyPoseInWorld(scene.ctx, scene.object).IsExactlyEqualTo(
+        X_WO
+    )
+    report = analyze_grasp(
+        scene.plant, scene.ctx, scene.object, hand=scene.hand, mu=0.5
+    )
+    assert report.pose.valid
+    assert report.J.shape[1] == 2
+    assert report.force_closure.frictional_closure == independent_force_closure(
+        report.contacts, 0.5
+    )
+    assert report.force_closure.frictional_closure
+    json.dumps(closure.to_dict())
+    assert "2 of 2 fingers touch" in str(closure)
+
+
+def test_allegro_closes_on_a_ball(real_hands):
+    scene = real_hands.allegro()
+    closure = close_hand(scene.plant, scene.root, scene.object, hand=scene.hand)
+    assert len(closure.fingers) == 4
+    assert all(len(f.joints) == 4 for f in closure.fingers)
+    assert len(closure.touching_fingers) >= 3
+    check_closed(scene, closure)
+    data = grasp_from_plant(
+        scene.plant, scene.ctx, scene.object, hand=scene.hand, mu=0.5
+    )
+    assert data.hand_jacobian.shape[1] == 16  # one column per hand velocity
+    assert data.pose.valid
+    for mu in (0.1, 0.5, 1.0):
+        report = analyze_grasp(
+            scene.plant, scene.ctx, scene.object, hand=scene.hand, mu=mu
+        )
+        assert report.force_closure.frictional_closure == independent_force_closure(
+            report.contacts, mu
+        )
+
+
+def test_allegro_dpsi_dv_matches_central_differences(real_hands, tools):
+    scene = real_hands.allegro()
+    close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    plant, ctx = scene.plant, scene.ctx
+    data = grasp_from_plant(plant, ctx, scene.object, hand=scene.hand, mu=0.5)
+    q0 = plant.GetPositions(ctx)
+
+    def psi_of(q):
+        plant.SetPositions(ctx, q)
+        query = plant.get_geometry_query_input_port().Eval(ctx)
+        return np.array(
+            [
+                query.ComputeSignedDistancePairClosestPoints(
+                    c.object_geometry, c.finger_geometry
+                ).distance
+                for c in data.contacts
+            ]
+        )
+
+    h = 1e-6
+    fd = np.zeros_like(data.dpsi_dv)
+    for k in range(plant.num_velocities()):
+        dv = np.zeros(plant.num_velocities())
+        dv[k] = h
+        plant.SetPositions(ctx, q0)
+        q_plus = tools.step_q(plant, ctx, dv)
+        q_minus = tools.step_q(plant, ctx, -dv)
+        fd[:, k] = (psi_of(q_plus) - psi_of(q_minus)) / (2 * h)
+    plant.SetPositions(ctx, q0)
+    # Sphere tips on a sphere: Drake's distance is analytic, so FD is clean.
+    np.testing.assert_allclose(data.dpsi_dv, fd, atol=1e-6)
+
+
+def test_franka_hand_closes_each_finger(real_hands):
+    scene = real_hands.franka()
+    closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    assert closure.touching_fingers == (
+        "hand::panda_finger_joint1",
+        "hand::panda_finger_joint2",
+    )
+    check_closed(scene, closure)
+    # The box sits 5 mm off-centre: the fingers stop 10 mm apart in q.
+    assert closure.q[0] - closure.q[1] == pytest.approx(0.01, abs=2 * TOL)
+
+
+def test_mimic_coupled_franka_moves_as_one_finger(
+    real_hands, drake_models_dir, tmp_path
+):
+    text = (drake_models_dir / "franka_description/urdf/hand.urdf").read_text()
+    marker = '<joint name="panda_finger_joint2" type="prismatic">'
+    assert marker in text
+    coupled = text.replace(
+        marker, marker + '<mimic joint="panda_finger_joint1" multiplier="1"/>'
+    )
+    path = tmp_path / "hand_mimic.urdf"
+    path.write_text(coupled)
+    scene = real_hands.franka(edit=path)
+    assert scene.plant.num_constraints() == 1  # Drake made a coupler constraint
+    with pytest.raises(InvalidOptionError, match="couplings="):
+        close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    closure = close_hand(
+        scene.plant,
+        scene.ctx,
+        scene.object,
+        hand=scene.hand,
+        couplings=[
+            ("hand::panda_finger_joint2", "hand::panda_finger_joint1", 1.0, 0.0)
+        ],
+    )
+    assert len(closure.fingers) == 1 and closure.fingers[0].status == "touching"
+    assert closure.q[0] == closure.q[1]  # the coupling holds
+    check_closed(scene, closure)
+    # Off-centre: the rigidly coupled pair stops when the nearer finger touches.
+    assert closure.fingers[0].touching_body == "hand::panda_leftfinger"
+
+
+def test_direction_synergy_and_bad_directions(real_hands):
+    scene = real_hands.wsg()
+    closure = close_hand(
+        scene.plant, scene.ctx, scene.object, hand=scene.hand, direction=[1.0, -1.0]
+    )
+    np.testing.assert_allclose(closure.q, [-0.01705, 0.01705], atol=TOL)
+    scene = real_hands.wsg()
+    closure = close_hand(
+        scene.plant, scene.ctx, scene.object, hand=scene.hand, direction=[1.0, 0.0]
+    )
+    assert [f.status for f in closure.fingers] == ["touching", "fixed"]
+    # Away from the object: the path ends at the limit.
+    scene = real_hands.wsg()
+    with pytest.raises(UnreachableError, match="at limit"):
+        close_hand(
+            scene.plant, scene.ctx, scene.object, hand=scene.hand, direction=[-1.0, 1.0]
+        )
+    for bad in ([1.0], [np.nan, 1.0], "up"):
+        with pytest.raises(InvalidOptionError, match="direction"):
+            close_hand(
+                scene.plant, scene.ctx, scene.object, hand=scene.hand, direction=bad
+            )
+
+
+def test_out_of_reach_names_the_fingers_and_leaves_the_context(real_hands):
+    scene = real_hands.allegro(p_ball=(0.3, 0.0, 0.1))
+    q0 = scene.plant.GetPositions(scene.ctx)
+    with pytest.raises(UnreachableError) as info:
+        close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    message = str(info.value)
+    for root in ("joint_0", "joint_4", "joint_8", "joint_12"):
+        assert f"allegro_hand_right::{root}" in message
+    assert "0 of 4 fingers" in message
+    np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
+    closure = info.value.closure
+    assert all(f.status in ("at limit", "not converged") for f in closure.fingers)
+    assert all(f.iterations <= 100 for f in closure.fingers)
+
+
+def test_bounded_iterations_and_min_fingers(real_hands):
+    scene = real_hands.allegro()
+    with pytest.raises(UnreachableError, match="not converged"):
+        close_hand(
+            scene.plant, scene.ctx, scene.object, hand=scene.hand, max_iterations=1
+        )
+    with pytest.raises(UnreachableError, match="min_fingers = 5"):
+        close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand, min_fingers=5)
+    for bad in (0, 2.5, None):
+        with pytest.raises(InvalidOptionError, match="max_iterations"):
+            close_hand(
+                scene.plant,
+                scene.ctx,
+                scene.object,
+                hand=scene.hand,
+                max_iterations=bad,
+            )
+    with pytest.raises(InvalidOptionError, match="distance_tolerance"):
+        close_hand(
+            scene.plant, scene.ctx, scene.object, hand=scene.hand, distance_tolerance=-1
+        )
+
+
+def test_pre_shape_penetration_is_refused(real_hands):
+    # The sugar box sunk 20.6 mm into the WSG-50's (welded) palm.
+    X = real_hands.rt([[0, 0, 1], [1, 0, 0], [0, 1, 0]], [0, 0.0590, 0])
+    scene = real_hands.wsg(X_WO=X)
+    with pytest.raises(PenetrationError, match=r"Schunk_Gripper::body .* 20\.6"):
+        close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)

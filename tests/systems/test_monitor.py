@@ -1,0 +1,232 @@
+"""GraspMonitor in a running simulation, checked against a second route.
+
+The pick of ``pick.py`` (the shipped parallel-jaw gripper closes on a free box
+under gravity, lifts it 5 cm, lowers it and opens) runs in a ``Simulator``.
+The monitor's logged verdicts must go "no contact" -> "force closure" ->
+"no contact", and every sample must equal what ``analyze_grasp`` says on the
+logged plant state, evaluated through the diagram's own scene graph (not the
+monitor's private context and query input).
+
+Drake's sample-and-hold: a log taken at a sample time t_k shows the value held
+before the update at t_k, so the verdict logged at t_{k+1} is the sample of
+the state logged at t_k.
+"""
+
+import numpy as np
+import pytest
+from pick import DURATION, LIFT, build_pick
+from pydrake.math import RigidTransform
+from pydrake.multibody.plant import MultibodyPlant
+
+import drakegrasp as dg
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.systems import VERDICT_NAMES, GraspMonitor, GraspSample
+
+SOFT = {"contact_model": "soft_finger", "torsional_friction": 0.1}
+OPTIONS = {"mu": 0.5, "distance_tolerance": 1e-3}
+
+
+def _runs(values: np.ndarray) -> list[float]:
+    """The sequence of distinct consecutive values."""
+    out: list[float] = []
+    for v in values:
+        if not out or v != out[-1]:
+            out.append(float(v))
+    return out
+
+
+def _second_route(pick, x, **options) -> np.ndarray:
+    """Verdicts of analyze_grasp on state x, in a fresh diagram context."""
+    context = pick.diagram.CreateDefaultContext()
+    plant_context = pick.plant.GetMyMutableContextFromRoot(context)
+    pick.plant.SetPositionsAndVelocities(plant_context, x)
+    box = pick.plant.GetBodyByName("box", pick.box)
+    try:
+        r = dg.analyze_grasp(
+            pick.plant, plant_context, object_body=box, hand=pick.gripper, **options
+        )
+    except dg.NoContactsError:
+        return np.zeros(len(VERDICT_NAMES))
+    eps = dg.ferrari_canny(r.grasp) if r.is_force_closure else 0.0
+    antipodal = r.antipodal is not None and r.antipodal.is_antipodal
+    return np.array(
+        [
+            1.0,
+            r.force_closure.is_closure,
+            r.form_closure.is_closure,
+            antipodal,
+            r.grasp.num_contacts,
+            r.force_closure.d_star,
+            eps,
+        ],
+        dtype=float,
+    )
+
+
+@pytest.fixture(scope="module")
+def point_pick():
+    pick = build_pick(plant_contact="point", **OPTIONS, **SOFT)
+    pick.run()
+    return pick
+
+
+def test_point_contact_pick_timeline(point_pick):
+    context = point_pick.simulator.get_context()
+    log = point_pick.verdict_log.FindLog(context)
+    times, verdicts = log.sample_times(), log.data()
+    status = verdicts[GraspMonitor.STATUS]
+    closure = verdicts[GraspMonitor.FORCE_CLOSURE]
+    print(
+        "verdict timeline:",
+        [
+            (round(float(times[k]), 3), int(status[k]), int(closure[k]))
+            for k in range(len(times))
+            if k == 0 or status[k] != status[k - 1] or closure[k] != closure[k - 1]
+        ],
+    )
+    assert _runs(status) == [0.0, 1.0, 0.0]
+    assert _runs(closure) == [0.0, 1.0, 0.0]
+    held = times[closure == 1.0]
+    # Closing starts at 0.3 s (contact near 0.55 s); opening at 2.3 s.
+    assert 0.4 < held[0] < 0.75 and 2.3 < held[-1] < 2.65
+    # While held, two antipodal soft-finger contacts with a positive margin.
+    assert np.all(verdicts[GraspMonitor.NUM_CONTACTS][closure == 1.0] == 2)
+    assert np.all(verdicts[GraspMonitor.ANTIPODAL][closure == 1.0] == 1)
+    assert np.all(verdicts[GraspMonitor.D_STAR][closure == 1.0] > 1e-3)
+    assert np.all(verdicts[GraspMonitor.EPSILON][closure == 1.0] > 0)
+    # The box really was lifted while in force closure.
+    states = point_pick.state_log.FindLog(context)
+    plant = point_pick.plant
+    plant_context = plant.CreateDefaultContext()
+    box = plant.GetBodyByName("box", point_pick.box)
+    heights = []
+    for x in states.data().T:
+        plant.SetPositionsAndVelocities(plant_context, x)
+        heights.append(plant.EvalBodyPoseInWorld(plant_context, box).translation()[2])
+    heights = np.array(heights)
+    lifted = np.isclose(times, 1.6)
+    assert heights[lifted][0] > 0.05 + 0.9 * LIFT
+    assert np.all(heights[:5] < 0.0505) and np.all(heights[-5:] < 0.0505)
+    # Every sample while the box hung in the air was force closure (the log
+    # lags the state by one sample).
+    airborne = np.flatnonzero(heights > 0.052)
+    assert len(airborne) > 10 and np.all(closure[airborne + 1] == 1.0)
+
+
+def test_point_contact_monitor_matches_analyze_grasp(point_pick):
+    context = point_pick.simulator.get_context()
+    states = point_pick.state_log.FindLog(context)
+    verdicts = point_pick.verdict_log.FindLog(context)
+    np.testing.assert_array_equal(states.sample_times(), verdicts.sample_times())
+    X, V = states.data(), verdicts.data()
+    assert X.shape[1] == round(DURATION / point_pick.monitor.period) + 1
+    for k in range(X.shape[1] - 1):
+        expected = _second_route(point_pick, X[:, k], **OPTIONS, **SOFT)
+        np.testing.assert_allclose(
+            V[:, k + 1], expected, rtol=1e-9, atol=1e-12, err_msg=f"sample {k}"
+        )
+
+
+def test_report_port_holds_the_last_sample(point_pick):
+    context = point_pick.simulator.get_context()
+    monitor_context = point_pick.monitor.GetMyContextFromRoot(context)
+    sample = point_pick.monitor.get_report_output_port().Eval(monitor_context)
+    assert isinstance(sample, GraspSample)
+    period = point_pick.monitor.period
+    assert sample.time == pytest.approx(DURATION - period)
+    assert sample.status == "no contact" and sample.report is None
+    assert "does not touch" in sample.message
+    np.testing.assert_array_equal(
+        sample.verdicts,
+        point_pick.monitor.get_verdicts_output_port().Eval(monitor_context),
+    )
+
+
+@pytest.fixture(scope="module")
+def hydro_pick():
+    """Flat pads, hydroelastic contact, contacts from the contact results.
+
+    Also returns the live sample while the box is lifted (t = 1.6 s): a
+    discrete plant's contact results come from its last step, so they exist
+    only in the simulator's own context, not in a fresh one.
+    """
+    pick = build_pick(
+        plant_contact="hydroelastic_with_fallback",
+        flat=True,
+        contacts="contact_results",
+        **OPTIONS,
+    )
+    pick.run(1.6)
+    context = pick.monitor.GetMyContextFromRoot(pick.simulator.get_context())
+    lifted = pick.monitor.evaluate(context)
+    pick.run()
+    return pick, lifted
+
+
+def test_hydroelastic_pick_timeline(hydro_pick):
+    pick, _ = hydro_pick
+    log = pick.verdict_log.FindLog(pick.simulator.get_context())
+    V = log.data()
+    closure = V[GraspMonitor.FORCE_CLOSURE]
+    assert _runs(V[GraspMonitor.STATUS]) == [0.0, 1.0, 0.0]
+    assert _runs(closure) == [0.0, 1.0, 0.0]
+    # Hard fingers: two flat patches (a 4-vertex polygon each) resist torsion.
+    assert set(V[GraspMonitor.NUM_CONTACTS][closure == 1.0]) == {8.0}
+
+
+def test_hydroelastic_patches_match_the_geometry(hydro_pick):
+    pick, sample = hydro_pick
+    assert sample.status == "ok", sample.message
+    report = sample.report
+    normals = np.array([c.nhat_O for c in report.contacts])
+    np.testing.assert_allclose(np.abs(normals[:, 1]), 1.0, atol=1e-6)
+    assert sorted(np.sign(normals[:, 1])) == [-1] * 4 + [1] * 4
+    p = np.array([c.p_OC for c in report.contacts])
+    np.testing.assert_allclose(np.abs(p[:, 1]), 0.025, atol=1e-3)  # box faces
+    assert np.all(np.abs(p[:, 0]) <= 0.0101)  # inside the 20 x 20 mm pads
+    assert {c.normal_source for c in report.contacts} == {"hydroelastic"}
+    # Signed distances on the same state find the same two patches.
+    geometric = _second_route(pick, sample.state, **OPTIONS)
+    assert geometric[GraspMonitor.FORCE_CLOSURE] == 1.0
+    assert geometric[GraspMonitor.NUM_CONTACTS] == 8
+    assert report.force_closure.d_star == pytest.approx(
+        geometric[GraspMonitor.D_STAR], rel=0.05
+    )
+
+
+def test_deep_penetration_is_an_invalid_sample(point_pick):
+    context = point_pick.diagram.CreateDefaultContext()
+    plant = point_pick.plant
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    for name in ("left_finger_joint", "right_finger_joint"):
+        plant.GetJointByName(name, point_pick.gripper).set_translation(
+            plant_context,
+            0.022,  # 3 mm into the 50 mm box
+        )
+    box = plant.GetBodyByName("box", point_pick.box)
+    plant.SetFreeBodyPose(plant_context, box, RigidTransform([0.0, 0.0, 0.05]))
+    sample = point_pick.monitor.evaluate(
+        point_pick.monitor.GetMyContextFromRoot(context)
+    )
+    assert sample.status == "invalid"
+    assert "penetrat" in sample.message
+    assert sample.verdicts[GraspMonitor.STATUS] == -1.0
+
+
+def test_bad_options_fail_at_construction(point_pick):
+    plant, box = point_pick.plant, "box::box"
+    with pytest.raises(InvalidOptionError, match="period"):
+        GraspMonitor(plant, object_body=box, mu=0.5, period=0.0)
+    with pytest.raises(InvalidOptionError, match="contacts must be"):
+        GraspMonitor(plant, object_body=box, mu=0.5, contacts="magic")
+    with pytest.raises(InvalidOptionError, match="torsional_friction"):
+        GraspMonitor(plant, object_body=box, mu=0.5, contact_model="soft_finger")
+    with pytest.raises(dg.GraspError, match="mu"):
+        GraspMonitor(plant, object_body=box, mu=-1.0)
+    with pytest.raises(InvalidOptionError, match="finalized"):
+        GraspMonitor(MultibodyPlant(0.0), object_body=box, mu=0.5)
+    with pytest.raises(dg.ModelError, match="no body named"):
+        GraspMonitor(plant, object_body="box::nothing", mu=0.5)
+    geometric = GraspMonitor(plant, object_body=box, mu=0.5)
+    with pytest.raises(InvalidOptionError, match="contact_results"):
+        geometric.get_contact_results_input_port()

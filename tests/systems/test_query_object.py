@@ -1,0 +1,62 @@
+"""``query_object=``: analyse a plant context that no scene graph feeds.
+
+A Drake ``System`` (the grasp monitor) holds its own plant context whose
+geometry query port is not connected; it passes the scene graph's query object
+from one of its input ports instead.  The answer must be the one the connected
+context gives.
+"""
+
+import numpy as np
+import pytest
+
+import drakegrasp as dg
+from drakegrasp.errors import InvalidOptionError
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return dg.load_scene("parallel_jaw_flat_box")
+
+
+def _private_context(scene):
+    """A fresh plant context with the scene's state: no scene graph behind it."""
+    context = scene.plant.CreateDefaultContext()
+    scene.plant.SetPositionsAndVelocities(
+        context, scene.plant.GetPositionsAndVelocities(scene.plant_context)
+    )
+    return context
+
+
+def _query(scene):
+    return scene.plant.get_geometry_query_input_port().Eval(scene.plant_context)
+
+
+def test_unconnected_context_needs_a_query_object(scene):
+    with pytest.raises(RuntimeError):
+        dg.find_contacts(
+            scene.plant, _private_context(scene), object_body=scene.object_body
+        )
+
+
+def test_query_object_gives_the_connected_answer(scene):
+    options = scene.analysis_options()
+    reference = dg.analyze_grasp(scene.plant, scene.plant_context, **options)
+    report = dg.analyze_grasp(
+        scene.plant, _private_context(scene), query_object=_query(scene), **options
+    )
+    assert len(report.contacts) == len(reference.contacts) == 8
+    for a, b in zip(report.contacts, reference.contacts, strict=True):
+        np.testing.assert_array_equal(a.p_OC, b.p_OC)
+        np.testing.assert_array_equal(a.nhat_O, b.nhat_O)
+    np.testing.assert_array_equal(report.J, reference.J)
+    assert report.force_closure.d_star == reference.force_closure.d_star
+
+
+def test_query_object_of_the_wrong_type(scene):
+    with pytest.raises(InvalidOptionError, match="query_object must be"):
+        dg.find_contacts(
+            scene.plant,
+            scene.plant_context,
+            object_body=scene.object_body,
+            query_object="scene_graph",
+        )
