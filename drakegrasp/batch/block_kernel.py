@@ -10,7 +10,7 @@ stops each problem at its own iteration.  The numpy version stays the reference
 that the tests compare against.
 
 numba is an optional dependency (``pip install drakegrasp[fast]``);
-:data:`AVAILABLE` says whether this kernel can be used.
+``AVAILABLE`` says whether this kernel can be used.
 """
 
 from __future__ import annotations

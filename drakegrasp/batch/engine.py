@@ -40,7 +40,7 @@ __all__ = [
 ]
 
 DEFAULT_CHUNK_SIZE = None
-"""``chunk_size=None``: chunks are sized by bytes (:data:`CHUNK_BYTES`)."""
+"""``chunk_size=None``: chunks are sized by bytes (``CHUNK_BYTES``)."""
 
 PARALLEL_MIN_WORK = 200_000
 """With ``workers=None``, batches of fewer than this many contacts (``K N``) run
@@ -356,7 +356,7 @@ def _chunks(K: int, chunk_size: int, progress: bool, desc: str) -> Iterator[slic
 
 
 def chunk_size_for(N: int, d: int, chunk_size: int | None) -> int:
-    """Grasps per chunk: ``chunk_size``, or as many as fit in :data:`CHUNK_BYTES`.
+    """Grasps per chunk: ``chunk_size``, or as many as fit in ``CHUNK_BYTES``.
 
     A grasp's working set is dominated by its grasp matrix, row-space basis
     and equality rows (``~3 (w + 1) M`` numbers, ``M <= 4N`` components) and
@@ -640,7 +640,7 @@ def batch_force_closure(
         as zero, so the rank does not depend on units or on ``p``.
     chunk_size : int, optional
         Grasps processed together; memory use grows with it, not with ``K``.
-        Default (None): as many as fit in :data:`CHUNK_BYTES` for this ``N``.
+        Default (None): as many as fit in ``CHUNK_BYTES`` for this ``N``.
     progress : bool, optional
         Show a tqdm progress bar (needs the optional package ``tqdm``).
     metrics : sequence of str, optional

@@ -8,8 +8,8 @@ business, see :mod:`drakegrasp.batch.io`):
 * ``.npz``: each result array is appended, chunk by chunk, to its own ``.npy``
   file in a scratch directory beside the output (the header is written first,
   since ``K`` is known); the files are then copied block by block into an
-  uncompressed zip archive that :func:`numpy.load` reads like
-  :func:`numpy.savez`'s, with the 0-d arrays ``kind``, ``tol`` and
+  uncompressed zip archive that ``numpy.load`` reads like
+  ``numpy.savez``'s, with the 0-d arrays ``kind``, ``tol`` and
   ``required_rank``.
 * ``.parquet`` (optional extra ``parquet``: pyarrow): one row group per chunk,
   one column per array, ``kind``/``tol``/``required_rank`` in the schema
