@@ -43,6 +43,10 @@ from pydrake.solvers import (
     SolutionResult,
 )
 
+from drakegrasp._dense_constraints import (
+    add_linear_constraint,
+    add_linear_equality_constraint,
+)
 from drakegrasp.errors import InvalidOptionError, SolverError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.grasp import (
@@ -170,7 +174,8 @@ def _margin_program(
 
 def _add_normal_budget(prog, normal_forces, num_contacts: int) -> None:
     """``Σ f_n <= N`` (the normalisation of LP1–LP3)."""
-    prog.AddLinearConstraint(
+    add_linear_constraint(
+        prog,
         np.ones((1, len(normal_forces))),
         [-np.inf],
         [float(num_contacts)],
@@ -181,7 +186,8 @@ def _add_normal_budget(prog, normal_forces, num_contacts: int) -> None:
 def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
     """``A x - 1 d >= 0``."""
     A = np.atleast_2d(A)
-    prog.AddLinearConstraint(
+    add_linear_constraint(
+        prog,
         np.hstack([A, -np.ones((A.shape[0], 1))]),
         np.zeros(A.shape[0]),
         np.full(A.shape[0], np.inf),
@@ -206,7 +212,7 @@ def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
     rows = _row_space(A_s, rank_tol) / scale
     if rows.shape[0]:
         rows = np.linalg.qr(rows.T)[0].T
-        prog.AddLinearEqualityConstraint(rows, np.zeros(rows.shape[0]), x)
+        add_linear_equality_constraint(prog, rows, np.zeros(rows.shape[0]), x)
 
 
 def build_form_closure_program(
