@@ -35,7 +35,11 @@ from drakegrasp.batch.construction import (
 )
 from drakegrasp.batch.margin import solve_margin_blocks
 from drakegrasp.batch.metrics import epsilon_l1_per_grasp, singular_value_metrics
-from drakegrasp.batch.rowspace import normalised_positions
+from drakegrasp.batch.rowspace import (
+    _householder,
+    _inverse_frobenius,
+    normalised_positions,
+)
 
 __all__ = ["finish", "force_chunk", "form_chunk"]
 
@@ -90,10 +94,17 @@ def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel)
     N = Gn.shape[2]
     if N <= Gn.shape[1]:
         # Balancing normal forces need N(G_n) != {0}; with no more contacts than
-        # wrench rows the single path's rank rule (SVD) rules it out cheaply.
-        sv = np.linalg.svd(Gn, compute_uv=False)
-        deficient = sv[:, -1] <= rank_tol * sv[:, 0]
-        rows, Gn = rows[deficient], Gn[deficient]
+        # wrench rows that is rare.  A vectorised QR certifies full column rank
+        # for most grasps (as in rowspace); the rest take the exact SVD rule.
+        A = np.ascontiguousarray(np.transpose(Gn, (1, 2, 0)))  # (w, N, k)
+        R, _ = _householder(A)
+        norm = np.sqrt(np.einsum("kij,kij->k", Gn, Gn))
+        unsure = ~(_inverse_frobenius(R) * rank_tol * norm < 1.0)
+        rows, Gn = rows[unsure], Gn[unsure]
+        if rows.size:
+            sv = np.linalg.svd(Gn, compute_uv=False)
+            deficient = sv[:, -1] <= rank_tol * sv[:, 0]
+            rows, Gn = rows[deficient], Gn[deficient]
         if rows.size == 0:
             return out
     out[rows] = _lp1(Gn, rank_tol, kernel).d_star

@@ -442,9 +442,9 @@ def _check_kernel(kernel: str) -> str:
             f"kernel must be 'auto', 'numba' or 'numpy', got {kernel!r}"
         )
     if kernel == "numba":
-        from drakegrasp.batch.block_kernel import AVAILABLE
+        from drakegrasp.batch.margin import numba_available
 
-        if not AVAILABLE:
+        if not numba_available():
             raise InvalidOptionError(
                 "kernel='numba' needs the optional package numba "
                 "(pip install drakegrasp[fast]); use kernel='numpy'"
