@@ -141,6 +141,9 @@ def solve_margin_blocks(
     d_star = np.zeros(K)
     converged = np.ones(K, dtype=bool)
     contact_groups = _contact_groups(facets, component_slices, kappa)
+    # d* = N t: tighten the tolerance on t beyond 4 contacts so that d* keeps
+    # about 4 ipm_tol absolute accuracy at any N.
+    tol_t = ipm_tol * min(1.0, 4.0 / N)
     for sel, Q in spaces:
         r = Q.shape[1]
         if r >= M:
@@ -174,7 +177,7 @@ def solve_margin_blocks(
                 np.transpose(A, (2, 0, 1)),
                 kappa[sel],
                 np.ascontiguousarray(f0.T),
-                tol=ipm_tol,
+                tol=tol_t,
                 max_iter=ipm_max_iter,
                 stop_below=0.0,
             )
@@ -189,7 +192,7 @@ def solve_margin_blocks(
                 for members, cols in contact_groups
             ]
             sol = solve_block_lp(
-                groups, tol=ipm_tol, max_iter=ipm_max_iter, stop_below=0.0
+                groups, tol=tol_t, max_iter=ipm_max_iter, stop_below=0.0
             )
             t, ok = sol.value, sol.converged
         if not ok.all():
