@@ -49,11 +49,13 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.optimize import linprog  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_batch import lp_matrices  # noqa: E402
+
 from drakegrasp import Contact, Grasp  # noqa: E402
 from drakegrasp.batch import batch_force_closure  # noqa: E402
 from drakegrasp.batch.parallel import available_cores  # noqa: E402
 from drakegrasp.closure import force_closure  # noqa: E402
-from drakegrasp.friction_cone import ConeLayout  # noqa: E402
 
 CASES = {
     # name: (dimension, model, torsional friction)
@@ -82,24 +84,6 @@ def make_grasp(P, Nrm, model, nu):
             for p, n in zip(P, Nrm, strict=True)
         ]
     )
-
-
-def lp_matrices(grasp):
-    """(c, A_ub, b_ub, A_eq, b_eq, bounds) of LP2 for linprog."""
-    N = grasp.num_contacts
-    layout = ConeLayout.of(grasp, 8)
-    G, F = layout.G, layout.facet_matrix()
-    w, M = G.shape
-    cost = np.zeros(M + 1)
-    cost[-1] = -1.0
-    budget = np.zeros(M + 1)
-    budget[list(layout.normal_positions)] = 1.0
-    A_ub = np.vstack([np.hstack([-F, np.ones((F.shape[0], 1))]), budget])
-    b_ub = np.zeros(A_ub.shape[0])
-    b_ub[-1] = N
-    A_eq = np.hstack([G, np.zeros((w, 1))])
-    bounds = [(None, None)] * M + [(0, None)]
-    return cost, A_ub, b_ub, A_eq, np.zeros(w), bounds
 
 
 def best_rate(fn, n, repeats):
@@ -143,7 +127,7 @@ def bench_one(case, N, *, quick, seed):
             d_mp[k], v_mp[k] = r.d_star, r.is_closure
 
     rmp, _ = best_rate(mp, n_slow, 1)
-    lps = [lp_matrices(g) for g in grasps]
+    lps = [lp_matrices(g, "force") for g in grasps]
     d_hi = np.empty(n_slow)
 
     def highs():
