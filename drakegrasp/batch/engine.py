@@ -17,6 +17,7 @@ matrices exist at any moment, and inputs may be memory-mapped arrays.
 from __future__ import annotations
 
 import math
+import mmap
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -369,6 +370,28 @@ def chunk_size_for(N: int, d: int, chunk_size: int | None) -> int:
     return int(min(65536, max(64, CHUNK_BYTES // per_grasp)))
 
 
+def _release_pages(a, stop: int) -> None:
+    """Drop the pages of a memory-mapped input read so far from this process.
+
+    A file-backed page stays in the process's resident set once read; over a
+    file of 10^7 grasps that would grow the RSS by the whole input.  The pages
+    stay in the OS's page cache (they are re-read from there if needed).
+    """
+    mm = getattr(a, "_mmap", None)
+    if getattr(a, "mode", None) not in ("r", "r+"):  # never drop copy-on-write pages
+        return
+    if mm is None or not hasattr(mm, "madvise") or not hasattr(mmap, "MADV_DONTNEED"):
+        return
+    row = int(np.prod(a.shape[1:], dtype=np.int64)) * a.itemsize
+    offset = int(a.offset) if hasattr(a, "offset") else 0
+    end = (offset + stop * row) // mmap.PAGESIZE * mmap.PAGESIZE
+    if end > 0:
+        try:
+            mm.madvise(mmap.MADV_DONTNEED, 0, min(end, len(mm)))
+        except (OSError, ValueError):  # pragma: no cover - advice only
+            pass
+
+
 def _stream(
     positions,
     normals,
@@ -395,9 +418,11 @@ def _stream(
 
     def tasks():
         for sl in _chunks(K, size, progress, f"{kind} closure"):
-            P = np.asarray(positions[sl], dtype=float)
+            P = np.array(positions[sl], dtype=float)
             _check_positions(P, sl.start)
-            Nrm = _unit_normals(np.asarray(normals[sl], dtype=float), sl.start)
+            Nrm = _unit_normals(np.array(normals[sl], dtype=float), sl.start)
+            _release_pages(positions, sl.stop)
+            _release_pages(normals, sl.stop)
             slices.append(sl)
             yield task(P, Nrm, sl)
 
