@@ -259,12 +259,23 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="few N, few grasps")
     parser.add_argument("--memory", action="store_true", help="peak memory vs K")
+    parser.add_argument(
+        "--memory-only", action="store_true", help="only peak memory vs K"
+    )
     parser.add_argument("--cases", nargs="*", default=list(CASES), choices=CASES)
     parser.add_argument("--out", default=str(Path(__file__).parent / "results"))
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     Ns = N_QUICK if args.quick else N_FULL
+    if args.memory_only:
+        print("peak memory of `drakegrasp batch` (memory-mapped .npy input, N = 3):")
+        sizes = [10**5, 10**6] if args.quick else [10**5, 10**6, 10**7]
+        memory = memory_vs_k(sizes, out)
+        with open(out / "scale_memory.json", "w") as f:
+            json.dump({"memory": memory, "cores": available_cores()}, f, indent=1)
+        print(f"wrote {out / 'scale_memory.json'}")
+        return
     load = os.getloadavg()[0]
     print(f"drakegrasp scale benchmark: {available_cores()} cores, load {load:.1f}; "
           "grasps per CPU-second (batch×all: per wall second)\n")  # fmt: skip

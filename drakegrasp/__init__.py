@@ -36,6 +36,7 @@ from drakegrasp.closure import (
 from drakegrasp.contact import Contact, ContactModel, contact_frame, contact_frames
 from drakegrasp.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import (
+    BatchFileError,
     GraspError,
     InvalidContactError,
     InvalidContextError,
@@ -111,6 +112,7 @@ __version__ = "0.1.0"
 __all__ = [
     "AntipodalResult",
     "BatchClosureResult",
+    "BatchFileError",
     "ClosureResult",
     "Contact",
     "ContactCurvature",

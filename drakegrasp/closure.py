@@ -55,6 +55,13 @@ from drakegrasp.grasp import (
     normalised_grasp_matrix,
 )
 from drakegrasp.results import ClosureResult, InternalForceResult, _relative_margin
+from drakegrasp.validation import check_grasp, check_rank_tol, check_tol, real_array
+from drakegrasp.witness import (
+    balance_certificate,
+    escape_twist,
+    uncontrollable_force,
+    unresisted_wrench,
+)
 
 __all__ = [
     "DEFAULT_TOL",
@@ -110,10 +117,13 @@ class ProgramVariables:
         Where each entry of ``forces`` sits in the grasp's stacked force vector
         (columns of :func:`~drakegrasp.grasp_matrix`; for LP1, the contact index).
     weights : ndarray of Variable or None
-        Generator weights ``λ >= 0`` (generator formulation only).
+        The program's own variables when ``forces`` are linear expressions of
+        them: generator weights ``λ >= 0`` (generator formulation), or the
+        scaled components of a grasp with soft-finger torsion (``m_n / (b ν)``,
+        see :class:`~drakegrasp.friction_cone.ConeLayout`).
     generators : (m, len(weights)) float or None
-        Block-diagonal generator matrix ``S`` with ``forces = S @ weights``
-        (generator formulation only).
+        The matrix with ``forces = generators @ weights``: the block-diagonal
+        generators ``S``, or ``diag(ConeLayout.scales)``.
     """
 
     d: object
@@ -135,8 +145,20 @@ def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
     Returns
     -------
     int
+
+    Raises
+    ------
+    InvalidOptionError
+        ``A`` not a real finite 2-D array (LAPACK's SVD can loop forever on
+        ``inf``/``NaN``), or ``rank_tol`` outside its valid range.
     """
-    A = np.asarray(A, dtype=float)
+    A = real_array("A", A, error=InvalidOptionError)
+    if A.ndim != 2 or not np.all(np.isfinite(A)):
+        raise InvalidOptionError(
+            f"matrix_rank needs a finite 2-D array, got shape {A.shape}"
+            + ("" if A.ndim != 2 else " with non-finite entries")
+        )
+    rank_tol = check_rank_tol(rank_tol)
     if A.size == 0:
         return 0
     s = np.linalg.svd(A, compute_uv=False)
@@ -146,14 +168,17 @@ def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
 
 
 def _check_tol(tol: float) -> float:
-    t = float(tol)
-    if not np.isfinite(t) or t <= 0:
-        raise InvalidOptionError(f"tol must be finite and > 0, got {tol!r}")
-    return t
+    return check_tol(tol)
+
+
+def _check_options(grasp: Grasp, rank_tol: float) -> float:
+    """Validate the grasp and ``rank_tol`` of a public program (see validation)."""
+    check_grasp(grasp)
+    return check_rank_tol(rank_tol)
 
 
 def _check_formulation(formulation: str) -> str:
-    if formulation not in _FORMULATIONS:
+    if not isinstance(formulation, str) or formulation not in _FORMULATIONS:
         raise InvalidOptionError(
             f"formulation must be one of {_FORMULATIONS}, got {formulation!r}"
         )
@@ -195,7 +220,23 @@ def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
     )
 
 
-def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
+def _scaled_variables(d, x, layout: ConeLayout) -> ProgramVariables:
+    """Variables whose forces are ``scales * x`` (see ``ConeLayout.scales``).
+
+    Without a soft finger's torsion every scale is 1 and ``forces`` are the
+    program's variables; otherwise ``forces = diag(scales) @ weights``.
+    """
+    if np.all(layout.scales == 1.0):
+        return ProgramVariables(d, x, layout.columns)
+    D = np.diag(layout.scales)
+    with np.errstate(invalid="ignore"):  # see build_force_closure_program
+        forces = D @ x
+    return ProgramVariables(d, forces, layout.columns, weights=x, generators=D)
+
+
+def _add_balance(
+    prog, A: np.ndarray, x, rank_tol: float, *, scales: np.ndarray | None = None
+) -> None:
     """``A x = 0``, imposed on the numerical row space of ``A`` (see below).
 
     ``A`` is a normalised balance matrix (:func:`_balance_matrix`), whose columns
@@ -210,6 +251,8 @@ def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
     A_s, scale = _equilibrated(A)
     # A x = A_s (D⁻¹ x) with D = diag(scale): impose V_rᵀ D⁻¹ x = 0.
     rows = _row_space(A_s, rank_tol) / scale
+    if scales is not None:  # x holds scaled components: A f = A diag(scales) x
+        rows = rows * scales
     if rows.shape[0]:
         rows = np.linalg.qr(rows.T)[0].T
         add_linear_equality_constraint(prog, rows, np.zeros(rows.shape[0]), x)
@@ -240,6 +283,7 @@ def build_form_closure_program(
         ``forces`` are the normal forces ``f_n`` (N,); ``columns`` the contact
         indices.
     """
+    rank_tol = _check_options(grasp, rank_tol)
     N = grasp.num_contacts
     prog, f, d = _margin_program(N, N)
     _add_balance(prog, _normal_balance_matrix(grasp), f, rank_tol)
@@ -278,15 +322,18 @@ def build_force_closure_program(
     variables : ProgramVariables
         ``forces`` cover the components the cones allow (see ``columns``).
     """
+    rank_tol = _check_options(grasp, rank_tol)
     _check_formulation(formulation)
     layout = ConeLayout.of(grasp, num_generators)
     N = grasp.num_contacts
     if formulation == "facets":
         prog, f, d = _margin_program(len(layout.columns), N)
-        _add_balance(prog, _balance_matrix(grasp, layout.columns), f, rank_tol)
-        _add_margin_rows(prog, layout.facet_matrix(), f, d)
+        scales = layout.scales
+        A = _balance_matrix(grasp, layout.columns)
+        _add_balance(prog, A, f, rank_tol, scales=scales)
+        _add_margin_rows(prog, layout.facet_matrix() * scales, f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
-        return prog, ProgramVariables(d, f, layout.columns)
+        return prog, _scaled_variables(d, f, layout)
     S = layout.generator_matrix()
     prog, lam, d = _margin_program(S.shape[1], N)
     _add_balance(prog, _balance_matrix(grasp, layout.columns) @ S, lam, rank_tol)
@@ -319,38 +366,44 @@ def build_exact_force_closure_program(
         ``max d`` s.t. ``G f = 0``, ``d >= 0``, ``Σ f_n <= N`` and, per contact,
         the ball of radius ``d`` around ``f_i`` inside its cone:
         hard finger ``‖f_t‖ <= μ f_n - sqrt(1 + μ²) d``; soft finger, for both
-        signs ``σ``, ``‖f_t‖ <= μ f_n - σ μ m_n / (b ν) - sqrt(1 + μ² +
-        μ²/(b ν)²) d``; frictionless ``f_n >= d``; planar cones (exact
-        polyhedra) as facets.
+        signs ``σ``, ``‖f_t‖ <= μ f_n - σ μ m_n / (b ν) - sqrt(1 + μ²) d``
+        (the hard-finger margin of the normal force left after torsion, so a
+        soft finger never scores below a hard one); frictionless
+        ``f_n >= d``; planar cones (exact polyhedra) as facets.
     variables : ProgramVariables
     """
+    rank_tol = _check_options(grasp, rank_tol)
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
-    _add_balance(prog, _balance_matrix(grasp, layout.columns), f, rank_tol)
+    # f holds scaled components (a soft finger's m_n / (b ν)): ConeLayout.scales.
+    A = _balance_matrix(grasp, layout.columns)
+    _add_balance(prog, A, f, rank_tol, scales=layout.scales)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     b = grasp.characteristic_length
     starts = list(layout.normal_positions) + [len(layout.columns)]
     for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
         fi = f[starts[i] : starts[i + 1]]
         if cone.components not in ((0, 1, 2), (0, 1, 2, 3)):
-            _add_margin_rows(prog, cone.facets, fi, d)  # exact already
+            scale = layout.scales[starts[i] : starts[i + 1]]
+            _add_margin_rows(prog, cone.facets * scale, fi, d)  # exact already
             continue
         mu = contact.mu
-        signs_and_slopes = [(0.0, 0.0)]
-        if cone.components == (0, 1, 2, 3):
-            k = mu / (b * contact.torsional_friction)
-            signs_and_slopes = [(1.0, k), (-1.0, k)]
-        for sign, k in signs_and_slopes:
-            # z = A [fi; d]: z0 = μ f_n - σ k m_n - sqrt(1+μ²+k²) d, z1:3 = f_t.
+        signs = [0.0] if cone.components == (0, 1, 2) else [1.0, -1.0]
+        for sign in signs:
+            # z = A [fi; d]: z0 = μ f_n - σ μ m_n/(b ν) - sqrt(1+μ²) d,
+            # z1:3 = f_t, with m_n = s m̃ (s = ConeLayout.scales): d is the
+            # hard-cone margin of (f_n - |m_n| / (b ν), f_t), as the polyhedral
+            # soft rows (friction_cone.soft_finger_facets).
             A = np.zeros((3, len(fi) + 1))
             A[0, 0] = mu
             if len(fi) == 4:
-                A[0, 3] = -sign * k
-            A[0, -1] = -np.sqrt(1.0 + mu * mu + k * k)
+                s = layout.scales[starts[i] + 3]
+                A[0, 3] = -sign * mu * s / (b * contact.torsional_friction)
+            A[0, -1] = -np.sqrt(1.0 + mu * mu)
             A[1, 1] = A[2, 2] = 1.0
             prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(fi, d))
-    return prog, ProgramVariables(d, f, layout.columns)
+    return prog, _scaled_variables(d, f, layout)
 
 
 def build_internal_force_program(
@@ -387,6 +440,7 @@ def build_internal_force_program(
     literally would let a singular value of 1e-12 (contacts measured to 1e-7 m)
     exclude an internal force that the rank count says exists.
     """
+    rank_tol = _check_options(grasp, rank_tol)
     J = check_hand_jacobian(grasp, hand_jacobian)
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
@@ -478,10 +532,18 @@ def _solve(prog: MathematicalProgram, *, conic: bool) -> MathematicalProgramResu
     )
 
 
+_VERDICTS = (SolutionResult.kSolutionFound, SolutionResult.kInfeasibleConstraints)
+
+
 def _solve_margin(prog, variables: ProgramVariables, *, conic: bool):
     """Solve; return (d*, full-vector forces or None, solver, status)."""
     result = _solve(prog, conic=conic)
     status = result.get_solution_result()
+    if conic and status not in _VERDICTS and ScsSolver().available():
+        # Clarabel can stall on degenerate SOCPs (d* = 0 with no interior, e.g.
+        # soft fingers with nu = 1e12); SCS, a first-order method, does not.
+        result = ScsSolver().Solve(prog)
+        status = result.get_solution_result()
     solver = result.get_solver_id().name()
     if status == SolutionResult.kSolutionFound:
         d_star = float(result.GetSolution(variables.d))
@@ -540,6 +602,7 @@ def form_closure(
     >>> result.is_closure, result.rank
     (True, 3)
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     required = grasp.wrench_dim
     rank = _balance_rank(_normal_balance_matrix(grasp), rank_tol)
@@ -548,6 +611,11 @@ def form_closure(
     if forces is None:
         forces = np.zeros(grasp.num_contacts)
     ok = rank == required and d_star > tol
+    forces = tuple(np.array([x]) for x in forces)
+    if ok:
+        certificate = balance_certificate(grasp, forces, cones="normals", rank=rank)
+    else:
+        certificate = escape_twist(grasp, rank)
     return ClosureResult(
         kind="form closure",
         is_closure=bool(ok),
@@ -555,12 +623,14 @@ def form_closure(
         rank=rank,
         required_rank=required,
         margin=_relative_margin(d_star, tol),
-        contact_forces=tuple(np.array([x]) for x in forces),
+        contact_forces=forces,
         solver=solver,
         status=status,
         tol=tol,
         formulation="normals",
         frictional_closure=bool(ok),
+        decided_by="d*" if rank == required else "rank",
+        certificate=certificate,
     )
 
 
@@ -587,6 +657,7 @@ def internal_forces(
     -------
     InternalForceResult
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_internal_force_program(
         grasp, hand_jacobian, rank_tol=rank_tol
@@ -596,15 +667,17 @@ def internal_forces(
     rank = 0 if equalities is None else equalities.evaluator().num_constraints()
     null_dim = len(variables.columns) - rank
     passes = not (d_star > tol)  # NaN (infeasible) passes: no such force exists
+    contact_forces = _split_forces(grasp, variables.columns, forces)
     return InternalForceResult(
         passes=bool(passes),
         d_star=d_star,
         margin=-_relative_margin(d_star, tol) if np.isfinite(d_star) else np.inf,
         null_space_dim=int(null_dim),
-        contact_forces=_split_forces(grasp, variables.columns, forces),
+        contact_forces=contact_forces,
         solver=solver,
         status=status,
         tol=tol,
+        certificate=None if passes else uncontrollable_force(grasp, contact_forces),
     )
 
 
@@ -619,6 +692,7 @@ def _force_closure_result(
     hand_jacobian: np.ndarray | None,
     tol: float,
     rank_tol: float,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
 ) -> ClosureResult:
     required = grasp.wrench_dim
     rank = _balance_rank(_balance_matrix(grasp, variables.columns), rank_tol)
@@ -626,7 +700,7 @@ def _force_closure_result(
     contact_forces = _split_forces(grasp, variables.columns, forces)
     margin = _relative_margin(d_star, tol)
     frictional = bool(rank == required and d_star > tol)
-    certificate = "d*"
+    decided_by = "d*" if rank == required else "rank"
     if rank == required and not frictional:
         # d is a distance to the cone boundaries, so it vanishes with μ.  Normal
         # forces alone (f_t = 0) lie inside every cone with μ > 0: if they
@@ -635,8 +709,19 @@ def _force_closure_result(
             grasp, variables.columns, tol=tol, rank_tol=rank_tol
         )
         if normal is not None:
-            frictional, certificate = True, "normal forces"
+            frictional, decided_by = True, "normal forces"
             margin, contact_forces = normal
+    cones = "exact" if formulation == "exact" else "polyhedral"
+    if frictional:
+        # LP1's forces (f_t = 0) on the normal-force route: inside every cone
+        # with μ > 0, and G (not G_n) is the matrix of full rank.
+        certificate = balance_certificate(
+            grasp, contact_forces, cones=cones, rank=rank, num_generators=num_generators
+        )
+    else:
+        certificate = unresisted_wrench(
+            grasp, rank, cones=cones, num_generators=num_generators
+        )
     result = ClosureResult(
         kind=kind,
         is_closure=frictional,
@@ -650,6 +735,7 @@ def _force_closure_result(
         tol=tol,
         formulation=formulation,
         frictional_closure=frictional,
+        decided_by=decided_by,
         certificate=certificate,
     )
     if hand_jacobian is None:
@@ -677,10 +763,19 @@ def with_internal_forces(
         ``result`` with ``internal_forces = lp3`` and
         ``is_closure = frictional_closure and lp3.passes``.
     """
+    changes = {}
+    if result.frictional_closure and not lp3.passes:
+        changes = {"decided_by": "LP3", "certificate": lp3.certificate}
+    elif result.decided_by == "LP3":  # re-attaching: undo a previous LP3 verdict
+        raise InvalidOptionError(
+            "with_internal_forces needs a result computed without the hand "
+            "Jacobian; this one was already decided by LP3"
+        )
     return dataclasses.replace(
         result,
         internal_forces=lp3,
         is_closure=result.frictional_closure and lp3.passes,
+        **changes,
     )
 
 
@@ -744,6 +839,7 @@ def force_closure(
     >>> result.is_closure, result.rank, round(result.d_star, 4)
     (True, 6, 0.4194)
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_force_closure_program(
         grasp, num_generators=num_generators, formulation=formulation, rank_tol=rank_tol
@@ -758,6 +854,7 @@ def force_closure(
         hand_jacobian=hand_jacobian,
         tol=tol,
         rank_tol=rank_tol,
+        num_generators=num_generators,
     )
 
 
@@ -785,6 +882,7 @@ def force_closure_exact(
     -------
     ClosureResult
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_exact_force_closure_program(grasp, rank_tol=rank_tol)
     conic = bool(prog.lorentz_cone_constraints())

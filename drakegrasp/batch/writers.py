@@ -260,24 +260,35 @@ def stream_file(
     metrics=(),
     workers: int | None = None,
     fmt: str | None = None,
+    overwrite: bool = False,
 ) -> BatchSummary:
     """:func:`~drakegrasp.batch.evaluate_file` in memory flat in ``K``.
 
     Reads the grasps as :func:`~drakegrasp.batch.read_grasps` does (a
     directory of ``.npy`` files is memory-mapped), decides closure chunk by
-    chunk on ``workers`` processes, and streams every chunk's results to
-    ``output_path`` (:func:`write_chunks`); the results are never held whole.
+    chunk on ``workers`` processes, and streams every chunk's results to a
+    temporary sibling of ``output_path`` (:func:`write_chunks`) that is renamed
+    into place when complete; the results are never held whole.  The output
+    rules of :func:`~drakegrasp.batch.evaluate_file` apply (never the input,
+    an existing file only with ``overwrite``), checked before any work.
 
     Returns
     -------
     BatchSummary
         Counts and ``d*`` range of what was written.
     """
+    from drakegrasp.batch import io
     from drakegrasp.batch.engine import stream_force_closure, stream_form_closure
-    from drakegrasp.batch.io import read_grasps
+    from drakegrasp.validation import check_flag
 
-    fmt = format_of(output_path, fmt)
-    data = read_grasps(input_path)
+    overwrite = check_flag("overwrite", overwrite)
+    source = io._as_path("input", input_path)
+    inputs = [source, *(sorted(source.glob("*.npy")) if source.is_dir() else [])]
+    output, _ = io._check_output(
+        io._as_path("output", output_path), inputs, overwrite=overwrite
+    )
+    fmt = format_of(output, fmt)
+    data = io.read_grasps(source)
     positions, normals = data["positions"], data["normals"]
     common = {
         "reference_points": data.get("reference_points"),
@@ -298,7 +309,7 @@ def stream_file(
             )
         nu = torsional_friction
         if nu is None:
-            nu = data.get("torsional_friction", 0.0)
+            nu = data.get("torsional_friction")
         chunks = stream_force_closure(
             positions, normals, mu_value, model=model,
             num_generators=num_generators, torsional_friction=nu, **common,
@@ -308,12 +319,30 @@ def stream_file(
     else:
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
     d = np.shape(positions)[-1]
-    return write_chunks(
-        chunks,
-        output_path,
-        K=int(np.shape(positions)[0]),
-        kind=kind,
-        tol=float(tol),
-        required_rank=6 if d == 3 else 3,
-        fmt=fmt,
+    fd, tmp = tempfile.mkstemp(
+        dir=output.parent, prefix=f".{output.name}.", suffix=".partial"
     )
+    os.close(fd)
+    try:
+        summary = write_chunks(
+            chunks,
+            tmp,
+            K=int(np.shape(positions)[0]),
+            kind=kind,
+            tol=float(tol),
+            required_rank=6 if d == 3 else 3,
+            fmt=fmt,
+        )
+        if overwrite:
+            os.replace(tmp, output)
+        else:
+            io._link_or_rename(tmp, output)
+    except FileExistsError:
+        raise io.BatchFileError(
+            f"output file {str(output)!r} appeared while writing; pass "
+            "overwrite=True to replace it"
+        ) from None
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return summary

@@ -7,7 +7,6 @@ the normal fan of a Minkowski sum (see ``_linf_radius``).
 from __future__ import annotations
 
 import functools
-import itertools
 import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
@@ -23,12 +22,14 @@ from drakegrasp.quality._common import (
     _scaled_grasp_matrix,
     _torque_scale,
 )
+from drakegrasp.validation import check_num_generators
 
 if TYPE_CHECKING:
     from scipy.spatial import ConvexHull
 
 __all__ = [
     "HULL_TOL",
+    "L1_MAX_POINTS",
     "LINF_MAX_CANDIDATES",
     "ferrari_canny",
     "primitive_wrenches",
@@ -39,6 +40,15 @@ HULL_TOL = 1e-9
 
 LINF_MAX_CANDIDATES = 2_000_000
 """Most candidate facet normals the L∞ ε may test (about 6 s per million)."""
+
+L1_MAX_POINTS = 2_000
+"""Most primitive wrenches whose hull the L1 ε may build.
+
+A 6-D hull's facets grow about linearly with its points here: 2,000 points
+(250 spatial hard fingers with 8 generators) make about 230,000 facets and
+take about 9 s; 8,000 points (1,000 fingers) took 150 s, and a facet check on
+them once asked for 57 GiB.  Beyond this bound ε is refused, not attempted.
+"""
 
 _NORMS = ("L1", "Linf")
 
@@ -75,6 +85,7 @@ def primitive_wrenches(
     .. math:: w_{i,k} = S\, G_i\, s_k, \qquad S = \operatorname{diag}(I, I / b_s)
     """
     _check_grasp(grasp)
+    num_generators = check_num_generators(num_generators)
     b = _torque_scale(grasp, torque_scale)
     if not grasp.planar and all(
         c.effective_components() == (0, 1, 2) for c in grasp.contacts
@@ -105,11 +116,7 @@ def _hard_finger_wrenches(
     μ sin(2πk/n_g)]`` in the contact frame); a test checks that they equal
     :func:`~drakegrasp.friction_cone_generators`.
     """
-    n_g = int(num_generators)
-    if n_g != num_generators or n_g < 3:
-        raise InvalidOptionError(
-            f"num_generators must be an integer >= 3, got {num_generators!r}"
-        )
+    n_g = check_num_generators(num_generators)
     R = np.array([c.frame for c in grasp.contacts])  # (N, 3, 3) columns n, t1, t2
     mu = np.array([c.mu for c in grasp.contacts])
     r = np.array([c.position for c in grasp.contacts]) - grasp.reference_point
@@ -148,8 +155,7 @@ def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
     tol = HULL_TOL * max(scale, 1e-300)
     try:
         hull = ConvexHull(points, qhull_options="Q0")
-        eq = hull.equations
-        if np.max(points @ eq[:, :-1].T + eq[:, -1]) <= tol:
+        if _below_every_facet(points, hull.equations, tol):
             return hull
     except QhullError:
         pass
@@ -164,6 +170,21 @@ def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
             f"Qhull could not build the convex hull of {points.shape[0]} points in "
             f"{points.shape[1]}-D: {err}"
         ) from err
+
+
+def _below_every_facet(points: np.ndarray, eq: np.ndarray, tol: float) -> bool:
+    """Whether every point is below every facet hyperplane, in bounded memory.
+
+    A thousand contacts make a hull of about 10^6 facets: the full
+    points-by-facets product would take 57 GiB, so facets go in blocks of
+    about 8 million products.
+    """
+    block = max(1, 8_000_000 // max(1, points.shape[0]))
+    for lo in range(0, eq.shape[0], block):
+        part = eq[lo : lo + block]
+        if np.max(points @ part[:, :-1].T + part[:, -1]) > tol:
+            return False
+    return True
 
 
 def _origin_distance_residual(points: np.ndarray, scale: float) -> float:
@@ -188,26 +209,61 @@ def _origin_distance_residual(points: np.ndarray, scale: float) -> float:
         return 0.0
 
 
-def _ball_radius(points: np.ndarray) -> float:
+FLAT_TOL = 1e-14
+"""Relative singular value below which a wrench set counts as flat (no interior).
+
+Wrench sets of thin cones (``μ = 1e-12``) are full-dimensional with singular
+values ratios near 1e-12; round-off leaves ratios near 1e-16.
+"""
+
+
+def _whitening(points: np.ndarray) -> np.ndarray | None:
+    """``A`` (D, D) with ``points @ A.T`` well conditioned; None if flat.
+
+    ``A = diag(1/s) Vᵀ`` from the SVD ``points = U S Vᵀ``, so the mapped points
+    are ``U`` (orthonormal columns).  A linear map keeps the origin, convex
+    hulls and Minkowski sums, and maps a facet ``n'·x' + o' <= 0`` of the mapped
+    set to the facet ``(Aᵀ n')·x + o' <= 0`` of the original one, so ε can be
+    computed in the mapped coordinates and measured in the original ones.
+    This keeps ε accurate for thin cones (``μ`` down to 1e-12: the wrench set is
+    then ``μ`` thin in four directions) and for very long soft-finger torsion
+    generators (``ν`` up to 1e12), where Qhull on the raw points returned 0.
+    """
+    _, s, vt = np.linalg.svd(points, full_matrices=False)
+    if s.size < points.shape[1] or not s[-1] > FLAT_TOL * s[0]:
+        return None
+    return vt / s[:, None]
+
+
+def _ball_radius(points: np.ndarray, A: np.ndarray | None = None) -> float:
     """Radius of the largest origin-centred ball in ``conv(points)``; 0 if none.
 
     Qhull is called only when needed: a hull that does not contain the origin
     (NNLS residual above round-off) or whose affine hull is lower-dimensional
-    than the space (no interior) has radius 0 without it.
+    than the space (no interior) has radius 0 without it.  Everything runs on
+    the whitened points (see :func:`_whitening`); the facets are measured in the
+    original coordinates.
     """
     num, dim = points.shape
-    scale = float(np.max(np.abs(points))) if points.size else 0.0
-    if num <= dim or scale == 0.0:
+    if num <= dim or not np.any(points):
         return 0.0
-    if _origin_distance_residual(points, scale) > HULL_TOL * scale:
+    if A is None:
+        A = _whitening(points)
+        if A is None:
+            return 0.0  # the points span less than the wrench space
+    X = points @ A.T
+    scale = float(np.max(np.abs(X)))
+    if _origin_distance_residual(X, scale) > HULL_TOL * scale:
         return 0.0  # the origin is outside the hull: no hull needed
-    s = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    s = np.linalg.svd(X - X.mean(axis=0), compute_uv=False)
     if s[-1] <= RANK_TOL * max(s[0], scale):
         return 0.0  # flat hull: no interior
-    eq = _qhull(points, scale).equations
-    # Unit outward normals n and offsets o: the hull is {x : n·x + o <= 0}, so
-    # the distance from the origin to each facet's hyperplane is -o.
-    radius = float(np.min(-eq[:, -1]))
+    eq = _qhull(X, scale).equations
+    # Unit outward normals n' and offsets o' in whitened coordinates: the hull
+    # is {x : (Aᵀ n')·x + o' <= 0}; the origin's distance to each facet's
+    # hyperplane is -o' / |Aᵀ n'|.
+    normals = eq[:, :-1] @ A
+    radius = float(np.min(-eq[:, -1] / np.linalg.norm(normals, axis=1)))
     return radius if radius > 0.0 else 0.0
 
 
@@ -294,20 +350,62 @@ def _support_min(U: np.ndarray, wrenches: Sequence[np.ndarray]) -> float:
     return float(min(hp.min(), hm.min()))
 
 
-def _face_tuples(families, dim_test):
+def _face_tuples(families, target: int, exact: bool):
     """Yield ``(parts, shape)`` for every choice of one face per contact.
 
     ``families[i]`` maps a face dimension to bases (see
     :func:`_face_directions`); a contact may also contribute a vertex (no
-    direction).  ``dim_test(total)`` selects the total dimensions to keep.
+    direction).  The total dimension is ``target`` (``exact``) or at least
+    ``target``.  Choices are built contact by contact and a partial choice whose
+    total already exceeds an exact target is dropped, so the work is
+    proportional to the choices kept, never to the ``∏ (faces + 1)`` of all
+    combinations (``4^40`` for 40 contacts).
     """
     choices = [[0, *sorted(f)] for f in families]
-    for combo in itertools.product(*choices):
-        if not dim_test(sum(combo)):
-            continue
-        parts = [(i, j) for i, j in enumerate(combo) if j > 0]
-        shape = [families[i][j].shape[0] for i, j in parts]
-        yield parts, shape
+    n = len(choices)
+    # Largest total the remaining contacts can still add.
+    room = [0] * (n + 1)
+    for i in range(n - 1, -1, -1):
+        room[i] = room[i + 1] + max(choices[i])
+
+    def walk(i, total, combo):
+        if exact and total > target:
+            return
+        if total + room[i] < target:
+            return
+        if i == n:
+            parts = [(k, j) for k, j in enumerate(combo) if j > 0]
+            yield parts, [families[k][j].shape[0] for k, j in parts]
+            return
+        for j in choices[i]:
+            combo.append(j)
+            yield from walk(i + 1, total + j, combo)
+            combo.pop()
+
+    yield from walk(0, 0, [])
+
+
+def _candidate_count(families, target: int, exact: bool) -> int:
+    """Number of candidate normals, by polynomial products (no enumeration).
+
+    Contact ``i`` contributes ``1 + Σ_j c_ij x^j`` (``c_ij`` faces of dimension
+    ``j``); the coefficient of ``x^t`` in the product counts the face choices
+    of total dimension ``t`` weighted by their number of bases.
+    """
+    top = max(target, 1) + 1
+    poly = [1] + [0] * top  # coefficient top collects every degree >= top
+    for family in families:
+        term = [1] + [0] * top
+        for j, bases in family.items():
+            term[min(j, top)] += int(bases.shape[0])
+        new = [0] * (top + 1)
+        for a, pa in enumerate(poly):
+            if pa:
+                for b, tb in enumerate(term):
+                    if tb:
+                        new[min(a + b, top)] += pa * tb
+        poly = new
+    return poly[target] if exact else sum(poly[target:])
 
 
 def _stacked_bases(families, parts, shape, lo, hi) -> np.ndarray:
@@ -317,8 +415,8 @@ def _stacked_bases(families, parts, shape, lo, hi) -> np.ndarray:
     )
 
 
-def _check_candidate_count(families, dim_test) -> None:
-    total = sum(int(np.prod(s)) for _, s in _face_tuples(families, dim_test))
+def _check_candidate_count(families, target: int, exact: bool) -> None:
+    total = _candidate_count(families, target, exact)
     if total > LINF_MAX_CANDIDATES:
         raise InvalidOptionError(
             f"the L∞ Ferrari–Canny metric of this grasp needs {total} candidate "
@@ -327,7 +425,7 @@ def _check_candidate_count(families, dim_test) -> None:
         )
 
 
-def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
+def _linf_radius(wrenches: Sequence[np.ndarray], A: np.ndarray | None = None) -> float:
     r"""ε of the Minkowski sum ``⊕_i conv({0} ∪ {w_ik})`` through its normal fan.
 
     Call only when the origin is strictly inside (ε_1 > 0).  Every facet of a
@@ -348,13 +446,30 @@ def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
        SVD); each facet is such a choice, with its own faces.
     """
     D = wrenches[0].shape[1]
-    sets = [np.vstack([np.zeros((1, D)), W]) for W in wrenches]
+    if A is None:
+        A = np.eye(D)
+    # Every summand has at least one edge, so there are at least C(N, D - 1)
+    # candidates: refuse before building N face lattices (40 ms each).
+    lower = math.comb(len(wrenches), D - 1)
+    if lower > LINF_MAX_CANDIDATES:
+        raise InvalidOptionError(
+            f"the L∞ Ferrari–Canny metric of {len(wrenches)} contacts needs at least "
+            f"{lower} candidate facet normals (more than LINF_MAX_CANDIDATES = "
+            f"{LINF_MAX_CANDIDATES}); use norm='L1' or fewer contacts"
+        )
+    mapped = [W @ A.T for W in wrenches]
+    sets = [np.vstack([np.zeros((1, D)), W]) for W in mapped]
     families = [_face_directions(P) for P in sets]
     chunk = 100_000
-    exact_dim = (lambda t: t == D - 1), (lambda t: t >= D - 1)
-    _check_candidate_count(families, exact_dim[0])
+
+    def support_min(U):
+        # Candidate normals in whitened coordinates map to U @ A originally.
+        V = U @ A
+        return _support_min(V / np.linalg.norm(V, axis=1)[:, None], wrenches)
+
+    _check_candidate_count(families, D - 1, exact=True)
     best, degenerate = math.inf, False
-    for parts, shape in _face_tuples(families, exact_dim[0]):
+    for parts, shape in _face_tuples(families, D - 1, exact=True):
         count = int(np.prod(shape))
         for lo in range(0, count, chunk):
             M = _stacked_bases(families, parts, shape, lo, min(count, lo + chunk))
@@ -363,14 +478,14 @@ def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
             if np.any(norms <= RANK_TOL):
                 degenerate = True
                 break
-            best = min(best, _support_min(u / norms[:, None], wrenches))
+            best = min(best, support_min(u / norms[:, None]))
         if degenerate:
             break
     if not degenerate:
         return best
-    _check_candidate_count(families, exact_dim[1])
+    _check_candidate_count(families, D - 1, exact=False)
     best = math.inf
-    for parts, shape in _face_tuples(families, exact_dim[1]):
+    for parts, shape in _face_tuples(families, D - 1, exact=False):
         count = int(np.prod(shape))
         for lo in range(0, count, chunk):
             M = _stacked_bases(families, parts, shape, lo, min(count, lo + chunk))
@@ -379,7 +494,7 @@ def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
             if M.shape[1] >= D:
                 keep &= s[:, D - 1] <= RANK_TOL * s[:, 0]
             if np.any(keep):
-                best = min(best, _support_min(vt[keep, D - 1, :], wrenches))
+                best = min(best, support_min(vt[keep, D - 1, :]))
     return best
 
 
@@ -447,18 +562,30 @@ def ferrari_canny(
     fingers with 8 generators (4,710 candidate normals) and about 1 s for four
     (166,188); five need 1.8 million candidates (about 15 s).  Grasps that
     need more than ``LINF_MAX_CANDIDATES`` (six hard fingers do) raise
-    :class:`~drakegrasp.InvalidOptionError`.
+    :class:`~drakegrasp.InvalidOptionError`, checked before any enumeration,
+    and so do grasps with more than :data:`L1_MAX_POINTS` primitive wrenches
+    (either norm).
     """
-    if norm not in _NORMS:
+    if not isinstance(norm, str) or norm not in _NORMS:
         raise InvalidOptionError(f"norm must be one of {_NORMS}, got {norm!r}")
     wrenches = primitive_wrenches(
         grasp, num_generators=num_generators, torque_scale=torque_scale
     )
+    points = np.vstack(wrenches)
+    if points.shape[0] > L1_MAX_POINTS:
+        raise InvalidOptionError(
+            f"the Ferrari–Canny metric of this grasp needs the hull of "
+            f"{points.shape[0]} primitive wrenches (more than L1_MAX_POINTS = "
+            f"{L1_MAX_POINTS}); use fewer contacts or fewer generators"
+        )
+    A = _whitening(points)
+    if A is None:
+        return 0.0  # the wrench set is flat: no interior for either norm
     if norm == "L1":
-        return _ball_radius(np.vstack(wrenches))
+        return _ball_radius(points, A)
     # The origin is strictly inside W_∞ exactly when it is strictly inside W_1
     # (both hold iff the primitive wrenches positively span the wrench space),
     # so the cheap L1 test settles ε_∞ = 0 first.
-    if _ball_radius(np.vstack(wrenches)) == 0.0:
+    if _ball_radius(points, A) == 0.0:
         return 0.0
-    return _linf_radius(wrenches)
+    return _linf_radius(wrenches, A)

@@ -23,6 +23,7 @@ import numpy as np
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, friction_cone_generators
 from drakegrasp.grasp import Grasp, wrench_columns
+from drakegrasp.validation import real_scalar
 from drakegrasp.visualization.plots import import_pyplot
 
 __all__ = [
@@ -166,6 +167,9 @@ class WrenchSpacePlot:
         Hull facets (None when ``hull=False`` or the hull is degenerate).
     origin : matplotlib collection
         The origin marker (green when inside, red when not).
+    separating_plane : CertificateArtists or None
+        The certificate's separating plane and unresisted direction, when a
+        "no" result was given.
     """
 
     ax: Any
@@ -176,6 +180,7 @@ class WrenchSpacePlot:
     hull: WrenchHull
     hull_artist: Any
     origin: Any
+    separating_plane: Any = None
 
     @property
     def origin_inside(self) -> bool:
@@ -191,6 +196,7 @@ def plot_wrench_space(
     hull: bool = True,
     rays: bool = True,
     tol: float = 1e-9,
+    result: Any = None,
 ) -> WrenchSpacePlot:
     """Plot the primitive wrenches of a planar grasp and their convex hull.
 
@@ -210,6 +216,10 @@ def plot_wrench_space(
         Draw a segment from the origin to each primitive wrench.
     tol : float, optional
         Margin the origin needs to count as inside (see :func:`wrench_hull`).
+    result : ClosureResult, optional
+        A force-closure "no" of this grasp: its certificate's separating plane
+        ``yᵀ w = 0`` (every primitive wrench lies on one side) and the
+        unresisted direction are drawn in red.
 
     Returns
     -------
@@ -226,6 +236,9 @@ def plot_wrench_space(
         raise InvalidOptionError(
             f"plot_wrench_space needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
+    tol = real_scalar("tol", tol)
+    if not (0.0 < tol < 1.0):
+        raise InvalidOptionError(f"tol must be a real number in (0, 1), got {tol!r}")
     if not grasp.planar:
         raise InvalidOptionError(
             "plot_wrench_space draws planar grasps, whose wrench space is 3-D; "
@@ -271,4 +284,12 @@ def plot_wrench_space(
     ax.set_zlabel("$m_z / b$ [N]")
     where = "inside" if info.origin_inside else "NOT inside"
     ax.set_title(f"origin {where} the hull (margin {info.margin:.3g})")
-    return WrenchSpacePlot(ax, W, owner, points, ray_artist, info, hull_artist, origin)
+    plane = None
+    cert = getattr(result, "certificate", None)
+    if getattr(cert, "separating_twist", None) is not None and not result.is_closure:
+        from drakegrasp.visualization.certificate_plots import plot_separating_plane
+
+        plane = plot_separating_plane(ax, grasp, cert, extent)
+    return WrenchSpacePlot(
+        ax, W, owner, points, ray_artist, info, hull_artist, origin, plane
+    )

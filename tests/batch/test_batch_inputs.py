@@ -116,12 +116,15 @@ def test_chunk_size_does_not_change_results():
         res = batch_force_closure(P, Nrm, mu, chunk_size=cs, metrics=["sigma_min"])
         np.testing.assert_array_equal(res.is_closure, ref.is_closure)
         np.testing.assert_array_equal(res.rank, ref.rank)
-        np.testing.assert_allclose(res.d_star, ref.d_star, rtol=0, atol=1e-12)
+        # The interior-point method stops at ~1e-10 on t = d*/N; the vectorised
+        # QR rounds differently for other stack sizes, which moves d* within
+        # that tolerance (chunk boundaries, not workers: see test_batch_scale).
+        np.testing.assert_allclose(res.d_star, ref.d_star, rtol=0, atol=1e-9)
         np.testing.assert_allclose(
             res.metrics["sigma_min"], ref.metrics["sigma_min"], rtol=1e-12
         )
     form = [batch_form_closure(P, Nrm, chunk_size=cs).d_star for cs in (3, K)]
-    np.testing.assert_allclose(form[0], form[1], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(form[0], form[1], rtol=0, atol=1e-9)
 
 
 class _RecordingArray:

@@ -65,7 +65,7 @@ def test_empty_input_writes_empty_arrays(tmp_path):
 
 def test_cli_workers_and_format(npy_dir, tmp_path, capsys):
     d, P, Nrm, mu = npy_dir
-    out = tmp_path / "o.data"
+    out = tmp_path / "o.npz"
     code = main(["batch", str(d), str(out), "--workers", "2", "--format", "npz",
                  "--chunk-size", "300"])  # fmt: skip
     assert code == 0
