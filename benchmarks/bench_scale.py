@@ -236,6 +236,7 @@ def plot(rows, path):
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        import matplotlib.ticker
     except ImportError:
         print("(matplotlib not installed: no plot)")
         return
@@ -247,6 +248,9 @@ def plot(rows, path):
         for route in ROUTES:
             ax.loglog(Ns, [r[route] for r in sub], marker="o", label=route)
         ax.set_title(case)
+        ax.set_xticks(Ns)
+        ax.set_xticklabels([str(n) for n in Ns])
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xlabel("contacts N")
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("grasps / s")
