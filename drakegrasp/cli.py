@@ -320,7 +320,7 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "--scheduler",
         default=None,
         metavar="ADDRESS",
-        help="run on a Dask cluster (e.g. tcp://host:8786; needs the 'dask' extra)",
+        help="run on the Dask scheduler at ADDRESS (host:port; needs the dask extra)",
     )
     batch.add_argument(
         "--progress",
