@@ -98,7 +98,7 @@ def _cmd_scenes(args: argparse.Namespace) -> int:
 
 
 def _cmd_batch(args: argparse.Namespace) -> int:
-    from drakegrasp.batch import evaluate_file
+    from drakegrasp.batch import stream_file
 
     if args.deprecated_model is not None:
         print(
@@ -113,23 +113,42 @@ def _cmd_batch(args: argparse.Namespace) -> int:
                 f"{args.contact_model} disagree; give --contact-model only"
             )
     model = args.contact_model or args.deprecated_model or "hard_finger"
-    result = evaluate_file(
-        args.input,
-        args.output,
-        kind=args.kind,
-        mu=args.mu,
-        model=model,
-        num_generators=args.num_generators,
-        torsional_friction=args.torsional_friction,
-        tol=args.tol,
-        chunk_size=args.chunk_size,
-        progress=args.progress,
-        metrics=tuple(args.metrics),
-        overwrite=args.overwrite,
-    )
-    print(result)
+    options = {
+        "kind": args.kind,
+        "mu": args.mu,
+        "model": model,
+        "num_generators": args.num_generators,
+        "torsional_friction": args.torsional_friction,
+        "tol": args.tol,
+        "chunk_size": args.chunk_size,
+        "progress": args.progress,
+        "metrics": tuple(args.metrics),
+        "workers": args.workers,
+        "fmt": args.format,
+    }
+    if args.scheduler is not None:
+        from drakegrasp.distributed import stream_file_on_cluster
+
+        summary = stream_file_on_cluster(
+            args.input, args.output, scheduler=args.scheduler, **options
+        )
+    else:
+        summary = stream_file(
+            args.input, args.output, overwrite=args.overwrite, **options
+        )
+    print(summary)
     print(f"wrote {args.output}")
     return 0
+
+
+def _workers(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {text!r}")
+    return n
 
 
 def _positive_float(text: str) -> float:
@@ -280,7 +299,28 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         help=f"metrics to add: {', '.join(METRICS)}",
     )
     batch.add_argument(
-        "--chunk-size", type=int, default=4096, help="grasps per chunk (default 4096)"
+        "--chunk-size",
+        type=int,
+        default=None,
+        help="grasps per chunk (default: sized to ~16 MiB of working memory)",
+    )
+    batch.add_argument(
+        "--workers",
+        type=_workers,
+        default=None,
+        help="worker processes (default: every available core)",
+    )
+    batch.add_argument(
+        "--format",
+        choices=["npz", "parquet"],
+        default=None,
+        help="output format (default: from OUT's suffix; parquet needs pyarrow)",
+    )
+    batch.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="run on the Dask scheduler at ADDRESS (host:port; needs the dask extra)",
     )
     batch.add_argument(
         "--progress",

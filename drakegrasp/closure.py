@@ -43,6 +43,10 @@ from pydrake.solvers import (
     SolutionResult,
 )
 
+from drakegrasp._dense_constraints import (
+    add_linear_constraint,
+    add_linear_equality_constraint,
+)
 from drakegrasp.errors import InvalidOptionError, SolverError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.grasp import (
@@ -195,7 +199,8 @@ def _margin_program(
 
 def _add_normal_budget(prog, normal_forces, num_contacts: int) -> None:
     """``Σ f_n <= N`` (the normalisation of LP1–LP3)."""
-    prog.AddLinearConstraint(
+    add_linear_constraint(
+        prog,
         np.ones((1, len(normal_forces))),
         [-np.inf],
         [float(num_contacts)],
@@ -211,17 +216,25 @@ def _add_margin_rows(prog, A, x, d) -> None:
     """``A x - 1 d >= 0``; ``A`` dense or scipy-sparse (large block diagonals).
 
     A thousand contacts with 64 generators make a 64,000 x 3,000 facet matrix:
-    1.5 GB dense, 1.5 MB of non-zeros.
+    1.5 GB dense, 1.5 MB of non-zeros.  Dense matrices go through
+    :func:`~drakegrasp._dense_constraints.add_linear_constraint`, which keeps
+    pydrake from importing scipy.sparse on the first call.
     """
     if hasattr(A, "tocsc"):  # scipy.sparse
         from scipy import sparse
 
         M = sparse.hstack([A, -np.ones((A.shape[0], 1))], format="csc")
-    else:
-        A = np.atleast_2d(A)
-        M = np.hstack([A, -np.ones((A.shape[0], 1))])
-    prog.AddLinearConstraint(
-        M, np.zeros(A.shape[0]), np.full(A.shape[0], np.inf), np.append(x, d)
+        prog.AddLinearConstraint(
+            M, np.zeros(A.shape[0]), np.full(A.shape[0], np.inf), np.append(x, d)
+        )
+        return
+    A = np.atleast_2d(A)
+    add_linear_constraint(
+        prog,
+        np.hstack([A, -np.ones((A.shape[0], 1))]),
+        np.zeros(A.shape[0]),
+        np.full(A.shape[0], np.inf),
+        np.append(x, d),
     )
 
 
@@ -282,7 +295,7 @@ def _add_balance(
         rows = rows * scales
     if rows.shape[0]:
         rows = np.linalg.qr(rows.T)[0].T
-        prog.AddLinearEqualityConstraint(rows, np.zeros(rows.shape[0]), x)
+        add_linear_equality_constraint(prog, rows, np.zeros(rows.shape[0]), x)
 
 
 def build_form_closure_program(

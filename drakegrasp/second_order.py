@@ -40,6 +40,10 @@ from pydrake.solvers import (
     SolutionResult,
 )
 
+from drakegrasp._dense_constraints import (
+    add_linear_constraint,
+    add_linear_equality_constraint,
+)
 from drakegrasp.closure import DEFAULT_RANK_TOL, _add_balance, form_closure
 from drakegrasp.curvature import ContactCurvature, _skew, contact_hessians
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
@@ -116,7 +120,8 @@ def equilibrium_support(
     _add_balance(prog, normal_grasp_matrix(grasp), lam, rank_tol)
     prog.AddBoundingBoxConstraint(0.0, 1.0, s)
     prog.AddBoundingBoxConstraint(0.0, 1e6, lam)
-    prog.AddLinearConstraint(
+    add_linear_constraint(
+        prog,
         np.hstack([np.eye(N), -np.eye(N)]),
         np.zeros(N),
         np.full(N, np.inf),
@@ -225,7 +230,7 @@ def build_second_order_program(
     lam = prog.NewContinuousVariables(len(S), "lambda")
     t = prog.NewContinuousVariables(1, "t")[0]
     prog.AddBoundingBoxConstraint(0.0, np.inf, lam)
-    prog.AddLinearEqualityConstraint(np.ones((1, len(S))), [1.0], lam)
+    add_linear_equality_constraint(prog, np.ones((1, len(S))), [1.0], lam)
     _add_balance(prog, Gs, lam, rank_tol)
     k = B.shape[1]
     lmi = prog.AddLinearMatrixInequalityConstraint(
@@ -539,14 +544,15 @@ def _escape_acceleration(Gt, closed, H, T, nu, b):
     prog.AddBoundingBoxConstraint(-_ESCAPE_BOX, _ESCAPE_BOX, a)
     prog.AddBoundingBoxConstraint(-np.inf, 1.0, s)
     eye = np.eye(n)
-    prog.AddLinearConstraint(
+    add_linear_constraint(
+        prog,
         np.block([[eye, eye], [-eye, eye]]),
         np.zeros(2 * n),
         np.full(2 * n, np.inf),
         np.append(a, z),
     )
     A = np.hstack([Gt[:, idx].T, -np.ones((len(idx), 1))])
-    prog.AddLinearConstraint(A, -h, np.full(len(idx), np.inf), np.append(a, s))
+    add_linear_constraint(prog, A, -h, np.full(len(idx), np.inf), np.append(a, s))
     prog.AddLinearCost(np.append(np.full(n, 1e-3), -1.0), 0.0, np.append(z, s))
     result = _solve(prog, (ClpSolver(), ClarabelSolver()))
     if result.get_solution_result() != SolutionResult.kSolutionFound:
@@ -565,7 +571,8 @@ def _no_equilibrium(grasp: Grasp, tol: float) -> SecondOrderResult:
     s = prog.NewContinuousVariables(1, "s")[0]
     prog.AddBoundingBoxConstraint(-1.0, 1.0, nu)
     prog.AddBoundingBoxConstraint(-np.inf, 1.0, s)
-    prog.AddLinearConstraint(
+    add_linear_constraint(
+        prog,
         np.hstack([Gt.T, -np.ones((N, 1))]),
         np.zeros(N),
         np.full(N, np.inf),

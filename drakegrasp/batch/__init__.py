@@ -10,7 +10,9 @@ Modules: :mod:`~drakegrasp.batch.construction` (vectorised frames, grasp
 matrices and cone facets), :mod:`~drakegrasp.batch.reduction` (null-space
 reduction of LP1/LP2), :mod:`~drakegrasp.batch.ipm` (batched interior-point
 method), :mod:`~drakegrasp.batch.engine` (chunked drivers),
-:mod:`~drakegrasp.batch.io` (files).
+:mod:`~drakegrasp.batch.io` (files), :mod:`~drakegrasp.batch.writers` (results
+streamed to .npz/.parquet in flat memory), :mod:`~drakegrasp.batch.parallel`
+(worker processes).
 """
 
 from drakegrasp.batch.engine import (
@@ -20,17 +22,25 @@ from drakegrasp.batch.engine import (
     batch_force_closure,
     batch_form_closure,
     iter_batch_closure,
+    stream_force_closure,
+    stream_form_closure,
 )
 from drakegrasp.batch.io import evaluate_file, read_grasps, write_result
+from drakegrasp.batch.writers import BatchSummary, stream_file, write_chunks
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
     "METRICS",
     "BatchClosureResult",
+    "BatchSummary",
     "batch_force_closure",
     "batch_form_closure",
     "evaluate_file",
     "iter_batch_closure",
     "read_grasps",
+    "stream_file",
+    "stream_force_closure",
+    "stream_form_closure",
+    "write_chunks",
     "write_result",
 ]

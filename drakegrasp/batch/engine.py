@@ -16,25 +16,15 @@ matrices exist at any moment, and inputs may be memory-mapped arrays.
 
 from __future__ import annotations
 
+import mmap
 import operator
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from drakegrasp.batch.construction import (
-    FRICTIONLESS,
-    KIND_COMPONENTS,
-    PLANAR_HARD,
-    SOFT_FULL,
-    SPATIAL_HARD,
-    batched_characteristic_lengths,
-    batched_grasp_matrix,
-    batched_normal_grasp_matrix,
-    contact_kinds,
-    kind_facets,
-)
-from drakegrasp.batch.reduction import solve_margin_lp
+from drakegrasp.batch.chunks import force_chunk, form_chunk
+from drakegrasp.batch.parallel import map_ordered, resolve_workers
 from drakegrasp.contact import ContactModel
 from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOptionError
 from drakegrasp.results import ZERO_FRACTION
@@ -59,11 +49,20 @@ __all__ = [
     "batch_force_closure",
     "batch_form_closure",
     "iter_batch_closure",
+    "stream_force_closure",
+    "stream_form_closure",
 ]
 
-DEFAULT_CHUNK_SIZE = 4096
-"""Grasps per chunk: large enough to amortise numpy's per-call cost, small
-enough that a chunk's matrices stay in cache-friendly sizes (a few MB)."""
+DEFAULT_CHUNK_SIZE = None
+"""``chunk_size=None``: chunks are sized by bytes (``CHUNK_BYTES``)."""
+
+PARALLEL_MIN_WORK = 200_000
+"""With ``workers=None``, batches of fewer than this many contacts (``K N``) run
+in this process: starting worker processes costs about 0.5 s."""
+
+CHUNK_BYTES = 16 * 2**20
+"""Working memory aimed at per chunk: a few times the L2 cache, so a chunk's
+arrays stay close to the CPU, and a flat peak whatever ``K`` and ``N``."""
 
 DEFAULT_TOL = 1e-6
 DEFAULT_RANK_TOL = 1e-9
@@ -380,164 +379,276 @@ def _chunks(K: int, chunk_size: int, progress: bool, desc: str) -> Iterator[slic
 
 
 # --------------------------------------------------------------------------
-# Metrics
-
-
-def _singular_value_metrics(
-    G: np.ndarray, b: np.ndarray, names: Sequence[str], out: dict, sl: slice
-) -> None:
-    """σ_min, σ_min/σ_max and ∏σ of ``G`` with moment rows divided by ``b``."""
-    wanted = [n for n in names if n in ("sigma_min", "isotropy", "ellipsoid_volume")]
-    if not wanted:
-        return
-    w = G.shape[1]
-    f = 2 if w == 3 else 3
-    Gs = G.copy()
-    Gs[:, f:, :] /= b[:, None, None]
-    sv = np.linalg.svd(Gs, compute_uv=False)
-    if sv.shape[1] < w:  # fewer columns than wrench rows: the rest are zero
-        sv = np.concatenate([sv, np.zeros((sv.shape[0], w - sv.shape[1]))], axis=1)
-    if "sigma_min" in wanted:
-        out["sigma_min"][sl] = sv[:, -1]
-    if "isotropy" in wanted:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = sv[:, -1] / sv[:, 0]
-        out["isotropy"][sl] = np.where(sv[:, 0] > 0.0, ratio, 0.0)
-    if "ellipsoid_volume" in wanted:
-        out["ellipsoid_volume"][sl] = np.prod(sv, axis=1)
-
-
-def _epsilon_l1(P, Nrm, mu, nu, p, b, *, model, num_generators, out, sl) -> None:
-    try:
-        from drakegrasp.quality import ferrari_canny
-    except ImportError as exc:
-        raise InvalidOptionError(
-            "metric 'epsilon_l1' needs drakegrasp.quality.ferrari_canny, which "
-            "this installation does not provide"
-        ) from exc
-    from drakegrasp.contact import Contact
-    from drakegrasp.grasp import Grasp
-
-    for k in range(P.shape[0]):
-        contacts = [
-            Contact(
-                P[k, i],
-                Nrm[k, i],
-                mu=mu[k, i],
-                model=model,
-                torsional_friction=nu[k, i],
-            )
-            for i in range(P.shape[1])
-        ]
-        grasp = Grasp(contacts, reference_point=p[k], characteristic_length=b[k])
-        out["epsilon_l1"][sl.start + k] = float(
-            ferrari_canny(grasp, norm="L1", num_generators=num_generators)
-        )
-
-
-# --------------------------------------------------------------------------
 # Drivers
 
 
-def _group_layouts(kinds: np.ndarray):
-    """Yield (layout tuple, row indices) for the distinct rows of ``kinds``."""
-    if kinds.shape[0] == 0:
-        return
-    first = kinds[0]
-    if (kinds == first).all():
-        yield tuple(int(x) for x in first), np.arange(kinds.shape[0])
-        return
-    layouts, inverse = np.unique(kinds, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    for j, layout in enumerate(layouts):
-        yield tuple(int(x) for x in layout), np.flatnonzero(inverse == j)
+def chunk_size_for(N: int, d: int, chunk_size: int | None, n_g: int = 8) -> int:
+    """Grasps per chunk: ``chunk_size``, or as many as fit in ``CHUNK_BYTES``.
+
+    A grasp's working set is dominated by its grasp matrix, row-space basis
+    and equality rows (``~3 (w + 1) M`` numbers, ``M <= 4N`` components) and
+    its facet slacks and multipliers (``~12 r`` numbers, ``r <= 16N`` rows).
+    """
+    if chunk_size is not None:
+        size = _positive_int("chunk_size", chunk_size, 1)
+    else:
+        w = 6 if d == 3 else 3
+        per_grasp = 8 * (3 * (w + 1) * 3 * N + 12 * 8 * N + 64)
+        size = int(min(65536, max(64, CHUNK_BYTES // per_grasp)))
+    return _bounded_chunk_size(size, N, n_g)
 
 
-def _run(
+def _release_pages(a, stop: int) -> None:
+    """Drop the pages of a memory-mapped input read so far from this process.
+
+    A file-backed page stays in the process's resident set once read; over a
+    file of 10^7 grasps that would grow the RSS by the whole input.  The pages
+    stay in the OS's page cache (they are re-read from there if needed).
+    """
+    mm = getattr(a, "_mmap", None)
+    if getattr(a, "mode", None) not in ("r", "r+"):  # never drop copy-on-write pages
+        return
+    if mm is None or not hasattr(mm, "madvise") or not hasattr(mmap, "MADV_DONTNEED"):
+        return
+    row = int(np.prod(a.shape[1:], dtype=np.int64)) * a.itemsize
+    offset = int(a.offset) if hasattr(a, "offset") else 0
+    end = (offset + stop * row) // mmap.PAGESIZE * mmap.PAGESIZE
+    if end > 0:
+        try:
+            mm.madvise(mmap.MADV_DONTNEED, 0, min(end, len(mm)))
+        except (OSError, ValueError):  # pragma: no cover - advice only
+            pass
+
+
+def _stream(
     positions,
     normals,
     *,
     kind: str,
-    chunk_fn: Callable,
-    tol: float,
-    chunk_size: int,
+    task: Callable,
+    chunk_size: int | None,
     progress: bool,
-    metrics: tuple[str, ...],
-) -> BatchClosureResult:
+    workers,
+    n_g: int = 1,
+) -> Iterator[tuple[slice, dict[str, np.ndarray]]]:
+    """Validated chunks through ``task`` (which builds one chunk's work), in order."""
     K, N, d = _shape_of("positions", positions)
     if np.shape(normals) != (K, N, d):
         raise InvalidContactError(
             f"normals must have the shape of positions {(K, N, d)}, got "
             f"{np.shape(normals)}"
         )
-    d_star = np.zeros(K)
-    rank = np.zeros(K, dtype=int)
-    converged = np.ones(K, dtype=bool)
-    normal_d_star = np.full(K, np.nan)  # LP1's d* where a certificate was sought
-    out_metrics = {name: np.full(K, np.nan) for name in metrics}
-    for sl in _chunks(K, chunk_size, progress, f"{kind} closure"):
-        P = real_array("positions", positions[sl])
-        _check_positions(P, sl.start)
-        Nrm = _unit_normals(real_array("normals", normals[sl]), sl.start)
-        chunk_fn(P, Nrm, sl, d_star, rank, converged, out_metrics, normal_d_star)
-    required = 3 if d == 2 else 6
-    certified = (rank == required) & ~(d_star > tol) & (normal_d_star > tol)
-    is_closure = (rank == required) & (d_star > tol) | certified
-    margin = (np.where(certified, normal_d_star, d_star) - tol) / tol
-    arrays = (is_closure, d_star, rank, margin, converged, certified)
-    for a in (*arrays, *out_metrics.values()):
+    size = chunk_size_for(N, d, chunk_size, n_g)
+    n_workers = resolve_workers(workers)
+    if workers is None and K * N < PARALLEL_MIN_WORK:
+        n_workers = 1  # starting processes would cost more than they save
+    n_workers = min(n_workers, -(-K // size))
+    slices: list[slice] = []
+
+    def tasks():
+        for sl in _chunks(K, size, progress, f"{kind} closure"):
+            P = real_array("positions", positions[sl])
+            _check_positions(P, sl.start)
+            Nrm = _unit_normals(real_array("normals", normals[sl]), sl.start)
+            _release_pages(positions, sl.stop)
+            _release_pages(normals, sl.stop)
+            slices.append(sl)
+            yield task(P, Nrm, sl)
+
+    for i, arrays in enumerate(map_ordered(tasks(), n_workers)):
+        yield slices[i], arrays
+
+
+def _collect(K: int, d: int, kind: str, tol: float, names, chunks):
+    """One :class:`BatchClosureResult` from streamed chunk results."""
+    out = {
+        "is_closure": np.zeros(K, dtype=bool),
+        "d_star": np.zeros(K),
+        "rank": np.zeros(K, dtype=int),
+        "margin": np.zeros(K),
+        "converged": np.ones(K, dtype=bool),
+    }
+    if kind == "force":
+        out["normal_certificate"] = np.zeros(K, dtype=bool)
+    out_metrics = {name: np.full(K, np.nan) for name in names}
+    for sl, arrays in chunks:
+        for name, target in (*out.items(), *out_metrics.items()):
+            target[sl] = arrays[name]
+    for a in (*out.values(), *out_metrics.values()):
         a.flags.writeable = False
     return BatchClosureResult(
         kind=kind,
-        is_closure=is_closure,
-        d_star=d_star,
-        rank=rank,
-        required_rank=required,
-        margin=margin,
-        converged=converged,
+        is_closure=out["is_closure"],
+        d_star=out["d_star"],
+        rank=out["rank"],
+        required_rank=3 if d == 2 else 6,
+        margin=out["margin"],
+        converged=out["converged"],
         tol=tol,
         metrics=out_metrics,
-        normal_certificate=certified if kind == "force" else None,
+        normal_certificate=out.get("normal_certificate"),
     )
 
 
-def _lp1(Gn: np.ndarray, rank_tol: float):
-    """LP1 on stacked normal grasp matrices ``G_n`` (k, w, N)."""
-    N = Gn.shape[2]
-    slices = [slice(i, i + 1) for i in range(N)]
-    ones = np.ones((Gn.shape[0], 1, 1))
-    return solve_margin_lp(Gn, [ones] * N, slices, np.arange(N), rank_tol=rank_tol)
+def _check_kernel(kernel: str) -> str:
+    if kernel not in ("auto", "numba", "numpy"):
+        raise InvalidOptionError(
+            f"kernel must be 'auto', 'numba' or 'numpy', got {kernel!r}"
+        )
+    if kernel == "numba":
+        from drakegrasp.batch.margin import numba_available
+
+        if not numba_available():
+            raise InvalidOptionError(
+                "kernel='numba' needs the optional package numba "
+                "(pip install drakegrasp[fast]); use kernel='numpy'"
+            )
+    return kernel
 
 
-def _normal_certificates(
-    P, Nrm, p, kinds, sl, d_star, rank, normal_d_star, *, tol: float, rank_tol: float
-) -> None:
-    """LP1 for the grasps whose force closure only normal forces could prove.
+def _force_task(positions, mu, model, num_generators, torsional_friction,
+                reference_points, characteristic_lengths, tol, rank_tol, metrics,
+                kernel):  # fmt: skip
+    """Validate options once; return the chunk-task builder of LP2 and options."""
+    model = ContactModel.parse(model).value
+    K, N, d = _shape_of("positions", positions)
+    if model == "soft_finger" and d == 2:
+        raise InvalidContactError(
+            "a soft-finger contact is spatial only; planar contacts are "
+            "'frictionless' or 'hard_finger'"
+        )
+    options = {
+        "model": model,
+        "num_generators": check_num_generators(num_generators),
+        "tol": _check_tol("tol", tol),
+        "rank_tol": _check_tol("rank_tol", rank_tol),
+        "metrics": _check_metrics(metrics),
+        "kernel": _check_kernel(kernel),
+    }
+    get_mu = _per_contact("mu", mu, K, N)
+    if torsional_friction is None:
+        if model == "soft_finger":
+            raise InvalidContactError(
+                "model='soft_finger' needs torsional_friction (nu: the moment "
+                "about the normal is bounded by b * nu * f_n); pass nu > 0, or 0 "
+                "for soft fingers that act as hard fingers"
+            )
+        torsional_friction = 0.0
+    get_nu = _per_contact("torsional_friction", torsional_friction, K, N)
+    get_p = _reference_points(reference_points, K, d)
+    get_b = _characteristic_lengths(characteristic_lengths, K)
+    soft = model == "soft_finger"
 
-    Those are the grasps with full rank, ``d* <= tol`` and some friction, the
-    same that :func:`drakegrasp.force_closure` checks; LP1's ``d*`` is stored
-    in ``normal_d_star`` (NaN elsewhere).
+    def task(P, Nrm, sl):
+        mu_c = get_mu(sl)
+        _check_coefficients("mu", mu_c, sl.start)
+        nu_c = get_nu(sl)
+        if soft:
+            _check_coefficients("torsional_friction", nu_c, sl.start)
+        p = np.ascontiguousarray(get_p(sl))
+        b = None if get_b is None else np.ascontiguousarray(get_b(sl))
+        return force_chunk, (P, Nrm, mu_c, nu_c, p, b), options
+
+    return task, options
+
+
+def _form_task(positions, reference_points, characteristic_lengths, tol, rank_tol,
+               metrics, kernel):  # fmt: skip
+    """Validate options once; return the chunk-task builder of LP1 and options."""
+    K, N, d = _shape_of("positions", positions)
+    options = {
+        "tol": _check_tol("tol", tol),
+        "rank_tol": _check_tol("rank_tol", rank_tol),
+        "metrics": _check_metrics(metrics),
+        "kernel": _check_kernel(kernel),
+    }
+    if "epsilon_l1" in options["metrics"]:
+        raise InvalidOptionError(
+            "metric 'epsilon_l1' needs friction; use batch_force_closure"
+        )
+    get_p = _reference_points(reference_points, K, d)
+    get_b = _characteristic_lengths(characteristic_lengths, K)
+
+    def task(P, Nrm, sl):
+        p = np.ascontiguousarray(get_p(sl))
+        b = None if get_b is None else np.ascontiguousarray(get_b(sl))
+        return form_chunk, (P, Nrm, p, b), options
+
+    return task, options
+
+
+def stream_force_closure(
+    positions,
+    normals,
+    mu,
+    *,
+    model: ContactModel | str = "hard_finger",
+    num_generators: int = 8,
+    torsional_friction=None,
+    reference_points=None,
+    characteristic_lengths=None,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+    chunk_size: int | None = DEFAULT_CHUNK_SIZE,
+    progress: bool = False,
+    metrics: Sequence[str] = (),
+    workers: int | None = None,
+    kernel: str = "auto",
+) -> Iterator[tuple[slice, dict[str, np.ndarray]]]:
+    """:func:`batch_force_closure` one chunk at a time: yields ``(slice, arrays)``.
+
+    The arrays are those of :meth:`BatchClosureResult.to_arrays` for the grasps
+    ``slice`` of the input, in order; only the chunks in flight are held, so a
+    writer can stream any number of grasps in bounded memory.  Options are
+    validated before the first chunk is read.
     """
-    required = 3 if P.shape[2] == 2 else 6
-    local = np.arange(P.shape[0])
-    full_rank = rank[sl] == required
-    frictional = (kinds != FRICTIONLESS).any(axis=1)
-    rows = local[full_rank & frictional & ~(d_star[sl] > tol)]
-    if rows.size == 0:
-        return
-    Gn = batched_normal_grasp_matrix(P[rows], Nrm[rows], p[rows])
-    N = Gn.shape[2]
-    if N <= Gn.shape[1]:
-        # Balancing normal forces need N(G_n) != {0}.  With no more contacts than
-        # wrench rows that is rare, and the rank rule of the single path
-        # (σ_min <= rank_tol σ_max, by SVD: a Gram eigenvalue test would square
-        # the singular values below eigvalsh's accuracy) rules it out at ~2 µs.
-        sv = np.linalg.svd(Gn, compute_uv=False)
-        deficient = sv[:, -1] <= rank_tol * sv[:, 0]
-        rows, Gn = rows[deficient], Gn[deficient]
-        if rows.size == 0:
-            return
-    normal_d_star[sl.start + rows] = _lp1(Gn, rank_tol).d_star
+    task, options = _force_task(
+        positions, mu, model, num_generators, torsional_friction, reference_points,
+        characteristic_lengths, tol, rank_tol, metrics, kernel,
+    )  # fmt: skip
+    return _stream(
+        positions,
+        normals,
+        kind="force",
+        task=task,
+        chunk_size=chunk_size,
+        progress=progress,
+        workers=workers,
+        n_g=options["num_generators"],
+    )
+
+
+def stream_form_closure(
+    positions,
+    normals,
+    *,
+    reference_points=None,
+    characteristic_lengths=None,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+    chunk_size: int | None = DEFAULT_CHUNK_SIZE,
+    progress: bool = False,
+    metrics: Sequence[str] = (),
+    workers: int | None = None,
+    kernel: str = "auto",
+) -> Iterator[tuple[slice, dict[str, np.ndarray]]]:
+    """:func:`batch_form_closure` one chunk at a time.
+
+    See :func:`stream_force_closure`.
+    """
+    task, _ = _form_task(
+        positions, reference_points, characteristic_lengths, tol, rank_tol, metrics,
+        kernel,
+    )  # fmt: skip
+    return _stream(
+        positions,
+        normals,
+        kind="form",
+        task=task,
+        chunk_size=chunk_size,
+        progress=progress,
+        workers=workers,
+    )
 
 
 def batch_force_closure(
@@ -552,9 +663,11 @@ def batch_force_closure(
     characteristic_lengths: float | np.ndarray | None = None,
     tol: float = DEFAULT_TOL,
     rank_tol: float = DEFAULT_RANK_TOL,
-    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    chunk_size: int | None = DEFAULT_CHUNK_SIZE,
     progress: bool = False,
     metrics: Sequence[str] = (),
+    workers: int | None = None,
+    kernel: str = "auto",
 ) -> BatchClosureResult:
     r"""Frictional force closure (LP2) of ``K`` grasps at once.
 
@@ -590,10 +703,13 @@ def batch_force_closure(
     tol : float, optional
         Closure needs ``d* > tol`` (default 1e-6, as the single path).
     rank_tol : float, optional
-        Singular values ``<= rank_tol * σ_max`` of ``G`` count as zero.
+        Singular values ``<= rank_tol * σ_max`` of the normalised ``G``
+        (moments about the contacts' centroid divided by their spread) count
+        as zero, so the rank does not depend on units or on ``p``.
     chunk_size : int, optional
         Grasps processed together; memory use grows with it, not with ``K``.
-        Capped so that a chunk's facet rows stay near 64 MB (large
+        Default (None): as many as fit in ``CHUNK_BYTES`` for this ``N``,
+        and at most so many that a chunk's facet rows stay near 64 MB (large
         ``num_generators``).
     progress : bool, optional
         Show a tqdm progress bar (needs the optional package ``tqdm``).
@@ -604,6 +720,12 @@ def batch_force_closure(
         ellipsoid's volume over the unit ball's) — and ``"epsilon_l1"``, the
         Ferrari–Canny L1 ε from :func:`drakegrasp.quality.ferrari_canny`
         (one call per grasp; slow).
+    workers : int, optional
+        Worker processes; default (None) every available core.  Results are
+        bitwise the same for any number (:mod:`drakegrasp.batch.parallel`).
+    kernel : {"auto", "numba", "numpy"}, optional
+        Interior-point implementation: the compiled one (needs numba) or the
+        numpy reference; ``"auto"`` takes numba when installed.
 
     Returns
     -------
@@ -623,104 +745,19 @@ def batch_force_closure(
     reduced on ``N(G)`` and solved for a whole chunk by a batched Mehrotra
     interior-point method (:mod:`drakegrasp.batch.reduction`).
     """
-    model = ContactModel.parse(model).value
     K, N, d = _shape_of("positions", positions)
-    if model == "soft_finger" and d == 2:
-        raise InvalidContactError(
-            "a soft-finger contact is spatial only; planar contacts are "
-            "'frictionless' or 'hard_finger'"
-        )
-    n_g = check_num_generators(num_generators)
-    chunk_size = _bounded_chunk_size(_positive_int("chunk_size", chunk_size, 1), N, n_g)
-    tol = _check_tol("tol", tol)
-    rank_tol = _check_tol("rank_tol", rank_tol)
-    names = _check_metrics(metrics)
-    get_mu = _per_contact("mu", mu, K, N)
-    if torsional_friction is None:
-        if model == "soft_finger":
-            raise InvalidContactError(
-                "model='soft_finger' needs torsional_friction (nu: the moment "
-                "about the normal is bounded by b * nu * f_n); pass nu > 0, or 0 "
-                "for soft fingers that act as hard fingers"
-            )
-        torsional_friction = 0.0
-    get_nu = _per_contact("torsional_friction", torsional_friction, K, N)
-    get_p = _reference_points(reference_points, K, d)
-    get_b = _characteristic_lengths(characteristic_lengths, K)
-    soft = model == "soft_finger"
-
-    def chunk(P, Nrm, sl, d_star, rank, converged, out_metrics, normal_d_star):
-        mu_c = get_mu(sl)
-        _check_coefficients("mu", mu_c, sl.start)
-        nu_c = get_nu(sl)
-        if soft:
-            _check_coefficients("torsional_friction", nu_c, sl.start)
-        p = get_p(sl)
-        b = batched_characteristic_lengths(P, p) if get_b is None else get_b(sl)
-        kinds = contact_kinds(mu_c, nu_c, model=model, dim=d)
-        for layout, rows in _group_layouts(kinds):
-            sub = rows if rows.size < P.shape[0] else slice(None)
-            G, normal_cols = batched_grasp_matrix(P[sub], Nrm[sub], p[sub], layout)
-            torsion = b[sub][:, None] * nu_c[sub]
-            facets, slices, start = [], [], 0
-            for i, kind in enumerate(layout):
-                k_i = len(KIND_COMPONENTS[kind])
-                mu_i, tor_i = mu_c[sub, i], torsion[:, i]
-                if (mu_i == mu_i[0]).all() and (tor_i == tor_i[0]).all():
-                    mu_i, tor_i = mu_i[:1], tor_i[:1]  # one cone for all grasps
-                facets.append(kind_facets(kind, mu_i, tor_i, n_g))
-                slices.append(slice(start, start + k_i))
-                start += k_i
-            sol = solve_margin_lp(G, facets, slices, normal_cols, rank_tol=rank_tol)
-            idx = sl.start + rows
-            d_star[idx] = sol.d_star
-            rank[idx] = sol.rank
-            converged[idx] = sol.converged
-        _normal_certificates(
-            P,
-            Nrm,
-            p,
-            kinds,
-            sl,
-            d_star,
-            rank,
-            normal_d_star,
-            tol=tol,
-            rank_tol=rank_tol,
-        )
-        if names:
-            full = {
-                "frictionless": FRICTIONLESS,
-                "hard_finger": SPATIAL_HARD if d == 3 else PLANAR_HARD,
-                "soft_finger": SOFT_FULL,
-            }[model]
-            full = (full,) * N
-            Gfull, _ = batched_grasp_matrix(P, Nrm, p, full)
-            _singular_value_metrics(Gfull, b, names, out_metrics, sl)
-            if "epsilon_l1" in names:
-                _epsilon_l1(
-                    P,
-                    Nrm,
-                    mu_c,
-                    nu_c,
-                    p,
-                    b,
-                    model=model,
-                    num_generators=n_g,
-                    out=out_metrics,
-                    sl=sl,
-                )
-
-    return _run(
-        positions,
-        normals,
-        kind="force",
-        chunk_fn=chunk,
-        tol=tol,
-        chunk_size=chunk_size,
-        progress=progress,
-        metrics=names,
-    )
+    _, options = _force_task(
+        positions, mu, model, num_generators, torsional_friction, reference_points,
+        characteristic_lengths, tol, rank_tol, metrics, kernel,
+    )  # fmt: skip
+    chunks = stream_force_closure(
+        positions, normals, mu, model=model, num_generators=num_generators,
+        torsional_friction=torsional_friction, reference_points=reference_points,
+        characteristic_lengths=characteristic_lengths, tol=tol, rank_tol=rank_tol,
+        chunk_size=chunk_size, progress=progress, metrics=metrics, workers=workers,
+        kernel=kernel,
+    )  # fmt: skip
+    return _collect(K, d, "force", options["tol"], options["metrics"], chunks)
 
 
 def batch_form_closure(
@@ -731,9 +768,11 @@ def batch_form_closure(
     characteristic_lengths: float | np.ndarray | None = None,
     tol: float = DEFAULT_TOL,
     rank_tol: float = DEFAULT_RANK_TOL,
-    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    chunk_size: int | None = DEFAULT_CHUNK_SIZE,
     progress: bool = False,
     metrics: Sequence[str] = (),
+    workers: int | None = None,
+    kernel: str = "auto",
 ) -> BatchClosureResult:
     r"""First-order form closure (LP1 and ``rank(G_n)``) of ``K`` grasps at once.
 
@@ -747,7 +786,7 @@ def batch_form_closure(
     characteristic_lengths : float or (K,) float, optional
         ``b`` for the scaled singular-value metrics (default as
         :class:`~drakegrasp.Grasp`).
-    tol, rank_tol, chunk_size, progress : optional
+    tol, rank_tol, chunk_size, progress, workers, kernel : optional
         As in :func:`batch_force_closure`.
     metrics : sequence of str, optional
         ``"sigma_min"``, ``"isotropy"``, ``"ellipsoid_volume"`` of ``G_n``.
@@ -767,38 +806,17 @@ def batch_form_closure(
         d \ge 0,\; \mathbf 1^T f_n \le N .
     """
     K, N, d = _shape_of("positions", positions)
-    chunk_size = _bounded_chunk_size(_positive_int("chunk_size", chunk_size, 1), N, 1)
-    tol = _check_tol("tol", tol)
-    rank_tol = _check_tol("rank_tol", rank_tol)
-    names = _check_metrics(metrics)
-    if "epsilon_l1" in names:
-        raise InvalidOptionError(
-            "metric 'epsilon_l1' needs friction; use batch_force_closure"
-        )
-    get_p = _reference_points(reference_points, K, d)
-    get_b = _characteristic_lengths(characteristic_lengths, K)
-
-    def chunk(P, Nrm, sl, d_star, rank, converged, out_metrics, normal_d_star):
-        p = get_p(sl)
-        Gn = batched_normal_grasp_matrix(P, Nrm, p)
-        sol = _lp1(Gn, rank_tol)
-        d_star[sl] = sol.d_star
-        rank[sl] = sol.rank
-        converged[sl] = sol.converged
-        if names:
-            b = batched_characteristic_lengths(P, p) if get_b is None else get_b(sl)
-            _singular_value_metrics(Gn, b, names, out_metrics, sl)
-
-    return _run(
-        positions,
-        normals,
-        kind="form",
-        chunk_fn=chunk,
-        tol=tol,
-        chunk_size=chunk_size,
-        progress=progress,
-        metrics=names,
-    )
+    _, options = _form_task(
+        positions, reference_points, characteristic_lengths, tol, rank_tol, metrics,
+        kernel,
+    )  # fmt: skip
+    chunks = stream_form_closure(
+        positions, normals, reference_points=reference_points,
+        characteristic_lengths=characteristic_lengths, tol=tol, rank_tol=rank_tol,
+        chunk_size=chunk_size, progress=progress, metrics=metrics, workers=workers,
+        kernel=kernel,
+    )  # fmt: skip
+    return _collect(K, d, "form", options["tol"], options["metrics"], chunks)
 
 
 def iter_batch_closure(

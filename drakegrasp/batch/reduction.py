@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.batch.ipm import solve_max_last
+from drakegrasp.batch.rowspace import _inverse_frobenius
 
 __all__ = ["MarginSolution", "null_spaces", "solve_margin_lp"]
 
@@ -113,22 +114,6 @@ def _householder_qr(A: np.ndarray):
         v, sub = vs[j], Q[j:]
         sub -= v[:, None, :] * (betas[j] * np.einsum("ik,ijk->jk", v, sub))[None]
     return A[:w], Q
-
-
-def _inverse_frobenius(R: np.ndarray) -> np.ndarray:
-    """``‖R⁻¹‖_F`` of upper-triangular (w, w, K) stacks (inf when singular)."""
-    w = R.shape[0]
-    X = np.zeros_like(R)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        for j in range(w):
-            X[j, j] = 1.0 / R[j, j]
-            for i in reversed(range(j)):
-                X[i, j] = -np.einsum(
-                    "ik,ik->k", R[i, i + 1 : j + 1], X[i + 1 : j + 1, j]
-                )
-                X[i, j] /= R[i, i]
-        out = np.sqrt(np.einsum("ijk,ijk->k", X, X))
-    return np.where(np.isfinite(out), out, np.inf)
 
 
 def null_spaces(G: np.ndarray, *, rank_tol: float):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from batch_support import random_grasps
 
-import drakegrasp.batch.engine as engine
+import drakegrasp.batch.chunks as chunks
 from drakegrasp.batch import batch_force_closure, batch_form_closure, iter_batch_closure
 from drakegrasp.errors import (
     GraspError,
@@ -116,12 +116,15 @@ def test_chunk_size_does_not_change_results():
         res = batch_force_closure(P, Nrm, mu, chunk_size=cs, metrics=["sigma_min"])
         np.testing.assert_array_equal(res.is_closure, ref.is_closure)
         np.testing.assert_array_equal(res.rank, ref.rank)
-        np.testing.assert_allclose(res.d_star, ref.d_star, rtol=0, atol=1e-12)
+        # The interior-point method stops at ~1e-10 on t = d*/N; the vectorised
+        # QR rounds differently for other stack sizes, which moves d* within
+        # that tolerance (chunk boundaries, not workers: see test_batch_scale).
+        np.testing.assert_allclose(res.d_star, ref.d_star, rtol=0, atol=1e-9)
         np.testing.assert_allclose(
             res.metrics["sigma_min"], ref.metrics["sigma_min"], rtol=1e-12
         )
     form = [batch_form_closure(P, Nrm, chunk_size=cs).d_star for cs in (3, K)]
-    np.testing.assert_allclose(form[0], form[1], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(form[0], form[1], rtol=0, atol=1e-9)
 
 
 class _RecordingArray:
@@ -144,13 +147,13 @@ def test_driver_reads_and_builds_one_chunk_at_a_time(monkeypatch):
     P, Nrm = random_grasps(rng, K, 3, 3)
     mu = rng.uniform(0.2, 0.8, (K, 3))
     sizes = []
-    real = engine.solve_margin_lp
+    real = chunks.solve_margin_blocks
 
     def spy(G, *args, **kwargs):
         sizes.append(G.shape[0])
         return real(G, *args, **kwargs)
 
-    monkeypatch.setattr(engine, "solve_margin_lp", spy)
+    monkeypatch.setattr(chunks, "solve_margin_blocks", spy)
     arrays = [_RecordingArray(a) for a in (P, Nrm, mu)]
     res = batch_force_closure(*arrays, chunk_size=cs)
     assert max(sizes) <= cs and sum(sizes) == K

@@ -207,24 +207,24 @@ def test_ipm_matches_highs_and_certificates_are_sound():
 
 
 def test_lps_that_hit_the_iteration_cap_are_finished_by_highs(monkeypatch):
-    import drakegrasp.batch.engine as engine
-    import drakegrasp.batch.reduction as reduction
+    import drakegrasp.batch.chunks as chunks
+    import drakegrasp.batch.margin as margin
 
     rng = np.random.default_rng(28)
     P, Nrm = random_grasps(rng, 150, 4, 3)
     ref = batch_force_closure(P, Nrm, 0.5)
     calls = []
-    real_highs = reduction._highs_max_last
+    real_highs = margin._highs
 
     def counting(*args):
         calls.append(1)
         return real_highs(*args)
 
     def capped(*args, **kwargs):
-        return reduction.solve_margin_lp(*args, ipm_max_iter=2, **kwargs)
+        return margin.solve_margin_blocks(*args, ipm_max_iter=2, **kwargs)
 
-    monkeypatch.setattr(reduction, "_highs_max_last", counting)
-    monkeypatch.setattr(engine, "solve_margin_lp", capped)
+    monkeypatch.setattr(margin, "_highs", counting)
+    monkeypatch.setattr(chunks, "solve_margin_blocks", capped)
     res = batch_force_closure(P, Nrm, 0.5)
     assert len(calls) > 50  # most LPs need more than two iterations
     assert res.converged.all()

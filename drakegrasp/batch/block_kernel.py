@@ -1,0 +1,387 @@
+"""The block interior-point method compiled with numba, one grasp at a time.
+
+The same iteration as :func:`drakegrasp.batch.block_ipm.solve_block_lp` (same
+starting point, predictor–corrector steps, tolerances, early exit and iteration
+cap), written as scalar loops over one problem's contacts and compiled.  The
+numpy version pays a Python-level call per array operation, which dominates at
+a few contacts, and compacts its stacks as problems converge; the compiled
+loop keeps every problem's working set (a few hundred numbers) in cache and
+stops each problem at its own iteration.  The numpy version stays the reference
+that the tests compare against.
+
+numba is an optional dependency (``pip install drakegrasp[fast]``);
+``AVAILABLE`` says whether this kernel can be used.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+try:  # pragma: no cover - exercised when numba is installed
+    from numba import njit
+
+    AVAILABLE = True
+except ImportError:  # pragma: no cover
+    AVAILABLE = False
+
+    def njit(*args, **kwargs):
+        """Stand-in decorator when numba is absent (the kernel is then unused)."""
+
+        def wrap(fn):
+            return fn
+
+        return wrap
+
+
+__all__ = ["AVAILABLE", "solve_block_stack"]
+
+_STEP = 0.9995
+_FLOOR = 0.1
+
+
+@njit(cache=True)
+def _chol(H, n):
+    """In-place lower Cholesky of H[:n, :n]; the diagonal holds 1/L_jj."""
+    big = 0.0
+    for j in range(n):
+        big = max(big, abs(H[j, j]))
+    floor = 1e-300 + 1e-14 * big
+    for j in range(n):
+        s = H[j, j]
+        for k in range(j):
+            s -= H[j, k] * H[j, k]
+        inv = 1.0 / math.sqrt(max(s, floor))
+        H[j, j] = inv
+        for i in range(j + 1, n):
+            s = H[i, j]
+            for k in range(j):
+                s -= H[i, k] * H[j, k]
+            H[i, j] = s * inv
+
+
+@njit(cache=True)
+def _solve(L, n, b):
+    """In-place solve of ``L Lᵀ z = b`` for b[:n]."""
+    for i in range(n):
+        acc = b[i]
+        for j in range(i):
+            acc -= L[i, j] * b[j]
+        b[i] = acc * L[i, i]
+    for i in range(n - 1, -1, -1):
+        acc = b[i]
+        for j in range(i + 1, n):
+            acc -= L[j, i] * b[j]
+        b[i] = acc * L[i, i]
+
+
+@njit(cache=True)
+def _cmul(F, foff, nrow, ncomp, roff, coff, N, f, out):
+    """Out = C f (block-diagonal facets)."""
+    for i in range(N):
+        c0, r0, nc, o = coff[i], roff[i], ncomp[i], foff[i]
+        for r in range(nrow[i]):
+            acc = 0.0
+            for c in range(nc):
+                acc += F[o + r * nc + c] * f[c0 + c]
+            out[r0 + r] = acc
+
+
+@njit(cache=True)
+def _ctmul(F, foff, nrow, ncomp, roff, coff, N, v, out):
+    """Out = Cᵀ v."""
+    for i in range(N):
+        c0, r0, nc, o = coff[i], roff[i], ncomp[i], foff[i]
+        for c in range(nc):
+            acc = 0.0
+            for r in range(nrow[i]):
+                acc += F[o + r * nc + c] * v[r0 + r]
+            out[c0 + c] = acc
+
+
+@njit(cache=True)
+def _max_step(v, dv, R):
+    q = 0.0
+    for j in range(R):
+        x = -dv[j] / v[j]
+        if x > q:
+            q = x
+    return q
+
+
+@njit(cache=True)
+def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_stop,
+         wr, wm, we, W, Hs, S):  # fmt: skip
+    """Solve one problem from ``f`` (which satisfies ``A f = b``); work arrays given."""
+    N = coff.shape[0]
+    e, M = A.shape
+    R = roff[N - 1] + nrow[N - 1]
+    s, lam, Cf, D, r4, q, ds, dl, r5, dsa, dla = (
+        wr[0], wr[1], wr[2], wr[3], wr[4], wr[5], wr[6], wr[7], wr[8], wr[9], wr[10]
+    )  # fmt: skip
+    g, r1, z, dg, ah = wm[0], wm[1], wm[2], wm[3], wm[4]
+    y, r3, a, u, w, dy = we[0], we[1], we[2], we[3], we[4], we[5]
+    # Starting point (as block_ipm._starting_point).
+    _cmul(F, foff, nrow, ncomp, roff, coff, N, f, Cf)
+    lo, hi = Cf[0], Cf[0]
+    for j in range(R):
+        lo = min(lo, Cf[j])
+        hi = max(hi, Cf[j])
+    t = lo - 0.5 * (hi - lo) - 1e-3
+    sl = 0.0
+    ssum = 0.0
+    for j in range(R):
+        s[j] = Cf[j] - t
+        lam[j] = 1.0 / R
+        sl += s[j] * lam[j]
+        ssum += s[j]
+    shift = 0.5 * sl / ssum
+    lsum = 0.0
+    for j in range(R):
+        lam[j] += shift
+        lsum += lam[j]
+    for j in range(R):
+        lam[j] /= lsum
+    # â (axis directions), g = f - t â, a = A â.
+    for m in range(M):
+        g[m] = f[m]
+        ah[m] = 0.0
+    for i in range(N):
+        ah[coff[i]] = 1.0 / F[foff[i]]
+        g[coff[i]] -= t * ah[coff[i]]
+    _ctmul(F, foff, nrow, ncomp, roff, coff, N, lam, z)
+    for i in range(e):
+        acc = 0.0
+        acc2 = 0.0
+        for m in range(M):
+            acc += A[i, m] * z[m]
+            acc2 += A[i, m] * ah[m]
+        y[i] = acc
+        a[i] = acc2
+        for b in range(i + 1):
+            acc = 0.0
+            for m in range(M):
+                acc += A[i, m] * A[b, m]
+            S[i, b] = acc
+    _chol(S, e)
+    _solve(S, e, y)
+    a_p = 1.0
+    a_d = 1.0
+    dt = 0.0
+    for it in range(1, max_iter + 1):
+        _cmul(F, foff, nrow, ncomp, roff, coff, N, g, Cf)
+        _ctmul(F, foff, nrow, ncomp, roff, coff, N, lam, r1)
+        for m in range(M):
+            acc = r1[m]
+            for i in range(e):
+                acc -= A[i, m] * y[i]
+            r1[m] = acc
+        lsum = 0.0
+        gap = 0.0
+        err_p = 0.0
+        for j in range(R):
+            lsum += lam[j]
+            gap += s[j] * lam[j]
+            r4[j] = s[j] - Cf[j]
+            err_p = max(err_p, abs(r4[j]))
+        r2 = 1.0
+        for i in range(e):
+            r2 -= a[i] * y[i]
+            acc = 0.0
+            for m in range(M):
+                acc += A[i, m] * g[m]
+            r3[i] = (1.0 if i == e - 1 else 0.0) - acc - a[i] * t
+            err_p = max(err_p, abs(r3[i]))
+        err_d = abs(r2)
+        for m in range(M):
+            err_d = max(err_d, abs(r1[m]))
+        err_g = gap / (1.0 + abs(t))
+        done = err_p <= tol and err_d <= tol and err_g <= tol
+        if use_stop and not done and lsum > 0.0:
+            worst = 0.0
+            for i in range(N):
+                acc = 0.0
+                for c in range(ncomp[i]):
+                    acc += r1[coff[i] + c] ** 2
+                worst = max(worst, math.sqrt(acc) * kap[i])
+            bound = (y[e - 1] + worst) / lsum
+            if bound < stop:
+                return bound, True, True, it
+        if done:
+            return t, True, False, it
+        if it == max_iter:
+            loose = 1e3 * tol
+            ok = err_p <= loose and err_d <= loose and err_g <= loose
+            return t, ok, False, it
+        mu = gap / R
+        for j in range(R):
+            D[j] = lam[j] / s[j]
+        for i in range(N):
+            c0, r0, nc, o = coff[i], roff[i], ncomp[i], foff[i]
+            H = Hs[i]
+            for x in range(nc):
+                for b in range(x + 1):
+                    acc = 0.0
+                    for r in range(nrow[i]):
+                        acc += F[o + r * nc + x] * F[o + r * nc + b] * D[r0 + r]
+                    H[x, b] = acc
+            _chol(H, nc)
+            for i2 in range(e):
+                for c in range(nc):
+                    z[c0 + c] = A[i2, c0 + c]
+                _solve(H, nc, z[c0 : c0 + nc])
+                for c in range(nc):
+                    W[c0 + c, i2] = z[c0 + c]
+        for i in range(e):
+            u[i] = a[i]
+            for b in range(i + 1):
+                acc = 0.0
+                for m in range(M):
+                    acc += A[i, m] * W[m, b]
+                S[i, b] = acc
+        _chol(S, e)
+        _solve(S, e, u)
+        denom = 0.0
+        for i in range(e):
+            denom += a[i] * u[i]
+        target = 0.0
+        for phase in range(2):
+            if phase == 0:
+                for j in range(R):
+                    r5[j] = -s[j] * lam[j]
+            else:
+                for j in range(R):
+                    r5[j] = target - s[j] * lam[j] - dsa[j] * dla[j]
+            for j in range(R):
+                q[j] = r5[j] / s[j] + D[j] * r4[j]
+            _ctmul(F, foff, nrow, ncomp, roff, coff, N, q, z)
+            for m in range(M):
+                z[m] += r1[m]
+            for i in range(N):
+                _solve(Hs[i], ncomp[i], z[coff[i] : coff[i] + ncomp[i]])
+            for i in range(e):
+                acc = r3[i]
+                for m in range(M):
+                    acc -= A[i, m] * z[m]
+                w[i] = acc
+            _solve(S, e, w)
+            aw = 0.0
+            for i in range(e):
+                aw += a[i] * w[i]
+            dt = (r2 + aw) / denom
+            for i in range(e):
+                dy[i] = u[i] * dt - w[i]
+            for m in range(M):
+                acc = z[m]
+                for i in range(e):
+                    acc -= W[m, i] * dy[i]
+                dg[m] = acc
+            _cmul(F, foff, nrow, ncomp, roff, coff, N, dg, ds)
+            for j in range(R):
+                ds[j] = ds[j] - r4[j]
+                dl[j] = r5[j] / s[j] - D[j] * ds[j]
+            qp = _max_step(s, ds, R)
+            qd = _max_step(lam, dl, R)
+            if phase == 0:
+                a_p = min(1.0, 1.0 / qp) if qp > 0.0 else 1.0
+                a_d = min(1.0, 1.0 / qd) if qd > 0.0 else 1.0
+                acc = 0.0
+                for j in range(R):
+                    acc += (s[j] + a_p * ds[j]) * (lam[j] + a_d * dl[j])
+                    dsa[j] = ds[j]
+                    dla[j] = dl[j]
+                sigma = (acc / R / max(mu, 1e-300)) ** 3
+                target = max(sigma * mu, _FLOOR * tol / R)
+            else:
+                a_p = min(1.0, _STEP / qp) if qp > 0.0 else 1.0
+                a_d = min(1.0, _STEP / qd) if qd > 0.0 else 1.0
+        for m in range(M):
+            g[m] += a_p * dg[m]
+        t += a_p * dt
+        for j in range(R):
+            s[j] += a_p * ds[j]
+            lam[j] += a_d * dl[j]
+        for i in range(e):
+            y[i] += a_d * dy[i]
+    return t, False, False, max_iter
+
+
+@njit(cache=True)
+def _stack(F, shared, A, kap, f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
+           stop, use_stop, out_t, out_conv, out_below, out_it):  # fmt: skip
+    N = coff.shape[0]
+    e, M = A.shape[1], A.shape[2]
+    R = roff[N - 1] + nrow[N - 1]
+    wr = np.empty((11, R))
+    wm = np.empty((5, M))
+    we = np.empty((6, e))
+    W = np.empty((M, e))
+    Hs = np.empty((N, 4, 4))
+    S = np.empty((e, e))
+    for k in range(A.shape[0]):
+        Fk = F[0] if shared else F[k]
+        t, ok, below, it = _one(
+            Fk, A[k], kap[k], f0[k], coff, ncomp, foff, nrow, roff, tol, max_iter,
+            stop, use_stop, wr, wm, we, W, Hs, S,
+        )  # fmt: skip
+        out_t[k] = t
+        out_conv[k] = ok
+        out_below[k] = below
+        out_it[k] = it
+
+
+def solve_block_stack(
+    facets: list[np.ndarray],
+    A: np.ndarray,
+    kappa: np.ndarray,
+    start: np.ndarray,
+    *,
+    tol: float = 1e-10,
+    max_iter: int = 60,
+    stop_below: float | None = None,
+):
+    """The compiled block IPM on a stack of LPs of one layout.
+
+    Parameters
+    ----------
+    facets : list of (K, r_i, c_i) or (1, r_i, c_i) float
+        Facet rows of each contact (leading 1: shared by the stack).
+    A : (K, e, M) float
+        Equality rows ``[Qᵀ; eᵀ]``.
+    kappa : (K, N) float
+        Cone bounds ``‖f_i‖ <= κ_i f_{n,i}``.
+    start : (K, M) float
+        Starting ``f`` with ``A f = b``.
+    tol, max_iter, stop_below : optional
+        As in :func:`drakegrasp.batch.block_ipm.solve_block_lp`.
+
+    Returns
+    -------
+    value, converged, below, iterations : (K,) arrays
+    """
+    K = A.shape[0]
+    ncomp = np.array([F.shape[2] for F in facets], dtype=np.int64)
+    nrow = np.array([F.shape[1] for F in facets], dtype=np.int64)
+    coff = np.concatenate([[0], np.cumsum(ncomp)[:-1]]).astype(np.int64)
+    roff = np.concatenate([[0], np.cumsum(nrow)[:-1]]).astype(np.int64)
+    sizes = nrow * ncomp
+    foff = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    shared = all(F.shape[0] == 1 for F in facets)
+    flat = np.concatenate(
+        [np.broadcast_to(F, (1 if shared else K,) + F.shape[1:]).reshape(
+            (1 if shared else K), -1) for F in facets],
+        axis=1,
+    )  # fmt: skip
+    out_t = np.zeros(K)
+    out_conv = np.zeros(K, dtype=np.bool_)
+    out_below = np.zeros(K, dtype=np.bool_)
+    out_it = np.zeros(K, dtype=np.int64)
+    _stack(
+        np.ascontiguousarray(flat), shared, np.ascontiguousarray(A),
+        np.ascontiguousarray(kappa, dtype=float), np.ascontiguousarray(start),
+        coff, ncomp, foff, nrow, roff, float(tol), int(max_iter),
+        0.0 if stop_below is None else float(stop_below), stop_below is not None,
+        out_t, out_conv, out_below, out_it,
+    )  # fmt: skip
+    return out_t, out_conv, out_below, out_it

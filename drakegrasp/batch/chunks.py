@@ -1,0 +1,264 @@
+r"""One chunk of grasps, start to finish: validated arrays in, result arrays out.
+
+These functions are the unit of work of the batch engine.  They are top-level
+and take only arrays and plain options, so a chunk can run in this process or
+in a worker process (:mod:`drakegrasp.batch.parallel`) with bitwise the same
+result: nothing in a chunk's computation depends on where it runs or on the
+other chunks.
+
+Ranks, row spaces and null spaces are decided on the normalised grasp matrix
+of :mod:`drakegrasp.batch.rowspace` (moments about the contacts' centroid,
+divided by their spread), so verdicts do not depend on units or on the
+reference point; ``d*`` does not either, since ``N(G)`` is the same.  A soft
+finger's torsion variable is measured in units of that spread, and its facet
+column is scaled to match.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from drakegrasp.batch.construction import (
+    FRICTIONLESS,
+    KIND_COMPONENTS,
+    PLANAR_HARD,
+    SOFT_FULL,
+    SOFT_TORSION,
+    SPATIAL_HARD,
+    batched_characteristic_lengths,
+    batched_grasp_matrix,
+    batched_normal_grasp_matrix,
+    contact_kinds,
+    kind_facets,
+)
+from drakegrasp.batch.margin import solve_margin_blocks
+from drakegrasp.batch.metrics import epsilon_l1_per_grasp, singular_value_metrics
+from drakegrasp.batch.rowspace import (
+    _householder,
+    _inverse_frobenius,
+    normalised_positions,
+)
+
+__all__ = ["finish", "force_chunk", "form_chunk"]
+
+_TORSION_COLUMN = {SOFT_FULL: 3, SOFT_TORSION: 1}
+
+
+def group_layouts(kinds: np.ndarray):
+    """Yield (layout tuple, row indices) for the distinct rows of ``kinds``."""
+    if kinds.shape[0] == 0:
+        return
+    first = kinds[0]
+    if (kinds == first).all():
+        yield tuple(int(x) for x in first), np.arange(kinds.shape[0])
+        return
+    layouts, inverse = np.unique(kinds, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    for j, layout in enumerate(layouts):
+        yield tuple(int(x) for x in layout), np.flatnonzero(inverse == j)
+
+
+def _lp1(Gn: np.ndarray, rank_tol: float, kernel: str):
+    """LP1 on stacked normalised normal grasp matrices ``G̃_n`` (k, w, N)."""
+    K, _, N = Gn.shape
+    slices = [slice(i, i + 1) for i in range(N)]
+    ones = np.ones((1, 1, 1))
+    return solve_margin_blocks(
+        Gn,
+        [ones] * N,
+        slices,
+        np.arange(N),
+        np.ones((K, N)),
+        rank_tol=rank_tol,
+        kernel=kernel,
+    )
+
+
+def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel):
+    """LP1's ``d*`` where only normal forces could prove force closure (else NaN).
+
+    Those are the grasps with full rank, ``d* <= tol`` and some friction, the
+    same that :func:`drakegrasp.force_closure` checks.
+    """
+    out = np.full(Pn.shape[0], np.nan)
+    required = 3 if Pn.shape[2] == 2 else 6
+    frictional = (kinds != FRICTIONLESS).any(axis=1)
+    rows = np.flatnonzero((rank == required) & frictional & ~(d_star > tol))
+    if rows.size == 0:
+        return out
+    Gn = batched_normal_grasp_matrix(
+        Pn[rows], Nrm[rows], np.zeros((rows.size, Pn.shape[2]))
+    )
+    N = Gn.shape[2]
+    if N <= Gn.shape[1]:
+        # Balancing normal forces need N(G_n) != {0}; with no more contacts than
+        # wrench rows that is rare.  A vectorised QR certifies full column rank
+        # for most grasps (as in rowspace); the rest take the exact SVD rule.
+        A = np.ascontiguousarray(np.transpose(Gn, (1, 2, 0)))  # (w, N, k)
+        R, _ = _householder(A)
+        norm = np.sqrt(np.einsum("kij,kij->k", Gn, Gn))
+        unsure = ~(_inverse_frobenius(R) * rank_tol * norm < 1.0)
+        rows, Gn = rows[unsure], Gn[unsure]
+        if rows.size:
+            sv = np.linalg.svd(Gn, compute_uv=False)
+            deficient = sv[:, -1] <= rank_tol * sv[:, 0]
+            rows, Gn = rows[deficient], Gn[deficient]
+        if rows.size == 0:
+            return out
+    out[rows] = _lp1(Gn, rank_tol, kernel).d_star
+    return out
+
+
+def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel):
+    """LP2 for grasps that share one layout: (d_star, rank, converged)."""
+    K = Pn.shape[0]
+    G, normal_cols = batched_grasp_matrix(Pn, Nrm, np.zeros((K, Pn.shape[2])), layout)
+    facets, slices, start = [], [], 0
+    kappa = np.empty((K, len(layout)))
+    for i, kind in enumerate(layout):
+        k_i = len(KIND_COMPONENTS[kind])
+        mu_i, tor_i = mu_c[:, i], torsion[:, i]
+        slope = mu_i + (tor_i / spread if kind in _TORSION_COLUMN else 0.0)
+        kappa[:, i] = np.sqrt(1.0 + slope**2)
+        if kind in _TORSION_COLUMN:
+            F = kind_facets(kind, mu_i, tor_i, n_g).copy()
+            F[:, :, _TORSION_COLUMN[kind]] *= spread[:, None]  # m_n = L m̃_n
+        else:
+            if (mu_i == mu_i[0]).all():
+                mu_i, tor_i = mu_i[:1], tor_i[:1]  # one cone for all grasps
+            F = kind_facets(kind, mu_i, tor_i, n_g)
+        facets.append(F)
+        slices.append(slice(start, start + k_i))
+        start += k_i
+    sol = solve_margin_blocks(
+        G, facets, slices, normal_cols, kappa, rank_tol=rank_tol, kernel=kernel
+    )
+    return sol.d_star, sol.rank, sol.converged
+
+
+def force_chunk(
+    P: np.ndarray,
+    Nrm: np.ndarray,
+    mu_c: np.ndarray,
+    nu_c: np.ndarray,
+    p: np.ndarray,
+    b: np.ndarray | None,
+    *,
+    model: str,
+    num_generators: int,
+    tol: float,
+    rank_tol: float,
+    metrics: Sequence[str],
+    kernel: str = "auto",
+) -> dict[str, np.ndarray]:
+    """LP2 (force closure) of one chunk of validated grasps.
+
+    Parameters
+    ----------
+    P, Nrm : (k, N, d) float
+        Contact points (metres) and unit inward normals.
+    mu_c, nu_c : (k, N) float
+        Friction and torsional friction coefficients (checked ``>= 0``).
+    p : (k, d) float
+        Reference points.
+    b : (k,) float or None
+        Characteristic lengths (None: the default of :class:`~drakegrasp.Grasp`).
+    model, num_generators, tol, rank_tol, metrics, kernel
+        As in :func:`drakegrasp.batch.batch_force_closure`.
+
+    Returns
+    -------
+    dict of str to (k,) array
+        ``is_closure``, ``d_star``, ``rank``, ``margin``, ``converged``,
+        ``normal_certificate`` and the metrics.
+    """
+    k, N, d = P.shape
+    if b is None:
+        b = batched_characteristic_lengths(P, p)
+    Pn, spread = normalised_positions(P)
+    kinds = contact_kinds(mu_c, nu_c, model=model, dim=d)
+    d_star = np.zeros(k)
+    rank = np.zeros(k, dtype=int)
+    converged = np.ones(k, dtype=bool)
+    torsion = b[:, None] * nu_c
+    for layout, rows in group_layouts(kinds):
+        sub = rows if rows.size < k else slice(None)
+        d_star[rows], rank[rows], converged[rows] = _layout_lp(
+            Pn[sub],
+            Nrm[sub],
+            spread[sub],
+            mu_c[sub],
+            torsion[sub],
+            layout,
+            num_generators,
+            rank_tol,
+            kernel,
+        )
+    normal = _normal_certificates(
+        Pn, Nrm, kinds, rank, d_star, tol=tol, rank_tol=rank_tol, kernel=kernel
+    )
+    out = finish(d_star, rank, converged, normal, tol=tol, required=6 if d == 3 else 3)
+    if metrics:
+        full = {
+            "frictionless": FRICTIONLESS,
+            "hard_finger": SPATIAL_HARD if d == 3 else PLANAR_HARD,
+            "soft_finger": SOFT_FULL,
+        }[model]
+        Gfull, _ = batched_grasp_matrix(P, Nrm, p, (full,) * N)
+        out.update(singular_value_metrics(Gfull, b, metrics))
+        if "epsilon_l1" in metrics:
+            out["epsilon_l1"] = epsilon_l1_per_grasp(
+                P, Nrm, mu_c, nu_c, p, b, model=model, num_generators=num_generators
+            )
+    return out
+
+
+def form_chunk(
+    P: np.ndarray,
+    Nrm: np.ndarray,
+    p: np.ndarray,
+    b: np.ndarray | None,
+    *,
+    tol: float,
+    rank_tol: float,
+    metrics: Sequence[str],
+    kernel: str = "auto",
+) -> dict[str, np.ndarray]:
+    """LP1 (first-order form closure) of one chunk; see :func:`force_chunk`."""
+    k, N, d = P.shape
+    Pn, _ = normalised_positions(P)
+    sol = _lp1(batched_normal_grasp_matrix(Pn, Nrm, np.zeros((k, d))), rank_tol, kernel)
+    out = finish(
+        sol.d_star, sol.rank, sol.converged, None, tol=tol, required=6 if d == 3 else 3
+    )
+    if metrics:
+        if b is None:
+            b = batched_characteristic_lengths(P, p)
+        Gn = batched_normal_grasp_matrix(P, Nrm, p)
+        out.update(singular_value_metrics(Gn, b, metrics))
+    return out
+
+
+def finish(d_star, rank, converged, normal_d_star, *, tol: float, required: int):
+    """Verdicts and margins from ``d*``, the ranks and the normal-force LP."""
+    full = rank == required
+    if normal_d_star is None:
+        certified = None
+        is_closure = full & (d_star > tol)
+        margin = (d_star - tol) / tol
+    else:
+        certified = full & ~(d_star > tol) & (normal_d_star > tol)
+        is_closure = full & (d_star > tol) | certified
+        margin = (np.where(certified, normal_d_star, d_star) - tol) / tol
+    out = {
+        "is_closure": is_closure,
+        "d_star": d_star,
+        "rank": rank,
+        "margin": margin,
+        "converged": converged,
+    }
+    if certified is not None:
+        out["normal_certificate"] = certified
+    return out

@@ -1,0 +1,208 @@
+r"""The closure LPs of a stack of grasps, solved in block form (cost linear in N).
+
+LP1/LP2 (``shared/CONVENTIONS.md``) have ``d* = N max(0, t*)`` with
+
+.. math::
+
+    t^* = \max_{f, t} t \quad \text{s.t.} \quad Q^T f = 0,\; e^T f = 1,\;
+    F f - \mathbf 1 t \ge 0 ,
+
+``Q`` an orthonormal basis of the (normalised) grasp matrix's numerical row
+space (:mod:`drakegrasp.batch.rowspace`): a positive margin is attained with
+the whole budget spent, and ``d* = 0`` otherwise.  Let ``c = e - Q Qᵀ e`` (the
+projection of ``e`` on ``N(G)``).  Corner cases: no null space or ``c = 0``
+(no balanced force pushes) give ``d* = 0``; a one-dimensional null space is
+spanned by ``c``, so ``t* = min F c / ‖c‖²``.  Everything else goes to the
+block interior-point method :func:`drakegrasp.batch.block_ipm.solve_block_lp`,
+started at ``f = c / ‖c‖²``; the rare LPs that reach its iteration cap are solved
+again one by one with HiGHS.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+import numpy as np
+
+from drakegrasp.batch.block_ipm import ContactGroup, solve_block_lp
+from drakegrasp.batch.reduction import MarginSolution
+from drakegrasp.batch.rowspace import row_spaces
+
+__all__ = ["solve_margin_blocks"]
+
+_PUSH_TOL = 1e-10  # ‖c‖ below this: no balanced force has a normal component
+
+
+def numba_available() -> bool:
+    """Whether numba is installed (checked without importing it: ~0.3 s)."""
+    return importlib.util.find_spec("numba") is not None
+
+
+def _contact_groups(facets, slices, kappa):
+    """Contacts with the same cone shape, as (indices, component columns)."""
+    by_shape: dict[tuple, list[int]] = {}
+    for i, F in enumerate(facets):
+        by_shape.setdefault(F.shape[1:], []).append(i)
+    out = []
+    for members in by_shape.values():
+        cols = np.array([np.arange(slices[i].start, slices[i].stop) for i in members])
+        out.append((np.array(members), cols.T))  # cols (c, n)
+    return out
+
+
+def _stack_facets(facets, members, sel, everyone):
+    """Facets of a contact group: (r, c) if shared by all, else (r, c, n, k|1)."""
+    Fs = [facets[i] for i in members]
+    if all(F.shape[0] == 1 for F in Fs):
+        if all(np.array_equal(F, Fs[0]) for F in Fs[1:]):
+            return Fs[0][0]
+        return np.stack([F[0] for F in Fs], axis=-1)[..., None]
+    stacked = np.stack(
+        [np.broadcast_to(F, (everyone,) + F.shape[1:]) for F in Fs], axis=0
+    )  # (n, K, r, c)
+    return np.ascontiguousarray(np.transpose(stacked[:, sel], (2, 3, 0, 1)))
+
+
+def _highs(Q, facets, slices, normal_columns, c, fallback):
+    """``t*`` of one LP with HiGHS (``scipy.optimize.linprog``): (value, ok)."""
+    from scipy.optimize import linprog
+
+    M = Q.shape[0]
+    Fblock = np.zeros((sum(F.shape[0] for F in facets), M))
+    row = 0
+    for F, s in zip(facets, slices, strict=True):
+        Fblock[row : row + F.shape[0], s] = F
+        row += F.shape[0]
+    e = np.zeros(M)
+    e[normal_columns] = 1.0
+    A_eq = np.hstack([np.vstack([Q.T, e]), np.zeros((Q.shape[1] + 1, 1))])
+    b_eq = np.zeros(Q.shape[1] + 1)
+    b_eq[-1] = 1.0
+    A_ub = np.hstack([-Fblock, np.ones((Fblock.shape[0], 1))])
+    cost = np.zeros(M + 1)
+    cost[-1] = -1.0
+    res = linprog(
+        cost,
+        A_ub=A_ub,
+        b_ub=np.zeros(A_ub.shape[0]),
+        A_eq=A_eq,
+        b_eq=b_eq,
+        bounds=[(None, None)] * (M + 1),
+        method="highs",
+    )
+    if res.status != 0:
+        return fallback, False
+    return -float(res.fun), True
+
+
+def solve_margin_blocks(
+    G: np.ndarray,
+    facets: list[np.ndarray],
+    component_slices: list[slice],
+    normal_columns: np.ndarray,
+    kappa: np.ndarray,
+    *,
+    rank_tol: float,
+    ipm_tol: float = 1e-10,
+    ipm_max_iter: int = 60,
+    kernel: str = "auto",
+) -> MarginSolution:
+    """Solve LP1/LP2 for a stack of grasps that share one layout.
+
+    Parameters
+    ----------
+    G : (K, w, M) float
+        Normalised effective grasp matrices (:mod:`drakegrasp.batch.rowspace`).
+    facets : list of (K, r_i, k_i) or (1, r_i, k_i) float
+        Facet rows of each contact's cone over its ``k_i`` components, in the
+        variables of ``G``'s columns (leading 1: the same for every grasp).
+    component_slices : list of slice
+        Columns of ``G`` that belong to each contact.
+    normal_columns : (N,) int
+        Column of each ``f_n``.
+    kappa : (K, N) float
+        Bounds ``‖f_i‖ <= κ_i f_{n,i}`` on each cone.
+    rank_tol : float
+        Singular values ``<= rank_tol * σ_max`` count as zero.
+    ipm_tol, ipm_max_iter : optional
+        Tolerance and iteration cap of the interior-point method.
+    kernel : {"auto", "numba", "numpy"}, optional
+        The compiled interior-point method (:mod:`~drakegrasp.batch.block_kernel`)
+        or the numpy reference (:mod:`~drakegrasp.batch.block_ipm`); ``"auto"``
+        takes numba when it is installed.
+
+    Returns
+    -------
+    MarginSolution
+    """
+    K, _, M = G.shape
+    N = len(normal_columns)
+    rank, spaces = row_spaces(G, rank_tol=rank_tol)
+    d_star = np.zeros(K)
+    converged = np.ones(K, dtype=bool)
+    contact_groups = _contact_groups(facets, component_slices, kappa)
+    # d* = N t: tighten the tolerance on t beyond 4 contacts so that d* keeps
+    # about 4 ipm_tol absolute accuracy at any N.
+    tol_t = ipm_tol * min(1.0, 4.0 / N)
+    for sel, Q in spaces:
+        r = Q.shape[1]
+        if r >= M:
+            continue  # no null space: only f = 0 balances
+        c = -np.einsum("mrk,rk->mk", Q, Q[normal_columns].sum(axis=0))
+        c[normal_columns] += 1.0  # c = e - Q Qᵀ e, (M, k)
+        cnorm2 = np.einsum("mk,mk->k", c, c)
+        push = cnorm2 > _PUSH_TOL**2
+        if not push.all():
+            sel, Q, c, cnorm2 = sel[push], Q[:, :, push], c[:, push], cnorm2[push]
+        if sel.size == 0:
+            continue
+        f0 = c / cnorm2
+        if M - r == 1:
+            t = np.full(sel.size, np.inf)
+            for F, s in zip(facets, component_slices, strict=True):
+                if F.shape[0] == 1:
+                    vals = np.einsum("rc,ck->rk", F[0], f0[s])
+                else:
+                    vals = np.einsum("krc,ck->rk", F[sel], f0[s])
+                t = np.minimum(t, vals.min(axis=0))
+            d_star[sel] = N * np.maximum(t, 0.0)
+            continue
+        A = np.concatenate([np.transpose(Q, (1, 0, 2)), np.zeros((1, M, sel.size))])
+        A[-1, normal_columns] = 1.0  # (e, M, k)
+        if kernel == "numba" or (kernel == "auto" and numba_available()):
+            from drakegrasp.batch import block_kernel  # imports numba
+
+            t, ok, _, _ = block_kernel.solve_block_stack(
+                [F if F.shape[0] == 1 else F[sel] for F in facets],
+                np.transpose(A, (2, 0, 1)),
+                kappa[sel],
+                np.ascontiguousarray(f0.T),
+                tol=tol_t,
+                max_iter=ipm_max_iter,
+                stop_below=0.0,
+            )
+        else:
+            groups = [
+                ContactGroup(
+                    facets=_stack_facets(facets, members, sel, K),
+                    rows=A[:, cols],
+                    kappa=np.ascontiguousarray(kappa[sel][:, members].T),
+                    start=f0[cols],
+                )
+                for members, cols in contact_groups
+            ]
+            sol = solve_block_lp(
+                groups, tol=tol_t, max_iter=ipm_max_iter, stop_below=0.0
+            )
+            t, ok = sol.value, sol.converged
+        if not ok.all():
+            t, ok = t.copy(), ok.copy()
+            for j in np.flatnonzero(~ok):
+                k = sel[j]
+                Fk = [F[0] if F.shape[0] == 1 else F[k] for F in facets]
+                t[j], ok[j] = _highs(
+                    Q[:, :, j], Fk, component_slices, normal_columns, c[:, j], t[j]
+                )
+        converged[sel] = ok
+        d_star[sel] = N * np.maximum(t, 0.0)
+    return MarginSolution(d_star, rank, converged)
