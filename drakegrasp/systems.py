@@ -36,7 +36,7 @@ one at initialization); outputs are state, held between samples.  As with
 any Drake discrete update, a logger publishing at a sample time ``t_k`` sees
 the value held *before* the update at ``t_k``: the verdict logged at
 ``t_{k+1}`` is the analysis of the plant state logged at ``t_k``
-(:attr:`GraspSample.time` and :attr:`GraspSample.state` say exactly which).
+(``time`` and ``state`` of :class:`GraspSample` say exactly which).
 A discrete plant's contact results are those of its last step; they exist in
 the simulator's context, not in a fresh context where only ``q`` and ``v``
 were set.

@@ -75,7 +75,7 @@ a :class:`~drakegrasp.errors.SceneError` (a :class:`~drakegrasp.ModelError`)
 naming the file, the key and what is valid (:mod:`drakegrasp.plant.scene_file`).
 
 Example: Drake's WSG-50 from ``drake_models``
---------------------------------------------
+---------------------------------------------
 ::
 
     directives:
