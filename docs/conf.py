@@ -34,6 +34,8 @@ extensions = [
     "sphinx.ext.autodoc",
     "numpydoc",
     "sphinx.ext.mathjax",
+    # MathJax copied into _static: the pages render their formulas offline.
+    "sphinx-mathjax-offline",
     "sphinx.ext.doctest",
     "sphinxarg.ext",
     "myst_nb",

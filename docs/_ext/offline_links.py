@@ -114,6 +114,10 @@ def _resolve(
         title = f"{full} (Drake documentation)"
     else:
         return None
+    if contnode.astext() == target and ":" in target:
+        # numpydoc's xref shows the raw target ("python:float"): show "float".
+        contnode = contnode.deepcopy()
+        contnode.children = [nodes.Text(target.split(":", 1)[1])]
     reference = nodes.reference("", "", internal=False, refuri=uri, reftitle=title)
     reference.append(contnode)
     return reference
