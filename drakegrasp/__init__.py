@@ -34,7 +34,9 @@ from drakegrasp.closure import (
     matrix_rank,
 )
 from drakegrasp.contact import Contact, ContactModel, contact_frame, contact_frames
+from drakegrasp.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import (
+    BatchFileError,
     GraspError,
     InvalidContactError,
     InvalidContextError,
@@ -96,6 +98,7 @@ from drakegrasp.quality import (
     wrench_ellipsoid_volume,
 )
 from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
+from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
 from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
 from drakegrasp.visualization import (
     clear_grasp,
@@ -107,21 +110,23 @@ from drakegrasp.visualization import (
 __version__ = "0.1.0"
 
 __all__ = [
-    "DEFAULT_TOL",
     "AntipodalResult",
     "BatchClosureResult",
+    "BatchFileError",
     "ClosureResult",
     "Contact",
+    "ContactCurvature",
     "ContactModel",
-    "Grasp",
+    "DEFAULT_TOL",
     "FingerClosure",
+    "Grasp",
     "GraspError",
     "GraspFromPlant",
     "GraspMonitor",
     "GraspQuality",
     "GraspReport",
-    "HandClosure",
     "GraspSample",
+    "HandClosure",
     "InternalForceResult",
     "InvalidContactError",
     "InvalidContextError",
@@ -137,7 +142,9 @@ __all__ = [
     "ProgramVariables",
     "Scene",
     "SceneError",
+    "SecondOrderResult",
     "SolverError",
+    "SurfaceCurvature",
     "UnreachableError",
     "add_grasp_monitor",
     "analyze_grasp",
@@ -185,8 +192,9 @@ __all__ = [
     "plot_wrench_space",
     "primitive_wrenches",
     "register_models",
-    "use_local_drake_models",
+    "second_order_form_closure",
     "signed_distance_jacobian",
     "uniformity_of_transformation",
+    "use_local_drake_models",
     "wrench_ellipsoid_volume",
 ]

@@ -19,6 +19,7 @@ from drakegrasp.contact import Contact, ContactModel
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError
 from drakegrasp.grasp import Grasp
 from drakegrasp.results import AntipodalResult
+from drakegrasp.validation import check_angle_tol, check_coefficient
 
 __all__ = ["DEFAULT_ANGLE_TOL", "is_antipodal"]
 
@@ -27,11 +28,16 @@ DEFAULT_ANGLE_TOL = 1e-9
 
 
 def _two_contacts(grasp_or_contacts: Grasp | Sequence[Contact]) -> tuple[Contact, ...]:
-    contacts = (
-        grasp_or_contacts.contacts
-        if isinstance(grasp_or_contacts, Grasp)
-        else tuple(grasp_or_contacts)
-    )
+    if isinstance(grasp_or_contacts, Grasp):
+        contacts = grasp_or_contacts.contacts
+    else:
+        try:
+            contacts = tuple(grasp_or_contacts)
+        except TypeError:
+            raise InvalidGraspError(
+                "the antipodal check takes a Grasp or a pair of Contact, got "
+                f"{type(grasp_or_contacts).__name__}"
+            ) from None
     if len(contacts) != 2 or not all(isinstance(c, Contact) for c in contacts):
         raise InvalidGraspError(
             "the antipodal check takes exactly two contacts (a Grasp or a pair of "
@@ -68,7 +74,8 @@ def is_antipodal(
         Friction coefficient to use at both contacts.  Default: each contact's own
         ``mu`` (0 for a frictionless contact).
     angle_tol : float, optional
-        Slack (rad) on the angle test, for contacts that are exactly collinear.
+        Slack (rad) on the angle test, for contacts that are exactly collinear;
+        in ``[0, 0.01]`` (:data:`~drakegrasp.validation.MAX_ANGLE_TOL`).
 
     Returns
     -------
@@ -89,15 +96,14 @@ def is_antipodal(
     (True, 0.1763)
     """
     c1, c2 = _two_contacts(grasp_or_contacts)
+    angle_tol = check_angle_tol(angle_tol)
     if mu is None:
         mus = np.array([_friction(c1), _friction(c2)])
     else:
-        m = float(mu)
-        if not np.isfinite(m) or m < 0:
-            raise InvalidOptionError(f"mu must be finite and >= 0, got {mu!r}")
+        m = check_coefficient("mu", mu, error=InvalidOptionError)
         mus = np.array([m, m])
     line = c2.position - c1.position
-    if np.linalg.norm(line) < 1e-12:
+    if not np.any(line):
         raise InvalidGraspError(
             f"the two contacts coincide at {c1.position.tolist()}; the antipodal "
             "line between them is undefined"

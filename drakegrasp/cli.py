@@ -6,32 +6,48 @@ Usage::
                        [--torsional-friction NU] [--package NAME=DIR ...]
                        [--allow-any-file] [--json]
     drakegrasp scenes
-    drakegrasp batch IN.npz OUT.npz [--kind force|form] [--mu M] [--model MODEL]
+    drakegrasp batch IN.npz OUT.npz [--kind force|form] [--mu M]
+                     [--contact-model MODEL] [--torsional-friction NU]
                      [--num-generators NG] [--metrics NAME ...] [--progress]
+                     [--overwrite]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
 form closure, force closure with the hand check, exact-cone verdict, antipodal
 test.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
 ``positions`` and ``normals`` of shape (K, N, d), optionally ``mu``, ...) with
-the vectorised batch engine and writes the verdicts to another file.  Errors
-print one line on stderr and exit with status 1 (2 for a bad
-command line).
+the vectorised batch engine and writes the verdicts to another file.
+
+One interface: both commands name the contact model ``--contact-model``
+(``batch --model`` is a deprecated alias that still works and says so), and
+both follow one rule for soft fingers: ``--contact-model soft_finger`` needs a
+torsional friction ν, from ``--torsional-friction`` or the scene / input file;
+an explicit ``--torsional-friction 0`` is valid and makes soft fingers act as
+hard ones.
+
+Exit status: 0 on success, 1 on an error (one line on stderr, never a
+traceback), 2 for a bad command line (argparse), 130 on Ctrl-C (SIGINT) with
+one line ``drakegrasp: interrupted``.  ``batch`` refuses an output that is its
+input or that exists, unless ``--overwrite``; it writes atomically (a
+temporary file renamed into place), so an interrupted run loses nothing.
+Set ``DRAKEGRASP_DEBUG=1`` to see the traceback of an unexpected error.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections.abc import Sequence
 
 from drakegrasp.contact import ContactModel
-from drakegrasp.errors import GraspError
+from drakegrasp.errors import GraspError, InvalidOptionError
 
 __all__ = ["build_parser", "main"]
 
 EXIT_ERROR = 1
+EXIT_INTERRUPTED = 130
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
@@ -49,12 +65,14 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     if args.contact_model is not None:
         options["contact_model"] = ContactModel.parse(args.contact_model)
     if args.torsional_friction is not None:
-        options["torsional_friction"] = args.torsional_friction
-    if (
+        options["torsional_friction"] = args.torsional_friction  # 0 is valid
+    elif (
         options["contact_model"] is ContactModel.SOFT_FINGER
         and not options["torsional_friction"]
     ):
-        options["torsional_friction"] = None  # analyze_grasp explains what is missing
+        # The scene gives no ν (its default is 0): not given, as in the batch
+        # command; analyze_grasp explains what is missing.
+        options["torsional_friction"] = None
     report = analyze_grasp(scene.plant, scene.plant_context, **options)
     if args.json:
         out = {"scene": scene.name, "scene_file": str(scene.info.path)}
@@ -82,18 +100,32 @@ def _cmd_scenes(args: argparse.Namespace) -> int:
 def _cmd_batch(args: argparse.Namespace) -> int:
     from drakegrasp.batch import evaluate_file
 
+    if args.deprecated_model is not None:
+        print(
+            "drakegrasp: warning: --model is deprecated; use --contact-model",
+            file=sys.stderr,
+        )
+        if args.contact_model is not None and args.contact_model != (
+            args.deprecated_model
+        ):
+            raise InvalidOptionError(
+                f"--model {args.deprecated_model} and --contact-model "
+                f"{args.contact_model} disagree; give --contact-model only"
+            )
+    model = args.contact_model or args.deprecated_model or "hard_finger"
     result = evaluate_file(
         args.input,
         args.output,
         kind=args.kind,
         mu=args.mu,
-        model=args.model,
+        model=model,
         num_generators=args.num_generators,
         torsional_friction=args.torsional_friction,
         tol=args.tol,
         chunk_size=args.chunk_size,
         progress=args.progress,
         metrics=tuple(args.metrics),
+        overwrite=args.overwrite,
     )
     print(result)
     print(f"wrote {args.output}")
@@ -207,13 +239,24 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "--kind", choices=["force", "form"], default="force", help="default: force"
     )
     batch.add_argument(
-        "--mu", type=_positive_float, help="friction for every contact (else file's)"
+        "--mu",
+        type=_positive_float,
+        help="friction coefficient of every contact, overriding the file's "
+        "array mu; --kind force needs one or the other (--kind form ignores it)",
+    )
+    batch.add_argument(
+        "--contact-model",
+        choices=[m.value for m in ContactModel],
+        default=None,
+        help="contact model (default: hard_finger); soft_finger needs a "
+        "torsional friction (--torsional-friction or the file's)",
     )
     batch.add_argument(
         "--model",
+        dest="deprecated_model",
         choices=[m.value for m in ContactModel],
-        default="hard_finger",
-        help="contact model (default: hard_finger)",
+        default=None,
+        help="deprecated alias of --contact-model",
     )
     batch.add_argument(
         "--num-generators", type=int, default=8, help="cone generators (default 8)"
@@ -221,7 +264,9 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
     batch.add_argument(
         "--torsional-friction",
         type=_positive_float,
-        help="soft-finger torsional friction (else the file's, or 0)",
+        help="soft-finger torsional friction nu, overriding the file's array "
+        "torsional_friction; required with --contact-model soft_finger unless "
+        "the file has it (0 makes soft fingers act as hard ones)",
     )
     batch.add_argument(
         "--tol", type=_positive_float, default=1e-6, help="threshold on d*"
@@ -237,7 +282,17 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
     batch.add_argument(
         "--chunk-size", type=int, default=4096, help="grasps per chunk (default 4096)"
     )
-    batch.add_argument("--progress", action="store_true", help="show a progress bar")
+    batch.add_argument(
+        "--progress",
+        action="store_true",
+        help='show a progress bar (needs: pip install "drakegrasp[progress]")',
+    )
+    batch.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an existing OUT (default: refuse); OUT is written to a "
+        "temporary file and renamed into place, and is never the input",
+    )
     batch.set_defaults(func=_cmd_batch)
 
 
@@ -253,14 +308,32 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))
+    except KeyboardInterrupt:
+        # Ctrl-C: one line and the conventional status 128 + SIGINT; batch
+        # output is written atomically, so nothing half-written is left.
+        print("drakegrasp: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # e.g. `drakegrasp analyze | head`
         return 0
-    except (GraspError, OSError, ValueError, RuntimeError) as e:
-        # GraspError covers bad scenes, bodies, contacts; the others are file or
-        # Drake errors that were not already wrapped.  One line, no traceback.
-        message = " ".join(str(e).split())
-        print(f"drakegrasp: error: {message}", file=sys.stderr)
-        return EXIT_ERROR
+    except GraspError as e:
+        return _error(str(e))
+    except (OSError, ValueError, RuntimeError, MemoryError) as e:
+        # File or Drake errors that were not already wrapped.
+        return _error(f"{type(e).__name__}: {e}" if not str(e) else str(e))
+    except Exception as e:  # noqa: BLE001 - the CLI never shows a traceback
+        if os.environ.get("DRAKEGRASP_DEBUG"):
+            raise
+        return _error(
+            f"unexpected {type(e).__name__}: {e} (a bug in drakegrasp; rerun with "
+            "DRAKEGRASP_DEBUG=1 for the traceback and report it)"
+        )
+
+
+def _error(message: str) -> int:
+    """Print one line on stderr; return the error status."""
+    text = " ".join(str(message).split())
+    print(f"drakegrasp: error: {text}", file=sys.stderr)
+    return EXIT_ERROR
 
 
 if __name__ == "__main__":

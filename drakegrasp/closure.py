@@ -51,6 +51,7 @@ from drakegrasp.grasp import (
     normalised_grasp_matrix,
 )
 from drakegrasp.results import ClosureResult, InternalForceResult, _relative_margin
+from drakegrasp.validation import check_grasp, check_rank_tol, check_tol, real_array
 
 __all__ = [
     "DEFAULT_TOL",
@@ -106,10 +107,13 @@ class ProgramVariables:
         Where each entry of ``forces`` sits in the grasp's stacked force vector
         (columns of :func:`~drakegrasp.grasp_matrix`; for LP1, the contact index).
     weights : ndarray of Variable or None
-        Generator weights ``λ >= 0`` (generator formulation only).
+        The program's own variables when ``forces`` are linear expressions of
+        them: generator weights ``λ >= 0`` (generator formulation), or the
+        scaled components of a grasp with soft-finger torsion (``m_n / (b ν)``,
+        see :class:`~drakegrasp.friction_cone.ConeLayout`).
     generators : (m, len(weights)) float or None
-        Block-diagonal generator matrix ``S`` with ``forces = S @ weights``
-        (generator formulation only).
+        The matrix with ``forces = generators @ weights``: the block-diagonal
+        generators ``S``, or ``diag(ConeLayout.scales)``.
     """
 
     d: object
@@ -131,8 +135,20 @@ def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
     Returns
     -------
     int
+
+    Raises
+    ------
+    InvalidOptionError
+        ``A`` not a real finite 2-D array (LAPACK's SVD can loop forever on
+        ``inf``/``NaN``), or ``rank_tol`` outside its valid range.
     """
-    A = np.asarray(A, dtype=float)
+    A = real_array("A", A, error=InvalidOptionError)
+    if A.ndim != 2 or not np.all(np.isfinite(A)):
+        raise InvalidOptionError(
+            f"matrix_rank needs a finite 2-D array, got shape {A.shape}"
+            + ("" if A.ndim != 2 else " with non-finite entries")
+        )
+    rank_tol = check_rank_tol(rank_tol)
     if A.size == 0:
         return 0
     s = np.linalg.svd(A, compute_uv=False)
@@ -142,14 +158,17 @@ def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
 
 
 def _check_tol(tol: float) -> float:
-    t = float(tol)
-    if not np.isfinite(t) or t <= 0:
-        raise InvalidOptionError(f"tol must be finite and > 0, got {tol!r}")
-    return t
+    return check_tol(tol)
+
+
+def _check_options(grasp: Grasp, rank_tol: float) -> float:
+    """Validate the grasp and ``rank_tol`` of a public program (see validation)."""
+    check_grasp(grasp)
+    return check_rank_tol(rank_tol)
 
 
 def _check_formulation(formulation: str) -> str:
-    if formulation not in _FORMULATIONS:
+    if not isinstance(formulation, str) or formulation not in _FORMULATIONS:
         raise InvalidOptionError(
             f"formulation must be one of {_FORMULATIONS}, got {formulation!r}"
         )
@@ -189,7 +208,23 @@ def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
     )
 
 
-def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
+def _scaled_variables(d, x, layout: ConeLayout) -> ProgramVariables:
+    """Variables whose forces are ``scales * x`` (see ``ConeLayout.scales``).
+
+    Without a soft finger's torsion every scale is 1 and ``forces`` are the
+    program's variables; otherwise ``forces = diag(scales) @ weights``.
+    """
+    if np.all(layout.scales == 1.0):
+        return ProgramVariables(d, x, layout.columns)
+    D = np.diag(layout.scales)
+    with np.errstate(invalid="ignore"):  # see build_force_closure_program
+        forces = D @ x
+    return ProgramVariables(d, forces, layout.columns, weights=x, generators=D)
+
+
+def _add_balance(
+    prog, A: np.ndarray, x, rank_tol: float, *, scales: np.ndarray | None = None
+) -> None:
     """``A x = 0``, imposed on the numerical row space of ``A`` (see below).
 
     ``A`` is a normalised balance matrix (:func:`_balance_matrix`), whose columns
@@ -204,6 +239,8 @@ def _add_balance(prog, A: np.ndarray, x, rank_tol: float) -> None:
     A_s, scale = _equilibrated(A)
     # A x = A_s (D⁻¹ x) with D = diag(scale): impose V_rᵀ D⁻¹ x = 0.
     rows = _row_space(A_s, rank_tol) / scale
+    if scales is not None:  # x holds scaled components: A f = A diag(scales) x
+        rows = rows * scales
     if rows.shape[0]:
         rows = np.linalg.qr(rows.T)[0].T
         prog.AddLinearEqualityConstraint(rows, np.zeros(rows.shape[0]), x)
@@ -234,6 +271,7 @@ def build_form_closure_program(
         ``forces`` are the normal forces ``f_n`` (N,); ``columns`` the contact
         indices.
     """
+    rank_tol = _check_options(grasp, rank_tol)
     N = grasp.num_contacts
     prog, f, d = _margin_program(N, N)
     _add_balance(prog, _normal_balance_matrix(grasp), f, rank_tol)
@@ -272,15 +310,18 @@ def build_force_closure_program(
     variables : ProgramVariables
         ``forces`` cover the components the cones allow (see ``columns``).
     """
+    rank_tol = _check_options(grasp, rank_tol)
     _check_formulation(formulation)
     layout = ConeLayout.of(grasp, num_generators)
     N = grasp.num_contacts
     if formulation == "facets":
         prog, f, d = _margin_program(len(layout.columns), N)
-        _add_balance(prog, _balance_matrix(grasp, layout.columns), f, rank_tol)
-        _add_margin_rows(prog, layout.facet_matrix(), f, d)
+        scales = layout.scales
+        A = _balance_matrix(grasp, layout.columns)
+        _add_balance(prog, A, f, rank_tol, scales=scales)
+        _add_margin_rows(prog, layout.facet_matrix() * scales, f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
-        return prog, ProgramVariables(d, f, layout.columns)
+        return prog, _scaled_variables(d, f, layout)
     S = layout.generator_matrix()
     prog, lam, d = _margin_program(S.shape[1], N)
     _add_balance(prog, _balance_matrix(grasp, layout.columns) @ S, lam, rank_tol)
@@ -313,38 +354,44 @@ def build_exact_force_closure_program(
         ``max d`` s.t. ``G f = 0``, ``d >= 0``, ``Σ f_n <= N`` and, per contact,
         the ball of radius ``d`` around ``f_i`` inside its cone:
         hard finger ``‖f_t‖ <= μ f_n - sqrt(1 + μ²) d``; soft finger, for both
-        signs ``σ``, ``‖f_t‖ <= μ f_n - σ μ m_n / (b ν) - sqrt(1 + μ² +
-        μ²/(b ν)²) d``; frictionless ``f_n >= d``; planar cones (exact
-        polyhedra) as facets.
+        signs ``σ``, ``‖f_t‖ <= μ f_n - σ μ m_n / (b ν) - sqrt(1 + μ²) d``
+        (the hard-finger margin of the normal force left after torsion, so a
+        soft finger never scores below a hard one); frictionless
+        ``f_n >= d``; planar cones (exact polyhedra) as facets.
     variables : ProgramVariables
     """
+    rank_tol = _check_options(grasp, rank_tol)
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
-    _add_balance(prog, _balance_matrix(grasp, layout.columns), f, rank_tol)
+    # f holds scaled components (a soft finger's m_n / (b ν)): ConeLayout.scales.
+    A = _balance_matrix(grasp, layout.columns)
+    _add_balance(prog, A, f, rank_tol, scales=layout.scales)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     b = grasp.characteristic_length
     starts = list(layout.normal_positions) + [len(layout.columns)]
     for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
         fi = f[starts[i] : starts[i + 1]]
         if cone.components not in ((0, 1, 2), (0, 1, 2, 3)):
-            _add_margin_rows(prog, cone.facets, fi, d)  # exact already
+            scale = layout.scales[starts[i] : starts[i + 1]]
+            _add_margin_rows(prog, cone.facets * scale, fi, d)  # exact already
             continue
         mu = contact.mu
-        signs_and_slopes = [(0.0, 0.0)]
-        if cone.components == (0, 1, 2, 3):
-            k = mu / (b * contact.torsional_friction)
-            signs_and_slopes = [(1.0, k), (-1.0, k)]
-        for sign, k in signs_and_slopes:
-            # z = A [fi; d]: z0 = μ f_n - σ k m_n - sqrt(1+μ²+k²) d, z1:3 = f_t.
+        signs = [0.0] if cone.components == (0, 1, 2) else [1.0, -1.0]
+        for sign in signs:
+            # z = A [fi; d]: z0 = μ f_n - σ μ m_n/(b ν) - sqrt(1+μ²) d,
+            # z1:3 = f_t, with m_n = s m̃ (s = ConeLayout.scales): d is the
+            # hard-cone margin of (f_n - |m_n| / (b ν), f_t), as the polyhedral
+            # soft rows (friction_cone.soft_finger_facets).
             A = np.zeros((3, len(fi) + 1))
             A[0, 0] = mu
             if len(fi) == 4:
-                A[0, 3] = -sign * k
-            A[0, -1] = -np.sqrt(1.0 + mu * mu + k * k)
+                s = layout.scales[starts[i] + 3]
+                A[0, 3] = -sign * mu * s / (b * contact.torsional_friction)
+            A[0, -1] = -np.sqrt(1.0 + mu * mu)
             A[1, 1] = A[2, 2] = 1.0
             prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(fi, d))
-    return prog, ProgramVariables(d, f, layout.columns)
+    return prog, _scaled_variables(d, f, layout)
 
 
 def build_internal_force_program(
@@ -381,6 +428,7 @@ def build_internal_force_program(
     literally would let a singular value of 1e-12 (contacts measured to 1e-7 m)
     exclude an internal force that the rank count says exists.
     """
+    rank_tol = _check_options(grasp, rank_tol)
     J = check_hand_jacobian(grasp, hand_jacobian)
     layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
@@ -472,10 +520,18 @@ def _solve(prog: MathematicalProgram, *, conic: bool) -> MathematicalProgramResu
     )
 
 
+_VERDICTS = (SolutionResult.kSolutionFound, SolutionResult.kInfeasibleConstraints)
+
+
 def _solve_margin(prog, variables: ProgramVariables, *, conic: bool):
     """Solve; return (d*, full-vector forces or None, solver, status)."""
     result = _solve(prog, conic=conic)
     status = result.get_solution_result()
+    if conic and status not in _VERDICTS and ScsSolver().available():
+        # Clarabel can stall on degenerate SOCPs (d* = 0 with no interior, e.g.
+        # soft fingers with nu = 1e12); SCS, a first-order method, does not.
+        result = ScsSolver().Solve(prog)
+        status = result.get_solution_result()
     solver = result.get_solver_id().name()
     if status == SolutionResult.kSolutionFound:
         d_star = float(result.GetSolution(variables.d))
@@ -534,6 +590,7 @@ def form_closure(
     >>> result.is_closure, result.rank
     (True, 3)
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     required = grasp.wrench_dim
     rank = _balance_rank(_normal_balance_matrix(grasp), rank_tol)
@@ -581,6 +638,7 @@ def internal_forces(
     -------
     InternalForceResult
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_internal_force_program(
         grasp, hand_jacobian, rank_tol=rank_tol
@@ -738,6 +796,7 @@ def force_closure(
     >>> result.is_closure, result.rank, round(result.d_star, 4)
     (True, 6, 0.4194)
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_force_closure_program(
         grasp, num_generators=num_generators, formulation=formulation, rank_tol=rank_tol
@@ -779,6 +838,7 @@ def force_closure_exact(
     -------
     ClosureResult
     """
+    rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
     prog, variables = build_exact_force_closure_program(grasp, rank_tol=rank_tol)
     conic = bool(prog.lorentz_cone_constraints())

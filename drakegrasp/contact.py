@@ -9,12 +9,17 @@ contact.  See ``docs/conventions.md`` for every sign and ordering used here.
 from __future__ import annotations
 
 import enum
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from drakegrasp.errors import InvalidContactError
+from drakegrasp.validation import (
+    check_coefficient,
+    check_positions,
+    real_array,
+    unit_vectors,
+)
 
 __all__ = ["Contact", "ContactModel", "contact_frame", "contact_frames"]
 
@@ -72,7 +77,11 @@ def contact_frames(normals: np.ndarray) -> np.ndarray:
     axis on ties), and ``t2 = n × t1``.  This depends on ``n`` alone, so equal
     normals always get equal frames.  Planar: ``t = (-n_y, n_x)``.
     """
-    n = np.asarray(normals, dtype=float)
+    n = real_array("normals", normals)
+    if n.ndim == 0:
+        raise InvalidContactError(
+            f"normals must have 2 or 3 components, got shape {n.shape}"
+        )
     if n.shape[-1] == 2:
         t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
         return np.stack([n, t], axis=-1)
@@ -107,20 +116,16 @@ def contact_frame(normal: np.ndarray) -> np.ndarray:
 
 
 def _unit_normal(normal: np.ndarray) -> np.ndarray:
-    n = np.array(normal, dtype=float).reshape(-1)
+    n = real_array("normal", normal)
+    if n.ndim > 1 and n.size in (2, 3):
+        n = n.reshape(-1)
     if n.shape not in ((2,), (3,)):
         raise InvalidContactError(
-            f"a normal must have 2 or 3 components, got {np.asarray(normal).tolist()}"
+            f"a normal must have 2 or 3 components, got shape {n.shape}"
         )
-    if not np.all(np.isfinite(n)):
-        raise InvalidContactError(f"normal {n.tolist()} is not finite")
-    norm = float(np.linalg.norm(n))
-    if norm < 1e-12:
-        raise InvalidContactError(
-            f"normal {n.tolist()} has zero length; a contact normal must be a "
-            "non-zero vector pointing into the object"
-        )
-    return n / norm
+    # Divided by its largest component first: |n|^2 of a finite normal such as
+    # [-1e155, 0, 0] overflows, and n / inf would be a zero vector.
+    return unit_vectors("normal", n)
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -145,10 +150,22 @@ class Contact:
     model : ContactModel or str, optional
         ``"frictionless"``, ``"hard_finger"`` (default) or ``"soft_finger"``.
         A soft finger is spatial only.
-    torsional_friction : float, optional
-        Torsional friction coefficient ``ν >= 0`` of a soft finger: the moment
+    torsional_friction : float or None, optional
+        Torsional friction coefficient ``ν`` of a soft finger: the moment
         about the normal is bounded by ``b ν f_n`` with ``b`` the grasp's
-        characteristic length.
+        characteristic length.  ``None`` (default) means "not given": 0 for
+        the other models, an error for a soft finger (one rule across the
+        package: :func:`~drakegrasp.grasp_from_plant`, the batch engine and
+        the command line do the same).  An explicit ``0`` is valid and makes a
+        soft finger behave exactly as a hard finger.
+
+    Raises
+    ------
+    InvalidContactError
+        A position that is not real, finite and within
+        :data:`~drakegrasp.validation.POSITION_BOUND`; a zero, non-finite or
+        non-real normal; ``mu`` or ``ν`` outside 0 or ``[1e-12, 1e12]``; an
+        unknown model; a planar soft finger or one without ``ν``.
 
     Notes
     -----
@@ -171,30 +188,39 @@ class Contact:
         *,
         mu: float = 0.0,
         model: ContactModel | str = ContactModel.HARD_FINGER,
-        torsional_friction: float = 0.0,
+        torsional_friction: float | None = None,
     ) -> None:
-        p = np.array(position, dtype=float).reshape(-1)
+        p = check_positions("contact position", position)
+        if p.ndim > 1 and p.size in (2, 3):
+            p = p.reshape(-1)
         if p.shape not in ((2,), (3,)):
             raise InvalidContactError(
                 "a contact position must have 2 (planar) or 3 (spatial) "
-                f"components, got {np.asarray(position).tolist()}"
+                f"components, got shape {p.shape}"
             )
-        if not np.all(np.isfinite(p)):
-            raise InvalidContactError(f"contact position {p.tolist()} is not finite")
+        p = np.array(p)
         n = _unit_normal(normal)
         if n.shape != p.shape:
             raise InvalidContactError(
                 f"position {p.tolist()} has {p.size} components but normal "
                 f"{n.tolist()} has {n.size}; both must be 2-D or both 3-D"
             )
-        mu_value = _nonnegative("mu", mu)
-        nu_value = _nonnegative("torsional_friction", torsional_friction)
+        mu_value = check_coefficient("mu", mu)
         contact_model = ContactModel.parse(model)
         if contact_model is ContactModel.SOFT_FINGER and p.size == 2:
             raise InvalidContactError(
                 "a soft-finger contact is spatial only; planar contacts are "
                 "'frictionless' or 'hard_finger'"
             )
+        if torsional_friction is None:
+            if contact_model is ContactModel.SOFT_FINGER:
+                raise InvalidContactError(
+                    "a soft-finger contact needs torsional_friction (nu: the "
+                    "moment about the normal is bounded by b * nu * f_n); pass "
+                    "nu > 0, or 0 for a soft finger that acts as a hard finger"
+                )
+            torsional_friction = 0.0
+        nu_value = check_coefficient("torsional_friction", torsional_friction)
         object.__setattr__(self, "position", _frozen(p))
         object.__setattr__(self, "normal", _frozen(n))
         object.__setattr__(self, "mu", mu_value)
@@ -294,13 +320,3 @@ class Contact:
             f"normal={np.round(self.normal, 6).tolist()}, mu={self.mu:g}, "
             f"model={self.model.value!r}{extra})"
         )
-
-
-def _nonnegative(name: str, value: float) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidContactError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(x) or x < 0.0:
-        raise InvalidContactError(f"{name} must be finite and >= 0, got {value!r}")
-    return x

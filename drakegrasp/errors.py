@@ -30,6 +30,14 @@ class InvalidOptionError(GraspError, ValueError):
     """Options passed to a function conflict or are out of range."""
 
 
+class BatchFileError(InvalidOptionError):
+    """A batch input or output file cannot be read or written as asked.
+
+    Raised for a missing, damaged, truncated or non-``.npz`` input, an output
+    that is the input, or an existing output without ``overwrite``.
+    """
+
+
 class NoContactsError(GraspError):
     """The hand does not touch the object (or a grasp has no contacts)."""
 

@@ -2,8 +2,11 @@
 
 Generators are inscribed in the exact Coulomb cone:
 ``s_k = [1, μ cos(2πk/n_g), μ sin(2πk/n_g)]``, ``k = 1 … n_g``; a soft finger adds
-``[1, 0, 0, ±b ν]``.  Facet rows have unit length and give a positive value on the
-cone's axis ``[1, 0, 0, …]``.  See ``docs/conventions.md``.
+``[1, 0, 0, ±b ν]``.  Facet rows give a positive value on the cone's axis
+``[1, 0, 0, …]``; they have unit length except a soft finger's, whose rows are
+the hard-finger rows applied to the normal force left after torsion (see
+:func:`soft_finger_facets`: so a soft finger never scores below a hard one).
+See ``docs/conventions.md``.
 """
 
 from __future__ import annotations
@@ -14,8 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.contact import Contact
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidContactError, InvalidOptionError
 from drakegrasp.grasp import Grasp, grasp_matrix
+from drakegrasp.validation import check_grasp, check_length, check_num_generators
 
 __all__ = [
     "DEFAULT_NUM_GENERATORS",
@@ -24,6 +28,8 @@ __all__ = [
     "effective_cone",
     "friction_cone_facets",
     "friction_cone_generators",
+    "soft_finger_facets",
+    "torsion_only_facets",
 ]
 
 DEFAULT_NUM_GENERATORS = 8
@@ -49,12 +55,7 @@ class EffectiveCone:
 
 
 def _check_num_generators(num_generators: int) -> int:
-    n = int(num_generators)
-    if n != num_generators or n < 3:
-        raise InvalidOptionError(
-            f"num_generators must be an integer >= 3, got {num_generators!r}"
-        )
-    return n
+    return check_num_generators(num_generators)
 
 
 def _torsion_scale(contact: Contact, characteristic_length: float | None) -> float:
@@ -63,12 +64,9 @@ def _torsion_scale(contact: Contact, characteristic_length: float | None) -> flo
             "a soft finger with torsional_friction > 0 needs the grasp's "
             "characteristic_length b (its moment bound is b * nu * f_n)"
         )
-    b = float(characteristic_length)
-    if not np.isfinite(b) or b <= 0:
-        raise InvalidOptionError(
-            "characteristic_length must be finite and > 0, got "
-            f"{characteristic_length!r}"
-        )
+    b = check_length(
+        "characteristic_length", characteristic_length, error=InvalidOptionError
+    )
     return b * contact.torsional_friction
 
 
@@ -77,6 +75,81 @@ def _two_sided(slope: float) -> tuple[np.ndarray, np.ndarray]:
     S = np.array([[1.0, 1.0], [slope, -slope]])
     F = np.array([[slope, 1.0], [slope, -1.0]]) / np.hypot(1.0, slope)
     return S, F
+
+
+def torsion_only_facets(torsion: np.ndarray) -> np.ndarray:
+    """Facet rows of a soft finger without tangential friction, on ``(f_n, m_n)``.
+
+    Parameters
+    ----------
+    torsion : (K,) float
+        ``τ = b ν > 0`` (metres).
+
+    Returns
+    -------
+    F : (K, 2, 2) float
+        Rows ``[1, ∓1/τ]``: the value is ``f_n - |m_n| / τ``, the normal force
+        left once the torsion has taken its share (see
+        :func:`soft_finger_facets`).  At ``m_n = 0`` it is the frictionless
+        row ``[1]``, so such a finger never scores below a frictionless one.
+    """
+    tau = np.asarray(torsion, dtype=float)
+    F = np.empty(tau.shape + (2, 2))
+    F[..., 0] = 1.0
+    F[..., 0, 1] = -1.0 / tau
+    F[..., 1, 1] = 1.0 / tau
+    return F
+
+
+def soft_finger_facets(mu: np.ndarray, torsion: np.ndarray, n_g: int) -> np.ndarray:
+    r"""Facet rows of the soft-finger cone on ``(f_n, f_t1, f_t2, m_n)``.
+
+    Parameters
+    ----------
+    mu : (K,) float
+        Friction coefficients, ``> 0``.
+    torsion : (K,) float
+        ``τ = b ν > 0`` (metres).
+    n_g : int
+        Generators of the Coulomb ring.
+
+    Returns
+    -------
+    F : (K, 2 n_g, 4) float
+        Row ``k`` (``+τ`` apex first, then ``-τ``):
+        ``[μ c, -u_k, ∓μ c / τ] / sqrt(1 + μ² c²)`` with ``c = cos(π/n_g)``.
+
+    Notes
+    -----
+    The cone is the bipyramid spanned by the generators ``s_k`` (``m_n = 0``)
+    and ``[1, 0, 0, ±τ]`` — the linearised
+    ``‖f_t‖/μ + |m_n|/τ <= f_n`` — and every row's value is the hard-finger
+    facet row applied to ``(f_n - |m_n|/τ, f_t)``:
+
+    .. math:: F_k f = h_k^T (f_n - |m_n|/	au,\; f_t), \qquad
+              h_k = [\mu c, -u_k] / \sqrt{1 + \mu^2 c^2}
+
+    so the LP margin ``d`` of a soft finger is the hard-finger margin of the
+    force that remains once the torsion has taken its share of the normal
+    force.  This is the documented definition (CONVENTIONS, "Monotonicity"):
+    rows scaled to unit length would tilt the facets out of the ``m_n = 0``
+    slice and make ``d`` vanish with ``τ`` (``d* = 0.0002`` where hard fingers
+    give 0.121 at ``ν = 0.01``).  With these rows a soft finger's ``d*`` is
+    never below the hard finger's (any hard solution, with ``m_n = 0``, is a
+    soft one with the same ``d``) and grows with ``ν``.
+    """
+    mu = np.asarray(mu, dtype=float)
+    tau = np.asarray(torsion, dtype=float)
+    a = mu * np.cos(np.pi / n_g)
+    u = _facet_directions(n_g)
+    scale = 1.0 / np.hypot(1.0, a)
+    F = np.empty(mu.shape + (2 * n_g, 4))
+    for half, sign in enumerate((1.0, -1.0)):
+        rows = F[..., half * n_g : (half + 1) * n_g, :]
+        rows[..., 0] = (a * scale)[..., None]
+        rows[..., 1:3] = -u * scale[..., None, None]
+        rows[..., 3] = (-sign * a * scale / tau)[..., None]
+    return F
 
 
 def _circle_generators(mu: float, n_g: int) -> np.ndarray:
@@ -99,30 +172,6 @@ def _pyramid_facets(mu: float, n_g: int) -> np.ndarray:
     a = mu * np.cos(np.pi / n_g)
     F = np.column_stack([np.full(n_g, a), -_facet_directions(n_g)])
     return F / np.hypot(1.0, a)
-
-
-def _bipyramid_facets(mu: float, n_g: int, torsion: float) -> np.ndarray:
-    """Facets of the soft-finger cone: triangles (s_k, s_{k+1}, [1, 0, 0, ±τ]).
-
-    The facet through the ring edge ``k`` and the apex ``±τ`` is
-    ``μ c τ f_n - τ u_k·f_t ∓ μ c m_n >= 0`` with ``c = cos(π/n_g)``.
-    """
-    a = mu * np.cos(np.pi / n_g)
-    u = _facet_directions(n_g)
-    # Divided by max(a, τ) so that tiny μ or τ cannot underflow the products.
-    m = max(a, torsion)
-    rows = [
-        np.column_stack(
-            [
-                np.full(n_g, min(a, torsion)),
-                -(torsion / m) * u,
-                np.full(n_g, -s * a / m),
-            ]
-        )
-        for s in (1.0, -1.0)
-    ]
-    F = np.vstack(rows)
-    return F / np.linalg.norm(F, axis=1, keepdims=True)
 
 
 def effective_cone(
@@ -149,6 +198,10 @@ def effective_cone(
     -------
     EffectiveCone
     """
+    if not isinstance(contact, Contact):
+        raise InvalidContactError(
+            f"contact must be a drakegrasp.Contact, got {type(contact).__name__}"
+        )
     n_g = _check_num_generators(num_generators)
     comps = contact.effective_components()
     torsion = 0.0
@@ -169,13 +222,14 @@ def _cone(comps: tuple[int, ...], mu: float, n_g: int, torsion: float) -> Effect
     elif comps == (0, 1):  # planar hard finger
         S, F = _two_sided(mu)
     elif comps == (0, 3):  # soft finger without tangential friction
-        S, F = _two_sided(torsion)
+        S = np.array([[1.0, 1.0], [torsion, -torsion]])
+        F = torsion_only_facets(np.array(torsion))
     elif comps == (0, 1, 2):
         S = _circle_generators(mu, n_g)
         F = _pyramid_facets(mu, n_g)
     else:  # (0, 1, 2, 3)
         ring = _circle_generators(mu, n_g)
-        F = _bipyramid_facets(mu, n_g, torsion)
+        F = soft_finger_facets(np.array(mu), np.array(torsion), n_g)
         apexes = np.array([[1.0, 1.0], [0, 0], [0, 0], [torsion, -torsion]])
         S = np.hstack([np.vstack([ring, np.zeros(n_g)]), apexes])
     S.flags.writeable = False
@@ -239,7 +293,9 @@ def friction_cone_facets(
         One unit row per facet, positive on the cone's axis.  Frictionless:
         ``[[1]]``.  Planar: ``[[μ, 1], [μ, -1]] / sqrt(1 + μ²)``.  Spatial hard
         finger: rows ``∝ s_k × s_{k+1}``.  Soft finger: the ``2 n_g`` triangles of
-        the bipyramid spanned by the generators (``+b ν`` apex first).
+        the bipyramid spanned by the generators (``+b ν`` apex first), scaled
+        as in :func:`soft_finger_facets` (not to unit length); without
+        friction, ``[1, ∓1/(b ν)]`` (:func:`torsion_only_facets`).
 
     Notes
     -----
@@ -279,16 +335,25 @@ class ConeLayout:
         Position of each contact's ``f_n`` within ``columns``.
     G : (w, m) float
         The grasp matrix restricted to ``columns``.
+    scales : (m,) float
+        A well-scaled program variable ``x_j`` is the force component
+        ``scales_j x_j``: ``b min(ν, 1)`` for a soft finger's moment ``m_n``
+        (whose natural size is ``b ν f_n``, from 1e-21 to 1e21 N·m across the
+        valid ranges), 1 elsewhere.  Programs use ``G diag(scales)`` and
+        ``F diag(scales)``, whose ``m_n`` coefficients are then at most
+        ``μ cos(π/n_g)`` and ``b`` instead of ``1/(b ν)``.
     """
 
     columns: np.ndarray
     cones: tuple[EffectiveCone, ...]
     normal_positions: np.ndarray
     G: np.ndarray
+    scales: np.ndarray | None = None
 
     @staticmethod
     def of(grasp: Grasp, num_generators: int = DEFAULT_NUM_GENERATORS) -> ConeLayout:
         """Layout of ``grasp`` with ``num_generators`` per spatial Coulomb cone."""
+        check_grasp(grasp)
         b = grasp.characteristic_length
         cones = tuple(
             effective_cone(c, num_generators, characteristic_length=b)
@@ -300,7 +365,15 @@ class ConeLayout:
             columns.extend(s.start + j for j in cone.components)
         columns = np.array(columns, dtype=int)
         G = grasp_matrix(grasp)[:, columns]
-        return ConeLayout(columns, cones, np.array(normals, dtype=int), G)
+        scales = np.ones(len(columns))
+        for contact, cone, start in zip(grasp.contacts, cones, normals, strict=True):
+            if 3 in cone.components:
+                # b min(ν, 1): the margin rows' m_n coefficient μ c s/(b ν)
+                # and G's m_n column s [0; n] both stay at most μ c and b.
+                scales[start + cone.components.index(3)] = b * min(
+                    contact.torsional_friction, 1.0
+                )
+        return ConeLayout(columns, cones, np.array(normals, dtype=int), G, scales)
 
     def facet_matrix(self) -> np.ndarray:
         """``F``: block-diagonal unit facet rows over ``columns``."""

@@ -20,6 +20,13 @@ import numpy as np
 
 from drakegrasp.contact import Contact, ContactModel
 from drakegrasp.errors import InvalidContactError, InvalidGraspError
+from drakegrasp.validation import (
+    JACOBIAN_BOUND,
+    check_length,
+    check_positions,
+    real_array,
+    safe_norm,
+)
 
 __all__ = [
     "Grasp",
@@ -45,7 +52,17 @@ class Grasp:
     characteristic_length : float, optional
         Length ``b`` > 0 (metres) that turns moments into forces in soft-finger
         cones and quality metrics.  Default: the largest distance from ``p`` to a
-        contact (1 m if every contact is at ``p``).
+        contact (1 m if every contact is at ``p``), computed without overflow.
+
+    Raises
+    ------
+    InvalidGraspError
+        ``contacts`` not an iterable of :class:`Contact`, or empty; a
+        reference point that is not a real finite ``d``-vector within
+        :data:`~drakegrasp.validation.POSITION_BOUND`; a characteristic length
+        outside ``(0, 1e30]`` m.
+    InvalidContactError
+        Mixed planar and spatial contacts, or an item that is not a Contact.
     """
 
     contacts: tuple[Contact, ...]
@@ -59,7 +76,15 @@ class Grasp:
         reference_point: np.ndarray | None = None,
         characteristic_length: float | None = None,
     ) -> None:
-        contacts = tuple(contacts)
+        if isinstance(contacts, Contact):
+            contacts = (contacts,)
+        try:
+            contacts = tuple(contacts)
+        except TypeError:
+            raise InvalidGraspError(
+                "contacts must be an iterable of drakegrasp.Contact, got "
+                f"{type(contacts).__name__}"
+            ) from None
         if not contacts:
             raise InvalidGraspError("a grasp needs at least one contact, got none")
         for i, c in enumerate(contacts):
@@ -78,23 +103,23 @@ class Grasp:
         if reference_point is None:
             p = np.zeros(dim)
         else:
-            p = np.array(reference_point, dtype=float).reshape(-1)
-            if p.shape != (dim,) or not np.all(np.isfinite(p)):
+            p = np.array(
+                check_positions(
+                    "reference_point", reference_point, error=InvalidGraspError
+                )
+            ).reshape(-1)
+            if p.shape != (dim,):
                 raise InvalidGraspError(
                     f"reference_point must be a finite {dim}-vector like the "
                     f"contacts, got {np.asarray(reference_point).tolist()}"
                 )
         p.flags.writeable = False
         if characteristic_length is None:
-            b = max(float(np.linalg.norm(c.position - p)) for c in contacts)
-            b = b if b > 1e-12 else 1.0
+            offsets = np.array([c.position for c in contacts]) - p
+            b = float(np.max(safe_norm(offsets, axis=-1)))
+            b = b if b > 0.0 else 1.0
         else:
-            b = float(characteristic_length)
-            if not np.isfinite(b) or b <= 0.0:
-                raise InvalidGraspError(
-                    "characteristic_length must be finite and > 0, got "
-                    f"{characteristic_length!r}"
-                )
+            b = check_length("characteristic_length", characteristic_length)
         object.__setattr__(self, "contacts", contacts)
         object.__setattr__(self, "reference_point", p)
         object.__setattr__(self, "characteristic_length", b)
@@ -362,9 +387,10 @@ def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
     Raises
     ------
     InvalidGraspError
-        On a wrong shape (naming the expected one) or non-finite entries.
+        On a wrong shape (naming the expected one), a non-real dtype, or
+        non-finite or out-of-bound entries.
     """
-    J = np.asarray(hand_jacobian, dtype=float)
+    J = real_array("hand_jacobian", hand_jacobian, error=InvalidGraspError)
     M = grasp.num_components
     if J.ndim != 2 or J.shape[0] != M or J.shape[1] < 1:
         raise InvalidGraspError(
@@ -374,4 +400,9 @@ def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
         )
     if not np.all(np.isfinite(J)):
         raise InvalidGraspError("hand_jacobian has non-finite entries")
+    if float(np.max(np.abs(J))) > JACOBIAN_BOUND:
+        raise InvalidGraspError(
+            f"hand_jacobian has an entry beyond |J_ij| <= {JACOBIAN_BOUND:g} "
+            "(drakegrasp.validation.JACOBIAN_BOUND)"
+        )
     return J

@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.contact import contact_frames
+from drakegrasp.friction_cone import soft_finger_facets, torsion_only_facets
 
 __all__ = [
     "KIND_COMPONENTS",
@@ -240,20 +241,11 @@ def kind_facets(
     if kind == PLANAR_HARD:
         return _two_sided(mu)
     if kind == SOFT_TORSION:
-        return _two_sided(torsion)
+        # Soft-finger rows are defined once, in friction_cone (they are not
+        # unit rows: a soft finger must never score below a hard one).
+        return torsion_only_facets(torsion)
+    if kind == SOFT_FULL:
+        return soft_finger_facets(mu, torsion, num_generators)
     S = _ring(mu, num_generators)
     S_next = np.roll(S, -1, axis=-2)
-    if kind == SPATIAL_HARD:
-        return _unit_rows(np.cross(S, S_next))
-    # SOFT_FULL: triangles (s_k, s_{k+1}, apex) of the bipyramid, +bν apex first.
-    zeros = np.zeros(S.shape[:-1] + (1,))
-    s0 = np.concatenate([S, zeros], axis=-1)
-    s1 = np.concatenate([S_next, zeros], axis=-1)
-    rows = []
-    for sign in (1.0, -1.0):
-        apex = np.zeros_like(s0)
-        apex[..., 0] = 1.0
-        apex[..., 3] = sign * torsion[:, None]
-        row = _normal_to_three(s0, s1, apex)
-        rows.append(np.where(row[..., :1] > 0, row, -row))
-    return _unit_rows(np.concatenate(rows, axis=-2))
+    return _unit_rows(np.cross(S, S_next))

@@ -16,7 +16,7 @@ matrices exist at any moment, and inputs may be memory-mapped arrays.
 
 from __future__ import annotations
 
-import math
+import operator
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -38,6 +38,19 @@ from drakegrasp.batch.reduction import solve_margin_lp
 from drakegrasp.contact import ContactModel
 from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOptionError
 from drakegrasp.results import ZERO_FRACTION
+from drakegrasp.validation import (
+    LENGTH_BOUND,
+    POSITION_BOUND,
+    check_coefficient,
+    check_coefficient_array,
+    check_flag,
+    check_num_generators,
+    check_positions,
+    check_rank_tol,
+    check_tol,
+    real_array,
+    unit_vectors,
+)
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -171,29 +184,40 @@ class BatchClosureResult:
 
 
 def _positive_int(name: str, value, minimum: int) -> int:
-    try:
-        n = int(value)
-    except (TypeError, ValueError):
+    if isinstance(value, (bool, np.bool_)):
         n = None
-    if n is None or n != value or n < minimum:
+    else:
+        try:
+            n = operator.index(value)
+        except TypeError:
+            n = None
+    if n is None or n < minimum:
         raise InvalidOptionError(
             f"{name} must be an integer >= {minimum}, got {value!r}"
         )
-    return n
+    return int(n)
 
 
 def _check_tol(name: str, value) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        x = math.nan
-    if not math.isfinite(x) or x <= 0.0:
-        raise InvalidOptionError(f"{name} must be finite and > 0, got {value!r}")
-    return x
+    return check_rank_tol(value) if name == "rank_tol" else check_tol(value, name)
+
+
+def _bounded_chunk_size(chunk_size: int, N: int, n_g: int) -> int:
+    """Grasps per chunk, capped so that a chunk's facet rows stay near 64 MB.
+
+    The facet rows of a chunk hold about ``chunk * N * 2 n_g * 4`` floats;
+    without a cap, ``num_generators = 256`` and 4096 grasps of ten contacts
+    would need gigabytes.  Memory then stays proportional to the real work.
+    """
+    per_grasp = max(1, N) * (2 * n_g + 2) * 4 * 8
+    return max(1, min(chunk_size, _CHUNK_BYTES // per_grasp))
+
+
+_CHUNK_BYTES = 64 * 2**20
 
 
 def _shape_of(name: str, a) -> tuple[int, int, int]:
-    shape = np.shape(a)
+    shape = np.shape(a) if a is not None else ()
     if len(shape) != 3 or shape[2] not in (2, 3) or shape[1] < 1:
         raise InvalidContactError(
             f"{name} must have shape (K, N, 2) or (K, N, 3) with N >= 1, got {shape}"
@@ -203,12 +227,10 @@ def _shape_of(name: str, a) -> tuple[int, int, int]:
 
 def _per_contact(name: str, value, K: int, N: int, *, error=InvalidContactError):
     """A per-contact coefficient as a function of a chunk slice -> (k, N) array."""
-    a = np.asarray(value, dtype=float) if np.isscalar(value) else value
-    shape = np.shape(a)
-    if shape == ():
-        x = float(a)
-        if not math.isfinite(x) or x < 0.0:
-            raise error(f"{name} must be finite and >= 0, got {value!r}")
+    a = value
+    shape = tuple(a.shape) if hasattr(a, "shape") else np.shape(a)
+    if value is None or shape == ():
+        x = check_coefficient(name, value, error=error)
         return lambda sl: np.full((sl.stop - sl.start, N), x)
     if shape == (K,) and K == N:
         raise InvalidOptionError(
@@ -217,13 +239,13 @@ def _per_contact(name: str, value, K: int, N: int, *, error=InvalidContactError)
         )
     if shape in ((K,), (K, 1)):
         return lambda sl: np.repeat(
-            np.asarray(a[sl], dtype=float).reshape(-1, 1), N, axis=1
+            real_array(name, a[sl], error=error).reshape(-1, 1), N, axis=1
         )
     if shape == (1, N):
-        row = np.asarray(a, dtype=float)
+        row = real_array(name, a, error=error)
         return lambda sl: np.repeat(row, sl.stop - sl.start, axis=0)
     if shape == (K, N):
-        return lambda sl: np.asarray(a[sl], dtype=float)
+        return lambda sl: real_array(name, a[sl], error=error)
     raise error(
         f"{name} must be a scalar or of shape (K,) = ({K},), (K, 1), (1, N) = "
         f"(1, {N}) or (K, N) = ({K}, {N}); got shape {shape}"
@@ -231,36 +253,32 @@ def _per_contact(name: str, value, K: int, N: int, *, error=InvalidContactError)
 
 
 def _check_coefficients(name: str, x: np.ndarray, start: int) -> None:
-    bad = ~np.isfinite(x) | (x < 0.0)
-    if bad.any():
-        k, i = np.argwhere(bad)[0]
-        raise InvalidContactError(
-            f"{name} of grasp {start + k}, contact {i} is {float(x[k, i])}; it must be "
-            "finite and >= 0"
-        )
+    check_coefficient_array(name, x, start=start)
 
 
 def _check_positions(P: np.ndarray, start: int) -> None:
-    bad = ~np.isfinite(P).all(axis=-1)
+    bad = ~(np.abs(P) <= POSITION_BOUND).all(axis=-1)  # NaN fails too
     if bad.any():
         k, i = np.argwhere(bad)[0]
         raise InvalidContactError(
-            f"position of grasp {start + k}, contact {i} is not finite: "
-            f"{P[k, i].tolist()}"
+            f"position of grasp {start + k}, contact {i} is {P[k, i].tolist()}: "
+            "not finite or out of range; it must be finite with "
+            f"|x| <= {POSITION_BOUND:g} m (drakegrasp.validation.POSITION_BOUND)"
         )
 
 
 def _unit_normals(Nrm: np.ndarray, start: int) -> np.ndarray:
-    norm = np.linalg.norm(Nrm, axis=-1)
-    bad = ~np.isfinite(Nrm).all(axis=-1) | ~(norm >= 1e-12)
-    if bad.any():
+    try:
+        return unit_vectors("normal", Nrm)
+    except InvalidContactError:
+        scale = np.max(np.abs(Nrm), axis=-1)
+        bad = ~np.isfinite(Nrm).all(axis=-1) | ~(scale > 0.0)
         k, i = np.argwhere(bad)[0]
         raise InvalidContactError(
             f"normal of grasp {start + k}, contact {i} is {Nrm[k, i].tolist()}; a "
             "contact normal must be a finite, non-zero vector pointing into the "
             "object"
-        )
-    return Nrm / norm[..., None]
+        ) from None
 
 
 def _reference_points(value, K: int, d: int):
@@ -268,9 +286,7 @@ def _reference_points(value, K: int, d: int):
         return lambda sl: np.zeros((sl.stop - sl.start, d))
     shape = np.shape(value)
     if shape == (d,):
-        p = np.asarray(value, dtype=float)
-        if not np.isfinite(p).all():
-            raise InvalidGraspError(f"reference_points {p.tolist()} is not finite")
+        p = check_positions("reference_points", value, error=InvalidGraspError)
         return lambda sl: np.broadcast_to(p, (sl.stop - sl.start, d))
     if shape != (K, d):
         raise InvalidGraspError(
@@ -279,13 +295,13 @@ def _reference_points(value, K: int, d: int):
         )
 
     def get(sl):
-        p = np.asarray(value[sl], dtype=float)
-        bad = ~np.isfinite(p).all(axis=1)
+        p = real_array("reference_points", value[sl], error=InvalidGraspError)
+        bad = ~(np.abs(p) <= POSITION_BOUND).all(axis=1)
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
             raise InvalidGraspError(
-                f"reference point of grasp {sl.start + k} is not finite: "
-                f"{p[k].tolist()}"
+                f"reference point of grasp {sl.start + k} is {p[k].tolist()}; it "
+                f"must be finite with |x| <= {POSITION_BOUND:g} m"
             )
         return p
 
@@ -304,15 +320,19 @@ def _characteristic_lengths(value, K: int):
 
     def get(sl):
         b = np.broadcast_to(
-            np.asarray(value if shape == () else value[sl], dtype=float),
+            real_array(
+                "characteristic_lengths",
+                value if shape == () else value[sl],
+                error=InvalidGraspError,
+            ),
             (sl.stop - sl.start,),
         )
-        bad = ~np.isfinite(b) | ~(b > 0.0)
+        bad = ~(b > 0.0) | ~(b <= LENGTH_BOUND)
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
             raise InvalidGraspError(
                 f"characteristic length of grasp {sl.start + k} is {float(b[k])}; it "
-                "must be finite and > 0"
+                f"must be finite and in (0, {LENGTH_BOUND:g}] m"
             )
         return b
 
@@ -333,13 +353,13 @@ def _check_metrics(metrics: Sequence[str]) -> tuple[str, ...]:
 
 def _chunks(K: int, chunk_size: int, progress: bool, desc: str) -> Iterator[slice]:
     bar = None
-    if progress:
+    if check_flag("progress", progress):
         try:
             from tqdm.auto import tqdm
         except ImportError as exc:
             raise InvalidOptionError(
-                "progress=True needs the optional package tqdm "
-                "(pip install tqdm), which is not installed"
+                "progress=True needs the optional package tqdm, which is not "
+                'installed: pip install "drakegrasp[progress]"'
             ) from exc
         bar = tqdm(total=K, desc=desc, unit="grasp")
     try:
@@ -450,9 +470,9 @@ def _run(
     normal_d_star = np.full(K, np.nan)  # LP1's d* where a certificate was sought
     out_metrics = {name: np.full(K, np.nan) for name in metrics}
     for sl in _chunks(K, chunk_size, progress, f"{kind} closure"):
-        P = np.asarray(positions[sl], dtype=float)
+        P = real_array("positions", positions[sl])
         _check_positions(P, sl.start)
-        Nrm = _unit_normals(np.asarray(normals[sl], dtype=float), sl.start)
+        Nrm = _unit_normals(real_array("normals", normals[sl]), sl.start)
         chunk_fn(P, Nrm, sl, d_star, rank, converged, out_metrics, normal_d_star)
     required = 3 if d == 2 else 6
     certified = (rank == required) & ~(d_star > tol) & (normal_d_star > tol)
@@ -521,7 +541,7 @@ def batch_force_closure(
     *,
     model: ContactModel | str = "hard_finger",
     num_generators: int = 8,
-    torsional_friction: float | np.ndarray = 0.0,
+    torsional_friction: float | np.ndarray | None = None,
     reference_points: np.ndarray | None = None,
     characteristic_lengths: float | np.ndarray | None = None,
     tol: float = DEFAULT_TOL,
@@ -542,14 +562,19 @@ def batch_force_closure(
         non-finite normal raises :class:`~drakegrasp.InvalidContactError`
         naming the grasp and contact.
     mu : float, (K,) or (K, N) float
-        Coulomb friction coefficients ``>= 0``.  A hard finger with ``μ = 0``
-        acts as frictionless, as in the single-grasp path.
+        Coulomb friction coefficients: 0 or in ``[1e-12, 1e12]`` (the range of
+        :mod:`drakegrasp.validation`, the same as the single-grasp path).  A
+        hard finger with ``μ = 0`` acts as frictionless, as in the single-grasp
+        path.
     model : {"hard_finger", "frictionless", "soft_finger"}, optional
         Contact model of every contact (soft fingers are spatial only).
     num_generators : int, optional
         Generators ``n_g >= 3`` of each linearised spatial cone (default 8).
     torsional_friction : float, (K,) or (K, N) float, optional
-        ``ν >= 0`` of soft fingers (moment bound ``b ν f_n``).
+        ``ν`` of soft fingers (moment bound ``b ν f_n``), 0 or in
+        ``[1e-12, 1e12]``.  ``None`` (default) means not given: required with
+        ``model="soft_finger"`` (an explicit 0 makes soft fingers act as hard
+        ones), 0 otherwise, as :class:`~drakegrasp.Contact` does.
     reference_points : (d,) or (K, d) float, optional
         Point ``p`` about which moments are taken; default the origin.
     characteristic_lengths : float or (K,) float, optional
@@ -562,6 +587,8 @@ def batch_force_closure(
         Singular values ``<= rank_tol * σ_max`` of ``G`` count as zero.
     chunk_size : int, optional
         Grasps processed together; memory use grows with it, not with ``K``.
+        Capped so that a chunk's facet rows stay near 64 MB (large
+        ``num_generators``).
     progress : bool, optional
         Show a tqdm progress bar (needs the optional package ``tqdm``).
     metrics : sequence of str, optional
@@ -597,12 +624,20 @@ def batch_force_closure(
             "a soft-finger contact is spatial only; planar contacts are "
             "'frictionless' or 'hard_finger'"
         )
-    n_g = _positive_int("num_generators", num_generators, 3)
-    chunk_size = _positive_int("chunk_size", chunk_size, 1)
+    n_g = check_num_generators(num_generators)
+    chunk_size = _bounded_chunk_size(_positive_int("chunk_size", chunk_size, 1), N, n_g)
     tol = _check_tol("tol", tol)
     rank_tol = _check_tol("rank_tol", rank_tol)
     names = _check_metrics(metrics)
     get_mu = _per_contact("mu", mu, K, N)
+    if torsional_friction is None:
+        if model == "soft_finger":
+            raise InvalidContactError(
+                "model='soft_finger' needs torsional_friction (nu: the moment "
+                "about the normal is bounded by b * nu * f_n); pass nu > 0, or 0 "
+                "for soft fingers that act as hard fingers"
+            )
+        torsional_friction = 0.0
     get_nu = _per_contact("torsional_friction", torsional_friction, K, N)
     get_p = _reference_points(reference_points, K, d)
     get_b = _characteristic_lengths(characteristic_lengths, K)
@@ -726,7 +761,7 @@ def batch_form_closure(
         d \ge 0,\; \mathbf 1^T f_n \le N .
     """
     K, N, d = _shape_of("positions", positions)
-    chunk_size = _positive_int("chunk_size", chunk_size, 1)
+    chunk_size = _bounded_chunk_size(_positive_int("chunk_size", chunk_size, 1), N, 1)
     tol = _check_tol("tol", tol)
     rank_tol = _check_tol("rank_tol", rank_tol)
     names = _check_metrics(metrics)

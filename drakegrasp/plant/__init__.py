@@ -19,6 +19,7 @@ from drakegrasp.plant.contacts import (
     find_contacts,
     hand_bodies,
 )
+from drakegrasp.plant.curvature import contact_curvatures
 from drakegrasp.plant.jacobians import (
     hand_jacobian,
     hand_velocity_indices,
@@ -48,6 +49,7 @@ __all__ = [
     "analyze_grasp",
     "close_hand",
     "contacts_from_results",
+    "contact_curvatures",
     "find_contacts",
     "grasp_from_plant",
     "hand_bodies",

@@ -28,7 +28,7 @@ from drakegrasp.closure import (
     with_internal_forces,
 )
 from drakegrasp.contact import Contact, ContactModel
-from drakegrasp.errors import InvalidOptionError, NoContactsError
+from drakegrasp.errors import GraspError, InvalidOptionError, NoContactsError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.grasp import Grasp, grasp_matrix
 from drakegrasp.plant.contacts import (
@@ -40,6 +40,7 @@ from drakegrasp.plant.contacts import (
     hand_bodies,
     resolve_object_body,
 )
+from drakegrasp.plant.curvature import SECOND_ORDER_RANK_TOL, contact_curvatures
 from drakegrasp.plant.jacobians import (
     PLANES,
     hand_jacobian,
@@ -50,6 +51,7 @@ from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.pose import check_pose as _check_pose
 from drakegrasp.plant.validation import hand_model_instances, plant_context_of
 from drakegrasp.results import AntipodalResult, ClosureResult, _jsonable
+from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
 
 __all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
 
@@ -363,6 +365,9 @@ class GraspReport:
     pose : PoseCheck or None
         Whether the pose is possible (``pose.valid``); an invalid pose is only
         analysed with ``check_pose=False`` (or ``allow_penetration=True``).
+    second_order : SecondOrderResult or None
+        Second-order form closure (curvatures read off the shapes) when
+        first-order form closure fails; None when it holds.
     """
 
     data: GraspFromPlant
@@ -372,6 +377,7 @@ class GraspReport:
     force_closure_exact: ClosureResult
     antipodal: AntipodalResult | None
     pose: PoseCheck | None = None
+    second_order: SecondOrderResult | None = None
 
     @property
     def grasp(self) -> Grasp:
@@ -403,6 +409,7 @@ class GraspReport:
             "force_closure_exact": self.force_closure_exact.to_dict(),
             "antipodal": None if self.antipodal is None else self.antipodal.to_dict(),
             "pose": None if self.pose is None else self.pose.to_dict(),
+            "second_order": _jsonable(self.second_order),
         }
 
     def __str__(self) -> str:
@@ -439,6 +446,8 @@ class GraspReport:
             lines += ["  " + line for line in str(result).splitlines()]
         if self.antipodal is not None:
             lines.append("  " + str(self.antipodal))
+        if self.second_order is not None:
+            lines += ["  " + line for line in str(self.second_order).splitlines()]
         return "\n".join(lines)
 
 
@@ -504,10 +513,11 @@ def analyze_grasp(
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
     lp3 = internal_forces(grasp, J, tol=tol)
+    first_order = form_closure(grasp, tol=tol)
     return GraspReport(
         data=data,
         G=grasp_matrix(grasp),
-        form_closure=form_closure(grasp, tol=tol),
+        form_closure=first_order,
         # One LP3 serves both verdicts: it depends on G and J, not on the cones.
         force_closure=with_internal_forces(
             force_closure(grasp, num_generators=num_generators, tol=tol), lp3
@@ -517,4 +527,30 @@ def analyze_grasp(
         ),
         antipodal=antipodal,
         pose=data.pose,
+        second_order=None
+        if first_order.is_closure
+        else _second_order(plant, plant_context, data, first_order, query_object),
     )
+
+
+def _second_order(
+    plant, plant_context, data, first_order, query_object
+) -> SecondOrderResult:
+    """Second-order form closure with the shapes' curvatures (or why not)."""
+    try:
+        curvatures = contact_curvatures(
+            plant,
+            plant_context,
+            data.contacts,
+            object_body=data.object_body,
+            plane=data.plane,
+            query_object=query_object,
+        )
+        return second_order_form_closure(
+            data.grasp,
+            curvatures,
+            first_order=first_order,
+            rank_tol=SECOND_ORDER_RANK_TOL,
+        )
+    except GraspError as e:  # a contact without a second-order model
+        return SecondOrderResult.undecided(data.grasp.num_contacts, str(e))

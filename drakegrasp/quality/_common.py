@@ -6,36 +6,22 @@ import math
 
 import numpy as np
 
-from drakegrasp.errors import InvalidGraspError, InvalidOptionError
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.grasp import Grasp, grasp_matrix
+from drakegrasp.validation import check_grasp, check_length
 
 RANK_TOL = 1e-9
 """Singular values below ``RANK_TOL * σ_max`` count as zero (rank tests here)."""
 
 
 def _check_grasp(grasp: Grasp) -> Grasp:
-    if not isinstance(grasp, Grasp):
-        raise InvalidGraspError(
-            f"expected a drakegrasp.Grasp, got a {type(grasp).__name__}"
-        )
-    return grasp
+    return check_grasp(grasp)
 
 
 def _torque_scale(grasp: Grasp, torque_scale: float | None) -> float:
     if torque_scale is None:
         return float(grasp.characteristic_length)
-    try:
-        b = float(torque_scale)
-    except (TypeError, ValueError):
-        raise InvalidOptionError(
-            f"torque_scale must be a length > 0 (metres) or None, got {torque_scale!r}"
-        ) from None
-    if not math.isfinite(b) or b <= 0.0:
-        raise InvalidOptionError(
-            f"torque_scale must be finite and > 0 (metres) or None, got "
-            f"{torque_scale!r}"
-        )
-    return b
+    return check_length("torque_scale", torque_scale, error=InvalidOptionError)
 
 
 def _moment_rows(wrench_dim: int) -> slice:

@@ -7,7 +7,6 @@ the normal fan of a Minkowski sum (see ``_linf_radius``).
 from __future__ import annotations
 
 import functools
-import itertools
 import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
@@ -188,26 +187,61 @@ def _origin_distance_residual(points: np.ndarray, scale: float) -> float:
         return 0.0
 
 
-def _ball_radius(points: np.ndarray) -> float:
+FLAT_TOL = 1e-14
+"""Relative singular value below which a wrench set counts as flat (no interior).
+
+Wrench sets of thin cones (``μ = 1e-12``) are full-dimensional with singular
+values ratios near 1e-12; round-off leaves ratios near 1e-16.
+"""
+
+
+def _whitening(points: np.ndarray) -> np.ndarray | None:
+    """``A`` (D, D) with ``points @ A.T`` well conditioned; None if flat.
+
+    ``A = diag(1/s) Vᵀ`` from the SVD ``points = U S Vᵀ``, so the mapped points
+    are ``U`` (orthonormal columns).  A linear map keeps the origin, convex
+    hulls and Minkowski sums, and maps a facet ``n'·x' + o' <= 0`` of the mapped
+    set to the facet ``(Aᵀ n')·x + o' <= 0`` of the original one, so ε can be
+    computed in the mapped coordinates and measured in the original ones.
+    This keeps ε accurate for thin cones (``μ`` down to 1e-12: the wrench set is
+    then ``μ`` thin in four directions) and for very long soft-finger torsion
+    generators (``ν`` up to 1e12), where Qhull on the raw points returned 0.
+    """
+    _, s, vt = np.linalg.svd(points, full_matrices=False)
+    if s.size < points.shape[1] or not s[-1] > FLAT_TOL * s[0]:
+        return None
+    return vt / s[:, None]
+
+
+def _ball_radius(points: np.ndarray, A: np.ndarray | None = None) -> float:
     """Radius of the largest origin-centred ball in ``conv(points)``; 0 if none.
 
     Qhull is called only when needed: a hull that does not contain the origin
     (NNLS residual above round-off) or whose affine hull is lower-dimensional
-    than the space (no interior) has radius 0 without it.
+    than the space (no interior) has radius 0 without it.  Everything runs on
+    the whitened points (see :func:`_whitening`); the facets are measured in the
+    original coordinates.
     """
     num, dim = points.shape
-    scale = float(np.max(np.abs(points))) if points.size else 0.0
-    if num <= dim or scale == 0.0:
+    if num <= dim or not np.any(points):
         return 0.0
-    if _origin_distance_residual(points, scale) > HULL_TOL * scale:
+    if A is None:
+        A = _whitening(points)
+        if A is None:
+            return 0.0  # the points span less than the wrench space
+    X = points @ A.T
+    scale = float(np.max(np.abs(X)))
+    if _origin_distance_residual(X, scale) > HULL_TOL * scale:
         return 0.0  # the origin is outside the hull: no hull needed
-    s = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    s = np.linalg.svd(X - X.mean(axis=0), compute_uv=False)
     if s[-1] <= RANK_TOL * max(s[0], scale):
         return 0.0  # flat hull: no interior
-    eq = _qhull(points, scale).equations
-    # Unit outward normals n and offsets o: the hull is {x : n·x + o <= 0}, so
-    # the distance from the origin to each facet's hyperplane is -o.
-    radius = float(np.min(-eq[:, -1]))
+    eq = _qhull(X, scale).equations
+    # Unit outward normals n' and offsets o' in whitened coordinates: the hull
+    # is {x : (Aᵀ n')·x + o' <= 0}; the origin's distance to each facet's
+    # hyperplane is -o' / |Aᵀ n'|.
+    normals = eq[:, :-1] @ A
+    radius = float(np.min(-eq[:, -1] / np.linalg.norm(normals, axis=1)))
     return radius if radius > 0.0 else 0.0
 
 
@@ -294,20 +328,62 @@ def _support_min(U: np.ndarray, wrenches: Sequence[np.ndarray]) -> float:
     return float(min(hp.min(), hm.min()))
 
 
-def _face_tuples(families, dim_test):
+def _face_tuples(families, target: int, exact: bool):
     """Yield ``(parts, shape)`` for every choice of one face per contact.
 
     ``families[i]`` maps a face dimension to bases (see
     :func:`_face_directions`); a contact may also contribute a vertex (no
-    direction).  ``dim_test(total)`` selects the total dimensions to keep.
+    direction).  The total dimension is ``target`` (``exact``) or at least
+    ``target``.  Choices are built contact by contact and a partial choice whose
+    total already exceeds an exact target is dropped, so the work is
+    proportional to the choices kept, never to the ``∏ (faces + 1)`` of all
+    combinations (``4^40`` for 40 contacts).
     """
     choices = [[0, *sorted(f)] for f in families]
-    for combo in itertools.product(*choices):
-        if not dim_test(sum(combo)):
-            continue
-        parts = [(i, j) for i, j in enumerate(combo) if j > 0]
-        shape = [families[i][j].shape[0] for i, j in parts]
-        yield parts, shape
+    n = len(choices)
+    # Largest total the remaining contacts can still add.
+    room = [0] * (n + 1)
+    for i in range(n - 1, -1, -1):
+        room[i] = room[i + 1] + max(choices[i])
+
+    def walk(i, total, combo):
+        if exact and total > target:
+            return
+        if total + room[i] < target:
+            return
+        if i == n:
+            parts = [(k, j) for k, j in enumerate(combo) if j > 0]
+            yield parts, [families[k][j].shape[0] for k, j in parts]
+            return
+        for j in choices[i]:
+            combo.append(j)
+            yield from walk(i + 1, total + j, combo)
+            combo.pop()
+
+    yield from walk(0, 0, [])
+
+
+def _candidate_count(families, target: int, exact: bool) -> int:
+    """Number of candidate normals, by polynomial products (no enumeration).
+
+    Contact ``i`` contributes ``1 + Σ_j c_ij x^j`` (``c_ij`` faces of dimension
+    ``j``); the coefficient of ``x^t`` in the product counts the face choices
+    of total dimension ``t`` weighted by their number of bases.
+    """
+    top = max(target, 1) + 1
+    poly = [1] + [0] * top  # coefficient top collects every degree >= top
+    for family in families:
+        term = [1] + [0] * top
+        for j, bases in family.items():
+            term[min(j, top)] += int(bases.shape[0])
+        new = [0] * (top + 1)
+        for a, pa in enumerate(poly):
+            if pa:
+                for b, tb in enumerate(term):
+                    if tb:
+                        new[min(a + b, top)] += pa * tb
+        poly = new
+    return poly[target] if exact else sum(poly[target:])
 
 
 def _stacked_bases(families, parts, shape, lo, hi) -> np.ndarray:
@@ -317,8 +393,8 @@ def _stacked_bases(families, parts, shape, lo, hi) -> np.ndarray:
     )
 
 
-def _check_candidate_count(families, dim_test) -> None:
-    total = sum(int(np.prod(s)) for _, s in _face_tuples(families, dim_test))
+def _check_candidate_count(families, target: int, exact: bool) -> None:
+    total = _candidate_count(families, target, exact)
     if total > LINF_MAX_CANDIDATES:
         raise InvalidOptionError(
             f"the L∞ Ferrari–Canny metric of this grasp needs {total} candidate "
@@ -327,7 +403,7 @@ def _check_candidate_count(families, dim_test) -> None:
         )
 
 
-def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
+def _linf_radius(wrenches: Sequence[np.ndarray], A: np.ndarray | None = None) -> float:
     r"""ε of the Minkowski sum ``⊕_i conv({0} ∪ {w_ik})`` through its normal fan.
 
     Call only when the origin is strictly inside (ε_1 > 0).  Every facet of a
@@ -348,13 +424,21 @@ def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
        SVD); each facet is such a choice, with its own faces.
     """
     D = wrenches[0].shape[1]
-    sets = [np.vstack([np.zeros((1, D)), W]) for W in wrenches]
+    if A is None:
+        A = np.eye(D)
+    mapped = [W @ A.T for W in wrenches]
+    sets = [np.vstack([np.zeros((1, D)), W]) for W in mapped]
     families = [_face_directions(P) for P in sets]
     chunk = 100_000
-    exact_dim = (lambda t: t == D - 1), (lambda t: t >= D - 1)
-    _check_candidate_count(families, exact_dim[0])
+
+    def support_min(U):
+        # Candidate normals in whitened coordinates map to U @ A originally.
+        V = U @ A
+        return _support_min(V / np.linalg.norm(V, axis=1)[:, None], wrenches)
+
+    _check_candidate_count(families, D - 1, exact=True)
     best, degenerate = math.inf, False
-    for parts, shape in _face_tuples(families, exact_dim[0]):
+    for parts, shape in _face_tuples(families, D - 1, exact=True):
         count = int(np.prod(shape))
         for lo in range(0, count, chunk):
             M = _stacked_bases(families, parts, shape, lo, min(count, lo + chunk))
@@ -363,14 +447,14 @@ def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
             if np.any(norms <= RANK_TOL):
                 degenerate = True
                 break
-            best = min(best, _support_min(u / norms[:, None], wrenches))
+            best = min(best, support_min(u / norms[:, None]))
         if degenerate:
             break
     if not degenerate:
         return best
-    _check_candidate_count(families, exact_dim[1])
+    _check_candidate_count(families, D - 1, exact=False)
     best = math.inf
-    for parts, shape in _face_tuples(families, exact_dim[1]):
+    for parts, shape in _face_tuples(families, D - 1, exact=False):
         count = int(np.prod(shape))
         for lo in range(0, count, chunk):
             M = _stacked_bases(families, parts, shape, lo, min(count, lo + chunk))
@@ -379,7 +463,7 @@ def _linf_radius(wrenches: Sequence[np.ndarray]) -> float:
             if M.shape[1] >= D:
                 keep &= s[:, D - 1] <= RANK_TOL * s[:, 0]
             if np.any(keep):
-                best = min(best, _support_min(vt[keep, D - 1, :], wrenches))
+                best = min(best, support_min(vt[keep, D - 1, :]))
     return best
 
 
@@ -454,11 +538,15 @@ def ferrari_canny(
     wrenches = primitive_wrenches(
         grasp, num_generators=num_generators, torque_scale=torque_scale
     )
+    points = np.vstack(wrenches)
+    A = _whitening(points)
+    if A is None:
+        return 0.0  # the wrench set is flat: no interior for either norm
     if norm == "L1":
-        return _ball_radius(np.vstack(wrenches))
+        return _ball_radius(points, A)
     # The origin is strictly inside W_∞ exactly when it is strictly inside W_1
     # (both hold iff the primitive wrenches positively span the wrench space),
     # so the cheap L1 test settles ε_∞ = 0 first.
-    if _ball_radius(np.vstack(wrenches)) == 0.0:
+    if _ball_radius(points, A) == 0.0:
         return 0.0
-    return _linf_radius(wrenches)
+    return _linf_radius(wrenches, A)

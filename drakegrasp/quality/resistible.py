@@ -179,7 +179,9 @@ def build_max_resistible_wrench_program(
     start = 0
     for cone in cones:
         k = len(cone.components)
-        F = cone.facets
+        # Unit rows: the same cone, better scaled (soft-finger margin rows are
+        # not unit length, see friction_cone.soft_finger_facets).
+        F = cone.facets / np.linalg.norm(cone.facets, axis=1, keepdims=True)
         prog.AddLinearConstraint(
             F, np.zeros(F.shape[0]), np.full(F.shape[0], np.inf), f[start : start + k]
         )

@@ -58,7 +58,7 @@ def test_contact_normalises_and_is_immutable():
         ({"model": "hard_finger", "mu": 0.0}, (0,)),
         ({"model": "hard_finger", "mu": 0.5}, (0, 1, 2)),
         ({"model": "soft_finger", "mu": 0.5, "torsional_friction": 0.1}, (0, 1, 2, 3)),
-        ({"model": "soft_finger", "mu": 0.5}, (0, 1, 2)),
+        ({"model": "soft_finger", "mu": 0.5, "torsional_friction": 0}, (0, 1, 2)),
         ({"model": "soft_finger", "mu": 0.0, "torsional_friction": 0.1}, (0, 3)),
     ],
 )

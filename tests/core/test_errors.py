@@ -18,9 +18,13 @@ from drakegrasp import examples as ex
         (
             ([0, 0, 1], [0, 0, -1]),
             {"mu": -0.1},
-            r"mu must be finite and >= 0, got -0\.1",
+            r"mu must be finite and 0 or in \[1e-12, 1e\+12\].*got -0\.1",
         ),
-        (([0, 0, 1], [0, 0, -1]), {"mu": "high"}, "mu must be a number, got 'high'"),
+        (
+            ([0, 0, 1], [0, 0, -1]),
+            {"mu": "high"},
+            "mu must be a real number, got 'high'",
+        ),
         (
             ([0, 0, 1], [0, 0, -1]),
             {"model": "sticky"},
@@ -30,7 +34,7 @@ from drakegrasp import examples as ex
         (
             ([0, 0, 1], [0, 0, -1]),
             {"torsional_friction": -1},
-            "torsional_friction must be finite and >= 0",
+            "torsional_friction must be finite and 0 or in",
         ),
     ],
 )
@@ -69,7 +73,10 @@ def test_invalid_options():
     grasp = ex.equator_fingers(0.5)
     with pytest.raises(dg.InvalidOptionError, match="num_generators .* got 2"):
         dg.force_closure(grasp, num_generators=2)
-    with pytest.raises(dg.InvalidOptionError, match="tol must be finite and > 0"):
+    with pytest.raises(
+        dg.InvalidOptionError,
+        match=r"tol must be finite and > 0, a real number in \[1e-10, 1\]",
+    ):
         dg.form_closure(grasp, tol=0)
     with pytest.raises(dg.InvalidOptionError, match="formulation .* 'vertices'"):
         dg.force_closure(grasp, formulation="vertices")
@@ -77,7 +84,7 @@ def test_invalid_options():
         dg.force_closure(grasp, hand_jacobian=np.full((9, 2), np.nan))
     with pytest.raises(dg.InvalidGraspError, match="exactly two contacts"):
         dg.is_antipodal(grasp)
-    with pytest.raises(dg.InvalidOptionError, match="mu must be finite and >= 0"):
+    with pytest.raises(dg.InvalidOptionError, match="mu must be finite and 0 or in"):
         dg.is_antipodal(grasp.contacts[:2], mu=-1)
     c = dg.Contact([0, 0, 1], [0, 0, -1])
     with pytest.raises(dg.InvalidGraspError, match="coincide"):

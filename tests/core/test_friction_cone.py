@@ -74,7 +74,12 @@ def test_soft_finger_cone_is_the_hull_of_its_generators():
     F = dg.friction_cone_facets(c, 8, characteristic_length=b)
     assert S.shape == (4, 10) and F.shape == (16, 4)
     assert np.allclose(S[:, -2:].T, [[1, 0, 0, b * 0.2], [1, 0, 0, -b * 0.2]])
-    assert np.allclose(np.linalg.norm(F, axis=1), 1.0) and np.all(F[:, 0] > 0)
+    assert np.all(F[:, 0] > 0)
+    # Not unit rows: on the m_n = 0 slice each row is the hard finger's unit row
+    # (so a soft finger's d* is never below a hard finger's).
+    hard = dg.friction_cone_facets(c.with_(model="hard_finger"), 8)
+    assert np.allclose(F[:8, :3], hard) and np.allclose(F[8:, :3], hard)
+    assert np.allclose(F[:8, 3], -F[8:, 3]) and np.all(F[:8, 3] < 0)
     FS = F @ S
     assert np.all(FS > -1e-12)
     # Every facet of a 4-D cone is spanned by exactly three generators here.

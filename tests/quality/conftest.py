@@ -17,14 +17,19 @@ def equator_grasp(mu=0.5, *, radius=1.0, model="hard_finger", **kwargs):
     return dg.Grasp(contacts)
 
 
-def random_grasp(rng, num, dim=3, *, mu=0.5, spread=0.5, model="hard_finger"):
-    """Contacts on the unit sphere/circle, normals tilted from the inward radial."""
+def random_grasp(rng, num, dim=3, *, mu=0.5, spread=0.5, model="hard_finger", nu=None):
+    """Contacts on the unit sphere/circle, normals tilted from the inward radial.
+
+    A soft finger without ``nu`` gets ``nu = 0`` (it acts as a hard finger).
+    """
     contacts = []
     for _ in range(num):
         p = rng.normal(size=dim)
         p /= np.linalg.norm(p)
         n = -p + spread * rng.normal(size=dim)
-        contacts.append(dg.Contact(p, n, mu=mu, model=model))
+        if nu is None and model == "soft_finger":
+            nu = 0.0
+        contacts.append(dg.Contact(p, n, mu=mu, model=model, torsional_friction=nu))
     return dg.Grasp(contacts)
 
 

@@ -346,7 +346,7 @@ def _first_pass_is_degenerate(wrenches):
 
     D = wrenches[0].shape[1]
     fams = [q._face_directions(np.vstack([np.zeros((1, D)), W])) for W in wrenches]
-    for parts, shape in q._face_tuples(fams, lambda t: t == D - 1):
+    for parts, shape in q._face_tuples(fams, D - 1, exact=True):
         M = q._stacked_bases(fams, parts, shape, 0, int(np.prod(shape)))
         if np.any(np.linalg.norm(q._cofactor_normals(M), axis=1) <= 1e-9):
             return True

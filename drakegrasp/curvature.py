@@ -1,0 +1,385 @@
+r"""Curvatures at a contact and the Hessian of its signed distance (numpy only).
+
+Second-order form closure (:mod:`drakegrasp.second_order`) needs, at every
+contact, how the signed distance ``ψ_i`` between the moving object and the
+fixed finger bends along a rigid motion of the object.  This module holds the
+geometry that decides it: the principal curvatures of the object's and the
+finger's surfaces at the contact (:class:`SurfaceCurvature`,
+:class:`ContactCurvature`) and the quadratic form ``H_i`` with
+
+.. math::
+
+    \psi_i(q(t)) = \psi_i(0) + t\, G_i^T v
+        + \tfrac{t^2}{2}\left(G_i^T a + v^T H_i v\right) + O(t^3),
+
+for the motion ``q(t)`` of the object whose rotation is ``exp(S(tω + t²α/2))``
+about the reference point ``p`` and whose point ``p`` moves by
+``t v_p + t² a_p / 2`` (``v = [v_p; ω]``, ``a = [a_p; α]``, grasp frame).
+The derivation is in ``docs/second_order.md``.
+
+**Curvature model.**  A principal curvature is positive where the surface is
+convex (it bends away from the other body), negative where concave, zero where
+flat and ``+inf`` across a sharp feature: a box edge is ``0`` along the edge
+and ``inf`` across it, a box corner or a sharp point finger is ``inf`` in every
+direction (a sphere of radius 0).  A spherical fingertip of radius ``r`` has
+curvature ``1/r``; a fingertip with a spherical cavity of radius ``R``,
+``-1/R``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from drakegrasp.errors import InvalidContactError
+from drakegrasp.grasp import Grasp
+
+__all__ = [
+    "ContactCurvature",
+    "SurfaceCurvature",
+    "contact_hessian",
+    "contact_hessians",
+]
+
+DIRECTION_TOL = 1e-6
+"""A principal direction may leave the tangent plane by at most this (cosine)."""
+
+ISOLATION_TOL = 1e-9
+"""Relative curvature ``κ_o + κ_f`` (times ``b``) at or below this is not a point
+contact: the surfaces conform along a line or an area."""
+
+
+def _skew(x: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
+
+
+@dataclass(frozen=True)
+class SurfaceCurvature:
+    """Principal curvatures of one surface at a contact point.
+
+    Parameters
+    ----------
+    curvatures : (1,) or (2,) float, 1/metres
+        One curvature (planar grasp) or the two principal curvatures (spatial).
+        Positive convex, negative concave, ``+inf`` across a sharp edge.
+    direction : (3,) float or None
+        Spatial only: the principal direction of ``curvatures[0]``, a unit
+        vector in the contact's tangent plane, in the grasp frame; the second
+        direction is ``n × direction``.  May be None when both curvatures are
+        equal (a sphere, a plane, a point).
+
+    Notes
+    -----
+    Build these with :meth:`flat`, :meth:`point`, :meth:`convex`,
+    :meth:`concave` and :meth:`edge` rather than by hand.
+    """
+
+    curvatures: tuple[float, ...]
+    direction: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        k = tuple(float(x) for x in np.atleast_1d(self.curvatures))
+        if len(k) not in (1, 2):
+            raise InvalidContactError(
+                f"a surface has 1 (planar) or 2 (spatial) principal curvatures, "
+                f"got {list(k)}"
+            )
+        for x in k:
+            if math.isnan(x) or x == -math.inf:
+                raise InvalidContactError(
+                    f"principal curvature {x} is not valid: use a finite value "
+                    "(positive convex, negative concave) or +inf across a sharp edge"
+                )
+        d = self.direction
+        if d is not None:
+            d = tuple(float(x) for x in np.asarray(d, dtype=float).reshape(-1))
+            if len(d) != 3 or not all(map(math.isfinite, d)):
+                raise InvalidContactError(
+                    f"a principal direction is a finite 3-vector, got {list(d)}"
+                )
+        if len(k) == 2 and d is None and k[0] != k[1]:
+            raise InvalidContactError(
+                f"principal curvatures {list(k)} differ, so the direction of the "
+                "first one is needed"
+            )
+        object.__setattr__(self, "curvatures", k)
+        object.__setattr__(self, "direction", d)
+
+    @classmethod
+    def flat(cls, *, planar: bool = False) -> SurfaceCurvature:
+        """A flat face (curvature 0)."""
+        return cls((0.0,) if planar else (0.0, 0.0))
+
+    @classmethod
+    def point(cls, *, planar: bool = False) -> SurfaceCurvature:
+        """A sharp point (a point finger, a corner): ``+inf`` in every direction."""
+        return cls((math.inf,) if planar else (math.inf, math.inf))
+
+    @classmethod
+    def convex(cls, radius: float, *, planar: bool = False) -> SurfaceCurvature:
+        """A sphere (disc) of ``radius`` metres seen from outside: ``1/radius``."""
+        k = 1.0 / _radius(radius)
+        return cls((k,) if planar else (k, k))
+
+    @classmethod
+    def concave(cls, radius: float, *, planar: bool = False) -> SurfaceCurvature:
+        """A spherical (circular) cavity of ``radius`` metres: ``-1/radius``."""
+        k = -1.0 / _radius(radius)
+        return cls((k,) if planar else (k, k))
+
+    @classmethod
+    def edge(cls, direction: np.ndarray, curvature: float = 0.0) -> SurfaceCurvature:
+        """A sharp edge along ``direction`` (spatial), ``curvature`` along it."""
+        return cls((curvature, math.inf), direction)
+
+    @classmethod
+    def from_shape_form(cls, form: np.ndarray, normal: np.ndarray) -> SurfaceCurvature:
+        """Principal curvatures of the form ``II(x, x) = xᵀ form x`` on the tangents.
+
+        Parameters
+        ----------
+        form : (3, 3) float, 1/m
+            Symmetric; for an implicit surface ``F(x) = 0`` with ``F < 0``
+            inside, ``∇²F / |∇F|`` (positive on a convex surface).
+        normal : (3,) float
+            Unit surface normal (either sign); ``form`` is restricted to the
+            plane orthogonal to it.
+
+        Returns
+        -------
+        SurfaceCurvature
+            Spatial, with the direction of the first principal curvature.
+        """
+        n = np.asarray(normal, dtype=float)
+        a = np.zeros(3)
+        a[int(np.argmin(np.abs(n)))] = 1.0
+        t1 = np.cross(n, a)
+        t1 /= np.linalg.norm(t1)
+        P = np.column_stack([t1, np.cross(n, t1)])
+        F = np.asarray(form, dtype=float)
+        k, V = np.linalg.eigh(P.T @ (0.5 * (F + F.T)) @ P)
+        return cls((float(k[0]), float(k[1])), P @ V[:, 0])
+
+    @property
+    def planar(self) -> bool:
+        """True for a planar (one-curvature) surface."""
+        return len(self.curvatures) == 1
+
+    def tangent_form(self, normal: np.ndarray, tangents: np.ndarray):
+        """The curvature in a tangent basis: finite part and sharp directions.
+
+        Parameters
+        ----------
+        normal : (3,) or (2,) float
+            The contact normal (unit).
+        tangents : (d, k) float
+            Orthonormal tangent basis (columns), ``k = d - 1``.
+
+        Returns
+        -------
+        K : (k, k) float
+            The second fundamental form's finite part in the tangent basis.
+        E : (m, k) float
+            Orthonormal rows spanning the directions of infinite curvature.
+        """
+        if self.planar:
+            (k,) = self.curvatures
+            if math.isinf(k):
+                return np.zeros((1, 1)), np.ones((1, 1))
+            return np.array([[k]]), np.zeros((0, 1))
+        n = np.asarray(normal, dtype=float)
+        if self.direction is None:
+            d1 = tangents[:, 0]
+        else:
+            d1 = np.asarray(self.direction)
+            d1 = d1 / np.linalg.norm(d1)
+            if abs(d1 @ n) > DIRECTION_TOL:
+                raise InvalidContactError(
+                    f"principal direction {np.round(d1, 6).tolist()} is not in the "
+                    f"tangent plane of normal {np.round(n, 6).tolist()}"
+                )
+            d1 = d1 - (d1 @ n) * n
+            d1 /= np.linalg.norm(d1)
+        d2 = np.cross(n, d1)
+        K = np.zeros((2, 2))
+        rows = []
+        for k, d in zip(self.curvatures, (d1, d2), strict=True):
+            e = tangents.T @ d
+            if math.isinf(k):
+                rows.append(e)
+            else:
+                K += k * np.outer(e, e)
+        return K, np.array(rows).reshape(-1, 2)
+
+
+def _radius(radius: float) -> float:
+    r = float(radius)
+    if not math.isfinite(r) or r <= 0:
+        raise InvalidContactError(f"a radius must be finite and > 0, got {radius!r}")
+    return r
+
+
+@dataclass(frozen=True)
+class ContactCurvature:
+    """The object's and the finger's curvature at one contact.
+
+    Parameters
+    ----------
+    object : SurfaceCurvature
+        The object's surface at the contact point.
+    finger : SurfaceCurvature
+        The finger's surface at the contact point (fixed during the motion).
+    """
+
+    object: SurfaceCurvature
+    finger: SurfaceCurvature
+
+    @classmethod
+    def point_finger(cls, object: SurfaceCurvature) -> ContactCurvature:
+        """A sharp point finger on a surface of the object."""
+        return cls(object, SurfaceCurvature.point(planar=object.planar))
+
+
+def _relative_quadratic(
+    contact_curvature: ContactCurvature,
+    normal: np.ndarray,
+    tangents: np.ndarray,
+    length: float,
+) -> np.ndarray:
+    r"""The form ``M`` with ``ψ̈ - n·β = zᵀ M z``, ``z = [u_T; w_T]``.
+
+    ``u_T`` is the tangential velocity of the object's material point at the
+    contact and ``w_T = Tᵀ (n × ω)``.  ``M`` comes from minimising over the
+    velocity ``σ`` of the closest point on the finger
+
+    .. math:: (\sigma - u)^T K_o (\sigma - u) + 2 w^T (\sigma - u)
+              + \sigma^T K_f \sigma
+
+    with the sharp directions as constraints ``E_o(σ - u) = 0``, ``E_f σ = 0``.
+    """
+    Ko, Eo = contact_curvature.object.tangent_form(normal, tangents)
+    Kf, Ef = contact_curvature.finger.tangent_form(normal, tangents)
+    k = tangents.shape[1]
+    eye, zero = np.eye(k), np.zeros((k, k))
+    B = np.block([[Ko + Kf, -Ko, eye], [-Ko, Ko, -eye], [eye, -eye, zero]])
+    C = np.vstack([Eo, Ef])
+    D = np.vstack([np.hstack([Eo, np.zeros_like(Eo)]), np.zeros((len(Ef), 2 * k))])
+    if C.shape[0] and np.linalg.matrix_rank(C, tol=1e-9) < C.shape[0]:
+        raise InvalidContactError(
+            "both surfaces are sharp in the same tangent direction (a point on "
+            "an edge, parallel edges, a vertex on a vertex): the contact normal "
+            "is not defined there, so neither is the second-order test"
+        )
+    P = np.linalg.pinv(C) @ D if C.shape[0] else np.zeros((k, 2 * k))
+    _, s, vt = np.linalg.svd(C) if C.shape[0] else (None, np.zeros(0), np.eye(k))
+    N = vt[len(s) :].T if C.shape[0] else np.eye(k)
+    L = np.vstack([P, np.eye(2 * k)])
+    if N.shape[1] == 0:
+        return L.T @ B @ L
+    R = np.vstack([N, np.zeros((2 * k, N.shape[1]))])
+    RBR = R.T @ B @ R
+    if np.min(np.linalg.eigvalsh(RBR)) * length <= ISOLATION_TOL:
+        raise InvalidContactError(
+            "the relative curvature κ_object + κ_finger is not positive: "
+            f"{np.round(np.linalg.eigvalsh(RBR), 9).tolist()} 1/m in the smooth "
+            "directions.  Zero means the surfaces conform along a line or an "
+            "area (flat on flat: describe the patch by its vertices, as "
+            "drakegrasp.find_contacts does); negative means the finger's cavity "
+            "is tighter than the object, which cannot touch at one point"
+        )
+    RBL = R.T @ B @ L
+    return L.T @ B @ L - RBL.T @ np.linalg.solve(RBR, RBL)
+
+
+def contact_hessian(
+    grasp: Grasp, index: int, contact_curvature: ContactCurvature
+) -> np.ndarray:
+    r"""Second-order term ``H_i`` of contact ``index``'s signed distance.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        Contacts and reference point ``p`` (grasp frame).
+    index : int
+        Which contact.
+    contact_curvature : ContactCurvature
+        Curvatures of object and finger at that contact (planar: one each).
+
+    Returns
+    -------
+    H : (6, 6) or (3, 3) float, metres per (twist unit)²
+        Symmetric; ``ψ̈_i = G_iᵀ a + vᵀ H_i v`` for the motion described in the
+        module docstring (twists ``[v_p; ω]`` about ``p``).
+
+    Notes
+    -----
+    With ``r = c_i - p``, ``u = v_p + ω × r`` and ``w = n × ω``:
+
+    .. math::
+
+        v^T H_i v = n \cdot \big(\omega \times (\omega \times r)\big)
+            + \min_{\sigma}\; (\sigma - u)^T K_o (\sigma - u)
+              + 2 w^T (\sigma - u) + \sigma^T K_f \sigma
+
+    over tangent vectors ``σ``; for finite curvatures the minimum is
+    ``uᵀ K_o K^{-1} K_f u − 2 wᵀ K^{-1} K_f u − wᵀ K^{-1} w`` with
+    ``K = K_o + K_f``.
+    """
+    contact = grasp.contacts[index]
+    n, c = contact.normal, contact.position
+    r = c - grasp.reference_point
+    planar = grasp.planar
+    if contact_curvature.object.planar != planar or (
+        contact_curvature.finger.planar != planar
+    ):
+        kind = "planar" if planar else "spatial"
+        raise InvalidContactError(
+            f"contact {index}: a {kind} grasp needs "
+            f"{'one curvature' if planar else 'two principal curvatures'} per "
+            "surface"
+        )
+    tangents = contact.frame[:, 1:]
+    M = _relative_quadratic(contact_curvature, n, tangents, grasp.characteristic_length)
+    if planar:
+        t = tangents[:, 0]
+        Z = np.array([[t[0], t[1], t @ np.array([-r[1], r[0]])], [0.0, 0.0, -1.0]])
+        H = Z.T @ M @ Z
+        H[2, 2] -= n @ r
+        return 0.5 * (H + H.T)
+    Tt = tangents.T
+    Z = np.block([[Tt, -Tt @ _skew(r)], [np.zeros((2, 3)), Tt @ _skew(n)]])
+    H = Z.T @ M @ Z
+    H[3:, 3:] += 0.5 * (np.outer(n, r) + np.outer(r, n)) - (n @ r) * np.eye(3)
+    return 0.5 * (H + H.T)
+
+
+def contact_hessians(
+    grasp: Grasp, curvatures: Sequence[ContactCurvature]
+) -> np.ndarray:
+    """:func:`contact_hessian` of every contact.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    curvatures : sequence of ContactCurvature
+        One per contact, in contact order.
+
+    Returns
+    -------
+    H : (N, 6, 6) or (N, 3, 3) float
+    """
+    curvatures = tuple(curvatures)
+    if len(curvatures) != grasp.num_contacts:
+        raise InvalidContactError(
+            f"curvatures has {len(curvatures)} entries but the grasp has "
+            f"{grasp.num_contacts} contacts; give one ContactCurvature per contact"
+        )
+    for i, cc in enumerate(curvatures):
+        if not isinstance(cc, ContactCurvature):
+            raise InvalidContactError(
+                f"curvatures[{i}] is a {type(cc).__name__}, not a ContactCurvature"
+            )
+    return np.array([contact_hessian(grasp, i, cc) for i, cc in enumerate(curvatures)])

@@ -1,0 +1,567 @@
+r"""Second-order form closure (Rimon–Burdick) as a small semidefinite program.
+
+When first-order form closure fails but the normal forces can balance,
+``λ >= 0, λ != 0, G_n λ = 0``, the object may still be immobilised by the
+curvature of the surfaces at the contacts.  Let ``S`` be the contacts that carry
+force in some equilibrium and ``W = {v : G_iᵀ v = 0, i ∈ S}`` the motions that
+roll or slide at every one of them to first order.  For ``v ∈ W`` and an
+equilibrium λ, the acceleration terms cancel in the weighted sum of the signed
+distances (:mod:`drakegrasp.curvature`):
+
+.. math:: \sum_i \lambda_i \psi_i(q(t)) = \tfrac{t^2}{2}\, v^T
+          \Big(\sum_i \lambda_i H_i\Big) v + O(t^3),
+
+so if some λ makes ``Σ λ_i H_i`` negative definite on ``W``, every motion
+penetrates some finger: the grasp is immobilised to second order.  Deciding it
+is the SDP
+
+.. math:: \max t \;\; \text{s.t.}\;\; -\textstyle\sum_i \lambda_i A_i \succeq t I,
+          \;\; \lambda \ge 0,\;\; G_n \lambda = 0,\;\; \mathbf 1^T \lambda = 1,
+
+with ``A_i = b B^T H_i B`` on an orthonormal basis ``B`` of ``W`` in the
+normalised twist coordinates ``[v_c; b ω]`` (``c`` the contacts' centroid,
+``b`` the characteristic length), so that ``t*`` is dimensionless and its sign
+does not depend on units or on the reference point.  Contacts are treated as
+frictionless whatever their model.  The derivation is ``docs/second_order.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, fields
+
+import numpy as np
+from pydrake.solvers import (
+    ClarabelSolver,
+    ClpSolver,
+    MathematicalProgram,
+    ScsSolver,
+    SolutionResult,
+)
+
+from drakegrasp.closure import DEFAULT_RANK_TOL, _add_balance, form_closure
+from drakegrasp.curvature import ContactCurvature, _skew, contact_hessians
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
+from drakegrasp.grasp import Grasp, normal_grasp_matrix
+from drakegrasp.results import ClosureResult, _jsonable, _near, _relative_margin
+
+__all__ = [
+    "DEFAULT_SECOND_ORDER_TOL",
+    "SecondOrderResult",
+    "SecondOrderVariables",
+    "build_second_order_program",
+    "equilibrium_support",
+    "second_order_form_closure",
+]
+
+DEFAULT_SECOND_ORDER_TOL = 1e-6
+"""Second-order closure needs ``t* > tol`` (``t*`` dimensionless, see above)."""
+
+_ESCAPE_BOX = 10.0  # bound on the normalised escape acceleration
+
+
+def _twist_scaling(grasp: Grasp) -> np.ndarray:
+    """``T`` with ``v = T ν``: raw twist about ``p`` from ``ν = [v_c; b ω]``."""
+    b = grasp.characteristic_length
+    r = grasp.reference_point - grasp.positions.mean(axis=0)
+    if grasp.planar:
+        return np.array([[1.0, 0.0, -r[1] / b], [0.0, 1.0, r[0] / b], [0, 0, 1 / b]])
+    T = np.eye(6)
+    T[:3, 3:] = -_skew(r) / b
+    T[3:, 3:] /= b
+    return T
+
+
+def _null_basis(A: np.ndarray, rank_tol: float) -> np.ndarray:
+    """Orthonormal basis (columns) of ``N(Aᵀ)``, numerically."""
+    if A.shape[1] == 0:
+        return np.eye(A.shape[0])
+    u, s, _ = np.linalg.svd(A)
+    rank = int(np.sum(s > rank_tol * s[0])) if s.size and s[0] > 0 else 0
+    return u[:, rank:]
+
+
+def _solve(prog: MathematicalProgram, solvers):
+    for solver in solvers:
+        if solver.available() and solver.enabled():
+            return solver.Solve(prog)
+    raise SolverError("no solver available (need Clarabel/SCS and Clp)", program=prog)
+
+
+def equilibrium_support(
+    grasp: Grasp, *, rank_tol: float = DEFAULT_RANK_TOL
+) -> tuple[int, ...]:
+    """Contacts whose normal force is positive in some equilibrium.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    rank_tol : float, optional
+        ``G_n λ = 0`` is imposed on ``G_n``'s numerical row space.
+
+    Returns
+    -------
+    tuple of int
+        The largest support ``S`` of ``λ >= 0, G_n λ = 0`` (empty when no
+        equilibrium exists), from one LP: ``max Σ s`` s.t. ``G_n λ = 0``,
+        ``λ >= s``, ``0 <= s <= 1``, ``λ <= 1e6``.  Contacts outside ``S`` can
+        separate to first order (Goldman–Tucker).
+    """
+    N = grasp.num_contacts
+    prog = MathematicalProgram()
+    lam = prog.NewContinuousVariables(N, "lambda")
+    s = prog.NewContinuousVariables(N, "s")
+    _add_balance(prog, normal_grasp_matrix(grasp), lam, rank_tol)
+    prog.AddBoundingBoxConstraint(0.0, 1.0, s)
+    prog.AddBoundingBoxConstraint(0.0, 1e6, lam)
+    prog.AddLinearConstraint(
+        np.hstack([np.eye(N), -np.eye(N)]),
+        np.zeros(N),
+        np.full(N, np.inf),
+        np.append(lam, s),
+    )
+    prog.AddLinearCost(-np.ones(N), 0.0, s)
+    result = _solve(prog, (ClpSolver(), ClarabelSolver()))
+    if result.get_solution_result() != SolutionResult.kSolutionFound:
+        raise SolverError(
+            "the equilibrium-support LP failed with "
+            f"{result.get_solution_result().name} (it is always feasible)",
+            program=prog,
+            result=result,
+        )
+    return tuple(int(i) for i in np.flatnonzero(result.GetSolution(s) > 0.5))
+
+
+@dataclass(frozen=True)
+class SecondOrderVariables:
+    """Decision variables and data of the second-order program.
+
+    Attributes
+    ----------
+    multipliers : ndarray of Variable, (len(support),)
+        ``λ_i`` of the contacts in ``support``.
+    t : pydrake.symbolic.Variable
+        The eigenvalue bound that the program maximises.
+    support : (s,) int
+        Contacts that carry force in some equilibrium.
+    basis : (3 or 6, dim W) float
+        Orthonormal basis of ``W`` in normalised twists ``ν = [v_c; b ω]``.
+    scaling : (3 or 6, 3 or 6) float
+        ``T`` with raw twist (about ``p``) ``v = T ν``.
+    matrices : (s, dim W, dim W) float
+        ``A_i = b Bᵀ Tᵀ H_i T B`` of the support's contacts (dimensionless).
+    hessians : (N, 3 or 6, 3 or 6) float
+        ``H_i`` in raw twists about ``p`` (metres per twist unit squared).
+    lmi : Binding
+        The constraint ``-Σ λ_i A_i - t I ⪰ 0``.
+    """
+
+    multipliers: np.ndarray
+    t: object
+    support: np.ndarray
+    basis: np.ndarray
+    scaling: np.ndarray
+    matrices: np.ndarray
+    hessians: np.ndarray
+    lmi: object
+
+
+def build_second_order_program(
+    grasp: Grasp,
+    curvatures: Sequence[ContactCurvature],
+    *,
+    support: Sequence[int] | None = None,
+    rank_tol: float = DEFAULT_RANK_TOL,
+) -> tuple[MathematicalProgram, SecondOrderVariables]:
+    """Build the SDP of second-order form closure.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    curvatures : sequence of ContactCurvature
+        Object and finger curvature at each contact, in contact order.
+    support : sequence of int, optional
+        The contacts that carry force in some equilibrium; default
+        :func:`equilibrium_support` (which solves one LP).
+    rank_tol : float, optional
+        Relative singular-value threshold for ``W`` and ``G_n λ = 0``.
+
+    Returns
+    -------
+    prog : MathematicalProgram
+        ``max t`` s.t. ``-Σ λ_i A_i ⪰ t I``, ``λ >= 0``, ``G_n λ = 0``,
+        ``Σ λ = 1`` over the support's multipliers.
+    variables : SecondOrderVariables
+
+    Raises
+    ------
+    InvalidGraspError
+        When the support is empty (no equilibrium) or ``W = {0}``.
+    """
+    H = contact_hessians(grasp, curvatures)
+    if support is None:
+        support = equilibrium_support(grasp, rank_tol=rank_tol)
+    S = np.array(sorted(set(int(i) for i in support)), dtype=int)
+    if S.size == 0:
+        raise InvalidGraspError(
+            "no equilibrium λ >= 0, λ != 0 with G_n λ = 0: nothing to test at "
+            "second order"
+        )
+    T = _twist_scaling(grasp)
+    Gs = T.T @ normal_grasp_matrix(grasp)[:, S]
+    B = _null_basis(Gs, rank_tol)
+    if B.shape[1] == 0:
+        raise InvalidGraspError("W = {0}: the grasp is decided at first order")
+    b = grasp.characteristic_length
+    A = np.array([b * B.T @ T.T @ H[i] @ T @ B for i in S])
+    A = 0.5 * (A + A.transpose(0, 2, 1))
+    prog = MathematicalProgram()
+    lam = prog.NewContinuousVariables(len(S), "lambda")
+    t = prog.NewContinuousVariables(1, "t")[0]
+    prog.AddBoundingBoxConstraint(0.0, np.inf, lam)
+    prog.AddLinearEqualityConstraint(np.ones((1, len(S))), [1.0], lam)
+    _add_balance(prog, Gs, lam, rank_tol)
+    k = B.shape[1]
+    lmi = prog.AddLinearMatrixInequalityConstraint(
+        [np.zeros((k, k))] + [-Ai for Ai in A] + [-np.eye(k)], np.append(lam, t)
+    )
+    prog.AddLinearCost(-t)
+    return prog, SecondOrderVariables(lam, t, S, B, T, A, H, lmi)
+
+
+@dataclass(frozen=True)
+class SecondOrderResult:
+    """Verdict of second-order form closure.
+
+    Attributes
+    ----------
+    is_closure : bool
+        Immobilised to first order (``order == 1``) or to second (``2``).
+    order : int or None
+        1, 2, or None when not immobilised (or not decided) at second order.
+    t_star : float
+        Optimal ``t`` (dimensionless: the least eigenvalue of ``-Σ λ_i A_i``
+        on ``W``); ``inf`` for first-order closure, NaN with no equilibrium.
+    multipliers : (N,) float
+        ``λ*`` (``Σ λ = 1``; zero outside ``support``).
+    dim_w : int
+        ``dim W`` (0 for first-order closure).
+    support : tuple of int
+        Contacts that carry force in some equilibrium.
+    escape_twist : (3,) or (6,) float or None
+        For a "no": a motion ``v = [v_p; ω]`` (about the reference point, grasp
+        frame, unit in normalised twists) that no contact resists to second
+        order together with ``escape_acceleration``.
+    escape_acceleration : (3,) or (6,) float or None
+        ``a`` with ``G_iᵀ a + vᵀ H_i v >= escape_margin`` at every contact that
+        ``v`` does not separate to first order.
+    escape_margin : float
+        That bound (dimensionless, times ``b``); NaN without an escape.
+    escape_verified : bool
+        True when the escape holds (``escape_margin >= -tol``).
+    margin : float
+        ``(t* - tol) / tol``.
+    tol : float
+    solver, status : str
+    reason : str
+        One sentence that says why.
+    """
+
+    is_closure: bool
+    order: int | None
+    t_star: float
+    multipliers: np.ndarray
+    dim_w: int
+    support: tuple[int, ...]
+    escape_twist: np.ndarray | None
+    escape_acceleration: np.ndarray | None
+    escape_margin: float
+    escape_verified: bool
+    margin: float
+    tol: float
+    solver: str
+    status: str
+    reason: str
+
+    @classmethod
+    def undecided(
+        cls, num_contacts: int, reason: str, *, tol: float = DEFAULT_SECOND_ORDER_TOL
+    ) -> SecondOrderResult:
+        """A result that decides nothing, for contacts without a curvature model."""
+        return cls(
+            is_closure=False,
+            order=None,
+            t_star=math.nan,
+            multipliers=np.zeros(num_contacts),
+            dim_w=-1,
+            support=(),
+            escape_twist=None,
+            escape_acceleration=None,
+            escape_margin=math.nan,
+            escape_verified=False,
+            margin=math.nan,
+            tol=tol,
+            solver="",
+            status="not solved",
+            reason=f"not decided: {reason}",
+        )
+
+    @property
+    def near_boundary(self) -> bool:
+        """True when ``t*`` is within ``tol`` of 0: higher orders decide."""
+        return math.isfinite(self.t_star) and _near(self.margin)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        d = {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+        d["near_boundary"] = self.near_boundary
+        return d
+
+    def __str__(self) -> str:
+        verdict = {1: "YES (first order)", 2: "YES (second order)"}.get(
+            self.order, "no"
+        )
+        lam = np.round(self.multipliers, 4).tolist()
+        line = (
+            f"second-order form closure: {verdict}, t* = {self.t_star:.6g}, "
+            f"dim W = {self.dim_w}, λ* = {lam}, solver {self.solver} "
+            f"({self.status})"
+        )
+        return line + "\n  " + self.reason
+
+
+def _check_tol(tol: float) -> float:
+    t = float(tol)
+    if not math.isfinite(t) or t <= 0:
+        raise InvalidOptionError(f"tol must be finite and > 0, got {tol!r}")
+    return t
+
+
+def second_order_form_closure(
+    grasp: Grasp,
+    curvatures: Sequence[ContactCurvature],
+    *,
+    tol: float = DEFAULT_SECOND_ORDER_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+    first_order: ClosureResult | None = None,
+) -> SecondOrderResult:
+    """Decide second-order form closure of a frictionless grasp (Rimon–Burdick).
+
+    Parameters
+    ----------
+    grasp : Grasp
+        Contacts in the grasp frame; friction is ignored.
+    curvatures : sequence of ContactCurvature
+        One per contact: object and finger principal curvatures (1/m) and
+        directions in the grasp frame (planar: one curvature each).
+    tol : float, optional
+        Closure needs ``t* > tol``.
+    rank_tol : float, optional
+        Relative singular-value threshold for ranks and ``W``.
+    first_order : ClosureResult, optional
+        :func:`~drakegrasp.form_closure` of the same grasp, if already known.
+
+    Returns
+    -------
+    SecondOrderResult
+        A "yes" is certain to second order (the multipliers are the
+        certificate).  A "no" carries an escape motion when one exists in
+        ``W``; ``escape_verified`` False means the test is inconclusive there
+        (no single λ blocks every motion, yet none escapes along the
+        candidate directions).
+    """
+    tol = _check_tol(tol)
+    H = contact_hessians(grasp, curvatures)  # validates before any solve
+    N = grasp.num_contacts
+    if first_order is None:
+        first_order = form_closure(grasp, rank_tol=rank_tol)
+    if first_order.is_closure:
+        lam = np.concatenate(first_order.contact_forces)
+        return SecondOrderResult(
+            True,
+            1,
+            math.inf,
+            lam / lam.sum(),
+            0,
+            tuple(range(N)),
+            None,
+            None,
+            math.nan,
+            False,
+            math.inf,
+            tol,
+            first_order.solver,
+            first_order.status,
+            "first-order form closure: W = {0}",
+        )
+    support = equilibrium_support(grasp, rank_tol=rank_tol)
+    if not support:
+        return _no_equilibrium(grasp, tol)
+    prog, var = build_second_order_program(
+        grasp, curvatures, support=support, rank_tol=rank_tol
+    )
+    result = _solve(prog, (ClarabelSolver(), ScsSolver()))
+    status = result.get_solution_result()
+    solver = result.get_solver_id().name()
+    if status != SolutionResult.kSolutionFound:
+        raise SolverError(
+            f"{solver} failed with status {status.name} on the second-order SDP "
+            "(always feasible and bounded, so this is numerical)",
+            program=prog,
+            result=result,
+        )
+    t_star = float(result.GetSolution(var.t))
+    lam = np.zeros(N)
+    lam[var.support] = np.clip(result.GetSolution(var.multipliers), 0.0, None)
+    k = var.basis.shape[1]
+    common = dict(
+        multipliers=lam,
+        dim_w=k,
+        support=tuple(int(i) for i in var.support),
+        margin=_relative_margin(t_star, tol),
+        tol=tol,
+        solver=solver,
+        status=status.name,
+        t_star=t_star,
+    )
+    if t_star > tol:
+        return SecondOrderResult(
+            is_closure=True,
+            order=2,
+            escape_twist=None,
+            escape_acceleration=None,
+            escape_margin=math.nan,
+            escape_verified=False,
+            reason=f"immobilised to second order: Σ λ_i H_i is negative definite "
+            f"on W (dim {k}); every motion in W penetrates a finger",
+            **common,
+        )
+    dual = _dual_matrix(result.GetDualSolution(var.lmi), k)
+    escape = _find_escape(grasp, var, H, lam, dual, tol)
+    if escape is None:
+        reason = (
+            "not immobilised by any single λ, but no candidate motion escapes "
+            "either: inconclusive at second order"
+        )
+        return SecondOrderResult(
+            is_closure=False,
+            order=None,
+            escape_twist=None,
+            escape_acceleration=None,
+            escape_margin=math.nan,
+            escape_verified=False,
+            reason=reason,
+            **common,
+        )
+    v, a, s_star = escape
+    how = "higher orders decide" if t_star > -tol else "it escapes to second order"
+    return SecondOrderResult(
+        is_closure=False,
+        order=None,
+        escape_twist=v,
+        escape_acceleration=a,
+        escape_margin=s_star,
+        escape_verified=True,
+        reason=f"not immobilised: the motion v = {np.round(v, 4).tolist()} "
+        f"penetrates no finger to second order ({how})",
+        **common,
+    )
+
+
+def _dual_matrix(values: np.ndarray, k: int) -> np.ndarray:
+    """The LMI's dual from its upper triangle, row-major (= lower, column-major)."""
+    X = np.zeros((k, k))
+    iu = np.triu_indices(k)
+    X[iu] = np.asarray(values, dtype=float).reshape(-1)[: len(iu[0])]
+    return X + np.triu(X, 1).T
+
+
+def _find_escape(grasp, var: SecondOrderVariables, H, lam, dual, tol):
+    """A motion in W that no contact resists to second order, or None.
+
+    Candidates: the eigenvectors of ``-Σ λ*_i A_i`` at its least eigenvalue and
+    the dual matrix's leading eigenvector.  Each one's sign is chosen so that
+    contacts outside the support separate (or roll) to first order, and an LP
+    then looks for an acceleration that keeps every other contact closed.
+    """
+    M = -np.einsum("i,ijk->jk", lam[var.support], var.matrices)
+    w, V = np.linalg.eigh(M)
+    candidates = [V[:, j] for j in range(len(w)) if w[j] <= w[0] + 10 * tol]
+    if np.all(np.isfinite(dual)) and np.trace(dual) > 0:
+        candidates.append(np.linalg.eigh(dual)[1][:, -1])
+    T, B = var.scaling, var.basis
+    Gt = T.T @ normal_grasp_matrix(grasp)
+    b = grasp.characteristic_length
+    best = None
+    for c in candidates:
+        for sign in (1.0, -1.0):
+            nu = sign * B @ c
+            g = Gt.T @ nu
+            if np.min(g) < -1e-9:
+                continue
+            found = _escape_acceleration(Gt, np.abs(g) <= 1e-9, H, T, nu, b)
+            if found is not None and (best is None or found[1] > best[2]):
+                best = (T @ nu, T @ found[0], found[1])
+    if best is None or best[2] < -tol:
+        return None
+    return best
+
+
+def _escape_acceleration(Gt, closed, H, T, nu, b):
+    """LP: ``max s`` s.t. ``G̃_iᵀ ã + b νᵀ H̃_i ν >= s`` on the closed contacts."""
+    idx = np.flatnonzero(closed)
+    h = np.array([b * nu @ T.T @ H[i] @ T @ nu for i in idx])
+    prog = MathematicalProgram()
+    a = prog.NewContinuousVariables(Gt.shape[0], "a")
+    s = prog.NewContinuousVariables(1, "s")[0]
+    prog.AddBoundingBoxConstraint(-_ESCAPE_BOX, _ESCAPE_BOX, a)
+    prog.AddBoundingBoxConstraint(-np.inf, 1.0, s)
+    A = np.hstack([Gt[:, idx].T, -np.ones((len(idx), 1))])
+    prog.AddLinearConstraint(A, -h, np.full(len(idx), np.inf), np.append(a, s))
+    prog.AddLinearCost(-s)
+    result = _solve(prog, (ClpSolver(), ClarabelSolver()))
+    if result.get_solution_result() != SolutionResult.kSolutionFound:
+        return None
+    return np.asarray(result.GetSolution(a)), float(result.GetSolution(s))
+
+
+def _no_equilibrium(grasp: Grasp, tol: float) -> SecondOrderResult:
+    """No equilibrium: a first-order escape (``G̃ᵀ ν > 0``) from one LP."""
+    T = _twist_scaling(grasp)
+    Gt = T.T @ normal_grasp_matrix(grasp)
+    n, N = Gt.shape
+    prog = MathematicalProgram()
+    nu = prog.NewContinuousVariables(n, "nu")
+    s = prog.NewContinuousVariables(1, "s")[0]
+    prog.AddBoundingBoxConstraint(-1.0, 1.0, nu)
+    prog.AddBoundingBoxConstraint(-np.inf, 1.0, s)
+    prog.AddLinearConstraint(
+        np.hstack([Gt.T, -np.ones((N, 1))]),
+        np.zeros(N),
+        np.full(N, np.inf),
+        np.append(nu, s),
+    )
+    prog.AddLinearCost(-s)
+    result = _solve(prog, (ClpSolver(), ClarabelSolver()))
+    v = np.asarray(result.GetSolution(nu))
+    v = T @ (v / np.linalg.norm(v))
+    s_star = float(result.GetSolution(s))
+    return SecondOrderResult(
+        is_closure=False,
+        order=None,
+        t_star=math.nan,
+        multipliers=np.zeros(N),
+        dim_w=n,
+        support=(),
+        escape_twist=v,
+        escape_acceleration=np.zeros(n),
+        escape_margin=s_star,
+        escape_verified=s_star > 0,
+        margin=-math.inf,
+        tol=tol,
+        solver=result.get_solver_id().name(),
+        status=result.get_solution_result().name,
+        reason="no equilibrium λ >= 0, λ != 0 with G_n λ = 0: the twist v = "
+        f"{np.round(v, 4).tolist()} separates every contact to first order",
+    )
