@@ -123,6 +123,21 @@ def test_api_reference_documents_every_public_name(html):
     assert not missing
 
 
+def test_every_public_module_has_an_api_page():
+    # A module added later (by anyone) must be added to docs/api/ too.
+    api = "".join(p.read_text() for p in (DOCS / "api").glob("*.rst"))
+    documented = set(re.findall(r"^\.\. automodule:: (\S+)$", api, re.M))
+    modules = set()
+    for path in (ROOT / "drakegrasp").rglob("*.py"):
+        parts = path.relative_to(ROOT).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        if any(p.startswith("_") for p in parts):
+            continue  # private modules and __main__
+        modules.add(".".join(parts))
+    assert modules - documented == set()
+
+
 def _canonical(obj, name):
     module = getattr(obj, "__module__", None)
     qualname = getattr(obj, "__qualname__", None)
