@@ -2,7 +2,9 @@
 
 Prints the median and 90th-percentile wall time of one call of each program, for
 3-contact spatial hard-finger grasps with 8 generators, and the share of that time
-spent building the program versus solving it.
+spent building the program versus solving it.  The certificate rows time the
+witness program alone on the full-rank "no" grasps (each verdict above already
+includes it), so that a certificate's cost can be read against a verdict's.
 
 Run: ``python benchmarks/bench_core.py [--grasps 200]``
 """
@@ -20,6 +22,9 @@ import numpy as np  # noqa: E402
 from pydrake.solvers import ClpSolver  # noqa: E402
 
 import drakegrasp as dg  # noqa: E402
+from drakegrasp import closure  # noqa: E402
+from drakegrasp.batch.certificates import batch_certificates  # noqa: E402
+from drakegrasp.witness import escape_twist, unresisted_wrench  # noqa: E402
 
 
 def random_grasps(count: int, num_contacts: int, seed: int = 7) -> list[dg.Grasp]:
@@ -31,6 +36,22 @@ def random_grasps(count: int, num_contacts: int, seed: int = 7) -> list[dg.Grasp
         n = -p + 0.5 * rng.normal(size=p.shape)
         grasps.append(dg.Grasp([dg.Contact(p[i], n[i], mu=0.5) for i in range(len(p))]))
     return grasps
+
+
+def batch_slice(result):
+    """The first five grasps of a batch result (for a warm-up call)."""
+    import dataclasses
+
+    return dataclasses.replace(
+        result,
+        is_closure=result.is_closure[:5],
+        rank=result.rank[:5],
+        d_star=result.d_star[:5],
+        margin=result.margin[:5],
+        converged=result.converged[:5],
+        metrics={},
+        normal_certificate=None,
+    )
 
 
 def timed(fn, items) -> np.ndarray:
@@ -62,13 +83,57 @@ def main() -> None:
         ("force_closure_exact (SOCP)", dg.force_closure_exact),
         ("form_closure (LP1)", dg.form_closure),
         ("build_force_closure_program only", dg.build_force_closure_program),
+        ("certificate of a force-closure 'no' (LP)", "cert_poly"),
+        ("certificate of an exact-cone 'no' (SOCP)", "cert_exact"),
+        ("certificate of a form-closure 'no' (LP)", "cert_form"),
+        ("certificate.check (no solver)", "check"),
         ("Clp solve of a prebuilt LP2 only", None),
     ]
     prebuilt = [dg.build_force_closure_program(g)[0] for g in grasps]
     solver = ClpSolver()
+    fails = [g for g in grasps if not dg.force_closure(g).is_closure]
+    certs = [dg.force_closure(g).certificate for g in fails]
+    extra = {
+        "cert_poly": lambda g: unresisted_wrench(g, 6, cones="polyhedral"),
+        "cert_exact": lambda g: unresisted_wrench(g, 6, cones="exact"),
+        "cert_form": lambda g: escape_twist(g, 6),
+    }
+    rows += [
+        ("batch_certificates, per failing grasp", "batch"),
+        ("force_closure without its certificate", "bare_poly"),
+        ("force_closure_exact without its certificate", "bare_exact"),
+    ]
+    P = np.array([g.positions for g in grasps])
+    n = np.array([g.normals for g in grasps])
     for name, fn in rows:
-        if fn is None:
+        if fn == "batch":
+            batch = dg.batch_force_closure(P, n, 0.5)
+            batch_certificates(P[:5], n[:5], batch_slice(batch), mu=0.5)  # warm up
+            t0 = time.perf_counter()
+            batch_certificates(P, n, batch, mu=0.5)
+            per = (time.perf_counter() - t0) / max(1, int((~batch.is_closure).sum()))
+            t = np.array([per])
+            t0 = time.perf_counter()
+            dg.batch_force_closure(P, n, 0.5)
+            verdict = (time.perf_counter() - t0) / len(grasps)
+            print(f"{'batch_force_closure, per grasp':<44}{verdict * 1e3:>8.3f}ms")
+        elif fn in ("bare_poly", "bare_exact"):
+            real = closure.unresisted_wrench
+            closure.unresisted_wrench = lambda *a, **k: None
+            try:
+                call = dg.force_closure if fn == "bare_poly" else dg.force_closure_exact
+                t = timed(call, grasps)
+            finally:
+                closure.unresisted_wrench = real
+        elif fn is None:
             t = timed(solver.Solve, prebuilt)
+        elif fn == "check":
+            t = timed(
+                lambda gc: gc[1].check(gc[0]), list(zip(fails, certs, strict=True))
+            )
+        elif isinstance(fn, str):
+            full = [g for g in fails if dg.force_closure(g).rank == 6]
+            t = timed(extra[fn], full)
         else:
             t = timed(fn, grasps)
         median, p90 = np.median(t) * 1e3, np.percentile(t, 90) * 1e3

@@ -52,6 +52,12 @@ from drakegrasp.grasp import (
 )
 from drakegrasp.results import ClosureResult, InternalForceResult, _relative_margin
 from drakegrasp.validation import check_grasp, check_rank_tol, check_tol, real_array
+from drakegrasp.witness import (
+    balance_certificate,
+    escape_twist,
+    uncontrollable_force,
+    unresisted_wrench,
+)
 
 __all__ = [
     "DEFAULT_TOL",
@@ -599,6 +605,11 @@ def form_closure(
     if forces is None:
         forces = np.zeros(grasp.num_contacts)
     ok = rank == required and d_star > tol
+    forces = tuple(np.array([x]) for x in forces)
+    if ok:
+        certificate = balance_certificate(grasp, forces, cones="normals", rank=rank)
+    else:
+        certificate = escape_twist(grasp, rank)
     return ClosureResult(
         kind="form closure",
         is_closure=bool(ok),
@@ -606,12 +617,14 @@ def form_closure(
         rank=rank,
         required_rank=required,
         margin=_relative_margin(d_star, tol),
-        contact_forces=tuple(np.array([x]) for x in forces),
+        contact_forces=forces,
         solver=solver,
         status=status,
         tol=tol,
         formulation="normals",
         frictional_closure=bool(ok),
+        decided_by="d*" if rank == required else "rank",
+        certificate=certificate,
     )
 
 
@@ -648,15 +661,17 @@ def internal_forces(
     rank = 0 if equalities is None else equalities.evaluator().num_constraints()
     null_dim = len(variables.columns) - rank
     passes = not (d_star > tol)  # NaN (infeasible) passes: no such force exists
+    contact_forces = _split_forces(grasp, variables.columns, forces)
     return InternalForceResult(
         passes=bool(passes),
         d_star=d_star,
         margin=-_relative_margin(d_star, tol) if np.isfinite(d_star) else np.inf,
         null_space_dim=int(null_dim),
-        contact_forces=_split_forces(grasp, variables.columns, forces),
+        contact_forces=contact_forces,
         solver=solver,
         status=status,
         tol=tol,
+        certificate=None if passes else uncontrollable_force(grasp, contact_forces),
     )
 
 
@@ -671,6 +686,7 @@ def _force_closure_result(
     hand_jacobian: np.ndarray | None,
     tol: float,
     rank_tol: float,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
 ) -> ClosureResult:
     required = grasp.wrench_dim
     rank = _balance_rank(_balance_matrix(grasp, variables.columns), rank_tol)
@@ -678,7 +694,7 @@ def _force_closure_result(
     contact_forces = _split_forces(grasp, variables.columns, forces)
     margin = _relative_margin(d_star, tol)
     frictional = bool(rank == required and d_star > tol)
-    certificate = "d*"
+    decided_by = "d*" if rank == required else "rank"
     if rank == required and not frictional:
         # d is a distance to the cone boundaries, so it vanishes with μ.  Normal
         # forces alone (f_t = 0) lie inside every cone with μ > 0: if they
@@ -687,8 +703,21 @@ def _force_closure_result(
             grasp, variables.columns, tol=tol, rank_tol=rank_tol
         )
         if normal is not None:
-            frictional, certificate = True, "normal forces"
+            frictional, decided_by = True, "normal forces"
             margin, contact_forces = normal
+    cones = "exact" if formulation == "exact" else "polyhedral"
+    if frictional:
+        certificate = balance_certificate(
+            grasp,
+            contact_forces,
+            cones="normals" if decided_by == "normal forces" else cones,
+            rank=rank,
+            num_generators=num_generators,
+        )
+    else:
+        certificate = unresisted_wrench(
+            grasp, rank, cones=cones, num_generators=num_generators
+        )
     result = ClosureResult(
         kind=kind,
         is_closure=frictional,
@@ -702,6 +731,7 @@ def _force_closure_result(
         tol=tol,
         formulation=formulation,
         frictional_closure=frictional,
+        decided_by=decided_by,
         certificate=certificate,
     )
     if hand_jacobian is None:
@@ -729,10 +759,19 @@ def with_internal_forces(
         ``result`` with ``internal_forces = lp3`` and
         ``is_closure = frictional_closure and lp3.passes``.
     """
+    changes = {}
+    if result.frictional_closure and not lp3.passes:
+        changes = {"decided_by": "LP3", "certificate": lp3.certificate}
+    elif result.decided_by == "LP3":  # re-attaching: undo a previous LP3 verdict
+        raise InvalidOptionError(
+            "with_internal_forces needs a result computed without the hand "
+            "Jacobian; this one was already decided by LP3"
+        )
     return dataclasses.replace(
         result,
         internal_forces=lp3,
         is_closure=result.frictional_closure and lp3.passes,
+        **changes,
     )
 
 
@@ -811,6 +850,7 @@ def force_closure(
         hand_jacobian=hand_jacobian,
         tol=tol,
         rank_tol=rank_tol,
+        num_generators=num_generators,
     )
 
 

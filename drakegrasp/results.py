@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from drakegrasp.certificates import Certificate
 
 __all__ = ["AntipodalResult", "ClosureResult", "InternalForceResult"]
 
@@ -70,6 +74,24 @@ class InternalForceResult:
         Solver name and its solution status.
     tol : float
         Threshold on ``d*``.
+    certificate : Certificate or None
+        When LP3 fails, the uncontrollable internal force (LP3's optimal forces:
+        ``f ∈ N(G) ∩ N(Jᵀ)`` with every ``f_n > 0``); None when it passes.
+
+    Notes
+    -----
+    Two facts, under two names.  **LP3 (uncontrollable squeezing)** asks for
+    an internal force with *positive normal components* that no joint torque
+    can change; **dim N(G) ∩ N(Jᵀ)** counts every such force, whatever the
+    signs of its normals.  The verdict (``passes``, and ``is_closure`` of a
+    force-closure result with a hand) follows LP3, as the source's test does:
+    an uncontrollable force that would pull a finger off the object cannot be
+    held as a squeeze, so it does not make the grasp slip.  Example: the
+    three-finger equator grasp with a hand that drives only one finger has
+    ``dim N(G) ∩ N(Jᵀ) = 2`` (the two undriven fingers can trade forces the
+    hand cannot feel) yet passes LP3: no squeeze with all three normals
+    positive escapes the driven finger.  The dimension is reported beside the
+    verdict, never in its place.
     """
 
     passes: bool
@@ -80,6 +102,7 @@ class InternalForceResult:
     solver: str
     status: str
     tol: float
+    certificate: Certificate | None = None
 
     @property
     def near_boundary(self) -> bool:
@@ -99,13 +122,32 @@ class InternalForceResult:
         return d
 
     def __str__(self) -> str:
-        verdict = "passes" if self.passes else "FAILS"
-        near = "  (within tol of the boundary)" if self.near_boundary else ""
-        return (
-            f"LP3 (internal forces the hand cannot control): {verdict}, "
-            f"d* = {self.d_star:.6g}, dim N(G)∩N(Jᵀ) = {self.null_space_dim}, "
-            f"solver {self.solver} ({self.status}){near}"
+        return "\n".join(self.report_lines())
+
+    def report_lines(self) -> list[str]:
+        """Two lines: LP3's verdict, and the null-space dimension under its name."""
+        if self.passes:
+            zero = _zero_text(self.d_star, self.tol)
+            lp3 = (
+                f"LP3 (uncontrollable squeezing): passes, decided by d* = {zero} "
+                f"<= tol {self.tol:g}: every squeeze with f_n > 0 is felt by "
+                "the joints"
+            )
+        else:
+            lp3 = (
+                f"LP3 (uncontrollable squeezing): FAILS, decided by d* = "
+                f"{self.d_star:.3g} > tol {self.tol:g}: a squeeze with every "
+                "f_n > 0 that no joint torque can change"
+            )
+        if self.near_boundary:
+            lp3 += "  [within tol of the boundary]"
+        dim = self.null_space_dim
+        null = (
+            f"dim N(G) ∩ N(Jᵀ) = {dim} (null-space condition: "
+            + ("holds" if dim == 0 else "fails")
+            + "; reported beside LP3, not used by the verdict)"
         )
+        return [lp3, null]
 
 
 @dataclass(frozen=True)
@@ -148,14 +190,25 @@ class ClosureResult:
         was given).
     internal_forces : InternalForceResult or None
         LP3, when a hand Jacobian was given.
-    certificate : str
-        What proved the verdict: ``"d*"`` (the program's own ``d* > tol``, or
-        the lack of it) or ``"normal forces"``.  ``d`` is a distance to the cone
-        boundaries, so it vanishes as ``μ -> 0`` even for a grasp in form
-        closure; when ``G`` has full rank and ``d* <= tol``, force closure is
-        also proved by balancing normal forces with ``f_n > tol`` (LP1), which
-        lie inside every cone with ``μ > 0``.  Then ``margin`` and
-        ``contact_forces`` are LP1's, and ``d_star`` stays the program's.
+    decided_by : str
+        What decided the verdict: ``"rank"`` (the rank is short: ``d*`` and
+        ``margin`` played no part), ``"d*"`` (full rank, and the program's own
+        ``d* > tol`` or the lack of it), ``"normal forces"`` or ``"LP3"``
+        (frictional closure holds but the hand cannot control a squeeze).
+        ``d`` is a distance to the cone boundaries, so it vanishes as
+        ``μ -> 0`` even for a grasp in form closure; when ``G`` has full rank
+        and ``d* <= tol``, force closure is also proved by balancing normal
+        forces with ``f_n > tol`` (LP1), which lie inside every cone with
+        ``μ > 0``.  Then ``margin`` and ``contact_forces`` are LP1's, and
+        ``d_star`` stays the program's.
+    certificate : Certificate or None
+        The verdict's witness (:mod:`drakegrasp.certificates`), in the grasp
+        frame about the reference point: an escape twist (form closure "no"),
+        an unresisted wrench (force closure "no"), LP3's uncontrollable
+        internal force (``decided_by == "LP3"``) or the balancing internal
+        force of a "yes".  None only for a "no" within ``tol`` of the boundary,
+        where no separating direction exists.  Re-verify it with
+        ``result.certificate.check(grasp)``.
     """
 
     kind: str
@@ -171,7 +224,8 @@ class ClosureResult:
     formulation: str
     frictional_closure: bool
     internal_forces: InternalForceResult | None = field(default=None)
-    certificate: str = "d*"
+    decided_by: str = "d*"
+    certificate: Certificate | None = None
 
     @property
     def near_boundary(self) -> bool:
@@ -186,25 +240,76 @@ class ClosureResult:
         return self.is_closure
 
     def to_dict(self) -> dict:
-        """JSON-ready dictionary (non-finite numbers become ``None``)."""
+        """JSON-ready dictionary (non-finite numbers become ``None``).
+
+        ``certificate`` is the witness's own dictionary; ``why`` is its one-line
+        reading for a "no" (None for a "yes").
+        """
         d = {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
         d["near_boundary"] = self.near_boundary
+        d["why"] = self.why()
         return d
 
+    def why(self) -> str | None:
+        """One line that says why the verdict is "no" (None for a "yes")."""
+        if self.is_closure:
+            return None
+        if self.certificate is None:
+            return (
+                "no witness exists at this tol (the verdict lies within tol of "
+                "the boundary)"
+            )
+        return self.certificate.describe()
+
     def __str__(self) -> str:
+        return "\n".join(self.report_lines())
+
+    def _decision_text(self) -> str:
+        rank = f"rank {self.rank}/{self.required_rank}"
+        d, tol = self.d_star, self.tol
+        if self.decided_by == "rank":
+            return (
+                f"decided by rank: {rank} < {self.required_rank} "
+                f"(d* = {d:.3g} not used)"
+            )
+        if self.decided_by == "normal forces":
+            return (
+                f"decided by normal forces (LP1): they balance with margin "
+                f"{self.margin:+.3g} tol, {rank}; this program's d* = "
+                f"{_zero_text(d, tol)} shrinks with mu and did not decide"
+            )
+        if self.decided_by == "LP3":
+            return (
+                "decided by LP3: frictional closure holds "
+                f"({rank}), but the hand cannot control a squeeze"
+            )
+        if self.frictional_closure:
+            return (
+                f"decided by d* = {d:.3g} > tol {tol:g} (margin {self.margin:+.3g} "
+                f"tol), {rank}"
+            )
+        return f"decided by d* = {_zero_text(d, tol)} <= tol {tol:g}, {rank}"
+
+    def report_lines(self, *, internal_forces: bool = True) -> list[str]:
+        """The report: verdict and what decided it, why, solver (and LP3)."""
         verdict = "YES" if self.is_closure else "no"
-        lines = [
-            f"{self.kind}: {verdict}",
-            f"  rank {self.rank}/{self.required_rank}, d* = {self.d_star:.6g} "
-            f"(tol {self.tol:g}, margin {self.margin:+.3g} tol)"
-            + ("  [within tol of the boundary]" if self.near_boundary else ""),
-            f"  solver {self.solver} ({self.status}), {self.formulation}",
-        ]
-        if self.certificate != "d*":
-            lines.insert(2, f"  proved by {self.certificate} (LP1), margin as LP1's")
-        if self.internal_forces is not None:
-            lines.append("  " + str(self.internal_forces))
-        return "\n".join(lines)
+        lines = [f"{self.kind}: {verdict}, {self._decision_text()}"]
+        if self.near_boundary and self.decided_by == "d*":
+            lines[0] += "  [within tol of the boundary]"
+        why = self.why()
+        if why is not None:
+            lines.append("  why: " + why)
+        lines.append(f"  solver {self.solver} ({self.status}), {self.formulation}")
+        if internal_forces and self.internal_forces is not None:
+            lines += ["  " + line for line in self.internal_forces.report_lines()]
+        return lines
+
+
+def _zero_text(d_star: float, tol: float) -> str:
+    """``d*`` as text, saying when it is the solver's zero rather than a value."""
+    if math.isfinite(d_star) and abs(d_star) <= ZERO_FRACTION * tol:
+        return "0 (solver zero)"
+    return f"{d_star:.3g}"
 
 
 @dataclass(frozen=True)
@@ -244,7 +349,19 @@ class AntipodalResult:
         verdict = "YES" if self.is_antipodal else "no"
         deg = np.degrees(self.angles)
         mdeg = np.degrees(self.margins)
+        head = (
+            f"antipodal (geometric test): {verdict}, decided by the angle margins "
+            f"{mdeg[0]:+.3f}°, {mdeg[1]:+.3f}° (angles {deg[0]:.3f}°, "
+            f"{deg[1]:.3f}° vs atan mu)"
+        )
+        if self.min_mu == 0.0:
+            mu_text = "the fingers are collinear: antipodal for every mu >= 0"
+        else:
+            mu_text = f"antipodal for mu >= {self.min_mu:.4g}"
+        if np.all(np.abs(self.margins) < 1e-9):
+            mu_text += "; on the cone boundary (margins 0°), not strictly inside"
         return (
-            f"antipodal: {verdict}  (angles {deg[0]:.3f}°, {deg[1]:.3f}°; margins "
-            f"{mdeg[0]:+.3f}°, {mdeg[1]:+.3f}°; needs mu >= {self.min_mu:.4g})"
+            f"{head}\n  {mu_text}; antipodal is necessary, not sufficient: in "
+            "space two hard fingers never resist a moment about the line "
+            "between them, and with mu = 0 nothing resists sliding"
         )

@@ -442,10 +442,17 @@ class GraspReport:
             f"J: {self.J.shape[0]} x {self.J.shape[1]} (hand velocities "
             f"{self.data.hand_velocity_indices.tolist()})"
         )
+        lines.append("  (points below are in frame O, metres)")
         for result in (self.form_closure, self.force_closure, self.force_closure_exact):
-            lines += ["  " + line for line in str(result).splitlines()]
+            lines += ["  " + x for x in result.report_lines(internal_forces=False)]
+            if result.certificate is not None:
+                check = result.certificate.check(g, hand_jacobian=self.J)
+                lines.append(f"    {result.certificate.kind} re-checked: {check}")
+        lp3 = self.force_closure.internal_forces
+        if lp3 is not None:  # one LP3 serves both force-closure verdicts
+            lines += ["  " + x for x in lp3.report_lines()]
         if self.antipodal is not None:
-            lines.append("  " + str(self.antipodal))
+            lines += ["  " + x for x in str(self.antipodal).splitlines()]
         if self.second_order is not None:
             lines += ["  " + line for line in str(self.second_order).splitlines()]
         return "\n".join(lines)

@@ -177,6 +177,8 @@ def draw_grasp(
     result : ClosureResult or sequence of array_like, optional
         Contact forces to draw as arrows: a result with ``contact_forces``, or
         one array per contact in that contact's frame, normal first (newtons).
+        A "no" result's certificate is drawn too (the unresisted wrench or
+        the escape axis, see :mod:`drakegrasp.visualization.certificates`).
     prefix : str, optional
         Meshcat path holding the drawing; an existing drawing there is deleted
         first.
@@ -319,6 +321,9 @@ def draw_grasp(
                     rgba=_rgba(palette, "force"),
                 )
                 paths.append(f"{base}/force")
+    from drakegrasp.visualization.certificates import draw_result_certificate
+
+    paths += draw_result_certificate(meshcat, grasp, result, prefix)  # why "no"
     return GraspDrawing(prefix, tuple(paths), h, scale, forces_G)
 
 

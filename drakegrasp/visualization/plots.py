@@ -84,6 +84,9 @@ class PlanarGraspPlot:
         Length of each drawn cone edge, metres.
     force_scale : float
         Arrow length per newton (m/N); 0 when no forces were drawn.
+    certificate : CertificateArtists or None
+        For a "no" result: the escape ghost or the unresisted wrench (see
+        :mod:`drakegrasp.visualization.certificate_plots`).
     """
 
     ax: Any
@@ -95,6 +98,7 @@ class PlanarGraspPlot:
     labels: tuple[Any, ...]
     cone_length: float
     force_scale: float
+    certificate: Any = None
 
 
 def _outline_patch(outline: Any, colors: Mapping[str, Any]):
@@ -155,7 +159,11 @@ def plot_planar_grasp(
         for a disc, or any matplotlib patch (added as given).
     result : ClosureResult or sequence of array_like, optional
         Contact forces to draw: a result with ``contact_forces`` or one array
-        per contact in its contact frame, ``[f_n, f_t]`` (newtons).
+        per contact in its contact frame, ``[f_n, f_t]`` (newtons).  For a
+        "no" result its certificate is drawn too: an escape twist as a dashed
+        ghost of the outline moved along it, with each contact's velocity and
+        the centre of rotation; an unresisted wrench as the external force
+        (or moment) the grasp cannot resist, in red.
     cone_length : float, optional
         Length of the drawn cone edges and normal arrows, metres.  Default
         0.3 b (b: the grasp's characteristic length).
@@ -299,6 +307,9 @@ def plot_planar_grasp(
                 ax.text(x, y, str(i), fontsize=9, ha="center", va="center", zorder=6)
             )
 
+    cert_artists = _draw_certificate(ax, grasp, result, patch)
+    if cert_artists is not None and cert_artists.ghost is not None:
+        extent.append(np.asarray(cert_artists.ghost.get_xydata()))
     pts = np.vstack(extent)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     pad = 0.1 * max(float(np.max(hi - lo)), b)
@@ -317,4 +328,23 @@ def plot_planar_grasp(
         tuple(labels),
         L,
         scale,
+        cert_artists,
     )
+
+
+def _draw_certificate(ax, grasp: Grasp, result: Any, patch: Any):
+    """Draw a "no" result's certificate (see :func:`plot_planar_grasp`)."""
+    from drakegrasp.certificates import ESCAPE_TWIST, UNRESISTED_WRENCH, Certificate
+    from drakegrasp.visualization.certificate_plots import (
+        plot_escape,
+        plot_unresisted_wrench,
+    )
+
+    cert = getattr(result, "certificate", None)
+    if not isinstance(cert, Certificate) or getattr(result, "is_closure", True):
+        return None
+    if cert.kind == ESCAPE_TWIST:
+        return plot_escape(ax, grasp, cert, outline=patch)
+    if cert.kind == UNRESISTED_WRENCH:
+        return plot_unresisted_wrench(ax, grasp, cert)
+    return None

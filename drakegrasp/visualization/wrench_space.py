@@ -166,6 +166,9 @@ class WrenchSpacePlot:
         Hull facets (None when ``hull=False`` or the hull is degenerate).
     origin : matplotlib collection
         The origin marker (green when inside, red when not).
+    separating_plane : CertificateArtists or None
+        The certificate's separating plane and unresisted direction, when a
+        "no" result was given.
     """
 
     ax: Any
@@ -176,6 +179,7 @@ class WrenchSpacePlot:
     hull: WrenchHull
     hull_artist: Any
     origin: Any
+    separating_plane: Any = None
 
     @property
     def origin_inside(self) -> bool:
@@ -191,6 +195,7 @@ def plot_wrench_space(
     hull: bool = True,
     rays: bool = True,
     tol: float = 1e-9,
+    result: Any = None,
 ) -> WrenchSpacePlot:
     """Plot the primitive wrenches of a planar grasp and their convex hull.
 
@@ -210,6 +215,10 @@ def plot_wrench_space(
         Draw a segment from the origin to each primitive wrench.
     tol : float, optional
         Margin the origin needs to count as inside (see :func:`wrench_hull`).
+    result : ClosureResult, optional
+        A force-closure "no" of this grasp: its certificate's separating plane
+        ``yᵀ w = 0`` (every primitive wrench lies on one side) and the
+        unresisted direction are drawn in red.
 
     Returns
     -------
@@ -271,4 +280,12 @@ def plot_wrench_space(
     ax.set_zlabel("$m_z / b$ [N]")
     where = "inside" if info.origin_inside else "NOT inside"
     ax.set_title(f"origin {where} the hull (margin {info.margin:.3g})")
-    return WrenchSpacePlot(ax, W, owner, points, ray_artist, info, hull_artist, origin)
+    plane = None
+    cert = getattr(result, "certificate", None)
+    if getattr(cert, "separating_twist", None) is not None and not result.is_closure:
+        from drakegrasp.visualization.certificate_plots import plot_separating_plane
+
+        plane = plot_separating_plane(ax, grasp, cert, extent)
+    return WrenchSpacePlot(
+        ax, W, owner, points, ray_artist, info, hull_artist, origin, plane
+    )

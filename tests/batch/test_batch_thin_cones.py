@@ -29,8 +29,8 @@ def test_verdicts_and_certificates_match_the_single_path(mu, planar):
         )
         single = dg.force_closure(grasp)
         assert batch.is_closure[k] == single.is_closure
-        assert batch.normal_certificate[k] == (single.certificate == "normal forces")
-        if single.certificate == "normal forces":
+        assert batch.normal_certificate[k] == (single.decided_by == "normal forces")
+        if single.decided_by == "normal forces":
             certified += 1
             assert batch.margin[k] == pytest.approx(single.margin, rel=1e-5)
     assert 2 <= certified < len(P)  # both outcomes occur
@@ -75,7 +75,7 @@ def test_few_contacts_with_rank_deficient_normals(mu):
         ]
         assert np.array_equal(batch.is_closure, [s.is_closure for s in single])
         assert batch.normal_certificate.sum() == sum(
-            s.certificate == "normal forces" for s in single
+            s.decided_by == "normal forces" for s in single
         )
     assert batch.is_closure.all() and batch.normal_certificate.all()
 

@@ -148,18 +148,18 @@ def test_thin_cones_keep_the_frictionless_verdict(mu):
         grasp = base.with_friction(mu, model="hard_finger")
         for solve in (dg.force_closure, dg.force_closure_exact):
             r = solve(grasp)
-            assert r.is_closure and r.certificate == "normal forces"
+            assert r.is_closure and r.decided_by == "normal forces"
             assert r.d_star < 1e-6 < r.margin
             f = np.concatenate(r.contact_forces)
             assert np.allclose(dg.grasp_matrix(grasp) @ f, 0, atol=1e-9)
     # Three equator fingers: normal forces (1, 1, 1) balance and G has rank 6
     # for any μ > 0, so closure holds however thin the cones.
     r = dg.force_closure(ex.equator_fingers(mu))
-    assert r.is_closure and r.certificate == "normal forces"
+    assert r.is_closure and r.decided_by == "normal forces"
     # Without such a certificate, a thin cone is an honest "no": the offset
     # fingers' normal forces cannot balance the moment between them.
     r = dg.force_closure(ex.planar_two_finger_square(mu))
-    assert not r.is_closure and r.certificate == "d*"
+    assert not r.is_closure and r.decided_by == "d*"
 
 
 @pytest.mark.parametrize("eps", [1e-8, 3e-8, 1e-7, 1e-6, 1e-3, 0.2])

@@ -29,7 +29,7 @@ def test_analyze_default_scene(capsys):
         "form closure: no",
         "force closure: no",
         "LP3",
-        "antipodal: YES",
+        "antipodal (geometric test): YES",
         "rank 5/6",
     ):
         assert text in out
