@@ -54,7 +54,7 @@ class BatchCertificates:
         Dimension of the left null space the witness was taken from (0 for a
         full-rank "no").
     contact_rates : (K, N) float
-        :attr:`~drakegrasp.certificates.Certificate.contact_rates` per grasp.
+        ``contact_rates`` of :class:`~drakegrasp.certificates.Certificate`, per grasp.
     certificates : tuple of Certificate or None
         The full witness of each grasp (None for a "yes").
     """
