@@ -2,6 +2,10 @@
 
 import sys
 
-from drakegrasp.cli import main
+try:
+    from drakegrasp.cli import main
+except KeyboardInterrupt:  # Ctrl-C while Drake is still importing
+    print("drakegrasp: interrupted", file=sys.stderr)
+    sys.exit(130)
 
 sys.exit(main())

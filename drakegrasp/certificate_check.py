@@ -104,7 +104,8 @@ def _check_wrench(cert: Certificate, grasp: Grasp):
             )
             worst = float(sigma.max()) / (scale * size)
             violation = max(violation, max(0.0, worst))
-            slack = min(slack, -worst)
+            # both signs are witnesses: G_iᵀ y = 0, the slack is 0 by definition
+            slack = 0.0 if cert.two_sided else min(slack, -worst)
     return (
         violation,
         slack,

@@ -3,7 +3,7 @@ r"""Certificates: checkable witnesses of every closure verdict (numpy only).
 A verdict says "yes" or "no"; its certificate says why, in a form that anyone
 can re-verify with a few matrix products and without a solver.
 
-Frames, orders and units follow ``docs/conventions.md``: every twist and wrench is
+Frames, orders and units follow CONVENTIONS.md: every twist and wrench is
 expressed in the grasp frame, about the grasp's reference point ``p``.
 
 * A twist ``v = [v_p; ω]`` (``[vx, vy, ω]`` planar) is the object's velocity:
@@ -23,7 +23,7 @@ The four kinds:
     ``G_n`` is rank deficient, ``v`` lies in ``N(G_nᵀ)`` and both ``±v``
     escape (``two_sided``).
 ``"unresisted wrench"`` (force closure "no")
-    ``y ≠ 0`` (``separating_twist``, the ``w`` of ``docs/conventions.md``) with
+    ``y ≠ 0`` (``separating_twist``, the ``w`` of CONVENTIONS.md) with
     ``yᵀ G f <= 0`` for every ``f`` in the contact cones (polyhedral or
     exact): every wrench the fingers can apply lies in a closed half-space, a
     hyperplane through the origin separates them from ``direction``
@@ -69,14 +69,14 @@ __all__ = [
     "support_of",
 ]
 
-#: ``Certificate.kind`` of a form-closure "no": a twist no contact resists.
 ESCAPE_TWIST = "escape twist"
-#: ``Certificate.kind`` of a force-closure "no": a wrench the grasp cannot resist.
+"""Kind of the witness of a form-closure "no"."""
 UNRESISTED_WRENCH = "unresisted wrench"
-#: ``Certificate.kind`` of an LP3 failure: a squeeze no joint torque can change.
+"""Kind of the witness of a force-closure "no"."""
 UNCONTROLLABLE = "uncontrollable internal force"
-#: ``Certificate.kind`` of a "yes": an internal force strictly inside the cones.
+"""Kind of the witness of an LP3 failure."""
 BALANCE = "balancing internal force"
+"""Kind of the witness of a "yes"."""
 _KINDS = (ESCAPE_TWIST, UNRESISTED_WRENCH, UNCONTROLLABLE, BALANCE)
 _CONES = ("normals", "polyhedral", "exact")
 
@@ -126,7 +126,7 @@ class CertificateCheck:
         verdict = "holds" if self.holds else "FAILS"
         return (
             f"witness {verdict}: violation {self.violation:.2g}, "
-            f"slack {self.slack:.3g} (tol {self.tol:g}); {self.detail}"
+            f"slack {self.slack + 0.0:.3g} (tol {self.tol:g}); {self.detail}"
         )
 
 

@@ -707,12 +707,10 @@ def _force_closure_result(
             margin, contact_forces = normal
     cones = "exact" if formulation == "exact" else "polyhedral"
     if frictional:
+        # LP1's forces (f_t = 0) on the normal-force route: inside every cone
+        # with μ > 0, and G (not G_n) is the matrix of full rank.
         certificate = balance_certificate(
-            grasp,
-            contact_forces,
-            cones="normals" if decided_by == "normal forces" else cones,
-            rank=rank,
-            num_generators=num_generators,
+            grasp, contact_forces, cones=cones, rank=rank, num_generators=num_generators
         )
     else:
         certificate = unresisted_wrench(

@@ -82,6 +82,11 @@ def contact_frames(normals: np.ndarray) -> np.ndarray:
         raise InvalidContactError(
             f"normals must have 2 or 3 components, got shape {n.shape}"
         )
+    if not np.all(np.isfinite(n)) or not np.all(np.any(n != 0.0, axis=-1)):
+        raise InvalidContactError(
+            "normals must be finite, non-zero unit vectors (see contact_frame, "
+            "which normalises one)"
+        )
     if n.shape[-1] == 2:
         t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
         return np.stack([n, t], axis=-1)

@@ -316,7 +316,7 @@ def grasp_matrix(grasp: Grasp) -> np.ndarray:
     >>> dg.grasp_matrix(grasp).shape
     (6, 9)
     """
-    return grasp._grasp_matrix.copy()
+    return _require_grasp(grasp)._grasp_matrix.copy()
 
 
 def normal_grasp_matrix(grasp: Grasp) -> np.ndarray:
@@ -332,7 +332,7 @@ def normal_grasp_matrix(grasp: Grasp) -> np.ndarray:
         Column ``i`` is the wrench ``[n_i; (c_i - p) × n_i]`` of a unit normal
         push at contact ``i``.
     """
-    return grasp._grasp_matrix[:, grasp.normal_indices()]
+    return _require_grasp(grasp)._grasp_matrix[:, grasp.normal_indices()]
 
 
 def normalised_grasp_matrix(grasp: Grasp) -> np.ndarray:
@@ -366,7 +366,15 @@ def normalised_grasp_matrix(grasp: Grasp) -> np.ndarray:
     moments about a point ``10⁶ b`` away, or in nanometres, no longer swamp or
     vanish beside the forces.
     """
-    return grasp._normalised_grasp_matrix.copy()
+    return _require_grasp(grasp)._normalised_grasp_matrix.copy()
+
+
+def _require_grasp(grasp) -> Grasp:
+    if not isinstance(grasp, Grasp):
+        raise InvalidGraspError(
+            f"grasp must be a drakegrasp.Grasp, got {type(grasp).__name__}"
+        )
+    return grasp
 
 
 def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
@@ -390,6 +398,7 @@ def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
         On a wrong shape (naming the expected one), a non-real dtype, or
         non-finite or out-of-bound entries.
     """
+    _require_grasp(grasp)
     J = real_array("hand_jacobian", hand_jacobian, error=InvalidGraspError)
     M = grasp.num_components
     if J.ndim != 2 or J.shape[0] != M or J.shape[1] < 1:

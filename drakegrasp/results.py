@@ -160,8 +160,11 @@ class ClosureResult:
         ``"form closure"``, ``"force closure"`` or ``"force closure (exact cones)"``.
     is_closure : bool
         The verdict: ``rank == required_rank`` and either ``d* > tol`` or the
-        normal-force certificate (see ``certificate``); with a hand
-        Jacobian, LP3 must pass too.
+        normal-force route (see ``decided_by``); with a hand Jacobian, LP3
+        must pass too.  It follows LP3 (uncontrollable squeezing), not the
+        stricter null-space condition ``dim N(G) ∩ N(Jᵀ) = 0``, which is
+        reported beside it (see :class:`InternalForceResult`: a hand driving
+        one finger of the equator grasp has dimension 2 and passes LP3).
     d_star : float
         Optimal ``d`` of LP1/LP2/SOCP: how far the best internal force lies inside
         the cones (the distance of each contact force to its cone's facets), with

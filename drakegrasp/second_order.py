@@ -173,6 +173,7 @@ def build_second_order_program(
     *,
     support: Sequence[int] | None = None,
     rank_tol: float = DEFAULT_RANK_TOL,
+    hessians: np.ndarray | None = None,
 ) -> tuple[MathematicalProgram, SecondOrderVariables]:
     """Build the SDP of second-order form closure.
 
@@ -186,6 +187,9 @@ def build_second_order_program(
         :func:`equilibrium_support` (which solves one LP).
     rank_tol : float, optional
         Relative singular-value threshold for ``W`` and ``G_n λ = 0``.
+    hessians : (N, 3 or 6, 3 or 6) float, optional
+        :func:`~drakegrasp.curvature.contact_hessians` of ``grasp`` and
+        ``curvatures``, when already computed.
 
     Returns
     -------
@@ -199,7 +203,7 @@ def build_second_order_program(
     InvalidGraspError
         When the support is empty (no equilibrium) or ``W = {0}``.
     """
-    H = contact_hessians(grasp, curvatures)
+    H = contact_hessians(grasp, curvatures) if hessians is None else hessians
     if support is None:
         support = equilibrium_support(grasp, rank_tol=rank_tol)
     S = np.array(sorted(set(int(i) for i in support)), dtype=int)
@@ -246,7 +250,7 @@ class SecondOrderResult:
     multipliers : (N,) float
         ``λ*`` (``Σ λ = 1``; zero outside ``support``).
     dim_w : int
-        ``dim W`` (0 for first-order closure).
+        ``dim W`` (0 for first-order closure, -1 when not decided).
     support : tuple of int
         Contacts that carry force in some equilibrium.
     escape_twist : (3,) or (6,) float or None
@@ -399,7 +403,7 @@ def second_order_form_closure(
     if not support:
         return _no_equilibrium(grasp, tol)
     prog, var = build_second_order_program(
-        grasp, curvatures, support=support, rank_tol=rank_tol
+        grasp, curvatures, support=support, rank_tol=rank_tol, hessians=H
     )
     result = _solve(prog, (ClarabelSolver(), ScsSolver()))
     status = result.get_solution_result()
@@ -503,27 +507,44 @@ def _find_escape(grasp, var: SecondOrderVariables, H, lam, dual, tol):
             found = _escape_acceleration(Gt, np.abs(g) <= 1e-9, H, T, nu, b)
             if found is not None and (best is None or found[1] > best[2]):
                 best = (T @ nu, T @ found[0], found[1])
+            if best is not None and best[2] >= -tol:
+                return best  # an escape that holds: no need to try the others
     if best is None or best[2] < -tol:
         return None
     return best
 
 
 def _escape_acceleration(Gt, closed, H, T, nu, b):
-    """LP: ``max s`` s.t. ``G̃_iᵀ ã + b νᵀ H̃_i ν >= s`` on the closed contacts."""
+    """LP: ``max s - ε |ã|₁`` s.t. ``G̃_iᵀ ã + b νᵀ H̃_i ν >= s`` on closed contacts.
+
+    The small ``ε`` picks the least acceleration among the near-optimal ones
+    (an LP vertex at the box's corner would make third-order terms large).
+    Returns ``ã`` and ``min_i (G̃_iᵀ ã + b νᵀ H̃_i ν)``.
+    """
     idx = np.flatnonzero(closed)
     h = np.array([b * nu @ T.T @ H[i] @ T @ nu for i in idx])
+    n = Gt.shape[0]
     prog = MathematicalProgram()
-    a = prog.NewContinuousVariables(Gt.shape[0], "a")
+    a = prog.NewContinuousVariables(n, "a")
+    z = prog.NewContinuousVariables(n, "abs_a")
     s = prog.NewContinuousVariables(1, "s")[0]
     prog.AddBoundingBoxConstraint(-_ESCAPE_BOX, _ESCAPE_BOX, a)
     prog.AddBoundingBoxConstraint(-np.inf, 1.0, s)
+    eye = np.eye(n)
+    prog.AddLinearConstraint(
+        np.block([[eye, eye], [-eye, eye]]),
+        np.zeros(2 * n),
+        np.full(2 * n, np.inf),
+        np.append(a, z),
+    )
     A = np.hstack([Gt[:, idx].T, -np.ones((len(idx), 1))])
     prog.AddLinearConstraint(A, -h, np.full(len(idx), np.inf), np.append(a, s))
-    prog.AddLinearCost(-s)
+    prog.AddLinearCost(np.append(np.full(n, 1e-3), -1.0), 0.0, np.append(z, s))
     result = _solve(prog, (ClpSolver(), ClarabelSolver()))
     if result.get_solution_result() != SolutionResult.kSolutionFound:
         return None
-    return np.asarray(result.GetSolution(a)), float(result.GetSolution(s))
+    acc = np.asarray(result.GetSolution(a))
+    return acc, float(np.min(Gt[:, idx].T @ acc + h)) if len(idx) else 1.0
 
 
 def _no_equilibrium(grasp: Grasp, tol: float) -> SecondOrderResult:

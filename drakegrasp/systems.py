@@ -36,7 +36,7 @@ one at initialization); outputs are state, held between samples.  As with
 any Drake discrete update, a logger publishing at a sample time ``t_k`` sees
 the value held *before* the update at ``t_k``: the verdict logged at
 ``t_{k+1}`` is the analysis of the plant state logged at ``t_k``
-(``time`` and ``state`` of :class:`GraspSample` say exactly which).
+(``GraspSample.time`` and ``GraspSample.state`` say exactly which).
 A discrete plant's contact results are those of its last step; they exist in
 the simulator's context, not in a fresh context where only ``q`` and ``v``
 were set.
@@ -162,6 +162,21 @@ class GraspSample:
         """Force closure (with LP3) in this sample."""
         return self.report is not None and self.report.is_force_closure
 
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (the report's own ``to_dict`` nested)."""
+        return {
+            "time": self.time,
+            "status": self.status,
+            "message": self.message,
+            "verdicts": dict(
+                zip(VERDICT_NAMES, (float(x) for x in self.verdicts), strict=True)
+            ),
+            "epsilon": self.epsilon,
+            "state": self.state.tolist(),
+            "seconds": self.seconds,
+            "report": None if self.report is None else self.report.to_dict(),
+        }
+
     def __str__(self) -> str:
         v = dict(zip(VERDICT_NAMES, self.verdicts, strict=True))
         if self.report is None:
@@ -203,8 +218,10 @@ class GraspMonitor(LeafSystem):
         The finalized plant of the simulation (registered with a SceneGraph).
     object_body, hand, mu, contact_model, torsional_friction,
     distance_tolerance, plane, characteristic_length, num_generators, tol,
-    allow_penetration, patches
-        As in :func:`drakegrasp.analyze_grasp`.
+    allow_penetration, patches, check_pose
+        As in :func:`drakegrasp.analyze_grasp`.  A pose that the check refuses
+        (penetration deeper than ``distance_tolerance`` by any hand body, a
+        joint off its limits) gives an ``"invalid"`` sample, not an exception.
     contacts : {"geometry", "contact_results"}, optional
         Signed distances (default), or the plant's contact results (then the
         ``contact_results`` input port exists and must be connected).
@@ -250,6 +267,7 @@ class GraspMonitor(LeafSystem):
         tol: float = DEFAULT_TOL,
         allow_penetration: bool = False,
         patches: str = "vertices",
+        check_pose: bool = True,
         contacts: str = "geometry",
         period: float = 0.05,
         offset: float = 0.0,
@@ -293,6 +311,7 @@ class GraspMonitor(LeafSystem):
             "tol": tol,
             "allow_penetration": allow_penetration,
             "patches": patches,
+            "check_pose": bool(check_pose),
         }
         self._plant_context = plant.CreateDefaultContext()
         nx = plant.num_multibody_states()

@@ -24,8 +24,10 @@ normals                     real, finite, not all zero; normalised without
                             fuzz suite checks it against a well-scaled copy);
                             outside it the cones are numerically a ray or a
                             half-space and the answer would not be trustworthy.
-``tol``                     real in [:data:`TOL_MIN`, 1] = [1e-10, 1]: ``d*`` is
-                            at most 1 and the solvers resolve it to about 1e-10.
+``tol``                     real in [:data:`TOL_MIN`, :data:`TOL_MAX`] =
+                            [1e-10, 0.5]: ``d*`` is at most 1 (LP1's reaches 1
+                            up to round-off, so a threshold near 1 would decide
+                            on noise) and the solvers resolve it to about 1e-10.
 ``rank_tol``                real in [:data:`RANK_TOL_MIN`, :data:`RANK_TOL_MAX`]
                             = [1e-14, 1e-3].
 ``num_generators``          integer in [3, :data:`MAX_NUM_GENERATORS`] = [3, 256]
@@ -46,6 +48,7 @@ from __future__ import annotations
 import math
 import numbers
 import operator
+import sys
 
 import numpy as np
 
@@ -65,6 +68,7 @@ __all__ = [
     "POSITION_BOUND",
     "RANK_TOL_MAX",
     "RANK_TOL_MIN",
+    "TOL_MAX",
     "TOL_MIN",
     "check_angle_tol",
     "check_coefficient",
@@ -94,6 +98,9 @@ COEFFICIENT_MAX = 1e12
 TOL_MIN = 1e-10
 """Smallest threshold ``tol`` on ``d*`` (the solvers resolve ``d*`` to ~1e-10)."""
 
+TOL_MAX = 0.5
+"""Largest threshold ``tol`` on ``d*`` (``d*`` never exceeds 1)."""
+
 RANK_TOL_MIN = 1e-14
 """Smallest relative singular-value threshold ``rank_tol``."""
 
@@ -114,7 +121,7 @@ JACOBIAN_BOUND = 1e100
 
 
 def _describe(value) -> str:
-    text = repr(value)
+    text = " ".join(repr(value).split())
     return text if len(text) <= 120 else text[:117] + "..."
 
 
@@ -125,7 +132,8 @@ def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
     ----------
     name : str
         Name of the input, for the message.
-    value : int, float, numpy real scalar or 0-d real array
+    value : int or float
+        Also a numpy real scalar or a 0-d real array.
     error : type, optional
         The :class:`~drakegrasp.GraspError` subclass to raise.
 
@@ -308,11 +316,12 @@ def check_coefficient_array(
 
 
 def check_tol(value, name: str = "tol") -> float:
-    """Threshold on ``d*``: real in ``[TOL_MIN, 1]``."""
+    """Threshold on ``d*``: real in ``[TOL_MIN, TOL_MAX]``."""
     x = real_scalar(name, value)
-    if not (TOL_MIN <= x <= 1.0):
+    if not (TOL_MIN <= x <= TOL_MAX):
         raise InvalidOptionError(
-            f"{name} must be finite and > 0, a real number in [{TOL_MIN:g}, 1] "
+            f"{name} must be finite and > 0, a real number in [{TOL_MIN:g}, "
+            f"{TOL_MAX:g}] "
             f"(d* is at most 1 and resolved to about 1e-10), got {_describe(value)}"
         )
     return x
@@ -373,9 +382,10 @@ def check_length(name: str, value, *, error: type = InvalidGraspError) -> float:
 
 def check_grasp(value, name: str = "grasp"):
     """``value`` if it is a :class:`~drakegrasp.Grasp`, else InvalidGraspError."""
-    from drakegrasp.grasp import Grasp  # grasp imports this module
-
-    if not isinstance(value, Grasp):
+    # No import of drakegrasp.grasp (it imports this module: a cycle): a Grasp
+    # can only exist once that module is loaded, so look it up there.
+    grasp_module = sys.modules.get("drakegrasp.grasp")
+    if grasp_module is None or not isinstance(value, grasp_module.Grasp):
         raise InvalidGraspError(
             f"{name} must be a drakegrasp.Grasp, got {_describe(value)} "
             f"({type(value).__name__})"

@@ -28,6 +28,8 @@ choice of reference point.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from pydrake.solvers import (
     ClarabelSolver,
@@ -49,7 +51,9 @@ from drakegrasp.friction_cone import ConeLayout
 from drakegrasp.grasp import Grasp, grasp_matrix, normalised_grasp_matrix
 
 __all__ = [
+    "GraspFrame",
     "balance_certificate",
+    "null_space_certificate",
     "escape_twist",
     "normalising_transform",
     "uncontrollable_force",
@@ -150,6 +154,82 @@ def _solve(prog, conic: bool):
     return None
 
 
+@dataclass(frozen=True)
+class GraspFrame:
+    """What a null-space witness needs of a grasp (a batch row has no Grasp).
+
+    Attributes
+    ----------
+    positions : (N, d) float
+        Contact points, metres.
+    reference_point : (d,) float
+    characteristic_length : float
+    """
+
+    positions: np.ndarray
+    reference_point: np.ndarray
+    characteristic_length: float
+
+    @property
+    def dim(self) -> int:
+        """2 (planar) or 3."""
+        return int(self.positions.shape[1])
+
+    @property
+    def wrench_dim(self) -> int:
+        """3 (planar) or 6."""
+        return 3 if self.dim == 2 else 6
+
+
+def null_space_certificate(
+    grasp: Grasp | GraspFrame,
+    A: np.ndarray,
+    rank: int,
+    *,
+    G_n: np.ndarray | None = None,
+    cones: str = "normals",
+    num_generators: int = 8,
+) -> Certificate:
+    """The witness of a rank-deficient "no": a basis of ``N(Aᵀ)``, both signs.
+
+    Parameters
+    ----------
+    grasp : Grasp or GraspFrame
+    A : (w, m) float
+        The normalised balance matrix (``Ḡ_n`` or ``Ḡ`` over the allowed
+        components); only its column span matters.
+    rank : int
+        Its rank, as decided (``< w``).
+    G_n : (w, N) float, optional
+        The physical ``G_n``: given for form closure, whose witness is an escape
+        twist with ``contact_rates = G_nᵀ v``; omitted for force closure.
+    cones : str, optional
+        The force-closure cones the witness refers to.
+    num_generators : int, optional
+
+    Returns
+    -------
+    Certificate
+    """
+    twists, wrenches = _physical_basis(grasp, A, rank, wrench=G_n is None)
+    if G_n is not None:
+        v = twists[:, 0]
+        return Certificate(
+            ESCAPE_TWIST, "normals", v, twists, contact_rates=G_n.T @ v, **_where(grasp)
+        )
+    return Certificate(
+        UNRESISTED_WRENCH,
+        cones,
+        wrenches[:, 0],
+        wrenches,
+        separating_twist=twists[:, 0],
+        separating_basis=twists,
+        contact_rates=np.zeros(len(grasp.positions)),
+        num_generators=num_generators,
+        **_where(grasp),
+    )
+
+
 def escape_twist(grasp: Grasp, rank: int) -> Certificate | None:
     """Escape twist of a grasp that is not in first-order form closure.
 
@@ -168,11 +248,7 @@ def escape_twist(grasp: Grasp, rank: int) -> Certificate | None:
     A = normalised_grasp_matrix(grasp)[:, grasp.normal_indices()]
     G_n = grasp_matrix(grasp)[:, grasp.normal_indices()]
     if rank < grasp.wrench_dim:
-        basis, _ = _physical_basis(grasp, A, rank, wrench=False)
-        v = basis[:, 0]
-        return Certificate(
-            ESCAPE_TWIST, "normals", v, basis, contact_rates=G_n.T @ v, **_where(grasp)
-        )
+        return null_space_certificate(grasp, A, rank, G_n=G_n)
     k = grasp.wrench_dim
     prog = MathematicalProgram()
     x = prog.NewContinuousVariables(k + 1, "u")
@@ -255,17 +331,8 @@ def unresisted_wrench(
     layout = ConeLayout.of(grasp, num_generators)
     A = normalised_grasp_matrix(grasp)[:, layout.columns]
     if rank < grasp.wrench_dim:
-        twists, wrenches = _physical_basis(grasp, A, rank, wrench=True)
-        return Certificate(
-            UNRESISTED_WRENCH,
-            cones,
-            wrenches[:, 0],
-            wrenches,
-            separating_twist=twists[:, 0],
-            separating_basis=twists,
-            contact_rates=np.zeros(grasp.num_contacts),
-            num_generators=num_generators,
-            **_where(grasp),
+        return null_space_certificate(
+            grasp, A, rank, cones=cones, num_generators=num_generators
         )
     k = grasp.wrench_dim
     prog = MathematicalProgram()

@@ -24,6 +24,19 @@ def local_drake_models() -> Path | None:
     return None
 
 
+def pytest_configure(config):
+    """Point ``package://drake_models`` at the local copy for the whole run.
+
+    Code under test that calls ``use_local_drake_models(parser)`` (the README's
+    real-hand block, tutorial 06, notebook kernels, which inherit the
+    environment) then reads the local copy instead of downloading; an explicit
+    ``$DRAKEGRASP_DRAKE_MODELS`` is left as it is.
+    """
+    path = local_drake_models()
+    if path is not None:
+        os.environ.setdefault(DRAKE_MODELS_ENV, str(path))
+
+
 @pytest.fixture(scope="session")
 def drake_models_dir() -> Path:
     """Folder of Drake's ``drake_models`` package; skips the test when absent."""

@@ -20,13 +20,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakegrasp.batch.construction import (
+    batched_characteristic_lengths,
+    batched_grasp_matrix,
+    batched_normal_grasp_matrix,
+    contact_kinds,
+)
 from drakegrasp.certificates import Certificate, CertificateCheck
 from drakegrasp.closure import DEFAULT_RANK_TOL, _balance_matrix, _balance_rank
 from drakegrasp.contact import Contact, ContactModel
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.friction_cone import ConeLayout
 from drakegrasp.grasp import Grasp
-from drakegrasp.witness import escape_twist, unresisted_wrench
+from drakegrasp.witness import (
+    GraspFrame,
+    escape_twist,
+    null_space_certificate,
+    unresisted_wrench,
+)
 
 __all__ = ["BatchCertificates", "batch_certificates", "grasp_at"]
 
@@ -54,7 +65,7 @@ class BatchCertificates:
         Dimension of the left null space the witness was taken from (0 for a
         full-rank "no").
     contact_rates : (K, N) float
-        ``contact_rates`` of :class:`~drakegrasp.certificates.Certificate`, per grasp.
+        ``Certificate.contact_rates`` per grasp.
     certificates : tuple of Certificate or None
         The full witness of each grasp (None for a "yes").
     """
@@ -90,6 +101,90 @@ def _per_contact(value, K: int, N: int, name: str) -> np.ndarray:
             f"{name} must be a scalar or of shape (K,), (K, 1), (1, N) or (K, N) "
             f"= ({K}, {N}); got shape {a.shape}"
         ) from None
+
+
+def _null_space_witnesses(
+    positions, normals, result, rows, form, num_generators, **options
+) -> dict[int, Certificate]:
+    """Vectorised witnesses of the rank-deficient "no"s (no Grasp, no solver).
+
+    The normalised balance matrices of the rows are built at once (moments
+    about each grasp's contacts' centroid over their spread, as
+    :func:`~drakegrasp.grasp.normalised_grasp_matrix`), and each row's left
+    null space at the batch's rank is the witness.  A row whose trailing
+    singular values are not numerically zero (the ranks disagree) is left to
+    the per-grasp path.
+    """
+    if rows.size == 0:
+        return {}
+    P = np.asarray(positions[rows], dtype=float)
+    n = np.asarray(normals[rows], dtype=float)
+    n = n / np.linalg.norm(n, axis=2, keepdims=True)
+    K_all, N, d = len(positions), P.shape[1], P.shape[2]
+    p = _reference(options["reference_points"], K_all, d)[rows]
+    b = _lengths(options["characteristic_lengths"], P, p, rows)
+    centroid = P.mean(axis=1)
+    spread = np.max(np.linalg.norm(P - centroid[:, None], axis=2), axis=1)
+    spread = np.where(np.isfinite(spread) & (spread > 0.0), spread, 1.0)
+    if form:
+        A = batched_normal_grasp_matrix(P, n, centroid)
+        G_n = batched_normal_grasp_matrix(P, n, p)
+        layouts = np.zeros((len(rows), 1), dtype=int)
+    else:
+        mus = _per_contact(options["mu"], K_all, N, "mu")[rows]
+        nus = _per_contact(options["torsional_friction"], K_all, N, "nu")[rows]
+        model = ContactModel.parse(options["model"]).value
+        layouts = contact_kinds(mus, nus, model=model, dim=d)
+    out: dict[int, Certificate] = {}
+    for layout in np.unique(layouts, axis=0):
+        group = np.flatnonzero((layouts == layout).all(axis=1))
+        if not form:
+            Ag = batched_grasp_matrix(
+                P[group], n[group], centroid[group], tuple(layout)
+            )[0]
+        else:
+            Ag = A[group]
+        Ag = Ag.copy()
+        Ag[:, d:, :] /= spread[group, None, None]
+        norms = np.linalg.norm(Ag, axis=1, keepdims=True)
+        sv = np.linalg.svd(Ag / np.where(norms > 0, norms, 1.0), compute_uv=False)
+        for j, row in zip(group, rows[group], strict=True):
+            rank = int(result.rank[row])
+            tail = sv[j, rank:] if rank < sv.shape[1] else np.zeros(0)
+            if tail.size and tail.max() > DEFAULT_RANK_TOL * sv[j, 0]:
+                continue  # the batch's rank is not this matrix's: per grasp
+            frame = GraspFrame(P[j], p[j], float(b[j]))
+            out[int(row)] = null_space_certificate(
+                frame,
+                Ag[j],
+                rank,
+                G_n=G_n[j] if form else None,
+                cones="polyhedral",
+                num_generators=num_generators,
+            )
+    return out
+
+
+def _reference(value, K: int, d: int) -> np.ndarray:
+    if value is None:
+        return np.zeros((K, d))
+    r = np.asarray(value, dtype=float)
+    return np.broadcast_to(r, (K, d)) if r.shape == (d,) else r
+
+
+def _lengths(value, P, p, rows) -> np.ndarray:
+    if value is None:
+        return batched_characteristic_lengths(P, p)
+    c = np.asarray(value, dtype=float)
+    return np.full(len(rows), float(c)) if c.shape == () else c[rows]
+
+
+def _witness(grasp: Grasp, rank: int, form: bool, num_generators: int):
+    if form:
+        return escape_twist(grasp, rank)
+    return unresisted_wrench(
+        grasp, rank, cones="polyhedral", num_generators=num_generators
+    )
 
 
 def _core_rank(grasp: Grasp, form: bool, num_generators: int) -> int:
@@ -180,7 +275,22 @@ def batch_certificates(
     null_dim = np.zeros(K, dtype=int)
     certs: list[Certificate | None] = [None] * K
     form = result.kind == "form"
-    for k in np.flatnonzero(~np.asarray(result.is_closure)):
+    options = {
+        "mu": mu,
+        "model": model,
+        "torsional_friction": torsional_friction,
+        "reference_points": reference_points,
+        "characteristic_lengths": characteristic_lengths,
+    }
+    fails = np.flatnonzero(~np.asarray(result.is_closure))
+    deficient = fails[np.asarray(result.rank)[fails] < w]
+    for k, cert in _null_space_witnesses(
+        positions, normals, result, deficient, form, num_generators, **options
+    ).items():
+        certs[k] = cert
+    for k in fails:
+        if certs[k] is not None:
+            continue
         g = grasp_at(
             positions,
             normals,
@@ -191,16 +301,17 @@ def batch_certificates(
             reference_points=reference_points,
             characteristic_lengths=characteristic_lengths,
         )
-        # the witness's rank is the core's, on the normalised G (the batch's
-        # own rank decided the verdict; they agree in the agreement tests)
-        rank = _core_rank(g, form, num_generators)
-        if form:
-            cert = escape_twist(g, rank)
-        else:
-            cert = unresisted_wrench(
-                g, rank, cones="polyhedral", num_generators=num_generators
+        # The batch's rank decided the verdict; it agrees with the core's on
+        # the normalised G in the agreement tests.  A witness that does not
+        # check out at that rank is recomputed at the core's rank.
+        cert = _witness(g, int(result.rank[k]), form, num_generators)
+        if cert is None or not cert.check(g).holds:
+            cert = _witness(
+                g, _core_rank(g, form, num_generators), form, num_generators
             )
         certs[k] = cert
+    for k in fails:
+        cert = certs[k]
         if cert is None:
             continue
         direction[k] = cert.direction

@@ -342,7 +342,13 @@ def _characteristic_lengths(value, K: int):
 def _check_metrics(metrics: Sequence[str]) -> tuple[str, ...]:
     if isinstance(metrics, str):
         metrics = (metrics,)
-    names = tuple(metrics)
+    try:
+        names = tuple(metrics)
+    except TypeError:
+        raise InvalidOptionError(
+            f"metrics must be a sequence of names from {', '.join(METRICS)}, got "
+            f"{metrics!r}"
+        ) from None
     for name in names:
         if name not in METRICS:
             raise InvalidOptionError(

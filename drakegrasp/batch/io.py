@@ -24,7 +24,7 @@ the name given (``OUT.NPZ`` stays ``OUT.NPZ``).
 No data is lost:
 
 * the output is written to a temporary file in the same directory and renamed
-  into place (:func:`os.replace`, atomic on POSIX), so an interrupted or failed
+  into place (``os.replace``, atomic on POSIX), so an interrupted or failed
   run leaves any earlier file intact and no partial file behind;
 * an output that is the input (the same path, or the same file through a
   symbolic or hard link) is refused;

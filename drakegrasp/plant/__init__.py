@@ -2,7 +2,10 @@
 
 Everything here takes ``(plant, plant_context, ...)`` as Drake users expect and
 builds on the numpy core (:mod:`drakegrasp.contact`, :mod:`drakegrasp.grasp`,
-:mod:`drakegrasp.closure`); the core never imports this package.
+:mod:`drakegrasp.closure`); the core never imports this package.  The context
+may be the plant's or the root context of the diagram that holds the plant, and
+``object_body`` may be positional (``find_contacts(plant, context, body)``); the
+options after it are keyword-only (:mod:`drakegrasp.plant.validation`).
 """
 
 from drakegrasp.plant.analysis import (

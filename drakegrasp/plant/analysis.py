@@ -49,7 +49,11 @@ from drakegrasp.plant.jacobians import (
 )
 from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.pose import check_pose as _check_pose
-from drakegrasp.plant.validation import hand_model_instances, plant_context_of
+from drakegrasp.plant.validation import (
+    check_distance_tolerance,
+    hand_model_instances,
+    plant_context_of,
+)
 from drakegrasp.results import AntipodalResult, ClosureResult, _jsonable
 from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
 
@@ -191,7 +195,7 @@ def grasp_from_plant(
         The grasped object; its body frame O is the grasp frame and its origin
         the reference point.  Positional or keyword.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
-        See :func:`drakegrasp.plant.hand_bodies`.
+        See :func:`~drakegrasp.plant.validation.hand_bodies`.
     mu : float
         Friction coefficient of every contact.
     contact_model : ContactModel or str, optional
@@ -321,12 +325,7 @@ def _pose_of(
     query_object=None,
 ) -> PoseCheck:
     """Check the pose; raise unless the caller opted out."""
-    tol = float(distance_tolerance)
-    if not np.isfinite(tol) or tol <= 0:
-        raise InvalidOptionError(
-            "distance_tolerance must be finite and > 0 (metres), got "
-            f"{distance_tolerance!r}"
-        )
+    tol = check_distance_tolerance(distance_tolerance)
     found = _check_pose(
         plant,
         plant_context,
@@ -442,7 +441,11 @@ class GraspReport:
             f"J: {self.J.shape[0]} x {self.J.shape[1]} (hand velocities "
             f"{self.data.hand_velocity_indices.tolist()})"
         )
-        lines.append("  (points below are in frame O, metres)")
+        if g.planar and self.data.plane is not None:
+            axes = ", ".join("xyz"[i] for i in PLANES[self.data.plane])
+            lines.append(f"  (points below are ({axes}) of frame O, metres)")
+        else:
+            lines.append("  (points below are in frame O, metres)")
         for result in (self.form_closure, self.force_closure, self.force_closure_exact):
             lines += ["  " + x for x in result.report_lines(internal_forces=False)]
             if result.certificate is not None:

@@ -126,7 +126,8 @@ def contacts_from_results(
     query_object : pydrake.geometry.QueryObject
         The scene graph's query object (its inspector names the geometries).
     object_body : RigidBody, BodyIndex or str
-    hand : see :func:`drakegrasp.plant.hand_bodies`
+    hand : ModelInstanceIndex, str, iterable of RigidBody, or None
+        As in :func:`drakegrasp.find_contacts`.
 
     Returns
     -------

@@ -60,6 +60,7 @@ from drakegrasp.plant._shapes import (
 )
 from drakegrasp.plant.validation import (
     HandSpec,
+    check_distance_tolerance,
     hand_bodies,
     plant_context_of,
     resolve_object_body,
@@ -264,7 +265,7 @@ def find_contacts(
         The grasped object (a ``"model::body"`` name is accepted); positional
         or keyword, like every option-free argument of the plant layer.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
-        See :func:`hand_bodies`.
+        See :func:`~drakegrasp.plant.validation.hand_bodies`.
     distance_tolerance : float, optional
         A pair is a contact when ``|ψ| <= distance_tolerance`` (metres, default
         1e-4).
@@ -300,12 +301,7 @@ def find_contacts(
         If the plant has no scene graph, or a geometry's shape is unsupported.
     """
     plant_context = plant_context_of(plant, plant_context)
-    tol = float(distance_tolerance)
-    if not np.isfinite(tol) or tol <= 0:
-        raise InvalidOptionError(
-            "distance_tolerance must be finite and > 0 (metres), got "
-            f"{distance_tolerance!r}"
-        )
+    tol = check_distance_tolerance(distance_tolerance)
     if patches not in ("vertices", "witness"):
         raise InvalidOptionError(
             f"patches must be 'vertices' or 'witness', got {patches!r}"

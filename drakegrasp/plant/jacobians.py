@@ -57,7 +57,7 @@ def hand_velocity_indices(
     ----------
     plant : MultibodyPlant
     bodies : iterable of RigidBody
-        The hand's bodies (see :func:`drakegrasp.plant.hand_bodies`).
+        The hand's bodies (see :func:`~drakegrasp.plant.validation.hand_bodies`).
 
     Returns
     -------

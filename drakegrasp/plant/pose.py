@@ -32,6 +32,7 @@ __all__ = [
     "Penetration",
     "PoseCheck",
     "check_pose",
+    "find_penetrations",
 ]
 
 JOINT_LIMIT_TOL = 1e-8
@@ -140,7 +141,7 @@ class PoseCheck:
         }
 
 
-def _penetrations(
+def find_penetrations(
     plant: MultibodyPlant,
     plant_context: Context,
     object_body: RigidBody,
@@ -148,6 +149,7 @@ def _penetrations(
     tol: float,
     query_object=None,
 ) -> list[Penetration]:
+    """Every (body geometry, object geometry) pair with ``ψ < −tol``, unfiltered."""
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     query = query_object
@@ -231,7 +233,7 @@ def check_pose(
     -------
     PoseCheck
     """
-    pens = _penetrations(
+    pens = find_penetrations(
         plant,
         plant_context,
         object_body,

@@ -61,7 +61,9 @@ list of directories holding a ``package.xml``, or a Drake ``PackageMap``),
 or ``ROS_PACKAGE_PATH``, crawled as Drake does.  Details:
 :mod:`drakegrasp.plant.scene_refs`.
 
-A scene may reference only files inside its packages and its own directory:
+A ``file:`` without a URL scheme is a path relative to the scene file
+(``file: models/my_object.sdf``).  A scene may reference only files inside its
+packages and its own directory:
 ``package://drakegrasp/../../outside/evil.sdf``, ``file:///etc/...`` or a
 path that climbs out of the scene's directory is a :class:`SceneError`
 unless ``allow_any_file=True`` says the scene is trusted.
@@ -76,15 +78,16 @@ naming the file, the key and what is valid (:mod:`drakegrasp.plant.scene_file`).
 
 Example: Drake's WSG-50 from ``drake_models``
 ---------------------------------------------
-::
+Its tip spheres touch the box's faces at finger values of ±22.5 mm, with the
+box's centre between the tips::
 
     directives:
     - add_model:
         name: wsg
         file: package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf
         default_joint_positions:
-          left_finger_sliding_joint: [-0.025]
-          right_finger_sliding_joint: [0.025]
+          left_finger_sliding_joint: [-0.0225]
+          right_finger_sliding_joint: [0.0225]
     - add_weld:
         parent: world
         child: wsg::body
@@ -93,8 +96,9 @@ Example: Drake's WSG-50 from ``drake_models``
         file: package://drakegrasp/objects/box.sdf
         default_free_body_pose:
           box:
-            translation: [0.0, 0.108, 0.0]   # between the tips
+            translation: [0.0, 0.108, 0.0]
     drakegrasp:
+      description: Drake's WSG-50 squeezing a 50 x 50 x 100 mm box
       object_body: box::box
       hand: wsg
       mu: 0.5
@@ -304,6 +308,22 @@ def _without_drakegrasp_section(text: str) -> str:
     return "".join(out)
 
 
+def _anchor_relative_files(directives, path: Path) -> None:
+    """Turn ``file:`` paths without a URL scheme into ``file://`` URLs.
+
+    A relative path is relative to the scene file's directory (Drake, reading
+    the directives from a string, would refuse it).
+    """
+    for directive in directives.directives:
+        for kind in (directive.add_model, directive.add_directives):
+            if kind is None or "://" in kind.file:
+                continue
+            local = Path(kind.file)
+            if not local.is_absolute():
+                local = path.resolve().parent / local
+            kind.file = f"file://{local}"
+
+
 def load_scene(
     path_or_name: str | Path | None = None,
     *,
@@ -354,6 +374,7 @@ def load_scene(
     except Exception as e:  # Drake raises RuntimeError/ValueError on bad schema
         msg = " ".join(str(e).split())
         raise SceneError(f"scene {str(path)!r}: bad model directives: {msg}") from None
+    _anchor_relative_files(directives, path)
     try:
         ProcessModelDirectives(directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError

@@ -40,6 +40,7 @@ The ε module imports ``scipy`` (Qhull, NNLS); the LPs import
 from drakegrasp.quality._common import RANK_TOL
 from drakegrasp.quality.epsilon import (
     HULL_TOL,
+    L1_MAX_POINTS,
     LINF_MAX_CANDIDATES,
     ferrari_canny,
     primitive_wrenches,
@@ -65,6 +66,7 @@ from drakegrasp.quality.summary import GraspQuality, grasp_quality, lp2_margin
 
 __all__ = [
     "HULL_TOL",
+    "L1_MAX_POINTS",
     "LINF_MAX_CANDIDATES",
     "RANK_TOL",
     "GraspQuality",

@@ -22,12 +22,14 @@ from drakegrasp.quality._common import (
     _scaled_grasp_matrix,
     _torque_scale,
 )
+from drakegrasp.validation import check_num_generators
 
 if TYPE_CHECKING:
     from scipy.spatial import ConvexHull
 
 __all__ = [
     "HULL_TOL",
+    "L1_MAX_POINTS",
     "LINF_MAX_CANDIDATES",
     "ferrari_canny",
     "primitive_wrenches",
@@ -38,6 +40,15 @@ HULL_TOL = 1e-9
 
 LINF_MAX_CANDIDATES = 2_000_000
 """Most candidate facet normals the L∞ ε may test (about 6 s per million)."""
+
+L1_MAX_POINTS = 2_000
+"""Most primitive wrenches whose hull the L1 ε may build.
+
+A 6-D hull's facets grow about linearly with its points here: 2,000 points
+(250 spatial hard fingers with 8 generators) make about 230,000 facets and
+take about 9 s; 8,000 points (1,000 fingers) took 150 s, and a facet check on
+them once asked for 57 GiB.  Beyond this bound ε is refused, not attempted.
+"""
 
 _NORMS = ("L1", "Linf")
 
@@ -74,6 +85,7 @@ def primitive_wrenches(
     .. math:: w_{i,k} = S\, G_i\, s_k, \qquad S = \operatorname{diag}(I, I / b_s)
     """
     _check_grasp(grasp)
+    num_generators = check_num_generators(num_generators)
     b = _torque_scale(grasp, torque_scale)
     if not grasp.planar and all(
         c.effective_components() == (0, 1, 2) for c in grasp.contacts
@@ -104,11 +116,7 @@ def _hard_finger_wrenches(
     μ sin(2πk/n_g)]`` in the contact frame); a test checks that they equal
     :func:`~drakegrasp.friction_cone_generators`.
     """
-    n_g = int(num_generators)
-    if n_g != num_generators or n_g < 3:
-        raise InvalidOptionError(
-            f"num_generators must be an integer >= 3, got {num_generators!r}"
-        )
+    n_g = check_num_generators(num_generators)
     R = np.array([c.frame for c in grasp.contacts])  # (N, 3, 3) columns n, t1, t2
     mu = np.array([c.mu for c in grasp.contacts])
     r = np.array([c.position for c in grasp.contacts]) - grasp.reference_point
@@ -147,8 +155,7 @@ def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
     tol = HULL_TOL * max(scale, 1e-300)
     try:
         hull = ConvexHull(points, qhull_options="Q0")
-        eq = hull.equations
-        if np.max(points @ eq[:, :-1].T + eq[:, -1]) <= tol:
+        if _below_every_facet(points, hull.equations, tol):
             return hull
     except QhullError:
         pass
@@ -163,6 +170,21 @@ def _qhull(points: np.ndarray, scale: float) -> ConvexHull:
             f"Qhull could not build the convex hull of {points.shape[0]} points in "
             f"{points.shape[1]}-D: {err}"
         ) from err
+
+
+def _below_every_facet(points: np.ndarray, eq: np.ndarray, tol: float) -> bool:
+    """Whether every point is below every facet hyperplane, in bounded memory.
+
+    A thousand contacts make a hull of about 10^6 facets: the full
+    points-by-facets product would take 57 GiB, so facets go in blocks of
+    about 8 million products.
+    """
+    block = max(1, 8_000_000 // max(1, points.shape[0]))
+    for lo in range(0, eq.shape[0], block):
+        part = eq[lo : lo + block]
+        if np.max(points @ part[:, :-1].T + part[:, -1]) > tol:
+            return False
+    return True
 
 
 def _origin_distance_residual(points: np.ndarray, scale: float) -> float:
@@ -426,6 +448,15 @@ def _linf_radius(wrenches: Sequence[np.ndarray], A: np.ndarray | None = None) ->
     D = wrenches[0].shape[1]
     if A is None:
         A = np.eye(D)
+    # Every summand has at least one edge, so there are at least C(N, D - 1)
+    # candidates: refuse before building N face lattices (40 ms each).
+    lower = math.comb(len(wrenches), D - 1)
+    if lower > LINF_MAX_CANDIDATES:
+        raise InvalidOptionError(
+            f"the L∞ Ferrari–Canny metric of {len(wrenches)} contacts needs at least "
+            f"{lower} candidate facet normals (more than LINF_MAX_CANDIDATES = "
+            f"{LINF_MAX_CANDIDATES}); use norm='L1' or fewer contacts"
+        )
     mapped = [W @ A.T for W in wrenches]
     sets = [np.vstack([np.zeros((1, D)), W]) for W in mapped]
     families = [_face_directions(P) for P in sets]
@@ -531,14 +562,22 @@ def ferrari_canny(
     fingers with 8 generators (4,710 candidate normals) and about 1 s for four
     (166,188); five need 1.8 million candidates (about 15 s).  Grasps that
     need more than ``LINF_MAX_CANDIDATES`` (six hard fingers do) raise
-    :class:`~drakegrasp.InvalidOptionError`.
+    :class:`~drakegrasp.InvalidOptionError`, checked before any enumeration,
+    and so do grasps with more than :data:`L1_MAX_POINTS` primitive wrenches
+    (either norm).
     """
-    if norm not in _NORMS:
+    if not isinstance(norm, str) or norm not in _NORMS:
         raise InvalidOptionError(f"norm must be one of {_NORMS}, got {norm!r}")
     wrenches = primitive_wrenches(
         grasp, num_generators=num_generators, torque_scale=torque_scale
     )
     points = np.vstack(wrenches)
+    if points.shape[0] > L1_MAX_POINTS:
+        raise InvalidOptionError(
+            f"the Ferrari–Canny metric of this grasp needs the hull of "
+            f"{points.shape[0]} primitive wrenches (more than L1_MAX_POINTS = "
+            f"{L1_MAX_POINTS}); use fewer contacts or fewer generators"
+        )
     A = _whitening(points)
     if A is None:
         return 0.0  # the wrench set is flat: no interior for either norm

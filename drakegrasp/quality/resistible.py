@@ -11,6 +11,7 @@ from drakegrasp.errors import InvalidOptionError, SolverError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.grasp import Grasp
 from drakegrasp.quality._common import _check_grasp, _jsonable
+from drakegrasp.validation import real_array
 
 __all__ = [
     "MaxWrenchResult",
@@ -95,7 +96,7 @@ class MaxWrenchResult:
 
 
 def _check_direction(grasp: Grasp, direction: np.ndarray) -> np.ndarray:
-    d = np.array(direction, dtype=float).reshape(-1)
+    d = real_array("direction", direction, error=InvalidOptionError).reshape(-1)
     D = grasp.wrench_dim
     if d.shape != (D,) or not np.all(np.isfinite(d)):
         raise InvalidOptionError(
@@ -110,13 +111,7 @@ def _check_direction(grasp: Grasp, direction: np.ndarray) -> np.ndarray:
 
 def _check_max_normal_force(grasp: Grasp, max_normal_force) -> np.ndarray:
     N = grasp.num_contacts
-    try:
-        f = np.array(max_normal_force, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidOptionError(
-            f"max_normal_force must be a number or {N} numbers (N), got "
-            f"{max_normal_force!r}"
-        ) from None
+    f = real_array("max_normal_force", max_normal_force, error=InvalidOptionError)
     if f.ndim == 0:
         f = np.full(N, float(f))
     if f.shape != (N,) or not np.all(np.isfinite(f)) or np.any(f < 0):

@@ -15,6 +15,7 @@ from drakegrasp.quality.indices import (
     grasp_singular_values,
     hand_object_singular_values,
 )
+from drakegrasp.validation import check_flag
 
 __all__ = ["GraspQuality", "grasp_quality", "lp2_margin"]
 
@@ -172,6 +173,8 @@ def grasp_quality(
     from drakegrasp.closure import force_closure  # the closure programs' owner
 
     _check_grasp(grasp)
+    if linf is not None:
+        linf = check_flag("linf", linf)
     b = _torque_scale(grasp, torque_scale)
     J = None if hand_jacobian is None else check_hand_jacobian(grasp, hand_jacobian)
     closure = force_closure(

@@ -31,6 +31,7 @@ from drakegrasp.visualization.plots import (
     PlanarGraspPlot,
     plot_planar_grasp,
 )
+from drakegrasp.visualization.robot import set_translucent, visualizer_paths
 from drakegrasp.visualization.wrench_space import (
     WrenchHull,
     WrenchSpacePlot,
@@ -57,6 +58,8 @@ __all__ = [
     "plot_planar_grasp",
     "plot_wrench_space",
     "pyramid_mesh",
+    "set_translucent",
+    "visualizer_paths",
     "wrench_hull",
     "wrench_space_points",
 ]

@@ -22,7 +22,7 @@ pushes); see :mod:`drakegrasp.visualization.geometry` on ``side``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -43,6 +43,7 @@ from drakegrasp.visualization.geometry import (
     pyramid_mesh,
     side_sign,
 )
+from drakegrasp.visualization.robot import set_translucent
 
 __all__ = [
     "DEFAULT_PREFIX",
@@ -124,8 +125,11 @@ def _draw_arrow(
     *,
     radius: float,
     rgba: Rgba,
-) -> None:
-    """Arrow from ``tail`` along ``vector`` (parent-frame coordinates)."""
+) -> list[str]:
+    """Arrow from ``tail`` along ``vector`` (parent-frame coordinates).
+
+    Returns the paths of its parts (shaft, head).
+    """
     length = float(np.linalg.norm(vector))
     head = min(0.35 * length, 5.0 * radius)
     shaft = length - head
@@ -142,6 +146,22 @@ def _draw_arrow(
         f"{path}/head",
         RigidTransform(RotationMatrix.MakeYRotation(np.pi / 2), [0.0, 0.0, length]),
     )
+    return ([f"{path}/shaft"] if shaft > 0 else []) + [f"{path}/head"]
+
+
+ON_TOP_RENDER_ORDER = 10.0
+"""three.js ``renderOrder`` of an on-top drawing (other objects have 0)."""
+
+
+def _draw_on_top(meshcat: Meshcat, path: str) -> None:
+    """Draw the object at ``path`` over everything else in the scene.
+
+    three.js skips the depth test for the object's material (nothing in front
+    of it hides it) and renders it after the scene's geometry.  Drake keeps
+    the object that ``SetObject`` sends in the child ``<object>`` of the path.
+    """
+    meshcat.SetProperty(f"{path}/<object>", "material.depthTest", False)
+    meshcat.SetProperty(f"{path}/<object>", "renderOrder", ON_TOP_RENDER_ORDER)
 
 
 def draw_grasp(
@@ -160,6 +180,10 @@ def draw_grasp(
     show_frames: bool = True,
     side: str = "outside",
     colors: Mapping[str, Any] | None = None,
+    on_top: bool = False,
+    size: float | None = None,
+    translucent: str | Sequence[str] = (),
+    translucent_opacity: float = 0.3,
 ) -> GraspDrawing:
     """Draw a grasp (and optionally the forces of a closure result) in Meshcat.
 
@@ -210,11 +234,31 @@ def draw_grasp(
     colors : mapping, optional
         RGB(A) overrides of :data:`MESHCAT_COLORS` (keys ``point``, ``n``,
         ``t1``, ``t2``, ``cone``, ``pyramid``, ``ray``, ``force``).
+    on_top : bool, optional
+        Draw over everything else in the scene (no depth test), so that a
+        robot drawn by ``MeshcatVisualizer`` never hides the drawing: with
+        ``side="outside"`` the cones and arrows lie inside the finger meshes,
+        with ``"inside"`` inside the object.  Default False.
+    size : float, optional
+        Length (metres) that the default sizes are fractions of: pass the
+        object's size (e.g. the diagonal of its bounding box) to draw to the
+        object's scale.  Default: the grasp's characteristic length b.
+    translucent : str or sequence of str, optional
+        Meshcat paths to make translucent with :func:`set_translucent` (e.g.
+        ``"visualizer/gripper"``, a hand drawn by ``MeshcatVisualizer``).
+    translucent_opacity : float, optional
+        Their opacity factor, in (0, 1] (default 0.3).
 
     Returns
     -------
     GraspDrawing
         The prefix, every path drawn, and the sizes used.
+
+    Notes
+    -----
+    Default sizes, as fractions of ``L`` = ``size`` or b: cones 0.4 L high,
+    contact spheres 0.04 L in radius, triads 0.2 L long, the largest force
+    0.6 L long.
 
     Raises
     ------
@@ -222,11 +266,13 @@ def draw_grasp(
         For an unknown ``cone``, ``side`` or colour key, a non-positive size, or
         forces that do not match the grasp's contacts.
     """
+    _check_meshcat(meshcat)
     if not isinstance(grasp, Grasp):
         raise InvalidOptionError(
             f"draw_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
-    if cone not in _CONE_CHOICES:
+    _check_rgba_colors(colors)
+    if not isinstance(cone, (str, type(None))) or cone not in _CONE_CHOICES:
         raise InvalidOptionError(
             f"cone must be 'exact', 'pyramid', 'both' or None, got {cone!r}"
         )
@@ -234,7 +280,7 @@ def draw_grasp(
         raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
     sign = side_sign(side)
     palette = merge_palette(MESHCAT_COLORS, colors)
-    b = grasp.characteristic_length
+    b = grasp.characteristic_length if size is None else positive_length("size", size)
     h = positive_length("cone_height", 0.4 * b if cone_height is None else cone_height)
     r = positive_length(
         "point_radius", 0.04 * b if point_radius is None else point_radius
@@ -269,6 +315,7 @@ def draw_grasp(
     meshcat.Delete(prefix)
     meshcat.SetTransform(prefix, X_WG)
     paths: list[str] = []
+    leaves: list[str] = []  # objects drawn by parts (arrows)
     axis_radius = 0.2 * r
     for i, contact in enumerate(grasp.contacts):
         base = f"{prefix}/contact_{i}"
@@ -312,7 +359,7 @@ def draw_grasp(
             if np.linalg.norm(f_C) * scale > 1e-9 * b:
                 vec = scale * f_C
                 tail = np.zeros(3) if sign > 0 else -vec
-                _draw_arrow(
+                leaves += _draw_arrow(
                     meshcat,
                     f"{base}/force",
                     tail,
@@ -323,7 +370,22 @@ def draw_grasp(
                 paths.append(f"{base}/force")
     from drakegrasp.visualization.certificates import draw_result_certificate
 
-    paths += draw_result_certificate(meshcat, grasp, result, prefix)  # why "no"
+    certificate = draw_result_certificate(meshcat, grasp, result, prefix)  # why "no"
+    paths += certificate
+    if on_top:
+        # Arrows are groups (shaft, head): their parts carry the materials.
+        arrows = {p for p in paths if p.endswith("/force")}
+        arrows |= {p for p in certificate if not p.endswith("/point")}
+        parts = [
+            f"{p}/{part}"
+            for p in certificate
+            if p in arrows
+            for part in ("shaft", "head")
+        ]
+        for path in [p for p in paths if p not in arrows] + leaves + parts:
+            _draw_on_top(meshcat, path)
+    if translucent:
+        set_translucent(meshcat, translucent, translucent_opacity)
     return GraspDrawing(prefix, tuple(paths), h, scale, forces_G)
 
 
@@ -381,6 +443,40 @@ def _draw_cone(
 
 def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
     """Delete a drawing made by :func:`draw_grasp` (everything under ``prefix``)."""
+    _check_meshcat(meshcat)
     if not isinstance(prefix, str) or not prefix.strip("/"):
         raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
     meshcat.Delete(prefix)
+
+
+def _check_meshcat(meshcat) -> None:
+    if not isinstance(meshcat, Meshcat):
+        raise InvalidOptionError(
+            f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
+        )
+
+
+def _check_rgba_colors(colors) -> None:
+    """Refuse colours that are not Rgba or 3/4 numbers in [0, 1]."""
+    if colors is None:
+        return
+    if not isinstance(colors, Mapping):
+        raise InvalidOptionError(
+            f"colors must be a mapping of names to RGB(A) colours, got {colors!r}"
+        )
+    for key, value in colors.items():
+        if isinstance(value, Rgba):
+            continue
+        try:
+            v = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            v = None
+        if (
+            v is None
+            or v.shape not in ((3,), (4,))
+            or not np.all((v >= 0.0) & (v <= 1.0))
+        ):
+            raise InvalidOptionError(
+                f"colour {key!r} must be an Rgba or 3 or 4 numbers in [0, 1], got "
+                f"{value!r}"
+            )

@@ -19,6 +19,7 @@ import numpy as np
 
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.grasp import Grasp
+from drakegrasp.validation import check_length
 from drakegrasp.visualization.geometry import (
     cone_edge_directions,
     contact_forces_in_grasp_frame,
@@ -197,6 +198,7 @@ def plot_planar_grasp(
         raise InvalidOptionError(
             f"plot_planar_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
+    _check_plot_options(colors, outline, force_scale)
     if not grasp.planar:
         raise InvalidOptionError(
             "plot_planar_grasp draws planar grasps; this grasp is spatial "
@@ -348,3 +350,27 @@ def _draw_certificate(ax, grasp: Grasp, result: Any, patch: Any):
     if cert.kind == UNRESISTED_WRENCH:
         return plot_unresisted_wrench(ax, grasp, cert)
     return None
+
+
+def _check_plot_options(colors, outline, force_scale) -> None:
+    """Refuse colours matplotlib cannot draw, a text outline, a bad force scale."""
+    if colors is not None:
+        if not isinstance(colors, Mapping):
+            raise InvalidOptionError(
+                f"colors must be a mapping of names to colours, got {colors!r}"
+            )
+        from matplotlib.colors import is_color_like
+
+        bad = {k: v for k, v in colors.items() if not is_color_like(v)}
+        if bad:
+            raise InvalidOptionError(
+                f"colors {bad} are not matplotlib colours (names such as 'red', "
+                "'#1f77b4', or RGB(A) tuples in [0, 1])"
+            )
+    if isinstance(outline, (str, bytes)):
+        raise InvalidOptionError(
+            "outline must be polygon vertices (M, 2), {'center': ..., 'radius': "
+            f"...}} or a matplotlib patch, got {outline!r}"
+        )
+    if force_scale is not None:
+        check_length("force_scale", force_scale, error=InvalidOptionError)

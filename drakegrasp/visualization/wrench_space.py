@@ -23,6 +23,7 @@ import numpy as np
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, friction_cone_generators
 from drakegrasp.grasp import Grasp, wrench_columns
+from drakegrasp.validation import real_scalar
 from drakegrasp.visualization.plots import import_pyplot
 
 __all__ = [
@@ -235,6 +236,9 @@ def plot_wrench_space(
         raise InvalidOptionError(
             f"plot_wrench_space needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
+    tol = real_scalar("tol", tol)
+    if not (0.0 < tol < 1.0):
+        raise InvalidOptionError(f"tol must be a real number in (0, 1), got {tol!r}")
     if not grasp.planar:
         raise InvalidOptionError(
             "plot_wrench_space draws planar grasps, whose wrench space is 3-D; "

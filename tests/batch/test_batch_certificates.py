@@ -90,3 +90,45 @@ def test_a_yes_has_no_batch_witness_and_shapes_are_checked():
     assert np.isnan(c.direction).all() and c.certificates == (None, None)
     with pytest.raises(dg.GraspError, match="2 grasps"):
         batch_certificates(P[:1], n[:1], r)
+
+
+@pytest.mark.parametrize("form", [True, False])
+def test_rank_deficient_witnesses_are_vectorised_and_span_the_single_paths(
+    form, monkeypatch
+):
+    """Two fingers (rank 5 with friction, 1 without): no Grasp is built per row."""
+    import drakegrasp.batch.certificates as bc
+
+    rng = np.random.default_rng(5)
+    K = 60
+    P, n = _random_batch(rng, K, 2, 3)
+    p = rng.normal(size=3) * 0.3
+    run = dg.batch_form_closure if form else dg.batch_force_closure
+    args = () if form else (0.4,)
+    result = run(P, n, *args, reference_points=p)
+    assert (result.rank < 6).all() and not result.is_closure.any()
+
+    def no_grasps(*a, **k):
+        raise AssertionError("the rank-deficient path built a Grasp")
+
+    monkeypatch.setattr(bc, "grasp_at", no_grasps)
+    kw = {} if form else {"mu": 0.4}
+    certs = batch_certificates(P, n, result, reference_points=p, **kw)
+    monkeypatch.undo()
+    assert certs.has_witness.all() and certs.two_sided.all()
+    for k in range(K):
+        g = grasp_at(
+            P,
+            n,
+            k,
+            model="frictionless" if form else "hard_finger",
+            reference_points=p,
+            **kw,
+        )
+        cert = certs.certificates[k]
+        assert cert.check(g).holds
+        single = (dg.form_closure(g) if form else dg.force_closure(g)).certificate
+        B, S = cert.null_basis, single.null_basis
+        assert B.shape == S.shape  # same dimension
+        coef = np.linalg.lstsq(S, B, rcond=None)[0]
+        assert np.allclose(S @ coef, B, atol=1e-8)  # same span

@@ -6,8 +6,12 @@ polyhedral cones, or by the closed-form support of the exact cones written here;
 LP3's forces by their residuals.
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 import drakegrasp as dg
@@ -20,6 +24,7 @@ SPATIAL_MODELS = [
     ("hard_finger", 0.0, 0.0),
     ("hard_finger", 0.3, 0.0),
     ("soft_finger", 0.3, 0.2),
+    ("soft_finger", 0.0, 0.2),
 ]
 PLANAR_MODELS = [("frictionless", 0.5, 0.0), ("hard_finger", 0.2, 0.0)]
 
@@ -172,11 +177,20 @@ def test_every_yes_certificate_balances_inside_the_cones(rng, make_contacts):
     assert count > 50
 
 
+def test_the_normal_force_route_certificate_holds_where_g_n_is_short():
+    # equator fingers with almost no friction: the normals balance, G has full
+    # rank through the (tiny) friction, G_n has rank 2
+    g = ex.equator_fingers(1e-8)
+    for fn in (dg.force_closure, dg.force_closure_exact):
+        r = fn(g)
+        assert r.is_closure and r.decided_by == "normal forces"
+        chk = r.certificate.check(g)
+        assert chk.holds and chk.slack > 0, chk
+
+
 def test_a_wrong_witness_fails_the_check():
     g = ex.planar_two_finger_square(0.2)
     cert = dg.force_closure(g).certificate
-    import dataclasses
-
     flipped = dataclasses.replace(cert, direction=-cert.direction)
     assert cert.check(g).holds and not flipped.check(g).holds
     tilted = dataclasses.replace(cert, separating_twist=-cert.separating_twist)
@@ -303,3 +317,45 @@ def test_certificates_are_invariant_to_units_and_reference_point(rng, make_conta
         r2 = dg.force_closure(scaled)
         assert not r2.is_closure and r2.certificate.check(scaled).holds
         assert r.certificate.check(g).holds
+
+
+def _adjoint(R, t):
+    """Map a twist [v_p; ω] about p to the moved frame (p moves to R p + t)."""
+    A = np.zeros((6, 6))
+    A[:3, :3] = A[3:, 3:] = R
+    return A
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 10**6))
+def test_a_witness_moves_with_the_grasp(seed):
+    """Rigidly moving the grasp (and p) rotates its witnesses, nothing else."""
+    rng = np.random.default_rng(seed)
+    contacts = []
+    for _ in range(int(rng.integers(2, 5))):
+        c = rng.normal(size=3)
+        c /= np.linalg.norm(c)
+        contacts.append(dg.Contact(c, -c + rng.normal(size=3), mu=0.3))
+    p = rng.normal(size=3)
+    g = dg.Grasp(contacts, reference_point=p)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    R = q * np.sign(np.linalg.det(q))
+    t = rng.normal(size=3)
+    moved = dg.Grasp(
+        [x.with_(position=R @ x.position + t, normal=R @ x.normal) for x in contacts],
+        reference_point=R @ p + t,
+    )
+    A = _adjoint(R, t)
+    for fn in (dg.form_closure, dg.force_closure, dg.force_closure_exact):
+        cert = fn(g).certificate
+        if cert is None or cert.kind == "balancing internal force":
+            continue
+        changes = {
+            "direction": A @ cert.direction,
+            "null_basis": A @ cert.null_basis,
+            "reference_point": R @ p + t,
+        }
+        if cert.separating_twist is not None:
+            changes["separating_twist"] = A @ cert.separating_twist
+            changes["separating_basis"] = A @ cert.separating_basis
+        assert dataclasses.replace(cert, **changes).check(moved).holds

@@ -75,7 +75,7 @@ def test_invalid_options():
         dg.force_closure(grasp, num_generators=2)
     with pytest.raises(
         dg.InvalidOptionError,
-        match=r"tol must be finite and > 0, a real number in \[1e-10, 1\]",
+        match=r"tol must be finite and > 0, a real number in \[1e-10, 0.5\]",
     ):
         dg.form_closure(grasp, tol=0)
     with pytest.raises(dg.InvalidOptionError, match="formulation .* 'vertices'"):

@@ -10,6 +10,7 @@ run through Sphinx's doctest builder on the same sources.
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import subprocess
 import sys
@@ -89,7 +90,10 @@ def test_page_exists(html, page):
 def test_every_tutorial_is_rendered_with_its_outputs(html):
     notebooks = sorted((ROOT / "tutorials").glob("[0-9][0-9]_*.ipynb"))
     assert notebooks
+    models = bool(os.environ.get("DRAKEGRASP_DRAKE_MODELS"))
     for notebook in notebooks:
+        if not models and "package://drake_models" in notebook.read_text():
+            continue  # docs/conf.py renders it unexecuted without drake_models
         page = (html / "tutorials" / f"{notebook.stem}.html").read_text()
         assert "cell_output" in page, f"{notebook.name} rendered without outputs"
     # At least one figure (the notebooks draw with matplotlib).

@@ -12,6 +12,8 @@ import json
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from pydrake.multibody.tree import BodyIndex
 from scipy.optimize import linprog
 
@@ -273,6 +275,14 @@ def test_bounded_iterations_and_min_fingers(real_hands):
         close_hand(
             scene.plant, scene.ctx, scene.object, hand=scene.hand, max_iterations=1
         )
+    # Out of steps with min_fingers met: the stopped fingers stay clear.
+    closure = close_hand(
+        scene.plant, scene.ctx, scene.object, hand=scene.hand, max_iterations=6
+    )
+    assert "not converged" in [f.status for f in closure.fingers]
+    assert closure.touching_fingers
+    check_closed(scene, closure)
+    scene = real_hands.allegro()
     with pytest.raises(UnreachableError, match="min_fingers = 5"):
         close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand, min_fingers=5)
     for bad in (0, 2.5, None):
@@ -296,3 +306,112 @@ def test_pre_shape_penetration_is_refused(real_hands):
     scene = real_hands.wsg(X_WO=X)
     with pytest.raises(PenetrationError, match=r"Schunk_Gripper::body .* 20\.6"):
         close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+
+
+def test_shipped_gripper_closes_back_onto_its_closed_form_pose(scene_cache, tools):
+    # The shipped scenes come from closed-form kinematics (|psi| < 1e-15 m):
+    # opened and closed again, the gripper must come back to them.
+    scene = scene_cache("parallel_jaw_box")
+    root, ctx = tools.fresh_context(scene)
+    q_star = scene.plant.GetPositions(ctx).copy()
+    for name in ("left_finger_joint", "right_finger_joint"):
+        scene.plant.GetJointByName(name).set_translation(ctx, 0.04)
+    closure = close_hand(scene.plant, root, scene.object_body, hand=scene.hand)
+    assert len(closure.touching_fingers) == 2
+    # 0 <= psi <= tol of a pad moving along its normal: q* + psi, psi ~ tol / 2.
+    np.testing.assert_allclose(scene.plant.GetPositions(ctx), q_star, atol=TOL)
+
+
+def test_shipped_three_finger_hand_closes_along_a_synergy(scene_cache, tools):
+    scene = scene_cache("three_finger_sphere")
+    plant = scene.plant
+    root, ctx = tools.fresh_context(scene)
+    q_star = plant.GetPositions(ctx).copy()
+    q = q_star.copy()
+    proximal = [
+        plant.GetJointByName(f"finger{k}_proximal_joint").position_start()
+        for k in (1, 2, 3)
+    ]
+    q[proximal] -= 0.25  # open the proximal joints only
+    plant.SetPositions(ctx, q)
+    names = [n.split("::")[1] for n in _closing_names(plant, scene)]
+    synergy = [1.0 if n.endswith("proximal_joint") else 0.0 for n in names]
+    plant.SetPositions(ctx, q)
+    closure = close_hand(
+        plant, root, scene.object_body, hand=scene.hand, direction=synergy
+    )
+    assert len(closure.touching_fingers) == 3
+    assert {f.touching_body for f in closure.fingers} == {
+        f"hand::finger{k}_distal" for k in (1, 2, 3)
+    }
+    # Only the proximal joints moved, back to the closed-form pose (a 0.05 mm
+    # gap on a ~0.1 m lever is well under 2 mrad).
+    np.testing.assert_allclose(plant.GetPositions(ctx), q_star, atol=2e-3)
+    moved = np.flatnonzero(plant.GetPositions(ctx) != q)
+    assert set(moved) == set(proximal)
+
+
+def _closing_names(plant, scene):
+    from drakegrasp.plant.fingers import hand_structure
+    from drakegrasp.plant.validation import hand_bodies
+
+    ctx = scene.plant_context
+    inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
+    bodies = hand_bodies(plant, scene.object_body, scene.hand)
+    return hand_structure(plant, scene.object_body, bodies, inspector=inspector).names
+
+
+@settings(
+    derandomize=True,
+    max_examples=8,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    x=st.floats(-0.04, 0.04),
+    y=st.floats(0.05, 0.16),
+    yaw=st.floats(-0.6, 0.6),
+)
+def test_wsg_anywhere_either_closes_truthfully_or_says_why(real_hands, x, y, yaw):
+    from pydrake.math import RigidTransform, RollPitchYaw
+
+    R = RollPitchYaw(np.pi / 2, yaw, np.pi / 2).ToRotationMatrix()
+    scene = real_hands.wsg(X_WO=RigidTransform(R, [x, y, 0.0]))
+    q0 = scene.plant.GetPositions(scene.ctx).copy()
+    try:
+        closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    except PenetrationError:
+        assert min(all_pair_distances(scene).values()) < -TOL
+        return
+    except UnreachableError as e:
+        np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
+        assert all(f.status != "touching" for f in e.closure.fingers)
+        return
+    assert all(f.status in ("touching", "at limit") for f in closure.fingers)
+    check_closed(scene, closure)
+
+
+@settings(
+    derandomize=True,
+    max_examples=8,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    x=st.floats(0.06, 0.12),
+    y=st.floats(-0.03, 0.03),
+    z=st.floats(0.06, 0.16),
+)
+def test_allegro_anywhere_either_closes_truthfully_or_says_why(real_hands, x, y, z):
+    scene = real_hands.allegro(p_ball=(x, y, z))
+    q0 = scene.plant.GetPositions(scene.ctx).copy()
+    try:
+        closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    except PenetrationError:
+        assert min(all_pair_distances(scene).values()) < -TOL
+        return
+    except UnreachableError as e:
+        np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
+        assert all(f.status != "touching" for f in e.closure.fingers)
+        return
+    check_closed(scene, closure)

@@ -144,10 +144,16 @@ def test_files_outside_the_scene_directory_are_refused(tmp_path):
     (scene_dir / "link.sdf").symlink_to(box)
     with pytest.raises(SceneError, match="outside the scene's directory"):
         load_scene(_write(scene_dir, _box_scene(f"file://{scene_dir}/link.sdf")))
-    # A file in the scene's own directory is fine.
+    # A file in the scene's own directory is fine, by URL or relative path.
     shutil.copy(box, scene_dir / "box.sdf")
     scene = load_scene(_write(scene_dir, _box_scene(f"file://{scene_dir}/box.sdf")))
     assert scene.object_body.name() == "box"
+    (scene_dir / "models").mkdir()
+    shutil.copy(box, scene_dir / "models" / "box.sdf")
+    scene = load_scene(_write(scene_dir, _box_scene("models/box.sdf"), "rel.yaml"))
+    assert scene.object_body.name() == "box"
+    with pytest.raises(SceneError, match="outside the scene's directory"):
+        load_scene(_write(scene_dir, _box_scene("../scene/../box.sdf"), "up.yaml"))
 
 
 def test_included_directive_files_are_checked(tmp_path):
@@ -240,3 +246,16 @@ def test_cli_package_option(user_package, monkeypatch, capsys):
         main(["analyze", str(scene), "--package", "mypkg"])
     assert info.value.code == 2
     assert "NAME=DIR" in capsys.readouterr().err
+
+
+def test_cli_allow_any_file(tmp_path, capsys):
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    shutil.copy(models_dir() / "objects" / "box.sdf", outside / "evil.sdf")
+    rel = os.path.relpath(outside / "evil.sdf", models_dir())
+    path = _write(tmp_path, _box_scene(f"package://drakegrasp/{rel}"))
+    assert main(["analyze", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "leaves the package 'drakegrasp'" in err and err.count("\n") == 1
+    assert main(["analyze", str(path), "--allow-any-file"]) == 0
+    assert "box::box" in capsys.readouterr().out

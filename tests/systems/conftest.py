@@ -1,4 +1,4 @@
-"""Make the pick builder of tests/systems importable (``pick``)."""
+"""Make the pick builder of tests/systems importable (``pick_support``)."""
 
 import sys
 from pathlib import Path

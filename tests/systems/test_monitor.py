@@ -1,6 +1,6 @@
 """GraspMonitor in a running simulation, checked against a second route.
 
-The pick of ``pick.py`` (the shipped parallel-jaw gripper closes on a free box
+The pick of ``pick_support.py`` (the shipped parallel-jaw gripper closes on a free box
 under gravity, lifts it 5 cm, lowers it and opens) runs in a ``Simulator``.
 The monitor's logged verdicts must go "no contact" -> "force closure" ->
 "no contact", and every sample must equal what ``analyze_grasp`` says on the
@@ -12,9 +12,11 @@ before the update at t_k, so the verdict logged at t_{k+1} is the sample of
 the state logged at t_k.
 """
 
+import json
+
 import numpy as np
 import pytest
-from pick import DURATION, LIFT, build_pick
+from pick_support import DURATION, LIFT, build_pick
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 
@@ -136,6 +138,7 @@ def test_report_port_holds_the_last_sample(point_pick):
     assert sample.time == pytest.approx(DURATION - period)
     assert sample.status == "no contact" and sample.report is None
     assert "does not touch" in sample.message
+    assert json.loads(json.dumps(sample.to_dict()))["status"] == "no contact"
     np.testing.assert_array_equal(
         sample.verdicts,
         point_pick.monitor.get_verdicts_output_port().Eval(monitor_context),
@@ -185,6 +188,10 @@ def test_hydroelastic_patches_match_the_geometry(hydro_pick):
     np.testing.assert_allclose(np.abs(p[:, 1]), 0.025, atol=1e-3)  # box faces
     assert np.all(np.abs(p[:, 0]) <= 0.0101)  # inside the 20 x 20 mm pads
     assert {c.normal_source for c in report.contacts} == {"hydroelastic"}
+    as_json = json.loads(json.dumps(sample.to_dict()))
+    assert as_json["verdicts"]["num_contacts"] == 8
+    assert len(as_json["report"]["contacts"]) == 8
+    assert "8 contacts, force closure YES" in str(sample)
     # Signed distances on the same state find the same two patches.
     geometric = _second_route(pick, sample.state, **OPTIONS)
     assert geometric[GraspMonitor.FORCE_CLOSURE] == 1.0
@@ -230,3 +237,38 @@ def test_bad_options_fail_at_construction(point_pick):
     geometric = GraspMonitor(plant, object_body=box, mu=0.5)
     with pytest.raises(InvalidOptionError, match="contact_results"):
         geometric.get_contact_results_input_port()
+
+
+def test_joint_off_its_limits_is_an_invalid_sample(point_pick):
+    context = point_pick.diagram.CreateDefaultContext()
+    plant = point_pick.plant
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    plant.GetJointByName("left_finger_joint", point_pick.gripper).set_translation(
+        plant_context,
+        0.05,  # upper limit 0.0425
+    )
+    monitor_context = point_pick.monitor.GetMyContextFromRoot(context)
+    sample = point_pick.monitor.evaluate(monitor_context)
+    assert sample.status == "invalid"
+    assert "left_finger_joint" in sample.message
+    # With check_pose=False the same pose is analysed, and marked invalid.
+    unchecked = GraspMonitor(
+        plant,
+        object_body="box::box",
+        hand=point_pick.gripper,
+        mu=0.5,
+        check_pose=False,
+    )
+    own = unchecked.CreateDefaultContext()
+    unchecked.get_plant_state_input_port().FixValue(
+        own, plant.GetPositionsAndVelocities(plant_context)
+    )
+    scene_graph = point_pick.scene_graph
+    query = scene_graph.get_query_output_port().Eval(
+        scene_graph.GetMyContextFromRoot(context)
+    )
+    unchecked.get_query_object_input_port().FixValue(own, query)
+    analysed = unchecked.evaluate(own)
+    assert analysed.status == "ok"
+    assert not analysed.report.pose.valid
+    assert "left_finger_joint" in str(analysed.report)

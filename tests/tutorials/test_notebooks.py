@@ -38,7 +38,11 @@ EXPECTED = [
     "03_force_closure.ipynb",
     "04_hand_jacobian_lp3.ipynb",
     "05_antipodal_parallel_jaw.ipynb",
+    "06_real_hand.ipynb",
+    "07_grasp_in_simulation.ipynb",
+    "08_why_not.ipynb",
 ]
+NEEDS_DRAKE_MODELS = {"06_real_hand.ipynb"}  # Drake's real hands and YCB objects
 
 WARNINGS_AS_ERRORS = """\
 import warnings
@@ -114,7 +118,12 @@ def test_deprecation_warnings_fail_a_notebook(kernel_spec_manager, test_env):
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
-def test_notebook_runs(path, kernel_spec_manager, test_env):
+def test_notebook_runs(path, kernel_spec_manager, test_env, request, monkeypatch):
+    if path.name in NEEDS_DRAKE_MODELS:
+        # The kernel inherits the variable: dg.use_local_drake_models(parser)
+        # then reads the local copy instead of downloading (skips if absent).
+        models = request.getfixturevalue("drake_models_dir")
+        monkeypatch.setenv("DRAKEGRASP_DRAKE_MODELS", str(models))
     nb = nbformat.read(path, as_version=4)
     try:
         executed = _execute(nb, kernel_spec_manager)

@@ -1,8 +1,14 @@
 """Headless matplotlib for the picture tests; figures closed after each test."""
 
 import os
+import sys
+from pathlib import Path
 
 import pytest
+
+_HERE = str(Path(__file__).resolve().parent)
+if _HERE not in sys.path:  # the browser tests share browser_support.py
+    sys.path.insert(0, _HERE)
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 

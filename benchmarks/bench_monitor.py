@@ -1,0 +1,109 @@
+"""Cost of GraspMonitor in a simulated pick, and the pick's wall time.
+
+Usage::
+
+    python benchmarks/bench_monitor.py [--period 0.05]
+
+Runs the pick of ``tests/systems/pick_support.py`` (the shipped parallel-jaw gripper
+closes on a 0.2 kg box, lifts it 5 cm, lowers it, opens; 3 s simulated, 1 ms
+SAP steps) in three set-ups: point contact with distances from geometry (soft
+fingers), hydroelastic contact with patches from the contact results (flat
+pads, hard fingers), and the same without the monitor's Ferrari–Canny ε.  For
+each it prints the wall time of the whole simulation, of the simulation with a
+monitor that never samples (period 1000 s), the median / 90th percentile / max
+cost of one evaluation (the first excluded: it loads the solvers) and the
+verdict timeline.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "systems"))
+from pick_support import DURATION, build_pick  # noqa: E402
+
+from drakegrasp.systems import GraspMonitor  # noqa: E402
+
+CASES = {
+    "point contact, geometry, soft fingers": dict(
+        plant_contact="point",
+        contact_model="soft_finger",
+        torsional_friction=0.1,
+    ),
+    "hydroelastic, contact results, flat pads": dict(
+        plant_contact="hydroelastic_with_fallback",
+        flat=True,
+        contacts="contact_results",
+    ),
+    "hydroelastic, contact results, no epsilon": dict(
+        plant_contact="hydroelastic_with_fallback",
+        flat=True,
+        contacts="contact_results",
+        compute_epsilon=False,
+    ),
+}
+
+
+def run(period: float, options: dict) -> tuple[float, list[float], object]:
+    pick = build_pick(period=period, mu=0.5, distance_tolerance=1e-3, **options)
+    costs: list[float] = []
+    evaluate = pick.monitor.evaluate
+
+    def timed(context):
+        sample = evaluate(context)
+        costs.append(sample.seconds)
+        return sample
+
+    pick.monitor.evaluate = timed
+    start = time.perf_counter()
+    pick.run()
+    return time.perf_counter() - start, costs, pick
+
+
+def timeline(pick) -> str:
+    log = pick.verdict_log.FindLog(pick.simulator.get_context())
+    parts, previous = [], None
+    for t, v in zip(log.sample_times(), log.data().T, strict=True):
+        key = (int(v[GraspMonitor.STATUS]), int(v[GraspMonitor.FORCE_CLOSURE]))
+        if key != previous:
+            label = {0: "no contact", 1: "contact", -1: "invalid"}[key[0]]
+            if key[1]:
+                label = f"force closure ({int(v[GraspMonitor.NUM_CONTACTS])} contacts)"
+            parts.append(f"{t:.2f} s {label}")
+            previous = key
+    return " -> ".join(parts)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--period", type=float, default=0.05)
+    args = parser.parse_args()
+    for name, options in CASES.items():
+        idle, _, _ = run(1000.0, options)
+        wall, costs, pick = run(args.period, options)
+        c = 1e3 * np.array(costs[1:])
+        print(f"{name}:")
+        print(
+            f"  {DURATION:g} s simulated: {wall:.2f} s wall with the monitor every "
+            f"{args.period:g} s, {idle:.2f} s with an idle monitor"
+        )
+        print(
+            f"  one evaluation: median {np.median(c):.2f} ms, p90 "
+            f"{np.percentile(c, 90):.2f} ms, max {c.max():.2f} ms "
+            f"({len(costs)} samples; first {1e3 * costs[0]:.1f} ms)"
+        )
+        print(f"  verdicts: {timeline(pick)}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,338 @@
+"""A hand's fingers: which joints close it and which bodies each one moves.
+
+**Closing joints.**  The hand's one-dof joints (revolute, prismatic) that have
+an actuator (all its one-dof joints when none has one), plus both joints of
+every coupling.
+
+**Fingers.**  A *finger* is the chain that one closing joint drives.  Its
+**root joint** is a closing joint whose parent body no other closing joint
+moves; the finger holds every closing joint and every hand body that the root
+moves (``plant.GetBodiesKinematicallyAffectedBy``).  Its **tip** is the set of
+its bodies (with collision geometry) that the most of its joints move.  The
+WSG-50 has two fingers (one prismatic joint each), the Allegro hand four (four
+revolute joints each).  Joints coupled across fingers make those fingers one,
+as the rigid mimic linkage of a real gripper does.  Bodies that no closing
+joint moves (the palm) stay where they are.
+
+**Couplings.**  Drake parses a URDF ``<mimic>`` (or SDFormat
+``<drake:mimic>``) into a coupler constraint ``q_0 = ρ q_1 + Δq``
+(``MultibodyPlant.AddCouplerConstraint(joint_0, joint_1, ρ, Δq)``); its Python
+API does not let us read the constraint back, so the caller passes the same
+four numbers as a *coupling* ``(joint_0, joint_1, ρ, Δq)``: ``joint_0``
+follows ``joint_1``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import Joint, JointIndex, RigidBody
+
+from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.plant.validation import scoped_name
+
+__all__ = ["MAX_STEP", "Coupling", "Finger", "HandStructure", "hand_structure"]
+
+MAX_STEP = {"revolute": 0.2, "prismatic": 0.01}
+"""Largest change of any joint of a finger in one closing step: radians, metres."""
+
+
+@dataclass(frozen=True, eq=False)
+class Finger:
+    """One finger of a hand (see the module docstring).
+
+    Attributes
+    ----------
+    name : str
+        ``model::root_joint`` (roots joined by ``+`` for coupled fingers).
+    joints : tuple of int
+        Positions of its joints in ``HandStructure.joints``.
+    bodies : tuple of RigidBody
+    pairs : tuple of (GeometryId, GeometryId, RigidBody)
+        (object geometry, finger geometry, finger body) for every pair that
+        the scene graph does not filter.
+    tip_pairs : tuple
+        The pairs of the finger's tip.
+    max_step : float
+        :data:`MAX_STEP` of its joints (the smallest).
+    """
+
+    name: str
+    joints: tuple[int, ...]
+    bodies: tuple[RigidBody, ...]
+    pairs: tuple
+    tip_pairs: tuple
+    max_step: float
+
+
+class Coupling:
+    """Followers move with their leaders, ``q_f = ρ q_l + Δq`` (closing-joint order)."""
+
+    def __init__(self, follows: dict[int, tuple[int, float, float]]):
+        self.follows = follows  # follower position -> (leader position, ρ, Δq)
+
+    def apply(self, q: np.ndarray) -> np.ndarray:
+        """Positions with every follower set from its leader."""
+        q = q.copy()
+        for f, (lead, rho, off) in self.follows.items():
+            q[f] = rho * q[lead] + off
+        return q
+
+    def tangent(self, d: np.ndarray) -> np.ndarray:
+        """A direction over the free joints extended to the followers."""
+        d = d.copy()
+        for f, (lead, rho, _) in self.follows.items():
+            d[f] = rho * d[lead]
+        return d
+
+    def project(self, d: np.ndarray) -> np.ndarray:
+        """A direction with the followers' entries dropped (they are derived)."""
+        d = d.copy()
+        d[list(self.follows)] = 0.0
+        return d
+
+    def pull_back(self, g: np.ndarray) -> np.ndarray:
+        """A gradient over the free joints (a follower's part goes to its leader)."""
+        g = g.copy()
+        for f, (lead, rho, _) in self.follows.items():
+            g[lead] += rho * g[f]
+            g[f] = 0.0
+        return g
+
+    def leader_limits(self, lower: np.ndarray, upper: np.ndarray):
+        """Limits with each leader's range cut to keep its follower in range."""
+        lower, upper = lower.copy(), upper.copy()
+        for f, (lead, rho, off) in self.follows.items():
+            a, b = sorted(((lower[f] - off) / rho, (upper[f] - off) / rho))
+            lower[lead], upper[lead] = max(lower[lead], a), min(upper[lead], b)
+        return lower, upper
+
+
+@dataclass(frozen=True, eq=False)
+class HandStructure:
+    """The closing joints of a hand, their limits, its fingers and couplings.
+
+    Attributes
+    ----------
+    joints : tuple of Joint
+        Closing joints, in the order of the plant's positions.
+    names : tuple of str
+        Their scoped names ``model::joint``.
+    position_indices, velocity_indices : (n_h,) int
+        Their indices in the plant's ``q`` and ``v``.
+    lower, upper : (n_h,) float
+        Position limits (a leader's cut to keep its follower in range).
+    fingers : tuple of Finger
+    coupling : Coupling
+    """
+
+    joints: tuple[Joint, ...]
+    names: tuple[str, ...]
+    position_indices: np.ndarray
+    velocity_indices: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    fingers: tuple[Finger, ...]
+    coupling: Coupling
+
+
+def joint_name(plant: MultibodyPlant, joint: Joint) -> str:
+    """``model::joint`` of a joint."""
+    return f"{plant.GetModelInstanceName(joint.model_instance())}::{joint.name()}"
+
+
+def _find_joint(plant: MultibodyPlant, spec) -> Joint:
+    if isinstance(spec, Joint) and spec.GetParentPlant() is plant:
+        return spec
+    if isinstance(spec, str):
+        model, _, name = spec.rpartition("::")
+        for i in range(plant.num_joints()):
+            j = plant.get_joint(JointIndex(i))
+            if j.name() == name and (
+                not model or plant.GetModelInstanceName(j.model_instance()) == model
+            ):
+                return j
+    raise InvalidOptionError(
+        f"coupling joint {spec!r} is not a joint of the plant (give a Joint or "
+        "a 'model::joint' name)"
+    )
+
+
+def _closing_joints(plant, bodies, couplings):
+    """The closing joints and the couplings as joint index -> (leader, ρ, Δq)."""
+    wanted = {int(b.index()) for b in bodies}
+
+    def of_hand(j: Joint) -> bool:
+        return j.num_positions() == 1 and int(j.child_body().index()) in wanted
+
+    one_dof = [
+        plant.get_joint(JointIndex(i))
+        for i in range(plant.num_joints())
+        if of_hand(plant.get_joint(JointIndex(i)))
+    ]
+    actuated = {
+        int(plant.get_joint_actuator(a).joint().index())
+        for a in plant.GetJointActuatorIndices()
+    }
+    joints = [j for j in one_dof if int(j.index()) in actuated] or one_dof
+    follows = {}
+    for entry in couplings:
+        if isinstance(entry, str) or len(entry) != 4:
+            raise InvalidOptionError(
+                "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
+                f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
+            )
+        j0, j1 = _find_joint(plant, entry[0]), _find_joint(plant, entry[1])
+        rho, off = float(entry[2]), float(entry[3])
+        if rho == 0 or not np.isfinite(rho) or not np.isfinite(off):
+            raise InvalidOptionError(
+                f"coupling gear_ratio must be finite and non-zero and offset finite, "
+                f"got {entry[2]!r}, {entry[3]!r}"
+            )
+        follows[int(j0.index())] = (int(j1.index()), rho, off)
+        for j in (j0, j1):
+            if not of_hand(j):
+                raise InvalidOptionError(
+                    f"coupled joint {joint_name(plant, j)} is not a one-dof joint "
+                    "of the hand"
+                )
+            if all(j.index() != k.index() for k in joints):
+                joints.append(j)
+    joints.sort(key=lambda j: j.position_start())
+    return joints, follows
+
+
+def _group(plant, joints, follows, moved) -> list[list[Joint]]:
+    """Union-find: a joint joins the finger of the joint that moves its parent."""
+    parent = {int(j.index()): int(j.index()) for j in joints}
+
+    def find(k):
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = parent[k]
+        return k
+
+    for j in joints:
+        for k in joints:
+            if k is not j and int(j.parent_body().index()) in moved[int(k.index())]:
+                parent[find(int(j.index()))] = find(int(k.index()))
+    for follower, (leader, _, _) in follows.items():
+        parent[find(follower)] = find(leader)
+    groups: dict[int, list[Joint]] = {}
+    for j in joints:
+        groups.setdefault(find(int(j.index())), []).append(j)
+    return list(groups.values())
+
+
+def _finger(plant, members, moved, bodies, position, object_geometries, inspector):
+    roots = [
+        j
+        for j in members
+        if not any(
+            int(j.parent_body().index()) in moved[int(k.index())]
+            for k in members
+            if k is not j
+        )
+    ]
+    ids = set().union(*(moved[int(j.index())] for j in members))
+    finger_bodies = tuple(b for b in bodies if int(b.index()) in ids)
+    pairs = tuple(
+        (go, gf, b)
+        for b in finger_bodies
+        for gf in plant.GetCollisionGeometriesForBody(b)
+        for go in object_geometries
+        if not inspector.CollisionFiltered(go, gf)
+    )
+    depth = {
+        int(b.index()): sum(int(b.index()) in moved[int(j.index())] for j in members)
+        for b in finger_bodies
+    }
+    deepest = max((depth[int(b.index())] for _, _, b in pairs), default=0)
+    return Finger(
+        name=" + ".join(joint_name(plant, j) for j in roots),
+        joints=tuple(sorted(position[int(j.index())] for j in members)),
+        bodies=finger_bodies,
+        pairs=pairs,
+        tip_pairs=tuple(p for p in pairs if depth[int(p[2].index())] == deepest),
+        max_step=min(
+            MAX_STEP["revolute" if j.type_name() == "revolute" else "prismatic"]
+            for j in members
+        ),
+    )
+
+
+def hand_structure(
+    plant: MultibodyPlant,
+    object_body: RigidBody,
+    bodies: Sequence[RigidBody],
+    couplings: Sequence[tuple] = (),
+    *,
+    inspector,
+) -> HandStructure:
+    """Closing joints, fingers and couplings of a hand (see the module docstring).
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    object_body : RigidBody
+        The object the fingers close on (its geometries make the pairs).
+    bodies : sequence of RigidBody
+        The hand's movable bodies (:func:`~drakegrasp.plant.validation.hand_bodies`).
+    couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
+    inspector : SceneGraphInspector
+        For the collision filters (``query_object.inspector()``).
+
+    Returns
+    -------
+    HandStructure
+
+    Raises
+    ------
+    ModelError
+        If the hand has no one-dof joint.
+    InvalidOptionError
+        For a malformed coupling.
+    """
+    joints, follows = _closing_joints(plant, bodies, couplings)
+    if not joints:
+        raise ModelError(
+            "the hand has no one-dof joint to close: "
+            f"{[scoped_name(plant, b) for b in bodies]}"
+        )
+    hand = {int(b.index()) for b in bodies}
+    moved = {
+        int(j.index()): {
+            int(i) for i in plant.GetBodiesKinematicallyAffectedBy([j.index()])
+        }
+        & hand
+        for j in joints
+    }
+    position = {int(j.index()): k for k, j in enumerate(joints)}
+    object_geometries = plant.GetCollisionGeometriesForBody(object_body)
+    fingers = tuple(
+        _finger(plant, members, moved, bodies, position, object_geometries, inspector)
+        for members in _group(plant, joints, follows, moved)
+    )
+    mapped = {}
+    for follower, (leader, rho, off) in follows.items():
+        f, lead = position[follower], position[leader]
+        if lead in mapped or f in {v[0] for v in mapped.values()}:
+            raise InvalidOptionError("a joint may not both lead and follow a coupling")
+        mapped[f] = (lead, rho, off)
+    coupling = Coupling(mapped)
+    lower = np.array([j.position_lower_limits()[0] for j in joints])
+    upper = np.array([j.position_upper_limits()[0] for j in joints])
+    lower, upper = coupling.leader_limits(lower, upper)
+    return HandStructure(
+        joints=tuple(joints),
+        names=tuple(joint_name(plant, j) for j in joints),
+        position_indices=np.array([j.position_start() for j in joints]),
+        velocity_indices=np.array([j.velocity_start() for j in joints]),
+        lower=lower,
+        upper=upper,
+        fingers=fingers,
+        coupling=coupling,
+    )

@@ -1,0 +1,1208 @@
+"""Hostile inputs for the public API and the command line, and their outcomes.
+
+A :class:`Case` is one call with what a right outcome is: a refusal
+(``GraspError``), an answer (checked against an independent route where one
+exists), or either.  :func:`run_case` classifies what happened into the
+outcome table of issue 9:
+
+* ``clear GraspError`` — refused with a one-line GraspError message;
+* ``plausible verdict`` — answered, and the independent check (if any) agrees;
+* ``raw exception`` — any exception that is not a GraspError;
+* ``hang`` — took longer than the time limit (a SIGALRM interrupts Python code;
+  a hard watchdog ends the process if C code never returns);
+* ``silent wrong answer`` — answered where a refusal was due, or the answer
+  disagrees with the independent route;
+* ``valid input refused`` — a GraspError for an input inside the documented
+  ranges (not in the issue's table; must also be 0);
+* ``lost data`` — a file that existed before (input or earlier output) changed
+  or vanished.
+
+:func:`all_cases` builds every family; each family is deterministic (fixed
+seeds), so the counts are reproducible.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import signal
+import tempfile
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import fuzz_oracles as oracle
+import numpy as np
+
+import drakegrasp as dg
+from drakegrasp import examples as ex
+from drakegrasp import validation as V
+
+OUTCOMES = (
+    "clear GraspError",
+    "plausible verdict",
+    "raw exception",
+    "hang",
+    "silent wrong answer",
+    "lost data",
+    "valid input refused",
+)
+BAD = OUTCOMES[2:]
+TIME_LIMIT = 10.0
+
+
+@dataclass
+class Case:
+    """One hostile call; ``expect`` is "refuse", "answer" or "either"."""
+
+    family: str
+    name: str
+    call: Callable[[], Any]
+    expect: str = "either"
+    check: Callable[[Any], bool] | None = None
+    files: tuple[Path, ...] = ()
+
+
+class _Timeout(Exception):
+    pass
+
+
+def _alarm(signum, frame):
+    raise _Timeout
+
+
+def _digest(path: Path) -> str | None:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
+
+
+def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:
+    """Run one case; return (outcome, detail)."""
+    before = {p: _digest(p) for p in case.files}
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.setitimer(signal.ITIMER_REAL, limit)
+    start = time.perf_counter()
+    outcome, detail = "plausible verdict", ""
+    try:
+        result = case.call()
+    except _Timeout:
+        outcome, detail = "hang", f"over {limit:g} s"
+    except dg.GraspError as e:
+        text = str(e)
+        if case.expect == "answer":
+            outcome, detail = "valid input refused", text[:200]
+        elif not text.strip() or "\n" in text.strip():
+            outcome, detail = "raw exception", f"unclear GraspError message {text!r}"
+        else:
+            outcome, detail = "clear GraspError", text[:200]
+    except Exception as e:  # noqa: BLE001 - this is what the fuzz counts
+        outcome, detail = "raw exception", f"{type(e).__name__}: {str(e)[:200]}"
+    else:
+        if case.expect == "refuse":
+            outcome, detail = "silent wrong answer", f"accepted: {_short(result)}"
+        elif case.check is not None:
+            try:
+                ok = case.check(result)
+            except Exception as e:  # noqa: BLE001
+                ok, detail = False, f"check failed: {type(e).__name__}: {e}"
+            if not ok:
+                outcome = "silent wrong answer"
+                detail = detail or f"disagrees: {_short(result)}"
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    if time.perf_counter() - start > limit and outcome != "hang":
+        outcome, detail = "hang", f"{time.perf_counter() - start:.1f} s"
+    for p, digest in before.items():
+        if digest is not None and _digest(p) != digest:
+            outcome, detail = "lost data", f"{p.name} changed or vanished"
+    return outcome, detail
+
+
+def _short(x) -> str:
+    text = repr(x)
+    return text if len(text) < 160 else text[:157] + "..."
+
+
+# ----------------------------------------------------------------- value pools
+
+NAN, INF = math.nan, math.inf
+BAD_SCALARS = [
+    NAN,
+    INF,
+    -INF,
+    -1.0,
+    "abc",
+    None,
+    True,
+    1j,
+    [1.0, 2.0],
+    np.array([0.5, 0.5]),
+    object(),
+    {"a": 1},
+]
+BAD_VECTORS = [
+    [NAN, 0, 1],
+    [INF, 0, 0],
+    [0, 0, 0],
+    [1, 2],
+    [1, 2, 3, 4],
+    "abc",
+    None,
+    [1 + 1j, 0, 0],
+    np.array([1, 0, 0], dtype=complex),
+    [[1, 0], [0]],
+    [1e308, -1e308, 1e308],
+    [1.5e308, -1.5e308, 0],
+    ["a", "b", "c"],
+    [None, 0, 1],
+    np.zeros((2, 2)),
+]
+HUGE_NORMALS = [
+    [-1e155, 0, 0],
+    [0, 1e200, 0],
+    [1e-300, 0, 0],
+    [3e307, 4e307, 0],
+    [-1e-200, 1e-200, 0],
+]
+
+
+def _valid_grasp(mu=0.5):
+    return ex.equator_fingers(mu)
+
+
+# ------------------------------------------------------------------- families
+
+
+def contact_cases() -> Iterator[Case]:
+    """Contact(...) with hostile positions, normals, mu, nu and models."""
+    for i, v in enumerate(BAD_VECTORS):
+        if i != 2:  # [0, 0, 0] is a valid position
+            yield Case(
+                "Contact",
+                f"position#{i}",
+                lambda v=v: dg.Contact(v, [0, 0, 1]),
+                "refuse",
+            )
+        if i in (10, 11):  # huge finite normals are valid (normalised safely)
+            continue
+        yield Case(
+            "Contact", f"normal#{i}", lambda v=v: dg.Contact([0, 0, 1], v), "refuse"
+        )
+    for i, n in enumerate(HUGE_NORMALS):
+        want = oracle.unit(n)
+
+        def check(c, want=want):
+            return np.allclose(c.normal, want, atol=1e-15)
+
+        yield Case(
+            "Contact",
+            f"huge-normal#{i}",
+            lambda n=n: dg.Contact([0, 0, 0], n),
+            "answer",
+            check,
+        )
+    coefficient_pool = BAD_SCALARS + [1e-300, 1e-13, 1e13, 1e78, 1e155, -0.0]
+    for name in ("mu", "torsional_friction"):
+        for i, x in enumerate(coefficient_pool):
+            kw = {name: x, "model": "soft_finger"}
+            if name == "mu":
+                kw["torsional_friction"] = 0.1
+            expect = "either" if (isinstance(x, float) and x == 0.0) else "refuse"
+            yield Case(
+                "Contact",
+                f"{name}#{i}",
+                lambda kw=kw: dg.Contact([0, 0, 1], [0, 0, -1], **kw),
+                expect,
+            )
+        for x in (0.0, 1e-12, 1e-6, 0.3, 1e6, 1e12):
+            kw = {name: x, "model": "soft_finger"}
+            if name == "mu":
+                kw["torsional_friction"] = 0.1
+            yield Case(
+                "Contact",
+                f"{name}={x:g}",
+                lambda kw=kw: dg.Contact([0, 0, 1], [0, 0, -1], **kw),
+                "answer",
+                lambda c, kw=kw, name=name: getattr(c, name) == kw[name],
+            )
+    for i, m in enumerate(["sticky", None, 3, "", "SOFT-FINGER", "Hard_Finger"]):
+        expect = "answer" if i >= 4 else "refuse"
+        kw = {"torsional_friction": 0.1} if i == 4 else {}
+        yield Case(
+            "Contact",
+            f"model#{i}",
+            lambda m=m, kw=kw: dg.Contact([0, 0, 1], [0, 0, -1], model=m, **kw),
+            expect,
+        )
+    # A perpendicular normal of length 1e200 is not antipodal (its squared norm
+    # overflowed, the normal became 0 and the pair passed).
+    a = dg.Contact([0, 0, 0], [1, 0, 0], mu=0.1)
+    for i, n in enumerate(([0, 1e200, 0], [0, 1e-300, 0], [1e300, 1e300, 0])):
+        b = dg.Contact([1, 0, 0], n, mu=0.1)
+        yield Case(
+            "Contact",
+            f"antipodal-huge#{i}",
+            lambda b=b: dg.is_antipodal([a, b]),
+            "answer",
+            lambda r: not r.is_antipodal,
+        )
+    yield Case(
+        "Contact",
+        "antipodal-huge-opposed",
+        lambda: dg.is_antipodal([a, dg.Contact([1, 0, 0], [-1e300, 0, 0], mu=0.1)]),
+        "answer",
+        lambda r: r.is_antipodal,
+    )
+    yield Case(
+        "Contact",
+        "soft-without-nu",
+        lambda: dg.Contact([0, 0, 1], [0, 0, -1], model="soft_finger"),
+        "refuse",
+    )
+    yield Case(
+        "Contact",
+        "planar-soft",
+        lambda: dg.Contact([0, 1], [0, -1], model="soft_finger", torsional_friction=1),
+        "refuse",
+    )
+
+
+def grasp_cases() -> Iterator[Case]:
+    """Grasp(...) with hostile contacts, reference points and lengths."""
+    c3 = dg.Contact([0, 0, 1], [0, 0, -1], mu=0.5)
+    c2 = dg.Contact([0, 1], [0, -1], mu=0.5)
+    for i, cs in enumerate(
+        [None, [], 5, "abc", [1, 2], [c3, c2], [c3, None], [(0, 0, 1)], {1: c3}]
+    ):
+        yield Case("Grasp", f"contacts#{i}", lambda cs=cs: dg.Grasp(cs), "refuse")
+    for i, p in enumerate(BAD_VECTORS + [[1e21, 0, 0]]):
+        # [0, 0, 0] is valid and None is the default; 1e308 is beyond the bound.
+        expect = "answer" if i in (2, 6) else "refuse"
+        yield Case(
+            "Grasp",
+            f"reference#{i}",
+            lambda p=p: dg.Grasp([c3], reference_point=p),
+            expect,
+        )
+    for i, b in enumerate(BAD_SCALARS + [0.0, 1e31, -5.0]):
+        expect = "answer" if b is None else "refuse"  # None: the default
+        yield Case(
+            "Grasp",
+            f"length#{i}",
+            lambda b=b: dg.Grasp([c3], characteristic_length=b),
+            expect,
+        )
+    far = [[1e20, 0, 0], [0, 1e19, 0]]
+    for i, p in enumerate(far):
+        yield Case(
+            "Grasp",
+            f"far-reference#{i}",
+            lambda p=p: dg.Grasp([c3], reference_point=p),
+            "answer",
+            lambda g: math.isfinite(g.characteristic_length),
+        )
+    # characteristic length of huge positions is finite (was inf for 1e200).
+    yield Case(
+        "Grasp",
+        "length-of-1e20",
+        lambda: dg.Grasp(
+            [
+                dg.Contact([1e20, 1e20, 0], [1, 0, 0]),
+                dg.Contact([-1e20, 0, 0], [1, 0, 0]),
+            ]
+        ),
+        "answer",
+        lambda g: g.characteristic_length == oracle_length(g),
+    )
+    for i, pos in enumerate([[1e200, 0, 0], [1.5e308, -1.5e308, 0], [1e21, 0, 0]]):
+        yield Case(
+            "Grasp",
+            f"position-beyond-bound#{i}",
+            lambda pos=pos: dg.Contact(pos, [1, 0, 0]),
+            "refuse",
+        )
+
+
+def oracle_length(g) -> float:
+    P = np.asarray(g.positions, dtype=np.longdouble) - np.asarray(
+        g.reference_point, dtype=np.longdouble
+    )
+    return float(np.max(np.sqrt(np.sum(P * P, axis=1))))
+
+
+def _functions_of_a_grasp():
+    """Public functions whose first argument is a Grasp, with a valid call."""
+    J = np.eye(9)
+    d = np.array([1.0, 0, 0, 0, 0, 0])
+    return {
+        "form_closure": lambda g, **k: dg.form_closure(g, **k),
+        "force_closure": lambda g, **k: dg.force_closure(g, **k),
+        "force_closure_exact": lambda g, **k: dg.force_closure_exact(g, **k),
+        "internal_forces": lambda g, **k: dg.internal_forces(g, J, **k),
+        "ferrari_canny": lambda g, **k: dg.ferrari_canny(g, **k),
+        "ferrari_canny_linf": lambda g, **k: dg.ferrari_canny(g, norm="Linf", **k),
+        "lp2_margin": lambda g, **k: dg.lp2_margin(g, **k),
+        "grasp_quality": lambda g, **k: dg.grasp_quality(g, **k),
+        "grasp_singular_values": lambda g, **k: dg.grasp_singular_values(g, **k),
+        "min_singular_value": lambda g, **k: dg.min_singular_value(g, **k),
+        "isotropy": lambda g, **k: dg.isotropy(g, **k),
+        "wrench_ellipsoid_volume": lambda g, **k: dg.wrench_ellipsoid_volume(g, **k),
+        "hand_object_matrix": lambda g, **k: dg.hand_object_matrix(g, J, **k),
+        "distance_to_singularity": lambda g, **k: dg.distance_to_singularity(g, J, **k),
+        "uniformity_of_transformation": lambda g, **k: dg.uniformity_of_transformation(
+            g, J, **k
+        ),
+        "manipulability_volume": lambda g, **k: dg.manipulability_volume(g, J, **k),
+        "max_resistible_wrench": lambda g, **k: dg.max_resistible_wrench(
+            g, d, max_normal_force=1.0, **k
+        ),
+        "build_max_resistible_wrench_program": lambda g, **k: (
+            dg.build_max_resistible_wrench_program(g, d, max_normal_force=1.0, **k)
+        ),
+        "primitive_wrenches": lambda g, **k: dg.primitive_wrenches(g, **k),
+        "grasp_matrix": lambda g, **k: dg.grasp_matrix(g, **k),
+        "normal_grasp_matrix": lambda g, **k: dg.normal_grasp_matrix(g, **k),
+        "build_form_closure_program": lambda g, **k: dg.build_form_closure_program(
+            g, **k
+        ),
+        "build_force_closure_program": lambda g, **k: dg.build_force_closure_program(
+            g, **k
+        ),
+        "build_exact_force_closure_program": lambda g, **k: (
+            dg.build_exact_force_closure_program(g, **k)
+        ),
+        "build_internal_force_program": lambda g, **k: dg.build_internal_force_program(
+            g, J, **k
+        ),
+        "is_antipodal": lambda g, **k: dg.is_antipodal(g, **k),
+        "plot_wrench_space": lambda g, **k: dg.plot_wrench_space(g, **k),
+    }
+
+
+WRONG_GRASPS = [
+    None,
+    1,
+    "grasp",
+    [],
+    np.zeros(3),
+    {"contacts": []},
+    dg.Contact([0, 0, 1], [0, 0, -1]),
+]
+
+
+def wrong_type_cases() -> Iterator[Case]:
+    """Every grasp function with a first argument that is not a Grasp."""
+    for name, fn in _functions_of_a_grasp().items():
+        for i, g in enumerate(WRONG_GRASPS):
+            if name == "is_antipodal" and i == 3:
+                continue  # [] is a (bad) sequence of contacts: still a refusal
+            yield Case(
+                "wrong type", f"{name}(#{i})", lambda fn=fn, g=g: fn(g), "refuse"
+            )
+    others = {
+        "friction_cone_facets": dg.friction_cone_facets,
+        "friction_cone_generators": dg.friction_cone_generators,
+        "contact_frame": dg.contact_frame,
+        "contact_frames": dg.contact_frames,
+        "matrix_rank": dg.matrix_rank,
+        "plot_planar_grasp": dg.plot_planar_grasp,
+    }
+    for name, fn in others.items():
+        for i, g in enumerate([None, "abc", 1j, np.array([np.nan, 1.0, 0]), object()]):
+            yield Case(
+                "wrong type", f"{name}(#{i})", lambda fn=fn, g=g: fn(g), "refuse"
+            )
+    for name in ("draw_grasp", "clear_grasp"):
+        fn = getattr(dg, name)
+        for i, g in enumerate([None, 1, "meshcat"]):
+            yield Case(
+                "wrong type",
+                f"{name}(#{i})",
+                lambda fn=fn, g=g: fn(g, _valid_grasp()),
+                "refuse",
+            )
+    # batch entry points
+    P, N = _valid_batch()
+    for i, x in enumerate(
+        [None, "abc", 1, np.zeros((2, 3)), np.zeros((1, 3, 4)), P.astype(complex)]
+    ):
+        yield Case(
+            "wrong type",
+            f"batch_force_closure(P#{i})",
+            lambda x=x: dg.batch_force_closure(x, N, 0.5),
+            "refuse",
+        )
+        yield Case(
+            "wrong type",
+            f"batch_form_closure(N#{i})",
+            lambda x=x: dg.batch_form_closure(P, x),
+            "refuse",
+        )
+    for i, x in enumerate([None, 1, [], object()]):
+        yield Case(
+            "wrong type",
+            f"evaluate_file(#{i})",
+            lambda x=x: dg.evaluate_file(x, x),
+            "refuse",
+        )
+
+
+OPTION_POOLS = {
+    "tol": [NAN, INF, 0.0, -1.0, 2.0, "abc", None, 1e-300, True, 1j],
+    "rank_tol": [NAN, INF, 2.0, 0.0, -1.0, "abc", None, 1e-300, 1j],
+    "num_generators": [None, 2, 2.5, 10**9, 10**7, "8", -3, True, INF],
+    "torque_scale": [NAN, INF, 0.0, -1.0, "abc", 1e40, 1j],
+    "angle_tol": [INF, NAN, -1.0, 1.0, "abc", None],
+    "mu": [NAN, INF, -1.0, 1e78, 1e-200, "abc", 1j],
+    "formulation": ["vertices", None, 3],
+    "norm": ["L2", None, 1],
+    "hand_jacobian": [
+        np.full((9, 2), np.nan),
+        np.eye(3),
+        "abc",
+        np.eye(9) * 1e200,
+        np.eye(9, dtype=complex),
+    ],
+}
+
+
+def _accepts(fn, option: str) -> bool:
+    import inspect
+
+    target = {
+        "ferrari_canny_linf": dg.ferrari_canny,
+    }.get(fn, getattr(dg, fn, None))
+    if target is None:
+        return False
+    return option in inspect.signature(target).parameters
+
+
+def option_cases() -> Iterator[Case]:
+    """Every option of every grasp function, with hostile values."""
+    g = _valid_grasp()
+    for name, fn in _functions_of_a_grasp().items():
+        for option, pool in OPTION_POOLS.items():
+            if not _accepts(name, option) or (
+                name == "ferrari_canny_linf" and option == "norm"
+            ):
+                continue
+            if option == "mu" and name != "is_antipodal":
+                continue
+            if option == "hand_jacobian" and name not in (
+                "force_closure",
+                "force_closure_exact",
+                "grasp_quality",
+            ):
+                continue
+            for i, value in enumerate(pool):
+                yield Case(
+                    "options",
+                    f"{name}({option}#{i})",
+                    lambda fn=fn, o=option, v=value: fn(g, **{o: v}),
+                    "refuse",
+                )
+    hostile = ["abc", None, [1j, 0, 0, 0, 0, 0], [NAN] * 6, np.zeros(6), [1, 0, 0], {}]
+    for i, d in enumerate(hostile):
+        yield Case(
+            "options",
+            f"max_resistible_wrench(direction#{i})",
+            lambda d=d: dg.max_resistible_wrench(g, d, max_normal_force=1.0),
+            "refuse",
+        )
+    for i, f in enumerate(["abc", None, 1j, -1.0, NAN, [1.0, 2.0], INF]):
+        yield Case(
+            "options",
+            f"max_resistible_wrench(max_normal_force#{i})",
+            lambda f=f: dg.max_resistible_wrench(g, np.eye(6)[0], max_normal_force=f),
+            "refuse",
+        )
+    for i, flag in enumerate(["yes", 1, [True]]):
+        yield Case(
+            "options",
+            f"grasp_quality(linf#{i})",
+            lambda f=flag: dg.grasp_quality(g, linf=f),
+            "refuse",
+        )
+    # Unbounded work is refused up front: L∞ with 40 contacts (4^40 face
+    # choices), any ε of 300 contacts (a 2,400-point hull in 6-D).
+    rng = np.random.default_rng(2)
+    for num in (40, 300):
+        P = rng.normal(size=(num, 3))
+        P /= np.linalg.norm(P, axis=1, keepdims=True)
+        big = dg.Grasp(
+            [dg.Contact(p, -p + 0.2 * rng.normal(size=3), mu=0.5) for p in P]
+        )
+        yield Case(
+            "options",
+            f"ferrari_canny_linf(N={num})",
+            lambda g=big: dg.ferrari_canny(g, norm="Linf"),
+            "refuse",
+        )
+        if num == 300:
+            yield Case(
+                "options",
+                f"ferrari_canny(N={num})",
+                lambda g=big: dg.ferrari_canny(g),
+                "refuse",
+            )
+    # Valid extremes are answered (and agree with the default where they should).
+    ref = dg.force_closure(g)
+    # Equator fingers: LP2's d* = 0.4194 and LP1's d* = 1 (three unit normal
+    # forces balance), so closure holds for every tol in the valid range.
+    for tol in (V.TOL_MIN, 1e-3, V.TOL_MAX):
+        yield Case(
+            "options",
+            f"force_closure(tol={tol:g})",
+            lambda tol=tol: dg.force_closure(g, tol=tol),
+            "answer",
+            lambda r: r.is_closure,
+        )
+    for tol in (1.0, 2.0):
+        yield Case(
+            "options",
+            f"force_closure(tol={tol:g})",
+            lambda tol=tol: dg.force_closure(g, tol=tol),
+            "refuse",
+        )
+    J = np.eye(9)
+    for name, fn in (
+        ("internal_forces", dg.internal_forces),
+        ("hand_object_matrix", dg.hand_object_matrix),
+        ("build_internal_force_program", dg.build_internal_force_program),
+        ("distance_to_singularity", dg.distance_to_singularity),
+    ):
+        for i, bad_J in enumerate(OPTION_POOLS["hand_jacobian"] + [None, J[:, :0]]):
+            yield Case(
+                "options",
+                f"{name}(J#{i})",
+                lambda fn=fn, bad_J=bad_J: fn(g, bad_J),
+                "refuse",
+            )
+    for rt in (V.RANK_TOL_MIN, 1e-6, V.RANK_TOL_MAX):
+        yield Case(
+            "options",
+            f"force_closure(rank_tol={rt:g})",
+            lambda rt=rt: dg.force_closure(g, rank_tol=rt),
+            "answer",
+            lambda r: r.is_closure and abs(r.d_star - ref.d_star) < 1e-7,
+        )
+    yield Case(
+        "options",
+        "force_closure(num_generators=256)",
+        lambda: dg.force_closure(g, num_generators=V.MAX_NUM_GENERATORS),
+        "answer",
+        lambda r: r.is_closure and r.d_star >= ref.d_star - 1e-7,
+    )
+
+
+def _valid_batch(K=4):
+    g = _valid_grasp()
+    return np.repeat(g.positions[None], K, 0), np.repeat(g.normals[None], K, 0)
+
+
+def batch_cases() -> Iterator[Case]:
+    """Batch entry points: hostile coefficient arrays, positions and options."""
+    P, N = _valid_batch()
+    single = dg.force_closure(_valid_grasp())
+    for i, mu in enumerate(
+        [
+            NAN,
+            INF,
+            -1.0,
+            1e78,
+            1e155,
+            1e-200,
+            "abc",
+            None,
+            1j,
+            np.full((4, 3), np.nan),
+            np.full((4, 3), 1e78),
+            np.full((4, 3), 1e-200),
+            np.full((4, 3), 0.5 + 0j),
+            np.full((4, 3), "x"),
+            np.ones((5, 3)),
+            np.ones((4, 2)),
+        ]
+    ):
+        yield Case(
+            "batch", f"mu#{i}", lambda mu=mu: dg.batch_force_closure(P, N, mu), "refuse"
+        )
+    for i, nu in enumerate([NAN, -1.0, 1e13, "abc", 1j, None]):
+        yield Case(
+            "batch",
+            f"nu#{i}",
+            lambda nu=nu: dg.batch_force_closure(
+                P, N, 0.5, model="soft_finger", torsional_friction=nu
+            ),
+            "refuse",
+        )
+    for option, pool in OPTION_POOLS.items():
+        if option in ("tol", "rank_tol", "num_generators"):
+            for i, v in enumerate(pool):
+                yield Case(
+                    "batch",
+                    f"{option}#{i}",
+                    lambda o=option, v=v: dg.batch_force_closure(P, N, 0.5, **{o: v}),
+                    "refuse",
+                )
+                if option != "num_generators":
+                    yield Case(
+                        "batch",
+                        f"form-{option}#{i}",
+                        lambda o=option, v=v: dg.batch_form_closure(P, N, **{o: v}),
+                        "refuse",
+                    )
+    for i, v in enumerate([0, -1, 2.5, None, "abc"]):
+        yield Case(
+            "batch",
+            f"chunk_size#{i}",
+            lambda v=v: dg.batch_force_closure(P, N, 0.5, chunk_size=v),
+            "refuse",
+        )
+    for i, v in enumerate(["yes", None, 1]):
+        yield Case(
+            "batch",
+            f"progress#{i}",
+            lambda v=v: dg.batch_force_closure(P, N, 0.5, progress=v),
+            "refuse",
+        )
+    for i, v in enumerate(["sigma", None, ["epsilon_l1", "bogus"]]):
+        yield Case(
+            "batch",
+            f"metrics#{i}",
+            lambda v=v: dg.batch_force_closure(P, N, 0.5, metrics=v),
+            "refuse",
+        )
+    bad_positions = P.copy()
+    bad_positions[2, 1] = [1.5e308, -1.5e308, 0]
+    yield Case(
+        "batch",
+        "overflowing-moments",
+        lambda: dg.batch_force_closure(bad_positions, N, 0.5),
+        "refuse",
+    )
+    huge = N.copy()
+    huge[1, 0] *= 1e155
+    huge[3, 2] *= 1e-300
+    yield Case(
+        "batch",
+        "huge-normals",
+        lambda: dg.batch_force_closure(P, huge, 0.5),
+        "answer",
+        lambda r: (
+            bool(np.all(r.is_closure == single.is_closure))
+            and np.allclose(r.d_star, single.d_star, atol=1e-6)
+        ),
+    )
+    for mu in (1e-12, 1e-6, 1e3, 1e12):
+        want = dg.force_closure(_valid_grasp(mu))
+        yield Case(
+            "batch",
+            f"mu={mu:g}-agrees",
+            lambda mu=mu: dg.batch_force_closure(P, N, mu),
+            "answer",
+            lambda r, want=want: (
+                bool(np.all(r.is_closure == want.is_closure))
+                and bool(np.all(r.converged))
+            ),
+        )
+
+
+def geometry_cases(seed: int = 0, count: int = 120) -> Iterator[Case]:
+    """Random grasps at extreme units, far references and huge/tiny normals.
+
+    Each verdict is compared with :func:`fuzz_oracles.closure_verdict` on the
+    same grasp (which the oracle rescales itself); near-boundary grasps, where
+    no independent verdict is clear, only need to answer.
+    """
+    rng = np.random.default_rng(seed)
+    for k in range(count):
+        num = int(rng.integers(2, 6))
+        planar = k % 5 == 4
+        dim = 2 if planar else 3
+        unit = 10.0 ** rng.uniform(-9, 9)
+        mu = float(rng.choice([0.0, 1e-12, 1e-6, 0.05, 0.5, 2.0, 1e6, 1e12]))
+        p = rng.normal(size=(num, dim))
+        p /= np.linalg.norm(p, axis=1, keepdims=True)
+        n = -p + 0.4 * rng.normal(size=(num, dim))
+        n *= 10.0 ** rng.uniform(-150, 150, size=(num, 1))
+        ref = rng.normal(size=dim) * 10.0 ** rng.uniform(0, 6)
+        P = p * unit
+        contacts = [dg.Contact(P[i], n[i], mu=mu) for i in range(num)]
+        grasp = dg.Grasp(contacts, reference_point=ref * unit)
+        want = oracle.closure_verdict(P, n, [mu] * num)
+        check = None if want is None else (lambda r, want=want: r.is_closure == want[0])
+        yield Case(
+            "geometry",
+            f"force#{k} unit={unit:.1e} mu={mu:g}",
+            lambda g=grasp: dg.force_closure(g),
+            "answer",
+            check,
+        )
+        if k % 3 == 0:
+            yield Case(
+                "geometry",
+                f"exact#{k}",
+                lambda g=grasp: dg.force_closure_exact(g),
+                "answer",
+                check,
+            )
+        if k % 3 == 1:
+            wf = oracle.form_closure_verdict(P, n)
+            fcheck = None if wf is None else (lambda r, wf=wf: r.is_closure == wf[0])
+            yield Case(
+                "geometry",
+                f"form#{k}",
+                lambda g=grasp: dg.form_closure(g),
+                "answer",
+                fcheck,
+            )
+        if k % 4 == 0:
+            Pb, Nb = P[None], n[None]
+            yield Case(
+                "geometry batch",
+                f"batch#{k}",
+                lambda Pb=Pb, Nb=Nb, r=ref * unit, mu=mu: dg.batch_force_closure(
+                    Pb, Nb, mu, reference_points=r
+                ),
+                "answer",
+                None
+                if want is None
+                else (lambda r, want=want: bool(r.is_closure[0] == want[0])),
+            )
+
+
+def monotonicity_cases(seed: int = 1, count: int = 40) -> Iterator[Case]:
+    """soft >= hard >= frictionless and larger mu/nu >= smaller, every metric."""
+    rng = np.random.default_rng(seed)
+    for k in range(count):
+        num = int(rng.integers(2, 5))
+        p = rng.normal(size=(num, 3))
+        p /= np.linalg.norm(p, axis=1, keepdims=True)
+        n = -p + 0.3 * rng.normal(size=(num, 3))
+        mu = float(10.0 ** rng.uniform(-12, 1))
+        nu = float(10.0 ** rng.uniform(-12, 12))
+        hard = dg.Grasp([dg.Contact(p[i], n[i], mu=mu) for i in range(num)])
+        soft = hard.with_friction(model="soft_finger", torsional_friction=nu)
+        fl = hard.with_friction(model="frictionless")
+
+        def both(hard=hard, soft=soft, fl=fl):
+            return [
+                (f(fl), f(hard), f(soft))
+                for f in (
+                    lambda g: dg.force_closure(g),
+                    lambda g: dg.force_closure_exact(g),
+                    lambda g: dg.ferrari_canny(g),
+                )
+            ]
+
+        def check(out):
+            (lf, lh, ls), (xf, xh, xs), (ef, eh, es) = out
+            verdicts = (lf.is_closure <= lh.is_closure <= ls.is_closure) and (
+                xf.is_closure <= xh.is_closure <= xs.is_closure
+            )
+            d_ok = ls.d_star >= lh.d_star - 1e-7 and xs.d_star >= xh.d_star - 1e-6
+            eps_ok = ef <= eh + 1e-9 and eh <= es + 1e-9 * max(1.0, eh)
+            return bool(verdicts and d_ok and eps_ok)
+
+        yield Case(
+            "monotone",
+            f"soft>=hard>=frictionless#{k} mu={mu:.1e} nu={nu:.1e}",
+            both,
+            "answer",
+            check,
+        )
+
+
+# ----------------------------------------------------------------- files, CLI
+
+
+def _save(path: Path, **arrays) -> Path:
+    with open(path, "wb") as f:
+        np.savez(f, **arrays)
+    return path
+
+
+def file_cases(root: Path) -> Iterator[Case]:
+    """evaluate_file and the CLI (in process) on damaged files and unsafe paths."""
+    from drakegrasp import cli
+
+    P, N = _valid_batch(6)
+    good = _save(root / "good.npz", positions=P, normals=N, mu=np.full((6, 3), 0.5))
+    payload = good.read_bytes()
+    damaged = {
+        "truncated": payload[: len(payload) // 2],
+        "empty": b"",
+        "text": b"positions,normals\n1,2,3\n",
+        "random": bytes(
+            np.random.default_rng(0).integers(0, 256, 4096, dtype=np.uint8)
+        ),
+        "zip-header-only": payload[:30],
+        "bit-flipped": payload[:200] + bytes([payload[200] ^ 0xFF]) + payload[201:],
+    }
+    for name, data in damaged.items():
+        path = root / f"{name}.npz"
+        path.write_bytes(data)
+        out = root / f"out-{name}.npz"
+        yield Case(
+            "files",
+            f"evaluate_file({name})",
+            lambda p=path, o=out: dg.evaluate_file(p, o),
+            "refuse",
+            files=(path,),
+        )
+        yield Case(
+            "files",
+            f"cli({name})",
+            lambda p=path, o=out: _cli(cli, "batch", str(p), str(o)),
+            "refuse",
+            files=(path,),
+        )
+    npy = root / "lone.npz"
+    np.save(open(npy, "wb"), P)
+    yield Case(
+        "files",
+        "lone-npy",
+        lambda: dg.evaluate_file(npy, root / "o1.npz"),
+        "refuse",
+        files=(npy,),
+    )
+    pickled = root / "pickled.npz"
+    np.savez(open(pickled, "wb"), positions=np.array([object()] * 3), normals=N)
+    yield Case(
+        "files",
+        "pickled",
+        lambda: dg.evaluate_file(pickled, root / "o2.npz"),
+        "refuse",
+        files=(pickled,),
+    )
+    for i, arrays in enumerate(
+        [
+            {"positions": P},
+            {"positions": P, "normals": N, "bogus": P},
+            {"positions": P.astype(complex), "normals": N, "mu": 0.5},
+            {"positions": np.array(["a"] * 3), "normals": N, "mu": 0.5},
+            {"positions": P, "normals": N, "mu": np.full((6, 3), np.nan)},
+            {"positions": P, "normals": N},
+            {"positions": P, "normals": N, "mu": 1e80},
+        ]
+    ):
+        path = _save(root / f"bad{i}.npz", **arrays)
+        yield Case(
+            "files",
+            f"bad-arrays#{i}",
+            lambda p=path, i=i: dg.evaluate_file(p, root / f"o-bad{i}.npz"),
+            "refuse",
+            files=(path,),
+        )
+    # The output is the input: directly, through a symlink, through a hard link.
+    link = root / "link.npz"
+    link.symlink_to(good)
+    hard = root / "hard.npz"
+    os.link(good, hard)
+    for name, out in (
+        ("same", good),
+        ("symlink", link),
+        ("hardlink", hard),
+        ("upper", root / "GOOD.npz"),
+    ):
+        if name == "upper" and not (root / "GOOD.npz").exists():
+            continue  # case-sensitive file system: a different file
+        yield Case(
+            "files",
+            f"output-is-input({name})",
+            lambda o=out: dg.evaluate_file(good, o),
+            "refuse",
+            files=(good,),
+        )
+        yield Case(
+            "files",
+            f"cli-output-is-input({name})",
+            lambda o=out: _cli(cli, "batch", str(good), str(o)),
+            "refuse",
+            files=(good,),
+        )
+    # An existing output is kept unless --overwrite; then it is replaced whole.
+    existing = _save(root / "existing.npz", kept=np.arange(3))
+    yield Case(
+        "files",
+        "existing-output",
+        lambda: dg.evaluate_file(good, existing),
+        "refuse",
+        files=(good, existing),
+    )
+    yield Case(
+        "files",
+        "cli-existing-output",
+        lambda: _cli(cli, "batch", str(good), str(existing)),
+        "refuse",
+        files=(good, existing),
+    )
+    upper = root / "OUT.NPZ"
+
+    def wrote_upper(result):
+        return (
+            upper.exists() and not (root / "OUT.NPZ.npz").exists() and _readable(upper)
+        )
+
+    yield Case(
+        "files",
+        "upper-suffix",
+        lambda: dg.evaluate_file(good, upper),
+        "answer",
+        wrote_upper,
+        files=(good,),
+    )
+    replaced = _save(root / "replace.npz", kept=np.arange(3))
+
+    def overwrite_and_check():
+        r = dg.evaluate_file(good, replaced, overwrite=True)
+        return r
+
+    yield Case(
+        "files",
+        "overwrite",
+        overwrite_and_check,
+        "answer",
+        lambda r: _readable(replaced) and len(r) == 6,
+        files=(good,),
+    )
+    yield Case(
+        "files",
+        "output-dir",
+        lambda: dg.evaluate_file(good, root),
+        "refuse",
+        files=(good,),
+    )
+    yield Case(
+        "files",
+        "output-missing-dir",
+        lambda: dg.evaluate_file(good, root / "nope" / "o.npz"),
+        "refuse",
+        files=(good,),
+    )
+    yield Case(
+        "files",
+        "output-suffix",
+        lambda: dg.evaluate_file(good, root / "o.txt"),
+        "refuse",
+        files=(good,),
+    )
+    yield Case(
+        "files",
+        "input-missing",
+        lambda: dg.evaluate_file(root / "missing.npz", root / "o3.npz"),
+        "refuse",
+    )
+    # A failure while writing leaves the earlier output intact (atomic write).
+    earlier = _save(root / "earlier.npz", kept=np.arange(3))
+
+    def failing_write():
+        from drakegrasp.batch import io
+
+        def boom(f):
+            f.write(b"partial")
+            raise OSError("disk full (simulated)")
+
+        try:
+            io._atomic_write(earlier, boom, overwrite=True)
+        except OSError:
+            return sorted(p.name for p in root.glob(".earlier.npz.*"))
+        return ["no error"]
+
+    # The error propagates, no temporary file is left, the earlier file stays.
+    yield Case(
+        "files",
+        "failed-write-keeps-earlier",
+        failing_write,
+        "answer",
+        lambda left: left == [],
+        files=(earlier,),
+    )
+    # CLI option errors: one line, non-zero exit.
+    for i, argv in enumerate(
+        [
+            ["batch", str(good), str(root / "c1.npz"), "--num-generators", "100000000"],
+            ["batch", str(good), str(root / "c2.npz"), "--tol", "2"],
+            [
+                "batch",
+                str(good),
+                str(root / "c3.npz"),
+                "--contact-model",
+                "soft_finger",
+            ],
+            ["batch", str(good), str(root / "c4.npz"), "--chunk-size", "0"],
+            ["batch", str(root / "bad5.npz"), str(root / "c5.npz")],
+        ]
+    ):
+        yield Case(
+            "files",
+            f"cli-options#{i}",
+            lambda a=argv: _cli(cli, *a),
+            "refuse",
+            files=(good,),
+        )
+
+
+def _readable(path: Path) -> bool:
+    with np.load(path) as data:
+        return "is_closure" in data.files
+
+
+def _cli(cli, *argv):
+    """Run the CLI in process; raise a GraspError-like failure on non-zero exit."""
+    import contextlib
+    import io
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        code = cli.main(list(argv))
+    text = err.getvalue()
+    if code == 0:
+        return text
+    lines = [line for line in text.splitlines() if line.strip()]
+    if (
+        "Traceback" in text
+        or len(lines) != 1
+        or not lines[0].startswith("drakegrasp: error:")
+    ):
+        raise RuntimeError(f"CLI exit {code} with stderr {text!r}")
+    raise dg.InvalidOptionError(lines[0])
+
+
+WALK_VALUES = (object(), 1j, None, "x", np.full(3, np.nan))
+
+
+def api_walk_cases(names=None) -> Iterator[Case]:
+    """Every callable of ``drakegrasp.__all__`` with wrong-typed required arguments.
+
+    Each required parameter (positional or keyword-only) gets the same wrong
+    value; functions without required parameters (``list_scenes``) are left
+    out, as are exceptions and result dataclasses (plain records).
+    """
+    import dataclasses
+    import inspect
+
+    for name in sorted(dg.__all__ if names is None else names):
+        obj = getattr(dg, name)
+        if inspect.ismodule(obj) or not callable(obj) or name == "ContactModel":
+            continue
+        if isinstance(obj, type) and (
+            issubclass(obj, BaseException)
+            or (dataclasses.is_dataclass(obj) and name not in ("Contact", "Grasp"))
+        ):
+            continue
+        params = inspect.signature(obj).parameters.values()
+        required = [
+            p
+            for p in params
+            if p.default is p.empty and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+        ]
+        if not required:
+            continue
+        for i, wrong in enumerate(WALK_VALUES):
+            args = [wrong for p in required if p.kind != p.KEYWORD_ONLY]
+            kwargs = {p.name: wrong for p in required if p.kind == p.KEYWORD_ONLY}
+            yield Case(
+                "api walk",
+                f"{name}#{i}",
+                lambda obj=obj, a=args, k=kwargs: obj(*a, **k),
+                "refuse",
+            )
+
+
+def picture_cases() -> Iterator[Case]:
+    """Pictures with bad colours, sizes and outlines (matplotlib and Meshcat)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from drakegrasp import examples
+
+    g = examples.planar_square_four_contacts()
+    bad = [
+        {"colors": {"contact": "notacolor"}},
+        {"colors": {"contact": (2.0, 0, 0)}},
+        {"colors": {"bogus": "red"}},
+        {"colors": "red"},
+        {"force_scale": NAN},
+        {"force_scale": -1.0},
+        {"cone_length": INF},
+        {"outline": "abc"},
+        {"side": None},
+        {"result": "abc"},
+    ]
+    for i, kw in enumerate(bad):
+        yield Case(
+            "pictures",
+            f"plot_planar_grasp#{i}",
+            lambda kw=kw: dg.plot_planar_grasp(g, **kw),
+            "refuse",
+        )
+    for i, kw in enumerate(
+        [{"tol": NAN}, {"tol": "abc"}, {"num_generators": 10**9}, {"tol": 2.0}]
+    ):
+        yield Case(
+            "pictures",
+            f"plot_wrench_space#{i}",
+            lambda kw=kw: dg.plot_wrench_space(g, **kw),
+            "refuse",
+        )
+    from pydrake.geometry import Meshcat
+
+    meshcat = _meshcat(Meshcat)
+    if meshcat is None:
+        return
+    g3 = _valid_grasp()
+    for i, kw in enumerate(
+        [
+            {"colors": {"point": "notacolor"}},
+            {"colors": {"point": (2.0, 0, 0)}},
+            {"colors": {"point": (1, 0)}},
+            {"colors": "red"},
+            {"cone": "wide"},
+            {"cone_height": NAN},
+            {"prefix": ""},
+            {"side": 3},
+        ]
+    ):
+        yield Case(
+            "pictures",
+            f"draw_grasp#{i}",
+            lambda kw=kw: dg.draw_grasp(meshcat, g3, **kw),
+            "refuse",
+        )
+
+
+_MESHCAT = []
+
+
+def _meshcat(cls):
+    """One Meshcat for all cases (each opens a server); None if none can open."""
+    if not _MESHCAT:
+        try:
+            _MESHCAT.append(cls())
+        except RuntimeError:
+            _MESHCAT.append(None)
+    return _MESHCAT[0]
+
+
+def all_cases(root: Path | None = None) -> Iterator[Case]:
+    """Every family, in a fixed order."""
+    yield from api_walk_cases()
+    yield from contact_cases()
+    yield from grasp_cases()
+    yield from wrong_type_cases()
+    yield from option_cases()
+    yield from batch_cases()
+    yield from geometry_cases()
+    yield from monotonicity_cases()
+    yield from picture_cases()
+    if root is None:
+        root = Path(tempfile.mkdtemp(prefix="drakegrasp-fuzz-"))
+    yield from file_cases(root)

@@ -1,0 +1,146 @@
+"""The ``drakegrasp`` command as a user runs it: a subprocess per call.
+
+Every bad input exits non-zero with exactly one line on stderr and no
+traceback; Ctrl-C (SIGINT) in the middle of a long batch exits 130 with one
+line, leaves no partial output and keeps the input intact.
+"""
+
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drakegrasp import examples as ex
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _run(*args, timeout=120):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.run(
+        [sys.executable, "-m", "drakegrasp", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=env,
+    )
+
+
+def _grasps(path: Path, K: int, *, mu=True) -> Path:
+    g = ex.equator_fingers(0.5)
+    arrays = {
+        "positions": np.repeat(g.positions[None], K, 0),
+        "normals": np.repeat(g.normals[None], K, 0),
+    }
+    if mu:
+        arrays["mu"] = np.full((K, 3), 0.5)
+    with open(path, "wb") as f:
+        np.savez(f, **arrays)
+    return path
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _one_line_error(proc, code=1):
+    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    assert proc.returncode == code, proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert len(lines) == 1, proc.stderr
+    return lines[0]
+
+
+def test_bad_inputs_one_line_each(tmp_path):
+    good = _grasps(tmp_path / "good.npz", 5)
+    truncated = tmp_path / "truncated.npz"
+    truncated.write_bytes(good.read_bytes()[:100])
+    text = tmp_path / "text.npz"
+    text.write_text("positions,normals\n")
+    link = tmp_path / "link.npz"
+    link.symlink_to(good)
+    existing = tmp_path / "existing.npz"
+    existing.write_bytes(b"earlier results")
+    before = {p: _digest(p) for p in (good, existing)}
+    cases = [
+        (["batch", str(truncated), str(tmp_path / "o1.npz")], "damaged or truncated"),
+        (["batch", str(text), str(tmp_path / "o2.npz")], "is not a .npz archive"),
+        (["batch", str(good), str(good)], "is the input file"),
+        (["batch", str(good), str(link)], "is the input file"),
+        (["batch", str(good), str(existing)], "--overwrite"),
+        (
+            [
+                "batch",
+                str(good),
+                str(tmp_path / "o3.npz"),
+                "--num-generators",
+                "100000000",
+            ],
+            "num_generators",
+        ),
+        (
+            [
+                "batch",
+                str(good),
+                str(tmp_path / "o4.npz"),
+                "--contact-model",
+                "soft_finger",
+            ],
+            "torsional_friction",
+        ),
+    ]
+    for argv, message in cases:
+        line = _one_line_error(_run(*argv))
+        assert line.startswith("drakegrasp: error:") and message in line, line
+    assert {p: _digest(p) for p in (good, existing)} == before
+    assert not list(tmp_path.glob(".*.partial"))
+
+
+def test_upper_case_suffix_overwrite_and_the_deprecated_alias(tmp_path):
+    good = _grasps(tmp_path / "good.npz", 5)
+    out = tmp_path / "OUT.NPZ"
+    proc = _run("batch", str(good), str(out), "--model", "hard_finger")
+    assert proc.returncode == 0, proc.stderr
+    assert "--model is deprecated" in proc.stderr
+    assert out.exists() and not (tmp_path / "OUT.NPZ.npz").exists()
+    with np.load(out) as data:
+        assert data["is_closure"].all()
+    first = _digest(out)
+    _one_line_error(_run("batch", str(good), str(out)))
+    assert _digest(out) == first  # refused: untouched
+    proc = _run("batch", str(good), str(out), "--overwrite", "--kind", "form")
+    assert proc.returncode == 0, proc.stderr
+    with np.load(out) as data:
+        assert str(data["kind"]) == "form"
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_sigint_during_a_long_batch(tmp_path):
+    big = _grasps(tmp_path / "big.npz", 400_000)
+    digest = _digest(big)
+    out = tmp_path / "out.npz"
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "drakegrasp", "batch", str(big), str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    time.sleep(6.0)  # past the imports, inside the engine's numpy work
+    assert proc.poll() is None, "the batch finished before the signal: make it bigger"
+    sent = time.perf_counter()
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=120)
+    latency = time.perf_counter() - sent
+    assert proc.returncode == 130, stderr
+    assert stderr.strip() == "drakegrasp: interrupted"
+    assert not out.exists() and not list(tmp_path.glob(".*.partial"))
+    assert _digest(big) == digest
+    print(f"SIGINT answered in {latency:.2f} s")  # shown with -s; never asserted
