@@ -450,7 +450,11 @@ def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
 
 
 def _check_meshcat(meshcat) -> None:
-    if not isinstance(meshcat, Meshcat):
+    # Duck-typed, so wrappers of a Meshcat (recorders in tests) still work.
+    if not isinstance(meshcat, Meshcat) and not all(
+        callable(getattr(meshcat, name, None))
+        for name in ("SetObject", "SetTransform", "Delete")
+    ):
         raise InvalidOptionError(
             f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
         )
