@@ -3,7 +3,7 @@ r"""Certificates: checkable witnesses of every closure verdict (numpy only).
 A verdict says "yes" or "no"; its certificate says why, in a form that anyone
 can re-verify with a few matrix products and without a solver.
 
-Frames, orders and units follow CONVENTIONS.md: every twist and wrench is
+Frames, orders and units follow ``docs/conventions.md``: every twist and wrench is
 expressed in the grasp frame, about the grasp's reference point ``p``.
 
 * A twist ``v = [v_p; ω]`` (``[vx, vy, ω]`` planar) is the object's velocity:
@@ -23,7 +23,7 @@ The four kinds:
     ``G_n`` is rank deficient, ``v`` lies in ``N(G_nᵀ)`` and both ``±v``
     escape (``two_sided``).
 ``"unresisted wrench"`` (force closure "no")
-    ``y ≠ 0`` (``separating_twist``, the ``w`` of CONVENTIONS.md) with
+    ``y ≠ 0`` (``separating_twist``, the ``w`` of ``docs/conventions.md``) with
     ``yᵀ G f <= 0`` for every ``f`` in the contact cones (polyhedral or
     exact): every wrench the fingers can apply lies in a closed half-space, a
     hyperplane through the origin separates them from ``direction``
