@@ -33,7 +33,7 @@ _KINDS = (ESCAPE_TWIST, UNRESISTED_WRENCH, UNCONTROLLABLE, BALANCE)
 _CONES = ("normals", "polyhedral", "exact")
 
 DEFAULT_CHECK_TOL = 1e-7
-"""Relative tolerance of :meth:`Certificate.check` (violations are scaled to 1)."""
+"""Relative tolerance of :meth:`drakegrasp.certificates.Certificate.check` (violations are scaled to 1)."""
 
 
 @dataclass(frozen=True)

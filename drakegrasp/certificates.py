@@ -42,7 +42,7 @@ The four kinds:
     ``internal_basis`` spans ``N(G)`` over the components the cones allow (the
     internal forces the margin was found among).
 
-:meth:`Certificate.check` evaluates these definitions on the grasp and returns
+:meth:`~drakegrasp.certificates.Certificate.check` evaluates these definitions on the grasp and returns
 a :class:`CertificateCheck` that says by how much the witness holds.
 """
 
@@ -88,8 +88,8 @@ class Certificate:
     Attributes
     ----------
     kind : str
-        :data:`ESCAPE_TWIST`, :data:`UNRESISTED_WRENCH`, :data:`UNCONTROLLABLE`
-        or :data:`BALANCE` (see the module docstring).
+        :data:`~drakegrasp.certificate_kinds.ESCAPE_TWIST`, :data:`~drakegrasp.certificate_kinds.UNRESISTED_WRENCH`, :data:`~drakegrasp.certificate_kinds.UNCONTROLLABLE`
+        or :data:`~drakegrasp.certificate_kinds.BALANCE` (see the module docstring).
     cones : str
         ``"normals"`` (form closure), ``"polyhedral"`` or ``"exact"``: which
         cones the witness refers to.
@@ -192,7 +192,7 @@ class Certificate:
         grasp : Grasp
             The grasp the verdict was computed for.
         hand_jacobian : (M, n_v) float, optional
-            Needed for :data:`UNCONTROLLABLE` (``Jᵀ f = 0``).
+            Needed for :data:`~drakegrasp.certificate_kinds.UNCONTROLLABLE` (``Jᵀ f = 0``).
         tol : float, optional
             Relative tolerance on the violation.
 
