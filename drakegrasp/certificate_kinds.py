@@ -33,7 +33,10 @@ _KINDS = (ESCAPE_TWIST, UNRESISTED_WRENCH, UNCONTROLLABLE, BALANCE)
 _CONES = ("normals", "polyhedral", "exact")
 
 DEFAULT_CHECK_TOL = 1e-7
-"""Relative tolerance of :meth:`drakegrasp.certificates.Certificate.check` (violations are scaled to 1)."""
+"""Relative tolerance of :meth:`drakegrasp.certificates.Certificate.check`.
+
+Violations are scaled to 1 before they are compared with it.
+"""
 
 
 @dataclass(frozen=True)

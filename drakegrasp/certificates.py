@@ -42,8 +42,9 @@ The four kinds:
     ``internal_basis`` spans ``N(G)`` over the components the cones allow (the
     internal forces the margin was found among).
 
-:meth:`~drakegrasp.certificates.Certificate.check` evaluates these definitions on the grasp and returns
-a :class:`CertificateCheck` that says by how much the witness holds.
+:meth:`~drakegrasp.certificates.Certificate.check` evaluates these definitions
+on the grasp and returns a :class:`CertificateCheck` that says by how much the
+witness holds.
 """
 
 from __future__ import annotations
@@ -88,8 +89,11 @@ class Certificate:
     Attributes
     ----------
     kind : str
-        :data:`~drakegrasp.certificate_kinds.ESCAPE_TWIST`, :data:`~drakegrasp.certificate_kinds.UNRESISTED_WRENCH`, :data:`~drakegrasp.certificate_kinds.UNCONTROLLABLE`
-        or :data:`~drakegrasp.certificate_kinds.BALANCE` (see the module docstring).
+        One of the kinds in :mod:`drakegrasp.certificate_kinds`:
+        :data:`~drakegrasp.certificate_kinds.ESCAPE_TWIST`,
+        :data:`~drakegrasp.certificate_kinds.UNRESISTED_WRENCH`,
+        :data:`~drakegrasp.certificate_kinds.UNCONTROLLABLE` or
+        :data:`~drakegrasp.certificate_kinds.BALANCE` (see the module docstring).
     cones : str
         ``"normals"`` (form closure), ``"polyhedral"`` or ``"exact"``: which
         cones the witness refers to.
@@ -192,7 +196,8 @@ class Certificate:
         grasp : Grasp
             The grasp the verdict was computed for.
         hand_jacobian : (M, n_v) float, optional
-            Needed for :data:`~drakegrasp.certificate_kinds.UNCONTROLLABLE` (``Jᵀ f = 0``).
+            Needed for :data:`~drakegrasp.certificate_kinds.UNCONTROLLABLE`
+            (``Jᵀ f = 0``).
         tol : float, optional
             Relative tolerance on the violation.
 
