@@ -1,6 +1,6 @@
 r"""The closure LPs of a stack of grasps, solved in block form (cost linear in N).
 
-LP1/LP2 (``shared/CONVENTIONS.md``) have ``d* = N max(0, t*)`` with
+LP1/LP2 (:doc:`/conventions`) have ``d* = N max(0, t*)`` with
 
 .. math::
 
@@ -170,7 +170,7 @@ def solve_margin_blocks(
         A = np.concatenate([np.transpose(Q, (1, 0, 2)), np.zeros((1, M, sel.size))])
         A[-1, normal_columns] = 1.0  # (e, M, k)
         if kernel == "numba" or (kernel == "auto" and numba_available()):
-            from drakegrasp.batch import block_kernel  # imports numba
+            import drakegrasp.batch.block_kernel as block_kernel  # imports numba
 
             t, ok, _, _ = block_kernel.solve_block_stack(
                 [F if F.shape[0] == 1 else F[sel] for F in facets],
