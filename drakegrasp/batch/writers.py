@@ -277,7 +277,7 @@ def stream_file(
     BatchSummary
         Counts and ``d*`` range of what was written.
     """
-    from drakegrasp.batch import io
+    import drakegrasp.batch.io as io
     from drakegrasp.batch.engine import stream_force_closure, stream_form_closure
     from drakegrasp.validation import check_flag
 
