@@ -7,21 +7,30 @@ sign in a program, a dual, or a mapping between frames shows up as a violation.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from drakegrasp.certificates import (
+from drakegrasp.certificate_kinds import (
     BALANCE,
     ESCAPE_TWIST,
     UNCONTROLLABLE,
     UNRESISTED_WRENCH,
-    Certificate,
     CertificateCheck,
-    _check_jacobian,
-    cone_support,
 )
+from drakegrasp.cone_support import cone_support
 from drakegrasp.contact import ContactModel
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.friction_cone import ConeLayout
-from drakegrasp.grasp import Grasp, grasp_matrix, normalised_grasp_matrix
+from drakegrasp.grasp import (
+    Grasp,
+    check_hand_jacobian,
+    grasp_matrix,
+    normalised_grasp_matrix,
+)
+
+if TYPE_CHECKING:
+    from drakegrasp.certificates import Certificate
 
 __all__ = ["check_certificate"]
 
@@ -179,3 +188,12 @@ def _check_balance(cert: Certificate, grasp: Grasp):
         inside,
         f"G f = 0, f inside the {cert.cones} cones, σ_min/σ_max(Ḡ) = {ratio:.2g}",
     )
+
+
+def _check_jacobian(grasp, hand_jacobian):
+    if hand_jacobian is None:
+        raise InvalidOptionError(
+            "checking an uncontrollable internal force needs hand_jacobian "
+            "(it must satisfy Jᵀ f = 0)"
+        )
+    return check_hand_jacobian(grasp, hand_jacobian)

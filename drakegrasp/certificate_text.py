@@ -6,15 +6,19 @@ axis through a point, or a translation), a wrench as a line of action.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from drakegrasp.certificates import (
+from drakegrasp.certificate_kinds import (
     BALANCE,
     ESCAPE_TWIST,
     UNCONTROLLABLE,
     UNRESISTED_WRENCH,
-    Certificate,
 )
+
+if TYPE_CHECKING:
+    from drakegrasp.certificates import Certificate
 
 __all__ = ["axis_name", "describe_certificate", "screw_point"]
 

@@ -3,7 +3,7 @@ r"""Certificates: checkable witnesses of every closure verdict (numpy only).
 A verdict says "yes" or "no"; its certificate says why, in a form that anyone
 can re-verify with a few matrix products and without a solver.
 
-Frames, orders and units follow CONVENTIONS.md: every twist and wrench is
+Frames, orders and units follow ``docs/conventions.md``: every twist and wrench is
 expressed in the grasp frame, about the grasp's reference point ``p``.
 
 * A twist ``v = [v_p; ω]`` (``[vx, vy, ω]`` planar) is the object's velocity:
@@ -23,7 +23,7 @@ The four kinds:
     ``G_n`` is rank deficient, ``v`` lies in ``N(G_nᵀ)`` and both ``±v``
     escape (``two_sided``).
 ``"unresisted wrench"`` (force closure "no")
-    ``y ≠ 0`` (``separating_twist``, the ``w`` of CONVENTIONS.md) with
+    ``y ≠ 0`` (``separating_twist``, the ``w`` of ``docs/conventions.md``) with
     ``yᵀ G f <= 0`` for every ``f`` in the contact cones (polyhedral or
     exact): every wrench the fingers can apply lies in a closed half-space, a
     hyperplane through the origin separates them from ``direction``
@@ -42,8 +42,9 @@ The four kinds:
     ``internal_basis`` spans ``N(G)`` over the components the cones allow (the
     internal forces the margin was found among).
 
-:meth:`Certificate.check` evaluates these definitions on the grasp and returns
-a :class:`CertificateCheck` that says by how much the witness holds.
+:meth:`~drakegrasp.certificates.Certificate.check` evaluates these definitions
+on the grasp and returns a :class:`CertificateCheck` that says by how much the
+witness holds.
 """
 
 from __future__ import annotations
@@ -52,10 +53,21 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from drakegrasp.contact import ContactModel
+from drakegrasp.certificate_check import check_certificate
+from drakegrasp.certificate_kinds import (
+    _CONES,
+    _KINDS,
+    BALANCE,
+    DEFAULT_CHECK_TOL,
+    ESCAPE_TWIST,
+    UNCONTROLLABLE,
+    UNRESISTED_WRENCH,
+    CertificateCheck,
+)
+from drakegrasp.certificate_text import describe_certificate
+from drakegrasp.cone_support import cone_support, support_of
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.friction_cone import ConeLayout
-from drakegrasp.grasp import Grasp, check_hand_jacobian, grasp_matrix
+from drakegrasp.grasp import Grasp
 from drakegrasp.results import _jsonable
 
 __all__ = [
@@ -69,66 +81,6 @@ __all__ = [
     "support_of",
 ]
 
-ESCAPE_TWIST = "escape twist"
-"""Kind of the witness of a form-closure "no"."""
-UNRESISTED_WRENCH = "unresisted wrench"
-"""Kind of the witness of a force-closure "no"."""
-UNCONTROLLABLE = "uncontrollable internal force"
-"""Kind of the witness of an LP3 failure."""
-BALANCE = "balancing internal force"
-"""Kind of the witness of a "yes"."""
-_KINDS = (ESCAPE_TWIST, UNRESISTED_WRENCH, UNCONTROLLABLE, BALANCE)
-_CONES = ("normals", "polyhedral", "exact")
-
-DEFAULT_CHECK_TOL = 1e-7
-"""Relative tolerance of :meth:`Certificate.check` (violations are scaled to 1)."""
-
-
-@dataclass(frozen=True)
-class CertificateCheck:
-    """How well a certificate holds on a grasp, evaluated without a solver.
-
-    Attributes
-    ----------
-    holds : bool
-        ``violation <= tol``.
-    violation : float
-        Largest relative violation of the witness's defining inequalities
-        (dimensionless; 0 when every inequality holds).  For an escape twist:
-        ``max_i max(0, −(G_nᵀ v)_i) / (‖G_{n,i}‖ ‖v‖)``; for a wrench, the
-        largest cone support ``max_f wᵀ G_i f`` per unit ``f_n`` over
-        ``‖G_i‖ ‖w‖``; for internal forces, the residuals ``‖G f‖`` and
-        ``‖Jᵀ f‖`` relative to ``‖G‖ ‖f‖`` and the cone slack.
-    slack : float
-        How firmly it holds, on the same scale: the smallest separation speed
-        (escape twist), ``−max`` support (unresisted wrench), the smallest
-        normal force over ``Σ f_n`` (internal forces).  0 on the boundary.
-    tol : float
-        Tolerance used.
-    detail : str
-        One line saying what was evaluated.
-    """
-
-    holds: bool
-    violation: float
-    slack: float
-    tol: float
-    detail: str
-
-    def __bool__(self) -> bool:
-        return self.holds
-
-    def to_dict(self) -> dict:
-        """JSON-ready dictionary."""
-        return {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
-
-    def __str__(self) -> str:
-        verdict = "holds" if self.holds else "FAILS"
-        return (
-            f"witness {verdict}: violation {self.violation:.2g}, "
-            f"slack {self.slack + 0.0:.3g} (tol {self.tol:g}); {self.detail}"
-        )
-
 
 @dataclass(frozen=True, eq=False)
 class Certificate:
@@ -137,8 +89,11 @@ class Certificate:
     Attributes
     ----------
     kind : str
-        :data:`ESCAPE_TWIST`, :data:`UNRESISTED_WRENCH`, :data:`UNCONTROLLABLE`
-        or :data:`BALANCE` (see the module docstring).
+        One of the kinds in :mod:`drakegrasp.certificate_kinds`:
+        :data:`~drakegrasp.certificate_kinds.ESCAPE_TWIST`,
+        :data:`~drakegrasp.certificate_kinds.UNRESISTED_WRENCH`,
+        :data:`~drakegrasp.certificate_kinds.UNCONTROLLABLE` or
+        :data:`~drakegrasp.certificate_kinds.BALANCE` (see the module docstring).
     cones : str
         ``"normals"`` (form closure), ``"polyhedral"`` or ``"exact"``: which
         cones the witness refers to.
@@ -241,7 +196,8 @@ class Certificate:
         grasp : Grasp
             The grasp the verdict was computed for.
         hand_jacobian : (M, n_v) float, optional
-            Needed for :data:`UNCONTROLLABLE` (``Jᵀ f = 0``).
+            Needed for :data:`~drakegrasp.certificate_kinds.UNCONTROLLABLE`
+            (``Jᵀ f = 0``).
         tol : float, optional
             Relative tolerance on the violation.
 
@@ -249,8 +205,6 @@ class Certificate:
         -------
         CertificateCheck
         """
-        from drakegrasp.certificate_check import check_certificate
-
         return check_certificate(self, grasp, hand_jacobian=hand_jacobian, tol=tol)
 
     def describe(self) -> str:
@@ -260,8 +214,6 @@ class Certificate:
         without penetrating any finger" or "cannot resist a force along −x
         through (0, 0, 0) m".  Points are in the grasp frame.
         """
-        from drakegrasp.certificate_text import describe_certificate
-
         return describe_certificate(self)
 
     def to_dict(self) -> dict:
@@ -269,69 +221,3 @@ class Certificate:
         d = {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
         d["two_sided"] = self.two_sided
         return d
-
-
-def cone_support(
-    grasp: Grasp, w: np.ndarray, *, cones: str, num_generators: int = 8
-) -> np.ndarray:
-    r"""Per contact, the largest ``wᵀ G_i f_i`` over its cone with ``f_n = 1``.
-
-    Parameters
-    ----------
-    grasp : Grasp
-    w : (6,) or (3,) float
-        A wrench-space direction (about ``p``, grasp frame).
-    cones : {"normals", "polyhedral", "exact"}
-        Frictionless normals, the polyhedral cones with ``num_generators``, or
-        the exact Coulomb / soft-finger cones.
-    num_generators : int, optional
-
-    Returns
-    -------
-    (N,) float
-        ``σ_i``: ``wᵀ G f <= 0`` on every cone exactly when ``max σ_i <= 0``.
-
-    Notes
-    -----
-    With ``a = G_iᵀ w`` in the contact frame: frictionless ``a_n``; polyhedral
-    ``max_k aᵀ s_k``; exact hard finger ``a_n + μ ‖a_t‖``; exact soft finger
-    ``a_n + max(μ ‖a_t‖, b ν |a_m|)`` (the cone ``‖f_t‖/μ + |m_n|/(bν) <= f_n``
-    has its extreme rays on the two norm balls).  Planar cones are exact
-    polyhedra.
-    """
-    G = grasp_matrix(grasp)
-    layout = ConeLayout.of(grasp, num_generators)
-    b = grasp.characteristic_length
-    out = np.empty(grasp.num_contacts)
-    for i, (s, cone, c) in enumerate(
-        zip(grasp.component_slices(), layout.cones, grasp.contacts, strict=True)
-    ):
-        a_full = G[:, s].T @ w
-        if cones == "normals":
-            out[i] = a_full[0]
-        else:
-            out[i] = support_of(a_full[list(cone.components)], cone, c, cones, b)
-    return out
-
-
-def support_of(a: np.ndarray, cone, contact, cones: str, b: float) -> float:
-    """``max aᵀ f`` over one contact's cone with ``f_n = 1``.
-
-    ``a`` is over the cone's components (``cone.components``); see
-    :func:`cone_support` for the formulas.
-    """
-    if not (cones == "exact" and cone.components in ((0, 1, 2), (0, 1, 2, 3))):
-        return float(np.max(cone.generators.T @ a))
-    value = contact.mu * np.linalg.norm(a[1:3])
-    if contact.model is ContactModel.SOFT_FINGER and len(a) == 4:
-        value = max(value, b * contact.torsional_friction * abs(a[3]))
-    return float(a[0] + value)
-
-
-def _check_jacobian(grasp, hand_jacobian):
-    if hand_jacobian is None:
-        raise InvalidOptionError(
-            "checking an uncontrollable internal force needs hand_jacobian "
-            "(it must satisfy Jᵀ f = 0)"
-        )
-    return check_hand_jacobian(grasp, hand_jacobian)

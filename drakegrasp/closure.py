@@ -208,8 +208,26 @@ def _add_normal_budget(prog, normal_forces, num_contacts: int) -> None:
     )
 
 
-def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
-    """``A x - 1 d >= 0``."""
+_DENSE_LIMIT = 250_000
+"""Margin matrices with more entries than this are passed to Drake as sparse."""
+
+
+def _add_margin_rows(prog, A, x, d) -> None:
+    """``A x - 1 d >= 0``; ``A`` dense or scipy-sparse (large block diagonals).
+
+    A thousand contacts with 64 generators make a 64,000 x 3,000 facet matrix:
+    1.5 GB dense, 1.5 MB of non-zeros.  Dense matrices go through
+    :func:`~drakegrasp._dense_constraints.add_linear_constraint`, which keeps
+    pydrake from importing scipy.sparse on the first call.
+    """
+    if hasattr(A, "tocsc"):  # scipy.sparse
+        from scipy import sparse
+
+        M = sparse.hstack([A, -np.ones((A.shape[0], 1))], format="csc")
+        prog.AddLinearConstraint(
+            M, np.zeros(A.shape[0]), np.full(A.shape[0], np.inf), np.append(x, d)
+        )
+        return
     A = np.atleast_2d(A)
     add_linear_constraint(
         prog,
@@ -218,6 +236,28 @@ def _add_margin_rows(prog, A: np.ndarray, x, d) -> None:
         np.full(A.shape[0], np.inf),
         np.append(x, d),
     )
+
+
+def _selection(rows: np.ndarray, n: int):
+    """Rows ``rows`` of the n x n identity, sparse when large."""
+    if len(rows) * n <= _DENSE_LIMIT:
+        return np.eye(n)[rows]
+    from scipy import sparse
+
+    return sparse.csr_matrix(
+        (np.ones(len(rows)), (np.arange(len(rows)), rows)), shape=(len(rows), n)
+    )
+
+
+def _margin_facets(layout: ConeLayout):
+    """``F diag(scales)``: dense when small, a sparse block diagonal when large."""
+    rows = sum(c.facets.shape[0] for c in layout.cones)
+    if rows * len(layout.columns) <= _DENSE_LIMIT:
+        return layout.facet_matrix() * layout.scales
+    from scipy import sparse
+
+    F = sparse.block_diag([c.facets for c in layout.cones], format="csr")
+    return F @ sparse.diags(layout.scales)
 
 
 def _scaled_variables(d, x, layout: ConeLayout) -> ProgramVariables:
@@ -287,7 +327,7 @@ def build_form_closure_program(
     N = grasp.num_contacts
     prog, f, d = _margin_program(N, N)
     _add_balance(prog, _normal_balance_matrix(grasp), f, rank_tol)
-    _add_margin_rows(prog, np.eye(N), f, d)
+    _add_margin_rows(prog, _selection(np.arange(N), N), f, d)
     _add_normal_budget(prog, f, N)
     return prog, ProgramVariables(d, f, np.arange(N))
 
@@ -331,13 +371,13 @@ def build_force_closure_program(
         scales = layout.scales
         A = _balance_matrix(grasp, layout.columns)
         _add_balance(prog, A, f, rank_tol, scales=scales)
-        _add_margin_rows(prog, layout.facet_matrix() * scales, f, d)
+        _add_margin_rows(prog, _margin_facets(layout), f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
         return prog, _scaled_variables(d, f, layout)
     S = layout.generator_matrix()
     prog, lam, d = _margin_program(S.shape[1], N)
     _add_balance(prog, _balance_matrix(grasp, layout.columns) @ S, lam, rank_tol)
-    _add_margin_rows(prog, np.eye(S.shape[1]), lam, d)
+    _add_margin_rows(prog, _selection(np.arange(S.shape[1]), S.shape[1]), lam, d)
     # Every generator has unit normal component, so Σ f_n = Σ λ.
     _add_normal_budget(prog, lam, N)
     # Object-dtype matmul can re-raise a floating-point flag left set by a
@@ -402,6 +442,9 @@ def build_exact_force_closure_program(
                 A[0, 3] = -sign * mu * s / (b * contact.torsional_friction)
             A[0, -1] = -np.sqrt(1.0 + mu * mu)
             A[1, 1] = A[2, 2] = 1.0
+            # The same cone divided by sqrt(1 + μ²): coefficients at most 1, so
+            # μ = 1e12 no longer makes Clarabel stall or SCS answer inaccurately.
+            A /= np.hypot(1.0, mu)
             prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(fi, d))
     return prog, _scaled_variables(d, f, layout)
 
@@ -449,7 +492,7 @@ def build_internal_force_program(
         [_balance_matrix(grasp, layout.columns), _unit_columns(J[layout.columns]).T]
     )
     _add_balance(prog, A, f, rank_tol)
-    _add_margin_rows(prog, np.eye(len(f))[layout.normal_positions], f, d)
+    _add_margin_rows(prog, _selection(layout.normal_positions, len(f)), f, d)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     return prog, ProgramVariables(d, f, layout.columns)
 

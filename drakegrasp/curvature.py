@@ -392,6 +392,11 @@ def contact_hessians(
     -------
     H : (N, 6, 6) or (N, 3, 3) float
     """
+    if isinstance(curvatures, (str, bytes)) or not hasattr(curvatures, "__iter__"):
+        raise InvalidContactError(
+            "curvatures must be a sequence of ContactCurvature (one per contact), "
+            f"got a {type(curvatures).__name__}"
+        )
     curvatures = tuple(curvatures)
     if len(curvatures) != grasp.num_contacts:
         raise InvalidContactError(

@@ -131,7 +131,7 @@ def soft_finger_facets(mu: np.ndarray, torsion: np.ndarray, n_g: int) -> np.ndar
 
     so the LP margin ``d`` of a soft finger is the hard-finger margin of the
     force that remains once the torsion has taken its share of the normal
-    force.  This is the documented definition (CONVENTIONS, "Monotonicity"):
+    force.  This is the documented definition (``docs/conventions.md``, "Monotonicity"):
     rows scaled to unit length would tilt the facets out of the ``m_n = 0``
     slice and make ``d`` vanish with ``τ`` (``d* = 0.0002`` where hard fingers
     give 0.121 at ``ν = 0.01``).  With these rows a soft finger's ``d*`` is

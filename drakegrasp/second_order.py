@@ -49,6 +49,7 @@ from drakegrasp.curvature import ContactCurvature, _skew, contact_hessians
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
 from drakegrasp.grasp import Grasp, normal_grasp_matrix
 from drakegrasp.results import ClosureResult, _jsonable, _near, _relative_margin
+from drakegrasp.validation import check_grasp, check_rank_tol
 
 __all__ = [
     "DEFAULT_SECOND_ORDER_TOL",
@@ -380,7 +381,14 @@ def second_order_form_closure(
         (no single λ blocks every motion, yet none escapes along the
         candidate directions).
     """
+    check_grasp(grasp)
     tol = _check_tol(tol)
+    rank_tol = check_rank_tol(rank_tol)
+    if first_order is not None and not isinstance(first_order, ClosureResult):
+        raise InvalidOptionError(
+            "first_order must be the ClosureResult of drakegrasp.form_closure on "
+            f"this grasp, or None; got a {type(first_order).__name__}"
+        )
     H = contact_hessians(grasp, curvatures)  # validates before any solve
     N = grasp.num_contacts
     if first_order is None:

@@ -487,6 +487,16 @@ def add_grasp_monitor(
         Connected to the plant's state, the scene graph's query output and, with
         ``contacts="contact_results"``, the plant's contact results.
     """
+    for name, value, kind in (
+        ("builder", builder, DiagramBuilder),
+        ("plant", plant, MultibodyPlant),
+        ("scene_graph", scene_graph, SceneGraph),
+    ):
+        if not isinstance(value, kind):
+            raise InvalidOptionError(
+                f"add_grasp_monitor: {name} must be a pydrake {kind.__name__}, got "
+                f"a {type(value).__name__}"
+            )
     monitor = builder.AddSystem(GraspMonitor(plant, **options))
     monitor.set_name("grasp_monitor")
     builder.Connect(plant.get_state_output_port(), monitor.get_plant_state_input_port())

@@ -214,6 +214,8 @@ for k, (name, g) in enumerate(grasps.items()):
     picture = plot_wrench_space(g, ax=ax)
     fc = dg.force_closure(g)
     ax.set_title(f"origin inside: {picture.origin_inside}; LP2: {fc.is_closure}")
+    for set_ticks in (ax.set_xticks, ax.set_yticks, ax.set_zticks):
+        set_ticks([-1, 0, 1])  # three ticks per axis: five ran together
     assert picture.origin_inside == fc.is_closure
 plt.tight_layout()
 plt.show()

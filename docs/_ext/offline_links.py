@@ -74,6 +74,9 @@ PYTHON_AND_NUMPY = {
     "python:path-like object": f"{PYTHON}glossary.html#term-path-like-object",
     "numpy:array_like": f"{NUMPY}glossary.html#term-array_like",
     "numpy.ndarray": f"{NUMPY}reference/generated/numpy.ndarray.html",
+    "numpy": f"{NUMPY}reference/index.html",
+    "numpy:arrays.scalars": f"{NUMPY}reference/arrays.scalars.html",
+    "os.replace": f"{PYTHON}library/os.html#os.replace",
 }
 
 
@@ -114,6 +117,10 @@ def _resolve(
         title = f"{full} (Drake documentation)"
     else:
         return None
+    if contnode.astext() == target and target.startswith(("python:", "numpy:")):
+        # numpydoc's xref shows the raw target ("python:float"): show "float".
+        contnode = contnode.deepcopy()
+        contnode.children = [nodes.Text(target.split(":", 1)[1])]
     reference = nodes.reference("", "", internal=False, refuri=uri, reftitle=title)
     reference.append(contnode)
     return reference

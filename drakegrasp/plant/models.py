@@ -15,7 +15,7 @@ from pathlib import Path
 
 from pydrake.multibody.parsing import PackageMap, Parser
 
-from drakegrasp.errors import ModelError
+from drakegrasp.errors import InvalidOptionError, ModelError
 
 __all__ = [
     "DRAKE_MODELS_ENV",
@@ -121,12 +121,19 @@ def use_local_drake_models(
     ------
     ModelError
         If ``path`` (or the variable's value) is not a directory.
+    InvalidOptionError
+        If ``parser_or_package_map`` is neither a Parser nor a PackageMap.
     """
     package_map = _package_map_of(parser_or_package_map, "use_local_drake_models")
     if path is None:
         path = os.environ.get(DRAKE_MODELS_ENV)
         if not path:
             return package_map
+    if not isinstance(path, (str, os.PathLike)):
+        raise InvalidOptionError(
+            f"path must be a folder name (str or os.PathLike), got a "
+            f"{type(path).__name__}"
+        )
     folder = Path(path).expanduser().resolve()
     if not folder.is_dir():
         raise ModelError(
@@ -144,7 +151,7 @@ def _package_map_of(parser_or_package_map, caller: str) -> PackageMap:
         return parser_or_package_map.package_map()
     if isinstance(parser_or_package_map, PackageMap):
         return parser_or_package_map
-    raise TypeError(
+    raise InvalidOptionError(
         f"{caller} expects a pydrake Parser or PackageMap, got "
         f"{type(parser_or_package_map).__name__}"
     )

@@ -25,7 +25,7 @@ from pydrake.math import RigidTransform
 
 from drakegrasp.certificates import ESCAPE_TWIST, UNRESISTED_WRENCH, Certificate
 from drakegrasp.grasp import Grasp
-from drakegrasp.visualization.meshcat import _draw_arrow
+from drakegrasp.visualization.primitives import _draw_arrow
 
 __all__ = [
     "CERTIFICATE_COLORS",

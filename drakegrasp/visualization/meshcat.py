@@ -33,6 +33,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.grasp import Grasp
+from drakegrasp.visualization.certificates import draw_result_certificate
 from drakegrasp.visualization.geometry import (
     contact_pose_3d,
     exact_cone_mesh,
@@ -43,6 +44,7 @@ from drakegrasp.visualization.geometry import (
     pyramid_mesh,
     side_sign,
 )
+from drakegrasp.visualization.primitives import _draw_arrow, _set_mesh
 from drakegrasp.visualization.robot import set_translucent
 
 __all__ = [
@@ -105,48 +107,6 @@ def _rgba(colors: Mapping[str, Any], key: str) -> Rgba:
     if len(v) != 4:
         raise InvalidOptionError(f"colour {key!r} must be RGB or RGBA, got {value!r}")
     return Rgba(*v)
-
-
-def _set_mesh(meshcat: Meshcat, path: str, vertices, faces, rgba: Rgba, **kw) -> None:
-    meshcat.SetTriangleMesh(
-        path,
-        np.asfortranarray(np.asarray(vertices, dtype=float).T),
-        np.asfortranarray(np.asarray(faces, dtype=np.int32).T),
-        rgba,
-        **kw,
-    )
-
-
-def _draw_arrow(
-    meshcat: Meshcat,
-    path: str,
-    tail: np.ndarray,
-    vector: np.ndarray,
-    *,
-    radius: float,
-    rgba: Rgba,
-) -> list[str]:
-    """Arrow from ``tail`` along ``vector`` (parent-frame coordinates).
-
-    Returns the paths of its parts (shaft, head).
-    """
-    length = float(np.linalg.norm(vector))
-    head = min(0.35 * length, 5.0 * radius)
-    shaft = length - head
-    R = RotationMatrix.MakeFromOneVector(vector, 2)
-    meshcat.SetTransform(path, RigidTransform(R, tail))
-    if shaft > 0:
-        meshcat.SetObject(f"{path}/shaft", Cylinder(radius, shaft), rgba)
-        meshcat.SetTransform(f"{path}/shaft", RigidTransform([0.0, 0.0, shaft / 2]))
-    # Head: a cone with its apex at the tip, opening back along -z (the mesh
-    # opens along +x; a rotation by π/2 about y takes +x to -z).
-    v, f = exact_cone_mesh(2.0 * radius / head, head, num_segments=16)
-    _set_mesh(meshcat, f"{path}/head", v, f, rgba)
-    meshcat.SetTransform(
-        f"{path}/head",
-        RigidTransform(RotationMatrix.MakeYRotation(np.pi / 2), [0.0, 0.0, length]),
-    )
-    return ([f"{path}/shaft"] if shaft > 0 else []) + [f"{path}/head"]
 
 
 ON_TOP_RENDER_ORDER = 10.0
@@ -368,8 +328,6 @@ def draw_grasp(
                     rgba=_rgba(palette, "force"),
                 )
                 paths.append(f"{base}/force")
-    from drakegrasp.visualization.certificates import draw_result_certificate
-
     certificate = draw_result_certificate(meshcat, grasp, result, prefix)  # why "no"
     paths += certificate
     if on_top:
@@ -450,7 +408,11 @@ def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
 
 
 def _check_meshcat(meshcat) -> None:
-    if not isinstance(meshcat, Meshcat):
+    # Duck-typed, so wrappers of a Meshcat (recorders in tests) still work.
+    if not isinstance(meshcat, Meshcat) and not all(
+        callable(getattr(meshcat, name, None))
+        for name in ("SetObject", "SetTransform", "Delete")
+    ):
         raise InvalidOptionError(
             f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
         )

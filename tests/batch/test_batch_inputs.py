@@ -225,3 +225,22 @@ def test_iter_batch_closure_is_lazy_and_matches_one_call():
     )
     with pytest.raises(InvalidOptionError, match="need mu"):
         next(iter_batch_closure([(P, Nrm)]))
+
+
+def test_missing_tqdm_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)  # import fails
+    P, Nrm = random_grasps(np.random.default_rng(0), 3, 3, 3)
+    with pytest.raises(
+        InvalidOptionError, match=r'pip install "drakegrasp\[progress\]"'
+    ):
+        batch_force_closure(P, Nrm, 0.5, progress=True)
+
+
+def test_soft_fingers_need_torsional_friction_explicit_zero_acts_hard():
+    P, Nrm = random_grasps(np.random.default_rng(1), 6, 4, 3)
+    with pytest.raises(InvalidContactError, match="needs torsional_friction"):
+        batch_force_closure(P, Nrm, 0.5, model="soft_finger")
+    soft0 = batch_force_closure(P, Nrm, 0.5, model="soft_finger", torsional_friction=0)
+    hard = batch_force_closure(P, Nrm, 0.5)
+    np.testing.assert_array_equal(soft0.is_closure, hard.is_closure)
+    np.testing.assert_allclose(soft0.d_star, hard.d_star, atol=1e-9)

@@ -778,14 +778,16 @@ def geometry_cases(seed: int = 0, count: int = 120) -> Iterator[Case]:
             )
 
 
-def monotonicity_cases(seed: int = 1, count: int = 40) -> Iterator[Case]:
+def monotonicity_cases(seed: int = 1, count: int = 80) -> Iterator[Case]:
     """soft >= hard >= frictionless and larger mu/nu >= smaller, every metric."""
     rng = np.random.default_rng(seed)
     for k in range(count):
-        num = int(rng.integers(2, 5))
+        # 3 to 6 contacts with normals near the inward radial: most grasps are
+        # in closure for some models and not others, so the chain is tested.
+        num = int(rng.integers(3, 7))
         p = rng.normal(size=(num, 3))
         p /= np.linalg.norm(p, axis=1, keepdims=True)
-        n = -p + 0.3 * rng.normal(size=(num, 3))
+        n = -p + 0.2 * rng.normal(size=(num, 3))
         mu = float(10.0 ** rng.uniform(-12, 1))
         nu = float(10.0 ** rng.uniform(-12, 12))
         hard = dg.Grasp([dg.Contact(p[i], n[i], mu=mu) for i in range(num)])

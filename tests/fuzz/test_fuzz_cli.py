@@ -122,12 +122,22 @@ def test_upper_case_suffix_overwrite_and_the_deprecated_alias(tmp_path):
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 def test_sigint_during_a_long_batch(tmp_path):
-    big = _grasps(tmp_path / "big.npz", 400_000)
+    # 200,000 random grasps with the per-grasp ε metric: minutes of work, so
+    # the signal always lands mid-run (first in the vectorised LPs' numpy
+    # work, then in the ε loop).
+    rng = np.random.default_rng(0)
+    K = 200_000
+    P = rng.normal(size=(K, 3, 3))
+    P /= np.linalg.norm(P, axis=2, keepdims=True)
+    big = tmp_path / "big.npz"
+    with open(big, "wb") as f:
+        np.savez(f, positions=P, normals=-P + 0.3 * rng.normal(size=P.shape), mu=0.5)
     digest = _digest(big)
     out = tmp_path / "out.npz"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
+    argv = ["batch", str(big), str(out), "--metrics", "epsilon_l1"]
     proc = subprocess.Popen(
-        [sys.executable, "-m", "drakegrasp", "batch", str(big), str(out)],
+        [sys.executable, "-m", "drakegrasp", *argv],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

@@ -14,6 +14,7 @@ from pydrake.multibody.parsing import PackageMap, Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import CalcSpatialInertia
 
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant import find_contacts, models_dir, register_models
 from drakegrasp.plant._shapes import flat_faces
 from drakegrasp.plant.contacts import hand_bodies
@@ -55,7 +56,7 @@ def test_register_models_on_parser_and_package_map():
     pm = PackageMap.MakeEmpty()
     assert register_models(pm) is pm
     assert Path(pm.GetPath("drakegrasp")) == MODELS
-    with pytest.raises(TypeError, match="Parser or PackageMap"):
+    with pytest.raises(InvalidOptionError, match="Parser or PackageMap"):
         register_models("not a parser")
 
 

@@ -15,19 +15,19 @@ def meshcat():
     return Meshcat(params)
 
 
-class Recording:
-    """A Meshcat that records SetProperty calls (pydrake cannot read them)."""
+@pytest.fixture
+def recorded(monkeypatch):
+    """Every Meshcat.SetProperty call, {(path, name): value} (pydrake cannot
+    read properties back)."""
+    calls = {}
+    original = Meshcat.SetProperty
 
-    def __init__(self, meshcat):
-        self._meshcat = meshcat
-        self.properties = {}
+    def record(self, path, name, value, *args, **kwargs):
+        calls[(path, name)] = value
+        return original(self, path, name, value, *args, **kwargs)
 
-    def SetProperty(self, path, name, value):  # noqa: N802 (Drake's name)
-        self.properties[(path, name)] = value
-        self._meshcat.SetProperty(path, name, value)
-
-    def __getattr__(self, name):
-        return getattr(self._meshcat, name)
+    monkeypatch.setattr(Meshcat, "SetProperty", record)
+    return calls
 
 
 @pytest.fixture(scope="module")
@@ -44,10 +44,9 @@ def test_size_sets_the_scale_of_the_defaults(meshcat, grasp):
         dg.draw_grasp(meshcat, grasp, size=-1.0)
 
 
-def test_on_top_marks_every_drawn_object(meshcat, grasp):
+def test_on_top_marks_every_drawn_object(meshcat, grasp, recorded):
     result = dg.force_closure(grasp)
-    recording = Recording(meshcat)
-    drawing = dg.draw_grasp(recording, grasp, result=result, cone="both", on_top=True)
+    drawing = dg.draw_grasp(meshcat, grasp, result=result, cone="both", on_top=True)
     leaves = [p for p in drawing.paths if not p.endswith("/force")]
     leaves += [
         f"{p}/{part}"
@@ -57,19 +56,18 @@ def test_on_top_marks_every_drawn_object(meshcat, grasp):
     ]
     assert len(leaves) > 3 * grasp.num_contacts
     for path in leaves:
-        assert recording.properties[(f"{path}/<object>", "material.depthTest")] is False
-        assert recording.properties[(f"{path}/<object>", "renderOrder")] > 0
-    assert len(recording.properties) == 2 * len(leaves)
-    plain = Recording(meshcat)
-    dg.draw_grasp(plain, grasp, result=result, prefix="plain")
-    assert plain.properties == {}
+        assert recorded[(f"{path}/<object>", "material.depthTest")] is False
+        assert recorded[(f"{path}/<object>", "renderOrder")] > 0
+    assert len(recorded) == 2 * len(leaves)
+    recorded.clear()
+    dg.draw_grasp(meshcat, grasp, result=result, prefix="plain")
+    assert recorded == {}
 
 
-def test_set_translucent_checks_its_arguments(meshcat):
+def test_set_translucent_checks_its_arguments(meshcat, recorded):
     meshcat.SetObject("thing", Sphere(0.1))
-    recording = Recording(meshcat)
-    set_translucent(recording, ["thing", "other"], 0.5)
-    assert recording.properties == {
+    set_translucent(meshcat, ["thing", "other"], 0.5)
+    assert recorded == {
         ("thing", "modulated_opacity"): 0.5,
         ("other", "modulated_opacity"): 0.5,
     }

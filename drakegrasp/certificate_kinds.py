@@ -1,0 +1,85 @@
+"""The kinds of certificate, and how a re-check reports.
+
+A low room of its own so that the certificate type
+(:mod:`drakegrasp.certificates`), its check (:mod:`drakegrasp.certificate_check`)
+and its text (:mod:`drakegrasp.certificate_text`) all import from here and never
+from each other in a circle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+from drakegrasp.results import _jsonable
+
+__all__ = [
+    "BALANCE",
+    "DEFAULT_CHECK_TOL",
+    "ESCAPE_TWIST",
+    "UNCONTROLLABLE",
+    "UNRESISTED_WRENCH",
+    "CertificateCheck",
+]
+
+ESCAPE_TWIST = "escape twist"
+"""Kind of the witness of a form-closure "no"."""
+UNRESISTED_WRENCH = "unresisted wrench"
+"""Kind of the witness of a force-closure "no"."""
+UNCONTROLLABLE = "uncontrollable internal force"
+"""Kind of the witness of an LP3 failure."""
+BALANCE = "balancing internal force"
+"""Kind of the witness of a "yes"."""
+_KINDS = (ESCAPE_TWIST, UNRESISTED_WRENCH, UNCONTROLLABLE, BALANCE)
+_CONES = ("normals", "polyhedral", "exact")
+
+DEFAULT_CHECK_TOL = 1e-7
+"""Relative tolerance of :meth:`drakegrasp.certificates.Certificate.check`.
+
+Violations are scaled to 1 before they are compared with it.
+"""
+
+
+@dataclass(frozen=True)
+class CertificateCheck:
+    """How well a certificate holds on a grasp, evaluated without a solver.
+
+    Attributes
+    ----------
+    holds : bool
+        ``violation <= tol``.
+    violation : float
+        Largest relative violation of the witness's defining inequalities
+        (dimensionless; 0 when every inequality holds).  For an escape twist:
+        ``max_i max(0, −(G_nᵀ v)_i) / (‖G_{n,i}‖ ‖v‖)``; for a wrench, the
+        largest cone support ``max_f wᵀ G_i f`` per unit ``f_n`` over
+        ``‖G_i‖ ‖w‖``; for internal forces, the residuals ``‖G f‖`` and
+        ``‖Jᵀ f‖`` relative to ``‖G‖ ‖f‖`` and the cone slack.
+    slack : float
+        How firmly it holds, on the same scale: the smallest separation speed
+        (escape twist), ``−max`` support (unresisted wrench), the smallest
+        normal force over ``Σ f_n`` (internal forces).  0 on the boundary.
+    tol : float
+        Tolerance used.
+    detail : str
+        One line saying what was evaluated.
+    """
+
+    holds: bool
+    violation: float
+    slack: float
+    tol: float
+    detail: str
+
+    def __bool__(self) -> bool:
+        return self.holds
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+
+    def __str__(self) -> str:
+        verdict = "holds" if self.holds else "FAILS"
+        return (
+            f"witness {verdict}: violation {self.violation:.2g}, "
+            f"slack {self.slack + 0.0:.3g} (tol {self.tol:g}); {self.detail}"
+        )
