@@ -55,12 +55,6 @@ def test_geometry_single_path_agrees_with_the_scipy_lp():
     assert counts["plausible verdict"] == len(cases) >= 200
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the batch engine's rank is not yet invariant to units and reference "
-    "point (batch/reduction.py, being rewritten by the 'scale' branch); when it "
-    "lands this passes and the marker must go",
-)
 def test_geometry_batch_agrees_with_the_scipy_lp():
     cases = [c for c in fuzz_cases.geometry_cases() if c.family == "geometry batch"]
     _, bad = _bad(cases)
