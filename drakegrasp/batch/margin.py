@@ -1,6 +1,6 @@
 r"""The closure LPs of a stack of grasps, solved in block form (cost linear in N).
 
-LP1/LP2 (``docs/conventions.md``) have ``d* = N max(0, t*)`` with
+LP1/LP2 (:doc:`/conventions`) have ``d* = N max(0, t*)`` with
 
 .. math::
 

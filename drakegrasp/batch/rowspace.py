@@ -1,7 +1,7 @@
 r"""Ranks and row spaces of stacks of grasp matrices, invariant to units and to ``p``.
 
 Ranks, row spaces and null spaces are decided on a *normalised* grasp matrix
-(``docs/conventions.md``, Invariance): moments about the contacts' centroid
+(:doc:`/conventions`, Invariance): moments about the contacts' centroid
 ``c̄`` divided by their spread ``L = max_i ‖c_i - c̄‖`` (``L = 1`` when all
 contacts coincide).  Moving the reference point or changing units multiplies
 ``G`` on the left by an invertible matrix ``T``, which changes neither

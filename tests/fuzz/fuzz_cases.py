@@ -658,8 +658,8 @@ def batch_cases() -> Iterator[Case]:
                         lambda o=option, v=v: dg.batch_form_closure(P, N, **{o: v}),
                         "refuse",
                     )
-    # chunk_size=None is valid: chunks sized by bytes (the default).
-    for i, v in enumerate([0, -1, 2.5, "abc"]):
+    # chunk_size=None is the default (as many grasps as fit in CHUNK_BYTES).
+    for i, v in enumerate([0, -1, 2.5, "abc", True]):
         yield Case(
             "batch",
             f"chunk_size#{i}",
