@@ -10,7 +10,9 @@ go through
 
 * ``batch×1``: :func:`drakegrasp.batch_force_closure` with ``workers=1``
   (validation and construction included);
-* ``batch×all``: the same with every available core (``workers=None``);
+* ``batch×all``: the same with every available core (``workers`` = the core
+  count, explicitly: ``workers=None`` keeps batches under
+  ``PARALLEL_MIN_WORK`` contacts in one process);
 * ``mathprog``: :func:`drakegrasp.force_closure` per grasp (one Drake
   ``MathematicalProgram`` each; ``Grasp`` objects built outside the clock);
 * ``highs``: ``scipy.optimize.linprog(method="highs")`` per grasp on the same
@@ -121,7 +123,7 @@ def bench_one(case, N, *, quick, seed):
         K, 1, time.perf_counter,
     )  # fmt: skip
     rall, res_all = best_rate(
-        lambda: batch_force_closure(P, Nrm, MU, workers=None, **opts),
+        lambda: batch_force_closure(P, Nrm, MU, workers=available_cores(), **opts),
         K, 2, time.perf_counter,
     )  # fmt: skip
     bitwise = all(

@@ -170,9 +170,9 @@ def solve_margin_blocks(
         A = np.concatenate([np.transpose(Q, (1, 0, 2)), np.zeros((1, M, sel.size))])
         A[-1, normal_columns] = 1.0  # (e, M, k)
         if kernel == "numba" or (kernel == "auto" and numba_available()):
-            import drakegrasp.batch.block_kernel as block_kernel  # imports numba
+            from drakegrasp.batch.block_kernel import solve_block_stack  # numba
 
-            t, ok, _, _ = block_kernel.solve_block_stack(
+            t, ok, _, _ = solve_block_stack(
                 [F if F.shape[0] == 1 else F[sel] for F in facets],
                 np.transpose(A, (2, 0, 1)),
                 kappa[sel],
