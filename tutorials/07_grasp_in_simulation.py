@@ -272,12 +272,15 @@ height = np.array(height)
 
 fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
 closed = V[GraspMonitor.FORCE_CLOSURE] == 1
+# fill_between(where=...) fills between consecutive True samples; a verdict holds
+# from its sample to the next one, so that next sample is marked too.
+shaded = closed | np.concatenate([[False], closed[:-1]])
 for ax in axes:
     ax.fill_between(
         times,
         0,
         1,
-        where=closed,
+        where=shaded,
         step="post",
         alpha=0.12,
         transform=ax.get_xaxis_transform(),
@@ -290,7 +293,7 @@ axes[1].set_ylabel(r"Ferrari–Canny $\varepsilon$")
 axes[2].plot(times, 1e3 * (height - height[0]), color="C2")
 axes[2].set_ylabel("box lifted [mm]")
 axes[2].set_xlabel("time [s]")
-axes[0].legend(loc="upper right")
+axes[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
 fig.suptitle(f"A simulated pick, checked by GraspMonitor every {1e3 * PERIOD:.0f} ms")
 fig.tight_layout()
 

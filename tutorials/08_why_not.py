@@ -128,6 +128,8 @@ fig.tight_layout()
 fig = plt.figure(figsize=(6, 5))
 ax = fig.add_subplot(projection="3d")
 dg.plot_wrench_space(weak, ax=ax, result=dg.force_closure(weak))
+for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+    axis.set_major_locator(plt.MaxNLocator(3))
 ax.set_title("mu = 0.2: the separating plane")
 fig.tight_layout()
 

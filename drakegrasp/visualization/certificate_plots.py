@@ -214,5 +214,11 @@ def plot_separating_plane(
     arrow = ax.quiver(
         0, 0, 0, *w_plot, color=_RED, linewidth=2.5, arrow_length_ratio=0.15
     )
-    ax.text(*(1.05 * w_plot), "fingers cannot apply", color=_RED, fontsize=8)
+    ax.text(
+        *(1.05 * w_plot),
+        "fingers cannot apply",
+        color=_RED,
+        fontsize=8,
+        bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0},
+    )
     return CertificateArtists(UNRESISTED_WRENCH, arrows=arrow, plane=plane)
