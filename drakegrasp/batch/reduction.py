@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.batch.ipm import solve_max_last
-from drakegrasp.batch.rowspace import _inverse_frobenius
+from drakegrasp.batch.rowspace import _householder, _inverse_frobenius
 
 __all__ = ["MarginSolution", "null_spaces", "solve_margin_lp"]
 
@@ -92,28 +92,7 @@ def _householder_qr(A: np.ndarray):
     the complete ``Q`` (M, M - w, K), an orthonormal basis of the complement of
     ``A``'s columns.
     """
-    M, w, K = A.shape
-    A = A.copy()
-    vs, betas = [], []
-    for j in range(w):
-        x = A[j:, j]
-        norm = np.sqrt(np.einsum("ik,ik->k", x, x))
-        alpha = np.where(x[0] >= 0.0, -norm, norm)
-        v = x.copy()
-        v[0] -= alpha
-        vv = np.einsum("ik,ik->k", v, v)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            beta = np.where(vv > 0.0, 2.0 / vv, 0.0)
-        sub = A[j:, j:]
-        sub -= v[:, None, :] * (beta * np.einsum("ik,ijk->jk", v, sub))[None]
-        vs.append(v)
-        betas.append(beta)
-    Q = np.zeros((M, M - w, K))
-    Q[w:] = np.eye(M - w)[:, :, None]
-    for j in reversed(range(w)):
-        v, sub = vs[j], Q[j:]
-        sub -= v[:, None, :] * (betas[j] * np.einsum("ik,ijk->jk", v, sub))[None]
-    return A[:w], Q
+    return _householder(A, complement=True)
 
 
 def null_spaces(G: np.ndarray, *, rank_tol: float):

@@ -55,8 +55,13 @@ def normalised_positions(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return np.where(ok[:, None, None], r / spread[:, None, None], 0.0), spread
 
 
-def _householder(GT: np.ndarray):
-    """Householder QR of stacks (M, w, K), M >= w: ``R`` (w, w, K), ``Q`` (M, w, K)."""
+def _householder(GT: np.ndarray, *, complement: bool = False):
+    """Householder QR of stacks (M, w, K), M >= w: ``R`` (w, w, K) and ``Q``.
+
+    ``Q`` is the thin factor (M, w, K), or with ``complement=True`` the last
+    ``M - w`` columns of the complete one (M, M - w, K): an orthonormal basis of
+    the complement of the columns.
+    """
     M, w, K = GT.shape
     A = GT.copy()
     vs, betas = [], []
@@ -73,8 +78,12 @@ def _householder(GT: np.ndarray):
         sub -= v[:, None, :] * (beta * np.einsum("ik,ijk->jk", v, sub))[None]
         vs.append(v)
         betas.append(beta)
-    Q = np.zeros((M, w, K))
-    Q[np.arange(w), np.arange(w)] = 1.0
+    if complement:
+        Q = np.zeros((M, M - w, K))
+        Q[w:] = np.eye(M - w)[:, :, None]
+    else:
+        Q = np.zeros((M, w, K))
+        Q[np.arange(w), np.arange(w)] = 1.0
     for j in reversed(range(w)):
         v, sub = vs[j], Q[j:]
         sub -= v[:, None, :] * (betas[j] * np.einsum("ik,ijk->jk", v, sub))[None]
