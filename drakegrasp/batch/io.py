@@ -380,35 +380,47 @@ def evaluate_file(
     output = _as_path("output", output_path)
     _check_output(output, inputs, overwrite=check_flag("overwrite", overwrite))
     data = read_grasps(source)
-    common = {
-        "reference_points": data.get("reference_points"),
-        "characteristic_lengths": data.get("characteristic_lengths"),
-        "tol": tol,
-        "rank_tol": rank_tol,
-        "chunk_size": chunk_size,
-        "progress": progress,
-        "metrics": metrics,
-    }
+    common = {"chunk_size": chunk_size, "progress": progress, "metrics": metrics}
+    common.update(_file_options(data, tol=tol, rank_tol=rank_tol))
     if kind == "force":
-        mu_value = mu if mu is not None else data.get("mu")
-        if mu_value is None:
-            raise InvalidOptionError(
-                f"force closure needs friction: {str(input_path)!r} has no array "
-                "'mu' and no mu was given"
-            )
-        nu = torsional_friction
-        if nu is None:
-            nu = data.get("torsional_friction")
         result = batch_force_closure(
             data["positions"],
             data["normals"],
-            mu_value,
+            _friction_of(data, input_path, mu),
             model=model,
             num_generators=num_generators,
-            torsional_friction=nu,
+            torsional_friction=_torsion_of(data, torsional_friction),
             **common,
         )
     else:
         result = batch_form_closure(data["positions"], data["normals"], **common)
     write_result(result, output, overwrite=overwrite)
     return result
+
+
+def _file_options(data: dict, *, tol: float, rank_tol: float) -> dict:
+    """Engine options every kind takes from a grasp file's optional arrays."""
+    return {
+        "reference_points": data.get("reference_points"),
+        "characteristic_lengths": data.get("characteristic_lengths"),
+        "tol": tol,
+        "rank_tol": rank_tol,
+    }
+
+
+def _friction_of(data: dict, input_path, mu):
+    """``mu`` if given, else the file's array ``mu``; force closure needs one."""
+    value = mu if mu is not None else data.get("mu")
+    if value is None:
+        raise InvalidOptionError(
+            f"force closure needs friction: {str(input_path)!r} has no array "
+            "'mu' and no mu was given"
+        )
+    return value
+
+
+def _torsion_of(data: dict, torsional_friction):
+    """``torsional_friction`` if given, else the file's array (or None)."""
+    if torsional_friction is not None:
+        return torsional_friction
+    return data.get("torsional_friction")

@@ -291,29 +291,22 @@ def stream_file(
     data = io.read_grasps(source)
     positions, normals = data["positions"], data["normals"]
     common = {
-        "reference_points": data.get("reference_points"),
-        "characteristic_lengths": data.get("characteristic_lengths"),
-        "tol": tol,
-        "rank_tol": rank_tol,
         "chunk_size": chunk_size,
         "progress": progress,
         "metrics": metrics,
         "workers": workers,
     }
+    common.update(io._file_options(data, tol=tol, rank_tol=rank_tol))
     if kind == "force":
-        mu_value = mu if mu is not None else data.get("mu")
-        if mu_value is None:
-            raise InvalidOptionError(
-                f"force closure needs friction: {str(input_path)!r} has no array "
-                "'mu' and no mu was given"
-            )
-        nu = torsional_friction
-        if nu is None:
-            nu = data.get("torsional_friction")
         chunks = stream_force_closure(
-            positions, normals, mu_value, model=model,
-            num_generators=num_generators, torsional_friction=nu, **common,
-        )  # fmt: skip
+            positions,
+            normals,
+            io._friction_of(data, input_path, mu),
+            model=model,
+            num_generators=num_generators,
+            torsional_friction=io._torsion_of(data, torsional_friction),
+            **common,
+        )
     elif kind == "form":
         chunks = stream_form_closure(positions, normals, **common)
     else:
