@@ -39,48 +39,112 @@ __all__ = ["AVAILABLE", "solve_block_stack"]
 
 _STEP = 0.9995
 _FLOOR = 0.1
+_FAST = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without nnan/ninf
 
 
-@njit(cache=True)
-def _chol(H, n):
-    """In-place lower Cholesky of H[:n, :n]; the diagonal holds 1/L_jj."""
+@njit(cache=True, fastmath=_FAST)
+def _chol3(H, i):
+    """:func:`_chol` unrolled for the 3 × 3 blocks of spatial hard fingers."""
+    h00, h10, h11, h20, h21, h22 = (
+        H[i, 0, 0], H[i, 1, 0], H[i, 1, 1], H[i, 2, 0], H[i, 2, 1], H[i, 2, 2]
+    )  # fmt: skip
+    floor = 1e-300 + 1e-14 * max(abs(h00), abs(h11), abs(h22))
+    d0 = 1.0 / math.sqrt(max(h00, floor))
+    l10 = h10 * d0
+    l20 = h20 * d0
+    d1 = 1.0 / math.sqrt(max(h11 - l10 * l10, floor))
+    l21 = (h21 - l20 * l10) * d1
+    d2 = 1.0 / math.sqrt(max(h22 - l20 * l20 - l21 * l21, floor))
+    H[i, 0, 0], H[i, 1, 0], H[i, 1, 1] = d0, l10, d1
+    H[i, 2, 0], H[i, 2, 1], H[i, 2, 2] = l20, l21, d2
+
+
+@njit(cache=True, fastmath=_FAST)
+def _solve3(L, i, b, off):
+    """:func:`_solve` unrolled for 3 × 3 blocks."""
+    d0, l10, d1, l20, l21, d2 = (
+        L[i, 0, 0], L[i, 1, 0], L[i, 1, 1], L[i, 2, 0], L[i, 2, 1], L[i, 2, 2]
+    )  # fmt: skip
+    x0 = b[off] * d0
+    x1 = (b[off + 1] - l10 * x0) * d1
+    x2 = (b[off + 2] - l20 * x0 - l21 * x1) * d2
+    x2 = x2 * d2
+    x1 = (x1 - l21 * x2) * d1
+    x0 = (x0 - l10 * x1 - l20 * x2) * d0
+    b[off], b[off + 1], b[off + 2] = x0, x1, x2
+
+
+@njit(cache=True, fastmath=_FAST)
+def _gram3(F, o, nr, D, r0, H, i):
+    """Lower triangle of ``C_iᵀ diag(D_i) C_i`` for 3 components, into H[i]."""
+    h00 = h10 = h11 = h20 = h21 = h22 = 0.0
+    for r in range(nr):
+        p = o + 3 * r
+        d = D[r0 + r]
+        f0, f1, f2 = F[p], F[p + 1], F[p + 2]
+        e0, e1, e2 = f0 * d, f1 * d, f2 * d
+        h00 += e0 * f0
+        h10 += e1 * f0
+        h11 += e1 * f1
+        h20 += e2 * f0
+        h21 += e2 * f1
+        h22 += e2 * f2
+    H[i, 0, 0], H[i, 1, 0], H[i, 1, 1] = h00, h10, h11
+    H[i, 2, 0], H[i, 2, 1], H[i, 2, 2] = h20, h21, h22
+
+
+@njit(cache=True, fastmath=_FAST)
+def _chol(H, i, n):
+    """In-place lower Cholesky of H[i, :n, :n]; the diagonal holds 1/L_jj."""
+    if n == 3:
+        _chol3(H, i)
+        return
     big = 0.0
     for j in range(n):
-        big = max(big, abs(H[j, j]))
+        big = max(big, abs(H[i, j, j]))
     floor = 1e-300 + 1e-14 * big
     for j in range(n):
-        s = H[j, j]
+        s = H[i, j, j]
         for k in range(j):
-            s -= H[j, k] * H[j, k]
+            s -= H[i, j, k] * H[i, j, k]
         inv = 1.0 / math.sqrt(max(s, floor))
-        H[j, j] = inv
-        for i in range(j + 1, n):
-            s = H[i, j]
+        H[i, j, j] = inv
+        for r in range(j + 1, n):
+            s = H[i, r, j]
             for k in range(j):
-                s -= H[i, k] * H[j, k]
-            H[i, j] = s * inv
+                s -= H[i, r, k] * H[i, j, k]
+            H[i, r, j] = s * inv
 
 
-@njit(cache=True)
-def _solve(L, n, b):
-    """In-place solve of ``L Lᵀ z = b`` for b[:n]."""
-    for i in range(n):
-        acc = b[i]
-        for j in range(i):
-            acc -= L[i, j] * b[j]
-        b[i] = acc * L[i, i]
-    for i in range(n - 1, -1, -1):
-        acc = b[i]
-        for j in range(i + 1, n):
-            acc -= L[j, i] * b[j]
-        b[i] = acc * L[i, i]
+@njit(cache=True, fastmath=_FAST)
+def _solve(L, i, n, b, off):
+    """In-place solve of ``L_i L_iᵀ z = b[off:off + n]``, factors from :func:`_chol`."""
+    if n == 3:
+        _solve3(L, i, b, off)
+        return
+    for r in range(n):
+        acc = b[off + r]
+        for j in range(r):
+            acc -= L[i, r, j] * b[off + j]
+        b[off + r] = acc * L[i, r, r]
+    for r in range(n - 1, -1, -1):
+        acc = b[off + r]
+        for j in range(r + 1, n):
+            acc -= L[i, j, r] * b[off + j]
+        b[off + r] = acc * L[i, r, r]
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=_FAST)
 def _cmul(F, foff, nrow, ncomp, roff, coff, N, f, out):
     """Out = C f (block-diagonal facets)."""
     for i in range(N):
         c0, r0, nc, o = coff[i], roff[i], ncomp[i], foff[i]
+        if nc == 3:
+            f0, f1, f2 = f[c0], f[c0 + 1], f[c0 + 2]
+            for r in range(nrow[i]):
+                p = o + 3 * r
+                out[r0 + r] = F[p] * f0 + F[p + 1] * f1 + F[p + 2] * f2
+            continue
         for r in range(nrow[i]):
             acc = 0.0
             for c in range(nc):
@@ -88,11 +152,21 @@ def _cmul(F, foff, nrow, ncomp, roff, coff, N, f, out):
             out[r0 + r] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=_FAST)
 def _ctmul(F, foff, nrow, ncomp, roff, coff, N, v, out):
     """Out = Cᵀ v."""
     for i in range(N):
         c0, r0, nc, o = coff[i], roff[i], ncomp[i], foff[i]
+        if nc == 3:
+            a0 = a1 = a2 = 0.0
+            for r in range(nrow[i]):
+                p = o + 3 * r
+                vr = v[r0 + r]
+                a0 += F[p] * vr
+                a1 += F[p + 1] * vr
+                a2 += F[p + 2] * vr
+            out[c0], out[c0 + 1], out[c0 + 2] = a0, a1, a2
+            continue
         for c in range(nc):
             acc = 0.0
             for r in range(nrow[i]):
@@ -100,25 +174,39 @@ def _ctmul(F, foff, nrow, ncomp, roff, coff, N, v, out):
             out[c0 + c] = acc
 
 
-@njit(cache=True)
-def _max_step(v, dv, R):
+@njit(cache=True, fastmath=_FAST)
+def _dot(x, y, n):
+    acc = 0.0
+    for m in range(n):
+        acc += x[m] * y[m]
+    return acc
+
+
+@njit(cache=True, fastmath=_FAST)
+def _max_step(vinv, dv, R):
+    """``max(0, max_j -dv_j / v_j)`` given ``1 / v``."""
     q = 0.0
     for j in range(R):
-        x = -dv[j] / v[j]
+        x = -dv[j] * vinv[j]
         if x > q:
             q = x
     return q
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=_FAST)
 def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_stop,
-         wr, wm, we, W, Hs, S):  # fmt: skip
-    """Solve one problem from ``f`` (which satisfies ``A f = b``); work arrays given."""
+         wr, wm, we, WT, Hs, S):  # fmt: skip
+    """Solve one problem from ``f`` (which satisfies ``A f = b``); work arrays given.
+
+    ``WT`` (e, M) holds ``H⁻¹ Aᵀ`` transposed, so every product with ``A`` or
+    ``WT`` runs along contiguous rows of length ``M``.
+    """
     N = coff.shape[0]
     e, M = A.shape
     R = roff[N - 1] + nrow[N - 1]
-    s, lam, Cf, D, r4, q, ds, dl, r5, dsa, dla = (
-        wr[0], wr[1], wr[2], wr[3], wr[4], wr[5], wr[6], wr[7], wr[8], wr[9], wr[10]
+    s, lam, Cf, D, r4, q, ds, dl, r5, dsa, dla, si, li = (
+        wr[0], wr[1], wr[2], wr[3], wr[4], wr[5], wr[6], wr[7], wr[8], wr[9], wr[10],
+        wr[11], wr[12],
     )  # fmt: skip
     g, r1, z, dg, ah = wm[0], wm[1], wm[2], wm[3], wm[4]
     y, r3, a, u, w, dy = we[0], we[1], we[2], we[3], we[4], we[5]
@@ -152,31 +240,22 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
         g[coff[i]] -= t * ah[coff[i]]
     _ctmul(F, foff, nrow, ncomp, roff, coff, N, lam, z)
     for i in range(e):
-        acc = 0.0
-        acc2 = 0.0
-        for m in range(M):
-            acc += A[i, m] * z[m]
-            acc2 += A[i, m] * ah[m]
-        y[i] = acc
-        a[i] = acc2
+        y[i] = _dot(A[i], z, M)
+        a[i] = _dot(A[i], ah, M)
         for b in range(i + 1):
-            acc = 0.0
-            for m in range(M):
-                acc += A[i, m] * A[b, m]
-            S[i, b] = acc
-    _chol(S, e)
-    _solve(S, e, y)
+            S[0, i, b] = _dot(A[i], A[b], M)
+    _chol(S, 0, e)
+    _solve(S, 0, e, y, 0)
     a_p = 1.0
     a_d = 1.0
     dt = 0.0
     for it in range(1, max_iter + 1):
         _cmul(F, foff, nrow, ncomp, roff, coff, N, g, Cf)
         _ctmul(F, foff, nrow, ncomp, roff, coff, N, lam, r1)
-        for m in range(M):
-            acc = r1[m]
-            for i in range(e):
-                acc -= A[i, m] * y[i]
-            r1[m] = acc
+        for i in range(e):
+            yi = y[i]
+            for m in range(M):
+                r1[m] -= A[i, m] * yi
         lsum = 0.0
         gap = 0.0
         err_p = 0.0
@@ -188,10 +267,7 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
         r2 = 1.0
         for i in range(e):
             r2 -= a[i] * y[i]
-            acc = 0.0
-            for m in range(M):
-                acc += A[i, m] * g[m]
-            r3[i] = (1.0 if i == e - 1 else 0.0) - acc - a[i] * t
+            r3[i] = (1.0 if i == e - 1 else 0.0) - _dot(A[i], g, M) - a[i] * t
             err_p = max(err_p, abs(r3[i]))
         err_d = abs(r2)
         for m in range(M):
@@ -216,35 +292,33 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
             return t, ok, False, it
         mu = gap / R
         for j in range(R):
-            D[j] = lam[j] / s[j]
+            si[j] = 1.0 / s[j]  # one division per row and iteration
+            li[j] = 1.0 / lam[j]
+            D[j] = lam[j] * si[j]
         for i in range(N):
-            c0, r0, nc, o = coff[i], roff[i], ncomp[i], foff[i]
-            H = Hs[i]
-            for x in range(nc):
-                for b in range(x + 1):
-                    acc = 0.0
-                    for r in range(nrow[i]):
-                        acc += F[o + r * nc + x] * F[o + r * nc + b] * D[r0 + r]
-                    H[x, b] = acc
-            _chol(H, nc)
+            c0, r0, nc, o, nr = coff[i], roff[i], ncomp[i], foff[i], nrow[i]
+            if nc == 3:
+                _gram3(F, o, nr, D, r0, Hs, i)
+            else:
+                for x in range(nc):
+                    for b in range(x + 1):
+                        acc = 0.0
+                        for r in range(nr):
+                            acc += F[o + r * nc + x] * F[o + r * nc + b] * D[r0 + r]
+                        Hs[i, x, b] = acc
+            _chol(Hs, i, nc)
             for i2 in range(e):
+                row = WT[i2]
                 for c in range(nc):
-                    z[c0 + c] = A[i2, c0 + c]
-                _solve(H, nc, z[c0 : c0 + nc])
-                for c in range(nc):
-                    W[c0 + c, i2] = z[c0 + c]
+                    row[c0 + c] = A[i2, c0 + c]
+                _solve(Hs, i, nc, row, c0)
         for i in range(e):
             u[i] = a[i]
             for b in range(i + 1):
-                acc = 0.0
-                for m in range(M):
-                    acc += A[i, m] * W[m, b]
-                S[i, b] = acc
-        _chol(S, e)
-        _solve(S, e, u)
-        denom = 0.0
-        for i in range(e):
-            denom += a[i] * u[i]
+                S[0, i, b] = _dot(A[i], WT[b], M)
+        _chol(S, 0, e)
+        _solve(S, 0, e, u, 0)
+        denom = _dot(a, u, e)
         target = 0.0
         for phase in range(2):
             if phase == 0:
@@ -254,35 +328,30 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
                 for j in range(R):
                     r5[j] = target - s[j] * lam[j] - dsa[j] * dla[j]
             for j in range(R):
-                q[j] = r5[j] / s[j] + D[j] * r4[j]
+                q[j] = r5[j] * si[j] + D[j] * r4[j]
             _ctmul(F, foff, nrow, ncomp, roff, coff, N, q, z)
             for m in range(M):
                 z[m] += r1[m]
             for i in range(N):
-                _solve(Hs[i], ncomp[i], z[coff[i] : coff[i] + ncomp[i]])
+                _solve(Hs, i, ncomp[i], z, coff[i])
             for i in range(e):
-                acc = r3[i]
-                for m in range(M):
-                    acc -= A[i, m] * z[m]
-                w[i] = acc
-            _solve(S, e, w)
-            aw = 0.0
-            for i in range(e):
-                aw += a[i] * w[i]
-            dt = (r2 + aw) / denom
+                w[i] = r3[i] - _dot(A[i], z, M)
+            _solve(S, 0, e, w, 0)
+            dt = (r2 + _dot(a, w, e)) / denom
             for i in range(e):
                 dy[i] = u[i] * dt - w[i]
             for m in range(M):
-                acc = z[m]
-                for i in range(e):
-                    acc -= W[m, i] * dy[i]
-                dg[m] = acc
+                dg[m] = z[m]
+            for i in range(e):
+                dyi = dy[i]
+                for m in range(M):
+                    dg[m] -= WT[i, m] * dyi
             _cmul(F, foff, nrow, ncomp, roff, coff, N, dg, ds)
             for j in range(R):
                 ds[j] = ds[j] - r4[j]
-                dl[j] = r5[j] / s[j] - D[j] * ds[j]
-            qp = _max_step(s, ds, R)
-            qd = _max_step(lam, dl, R)
+                dl[j] = r5[j] * si[j] - D[j] * ds[j]
+            qp = _max_step(si, ds, R)
+            qd = _max_step(li, dl, R)
             if phase == 0:
                 a_p = min(1.0, 1.0 / qp) if qp > 0.0 else 1.0
                 a_d = min(1.0, 1.0 / qd) if qd > 0.0 else 1.0
@@ -307,23 +376,23 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
     return t, False, False, max_iter
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=_FAST)
 def _stack(F, shared, A, kap, f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
            stop, use_stop, out_t, out_conv, out_below, out_it):  # fmt: skip
     N = coff.shape[0]
     e, M = A.shape[1], A.shape[2]
     R = roff[N - 1] + nrow[N - 1]
-    wr = np.empty((11, R))
+    wr = np.empty((13, R))
     wm = np.empty((5, M))
     we = np.empty((6, e))
-    W = np.empty((M, e))
+    WT = np.empty((e, M))
     Hs = np.empty((N, 4, 4))
-    S = np.empty((e, e))
+    S = np.empty((1, e, e))
     for k in range(A.shape[0]):
         Fk = F[0] if shared else F[k]
         t, ok, below, it = _one(
             Fk, A[k], kap[k], f0[k], coff, ncomp, foff, nrow, roff, tol, max_iter,
-            stop, use_stop, wr, wm, we, W, Hs, S,
+            stop, use_stop, wr, wm, we, WT, Hs, S,
         )  # fmt: skip
         out_t[k] = t
         out_conv[k] = ok
