@@ -94,6 +94,30 @@ def _gram3(F, o, nr, D, r0, H, i):
 
 
 @njit(cache=True, fastmath=_FAST)
+def _gram4(F, o, nr, D, r0, H, i):
+    """:func:`_gram3` for the 4 components of soft fingers."""
+    h00 = h10 = h11 = h20 = h21 = h22 = h30 = h31 = h32 = h33 = 0.0
+    for r in range(nr):
+        p = o + 4 * r
+        d = D[r0 + r]
+        f0, f1, f2, f3 = F[p], F[p + 1], F[p + 2], F[p + 3]
+        e0, e1, e2, e3 = f0 * d, f1 * d, f2 * d, f3 * d
+        h00 += e0 * f0
+        h10 += e1 * f0
+        h11 += e1 * f1
+        h20 += e2 * f0
+        h21 += e2 * f1
+        h22 += e2 * f2
+        h30 += e3 * f0
+        h31 += e3 * f1
+        h32 += e3 * f2
+        h33 += e3 * f3
+    H[i, 0, 0], H[i, 1, 0], H[i, 1, 1] = h00, h10, h11
+    H[i, 2, 0], H[i, 2, 1], H[i, 2, 2] = h20, h21, h22
+    H[i, 3, 0], H[i, 3, 1], H[i, 3, 2], H[i, 3, 3] = h30, h31, h32, h33
+
+
+@njit(cache=True, fastmath=_FAST)
 def _chol(H, i, n):
     """In-place lower Cholesky of H[i, :n, :n]; the diagonal holds 1/L_jj."""
     if n == 3:
@@ -145,6 +169,12 @@ def _cmul(F, foff, nrow, ncomp, roff, coff, N, f, out):
                 p = o + 3 * r
                 out[r0 + r] = F[p] * f0 + F[p + 1] * f1 + F[p + 2] * f2
             continue
+        if nc == 4:
+            f0, f1, f2, f3 = f[c0], f[c0 + 1], f[c0 + 2], f[c0 + 3]
+            for r in range(nrow[i]):
+                p = o + 4 * r
+                out[r0 + r] = F[p] * f0 + F[p + 1] * f1 + F[p + 2] * f2 + F[p + 3] * f3
+            continue
         for r in range(nrow[i]):
             acc = 0.0
             for c in range(nc):
@@ -166,6 +196,17 @@ def _ctmul(F, foff, nrow, ncomp, roff, coff, N, v, out):
                 a1 += F[p + 1] * vr
                 a2 += F[p + 2] * vr
             out[c0], out[c0 + 1], out[c0 + 2] = a0, a1, a2
+            continue
+        if nc == 4:
+            a0 = a1 = a2 = a3 = 0.0
+            for r in range(nrow[i]):
+                p = o + 4 * r
+                vr = v[r0 + r]
+                a0 += F[p] * vr
+                a1 += F[p + 1] * vr
+                a2 += F[p + 2] * vr
+                a3 += F[p + 3] * vr
+            out[c0], out[c0 + 1], out[c0 + 2], out[c0 + 3] = a0, a1, a2, a3
             continue
         for c in range(nc):
             acc = 0.0
@@ -299,6 +340,8 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
             c0, r0, nc, o, nr = coff[i], roff[i], ncomp[i], foff[i], nrow[i]
             if nc == 3:
                 _gram3(F, o, nr, D, r0, Hs, i)
+            elif nc == 4:
+                _gram4(F, o, nr, D, r0, Hs, i)
             else:
                 for x in range(nc):
                     for b in range(x + 1):
