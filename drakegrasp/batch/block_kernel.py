@@ -75,6 +75,39 @@ def _solve3(L, i, b, off):
 
 
 @njit(cache=True, fastmath=_FAST)
+def _solve3_rows(L, i, A, WT, c0, e):
+    """``WT[:, c0:c0 + 3] = (L_i L_iᵀ)⁻¹ A[:, c0:c0 + 3]ᵀ`` row by row."""
+    d0, l10, d1, l20, l21, d2 = (
+        L[i, 0, 0], L[i, 1, 0], L[i, 1, 1], L[i, 2, 0], L[i, 2, 1], L[i, 2, 2]
+    )  # fmt: skip
+    for j in range(e):
+        x0 = A[j, c0] * d0
+        x1 = (A[j, c0 + 1] - l10 * x0) * d1
+        x2 = (A[j, c0 + 2] - l20 * x0 - l21 * x1) * d2
+        x2 = x2 * d2
+        x1 = (x1 - l21 * x2) * d1
+        WT[j, c0 + 2] = x2
+        WT[j, c0 + 1] = x1
+        WT[j, c0] = (x0 - l10 * x1 - l20 * x2) * d0
+
+
+@njit(cache=True, fastmath=_FAST)
+def _solve_rows(L, i, n, A, WT, c0, e):
+    """:func:`_solve3_rows` for blocks of any size ``n``."""
+    for j in range(e):
+        for r in range(n):
+            acc = A[j, c0 + r]
+            for k in range(r):
+                acc -= L[i, r, k] * WT[j, c0 + k]
+            WT[j, c0 + r] = acc * L[i, r, r]
+        for r in range(n - 1, -1, -1):
+            acc = WT[j, c0 + r]
+            for k in range(r + 1, n):
+                acc -= L[i, k, r] * WT[j, c0 + k]
+            WT[j, c0 + r] = acc * L[i, r, r]
+
+
+@njit(cache=True, fastmath=_FAST)
 def _gram3(F, o, nr, D, r0, H, i):
     """Lower triangle of ``C_iᵀ diag(D_i) C_i`` for 3 components, into H[i]."""
     h00 = h10 = h11 = h20 = h21 = h22 = 0.0
@@ -224,6 +257,24 @@ def _dot(x, y, n):
 
 
 @njit(cache=True, fastmath=_FAST)
+def _dotrow(A, i, y, n):
+    """``A[i, :n] · y[:n]`` without forming the row view."""
+    acc = 0.0
+    for m in range(n):
+        acc += A[i, m] * y[m]
+    return acc
+
+
+@njit(cache=True, fastmath=_FAST)
+def _dot2(A, i, B, b, n):
+    """``A[i, :n] · B[b, :n]``."""
+    acc = 0.0
+    for m in range(n):
+        acc += A[i, m] * B[b, m]
+    return acc
+
+
+@njit(cache=True, fastmath=_FAST)
 def _max_step(vinv, dv, R):
     """``max(0, max_j -dv_j / v_j)`` given ``1 / v``."""
     q = 0.0
@@ -281,10 +332,10 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
         g[coff[i]] -= t * ah[coff[i]]
     _ctmul(F, foff, nrow, ncomp, roff, coff, N, lam, z)
     for i in range(e):
-        y[i] = _dot(A[i], z, M)
-        a[i] = _dot(A[i], ah, M)
+        y[i] = _dotrow(A, i, z, M)
+        a[i] = _dotrow(A, i, ah, M)
         for b in range(i + 1):
-            S[0, i, b] = _dot(A[i], A[b], M)
+            S[0, i, b] = _dot2(A, i, A, b, M)
     _chol(S, 0, e)
     _solve(S, 0, e, y, 0)
     a_p = 1.0
@@ -308,7 +359,7 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
         r2 = 1.0
         for i in range(e):
             r2 -= a[i] * y[i]
-            r3[i] = (1.0 if i == e - 1 else 0.0) - _dot(A[i], g, M) - a[i] * t
+            r3[i] = (1.0 if i == e - 1 else 0.0) - _dotrow(A, i, g, M) - a[i] * t
             err_p = max(err_p, abs(r3[i]))
         err_d = abs(r2)
         for m in range(M):
@@ -350,15 +401,14 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
                             acc += F[o + r * nc + x] * F[o + r * nc + b] * D[r0 + r]
                         Hs[i, x, b] = acc
             _chol(Hs, i, nc)
-            for i2 in range(e):
-                row = WT[i2]
-                for c in range(nc):
-                    row[c0 + c] = A[i2, c0 + c]
-                _solve(Hs, i, nc, row, c0)
+            if nc == 3:
+                _solve3_rows(Hs, i, A, WT, c0, e)
+            else:
+                _solve_rows(Hs, i, nc, A, WT, c0, e)
         for i in range(e):
             u[i] = a[i]
             for b in range(i + 1):
-                S[0, i, b] = _dot(A[i], WT[b], M)
+                S[0, i, b] = _dot2(A, i, WT, b, M)
         _chol(S, 0, e)
         _solve(S, 0, e, u, 0)
         denom = _dot(a, u, e)
@@ -378,7 +428,7 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
             for i in range(N):
                 _solve(Hs, i, ncomp[i], z, coff[i])
             for i in range(e):
-                w[i] = r3[i] - _dot(A[i], z, M)
+                w[i] = r3[i] - _dotrow(A, i, z, M)
             _solve(S, 0, e, w, 0)
             dt = (r2 + _dot(a, w, e)) / denom
             for i in range(e):
