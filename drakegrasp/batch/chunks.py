@@ -116,6 +116,7 @@ def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel):
     K = Pn.shape[0]
     G, normal_cols = batched_grasp_matrix(Pn, Nrm, np.zeros((K, Pn.shape[2])), layout)
     facets, slices, start = [], [], 0
+    shared: dict[tuple[int, float], np.ndarray] = {}  # one cone per (kind, μ)
     kappa = np.empty((K, len(layout)))
     for i, kind in enumerate(layout):
         k_i = len(KIND_COMPONENTS[kind])
@@ -126,9 +127,13 @@ def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel):
             F = kind_facets(kind, mu_i, tor_i, n_g).copy()
             F[:, :, _TORSION_COLUMN[kind]] *= spread[:, None]  # m_n = L m̃_n
         else:
-            if (mu_i == mu_i[0]).all():
-                mu_i, tor_i = mu_i[:1], tor_i[:1]  # one cone for all grasps
-            F = kind_facets(kind, mu_i, tor_i, n_g)
+            if (mu_i == mu_i[0]).all():  # one cone for all grasps
+                key = (kind, float(mu_i[0]))
+                if key not in shared:
+                    shared[key] = kind_facets(kind, mu_i[:1], tor_i[:1], n_g)
+                F = shared[key]
+            else:
+                F = kind_facets(kind, mu_i, tor_i, n_g)
         facets.append(F)
         slices.append(slice(start, start + k_i))
         start += k_i

@@ -137,20 +137,31 @@ def batched_grasp_matrix(
     normal_columns : (N,) int
         Column of each contact's ``f_n`` in ``G``.
     """
-    R = contact_frames(normals)  # (K, N, d, d), columns n, t1, t2
-    r = positions - reference_points[:, None, :]
-    cols, normal_columns = [], []
+    K, N, d = positions.shape
+    # Every frame column of every contact at once: U[k, i, j] = R_i e_j.
+    U = np.swapaxes(contact_frames(normals), -1, -2)  # (K, N, d, d)
+    r = (positions - reference_points[:, None, :])[:, :, None, :]
+    w = 6 if d == 3 else 3
+    width = 4 if d == 3 else d  # a soft finger's torsion column is component 3
+    cols = np.zeros((K, N, width, w))
+    cols[:, :, :d, :d] = U
+    if d == 3:
+        u0, u1, u2 = U[..., 0], U[..., 1], U[..., 2]
+        r0, r1, r2 = r[..., 0], r[..., 1], r[..., 2]
+        cols[:, :, :3, 3] = r1 * u2 - r2 * u1  # r × u, as np.cross
+        cols[:, :, :3, 4] = r2 * u0 - r0 * u2
+        cols[:, :, :3, 5] = r0 * u1 - r1 * u0
+        cols[:, :, 3, 3:] = U[:, :, 0]  # soft finger: pure moment about n
+    else:
+        cols[:, :, :, 2] = r[..., 0] * U[..., 1] - r[..., 1] * U[..., 0]
+    contact, component, normal_columns = [], [], []
     for i, kind in enumerate(layout):
-        normal_columns.append(len(cols))
-        ri = r[:, i, None, :]
+        normal_columns.append(len(contact))
         for comp in KIND_COMPONENTS[kind]:
-            if comp < positions.shape[-1]:
-                cols.append(_wrench_columns(ri[:, 0], R[:, i, :, comp]))
-            else:  # soft finger: pure moment about the normal
-                n = R[:, i, :, 0]
-                cols.append(np.concatenate([np.zeros_like(n), n], axis=-1))
-    G = np.stack(cols, axis=-1)
-    return G, np.array(normal_columns, dtype=int)
+            contact.append(i)
+            component.append(comp)
+    G = np.swapaxes(cols[:, contact, component, :], 1, 2)
+    return np.ascontiguousarray(G), np.array(normal_columns, dtype=int)
 
 
 def batched_normal_grasp_matrix(
