@@ -40,9 +40,11 @@ __all__ = ["AVAILABLE", "solve_block_stack"]
 _STEP = 0.9995
 _FLOOR = 0.1
 _FAST = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without nnan/ninf
+# error_model="numpy": x / 0 gives inf or NaN (IEEE) instead of raising; every
+# such value is caught by the tests it feeds (isfinite, comparisons).
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _chol3(H, i):
     """:func:`_chol` unrolled for the 3 × 3 blocks of spatial hard fingers."""
     h00, h10, h11, h20, h21, h22 = (
@@ -59,7 +61,7 @@ def _chol3(H, i):
     H[i, 2, 0], H[i, 2, 1], H[i, 2, 2] = l20, l21, d2
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _solve3(L, i, b, off):
     """:func:`_solve` unrolled for 3 × 3 blocks."""
     d0, l10, d1, l20, l21, d2 = (
@@ -74,7 +76,7 @@ def _solve3(L, i, b, off):
     b[off], b[off + 1], b[off + 2] = x0, x1, x2
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _solve3_rows(L, i, A, WT, c0, e):
     """``WT[:, c0:c0 + 3] = (L_i L_iᵀ)⁻¹ A[:, c0:c0 + 3]ᵀ`` row by row."""
     d0, l10, d1, l20, l21, d2 = (
@@ -91,7 +93,7 @@ def _solve3_rows(L, i, A, WT, c0, e):
         WT[j, c0] = (x0 - l10 * x1 - l20 * x2) * d0
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _solve_rows(L, i, n, A, WT, c0, e):
     """:func:`_solve3_rows` for blocks of any size ``n``."""
     for j in range(e):
@@ -107,7 +109,7 @@ def _solve_rows(L, i, n, A, WT, c0, e):
             WT[j, c0 + r] = acc * L[i, r, r]
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _gram3(F, o, nr, D, r0, H, i):
     """Lower triangle of ``C_iᵀ diag(D_i) C_i`` for 3 components, into H[i]."""
     h00 = h10 = h11 = h20 = h21 = h22 = 0.0
@@ -126,7 +128,7 @@ def _gram3(F, o, nr, D, r0, H, i):
     H[i, 2, 0], H[i, 2, 1], H[i, 2, 2] = h20, h21, h22
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _gram4(F, o, nr, D, r0, H, i):
     """:func:`_gram3` for the 4 components of soft fingers."""
     h00 = h10 = h11 = h20 = h21 = h22 = h30 = h31 = h32 = h33 = 0.0
@@ -150,7 +152,7 @@ def _gram4(F, o, nr, D, r0, H, i):
     H[i, 3, 0], H[i, 3, 1], H[i, 3, 2], H[i, 3, 3] = h30, h31, h32, h33
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _chol(H, i, n):
     """In-place lower Cholesky of H[i, :n, :n]; the diagonal holds 1/L_jj."""
     if n == 3:
@@ -173,7 +175,7 @@ def _chol(H, i, n):
             H[i, r, j] = s * inv
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _solve(L, i, n, b, off):
     """In-place solve of ``L_i L_iᵀ z = b[off:off + n]``, factors from :func:`_chol`."""
     if n == 3:
@@ -191,7 +193,7 @@ def _solve(L, i, n, b, off):
         b[off + r] = acc * L[i, r, r]
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _cmul(F, foff, nrow, ncomp, roff, coff, N, f, out):
     """Out = C f (block-diagonal facets)."""
     for i in range(N):
@@ -215,7 +217,7 @@ def _cmul(F, foff, nrow, ncomp, roff, coff, N, f, out):
             out[r0 + r] = acc
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _ctmul(F, foff, nrow, ncomp, roff, coff, N, v, out):
     """Out = Cᵀ v."""
     for i in range(N):
@@ -248,7 +250,7 @@ def _ctmul(F, foff, nrow, ncomp, roff, coff, N, v, out):
             out[c0 + c] = acc
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _dot(x, y, n):
     acc = 0.0
     for m in range(n):
@@ -256,7 +258,7 @@ def _dot(x, y, n):
     return acc
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _dotrow(A, i, y, n):
     """``A[i, :n] · y[:n]`` without forming the row view."""
     acc = 0.0
@@ -265,7 +267,7 @@ def _dotrow(A, i, y, n):
     return acc
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _dot2(A, i, B, b, n):
     """``A[i, :n] · B[b, :n]``."""
     acc = 0.0
@@ -274,7 +276,7 @@ def _dot2(A, i, B, b, n):
     return acc
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _max_step(vinv, dv, R):
     """``max(0, max_j -dv_j / v_j)`` given ``1 / v``."""
     q = 0.0
@@ -285,7 +287,7 @@ def _max_step(vinv, dv, R):
     return q
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_stop,
          wr, wm, we, WT, Hs, S):  # fmt: skip
     """Solve one problem from ``f`` (which satisfies ``A f = b``); work arrays given.
@@ -469,7 +471,7 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
     return t, False, False, max_iter
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _stack(F, shared, A, kap, f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
            stop, use_stop, out_t, out_conv, out_below, out_it):  # fmt: skip
     N = coff.shape[0]
@@ -491,6 +493,33 @@ def _stack(F, shared, A, kap, f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
         out_conv[k] = ok
         out_below[k] = below
         out_it[k] = it
+
+
+def flat_facets(facets: list[np.ndarray], K: int):
+    """Facet rows of one layout as the kernels take them.
+
+    Returns ``(flat, shared, (coff, ncomp, foff, nrow, roff))``: ``flat``
+    (1 or K, total) holds each contact's (r_i, c_i) rows one after the other
+    (one copy when every contact's facets are shared by the stack), and the
+    int64 offsets give each contact's first component, component count,
+    first facet number, row count and first row.
+    """
+    ncomp = np.array([F.shape[2] for F in facets], dtype=np.int64)
+    nrow = np.array([F.shape[1] for F in facets], dtype=np.int64)
+    coff = np.concatenate([[0], np.cumsum(ncomp)[:-1]]).astype(np.int64)
+    roff = np.concatenate([[0], np.cumsum(nrow)[:-1]]).astype(np.int64)
+    foff = np.concatenate([[0], np.cumsum(nrow * ncomp)[:-1]]).astype(np.int64)
+    shared = all(F.shape[0] == 1 for F in facets)
+    n = 1 if shared else K
+    flat = np.concatenate(
+        [np.broadcast_to(F, (n,) + F.shape[1:]).reshape(n, -1) for F in facets],
+        axis=1,
+    )
+    return (
+        np.ascontiguousarray(flat, dtype=float),
+        shared,
+        (coff, ncomp, foff, nrow, roff),
+    )
 
 
 def solve_block_stack(
@@ -523,24 +552,13 @@ def solve_block_stack(
     value, converged, below, iterations : (K,) arrays
     """
     K = A.shape[0]
-    ncomp = np.array([F.shape[2] for F in facets], dtype=np.int64)
-    nrow = np.array([F.shape[1] for F in facets], dtype=np.int64)
-    coff = np.concatenate([[0], np.cumsum(ncomp)[:-1]]).astype(np.int64)
-    roff = np.concatenate([[0], np.cumsum(nrow)[:-1]]).astype(np.int64)
-    sizes = nrow * ncomp
-    foff = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-    shared = all(F.shape[0] == 1 for F in facets)
-    flat = np.concatenate(
-        [np.broadcast_to(F, (1 if shared else K,) + F.shape[1:]).reshape(
-            (1 if shared else K), -1) for F in facets],
-        axis=1,
-    )  # fmt: skip
+    flat, shared, (coff, ncomp, foff, nrow, roff) = flat_facets(facets, K)
     out_t = np.zeros(K)
     out_conv = np.zeros(K, dtype=np.bool_)
     out_below = np.zeros(K, dtype=np.bool_)
     out_it = np.zeros(K, dtype=np.int64)
     _stack(
-        np.ascontiguousarray(flat), shared, np.ascontiguousarray(A),
+        flat, shared, np.ascontiguousarray(A),
         np.ascontiguousarray(kappa, dtype=float), np.ascontiguousarray(start),
         coff, ncomp, foff, nrow, roff, float(tol), int(max_iter),
         0.0 if stop_below is None else float(stop_below), stop_below is not None,

@@ -33,7 +33,7 @@ from drakegrasp.batch.construction import (
     contact_kinds,
     kind_facets,
 )
-from drakegrasp.batch.margin import solve_margin_blocks
+from drakegrasp.batch.margin import numba_available, solve_margin_blocks
 from drakegrasp.batch.metrics import epsilon_l1_per_grasp, singular_value_metrics
 from drakegrasp.batch.rowspace import (
     _householder,
@@ -96,10 +96,15 @@ def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel)
         # Balancing normal forces need N(G_n) != {0}; with no more contacts than
         # wrench rows that is rare.  A vectorised QR certifies full column rank
         # for most grasps (as in rowspace); the rest take the exact SVD rule.
-        A = np.ascontiguousarray(np.transpose(Gn, (1, 2, 0)))  # (w, N, k)
-        R, _ = _householder(A)
-        norm = np.sqrt(np.einsum("kij,kij->k", Gn, Gn))
-        unsure = ~(_inverse_frobenius(R) * rank_tol * norm < 1.0)
+        if kernel == "numba" or (kernel == "auto" and numba_available()):
+            from drakegrasp.batch.fused_kernel import full_column_rank_certain
+
+            unsure = ~full_column_rank_certain(Gn, rank_tol)
+        else:
+            A = np.ascontiguousarray(np.transpose(Gn, (1, 2, 0)))  # (w, N, k)
+            R, _ = _householder(A)
+            norm = np.sqrt(np.einsum("kij,kij->k", Gn, Gn))
+            unsure = ~(_inverse_frobenius(R) * rank_tol * norm < 1.0)
         rows, Gn = rows[unsure], Gn[unsure]
         if rows.size:
             sv = np.linalg.svd(Gn, compute_uv=False)

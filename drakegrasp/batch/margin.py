@@ -126,24 +126,49 @@ def solve_margin_blocks(
         Singular values ``<= rank_tol * σ_max`` count as zero.
     ipm_tol, ipm_max_iter : optional
         Tolerance and iteration cap of the interior-point method.
-    kernel : {"auto", "numba", "numpy"}, optional
-        The compiled interior-point method (:mod:`~drakegrasp.batch.block_kernel`)
-        or the numpy reference (:mod:`~drakegrasp.batch.block_ipm`); ``"auto"``
-        takes numba when it is installed.
+    kernel : {"auto", "numba", "numpy", "unfused"}, optional
+        The compiled interior-point method (:mod:`~drakegrasp.batch.block_kernel`,
+        with the full-rank grasps prepared in the compiled loop too,
+        :mod:`~drakegrasp.batch.fused_kernel`) or the numpy reference
+        (:mod:`~drakegrasp.batch.block_ipm`); ``"auto"`` takes numba when it is
+        installed.  ``"unfused"``: the compiled IPM after the numpy
+        preparation (what the fused pass hands its leftovers to).
 
     Returns
     -------
     MarginSolution
     """
-    K, _, M = G.shape
+    K, w, M = G.shape
     N = len(normal_columns)
+    # d* = N t: tighten the tolerance on t beyond 4 contacts so that d* keeps
+    # about 4 ipm_tol absolute accuracy at any N.
+    tol_t = ipm_tol * min(1.0, 4.0 / N)
+    use_numba = kernel == "numba" or (kernel == "auto" and numba_available())
+    if use_numba and M >= w and K > 0:
+        # Certified full-rank grasps are prepared and solved in one compiled
+        # pass (drakegrasp.batch.fused_kernel); the rest take the path below.
+        from drakegrasp.batch.fused_kernel import solve_full_rank_stack  # numba
+
+        d_fused, done = solve_full_rank_stack(
+            G, facets, normal_columns, kappa, rank_tol=rank_tol, tol=tol_t,
+            max_iter=ipm_max_iter,
+        )  # fmt: skip
+        rest = np.flatnonzero(~done)
+        if rest.size == 0:
+            return MarginSolution(d_fused, np.full(K, w), np.ones(K, dtype=bool))
+        sub = solve_margin_blocks(
+            G[rest], [F if F.shape[0] == 1 else F[rest] for F in facets],
+            component_slices, normal_columns, kappa[rest], rank_tol=rank_tol,
+            ipm_tol=ipm_tol, ipm_max_iter=ipm_max_iter, kernel="unfused",
+        )  # fmt: skip
+        rank = np.full(K, w)
+        converged = np.ones(K, dtype=bool)
+        d_fused[rest], rank[rest], converged[rest] = sub.d_star, sub.rank, sub.converged
+        return MarginSolution(d_fused, rank, converged)
     rank, spaces = row_spaces(G, rank_tol=rank_tol)
     d_star = np.zeros(K)
     converged = np.ones(K, dtype=bool)
     contact_groups = _contact_groups(facets, component_slices, kappa)
-    # d* = N t: tighten the tolerance on t beyond 4 contacts so that d* keeps
-    # about 4 ipm_tol absolute accuracy at any N.
-    tol_t = ipm_tol * min(1.0, 4.0 / N)
     for sel, Q in spaces:
         r = Q.shape[1]
         if r >= M:
@@ -169,7 +194,7 @@ def solve_margin_blocks(
             continue
         A = np.concatenate([np.transpose(Q, (1, 0, 2)), np.zeros((1, M, sel.size))])
         A[-1, normal_columns] = 1.0  # (e, M, k)
-        if kernel == "numba" or (kernel == "auto" and numba_available()):
+        if use_numba or kernel == "unfused":
             from drakegrasp.batch.block_kernel import solve_block_stack  # numba
 
             t, ok, _, _ = solve_block_stack(

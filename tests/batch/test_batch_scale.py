@@ -19,6 +19,8 @@ from hypothesis import strategies as st
 
 from drakegrasp.batch import batch_force_closure, batch_form_closure, block_kernel
 from drakegrasp.batch.construction import (
+    FRICTIONLESS,
+    PLANAR_HARD,
     SPATIAL_HARD,
     batched_grasp_matrix,
     kind_facets,
@@ -194,3 +196,66 @@ def test_results_are_bitwise_the_same_for_any_number_of_workers():
     form1 = batch_form_closure(P, Nrm, chunk_size=700, workers=1)
     form2 = batch_form_closure(P, Nrm, chunk_size=700, workers=2)
     assert form1.d_star.tobytes() == form2.d_star.tobytes()
+
+
+def _mixed_stack(rng, K, N, d, layout_kind):
+    """Random grasps with rank-deficient ones mixed in (collinear, coincident)."""
+    P, Nrm = random_grasps(rng, K, N, d, spread=0.4)
+    P[::5, :, 1:] = 0.0  # contacts on a line
+    P[1::7] = P[1::7, :1]  # all contacts at one point
+    Nrm /= np.linalg.norm(Nrm, axis=-1, keepdims=True)
+    Pn, _ = normalised_positions(P)
+    G, nc = batched_grasp_matrix(Pn, Nrm, np.zeros((K, d)), (layout_kind,) * N)
+    return G, nc
+
+
+@needs_numba
+@pytest.mark.parametrize(
+    ("N", "d", "kind", "mu"),
+    [
+        (3, 3, SPATIAL_HARD, 0.5),  # 3-D null space: the block IPM
+        (8, 3, SPATIAL_HARD, 0.3),
+        (2, 2, PLANAR_HARD, 0.6),  # M - w = 1: the closed form
+        (7, 3, FRICTIONLESS, 0.0),  # M - w = 1
+        (5, 3, FRICTIONLESS, 0.0),  # M < w: never full rank
+    ],
+)
+def test_fused_pass_matches_the_numpy_reference_on_mixed_ranks(N, d, kind, mu):
+    """The compiled preparation (fused_kernel) against numpy QR + block IPM."""
+    rng = np.random.default_rng(7600 + 10 * N + d)
+    K = 350
+    G, nc = _mixed_stack(rng, K, N, d, kind)
+    F = kind_facets(kind, np.array([mu]), np.array([0.0]), 8)
+    k_i = F.shape[2]
+    sl = [slice(k_i * i, k_i * i + k_i) for i in range(N)]
+    kappa = np.full((K, N), np.sqrt(1.0 + mu**2))
+    ref = solve_margin_blocks(G, [F] * N, sl, nc, kappa, rank_tol=1e-9, kernel="numpy")
+    new = solve_margin_blocks(G, [F] * N, sl, nc, kappa, rank_tol=1e-9, kernel="numba")
+    np.testing.assert_array_equal(new.rank, ref.rank)
+    np.testing.assert_allclose(new.d_star, ref.d_star, atol=1e-8, rtol=0)
+    np.testing.assert_array_equal(new.converged, ref.converged)
+    full = 6 if d == 3 else 3
+    if N * k_i >= full:  # not vacuous: both full-rank and deficient grasps
+        assert 0 < (ref.rank == full).sum() < K
+        assert (ref.d_star > 1e-6).any()
+
+
+@needs_numba
+def test_fused_rank_certificate_is_the_numpy_one():
+    """full_column_rank_certain against the vectorised QR test it replaces."""
+    from drakegrasp.batch.fused_kernel import full_column_rank_certain
+    from drakegrasp.batch.rowspace import _householder, _inverse_frobenius
+
+    rng = np.random.default_rng(7700)
+    Gn = rng.normal(size=(500, 6, 4))
+    Gn[::3, :, 3] = Gn[::3, :, 0] + Gn[::3, :, 1]  # exactly dependent columns
+    # nearly dependent, with σ_min spread log-uniformly across the threshold
+    scale = 10.0 ** rng.uniform(-11.0, -6.0, size=(167, 1))
+    Gn[1::3, :, 3] = Gn[1::3, :, 0] + scale * rng.normal(size=(167, 6))
+    R, _ = _householder(np.ascontiguousarray(np.transpose(Gn, (1, 2, 0))))
+    norm = np.sqrt(np.einsum("kij,kij->k", Gn, Gn))
+    ref = _inverse_frobenius(R) * 1e-9 * norm < 1.0
+    new = full_column_rank_certain(Gn, 1e-9)
+    np.testing.assert_array_equal(new, ref)
+    assert 0 < new[1::3].sum() < new[1::3].size  # the threshold is exercised
+    assert not new[::3].any() and new[2::3].all()

@@ -1,0 +1,244 @@
+"""Row space, starting point and block IPM of a stack of grasps in one compiled pass.
+
+:func:`drakegrasp.batch.margin.solve_margin_blocks` prepares each LP of a chunk
+with vectorised numpy (a Householder QR of ``G̃ᵀ`` to certify full rank and
+give ``Q``, then ``c = e - Q Qᵀ e``, ``f_0 = c / ‖c‖²`` and ``A = [Qᵀ; eᵀ]``)
+before the compiled IPM runs.  On a few contacts that preparation costs about
+half as much as the IPM, mostly numpy's per-call overhead and the (M, w, K)
+temporaries.  Here the same steps run per grasp inside the compiled loop, on
+a working set of a few hundred numbers, and go straight into
+:func:`drakegrasp.batch.block_kernel._one`.
+
+Only grasps whose full row rank the QR certifies (``‖R⁻¹‖_F rank_tol ‖G̃‖_F < 1``,
+as :func:`drakegrasp.batch.rowspace.row_spaces`) and whose IPM converges are
+finished here; the caller sends the others (rank-deficient or nearly so, or an
+IPM that hit its cap) through the numpy preparation, the SVD rank rule and the
+HiGHS fallback, so every verdict follows the same rules as before.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from drakegrasp.batch.block_kernel import _FAST, _cmul, _one, flat_facets, njit
+
+__all__ = ["full_column_rank_certain", "solve_full_rank_stack"]
+
+_PUSH_TOL = 1e-10  # as drakegrasp.batch.margin
+
+
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _qr(XT, rows, cols, V, beta):
+    """Householder QR of ``X`` (rows × cols, rows >= cols) stored transposed.
+
+    ``XT[c, i] = X[i, c]``, so each column is a contiguous row.  Reflector
+    ``j`` is left in ``V[j, j:rows]`` with ``beta[j]``, ``R`` in ``XT``
+    (``R[i, c] = XT[c, i]``, ``i <= c``).  Returns ``‖X‖_F`` (before the QR).
+    """
+    fro = 0.0
+    for c in range(cols):
+        for i in range(rows):
+            fro += XT[c, i] * XT[c, i]
+    for j in range(cols):
+        norm = 0.0
+        for i in range(j, rows):
+            norm += XT[j, i] * XT[j, i]
+            V[j, i] = XT[j, i]
+        norm = math.sqrt(norm)
+        V[j, j] -= -norm if XT[j, j] >= 0.0 else norm
+        vv = 0.0
+        for i in range(j, rows):
+            vv += V[j, i] * V[j, i]
+        b = 2.0 / vv if vv > 0.0 else 0.0
+        beta[j] = b
+        for c in range(j, cols):
+            acc = 0.0
+            for i in range(j, rows):
+                acc += V[j, i] * XT[c, i]
+            acc *= b
+            for i in range(j, rows):
+                XT[c, i] -= acc * V[j, i]
+    return math.sqrt(fro)
+
+
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _certain(XT, cols, fro, rank_tol, RI):
+    """Whether ``R`` (from :func:`_qr`) certifies full column rank.
+
+    ``σ_min >= 1/‖R⁻¹‖_F`` and ``σ_max <= ‖X‖_F``, so ``‖R⁻¹‖_F rank_tol ‖X‖_F
+    < 1`` proves ``σ_min > rank_tol σ_max``.  ``RI`` is (cols, cols) scratch.
+    """
+    total = 0.0
+    for j in range(cols):
+        for i in range(j, -1, -1):
+            if i == j:
+                x = 1.0 / XT[j, j]
+            else:
+                acc = 0.0
+                for m in range(i + 1, j + 1):
+                    acc += XT[m, i] * RI[m, j]
+                x = -acc / XT[i, i]
+            RI[i, j] = x
+            total += x * x
+    inv_fro = math.sqrt(total)
+    if not math.isfinite(inv_fro):
+        return False
+    return inv_fro * rank_tol * fro < 1.0
+
+
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _column_rank_stack(Gn, rank_tol, out):
+    K, w, N = Gn.shape
+    XT = np.empty((N, w))
+    V = np.empty((N, w))
+    beta = np.empty(N)
+    RI = np.empty((N, N))
+    for k in range(K):
+        for i in range(w):
+            for c in range(N):
+                XT[c, i] = Gn[k, i, c]
+        fro = _qr(XT, w, N, V, beta)
+        out[k] = _certain(XT, N, fro, rank_tol, RI)
+
+
+def full_column_rank_certain(Gn: np.ndarray, rank_tol: float) -> np.ndarray:
+    """Grasps whose ``G_n`` (K, w, N), ``N <= w``, a QR proves of full column rank.
+
+    The compiled form of the test in
+    :func:`drakegrasp.batch.chunks._normal_certificates`; False means unsure
+    (the SVD rule decides), never "deficient".
+    """
+    out = np.zeros(Gn.shape[0], dtype=np.bool_)
+    _column_rank_stack(np.ascontiguousarray(Gn, dtype=float), float(rank_tol), out)
+    return out
+
+
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nrow,
+                     roff, tol, max_iter, out_d, out_done):  # fmt: skip
+    K, w, M = G.shape
+    N = coff.shape[0]
+    e = w + 1
+    R = roff[N - 1] + nrow[N - 1]
+    XT = np.empty((w, M))
+    V = np.empty((w, M))
+    beta = np.empty(w)
+    RI = np.empty((w, w))
+    A = np.empty((e, M))
+    f0 = np.empty(M)
+    Qte = np.empty(w)
+    wr = np.empty((13, R))
+    wm = np.empty((5, M))
+    we = np.empty((6, e))
+    WT = np.empty((e, M))
+    Hs = np.empty((N, 4, 4))
+    S = np.empty((1, e, e))
+    Cf = np.empty(R)
+    for k in range(K):
+        for i in range(w):
+            for m in range(M):
+                XT[i, m] = G[k, i, m]  # Gᵀ stored transposed: G itself
+        fro = _qr(XT, M, w, V, beta)
+        if not _certain(XT, w, fro, rank_tol, RI):
+            continue  # rank not certified: the numpy path decides
+        # Thin Q = H_0 … H_{w-1} [I; 0], written straight into A = [Qᵀ; eᵀ].
+        for i in range(w):
+            for m in range(M):
+                A[i, m] = 1.0 if m == i else 0.0
+        for j in range(w - 1, -1, -1):
+            b = beta[j]
+            for i in range(w):
+                acc = 0.0
+                for m in range(j, M):
+                    acc += V[j, m] * A[i, m]
+                acc *= b
+                for m in range(j, M):
+                    A[i, m] -= acc * V[j, m]
+        for m in range(M):
+            A[w, m] = 0.0
+        for i in range(N):
+            A[w, normal[i]] = 1.0
+        out_done[k] = True
+        if M == w:
+            out_d[k] = 0.0  # no null space: only f = 0 balances
+            continue
+        # c = e - Q Qᵀ e, f0 = c / ‖c‖².
+        for i in range(w):
+            acc = 0.0
+            for j in range(N):
+                acc += A[i, normal[j]]
+            Qte[i] = acc
+        cn2 = 0.0
+        for m in range(M):
+            acc = A[w, m]
+            for i in range(w):
+                acc -= A[i, m] * Qte[i]
+            f0[m] = acc
+            cn2 += acc * acc
+        if not (cn2 > _PUSH_TOL * _PUSH_TOL):
+            out_d[k] = 0.0  # no balanced force pushes
+            continue
+        for m in range(M):
+            f0[m] /= cn2
+        Fk = F[0] if shared else F[k]
+        if M - w == 1:  # N(G) is spanned by c: t* = min C c / ‖c‖²
+            _cmul(Fk, foff, nrow, ncomp, roff, coff, N, f0, Cf)
+            t = Cf[0]
+            for j in range(R):
+                t = min(t, Cf[j])
+        else:
+            t, ok, _, _ = _one(
+                Fk, A, kap[k], f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
+                0.0, True, wr, wm, we, WT, Hs, S,
+            )  # fmt: skip
+            if not ok:
+                out_done[k] = False  # the numpy path retries, then HiGHS
+                continue
+        out_d[k] = N * max(t, 0.0)
+
+
+def solve_full_rank_stack(
+    G: np.ndarray,
+    facets: list[np.ndarray],
+    normal_columns: np.ndarray,
+    kappa: np.ndarray,
+    *,
+    rank_tol: float,
+    tol: float,
+    max_iter: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``d*`` of the grasps of one layout whose full row rank a QR certifies.
+
+    Parameters
+    ----------
+    G : (K, w, M) float
+        Normalised effective grasp matrices, ``M >= w``.
+    facets : list of (K, r_i, c_i) or (1, r_i, c_i) float
+        Facet rows of each contact (leading 1: shared by the stack).
+    normal_columns : (N,) int
+        Column of each ``f_n``.
+    kappa : (K, N) float
+        Cone bounds ``‖f_i‖ <= κ_i f_{n,i}``.
+    rank_tol, tol, max_iter
+        Rank threshold, IPM tolerance on ``t`` and iteration cap.
+
+    Returns
+    -------
+    d_star : (K,) float
+        ``N max(0, t*)`` where ``done``; 0 elsewhere.
+    done : (K,) bool
+        Rank ``w`` certified and the LP solved; the rest is left to the caller.
+    """
+    K = G.shape[0]
+    flat, shared, offsets = flat_facets(facets, K)
+    out_d = np.zeros(K)
+    out_done = np.zeros(K, dtype=np.bool_)
+    _full_rank_stack(
+        np.ascontiguousarray(G, dtype=float),
+        np.ascontiguousarray(normal_columns, dtype=np.int64), float(rank_tol),
+        flat, shared, np.ascontiguousarray(kappa, dtype=float), *offsets,
+        float(tol), int(max_iter), out_d, out_done,
+    )  # fmt: skip
+    return out_d, out_done
