@@ -447,16 +447,32 @@ def _stream(
 
     def tasks():
         for sl in _chunks(K, size, progress, f"{kind} closure"):
-            P = real_array("positions", positions[sl])
-            _check_positions(P, sl.start)
-            Nrm = _unit_normals(real_array("normals", normals[sl]), sl.start)
+            P, Nrm = _read(positions, sl), _read(normals, sl)
             _release_pages(positions, sl.stop)
             _release_pages(normals, sl.stop)
             slices.append(sl)
-            yield task(P, Nrm, sl)
+            fn, args, options = task(P, Nrm, sl)
+            # the checks run where the chunk is solved (in parallel with others)
+            yield _checked_chunk, (fn, sl.start, *args), options
 
     for i, arrays in enumerate(map_ordered(tasks(), n_workers)):
         yield slices[i], arrays
+
+
+def _read(a, sl: slice):
+    """One chunk of an input, as an array that owns or shares plain memory."""
+    x = a[sl]
+    if isinstance(x, np.memmap):
+        return np.array(x)  # its pages are released before the chunk is used
+    return x
+
+
+def _checked_chunk(fn: Callable, start: int, P, Nrm, *args, **options):
+    """Check a chunk's positions and normals (normalised), then ``fn`` on them."""
+    P = real_array("positions", P)
+    _check_positions(P, start)
+    Nrm = _unit_normals(real_array("normals", Nrm), start)
+    return fn(P, Nrm, *args, **options)
 
 
 def _collect(K: int, d: int, kind: str, tol: float, names, chunks):

@@ -8,20 +8,24 @@ workers.  Processes, not threads: the engine's inner loops (numpy on small
 arrays, the numba kernel) hold the GIL for most of their time.
 
 At most ``2 × workers`` chunks are in flight, so memory stays bounded by the
-chunk size whatever the number of grasps.
+chunk size whatever the number of grasps.  Each chunk's input checks run in
+the worker that solves it, so the parent only slices, sends and collects.
+The worker processes are kept between calls (:func:`shutdown_pool`).
 """
 
 from __future__ import annotations
 
+import atexit
 import multiprocessing
 import os
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["available_cores", "map_ordered", "resolve_workers"]
+__all__ = ["available_cores", "map_ordered", "resolve_workers", "shutdown_pool"]
 
 Task = tuple[Callable, tuple, dict]
 
@@ -73,20 +77,76 @@ def map_ordered(tasks: Iterable[Task], workers: int) -> Iterator:
         for fn, args, kwargs in tasks:
             yield fn(*args, **kwargs)
         return
+    pool = _pool(workers)
+    pending: deque = deque()  # (future, task), in task order
+    restarted = False
+
+    def next_result():
+        nonlocal pool, restarted
+        while True:
+            try:
+                return pending[0][0].result()
+            except BrokenProcessPool:
+                # A worker died (killed, out of memory).  The chunks in flight
+                # are pure functions of their inputs: run them again, in order,
+                # on a fresh pool, once; a second death is raised.
+                shutdown_pool()
+                if restarted:
+                    raise
+                restarted = True
+                pool = _pool(workers)
+                for i, (_, task) in enumerate(pending):
+                    pending[i] = (pool.submit(_call, *task), task)
+
+    try:
+        for task in tasks:
+            pending.append((pool.submit(_call, *task), task))
+            if len(pending) >= 2 * workers:
+                result = next_result()
+                pending.popleft()
+                yield result
+        while pending:
+            result = next_result()
+            pending.popleft()
+            yield result
+    finally:
+        for fut, _ in pending:
+            fut.cancel()
+
+
+_POOL: dict = {}
+
+
+def _pool(workers: int) -> ProcessPoolExecutor:
+    """The worker pool of ``workers`` processes, started once and kept.
+
+    Starting processes costs 10–50 ms and each new worker pays its first-call
+    costs again (copy-on-write page faults, loading the compiled kernel), which
+    at a few hundred thousand grasps per second is a tenth of a call or more;
+    so the pool outlives the call and the next call with the same number of
+    workers reuses it.  It is shut down at exit, when a worker dies, or when a
+    call asks for a different number of workers.
+    """
+    pool = _POOL.get("pool")
+    if pool is not None and _POOL.get("workers") == workers:
+        return pool
+    shutdown_pool()
     # fork where the OS has it: workers start in milliseconds with the parent's
     # modules loaded, and scripts need no ``if __name__ == "__main__"`` guard
     # (forkserver and spawn re-run the main module in every worker).
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        pending: deque = deque()
-        try:
-            for fn, args, kwargs in tasks:
-                pending.append(pool.submit(_call, fn, args, kwargs))
-                if len(pending) >= 2 * workers:
-                    yield pending.popleft().result()
-            while pending:
-                yield pending.popleft().result()
-        finally:
-            for fut in pending:
-                fut.cancel()
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    _POOL.update(pool=pool, workers=workers)
+    return pool
+
+
+def shutdown_pool() -> None:
+    """Stop the kept worker processes (if any); the next call starts new ones."""
+    pool = _POOL.pop("pool", None)
+    _POOL.pop("workers", None)
+    if pool is not None:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+atexit.register(shutdown_pool)

@@ -29,6 +29,7 @@ from drakegrasp.batch.margin import solve_margin_blocks
 from drakegrasp.batch.reduction import solve_margin_lp
 from drakegrasp.batch.rowspace import normalised_positions
 from drakegrasp.closure import force_closure, form_closure
+from drakegrasp.errors import InvalidContactError
 
 needs_numba = pytest.mark.skipif(
     not block_kernel.AVAILABLE, reason="numba (extra 'fast') is not installed"
@@ -259,3 +260,31 @@ def test_fused_rank_certificate_is_the_numpy_one():
     np.testing.assert_array_equal(new, ref)
     assert 0 < new[1::3].sum() < new[1::3].size  # the threshold is exercised
     assert not new[::3].any() and new[2::3].all()
+
+
+def test_the_worker_pool_is_kept_and_replaced_when_a_worker_dies():
+    """Calls reuse the worker processes; a killed worker's chunks run again."""
+    import os
+    import signal
+
+    from drakegrasp.batch import parallel
+
+    rng = np.random.default_rng(7800)
+    P, Nrm = random_grasps(rng, 1200, 4, 3)
+    one = batch_force_closure(P, Nrm, 0.5, chunk_size=200, workers=1)
+    first = batch_force_closure(P, Nrm, 0.5, chunk_size=200, workers=2)
+    pids = set(parallel._POOL["pool"]._processes)
+    again = batch_force_closure(P, Nrm, 0.5, chunk_size=200, workers=2)
+    assert set(parallel._POOL["pool"]._processes) == pids
+    for res in (first, again):
+        assert res.d_star.tobytes() == one.d_star.tobytes()
+    os.kill(next(iter(pids)), signal.SIGKILL)
+    fresh = batch_force_closure(P, Nrm, 0.5, chunk_size=200, workers=2)
+    assert set(parallel._POOL["pool"]._processes).isdisjoint(pids)
+    assert fresh.d_star.tobytes() == one.d_star.tobytes()
+    bad = Nrm.copy()
+    bad[777, 2] = 0.0  # checked in the worker, raised here with its index
+    with pytest.raises(InvalidContactError, match="grasp 777, contact 2"):
+        batch_force_closure(P, bad, 0.5, chunk_size=200, workers=2)
+    parallel.shutdown_pool()
+    assert "pool" not in parallel._POOL
