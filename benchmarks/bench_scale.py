@@ -12,7 +12,10 @@ go through
   (validation and construction included);
 * ``batch×all``: the same with every available core (``workers`` = the core
   count, explicitly: ``workers=None`` keeps batches under
-  ``PARALLEL_MIN_WORK`` contacts in one process);
+  ``PARALLEL_MIN_WORK`` contacts in one process).  The engine keeps its worker
+  processes between calls, so the best of the repeats is the rate of a call
+  after the first; the first call with a new worker count also pays process
+  start-up (tens of milliseconds);
 * ``mathprog``: :func:`drakegrasp.force_closure` per grasp (one Drake
   ``MathematicalProgram`` each; ``Grasp`` objects built outside the clock);
 * ``highs``: ``scipy.optimize.linprog(method="highs")`` per grasp on the same
