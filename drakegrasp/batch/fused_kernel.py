@@ -7,7 +7,7 @@ before the compiled IPM runs.  On a few contacts that preparation costs about
 half as much as the IPM, mostly numpy's per-call overhead and the (M, w, K)
 temporaries.  Here the same steps run per grasp inside the compiled loop, on
 a working set of a few hundred numbers, and go straight into
-:func:`drakegrasp.batch.block_kernel._one`.
+``drakegrasp.batch.block_kernel._one``.
 
 Only grasps whose full row rank the QR certifies (``‖R⁻¹‖_F rank_tol ‖G̃‖_F < 1``,
 as :func:`drakegrasp.batch.rowspace.row_spaces`) and whose IPM converges are
@@ -22,7 +22,8 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.block_kernel import _FAST, _cmul, _one, flat_facets, njit
+from drakegrasp.batch.block_kernel import _one, flat_facets, work_arrays
+from drakegrasp.batch.block_ops import _FAST, _cmul, njit
 
 __all__ = ["full_column_rank_certain", "solve_full_rank_stack"]
 
@@ -54,13 +55,19 @@ def _qr(XT, rows, cols, V, beta):
         b = 2.0 / vv if vv > 0.0 else 0.0
         beta[j] = b
         for c in range(j, cols):
-            acc = 0.0
-            for i in range(j, rows):
-                acc += V[j, i] * XT[c, i]
-            acc *= b
-            for i in range(j, rows):
-                XT[c, i] -= acc * V[j, i]
+            _reflect(V, j, b, XT, c, rows)
     return math.sqrt(fro)
+
+
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _reflect(V, j, b, Y, r, n):
+    """Apply reflector ``j`` (``I - b v vᵀ``, ``v = V[j, j:n]``) to ``Y[r, j:n]``."""
+    acc = 0.0
+    for i in range(j, n):
+        acc += V[j, i] * Y[r, i]
+    acc *= b
+    for i in range(j, n):
+        Y[r, i] -= acc * V[j, i]
 
 
 @njit(cache=True, fastmath=_FAST, error_model="numpy")
@@ -107,7 +114,7 @@ def full_column_rank_certain(Gn: np.ndarray, rank_tol: float) -> np.ndarray:
     """Grasps whose ``G_n`` (K, w, N), ``N <= w``, a QR proves of full column rank.
 
     The compiled form of the test in
-    :func:`drakegrasp.batch.chunks._normal_certificates`; False means unsure
+    ``drakegrasp.batch.chunks._normal_certificates``; False means unsure
     (the SVD rule decides), never "deficient".
     """
     out = np.zeros(Gn.shape[0], dtype=np.bool_)
@@ -129,12 +136,7 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
     A = np.empty((e, M))
     f0 = np.empty(M)
     Qte = np.empty(w)
-    wr = np.empty((13, R))
-    wm = np.empty((5, M))
-    we = np.empty((6, e))
-    WT = np.empty((e, M))
-    Hs = np.empty((N, 4, 4))
-    S = np.empty((1, e, e))
+    wr, wm, we, WT, Hs, S = work_arrays(R, M, e, N)
     Cf = np.empty(R)
     for k in range(K):
         for i in range(w):
@@ -148,14 +150,8 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
             for m in range(M):
                 A[i, m] = 1.0 if m == i else 0.0
         for j in range(w - 1, -1, -1):
-            b = beta[j]
             for i in range(w):
-                acc = 0.0
-                for m in range(j, M):
-                    acc += V[j, m] * A[i, m]
-                acc *= b
-                for m in range(j, M):
-                    A[i, m] -= acc * V[j, m]
+                _reflect(V, j, beta[j], A, i, M)
         for m in range(M):
             A[w, m] = 0.0
         for i in range(N):

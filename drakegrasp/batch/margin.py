@@ -129,7 +129,7 @@ def solve_margin_blocks(
     kernel : {"auto", "numba", "numpy", "unfused"}, optional
         The compiled interior-point method (:mod:`~drakegrasp.batch.block_kernel`,
         with the full-rank grasps prepared in the compiled loop too,
-        :mod:`~drakegrasp.batch.fused_kernel`) or the numpy reference
+        ``drakegrasp.batch.fused_kernel``) or the numpy reference
         (:mod:`~drakegrasp.batch.block_ipm`); ``"auto"`` takes numba when it is
         installed.  ``"unfused"``: the compiled IPM after the numpy
         preparation (what the fused pass hands its leftovers to).
