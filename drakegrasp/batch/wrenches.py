@@ -99,9 +99,10 @@ def batched_primitive_wrenches(
         F = n[:, :, None, :]
     elif d == 2:
         sign = np.array([1.0, -1.0])
-        F = n[:, :, None, :] + (mu_eff[..., None, None] * sign[:, None]) * R[
-            :, :, None, :, 1
-        ]
+        F = (
+            n[:, :, None, :]
+            + (mu_eff[..., None, None] * sign[:, None]) * R[:, :, None, :, 1]
+        )
     else:
         theta = 2.0 * np.pi * np.arange(1, num_generators + 1) / num_generators
         F = n[:, :, None, :] + mu_eff[..., None, None] * (
