@@ -29,9 +29,10 @@ A second table times the batch Ferrari–Canny ε L1
 (:func:`drakegrasp.batch.batch_epsilon_l1`, the compiled expanding polytope)
 against the per-grasp Qhull route (``ferrari_canny`` per grasp, what
 ``metrics=["epsilon_l1"]`` did before) for every case and N up to
-``--epsilon-max-n`` (default 12; Qhull takes tens of milliseconds per grasp
-beyond), with their ratio, the max relative |Δε| and the fallback count
-(``benchmarks/bench_epsilon.py`` has the details; ``--no-epsilon`` skips it).
+``--epsilon-max-n`` (default 32; Qhull takes 0.1–0.2 s per grasp at N = 24–32,
+so it runs on at least 20 grasps there), with their ratio, the max relative
+|Δε| and the fallback count (``benchmarks/bench_epsilon.py`` has the details;
+``--no-epsilon`` skips it).
 
 ``--memory`` also runs ``drakegrasp batch`` on memory-mapped ``.npy`` inputs of
 10^5, 10^6 (and, without ``--quick``, 10^7) grasps and reports each run's
@@ -280,7 +281,7 @@ def main(argv=None):
     )
     parser.add_argument("--cases", nargs="*", default=list(CASES), choices=CASES)
     parser.add_argument("--no-epsilon", action="store_true", help="skip batch ε")
-    parser.add_argument("--epsilon-max-n", type=int, default=12)
+    parser.add_argument("--epsilon-max-n", type=int, default=32)
     parser.add_argument("--out", default=str(Path(__file__).parent / "results"))
     args = parser.parse_args(argv)
     out = Path(args.out)

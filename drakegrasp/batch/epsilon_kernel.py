@@ -82,6 +82,10 @@ PENCIL_TOL = 1e-4
 DRIFT_TOL = 1e-9
 """A recomputed facet offset off by more than this times the scale is ILL."""
 
+MAX_CAPACITY = 2**16
+"""Most facets a grasp may store (about 10 MB of work arrays in 6-D); beyond
+it the grasp is handed to Qhull."""
+
 FLAT_TOL = 1e-13
 """A simplex height below this times the scale means a flat set (ε = 0)."""
 
@@ -578,7 +582,7 @@ def epsilon_l1_stack(
         ``K`` grasps, ``M`` each (repeated points are allowed: padding).
     capacity : int, optional
         Facets stored per grasp; a grasp that needs more is retried with four
-        times as many (up to ``2**20``).  Default from ``M`` and ``D``.
+        times as many (up to ``MAX_CAPACITY``).  Default from ``M`` and ``D``.
     return_info : bool, optional
         Also return ``info`` (K, 2) int: points added and facets made per grasp
         (for benchmarks).
@@ -603,7 +607,7 @@ def epsilon_l1_stack(
     info = np.zeros((K, 2), dtype=np.int64)
     _stack(W, hashes, int(capacity), eps, status, info)
     rows = np.flatnonzero(status == FULL)
-    while rows.size and capacity < 2**20:
+    while rows.size and capacity < MAX_CAPACITY:
         capacity *= 4
         sub_eps = np.zeros(rows.size)
         sub_status = np.zeros(rows.size, dtype=np.int8)
