@@ -213,3 +213,28 @@ def test_hostile_input_raises_grasp_errors(change, error, match):
     kwargs = {k: v for k, v in args.items() if k not in ("positions", "normals", "mu")}
     with pytest.raises(error, match=match):
         batch_epsilon_l1(args["positions"], args["normals"], args["mu"], **kwargs)
+
+
+def test_without_numba_every_grasp_takes_the_qhull_route(monkeypatch):
+    _, P, Nrm = _grasps(8, K=30, N=3)
+    eps = batch_epsilon_l1(P, Nrm, 0.5)
+    monkeypatch.setattr(epsilon_kernel, "AVAILABLE", False)
+    Nn = Nrm / np.linalg.norm(Nrm, axis=-1, keepdims=True)
+    K = P.shape[0]
+    p = np.zeros((K, 3))
+    slow, qhull = epsilon_l1_routes(
+        P, Nn, np.full((K, 3), 0.5), np.zeros((K, 3)), p,
+        batched_characteristic_lengths(P, p), model="hard_finger", num_generators=8,
+    )  # fmt: skip
+    assert qhull.all()
+    _close(slow, eps)
+
+
+def test_more_primitive_wrenches_than_qhull_takes_are_refused():
+    """The limit of ferrari_canny (L1_MAX_POINTS) holds here too, before any work."""
+    rng = np.random.default_rng(1)
+    P, Nrm = random_grasps(rng, 1, 251, 3)  # 251 × 8 = 2008 wrenches
+    with pytest.raises(InvalidOptionError, match="L1_MAX_POINTS"):
+        batch_epsilon_l1(P, Nrm, 0.5)
+    # Without friction, 251 wrenches: computed (form closure of 251 contacts).
+    _close(batch_epsilon_l1(P, Nrm, 0.0), batch_epsilon_l1(P, Nrm, 0.0, kernel="numpy"))
