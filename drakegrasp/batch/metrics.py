@@ -147,7 +147,7 @@ def epsilon_l1_routes(
     qhull : (k,) bool
         The grasps computed per grasp by Qhull.
     """
-    from drakegrasp.batch import epsilon_kernel
+    import drakegrasp.batch.epsilon_kernel as epsilon_kernel
     from drakegrasp.batch.wrenches import batched_primitive_wrenches
 
     _check_point_count(
