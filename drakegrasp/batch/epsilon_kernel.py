@@ -132,6 +132,27 @@ def _greedy_simplex(W, simplex, B, res):
 
 
 @njit(cache=True)
+def _deflate(x, i, Q, r):
+    """Remove from row ``i`` of ``x`` its parts along rows ``0 … r-1`` of ``Q``.
+
+    ``Q``'s rows are orthonormal; Gram–Schmidt twice (so the result is
+    orthogonal to working precision).  Returns the row's norm after.
+    """
+    D = x.shape[1]
+    for _ in range(2):
+        for q in range(r):
+            dot = 0.0
+            for a in range(D):
+                dot += x[i, a] * Q[q, a]
+            for a in range(D):
+                x[i, a] -= dot * Q[q, a]
+    nrm = 0.0
+    for a in range(D):
+        nrm += x[i, a] * x[i, a]
+    return math.sqrt(nrm)
+
+
+@njit(cache=True)
 def _plane(W, verts, f, c, Q, normal, offset):
     """Unit outward normal and offset of facet ``f``; returns (residual, side).
 
@@ -146,17 +167,7 @@ def _plane(W, verts, f, c, Q, normal, offset):
         vr = verts[f, r + 1]
         for a in range(D):
             Q[r, a] = W[vr, a] - W[v0, a]
-        for _ in range(2):
-            for q in range(r):
-                dot = 0.0
-                for a in range(D):
-                    dot += Q[r, a] * Q[q, a]
-                for a in range(D):
-                    Q[r, a] -= dot * Q[q, a]
-        nrm = 0.0
-        for a in range(D):
-            nrm += Q[r, a] * Q[r, a]
-        nrm = math.sqrt(nrm)
+        nrm = _deflate(Q, r, Q, r)
         rmin = min(rmin, nrm)
         if not nrm > 0.0:
             return 0.0, 0.0
@@ -173,17 +184,7 @@ def _plane(W, verts, f, c, Q, normal, offset):
     for a in range(D):
         normal[f, a] = 0.0
     normal[f, axis] = 1.0
-    for _ in range(2):
-        for r in range(D - 1):
-            dot = 0.0
-            for a in range(D):
-                dot += normal[f, a] * Q[r, a]
-            for a in range(D):
-                normal[f, a] -= dot * Q[r, a]
-    nrm = 0.0
-    for a in range(D):
-        nrm += normal[f, a] * normal[f, a]
-    nrm = math.sqrt(nrm)
+    nrm = _deflate(normal, f, Q, D - 1)
     b, nc = 0.0, 0.0
     for a in range(D):
         normal[f, a] /= nrm

@@ -48,6 +48,17 @@ def _cube_rotation(rng):
     return R
 
 
+def _hard_wrenches(P, Nrm, mu):
+    """Primitive wrenches of spatial hard fingers about the origin, (K, 8 N, 6)."""
+    Nn = Nrm / np.linalg.norm(Nrm, axis=-1, keepdims=True)
+    K, N, _ = P.shape
+    return batched_primitive_wrenches(
+        P, Nn, np.full((K, N), mu), np.zeros((K, N)), np.zeros((K, 3)),
+        batched_characteristic_lengths(P, np.zeros((K, 3))),
+        model="hard_finger", num_generators=8,
+    )  # fmt: skip
+
+
 def _close(a, b):
     np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12)
 
@@ -87,13 +98,7 @@ def test_length_and_force_scaling(seed, scale):
     rng, P, Nrm = _grasps(seed, N=5)
     eps = batch_epsilon_l1(P, Nrm, 0.5)
     _close(batch_epsilon_l1(scale * P, Nrm, 0.5), eps)
-    Nn = Nrm / np.linalg.norm(Nrm, axis=-1, keepdims=True)
-    K, N, _ = P.shape
-    W = batched_primitive_wrenches(
-        P, Nn, np.full((K, N), 0.5), np.zeros((K, N)), np.zeros((K, 3)),
-        batched_characteristic_lengths(P, np.zeros((K, 3))),
-        model="hard_finger", num_generators=8,
-    )  # fmt: skip
+    W = _hard_wrenches(P, Nrm, 0.5)
     e1, s1 = epsilon_kernel.epsilon_l1_stack(W)
     e2, s2 = epsilon_kernel.epsilon_l1_stack(scale * W)
     assert (s1 <= epsilon_kernel.FLAT).all() and (s2 == s1).all()
@@ -136,13 +141,7 @@ def test_thin_cones_are_flagged_and_answered_by_qhull():
 
 def test_a_full_facet_store_is_retried_with_more_room():
     rng, P, Nrm = _grasps(3, K=60, N=6)
-    Nn = Nrm / np.linalg.norm(Nrm, axis=-1, keepdims=True)
-    K, N, _ = P.shape
-    W = batched_primitive_wrenches(
-        P, Nn, np.full((K, N), 0.5), np.zeros((K, N)), np.zeros((K, 3)),
-        batched_characteristic_lengths(P, np.zeros((K, 3))),
-        model="hard_finger", num_generators=8,
-    )  # fmt: skip
+    W = _hard_wrenches(P, Nrm, 0.5)
     eps, status, info = epsilon_kernel.epsilon_l1_stack(W, return_info=True)
     assert info[:, 1].max() > 16  # so 16 facets cannot hold them
     small, small_status = epsilon_kernel.epsilon_l1_stack(W, capacity=16)
