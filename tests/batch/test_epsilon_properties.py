@@ -237,3 +237,28 @@ def test_more_primitive_wrenches_than_qhull_takes_are_refused():
         batch_epsilon_l1(P, Nrm, 0.5)
     # Without friction, 251 wrenches: computed (form closure of 251 contacts).
     _close(batch_epsilon_l1(P, Nrm, 0.0), batch_epsilon_l1(P, Nrm, 0.0, kernel="numpy"))
+
+
+def _stitched(ridges, D=3, point=9):
+    """Run the kernel's sub-ridge matching on new facets ``ridge + point``."""
+    count = len(ridges)
+    verts = np.array([[*r, point] for r in ridges], dtype=np.int64)
+    nbr = np.full((count, D), -1, dtype=np.int64)
+    size = 64
+    table = (np.zeros(size, dtype=np.int64), np.zeros(size, dtype=np.int64),
+             np.zeros(size, dtype=np.int64), np.zeros(size, dtype=np.int8))  # fmt: skip
+    ok = epsilon_kernel._stitch(verts, nbr, 0, count, epsilon_kernel._hashes(10),
+                                *table)  # fmt: skip
+    return ok, nbr
+
+
+def test_horizon_matching_links_a_cycle_and_rejects_a_branch():
+    """In 3-D each horizon vertex must join exactly two ridges (a closed loop)."""
+    ok, nbr = _stitched([(0, 1), (1, 2), (2, 0)])
+    assert ok
+    # Across slot q lies the facet sharing the other ridge vertex (and the point).
+    assert nbr[:, :2].tolist() == [[1, 2], [2, 0], [0, 1]]
+    ok, _ = _stitched([(0, 1), (0, 2), (0, 3)])  # vertex 0 in three ridges
+    assert not ok
+    ok, _ = _stitched([(0, 1), (1, 2)])  # an open chain
+    assert not ok
