@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from drakegrasp._deferred import deferrable
 
 if TYPE_CHECKING:
     from drakegrasp.certificates import Certificate
@@ -216,19 +218,19 @@ class ClosureResult:
 
     kind: str
     is_closure: bool
-    d_star: float
+    d_star: float = deferrable()
     rank: int
     required_rank: int
-    margin: float
-    contact_forces: tuple[np.ndarray, ...]
-    solver: str
-    status: str
+    margin: float = deferrable()
+    contact_forces: tuple[np.ndarray, ...] = deferrable()
+    solver: str = deferrable()
+    status: str = deferrable()
     tol: float
     formulation: str
     frictional_closure: bool
-    internal_forces: InternalForceResult | None = field(default=None)
+    internal_forces: InternalForceResult | None = deferrable(None)
     decided_by: str = "d*"
-    certificate: Certificate | None = None
+    certificate: Certificate | None = deferrable(None)
 
     @property
     def near_boundary(self) -> bool:
