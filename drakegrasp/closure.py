@@ -30,6 +30,7 @@ frictionless one.  This module imports ``pydrake.solvers`` only, never the plant
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -274,8 +275,59 @@ def _scaled_variables(d, x, layout: ConeLayout) -> ProgramVariables:
     return ProgramVariables(d, forces, layout.columns, weights=x, generators=D)
 
 
+_PER_GRASP: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""What the programs of one (immutable) grasp share: cone layouts, ranks, rows."""
+
+
+def _per_grasp(grasp: Grasp, key: tuple, compute):
+    """``compute()``, once per grasp and ``key`` (kept while the grasp lives).
+
+    LP2 and the exact-cone program impose the same ``G f = 0`` rows and read
+    the same rank and cone layout; a grasp is immutable, so they are computed
+    once.  Exceptions are raised and not kept.
+    """
+    store = _PER_GRASP.get(grasp)
+    if store is None:
+        store = _PER_GRASP[grasp] = {}
+    if key not in store:
+        store[key] = compute()
+    return store[key]
+
+
+def _read_only(*arrays) -> None:
+    for a in arrays:
+        if isinstance(a, np.ndarray):
+            a.flags.writeable = False
+
+
+def _layout(grasp: Grasp, num_generators: int) -> ConeLayout:
+    """:meth:`ConeLayout.of`, once per grasp and number of generators.
+
+    Its arrays are made read-only: programs of the same grasp share them (and
+    ``ProgramVariables.columns`` is one of them).
+    """
+
+    def compute():
+        layout = ConeLayout.of(grasp, num_generators)
+        _read_only(layout.columns, layout.normal_positions, layout.G, layout.scales)
+        return layout
+
+    return _per_grasp(grasp, ("layout", num_generators), compute)
+
+
+def _layout_key(layout: ConeLayout) -> tuple:
+    scales = None if layout.scales is None else layout.scales.tobytes()
+    return layout.columns.tobytes(), scales
+
+
 def _add_balance(
-    prog, A: np.ndarray, x, rank_tol: float, *, scales: np.ndarray | None = None
+    prog,
+    A: np.ndarray,
+    x,
+    rank_tol: float,
+    *,
+    scales: np.ndarray | None = None,
+    rows: np.ndarray | None = None,
 ) -> None:
     """``A x = 0``, imposed on the numerical row space of ``A`` (see below).
 
@@ -287,7 +339,18 @@ def _add_balance(
     leave ``x`` free in exactly the numerical null space that the reported rank
     counts.  Imposing a nearly rank-deficient ``A x = 0`` literally (contacts
     measured to 1e-8 m) made Clp declare an always-feasible LP infeasible.
+    ``rows``: those rows, already computed by :func:`_balance_rows`.
     """
+    if rows is None:
+        rows = _balance_rows(A, rank_tol, scales)
+    if rows.shape[0]:
+        add_linear_equality_constraint(prog, rows, np.zeros(rows.shape[0]), x)
+
+
+def _balance_rows(
+    A: np.ndarray, rank_tol: float, scales: np.ndarray | None = None
+) -> np.ndarray:
+    """The orthonormal rows that :func:`_add_balance` imposes (see there)."""
     A_s, scale = _equilibrated(A)
     # A x = A_s (D⁻¹ x) with D = diag(scale): impose V_rᵀ D⁻¹ x = 0.
     rows = _row_space(A_s, rank_tol) / scale
@@ -295,7 +358,20 @@ def _add_balance(
         rows = rows * scales
     if rows.shape[0]:
         rows = np.linalg.qr(rows.T)[0].T
-        add_linear_equality_constraint(prog, rows, np.zeros(rows.shape[0]), x)
+    return rows
+
+
+def _shared_balance_rows(grasp: Grasp, layout: ConeLayout, rank_tol: float):
+    """:func:`_balance_rows` of ``G`` on the layout's scaled columns, per grasp."""
+
+    def compute():
+        rows = _balance_rows(
+            _balance_matrix(grasp, layout.columns), rank_tol, layout.scales
+        )
+        _read_only(rows)
+        return rows
+
+    return _per_grasp(grasp, ("balance rows", rank_tol, *_layout_key(layout)), compute)
 
 
 def build_form_closure_program(
@@ -364,13 +440,12 @@ def build_force_closure_program(
     """
     rank_tol = _check_options(grasp, rank_tol)
     _check_formulation(formulation)
-    layout = ConeLayout.of(grasp, num_generators)
+    layout = _layout(grasp, num_generators)
     N = grasp.num_contacts
     if formulation == "facets":
         prog, f, d = _margin_program(len(layout.columns), N)
-        scales = layout.scales
-        A = _balance_matrix(grasp, layout.columns)
-        _add_balance(prog, A, f, rank_tol, scales=scales)
+        rows = _shared_balance_rows(grasp, layout, rank_tol)
+        _add_balance(prog, None, f, rank_tol, rows=rows)
         _add_margin_rows(prog, _margin_facets(layout), f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
         return prog, _scaled_variables(d, f, layout)
@@ -413,12 +488,12 @@ def build_exact_force_closure_program(
     variables : ProgramVariables
     """
     rank_tol = _check_options(grasp, rank_tol)
-    layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
+    layout = _layout(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
     # f holds scaled components (a soft finger's m_n / (b ν)): ConeLayout.scales.
-    A = _balance_matrix(grasp, layout.columns)
-    _add_balance(prog, A, f, rank_tol, scales=layout.scales)
+    rows = _shared_balance_rows(grasp, layout, rank_tol)
+    _add_balance(prog, None, f, rank_tol, rows=rows)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     b = grasp.characteristic_length
     starts = list(layout.normal_positions) + [len(layout.columns)]
@@ -485,7 +560,7 @@ def build_internal_force_program(
     """
     rank_tol = _check_options(grasp, rank_tol)
     J = check_hand_jacobian(grasp, hand_jacobian)
-    layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
+    layout = _layout(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
     A = np.vstack(
@@ -769,7 +844,11 @@ def _force_closure_result(
     certificate is computed when first read in every case.
     """
     required = grasp.wrench_dim
-    rank = _balance_rank(_balance_matrix(grasp, columns), rank_tol)
+    rank = _per_grasp(
+        grasp,
+        ("rank", rank_tol, columns.tobytes()),
+        lambda: _balance_rank(_balance_matrix(grasp, columns), rank_tol),
+    )
     args = (grasp, build, tol)
     solution = (
         _margin_solution(*args) if rank == required else defer(_margin_solution, *args)
@@ -942,7 +1021,7 @@ def force_closure(
     return _force_closure_result(
         grasp,
         build,
-        ConeLayout.of(grasp, num_generators).columns,
+        _layout(grasp, num_generators).columns,
         kind="force closure",
         formulation=formulation,
         hand_jacobian=hand_jacobian,
@@ -986,7 +1065,7 @@ def force_closure_exact(
     return _force_closure_result(
         grasp,
         build,
-        ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS).columns,
+        _layout(grasp, DEFAULT_NUM_GENERATORS).columns,
         kind="force closure (exact cones)",
         formulation="exact",
         hand_jacobian=hand_jacobian,
