@@ -16,6 +16,7 @@ by keyword; every option after it is keyword-only.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Iterable
 
 from pydrake.multibody.plant import MultibodyPlant
@@ -38,6 +39,27 @@ __all__ = [
 ]
 
 HandSpec = ModelInstanceIndex | str | Iterable[RigidBody] | None
+
+_TOPOLOGY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""Per finalized plant: answers that depend on its bodies, welds and instances."""
+
+
+def _per_plant(plant: MultibodyPlant, key: tuple, compute):
+    """``compute()``, once per finalized plant and ``key``.
+
+    A finalized plant's bodies, model instances and welds never change (Drake
+    refuses to add any after ``Finalize``), so what is computed from them alone
+    is kept while the plant lives; nothing that reads a context is.  Before
+    ``Finalize`` nothing is kept.  Exceptions are raised, never kept.
+    """
+    if not plant.is_finalized():
+        return compute()
+    store = _TOPOLOGY.get(plant)
+    if store is None:
+        store = _TOPOLOGY[plant] = {}
+    if key not in store:
+        store[key] = compute()
+    return store[key]
 
 
 def check_plant(plant) -> MultibodyPlant:
@@ -229,8 +251,14 @@ def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
     )
 
 
-def _welded_to_world(plant: MultibodyPlant) -> set[int]:
-    return {int(b.index()) for b in plant.GetBodiesWeldedTo(plant.world_body())}
+def _welded_to_world(plant: MultibodyPlant) -> frozenset[int]:
+    return _per_plant(
+        plant,
+        ("welded to world",),
+        lambda: frozenset(
+            int(b.index()) for b in plant.GetBodiesWeldedTo(plant.world_body())
+        ),
+    )
 
 
 def hand_bodies(
@@ -259,6 +287,17 @@ def hand_bodies(
         For an unknown instance or body, or a hand left with no body that can
         move (for instance a list of bodies all welded to the world).
     """
+    if isinstance(hand, str | ModelInstanceIndex) or hand is None:
+        obj = (int(object_body.index()), int(object_body.model_instance()))
+        spec = ("index", int(hand)) if isinstance(hand, ModelInstanceIndex) else hand
+        key = ("hand bodies", obj, spec)
+        return list(
+            _per_plant(plant, key, lambda: _hand_bodies(plant, object_body, hand))
+        )
+    return _hand_bodies(plant, object_body, hand)
+
+
+def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
     welded = _welded_to_world(plant)
     if isinstance(hand, str | ModelInstanceIndex):
         instance = model_instance(plant, hand)
@@ -305,10 +344,15 @@ def hand_model_instances(
     list of RigidBody
         In body-index order.
     """
-    instances = {int(b.model_instance()) for b in bodies}
-    out = []
-    for i in range(1, plant.num_bodies()):
-        b = plant.get_body(BodyIndex(i))
-        if int(b.model_instance()) in instances and b.index() != object_body.index():
-            out.append(b)
-    return out
+    instances = frozenset(int(b.model_instance()) for b in bodies)
+    obj = int(object_body.index())
+
+    def compute():
+        out = []
+        for i in range(1, plant.num_bodies()):
+            b = plant.get_body(BodyIndex(i))
+            if int(b.model_instance()) in instances and i != obj:
+                out.append(b)
+        return out
+
+    return list(_per_plant(plant, ("hand instances", instances, obj), compute))
