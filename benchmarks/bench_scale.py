@@ -201,11 +201,17 @@ def memory_vs_k(sizes, out_dir):
                     a[s:e] = P if name == "positions" else Nrm
                 del a
             out = Path(tmp) / f"out{K}.npz"
+            # The CLI's own peak is VmHWM of its process image: ru_maxrss
+            # would also count this benchmark's memory, which the child
+            # inherits at fork and keeps across exec.
             code = (
                 "import resource, sys, time; from drakegrasp.cli import main; "
                 "t = time.perf_counter(); c = main(sys.argv[1:]); "
                 "print('WALL', time.perf_counter() - t); "
-                "print('PEAK', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, "
+                "hwm = [ln.split()[1] for ln in open('/proc/self/status') "
+                "if ln.startswith('VmHWM')]; "
+                "print('PEAK', hwm[0] if hwm else "
+                "resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, "
                 "resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)"
             )
             proc = subprocess.run(

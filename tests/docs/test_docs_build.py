@@ -87,6 +87,15 @@ def test_page_exists(html, page):
     assert (html / f"{page}.html").is_file()
 
 
+def test_benchmarks_page_shows_the_scale_plot(html):
+    """The log-log plot bench_scale.py writes is on the benchmarks page."""
+    page = (html / "benchmarks.html").read_text()
+    images = re.findall(r'<img[^>]+src="([^"]*scale[^"]*\.png)"', page)
+    assert images, "benchmarks.html has no scale plot"
+    source = (ROOT / "benchmarks" / "results" / "scale.png").read_bytes()
+    assert (html / images[0]).read_bytes() == source
+
+
 def test_every_tutorial_is_rendered_with_its_outputs(html):
     notebooks = sorted((ROOT / "tutorials").glob("[0-9][0-9]_*.ipynb"))
     assert notebooks
