@@ -136,10 +136,7 @@ class deferrable:  # noqa: N801 (used like dataclasses.field)
             if self._default is dataclasses.MISSING:
                 raise AttributeError(self._name)
             return self._default
-        try:
-            value = obj.__dict__[self._slot]
-        except KeyError:  # unpickled from a version without deferred fields
-            value = obj.__dict__[self._name]
+        value = self.raw(obj)
         if isinstance(value, Deferred):
             value = value.value()
             obj.__dict__[self._slot] = value
@@ -151,7 +148,10 @@ class deferrable:  # noqa: N801 (used like dataclasses.field)
 
     def raw(self, obj) -> Any:
         """The stored value, pending or not (no computation)."""
-        return obj.__dict__[self._slot]
+        try:
+            return obj.__dict__[self._slot]
+        except KeyError:  # unpickled from a version without deferred fields
+            return obj.__dict__[self._name]
 
 
 def _slot_of(cls, name: str) -> deferrable | None:
@@ -171,19 +171,29 @@ def pending(obj, name: str) -> bool:
     return isinstance(value, Deferred) and not value.done
 
 
+_INIT_FIELDS: dict[type, tuple] = {}
+
+
+def _init_fields(cls) -> tuple:
+    """``(name, deferrable or None)`` of each ``__init__`` field of a dataclass."""
+    found = _INIT_FIELDS.get(cls)
+    if found is None:
+        found = _INIT_FIELDS[cls] = tuple(
+            (f.name, _slot_of(cls, f.name)) for f in dataclasses.fields(cls) if f.init
+        )
+    return found
+
+
 def replace(obj, **changes):
     """:func:`dataclasses.replace` that keeps pending fields pending."""
     kwargs = {}
-    for f in dataclasses.fields(obj):
-        if not f.init:
-            continue
-        if f.name in changes:
-            kwargs[f.name] = changes.pop(f.name)
-            continue
-        slot = _slot_of(type(obj), f.name)
-        kwargs[f.name] = (
-            slot.raw(obj) if isinstance(slot, deferrable) else getattr(obj, f.name)
-        )
+    for name, slot in _init_fields(type(obj)):
+        if name in changes:
+            kwargs[name] = changes.pop(name)
+        elif slot is not None:
+            kwargs[name] = slot.raw(obj)
+        else:
+            kwargs[name] = getattr(obj, name)
     if changes:
         raise TypeError(f"{type(obj).__name__} has no fields {sorted(changes)}")
     return type(obj)(**kwargs)

@@ -194,3 +194,14 @@ def test_a_bad_hand_jacobian_is_refused_at_once_even_when_lp3_waits():
     g = ex.spatial_two_fingers(0.5)  # rank 5: LP3 would wait
     with pytest.raises(dg.GraspError, match="hand_jacobian must have shape"):
         dg.force_closure(g, hand_jacobian=np.ones((2, 2)))
+
+
+def test_a_result_pickled_before_deferred_fields_still_reads():
+    """Older pickles stored every field under its own name in ``__dict__``."""
+    plain = dg.force_closure(ex.equator_fingers(0.5, num_fingers=3))
+    state = {f: getattr(plain, f) for f in plain.__dataclass_fields__}
+    old = object.__new__(ClosureResult)
+    old.__dict__.update(state)
+    assert old.d_star == plain.d_star and old.certificate is not None
+    assert old.to_dict() == plain.to_dict()
+    assert replace(old, decided_by="d*").to_dict() == plain.to_dict()
