@@ -214,6 +214,17 @@ class ClosureResult:
         force of a "yes".  None only for a "no" within ``tol`` of the boundary,
         where no separating direction exists.  Re-verify it with
         ``result.certificate.check(grasp)``.
+
+    Notes
+    -----
+    What no verdict needs is computed on first read and then kept
+    (:mod:`drakegrasp._deferred`): the certificate; ``d_star``, ``margin``,
+    ``contact_forces``, ``solver`` and ``status`` when the rank decided the
+    verdict (``decided_by == "rank"``: the program is built and solved then);
+    ``internal_forces`` when frictional closure fails.  The values are those
+    an eager computation stores, ``to_dict()``, ``str()`` and pickling compute
+    them, and a :class:`~drakegrasp.SolverError` of a deferred program is
+    raised at the read.
     """
 
     kind: str

@@ -7,6 +7,7 @@ from pydrake.multibody.tree import SpatialInertia, UnitInertia
 
 from drakegrasp import NoContactsError
 from drakegrasp.plant import analyze_grasp
+from drakegrasp.plant.jacobians import hand_velocity_indices
 from drakegrasp.plant.validation import (
     _TOPOLOGY,
     hand_bodies,
@@ -24,13 +25,14 @@ def _names(plant, bodies):
 
 def test_hand_bodies_are_kept_per_plant_and_equal_a_fresh_computation(scene_cache):
     scenes = [scene_cache(n) for n in SCENE_NAMES]
-    expected = {}
+    expected, expected_v = {}, {}
     for scene in scenes:  # fresh: nothing kept yet for this plant
         _TOPOLOGY.pop(scene.plant, None)
         body = resolve_object_body(scene.plant, scene.object_body)
         bodies = hand_bodies(scene.plant, body, scene.hand)
         everyone = hand_bodies(scene.plant, body, None)
         palm = hand_model_instances(scene.plant, bodies, body)
+        expected_v[scene.name] = hand_velocity_indices(scene.plant, bodies).tolist()
         expected[scene.name] = (
             _names(scene.plant, bodies),
             _names(scene.plant, everyone),
@@ -46,6 +48,8 @@ def test_hand_bodies_are_kept_per_plant_and_equal_a_fresh_computation(scene_cach
                 _names(scene.plant, hand_model_instances(scene.plant, bodies, body)),
             )
             assert got == expected[scene.name]
+            velocities = hand_velocity_indices(scene.plant, bodies).tolist()
+            assert velocities == expected_v[scene.name]
             assert all(b.GetParentPlant() is scene.plant for b in bodies)
             bodies.clear()  # a caller's list is its own copy
             assert hand_bodies(scene.plant, body, scene.hand)
