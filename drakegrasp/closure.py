@@ -918,7 +918,7 @@ def with_internal_forces(
     lp3 : InternalForceResult
         :func:`internal_forces` of the same grasp and hand Jacobian; one LP3
         can serve the polyhedral and the exact-cone verdicts alike.  It may be
-        deferred (:func:`drakegrasp._deferred.defer`); it is then computed
+        deferred (``drakegrasp._deferred.defer``); it is then computed
         here only when ``result`` holds frictional closure.
 
     Returns

@@ -218,7 +218,7 @@ class ClosureResult:
     Notes
     -----
     What no verdict needs is computed on first read and then kept
-    (:mod:`drakegrasp._deferred`): the certificate; ``d_star``, ``margin``,
+    (``drakegrasp._deferred``): the certificate; ``d_star``, ``margin``,
     ``contact_forces``, ``solver`` and ``status`` when the rank decided the
     verdict (``decided_by == "rank"``: the program is built and solved then);
     ``internal_forces`` when frictional closure fails.  The values are those
