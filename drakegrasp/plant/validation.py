@@ -291,9 +291,14 @@ def hand_bodies(
         obj = (int(object_body.index()), int(object_body.model_instance()))
         spec = ("index", int(hand)) if isinstance(hand, ModelInstanceIndex) else hand
         key = ("hand bodies", obj, spec)
-        return list(
-            _per_plant(plant, key, lambda: _hand_bodies(plant, object_body, hand))
-        )
+
+        # body indices, not bodies: a body keeps its plant alive, and the memo
+        # must not (it holds the plant weakly)
+        def compute():
+            return tuple(int(b.index()) for b in _hand_bodies(plant, object_body, hand))
+
+        indices = _per_plant(plant, key, compute)
+        return [plant.get_body(BodyIndex(i)) for i in indices]
     return _hand_bodies(plant, object_body, hand)
 
 
@@ -347,12 +352,13 @@ def hand_model_instances(
     instances = frozenset(int(b.model_instance()) for b in bodies)
     obj = int(object_body.index())
 
-    def compute():
-        out = []
-        for i in range(1, plant.num_bodies()):
-            b = plant.get_body(BodyIndex(i))
-            if int(b.model_instance()) in instances and i != obj:
-                out.append(b)
-        return out
+    def compute():  # indices only: a body would keep the plant alive
+        return tuple(
+            i
+            for i in range(1, plant.num_bodies())
+            if int(plant.get_body(BodyIndex(i)).model_instance()) in instances
+            and i != obj
+        )
 
-    return list(_per_plant(plant, ("hand instances", instances, obj), compute))
+    found = _per_plant(plant, ("hand instances", instances, obj), compute)
+    return [plant.get_body(BodyIndex(i)) for i in found]

@@ -205,3 +205,20 @@ def test_a_result_pickled_before_deferred_fields_still_reads():
     assert old.d_star == plain.d_star and old.certificate is not None
     assert old.to_dict() == plain.to_dict()
     assert replace(old, decided_by="d*").to_dict() == plain.to_dict()
+
+
+def test_what_the_programs_share_per_grasp_goes_with_the_grasp():
+    import gc
+
+    import drakegrasp.closure as closure
+
+    gc.collect()
+    before = len(closure._PER_GRASP)
+    g = ex.equator_fingers(0.5, num_fingers=3)
+    r = dg.force_closure(g)
+    e = dg.force_closure_exact(g)
+    assert len(closure._PER_GRASP) == before + 1
+    assert r.rank == e.rank == 6
+    del g, r, e
+    gc.collect()
+    assert len(closure._PER_GRASP) == before

@@ -6,7 +6,7 @@ import pytest
 from pydrake.multibody.tree import SpatialInertia, UnitInertia
 
 from drakegrasp import NoContactsError
-from drakegrasp.plant import analyze_grasp
+from drakegrasp.plant import DEFAULT_SCENE, analyze_grasp
 from drakegrasp.plant.jacobians import hand_velocity_indices
 from drakegrasp.plant.validation import (
     _TOPOLOGY,
@@ -88,3 +88,22 @@ def test_two_copies_of_a_scene_in_other_poses_get_their_own_answers(scene_cache)
         analyze_grasp(scene.plant, ctx_b, **options)  # the sphere left the hand
     a2 = analyze_grasp(scene.plant, ctx_a, **options)
     assert a1.to_dict() == a2.to_dict()
+
+
+def _plain(value) -> bool:
+    if isinstance(value, tuple | frozenset):
+        return all(_plain(v) for v in value)
+    return isinstance(value, int | str | type(None))
+
+
+def test_the_memo_holds_plain_numbers_only(scene_cache):
+    """A RigidBody would keep its plant alive through the weak memo: the memo
+    keeps indices, and callers get the plant's bodies back."""
+    scene = scene_cache(DEFAULT_SCENE)
+    body = resolve_object_body(scene.plant, scene.object_body)
+    bodies = hand_bodies(scene.plant, body, scene.hand)
+    hand_model_instances(scene.plant, bodies, body)
+    hand_velocity_indices(scene.plant, bodies)
+    store = _TOPOLOGY[scene.plant]
+    assert len(store) >= 4
+    assert all(_plain(k) and _plain(v) for k, v in store.items())
