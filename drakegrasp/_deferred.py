@@ -21,11 +21,13 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import weakref
 from collections.abc import Callable, Iterator
 from typing import Any
 
 __all__ = [
     "Deferred",
+    "WeakMemo",
     "computed_eagerly",
     "defer",
     "deferrable",
@@ -105,7 +107,11 @@ def resolve(value: Any) -> Any:
 
 @contextlib.contextmanager
 def computed_eagerly() -> Iterator[None]:
-    """Within the block, :func:`defer` computes at once (tests compare both)."""
+    """Within the block, :func:`defer` computes at once (tests compare both).
+
+    A process-wide switch, for tests and benchmarks: not for threads that
+    want different behaviour at the same time.
+    """
     before = _EAGER[0]
     _EAGER[0] = True
     try:
@@ -197,3 +203,21 @@ def replace(obj, **changes):
     if changes:
         raise TypeError(f"{type(obj).__name__} has no fields {sorted(changes)}")
     return type(obj)(**kwargs)
+
+
+class WeakMemo(weakref.WeakKeyDictionary):
+    """Values computed once per (owner, key), kept while the owner lives.
+
+    For what an immutable owner (a grasp, a finalized plant's topology)
+    decides alone.  The owner is held weakly, so a value must not refer back
+    to it (that would keep it alive).  Exceptions are raised, never kept.
+    """
+
+    def value(self, owner, key, compute: Callable[[], Any]) -> Any:
+        """``compute()`` the first time for ``owner`` and ``key``, then kept."""
+        store = self.get(owner)
+        if store is None:
+            store = self[owner] = {}
+        if key not in store:
+            store[key] = compute()
+        return store[key]

@@ -30,7 +30,6 @@ frictionless one.  This module imports ``pydrake.solvers`` only, never the plant
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +42,7 @@ from pydrake.solvers import (
     SolutionResult,
 )
 
-from drakegrasp._deferred import defer, parts, replace, resolve
+from drakegrasp._deferred import WeakMemo, defer, parts, replace, resolve
 from drakegrasp._dense_constraints import (
     add_linear_constraint,
     add_linear_equality_constraint,
@@ -275,7 +274,7 @@ def _scaled_variables(d, x, layout: ConeLayout) -> ProgramVariables:
     return ProgramVariables(d, forces, layout.columns, weights=x, generators=D)
 
 
-_PER_GRASP: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_PER_GRASP = WeakMemo()
 """What the programs of one (immutable) grasp share: cone layouts, ranks, rows."""
 
 
@@ -284,14 +283,9 @@ def _per_grasp(grasp: Grasp, key: tuple, compute):
 
     LP2 and the exact-cone program impose the same ``G f = 0`` rows and read
     the same rank and cone layout; a grasp is immutable, so they are computed
-    once.  Exceptions are raised and not kept.
+    once.
     """
-    store = _PER_GRASP.get(grasp)
-    if store is None:
-        store = _PER_GRASP[grasp] = {}
-    if key not in store:
-        store[key] = compute()
-    return store[key]
+    return _PER_GRASP.value(grasp, key, compute)
 
 
 def _read_only(*arrays) -> None:

@@ -16,13 +16,13 @@ by keyword; every option after it is keyword-only.
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Iterable
 
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context
 
+from drakegrasp._deferred import WeakMemo
 from drakegrasp.errors import InvalidContextError, InvalidOptionError, ModelError
 
 __all__ = [
@@ -40,26 +40,23 @@ __all__ = [
 
 HandSpec = ModelInstanceIndex | str | Iterable[RigidBody] | None
 
-_TOPOLOGY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_TOPOLOGY = WeakMemo()
 """Per finalized plant: answers that depend on its bodies, welds and instances."""
 
 
 def _per_plant(plant: MultibodyPlant, key: tuple, compute):
     """``compute()``, once per finalized plant and ``key``.
 
-    A finalized plant's bodies, model instances and welds never change (Drake
+    A finalized plant's bodies, model instances and joints never change (Drake
     refuses to add any after ``Finalize``), so what is computed from them alone
-    is kept while the plant lives; nothing that reads a context is.  Before
-    ``Finalize`` nothing is kept.  Exceptions are raised, never kept.
+    is kept while the plant lives; nothing that reads a context, and nothing
+    Drake lets change after ``Finalize`` (joint limits), is.  Before
+    ``Finalize`` nothing is kept.  Values hold indices, never bodies (a body
+    keeps its plant alive).
     """
     if not plant.is_finalized():
         return compute()
-    store = _TOPOLOGY.get(plant)
-    if store is None:
-        store = _TOPOLOGY[plant] = {}
-    if key not in store:
-        store[key] = compute()
-    return store[key]
+    return _TOPOLOGY.value(plant, key, compute)
 
 
 def check_plant(plant) -> MultibodyPlant:

@@ -222,3 +222,31 @@ def test_what_the_programs_share_per_grasp_goes_with_the_grasp():
     del g, r, e
     gc.collect()
     assert len(closure._PER_GRASP) == before
+
+
+def test_weak_memo_computes_once_per_key_and_never_keeps_an_exception():
+    from drakegrasp._deferred import WeakMemo
+
+    class Owner:
+        pass
+
+    memo, owner, calls = WeakMemo(), Owner(), []
+
+    def compute(value):
+        calls.append(value)
+        if value is None:
+            raise ValueError("no value")
+        return value
+
+    assert memo.value(owner, "a", lambda: compute(1)) == 1
+    assert memo.value(owner, "a", lambda: compute(2)) == 1  # kept
+    assert memo.value(owner, "b", lambda: compute(3)) == 3
+    for _ in range(2):
+        with pytest.raises(ValueError, match="no value"):
+            memo.value(owner, "c", lambda: compute(None))
+    assert calls == [1, 3, None, None]
+    del owner
+    import gc
+
+    gc.collect()
+    assert len(memo) == 0
