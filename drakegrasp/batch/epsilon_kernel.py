@@ -153,6 +153,21 @@ def _deflate(x, i, Q, r):
 
 
 @njit(cache=True)
+def _orient(normal, offset, f, b, nc):
+    """Store facet ``f``'s offset with its normal pointing away from ``c``.
+
+    ``b = n·x`` on the facet and ``nc = n·c``; returns ``b - n·c >= 0``, the
+    interior point's depth below the facet.
+    """
+    if b - nc < 0.0:
+        for a in range(normal.shape[1]):
+            normal[f, a] = -normal[f, a]
+        b, nc = -b, -nc
+    offset[f] = b
+    return b - nc
+
+
+@njit(cache=True)
 def _plane(W, verts, f, c, Q, normal, offset):
     """Unit outward normal and offset of facet ``f``; returns (residual, side).
 
@@ -192,13 +207,7 @@ def _plane(W, verts, f, c, Q, normal, offset):
     for k in range(D):
         for a in range(D):
             b += normal[f, a] * W[verts[f, k], a]
-    b /= D
-    if b - nc < 0.0:  # orient away from the interior point
-        for a in range(D):
-            normal[f, a] = -normal[f, a]
-        b, nc = -b, -nc
-    offset[f] = b
-    return rmin, b - nc
+    return rmin, _orient(normal, offset, f, b / D, nc)
 
 
 @njit(cache=True)
@@ -377,12 +386,7 @@ def _pencil_plane(W, s, f, g, nf, ws, c):
         normal[nf, a] /= nrm
         b += normal[nf, a] * W[s, a]
         nc += normal[nf, a] * c[a]
-    if b - nc < 0.0:
-        for a in range(D):
-            normal[nf, a] = -normal[nf, a]
-        b, nc = -b, -nc
-    offset[nf] = b
-    return True, b - nc
+    return True, _orient(normal, offset, nf, b, nc)
 
 
 @njit(cache=True)
