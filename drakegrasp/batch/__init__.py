@@ -12,7 +12,7 @@ matrices and cone facets), :mod:`~drakegrasp.batch.reduction` (null-space
 reduction of LP1/LP2), :mod:`~drakegrasp.batch.ipm` (batched interior-point
 method), :mod:`~drakegrasp.batch.engine` (chunked drivers),
 :mod:`~drakegrasp.batch.epsilon` (batch ε: :mod:`~drakegrasp.batch.wrenches`,
-:mod:`~drakegrasp.batch.epsilon_kernel`),
+:mod:`~drakegrasp.batch.epsilon_kernel`, :mod:`~drakegrasp.batch.polytope`),
 :mod:`~drakegrasp.batch.io` (files), :mod:`~drakegrasp.batch.writers` (results
 streamed to .npz/.parquet in flat memory), :mod:`~drakegrasp.batch.parallel`
 (worker processes).

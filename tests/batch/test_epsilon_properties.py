@@ -9,7 +9,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from drakegrasp import GraspError, InvalidContactError, InvalidOptionError
-from drakegrasp.batch import batch_epsilon_l1, batch_force_closure, epsilon_kernel
+from drakegrasp.batch import (
+    batch_epsilon_l1,
+    batch_force_closure,
+    epsilon_kernel,
+    polytope,
+)
 from drakegrasp.batch.construction import batched_characteristic_lengths
 from drakegrasp.batch.metrics import epsilon_l1_routes
 from drakegrasp.batch.wrenches import batched_primitive_wrenches
@@ -247,7 +252,7 @@ def _stitched(ridges, D=3, point=9):
     size = 64
     table = (np.zeros(size, dtype=np.int64), np.zeros(size, dtype=np.int64),
              np.zeros(size, dtype=np.int64), np.zeros(size, dtype=np.int8))  # fmt: skip
-    ok = epsilon_kernel._stitch(verts, nbr, 0, count, epsilon_kernel._hashes(10),
+    ok = polytope._stitch(verts, nbr, 0, count, epsilon_kernel._hashes(10),
                                 *table)  # fmt: skip
     return ok, nbr
 
