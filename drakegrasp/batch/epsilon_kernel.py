@@ -31,6 +31,15 @@ shared by exactly two new facets (``TOPOLOGY``), or a wrench set whose simplex
 is thin but not flat.  The caller then uses Qhull (which whitens).  A facet
 store that fills up is reported as ``FULL`` and retried with more room.
 
+Accuracy.  ``tol = VISIBLE_TOL × scale``, ``scale`` the largest absolute
+coordinate of a primitive wrench (about 1 for hard fingers, ``ν`` for soft fingers of
+large ``ν``).  A point ignored as not visible lies at most ``tol`` above a
+facet, a flat answer has ε below ``FLAT_TOL × scale`` (every wrench lies that
+close to a lower-dimensional flat, so no larger ball fits), and ε at most
+``tol`` is reported as 0: the answer is within about ``tol`` of the exact ε
+(measured: within 1e-13 relative of Qhull).  The answer's facet plane is always
+recomputed from its vertices, never carried over from other facets.
+
 The steps of one insertion (planes, visible region, cone, sub-ridge
 matching, heap) are in :mod:`drakegrasp.batch.polytope`.  numba is optional
 (``pip install drakegrasp[fast]``); ``AVAILABLE`` says whether this kernel is
