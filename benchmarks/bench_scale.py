@@ -28,6 +28,15 @@ ratio to ``batch×1`` in wall time, measured back to back.  The machine load
 (``os.getloadavg``) is printed beside every row.  The
 batch d* and verdicts are compared with both per-grasp routes on their grasps.
 
+A second table times the batch Ferrari–Canny ε L1
+(:func:`drakegrasp.batch.batch_epsilon_l1`, the compiled expanding polytope)
+against the per-grasp Qhull route (``ferrari_canny`` per grasp, what
+``metrics=["epsilon_l1"]`` did before) for every case and N up to
+``--epsilon-max-n`` (default 32; Qhull takes 0.1–0.2 s per grasp at N = 24–32,
+so it runs on at least 20 grasps there), with their ratio, the max relative
+|Δε| and the fallback count (``benchmarks/bench_epsilon.py`` has the details;
+``--no-epsilon`` skips it).
+
 ``--memory`` also runs ``drakegrasp batch`` on memory-mapped ``.npy`` inputs of
 10^5, 10^6 (and, without ``--quick``, 10^7) grasps and reports each run's
 peak resident memory.
@@ -58,6 +67,8 @@ from scipy.optimize import linprog  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_batch import lp_matrices  # noqa: E402
+from bench_epsilon import HEADER as EPS_HEADER  # noqa: E402
+from bench_epsilon import epsilon_rates, print_row  # noqa: E402
 
 from drakegrasp import Contact, Grasp  # noqa: E402
 from drakegrasp.batch import batch_force_closure  # noqa: E402
@@ -278,6 +289,8 @@ def main(argv=None):
         "--memory-only", action="store_true", help="only peak memory vs K"
     )
     parser.add_argument("--cases", nargs="*", default=list(CASES), choices=CASES)
+    parser.add_argument("--no-epsilon", action="store_true", help="skip batch ε")
+    parser.add_argument("--epsilon-max-n", type=int, default=32)
     parser.add_argument("--out", default=str(Path(__file__).parent / "results"))
     args = parser.parse_args(argv)
     out = Path(args.out)
@@ -324,6 +337,16 @@ def main(argv=None):
         }
         print(f"  {case:12s} " + "  ".join(
             f"{k} {v:.2f}" for k, v in exponents[case].items()))  # fmt: skip
+    eps_rows = []
+    if not args.no_epsilon:
+        print("\nbatch ε L1 vs per-grasp Qhull (grasps per CPU second, one core):")
+        print(EPS_HEADER)
+        print("-" * len(EPS_HEADER))
+        for ci, case in enumerate(args.cases):
+            for N in (n for n in Ns if n <= args.epsilon_max_n):
+                r = epsilon_rates(case, N, quick=args.quick, seed=1000 * ci + N)
+                eps_rows.append(r)
+                print_row(r)
     memory = []
     if args.memory:
         print("\npeak memory of `drakegrasp batch` (memory-mapped .npy input, N = 3):")
@@ -335,7 +358,8 @@ def main(argv=None):
         w.writerows(rows)
     with open(out / "scale.json", "w") as f:
         json.dump({"rows": rows, "exponents": exponents, "memory": memory,
-                   "cores": available_cores()}, f, indent=1)  # fmt: skip
+                   "epsilon": eps_rows, "cores": available_cores()}, f,
+                  indent=1)  # fmt: skip
     plot(rows, out / "scale.png")
     print(f"\nwrote {out / 'scale.csv'}, {out / 'scale.json'}, {out / 'scale.png'}")
 

@@ -16,6 +16,7 @@ from drakegrasp import examples
 from drakegrasp.antipodal import is_antipodal
 from drakegrasp.batch import (
     BatchClosureResult,
+    batch_epsilon_l1,
     batch_force_closure,
     batch_form_closure,
     evaluate_file,
@@ -148,6 +149,7 @@ __all__ = [
     "UnreachableError",
     "add_grasp_monitor",
     "analyze_grasp",
+    "batch_epsilon_l1",
     "batch_force_closure",
     "batch_form_closure",
     "build_exact_force_closure_program",

@@ -30,7 +30,6 @@ frictionless one.  This module imports ``pydrake.solvers`` only, never the plant
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +42,7 @@ from pydrake.solvers import (
     SolutionResult,
 )
 
+from drakegrasp._deferred import WeakMemo, defer, parts, replace, resolve
 from drakegrasp._dense_constraints import (
     add_linear_constraint,
     add_linear_equality_constraint,
@@ -274,8 +274,54 @@ def _scaled_variables(d, x, layout: ConeLayout) -> ProgramVariables:
     return ProgramVariables(d, forces, layout.columns, weights=x, generators=D)
 
 
+_PER_GRASP = WeakMemo()
+"""What the programs of one (immutable) grasp share: cone layouts, ranks, rows."""
+
+
+def _per_grasp(grasp: Grasp, key: tuple, compute):
+    """``compute()``, once per grasp and ``key`` (kept while the grasp lives).
+
+    LP2 and the exact-cone program impose the same ``G f = 0`` rows and read
+    the same rank and cone layout; a grasp is immutable, so they are computed
+    once.
+    """
+    return _PER_GRASP.value(grasp, key, compute)
+
+
+def _read_only(*arrays) -> None:
+    for a in arrays:
+        if isinstance(a, np.ndarray):
+            a.flags.writeable = False
+
+
+def _layout(grasp: Grasp, num_generators: int) -> ConeLayout:
+    """:meth:`ConeLayout.of`, once per grasp and number of generators.
+
+    Its arrays are made read-only: programs of the same grasp share them (and
+    ``ProgramVariables.columns`` is one of them).
+    """
+
+    def compute():
+        layout = ConeLayout.of(grasp, num_generators)
+        _read_only(layout.columns, layout.normal_positions, layout.G, layout.scales)
+        return layout
+
+    return _per_grasp(grasp, ("layout", num_generators), compute)
+
+
+def _layout_key(layout: ConeLayout) -> tuple:
+    scales = None if layout.scales is None else layout.scales.tobytes()
+    return layout.columns.tobytes(), scales
+
+
 def _add_balance(
-    prog, A: np.ndarray, x, rank_tol: float, *, scales: np.ndarray | None = None
+    prog,
+    A: np.ndarray,
+    x,
+    rank_tol: float,
+    *,
+    scales: np.ndarray | None = None,
+    rows: np.ndarray | None = None,
 ) -> None:
     """``A x = 0``, imposed on the numerical row space of ``A`` (see below).
 
@@ -287,7 +333,18 @@ def _add_balance(
     leave ``x`` free in exactly the numerical null space that the reported rank
     counts.  Imposing a nearly rank-deficient ``A x = 0`` literally (contacts
     measured to 1e-8 m) made Clp declare an always-feasible LP infeasible.
+    ``rows``: those rows, already computed by :func:`_balance_rows`.
     """
+    if rows is None:
+        rows = _balance_rows(A, rank_tol, scales)
+    if rows.shape[0]:
+        add_linear_equality_constraint(prog, rows, np.zeros(rows.shape[0]), x)
+
+
+def _balance_rows(
+    A: np.ndarray, rank_tol: float, scales: np.ndarray | None = None
+) -> np.ndarray:
+    """The orthonormal rows that :func:`_add_balance` imposes (see there)."""
     A_s, scale = _equilibrated(A)
     # A x = A_s (D⁻¹ x) with D = diag(scale): impose V_rᵀ D⁻¹ x = 0.
     rows = _row_space(A_s, rank_tol) / scale
@@ -295,7 +352,20 @@ def _add_balance(
         rows = rows * scales
     if rows.shape[0]:
         rows = np.linalg.qr(rows.T)[0].T
-        add_linear_equality_constraint(prog, rows, np.zeros(rows.shape[0]), x)
+    return rows
+
+
+def _shared_balance_rows(grasp: Grasp, layout: ConeLayout, rank_tol: float):
+    """:func:`_balance_rows` of ``G`` on the layout's scaled columns, per grasp."""
+
+    def compute():
+        rows = _balance_rows(
+            _balance_matrix(grasp, layout.columns), rank_tol, layout.scales
+        )
+        _read_only(rows)
+        return rows
+
+    return _per_grasp(grasp, ("balance rows", rank_tol, *_layout_key(layout)), compute)
 
 
 def build_form_closure_program(
@@ -364,13 +434,12 @@ def build_force_closure_program(
     """
     rank_tol = _check_options(grasp, rank_tol)
     _check_formulation(formulation)
-    layout = ConeLayout.of(grasp, num_generators)
+    layout = _layout(grasp, num_generators)
     N = grasp.num_contacts
     if formulation == "facets":
         prog, f, d = _margin_program(len(layout.columns), N)
-        scales = layout.scales
-        A = _balance_matrix(grasp, layout.columns)
-        _add_balance(prog, A, f, rank_tol, scales=scales)
+        rows = _shared_balance_rows(grasp, layout, rank_tol)
+        _add_balance(prog, None, f, rank_tol, rows=rows)
         _add_margin_rows(prog, _margin_facets(layout), f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
         return prog, _scaled_variables(d, f, layout)
@@ -413,12 +482,12 @@ def build_exact_force_closure_program(
     variables : ProgramVariables
     """
     rank_tol = _check_options(grasp, rank_tol)
-    layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
+    layout = _layout(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
     # f holds scaled components (a soft finger's m_n / (b ν)): ConeLayout.scales.
-    A = _balance_matrix(grasp, layout.columns)
-    _add_balance(prog, A, f, rank_tol, scales=layout.scales)
+    rows = _shared_balance_rows(grasp, layout, rank_tol)
+    _add_balance(prog, None, f, rank_tol, rows=rows)
     _add_normal_budget(prog, f[layout.normal_positions], N)
     b = grasp.characteristic_length
     starts = list(layout.normal_positions) + [len(layout.columns)]
@@ -485,7 +554,7 @@ def build_internal_force_program(
     """
     rank_tol = _check_options(grasp, rank_tol)
     J = check_hand_jacobian(grasp, hand_jacobian)
-    layout = ConeLayout.of(grasp, DEFAULT_NUM_GENERATORS)
+    layout = _layout(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns), N)
     A = np.vstack(
@@ -649,23 +718,28 @@ def form_closure(
     tol = _check_tol(tol)
     required = grasp.wrench_dim
     rank = _balance_rank(_normal_balance_matrix(grasp), rank_tol)
-    prog, variables = build_form_closure_program(grasp, rank_tol=rank_tol)
-    d_star, forces, solver, status = _solve_margin(prog, variables, conic=False)
-    if forces is None:
-        forces = np.zeros(grasp.num_contacts)
+    # A short rank decides "no" alone: LP1 then runs when d* is first read.
+    args = (grasp, tol, rank_tol)
+    solution = (
+        _form_closure_solution(*args)
+        if rank == required
+        else defer(_form_closure_solution, *args)
+    )
+    d_star, margin, forces, solver, status = parts(solution, 5)
     ok = rank == required and d_star > tol
-    forces = tuple(np.array([x]) for x in forces)
     if ok:
-        certificate = balance_certificate(grasp, forces, cones="normals", rank=rank)
+        certificate = defer(
+            balance_certificate, grasp, forces, cones="normals", rank=rank
+        )
     else:
-        certificate = escape_twist(grasp, rank)
+        certificate = defer(escape_twist, grasp, rank)
     return ClosureResult(
         kind="form closure",
         is_closure=bool(ok),
         d_star=d_star,
         rank=rank,
         required_rank=required,
-        margin=_relative_margin(d_star, tol),
+        margin=margin,
         contact_forces=forces,
         solver=solver,
         status=status,
@@ -675,6 +749,16 @@ def form_closure(
         decided_by="d*" if rank == required else "rank",
         certificate=certificate,
     )
+
+
+def _form_closure_solution(grasp: Grasp, tol: float, rank_tol: float) -> tuple:
+    """LP1 solved: ``(d*, margin, forces per contact, solver, status)``."""
+    prog, variables = build_form_closure_program(grasp, rank_tol=rank_tol)
+    d_star, forces, solver, status = _solve_margin(prog, variables, conic=False)
+    if forces is None:
+        forces = np.zeros(grasp.num_contacts)
+    forces = tuple(np.array([x]) for x in forces)
+    return d_star, _relative_margin(d_star, tol), forces, solver, status
 
 
 def internal_forces(
@@ -724,33 +808,53 @@ def internal_forces(
     )
 
 
+def _margin_solution(grasp: Grasp, build, tol: float) -> tuple:
+    """``build()``'s program solved: ``(d*, margin, forces, solver, status)``.
+
+    ``build`` returns ``(prog, variables, conic)``.
+    """
+    prog, variables, conic = build()
+    d_star, forces, solver, status = _solve_margin(prog, variables, conic=conic)
+    contact_forces = _split_forces(grasp, variables.columns, forces)
+    return d_star, _relative_margin(d_star, tol), contact_forces, solver, status
+
+
 def _force_closure_result(
     grasp: Grasp,
-    prog: MathematicalProgram,
-    variables: ProgramVariables,
+    build,
+    columns: np.ndarray,
     *,
     kind: str,
     formulation: str,
-    conic: bool,
     hand_jacobian: np.ndarray | None,
     tol: float,
     rank_tol: float,
     num_generators: int = DEFAULT_NUM_GENERATORS,
 ) -> ClosureResult:
+    """The verdict of the program ``build()`` makes over ``columns`` of ``G``.
+
+    A short rank decides "no" alone, so the program is then built and solved
+    only when its ``d*`` (or forces, solver, status) is first read; the
+    certificate is computed when first read in every case.
+    """
     required = grasp.wrench_dim
-    rank = _balance_rank(_balance_matrix(grasp, variables.columns), rank_tol)
-    d_star, forces, solver, status = _solve_margin(prog, variables, conic=conic)
-    contact_forces = _split_forces(grasp, variables.columns, forces)
-    margin = _relative_margin(d_star, tol)
+    rank = _per_grasp(
+        grasp,
+        ("rank", rank_tol, columns.tobytes()),
+        lambda: _balance_rank(_balance_matrix(grasp, columns), rank_tol),
+    )
+    args = (grasp, build, tol)
+    solution = (
+        _margin_solution(*args) if rank == required else defer(_margin_solution, *args)
+    )
+    d_star, margin, contact_forces, solver, status = parts(solution, 5)
     frictional = bool(rank == required and d_star > tol)
     decided_by = "d*" if rank == required else "rank"
     if rank == required and not frictional:
         # d is a distance to the cone boundaries, so it vanishes with μ.  Normal
         # forces alone (f_t = 0) lie inside every cone with μ > 0: if they
         # balance with f_n > tol, the grasp is in force closure for any μ.
-        normal = _normal_force_certificate(
-            grasp, variables.columns, tol=tol, rank_tol=rank_tol
-        )
+        normal = _normal_force_certificate(grasp, columns, tol=tol, rank_tol=rank_tol)
         if normal is not None:
             frictional, decided_by = True, "normal forces"
             margin, contact_forces = normal
@@ -758,12 +862,17 @@ def _force_closure_result(
     if frictional:
         # LP1's forces (f_t = 0) on the normal-force route: inside every cone
         # with μ > 0, and G (not G_n) is the matrix of full rank.
-        certificate = balance_certificate(
-            grasp, contact_forces, cones=cones, rank=rank, num_generators=num_generators
+        certificate = defer(
+            balance_certificate,
+            grasp,
+            contact_forces,
+            cones=cones,
+            rank=rank,
+            num_generators=num_generators,
         )
     else:
-        certificate = unresisted_wrench(
-            grasp, rank, cones=cones, num_generators=num_generators
+        certificate = defer(
+            unresisted_wrench, grasp, rank, cones=cones, num_generators=num_generators
         )
     result = ClosureResult(
         kind=kind,
@@ -783,7 +892,11 @@ def _force_closure_result(
     )
     if hand_jacobian is None:
         return result
-    lp3 = internal_forces(grasp, hand_jacobian, tol=tol, rank_tol=rank_tol)
+    if frictional:
+        lp3 = internal_forces(grasp, hand_jacobian, tol=tol, rank_tol=rank_tol)
+    else:  # the verdict is "no" whatever LP3 says: solve it when first read
+        check_hand_jacobian(grasp, hand_jacobian)
+        lp3 = defer(internal_forces, grasp, hand_jacobian, tol=tol, rank_tol=rank_tol)
     return with_internal_forces(result, lp3)
 
 
@@ -798,7 +911,9 @@ def with_internal_forces(
         A force-closure result computed without the hand Jacobian.
     lp3 : InternalForceResult
         :func:`internal_forces` of the same grasp and hand Jacobian; one LP3
-        can serve the polyhedral and the exact-cone verdicts alike.
+        can serve the polyhedral and the exact-cone verdicts alike.  It may be
+        deferred (``drakegrasp._deferred.defer``); it is then computed
+        here only when ``result`` holds frictional closure.
 
     Returns
     -------
@@ -807,6 +922,8 @@ def with_internal_forces(
         ``is_closure = frictional_closure and lp3.passes``.
     """
     changes = {}
+    if result.frictional_closure:
+        lp3 = resolve(lp3)  # the verdict needs it
     if result.frictional_closure and not lp3.passes:
         changes = {"decided_by": "LP3", "certificate": lp3.certificate}
     elif result.decided_by == "LP3":  # re-attaching: undo a previous LP3 verdict
@@ -814,7 +931,7 @@ def with_internal_forces(
             "with_internal_forces needs a result computed without the hand "
             "Jacobian; this one was already decided by LP3"
         )
-    return dataclasses.replace(
+    return replace(
         result,
         internal_forces=lp3,
         is_closure=result.frictional_closure and lp3.passes,
@@ -884,16 +1001,23 @@ def force_closure(
     """
     rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
-    prog, variables = build_force_closure_program(
-        grasp, num_generators=num_generators, formulation=formulation, rank_tol=rank_tol
-    )
+    _check_formulation(formulation)
+
+    def build():
+        prog, variables = build_force_closure_program(
+            grasp,
+            num_generators=num_generators,
+            formulation=formulation,
+            rank_tol=rank_tol,
+        )
+        return prog, variables, False
+
     return _force_closure_result(
         grasp,
-        prog,
-        variables,
+        build,
+        _layout(grasp, num_generators).columns,
         kind="force closure",
         formulation=formulation,
-        conic=False,
         hand_jacobian=hand_jacobian,
         tol=tol,
         rank_tol=rank_tol,
@@ -927,15 +1051,17 @@ def force_closure_exact(
     """
     rank_tol = _check_options(grasp, rank_tol)
     tol = _check_tol(tol)
-    prog, variables = build_exact_force_closure_program(grasp, rank_tol=rank_tol)
-    conic = bool(prog.lorentz_cone_constraints())
+
+    def build():
+        prog, variables = build_exact_force_closure_program(grasp, rank_tol=rank_tol)
+        return prog, variables, bool(prog.lorentz_cone_constraints())
+
     return _force_closure_result(
         grasp,
-        prog,
-        variables,
+        build,
+        _layout(grasp, DEFAULT_NUM_GENERATORS).columns,
         kind="force closure (exact cones)",
         formulation="exact",
-        conic=conic,
         hand_jacobian=hand_jacobian,
         tol=tol,
         rank_tol=rank_tol,

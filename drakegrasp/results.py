@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from drakegrasp._deferred import deferrable
 
 if TYPE_CHECKING:
     from drakegrasp.certificates import Certificate
@@ -212,23 +214,34 @@ class ClosureResult:
         force of a "yes".  None only for a "no" within ``tol`` of the boundary,
         where no separating direction exists.  Re-verify it with
         ``result.certificate.check(grasp)``.
+
+    Notes
+    -----
+    What no verdict needs is computed on first read and then kept
+    (``drakegrasp._deferred``): the certificate; ``d_star``, ``margin``,
+    ``contact_forces``, ``solver`` and ``status`` when the rank decided the
+    verdict (``decided_by == "rank"``: the program is built and solved then);
+    ``internal_forces`` when frictional closure fails.  The values are those
+    an eager computation stores, ``to_dict()``, ``str()`` and pickling compute
+    them, and a :class:`~drakegrasp.SolverError` of a deferred program is
+    raised at the read.
     """
 
     kind: str
     is_closure: bool
-    d_star: float
+    d_star: float = deferrable()
     rank: int
     required_rank: int
-    margin: float
-    contact_forces: tuple[np.ndarray, ...]
-    solver: str
-    status: str
+    margin: float = deferrable()
+    contact_forces: tuple[np.ndarray, ...] = deferrable()
+    solver: str = deferrable()
+    status: str = deferrable()
     tol: float
     formulation: str
     frictional_closure: bool
-    internal_forces: InternalForceResult | None = field(default=None)
+    internal_forces: InternalForceResult | None = deferrable(None)
     decided_by: str = "d*"
-    certificate: Certificate | None = None
+    certificate: Certificate | None = deferrable(None)
 
     @property
     def near_boundary(self) -> bool:

@@ -2,14 +2,17 @@
 
 :func:`batch_force_closure` (LP2) and :func:`batch_form_closure` (LP1) decide
 closure for ``K`` grasps with ``N`` contacts each, with the conventions and
-verdicts of :mod:`drakegrasp.closure`; :func:`iter_batch_closure` consumes a
-stream of chunks lazily; :func:`evaluate_file` runs them on a ``.npz`` file (the
-``drakegrasp batch`` command).
+verdicts of :mod:`drakegrasp.closure`; :func:`batch_epsilon_l1` gives their
+Ferrari–Canny L1 ε; :func:`iter_batch_closure` consumes a stream of chunks
+lazily; :func:`evaluate_file` runs them on a ``.npz`` file (the ``drakegrasp
+batch`` command).
 
 Modules: :mod:`~drakegrasp.batch.construction` (vectorised frames, grasp
 matrices and cone facets), :mod:`~drakegrasp.batch.reduction` (null-space
 reduction of LP1/LP2), :mod:`~drakegrasp.batch.ipm` (batched interior-point
 method), :mod:`~drakegrasp.batch.engine` (chunked drivers),
+:mod:`~drakegrasp.batch.epsilon` (batch ε: :mod:`~drakegrasp.batch.wrenches`,
+:mod:`~drakegrasp.batch.epsilon_kernel`, :mod:`~drakegrasp.batch.polytope`),
 :mod:`~drakegrasp.batch.io` (files), :mod:`~drakegrasp.batch.writers` (results
 streamed to .npz/.parquet in flat memory), :mod:`~drakegrasp.batch.parallel`
 (worker processes).
@@ -25,6 +28,7 @@ from drakegrasp.batch.engine import (
     stream_force_closure,
     stream_form_closure,
 )
+from drakegrasp.batch.epsilon import batch_epsilon_l1
 from drakegrasp.batch.io import evaluate_file, read_grasps, write_result
 from drakegrasp.batch.writers import BatchSummary, stream_file, write_chunks
 
@@ -33,6 +37,7 @@ __all__ = [
     "METRICS",
     "BatchClosureResult",
     "BatchSummary",
+    "batch_epsilon_l1",
     "batch_force_closure",
     "batch_form_closure",
     "evaluate_file",

@@ -34,7 +34,7 @@ from drakegrasp.batch.construction import (
     kind_facets,
 )
 from drakegrasp.batch.margin import numba_available, solve_margin_blocks
-from drakegrasp.batch.metrics import epsilon_l1_per_grasp, singular_value_metrics
+from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
 from drakegrasp.batch.rowspace import (
     _householder,
     _inverse_frobenius,
@@ -219,9 +219,10 @@ def force_chunk(
         Gfull, _ = batched_grasp_matrix(P, Nrm, p, (full,) * N)
         out.update(singular_value_metrics(Gfull, b, metrics))
         if "epsilon_l1" in metrics:
-            out["epsilon_l1"] = epsilon_l1_per_grasp(
-                P, Nrm, mu_c, nu_c, p, b, model=model, num_generators=num_generators
-            )
+            out["epsilon_l1"] = epsilon_l1_batch(
+                P, Nrm, mu_c, nu_c, p, b, model=model, num_generators=num_generators,
+                kernel=kernel,
+            )  # fmt: skip
     return out
 
 

@@ -734,14 +734,16 @@ def batch_force_closure(
         singular-value indices of ``G`` (full rows; moment rows divided by
         ``b``): ``σ_min``, ``σ_min/σ_max`` and ``∏ σ_i`` (the wrench
         ellipsoid's volume over the unit ball's) — and ``"epsilon_l1"``, the
-        Ferrari–Canny L1 ε from :func:`drakegrasp.quality.ferrari_canny`
-        (one call per grasp; slow).
+        Ferrari–Canny L1 ε of :func:`drakegrasp.quality.ferrari_canny`,
+        computed as :func:`~drakegrasp.batch.batch_epsilon_l1` does (a compiled
+        kernel; Qhull per grasp with ``kernel="numpy"`` or without numba).
     workers : int, optional
         Worker processes; default (None) every available core.  Results are
         bitwise the same for any number (:mod:`drakegrasp.batch.parallel`).
     kernel : {"auto", "numba", "numpy"}, optional
         Interior-point implementation: the compiled one (needs numba) or the
-        numpy reference; ``"auto"`` takes numba when installed.
+        numpy reference; ``"auto"`` takes numba when installed.  The same
+        choice for ``"epsilon_l1"``.
 
     Returns
     -------

@@ -1,4 +1,10 @@
-"""Per-grasp quality metrics of a chunk of grasps (singular values of G, ε L1)."""
+"""Per-grasp quality metrics of a chunk of grasps (singular values of G, ε L1).
+
+ε L1 of a chunk: the compiled expanding-polytope kernel
+(:mod:`drakegrasp.batch.epsilon_kernel`) on the chunk's primitive wrenches
+(:mod:`drakegrasp.batch.wrenches`), and :func:`drakegrasp.quality.ferrari_canny`
+(Qhull) for the grasps that the kernel flags and, without numba, for all.
+"""
 
 from __future__ import annotations
 
@@ -8,7 +14,12 @@ import numpy as np
 
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["epsilon_l1_per_grasp", "singular_value_metrics"]
+__all__ = [
+    "epsilon_l1_batch",
+    "epsilon_l1_per_grasp",
+    "epsilon_l1_routes",
+    "singular_value_metrics",
+]
 
 SINGULAR_VALUE_METRICS = ("sigma_min", "isotropy", "ellipsoid_volume")
 
@@ -85,3 +96,91 @@ def epsilon_l1_per_grasp(
         grasp = Grasp(contacts, reference_point=p[k], characteristic_length=b[k])
         out[k] = float(ferrari_canny(grasp, norm="L1", num_generators=num_generators))
     return out
+
+
+def _check_point_count(W_counts: np.ndarray) -> None:
+    from drakegrasp.quality.epsilon import L1_MAX_POINTS
+
+    if W_counts.size and int(W_counts.max()) > L1_MAX_POINTS:
+        raise InvalidOptionError(
+            f"the Ferrari–Canny metric of a grasp here needs the hull of "
+            f"{int(W_counts.max())} primitive wrenches (more than L1_MAX_POINTS = "
+            f"{L1_MAX_POINTS}); use fewer contacts or fewer generators"
+        )
+
+
+def _point_counts(mu, nu, *, model: str, dim: int, num_generators: int):
+    """Primitive wrenches of each grasp, as :func:`primitive_wrenches` counts them."""
+    if model == "frictionless":
+        per = np.ones(mu.shape)
+    elif dim == 2:
+        per = np.where(mu > 0.0, 2.0, 1.0)
+    else:
+        per = np.where(mu > 0.0, float(num_generators), 1.0)
+        if model == "soft_finger":
+            per = np.where(nu > 0.0, np.where(mu > 0.0, per + 2.0, 2.0), per)
+    return per.sum(axis=1)
+
+
+def epsilon_l1_routes(
+    P, Nrm, mu, nu, p, b, *, model: str, num_generators: int, kernel: str = "auto"
+) -> tuple[np.ndarray, np.ndarray]:
+    """Ferrari–Canny L1 ε of each grasp and which grasps took the Qhull route.
+
+    Parameters
+    ----------
+    P, Nrm, mu, nu, p, b
+        Validated chunk arrays, as :func:`drakegrasp.batch.chunks.force_chunk`
+        takes them (``b`` the characteristic lengths, not None).
+    model : str
+        Contact model name.
+    num_generators : int
+    kernel : {"auto", "numba", "numpy"}, optional
+        ``"numba"`` (or ``"auto"`` with numba installed): the compiled kernel,
+        Qhull for the grasps it flags; ``"numpy"`` (or no numba): Qhull for all.
+
+    Returns
+    -------
+    eps : (k,) float
+        ε as :func:`drakegrasp.quality.ferrari_canny` defines it (moments
+        divided by ``b``).
+    qhull : (k,) bool
+        The grasps computed per grasp by Qhull.
+    """
+    import drakegrasp.batch.epsilon_kernel as epsilon_kernel
+    from drakegrasp.batch.wrenches import batched_primitive_wrenches
+
+    _check_point_count(
+        _point_counts(
+            mu, nu, model=model, dim=P.shape[2], num_generators=num_generators
+        )
+    )
+    k = P.shape[0]
+    compiled = kernel == "numba" or (kernel == "auto" and epsilon_kernel.AVAILABLE)
+    if not compiled or k == 0:
+        eps = epsilon_l1_per_grasp(
+            P, Nrm, mu, nu, p, b, model=model, num_generators=num_generators
+        )
+        return eps, np.ones(k, dtype=bool)
+    W = batched_primitive_wrenches(
+        P, Nrm, mu, nu, p, b, model=model, num_generators=num_generators
+    )
+    eps, status = epsilon_kernel.epsilon_l1_stack(W)
+    qhull = status > epsilon_kernel.FLAT
+    rows = np.flatnonzero(qhull)
+    if rows.size:
+        eps[rows] = epsilon_l1_per_grasp(
+            P[rows], Nrm[rows], mu[rows], nu[rows], p[rows], b[rows],
+            model=model, num_generators=num_generators,
+        )  # fmt: skip
+    return eps, qhull
+
+
+def epsilon_l1_batch(
+    P, Nrm, mu, nu, p, b, *, model: str, num_generators: int, kernel: str = "auto"
+) -> np.ndarray:
+    """Ferrari–Canny L1 ε of each grasp of a chunk; see :func:`epsilon_l1_routes`."""
+    return epsilon_l1_routes(
+        P, Nrm, mu, nu, p, b, model=model, num_generators=num_generators,
+        kernel=kernel,
+    )[0]  # fmt: skip

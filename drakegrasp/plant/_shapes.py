@@ -59,7 +59,21 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
+_BOX_CACHE: dict[tuple[float, float, float], list] = {}
+"""Faces of a box by its half extents (read-only arrays, shared)."""
+
+
 def _box_faces(half: np.ndarray) -> list[tuple[np.ndarray, float, np.ndarray]]:
+    key = (float(half[0]), float(half[1]), float(half[2]))
+    faces = _BOX_CACHE.get(key)
+    if faces is None:
+        if len(_BOX_CACHE) >= 4096:  # many box sizes (a generated dataset)
+            _BOX_CACHE.clear()
+        faces = _BOX_CACHE[key] = _box_faces_of(np.array(key))
+    return faces
+
+
+def _box_faces_of(half: np.ndarray) -> list[tuple[np.ndarray, float, np.ndarray]]:
     faces = []
     for axis in range(3):
         for sign in (1.0, -1.0):
@@ -76,6 +90,7 @@ def _box_faces(half: np.ndarray) -> list[tuple[np.ndarray, float, np.ndarray]]:
             poly = np.array(corners)
             if sign < 0:
                 poly = poly[::-1]
+            n.flags.writeable = poly.flags.writeable = False
             faces.append((n, float(half[axis]), poly))
     return faces
 

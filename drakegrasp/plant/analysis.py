@@ -18,6 +18,7 @@ from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp._deferred import defer, deferrable
 from drakegrasp.antipodal import is_antipodal
 from drakegrasp.closure import (
     DEFAULT_TOL,
@@ -30,7 +31,7 @@ from drakegrasp.closure import (
 from drakegrasp.contact import Contact, ContactModel
 from drakegrasp.errors import GraspError, InvalidOptionError, NoContactsError
 from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.grasp import Grasp, grasp_matrix
+from drakegrasp.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.plant.contacts import (
     DEFAULT_DISTANCE_TOLERANCE,
     HandSpec,
@@ -367,6 +368,15 @@ class GraspReport:
     second_order : SecondOrderResult or None
         Second-order form closure (curvatures read off the shapes) when
         first-order form closure fails; None when it holds.
+
+    Notes
+    -----
+    The parts that no verdict needs (the second-order program, certificates,
+    the ``d*`` of a verdict the rank decided, LP3 when no frictional closure
+    holds) are computed on first access from inputs captured at the call
+    (never from the plant context), so reading them later gives exactly what
+    an eager computation would have stored; ``to_dict()``, ``str()`` and
+    pickling compute them.
     """
 
     data: GraspFromPlant
@@ -376,7 +386,7 @@ class GraspReport:
     force_closure_exact: ClosureResult
     antipodal: AntipodalResult | None
     pose: PoseCheck | None = None
-    second_order: SecondOrderResult | None = None
+    second_order: SecondOrderResult | None = deferrable(None)
 
     @property
     def grasp(self) -> Grasp:
@@ -522,19 +532,22 @@ def analyze_grasp(
     )
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
-    lp3 = internal_forces(grasp, J, tol=tol)
     first_order = form_closure(grasp, tol=tol)
+    polyhedral = force_closure(grasp, num_generators=num_generators, tol=tol)
+    exact = force_closure_exact(grasp, tol=tol)
+    # One LP3 serves both verdicts: it depends on G and J, not on the cones.
+    # Without frictional closure neither verdict needs it: solved when read.
+    if polyhedral.frictional_closure or exact.frictional_closure:
+        lp3 = internal_forces(grasp, J, tol=tol)
+    else:
+        check_hand_jacobian(grasp, J)
+        lp3 = defer(internal_forces, grasp, J, tol=tol)
     return GraspReport(
         data=data,
         G=grasp_matrix(grasp),
         form_closure=first_order,
-        # One LP3 serves both verdicts: it depends on G and J, not on the cones.
-        force_closure=with_internal_forces(
-            force_closure(grasp, num_generators=num_generators, tol=tol), lp3
-        ),
-        force_closure_exact=with_internal_forces(
-            force_closure_exact(grasp, tol=tol), lp3
-        ),
+        force_closure=with_internal_forces(polyhedral, lp3),
+        force_closure_exact=with_internal_forces(exact, lp3),
         antipodal=antipodal,
         pose=data.pose,
         second_order=None
@@ -543,10 +556,12 @@ def analyze_grasp(
     )
 
 
-def _second_order(
-    plant, plant_context, data, first_order, query_object
-) -> SecondOrderResult:
-    """Second-order form closure with the shapes' curvatures (or why not)."""
+def _second_order(plant, plant_context, data, first_order, query_object):
+    """Second-order form closure with the shapes' curvatures (or why not).
+
+    The curvatures are read from the plant now (the context may change
+    later); the program runs when the result is first read.
+    """
     try:
         curvatures = contact_curvatures(
             plant,
@@ -556,11 +571,15 @@ def _second_order(
             plane=data.plane,
             query_object=query_object,
         )
-        return second_order_form_closure(
-            data.grasp,
-            curvatures,
-            first_order=first_order,
-            rank_tol=SECOND_ORDER_RANK_TOL,
-        )
     except GraspError as e:  # a contact without a second-order model
         return SecondOrderResult.undecided(data.grasp.num_contacts, str(e))
+    return defer(_second_order_of, data.grasp, curvatures, first_order)
+
+
+def _second_order_of(grasp, curvatures, first_order) -> SecondOrderResult:
+    try:
+        return second_order_form_closure(
+            grasp, curvatures, first_order=first_order, rank_tol=SECOND_ORDER_RANK_TOL
+        )
+    except GraspError as e:  # e.g. a curvature the program cannot use
+        return SecondOrderResult.undecided(grasp.num_contacts, str(e))

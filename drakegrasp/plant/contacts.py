@@ -334,6 +334,16 @@ def find_contacts(
     contacts: list[PlantContact] = []
     penetrations: list[str] = []
     closest: tuple[float, str] | None = None
+
+    def finger_geom(finger_name, gf):
+        return f"{finger_name} ({inspector.GetName(gf)})"
+
+    def pair(go, finger_name, gf):
+        return (
+            f"{object_name} ({inspector.GetName(go)}) and "
+            f"{finger_geom(finger_name, gf)}"
+        )
+
     for finger in fingers:
         finger_name = _scoped_name(plant, finger)
         X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
@@ -355,12 +365,12 @@ def find_contacts(
                 else:  # Drake swapped the pair: normal now points into the finger
                     p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
                 psi = float(r.distance)
-                finger_geom = f"{finger_name} ({inspector.GetName(gf)})"
-                pair = f"{object_name} ({inspector.GetName(go)}) and {finger_geom}"
                 if closest is None or psi < closest[0]:
-                    closest = (psi, finger_geom)
+                    closest = (psi, finger_name, gf)
                 if psi < -tol and not allow_penetration:
-                    penetrations.append(f"{pair} penetrate by {-psi * 1e3:.4g} mm")
+                    penetrations.append(
+                        f"{pair(go, finger_name, gf)} penetrate by {-psi * 1e3:.4g} mm"
+                    )
                     continue
                 if abs(psi) > tol and not (allow_penetration and psi < 0):
                     continue
@@ -384,7 +394,8 @@ def find_contacts(
                 deepest = min(c.psi for c in found)
                 if deepest < -tol and not allow_penetration:  # a tilted patch
                     penetrations.append(
-                        f"{pair} penetrate by {-deepest * 1e3:.4g} mm at a patch corner"
+                        f"{pair(go, finger_name, gf)} penetrate by "
+                        f"{-deepest * 1e3:.4g} mm at a patch corner"
                     )
                     continue
                 contacts += found
@@ -400,8 +411,8 @@ def find_contacts(
             )
         raise NoContactsError(
             f"the hand does not touch {object_name!r}: the closest finger geometry "
-            f"is {closest[1]} at {closest[0] * 1e3:.4g} mm (distance_tolerance "
-            f"{tol * 1e3:g} mm)"
+            f"is {finger_geom(*closest[1:])} at {closest[0] * 1e3:.4g} mm "
+            f"(distance_tolerance {tol * 1e3:g} mm)"
         )
     return _dedupe_contacts(contacts)
 

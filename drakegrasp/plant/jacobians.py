@@ -31,7 +31,11 @@ from pydrake.systems.framework import Context
 from drakegrasp.contact import ContactModel
 from drakegrasp.grasp import Grasp
 from drakegrasp.plant.contacts import PlantContact
-from drakegrasp.plant.validation import plant_context_of, resolve_object_body
+from drakegrasp.plant.validation import (
+    _per_plant,
+    plant_context_of,
+    resolve_object_body,
+)
 
 __all__ = [
     "PLANES",
@@ -64,14 +68,20 @@ def hand_velocity_indices(
     (n_h,) int
         Sorted indices into ``v`` of every joint whose child is one of the bodies.
     """
-    wanted = {int(b.index()) for b in bodies}
-    out: list[int] = []
-    for i in range(plant.num_joints()):
-        joint = plant.get_joint(JointIndex(i))
-        if int(joint.child_body().index()) in wanted:
-            start = joint.velocity_start()
-            out += range(start, start + joint.num_velocities())
-    return np.array(sorted(out), dtype=int)
+    wanted = frozenset(int(b.index()) for b in bodies)
+
+    def compute():
+        out: list[int] = []
+        for i in range(plant.num_joints()):
+            joint = plant.get_joint(JointIndex(i))
+            if int(joint.child_body().index()) in wanted:
+                start = joint.velocity_start()
+                out += range(start, start + joint.num_velocities())
+        return tuple(sorted(out))
+
+    # joints and their velocity ranges are fixed once the plant is finalized
+    found = _per_plant(plant, ("hand velocities", wanted), compute)
+    return np.array(found, dtype=int)
 
 
 def _translational(plant, context, body: RigidBody, points_B: np.ndarray, frame_O):

@@ -22,6 +22,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context
 
+from drakegrasp._deferred import WeakMemo
 from drakegrasp.errors import InvalidContextError, InvalidOptionError, ModelError
 
 __all__ = [
@@ -38,6 +39,24 @@ __all__ = [
 ]
 
 HandSpec = ModelInstanceIndex | str | Iterable[RigidBody] | None
+
+_TOPOLOGY = WeakMemo()
+"""Per finalized plant: answers that depend on its bodies, welds and instances."""
+
+
+def _per_plant(plant: MultibodyPlant, key: tuple, compute):
+    """``compute()``, once per finalized plant and ``key``.
+
+    A finalized plant's bodies, model instances and joints never change (Drake
+    refuses to add any after ``Finalize``), so what is computed from them alone
+    is kept while the plant lives; nothing that reads a context, and nothing
+    Drake lets change after ``Finalize`` (joint limits), is.  Before
+    ``Finalize`` nothing is kept.  Values hold indices, never bodies (a body
+    keeps its plant alive).
+    """
+    if not plant.is_finalized():
+        return compute()
+    return _TOPOLOGY.value(plant, key, compute)
 
 
 def check_plant(plant) -> MultibodyPlant:
@@ -229,8 +248,14 @@ def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
     )
 
 
-def _welded_to_world(plant: MultibodyPlant) -> set[int]:
-    return {int(b.index()) for b in plant.GetBodiesWeldedTo(plant.world_body())}
+def _welded_to_world(plant: MultibodyPlant) -> frozenset[int]:
+    return _per_plant(
+        plant,
+        ("welded to world",),
+        lambda: frozenset(
+            int(b.index()) for b in plant.GetBodiesWeldedTo(plant.world_body())
+        ),
+    )
 
 
 def hand_bodies(
@@ -259,6 +284,22 @@ def hand_bodies(
         For an unknown instance or body, or a hand left with no body that can
         move (for instance a list of bodies all welded to the world).
     """
+    if isinstance(hand, str | ModelInstanceIndex) or hand is None:
+        obj = (int(object_body.index()), int(object_body.model_instance()))
+        spec = ("index", int(hand)) if isinstance(hand, ModelInstanceIndex) else hand
+        key = ("hand bodies", obj, spec)
+
+        # body indices, not bodies: a body keeps its plant alive, and the memo
+        # must not (it holds the plant weakly)
+        def compute():
+            return tuple(int(b.index()) for b in _hand_bodies(plant, object_body, hand))
+
+        indices = _per_plant(plant, key, compute)
+        return [plant.get_body(BodyIndex(i)) for i in indices]
+    return _hand_bodies(plant, object_body, hand)
+
+
+def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
     welded = _welded_to_world(plant)
     if isinstance(hand, str | ModelInstanceIndex):
         instance = model_instance(plant, hand)
@@ -305,10 +346,16 @@ def hand_model_instances(
     list of RigidBody
         In body-index order.
     """
-    instances = {int(b.model_instance()) for b in bodies}
-    out = []
-    for i in range(1, plant.num_bodies()):
-        b = plant.get_body(BodyIndex(i))
-        if int(b.model_instance()) in instances and b.index() != object_body.index():
-            out.append(b)
-    return out
+    instances = frozenset(int(b.model_instance()) for b in bodies)
+    obj = int(object_body.index())
+
+    def compute():  # indices only: a body would keep the plant alive
+        return tuple(
+            i
+            for i in range(1, plant.num_bodies())
+            if int(plant.get_body(BodyIndex(i)).model_instance()) in instances
+            and i != obj
+        )
+
+    found = _per_plant(plant, ("hand instances", instances, obj), compute)
+    return [plant.get_body(BodyIndex(i)) for i in found]
