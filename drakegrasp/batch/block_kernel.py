@@ -21,7 +21,6 @@ import numpy as np
 
 from drakegrasp.batch.block_ops import (
     _FAST,
-    AVAILABLE,
     _chol,
     _cmul,
     _ctmul,
@@ -34,8 +33,8 @@ from drakegrasp.batch.block_ops import (
     _solve,
     _solve3_rows,
     _solve_rows,
-    njit,
 )
+from drakegrasp.batch.compiled import AVAILABLE, njit
 
 __all__ = ["AVAILABLE", "solve_block_stack"]
 

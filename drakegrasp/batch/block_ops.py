@@ -14,21 +14,7 @@ from __future__ import annotations
 
 import math
 
-try:  # pragma: no cover - exercised when numba is installed
-    from numba import njit
-
-    AVAILABLE = True
-except ImportError:  # pragma: no cover
-    AVAILABLE = False
-
-    def njit(*args, **kwargs):
-        """Stand-in decorator when numba is absent (the kernel is then unused)."""
-
-        def wrap(fn):
-            return fn
-
-        return wrap
-
+from drakegrasp.batch.compiled import njit
 
 __all__: list[str] = []  # helpers of the compiled kernels only
 

@@ -23,7 +23,8 @@ import math
 import numpy as np
 
 from drakegrasp.batch.block_kernel import _one, flat_facets, work_arrays
-from drakegrasp.batch.block_ops import _FAST, _cmul, njit
+from drakegrasp.batch.block_ops import _FAST, _cmul
+from drakegrasp.batch.compiled import njit
 
 __all__ = ["full_column_rank_certain", "solve_full_rank_stack"]
 

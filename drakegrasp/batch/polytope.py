@@ -19,21 +19,7 @@ from __future__ import annotations
 
 import math
 
-try:  # pragma: no cover - exercised when numba is installed
-    from numba import njit
-
-    AVAILABLE = True
-except ImportError:  # pragma: no cover
-    AVAILABLE = False
-
-    def njit(*args, **kwargs):
-        """Stand-in decorator when numba is absent (the kernel is then unused)."""
-
-        def wrap(fn):
-            return fn
-
-        return wrap
-
+from drakegrasp.batch.compiled import AVAILABLE, njit
 
 __all__ = ["AVAILABLE", "ILL", "OK", "TOPOLOGY", "njit"]
 
