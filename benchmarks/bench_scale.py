@@ -252,7 +252,14 @@ def memory_vs_k(sizes, out_dir):
     return rows
 
 
-def plot(rows, path):
+EPSILON_ROUTES = {"batch ε": "batch ε (L1)", "qhull loop": "ε per grasp (Qhull)"}
+
+
+def plot(rows, path, eps_rows=()):
+    """Log-log grasps/s against N, one panel per case, one line per route.
+
+    Closure routes are solid; the ε routes of ``eps_rows`` (if any) dashed.
+    """
     try:
         import matplotlib
 
@@ -262,13 +269,18 @@ def plot(rows, path):
     except ImportError:
         print("(matplotlib not installed: no plot)")
         return
-    fig, axes = plt.subplots(1, len(CASES), figsize=(4 * len(CASES), 3.6),
+    fig, axes = plt.subplots(1, len(CASES), figsize=(4 * len(CASES), 4.0),
                              sharey=True)  # fmt: skip
     for ax, case in zip(axes, CASES, strict=True):
         sub = [r for r in rows if r["case"] == case]
         Ns = [r["N"] for r in sub]
         for route in ROUTES:
             ax.loglog(Ns, [r[route] for r in sub], marker="o", label=route)
+        eps = [r for r in eps_rows if r["case"] == case]
+        for key, label in EPSILON_ROUTES.items():
+            if eps:
+                ax.loglog([r["N"] for r in eps], [r[key] for r in eps],
+                          marker="s", linestyle="--", label=label)  # fmt: skip
         ax.set_title(case)
         ax.set_xticks(Ns)
         ax.set_xticklabels([str(n) for n in Ns])
@@ -276,8 +288,9 @@ def plot(rows, path):
         ax.set_xlabel("contacts N")
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("grasps / s")
-    axes[0].legend()
-    fig.tight_layout()
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     fig.savefig(path, dpi=120)
 
 
@@ -292,10 +305,18 @@ def main(argv=None):
     parser.add_argument("--no-epsilon", action="store_true", help="skip batch ε")
     parser.add_argument("--epsilon-max-n", type=int, default=32)
     parser.add_argument("--out", default=str(Path(__file__).parent / "results"))
+    parser.add_argument(
+        "--replot", action="store_true", help="only redraw scale.png from scale.json"
+    )
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     Ns = N_QUICK if args.quick else N_FULL
+    if args.replot:
+        saved = json.loads((out / "scale.json").read_text())
+        plot(saved["rows"], out / "scale.png", saved.get("epsilon") or ())
+        print(f"wrote {out / 'scale.png'}")
+        return
     if args.memory_only:
         print("peak memory of `drakegrasp batch` (memory-mapped .npy input, N = 3):")
         sizes = [10**5, 10**6] if args.quick else [10**5, 10**6, 10**7]
@@ -360,7 +381,7 @@ def main(argv=None):
         json.dump({"rows": rows, "exponents": exponents, "memory": memory,
                    "epsilon": eps_rows, "cores": available_cores()}, f,
                   indent=1)  # fmt: skip
-    plot(rows, out / "scale.png")
+    plot(rows, out / "scale.png", eps_rows)
     print(f"\nwrote {out / 'scale.csv'}, {out / 'scale.json'}, {out / 'scale.png'}")
 
 
