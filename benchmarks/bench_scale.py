@@ -67,32 +67,17 @@ from scipy.optimize import linprog  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_batch import lp_matrices  # noqa: E402
+from bench_epsilon import CASES, MU, epsilon_rates, print_row, random_grasps  # noqa: E402  # noqa: E402
 from bench_epsilon import HEADER as EPS_HEADER  # noqa: E402
-from bench_epsilon import epsilon_rates, print_row  # noqa: E402
 
 from drakegrasp import Contact, Grasp  # noqa: E402
 from drakegrasp.batch import batch_force_closure  # noqa: E402
 from drakegrasp.batch.parallel import available_cores  # noqa: E402
 from drakegrasp.closure import force_closure  # noqa: E402
 
-CASES = {
-    # name: (dimension, model, torsional friction)
-    "hard": (3, "hard_finger", 0.0),
-    "planar": (2, "hard_finger", 0.0),
-    "soft": (3, "soft_finger", 0.2),
-    "frictionless": (3, "frictionless", 0.0),
-}
-MU = 0.5
 N_FULL = [2, 3, 4, 6, 8, 12, 16, 24, 32]
 N_QUICK = [2, 3, 8, 24]
 ROUTES = ["batch×1", "batch×all", "mathprog", "highs"]
-
-
-def random_grasps(rng, K, N, d):
-    P = rng.normal(size=(K, N, d))
-    P /= np.linalg.norm(P, axis=-1, keepdims=True)
-    spread = 0.7 if N <= 4 else 0.4
-    return P, -P + spread * rng.normal(size=(K, N, d))
 
 
 def make_grasp(P, Nrm, model, nu):
@@ -222,6 +207,10 @@ def memory_vs_k(sizes, out_dir):
                 "import resource, sys, time; from drakegrasp.cli import main; "
                 "t = time.perf_counter(); c = main(sys.argv[1:]); "
                 "print('WALL', time.perf_counter() - t); "
+                # The kept worker pool is stopped (and its processes waited
+                # for) so that RUSAGE_CHILDREN counts them.
+                "from drakegrasp.batch.parallel import shutdown_pool; "
+                "shutdown_pool(); "
                 "hwm = [ln.split()[1] for ln in open('/proc/self/status') "
                 "if ln.startswith('VmHWM')]; "
                 "print('PEAK', hwm[0] if hwm else "
