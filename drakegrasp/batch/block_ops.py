@@ -18,7 +18,12 @@ from drakegrasp.batch.compiled import njit
 
 __all__: list[str] = []  # helpers of the compiled kernels only
 
-_FAST = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without nnan/ninf
+# No fast-math: with ``contract`` (FMA) or ``reassoc`` the rounding of the
+# compiled code depended on how numba compiled it (fresh in this process, with
+# the callees inlined, or loaded from its on-disk cache), so a cold cache gave
+# results that differed in the last bit between the local engine, its worker
+# processes and Dask workers.  IEEE arithmetic keeps them bitwise equal.
+_FAST = False
 # error_model="numpy": x / 0 gives inf or NaN (IEEE) instead of raising; every
 # such value is caught by the tests it feeds (isfinite, comparisons).
 

@@ -81,26 +81,36 @@ def map_ordered(tasks: Iterable[Task], workers: int) -> Iterator:
     pending: deque = deque()  # (future, task), in task order
     restarted = False
 
-    def next_result():
+    def restart():
+        # A worker died (killed, out of memory).  The chunks in flight are
+        # pure functions of their inputs: run them again, in order, on a fresh
+        # pool, once; a second death is raised.
         nonlocal pool, restarted
+        shutdown_pool()
+        if restarted:
+            raise BrokenProcessPool("a batch worker died twice during one call")
+        restarted = True
+        pool = _pool(workers)
+        for i, (_, task) in enumerate(pending):
+            pending[i] = (pool.submit(_call, *task), task)
+
+    def submit(task):
+        try:
+            return pool.submit(_call, *task)
+        except BrokenProcessPool:  # a worker died since the last submit
+            restart()
+            return pool.submit(_call, *task)
+
+    def next_result():
         while True:
             try:
                 return pending[0][0].result()
             except BrokenProcessPool:
-                # A worker died (killed, out of memory).  The chunks in flight
-                # are pure functions of their inputs: run them again, in order,
-                # on a fresh pool, once; a second death is raised.
-                shutdown_pool()
-                if restarted:
-                    raise
-                restarted = True
-                pool = _pool(workers)
-                for i, (_, task) in enumerate(pending):
-                    pending[i] = (pool.submit(_call, *task), task)
+                restart()
 
     try:
         for task in tasks:
-            pending.append((pool.submit(_call, *task), task))
+            pending.append((submit(task), task))
             if len(pending) >= 2 * workers:
                 result = next_result()
                 pending.popleft()
@@ -128,7 +138,7 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     call asks for a different number of workers.
     """
     pool = _POOL.get("pool")
-    if pool is not None and _POOL.get("workers") == workers:
+    if pool is not None and _POOL.get("workers") == workers and _healthy(pool):
         return pool
     shutdown_pool()
     # fork where the OS has it: workers start in milliseconds with the parent's
@@ -139,6 +149,19 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
     _POOL.update(pool=pool, workers=workers)
     return pool
+
+
+def _healthy(pool: ProcessPoolExecutor) -> bool:
+    """Whether a kept pool can take work: not broken, no worker has exited.
+
+    A worker killed between two calls is noticed by the pool's own thread only
+    after a while; checking its processes here lets the next call start on a
+    fresh pool instead of meeting ``BrokenProcessPool``.
+    """
+    if getattr(pool, "_broken", False):
+        return False
+    processes = getattr(pool, "_processes", None) or {}
+    return all(p.exitcode is None for p in processes.values())
 
 
 def shutdown_pool() -> None:
