@@ -80,6 +80,7 @@ __all__ = [
     "check_positions",
     "check_rank_tol",
     "check_tol",
+    "integer_or_none",
     "real_array",
     "real_scalar",
     "safe_norm",
@@ -339,17 +340,27 @@ def check_rank_tol(value, name: str = "rank_tol") -> float:
     return x
 
 
+def integer_or_none(value, *, integral_floats: bool = False) -> int | None:
+    """``value`` as an int, or None if it is not one.
+
+    Python and numpy integers count; bools never do; floats with an integral
+    value (``8.0``) only with ``integral_floats``.
+    """
+    if isinstance(value, (bool, np.bool_)):
+        return None
+    try:
+        return int(operator.index(value))
+    except TypeError:
+        pass
+    if integral_floats and isinstance(value, (float, np.floating)):
+        if float(value).is_integer():
+            return int(value)
+    return None
+
+
 def check_num_generators(value, name: str = "num_generators") -> int:
     """Generators of a spatial cone: an integer in ``[3, MAX_NUM_GENERATORS]``."""
-    if isinstance(value, (bool, np.bool_)):
-        n = None
-    else:
-        try:
-            n = operator.index(value)
-        except TypeError:
-            n = None
-            if isinstance(value, (float, np.floating)) and float(value).is_integer():
-                n = int(value)
+    n = integer_or_none(value, integral_floats=True)
     if n is None or not (3 <= n <= MAX_NUM_GENERATORS):
         raise InvalidOptionError(
             f"{name} must be an integer >= 3 and <= {MAX_NUM_GENERATORS} "

@@ -17,7 +17,6 @@ matrices exist at any moment, and inputs may be memory-mapped arrays.
 from __future__ import annotations
 
 import mmap
-import operator
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -38,6 +37,7 @@ from drakegrasp.validation import (
     check_positions,
     check_rank_tol,
     check_tol,
+    integer_or_none,
     real_array,
     unit_vectors,
 )
@@ -183,13 +183,7 @@ class BatchClosureResult:
 
 
 def _positive_int(name: str, value, minimum: int) -> int:
-    if isinstance(value, (bool, np.bool_)):
-        n = None
-    else:
-        try:
-            n = operator.index(value)
-        except TypeError:
-            n = None
+    n = integer_or_none(value)
     if n is None or n < minimum:
         raise InvalidOptionError(
             f"{name} must be an integer >= {minimum}, got {value!r}"
