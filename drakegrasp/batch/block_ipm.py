@@ -310,7 +310,7 @@ def solve_block_lp(
     kappa = [g.kappa for g in groups]
     gamma = [_axis_scale(Fg) for Fg in F]
     a = sum(
-        np.einsum("enk,n...->ek", Ag[:, 0], np.broadcast_to(1.0 / gm, Ag.shape[2:]))
+        np.einsum("enk,nk->ek", Ag[:, 0], np.broadcast_to(1.0 / gm, Ag.shape[2:]))
         if np.ndim(gm) else Ag[:, 0].sum(axis=1) / gm
         for Ag, gm in zip(A, gamma, strict=True)
     )  # fmt: skip
