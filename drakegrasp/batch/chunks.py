@@ -76,6 +76,44 @@ def _lp1(Gn: np.ndarray, rank_tol: float, kernel: str):
     )
 
 
+def _compiled(kernel: str) -> bool:
+    """Whether a chunk's arrays are built by the compiled loops (numba)."""
+    return kernel in ("numba", "unfused") or (kernel == "auto" and numba_available())
+
+
+def _positions(P, compiled: bool):
+    if compiled:
+        from drakegrasp.batch.construction_kernel import normalised_positions_stack
+
+        return normalised_positions_stack(P)
+    return normalised_positions(P)
+
+
+def _grasp_matrices(P, Nrm, p, layout, rows, compiled: bool):
+    """``batched_grasp_matrix`` of grasps ``rows`` (None: all), ``p`` None: 0."""
+    if compiled:
+        from drakegrasp.batch.construction_kernel import grasp_matrix_stack
+
+        return grasp_matrix_stack(P, Nrm, layout, reference_points=p, rows=rows)
+    if rows is not None:
+        P, Nrm, p = P[rows], Nrm[rows], None if p is None else p[rows]
+    if p is None:
+        p = np.zeros((P.shape[0], P.shape[2]))
+    return batched_grasp_matrix(P, Nrm, p, layout)
+
+
+def _normal_matrices(P, Nrm, p, rows, compiled: bool):
+    """``G_n`` (k, w, N) of grasps ``rows`` (None: all) about ``p`` (None: 0)."""
+    if compiled:
+        layout = (FRICTIONLESS,) * P.shape[1]
+        return _grasp_matrices(P, Nrm, p, layout, rows, True)[0]
+    if rows is not None:
+        P, Nrm, p = P[rows], Nrm[rows], None if p is None else p[rows]
+    if p is None:
+        p = np.zeros((P.shape[0], P.shape[2]))
+    return batched_normal_grasp_matrix(P, Nrm, p)
+
+
 def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel):
     """LP1's ``d*`` where only normal forces could prove force closure (else NaN).
 
@@ -83,62 +121,69 @@ def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel)
     same that :func:`drakegrasp.force_closure` checks.
     """
     out = np.full(Pn.shape[0], np.nan)
-    required = 3 if Pn.shape[2] == 2 else 6
+    w = 6 if Pn.shape[2] == 3 else 3
+    N = Pn.shape[1]
     frictional = (kinds != FRICTIONLESS).any(axis=1)
-    rows = np.flatnonzero((rank == required) & frictional & ~(d_star > tol))
+    rows = np.flatnonzero((rank == w) & frictional & ~(d_star > tol))
     if rows.size == 0:
         return out
-    Gn = batched_normal_grasp_matrix(
-        Pn[rows], Nrm[rows], np.zeros((rows.size, Pn.shape[2]))
-    )
-    N = Gn.shape[2]
-    if N <= Gn.shape[1]:
+    compiled = _compiled(kernel)
+    if N <= w:
         # Balancing normal forces need N(G_n) != {0}; with no more contacts than
-        # wrench rows that is rare.  A vectorised QR certifies full column rank
-        # for most grasps (as in rowspace); the rest take the exact SVD rule.
-        if kernel == "numba" or (kernel == "auto" and numba_available()):
-            from drakegrasp.batch.fused_kernel import full_column_rank_certain
+        # wrench rows that is rare.  A QR certifies full column rank for most
+        # grasps (as in rowspace); the rest take the exact SVD rule.
+        if compiled:
+            from drakegrasp.batch.construction_kernel import normal_rank_certain
 
-            unsure = ~full_column_rank_certain(Gn, rank_tol)
+            rows = rows[~normal_rank_certain(Pn, Nrm, rows, rank_tol)]
         else:
+            Gn = _normal_matrices(Pn, Nrm, None, rows, False)
             A = np.ascontiguousarray(np.transpose(Gn, (1, 2, 0)))  # (w, N, k)
             R, _ = _householder(A)
             norm = np.sqrt(np.einsum("kij,kij->k", Gn, Gn))
-            unsure = ~(_inverse_frobenius(R) * rank_tol * norm < 1.0)
-        rows, Gn = rows[unsure], Gn[unsure]
+            rows = rows[~(_inverse_frobenius(R) * rank_tol * norm < 1.0)]
         if rows.size:
+            Gn = _normal_matrices(Pn, Nrm, None, rows, compiled)
             sv = np.linalg.svd(Gn, compute_uv=False)
             deficient = sv[:, -1] <= rank_tol * sv[:, 0]
             rows, Gn = rows[deficient], Gn[deficient]
         if rows.size == 0:
             return out
+    else:
+        Gn = _normal_matrices(Pn, Nrm, None, rows, compiled)
     out[rows] = _lp1(Gn, rank_tol, kernel).d_star
     return out
 
 
-def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel):
-    """LP2 for grasps that share one layout: (d_star, rank, converged)."""
-    K = Pn.shape[0]
-    G, normal_cols = batched_grasp_matrix(Pn, Nrm, np.zeros((K, Pn.shape[2])), layout)
+def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, rows):
+    """LP2 for the grasps ``rows`` (None: all) that share one layout.
+
+    Returns (d_star, rank, converged) of those grasps; ``torsion`` (None when
+    no contact is soft) is ``b ν`` per contact.
+    """
+    G, normal_cols = _grasp_matrices(Pn, Nrm, None, layout, rows, _compiled(kernel))
+    if rows is not None:
+        spread, mu_c = spread[rows], mu_c[rows]
+        torsion = None if torsion is None else torsion[rows]
     facets, slices, start = [], [], 0
     shared: dict[tuple[int, float], np.ndarray] = {}  # one cone per (kind, μ)
-    kappa = np.empty((K, len(layout)))
+    uniform = (mu_c == mu_c[:1]).all(axis=0)  # contacts with one μ for all grasps
+    kappa = np.sqrt(1.0 + mu_c**2)  # ‖f_i‖ <= κ_i f_n (torsion columns below)
     for i, kind in enumerate(layout):
         k_i = len(KIND_COMPONENTS[kind])
-        mu_i, tor_i = mu_c[:, i], torsion[:, i]
-        slope = mu_i + (tor_i / spread if kind in _TORSION_COLUMN else 0.0)
-        kappa[:, i] = np.sqrt(1.0 + slope**2)
+        mu_i = mu_c[:, i]
         if kind in _TORSION_COLUMN:
+            tor_i = torsion[:, i]
+            kappa[:, i] = np.sqrt(1.0 + (mu_i + tor_i / spread) ** 2)
             F = kind_facets(kind, mu_i, tor_i, n_g).copy()
             F[:, :, _TORSION_COLUMN[kind]] *= spread[:, None]  # m_n = L m̃_n
+        elif uniform[i]:  # one cone for all grasps
+            key = (kind, float(mu_i[0]))
+            if key not in shared:
+                shared[key] = kind_facets(kind, mu_i[:1], None, n_g)
+            F = shared[key]
         else:
-            if (mu_i == mu_i[0]).all():  # one cone for all grasps
-                key = (kind, float(mu_i[0]))
-                if key not in shared:
-                    shared[key] = kind_facets(kind, mu_i[:1], tor_i[:1], n_g)
-                F = shared[key]
-            else:
-                F = kind_facets(kind, mu_i, tor_i, n_g)
+            F = kind_facets(kind, mu_i, None, n_g)
         facets.append(F)
         slices.append(slice(start, start + k_i))
         start += k_i
@@ -185,26 +230,27 @@ def force_chunk(
         ``normal_certificate`` and the metrics.
     """
     k, N, d = P.shape
-    if b is None:
+    compiled = _compiled(kernel)
+    if b is None and (model == "soft_finger" or metrics):  # else b is unused
         b = batched_characteristic_lengths(P, p)
-    Pn, spread = normalised_positions(P)
+    Pn, spread = _positions(P, compiled)
     kinds = contact_kinds(mu_c, nu_c, model=model, dim=d)
     d_star = np.zeros(k)
     rank = np.zeros(k, dtype=int)
     converged = np.ones(k, dtype=bool)
-    torsion = b[:, None] * nu_c
+    torsion = b[:, None] * nu_c if model == "soft_finger" else None
     for layout, rows in group_layouts(kinds):
-        sub = rows if rows.size < k else slice(None)
         d_star[rows], rank[rows], converged[rows] = _layout_lp(
-            Pn[sub],
-            Nrm[sub],
-            spread[sub],
-            mu_c[sub],
-            torsion[sub],
+            Pn,
+            Nrm,
+            spread,
+            mu_c,
+            torsion,
             layout,
             num_generators,
             rank_tol,
             kernel,
+            rows if rows.size < k else None,
         )
     normal = _normal_certificates(
         Pn, Nrm, kinds, rank, d_star, tol=tol, rank_tol=rank_tol, kernel=kernel
@@ -216,7 +262,7 @@ def force_chunk(
             "hard_finger": SPATIAL_HARD if d == 3 else PLANAR_HARD,
             "soft_finger": SOFT_FULL,
         }[model]
-        Gfull, _ = batched_grasp_matrix(P, Nrm, p, (full,) * N)
+        Gfull, _ = _grasp_matrices(P, Nrm, p, (full,) * N, None, compiled)
         out.update(singular_value_metrics(Gfull, b, metrics))
         if "epsilon_l1" in metrics:
             out["epsilon_l1"] = epsilon_l1_batch(
@@ -239,15 +285,16 @@ def form_chunk(
 ) -> dict[str, np.ndarray]:
     """LP1 (first-order form closure) of one chunk; see :func:`force_chunk`."""
     k, N, d = P.shape
-    Pn, _ = normalised_positions(P)
-    sol = _lp1(batched_normal_grasp_matrix(Pn, Nrm, np.zeros((k, d))), rank_tol, kernel)
+    compiled = _compiled(kernel)
+    Pn, _ = _positions(P, compiled)
+    sol = _lp1(_normal_matrices(Pn, Nrm, None, None, compiled), rank_tol, kernel)
     out = finish(
         sol.d_star, sol.rank, sol.converged, None, tol=tol, required=6 if d == 3 else 3
     )
     if metrics:
         if b is None:
             b = batched_characteristic_lengths(P, p)
-        Gn = batched_normal_grasp_matrix(P, Nrm, p)
+        Gn = _normal_matrices(P, Nrm, p, None, compiled)
         out.update(singular_value_metrics(Gn, b, metrics))
     return out
 

@@ -225,7 +225,7 @@ def _normal_to_three(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
 
 
 def kind_facets(
-    kind: int, mu: np.ndarray, torsion: np.ndarray, num_generators: int
+    kind: int, mu: np.ndarray, torsion: np.ndarray | None, num_generators: int
 ) -> np.ndarray:
     """Unit facet rows of one contact's effective cone, for a stack of grasps.
 
@@ -235,8 +235,9 @@ def kind_facets(
         Kind code of the contact.
     mu : (K,) float
         Friction coefficients.
-    torsion : (K,) float
-        ``b ν`` (metres), the soft-finger moment slope; ignored otherwise.
+    torsion : (K,) float or None
+        ``b ν`` (metres), the soft-finger moment slope; ignored (may be None)
+        for the other kinds.
     num_generators : int
         ``n_g`` of the spatial ring.
 
