@@ -262,14 +262,25 @@ def unit_vectors(name: str, value, *, error: type = InvalidContactError):
     Raises
     ------
     InvalidContactError
-        For a non-finite entry or a zero vector, naming the first bad one.
+        For a non-finite entry or a zero vector, naming the first bad one, or a
+        scalar / an empty last axis.
     """
     a = real_array(name, value, error=error)
-    finite = np.all(np.isfinite(a), axis=-1)
-    m = np.max(np.abs(a), axis=-1, keepdims=True) if a.size else a[..., :1]
-    bad = ~finite | ~(m[..., 0] > 0.0)
-    if np.any(bad):
-        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+    if a.ndim == 0 or a.shape[-1] == 0:
+        raise error(f"{name} must be vectors along its last axis, got shape {a.shape}")
+    if a.size == 0:
+        return a.copy()
+    # Component by component along the last axis (a batch has millions of
+    # short vectors, where a reduction over that axis is slow).  The largest
+    # |x| is NaN when some x is NaN and inf when some is inf, so one bound on
+    # it checks finiteness and non-zero length at once.
+    m = np.abs(a[..., 0])
+    for j in range(1, a.shape[-1]):
+        m = np.maximum(m, np.abs(a[..., j]))
+    good = (m > 0.0) & (m < np.inf)
+    if not good.all():
+        finite = np.all(np.isfinite(a), axis=-1)
+        idx = tuple(int(i) for i in np.argwhere(~good)[0])
         where = f" at index {idx}" if idx else ""
         v = a[idx].tolist()
         what = "is not finite" if not finite[idx] else "has zero length"
@@ -277,8 +288,12 @@ def unit_vectors(name: str, value, *, error: type = InvalidContactError):
             f"{name}{where} {v} {what}; a contact normal must be a finite, "
             "non-zero vector pointing into the object"
         )
-    scaled = a / m
-    return scaled / np.linalg.norm(scaled, axis=-1, keepdims=True)
+    scaled = a / m[..., None]
+    norm2 = scaled[..., 0] * scaled[..., 0]  # summed left to right, as np.linalg.norm
+    for j in range(1, a.shape[-1]):
+        norm2 += scaled[..., j] * scaled[..., j]
+    scaled /= np.sqrt(norm2)[..., None]
+    return scaled
 
 
 def check_coefficient(name: str, value, *, error: type = InvalidContactError) -> float:
