@@ -24,7 +24,6 @@ import numpy as np
 
 from drakegrasp.batch.compiled import njit
 from drakegrasp.batch.construction import KIND_COMPONENTS
-from drakegrasp.batch.fused_kernel import _certain, _qr
 
 __all__ = [
     "grasp_matrix_stack",
@@ -76,105 +75,158 @@ def _normalise(P, Pn, spread):
 
 
 @njit(cache=True, error_model="numpy")
-def _frame(n, U):
-    """Columns ``U[j] = R e_j`` of the contact frame of unit ``n`` (3 or 2)."""
-    d = n.shape[0]
-    for j in range(d):
-        U[0, j] = n[j]
-    if d == 2:
-        U[1, 0] = -n[1]
-        U[1, 1] = n[0]
-        return
-    # t1: the axis of the smallest |n_j| (first on ties), projected and scaled.
-    axis = 0
-    least = abs(n[0])
-    for j in range(1, 3):
-        if abs(n[j]) < least:
-            axis = j
-            least = abs(n[j])
-    dot = (1.0 if axis == 0 else 0.0) * n[0]
-    for j in range(1, 3):
-        dot += (1.0 if axis == j else 0.0) * n[j]
-    for j in range(3):
-        U[1, j] = (1.0 if axis == j else 0.0) - dot * n[j]
-    norm = math.sqrt((U[1, 0] * U[1, 0] + U[1, 1] * U[1, 1]) + U[1, 2] * U[1, 2])
-    for j in range(3):
-        U[1, j] = U[1, j] / norm
-    U[2, 0] = n[1] * U[1, 2] - n[2] * U[1, 1]  # t2 = n × t1, as numpy.cross
-    U[2, 1] = n[2] * U[1, 0] - n[0] * U[1, 2]
-    U[2, 2] = n[0] * U[1, 1] - n[1] * U[1, 0]
+def _tangents(n0, n1, n2):
+    """``t1, t2`` of the contact frame of unit ``n``, as ``contact_frames``.
+
+    ``t1``: the axis ``e`` of the smallest ``|n_j|`` (first on ties) minus its
+    projection on ``n``, scaled to unit length; ``t2 = n × t1``.
+    """
+    e0, e1, e2 = 1.0, 0.0, 0.0
+    least = abs(n0)
+    if abs(n1) < least:
+        e0, e1, least = 0.0, 1.0, abs(n1)
+    if abs(n2) < least:
+        e0, e1, e2 = 0.0, 0.0, 1.0
+    dot = (e0 * n0 + e1 * n1) + e2 * n2
+    a0, a1, a2 = e0 - dot * n0, e1 - dot * n1, e2 - dot * n2
+    norm = math.sqrt((a0 * a0 + a1 * a1) + a2 * a2)
+    a0, a1, a2 = a0 / norm, a1 / norm, a2 / norm
+    return a0, a1, a2, n1 * a2 - n2 * a1, n2 * a0 - n0 * a2, n0 * a1 - n1 * a0
 
 
 @njit(cache=True, error_model="numpy")
-def _wrench(r, u, G, k, m):
-    """Column ``m`` of ``G[k]``: ``[u; r × u]`` (planar ``[u; r_x u_y - r_y u_x]``)."""
-    if r.shape[0] == 2:
-        G[k, 0, m] = u[0]
-        G[k, 1, m] = u[1]
-        G[k, 2, m] = r[0] * u[1] - r[1] * u[0]
-        return
-    for j in range(3):
-        G[k, j, m] = u[j]
-    G[k, 3, m] = r[1] * u[2] - r[2] * u[1]
-    G[k, 4, m] = r[2] * u[0] - r[0] * u[2]
-    G[k, 5, m] = r[0] * u[1] - r[1] * u[0]
+def _column3(G, k, m, r0, r1, r2, u0, u1, u2):
+    """``G[k, :, m] = [u; r × u]`` (``r × u`` as :func:`numpy.cross`)."""
+    G[k, 0, m] = u0
+    G[k, 1, m] = u1
+    G[k, 2, m] = u2
+    G[k, 3, m] = r1 * u2 - r2 * u1
+    G[k, 4, m] = r2 * u0 - r0 * u2
+    G[k, 5, m] = r0 * u1 - r1 * u0
 
 
 @njit(cache=True, error_model="numpy")
-def _grasp_stack(P, Nrm, p, rows, contact, component, G):
-    """``G[k]`` of grasp ``rows[k]`` for the columns ``(contact, component)``."""
+def _grasp_stack3(P, Nrm, p, rows, start, component, tangent, G):
+    """Spatial ``G[k]`` of grasp ``rows[k]``.
+
+    Contact ``i`` owns the columns ``start[i]:start[i + 1]``, with the
+    components ``component`` (0 normal, 1-2 tangents, 3 torsion).
+    """
     K = rows.shape[0]
-    N, d = P.shape[1], P.shape[2]
-    M = contact.shape[0]
-    U = np.empty((d, d))
-    r = np.empty(d)
-    n = np.empty(d)
-    zero = np.zeros(d)
+    N = P.shape[1]
+    a0 = a1 = a2 = b0 = b1 = b2 = 0.0
     for k in range(K):
         g = rows[k]
-        m = 0
         for i in range(N):
-            if m < M and contact[m] != i:
-                continue
-            for j in range(d):
-                n[j] = Nrm[g, i, j]
-                r[j] = P[g, i, j] - p[g, j]
-            _frame(n, U)
-            while m < M and contact[m] == i:
+            n0, n1, n2 = Nrm[g, i, 0], Nrm[g, i, 1], Nrm[g, i, 2]
+            r0 = P[g, i, 0] - p[g, 0]
+            r1 = P[g, i, 1] - p[g, 1]
+            r2 = P[g, i, 2] - p[g, 2]
+            if tangent[i]:
+                a0, a1, a2, b0, b1, b2 = _tangents(n0, n1, n2)
+            for m in range(start[i], start[i + 1]):
                 c = component[m]
-                if c < d:
-                    _wrench(r, U[c], G, k, m)
+                if c == 0:
+                    _column3(G, k, m, r0, r1, r2, n0, n1, n2)
+                elif c == 1:
+                    _column3(G, k, m, r0, r1, r2, a0, a1, a2)
+                elif c == 2:
+                    _column3(G, k, m, r0, r1, r2, b0, b1, b2)
                 else:  # a soft finger's torsion: a pure moment about n
-                    _wrench(zero, zero, G, k, m)
-                    for j in range(3):
-                        G[k, 3 + j, m] = n[j]
-                m += 1
+                    _column3(G, k, m, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+                    G[k, 3, m] = n0
+                    G[k, 4, m] = n1
+                    G[k, 5, m] = n2
+
+
+@njit(cache=True, error_model="numpy")
+def _grasp_stack2(P, Nrm, p, rows, start, component, G):
+    """Planar ``G[k]`` (columns ``[u; r_x u_y - r_y u_x]``, ``t = (-n_y, n_x)``)."""
+    K = rows.shape[0]
+    N = P.shape[1]
+    for k in range(K):
+        g = rows[k]
+        for i in range(N):
+            n0, n1 = Nrm[g, i, 0], Nrm[g, i, 1]
+            r0 = P[g, i, 0] - p[g, 0]
+            r1 = P[g, i, 1] - p[g, 1]
+            for m in range(start[i], start[i + 1]):
+                u0, u1 = (n0, n1) if component[m] == 0 else (-n1, n0)
+                G[k, 0, m] = u0
+                G[k, 1, m] = u1
+                G[k, 2, m] = r0 * u1 - r1 * u0
+
+
+_EPS = 2.0**-52
 
 
 @njit(cache=True, error_model="numpy")
 def _normal_rank(P, Nrm, rows, rank_tol, out):
-    """Whether a QR of ``G_n`` (from ``P``, ``p = 0``) proves full column rank."""
+    """Whether ``G_n`` (from ``P``, ``p = 0``; w × N, N <= w) has full column rank.
+
+    Proved from the Cholesky factor ``L`` of the Gram matrix ``C = G_nᵀ G_n``
+    (N × N), which costs a third of a Householder QR of ``G_n``.  Rounding:
+    the computed ``L Lᵀ`` is ``C + E`` with ``‖E‖₂ <= (w + N + 2) ε ‖G_n‖_F²``
+    (forming ``C`` and the Cholesky steps, Higham ch. 3 and 10), so
+    ``σ_min(G_n)² >= 1 / ‖L⁻¹‖_F² - (w + N + 2) ε ‖G_n‖_F²``.  The test asks
+    ``1 / ‖L⁻¹‖_F² > 2 (rank_tol² + 4 (w + N + 2) ε) ‖G_n‖_F²``, which with
+    ``σ_max <= ‖G_n‖_F`` proves ``σ_min > rank_tol σ_max`` with room for the
+    rounding of ``‖L⁻¹‖_F`` itself.  It certifies only ``σ_min / σ_max`` above
+    about ``1e-7``; the rest is reported unsure and takes the SVD rule.
+    """
     K = rows.shape[0]
     N, d = P.shape[1], P.shape[2]
     w = 6 if d == 3 else 3
     XT = np.empty((N, w))  # G_nᵀ: row i is [n_i; c_i × n_i]
-    V = np.empty((N, w))
-    beta = np.empty(N)
-    RI = np.empty((N, N))
-    r = np.empty(d)
-    n = np.empty(d)
-    col = np.empty((1, w, 1))
+    L = np.empty((N, N))
+    y = np.empty(N)
+    slack = 2.0 * (rank_tol * rank_tol + 4.0 * (w + N + 2) * _EPS)
     for k in range(K):
         g = rows[k]
         for i in range(N):
-            for j in range(d):
-                r[j] = P[g, i, j]
-                n[j] = Nrm[g, i, j]
-            _wrench(r, n, col, 0, 0)
-            for j in range(w):
-                XT[i, j] = col[0, j, 0]
-        fro = _qr(XT, w, N, V, beta)
-        out[k] = _certain(XT, N, fro, rank_tol, RI)
+            n0, n1 = Nrm[g, i, 0], Nrm[g, i, 1]
+            r0, r1 = P[g, i, 0], P[g, i, 1]
+            XT[i, 0] = n0
+            XT[i, 1] = n1
+            if d == 2:
+                XT[i, 2] = r0 * n1 - r1 * n0
+            else:
+                n2, r2 = Nrm[g, i, 2], P[g, i, 2]
+                XT[i, 2] = n2
+                XT[i, 3] = r1 * n2 - r2 * n1
+                XT[i, 4] = r2 * n0 - r0 * n2
+                XT[i, 5] = r0 * n1 - r1 * n0
+        out[k] = _gram_certain(XT, N, w, L, y, slack)
+
+
+@njit(cache=True, error_model="numpy")
+def _gram_certain(XT, N, w, L, y, slack):
+    """The test of :func:`_normal_rank` on ``XT = Xᵀ`` (N × w); scratch L, y."""
+    fro2 = 0.0
+    for j in range(N):  # Cholesky C = L Lᵀ, column j, C formed on the fly
+        for i in range(j, N):
+            acc = 0.0
+            for m in range(w):
+                acc += XT[i, m] * XT[j, m]
+            if i == j:
+                fro2 += acc
+            for m in range(j):
+                acc -= L[i, m] * L[j, m]
+            if i > j:
+                L[i, j] = acc / L[j, j]
+            elif acc > 0.0:
+                L[j, j] = math.sqrt(acc)
+            else:
+                return False  # not positive definite in floating point
+    inv2 = 0.0  # ‖L⁻¹‖_F²: forward substitution of each unit vector
+    for j in range(N):
+        for i in range(j, N):
+            acc = 1.0 if i == j else 0.0
+            for m in range(j, i):
+                acc -= L[i, m] * y[m]
+            y[i] = acc / L[i, i]
+            inv2 += y[i] * y[i]
+    return inv2 * slack * fro2 < 1.0
 
 
 def normalised_positions_stack(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -200,17 +252,18 @@ def normalised_positions_stack(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return Pn, spread
 
 
-def _columns(layout: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    contact, component, normal = [], [], []
-    for i, kind in enumerate(layout):
-        normal.append(len(contact))
-        for comp in KIND_COMPONENTS[kind]:
-            contact.append(i)
-            component.append(comp)
+def _columns(layout: tuple[int, ...]):
+    """Column starts (N + 1,), components (M,), tangents needed (N,) of a layout."""
+    start, component, tangent = [0], [], []
+    for kind in layout:
+        comps = KIND_COMPONENTS[kind]
+        component.extend(comps)
+        start.append(start[-1] + len(comps))
+        tangent.append(any(c in (1, 2) for c in comps))
     return (
-        np.array(contact, dtype=np.int64),
+        np.array(start, dtype=np.int64),
         np.array(component, dtype=np.int64),
-        np.array(normal, dtype=int),
+        np.array(tangent, dtype=np.bool_),
     )
 
 
@@ -246,23 +299,25 @@ def grasp_matrix_stack(
     p = np.zeros((K, d)) if reference_points is None else reference_points
     p = np.ascontiguousarray(p, dtype=float)
     rows = np.arange(K) if rows is None else np.asarray(rows, dtype=np.int64)
-    contact, component, normal = _columns(tuple(layout))
-    G = np.empty((rows.shape[0], 6 if d == 3 else 3, contact.shape[0]))
-    if G.size:
-        _grasp_stack(P, Nrm, p, rows, contact, component, G)
-    return G, normal
+    start, component, tangent = _columns(tuple(layout))
+    G = np.empty((rows.shape[0], 6 if d == 3 else 3, component.shape[0]))
+    if G.size and d == 3:
+        _grasp_stack3(P, Nrm, p, rows, start, component, tangent, G)
+    elif G.size:
+        _grasp_stack2(P, Nrm, p, rows, start, component, G)
+    return G, start[:-1].astype(int)
 
 
 def normal_rank_certain(
     P: np.ndarray, Nrm: np.ndarray, rows: np.ndarray, rank_tol: float
 ) -> np.ndarray:
-    """Grasps ``rows`` whose ``G_n`` (about the origin) a QR proves of full column rank.
+    """Grasps ``rows`` whose ``G_n`` (about the origin) is proved of full column rank.
 
     ``G_n`` (w, N), ``N <= w``, is
     ``batched_normal_grasp_matrix(P[rows], Nrm[rows], 0)``, built per grasp
-    inside the loop; the test is that of
-    :func:`drakegrasp.batch.fused_kernel.full_column_rank_certain`.  False means
-    unsure (the SVD rule decides), never "deficient".
+    inside the loop; the proof (``σ_min > rank_tol σ_max``) is a Cholesky
+    factor of ``G_nᵀ G_n`` with a rounding margin (:func:`_normal_rank`).
+    False means unsure (the SVD rule decides), never "deficient".
     """
     P = np.ascontiguousarray(P, dtype=float)
     Nrm = np.ascontiguousarray(Nrm, dtype=float)

@@ -137,7 +137,7 @@ def test_compiled_grasp_matrix_matches_single_grasp_objects(model):
 
 @pytest.mark.parametrize("d", [2, 3])
 @pytest.mark.parametrize("N", [1, 2, 3, 4, 6])
-def test_normal_rank_certificate_is_the_compiled_qr_on_the_numpy_matrix(d, N):
+def test_normal_rank_certificate_agrees_with_the_svd_rule(d, N):
     if N > (6 if d == 3 else 3):
         pytest.skip("the certificate is for N <= w")
     rng = np.random.default_rng(300 + 10 * N + d)
@@ -148,13 +148,40 @@ def test_normal_rank_certificate_is_the_compiled_qr_on_the_numpy_matrix(d, N):
     rows = np.flatnonzero(rng.random(K) < 0.7)
     Gn = batched_normal_grasp_matrix(Pn[rows], Nrm[rows], np.zeros((rows.size, d)))
     got = normal_rank_certain(Pn, Nrm, rows, 1e-9)
-    np.testing.assert_array_equal(got, full_column_rank_certain(Gn, 1e-9))
-    # "certain" is never wrong: the SVD agrees that those have full column rank.
-    sv = np.linalg.svd(Gn[got], compute_uv=False)
-    assert (sv[:, -1] > 1e-9 * sv[:, 0]).all()
+    sv = np.linalg.svd(Gn, compute_uv=False)
+    ratio = sv[:, -1] / sv[:, 0]
+    assert (ratio[got] > 1e-9).all()  # "certain" is never wrong
+    assert got[ratio > 1e-6].all()  # and not shy
     if N > 1:
         assert not got[rows < 10].any()
-    assert got[rows >= 80].mean() > 0.9  # the generic grasps are certified
+    # The QR certificate of the fused kernel says no more than this one.
+    assert not (full_column_rank_certain(Gn, 1e-9) & ~got & (ratio > 1e-6)).any()
+
+
+@pytest.mark.parametrize("w", [3, 6])
+def test_gram_certificate_on_prescribed_singular_values(w):
+    """Soundness at the threshold: ``σ_min / σ_max <= rank_tol`` is never certified."""
+    from drakegrasp.batch.construction_kernel import _gram_certain
+
+    rng = np.random.default_rng(40 + w)
+    for N in range(1, w + 1):
+        for ratio in [1.0, 1e-3, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-13, 0.0]:
+            for _ in range(30):
+                U, _ = np.linalg.qr(rng.normal(size=(w, N)))
+                V, _ = np.linalg.qr(rng.normal(size=(N, N)))
+                s = np.geomspace(1.0, max(ratio, 1e-300), N) if N > 1 else [1.0]
+                if N > 1 and ratio == 0.0:
+                    s[-1] = 0.0
+                X = (U * s) @ V.T * 10.0 ** rng.uniform(-100, 100)
+                ok = _gram_certain(
+                    np.ascontiguousarray(X.T), N, w, np.empty((N, N)), np.empty(N),
+                    2.0 * (1e-18 + 4.0 * (w + N + 2) * 2.0**-52),
+                )  # fmt: skip
+                true = np.linalg.svd(X, compute_uv=False)
+                if true[-1] <= 1e-9 * true[0]:
+                    assert not ok, (N, ratio)
+                if N == 1 or ratio >= 1e-6:
+                    assert ok, (N, ratio)
 
 
 def _chunk(P, Nrm, mu, nu, model, kernel, metrics=()):
