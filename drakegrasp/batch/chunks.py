@@ -123,7 +123,8 @@ def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel)
     out = np.full(Pn.shape[0], np.nan)
     w = 6 if Pn.shape[2] == 3 else 3
     N = Pn.shape[1]
-    frictional = (kinds != FRICTIONLESS).any(axis=1)
+    rubs = kinds != FRICTIONLESS
+    frictional = True if rubs.all() else rubs.any(axis=1)
     rows = np.flatnonzero((rank == w) & frictional & ~(d_star > tol))
     if rows.size == 0:
         return out
@@ -167,7 +168,11 @@ def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, ro
         torsion = None if torsion is None else torsion[rows]
     facets, slices, start = [], [], 0
     shared: dict[tuple[int, float], np.ndarray] = {}  # one cone per (kind, μ)
-    uniform = (mu_c == mu_c[:1]).all(axis=0)  # contacts with one μ for all grasps
+    # Contacts with one μ for all grasps (whole-array test first: it is cheaper).
+    if (mu_c == mu_c[:1, :1]).all():
+        uniform = np.ones(mu_c.shape[1], dtype=bool)
+    else:
+        uniform = (mu_c == mu_c[:1]).all(axis=0)
     kappa = np.sqrt(1.0 + mu_c**2)  # ‖f_i‖ <= κ_i f_n (torsion columns below)
     for i, kind in enumerate(layout):
         k_i = len(KIND_COMPONENTS[kind])

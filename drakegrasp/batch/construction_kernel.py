@@ -10,7 +10,7 @@ contacts, straight into the output.
 
 Every number is computed with the same floating-point operations, in the same
 order, as the numpy route (sums left to right, ``‖x‖ = sqrt((x₀² + x₁²) +
-x₂²)``, ``a × b`` as :func:`numpy.cross`, no fast-math), so the outputs are
+x₂²)``, ``a × b`` as ``numpy.cross``, no fast-math), so the outputs are
 bitwise those of numpy; the tests compare the two on seeded and degenerate
 stacks.  The numpy functions stay the reference, and the route used when numba
 is absent.  Nothing here validates: the inputs are a chunk's checked arrays.
@@ -96,7 +96,7 @@ def _tangents(n0, n1, n2):
 
 @njit(cache=True, error_model="numpy")
 def _column3(G, k, m, r0, r1, r2, u0, u1, u2):
-    """``G[k, :, m] = [u; r × u]`` (``r × u`` as :func:`numpy.cross`)."""
+    """``G[k, :, m] = [u; r × u]`` (``r × u`` as ``numpy.cross``)."""
     G[k, 0, m] = u0
     G[k, 1, m] = u1
     G[k, 2, m] = u2
@@ -316,7 +316,7 @@ def normal_rank_certain(
     ``G_n`` (w, N), ``N <= w``, is
     ``batched_normal_grasp_matrix(P[rows], Nrm[rows], 0)``, built per grasp
     inside the loop; the proof (``σ_min > rank_tol σ_max``) is a Cholesky
-    factor of ``G_nᵀ G_n`` with a rounding margin (:func:`_normal_rank`).
+    factor of ``G_nᵀ G_n`` with a rounding margin (``_normal_rank`` gives the bound).
     False means unsure (the SVD rule decides), never "deficient".
     """
     P = np.ascontiguousarray(P, dtype=float)
