@@ -89,17 +89,20 @@ def _positions(P, compiled: bool):
     return normalised_positions(P)
 
 
+def _subset(P, Nrm, p, rows):
+    """The grasps ``rows`` (None: all) of the arrays, with ``p`` None as 0."""
+    if rows is not None:
+        P, Nrm, p = P[rows], Nrm[rows], None if p is None else p[rows]
+    return P, Nrm, np.zeros((P.shape[0], P.shape[2])) if p is None else p
+
+
 def _grasp_matrices(P, Nrm, p, layout, rows, compiled: bool):
     """``batched_grasp_matrix`` of grasps ``rows`` (None: all), ``p`` None: 0."""
     if compiled:
         from drakegrasp.batch.construction_kernel import grasp_matrix_stack
 
         return grasp_matrix_stack(P, Nrm, layout, reference_points=p, rows=rows)
-    if rows is not None:
-        P, Nrm, p = P[rows], Nrm[rows], None if p is None else p[rows]
-    if p is None:
-        p = np.zeros((P.shape[0], P.shape[2]))
-    return batched_grasp_matrix(P, Nrm, p, layout)
+    return batched_grasp_matrix(*_subset(P, Nrm, p, rows), layout)
 
 
 def _normal_matrices(P, Nrm, p, rows, compiled: bool):
@@ -107,11 +110,7 @@ def _normal_matrices(P, Nrm, p, rows, compiled: bool):
     if compiled:
         layout = (FRICTIONLESS,) * P.shape[1]
         return _grasp_matrices(P, Nrm, p, layout, rows, True)[0]
-    if rows is not None:
-        P, Nrm, p = P[rows], Nrm[rows], None if p is None else p[rows]
-    if p is None:
-        p = np.zeros((P.shape[0], P.shape[2]))
-    return batched_normal_grasp_matrix(P, Nrm, p)
+    return batched_normal_grasp_matrix(*_subset(P, Nrm, p, rows))
 
 
 def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel):
@@ -131,8 +130,9 @@ def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel)
     compiled = _compiled(kernel)
     if N <= w:
         # Balancing normal forces need N(G_n) != {0}; with no more contacts than
-        # wrench rows that is rare.  A QR certifies full column rank for most
-        # grasps (as in rowspace); the rest take the exact SVD rule.
+        # wrench rows that is rare.  A QR (as in rowspace; compiled: a Cholesky
+        # factor of G_nᵀ G_n with a rounding margin) certifies full column rank
+        # for most grasps; the rest take the exact SVD rule.
         if compiled:
             from drakegrasp.batch.construction_kernel import normal_rank_certain
 
