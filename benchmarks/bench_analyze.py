@@ -3,13 +3,26 @@
 Usage::
 
     python benchmarks/bench_analyze.py [SCENE] [--repeats 300] [--fresh 5] [--profile]
+    python benchmarks/bench_analyze.py --cli-only [--cli-runs 15] \
+        [--against OTHER_VENV/bin/python]
 
-Three tables:
+Four tables:
 
+* **the command**: the wall time of ``drakegrasp analyze SCENE`` as a new
+  process (interpreter start included), ``--cli-runs`` times, beside Python
+  alone and the imports of the pydrake modules the command uses, timed the
+  same way; with ``--against``, the same command of another tree (say
+  main's ``.venv/bin/python``) and its output compared with this tree's.  The
+  runs of all rows alternate (each round in a rotated order) so that load on
+  a shared machine falls on every row alike; the table gives the median and
+  the minimum, and the load average before and after.  Twice: once with the
+  environment as it is, and once with compiled bytecode kept (a private
+  ``PYTHONPYCACHEPREFIX``, warmed by one run), as an installed package has
+  it: with ``PYTHONDONTWRITEBYTECODE=1`` an editable install compiles its
+  modules from source at every start;
 * **first call**: in ``--fresh`` new processes, the first ``analyze_grasp``
-  after ``load_scene`` (imports and Drake's first-use costs included), the
-  second call, and ``drakegrasp analyze SCENE`` end to end (wall time of the
-  command, interpreter start included);
+  after ``load_scene`` (imports and Drake's first-use costs included) and the
+  second call;
 * **later calls**: median and 90th percentile of one ``analyze_grasp``, with
   the steps it runs in the order it runs them, each timed alone, and the
   rest (the remainder of the total: result assembly, validation, the calls'
@@ -27,6 +40,8 @@ from __future__ import annotations
 
 import os
 
+# The command rows run with the caller's environment, not the pinned one.
+_CALLER_ENV = dict(os.environ)
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
@@ -36,7 +51,9 @@ import json  # noqa: E402
 import pstats  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
+import tempfile  # noqa: E402
 import time  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -101,9 +118,113 @@ def _row(label: str, t: np.ndarray) -> str:
     return f"{label:<56} {np.median(t):10.3f} {np.percentile(t, 90):8.3f}"
 
 
+# The pydrake modules that `drakegrasp analyze` imports (with what they import).
+PYDRAKE_USED = (
+    "pydrake.geometry",
+    "pydrake.multibody.parsing",
+    "pydrake.multibody.plant",
+    "pydrake.multibody.tree",
+    "pydrake.solvers",
+    "pydrake.systems.framework",
+)
+
+
+def _analyze_command(python: str, scene: str) -> list[str]:
+    """``drakegrasp analyze SCENE`` of the environment that ``python`` is in."""
+    script = Path(python).parent / "drakegrasp"
+    if script.exists():  # the console script a user runs
+        return [str(script), "analyze", scene]
+    return [python, "-m", "drakegrasp", "analyze", scene]
+
+
+def command_rows(scene: str, against: str | None) -> dict[str, list[str]]:
+    """The commands of the command table, by label."""
+    rows = {
+        "python -c pass": [sys.executable, "-c", "pass"],
+        "import pydrake.multibody.plant": [
+            sys.executable,
+            "-c",
+            "import pydrake.multibody.plant",
+        ],
+        "import the pydrake modules analyze uses": [
+            sys.executable,
+            "-c",
+            f"import {', '.join(PYDRAKE_USED)}",
+        ],
+        "drakegrasp analyze (this tree)": _analyze_command(sys.executable, scene),
+    }
+    if against is not None:
+        rows["drakegrasp analyze (--against)"] = _analyze_command(against, scene)
+    return rows
+
+
+def _wall(argv: list[str], env: dict[str, str]) -> tuple[float, str]:
+    t0 = time.perf_counter()
+    run = subprocess.run(argv, env=env, capture_output=True, text=True, check=True)
+    return time.perf_counter() - t0, run.stdout
+
+
+def command_times(
+    rows: dict[str, list[str]], runs: int, env: dict[str, str]
+) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+    """Wall times (s) of each command, ``runs`` rounds of alternating runs.
+
+    One warm-up run of each first (file cache, bytecode); each round runs
+    every command once, the order rotated by one per round.
+    """
+    labels = list(rows)
+    outputs = {label: _wall(rows[label], env)[1] for label in labels}
+    times: dict[str, list[float]] = {label: [] for label in labels}
+    for r in range(runs):
+        for label in labels[r % len(labels) :] + labels[: r % len(labels)]:
+            times[label].append(_wall(rows[label], env)[0])
+    return {label: np.array(t) for label, t in times.items()}, outputs
+
+
+def print_command_table(scene: str, runs: int, against: str | None) -> None:
+    """The command table, with the environment as is and with bytecode kept."""
+    rows = command_rows(scene, against)
+    with tempfile.TemporaryDirectory(prefix="bench_analyze_pyc_") as pyc:
+        cached = {
+            k: v for k, v in _CALLER_ENV.items() if k != "PYTHONDONTWRITEBYTECODE"
+        }
+        cached["PYTHONPYCACHEPREFIX"] = pyc
+        settings = {
+            "environment as is"
+            + (
+                " (PYTHONDONTWRITEBYTECODE=1: sources compiled at every start)"
+                if _CALLER_ENV.get("PYTHONDONTWRITEBYTECODE")
+                else ""
+            ): dict(_CALLER_ENV),
+            "bytecode kept (PYTHONPYCACHEPREFIX, warmed)": cached,
+        }
+        for setting, env in settings.items():
+            before = os.getloadavg()
+            times, outputs = command_times(rows, runs, env)
+            after = os.getloadavg()
+            print(
+                f"\ndrakegrasp analyze {scene}, {setting}: {runs} alternating "
+                f"runs each; load average {before[0]:.2f} before, "
+                f"{after[0]:.2f} after"
+            )
+            print(f"{'':<56} {'median s':>10} {'min s':>8} {'max s':>8}")
+            for label, t in times.items():
+                print(f"{label:<56} {np.median(t):10.3f} {t.min():8.3f} {t.max():8.3f}")
+            used = times["import the pydrake modules analyze uses"]
+            for label in [k for k in times if k.startswith("drakegrasp")]:
+                extra = np.median(times[label]) - np.median(used)
+                print(f"  {label}: {extra:.3f} s (median) beyond pydrake's imports")
+            if against is not None:
+                same = (
+                    outputs["drakegrasp analyze (this tree)"]
+                    == outputs["drakegrasp analyze (--against)"]
+                )
+                print(f"  outputs of the two trees identical: {same}")
+
+
 def first_calls(scene: str, fresh: int) -> dict[str, np.ndarray]:
-    """First and second ``analyze_grasp`` and the CLI, each in new processes."""
-    first, second, cli = [], [], []
+    """First and second ``analyze_grasp``, each pair in a new process."""
+    first, second = [], []
     for _ in range(fresh):
         out = subprocess.run(
             [sys.executable, "-c", _FIRST_CALL, scene],
@@ -114,17 +235,9 @@ def first_calls(scene: str, fresh: int) -> dict[str, np.ndarray]:
         a, b = json.loads(out.splitlines()[-1])
         first.append(1e3 * a)
         second.append(1e3 * b)
-        t0 = time.perf_counter()
-        subprocess.run(
-            [sys.executable, "-m", "drakegrasp", "analyze", scene],
-            check=True,
-            capture_output=True,
-        )
-        cli.append(1e3 * (time.perf_counter() - t0))
     return {
         "analyze_grasp, first call": np.array(first),
         "analyze_grasp, second call": np.array(second),
-        "drakegrasp analyze (wall, whole command)": np.array(cli),
     }
 
 
@@ -138,7 +251,22 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=300)
     parser.add_argument("--fresh", type=int, default=5, help="new processes")
     parser.add_argument("--profile", action="store_true")
+    parser.add_argument(
+        "--cli-runs", type=int, default=15, help="runs of each command (0: none)"
+    )
+    parser.add_argument(
+        "--against",
+        metavar="PYTHON",
+        help="another tree's Python (e.g. main's .venv/bin/python) to compare",
+    )
+    parser.add_argument(
+        "--cli-only", action="store_true", help="only the command table"
+    )
     args = parser.parse_args()
+    if args.cli_runs > 0:
+        print_command_table(args.scene, args.cli_runs, args.against)
+    if args.cli_only:
+        return
 
     scene = load_scene(args.scene)
     plant, ctx = scene.plant, scene.plant_context
