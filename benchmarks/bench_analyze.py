@@ -49,6 +49,7 @@ import argparse  # noqa: E402
 import cProfile  # noqa: E402
 import json  # noqa: E402
 import pstats  # noqa: E402
+import resource  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -158,27 +159,54 @@ def command_rows(scene: str, against: str | None) -> dict[str, list[str]]:
     return rows
 
 
-def _wall(argv: list[str], env: dict[str, str]) -> tuple[float, str]:
+def _wall(argv: list[str], env: dict[str, str]) -> tuple[float, float, str]:
+    """Wall and CPU (user + system) seconds of one run, and its output."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     run = subprocess.run(argv, env=env, capture_output=True, text=True, check=True)
-    return time.perf_counter() - t0, run.stdout
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, run.stdout
 
 
 def command_times(
     rows: dict[str, list[str]], runs: int, env: dict[str, str]
 ) -> tuple[dict[str, np.ndarray], dict[str, str]]:
-    """Wall times (s) of each command, ``runs`` rounds of alternating runs.
+    """Wall and CPU times (s) of each command, ``runs`` rounds of alternating runs.
 
     One warm-up run of each first (file cache, bytecode); each round runs
-    every command once, the order rotated by one per round.
+    every command once, the order rotated by one per round.  Returns
+    ``(runs, 2)`` arrays (wall, CPU) by label, and each command's output.
     """
     labels = list(rows)
-    outputs = {label: _wall(rows[label], env)[1] for label in labels}
-    times: dict[str, list[float]] = {label: [] for label in labels}
+    outputs = {label: _wall(rows[label], env)[2] for label in labels}
+    times: dict[str, list[tuple[float, float]]] = {label: [] for label in labels}
     for r in range(runs):
         for label in labels[r % len(labels) :] + labels[: r % len(labels)]:
-            times[label].append(_wall(rows[label], env)[0])
+            times[label].append(_wall(rows[label], env)[:2])
     return {label: np.array(t) for label, t in times.items()}, outputs
+
+
+def _print_times(times: dict[str, np.ndarray]) -> None:
+    """Median, min and max wall time and median and min CPU time per command."""
+    print(
+        f"{'seconds':<48} {'wall median':>11} {'min':>6} {'max':>6}"
+        f" {'CPU median':>10} {'min':>6}"
+    )
+    for label, t in times.items():
+        wall, cpu = t[:, 0], t[:, 1]
+        print(
+            f"{label:<48} {np.median(wall):11.3f} {wall.min():6.3f} "
+            f"{wall.max():6.3f} {np.median(cpu):10.3f} {cpu.min():6.3f}"
+        )
+    used = np.median(times["import the pydrake modules analyze uses"], axis=0)
+    for label in [k for k in times if k.startswith("drakegrasp")]:
+        extra = np.median(times[label], axis=0) - used
+        print(
+            f"  {label}: {extra[0]:.3f} s wall, {extra[1]:.3f} s CPU beyond "
+            "pydrake's imports (medians)"
+        )
 
 
 def print_command_table(scene: str, runs: int, against: str | None) -> None:
@@ -207,13 +235,7 @@ def print_command_table(scene: str, runs: int, against: str | None) -> None:
                 f"runs each; load average {before[0]:.2f} before, "
                 f"{after[0]:.2f} after"
             )
-            print(f"{'':<56} {'median s':>10} {'min s':>8} {'max s':>8}")
-            for label, t in times.items():
-                print(f"{label:<56} {np.median(t):10.3f} {t.min():8.3f} {t.max():8.3f}")
-            used = times["import the pydrake modules analyze uses"]
-            for label in [k for k in times if k.startswith("drakegrasp")]:
-                extra = np.median(times[label]) - np.median(used)
-                print(f"  {label}: {extra:.3f} s (median) beyond pydrake's imports")
+            _print_times(times)
             if against is not None:
                 same = (
                     outputs["drakegrasp analyze (this tree)"]
