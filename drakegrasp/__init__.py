@@ -12,7 +12,7 @@ programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
 ``cli``).
 
 Every public name is imported from its module when it is first read
-(:mod:`drakegrasp._lazy`), so ``import drakegrasp`` and the ``drakegrasp``
+(``drakegrasp._lazy``), so ``import drakegrasp`` and the ``drakegrasp``
 command load only the layers they use: ``drakegrasp analyze`` never imports the
 batch engine, Meshcat drawing or Drake Systems.
 """

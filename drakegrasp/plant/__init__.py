@@ -8,7 +8,7 @@ may be the plant's or the root context of the diagram that holds the plant, and
 options after it are keyword-only (:mod:`drakegrasp.plant.validation`).
 
 Names are imported from their modules on first access
-(:mod:`drakegrasp._lazy`): loading a scene and analysing it does not import
+(``drakegrasp._lazy``): loading a scene and analysing it does not import
 :mod:`~drakegrasp.plant.closing` or :mod:`~drakegrasp.plant.contact_results`.
 """
 
