@@ -13,8 +13,8 @@ programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
 
 Every public name is imported from its module when it is first read
 (``drakegrasp._lazy``), so ``import drakegrasp`` and the ``drakegrasp``
-command load only the layers they use: ``drakegrasp analyze`` never imports the
-batch engine, Meshcat drawing or Drake Systems.
+command load only the layers they use: ``drakegrasp analyze`` imports no batch
+engine, quality metrics, pictures or grasp monitor.
 """
 
 from drakegrasp._lazy import lazy_exports
