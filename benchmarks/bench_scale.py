@@ -108,8 +108,11 @@ def best_rate(fn, n, repeats, clock=time.process_time):
 def bench_one(case, N, *, quick, seed):
     d, model, nu = CASES[case]
     rng = np.random.default_rng(seed)
-    budget = 1.5 if quick else 4.0  # seconds of single-core batch work aimed at
-    K = int(np.clip(budget * 60_000 / N**1.2, 2_000, 400_000))
+    # Seconds of single-core batch work aimed at per run, with a model of this
+    # round's hard-finger rates (about 230k/s at N = 3, 24k at 12, 9.5k at 24):
+    # enough chunks and work that batch×all measures the engine, not pool start.
+    budget = 0.5 if quick else 1.5
+    K = int(np.clip(budget * (1.6e6 / N**2 + 1.6e5 / N), 2_000, 1_000_000))
     P, Nrm = random_grasps(rng, K, N, d)
     opts = {"model": model, "torsional_friction": nu}
     batch_force_closure(P[:200], Nrm[:200], MU, workers=1, **opts)  # warm-up

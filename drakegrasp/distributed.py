@@ -36,6 +36,7 @@ from drakegrasp.batch.engine import (
     stream_form_closure,
 )
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.validation import check_num_generators
 
 __all__ = [
     "analyze_poses",
@@ -139,7 +140,11 @@ def evaluate_on_cluster(
         raise InvalidOptionError("force closure needs mu")
     client = _client(client)
     K, N, d = np.shape(positions)
-    size = chunk_size_for(N, d, chunk_size)
+    # the local engine's chunks (same n_g and K), so partitions align with them
+    n_g = 1
+    if kind == "force":
+        n_g = check_num_generators(options.get("num_generators", 8))
+    size = chunk_size_for(N, d, chunk_size, n_g, K)
     step = size * int(partition_chunks)
     arrays = {k: options.pop(k) for k in _ARRAY_OPTIONS if k in options}
     if kind == "force":

@@ -127,6 +127,29 @@ def test_chunk_size_does_not_change_results():
     np.testing.assert_allclose(form[0], form[1], rtol=0, atol=1e-9)
 
 
+def test_default_chunks_spread_a_small_batch_over_the_workers():
+    """chunk_size=None: bytes-sized chunks, cut into TARGET_CHUNKS for small K."""
+    from drakegrasp.batch.engine import (
+        MIN_CHUNK_CONTACTS,
+        TARGET_CHUNKS,
+        chunk_size_for,
+    )
+
+    for N in (3, 12, 24):
+        by_bytes = chunk_size_for(N, 3, None)
+        assert chunk_size_for(N, 3, None, K=10**8) == by_bytes  # large: unchanged
+        floor = -(-MIN_CHUNK_CONTACTS // N)
+        for K in (10, 5 * floor, 3 * TARGET_CHUNKS * floor, 10 * by_bytes):
+            size = chunk_size_for(N, 3, None, K=K)
+            assert floor <= size <= by_bytes or size == by_bytes < floor
+            n_chunks = -(-K // size)
+            if K >= TARGET_CHUNKS * floor:  # enough work for TARGET_CHUNKS
+                assert n_chunks >= TARGET_CHUNKS - 1
+            if K <= TARGET_CHUNKS * by_bytes:  # and not more than needed
+                assert n_chunks <= TARGET_CHUNKS
+        assert chunk_size_for(N, 3, 100, K=10**6) == 100  # explicit: as given
+
+
 class _RecordingArray:
     """An array-like that records how many grasps each read touches."""
 
