@@ -59,16 +59,21 @@ print(json.dumps(sorted(sys.modules)))
 """
 
 
-def loaded_modules(argv: list[str] | None) -> set[str]:
-    """``sys.modules`` of a fresh interpreter after ``main(argv)`` (None: import)."""
+def fresh_python(code: str, *args: str) -> str:
+    """The output of ``code`` run by a fresh interpreter (which must succeed)."""
     run = subprocess.run(
-        [sys.executable, "-c", _LOADED, json.dumps(argv)],
+        [sys.executable, "-c", code, *args],
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=600,
     )
     assert run.returncode == 0, run.stderr
-    return set(json.loads(run.stdout))
+    return run.stdout
+
+
+def loaded_modules(argv: list[str] | None) -> set[str]:
+    """``sys.modules`` of a fresh interpreter after ``main(argv)`` (None: import)."""
+    return set(json.loads(fresh_python(_LOADED, json.dumps(argv))))
 
 
 def deferred_in(modules: set[str]) -> list[str]:
@@ -113,10 +118,7 @@ def test_public_names_and_submodules_resolve_in_a_fresh_interpreter():
         "assert drakegrasp.batch.batch_force_closure is batch_force_closure\n"
         "assert drakegrasp.examples.__name__ == 'drakegrasp.examples'\n"
     )
-    run = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, timeout=300
-    )
-    assert run.returncode == 0, run.stderr
+    fresh_python(code)
 
 
 def test_an_unknown_name_is_an_attribute_error():
@@ -166,15 +168,9 @@ def test_analyze_prints_the_same_in_a_fresh_process_as_in_a_loaded_one(capsys):
     # A fresh process resolves everything lazily; this one has imported every
     # layer.  The reports (text and JSON) of every shipped scene must agree.
     argvs = [["analyze", s, *j] for s in SCENE_NAMES for j in ([], ["--json"])]
-    run = subprocess.run(
-        [sys.executable, "-c", _ANALYZE_ALL, json.dumps(argvs)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert run.returncode == 0, run.stderr
+    fresh = fresh_python(_ANALYZE_ALL, json.dumps(argvs))
     expected = []
     for argv in argvs:
         assert main(argv) == 0
         expected.append(f"===== {' '.join(argv)}\n" + capsys.readouterr().out)
-    assert run.stdout == "".join(expected)
+    assert fresh == "".join(expected)
