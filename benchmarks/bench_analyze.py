@@ -3,13 +3,26 @@
 Usage::
 
     python benchmarks/bench_analyze.py [SCENE] [--repeats 300] [--fresh 5] [--profile]
+    python benchmarks/bench_analyze.py --cli-only [--cli-runs 15] \
+        [--against OTHER_VENV/bin/python]
 
-Three tables:
+Four tables:
 
+* **the command**: the wall time of ``drakegrasp analyze SCENE`` as a new
+  process (interpreter start included), ``--cli-runs`` times, beside Python
+  alone and the imports of the pydrake modules the command uses, timed the
+  same way; with ``--against``, the same command of another tree (say
+  main's ``.venv/bin/python``) and its output compared with this tree's.  The
+  runs of all rows alternate (each round in a rotated order) so that load on
+  a shared machine falls on every row alike; the table gives the median and
+  the minimum, and the load average before and after.  Twice: once with the
+  environment as it is, and once with compiled bytecode kept (a private
+  ``PYTHONPYCACHEPREFIX``, warmed by one run), as an installed package has
+  it: with ``PYTHONDONTWRITEBYTECODE=1`` an editable install compiles its
+  modules from source at every start;
 * **first call**: in ``--fresh`` new processes, the first ``analyze_grasp``
-  after ``load_scene`` (imports and Drake's first-use costs included), the
-  second call, and ``drakegrasp analyze SCENE`` end to end (wall time of the
-  command, interpreter start included);
+  after ``load_scene`` (imports and Drake's first-use costs included) and the
+  second call;
 * **later calls**: median and 90th percentile of one ``analyze_grasp``, with
   the steps it runs in the order it runs them, each timed alone, and the
   rest (the remainder of the total: result assembly, validation, the calls'
@@ -27,6 +40,8 @@ from __future__ import annotations
 
 import os
 
+# The command rows run with the caller's environment, not the pinned one.
+_CALLER_ENV = dict(os.environ)
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
@@ -34,9 +49,12 @@ import argparse  # noqa: E402
 import cProfile  # noqa: E402
 import json  # noqa: E402
 import pstats  # noqa: E402
+import resource  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
+import tempfile  # noqa: E402
 import time  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -101,9 +119,134 @@ def _row(label: str, t: np.ndarray) -> str:
     return f"{label:<56} {np.median(t):10.3f} {np.percentile(t, 90):8.3f}"
 
 
+# The pydrake modules that `drakegrasp analyze` imports (with what they import).
+PYDRAKE_USED = (
+    "pydrake.geometry",
+    "pydrake.multibody.parsing",
+    "pydrake.multibody.plant",
+    "pydrake.multibody.tree",
+    "pydrake.solvers",
+    "pydrake.systems.framework",
+)
+
+
+def _analyze_command(python: str, scene: str) -> list[str]:
+    """``drakegrasp analyze SCENE`` of the environment that ``python`` is in."""
+    script = Path(python).parent / "drakegrasp"
+    if script.exists():  # the console script a user runs
+        return [str(script), "analyze", scene]
+    return [python, "-m", "drakegrasp", "analyze", scene]
+
+
+def command_rows(scene: str, against: str | None) -> dict[str, list[str]]:
+    """The commands of the command table, by label."""
+    rows = {
+        "python -c pass": [sys.executable, "-c", "pass"],
+        "import pydrake.multibody.plant": [
+            sys.executable,
+            "-c",
+            "import pydrake.multibody.plant",
+        ],
+        "import the pydrake modules analyze uses": [
+            sys.executable,
+            "-c",
+            f"import {', '.join(PYDRAKE_USED)}",
+        ],
+        "drakegrasp analyze (this tree)": _analyze_command(sys.executable, scene),
+    }
+    if against is not None:
+        rows["drakegrasp analyze (--against)"] = _analyze_command(against, scene)
+    return rows
+
+
+def _wall(argv: list[str], env: dict[str, str]) -> tuple[float, float, str]:
+    """Wall and CPU (user + system) seconds of one run, and its output."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    run = subprocess.run(argv, env=env, capture_output=True, text=True, check=True)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, run.stdout
+
+
+def command_times(
+    rows: dict[str, list[str]], runs: int, env: dict[str, str]
+) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+    """Wall and CPU times (s) of each command, ``runs`` rounds of alternating runs.
+
+    One warm-up run of each first (file cache, bytecode); each round runs
+    every command once, the order rotated by one per round.  Returns
+    ``(runs, 2)`` arrays (wall, CPU) by label, and each command's output.
+    """
+    labels = list(rows)
+    outputs = {label: _wall(rows[label], env)[2] for label in labels}
+    times: dict[str, list[tuple[float, float]]] = {label: [] for label in labels}
+    for r in range(runs):
+        for label in labels[r % len(labels) :] + labels[: r % len(labels)]:
+            times[label].append(_wall(rows[label], env)[:2])
+    return {label: np.array(t) for label, t in times.items()}, outputs
+
+
+def _print_times(times: dict[str, np.ndarray]) -> None:
+    """Median, min and max wall time and median and min CPU time per command."""
+    print(
+        f"{'seconds':<48} {'wall median':>11} {'min':>6} {'max':>6}"
+        f" {'CPU median':>10} {'min':>6}"
+    )
+    for label, t in times.items():
+        wall, cpu = t[:, 0], t[:, 1]
+        print(
+            f"{label:<48} {np.median(wall):11.3f} {wall.min():6.3f} "
+            f"{wall.max():6.3f} {np.median(cpu):10.3f} {cpu.min():6.3f}"
+        )
+    used = np.median(times["import the pydrake modules analyze uses"], axis=0)
+    for label in [k for k in times if k.startswith("drakegrasp")]:
+        extra = np.median(times[label], axis=0) - used
+        print(
+            f"  {label}: {extra[0]:.3f} s wall, {extra[1]:.3f} s CPU beyond "
+            "pydrake's imports (medians)"
+        )
+
+
+def print_command_table(scene: str, runs: int, against: str | None) -> None:
+    """The command table, with the environment as is and with bytecode kept."""
+    rows = command_rows(scene, against)
+    with tempfile.TemporaryDirectory(prefix="bench_analyze_pyc_") as pyc:
+        cached = {
+            k: v for k, v in _CALLER_ENV.items() if k != "PYTHONDONTWRITEBYTECODE"
+        }
+        cached["PYTHONPYCACHEPREFIX"] = pyc
+        settings = {
+            "environment as is"
+            + (
+                " (PYTHONDONTWRITEBYTECODE=1: sources compiled at every start)"
+                if _CALLER_ENV.get("PYTHONDONTWRITEBYTECODE")
+                else ""
+            ): dict(_CALLER_ENV),
+            "bytecode kept (PYTHONPYCACHEPREFIX, warmed)": cached,
+        }
+        for setting, env in settings.items():
+            before = os.getloadavg()
+            times, outputs = command_times(rows, runs, env)
+            after = os.getloadavg()
+            print(
+                f"\ndrakegrasp analyze {scene}, {setting}: {runs} alternating "
+                f"runs each; load average {before[0]:.2f} before, "
+                f"{after[0]:.2f} after"
+            )
+            _print_times(times)
+            if against is not None:
+                same = (
+                    outputs["drakegrasp analyze (this tree)"]
+                    == outputs["drakegrasp analyze (--against)"]
+                )
+                print(f"  outputs of the two trees identical: {same}")
+
+
 def first_calls(scene: str, fresh: int) -> dict[str, np.ndarray]:
-    """First and second ``analyze_grasp`` and the CLI, each in new processes."""
-    first, second, cli = [], [], []
+    """First and second ``analyze_grasp``, each pair in a new process."""
+    first, second = [], []
     for _ in range(fresh):
         out = subprocess.run(
             [sys.executable, "-c", _FIRST_CALL, scene],
@@ -114,17 +257,9 @@ def first_calls(scene: str, fresh: int) -> dict[str, np.ndarray]:
         a, b = json.loads(out.splitlines()[-1])
         first.append(1e3 * a)
         second.append(1e3 * b)
-        t0 = time.perf_counter()
-        subprocess.run(
-            [sys.executable, "-m", "drakegrasp", "analyze", scene],
-            check=True,
-            capture_output=True,
-        )
-        cli.append(1e3 * (time.perf_counter() - t0))
     return {
         "analyze_grasp, first call": np.array(first),
         "analyze_grasp, second call": np.array(second),
-        "drakegrasp analyze (wall, whole command)": np.array(cli),
     }
 
 
@@ -138,7 +273,22 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=300)
     parser.add_argument("--fresh", type=int, default=5, help="new processes")
     parser.add_argument("--profile", action="store_true")
+    parser.add_argument(
+        "--cli-runs", type=int, default=15, help="runs of each command (0: none)"
+    )
+    parser.add_argument(
+        "--against",
+        metavar="PYTHON",
+        help="another tree's Python (e.g. main's .venv/bin/python) to compare",
+    )
+    parser.add_argument(
+        "--cli-only", action="store_true", help="only the command table"
+    )
     args = parser.parse_args()
+    if args.cli_runs > 0:
+        print_command_table(args.scene, args.cli_runs, args.against)
+    if args.cli_only:
+        return
 
     scene = load_scene(args.scene)
     plant, ctx = scene.plant, scene.plant_context

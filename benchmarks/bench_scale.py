@@ -39,7 +39,8 @@ so it runs on at least 20 grasps there), with their ratio, the max relative
 
 ``--memory`` also runs ``drakegrasp batch`` on memory-mapped ``.npy`` inputs of
 10^5, 10^6 (and, without ``--quick``, 10^7) grasps and reports each run's
-peak resident memory.
+peak resident memory.  The ε and memory rows of a run that skips them
+(``--no-epsilon``, no ``--memory``) are kept from the previous ``scale.json``.
 
 Results go to ``DIR`` (default ``benchmarks/results``): ``scale.csv``,
 ``scale.json`` and ``scale.png`` (log–log grasps/s against N, one line per
@@ -350,7 +351,14 @@ def main(argv=None):
         }
         print(f"  {case:12s} " + "  ".join(
             f"{k} {v:.2f}" for k, v in exponents[case].items()))  # fmt: skip
+    # Parts not rerun (--no-epsilon, no --memory) keep the previous run's rows
+    # from scale.json, so the written results and the plot stay whole.
+    saved_path = out / "scale.json"
+    saved = json.loads(saved_path.read_text()) if saved_path.exists() else {}
     eps_rows = []
+    if args.no_epsilon and saved.get("epsilon"):
+        eps_rows = saved["epsilon"]
+        print(f"\n(batch ε rows kept from the previous {saved_path.name})")
     if not args.no_epsilon:
         print("\nbatch ε L1 vs per-grasp Qhull (grasps per CPU second, one core):")
         print(EPS_HEADER)
@@ -360,7 +368,7 @@ def main(argv=None):
                 r = epsilon_rates(case, N, quick=args.quick, seed=1000 * ci + N)
                 eps_rows.append(r)
                 print_row(r)
-    memory = []
+    memory = saved.get("memory") or []
     if args.memory:
         print("\npeak memory of `drakegrasp batch` (memory-mapped .npy input, N = 3):")
         sizes = [10**5, 10**6] if args.quick else [10**5, 10**6, 10**7]

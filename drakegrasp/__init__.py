@@ -10,102 +10,163 @@ Layers, inner to outer (an import never points outwards): the numpy core
 programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
 (``plant``), and the outside ring (``visualization``, ``batch``, ``systems``,
 ``cli``).
+
+Every public name is imported from its module when it is first read
+(``drakegrasp._lazy``), so ``import drakegrasp`` and the ``drakegrasp``
+command load only the layers they use: ``drakegrasp analyze`` imports no batch
+engine, quality metrics, pictures or grasp monitor.
 """
 
-from drakegrasp import examples
-from drakegrasp.antipodal import is_antipodal
-from drakegrasp.batch import (
-    BatchClosureResult,
-    batch_epsilon_l1,
-    batch_force_closure,
-    batch_form_closure,
-    evaluate_file,
+from drakegrasp._lazy import lazy_exports
+
+# Where each public name lives (the imports an eager package would run).
+_SOURCES = {
+    "drakegrasp.antipodal": ("is_antipodal",),
+    "drakegrasp.batch": (
+        "BatchClosureResult",
+        "batch_epsilon_l1",
+        "batch_force_closure",
+        "batch_form_closure",
+        "evaluate_file",
+    ),
+    "drakegrasp.closure": (
+        "DEFAULT_TOL",
+        "ProgramVariables",
+        "build_exact_force_closure_program",
+        "build_force_closure_program",
+        "build_form_closure_program",
+        "build_internal_force_program",
+        "force_closure",
+        "force_closure_exact",
+        "form_closure",
+        "internal_forces",
+        "matrix_rank",
+    ),
+    "drakegrasp.contact": (
+        "Contact",
+        "ContactModel",
+        "contact_frame",
+        "contact_frames",
+    ),
+    "drakegrasp.curvature": (
+        "ContactCurvature",
+        "SurfaceCurvature",
+    ),
+    "drakegrasp.errors": (
+        "BatchFileError",
+        "GraspError",
+        "InvalidContactError",
+        "InvalidContextError",
+        "InvalidGraspError",
+        "InvalidOptionError",
+        "InvalidPoseError",
+        "JointLimitError",
+        "ModelError",
+        "NoContactsError",
+        "PenetrationError",
+        "SceneError",
+        "SolverError",
+        "UnreachableError",
+    ),
+    "drakegrasp.friction_cone": (
+        "friction_cone_facets",
+        "friction_cone_generators",
+    ),
+    "drakegrasp.grasp": (
+        "Grasp",
+        "grasp_matrix",
+        "normal_grasp_matrix",
+        "normalised_grasp_matrix",
+    ),
+    "drakegrasp.plant": (
+        "FingerClosure",
+        "GraspFromPlant",
+        "GraspReport",
+        "HandClosure",
+        "PlantContact",
+        "Scene",
+        "analyze_grasp",
+        "close_hand",
+        "find_contacts",
+        "grasp_from_plant",
+        "hand_jacobian",
+        "list_scenes",
+        "load_scene",
+        "register_models",
+        "signed_distance_jacobian",
+        "use_local_drake_models",
+    ),
+    "drakegrasp.quality": (
+        "GraspQuality",
+        "MaxWrenchResult",
+        "build_max_resistible_wrench_program",
+        "distance_to_singularity",
+        "ferrari_canny",
+        "grasp_quality",
+        "grasp_singular_values",
+        "hand_object_matrix",
+        "isotropy",
+        "lp2_margin",
+        "manipulability_volume",
+        "max_resistible_wrench",
+        "min_singular_value",
+        "primitive_wrenches",
+        "uniformity_of_transformation",
+        "wrench_ellipsoid_volume",
+    ),
+    "drakegrasp.results": (
+        "AntipodalResult",
+        "ClosureResult",
+        "InternalForceResult",
+    ),
+    "drakegrasp.second_order": (
+        "SecondOrderResult",
+        "second_order_form_closure",
+    ),
+    "drakegrasp.systems": (
+        "GraspMonitor",
+        "GraspSample",
+        "add_grasp_monitor",
+    ),
+    "drakegrasp.visualization": (
+        "clear_grasp",
+        "draw_grasp",
+        "plot_planar_grasp",
+        "plot_wrench_space",
+    ),
+}
+
+# Submodules an eager package imported, so ``drakegrasp.batch`` keeps working
+# after a bare ``import drakegrasp``.
+_SUBMODULES = (
+    "_deferred",
+    "_dense_constraints",
+    "antipodal",
+    "batch",
+    "certificate_check",
+    "certificate_kinds",
+    "certificate_text",
+    "certificates",
+    "closure",
+    "cone_support",
+    "contact",
+    "curvature",
+    "errors",
+    "examples",
+    "friction_cone",
+    "grasp",
+    "plant",
+    "quality",
+    "results",
+    "second_order",
+    "systems",
+    "validation",
+    "visualization",
+    "witness",
 )
-from drakegrasp.closure import (
-    DEFAULT_TOL,
-    ProgramVariables,
-    build_exact_force_closure_program,
-    build_force_closure_program,
-    build_form_closure_program,
-    build_internal_force_program,
-    force_closure,
-    force_closure_exact,
-    form_closure,
-    internal_forces,
-    matrix_rank,
-)
-from drakegrasp.contact import Contact, ContactModel, contact_frame, contact_frames
-from drakegrasp.curvature import ContactCurvature, SurfaceCurvature
-from drakegrasp.errors import (
-    BatchFileError,
-    GraspError,
-    InvalidContactError,
-    InvalidContextError,
-    InvalidGraspError,
-    InvalidOptionError,
-    InvalidPoseError,
-    JointLimitError,
-    ModelError,
-    NoContactsError,
-    PenetrationError,
-    SceneError,
-    SolverError,
-    UnreachableError,
-)
-from drakegrasp.friction_cone import (
-    friction_cone_facets,
-    friction_cone_generators,
-)
-from drakegrasp.grasp import (
-    Grasp,
-    grasp_matrix,
-    normal_grasp_matrix,
-    normalised_grasp_matrix,
-)
-from drakegrasp.plant import (
-    FingerClosure,
-    GraspFromPlant,
-    GraspReport,
-    HandClosure,
-    PlantContact,
-    Scene,
-    analyze_grasp,
-    close_hand,
-    find_contacts,
-    grasp_from_plant,
-    hand_jacobian,
-    list_scenes,
-    load_scene,
-    register_models,
-    signed_distance_jacobian,
-    use_local_drake_models,
-)
-from drakegrasp.quality import (
-    GraspQuality,
-    MaxWrenchResult,
-    build_max_resistible_wrench_program,
-    distance_to_singularity,
-    ferrari_canny,
-    grasp_quality,
-    grasp_singular_values,
-    hand_object_matrix,
-    isotropy,
-    lp2_margin,
-    manipulability_volume,
-    max_resistible_wrench,
-    min_singular_value,
-    primitive_wrenches,
-    uniformity_of_transformation,
-    wrench_ellipsoid_volume,
-)
-from drakegrasp.results import AntipodalResult, ClosureResult, InternalForceResult
-from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
-from drakegrasp.systems import GraspMonitor, GraspSample, add_grasp_monitor
-from drakegrasp.visualization import (
-    clear_grasp,
-    draw_grasp,
-    plot_planar_grasp,
-    plot_wrench_space,
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
 )
 
 __version__ = "0.1.0"

@@ -237,9 +237,30 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
     return parser, sub
 
 
-def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
-    from drakegrasp.batch import METRICS
+class _BatchMetrics:
+    """The batch engine's metric names, read from it when argparse needs them.
 
+    ``choices`` of ``batch --metrics``: argparse reads it only to check a
+    given name or to print help, so every other command (``analyze``) runs
+    without importing the batch engine and its worker pools.
+    """
+
+    def _names(self) -> tuple[str, ...]:
+        from drakegrasp.batch import METRICS
+
+        return METRICS
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names()
+
+    def __iter__(self):
+        return iter(self._names())
+
+    def __len__(self) -> int:
+        return len(self._names())
+
+
+def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
     batch = sub.add_parser(
         "batch",
         help="decide closure for every grasp of an .npz file",
@@ -294,9 +315,9 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "--metrics",
         nargs="*",
         default=[],
-        choices=METRICS,
+        choices=_BatchMetrics(),
         metavar="NAME",
-        help=f"metrics to add: {', '.join(METRICS)}",
+        help="metrics to add: %(choices)s",
     )
     batch.add_argument(
         "--chunk-size",

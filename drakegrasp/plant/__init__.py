@@ -6,36 +6,74 @@ builds on the numpy core (:mod:`drakegrasp.contact`, :mod:`drakegrasp.grasp`,
 may be the plant's or the root context of the diagram that holds the plant, and
 ``object_body`` may be positional (``find_contacts(plant, context, body)``); the
 options after it are keyword-only (:mod:`drakegrasp.plant.validation`).
+
+Names are imported from their modules on first access
+(``drakegrasp._lazy``): loading a scene and analysing it does not import
+:mod:`~drakegrasp.plant.closing` or :mod:`~drakegrasp.plant.contact_results`.
 """
 
-from drakegrasp.plant.analysis import (
-    GraspFromPlant,
-    GraspReport,
-    analyze_grasp,
-    grasp_from_plant,
+from drakegrasp._lazy import lazy_exports
+
+_SOURCES = {
+    "drakegrasp.plant.analysis": (
+        "GraspFromPlant",
+        "GraspReport",
+        "analyze_grasp",
+        "grasp_from_plant",
+    ),
+    "drakegrasp.plant.closing": (
+        "FingerClosure",
+        "HandClosure",
+        "close_hand",
+    ),
+    "drakegrasp.plant.contact_results": ("contacts_from_results",),
+    "drakegrasp.plant.contacts": (
+        "DEFAULT_DISTANCE_TOLERANCE",
+        "PlantContact",
+        "find_contacts",
+        "hand_bodies",
+    ),
+    "drakegrasp.plant.curvature": ("contact_curvatures",),
+    "drakegrasp.plant.jacobians": (
+        "hand_jacobian",
+        "hand_velocity_indices",
+        "signed_distance_jacobian",
+    ),
+    "drakegrasp.plant.models": (
+        "models_dir",
+        "register_models",
+        "use_local_drake_models",
+    ),
+    "drakegrasp.plant.pose": ("PoseCheck",),
+    "drakegrasp.plant.scene": (
+        "DEFAULT_SCENE",
+        "Scene",
+        "SceneInfo",
+        "list_scenes",
+        "load_scene",
+    ),
+}
+
+# Submodules an eager package imported, reachable after ``import drakegrasp.plant``.
+_SUBMODULES = (
+    "_shapes",
+    "analysis",
+    "closing",
+    "contact_results",
+    "contacts",
+    "curvature",
+    "fingers",
+    "jacobians",
+    "models",
+    "pose",
+    "scene",
+    "scene_file",
+    "scene_refs",
+    "validation",
 )
-from drakegrasp.plant.closing import FingerClosure, HandClosure, close_hand
-from drakegrasp.plant.contact_results import contacts_from_results
-from drakegrasp.plant.contacts import (
-    DEFAULT_DISTANCE_TOLERANCE,
-    PlantContact,
-    find_contacts,
-    hand_bodies,
-)
-from drakegrasp.plant.curvature import contact_curvatures
-from drakegrasp.plant.jacobians import (
-    hand_jacobian,
-    hand_velocity_indices,
-    signed_distance_jacobian,
-)
-from drakegrasp.plant.models import models_dir, register_models, use_local_drake_models
-from drakegrasp.plant.pose import PoseCheck
-from drakegrasp.plant.scene import (
-    DEFAULT_SCENE,
-    Scene,
-    SceneInfo,
-    list_scenes,
-    load_scene,
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
 )
 
 __all__ = [
