@@ -9,7 +9,9 @@ arrays, the numba kernel) hold the GIL for most of their time.
 
 At most ``2 × workers`` chunks are in flight, so memory stays bounded by the
 chunk size whatever the number of grasps.  Each chunk's input checks run in
-the worker that solves it, so the parent only slices, sends and collects.
+the worker that solves it, so the parent only slices, sends and collects; its
+large arrays go through shared memory (:mod:`drakegrasp.batch.shared_arrays`)
+instead of the pool's pipe.
 The worker processes are kept between calls (:func:`shutdown_pool`).
 """
 
@@ -23,6 +25,13 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
+from drakegrasp.batch.shared_arrays import (
+    RESULT_ROOM,
+    Slabs,
+    load_result,
+    resolve,
+    store_result,
+)
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["available_cores", "map_ordered", "resolve_workers", "shutdown_pool"]
@@ -54,7 +63,10 @@ def resolve_workers(workers) -> int:
 
 
 def _call(fn: Callable, args: tuple, kwargs: dict):
-    return fn(*args, **kwargs)
+    room = kwargs.pop(RESULT_ROOM, None)
+    args = tuple(resolve(a) for a in args)
+    result = fn(*args, **{k: resolve(v) for k, v in kwargs.items()})
+    return store_result(result, room)
 
 
 def map_ordered(tasks: Iterable[Task], workers: int) -> Iterator:
@@ -78,7 +90,7 @@ def map_ordered(tasks: Iterable[Task], workers: int) -> Iterator:
             yield fn(*args, **kwargs)
         return
     pool = _pool(workers)
-    pending: deque = deque()  # (future, task), in task order
+    pending: deque = deque()  # (future, task, segment), in task order
     restarted = False
 
     def restart():
@@ -86,20 +98,23 @@ def map_ordered(tasks: Iterable[Task], workers: int) -> Iterator:
         # pure functions of their inputs: run them again, in order, on a fresh
         # pool, once; a second death is raised.
         nonlocal pool, restarted
-        shutdown_pool()
+        _stop_pool()  # the segments stay: the chunks in flight are rerun from them
         if restarted:
             raise BrokenProcessPool("a batch worker died twice during one call")
         restarted = True
         pool = _pool(workers)
-        for i, (_, task) in enumerate(pending):
-            pending[i] = (pool.submit(_call, *task), task)
+        for i, (_, task, shm) in enumerate(pending):
+            pending[i] = (pool.submit(_call, *task), task, shm)
 
     def submit(task):
+        fn, args, kwargs = task
+        args, kwargs, shm = _SLABS.pack(args, kwargs)  # large arrays: shared memory
+        task = (fn, args, kwargs)
         try:
-            return pool.submit(_call, *task)
+            return pool.submit(_call, *task), task, shm
         except BrokenProcessPool:  # a worker died since the last submit
             restart()
-            return pool.submit(_call, *task)
+            return pool.submit(_call, *task), task, shm
 
     def next_result():
         while True:
@@ -108,23 +123,28 @@ def map_ordered(tasks: Iterable[Task], workers: int) -> Iterator:
             except BrokenProcessPool:
                 restart()
 
+    def pop():
+        result = load_result(next_result(), _SLABS)
+        _SLABS.release(pending.popleft()[2])  # read by its worker, results copied
+        return result
+
     try:
         for task in tasks:
-            pending.append((submit(task), task))
+            pending.append(submit(task))
             if len(pending) >= 2 * workers:
-                result = next_result()
-                pending.popleft()
-                yield result
+                yield pop()
         while pending:
-            result = next_result()
-            pending.popleft()
-            yield result
+            yield pop()
     finally:
-        for fut, _ in pending:
-            fut.cancel()
+        for fut, _, shm in pending:
+            if fut.cancel() or fut.done():
+                _SLABS.release(shm)
+            else:  # still running: its segment must not be refilled
+                _SLABS.discard(shm)
 
 
 _POOL: dict = {}
+_SLABS = Slabs()  # the parent's shared-memory segments, kept with the pool
 
 
 def _pool(workers: int) -> ProcessPoolExecutor:
@@ -140,7 +160,7 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     pool = _POOL.get("pool")
     if pool is not None and _POOL.get("workers") == workers and _healthy(pool):
         return pool
-    shutdown_pool()
+    _stop_pool()  # its segments stay: chunks in flight may be rerun from them
     # fork where the OS has it: workers start in milliseconds with the parent's
     # modules loaded, and scripts need no ``if __name__ == "__main__"`` guard
     # (forkserver and spawn re-run the main module in every worker).
@@ -164,12 +184,20 @@ def _healthy(pool: ProcessPoolExecutor) -> bool:
     return all(p.exitcode is None for p in processes.values())
 
 
-def shutdown_pool() -> None:
-    """Stop the kept worker processes (if any); the next call starts new ones."""
+def _stop_pool() -> None:
     pool = _POOL.pop("pool", None)
     _POOL.pop("workers", None)
     if pool is not None:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def shutdown_pool() -> None:
+    """Stop the kept worker processes (if any); the next call starts new ones.
+
+    Their shared-memory segments are unlinked too.
+    """
+    _stop_pool()
+    _SLABS.close()
 
 
 atexit.register(shutdown_pool)
