@@ -73,7 +73,10 @@ class Slabs:
         if not big:
             return args, kwargs, None
         need = sum(-(-a.nbytes // _ALIGN) * _ALIGN for a in big)
-        shm = self._take(2 * need)  # the inputs, then room for the results
+        try:
+            shm = self._take(2 * need)  # the inputs, then room for the results
+        except OSError:  # no (or a full) /dev/shm: pickled through the pipe
+            return args, kwargs, None
         cursor = 0
 
         def move(a):

@@ -130,3 +130,19 @@ def test_a_worker_killed_mid_run_leaves_its_tasks_inputs_intact():
     killed = int(out[0]["pid"][0])
     assert killed not in parallel._POOL["pool"]._processes  # a new pool took over
     parallel.shutdown_pool()
+
+
+def test_without_shared_memory_the_arrays_are_pickled(monkeypatch):
+    """No (or a full) /dev/shm: the task keeps its arrays and still runs."""
+
+    def refuse(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(shared_memory, "SharedMemory", refuse)
+    x = np.random.default_rng(9400).normal(size=(20000, 3))
+    slabs = Slabs()
+    args, kwargs, shm = slabs.pack((x,), {})
+    assert shm is None and args[0] is x and RESULT_ROOM not in kwargs
+    out = list(parallel.map_ordered(iter([(_double, (x,), {})] * 3), 2))
+    assert all(r["y"].tobytes() == (2 * x).tobytes() for r in out)
+    parallel.shutdown_pool()
