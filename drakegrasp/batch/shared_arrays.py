@@ -56,6 +56,28 @@ def _shareable(a) -> bool:
     )
 
 
+def _span(a: np.ndarray) -> int:
+    """Bytes an array takes in a segment (aligned)."""
+    return -(-a.nbytes // _ALIGN) * _ALIGN
+
+
+def _put(shm, offset: int, a: np.ndarray) -> SharedArray:
+    """Copy ``a`` into ``shm`` at ``offset``, in the memory order pickle keeps."""
+    order = "F" if a.flags.f_contiguous and not a.flags.c_contiguous else "C"
+    view = np.ndarray(a.shape, a.dtype, buffer=shm.buf, offset=offset, order=order)
+    np.copyto(view, a)
+    del view  # no buffer export may outlive the copy
+    return SharedArray(shm.name, offset, a.shape, a.dtype, order)
+
+
+def _get(shm, x: SharedArray) -> np.ndarray:
+    """A private copy of the array behind ``x`` in ``shm``."""
+    view = np.ndarray(x.shape, x.dtype, buffer=shm.buf, offset=x.offset, order=x.order)
+    out = view.copy(order="K")
+    del view
+    return out
+
+
 class Slabs:
     """The parent's shared-memory segments, one per task in flight."""
 
@@ -72,7 +94,7 @@ class Slabs:
         big = [a for a in (*args, *kwargs.values()) if _shareable(a)]
         if not big:
             return args, kwargs, None
-        need = sum(-(-a.nbytes // _ALIGN) * _ALIGN for a in big)
+        need = sum(_span(a) for a in big)
         try:
             shm = self._take(2 * need)  # the inputs, then room for the results
         except OSError:  # no (or a full) /dev/shm: pickled through the pipe
@@ -83,14 +105,8 @@ class Slabs:
             nonlocal cursor
             if not _shareable(a):
                 return a
-            order = "F" if a.flags.f_contiguous and not a.flags.c_contiguous else "C"
-            view = np.ndarray(
-                a.shape, a.dtype, buffer=shm.buf, offset=cursor, order=order
-            )
-            np.copyto(view, a)
-            del view  # no buffer export may outlive the copy
-            handle = SharedArray(shm.name, cursor, a.shape, a.dtype, order)
-            cursor += -(-a.nbytes // _ALIGN) * _ALIGN
+            handle = _put(shm, cursor, a)
+            cursor += _span(a)
             return handle
 
         args = tuple(move(a) for a in args)
@@ -119,13 +135,7 @@ class Slabs:
 
     def read(self, x: SharedArray) -> np.ndarray:
         """A private copy of an array a worker left in one of these segments."""
-        shm = self._all[x.segment]
-        view = np.ndarray(
-            x.shape, x.dtype, buffer=shm.buf, offset=x.offset, order=x.order
-        )
-        out = view.copy(order="K")
-        del view
-        return out
+        return _get(self._all[x.segment], x)
 
     def discard(self, shm) -> None:
         """Unlink a segment that a task still running may read: never reused."""
@@ -175,16 +185,11 @@ def store_result(result, room):
     shm = _attach(name)
     out = {}
     for key, a in result.items():
-        step = -(-a.nbytes // _ALIGN) * _ALIGN if _shareable(a) else 0
-        if step == 0 or cursor + step > size:
-            out[key] = a
+        if not _shareable(a) or cursor + _span(a) > size:
+            out[key] = a  # pickled with the result
             continue
-        order = "F" if a.flags.f_contiguous and not a.flags.c_contiguous else "C"
-        view = np.ndarray(a.shape, a.dtype, buffer=shm.buf, offset=cursor, order=order)
-        np.copyto(view, a)
-        del view
-        out[key] = SharedArray(name, cursor, a.shape, a.dtype, order)
-        cursor += step
+        out[key] = _put(shm, cursor, a)
+        cursor += _span(a)
     return out
 
 
@@ -200,8 +205,4 @@ def resolve(x):
     """In the worker: a private copy of the array behind a handle, else ``x``."""
     if not isinstance(x, SharedArray):
         return x
-    shm = _attach(x.segment)
-    view = np.ndarray(x.shape, x.dtype, buffer=shm.buf, offset=x.offset, order=x.order)
-    out = view.copy(order="K")
-    del view
-    return out
+    return _get(_attach(x.segment), x)
