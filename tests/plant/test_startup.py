@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import importlib
 import json
+import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -60,12 +62,22 @@ print(json.dumps(sorted(sys.modules)))
 
 
 def fresh_python(code: str, *args: str) -> str:
-    """The output of ``code`` run by a fresh interpreter (which must succeed)."""
+    """The output of ``code`` run by a fresh interpreter (which must succeed).
+
+    It imports the same ``drakegrasp`` as this process (the source tree, or an
+    installed copy: in CI the tests run from the checkout beside an installed
+    package, whose scene paths differ).
+    """
+    root = str(Path(drakegrasp.__file__).resolve().parent.parent)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [root, env.get("PYTHONPATH")]))
     run = subprocess.run(
         [sys.executable, "-c", code, *args],
         capture_output=True,
         text=True,
         timeout=600,
+        env=env,
+        cwd=root,  # ``-c`` puts the working directory first on sys.path
     )
     assert run.returncode == 0, run.stderr
     return run.stdout
