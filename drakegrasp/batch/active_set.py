@@ -222,7 +222,7 @@ def _active_set(AT, nz, R, ct, cn2, max_iter, work):
 
 
 @njit(cache=True, fastmath=_FAST, error_model="numpy")
-def _cross_lam(bx, by, i, j):
+def _cross2(bx, by, i, j):
     """``β_i × β_j`` (the z component of the 2-D cross product)."""
     return bx[i] * by[j] - by[i] * bx[j]
 
@@ -273,7 +273,7 @@ def _plane_lp(AT, R, ct, cn2, al, bx, by, max_iter):
         elif k == 2:
             dx = by[ib] - by[ia]
             dy = bx[ia] - bx[ib]
-            dt = _cross_lam(bx, by, ia, ib)
+            dt = _cross2(bx, by, ia, ib)
             if dt < 0.0:
                 dx, dy, dt = -dx, -dy, -dt
             if dt * dt <= d2 * (dx * dx + dy * dy + dt * dt):
@@ -290,11 +290,11 @@ def _plane_lp(AT, R, ct, cn2, al, bx, by, max_iter):
                 k = 1
                 continue
         else:
-            D = _cross_lam(bx, by, ib, ic) + _cross_lam(bx, by, ic, ia)
-            D += _cross_lam(bx, by, ia, ib)
-            la = _cross_lam(bx, by, ib, ic) / D
-            lb = _cross_lam(bx, by, ic, ia) / D
-            lc = _cross_lam(bx, by, ia, ib) / D
+            xa = _cross2(bx, by, ib, ic)
+            xb = _cross2(bx, by, ic, ia)
+            xc = _cross2(bx, by, ia, ib)
+            D = xa + xb + xc  # twice the signed area of the triangle
+            la, lb, lc = xa / D, xb / D, xc / D
             if la >= -_DUAL_TOL and lb >= -_DUAL_TOL and lc >= -_DUAL_TOL:
                 optimal = True
                 break
@@ -352,8 +352,9 @@ def _plane_lp(AT, R, ct, cn2, al, bx, by, max_iter):
 @njit(cache=True, fastmath=_FAST, error_model="numpy")
 def reduced_lp(AT, nz, R, ct, cn2, max_iter, work):
     """``(t*, ok, steps)`` by :func:`_plane_lp` (``nz = 3``) or :func:`_active_set`."""
-    if nz == 3:
-        return _plane_lp(AT, R, ct, cn2, work[7], work[8], work[9], max_iter)
+    if nz == 3:  # the planar form's α, β_x, β_y live in three R-long work rows
+        _, _, _, _, _, _, _, slack, gnorm, rates, _, _ = work
+        return _plane_lp(AT, R, ct, cn2, slack, gnorm, rates, max_iter)
     return _active_set(AT, nz, R, ct, cn2, max_iter, work)
 
 

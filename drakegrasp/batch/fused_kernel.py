@@ -80,11 +80,11 @@ def _column_rank_stack(Gn, rank_tol, out):
 
 
 def full_column_rank_certain(Gn: np.ndarray, rank_tol: float) -> np.ndarray:
-    """Grasps whose ``G_n`` (K, w, N), ``N <= w``, a QR proves of full column rank.
+    """Matrices ``X`` (K, w, N), ``N <= w``, that a QR proves of full column rank.
 
-    The compiled form of the test in
-    ``drakegrasp.batch.chunks._normal_certificates``; False means unsure
-    (the SVD rule decides), never "deficient".
+    The certificate that ``_full_rank_stack`` applies to each ``G̃ᵀ``, on a
+    stack of its own so tests can hold it against the numpy rule of
+    ``rowspace``; False means unsure (the SVD rule decides), never "deficient".
     """
     out = np.zeros(Gn.shape[0], dtype=np.bool_)
     _column_rank_stack(np.ascontiguousarray(Gn, dtype=float), float(rank_tol), out)

@@ -154,8 +154,8 @@ def test_normal_rank_certificate_agrees_with_the_svd_rule(d, N):
     assert got[ratio > 1e-6].all()  # and not shy
     if N > 1:
         assert not got[rows < 10].any()
-    # The QR certificate of the fused kernel says no more than this one.
-    assert not (full_column_rank_certain(Gn, 1e-9) & ~got & (ratio > 1e-6)).any()
+    # The QR certificate of the fused kernel is sound on the same stacks.
+    assert (ratio[full_column_rank_certain(Gn, 1e-9)] > 1e-9).all()
 
 
 @pytest.mark.parametrize("w", [3, 6])
