@@ -58,15 +58,15 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from drakegrasp._deferred import computed_eagerly  # noqa: E402
-from drakegrasp.antipodal import is_antipodal  # noqa: E402
-from drakegrasp.closure import (  # noqa: E402
+from drakegrasp.closure.verdicts import (  # noqa: E402
     force_closure,
     force_closure_exact,
     form_closure,
     internal_forces,
 )
-from drakegrasp.grasp import grasp_matrix, normalised_grasp_matrix  # noqa: E402
+from drakegrasp.core.antipodal import is_antipodal  # noqa: E402
+from drakegrasp.core.deferred import computed_eagerly  # noqa: E402
+from drakegrasp.core.grasp import grasp_matrix, normalised_grasp_matrix  # noqa: E402
 from drakegrasp.plant import (  # noqa: E402
     DEFAULT_SCENE,
     analyze_grasp,

@@ -35,10 +35,10 @@ from scipy.optimize import linprog  # noqa: E402
 
 from drakegrasp import Contact, Grasp, normal_grasp_matrix  # noqa: E402
 from drakegrasp.batch import batch_force_closure, batch_form_closure  # noqa: E402
-from drakegrasp.friction_cone import ConeLayout  # noqa: E402
+from drakegrasp.core.friction_cone import ConeLayout  # noqa: E402
 
 try:  # the single-grasp MathematicalProgram path
-    from drakegrasp.closure import force_closure, form_closure  # noqa: E402
+    from drakegrasp.closure.verdicts import force_closure, form_closure  # noqa: E402
 except ImportError:  # pragma: no cover
     force_closure = form_closure = None
 

@@ -32,7 +32,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "systems"))
 from pick_support import DURATION, build_pick  # noqa: E402
 
-from drakegrasp.systems import GraspMonitor  # noqa: E402
+from drakegrasp.systems.monitor import GraspMonitor  # noqa: E402
 
 CASES = {
     "point contact, geometry, soft fingers": dict(

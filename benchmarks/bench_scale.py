@@ -76,7 +76,7 @@ from bench_epsilon import HEADER as EPS_HEADER  # noqa: E402
 from drakegrasp import Contact, Grasp  # noqa: E402
 from drakegrasp.batch import batch_force_closure  # noqa: E402
 from drakegrasp.batch.parallel import available_cores  # noqa: E402
-from drakegrasp.closure import force_closure  # noqa: E402
+from drakegrasp.closure.verdicts import force_closure  # noqa: E402
 
 N_FULL = [2, 3, 4, 6, 8, 12, 16, 24, 32]
 N_QUICK = [2, 3, 8, 24]

@@ -27,7 +27,7 @@ from drakegrasp import (  # noqa: E402
     SurfaceCurvature,
     second_order_form_closure,
 )
-from drakegrasp.second_order import build_second_order_program  # noqa: E402
+from drakegrasp.closure.second_order import build_second_order_program  # noqa: E402
 
 P2, P3 = SurfaceCurvature.point(planar=True), SurfaceCurvature.point()
 

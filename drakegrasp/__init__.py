@@ -5,11 +5,12 @@ antipodal grasps decided with Drake's ``MathematicalProgram``; grasps read from 
 ``MultibodyPlant``; quality metrics; pictures; a batch engine for many grasps.
 Conventions: ``docs/conventions.md``.
 
-Layers, inner to outer (an import never points outwards): the numpy core
-(``contact``, ``grasp``, ``friction_cone``, ``antipodal``, ``examples``), the
-programs on ``pydrake.solvers`` (``closure``, ``quality``), the plant adapters
-(``plant``), and the outside ring (``visualization``, ``batch``, ``systems``,
-``cli``).
+Layers as folders, inner to outer (an import never points outwards):
+``core`` (numpy only: contacts, G, cones, antipodal, curvature, validation),
+``certificates`` (witnesses, their check and wording), ``closure`` (the
+programs, verdicts and second order), then ``quality`` and ``plant``, then the
+outer ring ``batch``, ``systems``, ``visualization``, ``distributed`` and
+``cli``.  ``docs/architecture.md`` draws the map.
 
 Every public name is imported from its module when it is first read
 (``drakegrasp._lazy``), so ``import drakegrasp`` and the ``drakegrasp``
@@ -21,7 +22,7 @@ from drakegrasp._lazy import lazy_exports
 
 # Where each public name lives (the imports an eager package would run).
 _SOURCES = {
-    "drakegrasp.antipodal": ("is_antipodal",),
+    "drakegrasp.core.antipodal": ("AntipodalResult", "is_antipodal"),
     "drakegrasp.batch": (
         "BatchClosureResult",
         "batch_epsilon_l1",
@@ -29,26 +30,28 @@ _SOURCES = {
         "batch_form_closure",
         "evaluate_file",
     ),
-    "drakegrasp.closure": (
-        "DEFAULT_TOL",
+    "drakegrasp.closure.programs": (
         "ProgramVariables",
         "build_exact_force_closure_program",
         "build_force_closure_program",
         "build_form_closure_program",
         "build_internal_force_program",
+    ),
+    "drakegrasp.closure.verdicts": (
         "force_closure",
         "force_closure_exact",
         "form_closure",
         "internal_forces",
-        "matrix_rank",
     ),
-    "drakegrasp.contact": (
+    "drakegrasp.core.contact": (
         "Contact",
         "ContactModel",
         "contact_frame",
         "contact_frames",
     ),
-    "drakegrasp.curvature": (
+    "drakegrasp.core.linalg": ("matrix_rank",),
+    "drakegrasp.core.tolerances": ("DEFAULT_TOL",),
+    "drakegrasp.core.curvature": (
         "ContactCurvature",
         "SurfaceCurvature",
     ),
@@ -68,11 +71,11 @@ _SOURCES = {
         "SolverError",
         "UnreachableError",
     ),
-    "drakegrasp.friction_cone": (
+    "drakegrasp.core.friction_cone": (
         "friction_cone_facets",
         "friction_cone_generators",
     ),
-    "drakegrasp.grasp": (
+    "drakegrasp.core.grasp": (
         "Grasp",
         "grasp_matrix",
         "normal_grasp_matrix",
@@ -114,16 +117,15 @@ _SOURCES = {
         "uniformity_of_transformation",
         "wrench_ellipsoid_volume",
     ),
-    "drakegrasp.results": (
-        "AntipodalResult",
+    "drakegrasp.closure.results": (
         "ClosureResult",
         "InternalForceResult",
     ),
-    "drakegrasp.second_order": (
+    "drakegrasp.closure.second_order": (
         "SecondOrderResult",
         "second_order_form_closure",
     ),
-    "drakegrasp.systems": (
+    "drakegrasp.systems.monitor": (
         "GraspMonitor",
         "GraspSample",
         "add_grasp_monitor",
@@ -136,34 +138,23 @@ _SOURCES = {
     ),
 }
 
-# Submodules an eager package imported, so ``drakegrasp.batch`` keeps working
-# after a bare ``import drakegrasp``.
-_SUBMODULES = (
-    "_deferred",
-    "_dense_constraints",
-    "antipodal",
-    "batch",
-    "certificate_check",
-    "certificate_kinds",
-    "certificate_text",
-    "certificates",
-    "closure",
-    "cone_support",
-    "contact",
-    "curvature",
-    "errors",
-    "examples",
-    "friction_cone",
-    "grasp",
-    "plant",
-    "quality",
-    "results",
-    "second_order",
-    "systems",
-    "validation",
-    "visualization",
-    "witness",
-)
+# Subpackages reachable as attributes after a bare ``import drakegrasp``, and
+# ``drakegrasp.examples``, the textbook grasps the README uses.
+_SUBMODULES = {
+    name: f"drakegrasp.{name}"
+    for name in (
+        "batch",
+        "certificates",
+        "closure",
+        "core",
+        "distributed",
+        "errors",
+        "plant",
+        "quality",
+        "systems",
+        "visualization",
+    )
+} | {"examples": "drakegrasp.core.examples"}
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(), _SOURCES, submodules=_SUBMODULES

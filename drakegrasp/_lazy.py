@@ -25,7 +25,7 @@ def lazy_exports(
     namespace: dict[str, Any],
     sources: Mapping[str, Iterable[str]],
     *,
-    submodules: Iterable[str] = (),
+    submodules: Iterable[str] | Mapping[str, str] = (),
 ) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
     """``__getattr__`` and ``__dir__`` for a package with lazy public names.
 
@@ -37,9 +37,10 @@ def lazy_exports(
         The package's ``globals()``: a resolved name is stored there.
     sources : mapping of str to iterable of str
         ``{module: names}``: each public name and the module that defines it.
-    submodules : iterable of str, optional
+    submodules : iterable of str, or mapping of str to str, optional
         Submodules reachable as attributes (``drakegrasp.batch``), imported on
-        first access.
+        first access; a mapping gives the full module path of each attribute
+        (``{"examples": "drakegrasp.core.examples"}``).
 
     Returns
     -------
@@ -47,20 +48,24 @@ def lazy_exports(
         To be assigned to the package's ``__getattr__`` and ``__dir__``.
     """
     where = {name: module for module, names in sources.items() for name in names}
-    children = frozenset(submodules)
+    children = (
+        dict(submodules)
+        if isinstance(submodules, Mapping)
+        else {name: f"{package}.{name}" for name in submodules}
+    )
 
     def __getattr__(name: str) -> Any:
         module = where.get(name)
         if module is not None:
             value = getattr(importlib.import_module(module), name)
         elif name in children:
-            value = importlib.import_module(f"{package}.{name}")
+            value = importlib.import_module(children[name])
         else:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
         namespace[name] = value
         return value
 
     def __dir__() -> list[str]:
-        return sorted(set(namespace) | set(where) | children)
+        return sorted(set(namespace) | set(where) | set(children))
 
     return __getattr__, __dir__

@@ -41,7 +41,8 @@ import os
 import sys
 from collections.abc import Sequence
 
-from drakegrasp.contact import ContactModel
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.errors import GraspError, InvalidOptionError
 
 __all__ = ["build_parser", "main"]
@@ -127,7 +128,7 @@ def _cmd_batch(args: argparse.Namespace) -> int:
         "fmt": args.format,
     }
     if args.scheduler is not None:
-        from drakegrasp.distributed import stream_file_on_cluster
+        from drakegrasp.distributed.batch_side import stream_file_on_cluster
 
         summary = stream_file_on_cluster(
             args.input, args.output, scheduler=args.scheduler, **options
@@ -309,7 +310,7 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "the file has it (0 makes soft fingers act as hard ones)",
     )
     batch.add_argument(
-        "--tol", type=_positive_float, default=1e-6, help="threshold on d*"
+        "--tol", type=_positive_float, default=DEFAULT_TOL, help="threshold on d*"
     )
     batch.add_argument(
         "--metrics",

@@ -242,7 +242,7 @@ print(
 # analysis refuses (deep penetration, a joint beyond its limits).
 
 # %%
-from drakegrasp.systems import VERDICT_NAMES, GraspMonitor
+from drakegrasp.systems.monitor import VERDICT_NAMES, GraspMonitor
 
 context = pick["simulator"].get_context()
 log = pick["logs"]["verdicts"].FindLog(context)

@@ -1,7 +1,7 @@
 """Resolve references to drakegrasp objects by the names users import them by.
 
 The API reference documents every object once, in the module that defines it
-(``drakegrasp.grasp.Grasp``), while docstrings and pages also name the public
+(``drakegrasp.core.grasp.Grasp``), while docstrings and pages also name the public
 re-exports (``drakegrasp.Grasp``, or ``ferrari_canny`` inside
 ``drakegrasp.quality``).  For a reference Sphinx could not resolve, this
 extension imports the named object and, when its defining module's entry is

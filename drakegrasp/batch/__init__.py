@@ -2,7 +2,7 @@
 
 :func:`batch_force_closure` (LP2) and :func:`batch_form_closure` (LP1) decide
 closure for ``K`` grasps with ``N`` contacts each, with the conventions and
-verdicts of :mod:`drakegrasp.closure`; :func:`batch_epsilon_l1` gives their
+verdicts of :mod:`drakegrasp.closure.verdicts`; :func:`batch_epsilon_l1` gives their
 Ferrari–Canny L1 ε; :func:`iter_batch_closure` consumes a stream of chunks
 lazily; :func:`evaluate_file` runs them on a ``.npz`` file (the ``drakegrasp
 batch`` command).

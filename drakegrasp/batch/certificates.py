@@ -3,7 +3,7 @@
 :func:`batch_certificates` takes the arrays a batch was run on and its
 :class:`~drakegrasp.batch.BatchClosureResult`, and returns, for every grasp
 whose verdict is "no", the same witness as the single-grasp path
-(:mod:`drakegrasp.certificates`): an escape twist for form closure, an
+(:mod:`drakegrasp.certificates.certificate`): an escape twist for form closure, an
 unresisted wrench (polyhedral cones) for force closure.  The witnesses are
 computed per failing grasp with the core's witness programs, which take a
 fraction of a verdict's time (``benchmarks/bench_core.py``); a "yes" carries
@@ -11,7 +11,7 @@ no witness here, because the batched interior-point method does not keep the
 optimal forces.
 
 Every twist and wrench is in the grasp's frame about its reference point, with
-the orders and scalings of :class:`~drakegrasp.certificates.Certificate`.
+the orders and scalings of :class:`~drakegrasp.certificates.certificate.Certificate`.
 """
 
 from __future__ import annotations
@@ -26,18 +26,19 @@ from drakegrasp.batch.construction import (
     batched_normal_grasp_matrix,
     contact_kinds,
 )
-from drakegrasp.certificates import Certificate, CertificateCheck
-from drakegrasp.closure import DEFAULT_RANK_TOL, _balance_matrix, _balance_rank
-from drakegrasp.contact import Contact, ContactModel
-from drakegrasp.errors import InvalidOptionError
-from drakegrasp.friction_cone import ConeLayout
-from drakegrasp.grasp import Grasp
-from drakegrasp.witness import (
+from drakegrasp.certificates.certificate import Certificate, CertificateCheck
+from drakegrasp.certificates.witness import (
     GraspFrame,
     escape_twist,
     null_space_certificate,
     unresisted_wrench,
 )
+from drakegrasp.closure.programs import balance_matrix, balance_rank
+from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.friction_cone import ConeLayout
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
+from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["BatchCertificates", "batch_certificates", "grasp_at"]
 
@@ -110,7 +111,7 @@ def _null_space_witnesses(
 
     The normalised balance matrices of the rows are built at once (moments
     about each grasp's contacts' centroid over their spread, as
-    :func:`~drakegrasp.grasp.normalised_grasp_matrix`), and each row's left
+    :func:`~drakegrasp.core.grasp.normalised_grasp_matrix`), and each row's left
     null space at the batch's rank is the witness.  A row whose trailing
     singular values are not numerically zero (the ranks disagree) is left to
     the per-grasp path.
@@ -192,7 +193,7 @@ def _core_rank(grasp: Grasp, form: bool, num_generators: int) -> int:
         cols = grasp.normal_indices()
     else:
         cols = ConeLayout.of(grasp, num_generators).columns
-    return _balance_rank(_balance_matrix(grasp, cols), DEFAULT_RANK_TOL)
+    return balance_rank(balance_matrix(grasp, cols), DEFAULT_RANK_TOL)
 
 
 def grasp_at(

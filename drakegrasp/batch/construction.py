@@ -2,8 +2,9 @@ r"""Vectorised contact frames, grasp matrices and friction-cone facets (numpy on
 
 The single-grasp path builds one :class:`~drakegrasp.Grasp` at a time; here the
 same objects are built for a stack of ``K`` grasps with ``N`` contacts each, with
-exactly the conventions of :mod:`drakegrasp.contact`, :mod:`drakegrasp.grasp` and
-:mod:`drakegrasp.friction_cone` (``docs/conventions.md``):
+exactly the conventions of :mod:`drakegrasp.core.contact`,
+:mod:`drakegrasp.core.grasp` and :mod:`drakegrasp.core.friction_cone`
+(``docs/conventions.md``):
 
 * contact frames come from :func:`drakegrasp.contact_frames` (same ``t1``);
 * ``G_i = [R_i; S(c_i - p) R_i]`` restricted to the contact's *effective*
@@ -22,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.contact import contact_frames
-from drakegrasp.friction_cone import soft_finger_facets, torsion_only_facets
+from drakegrasp.core.contact import contact_frames
+from drakegrasp.core.friction_cone import soft_finger_facets, torsion_only_facets
 
 __all__ = [
     "KIND_COMPONENTS",
@@ -245,7 +246,7 @@ def kind_facets(
     -------
     F : (K, r_i, k_i) float
         Rows over the kind's effective components, as
-        :func:`drakegrasp.friction_cone.effective_cone` builds them.
+        :func:`drakegrasp.core.friction_cone.effective_cone` builds them.
     """
     K = mu.shape[0]
     if kind == FRICTIONLESS:

@@ -3,12 +3,12 @@ r"""Form and force closure of many grasps at once, streamed in chunks.
 :func:`batch_force_closure` and :func:`batch_form_closure` take ``K`` grasps of
 ``N`` contacts as stacked arrays and return a :class:`BatchClosureResult` of
 arrays.  Verdicts and ``d*`` follow the single-grasp programs of
-:mod:`drakegrasp.closure` exactly (same frames, effective cones, unit facet rows,
-budget ``Σ f_n <= N``, rank threshold and ``tol``); only the solver differs: the
-LPs are reduced on the null space of ``G`` (:mod:`drakegrasp.batch.reduction`)
-and solved together by a batched interior-point method
-(:mod:`drakegrasp.batch.ipm`).  ``d*`` agrees with the ``MathematicalProgram``
-path to about 1e-8 absolute (tested at 1e-6).
+:mod:`drakegrasp.closure.verdicts` exactly (same frames, effective cones, unit
+facet rows, budget ``Σ f_n <= N``, rank threshold and ``tol``); only the solver
+differs: each chunk's LPs are solved on the null space of ``G`` by compiled
+kernels (an exact active-set method for small null spaces, a block
+interior-point method for the rest; :mod:`drakegrasp.batch.margin`).  ``d*``
+agrees with the ``MathematicalProgram`` path to about 1e-8 absolute.
 
 The inputs are processed ``chunk_size`` grasps at a time: only one chunk's
 matrices exist at any moment, and inputs may be memory-mapped arrays.
@@ -24,10 +24,9 @@ import numpy as np
 
 from drakegrasp.batch.chunks import force_chunk, form_chunk
 from drakegrasp.batch.parallel import map_ordered, resolve_workers
-from drakegrasp.contact import ContactModel
-from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOptionError
-from drakegrasp.results import ZERO_FRACTION
-from drakegrasp.validation import (
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL, ZERO_FRACTION
+from drakegrasp.core.validation import (
     LENGTH_BOUND,
     POSITION_BOUND,
     check_coefficient,
@@ -41,6 +40,7 @@ from drakegrasp.validation import (
     real_array,
     unit_vectors,
 )
+from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOptionError
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -78,8 +78,6 @@ MIN_CHUNK_CONTACTS = 6144
 0.5 ms besides its grasps (measured: 3 contacts per grasp, 170k grasps/s in
 chunks of 256 grasps, 255k in 1024, 265k in 2048)."""
 
-DEFAULT_TOL = 1e-6
-DEFAULT_RANK_TOL = 1e-9
 
 METRICS = ("sigma_min", "isotropy", "ellipsoid_volume", "epsilon_l1")
 """Metric names that ``metrics=`` accepts; see :func:`batch_force_closure`."""
@@ -270,7 +268,7 @@ def _check_positions(P: np.ndarray, start: int) -> None:
         raise InvalidContactError(
             f"position of grasp {start + k}, contact {i} is {P[k, i].tolist()}: "
             "not finite or out of range; it must be finite with "
-            f"|x| <= {POSITION_BOUND:g} m (drakegrasp.validation.POSITION_BOUND)"
+            f"|x| <= {POSITION_BOUND:g} m (drakegrasp.core.validation.POSITION_BOUND)"
         )
 
 
@@ -715,7 +713,7 @@ def batch_force_closure(
         naming the grasp and contact.
     mu : float, (K,) or (K, N) float
         Coulomb friction coefficients: 0 or in ``[1e-12, 1e12]`` (the range of
-        :mod:`drakegrasp.validation`, the same as the single-grasp path).  A
+        :mod:`drakegrasp.core.validation`, the same as the single-grasp path).  A
         hard finger with ``μ = 0`` acts as frictionless, as in the single-grasp
         path.
     model : {"hard_finger", "frictionless", "soft_finger"}, optional

@@ -40,7 +40,7 @@ import numpy as np
 from drakegrasp.batch.construction import batched_characteristic_lengths
 from drakegrasp.batch.engine import DEFAULT_CHUNK_SIZE, _force_task, _stream
 from drakegrasp.batch.metrics import epsilon_l1_batch
-from drakegrasp.contact import ContactModel
+from drakegrasp.core.contact import ContactModel
 
 __all__ = ["batch_epsilon_l1", "epsilon_chunk"]
 

@@ -52,9 +52,9 @@ from drakegrasp.batch.engine import (
     batch_force_closure,
     batch_form_closure,
 )
-from drakegrasp.contact import ContactModel
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import BatchFileError, GraspError, InvalidOptionError
-from drakegrasp.validation import check_flag
 
 __all__ = ["BatchFileError", "evaluate_file", "read_grasps", "write_result"]
 
@@ -369,7 +369,7 @@ def evaluate_file(
         Unreadable, damaged or non-``.npz`` input; an output that is the input
         or that exists without ``overwrite``.
     GraspError
-        Any invalid grasp or option (see :mod:`drakegrasp.validation`).
+        Any invalid grasp or option (see :mod:`drakegrasp.core.validation`).
     """
     if kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")

@@ -78,8 +78,8 @@ def epsilon_l1_per_grasp(
             "metric 'epsilon_l1' needs drakegrasp.quality.ferrari_canny, which "
             "this installation does not provide"
         ) from exc
-    from drakegrasp.contact import Contact
-    from drakegrasp.grasp import Grasp
+    from drakegrasp.core.contact import Contact
+    from drakegrasp.core.grasp import Grasp
 
     out = np.empty(P.shape[0])
     for k in range(P.shape[0]):

@@ -103,7 +103,7 @@ def null_spaces(G: np.ndarray, *, rank_tol: float):
     G : (K, w, M) float
     rank_tol : float
         Singular values ``<= rank_tol * σ_max`` count as zero (as
-        :func:`drakegrasp.closure.matrix_rank`).
+        :func:`drakegrasp.core.linalg.matrix_rank`).
 
     Returns
     -------

@@ -4,7 +4,7 @@ The batch counterpart of :func:`drakegrasp.quality.primitive_wrenches`: the
 wrench ``w_ik = S G_i s_k`` of every friction-cone generator ``s_k`` of every
 contact, moments divided by the torque scale ``b``, with the frames of
 :func:`drakegrasp.contact_frames` and the generators of
-:mod:`drakegrasp.friction_cone` (``s_k = [1, μ cos(2πk/n_g), μ sin(2πk/n_g)]``,
+:mod:`drakegrasp.core.friction_cone` (``s_k = [1, μ cos(2πk/n_g), μ sin(2πk/n_g)]``,
 a soft finger adding ``[1, 0, 0, ±b ν]``).
 
 A stack needs one count of wrenches per contact, so contacts with fewer
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.contact import contact_frames
+from drakegrasp.core.contact import contact_frames
 
 __all__ = ["batched_primitive_wrenches", "wrenches_per_contact"]
 

@@ -30,10 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
+from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
 from drakegrasp.errors import InvalidOptionError
-
-_DEFAULT_TOL = 1e-6
-_DEFAULT_RANK_TOL = 1e-9
 
 __all__ = ["FORMATS", "BatchSummary", "format_of", "stream_file", "write_chunks"]
 
@@ -253,8 +251,8 @@ def stream_file(
     model: str = "hard_finger",
     num_generators: int = 8,
     torsional_friction: float | None = None,
-    tol: float = _DEFAULT_TOL,
-    rank_tol: float = _DEFAULT_RANK_TOL,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
     chunk_size: int | None = None,
     progress: bool = False,
     metrics=(),
@@ -279,7 +277,7 @@ def stream_file(
     """
     import drakegrasp.batch.io as io
     from drakegrasp.batch.engine import stream_force_closure, stream_form_closure
-    from drakegrasp.validation import check_flag
+    from drakegrasp.core.validation import check_flag
 
     overwrite = check_flag("overwrite", overwrite)
     source = io._as_path("input", input_path)

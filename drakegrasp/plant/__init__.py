@@ -1,8 +1,8 @@
 """The Drake plant layer: models, scenes, contacts, Jacobians and grasp analysis.
 
 Everything here takes ``(plant, plant_context, ...)`` as Drake users expect and
-builds on the numpy core (:mod:`drakegrasp.contact`, :mod:`drakegrasp.grasp`,
-:mod:`drakegrasp.closure`); the core never imports this package.  The context
+builds on the numpy core (:mod:`drakegrasp.core.contact`, :mod:`drakegrasp.core.grasp`,
+:mod:`drakegrasp.closure.verdicts`); the core never imports this package.  The context
 may be the plant's or the root context of the diagram that holds the plant, and
 ``object_body`` may be positional (``find_contacts(plant, context, body)``); the
 options after it are keyword-only (:mod:`drakegrasp.plant.validation`).

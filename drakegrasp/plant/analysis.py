@@ -18,20 +18,23 @@ from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
-from drakegrasp._deferred import defer, deferrable
-from drakegrasp.antipodal import is_antipodal
-from drakegrasp.closure import (
-    DEFAULT_TOL,
+from drakegrasp.closure.results import ClosureResult
+from drakegrasp.closure.second_order import SecondOrderResult, second_order_form_closure
+from drakegrasp.closure.verdicts import (
     force_closure,
     force_closure_exact,
     form_closure,
     internal_forces,
     with_internal_forces,
 )
-from drakegrasp.contact import Contact, ContactModel
+from drakegrasp.core.antipodal import AntipodalResult, is_antipodal
+from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.deferred import defer, deferrable
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.errors import GraspError, InvalidOptionError, NoContactsError
-from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.plant.contacts import (
     DEFAULT_DISTANCE_TOLERANCE,
     HandSpec,
@@ -55,8 +58,6 @@ from drakegrasp.plant.validation import (
     hand_model_instances,
     plant_context_of,
 )
-from drakegrasp.results import AntipodalResult, ClosureResult, _jsonable
-from drakegrasp.second_order import SecondOrderResult, second_order_form_closure
 
 __all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
 
@@ -109,7 +110,7 @@ class GraspFromPlant:
 
     @property
     def G(self) -> np.ndarray:
-        """Grasp matrix of :attr:`grasp`, (6, M) or (3, M)."""
+        """Grasp matrix of ``self.grasp``, (6, M) or (3, M)."""
         return grasp_matrix(self.grasp)
 
     def to_dict(self) -> dict:
@@ -120,10 +121,10 @@ class GraspFromPlant:
             "plane": self.plane,
             "grasp": self.grasp.to_dict(),
             "contacts": [c.to_dict() for c in self.contacts],
-            "psi": _jsonable(self.psi),
+            "psi": jsonable(self.psi),
             "hand_velocity_indices": self.hand_velocity_indices.tolist(),
-            "hand_jacobian": _jsonable(self.hand_jacobian),
-            "dpsi_dv": _jsonable(self.dpsi_dv),
+            "hand_jacobian": jsonable(self.hand_jacobian),
+            "dpsi_dv": jsonable(self.dpsi_dv),
             "pose": None if self.pose is None else self.pose.to_dict(),
         }
 
@@ -412,13 +413,13 @@ class GraspReport:
         """JSON-ready dictionary of the whole report."""
         return {
             **self.data.to_dict(),
-            "G": _jsonable(self.G),
+            "G": jsonable(self.G),
             "form_closure": self.form_closure.to_dict(),
             "force_closure": self.force_closure.to_dict(),
             "force_closure_exact": self.force_closure_exact.to_dict(),
             "antipodal": None if self.antipodal is None else self.antipodal.to_dict(),
             "pose": None if self.pose is None else self.pose.to_dict(),
-            "second_order": _jsonable(self.second_order),
+            "second_order": jsonable(self.second_order),
         }
 
     def __str__(self) -> str:
@@ -507,7 +508,7 @@ def analyze_grasp(
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
     tol : float, optional
-        Threshold on ``d*`` of every program (see :mod:`drakegrasp.closure`).
+        Threshold on ``d*`` of every program (see :mod:`drakegrasp.closure.verdicts`).
 
     Returns
     -------

@@ -42,7 +42,7 @@ from pydrake.geometry import (
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
-from drakegrasp.curvature import ContactCurvature, SurfaceCurvature
+from drakegrasp.core.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import flat_faces, surface_pieces
 from drakegrasp.plant.contacts import PlantContact, resolve_object_body

@@ -28,8 +28,8 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable, JointIndex, RigidBody
 from pydrake.systems.framework import Context
 
-from drakegrasp.contact import ContactModel
-from drakegrasp.grasp import Grasp
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.grasp import Grasp
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.validation import (
     _per_plant,

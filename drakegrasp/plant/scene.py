@@ -121,7 +121,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
-from drakegrasp.contact import ContactModel
+from drakegrasp.core.contact import ContactModel
 from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.models import models_dir
 from drakegrasp.plant.scene_file import check_section, read_yaml

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import yaml
 
-from drakegrasp.contact import ContactModel
+from drakegrasp.core.contact import ContactModel
 from drakegrasp.errors import GraspError, SceneError
 from drakegrasp.plant.jacobians import PLANES
 

@@ -22,7 +22,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context
 
-from drakegrasp._deferred import WeakMemo
+from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.errors import InvalidContextError, InvalidOptionError, ModelError
 
 __all__ = [

@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from drakegrasp.core.grasp import Grasp, grasp_matrix
+from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
+from drakegrasp.core.validation import check_grasp, check_length
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.grasp import Grasp, grasp_matrix
-from drakegrasp.validation import check_grasp, check_length
 
-RANK_TOL = 1e-9
-"""Singular values below ``RANK_TOL * σ_max`` count as zero (rank tests here)."""
+RANK_TOL = DEFAULT_RANK_TOL
+"""Singular values below ``RANK_TOL * σ_max`` count as zero (the default)."""
 
 
 def _check_grasp(grasp: Grasp) -> Grasp:
@@ -42,18 +41,3 @@ def _padded_singular_values(A: np.ndarray) -> np.ndarray:
         sv = np.linalg.svd(A, compute_uv=False)
         s[: sv.size] = sv[:rows]
     return s
-
-
-def _jsonable(value):
-    if isinstance(value, np.ndarray):
-        return [_jsonable(v) for v in value.tolist()]
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, (float, np.floating)):
-        x = float(value)
-        return x if math.isfinite(x) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    return value

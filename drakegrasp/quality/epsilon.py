@@ -13,16 +13,19 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from drakegrasp.core.friction_cone import (
+    DEFAULT_NUM_GENERATORS,
+    friction_cone_generators,
+)
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidOptionError, SolverError
-from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, friction_cone_generators
-from drakegrasp.grasp import Grasp
 from drakegrasp.quality._common import (
     RANK_TOL,
     _check_grasp,
     _scaled_grasp_matrix,
     _torque_scale,
 )
-from drakegrasp.validation import check_num_generators
 
 if TYPE_CHECKING:
     from scipy.spatial import ConvexHull

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from drakegrasp.grasp import Grasp, check_hand_jacobian
+from drakegrasp.core.grasp import Grasp, check_hand_jacobian
 from drakegrasp.quality._common import (
     RANK_TOL,
     _check_grasp,

@@ -5,13 +5,15 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 
 import numpy as np
-from pydrake.solvers import ClpSolver, MathematicalProgram, SolutionResult
+from pydrake.solvers import MathematicalProgram
 
-from drakegrasp.errors import InvalidOptionError, SolverError
-from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
-from drakegrasp.grasp import Grasp
-from drakegrasp.quality._common import _check_grasp, _jsonable
-from drakegrasp.validation import real_array
+from drakegrasp._solvers import require_solution, solve
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import real_array
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.quality._common import _check_grasp
 
 __all__ = [
     "MaxWrenchResult",
@@ -81,7 +83,7 @@ class MaxWrenchResult:
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (non-finite numbers become ``None``)."""
-        return {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+        return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
 
     def __str__(self) -> str:
         fn = ", ".join(f"{f[0]:.4g}" for f in self.contact_forces)
@@ -222,19 +224,9 @@ def max_resistible_wrench(
         max_normal_force=max_normal_force,
         num_generators=num_generators,
     )
-    solver = ClpSolver()
-    if not (solver.available() and solver.enabled()):  # pragma: no cover
-        raise SolverError("Clp is not available (it ships with Drake)", program=prog)
-    result = solver.Solve(prog)
+    result = require_solution(prog, solve(prog, "lp"), "the max-resistible-wrench LP")
     status = result.get_solution_result()
     name = result.get_solver_id().name()
-    if status != SolutionResult.kSolutionFound:
-        raise SolverError(
-            f"{name} failed with status {status.name} on the max-resistible-wrench "
-            "LP (always feasible and bounded, so this is a numerical failure)",
-            program=prog,
-            result=result,
-        )
     d = _check_direction(grasp, direction)
     alpha = max(float(result.GetSolution(v.alpha)), 0.0)
     full = np.zeros(grasp.num_components)

@@ -7,15 +7,17 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.grasp import Grasp, check_hand_jacobian
-from drakegrasp.quality._common import _check_grasp, _jsonable, _torque_scale
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.grasp import Grasp, check_hand_jacobian
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_TOL
+from drakegrasp.core.validation import check_flag
+from drakegrasp.quality._common import _check_grasp, _torque_scale
 from drakegrasp.quality.epsilon import ferrari_canny
 from drakegrasp.quality.indices import (
     grasp_singular_values,
     hand_object_singular_values,
 )
-from drakegrasp.validation import check_flag
 
 __all__ = ["GraspQuality", "grasp_quality", "lp2_margin"]
 
@@ -24,7 +26,7 @@ def lp2_margin(
     grasp: Grasp,
     *,
     num_generators: int = DEFAULT_NUM_GENERATORS,
-    tol: float = 1e-6,
+    tol: float = DEFAULT_TOL,
 ) -> float:
     r"""The optimal ``d*`` of LP2 (frictional force closure) as a quality metric.
 
@@ -34,8 +36,8 @@ def lp2_margin(
     num_generators : int, optional
         Generators ``n_g`` of each spatial Coulomb cone (default 8).
     tol : float, optional
-        Passed to :func:`~drakegrasp.closure.force_closure` (it only affects the
-        verdict there, not ``d*``).
+        Passed to :func:`~drakegrasp.closure.verdicts.force_closure` (it only
+        affects the verdict there, not ``d*``).
 
     Returns
     -------
@@ -50,9 +52,9 @@ def lp2_margin(
         can stay inside every cone facet.  Dimensionless (newtons per newton of
         normal force).  It says nothing about the rank of ``G``: force closure
         needs ``rank(G)`` full as well (see
-        :func:`~drakegrasp.closure.force_closure`).
+        :func:`~drakegrasp.closure.verdicts.force_closure`).
     """
-    from drakegrasp.closure import force_closure  # the closure programs' owner
+    from drakegrasp.closure.verdicts import force_closure  # the closure programs' owner
 
     _check_grasp(grasp)
     result = force_closure(grasp, num_generators=num_generators, tol=tol)
@@ -111,7 +113,7 @@ class GraspQuality:
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (non-finite numbers become ``None``)."""
-        return {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+        return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
 
     def __str__(self) -> str:
         def fmt(x):
@@ -142,7 +144,7 @@ def grasp_quality(
     hand_jacobian: np.ndarray | None = None,
     num_generators: int = DEFAULT_NUM_GENERATORS,
     torque_scale: float | None = None,
-    tol: float = 1e-6,
+    tol: float = DEFAULT_TOL,
     linf: bool | None = None,
 ) -> GraspQuality:
     """Compute every quality metric of a grasp.
@@ -170,7 +172,7 @@ def grasp_quality(
     -------
     GraspQuality
     """
-    from drakegrasp.closure import force_closure  # the closure programs' owner
+    from drakegrasp.closure.verdicts import force_closure  # the closure programs' owner
 
     _check_grasp(grasp)
     if linf is not None:

@@ -21,9 +21,13 @@ from typing import Any
 
 import numpy as np
 
-from drakegrasp.certificate_text import screw_point
-from drakegrasp.certificates import ESCAPE_TWIST, UNRESISTED_WRENCH, Certificate
-from drakegrasp.grasp import Grasp
+from drakegrasp.certificates.certificate import (
+    ESCAPE_TWIST,
+    UNRESISTED_WRENCH,
+    Certificate,
+)
+from drakegrasp.certificates.text import screw_point
+from drakegrasp.core.grasp import Grasp
 
 __all__ = [
     "CertificateArtists",

@@ -23,8 +23,12 @@ import numpy as np
 from pydrake.geometry import Meshcat, Rgba, Sphere
 from pydrake.math import RigidTransform
 
-from drakegrasp.certificates import ESCAPE_TWIST, UNRESISTED_WRENCH, Certificate
-from drakegrasp.grasp import Grasp
+from drakegrasp.certificates.certificate import (
+    ESCAPE_TWIST,
+    UNRESISTED_WRENCH,
+    Certificate,
+)
+from drakegrasp.core.grasp import Grasp
 from drakegrasp.visualization.primitives import _draw_arrow
 
 __all__ = [

@@ -3,7 +3,8 @@ r"""Animate a form-closure "no": the object moves along its escape twist.
 :func:`animate_escape` draws every body of the plant at its pose in the given
 context (the fingers stay where they are) and records a Meshcat animation in
 which the object follows the rigid motion ``exp(t ξ)`` of its escape twist ``ξ``
-(:class:`~drakegrasp.certificates.Certificate`, frame O about its origin), for
+(:class:`~drakegrasp.certificates.certificate.Certificate`, frame O about its
+origin), for
 ``t`` from 0 to ``amount · b`` (and back through ``−`` when both signs escape).
 
 The motion of a constant twist ``ξ = (v_O, ω)`` (``v_O`` the velocity of O's
@@ -27,7 +28,7 @@ from pydrake.geometry import Meshcat, MeshcatAnimation, Rgba, Role
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import BodyIndex
 
-from drakegrasp.certificates import ESCAPE_TWIST, Certificate
+from drakegrasp.certificates.certificate import ESCAPE_TWIST, Certificate
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.jacobians import PLANES
 

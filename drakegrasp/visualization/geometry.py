@@ -29,10 +29,10 @@ from typing import Any
 
 import numpy as np
 
-from drakegrasp.contact import Contact
+from drakegrasp.core.contact import Contact
+from drakegrasp.core.friction_cone import friction_cone_generators
+from drakegrasp.core.grasp import Grasp
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.friction_cone import friction_cone_generators
-from drakegrasp.grasp import Grasp
 
 __all__ = [
     "contact_forces_in_grasp_frame",

@@ -30,9 +30,9 @@ import numpy as np
 from pydrake.geometry import Cylinder, Meshcat, Rgba, Sphere
 from pydrake.math import RigidTransform, RotationMatrix
 
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.grasp import Grasp
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.grasp import Grasp
 from drakegrasp.visualization.certificates import draw_result_certificate
 from drakegrasp.visualization.geometry import (
     contact_pose_3d,

@@ -17,9 +17,9 @@ from typing import Any
 
 import numpy as np
 
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.validation import check_length
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.grasp import Grasp
-from drakegrasp.validation import check_length
 from drakegrasp.visualization.geometry import (
     cone_edge_directions,
     contact_forces_in_grasp_frame,
@@ -336,7 +336,11 @@ def plot_planar_grasp(
 
 def _draw_certificate(ax, grasp: Grasp, result: Any, patch: Any):
     """Draw a "no" result's certificate (see :func:`plot_planar_grasp`)."""
-    from drakegrasp.certificates import ESCAPE_TWIST, UNRESISTED_WRENCH, Certificate
+    from drakegrasp.certificates.certificate import (
+        ESCAPE_TWIST,
+        UNRESISTED_WRENCH,
+        Certificate,
+    )
     from drakegrasp.visualization.certificate_plots import (
         plot_escape,
         plot_unresisted_wrench,

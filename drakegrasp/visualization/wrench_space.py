@@ -20,10 +20,13 @@ from typing import Any
 
 import numpy as np
 
+from drakegrasp.core.friction_cone import (
+    DEFAULT_NUM_GENERATORS,
+    friction_cone_generators,
+)
+from drakegrasp.core.grasp import Grasp, wrench_columns
+from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS, friction_cone_generators
-from drakegrasp.grasp import Grasp, wrench_columns
-from drakegrasp.validation import real_scalar
 from drakegrasp.visualization.plots import import_pyplot
 
 __all__ = [

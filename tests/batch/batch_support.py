@@ -6,7 +6,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from drakegrasp import Contact, Grasp, normal_grasp_matrix
-from drakegrasp.friction_cone import ConeLayout
+from drakegrasp.core.friction_cone import ConeLayout
 
 
 def random_grasps(rng, K, N, d, *, spread=0.4, radius=1.0):

@@ -1,6 +1,6 @@
 """Batch verdicts and d* against the single-grasp routes on seeded random grasps.
 
-Two independent routes: the MathematicalProgram path of drakegrasp.closure (the
+Two independent routes: the MathematicalProgram path of drakegrasp.closure.verdicts (the
 contract), and HiGHS (scipy.optimize.linprog) on the unreduced LP built from the
 single-grasp building blocks.  Documented tolerance on d*: 1e-6 absolute (the
 batch IPM stops at ~1e-10 relative, Clp and HiGHS at ~1e-9).  Verdicts must agree
@@ -20,7 +20,7 @@ from batch_support import (
 )
 
 from drakegrasp.batch import batch_force_closure, batch_form_closure
-from drakegrasp.closure import force_closure, form_closure
+from drakegrasp.closure.verdicts import force_closure, form_closure
 
 D_TOL = 1e-6
 TOL = 1e-6

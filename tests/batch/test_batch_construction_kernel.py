@@ -30,8 +30,8 @@ from drakegrasp.batch.construction import (
     contact_kinds,
 )
 from drakegrasp.batch.rowspace import normalised_positions
+from drakegrasp.core.validation import unit_vectors
 from drakegrasp.errors import InvalidContactError
-from drakegrasp.validation import unit_vectors
 
 pytestmark = pytest.mark.skipif(
     not AVAILABLE, reason="numba (extra 'fast') is not installed"

@@ -17,8 +17,8 @@ from drakegrasp.batch.construction import (
 )
 from drakegrasp.batch.ipm import solve_max_last
 from drakegrasp.batch.reduction import null_spaces
+from drakegrasp.core.friction_cone import effective_cone
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.friction_cone import effective_cone
 
 # ----------------------------------------------------------------- files
 

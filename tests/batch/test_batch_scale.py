@@ -28,7 +28,7 @@ from drakegrasp.batch.construction import (
 from drakegrasp.batch.margin import solve_margin_blocks
 from drakegrasp.batch.reduction import solve_margin_lp
 from drakegrasp.batch.rowspace import normalised_positions
-from drakegrasp.closure import force_closure, form_closure
+from drakegrasp.closure.verdicts import force_closure, form_closure
 from drakegrasp.errors import InvalidContactError
 
 needs_numba = pytest.mark.skipif(

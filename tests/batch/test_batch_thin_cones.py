@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
+from drakegrasp.core import examples as ex
 
 
 def _perturbed(base, rng, count):

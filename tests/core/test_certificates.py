@@ -15,9 +15,9 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
-from drakegrasp.certificates import ESCAPE_TWIST, UNRESISTED_WRENCH
-from drakegrasp.witness import unresisted_wrench
+from drakegrasp.certificates.certificate import ESCAPE_TWIST, UNRESISTED_WRENCH
+from drakegrasp.certificates.witness import unresisted_wrench
+from drakegrasp.core import examples as ex
 
 SPATIAL_MODELS = [
     ("frictionless", 0.5, 0.0),
@@ -220,7 +220,7 @@ def test_a_disc_always_rotates_about_its_centre():
     cert = r.certificate
     assert cert.two_sided and cert.null_basis.shape[1] == 1
     v = cert.direction
-    from drakegrasp.certificate_text import screw_point
+    from drakegrasp.certificates.text import screw_point
 
     assert np.allclose(screw_point(g.reference_point, v[:2], v[2:]), centre)
     assert "rotate" in cert.describe() and "(0.3, -0.2)" in cert.describe()

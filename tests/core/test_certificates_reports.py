@@ -5,8 +5,8 @@ import json
 import numpy as np
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
 from drakegrasp.cli import main
+from drakegrasp.core import examples as ex
 
 
 def _lines(result):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
+from drakegrasp.core import examples as ex
 
 
 def _null_vector_is_one_signed(Gn):
@@ -143,7 +143,7 @@ def test_result_serialises_and_prints():
 def test_thin_cones_keep_the_frictionless_verdict(mu):
     # d* of LP2 is a distance to the cone boundaries and vanishes with μ, yet a
     # grasp in form closure is in force closure for every μ >= 0.  (1e-12 is
-    # the smallest non-zero μ drakegrasp.validation accepts.)
+    # the smallest non-zero μ drakegrasp.core.validation accepts.)
     for base in (ex.cube_seven_contacts(), ex.planar_square_four_contacts()):
         grasp = base.with_friction(mu, model="hard_finger")
         for solve in (dg.force_closure, dg.force_closure_exact):

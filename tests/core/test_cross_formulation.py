@@ -64,7 +64,7 @@ def test_planar_exact_program_is_the_lp(rng, make_contacts):
 
 
 def test_more_generators_converge_to_the_exact_margin():
-    from drakegrasp import examples as ex
+    from drakegrasp.core import examples as ex
 
     grasp = ex.equator_fingers(0.5)
     exact = dg.force_closure_exact(grasp).d_star

@@ -12,8 +12,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
-from drakegrasp._deferred import (
+from drakegrasp.closure.results import ClosureResult
+from drakegrasp.core import examples as ex
+from drakegrasp.core.deferred import (
     Deferred,
     computed_eagerly,
     defer,
@@ -22,7 +23,6 @@ from drakegrasp._deferred import (
     replace,
     resolve,
 )
-from drakegrasp.results import ClosureResult
 
 SETTINGS = settings(
     max_examples=30,
@@ -210,22 +210,22 @@ def test_a_result_pickled_before_deferred_fields_still_reads():
 def test_what_the_programs_share_per_grasp_goes_with_the_grasp():
     import gc
 
-    import drakegrasp.closure as closure
+    import drakegrasp.closure.programs as programs
 
     gc.collect()
-    before = len(closure._PER_GRASP)
+    before = len(programs.PER_GRASP)
     g = ex.equator_fingers(0.5, num_fingers=3)
     r = dg.force_closure(g)
     e = dg.force_closure_exact(g)
-    assert len(closure._PER_GRASP) == before + 1
+    assert len(programs.PER_GRASP) == before + 1
     assert r.rank == e.rank == 6
     del g, r, e
     gc.collect()
-    assert len(closure._PER_GRASP) == before
+    assert len(programs.PER_GRASP) == before
 
 
 def test_weak_memo_computes_once_per_key_and_never_keeps_an_exception():
-    from drakegrasp._deferred import WeakMemo
+    from drakegrasp.core.deferred import WeakMemo
 
     class Owner:
         pass

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
+from drakegrasp.core import examples as ex
 
 
 @pytest.mark.parametrize(
@@ -111,12 +111,12 @@ class _FakeResult:
 def test_a_failing_solver_raises_solver_error_with_program_and_result(monkeypatch):
     from pydrake.solvers import SolutionResult
 
-    import drakegrasp.closure as closure
+    import drakegrasp.closure.verdicts as closure
 
-    def failing(prog, *, conic):
+    def failing(prog, kind, *, retry=False):
         return _FakeResult(SolutionResult.kSolverSpecificError)
 
-    monkeypatch.setattr(closure, "_solve", failing)
+    monkeypatch.setattr(closure, "solve", failing)
     with pytest.raises(dg.SolverError, match="kSolverSpecificError") as info:
         dg.force_closure(ex.equator_fingers(0.5))
     assert info.value.program is not None
@@ -128,12 +128,12 @@ def test_a_failing_solver_raises_solver_error_with_program_and_result(monkeypatc
 def test_infeasibility_is_a_verdict_not_an_exception(monkeypatch):
     from pydrake.solvers import SolutionResult
 
-    import drakegrasp.closure as closure
+    import drakegrasp.closure.verdicts as closure
 
-    def infeasible(prog, *, conic):
+    def infeasible(prog, kind, *, retry=False):
         return _FakeResult(SolutionResult.kInfeasibleConstraints)
 
-    monkeypatch.setattr(closure, "_solve", infeasible)
+    monkeypatch.setattr(closure, "solve", infeasible)
     r = dg.form_closure(ex.cube_seven_contacts())
     assert not r.is_closure and np.isnan(r.d_star)
     assert r.status == "kInfeasibleConstraints" and r.to_dict()["d_star"] is None

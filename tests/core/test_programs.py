@@ -4,7 +4,7 @@ import numpy as np
 from pydrake.solvers import ClpSolver
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
+from drakegrasp.core import examples as ex
 
 
 def test_lp2_program_shape_follows_the_conventions():

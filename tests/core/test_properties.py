@@ -6,7 +6,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
+from drakegrasp.core import examples as ex
 
 SETTINGS = settings(
     max_examples=25,
@@ -18,7 +18,7 @@ seeds = st.integers(min_value=0, max_value=2**32 - 1)
 
 
 def valid_mu(high):
-    """0 or a friction coefficient in drakegrasp.validation's range, up to high."""
+    """0 or a friction coefficient in drakegrasp.core.validation's range, up to high."""
     return st.one_of(st.just(0.0), st.floats(1e-12, high))
 
 

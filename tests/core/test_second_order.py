@@ -29,9 +29,12 @@ from drakegrasp import (
     SurfaceCurvature,
     second_order_form_closure,
 )
-from drakegrasp.curvature import contact_hessian, contact_hessians
-from drakegrasp.grasp import normal_grasp_matrix
-from drakegrasp.second_order import build_second_order_program, equilibrium_support
+from drakegrasp.closure.second_order import (
+    build_second_order_program,
+    equilibrium_support,
+)
+from drakegrasp.core.curvature import contact_hessian, contact_hessians
+from drakegrasp.core.grasp import normal_grasp_matrix
 
 POINT2 = SurfaceCurvature.point(planar=True)
 POINT3 = SurfaceCurvature.point()

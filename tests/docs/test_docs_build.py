@@ -156,12 +156,12 @@ def _canonical(obj, name):
     qualname = getattr(obj, "__qualname__", None)
     if module and qualname:
         return f"{module}.{qualname}"
-    # A constant: documented in the module that defines it.
+    # A constant: documented in the module the lazy table reads it from.
     import drakegrasp
 
-    for mod in (drakegrasp.closure,):
-        if hasattr(mod, name):
-            return f"{mod.__name__}.{name}"
+    for source, names in drakegrasp._SOURCES.items():
+        if name in names:
+            return f"{source}.{name}"
     return name
 
 

@@ -38,8 +38,8 @@ import fuzz_oracles as oracle
 import numpy as np
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
-from drakegrasp import validation as V
+from drakegrasp.core import examples as ex
+from drakegrasp.core import validation as V
 
 OUTCOMES = (
     "clear GraspError",
@@ -1125,7 +1125,8 @@ def picture_cases() -> Iterator[Case]:
     import matplotlib
 
     matplotlib.use("Agg")
-    from drakegrasp import examples
+
+    from drakegrasp.core import examples
 
     g = examples.planar_square_four_contacts()
     bad = [

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drakegrasp import examples as ex
+from drakegrasp.core import examples as ex
 
 ROOT = Path(__file__).resolve().parents[2]
 

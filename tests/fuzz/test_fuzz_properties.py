@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import drakegrasp as dg
-from drakegrasp import validation as V
+from drakegrasp.core import validation as V
 
 SETTINGS = settings(
     derandomize=True,
@@ -253,7 +253,7 @@ def test_epsilon_of_thin_cones_is_linear_in_mu(mu):
     # The equator grasp's ε grows linearly with μ for small μ (its wrench set
     # is μ thin in four directions): ε(μ)/μ at 1e-12 ... 1e-6 matches the
     # well-conditioned value at 1e-3 (Qhull on raw points gave 0 below 1e-8).
-    from drakegrasp import examples as ex
+    from drakegrasp.core import examples as ex
 
     slope = dg.ferrari_canny(ex.equator_fingers(1e-3)) / 1e-3
     eps = dg.ferrari_canny(ex.equator_fingers(mu))
@@ -264,7 +264,7 @@ def test_epsilon_of_thin_cones_is_linear_in_mu(mu):
 
 def test_soft_finger_epsilon_with_huge_torsion_is_at_least_hard():
     # Issue 9: ν >= 1e9 gave ε = 0 where hard fingers give 0.276.
-    from drakegrasp import examples as ex
+    from drakegrasp.core import examples as ex
 
     hard = ex.equator_fingers(0.5)
     e_hard = dg.ferrari_canny(hard)

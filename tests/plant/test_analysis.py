@@ -26,8 +26,8 @@ from drakegrasp import (
     PenetrationError,
     grasp_matrix,
 )
-from drakegrasp.antipodal import is_antipodal
-from drakegrasp.closure import force_closure, force_closure_exact, form_closure
+from drakegrasp.closure.verdicts import force_closure, force_closure_exact, form_closure
+from drakegrasp.core.antipodal import is_antipodal
 from drakegrasp.plant import (
     DEFAULT_SCENE,
     analyze_grasp,

@@ -9,7 +9,7 @@ import pickle
 
 import pytest
 
-from drakegrasp._deferred import computed_eagerly, pending
+from drakegrasp.core.deferred import computed_eagerly, pending
 from drakegrasp.plant import DEFAULT_SCENE, analyze_grasp, close_hand
 
 from .conftest import SCENE_NAMES, fresh_context

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from pydrake.multibody.tree import JacobianWrtVariable
 
-from drakegrasp.grasp import normal_grasp_matrix
+from drakegrasp.core.grasp import normal_grasp_matrix
 from drakegrasp.plant import grasp_from_plant
 from drakegrasp.plant.jacobians import PLANES
 from drakegrasp.plant.scene import list_scenes

@@ -30,8 +30,8 @@ from drakegrasp import (
     analyze_grasp,
     second_order_form_closure,
 )
+from drakegrasp.closure.second_order import build_second_order_program
 from drakegrasp.plant import contact_curvatures
-from drakegrasp.second_order import build_second_order_program
 
 X_WO = RigidTransform(RollPitchYaw(0.3, -0.2, 0.5), [0.1, 0.2, 0.3])
 R_TIP = 0.01

@@ -7,7 +7,7 @@ import pytest
 from scipy.optimize import linprog
 
 import drakegrasp as dg
-from drakegrasp.closure import force_closure
+from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.quality import (
     GraspQuality,
     ferrari_canny,

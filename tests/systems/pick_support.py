@@ -34,7 +34,7 @@ from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 import drakegrasp as dg
-from drakegrasp.systems import add_grasp_monitor
+from drakegrasp.systems.monitor import add_grasp_monitor
 
 OPEN, CLOSED = 0.035, 0.015  # finger joint values, m (the box is 50 mm wide)
 LIFT = 0.05  # m

@@ -22,7 +22,7 @@ from pydrake.multibody.plant import MultibodyPlant
 
 import drakegrasp as dg
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.systems import VERDICT_NAMES, GraspMonitor, GraspSample
+from drakegrasp.systems.monitor import VERDICT_NAMES, GraspMonitor, GraspSample
 
 SOFT = {"contact_model": "soft_finger", "torsional_friction": 0.1}
 OPTIONS = {"mu": 0.5, "distance_tolerance": 1e-3}

@@ -35,7 +35,7 @@ from pydrake.geometry import Meshcat, MeshcatParams, Rgba, Sphere
 from pydrake.math import RigidTransform
 
 from drakegrasp import Contact, Grasp
-from drakegrasp.closure import force_closure
+from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.visualization import MESHCAT_COLORS, clear_grasp, draw_grasp
 
 pytestmark = SKIP_WITHOUT_CHROMIUM

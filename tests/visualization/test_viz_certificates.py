@@ -5,7 +5,7 @@ import pytest
 from pydrake.geometry import Meshcat
 
 import drakegrasp as dg
-from drakegrasp import examples as ex
+from drakegrasp.core import examples as ex
 from drakegrasp.visualization.certificate_plots import planar_motion
 from drakegrasp.visualization.escape import animate_escape, escape_transform
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from drakegrasp import Contact, Grasp, InvalidOptionError, grasp_matrix
-from drakegrasp.friction_cone import friction_cone_generators
+from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.visualization import (
     cone_edge_directions,
     contact_forces_in_grasp_frame,

@@ -6,7 +6,7 @@ from pydrake.geometry import Meshcat
 from pydrake.math import RigidTransform
 
 from drakegrasp import Contact, Grasp, InvalidOptionError
-from drakegrasp.closure import force_closure
+from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.visualization import clear_grasp, draw_grasp
 
 

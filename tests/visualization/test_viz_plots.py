@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from drakegrasp import Contact, Grasp, InvalidOptionError
-from drakegrasp.closure import force_closure
+from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.visualization import plot_planar_grasp
 
 

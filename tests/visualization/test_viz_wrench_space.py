@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from drakegrasp import Contact, Grasp, InvalidOptionError, grasp_matrix
-from drakegrasp.closure import force_closure
-from drakegrasp.friction_cone import friction_cone_generators
+from drakegrasp.closure.verdicts import force_closure
+from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.visualization import plot_wrench_space, wrench_hull, wrench_space_points
 
 pytest.importorskip("scipy", reason="scipy not installed")

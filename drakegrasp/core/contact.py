@@ -13,13 +13,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drakegrasp.errors import InvalidContactError
-from drakegrasp.validation import (
+from drakegrasp.core.validation import (
     check_coefficient,
     check_positions,
     real_array,
     unit_vectors,
 )
+from drakegrasp.errors import InvalidContactError
 
 __all__ = ["Contact", "ContactModel", "contact_frame", "contact_frames"]
 
@@ -168,7 +168,7 @@ class Contact:
     ------
     InvalidContactError
         A position that is not real, finite and within
-        :data:`~drakegrasp.validation.POSITION_BOUND`; a zero, non-finite or
+        :data:`~drakegrasp.core.validation.POSITION_BOUND`; a zero, non-finite or
         non-real normal; ``mu`` or ``ν`` outside 0 or ``[1e-12, 1e12]``; an
         unknown model; a planar soft finger or one without ``ν``.
 

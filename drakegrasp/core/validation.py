@@ -220,7 +220,7 @@ def check_positions(name: str, value, *, error: type = InvalidContactError):
     if a.size and float(np.max(np.abs(a))) > POSITION_BOUND:
         raise error(
             f"{name} {_short(a)} has a coordinate beyond the valid bound "
-            f"|x| <= {POSITION_BOUND:g} m (drakegrasp.validation.POSITION_BOUND)"
+            f"|x| <= {POSITION_BOUND:g} m (drakegrasp.core.validation.POSITION_BOUND)"
         )
     return a
 
@@ -309,7 +309,8 @@ def check_coefficient(name: str, value, *, error: type = InvalidContactError) ->
 def _coefficient_message(name: str, x: float) -> str:
     return (
         f"{name} must be finite and 0 or in [{COEFFICIENT_MIN:g}, "
-        f"{COEFFICIENT_MAX:g}] (drakegrasp.validation.COEFFICIENT_MIN/MAX), got {x!r}"
+        f"{COEFFICIENT_MAX:g}] (drakegrasp.core.validation.COEFFICIENT_MIN/MAX), "
+        f"got {x!r}"
     )
 
 
@@ -379,7 +380,7 @@ def check_num_generators(value, name: str = "num_generators") -> int:
     if n is None or not (3 <= n <= MAX_NUM_GENERATORS):
         raise InvalidOptionError(
             f"{name} must be an integer >= 3 and <= {MAX_NUM_GENERATORS} "
-            f"(drakegrasp.validation.MAX_NUM_GENERATORS), got {_describe(value)}"
+            f"(drakegrasp.core.validation.MAX_NUM_GENERATORS), got {_describe(value)}"
         )
     return int(n)
 
@@ -408,9 +409,9 @@ def check_length(name: str, value, *, error: type = InvalidGraspError) -> float:
 
 def check_grasp(value, name: str = "grasp"):
     """``value`` if it is a :class:`~drakegrasp.Grasp`, else InvalidGraspError."""
-    # No import of drakegrasp.grasp (it imports this module: a cycle): a Grasp
+    # No import of drakegrasp.core.grasp (it imports this module: a cycle): a Grasp
     # can only exist once that module is loaded, so look it up there.
-    grasp_module = sys.modules.get("drakegrasp.grasp")
+    grasp_module = sys.modules.get("drakegrasp.core.grasp")
     if grasp_module is None or not isinstance(value, grasp_module.Grasp):
         raise InvalidGraspError(
             f"{name} must be a drakegrasp.Grasp, got {_describe(value)} "

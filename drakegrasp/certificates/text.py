@@ -6,19 +6,15 @@ axis through a point, or a translation), a wrench as a line of action.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from drakegrasp.certificate_kinds import (
+from drakegrasp.certificates.kinds import (
     BALANCE,
     ESCAPE_TWIST,
     UNCONTROLLABLE,
     UNRESISTED_WRENCH,
+    Witness,
 )
-
-if TYPE_CHECKING:
-    from drakegrasp.certificates import Certificate
 
 __all__ = ["axis_name", "describe_certificate", "screw_point"]
 
@@ -73,12 +69,12 @@ def _line_point(p: np.ndarray, f: np.ndarray, m: np.ndarray) -> np.ndarray:
     return p + float(m[0]) * np.array([f[1], -f[0]]) / float(f @ f)
 
 
-def _more(cert: Certificate, what: str) -> str:
+def _more(cert: Witness, what: str) -> str:
     k = cert.null_basis.shape[-1] if cert.two_sided else 1
     return f" (and {k - 1} more independent {what})" if k > 1 else ""
 
 
-def _contacts_text(cert: Certificate) -> str:
+def _contacts_text(cert: Witness) -> str:
     sep = np.flatnonzero(cert.separating(1e-9))
     if sep.size == 0:
         return "every contact slides"
@@ -89,7 +85,7 @@ def _contacts_text(cert: Certificate) -> str:
     return text
 
 
-def _twist_text(cert: Certificate) -> str:
+def _twist_text(cert: Witness) -> str:
     p = np.asarray(cert.reference_point, dtype=float)
     b, d = cert.characteristic_length, len(p)
     v = np.asarray(cert.direction, dtype=float)
@@ -115,7 +111,7 @@ def _twist_text(cert: Certificate) -> str:
     )
 
 
-def _wrench_text(cert: Certificate) -> str:
+def _wrench_text(cert: Witness) -> str:
     p = np.asarray(cert.reference_point, dtype=float)
     b, d = cert.characteristic_length, len(p)
     e = -np.asarray(cert.direction, dtype=float)  # the external wrench
@@ -137,8 +133,8 @@ def _wrench_text(cert: Certificate) -> str:
     return f"cannot resist {what}{_more(cert, 'wrenches')}"
 
 
-def describe_certificate(cert: Certificate) -> str:
-    """See :meth:`drakegrasp.certificates.Certificate.describe`."""
+def describe_certificate(cert: Witness) -> str:
+    """See :meth:`drakegrasp.certificates.certificate.Certificate.describe`."""
     if cert.kind == ESCAPE_TWIST:
         return _twist_text(cert)
     if cert.kind == UNRESISTED_WRENCH:

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.contact import Contact, ContactModel
-from drakegrasp.grasp import Grasp
+from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.grasp import Grasp
 
 __all__ = [
     "cube_seven_contacts",

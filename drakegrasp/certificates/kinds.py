@@ -1,16 +1,20 @@
 """The kinds of certificate, and how a re-check reports.
 
-A low room of its own so that the certificate type
-(:mod:`drakegrasp.certificates`), its check (:mod:`drakegrasp.certificate_check`)
-and its text (:mod:`drakegrasp.certificate_text`) all import from here and never
-from each other in a circle.
+A low room of its own so that the certificate type and its check
+(:mod:`drakegrasp.certificates.certificate`) and its text
+(:mod:`drakegrasp.certificates.text`) both import from here and never from each
+other in a circle: the text reads a certificate through the :class:`Witness`
+protocol, and only the certificate type imports the text.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from typing import Protocol
 
-from drakegrasp.results import _jsonable
+import numpy as np
+
+from drakegrasp.core.serialize import jsonable
 
 __all__ = [
     "BALANCE",
@@ -19,6 +23,7 @@ __all__ = [
     "UNCONTROLLABLE",
     "UNRESISTED_WRENCH",
     "CertificateCheck",
+    "Witness",
 ]
 
 ESCAPE_TWIST = "escape twist"
@@ -33,7 +38,7 @@ _KINDS = (ESCAPE_TWIST, UNRESISTED_WRENCH, UNCONTROLLABLE, BALANCE)
 _CONES = ("normals", "polyhedral", "exact")
 
 DEFAULT_CHECK_TOL = 1e-7
-"""Relative tolerance of :meth:`drakegrasp.certificates.Certificate.check`.
+"""Relative tolerance of :meth:`drakegrasp.certificates.certificate.Certificate.check`.
 
 Violations are scaled to 1 before they are compared with it.
 """
@@ -75,7 +80,7 @@ class CertificateCheck:
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
-        return {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+        return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
 
     def __str__(self) -> str:
         verdict = "holds" if self.holds else "FAILS"
@@ -83,3 +88,37 @@ class CertificateCheck:
             f"witness {verdict}: violation {self.violation:.2g}, "
             f"slack {self.slack + 0.0:.3g} (tol {self.tol:g}); {self.detail}"
         )
+
+
+class Witness(Protocol):
+    """What the check and the wording read of a certificate.
+
+    :class:`~drakegrasp.certificates.certificate.Certificate` has these fields;
+    its check and :mod:`~drakegrasp.certificates.text` are written against this
+    protocol, so the text never imports the type that calls it.
+    """
+
+    kind: str
+    cones: str
+    direction: np.ndarray | None
+    null_basis: np.ndarray
+    separating_twist: np.ndarray | None
+    separating_basis: np.ndarray
+    contact_forces: tuple[np.ndarray, ...] | None
+    internal_basis: np.ndarray | None
+    num_generators: int
+    reference_point: np.ndarray | None
+    characteristic_length: float
+
+    @property
+    def two_sided(self) -> bool:
+        """True when the witness direction ``-w`` is a witness too."""
+        ...
+
+    def separating(self, tol: float = ...) -> np.ndarray:
+        """Which contacts the twist separates."""
+        ...
+
+    def stacked_forces(self) -> np.ndarray:
+        """The balancing forces as one vector."""
+        ...

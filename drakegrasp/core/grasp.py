@@ -18,15 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drakegrasp.contact import Contact, ContactModel
-from drakegrasp.errors import InvalidContactError, InvalidGraspError
-from drakegrasp.validation import (
+from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.validation import (
     JACOBIAN_BOUND,
     check_length,
     check_positions,
     real_array,
     safe_norm,
 )
+from drakegrasp.errors import InvalidContactError, InvalidGraspError
 
 __all__ = [
     "Grasp",
@@ -59,7 +59,7 @@ class Grasp:
     InvalidGraspError
         ``contacts`` not an iterable of :class:`Contact`, or empty; a
         reference point that is not a real finite ``d``-vector within
-        :data:`~drakegrasp.validation.POSITION_BOUND`; a characteristic length
+        :data:`~drakegrasp.core.validation.POSITION_BOUND`; a characteristic length
         outside ``(0, 1e30]`` m.
     InvalidContactError
         Mixed planar and spatial contacts, or an item that is not a Contact.
@@ -412,6 +412,6 @@ def check_hand_jacobian(grasp: Grasp, hand_jacobian: np.ndarray) -> np.ndarray:
     if float(np.max(np.abs(J))) > JACOBIAN_BOUND:
         raise InvalidGraspError(
             f"hand_jacobian has an entry beyond |J_ij| <= {JACOBIAN_BOUND:g} "
-            "(drakegrasp.validation.JACOBIAN_BOUND)"
+            "(drakegrasp.core.validation.JACOBIAN_BOUND)"
         )
     return J

@@ -8,47 +8,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from drakegrasp._deferred import deferrable
+from drakegrasp.core.deferred import deferrable
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import ZERO_FRACTION, near_threshold
 
 if TYPE_CHECKING:
-    from drakegrasp.certificates import Certificate
+    from drakegrasp.certificates.certificate import Certificate
 
-__all__ = ["AntipodalResult", "ClosureResult", "InternalForceResult"]
-
-
-def _jsonable(value):
-    if isinstance(value, np.ndarray):
-        return [_jsonable(v) for v in value.tolist()]
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, dict):
-        return {k: _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (np.floating, float)):
-        x = float(value)
-        return x if math.isfinite(x) else None
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if hasattr(value, "to_dict"):
-        return value.to_dict()
-    return value
-
-
-ZERO_FRACTION = 1e-3
-"""``d*`` below ``ZERO_FRACTION * tol`` is the solver's zero, not a near miss."""
-
-
-def _relative_margin(value: float, tol: float) -> float:
-    """(value - tol) / tol: positive above the threshold, |m| < 1 within tol."""
-    if not math.isfinite(value):
-        return -math.inf
-    return (value - tol) / tol
-
-
-def _near(margin: float) -> bool:
-    """True when ``d*`` lies in ``(ZERO_FRACTION tol, 2 tol)``: not certain."""
-    return ZERO_FRACTION - 1.0 < margin < 1.0
+__all__ = ["ClosureResult", "InternalForceResult"]
 
 
 @dataclass(frozen=True)
@@ -109,7 +76,7 @@ class InternalForceResult:
     @property
     def near_boundary(self) -> bool:
         """True when ``tol/1000 < d* < 2 tol``: the verdict is not certain."""
-        return _near(-self.margin)
+        return near_threshold(-self.margin)
 
     @property
     def null_space_trivial(self) -> bool:
@@ -118,7 +85,7 @@ class InternalForceResult:
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
-        d = {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+        d = {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
         d["null_space_trivial"] = self.null_space_trivial
         d["near_boundary"] = self.near_boundary
         return d
@@ -207,7 +174,7 @@ class ClosureResult:
         ``μ > 0``.  Then ``margin`` and ``contact_forces`` are LP1's, and
         ``d_star`` stays the program's.
     certificate : Certificate or None
-        The verdict's witness (:mod:`drakegrasp.certificates`), in the grasp
+        The verdict's witness (:mod:`drakegrasp.certificates.certificate`), in the grasp
         frame about the reference point: an escape twist (form closure "no"),
         an unresisted wrench (force closure "no"), LP3's uncontrollable
         internal force (``decided_by == "LP3"``) or the balancing internal
@@ -218,7 +185,7 @@ class ClosureResult:
     Notes
     -----
     What no verdict needs is computed on first read and then kept
-    (``drakegrasp._deferred``): the certificate; ``d_star``, ``margin``,
+    (``drakegrasp.core.deferred``): the certificate; ``d_star``, ``margin``,
     ``contact_forces``, ``solver`` and ``status`` when the rank decided the
     verdict (``decided_by == "rank"``: the program is built and solved then);
     ``internal_forces`` when frictional closure fails.  The values are those
@@ -250,7 +217,7 @@ class ClosureResult:
         ``d*`` at or below ``tol/1000`` is the solver's zero (Clp reports ``d*``
         to about 1e-10): a certain "no".
         """
-        return _near(self.margin)
+        return near_threshold(self.margin)
 
     def __bool__(self) -> bool:
         return self.is_closure
@@ -261,7 +228,7 @@ class ClosureResult:
         ``certificate`` is the witness's own dictionary; ``why`` is its one-line
         reading for a "no" (None for a "yes").
         """
-        d = {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+        d = {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
         d["near_boundary"] = self.near_boundary
         d["why"] = self.why()
         return d
@@ -326,58 +293,3 @@ def _zero_text(d_star: float, tol: float) -> str:
     if math.isfinite(d_star) and abs(d_star) <= ZERO_FRACTION * tol:
         return "0 (solver zero)"
     return f"{d_star:.3g}"
-
-
-@dataclass(frozen=True)
-class AntipodalResult:
-    """Antipodal check of a two-contact grasp.
-
-    Attributes
-    ----------
-    is_antipodal : bool
-        The segment between the contacts lies inside both friction cones.
-    angles : (2,) float
-        Angle (rad) between ``c_2 - c_1`` and ``n_1``, and between ``c_1 - c_2``
-        and ``n_2``.
-    mu : (2,) float
-        Friction coefficient used at each contact.
-    margins : (2,) float
-        ``atan(μ_i) - angle_i`` (rad): positive inside the cone.
-    min_mu : float
-        Smallest friction coefficient for which the pair is antipodal,
-        ``tan(max angle)`` (``inf`` when an angle reaches 90°).
-    """
-
-    is_antipodal: bool
-    angles: np.ndarray
-    mu: np.ndarray
-    margins: np.ndarray
-    min_mu: float
-
-    def __bool__(self) -> bool:
-        return self.is_antipodal
-
-    def to_dict(self) -> dict:
-        """JSON-ready dictionary."""
-        return {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
-
-    def __str__(self) -> str:
-        verdict = "YES" if self.is_antipodal else "no"
-        deg = np.degrees(self.angles)
-        mdeg = np.degrees(self.margins)
-        head = (
-            f"antipodal (geometric test): {verdict}, decided by the angle margins "
-            f"{mdeg[0]:+.3f}°, {mdeg[1]:+.3f}° (angles {deg[0]:.3f}°, "
-            f"{deg[1]:.3f}° vs atan mu)"
-        )
-        if self.min_mu == 0.0:
-            mu_text = "the fingers are collinear: antipodal for every mu >= 0"
-        else:
-            mu_text = f"antipodal for mu >= {self.min_mu:.4g}"
-        if np.all(np.abs(self.margins) < 1e-9):
-            mu_text += "; on the cone boundary (margins 0°), not strictly inside"
-        return (
-            f"{head}\n  {mu_text}; antipodal is necessary, not sufficient: in "
-            "space two hard fingers never resist a moment about the line "
-            "between them, and with mu = 0 nothing resists sliding"
-        )

@@ -12,19 +12,75 @@ with the normals pointing into the object.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass, fields
 
 import numpy as np
 
-from drakegrasp.contact import Contact, ContactModel
+from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import check_angle_tol, check_coefficient
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError
-from drakegrasp.grasp import Grasp
-from drakegrasp.results import AntipodalResult
-from drakegrasp.validation import check_angle_tol, check_coefficient
 
-__all__ = ["DEFAULT_ANGLE_TOL", "is_antipodal"]
+__all__ = ["DEFAULT_ANGLE_TOL", "AntipodalResult", "is_antipodal"]
 
 DEFAULT_ANGLE_TOL = 1e-9
 """Angles may exceed ``atan μ`` by this much (rad) and still count as inside."""
+
+
+@dataclass(frozen=True)
+class AntipodalResult:
+    """Antipodal check of a two-contact grasp.
+
+    Attributes
+    ----------
+    is_antipodal : bool
+        The segment between the contacts lies inside both friction cones.
+    angles : (2,) float
+        Angle (rad) between ``c_2 - c_1`` and ``n_1``, and between ``c_1 - c_2``
+        and ``n_2``.
+    mu : (2,) float
+        Friction coefficient used at each contact.
+    margins : (2,) float
+        ``atan(μ_i) - angle_i`` (rad): positive inside the cone.
+    min_mu : float
+        Smallest friction coefficient for which the pair is antipodal,
+        ``tan(max angle)`` (``inf`` when an angle reaches 90°).
+    """
+
+    is_antipodal: bool
+    angles: np.ndarray
+    mu: np.ndarray
+    margins: np.ndarray
+    min_mu: float
+
+    def __bool__(self) -> bool:
+        return self.is_antipodal
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
+
+    def __str__(self) -> str:
+        verdict = "YES" if self.is_antipodal else "no"
+        deg = np.degrees(self.angles)
+        mdeg = np.degrees(self.margins)
+        head = (
+            f"antipodal (geometric test): {verdict}, decided by the angle margins "
+            f"{mdeg[0]:+.3f}°, {mdeg[1]:+.3f}° (angles {deg[0]:.3f}°, "
+            f"{deg[1]:.3f}° vs atan mu)"
+        )
+        if self.min_mu == 0.0:
+            mu_text = "the fingers are collinear: antipodal for every mu >= 0"
+        else:
+            mu_text = f"antipodal for mu >= {self.min_mu:.4g}"
+        if np.all(np.abs(self.margins) < 1e-9):
+            mu_text += "; on the cone boundary (margins 0°), not strictly inside"
+        return (
+            f"{head}\n  {mu_text}; antipodal is necessary, not sufficient: in "
+            "space two hard fingers never resist a moment about the line "
+            "between them, and with mu = 0 nothing resists sliding"
+        )
 
 
 def _two_contacts(grasp_or_contacts: Grasp | Sequence[Contact]) -> tuple[Contact, ...]:
@@ -75,7 +131,7 @@ def is_antipodal(
         ``mu`` (0 for a frictionless contact).
     angle_tol : float, optional
         Slack (rad) on the angle test, for contacts that are exactly collinear;
-        in ``[0, 0.01]`` (:data:`~drakegrasp.validation.MAX_ANGLE_TOL`).
+        in ``[0, 0.01]`` (:data:`~drakegrasp.core.validation.MAX_ANGLE_TOL`).
 
     Returns
     -------

@@ -12,9 +12,8 @@ complete: a restarted run skips the shards it finds, and a task that Dask
 retries after a worker died rewrites the same shard, so nothing is lost or
 duplicated.
 
-Plant-based evaluation (:func:`analyze_poses`) builds each worker process's
-scene once, in a per-process cache keyed by the scene, and ships only joint
-positions; a plant is never pickled.
+Plant-based evaluation on a cluster is the other half of this folder
+(:mod:`drakegrasp.distributed.plant_side`).
 
 Needs the optional extra ``dask`` (``dask[distributed]``, and ``pyarrow`` for
 the Parquet shards).  See ``docs/distributed.md`` for pointing it at a cluster.
@@ -35,12 +34,12 @@ from drakegrasp.batch.engine import (
     stream_force_closure,
     stream_form_closure,
 )
+from drakegrasp.core.tolerances import DEFAULT_TOL
+from drakegrasp.core.validation import check_num_generators
+from drakegrasp.distributed.client import client_for
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.validation import check_num_generators
 
 __all__ = [
-    "analyze_poses",
-    "cached_scenes",
     "evaluate_on_cluster",
     "read_dataset",
     "stream_file_on_cluster",
@@ -48,19 +47,6 @@ __all__ = [
 
 _ARRAY_OPTIONS = ("mu", "torsional_friction", "reference_points",
                   "characteristic_lengths")  # fmt: skip
-
-
-def _client(client_or_address):
-    try:
-        from distributed import Client
-    except ImportError as exc:
-        raise InvalidOptionError(
-            "drakegrasp.distributed needs the optional packages dask and "
-            "distributed (pip install drakegrasp[dask])"
-        ) from exc
-    if isinstance(client_or_address, str):
-        return Client(client_or_address)
-    return client_or_address
 
 
 def _slice_option(value, sl: slice, K: int):
@@ -138,7 +124,7 @@ def evaluate_on_cluster(
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
     if kind == "force" and mu is None:
         raise InvalidOptionError("force closure needs mu")
-    client = _client(client)
+    client = client_for(client)
     K, N, d = np.shape(positions)
     # the local engine's chunks (same n_g and K), so partitions align with them
     n_g = 1
@@ -175,7 +161,7 @@ def evaluate_on_cluster(
         results.update(done_paths)
         return [results[j] for j in sorted(results)]
     chunks = ((sl, results[j]) for j, sl, _ in futures)
-    tol = float(options.get("tol", 1e-6))
+    tol = float(options.get("tol", DEFAULT_TOL))
     names = _check_metrics(options.get("metrics", ()))
     return _collect(K, d, kind, tol, names, chunks)
 
@@ -219,81 +205,10 @@ def stream_file_on_cluster(
     evaluate_on_cluster(scheduler, data["positions"], data["normals"], mu,
                         kind=kind, output_dir=output_path, **options)  # fmt: skip
     arrays = read_dataset(output_path)
-    summary = BatchSummary(kind=kind, tol=float(options.get("tol", 1e-6)))
+    summary = BatchSummary(kind=kind, tol=float(options.get("tol", DEFAULT_TOL)))
     summary.add(arrays)
     return summary
 
 
 # --------------------------------------------------------------------------
 # Plant-based evaluation: one scene per worker process, positions shipped.
-
-_SCENES: dict = {}
-
-
-def _scene(name: str):
-    """The worker process's scene ``name``, loaded on first use."""
-    if name not in _SCENES:
-        from drakegrasp.plant.scene import load_scene
-
-        _SCENES[name] = load_scene(name)
-    return _SCENES[name]
-
-
-def cached_scenes() -> list[str]:
-    """Names of the scenes this process has loaded (run on a worker to inspect)."""
-    return sorted(_SCENES)
-
-
-def _analyze_block(scene_name: str, q_block: np.ndarray, options: dict):
-    from drakegrasp.plant.analysis import analyze_grasp
-
-    scene = _scene(scene_name)
-    plant, ctx = scene.plant, scene.plant_context
-    out = {"is_force_closure": np.zeros(len(q_block), dtype=bool),
-           "d_star": np.zeros(len(q_block)),
-           "num_contacts": np.zeros(len(q_block), dtype=int)}  # fmt: skip
-    kwargs = {**scene.analysis_options(), **options}
-    for i, q in enumerate(q_block):
-        plant.SetPositions(ctx, q)
-        report = analyze_grasp(plant, ctx, **kwargs)
-        out["is_force_closure"][i] = report.is_force_closure
-        out["d_star"][i] = report.force_closure.d_star
-        out["num_contacts"][i] = len(report.contacts)
-    return out
-
-
-def analyze_poses(
-    client,
-    scene: str,
-    positions: np.ndarray,
-    *,
-    block: int = 64,
-    **options,
-) -> dict[str, np.ndarray]:
-    """:func:`drakegrasp.analyze_grasp` for many plant configurations of a scene.
-
-    Parameters
-    ----------
-    client : distributed.Client or str
-    scene : str
-        A shipped scene name or a scene file visible to the workers; each
-        worker process loads it once (a per-process cache) and reuses it.
-    positions : (P, n_q) float
-        Plant positions ``q`` (the scene plant's ``GetPositions`` order).
-    block : int, optional
-        Configurations per task.
-    **options
-        Overrides of the scene's analysis options (e.g. ``mu``).
-
-    Returns
-    -------
-    dict of str to (P,) array
-        ``is_force_closure``, ``d_star`` (LP2 of the report's force closure)
-        and ``num_contacts``.
-    """
-    client = _client(client)
-    q = np.asarray(positions, dtype=float)
-    futs = [client.submit(_analyze_block, scene, q[s:s + block], options,
-                          pure=False) for s in range(0, len(q), block)]  # fmt: skip
-    parts = client.gather(futs)
-    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]} if parts else {}

@@ -77,11 +77,12 @@ from pydrake.systems.framework import (
     State,
 )
 
-from drakegrasp.closure import DEFAULT_TOL, force_closure
-from drakegrasp.contact import Contact, ContactModel
+from drakegrasp.closure.verdicts import force_closure
+from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.errors import GraspError, InvalidOptionError, NoContactsError
-from drakegrasp.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.grasp import Grasp
 from drakegrasp.plant.analysis import GraspReport, analyze_grasp
 from drakegrasp.plant.contact_results import contacts_from_results
 from drakegrasp.plant.contacts import (

@@ -6,7 +6,7 @@ curvature of the surfaces at the contacts.  Let ``S`` be the contacts that carry
 force in some equilibrium and ``W = {v : G_iᵀ v = 0, i ∈ S}`` the motions that
 roll or slide at every one of them to first order.  For ``v ∈ W`` and an
 equilibrium λ, the acceleration terms cancel in the weighted sum of the signed
-distances (:mod:`drakegrasp.curvature`):
+distances (:mod:`drakegrasp.core.curvature`):
 
 .. math:: \sum_i \lambda_i \psi_i(q(t)) = \tfrac{t^2}{2}\, v^T
           \Big(\sum_i \lambda_i H_i\Big) v + O(t^3),
@@ -33,23 +33,25 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 from pydrake.solvers import (
-    ClarabelSolver,
-    ClpSolver,
     MathematicalProgram,
-    ScsSolver,
     SolutionResult,
 )
 
-from drakegrasp._dense_constraints import (
+from drakegrasp._solvers import solve
+from drakegrasp.closure.constraints import (
     add_linear_constraint,
     add_linear_equality_constraint,
 )
-from drakegrasp.closure import DEFAULT_RANK_TOL, _add_balance, form_closure
-from drakegrasp.curvature import ContactCurvature, _skew, contact_hessians
+from drakegrasp.closure.programs import add_balance
+from drakegrasp.closure.results import ClosureResult
+from drakegrasp.closure.verdicts import form_closure
+from drakegrasp.core.curvature import ContactCurvature, _skew, contact_hessians
+from drakegrasp.core.grasp import Grasp, normal_grasp_matrix
+from drakegrasp.core.linalg import left_null_space
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, near_threshold, relative_margin
+from drakegrasp.core.validation import check_grasp, check_rank_tol
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
-from drakegrasp.grasp import Grasp, normal_grasp_matrix
-from drakegrasp.results import ClosureResult, _jsonable, _near, _relative_margin
-from drakegrasp.validation import check_grasp, check_rank_tol
 
 __all__ = [
     "DEFAULT_SECOND_ORDER_TOL",
@@ -78,22 +80,6 @@ def _twist_scaling(grasp: Grasp) -> np.ndarray:
     return T
 
 
-def _null_basis(A: np.ndarray, rank_tol: float) -> np.ndarray:
-    """Orthonormal basis (columns) of ``N(Aᵀ)``, numerically."""
-    if A.shape[1] == 0:
-        return np.eye(A.shape[0])
-    u, s, _ = np.linalg.svd(A)
-    rank = int(np.sum(s > rank_tol * s[0])) if s.size and s[0] > 0 else 0
-    return u[:, rank:]
-
-
-def _solve(prog: MathematicalProgram, solvers):
-    for solver in solvers:
-        if solver.available() and solver.enabled():
-            return solver.Solve(prog)
-    raise SolverError("no solver available (need Clarabel/SCS and Clp)", program=prog)
-
-
 def equilibrium_support(
     grasp: Grasp, *, rank_tol: float = DEFAULT_RANK_TOL
 ) -> tuple[int, ...]:
@@ -117,7 +103,7 @@ def equilibrium_support(
     prog = MathematicalProgram()
     lam = prog.NewContinuousVariables(N, "lambda")
     s = prog.NewContinuousVariables(N, "s")
-    _add_balance(prog, normal_grasp_matrix(grasp), lam, rank_tol)
+    add_balance(prog, normal_grasp_matrix(grasp), lam, rank_tol)
     prog.AddBoundingBoxConstraint(0.0, 1.0, s)
     prog.AddBoundingBoxConstraint(0.0, 1e6, lam)
     add_linear_constraint(
@@ -128,7 +114,7 @@ def equilibrium_support(
         np.append(lam, s),
     )
     prog.AddLinearCost(-np.ones(N), 0.0, s)
-    result = _solve(prog, (ClpSolver(), ClarabelSolver()))
+    result = solve(prog, "lp")
     if result.get_solution_result() != SolutionResult.kSolutionFound:
         raise SolverError(
             "the equilibrium-support LP failed with "
@@ -194,7 +180,7 @@ def build_second_order_program(
     rank_tol : float, optional
         Relative singular-value threshold for ``W`` and ``G_n λ = 0``.
     hessians : (N, 3 or 6, 3 or 6) float, optional
-        :func:`~drakegrasp.curvature.contact_hessians` of ``grasp`` and
+        :func:`~drakegrasp.core.curvature.contact_hessians` of ``grasp`` and
         ``curvatures``, when already computed.
 
     Returns
@@ -220,7 +206,7 @@ def build_second_order_program(
         )
     T = _twist_scaling(grasp)
     Gs = T.T @ normal_grasp_matrix(grasp)[:, S]
-    B = _null_basis(Gs, rank_tol)
+    B = left_null_space(Gs, rank_tol=rank_tol)
     if B.shape[1] == 0:
         raise InvalidGraspError("W = {0}: the grasp is decided at first order")
     b = grasp.characteristic_length
@@ -231,7 +217,7 @@ def build_second_order_program(
     t = prog.NewContinuousVariables(1, "t")[0]
     prog.AddBoundingBoxConstraint(0.0, np.inf, lam)
     add_linear_equality_constraint(prog, np.ones((1, len(S))), [1.0], lam)
-    _add_balance(prog, Gs, lam, rank_tol)
+    add_balance(prog, Gs, lam, rank_tol)
     k = B.shape[1]
     lmi = prog.AddLinearMatrixInequalityConstraint(
         [np.zeros((k, k))] + [-Ai for Ai in A] + [-np.eye(k)], np.append(lam, t)
@@ -320,11 +306,11 @@ class SecondOrderResult:
     @property
     def near_boundary(self) -> bool:
         """True when ``t*`` is within ``tol`` of 0: higher orders decide."""
-        return math.isfinite(self.t_star) and _near(self.margin)
+        return math.isfinite(self.t_star) and near_threshold(self.margin)
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
-        d = {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+        d = {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
         d["near_boundary"] = self.near_boundary
         return d
 
@@ -418,7 +404,7 @@ def second_order_form_closure(
     prog, var = build_second_order_program(
         grasp, curvatures, support=support, rank_tol=rank_tol, hessians=H
     )
-    result = _solve(prog, (ClarabelSolver(), ScsSolver()))
+    result = solve(prog, "sdp")
     status = result.get_solution_result()
     solver = result.get_solver_id().name()
     if status != SolutionResult.kSolutionFound:
@@ -436,7 +422,7 @@ def second_order_form_closure(
         multipliers=lam,
         dim_w=k,
         support=tuple(int(i) for i in var.support),
-        margin=_relative_margin(t_star, tol),
+        margin=relative_margin(t_star, tol),
         tol=tol,
         solver=solver,
         status=status.name,
@@ -554,7 +540,7 @@ def _escape_acceleration(Gt, closed, H, T, nu, b):
     A = np.hstack([Gt[:, idx].T, -np.ones((len(idx), 1))])
     add_linear_constraint(prog, A, -h, np.full(len(idx), np.inf), np.append(a, s))
     prog.AddLinearCost(np.append(np.full(n, 1e-3), -1.0), 0.0, np.append(z, s))
-    result = _solve(prog, (ClpSolver(), ClarabelSolver()))
+    result = solve(prog, "lp")
     if result.get_solution_result() != SolutionResult.kSolutionFound:
         return None
     acc = np.asarray(result.GetSolution(a))
@@ -579,7 +565,7 @@ def _no_equilibrium(grasp: Grasp, tol: float) -> SecondOrderResult:
         np.append(nu, s),
     )
     prog.AddLinearCost(-s)
-    result = _solve(prog, (ClpSolver(), ClarabelSolver()))
+    result = solve(prog, "lp")
     v = np.asarray(result.GetSolution(nu))
     v = T @ (v / np.linalg.norm(v))
     s_star = float(result.GetSolution(s))

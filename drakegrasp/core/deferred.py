@@ -4,7 +4,7 @@ A verdict that the rank already decides does not need its program's ``d*``, and
 nobody needs a certificate or a second-order analysis until they read it; both
 cost more than the verdict.  :func:`defer` wraps such a computation in a
 :class:`Deferred`, and a result type declares the fields that may hold one with
-:class:`deferrable` (a data descriptor, which :mod:`dataclasses` accepts as a
+:class:`deferrable` (a data descriptor, which ``dataclasses`` accepts as a
 field's default).  Reading the field runs the computation once and keeps its
 value, so the attribute, ``to_dict()``, ``str()``, ``==`` and ``repr`` see
 exactly what an eager computation would have stored.  Pickling and copying
@@ -191,7 +191,7 @@ def _init_fields(cls) -> tuple:
 
 
 def replace(obj, **changes):
-    """:func:`dataclasses.replace` that keeps pending fields pending."""
+    """``dataclasses.replace`` that keeps pending fields pending."""
     kwargs = {}
     for name, slot in _init_fields(type(obj)):
         if name in changes:

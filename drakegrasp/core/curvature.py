@@ -1,6 +1,6 @@
 r"""Curvatures at a contact and the Hessian of its signed distance (numpy only).
 
-Second-order form closure (:mod:`drakegrasp.second_order`) needs, at every
+Second-order form closure (:mod:`drakegrasp.closure.second_order`) needs, at every
 contact, how the signed distance ``ψ_i`` between the moving object and the
 fixed finger bends along a rigid motion of the object.  This module holds the
 geometry that decides it: the principal curvatures of the object's and the
@@ -34,8 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakegrasp.core.grasp import Grasp
 from drakegrasp.errors import InvalidContactError
-from drakegrasp.grasp import Grasp
 
 __all__ = [
     "ContactCurvature",

@@ -1,7 +1,7 @@
 r"""Compute the certificates of the closure verdicts (``pydrake.solvers`` only).
 
 The witness of a "no" comes from the normalised balance matrix ``Ḡ = T G``
-(:func:`~drakegrasp.grasp.normalised_grasp_matrix`) on which every rank is
+(:func:`~drakegrasp.core.grasp.normalised_grasp_matrix`) on which every rank is
 decided, then is mapped to the grasp frame: ``Ḡᵀ u = Gᵀ (Tᵀ u)``, so a dual
 vector ``u`` of ``Ḡ`` is the physical twist ``Tᵀ u`` (an escape twist, or the
 normal of a separating hyperplane in wrench space), and the wrench that
@@ -17,7 +17,7 @@ choice of reference point.
             -\textstyle\sum_i a_{n,i}(u) = 1
 
   with ``a_i = Ḡ_iᵀ u`` and ``σ_i`` the support of contact ``i``'s cone
-  (:func:`~drakegrasp.certificates.cone_support`; linear for polyhedral
+  (:func:`~drakegrasp.certificates.certificate.cone_support`; linear for polyhedral
   cones, second-order for exact ones).  The normalisation is possible exactly
   when a witness exists (``a_n,i`` averages ``a_i`` over the cone's
   generators), and ``s*`` is how firmly the worst-resisted direction is
@@ -32,14 +32,12 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.solvers import (
-    ClarabelSolver,
-    ClpSolver,
     MathematicalProgram,
-    ScsSolver,
     SolutionResult,
 )
 
-from drakegrasp.certificates import (
+from drakegrasp._solvers import solve
+from drakegrasp.certificates.certificate import (
     BALANCE,
     ESCAPE_TWIST,
     UNCONTROLLABLE,
@@ -47,8 +45,9 @@ from drakegrasp.certificates import (
     Certificate,
     support_of,
 )
-from drakegrasp.friction_cone import ConeLayout
-from drakegrasp.grasp import Grasp, grasp_matrix, normalised_grasp_matrix
+from drakegrasp.core.friction_cone import ConeLayout
+from drakegrasp.core.grasp import Grasp, grasp_matrix, normalised_grasp_matrix
+from drakegrasp.core.linalg import left_null_space
 
 __all__ = [
     "GraspFrame",
@@ -107,14 +106,6 @@ def _scale_wrench(grasp: Grasp, w: np.ndarray) -> np.ndarray:
     return w / np.linalg.norm(np.concatenate([w[:d], w[d:] / b]))
 
 
-def _left_null_space(A: np.ndarray, rank: int) -> np.ndarray:
-    """Columns spanning ``N(Aᵀ)`` (column scaling of ``A`` does not change it)."""
-    norms = np.linalg.norm(A, axis=0)
-    A_s = A / np.where(norms > 0.0, norms, 1.0)
-    U = np.linalg.svd(A_s)[0]
-    return U[:, rank:]
-
-
 def _readable(N: np.ndarray) -> np.ndarray:
     """The same span as the orthonormal ``N``, axis directions first.
 
@@ -138,20 +129,12 @@ def _readable(N: np.ndarray) -> np.ndarray:
 def _physical_basis(grasp, A, rank, *, wrench: bool):
     """Twists ``Tᵀ u`` (and wrenches ``T⁻¹ u``) for ``u`` spanning ``N(Aᵀ)``."""
     T = normalising_transform(grasp)
-    U = _readable(_left_null_space(A, rank))
+    U = _readable(left_null_space(A, rank=rank, equilibrate=True))
     twists = np.column_stack([_scale_twist(grasp, x) for x in (T.T @ U).T])
     if not wrench:
         return twists, None
     wrenches = np.linalg.solve(T, U)
     return twists, np.column_stack([_scale_wrench(grasp, x) for x in wrenches.T])
-
-
-def _solve(prog, conic: bool):
-    solvers = (ClarabelSolver(), ScsSolver()) if conic else (ClpSolver(),)
-    for solver in solvers:
-        if solver.available() and solver.enabled():
-            return solver.Solve(prog)
-    return None
 
 
 @dataclass(frozen=True)
@@ -263,8 +246,8 @@ def escape_twist(grasp: Grasp, rank: int) -> Certificate | None:
 
 def _finish(prog, x, grasp, *, conic, kind, G=None, cones="normals", ng=8):
     """Solve a witness program; the certificate, or None if there is none."""
-    result = _solve(prog, conic)
-    if result is None or result.get_solution_result() != SolutionResult.kSolutionFound:
+    result = solve(prog, "socp" if conic else "lp")
+    if result.get_solution_result() != SolutionResult.kSolutionFound:
         return None
     sol = result.GetSolution(x)
     if not sol[-1] > _ACCEPT:

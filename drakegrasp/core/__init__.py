@@ -1,0 +1,10 @@
+"""The numpy core: contacts, frames, grasp matrices, friction cones, antipodal pairs.
+
+Everything here is numpy (no solver, no plant): contacts and their frames
+(:mod:`~drakegrasp.core.contact`), the grasp matrix **G** and its relatives
+(:mod:`~drakegrasp.core.grasp`), friction cones and their support functions
+(:mod:`~drakegrasp.core.friction_cone`), the antipodal test, surface curvature,
+the textbook example grasps, input validation, the tolerance table, rank and
+null spaces (:mod:`~drakegrasp.core.linalg`) and the JSON helper.  Every other
+layer imports from here; nothing here imports another layer.
+"""

@@ -1,0 +1,165 @@
+"""Rank, row spaces and null spaces: the linear algebra every verdict rests on.
+
+All of it is the singular value decomposition with one relative threshold
+(:data:`~drakegrasp.core.tolerances.DEFAULT_RANK_TOL`): a singular value counts
+when it exceeds ``rank_tol * σ_max``.  Balance matrices are *equilibrated*
+(columns scaled to unit length) before their rank is read, so a variable's unit
+(a soft finger's torsional moment in N·m beside forces in N) never decides what
+counts as zero; scaling columns changes neither the rank nor, pulled back, the
+null space.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
+from drakegrasp.core.validation import check_rank_tol, real_array
+from drakegrasp.errors import InvalidOptionError
+
+__all__ = [
+    "ZERO_COLUMN",
+    "equilibrated",
+    "left_null_space",
+    "matrix_rank",
+    "row_space",
+    "unit_columns",
+]
+
+ZERO_COLUMN = 1e-12
+"""Relative norm below which :func:`unit_columns` drops a column as zero."""
+
+
+def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
+    """Numerical rank: singular values above ``rank_tol * σ_max``.
+
+    Parameters
+    ----------
+    A : (m, n) float
+    rank_tol : float, optional
+        Relative threshold on the singular values.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    InvalidOptionError
+        ``A`` not a real finite 2-D array (LAPACK's SVD can loop forever on
+        ``inf``/``NaN``), or ``rank_tol`` outside its valid range.
+    """
+    A = real_array("A", A, error=InvalidOptionError)
+    if A.ndim != 2 or not np.all(np.isfinite(A)):
+        raise InvalidOptionError(
+            f"matrix_rank needs a finite 2-D array, got shape {A.shape}"
+            + ("" if A.ndim != 2 else " with non-finite entries")
+        )
+    rank_tol = check_rank_tol(rank_tol)
+    if A.size == 0:
+        return 0
+    s = np.linalg.svd(A, compute_uv=False)
+    if s[0] == 0.0:
+        return 0
+    return int(np.sum(s > rank_tol * s[0]))
+
+
+def equilibrated(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``A diag(scale)`` with unit columns, and ``scale`` (zero columns kept).
+
+    Parameters
+    ----------
+    A : (m, n) float
+
+    Returns
+    -------
+    A_s : (m, n) float
+        ``A`` with every non-zero column scaled to unit length.
+    scale : (n,) float
+        ``1 / ‖A_j‖`` per column (1 for a zero column).
+    """
+    norms = np.linalg.norm(A, axis=0)
+    scale = np.ones_like(norms)
+    np.divide(1.0, norms, out=scale, where=norms > 0.0)
+    return A * scale, scale
+
+
+def row_space(A: np.ndarray, rank_tol: float = DEFAULT_RANK_TOL) -> np.ndarray:
+    """Orthonormal basis (rows) of the numerical row space of ``A``.
+
+    Parameters
+    ----------
+    A : (m, n) float
+    rank_tol : float, optional
+
+    Returns
+    -------
+    (r, n) float
+        The right singular vectors whose singular values exceed
+        ``rank_tol σ_max`` (``r = 0`` for a zero matrix).
+    """
+    _, s, vt = np.linalg.svd(A)
+    if s.size == 0 or s[0] == 0.0:
+        return np.zeros((0, A.shape[1]))
+    return vt[: int(np.sum(s > rank_tol * s[0]))]
+
+
+def left_null_space(
+    A: np.ndarray,
+    *,
+    rank: int | None = None,
+    rank_tol: float = DEFAULT_RANK_TOL,
+    equilibrate: bool = False,
+) -> np.ndarray:
+    """Orthonormal basis (columns) of the numerical left null space ``N(Aᵀ)``.
+
+    Parameters
+    ----------
+    A : (m, n) float
+    rank : int, optional
+        The rank to use; by default the number of singular values above
+        ``rank_tol σ_max``.
+    rank_tol : float, optional
+        Relative threshold when ``rank`` is not given.
+    equilibrate : bool, optional
+        Scale ``A``'s columns to unit length first (:func:`equilibrated`): the
+        same null space, read without regard to the columns' units.
+
+    Returns
+    -------
+    (m, m - rank) float
+        The left singular vectors beyond the rank; the identity when ``A`` has
+        no columns.
+    """
+    if A.shape[1] == 0:
+        return np.eye(A.shape[0])
+    if equilibrate:
+        A = equilibrated(A)[0]
+    u, s, _ = np.linalg.svd(A)
+    if rank is None:
+        rank = int(np.sum(s > rank_tol * s[0])) if s.size and s[0] > 0 else 0
+    return u[:, rank:]
+
+
+def unit_columns(J: np.ndarray) -> np.ndarray:
+    """``J`` with its columns scaled to unit length, numerically zero ones dropped.
+
+    ``N(Jᵀ)`` is unchanged (each row of ``Jᵀ`` is only rescaled), but a joint
+    measured in other units, or a Jacobian scaled by 1e9, no longer decides which
+    singular values of ``[G; Jᵀ]`` count as zero.  A column below
+    :data:`ZERO_COLUMN` times the largest (a joint that moves no contact, up to
+    round-off) is dropped rather than blown up to a spurious constraint.
+
+    Parameters
+    ----------
+    J : (m, n) float
+
+    Returns
+    -------
+    (m, k) float, k <= n
+    """
+    norms = np.linalg.norm(J, axis=0)
+    if norms.size == 0 or not norms.max() > 0.0:
+        return J[:, :0]
+    keep = norms > ZERO_COLUMN * norms.max()
+    return J[:, keep] / norms[keep]

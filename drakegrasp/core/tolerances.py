@@ -1,0 +1,44 @@
+"""Every default tolerance of drakegrasp, defined once.
+
+The programs, the batch engine, the plant layer, the monitor and the command
+line all read their defaults from here, so a threshold means the same in each
+of them.
+"""
+
+from __future__ import annotations
+
+import math
+
+__all__ = [
+    "DEFAULT_RANK_TOL",
+    "DEFAULT_TOL",
+    "ZERO_FRACTION",
+    "near_threshold",
+    "relative_margin",
+]
+
+DEFAULT_TOL = 1e-6
+"""Default threshold on ``d*``: closure needs ``d* > tol`` (LP3 passes at ``<= tol``).
+
+LP1–LP3 normalise the normal forces to ``Σ f_n <= N``, so ``d*`` is of order 0.1
+for a good grasp; the solvers report ``d*`` to about 1e-10 (checked against
+closed forms), far below this threshold.
+"""
+
+DEFAULT_RANK_TOL = 1e-9
+"""Singular values below ``rank_tol * σ_max`` count as zero in rank tests."""
+
+ZERO_FRACTION = 1e-3
+"""``d*`` below ``ZERO_FRACTION * tol`` is the solver's zero, not a near miss."""
+
+
+def relative_margin(value: float, tol: float) -> float:
+    """``(value - tol) / tol``: positive above the threshold, ``|m| < 1`` within tol."""
+    if not math.isfinite(value):
+        return -math.inf
+    return (value - tol) / tol
+
+
+def near_threshold(margin: float) -> bool:
+    """True when ``d*`` lies in ``(ZERO_FRACTION tol, 2 tol)``: not certain."""
+    return ZERO_FRACTION - 1.0 < margin < 1.0

@@ -1,0 +1,252 @@
+"""The house: layers as folders, imports pointing inwards only, no cycle.
+
+The import graph is read from the source: every ``import`` statement counts,
+also those inside functions (which hide a cycle until the function runs) and
+those under ``if TYPE_CHECKING:`` (a type-only import is still a dependency of
+the design).  Package ``__init__`` files are left out of the graph: they hold
+lazy tables of names (strings), which import nothing until a name is read.
+
+The layers, inner to outer (``docs/architecture.md``)::
+
+    foundation   errors, _lazy
+    core, _solvers                    (numpy only; the solver gateway)
+    certificates
+    closure
+    quality, plant                    (peers: neither imports the other)
+    batch, visualization              (peers)
+    systems, planning, distributed    (peers)
+    cli
+    __main__
+
+This refines the order ``core → certificates → closure → {quality, plant} →
+{batch, systems, visualization, distributed} → cli``: the outer ring is split
+where one of its folders drives another (the Dask driver runs the batch
+engine; the monitor and the planner use the batch engine and the pictures).
+A module may import from its own folder and from any inner layer, never from a
+peer or an outer one.
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import drakegrasp
+
+PACKAGE = Path(drakegrasp.__file__).resolve().parent
+
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ("errors", "_lazy"),
+    ("core", "_solvers"),
+    ("certificates",),
+    ("closure",),
+    ("quality", "plant"),
+    ("batch", "visualization"),
+    ("systems", "planning", "distributed"),
+    ("cli",),
+    ("__main__",),
+)
+RANK = {room: rank for rank, rooms in enumerate(LAYERS) for room in rooms}
+
+MAX_DEPTH = 13
+"""The longest import chain, in edges (14 before the layers became folders).
+
+The chain that sets it is conceptual, one room per step: errors ← validation ←
+contact ← grasp ← friction cones ← certificate check ← certificate ← witness
+finding ← verdicts ← second order ← plant analysis ← cli ← ``__main__``, less
+what the folders' rules removed.  A change that lengthens it adds a level to
+every import of the package: it fails here so that it is a decision.
+"""
+
+MAX_ROOT_MODULES = 6
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {
+    module_name(p): p for p in sorted(PACKAGE.rglob("*.py")) if "models" not in p.parts
+}
+
+
+def _import_targets(node: ast.AST) -> list[str]:
+    if isinstance(node, ast.Import):
+        return [a.name for a in node.names]
+    if isinstance(node, ast.ImportFrom) and node.module:
+        return [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+    return []
+
+
+def imports_of(path: Path, *, module_level_only: bool = False) -> set[str]:
+    """drakegrasp modules that ``path`` imports (``from pkg import mod`` too)."""
+    tree = ast.parse(path.read_text())
+    me = module_name(path)
+    stack = list(tree.body)
+    found: set[str] = set()
+    while stack:
+        node = stack.pop()
+        if module_level_only and isinstance(
+            node, ast.FunctionDef | ast.AsyncFunctionDef
+        ):
+            continue
+        for name in _import_targets(node):
+            if name in MODULES and name != me and not me.startswith(name + "."):
+                found.add(name)
+        stack.extend(ast.iter_child_nodes(node))
+    return found
+
+
+def graph(*, module_level_only: bool = False) -> dict[str, set[str]]:
+    """Module → the modules it imports, package ``__init__`` files left out."""
+    inits = {n for n, p in MODULES.items() if p.name == "__init__.py"}
+    return {
+        name: imports_of(path, module_level_only=module_level_only) - inits
+        for name, path in MODULES.items()
+        if name not in inits
+    }
+
+
+def room(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "__init__"
+
+
+def find_cycle(edges: dict[str, set[str]]) -> list[str] | None:
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(n):
+        state[n] = 1
+        stack.append(n)
+        for m in sorted(edges.get(n, ())):
+            if state.get(m) == 1:
+                return stack[stack.index(m) :] + [m]
+            if m not in state:
+                cycle = visit(m)
+                if cycle:
+                    return cycle
+        state[n] = 2
+        stack.pop()
+        return None
+
+    for n in sorted(edges):
+        if n not in state:
+            cycle = visit(n)
+            if cycle:
+                return cycle
+    return None
+
+
+def layering_violations(edges: dict[str, set[str]]) -> list[str]:
+    """Imports that point outwards, or sideways into a peer folder."""
+    bad = []
+    for a, targets in edges.items():
+        for b in targets:
+            ra, rb = room(a), room(b)
+            if ra == rb:
+                continue
+            if ra not in RANK or rb not in RANK:
+                bad.append(f"{a} -> {b}: folder not in LAYERS")
+            elif RANK[b.split(".")[1]] >= RANK[ra]:
+                bad.append(f"{a} -> {b}")
+    return sorted(bad)
+
+
+def longest_chain(edges: dict[str, set[str]]) -> list[str]:
+    memo: dict[str, list[str]] = {}
+
+    def chain(m: str) -> list[str]:
+        if m not in memo:
+            best = [m]
+            for t in sorted(edges.get(m, ())):
+                c = [m, *chain(t)]
+                if len(c) > len(best):
+                    best = c
+            memo[m] = best
+        return memo[m]
+
+    return max((chain(m) for m in edges), key=len)
+
+
+def test_the_cycle_finder_finds_a_cycle():
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_no_import_cycle_type_only_and_function_level_imports_included():
+    cycle = find_cycle(graph())
+    assert cycle is None, f"import cycle: {' -> '.join(cycle)}"
+
+
+def test_type_only_and_lazy_imports_are_edges(tmp_path, monkeypatch):
+    source = (
+        "from typing import TYPE_CHECKING\n"
+        "if TYPE_CHECKING:\n    from drakegrasp.core.grasp import Grasp\n"
+        "def f():\n    from drakegrasp.plant.scene import load_scene\n"
+    )
+    path = PACKAGE / "core" / "contact.py"
+    monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: source)
+    found = imports_of(path)
+    assert {"drakegrasp.core.grasp", "drakegrasp.plant.scene"} <= found
+
+
+def test_every_folder_has_a_layer():
+    rooms = {room(m) for m in MODULES} - {"__init__"}
+    assert rooms <= set(RANK), rooms - set(RANK)
+
+
+def test_imports_point_inwards_only():
+    assert layering_violations(graph()) == []
+
+
+def test_the_layering_test_sees_an_upward_and_a_sideways_import():
+    edges = graph()
+    upward = {**edges, "drakegrasp.core.contact": {"drakegrasp.plant.analysis"}}
+    assert layering_violations(upward) == [
+        "drakegrasp.core.contact -> drakegrasp.plant.analysis"
+    ]
+    sideways = {**edges, "drakegrasp.quality.epsilon": {"drakegrasp.plant.scene"}}
+    assert layering_violations(sideways) == [
+        "drakegrasp.quality.epsilon -> drakegrasp.plant.scene"
+    ]
+
+
+def test_dependency_depth():
+    chain = longest_chain(graph())
+    assert len(chain) - 1 <= MAX_DEPTH, " -> ".join(chain)
+
+
+def test_few_modules_loose_at_the_root():
+    loose = sorted(p.name for p in PACKAGE.glob("*.py"))
+    assert len(loose) <= MAX_ROOT_MODULES, loose
+
+
+def test_the_core_imports_numpy_and_the_foundation_only():
+    allowed = {"numpy", "math", "dataclasses", "typing", "collections", "functools"}
+    for name, path in MODULES.items():
+        if room(name) != "core":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            for target in _import_targets(node):
+                top = target.split(".")[0]
+                if top == "drakegrasp":
+                    assert room(target) in ("core", "errors"), (name, target)
+                elif top in ("pydrake", "scipy", "matplotlib"):
+                    pytest.fail(f"{name} imports {target}: the core is numpy only")
+    assert allowed  # documentation of intent: the standard library is fine
+
+
+@pytest.mark.parametrize(
+    "name", [n for n in MODULES if room(n) in ("plant", "core", "closure")]
+)
+def test_each_module_imports_first_in_a_fresh_interpreter(name):
+    run = subprocess.run(
+        [sys.executable, "-c", f"import {name}"], capture_output=True, text=True
+    )
+    assert run.returncode == 0, run.stderr
