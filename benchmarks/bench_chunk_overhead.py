@@ -10,7 +10,7 @@ sampler of ``bench_epsilon.py``) go through
 :func:`drakegrasp.batch.batch_force_closure` with ``workers=1`` (validation,
 construction, the compiled kernel, normal certificates, results).  The CPU time
 of this process is split by timing every call of the compiled kernel
-``drakegrasp.batch.fused_kernel._full_rank_stack``; ``outside`` is the rest,
+``drakegrasp.batch.lp.fused_kernel._full_rank_stack``; ``outside`` is the rest,
 per grasp.  Rates are grasps per CPU second, best of ``--repeats``, numpy/BLAS
 pinned to one thread, numba compiled before the clock starts.
 
@@ -44,7 +44,8 @@ from bench_epsilon import random_grasps  # noqa: E402
 def measure(N: int, repeats: int) -> dict:
     """Best total and kernel CPU seconds of one ``batch_force_closure`` call."""
     import drakegrasp
-    from drakegrasp.batch import batch_force_closure, fused_kernel
+    from drakegrasp.batch import batch_force_closure
+    from drakegrasp.batch.lp import fused_kernel
 
     K = 200_000 if N <= 4 else 40_000
     rng = np.random.default_rng(0)

@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 from pydrake.solvers import ClpSolver  # noqa: E402
 
 import drakegrasp as dg  # noqa: E402
-from drakegrasp.batch.certificates import batch_certificates  # noqa: E402
+from drakegrasp.batch.witnesses import batch_certificates  # noqa: E402
 from drakegrasp.certificates.witness import escape_twist, unresisted_wrench  # noqa: E402
 from drakegrasp.closure import verdicts as closure  # noqa: E402
 

@@ -50,10 +50,11 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from drakegrasp import Contact, Grasp  # noqa: E402
-from drakegrasp.batch import batch_epsilon_l1, epsilon_kernel  # noqa: E402
-from drakegrasp.batch.construction import batched_characteristic_lengths  # noqa: E402
+from drakegrasp.batch import batch_epsilon_l1  # noqa: E402
+from drakegrasp.batch.build.construction import batched_characteristic_lengths  # noqa: E402
+from drakegrasp.batch.build.wrenches import batched_primitive_wrenches  # noqa: E402
+from drakegrasp.batch.epsilon import kernel as epsilon_kernel  # noqa: E402
 from drakegrasp.batch.metrics import epsilon_l1_per_grasp, epsilon_l1_routes  # noqa: E402
-from drakegrasp.batch.wrenches import batched_primitive_wrenches  # noqa: E402
 from drakegrasp.quality import ferrari_canny  # noqa: E402
 
 CASES = {

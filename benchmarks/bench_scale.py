@@ -75,7 +75,7 @@ from bench_epsilon import HEADER as EPS_HEADER  # noqa: E402
 
 from drakegrasp import Contact, Grasp  # noqa: E402
 from drakegrasp.batch import batch_force_closure  # noqa: E402
-from drakegrasp.batch.parallel import available_cores  # noqa: E402
+from drakegrasp.batch.run.workers import available_cores  # noqa: E402
 from drakegrasp.closure.verdicts import force_closure  # noqa: E402
 
 N_FULL = [2, 3, 4, 6, 8, 12, 16, 24, 32]
@@ -221,7 +221,7 @@ def memory_vs_k(sizes, out_dir):
                 "print('WALL', time.perf_counter() - t); "
                 # The kept worker pool is stopped (and its processes waited
                 # for) so that RUSAGE_CHILDREN counts them.
-                "from drakegrasp.batch.parallel import shutdown_pool; "
+                "from drakegrasp.batch.run.workers import shutdown_pool; "
                 "shutdown_pool(); "
                 "hwm = [ln.split()[1] for ln in open('/proc/self/status') "
                 "if ln.startswith('VmHWM')]; "

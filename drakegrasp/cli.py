@@ -130,6 +130,24 @@ def _cmd_batch(args: argparse.Namespace) -> int:
     if args.scheduler is not None:
         from drakegrasp.distributed.batch_side import stream_file_on_cluster
 
+        ignored = [
+            flag
+            for flag, given in (
+                ("--workers", args.workers is not None),
+                ("--progress", args.progress),
+                ("--format", args.format is not None),
+                ("--overwrite", args.overwrite),
+            )
+            if given
+        ]
+        if ignored:
+            raise InvalidOptionError(
+                f"{', '.join(ignored)} cannot be used with --scheduler: the "
+                "cluster's workers run the chunks and write Parquet shards into "
+                "OUT's dataset directory; drop them or run without --scheduler"
+            )
+        for key in ("workers", "progress", "fmt"):
+            options.pop(key)
         summary = stream_file_on_cluster(
             args.input, args.output, scheduler=args.scheduler, **options
         )
@@ -324,7 +342,8 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "--chunk-size",
         type=int,
         default=None,
-        help="grasps per chunk (default: sized to ~16 MiB of working memory)",
+        help="grasps per chunk (default: sized by the engine's working-memory "
+        "budget per chunk, drakegrasp.batch.run.stream.CHUNK_BYTES)",
     )
     batch.add_argument(
         "--workers",

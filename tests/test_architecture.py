@@ -52,7 +52,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
 )
 RANK = {room: rank for rank, rooms in enumerate(LAYERS) for room in rooms}
 
-MAX_DEPTH = 13
+MAX_DEPTH = 11
 """The longest import chain, in edges (14 before the layers became folders).
 
 The chain that sets it is conceptual, one room per step: errors ← validation ←

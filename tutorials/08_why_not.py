@@ -242,7 +242,7 @@ fig.tight_layout()
 # violation stays at round-off.
 
 # %%
-from drakegrasp.batch.certificates import batch_certificates, grasp_at
+from drakegrasp.batch.witnesses import batch_certificates, grasp_at
 
 rng = np.random.default_rng(8)
 count = 60 if TEST_MODE else 600

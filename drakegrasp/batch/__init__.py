@@ -2,23 +2,30 @@
 
 :func:`batch_force_closure` (LP2) and :func:`batch_form_closure` (LP1) decide
 closure for ``K`` grasps with ``N`` contacts each, with the conventions and
-verdicts of :mod:`drakegrasp.closure.verdicts`; :func:`batch_epsilon_l1` gives their
-Ferrari–Canny L1 ε; :func:`iter_batch_closure` consumes a stream of chunks
-lazily; :func:`evaluate_file` runs them on a ``.npz`` file (the ``drakegrasp
-batch`` command).
+verdicts of :mod:`drakegrasp.closure.verdicts`; :func:`batch_epsilon_l1` gives
+their Ferrari–Canny L1 ε; :func:`iter_batch_closure` consumes a stream of
+chunks lazily; :func:`evaluate_file` and :func:`stream_file` run them on a file
+(the ``drakegrasp batch`` command).
 
-Modules: :mod:`~drakegrasp.batch.construction` (vectorised frames, grasp
-matrices and cone facets), :mod:`~drakegrasp.batch.reduction` (null-space
-reduction of LP1/LP2), :mod:`~drakegrasp.batch.ipm` (batched interior-point
-method), :mod:`~drakegrasp.batch.engine` (chunked drivers),
-:mod:`~drakegrasp.batch.epsilon` (batch ε: :mod:`~drakegrasp.batch.wrenches`,
-:mod:`~drakegrasp.batch.epsilon_kernel`, :mod:`~drakegrasp.batch.polytope`),
-:mod:`~drakegrasp.batch.io` (files), :mod:`~drakegrasp.batch.writers` (results
-streamed to .npz/.parquet in flat memory), :mod:`~drakegrasp.batch.parallel`
-(worker processes).
+The folder reads as the pipeline, one stage per room:
+
+* :mod:`~drakegrasp.batch.api`: the public functions and
+  :class:`BatchClosureResult`;
+* :mod:`~drakegrasp.batch.inputs`: arrays and options checked, once, and the
+  kernel choice resolved;
+* :mod:`~drakegrasp.batch.run`: the chunk stream, one chunk start to finish,
+  worker processes and shared memory;
+* :mod:`~drakegrasp.batch.build`: frames, grasp matrices, facets, ranks and
+  wrenches of a chunk;
+* :mod:`~drakegrasp.batch.lp`: ``d*`` from the compiled LP kernels;
+* :mod:`~drakegrasp.batch.epsilon` and :mod:`~drakegrasp.batch.metrics`: ε and
+  the singular-value metrics;
+* :mod:`~drakegrasp.batch.witnesses`: certificates of the failing grasps;
+* :mod:`~drakegrasp.batch.files`: one reader, one writer per format, one file
+  driver.
 """
 
-from drakegrasp.batch.engine import (
+from drakegrasp.batch.api import (
     DEFAULT_CHUNK_SIZE,
     METRICS,
     BatchClosureResult,
@@ -28,9 +35,10 @@ from drakegrasp.batch.engine import (
     stream_force_closure,
     stream_form_closure,
 )
-from drakegrasp.batch.epsilon import batch_epsilon_l1
-from drakegrasp.batch.io import evaluate_file, read_grasps, write_result
-from drakegrasp.batch.writers import BatchSummary, stream_file, write_chunks
+from drakegrasp.batch.epsilon.driver import batch_epsilon_l1
+from drakegrasp.batch.files.driver import evaluate_file, stream_file, write_result
+from drakegrasp.batch.files.reader import read_grasps
+from drakegrasp.batch.files.writer import BatchSummary, write_chunks
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",

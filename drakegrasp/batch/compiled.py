@@ -1,8 +1,8 @@
 """numba's ``njit`` when numba is installed, a stand-in decorator when not.
 
 numba is an optional dependency (``pip install drakegrasp[fast]``).  The batch
-kernels (:mod:`~drakegrasp.batch.block_kernel`,
-:mod:`~drakegrasp.batch.fused_kernel`, :mod:`~drakegrasp.batch.epsilon_kernel`)
+kernels (:mod:`~drakegrasp.batch.lp.block_kernel`,
+:mod:`~drakegrasp.batch.lp.fused_kernel`, :mod:`~drakegrasp.batch.epsilon.kernel`)
 decorate their functions with :func:`njit` from here; ``AVAILABLE`` says
 whether they are compiled, and callers take the pure-numpy routes when not.
 """

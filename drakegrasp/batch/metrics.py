@@ -1,8 +1,8 @@
 """Per-grasp quality metrics of a chunk of grasps (singular values of G, ε L1).
 
 ε L1 of a chunk: the compiled expanding-polytope kernel
-(:mod:`drakegrasp.batch.epsilon_kernel`) on the chunk's primitive wrenches
-(:mod:`drakegrasp.batch.wrenches`), and :func:`drakegrasp.quality.ferrari_canny`
+(:mod:`drakegrasp.batch.epsilon.kernel`) on the chunk's primitive wrenches
+(:mod:`drakegrasp.batch.build.wrenches`), and :func:`drakegrasp.quality.ferrari_canny`
 (Qhull) for the grasps that the kernel flags and, without numba, for all.
 """
 
@@ -69,7 +69,7 @@ def epsilon_l1_per_grasp(
 ) -> np.ndarray:
     """Ferrari–Canny L1 ε of each grasp through :func:`drakegrasp.ferrari_canny`.
 
-    One call per grasp (slow); shapes as :func:`drakegrasp.batch.chunks.force_chunk`.
+    One call per grasp (slow); shapes as :func:`drakegrasp.batch.run.chunk.force_chunk`.
     """
     try:
         from drakegrasp.quality import ferrari_canny
@@ -130,7 +130,7 @@ def epsilon_l1_routes(
     Parameters
     ----------
     P, Nrm, mu, nu, p, b
-        Validated chunk arrays, as :func:`drakegrasp.batch.chunks.force_chunk`
+        Validated chunk arrays, as :func:`drakegrasp.batch.run.chunk.force_chunk`
         takes them (``b`` the characteristic lengths, not None).
     model : str
         Contact model name.
@@ -147,8 +147,8 @@ def epsilon_l1_routes(
     qhull : (k,) bool
         The grasps computed per grasp by Qhull.
     """
-    import drakegrasp.batch.epsilon_kernel as epsilon_kernel
-    from drakegrasp.batch.wrenches import batched_primitive_wrenches
+    import drakegrasp.batch.epsilon.kernel as epsilon_kernel
+    from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
 
     _check_point_count(
         _point_counts(

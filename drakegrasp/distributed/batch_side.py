@@ -27,13 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from drakegrasp.batch.engine import (
-    _check_metrics,
-    _collect,
-    chunk_size_for,
-    stream_force_closure,
-    stream_form_closure,
-)
+from drakegrasp.batch.api import collect, stream_force_closure, stream_form_closure
+from drakegrasp.batch.inputs import check_metrics
+from drakegrasp.batch.run.stream import chunk_size_for
 from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.distributed.client import client_for
@@ -162,8 +158,8 @@ def evaluate_on_cluster(
         return [results[j] for j in sorted(results)]
     chunks = ((sl, results[j]) for j, sl, _ in futures)
     tol = float(options.get("tol", DEFAULT_TOL))
-    names = _check_metrics(options.get("metrics", ()))
-    return _collect(K, d, kind, tol, names, chunks)
+    names = check_metrics(options.get("metrics", ()))
+    return collect(K, d, kind, tol, names, chunks)
 
 
 def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
@@ -191,8 +187,8 @@ def stream_file_on_cluster(
     partition (a rerun skips complete shards).  Returns a
     :class:`~drakegrasp.batch.BatchSummary`.
     """
-    from drakegrasp.batch.io import read_grasps
-    from drakegrasp.batch.writers import BatchSummary
+    from drakegrasp.batch.files.reader import read_grasps
+    from drakegrasp.batch.files.writer import BatchSummary
 
     del workers, progress, fmt  # the cluster decides; output is always a dataset
     data = read_grasps(input_path)

@@ -1,4 +1,4 @@
-"""The exact active-set method of small null spaces (drakegrasp.batch.active_set).
+"""The exact active-set method of small null spaces (drakegrasp.batch.lp.active_set).
 
 Its answers are checked against HiGHS on the same reduced LP, against the
 general n-dimensional route (the planar form of n = 3 is a second
@@ -16,22 +16,22 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
-from drakegrasp.batch.compiled import AVAILABLE
-from drakegrasp.batch.construction import (
+from drakegrasp.batch.build.construction import (
     FRICTIONLESS,
     PLANAR_HARD,
     SPATIAL_HARD,
     batched_grasp_matrix,
     kind_facets,
 )
-from drakegrasp.batch.rowspace import normalised_positions
+from drakegrasp.batch.build.rowspace import normalised_positions
+from drakegrasp.batch.compiled import AVAILABLE
 from drakegrasp.errors import InvalidOptionError
 
 pytestmark = pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")
 
 
 def _solve(a, c, **kw):
-    from drakegrasp.batch.active_set import solve_reduced_lp
+    from drakegrasp.batch.lp.active_set import solve_reduced_lp
 
     return solve_reduced_lp(a, c, **kw)
 
@@ -169,7 +169,7 @@ def _grasp_stack(rng, K, N, d, kind, mu):
 )
 def test_fused_active_set_matches_the_ipm_on_grasps(N, d, kind, mu):
     """The fused pass with the active-set method against the same pass, IPM only."""
-    from drakegrasp.batch.fused_kernel import solve_full_rank_stack
+    from drakegrasp.batch.lp.fused_kernel import solve_full_rank_stack
 
     rng = np.random.default_rng(8400 + 10 * N + d)
     G, F, nc, kappa = _grasp_stack(rng, 600, N, d, kind, mu)

@@ -5,7 +5,7 @@ import pytest
 from scipy.optimize import linprog
 
 import drakegrasp as dg
-from drakegrasp.batch.certificates import batch_certificates, grasp_at
+from drakegrasp.batch.witnesses import batch_certificates, grasp_at
 
 
 def _random_batch(rng, K, N, d, spread=1.5):
@@ -97,7 +97,7 @@ def test_rank_deficient_witnesses_are_vectorised_and_span_the_single_paths(
     form, monkeypatch
 ):
     """Two fingers (rank 5 with friction, 1 without): no Grasp is built per row."""
-    import drakegrasp.batch.certificates as bc
+    import drakegrasp.batch.witnesses as bc
 
     rng = np.random.default_rng(5)
     K = 60

@@ -88,3 +88,26 @@ def test_a_directory_without_normals_is_named(tmp_path, capsys):
         main(["batch", str(tmp_path / "g"), str(tmp_path / "o.npz"), "--mu", "1"]) == 1
     )
     assert "has no array(s) ['normals']" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "extra, named",
+    [
+        (["--workers", "2"], "--workers"),
+        (["--progress"], "--progress"),
+        (["--format", "npz"], "--format"),
+        (["--overwrite"], "--overwrite"),
+        (["--workers", "1", "--overwrite"], "--workers, --overwrite"),
+    ],
+)
+def test_scheduler_refuses_options_it_would_ignore(
+    grasp_file, tmp_path, capsys, extra, named
+):
+    # No scheduler is contacted: the refusal comes before any connection.
+    path, _, _ = grasp_file
+    out = tmp_path / "dataset"
+    args = ["batch", str(path), str(out), "--scheduler", "127.0.0.1:1", *extra]
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{named} cannot be used with --scheduler" in err
+    assert not out.exists()

@@ -1,6 +1,6 @@
 """The compiled chunk construction against its numpy reference and the single path.
 
-:mod:`drakegrasp.batch.construction_kernel` builds normalised positions, grasp
+:mod:`drakegrasp.batch.build.construction_kernel` builds normalised positions, grasp
 matrices and the normal-certificate rank test per grasp; it promises the same
 floating-point operations in the same order as the numpy route, so the two are
 compared bitwise here, on seeded stacks with degenerate grasps mixed in
@@ -17,9 +17,7 @@ import pytest
 from batch_support import make_grasp, random_grasps
 
 from drakegrasp import grasp_matrix
-from drakegrasp.batch import chunks
-from drakegrasp.batch.compiled import AVAILABLE
-from drakegrasp.batch.construction import (
+from drakegrasp.batch.build.construction import (
     FRICTIONLESS,
     PLANAR_HARD,
     SOFT_FULL,
@@ -29,7 +27,9 @@ from drakegrasp.batch.construction import (
     batched_normal_grasp_matrix,
     contact_kinds,
 )
-from drakegrasp.batch.rowspace import normalised_positions
+from drakegrasp.batch.build.rowspace import normalised_positions
+from drakegrasp.batch.compiled import AVAILABLE
+from drakegrasp.batch.run import chunk as chunks
 from drakegrasp.core.validation import unit_vectors
 from drakegrasp.errors import InvalidContactError
 
@@ -38,12 +38,12 @@ pytestmark = pytest.mark.skipif(
 )
 
 if AVAILABLE:
-    from drakegrasp.batch.construction_kernel import (
+    from drakegrasp.batch.build.construction_kernel import (
         grasp_matrix_stack,
         normal_rank_certain,
         normalised_positions_stack,
     )
-    from drakegrasp.batch.fused_kernel import full_column_rank_certain
+    from drakegrasp.batch.lp.fused_kernel import full_column_rank_certain
 
 
 def hostile_stack(rng, K, N, d):
@@ -161,7 +161,7 @@ def test_normal_rank_certificate_agrees_with_the_svd_rule(d, N):
 @pytest.mark.parametrize("w", [3, 6])
 def test_gram_certificate_on_prescribed_singular_values(w):
     """Soundness at the threshold: ``σ_min / σ_max <= rank_tol`` is never certified."""
-    from drakegrasp.batch.construction_kernel import _gram_certain
+    from drakegrasp.batch.build.construction_kernel import _gram_certain
 
     rng = np.random.default_rng(40 + w)
     for N in range(1, w + 1):

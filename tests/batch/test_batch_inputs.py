@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from batch_support import random_grasps
 
-import drakegrasp.batch.chunks as chunks
+import drakegrasp.batch.run.chunk as chunks
 from drakegrasp.batch import batch_force_closure, batch_form_closure, iter_batch_closure
 from drakegrasp.errors import (
     GraspError,
@@ -129,7 +129,7 @@ def test_chunk_size_does_not_change_results():
 
 def test_default_chunks_spread_a_small_batch_over_the_workers():
     """chunk_size=None: bytes-sized chunks, cut into TARGET_CHUNKS for small K."""
-    from drakegrasp.batch.engine import (
+    from drakegrasp.batch.run.stream import (
         MIN_CHUNK_CONTACTS,
         TARGET_CHUNKS,
         chunk_size_for,

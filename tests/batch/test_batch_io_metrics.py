@@ -5,18 +5,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from batch_support import make_grasp, random_grasps
+from reference_ipm import solve_max_last
+from reference_lp import null_spaces
 from scipy.optimize import linprog
 
 from drakegrasp import grasp_matrix
 from drakegrasp.batch import batch_force_closure, batch_form_closure, evaluate_file
-from drakegrasp.batch.construction import (
+from drakegrasp.batch.build.construction import (
     KIND_COMPONENTS,
     batched_grasp_matrix,
     contact_kinds,
     kind_facets,
 )
-from drakegrasp.batch.ipm import solve_max_last
-from drakegrasp.batch.reduction import null_spaces
 from drakegrasp.core.friction_cone import effective_cone
 from drakegrasp.errors import InvalidOptionError
 
@@ -207,8 +207,8 @@ def test_ipm_matches_highs_and_certificates_are_sound():
 
 
 def test_lps_that_hit_the_iteration_cap_are_finished_by_highs(monkeypatch):
-    import drakegrasp.batch.chunks as chunks
-    import drakegrasp.batch.margin as margin
+    import drakegrasp.batch.lp.dstar as margin
+    import drakegrasp.batch.run.chunk as chunks
 
     rng = np.random.default_rng(28)
     P, Nrm = random_grasps(rng, 150, 4, 3)

@@ -16,18 +16,19 @@ import pytest
 from batch_support import make_grasp, random_grasps
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from reference_lp import solve_margin_lp
 
-from drakegrasp.batch import batch_force_closure, batch_form_closure, block_kernel
-from drakegrasp.batch.construction import (
+from drakegrasp.batch import batch_force_closure, batch_form_closure
+from drakegrasp.batch.build.construction import (
     FRICTIONLESS,
     PLANAR_HARD,
     SPATIAL_HARD,
     batched_grasp_matrix,
     kind_facets,
 )
-from drakegrasp.batch.margin import solve_margin_blocks
-from drakegrasp.batch.reduction import solve_margin_lp
-from drakegrasp.batch.rowspace import normalised_positions
+from drakegrasp.batch.build.rowspace import normalised_positions
+from drakegrasp.batch.lp import block_kernel
+from drakegrasp.batch.lp.dstar import solve_margin_blocks
 from drakegrasp.closure.verdicts import force_closure, form_closure
 from drakegrasp.errors import InvalidContactError
 
@@ -244,8 +245,8 @@ def test_fused_pass_matches_the_numpy_reference_on_mixed_ranks(N, d, kind, mu):
 @needs_numba
 def test_fused_rank_certificate_is_the_numpy_one():
     """full_column_rank_certain against the vectorised QR test it replaces."""
-    from drakegrasp.batch.fused_kernel import full_column_rank_certain
-    from drakegrasp.batch.rowspace import _householder, _inverse_frobenius
+    from drakegrasp.batch.build.rowspace import _householder, _inverse_frobenius
+    from drakegrasp.batch.lp.fused_kernel import full_column_rank_certain
 
     rng = np.random.default_rng(7700)
     Gn = rng.normal(size=(500, 6, 4))
@@ -267,7 +268,7 @@ def test_the_worker_pool_is_kept_and_replaced_when_a_worker_dies():
     import os
     import signal
 
-    from drakegrasp.batch import parallel
+    from drakegrasp.batch.run import workers as parallel
 
     rng = np.random.default_rng(7800)
     P, Nrm = random_grasps(rng, 1200, 4, 3)

@@ -8,7 +8,7 @@ import pytest
 from batch_support import random_grasps
 
 from drakegrasp.batch import batch_force_closure, batch_form_closure, stream_file
-from drakegrasp.batch.writers import format_of
+from drakegrasp.batch.files.writer import format_of
 from drakegrasp.cli import main
 from drakegrasp.errors import InvalidOptionError
 

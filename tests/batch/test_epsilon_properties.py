@@ -9,15 +9,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from drakegrasp import GraspError, InvalidContactError, InvalidOptionError
-from drakegrasp.batch import (
-    batch_epsilon_l1,
-    batch_force_closure,
-    epsilon_kernel,
-    polytope,
-)
-from drakegrasp.batch.construction import batched_characteristic_lengths
+from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
+from drakegrasp.batch.build.construction import batched_characteristic_lengths
+from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
+from drakegrasp.batch.epsilon import kernel as epsilon_kernel
+from drakegrasp.batch.epsilon import polytope
 from drakegrasp.batch.metrics import epsilon_l1_routes
-from drakegrasp.batch.wrenches import batched_primitive_wrenches
 from drakegrasp.quality import ferrari_canny
 
 pytestmark = pytest.mark.skipif(

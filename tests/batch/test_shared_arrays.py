@@ -1,4 +1,4 @@
-"""Large task arrays through shared memory (drakegrasp.batch.shared_arrays).
+"""Large task arrays through shared memory (drakegrasp.batch.run.shared_arrays).
 
 The transport must be invisible: the worker sees the same bytes, dtype,
 shape and memory order as after pickling, results come back the same, a task
@@ -16,8 +16,8 @@ from multiprocessing import shared_memory
 import numpy as np
 import pytest
 
-from drakegrasp.batch import parallel
-from drakegrasp.batch.shared_arrays import (
+from drakegrasp.batch.run import workers as parallel
+from drakegrasp.batch.run.shared_arrays import (
     RESULT_ROOM,
     SHARE_MIN_BYTES,
     SharedArray,

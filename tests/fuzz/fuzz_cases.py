@@ -1007,14 +1007,13 @@ def file_cases(root: Path) -> Iterator[Case]:
     earlier = _save(root / "earlier.npz", kept=np.arange(3))
 
     def failing_write():
-        from drakegrasp.batch import io
-
-        def boom(f):
-            f.write(b"partial")
-            raise OSError("disk full (simulated)")
+        from drakegrasp.batch.files.writer import placed
 
         try:
-            io._atomic_write(earlier, boom, overwrite=True)
+            with placed(earlier, overwrite=True) as tmp:
+                with open(tmp, "wb") as f:
+                    f.write(b"partial")
+                raise OSError("disk full (simulated)")
         except OSError:
             return sorted(p.name for p in root.glob(".earlier.npz.*"))
         return ["no error"]

@@ -3,7 +3,7 @@
 The facet rows of contact ``i`` are ``F[foff[i] : foff[i] + nrow[i] ncomp[i]]``
 (row-major ``nrow[i] × ncomp[i]``), its components ``coff[i] …`` of the force
 vector and its rows ``roff[i] …`` of the row vectors (see
-``drakegrasp.batch.block_kernel.flat_facets``).  Spatial hard fingers (3
+``drakegrasp.batch.lp.block_kernel.flat_facets``).  Spatial hard fingers (3
 components) and soft fingers (4) take unrolled code: with run-time trip
 counts of 3 the loops ran at about 0.4 multiply–adds per ns, bound by latency
 and loop control; unrolled, about twice that.  Nothing here takes an array

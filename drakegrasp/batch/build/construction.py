@@ -23,6 +23,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from drakegrasp.batch.build.kinds import (
+    FRICTIONLESS,
+    KIND_COMPONENTS,
+    PLANAR_HARD,
+    SOFT_FULL,
+    SOFT_TORSION,
+    SPATIAL_HARD,
+)
 from drakegrasp.core.contact import contact_frames
 from drakegrasp.core.friction_cone import soft_finger_facets, torsion_only_facets
 
@@ -35,15 +43,6 @@ __all__ = [
     "kind_facets",
 ]
 
-# Kind code -> effective components (indices into the contact's force vector).
-FRICTIONLESS, PLANAR_HARD, SPATIAL_HARD, SOFT_TORSION, SOFT_FULL = range(5)
-KIND_COMPONENTS: dict[int, tuple[int, ...]] = {
-    FRICTIONLESS: (0,),
-    PLANAR_HARD: (0, 1),
-    SPATIAL_HARD: (0, 1, 2),
-    SOFT_TORSION: (0, 3),
-    SOFT_FULL: (0, 1, 2, 3),
-}
 
 
 def contact_kinds(
@@ -207,22 +206,6 @@ def _ring(mu: np.ndarray, num_generators: int) -> np.ndarray:
 def _unit_rows(F: np.ndarray) -> np.ndarray:
     return F / np.linalg.norm(F, axis=-1, keepdims=True)
 
-
-def _det3(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    return np.einsum("...i,...i->...", a, np.cross(b, c))
-
-
-def _normal_to_three(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """A vector orthogonal to three 4-vectors (their generalised cross product)."""
-    M = np.stack([a, b, c], axis=-2)  # (..., 3, 4)
-    out = np.empty(a.shape)
-    for j in range(4):
-        keep = [i for i in range(4) if i != j]
-        minor = M[..., keep]
-        out[..., j] = (-1) ** j * _det3(
-            minor[..., 0, :], minor[..., 1, :], minor[..., 2, :]
-        )
-    return out
 
 
 def kind_facets(

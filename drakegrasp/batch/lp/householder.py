@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import math
 
-from drakegrasp.batch.block_ops import _FAST
 from drakegrasp.batch.compiled import njit
+from drakegrasp.batch.lp.block_ops import _FAST
 
 __all__: list[str] = []  # helpers of the compiled kernels only
 

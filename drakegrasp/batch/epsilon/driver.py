@@ -10,7 +10,7 @@ workers of :func:`~drakegrasp.batch.batch_force_closure`, and is what
 convex hull ``P`` of the primitive wrenches.  Qhull builds all of ``P``: hundreds to
 thousands of facets in 6-D for 3 to 8 contacts.  Only the facets near the
 origin matter, so each grasp runs an expanding polytope
-(:mod:`drakegrasp.batch.epsilon_kernel`, compiled with numba; Zheng's
+(:mod:`drakegrasp.batch.epsilon.kernel`, compiled with numba; Zheng's
 incremental algorithm for the Q1 measure, IEEE T-RO 2013, is of this family):
 
 1. a simplex of ``D + 1`` primitive wrenches, each chosen farthest from the
@@ -37,9 +37,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.batch.construction import batched_characteristic_lengths
-from drakegrasp.batch.engine import DEFAULT_CHUNK_SIZE, _force_task, _stream
+from drakegrasp.batch.build.construction import batched_characteristic_lengths
 from drakegrasp.batch.metrics import epsilon_l1_batch
+from drakegrasp.batch.run.chunk import force_task
+from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
 
 __all__ = ["batch_epsilon_l1", "epsilon_chunk"]
@@ -106,7 +107,7 @@ def batch_epsilon_l1(
         \varepsilon = \min_{\text{facets } F \text{ of } P} \operatorname{dist}(0, F),
         \qquad P = \operatorname{conv}\{\operatorname{diag}(I, I/b)\, G_i s_k\}
     """
-    task, options = _force_task(
+    task, options = force_task(
         positions, mu, model, num_generators, torsional_friction, reference_points,
         characteristic_lengths, 1e-6, 1e-9, (), kernel,
     )  # fmt: skip
@@ -121,7 +122,7 @@ def batch_epsilon_l1(
         return epsilon_chunk, args, eps_options
 
     out = np.zeros(np.shape(positions)[0])
-    chunks = _stream(
+    chunks = stream(
         positions, normals, kind="epsilon", task=eps_task, chunk_size=chunk_size,
         progress=progress, workers=workers, n_g=options["num_generators"],
     )  # fmt: skip

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drakegrasp.batch.construction import (
+from drakegrasp.batch.build.construction import (
     batched_characteristic_lengths,
     batched_grasp_matrix,
     batched_normal_grasp_matrix,
@@ -91,7 +91,7 @@ class BatchCertificates:
         ]
 
 
-def _per_contact(value, K: int, N: int, name: str) -> np.ndarray:
+def per_contact_getter(value, K: int, N: int, name: str) -> np.ndarray:
     a = np.asarray(value, dtype=float)
     if a.ndim == 1 and a.shape == (K,):
         a = a[:, None]
@@ -132,8 +132,8 @@ def _null_space_witnesses(
         G_n = batched_normal_grasp_matrix(P, n, p)
         layouts = np.zeros((len(rows), 1), dtype=int)
     else:
-        mus = _per_contact(options["mu"], K_all, N, "mu")[rows]
-        nus = _per_contact(options["torsional_friction"], K_all, N, "nu")[rows]
+        mus = per_contact_getter(options["mu"], K_all, N, "mu")[rows]
+        nus = per_contact_getter(options["torsional_friction"], K_all, N, "nu")[rows]
         model = ContactModel.parse(options["model"]).value
         layouts = contact_kinds(mus, nus, model=model, dim=d)
     out: dict[int, Certificate] = {}
@@ -215,8 +215,8 @@ def grasp_at(
     n = np.asarray(normals[k], dtype=float)
     N, d = P.shape
     K = len(positions)
-    mus = _per_contact(mu, K, N, "mu")[k]
-    nus = _per_contact(torsional_friction, K, N, "torsional_friction")[k]
+    mus = per_contact_getter(mu, K, N, "mu")[k]
+    nus = per_contact_getter(torsional_friction, K, N, "torsional_friction")[k]
     model = ContactModel.parse(model)
     contacts = [
         Contact(P[i], n[i], mu=mus[i], model=model, torsional_friction=nus[i])

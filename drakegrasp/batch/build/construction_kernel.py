@@ -1,8 +1,8 @@
 r"""Normalised positions, contact frames and grasp matrices in compiled loops.
 
-The numpy routes (:func:`drakegrasp.batch.rowspace.normalised_positions`,
-:func:`drakegrasp.batch.construction.batched_grasp_matrix`,
-:func:`drakegrasp.batch.construction.batched_normal_grasp_matrix`) build a
+The numpy routes (:func:`drakegrasp.batch.build.rowspace.normalised_positions`,
+:func:`drakegrasp.batch.build.construction.batched_grasp_matrix`,
+:func:`drakegrasp.batch.build.construction.batched_normal_grasp_matrix`) build a
 chunk's arrays in a few dozen whole-stack passes, each with its (K, N, 3) or
 (K, N, 4, 6) temporary; on a few contacts those passes cost about a third as
 much as the LP itself.  Here each grasp is built in one pass over its ``N``
@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from drakegrasp.batch.compiled import njit
-from drakegrasp.batch.construction import KIND_COMPONENTS
+from drakegrasp.batch.build.kinds import KIND_COMPONENTS
 
 __all__ = [
     "grasp_matrix_stack",
@@ -230,7 +230,7 @@ def _gram_certain(XT, N, w, L, y, slack):
 
 
 def normalised_positions_stack(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~drakegrasp.batch.rowspace.normalised_positions`, compiled.
+    """:func:`~drakegrasp.batch.build.rowspace.normalised_positions`, compiled.
 
     Parameters
     ----------
@@ -275,7 +275,7 @@ def grasp_matrix_stack(
     reference_points: np.ndarray | None = None,
     rows: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~drakegrasp.batch.construction.batched_grasp_matrix`, compiled.
+    """:func:`~drakegrasp.batch.build.construction.batched_grasp_matrix`, compiled.
 
     Parameters
     ----------

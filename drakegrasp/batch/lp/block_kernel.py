@@ -1,6 +1,6 @@
 """The block interior-point method compiled with numba, one grasp at a time.
 
-The same iteration as :func:`drakegrasp.batch.block_ipm.solve_block_lp` (same
+The same iteration as :func:`drakegrasp.batch.lp.block_ipm.solve_block_lp` (same
 starting point, predictor–corrector steps, tolerances, early exit and iteration
 cap), written as scalar loops over one problem's contacts and compiled.  The
 numpy version pays a Python-level call per array operation, which dominates at
@@ -19,7 +19,8 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.block_ops import (
+from drakegrasp.batch.compiled import AVAILABLE, njit
+from drakegrasp.batch.lp.block_ops import (
     _FAST,
     _chol,
     _cmul,
@@ -34,7 +35,6 @@ from drakegrasp.batch.block_ops import (
     _solve3_rows,
     _solve_rows,
 )
-from drakegrasp.batch.compiled import AVAILABLE, njit
 
 __all__ = ["AVAILABLE", "solve_block_stack"]
 
@@ -311,7 +311,7 @@ def solve_block_stack(
     start : (K, M) float
         Starting ``f`` with ``A f = b``.
     tol, max_iter, stop_below : optional
-        As in :func:`drakegrasp.batch.block_ipm.solve_block_lp`.
+        As in :func:`drakegrasp.batch.lp.block_ipm.solve_block_lp`.
 
     Returns
     -------

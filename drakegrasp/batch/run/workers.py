@@ -1,6 +1,6 @@
 """Run chunks of a batch in worker processes, in order, with bounded memory.
 
-Each chunk is an independent task (:mod:`drakegrasp.batch.chunks`) whose
+Each chunk is an independent task (:mod:`drakegrasp.batch.run.chunk`) whose
 result depends only on its own grasps, and chunk boundaries depend only on the
 inputs and ``chunk_size``, never on the number of workers; results are
 consumed in chunk order.  So the output is bitwise the same for any number of
@@ -10,7 +10,7 @@ arrays, the numba kernel) hold the GIL for most of their time.
 At most ``2 × workers`` chunks are in flight, so memory stays bounded by the
 chunk size whatever the number of grasps.  Each chunk's input checks run in
 the worker that solves it, so the parent only slices, sends and collects; its
-large arrays go through shared memory (:mod:`drakegrasp.batch.shared_arrays`)
+large arrays go through shared memory (:mod:`drakegrasp.batch.run.shared_arrays`)
 instead of the pool's pipe.
 The worker processes are kept between calls (:func:`shutdown_pool`).
 """
@@ -25,7 +25,7 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
-from drakegrasp.batch.shared_arrays import (
+from drakegrasp.batch.run.shared_arrays import (
     RESULT_ROOM,
     Slabs,
     load_result,

@@ -8,34 +8,49 @@ LP1/LP2 (:doc:`/conventions`) have ``d* = N max(0, t*)`` with
     F f - \mathbf 1 t \ge 0 ,
 
 ``Q`` an orthonormal basis of the (normalised) grasp matrix's numerical row
-space (:mod:`drakegrasp.batch.rowspace`): a positive margin is attained with
+space (:mod:`drakegrasp.batch.build.rowspace`): a positive margin is attained with
 the whole budget spent, and ``d* = 0`` otherwise.  Let ``c = e - Q Qᵀ e`` (the
 projection of ``e`` on ``N(G)``).  Corner cases: no null space or ``c = 0``
 (no balanced force pushes) give ``d* = 0``; a one-dimensional null space is
 spanned by ``c``, so ``t* = min F c / ‖c‖²``.  Everything else goes to the
-block interior-point method :func:`drakegrasp.batch.block_ipm.solve_block_lp`,
+block interior-point method :func:`drakegrasp.batch.lp.block_ipm.solve_block_lp`,
 started at ``f = c / ‖c‖²``; the rare LPs that reach its iteration cap are solved
 again one by one with HiGHS.
 """
 
 from __future__ import annotations
 
-import importlib.util
+from dataclasses import dataclass
 
 import numpy as np
 
-from drakegrasp.batch.block_ipm import ContactGroup, solve_block_lp
-from drakegrasp.batch.reduction import MarginSolution
-from drakegrasp.batch.rowspace import row_spaces
+from drakegrasp.batch.build.rowspace import row_spaces
+from drakegrasp.batch.inputs import numba_available
+from drakegrasp.batch.lp.block_ipm import ContactGroup, solve_block_lp
 
 __all__ = ["solve_margin_blocks"]
 
+
+@dataclass(frozen=True)
+class MarginSolution:
+    """``d*`` and ranks of a stack of closure LPs.
+
+    Attributes
+    ----------
+    d_star : (K,) float
+        Optimal margin of the LP, ``>= 0``.
+    rank : (K,) int
+        Numerical rank of ``G``.
+    converged : (K,) bool
+        False where neither the interior-point method nor HiGHS solved the LP.
+    """
+
+    d_star: np.ndarray
+    rank: np.ndarray
+    converged: np.ndarray
+
+
 _PUSH_TOL = 1e-10  # ‖c‖ below this: no balanced force has a normal component
-
-
-def numba_available() -> bool:
-    """Whether numba is installed (checked without importing it: ~0.3 s)."""
-    return importlib.util.find_spec("numba") is not None
 
 
 def _contact_groups(facets, slices, kappa):
@@ -112,7 +127,7 @@ def solve_margin_blocks(
     Parameters
     ----------
     G : (K, w, M) float
-        Normalised effective grasp matrices (:mod:`drakegrasp.batch.rowspace`).
+        Normalised effective grasp matrices (:mod:`drakegrasp.batch.build.rowspace`).
     facets : list of (K, r_i, k_i) or (1, r_i, k_i) float
         Facet rows of each contact's cone over its ``k_i`` components, in the
         variables of ``G``'s columns (leading 1: the same for every grasp).
@@ -127,10 +142,10 @@ def solve_margin_blocks(
     ipm_tol, ipm_max_iter : optional
         Tolerance and iteration cap of the interior-point method.
     kernel : {"auto", "numba", "numpy", "unfused"}, optional
-        The compiled interior-point method (:mod:`~drakegrasp.batch.block_kernel`,
+        The compiled interior-point method (:mod:`~drakegrasp.batch.lp.block_kernel`,
         with the full-rank grasps prepared in the compiled loop too,
-        ``drakegrasp.batch.fused_kernel``) or the numpy reference
-        (:mod:`~drakegrasp.batch.block_ipm`); ``"auto"`` takes numba when it is
+        ``drakegrasp.batch.lp.fused_kernel``) or the numpy reference
+        (:mod:`~drakegrasp.batch.lp.block_ipm`); ``"auto"`` takes numba when it is
         installed.  ``"unfused"``: the compiled IPM after the numpy
         preparation (what the fused pass hands its leftovers to).
 
@@ -146,8 +161,8 @@ def solve_margin_blocks(
     use_numba = kernel == "numba" or (kernel == "auto" and numba_available())
     if use_numba and M >= w and K > 0:
         # Certified full-rank grasps are prepared and solved in one compiled
-        # pass (drakegrasp.batch.fused_kernel); the rest take the path below.
-        from drakegrasp.batch.fused_kernel import solve_full_rank_stack  # numba
+        # pass (drakegrasp.batch.lp.fused_kernel); the rest take the path below.
+        from drakegrasp.batch.lp.fused_kernel import solve_full_rank_stack  # numba
 
         d_fused, done = solve_full_rank_stack(
             G, facets, normal_columns, kappa, rank_tol=rank_tol, tol=tol_t,
@@ -195,7 +210,7 @@ def solve_margin_blocks(
         A = np.concatenate([np.transpose(Q, (1, 0, 2)), np.zeros((1, M, sel.size))])
         A[-1, normal_columns] = 1.0  # (e, M, k)
         if use_numba or kernel == "unfused":
-            from drakegrasp.batch.block_kernel import solve_block_stack  # numba
+            from drakegrasp.batch.lp.block_kernel import solve_block_stack  # numba
 
             t, ok, _, _ = solve_block_stack(
                 [F if F.shape[0] == 1 else F[sel] for F in facets],

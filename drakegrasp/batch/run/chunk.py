@@ -2,12 +2,12 @@ r"""One chunk of grasps, start to finish: validated arrays in, result arrays out
 
 These functions are the unit of work of the batch engine.  They are top-level
 and take only arrays and plain options, so a chunk can run in this process or
-in a worker process (:mod:`drakegrasp.batch.parallel`) with bitwise the same
+in a worker process (:mod:`drakegrasp.batch.run.workers`) with bitwise the same
 result: nothing in a chunk's computation depends on where it runs or on the
 other chunks.
 
 Ranks, row spaces and null spaces are decided on the normalised grasp matrix
-of :mod:`drakegrasp.batch.rowspace` (moments about the contacts' centroid,
+of :mod:`drakegrasp.batch.build.rowspace` (moments about the contacts' centroid,
 divided by their spread), so verdicts do not depend on units or on the
 reference point; ``d*`` does not either, since ``N(G)`` is the same.  A soft
 finger's torsion variable is measured in units of that spread, and its facet
@@ -21,7 +21,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from drakegrasp.batch.construction import (
+from drakegrasp.batch.build.construction import (
     FRICTIONLESS,
     KIND_COMPONENTS,
     PLANAR_HARD,
@@ -34,15 +34,35 @@ from drakegrasp.batch.construction import (
     contact_kinds,
     kind_facets,
 )
-from drakegrasp.batch.margin import numba_available, solve_margin_blocks
-from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
-from drakegrasp.batch.rowspace import (
+from drakegrasp.batch.build.rowspace import (
     _householder,
     _inverse_frobenius,
     normalised_positions,
 )
+from drakegrasp.batch.inputs import (
+    _characteristic_lengths,
+    _check_tol,
+    _reference_points,
+    check_chunk_coefficients,
+    check_metrics,
+    numba_available,
+    per_contact_getter,
+    resolve_kernel,
+    shape_of,
+)
+from drakegrasp.batch.lp.dstar import solve_margin_blocks
+from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.validation import check_num_generators
+from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
-__all__ = ["finish", "force_chunk", "form_chunk"]
+__all__ = [
+    "finish",
+    "force_chunk",
+    "force_task",
+    "form_chunk",
+    "form_task",
+]
 
 _TORSION_COLUMN = {SOFT_FULL: 3, SOFT_TORSION: 1}
 
@@ -84,7 +104,9 @@ def _compiled(kernel: str) -> bool:
 
 def _positions(P, compiled: bool):
     if compiled:
-        from drakegrasp.batch.construction_kernel import normalised_positions_stack
+        from drakegrasp.batch.build.construction_kernel import (
+            normalised_positions_stack,
+        )
 
         return normalised_positions_stack(P)
     return normalised_positions(P)
@@ -100,7 +122,7 @@ def _subset(P, Nrm, p, rows):
 def _grasp_matrices(P, Nrm, p, layout, rows, compiled: bool):
     """``batched_grasp_matrix`` of grasps ``rows`` (None: all), ``p`` None: 0."""
     if compiled:
-        from drakegrasp.batch.construction_kernel import grasp_matrix_stack
+        from drakegrasp.batch.build.construction_kernel import grasp_matrix_stack
 
         return grasp_matrix_stack(P, Nrm, layout, reference_points=p, rows=rows)
     return batched_grasp_matrix(*_subset(P, Nrm, p, rows), layout)
@@ -135,7 +157,7 @@ def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel)
         # factor of G_nᵀ G_n with a rounding margin) certifies full column rank
         # for most grasps; the rest take the exact SVD rule.
         if compiled:
-            from drakegrasp.batch.construction_kernel import normal_rank_certain
+            from drakegrasp.batch.build.construction_kernel import normal_rank_certain
 
             rows = rows[~normal_rank_certain(Pn, Nrm, rows, rank_tol)]
         else:
@@ -335,3 +357,77 @@ def finish(d_star, rank, converged, normal_d_star, *, tol: float, required: int)
     if certified is not None:
         out["normal_certificate"] = certified
     return out
+
+
+# ------------------------------------------------ a run's task builders
+
+
+def force_task(positions, mu, model, num_generators, torsional_friction,
+                reference_points, characteristic_lengths, tol, rank_tol, metrics,
+                kernel):  # fmt: skip
+    """Validate options once; return the chunk-task builder of LP2 and options."""
+    model = ContactModel.parse(model).value
+    K, N, d = shape_of("positions", positions)
+    if model == "soft_finger" and d == 2:
+        raise InvalidContactError(
+            "a soft-finger contact is spatial only; planar contacts are "
+            "'frictionless' or 'hard_finger'"
+        )
+    options = {
+        "model": model,
+        "num_generators": check_num_generators(num_generators),
+        "tol": _check_tol("tol", tol),
+        "rank_tol": _check_tol("rank_tol", rank_tol),
+        "metrics": check_metrics(metrics),
+        "kernel": resolve_kernel(kernel),
+    }
+    get_mu = per_contact_getter("mu", mu, K, N)
+    if torsional_friction is None:
+        if model == "soft_finger":
+            raise InvalidContactError(
+                "model='soft_finger' needs torsional_friction (nu: the moment "
+                "about the normal is bounded by b * nu * f_n); pass nu > 0, or 0 "
+                "for soft fingers that act as hard fingers"
+            )
+        torsional_friction = 0.0
+    get_nu = per_contact_getter("torsional_friction", torsional_friction, K, N)
+    get_p = _reference_points(reference_points, K, d)
+    get_b = _characteristic_lengths(characteristic_lengths, K)
+    soft = model == "soft_finger"
+
+    def task(P, Nrm, sl):
+        mu_c = get_mu(sl)
+        check_chunk_coefficients("mu", mu_c, sl.start)
+        nu_c = get_nu(sl)
+        if soft:
+            check_chunk_coefficients("torsional_friction", nu_c, sl.start)
+        p = np.ascontiguousarray(get_p(sl))
+        b = None if get_b is None else np.ascontiguousarray(get_b(sl))
+        return force_chunk, (P, Nrm, mu_c, nu_c, p, b), options
+
+    return task, options
+
+
+def form_task(positions, reference_points, characteristic_lengths, tol, rank_tol,
+               metrics, kernel):  # fmt: skip
+    """Validate options once; return the chunk-task builder of LP1 and options."""
+    K, N, d = shape_of("positions", positions)
+    options = {
+        "tol": _check_tol("tol", tol),
+        "rank_tol": _check_tol("rank_tol", rank_tol),
+        "metrics": check_metrics(metrics),
+        "kernel": resolve_kernel(kernel),
+    }
+    if "epsilon_l1" in options["metrics"]:
+        raise InvalidOptionError(
+            "metric 'epsilon_l1' needs friction; use batch_force_closure"
+        )
+    get_p = _reference_points(reference_points, K, d)
+    get_b = _characteristic_lengths(characteristic_lengths, K)
+
+    def task(P, Nrm, sl):
+        p = np.ascontiguousarray(get_p(sl))
+        b = None if get_b is None else np.ascontiguousarray(get_b(sl))
+        return form_chunk, (P, Nrm, p, b), options
+
+    return task, options

@@ -4,7 +4,7 @@ Facets of a simplicial polytope in ``D`` dimensions, stored as arrays: vertex
 indices ``verts (F, D)``, unit outward normals ``normal (F, D)``, offsets
 ``offset (F,)`` (``n·x = b`` on the facet) and ``nbr (F, D)``, the facet
 across the ridge opposite each vertex slot.  The functions here are the steps
-of one beneath–beyond insertion used by :mod:`drakegrasp.batch.epsilon_kernel`:
+of one beneath–beyond insertion used by :mod:`drakegrasp.batch.epsilon.kernel`:
 the planes of new facets (from their vertices by Gram–Schmidt, or O(D) from
 the planes of the two facets that meet at their ridge), the facets a point
 sees and their horizon, the cone of new facets over the horizon and the

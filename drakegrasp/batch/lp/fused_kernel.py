@@ -1,22 +1,22 @@
 """Row space, starting point and block IPM of a stack of grasps in one compiled pass.
 
-:func:`drakegrasp.batch.margin.solve_margin_blocks` prepares each LP of a chunk
+:func:`drakegrasp.batch.lp.dstar.solve_margin_blocks` prepares each LP of a chunk
 with vectorised numpy (a Householder QR of ``G̃ᵀ`` to certify full rank and
 give ``Q``, then ``c = e - Q Qᵀ e``, ``f_0 = c / ‖c‖²`` and ``A = [Qᵀ; eᵀ]``)
 before the compiled IPM runs.  On a few contacts that preparation costs about
 half as much as the IPM, mostly numpy's per-call overhead and the (M, w, K)
 temporaries.  Here the same steps run per grasp inside the compiled loop, on
 a working set of a few hundred numbers, and go straight into
-``drakegrasp.batch.block_kernel._one``.
+``drakegrasp.batch.lp.block_kernel._one``.
 
 When the null space is small (three hard contacts: 3 dimensions, 24 facets;
-see ``drakegrasp.batch.active_set.worth_it``) the LP is instead solved exactly
-in ``f = Z v`` by the active-set method of :mod:`drakegrasp.batch.active_set`,
+see ``drakegrasp.batch.lp.active_set.worth_it``) the LP is instead solved exactly
+in ``f = Z v`` by the active-set method of :mod:`drakegrasp.batch.lp.active_set`,
 with ``Z`` the trailing columns of the same Householder ``Q``: 0.7–1.8 µs per
 LP where the IPM took 4–6 µs.  An LP it cannot certify goes on to the IPM.
 
 Only grasps whose full row rank the QR certifies (``‖R⁻¹‖_F rank_tol ‖G̃‖_F < 1``,
-as :func:`drakegrasp.batch.rowspace.row_spaces`) and whose IPM converges are
+as :func:`drakegrasp.batch.build.rowspace.row_spaces`) and whose IPM converges are
 finished here; the caller sends the others (rank-deficient or nearly so, or an
 IPM that hit its cap) through the numpy preparation, the SVD rank rule and the
 HiGHS fallback, so every verdict follows the same rules as before.
@@ -28,15 +28,15 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.active_set import active_set_work, reduced_lp, worth_it
-from drakegrasp.batch.block_kernel import _one, flat_facets, work_arrays
-from drakegrasp.batch.block_ops import _FAST, _cmul
 from drakegrasp.batch.compiled import njit
-from drakegrasp.batch.householder import _qr, _reflect
+from drakegrasp.batch.lp.active_set import active_set_work, reduced_lp, worth_it
+from drakegrasp.batch.lp.block_kernel import _one, flat_facets, work_arrays
+from drakegrasp.batch.lp.block_ops import _FAST, _cmul
+from drakegrasp.batch.lp.householder import _qr, _reflect
 
 __all__ = ["full_column_rank_certain", "solve_full_rank_stack"]
 
-_PUSH_TOL = 1e-10  # as drakegrasp.batch.margin
+_PUSH_TOL = 1e-10  # as drakegrasp.batch.lp.dstar
 
 
 @njit(cache=True, fastmath=_FAST, error_model="numpy")
@@ -220,7 +220,7 @@ def solve_full_rank_stack(
     rank_tol, tol, max_iter
         Rank threshold, IPM tolerance on ``t`` and iteration cap.
     active_set : bool, optional
-        Solve the LPs of small null spaces (``drakegrasp.batch.active_set.worth_it``)
+        Solve the LPs of small null spaces (``drakegrasp.batch.lp.active_set.worth_it``)
         with the exact active-set method first (default); False: the IPM only.
 
     Returns

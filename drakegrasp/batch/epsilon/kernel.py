@@ -41,7 +41,7 @@ close to a lower-dimensional flat, so no larger ball fits), and ε at most
 recomputed from its vertices, never carried over from other facets.
 
 The steps of one insertion (planes, visible region, cone, sub-ridge
-matching, heap) are in :mod:`drakegrasp.batch.polytope`.  numba is optional
+matching, heap) are in :mod:`drakegrasp.batch.epsilon.polytope`.  numba is optional
 (``pip install drakegrasp[fast]``); ``AVAILABLE`` says whether this kernel is
 compiled.
 """
@@ -52,7 +52,7 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.polytope import (
+from drakegrasp.batch.epsilon.polytope import (
     AVAILABLE,
     ILL,
     ILL_TOL,

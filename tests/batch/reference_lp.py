@@ -28,7 +28,7 @@ reflection of ``c``: ``y = c/‖c‖² + W u`` with ``W`` (m, m−1) orthonormal
     \qquad A = F Z ,
 
 an LP with ``m`` variables (3 for three spatial hard fingers) and one row per
-facet, solved for all grasps at once by :func:`drakegrasp.batch.ipm.solve_max_last`.
+facet, solved for all grasps at once by :func:`reference_ipm.solve_max_last`.
 It is bounded because every effective cone is pointed (``F f >= 0`` and
 ``e^T f = 0`` force ``f = 0``).  Corner cases: ``m = 0`` (only ``f = 0`` balances)
 and ``c = 0`` (no balanced force pushes) give ``d* = 0``; ``m = 1`` is solved in
@@ -37,35 +37,15 @@ closed form, ``t* = min(A y_0)``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+from reference_ipm import solve_max_last
 
-from drakegrasp.batch.ipm import solve_max_last
-from drakegrasp.batch.rowspace import _householder, _inverse_frobenius
+from drakegrasp.batch.build.rowspace import _householder, _inverse_frobenius
+from drakegrasp.batch.lp.dstar import MarginSolution
 
-__all__ = ["MarginSolution", "null_spaces", "solve_margin_lp"]
+__all__ = ["null_spaces", "solve_margin_lp"]
 
 _PUSH_TOL = 1e-10  # ‖Zᵀe‖ below this: no balanced force has a normal component
-
-
-@dataclass(frozen=True)
-class MarginSolution:
-    """``d*`` and ranks of a stack of closure LPs.
-
-    Attributes
-    ----------
-    d_star : (K,) float
-        Optimal margin of the LP, ``>= 0``.
-    rank : (K,) int
-        Numerical rank of ``G``.
-    converged : (K,) bool
-        False where neither the interior-point method nor HiGHS solved the LP.
-    """
-
-    d_star: np.ndarray
-    rank: np.ndarray
-    converged: np.ndarray
 
 
 def _householder_complement(c: np.ndarray) -> np.ndarray:

@@ -2,7 +2,7 @@ r"""An exact active-set (simplex) solver for the closure LP in a small null spac
 
 On a grasp of full row rank ``w`` with an orthonormal basis ``Z`` (M × n) of
 ``N(G)``, every balanced force is ``f = Z v`` and the closure LP of
-:mod:`drakegrasp.batch.margin` becomes
+:mod:`drakegrasp.batch.lp.dstar` becomes
 
 .. math::
 
@@ -44,9 +44,9 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.block_ops import _FAST
 from drakegrasp.batch.compiled import njit
-from drakegrasp.batch.householder import _qr, _reflect
+from drakegrasp.batch.lp.block_ops import _FAST
+from drakegrasp.batch.lp.householder import _qr, _reflect
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["solve_reduced_lp", "worth_it"]

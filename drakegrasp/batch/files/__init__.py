@@ -1,0 +1,7 @@
+"""Files: grasps in, verdicts out.
+
+Grasps read from ``.npz``/``.npy`` (:mod:`~drakegrasp.batch.files.reader`),
+results written as ``.npz`` or Parquet (one writer per format,
+:mod:`~drakegrasp.batch.files.writer`), and the one driver that runs a file
+end to end (:mod:`~drakegrasp.batch.files.driver`).
+"""

@@ -1,0 +1,55 @@
+"""The Parquet result writer (optional extra ``parquet``: pyarrow).
+
+One row group per chunk, one column per array, ``kind``/``tol``/
+``required_rank`` in the schema metadata; ``pandas.read_parquet`` loads it
+directly.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from drakegrasp.errors import BatchFileError
+
+__all__ = ["ParquetWriter"]
+
+
+class ParquetWriter:
+    """Write result arrays to ``path`` as Parquet, one row group per chunk."""
+
+    def __init__(self, path: Path, K: int, meta: dict):
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ImportError as exc:
+            raise BatchFileError(
+                "writing .parquet needs the optional package pyarrow "
+                "(pip install drakegrasp[parquet]); write .npz instead"
+            ) from exc
+        self.pa, self.pq, self.path = pa, pq, path
+        self.meta = {k: repr(v) if isinstance(v, float) else str(v)
+                     for k, v in meta.items()}  # fmt: skip
+        self.writer = None
+
+    def write(self, arrays: dict[str, np.ndarray]) -> None:
+        """Append one chunk's arrays as a row group."""
+        table = self.pa.table(dict(arrays))
+        if self.writer is None:
+            schema = table.schema.with_metadata(self.meta)
+            self.writer = self.pq.ParquetWriter(self.path, schema)
+        self.writer.write_table(table.replace_schema_metadata(self.meta))
+
+    def close(self) -> None:
+        """Finish the file (an empty table with the metadata if nothing came)."""
+        if self.writer is None:  # no grasps: an empty table with the metadata
+            self.pq.write_table(self.pa.table({}).replace_schema_metadata(self.meta),
+                                self.path)  # fmt: skip
+        else:
+            self.writer.close()
+
+    def abort(self) -> None:
+        """Give up: close the writer."""
+        if self.writer is not None:
+            self.writer.close()

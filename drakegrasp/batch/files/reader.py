@@ -1,0 +1,192 @@
+"""Files of grasps in: a ``.npz`` archive or a directory of ``.npy`` files.
+
+Input arrays (a directory's files are named after them: ``positions.npy``,
+``normals.npy``, ...):
+
+* ``positions`` (K, N, d) float, metres;
+* ``normals`` (K, N, d) float, pointing into the object;
+* optional ``mu`` (scalar, (K,) or (K, N)), ``torsional_friction`` (same
+  shapes), ``reference_points`` ((d,) or (K, d)) and ``characteristic_lengths``
+  (scalar or (K,)).
+
+A ``.npz`` archive is read whole (numpy cannot map a member of a zip file); a
+directory's ``.npy`` files are memory-mapped, so the engine reads one chunk of
+grasps at a time and a file of millions of grasps is analysed in bounded memory
+(only the per-grasp results, a few numbers each, are held).
+"""
+
+from __future__ import annotations
+
+import os
+import zipfile
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from drakegrasp.errors import BatchFileError, GraspError, InvalidOptionError
+
+__all__ = ["as_path", "engine_options", "input_files", "read_grasps"]
+
+_OPTIONAL = ("mu", "torsional_friction", "reference_points", "characteristic_lengths")
+
+
+def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
+    """Read grasps from a ``.npz`` archive or a directory of ``.npy`` files.
+
+    Parameters
+    ----------
+    path : str or path-like
+        ``.npz`` archive, or directory of ``.npy`` files, holding ``positions``
+        and ``normals`` and the optional arrays listed in the module docstring.
+
+    Returns
+    -------
+    dict of str to ndarray
+        The arrays present, by name (memory-mapped for a directory).
+    """
+    path = as_path("input", path)
+    if path.is_dir():
+        return _read_npy_directory(path)
+    if path.suffix.lower() != ".npz":
+        raise BatchFileError(
+            f"input file {str(path)!r} must be a .npz archive (arrays positions, "
+            "normals and optionally mu, torsional_friction, reference_points, "
+            "characteristic_lengths)"
+        )
+    _check_magic(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if not hasattr(data, "files"):  # pragma: no cover - magic says zip
+                raise BatchFileError(f"input file {str(path)!r} is not an archive")
+            _check_names(path, "input file", list(data.files))
+            return {k: data[k] for k in data.files}
+    except GraspError:
+        raise
+    except ValueError as err:
+        if "pickle" in str(err):
+            raise BatchFileError(
+                f"input file {str(path)!r} holds object arrays (pickled Python "
+                "objects), which drakegrasp never loads; store numeric arrays"
+            ) from None
+        raise _corrupt(path, err) from None
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, KeyError) as err:
+        raise _corrupt(path, err) from None
+
+
+_ZIP_MAGIC = (b"PK\x03\x04", b"PK\x05\x06")
+
+
+_NPY_MAGIC = b"\x93NUMPY"
+
+
+def as_path(what: str, path) -> Path:
+    """``path`` as a ``Path``; a clear error for anything but a non-empty path."""
+    if not isinstance(path, (str, os.PathLike)) or not str(path):
+        raise BatchFileError(f"{what} must be a file path, got {path!r}")
+    return Path(path)
+
+
+def _check_magic(path: Path) -> None:
+    """Refuse a file that is not a zip archive before numpy guesses at it."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(6)
+    except FileNotFoundError:
+        raise BatchFileError(f"input file {str(path)!r} does not exist") from None
+    except OSError as err:
+        raise BatchFileError(
+            f"input file {str(path)!r} cannot be read: {err.strerror or err}"
+        ) from None
+    if head.startswith(_NPY_MAGIC):
+        raise BatchFileError(
+            f"input file {str(path)!r} holds one .npy array, not a .npz archive "
+            "of named arrays (positions, normals, ...)"
+        )
+    if not head.startswith(_ZIP_MAGIC):
+        kind = "is empty" if not head else f"starts with {head!r}"
+        raise BatchFileError(
+            f"input file {str(path)!r} is not a .npz archive (it {kind}; a .npz "
+            "file is the zip archive that numpy.savez writes)"
+        )
+
+
+def _corrupt(path: Path, err: Exception) -> BatchFileError:
+    return BatchFileError(
+        f"input file {str(path)!r} is a damaged or truncated .npz archive "
+        f"({type(err).__name__}: {err}); write it again"
+    )
+
+
+def _check_names(path: Path, what: str, names: list[str]) -> None:
+    missing = [k for k in ("positions", "normals") if k not in names]
+    if missing:
+        raise BatchFileError(
+            f"{what} {str(path)!r} has no array(s) {missing}; it holds {sorted(names)}"
+        )
+    unknown = set(names) - {"positions", "normals", *_OPTIONAL}
+    if unknown:
+        raise BatchFileError(
+            f"{what} {str(path)!r} has unknown array(s) {sorted(unknown)}; "
+            f"valid names are positions, normals, {', '.join(_OPTIONAL)}"
+        )
+
+
+def _read_npy_directory(path: Path) -> dict[str, np.ndarray]:
+    names = {f.stem: f for f in sorted(path.glob("*.npy"))}
+    _check_names(path, "input directory", list(names))
+    try:
+        return {
+            k: np.load(f, mmap_mode="r", allow_pickle=False) for k, f in names.items()
+        }
+    except (ValueError, OSError, EOFError) as err:
+        raise BatchFileError(
+            f"input directory {str(path)!r} holds an unreadable .npy file ({err})"
+        ) from None
+
+
+def input_files(source: Path) -> list[Path]:
+    """``source`` and, for a directory, the ``.npy`` files it holds."""
+    return [source, *(sorted(source.glob("*.npy")) if source.is_dir() else [])]
+
+
+def engine_options(
+    data: dict, input_path, *, kind: str, mu, torsional_friction
+) -> dict:
+    """What a grasp file gives the engine besides positions and normals.
+
+    Parameters
+    ----------
+    data : dict
+        The arrays :func:`read_grasps` returned.
+    input_path : str or path-like
+        The file, named in the error when friction is missing.
+    kind : {"force", "form"}
+    mu, torsional_friction : optional
+        Given values override the file's arrays.
+
+    Returns
+    -------
+    dict
+        ``reference_points`` and ``characteristic_lengths`` (or None); for
+        force closure also ``mu`` (given, else the file's: one is needed) and
+        ``torsional_friction`` (given, else the file's, else None).
+    """
+    options = {
+        "reference_points": data.get("reference_points"),
+        "characteristic_lengths": data.get("characteristic_lengths"),
+    }
+    if kind == "force":
+        value = mu if mu is not None else data.get("mu")
+        if value is None:
+            raise InvalidOptionError(
+                f"force closure needs friction: {str(input_path)!r} has no array "
+                "'mu' and no mu was given"
+            )
+        options["mu"] = value
+        options["torsional_friction"] = (
+            torsional_friction
+            if torsional_friction is not None
+            else data.get("torsional_friction")
+        )
+    return options

@@ -1,0 +1,260 @@
+"""Result files out: ``.npz`` or Parquet, written whole or chunk by chunk.
+
+:func:`write_chunks` consumes the ``(slice, arrays)`` stream of
+:func:`~drakegrasp.batch.stream_force_closure` and writes it with the writer
+of its format (:class:`~drakegrasp.batch.files.npz.NpzWriter`,
+:class:`~drakegrasp.batch.files.parquet.ParquetWriter`);
+:func:`~drakegrasp.batch.files.driver.write_result` writes a whole result the
+same way, as one chunk.  Only the chunk in hand is held, plus a few running
+totals for the summary.
+
+Output: the per-grasp arrays of the result (``is_closure``, ``d_star``,
+``rank``, ``margin``, ``converged`` and the metrics) plus ``kind``, ``tol`` and
+``required_rank``.  The suffix is matched case-insensitively and the file is
+written under exactly the name given (``OUT.NPZ`` stays ``OUT.NPZ``).
+
+No data is lost:
+
+* the output is written to a temporary file in the same directory and renamed
+  into place (:func:`placed`), so an interrupted or failed run leaves any
+  earlier file intact and no partial file behind;
+* an output that is the input (the same path, or the same file through a
+  symbolic or hard link) is refused (:func:`check_output`);
+* an existing output is refused unless ``overwrite=True``
+  (``drakegrasp batch --overwrite``), checked before any grasp is analysed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from drakegrasp.batch.files.npz import NpzWriter
+from drakegrasp.batch.files.parquet import ParquetWriter
+from drakegrasp.errors import BatchFileError, InvalidOptionError
+
+__all__ = [
+    "FORMATS",
+    "BatchSummary",
+    "check_output",
+    "format_of",
+    "placed",
+    "write_chunks",
+]
+
+FORMATS = ("npz", "parquet")
+
+
+@dataclass
+class BatchSummary:
+    """Running totals of a streamed batch (what a summary line needs).
+
+    Attributes
+    ----------
+    kind : str
+    count, closed, near, not_converged : int
+        Grasps, grasps in closure, grasps within ``tol`` of the boundary, LPs
+        that did not converge.
+    d_min, d_max, d_sum : float
+        Smallest, largest and summed ``d*``.
+    tol : float
+    """
+
+    kind: str
+    tol: float
+    count: int = 0
+    closed: int = 0
+    near: int = 0
+    not_converged: int = 0
+    d_min: float = np.inf
+    d_max: float = -np.inf
+    d_sum: float = 0.0
+
+    def add(self, arrays: dict[str, np.ndarray]) -> None:
+        """Fold one chunk's arrays into the totals."""
+        d = arrays["d_star"]
+        m = arrays["margin"]
+        self.count += int(d.size)
+        self.closed += int(arrays["is_closure"].sum())
+        self.near += int(np.sum((m > -0.999) & (m < 1.0)))
+        self.not_converged += int((~arrays["converged"]).sum())
+        if d.size:
+            self.d_min = min(self.d_min, float(d.min()))
+            self.d_max = max(self.d_max, float(d.max()))
+            self.d_sum += float(d.sum())
+
+    def __str__(self) -> str:
+        K = self.count
+        lines = [
+            f"{self.kind} closure of {K} grasps: {self.closed} closed, "
+            f"{K - self.closed} not (tol {self.tol:g}, {self.near} within tol of "
+            "the boundary)"
+        ]
+        if K:
+            lines.append(
+                f"d*: min {self.d_min:.6g}, mean {self.d_sum / K:.6g}, "
+                f"max {self.d_max:.6g}"
+            )
+        if self.not_converged:
+            lines.append(f"{self.not_converged} LPs did not converge")
+        return "\n".join(lines)
+
+
+def format_of(path: str | os.PathLike, fmt: str | None = None) -> str:
+    """``fmt``, or the format the suffix of ``path`` names (``.npz``/``.parquet``)."""
+    if fmt is not None:
+        if fmt not in FORMATS:
+            raise InvalidOptionError(
+                f"format must be one of {', '.join(FORMATS)}, got {fmt!r}"
+            )
+        return fmt
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if suffix not in FORMATS:
+        raise InvalidOptionError(
+            f"output file {str(path)!r} must end in .npz or .parquet (or pass "
+            "format='npz' / 'parquet')"
+        )
+    return suffix
+
+
+def check_output(
+    output: Path, inputs: Sequence[Path], *, overwrite: bool
+) -> tuple[Path, str]:
+    """Refuse an output that is an input or exists (unless overwrite); its suffix."""
+    suffix = output.suffix.lower()
+    if suffix not in (".npz", ".parquet"):
+        raise BatchFileError(
+            f"output file {str(output)!r} must end in .npz (or .parquet with pyarrow)"
+        )
+    for source in inputs:
+        same = output.resolve() == source.resolve()
+        if not same and output.exists() and source.exists():
+            same = os.path.samefile(output, source)
+        if same:
+            raise BatchFileError(
+                f"output file {str(output)!r} is the input file {str(source)!r}; "
+                "writing the results would destroy the grasps: choose another "
+                "output"
+            )
+    if output.is_dir():
+        raise BatchFileError(f"output {str(output)!r} is a directory, not a file")
+    if output.exists() and not overwrite:
+        raise BatchFileError(
+            f"output file {str(output)!r} exists; pass overwrite=True "
+            "(drakegrasp batch --overwrite) to replace it"
+        )
+    if not output.parent.is_dir():
+        raise BatchFileError(f"output directory {str(output.parent)!r} does not exist")
+    return output, suffix
+
+
+def _link_or_rename(tmp: str, path: Path) -> None:
+    """Move tmp to path without replacing a file that appeared meanwhile."""
+    try:
+        os.link(tmp, path)  # atomic, and fails if path exists
+    except FileExistsError:
+        raise
+    except OSError:  # a file system without hard links
+        if path.exists():
+            raise FileExistsError(path) from None
+        os.replace(tmp, path)
+        return
+    os.unlink(tmp)
+
+
+@contextlib.contextmanager
+def placed(path: Path, *, overwrite: bool) -> Iterator[str]:
+    """A temporary sibling of ``path`` to write; renamed onto ``path`` on success.
+
+    The file is synced before the rename.  Without ``overwrite``, a file that
+    appeared at ``path`` meanwhile is kept and the call fails; on any failure
+    the temporary file is removed and an earlier ``path`` is untouched.
+    """
+    fd, tmp = tempfile.mkstemp(
+        dir=path.parent, prefix=f".{path.name}.", suffix=".partial"
+    )
+    os.close(fd)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
+        if overwrite:
+            os.replace(tmp, path)
+        else:
+            _link_or_rename(tmp, path)
+    except FileExistsError:
+        raise BatchFileError(
+            f"output file {str(path)!r} appeared while writing; pass "
+            "overwrite=True to replace it"
+        ) from None
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def write_chunks(
+    chunks: Iterable[tuple[slice, dict[str, np.ndarray]]],
+    path: str | os.PathLike,
+    *,
+    K: int,
+    kind: str,
+    tol: float,
+    required_rank: int,
+    fmt: str | None = None,
+) -> BatchSummary:
+    """Write a stream of chunk results to ``path``; return the summary.
+
+    Parameters
+    ----------
+    chunks : iterable of (slice, dict of str to (k,) array)
+        Consecutive chunks covering ``0 … K`` in order, as
+        :func:`~drakegrasp.batch.stream_force_closure` yields them.
+    path : str or path-like
+        The file to write (replaced if it exists).
+    K : int
+        Total number of grasps.
+    kind, tol, required_rank
+        Stored beside the arrays.
+    fmt : {"npz", "parquet"}, optional
+        Default: from the suffix of ``path``.
+
+    Returns
+    -------
+    BatchSummary
+    """
+    path = Path(path)
+    fmt = format_of(path, fmt)
+    meta = {"kind": kind, "tol": tol, "required_rank": required_rank}
+    writer = (NpzWriter if fmt == "npz" else ParquetWriter)(path, K, meta)
+    summary = BatchSummary(kind=kind, tol=tol)
+    expected = 0
+    try:
+        for sl, arrays in chunks:
+            if sl.start != expected:
+                raise ValueError(f"chunk {sl} out of order (expected {expected})")
+            expected = sl.stop
+            writer.write(arrays)
+            summary.add(arrays)
+        if expected != K:
+            raise ValueError(f"the chunks covered {expected} of {K} grasps")
+        if K == 0:
+            writer.write(
+                {
+                    "is_closure": np.zeros(0, dtype=bool),
+                    "d_star": np.zeros(0),
+                    "rank": np.zeros(0, dtype=int),
+                    "margin": np.zeros(0),
+                    "converged": np.zeros(0, dtype=bool),
+                }
+            )
+        writer.close()
+    except BaseException:
+        writer.abort()
+        raise
+    return summary

@@ -1,0 +1,219 @@
+"""Inputs and options of the batch engine, validated once per call.
+
+Arrays are checked chunk by chunk (:mod:`drakegrasp.batch.run.stream` calls the
+per-chunk checks where the chunk is solved), so a memory-mapped input is never
+loaded whole; options are checked once, when a run's task builder is made
+(:func:`~drakegrasp.batch.run.chunk.force_task`,
+:func:`~drakegrasp.batch.run.chunk.form_task`), and the kernel choice is
+resolved there: the chunks receive ``"numba"`` or ``"numpy"``, never ``"auto"``.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from collections.abc import Sequence
+
+import numpy as np
+
+from drakegrasp.core.validation import (
+    LENGTH_BOUND,
+    POSITION_BOUND,
+    check_coefficient,
+    check_coefficient_array,
+    check_positions,
+    check_rank_tol,
+    check_tol,
+    integer_or_none,
+    real_array,
+    unit_vectors,
+)
+from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOptionError
+
+__all__ = [
+    "METRICS",
+    "check_metrics",
+    "per_contact_getter",
+    "resolve_kernel",
+    "shape_of",
+]
+
+METRICS = ("sigma_min", "isotropy", "ellipsoid_volume", "epsilon_l1")
+"""Metric names that ``metrics=`` accepts; see :func:`batch_force_closure`."""
+
+
+def positive_int(name: str, value, minimum: int) -> int:
+    n = integer_or_none(value)
+    if n is None or n < minimum:
+        raise InvalidOptionError(
+            f"{name} must be an integer >= {minimum}, got {value!r}"
+        )
+    return int(n)
+
+
+def _check_tol(name: str, value) -> float:
+    return check_rank_tol(value) if name == "rank_tol" else check_tol(value, name)
+
+
+def shape_of(name: str, a) -> tuple[int, int, int]:
+    """``(K, N, d)`` of a stacked input, or a clear error naming ``name``."""
+    shape = np.shape(a) if a is not None else ()
+    if len(shape) != 3 or shape[2] not in (2, 3) or shape[1] < 1:
+        raise InvalidContactError(
+            f"{name} must have shape (K, N, 2) or (K, N, 3) with N >= 1, got {shape}"
+        )
+    return shape
+
+
+def per_contact_getter(name: str, value, K: int, N: int, *, error=InvalidContactError):
+    """A per-contact coefficient as a function of a chunk slice -> (k, N) array."""
+    a = value
+    shape = tuple(a.shape) if hasattr(a, "shape") else np.shape(a)
+    if value is None or shape == ():
+        x = check_coefficient(name, value, error=error)
+        return lambda sl: np.full((sl.stop - sl.start, N), x)
+    if shape == (K,) and K == N:
+        raise InvalidOptionError(
+            f"{name} of shape ({K},) is ambiguous because K == N == {K}: pass "
+            f"shape ({K}, 1) for one value per grasp or (1, {N}) for one per contact"
+        )
+    if shape in ((K,), (K, 1)):
+        return lambda sl: np.repeat(
+            real_array(name, a[sl], error=error).reshape(-1, 1), N, axis=1
+        )
+    if shape == (1, N):
+        row = real_array(name, a, error=error)
+        return lambda sl: np.repeat(row, sl.stop - sl.start, axis=0)
+    if shape == (K, N):
+        return lambda sl: real_array(name, a[sl], error=error)
+    raise error(
+        f"{name} must be a scalar or of shape (K,) = ({K},), (K, 1), (1, N) = "
+        f"(1, {N}) or (K, N) = ({K}, {N}); got shape {shape}"
+    )
+
+
+def check_chunk_coefficients(name: str, x: np.ndarray, start: int) -> None:
+    check_coefficient_array(name, x, start=start)
+
+
+def check_chunk_positions(P: np.ndarray, start: int) -> None:
+    bad = ~(np.abs(P) <= POSITION_BOUND).all(axis=-1)  # NaN fails too
+    if bad.any():
+        k, i = np.argwhere(bad)[0]
+        raise InvalidContactError(
+            f"position of grasp {start + k}, contact {i} is {P[k, i].tolist()}: "
+            "not finite or out of range; it must be finite with "
+            f"|x| <= {POSITION_BOUND:g} m (drakegrasp.core.validation.POSITION_BOUND)"
+        )
+
+
+def chunk_unit_normals(Nrm: np.ndarray, start: int) -> np.ndarray:
+    try:
+        return unit_vectors("normal", Nrm)
+    except InvalidContactError:
+        scale = np.max(np.abs(Nrm), axis=-1)
+        bad = ~np.isfinite(Nrm).all(axis=-1) | ~(scale > 0.0)
+        k, i = np.argwhere(bad)[0]
+        raise InvalidContactError(
+            f"normal of grasp {start + k}, contact {i} is {Nrm[k, i].tolist()}; a "
+            "contact normal must be a finite, non-zero vector pointing into the "
+            "object"
+        ) from None
+
+
+def _reference_points(value, K: int, d: int):
+    if value is None:
+        return lambda sl: np.zeros((sl.stop - sl.start, d))
+    shape = np.shape(value)
+    if shape == (d,):
+        p = check_positions("reference_points", value, error=InvalidGraspError)
+        return lambda sl: np.broadcast_to(p, (sl.stop - sl.start, d))
+    if shape != (K, d):
+        raise InvalidGraspError(
+            f"reference_points must have shape ({d},) or (K, {d}) = ({K}, {d}), "
+            f"got {shape}"
+        )
+
+    def get(sl):
+        p = real_array("reference_points", value[sl], error=InvalidGraspError)
+        bad = ~(np.abs(p) <= POSITION_BOUND).all(axis=1)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise InvalidGraspError(
+                f"reference point of grasp {sl.start + k} is {p[k].tolist()}; it "
+                f"must be finite with |x| <= {POSITION_BOUND:g} m"
+            )
+        return p
+
+    return get
+
+
+def _characteristic_lengths(value, K: int):
+    if value is None:
+        return None
+    shape = np.shape(value)
+    if shape not in ((), (K,)):
+        raise InvalidGraspError(
+            f"characteristic_lengths must be a scalar or shape (K,) = ({K},), "
+            f"got {shape}"
+        )
+
+    def get(sl):
+        b = np.broadcast_to(
+            real_array(
+                "characteristic_lengths",
+                value if shape == () else value[sl],
+                error=InvalidGraspError,
+            ),
+            (sl.stop - sl.start,),
+        )
+        bad = ~(b > 0.0) | ~(b <= LENGTH_BOUND)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise InvalidGraspError(
+                f"characteristic length of grasp {sl.start + k} is {float(b[k])}; it "
+                f"must be finite and in (0, {LENGTH_BOUND:g}] m"
+            )
+        return b
+
+    return get
+
+
+def check_metrics(metrics: Sequence[str]) -> tuple[str, ...]:
+    """``metrics`` as a tuple of known names (:data:`METRICS`), or a clear error."""
+    if isinstance(metrics, str):
+        metrics = (metrics,)
+    try:
+        names = tuple(metrics)
+    except TypeError:
+        raise InvalidOptionError(
+            f"metrics must be a sequence of names from {', '.join(METRICS)}, got "
+            f"{metrics!r}"
+        ) from None
+    for name in names:
+        if name not in METRICS:
+            raise InvalidOptionError(
+                f"unknown metric {name!r}; valid metrics are {', '.join(METRICS)}"
+            )
+    return names
+
+
+def numba_available() -> bool:
+    """Whether numba is installed (checked without importing it: ~0.3 s)."""
+    return importlib.util.find_spec("numba") is not None
+
+
+def resolve_kernel(kernel: str) -> str:
+    """``kernel`` checked, and ``"auto"`` resolved to ``"numba"`` or ``"numpy"``."""
+    if kernel not in ("auto", "numba", "numpy"):
+        raise InvalidOptionError(
+            f"kernel must be 'auto', 'numba' or 'numpy', got {kernel!r}"
+        )
+    if kernel == "numba":
+        if not numba_available():
+            raise InvalidOptionError(
+                "kernel='numba' needs the optional package numba "
+                "(pip install drakegrasp[fast]); use kernel='numpy'"
+            )
+    if kernel == "auto":
+        return "numba" if numba_available() else "numpy"
+    return kernel
