@@ -27,12 +27,19 @@ The metrics:
   :func:`manipulability_volume`);
 * :func:`max_resistible_wrench`: the largest multiple of a given external
   wrench that bounded contact forces can resist (an LP solved with Clp);
-* :func:`grasp_quality`: all of them at once, as a :class:`GraspQuality`.
+* :func:`grasp_quality`: all of them at once, as a :class:`GraspQuality`;
+* :func:`grasp_forces`: contact forces and joint torques that hold a load
+  within the cones and the motors' limits (least squeeze, least torque or most
+  margin), with a re-checkable certificate when none exist;
+* :func:`max_load`: the payload, the largest multiple of a load the hand holds.
 
 Submodules: :mod:`~drakegrasp.quality.epsilon` (primitive wrenches and ε),
 :mod:`~drakegrasp.quality.indices` (singular values of ``G`` and ``H``),
-:mod:`~drakegrasp.quality.resistible` (the LP) and
-:mod:`~drakegrasp.quality.summary` (LP2 margin and :class:`GraspQuality`).
+:mod:`~drakegrasp.quality.resistible` (the LP),
+:mod:`~drakegrasp.quality.summary` (LP2 margin and :class:`GraspQuality`),
+:mod:`~drakegrasp.quality.load_problem` (what the load programs share),
+:mod:`~drakegrasp.quality.grasp_forces`, :mod:`~drakegrasp.quality.payload`
+and :mod:`~drakegrasp.quality.force_dual` (the certificates' program).
 The ε module imports ``scipy`` (Qhull, NNLS); the LPs import
 ``pydrake.solvers``.  Nothing here touches a plant.
 """
@@ -45,6 +52,12 @@ from drakegrasp.quality.epsilon import (
     ferrari_canny,
     primitive_wrenches,
 )
+from drakegrasp.quality.grasp_forces import (
+    GraspForceResult,
+    GraspForceVariables,
+    build_grasp_forces_program,
+    grasp_forces,
+)
 from drakegrasp.quality.indices import (
     distance_to_singularity,
     grasp_singular_values,
@@ -56,6 +69,7 @@ from drakegrasp.quality.indices import (
     uniformity_of_transformation,
     wrench_ellipsoid_volume,
 )
+from drakegrasp.quality.payload import MaxLoadResult, build_max_load_program, max_load
 from drakegrasp.quality.resistible import (
     MaxWrenchResult,
     MaxWrenchVariables,
@@ -69,12 +83,18 @@ __all__ = [
     "L1_MAX_POINTS",
     "LINF_MAX_CANDIDATES",
     "RANK_TOL",
+    "GraspForceResult",
+    "GraspForceVariables",
     "GraspQuality",
+    "MaxLoadResult",
     "MaxWrenchResult",
     "MaxWrenchVariables",
+    "build_grasp_forces_program",
+    "build_max_load_program",
     "build_max_resistible_wrench_program",
     "distance_to_singularity",
     "ferrari_canny",
+    "grasp_forces",
     "grasp_quality",
     "grasp_singular_values",
     "hand_object_matrix",
@@ -82,6 +102,7 @@ __all__ = [
     "isotropy",
     "lp2_margin",
     "manipulability_volume",
+    "max_load",
     "max_resistible_wrench",
     "min_singular_value",
     "primitive_wrenches",
