@@ -28,6 +28,7 @@ _SOURCES = {
         "batch_epsilon_l1",
         "batch_force_closure",
         "batch_form_closure",
+        "batch_grasp_forces",
         "evaluate_file",
     ),
     "drakegrasp.closure.programs": (
@@ -212,6 +213,7 @@ __all__ = [
     "batch_epsilon_l1",
     "batch_force_closure",
     "batch_form_closure",
+    "batch_grasp_forces",
     "build_exact_force_closure_program",
     "build_force_closure_program",
     "build_form_closure_program",

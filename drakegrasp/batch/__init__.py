@@ -4,8 +4,10 @@
 closure for ``K`` grasps with ``N`` contacts each, with the conventions and
 verdicts of :mod:`drakegrasp.closure.verdicts`; :func:`batch_epsilon_l1` gives their
 Ferrari–Canny L1 ε; :func:`iter_batch_closure` consumes a stream of chunks
-lazily; :func:`evaluate_file` runs them on a ``.npz`` file (the ``drakegrasp
-batch`` command).
+lazily; :func:`batch_grasp_forces` finds the grasp forces of many grasps
+under load (a loop over the single-grasp program,
+:mod:`~drakegrasp.batch.loads`); :func:`evaluate_file` runs the closure
+functions on a ``.npz`` file (the ``drakegrasp batch`` command).
 
 Modules: :mod:`~drakegrasp.batch.construction` (vectorised frames, grasp
 matrices and cone facets), :mod:`~drakegrasp.batch.reduction` (null-space
@@ -30,16 +32,19 @@ from drakegrasp.batch.engine import (
 )
 from drakegrasp.batch.epsilon import batch_epsilon_l1
 from drakegrasp.batch.io import evaluate_file, read_grasps, write_result
+from drakegrasp.batch.loads import BatchGraspForceResult, batch_grasp_forces
 from drakegrasp.batch.writers import BatchSummary, stream_file, write_chunks
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
     "METRICS",
     "BatchClosureResult",
+    "BatchGraspForceResult",
     "BatchSummary",
     "batch_epsilon_l1",
     "batch_force_closure",
     "batch_form_closure",
+    "batch_grasp_forces",
     "evaluate_file",
     "iter_batch_closure",
     "read_grasps",
