@@ -6,8 +6,8 @@ program, so its answers are those of the single path by construction (the
 tests check it); it is not vectorised like the closure engine — about 3.5 ms
 per grasp with four contacts (one SOCP, or an LP with
 ``cones="polyhedral"``, measured on 200 grasps, about 40 % of them refuted),
-including a second program per infeasible grasp for its certificate.  Grasps may differ in their
-number of contacts.
+including a second program per infeasible grasp for its certificate.
+Grasps may differ in their number of contacts.
 """
 
 from __future__ import annotations
@@ -17,11 +17,11 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from drakegrasp.closure.grasp_forces import GraspForceResult, grasp_forces
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.quality.grasp_forces import GraspForceResult, grasp_forces
 
 __all__ = ["BatchGraspForceResult", "batch_grasp_forces"]
 

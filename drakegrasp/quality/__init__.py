@@ -35,15 +35,22 @@ The metrics:
 
 Submodules: :mod:`~drakegrasp.quality.epsilon` (primitive wrenches and ε),
 :mod:`~drakegrasp.quality.indices` (singular values of ``G`` and ``H``),
-:mod:`~drakegrasp.quality.resistible` (the LP),
-:mod:`~drakegrasp.quality.summary` (LP2 margin and :class:`GraspQuality`),
-:mod:`~drakegrasp.quality.load_problem` (what the load programs share),
-:mod:`~drakegrasp.quality.grasp_forces`, :mod:`~drakegrasp.quality.payload`
-and :mod:`~drakegrasp.quality.force_dual` (the certificates' program).
+:mod:`~drakegrasp.quality.resistible` (the LP) and
+:mod:`~drakegrasp.quality.summary` (LP2 margin and :class:`GraspQuality`).
+The grasp-force programs live beside the closure programs
+(:mod:`~drakegrasp.closure.grasp_forces`, :mod:`~drakegrasp.closure.payload`),
+so that the plant layer can use them; they are re-exported here.
 The ε module imports ``scipy`` (Qhull, NNLS); the LPs import
 ``pydrake.solvers``.  Nothing here touches a plant.
 """
 
+from drakegrasp.closure.grasp_forces import (
+    GraspForceResult,
+    GraspForceVariables,
+    build_grasp_forces_program,
+    grasp_forces,
+)
+from drakegrasp.closure.payload import MaxLoadResult, build_max_load_program, max_load
 from drakegrasp.quality._common import RANK_TOL
 from drakegrasp.quality.epsilon import (
     HULL_TOL,
@@ -51,12 +58,6 @@ from drakegrasp.quality.epsilon import (
     LINF_MAX_CANDIDATES,
     ferrari_canny,
     primitive_wrenches,
-)
-from drakegrasp.quality.grasp_forces import (
-    GraspForceResult,
-    GraspForceVariables,
-    build_grasp_forces_program,
-    grasp_forces,
 )
 from drakegrasp.quality.indices import (
     distance_to_singularity,
@@ -69,7 +70,6 @@ from drakegrasp.quality.indices import (
     uniformity_of_transformation,
     wrench_ellipsoid_volume,
 )
-from drakegrasp.quality.payload import MaxLoadResult, build_max_load_program, max_load
 from drakegrasp.quality.resistible import (
     MaxWrenchResult,
     MaxWrenchVariables,

@@ -44,9 +44,9 @@ from drakegrasp.closure.constraints import (
 from drakegrasp.closure.programs import cone_layout
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
+from drakegrasp.core.validation import check_grasp as _check_grasp
 from drakegrasp.core.validation import check_num_generators, real_array
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.quality._common import _check_grasp
 
 __all__ = ["CONES", "LoadProblem", "check_wrench", "load_problem"]
 

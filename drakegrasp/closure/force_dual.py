@@ -5,7 +5,7 @@ twist ``y`` and multipliers ``η`` (joints), ``ρ >= 0`` (per-contact normal
 bounds), ``σ >= 0`` (total squeeze) with ``a_i = G_iᵀ y - J_i η - (ρ_i + σ) e_n``
 in the negative polar of every cone.  It is found by one program over those
 variables, written on the normalised grasp matrix (``y = Tᵀ ȳ``) and the unit
-columns of ``J`` (:mod:`~drakegrasp.quality.load_problem`):
+columns of ``J`` (:mod:`~drakegrasp.closure.load_problem`):
 
 * **refute** a load ``w``: ``min ȳᵀ w̄ + B`` s.t. the cone conditions and
   ``‖ȳ‖_∞ <= 1``; a negative optimum is a certificate;
@@ -30,7 +30,7 @@ from drakegrasp.closure.constraints import (
     add_linear_constraint,
     add_linear_equality_constraint,
 )
-from drakegrasp.quality.load_problem import LoadProblem
+from drakegrasp.closure.load_problem import LoadProblem
 
 __all__ = ["find_load_certificate"]
 

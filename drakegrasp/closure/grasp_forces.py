@@ -38,18 +38,18 @@ from pydrake.solvers import MathematicalProgram, SolutionResult
 from drakegrasp._solvers import solve
 from drakegrasp.certificates.load import LoadCertificate
 from drakegrasp.closure.constraints import add_linear_constraint
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.grasp import Grasp, grasp_matrix
-from drakegrasp.core.serialize import jsonable
-from drakegrasp.errors import InvalidOptionError, SolverError
-from drakegrasp.quality.force_dual import find_load_certificate
-from drakegrasp.quality.load_problem import (
+from drakegrasp.closure.force_dual import find_load_certificate
+from drakegrasp.closure.load_problem import (
     LoadProblem,
     add_balance,
     add_force_constraints,
     check_wrench,
     load_problem,
 )
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.grasp import Grasp, grasp_matrix
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidOptionError, SolverError
 
 __all__ = [
     "OBJECTIVES",
@@ -264,7 +264,7 @@ def build_grasp_forces_program(
                   f_i \in K_i,\; |J^T f| \le \tau_{\max},\;
                   0 \le f_{n,i} \le f_{\max,i},\; \textstyle\sum f_n \le s_{\max}
 
-        in units of ``F0`` (see :mod:`~drakegrasp.quality.load_problem`).
+        in units of ``F0`` (see :mod:`~drakegrasp.closure.load_problem`).
     variables : GraspForceVariables
     """
     objective = _check_objective(objective)

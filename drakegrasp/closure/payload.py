@@ -28,19 +28,19 @@ from pydrake.solvers import MathematicalProgram, SolutionResult
 
 from drakegrasp._solvers import solve
 from drakegrasp.certificates.load import LoadCertificate
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.serialize import jsonable
-from drakegrasp.errors import InvalidOptionError, SolverError
-from drakegrasp.quality.force_dual import find_load_certificate
-from drakegrasp.quality.grasp_forces import saturating_joints
-from drakegrasp.quality.load_problem import (
+from drakegrasp.closure.force_dual import find_load_certificate
+from drakegrasp.closure.grasp_forces import saturating_joints
+from drakegrasp.closure.load_problem import (
     LoadProblem,
     add_balance,
     add_force_constraints,
     check_wrench,
     load_problem,
 )
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidOptionError, SolverError
 
 __all__ = ["ALPHA_CAP", "MaxLoadResult", "build_max_load_program", "max_load"]
 
