@@ -21,6 +21,7 @@ The folder reads as the pipeline, one stage per room:
 * :mod:`~drakegrasp.batch.epsilon` and :mod:`~drakegrasp.batch.metrics`: ε and
   the singular-value metrics;
 * :mod:`~drakegrasp.batch.witnesses`: certificates of the failing grasps;
+* :mod:`~drakegrasp.batch.loads`: grasp forces under load, grasp by grasp;
 * :mod:`~drakegrasp.batch.files`: one reader, one writer per format, one file
   driver.
 """
@@ -39,6 +40,7 @@ from drakegrasp.batch.epsilon.driver import batch_epsilon_l1
 from drakegrasp.batch.files.driver import evaluate_file, stream_file, write_result
 from drakegrasp.batch.files.reader import read_grasps
 from drakegrasp.batch.files.writer import BatchSummary, write_chunks
+from drakegrasp.batch.loads import batch_grasp_forces
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -48,6 +50,7 @@ __all__ = [
     "batch_epsilon_l1",
     "batch_force_closure",
     "batch_form_closure",
+    "batch_grasp_forces",
     "evaluate_file",
     "iter_batch_closure",
     "read_grasps",

@@ -3,7 +3,9 @@
 :mod:`~drakegrasp.certificates.certificate` holds the frozen
 :class:`~drakegrasp.certificates.certificate.Certificate` and its solver-free
 re-check, :mod:`~drakegrasp.certificates.kinds` the four kinds and their meaning,
-:mod:`~drakegrasp.certificates.text` the words a report prints, and
+:mod:`~drakegrasp.certificates.text` the words a report prints,
+:mod:`~drakegrasp.certificates.load` the witness that a load cannot be held
+(a Farkas dual of the grasp-force system), and
 :mod:`~drakegrasp.certificates.witness` the small programs that find a
 witness.  The layer imports only the core (and the solver gateway): the
 closure programs import it, never the reverse.
@@ -13,8 +15,9 @@ from drakegrasp._lazy import lazy_exports
 
 _SOURCES = {
     "drakegrasp.certificates.certificate": ("Certificate", "CertificateCheck"),
+    "drakegrasp.certificates.load": ("LoadCertificate",),
 }
 
 __getattr__, __dir__ = lazy_exports(__name__, globals(), _SOURCES)
 
-__all__ = ["Certificate", "CertificateCheck"]
+__all__ = ["Certificate", "CertificateCheck", "LoadCertificate"]

@@ -5,7 +5,11 @@
 solver gateway (``drakegrasp._solvers``) and assembles the frozen results
 of :mod:`~drakegrasp.closure.results`, and
 :mod:`~drakegrasp.closure.second_order` decides Rimon–Burdick second-order
-form closure.
+form closure.  Under load: :mod:`~drakegrasp.closure.grasp_forces` (forces and
+joint torques that hold a wrench within cones and motor limits, or a
+certificate that none do), :mod:`~drakegrasp.closure.payload` (the largest
+multiple of a load), with :mod:`~drakegrasp.closure.load_problem` (what they
+share) and :mod:`~drakegrasp.closure.force_dual` (the certificates' program).
 """
 
 from drakegrasp._lazy import lazy_exports
@@ -18,6 +22,16 @@ _SOURCES = {
         "internal_forces",
     ),
     "drakegrasp.closure.results": ("ClosureResult", "InternalForceResult"),
+    "drakegrasp.closure.grasp_forces": (
+        "GraspForceResult",
+        "build_grasp_forces_program",
+        "grasp_forces",
+    ),
+    "drakegrasp.closure.payload": (
+        "MaxLoadResult",
+        "build_max_load_program",
+        "max_load",
+    ),
     "drakegrasp.closure.second_order": (
         "SecondOrderResult",
         "second_order_form_closure",
@@ -28,11 +42,17 @@ __getattr__, __dir__ = lazy_exports(__name__, globals(), _SOURCES)
 
 __all__ = [
     "ClosureResult",
+    "GraspForceResult",
     "InternalForceResult",
+    "MaxLoadResult",
     "SecondOrderResult",
     "force_closure",
     "force_closure_exact",
+    "build_grasp_forces_program",
+    "build_max_load_program",
     "form_closure",
+    "grasp_forces",
     "internal_forces",
+    "max_load",
     "second_order_form_closure",
 ]

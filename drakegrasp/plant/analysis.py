@@ -51,6 +51,7 @@ from drakegrasp.plant.jacobians import (
     hand_velocity_indices,
     signed_distance_jacobian,
 )
+from drakegrasp.plant.load import LoadReport, load_section
 from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.pose import check_pose as _check_pose
 from drakegrasp.plant.validation import (
@@ -369,6 +370,10 @@ class GraspReport:
     second_order : SecondOrderResult or None
         Second-order form closure (curvatures read off the shapes) when
         first-order form closure fails; None when it holds.
+    load : LoadReport or None
+        With ``analyze_grasp(..., load=...)``: whether the hand holds the load,
+        with which joint torques and squeeze, the payload factor and the
+        joint that saturates first (:mod:`drakegrasp.plant.load`).
 
     Notes
     -----
@@ -388,6 +393,7 @@ class GraspReport:
     antipodal: AntipodalResult | None
     pose: PoseCheck | None = None
     second_order: SecondOrderResult | None = deferrable(None)
+    load: LoadReport | None = None
 
     @property
     def grasp(self) -> Grasp:
@@ -420,6 +426,7 @@ class GraspReport:
             "antipodal": None if self.antipodal is None else self.antipodal.to_dict(),
             "pose": None if self.pose is None else self.pose.to_dict(),
             "second_order": jsonable(self.second_order),
+            "load": None if self.load is None else self.load.to_dict(),
         }
 
     def __str__(self) -> str:
@@ -469,6 +476,8 @@ class GraspReport:
             lines += ["  " + x for x in str(self.antipodal).splitlines()]
         if self.second_order is not None:
             lines += ["  " + line for line in str(self.second_order).splitlines()]
+        if self.load is not None:
+            lines += ["  " + line for line in self.load.report_lines()]
         return "\n".join(lines)
 
 
@@ -478,7 +487,7 @@ def analyze_grasp(
     object_body,
     *,
     hand: HandSpec = None,
-    mu: float,
+    mu: float | str,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
     torsional_friction: float | None = None,
     distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
@@ -491,14 +500,20 @@ def analyze_grasp(
     check_pose: bool = True,
     query_object: QueryObject | None = None,
     contacts: list[PlantContact] | None = None,
+    load=None,
+    torque_limits=None,
 ) -> GraspReport:
     """Read the grasp from the plant and decide every closure property.
 
     Parameters
     ----------
-    plant, plant_context, object_body, hand, mu
+    plant, plant_context, object_body, hand
         As in :func:`grasp_from_plant` (``plant_context`` may be the diagram's
         root context; ``object_body`` may be positional).
+    mu : float or "plant"
+        Friction of every contact, or ``"plant"``: each contact's coefficient
+        combined from its two geometries' proximity properties
+        (:func:`~drakegrasp.plant.load.plant_friction`).
     contact_model, torsional_friction, distance_tolerance, plane
         As in :func:`grasp_from_plant`.
     characteristic_length, allow_penetration, patches
@@ -509,6 +524,14 @@ def analyze_grasp(
         Generators of each polyhedral Coulomb cone (default 8).
     tol : float, optional
         Threshold on ``d*`` of every program (see :mod:`drakegrasp.closure.verdicts`).
+    load : None, "gravity" or (6,) / (3,) float, optional
+        An external wrench on the object (frame O about its origin), or its
+        weight: the report then has a ``load`` section
+        (:class:`~drakegrasp.plant.load.LoadReport`), with a warning where a
+        given ``mu`` disagrees with the plant's friction.
+    torque_limits : None, "plant" or (n_h,) float, optional
+        Motor limits for the load section: the actuators' effort limits, or
+        one per hand velocity.
 
     Returns
     -------
@@ -519,7 +542,7 @@ def analyze_grasp(
         plant_context,
         object_body=object_body,
         hand=hand,
-        mu=mu,
+        mu=1.0 if isinstance(mu, str) else mu,
         contact_model=contact_model,
         torsional_friction=torsional_friction,
         distance_tolerance=distance_tolerance,
@@ -530,6 +553,15 @@ def analyze_grasp(
         check_pose=check_pose,
         query_object=query_object,
         contacts=contacts,
+    )
+    data, load_report = load_section(
+        plant,
+        plant_context,
+        data,
+        mu=mu,
+        load=load,
+        torque_limits=torque_limits,
+        query_object=query_object,
     )
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
@@ -554,6 +586,7 @@ def analyze_grasp(
         second_order=None
         if first_order.is_closure
         else _second_order(plant, plant_context, data, first_order, query_object),
+        load=load_report,
     )
 
 

@@ -27,16 +27,30 @@ The metrics:
   :func:`manipulability_volume`);
 * :func:`max_resistible_wrench`: the largest multiple of a given external
   wrench that bounded contact forces can resist (an LP solved with Clp);
-* :func:`grasp_quality`: all of them at once, as a :class:`GraspQuality`.
+* :func:`grasp_quality`: all of them at once, as a :class:`GraspQuality`;
+* :func:`grasp_forces`: contact forces and joint torques that hold a load
+  within the cones and the motors' limits (least squeeze, least torque or most
+  margin), with a re-checkable certificate when none exist;
+* :func:`max_load`: the payload, the largest multiple of a load the hand holds.
 
 Submodules: :mod:`~drakegrasp.quality.epsilon` (primitive wrenches and ε),
 :mod:`~drakegrasp.quality.indices` (singular values of ``G`` and ``H``),
 :mod:`~drakegrasp.quality.resistible` (the LP) and
 :mod:`~drakegrasp.quality.summary` (LP2 margin and :class:`GraspQuality`).
+The grasp-force programs live beside the closure programs
+(:mod:`~drakegrasp.closure.grasp_forces`, :mod:`~drakegrasp.closure.payload`),
+so that the plant layer can use them; they are re-exported here.
 The ε module imports ``scipy`` (Qhull, NNLS); the LPs import
 ``pydrake.solvers``.  Nothing here touches a plant.
 """
 
+from drakegrasp.closure.grasp_forces import (
+    GraspForceResult,
+    GraspForceVariables,
+    build_grasp_forces_program,
+    grasp_forces,
+)
+from drakegrasp.closure.payload import MaxLoadResult, build_max_load_program, max_load
 from drakegrasp.quality._common import RANK_TOL
 from drakegrasp.quality.epsilon import (
     HULL_TOL,
@@ -69,12 +83,18 @@ __all__ = [
     "L1_MAX_POINTS",
     "LINF_MAX_CANDIDATES",
     "RANK_TOL",
+    "GraspForceResult",
+    "GraspForceVariables",
     "GraspQuality",
+    "MaxLoadResult",
     "MaxWrenchResult",
     "MaxWrenchVariables",
+    "build_grasp_forces_program",
+    "build_max_load_program",
     "build_max_resistible_wrench_program",
     "distance_to_singularity",
     "ferrari_canny",
+    "grasp_forces",
     "grasp_quality",
     "grasp_singular_values",
     "hand_object_matrix",
@@ -82,6 +102,7 @@ __all__ = [
     "isotropy",
     "lp2_margin",
     "manipulability_volume",
+    "max_load",
     "max_resistible_wrench",
     "min_singular_value",
     "primitive_wrenches",

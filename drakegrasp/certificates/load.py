@@ -1,0 +1,291 @@
+r"""The witness that a load cannot be held: a Farkas dual of the grasp-force system.
+
+A grasp holds the external wrench ``w`` (on the object, ``[f; m]`` about ``p``,
+grasp frame) when contact forces ``f`` exist with
+
+.. math::
+
+    G f = -w,\quad f_i \in K_i,\quad |J^T f| \le \tau_{\max},\quad
+    f_{n,i} \le f_{\max,i},\quad \textstyle\sum_i f_{n,i} \le s_{\max}
+
+(``K_i`` the friction cones, ``J`` the hand Jacobian: ``τ = Jᵀ f`` are the
+joint torques that press the fingers on with ``f``).  When no such ``f``
+exists, Farkas' lemma for this conic system gives a **dual direction**: a twist
+``y`` of the object and multipliers ``η`` (joints), ``ρ >= 0`` (per-contact
+normal bounds) and ``σ >= 0`` (total squeeze) with, at every contact,
+
+.. math::
+
+    a_i = G_i^T y - J_i \eta - (\rho_i + \sigma)\, e_n \in -K_i^*,
+    \quad\text{i.e.}\quad \max_{f_i \in K_i,\, f_{n,i} = 1} a_i^T f_i \le 0,
+
+checked with the cones' support functions
+(:func:`~drakegrasp.core.friction_cone.support_of`), and a power deficit
+
+.. math::
+
+    -y^T w \;>\; B = \textstyle\sum_j |\eta_j|\, \tau_{\max,j}
+    + \sum_i \rho_i f_{\max,i} + \sigma s_{\max}.
+
+Proof: for any admissible ``f``, ``Σ a_iᵀ f_i = -yᵀ w - ηᵀ Jᵀ f - Σ (ρ_i +
+σ) f_{n,i} >= -yᵀ w - B > 0``, yet every term ``a_iᵀ f_i <= 0``.  In words:
+moving the object along ``y``, the load delivers power ``-yᵀ w``; the contacts,
+the motors within their limits and the bounded normal forces can absorb at most
+``B`` of it.  The same numbers prove that ``α w`` cannot be held for any
+``α > B / (-yᵀ w)`` (a **payload bound**).
+
+When floating point leaves a contact's support ``ε_i > 0`` instead of ``<= 0``,
+the argument still shows that any balancing forces need a total normal force of
+at least ``(-yᵀ w - B) / max_i ε_i``; the check reports that number.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from drakegrasp.certificates.kinds import DEFAULT_CHECK_TOL, CertificateCheck
+from drakegrasp.core.friction_cone import ConeLayout, support_of
+from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidOptionError
+
+__all__ = ["LOAD_NOT_HELD", "PAYLOAD_BOUND", "LoadCertificate"]
+
+LOAD_NOT_HELD = "load not held"
+"""Kind of the witness that the wrench ``w`` itself cannot be held (bound < 1)."""
+PAYLOAD_BOUND = "payload bound"
+"""Kind of the witness that ``α w`` cannot be held for any ``α > bound``."""
+_KINDS = (LOAD_NOT_HELD, PAYLOAD_BOUND)
+_CONES = ("polyhedral", "exact")
+
+
+@dataclass(frozen=True, eq=False)
+class LoadCertificate:
+    """A dual direction proving that no admissible contact forces hold a load.
+
+    Everything is in the grasp frame, moments about ``p``
+    (``docs/conventions.md``).
+
+    Attributes
+    ----------
+    kind : str
+        :data:`LOAD_NOT_HELD` (``wrench`` cannot be held: ``bound < 1``) or
+        :data:`PAYLOAD_BOUND` (``α · wrench`` cannot be held for ``α > bound``).
+    cones : {"exact", "polyhedral"}
+        The cones the forces were asked to lie in.
+    num_generators : int
+        Generators of the polyhedral cones (unused for exact ones).
+    wrench : (6,) or (3,) float
+        The external wrench on the object ``[f; m]`` (N, N·m), or the payload
+        direction.
+    twist : (6,) or (3,) float
+        ``y = [v_p; ω]``: the object's motion along which the load delivers
+        more power than the grasp can absorb (any positive scale).
+    joint_multipliers : (n_v,) float
+        ``η``, one per column of the hand Jacobian (empty without one).
+    normal_multipliers : (N,) float
+        ``ρ >= 0``, on the per-contact bounds ``f_n <= max_normal_force``.
+    squeeze_multiplier : float
+        ``σ >= 0``, on the bound ``Σ f_n <= max_squeeze``.
+    torque_limits : (n_v,) float or None
+        ``τ_max`` (N·m or N; ``inf`` = no limit) the certificate refers to.
+    max_normal_force : (N,) float or None
+        Per-contact bounds on ``f_n`` (N; ``inf`` = none).
+    max_squeeze : float
+        Bound on ``Σ f_n`` (N; ``inf`` = none).
+    bound : float
+        The proven payload bound ``B / (-yᵀ w)`` as computed when it was found.
+    """
+
+    kind: str
+    cones: str
+    num_generators: int
+    wrench: np.ndarray
+    twist: np.ndarray
+    joint_multipliers: np.ndarray
+    normal_multipliers: np.ndarray
+    squeeze_multiplier: float
+    torque_limits: np.ndarray | None
+    max_normal_force: np.ndarray | None
+    max_squeeze: float
+    bound: float
+
+    def __post_init__(self):
+        if self.kind not in _KINDS:
+            raise InvalidOptionError(f"kind must be one of {_KINDS}, got {self.kind!r}")
+        if self.cones not in _CONES:
+            raise InvalidOptionError(
+                f"cones must be one of {_CONES}, got {self.cones!r}"
+            )
+
+    def power_budget(self) -> float:
+        """``B``: the most power the motors and force bounds absorb along ``y`` (W)."""
+        return _budget(self)
+
+    def check(
+        self,
+        grasp: Grasp,
+        *,
+        hand_jacobian: np.ndarray | None = None,
+        tol: float = DEFAULT_CHECK_TOL,
+    ) -> CertificateCheck:
+        """Re-verify the certificate on ``grasp`` with matrix products (no solver).
+
+        Parameters
+        ----------
+        grasp : Grasp
+            The grasp the load was analysed for.
+        hand_jacobian : (M, n_v) float, optional
+            Needed when the certificate has joint multipliers.
+        tol : float, optional
+            Relative tolerance on the cone condition and on the bound.
+
+        Returns
+        -------
+        CertificateCheck
+            ``violation``: the largest cone support over the size of its terms
+            (``inf`` when ``-yᵀ w <= B``, i.e. nothing is proven); ``slack``:
+            the relative power deficit ``(-yᵀ w - B) / (|yᵀ w| + B)``.
+        """
+        return check_load_certificate(self, grasp, hand_jacobian, tol)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (``inf`` limits become ``None``)."""
+        return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
+
+    def __str__(self) -> str:
+        y = np.round(self.twist / np.linalg.norm(self.twist), 4).tolist()
+        what = (
+            "the load cannot be held"
+            if self.kind == LOAD_NOT_HELD
+            else f"no more than {self.bound:.6g} x the load can be held"
+        )
+        return (
+            f"{self.kind} ({self.cones} cones): {what}; along the twist {y} the "
+            f"load delivers more power than the grasp absorbs "
+            f"(bound {self.bound:.6g})"
+        )
+
+
+def _budget(cert: LoadCertificate) -> float:
+    total = 0.0
+    eta = np.asarray(cert.joint_multipliers, dtype=float)
+    if eta.size:
+        limits = np.asarray(cert.torque_limits, dtype=float)
+        used = eta != 0.0
+        total += float(np.sum(np.abs(eta[used]) * limits[used]))
+    rho = np.asarray(cert.normal_multipliers, dtype=float)
+    if rho.size and np.any(rho != 0.0):
+        fmax = np.asarray(cert.max_normal_force, dtype=float)
+        used = rho != 0.0
+        total += float(np.sum(rho[used] * fmax[used]))
+    if cert.squeeze_multiplier != 0.0:
+        total += cert.squeeze_multiplier * cert.max_squeeze
+    return total
+
+
+def _supports(cert: LoadCertificate, grasp: Grasp, J: np.ndarray | None):
+    """Per contact the support ``max a_iᵀ f_i`` (``f_n = 1``); and the terms' size.
+
+    The size ``‖G‖ ‖y‖ + ‖J‖ ‖η‖ + max ρ + σ`` scales the supports into a
+    relative violation (as the unresisted-wrench check scales by ``‖G‖ ‖y‖``).
+    """
+    G = grasp_matrix(grasp)
+    layout = ConeLayout.of(grasp, cert.num_generators)
+    b = grasp.characteristic_length
+    y = np.asarray(cert.twist, dtype=float)
+    eta = np.asarray(cert.joint_multipliers, dtype=float)
+    rho = np.asarray(cert.normal_multipliers, dtype=float)
+    support = []
+    for i, (s, cone, c) in enumerate(
+        zip(grasp.component_slices(), layout.cones, grasp.contacts, strict=True)
+    ):
+        a = G[:, s].T @ y
+        if J is not None:
+            a = a - J[s] @ eta
+        a[0] -= rho[i] + cert.squeeze_multiplier
+        support.append(support_of(a[list(cone.components)], cone, c, cert.cones, b))
+    size = np.linalg.norm(G, 2) * np.linalg.norm(y) + cert.squeeze_multiplier
+    if J is not None:
+        size += np.linalg.norm(J, 2) * np.linalg.norm(eta)
+    if rho.size:
+        size += float(rho.max())
+    return np.array(support), float(size)
+
+
+def check_load_certificate(
+    cert: LoadCertificate, grasp: Grasp, hand_jacobian, tol: float
+) -> CertificateCheck:
+    """See :meth:`LoadCertificate.check`."""
+    w = np.asarray(cert.wrench, dtype=float)
+    y = np.asarray(cert.twist, dtype=float)
+    if w.shape != (grasp.wrench_dim,) or y.shape != w.shape:
+        raise InvalidOptionError(
+            f"the certificate's wrench and twist must have {grasp.wrench_dim} "
+            f"entries like the grasp's wrenches, got {w.shape} and {y.shape}"
+        )
+    eta = np.asarray(cert.joint_multipliers, dtype=float)
+    J = None
+    if eta.size and np.any(eta != 0.0):
+        if hand_jacobian is None:
+            raise InvalidOptionError(
+                "this certificate has joint multipliers: checking it needs the "
+                "hand_jacobian (τ = Jᵀ f)"
+            )
+        J = check_hand_jacobian(grasp, hand_jacobian)
+        if J.shape[1] != eta.size:
+            raise InvalidOptionError(
+                f"hand_jacobian has {J.shape[1]} columns but the certificate has "
+                f"{eta.size} joint multipliers"
+            )
+    rho = np.asarray(cert.normal_multipliers, dtype=float)
+    if np.any(rho < 0.0) or cert.squeeze_multiplier < 0.0:
+        return CertificateCheck(
+            False, math.inf, 0.0, tol, "a bound's multiplier is negative"
+        )
+    power = -float(y @ w)
+    budget = _budget(cert)
+    if not (power > 0.0 and math.isfinite(budget)):
+        return CertificateCheck(
+            False,
+            math.inf,
+            0.0,
+            tol,
+            f"the load delivers power {power:.3g} along y against a budget "
+            f"{budget:.3g}: nothing is proven",
+        )
+    support, size = _supports(cert, grasp, J)
+    excess = np.maximum(support, 0.0)
+    cone_violation = float(excess.max()) / size if size > 0.0 else math.inf
+    bound = budget / power
+    bound_violation = max(0.0, bound - cert.bound) / max(1.0, abs(cert.bound))
+    if cert.kind == LOAD_NOT_HELD and not bound < 1.0:
+        bound_violation = math.inf
+    violation = max(cone_violation, bound_violation)
+    # A support eps > 0 (round-off) weakens the proof to forces whose total
+    # normal force stays below (α power - budget) / eps; said per unit of α.
+    eps = float(excess.max())
+    if eps == 0.0:
+        caveat = ""
+    elif cert.kind == LOAD_NOT_HELD:
+        caveat = f" (by any forces with Σ f_n < {(power - budget) / eps:.3g} N)"
+    else:
+        caveat = f" (by forces with Σ f_n < {power / eps:.3g} N per unit α − bound)"
+    if cert.kind == LOAD_NOT_HELD:
+        slack = (power - budget) / (abs(power) + budget)
+    else:
+        slack = (cert.bound - bound) / max(1.0, abs(cert.bound))
+    detail = (
+        f"max over the {cert.cones} cones of a_iᵀ f_i (f_n = 1) and the power "
+        f"budget: α·w cannot be held for α > {bound:.6g}{caveat}"
+    )
+    return CertificateCheck(
+        holds=bool(violation <= tol),
+        violation=float(violation),
+        slack=float(slack),
+        tol=float(tol),
+        detail=detail,
+    )

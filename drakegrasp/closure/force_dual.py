@@ -1,0 +1,205 @@
+r"""Finding the Farkas dual that proves a load cannot be held (or bounds a payload).
+
+The certificate (:class:`~drakegrasp.certificates.load.LoadCertificate`) is a
+twist ``y`` and multipliers ``η`` (joints), ``ρ >= 0`` (per-contact normal
+bounds), ``σ >= 0`` (total squeeze) with ``a_i = G_iᵀ y - J_i η - (ρ_i + σ) e_n``
+in the negative polar of every cone.  It is found by one program over those
+variables, written on the normalised grasp matrix (``y = Tᵀ ȳ``) and the unit
+columns of ``J`` (:mod:`~drakegrasp.closure.load_problem`):
+
+* **refute** a load ``w``: ``min ȳᵀ w̄ + B`` s.t. the cone conditions and
+  ``‖ȳ‖_∞ <= 1``; a negative optimum is a certificate;
+* **bound** a payload along ``d``: ``min B`` s.t. the cone conditions and
+  ``ȳᵀ d̄ = -1``; the optimum is the largest multiple of ``d`` the grasp can
+  hold (the dual of :func:`~drakegrasp.max_load`'s program).
+
+The cone conditions, per contact over the components its cone allows: on a
+polyhedral (or planar, or frictionless) cone ``S_iᵀ a_i <= 0`` (its
+generators); on an exact Coulomb cone ``μ ‖a_t‖ <= -a_n`` (a Lorentz cone); a
+soft finger adds ``a_n ± b ν a_m <= 0``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.solvers import MathematicalProgram, SolutionResult
+
+from drakegrasp._solvers import solve
+from drakegrasp.certificates.load import LOAD_NOT_HELD, PAYLOAD_BOUND, LoadCertificate
+from drakegrasp.closure.constraints import (
+    add_linear_constraint,
+    add_linear_equality_constraint,
+)
+from drakegrasp.closure.load_problem import LoadProblem
+
+__all__ = ["find_load_certificate"]
+
+REFUTE_THRESHOLD = 1e-7
+"""A refuting dual needs ``ȳᵀ w̄ + B < -REFUTE_THRESHOLD`` (program units, ‖w̄‖_∞ = 1)."""
+
+
+def _dual_matrix(P: LoadProblem):
+    """``a = A z`` over ``z = [ȳ, η⁺, η⁻, ρ, σ]`` and the cost weights of ``z``.
+
+    Only limited joints, bounded contacts and a finite squeeze bound bring a
+    multiplier.  Returns ``(A, weights, blocks)`` with ``blocks`` the slices of
+    ``z``.
+    """
+    D = P.Gbar.shape[0]
+    m = P.num_forces
+    lim = P.limited_joints()
+    bounded = P.bounded_contacts()
+    squeeze = np.isfinite(P.max_squeeze)
+    normals = P.layout.normal_positions
+    E = np.zeros((m, len(bounded)))
+    E[normals[bounded], np.arange(len(bounded))] = 1.0
+    e_all = np.zeros((m, 1 if squeeze else 0))
+    if squeeze:
+        e_all[normals, 0] = 1.0
+    Jl = P.Jt[lim].T  # (m, n_lim)
+    A = np.hstack([P.Gbar.T, -Jl, Jl, -E, -e_all])
+    sizes = [D, len(lim), len(lim), len(bounded), int(squeeze)]
+    edges = np.cumsum([0, *sizes])
+    blocks = [slice(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    return A, blocks
+
+
+def _weights(P: LoadProblem, force_scale: float, blocks) -> np.ndarray:
+    """Cost of each multiplier: the limit it prices, in program units."""
+    lim = P.limited_joints()
+    bounded = P.bounded_contacts()
+    w = np.zeros(blocks[-1].stop)
+    tau = P.torque_limits[lim] / (P.jscale[lim] * force_scale) if lim.size else []
+    w[blocks[1]] = tau
+    w[blocks[2]] = tau
+    w[blocks[3]] = P.max_normal_force[bounded] / force_scale
+    if blocks[4].stop > blocks[4].start:
+        w[blocks[4]] = P.max_squeeze / force_scale
+    return w
+
+
+def _add_polar_conditions(prog, P: LoadProblem, A: np.ndarray, z) -> None:
+    """Every contact's ``a_i = A_i z`` in the negative polar of its cone."""
+    b = P.grasp.characteristic_length
+    starts = list(P.layout.normal_positions) + [P.num_forces]
+    for i, (contact, cone) in enumerate(
+        zip(P.grasp.contacts, P.layout.cones, strict=True)
+    ):
+        Ai = A[starts[i] : starts[i + 1]]
+        exact = P.cones == "exact" and cone.components in ((0, 1, 2), (0, 1, 2, 3))
+        if not exact:
+            S = cone.generators.T @ Ai
+            add_linear_constraint(
+                prog, S, np.full(len(S), -np.inf), np.zeros(len(S)), z
+            )
+            continue
+        mu = contact.mu
+        # μ ‖a_t‖ <= -a_n, divided by max(1, μ) to keep coefficients near 1.
+        L = np.vstack([-Ai[0], mu * Ai[1], mu * Ai[2]]) / max(1.0, mu)
+        prog.AddLorentzConeConstraint(L, np.zeros(3), z)
+        if len(Ai) == 4:
+            tau = b * contact.torsional_friction
+            rows = np.vstack([Ai[0] + tau * Ai[3], Ai[0] - tau * Ai[3]]) / max(1.0, tau)
+            add_linear_constraint(prog, rows, [-np.inf] * 2, [0.0, 0.0], z)
+
+
+def build_load_dual_program(
+    P: LoadProblem, target: np.ndarray, force_scale: float, *, mode: str
+):
+    """The dual program in ``z = [ȳ, η⁺, η⁻, ρ, σ]`` (see the module docstring).
+
+    ``target`` is ``T w / F0`` (refute) or ``T d`` (bound).
+    """
+    A, blocks = _dual_matrix(P)
+    weights = _weights(P, force_scale, blocks)
+    prog = MathematicalProgram()
+    z = prog.NewContinuousVariables(A.shape[1], "z")
+    y = z[blocks[0]]
+    if blocks[0].stop < len(z):
+        prog.AddBoundingBoxConstraint(0.0, np.inf, z[blocks[0].stop :])
+    _add_polar_conditions(prog, P, A, z)
+    if mode == "refute":
+        prog.AddBoundingBoxConstraint(-1.0, 1.0, y)
+        prog.AddLinearCost(np.concatenate([target, weights[blocks[0].stop :]]), 0.0, z)
+    else:
+        add_linear_equality_constraint(prog, target[None, :], [-1.0], y)
+        prog.AddLinearCost(weights, 0.0, z)
+    return prog, z, blocks, weights
+
+
+def find_load_certificate(
+    P: LoadProblem,
+    wrench: np.ndarray,
+    *,
+    mode: str = "refute",
+    force_scale: float,
+) -> tuple[LoadCertificate | None, float]:
+    """Solve the dual program; the certificate it finds (or None) and its value.
+
+    Parameters
+    ----------
+    P : LoadProblem
+    wrench : (D,) float
+        The load (refute) or the payload direction (bound), grasp frame.
+    mode : {"refute", "bound"}
+    force_scale : float
+        ``F0`` of the primal program (refute) or of the limits (bound).
+
+    Returns
+    -------
+    certificate : LoadCertificate or None
+        None when the program finds no refutation (the load may be held, or
+        the infeasibility is too weak to have a separating direction).
+    value : float
+        The optimum in newton-scaled units: ``F0 (ȳᵀ w̄/F0 + B/F0)`` for
+        refute, the payload bound for bound (``inf`` when no dual exists).
+    """
+    target = P.normalised(wrench)
+    if mode == "refute":
+        target = target / force_scale
+    prog, z, blocks, weights = build_load_dual_program(
+        P, target, force_scale, mode=mode
+    )
+    result = solve(prog, P.kind, retry=True)
+    status = result.get_solution_result()
+    if status != SolutionResult.kSolutionFound:
+        return None, np.inf if mode == "bound" else 0.0
+    zv = result.GetSolution(z)
+    value = float(result.get_optimal_cost())
+    if mode == "refute" and not value < -REFUTE_THRESHOLD:
+        return None, value * force_scale
+    cert = _certificate(P, wrench, zv, blocks, force_scale, mode)
+    if mode == "bound":
+        return cert, cert.bound
+    return cert, value * force_scale
+
+
+def _certificate(P, wrench, zv, blocks, force_scale, mode) -> LoadCertificate:
+    y = P.T.T @ zv[blocks[0]]
+    n_v = P.Jt.shape[0]
+    eta = np.zeros(n_v)
+    lim = P.limited_joints()
+    eta[lim] = (zv[blocks[1]] - zv[blocks[2]]) / P.jscale[lim]
+    rho = np.zeros(P.grasp.num_contacts)
+    rho[P.bounded_contacts()] = np.maximum(zv[blocks[3]], 0.0)
+    sigma = (
+        float(max(zv[blocks[4]][0], 0.0)) if blocks[4].stop > blocks[4].start else 0.0
+    )
+    cert = LoadCertificate(
+        kind=LOAD_NOT_HELD if mode == "refute" else PAYLOAD_BOUND,
+        cones=P.cones,
+        num_generators=P.num_generators,
+        wrench=np.asarray(wrench, dtype=float).copy(),
+        twist=y,
+        joint_multipliers=eta,
+        normal_multipliers=rho,
+        squeeze_multiplier=sigma,
+        torque_limits=None if P.torque_limits is None else P.torque_limits.copy(),
+        max_normal_force=P.max_normal_force.copy(),
+        max_squeeze=P.max_squeeze,
+        bound=0.0,
+    )
+    power = -float(y @ cert.wrench)
+    bound = cert.power_budget() / power if power > 0.0 else np.inf
+    object.__setattr__(cert, "bound", float(bound))
+    return cert

@@ -1,0 +1,413 @@
+r"""The data every grasp-under-load program shares: limits, scales and constraints.
+
+A load problem asks for contact forces ``f`` (contact frames, normal first) with
+
+.. math::
+
+    G f = -w,\quad f_i \in K_i,\quad |J^T f| \le \tau_{\max},\quad
+    0 \le f_{n,i} \le f_{\max,i},\quad \textstyle\sum_i f_{n,i} \le s_{\max}
+
+where ``w`` is the external wrench on the object (``[f; m]`` about ``p``, grasp
+frame: gravity, a payload, a disturbance), so the contacts supply ``-w``
+(the sign of :func:`~drakegrasp.max_resistible_wrench`), and ``τ = Jᵀ f`` are
+the joint torques that press the fingers on with ``f`` (quasi-static: the hand
+pushes ``f`` on the object, the object pushes ``-f`` back on the hand; the
+hand's own weight is not part of ``τ``).
+
+Every program is written in well-scaled variables so that no unit enters a
+solver tolerance:
+
+* balance on the normalised grasp matrix ``Ḡ = T G``
+  (:func:`~drakegrasp.normalised_grasp_matrix`; moments about the centroid,
+  over the spread), imposed as ``Ḡ f = -T w``;
+* forces in units of a force scale ``F0`` (the load's size), so ``x = f / F0``;
+* torques on the unit columns of ``J``: ``τ̃_j = τ_j / (c_j F0)`` with ``c_j``
+  the column norm, against ``τ_max,j / (c_j F0)``;
+* a soft finger's ``m_n`` scaled as in
+  :class:`~drakegrasp.core.friction_cone.ConeLayout`.
+
+Only the components a cone allows are variables (a hard finger with ``μ = 0``
+has ``f_n`` alone).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from drakegrasp.closure.constraints import (
+    add_linear_constraint,
+    add_linear_equality_constraint,
+)
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
+from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
+from drakegrasp.core.validation import check_grasp as _check_grasp
+from drakegrasp.core.validation import check_num_generators, real_array
+from drakegrasp.errors import InvalidOptionError
+
+__all__ = [
+    "CONES",
+    "SATURATION_TOL",
+    "LoadProblem",
+    "check_wrench",
+    "load_problem",
+    "saturating_joints",
+]
+
+SATURATION_TOL = 1e-6
+"""A joint saturates when ``|τ_j| >= (1 - SATURATION_TOL) τ_max,j``."""
+
+CONES = ("exact", "polyhedral")
+"""The cones a load problem may use: exact Coulomb / soft-finger, or inscribed."""
+
+_SPATIAL_FRICTION = ((0, 1, 2), (0, 1, 2, 3))
+
+
+@dataclass(frozen=True, eq=False)
+class LoadProblem:
+    """A grasp, its cones and limits, validated and scaled once.
+
+    Attributes
+    ----------
+    grasp : Grasp
+    cones : {"exact", "polyhedral"}
+    num_generators : int
+    layout : ConeLayout
+        The force components the cones allow (``layout.columns``).
+    T : (D, D) float
+        The normalising transform: ``Ḡ = T G``; a wrench ``w`` becomes
+        ``T w`` and a dual twist ``ȳ`` becomes ``y = Tᵀ ȳ``.
+    Gbar : (D, m) float
+        ``T G`` on the layout's columns (unscaled components).
+    hand_jacobian : (M, n_v) float or None
+    Jt : (n_v, m) float
+        ``(J[columns] / c)ᵀ``: unit-column torques per unit force (empty
+        without a hand Jacobian).
+    jscale : (n_v,) float
+        ``c_j``, the column norms of ``J[columns]`` (1 for a zero column).
+    torque_limits : (n_v,) float or None
+        ``τ_max`` (``inf`` = no limit); None when not given.
+    max_normal_force : (N,) float
+        Per-contact bounds on ``f_n`` (``inf`` = none).
+    max_squeeze : float
+        Bound on ``Σ f_n`` (``inf`` = none).
+    """
+
+    grasp: Grasp
+    cones: str
+    num_generators: int
+    layout: ConeLayout
+    T: np.ndarray
+    Gbar: np.ndarray
+    hand_jacobian: np.ndarray | None
+    Jt: np.ndarray
+    jscale: np.ndarray
+    torque_limits: np.ndarray | None
+    max_normal_force: np.ndarray
+    max_squeeze: float
+
+    @property
+    def num_forces(self) -> int:
+        """Number ``m`` of force variables (components the cones allow)."""
+        return len(self.layout.columns)
+
+    @property
+    def needs_socp(self) -> bool:
+        """True when an exact spatial friction cone makes the program an SOCP."""
+        return self.cones == "exact" and any(
+            c.components in _SPATIAL_FRICTION for c in self.layout.cones
+        )
+
+    @property
+    def kind(self) -> str:
+        """The solver gateway's kind: ``"socp"`` or ``"lp"``."""
+        return "socp" if self.needs_socp else "lp"
+
+    def limited_joints(self) -> np.ndarray:
+        """Indices of the joints with a finite torque limit."""
+        if self.torque_limits is None:
+            return np.zeros(0, dtype=int)
+        return np.flatnonzero(np.isfinite(self.torque_limits))
+
+    def bounded_contacts(self) -> np.ndarray:
+        """Indices of the contacts with a finite bound on ``f_n``."""
+        return np.flatnonzero(np.isfinite(self.max_normal_force))
+
+    def force_scale(self, wrench: np.ndarray | None = None) -> float:
+        """``F0``: the load's size when it has one, else the finite limits'.
+
+        Parameters
+        ----------
+        wrench : (D,) float, optional
+            The load in the grasp frame.
+        """
+        if wrench is not None:
+            size = float(np.max(np.abs(self.T @ wrench)))
+            if size > 0.0:
+                return size
+        sizes = list(self.max_normal_force[np.isfinite(self.max_normal_force)])
+        if math.isfinite(self.max_squeeze):
+            sizes.append(self.max_squeeze)
+        lim = self.limited_joints()
+        if lim.size:
+            sizes += list(self.torque_limits[lim] / self.jscale[lim])
+        sizes = [s for s in sizes if s > 0.0]
+        return float(max(sizes)) if sizes else 1.0
+
+    def stacked(self, x: np.ndarray, force_scale: float) -> np.ndarray:
+        """Program values ``x`` as the (M,) stacked forces of the grasp, N."""
+        full = np.zeros(self.grasp.num_components)
+        full[self.layout.columns] = force_scale * self.layout.scales * x
+        return full
+
+    def per_contact(self, full: np.ndarray) -> tuple[np.ndarray, ...]:
+        """(M,) stacked forces cut into one array per contact."""
+        return tuple(full[s].copy() for s in self.grasp.component_slices())
+
+    def joint_torques(self, full: np.ndarray) -> np.ndarray | None:
+        """``τ = Jᵀ f`` of (M,) stacked forces (None without a hand Jacobian)."""
+        if self.hand_jacobian is None:
+            return None
+        return self.hand_jacobian.T @ full
+
+    def normalised(self, wrench: np.ndarray) -> np.ndarray:
+        """``T w``: a wrench about the centroid, moments over the spread."""
+        return self.T @ wrench
+
+
+def check_wrench(grasp: Grasp, wrench, name: str = "wrench") -> np.ndarray:
+    """A finite ``[f; m]`` of the grasp's wrench dimension (3 planar, 6 spatial)."""
+    w = real_array(name, wrench, error=InvalidOptionError).reshape(-1)
+    D = grasp.wrench_dim
+    if w.shape != (D,) or not np.all(np.isfinite(w)):
+        raise InvalidOptionError(
+            f"{name} must be a finite {D}-vector [f; m] about the grasp's "
+            f"reference point (the grasp is {'planar' if grasp.planar else 'spatial'}"
+            f"), got {np.asarray(wrench).tolist()}"
+        )
+    return w
+
+
+def _check_cones(cones) -> str:
+    if not isinstance(cones, str) or cones not in CONES:
+        raise InvalidOptionError(f"cones must be one of {CONES}, got {cones!r}")
+    return cones
+
+
+def _check_limits(name: str, value, n: int, what: str) -> np.ndarray:
+    v = real_array(name, value, error=InvalidOptionError)
+    if v.ndim == 0:
+        v = np.full(n, float(v))
+    if v.shape != (n,) or np.any(np.isnan(v)) or np.any(v < 0.0):
+        raise InvalidOptionError(
+            f"{name} must be a number >= 0 or {n} of them (one per {what}; inf "
+            f"for none), got {np.asarray(value).tolist()}"
+        )
+    return v.astype(float)
+
+
+def _check_squeeze(value) -> float:
+    if value is None:
+        return math.inf
+    v = real_array("max_squeeze", value, error=InvalidOptionError)
+    if v.ndim != 0 or np.isnan(v) or v < 0.0:
+        raise InvalidOptionError(
+            f"max_squeeze must be one number >= 0 (N; None or inf for none), got "
+            f"{np.asarray(value).tolist()}"
+        )
+    return float(v)
+
+
+def normalising_transform(grasp: Grasp) -> np.ndarray:
+    """``T`` with ``normalised_grasp_matrix(grasp) = T @ grasp_matrix(grasp)``.
+
+    Moments move from ``p`` to the contacts' centroid ``c̄`` and are divided by
+    the spread ``L`` (``docs/conventions.md``, "Invariance").
+    """
+    positions = grasp.positions
+    centroid = positions.mean(axis=0)
+    spread = float(np.max(np.linalg.norm(positions - centroid, axis=1)))
+    if not (np.isfinite(spread) and spread > 0.0):
+        spread = 1.0
+    r = grasp.reference_point - centroid
+    d = grasp.dim
+    if d == 2:
+        shift = np.array([[1.0, 0, 0], [0, 1.0, 0], [-r[1], r[0], 1.0]])
+        return np.diag([1.0, 1.0, 1.0 / spread]) @ shift
+    S = np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+    shift = np.block([[np.eye(3), np.zeros((3, 3))], [S, np.eye(3)]])
+    return np.diag([1.0, 1.0, 1.0, 1 / spread, 1 / spread, 1 / spread]) @ shift
+
+
+def load_problem(
+    grasp: Grasp,
+    *,
+    hand_jacobian=None,
+    torque_limits=None,
+    max_normal_force=None,
+    max_squeeze=None,
+    cones: str = "exact",
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+) -> LoadProblem:
+    """Validate the options of a load program and scale its data.
+
+    Raises
+    ------
+    InvalidOptionError
+        Unknown ``cones``; torque limits without a hand Jacobian, or of the wrong
+        length; a negative or NaN limit.
+    InvalidGraspError
+        A hand Jacobian of the wrong shape.
+    """
+    _check_grasp(grasp)
+    cones = _check_cones(cones)
+    n_g = check_num_generators(num_generators)
+    layout = ConeLayout.of(grasp, n_g)
+    cols = layout.columns
+    T = normalising_transform(grasp)
+    Gbar = T @ grasp_matrix(grasp)[:, cols]
+    J = None
+    Jt = np.zeros((0, len(cols)))
+    jscale = np.zeros(0)
+    limits = None
+    if hand_jacobian is not None:
+        J = check_hand_jacobian(grasp, hand_jacobian)
+        Jc = J[cols]
+        norms = np.linalg.norm(Jc, axis=0)
+        jscale = np.where(norms > 0.0, norms, 1.0)
+        Jt = (Jc / jscale).T
+        if torque_limits is not None:
+            limits = _check_limits("torque_limits", torque_limits, J.shape[1], "joint")
+    elif torque_limits is not None:
+        raise InvalidOptionError(
+            "torque_limits need the hand_jacobian J (the joint torques are "
+            "τ = Jᵀ f); pass hand_jacobian=..."
+        )
+    N = grasp.num_contacts
+    fmax = (
+        np.full(N, math.inf)
+        if max_normal_force is None
+        else _check_limits("max_normal_force", max_normal_force, N, "contact")
+    )
+    return LoadProblem(
+        grasp=grasp,
+        cones=cones,
+        num_generators=n_g,
+        layout=layout,
+        T=T,
+        Gbar=Gbar,
+        hand_jacobian=J,
+        Jt=Jt,
+        jscale=jscale,
+        torque_limits=limits,
+        max_normal_force=fmax,
+        max_squeeze=_check_squeeze(max_squeeze),
+    )
+
+
+# ------------------------------------------------ constraints on the forces
+
+
+def add_force_constraints(prog, P: LoadProblem, x, force_scale: float, d=None):
+    """Cones (each force at least ``d`` inside when ``d`` is given) and limits.
+
+    ``x`` are the program's force variables: the force components on
+    ``P.layout.columns`` are ``force_scale * P.layout.scales * x``.  Returns
+    the scaled torque expressions' matrix ``A_τ`` (``τ_j = c_j F0 (A_τ x)_j``).
+    """
+    _add_cones(prog, P, x, d)
+    scales = P.layout.scales
+    A_tau = P.Jt * scales
+    lim = P.limited_joints()
+    if lim.size:
+        bound = P.torque_limits[lim] / (P.jscale[lim] * force_scale)
+        add_linear_constraint(prog, A_tau[lim], -bound, bound, x)
+    normals = P.layout.normal_positions
+    bounded = P.bounded_contacts()
+    upper = np.full(len(normals), np.inf)
+    upper[bounded] = P.max_normal_force[bounded] / force_scale
+    prog.AddBoundingBoxConstraint(np.zeros(len(normals)), upper, x[normals])
+    if math.isfinite(P.max_squeeze):
+        add_linear_constraint(
+            prog,
+            np.ones((1, len(normals))),
+            [-np.inf],
+            [P.max_squeeze / force_scale],
+            x[normals],
+        )
+    return A_tau
+
+
+def add_balance(prog, P: LoadProblem, x, rhs: np.ndarray, alpha=None) -> None:
+    """``Ḡ f = rhs`` in program units; with ``alpha``: ``Ḡ f + α rhs' = 0``."""
+    A = P.Gbar * P.layout.scales
+    if alpha is None:
+        add_linear_equality_constraint(prog, A, rhs, x)
+    else:
+        add_linear_equality_constraint(
+            prog,
+            np.hstack([A, rhs[:, None]]),
+            np.zeros(A.shape[0]),
+            np.append(x, alpha),
+        )
+
+
+def _add_cones(prog, P: LoadProblem, x, d) -> None:
+    grasp, layout = P.grasp, P.layout
+    b = grasp.characteristic_length
+    starts = list(layout.normal_positions) + [P.num_forces]
+    for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
+        xi = x[starts[i] : starts[i + 1]]
+        scale = layout.scales[starts[i] : starts[i + 1]]
+        exact = P.cones == "exact" and cone.components in _SPATIAL_FRICTION
+        if not exact:
+            F = cone.facets * scale
+            if d is None:
+                add_linear_constraint(
+                    prog, F, np.zeros(len(F)), np.full(len(F), np.inf), xi
+                )
+            else:
+                add_linear_constraint(
+                    prog,
+                    np.hstack([F, -np.ones((len(F), 1))]),
+                    np.zeros(len(F)),
+                    np.full(len(F), np.inf),
+                    np.append(xi, d),
+                )
+            continue
+        mu = contact.mu
+        signs = [0.0] if cone.components == (0, 1, 2) else [1.0, -1.0]
+        for sign in signs:
+            # ‖f_t‖ <= μ (f_n - σ m_n / (b ν)) - sqrt(1 + μ²) d, divided by
+            # sqrt(1 + μ²) (the exact-cone closure program's rows).
+            A = np.zeros((3, len(xi) + 1))
+            A[0, 0] = mu
+            if len(xi) == 4:
+                A[0, 3] = -sign * mu * scale[3] / (b * contact.torsional_friction)
+            A[0, -1] = -np.sqrt(1.0 + mu * mu)
+            A[1, 1] = A[2, 2] = 1.0
+            A /= np.hypot(1.0, mu)
+            if d is None:
+                prog.AddLorentzConeConstraint(A[:, :-1], np.zeros(3), xi)
+            else:
+                prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(xi, d))
+
+
+def saturating_joints(
+    joint_torques: np.ndarray | None, torque_limits: np.ndarray | None
+) -> tuple[tuple[int, ...], float]:
+    """Joints at their limit (most loaded first) and the largest ``|τ_j|/τ_max,j``."""
+    if joint_torques is None or torque_limits is None:
+        return (), math.nan
+    lim = np.asarray(torque_limits, dtype=float)
+    tau = np.abs(np.asarray(joint_torques, dtype=float))
+    use = np.isfinite(lim) & (lim > 0.0)
+    if not np.any(use):
+        return (), math.nan
+    ratio = np.full(len(lim), -np.inf)
+    ratio[use] = tau[use] / lim[use]
+    at = np.flatnonzero(use & (ratio >= 1.0 - SATURATION_TOL))
+    order = at[np.argsort(-ratio[at], kind="stable")]
+    return tuple(int(j) for j in order), float(np.max(ratio[use]))

@@ -1,0 +1,273 @@
+r"""Payload: the largest multiple of a load that a hand holds within its limits.
+
+:func:`max_load` solves
+
+.. math::
+
+    \max_{\alpha, f} \alpha \;\text{s.t.}\; G f = -\alpha\, w_d,\;
+    f_i \in K_i,\; |J^T f| \le \tau_{\max},\; 0 \le f_{n,i} \le f_{\max,i},\;
+    \textstyle\sum_i f_{n,i} \le s_{\max}
+
+for a load direction ``w_d`` (e.g. the gravity wrench of the object: ``α`` is
+then the payload factor, ``α >= 1`` holds the object).  It refines
+:func:`~drakegrasp.max_resistible_wrench`, which bounds normal forces but knows
+no motors: with ``max_normal_force`` only and polyhedral cones the two agree.
+The answer comes with a dual certificate
+(:class:`~drakegrasp.certificates.load.LoadCertificate`, kind ``"payload
+bound"``) that no ``α`` above ``upper_bound`` can be held, and with the
+forces, torques and the joints that limit it at ``α*``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+from pydrake.solvers import MathematicalProgram, SolutionResult
+
+from drakegrasp._solvers import solve
+from drakegrasp.certificates.load import LoadCertificate
+from drakegrasp.closure.force_dual import find_load_certificate
+from drakegrasp.closure.load_problem import (
+    LoadProblem,
+    add_balance,
+    add_force_constraints,
+    check_wrench,
+    load_problem,
+    saturating_joints,
+)
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidOptionError, SolverError
+
+__all__ = ["ALPHA_CAP", "MaxLoadResult", "build_max_load_program", "max_load"]
+
+ALPHA_CAP = 1e8
+"""In the program's units, ``α`` is capped here; reaching it reports ``inf``."""
+
+
+@dataclass(frozen=True, eq=False)
+class MaxLoadResult:
+    """The largest multiple of a load direction that the grasp holds.
+
+    Attributes
+    ----------
+    alpha : float
+        ``α*``: the payload factor (``inf`` when no limit binds along the
+        direction, 0 when not even a small load along it can be held).
+    direction : (6,) or (3,) float
+        The load direction ``w_d = [f; m]`` about ``p``, grasp frame.
+    wrench : (6,) or (3,) float
+        ``α* w_d`` (zeros when ``α*`` is infinite).
+    upper_bound : float
+        The bound proven by ``certificate`` (equal to ``alpha`` up to the
+        solvers' accuracy); ``inf`` without a certificate.
+    contact_forces : tuple of ndarray
+        The forces at ``α*`` per contact, contact frame, normal first (N).
+    joint_torques : (n_v,) float or None
+        ``τ = Jᵀ f`` at ``α*``.
+    squeeze : float
+        ``Σ f_n`` at ``α*`` (N).
+    saturating_joints : tuple of int
+        Joints at their torque limit at ``α*`` (the ones that limit the
+        payload, with the cones and the force bounds), most loaded first.
+    saturating_contacts : tuple of int
+        Contacts whose ``f_n`` is at its bound at ``α*``.
+    cones : str
+    num_generators : int
+    solver, status : str
+    certificate : LoadCertificate or None
+        Kind ``"payload bound"``: re-check with
+        ``certificate.check(grasp, hand_jacobian=J)``.
+    """
+
+    alpha: float
+    direction: np.ndarray
+    wrench: np.ndarray
+    upper_bound: float
+    contact_forces: tuple[np.ndarray, ...]
+    joint_torques: np.ndarray | None
+    squeeze: float
+    saturating_joints: tuple[int, ...]
+    saturating_contacts: tuple[int, ...]
+    cones: str
+    num_generators: int
+    solver: str
+    status: str
+    certificate: LoadCertificate | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (non-finite numbers become ``None``)."""
+        return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
+
+    def __str__(self) -> str:
+        d = np.round(self.direction, 6).tolist()
+        lines = [f"max load: alpha = {self.alpha:.6g} x {d} ({self.cones} cones)"]
+        if math.isfinite(self.alpha):
+            lines.append(
+                f"  proven bound {self.upper_bound:.6g}; squeeze {self.squeeze:.6g} N"
+            )
+            joints = list(self.saturating_joints) or "none"
+            contacts = list(self.saturating_contacts) or "none"
+            lines.append(
+                f"  limited by joints {joints}, contacts at their f_n bound {contacts}"
+            )
+        lines.append(f"  solver {self.solver} ({self.status})")
+        return "\n".join(lines)
+
+
+def build_max_load_program(
+    grasp: Grasp,
+    direction: np.ndarray,
+    *,
+    hand_jacobian: np.ndarray | None = None,
+    torque_limits: np.ndarray | float | None = None,
+    max_normal_force: np.ndarray | float | None = None,
+    max_squeeze: float | None = None,
+    cones: str = "exact",
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+):
+    """Build the payload program (unsolved); see :func:`max_load`.
+
+    Returns
+    -------
+    prog : MathematicalProgram
+        ``max α`` in program units (forces over ``F0``, ``α`` over
+        ``F0 / max|T w_d|``).
+    x : ndarray of Variable
+        Force variables (components ``F0 * scales * x``).
+    alpha : Variable
+        ``α`` in program units.
+    problem : LoadProblem
+    scales : (float, float)
+        ``(F0, α unit)``: ``α* = alpha_unit * alpha``.
+    """
+    d = check_wrench(grasp, direction, "direction")
+    if not np.any(d):
+        raise InvalidOptionError("direction must be a non-zero wrench, got zeros")
+    P = load_problem(
+        grasp,
+        hand_jacobian=hand_jacobian,
+        torque_limits=torque_limits,
+        max_normal_force=max_normal_force,
+        max_squeeze=max_squeeze,
+        cones=cones,
+        num_generators=num_generators,
+    )
+    return _build(P, d)
+
+
+def _build(P: LoadProblem, d: np.ndarray):
+    F0 = P.force_scale(None)
+    target = P.normalised(d)
+    size = float(np.max(np.abs(target)))
+    prog = MathematicalProgram()
+    x = prog.NewContinuousVariables(P.num_forces, "f")
+    alpha = prog.NewContinuousVariables(1, "alpha")[0]
+    prog.AddBoundingBoxConstraint(0.0, ALPHA_CAP, alpha)
+    prog.AddLinearCost(-1.0 * alpha)
+    add_force_constraints(prog, P, x, F0)
+    # Ḡ f + α T d = 0 with f = F0 x and α = (F0 / size) α̃.
+    add_balance(prog, P, x, target / size, alpha=alpha)
+    return prog, x, alpha, P, (F0, F0 / size)
+
+
+def max_load(
+    grasp: Grasp,
+    direction: np.ndarray,
+    *,
+    hand_jacobian: np.ndarray | None = None,
+    torque_limits: np.ndarray | float | None = None,
+    max_normal_force: np.ndarray | float | None = None,
+    max_squeeze: float | None = None,
+    cones: str = "exact",
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    certify: bool = True,
+) -> MaxLoadResult:
+    """The largest ``α`` such that the grasp holds the load ``α · direction``.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    direction : (6,) or (3,) float
+        Load direction ``[f; m]`` about ``p``, grasp frame (the object's
+        gravity wrench gives the payload factor).
+    hand_jacobian : (M, n_v) float, optional
+        ``J``; with ``torque_limits`` the motors bound the load.
+    torque_limits : float or (n_v,) float, optional
+        ``τ_max`` per joint (``inf`` = none, ``0`` = passive).
+    max_normal_force : float or (N,) float, optional
+        Bound on each contact's ``f_n`` (N).
+    max_squeeze : float, optional
+        Bound on ``Σ f_n`` (N).
+    cones : {"exact", "polyhedral"}, optional
+    num_generators : int, optional
+    certify : bool, optional
+        Also solve the dual for a re-checkable bound (default True).
+
+    Returns
+    -------
+    MaxLoadResult
+        ``alpha = inf`` when nothing bounds the forces along the direction.
+
+    Raises
+    ------
+    SolverError
+        The program (always feasible: ``α = 0``, ``f = 0``) was not solved.
+    """
+    d = check_wrench(grasp, direction, "direction")
+    if not np.any(d):
+        raise InvalidOptionError("direction must be a non-zero wrench, got zeros")
+    prog, x, alpha, P, (F0, unit) = build_max_load_program(
+        grasp,
+        d,
+        hand_jacobian=hand_jacobian,
+        torque_limits=torque_limits,
+        max_normal_force=max_normal_force,
+        max_squeeze=max_squeeze,
+        cones=cones,
+        num_generators=num_generators,
+    )
+    result = solve(prog, P.kind, retry=True)
+    status = result.get_solution_result()
+    if status != SolutionResult.kSolutionFound:
+        raise SolverError(
+            f"{result.get_solver_id().name()} failed with status {status.name} on "
+            "the payload program (always feasible with α = 0, f = 0): a numerical "
+            "failure, not a verdict",
+            program=prog,
+            result=result,
+        )
+    a = max(float(result.GetSolution(alpha)), 0.0)
+    full = P.stacked(result.GetSolution(x), F0)
+    unbounded = a >= ALPHA_CAP * (1.0 - 1e-6)
+    value = math.inf if unbounded else a * unit
+    tau = P.joint_torques(full)
+    sat, _ = saturating_joints(tau, P.torque_limits)
+    normals = P.grasp.normal_indices()
+    fn = full[normals]
+    fmax = P.max_normal_force
+    at = np.flatnonzero(np.isfinite(fmax) & (fn >= fmax * (1 - 1e-6)) & (fmax > 0))
+    cert, bound = None, math.inf
+    if certify and not unbounded:
+        cert, bound = find_load_certificate(P, d, mode="bound", force_scale=F0)
+    return MaxLoadResult(
+        alpha=value,
+        direction=d.copy(),
+        wrench=np.zeros_like(d) if unbounded else value * d,
+        upper_bound=float(bound),
+        contact_forces=P.per_contact(full),
+        joint_torques=tau,
+        squeeze=float(np.sum(fn)),
+        saturating_joints=sat,
+        saturating_contacts=tuple(int(i) for i in at),
+        cones=P.cones,
+        num_generators=P.num_generators,
+        solver=result.get_solver_id().name(),
+        status="unbounded (no limit binds along the direction)"
+        if unbounded
+        else status.name,
+        certificate=cert,
+    )

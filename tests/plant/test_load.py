@@ -1,0 +1,142 @@
+"""Grasps under load from a plant: gravity, actuator limits, the plant's friction."""
+
+import json
+
+import numpy as np
+import pytest
+from pydrake.multibody.tree import JointActuatorIndex
+
+import drakegrasp as dg
+from drakegrasp.plant.load import gravity_wrench, plant_friction, plant_torque_limits
+
+
+@pytest.fixture
+def wsg_closed(real_hands):
+    scene = real_hands.wsg()
+    dg.close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    return scene
+
+
+def test_gravity_wrench_matches_the_plants_generalized_gravity(wsg_closed):
+    s = wsg_closed
+    w = gravity_wrench(s.plant, s.ctx, s.object)
+    mass = s.object.get_mass(s.ctx)
+    assert mass == pytest.approx(0.514, rel=1e-3)  # the YCB sugar box
+    assert np.linalg.norm(w[:3]) == pytest.approx(mass * 9.81, rel=1e-9)
+    # Independent route: Drake's generalized gravity forces on the free body's
+    # velocities are [torque; force] in W about the body origin.
+    tau_g = s.plant.CalcGravityGeneralizedForces(s.ctx)
+    v0 = s.object.floating_velocities_start_in_v()
+    R_WO = s.plant.EvalBodyPoseInWorld(s.ctx, s.object).rotation().matrix()
+    expected = np.concatenate(
+        [R_WO.T @ tau_g[v0 + 3 : v0 + 6], R_WO.T @ tau_g[v0 : v0 + 3]]
+    )
+    np.testing.assert_allclose(w, expected, atol=1e-12)
+
+
+def test_wsg_holds_the_sugar_box_with_its_motors(wsg_closed):
+    s = wsg_closed
+    report = dg.analyze_grasp(
+        s.plant,
+        s.ctx,
+        s.object,
+        hand=s.hand,
+        mu=0.5,
+        load="gravity",
+        torque_limits="plant",
+    )
+    load = report.load
+    np.testing.assert_array_equal(load.torque_limits, [80.0, 80.0])  # the SDF's
+    assert load.torque_limits_source == "plant"
+    assert load.holds
+    f = load.forces
+    assert f.joint_torques == pytest.approx(report.J.T @ f.stacked_forces())
+    # The pads squeeze along O's z; the weight lies in their plane: friction
+    # alone carries it, so Σ f_n >= m g / μ.
+    assert f.squeeze >= np.linalg.norm(load.wrench[:3]) / 0.5 * (1 - 1e-7)
+    assert load.payload.alpha > 1.0
+    assert load.payload.certificate.check(report.grasp, hand_jacobian=report.J)
+    assert load.first_saturating_joint in load.joint_names
+    assert load.joint_names == (
+        "left_finger_sliding_joint",
+        "right_finger_sliding_joint",
+    )
+    # the model's pads have μ = 1 (continuous plant: the static coefficient)
+    assert load.friction_rule == "static"
+    np.testing.assert_allclose(load.mu_plant, 1.0)
+    assert any("mu = 0.5 was given" in w for w in load.warnings)
+    text = str(report)
+    assert "Load (gravity" in text and "payload factor" in text
+    json.dumps(report.to_dict())
+
+
+def test_mu_from_the_plant_and_weak_motors(wsg_closed):
+    s = wsg_closed
+    weak = dg.analyze_grasp(
+        s.plant,
+        s.ctx,
+        s.object,
+        hand=s.hand,
+        mu="plant",
+        load="gravity",
+        torque_limits=[1.0, 1.0],
+    )
+    assert [c.mu for c in weak.grasp.contacts] == pytest.approx([1.0] * 8)
+    assert not weak.load.warnings
+    assert not weak.load.holds
+    cert = weak.load.forces.certificate
+    assert cert.check(weak.grasp, hand_jacobian=weak.J).holds
+    assert weak.load.payload.alpha < 1.0
+    strong = dg.analyze_grasp(
+        s.plant,
+        s.ctx,
+        s.object,
+        hand=s.hand,
+        mu="plant",
+        load="gravity",
+        torque_limits="plant",
+    )
+    # payload scales with the motors while they are what binds
+    if strong.load.payload.saturating_joints:
+        assert strong.load.payload.alpha == pytest.approx(
+            80.0 * weak.load.payload.alpha, rel=1e-4
+        )
+    with pytest.raises(dg.InvalidOptionError, match="load"):
+        dg.analyze_grasp(
+            s.plant, s.ctx, s.object, hand=s.hand, mu=0.5, torque_limits="plant"
+        )
+    with pytest.raises(dg.InvalidOptionError, match="mu"):
+        dg.analyze_grasp(s.plant, s.ctx, s.object, hand=s.hand, mu="model")
+
+
+def test_torque_limits_and_friction_read_from_the_models(real_hands):
+    s = real_hands.allegro()
+    dg.close_hand(s.plant, s.root, s.object, hand=s.hand)
+    report = dg.analyze_grasp(
+        s.plant,
+        s.ctx,
+        s.object,
+        hand=s.hand,
+        mu=0.8,
+        load="gravity",
+        torque_limits="plant",
+    )
+    limits = report.load.torque_limits
+    assert limits.shape == (16,)
+    # every Allegro joint has an actuator with the SDF's 0.7 N·m effort limit
+    np.testing.assert_allclose(limits, 0.7)
+    for k in range(s.plant.num_actuators()):
+        a = s.plant.get_joint_actuator(JointActuatorIndex(k))
+        assert a.effort_limit() == pytest.approx(0.7)
+    mu = plant_friction(s.plant, s.ctx, report.contacts)
+    assert mu.shape == (report.grasp.num_contacts,)
+    assert np.all(mu > 0)
+    assert plant_torque_limits(s.plant, report.data.hand_velocity_indices) == (
+        pytest.approx(limits)
+    )
+    f = report.load.forces
+    if f.feasible:
+        assert np.all(np.abs(f.joint_torques) <= 0.7 * (1 + 1e-6))
+    else:
+        assert f.certificate.check(report.grasp, hand_jacobian=report.J).holds
+    json.dumps(report.load.to_dict())

@@ -1,0 +1,380 @@
+"""Grasp-force optimisation: closed forms, a second LP, certificates, invariances."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.optimize import linprog
+
+import drakegrasp as dg
+from drakegrasp.certificates.load import LoadCertificate
+
+SETTINGS = settings(
+    max_examples=15,
+    derandomize=True,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
+seeds = st.integers(min_value=0, max_value=2**32 - 1)
+
+G_EARTH = 9.81
+
+
+def pinch(mu=0.5, *, model="hard_finger", nu=None, half_width=0.05):
+    """Two fingers on a box's faces x = ±half_width, squeezing along x."""
+    kw = {} if nu is None else {"torsional_friction": nu}
+    return dg.Grasp(
+        [
+            dg.Contact([-half_width, 0, 0], [1, 0, 0], mu=mu, model=model, **kw),
+            dg.Contact([half_width, 0, 0], [-1, 0, 0], mu=mu, model=model, **kw),
+        ]
+    )
+
+
+def weight(m, dim=3):
+    """The gravity wrench of mass m (kg) at the reference point, along -z (-y)."""
+    return np.array([0, 0, -m * G_EARTH, 0, 0, 0] if dim == 3 else [0, -m * G_EARTH, 0])
+
+
+def pinch_jacobian(grasp):
+    """Two prismatic fingers: joint j pushes finger j along its contact normal."""
+    J = np.zeros((grasp.num_components, 2))
+    for j, s in enumerate(grasp.component_slices()):
+        J[s.start, j] = 1.0
+    return J
+
+
+# ------------------------------------------------ closed forms
+
+
+@pytest.mark.parametrize("model,nu", [("hard_finger", None), ("soft_finger", 0.2)])
+@pytest.mark.parametrize("cones", ["exact", "polyhedral"])
+@pytest.mark.parametrize("mu", [0.3, 0.5, 1.2])
+def test_two_fingers_holding_a_weight_squeeze_mg_over_mu(model, nu, cones, mu):
+    m = 0.514
+    r = dg.grasp_forces(pinch(mu, model=model, nu=nu), weight(m), cones=cones)
+    assert r.feasible
+    assert r.squeeze == pytest.approx(m * G_EARTH / mu, rel=1e-6)
+    for f in r.contact_forces:  # each finger m g / (2 μ), carrying m g / 2
+        assert f[0] == pytest.approx(m * G_EARTH / (2 * mu), rel=1e-6)
+    assert r.balance_residual < 1e-7
+
+
+def test_planar_two_fingers_holding_a_weight():
+    g = dg.Grasp(
+        [dg.Contact([-0.04, 0], [1, 0], mu=0.4), dg.Contact([0.04, 0], [-1, 0], mu=0.4)]
+    )
+    r = dg.grasp_forces(g, weight(2.0, dim=2))
+    assert r.squeeze == pytest.approx(2.0 * G_EARTH / 0.4, rel=1e-7)
+    assert [f[0] for f in r.contact_forces] == pytest.approx([2.0 * G_EARTH / 0.8] * 2)
+
+
+@pytest.mark.parametrize("cones", ["exact", "polyhedral"])
+def test_three_finger_equator_grasp_holds_weight_along_its_axis(helpers, cones):
+    # Weight along -z is tangent to all three contacts: each carries m g / 3,
+    # so Σ f_n >= Σ |f_t| / μ >= m g / μ, reached by the symmetric forces.
+    mu, m = 0.4, 1.5
+    g = helpers.equator_grasp(mu, radius=0.04)
+    r = dg.grasp_forces(g, weight(m), cones=cones, num_generators=12)
+    assert r.squeeze == pytest.approx(m * G_EARTH / mu, rel=1e-6)
+    assert [f[0] for f in r.contact_forces] == pytest.approx(
+        [m * G_EARTH / (3 * mu)] * 3, rel=1e-5
+    )
+
+
+def test_soft_fingers_resist_a_twist_about_their_axis_with_torsion():
+    # A pure moment M about x: each soft finger's m_n <= b ν f_n, so the least
+    # squeeze is M / (b ν); hard fingers cannot resist it at all.
+    M, nu = 0.3, 0.5
+    g = pinch(0.5, model="soft_finger", nu=nu)
+    b = g.characteristic_length
+    r = dg.grasp_forces(g, [0, 0, 0, M, 0, 0])
+    assert r.squeeze == pytest.approx(M / (b * nu), rel=1e-6)
+    hard = dg.grasp_forces(pinch(0.5), [0, 0, 0, M, 0, 0])
+    assert not hard.feasible
+    assert hard.certificate.check(pinch(0.5))
+
+
+def test_torques_are_J_transpose_f_and_limits_hold():
+    g = pinch(0.5)
+    J = pinch_jacobian(g)
+    r = dg.grasp_forces(g, weight(1.0), hand_jacobian=J, torque_limits=[30, 30])
+    assert r.joint_torques == pytest.approx(J.T @ r.stacked_forces())
+    assert r.torque_usage == pytest.approx(G_EARTH / 30, rel=1e-6)
+    assert r.saturating_joints == ()
+
+
+# ------------------------------------------------ infeasible, with certificates
+
+
+@pytest.mark.parametrize("cones", ["exact", "polyhedral"])
+def test_weak_motors_cannot_hold_and_the_certificate_says_why(cones):
+    g = pinch(0.5)
+    J = pinch_jacobian(g)
+    need = G_EARTH / 0.5 / 2  # each finger must push m g / (2 μ)
+    r = dg.grasp_forces(
+        g, weight(1.0), hand_jacobian=J, torque_limits=0.9 * need, cones=cones
+    )
+    assert not r.feasible and r.contact_forces is None
+    cert = r.certificate
+    assert isinstance(cert, LoadCertificate)
+    check = cert.check(g, hand_jacobian=J)
+    assert check.holds, check
+    assert cert.bound == pytest.approx(0.9, rel=1e-5)  # 90 % of the load at most
+    assert np.any(cert.joint_multipliers != 0)
+    json.dumps(r.to_dict())
+    assert "NOT HELD" in str(r)
+
+
+def test_low_friction_with_a_bounded_squeeze_is_refuted():
+    g = pinch(0.05)
+    r = dg.grasp_forces(g, weight(1.0), max_squeeze=100.0)  # needs 196.2 N
+    assert not r.feasible
+    assert r.certificate.check(g).holds
+    assert r.certificate.bound == pytest.approx(100.0 / 196.2, rel=1e-5)
+
+
+def test_unbalanceable_wrench_is_refuted_without_limits():
+    # A force along +x pushes finger 1 off: no limit needed for the proof.
+    g = pinch(0.5)
+    r = dg.grasp_forces(g, [0, 0, 0, 0.1, 0, 0])
+    assert not r.feasible
+    cert = r.certificate
+    assert cert.check(g).holds
+    assert cert.power_budget() == pytest.approx(0.0, abs=1e-12)
+
+
+def test_forged_certificates_fail_their_check():
+    g = pinch(0.5)
+    J = pinch_jacobian(g)
+    r = dg.grasp_forces(g, weight(1.0), hand_jacobian=J, torque_limits=5.0)
+    cert = r.certificate
+    assert cert.check(g, hand_jacobian=J).holds
+
+    def forged(**changes):
+        fields = {k: getattr(cert, k) for k in cert.__dataclass_fields__}
+        fields.update(changes)
+        return LoadCertificate(**fields)
+
+    # the opposite twist: the load delivers no power along it
+    assert not forged(twist=-cert.twist).check(g, hand_jacobian=J).holds
+    # smaller joint multipliers leave the cone condition violated
+    eta = 0.5 * cert.joint_multipliers
+    assert not forged(joint_multipliers=eta).check(g, hand_jacobian=J).holds
+    # stronger motors than the certificate was found for: the bound exceeds 1
+    strong = forged(torque_limits=cert.torque_limits * 3)
+    assert not strong.check(g, hand_jacobian=J).holds
+    # another grasp (more friction) is not refuted by this direction
+    assert not cert.check(pinch(2.0), hand_jacobian=J).holds
+
+
+# ------------------------------------------------ a second route, written here
+
+
+def reference_min_squeeze(grasp, w, J=None, tau_max=None, n_g=8):
+    """Least Σ f_n on the polyhedral cones in generator form, with scipy's HiGHS.
+
+    Variables: generator weights λ >= 0 per contact (f_i = S_i λ_i, f_n = Σ λ).
+    """
+    G = dg.grasp_matrix(grasp)
+    blocks, cols = [], []
+    for c, s in zip(grasp.contacts, grasp.component_slices(), strict=True):
+        S = dg.friction_cone_generators(c, n_g)
+        blocks.append(S)
+        cols.append(s)
+    M = grasp.num_components
+    K = sum(S.shape[1] for S in blocks)
+    Sfull = np.zeros((M, K))
+    k = 0
+    for S, s in zip(blocks, cols, strict=True):
+        Sfull[s, k : k + S.shape[1]] = S
+        k += S.shape[1]
+    cost = Sfull[grasp.normal_indices()].sum(axis=0)
+    A_ub = b_ub = None
+    if J is not None:
+        JS = J.T @ Sfull
+        A_ub = np.vstack([JS, -JS])
+        b_ub = np.concatenate([tau_max, tau_max])
+    res = linprog(cost, A_ub=A_ub, b_ub=b_ub, A_eq=G @ Sfull, b_eq=-w, method="highs")
+    return (res.fun if res.status == 0 else math.inf), res.status
+
+
+@given(seed=seeds)
+@SETTINGS
+def test_polyhedral_squeeze_matches_an_independent_generator_lp(seed):
+    rng = np.random.default_rng(seed)
+    contacts = []
+    for _ in range(rng.integers(3, 6)):
+        p = rng.normal(size=3)
+        p *= 0.05 / np.linalg.norm(p)
+        n = -p / np.linalg.norm(p) + 0.3 * rng.normal(size=3)
+        contacts.append(dg.Contact(p, n, mu=rng.uniform(0.2, 1.0)))
+    g = dg.Grasp(contacts)
+    w = np.concatenate([rng.normal(size=3) * 5, rng.normal(size=3) * 0.1])
+    J = rng.normal(size=(g.num_components, 4)) * 0.05
+    tau = rng.uniform(0.05, 1.0, size=4)
+    r = dg.grasp_forces(g, w, hand_jacobian=J, torque_limits=tau, cones="polyhedral")
+    ref, status = reference_min_squeeze(g, w, J, tau)
+    assert r.feasible == (status == 0)
+    if r.feasible:
+        assert r.squeeze == pytest.approx(ref, rel=1e-5, abs=1e-7)
+        assert np.all(np.abs(r.joint_torques) <= tau * (1 + 1e-6) + 1e-9)
+    else:
+        assert r.certificate is not None
+        assert r.certificate.check(g, hand_jacobian=J).holds
+
+
+# ------------------------------------------------ objectives
+
+
+def test_min_torque_and_max_margin_do_what_they_say(helpers):
+    g = helpers.equator_grasp(0.6, radius=0.04)
+    rng = np.random.default_rng(3)
+    J = rng.normal(size=(g.num_components, 5)) * 0.04
+    limits = np.array([2.0, 2.0, 1.0, 1.0, 3.0])
+    w = weight(0.3)
+    squeeze = dg.grasp_forces(g, w, hand_jacobian=J, torque_limits=limits)
+    torque = dg.grasp_forces(
+        g, w, hand_jacobian=J, torque_limits=limits, objective="min_torque"
+    )
+    assert squeeze.feasible and torque.feasible
+    assert torque.torque_usage <= squeeze.torque_usage + 1e-7
+    assert torque.squeeze >= squeeze.squeeze - 1e-6
+    bound = 2 * squeeze.squeeze
+    margin = dg.grasp_forces(
+        g,
+        w,
+        hand_jacobian=J,
+        torque_limits=limits,
+        objective="max_margin",
+        max_squeeze=bound,
+    )
+    assert margin.margin > 0 and margin.squeeze <= bound * (1 + 1e-7)
+    for f, c in zip(margin.contact_forces, g.contacts, strict=True):
+        inside = (c.mu * f[0] - np.linalg.norm(f[1:3])) / np.hypot(1, c.mu)
+        assert inside >= margin.margin * (1 - 1e-5)
+    with pytest.raises(dg.InvalidOptionError, match="max_squeeze"):
+        dg.grasp_forces(g, w, objective="max_margin")
+    with pytest.raises(dg.InvalidOptionError, match="hand_jacobian"):
+        dg.grasp_forces(g, w, objective="min_torque")
+    with pytest.raises(dg.InvalidOptionError, match="hand_jacobian"):
+        dg.grasp_forces(g, w, torque_limits=1.0)
+    with pytest.raises(dg.InvalidOptionError, match="objective"):
+        dg.grasp_forces(g, w, objective="least")
+
+
+def test_build_twin_returns_the_program():
+    g = pinch(0.5)
+    prog, v = dg.build_grasp_forces_program(g, weight(1.0))
+    assert prog.num_vars() == len(v.x)
+    assert v.force_scale == pytest.approx(G_EARTH)
+
+
+# ------------------------------------------------ invariances and monotonicity
+
+
+def _moved_reference(grasp, w, p_new):
+    """The same grasp and load with moments about p_new."""
+    f, m = w[:3], w[3:]
+    r = grasp.reference_point - p_new
+    g2 = dg.Grasp(grasp.contacts, reference_point=p_new)
+    return g2, np.concatenate([f, m + np.cross(r, f)])
+
+
+@given(seed=seeds)
+@SETTINGS
+def test_invariant_to_reference_point_and_units(seed, helpers):
+    rng = np.random.default_rng(seed)
+    g = helpers.random_grasp(rng, 4, mu=0.7)
+    w = np.concatenate([rng.normal(size=3), 0.2 * rng.normal(size=3)])
+    base = dg.grasp_forces(g, w)
+    g2, w2 = _moved_reference(g, w, rng.normal(size=3) * 3)
+    moved = dg.grasp_forces(g2, w2)
+    assert moved.feasible == base.feasible
+    # millimetres: positions x1000, moments x1000
+    k = 1000.0
+    gmm = dg.Grasp([c.with_(position=c.position * k) for c in g.contacts])
+    mm = dg.grasp_forces(gmm, np.concatenate([w[:3], w[3:] * k]))
+    assert mm.feasible == base.feasible
+    if base.feasible:
+        assert moved.squeeze == pytest.approx(base.squeeze, rel=1e-5, abs=1e-8)
+        assert mm.squeeze == pytest.approx(base.squeeze, rel=1e-5, abs=1e-8)
+
+
+@given(seed=seeds, factor=st.floats(1.0, 10.0))
+@SETTINGS
+def test_monotone_in_mu_motor_strength_and_load(seed, factor):
+    rng = np.random.default_rng(seed)
+    g = pinch(rng.uniform(0.1, 1.0))
+    J = pinch_jacobian(g)
+    w = weight(rng.uniform(0.1, 2.0))
+    tau = rng.uniform(1.0, 30.0, size=2)
+    base = dg.grasp_forces(g, w, hand_jacobian=J, torque_limits=tau)
+    more_mu = dg.grasp_forces(
+        g.with_friction(g.contacts[0].mu * factor),
+        w,
+        hand_jacobian=J,
+        torque_limits=tau,
+    )
+    stronger = dg.grasp_forces(g, w, hand_jacobian=J, torque_limits=tau * factor)
+    lighter = dg.grasp_forces(g, w / factor, hand_jacobian=J, torque_limits=tau)
+    for r in (more_mu, stronger, lighter):
+        assert r.feasible or not base.feasible
+    if base.feasible:
+        assert more_mu.squeeze <= base.squeeze * (1 + 1e-6)
+        assert lighter.squeeze == pytest.approx(base.squeeze / factor, rel=1e-5)
+    for r in (base, more_mu, stronger, lighter):
+        if not r.feasible:
+            assert r.certificate.check(
+                g if r is not more_mu else g.with_friction(g.contacts[0].mu * factor),
+                hand_jacobian=J,
+            ).holds
+
+
+# ------------------------------------------------ payload
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_max_load_agrees_with_max_resistible_wrench(seed, helpers):
+    rng = np.random.default_rng(seed)
+    g = helpers.random_grasp(rng, 4, mu=0.6)
+    d = np.concatenate([rng.normal(size=3), 0.3 * rng.normal(size=3)])
+    old = dg.max_resistible_wrench(g, d, max_normal_force=5.0)
+    new = dg.max_load(g, d, max_normal_force=5.0, cones="polyhedral")
+    assert new.alpha == pytest.approx(old.alpha, rel=1e-6, abs=1e-9)
+    assert new.upper_bound == pytest.approx(new.alpha, rel=1e-5, abs=1e-8)
+    assert new.certificate.check(g).holds
+
+
+@pytest.mark.parametrize("cones", ["exact", "polyhedral"])
+def test_payload_of_a_pinch_with_motors_is_the_closed_form(cones):
+    g = pinch(0.5)
+    J = pinch_jacobian(g)
+    r = dg.max_load(
+        g, weight(1.0), hand_jacobian=J, torque_limits=[15, 20], cones=cones
+    )
+    # the weaker finger presses at most 15 N: friction carries 2 · μ · 15 N
+    assert r.alpha == pytest.approx(2 * 0.5 * 15 / G_EARTH, rel=1e-6)
+    assert r.upper_bound == pytest.approx(r.alpha, rel=1e-6)
+    assert r.saturating_joints[0] == 0
+    assert r.certificate.check(g, hand_jacobian=J).holds
+    below = dg.grasp_forces(
+        g, 0.999 * r.alpha * weight(1.0), hand_jacobian=J, torque_limits=[15, 20]
+    )
+    above = dg.grasp_forces(
+        g, 1.001 * r.alpha * weight(1.0), hand_jacobian=J, torque_limits=[15, 20]
+    )
+    assert below.feasible and not above.feasible
+    assert above.certificate.check(g, hand_jacobian=J).holds
+
+
+def test_payload_without_limits_is_infinite_and_exact_beats_polyhedral():
+    g = pinch(0.5)
+    assert dg.max_load(g, weight(1.0)).alpha == math.inf
+    d = [0.3, 0.2, -1.0, 0, 0, 0]  # not along a generator
+    exact = dg.max_load(g, d, max_normal_force=10.0)
+    poly = dg.max_load(g, d, max_normal_force=10.0, cones="polyhedral")
+    assert poly.alpha <= exact.alpha * (1 + 1e-7)
