@@ -82,6 +82,7 @@ _SOURCES = {
         "normal_grasp_matrix",
         "normalised_grasp_matrix",
     ),
+    "drakegrasp.plant.options": ("AnalysisOptions",),
     "drakegrasp.plant": (
         "FingerClosure",
         "GraspFromPlant",
@@ -170,6 +171,7 @@ __getattr__, __dir__ = lazy_exports(
 __version__ = "0.1.0"
 
 __all__ = [
+    "AnalysisOptions",
     "AntipodalResult",
     "BatchClosureResult",
     "BatchFileError",

@@ -60,21 +60,19 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         package_map=dict(args.package) or None,
         allow_any_file=args.allow_any_file,
     )
-    options = scene.analysis_options()
-    if args.mu is not None:
-        options["mu"] = args.mu
-    if args.contact_model is not None:
-        options["contact_model"] = ContactModel.parse(args.contact_model)
-    if args.torsional_friction is not None:
-        options["torsional_friction"] = args.torsional_friction  # 0 is valid
-    elif (
-        options["contact_model"] is ContactModel.SOFT_FINGER
-        and not options["torsional_friction"]
-    ):
-        # The scene gives no ν (its default is 0): not given, as in the batch
-        # command; analyze_grasp explains what is missing.
-        options["torsional_friction"] = None
-    report = analyze_grasp(scene.plant, scene.plant_context, **options)
+    changes = {
+        name: getattr(args, name)
+        for name in _ANALYSIS_FLAGS
+        if getattr(args, name, None) is not None
+    }
+    options = scene.options.replace(**changes)
+    report = analyze_grasp(
+        scene.plant,
+        scene.plant_context,
+        scene.object_body,
+        hand=scene.hand,
+        options=options,
+    )
     if args.json:
         out = {"scene": scene.name, "scene_file": str(scene.info.path)}
         out.update(report.to_dict())
@@ -219,19 +217,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
         default=None,
         help="shipped scene name (see `drakegrasp scenes`) or scene YAML file",
     )
-    analyze.add_argument(
-        "--mu", type=_positive_float, help="friction coefficient (default: scene's)"
-    )
-    analyze.add_argument(
-        "--contact-model",
-        choices=[m.value for m in ContactModel],
-        help="contact model (default: scene's)",
-    )
-    analyze.add_argument(
-        "--torsional-friction",
-        type=_positive_float,
-        help="torsional friction coefficient of soft fingers (default: scene's)",
-    )
+    _add_analysis_options(analyze)
     analyze.add_argument(
         "--package",
         action="append",
@@ -254,6 +240,84 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
     scenes.set_defaults(func=_cmd_scenes)
     _add_batch_parser(sub)
     return parser, sub
+
+
+# AnalysisOptions fields the analyze command sets (None: the scene's value).
+# load and torque_limits take arrays in Python; the command line leaves them out.
+_ANALYSIS_FLAGS = (
+    "mu",
+    "contact_model",
+    "torsional_friction",
+    "distance_tolerance",
+    "plane",
+    "characteristic_length",
+    "num_generators",
+    "tol",
+    "allow_penetration",
+    "patches",
+    "check_pose",
+)
+
+
+def _add_analysis_options(parser: argparse.ArgumentParser) -> None:
+    """``analyze``'s options, with the help and defaults of AnalysisOptions."""
+    from drakegrasp.plant.options import OPTION_HELP, PATCH_MODES, PLANES
+
+    defaults = _analysis_defaults()
+    kinds = {
+        "mu": {"type": _mu},
+        "contact_model": {"choices": [m.value for m in ContactModel]},
+        "torsional_friction": {"type": _positive_float},
+        "distance_tolerance": {"type": _positive_float},
+        "plane": {"choices": sorted(PLANES)},
+        "characteristic_length": {"type": _positive_float},
+        "num_generators": {"type": int},
+        "tol": {"type": _positive_float},
+        "patches": {"choices": list(PATCH_MODES)},
+    }
+    for name in _ANALYSIS_FLAGS:
+        flag = "--" + name.replace("_", "-")
+        default = defaults[name]
+        shown = (
+            "the scene's"
+            if name in _SCENE_OPTIONS
+            else "the farthest contact from O's origin"
+            if default is None
+            else f"{default}"
+        )
+        help_text = f"{OPTION_HELP[name]} (default: {shown})"
+        if isinstance(default, bool):
+            parser.add_argument(
+                flag,
+                action=argparse.BooleanOptionalAction,
+                default=None,
+                help=help_text,
+            )
+        else:
+            parser.add_argument(flag, default=None, help=help_text, **kinds[name])
+
+
+# The options a scene file sets; the others default to AnalysisOptions'.
+_SCENE_OPTIONS = (
+    "mu",
+    "contact_model",
+    "torsional_friction",
+    "plane",
+    "distance_tolerance",
+)
+
+
+def _analysis_defaults() -> dict:
+    from dataclasses import fields
+
+    from drakegrasp.plant.options import AnalysisOptions
+
+    return {f.name: f.default for f in fields(AnalysisOptions)}
+
+
+def _mu(text: str) -> float | str:
+    """``--mu``: a friction coefficient, or ``plant``."""
+    return text if text == "plant" else _positive_float(text)
 
 
 class _BatchMetrics:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 __all__ = [
+    "DEFAULT_DISTANCE_TOLERANCE",
     "DEFAULT_RANK_TOL",
     "DEFAULT_TOL",
     "ZERO_FRACTION",
@@ -27,6 +28,9 @@ closed forms), far below this threshold.
 
 DEFAULT_RANK_TOL = 1e-9
 """Singular values below ``rank_tol * σ_max`` count as zero in rank tests."""
+
+DEFAULT_DISTANCE_TOLERANCE = 1e-4
+"""Default ``|ψ|`` (metres) below which a geometry pair counts as a contact."""
 
 ZERO_FRACTION = 1e-3
 """``d*`` below ``ZERO_FRACTION * tol`` is the solver's zero, not a near miss."""

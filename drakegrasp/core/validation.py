@@ -73,6 +73,7 @@ __all__ = [
     "check_angle_tol",
     "check_coefficient",
     "check_coefficient_array",
+    "check_distance_tolerance",
     "check_flag",
     "check_grasp",
     "check_length",
@@ -425,3 +426,22 @@ def check_flag(name: str, value) -> bool:
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
     raise InvalidOptionError(f"{name} must be True or False, got {_describe(value)}")
+
+
+def check_distance_tolerance(value) -> float:
+    """``distance_tolerance`` as a float, once it is finite and > 0 (metres).
+
+    Raises
+    ------
+    InvalidOptionError
+        For anything else (also a string or None), naming the value.
+    """
+    try:
+        tol = float(value)
+    except (TypeError, ValueError):
+        tol = float("nan")
+    if not tol > 0 or tol == float("inf"):
+        raise InvalidOptionError(
+            f"distance_tolerance must be finite and > 0 (metres), got {value!r}"
+        )
+    return tol

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.distributed.client import client_for
+from drakegrasp.plant.options import AnalysisOptions
 
 __all__ = ["analyze_poses", "cached_scenes"]
 
@@ -38,10 +39,12 @@ def _analyze_block(scene_name: str, q_block: np.ndarray, options: dict):
     out = {"is_force_closure": np.zeros(len(q_block), dtype=bool),
            "d_star": np.zeros(len(q_block)),
            "num_contacts": np.zeros(len(q_block), dtype=int)}  # fmt: skip
-    kwargs = {**scene.analysis_options(), **options}
+    analysis = scene.options.replace(**options)
     for i, q in enumerate(q_block):
         plant.SetPositions(ctx, q)
-        report = analyze_grasp(plant, ctx, **kwargs)
+        report = analyze_grasp(
+            plant, ctx, scene.object_body, hand=scene.hand, options=analysis
+        )
         out["is_force_closure"][i] = report.is_force_closure
         out["d_star"][i] = report.force_closure.d_star
         out["num_contacts"][i] = len(report.contacts)
@@ -77,6 +80,7 @@ def analyze_poses(
         ``is_force_closure``, ``d_star`` (LP2 of the report's force closure)
         and ``num_contacts``.
     """
+    AnalysisOptions().replace(**options)  # a bad option fails here, not on a worker
     client = client_for(client)
     q = np.asarray(positions, dtype=float)
     futs = [client.submit(_analyze_block, scene, q[s:s + block], options,

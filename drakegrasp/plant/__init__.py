@@ -44,6 +44,7 @@ _SOURCES = {
         "register_models",
         "use_local_drake_models",
     ),
+    "drakegrasp.plant.options": ("AnalysisOptions",),
     "drakegrasp.plant.pose": ("PoseCheck",),
     "drakegrasp.plant.scene": (
         "DEFAULT_SCENE",
@@ -64,7 +65,9 @@ _SUBMODULES = (
     "curvature",
     "fingers",
     "jacobians",
+    "load",
     "models",
+    "options",
     "pose",
     "scene",
     "scene_file",
@@ -77,6 +80,7 @@ __getattr__, __dir__ = lazy_exports(
 )
 
 __all__ = [
+    "AnalysisOptions",
     "DEFAULT_DISTANCE_TOLERANCE",
     "DEFAULT_SCENE",
     "FingerClosure",

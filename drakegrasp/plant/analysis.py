@@ -11,6 +11,7 @@ nothing here re-decides them.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,6 +19,7 @@ from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp.certificates.kinds import CertificateCheck
 from drakegrasp.closure.results import ClosureResult
 from drakegrasp.closure.second_order import SecondOrderResult, second_order_form_closure
 from drakegrasp.closure.verdicts import (
@@ -34,6 +36,7 @@ from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_TOL
+from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import GraspError, InvalidOptionError, NoContactsError
 from drakegrasp.plant.contacts import (
     DEFAULT_DISTANCE_TOLERANCE,
@@ -52,10 +55,10 @@ from drakegrasp.plant.jacobians import (
     signed_distance_jacobian,
 )
 from drakegrasp.plant.load import LoadReport, load_section
+from drakegrasp.plant.options import AnalysisOptions, resolve_options
 from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.pose import check_pose as _check_pose
 from drakegrasp.plant.validation import (
-    check_distance_tolerance,
     hand_model_instances,
     plant_context_of,
 )
@@ -130,15 +133,6 @@ class GraspFromPlant:
         }
 
 
-def _check_plane(plane: str | None) -> str | None:
-    if plane is None or plane in PLANES:
-        return plane
-    raise InvalidOptionError(
-        f"plane must be one of {sorted(PLANES)} (object-frame axes) or None, "
-        f"got {plane!r}"
-    )
-
-
 def _core_contact(
     pc: PlantContact,
     *,
@@ -174,7 +168,8 @@ def grasp_from_plant(
     object_body,
     *,
     hand: HandSpec = None,
-    mu: float,
+    options: AnalysisOptions | None = None,
+    mu: float | str | None = None,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
     torsional_friction: float | None = None,
     distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
@@ -199,8 +194,14 @@ def grasp_from_plant(
         the reference point.  Positional or keyword.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
         See :func:`~drakegrasp.plant.validation.hand_bodies`.
-    mu : float
-        Friction coefficient of every contact.
+    options : AnalysisOptions, optional
+        Every option below at once, validated when it was made; give it or
+        the keywords, not both.
+    mu : float or "plant"
+        Friction coefficient of every contact, or ``"plant"``: each contact's
+        coefficient from its two geometries' proximity properties
+        (:func:`~drakegrasp.plant.load.plant_friction`).  Required (here or in
+        ``options``).
     contact_model : ContactModel or str, optional
         ``"frictionless"``, ``"hard_finger"`` (default) or ``"soft_finger"``.
     torsional_friction : float, optional
@@ -239,21 +240,26 @@ def grasp_from_plant(
         (names the bodies and the depth, or the joint, its value and limits).
     NoContactsError, ModelError, InvalidOptionError, InvalidContextError
     """
+    opts = resolve_options(
+        options,
+        mu=mu,
+        contact_model=contact_model,
+        torsional_friction=torsional_friction,
+        distance_tolerance=distance_tolerance,
+        plane=plane,
+        characteristic_length=characteristic_length,
+        allow_penetration=allow_penetration,
+        patches=patches,
+        check_pose=check_pose,
+    ).require_friction()
     plant_context = plant_context_of(plant, plant_context)
-    plane = _check_plane(plane)
-    model = ContactModel.parse(contact_model)
-    if plane is not None and model is ContactModel.SOFT_FINGER:
-        raise InvalidOptionError(
-            "a planar analysis has no soft fingers (no moment about an in-plane "
-            "normal); use 'hard_finger' or 'frictionless'"
-        )
-    if torsional_friction is None:
-        if model is ContactModel.SOFT_FINGER:
-            raise InvalidOptionError(
-                "contact_model='soft_finger' needs torsional_friction > 0 (the "
-                "moment about the normal is bounded by b * nu * f_n)"
-            )
-        torsional_friction = 0.0
+    plane, model = opts.plane, opts.contact_model
+    distance_tolerance, allow_penetration = (
+        opts.distance_tolerance,
+        opts.allow_penetration,
+    )
+    check_pose = opts.check_pose
+    torsional_friction = opts.torsional_friction or 0.0
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
     pose = _pose_of(
@@ -274,22 +280,28 @@ def grasp_from_plant(
             hand=bodies,
             distance_tolerance=distance_tolerance,
             allow_penetration=allow_penetration or not check_pose,
-            patches=patches,
+            patches=opts.patches,
             query_object=query_object,
         )
     elif not contacts:
         raise NoContactsError(f"no contacts given for {_scoped_name(plant, body)!r}")
+    if opts.mu == "plant":
+        from drakegrasp.plant.load import plant_friction
+
+        mus = plant_friction(plant, plant_context, contacts, query_object=query_object)
+    else:
+        mus = [opts.mu] * len(contacts)
     core = [
         _core_contact(
-            c, plane=plane, mu=mu, model=model, torsional_friction=torsional_friction
+            c, plane=plane, mu=m, model=model, torsional_friction=torsional_friction
         )
-        for c in contacts
+        for c, m in zip(contacts, mus, strict=True)
     ]
     dim = 2 if plane is not None else 3
     grasp = Grasp(
         core,
         reference_point=np.zeros(dim),
-        characteristic_length=characteristic_length,
+        characteristic_length=opts.characteristic_length,
     )
     indices = hand_velocity_indices(plant, bodies)
     J = hand_jacobian(
@@ -374,6 +386,8 @@ class GraspReport:
         With ``analyze_grasp(..., load=...)``: whether the hand holds the load,
         with which joint torques and squeeze, the payload factor and the
         joint that saturates first (:mod:`drakegrasp.plant.load`).
+    options : AnalysisOptions or None
+        The options the analysis used (validated).
 
     Notes
     -----
@@ -394,6 +408,7 @@ class GraspReport:
     pose: PoseCheck | None = None
     second_order: SecondOrderResult | None = deferrable(None)
     load: LoadReport | None = None
+    options: AnalysisOptions | None = None
 
     @property
     def grasp(self) -> Grasp:
@@ -415,6 +430,23 @@ class GraspReport:
         """Polyhedral force closure with LP3 passing."""
         return self.force_closure.is_closure
 
+    @functools.cached_property
+    def certificate_checks(self) -> dict[str, CertificateCheck | None]:
+        """Each verdict's certificate re-checked on this grasp, once per report.
+
+        Keys ``form_closure``, ``force_closure``, ``force_closure_exact``; None
+        where a verdict has no certificate.  The checks run on first access
+        and are kept (the report is immutable), so printing a report twice
+        does not check twice.
+        """
+        out = {}
+        for name in ("form_closure", "force_closure", "force_closure_exact"):
+            cert = getattr(self, name).certificate
+            out[name] = (
+                None if cert is None else cert.check(self.grasp, hand_jacobian=self.J)
+            )
+        return out
+
     def to_dict(self) -> dict:
         """JSON-ready dictionary of the whole report."""
         return {
@@ -427,6 +459,7 @@ class GraspReport:
             "pose": None if self.pose is None else self.pose.to_dict(),
             "second_order": jsonable(self.second_order),
             "load": None if self.load is None else self.load.to_dict(),
+            "options": None if self.options is None else self.options.to_dict(),
         }
 
     def __str__(self) -> str:
@@ -464,11 +497,13 @@ class GraspReport:
             lines.append(f"  (points below are ({axes}) of frame O, metres)")
         else:
             lines.append("  (points below are in frame O, metres)")
-        for result in (self.form_closure, self.force_closure, self.force_closure_exact):
+        checks = self.certificate_checks
+        for name in ("form_closure", "force_closure", "force_closure_exact"):
+            result = getattr(self, name)
             lines += ["  " + x for x in result.report_lines(internal_forces=False)]
-            if result.certificate is not None:
-                check = result.certificate.check(g, hand_jacobian=self.J)
-                lines.append(f"    {result.certificate.kind} re-checked: {check}")
+            if checks[name] is not None:
+                kind = result.certificate.kind
+                lines.append(f"    {kind} re-checked: {checks[name]}")
         lp3 = self.force_closure.internal_forces
         if lp3 is not None:  # one LP3 serves both force-closure verdicts
             lines += ["  " + x for x in lp3.report_lines()]
@@ -487,7 +522,8 @@ def analyze_grasp(
     object_body,
     *,
     hand: HandSpec = None,
-    mu: float | str,
+    options: AnalysisOptions | None = None,
+    mu: float | str | None = None,
     contact_model: ContactModel | str = ContactModel.HARD_FINGER,
     torsional_friction: float | None = None,
     distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
@@ -510,10 +546,15 @@ def analyze_grasp(
     plant, plant_context, object_body, hand
         As in :func:`grasp_from_plant` (``plant_context`` may be the diagram's
         root context; ``object_body`` may be positional).
+    options : AnalysisOptions, optional
+        Every option below at once (validated when it was made); give it or
+        the keywords, not both.  The report keeps the options it used
+        (``report.options``).
     mu : float or "plant"
         Friction of every contact, or ``"plant"``: each contact's coefficient
         combined from its two geometries' proximity properties
-        (:func:`~drakegrasp.plant.load.plant_friction`).
+        (:func:`~drakegrasp.plant.load.plant_friction`).  Required (here or in
+        ``options``).
     contact_model, torsional_friction, distance_tolerance, plane
         As in :func:`grasp_from_plant`.
     characteristic_length, allow_penetration, patches
@@ -537,20 +578,28 @@ def analyze_grasp(
     -------
     GraspReport
     """
-    data = grasp_from_plant(
-        plant,
-        plant_context,
-        object_body=object_body,
-        hand=hand,
-        mu=1.0 if isinstance(mu, str) else mu,
+    opts = resolve_options(
+        options,
+        mu=mu,
         contact_model=contact_model,
         torsional_friction=torsional_friction,
         distance_tolerance=distance_tolerance,
         plane=plane,
         characteristic_length=characteristic_length,
+        num_generators=num_generators,
+        tol=tol,
         allow_penetration=allow_penetration,
         patches=patches,
         check_pose=check_pose,
+        load=load,
+        torque_limits=torque_limits,
+    ).require_friction()
+    data = grasp_from_plant(
+        plant,
+        plant_context,
+        object_body=object_body,
+        hand=hand,
+        options=opts.replace(mu=1.0) if opts.mu == "plant" else opts,
         query_object=query_object,
         contacts=contacts,
     )
@@ -558,11 +607,14 @@ def analyze_grasp(
         plant,
         plant_context,
         data,
-        mu=mu,
-        load=load,
-        torque_limits=torque_limits,
+        mu=opts.mu,
+        load=None if opts.load is None else _as_load(opts.load),
+        torque_limits=None
+        if opts.torque_limits is None
+        else _as_load(opts.torque_limits),
         query_object=query_object,
     )
+    tol, num_generators = opts.tol, opts.num_generators
     grasp, J = data.grasp, data.hand_jacobian
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
     first_order = form_closure(grasp, tol=tol)
@@ -587,7 +639,13 @@ def analyze_grasp(
         if first_order.is_closure
         else _second_order(plant, plant_context, data, first_order, query_object),
         load=load_report,
+        options=opts,
     )
+
+
+def _as_load(value):
+    """A load option as the load section takes it: a word, or an array."""
+    return value if isinstance(value, str) else np.array(value)
 
 
 def _second_order(plant, plant_context, data, first_order, query_object):

@@ -41,18 +41,18 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
+from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
     InvalidOptionError,
     ModelError,
     PenetrationError,
     UnreachableError,
 )
-from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.plant.fingers import Finger, HandStructure, hand_structure
 from drakegrasp.plant.pose import find_penetrations
 from drakegrasp.plant.validation import (
     HandSpec,
-    check_distance_tolerance,
     hand_bodies,
     hand_model_instances,
     plant_context_of,

@@ -46,6 +46,8 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
+from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
     InvalidOptionError,
     ModelError,
@@ -60,7 +62,6 @@ from drakegrasp.plant._shapes import (
 )
 from drakegrasp.plant.validation import (
     HandSpec,
-    check_distance_tolerance,
     hand_bodies,
     plant_context_of,
     resolve_object_body,
@@ -75,9 +76,6 @@ __all__ = [
     "hand_bodies",
     "resolve_object_body",
 ]
-
-DEFAULT_DISTANCE_TOLERANCE = 1e-4
-"""Default ``|ψ|`` (metres) below which a geometry pair counts as a contact."""
 
 PATCH_ANGLE_TOL = np.radians(2.0)
 """Two flat faces whose normals are opposite within this angle (rad) form a patch."""

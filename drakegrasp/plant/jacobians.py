@@ -31,6 +31,7 @@ from pydrake.systems.framework import Context
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.plant.contacts import PlantContact
+from drakegrasp.plant.options import PLANES
 from drakegrasp.plant.validation import (
     _per_plant,
     plant_context_of,
@@ -43,13 +44,6 @@ __all__ = [
     "hand_velocity_indices",
     "signed_distance_jacobian",
 ]
-
-PLANES = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
-"""Planes of the object frame for a planar analysis: name -> the two axes.
-
-Each pair is ordered so that the plane's normal (the moment axis) is the third
-axis of a right-handed frame: ``"yz"`` gives wrenches ``[f_y, f_z, m_x]``.
-"""
 
 
 def hand_velocity_indices(

@@ -124,6 +124,7 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.models import models_dir
+from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import check_section, read_yaml
 from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
 from drakegrasp.plant.validation import resolve_body
@@ -216,6 +217,21 @@ class Scene:
     def name(self) -> str:
         """The scene's name (file stem)."""
         return self.info.name
+
+    @property
+    def options(self) -> AnalysisOptions:
+        """The scene file's analysis options (friction, model, plane, tolerance)."""
+        info = self.info
+        torsion = info.torsional_friction
+        if info.contact_model is ContactModel.SOFT_FINGER and not torsion:
+            torsion = None  # the file gives no ν: the analysis says what is missing
+        return AnalysisOptions(
+            mu=info.mu,
+            contact_model=info.contact_model,
+            torsional_friction=torsion,
+            plane=info.plane,
+            distance_tolerance=info.distance_tolerance,
+        )
 
     def analysis_options(self) -> dict:
         """Keyword arguments of :func:`drakegrasp.analyze_grasp` from the file."""

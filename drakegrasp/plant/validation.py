@@ -27,7 +27,6 @@ from drakegrasp.errors import InvalidContextError, InvalidOptionError, ModelErro
 
 __all__ = [
     "HandSpec",
-    "check_distance_tolerance",
     "check_plant",
     "hand_bodies",
     "hand_model_instances",
@@ -124,25 +123,6 @@ def plant_context_of(plant, context) -> Context:
             f"holds it (pass plant.GetMyContextFromRoot(root) or the root); "
             f"Drake says: {msg}"
         ) from None
-
-
-def check_distance_tolerance(value) -> float:
-    """``distance_tolerance`` as a float, once it is finite and > 0 (metres).
-
-    Raises
-    ------
-    InvalidOptionError
-        For anything else (also a string or None), naming the value.
-    """
-    try:
-        tol = float(value)
-    except (TypeError, ValueError):
-        tol = float("nan")
-    if not tol > 0 or tol == float("inf"):
-        raise InvalidOptionError(
-            f"distance_tolerance must be finite and > 0 (metres), got {value!r}"
-        )
-    return tol
 
 
 def scoped_name(plant: MultibodyPlant, body: RigidBody) -> str:

@@ -441,8 +441,8 @@ def test_public_signatures_follow_the_issue():
 
     for fn, required in (
         (find_contacts, ["object_body"]),
-        (grasp_from_plant, ["object_body", "mu"]),
-        (analyze_grasp, ["object_body", "mu"]),
+        (grasp_from_plant, ["object_body"]),
+        (analyze_grasp, ["object_body"]),
     ):
         params = inspect.signature(fn).parameters
         names = list(params)
@@ -457,6 +457,8 @@ def test_public_signatures_follow_the_issue():
         assert params["hand"].default is None
         assert params["distance_tolerance"].default == 1e-4
     params = inspect.signature(grasp_from_plant).parameters
+    # mu is required: as a keyword or in options=AnalysisOptions(mu=...).
+    assert params["mu"].default is None and params["options"].default is None
     assert params["contact_model"].default == "hard_finger"
 
 
@@ -474,3 +476,84 @@ def test_scene_hand_as_body_list_and_tolerance(tmp_path):
     assert report.data.hand_velocity_indices.tolist() == [
         scene.plant.GetJointByName("left_finger_joint").velocity_start()
     ]
+
+
+def test_analysis_options_are_one_validated_object(tmp_path):
+    from drakegrasp import AnalysisOptions, GraspError, InvalidOptionError, load_scene
+
+    scene = load_scene("three_finger_sphere")
+    keywords = analyze_grasp(
+        scene.plant, scene.plant_context, **scene.analysis_options()
+    )
+    report = analyze_grasp(
+        scene.plant,
+        scene.plant_context,
+        scene.object_body,
+        hand=scene.hand,
+        options=scene.options,
+    )
+    # The same analysis either way, and the report keeps what it used.
+    assert report.to_dict() == keywords.to_dict()
+    assert report.options == keywords.options == scene.options
+    # Invalid values are refused when the object is made, with the field named.
+    for bad in (
+        {"mu": -1},
+        {"tol": 0},
+        {"plane": "xz"},
+        {"patches": "all"},
+        {"check_pose": 1},
+        {"num_generators": 2},
+        {"load": "weight"},
+        {"contact_model": "sticky"},
+        {"distance_tolerance": float("nan")},
+    ):
+        name = next(iter(bad))
+        with pytest.raises(GraspError, match=name.split("_")[0]):
+            AnalysisOptions(**bad)
+    with pytest.raises(InvalidOptionError, match="unknown analysis option"):
+        scene.options.replace(friction=0.3)
+    # Options and keywords together: refused rather than one silently ignored.
+    with pytest.raises(InvalidOptionError, match=r"\['tol'\], not both"):
+        analyze_grasp(
+            scene.plant,
+            scene.plant_context,
+            scene.object_body,
+            options=scene.options,
+            tol=1e-3,
+        )
+    # mu is required, here or in the options.
+    with pytest.raises(InvalidOptionError, match="needs mu"):
+        analyze_grasp(scene.plant, scene.plant_context, scene.object_body)
+    # A changed field changes the analysis.
+    strict = analyze_grasp(
+        scene.plant,
+        scene.plant_context,
+        scene.object_body,
+        hand=scene.hand,
+        options=scene.options.replace(mu=0.0),
+    )
+    assert not strict.force_closure.frictional_closure
+    assert strict.options.mu == 0.0 and strict.to_dict()["options"]["mu"] == 0.0
+
+
+def test_printing_a_report_checks_its_certificates_once(monkeypatch):
+    from drakegrasp import load_scene
+    from drakegrasp.certificates.certificate import Certificate
+
+    scene = load_scene("three_finger_sphere")
+    report = analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
+    calls = []
+    original = Certificate.check
+
+    def counted(self, *args, **kwargs):
+        calls.append(self.kind)
+        return original(self, *args, **kwargs)
+
+    monkeypatch.setattr(Certificate, "check", counted)
+    first, second = str(report), str(report)
+    assert first == second and "re-checked" in first
+    n = sum(
+        r.certificate is not None
+        for r in (report.form_closure, report.force_closure, report.force_closure_exact)
+    )
+    assert len(calls) == n > 0

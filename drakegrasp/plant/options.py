@@ -1,0 +1,270 @@
+"""One options object for reading a grasp from a plant and judging it.
+
+:class:`AnalysisOptions` holds every choice of :func:`~drakegrasp.analyze_grasp`
+and :func:`~drakegrasp.grasp_from_plant` besides the plant, its context, the
+object and the hand: friction, contact model, tolerances, the plane of a
+planar analysis, how flat patches are reported and whether the pose is
+checked.  It is frozen and validated once, when it is made; the analysis, the
+grasp monitor, scene files, the Dask driver and the command line all take or
+give one, and the command line reads its defaults and help from
+:data:`OPTION_HELP`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE, DEFAULT_TOL
+from drakegrasp.core.validation import (
+    check_coefficient,
+    check_distance_tolerance,
+    check_flag,
+    check_length,
+    check_num_generators,
+    check_tol,
+)
+from drakegrasp.errors import InvalidOptionError
+
+__all__ = [
+    "OPTION_HELP",
+    "PATCH_MODES",
+    "PLANES",
+    "AnalysisOptions",
+    "resolve_options",
+]
+
+PLANES = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
+"""Planes of the object frame for a planar analysis: name -> the two axes.
+
+Each pair is ordered so that the plane's normal (the moment axis) is the third
+axis of a right-handed frame: ``"yz"`` gives wrenches ``[f_y, f_z, m_x]``.
+"""
+
+PATCH_MODES = ("vertices", "witness")
+"""How a flat contact patch is reported: its corners, or Drake's witness point."""
+
+OPTION_HELP = {
+    "mu": "Coulomb friction coefficient of every contact (dimensionless, >= 0), "
+    "or 'plant': each pair's friction from its geometries' proximity properties",
+    "contact_model": "contact model: frictionless, hard_finger or soft_finger",
+    "torsional_friction": "soft-finger torsional friction nu (>= 0; soft_finger "
+    "needs it)",
+    "distance_tolerance": "signed distance below which a pair touches (metres)",
+    "plane": "planar analysis in this plane of the object frame (xy, yz or zx)",
+    "characteristic_length": "length b that makes moments comparable with "
+    "forces (metres)",
+    "num_generators": "generators of each polyhedral Coulomb cone",
+    "tol": "threshold on d*: closure needs d* > tol",
+    "allow_penetration": "analyse a penetrating pose anyway (contacts still "
+    "found within the tolerance)",
+    "patches": "how a flat contact patch is reported: vertices or witness",
+    "check_pose": "refuse an impossible pose (penetration, joints beyond limits)",
+    "load": "an external wrench on the object (frame O about its origin), or "
+    "'gravity' (its weight): adds the load section",
+    "torque_limits": "motor limits of the load section: 'plant' (the actuators' "
+    "effort limits) or one per hand velocity",
+}
+"""One line per option: the docstring below and the command line's help."""
+
+
+@dataclass(frozen=True)
+class AnalysisOptions:
+    """How a grasp is read from a plant and judged (validated when made).
+
+    Attributes
+    ----------
+    mu : float, "plant" or None
+        Coulomb friction coefficient of every contact (dimensionless), or
+        ``"plant"``: each pair's coefficient from its geometries' proximity
+        properties; None until given (an analysis needs it).
+    contact_model : ContactModel
+        ``frictionless``, ``hard_finger`` (default) or ``soft_finger``.
+    torsional_friction : float or None
+        Soft-finger torsional friction ``ν`` (the moment about the normal is
+        bounded by ``b ν f_n``); a soft-finger analysis needs it, 0 otherwise.
+    distance_tolerance : float
+        A pair closer than this (metres) touches (default
+        :data:`~drakegrasp.core.tolerances.DEFAULT_DISTANCE_TOLERANCE`).
+    plane : {"xy", "yz", "zx"} or None
+        Planar analysis in this plane of the object frame O.
+    characteristic_length : float or None
+        Length ``b`` (metres) scaling moments; None: from the contacts.
+    num_generators : int
+        Generators of each polyhedral Coulomb cone (default 8).
+    tol : float
+        Threshold on ``d*`` (dimensionless).
+    allow_penetration : bool
+        Analyse a penetrating pose anyway.
+    patches : {"vertices", "witness"}
+        How a flat contact patch is reported.
+    check_pose : bool
+        Refuse an impossible pose (penetration, joints beyond their limits).
+    load : None, "gravity" or tuple of float
+        An external wrench on the object, (6,) or planar (3,), in frame O about
+        its origin, or the object's weight: the report then has a load section.
+    torque_limits : None, "plant" or tuple of float
+        Motor limits of the load section (N·m or N per hand velocity).
+    """
+
+    mu: float | None = None
+    contact_model: ContactModel = ContactModel.HARD_FINGER
+    torsional_friction: float | None = None
+    distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE
+    plane: str | None = None
+    characteristic_length: float | None = None
+    num_generators: int = DEFAULT_NUM_GENERATORS
+    tol: float = DEFAULT_TOL
+    allow_penetration: bool = False
+    patches: str = "vertices"
+    check_pose: bool = True
+    load: str | tuple[float, ...] | None = None
+    torque_limits: str | tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        def put(name: str, value: Any) -> None:
+            object.__setattr__(self, name, value)
+
+        if isinstance(self.mu, str):
+            if self.mu != "plant":
+                raise InvalidOptionError(
+                    f"mu must be a number or 'plant', got {self.mu!r}"
+                )
+        elif self.mu is not None:
+            put("mu", check_coefficient("mu", self.mu))
+        model = ContactModel.parse(self.contact_model)
+        put("contact_model", model)
+        if self.plane is not None and self.plane not in PLANES:
+            raise InvalidOptionError(
+                f"plane must be one of {sorted(PLANES)} (object-frame axes) or "
+                f"None, got {self.plane!r}"
+            )
+        if self.plane is not None and model is ContactModel.SOFT_FINGER:
+            raise InvalidOptionError(
+                "a planar analysis has no soft fingers (no moment about an in-plane "
+                "normal); use 'hard_finger' or 'frictionless'"
+            )
+        if self.torsional_friction is not None:
+            put(
+                "torsional_friction",
+                check_coefficient("torsional_friction", self.torsional_friction),
+            )
+        put("distance_tolerance", check_distance_tolerance(self.distance_tolerance))
+        if self.characteristic_length is not None:
+            put(
+                "characteristic_length",
+                check_length("characteristic_length", self.characteristic_length),
+            )
+        put("num_generators", check_num_generators(self.num_generators))
+        put("tol", check_tol(self.tol))
+        put(
+            "allow_penetration", check_flag("allow_penetration", self.allow_penetration)
+        )
+        put("check_pose", check_flag("check_pose", self.check_pose))
+        if not isinstance(self.patches, str) or self.patches not in PATCH_MODES:
+            raise InvalidOptionError(
+                f"patches must be one of {list(PATCH_MODES)}, got {self.patches!r}"
+            )
+        put("load", _named_or_values("load", self.load, "gravity"))
+        put(
+            "torque_limits",
+            _named_or_values("torque_limits", self.torque_limits, "plant"),
+        )
+
+    def replace(self, **changes: Any) -> AnalysisOptions:
+        """A copy with ``changes`` (validated again); unknown names are refused."""
+        unknown = sorted(set(changes) - {f.name for f in fields(self)})
+        if unknown:
+            raise InvalidOptionError(
+                f"unknown analysis option(s) {unknown}; valid: "
+                f"{[f.name for f in fields(self)]}"
+            )
+        return dataclasses.replace(self, **changes)
+
+    def require_friction(self) -> AnalysisOptions:
+        """``self`` when ``mu`` (and a soft finger's ``ν``) are given; else an error."""
+        if self.mu is None:
+            raise InvalidOptionError(
+                "the analysis needs mu, the friction coefficient of every contact "
+                "(AnalysisOptions(mu=...), mu=..., or --mu on the command line)"
+            )
+        if (
+            self.contact_model is ContactModel.SOFT_FINGER
+            and self.torsional_friction is None
+        ):
+            raise InvalidOptionError(
+                "contact_model='soft_finger' needs torsional_friction > 0 (the "
+                "moment about the normal is bounded by b * nu * f_n)"
+            )
+        return self
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (the contact model by its name)."""
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        out["contact_model"] = self.contact_model.value
+        return jsonable(out)
+
+
+def _named_or_values(name: str, value: Any, word: str):
+    """None, ``word``, or a finite 1-D sequence of numbers as a tuple."""
+    if value is None or (isinstance(value, str) and value == word):
+        return value
+    if isinstance(value, str):
+        raise InvalidOptionError(
+            f"{name} must be {word!r}, numbers or None, got {value!r}"
+        )
+    try:
+        values = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidOptionError(
+            f"{name} must be {word!r}, numbers or None, got {value!r}"
+        ) from None
+    if values.ndim != 1 or not np.all(np.isfinite(values)):
+        raise InvalidOptionError(
+            f"{name} must be a finite 1-D sequence of numbers, got {value!r}"
+        )
+    return tuple(float(x) for x in values)
+
+
+def resolve_options(
+    options: AnalysisOptions | None, **keywords: Any
+) -> AnalysisOptions:
+    """The options of a call: ``options``, or one made from its keywords.
+
+    A call may give an :class:`AnalysisOptions` or keywords, not both: a
+    keyword whose value differs from the field's default next to ``options``
+    is refused (it would be silently ignored otherwise).
+    """
+    if options is None:
+        return AnalysisOptions(**keywords)
+    if not isinstance(options, AnalysisOptions):
+        raise InvalidOptionError(
+            f"options must be an AnalysisOptions, got {type(options).__name__}"
+        )
+    defaults = AnalysisOptions()
+    given = sorted(
+        name
+        for name, value in keywords.items()
+        if not _same(value, getattr(defaults, name))
+    )
+    if given:
+        raise InvalidOptionError(
+            f"give options= or the keywords {given}, not both "
+            "(options.replace(...) changes a field)"
+        )
+    return options
+
+
+def _same(value: Any, default: Any) -> bool:
+    if isinstance(default, ContactModel):
+        try:
+            return ContactModel.parse(value) is default
+        except Exception:  # noqa: BLE001 - an invalid value is "given"
+            return False
+    return value is default or (type(value) is type(default) and value == default)
