@@ -59,6 +59,8 @@ _SUBMODULES = (
     "_shapes",
     "analysis",
     "closing",
+    "contact_normals",
+    "contact_patches",
     "contact_results",
     "contacts",
     "curvature",

@@ -30,10 +30,10 @@ from pydrake.systems.framework import Context
 
 from drakegrasp.errors import InvalidOptionError, NoContactsError
 from drakegrasp.plant._shapes import plane_basis
+from drakegrasp.plant.contact_normals import clean_unit as _clean_unit
 from drakegrasp.plant.contacts import (
     HandSpec,
     PlantContact,
-    _clean_unit,
     _scoped_name,
     hand_bodies,
     resolve_object_body,
