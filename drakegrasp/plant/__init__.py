@@ -57,6 +57,7 @@ _SOURCES = {
 # Submodules an eager package imported, reachable after ``import drakegrasp.plant``.
 _SUBMODULES = (
     "_shapes",
+    "advancement",
     "analysis",
     "closing",
     "contact_normals",

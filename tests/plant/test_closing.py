@@ -277,7 +277,7 @@ def test_bounded_iterations_and_min_fingers(real_hands):
         )
     # Out of steps with min_fingers met: the stopped fingers stay clear.
     closure = close_hand(
-        scene.plant, scene.ctx, scene.object, hand=scene.hand, max_iterations=6
+        scene.plant, scene.ctx, scene.object, hand=scene.hand, max_iterations=10
     )
     assert "not converged" in [f.status for f in closure.fingers]
     assert closure.touching_fingers
