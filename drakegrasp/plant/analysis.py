@@ -41,7 +41,6 @@ from drakegrasp.plant.contacts import (
     PlantContact,
     _scoped_name,
     find_contacts,
-    hand_bodies,
     resolve_object_body,
 )
 from drakegrasp.plant.curvature import SECOND_ORDER_RANK_TOL, contact_curvatures
@@ -55,6 +54,7 @@ from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.pose import check_pose as _check_pose
 from drakegrasp.plant.validation import (
     check_distance_tolerance,
+    hand_contact_bodies,
     hand_model_instances,
     plant_context_of,
 )
@@ -88,7 +88,7 @@ class GraspFromPlant:
     object_body : str
         Scoped name of the object body (the frame O).
     hand_bodies : tuple of str
-        Scoped names of the hand's bodies.
+        Scoped names of the hand's bodies, welded ones (a palm) included.
     plane : str or None
         Object-frame plane of a planar analysis (``"yz"``...), or None.
     pose : PoseCheck or None
@@ -127,6 +127,16 @@ class GraspFromPlant:
             "dpsi_dv": jsonable(self.dpsi_dv),
             "pose": None if self.pose is None else self.pose.to_dict(),
         }
+
+
+def lp3_jacobian(J: np.ndarray) -> np.ndarray:
+    """``J`` as the programs take it: one zero column for a hand without joints.
+
+    A hand made only of welded bodies (``hand=[palm]``) has no velocities, so
+    ``J`` has no column and ``Jᵀ f = 0`` constrains nothing; a single zero
+    column states exactly that to the programs, which want at least one.
+    """
+    return J if J.shape[1] else np.zeros((J.shape[0], 1))
 
 
 def _check_plane(plane: str | None) -> str | None:
@@ -197,7 +207,9 @@ def grasp_from_plant(
         The grasped object; its body frame O is the grasp frame and its origin
         the reference point.  Positional or keyword.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
-        See :func:`~drakegrasp.plant.validation.hand_bodies`.
+        See :func:`~drakegrasp.plant.validation.hand_contact_bodies`: every
+        body of the hand touches, a palm welded to the world included (its
+        contacts are in ``G``, its rows of ``J`` are zero).
     mu : float
         Friction coefficient of every contact.
     contact_model : ContactModel or str, optional
@@ -254,7 +266,7 @@ def grasp_from_plant(
             )
         torsional_friction = 0.0
     body = resolve_object_body(plant, object_body)
-    bodies = hand_bodies(plant, body, hand)
+    bodies = hand_contact_bodies(plant, body, hand)
     pose = _pose_of(
         plant,
         plant_context,
@@ -460,7 +472,9 @@ class GraspReport:
         for result in (self.form_closure, self.force_closure, self.force_closure_exact):
             lines += ["  " + x for x in result.report_lines(internal_forces=False)]
             if result.certificate is not None:
-                check = result.certificate.check(g, hand_jacobian=self.J)
+                check = result.certificate.check(
+                    g, hand_jacobian=lp3_jacobian(self.J)
+                )
                 lines.append(f"    {result.certificate.kind} re-checked: {check}")
         lp3 = self.force_closure.internal_forces
         if lp3 is not None:  # one LP3 serves both force-closure verdicts
@@ -531,7 +545,7 @@ def analyze_grasp(
         query_object=query_object,
         contacts=contacts,
     )
-    grasp, J = data.grasp, data.hand_jacobian
+    grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
     first_order = form_closure(grasp, tol=tol)
     polyhedral = force_closure(grasp, num_generators=num_generators, tol=tol)

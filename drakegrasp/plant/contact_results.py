@@ -35,9 +35,9 @@ from drakegrasp.plant.contacts import (
     HandSpec,
     PlantContact,
     _scoped_name,
-    hand_bodies,
     resolve_object_body,
 )
+from drakegrasp.plant.validation import hand_contact_bodies
 
 __all__ = ["contacts_from_results", "patch_polygon"]
 
@@ -148,7 +148,7 @@ def contacts_from_results(
         )
     plant.ValidateContext(plant_context)
     body = resolve_object_body(plant, object_body)
-    fingers = {b.index(): b for b in hand_bodies(plant, body, hand)}
+    fingers = {b.index(): b for b in hand_contact_bodies(plant, body, hand)}
     inspector = query_object.inspector()
     X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
     R_OW = X_OW.rotation().matrix()

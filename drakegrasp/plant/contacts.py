@@ -52,6 +52,7 @@ from drakegrasp.plant.validation import (
     HandSpec,
     check_distance_tolerance,
     hand_bodies,
+    hand_contact_bodies,
     plant_context_of,
     resolve_object_body,
     scoped_name,
@@ -174,7 +175,8 @@ def find_contacts(
         The grasped object (a ``"model::body"`` name is accepted); positional
         or keyword, like every option-free argument of the plant layer.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
-        See :func:`~drakegrasp.plant.validation.hand_bodies`.
+        See :func:`~drakegrasp.plant.validation.hand_contact_bodies`: every
+        body of the hand touches, a palm welded to the world included.
     distance_tolerance : float, optional
         A pair is a contact when ``|ψ| <= distance_tolerance`` (metres, default
         1e-4).
@@ -216,7 +218,7 @@ def find_contacts(
             f"patches must be 'vertices' or 'witness', got {patches!r}"
         )
     body = resolve_object_body(plant, object_body)
-    fingers = hand_bodies(plant, body, hand)
+    fingers = hand_contact_bodies(plant, body, hand)
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     if query_object is None:

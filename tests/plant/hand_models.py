@@ -214,3 +214,73 @@ class Rig:
                         key = (inspector.GetName(gh), inspector.GetName(go))
                         out[key] = r.distance
         return out
+
+
+PALM_FINGER_X = 0.05
+"""|x| (m) of the two finger joints of :func:`palm_hand` on the palm's top face."""
+PALM_LINKS = (0.035, 0.025)  # proximal and distal lengths to the next joint / tip
+PALM_TIP_RADIUS = 0.008
+
+
+def palm_hand() -> str:
+    """A palm (top face z = 0) welded to the world and two opposed two-link fingers.
+
+    Each finger's joints turn about axes parallel to y, the proximal one
+    through ``(±x, 0, 0)``; at ``q = 0`` the finger points up (+z): a 6 x 6 mm
+    proximal bar 35 mm long, then a distal bar and a spherical tip (radius
+    8 mm) 25 mm above the distal joint.  The ``left_*`` joints (at −x) close
+    with q > 0, the ``right_*`` joints with q < 0.
+    """
+    x, r = PALM_FINGER_X, PALM_TIP_RADIUS
+    l1, l2 = PALM_LINKS
+    palm = (
+        '<link name="palm">'
+        + _inertial(0.5, 1e-3)
+        + _collision("palm_box", _box(0.16, 0.08, 0.02), xyz=(0, 0, -0.01))
+        + "</link>"
+    )
+    links, joints = "", ""
+    for side, sx, sign in (("left", -x, 1.0), ("right", x, -1.0)):
+        lo, hi = sorted((-0.3 * sign, 1.4 * sign))
+        links += (
+            f'<link name="{side}_proximal"><pose>{_v(sx, 0, 0, 0, 0, 0)}</pose>'
+            + _inertial()
+            + _collision(
+                f"{side}_proximal_bar",
+                _box(0.006, 0.006, l1 - 0.004),
+                xyz=(0, 0, 0.5 * l1),
+            )
+            + "</link>"
+            + f'<link name="{side}_distal"><pose>{_v(sx, 0, l1, 0, 0, 0)}</pose>'
+            + _inertial()
+            + _collision(
+                f"{side}_distal_bar",
+                _box(0.006, 0.006, l2 - r),
+                xyz=(0, 0, 0.5 * (l2 - r)),
+            )
+            + _collision(f"{side}_tip", _sphere(r), xyz=(0, 0, l2))
+            + "</link>"
+        )
+        joints += _revolute(
+            f"{side}_proximal_joint", "palm", f"{side}_proximal", (0, 1, 0), lo, hi
+        )
+        joints += _revolute(
+            f"{side}_distal_joint",
+            f"{side}_proximal",
+            f"{side}_distal",
+            (0, 1, 0),
+            lo,
+            hi,
+        )
+    return _sdf("hand", palm + links + _weld_to_world("palm") + joints)
+
+
+def ball(radius: float = 0.035) -> str:
+    """A free ball (SDFormat model ``ball``)."""
+    return _sdf(
+        "ball",
+        '<link name="ball">'
+        + _inertial(0.1, 5e-5)
+        + _collision("ball", _sphere(radius))
+        + "</link>",
+    )

@@ -112,11 +112,15 @@ def test_reach_of_a_one_joint_finger_is_its_closed_form():
         assert row[0] == pytest.approx(expected[inspector.GetName(gf)], rel=1e-12)
 
 
-@settings(derandomize=True, max_examples=10, deadline=None)
+@settings(
+    derandomize=True,
+    max_examples=10,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
 @given(seed=st.integers(0, 2**16))
-def test_speed_bound_holds_on_the_allegro_hand(seed, drake_models_dir):
+def test_speed_bound_holds_on_the_allegro_hand(seed, real_hands):
     """Every corner of every finger geometry's bounding box moves slower than V."""
-    from conftest import ALLEGRO_URL, RealScene
     from pydrake.geometry import Box, Capsule, Cylinder, Sphere
 
     from drakegrasp.plant._shapes import bounding_sphere
@@ -125,13 +129,7 @@ def test_speed_bound_holds_on_the_allegro_hand(seed, drake_models_dir):
     from drakegrasp.plant.validation import hand_bodies
 
     rng = np.random.default_rng(seed)
-    scene = RealScene(
-        drake_models_dir,
-        ALLEGRO_URL,
-        "hand_root",
-        "package://drakegrasp/objects/sphere.sdf",
-        RigidTransform([0.08, 0.0, 0.1]),
-    )
+    scene = real_hands.allegro()
     plant, ctx = scene.plant, scene.ctx
     query = plant.get_geometry_query_input_port().Eval(ctx)
     inspector = query.inspector()

@@ -291,12 +291,20 @@ def test_report_text_and_json(scene_cache):
     assert np.array(data["dpsi_dv"]).shape == (2, 8)
 
 
-def test_hand_none_means_every_free_body_but_the_objects(scene_cache):
+def test_hand_none_means_the_free_bodies_and_their_models_but_not_the_objects(
+    scene_cache,
+):
     scene = scene_cache("parallel_jaw_box")
     data = grasp_from_plant(
         scene.plant, scene.plant_context, object_body=scene.object_body, mu=0.5
     )
-    assert data.hand_bodies == ("gripper::left_finger", "gripper::right_finger")
+    # The welded palm belongs to the hand (it can touch); its weld adds no column.
+    assert data.hand_bodies == (
+        "gripper::palm",
+        "gripper::left_finger",
+        "gripper::right_finger",
+    )
+    assert data.hand_velocity_indices.size == 2
     scene = scene_cache("planar_gripper_brick")
     data = grasp_from_plant(
         scene.plant,
