@@ -11,6 +11,7 @@ nothing here re-decides them.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +44,7 @@ from drakegrasp.plant.contacts import (
     find_contacts,
     resolve_object_body,
 )
+from drakegrasp.plant.couplings import coupling_map, plant_couplings
 from drakegrasp.plant.curvature import SECOND_ORDER_RANK_TOL, contact_curvatures
 from drakegrasp.plant.jacobians import (
     PLANES,
@@ -78,9 +80,12 @@ class GraspFromPlant:
         The plant contacts, in the order of ``grasp.contacts``.
     hand_jacobian : (M, n_h) float
         ``J``: rows in the contact-frame components of ``G``'s columns, columns
-        the hand velocities ``hand_velocity_indices``.
+        the hand's independent velocities ``hand_velocity_indices``; for a
+        coupled hand ``J C`` (:func:`~drakegrasp.plant.couplings.coupling_map`),
+        one column per independent motion.
     hand_velocity_indices : (n_h,) int
-        Which plant velocities are the hand's.
+        Which plant velocities are the hand's independent ones (a coupling's
+        follower is not).
     psi : (N,) float
         Signed distance of each contact, metres.
     dpsi_dv : (N, nv) float
@@ -95,6 +100,8 @@ class GraspFromPlant:
         Penetrations and joint-limit violations of the hand's model instances
         (``pose.valid`` is False only when the caller opted out of the refusal
         with ``check_pose=False`` or ``allow_penetration=True``).
+    couplings : tuple of (joint_0, joint_1, gear_ratio, offset)
+        The couplings of the hand's joints that shaped ``J``.
     """
 
     grasp: Grasp
@@ -107,6 +114,7 @@ class GraspFromPlant:
     hand_bodies: tuple[str, ...]
     plane: str | None
     pose: PoseCheck | None = None
+    couplings: tuple = ()
 
     @property
     def G(self) -> np.ndarray:
@@ -126,6 +134,7 @@ class GraspFromPlant:
             "hand_jacobian": jsonable(self.hand_jacobian),
             "dpsi_dv": jsonable(self.dpsi_dv),
             "pose": None if self.pose is None else self.pose.to_dict(),
+            "couplings": [jsonable(list(c)) for c in self.couplings],
         }
 
 
@@ -194,6 +203,7 @@ def grasp_from_plant(
     check_pose: bool = True,
     query_object: QueryObject | None = None,
     contacts: list[PlantContact] | None = None,
+    couplings: Sequence[tuple] | None = None,
 ) -> GraspFromPlant:
     """The grasp that the plant's configuration makes, with ``J``, ``ψ``, ``∂ψ/∂v``.
 
@@ -238,6 +248,12 @@ def grasp_from_plant(
         Analyse these contacts (frame O of ``object_body``) instead of finding
         them from signed distances: e.g. the patches of hydroelastic contact
         surfaces read by :func:`drakegrasp.plant.contacts_from_results`.
+    couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
+        Joint couplings ``q_0 = gear_ratio * q_1 + offset``; ``J`` becomes
+        ``J C`` with one column per independent motion.  Default: those
+        recorded on the plant
+        (:func:`~drakegrasp.plant.couplings.plant_couplings`); an explicit
+        list overrides them (``()``: none).
 
     Returns
     -------
@@ -267,6 +283,7 @@ def grasp_from_plant(
         torsional_friction = 0.0
     body = resolve_object_body(plant, object_body)
     bodies = hand_contact_bodies(plant, body, hand)
+    couplings = plant_couplings(plant, couplings)
     pose = _pose_of(
         plant,
         plant_context,
@@ -312,6 +329,8 @@ def grasp_from_plant(
         velocity_indices=indices,
         plane=plane,
     )
+    C, indices = coupling_map(plant, indices, couplings)
+    J = J @ C
     dpsi = signed_distance_jacobian(plant, plant_context, contacts, object_body=body)
     return GraspFromPlant(
         grasp=grasp,
@@ -324,6 +343,7 @@ def grasp_from_plant(
         hand_bodies=tuple(_scoped_name(plant, b) for b in bodies),
         plane=plane,
         pose=pose,
+        couplings=couplings,
     )
 
 
@@ -472,9 +492,7 @@ class GraspReport:
         for result in (self.form_closure, self.force_closure, self.force_closure_exact):
             lines += ["  " + x for x in result.report_lines(internal_forces=False)]
             if result.certificate is not None:
-                check = result.certificate.check(
-                    g, hand_jacobian=lp3_jacobian(self.J)
-                )
+                check = result.certificate.check(g, hand_jacobian=lp3_jacobian(self.J))
                 lines.append(f"    {result.certificate.kind} re-checked: {check}")
         lp3 = self.force_closure.internal_forces
         if lp3 is not None:  # one LP3 serves both force-closure verdicts
@@ -505,6 +523,7 @@ def analyze_grasp(
     check_pose: bool = True,
     query_object: QueryObject | None = None,
     contacts: list[PlantContact] | None = None,
+    couplings: Sequence[tuple] | None = None,
 ) -> GraspReport:
     """Read the grasp from the plant and decide every closure property.
 
@@ -517,7 +536,7 @@ def analyze_grasp(
         As in :func:`grasp_from_plant`.
     characteristic_length, allow_penetration, patches
         As in :func:`grasp_from_plant`.
-    check_pose, query_object, contacts
+    check_pose, query_object, contacts, couplings
         As in :func:`grasp_from_plant`.
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
@@ -544,6 +563,7 @@ def analyze_grasp(
         check_pose=check_pose,
         query_object=query_object,
         contacts=contacts,
+        couplings=couplings,
     )
     grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)
     antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None

@@ -55,6 +55,7 @@ from drakegrasp.plant.advancement import (
     reach,
 )
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE
+from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import Finger, HandStructure, hand_structure
 from drakegrasp.plant.pose import find_penetrations
 from drakegrasp.plant.validation import (
@@ -264,9 +265,10 @@ def close_hand(
     couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
         ``q_0 = gear_ratio * q_1 + offset``, as in Drake's
         ``AddCouplerConstraint`` and a URDF ``<mimic>``; joints are ``Joint``
-        objects or ``"model::joint"`` names (see
-        :mod:`drakegrasp.plant.fingers`).  Required (``()`` for none) when the
-        plant has constraints, which Drake does not let us read.
+        objects or ``"model::joint"`` names.  Default: the couplings recorded
+        on the plant (:func:`~drakegrasp.plant.couplings.plant_couplings`:
+        models loaded with :func:`~drakegrasp.plant.couplings.add_models` or
+        from a scene file); an explicit list overrides them (``()``: none).
     distance_tolerance : float, optional
         A finger touches when ``0 <= ψ <= distance_tolerance`` (metres,
         default 1e-4, the contact tolerance of
@@ -307,7 +309,7 @@ def close_hand(
             raise InvalidOptionError(f"{name} must be an integer >= 1, got {value!r}")
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
-    couplings = _couplings(plant, couplings)
+    couplings = plant_couplings(plant, couplings)
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     query = plant.get_geometry_query_input_port().Eval(plant_context)
@@ -359,19 +361,6 @@ def close_hand(
             closure=closure,
         )
     return closure
-
-
-def _couplings(plant, couplings):
-    if couplings is not None:
-        return tuple(couplings)
-    if plant.num_constraints() > 0:
-        raise InvalidOptionError(
-            f"the plant has {plant.num_constraints()} constraint(s) (a URDF <mimic> "
-            "becomes a coupler constraint) and Drake's Python API does not let "
-            "drakegrasp read them: pass couplings=[(joint_0, joint_1, gear_ratio, "
-            "offset)], or couplings=() to close without them"
-        )
-    return ()
 
 
 def _check_coupled(hand: HandStructure, q0: np.ndarray) -> None:

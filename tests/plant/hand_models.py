@@ -21,6 +21,8 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
+from drakegrasp.plant import add_models
+
 
 def _v(*xs) -> str:
     return " ".join(repr(float(x)) for x in xs)
@@ -170,10 +172,20 @@ class Rig:
     weld_hand : str, optional
         A frame of the hand to weld to the world (URDF has no world joint).
     time_step : float
+    record_couplings : bool
+        Parse with :func:`drakegrasp.plant.add_models` (default), which records
+        the models' mimic couplings, or with a bare ``Parser``.
     """
 
     def __init__(
-        self, texts, object_model, X_WO=None, *, weld_hand=None, time_step=0.0
+        self,
+        texts,
+        object_model,
+        X_WO=None,
+        *,
+        weld_hand=None,
+        time_step=0.0,
+        record_couplings=True,
     ):
         from pydrake.math import RigidTransform
 
@@ -182,7 +194,10 @@ class Rig:
         parser = Parser(plant)
         instances = []
         for text, kind in texts:
-            instances += parser.AddModelsFromString(text, kind)
+            if record_couplings:
+                instances += add_models(parser, text=text, kind=kind)
+            else:
+                instances += parser.AddModelsFromString(text, kind)
         self.hand = instances[0]
         if weld_hand is not None:
             plant.WeldFrames(
@@ -282,5 +297,102 @@ def ball(radius: float = 0.035) -> str:
         '<link name="ball">'
         + _inertial(0.1, 5e-5)
         + _collision("ball", _sphere(radius))
+        + "</link>",
+    )
+
+
+JAW_Y0 = 0.05
+"""|y| (m) of each jaw's pad centre at q = 0; a jaw at q has its pad centre
+at ``|y| = JAW_Y0 − q``."""
+JAW_PAD = (0.02, 0.004, 0.02)
+JAW_STROKE = 0.045
+
+
+def _urdf_box_link(name, size=None, xyz=(0, 0, 0), mass=0.05) -> str:
+    geometry = (
+        ""
+        if size is None
+        else (
+            f'<collision name="{name}_pad"><origin xyz="{_v(*xyz)}"/>'
+            f'<geometry><box size="{_v(*size)}"/></geometry></collision>'
+        )
+    )
+    return (
+        f'<link name="{name}"><inertial><mass value="{mass}"/>'
+        '<inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/>'
+        f"</inertial>{geometry}</link>"
+    )
+
+
+def mimic_gripper_urdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
+    """A parallel gripper whose right jaw follows the left by URDF ``<mimic>``.
+
+    Palm frame: the jaws close along y, their pads centred at z = 0.05 m.
+    ``left_jaw_joint`` moves the left pad from ``y = −JAW_Y0`` towards +y,
+    ``right_jaw_joint`` (the follower) the right pad from ``+JAW_Y0`` towards
+    −y; both prismatic, ``[0, JAW_STROKE]``, flat 20 x 20 mm pads.  Weld the
+    frame ``palm`` to the world.
+    """
+    joints = ""
+    for side, sign in (("left", -1.0), ("right", 1.0)):
+        mimic = (
+            f'<mimic joint="left_jaw_joint" multiplier="{multiplier}" '
+            f'offset="{offset}"/>'
+            if side == "right"
+            else ""
+        )
+        joints += (
+            f'<joint name="{side}_jaw_joint" type="prismatic"><parent link="palm"/>'
+            f'<child link="{side}_jaw"/><origin xyz="{_v(0, sign * JAW_Y0, 0.05)}"/>'
+            f'<axis xyz="{_v(0, -sign, 0)}"/>'
+            f'<limit lower="0" upper="{JAW_STROKE}" effort="40" velocity="0.1"/>'
+            f"{mimic}</joint>"
+        )
+    links = (
+        _urdf_box_link("palm", (0.04, 0.12, 0.02), xyz=(0, 0, 0.0), mass=0.5)
+        + _urdf_box_link("left_jaw", JAW_PAD)
+        + _urdf_box_link("right_jaw", JAW_PAD)
+    )
+    return f'<?xml version="1.0"?><robot name="mimic_gripper">{links}{joints}</robot>'
+
+
+def mimic_gripper_sdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
+    """The gripper of :func:`mimic_gripper_urdf`, coupled by ``<drake:mimic>``."""
+    palm = (
+        '<link name="palm">'
+        + _inertial(0.5, 1e-3)
+        + _collision("palm_box", _box(0.04, 0.12, 0.02))
+        + "</link>"
+    )
+    body = palm
+    for side, sign in (("left", -1.0), ("right", 1.0)):
+        mimic = (
+            f'<drake:mimic joint="left_jaw_joint" multiplier="{multiplier}" '
+            f'offset="{offset}"/>'
+            if side == "right"
+            else ""
+        )
+        body += (
+            f'<link name="{side}_jaw">'
+            f"<pose>{_v(0, sign * JAW_Y0, 0.05, 0, 0, 0)}</pose>"
+            + _inertial()
+            + _collision(f"{side}_jaw_pad", _box(*JAW_PAD))
+            + "</link>"
+            + f'<joint name="{side}_jaw_joint" type="prismatic"><parent>palm</parent>'
+            f"<child>{side}_jaw</child><axis><xyz>{_v(0, -sign, 0)}</xyz>"
+            f"<limit><lower>0</lower><upper>{JAW_STROKE}</upper></limit></axis>"
+            f"{mimic}</joint>"
+        )
+    body += _weld_to_world("palm")
+    return _sdf("mimic_gripper", body)
+
+
+def box_object(size=(0.03, 0.03, 0.03), name="box") -> str:
+    """A free box (SDFormat model ``name``)."""
+    return _sdf(
+        name,
+        f'<link name="{name}">'
+        + _inertial(0.1, 5e-5)
+        + _collision(name, _box(*size))
         + "</link>",
     )
