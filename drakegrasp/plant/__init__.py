@@ -40,6 +40,7 @@ _SOURCES = {
         "plant_couplings",
     ),
     "drakegrasp.plant.curvature": ("contact_curvatures",),
+    "drakegrasp.plant.finger_antipodal": ("FingerAntipodal",),
     "drakegrasp.plant.jacobians": (
         "hand_jacobian",
         "hand_velocity_indices",
@@ -72,6 +73,7 @@ _SUBMODULES = (
     "contacts",
     "couplings",
     "curvature",
+    "finger_antipodal",
     "fingers",
     "jacobians",
     "models",
@@ -89,6 +91,7 @@ __getattr__, __dir__ = lazy_exports(
 __all__ = [
     "DEFAULT_DISTANCE_TOLERANCE",
     "DEFAULT_SCENE",
+    "FingerAntipodal",
     "FingerClosure",
     "GraspFromPlant",
     "GraspReport",

@@ -46,6 +46,7 @@ from drakegrasp.plant.contacts import (
 )
 from drakegrasp.plant.couplings import coupling_map, plant_couplings
 from drakegrasp.plant.curvature import SECOND_ORDER_RANK_TOL, contact_curvatures
+from drakegrasp.plant.finger_antipodal import FingerAntipodal, finger_antipodal
 from drakegrasp.plant.jacobians import (
     PLANES,
     hand_jacobian,
@@ -393,8 +394,10 @@ class GraspReport:
         (``force_closure.internal_forces``).
     force_closure_exact : ClosureResult
         Force closure on exact (second-order / planar) cones, with LP3.
-    antipodal : AntipodalResult or None
-        The antipodal test when there are exactly two contacts.
+    antipodal : AntipodalResult, FingerAntipodal or None
+        The antipodal test: of the two contacts when there are exactly two,
+        else per finger for a two-finger hand (one patch per finger,
+        :mod:`drakegrasp.plant.finger_antipodal`), else None.
     pose : PoseCheck or None
         Whether the pose is possible (``pose.valid``); an invalid pose is only
         analysed with ``check_pose=False`` (or ``allow_penetration=True``).
@@ -417,7 +420,7 @@ class GraspReport:
     form_closure: ClosureResult
     force_closure: ClosureResult
     force_closure_exact: ClosureResult
-    antipodal: AntipodalResult | None
+    antipodal: AntipodalResult | FingerAntipodal | None
     pose: PoseCheck | None = None
     second_order: SecondOrderResult | None = deferrable(None)
 
@@ -566,7 +569,15 @@ def analyze_grasp(
         couplings=couplings,
     )
     grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)
-    antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
+    if grasp.num_contacts == 2:
+        antipodal = is_antipodal(grasp)
+    else:
+        antipodal = finger_antipodal(
+            plant,
+            data.contacts,
+            grasp,
+            hand_contact_bodies(plant, resolve_object_body(plant, object_body), hand),
+        )
     first_order = form_closure(grasp, tol=tol)
     polyhedral = force_closure(grasp, num_generators=num_generators, tol=tol)
     exact = force_closure_exact(grasp, tol=tol)
