@@ -86,8 +86,13 @@ class PlantContact:
     psi : float
         Signed distance ``ψ`` (metres): > 0 separated, < 0 penetrating.
     p_FC : (3,) float
-        The finger's witness point (``p_OC − ψ nhat``) in the finger body's frame
-        F: the material point of the finger that touches the object.
+        The finger's witness point in the finger body's frame F: the material
+        point of the finger that touches the object.  It is Drake's closest
+        point on the finger geometry (``centre + r nhat`` for a spherical tip;
+        ``p_OC − ψ nhat`` at a patch vertex), so ``p_OC − p_FC`` (in a common
+        frame) equals ``ψ nhat`` only where the normal is Drake's own: when the
+        normal comes from a surface (``normal_source``), the two witness
+        points need not lie on it.
     finger_body : str
         Scoped name ``model::body`` of the finger body.
     finger_body_index : BodyIndex
@@ -117,8 +122,26 @@ class PlantContact:
     normal_source: str
     patch_vertex: int | None = None
 
+    @property
+    def finger_geometry_label(self) -> str:
+        """``model::body/geometry#id``: unique, though URDF collision names repeat."""
+        return (
+            f"{self.finger_body}/{self.finger_geometry_name.rpartition('::')[2]}"
+            f"#{self.finger_geometry.get_value()}"
+        )
+
+    @property
+    def object_geometry_label(self) -> str:
+        """``geometry#id`` of the object's geometry: unique within the scene graph."""
+        return f"{self.object_geometry_name}#{self.object_geometry.get_value()}"
+
     def to_dict(self) -> dict:
-        """JSON-ready dictionary (geometry ids as their integer values)."""
+        """JSON-ready dictionary (geometry ids as their integer values).
+
+        ``finger_geometry_label`` and ``object_geometry_label`` name each
+        geometry uniquely (body and geometry id); the ``*_geometry`` names are
+        the scene graph's, which can repeat across bodies.
+        """
         return {
             "p_OC": self.p_OC.tolist(),
             "nhat_O": self.nhat_O.tolist(),
@@ -127,6 +150,10 @@ class PlantContact:
             "finger_body": self.finger_body,
             "object_geometry": self.object_geometry_name,
             "finger_geometry": self.finger_geometry_name,
+            "object_geometry_id": int(self.object_geometry.get_value()),
+            "finger_geometry_id": int(self.finger_geometry.get_value()),
+            "object_geometry_label": self.object_geometry_label,
+            "finger_geometry_label": self.finger_geometry_label,
             "normal_source": self.normal_source,
             "patch_vertex": self.patch_vertex,
         }

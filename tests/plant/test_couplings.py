@@ -189,3 +189,28 @@ drakegrasp:
         scene.plant, scene.plant_context, scene.object_body, hand=scene.hand, mu=0.5
     )
     assert report.J.shape[1] == 1
+
+
+def test_repeated_urdf_collision_names_get_unique_labels():
+    # Both jaws' collisions are called "Box", as both PR2 pads are (issue 20, 11).
+    text = (
+        mimic_gripper_urdf()
+        .replace("left_jaw_pad", "Box")
+        .replace("right_jaw_pad", "Box")
+    )
+    rig = Rig(
+        [(text, "urdf"), (box_object(), "sdf")],
+        "box",
+        RigidTransform([0.0, 0.0, 0.05]),
+        weld_hand="palm",
+    )
+    close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand)
+    report = analyze_grasp(rig.plant, rig.ctx, rig.object, hand=rig.hand, mu=0.5)
+    entries = report.to_dict()["contacts"]
+    assert {e["finger_geometry"] for e in entries} == {"mimic_gripper::Box"}
+    labels = {(e["finger_body"], e["finger_geometry_label"]) for e in entries}
+    assert len({label for _, label in labels}) == 2  # one per jaw
+    for body, label in labels:
+        assert label.startswith(body + "/Box#")
+    ids = {e["finger_geometry_id"] for e in entries}
+    assert len(ids) == 2
