@@ -107,6 +107,10 @@ class PlantContact:
     patch_vertex : int or None
         Index of this contact among the vertices of a flat patch, or None for a
         point contact.
+    finger_geometry_index, object_geometry_index : int or None
+        Place of each geometry among its body's collision geometries (None
+        when not known, e.g. contacts read from contact results); they make
+        the labels ``finger_geometry_label``/``object_geometry_label`` unique.
     """
 
     p_OC: np.ndarray
@@ -121,26 +125,33 @@ class PlantContact:
     finger_geometry_name: str
     normal_source: str
     patch_vertex: int | None = None
+    finger_geometry_index: int | None = None
+    object_geometry_index: int | None = None
 
     @property
     def finger_geometry_label(self) -> str:
-        """``model::body/geometry#id``: unique, though URDF collision names repeat."""
-        return (
-            f"{self.finger_body}/{self.finger_geometry_name.rpartition('::')[2]}"
-            f"#{self.finger_geometry.get_value()}"
+        """``model::body/geometry#k``: unique, though URDF collision names repeat.
+
+        ``k`` is the geometry's place among its body's collision geometries
+        (``plant.GetCollisionGeometriesForBody``), which, unlike a
+        ``GeometryId``, is the same in every process.
+        """
+        return _label(
+            self.finger_body, self.finger_geometry_name, self.finger_geometry_index
         )
 
     @property
     def object_geometry_label(self) -> str:
-        """``geometry#id`` of the object's geometry: unique within the scene graph."""
-        return f"{self.object_geometry_name}#{self.object_geometry.get_value()}"
+        """``geometry#k`` of the object's geometry (see ``finger_geometry_label``)."""
+        return _label("", self.object_geometry_name, self.object_geometry_index)
 
     def to_dict(self) -> dict:
-        """JSON-ready dictionary (geometry ids as their integer values).
+        """JSON-ready dictionary.
 
         ``finger_geometry_label`` and ``object_geometry_label`` name each
-        geometry uniquely (body and geometry id); the ``*_geometry`` names are
-        the scene graph's, which can repeat across bodies.
+        geometry uniquely and the same in every process (body and the
+        geometry's index in its body); the ``*_geometry`` names are the scene
+        graph's, which can repeat across bodies.
         """
         return {
             "p_OC": self.p_OC.tolist(),
@@ -150,8 +161,6 @@ class PlantContact:
             "finger_body": self.finger_body,
             "object_geometry": self.object_geometry_name,
             "finger_geometry": self.finger_geometry_name,
-            "object_geometry_id": int(self.object_geometry.get_value()),
-            "finger_geometry_id": int(self.finger_geometry.get_value()),
             "object_geometry_label": self.object_geometry_label,
             "finger_geometry_label": self.finger_geometry_label,
             "normal_source": self.normal_source,
@@ -166,6 +175,12 @@ class PlantContact:
             f"PlantContact({self.finger_body}: p_OC={np.round(self.p_OC, 6).tolist()}, "
             f"nhat_O={np.round(self.nhat_O, 6).tolist()}, psi={self.psi:.3g}{patch})"
         )
+
+
+def _label(body: str, name: str, index: int | None) -> str:
+    short = name.rpartition("::")[2]
+    where = f"{body}/{short}" if body else name
+    return where if index is None else f"{where}#{index}"
 
 
 def _rotation(X) -> np.ndarray:
@@ -285,8 +300,8 @@ def find_contacts(
     for finger in fingers:
         finger_name = _scoped_name(plant, finger)
         X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
-        for gf in plant.GetCollisionGeometriesForBody(finger):
-            for go in object_geometries:
+        for kf, gf in enumerate(plant.GetCollisionGeometriesForBody(finger)):
+            for ko, go in enumerate(object_geometries):
                 if inspector.CollisionFiltered(go, gf):
                     continue
                 try:
@@ -326,6 +341,7 @@ def find_contacts(
                     X_FO=X_WF.inverse().multiply(X_WO),
                     finger=finger,
                     finger_name=finger_name,
+                    indices=(kf, ko),
                     tol=tol,
                     patches=patches,
                 )
@@ -384,6 +400,7 @@ def _pair_contacts(
     X_FO,
     finger,
     finger_name,
+    indices,
     tol,
     patches,
 ) -> list[PlantContact]:
@@ -406,6 +423,8 @@ def _pair_contacts(
         "finger_geometry": gf,
         "object_geometry_name": inspector.GetName(go),
         "finger_geometry_name": inspector.GetName(gf),
+        "finger_geometry_index": indices[0],
+        "object_geometry_index": indices[1],
     }
     if patches == "vertices":
         for po in obj_pieces:

@@ -211,6 +211,5 @@ def test_repeated_urdf_collision_names_get_unique_labels():
     labels = {(e["finger_body"], e["finger_geometry_label"]) for e in entries}
     assert len({label for _, label in labels}) == 2  # one per jaw
     for body, label in labels:
-        assert label.startswith(body + "/Box#")
-    ids = {e["finger_geometry_id"] for e in entries}
-    assert len(ids) == 2
+        assert label == body + "/Box#0"
+    assert {e["object_geometry_label"] for e in entries} == {"box::box#0"}
