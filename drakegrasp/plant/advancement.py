@@ -18,7 +18,7 @@ at most the sum, along the kinematic chain from ``j`` to ``g``'s body, of the
 fixed distances between successive joint origins in each body, the travel of
 every prismatic closing joint in between (its largest ``|q|``), the current
 offset of every joint that does not move while closing, and the radius of a
-sphere that bounds ``g`` (:func:`~drakegrasp.plant._shapes.bounding_sphere`)
+sphere that bounds ``g`` (``bounding_sphere`` of its shape)
 around its centre.
 
 **Step bound.**  The distance between two sets changes no faster than the
