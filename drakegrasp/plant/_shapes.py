@@ -190,6 +190,55 @@ def flat_faces(shape: Shape) -> list[tuple[np.ndarray, float, np.ndarray]] | Non
     return None
 
 
+def _hull_vertices(shape: Convex | Mesh) -> np.ndarray:
+    hull = shape.GetConvexHull()
+    return np.array([hull.vertex(i) for i in range(hull.num_vertices())])
+
+
+def bounding_sphere(shape: Shape) -> tuple[np.ndarray, float]:
+    """A sphere that contains the shape: centre (geometry frame G) and radius.
+
+    Parameters
+    ----------
+    shape : pydrake.geometry.Shape
+        Box, Sphere, Cylinder, Capsule, Ellipsoid, Convex or Mesh (its convex
+        hull, which is what Drake's distance queries see).
+
+    Returns
+    -------
+    centre_G : (3,) float
+        Metres, in the geometry frame.
+    radius : float
+        Metres; ``inf`` for a half space.
+
+    Raises
+    ------
+    ModelError
+        For a shape type drakegrasp cannot bound.
+    """
+    origin = np.zeros(3)
+    if isinstance(shape, Sphere):
+        return origin, float(shape.radius())
+    if isinstance(shape, Box):
+        return origin, 0.5 * float(np.linalg.norm(shape.size()))
+    if isinstance(shape, Cylinder):
+        return origin, float(np.hypot(shape.radius(), 0.5 * shape.length()))
+    if isinstance(shape, Capsule):
+        return origin, float(shape.radius() + 0.5 * shape.length())
+    if isinstance(shape, Ellipsoid):
+        return origin, float(max(shape.a(), shape.b(), shape.c()))
+    if isinstance(shape, HalfSpace):
+        return origin, float("inf")
+    if isinstance(shape, (Convex, Mesh)):
+        v = _hull_vertices(shape)
+        centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+        return centre, float(np.max(np.linalg.norm(v - centre, axis=1)))
+    raise ModelError(
+        f"drakegrasp cannot bound a {type(shape).__name__} geometry; use Box, "
+        "Sphere, Cylinder, Capsule, Ellipsoid or Convex"
+    )
+
+
 def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
     """Outward normals (and flat faces) of ``shape`` at the surface point ``Q``.
 

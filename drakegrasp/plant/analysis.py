@@ -12,6 +12,7 @@ nothing here re-decides them.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,10 +45,11 @@ from drakegrasp.plant.contacts import (
     PlantContact,
     _scoped_name,
     find_contacts,
-    hand_bodies,
     resolve_object_body,
 )
+from drakegrasp.plant.couplings import coupling_map, plant_couplings
 from drakegrasp.plant.curvature import SECOND_ORDER_RANK_TOL, contact_curvatures
+from drakegrasp.plant.finger_antipodal import FingerAntipodal, finger_antipodal
 from drakegrasp.plant.jacobians import (
     PLANES,
     hand_jacobian,
@@ -59,6 +61,7 @@ from drakegrasp.plant.options import AnalysisOptions, resolve_options
 from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.pose import check_pose as _check_pose
 from drakegrasp.plant.validation import (
+    hand_contact_bodies,
     hand_model_instances,
     plant_context_of,
 )
@@ -82,9 +85,12 @@ class GraspFromPlant:
         The plant contacts, in the order of ``grasp.contacts``.
     hand_jacobian : (M, n_h) float
         ``J``: rows in the contact-frame components of ``G``'s columns, columns
-        the hand velocities ``hand_velocity_indices``.
+        the hand's independent velocities ``hand_velocity_indices``; for a
+        coupled hand ``J C`` (:func:`~drakegrasp.plant.couplings.coupling_map`),
+        one column per independent motion.
     hand_velocity_indices : (n_h,) int
-        Which plant velocities are the hand's.
+        Which plant velocities are the hand's independent ones (a coupling's
+        follower is not).
     psi : (N,) float
         Signed distance of each contact, metres.
     dpsi_dv : (N, nv) float
@@ -92,13 +98,15 @@ class GraspFromPlant:
     object_body : str
         Scoped name of the object body (the frame O).
     hand_bodies : tuple of str
-        Scoped names of the hand's bodies.
+        Scoped names of the hand's bodies, welded ones (a palm) included.
     plane : str or None
         Object-frame plane of a planar analysis (``"yz"``...), or None.
     pose : PoseCheck or None
         Penetrations and joint-limit violations of the hand's model instances
         (``pose.valid`` is False only when the caller opted out of the refusal
         with ``check_pose=False`` or ``allow_penetration=True``).
+    couplings : tuple of (joint_0, joint_1, gear_ratio, offset)
+        The couplings of the hand's joints that shaped ``J``.
     """
 
     grasp: Grasp
@@ -111,6 +119,7 @@ class GraspFromPlant:
     hand_bodies: tuple[str, ...]
     plane: str | None
     pose: PoseCheck | None = None
+    couplings: tuple = ()
 
     @property
     def G(self) -> np.ndarray:
@@ -130,7 +139,18 @@ class GraspFromPlant:
             "hand_jacobian": jsonable(self.hand_jacobian),
             "dpsi_dv": jsonable(self.dpsi_dv),
             "pose": None if self.pose is None else self.pose.to_dict(),
+            "couplings": [jsonable(list(c)) for c in self.couplings],
         }
+
+
+def lp3_jacobian(J: np.ndarray) -> np.ndarray:
+    """``J`` as the programs take it: one zero column for a hand without joints.
+
+    A hand made only of welded bodies (``hand=[palm]``) has no velocities, so
+    ``J`` has no column and ``Jᵀ f = 0`` constrains nothing; a single zero
+    column states exactly that to the programs, which want at least one.
+    """
+    return J if J.shape[1] else np.zeros((J.shape[0], 1))
 
 
 def _core_contact(
@@ -180,6 +200,7 @@ def grasp_from_plant(
     check_pose: bool = True,
     query_object: QueryObject | None = None,
     contacts: list[PlantContact] | None = None,
+    couplings: Sequence[tuple] | None = None,
 ) -> GraspFromPlant:
     """The grasp that the plant's configuration makes, with ``J``, ``ψ``, ``∂ψ/∂v``.
 
@@ -193,7 +214,9 @@ def grasp_from_plant(
         The grasped object; its body frame O is the grasp frame and its origin
         the reference point.  Positional or keyword.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
-        See :func:`~drakegrasp.plant.validation.hand_bodies`.
+        See :func:`~drakegrasp.plant.validation.hand_contact_bodies`: every
+        body of the hand touches, a palm welded to the world included (its
+        contacts are in ``G``, its rows of ``J`` are zero).
     options : AnalysisOptions, optional
         Every option below at once, validated when it was made; give it or
         the keywords, not both.
@@ -228,6 +251,12 @@ def grasp_from_plant(
         Analyse these contacts (frame O of ``object_body``) instead of finding
         them from signed distances: e.g. the patches of hydroelastic contact
         surfaces read by :func:`drakegrasp.plant.contacts_from_results`.
+    couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
+        Joint couplings ``q_0 = gear_ratio * q_1 + offset``; ``J`` becomes
+        ``J C`` with one column per independent motion.  Default: those
+        recorded on the plant
+        (:func:`~drakegrasp.plant.couplings.plant_couplings`); an explicit
+        list overrides them (``()``: none).
 
     Returns
     -------
@@ -261,7 +290,8 @@ def grasp_from_plant(
     check_pose = opts.check_pose
     torsional_friction = opts.torsional_friction or 0.0
     body = resolve_object_body(plant, object_body)
-    bodies = hand_bodies(plant, body, hand)
+    bodies = hand_contact_bodies(plant, body, hand)
+    couplings = plant_couplings(plant, couplings)
     pose = _pose_of(
         plant,
         plant_context,
@@ -313,6 +343,8 @@ def grasp_from_plant(
         velocity_indices=indices,
         plane=plane,
     )
+    C, indices = coupling_map(plant, indices, couplings)
+    J = J @ C
     dpsi = signed_distance_jacobian(plant, plant_context, contacts, object_body=body)
     return GraspFromPlant(
         grasp=grasp,
@@ -325,6 +357,7 @@ def grasp_from_plant(
         hand_bodies=tuple(_scoped_name(plant, b) for b in bodies),
         plane=plane,
         pose=pose,
+        couplings=couplings,
     )
 
 
@@ -374,8 +407,10 @@ class GraspReport:
         (``force_closure.internal_forces``).
     force_closure_exact : ClosureResult
         Force closure on exact (second-order / planar) cones, with LP3.
-    antipodal : AntipodalResult or None
-        The antipodal test when there are exactly two contacts.
+    antipodal : AntipodalResult, FingerAntipodal or None
+        The antipodal test: of the two contacts when there are exactly two,
+        else per finger for a two-finger hand (one patch per finger,
+        :mod:`drakegrasp.plant.finger_antipodal`), else None.
     pose : PoseCheck or None
         Whether the pose is possible (``pose.valid``); an invalid pose is only
         analysed with ``check_pose=False`` (or ``allow_penetration=True``).
@@ -404,7 +439,7 @@ class GraspReport:
     form_closure: ClosureResult
     force_closure: ClosureResult
     force_closure_exact: ClosureResult
-    antipodal: AntipodalResult | None
+    antipodal: AntipodalResult | FingerAntipodal | None
     pose: PoseCheck | None = None
     second_order: SecondOrderResult | None = deferrable(None)
     load: LoadReport | None = None
@@ -538,6 +573,7 @@ def analyze_grasp(
     contacts: list[PlantContact] | None = None,
     load=None,
     torque_limits=None,
+    couplings: Sequence[tuple] | None = None,
 ) -> GraspReport:
     """Read the grasp from the plant and decide every closure property.
 
@@ -559,7 +595,7 @@ def analyze_grasp(
         As in :func:`grasp_from_plant`.
     characteristic_length, allow_penetration, patches
         As in :func:`grasp_from_plant`.
-    check_pose, query_object, contacts
+    check_pose, query_object, contacts, couplings
         As in :func:`grasp_from_plant`.
     num_generators : int, optional
         Generators of each polyhedral Coulomb cone (default 8).
@@ -602,6 +638,7 @@ def analyze_grasp(
         options=opts.replace(mu=1.0) if opts.mu == "plant" else opts,
         query_object=query_object,
         contacts=contacts,
+        couplings=couplings,
     )
     data, load_report = load_section(
         plant,
@@ -615,8 +652,16 @@ def analyze_grasp(
         query_object=query_object,
     )
     tol, num_generators = opts.tol, opts.num_generators
-    grasp, J = data.grasp, data.hand_jacobian
-    antipodal = is_antipodal(grasp) if grasp.num_contacts == 2 else None
+    grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)
+    if grasp.num_contacts == 2:
+        antipodal = is_antipodal(grasp)
+    else:
+        antipodal = finger_antipodal(
+            plant,
+            data.contacts,
+            grasp,
+            hand_contact_bodies(plant, resolve_object_body(plant, object_body), hand),
+        )
     first_order = form_closure(grasp, tol=tol)
     polyhedral = force_closure(grasp, num_generators=num_generators, tol=tol)
     exact = force_closure_exact(grasp, tol=tol)

@@ -15,15 +15,17 @@ accepted step along the steepest descent of the fingertip's distance,
 
 **The steps.**  ``ψ_f`` is the smallest signed distance between the finger's
 collision geometries and the object's (Drake's
-``ComputeSignedDistancePairClosestPoints``).  Each step is a Newton step on
-``ψ_f(α) = tol / 2`` with the slope
-
-.. math:: \frac{d\psi_f}{d\alpha} = -\hat n^T J_{v,C_b}\, d
-
-from the translational Jacobian of the finger's witness point ``Cb`` (``n̂``
-from the finger into the object), capped at
-:data:`~drakegrasp.plant.fingers.MAX_STEP`.  A step that penetrates is cut
-back by regula falsi between the last clear point and the penetrating one.
+``ComputeSignedDistancePairClosestPoints`` over every pair that the scene
+graph does not filter).  Each step is bounded by conservative advancement
+(:mod:`drakegrasp.plant.advancement`): by the distance of *every* pair divided
+by the fastest point speed of the finger's geometries along ``d``, less the
+target ``ψ* = tol / 2``, so no step can carry a finger through anything on its
+way, however thin; it is also capped at
+:data:`~drakegrasp.plant.fingers.MAX_STEP` and at the end of the path.  The
+steps shrink geometrically as the finger nears the object, as fast as the
+closest point's approach speed is to that bound (in one step for a pad moving
+along its normal).  A trial point that penetrates (which only an inaccurate
+distance can produce) is cut back by regula falsi towards the last clear point.
 All fingers step at once, one kinematics update per step.  A finger is
 **touching** when ``0 <= ψ_f <= tol`` (no finger geometry penetrates), **at
 limit** when every joint it would move is at a limit with ``ψ_f > tol``; the
@@ -49,6 +51,12 @@ from drakegrasp.errors import (
     PenetrationError,
     UnreachableError,
 )
+from drakegrasp.plant.advancement import (
+    advancement_bound,
+    finger_speed_bound,
+    reach,
+)
+from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import Finger, HandStructure, hand_structure
 from drakegrasp.plant.pose import find_penetrations
 from drakegrasp.plant.validation import (
@@ -186,6 +194,7 @@ class _State:
     finger: Finger
     q_good: np.ndarray  # ψ > tol here (the last accepted point)
     q_trial: np.ndarray
+    reach: np.ndarray  # (n_pairs, n_h), see drakegrasp.plant.advancement
     d: np.ndarray = field(default_factory=lambda: np.zeros(0))
     psi_good: float = np.inf
     alpha: float = 0.0
@@ -196,13 +205,18 @@ class _State:
 
 
 def _closest(query, plant, context, pairs):
-    """(ψ, n̂_W from finger to object, finger body, witness p_BCb) of the closest pair.
+    """The closest pair and the distance of every pair.
 
-    (inf, None, None, None) when there is no pair.
+    Returns
+    -------
+    (ψ, n̂_W from finger to object, finger body, witness p_BCb, ψ of every pair)
+        ``(inf, None, None, None, ψs)`` when there is no pair.
     """
     best = (np.inf, None, None, None, None)
-    for go, gf, body in pairs:
+    every = np.empty(len(pairs))
+    for k, (go, gf, body) in enumerate(pairs):
         r = query.ComputeSignedDistancePairClosestPoints(go, gf)
+        every[k] = r.distance
         if r.distance < best[0]:
             if r.id_A == go:
                 n_W, p_GC = np.asarray(r.nhat_BA_W), r.p_BCb
@@ -211,10 +225,10 @@ def _closest(query, plant, context, pairs):
             best = (float(r.distance), n_W, body, gf, p_GC)
     psi, n_W, body, gf, p_GC = best
     if body is None:
-        return psi, None, None, None
+        return psi, None, None, None, every
     p_WC = query.GetPoseInWorld(gf).multiply(p_GC)
     p_BC = plant.EvalBodyPoseInWorld(context, body).inverse().multiply(p_WC)
-    return psi, n_W, body, np.asarray(p_BC)
+    return psi, n_W, body, np.asarray(p_BC), every
 
 
 def close_hand(
@@ -251,9 +265,10 @@ def close_hand(
     couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
         ``q_0 = gear_ratio * q_1 + offset``, as in Drake's
         ``AddCouplerConstraint`` and a URDF ``<mimic>``; joints are ``Joint``
-        objects or ``"model::joint"`` names (see
-        :mod:`drakegrasp.plant.fingers`).  Required (``()`` for none) when the
-        plant has constraints, which Drake does not let us read.
+        objects or ``"model::joint"`` names.  Default: the couplings recorded
+        on the plant (:func:`~drakegrasp.plant.couplings.plant_couplings`:
+        models loaded with :func:`~drakegrasp.plant.couplings.add_models` or
+        from a scene file); an explicit list overrides them (``()``: none).
     distance_tolerance : float, optional
         A finger touches when ``0 <= ψ <= distance_tolerance`` (metres,
         default 1e-4, the contact tolerance of
@@ -294,7 +309,7 @@ def close_hand(
             raise InvalidOptionError(f"{name} must be an integer >= 1, got {value!r}")
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
-    couplings = _couplings(plant, couplings)
+    couplings = plant_couplings(plant, couplings)
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     query = plant.get_geometry_query_input_port().Eval(plant_context)
@@ -313,7 +328,13 @@ def close_hand(
     _check_coupled(hand_, q0)
     user_d = _user_direction(direction, len(q0), hand_)
     search = _Search(plant, plant_context, hand_, tol, user_d, max_iterations)
-    states = [_State(f, q0.copy(), q0.copy()) for f in hand_.fingers]
+    inspector = query.inspector()
+    states = [
+        _State(
+            f, q0.copy(), q0.copy(), reach(plant, plant_context, hand_, f, inspector)
+        )
+        for f in hand_.fingers
+    ]
     steps = search.run(states, q_all, q0)
     closure = HandClosure(
         joints=hand_.names,
@@ -340,19 +361,6 @@ def close_hand(
             closure=closure,
         )
     return closure
-
-
-def _couplings(plant, couplings):
-    if couplings is not None:
-        return tuple(couplings)
-    if plant.num_constraints() > 0:
-        raise InvalidOptionError(
-            f"the plant has {plant.num_constraints()} constraint(s) (a URDF <mimic> "
-            "becomes a coupler constraint) and Drake's Python API does not let "
-            "drakegrasp read them: pass couplings=[(joint_0, joint_1, gear_ratio, "
-            "offset)], or couplings=() to close without them"
-        )
-    return ()
 
 
 def _check_coupled(hand: HandStructure, q0: np.ndarray) -> None:
@@ -434,7 +442,7 @@ class _Search:
 
     def advance(self, st: _State, query) -> None:
         """Classify the finger's trial point, then aim its next one."""
-        psi, n_W, body, p_BC = _closest(
+        psi, _, body, _, every = _closest(
             query, self.plant, self.context, st.finger.pairs
         )
         st.psi, st.closest_body = psi, body
@@ -460,11 +468,9 @@ class _Search:
                 unmoved = self.user_d is not None and not np.any(self.user_d[mine])
                 st.status = "fixed" if unmoved else "at limit"
                 return
-            slope = float(
-                self._dpsi(n_W, body, p_BC) @ self.hand.coupling.tangent(st.d)
-            )
-            newton = (psi - self.target) / -slope if slope < 0 else np.inf
-            st.alpha = min(newton, st.finger.max_step, alpha_end)
+            speed = finger_speed_bound(st.reach, self.hand.coupling.tangent(st.d))
+            alpha_ca = advancement_bound(every, speed, self.target)
+            st.alpha = min(alpha_ca, st.finger.max_step, alpha_end)
             st.q_trial = self._at(st, st.alpha)
             st.iterations += 1
 
@@ -493,7 +499,7 @@ class _Search:
             tip = _closest(query, self.plant, self.context, st.finger.tip_pairs)
             if tip[2] is None:
                 return np.zeros(len(mine))
-            d = np.where(mine, -hand.coupling.pull_back(self._dpsi(*tip[1:])), 0.0)
+            d = np.where(mine, -hand.coupling.pull_back(self._dpsi(*tip[1:4])), 0.0)
         q = st.q_good
         blocked = ((d > 0) & (q >= hand.upper)) | ((d < 0) & (q <= hand.lower))
         d = np.where(blocked, 0.0, d)

@@ -30,14 +30,14 @@ from pydrake.systems.framework import Context
 
 from drakegrasp.errors import InvalidOptionError, NoContactsError
 from drakegrasp.plant._shapes import plane_basis
+from drakegrasp.plant.contact_normals import clean_unit as _clean_unit
 from drakegrasp.plant.contacts import (
     HandSpec,
     PlantContact,
-    _clean_unit,
     _scoped_name,
-    hand_bodies,
     resolve_object_body,
 )
+from drakegrasp.plant.validation import hand_contact_bodies
 
 __all__ = ["contacts_from_results", "patch_polygon"]
 
@@ -148,7 +148,7 @@ def contacts_from_results(
         )
     plant.ValidateContext(plant_context)
     body = resolve_object_body(plant, object_body)
-    fingers = {b.index(): b for b in hand_bodies(plant, body, hand)}
+    fingers = {b.index(): b for b in hand_contact_bodies(plant, body, hand)}
     inspector = query_object.inspector()
     X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
     R_OW = X_OW.rotation().matrix()

@@ -6,34 +6,19 @@ scene-graph query port gives the signed distance ``ψ`` and the witness points
 ``p_Ca − p_Cb = ψ n̂`` and ``n̂`` pointing from the finger into the object.  A
 pair is a contact when ``|ψ| <= distance_tolerance``.
 
+The query loop lives here; the choice of the normal (and the exact contact
+of a spherical fingertip) in :mod:`drakegrasp.plant.contact_normals`, and the
+corners of a flat pad's patch in :mod:`drakegrasp.plant.contact_patches`.
+
 **Normals.**  Drake guarantees the witness normal at ``ψ = 0`` only for a few
-shape pairs, so the normal is derived from the shapes themselves: the object's
-outward face normal at ``Ca`` (negated) when the object is smooth or on a face
-there; else the finger's outward normal at ``Cb`` when the finger is smooth
-there (a rounded fingertip on a box edge); else the direction ``Ca − Cb`` when
-``ψ`` is clearly non-zero; else Drake's ``nhat_BA_W``.  ``PlantContact.normal_source``
-says which.
+shape pairs, so the normal is derived from the shapes themselves (see
+:mod:`~drakegrasp.plant.contact_normals`); ``PlantContact.normal_source`` says
+which surface gave it.
 
-**Accuracy.**  Drake computes some pairs in closed form (sphere–sphere,
-sphere–box, sphere–cylinder...) and the others with GJK/EPA, whose witness
-points are accurate to about 1e-5 m (convex meshes, ellipsoids).  For a
-spherical fingertip drakegrasp recomputes the finger's contact point as
-``centre + r n̂`` and, on a flat face, ``ψ`` exactly as the centre's distance to
-the face plane minus ``r``; on an edge or a corner of flat faces (boxes, convex
-meshes) the normal runs from the centre to the closest point of that edge or
-corner.  Other pairs keep Drake's values.
-
-**Flat patches.**  A flat pad on a flat face touches along an area, for which
-Drake reports a single witness point somewhere in the patch.  When both surfaces
-are flat faces of boxes or convex meshes with opposite normals (within
-:data:`PATCH_ANGLE_TOL`), drakegrasp intersects the two face polygons in the
-contact plane, keeps the part where the gap between the faces is within the
-distance tolerance, and reports one contact at **each vertex** of that patch
-polygon (same normal; ``ψ`` the gap at the vertex).  A square pad on a box face
-thus gives four contacts, so the pad's resistance to torsion and tilt appears in
-the analysis, as a user would expect.  Patches on a cylinder's flat cap (a disc)
-are reported as the single witness point.  ``patches="witness"`` turns patch
-handling off.
+**Flat patches.**  A flat pad on a flat face is reported as one contact at
+**each vertex** of its patch polygon (same normal; ``ψ`` the gap at the
+vertex), see :mod:`~drakegrasp.plant.contact_patches`.  A square pad on a box
+face thus gives four contacts.  ``patches="witness"`` turns patch handling off.
 """
 
 from __future__ import annotations
@@ -57,12 +42,18 @@ from drakegrasp.errors import (
 from drakegrasp.plant._shapes import (
     ON_SURFACE_TOL,
     SurfacePiece,
-    plane_basis,
     surface_pieces,
 )
+from drakegrasp.plant.contact_normals import (
+    choose_normal,
+    clean_unit,
+    refine_sphere_tip,
+)
+from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
+    hand_contact_bodies,
     plant_context_of,
     resolve_object_body,
     scoped_name,
@@ -77,8 +68,6 @@ __all__ = [
     "resolve_object_body",
 ]
 
-PATCH_ANGLE_TOL = np.radians(2.0)
-"""Two flat faces whose normals are opposite within this angle (rad) form a patch."""
 
 _scoped_name = scoped_name  # the name other modules of the plant layer import
 
@@ -96,8 +85,13 @@ class PlantContact:
     psi : float
         Signed distance ``ψ`` (metres): > 0 separated, < 0 penetrating.
     p_FC : (3,) float
-        The finger's witness point (``p_OC − ψ nhat``) in the finger body's frame
-        F: the material point of the finger that touches the object.
+        The finger's witness point in the finger body's frame F: the material
+        point of the finger that touches the object.  It is Drake's closest
+        point on the finger geometry (``centre + r nhat`` for a spherical tip;
+        ``p_OC − ψ nhat`` at a patch vertex), so ``p_OC − p_FC`` (in a common
+        frame) equals ``ψ nhat`` only where the normal is Drake's own: when the
+        normal comes from a surface (``normal_source``), the two witness
+        points need not lie on it.
     finger_body : str
         Scoped name ``model::body`` of the finger body.
     finger_body_index : BodyIndex
@@ -112,6 +106,10 @@ class PlantContact:
     patch_vertex : int or None
         Index of this contact among the vertices of a flat patch, or None for a
         point contact.
+    finger_geometry_index, object_geometry_index : int or None
+        Place of each geometry among its body's collision geometries (None
+        when not known, e.g. contacts read from contact results); they make
+        the labels ``finger_geometry_label``/``object_geometry_label`` unique.
     """
 
     p_OC: np.ndarray
@@ -126,9 +124,34 @@ class PlantContact:
     finger_geometry_name: str
     normal_source: str
     patch_vertex: int | None = None
+    finger_geometry_index: int | None = None
+    object_geometry_index: int | None = None
+
+    @property
+    def finger_geometry_label(self) -> str:
+        """``model::body/geometry#k``: unique, though URDF collision names repeat.
+
+        ``k`` is the geometry's place among its body's collision geometries
+        (``plant.GetCollisionGeometriesForBody``), which, unlike a
+        ``GeometryId``, is the same in every process.
+        """
+        return _label(
+            self.finger_body, self.finger_geometry_name, self.finger_geometry_index
+        )
+
+    @property
+    def object_geometry_label(self) -> str:
+        """``geometry#k`` of the object's geometry (see ``finger_geometry_label``)."""
+        return _label("", self.object_geometry_name, self.object_geometry_index)
 
     def to_dict(self) -> dict:
-        """JSON-ready dictionary (geometry ids as their integer values)."""
+        """JSON-ready dictionary.
+
+        ``finger_geometry_label`` and ``object_geometry_label`` name each
+        geometry uniquely and the same in every process (body and the
+        geometry's index in its body); the ``*_geometry`` names are the scene
+        graph's, which can repeat across bodies.
+        """
         return {
             "p_OC": self.p_OC.tolist(),
             "nhat_O": self.nhat_O.tolist(),
@@ -137,6 +160,8 @@ class PlantContact:
             "finger_body": self.finger_body,
             "object_geometry": self.object_geometry_name,
             "finger_geometry": self.finger_geometry_name,
+            "object_geometry_label": self.object_geometry_label,
+            "finger_geometry_label": self.finger_geometry_label,
             "normal_source": self.normal_source,
             "patch_vertex": self.patch_vertex,
         }
@@ -151,6 +176,12 @@ class PlantContact:
         )
 
 
+def _label(body: str, name: str, index: int | None) -> str:
+    short = name.rpartition("::")[2]
+    where = f"{body}/{short}" if body else name
+    return where if index is None else f"{where}#{index}"
+
+
 def _rotation(X) -> np.ndarray:
     return X.rotation().matrix()
 
@@ -159,84 +190,6 @@ def _pieces_in(
     inspector: SceneGraphInspector, gid: GeometryId, p_GC: np.ndarray
 ) -> list[SurfacePiece]:
     return surface_pieces(inspector.GetShape(gid), p_GC)
-
-
-def _clip(poly: np.ndarray, a: np.ndarray, b: float) -> np.ndarray:
-    """Clip a 2-D polygon (k, 2) to the half-plane ``a·x <= b``."""
-    if len(poly) == 0:
-        return poly
-    out = []
-    for i in range(len(poly)):
-        p, q = poly[i], poly[(i + 1) % len(poly)]
-        fp, fq = a @ p - b, a @ q - b
-        if fp <= 0:
-            out.append(p)
-        if fp * fq < 0:
-            t = fp / (fp - fq)
-            out.append(p + t * (q - p))
-    return np.array(out).reshape(-1, 2)
-
-
-def _ccw(poly: np.ndarray) -> np.ndarray:
-    area = 0.5 * np.sum(
-        poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1]
-    )
-    return poly if area >= 0 else poly[::-1]
-
-
-def _clip_convex(subject: np.ndarray, clipper: np.ndarray) -> np.ndarray:
-    """Intersection of two convex 2-D polygons (Sutherland–Hodgman)."""
-    clipper = _ccw(clipper)
-    out = _ccw(subject)
-    for i in range(len(clipper)):
-        p, q = clipper[i], clipper[(i + 1) % len(clipper)]
-        edge = q - p
-        outward = np.array([edge[1], -edge[0]])  # right of a CCW edge is outside
-        out = _clip(out, outward, outward @ p)
-    return out
-
-
-def _dedupe(points: np.ndarray, tol: float) -> np.ndarray:
-    keep: list[np.ndarray] = []
-    for p in points:
-        if all(np.linalg.norm(p - k) > tol for k in keep):
-            keep.append(p)
-    return np.array(keep).reshape(-1, points.shape[1])
-
-
-def _patch(
-    *,
-    n_O: np.ndarray,
-    poly_obj_O: np.ndarray,
-    poly_fin_O: np.ndarray,
-    plane_point_obj_O: np.ndarray,
-    finger_normal_O: np.ndarray,
-    plane_point_fin_O: np.ndarray,
-    tol: float,
-) -> list[tuple[np.ndarray, float]]:
-    """Vertices (on the object face, frame O) of a flat patch and their gaps ψ.
-
-    ``n_O`` is the inward contact normal (minus the object face's normal).  The
-    gap at a point x of the object face is the distance along ``-n`` to the
-    finger face's plane.
-    """
-    u, w = plane_basis(n_O)
-    origin = plane_point_obj_O
-
-    def to2(P):
-        d = P - origin
-        return np.column_stack([d @ u, d @ w])
-
-    inter = _clip_convex(to2(poly_fin_O), to2(poly_obj_O))
-    # The finger point above x is x - gap n, on the finger's plane
-    # m · (y - p_fin) = 0 (m: the finger face's outward normal, m ≈ n), so
-    # gap(x) = m · (x - p_fin) / (m · n), affine in the 2-D coordinates.
-    denom = float(n_O @ finger_normal_O)
-    g0 = float((origin - plane_point_fin_O) @ finger_normal_O) / denom
-    g = np.array([u @ finger_normal_O, w @ finger_normal_O]) / denom
-    inter = _clip(inter, g, tol - g0)
-    inter = _dedupe(inter, 1e-9)
-    return [(origin + x[0] * u + x[1] * w, g0 + float(g @ x)) for x in inter]
 
 
 def find_contacts(
@@ -263,7 +216,8 @@ def find_contacts(
         The grasped object (a ``"model::body"`` name is accepted); positional
         or keyword, like every option-free argument of the plant layer.
     hand : ModelInstanceIndex, str, iterable of RigidBody, or None, optional
-        See :func:`~drakegrasp.plant.validation.hand_bodies`.
+        See :func:`~drakegrasp.plant.validation.hand_contact_bodies`: every
+        body of the hand touches, a palm welded to the world included.
     distance_tolerance : float, optional
         A pair is a contact when ``|ψ| <= distance_tolerance`` (metres, default
         1e-4).
@@ -305,7 +259,7 @@ def find_contacts(
             f"patches must be 'vertices' or 'witness', got {patches!r}"
         )
     body = resolve_object_body(plant, object_body)
-    fingers = hand_bodies(plant, body, hand)
+    fingers = hand_contact_bodies(plant, body, hand)
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     if query_object is None:
@@ -345,8 +299,8 @@ def find_contacts(
     for finger in fingers:
         finger_name = _scoped_name(plant, finger)
         X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
-        for gf in plant.GetCollisionGeometriesForBody(finger):
-            for go in object_geometries:
+        for kf, gf in enumerate(plant.GetCollisionGeometriesForBody(finger)):
+            for ko, go in enumerate(object_geometries):
                 if inspector.CollisionFiltered(go, gf):
                     continue
                 try:
@@ -386,6 +340,7 @@ def find_contacts(
                     X_FO=X_WF.inverse().multiply(X_WO),
                     finger=finger,
                     finger_name=finger_name,
+                    indices=(kf, ko),
                     tol=tol,
                     patches=patches,
                 )
@@ -444,6 +399,7 @@ def _pair_contacts(
     X_FO,
     finger,
     finger_name,
+    indices,
     tol,
     patches,
 ) -> list[PlantContact]:
@@ -466,6 +422,8 @@ def _pair_contacts(
         "finger_geometry": gf,
         "object_geometry_name": inspector.GetName(go),
         "finger_geometry_name": inspector.GetName(gf),
+        "finger_geometry_index": indices[0],
+        "object_geometry_index": indices[1],
     }
     if patches == "vertices":
         for po in obj_pieces:
@@ -480,8 +438,8 @@ def _pair_contacts(
                     continue
                 poly_obj = _to_O_points(po.polygon_G, X_WGa, to_O)
                 poly_fin = _to_O_points(pf.polygon_G, X_WGb, to_O)
-                n_O = _clean_unit(-m_O)
-                verts = _patch(
+                n_O = clean_unit(-m_O)
+                verts = patch_vertices(
                     n_O=n_O,
                     poly_obj_O=poly_obj,
                     poly_fin_O=poly_fin,
@@ -503,7 +461,7 @@ def _pair_contacts(
                         )
                         for k, (p, gap) in enumerate(verts)
                     ]
-    n_O, source = _choose_normal(
+    n_O, source = choose_normal(
         obj=[-(R_OGa @ p.normal_G) for p in obj_pieces],
         obj_flat=all(p.polygon_G is not None for p in obj_pieces),
         fin=[R_OGb @ p.normal_G for p in fin_pieces],
@@ -512,31 +470,19 @@ def _pair_contacts(
         psi=psi,
         drake=R_OW @ nhat_W,
     )
-    n_O = _clean_unit(n_O)
+    n_O = clean_unit(n_O)
     finger_shape = inspector.GetShape(gf)
     if isinstance(finger_shape, Sphere):
-        # A spherical fingertip touches at centre + r n.  Recompute the witness
-        # points from the sphere's centre: on a flat face ψ is the centre's
-        # distance to the face's plane minus r; on an edge or a corner of flat
-        # faces, the normal runs from the centre to the closest point of that
-        # edge or corner.  All exact, whatever the accuracy of Drake's witnesses.
-        r = finger_shape.radius()
-        centre_O = to_O(X_WGb.translation())
         flat = [p.polygon_G for p in obj_pieces if p.polygon_G is not None]
-        feature = _shared_feature(flat) if len(flat) == len(obj_pieces) else None
-        if len(obj_pieces) == 1 and flat and source == "object":
-            face_point_O = to_O(X_WGa.multiply(flat[0][0]))
-            psi = float(-n_O @ (centre_O - face_point_O)) - r
-        elif feature is not None and len(obj_pieces) > 1:
-            closest_O = _closest_on_segment(
-                centre_O, *(to_O(X_WGa.multiply(v)) for v in feature)
-            )
-            d = closest_O - centre_O
-            if np.linalg.norm(d) > r / 2:  # the centre is outside the object
-                n_O, source = _clean_unit(d), "edge" if len(feature) == 2 else "corner"
-                psi = float(np.linalg.norm(d)) - r
-        p_OCb = centre_O + r * n_O
-        p_OCa = p_OCb + psi * n_O
+        n_O, source, psi, p_OCa, p_OCb = refine_sphere_tip(
+            radius=finger_shape.radius(),
+            centre_O=to_O(X_WGb.translation()),
+            object_faces_G=flat if len(flat) == len(obj_pieces) else None,
+            G_to_O=lambda p_G: to_O(X_WGa.multiply(p_G)),
+            n_O=n_O,
+            source=source,
+            psi=psi,
+        )
     return [
         PlantContact(
             p_OC=p_OCa,
@@ -547,78 +493,6 @@ def _pair_contacts(
             **common,
         )
     ]
-
-
-def _shared_feature(polygons: list[np.ndarray]) -> tuple[np.ndarray, ...] | None:
-    """The edge (two vertices) or corner (one) that several faces share."""
-    if len(polygons) < 2:
-        return None
-    shared = [
-        v
-        for v in polygons[0]
-        if all(np.min(np.linalg.norm(P - v, axis=1)) < 1e-9 for P in polygons[1:])
-    ]
-    return tuple(shared) if len(shared) in (1, 2) else None
-
-
-def _closest_on_segment(x: np.ndarray, a: np.ndarray, b: np.ndarray | None = None):
-    """Closest point to ``x`` on the segment ``ab`` (or the point ``a``)."""
-    if b is None:
-        return np.asarray(a)
-    ab = b - a
-    s = float(np.clip((x - a) @ ab / (ab @ ab), 0.0, 1.0))
-    return a + s * ab
-
-
-def _clean_unit(n: np.ndarray) -> np.ndarray:
-    """Unit vector with round-off components (< 1e-12) set to exactly zero.
-
-    The core picks each contact frame's ``t1`` from the smallest component of
-    ``n``; zeroing round-off keeps that choice, hence ``G``, the same wherever
-    the object sits in the world.
-    """
-    n = np.array(n, dtype=float)
-    n[np.abs(n) < 1e-12] = 0.0
-    return n / np.linalg.norm(n)
-
-
-NORMAL_AGREEMENT = np.cos(np.radians(5.0))
-"""Object and finger normals within 5 degrees of each other agree."""
-
-
-def _choose_normal(*, obj, obj_flat, fin, fin_flat, witness, psi, drake):
-    """Pick the inward normal (frame O) from the candidates of both surfaces.
-
-    ``obj`` and ``fin`` hold the candidate inward normals from the object's and
-    the finger's surface pieces at the witness points (several at an edge or a
-    corner).  A unique normal of one surface is used when the other agrees
-    with it or has no unique normal; when both are unique but disagree, one
-    witness point sits numerically next to an edge it should be on (Drake's GJK
-    witnesses are accurate to ~1e-5 m), and the curved surface wins over the
-    flat face, whose normal jumps there.
-    """
-    if len(obj) == 1 and len(fin) == 1:
-        if obj[0] @ fin[0] >= NORMAL_AGREEMENT:
-            return obj[0], "object"
-        if obj_flat and not fin_flat:
-            return fin[0], "finger"
-        if fin_flat and not obj_flat:
-            return obj[0], "object"
-    elif len(obj) == 1:
-        return obj[0], "object"
-    elif len(fin) == 1:
-        return fin[0], "finger"
-    if abs(psi) > _WITNESS_DIRECTION_MIN_DISTANCE:
-        return witness / np.linalg.norm(witness) * np.sign(psi), "witness points"
-    return drake, "drake"
-
-
-_WITNESS_DIRECTION_MIN_DISTANCE = 1e-3
-"""|ψ| (m) above which the line between witness points gives the normal.
-
-GJK witnesses are accurate to ~1e-5 m, so nearer than this their direction is
-mostly noise; Drake's own normal is then used (exact for the shape pairs that
-Drake computes analytically)."""
 
 
 def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:

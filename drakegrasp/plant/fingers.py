@@ -16,10 +16,10 @@ joint moves (the palm) stay where they are.
 
 **Couplings.**  Drake parses a URDF ``<mimic>`` (or SDFormat
 ``<drake:mimic>``) into a coupler constraint ``q_0 = ρ q_1 + Δq``
-(``MultibodyPlant.AddCouplerConstraint(joint_0, joint_1, ρ, Δq)``); its Python
-API does not let us read the constraint back, so the caller passes the same
-four numbers as a *coupling* ``(joint_0, joint_1, ρ, Δq)``: ``joint_0``
-follows ``joint_1``.
+(``MultibodyPlant.AddCouplerConstraint(joint_0, joint_1, ρ, Δq)``); a
+*coupling* is the same four numbers ``(joint_0, joint_1, ρ, Δq)``:
+``joint_0`` follows ``joint_1``.  They are read where the models enter the
+plant (:mod:`drakegrasp.plant.couplings`).
 """
 
 from __future__ import annotations

@@ -123,6 +123,7 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.errors import ModelError, SceneError
+from drakegrasp.plant.couplings import record_model_couplings
 from drakegrasp.plant.models import models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import check_section, read_yaml
@@ -392,12 +393,13 @@ def load_scene(
         raise SceneError(f"scene {str(path)!r}: bad model directives: {msg}") from None
     _anchor_relative_files(directives, path)
     try:
-        ProcessModelDirectives(directives, plant, parser)
+        added = ProcessModelDirectives(directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError
         msg = " ".join(str(e).split())
         raise ModelError(
             f"scene {str(path)!r}: cannot load the models: {msg}"
         ) from None
+    record_model_couplings(plant, added)
     plant.Finalize()
     object_body = resolve_body(plant, info.object_body)
     hand = _resolve_hand(plant, info.hand)

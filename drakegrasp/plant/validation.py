@@ -29,6 +29,7 @@ __all__ = [
     "HandSpec",
     "check_plant",
     "hand_bodies",
+    "hand_contact_bodies",
     "hand_model_instances",
     "model_instance",
     "plant_context_of",
@@ -310,6 +311,54 @@ def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
             "instance or list its bodies"
         )
     return sorted(bodies, key=lambda b: int(b.index()))
+
+
+def hand_contact_bodies(
+    plant: MultibodyPlant, object_body: RigidBody, hand: HandSpec = None
+) -> list[RigidBody]:
+    """Every body of the hand that can touch the object, welded ones included.
+
+    A palm welded to the world cannot move, but it touches: its contacts
+    belong in ``G``, and its rows of the hand Jacobian are zero.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    object_body : RigidBody
+    hand : ModelInstanceIndex, str, iterable of RigidBody (or scoped names), or None
+        A model instance (all its bodies), an explicit list of bodies (all of
+        them, welded or not), or None: the movable bodies of
+        :func:`hand_bodies` and every body of their model instances (so the
+        welded palm of a hand, but not a table welded to the world in a model
+        instance of its own).
+
+    Returns
+    -------
+    list of RigidBody
+        In body-index order; never the object nor the world body.
+
+    Raises
+    ------
+    ModelError
+        For an unknown instance or body, or a hand with no body at all.
+    """
+    obj = int(object_body.index())
+    if hand is None:
+        movable = hand_bodies(plant, object_body, None)
+        return hand_model_instances(plant, movable, object_body)
+    if isinstance(hand, str | ModelInstanceIndex):
+        instance = model_instance(plant, hand)
+        bodies = [plant.get_body(i) for i in plant.GetBodyIndices(instance)]
+    else:
+        bodies = [resolve_object_body(plant, b) for b in hand]
+    bodies = [b for b in bodies if int(b.index()) not in (0, obj)]
+    if not bodies:
+        raise ModelError(
+            f"the hand has no bodies (hand={hand!r}); name its model instance or "
+            "list its bodies"
+        )
+    unique = {int(b.index()): b for b in bodies}
+    return [unique[i] for i in sorted(unique)]
 
 
 def hand_model_instances(

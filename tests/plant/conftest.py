@@ -2,12 +2,19 @@
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.plant.scene import list_scenes, load_scene
+
+_HERE = str(Path(__file__).resolve().parent)
+if _HERE not in sys.path:  # the test models (hand_models) are importable
+    sys.path.insert(0, _HERE)
 
 SCENE_NAMES = [info.name for info in list_scenes()]
 SPATIAL_SCENES = [n for n in SCENE_NAMES if not n.startswith("planar")]

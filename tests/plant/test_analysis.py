@@ -145,6 +145,9 @@ def test_scene_verdicts_match_the_geometry_and_the_core(scene_cache, name):
     if len(report.contacts) == 2:
         assert report.antipodal is not None
         assert report.antipodal.is_antipodal == is_antipodal(grasp).is_antipodal
+    elif name.startswith("parallel_jaw"):  # two fingers: answered per finger
+        assert report.antipodal.is_antipodal
+        assert [len(c) for c in report.antipodal.contacts] == [4, 4]
     else:
         assert report.antipodal is None
 
@@ -291,12 +294,20 @@ def test_report_text_and_json(scene_cache):
     assert np.array(data["dpsi_dv"]).shape == (2, 8)
 
 
-def test_hand_none_means_every_free_body_but_the_objects(scene_cache):
+def test_hand_none_means_the_free_bodies_and_their_models_but_not_the_objects(
+    scene_cache,
+):
     scene = scene_cache("parallel_jaw_box")
     data = grasp_from_plant(
         scene.plant, scene.plant_context, object_body=scene.object_body, mu=0.5
     )
-    assert data.hand_bodies == ("gripper::left_finger", "gripper::right_finger")
+    # The welded palm belongs to the hand (it can touch); its weld adds no column.
+    assert data.hand_bodies == (
+        "gripper::palm",
+        "gripper::left_finger",
+        "gripper::right_finger",
+    )
+    assert data.hand_velocity_indices.size == 2
     scene = scene_cache("planar_gripper_brick")
     data = grasp_from_plant(
         scene.plant,

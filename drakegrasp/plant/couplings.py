@@ -1,0 +1,379 @@
+r"""Joint couplings of a hand: read where the models enter the plant, used in J.
+
+A URDF ``<mimic>`` or an SDFormat ``<drake:mimic>`` makes Drake add a coupler
+constraint ``q_0 = ρ q_1 + Δq`` (``MultibodyPlant.AddCouplerConstraint(joint_0,
+joint_1, ρ, Δq)``): ``joint_0`` *follows* ``joint_1``.  pydrake cannot read a
+constraint back from a plant, so drakegrasp reads each coupling where it enters
+the plant and records it on the plant:
+
+- :func:`add_models` — a drop-in for ``Parser.AddModels`` that also reads the
+  mimic elements of the file (or URL, or text) it parses;
+- :func:`drakegrasp.load_scene` — every model of a scene file;
+- :func:`add_coupler_constraint` — ``plant.AddCouplerConstraint`` for a
+  coupling written in code.
+
+:func:`plant_couplings` returns what was recorded; an explicit ``couplings=``
+argument (of :func:`~drakegrasp.close_hand`, :func:`~drakegrasp.grasp_from_plant`
+and :func:`~drakegrasp.analyze_grasp`) overrides it, and a plant with more
+constraints than recorded couplings is refused rather than analysed as if its
+joints were free.
+
+**The coupling map.**  With the hand's velocities ``v_h`` (one-dof joints:
+``v = q̇``), a follower moves as ``v_f = ρ v_l``, so ``v_h = C u`` with ``u``
+the *independent* velocities (every hand velocity but the followers') and
+``C`` the identity on them plus ``ρ`` in the follower's row and the leader's
+column.  The hand Jacobian of a coupled hand is ``J C``: one column per
+independent motion, so LP3 judges the motors the hand has.
+"""
+
+from __future__ import annotations
+
+import weakref
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import Joint, JointIndex, ModelInstanceIndex
+
+from drakegrasp.errors import InvalidOptionError, ModelError
+
+__all__ = [
+    "JointCoupling",
+    "add_coupler_constraint",
+    "add_models",
+    "coupling_map",
+    "couplings_in_model",
+    "plant_couplings",
+    "record_model_couplings",
+]
+
+_DRAKE_NS = "{http://drake.mit.edu}"
+
+
+class JointCoupling(NamedTuple):
+    """``q_follower = gear_ratio * q_leader + offset`` (Drake's coupler constraint).
+
+    A tuple ``(joint_0, joint_1, gear_ratio, offset)`` as ``couplings=`` takes
+    it; the joints are scoped names ``model::joint``.
+    """
+
+    follower: str
+    leader: str
+    gear_ratio: float
+    offset: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return dict(self._asdict())
+
+
+_RECORDED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""Per plant: the couplings recorded as its models were added."""
+
+
+def _record(plant: MultibodyPlant, couplings: Iterable[JointCoupling]) -> None:
+    known = _RECORDED.setdefault(plant, [])
+    for c in couplings:
+        if c not in known:
+            known.append(c)
+
+
+def couplings_in_model(
+    text: str, kind: str
+) -> list[list[tuple[str, str, float, float]]]:
+    """The mimic elements of a URDF or SDFormat document, per model.
+
+    Parameters
+    ----------
+    text : str
+        The document.
+    kind : {"urdf", "sdf"}
+        Its format.
+
+    Returns
+    -------
+    list of list of (follower, leader, gear_ratio, offset)
+        One list per model, in the document's order (a URDF has one model; an
+        SDFormat file one per top-level ``<model>``), with joint names local
+        to the model.  ``multiplier`` defaults to 1 and ``offset`` to 0, as in
+        Drake's parsers.
+
+    Raises
+    ------
+    ModelError
+        For a document that is not XML or a mimic element without a joint.
+    """
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as e:
+        raise ModelError(f"cannot read the model's couplings: {e}") from None
+    if kind == "urdf":
+        models, tag = [root], "mimic"
+    elif kind == "sdf":
+        models = [root] if root.tag == "model" else root.findall("model")
+        tag = _DRAKE_NS + "mimic"
+    else:
+        raise InvalidOptionError(f"kind must be 'urdf' or 'sdf', got {kind!r}")
+    out = []
+    for model in models:
+        found = []
+        for joint in model.iter("joint"):
+            for mimic in joint.findall(tag):
+                leader = mimic.get("joint")
+                if not leader:
+                    raise ModelError(
+                        f"the mimic element of joint {joint.get('name')!r} names no "
+                        "joint to follow"
+                    )
+                found.append(
+                    (
+                        joint.get("name"),
+                        leader,
+                        float(mimic.get("multiplier", 1.0)),
+                        float(mimic.get("offset", 0.0)),
+                    )
+                )
+        out.append(found)
+    return out
+
+
+def _kind_of(name: str) -> str:
+    suffix = Path(name).suffix.lower()
+    if suffix == ".urdf":
+        return "urdf"
+    if suffix == ".sdf":
+        return "sdf"
+    return ""
+
+
+def _scoped(plant: MultibodyPlant, instance, local: str) -> str:
+    return f"{plant.GetModelInstanceName(instance)}::{local}"
+
+
+def _record_text(plant, text: str, kind: str, instances: Sequence) -> None:
+    per_model = couplings_in_model(text, kind)
+    for instance, found in zip(instances, per_model, strict=False):
+        _record(
+            plant,
+            (
+                JointCoupling(
+                    _scoped(plant, instance, f), _scoped(plant, instance, lead), r, o
+                )
+                for f, lead, r, o in found
+            ),
+        )
+
+
+def record_model_couplings(plant: MultibodyPlant, infos: Iterable) -> None:
+    """Record the couplings of models added by ``ProcessModelDirectives``.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        The plant the models were added to.
+    infos : iterable of ModelInstanceInfo
+        What ``ProcessModelDirectives`` returned (each with its resolved
+        ``model_path`` and ``model_instance``).
+    """
+    for info in infos:
+        kind = _kind_of(info.model_path)
+        if kind:
+            text = Path(info.model_path).read_text()
+            _record_text(plant, text, kind, [info.model_instance])
+
+
+def add_models(
+    parser: Parser,
+    file_name: str | Path | None = None,
+    *,
+    url: str | None = None,
+    text: str | None = None,
+    kind: str | None = None,
+) -> list[ModelInstanceIndex]:
+    """``Parser.AddModels`` that also records the models' mimic couplings.
+
+    Parameters
+    ----------
+    parser : pydrake.multibody.parsing.Parser
+        The user's parser (its package map resolves ``url``).
+    file_name : str or Path, optional
+        A URDF or SDFormat file.
+    url : str, optional
+        A ``package://`` or ``file://`` URL instead.
+    text : str, optional
+        The document itself instead; then ``kind`` (``"urdf"`` or ``"sdf"``)
+        is required.
+
+    Returns
+    -------
+    list of ModelInstanceIndex
+        What the parser returned.
+
+    Raises
+    ------
+    InvalidOptionError
+        Unless exactly one of ``file_name``, ``url`` and ``text`` is given.
+    """
+    given = [x is not None for x in (file_name, url, text)]
+    if sum(given) != 1:
+        raise InvalidOptionError("give exactly one of file_name, url and text")
+    plant = parser.plant()
+    if text is not None:
+        if kind not in ("urdf", "sdf"):
+            raise InvalidOptionError(f"text needs kind='urdf' or 'sdf', got {kind!r}")
+        instances = parser.AddModelsFromString(text, kind)
+        _record_text(plant, text, kind, instances)
+        return instances
+    if url is not None:
+        instances = parser.AddModels(url=url)
+        path = parser.package_map().ResolveUrl(url)
+    else:
+        instances = parser.AddModels(str(file_name))
+        path = str(file_name)
+    kind = _kind_of(path)
+    if kind:
+        _record_text(plant, Path(path).read_text(), kind, instances)
+    return instances
+
+
+def add_coupler_constraint(
+    plant: MultibodyPlant,
+    joint_0: Joint,
+    joint_1: Joint,
+    gear_ratio: float,
+    offset: float = 0.0,
+):
+    """``plant.AddCouplerConstraint`` that drakegrasp can read back.
+
+    ``q_0 = gear_ratio * q_1 + offset``; returns Drake's constraint id.
+    """
+    cid = plant.AddCouplerConstraint(joint_0, joint_1, gear_ratio, offset)
+    _record(
+        plant,
+        [
+            JointCoupling(
+                _scoped(plant, joint_0.model_instance(), joint_0.name()),
+                _scoped(plant, joint_1.model_instance(), joint_1.name()),
+                float(gear_ratio),
+                float(offset),
+            )
+        ],
+    )
+    return cid
+
+
+def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
+    """The couplings to use: ``couplings`` when given, else those of the plant.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
+        An explicit list (``()`` for none) overrides what was recorded.
+
+    Returns
+    -------
+    tuple
+        ``couplings`` as given, or the recorded :class:`JointCoupling` s.
+
+    Raises
+    ------
+    InvalidOptionError
+        When ``couplings`` is None and the plant has constraints that were not
+        recorded as couplings (a ``<mimic>`` parsed by a bare ``Parser``, a
+        constraint added in code): names the ways to tell drakegrasp.
+    """
+    if couplings is not None:
+        return tuple(couplings)
+    known = tuple(_RECORDED.get(plant, ()))
+    if plant.num_constraints() > len(known):
+        raise InvalidOptionError(
+            f"the plant has {plant.num_constraints()} constraint(s) and drakegrasp "
+            f"knows {len(known)} of them as joint couplings (a URDF <mimic> or "
+            "SDFormat <drake:mimic> becomes a coupler constraint, which pydrake "
+            "cannot read back): load the models with drakegrasp.plant.add_models"
+            "(parser, ...) or a scene file, add the constraint with "
+            "drakegrasp.plant.add_coupler_constraint, or pass couplings=[(joint_0, "
+            "joint_1, gear_ratio, offset)] (couplings=() to ignore them)"
+        )
+    return known
+
+
+def _joint(plant: MultibodyPlant, spec) -> Joint:
+    if isinstance(spec, Joint) and spec.GetParentPlant() is plant:
+        return spec
+    if isinstance(spec, str):
+        model, _, name = spec.rpartition("::")
+        for i in range(plant.num_joints()):
+            j = plant.get_joint(JointIndex(i))
+            if j.name() == name and (
+                not model or plant.GetModelInstanceName(j.model_instance()) == model
+            ):
+                return j
+    raise InvalidOptionError(
+        f"coupling joint {spec!r} is not a joint of the plant (give a Joint or "
+        "a 'model::joint' name)"
+    )
+
+
+def coupling_map(
+    plant: MultibodyPlant, velocity_indices: np.ndarray, couplings: Sequence
+) -> tuple[np.ndarray, np.ndarray]:
+    """``C`` with ``v_h = C u``, and the plant indices of ``u``.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    velocity_indices : (n_h,) int
+        The hand's velocities (plant indices).
+    couplings : sequence of (joint_0, joint_1, gear_ratio, offset)
+        Couplings whose joints are not both among the hand's velocities are
+        left out.
+
+    Returns
+    -------
+    C : (n_h, n_u) float
+        Identity on the independent velocities, ``gear_ratio`` at (follower,
+        leader).
+    independent : (n_u,) int
+        Plant velocity indices of the independent velocities, in order.
+
+    Raises
+    ------
+    InvalidOptionError
+        For an unknown joint, a joint that is not one-dof, or a joint that
+        both leads and follows.
+    """
+    v = [int(i) for i in velocity_indices]
+    row = {vi: k for k, vi in enumerate(v)}
+    follows: dict[int, tuple[int, float]] = {}
+    for entry in couplings:
+        if isinstance(entry, str) or len(entry) != 4:
+            raise InvalidOptionError(
+                "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
+                f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
+            )
+        j0, j1 = _joint(plant, entry[0]), _joint(plant, entry[1])
+        for j in (j0, j1):
+            if j.num_velocities() != 1:
+                raise InvalidOptionError(
+                    f"coupled joint {j.name()!r} has {j.num_velocities()} "
+                    "velocities; a coupling joins one-dof joints"
+                )
+        f, lead = j0.velocity_start(), j1.velocity_start()
+        if f in row and lead in row:
+            follows[f] = (lead, float(entry[2]))
+    if set(follows) & {lead for lead, _ in follows.values()}:
+        raise InvalidOptionError("a joint may not both lead and follow a coupling")
+    independent = [vi for vi in v if vi not in follows]
+    col = {vi: k for k, vi in enumerate(independent)}
+    C = np.zeros((len(v), len(independent)))
+    for vi in independent:
+        C[row[vi], col[vi]] = 1.0
+    for f, (lead, rho) in follows.items():
+        C[row[f], col[lead]] = rho
+    return C, np.array(independent, dtype=int)

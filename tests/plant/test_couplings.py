@@ -1,0 +1,215 @@
+"""Couplings read from the model (issue 20, point 5): close_hand, J and LP3 use them.
+
+Own models: a parallel gripper whose right jaw follows the left by a URDF
+``<mimic>`` and the same gripper with an SDFormat ``<drake:mimic>``.  ``J C``
+is checked against the uncoupled ``J`` times the coupling written here, and
+against finite differences of the finger points along the coupled motion.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from hand_models import (
+    JAW_PAD,
+    JAW_Y0,
+    Rig,
+    box_object,
+    mimic_gripper_sdf,
+    mimic_gripper_urdf,
+)
+from pydrake.math import RigidTransform
+
+from drakegrasp import InvalidOptionError, analyze_grasp, close_hand, load_scene
+from drakegrasp.plant import JointCoupling, add_coupler_constraint, plant_couplings
+from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
+
+GRIPPERS = {
+    "urdf": lambda **k: (mimic_gripper_urdf(**k), "urdf", "palm"),
+    "sdf": lambda **k: (mimic_gripper_sdf(**k), "sdf", None),
+}
+FOLLOWER = "mimic_gripper::right_jaw_joint"
+LEADER = "mimic_gripper::left_jaw_joint"
+
+
+def gripper_rig(kind, *, y=0.0, record=True, **mimic):
+    text, fmt, weld = GRIPPERS[kind](**mimic)
+    return Rig(
+        [(text, fmt), (box_object(), "sdf")],
+        "box",
+        RigidTransform([0.0, y, 0.05]),
+        weld_hand=weld,
+        record_couplings=record,
+    )
+
+
+@pytest.mark.parametrize("kind", sorted(GRIPPERS))
+def test_the_mimic_element_is_read_with_its_numbers(kind):
+    rig = gripper_rig(kind, multiplier=2.0, offset=-0.01)
+    assert rig.plant.num_constraints() == 1  # Drake made its coupler constraint
+    assert plant_couplings(rig.plant) == (JointCoupling(FOLLOWER, LEADER, 2.0, -0.01),)
+
+
+@pytest.mark.parametrize("kind", sorted(GRIPPERS))
+def test_coupled_jaws_close_as_one_and_j_has_one_column(kind):
+    rig = gripper_rig(kind)
+    closure = close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand)
+    (finger,) = closure.fingers
+    assert finger.status == "touching"
+    assert closure.q[0] == closure.q[1]  # the coupling holds
+    # Centred 30 mm box: both pads at 15 mm from the middle, within the tolerance.
+    q_star = JAW_Y0 - 0.015 - 0.5 * JAW_PAD[1]
+    np.testing.assert_allclose(closure.q, q_star, atol=TOL)
+    distances = rig.pair_distances()
+    for pad in ("left_jaw_pad", "right_jaw_pad"):
+        (psi,) = [d for (g, _), d in distances.items() if g.endswith(pad)]
+        assert 0.0 <= psi <= TOL
+
+    report = analyze_grasp(rig.plant, rig.ctx, rig.object, hand=rig.hand, mu=0.5)
+    coupled = report.J
+    assert coupled.shape == (report.grasp.num_components, 1)
+    assert report.data.couplings == (JointCoupling(FOLLOWER, LEADER, 1.0, 0.0),)
+    left = rig.plant.GetJointByName("left_jaw_joint", rig.hand)
+    assert report.data.hand_velocity_indices.tolist() == [left.velocity_start()]
+    # An explicit couplings=() overrides the model: the free jaws' J.
+    free = analyze_grasp(
+        rig.plant, rig.ctx, rig.object, hand=rig.hand, mu=0.5, couplings=()
+    )
+    assert free.J.shape[1] == 2
+    np.testing.assert_allclose(coupled[:, 0], free.J @ [1.0, 1.0], atol=1e-15)
+    # Finite differences of the finger points along the coupled motion.
+    plant, ctx = rig.plant, rig.ctx
+    q0 = plant.GetPositions(ctx).copy()
+    right = rig.plant.GetJointByName("right_jaw_joint", rig.hand)
+    h = 1e-6
+
+    def finger_points(dq):
+        q = q0.copy()
+        q[left.position_start()] += dq
+        q[right.position_start()] += dq
+        plant.SetPositions(ctx, q)
+        X_WO = plant.EvalBodyPoseInWorld(ctx, rig.object)
+        out = []
+        for c in report.contacts:
+            body = plant.get_body(c.finger_body_index)
+            p_W = plant.EvalBodyPoseInWorld(ctx, body).multiply(c.p_FC)
+            out.append(X_WO.inverse().multiply(p_W))
+        return np.array(out)
+
+    velocity = (finger_points(h) - finger_points(-h)) / (2 * h)
+    plant.SetPositions(ctx, q0)
+    fd = np.concatenate(
+        [c.frame.T @ v for c, v in zip(report.grasp.contacts, velocity, strict=True)]
+    )
+    np.testing.assert_allclose(coupled[:, 0], fd, atol=1e-8)
+    json.dumps(report.data.to_dict())
+
+
+def test_an_off_centre_object_is_touched_by_one_coupled_jaw():
+    rig = gripper_rig("urdf", y=0.004)
+    closure = close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand)
+    assert closure.fingers[0].touching_body == "mimic_gripper::right_jaw"
+    distances = rig.pair_distances()
+    (left,) = [d for (g, _), d in distances.items() if g.endswith("left_jaw_pad")]
+    assert left == pytest.approx(0.008, abs=2 * TOL)
+
+
+def test_a_plant_parsed_without_drakegrasp_must_be_told(tmp_path):
+    rig = gripper_rig("urdf", record=False)
+    for call in (
+        lambda: close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand),
+        lambda: analyze_grasp(rig.plant, rig.ctx, rig.object, hand=rig.hand, mu=0.5),
+    ):
+        with pytest.raises(InvalidOptionError, match="add_models.*couplings="):
+            call()
+    closure = close_hand(
+        rig.plant,
+        rig.ctx,
+        rig.object,
+        hand=rig.hand,
+        couplings=[(FOLLOWER, LEADER, 1.0, 0.0)],
+    )
+    assert closure.q[0] == closure.q[1]
+
+
+def test_a_coupler_added_in_code_is_recorded():
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    plant = MultibodyPlant(0.001)
+    text = (
+        mimic_gripper_sdf()
+        .replace("<drake:mimic", "<!-- ")
+        .replace('offset="0.0"/>', "-->")
+    )
+    (hand,) = Parser(plant).AddModelsFromString(text, "sdf")
+    assert plant.num_constraints() == 0
+    add_coupler_constraint(
+        plant,
+        plant.GetJointByName("right_jaw_joint", hand),
+        plant.GetJointByName("left_jaw_joint", hand),
+        -1.0,
+        0.02,
+    )
+    assert plant_couplings(plant) == (JointCoupling(FOLLOWER, LEADER, -1.0, 0.02),)
+
+
+def test_a_scene_file_records_its_models_couplings(tmp_path):
+    (tmp_path / "gripper.urdf").write_text(mimic_gripper_urdf())
+    (tmp_path / "box.sdf").write_text(box_object())
+    q = JAW_Y0 - 0.015 - 0.5 * JAW_PAD[1] - 3e-5
+    (tmp_path / "scene.yaml").write_text(
+        f"""directives:
+- add_model:
+    name: mimic_gripper
+    file: gripper.urdf
+    default_joint_positions:
+      left_jaw_joint: [{q!r}]
+      right_jaw_joint: [{q!r}]
+- add_weld:
+    parent: world
+    child: mimic_gripper::palm
+- add_model:
+    name: box
+    file: box.sdf
+    default_free_body_pose:
+      box:
+        translation: [0.0, 0.0, 0.05]
+drakegrasp:
+  object_body: box::box
+  hand: mimic_gripper
+  mu: 0.5
+"""
+    )
+    scene = load_scene(tmp_path / "scene.yaml")
+    assert plant_couplings(scene.plant) == (JointCoupling(FOLLOWER, LEADER, 1.0, 0.0),)
+    report = analyze_grasp(
+        scene.plant, scene.plant_context, scene.object_body, hand=scene.hand, mu=0.5
+    )
+    assert report.J.shape[1] == 1
+
+
+def test_repeated_urdf_collision_names_get_unique_labels():
+    # Both jaws' collisions are called "Box", as both PR2 pads are (issue 20, 11).
+    text = (
+        mimic_gripper_urdf()
+        .replace("left_jaw_pad", "Box")
+        .replace("right_jaw_pad", "Box")
+    )
+    rig = Rig(
+        [(text, "urdf"), (box_object(), "sdf")],
+        "box",
+        RigidTransform([0.0, 0.0, 0.05]),
+        weld_hand="palm",
+    )
+    close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand)
+    report = analyze_grasp(rig.plant, rig.ctx, rig.object, hand=rig.hand, mu=0.5)
+    entries = report.to_dict()["contacts"]
+    assert {e["finger_geometry"] for e in entries} == {"mimic_gripper::Box"}
+    labels = {(e["finger_body"], e["finger_geometry_label"]) for e in entries}
+    assert len({label for _, label in labels}) == 2  # one per jaw
+    for body, label in labels:
+        assert label == body + "/Box#0"
+    assert {e["object_geometry_label"] for e in entries} == {"box::box#0"}
