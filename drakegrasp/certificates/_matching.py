@@ -138,6 +138,9 @@ def _forces(cert: Witness, grasp: Grasp) -> tuple[np.ndarray, ...]:
         a = real_array(
             f"the certificate's force of contact {i}", f, error=InvalidOptionError
         )
+        if cert.cones == "normals" and a.shape == (1,):
+            # form closure reports [f_n] only: the other components are zero
+            a = np.concatenate([a, np.zeros(c.num_components - 1)])
         if a.shape != (c.num_components,):
             raise _foreign(
                 f"force of contact {i}",

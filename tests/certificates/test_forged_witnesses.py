@@ -290,3 +290,14 @@ def test_no_generated_twist_escapes_a_form_closure_grasp(v):
     check = _twist(v).check(g)
     assert not check.holds
     assert np.isfinite(check.slack) or check.violation == np.inf
+
+
+@pytest.mark.parametrize("model", ["hard_finger", "soft_finger"])
+def test_a_form_closure_yes_checks_on_a_grasp_with_friction(model):
+    # form closure reports [f_n] per contact; the check reads the other
+    # components as zero (it read the normal indices of the full layout)
+    g = _cube().with_friction(0.5, model=model, torsional_friction=0.1)
+    r = dg.form_closure(g)
+    assert r.is_closure and all(len(f) == 1 for f in r.certificate.contact_forces)
+    check = r.certificate.check(g)
+    assert check.holds, check
