@@ -47,3 +47,9 @@ def drake_models_dir() -> Path:
             "../shared/drake_models"
         )
     return path
+
+
+@pytest.fixture(scope="session")
+def local_drake_models_or_none() -> Path | None:
+    """Folder of ``drake_models``, or None when absent (no skip)."""
+    return local_drake_models()

@@ -49,10 +49,12 @@ much the witness holds.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from drakegrasp.certificates._matching import ReadWitness, check_tolerance, read_witness
 from drakegrasp.certificates.kinds import (
     _CONES,
     _KINDS,
@@ -206,11 +208,20 @@ class Certificate:
             Needed for :data:`~drakegrasp.certificates.kinds.UNCONTROLLABLE`
             (``Jᵀ f = 0``).
         tol : float, optional
-            Relative tolerance on the violation.
+            Relative tolerance on the violation, in (0, 1).
 
         Returns
         -------
         CertificateCheck
+            A witness with a NaN or infinite component fails (violation
+            ``inf``).
+
+        Raises
+        ------
+        InvalidOptionError
+            When ``tol`` is not in (0, 1), or the certificate belongs to another
+            grasp (another number of contacts, dimension or contact models:
+            its arrays have other shapes).
         """
         return check_certificate(self, grasp, hand_jacobian=hand_jacobian, tol=tol)
 
@@ -241,16 +252,22 @@ def check_certificate(
     tol: float,
 ) -> CertificateCheck:
     """See :meth:`drakegrasp.certificates.certificate.Certificate.check`."""
-    if cert.kind == ESCAPE_TWIST:
-        violation, slack, detail = _check_twist(cert, grasp)
-    elif cert.kind == UNRESISTED_WRENCH:
-        violation, slack, detail = _check_wrench(cert, grasp)
-    elif cert.kind == UNCONTROLLABLE:
-        J = _check_jacobian(grasp, hand_jacobian)
-        violation, slack, detail = _check_uncontrollable(cert, grasp, J)
+    tol = check_tolerance(tol)
+    read = read_witness(cert, grasp)
+    J = _check_jacobian(grasp, hand_jacobian) if read.kind == UNCONTROLLABLE else None
+    if not read.finite:
+        violation, slack, detail = np.inf, 0.0, "the witness is not finite"
+    elif read.kind == ESCAPE_TWIST:
+        violation, slack, detail = _check_twist(read, grasp)
+    elif read.kind == UNRESISTED_WRENCH:
+        violation, slack, detail = _check_wrench(read, grasp)
+    elif read.kind == UNCONTROLLABLE:
+        violation, slack, detail = _check_uncontrollable(read, grasp, J)
     else:
-        assert cert.kind == BALANCE
-        violation, slack, detail = _check_balance(cert, grasp)
+        assert read.kind == BALANCE
+        violation, slack, detail = _check_balance(read, grasp)
+    if not math.isfinite(violation):  # NaN never passes a comparison, inf fails
+        violation, slack = np.inf, 0.0
     return CertificateCheck(
         holds=bool(violation <= tol),
         violation=float(violation),
@@ -260,14 +277,20 @@ def check_certificate(
     )
 
 
-def _directions(cert: Witness) -> list[np.ndarray]:
-    out = [np.asarray(cert.direction, dtype=float)]
+def _unit_scaled(x: np.ndarray) -> np.ndarray:
+    """``x`` over its largest absolute entry: norms of it cannot overflow."""
+    m = float(np.max(np.abs(x))) if x.size else 0.0
+    return x / m if m > 0.0 else x
+
+
+def _directions(cert: ReadWitness) -> list[np.ndarray]:
+    out = [cert.direction]
     if cert.two_sided:
-        out += list(np.asarray(cert.null_basis, dtype=float).T)
-    return out
+        out += list(cert.null_basis.T)
+    return [_unit_scaled(v) for v in out]
 
 
-def _check_twist(cert: Witness, grasp: Grasp):
+def _check_twist(cert: ReadWitness, grasp: Grasp):
     G_n = grasp_matrix(grasp)[:, grasp.normal_indices()]
     col = np.linalg.norm(G_n, axis=0)
     violation, slack = 0.0, np.inf
@@ -286,16 +309,16 @@ def _check_twist(cert: Witness, grasp: Grasp):
     return violation, slack, f"G_nᵀ v >= 0 evaluated for {sides}"
 
 
-def _check_wrench(cert: Witness, grasp: Grasp):
+def _check_wrench(cert: ReadWitness, grasp: Grasp):
     G = grasp_matrix(grasp)
     scale = np.linalg.norm(G, 2)
-    ys = [np.asarray(cert.separating_twist, dtype=float)]
-    ws = [np.asarray(cert.direction, dtype=float)]
+    ys = [cert.separating_twist]
+    ws = [cert.direction]
     if cert.two_sided:
-        ys += list(np.asarray(cert.separating_basis, dtype=float).T)
-        ws += list(np.asarray(cert.null_basis, dtype=float).T)
+        ys += list(cert.separating_basis.T)
+        ws += list(cert.null_basis.T)
     violation, slack = 0.0, np.inf
-    for y, w in zip(ys, ws, strict=True):
+    for y, w in zip(map(_unit_scaled, ys), map(_unit_scaled, ws), strict=True):
         size = np.linalg.norm(y)
         if not (size > 0.0 and np.linalg.norm(w) > 0.0):
             return np.inf, 0.0, "the wrench or its hyperplane normal is zero"
@@ -322,8 +345,8 @@ def _relative_residual(A: np.ndarray, f: np.ndarray) -> float:
     return float(np.linalg.norm(A @ f) / scale) if scale > 0 else 0.0
 
 
-def _check_uncontrollable(cert: Witness, grasp: Grasp, J: np.ndarray):
-    f = cert.stacked_forces()
+def _check_uncontrollable(cert: ReadWitness, grasp: Grasp, J: np.ndarray):
+    f = _unit_scaled(cert.stacked_forces())
     G = grasp_matrix(grasp)
     f_n = f[grasp.normal_indices()]
     total = float(np.sum(np.abs(f_n)))
@@ -338,17 +361,17 @@ def _check_uncontrollable(cert: Witness, grasp: Grasp, J: np.ndarray):
     )
 
 
-def _cone_slack(grasp: Grasp, cert: Witness) -> np.ndarray:
-    """Per contact, how far its force lies inside its cone (N)."""
+def _cone_slack(
+    grasp: Grasp, cert: ReadWitness, forces: list[np.ndarray]
+) -> np.ndarray:
+    """Per contact, how far its force (one of ``forces``) lies inside its cone."""
     if cert.cones == "normals":
-        return np.array([f[0] for f in cert.contact_forces])
+        return np.array([f[0] for f in forces])
     layout = ConeLayout.of(grasp, cert.num_generators)
     b = grasp.characteristic_length
     out = []
-    for f, cone, c in zip(
-        cert.contact_forces, layout.cones, grasp.contacts, strict=True
-    ):
-        x = np.asarray(f)[list(cone.components)]
+    for f, cone, c in zip(forces, layout.cones, grasp.contacts, strict=True):
+        x = f[list(cone.components)]
         if cert.cones == "exact" and cone.components in ((0, 1, 2), (0, 1, 2, 3)):
             used = np.linalg.norm(x[1:3]) / c.mu
             if c.model is ContactModel.SOFT_FINGER and len(x) == 4:
@@ -359,19 +382,23 @@ def _cone_slack(grasp: Grasp, cert: Witness) -> np.ndarray:
     return np.array(out)
 
 
-def _check_balance(cert: Witness, grasp: Grasp):
-    f = cert.stacked_forces()
+def _check_balance(cert: ReadWitness, grasp: Grasp):
+    stacked = cert.stacked_forces()
+    scale = float(np.max(np.abs(stacked)))
+    if not scale > 0.0:
+        return np.inf, 0.0, "the internal force is zero"
+    forces = [f / scale for f in cert.contact_forces]
+    stacked = stacked / scale
     if cert.cones == "normals":
         cols = grasp.normal_indices()
-        f = f[cols]
     else:
         cols = ConeLayout.of(grasp, cert.num_generators).columns
-        f = f[cols]
+    f = stacked[cols]
     G = grasp_matrix(grasp)[:, cols]
-    total = float(np.sum(np.concatenate(cert.contact_forces)[grasp.normal_indices()]))
+    total = float(np.sum(stacked[grasp.normal_indices()]))
     if not total > 0.0:
         return np.inf, 0.0, "the internal force is zero"
-    inside = _cone_slack(grasp, cert).min() / total
+    inside = _cone_slack(grasp, cert, forces).min() / total
     A = normalised_grasp_matrix(grasp)[:, cols]
     norms = np.linalg.norm(A, axis=0)
     s = np.linalg.svd(A / np.where(norms > 0, norms, 1.0), compute_uv=False)

@@ -38,6 +38,7 @@ from pydrake.solvers import (
 )
 
 from drakegrasp._solvers import solve
+from drakegrasp.certificates.kinds import BALANCE, ESCAPE_TWIST
 from drakegrasp.closure.constraints import (
     add_linear_constraint,
     add_linear_equality_constraint,
@@ -50,8 +51,13 @@ from drakegrasp.core.grasp import Grasp, normal_grasp_matrix
 from drakegrasp.core.linalg import left_null_space
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, near_threshold, relative_margin
-from drakegrasp.core.validation import check_grasp, check_rank_tol
-from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
+from drakegrasp.core.validation import check_grasp, check_rank_tol, real_scalar
+from drakegrasp.errors import (
+    GraspError,
+    InvalidGraspError,
+    InvalidOptionError,
+    SolverError,
+)
 
 __all__ = [
     "DEFAULT_SECOND_ORDER_TOL",
@@ -328,10 +334,52 @@ class SecondOrderResult:
 
 
 def _check_tol(tol: float) -> float:
-    t = float(tol)
+    t = real_scalar("tol", tol)
     if not math.isfinite(t) or t <= 0:
         raise InvalidOptionError(f"tol must be finite and > 0, got {tol!r}")
     return t
+
+
+def _check_first_order(first_order, grasp: Grasp) -> None:
+    """Refuse a ``first_order`` that is not :func:`form_closure` of ``grasp``.
+
+    Its verdict decides the answer outright ("yes" at first order), so it is
+    checked, not trusted: it must be a form-closure result over ``grasp``'s
+    contacts whose certificate (balancing normal forces for a "yes", an escape
+    twist for a "no") holds on ``grasp``.
+    """
+    what = (
+        "first_order must be the ClosureResult of drakegrasp.form_closure on this "
+        "grasp, or None"
+    )
+    if not isinstance(first_order, ClosureResult):
+        raise InvalidOptionError(f"{what}; got a {type(first_order).__name__}")
+    if first_order.kind != "form closure":
+        raise InvalidOptionError(
+            f"{what}; got a {first_order.kind!r} result (friction does not count "
+            "in form closure)"
+        )
+    forces = first_order.contact_forces
+    if forces is None or len(forces) != grasp.num_contacts:
+        count = "no" if forces is None else len(forces)
+        raise InvalidOptionError(
+            f"{what}; it has {count} contact forces, the grasp "
+            f"{grasp.num_contacts} contacts"
+        )
+    cert = first_order.certificate
+    want = BALANCE if first_order.is_closure else ESCAPE_TWIST
+    held = False
+    if cert is not None and cert.kind == want and cert.cones == "normals":
+        try:
+            held = cert.check(grasp).holds
+        except GraspError:  # shapes of another grasp
+            held = False
+    if not held:
+        verdict = "form closure" if first_order.is_closure else "no form closure"
+        raise InvalidOptionError(
+            f"{what}: its certificate of {verdict} does not hold on this grasp, so "
+            "it was computed for another grasp (or edited)"
+        )
 
 
 def second_order_form_closure(
@@ -370,11 +418,8 @@ def second_order_form_closure(
     check_grasp(grasp)
     tol = _check_tol(tol)
     rank_tol = check_rank_tol(rank_tol)
-    if first_order is not None and not isinstance(first_order, ClosureResult):
-        raise InvalidOptionError(
-            "first_order must be the ClosureResult of drakegrasp.form_closure on "
-            f"this grasp, or None; got a {type(first_order).__name__}"
-        )
+    if first_order is not None:
+        _check_first_order(first_order, grasp)
     H = contact_hessians(grasp, curvatures)  # validates before any solve
     N = grasp.num_contacts
     if first_order is None:

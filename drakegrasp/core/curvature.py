@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.validation import real_array, real_scalar, unit_vectors
 from drakegrasp.errors import InvalidContactError
 
 __all__ = [
@@ -46,6 +47,20 @@ __all__ = [
 
 DIRECTION_TOL = 1e-6
 """A principal direction may leave the tangent plane by at most this (cosine)."""
+
+CURVATURE_BOUND = 1e100
+"""Largest finite principal curvature (1/m).  Beyond it use ``+inf`` (a sharp
+feature): the relative-curvature form squares curvatures, and ``1e308`` overflowed
+it into ``inf`` and LAPACK errors.  The grasp-relative bound is
+:data:`RELATIVE_CURVATURE_BOUND`."""
+
+RELATIVE_CURVATURE_BOUND = 1e12
+"""Largest finite ``|κ| b`` (curvature times the grasp's characteristic length).
+
+A curvature this sharp relative to the grasp is a sharp feature to double
+precision (its radius is ``1e-12`` of the grasp's size); the second-order form
+would mix ``κ`` with terms of order 1 and lose every digit of the latter.
+Describe such a feature by ``+inf``."""
 
 ISOLATION_TOL = 1e-9
 """Relative curvature ``κ_o + κ_f`` (times ``b``) at or below this is not a point
@@ -92,25 +107,34 @@ class SurfaceCurvature:
     direction: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
-        k = tuple(float(x) for x in np.atleast_1d(self.curvatures))
-        if len(k) not in (1, 2):
+        values = real_array("principal curvatures", self.curvatures)
+        k = tuple(float(x) for x in values.reshape(-1))
+        if values.ndim > 1 or len(k) not in (1, 2):
             raise InvalidContactError(
                 f"a surface has 1 (planar) or 2 (spatial) principal curvatures, "
-                f"got {list(k)}"
+                f"got {values.tolist()}"
             )
         for x in k:
-            if math.isnan(x) or x == -math.inf:
+            if (
+                math.isnan(x)
+                or x == -math.inf
+                or (math.isfinite(x) and abs(x) > CURVATURE_BOUND)
+            ):
                 raise InvalidContactError(
-                    f"principal curvature {x} is not valid: use a finite value "
-                    "(positive convex, negative concave) or +inf across a sharp edge"
+                    f"principal curvature {x!r} is not valid: use a finite value "
+                    f"with |κ| <= {CURVATURE_BOUND:g} 1/m (positive convex, "
+                    "negative concave) or +inf across a sharp edge"
                 )
         d = self.direction
         if d is not None:
-            d = tuple(float(x) for x in np.asarray(d, dtype=float).reshape(-1))
-            if len(d) != 3 or not all(map(math.isfinite, d)):
+            raw = real_array("a principal direction", d)
+            if raw.shape != (3,):
                 raise InvalidContactError(
-                    f"a principal direction is a finite 3-vector, got {list(d)}"
+                    f"a principal direction is a finite 3-vector, got shape "
+                    f"{raw.shape}: {raw.reshape(-1).tolist()[:6]}"
                 )
+            # normalised without overflow or underflow; zero and NaN refused
+            d = tuple(float(x) for x in unit_vectors("a principal direction", raw))
         if len(k) == 2 and d is None and k[0] != k[1]:
             raise InvalidContactError(
                 f"principal curvatures {list(k)} differ, so the direction of the "
@@ -227,9 +251,12 @@ class SurfaceCurvature:
 
 
 def _radius(radius: float) -> float:
-    r = float(radius)
-    if not math.isfinite(r) or r <= 0:
-        raise InvalidContactError(f"a radius must be finite and > 0, got {radius!r}")
+    r = real_scalar("a radius", radius, error=InvalidContactError)
+    if not math.isfinite(r) or not r >= 1.0 / CURVATURE_BOUND:
+        raise InvalidContactError(
+            f"a radius must be finite and >= {1.0 / CURVATURE_BOUND:g} m "
+            f"(1 / CURVATURE_BOUND), got {radius!r}"
+        )
     return r
 
 
@@ -247,6 +274,22 @@ class ContactCurvature:
 
     object: SurfaceCurvature
     finger: SurfaceCurvature
+
+    def __post_init__(self) -> None:
+        for name in ("object", "finger"):
+            value = getattr(self, name)
+            if not isinstance(value, SurfaceCurvature):
+                raise InvalidContactError(
+                    f"ContactCurvature's {name} must be a SurfaceCurvature (build "
+                    "one with SurfaceCurvature.flat/point/convex/concave/edge), got "
+                    f"{type(value).__name__}"
+                )
+        if self.object.planar != self.finger.planar:
+            raise InvalidContactError(
+                "ContactCurvature's object and finger must both be planar (one "
+                "curvature) or both spatial (two): got "
+                f"{len(self.object.curvatures)} and {len(self.finger.curvatures)}"
+            )
 
     @classmethod
     def point_finger(cls, object: SurfaceCurvature) -> ContactCurvature:
@@ -362,6 +405,20 @@ def contact_hessian(
             f"{'one curvature' if planar else 'two principal curvatures'} per "
             "surface"
         )
+    b = grasp.characteristic_length
+    for surface, which in (
+        (contact_curvature.object, "object"),
+        (contact_curvature.finger, "finger"),
+    ):
+        finite = [abs(k) for k in surface.curvatures if math.isfinite(k)]
+        if finite and max(finite) * b > RELATIVE_CURVATURE_BOUND:
+            raise InvalidContactError(
+                f"contact {index}: the {which}'s curvature {max(finite):g} 1/m times "
+                f"the grasp's length b = {b:g} m is beyond "
+                f"{RELATIVE_CURVATURE_BOUND:g} (RELATIVE_CURVATURE_BOUND): a "
+                "feature that sharp is an edge or a point; give its curvature as "
+                "+inf"
+            )
     tangents = contact.frame[:, 1:]
     M = _relative_quadratic(contact_curvature, n, tangents, grasp.characteristic_length)
     if planar:

@@ -213,7 +213,9 @@ class Grasp:
         """``T G`` with moments about the centroid over the spread; read-only."""
         positions = self.positions
         centroid = positions.mean(axis=0)
-        spread = float(np.max(np.linalg.norm(positions - centroid, axis=1)))
+        # safe_norm: squares of coordinates below 1e-154 m underflow, and a
+        # spread of 0 dropped every moment row (the rank collapsed at 1e-163 m)
+        spread = float(np.max(safe_norm(positions - centroid, axis=1)))
         if not (np.isfinite(spread) and spread > 0.0):
             spread = 1.0  # every contact at one point: all moments vanish anyway
         G = np.hstack([_contact_block(c, centroid) for c in self.contacts])

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
-from drakegrasp.core.validation import check_rank_tol, real_array
+from drakegrasp.core.validation import check_rank_tol, real_array, safe_norm
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -78,7 +78,9 @@ def equilibrated(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     scale : (n,) float
         ``1 / ‖A_j‖`` per column (1 for a zero column).
     """
-    norms = np.linalg.norm(A, axis=0)
+    # safe_norm: a soft finger's torsion column of a grasp 1e-168 m across holds
+    # 1/spread ~ 1e168, whose square overflowed the plain norm to inf (scale 0)
+    norms = safe_norm(A, axis=0) if A.size else np.zeros(A.shape[1])
     scale = np.ones_like(norms)
     np.divide(1.0, norms, out=scale, where=norms > 0.0)
     return A * scale, scale

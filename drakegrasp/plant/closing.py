@@ -323,6 +323,12 @@ def close_hand(
             + "; ".join(map(str, found))
             + " (open the hand or move the object before closing)"
         )
+    if min_fingers > len(hand_.fingers):  # unreachable before any search
+        raise UnreachableError(
+            f"min_fingers = {min_fingers} exceeds the hand's {len(hand_.fingers)} "
+            f"fingers ({', '.join(f.name for f in hand_.fingers)}); at most "
+            f"{len(hand_.fingers)} can touch"
+        )
     q_all = plant.GetPositions(plant_context)
     q0 = q_all[hand_.position_indices].copy()
     _check_coupled(hand_, q0)

@@ -28,7 +28,8 @@ from pydrake.geometry import ContactSurface, GeometryId, QueryObject
 from pydrake.multibody.plant import ContactResults, MultibodyPlant
 from pydrake.systems.framework import Context
 
-from drakegrasp.errors import InvalidOptionError, NoContactsError
+from drakegrasp.core.validation import real_array, unit_vectors
+from drakegrasp.errors import InvalidContactError, InvalidOptionError, NoContactsError
 from drakegrasp.plant._shapes import plane_basis
 from drakegrasp.plant.contact_normals import clean_unit as _clean_unit
 from drakegrasp.plant.contacts import (
@@ -53,7 +54,7 @@ def patch_polygon(points: np.ndarray, normal: np.ndarray) -> np.ndarray:
     points : (K, 3) float
         Points (metres, any frame).
     normal : (3,) float
-        Unit normal of the plane, same frame.
+        Normal of the plane, same frame (normalised here).
 
     Returns
     -------
@@ -61,8 +62,24 @@ def patch_polygon(points: np.ndarray, normal: np.ndarray) -> np.ndarray:
         Vertices of the convex hull of the projected points, counter-clockwise
         about ``normal``, on the plane through the points' mean.  Fewer than
         three vertices when the points are (nearly) collinear.
+
+    Raises
+    ------
+    InvalidContactError
+        Non-finite points, or a zero or non-finite normal (a zero-area contact
+        surface has a NaN normal).
     """
-    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    points = real_array("patch points", points, error=InvalidContactError)
+    if points.size == 0 or points.size % 3 or not np.all(np.isfinite(points)):
+        raise InvalidContactError(
+            f"patch points must be a non-empty finite (K, 3) array, got shape "
+            f"{points.shape}" + ("" if np.all(np.isfinite(points)) else " with NaN/inf")
+        )
+    points = points.reshape(-1, 3)
+    # A zero-area hydroelastic surface reports a NaN normal: its plane is undefined.
+    normal = unit_vectors("patch normal", normal, error=InvalidContactError)
+    if normal.shape != (3,):
+        raise InvalidContactError(f"patch normal must be a 3-vector, got {normal}")
     origin = points.mean(axis=0)
     u, w = plane_basis(normal)
     uv = np.column_stack([(points - origin) @ u, (points - origin) @ w])

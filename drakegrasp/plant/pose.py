@@ -19,11 +19,17 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JointIndex, RigidBody
 from pydrake.systems.framework import Context
 
-from drakegrasp.errors import JointLimitError, ModelError, PenetrationError
+from drakegrasp.errors import (
+    InvalidPoseError,
+    JointLimitError,
+    ModelError,
+    PenetrationError,
+)
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
@@ -141,6 +147,39 @@ class PoseCheck:
         }
 
 
+RESOLUTION_MARGIN = 1e3
+"""Position round-off must be this many times finer than the distance tolerance."""
+
+
+def _check_resolvable(plant, plant_context, bodies, tol: float) -> None:
+    """Refuse bodies so far from the origin that ``tol`` is below round-off.
+
+    Drake computes signed distances in the world frame: at ``|p_WB| = 1e300`` m
+    one unit in the last place is ``1e284`` m, its distances overflow, and two
+    bodies 1e300 m apart were reported "penetrating by 6 mm".  A pose check
+    with tolerance ``tol`` needs ``|p_WB| ε RESOLUTION_MARGIN <= tol`` for every
+    body (``ε`` the double precision's 2.2e-16): 4.5e8 m at the default 1e-4 m.
+    """
+    eps = float(np.finfo(float).eps)
+    for body in bodies:
+        p = np.asarray(plant.EvalBodyPoseInWorld(plant_context, body).translation())
+        size = float(np.max(np.abs(p)))
+        if not np.isfinite(size):
+            raise InvalidPoseError(
+                f"body {scoped_name(plant, body)!r} is at {p.tolist()} in the world: "
+                "not finite (set the plant's positions to finite values)"
+            )
+        if size * eps * RESOLUTION_MARGIN > tol:
+            raise InvalidPoseError(
+                f"body {scoped_name(plant, body)!r} is {size:.3g} m from the world "
+                f"origin, where double precision resolves positions only to "
+                f"{size * eps:.2g} m: too coarse to tell contact from penetration "
+                f"at distance_tolerance = {tol:g} m (valid: |p_WB| <= "
+                f"{tol / (eps * RESOLUTION_MARGIN):.3g} m); move the scene near the "
+                "origin"
+            )
+
+
 def find_penetrations(
     plant: MultibodyPlant,
     plant_context: Context,
@@ -156,6 +195,7 @@ def find_penetrations(
     if query is None:
         query = plant.get_geometry_query_input_port().Eval(plant_context)
     inspector = query.inspector()
+    _check_resolvable(plant, plant_context, [object_body, *bodies], tol)
     object_geometries = plant.GetCollisionGeometriesForBody(object_body)
     out = []
     for body in bodies:

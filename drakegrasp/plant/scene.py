@@ -72,7 +72,10 @@ Safety
 ------
 A scene file is read with a safe YAML loader, at most 1 MiB, without YAML
 anchors or aliases (which can expand without bound) and at most 64 levels
-deep; every key and value of ``drakegrasp:`` is type-checked.  Every problem is
+deep, with no key given twice and numbers read as YAML 1.2 (as Drake reads
+them); every key and value of ``drakegrasp:`` is type-checked.  References are
+checked on Drake's own reading of the directives, include loops are refused
+before Drake would follow them, and the include limit counts loads.  Every problem is
 a :class:`~drakegrasp.errors.SceneError` (a :class:`~drakegrasp.ModelError`)
 naming the file, the key and what is valid (:mod:`drakegrasp.plant.scene_file`).
 
@@ -122,11 +125,12 @@ from pydrake.multibody.tree import ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.couplings import record_model_couplings
 from drakegrasp.plant.models import models_dir
 from drakegrasp.plant.options import AnalysisOptions
-from drakegrasp.plant.scene_file import check_section, read_yaml
+from drakegrasp.plant.scene_file import check_section, directives_text, read_yaml
 from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
 from drakegrasp.plant.validation import resolve_body
 
@@ -308,39 +312,6 @@ def _resolve_hand(plant: MultibodyPlant, hand) -> ModelInstanceIndex | tuple | N
     return tuple(resolve_body(plant, h) for h in hand)
 
 
-def _without_drakegrasp_section(text: str) -> str:
-    """The scene text without its top-level ``drakegrasp:`` block.
-
-    Drake's directive loader rejects unknown keys (so typos in the directives
-    are caught); the block-style ``drakegrasp:`` mapping is cut out first: from
-    its line to the next line that starts in column 0 with a key.
-    """
-    out, skipping = [], False
-    for line in text.splitlines(keepends=True):
-        starts_key = bool(line) and not line[0].isspace() and not line.startswith("#")
-        if starts_key:
-            skipping = line.startswith("drakegrasp:")
-        if not skipping:
-            out.append(line)
-    return "".join(out)
-
-
-def _anchor_relative_files(directives, path: Path) -> None:
-    """Turn ``file:`` paths without a URL scheme into ``file://`` URLs.
-
-    A relative path is relative to the scene file's directory (Drake, reading
-    the directives from a string, would refuse it).
-    """
-    for directive in directives.directives:
-        for kind in (directive.add_model, directive.add_directives):
-            if kind is None or "://" in kind.file:
-                continue
-            local = Path(kind.file)
-            if not local.is_absolute():
-                local = path.resolve().parent / local
-            kind.file = f"file://{local}"
-
-
 def load_scene(
     path_or_name: str | Path | None = None,
     *,
@@ -384,14 +355,23 @@ def load_scene(
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     parser = Parser(plant)
     packages = add_packages(parser, package_map, ros_package_path=ros_package_path)
-    if not allow_any_file:
-        check_references(path, data, packages, read_yaml=read_yaml)
     try:
-        directives = LoadModelDirectivesFromString(_without_drakegrasp_section(text))
+        directives = LoadModelDirectivesFromString(directives_text(path, text))
+    except SceneError:
+        raise
     except Exception as e:  # Drake raises RuntimeError/ValueError on bad schema
         msg = " ".join(str(e).split())
         raise SceneError(f"scene {str(path)!r}: bad model directives: {msg}") from None
-    _anchor_relative_files(directives, path)
+    # What Drake will load, from Drake's reading (and includes followed first:
+    # a loop would crash Drake), with the reference policy unless trusted.
+    check_references(
+        path,
+        data,
+        directives,
+        packages,
+        read_yaml=read_yaml,
+        allow_any_file=check_flag("allow_any_file", allow_any_file),
+    )
     try:
         added = ProcessModelDirectives(directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError

@@ -7,9 +7,15 @@ must answer or refuse quickly and within memory proportional to the file:
 - YAML **anchors and aliases** (``&a`` / ``*a``) are refused: eight nested
   aliases in 1.3 KB expand to gigabytes ("billion laughs"), and no scene needs
   them; so is nesting deeper than :data:`MAX_DEPTH`;
+- a key given twice in one mapping is refused (PyYAML keeps the last, other
+  readers the first: the two readings of the file would differ);
+- plain scalars are read with the YAML 1.2 core schema, as Drake reads them:
+  ``5e-1`` and ``1e-3`` are numbers, ``yes``/``on`` and ``2001-12-14`` strings,
+  ``017`` is seventeen, and ``<<`` merges nothing;
 - Drake's tags (``!Rpy``...) are read as plain data;
 - the ``drakegrasp:`` section is checked key by key, with the type each value
-  must have.
+  must have; its strings are printable text (no terminal escapes or other
+  control characters).
 
 Every refusal is a :class:`~drakegrasp.errors.SceneError` that names the file,
 the key and what would be valid.
@@ -18,6 +24,8 @@ the key and what would be valid.
 from __future__ import annotations
 
 import math
+import re
+import unicodedata
 from pathlib import Path
 
 import yaml
@@ -26,7 +34,14 @@ from drakegrasp.core.contact import ContactModel
 from drakegrasp.errors import GraspError, SceneError
 from drakegrasp.plant.jacobians import PLANES
 
-__all__ = ["KEYS", "MAX_DEPTH", "MAX_SCENE_BYTES", "check_section", "read_yaml"]
+__all__ = [
+    "KEYS",
+    "MAX_DEPTH",
+    "MAX_SCENE_BYTES",
+    "check_section",
+    "directives_text",
+    "read_yaml",
+]
 
 MAX_SCENE_BYTES = 1 << 20
 """Largest scene file read (1 MiB; the shipped scenes are under 2 KB)."""
@@ -48,7 +63,11 @@ KEYS = {
 
 
 class _SceneLoader(yaml.SafeLoader):
-    """Safe loader: Drake's tags as plain data; no anchors, no aliases."""
+    """Safe loader for scene files (see the module docstring).
+
+    Drake's tags as plain data; no anchors, no aliases, no key given twice;
+    plain scalars resolved by the YAML 1.2 core schema.
+    """
 
     def compose_node(self, parent, index):
         event = self.peek_event()
@@ -71,6 +90,52 @@ class _SceneLoader(yaml.SafeLoader):
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen = {}
+            for key_node, _ in node.value:
+                key = key_node.value
+                if isinstance(key_node, yaml.ScalarNode) and key in seen:
+                    raise SceneError(
+                        f"key {key_node.value!r} given twice in one mapping (lines "
+                        f"{seen[key] + 1} and {key_node.start_mark.line + 1}); "
+                        "each key may appear once"
+                    )
+                seen[key] = key_node.start_mark.line
+        return super().construct_mapping(node, deep=deep)
+
+    def construct_yaml_int(self, node):
+        text = self.construct_scalar(node)
+        sign, digits = (-1, text[1:]) if text[:1] == "-" else (1, text.lstrip("+"))
+        if digits[:2] in ("0o", "0x"):
+            return sign * int(digits[2:], 8 if digits[1] == "o" else 16)
+        return sign * int(digits, 10)
+
+
+# YAML 1.2 core schema (https://yaml.org/spec/1.2.2/#1032-tag-resolution), the
+# schema of Drake's reader: PyYAML's 1.1 table reads 5e-1 as a string, yes/on as
+# booleans, 017 as octal, 1_000 and 1:30 as numbers, dates as timestamps and <<
+# as a merge.
+_SceneLoader.yaml_implicit_resolvers = {}
+for _tag, _pattern, _first in (
+    ("null", r"^(?:~|null|Null|NULL|)$", "~nN"),
+    ("bool", r"^(?:true|True|TRUE|false|False|FALSE)$", "tTfF"),
+    ("int", r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$", "-+0123456789"),
+    (
+        "float",
+        r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$",
+        "-+0123456789.",
+    ),
+):
+    _SceneLoader.add_implicit_resolver(
+        f"tag:yaml.org,2002:{_tag}", re.compile(_pattern), list(_first)
+    )
+_SceneLoader.yaml_implicit_resolvers.setdefault("", []).insert(
+    0, ("tag:yaml.org,2002:null", re.compile(r"^$"))
+)
+_SceneLoader.add_constructor("tag:yaml.org,2002:int", _SceneLoader.construct_yaml_int)
 
 
 def _construct_tagged(loader, suffix, node):
@@ -134,6 +199,13 @@ def _string(path: Path, key: str, value) -> str:
             f"scene {str(path)!r}: drakegrasp.{key} must be {KEYS[key]}, got "
             f"{value!r} ({type(value).__name__})"
         )
+    bad = next((c for c in value if unicodedata.category(c) in ("Cc", "Cf")), None)
+    if bad is not None:
+        raise SceneError(
+            f"scene {str(path)!r}: drakegrasp.{key} holds the control character "
+            f"U+{ord(bad):04X} in {value!r}; it must be one line of printable "
+            "text (terminal escapes and bidirectional controls are refused)"
+        )
     return value
 
 
@@ -143,7 +215,10 @@ def _number(path: Path, key: str, value, *, positive: bool = False) -> float:
             f"scene {str(path)!r}: drakegrasp.{key} must be a number, got "
             f"{value!r} ({type(value).__name__}); valid: {KEYS[key]}"
         )
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:
+        x = math.inf
     if not (x >= 0.0) or (positive and x == 0.0) or x == math.inf:
         bound = "> 0" if positive else ">= 0"
         raise SceneError(
@@ -226,3 +301,40 @@ def check_section(path: Path, data: dict) -> dict:
             positive=True,
         ),
     }
+
+
+def directives_text(path: Path, text: str) -> str:
+    """The scene text without its top-level ``drakegrasp:`` entry, for Drake.
+
+    Drake's directive loader rejects unknown keys (so typos in the directives are
+    caught), so the ``drakegrasp:`` entry is cut out first: the characters from
+    its key to the end of its value, as this module's reading of the file places
+    them.  Cutting where the YAML parser says (rather than by lines) leaves no
+    way to hide text from one reader: a quoted multi-line value that looks like a
+    ``directives:`` key is cut with its entry.
+
+    Raises
+    ------
+    SceneError
+        When the file does not parse (:func:`read_yaml` says why).
+    """
+    loader = _SceneLoader(text)
+    try:
+        root = loader.get_single_node()
+    except (yaml.YAMLError, SceneError) as e:
+        raise SceneError(f"scene file {str(path)!r}: {e}") from None
+    finally:
+        loader.dispose()
+    if not isinstance(root, yaml.MappingNode):
+        return text
+    cuts = [
+        (key.start_mark.index, value.end_mark.index)
+        for key, value in root.value
+        if isinstance(key, yaml.ScalarNode) and key.value == "drakegrasp"
+    ]
+    out, start = [], 0
+    for begin, end in sorted(cuts):
+        out.append(text[start:begin])
+        start = end
+    out.append(text[start:])
+    return "".join(out)

@@ -15,13 +15,20 @@ parser that loads it knows, in this order of precedence:
 
 **References.**  Every ``file:`` of the scene's ``add_model`` and
 ``add_directives`` entries (and of the directive files those include, up to
-:data:`MAX_INCLUDED_FILES`) must be
+:data:`MAX_INCLUDED_FILES` loads), *as Drake reads them*, must be
 
 - ``package://NAME/PATH`` with NAME a known package and PATH staying inside it
   (no ``..`` that climbs out: ``package://drakegrasp/../../etc/x.sdf`` is
   refused), or
-- ``file:///ABS/PATH`` or a relative path inside the scene file's own directory
-  (after resolving symbolic links).
+- ``file:///ABS/PATH`` or a relative path (in the scene file itself; Drake
+  refuses them in included files) inside the scene file's own directory (after
+  resolving symbolic links, and with the host of ``file://HOST/ABS`` dropped, as
+  Drake drops it).
+
+The scene's YAML is read twice, by the safe reader
+(:mod:`drakegrasp.plant.scene_file`) and by Drake; a file the two read apart (a
+tag on a directive, a key given twice) is refused, and the check runs on Drake's
+reading, which is what gets loaded.
 
 Anything else (other schemes, other directories) is a
 :class:`~drakegrasp.errors.SceneError` unless the caller passes
@@ -37,7 +44,7 @@ import posixpath
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
-from pydrake.multibody.parsing import PackageMap, Parser
+from pydrake.multibody.parsing import LoadModelDirectives, PackageMap, Parser
 
 from drakegrasp.errors import SceneError
 from drakegrasp.plant.models import register_models, use_local_drake_models
@@ -46,6 +53,7 @@ __all__ = [
     "MAX_INCLUDED_FILES",
     "PackagesSpec",
     "add_packages",
+    "anchor_relative_files",
     "check_references",
 ]
 
@@ -139,26 +147,85 @@ def _add_package_xml(package_map: PackageMap, folder) -> None:
         raise SceneError(f"cannot add the package of {str(xml)!r}: {e}") from None
 
 
-def _files(data: dict) -> list[tuple[str, str]]:
-    """(directive kind, file URL) of every add_model / add_directives entry."""
-    directives = data.get("directives", [])
-    if not isinstance(directives, list):
-        raise SceneError(
-            f"'directives' must be a list, got {type(directives).__name__}"
-        )
+def _entries(directives) -> list[tuple[str, str]]:
+    """(directive kind, file URL) of every add_model / add_directives (Drake's)."""
     out = []
-    for entry in directives:
-        if not isinstance(entry, dict):
-            continue  # Drake's own schema check reports it
+    for directive in directives.directives:
         for kind in ("add_model", "add_directives"):
-            body = entry.get(kind)
-            if isinstance(body, dict) and "file" in body:
-                if not isinstance(body["file"], str):
-                    raise SceneError(
-                        f"{kind}.file must be a string URL, got {body['file']!r}"
-                    )
-                out.append((kind, body["file"]))
+            body = getattr(directive, kind)
+            if body is not None:
+                out.append((kind, body.file))
     return out
+
+
+def _kinds(directive) -> list[str]:
+    return [k for k in _DIRECTIVE_KINDS if getattr(directive, k) is not None]
+
+
+_DIRECTIVE_KINDS = (
+    "add_model",
+    "add_model_instance",
+    "add_frame",
+    "add_weld",
+    "add_collision_filter_group",
+    "add_directives",
+)
+
+
+def _check_agreement(data: dict, directives) -> None:
+    """Refuse a file that this module's YAML reading and Drake's read apart.
+
+    Both must see the same list of directives, each of the same kind, and the
+    same ``file`` in every ``add_model`` and ``add_directives``.  (A YAML tag on
+    a directive, ``add_model: !!set {...}``, is a set to one reader and a
+    mapping to the other.)
+    """
+    listed = data.get("directives", [])
+    if not isinstance(listed, list):
+        raise SceneError(f"'directives' must be a list, got {type(listed).__name__}")
+    if len(listed) != len(directives.directives):
+        raise SceneError(
+            f"Drake reads {len(directives.directives)} directives where the YAML "
+            f"has {len(listed)}; the file is ambiguous"
+        )
+    for i, (entry, directive) in enumerate(
+        zip(listed, directives.directives, strict=True)
+    ):
+        kinds = _kinds(directive)
+        if not isinstance(entry, dict) or sorted(entry) != sorted(kinds):
+            got = sorted(map(str, entry)) if isinstance(entry, dict) else entry
+            raise SceneError(
+                f"directive {i} reads as {got!r} in YAML but as {kinds} to Drake "
+                "(a YAML tag or an unusual form); write it as a plain mapping"
+            )
+        for kind in ("add_model", "add_directives"):
+            if kind not in kinds:
+                continue
+            body, url = entry[kind], getattr(directive, kind).file
+            if type(body) is not dict or body.get("file") != url:
+                shown = body.get("file") if type(body) is dict else body
+                raise SceneError(
+                    f"directive {i}: {kind}.file reads as {shown!r} in YAML but as "
+                    f"{url!r} to Drake (a YAML tag or an unusual form); write it "
+                    "as a plain string in a plain mapping"
+                )
+
+
+def anchor_relative_files(directives, path: Path) -> None:
+    """Turn the scene's ``file:`` paths without a URL scheme into ``file://`` URLs.
+
+    A relative path is relative to the scene file's directory (Drake, reading
+    the directives from a string, would refuse it).  ``directives`` is changed
+    in place.
+    """
+    for directive in directives.directives:
+        for kind in (directive.add_model, directive.add_directives):
+            if kind is None or "://" in kind.file:
+                continue
+            local = Path(kind.file)
+            if not local.is_absolute():
+                local = path.resolve().parent / local
+            kind.file = f"file://{local}"
 
 
 def _within(path: str, root: Path) -> bool:
@@ -169,7 +236,12 @@ def _within(path: str, root: Path) -> bool:
 def _check_url(
     url: str, *, scene_dir: Path, package_map: PackageMap
 ) -> tuple[str, str | None]:
-    """Refuse a URL the policy forbids; return (why-ok, local path or None)."""
+    """Refuse a URL the policy forbids; return (why-ok, local path or None).
+
+    ``url`` is Drake's reading of a ``file:``; a ``file://`` URL is resolved by
+    Drake's own :meth:`PackageMap.ResolveUrl` (which drops a host:
+    ``file://localhost/ABS`` is ``/ABS``), so the check reads what Drake loads.
+    """
     if url.startswith("package://"):
         name, _, rel = url[len("package://") :].partition("/")
         if not package_map.Contains(name):
@@ -193,69 +265,125 @@ def _check_url(
                 "trusts the scene)"
             )
         return "package", None
-    if "://" in url and not url.startswith("file://"):
+    if not url.startswith("file://"):
         raise SceneError(
             f"{url!r}: only package:// and file:// URLs (or paths relative to the "
-            "scene file) may be referenced"
+            "scene file, in the scene file itself) may be referenced"
         )
-    local = url[len("file://") :] if url.startswith("file://") else url
-    path = local if os.path.isabs(local) else str(scene_dir / local)
-    if not _within(path, scene_dir):
+    # Drake's reading of file://HOST/PATH is /PATH (the host is dropped).
+    rest = url[len("file://") :]
+    path = rest[rest.find("/") :] if "/" in rest else ""
+    try:
+        drake_path = package_map.ResolveUrl(url)
+    except RuntimeError:
+        drake_path = None  # does not exist: Drake will say so when loading
+    if drake_path is not None and os.path.realpath(drake_path) != os.path.realpath(
+        path
+    ):
         raise SceneError(
-            f"{url!r} is outside the scene's directory {str(scene_dir)!r}; a scene "
-            "may only reference files inside its packages and its own directory "
-            "(allow_any_file=True trusts the scene)"
+            f"{url!r} resolves to {drake_path!r} to Drake, not to {path!r}; the "
+            "URL is ambiguous"
+        )
+    if not path or not _within(path, scene_dir):
+        raise SceneError(
+            f"{url!r} is {path!r} to Drake, outside the scene's directory "
+            f"{str(scene_dir)!r}; a scene may only reference files inside its "
+            "packages and its own directory (allow_any_file=True trusts the scene)"
         )
     return "file", path
 
 
+def _resolve(url: str, package_map: PackageMap) -> str:
+    try:
+        return package_map.ResolveUrl(url)
+    except RuntimeError as e:
+        msg = " ".join(str(e).split())
+        raise SceneError(f"cannot resolve {url!r}: {msg}") from None
+
+
 def check_references(
-    path: Path, data: dict, package_map: PackageMap, *, read_yaml
+    path: Path,
+    data: dict,
+    directives,
+    package_map: PackageMap,
+    *,
+    read_yaml,
+    allow_any_file: bool = False,
 ) -> None:
-    """Enforce the reference policy on a scene and the directive files it adds.
+    """Check what Drake will load for a scene, its includes first.
+
+    Drake's reading is what counts: ``directives`` is the scene's
+    ``ModelDirectives`` as Drake parsed them (its relative paths are anchored to
+    the scene's directory here, in place: see :func:`anchor_relative_files`),
+    and every included directive file is read by Drake
+    (``LoadModelDirectives``) as well as by the safe reader, and the two readings
+    must agree.  Whatever ``allow_any_file`` says, includes are followed here
+    before Drake follows them: a loop (a file that includes itself, directly or
+    through others) is refused, where Drake would recurse until the process
+    dies, and so is a scene that loads more than :data:`MAX_INCLUDED_FILES`
+    directive files in all, counting a file each time it is loaded.  Every
+    included file passes the safe reader's limits (size, no aliases, depth).
 
     Parameters
     ----------
     path : pathlib.Path
         The scene file.
     data : dict
-        Its YAML data.
+        Its YAML data (the safe reader's).
+    directives : pydrake.multibody.parsing.ModelDirectives
+        Drake's reading of the scene's directives.
     package_map : PackageMap
         The packages it may name.
     read_yaml : callable
-        ``read_yaml(path) -> (text, data)`` for included directive files.
+        ``read_yaml(path) -> (text, data)``, the safe reader.
+    allow_any_file : bool, optional
+        Trust the scene: skip the reference policy (the loop, count and reader
+        checks still apply).
 
     Raises
     ------
     SceneError
-        Naming the scene, the offending URL and the rule.
+        Naming the file, the offending URL and the rule.
     """
     scene_dir = Path(os.path.realpath(path)).parent
-    pending, seen = [(path, data)], set()
-    while pending:
-        current, current_data = pending.pop()
-        seen.add(os.path.realpath(current))
-        if len(seen) > MAX_INCLUDED_FILES:
-            raise SceneError(
-                f"scene {str(path)!r} includes more than {MAX_INCLUDED_FILES} "
-                "directive files"
-            )
+    loads = [0]
+
+    def visit(current: Path, current_data: dict, parsed, chain: tuple[str, ...]):
         try:
-            entries = _files(current_data)
+            _check_agreement(current_data, parsed)
         except SceneError as e:
             raise SceneError(f"scene {str(current)!r}: {e}") from None
-        for kind, url in entries:
+        if current is path:
+            anchor_relative_files(parsed, path)
+        for kind, url in _entries(parsed):
             try:
-                how, local = _check_url(
-                    url, scene_dir=scene_dir, package_map=package_map
-                )
-                if kind == "add_directives" and local is None and how == "package":
-                    local = package_map.ResolveUrl(url)
+                if not allow_any_file:
+                    _check_url(url, scene_dir=scene_dir, package_map=package_map)
+                if kind != "add_directives":
+                    continue
+                local = os.path.realpath(_resolve(url, package_map))
             except SceneError as e:
                 raise SceneError(f"scene {str(current)!r}: {e}") from None
-            except RuntimeError as e:
+            if local in chain:
+                names = " -> ".join(Path(p).name for p in (*chain, local))
                 raise SceneError(
-                    f"scene {str(current)!r}: cannot resolve {url!r}: {e}"
+                    f"scene {str(path)!r}: directive files include each other in a "
+                    f"loop ({names}); Drake would recurse without end"
+                )
+            loads[0] += 1
+            if loads[0] > MAX_INCLUDED_FILES:
+                raise SceneError(
+                    f"scene {str(path)!r} loads more than {MAX_INCLUDED_FILES} "
+                    "directive files (counting each time a file is included)"
+                )
+            _, included_data = read_yaml(Path(local))
+            try:
+                included = LoadModelDirectives(local)
+            except Exception as e:  # Drake's schema errors: RuntimeError et al.
+                msg = " ".join(str(e).split())
+                raise SceneError(
+                    f"scene {str(current)!r}: bad model directives in {local!r}: {msg}"
                 ) from None
-            if kind == "add_directives" and os.path.realpath(local) not in seen:
-                pending.append((Path(local), read_yaml(Path(local))[1]))
+            visit(Path(local), included_data, included, (*chain, local))
+
+    visit(path, data, directives, (os.path.realpath(path),))

@@ -36,6 +36,7 @@ from typing import Any
 
 import fuzz_oracles as oracle
 import numpy as np
+from sandbox import SandboxTimeout
 
 import drakegrasp as dg
 from drakegrasp.core import examples as ex
@@ -90,7 +91,7 @@ def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:
     outcome, detail = "plausible verdict", ""
     try:
         result = case.call()
-    except _Timeout:
+    except (_Timeout, SandboxTimeout):
         outcome, detail = "hang", f"over {limit:g} s"
     except dg.GraspError as e:
         text = str(e)
