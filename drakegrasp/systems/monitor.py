@@ -72,23 +72,23 @@ were set.
 ``GraspMonitor.CONTACT_GAP``), then per hand body its friction in use and slip
 speed:
 
-=================  ===========================================================
-``status``         1 analysed, 0 no contact, −1 invalid pose (e.g. penetration
-                   deeper than the tolerance, a non-finite state; the report
-                   says why)
-``force_closure``  1 / 0: polyhedral force closure with the hand check LP3
-``form_closure``   1 / 0: first-order form closure (LP1)
-``antipodal``      1 / 0: two contacts that are antipodal (0 for other counts)
-``num_contacts``   number of contacts analysed
-``d_star``         LP2's ``d*``, 0 without contact (see "What d* is")
-``epsilon``        Ferrari–Canny ε (L1), 0 when not in force closure or not
-                   asked for (``compute_epsilon=False``, the default)
-``holding``        code of the holding state (index in ``HOLDING_STATES``)
-``friction_use``   largest ``‖f_t‖/(μ f_n)``; NaN in geometry mode
-``slip_speed``     largest slip speed at a contact, m/s
-``relative_speed`` object's centre of mass relative to a touching finger, m/s
-``contact_gap``    samples without contact bridged by the hysteresis
-=================  ===========================================================
+===================  ===========================================================
+``status``           1 analysed, 0 no contact, −1 invalid pose (e.g. penetration
+                     deeper than the tolerance, a non-finite state; the report
+                     says why)
+``force_closure``    1 / 0: polyhedral force closure with the hand check LP3
+``form_closure``     1 / 0: first-order form closure (LP1)
+``antipodal``        1 / 0: two contacts that are antipodal (0 for other counts)
+``num_contacts``     number of contacts analysed
+``d_star``           LP2's ``d*``, 0 without contact (see "What d* is")
+``epsilon``          Ferrari–Canny ε (L1), 0 when not in force closure or not
+                     asked for (``compute_epsilon=False``, the default)
+``holding``          code of the holding state (index in ``HOLDING_STATES``)
+``friction_use``     largest ``‖f_t‖/(μ f_n)``; NaN in geometry mode
+``slip_speed``       largest slip speed at a contact, m/s
+``relative_speed``   object's centre of mass relative to a touching finger, m/s
+``contact_gap``      samples without contact bridged by the hysteresis
+===================  ===========================================================
 
 ``report`` is an abstract port holding a :class:`GraspSample`: the time, the
 status, the full :class:`~drakegrasp.GraspReport` (None without one), ε, the
