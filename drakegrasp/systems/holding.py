@@ -140,7 +140,7 @@ class FingerLoad:
         Scoped name ``model::body``.
     touching : bool
         The finger presses on the object (a reported pair with normal force
-        above :data:`FORCE_FLOOR`; in geometry mode, a contact that is not
+        above ``FORCE_FLOOR`` (1e-6 N); in geometry mode, a contact that is not
         separating).
     normal_force : float
         Total normal force on the object, N (NaN when the source cannot see

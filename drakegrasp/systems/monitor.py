@@ -396,7 +396,7 @@ class GraspMonitor(LeafSystem):
         return self._results_port
 
     def get_verdicts_output_port(self):
-        """Output: the verdict vector (:data:`VERDICT_NAMES`)."""
+        """Output: the verdict vector (named by :attr:`verdict_names`)."""
         return self.GetOutputPort("verdicts")
 
     def get_report_output_port(self):
