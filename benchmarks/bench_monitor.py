@@ -8,7 +8,8 @@ Runs the pick of ``tests/systems/pick_support.py`` (the shipped parallel-jaw gri
 closes on a 0.2 kg box, lifts it 5 cm, lowers it, opens; 3 s simulated, 1 ms
 SAP steps) in three set-ups: point contact with distances from geometry (soft
 fingers), hydroelastic contact with patches from the contact results (flat
-pads, hard fingers), and the same without the monitor's Ferrari–Canny ε.  For
+pads, hard fingers), and the same with the monitor's Ferrari–Canny ε (off by
+default).  Then the weak pick's slip-detection times.  For
 each it prints the wall time of the whole simulation, of the simulation with a
 monitor that never samples (period 1000 s), the median / 90th percentile / max
 cost of one evaluation (the first excluded: it loads the solvers) and the
@@ -45,13 +46,49 @@ CASES = {
         flat=True,
         contacts="contact_results",
     ),
-    "hydroelastic, contact results, no epsilon": dict(
+    "hydroelastic, contact results, with epsilon": dict(
         plant_contact="hydroelastic_with_fallback",
         flat=True,
         contacts="contact_results",
-        compute_epsilon=False,
+        compute_epsilon=True,
     ),
 }
+SLIP_CASES = {
+    "point, contact results": dict(
+        plant_contact="point",
+        contact_model="soft_finger",
+        torsional_friction=0.1,
+        contacts="contact_results",
+    ),
+    "point, geometry": dict(
+        plant_contact="point",
+        contact_model="soft_finger",
+        torsional_friction=0.1,
+    ),
+    "hydroelastic, contact results": dict(
+        plant_contact="hydroelastic_with_fallback",
+        flat=True,
+        contacts="contact_results",
+    ),
+}
+
+
+def slip_times() -> None:
+    """Weak pick: when the monitor flagged slip against when the box moved 5 mm."""
+    from holding_support import FLAGS, timeline
+
+    print("weak pick (fingers 3 mm past the box), 10 ms samples, lift at 1.0 s:")
+    for name, options in SLIP_CASES.items():
+        pick = build_pick(
+            period=0.01, mu=0.5, distance_tolerance=1e-3, closed=0.022, **options
+        )
+        pick.run(2.0)
+        line = timeline(pick, finger="left_finger", t_ref=1.0)
+        print(
+            f"  {name}: flagged {line.first(FLAGS, after=1.0):.3f} s, moved 5 mm "
+            f"{line.moved(5e-3, after=1.0):.3f} s, dropped "
+            f"{line.first(('dropped',), after=1.0):.3f} s"
+        )
 
 
 def run(period: float, options: dict) -> tuple[float, list[float], object]:
@@ -103,6 +140,7 @@ def main() -> None:
             f"({len(costs)} samples; first {1e3 * costs[0]:.1f} ms)"
         )
         print(f"  verdicts: {timeline(pick)}")
+    slip_times()
 
 
 if __name__ == "__main__":

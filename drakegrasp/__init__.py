@@ -135,8 +135,14 @@ _SOURCES = {
     ),
     "drakegrasp.systems.monitor": (
         "GraspMonitor",
+        "HOLDING_STATES",
+        "HoldingThresholds",
         "GraspSample",
         "add_grasp_monitor",
+    ),
+    "drakegrasp.systems.holding": (
+        "HOLDING_STATES",
+        "HoldingThresholds",
     ),
     "drakegrasp.visualization": (
         "clear_grasp",

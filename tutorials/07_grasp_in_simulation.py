@@ -211,7 +211,9 @@ SOFT = dict(mu=0.5, contact_model="soft_finger", torsional_friction=0.1)
 params = MeshcatParams()
 params.show_stats_plot = False
 meshcat = Meshcat(params)  # open meshcat.web_url() in a browser to watch
-pick = build_pick(distance_tolerance=1e-3, meshcat=meshcat, **SOFT)
+pick = build_pick(
+    distance_tolerance=1e-3, meshcat=meshcat, compute_epsilon=True, **SOFT
+)
 
 # Time every evaluation of the monitor (it stores its own wall time per sample).
 costs = []
@@ -237,7 +239,8 @@ print(
 # %% [markdown]
 # ## The verdict over time
 #
-# `VERDICT_NAMES` says what each row of the logged vector is.  The status is 1 when
+# `VERDICT_NAMES` names the first seven rows of the logged vector (the grip
+# rows that follow are named by `monitor.verdict_names`).  The status is 1 when
 # the hand touches the box (the analysis ran), 0 without contact, −1 for a pose the
 # analysis refuses (deep penetration, a joint beyond its limits).
 
@@ -252,7 +255,7 @@ previous = None
 for t, v in zip(times, V.T, strict=True):
     key = (v[GraspMonitor.STATUS], v[GraspMonitor.FORCE_CLOSURE])
     if key != previous:
-        values = zip(VERDICT_NAMES, v, strict=True)
+        values = zip(VERDICT_NAMES, v[: len(VERDICT_NAMES)], strict=True)
         print(f"t = {t:5.2f} s: " + ", ".join(f"{n} {x:.4g}" for n, x in values))
         previous = key
 

@@ -12,8 +12,16 @@ _SOURCES = {
         "GraspSample",
         "add_grasp_monitor",
     ),
+    "drakegrasp.systems.holding": ("HOLDING_STATES", "HoldingThresholds"),
 }
 
 __getattr__, __dir__ = lazy_exports(__name__, globals(), _SOURCES)
 
-__all__ = ["VERDICT_NAMES", "GraspMonitor", "GraspSample", "add_grasp_monitor"]
+__all__ = [
+    "HOLDING_STATES",
+    "VERDICT_NAMES",
+    "GraspMonitor",
+    "GraspSample",
+    "HoldingThresholds",
+    "add_grasp_monitor",
+]

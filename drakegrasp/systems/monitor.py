@@ -18,18 +18,42 @@ velocities from the ``plant_state`` input at each sample, and passes the scene
 graph's query object from its ``query_object`` input (the query object of the
 same instant, so geometry and kinematics agree).
 
-**Where the contacts come from** (``contacts=``):
+**Where the contacts come from** (``contacts=``), and what each mode sees:
 
 - ``"geometry"`` (default): signed distances, as :func:`~drakegrasp.find_contacts`
-  does outside a simulation (contact when ``|ψ| <= distance_tolerance``).  A
-  simulated contact penetrates a little (point contact: ~0.1 mm for newtons of
-  squeeze), so choose ``distance_tolerance`` above that (1e-3 m is a good start)
-  or pass ``allow_penetration=True``.
+  does outside a simulation: a contact is a pair within ``distance_tolerance``
+  (``|ψ| <= tol``) whose points are not moving apart faster than
+  ``separation_speed``.  A simulated contact penetrates a little (point
+  contact: ~0.1 mm for newtons of squeeze), so choose ``distance_tolerance``
+  above that (1e-3 m is a good start) or pass ``allow_penetration=True``.
+  *It sees* positions, normals and velocities, hence slip; *it cannot see*
+  forces: a finger within the tolerance that carries no load still counts, and
+  friction in use is NaN, so a grip is never "at risk", only "slipping" once it
+  moves.
 - ``"contact_results"``: the contacts the plant's contact model used in the
   last step, read from the ``contact_results`` input
   (:func:`drakegrasp.plant.contacts_from_results`): with hydroelastic contact
   each contact surface becomes a patch polygon, point pairs become point
-  contacts.
+  contacts.  *It sees* the forces the plant applied, so friction in use
+  ``‖f_t‖/(μ f_n)`` with the plant's own μ (read from the geometries' proximity
+  properties, not the ``mu`` option), and a grip nearing its friction limit is
+  "at risk" before it slips.  *It cannot see* contacts the step did not
+  compute (a hydroelastic surface has one net force, not a distribution), and
+  it depends on a simulator's context: a fresh context has no results.
+
+**Holding.**  Each sample also judges the grip
+(:mod:`drakegrasp.systems.holding`): ``no contact``, ``touching``, ``holding``,
+``at risk`` (friction in use above ``risk``), ``slipping`` (a contact slips
+faster than ``slip_speed``) or ``dropped``.  A sample without contact after a
+grip keeps the last grip's analysis and state for ``hold_samples`` samples
+(hysteresis), so one frame without contact is not a drop.  These thresholds
+are a :class:`~drakegrasp.systems.holding.HoldingThresholds` (``holding=``).
+
+**What d* is.**  LP2's ``d*`` is the geometric distance of the best internal
+force to the boundaries of the friction cones: it depends on the contacts'
+positions, normals and μ, not on the load, the squeeze or the motors.  A flat
+``d*`` says the contact geometry did not change; the holding state and friction
+in use say whether the hand carries the object.
 
 **Timing.**  Samples are unrestricted updates at ``offset + k * period`` (and
 one at initialization); outputs are state, held between samples.  As with
@@ -41,29 +65,41 @@ A discrete plant's contact results are those of its last step; they exist in
 the simulator's context, not in a fresh context where only ``q`` and ``v``
 were set.
 
-**Outputs.**  ``verdicts`` is a vector of :data:`VERDICT_NAMES` (index
-constants ``GraspMonitor.STATUS`` ... ``GraspMonitor.EPSILON``):
+**Outputs.**  ``verdicts`` is a vector named by ``monitor.verdict_names``:
+:data:`~drakegrasp.systems.sample.VERDICT_NAMES` (index constants
+``GraspMonitor.STATUS`` ... ``GraspMonitor.EPSILON``), then
+:data:`~drakegrasp.systems.sample.HOLDING_NAMES` (``GraspMonitor.HOLDING`` ...
+``GraspMonitor.CONTACT_GAP``), then per hand body its friction in use and slip
+speed:
 
-=================  ===========================================================
-``status``         1 analysed, 0 no contact, −1 invalid pose (e.g. penetration
-                   deeper than the tolerance; the report says why)
-``force_closure``  1 / 0: polyhedral force closure with the hand check LP3
-``form_closure``   1 / 0: first-order form closure (LP1)
-``antipodal``      1 / 0: two contacts that are antipodal (0 for other counts)
-``num_contacts``   number of contacts analysed
-``d_star``         LP2's ``d*`` (the force-closure margin), 0 without contact
-``epsilon``        Ferrari–Canny ε (L1), 0 when not in force closure
-=================  ===========================================================
+===================  ===========================================================
+``status``           1 analysed, 0 no contact, −1 invalid pose (e.g. penetration
+                     deeper than the tolerance, a non-finite state; the report
+                     says why)
+``force_closure``    1 / 0: polyhedral force closure with the hand check LP3
+``form_closure``     1 / 0: first-order form closure (LP1)
+``antipodal``        1 / 0: two contacts that are antipodal (0 for other counts)
+``num_contacts``     number of contacts analysed
+``d_star``           LP2's ``d*``, 0 without contact (see "What d* is")
+``epsilon``          Ferrari–Canny ε (L1), 0 when not in force closure or not
+                     asked for (``compute_epsilon=False``, the default)
+``holding``          code of the holding state (index in ``HOLDING_STATES``)
+``friction_use``     largest ``‖f_t‖/(μ f_n)``; NaN in geometry mode
+``slip_speed``       largest slip speed at a contact, m/s
+``relative_speed``   object's centre of mass relative to a touching finger, m/s
+``contact_gap``      samples without contact bridged by the hysteresis
+===================  ===========================================================
 
 ``report`` is an abstract port holding a :class:`GraspSample`: the time, the
-status, the full :class:`~drakegrasp.GraspReport` (None without one), ε, and
-the plant state the sample was computed from.
+status, the full :class:`~drakegrasp.GraspReport` (None without one), ε, the
+holding state with the per-finger loads, and the plant state the sample was
+computed from.
 """
 
 from __future__ import annotations
 
+import numbers
 import time as _time
-from dataclasses import dataclass
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -83,131 +119,68 @@ from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.errors import GraspError, InvalidOptionError, NoContactsError
-from drakegrasp.plant.analysis import GraspReport, analyze_grasp
+from drakegrasp.plant.analysis import analyze_grasp
 from drakegrasp.plant.contact_results import contacts_from_results
 from drakegrasp.plant.contacts import (
     DEFAULT_DISTANCE_TOLERANCE,
     HandSpec,
     _scoped_name,
+    find_contacts,
     hand_bodies,
     resolve_object_body,
 )
 from drakegrasp.plant.jacobians import PLANES
 from drakegrasp.quality import ferrari_canny
+from drakegrasp.systems.holding import (
+    FingerLoad,
+    HoldingThresholds,
+    finger_loads_from_results,
+    finger_motion_from_contacts,
+    next_holding_state,
+    speeds_against,
+)
+from drakegrasp.systems.sample import (
+    VERDICT_NAMES,
+    GraspSample,
+    analysis_verdicts,
+    grip_verdicts,
+    verdict_names,
+)
 
 __all__ = [
+    "MIN_PERIOD",
     "VERDICT_NAMES",
     "GraspMonitor",
     "GraspSample",
     "add_grasp_monitor",
 ]
 
-VERDICT_NAMES = (
-    "status",
-    "force_closure",
-    "form_closure",
-    "antipodal",
-    "num_contacts",
-    "d_star",
-    "epsilon",
-)
-"""Names of the elements of :class:`GraspMonitor`'s ``verdicts`` output."""
-
 _CONTACT_SOURCES = ("geometry", "contact_results")
+MIN_PERIOD = 1e-6
+"""Shortest sample period (s) accepted: a plant steps at ~1e-3 s."""
 
 
-@dataclass(frozen=True, eq=False)
-class GraspSample:
-    """One evaluation of the monitor.
-
-    Attributes
-    ----------
-    time : float
-        Simulation time of the sample, seconds.
-    status : str
-        ``"ok"``, ``"no contact"``, ``"invalid"`` (a pose the analysis refuses,
-        e.g. deep penetration; see ``message``) or ``"not sampled"`` (before the
-        first sample).
-    message : str
-        Why there is no report (the error's message), else ``""``.
-    report : GraspReport or None
-        The full analysis when ``status == "ok"``.
-    epsilon : float
-        Ferrari–Canny ε (L1 norm, moments divided by ``b``); 0 when not in
-        force closure.
-    verdicts : (7,) float
-        The vector output, in :data:`VERDICT_NAMES` order.
-    state : (nq + nv,) float
-        The plant state the sample analysed.
-    seconds : float
-        Wall time the evaluation took.
-    """
-
-    time: float
-    status: str
-    message: str
-    report: GraspReport | None
-    epsilon: float
-    verdicts: np.ndarray
-    state: np.ndarray
-    seconds: float
-
-    def __deepcopy__(self, memo) -> GraspSample:
-        # Drake copies abstract state values (by deepcopy for Python objects)
-        # whenever it clones a context; a sample is never mutated, so sharing
-        # it is safe and avoids copying Drake ids that cannot be pickled.
-        return self
-
-    @property
-    def is_force_closure(self) -> bool:
-        """Force closure (with LP3) in this sample."""
-        return self.report is not None and self.report.is_force_closure
-
-    def to_dict(self) -> dict:
-        """JSON-ready dictionary (the report's own ``to_dict`` nested)."""
-        return {
-            "time": self.time,
-            "status": self.status,
-            "message": self.message,
-            "verdicts": dict(
-                zip(VERDICT_NAMES, (float(x) for x in self.verdicts), strict=True)
-            ),
-            "epsilon": self.epsilon,
-            "state": self.state.tolist(),
-            "seconds": self.seconds,
-            "report": None if self.report is None else self.report.to_dict(),
-        }
-
-    def __str__(self) -> str:
-        v = dict(zip(VERDICT_NAMES, self.verdicts, strict=True))
-        if self.report is None:
-            return f"t = {self.time:.4g} s: {self.status}" + (
-                f" ({self.message})" if self.message else ""
-            )
-        yes = {True: "YES", False: "no"}
-        return (
-            f"t = {self.time:.4g} s: {int(v['num_contacts'])} contacts, force "
-            f"closure {yes[bool(v['force_closure'])]}, form closure "
-            f"{yes[bool(v['form_closure'])]}, d* = {v['d_star']:.4g}, "
-            f"eps = {v['epsilon']:.4g}"
+def _seconds(name: str, value, *, least: float) -> float:
+    """``value`` as finite seconds >= ``least`` (> 0 when least > 0), or refuse."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InvalidOptionError(
+            f"{name} must be a real number of seconds, got {value!r} "
+            f"({type(value).__name__})"
         )
+    value = float(value)
+    if not np.isfinite(value) or value < least:
+        raise InvalidOptionError(
+            f"{name} must be finite and >= {least:g} s, got {value!r}"
+        )
+    return value
 
 
-def _verdicts(report: GraspReport | None, status: float, epsilon: float):
-    if report is None:
-        return np.array([status, 0, 0, 0, 0, 0, 0], dtype=float)
-    antipodal = report.antipodal is not None and report.antipodal.is_antipodal
-    return np.array(
-        [
-            status,
-            float(report.force_closure.is_closure),
-            float(report.form_closure.is_closure),
-            float(antipodal),
-            float(report.grasp.num_contacts),
-            float(report.force_closure.d_star),
-            epsilon,
-        ]
-    )
+def _flag(name: str, value) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidOptionError(
+            f"{name} must be True or False, got {value!r} ({type(value).__name__})"
+        )
+    return bool(value)
 
 
 class GraspMonitor(LeafSystem):
@@ -223,34 +196,42 @@ class GraspMonitor(LeafSystem):
         As in :func:`drakegrasp.analyze_grasp`.  A pose that the check refuses
         (penetration deeper than ``distance_tolerance`` by any hand body, a
         joint off its limits) gives an ``"invalid"`` sample, not an exception.
+        ``mu`` is the analysis's friction coefficient; friction in use is
+        computed with the plant's own.
     contacts : {"geometry", "contact_results"}, optional
         Signed distances (default), or the plant's contact results (then the
-        ``contact_results`` input port exists and must be connected).
+        ``contact_results`` input port exists and must be connected).  See the
+        module docstring for what each can see.
     period : float, optional
-        Seconds between samples (default 0.05).
+        Seconds between samples (default 0.05, at least :data:`MIN_PERIOD`).
     offset : float, optional
         Time of the first periodic sample (default 0); a sample is also taken
         at initialization.
     compute_epsilon : bool, optional
-        Compute the Ferrari–Canny ε of force-closure samples (default True).
+        Compute the Ferrari–Canny ε of force-closure samples (default False:
+        it is the costliest part of a sample).
+    holding : HoldingThresholds, optional
+        Thresholds of the holding state and the hysteresis (default
+        ``HoldingThresholds()``).
 
     Notes
     -----
     Input ports: ``plant_state`` (vector, ``nq + nv``), ``query_object``
     (abstract ``QueryObject``), and with ``contacts="contact_results"``
     ``contact_results`` (abstract ``ContactResults``).  Output ports:
-    ``verdicts`` (vector, :data:`VERDICT_NAMES`) and ``report`` (abstract
+    ``verdicts`` (vector, :attr:`verdict_names`) and ``report`` (abstract
     :class:`GraspSample`).  Both are state: they change only at samples.
 
     Raises
     ------
     InvalidOptionError
-        For an unfinalized plant, a bad period or contact source, or options
-        that :func:`drakegrasp.analyze_grasp` would refuse.
+        For an unfinalized plant, a bad period, offset, flag or contact
+        source, or options that :func:`drakegrasp.analyze_grasp` would refuse.
     """
 
     STATUS, FORCE_CLOSURE, FORM_CLOSURE, ANTIPODAL = 0, 1, 2, 3
     NUM_CONTACTS, D_STAR, EPSILON = 4, 5, 6
+    HOLDING, FRICTION_USE, SLIP_SPEED, RELATIVE_SPEED, CONTACT_GAP = 7, 8, 9, 10, 11
 
     def __init__(
         self,
@@ -272,32 +253,47 @@ class GraspMonitor(LeafSystem):
         contacts: str = "geometry",
         period: float = 0.05,
         offset: float = 0.0,
-        compute_epsilon: bool = True,
+        compute_epsilon: bool = False,
+        holding: HoldingThresholds | None = None,
     ):
         super().__init__()
         if not isinstance(plant, MultibodyPlant) or not plant.is_finalized():
             raise InvalidOptionError(
                 f"GraspMonitor needs a finalized pydrake MultibodyPlant, got {plant!r}"
             )
-        if contacts not in _CONTACT_SOURCES:
+        if not isinstance(contacts, str) or contacts not in _CONTACT_SOURCES:
             raise InvalidOptionError(
                 f"contacts must be one of {_CONTACT_SOURCES}, got {contacts!r}"
             )
-        period, offset = float(period), float(offset)
-        if not (np.isfinite(period) and period > 0):
-            raise InvalidOptionError(f"period must be finite and > 0 s, got {period}")
-        if not (np.isfinite(offset) and offset >= 0):
-            raise InvalidOptionError(f"offset must be finite and >= 0 s, got {offset}")
+        period = _seconds("period", period, least=MIN_PERIOD)
+        offset = _seconds("offset", offset, least=0.0)
         if plane is not None and plane not in PLANES:
             raise InvalidOptionError(
                 f"plane must be one of {sorted(PLANES)} or None, got {plane!r}"
             )
+        b = characteristic_length
+        if b is not None and (
+            isinstance(b, bool)
+            or not isinstance(b, numbers.Real)
+            or not (np.isfinite(b) and b > 0)
+        ):
+            raise InvalidOptionError(
+                f"characteristic_length must be None or finite and > 0 (metres), "
+                f"got {b!r}"
+            )
+        holding = HoldingThresholds() if holding is None else holding
+        if not isinstance(holding, HoldingThresholds):
+            raise InvalidOptionError(
+                f"holding must be a HoldingThresholds, got {type(holding).__name__}"
+            )
+        self._thresholds = holding
         self._plant = plant
         body = resolve_object_body(plant, object_body)
+        self._body = body
         self._bodies = hand_bodies(plant, body, hand)
         self._object_name = _scoped_name(plant, body)
         self._contacts = contacts
-        self._compute_epsilon = bool(compute_epsilon)
+        self._compute_epsilon = _flag("compute_epsilon", compute_epsilon)
         self._num_generators = num_generators
         self._options = {
             "object_body": body,
@@ -307,13 +303,17 @@ class GraspMonitor(LeafSystem):
             "torsional_friction": torsional_friction,
             "distance_tolerance": distance_tolerance,
             "plane": plane,
-            "characteristic_length": characteristic_length,
+            "characteristic_length": None if b is None else float(b),
             "num_generators": num_generators,
             "tol": tol,
-            "allow_penetration": allow_penetration,
+            "allow_penetration": _flag("allow_penetration", allow_penetration),
             "patches": patches,
-            "check_pose": bool(check_pose),
+            "check_pose": _flag("check_pose", check_pose),
         }
+        self.verdict_names = verdict_names(
+            [_scoped_name(plant, f) for f in self._bodies]
+        )
+        """Names of the ``verdicts`` output's elements."""
         self._plant_context = plant.CreateDefaultContext()
         nx = plant.num_multibody_states()
         self._state_port = self.DeclareVectorInputPort("plant_state", nx)
@@ -325,17 +325,10 @@ class GraspMonitor(LeafSystem):
             self._results_port = self.DeclareAbstractInputPort(
                 "contact_results", AbstractValue.Make(ContactResults())
             )
-        empty = GraspSample(
-            time=0.0,
-            status="not sampled",
-            message="",
-            report=None,
-            epsilon=0.0,
-            verdicts=_verdicts(None, 0.0, 0.0),
-            state=np.zeros(nx),
-            seconds=0.0,
+        empty = self._sample(
+            0.0, "not sampled", "", None, 0.0, np.zeros(nx), 0.0, grip=None
         )
-        self._verdict_index = self.DeclareDiscreteState(len(VERDICT_NAMES))
+        self._verdict_index = self.DeclareDiscreteState(len(self.verdict_names))
         self._report_index = self.DeclareAbstractState(AbstractValue.Make(empty))
         self.DeclareStateOutputPort("verdicts", self._verdict_index)
         self.DeclareStateOutputPort("report", self._report_index)
@@ -403,7 +396,7 @@ class GraspMonitor(LeafSystem):
         return self._results_port
 
     def get_verdicts_output_port(self):
-        """Output: the verdict vector (:data:`VERDICT_NAMES`)."""
+        """Output: the verdict vector (named by :attr:`verdict_names`)."""
         return self.GetOutputPort("verdicts")
 
     def get_report_output_port(self):
@@ -411,24 +404,161 @@ class GraspMonitor(LeafSystem):
         return self.GetOutputPort("report")
 
     # The evaluation ------------------------------------------------------
-    def evaluate(self, context: Context) -> GraspSample:
-        """Analyse the grasp at the inputs of ``context`` (one sample)."""
-        start = _time.perf_counter()
-        x = np.array(self._state_port.Eval(context), dtype=float)
-        self._plant.SetPositionsAndVelocities(self._plant_context, x)
-        query = self._query_port.Eval(context)
-        status, message, report, epsilon = "ok", "", None, 0.0
+    def _no_loads(self) -> tuple[FingerLoad, ...]:
+        nan = np.nan if self._results_port is None else 0.0
+        return tuple(
+            FingerLoad(_scoped_name(self._plant, f), False, nan, nan, np.nan, nan, 0.0)
+            for f in self._bodies
+        )
+
+    def _sample(self, t, status, message, report, epsilon, x, start, *, grip):
+        """A GraspSample; ``grip`` = (holding, loads, speeds, gap, last) or None."""
+        if grip is None:
+            grip = ("no contact", self._no_loads(), (np.nan, 0.0), 0, "no contact", ())
+        holding, loads, (relative, sliding), gap, last, normals = grip
+        code = {"ok": 1.0, "no contact": 0.0, "invalid": -1.0, "not sampled": 0.0}
+        verdicts = np.concatenate(
+            [
+                analysis_verdicts(report, code[status], epsilon),
+                grip_verdicts(holding, loads, relative, gap),
+            ]
+        )
+        return GraspSample(
+            time=float(t),
+            status=status,
+            message=message,
+            report=report,
+            epsilon=epsilon,
+            holding=holding,
+            loads=tuple(loads),
+            relative_speed=relative,
+            sliding_speed=sliding,
+            last_normals=normals,
+            contact_gap=gap,
+            last_grip=last,
+            names=self.verdict_names,
+            verdicts=verdicts,
+            state=x,
+            seconds=_time.perf_counter() - start if start else 0.0,
+        )
+
+    def _validate(self, context) -> None:
+        if not isinstance(context, Context):
+            raise InvalidOptionError(
+                f"expected this GraspMonitor's pydrake Context, got "
+                f"{type(context).__name__}"
+            )
         try:
+            self.ValidateContext(context)
+        except RuntimeError as e:
+            raise InvalidOptionError(
+                "this context belongs to another system; pass "
+                "monitor.GetMyContextFromRoot(root_context) or "
+                f"monitor.CreateDefaultContext() ({e})"
+            ) from None
+
+    def _contacts_and_loads(self, context, query):
+        """(contacts for the analysis, per-finger loads); NoContactsError if none."""
+        if self._results_port is not None:
+            results = self._results_port.Eval(context)
+            loads = finger_loads_from_results(
+                self._plant,
+                self._plant_context,
+                results,
+                query,
+                object_body=self._body,
+                fingers=self._bodies,
+            )
             found = None
-            if self._results_port is not None:
+            try:
                 found = contacts_from_results(
                     self._plant,
                     self._plant_context,
-                    self._results_port.Eval(context),
+                    results,
                     query,
-                    object_body=self._options["object_body"],
+                    object_body=self._body,
                     hand=self._bodies,
                 )
+            except NoContactsError as e:
+                return None, loads, e
+            return found, loads, None
+        o = self._options
+        try:
+            candidates = find_contacts(
+                self._plant,
+                self._plant_context,
+                object_body=self._body,
+                hand=self._bodies,
+                distance_tolerance=o["distance_tolerance"],
+                allow_penetration=o["allow_penetration"],
+                patches=o["patches"],
+                query_object=query,
+            )
+        except NoContactsError as e:
+            return None, self._no_loads(), e
+        found, loads = finger_motion_from_contacts(
+            self._plant,
+            self._plant_context,
+            candidates,
+            object_body=self._body,
+            fingers=self._bodies,
+            separation_speed=self._thresholds.separation_speed,
+        )
+        if not found:
+            return (
+                None,
+                tuple(loads),
+                NoContactsError(
+                    f"every hand contact with {self._object_name!r} within the "
+                    f"tolerance is separating faster than "
+                    f"{self._thresholds.separation_speed:g} m/s"
+                ),
+            )
+        return found, loads, None
+
+    def evaluate(self, context: Context) -> GraspSample:
+        """Analyse the grasp at the inputs of ``context`` (one sample).
+
+        The holding state continues from the sample held in ``context``'s
+        state (the previous sample).
+
+        Raises
+        ------
+        InvalidOptionError
+            If ``context`` is not a context of this monitor.
+        """
+        start = _time.perf_counter()
+        self._validate(context)
+        previous = context.get_abstract_state(self._report_index).get_value()
+        t = context.get_time()
+        x = np.array(self._state_port.Eval(context), dtype=float)
+        if not np.all(np.isfinite(x)):
+            bad = np.flatnonzero(~np.isfinite(x))
+            return self._sample(
+                t,
+                "invalid",
+                f"the plant state has non-finite entries at indices {bad[:8].tolist()}",
+                None,
+                0.0,
+                x,
+                start,
+                grip=(
+                    previous.holding,
+                    previous.loads,
+                    (np.nan, 0.0),
+                    previous.contact_gap,
+                    previous.last_grip,
+                    previous.last_normals,
+                ),
+            )
+        self._plant.SetPositionsAndVelocities(self._plant_context, x)
+        query = self._query_port.Eval(context)
+        status, message, report, epsilon = "ok", "", None, 0.0
+        loads = self._no_loads()
+        try:
+            found, loads, missing = self._contacts_and_loads(context, query)
+            if missing is not None:
+                raise missing
             report = analyze_grasp(
                 self._plant,
                 self._plant_context,
@@ -440,20 +570,48 @@ class GraspMonitor(LeafSystem):
             status, message = "no contact", str(e)
         except GraspError as e:  # the pose: penetration, a non-planar normal...
             status, message = "invalid", str(e)
-        if report is not None and self._compute_epsilon and report.is_force_closure:
+        except (ValueError, ArithmeticError) as e:  # degenerate contact data
+            status, message = "invalid", f"{type(e).__name__}: {e}"
+        touching = tuple(
+            (k, load.normal_W) for k, load in enumerate(loads) if load.touching
+        )
+        against = touching or previous.last_normals  # the last fingers if none now
+        relative, sliding = speeds_against(
+            self._plant,
+            self._plant_context,
+            self._body,
+            [(self._bodies[k], n_W) for k, n_W in against],
+        )
+        if not touching:
+            relative = np.nan
+        uses = [f.friction_use for f in loads if not np.isnan(f.friction_use)]
+        holding, gap, last = next_holding_state(
+            previous.holding,
+            previous.contact_gap,
+            touching=bool(touching),
+            grasped=report is not None and report.is_force_closure,
+            friction_use=max(uses) if uses else np.nan,
+            slip_speed=max(f.slip_speed for f in loads),
+            sliding_away=sliding,
+            last_grip=previous.last_grip,
+            thresholds=self._thresholds,
+        )
+        if gap > 0 and previous.report is not None:  # bridge the gap
+            status, report, epsilon = previous.status, previous.report, previous.epsilon
+            message = f"no contact in this sample ({message}); the last grip is held"
+        elif report is not None and self._compute_epsilon and report.is_force_closure:
             epsilon = float(
                 ferrari_canny(report.grasp, num_generators=self._num_generators)
             )
-        code = {"ok": 1.0, "no contact": 0.0, "invalid": -1.0}[status]
-        return GraspSample(
-            time=float(context.get_time()),
-            status=status,
-            message=message,
-            report=report,
-            epsilon=epsilon,
-            verdicts=_verdicts(report, code, epsilon),
-            state=x,
-            seconds=_time.perf_counter() - start,
+        return self._sample(
+            t,
+            status,
+            message,
+            report,
+            epsilon,
+            x,
+            start,
+            grip=(holding, loads, (relative, sliding), gap, last, against),
         )
 
     def _update(self, context: Context, state: State) -> EventStatus:
@@ -463,10 +621,22 @@ class GraspMonitor(LeafSystem):
         return EventStatus.Succeeded()
 
 
+def _unique_name(builder: DiagramBuilder, base: str) -> str:
+    taken = {s.get_name() for s in builder.GetSystems()}
+    if base not in taken:
+        return base
+    k = 2
+    while f"{base}_{k}" in taken:
+        k += 1
+    return f"{base}_{k}"
+
+
 def add_grasp_monitor(
     builder: DiagramBuilder,
     plant: MultibodyPlant,
     scene_graph: SceneGraph,
+    *,
+    name: str = "grasp_monitor",
     **options,
 ) -> GraspMonitor:
     """Add a :class:`GraspMonitor` to ``builder`` and connect its inputs.
@@ -479,6 +649,9 @@ def add_grasp_monitor(
     plant : MultibodyPlant
         Finalized.
     scene_graph : SceneGraph
+    name : str, optional
+        The system's name; ``_2``, ``_3`` ... is appended when the builder
+        already holds a system of that name (two monitors in one diagram).
     **options
         Keyword arguments of :class:`GraspMonitor`.
 
@@ -487,19 +660,36 @@ def add_grasp_monitor(
     GraspMonitor
         Connected to the plant's state, the scene graph's query output and, with
         ``contacts="contact_results"``, the plant's contact results.
+
+    Raises
+    ------
+    InvalidOptionError
+        If an argument has the wrong type, the builder was already built, or
+        the plant or scene graph is not in this builder.
     """
-    for name, value, kind in (
+    for arg, value, kind in (
         ("builder", builder, DiagramBuilder),
         ("plant", plant, MultibodyPlant),
         ("scene_graph", scene_graph, SceneGraph),
+        ("name", name, str),
     ):
         if not isinstance(value, kind):
             raise InvalidOptionError(
-                f"add_grasp_monitor: {name} must be a pydrake {kind.__name__}, got "
+                f"add_grasp_monitor: {arg} must be a {kind.__name__}, got "
                 f"a {type(value).__name__}"
             )
-    monitor = builder.AddSystem(GraspMonitor(plant, **options))
-    monitor.set_name("grasp_monitor")
+    if builder.already_built():
+        raise InvalidOptionError("add_grasp_monitor: this builder was already built")
+    systems = builder.GetSystems()
+    for arg, value in (("plant", plant), ("scene_graph", scene_graph)):
+        if not any(s is value for s in systems):
+            raise InvalidOptionError(
+                f"add_grasp_monitor: the {arg} {value.get_name()!r} is not in this "
+                "builder; pass the builder that holds the plant and scene graph"
+            )
+    monitor = GraspMonitor(plant, **options)
+    monitor.set_name(_unique_name(builder, name))
+    builder.AddSystem(monitor)
     builder.Connect(plant.get_state_output_port(), monitor.get_plant_state_input_port())
     builder.Connect(
         scene_graph.get_query_output_port(), monitor.get_query_object_input_port()

@@ -75,6 +75,7 @@ def build_pick(
     flat: bool = False,
     plant_contact: str = "point",
     period: float = 0.05,
+    closed: float = CLOSED,
     **monitor_options,
 ) -> Pick:
     builder = DiagramBuilder()
@@ -126,9 +127,10 @@ def build_pick(
         for i in plant.GetJointActuatorIndices(gripper)
     ]
     times = [t for t, _, _ in SCHEDULE]
+    fingers = [closed if f == CLOSED else f for _, f, _ in SCHEDULE]
     values = {
-        "left_finger_joint": [f for _, f, _ in SCHEDULE],
-        "right_finger_joint": [f for _, f, _ in SCHEDULE],
+        "left_finger_joint": fingers,
+        "right_finger_joint": fingers,
         "lift": [z for _, _, z in SCHEDULE],
     }
     q_desired = PiecewisePolynomial.FirstOrderHold(

@@ -26,6 +26,7 @@ from drakegrasp.systems.monitor import VERDICT_NAMES, GraspMonitor, GraspSample
 
 SOFT = {"contact_model": "soft_finger", "torsional_friction": 0.1}
 OPTIONS = {"mu": 0.5, "distance_tolerance": 1e-3}
+EPS = {"compute_epsilon": True}
 
 
 def _runs(values: np.ndarray) -> list[float]:
@@ -37,6 +38,31 @@ def _runs(values: np.ndarray) -> list[float]:
     return out
 
 
+def _not_separating(plant, plant_context, box, contacts, speed=5e-3):
+    """Contacts whose points do not move apart faster than ``speed`` (m/s).
+
+    A second route to the monitor's filter: velocities from translational
+    Jacobians (J_v v), not from the bodies' spatial velocities.
+    """
+    from pydrake.multibody.tree import JacobianWrtVariable
+
+    world = plant.world_frame()
+    v = plant.GetVelocities(plant_context)
+    R_WO = plant.EvalBodyPoseInWorld(plant_context, box).rotation().matrix()
+    kept = []
+    for c in contacts:
+        finger = plant.get_body(c.finger_body_index)
+        J = [
+            plant.CalcJacobianTranslationalVelocity(
+                plant_context, JacobianWrtVariable.kV, frame, p, world, world
+            )
+            for frame, p in ((box.body_frame(), c.p_OC), (finger.body_frame(), c.p_FC))
+        ]
+        if ((J[0] - J[1]) @ v) @ (R_WO @ c.nhat_O) <= speed:
+            kept.append(c)
+    return kept
+
+
 def _second_route(pick, x, **options) -> np.ndarray:
     """Verdicts of analyze_grasp on state x, in a fresh diagram context."""
     context = pick.diagram.CreateDefaultContext()
@@ -44,8 +70,23 @@ def _second_route(pick, x, **options) -> np.ndarray:
     pick.plant.SetPositionsAndVelocities(plant_context, x)
     box = pick.plant.GetBodyByName("box", pick.box)
     try:
+        found = dg.find_contacts(
+            pick.plant,
+            plant_context,
+            object_body=box,
+            hand=pick.gripper,
+            distance_tolerance=options["distance_tolerance"],
+        )
+        found = _not_separating(pick.plant, plant_context, box, found)
+        if not found:
+            raise dg.NoContactsError("all separating")
         r = dg.analyze_grasp(
-            pick.plant, plant_context, object_body=box, hand=pick.gripper, **options
+            pick.plant,
+            plant_context,
+            object_body=box,
+            hand=pick.gripper,
+            contacts=found,
+            **options,
         )
     except dg.NoContactsError:
         return np.zeros(len(VERDICT_NAMES))
@@ -67,7 +108,7 @@ def _second_route(pick, x, **options) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def point_pick():
-    pick = build_pick(plant_contact="point", **OPTIONS, **SOFT)
+    pick = build_pick(plant_contact="point", **OPTIONS, **SOFT, **EPS)
     pick.run()
     return pick
 
@@ -87,7 +128,10 @@ def test_point_contact_pick_timeline(point_pick):
         ],
     )
     assert _runs(status) == [0.0, 1.0, 0.0]
-    assert _runs(closure) == [0.0, 1.0, 0.0]
+    # While the hand opens (2.3 - 2.6 s) a finger whose points separate faster
+    # than the separation speed is no contact, so closure may flicker there.
+    assert _runs(closure[times <= 2.3]) == [0.0, 1.0]
+    assert np.all(closure[times > 2.65] == 0.0)
     held = times[closure == 1.0]
     # Closing starts at 0.3 s (contact near 0.55 s); opening at 2.3 s.
     assert 0.4 < held[0] < 0.75 and 2.3 < held[-1] < 2.65
@@ -124,8 +168,14 @@ def test_point_contact_monitor_matches_analyze_grasp(point_pick):
     assert X.shape[1] == round(DURATION / point_pick.monitor.period) + 1
     for k in range(X.shape[1] - 1):
         expected = _second_route(point_pick, X[:, k], **OPTIONS, **SOFT)
+        if V[GraspMonitor.CONTACT_GAP, k + 1] > 0:  # a bridged gap: the last grip
+            expected = _second_route(point_pick, X[:, k - 1], **OPTIONS, **SOFT)
         np.testing.assert_allclose(
-            V[:, k + 1], expected, rtol=1e-9, atol=1e-12, err_msg=f"sample {k}"
+            V[: len(VERDICT_NAMES), k + 1],
+            expected,
+            rtol=1e-9,
+            atol=1e-12,
+            err_msg=f"sample {k}",
         )
 
 

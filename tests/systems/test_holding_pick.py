@@ -1,0 +1,72 @@
+"""The holding state in simulated picks, judged by the object's real motion.
+
+The shipped parallel-jaw gripper picks the shipped 0.2 kg box (no download):
+a firm grip (fingers commanded 10 mm past the box faces, ~3 N squeeze each)
+holds it through the lift; a weak grip (3 mm past, ~0.9 N: with the plant's
+μ = 1 two fingers carry at most ~1.8 N < the box's 1.96 N weight) lets it
+slip out.  What the box did is read from the logged plant states, apart from
+the monitor: its displacement in the left finger's frame since the lift began
+(t = 1.0 s) and its height.
+"""
+
+import pytest
+from holding_support import FLAGS, timeline
+from pick_support import OPEN, build_pick
+
+LIFT_START = 1.0
+MOVED = 5e-3  # m
+POINT = {
+    "plant_contact": "point",
+    "contact_model": "soft_finger",
+    "torsional_friction": 0.1,
+}
+HYDRO = {"plant_contact": "hydroelastic_with_fallback", "flat": True}
+CASES = {
+    "point, contact results": dict(POINT, contacts="contact_results"),
+    "point, geometry": dict(POINT, contacts="geometry"),
+    "hydroelastic, contact results": dict(HYDRO, contacts="contact_results"),
+}
+
+
+def _run(closed, options, until=2.0):
+    pick = build_pick(
+        mu=0.5, distance_tolerance=1e-3, period=0.01, closed=closed, **options
+    )
+    pick.run(until)
+    return timeline(pick, finger="left_finger", t_ref=LIFT_START)
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_firm_pick_is_holding_throughout_the_lift(case):
+    line = _run(0.015, CASES[case])
+    airborne = line.height > 0.0505  # the box rests at 0.05 on the ground
+    assert airborne.sum() > 30
+    assert line.displacement[line.times >= LIFT_START].max() < 2e-3  # it held
+    held = [s for s, up in zip(line.states, airborne, strict=True) if up]
+    assert set(held) == {"holding"}, held
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_weak_pick_is_flagged_before_it_moves_5_mm_and_dropped_after(case):
+    line = _run(0.022, CASES[case])
+    moved = line.moved(MOVED, after=LIFT_START)
+    flagged = line.first(FLAGS, after=LIFT_START)
+    dropped = line.first(("dropped",), after=LIFT_START)
+    print(
+        f"{case}: flagged {flagged:.3f} s, moved 5 mm {moved:.3f} s, "
+        f"dropped {dropped:.3f} s"
+    )
+    assert moved < 1.3  # the box did slip out of the fingers
+    assert flagged < moved
+    assert flagged <= dropped < 1.5  # and the drop follows the flag
+    # Once dropped, never holding again while the hand stays up.
+    up = (line.times >= dropped) & (line.times < 1.8)
+    assert "holding" not in [s for s, u in zip(line.states, up, strict=True) if u]
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_box_at_rest_between_open_fingers_is_never_holding(case):
+    line = _run(OPEN, CASES[case], until=1.6)
+    assert line.displacement.max() < 1e-3 or line.height.max() < 0.0505
+    assert "holding" not in line.states
+    assert set(line.states) <= {"no contact", "touching"}
