@@ -18,7 +18,10 @@ The metrics:
 
 * :func:`ferrari_canny`: the Ferrari–Canny ε (L1 form with a Qhull hull, L∞
   form through the normal fan of a Minkowski sum);
-* :func:`lp2_margin`: the ``d*`` of the force-closure program LP2;
+* :func:`lp2_margin`: the ``d*`` of the force-closure program LP2, the
+  geometric distance of the best internal force (no load) to the cones'
+  boundaries; it does not measure the load a grasp carries (that is
+  :func:`grasp_forces` and :func:`max_load`);
 * :func:`grasp_singular_values` and the indices of ``G`` built from them
   (:func:`min_singular_value`, :func:`isotropy`,
   :func:`wrench_ellipsoid_volume`);

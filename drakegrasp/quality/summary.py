@@ -50,7 +50,10 @@ def lp2_margin(
         (``F`` with unit facet rows): the largest distance by which a
         self-balanced set of contact forces, with mean normal force at most 1,
         can stay inside every cone facet.  Dimensionless (newtons per newton of
-        normal force).  It says nothing about the rank of ``G``: force closure
+        normal force).  It is geometry, not load: it does not change with the
+        object's weight or the motors (for those see
+        :func:`~drakegrasp.grasp_forces` and :func:`~drakegrasp.max_load`).
+        It says nothing about the rank of ``G``: force closure
         needs ``rank(G)`` full as well (see
         :func:`~drakegrasp.closure.verdicts.force_closure`).
     """
