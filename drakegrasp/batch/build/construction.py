@@ -44,7 +44,6 @@ __all__ = [
 ]
 
 
-
 def contact_kinds(
     mu: np.ndarray, torsional_friction: np.ndarray, *, model: str, dim: int
 ) -> np.ndarray:
@@ -205,7 +204,6 @@ def _ring(mu: np.ndarray, num_generators: int) -> np.ndarray:
 
 def _unit_rows(F: np.ndarray) -> np.ndarray:
     return F / np.linalg.norm(F, axis=-1, keepdims=True)
-
 
 
 def kind_facets(

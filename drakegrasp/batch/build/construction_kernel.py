@@ -22,8 +22,8 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.compiled import njit
 from drakegrasp.batch.build.kinds import KIND_COMPONENTS
+from drakegrasp.batch.compiled import njit
 
 __all__ = [
     "grasp_matrix_stack",
