@@ -112,9 +112,13 @@ def _grasps(K: int, N: int, d: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     p /= np.linalg.norm(p, axis=-1, keepdims=True)
     n = -p + 0.3 * rng.normal(size=(K, N, d))
     # A few rank-deficient grasps (all contacts on one line through the
-    # origin) so that the route past the fused full-rank pass compiles too.
+    # origin: the corner cases of the routes past the fused full-rank pass).
     p[:4] = p[:4, :1] * np.linspace(0.5, 1.5, N)[None, :, None]
     n[:4] = -p[:4]
+    # And a few with a repeated contact: rank-deficient with a null space of
+    # several dimensions, which the unfused interior-point pass solves.
+    p[4:8, -1] = p[4:8, 0]
+    n[4:8, -1] = n[4:8, 0]
     return p, n
 
 
