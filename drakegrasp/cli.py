@@ -10,6 +10,7 @@ Usage::
                      [--contact-model MODEL] [--torsional-friction NU]
                      [--num-generators NG] [--metrics NAME ...] [--progress]
                      [--overwrite]
+    drakegrasp warmup [--json]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
@@ -17,6 +18,9 @@ form closure, force closure with the hand check, exact-cone verdict, antipodal
 test.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
 ``positions`` and ``normals`` of shape (K, N, d), optionally ``mu``, ...) with
 the vectorised batch engine and writes the verdicts to another file.
+``warmup`` compiles the batch engine's numba kernels now (once per install;
+later processes load them from numba's cache) and prints what it compiled and
+how long each step took.
 
 One interface: both commands name the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
@@ -185,6 +189,30 @@ def _package(text: str) -> tuple[str, str]:
             f"expected NAME=DIR (a package name, '=', its directory), got {text!r}"
         )
     return name, folder
+
+
+def _cmd_warmup(args: argparse.Namespace) -> int:
+    from drakegrasp.batch.warmup import warmup
+
+    if not args.json:
+        print("compiling the batch kernels (a minute or two on a fresh install) ...")
+
+    def show(step) -> None:
+        if not args.json:
+            print(f"  {step.name}: {step.seconds:.2f} s, {step.compiled} compiled")
+
+    report = warmup(progress=show)
+    if args.json:
+        print(json.dumps(report.to_dict(), indent=2))
+    elif not report.available:
+        print(str(report))
+    else:
+        where = report.cache_dir or "numba's default cache"
+        print(
+            f"done: {report.compiled} functions compiled in {report.seconds:.1f} s "
+            f"(cache: {where})"
+        )
+    return 0
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
@@ -439,6 +467,16 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "temporary file and renamed into place, and is never the input",
     )
     batch.set_defaults(func=_cmd_batch)
+
+    warm = sub.add_parser(
+        "warmup",
+        help="compile the batch engine's kernels now (once per install)",
+        description="Compile every numba kernel of the batch engine into numba's "
+        "on-disk cache, so that the first batch call of later processes does "
+        "not wait; print each step and its time.",
+    )
+    warm.add_argument("--json", action="store_true", help="print the report as JSON")
+    warm.set_defaults(func=_cmd_warmup)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -211,9 +211,14 @@ def resolve_kernel(kernel: str) -> str:
     if kernel == "numba":
         if not numba_available():
             raise InvalidOptionError(
-                "kernel='numba' needs the optional package numba "
-                "(pip install drakegrasp[fast]); use kernel='numpy'"
+                "kernel='numba' needs numba, a dependency of drakegrasp that "
+                "is not installed here (pip install numba); use kernel='numpy'"
             )
     if kernel == "auto":
-        return "numba" if numba_available() else "numpy"
+        if numba_available():
+            return "numba"
+        from drakegrasp.batch.compiled import announce_numpy_route
+
+        announce_numpy_route()  # once per process
+        return "numpy"
     return kernel

@@ -41,9 +41,9 @@ close to a lower-dimensional flat, so no larger ball fits), and ε at most
 recomputed from its vertices, never carried over from other facets.
 
 The steps of one insertion (planes, visible region, cone, sub-ridge
-matching, heap) are in :mod:`drakegrasp.batch.epsilon.polytope`.  numba is optional
-(``pip install drakegrasp[fast]``); ``AVAILABLE`` says whether this kernel is
-compiled.
+matching, heap) are in :mod:`drakegrasp.batch.epsilon.polytope`.  numba is a
+dependency of drakegrasp (:mod:`drakegrasp.batch.compiled`); ``AVAILABLE`` says
+whether this kernel is compiled (False only where numba is missing).
 """
 
 from __future__ import annotations

@@ -9,8 +9,8 @@ loop keeps every problem's working set (a few hundred numbers) in cache and
 stops each problem at its own iteration.  The numpy version stays the reference
 that the tests compare against.
 
-numba is an optional dependency (``pip install drakegrasp[fast]``);
-``AVAILABLE`` says whether this kernel can be used.
+numba is a dependency of drakegrasp (:mod:`drakegrasp.batch.compiled`);
+``AVAILABLE`` says whether this kernel can be used (False where numba is missing).
 """
 
 from __future__ import annotations

@@ -1,0 +1,125 @@
+"""Record the batch engine's results on seeded grasps, to compare two trees bit for bit.
+
+Usage::
+
+    NUMBA_CACHE_DIR=$(mktemp -d) PYTHONPATH=TREE python benchmarks/check_bitwise.py \
+        record OUT.npz [--grasps 3000]
+    python benchmarks/check_bitwise.py compare A.npz B.npz
+
+``record`` runs, in this process, ``batch_force_closure`` (d*, rank, verdict,
+margin, converged, normal certificate) and ``batch_epsilon_l1`` (ε) on
+``--grasps`` seeded grasps for each configuration: spatial hard fingers at
+N = 2, 3, 4, 12, 24, planar hard fingers at N = 2, 3, 4, 12, soft fingers at
+N = 2, 3, 4, 12, frictionless contacts (form closure, LP1) at N = 4, 7, 12, 24,
+with a per-grasp μ and a per-contact μ on the hard fingers.  Run it once per
+tree, each in a fresh process with an empty ``NUMBA_CACHE_DIR`` (so each tree's
+kernels are compiled from its own sources), then ``compare`` prints, per array,
+the number of elements that differ in any bit (NaNs equal where both are NaN).
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import sys  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+
+def configurations():
+    """(name, N, d, model, mu kind, nu) of each configuration."""
+    for N in (2, 3, 4, 12, 24):
+        yield f"spatial_hard_N{N}", N, 3, "hard_finger", "grasp", None
+    yield "spatial_hard_N3_mu_contact", 3, 3, "hard_finger", "contact", None
+    yield "spatial_hard_N4_mu_scalar", 4, 3, "hard_finger", "scalar", None
+    for N in (2, 3, 4, 12):
+        yield f"planar_hard_N{N}", N, 2, "hard_finger", "grasp", None
+        yield f"soft_N{N}", N, 3, "soft_finger", "grasp", 0.05
+    for N in (4, 7, 12, 24):
+        yield f"frictionless_N{N}", N, 3, "frictionless", "zero", None
+
+
+def grasps(K, N, d, seed):
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=(K, N, d))
+    p /= np.linalg.norm(p, axis=-1, keepdims=True)
+    n = -p + 0.35 * rng.normal(size=(K, N, d))
+    # Rank-deficient and degenerate grasps: contacts on a line, repeated contacts.
+    m = K // 20
+    p[:m] = p[:m, :1] * np.linspace(0.5, 1.5, N)[None, :, None]
+    n[:m] = -p[:m]
+    p[m : 2 * m, -1] = p[m : 2 * m, 0]
+    n[m : 2 * m, -1] = n[m : 2 * m, 0]
+    return p, n
+
+
+def record(out: str, K: int) -> None:
+    from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
+
+    arrays = {}
+    for i, (name, N, d, model, mu_kind, nu) in enumerate(configurations()):
+        p, n = grasps(K, N, d, seed=1000 + i)
+        rng = np.random.default_rng(2000 + i)
+        mu = {
+            "grasp": rng.uniform(0.1, 1.0, K),
+            "contact": rng.uniform(0.1, 1.0, (K, N)),
+            "scalar": 0.5,
+            "zero": 0.0,
+        }[mu_kind]
+        opts = {"model": model, "torsional_friction": nu, "workers": 1}
+        r = batch_force_closure(p, n, mu, **opts)
+        for key in ("d_star", "rank", "is_closure", "margin", "converged"):
+            arrays[f"{name}/{key}"] = np.asarray(getattr(r, key))
+        if r.normal_certificate is not None:
+            arrays[f"{name}/normal_certificate"] = np.asarray(r.normal_certificate)
+        arrays[f"{name}/epsilon"] = np.asarray(batch_epsilon_l1(p, n, mu, **opts))
+        print(name, int(r.is_closure.sum()), "closed of", K, flush=True)
+    np.savez(out, **arrays)
+
+
+def compare(a: str, b: str) -> int:
+    A, B = np.load(a), np.load(b)
+    bad = 0
+    if sorted(A.files) != sorted(B.files):
+        print("different arrays:", sorted(set(A.files) ^ set(B.files)))
+        bad += 1
+    for key in sorted(set(A.files) & set(B.files)):
+        x, y = A[key], B[key]
+        if x.shape != y.shape or x.dtype != y.dtype:
+            print(f"{key}: shape/dtype {x.shape} {x.dtype} vs {y.shape} {y.dtype}")
+            bad += 1
+            continue
+        if x.dtype.kind == "f":
+            bits = x.view(np.uint64) == y.view(np.uint64)
+            same = bits | (np.isnan(x) & np.isnan(y))
+        else:
+            same = x == y
+        diff = int((~same).sum())
+        bad += diff > 0
+        print(f"{key:45s} {x.size:6d} values, {diff} differ")
+    print("BITWISE EQUAL" if bad == 0 else f"{bad} arrays differ")
+    return 1 if bad else 0
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("record")
+    r.add_argument("out")
+    r.add_argument("--grasps", type=int, default=3000)
+    c = sub.add_parser("compare")
+    c.add_argument("a")
+    c.add_argument("b")
+    args = parser.parse_args()
+    if args.cmd == "record":
+        record(args.out, args.grasps)
+        return 0
+    return compare(args.a, args.b)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

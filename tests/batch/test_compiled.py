@@ -1,0 +1,193 @@
+"""The compile machinery: the on-disk cache is used, the numpy route is announced
+once, the first compile says so, and ``drakegrasp warmup`` works.
+
+Timings are never asserted: a warm cache shows as numba's own counters (cache
+hits and misses of a dispatcher, the functions compiled in a process).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drakegrasp.batch import compiled
+from drakegrasp.batch.inputs import resolve_kernel
+
+ROOT = Path(__file__).resolve().parents[2]
+
+pytestmark = pytest.mark.skipif(
+    not compiled.AVAILABLE, reason="numba is not installed (the numpy route runs)"
+)
+
+# A small kernel with callees: compiling it from an empty cache takes a few
+# seconds, loading it takes milliseconds.
+_CHILD = r"""
+import json, sys
+import numpy as np
+from drakegrasp.batch import compiled
+from drakegrasp.batch.build import construction_kernel as ck
+P = np.ascontiguousarray(np.random.default_rng(0).normal(size=(5, 3, 3)))
+Nrm = P.copy()
+out = np.empty(5)
+ck._normalise(Nrm, P, out)
+stats = ck._normalise.stats
+print(json.dumps({
+    "compiled": compiled.compile_count(),
+    "hits": sum(stats.cache_hits.values()),
+    "misses": sum(stats.cache_misses.values()),
+    "out": out.tolist(),
+}))
+"""
+
+
+def _child_env(cache_dir: Path) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir))
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(ROOT)] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
+    )
+    return env
+
+
+def _run(code: str, env: dict, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-c", code, *args],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=True,
+    )
+
+
+def _notices(stderr: str) -> int:
+    return sum("compiling the batch kernels" in line for line in stderr.splitlines())
+
+
+def test_a_second_process_loads_from_the_cache_without_compiling(tmp_path):
+    env = _child_env(tmp_path / "numba-cache")
+    first = _run(_CHILD, env)
+    second = _run(_CHILD, env)
+    a, b = json.loads(first.stdout), json.loads(second.stdout)
+    # The first process compiled (an empty cache misses), and said so once.
+    assert a["misses"] >= 1 and a["hits"] == 0 and a["compiled"] >= 1
+    assert _notices(first.stderr) == 1, first.stderr
+    # The second loaded the same code: hits, no miss, nothing compiled, silent.
+    assert b["hits"] >= 1 and b["misses"] == 0 and b["compiled"] == 0
+    assert _notices(second.stderr) == 0, second.stderr
+    assert a["out"] == b["out"]
+    assert any((tmp_path / "numba-cache").rglob("*.nbi"))
+
+
+def _kernel_dispatchers():
+    import importlib
+
+    from numba.core.registry import CPUDispatcher
+
+    names = [
+        "drakegrasp.batch.build.construction_kernel",
+        "drakegrasp.batch.lp.active_set",
+        "drakegrasp.batch.lp.block_kernel",
+        "drakegrasp.batch.lp.block_ops",
+        "drakegrasp.batch.lp.fused_kernel",
+        "drakegrasp.batch.lp.householder",
+        "drakegrasp.batch.epsilon.kernel",
+        "drakegrasp.batch.epsilon.polytope",
+    ]
+    for name in names:
+        module = importlib.import_module(name)
+        for attr, value in vars(module).items():
+            if isinstance(value, CPUDispatcher) and value.__module__ == name:
+                yield f"{name}.{attr}", value
+
+
+def test_every_kernel_is_cached_on_disk():
+    from numba.core.caching import NullCache
+
+    found = dict(_kernel_dispatchers())
+    assert len(found) >= 40  # the engine's kernels, not an empty scan
+    uncached = [n for n, d in found.items() if isinstance(d._cache, NullCache)]
+    assert uncached == []
+
+
+def test_the_numpy_route_is_announced_once(monkeypatch):
+    import drakegrasp.batch.inputs as inputs
+
+    monkeypatch.setattr(inputs, "numba_available", lambda: False)
+    monkeypatch.setattr(compiled, "_announced", False)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert [resolve_kernel("auto") for _ in range(3)] == ["numpy"] * 3
+        # An explicit choice of the numpy route is not announced.
+        assert resolve_kernel("numpy") == "numpy"
+    ours = [w for w in caught if issubclass(w.category, compiled.NumbaMissingWarning)]
+    assert len(ours) == 1
+    assert "numba is not installed" in str(ours[0].message)
+
+
+_NO_NUMBA = r"""
+import sys, json
+sys.modules["numba"] = None  # as if numba could not be installed
+import numpy as np
+from drakegrasp.batch import batch_force_closure, compiled
+assert not compiled.AVAILABLE
+rng = np.random.default_rng(3)
+p = rng.normal(size=(40, 3, 3)); n = -p + 0.3 * rng.normal(size=(40, 3, 3))
+a = batch_force_closure(p, n, 0.5, workers=1)
+b = batch_force_closure(p, n, 0.5, workers=1)
+print(json.dumps({"a": a.is_closure.tolist(), "b": b.is_closure.tolist()}))
+"""
+
+
+def test_without_numba_the_engine_runs_numpy_and_says_so_once(tmp_path):
+    from drakegrasp.batch import batch_force_closure
+
+    out = _run(_NO_NUMBA, _child_env(tmp_path / "cache"))
+    verdicts = json.loads(out.stdout)
+    lines = [ln for ln in out.stderr.splitlines() if "numba is not installed" in ln]
+    assert len(lines) == 1, out.stderr
+    rng = np.random.default_rng(3)
+    p = rng.normal(size=(40, 3, 3))
+    n = -p + 0.3 * rng.normal(size=(40, 3, 3))
+    reference = batch_force_closure(p, n, 0.5, workers=1, kernel="numpy")
+    assert verdicts["a"] == verdicts["b"] == reference.is_closure.tolist()
+
+
+def test_warmup_compiles_every_route_then_a_new_process_compiles_nothing(capsys):
+    from drakegrasp.cli import main
+
+    assert main(["warmup", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["available"] is True
+    names = [s["name"] for s in report["steps"]]
+    for route in ("force closure", "epsilon", "form closure", "planar", "soft"):
+        assert any(route in n for n in names), (route, names)
+    # Run again in this process: every kernel is in memory, nothing compiles.
+    assert main(["warmup", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["compiled"] == 0
+    # A new process with the same cache loads everything from disk.
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(ROOT)] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
+    )
+    fresh = _run("from drakegrasp.cli import main; main()", env, "warmup", "--json")
+    again = json.loads(fresh.stdout)
+    assert again["compiled"] == 0, again
+    assert [s["name"] for s in again["steps"]] == names
+    assert _notices(fresh.stderr) == 0
+
+
+def test_warmup_prints_its_steps(capsys):
+    from drakegrasp.cli import main
+
+    assert main(["warmup"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("compiling the batch kernels")
+    assert any(line.startswith("  force closure, spatial hard fingers") for line in out)
+    assert out[-1].startswith("done: ")
