@@ -21,6 +21,7 @@ from drakegrasp.closure.grasp_forces import GraspForceResult, grasp_forces
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import check_grasp, real_array
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["BatchGraspForceResult", "batch_grasp_forces"]
@@ -109,9 +110,14 @@ def batch_grasp_forces(
     -------
     BatchGraspForceResult
     """
-    grasps = list(grasps)
+    if isinstance(grasps, (str, bytes)) or not hasattr(grasps, "__iter__"):
+        raise InvalidOptionError(
+            f"grasps must be a sequence of drakegrasp.Grasp, got "
+            f"{type(grasps).__name__}"
+        )
+    grasps = [check_grasp(g, f"grasps[{k}]") for k, g in enumerate(grasps)]
     K = len(grasps)
-    W = np.asarray(wrenches, dtype=float)
+    W = real_array("wrenches", wrenches, error=InvalidOptionError)
     if W.ndim == 1:
         W = np.broadcast_to(W, (K, W.size))
     if W.ndim != 2 or W.shape[0] != K:

@@ -179,6 +179,7 @@ class LoadProblem:
 
 def check_wrench(grasp: Grasp, wrench, name: str = "wrench") -> np.ndarray:
     """A finite ``[f; m]`` of the grasp's wrench dimension (3 planar, 6 spatial)."""
+    _check_grasp(grasp)
     w = real_array(name, wrench, error=InvalidOptionError).reshape(-1)
     D = grasp.wrench_dim
     if w.shape != (D,) or not np.all(np.isfinite(w)):
