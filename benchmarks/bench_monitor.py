@@ -9,7 +9,8 @@ closes on a 0.2 kg box, lifts it 5 cm, lowers it, opens; 3 s simulated, 1 ms
 SAP steps) in three set-ups: point contact with distances from geometry (soft
 fingers), hydroelastic contact with patches from the contact results (flat
 pads, hard fingers), and the same with the monitor's Ferrari–Canny ε (off by
-default).  Then the weak pick's slip-detection times.  For
+default).  Then the weak pick's slip-detection times, and those of the
+WSG-50 + YCB sugar box picks (``tests/systems/wsg_pick_support.py``).  For
 each it prints the wall time of the whole simulation, of the simulation with a
 monitor that never samples (period 1000 s), the median / 90th percentile / max
 cost of one evaluation (the first excluded: it loads the solvers) and the
@@ -91,6 +92,42 @@ def slip_times() -> None:
         )
 
 
+def wsg_slip_times() -> None:
+    """WSG-50 + YCB sugar box: firm and weak picks, slip flagged against 5 mm moved."""
+    from holding_support import FLAGS, timeline
+    from wsg_pick_support import FIRM, LIFT_START, WEAK, build_wsg_pick
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from conftest import local_drake_models
+
+    models = local_drake_models()
+    if models is None:
+        print(
+            "WSG-50 + sugar box: skipped (no drake_models; set DRAKEGRASP_DRAKE_MODELS)"
+        )
+        return
+    print(f"WSG-50 + sugar box (mu='plant'), 10 ms samples, lift at {LIFT_START} s:")
+    for contacts in ("contact_results", "geometry"):
+        for name, squeeze in (("firm", FIRM), ("weak", WEAK)):
+            pick = build_wsg_pick(
+                models,
+                squeeze=squeeze,
+                mu="plant",
+                distance_tolerance=1e-3,
+                contacts=contacts,
+            )
+            pick.run()
+            line = timeline(pick, finger="left_finger", t_ref=LIFT_START)
+            print(
+                f"  {contacts}, {name}: flagged "
+                f"{line.first(FLAGS, after=LIFT_START):.3f} s, moved 5 mm "
+                f"{line.moved(5e-3, after=LIFT_START):.3f} s, dropped "
+                f"{line.first(('dropped',), after=LIFT_START):.3f} s, box moved "
+                f"{1e3 * line.displacement[line.times >= LIFT_START].max():.1f} mm "
+                "in the fingers after the lift began"
+            )
+
+
 def run(period: float, options: dict) -> tuple[float, list[float], object]:
     pick = build_pick(period=period, mu=0.5, distance_tolerance=1e-3, **options)
     costs: list[float] = []
@@ -141,6 +178,7 @@ def main() -> None:
         )
         print(f"  verdicts: {timeline(pick)}")
     slip_times()
+    wsg_slip_times()
 
 
 if __name__ == "__main__":

@@ -133,13 +133,9 @@ _SOURCES = {
         "SecondOrderResult",
         "second_order_form_closure",
     ),
-    "drakegrasp.systems.monitor": (
-        "GraspMonitor",
-        "HOLDING_STATES",
-        "HoldingThresholds",
-        "GraspSample",
-        "add_grasp_monitor",
-    ),
+    "drakegrasp.systems.grasp_monitor": ("GraspMonitor",),
+    "drakegrasp.systems.sample": ("GraspSample",),
+    "drakegrasp.systems.monitor": ("add_grasp_monitor",),
     "drakegrasp.systems.holding": (
         "HOLDING_STATES",
         "HoldingThresholds",

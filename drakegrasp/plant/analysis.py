@@ -223,7 +223,7 @@ def grasp_from_plant(
     mu : float or "plant"
         Friction coefficient of every contact, or ``"plant"``: each contact's
         coefficient from its two geometries' proximity properties
-        (:func:`~drakegrasp.plant.load.plant_friction`).  Required (here or in
+        (:func:`~drakegrasp.plant.friction.plant_friction`).  Required (here or in
         ``options``).
     contact_model : ContactModel or str, optional
         ``"frictionless"``, ``"hard_finger"`` (default) or ``"soft_finger"``.
@@ -316,7 +316,7 @@ def grasp_from_plant(
     elif not contacts:
         raise NoContactsError(f"no contacts given for {_scoped_name(plant, body)!r}")
     if opts.mu == "plant":
-        from drakegrasp.plant.load import plant_friction
+        from drakegrasp.plant.friction import plant_friction
 
         mus = plant_friction(plant, plant_context, contacts, query_object=query_object)
     else:
@@ -589,7 +589,7 @@ def analyze_grasp(
     mu : float or "plant"
         Friction of every contact, or ``"plant"``: each contact's coefficient
         combined from its two geometries' proximity properties
-        (:func:`~drakegrasp.plant.load.plant_friction`).  Required (here or in
+        (:func:`~drakegrasp.plant.friction.plant_friction`).  Required (here or in
         ``options``).
     contact_model, torsional_friction, distance_tolerance, plane
         As in :func:`grasp_from_plant`.

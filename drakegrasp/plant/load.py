@@ -9,14 +9,7 @@ What the plant already knows is read from it, never re-derived:
   joint actuator that drives it (``JointActuator.effort_limit()``; ``inf``
   when an actuator has none); a hand joint without an actuator is passive and
   gets 0 (it can carry no torque).
-* :func:`plant_friction`: per contact, Drake's combined Coulomb coefficient of
-  the two geometries' proximity properties (``material/coulomb_friction``),
-  ``μ = 2 μ_a μ_b / (μ_a + μ_b)``
-  (``CalcContactFrictionFromSurfaceProperties``).  **Which coefficient**: a
-  discrete plant (``time_step > 0``) uses the *dynamic* one — Drake's discrete
-  solvers (TAMSI, SAP) ignore the static coefficient — so that is the one a
-  held object gets in simulation; a continuous plant's Stribeck model lets a
-  sticking contact reach the *static* one, so that one is used there.
+* the plant's friction, per contact (:mod:`drakegrasp.plant.friction`).
 
 :func:`analyze_load` puts them together for
 :func:`~drakegrasp.analyze_grasp` (options ``load``, ``torque_limits`` and
@@ -32,10 +25,7 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
-from pydrake.multibody.plant import (
-    CalcContactFrictionFromSurfaceProperties,
-    MultibodyPlant,
-)
+from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JointActuatorIndex
 
 from drakegrasp.closure.grasp_forces import GraspForceResult, grasp_forces
@@ -43,23 +33,21 @@ from drakegrasp.closure.payload import MaxLoadResult, max_load
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.plant.friction import (
+    friction_disagreement,
+    friction_rule,
+    plant_friction,
+)
 from drakegrasp.plant.jacobians import PLANES
 from drakegrasp.plant.validation import plant_context_of, resolve_object_body
 
 __all__ = [
-    "MU_RELATIVE_TOL",
     "LoadReport",
     "analyze_load",
     "load_section",
-    "friction_rule",
     "gravity_wrench",
-    "plant_friction",
     "plant_torque_limits",
 ]
-
-MU_RELATIVE_TOL = 1e-6
-"""A given ``μ`` that differs from the plant's by more than this (relative) is
-reported as a disagreement."""
 
 
 def gravity_wrench(plant: MultibodyPlant, plant_context, object_body, *, plane=None):
@@ -119,54 +107,6 @@ def plant_torque_limits(
         for j in range(joint.num_velocities()):
             limit_of[joint.velocity_start() + j] = float(actuator.effort_limit())
     return np.array([limit_of.get(int(v), 0.0) for v in velocity_indices], dtype=float)
-
-
-def friction_rule(plant: MultibodyPlant) -> str:
-    """``"dynamic"`` for a discrete plant, ``"static"`` for a continuous one."""
-    return "dynamic" if plant.time_step() > 0.0 else "static"
-
-
-def _coulomb(inspector, geometry_id, name: str):
-    props = inspector.GetProximityProperties(geometry_id)
-    if props is None or not props.HasProperty("material", "coulomb_friction"):
-        raise ModelError(
-            f"geometry {name!r} has no proximity property material/coulomb_friction"
-            "; mu='plant' needs the friction of both geometries of every contact"
-        )
-    return props.GetProperty("material", "coulomb_friction")
-
-
-def plant_friction(
-    plant: MultibodyPlant, plant_context, contacts, *, query_object=None
-) -> np.ndarray:
-    """Per contact, the plant's combined friction coefficient (see the module).
-
-    Parameters
-    ----------
-    plant : MultibodyPlant
-    plant_context : Context
-    contacts : sequence of PlantContact
-    query_object : QueryObject, optional
-        Read the geometry from it instead of the plant's query port.
-
-    Returns
-    -------
-    (N,) float
-        ``2 μ_a μ_b / (μ_a + μ_b)`` of the dynamic (discrete plant) or static
-        (continuous plant) coefficients.
-    """
-    if query_object is None:
-        ctx = plant_context_of(plant, plant_context)
-        query_object = plant.get_geometry_query_input_port().Eval(ctx)
-    inspector = query_object.inspector()
-    dynamic = friction_rule(plant) == "dynamic"
-    out = []
-    for c in contacts:
-        a = _coulomb(inspector, c.object_geometry, c.object_geometry_name)
-        b = _coulomb(inspector, c.finger_geometry, c.finger_geometry_name)
-        pair = CalcContactFrictionFromSurfaceProperties(a, b)
-        out.append(pair.dynamic_friction() if dynamic else pair.static_friction())
-    return np.array(out, dtype=float)
 
 
 @dataclass(frozen=True, eq=False)
@@ -338,16 +278,8 @@ def analyze_load(
     payload = max_load(data.grasp, w, hand_jacobian=J, torque_limits=limits)
     names = _joint_names(plant, data.hand_velocity_indices)
     first = names[payload.saturating_joints[0]] if payload.saturating_joints else None
-    warnings = []
-    if mu_given is not None and mu_plant is not None:
-        off = np.abs(mu_plant - mu_given) > MU_RELATIVE_TOL * np.maximum(mu_plant, 1.0)
-        if np.any(off):
-            warnings.append(
-                f"mu = {mu_given:g} was given but the plant simulates "
-                f"{np.round(np.unique(mu_plant[off]), 6).tolist()} "
-                f"({friction_rule(plant)} friction) at contacts "
-                f"{np.flatnonzero(off).tolist()}; pass mu='plant' to use it"
-            )
+    disagreement = friction_disagreement(plant, mu_given, mu_plant)
+    warnings = [] if disagreement is None else [disagreement]
     return LoadReport(
         wrench=w,
         source="gravity" if isinstance(load, str) else "given",

@@ -159,7 +159,11 @@ class AnalysisOptions:
         if self.characteristic_length is not None:
             put(
                 "characteristic_length",
-                check_length("characteristic_length", self.characteristic_length),
+                check_length(
+                    "characteristic_length",
+                    self.characteristic_length,
+                    error=InvalidOptionError,
+                ),
             )
         put("num_generators", check_num_generators(self.num_generators))
         put("tol", check_tol(self.tol))

@@ -6,12 +6,10 @@ The outer ring: it imports the plant layer, and nothing inside imports it.
 from drakegrasp._lazy import lazy_exports
 
 _SOURCES = {
-    "drakegrasp.systems.monitor": (
-        "VERDICT_NAMES",
-        "GraspMonitor",
-        "GraspSample",
-        "add_grasp_monitor",
-    ),
+    "drakegrasp.systems.grasp_monitor": ("GraspMonitor",),
+    "drakegrasp.systems.sample": ("VERDICT_NAMES", "GraspSample"),
+    "drakegrasp.systems.monitor": ("add_grasp_monitor",),
+    "drakegrasp.systems.monitor_options": ("MonitorSettings",),
     "drakegrasp.systems.holding": ("HOLDING_STATES", "HoldingThresholds"),
 }
 
@@ -23,5 +21,6 @@ __all__ = [
     "GraspMonitor",
     "GraspSample",
     "HoldingThresholds",
+    "MonitorSettings",
     "add_grasp_monitor",
 ]

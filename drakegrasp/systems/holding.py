@@ -30,17 +30,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from pydrake.geometry import GeometryId, QueryObject
-from pydrake.multibody.plant import (
-    CalcContactFrictionFromSurfaceProperties,
-    ContactResults,
-    MultibodyPlant,
-)
+from pydrake.geometry import QueryObject
+from pydrake.multibody.plant import ContactResults, MultibodyPlant
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.contacts import PlantContact, _scoped_name
+from drakegrasp.plant.friction import pair_friction
 
 __all__ = [
     "HOLDING_STATES",
@@ -51,7 +48,6 @@ __all__ = [
     "holding_code",
     "next_holding_state",
     "speeds_against",
-    "plant_friction",
 ]
 
 HOLDING_STATES = (
@@ -148,8 +144,9 @@ class FingerLoad:
     tangential_force : float
         Magnitude of the total tangential force on the object, N (NaN likewise).
     mu : float
-        The plant's friction coefficient of the pair (Drake's combination of
-        the two geometries' dynamic friction; the largest ratio's pair when
+        The plant's friction coefficient of the pair
+        (:func:`~drakegrasp.plant.friction.pair_friction`: Drake's combination of
+        the two geometries' coefficients; the largest ratio's pair when
         several), NaN when unknown.
     friction_use : float
         Largest ``‖f_t‖/(μ f_n)`` over this finger's pairs (0 without load, NaN
@@ -174,34 +171,6 @@ class FingerLoad:
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
         return jsonable(self.__dict__)
-
-
-def plant_friction(
-    query_object: QueryObject, id_a: GeometryId, id_b: GeometryId
-) -> float:
-    """The plant's dynamic friction coefficient of a geometry pair.
-
-    Drake's combination rule (``CalcContactFrictionFromSurfaceProperties``) of
-    the two geometries' ``("material", "coulomb_friction")`` proximity
-    properties; a discrete plant (SAP, TAMSI) uses the dynamic coefficient.
-
-    Raises
-    ------
-    ModelError
-        If either geometry has no friction property.
-    """
-    inspector = query_object.inspector()
-    frictions = []
-    for gid in (id_a, id_b):
-        props = inspector.GetProximityProperties(gid)
-        if props is None or not props.HasProperty("material", "coulomb_friction"):
-            raise ModelError(
-                f"geometry {inspector.GetName(gid)!r} has no ('material', "
-                "'coulomb_friction') proximity property"
-            )
-        frictions.append(props.GetProperty("material", "coulomb_friction"))
-    combined = CalcContactFrictionFromSurfaceProperties(*frictions)
-    return float(combined.dynamic_friction())
 
 
 def _point_velocity(plant, plant_context, body, p_WP: np.ndarray) -> np.ndarray:
@@ -292,7 +261,7 @@ def finger_loads_from_results(
             k, f_W, n_W = index[a], np.asarray(info.contact_force()), -pp.nhat_BA_W
         else:
             continue
-        mu = plant_friction(query_object, pp.id_A, pp.id_B)
+        mu = pair_friction(plant, query_object, pp.id_A, pp.id_B)
         record(k, f_W, np.asarray(n_W), mu, float(info.slip_speed()))
     for i in range(contact_results.num_hydroelastic_contacts()):
         info = contact_results.hydroelastic_contact_info(i)
@@ -314,7 +283,7 @@ def finger_loads_from_results(
         c_W = np.asarray(surface.centroid())
         v_rel = _point_velocity(plant, plant_context, object_body, c_W)
         v_rel = v_rel - _point_velocity(plant, plant_context, finger, c_W)
-        mu = plant_friction(query_object, surface.id_M(), surface.id_N())
+        mu = pair_friction(plant, query_object, surface.id_M(), surface.id_N())
         record(k, f_W, n_W, mu, _split(v_rel, n_W)[1])
     out = []
     for k, body in enumerate(fingers):

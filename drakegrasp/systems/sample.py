@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.plant.analysis import GraspReport
 from drakegrasp.systems.holding import FingerLoad, holding_code
 
 __all__ = ["HOLDING_NAMES", "VERDICT_NAMES", "GraspSample", "verdict_names"]
@@ -54,7 +54,7 @@ def verdict_names(finger_bodies) -> tuple[str, ...]:
     return VERDICT_NAMES + HOLDING_NAMES + tuple(per_finger)
 
 
-def analysis_verdicts(report: GraspReport | None, status: float, epsilon: float):
+def analysis_verdicts(report: Any, status: float, epsilon: float):
     """The seven analysis elements (:data:`VERDICT_NAMES`)."""
     if report is None:
         return np.array([status, 0, 0, 0, 0, 0, 0], dtype=float)
@@ -140,7 +140,7 @@ class GraspSample:
     time: float
     status: str
     message: str
-    report: GraspReport | None
+    report: Any  # a GraspReport or None (not imported: a sample only reads it)
     epsilon: float
     holding: str
     loads: tuple[FingerLoad, ...]

@@ -7,7 +7,8 @@ import pytest
 from pydrake.multibody.tree import JointActuatorIndex
 
 import drakegrasp as dg
-from drakegrasp.plant.load import gravity_wrench, plant_friction, plant_torque_limits
+from drakegrasp.plant.friction import plant_friction
+from drakegrasp.plant.load import gravity_wrench, plant_torque_limits
 
 
 @pytest.fixture

@@ -1,0 +1,161 @@
+r"""The friction a plant simulates, read from its geometries.
+
+Drake stores a Coulomb friction per geometry (the proximity property
+``material/coulomb_friction``) and combines the two of a contact pair as
+``μ = 2 μ_a μ_b / (μ_a + μ_b)`` (``CalcContactFrictionFromSurfaceProperties``).
+
+* :func:`pair_friction`: the combined coefficient of one geometry pair, as a
+  step's contact results name them;
+* :func:`plant_friction`: the same per contact of a grasp read from the plant
+  (``mu="plant"`` in :func:`~drakegrasp.analyze_grasp` and the grasp monitor);
+* :func:`friction_disagreement`: why a ``μ`` typed by hand is not the plant's
+  (the load report's warning, the monitor's
+  :class:`FrictionMismatchWarning`).
+
+**Which coefficient** (:func:`friction_rule`): a discrete plant
+(``time_step > 0``) uses the *dynamic* one — Drake's discrete solvers (TAMSI,
+SAP) ignore the static coefficient — so that is the one a held object gets in
+simulation; a continuous plant's Stribeck model lets a sticking contact reach
+the *static* one, so that one is used there.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.multibody.plant import (
+    CalcContactFrictionFromSurfaceProperties,
+    MultibodyPlant,
+)
+
+from drakegrasp.errors import ModelError
+from drakegrasp.plant.validation import plant_context_of
+
+__all__ = [
+    "MU_RELATIVE_TOL",
+    "FrictionMismatchWarning",
+    "friction_disagreement",
+    "friction_rule",
+    "pair_friction",
+    "plant_friction",
+]
+
+
+class FrictionMismatchWarning(UserWarning):
+    """A given friction coefficient is not the one the plant simulates."""
+
+
+MU_RELATIVE_TOL = 1e-6
+"""A given ``μ`` that differs from the plant's by more than this (relative) is
+reported as a disagreement."""
+
+
+def friction_rule(plant: MultibodyPlant) -> str:
+    """``"dynamic"`` for a discrete plant, ``"static"`` for a continuous one."""
+    return "dynamic" if plant.time_step() > 0.0 else "static"
+
+
+def _coulomb(inspector, geometry_id):
+    props = inspector.GetProximityProperties(geometry_id)
+    if props is None or not props.HasProperty("material", "coulomb_friction"):
+        raise ModelError(
+            f"geometry {inspector.GetName(geometry_id)!r} has no proximity property "
+            "material/coulomb_friction; the plant's friction needs the friction of "
+            "both geometries of every contact"
+        )
+    return props.GetProperty("material", "coulomb_friction")
+
+
+def pair_friction(plant: MultibodyPlant, query_object, id_a, id_b) -> float:
+    """The plant's combined friction coefficient of one geometry pair.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Decides which coefficient (:func:`friction_rule`).
+    query_object : QueryObject
+        Holds the geometries' proximity properties.
+    id_a, id_b : GeometryId
+        The two geometries, in either order.
+
+    Returns
+    -------
+    float
+        ``2 μ_a μ_b / (μ_a + μ_b)`` of the dynamic (discrete plant) or static
+        (continuous plant) coefficients (dimensionless).
+
+    Raises
+    ------
+    ModelError
+        If either geometry has no ``material/coulomb_friction`` property.
+    """
+    inspector = query_object.inspector()
+    pair = CalcContactFrictionFromSurfaceProperties(
+        _coulomb(inspector, id_a), _coulomb(inspector, id_b)
+    )
+    if friction_rule(plant) == "dynamic":
+        return float(pair.dynamic_friction())
+    return float(pair.static_friction())
+
+
+def plant_friction(
+    plant: MultibodyPlant, plant_context, contacts, *, query_object=None
+) -> np.ndarray:
+    """Per contact, the plant's combined friction coefficient (see the module).
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    plant_context : Context
+    contacts : sequence of PlantContact
+    query_object : QueryObject, optional
+        Read the geometry from it instead of the plant's query port.
+
+    Returns
+    -------
+    (N,) float
+        :func:`pair_friction` of each contact's object and finger geometries.
+    """
+    if query_object is None:
+        ctx = plant_context_of(plant, plant_context)
+        query_object = plant.get_geometry_query_input_port().Eval(ctx)
+    return np.array(
+        [
+            pair_friction(plant, query_object, c.object_geometry, c.finger_geometry)
+            for c in contacts
+        ],
+        dtype=float,
+    )
+
+
+def friction_disagreement(
+    plant: MultibodyPlant, mu_given: float | None, mu_plant
+) -> str | None:
+    """Why a given ``μ`` is not the plant's, or None when they agree.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Names the friction rule in the message.
+    mu_given : float or None
+        The coefficient the caller typed (None: nothing to compare).
+    mu_plant : (N,) float or None
+        The plant's coefficient per contact (:func:`plant_friction`).
+
+    Returns
+    -------
+    str or None
+        A sentence naming both values and the contacts where they differ by
+        more than :data:`MU_RELATIVE_TOL` (relative), or None.
+    """
+    if mu_given is None or mu_plant is None:
+        return None
+    mu_plant = np.asarray(mu_plant, dtype=float)
+    off = np.abs(mu_plant - mu_given) > MU_RELATIVE_TOL * np.maximum(mu_plant, 1.0)
+    if not np.any(off):
+        return None
+    return (
+        f"mu = {mu_given:g} was given but the plant simulates "
+        f"{np.round(np.unique(mu_plant[off]), 6).tolist()} "
+        f"({friction_rule(plant)} friction) at contacts "
+        f"{np.flatnonzero(off).tolist()}; pass mu='plant' to use it"
+    )

@@ -1,0 +1,424 @@
+"""The grasp monitor System: a ``LeafSystem`` that samples a grasp's analysis.
+
+See :mod:`drakegrasp.systems.monitor` for what the monitor sees in each
+contact mode, its timing and its outputs; this module holds the System
+itself: its ports, its state and one sample (:meth:`GraspMonitor.evaluate`).
+"""
+
+from __future__ import annotations
+
+import time as _time
+import warnings
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.geometry import QueryObject
+from pydrake.multibody.plant import ContactResults, MultibodyPlant
+from pydrake.systems.framework import Context, EventStatus, LeafSystem, State
+
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE, DEFAULT_TOL
+from drakegrasp.errors import (
+    GraspError,
+    InvalidOptionError,
+    ModelError,
+    NoContactsError,
+)
+from drakegrasp.plant.analysis import analyze_grasp
+from drakegrasp.plant.contacts import (
+    HandSpec,
+    _scoped_name,
+    hand_bodies,
+    resolve_object_body,
+)
+from drakegrasp.plant.friction import (
+    FrictionMismatchWarning,
+    friction_disagreement,
+    plant_friction,
+)
+from drakegrasp.plant.options import AnalysisOptions
+from drakegrasp.quality import ferrari_canny
+from drakegrasp.systems.holding import (
+    HoldingThresholds,
+    next_holding_state,
+    speeds_against,
+)
+from drakegrasp.systems.monitor_options import monitor_settings
+from drakegrasp.systems.sample import (
+    GraspSample,
+    analysis_verdicts,
+    grip_verdicts,
+    verdict_names,
+)
+from drakegrasp.systems.sensing import no_loads, sense_contacts
+
+__all__ = ["GraspMonitor"]
+
+_STATUS_CODE = {"ok": 1.0, "no contact": 0.0, "invalid": -1.0, "not sampled": 0.0}
+
+
+class GraspMonitor(LeafSystem):
+    """Analyse the grasp of a simulated plant every ``period`` seconds.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        The finalized plant of the simulation (registered with a SceneGraph).
+    object_body, hand
+        As in :func:`drakegrasp.analyze_grasp`.
+    options : AnalysisOptions, optional
+        The analysis options of every sample, validated when they were made;
+        give them or the keywords below, not both.  A ``load`` in them adds the
+        load section to every sample's report.
+    mu : float or "plant"
+        Friction coefficient of the analysis, or ``"plant"``: each contact's
+        coefficient from its geometries' proximity properties.  Required (here
+        or in ``options``).  A number that disagrees with the plant's friction
+        at the contacts is warned about (:class:`FrictionMismatchWarning`,
+        once per monitor) and kept in :attr:`friction_warning`.  Friction in
+        use is always computed with the plant's own coefficients.
+    contact_model, torsional_friction, distance_tolerance, plane
+        As in :func:`drakegrasp.analyze_grasp` (or ``options``).
+    characteristic_length, num_generators, tol, allow_penetration, patches
+        As in :func:`drakegrasp.analyze_grasp` (or ``options``).
+    check_pose : bool, optional
+        As in :func:`drakegrasp.analyze_grasp`: a pose that the check refuses
+        (penetration deeper than ``distance_tolerance`` by any hand body, a
+        joint off its limits) gives an ``"invalid"`` sample, not an exception.
+    contacts : {"geometry", "contact_results"}, optional
+        Signed distances (default), or the plant's contact results (then the
+        ``contact_results`` input port exists and must be connected).  See
+        :mod:`drakegrasp.systems.monitor` for what each can see.
+    period : float, optional
+        Seconds between samples (default 0.05, at least
+        :data:`~drakegrasp.systems.monitor_options.MIN_PERIOD`).
+    offset : float, optional
+        Time of the first periodic sample (default 0); a sample is also taken
+        at initialization.
+    compute_epsilon : bool, optional
+        Compute the Ferrari–Canny ε of force-closure samples (default False:
+        it is the costliest part of a sample).
+    holding : HoldingThresholds, optional
+        Thresholds of the holding state and the hysteresis (default
+        ``HoldingThresholds()``).
+
+    Notes
+    -----
+    Input ports: ``plant_state`` (vector, ``nq + nv``), ``query_object``
+    (abstract ``QueryObject``), and with ``contacts="contact_results"``
+    ``contact_results`` (abstract ``ContactResults``).  Output ports:
+    ``verdicts`` (vector, :attr:`verdict_names`) and ``report`` (abstract
+    :class:`~drakegrasp.systems.sample.GraspSample`).  Both are state: they
+    change only at samples.
+
+    Raises
+    ------
+    InvalidOptionError
+        For an unfinalized plant, a bad period, offset, flag or contact
+        source, ``options`` next to a keyword, or options that
+        :class:`~drakegrasp.AnalysisOptions` refuses.
+    """
+
+    STATUS, FORCE_CLOSURE, FORM_CLOSURE, ANTIPODAL = 0, 1, 2, 3
+    NUM_CONTACTS, D_STAR, EPSILON = 4, 5, 6
+    HOLDING, FRICTION_USE, SLIP_SPEED, RELATIVE_SPEED, CONTACT_GAP = 7, 8, 9, 10, 11
+
+    def __init__(
+        self,
+        plant: MultibodyPlant,
+        *,
+        object_body,
+        hand: HandSpec = None,
+        options: AnalysisOptions | None = None,
+        mu: float | str | None = None,
+        contact_model: ContactModel | str = ContactModel.HARD_FINGER,
+        torsional_friction: float | None = None,
+        distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
+        plane: str | None = None,
+        characteristic_length: float | None = None,
+        num_generators: int = DEFAULT_NUM_GENERATORS,
+        tol: float = DEFAULT_TOL,
+        allow_penetration: bool = False,
+        patches: str = "vertices",
+        check_pose: bool = True,
+        contacts: str = "geometry",
+        period: float = 0.05,
+        offset: float = 0.0,
+        compute_epsilon: bool = False,
+        holding: HoldingThresholds | None = None,
+    ):
+        super().__init__()
+        if not isinstance(plant, MultibodyPlant) or not plant.is_finalized():
+            raise InvalidOptionError(
+                f"GraspMonitor needs a finalized pydrake MultibodyPlant, got {plant!r}"
+            )
+        self.settings = monitor_settings(
+            options,
+            contacts=contacts,
+            period=period,
+            offset=offset,
+            compute_epsilon=compute_epsilon,
+            holding=holding,
+            mu=mu,
+            contact_model=contact_model,
+            torsional_friction=torsional_friction,
+            distance_tolerance=distance_tolerance,
+            plane=plane,
+            characteristic_length=characteristic_length,
+            num_generators=num_generators,
+            tol=tol,
+            allow_penetration=allow_penetration,
+            patches=patches,
+            check_pose=check_pose,
+        )
+        """The validated options (a ``MonitorSettings``)."""
+        self.period = self.settings.period
+        """Seconds between samples."""
+        self.friction_warning: str | None = None
+        """Why the given ``mu`` is not the plant's friction (None until seen)."""
+        self._plant = plant
+        self._body = resolve_object_body(plant, object_body)
+        self._bodies = hand_bodies(plant, self._body, hand)
+        self.verdict_names = verdict_names(
+            [_scoped_name(plant, f) for f in self._bodies]
+        )
+        """Names of the ``verdicts`` output's elements."""
+        self._plant_context = plant.CreateDefaultContext()
+        self._declare_ports_and_state(plant.num_multibody_states())
+
+    def _declare_ports_and_state(self, nx: int) -> None:
+        self._state_port = self.DeclareVectorInputPort("plant_state", nx)
+        self._query_port = self.DeclareAbstractInputPort(
+            "query_object", AbstractValue.Make(QueryObject())
+        )
+        self._results_port = None
+        if self.settings.contacts == "contact_results":
+            self._results_port = self.DeclareAbstractInputPort(
+                "contact_results", AbstractValue.Make(ContactResults())
+            )
+        empty = self._sample(
+            0.0, "not sampled", "", None, 0.0, np.zeros(nx), 0.0, grip=None
+        )
+        self._verdict_index = self.DeclareDiscreteState(len(self.verdict_names))
+        self._report_index = self.DeclareAbstractState(AbstractValue.Make(empty))
+        self.DeclareStateOutputPort("verdicts", self._verdict_index)
+        self.DeclareStateOutputPort("report", self._report_index)
+        self.DeclareInitializationUnrestrictedUpdateEvent(self._update)
+        self.DeclarePeriodicUnrestrictedUpdateEvent(
+            self.settings.period, self.settings.offset, self._update
+        )
+
+    # Ports ---------------------------------------------------------------
+    def get_plant_state_input_port(self):
+        """Input: the plant's state ``[q; v]`` (``plant.get_state_output_port()``)."""
+        return self._state_port
+
+    def get_query_object_input_port(self):
+        """Input: the scene graph's ``QueryObject`` (``get_query_output_port()``)."""
+        return self._query_port
+
+    def get_contact_results_input_port(self):
+        """Input: the plant's ``ContactResults``; only with contact results."""
+        if self._results_port is None:
+            raise InvalidOptionError(
+                "this monitor reads contacts from geometry; build it with "
+                "contacts='contact_results' to have a contact_results port"
+            )
+        return self._results_port
+
+    def get_verdicts_output_port(self):
+        """Output: the verdict vector (named by :attr:`verdict_names`)."""
+        return self.GetOutputPort("verdicts")
+
+    def get_report_output_port(self):
+        """Output: the latest :class:`~drakegrasp.systems.sample.GraspSample`."""
+        return self.GetOutputPort("report")
+
+    # One sample ----------------------------------------------------------
+    def _no_loads(self):
+        return no_loads(
+            self._plant, self._bodies, forces_seen=self._results_port is not None
+        )
+
+    def _sample(self, t, status, message, report, epsilon, x, start, *, grip):
+        """A GraspSample; ``grip`` = (holding, loads, speeds, gap, last, normals)."""
+        if grip is None:
+            grip = ("no contact", self._no_loads(), (np.nan, 0.0), 0, "no contact", ())
+        holding, loads, (relative, sliding), gap, last, normals = grip
+        verdicts = np.concatenate(
+            [
+                analysis_verdicts(report, _STATUS_CODE[status], epsilon),
+                grip_verdicts(holding, loads, relative, gap),
+            ]
+        )
+        return GraspSample(
+            time=float(t),
+            status=status,
+            message=message,
+            report=report,
+            epsilon=epsilon,
+            holding=holding,
+            loads=tuple(loads),
+            relative_speed=relative,
+            sliding_speed=sliding,
+            last_normals=normals,
+            contact_gap=gap,
+            last_grip=last,
+            names=self.verdict_names,
+            verdicts=verdicts,
+            state=x,
+            seconds=_time.perf_counter() - start if start else 0.0,
+        )
+
+    def _validate(self, context) -> None:
+        if not isinstance(context, Context):
+            raise InvalidOptionError(
+                f"expected this GraspMonitor's pydrake Context, got "
+                f"{type(context).__name__}"
+            )
+        try:
+            self.ValidateContext(context)
+        except RuntimeError as e:
+            raise InvalidOptionError(
+                "this context belongs to another system; pass "
+                "monitor.GetMyContextFromRoot(root_context) or "
+                f"monitor.CreateDefaultContext() ({e})"
+            ) from None
+
+    def _check_friction(self, contacts, query) -> None:
+        """Warn, once, when the given ``mu`` is not the plant's at ``contacts``."""
+        mu = self.settings.analysis.mu
+        if self.friction_warning is not None or isinstance(mu, str):
+            return
+        try:
+            mu_plant = plant_friction(
+                self._plant, self._plant_context, contacts, query_object=query
+            )
+        except ModelError:  # a geometry without friction: nothing to compare
+            return
+        message = friction_disagreement(self._plant, mu, mu_plant)
+        if message is not None:
+            self.friction_warning = message
+            warnings.warn(
+                f"GraspMonitor {self.get_name()!r}: {message}",
+                FrictionMismatchWarning,
+                stacklevel=3,
+            )
+
+    def _analyse(self, context, query):
+        """(status, message, report, loads) of the plant state in the context."""
+        sensed = None
+        try:
+            results = None
+            if self._results_port is not None:
+                results = self._results_port.Eval(context)
+            sensed = sense_contacts(
+                self._plant,
+                self._plant_context,
+                query,
+                object_body=self._body,
+                fingers=self._bodies,
+                analysis=self.settings.analysis,
+                thresholds=self.settings.thresholds,
+                contact_results=results,
+            )
+            if sensed.missing is not None:
+                return "no contact", str(sensed.missing), None, sensed.loads
+            self._check_friction(sensed.contacts, query)
+            report = analyze_grasp(
+                self._plant,
+                self._plant_context,
+                self._body,
+                hand=self._bodies,
+                options=self.settings.analysis,
+                query_object=query,
+                contacts=sensed.contacts,
+            )
+            return "ok", "", report, sensed.loads
+        except NoContactsError as e:
+            status, message = "no contact", str(e)
+        except GraspError as e:  # the pose: penetration, a non-planar normal...
+            status, message = "invalid", str(e)
+        except (ValueError, ArithmeticError) as e:  # degenerate contact data
+            status, message = "invalid", f"{type(e).__name__}: {e}"
+        loads = self._no_loads() if sensed is None else sensed.loads
+        return status, message, None, loads
+
+    def evaluate(self, context: Context) -> GraspSample:
+        """Analyse the grasp at the inputs of ``context`` (one sample).
+
+        The holding state continues from the sample held in ``context``'s
+        state (the previous sample).
+
+        Raises
+        ------
+        InvalidOptionError
+            If ``context`` is not a context of this monitor.
+        """
+        start = _time.perf_counter()
+        self._validate(context)
+        previous = context.get_abstract_state(self._report_index).get_value()
+        t = context.get_time()
+        x = np.array(self._state_port.Eval(context), dtype=float)
+        if not np.all(np.isfinite(x)):
+            bad = np.flatnonzero(~np.isfinite(x))
+            kept = (previous.holding, previous.loads, (np.nan, 0.0))
+            kept += (previous.contact_gap, previous.last_grip, previous.last_normals)
+            message = (
+                f"the plant state has non-finite entries at indices {bad[:8].tolist()}"
+            )
+            return self._sample(t, "invalid", message, None, 0.0, x, start, grip=kept)
+        self._plant.SetPositionsAndVelocities(self._plant_context, x)
+        query = self._query_port.Eval(context)
+        status, message, report, loads = self._analyse(context, query)
+        grip = self._grip(previous, report, loads)
+        epsilon = 0.0
+        if grip[3] > 0 and previous.report is not None:  # bridge the gap
+            status, report, epsilon = previous.status, previous.report, previous.epsilon
+            message = f"no contact in this sample ({message}); the last grip is held"
+        elif (
+            report is not None
+            and self.settings.compute_epsilon
+            and report.is_force_closure
+        ):
+            epsilon = float(
+                ferrari_canny(
+                    report.grasp, num_generators=self.settings.analysis.num_generators
+                )
+            )
+        return self._sample(t, status, message, report, epsilon, x, start, grip=grip)
+
+    def _grip(self, previous: GraspSample, report, loads):
+        """The holding state after ``previous``: (holding, loads, speeds, gap, ...)."""
+        touching = tuple(
+            (k, load.normal_W) for k, load in enumerate(loads) if load.touching
+        )
+        against = touching or previous.last_normals  # the last fingers if none now
+        relative, sliding = speeds_against(
+            self._plant,
+            self._plant_context,
+            self._body,
+            [(self._bodies[k], n_W) for k, n_W in against],
+        )
+        if not touching:
+            relative = np.nan
+        uses = [f.friction_use for f in loads if not np.isnan(f.friction_use)]
+        holding, gap, last = next_holding_state(
+            previous.holding,
+            previous.contact_gap,
+            touching=bool(touching),
+            grasped=report is not None and report.is_force_closure,
+            friction_use=max(uses) if uses else np.nan,
+            slip_speed=max(f.slip_speed for f in loads),
+            sliding_away=sliding,
+            last_grip=previous.last_grip,
+            thresholds=self.settings.thresholds,
+        )
+        return holding, loads, (relative, sliding), gap, last, against
+
+    def _update(self, context: Context, state: State) -> EventStatus:
+        sample = self.evaluate(context)
+        state.get_mutable_discrete_state(self._verdict_index).set_value(sample.verdicts)
+        state.get_mutable_abstract_state(self._report_index).set_value(sample)
+        return EventStatus.Succeeded()

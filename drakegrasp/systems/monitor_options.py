@@ -1,0 +1,152 @@
+"""The grasp monitor's options, checked once when the monitor is made.
+
+:class:`MonitorSettings` holds what a :class:`~drakegrasp.GraspMonitor` needs
+besides its plant, object and hand: the analysis options (an
+:class:`~drakegrasp.AnalysisOptions`, the object
+:func:`~drakegrasp.analyze_grasp` takes), where the contacts come from, when it
+samples, whether it computes ε, and the holding thresholds.
+:func:`monitor_settings` makes one from a monitor's keywords, refusing at
+construction every option that no configuration of the plant could fix, so a
+bad value stops there and not in the middle of a simulation.
+"""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import check_flag
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.plant.options import AnalysisOptions, resolve_options
+from drakegrasp.systems.holding import HoldingThresholds
+
+__all__ = ["CONTACT_SOURCES", "MIN_PERIOD", "MonitorSettings", "monitor_settings"]
+
+CONTACT_SOURCES = ("geometry", "contact_results")
+"""Where a monitor's contacts come from: signed distances, or the plant's results."""
+
+MIN_PERIOD = 1e-6
+"""Shortest sample period (s) accepted: a plant steps at ~1e-3 s."""
+
+
+@dataclass(frozen=True)
+class MonitorSettings:
+    """A grasp monitor's validated options.
+
+    Attributes
+    ----------
+    analysis : AnalysisOptions
+        What each sample's :func:`~drakegrasp.analyze_grasp` is given (``mu`` is
+        set: a number or ``"plant"``).
+    contacts : {"geometry", "contact_results"}
+        Where the contacts come from.
+    period : float
+        Seconds between samples (>= :data:`MIN_PERIOD`).
+    offset : float
+        Time of the first periodic sample, s (>= 0).
+    compute_epsilon : bool
+        Compute the Ferrari–Canny ε of force-closure samples.
+    thresholds : HoldingThresholds
+        When a grip is at risk, slips, or has lost contact.
+    """
+
+    analysis: AnalysisOptions
+    contacts: str
+    period: float
+    offset: float
+    compute_epsilon: bool
+    thresholds: HoldingThresholds
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return jsonable(
+            {
+                "analysis": self.analysis.to_dict(),
+                "contacts": self.contacts,
+                "period": self.period,
+                "offset": self.offset,
+                "compute_epsilon": self.compute_epsilon,
+                "thresholds": self.thresholds.to_dict(),
+            }
+        )
+
+    def __str__(self) -> str:
+        mu = self.analysis.mu
+        return (
+            f"MonitorSettings(contacts={self.contacts}, every {self.period:g} s "
+            f"from {self.offset:g} s, mu={mu if isinstance(mu, str) else f'{mu:g}'}, "
+            f"{self.analysis.contact_model.value}, epsilon "
+            f"{'on' if self.compute_epsilon else 'off'})"
+        )
+
+
+def seconds(name: str, value: Any, *, least: float) -> float:
+    """``value`` as finite seconds >= ``least``, or an InvalidOptionError."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InvalidOptionError(
+            f"{name} must be a real number of seconds, got {value!r} "
+            f"({type(value).__name__})"
+        )
+    value = float(value)
+    if not np.isfinite(value) or value < least:
+        raise InvalidOptionError(
+            f"{name} must be finite and >= {least:g} s, got {value!r}"
+        )
+    return value
+
+
+def monitor_settings(
+    options: AnalysisOptions | None,
+    *,
+    contacts: str,
+    period: Any,
+    offset: Any,
+    compute_epsilon: Any,
+    holding: HoldingThresholds | None,
+    **analysis_keywords: Any,
+) -> MonitorSettings:
+    """A monitor's options, validated once.
+
+    Parameters
+    ----------
+    options : AnalysisOptions or None
+        The analysis options; give them or ``analysis_keywords``, not both
+        (:func:`~drakegrasp.plant.options.resolve_options`).
+    contacts, period, offset, compute_epsilon, holding
+        As in :class:`~drakegrasp.GraspMonitor`.
+    **analysis_keywords
+        The fields of :class:`~drakegrasp.AnalysisOptions` given one by one.
+
+    Returns
+    -------
+    MonitorSettings
+
+    Raises
+    ------
+    InvalidOptionError
+        For a missing ``mu`` (or a soft finger's ``ν``), any invalid analysis
+        option, an unknown contact source, a period or offset that is not
+        finite seconds in range, a flag that is not a bool, or ``holding``
+        that is not a :class:`~drakegrasp.HoldingThresholds`.
+    """
+    if not isinstance(contacts, str) or contacts not in CONTACT_SOURCES:
+        raise InvalidOptionError(
+            f"contacts must be one of {CONTACT_SOURCES}, got {contacts!r}"
+        )
+    holding = HoldingThresholds() if holding is None else holding
+    if not isinstance(holding, HoldingThresholds):
+        raise InvalidOptionError(
+            f"holding must be a HoldingThresholds, got {type(holding).__name__}"
+        )
+    return MonitorSettings(
+        analysis=resolve_options(options, **analysis_keywords).require_friction(),
+        contacts=contacts,
+        period=seconds("period", period, least=MIN_PERIOD),
+        offset=seconds("offset", offset, least=0.0),
+        compute_epsilon=check_flag("compute_epsilon", compute_epsilon),
+        thresholds=holding,
+    )

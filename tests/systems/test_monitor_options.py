@@ -1,0 +1,185 @@
+"""GraspMonitor's options: one AnalysisOptions or keywords, and the plant's friction.
+
+The monitor takes the object :func:`drakegrasp.analyze_grasp` takes
+(``options=AnalysisOptions(...)``) or the same keywords, never both; it reads
+μ from the plant with ``mu="plant"`` and warns once when a typed μ is not the
+plant's.  The plant's friction is checked against Drake's combination rule
+written out here, ``2 μ_a μ_b / (μ_a + μ_b)`` of the geometries' dynamic
+coefficients (the plant is discrete).
+"""
+
+import warnings
+
+import numpy as np
+import pytest
+from pick_support import build_pick
+
+import drakegrasp as dg
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.plant.friction import (
+    FrictionMismatchWarning,
+    pair_friction,
+    plant_friction,
+)
+from drakegrasp.systems.grasp_monitor import GraspMonitor
+from drakegrasp.systems.monitor_options import MonitorSettings
+
+BOX = "box::box"
+GRIPPED = 1.2  # s: the fingers are closed on the box, before the lift
+
+
+@pytest.fixture(scope="module")
+def gripped():
+    """A pick run until the fingers squeeze the box; warnings of the run kept."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        pick = build_pick(mu=0.5, distance_tolerance=1e-3)
+        pick.run(GRIPPED)
+    pick.caught = caught
+    return pick
+
+
+def _evaluate(pick, monitor):
+    """One sample of a standalone ``monitor`` at the pick's current state."""
+    root = pick.simulator.get_context()
+    own = monitor.CreateDefaultContext()
+    x = pick.plant.GetPositionsAndVelocities(pick.plant.GetMyContextFromRoot(root))
+    monitor.get_plant_state_input_port().FixValue(own, x)
+    query = pick.scene_graph.get_query_output_port().Eval(
+        pick.scene_graph.GetMyContextFromRoot(root)
+    )
+    monitor.get_query_object_input_port().FixValue(own, query)
+    return monitor.evaluate(own)
+
+
+def _combined(inspector, id_a, id_b):
+    """Drake's rule, written out: the harmonic mean of the dynamic coefficients."""
+    a, b = (
+        inspector.GetProximityProperties(g)
+        .GetProperty("material", "coulomb_friction")
+        .dynamic_friction()
+        for g in (id_a, id_b)
+    )
+    return 2 * a * b / (a + b)
+
+
+def test_options_object_and_keywords_give_the_same_samples(gripped):
+    keywords = GraspMonitor(
+        gripped.plant, object_body=BOX, mu=1.0, distance_tolerance=1e-3
+    )
+    options = dg.AnalysisOptions(mu=1.0, distance_tolerance=1e-3)
+    given = GraspMonitor(gripped.plant, object_body=BOX, options=options)
+    assert given.settings.analysis == options == keywords.settings.analysis
+    a, b = _evaluate(gripped, keywords), _evaluate(gripped, given)
+    assert a.status == b.status == "ok"
+    np.testing.assert_array_equal(a.verdicts, b.verdicts)
+    assert a.report.options == b.report.options == options
+
+
+def test_options_and_a_differing_keyword_are_refused(gripped):
+    options = dg.AnalysisOptions(mu=0.5)
+    with pytest.raises(InvalidOptionError, match=r"distance_tolerance.*not both"):
+        GraspMonitor(
+            gripped.plant, object_body=BOX, options=options, distance_tolerance=1e-3
+        )
+    with pytest.raises(InvalidOptionError, match="options must be an AnalysisOptions"):
+        GraspMonitor(gripped.plant, object_body=BOX, options={"mu": 0.5})
+
+
+def test_a_monitor_needs_mu_and_a_soft_fingers_nu(gripped):
+    with pytest.raises(InvalidOptionError, match="needs mu"):
+        GraspMonitor(gripped.plant, object_body=BOX)
+    with pytest.raises(InvalidOptionError, match="needs mu"):
+        GraspMonitor(gripped.plant, object_body=BOX, options=dg.AnalysisOptions())
+    with pytest.raises(InvalidOptionError, match="torsional_friction"):
+        GraspMonitor(
+            gripped.plant, object_body=BOX, mu=0.5, contact_model="soft_finger"
+        )
+
+
+def test_settings_say_what_the_monitor_does(gripped):
+    monitor = GraspMonitor(
+        gripped.plant, object_body=BOX, mu="plant", period=0.02, offset=0.01
+    )
+    s = monitor.settings
+    assert isinstance(s, MonitorSettings)
+    assert (s.period, s.offset, s.contacts, s.compute_epsilon) == (
+        0.02,
+        0.01,
+        "geometry",
+        False,
+    )
+    d = s.to_dict()
+    assert d["analysis"]["mu"] == "plant" and d["thresholds"]["risk"] == 0.8
+    assert "mu=plant" in str(s) and "every 0.02 s" in str(s)
+    with pytest.raises(Exception):  # noqa: B017 - frozen
+        s.period = 1.0
+
+
+def test_plant_friction_is_drakes_rule_per_pair(gripped):
+    sample = _evaluate(
+        gripped,
+        GraspMonitor(gripped.plant, object_body=BOX, mu=1.0, distance_tolerance=1e-3),
+    )
+    contacts = sample.report.contacts
+    assert len(contacts) >= 2
+    root = gripped.simulator.get_context()
+    query = gripped.scene_graph.get_query_output_port().Eval(
+        gripped.scene_graph.GetMyContextFromRoot(root)
+    )
+    inspector = query.inspector()
+    expected = [
+        _combined(inspector, c.object_geometry, c.finger_geometry) for c in contacts
+    ]
+    mus = plant_friction(gripped.plant, None, contacts, query_object=query)
+    np.testing.assert_allclose(mus, expected, rtol=1e-12)
+    for c, mu in zip(contacts, expected, strict=True):  # either order of the pair
+        pair = (c.object_geometry, c.finger_geometry)
+        assert pair_friction(gripped.plant, query, *pair) == pytest.approx(mu)
+        assert pair_friction(gripped.plant, query, *pair[::-1]) == pytest.approx(mu)
+
+
+def test_mu_plant_analyses_with_the_plants_friction(gripped):
+    monitor = GraspMonitor(
+        gripped.plant, object_body=BOX, mu="plant", distance_tolerance=1e-3
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FrictionMismatchWarning)
+        sample = _evaluate(gripped, monitor)
+    assert sample.status == "ok"
+    assert monitor.friction_warning is None
+    root = gripped.simulator.get_context()
+    query = gripped.scene_graph.get_query_output_port().Eval(
+        gripped.scene_graph.GetMyContextFromRoot(root)
+    )
+    expected = [
+        _combined(query.inspector(), c.object_geometry, c.finger_geometry)
+        for c in sample.report.contacts
+    ]
+    used = [c.mu for c in sample.report.grasp.contacts]
+    np.testing.assert_allclose(used, expected, rtol=1e-12)
+    assert not np.allclose(used, 0.5)  # the plant's, not the typed default
+
+
+def test_a_typed_mu_that_is_not_the_plants_is_warned_once(gripped):
+    mismatch = [w for w in gripped.caught if w.category is FrictionMismatchWarning]
+    assert len(mismatch) == 1, [str(w.message) for w in mismatch]
+    text = str(mismatch[0].message)
+    assert "mu = 0.5 was given but the plant simulates [1.0]" in text
+    assert "mu='plant'" in text and "grasp_monitor" in text
+    assert gripped.monitor.friction_warning in text
+    agreeing = GraspMonitor(
+        gripped.plant, object_body=BOX, mu=1.0, distance_tolerance=1e-3
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FrictionMismatchWarning)
+        assert _evaluate(gripped, agreeing).status == "ok"
+    assert agreeing.friction_warning is None
+
+
+def test_no_warning_before_contact():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FrictionMismatchWarning)
+        pick = build_pick(mu=0.5, distance_tolerance=1e-3)
+        pick.run(0.3)  # the fingers are still open
+    assert pick.monitor.friction_warning is None

@@ -1,0 +1,68 @@
+"""The holding state in a pick with real models: the WSG-50 and the YCB sugar box.
+
+A firm grip (fingers commanded 10 mm past the box, ~10 N per pad with μ = 1)
+lifts the 0.514 kg box 8 cm; a weak one (1.5 mm past, ~1.5 N per pad: two
+pads carry at most ~3 N < 5.04 N) slides up the box, which stays on the
+ground, until the pads leave it.  What the box did is read from the logged
+plant states, apart from the monitor (``holding_support.timeline``).  The
+monitor reads μ from the plant (``mu="plant"``).
+"""
+
+import pytest
+from holding_support import FLAGS, timeline
+from wsg_pick_support import (
+    BOX_HALF_HEIGHT,
+    FIRM,
+    LIFT,
+    LIFT_START,
+    WEAK,
+    build_wsg_pick,
+)
+
+MOVED = 5e-3  # m
+PADS_OFF = 1.45  # s: by then the weak pick's pads have slid off the box top
+MODES = ["contact_results", "geometry"]
+
+
+def _run(models_dir, squeeze, contacts):
+    pick = build_wsg_pick(
+        models_dir,
+        squeeze=squeeze,
+        mu="plant",
+        distance_tolerance=1e-3,
+        contacts=contacts,
+    )
+    pick.run()
+    return timeline(pick, finger="left_finger", t_ref=LIFT_START)
+
+
+@pytest.mark.parametrize("contacts", MODES)
+def test_firm_wsg_pick_is_holding_throughout_the_lift(drake_models_dir, contacts):
+    line = _run(drake_models_dir, FIRM, contacts)
+    airborne = line.height > BOX_HALF_HEIGHT + 5e-4
+    assert airborne.sum() > 50
+    assert line.height.max() > BOX_HALF_HEIGHT + LIFT - 2e-3  # lifted 8 cm
+    assert line.displacement[line.times >= LIFT_START].max() < 2e-3  # it held
+    held = [s for s, up in zip(line.states, airborne, strict=True) if up]
+    assert set(held) == {"holding"}, held
+
+
+@pytest.mark.parametrize("contacts", MODES)
+def test_weak_wsg_pick_is_flagged_before_it_moves_5_mm_and_dropped_after(
+    drake_models_dir, contacts
+):
+    line = _run(drake_models_dir, WEAK, contacts)
+    moved = line.moved(MOVED, after=LIFT_START)
+    flagged = line.first(FLAGS, after=LIFT_START)
+    dropped = line.first(("dropped",), after=LIFT_START)
+    print(
+        f"WSG-50 + sugar box, {contacts}: flagged {flagged:.3f} s, moved 5 mm "
+        f"{moved:.3f} s, dropped {dropped:.3f} s"
+    )
+    assert line.height.max() < BOX_HALF_HEIGHT + 5e-4  # it never left the ground
+    assert moved < LIFT_START + 0.2  # the fingers slid along it
+    assert flagged < moved
+    assert flagged <= dropped < PADS_OFF
+    after = [s for t, s in zip(line.times, line.states, strict=True) if t >= flagged]
+    assert "holding" not in after
+    assert line.states[-1] == "dropped"  # the pads have left the box
