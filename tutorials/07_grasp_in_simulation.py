@@ -23,12 +23,20 @@
 # simulation, every `period` seconds, and reports
 #
 # - a vector output: status, force closure, form closure, antipodal, number of
-#   contacts, $d^*$ (the force-closure margin of LP2) and the Ferrari–Canny
-#   $\varepsilon$;
+#   contacts, $d^*$ of LP2, the Ferrari–Canny $\varepsilon$ (when asked), and the
+#   grip as the simulator sees it: a *holding state* (holding, at risk, slipping,
+#   dropped, ...), the friction in use $\|f_t\| / (\mu f_n)$ and the slip speed;
 # - an abstract output holding the full report of the latest sample.
 #
+# $d^*$ is the geometric distance of the best internal force to the friction
+# cones' boundaries: it depends on where the contacts are, their normals and
+# $\mu$, not on how hard the fingers squeeze or what the object weighs.  Whether
+# the grip *holds* is the holding state's question, read from the forces and slip
+# speeds of the plant's contact results (and, without a simulation,
+# `drakegrasp.grasp_forces` and the report's `load` section, tutorial 10).
+#
 # Here a parallel-jaw gripper picks a box off the ground, lifts it 5 cm, puts it
-# down and lets go, and we watch the margin over time.
+# down and lets go, and we watch both over time: first a firm grip, then a weak one.
 
 # %%
 import os
@@ -97,7 +105,9 @@ SCHEDULE = [  # (time s, finger joint m, lift m)
 ]
 
 
-def build_pick(*, flat=False, plant_contact="point", meshcat=None, **monitor_options):
+def build_pick(
+    *, flat=False, plant_contact="point", meshcat=None, closed=CLOSED, **monitor_options
+):
     """Gripper, box, ground, PD schedule and a GraspMonitor, ready to simulate."""
     builder = DiagramBuilder()
     plant_config = MultibodyPlantConfig(
@@ -150,8 +160,9 @@ def build_pick(*, flat=False, plant_contact="point", meshcat=None, **monitor_opt
         for i in plant.GetJointActuatorIndices(gripper)
     ]
     columns = {
-        "left_finger_joint": [f for _, f, _ in SCHEDULE],
-        "right_finger_joint": [f for _, f, _ in SCHEDULE],
+        # `closed` sets how far past the box the PD drives the fingers: the squeeze
+        "left_finger_joint": [closed if f == CLOSED else f for _, f, _ in SCHEDULE],
+        "right_finger_joint": [closed if f == CLOSED else f for _, f, _ in SCHEDULE],
         "lift": [z for _, _, z in SCHEDULE],
     }
     q_desired = PiecewisePolynomial.FirstOrderHold(
@@ -202,12 +213,14 @@ def build_pick(*, flat=False, plant_contact="point", meshcat=None, **monitor_opt
 # %% [markdown]
 # The monitor's options are those of `analyze_grasp`.  Two rounded pads make two
 # point contacts, which resist a torque about the line between them only through
-# torsional friction, so we analyse soft fingers (μ = 0.5, ν = 0.1).  A simulated
+# torsional friction, so we analyse soft fingers (ν = 0.1), with the friction the
+# plant simulates (`mu="plant"`: read from the geometries' proximity properties
+# with Drake's combination rule; a typed μ that disagrees would be warned about).  A simulated
 # contact penetrates a little (here about 0.1 mm for a few newtons of squeeze), so
 # the distance tolerance is 1 mm rather than the default 0.1 mm.
 
 # %%
-SOFT = dict(mu=0.5, contact_model="soft_finger", torsional_friction=0.1)
+SOFT = dict(mu="plant", contact_model="soft_finger", torsional_friction=0.1)
 params = MeshcatParams()
 params.show_stats_plot = False
 meshcat = Meshcat(params)  # open meshcat.web_url() in a browser to watch
@@ -290,7 +303,7 @@ for ax in axes:
         label="force closure",
     )
 axes[0].step(times, V[GraspMonitor.D_STAR], where="post")
-axes[0].set_ylabel("LP2 margin $d^*$")
+axes[0].set_ylabel("LP2 $d^*$")
 axes[1].step(times, V[GraspMonitor.EPSILON], where="post", color="C1")
 axes[1].set_ylabel(r"Ferrari–Canny $\varepsilon$")
 axes[2].plot(times, 1e3 * (height - height[0]), color="C2")
@@ -301,11 +314,69 @@ fig.suptitle(f"A simulated pick, checked by GraspMonitor every {1e3 * PERIOD:.0f
 fig.tight_layout()
 
 # %% [markdown]
-# The margin appears when the pads reach the box (~0.55 s), stays through the lift
-# (the grasp does not change much: the box hangs between the pads) and vanishes
-# when the fingers open (~2.5 s).  A log taken at a sample time shows the value held
+# $d^*$ appears when the pads reach the box (~0.55 s), stays through the lift
+# (the grasp's geometry does not change much: the box hangs between the pads) and
+# vanishes when the fingers open (~2.5 s).  A log taken at a sample time shows the value held
 # *before* that sample's update — Drake's sample-and-hold — so the plot lags the
 # state by one period.
+#
+# ## A firm grip and a weak one: the holding state beside $d^*$
+#
+# Now the same pick twice with the plant's contact results as the monitor's
+# source (`contacts="contact_results"`), which gives it the contact forces and
+# slip speeds: once with the fingers driven 10 mm past the box (a firm squeeze of
+# a few newtons), once only 3 mm past (about 1 N per finger, too little to carry
+# the 0.2 kg box).  $d^*$ cannot tell them apart before the lift: the contacts
+# are in the same places.  The holding state can.
+
+# %%
+from drakegrasp.systems.holding import HOLDING_STATES
+
+UNTIL = 1.8 if TEST_MODE else SCHEDULE[-1][0]
+runs = {}
+for label, closed in (("firm", CLOSED), ("weak", 0.022)):
+    run = build_pick(
+        closed=closed, contacts="contact_results", distance_tolerance=1e-3, **SOFT
+    )
+    run["simulator"].AdvanceTo(UNTIL)
+    ctx = run["simulator"].get_context()
+    log = run["logs"]["verdicts"].FindLog(ctx)
+    xs = run["logs"]["state"].FindLog(ctx).data()
+    box_body = run["plant"].GetBodyByName("box", run["box"])
+    scratch = run["plant"].CreateDefaultContext()
+    z = []
+    for x in xs.T:
+        run["plant"].SetPositionsAndVelocities(scratch, x)
+        z.append(run["plant"].EvalBodyPoseInWorld(scratch, box_body).translation()[2])
+    runs[label] = (log.sample_times(), log.data(), np.array(z))
+    seen = [HOLDING_STATES[int(c)] for c in log.data()[GraspMonitor.HOLDING]]
+    lifted = 1e3 * (z[-1] - z[0])
+    print(
+        f"{label}: box lifted {lifted:.1f} mm by t = {UNTIL} s; states seen: "
+        + ", ".join(dict.fromkeys(seen))
+    )
+
+fig, axes = plt.subplots(3, 2, figsize=(10, 7), sharex=True, sharey="row")
+for col, (label, (t, V2, z)) in enumerate(runs.items()):
+    axes[0, col].step(t, V2[GraspMonitor.D_STAR], where="post")
+    axes[0, col].set_title(f"{label} grip")
+    axes[1, col].step(t, V2[GraspMonitor.HOLDING], where="post", color="C3")
+    axes[2, col].plot(t, 1e3 * (z - z[0]), color="C2")
+    axes[2, col].set_xlabel("time [s]")
+axes[0, 0].set_ylabel("LP2 $d^*$")
+axes[1, 0].set_yticks(range(len(HOLDING_STATES)), HOLDING_STATES)
+axes[1, 0].set_ylabel("holding state")
+axes[2, 0].set_ylabel("box lifted [mm]")
+fig.tight_layout()
+
+# %% [markdown]
+# The firm grip reads `holding` through the lift and the box rises 5 cm.  The weak
+# grip has the same $d^*$ while the box is still on the ground, but when the lift
+# starts the fingers slide along the box: the monitor flags `slipping` (or `at
+# risk`, friction in use near 1) and then `dropped`, and the box stays behind.
+# The thresholds are `drakegrasp.HoldingThresholds`; the systems tests check, on
+# this pick and on Drake's WSG-50 with a YCB box, that the flag comes before the
+# box has moved 5 mm relative to the fingers.
 #
 # ## A second opinion
 #
@@ -369,7 +440,7 @@ hydro = build_pick(
     flat=True,
     plant_contact="hydroelastic_with_fallback",
     contacts="contact_results",
-    mu=0.5,
+    mu="plant",
     distance_tolerance=1e-3,
 )
 hydro["simulator"].AdvanceTo(1.6)  # lifted
