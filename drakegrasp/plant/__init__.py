@@ -27,6 +27,7 @@ _SOURCES = {
         "close_hand",
     ),
     "drakegrasp.plant.contact_results": ("contacts_from_results",),
+    "drakegrasp.plant.scale": ("object_radius",),
     "drakegrasp.plant.contacts": (
         "DEFAULT_DISTANCE_TOLERANCE",
         "PlantContact",
@@ -48,6 +49,7 @@ _SOURCES = {
     ),
     "drakegrasp.plant.models": (
         "models_dir",
+        "object_radius",
         "register_models",
         "use_local_drake_models",
     ),
