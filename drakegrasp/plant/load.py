@@ -44,7 +44,11 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.jacobians import PLANES
-from drakegrasp.plant.validation import plant_context_of, resolve_object_body
+from drakegrasp.plant.validation import (
+    plant_context_of,
+    query_object_of,
+    resolve_object_body,
+)
 
 __all__ = [
     "MU_RELATIVE_TOL",
@@ -157,7 +161,7 @@ def plant_friction(
     """
     if query_object is None:
         ctx = plant_context_of(plant, plant_context)
-        query_object = plant.get_geometry_query_input_port().Eval(ctx)
+        query_object = query_object_of(plant, ctx)
     inspector = query_object.inspector()
     dynamic = friction_rule(plant) == "dynamic"
     out = []

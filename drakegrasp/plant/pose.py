@@ -30,7 +30,7 @@ from drakegrasp.errors import (
     ModelError,
     PenetrationError,
 )
-from drakegrasp.plant.validation import scoped_name
+from drakegrasp.plant.validation import query_object_of, scoped_name
 
 __all__ = [
     "JOINT_LIMIT_REMEDY",
@@ -208,7 +208,7 @@ def find_penetrations(
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     query = query_object
     if query is None:
-        query = plant.get_geometry_query_input_port().Eval(plant_context)
+        query = query_object_of(plant, plant_context)
     inspector = query.inspector()
     _check_resolvable(plant, plant_context, [object_body, *bodies], tol)
     object_geometries = plant.GetCollisionGeometriesForBody(object_body)

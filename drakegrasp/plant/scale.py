@@ -25,6 +25,7 @@ from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.validation import (
     plant_context_of,
+    query_object_of,
     resolve_object_body,
     scoped_name,
 )
@@ -63,7 +64,7 @@ def object_radius(plant: MultibodyPlant, plant_context: Context, object_body) ->
     """
     plant_context = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
-    query = plant.get_geometry_query_input_port().Eval(plant_context)
+    query = query_object_of(plant, plant_context)
     inspector = query.inspector()
     radius = 0.0
     for g in plant.GetCollisionGeometriesForBody(body):

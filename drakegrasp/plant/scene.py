@@ -138,7 +138,7 @@ from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.closing import HandClosure, close_hand
 from drakegrasp.plant.couplings import record_model_couplings
-from drakegrasp.plant.models import models_dir
+from drakegrasp.plant.models import explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import check_section, directives_text, read_yaml
 from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
@@ -385,7 +385,13 @@ def load_scene(
     info = SceneInfo(name=path.stem, path=path.resolve(), **check_section(path, data))
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    parser = Parser(plant)
+    try:
+        parser = Parser(plant)
+    except RuntimeError as e:  # its default PackageMap could not add drake_models
+        raise ModelError(
+            f"scene {str(path)!r}: cannot make Drake's parser: "
+            + explain_drake_models(str(e))
+        ) from None
     packages = add_packages(parser, package_map, ros_package_path=ros_package_path)
     try:
         directives = LoadModelDirectivesFromString(directives_text(path, text))
@@ -407,7 +413,7 @@ def load_scene(
     try:
         added = ProcessModelDirectives(directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError
-        msg = " ".join(str(e).split())
+        msg = explain_drake_models(str(e))
         raise ModelError(
             f"scene {str(path)!r}: cannot load the models: {msg}"
         ) from None
