@@ -27,7 +27,6 @@ _SOURCES = {
         "close_hand",
     ),
     "drakegrasp.plant.contact_results": ("contacts_from_results",),
-    "drakegrasp.plant.scale": ("object_radius",),
     "drakegrasp.plant.contacts": (
         "DEFAULT_DISTANCE_TOLERANCE",
         "PlantContact",
@@ -49,12 +48,12 @@ _SOURCES = {
     ),
     "drakegrasp.plant.models": (
         "models_dir",
-        "object_radius",
         "register_models",
         "use_local_drake_models",
     ),
     "drakegrasp.plant.options": ("AnalysisOptions",),
     "drakegrasp.plant.pose": ("PoseCheck",),
+    "drakegrasp.plant.scale": ("object_radius",),
     "drakegrasp.plant.scene": (
         "DEFAULT_SCENE",
         "Scene",
@@ -121,6 +120,7 @@ __all__ = [
     "list_scenes",
     "load_scene",
     "models_dir",
+    "object_radius",
     "plant_couplings",
     "register_models",
     "use_local_drake_models",
