@@ -3,8 +3,9 @@
 Usage::
 
     drakegrasp analyze [SCENE] [--mu M] [--contact-model MODEL]
-                       [--torsional-friction NU] [--package NAME=DIR ...]
-                       [--allow-any-file] [--json]
+                       [--torsional-friction NU] [--close | --no-close]
+                       [--allow-penetration] [--no-check-pose]
+                       [--package NAME=DIR ...] [--allow-any-file] [--json]
     drakegrasp scenes
     drakegrasp batch IN.npz OUT.npz [--kind force|form] [--mu M]
                      [--contact-model MODEL] [--torsional-friction NU]
@@ -15,7 +16,12 @@ Usage::
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
 form closure, force closure with the hand check, exact-cone verdict, antipodal
-test.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
+test, and Ferrari–Canny's ε with moments divided by the object's size (the
+radius about its origin that bounds its collision geometry;
+:mod:`drakegrasp.plant.scale`).  ``--close`` closes the hand onto the object
+first (as a scene's ``close: true`` does); an impossible pose is refused with
+a hint naming ``--allow-penetration`` and ``--no-check-pose``, which analyse
+it anyway.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
 ``positions`` and ``normals`` of shape (K, N, d), optionally ``mu``, ...) with
 the vectorised batch engine and writes the verdicts to another file.
 ``warmup`` compiles the batch engine's numba kernels now (once per install;
@@ -47,7 +53,7 @@ from collections.abc import Sequence
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import DEFAULT_TOL
-from drakegrasp.errors import GraspError, InvalidOptionError
+from drakegrasp.errors import GraspError, InvalidOptionError, InvalidPoseError
 
 __all__ = ["build_parser", "main"]
 
@@ -55,14 +61,37 @@ EXIT_ERROR = 1
 EXIT_INTERRUPTED = 130
 
 
+# The remedy of a refused pose in the command line's words.
+PENETRATION_REMEDY = "add --allow-penetration or --no-check-pose to analyse it anyway"
+JOINT_LIMIT_REMEDY = "add --no-check-pose to analyse it anyway"
+
+
 def _cmd_analyze(args: argparse.Namespace) -> int:
+    from drakegrasp.errors import PenetrationError
+
+    try:
+        return _analyze(args)
+    except InvalidPoseError as e:
+        if not e.remedy:  # not a refusal that an option lifts
+            raise
+        cli = (
+            PENETRATION_REMEDY
+            if isinstance(e, PenetrationError)
+            else (JOINT_LIMIT_REMEDY)
+        )
+        raise e.with_remedy(cli) from None
+
+
+def _analyze(args: argparse.Namespace) -> int:
     from drakegrasp.plant.analysis import analyze_grasp
+    from drakegrasp.plant.scale import SCALE_NAME, object_radius
     from drakegrasp.plant.scene import load_scene
 
     scene = load_scene(
         args.scene,
         package_map=dict(args.package) or None,
         allow_any_file=args.allow_any_file,
+        close=args.close,
     )
     changes = {
         name: getattr(args, name)
@@ -77,15 +106,52 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         hand=scene.hand,
         options=options,
     )
+    epsilon = {
+        "epsilon": None,
+        "norm": "L1",
+        "torque_scale": object_radius(
+            scene.plant, scene.plant_context, scene.object_body
+        ),
+        "scale": SCALE_NAME,
+        "reason": None,
+    }
+    epsilon.update(_epsilon(report, epsilon["torque_scale"]))
     if args.json:
         out = {"scene": scene.name, "scene_file": str(scene.info.path)}
         out.update(report.to_dict())
+        out["closure"] = None if scene.closure is None else scene.closure.to_dict()
+        out["epsilon"] = epsilon
         json.dump(out, sys.stdout, indent=2)
         sys.stdout.write("\n")
     else:
         print(f"scene {scene.name}: {scene.info.description}")
+        if scene.closure is not None:
+            print(scene.closure)
         print(report)
+        value = epsilon["epsilon"]
+        shown = (
+            f"not computed ({epsilon['reason']})" if value is None else f"{value:.4g}"
+        )
+        print(
+            f"  epsilon (Ferrari-Canny, L1) = {shown}, moments / b_s with b_s = "
+            f"{epsilon['torque_scale'] * 1e3:.4g} mm, {SCALE_NAME}"
+        )
     return 0
+
+
+def _epsilon(report, torque_scale: float) -> dict:
+    """ε (L1) of the report's grasp with moments divided by ``torque_scale``."""
+    from drakegrasp.quality.epsilon import ferrari_canny
+
+    try:
+        value = ferrari_canny(
+            report.grasp,
+            num_generators=report.options.num_generators,
+            torque_scale=torque_scale,
+        )
+    except InvalidOptionError as e:  # too many primitive wrenches for a hull
+        return {"reason": str(e)}
+    return {"epsilon": float(value)}
 
 
 def _cmd_scenes(args: argparse.Namespace) -> int:
@@ -246,6 +312,13 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
         help="shipped scene name (see `drakegrasp scenes`) or scene YAML file",
     )
     _add_analysis_options(analyze)
+    analyze.add_argument(
+        "--close",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="close the hand onto the object before analysing (from the "
+        "scene's joint values; default: the scene's 'close:', else no)",
+    )
     analyze.add_argument(
         "--package",
         action="append",

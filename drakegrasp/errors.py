@@ -48,7 +48,28 @@ class InvalidPoseError(GraspError):
     The common base of :class:`PenetrationError` and :class:`JointLimitError`;
     ``analyze_grasp(..., check_pose=False)`` analyses such a pose anyway and
     marks the report invalid.
+
+    Parameters
+    ----------
+    problem : str
+        What is wrong with the pose.
+    remedy : str, optional
+        How to analyse it anyway, in the caller's words (a Python argument,
+        a command-line flag); the message is ``"problem (remedy)"``.
+
+    Attributes
+    ----------
+    problem, remedy : str
     """
+
+    def __init__(self, problem: str, *, remedy: str = ""):
+        super().__init__(f"{problem} ({remedy})" if remedy else problem)
+        self.problem = problem
+        self.remedy = remedy
+
+    def with_remedy(self, remedy: str) -> InvalidPoseError:
+        """The same error, of the same type, with another remedy."""
+        return type(self)(self.problem, remedy=remedy)
 
 
 class PenetrationError(InvalidPoseError):

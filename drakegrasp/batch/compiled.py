@@ -43,6 +43,7 @@ PROGRESS_EVERY = 5.0
 """Seconds between progress lines of a long compile (stderr)."""
 
 AVAILABLE = importlib.util.find_spec("numba") is not None
+"""Whether numba is installed: the kernels are compiled, else the numpy route runs."""
 
 
 class NumbaMissingWarning(UserWarning):

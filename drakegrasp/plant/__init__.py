@@ -53,6 +53,7 @@ _SOURCES = {
     ),
     "drakegrasp.plant.options": ("AnalysisOptions",),
     "drakegrasp.plant.pose": ("PoseCheck",),
+    "drakegrasp.plant.scale": ("object_radius",),
     "drakegrasp.plant.scene": (
         "DEFAULT_SCENE",
         "Scene",
@@ -119,6 +120,7 @@ __all__ = [
     "list_scenes",
     "load_scene",
     "models_dir",
+    "object_radius",
     "plant_couplings",
     "register_models",
     "use_local_drake_models",

@@ -47,7 +47,6 @@ from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
     InvalidOptionError,
-    ModelError,
     PenetrationError,
     UnreachableError,
 )
@@ -64,6 +63,7 @@ from drakegrasp.plant.validation import (
     hand_bodies,
     hand_model_instances,
     plant_context_of,
+    query_object_of,
     resolve_object_body,
     scoped_name,
 )
@@ -310,9 +310,7 @@ def close_hand(
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
     couplings = plant_couplings(plant, couplings)
-    if not plant.geometry_source_is_registered():
-        raise ModelError("the plant is not registered with a SceneGraph; no geometry")
-    query = plant.get_geometry_query_input_port().Eval(plant_context)
+    query = query_object_of(plant, plant_context)
     hand_ = hand_structure(plant, body, bodies, couplings, inspector=query.inspector())
     found = find_penetrations(
         plant, plant_context, body, hand_model_instances(plant, bodies, body), tol

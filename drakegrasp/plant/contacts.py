@@ -55,6 +55,7 @@ from drakegrasp.plant.validation import (
     hand_bodies,
     hand_contact_bodies,
     plant_context_of,
+    query_object_of,
     resolve_object_body,
     scoped_name,
 )
@@ -263,7 +264,7 @@ def find_contacts(
     if not plant.geometry_source_is_registered():
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     if query_object is None:
-        query = plant.get_geometry_query_input_port().Eval(plant_context)
+        query = query_object_of(plant, plant_context)
     elif isinstance(query_object, QueryObject):
         query = query_object
     else:

@@ -47,7 +47,7 @@ from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import flat_faces, surface_pieces
 from drakegrasp.plant.contacts import PlantContact, resolve_object_body
 from drakegrasp.plant.jacobians import PLANES
-from drakegrasp.plant.validation import plant_context_of
+from drakegrasp.plant.validation import plant_context_of, query_object_of
 
 __all__ = ["SECOND_ORDER_RANK_TOL", "contact_curvatures", "shape_curvature"]
 
@@ -250,7 +250,7 @@ def contact_curvatures(
     body = resolve_object_body(plant, object_body)
     query = query_object
     if query is None:
-        query = plant.get_geometry_query_input_port().Eval(plant_context)
+        query = query_object_of(plant, plant_context)
     inspector = query.inspector()
     X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
     out = []

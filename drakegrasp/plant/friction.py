@@ -28,7 +28,7 @@ from pydrake.multibody.plant import (
 )
 
 from drakegrasp.errors import ModelError
-from drakegrasp.plant.validation import plant_context_of
+from drakegrasp.plant.validation import plant_context_of, query_object_of
 
 __all__ = [
     "MU_RELATIVE_TOL",
@@ -117,7 +117,7 @@ def plant_friction(
     """
     if query_object is None:
         ctx = plant_context_of(plant, plant_context)
-        query_object = plant.get_geometry_query_input_port().Eval(ctx)
+        query_object = query_object_of(plant, ctx)
     return np.array(
         [
             pair_friction(plant, query_object, c.object_geometry, c.finger_geometry)

@@ -39,7 +39,10 @@ from drakegrasp.plant.friction import (
     plant_friction,
 )
 from drakegrasp.plant.jacobians import PLANES
-from drakegrasp.plant.validation import plant_context_of, resolve_object_body
+from drakegrasp.plant.validation import (
+    plant_context_of,
+    resolve_object_body,
+)
 
 __all__ = [
     "LoadReport",

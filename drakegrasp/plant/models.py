@@ -19,7 +19,9 @@ from drakegrasp.errors import InvalidOptionError, ModelError
 
 __all__ = [
     "DRAKE_MODELS_ENV",
+    "DRAKE_MODELS_HINT",
     "PACKAGE_NAME",
+    "explain_drake_models",
     "models_dir",
     "register_models",
     "use_local_drake_models",
@@ -34,6 +36,38 @@ Drake's wheel downloads ``package://drake_models/...`` on demand; offline
 machines (CI, a laptop on a plane) set this variable to a folder holding the
 package and call :func:`use_local_drake_models` on their parser.
 """
+
+DRAKE_MODELS_HINT = (
+    "Drake downloads the drake_models package on first use, and that failed "
+    "(offline, or the download is blocked); use a local copy of it instead: set "
+    f"{DRAKE_MODELS_ENV}=DIR, or pass --package drake_models=DIR to 'drakegrasp "
+    "analyze' (package_map={'drake_models': DIR} to load_scene), DIR being the "
+    "folder that holds wsg_50_description/, allegro_hand_description/, ..."
+)
+"""What to do when ``package://drake_models/...`` cannot be fetched."""
+
+
+def explain_drake_models(message: str) -> str:
+    """``message``, with :data:`DRAKE_MODELS_HINT` when drake_models failed to load.
+
+    Drake's own words for a failed download (``"when downloading
+    'drake_models'"``, or networking disabled by ``DRAKE_ALLOW_NETWORK`` for
+    ``'drake_models'``) name neither drakegrasp's variable nor its command-line
+    flag; other messages are returned unchanged.
+    """
+    text = " ".join(str(message).split())
+    if "drake_models" not in text:
+        return text
+    if "DRAKE_ALLOW_NETWORK" in text:  # Drake's Parser() itself refuses
+        return (
+            f"{text}. Drake's Parser registers drake_models when it is made, "
+            "so it cannot be made while DRAKE_ALLOW_NETWORK forbids package "
+            "downloads and the cache lacks drake_models: unset "
+            "DRAKE_ALLOW_NETWORK (or let it include package_map). " + DRAKE_MODELS_HINT
+        )
+    if "download" in text:
+        return f"{text}. {DRAKE_MODELS_HINT}"
+    return text
 
 
 @functools.cache

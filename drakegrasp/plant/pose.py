@@ -30,10 +30,12 @@ from drakegrasp.errors import (
     ModelError,
     PenetrationError,
 )
-from drakegrasp.plant.validation import scoped_name
+from drakegrasp.plant.validation import query_object_of, scoped_name
 
 __all__ = [
+    "JOINT_LIMIT_REMEDY",
     "JOINT_LIMIT_TOL",
+    "PENETRATION_REMEDY",
     "JointLimitViolation",
     "Penetration",
     "PoseCheck",
@@ -93,6 +95,15 @@ class JointLimitViolation:
         )
 
 
+PENETRATION_REMEDY = (
+    "pass check_pose=False, or allow_penetration=True, to analyse it anyway"
+)
+"""The remedy of a :class:`PenetrationError` raised by a pose check (Python)."""
+
+JOINT_LIMIT_REMEDY = "pass check_pose=False to analyse it anyway"
+"""The remedy of a :class:`JointLimitError` raised by a pose check (Python)."""
+
+
 @dataclass(frozen=True)
 class PoseCheck:
     """What :func:`check_pose` found.
@@ -116,17 +127,21 @@ class PoseCheck:
         return not self.penetrations and not self.joint_limit_violations
 
     def raise_if_invalid(self) -> None:
-        """Raise :class:`PenetrationError` or :class:`JointLimitError` if invalid."""
-        opt_out = " (pass check_pose=False to analyse it anyway)"
+        """Raise :class:`PenetrationError` or :class:`JointLimitError` if invalid.
+
+        The message's remedy names the Python options (:data:`PENETRATION_REMEDY`,
+        :data:`JOINT_LIMIT_REMEDY`); the command line swaps in its flags with
+        :meth:`~drakegrasp.errors.InvalidPoseError.with_remedy`.
+        """
         if self.penetrations:
             raise PenetrationError(
-                "impossible pose: " + "; ".join(map(str, self.penetrations)) + opt_out
+                "impossible pose: " + "; ".join(map(str, self.penetrations)),
+                remedy=PENETRATION_REMEDY,
             )
         if self.joint_limit_violations:
             raise JointLimitError(
-                "impossible pose: "
-                + "; ".join(map(str, self.joint_limit_violations))
-                + opt_out
+                "impossible pose: " + "; ".join(map(str, self.joint_limit_violations)),
+                remedy=JOINT_LIMIT_REMEDY,
             )
 
     def summary(self) -> str:
@@ -193,7 +208,7 @@ def find_penetrations(
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     query = query_object
     if query is None:
-        query = plant.get_geometry_query_input_port().Eval(plant_context)
+        query = query_object_of(plant, plant_context)
     inspector = query.inspector()
     _check_resolvable(plant, plant_context, [object_body, *bodies], tol)
     object_geometries = plant.GetCollisionGeometriesForBody(object_body)

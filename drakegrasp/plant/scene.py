@@ -34,6 +34,7 @@ The format
       torsional_friction: 0.1        # soft fingers: nu >= 0
       plane: yz                      # optional: planar analysis (xy | yz | zx)
       distance_tolerance: 1.0e-4     # optional, metres, > 0
+      close: true                    # optional: close the hand when loading
 
 ``directives`` is any list that Drake's ``LoadModelDirectives`` accepts
 (``add_model``, ``add_weld``, ``add_frame``, ``add_directives``,
@@ -47,7 +48,15 @@ unknown keys.  ``drakegrasp:`` keys (see :data:`drakegrasp.plant.scene_file.KEYS
   object, not welded to the world and not in the object's model instance;
 - ``contact_model`` (default ``hard_finger``), ``torsional_friction``
   (default 0; needed > 0 by ``soft_finger``), ``plane`` (absent: spatial),
-  ``distance_tolerance`` (default 1e-4 m), ``description`` (default empty).
+  ``distance_tolerance`` (default 1e-4 m), ``description`` (default empty);
+- ``close`` (default false): ``true`` closes the hand onto the object when
+  the scene is loaded (:func:`~drakegrasp.plant.closing.close_hand` from the
+  joint values of the directives, the pre-shape, with the scene's distance
+  tolerance), so the directives need only an open hand; ``close:
+  {direction: [...]}`` closes along that direction over the closing joints
+  (order of ``HandClosure.joints``) instead of each fingertip's steepest
+  descent.  ``load_scene(..., close=...)`` and ``drakegrasp analyze
+  --close`` / ``--no-close`` override the file.
 
 Packages and files
 ------------------
@@ -127,8 +136,9 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import ModelError, SceneError
+from drakegrasp.plant.closing import HandClosure, close_hand
 from drakegrasp.plant.couplings import record_model_couplings
-from drakegrasp.plant.models import models_dir
+from drakegrasp.plant.models import explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import check_section, directives_text, read_yaml
 from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
@@ -176,6 +186,11 @@ class SceneInfo:
         object frame, None for a spatial one.
     distance_tolerance : float
         ``|ψ|`` (metres) below which a pair is in contact.
+    close : bool
+        Close the hand onto the object when the scene is loaded.
+    close_direction : tuple of float or None
+        The closing direction over the closing joints; None: each fingertip's
+        steepest descent.
     """
 
     name: str
@@ -188,6 +203,8 @@ class SceneInfo:
     torsional_friction: float
     plane: str | None
     distance_tolerance: float
+    close: bool = False
+    close_direction: tuple[float, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -208,6 +225,10 @@ class Scene:
     object_body : pydrake.multibody.tree.RigidBody
     hand : ModelInstanceIndex or tuple of RigidBody or None
         Argument to pass as ``hand=`` to :func:`drakegrasp.find_contacts`.
+    closure : HandClosure or None
+        How the hand was closed when the scene was loaded with closing (the
+        file's ``close:`` or ``load_scene(..., close=True)``); the context
+        holds the closed hand.  None when it was not closed.
     """
 
     info: SceneInfo
@@ -217,6 +238,7 @@ class Scene:
     plant_context: Context
     object_body: RigidBody
     hand: ModelInstanceIndex | tuple[RigidBody, ...] | None
+    closure: HandClosure | None = None
 
     @property
     def name(self) -> str:
@@ -318,6 +340,7 @@ def load_scene(
     package_map: PackagesSpec = None,
     ros_package_path: bool = True,
     allow_any_file: bool = False,
+    close: bool | None = None,
 ) -> Scene:
     """Build the plant of a scene file and set the configuration it describes.
 
@@ -335,6 +358,10 @@ def load_scene(
     allow_any_file : bool, optional
         Trust the scene: let it reference files outside its packages and its
         own directory (default False: refused).
+    close : bool, optional
+        Close the hand onto the object (:func:`~drakegrasp.close_hand`, from
+        the file's joint values, along the file's ``close: {direction: ...}``
+        if it gives one).  Default: what the file's ``close:`` says.
 
     Returns
     -------
@@ -347,13 +374,24 @@ def load_scene(
         For a malformed file or a reference the policy refuses.
     ModelError
         For a model that does not parse, or an unknown body or model instance.
+    UnreachableError, PenetrationError
+        Closing asked for, and no finger reaches the object, or the file's
+        pre-shape already penetrates it.
     """
+    if close is not None:
+        close = check_flag("close", close)
     path = scene_path(DEFAULT_SCENE if path_or_name is None else path_or_name)
     text, data = read_yaml(path)
     info = SceneInfo(name=path.stem, path=path.resolve(), **check_section(path, data))
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    parser = Parser(plant)
+    try:
+        parser = Parser(plant)
+    except RuntimeError as e:  # its default PackageMap could not add drake_models
+        raise ModelError(
+            f"scene {str(path)!r}: cannot make Drake's parser: "
+            + explain_drake_models(str(e))
+        ) from None
     packages = add_packages(parser, package_map, ros_package_path=ros_package_path)
     try:
         directives = LoadModelDirectivesFromString(directives_text(path, text))
@@ -375,7 +413,7 @@ def load_scene(
     try:
         added = ProcessModelDirectives(directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError
-        msg = " ".join(str(e).split())
+        msg = explain_drake_models(str(e))
         raise ModelError(
             f"scene {str(path)!r}: cannot load the models: {msg}"
         ) from None
@@ -386,6 +424,16 @@ def load_scene(
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     plant_context = plant.GetMyContextFromRoot(context)
+    closure = None
+    if info.close if close is None else close:
+        closure = close_hand(
+            plant,
+            plant_context,
+            object_body,
+            hand=hand,
+            direction=info.close_direction,
+            distance_tolerance=info.distance_tolerance,
+        )
     return Scene(
         info=info,
         diagram=diagram,
@@ -394,4 +442,5 @@ def load_scene(
         plant_context=plant_context,
         object_body=object_body,
         hand=hand,
+        closure=closure,
     )

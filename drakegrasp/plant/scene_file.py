@@ -58,6 +58,8 @@ KEYS = {
     "torsional_friction": "a number >= 0",
     "plane": f"one of {sorted(PLANES)}",
     "distance_tolerance": "a number > 0 (metres)",
+    "close": "true, false, or a mapping {direction: [one number per closing "
+    "joint]}: close the hand onto the object when the scene is loaded",
 }
 """The keys of the ``drakegrasp:`` section and what each must be."""
 
@@ -209,7 +211,9 @@ def _string(path: Path, key: str, value) -> str:
     return value
 
 
-def _number(path: Path, key: str, value, *, positive: bool = False) -> float:
+def _number(
+    path: Path, key: str, value, *, positive: bool = False, signed: bool = False
+) -> float:
     if not isinstance(value, int | float) or isinstance(value, bool):
         raise SceneError(
             f"scene {str(path)!r}: drakegrasp.{key} must be a number, got "
@@ -219,6 +223,13 @@ def _number(path: Path, key: str, value, *, positive: bool = False) -> float:
         x = float(value)
     except OverflowError:
         x = math.inf
+    if signed:
+        if not math.isfinite(x):
+            raise SceneError(
+                f"scene {str(path)!r}: drakegrasp.{key} holds {value!r}; valid: "
+                f"{KEYS[key]}, every number finite"
+            )
+        return x
     if not (x >= 0.0) or (positive and x == 0.0) or x == math.inf:
         bound = "> 0" if positive else ">= 0"
         raise SceneError(
@@ -228,6 +239,22 @@ def _number(path: Path, key: str, value, *, positive: bool = False) -> float:
     return x
 
 
+def _close(path: Path, value) -> tuple[bool, tuple[float, ...] | None]:
+    """``close:`` as (close the hand?, its direction or None)."""
+    if isinstance(value, bool):
+        return value, None
+    if isinstance(value, dict):
+        unknown = [k for k in value if k != "direction"]
+        direction = value.get("direction")
+        if not unknown and isinstance(direction, list) and direction:
+            return True, tuple(
+                _number(path, "close", x, signed=True) for x in direction
+            )
+    raise SceneError(
+        f"scene {str(path)!r}: drakegrasp.close must be {KEYS['close']}, got {value!r}"
+    )
+
+
 def check_section(path: Path, data: dict) -> dict:
     """The checked ``drakegrasp:`` section, with defaults filled in.
 
@@ -235,8 +262,10 @@ def check_section(path: Path, data: dict) -> dict:
     -------
     dict
         Keys ``description, object_body, hand, mu, contact_model,
-        torsional_friction, plane, distance_tolerance``; ``hand`` is None, a
-        string or a tuple of strings, ``contact_model`` a ContactModel.
+        torsional_friction, plane, distance_tolerance, close,
+        close_direction``; ``hand`` is None, a string or a tuple of strings,
+        ``contact_model`` a ContactModel, ``close`` a bool and
+        ``close_direction`` None or a tuple of floats.
 
     Raises
     ------
@@ -282,6 +311,7 @@ def check_section(path: Path, data: dict) -> dict:
             f"absent, got {plane!r}"
         )
     description = section.get("description", "")
+    close, close_direction = _close(path, section.get("close", False))
     return {
         "description": ""
         if description == ""
@@ -300,6 +330,8 @@ def check_section(path: Path, data: dict) -> dict:
             section.get("distance_tolerance", 1e-4),
             positive=True,
         ),
+        "close": close,
+        "close_direction": close_direction,
     }
 
 

@@ -47,7 +47,11 @@ from pathlib import Path
 from pydrake.multibody.parsing import LoadModelDirectives, PackageMap, Parser
 
 from drakegrasp.errors import SceneError
-from drakegrasp.plant.models import register_models, use_local_drake_models
+from drakegrasp.plant.models import (
+    explain_drake_models,
+    register_models,
+    use_local_drake_models,
+)
 
 __all__ = [
     "MAX_INCLUDED_FILES",
@@ -297,7 +301,7 @@ def _resolve(url: str, package_map: PackageMap) -> str:
     try:
         return package_map.ResolveUrl(url)
     except RuntimeError as e:
-        msg = " ".join(str(e).split())
+        msg = explain_drake_models(str(e))
         raise SceneError(f"cannot resolve {url!r}: {msg}") from None
 
 

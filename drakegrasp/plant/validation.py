@@ -33,6 +33,7 @@ __all__ = [
     "hand_model_instances",
     "model_instance",
     "plant_context_of",
+    "query_object_of",
     "resolve_body",
     "resolve_object_body",
     "scoped_name",
@@ -124,6 +125,44 @@ def plant_context_of(plant, context) -> Context:
             f"holds it (pass plant.GetMyContextFromRoot(root) or the root); "
             f"Drake says: {msg}"
         ) from None
+
+
+def query_object_of(plant: MultibodyPlant, plant_context: Context):
+    """The scene graph's ``QueryObject`` seen through the plant's context.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized, registered with a ``SceneGraph``.
+    plant_context : Context
+        The plant's context (already resolved by :func:`plant_context_of`).
+
+    Returns
+    -------
+    pydrake.geometry.QueryObject
+
+    Raises
+    ------
+    ModelError
+        The plant is not registered with a ``SceneGraph`` (it has no geometry).
+    InvalidContextError
+        The plant's geometry query port is not connected in this context:
+        ``plant.CreateDefaultContext()`` of a plant inside a diagram is a
+        context of the plant alone, with no scene graph behind it.  The
+        message names the fix: the plant's part of the diagram's context.
+    """
+    if not plant.geometry_source_is_registered():
+        raise ModelError("the plant is not registered with a SceneGraph; no geometry")
+    port = plant.get_geometry_query_input_port()
+    if not port.HasValue(plant_context):
+        raise InvalidContextError(
+            "the plant's geometry_query input port is not connected in this "
+            "context: a context made by plant.CreateDefaultContext() holds the "
+            "plant alone, without its SceneGraph. Use the diagram's context: "
+            "diagram_context = diagram.CreateDefaultContext(), then pass it or "
+            "plant.GetMyContextFromRoot(diagram_context)"
+        )
+    return port.Eval(plant_context)
 
 
 def scoped_name(plant: MultibodyPlant, body: RigidBody) -> str:
