@@ -77,7 +77,8 @@ class GraspMonitor(LeafSystem):
         or in ``options``).  A number that disagrees with the plant's friction
         at the contacts is warned about once per monitor
         (:class:`~drakegrasp.plant.friction.FrictionMismatchWarning`) and kept
-        in :attr:`friction_warning`.  Friction in use is always computed with the plant's own coefficients.
+        in :attr:`friction_warning`.  Friction in use is always computed with
+        the plant's own coefficients.
     contact_model, torsional_friction, distance_tolerance, plane
         As in :func:`drakegrasp.analyze_grasp` (or ``options``).
     characteristic_length, num_generators, tol, allow_penetration, patches
