@@ -138,7 +138,6 @@ def _cmd_batch(args: argparse.Namespace) -> int:
                 ("--workers", args.workers is not None),
                 ("--progress", args.progress),
                 ("--format", args.format is not None),
-                ("--overwrite", args.overwrite),
             )
             if given
         ]
@@ -151,7 +150,11 @@ def _cmd_batch(args: argparse.Namespace) -> int:
         for key in ("workers", "progress", "fmt"):
             options.pop(key)
         summary = stream_file_on_cluster(
-            args.input, args.output, scheduler=args.scheduler, **options
+            args.input,
+            args.output,
+            scheduler=args.scheduler,
+            overwrite=args.overwrite,
+            **options,
         )
     else:
         summary = stream_file(
@@ -464,7 +467,9 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "--overwrite",
         action="store_true",
         help="replace an existing OUT (default: refuse); OUT is written to a "
-        "temporary file and renamed into place, and is never the input",
+        "temporary file and renamed into place, and is never the input; with "
+        "--scheduler, replace the shards of another job in OUT's dataset "
+        "directory (a rerun of the same job resumes it)",
     )
     batch.set_defaults(func=_cmd_batch)
 
