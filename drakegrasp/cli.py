@@ -37,25 +37,32 @@ hard ones.
 
 Exit status: 0 on success, 1 on an error (one line on stderr, never a
 traceback), 2 for a bad command line (argparse), 130 on Ctrl-C (SIGINT) with
-one line ``drakegrasp: interrupted``.  ``batch`` refuses an output that is its
-input or that exists, unless ``--overwrite``; it writes atomically (a
-temporary file renamed into place), so an interrupted run loses nothing.
+one line ``drakegrasp: interrupted``, 143 on SIGTERM and 129 on SIGHUP with one
+line ``drakegrasp: terminated by SIGTERM`` (the run unwinds as on Ctrl-C: no
+partial file, scratch folder or worker process is left).  ``batch`` refuses
+an output that is its input or that exists, unless ``--overwrite``; it writes
+atomically (a temporary file renamed into place), so an interrupted run loses
+nothing.
 Set ``DRAKEGRASP_DEBUG=1`` to see the traceback of an unexpected error.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
+import signal
 import sys
+import threading
+import unicodedata
 from collections.abc import Sequence
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.errors import GraspError, InvalidOptionError, InvalidPoseError
 
-__all__ = ["build_parser", "main"]
+__all__ = ["Terminated", "build_parser", "main", "printable"]
 
 EXIT_ERROR = 1
 EXIT_INTERRUPTED = 130
@@ -124,7 +131,7 @@ def _analyze(args: argparse.Namespace) -> int:
         json.dump(out, sys.stdout, indent=2)
         sys.stdout.write("\n")
     else:
-        print(f"scene {scene.name}: {scene.info.description}")
+        print(f"scene {printable(scene.name)}: {scene.info.description}")
         if scene.closure is not None:
             print(scene.closure)
         print(report)
@@ -204,7 +211,6 @@ def _cmd_batch(args: argparse.Namespace) -> int:
                 ("--workers", args.workers is not None),
                 ("--progress", args.progress),
                 ("--format", args.format is not None),
-                ("--overwrite", args.overwrite),
             )
             if given
         ]
@@ -217,14 +223,18 @@ def _cmd_batch(args: argparse.Namespace) -> int:
         for key in ("workers", "progress", "fmt"):
             options.pop(key)
         summary = stream_file_on_cluster(
-            args.input, args.output, scheduler=args.scheduler, **options
+            args.input,
+            args.output,
+            scheduler=args.scheduler,
+            overwrite=args.overwrite,
+            **options,
         )
     else:
         summary = stream_file(
             args.input, args.output, overwrite=args.overwrite, **options
         )
     print(summary)
-    print(f"wrote {args.output}")
+    print(f"wrote {printable(args.output)}")
     return 0
 
 
@@ -537,7 +547,9 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "--overwrite",
         action="store_true",
         help="replace an existing OUT (default: refuse); OUT is written to a "
-        "temporary file and renamed into place, and is never the input",
+        "temporary file and renamed into place, and is never the input; with "
+        "--scheduler, replace the shards of another job in OUT's dataset "
+        "directory (a rerun of the same job resumes it)",
     )
     batch.set_defaults(func=_cmd_batch)
 
@@ -563,7 +575,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser, _ = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args))
+        with _terminable():
+            return int(args.func(args))
+    except Terminated as t:
+        # SIGTERM or SIGHUP: unwound like Ctrl-C, so partial files and scratch
+        # folders are removed; the worker pool stops here, not at exit.
+        _stop_workers()
+        _say(f"drakegrasp: terminated by {t.name}")
+        return 128 + t.signum
     except KeyboardInterrupt:
         # Ctrl-C: one line and the conventional status 128 + SIGINT; batch
         # output is written atomically, so nothing half-written is left.
@@ -585,9 +604,86 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
 
 
+class Terminated(BaseException):  # noqa: N818 - like KeyboardInterrupt
+    """SIGTERM or SIGHUP received: raised in the main thread to unwind the run.
+
+    A ``BaseException``, like ``KeyboardInterrupt``, so that ``finally``
+    blocks and writers' ``except BaseException`` cleanups run while no
+    ``except Exception`` swallows it.
+    """
+
+    def __init__(self, signum: int):
+        self.signum = signum
+        self.name = signal.Signals(signum).name
+        super().__init__(self.name)
+
+
+_TERMINATING = tuple(
+    getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name)
+)
+
+
+def _raise_terminated(signum: int, frame) -> None:
+    for sig in _TERMINATING:  # a second signal must not interrupt the cleanup
+        signal.signal(sig, signal.SIG_IGN)
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _terminable():
+    """Turn SIGTERM and SIGHUP into :class:`Terminated` while the command runs.
+
+    Without this, either signal kills the interpreter at once: no ``finally``
+    runs, ``.partial`` files and ``.batch-*`` scratch folders stay, and the
+    kept worker pool is never told to stop.  Only the main thread can set
+    handlers; elsewhere (``main`` called from a thread) nothing changes.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {sig: signal.signal(sig, _raise_terminated) for sig in _TERMINATING}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _stop_workers() -> None:
+    """Stop the batch engine's kept worker pool, if this process started one."""
+    workers = sys.modules.get("drakegrasp.batch.run.workers")
+    if workers is not None:
+        workers.shutdown_pool()
+
+
+def _say(line: str) -> None:
+    """One line on stderr, unless stderr is gone (a hung-up terminal)."""
+    try:
+        print(line, file=sys.stderr)
+    except OSError:
+        pass
+
+
+def printable(text: str) -> str:
+    r"""``text`` safe to print on a terminal: control characters escaped.
+
+    File names may hold anything but ``/`` and NUL: a terminal escape
+    (``]0;...``), a bidirectional override (U+202E) or an undecodable
+    byte (a lone surrogate, which ``print`` cannot even encode).  Those
+    characters (Unicode categories Cc, Cf and Cs) are shown as Python escapes,
+    ```` or ``‮``; every other character is kept.
+    """
+    return "".join(
+        c.encode("unicode_escape", "backslashreplace").decode("ascii")
+        if unicodedata.category(c) in ("Cc", "Cf", "Cs")
+        else c
+        for c in str(text)
+    )
+
+
 def _error(message: str) -> int:
     """Print one line on stderr; return the error status."""
-    text = " ".join(str(message).split())
+    text = printable(" ".join(str(message).split()))
     print(f"drakegrasp: error: {text}", file=sys.stderr)
     return EXIT_ERROR
 

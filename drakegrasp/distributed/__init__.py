@@ -11,9 +11,9 @@ from drakegrasp._lazy import lazy_exports
 _SOURCES = {
     "drakegrasp.distributed.batch_side": (
         "evaluate_on_cluster",
-        "read_dataset",
         "stream_file_on_cluster",
     ),
+    "drakegrasp.distributed.dataset": ("read_dataset",),
     "drakegrasp.distributed.plant_side": ("analyze_poses", "cached_scenes"),
 }
 

@@ -8,9 +8,11 @@ partition runs the engine in one Dask task (``workers=1`` inside it: Dask's
 workers are the parallelism) and either returns its arrays or writes them as
 one Parquet shard ``part-NNNNN.parquet`` of a dataset directory, by writing a
 temporary file and renaming it into place.  A shard therefore exists only when
-complete: a restarted run skips the shards it finds, and a task that Dask
-retries after a worker died rewrites the same shard, so nothing is lost or
-duplicated.
+complete, and the dataset's manifest (:mod:`~drakegrasp.distributed.dataset`)
+names its job: a restarted run of the same job skips its complete shards, a
+directory of another job is refused (or replaced with ``overwrite``), and a
+task that Dask retries after a worker died rewrites the same shard, so nothing
+is lost or duplicated.
 
 Plant-based evaluation on a cluster is the other half of this folder
 (:mod:`drakegrasp.distributed.plant_side`).
@@ -28,21 +30,54 @@ from pathlib import Path
 import numpy as np
 
 from drakegrasp.batch.api import collect, stream_force_closure, stream_form_closure
-from drakegrasp.batch.inputs import check_metrics
+from drakegrasp.batch.inputs import (
+    check_metrics,
+    per_contact_getter,
+    positive_int,
+    shape_of,
+)
 from drakegrasp.batch.run.stream import chunk_size_for
 from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.core.validation import check_num_generators
-from drakegrasp.distributed.client import client_for
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.distributed.client import connected
+from drakegrasp.distributed.dataset import (
+    job_manifest,
+    prepare_dataset,
+    read_dataset,
+    shard_is_done,
+    shard_path,
+    write_shard,
+)
+from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
 __all__ = [
     "evaluate_on_cluster",
-    "read_dataset",
     "stream_file_on_cluster",
 ]
 
 _ARRAY_OPTIONS = ("mu", "torsional_friction", "reference_points",
                   "characteristic_lengths")  # fmt: skip
+_PER_CONTACT = ("mu", "torsional_friction")
+_RESERVED = ("workers", "progress")  # the cluster decides these
+
+
+def _per_grasp_arrays(arrays: dict, K: int, N: int) -> dict:
+    """Per-contact options checked whole and made partition-proof.
+
+    A per-grasp ``(K,)`` array is refused as ambiguous when ``K == N``, as the
+    local engine refuses it, and otherwise reshaped to ``(K, 1)``: a
+    partition's slice ``(k,)`` would be ambiguous whenever ``k == N``.
+    """
+    out = dict(arrays)
+    for name in _PER_CONTACT:
+        value = out.get(name)
+        if value is None:
+            continue
+        per_contact_getter(name, value, K, N)  # the local engine's shape rules
+        if np.shape(value) == (K,):
+            out[name] = (value if hasattr(value, "reshape") else np.asarray(value)
+                         ).reshape(K, 1)  # fmt: skip
+    return out
 
 
 def _slice_option(value, sl: slice, K: int):
@@ -53,7 +88,7 @@ def _slice_option(value, sl: slice, K: int):
     return np.asarray(value[sl])
 
 
-def _partition(kind, positions, normals, arrays, options, shard, chunk_size):
+def _partition(kind, positions, normals, arrays, options, shard, chunk_size, job):
     """One partition through the local engine; write its shard or return arrays."""
     run = stream_force_closure if kind == "force" else stream_form_closure
     args = (positions, normals) + ((arrays.pop("mu"),) if kind == "force" else ())
@@ -63,14 +98,7 @@ def _partition(kind, positions, normals, arrays, options, shard, chunk_size):
     out = {n: np.concatenate([p[n] for p in parts]) for n in names}
     if shard is None:
         return out
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    shard = Path(shard)
-    tmp = shard.with_name(f".{shard.name}.{os.getpid()}.tmp")
-    pq.write_table(pa.table(out), tmp)
-    os.replace(tmp, shard)  # the shard appears only when complete
-    return str(shard)
+    return write_shard(Path(shard), out, job)
 
 
 def evaluate_on_cluster(
@@ -81,6 +109,7 @@ def evaluate_on_cluster(
     *,
     kind: str = "force",
     output_dir: str | os.PathLike | None = None,
+    overwrite: bool = False,
     partition_chunks: int = 4,
     chunk_size: int | None = None,
     **options,
@@ -99,10 +128,17 @@ def evaluate_on_cluster(
     kind : {"force", "form"}, optional
     output_dir : path, optional
         Write one Parquet shard per partition to this directory (a dataset
-        that ``pandas.read_parquet`` or :func:`read_dataset` reads) instead of
-        returning the results; shards already present are skipped.
+        that ``pandas.read_parquet`` or
+        :func:`~drakegrasp.distributed.dataset.read_dataset` reads) instead of
+        returning the results.  The directory's manifest names the job (a
+        fingerprint of the inputs and options, see
+        :mod:`~drakegrasp.distributed.dataset`): a rerun of the same job skips
+        its complete shards and recomputes truncated or foreign ones; a
+        directory of another job is refused unless ``overwrite``.
+    overwrite : bool, optional
+        Replace the shards of another job found in ``output_dir``.
     partition_chunks : int, optional
-        Engine chunks per partition (default 4).
+        Engine chunks per partition (an integer >= 1, default 4).
     chunk_size : int, optional
         The engine's chunk size (default: sized by bytes, as locally).
     **options
@@ -115,44 +151,72 @@ def evaluate_on_cluster(
     BatchClosureResult or list of str
         The result, bitwise equal to the local engine's; or, with
         ``output_dir``, the shard paths in order.
+
+    Raises
+    ------
+    InvalidOptionError
+        A bad option (``partition_chunks``, ``kind``, ``workers``, ...).
+    BatchFileError
+        ``output_dir`` holds another job and ``overwrite`` is not set.
     """
     if kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
     if kind == "force" and mu is None:
         raise InvalidOptionError("force closure needs mu")
-    client = client_for(client)
-    K, N, d = np.shape(positions)
+    reserved = sorted(set(_RESERVED) & set(options))
+    if reserved:
+        raise InvalidOptionError(
+            f"{', '.join(reserved)} cannot be given on a cluster: each partition "
+            "runs in one Dask task, and the cluster's workers are the parallelism"
+        )
+    per_partition = positive_int("partition_chunks", partition_chunks, 1)
+    K, N, d = shape_of("positions", positions)
+    if np.shape(normals) != (K, N, d):
+        raise InvalidContactError(
+            f"normals must have the shape of positions {(K, N, d)}, got "
+            f"{np.shape(normals)}"
+        )
     # the local engine's chunks (same n_g and K), so partitions align with them
     n_g = 1
     if kind == "force":
         n_g = check_num_generators(options.get("num_generators", 8))
     size = chunk_size_for(N, d, chunk_size, n_g, K)
-    step = size * int(partition_chunks)
+    step = size * per_partition
     arrays = {k: options.pop(k) for k in _ARRAY_OPTIONS if k in options}
     if kind == "force":
         arrays["mu"] = mu
+    arrays = _per_grasp_arrays(arrays, K, N)
+    starts = list(range(0, K, step))
+    job = None
     if output_dir is not None:
-        output_dir = Path(output_dir)
-        output_dir.mkdir(parents=True, exist_ok=True)
-    futures, done_paths = [], {}
-    run = uuid.uuid4().hex  # task keys unique to this call
-    for j, start in enumerate(range(0, K, step)):
-        sl = slice(start, min(K, start + step))
-        shard = None if output_dir is None else output_dir / f"part-{j:05d}.parquet"
-        if shard is not None and shard.exists():
-            done_paths[j] = str(shard)
-            continue
-        P, Nrm = positions[sl], normals[sl]
-        if hasattr(P, "dask"):  # a Dask array block: computed on the cluster
-            P, Nrm = client.compute(P), client.compute(Nrm)
-        else:
-            P, Nrm = np.asarray(P), np.asarray(Nrm)
-        part = {k: _slice_option(v, sl, K) for k, v in arrays.items()}
-        futures.append((j, sl, client.submit(
-            _partition, kind, P, Nrm, part, options, shard, size,
-            key=f"drakegrasp-partition-{j}-{run}", pure=False,
-        )))  # fmt: skip
-    results = {j: f.result() for j, _, f in futures}
+        manifest = job_manifest(
+            kind=kind, shape=(K, N, d),
+            arrays={"positions": positions, "normals": normals, **arrays},
+            options=options, step=step, chunk_size=size,
+            rows=[min(K, s + step) - s for s in starts],
+        )  # fmt: skip
+        output_dir = prepare_dataset(output_dir, manifest, overwrite=overwrite)
+        job = manifest["job"]
+    with connected(client) as client:
+        futures, done_paths = [], {}
+        run = uuid.uuid4().hex  # task keys unique to this call
+        for j, start in enumerate(starts):
+            sl = slice(start, min(K, start + step))
+            shard = None if output_dir is None else shard_path(output_dir, j)
+            if shard is not None and shard_is_done(shard, job, sl.stop - sl.start):
+                done_paths[j] = str(shard)
+                continue
+            P, Nrm = positions[sl], normals[sl]
+            if hasattr(P, "dask"):  # a Dask array block: computed on the cluster
+                P, Nrm = client.compute(P), client.compute(Nrm)
+            else:
+                P, Nrm = np.asarray(P), np.asarray(Nrm)
+            part = {k: _slice_option(v, sl, K) for k, v in arrays.items()}
+            futures.append((j, sl, client.submit(
+                _partition, kind, P, Nrm, part, options, shard, size, job,
+                key=f"drakegrasp-partition-{j}-{run}", pure=False,
+            )))  # fmt: skip
+        results = {j: f.result() for j, _, f in futures}
     if output_dir is not None:
         results.update(done_paths)
         return [results[j] for j in sorted(results)]
@@ -162,47 +226,43 @@ def evaluate_on_cluster(
     return collect(K, d, kind, tol, names, chunks)
 
 
-def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
-    """The arrays of a dataset of :func:`evaluate_on_cluster`, shards in order."""
-    import pyarrow.parquet as pq
-
-    shards = sorted(Path(output_dir).glob("part-*.parquet"))
-    tables = [pq.read_table(s) for s in shards]
-    if not tables:
-        return {}
-    return {
-        name: np.concatenate([t.column(name).to_numpy() for t in tables])
-        for name in tables[0].column_names
-    }
-
-
 def stream_file_on_cluster(
     input_path, output_path, *, scheduler: str, fmt: str | None = None,
     workers=None, progress: bool = False, kind: str = "force", mu=None,
-    **options,
+    torsional_friction=None, overwrite: bool = False, **options,
 ):  # fmt: skip
     """``drakegrasp batch --scheduler ADDRESS``: a file's grasps on a cluster.
 
     ``output_path`` becomes a Parquet dataset directory, one shard per
-    partition (a rerun skips complete shards).  Returns a
-    :class:`~drakegrasp.batch.BatchSummary`.
+    partition: a rerun of the same job resumes it, a directory of another
+    job is refused unless ``overwrite`` (then its shards are replaced).
+    ``mu`` and ``torsional_friction``, when given, override the file's
+    arrays, as in :func:`~drakegrasp.batch.stream_file`.
+
+    Returns
+    -------
+    BatchSummary
+        Of this run's dataset (every shard of this job).
     """
-    from drakegrasp.batch.files.reader import read_grasps
+    from drakegrasp.batch.files.reader import as_path, engine_options, read_grasps
     from drakegrasp.batch.files.writer import BatchSummary
 
     del workers, progress, fmt  # the cluster decides; output is always a dataset
-    data = read_grasps(input_path)
-    for name in _ARRAY_OPTIONS:
-        if name in data and options.get(name) is None:
-            options[name] = data[name]
-    if kind == "force" and mu is None:
-        mu = data.get("mu")
+    source = as_path("input", input_path)
+    data = read_grasps(source)
+    extra = engine_options(
+        data, source, kind=kind, mu=mu, torsional_friction=torsional_friction
+    )
+    mu = extra.pop("mu", None)
+    options.update({k: v for k, v in extra.items() if v is not None})
     options = {k: v for k, v in options.items() if v is not None}
     evaluate_on_cluster(scheduler, data["positions"], data["normals"], mu,
-                        kind=kind, output_dir=output_path, **options)  # fmt: skip
+                        kind=kind, output_dir=as_path("output", output_path),
+                        overwrite=overwrite, **options)  # fmt: skip
     arrays = read_dataset(output_path)
     summary = BatchSummary(kind=kind, tol=float(options.get("tol", DEFAULT_TOL)))
-    summary.add(arrays)
+    if arrays:
+        summary.add(arrays)
     return summary
 
 

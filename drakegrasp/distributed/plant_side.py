@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.distributed.client import client_for
+from drakegrasp.core.validation import integer_or_none
+from drakegrasp.distributed.client import connected
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.options import AnalysisOptions
 
 __all__ = ["analyze_poses", "cached_scenes"]
@@ -36,6 +38,13 @@ def _analyze_block(scene_name: str, q_block: np.ndarray, options: dict):
 
     scene = _scene(scene_name)
     plant, ctx = scene.plant, scene.plant_context
+    n_q = plant.num_positions()
+    if q_block.shape[1] != n_q:  # Drake would raise SystemExit and kill the task
+        raise InvalidOptionError(
+            f"positions have {q_block.shape[1]} columns, but scene {scene_name!r} "
+            f"has {n_q} positions (its plant's GetPositions order); pass an array "
+            f"of shape (P, {n_q})"
+        )
     out = {"is_force_closure": np.zeros(len(q_block), dtype=bool),
            "d_star": np.zeros(len(q_block)),
            "num_contacts": np.zeros(len(q_block), dtype=int)}  # fmt: skip
@@ -70,7 +79,7 @@ def analyze_poses(
     positions : (P, n_q) float
         Plant positions ``q`` (the scene plant's ``GetPositions`` order).
     block : int, optional
-        Configurations per task.
+        Configurations per task (an integer >= 1).
     **options
         Overrides of the scene's analysis options (e.g. ``mu``).
 
@@ -78,12 +87,52 @@ def analyze_poses(
     -------
     dict of str to (P,) array
         ``is_force_closure``, ``d_star`` (LP2 of the report's force closure)
-        and ``num_contacts``.
+        and ``num_contacts`` (empty arrays for ``P = 0``).
+
+    Raises
+    ------
+    InvalidOptionError
+        A bad option or ``block``; positions that are not a finite (P, n_q)
+        array, or whose ``n_q`` is not the scene plant's number of positions.
     """
     AnalysisOptions().replace(**options)  # a bad option fails here, not on a worker
-    client = client_for(client)
-    q = np.asarray(positions, dtype=float)
-    futs = [client.submit(_analyze_block, scene, q[s:s + block], options,
-                          pure=False) for s in range(0, len(q), block)]  # fmt: skip
-    parts = client.gather(futs)
-    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]} if parts else {}
+    n = integer_or_none(block)
+    if n is None or n < 1:
+        raise InvalidOptionError(
+            f"block (configurations per task) must be an integer >= 1, got {block!r}"
+        )
+    block = n
+    q = _configurations(positions)
+    with connected(client) as client:
+        futs = [client.submit(_analyze_block, scene, q[s:s + block], options,
+                              pure=False) for s in range(0, len(q), block)]  # fmt: skip
+        parts = client.gather(futs)
+    names = {"is_force_closure": bool, "d_star": float, "num_contacts": int}
+    return {
+        k: np.concatenate([p[k] for p in parts]) if parts else np.zeros(0, dtype)
+        for k, dtype in names.items()
+    }
+
+
+def _configurations(positions) -> np.ndarray:
+    """``positions`` as a finite (P, n_q) float array, or a clear error."""
+    try:
+        q = np.asarray(positions)
+    except (TypeError, ValueError) as err:
+        raise InvalidOptionError(
+            f"positions must be a (P, n_q) array of plant positions: {err}"
+        ) from None
+    if q.ndim != 2 or q.dtype.kind not in "iuf":
+        raise InvalidOptionError(
+            "positions must be a real (P, n_q) array of plant positions, one row "
+            f"per configuration; got shape {q.shape} and dtype {q.dtype}"
+        )
+    q = q.astype(float)
+    bad = ~np.isfinite(q).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InvalidOptionError(
+            f"configuration {i} is not finite ({q[i].tolist()}); plant positions "
+            "must be finite numbers"
+        )
+    return q

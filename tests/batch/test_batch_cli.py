@@ -96,8 +96,7 @@ def test_a_directory_without_normals_is_named(tmp_path, capsys):
         (["--workers", "2"], "--workers"),
         (["--progress"], "--progress"),
         (["--format", "npz"], "--format"),
-        (["--overwrite"], "--overwrite"),
-        (["--workers", "1", "--overwrite"], "--workers, --overwrite"),
+        (["--workers", "1", "--progress"], "--workers, --progress"),
     ],
 )
 def test_scheduler_refuses_options_it_would_ignore(

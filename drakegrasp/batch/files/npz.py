@@ -10,6 +10,7 @@ success and on failure.
 
 from __future__ import annotations
 
+import contextlib
 import shutil
 import tempfile
 import zipfile
@@ -55,7 +56,15 @@ class NpzWriter:
         shutil.rmtree(self.scratch, ignore_errors=True)
 
     def abort(self) -> None:
-        """Give up: close and remove everything written so far."""
-        for f in self.files.values():
-            f.close()
-        shutil.rmtree(self.scratch, ignore_errors=True)
+        """Give up: close and remove everything written so far.
+
+        Closing a file flushes its buffer, which fails again on a full disk;
+        the scratch directory is removed whatever the files say, so a failed
+        run never leaves the disk fuller than it found it.
+        """
+        try:
+            for f in self.files.values():
+                with contextlib.suppress(OSError):
+                    f.close()
+        finally:
+            shutil.rmtree(self.scratch, ignore_errors=True)

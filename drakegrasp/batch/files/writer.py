@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
+import secrets
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -168,6 +168,26 @@ def _link_or_rename(tmp: str, path: Path) -> None:
     os.unlink(tmp)
 
 
+def _new_sibling(path: Path) -> str:
+    """Create an empty ``.NAME.XXXX.partial`` beside ``path``; return its name.
+
+    Like ``tempfile.mkstemp`` (exclusive creation, a random name) but with the
+    mode an ordinary file gets, 0666 less the umask (0644 under umask 022):
+    mkstemp's 0600 would make the results unreadable to the user's group.
+    """
+    for _ in range(100):
+        tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.partial"
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        except FileExistsError:
+            continue
+        os.close(fd)
+        return str(tmp)
+    raise BatchFileError(  # pragma: no cover - 100 collisions of 48 random bits
+        f"could not create a temporary file beside {str(path)!r}"
+    )
+
+
 @contextlib.contextmanager
 def placed(path: Path, *, overwrite: bool) -> Iterator[str]:
     """A temporary sibling of ``path`` to write; renamed onto ``path`` on success.
@@ -176,10 +196,7 @@ def placed(path: Path, *, overwrite: bool) -> Iterator[str]:
     appeared at ``path`` meanwhile is kept and the call fails; on any failure
     the temporary file is removed and an earlier ``path`` is untouched.
     """
-    fd, tmp = tempfile.mkstemp(
-        dir=path.parent, prefix=f".{path.name}.", suffix=".partial"
-    )
-    os.close(fd)
+    tmp = _new_sibling(path)
     try:
         yield tmp
         with open(tmp, "rb+") as f:

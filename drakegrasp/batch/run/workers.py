@@ -13,6 +13,14 @@ the worker that solves it, so the parent only slices, sends and collects; its
 large arrays go through shared memory (:mod:`drakegrasp.batch.run.shared_arrays`)
 instead of the pool's pipe.
 The worker processes are kept between calls (:func:`shutdown_pool`).
+
+A kept pool never outlives its program: each worker watches its parent and
+exits as soon as the parent is gone, however it ended (killed, ``os._exit``,
+a crash), so no orphan keeps the program's stdout open (``| tee`` would wait
+for ever) or its memory; the shared-memory segments are then unlinked by
+Python's resource tracker, which exits with the last of them.  Workers ignore
+a Ctrl-C sent to the whole process group: the parent decides, stops them and
+cleans up.
 """
 
 from __future__ import annotations
@@ -20,6 +28,9 @@ from __future__ import annotations
 import atexit
 import multiprocessing
 import os
+import signal
+import threading
+import time
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
@@ -35,6 +46,9 @@ from drakegrasp.batch.run.shared_arrays import (
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["available_cores", "map_ordered", "resolve_workers", "shutdown_pool"]
+
+PARENT_WATCH_PERIOD = 0.2
+"""Seconds between a worker's checks that its parent is alive."""
 
 Task = tuple[Callable, tuple, dict]
 
@@ -166,9 +180,42 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     # (forkserver and spawn re-run the main module in every worker).
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    pool = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=ctx,
+        initializer=_init_worker,
+        initargs=(os.getpid(),),
+    )
     _POOL.update(pool=pool, workers=workers)
     return pool
+
+
+def _init_worker(parent: int) -> None:
+    """Run in each worker as it starts: outlive no parent, leave signals to it.
+
+    A daemon thread checks every ``PARENT_WATCH_PERIOD`` that the process that
+    started the pool is still this worker's parent (an orphan is adopted by
+    another process) and ends the worker at once if not.  Unlike Linux's
+    ``PR_SET_PDEATHSIG``, this does not fire when the thread that started the
+    worker ends while the program goes on, and it works on every POSIX system.
+    """
+    # A Ctrl-C reaches the whole process group: the parent stops the pool.
+    # SIGTERM and SIGHUP end a worker at once (the parent's handlers, which a
+    # fork copies, are for the parent; the pool itself stops workers with
+    # SIGTERM when one died).
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for name in ("SIGTERM", "SIGHUP"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), signal.SIG_DFL)
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(PARENT_WATCH_PERIOD)
+        os._exit(1)  # no cleanup of the parent's state: it is not ours
+
+    if os.getppid() != parent:  # the parent died while this worker started
+        os._exit(1)
+    threading.Thread(target=watch, name="drakegrasp-parent-watch", daemon=True).start()
 
 
 def _healthy(pool: ProcessPoolExecutor) -> bool:
