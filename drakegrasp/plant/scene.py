@@ -123,6 +123,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pydrake.multibody.parsing import (
     LoadModelDirectivesFromString,
@@ -136,13 +137,15 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import ModelError, SceneError
-from drakegrasp.plant.closing import HandClosure, close_hand
 from drakegrasp.plant.couplings import record_model_couplings
 from drakegrasp.plant.models import explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import check_section, directives_text, read_yaml
 from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
 from drakegrasp.plant.validation import resolve_body
+
+if TYPE_CHECKING:  # closing is imported only when a scene closes its hand
+    from drakegrasp.plant.closing import HandClosure
 
 __all__ = [
     "DEFAULT_SCENE",
@@ -426,6 +429,8 @@ def load_scene(
     plant_context = plant.GetMyContextFromRoot(context)
     closure = None
     if info.close if close is None else close:
+        from drakegrasp.plant.closing import close_hand
+
         closure = close_hand(
             plant,
             plant_context,

@@ -53,8 +53,12 @@ def test_the_best_line_beats_every_sampled_line(seed, k1, k2, tilt):
     x1, x2 = patch_line(P1, n1, P2, n2)
     assert _in_hull(x1, P1) and _in_hull(x2, P2)
     best = max(_angles(x1, x2, n1, n2))
-    W1 = rng.dirichlet(np.ones(k1), 20000)
-    W2 = rng.dirichlet(np.ones(k2), 20000)
+    # Half the samples spread over the patches, half near their edges and
+    # corners (a sparse Dirichlet), where the best line of two polygons lies.
+    W1 = np.vstack([rng.dirichlet(np.ones(k1), 10000),
+                    rng.dirichlet(np.full(k1, 0.1), 10000)])  # fmt: skip
+    W2 = np.vstack([rng.dirichlet(np.ones(k2), 10000),
+                    rng.dirichlet(np.full(k2, 0.1), 10000)])  # fmt: skip
     D = W2 @ P2 - W1 @ P1
     corners = (P2[None, :, :] - P1[:, None, :]).reshape(-1, 3)
     D = np.vstack([D, corners])

@@ -25,11 +25,11 @@ from drakegrasp.plant import list_scenes
 
 SCENE_NAMES = [info.name for info in list_scenes()]
 
-# Never needed to load a scene and print its analysis.
+# Never needed to load a scene and print its analysis (the quality layer is:
+# analyze prints Ferrari-Canny epsilon).
 DEFERRED = (
     "drakegrasp.batch",
     "drakegrasp.distributed",
-    "drakegrasp.quality",
     "drakegrasp.systems.monitor",
     "drakegrasp.visualization",
     "drakegrasp.plant.closing",

@@ -32,7 +32,7 @@ def _query(scene):
 
 
 def test_unconnected_context_needs_a_query_object(scene):
-    with pytest.raises(RuntimeError):
+    with pytest.raises(dg.InvalidContextError, match="GetMyContextFromRoot"):
         dg.find_contacts(
             scene.plant, _private_context(scene), object_body=scene.object_body
         )
