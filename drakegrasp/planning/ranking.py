@@ -1,0 +1,200 @@
+r"""Ranking planned grasps: verdicts, ε on one scale, robustness and the score.
+
+Every measure runs in the batch engine (:mod:`drakegrasp.batch`), on the
+candidates grouped by their number of contacts (the engine takes ``K`` grasps
+of ``N`` contacts each; a WSG finger seats one to four tip spheres, so the
+counts are ragged).
+
+**ε on one scale.**  The Ferrari–Canny L1 ε divides moments by a length; by
+default each grasp uses its own (its largest contact distance), which makes a
+shallow grasp look better than a centred one.  Here every candidate of an
+object uses the same ``torque_scale`` (the radius of a ball about the object's
+origin holding its collision geometry), so ε compares across candidates.
+
+**Robustness** is the fraction of ``S`` perturbed copies of a grasp that stay
+force closure (LP2).  A copy moves each finger's contacts rigidly, as a
+misplaced pad would: a rotation by an angle drawn from
+:math:`\mathcal N(0, \sigma_\theta^2)` about a uniformly random axis through the
+finger's contact centroid, then a translation drawn from
+:math:`\mathcal N(0, \sigma_p^2 I_3)`; and it scales μ by
+:math:`\max(0, 1 + \sigma_\mu \xi)`, :math:`\xi \sim \mathcal N(0, 1)`, one
+draw per copy.  A rigid motion of the whole grasp changes no verdict, so the
+noise is per finger: it models the object's pose error and the fingers'
+placement error relative to each other.
+
+**Score** :math:`= \varepsilon \cdot \rho` (ε times robustness): 0 for a grasp
+that is not force closure; among force-closure grasps it favours one that
+resists every wrench well and keeps closure when misplaced.  Ties are broken by
+``d*`` and then by the sample index, so a ranking is reproducible.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
+
+__all__ = [
+    "DEFAULT_NOISE",
+    "group_by_count",
+    "perturbed_copies",
+    "rank_order",
+    "robustness",
+    "verdicts",
+]
+
+DEFAULT_NOISE = {"position": 2e-3, "angle_deg": 3.0, "friction": 0.1}
+"""Default robustness noise: σ_p (m), σ_θ (degrees), σ_μ (relative)."""
+
+
+def group_by_count(counts: np.ndarray) -> dict[int, np.ndarray]:
+    """Candidate indices by their number of contacts, ``{N: indices}``."""
+    counts = np.asarray(counts)
+    return {int(n): np.flatnonzero(counts == n) for n in np.unique(counts)}
+
+
+def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """(…, 3, 3) rotations about unit ``axes`` (…, 3) by ``angles`` (…) (Rodrigues)."""
+    x, y, z = axes[..., 0], axes[..., 1], axes[..., 2]
+    zero = np.zeros_like(x)
+    K = np.stack(
+        [
+            np.stack([zero, -z, y], -1),
+            np.stack([z, zero, -x], -1),
+            np.stack([-y, x, zero], -1),
+        ],
+        -2,
+    )
+    s, c = np.sin(angles)[..., None, None], np.cos(angles)[..., None, None]
+    return np.eye(3) + s * K + (1 - c) * (K @ K)
+
+
+def perturbed_copies(
+    positions: np.ndarray,
+    normals: np.ndarray,
+    fingers: np.ndarray,
+    mu: float,
+    *,
+    samples: int,
+    rng: np.random.Generator,
+    position: float,
+    angle_deg: float,
+    friction: float,
+):
+    """``samples`` perturbed copies of each of ``K`` grasps (module docstring).
+
+    Parameters
+    ----------
+    positions, normals : (K, N, 3) float
+        Contacts (metres) and inward unit normals, one frame per grasp.
+    fingers : (K, N) int
+        Which finger (0 or 1) made each contact.
+    mu : float
+    samples : int
+    rng : numpy.random.Generator
+    position, angle_deg, friction : float
+        σ_p (m), σ_θ (degrees), σ_μ.
+
+    Returns
+    -------
+    P, Nrm : (K * samples, N, 3) float
+        Copies, grasp-major (copy ``s`` of grasp ``k`` at row ``k * samples + s``).
+    mu : (K * samples,) float
+    """
+    K, N, _ = positions.shape
+    P = np.repeat(positions, samples, axis=0)
+    Nrm = np.repeat(normals, samples, axis=0)
+    F = np.repeat(fingers, samples, axis=0)
+    M = K * samples
+    for f in (0, 1):
+        mask = (F == f)[..., None]
+        count = np.maximum(mask.sum(axis=1), 1)
+        centre = (P * mask).sum(axis=1) / count  # (M, 3)
+        axes = rng.standard_normal((M, 3))
+        axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+        R = _rotations(axes, np.radians(angle_deg) * rng.standard_normal(M))
+        shift = position * rng.standard_normal((M, 3))
+        moved = np.einsum("mij,mnj->mni", R, P - centre[:, None]) + (centre + shift)[:, None]
+        P = np.where(mask, moved, P)
+        Nrm = np.where(mask, np.einsum("mij,mnj->mni", R, Nrm), Nrm)
+    mus = mu * np.maximum(0.0, 1.0 + friction * rng.standard_normal(M))
+    return P, Nrm, mus
+
+
+def verdicts(
+    positions,
+    normals,
+    mu,
+    *,
+    torque_scale: float,
+    model: str,
+    torsional_friction,
+    workers: int | None,
+):
+    """LP2 verdicts and ε (one torque scale) of ``K`` grasps of ``N`` contacts.
+
+    Returns
+    -------
+    is_closure, d_star, rank, epsilon : (K,) arrays
+    """
+    res = batch_force_closure(
+        positions,
+        normals,
+        mu,
+        model=model,
+        torsional_friction=torsional_friction,
+        workers=workers,
+    )
+    eps = np.zeros(len(positions))
+    closed = np.flatnonzero(res.is_closure)
+    if len(closed):
+        eps[closed] = batch_epsilon_l1(
+            positions[closed],
+            normals[closed],
+            mu,
+            model=model,
+            torsional_friction=torsional_friction,
+            characteristic_lengths=torque_scale,
+            workers=workers,
+        )
+    return (
+        np.asarray(res.is_closure, bool),
+        np.asarray(res.d_star, float),
+        np.asarray(res.rank, int),
+        eps,
+    )
+
+
+def robustness(
+    positions,
+    normals,
+    fingers,
+    mu: float,
+    *,
+    samples: int,
+    rng: np.random.Generator,
+    noise: dict,
+    model: str,
+    torsional_friction,
+    workers: int | None,
+) -> np.ndarray:
+    """(K,) fraction of perturbed copies that stay force closure (LP2)."""
+    if samples == 0 or len(positions) == 0:
+        return np.zeros(len(positions))
+    P, Nrm, mus = perturbed_copies(
+        positions, normals, fingers, mu, samples=samples, rng=rng, **noise
+    )
+    res = batch_force_closure(
+        P,
+        Nrm,
+        mus,
+        model=model,
+        torsional_friction=torsional_friction,
+        workers=workers,
+    )
+    return np.asarray(res.is_closure, float).reshape(len(positions), samples).mean(axis=1)
+
+
+def rank_order(score, d_star, sample) -> np.ndarray:
+    """Indices best first: highest score, then highest ``d*``, then lowest sample."""
+    return np.lexsort((np.asarray(sample), -np.asarray(d_star), -np.asarray(score)))
