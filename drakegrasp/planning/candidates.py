@@ -53,7 +53,9 @@ class GraspCandidate:
         Closing joints' values of the closed hand (metres), in the order of
         ``joint_names``.
     joint_names : tuple of str
-        Names of the closing joints.
+        Scoped names ``model::joint`` of the closing joints.
+    closing_signs : tuple of float
+        The sign of each joint's motion that closes the gripper (±1).
     opening : float
         Pad-to-pad width of the pre-grasp (open) hand, metres.
     contacts : tuple of PlantContact
@@ -84,6 +86,7 @@ class GraspCandidate:
     X_WO: RigidTransform
     q_hand: np.ndarray
     joint_names: tuple[str, ...]
+    closing_signs: tuple[float, ...]
     opening: float
     contacts: tuple[PlantContact, ...]
     grasp: Grasp
@@ -106,7 +109,8 @@ class GraspCandidate:
         Parameters
         ----------
         plant : MultibodyPlant
-            The plant the candidate was planned in (or one with the same hand).
+            The plant the candidate was planned in (or one with the same hand;
+            a hand base welded there is left where the weld puts it).
         context : Context
             The plant's context or its diagram's root context; changed.
         object_body : RigidBody, optional
@@ -114,7 +118,9 @@ class GraspCandidate:
         """
         ctx = plant_context_of(plant, context)
         joints = [_joint(plant, n) for n in self.joint_names]
-        plant.SetFreeBodyPose(ctx, resolve_body(plant, self.hand_base), self.X_WH)
+        base = resolve_body(plant, self.hand_base)
+        if base.is_floating_base_body():  # else welded (at X_WH, the caller's word)
+            plant.SetFreeBodyPose(ctx, base, self.X_WH)
         for j, q in zip(joints, self.q_hand, strict=True):
             j.set_translation(ctx, float(q))
         if object_body is not None and object_body.is_floating_base_body():

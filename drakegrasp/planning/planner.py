@@ -472,6 +472,10 @@ def _rank(
                 X_WO=X_WO,
                 q_hand=np.asarray(q, float),
                 joint_names=joint_names,
+                closing_signs=(
+                    float(np.sign(1 / gripper.pad_rate[0])),
+                    float(np.sign(-1 / gripper.pad_rate[1])),
+                ),
                 opening=opening,
                 contacts=tuple(found),
                 grasp=grasp,
