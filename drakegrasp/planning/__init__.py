@@ -16,10 +16,20 @@ _SOURCES = {
     "drakegrasp.planning.candidates": ("GraspCandidate", "GraspCandidates"),
     "drakegrasp.planning.gripper": ("ParallelJaw", "parallel_jaw"),
     "drakegrasp.planning.planner": ("REASONS", "object_surface", "plan_grasps"),
+    "drakegrasp.planning.scenes": ("PlanningScene", "planning_scene"),
+    "drakegrasp.planning.shake": ("ShakeResult", "shake_test"),
     "drakegrasp.planning.surface": ("ObjectSurface",),
 }
 
-_SUBMODULES = ("candidates", "gripper", "planner", "ranking", "surface")
+_SUBMODULES = (
+    "candidates",
+    "gripper",
+    "planner",
+    "ranking",
+    "scenes",
+    "shake",
+    "surface",
+)
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(), _SOURCES, submodules=_SUBMODULES
@@ -31,7 +41,11 @@ __all__ = [
     "GraspCandidates",
     "ObjectSurface",
     "ParallelJaw",
+    "PlanningScene",
+    "ShakeResult",
     "object_surface",
     "parallel_jaw",
     "plan_grasps",
+    "planning_scene",
+    "shake_test",
 ]

@@ -109,15 +109,19 @@ def _check_count(value) -> int:
     return int(value)
 
 
-def _axis_frames(d_W: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """(K, 3, 3) rotations R_WK: x along ``d``, y at angle θ about it."""
-    helper = np.zeros_like(d_W)
-    helper[np.arange(len(d_W)), np.argmin(np.abs(d_W), axis=1)] = 1.0
-    e1 = np.cross(helper, d_W)
+def _axis_frames(d: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """(K, 3, 3) rotations whose x axis is ``d`` and y axis at angle θ about it.
+
+    The angle is measured from a first tangent that depends on ``d`` alone (the
+    convention of the contact frames), in the frame ``d`` is expressed in.
+    """
+    helper = np.zeros_like(d)
+    helper[np.arange(len(d)), np.argmin(np.abs(d), axis=1)] = 1.0
+    e1 = np.cross(helper, d)
     e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
-    e2 = np.cross(d_W, e1)
+    e2 = np.cross(d, e1)
     y = np.cos(theta)[:, None] * e1 + np.sin(theta)[:, None] * e2
-    return np.stack([d_W, y, np.cross(d_W, y)], axis=-1)
+    return np.stack([d, y, np.cross(d, y)], axis=-1)
 
 
 def _sample_poses(surface, gripper: ParallelJaw, X_WO, n, mu, clearance, rng, tol):
@@ -139,9 +143,8 @@ def _sample_poses(surface, gripper: ParallelJaw, X_WO, n, mu, clearance, rng, to
     reject(np.sum(nexit_O * d_O, axis=1) < cos_cone, "outside the friction cone")
     keep = np.flatnonzero(reasons == "")
     R_WO = X_WO.rotation().matrix()
-    d_W = d_O[keep] @ R_WO.T
     centre_W = (p_O[keep] + 0.5 * t_out[keep, None] * d_O[keep]) @ R_WO.T + X_WO.translation()
-    R_WK = _axis_frames(d_W, theta[keep])
+    R_WK = R_WO @ _axis_frames(d_O[keep], theta[keep])  # built in O: invariant
     X_KH = gripper.X_HK.inverse()
     R_WH = R_WK @ X_KH.rotation().matrix()
     p_WH = centre_W + R_WK @ X_KH.translation()
