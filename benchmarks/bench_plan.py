@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_plan.py [--num 1000] [--top 10] [--random 10]
-        [--squeeze 20] [--seed 0] [--objects NAME ...] [--no-shake]
+        [--squeeze 6 20] [--seed 0] [--objects NAME ...] [--no-shake]
 
 For each object (the YCB boxes and can of ``drake_models``, when present, and
 drakegrasp's own box, cylinder, sphere and hexagonal prism), with Drake's
@@ -16,7 +16,10 @@ WSG-50 as a free gripper:
 * **hold rates**: :func:`drakegrasp.planning.shake_test` on the ``--top``
   best candidates and on ``--random`` candidates drawn uniformly (seeded)
   from all collision-free closed antipodal candidates of the same run (the
-  baseline a planner without ranking would give), as held / tried.
+  baseline a planner without ranking would give), as held / tried, for each
+  ``--squeeze`` (newtons per finger: a light 6 N, at which a grasp must be
+  well placed to hold, and a firm 20 N, at which with the models' friction of
+  1 almost any two-sided grasp holds).
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drakegrasp.planning import planning_scene, plan_grasps, shake_test
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 
 ROOT = Path(__file__).resolve().parents[1]
 YCB = ("003_cracker_box", "004_sugar_box", "005_tomato_soup_can")
@@ -37,7 +40,10 @@ OWN = ("box", "cylinder", "sphere", "hex_prism")
 
 
 def drake_models() -> Path | None:
-    for p in (os.environ.get("DRAKEGRASP_DRAKE_MODELS"), ROOT.parent / "shared" / "drake_models"):
+    for p in (
+        os.environ.get("DRAKEGRASP_DRAKE_MODELS"),
+        ROOT.parent / "shared" / "drake_models",
+    ):
         if p and Path(p).is_dir():
             return Path(p)
     return None
@@ -54,7 +60,7 @@ def main(argv=None) -> int:
     ap.add_argument("--num", type=int, default=1000)
     ap.add_argument("--top", type=int, default=10)
     ap.add_argument("--random", type=int, default=10)
-    ap.add_argument("--squeeze", type=float, default=20.0)
+    ap.add_argument("--squeeze", type=float, nargs="+", default=[6.0, 20.0])
     ap.add_argument("--mu", type=float, default=0.5)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--objects", nargs="*", default=None)
@@ -62,39 +68,59 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     models = drake_models()
     if models is None:
-        print("drake_models not found (set DRAKEGRASP_DRAKE_MODELS): the WSG-50 is needed")
+        print(
+            "drake_models not found (set DRAKEGRASP_DRAKE_MODELS): the WSG-50 is needed"
+        )
         return 1
     names = args.objects or [*YCB, *OWN]
-    print(f"load {os.getloadavg()[0]:.2f}; WSG-50, mu = {args.mu}, squeeze {args.squeeze} N")
+    squeezes = [float(x) for x in args.squeeze]
+    print(f"load {os.getloadavg()[0]:.2f}; WSG-50, mu = {args.mu}")
+    held_cols = "".join(f" {f'top@{q:g}N':>9} {f'rand@{q:g}N':>9}" for q in squeezes)
     print(
-        f"{'object':<22} {'samples/s':>10} {'cands/s':>8} {'cands':>6} "
-        f"{'FC':>5} {'top held':>9} {'random held':>12}"
+        f"{'object':<20} {'samples/s':>10} {'cands/s':>8} {'cands':>6} {'FC':>5}"
+        + held_cols
     )
     for name in names:
         scene = planning_scene(object_url(name), models_dir=models)
         kwargs = dict(hand=scene.hand, mu=args.mu, workers=1)
-        plan_grasps(scene.plant, scene.context, scene.object_body, num_candidates=50, seed=1, **kwargs)
+        plan_grasps(
+            scene.plant, scene.context, scene.object_body, num_candidates=50, seed=1,
+            **kwargs,
+        )  # fmt: skip
         t = time.perf_counter()
         result = plan_grasps(
             scene.plant, scene.context, scene.object_body, num_candidates=args.num,
             seed=args.seed, **kwargs,
         )  # fmt: skip
         wall = time.perf_counter() - t
-        top = random = "-"
-        if not args.no_shake and len(result):
-            held_top = [shake_test(scene.add_models, c, squeeze=args.squeeze).held for c in result[: args.top]]
-            rng = np.random.default_rng(args.seed)
-            pick = rng.choice(len(result), size=min(args.random, len(result)), replace=False)
-            held_rand = [shake_test(scene.add_models, result[int(i)], squeeze=args.squeeze).held for i in pick]
-            top = f"{sum(held_top)}/{len(held_top)}"
-            random = f"{sum(held_rand)}/{len(held_rand)}"
+        rng = np.random.default_rng(args.seed)
+        pick = rng.choice(
+            len(result), size=min(args.random, len(result)), replace=False
+        )
+        cells = ""
+        for q in squeezes:
+            if args.no_shake or not len(result):
+                cells += f" {'-':>9} {'-':>9}"
+                continue
+            top = [
+                shake_test(scene.add_models, c, squeeze=q).held
+                for c in result[: args.top]
+            ]
+            rand = [
+                shake_test(scene.add_models, result[int(i)], squeeze=q).held
+                for i in pick
+            ]
+            cells += f" {f'{sum(top)}/{len(top)}':>9} {f'{sum(rand)}/{len(rand)}':>9}"
         fc = sum(c.is_closure for c in result)
         print(
-            f"{name:<22} {args.num / wall:>10.0f} {len(result) / wall:>8.0f} {len(result):>6} "
-            f"{fc:>5} {top:>9} {random:>12}",
+            f"{name:<20} {args.num / wall:>10.0f} {len(result) / wall:>8.0f} "
+            f"{len(result):>6} {fc:>5}" + cells,
             flush=True,
         )
-        reasons = ", ".join(f"{k} {v}" for k, v in sorted(result.rejections.items(), key=lambda kv: -kv[1]))
+        reasons = ", ".join(
+            f"{k} {v}"
+            for k, v in sorted(result.rejections.items(), key=lambda kv: -kv[1])
+        )
         print(f"    rejected: {reasons or 'none'}")
     return 0
 

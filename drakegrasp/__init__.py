@@ -9,8 +9,8 @@ Layers as folders, inner to outer (an import never points outwards):
 ``core`` (numpy only: contacts, G, cones, antipodal, curvature, validation),
 ``certificates`` (witnesses, their check and wording), ``closure`` (the
 programs, verdicts and second order), then ``quality`` and ``plant``, then the
-outer ring ``batch``, ``systems``, ``visualization``, ``distributed`` and
-``cli``.  ``docs/architecture.md`` draws the map.
+outer ring ``batch``, ``systems``, ``planning`` (finding grasps),
+``visualization``, ``distributed`` and ``cli``.  ``docs/architecture.md`` draws the map.
 
 Every public name is imported from its module when it is first read
 (``drakegrasp._lazy``), so ``import drakegrasp`` and the ``drakegrasp``
@@ -57,6 +57,8 @@ _SOURCES = {
     ),
     "drakegrasp.errors": (
         "BatchFileError",
+        "GraspCandidate",
+        "GraspCandidates",
         "GraspError",
         "InvalidContactError",
         "InvalidContextError",
@@ -80,6 +82,8 @@ _SOURCES = {
         "grasp_matrix",
         "normal_grasp_matrix",
         "normalised_grasp_matrix",
+        "plan_grasps",
+        "planning_scene",
     ),
     "drakegrasp.plant": (
         "FingerClosure",
@@ -123,7 +127,17 @@ _SOURCES = {
     ),
     "drakegrasp.closure.second_order": (
         "SecondOrderResult",
+        "ShakeResult",
         "second_order_form_closure",
+        "shake_test",
+    ),
+    "drakegrasp.planning": (
+        "GraspCandidate",
+        "GraspCandidates",
+        "ShakeResult",
+        "plan_grasps",
+        "planning_scene",
+        "shake_test",
     ),
     "drakegrasp.systems.monitor": (
         "GraspMonitor",
@@ -149,6 +163,7 @@ _SUBMODULES = {
         "core",
         "distributed",
         "errors",
+        "planning",
         "plant",
         "quality",
         "systems",
@@ -173,6 +188,8 @@ __all__ = [
     "DEFAULT_TOL",
     "FingerClosure",
     "Grasp",
+    "GraspCandidate",
+    "GraspCandidates",
     "GraspError",
     "GraspFromPlant",
     "GraspMonitor",
@@ -196,6 +213,7 @@ __all__ = [
     "Scene",
     "SceneError",
     "SecondOrderResult",
+    "ShakeResult",
     "SolverError",
     "SurfaceCurvature",
     "UnreachableError",
@@ -242,11 +260,14 @@ __all__ = [
     "min_singular_value",
     "normal_grasp_matrix",
     "normalised_grasp_matrix",
+    "plan_grasps",
+    "planning_scene",
     "plot_planar_grasp",
     "plot_wrench_space",
     "primitive_wrenches",
     "register_models",
     "second_order_form_closure",
+    "shake_test",
     "signed_distance_jacobian",
     "uniformity_of_transformation",
     "use_local_drake_models",

@@ -158,10 +158,12 @@ class GraspCandidate:
     def __str__(self) -> str:
         p = self.X_WH.translation() * 1e3
         return (
-            f"sample {self.sample}: {'force closure' if self.is_closure else 'no closure'}"
+            f"sample {self.sample}: "
+            f"{'force closure' if self.is_closure else 'no closure'}"
             f", {self.num_contacts} contacts, eps = {self.epsilon:.4f}, robustness "
             f"{self.robustness:.2f}, score {self.score:.4f}; opening "
-            f"{self.opening * 1e3:.1f} mm, p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
+            f"{self.opening * 1e3:.1f} mm, "
+            f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
         )
 
 

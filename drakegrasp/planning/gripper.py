@@ -116,7 +116,8 @@ def _free_base(plant: MultibodyPlant, bodies) -> RigidBody:
     if len(free) != 1:
         raise ModelError(
             "the hand's base must be one free body (a floating gripper placed by "
-            f"its pose X_WH); the hand's bodies {[scoped_name(plant, b) for b in bodies]} "
+            "its pose X_WH); the hand's bodies "
+            f"{[scoped_name(plant, b) for b in bodies]} "
             f"have {len(free)} free bodies: add the hand without welding it"
         )
     return free[0]
@@ -206,7 +207,8 @@ def parallel_jaw(
     if abs(abs(a_H @ u[1]) / np.linalg.norm(u[1]) - 1) > 1e-6:
         raise ModelError(
             "the two finger joints of a parallel jaw must move along parallel axes; "
-            f"they move along {np.round(u[0], 6).tolist()} and {np.round(u[1], 6).tolist()}"
+            f"they move along {np.round(u[0], 6).tolist()} and "
+            f"{np.round(u[1], 6).tolist()}"
         )
     mid = 0.5 * (lower + upper)
     m0, m1 = finger_origins(mid)

@@ -93,14 +93,18 @@ def object_surface(plant, plant_context, object_body) -> ObjectSurface:
     body = resolve_object_body(plant, object_body)
     inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
     return ObjectSurface.from_pieces(
-        piece_of_shape(inspector.GetShape(g), inspector.GetPoseInFrame(g), inspector.GetName(g))
+        piece_of_shape(
+            inspector.GetShape(g), inspector.GetPoseInFrame(g), inspector.GetName(g)
+        )
         for g in plant.GetCollisionGeometriesForBody(body)
     )
 
 
 def _check_count(value) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise InvalidOptionError(f"num_candidates must be an integer >= 0, got {value!r}")
+        raise InvalidOptionError(
+            f"num_candidates must be an integer >= 0, got {value!r}"
+        )
     if not 0 <= int(value) <= MAX_CANDIDATES:
         raise InvalidOptionError(
             f"num_candidates must be in [0, {MAX_CANDIDATES}] (one call; call again "
@@ -143,7 +147,9 @@ def _sample_poses(surface, gripper: ParallelJaw, X_WO, n, mu, clearance, rng, to
     reject(np.sum(nexit_O * d_O, axis=1) < cos_cone, "outside the friction cone")
     keep = np.flatnonzero(reasons == "")
     R_WO = X_WO.rotation().matrix()
-    centre_W = (p_O[keep] + 0.5 * t_out[keep, None] * d_O[keep]) @ R_WO.T + X_WO.translation()
+    centre_W = (
+        p_O[keep] + 0.5 * t_out[keep, None] * d_O[keep]
+    ) @ R_WO.T + X_WO.translation()
     R_WK = R_WO @ _axis_frames(d_O[keep], theta[keep])  # built in O: invariant
     X_KH = gripper.X_HK.inverse()
     R_WH = R_WK @ X_KH.rotation().matrix()
@@ -250,7 +256,9 @@ class _Closer:
             return None, "one finger touches"
         except PenetrationError:
             return None, "closing did not converge"
-        touched = [any(c.finger_body in names for c in found) for names in self.finger_names]
+        touched = [
+            any(c.finger_body in names for c in found) for names in self.finger_names
+        ]
         if not all(touched):
             return None, "one finger touches"
         return found, None
@@ -366,7 +374,9 @@ def plan_grasps(
         "noise": noise,
         "gripper": gripper.to_dict(),
     }
-    poses, rejections = _sample_poses(surface, gripper, X_WO, n, mu, clearance, rng, tol)
+    poses, rejections = _sample_poses(
+        surface, gripper, X_WO, n, mu, clearance, rng, tol
+    )
     saved = plant.GetPositions(ctx).copy()
     closer = _Closer(plant, ctx, body, hand, gripper, tol)
     kept = []
@@ -437,7 +447,7 @@ def _rank(
     eps = np.zeros(K)
     rho = np.zeros(K)
     names = closer.finger_names
-    for N, idx in group_by_count(counts).items():
+    for idx in group_by_count(counts).values():
         P = np.array([[c.p_OC for c in kept[i][4]] for i in idx])
         Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
         F = np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx])
@@ -456,7 +466,8 @@ def _rank(
     order = rank_order(score, d_star, [k[0] for k in kept])
     base = scoped_name(plant, gripper.base)
     joint_names = tuple(
-        f"{plant.GetModelInstanceName(j.model_instance())}::{j.name()}" for j in gripper.joints
+        f"{plant.GetModelInstanceName(j.model_instance())}::{j.name()}"
+        for j in gripper.joints
     )
     out = []
     for place, i in enumerate(order):

@@ -114,7 +114,10 @@ def perturbed_copies(
         axes /= np.linalg.norm(axes, axis=1, keepdims=True)
         R = _rotations(axes, np.radians(angle_deg) * rng.standard_normal(M))
         shift = position * rng.standard_normal((M, 3))
-        moved = np.einsum("mij,mnj->mni", R, P - centre[:, None]) + (centre + shift)[:, None]
+        moved = (
+            np.einsum("mij,mnj->mni", R, P - centre[:, None])
+            + (centre + shift)[:, None]
+        )
         P = np.where(mask, moved, P)
         Nrm = np.where(mask, np.einsum("mij,mnj->mni", R, Nrm), Nrm)
     mus = mu * np.maximum(0.0, 1.0 + friction * rng.standard_normal(M))
@@ -192,7 +195,9 @@ def robustness(
         torsional_friction=torsional_friction,
         workers=workers,
     )
-    return np.asarray(res.is_closure, float).reshape(len(positions), samples).mean(axis=1)
+    return (
+        np.asarray(res.is_closure, float).reshape(len(positions), samples).mean(axis=1)
+    )
 
 
 def rank_order(score, d_star, sample) -> np.ndarray:

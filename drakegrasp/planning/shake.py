@@ -33,16 +33,15 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.math import RigidTransform
+from pydrake.common.value import AbstractValue
+from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import (
     AddMultibodyPlantSceneGraph,
     ExternallyAppliedSpatialForce,
 )
 from pydrake.multibody.tree import PdControllerGains
-from pydrake.multibody.math import SpatialForce
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
-from pydrake.common.value import AbstractValue
 
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import InvalidOptionError, ModelError
@@ -110,8 +109,10 @@ class ShakeResult:
     def __str__(self) -> str:
         return (
             f"{'held' if self.held else 'dropped'}: moved at most "
-            f"{self.max_displacement * 1e3:.2f} mm and {np.degrees(self.max_rotation):.2f}"
-            f" deg (bounds {self.bounds[0] * 1e3:g} mm, {np.degrees(self.bounds[1]):g} deg)"
+            f"{self.max_displacement * 1e3:.2f} mm and "
+            f"{np.degrees(self.max_rotation):.2f}"
+            f" deg (bounds {self.bounds[0] * 1e3:g} mm, "
+            f"{np.degrees(self.bounds[1]):g} deg)"
             f" over {self.duration:g} s, squeeze {self.squeeze:g} N, "
             f"{len(self.phases)} gravity directions; {self.wall_time:.2f} s wall"
         )
@@ -140,7 +141,9 @@ class _TurnedGravity(LeafSystem):
 
 
 def _schedule(settle, phase, blend, directions):
-    dirs = [np.array([0.0, 0.0, -1.0])] + [np.asarray(d, float) / np.linalg.norm(d) for d in directions]
+    dirs = [np.array([0.0, 0.0, -1.0])] + [
+        np.asarray(d, float) / np.linalg.norm(d) for d in directions
+    ]
 
     def g(t: float) -> np.ndarray:
         if t < settle:
@@ -225,10 +228,14 @@ def shake_test(
         ("phase", phase),
     ):
         if not (isinstance(value, int | float) and np.isfinite(value) and value > 0):
-            raise InvalidOptionError(f"{name} must be a finite number > 0, got {value!r}")
+            raise InvalidOptionError(
+                f"{name} must be a finite number > 0, got {value!r}"
+            )
     dirs = np.asarray(directions, dtype=float).reshape(-1, 3)
     if not np.all(np.isfinite(dirs)) or np.any(np.linalg.norm(dirs, axis=1) == 0):
-        raise InvalidOptionError(f"directions must be finite non-zero 3-vectors, got {directions!r}")
+        raise InvalidOptionError(
+            f"directions must be finite non-zero 3-vectors, got {directions!r}"
+        )
     t0 = time.perf_counter()
     from pydrake.multibody.parsing import Parser
 
@@ -257,7 +264,9 @@ def shake_test(
     gravity = builder.AddSystem(
         _TurnedGravity(body.index(), body.default_mass(), body.default_com(), schedule)
     )
-    builder.Connect(gravity.get_output_port(), plant.get_applied_spatial_force_input_port())
+    builder.Connect(
+        gravity.get_output_port(), plant.get_applied_spatial_force_input_port()
+    )
     diagram = builder.Build()
     simulator = Simulator(diagram)
     root = simulator.get_mutable_context()
@@ -268,9 +277,10 @@ def shake_test(
     for actuator in actuators:
         joint = actuator.joint()
         desired.setdefault(joint.model_instance(), []).append(
-            (int(actuator.index()), q_now[joint.position_start()] + targets.get(
-                int(joint.index()), 0.0
-            ))
+            (
+                int(actuator.index()),
+                q_now[joint.position_start()] + targets.get(int(joint.index()), 0.0),
+            )
         )
     for instance, entries in desired.items():
         entries.sort()
@@ -294,7 +304,13 @@ def shake_test(
             d = float(np.linalg.norm(X_HO.translation() - X_HO0.translation()))
             r = _angle(X_HO0.rotation().matrix().T @ X_HO.rotation().matrix())
             max_d, max_r = max(max_d, d), max(max_r, r)
-        phases.append({"direction": schedule(end - 1e-9).tolist(), "displacement": d, "rotation": r})
+        phases.append(
+            {
+                "direction": schedule(end - 1e-9).tolist(),
+                "displacement": d,
+                "rotation": r,
+            }
+        )
     return ShakeResult(
         held=bool(max_d <= max_displacement and max_r <= max_rotation),
         max_displacement=max_d,

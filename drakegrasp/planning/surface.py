@@ -124,7 +124,9 @@ class Piece:
             a, b, c = self.semi_axes
             p = 1.6075
             return float(
-                4 * np.pi * (((a * b) ** p + (a * c) ** p + (b * c) ** p) / 3) ** (1 / p)
+                4
+                * np.pi
+                * (((a * b) ** p + (a * c) ** p + (b * c) ** p) / 3) ** (1 / p)
             )
         return float(sum(self._side_and_caps()))
 
@@ -150,8 +152,10 @@ class Piece:
             flip = r1 + r2 > 1
             r1, r2 = np.where(flip, 1 - r1, r1), np.where(flip, 1 - r2, r2)
             t = tri[k]
-            pts = t[:, 0] + r1[:, None] * (t[:, 1] - t[:, 0]) + r2[:, None] * (
-                t[:, 2] - t[:, 0]
+            pts = (
+                t[:, 0]
+                + r1[:, None] * (t[:, 1] - t[:, 0])
+                + r2[:, None] * (t[:, 2] - t[:, 0])
             )
             return pts, _unit_rows(cr[k])
         r, _, h = self.semi_axes
@@ -253,7 +257,9 @@ class Piece:
         t_in, t_out = np.where(miss, np.nan, t_in), np.where(miss, np.nan, t_out)
         radial_exit = r_out <= s_out
         x = p + np.nan_to_num(t_out, posinf=0.0, neginf=0.0)[:, None] * d
-        n_rad = _unit_rows(np.column_stack([x[:, 0], x[:, 1], np.zeros(len(p))]) + 1e-300)
+        n_rad = _unit_rows(
+            np.column_stack([x[:, 0], x[:, 1], np.zeros(len(p))]) + 1e-300
+        )
         n_cap = np.zeros_like(p)
         n_cap[:, 2] = np.sign(dz_safe)
         return t_in, t_out, np.where(radial_exit[:, None], n_rad, n_cap)
@@ -273,7 +279,9 @@ class Piece:
         """An upper bound of the distance from ``p_O`` to the piece's points, m."""
         if self.kind == "hull":
             v = self.triangles.reshape(-1, 3)
-            return float(np.max(np.linalg.norm(self.X_OG.multiply(v.T).T - p_O, axis=1)))
+            return float(
+                np.max(np.linalg.norm(self.X_OG.multiply(v.T).T - p_O, axis=1))
+            )
         centre = np.linalg.norm(self.X_OG.translation() - p_O)
         r, _, h = self.semi_axes
         if self.kind == "ellipsoid":
@@ -332,9 +340,21 @@ def piece_of_shape(shape: Shape, X_OG: RigidTransform, name: str = "") -> Piece:
     elif isinstance(shape, Box):
         hx, hy, hz = shape.width() / 2, shape.depth() / 2, shape.height() / 2
         corners = np.array(
-            [[sx * hx, sy * hy, sz * hz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+            [
+                [sx * hx, sy * hy, sz * hz]
+                for sx in (-1, 1)
+                for sy in (-1, 1)
+                for sz in (-1, 1)
+            ]
         )
-        faces = [(0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4), (1, 3, 7, 5)]
+        faces = [
+            (0, 1, 3, 2),
+            (4, 5, 7, 6),
+            (0, 1, 5, 4),
+            (2, 3, 7, 6),
+            (0, 2, 6, 4),
+            (1, 3, 7, 5),
+        ]
         return _hull_piece(X_OG, name, corners, faces)
     elif isinstance(shape, Convex | Mesh):
         hull = shape.GetConvexHull()

@@ -15,7 +15,9 @@ def wsg_scene(drake_models_dir):
 
     def make(name="004_sugar_box", X_WO=None):
         return planning_scene(
-            f"package://drake_models/ycb/{name}.sdf", X_WO=X_WO, models_dir=drake_models_dir
+            f"package://drake_models/ycb/{name}.sdf",
+            X_WO=X_WO,
+            models_dir=drake_models_dir,
         )
 
     return make

@@ -144,7 +144,9 @@ def test_unreachable_object_gives_an_empty_result_that_says_why(tmp_path, own_sc
         "<collision name='c'><geometry><box><size>0.3 0.3 0.3</size></box></geometry>"
         "</collision></link></model></sdf>"
     )
-    scene = planning_scene(str(big), hand_url="package://drakegrasp/hands/parallel_jaw.sdf")
+    scene = planning_scene(
+        str(big), hand_url="package://drakegrasp/hands/parallel_jaw.sdf"
+    )
     result = plan(scene, n=50)
     assert len(result) == 0
     assert result.rejections == {"wider than the stroke": 50}
@@ -160,11 +162,14 @@ def test_hand_that_is_not_a_free_parallel_jaw(own_scene, tmp_path):
         )  # fmt: skip
     nofinger = tmp_path / "nofinger.sdf"
     nofinger.write_text(
-        '<?xml version="1.0"?><sdf version="1.9"><model name="paddle"><link name="palm">'
-        "<collision name='c'><geometry><box><size>0.05 0.05 0.05</size></box></geometry>"
-        "</collision></link></model></sdf>"
+        '<?xml version="1.0"?><sdf version="1.9"><model name="paddle">'
+        '<link name="palm">'
+        "<collision name='c'><geometry><box><size>0.05 0.05 0.05</size></box>"
+        "</geometry></collision></link></model></sdf>"
     )
-    scene = planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(nofinger))
+    scene = planning_scene(
+        "package://drakegrasp/objects/box.sdf", hand_url=str(nofinger)
+    )
     with pytest.raises(ModelError, match="one-dof joint"):
         plan(scene, n=5)
 

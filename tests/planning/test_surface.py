@@ -30,19 +30,22 @@ SHAPES = {
     ),
     "capsule": (
         Capsule(0.02, 0.08),
-        lambda x: np.linalg.norm(
-            x - np.column_stack([0 * x[:, 0], 0 * x[:, 0], np.clip(x[:, 2], -0.04, 0.04)]),
-            axis=1,
-        )
-        - 0.02,
+        lambda x: (
+            np.linalg.norm(
+                x
+                - np.column_stack(
+                    [0 * x[:, 0], 0 * x[:, 0], np.clip(x[:, 2], -0.04, 0.04)]
+                ),
+                axis=1,
+            )
+            - 0.02
+        ),
     ),
 }
 
 
 def _gradient(f, x, h=1e-7):
-    g = np.column_stack(
-        [(f(x + h * e) - f(x - h * e)) / (2 * h) for e in np.eye(3)]
-    )
+    g = np.column_stack([(f(x + h * e) - f(x - h * e)) / (2 * h) for e in np.eye(3)])
     return g / np.linalg.norm(g, axis=1, keepdims=True)
 
 
@@ -111,7 +114,9 @@ def test_union_chord_spans_the_outer_pieces():
 
 @settings(max_examples=25, deadline=None, derandomize=True)
 @given(
-    st.floats(-np.pi, np.pi), st.floats(-1, 1), st.floats(-np.pi, np.pi),
+    st.floats(-np.pi, np.pi),
+    st.floats(-1, 1),
+    st.floats(-np.pi, np.pi),
     st.floats(-0.2, 0.2),
 )
 def test_chord_lengths_are_invariant_to_the_geometry_pose(r, p, y, x):
