@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_plan.py [--num 1000] [--top 10] [--random 10]
-        [--squeeze 6 20] [--seed 0] [--objects NAME ...] [--no-shake]
+        [--squeeze 1.5 5] [--seed 0] [--objects NAME ...] [--no-shake]
 
 For each object (the YCB boxes and can of ``drake_models``, when present, and
 drakegrasp's own box, cylinder, sphere and hexagonal prism), with Drake's
@@ -17,9 +17,11 @@ WSG-50 as a free gripper:
   best candidates and on ``--random`` candidates drawn uniformly (seeded)
   from all collision-free closed antipodal candidates of the same run (the
   baseline a planner without ranking would give), as held / tried, for each
-  ``--squeeze`` (newtons per finger: a light 6 N, at which a grasp must be
-  well placed to hold, and a firm 20 N, at which with the models' friction of
-  1 almost any two-sided grasp holds).
+  ``--squeeze`` (per finger, in multiples of the object's weight ``m g``: a
+  light 1.5 w, at which a grasp must be well placed to hold, and a firm 5 w, at
+  which, with the models' friction coefficient of 1, almost any two-sided
+  grasp holds).  The planner's verdicts use ``--mu`` (0.5), half the
+  simulation's friction.
 """
 
 from __future__ import annotations
@@ -57,10 +59,16 @@ def object_url(name: str) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--num", type=int, default=1000)
+    ap.add_argument("--num", type=int, default=1500)
     ap.add_argument("--top", type=int, default=10)
     ap.add_argument("--random", type=int, default=10)
-    ap.add_argument("--squeeze", type=float, nargs="+", default=[6.0, 20.0])
+    ap.add_argument(
+        "--squeeze",
+        type=float,
+        nargs="+",
+        default=[1.5, 5.0],
+        help="squeezes per finger, in multiples of the object's weight m g",
+    )
     ap.add_argument("--mu", type=float, default=0.5)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--objects", nargs="*", default=None)
@@ -75,7 +83,7 @@ def main(argv=None) -> int:
     names = args.objects or [*YCB, *OWN]
     squeezes = [float(x) for x in args.squeeze]
     print(f"load {os.getloadavg()[0]:.2f}; WSG-50, mu = {args.mu}")
-    held_cols = "".join(f" {f'top@{q:g}N':>9} {f'rand@{q:g}N':>9}" for q in squeezes)
+    held_cols = "".join(f" {f'top@{q:g}w':>9} {f'rand@{q:g}w':>9}" for q in squeezes)
     print(
         f"{'object':<20} {'samples/s':>10} {'cands/s':>8} {'cands':>6} {'FC':>5}"
         + held_cols
@@ -98,7 +106,9 @@ def main(argv=None) -> int:
             len(result), size=min(args.random, len(result)), replace=False
         )
         cells = ""
-        for q in squeezes:
+        weight = scene.object_body.default_mass() * 9.81
+        for k in squeezes:
+            q = k * weight
             if args.no_shake or not len(result):
                 cells += f" {'-':>9} {'-':>9}"
                 continue

@@ -74,7 +74,17 @@ class GraspCandidate:
     robustness : float
         Fraction of perturbed copies of the grasp that stay force closure.
     score : float
-        ``epsilon * robustness`` (see :func:`~drakegrasp.planning.ranking.score`).
+        ``robustness * weight_capacity``; 0 when no weight capacity was
+        computed (see :mod:`~drakegrasp.planning.ranking`).
+    weight_capacity : float
+        Newtons of the object's weight held per newton of squeeze on each
+        finger, in the worst of the directions of
+        :data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS` (at ``mu``); NaN
+        when not computed.
+    squeeze_needed : float
+        The squeeze per finger (N) that holds the object's weight in all those
+        directions, ``m g / weight_capacity`` (inf: none does; NaN: not
+        computed).
     closure : ClosureResult or None
         The single-grasp verdict with its certificate (witness), for the top
         candidates (``certify`` of ``plan_grasps``); None for the rest.
@@ -96,6 +106,8 @@ class GraspCandidate:
     epsilon: float
     robustness: float
     score: float
+    weight_capacity: float = float("nan")
+    squeeze_needed: float = float("nan")
     closure: ClosureResult | None = None
 
     @property
@@ -152,6 +164,8 @@ class GraspCandidate:
             "epsilon": jsonable(self.epsilon),
             "robustness": jsonable(self.robustness),
             "score": jsonable(self.score),
+            "weight_capacity": jsonable(self.weight_capacity),
+            "squeeze_needed": jsonable(self.squeeze_needed),
             "closure": None if self.closure is None else self.closure.to_dict(),
         }
 
@@ -161,7 +175,8 @@ class GraspCandidate:
             f"sample {self.sample}: "
             f"{'force closure' if self.is_closure else 'no closure'}"
             f", {self.num_contacts} contacts, eps = {self.epsilon:.4f}, robustness "
-            f"{self.robustness:.2f}, score {self.score:.4f}; opening "
+            f"{self.robustness:.2f}, holds {self.weight_capacity:.3f} N/N "
+            f"(squeeze {self.squeeze_needed:.1f} N), score {self.score:.4f}; opening "
             f"{self.opening * 1e3:.1f} mm, "
             f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
         )
@@ -181,7 +196,8 @@ class GraspCandidates(Sequence):
     Attributes
     ----------
     candidates : tuple of GraspCandidate
-        Best first (highest score; ties by ``d*``, then sample index).
+        Best first (highest score, then ``ε × robustness``, ``d*`` and the
+        sample index).
     rejections : dict of str to int
         Sampled poses dropped, by reason.
     num_sampled : int
@@ -251,6 +267,8 @@ class GraspCandidates(Sequence):
             "rank_in_result": np.arange(len(rows)),
             "sample": np.array([c.sample for c in rows], dtype=np.int64),
             "score": np.array([c.score for c in rows]),
+            "weight_capacity": np.array([c.weight_capacity for c in rows]),
+            "squeeze_needed": np.array([c.squeeze_needed for c in rows]),
             "epsilon": np.array([c.epsilon for c in rows]),
             "robustness": np.array([c.robustness for c in rows]),
             "is_closure": np.array([c.is_closure for c in rows], dtype=bool),

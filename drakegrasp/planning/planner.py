@@ -24,7 +24,9 @@ candidate or is counted under one rejection reason.
    anything but the object is blocked.  The contacts are then those of
    :func:`~drakegrasp.find_contacts` (the same as :func:`~drakegrasp.analyze_grasp`
    reads on the applied candidate), and both fingers must touch.
-4. **Ranking** (batch engine): :mod:`drakegrasp.planning.ranking`.
+4. **Ranking**: verdicts, ε and robustness in the batch engine
+   (:mod:`drakegrasp.planning.ranking`), weight capacity in one LP per grasp
+   (:mod:`drakegrasp.planning.weight`).
 """
 
 from __future__ import annotations
@@ -54,6 +56,7 @@ from drakegrasp.planning.ranking import (
     verdicts,
 )
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
+from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE, find_contacts
 from drakegrasp.plant.validation import (
     HandSpec,
@@ -68,6 +71,9 @@ __all__ = ["MAX_CANDIDATES", "REASONS", "object_surface", "plan_grasps"]
 
 MAX_CANDIDATES = 1_000_000
 """Most poses one call samples (memory grows with it; call again for more)."""
+
+GRAVITY = 9.81
+"""m/s², for the squeeze that holds the object's weight."""
 
 MAX_CLOSING_STEPS = 50
 """Bound on the conservative-advancement steps of one closing."""
@@ -280,6 +286,7 @@ def plan_grasps(
     robustness_samples: int = 32,
     noise: dict | None = None,
     certify: int = 10,
+    weight_check: int | None = 100,
     workers: int | None = 1,
     progress: bool = False,
 ) -> GraspCandidates:
@@ -324,6 +331,10 @@ def plan_grasps(
     certify : int, optional
         The best ``certify`` candidates also get the single-grasp verdict with
         its certificate (``GraspCandidate.closure``).
+    weight_check : int or None, optional
+        How many force-closure candidates (the best by ``ε × robustness``) get
+        their weight capacity and a score (default 100; None: all of them);
+        see :mod:`drakegrasp.planning.ranking`.
     workers : int, optional
         Worker processes of the batch engine (default 1).
     progress : bool, optional
@@ -355,6 +366,14 @@ def plan_grasps(
     if set(noise) != set(DEFAULT_NOISE) or any(not v >= 0 for v in noise.values()):
         raise InvalidOptionError(
             f"noise takes non-negative {sorted(DEFAULT_NOISE)}, got {noise!r}"
+        )
+    if weight_check is not None and (
+        isinstance(weight_check, bool)
+        or not isinstance(weight_check, int | np.integer)
+        or weight_check < 0
+    ):
+        raise InvalidOptionError(
+            f"weight_check must be an integer >= 0 or None, got {weight_check!r}"
         )
     model = ContactModel(contact_model).value
     ctx = plant_context_of(plant, plant_context)
@@ -403,6 +422,7 @@ def plan_grasps(
     candidates = _rank(
         kept, closer, gripper, mu, model, torsional_friction, torque_scale,
         robustness_samples, noise, rng, certify, workers, X_WO, body, plant,
+        weight_check,
     )  # fmt: skip
     reason = ""
     if not candidates:
@@ -432,9 +452,15 @@ def _finger_label(contact, names) -> int:
     return 2
 
 
+def _squeeze(weight: float, alpha: float) -> float:
+    if not np.isfinite(alpha):
+        return float("nan")
+    return float(weight / alpha) if alpha > 0 else float("inf")
+
+
 def _rank(
     kept, closer, gripper, mu, model, nu, torque_scale, samples, noise, rng,
-    certify, workers, X_WO, body, plant,
+    certify, workers, X_WO, body, plant, weight_check,
 ):  # fmt: skip
     """Stage 4: verdicts, ε, robustness and score in the batch engine."""
     if not kept:
@@ -462,8 +488,22 @@ def _rank(
                 P[fc], Nrm[fc], F[fc], mu, samples=samples, rng=rng, noise=noise,
                 model=model, torsional_friction=nu, workers=workers,
             )  # fmt: skip
-    score = eps * rho
-    order = rank_order(score, d_star, [k[0] for k in kept])
+    samples_of = np.array([k[0] for k in kept])
+    pre = eps * rho
+    checked = rank_order(pre, d_star, samples_of)
+    checked = checked[is_closure[checked]][:weight_check]
+    alpha = np.full(K, np.nan)
+    for idx in group_by_count(counts[checked]).values():
+        idx = checked[idx]
+        alpha[idx] = weight_capacity(
+            np.array([[c.p_OC for c in kept[i][4]] for i in idx]),
+            np.array([[c.nhat_O for c in kept[i][4]] for i in idx]),
+            np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx]),
+            mu, torque_scale=torque_scale, model=model, torsional_friction=nu,
+        ).min(axis=1)  # fmt: skip
+    score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
+    order = np.lexsort((samples_of, -d_star, -pre, -score))
+    weight = body.get_mass(closer.ctx) * GRAVITY
     base = scoped_name(plant, gripper.base)
     joint_names = tuple(
         f"{plant.GetModelInstanceName(j.model_instance())}::{j.name()}"
@@ -499,6 +539,8 @@ def _rank(
                 epsilon=float(eps[i]),
                 robustness=float(rho[i]),
                 score=float(score[i]),
+                weight_capacity=float(alpha[i]),
+                squeeze_needed=_squeeze(weight, alpha[i]),
                 closure=force_closure(grasp) if place < certify else None,
             )
         )

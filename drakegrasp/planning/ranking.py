@@ -22,10 +22,18 @@ draw per copy.  A rigid motion of the whole grasp changes no verdict, so the
 noise is per finger: it models the object's pose error and the fingers'
 placement error relative to each other.
 
-**Score** :math:`= \varepsilon \cdot \rho` (ε times robustness): 0 for a grasp
-that is not force closure; among force-closure grasps it favours one that
-resists every wrench well and keeps closure when misplaced.  Ties are broken by
-``d*`` and then by the sample index, so a ranking is reproducible.
+**Score** :math:`= \rho \cdot \alpha_{\min}` (robustness times the weight
+capacity of :mod:`drakegrasp.planning.weight`: the object's weight, per newton
+of squeeze on each finger, that the grasp holds in the worst of 14 directions).
+A ball-shaped measure such as ε is set by a grasp's weakest wrench direction,
+which for two pads is the torsion about the grasp axis, the same for every
+placement of the pads; the weight capacity asks for the wrenches that gravity
+and shaking apply, and falls as the pads move away from the centre of mass
+(tested against Drake simulations in ``tests/planning/test_shake.py``).  The
+weight capacity is computed for the ``weight_check`` force-closure candidates
+that are best by :math:`\varepsilon \rho`; the others score 0.  Candidates are
+ordered by score, then :math:`\varepsilon \rho`, ``d*`` and the sample index,
+so a ranking is reproducible.
 """
 
 from __future__ import annotations

@@ -40,13 +40,28 @@ def test_every_sample_is_a_candidate_or_a_counted_rejection(wsg_result):
 
 
 def test_ranked_best_first(wsg_result):
-    _, result = wsg_result
+    scene, result = wsg_result
     scores = [c.score for c in result]
     assert scores == sorted(scores, reverse=True)
+    weight = scene.object_body.default_mass() * 9.81
+    checked = [c for c in result if np.isfinite(c.weight_capacity)]
+    assert len(checked) == min(100, sum(c.is_closure for c in result))
     for c in result:
-        assert c.score == pytest.approx(c.epsilon * c.robustness)
         assert (c.epsilon > 0) == c.is_closure
+        if np.isfinite(c.weight_capacity):
+            assert c.score == pytest.approx(c.robustness * c.weight_capacity)
+            assert c.squeeze_needed == pytest.approx(weight / c.weight_capacity)
+        else:
+            assert c.score == 0
     assert result[0].closure is not None and result[0].closure.is_closure
+
+
+def test_weight_check_limits_the_scored_candidates(wsg_scene):
+    result = plan(wsg_scene(), n=60, weight_check=3)
+    assert sum(np.isfinite(c.weight_capacity) for c in result) == 3
+    assert all(c.score > 0 for c in result[:3]) and result[3].score == 0
+    with pytest.raises(InvalidOptionError, match="weight_check"):
+        plan(wsg_scene(), n=5, weight_check=-1)
 
 
 def test_candidates_are_valid_and_agree_with_analyze_grasp(wsg_result):

@@ -1,0 +1,149 @@
+r"""How much weight a parallel-jaw grasp holds per newton of squeeze, in one LP.
+
+A gripper presses each finger with a set force ``S``; the object's weight
+``m g`` acts at its origin O (the centre of mass of the shipped objects) in a
+direction ``u`` that a shake test turns around.  The grasp holds when the
+contact forces, inside their (polyhedral) friction cones and with each
+finger's normal forces summing to at most ``S``, can balance ``m g u``.  By
+linearity the answer scales with ``S``, so each grasp has a **weight
+capacity**
+
+.. math::
+
+    \alpha(u) = \max \alpha \;\text{s.t.}\;
+    \sum_{i,k} \lambda_{ik} w_{ik} + \alpha \begin{bmatrix} u \\ 0 \end{bmatrix} = 0,
+    \quad \sum_{i \in \text{finger } f} \sum_k \lambda_{ik} \le 1 \;(f = 0, 1),
+    \quad \lambda \ge 0,
+
+with ``w_ik`` the primitive wrenches about O (unit normal force, generator
+``k`` of contact ``i``, moments divided by the object's torque scale, which
+changes no ``α``), and :math:`\alpha_{\min} = \min_u \alpha(u)` over a set of
+directions in O.  The squeeze that holds the object's weight in every such
+direction is :math:`m g / \alpha_{\min}`.  (A per-finger bound, not the L1
+bound of ε: it is what a gripper's actuators set.)
+
+A grasp's directions are independent blocks of **one** LP (the sum of their
+``α`` is maximised, which maximises each), built by
+:func:`build_weight_capacity_program` and solved through drakegrasp's solver
+gateway, one LP per grasp (one LP for many grasps is slower in Clp).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.solvers import MathematicalProgram
+
+from drakegrasp._solvers import require_solution, solve
+from drakegrasp.batch.wrenches import batched_primitive_wrenches
+
+__all__ = [
+    "WEIGHT_DIRECTIONS",
+    "build_weight_capacity_program",
+    "weight_capacity",
+]
+
+WEIGHT_DIRECTIONS = np.array(
+    [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
+    + [[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)],
+    dtype=float,
+)
+WEIGHT_DIRECTIONS /= np.linalg.norm(WEIGHT_DIRECTIONS, axis=1, keepdims=True)
+"""The 14 weight directions in O: the axes and the cube's diagonals."""
+
+
+def build_weight_capacity_program(
+    W: np.ndarray, groups: np.ndarray, directions: np.ndarray = WEIGHT_DIRECTIONS
+):
+    """The LP of one grasp's weight capacity in every direction (one block each).
+
+    Parameters
+    ----------
+    W : (M, 6) float
+        Primitive wrenches of the grasp about O (contact-major).
+    groups : (M,) int
+        The finger (0, 1; 2 for any other hand body, a palm, bounded alike)
+        of each wrench.
+    directions : (D, 3) float
+        Unit weight directions, frame O.
+
+    Returns
+    -------
+    prog : MathematicalProgram
+    alpha : (D,) array of Variable
+        ``α`` of each direction.
+    """
+    M, w = W.shape
+    D = len(directions)
+    prog = MathematicalProgram()
+    lam = prog.NewContinuousVariables(D, M, "lambda")
+    alpha = prog.NewContinuousVariables(D, "alpha")
+    U = np.hstack([directions, np.zeros((D, w - 3))])  # (D, 6) weight wrenches
+    g = np.clip(groups, 0, 2)
+    member = (g[None, :] == np.arange(3)[:, None]).astype(float)
+    A = np.hstack([W.T, np.zeros((w, 1))])
+    for d in range(D):
+        A[:, -1] = U[d]
+        prog.AddLinearEqualityConstraint(A, np.zeros(w), np.r_[lam[d], alpha[d]])
+        prog.AddLinearConstraint(member, np.full(3, -np.inf), np.ones(3), lam[d])
+    prog.AddBoundingBoxConstraint(0.0, np.inf, lam.ravel())
+    prog.AddBoundingBoxConstraint(0.0, np.inf, alpha)
+    prog.AddLinearCost(-np.ones(D), 0.0, alpha)
+    return prog, alpha
+
+
+def weight_capacity(
+    positions: np.ndarray,
+    normals: np.ndarray,
+    fingers: np.ndarray,
+    mu: float,
+    *,
+    torque_scale: float,
+    model: str = "hard_finger",
+    torsional_friction: float | None = None,
+    directions: np.ndarray = WEIGHT_DIRECTIONS,
+    num_generators: int = 8,
+) -> np.ndarray:
+    """(K, D) weight capacities ``α(u)`` of ``K`` grasps of ``N`` contacts.
+
+    Parameters
+    ----------
+    positions, normals : (K, N, 3) float
+        Contacts (metres) and inward unit normals in O; moments about O.
+    fingers : (K, N) int
+        Finger (0 or 1) of each contact, 2 for another hand body (a palm,
+        whose normal forces are bounded by the squeeze too).
+    mu : float
+    torque_scale : float
+        Metres dividing the moments (conditioning only; a soft finger's
+        torsion bound is ``torque_scale · ν``, as in ε).
+    model : str, optional
+    torsional_friction : float, optional
+    directions : (D, 3) float, optional
+    num_generators : int, optional
+
+    Returns
+    -------
+    alpha : (K, D) float
+        Newtons of weight held per newton of squeeze on each finger.
+    """
+    K, N, _ = positions.shape
+    if K == 0:
+        return np.zeros((0, len(directions)))
+    W = batched_primitive_wrenches(
+        positions,
+        normals,
+        np.full((K, N), float(mu)),
+        np.full((K, N), float(torsional_friction or 0.0)),
+        np.zeros((K, 3)),
+        np.full(K, float(torque_scale)),
+        model=model,
+        num_generators=num_generators,
+    )
+    per = W.shape[1] // N
+    groups = np.repeat(fingers, per, axis=1)
+    out = np.zeros((K, len(directions)))
+    for k in range(K):
+        prog, alpha = build_weight_capacity_program(W[k], groups[k], directions)
+        result = require_solution(prog, solve(prog, "lp"), "the weight-capacity LP")
+        out[k] = np.maximum(result.GetSolution(alpha), 0.0)
+    return out
