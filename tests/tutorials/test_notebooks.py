@@ -41,8 +41,10 @@ EXPECTED = [
     "06_real_hand.ipynb",
     "07_grasp_in_simulation.ipynb",
     "08_why_not.ipynb",
+    "09_find_grasps.ipynb",
 ]
-NEEDS_DRAKE_MODELS = {"06_real_hand.ipynb"}  # Drake's real hands and YCB objects
+# Drake's real hands and YCB objects
+NEEDS_DRAKE_MODELS = {"06_real_hand.ipynb", "09_find_grasps.ipynb"}
 
 WARNINGS_AS_ERRORS = """\
 import warnings
