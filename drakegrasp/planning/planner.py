@@ -286,7 +286,7 @@ def plan_grasps(
     robustness_samples: int = 32,
     noise: dict | None = None,
     certify: int = 10,
-    weight_check: int | None = 100,
+    weight_check: int | None = None,
     workers: int | None = 1,
     progress: bool = False,
 ) -> GraspCandidates:
@@ -332,9 +332,10 @@ def plan_grasps(
         The best ``certify`` candidates also get the single-grasp verdict with
         its certificate (``GraspCandidate.closure``).
     weight_check : int or None, optional
-        How many force-closure candidates (the best by ``ε × robustness``) get
-        their weight capacity and a score (default 100; None: all of them);
-        see :mod:`drakegrasp.planning.ranking`.
+        How many force-closure candidates get their weight capacity and a
+        score: None (default) all of them; a number limits the LPs (one per
+        grasp) to the best by ``ε × robustness``, which is faster but may miss
+        good grasps (see :mod:`drakegrasp.planning.ranking`).
     workers : int, optional
         Worker processes of the batch engine (default 1).
     progress : bool, optional

@@ -30,8 +30,9 @@ which for two pads is the torsion about the grasp axis, the same for every
 placement of the pads; the weight capacity asks for the wrenches that gravity
 and shaking apply, and falls as the pads move away from the centre of mass
 (tested against Drake simulations in ``tests/planning/test_shake.py``).  The
-weight capacity is computed for the ``weight_check`` force-closure candidates
-that are best by :math:`\varepsilon \rho`; the others score 0.  Candidates are
+weight capacity is computed for every force-closure candidate (or, with
+``weight_check``, for that many, the best by :math:`\varepsilon \rho`; the
+others score 0).  Candidates are
 ordered by score, then :math:`\varepsilon \rho`, ``d*`` and the sample index,
 so a ranking is reproducible.
 """

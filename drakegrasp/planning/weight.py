@@ -72,23 +72,50 @@ def build_weight_capacity_program(
     alpha : (D,) array of Variable
         ``α`` of each direction.
     """
+    prog, alpha, _ = _program(W, groups, directions)
+    return prog, alpha
+
+
+def _memberships(groups: np.ndarray) -> np.ndarray:
+    return (np.clip(groups, 0, 2)[None, :] == np.arange(3)[:, None]).astype(float)
+
+
+def _program(W, groups, directions):
+    """The program, its α variables and the (equality, bound) bindings per block."""
     M, w = W.shape
     D = len(directions)
     prog = MathematicalProgram()
     lam = prog.NewContinuousVariables(D, M, "lambda")
     alpha = prog.NewContinuousVariables(D, "alpha")
-    U = np.hstack([directions, np.zeros((D, w - 3))])  # (D, 6) weight wrenches
-    g = np.clip(groups, 0, 2)
-    member = (g[None, :] == np.arange(3)[:, None]).astype(float)
-    A = np.hstack([W.T, np.zeros((w, 1))])
-    for d in range(D):
-        A[:, -1] = U[d]
-        prog.AddLinearEqualityConstraint(A, np.zeros(w), np.r_[lam[d], alpha[d]])
-        prog.AddLinearConstraint(member, np.full(3, -np.inf), np.ones(3), lam[d])
+    member = _memberships(groups)
+    bindings = []
+    for d, A in enumerate(_equalities(W, directions)):
+        bindings.append(
+            (
+                prog.AddLinearEqualityConstraint(
+                    A, np.zeros(w), np.r_[lam[d], alpha[d]]
+                ),
+                prog.AddLinearConstraint(
+                    member, np.full(3, -np.inf), np.ones(3), lam[d]
+                ),
+            )
+        )
     prog.AddBoundingBoxConstraint(0.0, np.inf, lam.ravel())
     prog.AddBoundingBoxConstraint(0.0, np.inf, alpha)
     prog.AddLinearCost(-np.ones(D), 0.0, alpha)
-    return prog, alpha
+    return prog, alpha, bindings
+
+
+def _equalities(W: np.ndarray, directions: np.ndarray) -> list[np.ndarray]:
+    """``[W^T | (u; 0)]`` of each direction: (6, M + 1) each."""
+    w = W.shape[1]
+    out = []
+    for u in directions:
+        A = np.empty((w, W.shape[0] + 1))
+        A[:, :-1] = W.T
+        A[:, -1] = np.r_[u, np.zeros(w - 3)]
+        out.append(A)
+    return out
 
 
 def weight_capacity(
@@ -142,8 +169,18 @@ def weight_capacity(
     per = W.shape[1] // N
     groups = np.repeat(fingers, per, axis=1)
     out = np.zeros((K, len(directions)))
-    for k in range(K):
-        prog, alpha = build_weight_capacity_program(W[k], groups[k], directions)
+    prog, alpha, bindings = _program(W[0], groups[0], directions)
+    w = W.shape[2]
+    for k in range(K):  # one program, its coefficients updated per grasp
+        if k:
+            member = _memberships(groups[k])
+            for (eq, bound), A in zip(
+                bindings, _equalities(W[k], directions), strict=True
+            ):
+                eq.evaluator().UpdateCoefficients(A, np.zeros(w))
+                bound.evaluator().UpdateCoefficients(
+                    member, np.full(3, -np.inf), np.ones(3)
+                )
         result = require_solution(prog, solve(prog, "lp"), "the weight-capacity LP")
         out[k] = np.maximum(result.GetSolution(alpha), 0.0)
     return out
