@@ -42,11 +42,18 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
+from drakegrasp.closure.verdicts import force_closure
+from drakegrasp.core.contact import Contact
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.planning.candidates import GraspCandidate
+from drakegrasp.planning.weight import weight_capacity
+from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
     "DEFAULT_NOISE",
     "group_by_count",
     "perturbed_copies",
+    "rank_candidates",
     "rank_order",
     "robustness",
     "verdicts",
@@ -212,3 +219,110 @@ def robustness(
 def rank_order(score, d_star, sample) -> np.ndarray:
     """Indices best first: highest score, then highest ``d*``, then lowest sample."""
     return np.lexsort((np.asarray(sample), -np.asarray(d_star), -np.asarray(score)))
+
+
+def _finger_label(contact, names) -> int:
+    """0 or 1 for a contact of finger 0 or 1, 2 for another hand body (palm)."""
+    for f, bodies in enumerate(names):
+        if contact.finger_body in bodies:
+            return f
+    return 2
+
+
+def _squeeze(weight: float, alpha: float) -> float:
+    if not np.isfinite(alpha):
+        return float("nan")
+    return float(weight / alpha) if alpha > 0 else float("inf")
+
+
+def rank_candidates(
+    kept, *, finger_names, gripper, plant, mu, model, nu, torque_scale, samples,
+    noise, rng, certify, workers, X_WO, weight, weight_check,
+):  # fmt: skip
+    """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
+
+    ``kept`` holds ``(sample, X_WH, q, opening, contacts)`` of every closed
+    pose; contacts have ``p_OC``, ``nhat_O`` and ``finger_body``.  ``weight``
+    is the object's weight (N), NaN when unknown.
+    """
+    if not kept:
+        return ()
+    counts = np.array([len(k[4]) for k in kept])
+    K = len(kept)
+    is_closure = np.zeros(K, bool)
+    d_star = np.zeros(K)
+    rank = np.zeros(K, int)
+    eps = np.zeros(K)
+    rho = np.zeros(K)
+    names = finger_names
+    for idx in group_by_count(counts).values():
+        P = np.array([[c.p_OC for c in kept[i][4]] for i in idx])
+        Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
+        F = np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx])
+        fc, ds, rk, ep = verdicts(
+            P, Nrm, mu, torque_scale=torque_scale, model=model,
+            torsional_friction=nu, workers=workers,
+        )  # fmt: skip
+        is_closure[idx], d_star[idx], rank[idx], eps[idx] = fc, ds, rk, ep
+        closed = idx[fc]
+        if len(closed):
+            rho[closed] = robustness(
+                P[fc], Nrm[fc], F[fc], mu, samples=samples, rng=rng, noise=noise,
+                model=model, torsional_friction=nu, workers=workers,
+            )  # fmt: skip
+    samples_of = np.array([k[0] for k in kept])
+    pre = eps * rho
+    checked = rank_order(pre, d_star, samples_of)
+    checked = checked[is_closure[checked]][:weight_check]
+    alpha = np.full(K, np.nan)
+    for idx in group_by_count(counts[checked]).values():
+        idx = checked[idx]
+        alpha[idx] = weight_capacity(
+            np.array([[c.p_OC for c in kept[i][4]] for i in idx]),
+            np.array([[c.nhat_O for c in kept[i][4]] for i in idx]),
+            np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx]),
+            mu, torque_scale=torque_scale, model=model, torsional_friction=nu,
+        ).min(axis=1)  # fmt: skip
+    score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
+    order = np.lexsort((samples_of, -d_star, -pre, -score))
+    base = scoped_name(plant, gripper.base)
+    joint_names = tuple(
+        f"{plant.GetModelInstanceName(j.model_instance())}::{j.name()}"
+        for j in gripper.joints
+    )
+    out = []
+    for place, i in enumerate(order):
+        sample, X_WH, q, opening, found = kept[i]
+        grasp = Grasp(
+            [
+                Contact(c.p_OC, c.nhat_O, mu=mu, model=model, torsional_friction=nu)
+                for c in found
+            ]
+        )
+        out.append(
+            GraspCandidate(
+                sample=sample,
+                hand_base=base,
+                X_WH=X_WH,
+                X_WO=X_WO,
+                q_hand=np.asarray(q, float),
+                joint_names=joint_names,
+                closing_signs=(
+                    float(np.sign(1 / gripper.pad_rate[0])),
+                    float(np.sign(-1 / gripper.pad_rate[1])),
+                ),
+                opening=opening,
+                contacts=tuple(found),
+                grasp=grasp,
+                is_closure=bool(is_closure[i]),
+                d_star=float(d_star[i]),
+                rank=int(rank[i]),
+                epsilon=float(eps[i]),
+                robustness=float(rho[i]),
+                score=float(score[i]),
+                weight_capacity=float(alpha[i]),
+                squeeze_needed=_squeeze(weight, alpha[i]),
+                closure=force_closure(grasp) if place < certify else None,
+            )
+        )
+    return tuple(out)
