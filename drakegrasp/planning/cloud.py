@@ -11,7 +11,9 @@ Points that are not finite (Drake marks missing depth with NaN) are dropped.
 (moments about the centroid, the best guess of the centre of mass).
 
 **Chords.**  A grasp line through a sampled point ``p`` along its inward normal
-``d`` gathers the cloud points within ``line_radius`` of it; the farthest of
+``d`` (with a ``viewpoint``, the inward normal turned across the line of sight,
+and the approach drawn from the camera's side: the seen side of a one-sided
+cloud) gathers the cloud points within ``line_radius`` of it; the farthest of
 them along ``d`` is the opposite contact (none: ``"no opposite surface"``, as
 on the unseen side of a one-sided cloud), and a point clearly before ``p``
 (more than ``line_radius``) occludes it.
@@ -21,10 +23,16 @@ on the unseen side of a one-sided cloud), and a point clearly before ``p``
 deeper than the distance tolerance inside any hand shape collides.  Each
 finger closes along the grasp axis by the smallest travel at which one of its
 shapes reaches a cloud point (a point moving against the closing direction
-enters a convex piece at its chord's entry), and its contacts are the points
+enters a convex piece at its chord's entry; a spherical fingertip, often smaller
+than the cloud's spacing, meets the points that pass within ``line_radius`` of
+it), and its contacts are the points
 its shapes touch within ``band``: the nearest point for a sphere (a fingertip),
 the corners of the touched set's convex hull across the axis for a flat pad.
 The contact normals are the cloud's.
+
+**The unseen side.**  With a ``viewpoint``, space behind the seen surface
+(along the camera's rays) may hold the object: a hand whose shapes reach there
+(probe points on their surfaces) is rejected, open and closed.
 """
 
 from __future__ import annotations
@@ -41,6 +49,7 @@ from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
     "CONTACT_BAND",
+    "LINE_RADIUS_SPACINGS",
     "CloudContact",
     "CloudFingers",
     "CloudSurface",
@@ -55,6 +64,14 @@ NORMAL_RADIUS = 0.01
 
 NORMAL_NEIGHBOURS = 30
 """Most neighbours of Drake's normal estimate."""
+
+LINE_RADIUS_SPACINGS = 2.5
+"""Default line radius in median nearest-neighbour spacings: a disc of that
+radius on a randomly sampled surface holds about six points, so a far side
+that is there is found (at 1.5 spacings one line in five found none)."""
+
+SHADOW_PROBES = 64
+"""Surface points per hand shape tested against a one-sided cloud's shadow."""
 
 _CHUNK = 64
 """Sampled lines processed at once (memory: chunk × points × 3 floats)."""
@@ -178,23 +195,54 @@ class CloudSurface:
     points, normals : (M, 3) float
         World frame, outward unit normals.
     line_radius : float, optional
-        Points this close (m) to a grasp line are on it; default 1.5 times the
-        median spacing of the cloud, at least 1 mm.
+        Points this close (m) to a grasp line are on it; default
+        :data:`LINE_RADIUS_SPACINGS` times the median distance from a point to
+        its nearest neighbour, at least 1 mm.
     """
 
-    def __init__(self, points, normals, line_radius=None):
+    def __init__(self, points, normals, line_radius=None, viewpoint=None):
         self.centroid = points.mean(axis=0)
         self.points = points - self.centroid
         self.normals = normals
+        self.viewpoint = (
+            None if viewpoint is None else np.asarray(viewpoint, float) - self.centroid
+        )
+        gaps = cKDTree(self.points).query(self.points, k=2)[0][:, 1]
+        self.spacing = float(np.median(gaps))
         if line_radius is None:
-            spacing = cKDTree(self.points).query(self.points, k=2)[0][:, 1]
-            line_radius = max(1.5 * float(np.median(spacing)), 1e-3)
+            line_radius = max(LINE_RADIUS_SPACINGS * self.spacing, 1e-3)
         self.line_radius = float(line_radius)
 
     def sample(self, n: int, rng: np.random.Generator):
         """``n`` cloud points (with replacement), their normals and indices."""
         idx = rng.integers(len(self.points), size=n)
         return self.points[idx], self.normals[idx], idx
+
+    def _views(self, p_O: np.ndarray) -> np.ndarray:
+        v = self.viewpoint[None, :] - p_O
+        return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+    def axes(self, p_O: np.ndarray, nout_O: np.ndarray) -> np.ndarray:
+        """Grasp axes: the inward normals, across the line of sight with a view.
+
+        A one-sided cloud shows no far side along an inward normal; across the
+        line of sight the axis meets the cloud again on the seen side (for a
+        convex object), so with a viewpoint the axis is the inward normal with
+        its component along the line of sight removed.
+        """
+        if self.viewpoint is None:
+            return -nout_O
+        v = self._views(p_O)
+        d = -nout_O + np.sum(nout_O * v, axis=1, keepdims=True) * v
+        norm = np.linalg.norm(d, axis=1, keepdims=True)
+        return np.where(norm > 1e-9, d / np.where(norm > 0, norm, 1.0), -nout_O)
+
+    def approach_hint(self, p_O: np.ndarray, d_O: np.ndarray):
+        """With a viewpoint, approach from the camera (the seen side); else None."""
+        if self.viewpoint is None:
+            return None
+        v = -self._views(p_O)
+        return v - np.sum(v * d_O, axis=1, keepdims=True) * d_O
 
     def chord(self, p_O: np.ndarray, d_O: np.ndarray):
         """Entry (0, or negative when occluded), exit and exit normal of lines."""
@@ -276,6 +324,13 @@ class CloudFingers:
             ]
 
         self.hand = [(b, pieces_of(b)) for b in hand_bodies]
+        rng = np.random.default_rng(0)  # fixed: the same probe points every call
+        self.probes = [
+            (b, piece, piece.sample(SHADOW_PROBES, rng)[0])
+            for b, pieces in self.hand
+            for piece in pieces
+            if piece.area > 0
+        ]
         self.fingers = [
             [(b, pieces_of(b)) for b in bodies] for bodies in gripper.finger_bodies
         ]
@@ -302,10 +357,42 @@ class CloudFingers:
                     return True
         return False
 
+    def in_shadow(self) -> bool:
+        """Whether the hand reaches into the unseen side of a one-sided cloud.
+
+        With a viewpoint, space behind the seen surface (farther along a ray
+        from the camera than a cloud point within one spacing of the ray) may
+        be the object's: a probe point of a hand shape deeper there than two
+        spacings plus the distance tolerance collides with it (the margin
+        keeps a fingertip that grazes the seen surface clear).
+        """
+        view = self.surface.viewpoint
+        if view is None:
+            return False
+        camera = view + self.surface.centroid
+        rho = self.surface.spacing
+        for body, piece, probes_G in self.probes:
+            R, p = self._world(body, piece)
+            h = probes_G @ R.T + p - camera  # (P, 3) from the camera
+            dist = np.linalg.norm(h, axis=1)
+            u = h / dist[:, None]
+            idx = self._near(p, piece.radius_about(piece.X_OG.translation()) + rho)
+            if not len(idx):
+                continue
+            q = self.points_W[idx] - camera  # (Q, 3)
+            along = u @ q.T  # (P, Q)
+            perp2 = np.sum(q * q, axis=1)[None, :] - along**2
+            shadowed = (perp2 <= rho * rho) & (
+                along < dist[:, None] - self.tol - 2 * rho
+            )
+            if np.any(shadowed):
+                return True
+        return False
+
     def close(self, X_WH, q_open):
         """Travel of each finger to the cloud: (q, hits per finger, reason)."""
         g = self.g
-        a_W = (X_WH.rotation() @ g.X_HK.rotation()).col(0)
+        a_W = (X_WH.rotation() @ g.X_HK.rotation()).matrix()[:, 0].copy()
         toward = np.array([1.0, -1.0])
         closed_limit = np.where(toward / g.pad_rate > 0, g.upper, g.lower)
         reach = np.abs((closed_limit - q_open) * g.pad_rate)
@@ -321,7 +408,7 @@ class CloudFingers:
                     if not len(idx):
                         continue
                     q_G = (self.points_W[idx] - p) @ R
-                    t_in, _, _ = piece.chord(q_G, np.tile(-c_W @ R, (len(idx), 1)))
+                    t_in = self._entry(piece, q_G, -c_W @ R)
                     ok = np.isfinite(t_in) & (t_in >= -self.tol) & (t_in <= reach[f])
                     if np.any(ok):
                         hits[f].append((body, piece, idx[ok], t_in[ok], c_W))
@@ -331,6 +418,25 @@ class CloudFingers:
         step = np.maximum(travel - 0.5 * self.tol, 0.0)
         q = q_open + toward * step / g.pad_rate
         return q, (travel, hits), None
+
+    def _entry(self, piece, q_G, u_G) -> np.ndarray:
+        """Travel at which each point, moving along ``u_G``, meets the piece.
+
+        A sphere (a fingertip, often smaller than the cloud's spacing) meets a
+        point that passes within ``line_radius`` of its surface: the cloud's
+        surface runs between its points, so the tip meets it where the point's
+        lateral offset ``δ`` allows, at ``s − sqrt(max(r² − δ², 0))`` (``s`` the
+        travel to the centre's closest approach); other shapes meet a point
+        where it enters them (the chord's entry).
+        """
+        if piece.kind == "ellipsoid" and np.ptp(piece.semi_axes) == 0:
+            r = piece.semi_axes[0]
+            s = -(q_G @ u_G)  # centre at the origin; the point moves along u
+            delta = np.linalg.norm(q_G + s[:, None] * u_G, axis=1)
+            reach = delta <= r + self.surface.line_radius
+            t = s - np.sqrt(np.maximum(r * r - delta * delta, 0.0))
+            return np.where(reach, t, np.nan)
+        return piece.chord(q_G, np.tile(u_G, (len(q_G), 1)))[0]
 
     def contacts(self, travel_hits) -> list[CloudContact] | None:
         """The cloud points each finger touches (None unless both fingers do)."""

@@ -103,8 +103,8 @@ class ParallelJaw:
         return {
             "base": self.base.name(),
             "joints": [j.name() for j in self.joints],
-            "grasp_axis_H": self.X_HK.rotation().col(0).tolist(),
-            "approach_H": self.X_HK.rotation().col(1).tolist(),
+            "grasp_axis_H": self.X_HK.rotation().matrix()[:, 0].tolist(),
+            "approach_H": self.X_HK.rotation().matrix()[:, 1].tolist(),
             "p_HK": self.X_HK.translation().tolist(),
             "min_opening": self.min_opening,
             "max_opening": self.max_opening,

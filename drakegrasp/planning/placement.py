@@ -46,7 +46,11 @@ def sample_poses(surface, gripper: ParallelJaw, X_WO, n, mu, clearance, rng, tol
     ----------
     surface : ObjectSurface or CloudSurface
         Anything with ``sample(n, rng) -> (p_O, nout_O, piece)`` and
-        ``chord(p_O, d_O) -> (t_in, t_out, nexit_O)``, in frame O.
+        ``chord(p_O, d_O) -> (t_in, t_out, nexit_O)``, in frame O; optionally
+        ``axes(p_O, nout_O)`` (grasp axes other than the inward normals; both
+        normals must then lie in the friction cone about the axis) and
+        ``approach_hint(p_O, d_O)`` (directions the approach is drawn around,
+        within ±60°, instead of all round the axis).
     gripper : ParallelJaw
     X_WO : RigidTransform
     n : int
@@ -62,7 +66,16 @@ def sample_poses(surface, gripper: ParallelJaw, X_WO, n, mu, clearance, rng, tol
     """
     p_O, nout_O, _ = surface.sample(n, rng)
     theta = rng.uniform(0.0, 2 * np.pi, n)
-    d_O = -nout_O
+    d_O = surface.axes(p_O, nout_O) if hasattr(surface, "axes") else -nout_O
+    hint = (
+        surface.approach_hint(p_O, d_O) if hasattr(surface, "approach_hint") else None
+    )
+    if hint is not None:  # approach from the hint's side, within ±60°
+        R0 = axis_frames(d_O, np.zeros(n))
+        centre = np.arctan2(
+            np.sum(hint * R0[:, :, 2], axis=1), np.sum(hint * R0[:, :, 1], axis=1)
+        )
+        theta = centre + (theta / (2 * np.pi) - 0.5) * (2 * np.pi / 3)
     t_in, t_out, nexit_O = surface.chord(p_O, d_O)
     reasons = np.full(n, "", dtype=object)
     cos_cone = np.cos(np.arctan(mu))
@@ -75,7 +88,9 @@ def sample_poses(surface, gripper: ParallelJaw, X_WO, n, mu, clearance, rng, tol
     reject(np.isnan(t_out), "no opposite surface")
     reject(t_out > gripper.max_opening, "wider than the stroke")
     reject(t_out < gripper.min_opening, "narrower than the stroke")
-    reject(np.sum(nexit_O * d_O, axis=1) < cos_cone, "outside the friction cone")
+    outside = np.sum(nexit_O * d_O, axis=1) < cos_cone
+    outside |= np.sum(-nout_O * d_O, axis=1) < cos_cone  # an axis off the normal
+    reject(outside, "outside the friction cone")
     keep = np.flatnonzero(reasons == "")
     R_WO = X_WO.rotation().matrix()
     centre_W = (

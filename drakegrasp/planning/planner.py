@@ -80,6 +80,7 @@ REASONS = {
     "closing did not converge": f"more than {MAX_CLOSING_STEPS} closing steps",
     "one finger touches": "only one finger's geometry touches the object",
     "hand collides with the cloud": "a cloud point lies inside the open hand",
+    "hand enters the unseen side": "the hand reaches behind a one-sided cloud",
 }
 """Every rejection reason, with what it means."""
 
@@ -264,7 +265,7 @@ def plan_grasps(
             point_cloud, cloud_normals, viewpoint=viewpoint
         )
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
-        surface = CloudSurface(points, normals)
+        surface = CloudSurface(points, normals, viewpoint=viewpoint)
         X_WO = RigidTransform(surface.centroid)
         name = "point cloud"
         mass = np.nan if object_mass is None else float(object_mass)
@@ -351,11 +352,15 @@ def _close_on_cloud(closer: BodyCloser, cloud: CloudFingers, X_WH, opening):
         return None, None, reason
     if cloud.collides():
         return None, None, "hand collides with the cloud"
+    if cloud.in_shadow():
+        return None, None, "hand enters the unseen side"
     q, travel_hits, reason = cloud.close(X_WH, q_open)
     if reason is not None:
         return None, None, reason
     if closer.clear_at(X_WH, q) is not None:
         return None, None, "finger blocked by the scene"
+    if cloud.in_shadow():
+        return None, None, "hand enters the unseen side"
     found = cloud.contacts(travel_hits)
     if found is None:
         return None, None, "one finger touches"

@@ -37,7 +37,7 @@ class PlanningScene:
     context : Context
         The diagram's root context (object at ``X_WO``).
     hand : ModelInstanceIndex
-    object_body : RigidBody
+    object_body : RigidBody or None
     add_models : callable
         ``add_models(plant, parser) -> (hand, object body name)``, the recipe.
     """
@@ -51,7 +51,7 @@ class PlanningScene:
 
 
 def planning_scene(
-    object_url: str,
+    object_url: str | None,
     *,
     hand_url: str = WSG_URL,
     X_WO: RigidTransform | None = None,
@@ -61,9 +61,10 @@ def planning_scene(
 
     Parameters
     ----------
-    object_url : str
+    object_url : str or None
         ``package://`` URL or file path of the object's model (one body with
-        collision geometry is the object: the model's first body).
+        collision geometry is the object: the model's first body); None for a
+        scene with the hand only (planning on a point cloud).
     hand_url : str, optional
         The gripper's model (default Drake's WSG-50 with tip spheres); its
         base is left free.
@@ -85,9 +86,11 @@ def planning_scene(
         register_models(parser)
         try:
             hand = _add(parser, hand_url)
-            obj = _add(parser, object_url)
+            obj = None if object_url is None else _add(parser, object_url)
         except RuntimeError as exc:  # Drake's parser errors
             raise ModelError(f"could not load a model: {exc}") from exc
+        if obj is None:
+            return hand, None
         body = plant.get_body(plant.GetBodyIndices(obj)[0])
         plant.SetDefaultFloatingBaseBodyPose(body, X_WO)
         return hand, f"{plant.GetModelInstanceName(obj)}::{body.name()}"
@@ -98,8 +101,10 @@ def planning_scene(
     plant.Finalize()
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
-    model, _, body = name.rpartition("::")
-    object_body = plant.GetBodyByName(body, plant.GetModelInstanceByName(model))
+    object_body = None
+    if name is not None:
+        model, _, body = name.rpartition("::")
+        object_body = plant.GetBodyByName(body, plant.GetModelInstanceByName(model))
     return PlanningScene(diagram, plant, context, hand, object_body, add_models)
 
 
