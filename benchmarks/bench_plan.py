@@ -3,7 +3,8 @@
 Usage::
 
     python benchmarks/bench_plan.py [--num 1000] [--top 10] [--random 10]
-        [--squeeze 1.5 5] [--seed 0] [--objects NAME ...] [--no-shake]
+        [--margin 1.2] [--firm 5] [--mu 1] [--seed 0] [--objects NAME ...]
+        [--no-shake]
 
 For each object (the YCB boxes and can of ``drake_models``, when present, and
 drakegrasp's own box, cylinder, sphere and hexagonal prism), with Drake's
@@ -16,12 +17,12 @@ WSG-50 as a free gripper:
 * **hold rates**: :func:`drakegrasp.planning.shake_test` on the ``--top``
   best candidates and on ``--random`` candidates drawn uniformly (seeded)
   from all collision-free closed antipodal candidates of the same run (the
-  baseline a planner without ranking would give), as held / tried, for each
-  ``--squeeze`` (per finger, in multiples of the object's weight ``m g``: a
-  light 1.5 w, at which a grasp must be well placed to hold, and a firm 5 w, at
-  which, with the models' friction coefficient of 1, almost any two-sided
-  grasp holds).  The planner's verdicts use ``--mu`` (0.5), half the
-  simulation's friction.
+  baseline a planner without ranking would give), as held / tried, at two
+  squeezes per finger: the *predicted* one, ``--margin`` (1.2) times the
+  largest ``squeeze_needed`` the planner gives its top candidates, and a
+  *firm* one, ``--firm`` (5) times the object's weight, at which almost any
+  two-sided grasp holds.  The planner uses ``--mu`` 1.0, the friction
+  coefficient of the models' proximity properties (what the simulation uses).
 """
 
 from __future__ import annotations
@@ -63,13 +64,19 @@ def main(argv=None) -> int:
     ap.add_argument("--top", type=int, default=10)
     ap.add_argument("--random", type=int, default=10)
     ap.add_argument(
-        "--squeeze",
+        "--firm",
         type=float,
-        nargs="+",
-        default=[1.5, 5.0],
-        help="squeezes per finger, in multiples of the object's weight m g",
+        default=5.0,
+        help="the firm squeeze per finger, in multiples of the object's weight",
     )
-    ap.add_argument("--mu", type=float, default=0.5)
+    ap.add_argument(
+        "--margin",
+        type=float,
+        default=1.2,
+        help="the predicted squeeze is this times the largest squeeze_needed "
+        "of the top candidates",
+    )
+    ap.add_argument("--mu", type=float, default=1.0)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--objects", nargs="*", default=None)
     ap.add_argument("--no-shake", action="store_true")
@@ -81,12 +88,11 @@ def main(argv=None) -> int:
         )
         return 1
     names = args.objects or [*YCB, *OWN]
-    squeezes = [float(x) for x in args.squeeze]
     print(f"load {os.getloadavg()[0]:.2f}; WSG-50, mu = {args.mu}")
-    held_cols = "".join(f" {f'top@{q:g}w':>9} {f'rand@{q:g}w':>9}" for q in squeezes)
     print(
         f"{'object':<20} {'samples/s':>10} {'cands/s':>8} {'cands':>6} {'FC':>5}"
-        + held_cols
+        f" {'predicted':>9} {'top':>5} {'random':>6}"
+        f" {'firm':>9} {'top':>5} {'random':>6}"
     )
     for name in names:
         scene = planning_scene(object_url(name), models_dir=models)
@@ -105,22 +111,21 @@ def main(argv=None) -> int:
         pick = rng.choice(
             len(result), size=min(args.random, len(result)), replace=False
         )
-        cells = ""
         weight = scene.object_body.default_mass() * 9.81
-        for k in squeezes:
-            q = k * weight
-            if args.no_shake or not len(result):
-                cells += f" {'-':>9} {'-':>9}"
+        top = list(result[: args.top])
+        rand = [result[int(i)] for i in pick]
+        predicted = args.margin * max((c.squeeze_needed for c in top), default=0.0)
+        cells = ""
+        for q in (predicted, args.firm * weight):
+            if args.no_shake or not top or not np.isfinite(q):
+                cells += f" {'-':>9} {'-':>5} {'-':>6}"
                 continue
-            top = [
-                shake_test(scene.add_models, c, squeeze=q).held
-                for c in result[: args.top]
-            ]
-            rand = [
-                shake_test(scene.add_models, result[int(i)], squeeze=q).held
-                for i in pick
-            ]
-            cells += f" {f'{sum(top)}/{len(top)}':>9} {f'{sum(rand)}/{len(rand)}':>9}"
+            held = [shake_test(scene.add_models, c, squeeze=q).held for c in top]
+            held_r = [shake_test(scene.add_models, c, squeeze=q).held for c in rand]
+            cells += (
+                f" {q:>8.1f}N {f'{sum(held)}/{len(held)}':>5}"
+                f" {f'{sum(held_r)}/{len(held_r)}':>6}"
+            )
         fc = sum(c.is_closure for c in result)
         print(
             f"{name:<20} {args.num / wall:>10.0f} {len(result) / wall:>8.0f} "
