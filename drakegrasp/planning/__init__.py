@@ -3,11 +3,14 @@
 :func:`plan_grasps` samples antipodal parallel-jaw grasps on an object's
 collision geometry (:mod:`~drakegrasp.planning.surface`), places the gripper
 whose geometry it learns from the plant (:mod:`~drakegrasp.planning.gripper`),
-rejects colliding poses, closes the fingers with Drake's distance queries and
-ranks the grasps in the batch engine (:mod:`~drakegrasp.planning.ranking`);
-the results are :mod:`~drakegrasp.planning.candidates`.  This folder imports
-the plant, quality, batch and closure layers; nothing inside the package
-imports it except the command line.
+rejects colliding poses and closes the fingers with Drake's distance queries
+(:mod:`~drakegrasp.planning.placement`) or on a point cloud
+(:mod:`~drakegrasp.planning.cloud`), and ranks the grasps
+(:mod:`~drakegrasp.planning.ranking`, :mod:`~drakegrasp.planning.weight`);
+the results are :mod:`~drakegrasp.planning.candidates`, and
+:mod:`~drakegrasp.planning.shake` checks them in a Drake simulation.  This
+folder imports the plant, quality, batch and closure layers; nothing inside
+the package imports it except the command line.
 """
 
 from drakegrasp._lazy import lazy_exports
@@ -23,12 +26,15 @@ _SOURCES = {
 
 _SUBMODULES = (
     "candidates",
+    "cloud",
     "gripper",
+    "placement",
     "planner",
     "ranking",
     "scenes",
     "shake",
     "surface",
+    "weight",
 )
 
 __getattr__, __dir__ = lazy_exports(

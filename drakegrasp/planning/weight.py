@@ -42,12 +42,16 @@ __all__ = [
     "weight_capacity",
 ]
 
-WEIGHT_DIRECTIONS = np.array(
-    [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
-    + [[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)],
-    dtype=float,
-)
-WEIGHT_DIRECTIONS /= np.linalg.norm(WEIGHT_DIRECTIONS, axis=1, keepdims=True)
+
+def _directions() -> np.ndarray:
+    axes = np.vstack([np.eye(3), -np.eye(3)])
+    diagonals = np.array(
+        [[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float
+    )
+    return np.vstack([axes, diagonals / np.sqrt(3.0)])
+
+
+WEIGHT_DIRECTIONS = _directions()
 """The 14 weight directions in O: the axes and the cube's diagonals."""
 
 
