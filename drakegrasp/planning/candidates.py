@@ -14,11 +14,13 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from pydrake.math import RigidTransform
 
 from drakegrasp.closure.results import ClosureResult
+from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.plant.contacts import PlantContact
@@ -60,8 +62,8 @@ class GraspCandidate:
         Pad-to-pad width of the pre-grasp (open) hand, metres.
     contacts : tuple of PlantContact
         Contacts of the closed hand (object frame O).
-    grasp : Grasp
-        The core grasp of those contacts (frame O, moments about O's origin).
+    contact_options : dict
+        ``mu``, ``model`` and ``torsional_friction`` of the contacts.
     is_closure : bool
         Frictional force closure on the polyhedral cones (LP2).
     d_star : float
@@ -84,7 +86,10 @@ class GraspCandidate:
     squeeze_needed : float
         The squeeze per finger (N) that holds the object's weight in all those
         directions, ``m g / weight_capacity`` (inf: none does; NaN: not
-        computed).
+        computed).  A lower bound: the LP shares each finger's force among its
+        contacts at will, while a rigid pad shares it as its geometry and
+        compliance dictate (in the shake test, grasps of cylinders with two
+        tip spheres per finger needed up to twice this).
     closure : ClosureResult or None
         The single-grasp verdict with its certificate (witness), for the top
         candidates (``certify`` of ``plan_grasps``); None for the rest.
@@ -99,7 +104,7 @@ class GraspCandidate:
     closing_signs: tuple[float, ...]
     opening: float
     contacts: tuple[PlantContact, ...]
-    grasp: Grasp
+    contact_options: dict
     is_closure: bool
     d_star: float
     rank: int
@@ -109,6 +114,16 @@ class GraspCandidate:
     weight_capacity: float = float("nan")
     squeeze_needed: float = float("nan")
     closure: ClosureResult | None = None
+
+    @cached_property
+    def grasp(self) -> Grasp:
+        """The core grasp of the contacts (frame O, moments about O's origin).
+
+        Built on first access (thousands of candidates rarely need it).
+        """
+        return Grasp(
+            [Contact(c.p_OC, c.nhat_O, **self.contact_options) for c in self.contacts]
+        )
 
     @property
     def num_contacts(self) -> int:

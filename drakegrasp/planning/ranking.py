@@ -39,12 +39,12 @@ so a ranking is reproducible.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
 from drakegrasp.closure.verdicts import force_closure
-from drakegrasp.core.contact import Contact
-from drakegrasp.core.grasp import Grasp
 from drakegrasp.planning.candidates import GraspCandidate
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.validation import scoped_name
@@ -293,12 +293,6 @@ def rank_candidates(
     out = []
     for place, i in enumerate(order):
         sample, X_WH, q, opening, found = kept[i]
-        grasp = Grasp(
-            [
-                Contact(c.p_OC, c.nhat_O, mu=mu, model=model, torsional_friction=nu)
-                for c in found
-            ]
-        )
         out.append(
             GraspCandidate(
                 sample=sample,
@@ -313,7 +307,7 @@ def rank_candidates(
                 ),
                 opening=opening,
                 contacts=tuple(found),
-                grasp=grasp,
+                contact_options={"mu": mu, "model": model, "torsional_friction": nu},
                 is_closure=bool(is_closure[i]),
                 d_star=float(d_star[i]),
                 rank=int(rank[i]),
@@ -322,7 +316,8 @@ def rank_candidates(
                 score=float(score[i]),
                 weight_capacity=float(alpha[i]),
                 squeeze_needed=_squeeze(weight, alpha[i]),
-                closure=force_closure(grasp) if place < certify else None,
             )
         )
+        if place < certify:  # the certificate of the best few
+            out[-1] = replace(out[-1], closure=force_closure(out[-1].grasp))
     return tuple(out)

@@ -20,7 +20,9 @@ with ``w_ik`` the primitive wrenches about O (unit normal force, generator
 changes no ``α``), and :math:`\alpha_{\min} = \min_u \alpha(u)` over a set of
 directions in O.  The squeeze that holds the object's weight in every such
 direction is :math:`m g / \alpha_{\min}`.  (A per-finger bound, not the L1
-bound of ε: it is what a gripper's actuators set.)
+bound of ε: it is what a gripper's actuators set.)  It is a lower bound of the
+squeeze a real pad needs: the LP shares a finger's force among its contacts at
+will, a rigid pad as its geometry and compliance dictate.
 
 A grasp's directions are independent blocks of **one** LP (the sum of their
 ``α`` is maximised, which maximises each), built by
