@@ -24,10 +24,12 @@ bound of ε: it is what a gripper's actuators set.)  It is a lower bound of the
 squeeze a real pad needs: the LP shares a finger's force among its contacts at
 will, a rigid pad as its geometry and compliance dictate.
 
-A grasp's directions are independent blocks of **one** LP (the sum of their
-``α`` is maximised, which maximises each), built by
-:func:`build_weight_capacity_program` and solved through drakegrasp's solver
-gateway, one LP per grasp (one LP for many grasps is slower in Clp).
+The LPs of all grasps and directions are solved at once by the batch engine's
+interior-point method, in their dual form (nine variables each, see
+:func:`weight_capacity`); :func:`build_weight_capacity_program` builds the
+primal LP of one grasp (its directions as independent blocks: the sum of their
+``α`` is maximised, which maximises each) for inspection, for a second route
+through drakegrasp's solver gateway and for the tests.
 """
 
 from __future__ import annotations
@@ -36,7 +38,9 @@ import numpy as np
 from pydrake.solvers import MathematicalProgram
 
 from drakegrasp._solvers import require_solution, solve
+from drakegrasp.batch.ipm import solve_max_last
 from drakegrasp.batch.wrenches import batched_primitive_wrenches
+from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
     "WEIGHT_DIRECTIONS",
@@ -135,6 +139,7 @@ def weight_capacity(
     torsional_friction: float | None = None,
     directions: np.ndarray = WEIGHT_DIRECTIONS,
     num_generators: int = 8,
+    solver: str = "batch",
 ) -> np.ndarray:
     """(K, D) weight capacities ``α(u)`` of ``K`` grasps of ``N`` contacts.
 
@@ -153,6 +158,12 @@ def weight_capacity(
     torsional_friction : float, optional
     directions : (D, 3) float, optional
     num_generators : int, optional
+    solver : {"batch", "drake"}, optional
+        ``"batch"`` (default): the dual LPs of all grasps and directions at
+        once in the batch engine's interior-point method
+        (:func:`~drakegrasp.batch.ipm.solve_max_last`); ``"drake"``: the LP of
+        :func:`build_weight_capacity_program` per grasp through the solver
+        gateway (Clp; slower, about 1 ms per direction).
 
     Returns
     -------
@@ -174,9 +185,18 @@ def weight_capacity(
     )
     per = W.shape[1] // N
     groups = np.repeat(fingers, per, axis=1)
+    if solver == "batch":
+        return _batch_capacity(W, groups, np.asarray(directions, float))
+    if solver != "drake":
+        raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
+    return _drake_capacity(W, groups, directions)
+
+
+def _drake_capacity(W: np.ndarray, groups: np.ndarray, directions) -> np.ndarray:
+    """The primal LP of each grasp through the solver gateway (one program)."""
+    K, _, w = W.shape
     out = np.zeros((K, len(directions)))
     prog, alpha, bindings = _program(W[0], groups[0], directions)
-    w = W.shape[2]
     for k in range(K):  # one program, its coefficients updated per grasp
         if k:
             member = _memberships(groups[k])
@@ -190,3 +210,53 @@ def weight_capacity(
         result = require_solution(prog, solve(prog, "lp"), "the weight-capacity LP")
         out[k] = np.maximum(result.GetSolution(alpha), 0.0)
     return out
+
+
+def _complement(v: np.ndarray) -> np.ndarray:
+    """(D, w, w - 1) orthonormal bases of the complements of unit rows ``v``."""
+    D, w = v.shape
+    out = np.empty((D, w, w - 1))
+    for d in range(D):
+        Q, _ = np.linalg.qr(np.column_stack([v[d], np.eye(w)]))
+        out[d] = Q[:, 1:w]
+    return out
+
+
+def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
+    """The dual LPs of every grasp and direction in the batch engine's IPM.
+
+    The dual of the capacity LP, with ``y = v + P z`` (``P`` a basis of the
+    complement of ``v = (u; 0)``, so ``yᵀv = 1``), is
+    ``min Σ_f s_f`` s.t. ``s_f >= -yᵀw_j`` (``j`` in group ``f``), ``s >= 0``:
+    nine variables ``(z, s, ζ)`` with ``ζ <= -Σ s`` maximised, the form of
+    :func:`~drakegrasp.batch.ipm.solve_max_last`.  ``α = -ζ*``.  A grasp with a
+    direction whose dual does not converge (degenerate: coplanar pad contacts)
+    is solved again as the primal through the solver gateway.
+    """
+    K, M, w = W.shape
+    D = len(directions)
+    v = np.hstack([directions, np.zeros((D, w - 3))])  # (D, w)
+    P = _complement(v)  # (D, w, w-1)
+    n = (w - 1) + 3 + 1
+    B = np.zeros((K, D, M + 4, n))
+    h = np.zeros((K, D, M + 4))
+    # generator rows: -(Pᵀ w_j)·z - s_f <= v·w_j
+    B[:, :, :M, : w - 1] = -np.einsum("kmi,dij->kdmj", W, P)
+    g = np.clip(groups, 0, 2)
+    onehot = (g[..., None] == np.arange(3)).astype(float)  # (K, M, 3)
+    B[:, :, :M, w - 1 : w + 2] = -onehot[:, None]
+    h[:, :, :M] = np.einsum("kmi,di->kdm", W, v)
+    # s >= 0
+    for f in range(3):
+        B[:, :, M + f, w - 1 + f] = -1.0
+    # ζ + Σ s <= 0
+    B[:, :, M + 3, w - 1 : w + 2] = 1.0
+    B[:, :, M + 3, n - 1] = 1.0
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        # a degenerate dual may diverge (overflow); it is re-solved below
+        sol = solve_max_last(B.reshape(K * D, M + 4, n), h.reshape(K * D, M + 4))
+    alpha = np.maximum(-sol.value, 0.0).reshape(K, D)
+    stuck = np.flatnonzero(~sol.converged.reshape(K, D).all(axis=1))
+    if len(stuck):  # degenerate duals (coplanar pads): the primal through Clp
+        alpha[stuck] = _drake_capacity(W[stuck], groups[stuck], directions)
+    return alpha

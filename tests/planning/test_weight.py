@@ -13,12 +13,15 @@ from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, weight_capacity
 from drakegrasp.quality import primitive_wrenches
 
 
-def test_two_opposed_contacts_closed_form():
+@pytest.mark.parametrize("solver", ["batch", "drake"])
+def test_two_opposed_contacts_closed_form(solver):
     mu, r = 0.4, 0.03
     P = np.array([[[-r, 0, 0], [r, 0, 0]]])
     N = np.array([[[1.0, 0, 0], [-1.0, 0, 0]]])
     dirs = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, 0, -1]])
-    a = weight_capacity(P, N, np.array([[0, 1]]), mu, torque_scale=r, directions=dirs)
+    a = weight_capacity(
+        P, N, np.array([[0, 1]]), mu, torque_scale=r, directions=dirs, solver=solver
+    )
     # along the axis one finger's normal force (<= 1); across it both frictions
     assert a[0] == pytest.approx([1.0, 1.0, 2 * mu, 2 * mu], abs=1e-7)
 
@@ -40,7 +43,8 @@ def _scipy_capacity(grasp, fingers, u, b):
     return -res.fun
 
 
-def test_agrees_with_a_second_formulation():
+@pytest.mark.parametrize("solver", ["batch", "drake"])
+def test_agrees_with_a_second_formulation(solver):
     rng = np.random.default_rng(11)
     for _ in range(4):
         # two pads of three contacts each, facing each other across x
@@ -51,7 +55,9 @@ def test_agrees_with_a_second_formulation():
         N = np.vstack([np.tile([1.0, 0, 0], (3, 1)), np.tile([-1.0, 0, 0], (3, 1))])
         N = (N + tilt) / np.linalg.norm(N + tilt, axis=1, keepdims=True)
         fingers = np.array([0, 0, 0, 1, 1, 1])
-        a = weight_capacity(P[None], N[None], fingers[None], 0.5, torque_scale=0.05)[0]
+        a = weight_capacity(
+            P[None], N[None], fingers[None], 0.5, torque_scale=0.05, solver=solver
+        )[0]
         grasp = Grasp([Contact(p, n, mu=0.5) for p, n in zip(P, N, strict=True)])
         ref = [_scipy_capacity(grasp, fingers, u, 0.05) for u in WEIGHT_DIRECTIONS]
         assert a == pytest.approx(ref, rel=1e-6, abs=1e-8)
@@ -65,3 +71,14 @@ def test_independent_of_units_and_torque_scale():
     a = weight_capacity(P, N, F, 0.6, torque_scale=0.05)
     b = weight_capacity(P * 1000, N, F, 0.6, torque_scale=3.0)
     assert a == pytest.approx(b, rel=1e-6, abs=1e-9)
+
+
+def test_the_batch_dual_and_the_primal_program_agree_on_many_grasps():
+    rng = np.random.default_rng(13)
+    P = rng.normal(0, 0.03, (30, 8, 3))
+    N = -P / np.linalg.norm(P, axis=2, keepdims=True) + rng.normal(0, 0.3, P.shape)
+    N /= np.linalg.norm(N, axis=2, keepdims=True)
+    F = np.repeat([[0, 0, 0, 0, 1, 1, 1, 2]], 30, axis=0)  # one palm contact
+    a = weight_capacity(P, N, F, 0.7, torque_scale=0.05)
+    b = weight_capacity(P, N, F, 0.7, torque_scale=0.05, solver="drake")
+    assert a == pytest.approx(b, rel=1e-6, abs=1e-8)
