@@ -8,6 +8,8 @@ import json
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from drakegrasp import analyze_grasp
@@ -195,3 +197,21 @@ def test_bad_mu_and_noise(own_scene):
         plan(scene, n=5, mu=-1)
     with pytest.raises(InvalidOptionError, match="noise"):
         plan(scene, n=5, noise={"wobble": 1})
+
+
+@settings(max_examples=4, deadline=None, derandomize=True)
+@given(
+    st.floats(-np.pi, np.pi),
+    st.floats(-1.5, 1.5),
+    st.floats(-np.pi, np.pi),
+    st.tuples(*[st.floats(-1.0, 1.0)] * 3),
+)
+def test_rigid_motion_invariance_property(own_scene, roll, pitch, yaw, p):
+    X = RigidTransform(RollPitchYaw(roll, pitch, yaw), list(p))
+    a = plan(own_scene("hex_prism"), n=40, seed=3)
+    b = plan(own_scene("hex_prism", X_WO=X), n=40, seed=3)
+    assert a.rejections == b.rejections
+    assert [c.sample for c in a] == [c.sample for c in b]
+    for ca, cb in zip(a, b, strict=True):
+        assert (X @ ca.X_WH).IsNearlyEqualTo(cb.X_WH, 1e-8)
+        assert cb.score == pytest.approx(ca.score, rel=1e-6, abs=1e-9)
