@@ -10,7 +10,8 @@ Layers as folders, inner to outer (an import never points outwards):
 ``certificates`` (witnesses, their check and wording), ``closure`` (the
 programs, verdicts and second order), then ``quality`` and ``plant``, then the
 outer ring ``batch``, ``systems``, ``planning`` (finding grasps),
-``visualization``, ``distributed`` and ``cli``.  ``docs/architecture.md`` draws the map.
+``visualization``, ``distributed`` and ``cli``.  ``docs/architecture.md``
+draws the map.
 
 Every public name is imported from its module when it is first read
 (``drakegrasp._lazy``), so ``import drakegrasp`` and the ``drakegrasp``
@@ -57,8 +58,6 @@ _SOURCES = {
     ),
     "drakegrasp.errors": (
         "BatchFileError",
-        "GraspCandidate",
-        "GraspCandidates",
         "GraspError",
         "InvalidContactError",
         "InvalidContextError",
@@ -82,8 +81,6 @@ _SOURCES = {
         "grasp_matrix",
         "normal_grasp_matrix",
         "normalised_grasp_matrix",
-        "plan_grasps",
-        "planning_scene",
     ),
     "drakegrasp.plant": (
         "FingerClosure",
@@ -127,9 +124,7 @@ _SOURCES = {
     ),
     "drakegrasp.closure.second_order": (
         "SecondOrderResult",
-        "ShakeResult",
         "second_order_form_closure",
-        "shake_test",
     ),
     "drakegrasp.planning": (
         "GraspCandidate",

@@ -215,3 +215,10 @@ def test_rigid_motion_invariance_property(own_scene, roll, pitch, yaw, p):
     for ca, cb in zip(a, b, strict=True):
         assert (X @ ca.X_WH).IsNearlyEqualTo(cb.X_WH, 1e-8)
         assert cb.score == pytest.approx(ca.score, rel=1e-6, abs=1e-9)
+
+
+def test_progress_bar(own_scene, capsys):
+    pytest.importorskip("tqdm")
+    result = plan(own_scene(), n=10, progress=True)
+    assert len(result) + sum(result.rejections.values()) == 10
+    assert "closing" in capsys.readouterr().err
