@@ -14,6 +14,9 @@ WSG-50 as a free gripper:
   first, so numba's compilation is not timed), the wall time, samples/s and
   candidates/s (candidates are the samples that survive the collision filter
   and the closing), and the rejections by reason;
+* **the user's loop**: ``--loop`` candidates closed and analysed one at a
+  time with ``close_hand``, ``analyze_grasp`` and ``ferrari_canny`` from the
+  open hand at the candidate's pose (the baseline of issue 18), candidates/s;
 * **hold rates**: :func:`drakegrasp.planning.shake_test` on the ``--top``
   best candidates and on ``--random`` candidates drawn uniformly (seeded)
   from all collision-free closed antipodal candidates of the same run (the
@@ -58,6 +61,38 @@ def object_url(name: str) -> str:
     return f"package://drakegrasp/objects/{name}.sdf"
 
 
+def user_loop(scene, candidates, mu: float) -> float:
+    """Candidates/s of the one-at-a-time loop a user writes without the planner.
+
+    From each candidate's open pre-grasp: ``close_hand``, ``analyze_grasp`` and
+    ``ferrari_canny`` (the issue's baseline), on the same plant.
+    """
+    from drakegrasp import GraspError, analyze_grasp, close_hand, ferrari_canny
+
+    plant = scene.plant
+    ctx = scene.context.Clone()
+    pctx = plant.GetMyContextFromRoot(ctx)
+    base = plant.GetBodyByName(candidates[0].hand_base.rpartition("::")[2])
+    joints = [
+        plant.GetJointByName(n.rpartition("::")[2]) for n in candidates[0].joint_names
+    ]
+    t = time.perf_counter()
+    for c in candidates:
+        plant.SetFreeBodyPose(pctx, base, c.X_WH)
+        for j, sign in zip(joints, c.closing_signs, strict=True):
+            lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
+            j.set_translation(pctx, lo if sign > 0 else hi)  # wide open
+        try:
+            close_hand(plant, ctx, scene.object_body, hand=scene.hand)
+            report = analyze_grasp(
+                plant, ctx, scene.object_body, hand=scene.hand, mu=mu
+            )
+            ferrari_canny(report.grasp)
+        except GraspError:  # timed all the same: the loop pays for it
+            pass
+    return len(candidates) / (time.perf_counter() - t)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--num", type=int, default=1500)
@@ -80,6 +115,13 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--objects", nargs="*", default=None)
     ap.add_argument("--no-shake", action="store_true")
+    ap.add_argument(
+        "--loop",
+        type=int,
+        default=50,
+        help="candidates run through the user's loop (close_hand, analyze_grasp, "
+        "ferrari_canny one at a time) for comparison; 0 skips it",
+    )
     args = ap.parse_args(argv)
     models = drake_models()
     if models is None:
@@ -132,6 +174,11 @@ def main(argv=None) -> int:
             f"{len(result):>6} {fc:>5}" + cells,
             flush=True,
         )
+        if args.loop and len(result):
+            rate = user_loop(scene, result[: args.loop], args.mu)
+            print(
+                f"    the user's loop: {rate:.0f} candidates/s ({args.loop} candidates)"
+            )
         reasons = ", ".join(
             f"{k} {v}"
             for k, v in sorted(result.rejections.items(), key=lambda kv: -kv[1])
