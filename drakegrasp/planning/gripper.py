@@ -166,9 +166,66 @@ def parallel_jaw(
         A hand without a free base, without two prismatic fingers with parallel
         axes and finite limits, or whose pads cannot be told from its palm.
     """
+    base, fingers, joints = _two_prismatic_fingers(
+        plant, plant_context, object_body, hand
+    )
+    inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
+    lower = np.array([j.position_lower_limits()[0] for j in joints])
+    upper = np.array([j.position_upper_limits()[0] for j in joints])
+    ctx = plant.CreateDefaultContext()
+
+    def finger_origins(q):  # finger body origins in H at joint values q
+        for j, v in zip(joints, q, strict=True):
+            j.set_translation(ctx, float(v))
+        return [
+            plant.CalcRelativeTransform(
+                ctx, base.body_frame(), f.bodies[0].body_frame()
+            ).translation()
+            for f in fingers
+        ]
+
+    a_H = _grasp_axis(finger_origins, lower, upper)
+
+    def supports(q):  # per finger: (ids, supports towards the other, centres)
+        finger_origins(q)
+        return [
+            _finger_supports(plant, ctx, inspector, f, base, a_H, sign)
+            for f, sign in zip(fingers, (1.0, -1.0), strict=True)
+        ]
+
+    # pad coordinate along a, affine in q: finger 0's max of a·x, finger 1's min
+    pad = np.array(
+        [[s0[1].max(), -s1[1].max()] for s0, s1 in map(supports, (lower, upper))]
+    )
+    rate = (pad[1] - pad[0]) / (upper - lower)
+    at_zero = pad[0] - rate * lower
+    pad_ids, pad_lateral = _pads(supports(0.5 * (lower + upper)), a_H)
+    approach = _approach(plant, inspector, base, pad_lateral, a_H)
+    # open-stroke pad positions along a decide the origin of K along the axis
+    closing = rate * np.array([-1.0, 1.0]) > 0  # where q opens: upper
+    x_open = at_zero + rate * np.where(closing, upper, lower)
+    x_closed = at_zero + rate * np.where(closing, lower, upper)
+    centre = 0.5 * (x_open[0] + x_open[1])
+    R_HK = RotationMatrix(np.column_stack([a_H, approach, np.cross(a_H, approach)]))
+    return ParallelJaw(
+        base=base,
+        joints=joints,
+        finger_bodies=tuple(tuple(f.bodies) for f in fingers),
+        position_indices=np.array([j.position_start() for j in joints]),
+        lower=lower,
+        upper=upper,
+        X_HK=RigidTransform(R_HK, pad_lateral + centre * a_H),
+        pad_at_zero=at_zero - centre,
+        pad_rate=rate,
+        pad_geometries=pad_ids,
+        min_opening=float(max(2 * max(centre - x_closed[0], x_closed[1] - centre), 0)),
+        max_opening=float(2 * min(centre - x_open[0], x_open[1] - centre)),
+    )
+
+
+def _two_prismatic_fingers(plant, plant_context, object_body, hand):
+    """(free base, the two fingers, their prismatic joints), or a ModelError."""
     bodies = hand_bodies(plant, object_body, hand)
-    if not bodies:
-        raise ModelError(f"the hand {hand!r} has no body that can move")
     base = _free_base(plant, bodies)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     structure = hand_structure(plant, object_body, bodies, inspector=inspector)
@@ -187,19 +244,11 @@ def parallel_jaw(
                 f"finger joint {j.name()} must be prismatic with finite limits to "
                 f"make a parallel jaw (it is {j.type_name()}, limits [{lo}, {hi}])"
             )
-    ctx = plant.CreateDefaultContext()
-    H = base.body_frame()
-    lower = np.array([j.position_lower_limits()[0] for j in joints])
-    upper = np.array([j.position_upper_limits()[0] for j in joints])
+    return base, fingers, joints
 
-    def finger_origins(q):
-        for j, v in zip(joints, q, strict=True):
-            j.set_translation(ctx, float(v))
-        return [
-            plant.CalcRelativeTransform(ctx, H, f.bodies[0].body_frame()).translation()
-            for f in fingers
-        ]
 
+def _grasp_axis(finger_origins, lower, upper) -> np.ndarray:
+    """Unit axis in H along which the fingers slide, from finger 0 to finger 1."""
     lo0, lo1 = finger_origins(lower)
     hi0, hi1 = finger_origins(upper)
     u = [(hi0 - lo0) / (upper[0] - lower[0]), (hi1 - lo1) / (upper[1] - lower[1])]
@@ -210,32 +259,23 @@ def parallel_jaw(
             f"they move along {np.round(u[0], 6).tolist()} and "
             f"{np.round(u[1], 6).tolist()}"
         )
-    mid = 0.5 * (lower + upper)
-    m0, m1 = finger_origins(mid)
-    if (m1 - m0) @ a_H < 0:
-        a_H = -a_H
-    supports = []
-    for q in (lower, upper):
-        finger_origins(q)
-        supports.append(
-            [
-                _finger_supports(plant, ctx, inspector, f, base, a_H, sign)
-                for f, sign in zip(fingers, (1.0, -1.0), strict=True)
-            ]
-        )
-    # pad coordinate along a: finger 0's max of a·x, finger 1's min
-    pad = np.array([[s0[1].max(), -s1[1].max()] for s0, s1 in supports])
-    rate = (pad[1] - pad[0]) / (upper - lower)
-    at_zero = pad[0] - rate * lower
-    finger_origins(mid)
+    m0, m1 = finger_origins(0.5 * (lower + upper))
+    return -a_H if (m1 - m0) @ a_H < 0 else a_H
+
+
+def _pads(supports, a_H):
+    """Each finger's pad geometries and the pads' mean centre across the axis."""
     pad_ids, lateral = [], []
-    for f, sign in zip(fingers, (1.0, -1.0), strict=True):
-        ids, sup, centres = _finger_supports(plant, ctx, inspector, f, base, a_H, sign)
+    for ids, sup, centres in supports:
         on_pad = sup >= sup.max() - PAD_DEPTH
         pad_ids.append(tuple(g for g, k in zip(ids, on_pad, strict=True) if k))
         c = centres[on_pad].mean(axis=0)
         lateral.append(c - (c @ a_H) * a_H)
-    pad_lateral = 0.5 * (lateral[0] + lateral[1])
+    return tuple(pad_ids), 0.5 * (lateral[0] + lateral[1])
+
+
+def _approach(plant, inspector, base, pad_lateral, a_H) -> np.ndarray:
+    """Unit direction in H from the palm's collision geometry to the pads."""
     palm = [
         inspector.GetPoseInFrame(g).translation()
         for g in plant.GetCollisionGeometriesForBody(base)
@@ -249,29 +289,4 @@ def parallel_jaw(
             f"{np.round(pad_lateral, 4).tolist()} is within {_LATERAL_MIN * 1e3:g} mm "
             f"of its palm's {np.round(palm_lateral, 4).tolist()} across the grasp axis"
         )
-    approach /= np.linalg.norm(approach)
-    # open-stroke pad positions along a decide the origin of K along the axis
-    open_q = np.where(rate * np.array([-1.0, 1.0]) > 0, upper, lower)
-    closed_q = np.where(rate * np.array([-1.0, 1.0]) > 0, lower, upper)
-    x_open = at_zero + rate * open_q
-    x_closed = at_zero + rate * closed_q
-    centre = 0.5 * (x_open[0] + x_open[1])
-    at_zero_K = at_zero - centre
-    max_opening = 2 * min(centre - x_open[0], x_open[1] - centre)
-    min_opening = max(2 * max(centre - x_closed[0], x_closed[1] - centre), 0.0)
-    R_HK = RotationMatrix(np.column_stack([a_H, approach, np.cross(a_H, approach)]))
-    X_HK = RigidTransform(R_HK, pad_lateral + centre * a_H)
-    return ParallelJaw(
-        base=base,
-        joints=joints,
-        finger_bodies=tuple(tuple(f.bodies) for f in fingers),
-        position_indices=np.array([j.position_start() for j in joints]),
-        lower=lower,
-        upper=upper,
-        X_HK=X_HK,
-        pad_at_zero=at_zero_K,
-        pad_rate=rate,
-        pad_geometries=tuple(pad_ids),
-        min_opening=float(min_opening),
-        max_opening=float(max_opening),
-    )
+    return approach / np.linalg.norm(approach)
