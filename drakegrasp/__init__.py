@@ -9,8 +9,9 @@ Layers as folders, inner to outer (an import never points outwards):
 ``core`` (numpy only: contacts, G, cones, antipodal, curvature, validation),
 ``certificates`` (witnesses, their check and wording), ``closure`` (the
 programs, verdicts and second order), then ``quality`` and ``plant``, then the
-outer ring ``batch``, ``systems``, ``visualization``, ``distributed`` and
-``cli``.  ``docs/architecture.md`` draws the map.
+outer ring ``batch``, ``systems``, ``planning`` (finding grasps),
+``visualization``, ``distributed`` and ``cli``.  ``docs/architecture.md``
+draws the map.
 
 Every public name is imported from its module when it is first read
 (``drakegrasp._lazy``), so ``import drakegrasp`` and the ``drakegrasp``
@@ -134,6 +135,14 @@ _SOURCES = {
         "SecondOrderResult",
         "second_order_form_closure",
     ),
+    "drakegrasp.planning": (
+        "GraspCandidate",
+        "GraspCandidates",
+        "ShakeResult",
+        "plan_grasps",
+        "planning_scene",
+        "shake_test",
+    ),
     "drakegrasp.systems.grasp_monitor": ("GraspMonitor",),
     "drakegrasp.systems.sample": ("GraspSample",),
     "drakegrasp.systems.monitor": ("add_grasp_monitor",),
@@ -160,6 +169,7 @@ _SUBMODULES = {
         "core",
         "distributed",
         "errors",
+        "planning",
         "plant",
         "quality",
         "systems",
@@ -185,6 +195,8 @@ __all__ = [
     "DEFAULT_TOL",
     "FingerClosure",
     "Grasp",
+    "GraspCandidate",
+    "GraspCandidates",
     "GraspError",
     "GraspForceResult",
     "GraspFromPlant",
@@ -212,6 +224,7 @@ __all__ = [
     "Scene",
     "SceneError",
     "SecondOrderResult",
+    "ShakeResult",
     "SolverError",
     "SurfaceCurvature",
     "UnreachableError",
@@ -264,11 +277,14 @@ __all__ = [
     "normal_grasp_matrix",
     "normalised_grasp_matrix",
     "object_radius",
+    "plan_grasps",
+    "planning_scene",
     "plot_planar_grasp",
     "plot_wrench_space",
     "primitive_wrenches",
     "register_models",
     "second_order_form_closure",
+    "shake_test",
     "signed_distance_jacobian",
     "uniformity_of_transformation",
     "use_local_drake_models",

@@ -12,6 +12,8 @@ Usage::
                      [--num-generators NG] [--metrics NAME ...] [--progress]
                      [--overwrite]
     drakegrasp warmup [--json]
+    drakegrasp plan [OBJECT] [--hand HAND] [--num N] [--top K] [--seed S]
+                    [--mu M] [--json | --out FILE.parquet]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
@@ -27,6 +29,11 @@ the vectorised batch engine and writes the verdicts to another file.
 ``warmup`` compiles the batch engine's numba kernels now (once per install;
 later processes load them from numba's cache) and prints what it compiled and
 how long each step took.
+
+``plan`` finds grasps: a free-floating parallel-jaw gripper (``--hand``: a
+model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
+jaw) sampled, filtered, closed and ranked on an object (a shipped object's
+name, a model URL or a file; default ``box``), and prints the best ``--top``.
 
 One interface: both commands name the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
@@ -350,6 +357,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
     scenes = sub.add_parser("scenes", help="list the shipped scenes")
     scenes.set_defaults(func=_cmd_scenes)
     _add_batch_parser(sub)
+    _add_plan_parser(sub)
     return parser, sub
 
 
@@ -562,6 +570,105 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
     )
     warm.add_argument("--json", action="store_true", help="print the report as JSON")
     warm.set_defaults(func=_cmd_warmup)
+
+
+PLAN_HANDS = {
+    "flat": "package://drakegrasp/hands/parallel_jaw_flat.sdf",
+    "rounded": "package://drakegrasp/hands/parallel_jaw.sdf",
+    "wsg": "package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf",
+}
+"""``plan --hand`` short names: drakegrasp's two jaws and Drake's WSG-50."""
+
+
+def _plan_url(spec: str, folder: str) -> str:
+    if "://" in spec or spec.endswith((".sdf", ".urdf", ".xml")):
+        return spec
+    return f"package://drakegrasp/{folder}/{spec}.sdf"
+
+
+def _cmd_plan(args: argparse.Namespace) -> int:
+    from drakegrasp.planning import plan_grasps, planning_scene
+
+    if args.out is not None and not args.out.endswith(".parquet"):
+        raise InvalidOptionError(f"--out must name a .parquet file, got {args.out!r}")
+    hand = PLAN_HANDS.get(args.hand, args.hand)
+    scene = planning_scene(_plan_url(args.object, "objects"), hand_url=hand)
+    result = plan_grasps(
+        scene.plant,
+        scene.context,
+        scene.object_body,
+        hand=scene.hand,
+        num_candidates=args.num,
+        mu=args.mu,
+        seed=args.seed,
+        progress=args.progress,
+    )
+    if args.out is not None:
+        _write_plan_parquet(result, args.out)
+    if args.json:
+        data = result.to_dict()
+        data["candidates"] = data["candidates"][: args.top]
+        json.dump(data, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    elif args.out is None:
+        print(result.__str__().split("\n  #")[0])
+        for k, c in enumerate(result[: args.top]):
+            print(f"  #{k:<3} {c}")
+    else:
+        print(f"wrote {len(result)} candidates to {args.out}")
+    return 0
+
+
+def _write_plan_parquet(result, path: str) -> None:
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError as exc:
+        raise InvalidOptionError(
+            "--out FILE.parquet needs pyarrow (pip install pyarrow)"
+        ) from exc
+    columns = {}
+    for name, values in result.table().items():
+        if values.ndim == 1:
+            columns[name] = values
+        else:
+            for j in range(values.shape[1]):
+                columns[f"{name}_{j}"] = values[:, j]
+    pq.write_table(pa.table(columns), path)
+
+
+def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
+    plan = sub.add_parser(
+        "plan",
+        help="find ranked parallel-jaw grasps of an object",
+        description="Sample antipodal grasps of a free parallel-jaw gripper on an "
+        "object's collision geometry, reject colliding poses, close the fingers "
+        "and rank the grasps (force closure, epsilon on one torque scale, "
+        "robustness).",
+    )
+    plan.add_argument(
+        "object",
+        nargs="?",
+        default="box",
+        help="shipped object name (box, cylinder, sphere, hex_prism), a "
+        "package:// URL or a model file (default: box)",
+    )
+    plan.add_argument(
+        "--hand",
+        default="flat",
+        help=f"gripper: {', '.join(PLAN_HANDS)} or a model URL/file (default: flat)",
+    )
+    plan.add_argument("--num", type=int, default=500, help="poses to sample (500)")
+    plan.add_argument("--top", type=int, default=10, help="candidates to print (10)")
+    plan.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    plan.add_argument(
+        "--mu", type=_positive_float, default=0.5, help="friction coefficient (0.5)"
+    )
+    plan.add_argument("--progress", action="store_true", help="show a progress bar")
+    out = plan.add_mutually_exclusive_group()
+    out.add_argument("--json", action="store_true", help="print JSON")
+    out.add_argument("--out", default=None, help="write every candidate to a .parquet")
+    plan.set_defaults(func=_cmd_plan)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -28,7 +28,7 @@ reflection of ``c``: ``y = c/‖c‖² + W u`` with ``W`` (m, m−1) orthonormal
     \qquad A = F Z ,
 
 an LP with ``m`` variables (3 for three spatial hard fingers) and one row per
-facet, solved for all grasps at once by :func:`reference_ipm.solve_max_last`.
+facet, solved for all grasps at once by :func:`drakegrasp.batch.lp.ipm.solve_max_last`.
 It is bounded because every effective cone is pointed (``F f >= 0`` and
 ``e^T f = 0`` force ``f = 0``).  Corner cases: ``m = 0`` (only ``f = 0`` balances)
 and ``c = 0`` (no balanced force pushes) give ``d* = 0``; ``m = 1`` is solved in
@@ -38,10 +38,10 @@ closed form, ``t* = min(A y_0)``.
 from __future__ import annotations
 
 import numpy as np
-from reference_ipm import solve_max_last
 
 from drakegrasp.batch.build.rowspace import _householder, _inverse_frobenius
 from drakegrasp.batch.lp.dstar import MarginSolution
+from drakegrasp.batch.lp.ipm import solve_max_last
 
 __all__ = ["null_spaces", "solve_margin_lp"]
 

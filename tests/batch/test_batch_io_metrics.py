@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from batch_support import make_grasp, random_grasps
-from reference_ipm import solve_max_last
 from reference_lp import null_spaces
 from scipy.optimize import linprog
 
@@ -17,6 +16,7 @@ from drakegrasp.batch.build.construction import (
     contact_kinds,
     kind_facets,
 )
+from drakegrasp.batch.lp.ipm import solve_max_last
 from drakegrasp.core.friction_cone import effective_cone
 from drakegrasp.errors import InvalidOptionError
 

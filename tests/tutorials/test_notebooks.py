@@ -41,6 +41,7 @@ EXPECTED = [
     "06_real_hand.ipynb",
     "07_grasp_in_simulation.ipynb",
     "08_why_not.ipynb",
+    "09_find_grasps.ipynb",
     "10_grasp_under_load.ipynb",
 ]
 # Drake's real hands and YCB objects: read from the sources, so a new tutorial that

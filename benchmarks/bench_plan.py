@@ -1,0 +1,191 @@
+"""Grasp planning: candidates per second, and how often the chosen grasps hold.
+
+Usage::
+
+    python benchmarks/bench_plan.py [--num 1000] [--top 10] [--random 10]
+        [--margin 1.2] [--firm 5] [--mu 1] [--seed 0] [--objects NAME ...]
+        [--no-shake]
+
+For each object (the YCB boxes and can of ``drake_models``, when present, and
+drakegrasp's own box, cylinder, sphere and hexagonal prism), with Drake's
+WSG-50 as a free gripper:
+
+* **planning**: ``plan_grasps`` on ``--num`` sampled poses (one warm-up call
+  first, so numba's compilation is not timed), the wall time, samples/s and
+  candidates/s (candidates are the samples that survive the collision filter
+  and the closing), and the rejections by reason;
+* **the user's loop**: ``--loop`` candidates closed and analysed one at a
+  time with ``close_hand``, ``analyze_grasp`` and ``ferrari_canny`` from the
+  open hand at the candidate's pose (the baseline of issue 18), candidates/s;
+* **hold rates**: :func:`drakegrasp.planning.shake_test` on the ``--top``
+  best candidates and on ``--random`` candidates drawn uniformly (seeded)
+  from all collision-free closed antipodal candidates of the same run (the
+  baseline a planner without ranking would give), as held / tried, at two
+  squeezes per finger: the *predicted* one, ``--margin`` (1.2) times the
+  largest ``squeeze_needed`` the planner gives its top candidates, and a
+  *firm* one, ``--firm`` (5) times the object's weight, at which almost any
+  two-sided grasp holds.  The planner uses ``--mu`` 1.0, the friction
+  coefficient of the models' proximity properties (what the simulation uses).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+
+ROOT = Path(__file__).resolve().parents[1]
+YCB = ("003_cracker_box", "004_sugar_box", "005_tomato_soup_can")
+OWN = ("box", "cylinder", "sphere", "hex_prism")
+
+
+def drake_models() -> Path | None:
+    for p in (
+        os.environ.get("DRAKEGRASP_DRAKE_MODELS"),
+        ROOT.parent / "shared" / "drake_models",
+    ):
+        if p and Path(p).is_dir():
+            return Path(p)
+    return None
+
+
+def object_url(name: str) -> str:
+    if name in YCB:
+        return f"package://drake_models/ycb/{name}.sdf"
+    return f"package://drakegrasp/objects/{name}.sdf"
+
+
+def user_loop(scene, candidates, mu: float) -> float:
+    """Candidates/s of the one-at-a-time loop a user writes without the planner.
+
+    From each candidate's open pre-grasp: ``close_hand``, ``analyze_grasp`` and
+    ``ferrari_canny`` (the issue's baseline), on the same plant.
+    """
+    from drakegrasp import GraspError, analyze_grasp, close_hand, ferrari_canny
+
+    plant = scene.plant
+    ctx = scene.context.Clone()
+    pctx = plant.GetMyContextFromRoot(ctx)
+    base = plant.GetBodyByName(candidates[0].hand_base.rpartition("::")[2])
+    joints = [
+        plant.GetJointByName(n.rpartition("::")[2]) for n in candidates[0].joint_names
+    ]
+    t = time.perf_counter()
+    for c in candidates:
+        plant.SetFreeBodyPose(pctx, base, c.X_WH)
+        for j, sign in zip(joints, c.closing_signs, strict=True):
+            lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
+            j.set_translation(pctx, lo if sign > 0 else hi)  # wide open
+        try:
+            close_hand(plant, ctx, scene.object_body, hand=scene.hand)
+            report = analyze_grasp(
+                plant, ctx, scene.object_body, hand=scene.hand, mu=mu
+            )
+            ferrari_canny(report.grasp)
+        except GraspError:  # timed all the same: the loop pays for it
+            pass
+    return len(candidates) / (time.perf_counter() - t)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--num", type=int, default=1500)
+    ap.add_argument("--top", type=int, default=10)
+    ap.add_argument("--random", type=int, default=10)
+    ap.add_argument(
+        "--firm",
+        type=float,
+        default=5.0,
+        help="the firm squeeze per finger, in multiples of the object's weight",
+    )
+    ap.add_argument(
+        "--margin",
+        type=float,
+        default=1.2,
+        help="the predicted squeeze is this times the largest squeeze_needed "
+        "of the top candidates",
+    )
+    ap.add_argument("--mu", type=float, default=1.0)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--objects", nargs="*", default=None)
+    ap.add_argument("--no-shake", action="store_true")
+    ap.add_argument(
+        "--loop",
+        type=int,
+        default=50,
+        help="candidates run through the user's loop (close_hand, analyze_grasp, "
+        "ferrari_canny one at a time) for comparison; 0 skips it",
+    )
+    args = ap.parse_args(argv)
+    models = drake_models()
+    if models is None:
+        print(
+            "drake_models not found (set DRAKEGRASP_DRAKE_MODELS): the WSG-50 is needed"
+        )
+        return 1
+    names = args.objects or [*YCB, *OWN]
+    print(f"load {os.getloadavg()[0]:.2f}; WSG-50, mu = {args.mu}")
+    print(
+        f"{'object':<20} {'samples/s':>10} {'cands/s':>8} {'cands':>6} {'FC':>5}"
+        f" {'predicted':>9} {'top':>5} {'random':>6}"
+        f" {'firm':>9} {'top':>5} {'random':>6}"
+    )
+    for name in names:
+        scene = planning_scene(object_url(name), models_dir=models)
+        kwargs = dict(hand=scene.hand, mu=args.mu, workers=1)
+        plan_grasps(
+            scene.plant, scene.context, scene.object_body, num_candidates=50, seed=1,
+            **kwargs,
+        )  # fmt: skip
+        t = time.perf_counter()
+        result = plan_grasps(
+            scene.plant, scene.context, scene.object_body, num_candidates=args.num,
+            seed=args.seed, **kwargs,
+        )  # fmt: skip
+        wall = time.perf_counter() - t
+        rng = np.random.default_rng(args.seed)
+        pick = rng.choice(
+            len(result), size=min(args.random, len(result)), replace=False
+        )
+        weight = scene.object_body.default_mass() * 9.81
+        top = list(result[: args.top])
+        rand = [result[int(i)] for i in pick]
+        predicted = args.margin * max((c.squeeze_needed for c in top), default=0.0)
+        cells = ""
+        for q in (predicted, args.firm * weight):
+            if args.no_shake or not top or not np.isfinite(q):
+                cells += f" {'-':>9} {'-':>5} {'-':>6}"
+                continue
+            held = [shake_test(scene.add_models, c, squeeze=q).held for c in top]
+            held_r = [shake_test(scene.add_models, c, squeeze=q).held for c in rand]
+            cells += (
+                f" {q:>8.1f}N {f'{sum(held)}/{len(held)}':>5}"
+                f" {f'{sum(held_r)}/{len(held_r)}':>6}"
+            )
+        fc = sum(c.is_closure for c in result)
+        print(
+            f"{name:<20} {args.num / wall:>10.0f} {len(result) / wall:>8.0f} "
+            f"{len(result):>6} {fc:>5}" + cells,
+            flush=True,
+        )
+        if args.loop and len(result):
+            rate = user_loop(scene, result[: args.loop], args.mu)
+            print(
+                f"    the user's loop: {rate:.0f} candidates/s ({args.loop} candidates)"
+            )
+        reasons = ", ".join(
+            f"{k} {v}"
+            for k, v in sorted(result.rejections.items(), key=lambda kv: -kv[1])
+        )
+        print(f"    rejected: {reasons or 'none'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,57 @@
+"""Finding grasps: candidates from object bodies, filters, ranking, shake test.
+
+:func:`plan_grasps` samples antipodal parallel-jaw grasps on an object's
+collision geometry (:mod:`~drakegrasp.planning.surface`), places the gripper
+whose geometry it learns from the plant (:mod:`~drakegrasp.planning.gripper`),
+rejects colliding poses and closes the fingers with Drake's distance queries
+(:mod:`~drakegrasp.planning.placement`) or on a point cloud
+(:mod:`~drakegrasp.planning.cloud`), and ranks the grasps
+(:mod:`~drakegrasp.planning.ranking`, :mod:`~drakegrasp.planning.weight`);
+the results are :mod:`~drakegrasp.planning.candidates`, and
+:mod:`~drakegrasp.planning.shake` checks them in a Drake simulation.  This
+folder imports the plant, quality, batch and closure layers; nothing inside
+the package imports it except the command line.
+"""
+
+from drakegrasp._lazy import lazy_exports
+
+_SOURCES = {
+    "drakegrasp.planning.candidates": ("GraspCandidate", "GraspCandidates"),
+    "drakegrasp.planning.gripper": ("ParallelJaw", "parallel_jaw"),
+    "drakegrasp.planning.planner": ("REASONS", "object_surface", "plan_grasps"),
+    "drakegrasp.planning.scenes": ("PlanningScene", "planning_scene"),
+    "drakegrasp.planning.shake": ("ShakeResult", "shake_test"),
+    "drakegrasp.planning.surface": ("ObjectSurface",),
+}
+
+_SUBMODULES = (
+    "candidates",
+    "cloud",
+    "gripper",
+    "placement",
+    "planner",
+    "ranking",
+    "scenes",
+    "shake",
+    "surface",
+    "weight",
+)
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
+)
+
+__all__ = [
+    "REASONS",
+    "GraspCandidate",
+    "GraspCandidates",
+    "ObjectSurface",
+    "ParallelJaw",
+    "PlanningScene",
+    "ShakeResult",
+    "object_surface",
+    "parallel_jaw",
+    "plan_grasps",
+    "planning_scene",
+    "shake_test",
+]

@@ -1,0 +1,313 @@
+"""Planned grasps: one candidate, and a ranked sequence of them with rejections.
+
+A :class:`GraspCandidate` is a hand pose (``X_WH``, the free base's pose in the
+world, and ``q_hand``, the closing joints' values) with the contacts the
+closed hand makes and what drakegrasp says about them.  A
+:class:`GraspCandidates` is the ranked result of
+:func:`~drakegrasp.planning.planner.plan_grasps`, best first, with every
+sampled pose accounted for: ``len(candidates) + sum(rejections.values()) ==
+num_sampled``.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from pydrake.math import RigidTransform
+
+from drakegrasp.closure.results import ClosureResult
+from drakegrasp.core.contact import Contact
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.plant.contacts import PlantContact
+from drakegrasp.plant.validation import plant_context_of, resolve_body
+
+__all__ = ["GraspCandidate", "GraspCandidates", "pose_dict"]
+
+
+def pose_dict(X: RigidTransform) -> dict:
+    """A pose as ``{"translation": [3], "rotation": [[3]*3]}`` (JSON-ready)."""
+    return {
+        "translation": X.translation().tolist(),
+        "rotation": X.rotation().matrix().tolist(),
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class GraspCandidate:
+    """One planned grasp.
+
+    Attributes
+    ----------
+    sample : int
+        Index of the sampled pose this candidate came from (stable for a seed).
+    hand_base : str
+        Scoped name ``model::body`` of the hand's free base (frame H).
+    X_WH : RigidTransform
+        Pose of the hand's base frame H in the world.
+    X_WO : RigidTransform
+        Pose of the object's body frame O when the grasp was planned.
+    q_hand : (2,) float
+        Closing joints' values of the closed hand (metres), in the order of
+        ``joint_names``.
+    joint_names : tuple of str
+        Scoped names ``model::joint`` of the closing joints.
+    closing_signs : tuple of float
+        The sign of each joint's motion that closes the gripper (±1).
+    opening : float
+        Pad-to-pad width of the pre-grasp (open) hand, metres.
+    contacts : tuple of PlantContact
+        Contacts of the closed hand (object frame O).
+    contact_options : dict
+        ``mu``, ``model`` and ``torsional_friction`` of the contacts.
+    is_closure : bool
+        Frictional force closure on the polyhedral cones (LP2).
+    d_star : float
+        LP2's ``d*`` (dimensionless).
+    rank : int
+        Rank of ``G`` over the contacts' force components.
+    epsilon : float
+        Ferrari–Canny L1 ε with the object's torque scale (see
+        ``GraspCandidates.torque_scale``).
+    robustness : float
+        Fraction of perturbed copies of the grasp that stay force closure.
+    score : float
+        ``robustness * weight_capacity``; 0 when no weight capacity was
+        computed (see :mod:`~drakegrasp.planning.ranking`).
+    weight_capacity : float
+        Newtons of the object's weight held per newton of squeeze on each
+        finger, in the worst of the directions of
+        :data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS` (at ``mu``); NaN
+        when not computed.
+    squeeze_needed : float
+        The squeeze per finger (N) that holds the object's weight in all those
+        directions, ``m g / weight_capacity`` (inf: none does; NaN: not
+        computed).  A lower bound: the LP shares each finger's force among its
+        contacts at will, while a rigid pad shares it as its geometry and
+        compliance dictate (in the shake test, grasps of cylinders with two
+        tip spheres per finger needed up to twice this).
+    closure : ClosureResult or None
+        The single-grasp verdict with its certificate (witness), for the top
+        candidates (``certify`` of ``plan_grasps``); None for the rest.
+    """
+
+    sample: int
+    hand_base: str
+    X_WH: RigidTransform
+    X_WO: RigidTransform
+    q_hand: np.ndarray
+    joint_names: tuple[str, ...]
+    closing_signs: tuple[float, ...]
+    opening: float
+    contacts: tuple[PlantContact, ...]
+    contact_options: dict
+    is_closure: bool
+    d_star: float
+    rank: int
+    epsilon: float
+    robustness: float
+    score: float
+    weight_capacity: float = float("nan")
+    squeeze_needed: float = float("nan")
+    closure: ClosureResult | None = None
+
+    @cached_property
+    def grasp(self) -> Grasp:
+        """The core grasp of the contacts (frame O, moments about O's origin).
+
+        Built on first access (thousands of candidates rarely need it).
+        """
+        return Grasp(
+            [Contact(c.p_OC, c.nhat_O, **self.contact_options) for c in self.contacts]
+        )
+
+    @property
+    def num_contacts(self) -> int:
+        """Number of contacts."""
+        return len(self.contacts)
+
+    def apply(self, plant, context, *, object_body=None) -> None:
+        """Put the candidate's hand pose (and the planned object pose) in a context.
+
+        Parameters
+        ----------
+        plant : MultibodyPlant
+            The plant the candidate was planned in (or one with the same hand;
+            a hand base welded there is left where the weld puts it).
+        context : Context
+            The plant's context or its diagram's root context; changed.
+        object_body : RigidBody, optional
+            When given (and free), set to the planned pose ``X_WO`` too.
+        """
+        ctx = plant_context_of(plant, context)
+        joints = [_joint(plant, n) for n in self.joint_names]
+        base = resolve_body(plant, self.hand_base)
+        if base.is_floating_base_body():  # else welded (at X_WH, the caller's word)
+            plant.SetFreeBodyPose(ctx, base, self.X_WH)
+        for j, q in zip(joints, self.q_hand, strict=True):
+            j.set_translation(ctx, float(q))
+        if object_body is not None and object_body.is_floating_base_body():
+            plant.SetFreeBodyPose(ctx, object_body, self.X_WO)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {
+            "sample": self.sample,
+            "hand_base": self.hand_base,
+            "X_WH": pose_dict(self.X_WH),
+            "X_WO": pose_dict(self.X_WO),
+            "q_hand": jsonable(self.q_hand),
+            "joint_names": list(self.joint_names),
+            "opening": self.opening,
+            "num_contacts": self.num_contacts,
+            "contacts": [
+                {
+                    "finger_body": c.finger_body,
+                    "p_OC": jsonable(c.p_OC),
+                    "nhat_O": jsonable(c.nhat_O),
+                    "psi": c.psi,
+                }
+                for c in self.contacts
+            ],
+            "is_closure": bool(self.is_closure),
+            "d_star": jsonable(self.d_star),
+            "rank": int(self.rank),
+            "epsilon": jsonable(self.epsilon),
+            "robustness": jsonable(self.robustness),
+            "score": jsonable(self.score),
+            "weight_capacity": jsonable(self.weight_capacity),
+            "squeeze_needed": jsonable(self.squeeze_needed),
+            "closure": None if self.closure is None else self.closure.to_dict(),
+        }
+
+    def __str__(self) -> str:
+        p = self.X_WH.translation() * 1e3
+        return (
+            f"sample {self.sample}: "
+            f"{'force closure' if self.is_closure else 'no closure'}"
+            f", {self.num_contacts} contacts, eps = {self.epsilon:.4f}, robustness "
+            f"{self.robustness:.2f}, holds {self.weight_capacity:.3f} N/N "
+            f"(squeeze {self.squeeze_needed:.1f} N), score {self.score:.4f}; opening "
+            f"{self.opening * 1e3:.1f} mm, "
+            f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
+        )
+
+
+def _joint(plant, name: str):
+    model, _, joint = name.rpartition("::")
+    if model:
+        return plant.GetJointByName(joint, plant.GetModelInstanceByName(model))
+    return plant.GetJointByName(joint)
+
+
+@dataclass(frozen=True, eq=False)
+class GraspCandidates(Sequence):
+    """Ranked planned grasps, best first, and why the other samples were dropped.
+
+    Attributes
+    ----------
+    candidates : tuple of GraspCandidate
+        Best first (highest score, then ``ε × robustness``, ``d*`` and the
+        sample index).
+    rejections : dict of str to int
+        Sampled poses dropped, by reason.
+    num_sampled : int
+        Poses sampled: ``len(self) + sum(rejections.values())``.
+    object_body : str
+        Scoped name of the object body (frame O).
+    mu : float
+        Friction coefficient of the verdicts.
+    torque_scale : float
+        Length (m) dividing moments in ε: the radius of a ball about O's
+        origin that holds the object, the same for every candidate.
+    reason : str
+        Why the result is empty (empty string otherwise).
+    settings : dict
+        The options of the run (noise, seed, tolerances), for the record.
+    time : float
+        Wall-clock seconds.
+    """
+
+    candidates: tuple[GraspCandidate, ...]
+    rejections: dict[str, int]
+    num_sampled: int
+    object_body: str
+    mu: float
+    torque_scale: float
+    reason: str = ""
+    settings: dict = field(default_factory=dict)
+    time: float = 0.0
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return self.candidates[index]
+        return self.candidates[index]
+
+    def __len__(self) -> int:
+        return len(self.candidates)
+
+    @property
+    def closure_rate(self) -> float:
+        """Fraction of the returned candidates that are force closure."""
+        if not self.candidates:
+            return 0.0
+        return float(np.mean([c.is_closure for c in self.candidates]))
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {
+            "object_body": self.object_body,
+            "mu": self.mu,
+            "torque_scale": self.torque_scale,
+            "num_sampled": self.num_sampled,
+            "rejections": dict(self.rejections),
+            "reason": self.reason,
+            "settings": jsonable(self.settings),
+            "time": self.time,
+            "candidates": [c.to_dict() for c in self.candidates],
+        }
+
+    def to_json(self, **kwargs) -> str:
+        """``json.dumps(self.to_dict())``."""
+        return json.dumps(self.to_dict(), **kwargs)
+
+    def table(self) -> dict[str, np.ndarray]:
+        """One row per candidate (columns of equal length), for Parquet or pandas."""
+        rows = self.candidates
+        return {
+            "rank_in_result": np.arange(len(rows)),
+            "sample": np.array([c.sample for c in rows], dtype=np.int64),
+            "score": np.array([c.score for c in rows]),
+            "weight_capacity": np.array([c.weight_capacity for c in rows]),
+            "squeeze_needed": np.array([c.squeeze_needed for c in rows]),
+            "epsilon": np.array([c.epsilon for c in rows]),
+            "robustness": np.array([c.robustness for c in rows]),
+            "is_closure": np.array([c.is_closure for c in rows], dtype=bool),
+            "d_star": np.array([c.d_star for c in rows]),
+            "num_contacts": np.array([c.num_contacts for c in rows], dtype=np.int64),
+            "opening": np.array([c.opening for c in rows]),
+            "p_WH": np.array([c.X_WH.translation() for c in rows]).reshape(-1, 3),
+            "R_WH": np.array([c.X_WH.rotation().matrix() for c in rows]).reshape(-1, 9),
+            "q_hand": np.array([c.q_hand for c in rows]).reshape(len(rows), -1),
+        }
+
+    def __str__(self) -> str:
+        head = (
+            f"{len(self)} grasp candidates of {self.object_body} from "
+            f"{self.num_sampled} samples ({self.time:.2f} s), mu = {self.mu:g}, "
+            f"torque scale {self.torque_scale * 1e3:.1f} mm"
+        )
+        lines = [head]
+        if self.reason:
+            lines.append(f"  empty: {self.reason}")
+        for reason, n in sorted(self.rejections.items(), key=lambda kv: -kv[1]):
+            lines.append(f"  rejected {n:>6}  {reason}")
+        for k, c in enumerate(self.candidates[:10]):
+            lines.append(f"  #{k:<3} {c}")
+        if len(self) > 10:
+            lines.append(f"  ... {len(self) - 10} more")
+        return "\n".join(lines)

@@ -1,0 +1,486 @@
+r"""Planning on a point cloud: the object is points with normals, not a body.
+
+The perception route: the plant holds the gripper and the surroundings, and
+the object is a cloud, a pydrake ``PointCloud`` or an ``(M, 3)`` array in the
+world frame, with normals given or estimated as Drake does
+(``PointCloud.EstimateNormals``) and turned outwards (away from the cloud's
+centroid, or towards a ``viewpoint``: the camera, for a one-sided cloud).
+Points that are not finite (Drake marks missing depth with NaN) are dropped.
+
+**Frame O** of a cloud is the world frame moved to the cloud's centroid
+(moments about the centroid, the best guess of the centre of mass).
+
+**Chords.**  A grasp line through a sampled point ``p`` along its inward normal
+``d`` (with a ``viewpoint``, the inward normal turned across the line of sight,
+and the approach drawn from the camera's side: the seen side of a one-sided
+cloud) gathers the cloud points within ``line_radius`` of it; the farthest of
+them along ``d`` is the opposite contact (none: ``"no opposite surface"``, as
+on the unseen side of a one-sided cloud), and a point clearly before ``p``
+(more than ``line_radius``) occludes it.
+
+**Hand and cloud.**  The gripper's collision shapes are the convex pieces of
+:mod:`drakegrasp.planning.surface`.  A pose whose open hand has a cloud point
+deeper than the distance tolerance inside any hand shape collides.  Each
+finger closes along the grasp axis by the smallest travel at which one of its
+shapes reaches a cloud point (a point moving against the closing direction
+enters a convex piece at its chord's entry; a spherical fingertip, often smaller
+than the cloud's spacing, meets the points that pass within ``line_radius`` of
+it), and its contacts are the points
+its shapes touch within ``band``: the nearest point for a sphere (a fingertip),
+the corners of the touched set's convex hull across the axis for a flat pad.
+The contact normals are the cloud's.
+
+**The unseen side.**  With a ``viewpoint``, space behind the seen surface
+(along the camera's rays) may hold the object: a hand whose shapes reach there
+(probe points on their surfaces) is rejected, open and closed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import ConvexHull, cKDTree
+
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.planning.gripper import ParallelJaw
+from drakegrasp.planning.surface import piece_of_shape
+from drakegrasp.plant.validation import scoped_name
+
+__all__ = [
+    "CONTACT_BAND",
+    "LINE_RADIUS_SPACINGS",
+    "CloudContact",
+    "CloudFingers",
+    "CloudSurface",
+    "read_cloud",
+]
+
+CONTACT_BAND = 1e-3
+"""A finger shape touches the cloud points within this travel (m) of its first."""
+
+NORMAL_RADIUS = 0.01
+"""Radius (m) of the neighbourhood of Drake's normal estimate."""
+
+NORMAL_NEIGHBOURS = 30
+"""Most neighbours of Drake's normal estimate."""
+
+LINE_RADIUS_SPACINGS = 2.5
+"""Default line radius in median nearest-neighbour spacings: a disc of that
+radius on a randomly sampled surface holds about six points, so a far side
+that is there is found (at 1.5 spacings one line in five found none)."""
+
+SHADOW_PROBES = 64
+"""Surface points per hand shape tested against a one-sided cloud's shadow."""
+
+_CHUNK = 64
+"""Sampled lines processed at once (memory: chunk × points × 3 floats)."""
+
+
+@dataclass(frozen=True, eq=False)
+class CloudContact:
+    """A contact between a finger shape and a cloud point.
+
+    Attributes
+    ----------
+    p_OC : (3,) float
+        The cloud point, metres, frame O (the cloud's centroid frame).
+    nhat_O : (3,) float
+        Inward unit normal (the cloud's normal, negated).
+    psi : float
+        Gap left between the shape and the point along the closing direction, m.
+    finger_body : str
+        Scoped name of the finger body.
+    """
+
+    p_OC: np.ndarray
+    nhat_O: np.ndarray
+    psi: float
+    finger_body: str
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {
+            "p_OC": self.p_OC.tolist(),
+            "nhat_O": self.nhat_O.tolist(),
+            "psi": self.psi,
+            "finger_body": self.finger_body,
+        }
+
+
+def read_cloud(point_cloud, normals=None, *, viewpoint=None):
+    """Points and outward unit normals of a cloud, world frame, finite only.
+
+    Parameters
+    ----------
+    point_cloud : pydrake.perception.PointCloud or (M, 3) array
+    normals : (M, 3) array, optional
+        Overrides the cloud's; estimated when neither gives them.
+    viewpoint : (3,) array, optional
+        Normals are turned towards it (the camera); default away from the
+        centroid.
+
+    Returns
+    -------
+    points, normals : (M', 3) float
+    dropped : int
+        Points left out (not finite, or no normal could be estimated).
+
+    Raises
+    ------
+    InvalidOptionError
+        An empty cloud, one with no finite point, or malformed arrays.
+    """
+    from pydrake.perception import BaseField, Fields, PointCloud
+
+    if isinstance(point_cloud, PointCloud):
+        points = np.asarray(point_cloud.xyzs(), float).T.copy()
+        if normals is None and point_cloud.has_normals():
+            normals = np.asarray(point_cloud.normals(), float).T.copy()
+    else:
+        points = np.asarray(point_cloud, dtype=float)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise InvalidOptionError(
+            f"point_cloud must be a PointCloud or an (M, 3) array, got shape "
+            f"{points.shape}"
+        )
+    if normals is not None:
+        normals = np.asarray(normals, dtype=float)
+        if normals.shape != points.shape:
+            raise InvalidOptionError(
+                f"normals must have the cloud's shape {points.shape}, got "
+                f"{normals.shape}"
+            )
+    if len(points) == 0:
+        raise InvalidOptionError("point_cloud is empty: there is nothing to grasp")
+    total = len(points)
+    finite = np.all(np.isfinite(points), axis=1)
+    if normals is not None:
+        finite &= np.all(np.isfinite(normals), axis=1)
+    points = points[finite]
+    normals = None if normals is None else normals[finite]
+    if len(points) < 3:
+        raise InvalidOptionError(
+            f"point_cloud has {len(points)} finite points of {total}: too few to "
+            "grasp (NaN marks missing points)"
+        )
+    if normals is None:
+        cloud = PointCloud(len(points), Fields(BaseField.kXYZs | BaseField.kNormals))
+        cloud.mutable_xyzs()[:] = points.T
+        cloud.EstimateNormals(NORMAL_RADIUS, NORMAL_NEIGHBOURS, parallelize=False)
+        normals = np.asarray(cloud.normals(), float).T.copy()
+        ok = np.all(np.isfinite(normals), axis=1)
+        points, normals = points[ok], normals[ok]
+    norm = np.linalg.norm(normals, axis=1)
+    ok = norm > 0
+    points, normals = points[ok], normals[ok] / norm[ok, None]
+    towards = (
+        points - points.mean(axis=0)
+        if viewpoint is None
+        else np.asarray(viewpoint, float) - points
+    )
+    flip = np.sum(normals * towards, axis=1) < 0
+    normals[flip] *= -1
+    return points, normals, total - len(points)
+
+
+class CloudSurface:
+    """A cloud in its centroid frame O, sampled and cut by lines.
+
+    The sample/chord interface of
+    :class:`~drakegrasp.planning.surface.ObjectSurface`.
+
+    Parameters
+    ----------
+    points, normals : (M, 3) float
+        World frame, outward unit normals.
+    line_radius : float, optional
+        Points this close (m) to a grasp line are on it; default
+        :data:`LINE_RADIUS_SPACINGS` times the median distance from a point to
+        its nearest neighbour, at least 1 mm.
+    """
+
+    def __init__(self, points, normals, line_radius=None, viewpoint=None):
+        self.centroid = points.mean(axis=0)
+        self.points = points - self.centroid
+        self.normals = normals
+        self.viewpoint = (
+            None if viewpoint is None else np.asarray(viewpoint, float) - self.centroid
+        )
+        gaps = cKDTree(self.points).query(self.points, k=2)[0][:, 1]
+        self.spacing = float(np.median(gaps))
+        if line_radius is None:
+            line_radius = max(LINE_RADIUS_SPACINGS * self.spacing, 1e-3)
+        self.line_radius = float(line_radius)
+
+    def sample(self, n: int, rng: np.random.Generator):
+        """``n`` cloud points (with replacement), their normals and indices."""
+        idx = rng.integers(len(self.points), size=n)
+        return self.points[idx], self.normals[idx], idx
+
+    def _views(self, p_O: np.ndarray) -> np.ndarray:
+        v = self.viewpoint[None, :] - p_O
+        return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+    def axes(self, p_O: np.ndarray, nout_O: np.ndarray) -> np.ndarray:
+        """Grasp axes: the inward normals, across the line of sight with a view.
+
+        A one-sided cloud shows no far side along an inward normal; across the
+        line of sight the axis meets the cloud again on the seen side (for a
+        convex object), so with a viewpoint the axis is the inward normal with
+        its component along the line of sight removed.
+        """
+        if self.viewpoint is None:
+            return -nout_O
+        v = self._views(p_O)
+        d = -nout_O + np.sum(nout_O * v, axis=1, keepdims=True) * v
+        norm = np.linalg.norm(d, axis=1, keepdims=True)
+        return np.where(norm > 1e-9, d / np.where(norm > 0, norm, 1.0), -nout_O)
+
+    def approach_hint(self, p_O: np.ndarray, d_O: np.ndarray):
+        """With a viewpoint, approach from the camera (the seen side); else None."""
+        if self.viewpoint is None:
+            return None
+        v = -self._views(p_O)
+        return v - np.sum(v * d_O, axis=1, keepdims=True) * d_O
+
+    def chord(self, p_O: np.ndarray, d_O: np.ndarray):
+        """Entry (0, or negative when occluded), exit and exit normal of lines."""
+        K = len(p_O)
+        t_in = np.zeros(K)
+        t_out = np.full(K, np.nan)
+        n_out = np.zeros((K, 3))
+        rho = self.line_radius
+        for s in range(0, K, _CHUNK):
+            v = self.points[None, :, :] - p_O[s : s + _CHUNK, None, :]  # (k, M, 3)
+            t = np.einsum("kmi,ki->km", v, d_O[s : s + _CHUNK])
+            perp = np.linalg.norm(
+                v - t[..., None] * d_O[s : s + _CHUNK, None, :], axis=2
+            )
+            near = perp <= rho
+            before = np.where(near & (t < -rho), t, 0.0).min(axis=1)
+            after = np.where(near & (t > rho), t, -np.inf)
+            j = np.argmax(after, axis=1)
+            best = after[np.arange(len(j)), j]
+            t_in[s : s + _CHUNK] = before
+            t_out[s : s + _CHUNK] = np.where(np.isfinite(best), best, np.nan)
+            n_out[s : s + _CHUNK] = self.normals[j]
+        return t_in, t_out, n_out
+
+    def radius_about(self, p_O) -> float:
+        """Largest distance of a point from ``p_O``, metres."""
+        return float(np.max(np.linalg.norm(self.points - np.asarray(p_O), axis=1)))
+
+
+def _depth_inside(piece, q_G: np.ndarray) -> np.ndarray:
+    """How deep points lie inside a piece (negative outside), frame G.
+
+    The smallest distance to the boundary along ±x, ±y, ±z: exact for a box,
+    an upper bound of the true depth otherwise (so a point deeper than a
+    tolerance is always caught).
+    """
+    depth = np.full(len(q_G), np.inf)
+    for axis in np.eye(3):
+        t_in, t_out, _ = piece.chord(q_G, np.tile(axis, (len(q_G), 1)))
+        inside = (t_in <= 0) & (t_out >= 0)
+        depth = np.minimum(depth, np.where(inside, np.minimum(-t_in, t_out), -1.0))
+    return depth
+
+
+class CloudFingers:
+    """Stages 2 and 3 on a cloud: hand-cloud collisions, closing, contacts.
+
+    Parameters
+    ----------
+    plant, ctx : MultibodyPlant, Context
+        The plant (hand and surroundings) and its own context (scratch).
+    gripper : ParallelJaw
+    hand_bodies : sequence of RigidBody
+        Every body of the hand's model instance (palm included).
+    surface : CloudSurface
+    tol : float
+        Distance tolerance, metres.
+    band : float
+        Contact band, metres (:data:`CONTACT_BAND`).
+    """
+
+    def __init__(
+        self, plant, ctx, gripper: ParallelJaw, hand_bodies, surface, tol, band
+    ):
+        self.plant, self.ctx, self.g = plant, ctx, gripper
+        self.surface, self.tol, self.band = surface, tol, band
+        self.points_W = surface.points + surface.centroid
+        self.tree = cKDTree(self.points_W)
+        inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
+
+        def pieces_of(body):
+            return [
+                piece_of_shape(
+                    inspector.GetShape(g),
+                    inspector.GetPoseInFrame(g),
+                    inspector.GetName(g),
+                )
+                for g in plant.GetCollisionGeometriesForBody(body)
+            ]
+
+        self.hand = [(b, pieces_of(b)) for b in hand_bodies]
+        rng = np.random.default_rng(0)  # fixed: the same probe points every call
+        self.probes = [
+            (b, piece, piece.sample(SHADOW_PROBES, rng)[0])
+            for b, pieces in self.hand
+            for piece in pieces
+            if piece.area > 0
+        ]
+        self.fingers = [
+            [(b, pieces_of(b)) for b in bodies] for bodies in gripper.finger_bodies
+        ]
+        self.names = [
+            [scoped_name(plant, b) for b in bodies] for bodies in gripper.finger_bodies
+        ]
+
+    def _world(self, body, piece):
+        X_WG = self.plant.EvalBodyPoseInWorld(self.ctx, body) @ piece.X_OG
+        return X_WG.rotation().matrix(), X_WG.translation()
+
+    def _near(self, centre, radius) -> np.ndarray:
+        return np.asarray(self.tree.query_ball_point(centre, radius), dtype=int)
+
+    def collides(self) -> bool:
+        """Whether a cloud point lies deeper than ``tol`` inside a hand shape."""
+        for body, pieces in self.hand:
+            for piece in pieces:
+                R, p = self._world(body, piece)
+                idx = self._near(p, piece.radius_about(piece.X_OG.translation()))
+                if len(idx) and np.any(
+                    _depth_inside(piece, (self.points_W[idx] - p) @ R) > self.tol
+                ):
+                    return True
+        return False
+
+    def in_shadow(self) -> bool:
+        """Whether the hand reaches into the unseen side of a one-sided cloud.
+
+        With a viewpoint, space behind the seen surface (farther along a ray
+        from the camera than a cloud point within one spacing of the ray) may
+        be the object's: a probe point of a hand shape deeper there than two
+        spacings plus the distance tolerance collides with it (the margin
+        keeps a fingertip that grazes the seen surface clear).
+        """
+        view = self.surface.viewpoint
+        if view is None:
+            return False
+        camera = view + self.surface.centroid
+        rho = self.surface.spacing
+        for body, piece, probes_G in self.probes:
+            R, p = self._world(body, piece)
+            h = probes_G @ R.T + p - camera  # (P, 3) from the camera
+            dist = np.linalg.norm(h, axis=1)
+            u = h / dist[:, None]
+            idx = self._near(p, piece.radius_about(piece.X_OG.translation()) + rho)
+            if not len(idx):
+                continue
+            q = self.points_W[idx] - camera  # (Q, 3)
+            along = u @ q.T  # (P, Q)
+            perp2 = np.sum(q * q, axis=1)[None, :] - along**2
+            shadowed = (perp2 <= rho * rho) & (
+                along < dist[:, None] - self.tol - 2 * rho
+            )
+            if np.any(shadowed):
+                return True
+        return False
+
+    def close(self, X_WH, q_open):
+        """Travel of each finger to the cloud: (q, hits per finger, reason)."""
+        g = self.g
+        a_W = (X_WH.rotation() @ g.X_HK.rotation()).matrix()[:, 0].copy()
+        toward = np.array([1.0, -1.0])
+        closed_limit = np.where(toward / g.pad_rate > 0, g.upper, g.lower)
+        reach = np.abs((closed_limit - q_open) * g.pad_rate)
+        travel = np.full(2, np.inf)
+        hits = [[], []]
+        for f in (0, 1):
+            c_W = toward[f] * a_W
+            for body, pieces in self.fingers[f]:
+                for piece in pieces:
+                    R, p = self._world(body, piece)
+                    r = piece.radius_about(piece.X_OG.translation())
+                    idx = self._near(p + 0.5 * reach[f] * c_W, r + 0.5 * reach[f])
+                    if not len(idx):
+                        continue
+                    q_G = (self.points_W[idx] - p) @ R
+                    t_in = self._entry(piece, q_G, -c_W @ R)
+                    ok = np.isfinite(t_in) & (t_in >= -self.tol) & (t_in <= reach[f])
+                    if np.any(ok):
+                        hits[f].append((body, piece, idx[ok], t_in[ok], c_W))
+                        travel[f] = min(travel[f], float(t_in[ok].min()))
+        if not np.all(np.isfinite(travel)):
+            return None, None, "finger misses the object"
+        step = np.maximum(travel - 0.5 * self.tol, 0.0)
+        q = q_open + toward * step / g.pad_rate
+        return q, (travel, hits), None
+
+    def _entry(self, piece, q_G, u_G) -> np.ndarray:
+        """Travel at which each point, moving along ``u_G``, meets the piece.
+
+        A sphere (a fingertip, often smaller than the cloud's spacing) meets a
+        point that passes within ``line_radius`` of its surface: the cloud's
+        surface runs between its points, so the tip meets it where the point's
+        lateral offset ``δ`` allows, at ``s − sqrt(max(r² − δ², 0))`` (``s`` the
+        travel to the centre's closest approach); other shapes meet a point
+        where it enters them (the chord's entry).
+        """
+        if piece.kind == "ellipsoid" and np.ptp(piece.semi_axes) == 0:
+            r = piece.semi_axes[0]
+            s = -(q_G @ u_G)  # centre at the origin; the point moves along u
+            delta = np.linalg.norm(q_G + s[:, None] * u_G, axis=1)
+            reach = delta <= r + self.surface.line_radius
+            t = s - np.sqrt(np.maximum(r * r - delta * delta, 0.0))
+            return np.where(reach, t, np.nan)
+        return piece.chord(q_G, np.tile(u_G, (len(q_G), 1)))[0]
+
+    def contacts(self, travel_hits) -> list[CloudContact] | None:
+        """The cloud points each finger touches (None unless both fingers do)."""
+        travel, hits = travel_hits
+        out = []
+        for f in (0, 1):
+            mine = []
+            for body, piece, idx, t_in, c_W in hits[f]:
+                close = t_in <= travel[f] + self.band
+                if not np.any(close):
+                    continue
+                idx, t_in = idx[close], t_in[close]
+                if piece.kind == "ellipsoid":  # a fingertip: its nearest point
+                    keep = [int(np.argmin(t_in))]
+                else:  # a pad: the corners of what it touches
+                    keep = _hull_corners(self.points_W[idx], c_W)
+                name = scoped_name(self.plant, body)
+                for k in keep:
+                    i = idx[k]
+                    mine.append(
+                        CloudContact(
+                            p_OC=self.surface.points[i].copy(),
+                            nhat_O=-self.surface.normals[i],
+                            psi=float(t_in[k] - travel[f] + 0.5 * self.tol),
+                            finger_body=name,
+                        )
+                    )
+            if not mine:
+                return None
+            out += mine
+        return out
+
+
+def _hull_corners(points: np.ndarray, axis: np.ndarray) -> list[int]:
+    """Indices of the corners of the points' convex hull across ``axis``."""
+    if len(points) <= 2:
+        return list(range(len(points)))
+    helper = np.eye(3)[int(np.argmin(np.abs(axis)))]
+    u = np.cross(axis, helper)
+    u /= np.linalg.norm(u)
+    w = np.cross(axis, u)
+    flat = np.column_stack([points @ u, points @ w])
+    try:
+        return [int(i) for i in ConvexHull(flat).vertices]
+    except Exception:  # noqa: BLE001 - collinear or repeated points (Qhull refuses)
+        order = np.argsort(flat[:, 0] + 1e-3 * flat[:, 1])
+        return [int(order[0]), int(order[-1])]

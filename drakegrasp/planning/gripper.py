@@ -1,0 +1,292 @@
+"""A parallel-jaw gripper's geometry, learnt from the plant that holds it.
+
+Nothing here is a constant of one gripper: the grasp axis, the opening, the
+pads and the approach direction are read from the hand's joints and collision
+geometry (the WSG-50 of ``drake_models``, drakegrasp's ``parallel_jaw``, or a
+user's model).
+
+**The hand.**  Its base ``H`` is a free body (a floating gripper): a planner
+places it by setting its pose ``X_WH``.  Its fingers are those of
+:mod:`drakegrasp.plant.fingers`; a parallel jaw has two, each driven by one
+prismatic joint, the two joints' axes parallel.
+
+**The grasp frame K** (fixed in ``H``): its x axis is the *grasp axis* ``a``,
+from finger 0's pad towards finger 1's; its y axis the *approach* direction,
+from the palm's collision geometry towards the pads, perpendicular to ``a``;
+its origin halfway between the pads at the open stroke and at the pads'
+lateral centre.
+
+**Pads.**  A finger's pad is the part of its collision geometry that faces the
+other finger: the geometries whose support along the closing direction is
+within :data:`PAD_DEPTH` of the innermost one (the WSG's four 1 mm tip
+spheres, a flat pad, a rounded dome).  The pad's coordinate along ``a`` is
+affine in its joint's value (a prismatic joint), which gives the opening
+``w(q) = c_1(q_1) − c_0(q_0)`` and its inverse.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import Joint, RigidBody
+
+from drakegrasp.errors import ModelError
+from drakegrasp.planning.surface import piece_of_shape
+from drakegrasp.plant.fingers import hand_structure
+from drakegrasp.plant.validation import HandSpec, hand_bodies, scoped_name
+
+__all__ = ["PAD_DEPTH", "ParallelJaw", "parallel_jaw"]
+
+PAD_DEPTH = 5e-4
+"""Geometries this close (m) to a finger's innermost support make its pad."""
+
+_LATERAL_MIN = 1e-3
+"""The pads' centre must lie this far (m) from the palm's across the axis."""
+
+
+@dataclass(frozen=True, eq=False)
+class ParallelJaw:
+    """Geometry of a two-finger prismatic gripper, in its base frame H.
+
+    Attributes
+    ----------
+    base : RigidBody
+        The hand's free base body (frame H).
+    joints : tuple of Joint
+        Finger 0's and finger 1's prismatic joints.
+    finger_bodies : tuple of tuple of RigidBody
+        Each finger's bodies.
+    position_indices : (2,) int
+        The joints' indices in the plant's ``q``.
+    lower, upper : (2,) float
+        Joint limits, metres.
+    X_HK : RigidTransform
+        The grasp frame K in H (see the module docstring).
+    pad_at_zero, pad_rate : (2,) float
+        Finger ``f``'s pad sits at ``x_K = pad_at_zero[f] + pad_rate[f] q_f``
+        (metres along the grasp axis).
+    pad_geometries : tuple of tuple of GeometryId
+        Each finger's pad geometries.
+    min_opening, max_opening : float
+        The symmetric opening's range over the joint limits, metres.
+    """
+
+    base: RigidBody
+    joints: tuple[Joint, Joint]
+    finger_bodies: tuple[tuple[RigidBody, ...], tuple[RigidBody, ...]]
+    position_indices: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    X_HK: RigidTransform
+    pad_at_zero: np.ndarray
+    pad_rate: np.ndarray
+    pad_geometries: tuple
+    min_opening: float
+    max_opening: float
+
+    def q_for_opening(self, width) -> np.ndarray:
+        """(…, 2) joint values that put the pads at ``x_K = ∓ width / 2``."""
+        w = np.asarray(width, dtype=float)[..., None]
+        target = np.concatenate([-w / 2, w / 2], axis=-1)
+        return (target - self.pad_at_zero) / self.pad_rate
+
+    def opening(self, q) -> np.ndarray:
+        """The distance between the pads at joint values ``q`` (…, 2), metres."""
+        x = self.pad_at_zero + self.pad_rate * np.asarray(q, dtype=float)
+        return x[..., 1] - x[..., 0]
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary."""
+        return {
+            "base": self.base.name(),
+            "joints": [j.name() for j in self.joints],
+            "grasp_axis_H": self.X_HK.rotation().matrix()[:, 0].tolist(),
+            "approach_H": self.X_HK.rotation().matrix()[:, 1].tolist(),
+            "p_HK": self.X_HK.translation().tolist(),
+            "min_opening": self.min_opening,
+            "max_opening": self.max_opening,
+        }
+
+
+def _free_base(plant: MultibodyPlant, bodies) -> RigidBody:
+    free = [b for b in bodies if b.is_floating_base_body()]
+    if len(free) != 1:
+        raise ModelError(
+            "the hand's base must be one free body (a floating gripper placed by "
+            "its pose X_WH); the hand's bodies "
+            f"{[scoped_name(plant, b) for b in bodies]} "
+            f"have {len(free)} free bodies: add the hand without welding it"
+        )
+    return free[0]
+
+
+def _finger_supports(plant, ctx, inspector, finger, base, a_H, sign):
+    """Innermost support along ``sign·a`` of each collision geometry of a finger.
+
+    Returns (geometry ids, supports (G,), p_HG (G, 3)).
+    """
+    H = base.body_frame()
+    ids, supports, centres = [], [], []
+    for body in finger.bodies:
+        X_HB = plant.CalcRelativeTransform(ctx, H, body.body_frame())
+        for g in plant.GetCollisionGeometriesForBody(body):
+            X_HG = X_HB @ inspector.GetPoseInFrame(g)
+            piece = piece_of_shape(inspector.GetShape(g), X_HG, inspector.GetName(g))
+            u_G = X_HG.rotation().inverse().multiply(sign * a_H)
+            ids.append(g)
+            supports.append(sign * (X_HG.translation() @ a_H) + piece.support(u_G))
+            centres.append(X_HG.translation())
+    if not ids:
+        raise ModelError(f"finger {finger.name} has no collision geometry")
+    return ids, np.array(supports), np.array(centres)
+
+
+def parallel_jaw(
+    plant: MultibodyPlant, plant_context, object_body: RigidBody, hand: HandSpec
+) -> ParallelJaw:
+    """Learn a parallel-jaw gripper's geometry from the plant.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized, registered with a ``SceneGraph``.
+    plant_context : Context
+        The plant's context (for the scene graph's inspector; not changed).
+    object_body : RigidBody
+        The object (the fingers' pairs are read against it).
+    hand : HandSpec
+        The hand (see :func:`~drakegrasp.plant.validation.hand_bodies`).
+
+    Raises
+    ------
+    ModelError
+        A hand without a free base, without two prismatic fingers with parallel
+        axes and finite limits, or whose pads cannot be told from its palm.
+    """
+    base, fingers, joints = _two_prismatic_fingers(
+        plant, plant_context, object_body, hand
+    )
+    inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
+    lower = np.array([j.position_lower_limits()[0] for j in joints])
+    upper = np.array([j.position_upper_limits()[0] for j in joints])
+    ctx = plant.CreateDefaultContext()
+
+    def finger_origins(q):  # finger body origins in H at joint values q
+        for j, v in zip(joints, q, strict=True):
+            j.set_translation(ctx, float(v))
+        return [
+            plant.CalcRelativeTransform(
+                ctx, base.body_frame(), f.bodies[0].body_frame()
+            ).translation()
+            for f in fingers
+        ]
+
+    a_H = _grasp_axis(finger_origins, lower, upper)
+
+    def supports(q):  # per finger: (ids, supports towards the other, centres)
+        finger_origins(q)
+        return [
+            _finger_supports(plant, ctx, inspector, f, base, a_H, sign)
+            for f, sign in zip(fingers, (1.0, -1.0), strict=True)
+        ]
+
+    # pad coordinate along a, affine in q: finger 0's max of a·x, finger 1's min
+    pad = np.array(
+        [[s0[1].max(), -s1[1].max()] for s0, s1 in map(supports, (lower, upper))]
+    )
+    rate = (pad[1] - pad[0]) / (upper - lower)
+    at_zero = pad[0] - rate * lower
+    pad_ids, pad_lateral = _pads(supports(0.5 * (lower + upper)), a_H)
+    approach = _approach(plant, inspector, base, pad_lateral, a_H)
+    # open-stroke pad positions along a decide the origin of K along the axis
+    closing = rate * np.array([-1.0, 1.0]) > 0  # where q opens: upper
+    x_open = at_zero + rate * np.where(closing, upper, lower)
+    x_closed = at_zero + rate * np.where(closing, lower, upper)
+    centre = 0.5 * (x_open[0] + x_open[1])
+    R_HK = RotationMatrix(np.column_stack([a_H, approach, np.cross(a_H, approach)]))
+    return ParallelJaw(
+        base=base,
+        joints=joints,
+        finger_bodies=tuple(tuple(f.bodies) for f in fingers),
+        position_indices=np.array([j.position_start() for j in joints]),
+        lower=lower,
+        upper=upper,
+        X_HK=RigidTransform(R_HK, pad_lateral + centre * a_H),
+        pad_at_zero=at_zero - centre,
+        pad_rate=rate,
+        pad_geometries=pad_ids,
+        min_opening=float(max(2 * max(centre - x_closed[0], x_closed[1] - centre), 0)),
+        max_opening=float(2 * min(centre - x_open[0], x_open[1] - centre)),
+    )
+
+
+def _two_prismatic_fingers(plant, plant_context, object_body, hand):
+    """(free base, the two fingers, their prismatic joints), or a ModelError."""
+    bodies = hand_bodies(plant, object_body, hand)
+    base = _free_base(plant, bodies)
+    inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
+    structure = hand_structure(plant, object_body, bodies, inspector=inspector)
+    fingers = structure.fingers
+    if len(fingers) != 2 or any(len(f.joints) != 1 for f in fingers):
+        raise ModelError(
+            "plan_grasps samples parallel-jaw grasps: the hand needs two fingers, "
+            f"each driven by one prismatic joint; it has {len(fingers)} finger(s) "
+            f"({[f.name for f in fingers]})"
+        )
+    joints = tuple(structure.joints[f.joints[0]] for f in fingers)
+    for j in joints:
+        lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
+        if j.type_name() != "prismatic" or not (np.isfinite(lo) and np.isfinite(hi)):
+            raise ModelError(
+                f"finger joint {j.name()} must be prismatic with finite limits to "
+                f"make a parallel jaw (it is {j.type_name()}, limits [{lo}, {hi}])"
+            )
+    return base, fingers, joints
+
+
+def _grasp_axis(finger_origins, lower, upper) -> np.ndarray:
+    """Unit axis in H along which the fingers slide, from finger 0 to finger 1."""
+    lo0, lo1 = finger_origins(lower)
+    hi0, hi1 = finger_origins(upper)
+    u = [(hi0 - lo0) / (upper[0] - lower[0]), (hi1 - lo1) / (upper[1] - lower[1])]
+    a_H = u[0] / np.linalg.norm(u[0])
+    if abs(abs(a_H @ u[1]) / np.linalg.norm(u[1]) - 1) > 1e-6:
+        raise ModelError(
+            "the two finger joints of a parallel jaw must move along parallel axes; "
+            f"they move along {np.round(u[0], 6).tolist()} and "
+            f"{np.round(u[1], 6).tolist()}"
+        )
+    m0, m1 = finger_origins(0.5 * (lower + upper))
+    return -a_H if (m1 - m0) @ a_H < 0 else a_H
+
+
+def _pads(supports, a_H):
+    """Each finger's pad geometries and the pads' mean centre across the axis."""
+    pad_ids, lateral = [], []
+    for ids, sup, centres in supports:
+        on_pad = sup >= sup.max() - PAD_DEPTH
+        pad_ids.append(tuple(g for g, k in zip(ids, on_pad, strict=True) if k))
+        c = centres[on_pad].mean(axis=0)
+        lateral.append(c - (c @ a_H) * a_H)
+    return tuple(pad_ids), 0.5 * (lateral[0] + lateral[1])
+
+
+def _approach(plant, inspector, base, pad_lateral, a_H) -> np.ndarray:
+    """Unit direction in H from the palm's collision geometry to the pads."""
+    palm = [
+        inspector.GetPoseInFrame(g).translation()
+        for g in plant.GetCollisionGeometriesForBody(base)
+    ]
+    palm_centre = np.mean(palm, axis=0) if palm else np.zeros(3)
+    palm_lateral = palm_centre - (palm_centre @ a_H) * a_H
+    approach = pad_lateral - palm_lateral
+    if np.linalg.norm(approach) < _LATERAL_MIN:
+        raise ModelError(
+            "cannot tell the gripper's approach direction: its pads' centre "
+            f"{np.round(pad_lateral, 4).tolist()} is within {_LATERAL_MIN * 1e3:g} mm "
+            f"of its palm's {np.round(palm_lateral, 4).tolist()} across the grasp axis"
+        )
+    return approach / np.linalg.norm(approach)

@@ -1,0 +1,367 @@
+r"""Plan parallel-jaw grasps on an object body: sample, filter, close, rank.
+
+:func:`plan_grasps` runs four stages; every sampled pose either becomes a
+candidate or is counted under one rejection reason.
+
+1. **Antipodal sampling** (numpy, all samples at once).  Surface points of the
+   object's collision geometry with their outward normals ``n``, area-uniform
+   (:mod:`drakegrasp.planning.surface`); the grasp axis runs along ``−n`` through
+   the object, whose chord gives the opposite point and the width ``w``.  The
+   axis is kept when ``w`` fits the gripper's stroke and the exit normal lies in
+   the friction cone about the axis (the angle between them at most
+   ``atan μ``).  A rotation about the axis, uniform in ``[0, 2π)``, sets the
+   approach.  The gripper's grasp frame K (:mod:`drakegrasp.planning.gripper`)
+   is put at the chord's midpoint with its x axis along the axis, and
+   ``X_WH = X_WK X_HK⁻¹``; the pre-grasp opening is ``w`` plus twice
+   ``clearance``, at most the stroke.
+2. **Collision filter** (Drake).  The hand is placed open at ``X_WH``; any
+   pair of a hand geometry and another geometry with signed distance below
+   ``−distance_tolerance`` rejects the pose (object or rest of the scene).
+3. **Closing** (Drake).  Each finger moves along the grasp axis by conservative
+   advancement: by its smallest signed distance ``ψ`` to the geometry outside
+   the hand minus ``tol / 2`` (a translation by ``ψ`` cannot penetrate), until
+   ``ψ <= tol``; a finger that reaches its joint limit misses, one stopped by
+   anything but the object is blocked.  The contacts are then those of
+   :func:`~drakegrasp.find_contacts` (the same as :func:`~drakegrasp.analyze_grasp`
+   reads on the applied candidate), and both fingers must touch.
+4. **Ranking**: verdicts, ε and robustness in the batch engine
+   (:mod:`drakegrasp.planning.ranking`), weight capacity in one LP per grasp
+   (:mod:`drakegrasp.planning.weight`).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from pydrake.math import RigidTransform, RotationMatrix
+
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.validation import check_coefficient, real_scalar
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.planning.candidates import GraspCandidates
+from drakegrasp.planning.cloud import (
+    CONTACT_BAND,
+    CloudFingers,
+    CloudSurface,
+    read_cloud,
+)
+from drakegrasp.planning.gripper import parallel_jaw
+from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
+from drakegrasp.planning.ranking import DEFAULT_NOISE, rank_candidates
+from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
+from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE
+from drakegrasp.plant.validation import (
+    HandSpec,
+    check_distance_tolerance,
+    plant_context_of,
+    resolve_object_body,
+    scoped_name,
+)
+
+__all__ = ["MAX_CANDIDATES", "REASONS", "object_surface", "plan_grasps"]
+
+MAX_CANDIDATES = 1_000_000
+"""Most poses one call samples (memory grows with it; call again for more)."""
+
+GRAVITY = 9.81
+"""m/s², for the squeeze that holds the object's weight."""
+
+REASONS = {
+    "occluded": "another part of the object lies outside the sampled point on the axis",
+    "no opposite surface": "the axis leaves the object (cloud) without a far side",
+    "wider than the stroke": "the object's chord is wider than the open gripper",
+    "narrower than the stroke": "the chord is narrower than the closed gripper",
+    "outside the friction cone": "the opposite normal leaves the cone about the axis",
+    "hand collides with the object": "the open hand penetrates the object",
+    "hand collides with the scene": "the open hand penetrates another body",
+    "finger misses the object": "a finger reached its joint limit without touching",
+    "finger blocked by the scene": "a finger touched another body first",
+    "closing did not converge": f"more than {MAX_CLOSING_STEPS} closing steps",
+    "one finger touches": "only one finger's geometry touches the object",
+    "hand collides with the cloud": "a cloud point lies inside the open hand",
+    "hand enters the unseen side": "the hand reaches behind a one-sided cloud",
+}
+"""Every rejection reason, with what it means."""
+
+
+def object_surface(plant, plant_context, object_body) -> ObjectSurface:
+    """The object's collision geometry as convex pieces in its body frame O."""
+    ctx = plant_context_of(plant, plant_context)
+    body = resolve_object_body(plant, object_body)
+    inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
+    return ObjectSurface.from_pieces(
+        piece_of_shape(
+            inspector.GetShape(g), inspector.GetPoseInFrame(g), inspector.GetName(g)
+        )
+        for g in plant.GetCollisionGeometriesForBody(body)
+    )
+
+
+def _check_count(value) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise InvalidOptionError(
+            f"num_candidates must be an integer >= 0, got {value!r}"
+        )
+    if not 0 <= int(value) <= MAX_CANDIDATES:
+        raise InvalidOptionError(
+            f"num_candidates must be in [0, {MAX_CANDIDATES}] (one call; call again "
+            f"with another seed for more), got {value}"
+        )
+    return int(value)
+
+
+def plan_grasps(
+    plant,
+    plant_context,
+    object_body,
+    *,
+    hand: HandSpec,
+    num_candidates: int,
+    mu: float,
+    seed: int | None = None,
+    contact_model: ContactModel | str = ContactModel.HARD_FINGER,
+    torsional_friction: float | None = None,
+    clearance: float = 5e-3,
+    distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
+    robustness_samples: int = 32,
+    noise: dict | None = None,
+    certify: int = 10,
+    weight_check: int | None = None,
+    workers: int | None = 1,
+    progress: bool = False,
+    point_cloud=None,
+    cloud_normals=None,
+    viewpoint=None,
+    object_mass: float | None = None,
+) -> GraspCandidates:
+    """Sample, filter, close and rank parallel-jaw grasps of an object body.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized, registered with a ``SceneGraph``; holds the hand (its base a
+        free body), the object and anything else (a table, other objects).
+    plant_context : Context
+        The plant's context or its diagram's root.  The object's pose (and the
+        scene's) is read from it; the hand's configuration is used as scratch
+        and restored on return.
+    object_body : RigidBody, BodyIndex, str or None
+        The object to grasp (frame O); None with ``point_cloud``.
+    hand : ModelInstanceIndex, str or iterable of RigidBody
+        The gripper: two prismatic fingers (see
+        :mod:`drakegrasp.planning.gripper`).
+    num_candidates : int
+        Poses to sample, ``0 <= num_candidates <= MAX_CANDIDATES``; each
+        becomes a candidate or a counted rejection.
+    mu : float
+        Coulomb friction coefficient of the verdicts (and of the sampler's
+        cone test).
+    seed : int, optional
+        Seed of every random draw (sampling and robustness noise).  The same
+        seed gives the same candidates.
+    contact_model : {"hard_finger", "soft_finger", "frictionless"}, optional
+    torsional_friction : float, optional
+        ``ν`` of soft fingers.
+    clearance : float, optional
+        Gap (m) left on each side of the object by the pre-grasp opening.
+    distance_tolerance : float, optional
+        Contact and penetration tolerance (m), as in
+        :func:`~drakegrasp.find_contacts`.
+    robustness_samples : int, optional
+        Perturbed copies per force-closure candidate (0: robustness 0).
+    noise : dict, optional
+        ``{"position": m, "angle_deg": deg, "friction": relative}``; default
+        :data:`~drakegrasp.planning.ranking.DEFAULT_NOISE`.
+    certify : int, optional
+        The best ``certify`` candidates also get the single-grasp verdict with
+        its certificate (``GraspCandidate.closure``).
+    weight_check : int or None, optional
+        How many force-closure candidates get their weight capacity and a
+        score: None (default) all of them; a number limits the LPs (one per
+        grasp) to the best by ``ε × robustness``, which is faster but may miss
+        good grasps (see :mod:`drakegrasp.planning.ranking`).
+    workers : int, optional
+        Worker processes of the batch engine (default 1).
+    progress : bool, optional
+        A tqdm bar over the Drake stages (needs ``tqdm``).
+    point_cloud : pydrake.perception.PointCloud or (M, 3) float, optional
+        The object as a cloud in the world frame, with ``object_body=None``
+        (:mod:`drakegrasp.planning.cloud`); the plant then holds the hand and
+        the surroundings only.
+    cloud_normals : (M, 3) float, optional
+        Outward normals of the cloud's points; default the cloud's own, else
+        estimated with Drake's ``PointCloud.EstimateNormals``.
+    viewpoint : (3,) float, optional
+        Where the cloud was seen from (normals are turned towards it); default
+        normals point away from the cloud's centroid.
+    object_mass : float, optional
+        The object's mass (kg) for ``squeeze_needed``; default the body's mass
+        (a cloud has none: NaN).
+
+    Returns
+    -------
+    GraspCandidates
+        Ranked best first; ``rejections`` counts the other samples by reason
+        (:data:`REASONS`); ``reason`` says why when it is empty.
+
+    Raises
+    ------
+    InvalidOptionError
+        Bad options (``num_candidates`` negative, not an integer or above
+        :data:`MAX_CANDIDATES`; ``mu`` negative...).
+    ModelError
+        A hand that is not a free-based parallel jaw, an object without
+        graspable collision geometry.
+    """
+    t0 = time.perf_counter()
+    n = _check_count(num_candidates)
+    mu = check_coefficient("mu", mu, error=InvalidOptionError)
+    tol = check_distance_tolerance(distance_tolerance)
+    clearance = real_scalar("clearance", clearance)
+    if not clearance >= 0:
+        raise InvalidOptionError(f"clearance must be >= 0 metres, got {clearance}")
+    noise = {**DEFAULT_NOISE, **(noise or {})}
+    if set(noise) != set(DEFAULT_NOISE) or any(not v >= 0 for v in noise.values()):
+        raise InvalidOptionError(
+            f"noise takes non-negative {sorted(DEFAULT_NOISE)}, got {noise!r}"
+        )
+    if weight_check is not None and (
+        isinstance(weight_check, bool)
+        or not isinstance(weight_check, int | np.integer)
+        or weight_check < 0
+    ):
+        raise InvalidOptionError(
+            f"weight_check must be an integer >= 0 or None, got {weight_check!r}"
+        )
+    model = ContactModel(contact_model).value
+    ctx = plant_context_of(plant, plant_context)
+    if (object_body is None) == (point_cloud is None):
+        raise InvalidOptionError(
+            "give the object either as object_body or as point_cloud= with "
+            "object_body=None (got "
+            + ("neither" if object_body is None else "both")
+            + ")"
+        )
+    settings = {
+        "seed": seed,
+        "contact_model": model,
+        "torsional_friction": torsional_friction,
+        "clearance": clearance,
+        "distance_tolerance": tol,
+        "robustness_samples": robustness_samples,
+        "noise": noise,
+    }
+    if point_cloud is None:
+        body = resolve_object_body(plant, object_body)
+        gripper = parallel_jaw(plant, ctx, body, hand)
+        surface = object_surface(plant, ctx, body)
+        X_WO = plant.EvalBodyPoseInWorld(ctx, body)
+        name = scoped_name(plant, body)
+        mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
+    else:
+        body = None
+        points, normals, dropped = read_cloud(
+            point_cloud, cloud_normals, viewpoint=viewpoint
+        )
+        gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
+        surface = CloudSurface(points, normals, viewpoint=viewpoint)
+        X_WO = RigidTransform(surface.centroid)
+        name = "point cloud"
+        mass = np.nan if object_mass is None else float(object_mass)
+        settings.update(
+            cloud_points=len(points),
+            cloud_dropped=dropped,
+            line_radius=surface.line_radius,
+            contact_band=CONTACT_BAND,
+        )
+    settings["gripper"] = gripper.to_dict()
+    torque_scale = surface.radius_about(np.zeros(3))
+    rng = np.random.default_rng(seed)
+    poses, rejections = sample_poses(surface, gripper, X_WO, n, mu, clearance, rng, tol)
+    saved = plant.GetPositions(ctx).copy()
+    closer = BodyCloser(plant, ctx, body, hand, gripper, tol)
+    cloud = None
+    if body is None:
+        cloud = CloudFingers(
+            plant, ctx, gripper, closer.hand_instance_bodies, surface, tol, CONTACT_BAND
+        )
+    order = range(len(poses["sample"]))
+    if progress:
+        from tqdm.auto import tqdm
+
+        order = tqdm(order, desc="closing", unit="pose")
+    kept = []
+    try:
+        for k in order:
+            X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
+            opening = float(poses["opening"][k])
+            if cloud is None:
+                found, q, reason = _close_on_body(closer, X_WH, opening)
+            else:
+                found, q, reason = _close_on_cloud(closer, cloud, X_WH, opening)
+            if reason is not None:
+                rejections[reason] += 1
+                continue
+            kept.append((int(poses["sample"][k]), X_WH, q, opening, found))
+    finally:
+        plant.SetPositions(ctx, saved)
+    candidates = rank_candidates(
+        kept, finger_names=closer.finger_names, gripper=gripper, plant=plant, mu=mu,
+        model=model, nu=torsional_friction, torque_scale=torque_scale,
+        samples=robustness_samples, noise=noise, rng=rng, certify=certify,
+        workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
+    )  # fmt: skip
+    reason = ""
+    if not candidates:
+        reason = (
+            "num_candidates is 0"
+            if n == 0
+            else f"all {n} sampled poses were rejected (see rejections)"
+        )
+    return GraspCandidates(
+        candidates=candidates,
+        rejections=dict(rejections),
+        num_sampled=n,
+        object_body=name,
+        mu=mu,
+        torque_scale=torque_scale,
+        reason=reason,
+        settings=settings,
+        time=time.perf_counter() - t0,
+    )
+
+
+def _close_on_body(closer: BodyCloser, X_WH, opening):
+    """Stages 2-3 on the object body: (contacts, q, reason)."""
+    reason = closer.place(X_WH, opening)
+    if reason is not None:
+        return None, None, reason
+    q, reason = closer.close(opening)
+    if reason is not None:
+        return None, None, reason
+    found, reason = closer.contacts()
+    return found, q, reason
+
+
+def _close_on_cloud(closer: BodyCloser, cloud: CloudFingers, X_WH, opening):
+    """Stages 2-3 on a cloud: (contacts, q, reason)."""
+    q_open = closer.g.q_for_opening(opening)
+    reason = closer.clear_at(X_WH, q_open)
+    if reason is not None:
+        return None, None, reason
+    if cloud.collides():
+        return None, None, "hand collides with the cloud"
+    if cloud.in_shadow():
+        return None, None, "hand enters the unseen side"
+    q, travel_hits, reason = cloud.close(X_WH, q_open)
+    if reason is not None:
+        return None, None, reason
+    if closer.clear_at(X_WH, q) is not None:
+        return None, None, "finger blocked by the scene"
+    if cloud.in_shadow():
+        return None, None, "hand enters the unseen side"
+    found = cloud.contacts(travel_hits)
+    if found is None:
+        return None, None, "one finger touches"
+    return found, q, None

@@ -1,0 +1,323 @@
+r"""Ranking planned grasps: verdicts, ε on one scale, robustness and the score.
+
+Every measure runs in the batch engine (:mod:`drakegrasp.batch`), on the
+candidates grouped by their number of contacts (the engine takes ``K`` grasps
+of ``N`` contacts each; a WSG finger seats one to four tip spheres, so the
+counts are ragged).
+
+**ε on one scale.**  The Ferrari–Canny L1 ε divides moments by a length; by
+default each grasp uses its own (its largest contact distance), which makes a
+shallow grasp look better than a centred one.  Here every candidate of an
+object uses the same ``torque_scale`` (the radius of a ball about the object's
+origin holding its collision geometry), so ε compares across candidates.
+
+**Robustness** is the fraction of ``S`` perturbed copies of a grasp that stay
+force closure (LP2).  A copy moves each finger's contacts rigidly, as a
+misplaced pad would: a rotation by an angle drawn from
+:math:`\mathcal N(0, \sigma_\theta^2)` about a uniformly random axis through the
+finger's contact centroid, then a translation drawn from
+:math:`\mathcal N(0, \sigma_p^2 I_3)`; and it scales μ by
+:math:`\max(0, 1 + \sigma_\mu \xi)`, :math:`\xi \sim \mathcal N(0, 1)`, one
+draw per copy.  A rigid motion of the whole grasp changes no verdict, so the
+noise is per finger: it models the object's pose error and the fingers'
+placement error relative to each other.
+
+**Score** :math:`= \rho \cdot \alpha_{\min}` (robustness times the weight
+capacity of :mod:`drakegrasp.planning.weight`: the object's weight, per newton
+of squeeze on each finger, that the grasp holds in the worst of 14 directions).
+A ball-shaped measure such as ε is set by a grasp's weakest wrench direction,
+which for two pads is the torsion about the grasp axis, the same for every
+placement of the pads; the weight capacity asks for the wrenches that gravity
+and shaking apply, and falls as the pads move away from the centre of mass
+(tested against Drake simulations in ``tests/planning/test_shake.py``).  The
+weight capacity is computed for every force-closure candidate (or, with
+``weight_check``, for that many, the best by :math:`\varepsilon \rho`; the
+others score 0).  Candidates are
+ordered by score, then :math:`\varepsilon \rho`, ``d*`` and the sample index,
+so a ranking is reproducible.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
+from drakegrasp.closure.verdicts import force_closure
+from drakegrasp.planning.candidates import GraspCandidate
+from drakegrasp.planning.weight import weight_capacity
+from drakegrasp.plant.validation import scoped_name
+
+__all__ = [
+    "DEFAULT_NOISE",
+    "group_by_count",
+    "perturbed_copies",
+    "rank_candidates",
+    "rank_order",
+    "robustness",
+    "verdicts",
+]
+
+DEFAULT_NOISE = {"position": 2e-3, "angle_deg": 3.0, "friction": 0.1}
+"""Default robustness noise: σ_p (m), σ_θ (degrees), σ_μ (relative)."""
+
+
+def group_by_count(counts: np.ndarray) -> dict[int, np.ndarray]:
+    """Candidate indices by their number of contacts, ``{N: indices}``."""
+    counts = np.asarray(counts)
+    return {int(n): np.flatnonzero(counts == n) for n in np.unique(counts)}
+
+
+def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """(…, 3, 3) rotations about unit ``axes`` (…, 3) by ``angles`` (…) (Rodrigues)."""
+    x, y, z = axes[..., 0], axes[..., 1], axes[..., 2]
+    zero = np.zeros_like(x)
+    K = np.stack(
+        [
+            np.stack([zero, -z, y], -1),
+            np.stack([z, zero, -x], -1),
+            np.stack([-y, x, zero], -1),
+        ],
+        -2,
+    )
+    s, c = np.sin(angles)[..., None, None], np.cos(angles)[..., None, None]
+    return np.eye(3) + s * K + (1 - c) * (K @ K)
+
+
+def perturbed_copies(
+    positions: np.ndarray,
+    normals: np.ndarray,
+    fingers: np.ndarray,
+    mu: float,
+    *,
+    samples: int,
+    rng: np.random.Generator,
+    position: float,
+    angle_deg: float,
+    friction: float,
+):
+    """``samples`` perturbed copies of each of ``K`` grasps (module docstring).
+
+    Parameters
+    ----------
+    positions, normals : (K, N, 3) float
+        Contacts (metres) and inward unit normals, one frame per grasp.
+    fingers : (K, N) int
+        Which finger (0 or 1) made each contact.
+    mu : float
+    samples : int
+    rng : numpy.random.Generator
+    position, angle_deg, friction : float
+        σ_p (m), σ_θ (degrees), σ_μ.
+
+    Returns
+    -------
+    P, Nrm : (K * samples, N, 3) float
+        Copies, grasp-major (copy ``s`` of grasp ``k`` at row ``k * samples + s``).
+    mu : (K * samples,) float
+    """
+    K, N, _ = positions.shape
+    P = np.repeat(positions, samples, axis=0)
+    Nrm = np.repeat(normals, samples, axis=0)
+    F = np.repeat(fingers, samples, axis=0)
+    M = K * samples
+    for f in (0, 1):
+        mask = (F == f)[..., None]
+        count = np.maximum(mask.sum(axis=1), 1)
+        centre = (P * mask).sum(axis=1) / count  # (M, 3)
+        axes = rng.standard_normal((M, 3))
+        axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+        R = _rotations(axes, np.radians(angle_deg) * rng.standard_normal(M))
+        shift = position * rng.standard_normal((M, 3))
+        moved = (
+            np.einsum("mij,mnj->mni", R, P - centre[:, None])
+            + (centre + shift)[:, None]
+        )
+        P = np.where(mask, moved, P)
+        Nrm = np.where(mask, np.einsum("mij,mnj->mni", R, Nrm), Nrm)
+    mus = mu * np.maximum(0.0, 1.0 + friction * rng.standard_normal(M))
+    return P, Nrm, mus
+
+
+def verdicts(
+    positions,
+    normals,
+    mu,
+    *,
+    torque_scale: float,
+    model: str,
+    torsional_friction,
+    workers: int | None,
+):
+    """LP2 verdicts and ε (one torque scale) of ``K`` grasps of ``N`` contacts.
+
+    Returns
+    -------
+    is_closure, d_star, rank, epsilon : (K,) arrays
+    """
+    res = batch_force_closure(
+        positions,
+        normals,
+        mu,
+        model=model,
+        torsional_friction=torsional_friction,
+        workers=workers,
+    )
+    eps = np.zeros(len(positions))
+    closed = np.flatnonzero(res.is_closure)
+    if len(closed):
+        eps[closed] = batch_epsilon_l1(
+            positions[closed],
+            normals[closed],
+            mu,
+            model=model,
+            torsional_friction=torsional_friction,
+            characteristic_lengths=torque_scale,
+            workers=workers,
+        )
+    return (
+        np.asarray(res.is_closure, bool),
+        np.asarray(res.d_star, float),
+        np.asarray(res.rank, int),
+        eps,
+    )
+
+
+def robustness(
+    positions,
+    normals,
+    fingers,
+    mu: float,
+    *,
+    samples: int,
+    rng: np.random.Generator,
+    noise: dict,
+    model: str,
+    torsional_friction,
+    workers: int | None,
+) -> np.ndarray:
+    """(K,) fraction of perturbed copies that stay force closure (LP2)."""
+    if samples == 0 or len(positions) == 0:
+        return np.zeros(len(positions))
+    P, Nrm, mus = perturbed_copies(
+        positions, normals, fingers, mu, samples=samples, rng=rng, **noise
+    )
+    res = batch_force_closure(
+        P,
+        Nrm,
+        mus,
+        model=model,
+        torsional_friction=torsional_friction,
+        workers=workers,
+    )
+    return (
+        np.asarray(res.is_closure, float).reshape(len(positions), samples).mean(axis=1)
+    )
+
+
+def rank_order(score, d_star, sample) -> np.ndarray:
+    """Indices best first: highest score, then highest ``d*``, then lowest sample."""
+    return np.lexsort((np.asarray(sample), -np.asarray(d_star), -np.asarray(score)))
+
+
+def _finger_label(contact, names) -> int:
+    """0 or 1 for a contact of finger 0 or 1, 2 for another hand body (palm)."""
+    for f, bodies in enumerate(names):
+        if contact.finger_body in bodies:
+            return f
+    return 2
+
+
+def _squeeze(weight: float, alpha: float) -> float:
+    if not np.isfinite(alpha):
+        return float("nan")
+    return float(weight / alpha) if alpha > 0 else float("inf")
+
+
+def rank_candidates(
+    kept, *, finger_names, gripper, plant, mu, model, nu, torque_scale, samples,
+    noise, rng, certify, workers, X_WO, weight, weight_check,
+):  # fmt: skip
+    """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
+
+    ``kept`` holds ``(sample, X_WH, q, opening, contacts)`` of every closed
+    pose; contacts have ``p_OC``, ``nhat_O`` and ``finger_body``.  ``weight``
+    is the object's weight (N), NaN when unknown.
+    """
+    if not kept:
+        return ()
+    counts = np.array([len(k[4]) for k in kept])
+    K = len(kept)
+    is_closure = np.zeros(K, bool)
+    d_star = np.zeros(K)
+    rank = np.zeros(K, int)
+    eps = np.zeros(K)
+    rho = np.zeros(K)
+    names = finger_names
+    for idx in group_by_count(counts).values():
+        P = np.array([[c.p_OC for c in kept[i][4]] for i in idx])
+        Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
+        F = np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx])
+        fc, ds, rk, ep = verdicts(
+            P, Nrm, mu, torque_scale=torque_scale, model=model,
+            torsional_friction=nu, workers=workers,
+        )  # fmt: skip
+        is_closure[idx], d_star[idx], rank[idx], eps[idx] = fc, ds, rk, ep
+        closed = idx[fc]
+        if len(closed):
+            rho[closed] = robustness(
+                P[fc], Nrm[fc], F[fc], mu, samples=samples, rng=rng, noise=noise,
+                model=model, torsional_friction=nu, workers=workers,
+            )  # fmt: skip
+    samples_of = np.array([k[0] for k in kept])
+    pre = eps * rho
+    checked = rank_order(pre, d_star, samples_of)
+    checked = checked[is_closure[checked]][:weight_check]
+    alpha = np.full(K, np.nan)
+    for idx in group_by_count(counts[checked]).values():
+        idx = checked[idx]
+        alpha[idx] = weight_capacity(
+            np.array([[c.p_OC for c in kept[i][4]] for i in idx]),
+            np.array([[c.nhat_O for c in kept[i][4]] for i in idx]),
+            np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx]),
+            mu, torque_scale=torque_scale, model=model, torsional_friction=nu,
+        ).min(axis=1)  # fmt: skip
+    score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
+    order = np.lexsort((samples_of, -d_star, -pre, -score))
+    base = scoped_name(plant, gripper.base)
+    joint_names = tuple(
+        f"{plant.GetModelInstanceName(j.model_instance())}::{j.name()}"
+        for j in gripper.joints
+    )
+    out = []
+    for place, i in enumerate(order):
+        sample, X_WH, q, opening, found = kept[i]
+        out.append(
+            GraspCandidate(
+                sample=sample,
+                hand_base=base,
+                X_WH=X_WH,
+                X_WO=X_WO,
+                q_hand=np.asarray(q, float),
+                joint_names=joint_names,
+                closing_signs=(
+                    float(np.sign(1 / gripper.pad_rate[0])),
+                    float(np.sign(-1 / gripper.pad_rate[1])),
+                ),
+                opening=opening,
+                contacts=tuple(found),
+                contact_options={"mu": mu, "model": model, "torsional_friction": nu},
+                is_closure=bool(is_closure[i]),
+                d_star=float(d_star[i]),
+                rank=int(rank[i]),
+                epsilon=float(eps[i]),
+                robustness=float(rho[i]),
+                score=float(score[i]),
+                weight_capacity=float(alpha[i]),
+                squeeze_needed=_squeeze(weight, alpha[i]),
+            )
+        )
+        if place < certify:  # the certificate of the best few
+            out[-1] = replace(out[-1], closure=force_closure(out[-1].grasp))
+    return tuple(out)

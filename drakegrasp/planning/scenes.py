@@ -1,0 +1,114 @@
+"""A planning scene: a free-floating gripper and an object, built from model URLs.
+
+:func:`planning_scene` builds the plant :func:`~drakegrasp.planning.planner.plan_grasps`
+needs (the hand's base a free body) and keeps the recipe, ``add_models``,
+that :func:`~drakegrasp.planning.shake.shake_test` replays in its own
+discrete-time plant.  A user with a scene of their own (a table, clutter)
+writes the same kind of function and builds the plant themselves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from pydrake.math import RigidTransform
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.framework import DiagramBuilder
+
+from drakegrasp.errors import ModelError
+from drakegrasp.plant.models import register_models, use_local_drake_models
+
+__all__ = ["WSG_URL", "PlanningScene", "planning_scene"]
+
+WSG_URL = "package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf"
+"""Drake's Schunk WSG-50 with its four tip spheres per finger."""
+
+
+@dataclass(frozen=True, eq=False)
+class PlanningScene:
+    """A built planning scene.
+
+    Attributes
+    ----------
+    diagram : Diagram
+    plant : MultibodyPlant
+    context : Context
+        The diagram's root context (object at ``X_WO``).
+    hand : ModelInstanceIndex
+    object_body : RigidBody or None
+    add_models : callable
+        ``add_models(plant, parser) -> (hand, object body name)``, the recipe.
+    """
+
+    diagram: Any
+    plant: Any
+    context: Any
+    hand: Any
+    object_body: Any
+    add_models: Any
+
+
+def planning_scene(
+    object_url: str | None,
+    *,
+    hand_url: str = WSG_URL,
+    X_WO: RigidTransform | None = None,
+    models_dir=None,
+) -> PlanningScene:
+    """A free gripper and a free object in a new plant (time step 0).
+
+    Parameters
+    ----------
+    object_url : str or None
+        ``package://`` URL or file path of the object's model (one body with
+        collision geometry is the object: the model's first body); None for a
+        scene with the hand only (planning on a point cloud).
+    hand_url : str, optional
+        The gripper's model (default Drake's WSG-50 with tip spheres); its
+        base is left free.
+    X_WO : RigidTransform, optional
+        The object's pose (default the identity).
+    models_dir : path, optional
+        Local ``drake_models`` folder
+        (:func:`~drakegrasp.plant.models.use_local_drake_models`).
+
+    Raises
+    ------
+    ModelError
+        A model that does not load.
+    """
+    X_WO = RigidTransform() if X_WO is None else X_WO
+
+    def add_models(plant, parser):
+        use_local_drake_models(parser, models_dir)
+        register_models(parser)
+        try:
+            hand = _add(parser, hand_url)
+            obj = None if object_url is None else _add(parser, object_url)
+        except RuntimeError as exc:  # Drake's parser errors
+            raise ModelError(f"could not load a model: {exc}") from exc
+        if obj is None:
+            return hand, None
+        body = plant.get_body(plant.GetBodyIndices(obj)[0])
+        plant.SetDefaultFloatingBaseBodyPose(body, X_WO)
+        return hand, f"{plant.GetModelInstanceName(obj)}::{body.name()}"
+
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    hand, name = add_models(plant, Parser(plant))
+    plant.Finalize()
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    object_body = None
+    if name is not None:
+        model, _, body = name.rpartition("::")
+        object_body = plant.GetBodyByName(body, plant.GetModelInstanceByName(model))
+    return PlanningScene(diagram, plant, context, hand, object_body, add_models)
+
+
+def _add(parser, url: str):
+    if "://" in url:
+        return parser.AddModels(url=url)[0]
+    return parser.AddModels(str(url))[0]

@@ -1,0 +1,324 @@
+r"""The check against physics: squeeze a planned grasp and turn gravity around it.
+
+:func:`shake_test` builds a fresh discrete-time ``MultibodyPlant`` from the
+user's own model function (the same one that built the planning plant), welds
+the hand's base at the candidate's ``X_WH``, sets the fingers and the object
+where the candidate put them, and simulates with Drake's ``Simulator``:
+
+- the fingers are position-controlled by Drake's PD-controlled actuators
+  (``JointActuator.set_controller_gains``, stiffness ``k``) aimed
+  ``squeeze / k`` past the place where they touch, so each presses with
+  about ``squeeze`` newtons (within its effort limit) and resists being
+  pushed open with stiffness ``k``, as a position-controlled gripper does (two
+  force-controlled fingers would let gravity along the grasp axis carry
+  object and fingers to a joint limit);
+- the object is free; gravity (``9.81 m/s²``, the plant's own gravity field is
+  set to zero) acts on the object only, as an external force at its centre of
+  mass whose direction is held for ``settle`` seconds along the world's
+  ``−z`` and then turned through ``directions`` (each held for ``phase``
+  seconds, blended over the first ``blend`` seconds of a phase);
+- contact, friction and stiffness are the plant's (point contact, the models'
+  proximity properties).
+
+The object *holds* when its pose in the hand frame never moves more than
+``max_displacement`` (metres) or ``max_rotation`` (radians) from the planned
+one.  Gravity acting on the fingers is left out: the hand is held by its base
+weld and actuators, and the grasp is what is tested.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.plant import (
+    AddMultibodyPlantSceneGraph,
+    ExternallyAppliedSpatialForce,
+)
+from pydrake.multibody.tree import PdControllerGains
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.planning.candidates import GraspCandidate
+from drakegrasp.plant.validation import resolve_body, resolve_object_body
+
+__all__ = ["DEFAULT_DIRECTIONS", "ShakeResult", "shake_test"]
+
+GRAVITY = 9.81
+"""Magnitude of the turned gravity, m/s²."""
+
+DEFAULT_DIRECTIONS = (
+    (1.0, 0.0, 0.0),
+    (0.0, -1.0, 0.0),
+    (0.0, 0.0, 1.0),
+    (-1.0, 0.0, 0.0),
+    (0.0, 1.0, 0.0),
+    (0.0, 0.0, -1.0),
+)
+"""World directions gravity turns through after settling along −z (each
+consecutive pair orthogonal, so a blend never passes through zero)."""
+
+
+@dataclass(frozen=True, eq=False)
+class ShakeResult:
+    """What the shake test saw.
+
+    Attributes
+    ----------
+    held : bool
+        Whether the object stayed within both bounds for the whole run.
+    max_displacement : float
+        Largest distance (m) of the object's origin from its planned place in
+        the hand frame.
+    max_rotation : float
+        Largest rotation angle (rad) of the object from its planned
+        orientation in the hand frame.
+    phases : tuple of dict
+        Per gravity direction: ``direction`` (world), ``displacement`` and
+        ``rotation`` at the end of the phase.
+    squeeze : float
+        Actuator force per finger joint, newtons.
+    time_step, duration : float
+        Seconds (simulated).
+    wall_time : float
+        Seconds.
+    bounds : tuple of float
+        ``(max_displacement, max_rotation)`` allowed.
+    """
+
+    held: bool
+    max_displacement: float
+    max_rotation: float
+    phases: tuple
+    squeeze: float
+    time_step: float
+    duration: float
+    wall_time: float
+    bounds: tuple[float, float]
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return jsonable(dict(vars(self)))
+
+    def __str__(self) -> str:
+        return (
+            f"{'held' if self.held else 'dropped'}: moved at most "
+            f"{self.max_displacement * 1e3:.2f} mm and "
+            f"{np.degrees(self.max_rotation):.2f}"
+            f" deg (bounds {self.bounds[0] * 1e3:g} mm, "
+            f"{np.degrees(self.bounds[1]):g} deg)"
+            f" over {self.duration:g} s, squeeze {self.squeeze:g} N, "
+            f"{len(self.phases)} gravity directions; {self.wall_time:.2f} s wall"
+        )
+
+
+class _TurnedGravity(LeafSystem):
+    """Outputs ``m g(t)`` on one body at its centre of mass (world frame)."""
+
+    def __init__(self, body_index, mass, p_BoBcm_B, schedule):
+        super().__init__()
+        self._body, self._mass, self._com = body_index, mass, np.asarray(p_BoBcm_B)
+        self._schedule = schedule
+        self.DeclareAbstractOutputPort(
+            "spatial_forces",
+            lambda: AbstractValue.Make([ExternallyAppliedSpatialForce()]),
+            self._calc,
+        )
+
+    def _calc(self, context, output):
+        force = ExternallyAppliedSpatialForce()
+        force.body_index = self._body
+        force.p_BoBq_B = self._com
+        g = self._schedule(context.get_time())
+        force.F_Bq_W = SpatialForce(np.zeros(3), self._mass * GRAVITY * g)
+        output.set_value([force])
+
+
+def _schedule(settle, phase, blend, directions):
+    dirs = [np.array([0.0, 0.0, -1.0])] + [
+        np.asarray(d, float) / np.linalg.norm(d) for d in directions
+    ]
+
+    def g(t: float) -> np.ndarray:
+        if t < settle:
+            return dirs[0]
+        k = min(int((t - settle) // phase), len(dirs) - 2)
+        s = min((t - settle - k * phase) / blend, 1.0) if blend > 0 else 1.0
+        v = (1 - s) * dirs[k] + s * dirs[k + 1]
+        return v / np.linalg.norm(v)
+
+    return g
+
+
+def _scoped(plant, joint) -> str:
+    return f"{plant.GetModelInstanceName(joint.model_instance())}::{joint.name()}"
+
+
+def _angle(R: np.ndarray) -> float:
+    return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)))
+
+
+def shake_test(
+    add_models: Callable,
+    candidate: GraspCandidate,
+    *,
+    squeeze: float = 20.0,
+    stiffness: float = 4000.0,
+    damping: float = 50.0,
+    directions: Sequence[Sequence[float]] = DEFAULT_DIRECTIONS,
+    settle: float = 0.3,
+    phase: float = 0.4,
+    blend: float = 0.1,
+    time_step: float = 1e-3,
+    max_displacement: float = 0.01,
+    max_rotation: float = np.radians(10.0),
+    object_body=None,
+) -> ShakeResult:
+    """Simulate a planned grasp in Drake and report whether the object stays put.
+
+    Parameters
+    ----------
+    add_models : callable
+        ``add_models(plant, parser) -> (hand, object_body)``: adds the hand (its
+        base not welded) and the object to a fresh plant, as for planning;
+        ``hand`` a model instance, ``object_body`` a body or its scoped name.
+        Leave out supports such as a table: the test turns gravity around.
+    candidate : GraspCandidate
+        From :func:`~drakegrasp.planning.planner.plan_grasps`.
+    squeeze : float, optional
+        Force with which each finger presses, newtons (default 20 N; at most
+        the actuator's effort limit).
+    stiffness, damping : float, optional
+        Gains of the fingers' position control (N/m, N·s/m): each finger is
+        aimed ``squeeze / stiffness`` past where it touches.
+    directions : sequence of (3,) float, optional
+        World gravity directions after the settling phase along −z.
+    settle, phase, blend : float, optional
+        Seconds: settling under −z gravity, each direction's hold, the blend
+        between directions.
+    time_step : float, optional
+        The discrete plant's step, seconds.
+    max_displacement, max_rotation : float, optional
+        Bounds on the object's motion in the hand frame: metres, radians.
+    object_body : optional
+        Overrides the object that ``add_models`` returns.
+
+    Returns
+    -------
+    ShakeResult
+
+    Raises
+    ------
+    InvalidOptionError
+        Bad options (non-positive time step or squeeze, a zero direction...).
+    ModelError
+        ``add_models`` did not add the candidate's hand base or closing joints.
+    """
+    for name, value in (
+        ("squeeze", squeeze),
+        ("stiffness", stiffness),
+        ("damping", damping),
+        ("time_step", time_step),
+        ("phase", phase),
+    ):
+        if not (isinstance(value, int | float) and np.isfinite(value) and value > 0):
+            raise InvalidOptionError(
+                f"{name} must be a finite number > 0, got {value!r}"
+            )
+    dirs = np.asarray(directions, dtype=float).reshape(-1, 3)
+    if not np.all(np.isfinite(dirs)) or np.any(np.linalg.norm(dirs, axis=1) == 0):
+        raise InvalidOptionError(
+            f"directions must be finite non-zero 3-vectors, got {directions!r}"
+        )
+    t0 = time.perf_counter()
+    from pydrake.multibody.parsing import Parser
+
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=float(time_step))
+    hand, obj = add_models(plant, Parser(plant))
+    if object_body is not None:
+        obj = object_body
+    base = resolve_body(plant, candidate.hand_base)
+    actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
+    by_name = {_scoped(plant, a.joint()): a for a in actuators}
+    targets = {}
+    for name, sign in zip(candidate.joint_names, candidate.closing_signs, strict=True):
+        actuator = by_name.get(name)
+        if actuator is None:
+            raise ModelError(f"closing joint {name} has no actuator to squeeze with")
+        push = min(squeeze, actuator.effort_limit())
+        targets[int(actuator.joint().index())] = sign * push / stiffness
+    for actuator in actuators:  # every actuator position-controlled (Drake's PD)
+        actuator.set_controller_gains(PdControllerGains(p=stiffness, d=damping))
+    plant.WeldFrames(plant.world_frame(), base.body_frame(), candidate.X_WH)
+    plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
+    plant.Finalize()
+    body = resolve_object_body(plant, obj)
+    schedule = _schedule(settle, phase, blend, dirs)
+    gravity = builder.AddSystem(
+        _TurnedGravity(body.index(), body.default_mass(), body.default_com(), schedule)
+    )
+    builder.Connect(
+        gravity.get_output_port(), plant.get_applied_spatial_force_input_port()
+    )
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    root = simulator.get_mutable_context()
+    ctx = plant.GetMyContextFromRoot(root)
+    candidate.apply(plant, ctx, object_body=body)
+    q_now = plant.GetPositions(ctx)
+    desired = {}
+    for actuator in actuators:
+        joint = actuator.joint()
+        desired.setdefault(joint.model_instance(), []).append(
+            (
+                int(actuator.index()),
+                q_now[joint.position_start()] + targets.get(int(joint.index()), 0.0),
+            )
+        )
+    for instance, entries in desired.items():
+        entries.sort()
+        q_d = np.array([q for _, q in entries])
+        plant.get_desired_state_input_port(instance).FixValue(
+            ctx, np.concatenate([q_d, np.zeros_like(q_d)])
+        )
+    plant.get_actuation_input_port().FixValue(ctx, np.zeros(plant.num_actuated_dofs()))
+    H = base.body_frame()
+    X_HO0 = plant.CalcRelativeTransform(ctx, H, body.body_frame())
+    ends = [settle + (k + 1) * phase for k in range(len(dirs))]
+    duration = ends[-1]
+    max_d = max_r = 0.0
+    phases = []
+    t, dt_check = 0.0, 0.01
+    for end in ends:
+        while t < end - 1e-12:
+            t = min(t + dt_check, end)
+            simulator.AdvanceTo(t)
+            X_HO = plant.CalcRelativeTransform(ctx, H, body.body_frame())
+            d = float(np.linalg.norm(X_HO.translation() - X_HO0.translation()))
+            r = _angle(X_HO0.rotation().matrix().T @ X_HO.rotation().matrix())
+            max_d, max_r = max(max_d, d), max(max_r, r)
+        phases.append(
+            {
+                "direction": schedule(end - 1e-9).tolist(),
+                "displacement": d,
+                "rotation": r,
+            }
+        )
+    return ShakeResult(
+        held=bool(max_d <= max_displacement and max_r <= max_rotation),
+        max_displacement=max_d,
+        max_rotation=max_r,
+        phases=tuple(phases),
+        squeeze=float(squeeze),
+        time_step=float(time_step),
+        duration=duration,
+        wall_time=time.perf_counter() - t0,
+        bounds=(float(max_displacement), float(max_rotation)),
+    )

@@ -1,0 +1,262 @@
+r"""How much weight a parallel-jaw grasp holds per newton of squeeze, in one LP.
+
+A gripper presses each finger with a set force ``S``; the object's weight
+``m g`` acts at its origin O (the centre of mass of the shipped objects) in a
+direction ``u`` that a shake test turns around.  The grasp holds when the
+contact forces, inside their (polyhedral) friction cones and with each
+finger's normal forces summing to at most ``S``, can balance ``m g u``.  By
+linearity the answer scales with ``S``, so each grasp has a **weight
+capacity**
+
+.. math::
+
+    \alpha(u) = \max \alpha \;\text{s.t.}\;
+    \sum_{i,k} \lambda_{ik} w_{ik} + \alpha \begin{bmatrix} u \\ 0 \end{bmatrix} = 0,
+    \quad \sum_{i \in \text{finger } f} \sum_k \lambda_{ik} \le 1 \;(f = 0, 1),
+    \quad \lambda \ge 0,
+
+with ``w_ik`` the primitive wrenches about O (unit normal force, generator
+``k`` of contact ``i``, moments divided by the object's torque scale, which
+changes no ``α``), and :math:`\alpha_{\min} = \min_u \alpha(u)` over a set of
+directions in O.  The squeeze that holds the object's weight in every such
+direction is :math:`m g / \alpha_{\min}`.  (A per-finger bound, not the L1
+bound of ε: it is what a gripper's actuators set.)  It is a lower bound of the
+squeeze a real pad needs: the LP shares a finger's force among its contacts at
+will, a rigid pad as its geometry and compliance dictate.
+
+The LPs of all grasps and directions are solved at once by the batch engine's
+interior-point method, in their dual form (nine variables each, see
+:func:`weight_capacity`); :func:`build_weight_capacity_program` builds the
+primal LP of one grasp (its directions as independent blocks: the sum of their
+``α`` is maximised, which maximises each) for inspection, for a second route
+through drakegrasp's solver gateway and for the tests.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.solvers import MathematicalProgram
+
+from drakegrasp._solvers import require_solution, solve
+from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
+from drakegrasp.batch.lp.ipm import solve_max_last
+from drakegrasp.errors import InvalidOptionError
+
+__all__ = [
+    "WEIGHT_DIRECTIONS",
+    "build_weight_capacity_program",
+    "weight_capacity",
+]
+
+
+def _directions() -> np.ndarray:
+    axes = np.vstack([np.eye(3), -np.eye(3)])
+    diagonals = np.array(
+        [[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float
+    )
+    return np.vstack([axes, diagonals / np.sqrt(3.0)])
+
+
+WEIGHT_DIRECTIONS = _directions()
+"""The 14 weight directions in O: the axes and the cube's diagonals."""
+
+
+def build_weight_capacity_program(
+    W: np.ndarray, groups: np.ndarray, directions: np.ndarray = WEIGHT_DIRECTIONS
+):
+    """The LP of one grasp's weight capacity in every direction (one block each).
+
+    Parameters
+    ----------
+    W : (M, 6) float
+        Primitive wrenches of the grasp about O (contact-major).
+    groups : (M,) int
+        The finger (0, 1; 2 for any other hand body, a palm, bounded alike)
+        of each wrench.
+    directions : (D, 3) float
+        Unit weight directions, frame O.
+
+    Returns
+    -------
+    prog : MathematicalProgram
+    alpha : (D,) array of Variable
+        ``α`` of each direction.
+    """
+    prog, alpha, _ = _program(W, groups, directions)
+    return prog, alpha
+
+
+def _memberships(groups: np.ndarray) -> np.ndarray:
+    return (np.clip(groups, 0, 2)[None, :] == np.arange(3)[:, None]).astype(float)
+
+
+def _program(W, groups, directions):
+    """The program, its α variables and the (equality, bound) bindings per block."""
+    M, w = W.shape
+    D = len(directions)
+    prog = MathematicalProgram()
+    lam = prog.NewContinuousVariables(D, M, "lambda")
+    alpha = prog.NewContinuousVariables(D, "alpha")
+    member = _memberships(groups)
+    bindings = []
+    for d, A in enumerate(_equalities(W, directions)):
+        bindings.append(
+            (
+                prog.AddLinearEqualityConstraint(
+                    A, np.zeros(w), np.r_[lam[d], alpha[d]]
+                ),
+                prog.AddLinearConstraint(
+                    member, np.full(3, -np.inf), np.ones(3), lam[d]
+                ),
+            )
+        )
+    prog.AddBoundingBoxConstraint(0.0, np.inf, lam.ravel())
+    prog.AddBoundingBoxConstraint(0.0, np.inf, alpha)
+    prog.AddLinearCost(-np.ones(D), 0.0, alpha)
+    return prog, alpha, bindings
+
+
+def _equalities(W: np.ndarray, directions: np.ndarray) -> list[np.ndarray]:
+    """``[W^T | (u; 0)]`` of each direction: (6, M + 1) each."""
+    w = W.shape[1]
+    out = []
+    for u in directions:
+        A = np.empty((w, W.shape[0] + 1))
+        A[:, :-1] = W.T
+        A[:, -1] = np.r_[u, np.zeros(w - 3)]
+        out.append(A)
+    return out
+
+
+def weight_capacity(
+    positions: np.ndarray,
+    normals: np.ndarray,
+    fingers: np.ndarray,
+    mu: float,
+    *,
+    torque_scale: float,
+    model: str = "hard_finger",
+    torsional_friction: float | None = None,
+    directions: np.ndarray = WEIGHT_DIRECTIONS,
+    num_generators: int = 8,
+    solver: str = "batch",
+) -> np.ndarray:
+    """(K, D) weight capacities ``α(u)`` of ``K`` grasps of ``N`` contacts.
+
+    Parameters
+    ----------
+    positions, normals : (K, N, 3) float
+        Contacts (metres) and inward unit normals in O; moments about O.
+    fingers : (K, N) int
+        Finger (0 or 1) of each contact, 2 for another hand body (a palm,
+        whose normal forces are bounded by the squeeze too).
+    mu : float
+    torque_scale : float
+        Metres dividing the moments (conditioning only; a soft finger's
+        torsion bound is ``torque_scale · ν``, as in ε).
+    model : str, optional
+    torsional_friction : float, optional
+    directions : (D, 3) float, optional
+    num_generators : int, optional
+    solver : {"batch", "drake"}, optional
+        ``"batch"`` (default): the dual LPs of all grasps and directions at
+        once in the batch engine's interior-point method
+        (:func:`~drakegrasp.batch.lp.ipm.solve_max_last`); ``"drake"``: the LP of
+        :func:`build_weight_capacity_program` per grasp through the solver
+        gateway (Clp; slower, about 1 ms per direction).
+
+    Returns
+    -------
+    alpha : (K, D) float
+        Newtons of weight held per newton of squeeze on each finger.
+    """
+    K, N, _ = positions.shape
+    if K == 0:
+        return np.zeros((0, len(directions)))
+    W = batched_primitive_wrenches(
+        positions,
+        normals,
+        np.full((K, N), float(mu)),
+        np.full((K, N), float(torsional_friction or 0.0)),
+        np.zeros((K, 3)),
+        np.full(K, float(torque_scale)),
+        model=model,
+        num_generators=num_generators,
+    )
+    per = W.shape[1] // N
+    groups = np.repeat(fingers, per, axis=1)
+    if solver == "batch":
+        return _batch_capacity(W, groups, np.asarray(directions, float))
+    if solver != "drake":
+        raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
+    return _drake_capacity(W, groups, directions)
+
+
+def _drake_capacity(W: np.ndarray, groups: np.ndarray, directions) -> np.ndarray:
+    """The primal LP of each grasp through the solver gateway (one program)."""
+    K, _, w = W.shape
+    out = np.zeros((K, len(directions)))
+    prog, alpha, bindings = _program(W[0], groups[0], directions)
+    for k in range(K):  # one program, its coefficients updated per grasp
+        if k:
+            member = _memberships(groups[k])
+            for (eq, bound), A in zip(
+                bindings, _equalities(W[k], directions), strict=True
+            ):
+                eq.evaluator().UpdateCoefficients(A, np.zeros(w))
+                bound.evaluator().UpdateCoefficients(
+                    member, np.full(3, -np.inf), np.ones(3)
+                )
+        result = require_solution(prog, solve(prog, "lp"), "the weight-capacity LP")
+        out[k] = np.maximum(result.GetSolution(alpha), 0.0)
+    return out
+
+
+def _complement(v: np.ndarray) -> np.ndarray:
+    """(D, w, w - 1) orthonormal bases of the complements of unit rows ``v``."""
+    D, w = v.shape
+    out = np.empty((D, w, w - 1))
+    for d in range(D):
+        Q, _ = np.linalg.qr(np.column_stack([v[d], np.eye(w)]))
+        out[d] = Q[:, 1:w]
+    return out
+
+
+def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
+    """The dual LPs of every grasp and direction in the batch engine's IPM.
+
+    The dual of the capacity LP, with ``y = v + P z`` (``P`` a basis of the
+    complement of ``v = (u; 0)``, so ``yᵀv = 1``), is
+    ``min Σ_f s_f`` s.t. ``s_f >= -yᵀw_j`` (``j`` in group ``f``), ``s >= 0``:
+    nine variables ``(z, s, ζ)`` with ``ζ <= -Σ s`` maximised, the form of
+    :func:`~drakegrasp.batch.lp.ipm.solve_max_last`.  ``α = -ζ*``.  A grasp with a
+    direction whose dual does not converge (degenerate: coplanar pad contacts)
+    is solved again as the primal through the solver gateway.
+    """
+    K, M, w = W.shape
+    D = len(directions)
+    v = np.hstack([directions, np.zeros((D, w - 3))])  # (D, w)
+    P = _complement(v)  # (D, w, w-1)
+    n = (w - 1) + 3 + 1
+    B = np.zeros((K, D, M + 4, n))
+    h = np.zeros((K, D, M + 4))
+    # generator rows: -(Pᵀ w_j)·z - s_f <= v·w_j
+    B[:, :, :M, : w - 1] = -np.einsum("kmi,dij->kdmj", W, P)
+    g = np.clip(groups, 0, 2)
+    onehot = (g[..., None] == np.arange(3)).astype(float)  # (K, M, 3)
+    B[:, :, :M, w - 1 : w + 2] = -onehot[:, None]
+    h[:, :, :M] = np.einsum("kmi,di->kdm", W, v)
+    # s >= 0
+    for f in range(3):
+        B[:, :, M + f, w - 1 + f] = -1.0
+    # ζ + Σ s <= 0
+    B[:, :, M + 3, w - 1 : w + 2] = 1.0
+    B[:, :, M + 3, n - 1] = 1.0
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        # a degenerate dual may diverge (overflow); it is re-solved below
+        sol = solve_max_last(B.reshape(K * D, M + 4, n), h.reshape(K * D, M + 4))
+    alpha = np.maximum(-sol.value, 0.0).reshape(K, D)
+    stuck = np.flatnonzero(~sol.converged.reshape(K, D).all(axis=1))
+    if len(stuck):  # degenerate duals (coplanar pads): the primal through Clp
+        alpha[stuck] = _drake_capacity(W[stuck], groups[stuck], directions)
+    return alpha

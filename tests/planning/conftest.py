@@ -1,0 +1,35 @@
+"""Fixtures of the planning tests: planning scenes, built once per session."""
+
+from __future__ import annotations
+
+import pytest
+
+from drakegrasp.planning import planning_scene
+
+OWN_HAND = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+
+
+@pytest.fixture(scope="session")
+def wsg_scene(drake_models_dir):
+    """Drake's WSG-50 (free) and the YCB sugar box (skips without drake_models)."""
+
+    def make(name="004_sugar_box", X_WO=None):
+        return planning_scene(
+            f"package://drake_models/ycb/{name}.sdf",
+            X_WO=X_WO,
+            models_dir=drake_models_dir,
+        )
+
+    return make
+
+
+@pytest.fixture(scope="session")
+def own_scene():
+    """drakegrasp's flat-pad parallel jaw (free) and one of its objects."""
+
+    def make(name="box", X_WO=None, hand=OWN_HAND):
+        return planning_scene(
+            f"package://drakegrasp/objects/{name}.sdf", hand_url=hand, X_WO=X_WO
+        )
+
+    return make

@@ -1,0 +1,126 @@
+"""Planning on point clouds: full and one-sided clouds of true meshes, checked
+on those meshes; hostile clouds refused or answered with a reason."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydrake.perception import BaseField, Fields, PointCloud
+
+from drakegrasp import analyze_grasp
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.planning import object_surface, plan_grasps, planning_scene
+
+
+@pytest.fixture(scope="module")
+def scenes(drake_models_dir):
+    def make(name):
+        url = f"package://drake_models/ycb/{name}.sdf"
+        full = planning_scene(url, models_dir=drake_models_dir)
+        return full, planning_scene(None, models_dir=drake_models_dir)
+
+    return make
+
+
+def _cloud(full, n=4000, seed=0, view=None):
+    surface = object_surface(full.plant, full.context, full.object_body)
+    p, nrm, _ = surface.sample(n, np.random.default_rng(seed))
+    if view is not None:  # keep what a camera at `view` sees (convex object)
+        seen = np.sum(nrm * (np.asarray(view) - p), axis=1) > 0
+        p, nrm = p[seen], nrm[seen]
+    return p, nrm
+
+
+def _plan(hand_only, cloud, normals=None, n=200, **kw):
+    return plan_grasps(
+        hand_only.plant, hand_only.context, None, hand=hand_only.hand,
+        num_candidates=n, mu=0.5, seed=0, robustness_samples=8,
+        point_cloud=cloud, cloud_normals=normals, **kw,
+    )  # fmt: skip
+
+
+def _check_on_the_true_object(full, candidates, band=1.5e-3):
+    """Each finger within ``band`` of the true surface, never deeper; verdicts."""
+    plant, obj = full.plant, full.object_body
+    ctx = full.context.Clone()
+    agree = []
+    for c in candidates:
+        c.apply(plant, ctx)
+        pctx = plant.GetMyContextFromRoot(ctx)
+        query = plant.get_geometry_query_input_port().Eval(pctx)
+        psi = {}
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.05):
+            for a, b in ((pair.id_A, pair.id_B), (pair.id_B, pair.id_A)):
+                if a in plant.GetCollisionGeometriesForBody(obj):
+                    body = plant.GetBodyFromFrameId(query.inspector().GetFrameId(b))
+                    psi[body.name()] = min(psi.get(body.name(), np.inf), pair.distance)
+        for finger in ("left_finger", "right_finger"):
+            assert -band <= psi[finger] <= band, (finger, psi[finger])
+        report = analyze_grasp(
+            plant, ctx, obj, hand=full.hand, mu=0.5, distance_tolerance=band,
+            allow_penetration=True,
+        )  # fmt: skip
+        agree.append(report.force_closure.is_closure == c.is_closure)
+    return np.mean(agree)
+
+
+@pytest.mark.parametrize("given_normals", [True, False])
+def test_full_cloud_of_the_sugar_box(scenes, given_normals):
+    full, hand_only = scenes("004_sugar_box")
+    p, nrm = _cloud(full)
+    result = _plan(hand_only, p, nrm if given_normals else None)
+    assert len(result) > 30 and result[0].is_closure
+    assert len(result) + sum(result.rejections.values()) == 200
+    # the cloud's frame is its centroid: the contacts lie on the box's faces
+    for c in result[:5]:
+        p_WC = np.array([k.p_OC for k in c.contacts]) + c.X_WO.translation()
+        assert np.all(
+            np.abs(np.abs(p_WC) - [0.04335, 0.08515, 0.01955]).min(axis=1) < 2e-3
+        )
+    assert _check_on_the_true_object(full, result[:8]) >= 0.75
+
+
+def test_one_sided_cloud_of_the_can(scenes):
+    full, hand_only = scenes("005_tomato_soup_can")
+    # the can's axis is its y; a camera on +x sees the near half of the side
+    p, nrm = _cloud(full, view=[0.5, 0.0, 0.0])
+    assert len(p) < 0.7 * 4000
+    result = _plan(hand_only, p, nrm, viewpoint=[0.5, 0.0, 0.0])
+    assert result.rejections.get("no opposite surface", 0) > 0
+    assert len(result) > 0 and result[0].is_closure
+    assert _check_on_the_true_object(full, result[:5]) >= 0.6
+
+
+def test_a_drake_point_cloud_with_nan_points(scenes):
+    full, hand_only = scenes("004_sugar_box")
+    p, _ = _cloud(full, n=3000)
+    p[::10] = np.nan  # missing depth, as Drake marks it
+    cloud = PointCloud(len(p), Fields(BaseField.kXYZs))
+    cloud.mutable_xyzs()[:] = p.T
+    result = _plan(hand_only, cloud, n=60)
+    assert result.settings["cloud_dropped"] >= 300
+    assert len(result) > 0
+
+
+def test_hostile_clouds(scenes):
+    full, hand_only = scenes("004_sugar_box")
+    with pytest.raises(InvalidOptionError, match="empty"):
+        _plan(hand_only, np.zeros((0, 3)))
+    with pytest.raises(InvalidOptionError, match="finite"):
+        _plan(hand_only, np.full((50, 3), np.nan))
+    with pytest.raises(InvalidOptionError, match=r"\(M, 3\)"):
+        _plan(hand_only, np.zeros((10, 2)))
+    with pytest.raises(InvalidOptionError, match="either"):
+        plan_grasps(
+            full.plant, full.context, full.object_body, hand=full.hand,
+            num_candidates=5, mu=0.5, point_cloud=np.zeros((10, 3)),
+        )  # fmt: skip
+    with pytest.raises(InvalidOptionError, match="either"):
+        plan_grasps(
+            hand_only.plant, hand_only.context, None, hand=hand_only.hand,
+            num_candidates=5, mu=0.5,
+        )  # fmt: skip
+    # a cloud far out of the gripper's reach on every side: a reason, no error
+    far = np.random.default_rng(1).normal(0, 0.3, (500, 3))
+    result = _plan(hand_only, far, -far / np.linalg.norm(far, axis=1, keepdims=True))
+    assert len(result) == 0 and "rejected" in result.reason

@@ -1,0 +1,84 @@
+"""Weight capacity: closed forms for two opposed contacts, a second formulation
+(scipy's HiGHS on the primal written out here), and invariance to units."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+from drakegrasp.core.contact import Contact
+from drakegrasp.core.grasp import Grasp
+from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, weight_capacity
+from drakegrasp.quality import primitive_wrenches
+
+
+@pytest.mark.parametrize("solver", ["batch", "drake"])
+def test_two_opposed_contacts_closed_form(solver):
+    mu, r = 0.4, 0.03
+    P = np.array([[[-r, 0, 0], [r, 0, 0]]])
+    N = np.array([[[1.0, 0, 0], [-1.0, 0, 0]]])
+    dirs = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, 0, -1]])
+    a = weight_capacity(
+        P, N, np.array([[0, 1]]), mu, torque_scale=r, directions=dirs, solver=solver
+    )
+    # along the axis one finger's normal force (<= 1); across it both frictions
+    assert a[0] == pytest.approx([1.0, 1.0, 2 * mu, 2 * mu], abs=1e-7)
+
+
+def _scipy_capacity(grasp, fingers, u, b):
+    per_contact = primitive_wrenches(grasp, torque_scale=b)
+    W = np.vstack(per_contact)  # (M, 6), contact-major
+    g = np.concatenate(
+        [np.full(len(w), f) for w, f in zip(per_contact, fingers, strict=True)]
+    )
+    M = len(W)
+    A_eq = np.hstack([W.T, np.r_[u, 0, 0, 0][:, None]])
+    A_ub = np.array([np.r_[(g == f).astype(float), 0.0] for f in (0, 1)])
+    res = linprog(
+        np.r_[np.zeros(M), -1.0], A_ub=A_ub, b_ub=np.ones(2), A_eq=A_eq,
+        b_eq=np.zeros(6), bounds=(0, None), method="highs",
+    )  # fmt: skip
+    assert res.status == 0
+    return -res.fun
+
+
+@pytest.mark.parametrize("solver", ["batch", "drake"])
+def test_agrees_with_a_second_formulation(solver):
+    rng = np.random.default_rng(11)
+    for _ in range(4):
+        # two pads of three contacts each, facing each other across x
+        pad = rng.normal(0, 0.01, (3, 3)) * [0, 1, 1]
+        P = np.vstack([pad + [-0.03, 0, 0], pad * [1, -1, 1] + [0.03, 0, 0]])
+        P += rng.normal(0, 0.01, 3)  # off the centre of mass
+        tilt = rng.normal(0, 0.1, (6, 3))
+        N = np.vstack([np.tile([1.0, 0, 0], (3, 1)), np.tile([-1.0, 0, 0], (3, 1))])
+        N = (N + tilt) / np.linalg.norm(N + tilt, axis=1, keepdims=True)
+        fingers = np.array([0, 0, 0, 1, 1, 1])
+        a = weight_capacity(
+            P[None], N[None], fingers[None], 0.5, torque_scale=0.05, solver=solver
+        )[0]
+        grasp = Grasp([Contact(p, n, mu=0.5) for p, n in zip(P, N, strict=True)])
+        ref = [_scipy_capacity(grasp, fingers, u, 0.05) for u in WEIGHT_DIRECTIONS]
+        assert a == pytest.approx(ref, rel=1e-6, abs=1e-8)
+
+
+def test_independent_of_units_and_torque_scale():
+    rng = np.random.default_rng(12)
+    P = rng.normal(0, 0.02, (1, 6, 3))
+    N = -P / np.linalg.norm(P, axis=2, keepdims=True)
+    F = np.array([[0, 0, 0, 1, 1, 1]])
+    a = weight_capacity(P, N, F, 0.6, torque_scale=0.05)
+    b = weight_capacity(P * 1000, N, F, 0.6, torque_scale=3.0)
+    assert a == pytest.approx(b, rel=1e-6, abs=1e-9)
+
+
+def test_the_batch_dual_and_the_primal_program_agree_on_many_grasps():
+    rng = np.random.default_rng(13)
+    P = rng.normal(0, 0.03, (30, 8, 3))
+    N = -P / np.linalg.norm(P, axis=2, keepdims=True) + rng.normal(0, 0.3, P.shape)
+    N /= np.linalg.norm(N, axis=2, keepdims=True)
+    F = np.repeat([[0, 0, 0, 0, 1, 1, 1, 2]], 30, axis=0)  # one palm contact
+    a = weight_capacity(P, N, F, 0.7, torque_scale=0.05)
+    b = weight_capacity(P, N, F, 0.7, torque_scale=0.05, solver="drake")
+    assert a == pytest.approx(b, rel=1e-6, abs=1e-8)
