@@ -37,7 +37,12 @@ import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
 from drakegrasp.core.contact import ContactModel
-from drakegrasp.core.validation import check_coefficient, real_scalar
+from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
+from drakegrasp.core.validation import (
+    check_coefficient,
+    check_distance_tolerance,
+    real_scalar,
+)
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidates
 from drakegrasp.planning.cloud import (
@@ -50,10 +55,8 @@ from drakegrasp.planning.gripper import parallel_jaw
 from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
 from drakegrasp.planning.ranking import DEFAULT_NOISE, rank_candidates
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
-from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.plant.validation import (
     HandSpec,
-    check_distance_tolerance,
     plant_context_of,
     resolve_object_body,
     scoped_name,
