@@ -9,6 +9,7 @@ writes the same kind of function and builds the plant themselves.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,7 +18,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
-from drakegrasp.errors import ModelError
+from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.models import register_models, use_local_drake_models
 
 __all__ = ["WSG_URL", "PlanningScene", "planning_scene"]
@@ -51,7 +52,7 @@ class PlanningScene:
 
 
 def planning_scene(
-    object_url: str | None,
+    object_url: str | None = None,
     *,
     hand_url: str = WSG_URL,
     X_WO: RigidTransform | None = None,
@@ -61,10 +62,10 @@ def planning_scene(
 
     Parameters
     ----------
-    object_url : str or None
+    object_url : str or None, optional
         ``package://`` URL or file path of the object's model (one body with
-        collision geometry is the object: the model's first body); None for a
-        scene with the hand only (planning on a point cloud).
+        collision geometry is the object: the model's first body); None
+        (default) for a scene with the hand only (planning on a point cloud).
     hand_url : str, optional
         The gripper's model (default Drake's WSG-50 with tip spheres); its
         base is left free.
@@ -79,6 +80,19 @@ def planning_scene(
     ModelError
         A model that does not load.
     """
+    for name, url in (("object_url", object_url), ("hand_url", hand_url)):
+        if not (
+            isinstance(url, (str, os.PathLike))
+            or (url is None and name == "object_url")
+        ):
+            raise InvalidOptionError(
+                f"{name} must be a package:// URL or a file path, got "
+                f"{type(url).__name__} {url!r}"
+            )
+    if X_WO is not None and not isinstance(X_WO, RigidTransform):
+        raise InvalidOptionError(
+            f"X_WO must be a pydrake RigidTransform, got {type(X_WO).__name__}"
+        )
     X_WO = RigidTransform() if X_WO is None else X_WO
 
     def add_models(plant, parser):

@@ -220,6 +220,16 @@ def shake_test(
     ModelError
         ``add_models`` did not add the candidate's hand base or closing joints.
     """
+    if not callable(add_models):
+        raise InvalidOptionError(
+            "add_models must be a function add_models(plant, parser) -> (hand, "
+            f"object_body), got {type(add_models).__name__}"
+        )
+    if not isinstance(candidate, GraspCandidate):
+        raise InvalidOptionError(
+            "candidate must be a GraspCandidate from plan_grasps, got "
+            f"{type(candidate).__name__}"
+        )
     for name, value in (
         ("squeeze", squeeze),
         ("stiffness", stiffness),

@@ -20,7 +20,10 @@ import pytest
 from drakegrasp.batch import compiled
 from drakegrasp.batch.inputs import resolve_kernel
 
-ROOT = Path(__file__).resolve().parents[2]
+# The folder holding the drakegrasp this process imports: the checkout, or an
+# installed copy (CI tests the installed package). A child process must import
+# the same one: numba's cache is keyed by the kernels' source files.
+ROOT = Path(compiled.__file__).resolve().parents[2]
 
 pytestmark = pytest.mark.skipif(
     not compiled.AVAILABLE, reason="numba is not installed (the numpy route runs)"

@@ -19,7 +19,7 @@ normal matrices are factorised by an explicit Cholesky loop over their entries
 (each step one vector operation over the batch) instead of one LAPACK call per
 problem.  Measured on this project's machine this is 3–5× faster than batched
 ``numpy.matmul``/``numpy.linalg.solve`` on (K, r, n) stacks.
-The closure engine (:mod:`reference_lp`) brings LP1/LP2 to this form
+The closure engine (``tests/batch/reference_lp.py``) brings LP1/LP2 to this form
 with ``n`` of 1 to 7 and ``r`` of 7 to 40, where the per-problem cost of a general
 purpose solver is all overhead.
 
