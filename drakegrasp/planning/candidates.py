@@ -24,6 +24,7 @@ from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.plant.contacts import PlantContact
+from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import plant_context_of, resolve_body
 
 __all__ = ["GraspCandidate", "GraspCandidates", "pose_dict"]
@@ -144,7 +145,7 @@ class GraspCandidate:
             When given (and free), set to the planned pose ``X_WO`` too.
         """
         ctx = plant_context_of(plant, context)
-        joints = [_joint(plant, n) for n in self.joint_names]
+        joints = [find_joint(plant, n) for n in self.joint_names]
         base = resolve_body(plant, self.hand_base)
         if base.is_floating_base_body():  # else welded (at X_WH, the caller's word)
             plant.SetFreeBodyPose(ctx, base, self.X_WH)
@@ -195,13 +196,6 @@ class GraspCandidate:
             f"{self.opening * 1e3:.1f} mm, "
             f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
         )
-
-
-def _joint(plant, name: str):
-    model, _, joint = name.rpartition("::")
-    if model:
-        return plant.GetJointByName(joint, plant.GetModelInstanceByName(model))
-    return plant.GetJointByName(joint)
 
 
 @dataclass(frozen=True, eq=False)

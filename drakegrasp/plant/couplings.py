@@ -37,9 +37,10 @@ from typing import NamedTuple
 import numpy as np
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import Joint, JointIndex, ModelInstanceIndex
+from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.plant.fingers import find_joint
 
 __all__ = [
     "JointCoupling",
@@ -303,23 +304,6 @@ def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
     return known
 
 
-def _joint(plant: MultibodyPlant, spec) -> Joint:
-    if isinstance(spec, Joint) and spec.GetParentPlant() is plant:
-        return spec
-    if isinstance(spec, str):
-        model, _, name = spec.rpartition("::")
-        for i in range(plant.num_joints()):
-            j = plant.get_joint(JointIndex(i))
-            if j.name() == name and (
-                not model or plant.GetModelInstanceName(j.model_instance()) == model
-            ):
-                return j
-    raise InvalidOptionError(
-        f"coupling joint {spec!r} is not a joint of the plant (give a Joint or "
-        "a 'model::joint' name)"
-    )
-
-
 def coupling_map(
     plant: MultibodyPlant, velocity_indices: np.ndarray, couplings: Sequence
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -357,7 +341,7 @@ def coupling_map(
                 "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
                 f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
             )
-        j0, j1 = _joint(plant, entry[0]), _joint(plant, entry[1])
+        j0, j1 = find_joint(plant, entry[0]), find_joint(plant, entry[1])
         for j in (j0, j1):
             if j.num_velocities() != 1:
                 raise InvalidOptionError(

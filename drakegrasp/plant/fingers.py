@@ -34,7 +34,14 @@ from pydrake.multibody.tree import Joint, JointIndex, RigidBody
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.validation import scoped_name
 
-__all__ = ["MAX_STEP", "Coupling", "Finger", "HandStructure", "hand_structure"]
+__all__ = [
+    "Coupling",
+    "Finger",
+    "HandStructure",
+    "MAX_STEP",
+    "find_joint",
+    "hand_structure",
+]
 
 MAX_STEP = {"revolute": 0.2, "prismatic": 0.01}
 """Largest change of any joint of a finger in one closing step: radians, metres."""
@@ -144,7 +151,8 @@ def joint_name(plant: MultibodyPlant, joint: Joint) -> str:
     return f"{plant.GetModelInstanceName(joint.model_instance())}::{joint.name()}"
 
 
-def _find_joint(plant: MultibodyPlant, spec) -> Joint:
+def find_joint(plant: MultibodyPlant, spec) -> Joint:
+    """The joint ``spec`` names: a Joint of ``plant``, or ``"model::joint"``."""
     if isinstance(spec, Joint) and spec.GetParentPlant() is plant:
         return spec
     if isinstance(spec, str):
@@ -185,7 +193,7 @@ def _closing_joints(plant, bodies, couplings):
                 "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
                 f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
             )
-        j0, j1 = _find_joint(plant, entry[0]), _find_joint(plant, entry[1])
+        j0, j1 = find_joint(plant, entry[0]), find_joint(plant, entry[1])
         rho, off = float(entry[2]), float(entry[3])
         if rho == 0 or not np.isfinite(rho) or not np.isfinite(off):
             raise InvalidOptionError(
