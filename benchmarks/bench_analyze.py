@@ -66,7 +66,7 @@ from drakegrasp.closure.verdicts import (  # noqa: E402
 )
 from drakegrasp.core.antipodal import is_antipodal  # noqa: E402
 from drakegrasp.core.deferred import computed_eagerly  # noqa: E402
-from drakegrasp.core.grasp import grasp_matrix, normalised_grasp_matrix  # noqa: E402
+from drakegrasp.core.grasp import grasp_matrix, invariant_grasp_matrix  # noqa: E402
 from drakegrasp.plant import (  # noqa: E402
     DEFAULT_SCENE,
     analyze_grasp,
@@ -298,7 +298,8 @@ def main() -> None:
     report = analyze_grasp(plant, ctx, **options)
     print(
         f"scene {scene.name}: {grasp.num_contacts} contacts, "
-        f"{'planar' if grasp.planar else 'spatial'}, {grasp.contacts[0].model.value}; "
+        f"{'planar' if grasp.planar else 'spatial'}, "
+        f"{grasp.contacts[0].contact_model.value}; "
         f"rank G {report.force_closure.rank}/{report.force_closure.required_rank}, "
         f"rank G_n {report.form_closure.rank}; decided by: form "
         f"{report.form_closure.decided_by}, polyhedral "
@@ -334,7 +335,7 @@ def main() -> None:
         grasps = [grasp.with_contacts(grasp.contacts) for _ in range(size)]
         for g in grasps if warm else ():
             grasp_matrix(g)
-            normalised_grasp_matrix(g)
+            invariant_grasp_matrix(g)
             g.normal_indices()
         return iter(grasps)
 
@@ -375,7 +376,7 @@ def main() -> None:
 
     def first_use(g):
         grasp_matrix(g)
-        normalised_grasp_matrix(g)
+        invariant_grasp_matrix(g)
         g.normal_indices()
 
     steps["  G, normalised G, slices (first use on a new grasp)"] = on_fresh(

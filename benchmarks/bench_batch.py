@@ -60,7 +60,7 @@ def random_grasps(rng, K, N, d, spread):
 def make_grasp(P, Nrm, mu, kind):
     model = "frictionless" if kind == "form" else "hard_finger"
     return Grasp(
-        [Contact(p, n, mu=mu, model=model) for p, n in zip(P, Nrm, strict=True)]
+        [Contact(p, n, mu=mu, contact_model=model) for p, n in zip(P, Nrm, strict=True)]
     )
 
 
@@ -89,7 +89,7 @@ def lp_matrices(grasp, kind):
 def run_batch(P, Nrm, mu, kind, chunk_size):
     if kind == "form":
         return batch_form_closure(P, Nrm, chunk_size=chunk_size)
-    return batch_force_closure(P, Nrm, mu, chunk_size=chunk_size)
+    return batch_force_closure(P, Nrm, mu=mu, chunk_size=chunk_size)
 
 
 def rate(n, seconds):
@@ -208,7 +208,7 @@ def main(argv=None):
         print("\nprofile: batch_force_closure, 3 spatial hard fingers")
         prof = cProfile.Profile()
         prof.enable()
-        batch_force_closure(P, Nrm, 0.5, chunk_size=chunk)
+        batch_force_closure(P, Nrm, mu=0.5, chunk_size=chunk)
         prof.disable()
         pstats.Stats(prof).sort_stats("tottime").print_stats(12)
 

@@ -59,12 +59,12 @@ def measure(N: int, repeats: int) -> dict:
         spent[0] += time.process_time() - t0
 
     fused_kernel._full_rank_stack = timed
-    batch_force_closure(P[:200], Nrm[:200], 0.5, workers=1)  # compile / load
+    batch_force_closure(P[:200], Nrm[:200], mu=0.5, workers=1)  # compile / load
     best = None
     for _ in range(repeats):
         spent[0] = 0.0
         t0 = time.process_time()
-        res = batch_force_closure(P, Nrm, 0.5, workers=1)
+        res = batch_force_closure(P, Nrm, mu=0.5, workers=1)
         total = time.process_time() - t0
         if best is None or total < best["total"]:
             best = {"total": total, "kernel": spent[0]}

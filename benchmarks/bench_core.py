@@ -107,7 +107,7 @@ def main() -> None:
     n = np.array([g.normals for g in grasps])
     for name, fn in rows:
         if fn == "batch":
-            batch = dg.batch_force_closure(P, n, 0.5)
+            batch = dg.batch_force_closure(P, n, mu=0.5)
             batch_certificates(P[:5], n[:5], batch_slice(batch), mu=0.5)  # warm up
             t0 = time.perf_counter()
             batch_certificates(P, n, batch, mu=0.5)
@@ -118,14 +118,14 @@ def main() -> None:
             rng = np.random.default_rng(3)
             P2 = rng.normal(size=(2000, 2, 3))
             n2 = -P2 + 0.3 * rng.normal(size=P2.shape)
-            jaws = dg.batch_force_closure(P2, n2, 0.5)
+            jaws = dg.batch_force_closure(P2, n2, mu=0.5)
             t0 = time.perf_counter()
             batch_certificates(P2, n2, jaws, mu=0.5)
             per = (time.perf_counter() - t0) / max(1, int((~jaws.is_closure).sum()))
             name = "batch_certificates, rank-deficient (2 jaws)"
             t = np.array([per])
             t0 = time.perf_counter()
-            dg.batch_force_closure(P, n, 0.5)
+            dg.batch_force_closure(P, n, mu=0.5)
             verdict = (time.perf_counter() - t0) / len(grasps)
             print(f"{'batch_force_closure, per grasp':<44}{verdict * 1e3:>8.3f}ms")
         elif fn in ("bare_poly", "bare_exact"):

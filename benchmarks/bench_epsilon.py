@@ -96,9 +96,9 @@ def epsilon_rates(case, N, *, quick=False, seed=0, repeats=3, spread=None):
     p = np.zeros((K, d))
     b = batched_characteristic_lengths(P, p)
     opts = {"model": model, "torsional_friction": nu}
-    batch_epsilon_l1(P[:50], Nrm[:50], MU, workers=1, **opts)  # compile / load
+    batch_epsilon_l1(P[:50], Nrm[:50], mu=MU, workers=1, **opts)  # compile / load
     t_batch, eps = best_cpu(
-        lambda: batch_epsilon_l1(P, Nrm, MU, workers=1, **opts), repeats
+        lambda: batch_epsilon_l1(P, Nrm, mu=MU, workers=1, **opts), repeats
     )
     W = batched_primitive_wrenches(
         P, Nrm, mu_c, nu_c, p, b, model=model, num_generators=N_GEN
@@ -127,7 +127,7 @@ def epsilon_rates(case, N, *, quick=False, seed=0, repeats=3, spread=None):
         1,
     )  # fmt: skip
     grasps = [
-        Grasp([Contact(P[k, i], Nrm[k, i], mu=MU, model=model,
+        Grasp([Contact(P[k, i], Nrm[k, i], mu=MU, contact_model=model,
                        torsional_friction=nu) for i in range(N)],
               characteristic_length=b[k])
         for k in range(Kq)

@@ -86,7 +86,7 @@ ROUTES = ["batch×1", "batch×all", "mathprog", "highs"]
 def make_grasp(P, Nrm, model, nu):
     return Grasp(
         [
-            Contact(p, n, mu=MU, model=model, torsional_friction=nu)
+            Contact(p, n, mu=MU, contact_model=model, torsional_friction=nu)
             for p, n in zip(P, Nrm, strict=True)
         ]
     )
@@ -124,16 +124,18 @@ def bench_one(case, N, *, quick, seed):
     P, Nrm = random_grasps(rng, K, N, d)
     load = os.getloadavg()[0]
     r1, res = best_rate(
-        lambda: batch_force_closure(P, Nrm, MU, workers=1, **opts), K, 2
+        lambda: batch_force_closure(P, Nrm, mu=MU, workers=1, **opts), K, 2
     )
     # one worker and every core in wall time, alternately, best of three each
     wall1 = rall = 0.0
     for _ in range(3):
-        w1, _ = best_rate(lambda: batch_force_closure(P, Nrm, MU, workers=1, **opts),
+        w1, _ = best_rate(lambda: batch_force_closure(P, Nrm, mu=MU, workers=1, **opts),
                           K, 1, time.perf_counter)  # fmt: skip
         wall1 = max(wall1, w1)
         wa, res_all = best_rate(
-            lambda: batch_force_closure(P, Nrm, MU, workers=available_cores(), **opts),
+            lambda: batch_force_closure(
+                P, Nrm, mu=MU, workers=available_cores(), **opts
+            ),
             K, 1, time.perf_counter,
         )  # fmt: skip
         rall = max(rall, wa)

@@ -71,12 +71,12 @@ def record(out: str, K: int) -> None:
             "zero": 0.0,
         }[mu_kind]
         opts = {"model": model, "torsional_friction": nu, "workers": 1}
-        r = batch_force_closure(p, n, mu, **opts)
+        r = batch_force_closure(p, n, mu=mu, **opts)
         for key in ("d_star", "rank", "is_closure", "margin", "converged"):
             arrays[f"{name}/{key}"] = np.asarray(getattr(r, key))
         if r.normal_certificate is not None:
             arrays[f"{name}/normal_certificate"] = np.asarray(r.normal_certificate)
-        arrays[f"{name}/epsilon"] = np.asarray(batch_epsilon_l1(p, n, mu, **opts))
+        arrays[f"{name}/epsilon"] = np.asarray(batch_epsilon_l1(p, n, mu=mu, **opts))
         print(name, int(r.is_closure.sum()), "closed of", K, flush=True)
     np.savez(out, **arrays)
 

@@ -199,7 +199,7 @@ def _cmd_batch(args: argparse.Namespace) -> int:
     options = {
         "kind": args.kind,
         "mu": args.mu,
-        "model": model,
+        "contact_model": model,
         "num_generators": args.num_generators,
         "torsional_friction": args.torsional_friction,
         "tol": args.tol,

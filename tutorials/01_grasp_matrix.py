@@ -117,7 +117,9 @@ plt.show()
 c = [0.1, 0.0, 0.05]  # metres
 n = [-1.0, 0.0, 0.0]  # pushes towards -x, into the object
 for model in ("frictionless", "hard_finger", "soft_finger"):
-    one = dg.Grasp([dg.Contact(c, n, mu=0.5, model=model, torsional_friction=0.1)])
+    one = dg.Grasp(
+        [dg.Contact(c, n, mu=0.5, contact_model=model, torsional_friction=0.1)]
+    )
     print(f"{model}: G_i is {dg.grasp_matrix(one).shape}")
     print(dg.grasp_matrix(one))
 
@@ -129,9 +131,9 @@ for model in ("frictionless", "hard_finger", "soft_finger"):
 # %%
 rng = np.random.default_rng(0)
 soft = examples.equator_fingers(
-    0.5, num_fingers=3, model="soft_finger", torsional_friction=0.2
+    0.5, num_fingers=3, contact_model="soft_finger", torsional_friction=0.2
 )
-for g in (grasp, soft, grasp.with_friction(model="frictionless")):
+for g in (grasp, soft, grasp.with_friction(contact_model="frictionless")):
     G = dg.grasp_matrix(g)
     f = rng.normal(size=G.shape[1])
     force, moment = np.zeros(3), np.zeros(3)
@@ -143,7 +145,7 @@ for g in (grasp, soft, grasp.with_friction(model="frictionless")):
         if len(fi) == 4:  # soft finger: pure moment about n
             moment += fi[3] * ci.normal
     print(
-        f"{g.contacts[0].model.value:>12}: G {G.shape}, "
+        f"{g.contacts[0].contact_model.value:>12}: G {G.shape}, "
         f"|G f - w| = {np.abs(G @ f - np.r_[force, moment]).max():.1e}"
     )
 

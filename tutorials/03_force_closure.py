@@ -68,11 +68,13 @@ SQUARE = [[-1, -1], [1, -1], [1, 1], [-1, 1]]
 
 # %%
 cases = {
-    "3 frictionless (equator)": examples.equator_fingers(0.5, model="frictionless"),
+    "3 frictionless (equator)": examples.equator_fingers(
+        0.5, contact_model="frictionless"
+    ),
     "3 hard fingers, mu=0.5": examples.equator_fingers(0.5),
     "2 hard fingers, mu=0.5": examples.spatial_two_fingers(0.5),
     "2 soft fingers, mu=0.5, nu=0.2": examples.spatial_two_fingers(
-        0.5, model="soft_finger", torsional_friction=0.2
+        0.5, contact_model="soft_finger", torsional_friction=0.2
     ),
 }
 for name, g in cases.items():
@@ -154,9 +156,9 @@ def offset_grasp(mu):
     return dg.Grasp(
         [
             dg.Contact(np.r_[-1.0, 0, 0] - offset, [1, 0, 0], mu=mu,
-                       model="soft_finger", torsional_friction=0.2),
+                       contact_model="soft_finger", torsional_friction=0.2),
             dg.Contact(np.r_[1.0, 0, 0] + offset, [-1, 0, 0], mu=mu,
-                       model="soft_finger", torsional_friction=0.2),
+                       contact_model="soft_finger", torsional_friction=0.2),
         ]
     )  # fmt: skip
 
@@ -203,7 +205,7 @@ grasps = {
     "two fingers, mu=0.3": examples.planar_two_finger_square(0.3),
     "two fingers, mu=0.7": examples.planar_two_finger_square(0.7),
     "four fingers, mu=0.2": examples.planar_square_four_contacts().with_friction(
-        0.2, model="hard_finger"
+        0.2, contact_model="hard_finger"
     ),
 }
 fig = plt.figure(figsize=(16, 7.5))

@@ -142,7 +142,9 @@ for mu in mus:
     d_soft.append(r.d_star)
     fc_soft.append(r.is_closure)
     fc_hard.append(
-        dg.force_closure_exact(soft.with_friction(model="hard_finger")).is_closure
+        dg.force_closure_exact(
+            soft.with_friction(contact_model="hard_finger")
+        ).is_closure
     )
 margins = np.array(margins)
 

@@ -151,7 +151,7 @@ fixes = {
         [*two.contacts, dg.Contact([0, 0, -0.05], [0, 0, 1], mu=0.5)]
     ),
     "two soft fingers, nu = 0.3": ex.spatial_two_fingers(
-        0.5, model="soft_finger", torsional_friction=0.3
+        0.5, contact_model="soft_finger", torsional_friction=0.3
     ),
 }
 for name, g in fixes.items():
@@ -205,10 +205,10 @@ from drakegrasp import ContactCurvature, SurfaceCurvature
 def axis_fingers(a, b):
     """Four point fingers on the axes of the ellipse x²/a² + y²/b² = 1."""
     contacts = [
-        dg.Contact([a, 0], [-1, 0], model="frictionless"),
-        dg.Contact([-a, 0], [1, 0], model="frictionless"),
-        dg.Contact([0, b], [0, -1], model="frictionless"),
-        dg.Contact([0, -b], [0, 1], model="frictionless"),
+        dg.Contact([a, 0], [-1, 0], contact_model="frictionless"),
+        dg.Contact([-a, 0], [1, 0], contact_model="frictionless"),
+        dg.Contact([0, b], [0, -1], contact_model="frictionless"),
+        dg.Contact([0, -b], [0, 1], contact_model="frictionless"),
     ]
     kappa = [a / b**2, a / b**2, b / a**2, b / a**2]  # the ellipse at each finger
     point = SurfaceCurvature.point(planar=True)
@@ -254,7 +254,7 @@ for k in range(count):
     n = -P + 0.9 * rng.normal(size=P.shape)
     g = dg.Grasp(
         [
-            dg.Contact(P[i], n[i], mu=0.3, model=model, torsional_friction=0.1)
+            dg.Contact(P[i], n[i], mu=0.3, contact_model=model, torsional_friction=0.1)
             for i in range(3)
         ]
     )
@@ -268,7 +268,7 @@ K = 200 if TEST_MODE else 2000
 P = rng.normal(size=(K, 3, 2))
 P /= np.linalg.norm(P, axis=2, keepdims=True)
 n = -P + 0.9 * rng.normal(size=P.shape)
-batch = dg.batch_force_closure(P, n, 0.2)
+batch = dg.batch_force_closure(P, n, mu=0.2)
 certs = batch_certificates(P, n, batch, mu=0.2)
 violations = [
     certs.certificates[k].check(grasp_at(P, n, k, mu=0.2)).violation

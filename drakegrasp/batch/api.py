@@ -25,6 +25,7 @@ from drakegrasp.batch.inputs import METRICS, shape_of
 from drakegrasp.batch.run.chunk import force_task, form_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL, ZERO_FRACTION
 from drakegrasp.errors import InvalidOptionError
 
@@ -178,12 +179,14 @@ def collect(K: int, d: int, kind: str, tol: float, names, chunks):
     )
 
 
+@renamed_keyword("model", "contact_model")
+@keyword_only("mu", after=2)
 def stream_force_closure(
     positions,
     normals,
-    mu,
     *,
-    model: ContactModel | str = "hard_finger",
+    mu: float | np.ndarray,
+    contact_model: ContactModel | str = "hard_finger",
     num_generators: int = 8,
     torsional_friction=None,
     reference_points=None,
@@ -204,8 +207,8 @@ def stream_force_closure(
     validated before the first chunk is read.
     """
     task, options = force_task(
-        positions, mu, model, num_generators, torsional_friction, reference_points,
-        characteristic_lengths, tol, rank_tol, metrics, kernel,
+        positions, mu, contact_model, num_generators, torsional_friction,
+        reference_points, characteristic_lengths, tol, rank_tol, metrics, kernel,
     )  # fmt: skip
     return stream(
         positions,
@@ -252,12 +255,14 @@ def stream_form_closure(
     )
 
 
+@renamed_keyword("model", "contact_model")
+@keyword_only("mu", after=2)
 def batch_force_closure(
     positions: np.ndarray,
     normals: np.ndarray,
-    mu: float | np.ndarray,
     *,
-    model: ContactModel | str = "hard_finger",
+    mu: float | np.ndarray,
+    contact_model: ContactModel | str = "hard_finger",
     num_generators: int = 8,
     torsional_friction: float | np.ndarray | None = None,
     reference_points: np.ndarray | None = None,
@@ -286,7 +291,7 @@ def batch_force_closure(
         :mod:`drakegrasp.core.validation`, the same as the single-grasp path).  A
         hard finger with ``μ = 0`` acts as frictionless, as in the single-grasp
         path.
-    model : {"hard_finger", "frictionless", "soft_finger"}, optional
+    contact_model : {"hard_finger", "frictionless", "soft_finger"}, optional
         Contact model of every contact (soft fingers are spatial only).
     num_generators : int, optional
         Generators ``n_g >= 3`` of each linearised spatial cone (default 8).
@@ -351,8 +356,8 @@ def batch_force_closure(
     """
     K, N, d = shape_of("positions", positions)
     task, options = force_task(
-        positions, mu, model, num_generators, torsional_friction, reference_points,
-        characteristic_lengths, tol, rank_tol, metrics, kernel,
+        positions, mu, contact_model, num_generators, torsional_friction,
+        reference_points, characteristic_lengths, tol, rank_tol, metrics, kernel,
     )  # fmt: skip
     chunks = stream(
         positions, normals, kind="force", task=task, chunk_size=chunk_size,
@@ -470,4 +475,4 @@ def iter_batch_closure(
             if "mu" not in arrays:
                 raise InvalidOptionError("force closure chunks need mu")
             mu = arrays.pop("mu")
-            yield batch_force_closure(P, Nrm, mu, **arrays, **options)
+            yield batch_force_closure(P, Nrm, mu=mu, **arrays, **options)

@@ -88,7 +88,7 @@ def epsilon_l1_per_grasp(
                 P[k, i],
                 Nrm[k, i],
                 mu=mu[k, i],
-                model=model,
+                contact_model=model,
                 torsional_friction=nu[k, i],
             )
             for i in range(P.shape[1])

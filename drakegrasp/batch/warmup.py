@@ -140,17 +140,19 @@ def _steps() -> list[tuple[str, Callable[[], object]]]:
     for label, N, d, model, nu in cases:
         p, n = _grasps(K, N, d, seed=N * 10 + d)
         mu = 0.0 if model == "frictionless" else np.linspace(0.2, 0.8, K)
-        options = {"model": model, "torsional_friction": nu, "workers": 1}
+        options = {"contact_model": model, "torsional_friction": nu, "workers": 1}
         out.append(
             (
                 f"force closure, {label}, N = {N}",
-                lambda p=p, n=n, mu=mu, o=options: batch_force_closure(p, n, mu, **o),
+                lambda p=p, n=n, mu=mu, o=options: batch_force_closure(
+                    p, n, mu=mu, **o
+                ),
             )
         )
         out.append(
             (
                 f"epsilon (L1), {label}, N = {N}",
-                lambda p=p, n=n, mu=mu, o=options: batch_epsilon_l1(p, n, mu, **o),
+                lambda p=p, n=n, mu=mu, o=options: batch_epsilon_l1(p, n, mu=mu, **o),
             )
         )
     p, n = _grasps(K, 7, 3, seed=7)

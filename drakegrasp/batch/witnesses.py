@@ -35,6 +35,7 @@ from drakegrasp.certificates.witness import (
 )
 from drakegrasp.closure.programs import balance_matrix, balance_rank
 from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
@@ -111,7 +112,7 @@ def _null_space_witnesses(
 
     The normalised balance matrices of the rows are built at once (moments
     about each grasp's contacts' centroid over their spread, as
-    :func:`~drakegrasp.core.grasp.normalised_grasp_matrix`), and each row's left
+    :func:`~drakegrasp.core.grasp.invariant_grasp_matrix`), and each row's left
     null space at the batch's rank is the witness.  A row whose trailing
     singular values are not numerically zero (the ranks disagree) is left to
     the per-grasp path.
@@ -196,13 +197,14 @@ def _core_rank(grasp: Grasp, form: bool, num_generators: int) -> int:
     return balance_rank(balance_matrix(grasp, cols), DEFAULT_RANK_TOL)
 
 
+@renamed_keyword("model", "contact_model")
 def grasp_at(
     positions,
     normals,
     k: int,
     *,
     mu=0.0,
-    model: ContactModel | str = "hard_finger",
+    contact_model: ContactModel | str = "hard_finger",
     torsional_friction=0.0,
     reference_points=None,
     characteristic_lengths=None,
@@ -217,9 +219,15 @@ def grasp_at(
     K = len(positions)
     mus = per_contact_getter(mu, K, N, "mu")[k]
     nus = per_contact_getter(torsional_friction, K, N, "torsional_friction")[k]
-    model = ContactModel.parse(model)
+    contact_model = ContactModel.parse(contact_model)
     contacts = [
-        Contact(P[i], n[i], mu=mus[i], model=model, torsional_friction=nus[i])
+        Contact(
+            P[i],
+            n[i],
+            mu=mus[i],
+            contact_model=contact_model,
+            torsional_friction=nus[i],
+        )
         for i in range(N)
     ]
     p = None
@@ -233,13 +241,14 @@ def grasp_at(
     return Grasp(contacts, reference_point=p, characteristic_length=b)
 
 
+@renamed_keyword("model", "contact_model")
 def batch_certificates(
     positions,
     normals,
     result,
     *,
     mu=0.0,
-    model: ContactModel | str = "hard_finger",
+    contact_model: ContactModel | str = "hard_finger",
     num_generators: int = 8,
     torsional_friction=0.0,
     reference_points=None,
@@ -254,7 +263,7 @@ def batch_certificates(
     result : BatchClosureResult
         Of :func:`~drakegrasp.batch_form_closure` (``kind="form"``) or
         :func:`~drakegrasp.batch_force_closure` (``kind="force"``).
-    mu, model, num_generators, torsional_friction, reference_points,
+    mu, contact_model, num_generators, torsional_friction, reference_points,
     characteristic_lengths
         As given to the batch call (form closure ignores the friction ones).
 
@@ -278,7 +287,7 @@ def batch_certificates(
     form = result.kind == "form"
     options = {
         "mu": mu,
-        "model": model,
+        "model": contact_model,
         "torsional_friction": torsional_friction,
         "reference_points": reference_points,
         "characteristic_lengths": characteristic_lengths,
@@ -297,7 +306,7 @@ def batch_certificates(
             normals,
             int(k),
             mu=mu,
-            model="frictionless" if form else model,
+            contact_model="frictionless" if form else contact_model,
             torsional_friction=torsional_friction,
             reference_points=reference_points,
             characteristic_lengths=characteristic_lengths,

@@ -145,7 +145,7 @@ def _forces(cert: Witness, grasp: Grasp) -> tuple[np.ndarray, ...]:
             raise _foreign(
                 f"force of contact {i}",
                 a.shape,
-                f"({c.num_components},) for a {c.model.value} contact",
+                f"({c.num_components},) for a {c.contact_model.value} contact",
                 grasp,
             )
         out.append(a)

@@ -73,7 +73,7 @@ from drakegrasp.core.grasp import (
     Grasp,
     check_hand_jacobian,
     grasp_matrix,
-    normalised_grasp_matrix,
+    invariant_grasp_matrix,
 )
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
@@ -374,7 +374,7 @@ def _cone_slack(
         x = f[list(cone.components)]
         if cert.cones == "exact" and cone.components in ((0, 1, 2), (0, 1, 2, 3)):
             used = np.linalg.norm(x[1:3]) / c.mu
-            if c.model is ContactModel.SOFT_FINGER and len(x) == 4:
+            if c.contact_model is ContactModel.SOFT_FINGER and len(x) == 4:
                 used += abs(x[3]) / (b * c.torsional_friction)
             out.append(x[0] - used)
         else:
@@ -399,7 +399,7 @@ def _check_balance(cert: ReadWitness, grasp: Grasp):
     if not total > 0.0:
         return np.inf, 0.0, "the internal force is zero"
     inside = _cone_slack(grasp, cert, forces).min() / total
-    A = normalised_grasp_matrix(grasp)[:, cols]
+    A = invariant_grasp_matrix(grasp)[:, cols]
     norms = np.linalg.norm(A, axis=0)
     s = np.linalg.svd(A / np.where(norms > 0, norms, 1.0), compute_uv=False)
     ratio = s[-1] / s[0] if s.size >= grasp.wrench_dim else 0.0

@@ -1,7 +1,7 @@
 r"""Compute the certificates of the closure verdicts (``pydrake.solvers`` only).
 
 The witness of a "no" comes from the normalised balance matrix ``Ḡ = T G``
-(:func:`~drakegrasp.core.grasp.normalised_grasp_matrix`) on which every rank is
+(:func:`~drakegrasp.core.grasp.invariant_grasp_matrix`) on which every rank is
 decided, then is mapped to the grasp frame: ``Ḡᵀ u = Gᵀ (Tᵀ u)``, so a dual
 vector ``u`` of ``Ḡ`` is the physical twist ``Tᵀ u`` (an escape twist, or the
 normal of a separating hyperplane in wrench space), and the wrench that
@@ -46,7 +46,7 @@ from drakegrasp.certificates.certificate import (
     support_of,
 )
 from drakegrasp.core.friction_cone import ConeLayout
-from drakegrasp.core.grasp import Grasp, grasp_matrix, normalised_grasp_matrix
+from drakegrasp.core.grasp import Grasp, grasp_matrix, invariant_grasp_matrix
 from drakegrasp.core.linalg import left_null_space
 
 __all__ = [
@@ -64,7 +64,7 @@ _ACCEPT = -1e-9
 
 
 def normalising_transform(grasp: Grasp) -> np.ndarray:
-    """``T`` with ``normalised_grasp_matrix(grasp) = T @ grasp_matrix(grasp)``.
+    """``T`` with ``invariant_grasp_matrix(grasp) = T @ grasp_matrix(grasp)``.
 
     Returns
     -------
@@ -228,7 +228,7 @@ def escape_twist(grasp: Grasp, rank: int) -> Certificate | None:
         None when no ``v`` with ``G_nᵀ v >= 0`` exists (LP1's "no" was within
         ``tol`` of the boundary).
     """
-    A = normalised_grasp_matrix(grasp)[:, grasp.normal_indices()]
+    A = invariant_grasp_matrix(grasp)[:, grasp.normal_indices()]
     G_n = grasp_matrix(grasp)[:, grasp.normal_indices()]
     if rank < grasp.wrench_dim:
         return null_space_certificate(grasp, A, rank, G_n=G_n)
@@ -312,7 +312,7 @@ def unresisted_wrench(
         "no" was within ``tol`` of the boundary).
     """
     layout = ConeLayout.of(grasp, num_generators)
-    A = normalised_grasp_matrix(grasp)[:, layout.columns]
+    A = invariant_grasp_matrix(grasp)[:, layout.columns]
     if rank < grasp.wrench_dim:
         return null_space_certificate(
             grasp, A, rank, cones=cones, num_generators=num_generators
@@ -407,7 +407,7 @@ def balance_certificate(
         cols = grasp.normal_indices()
     else:
         cols = ConeLayout.of(grasp, num_generators).columns
-    A = normalised_grasp_matrix(grasp)[:, cols]
+    A = invariant_grasp_matrix(grasp)[:, cols]
     norms = np.linalg.norm(A, axis=0)
     scale = np.where(norms > 0.0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
     # N(A) = D N(A D): the null space of the equilibrated matrix, pulled back.

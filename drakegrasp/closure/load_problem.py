@@ -18,7 +18,7 @@ Every program is written in well-scaled variables so that no unit enters a
 solver tolerance:
 
 * balance on the normalised grasp matrix ``Ḡ = T G``
-  (:func:`~drakegrasp.normalised_grasp_matrix`; moments about the centroid,
+  (:func:`~drakegrasp.invariant_grasp_matrix`; moments about the centroid,
   over the spread), imposed as ``Ḡ f = -T w``;
 * forces in units of a force scale ``F0`` (the load's size), so ``x = f / F0``;
 * torques on the unit columns of ``J``: ``τ̃_j = τ_j / (c_j F0)`` with ``c_j``
@@ -222,7 +222,7 @@ def _check_squeeze(value) -> float:
 
 
 def normalising_transform(grasp: Grasp) -> np.ndarray:
-    """``T`` with ``normalised_grasp_matrix(grasp) = T @ grasp_matrix(grasp)``.
+    """``T`` with ``invariant_grasp_matrix(grasp) = T @ grasp_matrix(grasp)``.
 
     Moments move from ``p`` to the contacts' centroid ``c̄`` and are divided by
     the spread ``L`` (``docs/conventions.md``, "Invariance").

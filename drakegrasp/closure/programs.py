@@ -44,7 +44,7 @@ from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.core.grasp import (
     Grasp,
     check_hand_jacobian,
-    normalised_grasp_matrix,
+    invariant_grasp_matrix,
 )
 from drakegrasp.core.linalg import (
     equilibrated,
@@ -514,10 +514,10 @@ def balance_matrix(grasp: Grasp, columns: np.ndarray) -> np.ndarray:
     """Columns ``columns`` of the normalised ``G`` (same null space as ``G``).
 
     Every rank, row space and null space below is computed on
-    :func:`~drakegrasp.core.grasp.normalised_grasp_matrix`, so no verdict depends on
+    :func:`~drakegrasp.core.grasp.invariant_grasp_matrix`, so no verdict depends on
     units, on the reference point or on where the grasp sits in its frame.
     """
-    return normalised_grasp_matrix(grasp)[:, columns]
+    return invariant_grasp_matrix(grasp)[:, columns]
 
 
 def normal_balance_matrix(grasp: Grasp) -> np.ndarray:

@@ -105,7 +105,7 @@ def _two_contacts(grasp_or_contacts: Grasp | Sequence[Contact]) -> tuple[Contact
 
 
 def _friction(contact: Contact) -> float:
-    return 0.0 if contact.model is ContactModel.FRICTIONLESS else contact.mu
+    return 0.0 if contact.contact_model is ContactModel.FRICTIONLESS else contact.mu
 
 
 def _angle(u: np.ndarray, v: np.ndarray) -> float:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from drakegrasp.core.deprecation import warn_deprecated
 from drakegrasp.core.validation import (
     check_coefficient,
     check_positions,
@@ -133,6 +134,24 @@ def _unit_normal(normal: np.ndarray) -> np.ndarray:
     return unit_vectors("normal", n)
 
 
+def _deprecated_model(contact_model, deprecated: dict, where: str):
+    """``contact_model``, or the deprecated ``model=`` of ``deprecated`` (warned)."""
+    unknown = set(deprecated) - {"model"}
+    if unknown:
+        raise InvalidContactError(
+            f"{where} got unexpected keyword(s) {sorted(unknown)}"
+        )
+    if "model" not in deprecated:
+        return contact_model
+    if contact_model is not None:
+        raise InvalidContactError(
+            f"{where} got both model= (deprecated) and contact_model=; give "
+            "contact_model= only"
+        )
+    warn_deprecated(f"{where}: model= is deprecated; use contact_model=", stacklevel=4)
+    return deprecated["model"]
+
+
 def _frozen(a: np.ndarray) -> np.ndarray:
     a = np.array(a, dtype=float)
     a.flags.writeable = False
@@ -152,9 +171,10 @@ class Contact:
         normalised.  Its dimension must match ``position``.
     mu : float, optional
         Coulomb friction coefficient, ``>= 0``.  Ignored by frictionless contacts.
-    model : ContactModel or str, optional
-        ``"frictionless"``, ``"hard_finger"`` (default) or ``"soft_finger"``.
-        A soft finger is spatial only.
+    contact_model : ContactModel or str, optional
+        ``"frictionless"``, ``"hard_finger"`` (default, also for ``None``) or
+        ``"soft_finger"``.  A soft finger is spatial only.  ``model=`` is its
+        deprecated alias.
     torsional_friction : float or None, optional
         Torsional friction coefficient ``ν`` of a soft finger: the moment
         about the normal is bounded by ``b ν f_n`` with ``b`` the grasp's
@@ -182,7 +202,7 @@ class Contact:
     position: np.ndarray
     normal: np.ndarray
     mu: float = 0.0
-    model: ContactModel = ContactModel.HARD_FINGER
+    contact_model: ContactModel = ContactModel.HARD_FINGER
     torsional_friction: float = 0.0
     _frame: np.ndarray = field(init=False, repr=False, compare=False)
 
@@ -192,9 +212,11 @@ class Contact:
         normal: np.ndarray,
         *,
         mu: float = 0.0,
-        model: ContactModel | str = ContactModel.HARD_FINGER,
+        contact_model: ContactModel | str | None = None,
         torsional_friction: float | None = None,
+        **deprecated,
     ) -> None:
+        contact_model = _deprecated_model(contact_model, deprecated, "Contact()")
         p = check_positions("contact position", position)
         if p.ndim > 1 and p.size in (2, 3):
             p = p.reshape(-1)
@@ -211,7 +233,9 @@ class Contact:
                 f"{n.tolist()} has {n.size}; both must be 2-D or both 3-D"
             )
         mu_value = check_coefficient("mu", mu)
-        contact_model = ContactModel.parse(model)
+        contact_model = ContactModel.parse(
+            ContactModel.HARD_FINGER if contact_model is None else contact_model
+        )
         if contact_model is ContactModel.SOFT_FINGER and p.size == 2:
             raise InvalidContactError(
                 "a soft-finger contact is spatial only; planar contacts are "
@@ -229,7 +253,7 @@ class Contact:
         object.__setattr__(self, "position", _frozen(p))
         object.__setattr__(self, "normal", _frozen(n))
         object.__setattr__(self, "mu", mu_value)
-        object.__setattr__(self, "model", contact_model)
+        object.__setattr__(self, "contact_model", contact_model)
         object.__setattr__(self, "torsional_friction", nu_value)
         object.__setattr__(self, "_frame", _frozen(contact_frames(n)))
 
@@ -237,6 +261,12 @@ class Contact:
     def dim(self) -> int:
         """Dimension of the contact: 2 (planar) or 3 (spatial)."""
         return int(self.position.size)
+
+    @property
+    def model(self) -> ContactModel:
+        """Deprecated alias of :attr:`contact_model`."""
+        warn_deprecated("Contact.model is deprecated; use Contact.contact_model")
+        return self.contact_model
 
     @property
     def planar(self) -> bool:
@@ -256,11 +286,11 @@ class Contact:
     @property
     def component_names(self) -> tuple[str, ...]:
         """Names of the force components in order, normal component first."""
-        if self.model is ContactModel.FRICTIONLESS:
+        if self.contact_model is ContactModel.FRICTIONLESS:
             return ("f_n",)
         if self.planar:
             return ("f_n", "f_t")
-        if self.model is ContactModel.HARD_FINGER:
+        if self.contact_model is ContactModel.HARD_FINGER:
             return ("f_n", "f_t1", "f_t2")
         return ("f_n", "f_t1", "f_t2", "m_n")
 
@@ -273,9 +303,12 @@ class Contact:
         degenerate cone never changes a verdict.
         """
         keep = [0]
-        if self.model is not ContactModel.FRICTIONLESS and self.mu > 0.0:
+        if self.contact_model is not ContactModel.FRICTIONLESS and self.mu > 0.0:
             keep += [1] if self.planar else [1, 2]
-        if self.model is ContactModel.SOFT_FINGER and self.torsional_friction > 0:
+        if (
+            self.contact_model is ContactModel.SOFT_FINGER
+            and self.torsional_friction > 0
+        ):
             keep.append(3)
         return tuple(keep)
 
@@ -289,12 +322,19 @@ class Contact:
         return ContactModel.HARD_FINGER
 
     def with_(self, **changes) -> Contact:
-        """Return a copy with some fields replaced (``mu``, ``model``, ...)."""
+        """Return a copy with some fields replaced (``mu``, ``contact_model``, ...)."""
+        if "model" in changes:
+            changes = dict(changes)
+            changes["contact_model"] = _deprecated_model(
+                changes.pop("contact_model", None),
+                {"model": changes.pop("model")},
+                "Contact.with_()",
+            )
         kwargs = {
             "position": self.position,
             "normal": self.normal,
             "mu": self.mu,
-            "model": self.model,
+            "contact_model": self.contact_model,
             "torsional_friction": self.torsional_friction,
         }
         unknown = set(changes) - set(kwargs)
@@ -314,7 +354,7 @@ class Contact:
             "position": self.position.tolist(),
             "normal": self.normal.tolist(),
             "mu": self.mu,
-            "model": self.model.value,
+            "contact_model": self.contact_model.value,
             "torsional_friction": self.torsional_friction,
         }
 
@@ -323,5 +363,5 @@ class Contact:
         return (
             f"Contact(position={np.round(self.position, 6).tolist()}, "
             f"normal={np.round(self.normal, 6).tolist()}, mu={self.mu:g}, "
-            f"model={self.model.value!r}{extra})"
+            f"contact_model={self.contact_model.value!r}{extra})"
         )

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.grasp import Grasp
 
 __all__ = [
@@ -73,10 +74,10 @@ def planar_square_four_contacts(half_width: float = 1.0) -> Grasp:
     h = half_width
     return Grasp(
         [
-            Contact([h, h / 2], [-1, 0], model=ContactModel.FRICTIONLESS),
-            Contact([-h, -h / 2], [1, 0], model=ContactModel.FRICTIONLESS),
-            Contact([-h / 2, -h], [0, 1], model=ContactModel.FRICTIONLESS),
-            Contact([h / 2, h], [0, -1], model=ContactModel.FRICTIONLESS),
+            Contact([h, h / 2], [-1, 0], contact_model=ContactModel.FRICTIONLESS),
+            Contact([-h, -h / 2], [1, 0], contact_model=ContactModel.FRICTIONLESS),
+            Contact([-h / 2, -h], [0, 1], contact_model=ContactModel.FRICTIONLESS),
+            Contact([h / 2, h], [0, -1], contact_model=ContactModel.FRICTIONLESS),
         ]
     )
 
@@ -112,18 +113,21 @@ def cube_seven_contacts(half_width: float = 1.0) -> Grasp:
     """
     return Grasp(
         [
-            Contact(np.array(p) * half_width, n, model=ContactModel.FRICTIONLESS)
+            Contact(
+                np.array(p) * half_width, n, contact_model=ContactModel.FRICTIONLESS
+            )
             for p, n in _CUBE_CONTACTS
         ]
     )
 
 
+@renamed_keyword("model", "contact_model")
 def equator_fingers(
     mu: float,
     *,
     num_fingers: int = 3,
     radius: float = 1.0,
-    model: ContactModel | str = ContactModel.HARD_FINGER,
+    contact_model: ContactModel | str = ContactModel.HARD_FINGER,
     torsional_friction: float = 0.0,
 ) -> Grasp:
     """Fingers evenly spaced on a sphere's equator, pushing towards the centre.
@@ -139,7 +143,7 @@ def equator_fingers(
     num_fingers : int, optional
     radius : float, optional
         Sphere radius, metres.
-    model : ContactModel or str, optional
+    contact_model : ContactModel or str, optional
     torsional_friction : float, optional
 
     Returns
@@ -156,18 +160,19 @@ def equator_fingers(
                 radius * outward,
                 -outward,
                 mu=mu,
-                model=model,
+                contact_model=contact_model,
                 torsional_friction=torsional_friction,
             )
         )
     return Grasp(contacts)
 
 
+@renamed_keyword("model", "contact_model")
 def spatial_two_fingers(
     mu: float,
     *,
     half_width: float = 0.05,
-    model: ContactModel | str = ContactModel.HARD_FINGER,
+    contact_model: ContactModel | str = ContactModel.HARD_FINGER,
     torsional_friction: float = 0.0,
 ) -> Grasp:
     """Two fingers squeezing a box along x, as a parallel-jaw gripper does.
@@ -181,7 +186,7 @@ def spatial_two_fingers(
     mu : float
     half_width : float, optional
         Half the box's width along x, metres.
-    model : ContactModel or str, optional
+    contact_model : ContactModel or str, optional
     torsional_friction : float, optional
 
     Returns
@@ -194,14 +199,14 @@ def spatial_two_fingers(
                 [-half_width, 0, 0],
                 [1, 0, 0],
                 mu=mu,
-                model=model,
+                contact_model=contact_model,
                 torsional_friction=torsional_friction,
             ),
             Contact(
                 [half_width, 0, 0],
                 [-1, 0, 0],
                 mu=mu,
-                model=model,
+                contact_model=contact_model,
                 torsional_friction=torsional_friction,
             ),
         ]

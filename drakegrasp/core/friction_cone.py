@@ -456,6 +456,6 @@ def support_of(a: np.ndarray, cone, contact, cones: str, b: float) -> float:
     if not (cones == "exact" and cone.components in ((0, 1, 2), (0, 1, 2, 3))):
         return float(np.max(cone.generators.T @ a))
     value = contact.mu * np.linalg.norm(a[1:3])
-    if contact.model is ContactModel.SOFT_FINGER and len(a) == 4:
+    if contact.contact_model is ContactModel.SOFT_FINGER and len(a) == 4:
         value = max(value, b * contact.torsional_friction * abs(a[3]))
     return float(a[0] + value)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.core.contact import Contact, ContactModel
+from drakegrasp.core.deprecation import renamed_keyword, warn_deprecated
 from drakegrasp.core.validation import (
     JACOBIAN_BOUND,
     check_length,
@@ -33,6 +34,7 @@ __all__ = [
     "check_hand_jacobian",
     "grasp_matrix",
     "normal_grasp_matrix",
+    "invariant_grasp_matrix",
     "normalised_grasp_matrix",
     "wrench_columns",
 ]
@@ -183,19 +185,23 @@ class Grasp:
             characteristic_length=self.characteristic_length,
         )
 
+    @renamed_keyword("model", "contact_model")
     def with_friction(
         self,
         mu: float | None = None,
         *,
-        model: ContactModel | str | None = None,
+        contact_model: ContactModel | str | None = None,
         torsional_friction: float | None = None,
     ) -> Grasp:
-        """Copy with every contact's ``mu``/``model``/``torsional_friction`` set."""
+        """Copy with every contact's friction and contact model set (those given).
+
+        ``model=`` is a deprecated alias of ``contact_model=``.
+        """
         changes = {}
         if mu is not None:
             changes["mu"] = mu
-        if model is not None:
-            changes["model"] = model
+        if contact_model is not None:
+            changes["contact_model"] = contact_model
         if torsional_friction is not None:
             changes["torsional_friction"] = torsional_friction
         return self.with_contacts([c.with_(**changes) for c in self.contacts])
@@ -209,7 +215,7 @@ class Grasp:
         return G
 
     @functools.cached_property
-    def _normalised_grasp_matrix(self) -> np.ndarray:
+    def _invariant_grasp_matrix(self) -> np.ndarray:
         """``T G`` with moments about the centroid over the spread; read-only."""
         positions = self.positions
         centroid = positions.mean(axis=0)
@@ -276,7 +282,7 @@ def wrench_columns(
 def _contact_block(contact: Contact, p: np.ndarray) -> np.ndarray:
     R = contact.frame
     k = contact.num_components
-    if contact.model is ContactModel.FRICTIONLESS:
+    if contact.contact_model is ContactModel.FRICTIONLESS:
         return wrench_columns(contact.position, R[:, :1], p)
     block = wrench_columns(contact.position, R, p)
     if k == 4:  # soft finger: a pure moment about the normal
@@ -337,7 +343,7 @@ def normal_grasp_matrix(grasp: Grasp) -> np.ndarray:
     return _require_grasp(grasp)._grasp_matrix[:, grasp.normal_indices()]
 
 
-def normalised_grasp_matrix(grasp: Grasp) -> np.ndarray:
+def invariant_grasp_matrix(grasp: Grasp) -> np.ndarray:
     r"""``G`` made invariant to units and to the reference point, for rank tests.
 
     Parameters
@@ -368,7 +374,20 @@ def normalised_grasp_matrix(grasp: Grasp) -> np.ndarray:
     moments about a point ``10⁶ b`` away, or in nanometres, no longer swamp or
     vanish beside the forces.
     """
-    return _require_grasp(grasp)._normalised_grasp_matrix.copy()
+    return _require_grasp(grasp)._invariant_grasp_matrix.copy()
+
+
+def normalised_grasp_matrix(grasp: Grasp) -> np.ndarray:
+    """Deprecated name of :func:`invariant_grasp_matrix` (``T G``).
+
+    It was four letters away from :func:`normal_grasp_matrix` (``G_n``), which
+    holds something else.
+    """
+    warn_deprecated(
+        "normalised_grasp_matrix is deprecated; use invariant_grasp_matrix "
+        "(normal_grasp_matrix is G_n, another matrix)"
+    )
+    return invariant_grasp_matrix(grasp)
 
 
 def _require_grasp(grasp) -> Grasp:

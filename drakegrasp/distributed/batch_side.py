@@ -143,7 +143,7 @@ def evaluate_on_cluster(
         The engine's chunk size (default: sized by bytes, as locally).
     **options
         The other keyword options of :func:`drakegrasp.batch_force_closure`
-        (or :func:`~drakegrasp.batch_form_closure`), e.g. ``model``, ``tol``,
+        (or :func:`~drakegrasp.batch_form_closure`), e.g. ``contact_model``, ``tol``,
         ``torsional_friction``, ``reference_points``.
 
     Returns

@@ -95,7 +95,7 @@ def job_manifest(*, kind: str, shape, arrays: dict, options: dict,
     arrays : dict of str to array-like
         ``positions``, ``normals`` and the per-grasp options (``mu`` ...).
     options : dict
-        The engine's other options (``model``, ``tol``, ...).
+        The engine's other options (``contact_model``, ``tol``, ...).
     step, chunk_size : int
         Grasps per partition and per engine chunk.
     rows : list of int

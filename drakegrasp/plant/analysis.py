@@ -177,7 +177,7 @@ def _core_contact(
         position,
         normal,
         mu=mu,
-        model=model,
+        contact_model=model,
         torsional_friction=torsional_friction,
     )
 
@@ -502,11 +502,11 @@ class GraspReport:
         c0 = g.contacts[0]
         kind = f"planar ({self.data.plane} plane of O)" if g.planar else "spatial"
         friction = f"mu = {c0.mu:g}"
-        if c0.model is ContactModel.SOFT_FINGER:
+        if c0.contact_model is ContactModel.SOFT_FINGER:
             friction += f", nu = {c0.torsional_friction:g}"
         lines = [
             f"Grasp of {self.data.object_body} — {g.num_contacts} contacts, {kind}, "
-            f"{c0.model.value}, {friction}",
+            f"{c0.contact_model.value}, {friction}",
             "  frame O = the object body frame; moments about its origin; "
             f"b = {g.characteristic_length * 1e3:.4g} mm",
             *([] if self.pose is None else ["  " + self.pose.summary()]),

@@ -188,7 +188,7 @@ def hand_jacobian(
             Jv = Jv[list(PLANES[plane]), :]
         R = c.frame
         k = c.num_components
-        if c.model is ContactModel.FRICTIONLESS:
+        if c.contact_model is ContactModel.FRICTIONLESS:
             blocks.append(R[:, :1].T @ Jv)
             continue
         block = R.T @ Jv

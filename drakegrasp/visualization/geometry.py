@@ -170,7 +170,7 @@ def normalize_contact_forces(grasp: Grasp, forces: Any) -> list[np.ndarray] | No
         k = contact.num_components
         if a.size > k or a.size == 0:
             raise InvalidOptionError(
-                f"contact {i} ({contact.model.value}) has {k} force components "
+                f"contact {i} ({contact.contact_model.value}) has {k} force components "
                 f"({', '.join(contact.component_names)}), got {a.tolist()}"
             )
         if not np.all(np.isfinite(a)):

@@ -26,7 +26,7 @@ def make_grasp(P, Nrm, mu, *, model="hard_finger", nu=0.0, p=None, b=None):
     mu = np.broadcast_to(np.asarray(mu, dtype=float), (N,))
     nu = np.broadcast_to(np.asarray(nu, dtype=float), (N,))
     contacts = [
-        Contact(P[i], Nrm[i], mu=mu[i], model=model, torsional_friction=nu[i])
+        Contact(P[i], Nrm[i], mu=mu[i], contact_model=model, torsional_friction=nu[i])
         for i in range(N)
     ]
     return Grasp(contacts, reference_point=p, characteristic_length=b)

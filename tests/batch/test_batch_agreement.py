@@ -80,8 +80,8 @@ def test_force_closure_matches_mathematical_program(N, d, model, mu_case, K):
     batch = batch_force_closure(
         P,
         Nrm,
-        mu,
-        model=model,
+        mu=mu,
+        contact_model=model,
         torsional_friction=nu,
         reference_points=p,
         chunk_size=97,
@@ -131,7 +131,7 @@ def test_force_closure_matches_highs_on_the_unreduced_lp(N, d, mu_case, K):
     P, Nrm = random_grasps(rng, K, N, d, spread=0.5)
     mu = _mu_array(rng, K, N, mu_case)
     mu_a = _full(mu, K, N)
-    batch = batch_force_closure(P, Nrm, mu_a, num_generators=6)
+    batch = batch_force_closure(P, Nrm, mu=mu_a, num_generators=6)
     refs = [
         scipy_force_closure(make_grasp(P[k], Nrm[k], mu_a[k]), num_generators=6)
         for k in range(K)
@@ -180,6 +180,6 @@ def test_degenerate_and_badly_scaled_grasps_match_highs():
     rng = np.random.default_rng(5000)
     for what, P, Nrm, mu in _edge_cases(rng):
         K, N, _ = P.shape
-        batch = batch_force_closure(P, Nrm, mu)
+        batch = batch_force_closure(P, Nrm, mu=mu)
         refs = [scipy_force_closure(make_grasp(P[k], Nrm[k], mu)) for k in range(K)]
         _check(batch, refs, what=what)

@@ -51,7 +51,7 @@ def test_every_batch_no_has_a_witness_that_holds(d, N, model, mu, nu):
     certs = batch_certificates(P, n, form, reference_points=p)
     assert np.array_equal(certs.has_witness, ~form.is_closure)
     for k in np.flatnonzero(~form.is_closure):
-        g = grasp_at(P, n, k, model="frictionless", reference_points=p)
+        g = grasp_at(P, n, k, contact_model="frictionless", reference_points=p)
         G_n = dg.normal_grasp_matrix(g)
         v = certs.direction[k]
         rates = G_n.T @ v / (np.linalg.norm(G_n, 2) * np.linalg.norm(v))
@@ -60,15 +60,27 @@ def test_every_batch_no_has_a_witness_that_holds(d, N, model, mu, nu):
         )
         checked += 1
     force = dg.batch_force_closure(
-        P, n, mu, model=model, torsional_friction=nu, reference_points=p
+        P, n, mu=mu, contact_model=model, torsional_friction=nu, reference_points=p
     )
     certs = batch_certificates(
-        P, n, force, mu=mu, model=model, torsional_friction=nu, reference_points=p
+        P,
+        n,
+        force,
+        mu=mu,
+        contact_model=model,
+        torsional_friction=nu,
+        reference_points=p,
     )
     assert np.array_equal(certs.has_witness, ~force.is_closure)
     for k in np.flatnonzero(~force.is_closure):
         g = grasp_at(
-            P, n, k, mu=mu, model=model, torsional_friction=nu, reference_points=p
+            P,
+            n,
+            k,
+            mu=mu,
+            contact_model=model,
+            torsional_friction=nu,
+            reference_points=p,
         )
         y, w = certs.separating_twist[k], certs.direction[k]
         assert y @ w > 0
@@ -121,7 +133,7 @@ def test_rank_deficient_witnesses_are_vectorised_and_span_the_single_paths(
             P,
             n,
             k,
-            model="frictionless" if form else "hard_finger",
+            contact_model="frictionless" if form else "hard_finger",
             reference_points=p,
             **kw,
         )

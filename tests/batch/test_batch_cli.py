@@ -23,7 +23,7 @@ def test_batch_command_writes_the_api_verdicts(grasp_file, tmp_path, capsys):
     out = tmp_path / "out.npz"
     assert main(["batch", str(path), str(out), "--metrics", "sigma_min"]) == 0
     written = np.load(out)
-    expected = dg.batch_force_closure(p, n, 0.5, metrics=("sigma_min",))
+    expected = dg.batch_force_closure(p, n, mu=0.5, metrics=("sigma_min",))
     assert np.array_equal(written["is_closure"], expected.is_closure)
     assert np.allclose(written["d_star"], expected.d_star)
     assert np.allclose(written["sigma_min"], expected.metrics["sigma_min"])
@@ -36,7 +36,7 @@ def test_mu_on_the_command_line_overrides_the_file(grasp_file, tmp_path):
     out = tmp_path / "out.npz"
     assert main(["batch", str(path), str(out), "--mu", "0"]) == 0
     assert np.array_equal(
-        np.load(out)["is_closure"], dg.batch_force_closure(p, n, 0.0).is_closure
+        np.load(out)["is_closure"], dg.batch_force_closure(p, n, mu=0.0).is_closure
     )
 
 
@@ -77,7 +77,7 @@ def test_a_directory_of_npy_files_is_read_chunk_by_chunk(grasp_file, tmp_path):
     assert (
         main(["batch", str(folder), str(out), "--mu", "0.5", "--chunk-size", "64"]) == 0
     )
-    expected = dg.batch_force_closure(p, n, 0.5)
+    expected = dg.batch_force_closure(p, n, mu=0.5)
     assert np.array_equal(np.load(out)["is_closure"], expected.is_closure)
 
 

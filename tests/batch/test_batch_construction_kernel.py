@@ -283,8 +283,8 @@ def test_numpy_kernel_takes_friction_that_differs_between_grasps_and_contacts(N)
     K = 150
     P, Nrm = random_grasps(rng, K, N, 3)
     for mu in (rng.uniform(0.2, 0.9, (K, 1)), rng.choice([0.3, 0.6, 1.0], (1, N))):
-        ref = batch_force_closure(P, Nrm, mu, workers=1, kernel="numpy")
-        fast = batch_force_closure(P, Nrm, mu, workers=1, kernel="numba")
+        ref = batch_force_closure(P, Nrm, mu=mu, workers=1, kernel="numpy")
+        fast = batch_force_closure(P, Nrm, mu=mu, workers=1, kernel="numba")
         np.testing.assert_array_equal(ref.is_closure, fast.is_closure)
         np.testing.assert_allclose(ref.d_star, fast.d_star, rtol=0, atol=1e-8)
         assert 0 < ref.is_closure.sum() < K

@@ -30,7 +30,7 @@ def test_bad_normal_names_grasp_and_contact(grasps, bad):
     Nrm = Nrm.copy()
     Nrm[27, 2] = bad
     with pytest.raises(InvalidContactError, match=r"grasp 27, contact 2"):
-        batch_force_closure(P, Nrm, 0.5, chunk_size=8)
+        batch_force_closure(P, Nrm, mu=0.5, chunk_size=8)
     with pytest.raises(InvalidContactError, match=r"grasp 27, contact 2"):
         batch_form_closure(P, Nrm)
 
@@ -40,7 +40,7 @@ def test_non_finite_position(grasps):
     P = P.copy()
     P[5, 0, 1] = np.nan
     with pytest.raises(InvalidContactError, match=r"grasp 5, contact 0.*not finite"):
-        batch_force_closure(P, Nrm, 0.5)
+        batch_force_closure(P, Nrm, mu=0.5)
 
 
 @pytest.mark.parametrize("bad", [-0.1, np.nan])
@@ -51,56 +51,60 @@ def test_bad_mu_names_index_and_value(grasps, bad):
     with pytest.raises(
         InvalidContactError, match=rf"mu of grasp 33, contact 1 is {bad}"
     ):
-        batch_force_closure(P, Nrm, mu, chunk_size=16)
+        batch_force_closure(P, Nrm, mu=mu, chunk_size=16)
     with pytest.raises(InvalidContactError, match="mu must be finite"):
-        batch_force_closure(P, Nrm, bad)
+        batch_force_closure(P, Nrm, mu=bad)
 
 
 def test_shape_errors(grasps):
     P, Nrm = grasps
     with pytest.raises(InvalidContactError, match=r"\(K, N, 2\) or \(K, N, 3\)"):
-        batch_force_closure(P[..., :1], Nrm[..., :1], 0.5)
+        batch_force_closure(P[..., :1], Nrm[..., :1], mu=0.5)
     with pytest.raises(InvalidContactError, match="normals must have the shape"):
-        batch_force_closure(P, Nrm[:, :2], 0.5)
+        batch_force_closure(P, Nrm[:, :2], mu=0.5)
     with pytest.raises(InvalidContactError, match=r"mu must be a scalar.*\(7,\)"):
-        batch_force_closure(P, Nrm, np.ones(7))
+        batch_force_closure(P, Nrm, mu=np.ones(7))
     with pytest.raises(InvalidGraspError, match="reference_points"):
-        batch_force_closure(P, Nrm, 0.5, reference_points=np.zeros((3, 3)))
+        batch_force_closure(P, Nrm, mu=0.5, reference_points=np.zeros((3, 3)))
     with pytest.raises(InvalidGraspError, match="reference point of grasp 4"):
         p = np.zeros((40, 3))
         p[4, 0] = np.inf
-        batch_force_closure(P, Nrm, 0.5, reference_points=p)
+        batch_force_closure(P, Nrm, mu=0.5, reference_points=p)
     with pytest.raises(InvalidGraspError, match="characteristic length of grasp 0"):
-        batch_force_closure(P, Nrm, 0.5, characteristic_lengths=-1.0)
+        batch_force_closure(P, Nrm, mu=0.5, characteristic_lengths=-1.0)
 
 
 def test_option_errors(grasps):
     P, Nrm = grasps
     with pytest.raises(InvalidContactError, match="unknown contact model 'sticky'"):
-        batch_force_closure(P, Nrm, 0.5, model="sticky")
+        batch_force_closure(P, Nrm, mu=0.5, contact_model="sticky")
     with pytest.raises(InvalidContactError, match="soft-finger contact is spatial"):
-        batch_force_closure(P[..., :2], Nrm[..., :2], 0.5, model="soft_finger")
+        batch_force_closure(
+            P[..., :2], Nrm[..., :2], mu=0.5, contact_model="soft_finger"
+        )
     with pytest.raises(
         InvalidOptionError, match="num_generators must be an integer >= 3"
     ):
-        batch_force_closure(P, Nrm, 0.5, num_generators=2)
+        batch_force_closure(P, Nrm, mu=0.5, num_generators=2)
     with pytest.raises(
         InvalidOptionError, match="chunk_size must be an integer >= 1, got 0"
     ):
-        batch_force_closure(P, Nrm, 0.5, chunk_size=0)
+        batch_force_closure(P, Nrm, mu=0.5, chunk_size=0)
     with pytest.raises(InvalidOptionError, match="tol must be finite"):
-        batch_force_closure(P, Nrm, 0.5, tol=-1)
+        batch_force_closure(P, Nrm, mu=0.5, tol=-1)
     with pytest.raises(InvalidOptionError, match="unknown metric 'beauty'"):
-        batch_force_closure(P, Nrm, 0.5, metrics=["beauty"])
+        batch_force_closure(P, Nrm, mu=0.5, metrics=["beauty"])
     with pytest.raises(InvalidContactError, match="torsional_friction of grasp 1"):
         nu = np.zeros((40, 3))
         nu[1, 1] = -2
-        batch_force_closure(P, Nrm, 0.5, model="soft_finger", torsional_friction=nu)
+        batch_force_closure(
+            P, Nrm, mu=0.5, contact_model="soft_finger", torsional_friction=nu
+        )
     assert issubclass(InvalidOptionError, GraspError)
 
 
 def test_empty_batch():
-    res = batch_force_closure(np.zeros((0, 3, 3)), np.zeros((0, 3, 3)), 0.5)
+    res = batch_force_closure(np.zeros((0, 3, 3)), np.zeros((0, 3, 3)), mu=0.5)
     assert len(res) == 0 and res.d_star.shape == (0,) and res.required_rank == 6
 
 
@@ -110,10 +114,10 @@ def test_chunk_size_does_not_change_results():
     P, Nrm = random_grasps(rng, K, 4, 3)
     mu = rng.uniform(0, 1, (K, 4))
     mu[rng.random((K, 4)) < 0.25] = 0.0  # several layouts per chunk
-    ref = batch_force_closure(P, Nrm, mu, chunk_size=K, metrics=["sigma_min"])
+    ref = batch_force_closure(P, Nrm, mu=mu, chunk_size=K, metrics=["sigma_min"])
     assert 0 < ref.is_closure.sum() < K
     for cs in (1, 7, 64):
-        res = batch_force_closure(P, Nrm, mu, chunk_size=cs, metrics=["sigma_min"])
+        res = batch_force_closure(P, Nrm, mu=mu, chunk_size=cs, metrics=["sigma_min"])
         np.testing.assert_array_equal(res.is_closure, ref.is_closure)
         np.testing.assert_array_equal(res.rank, ref.rank)
         # The interior-point method stops at ~1e-10 on t = d*/N; the vectorised
@@ -182,7 +186,7 @@ def test_driver_reads_and_builds_one_chunk_at_a_time(monkeypatch):
     assert max(sizes) <= cs and sum(sizes) == K
     for a in arrays:
         assert max(a.reads) <= cs and sum(a.reads) == K
-    direct = batch_force_closure(P, Nrm, mu, chunk_size=cs)
+    direct = batch_force_closure(P, Nrm, mu=mu, chunk_size=cs)
     np.testing.assert_array_equal(res.d_star, direct.d_star)
 
 
@@ -190,19 +194,19 @@ def test_progress_bar_and_missing_tqdm(monkeypatch, capsys):
     rng = np.random.default_rng(14)
     P, Nrm = random_grasps(rng, 50, 3, 3)
     pytest.importorskip("tqdm")
-    res = batch_force_closure(P, Nrm, 0.5, chunk_size=10, progress=True)
+    res = batch_force_closure(P, Nrm, mu=0.5, chunk_size=10, progress=True)
     assert "50/50" in capsys.readouterr().err
     assert len(res) == 50
     monkeypatch.setitem(sys.modules, "tqdm", None)
     monkeypatch.setitem(sys.modules, "tqdm.auto", None)
     with pytest.raises(InvalidOptionError, match="needs the optional package tqdm"):
-        batch_force_closure(P, Nrm, 0.5, progress=True)
+        batch_force_closure(P, Nrm, mu=0.5, progress=True)
 
 
 def test_result_accessors_and_text():
     rng = np.random.default_rng(15)
     P, Nrm = random_grasps(rng, 30, 3, 3)
-    res = batch_force_closure(P, Nrm, 0.5, metrics=("isotropy",))
+    res = batch_force_closure(P, Nrm, mu=0.5, metrics=("isotropy",))
     assert res["d_star"] is res.d_star and res["isotropy"] is res.metrics["isotropy"]
     with pytest.raises(KeyError, match="available"):
         res["nope"]
@@ -234,7 +238,7 @@ def test_iter_batch_closure_is_lazy_and_matches_one_call():
     assert produced == [0] and len(first) == 30
     parts = [first, *stream]
     assert produced == [0, 30, 60]
-    whole = batch_force_closure(P, Nrm, mu)
+    whole = batch_force_closure(P, Nrm, mu=mu)
     np.testing.assert_allclose(
         np.concatenate([r.d_star for r in parts]), whole.d_star, atol=1e-12
     )
@@ -256,14 +260,16 @@ def test_missing_tqdm_names_the_extra(monkeypatch):
     with pytest.raises(
         InvalidOptionError, match=r'pip install "drakegrasp\[progress\]"'
     ):
-        batch_force_closure(P, Nrm, 0.5, progress=True)
+        batch_force_closure(P, Nrm, mu=0.5, progress=True)
 
 
 def test_soft_fingers_need_torsional_friction_explicit_zero_acts_hard():
     P, Nrm = random_grasps(np.random.default_rng(1), 6, 4, 3)
     with pytest.raises(InvalidContactError, match="needs torsional_friction"):
-        batch_force_closure(P, Nrm, 0.5, model="soft_finger")
-    soft0 = batch_force_closure(P, Nrm, 0.5, model="soft_finger", torsional_friction=0)
-    hard = batch_force_closure(P, Nrm, 0.5)
+        batch_force_closure(P, Nrm, mu=0.5, contact_model="soft_finger")
+    soft0 = batch_force_closure(
+        P, Nrm, mu=0.5, contact_model="soft_finger", torsional_friction=0
+    )
+    hard = batch_force_closure(P, Nrm, mu=0.5)
     np.testing.assert_array_equal(soft0.is_closure, hard.is_closure)
     np.testing.assert_allclose(soft0.d_star, hard.d_star, atol=1e-9)

@@ -33,7 +33,9 @@ def test_npz_round_trip(tmp_path):
     np.savez(src, positions=P, normals=Nrm, mu=mu, reference_points=p)
     out = tmp_path / "verdicts.npz"
     res = evaluate_file(src, out, metrics=["isotropy"], chunk_size=50)
-    direct = batch_force_closure(P, Nrm, mu, reference_points=p, metrics=["isotropy"])
+    direct = batch_force_closure(
+        P, Nrm, mu=mu, reference_points=p, metrics=["isotropy"]
+    )
     with np.load(out) as data:
         for name in ("is_closure", "d_star", "rank", "margin", "converged", "isotropy"):
             np.testing.assert_array_equal(data[name], direct[name])
@@ -97,7 +99,7 @@ def test_singular_value_metrics_match_the_quality_module():
         nu = 0.2 if model == "soft_finger" else 0.0
         names = ["sigma_min", "isotropy", "ellipsoid_volume"]
         res = batch_force_closure(
-            P, Nrm, mu, model=model, torsional_friction=nu, metrics=names
+            P, Nrm, mu=mu, contact_model=model, torsional_friction=nu, metrics=names
         )
         for k in range(K):
             g = make_grasp(P[k], Nrm[k], mu[k], model=model, nu=nu)
@@ -114,7 +116,7 @@ def test_epsilon_metric_calls_ferrari_canny():
     quality = pytest.importorskip("drakegrasp.quality")
     rng = np.random.default_rng(24)
     P, Nrm = random_grasps(rng, 6, 3, 3, spread=0.1)
-    res = batch_force_closure(P, Nrm, 0.5, metrics=["epsilon_l1"])
+    res = batch_force_closure(P, Nrm, mu=0.5, metrics=["epsilon_l1"])
     want = [quality.ferrari_canny(make_grasp(P[k], Nrm[k], 0.5)) for k in range(6)]
     np.testing.assert_allclose(res.metrics["epsilon_l1"], want, rtol=1e-12)
     assert (res.metrics["epsilon_l1"][res.is_closure] > 0).all()
@@ -212,7 +214,7 @@ def test_lps_that_hit_the_iteration_cap_are_finished_by_highs(monkeypatch):
 
     rng = np.random.default_rng(28)
     P, Nrm = random_grasps(rng, 150, 4, 3)
-    ref = batch_force_closure(P, Nrm, 0.5)
+    ref = batch_force_closure(P, Nrm, mu=0.5)
     calls = []
     real_highs = margin._highs
 
@@ -225,7 +227,7 @@ def test_lps_that_hit_the_iteration_cap_are_finished_by_highs(monkeypatch):
 
     monkeypatch.setattr(margin, "_highs", counting)
     monkeypatch.setattr(chunks, "solve_margin_blocks", capped)
-    res = batch_force_closure(P, Nrm, 0.5)
+    res = batch_force_closure(P, Nrm, mu=0.5)
     assert len(calls) > 50  # most LPs need more than two iterations
     assert res.converged.all()
     np.testing.assert_allclose(res.d_star, ref.d_star, atol=1e-8)

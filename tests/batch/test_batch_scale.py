@@ -33,7 +33,7 @@ from drakegrasp.batch.lp import block_kernel
 from drakegrasp.batch.lp.block_ipm import solve_block_lp
 from drakegrasp.batch.lp.dstar import solve_margin_blocks
 from drakegrasp.closure.verdicts import force_closure, form_closure
-from drakegrasp.core.grasp import normalised_grasp_matrix
+from drakegrasp.core.grasp import invariant_grasp_matrix
 from drakegrasp.errors import InvalidContactError
 
 needs_numba = pytest.mark.skipif(
@@ -79,7 +79,7 @@ def agreement_bound(grasp, d_star: float) -> float:
     (measured: at N = 32, κ <= 1.9, differences up to 1.6e-8 against a bound
     of 9e-8; the former fixed 1e-8 failed on one machine).
     """
-    s = np.linalg.svd(normalised_grasp_matrix(grasp), compute_uv=False)
+    s = np.linalg.svd(invariant_grasp_matrix(grasp), compute_uv=False)
     kappa = s[0] / s[-1] if s[-1] > 0 else np.inf
     return 10.0 * IPM_TOL * grasp.num_contacts * kappa * (1.0 + abs(d_star))
 
@@ -90,7 +90,9 @@ def test_agrees_with_the_single_path_across_n(N, d, model, K):
     P, Nrm = random_grasps(rng, K, N, d, spread=0.3 + 0.4 * (N <= 4))
     mu = rng.uniform(0.05, 0.9, (K, 1))
     nu = rng.uniform(0.0, 0.3, (K, 1)) if model == "soft_finger" else np.zeros((K, 1))
-    batch = batch_force_closure(P, Nrm, mu, model=model, torsional_friction=nu)
+    batch = batch_force_closure(
+        P, Nrm, mu=mu, contact_model=model, torsional_friction=nu
+    )
     d_ref = np.empty(K)
     bound = np.empty(K)
     v_ref = np.empty(K, dtype=bool)
@@ -156,8 +158,8 @@ def test_verdicts_do_not_depend_on_units_or_reference_point(
         ref = batch_form_closure(P, Nrm)
         res = batch_form_closure(scale * P, Nrm, reference_points=p)
     else:
-        ref = batch_force_closure(P, Nrm, 0.4)
-        res = batch_force_closure(scale * P, Nrm, 0.4, reference_points=p)
+        ref = batch_force_closure(P, Nrm, mu=0.4)
+        res = batch_force_closure(scale * P, Nrm, mu=0.4, reference_points=p)
     np.testing.assert_array_equal(res.rank, ref.rank)
     np.testing.assert_array_equal(res.is_closure, ref.is_closure)
     np.testing.assert_allclose(res.d_star, ref.d_star, atol=1e-8, rtol=0)
@@ -168,7 +170,7 @@ def test_the_well_scaled_copy_has_a_mix_of_verdicts():
     for d in (2, 3):
         for N in (3, 4, 8):
             P, Nrm = _well_scaled(d, N, 7200 + N + d)
-            v = batch_force_closure(P, Nrm, 0.4).is_closure
+            v = batch_force_closure(P, Nrm, mu=0.4).is_closure
             assert 0 < v.sum() < v.size or (d, N) == (3, 8)
 
 
@@ -176,7 +178,7 @@ def test_rank_uses_the_normalised_matrix():
     """Three equator fingers, p = (1e5, 3e4, -2e4): rank 6 and closure (issue 9)."""
     angles = 2 * np.pi * np.arange(3) / 3
     P = np.stack([np.cos(angles), np.sin(angles), np.zeros(3)], axis=1)[None]
-    res = batch_force_closure(P, -P, 0.5, reference_points=[1e5, 3e4, -2e4])
+    res = batch_force_closure(P, -P, mu=0.5, reference_points=[1e5, 3e4, -2e4])
     assert res.rank[0] == 6 and res.is_closure[0]
     assert abs(res.d_star[0] - 0.4194) < 1e-3
 
@@ -220,8 +222,8 @@ def test_results_are_bitwise_the_same_for_any_number_of_workers():
     K, N = 3000, 6
     P, Nrm = random_grasps(rng, K, N, 3)
     mu = rng.uniform(0.1, 0.8, (K, N))
-    one = batch_force_closure(P, Nrm, mu, chunk_size=500, workers=1)
-    two = batch_force_closure(P, Nrm, mu, chunk_size=500, workers=2)
+    one = batch_force_closure(P, Nrm, mu=mu, chunk_size=500, workers=1)
+    two = batch_force_closure(P, Nrm, mu=mu, chunk_size=500, workers=2)
     for name, a in one.to_arrays().items():
         b = two.to_arrays()[name]
         assert a.dtype == b.dtype and a.tobytes() == b.tobytes(), name
@@ -302,20 +304,20 @@ def test_the_worker_pool_is_kept_and_replaced_when_a_worker_dies():
 
     rng = np.random.default_rng(7800)
     P, Nrm = random_grasps(rng, 1200, 4, 3)
-    one = batch_force_closure(P, Nrm, 0.5, chunk_size=200, workers=1)
-    first = batch_force_closure(P, Nrm, 0.5, chunk_size=200, workers=2)
+    one = batch_force_closure(P, Nrm, mu=0.5, chunk_size=200, workers=1)
+    first = batch_force_closure(P, Nrm, mu=0.5, chunk_size=200, workers=2)
     pids = set(parallel._POOL["pool"]._processes)
-    again = batch_force_closure(P, Nrm, 0.5, chunk_size=200, workers=2)
+    again = batch_force_closure(P, Nrm, mu=0.5, chunk_size=200, workers=2)
     assert set(parallel._POOL["pool"]._processes) == pids
     for res in (first, again):
         assert res.d_star.tobytes() == one.d_star.tobytes()
     os.kill(next(iter(pids)), signal.SIGKILL)
-    fresh = batch_force_closure(P, Nrm, 0.5, chunk_size=200, workers=2)
+    fresh = batch_force_closure(P, Nrm, mu=0.5, chunk_size=200, workers=2)
     assert set(parallel._POOL["pool"]._processes).isdisjoint(pids)
     assert fresh.d_star.tobytes() == one.d_star.tobytes()
     bad = Nrm.copy()
     bad[777, 2] = 0.0  # checked in the worker, raised here with its index
     with pytest.raises(InvalidContactError, match="grasp 777, contact 2"):
-        batch_force_closure(P, bad, 0.5, chunk_size=200, workers=2)
+        batch_force_closure(P, bad, mu=0.5, chunk_size=200, workers=2)
     parallel.shutdown_pool()
     assert "pool" not in parallel._POOL

@@ -28,7 +28,7 @@ def npy_dir(tmp_path):
 
 def test_npz_stream_matches_the_in_memory_result(npy_dir, tmp_path):
     d, P, Nrm, mu = npy_dir
-    want = batch_force_closure(P, Nrm, mu, metrics=["isotropy"])
+    want = batch_force_closure(P, Nrm, mu=mu, metrics=["isotropy"])
     out = tmp_path / "out.npz"
     summary = stream_file(d, out, chunk_size=200, metrics=["isotropy"], workers=1)
     with np.load(out) as got:
@@ -69,7 +69,7 @@ def test_cli_workers_and_format(npy_dir, tmp_path, capsys):
     code = main(["batch", str(d), str(out), "--workers", "2", "--format", "npz",
                  "--chunk-size", "300"])  # fmt: skip
     assert code == 0
-    want = batch_force_closure(P, Nrm, mu, workers=1, chunk_size=300)
+    want = batch_force_closure(P, Nrm, mu=mu, workers=1, chunk_size=300)
     with np.load(out) as got:
         assert got["d_star"].tobytes() == want.d_star.tobytes()
     assert "wrote" in capsys.readouterr().out

@@ -34,14 +34,14 @@ def test_fingers_evenly_spaced_on_the_equator(num, n_g):
     # facet values average to f_n times the axis value.  Hence d* is the axis value.
     mu = 0.5
     P, Nrm = _ring_grasp(num, phase=0.3)
-    res = batch_force_closure(P[None], Nrm[None], mu, num_generators=n_g)
+    res = batch_force_closure(P[None], Nrm[None], mu=mu, num_generators=n_g)
     assert res.is_closure[0] and res.rank[0] == 6
     np.testing.assert_allclose(res.d_star[0], _pyramid_axis_margin(mu, n_g), atol=1e-8)
 
 
 def test_three_fingers_120_degrees_mu_half_closure():
     P, Nrm = _ring_grasp(3)
-    res = batch_force_closure(P[None], Nrm[None], 0.5)
+    res = batch_force_closure(P[None], Nrm[None], mu=0.5)
     assert bool(res.is_closure[0])
     np.testing.assert_allclose(res.d_star[0], 0.41935, atol=1e-5)
 
@@ -49,7 +49,7 @@ def test_three_fingers_120_degrees_mu_half_closure():
 @pytest.mark.parametrize("mu", [0.1, 0.5, 2.0])
 def test_planar_fingers_on_a_circle(mu):
     P, Nrm = _ring_grasp(3, dim=2)
-    res = batch_force_closure(P[None], Nrm[None], mu)
+    res = batch_force_closure(P[None], Nrm[None], mu=mu)
     assert res.is_closure[0] and res.rank[0] == 3
     np.testing.assert_allclose(res.d_star[0], mu / np.hypot(1, mu), atol=1e-8)
 
@@ -59,7 +59,7 @@ def test_two_spatial_hard_fingers_never_close():
     P, Nrm = random_grasps(rng, 200, 2, 3, spread=0.2)
     P[:100, 1] = -P[:100, 0]  # first half exactly antipodal
     Nrm[:100] = -P[:100]
-    res = batch_force_closure(P, Nrm, 0.8)
+    res = batch_force_closure(P, Nrm, mu=0.8)
     assert not res.is_closure.any()
     assert (res.rank <= 5).all()
     # the antipodal ones squeeze: d* > 0 is reported although rank is short
@@ -68,9 +68,9 @@ def test_two_spatial_hard_fingers_never_close():
 
 def test_two_planar_antipodal_fingers_close_with_friction():
     P = np.array([[[1.0, 0.0], [-1.0, 0.0]]])
-    res = batch_force_closure(P, -P, 0.3)
+    res = batch_force_closure(P, -P, mu=0.3)
     assert res.is_closure[0] and res.rank[0] == 3
-    res0 = batch_force_closure(P, -P, 0.0)
+    res0 = batch_force_closure(P, -P, mu=0.0)
     assert not res0.is_closure[0] and res0.rank[0] == 1  # opposite pushes
 
 
@@ -106,14 +106,14 @@ def test_cube_form_closure_with_twelve_contacts():
     assert res.is_closure[0] and res.rank[0] == 6
     np.testing.assert_allclose(res.d_star[0], 1.0, atol=1e-9)
     # Frictionless force closure is the same LP.
-    frc = batch_force_closure(P, Nrm, 0.7, model="frictionless")
+    frc = batch_force_closure(P, Nrm, mu=0.7, contact_model="frictionless")
     np.testing.assert_allclose(frc.d_star, res.d_star, atol=1e-9)
 
 
 def test_zero_friction_hard_fingers_are_form_closure():
     rng = np.random.default_rng(6)
     P, Nrm = random_grasps(rng, 300, 7, 3, spread=0.3)
-    hard = batch_force_closure(P, Nrm, 0.0)
+    hard = batch_force_closure(P, Nrm, mu=0.0)
     form = batch_form_closure(P, Nrm)
     np.testing.assert_allclose(hard.d_star, form.d_star, atol=1e-8)
     np.testing.assert_array_equal(hard.rank, form.rank)
@@ -127,13 +127,13 @@ def test_translation_scaling_and_permutation_invariance(d):
     K, N = 300, 4
     P, Nrm = random_grasps(rng, K, N, d)
     mu = rng.uniform(0.1, 0.9, (K, N))
-    base = batch_force_closure(P, Nrm, mu)
+    base = batch_force_closure(P, Nrm, mu=mu)
     assert 0 < base.is_closure.sum() < K
     shift = rng.normal(size=(K, 1, d)) * 3
-    moved = batch_force_closure(P + shift, Nrm, mu, reference_points=shift[:, 0])
-    scaled = batch_force_closure(2.5 * P, Nrm, mu)
+    moved = batch_force_closure(P + shift, Nrm, mu=mu, reference_points=shift[:, 0])
+    scaled = batch_force_closure(2.5 * P, Nrm, mu=mu)
     perm = rng.permutation(N)
-    permuted = batch_force_closure(P[:, perm], Nrm[:, perm], mu[:, perm])
+    permuted = batch_force_closure(P[:, perm], Nrm[:, perm], mu=mu[:, perm])
     for other in (moved, scaled, permuted):
         np.testing.assert_allclose(other.d_star, base.d_star, atol=1e-8)
         np.testing.assert_array_equal(other.is_closure, base.is_closure)
@@ -144,8 +144,8 @@ def test_normals_are_normalised():
     rng = np.random.default_rng(8)
     P, Nrm = random_grasps(rng, 100, 3, 3)
     scale = rng.uniform(0.01, 100, (100, 3, 1))
-    a = batch_force_closure(P, Nrm, 0.4)
-    b = batch_force_closure(P, Nrm * scale, 0.4)
+    a = batch_force_closure(P, Nrm, mu=0.4)
+    b = batch_force_closure(P, Nrm * scale, mu=0.4)
     np.testing.assert_allclose(a.d_star, b.d_star, atol=1e-9)
 
 

@@ -21,7 +21,7 @@ def test_verdicts_and_certificates_match_the_single_path(mu, planar):
     rng = np.random.default_rng(11)
     base = ex.planar_square_four_contacts() if planar else ex.cube_seven_contacts()
     P, N = _perturbed(base, rng, 40)
-    batch = dg.batch_force_closure(P, N, mu)
+    batch = dg.batch_force_closure(P, N, mu=mu)
     certified = 0
     for k in range(len(P)):
         grasp = dg.Grasp(
@@ -38,7 +38,7 @@ def test_verdicts_and_certificates_match_the_single_path(mu, planar):
 
 def test_frictionless_contacts_need_no_certificate():
     base = ex.cube_seven_contacts()
-    r = dg.batch_force_closure(base.positions[None], base.normals[None], 0.0)
+    r = dg.batch_force_closure(base.positions[None], base.normals[None], mu=0.0)
     assert r.is_closure[0] and not r.normal_certificate[0]
     assert "normal_certificate" in r.to_arrays()
 
@@ -64,7 +64,7 @@ def test_few_contacts_with_rank_deficient_normals(mu):
             np.repeat(base.normals[None], 60, 0),
             rng,
         )
-        batch = dg.batch_force_closure(P, N, mu)
+        batch = dg.batch_force_closure(P, N, mu=mu)
         single = [
             dg.force_closure(
                 dg.Grasp(
@@ -86,9 +86,9 @@ def test_one_dimensional_mu_is_not_guessed_when_k_equals_n():
     with pytest.raises(
         dg.InvalidOptionError, match=r"ambiguous .* \(3, 1\) .* \(1, 3\)"
     ):
-        dg.batch_force_closure(P, N, [0.0, 0.0, 0.9])
-    per_contact = dg.batch_force_closure(P, N, [[0.0, 0.0, 0.9]])
-    per_grasp = dg.batch_force_closure(P, N, [[0.0], [0.0], [0.9]])
+        dg.batch_force_closure(P, N, mu=[0.0, 0.0, 0.9])
+    per_contact = dg.batch_force_closure(P, N, mu=[[0.0, 0.0, 0.9]])
+    per_grasp = dg.batch_force_closure(P, N, mu=[[0.0], [0.0], [0.9]])
     assert per_contact.d_star[0] == per_contact.d_star[2]
     assert per_grasp.d_star[0] != per_grasp.d_star[2]
 
@@ -96,4 +96,4 @@ def test_one_dimensional_mu_is_not_guessed_when_k_equals_n():
 def test_tol_must_be_positive_as_in_the_single_path():
     base = ex.equator_fingers(0.5)
     with pytest.raises(dg.InvalidOptionError, match="tol must be finite and > 0"):
-        dg.batch_force_closure(base.positions[None], base.normals[None], 0.5, tol=0)
+        dg.batch_force_closure(base.positions[None], base.normals[None], mu=0.5, tol=0)

@@ -158,7 +158,7 @@ def test_without_numba_the_engine_runs_numpy_and_says_so_once(tmp_path):
     rng = np.random.default_rng(3)
     p = rng.normal(size=(40, 3, 3))
     n = -p + 0.3 * rng.normal(size=(40, 3, 3))
-    reference = batch_force_closure(p, n, 0.5, workers=1, kernel="numpy")
+    reference = batch_force_closure(p, n, mu=0.5, workers=1, kernel="numpy")
     assert verdicts["a"] == verdicts["b"] == reference.is_closure.tolist()
 
 

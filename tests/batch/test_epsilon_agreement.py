@@ -177,7 +177,7 @@ def test_two_hard_fingers_are_flat_and_zero():
     """Two spatial hard fingers cannot resist torque about their axis: ε = 0."""
     rng = np.random.default_rng(2)
     P, Nrm = random_grasps(rng, 200, 2, 3, spread=0.0)
-    eps = batch_epsilon_l1(P, Nrm, 1.0)
+    eps = batch_epsilon_l1(P, Nrm, mu=1.0)
     assert (eps == 0.0).all()
     W = batched_primitive_wrenches(
         P, Nrm / np.linalg.norm(Nrm, axis=-1, keepdims=True), np.ones((200, 2)),

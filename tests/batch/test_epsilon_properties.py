@@ -72,8 +72,8 @@ def test_contact_order_does_not_matter(seed, N):
     mu = rng.uniform(0.1, 1.0, size=(40, N))
     perm = rng.permutation(N)
     _close(
-        batch_epsilon_l1(P[:, perm], Nrm[:, perm], mu[:, perm]),
-        batch_epsilon_l1(P, Nrm, mu),
+        batch_epsilon_l1(P[:, perm], Nrm[:, perm], mu=mu[:, perm]),
+        batch_epsilon_l1(P, Nrm, mu=mu),
     )
 
 
@@ -88,8 +88,10 @@ def test_rigid_motion_does_not_matter(seed):
     rng, P, Nrm = _grasps(seed)
     p = 0.3 * rng.normal(size=(40, 3))
     R, t = _cube_rotation(rng), rng.normal(size=3)
-    eps = batch_epsilon_l1(P, Nrm, 0.5, reference_points=p)
-    moved = batch_epsilon_l1(P @ R.T + t, Nrm @ R.T, 0.5, reference_points=p @ R.T + t)
+    eps = batch_epsilon_l1(P, Nrm, mu=0.5, reference_points=p)
+    moved = batch_epsilon_l1(
+        P @ R.T + t, Nrm @ R.T, mu=0.5, reference_points=p @ R.T + t
+    )
     _close(moved, eps)
 
 
@@ -98,8 +100,8 @@ def test_rigid_motion_does_not_matter(seed):
 def test_length_and_force_scaling(seed, scale):
     """Scaling lengths keeps ε (moments over b); scaling wrenches scales ε."""
     rng, P, Nrm = _grasps(seed, N=5)
-    eps = batch_epsilon_l1(P, Nrm, 0.5)
-    _close(batch_epsilon_l1(scale * P, Nrm, 0.5), eps)
+    eps = batch_epsilon_l1(P, Nrm, mu=0.5)
+    _close(batch_epsilon_l1(scale * P, Nrm, mu=0.5), eps)
     W = _hard_wrenches(P, Nrm, 0.5)
     e1, s1 = epsilon_kernel.epsilon_l1_stack(W)
     e2, s2 = epsilon_kernel.epsilon_l1_stack(scale * W)
@@ -112,8 +114,8 @@ def test_length_and_force_scaling(seed, scale):
 def test_more_friction_never_lowers_epsilon(seed, mu, factor):
     """The μ ring's hull contains the smaller ring's (same angles, same axis)."""
     _, P, Nrm = _grasps(seed, N=4)
-    low = batch_epsilon_l1(P, Nrm, mu)
-    high = batch_epsilon_l1(P, Nrm, mu * factor)
+    low = batch_epsilon_l1(P, Nrm, mu=mu)
+    high = batch_epsilon_l1(P, Nrm, mu=mu * factor)
     assert (high >= low - 1e-12).all()
 
 
@@ -153,21 +155,21 @@ def test_a_full_facet_store_is_retried_with_more_room():
 
 def test_metric_of_batch_force_closure_is_the_batch_epsilon():
     _, P, Nrm = _grasps(9, K=300, N=4)
-    res = batch_force_closure(P, Nrm, 0.6, metrics=["epsilon_l1"])
-    eps = batch_epsilon_l1(P, Nrm, 0.6)
+    res = batch_force_closure(P, Nrm, mu=0.6, metrics=["epsilon_l1"])
+    eps = batch_epsilon_l1(P, Nrm, mu=0.6)
     np.testing.assert_array_equal(res.metrics["epsilon_l1"], eps)
     # ε > 0 exactly when the polyhedral cones give force closure.
     assert ((eps > 0) == res.is_closure).mean() > 0.99
-    ref = batch_epsilon_l1(P, Nrm, 0.6, kernel="numpy")
+    ref = batch_epsilon_l1(P, Nrm, mu=0.6, kernel="numpy")
     _close(eps, ref)
 
 
 def test_workers_and_chunks_give_the_same_answer():
     _, P, Nrm = _grasps(4, K=90, N=3)
-    eps = batch_epsilon_l1(P, Nrm, 0.5)
-    np.testing.assert_array_equal(batch_epsilon_l1(P, Nrm, 0.5, chunk_size=7), eps)
+    eps = batch_epsilon_l1(P, Nrm, mu=0.5)
+    np.testing.assert_array_equal(batch_epsilon_l1(P, Nrm, mu=0.5, chunk_size=7), eps)
     np.testing.assert_array_equal(
-        batch_epsilon_l1(P, Nrm, 0.5, chunk_size=30, workers=2), eps
+        batch_epsilon_l1(P, Nrm, mu=0.5, chunk_size=30, workers=2), eps
     )
     assert not eps.flags.writeable
 
@@ -175,10 +177,14 @@ def test_workers_and_chunks_give_the_same_answer():
 def test_soft_finger_needs_torsion_and_planar_rejects_it():
     _, P, Nrm = _grasps(5, K=4, N=3)
     with pytest.raises(InvalidContactError, match="torsional_friction"):
-        batch_epsilon_l1(P, Nrm, 0.5, model="soft_finger")
+        batch_epsilon_l1(P, Nrm, mu=0.5, contact_model="soft_finger")
     with pytest.raises(InvalidContactError, match="spatial only"):
         batch_epsilon_l1(
-            P[:, :, :2], Nrm[:, :, :2], 0.5, model="soft_finger", torsional_friction=1
+            P[:, :, :2],
+            Nrm[:, :, :2],
+            mu=0.5,
+            contact_model="soft_finger",
+            torsional_friction=1,
         )
 
 
@@ -200,7 +206,7 @@ def test_soft_finger_needs_torsion_and_planar_rejects_it():
         (lambda a: a.update(mu=float("nan")), InvalidContactError, "mu"),
         (lambda a: a.update(num_generators=2), InvalidOptionError, "num_generators"),
         (lambda a: a.update(kernel="fortran"), InvalidOptionError, "kernel"),
-        (lambda a: a.update(model="glue"), GraspError, "model"),
+        (lambda a: a.update(contact_model="glue"), GraspError, "model"),
         (lambda a: a.update(reference_points=np.ones(2)), GraspError, "reference"),
         (lambda a: a.update(characteristic_lengths=-1.0), GraspError,
          "characteristic"),
@@ -213,12 +219,12 @@ def test_hostile_input_raises_grasp_errors(change, error, match):
     change(args)
     kwargs = {k: v for k, v in args.items() if k not in ("positions", "normals", "mu")}
     with pytest.raises(error, match=match):
-        batch_epsilon_l1(args["positions"], args["normals"], args["mu"], **kwargs)
+        batch_epsilon_l1(args["positions"], args["normals"], mu=args["mu"], **kwargs)
 
 
 def test_without_numba_every_grasp_takes_the_qhull_route(monkeypatch):
     _, P, Nrm = _grasps(8, K=30, N=3)
-    eps = batch_epsilon_l1(P, Nrm, 0.5)
+    eps = batch_epsilon_l1(P, Nrm, mu=0.5)
     monkeypatch.setattr(epsilon_kernel, "AVAILABLE", False)
     Nn = Nrm / np.linalg.norm(Nrm, axis=-1, keepdims=True)
     K = P.shape[0]
@@ -236,9 +242,12 @@ def test_more_primitive_wrenches_than_qhull_takes_are_refused():
     rng = np.random.default_rng(1)
     P, Nrm = random_grasps(rng, 1, 251, 3)  # 251 × 8 = 2008 wrenches
     with pytest.raises(InvalidOptionError, match="L1_MAX_POINTS"):
-        batch_epsilon_l1(P, Nrm, 0.5)
+        batch_epsilon_l1(P, Nrm, mu=0.5)
     # Without friction, 251 wrenches: computed (form closure of 251 contacts).
-    _close(batch_epsilon_l1(P, Nrm, 0.0), batch_epsilon_l1(P, Nrm, 0.0, kernel="numpy"))
+    _close(
+        batch_epsilon_l1(P, Nrm, mu=0.0),
+        batch_epsilon_l1(P, Nrm, mu=0.0, kernel="numpy"),
+    )
 
 
 def _stitched(ridges, D=3, point=9):

@@ -143,7 +143,7 @@ def _forces(g, value):
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
 def test_a_balancing_force_with_a_non_finite_component_fails(bad):
     # Two frictionless fingers are never in force closure (rank of G is 1).
-    g = ex.spatial_two_fingers(mu=0.0, model="frictionless")
+    g = ex.spatial_two_fingers(mu=0.0, contact_model="frictionless")
     assert not dg.force_closure(g).is_closure
     forces = list(_forces(g, 1.0))
     forces[0] = forces[0].copy()
@@ -204,7 +204,7 @@ def _other_grasps():
         "planar": ex.planar_square_four_contacts(),
         "three contacts": dg.Grasp(ex.equator_fingers(0.5).contacts[:2]),
         "soft fingers": ex.equator_fingers(0.5).with_friction(
-            model="soft_finger", torsional_friction=0.1
+            contact_model="soft_finger", torsional_friction=0.1
         ),
     }
 
@@ -217,7 +217,7 @@ def test_a_certificate_checked_on_another_grasp_says_so(other, kind):
         cert = dg.form_closure(g).certificate
         assert cert.kind == ESCAPE_TWIST
     elif kind == "force":
-        g = ex.spatial_two_fingers(mu=0.0, model="frictionless")
+        g = ex.spatial_two_fingers(mu=0.0, contact_model="frictionless")
         cert = dg.force_closure(g).certificate
         assert cert.kind == UNRESISTED_WRENCH
     else:
@@ -296,7 +296,7 @@ def test_no_generated_twist_escapes_a_form_closure_grasp(v):
 def test_a_form_closure_yes_checks_on_a_grasp_with_friction(model):
     # form closure reports [f_n] per contact; the check reads the other
     # components as zero (it read the normal indices of the full layout)
-    g = _cube().with_friction(0.5, model=model, torsional_friction=0.1)
+    g = _cube().with_friction(0.5, contact_model=model, torsional_friction=0.1)
     r = dg.form_closure(g)
     assert r.is_closure and all(len(f) == 1 for f in r.certificate.contact_forces)
     check = r.certificate.check(g)

@@ -23,7 +23,9 @@ def random_inward_contacts(
         p = rng.normal(size=dim)
         p /= np.linalg.norm(p)
         n = -p + spread * rng.normal(size=dim) * 0.6
-        contacts.append(dg.Contact(p, n, mu=mu, model=model, torsional_friction=nu))
+        contacts.append(
+            dg.Contact(p, n, mu=mu, contact_model=model, torsional_friction=nu)
+        )
     return contacts
 
 

@@ -17,10 +17,10 @@ def test_angles_margins_and_needed_friction():
 
 
 def test_frictionless_pair_is_antipodal_only_when_collinear():
-    a = dg.Contact([0, 0], [1, 0], model="frictionless", mu=0.9)
-    b = dg.Contact([1, 0], [-1, 0], model="frictionless")
+    a = dg.Contact([0, 0], [1, 0], contact_model="frictionless", mu=0.9)
+    b = dg.Contact([1, 0], [-1, 0], contact_model="frictionless")
     assert dg.is_antipodal([a, b]).is_antipodal
-    b2 = dg.Contact([1, 1e-3], [-1, 0], model="frictionless")
+    b2 = dg.Contact([1, 1e-3], [-1, 0], contact_model="frictionless")
     assert not dg.is_antipodal([a, b2]).is_antipodal
 
 

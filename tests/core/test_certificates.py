@@ -75,7 +75,11 @@ def _exact_support(grasp, w):
     out = []
     for s, c in zip(grasp.component_slices(), grasp.contacts, strict=True):
         a = G[:, s].T @ w
-        if c.model is dg.ContactModel.FRICTIONLESS or c.mu == 0.0 and len(a) < 4:
+        if (
+            c.contact_model is dg.ContactModel.FRICTIONLESS
+            or c.mu == 0.0
+            and len(a) < 4
+        ):
             out.append(a[0])
         elif len(a) == 2:  # planar: the two edges of the cone
             out.append(a[0] + c.mu * abs(a[1]))
@@ -210,7 +214,7 @@ def test_a_disc_always_rotates_about_its_centre():
         dg.Contact(
             centre + 0.05 * np.array([np.cos(a), np.sin(a)]),
             -np.array([np.cos(a), np.sin(a)]),
-            model="frictionless",
+            contact_model="frictionless",
         )
         for a in angles
     ]
@@ -228,7 +232,7 @@ def test_a_disc_always_rotates_about_its_centre():
     # spatial: a sphere held by four frictionless fingers turns about its centre
     sphere = dg.Grasp(
         [
-            dg.Contact(c, -np.asarray(c, float), model="frictionless")
+            dg.Contact(c, -np.asarray(c, float), contact_model="frictionless")
             for c in ([1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, 0, 1])
         ],
         reference_point=[0.5, 0.5, 0.5],
@@ -242,7 +246,7 @@ def test_a_disc_always_rotates_about_its_centre():
 
 
 def test_a_box_between_two_frictionless_fingers_slides_in_their_face_plane():
-    g = ex.spatial_two_fingers(0.0, model="frictionless")
+    g = ex.spatial_two_fingers(0.0, contact_model="frictionless")
     r = dg.form_closure(g)
     cert = r.certificate
     assert not r.is_closure and cert.two_sided
@@ -260,9 +264,9 @@ def test_full_rank_escape_reports_which_contacts_separate():
     # a box on two supports with one finger on its left side: it can lift off
     g = dg.Grasp(
         [
-            dg.Contact([-1, 0], [0, 1], model="frictionless"),
-            dg.Contact([1, 0], [0, 1], model="frictionless"),
-            dg.Contact([-1, 0.5], [1, 0], model="frictionless"),
+            dg.Contact([-1, 0], [0, 1], contact_model="frictionless"),
+            dg.Contact([1, 0], [0, 1], contact_model="frictionless"),
+            dg.Contact([-1, 0.5], [1, 0], contact_model="frictionless"),
         ]
     )
     r = dg.form_closure(g)

@@ -31,7 +31,9 @@ def test_a_d_star_verdict_shows_its_margin_and_a_no_shows_why():
 
 
 def test_the_normal_force_route_says_lp2_did_not_decide():
-    g = ex.planar_square_four_contacts().with_friction(1e-9, model="hard_finger")
+    g = ex.planar_square_four_contacts().with_friction(
+        1e-9, contact_model="hard_finger"
+    )
     r = dg.force_closure(g)
     assert r.decided_by == "normal forces"
     assert "did not decide" in _lines(r)[0]

@@ -49,7 +49,7 @@ def test_disk_and_sphere_are_never_in_form_closure(rng, dim):
     for num in (4, 7, 12):
         p = rng.normal(size=(num, dim))
         p /= np.linalg.norm(p, axis=1, keepdims=True)
-        grasp = dg.Grasp([dg.Contact(x, -x, model="frictionless") for x in p])
+        grasp = dg.Grasp([dg.Contact(x, -x, contact_model="frictionless") for x in p])
         result = dg.form_closure(grasp)
         assert not result.is_closure
         assert result.rank <= dim  # no moment about the centre
@@ -73,11 +73,15 @@ def test_two_spatial_hard_fingers_never_give_force_closure(mu):
 
 
 def test_two_soft_fingers_can_give_force_closure():
-    soft = ex.spatial_two_fingers(0.5, model="soft_finger", torsional_friction=0.3)
+    soft = ex.spatial_two_fingers(
+        0.5, contact_model="soft_finger", torsional_friction=0.3
+    )
     assert dg.force_closure(soft).is_closure
     assert dg.force_closure_exact(soft).is_closure
     # ... but not without torsional friction (then they are hard fingers).
-    assert not dg.force_closure(ex.spatial_two_fingers(0.5, model="soft_finger"))
+    assert not dg.force_closure(
+        ex.spatial_two_fingers(0.5, contact_model="soft_finger")
+    )
 
 
 def test_three_fingers_on_the_equator():
@@ -107,7 +111,7 @@ def test_hard_finger_with_zero_friction_is_exactly_frictionless(rng, make_contac
     for num, dim in [(4, 2), (5, 2), (7, 3), (9, 3)]:
         for _ in range(5):
             hard = dg.Grasp(make_contacts(rng, num, dim=dim, mu=0.0, spread=1.2))
-            smooth = hard.with_friction(model="frictionless")
+            smooth = hard.with_friction(contact_model="frictionless")
             a, b = dg.force_closure(hard), dg.force_closure(smooth)
             assert a.is_closure == b.is_closure and a.rank == b.rank
             assert a.d_star == pytest.approx(b.d_star, abs=1e-9)
@@ -145,7 +149,7 @@ def test_thin_cones_keep_the_frictionless_verdict(mu):
     # grasp in form closure is in force closure for every μ >= 0.  (1e-12 is
     # the smallest non-zero μ drakegrasp.core.validation accepts.)
     for base in (ex.cube_seven_contacts(), ex.planar_square_four_contacts()):
-        grasp = base.with_friction(mu, model="hard_finger")
+        grasp = base.with_friction(mu, contact_model="hard_finger")
         for solve in (dg.force_closure, dg.force_closure_exact):
             r = solve(grasp)
             assert r.is_closure and r.decided_by == "normal forces"

@@ -54,12 +54,21 @@ def test_contact_normalises_and_is_immutable():
 @pytest.mark.parametrize(
     ("kwargs", "expected"),
     [
-        ({"model": "frictionless", "mu": 0.5}, (0,)),
-        ({"model": "hard_finger", "mu": 0.0}, (0,)),
-        ({"model": "hard_finger", "mu": 0.5}, (0, 1, 2)),
-        ({"model": "soft_finger", "mu": 0.5, "torsional_friction": 0.1}, (0, 1, 2, 3)),
-        ({"model": "soft_finger", "mu": 0.5, "torsional_friction": 0}, (0, 1, 2)),
-        ({"model": "soft_finger", "mu": 0.0, "torsional_friction": 0.1}, (0, 3)),
+        ({"contact_model": "frictionless", "mu": 0.5}, (0,)),
+        ({"contact_model": "hard_finger", "mu": 0.0}, (0,)),
+        ({"contact_model": "hard_finger", "mu": 0.5}, (0, 1, 2)),
+        (
+            {"contact_model": "soft_finger", "mu": 0.5, "torsional_friction": 0.1},
+            (0, 1, 2, 3),
+        ),
+        (
+            {"contact_model": "soft_finger", "mu": 0.5, "torsional_friction": 0},
+            (0, 1, 2),
+        ),
+        (
+            {"contact_model": "soft_finger", "mu": 0.0, "torsional_friction": 0.1},
+            (0, 3),
+        ),
     ],
 )
 def test_effective_components(kwargs, expected):
@@ -68,7 +77,7 @@ def test_effective_components(kwargs, expected):
 
 
 def test_model_enum_and_strings_are_interchangeable():
-    a = dg.Contact([0, 0], [1, 0], model=dg.ContactModel.FRICTIONLESS)
-    b = dg.Contact([0, 0], [1, 0], model="Frictionless")
-    assert a.model is b.model is dg.ContactModel.FRICTIONLESS
-    assert a.to_dict()["model"] == "frictionless"
+    a = dg.Contact([0, 0], [1, 0], contact_model=dg.ContactModel.FRICTIONLESS)
+    b = dg.Contact([0, 0], [1, 0], contact_model="Frictionless")
+    assert a.contact_model is b.contact_model is dg.ContactModel.FRICTIONLESS
+    assert a.to_dict()["contact_model"] == "frictionless"

@@ -128,7 +128,9 @@ def _grasp(seed, num, model, mu, dim=3):
         p = rng.normal(size=dim)
         p /= np.linalg.norm(p)
         n = -p + 0.6 * rng.normal(size=dim)
-        contacts.append(dg.Contact(p, n, mu=mu, model=model, torsional_friction=0.3))
+        contacts.append(
+            dg.Contact(p, n, mu=mu, contact_model=model, torsional_friction=0.3)
+        )
     return dg.Grasp(contacts, reference_point=0.2 * rng.normal(size=dim))
 
 

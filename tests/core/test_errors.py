@@ -27,10 +27,14 @@ from drakegrasp.core import examples as ex
         ),
         (
             ([0, 0, 1], [0, 0, -1]),
-            {"model": "sticky"},
+            {"contact_model": "sticky"},
             "unknown contact model 'sticky'",
         ),
-        (([0, 1], [0, -1]), {"model": "soft_finger"}, "soft-finger contact is spatial"),
+        (
+            ([0, 1], [0, -1]),
+            {"contact_model": "soft_finger"},
+            "soft-finger contact is spatial",
+        ),
         (
             ([0, 0, 1], [0, 0, -1]),
             {"torsional_friction": -1},

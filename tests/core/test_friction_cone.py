@@ -53,7 +53,7 @@ def test_planar_cone_matches_the_formula():
 
 
 def test_frictionless_and_degenerate_cones():
-    c = dg.Contact([0, 0, 1], [0, 0, -1], model="frictionless", mu=0.9)
+    c = dg.Contact([0, 0, 1], [0, 0, -1], contact_model="frictionless", mu=0.9)
     assert np.allclose(dg.friction_cone_facets(c), [[1.0]])
     assert np.allclose(dg.friction_cone_generators(c), [[1.0]])
     ray = dg.Contact([0, 0, 1], [0, 0, -1], mu=0.0)
@@ -67,7 +67,11 @@ def test_frictionless_and_degenerate_cones():
 
 def test_soft_finger_cone_is_the_hull_of_its_generators():
     c = dg.Contact(
-        [0, 0, 1], [0, 0, -1], mu=0.5, model="soft_finger", torsional_friction=0.2
+        [0, 0, 1],
+        [0, 0, -1],
+        mu=0.5,
+        contact_model="soft_finger",
+        torsional_friction=0.2,
     )
     b = 0.1
     S = dg.friction_cone_generators(c, 8, characteristic_length=b)
@@ -77,7 +81,7 @@ def test_soft_finger_cone_is_the_hull_of_its_generators():
     assert np.all(F[:, 0] > 0)
     # Not unit rows: on the m_n = 0 slice each row is the hard finger's unit row
     # (so a soft finger's d* is never below a hard finger's).
-    hard = dg.friction_cone_facets(c.with_(model="hard_finger"), 8)
+    hard = dg.friction_cone_facets(c.with_(contact_model="hard_finger"), 8)
     assert np.allclose(F[:8, :3], hard) and np.allclose(F[8:, :3], hard)
     assert np.allclose(F[:8, 3], -F[8:, 3]) and np.all(F[:8, 3] < 0)
     FS = F @ S
@@ -100,7 +104,11 @@ def test_soft_finger_cone_is_the_hull_of_its_generators():
 
 def test_soft_finger_needs_the_characteristic_length():
     c = dg.Contact(
-        [0, 0, 1], [0, 0, -1], mu=0.5, model="soft_finger", torsional_friction=0.2
+        [0, 0, 1],
+        [0, 0, -1],
+        mu=0.5,
+        contact_model="soft_finger",
+        torsional_friction=0.2,
     )
     with pytest.raises(dg.InvalidOptionError, match="characteristic_length"):
         dg.friction_cone_facets(c)

@@ -65,7 +65,11 @@ def test_planar_matrix_is_the_planar_slice_of_the_spatial_one(rng, make_contacts
 def test_hand_computed_example():
     # Finger at (0, 0, 1) pushing down (-z), p at the origin.
     c = dg.Contact(
-        [0, 0, 1], [0, 0, -1], mu=0.5, model="soft_finger", torsional_friction=0.0
+        [0, 0, 1],
+        [0, 0, -1],
+        mu=0.5,
+        contact_model="soft_finger",
+        torsional_friction=0.0,
     )
     G = dg.grasp_matrix(dg.Grasp([c]))
     n, t1, t2 = c.frame.T

@@ -37,7 +37,7 @@ def _scaled(grasp: dg.Grasp, scale: float, offset=None, reference_point=None):
 
 def test_normalised_matrix_has_the_null_space_of_g():
     grasp = ex.equator_fingers(mu=0.5)
-    G, G_bar = dg.grasp_matrix(grasp), dg.normalised_grasp_matrix(grasp)
+    G, G_bar = dg.grasp_matrix(grasp), dg.invariant_grasp_matrix(grasp)
     # Same null space: G_bar = T G with T invertible, so T = G_bar G⁺ maps G
     # onto G_bar exactly when G has full row rank.
     T = G_bar @ np.linalg.pinv(G)
@@ -47,12 +47,12 @@ def test_normalised_matrix_has_the_null_space_of_g():
 
 def test_normalised_matrix_ignores_reference_point_and_units():
     grasp = ex.equator_fingers(mu=0.5)
-    reference = dg.normalised_grasp_matrix(grasp)
+    reference = dg.invariant_grasp_matrix(grasp)
     for scale in SCALES:
         for p in ([0, 0, 0], [1e5, 3e4, -2e4]):
             moved = _scaled(grasp, scale, reference_point=p)
             np.testing.assert_allclose(
-                dg.normalised_grasp_matrix(moved), reference, atol=1e-9
+                dg.invariant_grasp_matrix(moved), reference, atol=1e-9
             )
 
 
@@ -136,7 +136,9 @@ def _random_grasp(seed: int, num: int, dim: int, model: str) -> dg.Grasp:
         c = rng.normal(size=dim)
         c /= np.linalg.norm(c)
         n = -c + 0.6 * rng.normal(size=dim)
-        contacts.append(dg.Contact(c, n, mu=0.5, model=model, torsional_friction=0.3))
+        contacts.append(
+            dg.Contact(c, n, mu=0.5, contact_model=model, torsional_friction=0.3)
+        )
     return dg.Grasp(contacts, characteristic_length=1.0)
 
 

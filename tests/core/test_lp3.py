@@ -38,7 +38,9 @@ def test_fingers_that_only_slide_tangentially_cannot_squeeze():
 
 
 def test_one_actuator_closing_both_jaws_controls_the_squeeze():
-    grasp = ex.spatial_two_fingers(0.5, model="soft_finger", torsional_friction=0.3)
+    grasp = ex.spatial_two_fingers(
+        0.5, contact_model="soft_finger", torsional_friction=0.3
+    )
     closing = np.zeros((8, 1))
     closing[[0, 4], 0] = 1.0  # both fingers move along their normals together
     assert dg.force_closure(grasp, hand_jacobian=closing).is_closure

@@ -47,6 +47,8 @@ def test_lp1_lp3_and_socp_builders():
     assert len(prog.linear_equality_constraints()) == 1
     prog, v = dg.build_exact_force_closure_program(grasp)
     assert len(prog.lorentz_cone_constraints()) == 3
-    soft = ex.spatial_two_fingers(0.5, model="soft_finger", torsional_friction=0.2)
+    soft = ex.spatial_two_fingers(
+        0.5, contact_model="soft_finger", torsional_friction=0.2
+    )
     prog, v = dg.build_exact_force_closure_program(soft)
     assert len(prog.lorentz_cone_constraints()) == 4  # two per soft finger

@@ -29,7 +29,9 @@ def _grasp(seed, num=3, dim=3, mu=0.5, model="hard_finger"):
         p = rng.normal(size=dim)
         p /= np.linalg.norm(p)
         n = -p + 0.5 * rng.normal(size=dim)
-        contacts.append(dg.Contact(p, n, mu=mu, model=model, torsional_friction=0.2))
+        contacts.append(
+            dg.Contact(p, n, mu=mu, contact_model=model, torsional_friction=0.2)
+        )
     return dg.Grasp(contacts, reference_point=0.2 * rng.normal(size=dim)), rng
 
 
@@ -141,7 +143,9 @@ def test_form_closure_implies_force_closure_for_any_mu(seed, mu, planar):
     # Small perturbations keep form closure (it is an open condition).
     contacts = [
         c.with_(
-            normal=c.normal + 0.05 * rng.normal(size=c.dim), mu=mu, model="hard_finger"
+            normal=c.normal + 0.05 * rng.normal(size=c.dim),
+            mu=mu,
+            contact_model="hard_finger",
         )
         for c in base.contacts
     ]

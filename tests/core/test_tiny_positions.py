@@ -52,6 +52,6 @@ def test_tiny_grasps_agree_with_the_batch_engine():
     P = np.array([c[0] for c in cases]) * 1e-200
     Nrm = np.array([c[1] for c in cases])
     mu = np.array([[c[2]] for c in cases])
-    batch = dg.batch_force_closure(P, Nrm, mu)
+    batch = dg.batch_force_closure(P, Nrm, mu=mu)
     single = [dg.force_closure(_grasp(p * 1e-200, n, m, 1.0)) for p, n, m in cases]
     np.testing.assert_array_equal(batch.is_closure, [r.is_closure for r in single])

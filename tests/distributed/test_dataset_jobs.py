@@ -54,13 +54,13 @@ def test_scheduler_reads_the_files_mu_array(client, tmp_path, capsys):
     out = tmp_path / "ds"
     address = client.scheduler.address
     assert main(["batch", str(path), str(out), "--scheduler", address]) == 0
-    _same(read_dataset(out), batch_force_closure(P, Nrm, mu, workers=1))
+    _same(read_dataset(out), batch_force_closure(P, Nrm, mu=mu, workers=1))
     assert "force closure of 200 grasps" in capsys.readouterr().out
     # --mu overrides the file's array, as without --scheduler: another job
     out2 = tmp_path / "ds2"
     cmd = ["batch", str(path), str(out2), "--scheduler", address, "--mu", "0.3"]
     assert main(cmd) == 0
-    _same(read_dataset(out2), batch_force_closure(P, Nrm, 0.3, workers=1))
+    _same(read_dataset(out2), batch_force_closure(P, Nrm, mu=0.3, workers=1))
 
 
 def test_a_rerun_resumes_only_its_own_job(client, tmp_path):
@@ -82,7 +82,7 @@ def test_a_rerun_resumes_only_its_own_job(client, tmp_path):
     assert sorted(p.name for p in out.glob("part-*")) == [Path(p).name for p in first]
     # with overwrite the 12-grasp job replaces the 53-grasp one entirely
     evaluate_on_cluster(client, P[:12], Nrm[:12], mu[:12], overwrite=True, **kw)
-    _same(read_dataset(out), batch_force_closure(P[:12], Nrm[:12], mu[:12]))
+    _same(read_dataset(out), batch_force_closure(P[:12], Nrm[:12], mu=mu[:12]))
     assert len(list(out.glob("part-*.parquet"))) == 2
 
 
@@ -101,7 +101,7 @@ def test_the_cli_replaces_another_job_only_with_overwrite(client, tmp_path, caps
     assert main(["batch", str(small), str(out), *cmd, "--overwrite"]) == 0
     printed = capsys.readouterr().out
     assert "force closure of 12 grasps" in printed  # this run's summary
-    _same(read_dataset(out), batch_force_closure(P[:12], Nrm[:12], mu[:12]))
+    _same(read_dataset(out), batch_force_closure(P[:12], Nrm[:12], mu=mu[:12]))
 
 
 def test_shards_without_a_manifest_are_refused(client, tmp_path):
@@ -112,7 +112,7 @@ def test_shards_without_a_manifest_are_refused(client, tmp_path):
     with pytest.raises(BatchFileError, match="unknown job"):
         evaluate_on_cluster(client, P, Nrm, mu, output_dir=out)
     evaluate_on_cluster(client, P, Nrm, mu, output_dir=out, overwrite=True)
-    _same(read_dataset(out), batch_force_closure(P, Nrm, mu))
+    _same(read_dataset(out), batch_force_closure(P, Nrm, mu=mu))
 
 
 def test_truncated_and_foreign_shards_are_computed_again(client, tmp_path):
@@ -131,12 +131,12 @@ def test_truncated_and_foreign_shards_are_computed_again(client, tmp_path):
     again = evaluate_on_cluster(client, P, Nrm, mu, output_dir=out, **kw)
     assert again == paths
     assert Path(paths[2]).stat().st_mtime_ns == untouched  # a good shard is kept
-    _same(read_dataset(out), batch_force_closure(P, Nrm, mu))
+    _same(read_dataset(out), batch_force_closure(P, Nrm, mu=mu))
     shutil.copy(other / "part-00001.parquet", paths[1])
     with pytest.raises(BatchFileError, match="another job"):
         read_dataset(out)
     evaluate_on_cluster(client, P, Nrm, mu, output_dir=out, **kw)
-    _same(read_dataset(out), batch_force_closure(P, Nrm, mu))
+    _same(read_dataset(out), batch_force_closure(P, Nrm, mu=mu))
     # a missing shard is named, not silently skipped
     Path(paths[1]).unlink()
     with pytest.raises(BatchFileError, match="incomplete"):
@@ -174,8 +174,8 @@ def test_per_grasp_friction_whatever_the_last_partition(client, name):
     mu = per_grasp if name == "mu" else 0.5
     extra = {}
     if name == "torsional_friction":
-        extra = {"model": "soft_finger", "torsional_friction": per_grasp}
-    want = batch_force_closure(P, Nrm, mu, workers=1, **extra)
+        extra = {"contact_model": "soft_finger", "torsional_friction": per_grasp}
+    want = batch_force_closure(P, Nrm, mu=mu, workers=1, **extra)
     got = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=10,
                               partition_chunks=1, **extra)  # fmt: skip
     _same(got.to_arrays(), want)
@@ -184,7 +184,7 @@ def test_per_grasp_friction_whatever_the_last_partition(client, name):
     value = per_grasp[:3]
     args = (value, {}) if name == "mu" else (0.5, {**extra, name: value})
     with pytest.raises(InvalidOptionError, match="ambiguous"):
-        batch_force_closure(P3, N3, args[0], **args[1])
+        batch_force_closure(P3, N3, mu=args[0], **args[1])
     with pytest.raises(InvalidOptionError, match="ambiguous"):
         evaluate_on_cluster(client, P3, N3, args[0], **args[1])
 

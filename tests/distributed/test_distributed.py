@@ -43,7 +43,7 @@ def grasps():
 
 def test_results_are_bitwise_the_local_engine(client, grasps):
     P, Nrm, mu = grasps
-    local = batch_force_closure(P, Nrm, mu, chunk_size=300, workers=1)
+    local = batch_force_closure(P, Nrm, mu=mu, chunk_size=300, workers=1)
     remote = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=300,
                                  partition_chunks=3)  # fmt: skip
     for name, a in local.to_arrays().items():
@@ -56,7 +56,7 @@ def test_results_are_bitwise_the_local_engine(client, grasps):
 def test_dask_array_input(client, grasps):
     da = pytest.importorskip("dask.array")
     P, Nrm, mu = grasps
-    local = batch_force_closure(P, Nrm, 0.5, chunk_size=500, workers=1)
+    local = batch_force_closure(P, Nrm, mu=0.5, chunk_size=500, workers=1)
     remote = evaluate_on_cluster(client, da.from_array(P, chunks=(1000, 5, 3)),
                                  da.from_array(Nrm, chunks=(1000, 5, 3)), 0.5,
                                  chunk_size=500)  # fmt: skip
@@ -69,7 +69,7 @@ def test_dataset_shards_and_restart(client, grasps, tmp_path):
     paths = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=250,
                                 partition_chunks=4, output_dir=out)  # fmt: skip
     assert len(paths) == 5 and all(Path(p).exists() for p in paths)
-    local = batch_force_closure(P, Nrm, mu, chunk_size=250, workers=1)
+    local = batch_force_closure(P, Nrm, mu=mu, chunk_size=250, workers=1)
     got = read_dataset(out)
     assert got["d_star"].tobytes() == local.d_star.tobytes()
     # a rerun recomputes only the missing shard
@@ -86,7 +86,7 @@ def test_a_worker_killed_mid_run_loses_and_duplicates_nothing(client, tmp_path):
     rng = np.random.default_rng(9100)
     K, N = 24000, 8
     P, Nrm = random_grasps(rng, K, N, 3)
-    local = batch_force_closure(P, Nrm, 0.5, chunk_size=500, workers=1)
+    local = batch_force_closure(P, Nrm, mu=0.5, chunk_size=500, workers=1)
     out = tmp_path / "killed"
     pids = list(client.run(os.getpid).values())
     killed = []

@@ -211,7 +211,7 @@ def contact_cases() -> Iterator[Case]:
     coefficient_pool = BAD_SCALARS + [1e-300, 1e-13, 1e13, 1e78, 1e155, -0.0]
     for name in ("mu", "torsional_friction"):
         for i, x in enumerate(coefficient_pool):
-            kw = {name: x, "model": "soft_finger"}
+            kw = {name: x, "contact_model": "soft_finger"}
             if name == "mu":
                 kw["torsional_friction"] = 0.1
             expect = "either" if (isinstance(x, float) and x == 0.0) else "refuse"
@@ -222,7 +222,7 @@ def contact_cases() -> Iterator[Case]:
                 expect,
             )
         for x in (0.0, 1e-12, 1e-6, 0.3, 1e6, 1e12):
-            kw = {name: x, "model": "soft_finger"}
+            kw = {name: x, "contact_model": "soft_finger"}
             if name == "mu":
                 kw["torsional_friction"] = 0.1
             yield Case(
@@ -238,7 +238,7 @@ def contact_cases() -> Iterator[Case]:
         yield Case(
             "Contact",
             f"model#{i}",
-            lambda m=m, kw=kw: dg.Contact([0, 0, 1], [0, 0, -1], model=m, **kw),
+            lambda m=m, kw=kw: dg.Contact([0, 0, 1], [0, 0, -1], contact_model=m, **kw),
             expect,
         )
     # A perpendicular normal of length 1e200 is not antipodal (its squared norm
@@ -263,13 +263,15 @@ def contact_cases() -> Iterator[Case]:
     yield Case(
         "Contact",
         "soft-without-nu",
-        lambda: dg.Contact([0, 0, 1], [0, 0, -1], model="soft_finger"),
+        lambda: dg.Contact([0, 0, 1], [0, 0, -1], contact_model="soft_finger"),
         "refuse",
     )
     yield Case(
         "Contact",
         "planar-soft",
-        lambda: dg.Contact([0, 1], [0, -1], model="soft_finger", torsional_friction=1),
+        lambda: dg.Contact(
+            [0, 1], [0, -1], contact_model="soft_finger", torsional_friction=1
+        ),
         "refuse",
     )
 
@@ -436,7 +438,7 @@ def wrong_type_cases() -> Iterator[Case]:
         yield Case(
             "wrong type",
             f"batch_force_closure(P#{i})",
-            lambda x=x: dg.batch_force_closure(x, N, 0.5),
+            lambda x=x: dg.batch_force_closure(x, N, mu=0.5),
             "refuse",
         )
         yield Case(
@@ -632,14 +634,17 @@ def batch_cases() -> Iterator[Case]:
         ]
     ):
         yield Case(
-            "batch", f"mu#{i}", lambda mu=mu: dg.batch_force_closure(P, N, mu), "refuse"
+            "batch",
+            f"mu#{i}",
+            lambda mu=mu: dg.batch_force_closure(P, N, mu=mu),
+            "refuse",
         )
     for i, nu in enumerate([NAN, -1.0, 1e13, "abc", 1j, None]):
         yield Case(
             "batch",
             f"nu#{i}",
             lambda nu=nu: dg.batch_force_closure(
-                P, N, 0.5, model="soft_finger", torsional_friction=nu
+                P, N, mu=0.5, contact_model="soft_finger", torsional_friction=nu
             ),
             "refuse",
         )
@@ -649,7 +654,9 @@ def batch_cases() -> Iterator[Case]:
                 yield Case(
                     "batch",
                     f"{option}#{i}",
-                    lambda o=option, v=v: dg.batch_force_closure(P, N, 0.5, **{o: v}),
+                    lambda o=option, v=v: dg.batch_force_closure(
+                        P, N, mu=0.5, **{o: v}
+                    ),
                     "refuse",
                 )
                 if option != "num_generators":
@@ -664,21 +671,21 @@ def batch_cases() -> Iterator[Case]:
         yield Case(
             "batch",
             f"chunk_size#{i}",
-            lambda v=v: dg.batch_force_closure(P, N, 0.5, chunk_size=v),
+            lambda v=v: dg.batch_force_closure(P, N, mu=0.5, chunk_size=v),
             "refuse",
         )
     for i, v in enumerate(["yes", None, 1]):
         yield Case(
             "batch",
             f"progress#{i}",
-            lambda v=v: dg.batch_force_closure(P, N, 0.5, progress=v),
+            lambda v=v: dg.batch_force_closure(P, N, mu=0.5, progress=v),
             "refuse",
         )
     for i, v in enumerate(["sigma", None, ["epsilon_l1", "bogus"]]):
         yield Case(
             "batch",
             f"metrics#{i}",
-            lambda v=v: dg.batch_force_closure(P, N, 0.5, metrics=v),
+            lambda v=v: dg.batch_force_closure(P, N, mu=0.5, metrics=v),
             "refuse",
         )
     bad_positions = P.copy()
@@ -686,7 +693,7 @@ def batch_cases() -> Iterator[Case]:
     yield Case(
         "batch",
         "overflowing-moments",
-        lambda: dg.batch_force_closure(bad_positions, N, 0.5),
+        lambda: dg.batch_force_closure(bad_positions, N, mu=0.5),
         "refuse",
     )
     huge = N.copy()
@@ -695,7 +702,7 @@ def batch_cases() -> Iterator[Case]:
     yield Case(
         "batch",
         "huge-normals",
-        lambda: dg.batch_force_closure(P, huge, 0.5),
+        lambda: dg.batch_force_closure(P, huge, mu=0.5),
         "answer",
         lambda r: (
             bool(np.all(r.is_closure == single.is_closure))
@@ -707,7 +714,7 @@ def batch_cases() -> Iterator[Case]:
         yield Case(
             "batch",
             f"mu={mu:g}-agrees",
-            lambda mu=mu: dg.batch_force_closure(P, N, mu),
+            lambda mu=mu: dg.batch_force_closure(P, N, mu=mu),
             "answer",
             lambda r, want=want: (
                 bool(np.all(r.is_closure == want.is_closure))
@@ -771,7 +778,7 @@ def geometry_cases(seed: int = 0, count: int = 120) -> Iterator[Case]:
                 "geometry batch",
                 f"batch#{k}",
                 lambda Pb=Pb, Nb=Nb, r=ref * unit, mu=mu: dg.batch_force_closure(
-                    Pb, Nb, mu, reference_points=r
+                    Pb, Nb, mu=mu, reference_points=r
                 ),
                 "answer",
                 None
@@ -793,8 +800,8 @@ def monotonicity_cases(seed: int = 1, count: int = 80) -> Iterator[Case]:
         mu = float(10.0 ** rng.uniform(-12, 1))
         nu = float(10.0 ** rng.uniform(-12, 12))
         hard = dg.Grasp([dg.Contact(p[i], n[i], mu=mu) for i in range(num)])
-        soft = hard.with_friction(model="soft_finger", torsional_friction=nu)
-        fl = hard.with_friction(model="frictionless")
+        soft = hard.with_friction(contact_model="soft_finger", torsional_friction=nu)
+        fl = hard.with_friction(contact_model="frictionless")
 
         def both(hard=hard, soft=soft, fl=fl):
             return [

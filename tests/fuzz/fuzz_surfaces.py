@@ -59,7 +59,7 @@ def random_grasp(rng: np.random.Generator, *, n: int | None = None, planar=None)
         p /= np.linalg.norm(p)
         normal = -p + 0.6 * rng.normal(size=d)
         contacts.append(
-            dg.Contact(p, normal, mu=mu, model=model, torsional_friction=0.1)
+            dg.Contact(p, normal, mu=mu, contact_model=model, torsional_friction=0.1)
         )
     return dg.Grasp(contacts, reference_point=0.3 * rng.normal(size=d))
 

@@ -97,7 +97,11 @@ def test_coefficients_in_range_or_refused(mu, nu):
 
     _outcome(
         lambda: dg.Contact(
-            [0, 0, 1], [0, 0, -1], mu=mu, model="soft_finger", torsional_friction=nu
+            [0, 0, 1],
+            [0, 0, -1],
+            mu=mu,
+            contact_model="soft_finger",
+            torsional_friction=nu,
         ),
         check=check,
     )
@@ -145,7 +149,7 @@ def test_batch_refuses_or_answers_hostile_arrays(P, mu):
     N = np.repeat(g.normals[: P.shape[1]][None], 1, 0) if P.shape[1] <= 3 else None
     if N is None:
         return
-    _outcome(lambda: dg.batch_force_closure(P, N, mu))
+    _outcome(lambda: dg.batch_force_closure(P, N, mu=mu))
 
 
 def _random_grasp(rng, num, dim=3, mu=0.5, model="hard_finger", nu=None, spread=0.35):
@@ -154,7 +158,7 @@ def _random_grasp(rng, num, dim=3, mu=0.5, model="hard_finger", nu=None, spread=
     n = -p + spread * rng.normal(size=(num, dim))
     kw = {"torsional_friction": nu} if nu is not None else {}
     return dg.Grasp(
-        [dg.Contact(p[i], n[i], mu=mu, model=model, **kw) for i in range(num)]
+        [dg.Contact(p[i], n[i], mu=mu, contact_model=model, **kw) for i in range(num)]
     )
 
 
@@ -231,8 +235,8 @@ def test_a_more_capable_contact_never_scores_lower(seed, mu, nu, more, num):
     """soft >= hard >= frictionless; larger mu, nu >= smaller: verdicts, d*, ε."""
     rng = np.random.default_rng(seed)
     hard = _random_grasp(rng, num, mu=mu, spread=0.2)
-    fl = hard.with_friction(model="frictionless")
-    soft = hard.with_friction(model="soft_finger", torsional_friction=nu)
+    fl = hard.with_friction(contact_model="frictionless")
+    soft = hard.with_friction(contact_model="soft_finger", torsional_friction=nu)
     softer = soft.with_friction(torsional_friction=min(nu * more, V.COEFFICIENT_MAX))
     rough = hard.with_friction(min(mu * more, V.COEFFICIENT_MAX))
     chain = [fl, hard, soft, softer]
@@ -272,7 +276,7 @@ def test_soft_finger_epsilon_with_huge_torsion_is_at_least_hard():
     previous = e_hard
     for nu in (1e-3, 1.0, 1e3, 1e9, 1e12):
         e = dg.ferrari_canny(
-            hard.with_friction(model="soft_finger", torsional_friction=nu)
+            hard.with_friction(contact_model="soft_finger", torsional_friction=nu)
         )
         assert e >= previous - 1e-9
         previous = e
@@ -285,7 +289,9 @@ def test_soft_finger_d_star_with_small_torsion_is_at_least_hard():
         hard = _random_grasp(rng, 4, mu=0.3)
         d_hard = dg.force_closure(hard).d_star
         for nu in (1e-12, 1e-6, 0.01, 1.0):
-            soft = hard.with_friction(model="soft_finger", torsional_friction=nu)
+            soft = hard.with_friction(
+                contact_model="soft_finger", torsional_friction=nu
+            )
             assert dg.force_closure(soft).d_star >= d_hard - 1e-8
             assert math.isfinite(dg.force_closure_exact(soft).d_star)
 
@@ -299,7 +305,7 @@ def test_batch_agrees_with_the_single_path_across_the_mu_range(mu):
     p = rng.normal(size=(K, N, 3))
     p /= np.linalg.norm(p, axis=2, keepdims=True)
     n = -p + 0.4 * rng.normal(size=(K, N, 3))
-    batch = dg.batch_force_closure(p, n, mu)
+    batch = dg.batch_force_closure(p, n, mu=mu)
     single = [
         dg.force_closure(
             dg.Grasp([dg.Contact(p[k, i], n[k, i], mu=mu) for i in range(N)])

@@ -110,7 +110,7 @@ def _by_hand(name, plant_contacts, *, mu, model="hard_finger", nu=0.0):
     assert len({id(e) for e in ordered}) == len(entries)  # a bijection
     return Grasp(
         [
-            Contact(pos, n, mu=mu, model=model, torsional_friction=nu)
+            Contact(pos, n, mu=mu, contact_model=model, torsional_friction=nu)
             for pos, n in ordered
         ],
         reference_point=np.zeros(len(entries[0][0])),

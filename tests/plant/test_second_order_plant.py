@@ -118,7 +118,7 @@ def exact_grasp(axes, which=(0, 1, 2), r=R_TIP):
     """The same grasp from the geometry in closed form (no Drake queries)."""
     contacts, curv = [], []
     for x, n in axis_tips(axes, which):
-        contacts.append(Contact(x, n, model="frictionless"))
+        contacts.append(Contact(x, n, contact_model="frictionless"))
         i = int(np.argmax(np.abs(x)))
         j, k = [m for m in range(3) if m != i]
         # at the end of axis i the principal curvatures are a_i / a_j²

@@ -13,7 +13,7 @@ def equator_grasp(mu=0.5, *, radius=1.0, model="hard_finger", **kwargs):
     contacts = []
     for t in np.deg2rad([0.0, 120.0, 240.0]):
         c = radius * np.array([np.cos(t), np.sin(t), 0.0])
-        contacts.append(dg.Contact(c, -c, mu=mu, model=model, **kwargs))
+        contacts.append(dg.Contact(c, -c, mu=mu, contact_model=model, **kwargs))
     return dg.Grasp(contacts)
 
 
@@ -29,7 +29,9 @@ def random_grasp(rng, num, dim=3, *, mu=0.5, spread=0.5, model="hard_finger", nu
         n = -p + spread * rng.normal(size=dim)
         if nu is None and model == "soft_finger":
             nu = 0.0
-        contacts.append(dg.Contact(p, n, mu=mu, model=model, torsional_friction=nu))
+        contacts.append(
+            dg.Contact(p, n, mu=mu, contact_model=model, torsional_friction=nu)
+        )
     return dg.Grasp(contacts)
 
 

@@ -28,8 +28,12 @@ def pinch(mu=0.5, *, model="hard_finger", nu=None, half_width=0.05):
     kw = {} if nu is None else {"torsional_friction": nu}
     return dg.Grasp(
         [
-            dg.Contact([-half_width, 0, 0], [1, 0, 0], mu=mu, model=model, **kw),
-            dg.Contact([half_width, 0, 0], [-1, 0, 0], mu=mu, model=model, **kw),
+            dg.Contact(
+                [-half_width, 0, 0], [1, 0, 0], mu=mu, contact_model=model, **kw
+            ),
+            dg.Contact(
+                [half_width, 0, 0], [-1, 0, 0], mu=mu, contact_model=model, **kw
+            ),
         ]
     )
 

@@ -311,7 +311,7 @@ def _seven_frictionless():
         ([-0.5, -0.5, -1.0], [0.0, 0.0, 1.0]),
         ([-1.0, 0.1, 0.7], [1.0, 0.0, 0.0]),
     ]
-    return dg.Grasp([dg.Contact(p, n, model="frictionless") for p, n in spec])
+    return dg.Grasp([dg.Contact(p, n, contact_model="frictionless") for p, n in spec])
 
 
 def test_primitive_wrenches_fast_path_matches_generic(helpers, rng):

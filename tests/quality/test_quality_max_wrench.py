@@ -126,7 +126,8 @@ def test_against_generator_form_with_scipy(helpers, rng, dim, num, model):
         contacts = helpers.random_grasp(rng, num, dim, mu=0.6, spread=0.4).contacts
         if model == "soft_finger":
             contacts = [
-                c.with_(model="soft_finger", torsional_friction=0.3) for c in contacts
+                c.with_(contact_model="soft_finger", torsional_friction=0.3)
+                for c in contacts
             ]
         g = dg.Grasp(contacts)
         d = rng.normal(size=g.wrench_dim)

@@ -29,7 +29,7 @@ def test_draw_grasp_draws_the_unresisted_moment_of_two_hard_fingers(meshcat):
 
 def test_draw_grasp_draws_an_offset_force_and_an_escape_axis(meshcat):
     g = ex.planar_two_finger_square(0.2, offset=0.5)
-    frictionless = g.with_friction(0.0, model="frictionless")
+    frictionless = g.with_friction(0.0, contact_model="frictionless")
     d = dg.draw_grasp(meshcat, frictionless, result=dg.force_closure(frictionless))
     assert any(p.endswith("/certificate/motion") for p in d.paths) or any(
         p.endswith("/certificate/force") for p in d.paths
@@ -37,7 +37,9 @@ def test_draw_grasp_draws_an_offset_force_and_an_escape_axis(meshcat):
     disc = dg.Grasp(
         [
             dg.Contact(
-                [np.cos(a), np.sin(a)], [-np.cos(a), -np.sin(a)], model="frictionless"
+                [np.cos(a), np.sin(a)],
+                [-np.cos(a), -np.sin(a)],
+                contact_model="frictionless",
             )
             for a in (0.1, 2.0, 4.0)
         ]

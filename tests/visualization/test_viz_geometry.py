@@ -23,9 +23,9 @@ def _spatial_grasp():
         c = rng.normal(size=3)
         n = rng.normal(size=3)
         contacts.append(
-            Contact(c, n, mu=0.4, model=model, torsional_friction=0.2)
+            Contact(c, n, mu=0.4, contact_model=model, torsional_friction=0.2)
             if model == "soft_finger"
-            else Contact(c, n, mu=0.4, model=model)
+            else Contact(c, n, mu=0.4, contact_model=model)
         )
     return Grasp(contacts, reference_point=[0.1, -0.2, 0.3])
 
@@ -59,12 +59,16 @@ def test_pyramid_edges_are_the_cone_generators():
 
 def test_pyramid_of_soft_finger_drops_the_pure_moment_generators():
     contact = Contact(
-        [0, 0, 0], [1, 0, 0], mu=0.3, model="soft_finger", torsional_friction=0.1
+        [0, 0, 0],
+        [1, 0, 0],
+        mu=0.3,
+        contact_model="soft_finger",
+        torsional_friction=0.1,
     )
     S = pyramid_generators(contact, 5, characteristic_length=2.0)
     assert S.shape == (3, 5)
     np.testing.assert_allclose(np.linalg.norm(S[1:], axis=0), 0.3)
-    frictionless = Contact([0, 0, 0], [1, 0, 0], mu=0.3, model="frictionless")
+    frictionless = Contact([0, 0, 0], [1, 0, 0], mu=0.3, contact_model="frictionless")
     assert pyramid_generators(frictionless, 5, characteristic_length=1.0).shape == (
         3,
         0,
@@ -109,7 +113,7 @@ def test_planar_forces_in_grasp_frame_reproduce_the_grasp_matrix():
     grasp = Grasp(
         [
             Contact([1.0, 0.2], [-1.0, 0.1], mu=0.5),
-            Contact([-0.3, 1.0], [0.2, -1.0], mu=0.5, model="frictionless"),
+            Contact([-0.3, 1.0], [0.2, -1.0], mu=0.5, contact_model="frictionless"),
         ],
         reference_point=[0.1, 0.1],
     )
@@ -160,7 +164,9 @@ def test_planar_cone_edges_make_angle_atan_mu_with_the_normal():
             [[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]]
         )
         np.testing.assert_allclose(row, rot @ n, atol=1e-12)
-    U0 = cone_edge_directions(Contact([0.0, 0.0], n, mu=mu, model="frictionless"))
+    U0 = cone_edge_directions(
+        Contact([0.0, 0.0], n, mu=mu, contact_model="frictionless")
+    )
     np.testing.assert_allclose(U0, [n, n])
     with pytest.raises(InvalidOptionError, match="planar"):
         cone_edge_directions(Contact([0, 0, 0], [1, 0, 0], mu=0.1))

@@ -118,7 +118,7 @@ def test_frictionless_planar_and_soft_contacts(meshcat):
     planar = Grasp(
         [
             Contact([1.0, 0.0], [-1.0, 0.0], mu=0.4),
-            Contact([-1.0, 0.0], [1.0, 0.0], model="frictionless"),
+            Contact([-1.0, 0.0], [1.0, 0.0], contact_model="frictionless"),
         ]
     )
     drawing = draw_grasp(
@@ -145,7 +145,7 @@ def test_frictionless_planar_and_soft_contacts(meshcat):
                 [0, 0, 0.1],
                 [0, 0, -1],
                 mu=0.5,
-                model="soft_finger",
+                contact_model="soft_finger",
                 torsional_friction=0.2,
             )
         ]

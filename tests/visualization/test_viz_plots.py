@@ -17,7 +17,7 @@ def _disc_grasp(mu=0.5):
     contacts = [
         Contact([np.cos(a), np.sin(a)], [-np.cos(a), -np.sin(a)], mu=mu) for a in angles
     ]
-    contacts.append(Contact([0.0, -1.0], [0.0, 1.0], model="frictionless"))
+    contacts.append(Contact([0.0, -1.0], [0.0, 1.0], contact_model="frictionless"))
     return Grasp(contacts)
 
 

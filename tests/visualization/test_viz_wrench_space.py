@@ -51,10 +51,10 @@ def test_points_are_grasp_matrix_times_generators():
             rng.normal(size=3),
             rng.normal(size=3),
             mu=0.6,
-            model="soft_finger",
+            contact_model="soft_finger",
             torsional_friction=0.3,
         ),
-        Contact(rng.normal(size=3), rng.normal(size=3), model="frictionless"),
+        Contact(rng.normal(size=3), rng.normal(size=3), contact_model="frictionless"),
     ]
     grasp = Grasp(contacts, reference_point=[0.2, 0.0, -0.1])
     W, owner = wrench_space_points(grasp, num_generators=5, scale_moments=False)

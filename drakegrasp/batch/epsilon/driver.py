@@ -42,6 +42,7 @@ from drakegrasp.batch.metrics import epsilon_l1_batch
 from drakegrasp.batch.run.chunk import force_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 
 __all__ = ["batch_epsilon_l1", "epsilon_chunk"]
 
@@ -57,12 +58,14 @@ def epsilon_chunk(P, Nrm, mu_c, nu_c, p, b, *, model, num_generators, kernel):
     return {"epsilon_l1": eps}
 
 
+@renamed_keyword("model", "contact_model")
+@keyword_only("mu", after=2)
 def batch_epsilon_l1(
     positions: np.ndarray,
     normals: np.ndarray,
-    mu: float | np.ndarray,
     *,
-    model: ContactModel | str = "hard_finger",
+    mu: float | np.ndarray,
+    contact_model: ContactModel | str = "hard_finger",
     num_generators: int = 8,
     torsional_friction: float | np.ndarray | None = None,
     reference_points: np.ndarray | None = None,
@@ -76,7 +79,7 @@ def batch_epsilon_l1(
 
     Parameters
     ----------
-    positions, normals, mu, model, num_generators, torsional_friction
+    positions, normals, mu, contact_model, num_generators, torsional_friction
         The contacts, as in :func:`~drakegrasp.batch.batch_force_closure`:
         (K, N, 3) or (K, N, 2) points (metres) and inward normals, ``μ`` and
         ``ν`` as scalars, (K,), (1, N) or (K, N).
@@ -108,8 +111,8 @@ def batch_epsilon_l1(
         \qquad P = \operatorname{conv}\{\operatorname{diag}(I, I/b)\, G_i s_k\}
     """
     task, options = force_task(
-        positions, mu, model, num_generators, torsional_friction, reference_points,
-        characteristic_lengths, 1e-6, 1e-9, (), kernel,
+        positions, mu, contact_model, num_generators, torsional_friction,
+        reference_points, characteristic_lengths, 1e-6, 1e-9, (), kernel,
     )  # fmt: skip
     eps_options = {
         "model": options["model"],

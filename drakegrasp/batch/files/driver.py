@@ -33,6 +33,7 @@ from drakegrasp.batch.inputs import shape_of
 from drakegrasp.batch.run.chunk import force_task, form_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
 from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import BatchFileError, InvalidOptionError
@@ -82,13 +83,14 @@ def _file_run(
     return output, K, d, options, chunks
 
 
+@renamed_keyword("model", "contact_model")
 def evaluate_file(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
     *,
     kind: str = "force",
     mu: float | None = None,
-    model: ContactModel | str = "hard_finger",
+    contact_model: ContactModel | str = "hard_finger",
     num_generators: int = 8,
     torsional_friction: float | None = None,
     tol: float = DEFAULT_TOL,
@@ -113,8 +115,8 @@ def evaluate_file(
     mu : float, optional
         Friction coefficient for every contact; overrides the file's ``mu``.
         Force closure needs one or the other; form closure ignores both.
-    model, num_generators, tol, rank_tol, chunk_size, progress, metrics : optional
-        As in :func:`batch_force_closure`.
+    contact_model, num_generators, tol, rank_tol, chunk_size, progress, metrics
+        Optional, as in :func:`batch_force_closure`.
     torsional_friction : float, optional
         Overrides the file's ``torsional_friction``.  A soft-finger run needs
         one or the other (an explicit 0 makes the fingers act as hard ones).
@@ -135,7 +137,7 @@ def evaluate_file(
         Any invalid grasp or option (see :mod:`drakegrasp.core.validation`).
     """
     output, K, d, options, chunks = _file_run(
-        input_path, output_path, kind=kind, mu=mu, model=model,
+        input_path, output_path, kind=kind, mu=mu, model=contact_model,
         num_generators=num_generators, torsional_friction=torsional_friction,
         tol=tol, rank_tol=rank_tol, chunk_size=chunk_size, progress=progress,
         metrics=metrics, workers=None, overwrite=overwrite,
@@ -145,13 +147,14 @@ def evaluate_file(
     return result
 
 
+@renamed_keyword("model", "contact_model")
 def stream_file(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
     *,
     kind: str = "force",
     mu: float | None = None,
-    model: str = "hard_finger",
+    contact_model: str = "hard_finger",
     num_generators: int = 8,
     torsional_friction: float | None = None,
     tol: float = DEFAULT_TOL,
@@ -179,7 +182,7 @@ def stream_file(
         Counts and ``d*`` range of what was written.
     """
     output, K, d, options, chunks = _file_run(
-        input_path, output_path, kind=kind, mu=mu, model=model,
+        input_path, output_path, kind=kind, mu=mu, model=contact_model,
         num_generators=num_generators, torsional_friction=torsional_friction,
         tol=tol, rank_tol=rank_tol, chunk_size=chunk_size, progress=progress,
         metrics=metrics, workers=workers, overwrite=overwrite,

@@ -1,0 +1,116 @@
+"""Old spellings of public keywords, kept for a while with a warning.
+
+A renamed keyword or an argument that became keyword-only keeps working: the
+old call does what it did and warns once per call site with a
+:class:`DeprecationWarning` that names the new spelling.  Giving both the old
+and the new spelling is refused.  The renames are listed on the docs' Changes
+page.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import warnings
+from collections.abc import Callable
+from typing import TypeVar
+
+from drakegrasp.errors import InvalidOptionError
+
+__all__ = ["keyword_only", "renamed_keyword", "warn_deprecated"]
+
+F = TypeVar("F", bound=Callable)
+
+
+def warn_deprecated(message: str, *, stacklevel: int = 3) -> None:
+    """Warn with a :class:`DeprecationWarning` attributed to the caller's caller."""
+    warnings.warn(message, DeprecationWarning, stacklevel=stacklevel)
+
+
+def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
+    """Accept the keyword ``old`` as a deprecated alias of ``new``.
+
+    Parameters
+    ----------
+    old, new : str
+        The old and the current keyword names; ``new`` must be a parameter of
+        the decorated function.
+
+    Returns
+    -------
+    decorator
+        Wraps a function so that ``f(..., old=x)`` warns and calls
+        ``f(..., new=x)``; ``f(..., old=x, new=y)`` raises
+        :class:`~drakegrasp.InvalidOptionError`.
+    """
+
+    def decorate(function: F) -> F:
+        if new not in inspect.signature(function).parameters:
+            raise TypeError(f"{function.__qualname__} has no parameter {new!r}")
+        where = f"{function.__qualname__}()"
+
+        @functools.wraps(function)
+        def wrapper(*args, **kwargs):
+            if old in kwargs:
+                if new in kwargs:
+                    raise InvalidOptionError(
+                        f"{where} got both {old}= (deprecated) and {new}=; give "
+                        f"{new}= only"
+                    )
+                warn_deprecated(f"{where}: {old}= is deprecated; use {new}=")
+                kwargs[new] = kwargs.pop(old)
+            return function(*args, **kwargs)
+
+        return wrapper  # type: ignore[return-value]
+
+    return decorate
+
+
+def keyword_only(name: str, *, after: int) -> Callable[[F], F]:
+    """Accept ``name`` positionally (deprecated) where it is now keyword-only.
+
+    Parameters
+    ----------
+    name : str
+        The keyword-only parameter that used to be positional.
+    after : int
+        How many positional parameters come before it.
+
+    Returns
+    -------
+    decorator
+        Wraps a function so that a positional argument in place ``after``
+        warns and is passed as ``name=``; more positional arguments than
+        that, or the value given both ways, raise
+        :class:`~drakegrasp.InvalidOptionError`.
+    """
+
+    def decorate(function: F) -> F:
+        parameter = inspect.signature(function).parameters.get(name)
+        if parameter is None or parameter.kind is not inspect.Parameter.KEYWORD_ONLY:
+            raise TypeError(f"{function.__qualname__}: {name!r} is not keyword-only")
+        where = f"{function.__qualname__}()"
+
+        @functools.wraps(function)
+        def wrapper(*args, **kwargs):
+            if len(args) > after:
+                if len(args) > after + 1:
+                    raise InvalidOptionError(
+                        f"{where} takes {after} positional arguments and "
+                        f"{name}= by keyword; got {len(args)} positional"
+                    )
+                if name in kwargs:
+                    raise InvalidOptionError(
+                        f"{where} got {name} both by position and as {name}="
+                    )
+                warn_deprecated(
+                    f"{where}: passing {name} by position is deprecated; "
+                    f"write {name}=..."
+                )
+                kwargs[name] = args[after]
+                args = args[:after]
+            return function(*args, **kwargs)
+
+        return wrapper  # type: ignore[return-value]
+
+    return decorate
