@@ -24,7 +24,7 @@ MODELS = models_dir()
 
 def _load_generator():
     spec = importlib.util.spec_from_file_location(
-        "make_models", MODELS / "make_models.py"
+        "make_models", MODELS / "generator" / "make_models.py"
     )
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -208,3 +208,20 @@ def test_scene_objects_float_freely(scene_cache):
     body = plant.GetBodyByName("box")
     assert body.is_floating_base_body()
     assert plant.num_positions() == 2 + 7 and plant.num_velocities() == 2 + 6
+
+
+def test_the_installed_models_package_is_data_only():
+    """The generator lives beside the data and is not installed with it."""
+    import fnmatch
+
+    tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+    root = Path(__file__).resolve().parents[2]
+    models = root / "models"
+    config = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]
+    globs = config["package-data"]["drakegrasp.models"]
+    files = [p.relative_to(models).as_posix() for p in models.rglob("*") if p.is_file()]
+    shipped = [f for f in files if any(fnmatch.fnmatch(f, g) for g in globs)]
+    assert "scenes/parallel_jaw_box.yaml" in shipped
+    assert "generator/make_models.py" in files
+    assert not any(f.startswith("generator/") for f in shipped)
+    assert [p.name for p in models.glob("*.py")] == ["__init__.py"]
