@@ -73,3 +73,19 @@ def test_each_readme_python_block_runs_alone(index, capsys, request):
         # clone without ../shared and without a network must stay green).
         request.getfixturevalue("drake_models_dir")
     exec(compile(block, f"README.md block {index + 1}", "exec"), {})
+
+
+def test_the_speed_summary_has_one_source():
+    """README's Speed table is the one summary: the docs include it, none copies it."""
+    readme = (ROOT / "README.md").read_text()
+    start, end = "<!-- speed-summary:start -->", "<!-- speed-summary:end -->"
+    assert readme.count(start) == 1 and readme.count(end) == 1
+    table = readme[readme.index(start) : readme.index(end)]
+    assert "| what | figure |" in table
+    docs = (ROOT / "docs" / "benchmarks.md").read_text()
+    assert f":start-after: {start}" in docs and f":end-before: {end}" in docs
+    for path in [
+        ROOT / "benchmarks" / "README.md",
+        *sorted((ROOT / "docs").rglob("*.md")),
+    ]:
+        assert "| what | figure |" not in path.read_text(), f"{path} copies the summary"
