@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+import sys
 import warnings
 from collections.abc import Callable
 from typing import TypeVar
@@ -22,8 +23,20 @@ __all__ = ["keyword_only", "renamed_keyword", "warn_deprecated"]
 F = TypeVar("F", bound=Callable)
 
 
-def warn_deprecated(message: str, *, stacklevel: int = 3) -> None:
-    """Warn with a :class:`DeprecationWarning` attributed to the caller's caller."""
+def warn_deprecated(message: str, *, stacklevel: int | None = 3) -> None:
+    """Warn with a :class:`DeprecationWarning` attributed to the user's line.
+
+    ``stacklevel`` counts as :func:`warnings.warn` does, from this function
+    (3: the caller of the function that calls this one).  ``None`` (used by the
+    decorators here) attributes the warning to the first frame outside this
+    module, however many of its wrappers are stacked.
+    """
+    if stacklevel is None:
+        stacklevel = 2
+        frame = sys._getframe(1)
+        while frame is not None and frame.f_globals.get("__name__") == __name__:
+            frame = frame.f_back
+            stacklevel += 1
     warnings.warn(message, DeprecationWarning, stacklevel=stacklevel)
 
 
@@ -57,7 +70,9 @@ def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
                         f"{where} got both {old}= (deprecated) and {new}=; give "
                         f"{new}= only"
                     )
-                warn_deprecated(f"{where}: {old}= is deprecated; use {new}=")
+                warn_deprecated(
+                    f"{where}: {old}= is deprecated; use {new}=", stacklevel=None
+                )
                 kwargs[new] = kwargs.pop(old)
             return function(*args, **kwargs)
 
@@ -105,7 +120,8 @@ def keyword_only(name: str, *, after: int) -> Callable[[F], F]:
                     )
                 warn_deprecated(
                     f"{where}: passing {name} by position is deprecated; "
-                    f"write {name}=..."
+                    f"write {name}=...",
+                    stacklevel=None,
                 )
                 kwargs[name] = args[after]
                 args = args[:after]

@@ -116,8 +116,8 @@ def test_rank_deficient_witnesses_are_vectorised_and_span_the_single_paths(
     P, n = _random_batch(rng, K, 2, 3)
     p = rng.normal(size=3) * 0.3
     run = dg.batch_form_closure if form else dg.batch_force_closure
-    args = () if form else (0.4,)
-    result = run(P, n, *args, reference_points=p)
+    friction = {} if form else {"mu": 0.4}
+    result = run(P, n, reference_points=p, **friction)
     assert (result.rank < 6).all() and not result.is_closure.any()
 
     def no_grasps(*a, **k):

@@ -92,3 +92,14 @@ def test_signatures_show_the_new_spelling():
     params = inspect.signature(dg.batch_force_closure).parameters
     assert params["mu"].kind is inspect.Parameter.KEYWORD_ONLY
     assert "contact_model" in params and "model" not in params
+
+
+def test_warnings_point_at_the_callers_line():
+    """Stacked wrappers still attribute the warning to the user's file."""
+    P, N, _ = _arrays()
+    with pytest.warns(DeprecationWarning) as record:
+        dg.batch_force_closure(P, N, 0.5, model="hard_finger")
+    assert {w.filename for w in record} == {__file__}
+    with pytest.warns(DeprecationWarning) as record:
+        dg.Contact([0, 0, 0], [1, 0, 0], model="frictionless").model  # noqa: B018
+    assert {w.filename for w in record} == {__file__}
