@@ -51,8 +51,8 @@ def _ring(radius, z=0.0):
 
 # The contacts each scene's geometry makes, in the object frame, from the model
 # dimensions (models/generator/make_models.py): pad height 55 mm above the palm,
-# box centre 65 mm, cylinder centre 75 mm; 35 mm sphere; hexagonal prism 25 mm apothem; brick
-# faces at 50 mm with Drake's fingertips at z = 20 mm and y = 0.
+# box centre 65 mm, cylinder centre 75 mm; 35 mm sphere; hexagonal prism 25 mm
+# apothem; brick faces at 50 mm with Drake's fingertips at z = 20 mm and y = 0.
 BY_HAND = {
     "parallel_jaw_box": [
         ([0, 0.025, -0.01], [0, -1, 0]),
