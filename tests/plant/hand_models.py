@@ -172,6 +172,8 @@ class Rig:
     weld_hand : str, optional
         A frame of the hand to weld to the world (URDF has no world joint).
     time_step : float
+    gravity : bool
+        False: no gravity (``plant.mutable_gravity_field()`` set to zero).
     record_couplings : bool
         Parse with :func:`drakegrasp.plant.add_models` (default), which records
         the models' mimic couplings, or with a bare ``Parser``.
@@ -186,6 +188,7 @@ class Rig:
         weld_hand=None,
         time_step=0.0,
         record_couplings=True,
+        gravity=True,
     ):
         from pydrake.math import RigidTransform
 
@@ -199,6 +202,8 @@ class Rig:
             else:
                 instances += parser.AddModelsFromString(text, kind)
         self.hand = instances[0]
+        if not gravity:
+            plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
         if weld_hand is not None:
             plant.WeldFrames(
                 plant.world_frame(), plant.GetFrameByName(weld_hand, self.hand)
@@ -387,14 +392,17 @@ def mimic_gripper_sdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
     return _sdf("mimic_gripper", body)
 
 
-def box_object(size=(0.03, 0.03, 0.03), name="box") -> str:
-    """A free box (SDFormat model ``name``)."""
+def box_object(size=(0.03, 0.03, 0.03), name="box", mu=None) -> str:
+    """A free box (SDFormat model ``name``), with friction ``mu`` if given."""
+    collision = _collision(name, _box(*size))
+    if mu is not None:
+        friction = (
+            f"<drake:proximity_properties><drake:mu_dynamic>{mu}</drake:mu_dynamic>"
+            f"<drake:mu_static>{mu}</drake:mu_static></drake:proximity_properties>"
+        )
+        collision = collision.replace("</collision>", friction + "</collision>")
     return _sdf(
-        name,
-        f'<link name="{name}">'
-        + _inertial(0.1, 5e-5)
-        + _collision(name, _box(*size))
-        + "</link>",
+        name, f'<link name="{name}">' + _inertial(0.1, 5e-5) + collision + "</link>"
     )
 
 
