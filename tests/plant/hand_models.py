@@ -215,7 +215,8 @@ class Rig:
         self.ctx = plant.GetMyContextFromRoot(self.root)
         instance = plant.GetModelInstanceByName(object_model)
         self.object = plant.get_body(plant.GetBodyIndices(instance)[0])
-        plant.SetFreeBodyPose(self.ctx, self.object, X_WO or RigidTransform())
+        if self.object.is_floating_base_body():
+            plant.SetFreeBodyPose(self.ctx, self.object, X_WO or RigidTransform())
 
     def query(self):
         """The scene graph's query object in the present configuration."""
