@@ -29,7 +29,20 @@ distance can produce) is cut back by regula falsi towards the last clear point.
 All fingers step at once, one kinematics update per step.  A finger is
 **touching** when ``0 <= ψ_f <= tol`` (no finger geometry penetrates), **at
 limit** when every joint it would move is at a limit with ``ψ_f > tol``; the
-loop is bounded by ``max_iterations`` steps per finger.
+loop is bounded by ``max_iterations`` steps per finger.  The loop itself is
+in ``drakegrasp.plant._closing_steps``.
+
+**Parallel grippers.**  A hand whose closing joints are two prismatic jaws
+facing each other (:mod:`drakegrasp.plant.jaws`) gets each jaw's distance in
+:attr:`HandClosure.jaws`, and a warning when only one of them touches.
+``symmetric=True`` couples the jaws to close at one speed, as the real
+grippers' single motor does; an object off their midpoint then touches one
+jaw.
+
+**Re-seating.**  ``settle=True`` then lets a free object move
+(:mod:`drakegrasp.plant.settle`: quasi-static, frictionless, no gravity)
+while the fingers keep pushing, until they seat; the object's new pose is in
+:attr:`HandClosure.settle` and in the context.
 """
 
 from __future__ import annotations
