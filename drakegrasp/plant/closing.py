@@ -309,7 +309,9 @@ def close_hand(
         pushing, the object is free, quasi-statically and without gravity).
         Its new pose ``X_WO`` is in :attr:`HandClosure.settle` and written
         into the context with the fingers' positions.  The object must be a
-        free body.  Default False: the object does not move.
+        free body; without friction, it suits fingers that oppose each other
+        across it (a parallel gripper).  Default False: the object does not
+        move.
 
     Returns
     -------
@@ -320,8 +322,9 @@ def close_hand(
     Raises
     ------
     UnreachableError
-        Fewer than ``min_fingers`` fingers touch; names the others, their
-        distance and why they stopped.  The context is left unchanged.
+        Fewer than ``min_fingers`` fingers touch (after settling, with
+        ``settle=True``); names the others, their distance and why they
+        stopped.  The context is left unchanged (the object's pose too).
     PenetrationError
         A body of the hand's model instances penetrates the object at the
         pre-shape (open the hand first).
@@ -414,17 +417,25 @@ def close_hand(
         settle=settled,
     )
     if len(closure.touching_fingers) < min_fingers:
-        q_all[hand_.position_indices] = q0
+        q_all[hand_.position_indices] = q0  # q_all holds the object's start pose
         plant.SetPositions(plant_context, q_all)
         others = [
             f"{f.name} ({f.status}, psi = {f.psi * 1e3:.4g} mm)"
             for f in closure.fingers
             if f.status != "touching"
         ]
+        moved = ""
+        if settled is not None:
+            moved = (
+                f" after settle=True moved it {settled.translation * 1e3:.4g} mm and "
+                f"turned it {np.rad2deg(settled.rotation):.4g} deg (without "
+                "friction, fingers that do not enclose an object squeeze it out; "
+                "settle=False closes onto it where it is)"
+            )
         raise UnreachableError(
             f"only {len(closure.touching_fingers)} of {len(states)} fingers reach "
-            f"{scoped_name(plant, body)!r} (min_fingers = {min_fingers}); could not "
-            f"reach it: {'; '.join(others)}",
+            f"{scoped_name(plant, body)!r} (min_fingers = {min_fingers}){moved}; "
+            f"could not reach it: {'; '.join(others)}",
             closure=closure,
         )
     return closure

@@ -41,8 +41,13 @@ it was (a linearisation error) is refused and ``r`` halved; an accepted one
 doubles it (up to its start).  The object is seated when the LP predicts less
 gain than ``1e-3 tol`` or ``r`` falls below ``1e-3 tol``.
 
-Only the hand's geometries count: other bodies of the scene (a table) do not
-stop the object.
+**Scope.**  Only the hand's geometries count: other bodies of the scene (a
+table) do not stop the object.  Without friction the object goes wherever the
+pushes send it, so settling suits fingers that oppose each other across the
+object (a parallel gripper's jaws; a thumb opposite fingers that enclose the
+object).  Fingers that push a frictionless object from one side squeeze it out
+of the hand; :func:`~drakegrasp.plant.closing.close_hand` then finds fewer
+fingers touching and says so.
 """
 
 from __future__ import annotations

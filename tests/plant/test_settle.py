@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.systems.analysis import Simulator
 
-from drakegrasp import InvalidOptionError, close_hand
+from drakegrasp import InvalidOptionError, UnreachableError, close_hand
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
 
 BOX = 0.03
@@ -203,3 +203,29 @@ def test_wsg_reseats_a_tilted_sugar_box(real_hands):
     assert all(0.0 <= d <= TOL for d in after.values()), after
     assert closure.settle.converged
     assert closure.settle.rotation == pytest.approx(np.deg2rad(7), abs=1e-3)
+
+
+def test_franka_jaws_centre_an_off_centre_box(real_hands):
+    scene = real_hands.franka()  # the box 5 mm off the fingers' midplane
+    closure = close_hand(
+        scene.plant,
+        scene.ctx,
+        scene.object,
+        hand=scene.hand,
+        symmetric=True,
+        settle=True,
+    )
+    assert all(j.touching for j in closure.jaws) and not closure.warnings
+    assert closure.X_WO.translation()[1] == pytest.approx(0.0, abs=TOL)
+    assert closure.settle.translation == pytest.approx(0.005, abs=TOL)
+
+
+def test_an_object_squeezed_out_without_friction_is_refused(real_hands):
+    # Frictionless, the Allegro's fingers push the ball out of the open hand:
+    # nothing touches any more, and the context goes back as it was.
+    scene = real_hands.allegro()
+    q0 = scene.plant.GetPositions(scene.ctx).copy()
+    with pytest.raises(UnreachableError, match="squeeze it out") as info:
+        close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand, settle=True)
+    np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
+    assert info.value.closure.settle.translation > 0.05
