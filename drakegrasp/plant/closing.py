@@ -34,7 +34,7 @@ in ``drakegrasp.plant._closing_steps``.
 
 **Parallel grippers.**  A hand whose closing joints are two prismatic jaws
 facing each other (:mod:`drakegrasp.plant.jaws`) gets each jaw's distance in
-:attr:`HandClosure.jaws`, and a warning when only one of them touches.
+``HandClosure.jaws``, and a warning when only one of them touches.
 ``symmetric=True`` couples the jaws to close at one speed, as the real
 grippers' single motor does; an object off their midpoint then touches one
 jaw.
@@ -42,7 +42,7 @@ jaw.
 **Re-seating.**  ``settle=True`` then lets a free object move
 (:mod:`drakegrasp.plant.settle`: quasi-static, frictionless, no gravity)
 while the fingers keep pushing, until they seat; the object's new pose is in
-:attr:`HandClosure.settle` and in the context.
+``HandClosure.settle`` and in the context.
 """
 
 from __future__ import annotations
@@ -307,7 +307,7 @@ def close_hand(
         After closing, let the object move until the fingers seat
         (:func:`~drakegrasp.plant.settle.settle_object`: the fingers keep
         pushing, the object is free, quasi-statically and without gravity).
-        Its new pose ``X_WO`` is in :attr:`HandClosure.settle` and written
+        Its new pose ``X_WO`` is in ``HandClosure.settle`` and written
         into the context with the fingers' positions.  The object must be a
         free body; without friction, it suits fingers that oppose each other
         across it (a parallel gripper).  Default False: the object does not
