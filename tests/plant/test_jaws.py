@@ -21,6 +21,8 @@ from hand_models import (
     one_finger_hand,
     sphere_pad_gripper,
 )
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pydrake.math import RigidTransform
 
 from drakegrasp import InvalidOptionError, close_hand
@@ -190,3 +192,19 @@ def test_franka_closes_as_one_onto_an_off_centre_box(real_hands):
     assert closure.one_jaw_only
     far = next(j for j in closure.jaws if not j.touching)
     assert far.psi == pytest.approx(0.01, abs=2 * TOL)
+
+
+@settings(derandomize=True, max_examples=8, deadline=None)
+@given(offset=st.floats(-0.004, 0.004).filter(lambda x: abs(x) > 2 * TOL))
+def test_the_jaw_report_mirrors_the_offset(offset):
+    rig = gripper(offset)
+    closure = close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand, symmetric=True)
+    assert closure.q[0] == closure.q[1]
+    left, right = jaw_distances(rig)
+    near = right if offset > 0 else left
+    far = left if offset > 0 else right
+    assert 0.0 <= near <= TOL
+    assert far == pytest.approx(2 * abs(offset) + near, abs=1e-9)
+    touching = [j.touching for j in closure.jaws]
+    assert touching == ([False, True] if offset > 0 else [True, False])
+    assert closure.one_jaw_only

@@ -229,3 +229,12 @@ def test_an_object_squeezed_out_without_friction_is_refused(real_hands):
         close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand, settle=True)
     np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
     assert info.value.closure.settle.translation > 0.05
+
+
+def test_a_seated_box_is_a_fixed_point():
+    rig, _ = tilted(0.0, 6.0)
+    first = close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand, settle=True)
+    again = close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand, settle=True)
+    assert again.settle.converged
+    assert again.settle.translation < 1e-9 and again.settle.rotation < 1e-9
+    np.testing.assert_allclose(again.q, first.q, atol=1e-9)
