@@ -188,7 +188,9 @@ class JawContact:
         Smallest signed distance from the jaw's geometries to the object,
         metres.
     touching : bool
-        ``0 <= psi <= distance_tolerance``.
+        ``−tol <= psi <= tol`` (``tol`` the contact tolerance; a jaw may
+        touch slightly inside the object where its pre-shape did, as
+        :func:`~drakegrasp.plant.closing.close_hand` allows).
     body : str
         The jaw body (``model::body``) of the closest geometry.
     """

@@ -29,17 +29,20 @@ solves the LP (:func:`build_settle_step`)
 .. math::
     \max_{\delta u, \delta\xi}\; \tau^T T \delta u
       - w_p \|\delta p\|_1 - w_\omega \|\delta\omega\|_1
-    \quad\text{s.t.}\quad \psi_k + \delta\psi_k \ge \min(\psi^*, \psi_k),\;
-    \text{joint limits},\; |\delta u|, |\delta p| \le r,\;
-    |\delta\omega| \le r / L,
+    \quad\text{s.t.}\quad \psi_k + \delta\psi_k \ge \psi^*,\;
+    \text{joint limits},\; |\delta u_j|, |\delta p_i| \le r,\;
+    |\delta\omega_i| \le r / L,
 
-``ψ* = tol / 2``, ``L`` the object's bounding radius.  The small weights
-``w_p = w_ω / L =`` :data:`MOTION_WEIGHT` leave the object where it is along
-the motions that do no work (an object between two independent jaws slides
-freely along their axis).  A step after which some pair penetrates deeper than
-it was (a linearisation error) is refused and ``r`` halved; an accepted one
-doubles it (up to its start).  The object is seated when the LP predicts less
-gain than ``1e-3 tol`` or ``r`` falls below ``1e-3 tol``.
+``ψ* = tol / 2``, ``L`` the object's bounding radius; a revolute joint's bound
+is ``r / 0.05 m`` per radian.  When no motion meets ``ψ*`` (the object wedged
+against the palm), the floor is ``min(ψ*, ψ_k)``, which ``δ = 0`` meets.  The
+small weights ``w_p = w_ω / L =`` :data:`MOTION_WEIGHT` leave the object where
+it is along the motions that do no work (an object between two independent
+jaws slides freely along their axis).  A step after which a pair is at
+``ψ_k < min(0, ψ_k^{before})`` (a linearisation error) is refused and ``r``
+halved; an accepted one doubles it (up to its start, 2 mm).  The object is
+seated when the LP predicts less gain than ``1e-3 tol`` or ``r`` falls below
+``1e-3 tol``.
 
 **Scope.**  Only the hand's geometries count: other bodies of the scene (a
 table) do not stop the object.  Without friction the object goes wherever the
@@ -84,6 +87,7 @@ MOTION_WEIGHT = 1e-3
 """Cost of moving the object, per metre of its points, against a motor's unit gain."""
 
 _START_RADIUS = 2e-3  # metres: the first trust region
+_LEVER = 0.05  # metres per radian: a revolute joint's trust region is r / _LEVER
 
 
 @dataclass(frozen=True, eq=False)
@@ -349,7 +353,7 @@ def settle_object(
     gain = T.T @ tau
     still_u = still[free]
     lever = np.array(
-        [1.0 if hand.joints[k].type_name() == "prismatic" else 0.05 for k in free]
+        [1.0 if hand.joints[k].type_name() == "prismatic" else _LEVER for k in free]
     )
     X_start = plant.EvalBodyPoseInWorld(plant_context, object_body)
     q_all = plant.GetPositions(plant_context)
