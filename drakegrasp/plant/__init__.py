@@ -41,6 +41,11 @@ _SOURCES = {
     ),
     "drakegrasp.plant.curvature": ("contact_curvatures",),
     "drakegrasp.plant.finger_antipodal": ("FingerAntipodal",),
+    "drakegrasp.plant.jaws": (
+        "JawContact",
+        "ParallelJaws",
+        "parallel_jaws",
+    ),
     "drakegrasp.plant.jacobians": (
         "hand_jacobian",
         "hand_velocity_indices",
@@ -54,6 +59,10 @@ _SOURCES = {
     "drakegrasp.plant.options": ("AnalysisOptions",),
     "drakegrasp.plant.pose": ("PoseCheck",),
     "drakegrasp.plant.scale": ("object_radius",),
+    "drakegrasp.plant.settle": (
+        "SettleResult",
+        "settle_object",
+    ),
     "drakegrasp.plant.scene": (
         "DEFAULT_SCENE",
         "Scene",
@@ -78,6 +87,7 @@ _SUBMODULES = (
     "finger_antipodal",
     "fingers",
     "jacobians",
+    "jaws",
     "load",
     "models",
     "options",
@@ -85,6 +95,7 @@ _SUBMODULES = (
     "scene",
     "scene_file",
     "scene_refs",
+    "settle",
     "validation",
 )
 
@@ -101,11 +112,14 @@ __all__ = [
     "GraspFromPlant",
     "GraspReport",
     "HandClosure",
+    "JawContact",
     "JointCoupling",
+    "ParallelJaws",
     "PlantContact",
     "PoseCheck",
     "Scene",
     "SceneInfo",
+    "SettleResult",
     "add_coupler_constraint",
     "add_models",
     "analyze_grasp",
@@ -121,8 +135,10 @@ __all__ = [
     "load_scene",
     "models_dir",
     "object_radius",
+    "parallel_jaws",
     "plant_couplings",
     "register_models",
     "use_local_drake_models",
+    "settle_object",
     "signed_distance_jacobian",
 ]

@@ -29,18 +29,31 @@ distance can produce) is cut back by regula falsi towards the last clear point.
 All fingers step at once, one kinematics update per step.  A finger is
 **touching** when ``0 <= ψ_f <= tol`` (no finger geometry penetrates), **at
 limit** when every joint it would move is at a limit with ``ψ_f > tol``; the
-loop is bounded by ``max_iterations`` steps per finger.
+loop is bounded by ``max_iterations`` steps per finger.  The loop itself is
+in ``drakegrasp.plant._closing_steps``.
+
+**Parallel grippers.**  A hand whose closing joints are two prismatic jaws
+facing each other (:mod:`drakegrasp.plant.jaws`) gets each jaw's distance in
+``HandClosure.jaws``, and a warning when only one of them touches.
+``symmetric=True`` couples the jaws to close at one speed, as the real
+grippers' single motor does; an object off their midpoint then touches one
+jaw.
+
+**Re-seating.**  ``settle=True`` then lets a free object move
+(:mod:`drakegrasp.plant.settle`: quasi-static, frictionless, no gravity)
+while the fingers keep pushing, until they seat; the object's new pose is in
+``HandClosure.settle`` and in the context.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
+from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
@@ -50,14 +63,13 @@ from drakegrasp.errors import (
     PenetrationError,
     UnreachableError,
 )
-from drakegrasp.plant.advancement import (
-    advancement_bound,
-    finger_speed_bound,
-    reach,
-)
+from drakegrasp.plant._closing_steps import FingerState, Search, closest
+from drakegrasp.plant.advancement import reach
 from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import Finger, HandStructure, hand_structure
+from drakegrasp.plant.fingers import HandStructure, hand_structure
+from drakegrasp.plant.jaws import JawContact, jaw_contacts, parallel_jaws
 from drakegrasp.plant.pose import find_penetrations
+from drakegrasp.plant.settle import SettleResult, settle_object
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -130,6 +142,14 @@ class HandClosure:
         Wall-clock seconds.
     distance_tolerance : float
         Metres.
+    symmetric : bool
+        The jaws of a parallel gripper closed as one
+        (:mod:`drakegrasp.plant.jaws`).
+    jaws : tuple of JawContact
+        A parallel gripper's two jaws where they stopped (empty for other
+        hands).
+    settle : SettleResult or None
+        How the object moved to seat the fingers (``settle=True``), else None.
     """
 
     joints: tuple[str, ...]
@@ -140,6 +160,9 @@ class HandClosure:
     iterations: int
     time: float
     distance_tolerance: float
+    symmetric: bool = False
+    jaws: tuple[JawContact, ...] = ()
+    settle: SettleResult | None = None
 
     @property
     def psi(self) -> np.ndarray:
@@ -156,6 +179,29 @@ class HandClosure:
         """Names of the fingers that touch the object."""
         return tuple(f.name for f in self.fingers if f.status == "touching")
 
+    @property
+    def one_jaw_only(self) -> bool:
+        """True when exactly one jaw of a parallel gripper touches the object."""
+        return sum(j.touching for j in self.jaws) == 1
+
+    @property
+    def X_WO(self) -> RigidTransform | None:
+        """The object's pose after settling (``settle=True``), else None."""
+        return None if self.settle is None else self.settle.X_WO
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """What a user should know before trusting the grasp (may be empty)."""
+        if not self.one_jaw_only:
+            return ()
+        on = next(j for j in self.jaws if j.touching)
+        off = next(j for j in self.jaws if not j.touching)
+        return (
+            f"only one jaw touches the object: {on.body} touches, {off.body} is "
+            f"{off.psi * 1e3:.4g} mm away (the object is off the jaws' midpoint; "
+            "settle=True lets it move until both jaws touch)",
+        )
+
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
         return {
@@ -167,13 +213,19 @@ class HandClosure:
             "iterations": self.iterations,
             "time": self.time,
             "distance_tolerance": self.distance_tolerance,
+            "symmetric": self.symmetric,
+            "jaws": [j.to_dict() for j in self.jaws],
+            "one_jaw_only": self.one_jaw_only,
+            "settle": None if self.settle is None else self.settle.to_dict(),
+            "warnings": list(self.warnings),
         }
 
     def __str__(self) -> str:
         n = len(self.touching_fingers)
+        mode = ", jaws closed as one" if self.symmetric else ""
         lines = [
             f"Hand closed: {n} of {len(self.fingers)} fingers touch "
-            f"(tol {self.distance_tolerance * 1e3:g} mm), {self.iterations} "
+            f"(tol {self.distance_tolerance * 1e3:g} mm{mode}), {self.iterations} "
             f"steps, {self.time * 1e3:.1f} ms",
         ]
         for f in self.fingers:
@@ -182,53 +234,18 @@ class HandClosure:
                 f"  {f.name:<34} {f.status:<13} psi = {f.psi * 1e3:+.4f} mm"
                 f"{where}, {f.iterations} steps"
             )
+        for j in self.jaws:
+            state = "touches" if j.touching else "does not touch"
+            lines.append(
+                f"  jaw {j.joint:<30} {state:<14} psi = {j.psi * 1e3:+.4f} mm "
+                f"({j.body})"
+            )
         for name, q0, q in zip(self.joints, self.q_start, self.q, strict=True):
             lines.append(f"    {name:<40} {q0:+.5f} -> {q:+.5f}")
+        if self.settle is not None:
+            lines.append("  " + str(self.settle))
+        lines += [f"  WARNING: {w}" for w in self.warnings]
         return "\n".join(lines)
-
-
-@dataclass
-class _State:
-    """Working state of one finger during the search."""
-
-    finger: Finger
-    q_good: np.ndarray  # ψ > tol here (the last accepted point)
-    q_trial: np.ndarray
-    reach: np.ndarray  # (n_pairs, n_h), see drakegrasp.plant.advancement
-    d: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    psi_good: float = np.inf
-    alpha: float = 0.0
-    status: str = ""
-    psi: float = np.inf
-    closest_body: object = None
-    iterations: int = 0
-
-
-def _closest(query, plant, context, pairs):
-    """The closest pair and the distance of every pair.
-
-    Returns
-    -------
-    (ψ, n̂_W from finger to object, finger body, witness p_BCb, ψ of every pair)
-        ``(inf, None, None, None, ψs)`` when there is no pair.
-    """
-    best = (np.inf, None, None, None, None)
-    every = np.empty(len(pairs))
-    for k, (go, gf, body) in enumerate(pairs):
-        r = query.ComputeSignedDistancePairClosestPoints(go, gf)
-        every[k] = r.distance
-        if r.distance < best[0]:
-            if r.id_A == go:
-                n_W, p_GC = np.asarray(r.nhat_BA_W), r.p_BCb
-            else:  # Drake swapped the pair
-                n_W, p_GC = -np.asarray(r.nhat_BA_W), r.p_ACa
-            best = (float(r.distance), n_W, body, gf, p_GC)
-    psi, n_W, body, gf, p_GC = best
-    if body is None:
-        return psi, None, None, None, every
-    p_WC = query.GetPoseInWorld(gf).multiply(p_GC)
-    p_BC = plant.EvalBodyPoseInWorld(context, body).inverse().multiply(p_WC)
-    return psi, n_W, body, np.asarray(p_BC), every
 
 
 def close_hand(
@@ -242,6 +259,8 @@ def close_hand(
     distance_tolerance: float = DEFAULT_DISTANCE_TOLERANCE,
     min_fingers: int = 1,
     max_iterations: int = DEFAULT_MAX_ITERATIONS,
+    symmetric: bool = False,
+    settle: bool = False,
 ) -> HandClosure:
     """Move the hand's fingers from their pre-shape until they touch the object.
 
@@ -277,22 +296,42 @@ def close_hand(
         Fewest fingers that must touch (default 1).
     max_iterations : int, optional
         Bound on the steps of each finger (default 100).
+    symmetric : bool, optional
+        Close the two jaws of a parallel gripper as one, at one speed, as the
+        real WSG-50 and Franka hand do (default False: each jaw closes on its
+        own).  The jaws are coupled on top of ``couplings``
+        (:meth:`~drakegrasp.plant.jaws.ParallelJaws.symmetric_coupling`);
+        jaws already coupled stay as they are.  An object off the jaws'
+        midpoint then touches one jaw: :attr:`HandClosure.warnings` says so.
+    settle : bool, optional
+        After closing, let the object move until the fingers seat
+        (:func:`~drakegrasp.plant.settle.settle_object`: the fingers keep
+        pushing, the object is free, quasi-statically and without gravity).
+        Its new pose ``X_WO`` is in ``HandClosure.settle`` and written
+        into the context with the fingers' positions.  The object must be a
+        free body; without friction, it suits fingers that oppose each other
+        across it (a parallel gripper).  Default False: the object does not
+        move.
 
     Returns
     -------
     HandClosure
-        Final positions, which fingers touch, ψ per finger, steps, time.
+        Final positions, which fingers touch, ψ per finger, each jaw of a
+        parallel gripper, steps, time, and the settled pose.
 
     Raises
     ------
     UnreachableError
-        Fewer than ``min_fingers`` fingers touch; names the others, their
-        distance and why they stopped.  The context is left unchanged.
+        Fewer than ``min_fingers`` fingers touch (after settling, with
+        ``settle=True``); names the others, their distance and why they
+        stopped.  The context is left unchanged (the object's pose too).
     PenetrationError
         A body of the hand's model instances penetrates the object at the
         pre-shape (open the hand first).
     InvalidOptionError, ModelError, InvalidContextError
-        Bad options, a hand without closing joints, a bad context.
+        Bad options (``symmetric=True`` for a hand that is not a parallel
+        gripper, ``settle=True`` for an object that is not a free body), a
+        hand without closing joints, a bad context.
     """
     t0 = time.perf_counter()
     plant_context = plant_context_of(plant, plant_context)
@@ -311,15 +350,28 @@ def close_hand(
     bodies = hand_bodies(plant, body, hand)
     couplings = plant_couplings(plant, couplings)
     query = query_object_of(plant, plant_context)
-    hand_ = hand_structure(plant, body, bodies, couplings, inspector=query.inspector())
-    found = find_penetrations(
-        plant, plant_context, body, hand_model_instances(plant, bodies, body), tol
-    )
+    inspector = query.inspector()
+    hand_ = hand_structure(plant, body, bodies, couplings, inspector=inspector)
+    instance_bodies = hand_model_instances(plant, bodies, body)
+    found = find_penetrations(plant, plant_context, body, instance_bodies, tol)
     if found:
         raise PenetrationError(
             "the pre-shape already penetrates the object: "
             + "; ".join(map(str, found))
             + " (open the hand or move the object before closing)"
+        )
+    q_all = plant.GetPositions(plant_context)
+    q0 = q_all[hand_.position_indices].copy()
+    jaws = parallel_jaws(plant, plant_context, hand_, query)
+    _check_flag("symmetric", symmetric)
+    _check_flag("settle", settle)
+    if symmetric:
+        hand_ = _couple_jaws(plant, body, bodies, couplings, hand_, jaws, q0, inspector)
+    if settle and not body.is_floating_base_body():
+        raise InvalidOptionError(
+            f"settle=True moves the object, and {scoped_name(plant, body)!r} is not "
+            "a free body (it is welded or jointed); settle=False closes onto it "
+            "where it is"
         )
     if min_fingers > len(hand_.fingers):  # unreachable before any search
         raise UnreachableError(
@@ -327,19 +379,30 @@ def close_hand(
             f"fingers ({', '.join(f.name for f in hand_.fingers)}); at most "
             f"{len(hand_.fingers)} can touch"
         )
-    q_all = plant.GetPositions(plant_context)
-    q0 = q_all[hand_.position_indices].copy()
     _check_coupled(hand_, q0)
     user_d = _user_direction(direction, len(q0), hand_)
-    search = _Search(plant, plant_context, hand_, tol, user_d, max_iterations)
-    inspector = query.inspector()
+    search = Search(plant, plant_context, hand_, tol, user_d, max_iterations)
     states = [
-        _State(
+        FingerState(
             f, q0.copy(), q0.copy(), reach(plant, plant_context, hand_, f, inspector)
         )
         for f in hand_.fingers
     ]
     steps = search.run(states, q_all, q0)
+    touching = sum(st.status == "touching" for st in states)
+    settled = None
+    if settle and touching >= min_fingers:
+        settled = settle_object(
+            plant,
+            plant_context,
+            body,
+            hand_,
+            _pushing(search, states, len(q0)),
+            bodies=instance_bodies,
+            distance_tolerance=tol,
+        )
+        _reclassify(plant, plant_context, states, tol)
+    query = query_object_of(plant, plant_context)
     closure = HandClosure(
         joints=hand_.names,
         position_indices=hand_.position_indices,
@@ -349,22 +412,87 @@ def close_hand(
         iterations=steps,
         time=time.perf_counter() - t0,
         distance_tolerance=tol,
+        symmetric=bool(symmetric),
+        jaws=() if jaws is None else jaw_contacts(plant, jaws, query, tol),
+        settle=settled,
     )
     if len(closure.touching_fingers) < min_fingers:
-        q_all[hand_.position_indices] = q0
+        q_all[hand_.position_indices] = q0  # q_all holds the object's start pose
         plant.SetPositions(plant_context, q_all)
         others = [
             f"{f.name} ({f.status}, psi = {f.psi * 1e3:.4g} mm)"
             for f in closure.fingers
             if f.status != "touching"
         ]
+        moved = ""
+        if settled is not None:
+            moved = (
+                f" after settle=True moved it {settled.translation * 1e3:.4g} mm and "
+                f"turned it {np.rad2deg(settled.rotation):.4g} deg (without "
+                "friction, fingers that do not enclose an object squeeze it out; "
+                "settle=False closes onto it where it is)"
+            )
         raise UnreachableError(
             f"only {len(closure.touching_fingers)} of {len(states)} fingers reach "
-            f"{scoped_name(plant, body)!r} (min_fingers = {min_fingers}); could not "
-            f"reach it: {'; '.join(others)}",
+            f"{scoped_name(plant, body)!r} (min_fingers = {min_fingers}){moved}; "
+            f"could not reach it: {'; '.join(others)}",
             closure=closure,
         )
     return closure
+
+
+def _check_flag(name: str, value) -> None:
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidOptionError(f"{name} must be True or False, got {value!r}")
+
+
+def _couple_jaws(plant, body, bodies, couplings, hand, jaws, q0, inspector):
+    """The hand structure with a parallel gripper's jaws coupled at one speed."""
+    if jaws is None:
+        kinds = ", ".join(
+            f"{name} ({j.type_name()})"
+            for name, j in zip(hand.names, hand.joints, strict=True)
+        )
+        raise InvalidOptionError(
+            "symmetric=True closes the two jaws of a parallel gripper as one: it "
+            "needs exactly two prismatic closing joints with parallel axes whose "
+            f"jaws face each other; this hand closes with {kinds or 'no joint'}"
+        )
+    if len(hand.fingers) == 1:  # the jaws are coupled already
+        return hand
+    coupled = (*couplings, jaws.symmetric_coupling(q0))
+    return hand_structure(plant, body, bodies, coupled, inspector=inspector)
+
+
+def _pushing(search: Search, states: list[FingerState], n: int) -> np.ndarray:
+    """(n_h,) the direction each finger's motor pushes (zero for idle fingers).
+
+    A finger that closed pushes along its last closing direction; one that
+    touched at its pre-shape along the direction it would have closed in.
+    """
+    tau = np.zeros(n)
+    query = search.plant.get_geometry_query_input_port().Eval(search.context)
+    for st in states:
+        if st.status not in ("touching", "at limit"):
+            continue
+        d = st.d if st.d.size == n and np.any(st.d) else search.direction(st, query)
+        mine = list(st.finger.joints)
+        tau[mine] = d[mine]
+    return tau
+
+
+def _reclassify(plant, plant_context, states: list[FingerState], tol) -> None:
+    """Each finger's distance and contact after the object settled."""
+    query = query_object_of(plant, plant_context)
+    for st in states:
+        psi, _, body, _, _ = closest(query, plant, plant_context, st.finger.pairs)
+        if body is None:
+            continue
+        st.psi, st.closest_body = psi, body
+        if 0.0 <= psi <= tol:
+            st.status = "touching"
+        elif st.status == "touching":
+            st.status = "at limit"
 
 
 def _check_coupled(hand: HandStructure, q0: np.ndarray) -> None:
@@ -392,15 +520,7 @@ def _user_direction(direction, n: int, hand: HandStructure) -> np.ndarray | None
     return hand.coupling.project(d)
 
 
-def _path_end(q, d, lower, upper) -> float:
-    """Largest α at which a joint with d != 0 still moves (capped at 1e3)."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        t = np.where(d > 0, (upper - q) / d, np.where(d < 0, (lower - q) / d, 0.0))
-    t = np.where(np.isfinite(t), t, 1e3)
-    return float(max(np.max(t, initial=0.0), 0.0))
-
-
-def _finger_result(plant, st: _State, hand: HandStructure) -> FingerClosure:
+def _finger_result(plant, st: FingerState, hand: HandStructure) -> FingerClosure:
     touching = st.status == "touching"
     return FingerClosure(
         name=st.finger.name,
@@ -411,104 +531,3 @@ def _finger_result(plant, st: _State, hand: HandStructure) -> FingerClosure:
         touching_body=scoped_name(plant, st.closest_body) if touching else None,
         iterations=st.iterations,
     )
-
-
-class _Search:
-    """The steps of every finger (see the module docstring)."""
-
-    def __init__(self, plant, context, hand: HandStructure, tol, user_d, max_it):
-        self.plant, self.context, self.hand = plant, context, hand
-        self.tol, self.target = tol, 0.5 * tol
-        self.user_d, self.max_iterations = user_d, max_it
-
-    def run(self, states: list[_State], q_all: np.ndarray, q0: np.ndarray) -> int:
-        """Step until every finger has a status; the number of steps."""
-        hand, steps = self.hand, 0
-        while not all(st.status for st in states):
-            q = q0.copy()
-            for st in states:
-                q[list(st.finger.joints)] = st.q_trial[list(st.finger.joints)]
-            q_all[hand.position_indices] = hand.coupling.apply(q)
-            self.plant.SetPositions(self.context, q_all)
-            query = self.plant.get_geometry_query_input_port().Eval(self.context)
-            for st in states:
-                if not st.status:
-                    self.advance(st, query)
-            steps += 1
-        # Where each finger stopped (a finger that ran out of steps goes back
-        # to its last point clear of the object).
-        q = q0.copy()
-        for st in states:
-            q[list(st.finger.joints)] = st.q_trial[list(st.finger.joints)]
-        q_all[hand.position_indices] = hand.coupling.apply(q)
-        self.plant.SetPositions(self.context, q_all)
-        return steps
-
-    def advance(self, st: _State, query) -> None:
-        """Classify the finger's trial point, then aim its next one."""
-        psi, _, body, _, every = _closest(
-            query, self.plant, self.context, st.finger.pairs
-        )
-        st.psi, st.closest_body = psi, body
-        first = st.iterations == 0
-        if body is None:  # no collision geometry that can touch the object
-            st.status = "fixed"
-        elif 0.0 <= psi <= self.tol or (first and -self.tol <= psi <= self.tol):
-            st.status = "touching"
-        elif st.iterations >= self.max_iterations:  # back to the last clear point
-            st.status = "not converged"
-            st.q_trial, st.psi = st.q_good.copy(), st.psi_good
-        elif psi < 0.0:  # the step went in: regula falsi back to the surface
-            alpha = st.alpha * (st.psi_good - self.target) / (st.psi_good - psi)
-            st.alpha = float(np.clip(alpha, 0.1 * st.alpha, 0.9 * st.alpha))
-            st.q_trial = self._at(st, st.alpha)
-            st.iterations += 1
-        else:  # clear of the object: accept the point, aim the next step
-            st.q_good, st.psi_good = st.q_trial.copy(), psi
-            st.d = self._direction(st, query)
-            alpha_end = _path_end(st.q_good, st.d, self.hand.lower, self.hand.upper)
-            if alpha_end <= 1e-12:
-                mine = list(st.finger.joints)
-                unmoved = self.user_d is not None and not np.any(self.user_d[mine])
-                st.status = "fixed" if unmoved else "at limit"
-                return
-            speed = finger_speed_bound(st.reach, self.hand.coupling.tangent(st.d))
-            alpha_ca = advancement_bound(every, speed, self.target)
-            st.alpha = min(alpha_ca, st.finger.max_step, alpha_end)
-            st.q_trial = self._at(st, st.alpha)
-            st.iterations += 1
-
-    def _at(self, st: _State, alpha: float) -> np.ndarray:
-        return np.clip(st.q_good + alpha * st.d, self.hand.lower, self.hand.upper)
-
-    def _dpsi(self, n_W, body, p_BC) -> np.ndarray:
-        """``∂ψ/∂q`` over the closing joints (object fixed; one-dof, q̇ = v)."""
-        J = self.plant.CalcJacobianTranslationalVelocity(
-            self.context,
-            JacobianWrtVariable.kV,
-            body.body_frame(),
-            p_BC,
-            self.plant.world_frame(),
-            self.plant.world_frame(),
-        )
-        return -(n_W @ J[:, self.hand.velocity_indices])
-
-    def _direction(self, st: _State, query) -> np.ndarray:
-        """The finger's direction, zero on joints blocked by a limit."""
-        hand = self.hand
-        mine = np.isin(np.arange(len(hand.lower)), st.finger.joints)
-        if self.user_d is not None:
-            d = np.where(mine, self.user_d, 0.0)
-        else:  # steepest descent of the fingertip's distance, here
-            tip = _closest(query, self.plant, self.context, st.finger.tip_pairs)
-            if tip[2] is None:
-                return np.zeros(len(mine))
-            d = np.where(mine, -hand.coupling.pull_back(self._dpsi(*tip[1:4])), 0.0)
-        q = st.q_good
-        blocked = ((d > 0) & (q >= hand.upper)) | ((d < 0) & (q <= hand.lower))
-        d = np.where(blocked, 0.0, d)
-        scale = np.max(np.abs(d), initial=0.0)
-        if scale <= 1e-12:
-            return np.zeros_like(d)
-        d = d / scale
-        return np.where(np.abs(d) < 1e-9, 0.0, d)  # round-off, not a motion

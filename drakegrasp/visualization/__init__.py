@@ -1,7 +1,8 @@
 """Pictures of grasps: Meshcat drawings and matplotlib plots.
 
 - :func:`draw_grasp` / :func:`clear_grasp`: contacts, contact frames, friction
-  cones and contact forces in Drake's Meshcat.
+  cones and contact forces in Drake's Meshcat, framed by the camera
+  (:func:`frame_points`).
 - :func:`plot_planar_grasp`: a planar grasp with its outline, normals, exact
   cones and forces (matplotlib).
 - :func:`plot_wrench_space`: the primitive wrenches of a planar grasp and their
@@ -32,6 +33,7 @@ from drakegrasp.visualization.plots import (
     plot_planar_grasp,
 )
 from drakegrasp.visualization.robot import set_translucent, visualizer_paths
+from drakegrasp.visualization.view import CameraView, frame_points, grasp_pose
 from drakegrasp.visualization.wrench_space import (
     WrenchHull,
     WrenchSpacePlot,
@@ -41,6 +43,7 @@ from drakegrasp.visualization.wrench_space import (
 )
 
 __all__ = [
+    "CameraView",
     "DEFAULT_PREFIX",
     "MESHCAT_COLORS",
     "PLOT_COLORS",
@@ -54,6 +57,8 @@ __all__ = [
     "contact_pose_3d",
     "draw_grasp",
     "exact_cone_mesh",
+    "frame_points",
+    "grasp_pose",
     "normalize_contact_forces",
     "plot_planar_grasp",
     "plot_wrench_space",

@@ -29,6 +29,8 @@ from typing import Any
 import numpy as np
 from pydrake.geometry import Cylinder, Meshcat, Rgba, Sphere
 from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import Context
 
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
@@ -46,6 +48,7 @@ from drakegrasp.visualization.geometry import (
 )
 from drakegrasp.visualization.primitives import _draw_arrow, _set_mesh
 from drakegrasp.visualization.robot import set_translucent
+from drakegrasp.visualization.view import CameraView, frame_points, grasp_pose
 
 __all__ = [
     "DEFAULT_PREFIX",
@@ -88,6 +91,8 @@ class GraspDrawing:
         Arrow length per newton, metres/N (0 when no forces were drawn).
     forces_G : (N, 3) ndarray or None
         Drawn contact forces in the grasp frame, newtons (planar: ``z = 0``).
+    camera : CameraView or None
+        Where the camera was aimed (None with ``keep_camera=True``).
     """
 
     prefix: str
@@ -95,6 +100,7 @@ class GraspDrawing:
     cone_height: float
     force_scale: float
     forces_G: np.ndarray | None
+    camera: CameraView | None = None
 
 
 def _rgba(colors: Mapping[str, Any], key: str) -> Rgba:
@@ -144,6 +150,10 @@ def draw_grasp(
     size: float | None = None,
     translucent: str | Sequence[str] = (),
     translucent_opacity: float = 0.3,
+    plant: MultibodyPlant | None = None,
+    plant_context: Context | None = None,
+    object_body: Any = None,
+    keep_camera: bool = False,
 ) -> GraspDrawing:
     """Draw a grasp (and optionally the forces of a closure result) in Meshcat.
 
@@ -156,7 +166,8 @@ def draw_grasp(
         z = 0 plane.
     X_WG : RigidTransform, optional
         Pose of G in world (for a grasp from a plant: the object body's pose
-        ``X_WO``).  Default identity.  It is set on ``prefix``, so
+        ``X_WO``, which ``plant``, ``plant_context`` and ``object_body`` give
+        instead).  Default identity.  It is set on ``prefix``, so
         ``meshcat.SetTransform(prefix, X_WG)`` later moves the whole drawing.
     result : ClosureResult or sequence of array_like, optional
         Contact forces to draw as arrows: a result with ``contact_forces``, or
@@ -208,6 +219,18 @@ def draw_grasp(
         ``"visualizer/gripper"``, a hand drawn by ``MeshcatVisualizer``).
     translucent_opacity : float, optional
         Their opacity factor, in (0, 1] (default 0.3).
+    plant, plant_context, object_body : optional
+        Together, and instead of ``X_WG``: the grasp frame is the object
+        body's frame, ``X_WG = plant.EvalBodyPoseInWorld(plant_context,
+        object_body)`` (a grasp from
+        :func:`~drakegrasp.grasp_from_plant` or
+        :func:`~drakegrasp.analyze_grasp` is expressed in it).
+        ``plant_context`` may be the diagram's root context; ``object_body`` a
+        body, ``BodyIndex`` or name.
+    keep_camera : bool, optional
+        Leave Meshcat's camera where it is.  Default False: aim it at the
+        drawing (:func:`~drakegrasp.visualization.view.frame_points` over
+        the contact points, with the cones and arrows in view).
 
     Returns
     -------
@@ -223,8 +246,9 @@ def draw_grasp(
     Raises
     ------
     InvalidOptionError
-        For an unknown ``cone``, ``side`` or colour key, a non-positive size, or
-        forces that do not match the grasp's contacts.
+        For an unknown ``cone``, ``side`` or colour key, a non-positive size,
+        forces that do not match the grasp's contacts, or both ``X_WG`` and a
+        plant (or a plant without its context and object body).
     """
     _check_meshcat(meshcat)
     if not isinstance(grasp, Grasp):
@@ -248,11 +272,10 @@ def draw_grasp(
     axis_len = positive_length(
         "frame_length", 0.2 * b if frame_length is None else frame_length
     )
-    if X_WG is None:
-        X_WG = RigidTransform()
-    elif not isinstance(X_WG, RigidTransform):
+    X_WG = grasp_pose(X_WG, plant, plant_context, object_body)
+    if not isinstance(keep_camera, bool | np.bool_):
         raise InvalidOptionError(
-            f"X_WG must be a pydrake RigidTransform, got {type(X_WG).__name__}"
+            f"keep_camera must be True or False, got {keep_camera!r}"
         )
 
     forces = normalize_contact_forces(grasp, result)
@@ -344,7 +367,14 @@ def draw_grasp(
             _draw_on_top(meshcat, path)
     if translucent:
         set_translucent(meshcat, translucent, translucent_opacity)
-    return GraspDrawing(prefix, tuple(paths), h, scale, forces_G)
+    camera = None
+    if not keep_camera:
+        reach = max(h if cone is not None else 0.0, axis_len, r)
+        if forces_G is not None:
+            reach = max(reach, scale * float(np.max(np.linalg.norm(forces_G, axis=1))))
+        points_W = [X_WG.multiply(contact_pose_3d(c)[1]) for c in grasp.contacts]
+        camera = frame_points(meshcat, np.array(points_W), pad=reach)
+    return GraspDrawing(prefix, tuple(paths), h, scale, forces_G, camera)
 
 
 def _draw_cone(

@@ -172,6 +172,8 @@ class Rig:
     weld_hand : str, optional
         A frame of the hand to weld to the world (URDF has no world joint).
     time_step : float
+    gravity : bool
+        False: no gravity (``plant.mutable_gravity_field()`` set to zero).
     record_couplings : bool
         Parse with :func:`drakegrasp.plant.add_models` (default), which records
         the models' mimic couplings, or with a bare ``Parser``.
@@ -186,6 +188,7 @@ class Rig:
         weld_hand=None,
         time_step=0.0,
         record_couplings=True,
+        gravity=True,
     ):
         from pydrake.math import RigidTransform
 
@@ -199,6 +202,8 @@ class Rig:
             else:
                 instances += parser.AddModelsFromString(text, kind)
         self.hand = instances[0]
+        if not gravity:
+            plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
         if weld_hand is not None:
             plant.WeldFrames(
                 plant.world_frame(), plant.GetFrameByName(weld_hand, self.hand)
@@ -210,7 +215,8 @@ class Rig:
         self.ctx = plant.GetMyContextFromRoot(self.root)
         instance = plant.GetModelInstanceByName(object_model)
         self.object = plant.get_body(plant.GetBodyIndices(instance)[0])
-        plant.SetFreeBodyPose(self.ctx, self.object, X_WO or RigidTransform())
+        if self.object.is_floating_base_body():
+            plant.SetFreeBodyPose(self.ctx, self.object, X_WO or RigidTransform())
 
     def query(self):
         """The scene graph's query object in the present configuration."""
@@ -387,12 +393,67 @@ def mimic_gripper_sdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
     return _sdf("mimic_gripper", body)
 
 
-def box_object(size=(0.03, 0.03, 0.03), name="box") -> str:
-    """A free box (SDFormat model ``name``)."""
+def box_object(size=(0.03, 0.03, 0.03), name="box", mu=None) -> str:
+    """A free box (SDFormat model ``name``), with friction ``mu`` if given."""
+    collision = _collision(name, _box(*size))
+    if mu is not None:
+        friction = (
+            f"<drake:proximity_properties><drake:mu_dynamic>{mu}</drake:mu_dynamic>"
+            f"<drake:mu_static>{mu}</drake:mu_static></drake:proximity_properties>"
+        )
+        collision = collision.replace("</collision>", friction + "</collision>")
     return _sdf(
-        name,
-        f'<link name="{name}">'
-        + _inertial(0.1, 5e-5)
-        + _collision(name, _box(*size))
-        + "</link>",
+        name, f'<link name="{name}">' + _inertial(0.1, 5e-5) + collision + "</link>"
     )
+
+
+PAD_SPHERE = 0.002
+"""Radius (m) of the four spheres of each pad of :func:`sphere_pad_gripper`."""
+PAD_HALF = 0.008
+"""Half the side (m) of the square the pad spheres' centres make."""
+PAD_Y0 = 0.05
+"""|y| (m) of each pad's sphere centres at q = 0; a jaw at q has them at
+``|y| = PAD_Y0 − q``."""
+
+
+def sphere_pad_gripper(mimic: bool = False) -> str:
+    """A WSG-like parallel gripper: two prismatic jaws with four-sphere pads.
+
+    A palm box below z = 0 is welded to the world.  ``left_jaw_joint`` moves
+    the left jaw from ``y = −PAD_Y0`` towards +y, ``right_jaw_joint`` the right
+    one from ``+PAD_Y0`` towards −y (both ``[0, 0.045]`` m, actuated).  Each pad
+    is four spheres (radius :data:`PAD_SPHERE`) centred at ``x, z − 0.05 ∈
+    {±PAD_HALF}`` in the plane ``|y| = PAD_Y0 − q``, as the WSG-50's tips.
+    With ``mimic`` the right jaw follows the left by ``<drake:mimic>``.
+    """
+    palm = (
+        '<link name="palm">'
+        + _inertial(0.5, 1e-3)
+        + _collision("palm_box", _box(0.04, 0.14, 0.01), xyz=(0, 0, -0.005))
+        + "</link>"
+    )
+    body = palm
+    for side, sign in (("left", -1.0), ("right", 1.0)):
+        spheres = "".join(
+            _collision(f"{side}_tip_{i}{j}", _sphere(PAD_SPHERE), xyz=(x, 0, z))
+            for i, x in enumerate((-PAD_HALF, PAD_HALF))
+            for j, z in enumerate((-PAD_HALF, PAD_HALF))
+        )
+        mimic_text = (
+            '<drake:mimic joint="left_jaw_joint" multiplier="1" offset="0"/>'
+            if mimic and side == "right"
+            else ""
+        )
+        body += (
+            f'<link name="{side}_jaw">'
+            f"<pose>{_v(0, sign * PAD_Y0, 0.05, 0, 0, 0)}</pose>"
+            + _inertial()
+            + spheres
+            + "</link>"
+            + f'<joint name="{side}_jaw_joint" type="prismatic"><parent>palm</parent>'
+            f"<child>{side}_jaw</child><axis><xyz>{_v(0, -sign, 0)}</xyz>"
+            f"<limit><lower>0</lower><upper>0.045</upper><effort>20</effort>"
+            f"</limit></axis>{mimic_text}</joint>"
+        )
+    body += _weld_to_world("palm")
+    return _sdf("gripper", body)

@@ -69,7 +69,7 @@ def test_chromium_shows_the_drawn_grasp(meshcat, tmp_path):
     profile = tmp_path / "chromium-profile"
 
     empty = screenshot(url, tmp_path / "empty.png", profile)
-    drawing = draw_grasp(meshcat, grasp, result=result, cone="both")
+    drawing = draw_grasp(meshcat, grasp, result=result, cone="both", keep_camera=True)
     drawn_path = tmp_path / "meshcat_screenshot.png"
     drawn = screenshot(url, drawn_path, profile)
     print(f"Meshcat screenshot with the grasp: {drawn_path}")

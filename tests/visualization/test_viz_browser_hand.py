@@ -125,7 +125,12 @@ def test_shipped_hand_on_top_and_translucent(meshcat, tmp_path):
     )
     camera, target = np.array([0.07, 0.0, 0.075]), np.array([0.0, 0.0, 0.055])
     meshcat.SetCameraPose(camera, target)
-    options = {"X_WG": X_WO, "result": report.force_closure, "cone": "exact"}
+    options = {
+        "X_WG": X_WO,
+        "result": report.force_closure,
+        "cone": "exact",
+        "keep_camera": True,
+    }
 
     hand_only, _ = _force_pixels(meshcat, tmp_path, "hand")
     assert colour_mask(hand_only, FORCE).sum() == 0
@@ -159,7 +164,12 @@ def test_wsg50_meshes_do_not_hide_an_on_top_drawing(
     )
     camera, target = np.array([0.0, 0.05, 0.07]), np.array([0.0, 0.108, 0.0])
     meshcat.SetCameraPose(camera, target)
-    options = {"X_WG": X_WO, "result": report.force_closure, "cone": "exact"}
+    options = {
+        "X_WG": X_WO,
+        "result": report.force_closure,
+        "cone": "exact",
+        "keep_camera": True,
+    }
     _hidden_then_on_top(
         meshcat, tmp_path, "wsg50", report, X_WO, camera, target, options, each=False
     )

@@ -1,0 +1,169 @@
+"""The steps of :func:`~drakegrasp.plant.closing.close_hand` (its docstring says how).
+
+Each finger's working state and the loop that advances every finger at once,
+one kinematics update per step, each step bounded by conservative advancement
+(:mod:`drakegrasp.plant.advancement`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.multibody.tree import JacobianWrtVariable
+
+from drakegrasp.plant.advancement import advancement_bound, finger_speed_bound
+from drakegrasp.plant.fingers import Finger, HandStructure
+
+
+@dataclass
+class FingerState:
+    """Working state of one finger during the search."""
+
+    finger: Finger
+    q_good: np.ndarray  # ψ > tol here (the last accepted point)
+    q_trial: np.ndarray
+    reach: np.ndarray  # (n_pairs, n_h), see drakegrasp.plant.advancement
+    d: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    psi_good: float = np.inf
+    alpha: float = 0.0
+    status: str = ""
+    psi: float = np.inf
+    closest_body: object = None
+    iterations: int = 0
+
+
+def closest(query, plant, context, pairs):
+    """The closest pair and the distance of every pair.
+
+    Returns
+    -------
+    (ψ, n̂_W from finger to object, finger body, witness p_BCb, ψ of every pair)
+        ``(inf, None, None, None, ψs)`` when there is no pair.
+    """
+    best = (np.inf, None, None, None, None)
+    every = np.empty(len(pairs))
+    for k, (go, gf, body) in enumerate(pairs):
+        r = query.ComputeSignedDistancePairClosestPoints(go, gf)
+        every[k] = r.distance
+        if r.distance < best[0]:
+            if r.id_A == go:
+                n_W, p_GC = np.asarray(r.nhat_BA_W), r.p_BCb
+            else:  # Drake swapped the pair
+                n_W, p_GC = -np.asarray(r.nhat_BA_W), r.p_ACa
+            best = (float(r.distance), n_W, body, gf, p_GC)
+    psi, n_W, body, gf, p_GC = best
+    if body is None:
+        return psi, None, None, None, every
+    p_WC = query.GetPoseInWorld(gf).multiply(p_GC)
+    p_BC = plant.EvalBodyPoseInWorld(context, body).inverse().multiply(p_WC)
+    return psi, n_W, body, np.asarray(p_BC), every
+
+
+def _path_end(q, d, lower, upper) -> float:
+    """Largest α at which a joint with d != 0 still moves (capped at 1e3)."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        t = np.where(d > 0, (upper - q) / d, np.where(d < 0, (lower - q) / d, 0.0))
+    t = np.where(np.isfinite(t), t, 1e3)
+    return float(max(np.max(t, initial=0.0), 0.0))
+
+
+class Search:
+    """The steps of every finger (see the module docstring)."""
+
+    def __init__(self, plant, context, hand: HandStructure, tol, user_d, max_it):
+        self.plant, self.context, self.hand = plant, context, hand
+        self.tol, self.target = tol, 0.5 * tol
+        self.user_d, self.max_iterations = user_d, max_it
+
+    def run(self, states: list[FingerState], q_all: np.ndarray, q0: np.ndarray) -> int:
+        """Step until every finger has a status; the number of steps."""
+        hand, steps = self.hand, 0
+        while not all(st.status for st in states):
+            q = q0.copy()
+            for st in states:
+                q[list(st.finger.joints)] = st.q_trial[list(st.finger.joints)]
+            q_all[hand.position_indices] = hand.coupling.apply(q)
+            self.plant.SetPositions(self.context, q_all)
+            query = self.plant.get_geometry_query_input_port().Eval(self.context)
+            for st in states:
+                if not st.status:
+                    self.advance(st, query)
+            steps += 1
+        # Where each finger stopped (a finger that ran out of steps goes back
+        # to its last point clear of the object).
+        q = q0.copy()
+        for st in states:
+            q[list(st.finger.joints)] = st.q_trial[list(st.finger.joints)]
+        q_all[hand.position_indices] = hand.coupling.apply(q)
+        self.plant.SetPositions(self.context, q_all)
+        return steps
+
+    def advance(self, st: FingerState, query) -> None:
+        """Classify the finger's trial point, then aim its next one."""
+        psi, _, body, _, every = closest(
+            query, self.plant, self.context, st.finger.pairs
+        )
+        st.psi, st.closest_body = psi, body
+        first = st.iterations == 0
+        if body is None:  # no collision geometry that can touch the object
+            st.status = "fixed"
+        elif 0.0 <= psi <= self.tol or (first and -self.tol <= psi <= self.tol):
+            st.status = "touching"
+        elif st.iterations >= self.max_iterations:  # back to the last clear point
+            st.status = "not converged"
+            st.q_trial, st.psi = st.q_good.copy(), st.psi_good
+        elif psi < 0.0:  # the step went in: regula falsi back to the surface
+            alpha = st.alpha * (st.psi_good - self.target) / (st.psi_good - psi)
+            st.alpha = float(np.clip(alpha, 0.1 * st.alpha, 0.9 * st.alpha))
+            st.q_trial = self._at(st, st.alpha)
+            st.iterations += 1
+        else:  # clear of the object: accept the point, aim the next step
+            st.q_good, st.psi_good = st.q_trial.copy(), psi
+            st.d = self.direction(st, query)
+            alpha_end = _path_end(st.q_good, st.d, self.hand.lower, self.hand.upper)
+            if alpha_end <= 1e-12:
+                mine = list(st.finger.joints)
+                unmoved = self.user_d is not None and not np.any(self.user_d[mine])
+                st.status = "fixed" if unmoved else "at limit"
+                return
+            speed = finger_speed_bound(st.reach, self.hand.coupling.tangent(st.d))
+            alpha_ca = advancement_bound(every, speed, self.target)
+            st.alpha = min(alpha_ca, st.finger.max_step, alpha_end)
+            st.q_trial = self._at(st, st.alpha)
+            st.iterations += 1
+
+    def _at(self, st: FingerState, alpha: float) -> np.ndarray:
+        return np.clip(st.q_good + alpha * st.d, self.hand.lower, self.hand.upper)
+
+    def _dpsi(self, n_W, body, p_BC) -> np.ndarray:
+        """``∂ψ/∂q`` over the closing joints (object fixed; one-dof, q̇ = v)."""
+        J = self.plant.CalcJacobianTranslationalVelocity(
+            self.context,
+            JacobianWrtVariable.kV,
+            body.body_frame(),
+            p_BC,
+            self.plant.world_frame(),
+            self.plant.world_frame(),
+        )
+        return -(n_W @ J[:, self.hand.velocity_indices])
+
+    def direction(self, st: FingerState, query) -> np.ndarray:
+        """The finger's direction, zero on joints blocked by a limit."""
+        hand = self.hand
+        mine = np.isin(np.arange(len(hand.lower)), st.finger.joints)
+        if self.user_d is not None:
+            d = np.where(mine, self.user_d, 0.0)
+        else:  # steepest descent of the fingertip's distance, here
+            tip = closest(query, self.plant, self.context, st.finger.tip_pairs)
+            if tip[2] is None:
+                return np.zeros(len(mine))
+            d = np.where(mine, -hand.coupling.pull_back(self._dpsi(*tip[1:4])), 0.0)
+        q = st.q_good
+        blocked = ((d > 0) & (q >= hand.upper)) | ((d < 0) & (q <= hand.lower))
+        d = np.where(blocked, 0.0, d)
+        scale = np.max(np.abs(d), initial=0.0)
+        if scale <= 1e-12:
+            return np.zeros_like(d)
+        d = d / scale
+        return np.where(np.abs(d) < 1e-9, 0.0, d)  # round-off, not a motion
