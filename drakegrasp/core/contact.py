@@ -143,13 +143,16 @@ def _deprecated_model(contact_model, deprecated: dict, where: str):
         )
     if "model" not in deprecated:
         return contact_model
-    if contact_model is not None:
+    # The default is the one value model= may be combined with (it cannot be
+    # told apart from an explicit hard finger, which model= then overrides).
+    if contact_model is not ContactModel.HARD_FINGER:
         raise InvalidContactError(
             f"{where} got both model= (deprecated) and contact_model=; give "
             "contact_model= only"
         )
     warn_deprecated(f"{where}: model= is deprecated; use contact_model=", stacklevel=4)
-    return deprecated["model"]
+    # Parsed here: model=None is refused as it always was, not read as the default.
+    return ContactModel.parse(deprecated["model"])
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -172,9 +175,8 @@ class Contact:
     mu : float, optional
         Coulomb friction coefficient, ``>= 0``.  Ignored by frictionless contacts.
     contact_model : ContactModel or str, optional
-        ``"frictionless"``, ``"hard_finger"`` (default, also for ``None``) or
-        ``"soft_finger"``.  A soft finger is spatial only.  ``model=`` is its
-        deprecated alias.
+        ``"frictionless"``, ``"hard_finger"`` (default) or ``"soft_finger"``.  A
+        soft finger is spatial only.  ``model=`` is its deprecated alias.
     torsional_friction : float or None, optional
         Torsional friction coefficient ``ν`` of a soft finger: the moment
         about the normal is bounded by ``b ν f_n`` with ``b`` the grasp's
@@ -212,7 +214,7 @@ class Contact:
         normal: np.ndarray,
         *,
         mu: float = 0.0,
-        contact_model: ContactModel | str | None = None,
+        contact_model: ContactModel | str = ContactModel.HARD_FINGER,
         torsional_friction: float | None = None,
         **deprecated,
     ) -> None:
@@ -233,9 +235,7 @@ class Contact:
                 f"{n.tolist()} has {n.size}; both must be 2-D or both 3-D"
             )
         mu_value = check_coefficient("mu", mu)
-        contact_model = ContactModel.parse(
-            ContactModel.HARD_FINGER if contact_model is None else contact_model
-        )
+        contact_model = ContactModel.parse(contact_model)
         if contact_model is ContactModel.SOFT_FINGER and p.size == 2:
             raise InvalidContactError(
                 "a soft-finger contact is spatial only; planar contacts are "
@@ -326,7 +326,7 @@ class Contact:
         if "model" in changes:
             changes = dict(changes)
             changes["contact_model"] = _deprecated_model(
-                changes.pop("contact_model", None),
+                changes.pop("contact_model", ContactModel.HARD_FINGER),
                 {"model": changes.pop("model")},
                 "Contact.with_()",
             )

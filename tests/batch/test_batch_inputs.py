@@ -182,7 +182,7 @@ def test_driver_reads_and_builds_one_chunk_at_a_time(monkeypatch):
 
     monkeypatch.setattr(chunks, "solve_margin_blocks", spy)
     arrays = [_RecordingArray(a) for a in (P, Nrm, mu)]
-    res = batch_force_closure(*arrays, chunk_size=cs)
+    res = batch_force_closure(arrays[0], arrays[1], mu=arrays[2], chunk_size=cs)
     assert max(sizes) <= cs and sum(sizes) == K
     for a in arrays:
         assert max(a.reads) <= cs and sum(a.reads) == K
