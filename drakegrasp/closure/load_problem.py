@@ -51,6 +51,7 @@ __all__ = [
     "CONES",
     "SATURATION_TOL",
     "LoadProblem",
+    "check_direction",
     "check_wrench",
     "load_problem",
     "saturating_joints",
@@ -189,6 +190,14 @@ def check_wrench(grasp: Grasp, wrench, name: str = "wrench") -> np.ndarray:
             f"), got {np.asarray(wrench).tolist()}"
         )
     return w
+
+
+def check_direction(grasp: Grasp, direction, name: str = "direction") -> np.ndarray:
+    """A load direction: a :func:`check_wrench` that is not all zeros."""
+    d = check_wrench(grasp, direction, name)
+    if not np.any(d):
+        raise InvalidOptionError(f"{name} must be a non-zero wrench, got zeros")
+    return d
 
 
 def _check_cones(cones) -> str:
