@@ -70,6 +70,16 @@ def _revolute(name, parent, child, axis, lower, upper, xyz=(0, 0, 0)) -> str:
     )
 
 
+def _palm(size, z) -> str:
+    """The 0.5 kg link ``palm``: a box of ``size`` (m) centred at height ``z``."""
+    return (
+        '<link name="palm">'
+        + _inertial(0.5, 1e-3)
+        + _collision("palm_box", _box(*size), xyz=(0, 0, z))
+        + "</link>"
+    )
+
+
 def _weld_to_world(child) -> str:
     return (
         f'<joint name="{child}_weld" type="fixed"><parent>world</parent>'
@@ -91,12 +101,7 @@ def one_finger_hand() -> str:
     ``x ∈ [2, 75] mm``; the tip a sphere of radius 4 mm at ``x = 90 mm``.
     """
     x0, x1 = PHALANX
-    palm = (
-        '<link name="palm">'
-        + _inertial(0.5, 1e-3)
-        + _collision("palm_box", _box(0.05, 0.05, 0.01), xyz=(0, 0, -0.03))
-        + "</link>"
-    )
+    palm = _palm((0.05, 0.05, 0.01), z=-0.03)
     finger = (
         '<link name="finger">'
         + _inertial()
@@ -248,12 +253,7 @@ def palm_hand() -> str:
     """
     x, r = PALM_FINGER_X, PALM_TIP_RADIUS
     l1, l2 = PALM_LINKS
-    palm = (
-        '<link name="palm">'
-        + _inertial(0.5, 1e-3)
-        + _collision("palm_box", _box(0.16, 0.08, 0.02), xyz=(0, 0, -0.01))
-        + "</link>"
-    )
+    palm = _palm((0.16, 0.08, 0.02), z=-0.01)
     links, joints = "", ""
     for side, sx, sign in (("left", -x, 1.0), ("right", x, -1.0)):
         lo, hi = sorted((-0.3 * sign, 1.4 * sign))
