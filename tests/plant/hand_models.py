@@ -324,6 +324,13 @@ def _urdf_box_link(name, size=None, xyz=(0, 0, 0), mass=0.05) -> str:
     )
 
 
+def _follows_left(tag: str, multiplier: float, offset: float) -> str:
+    """The ``<mimic>`` (URDF) or ``<drake:mimic>`` (SDF) that follows the left jaw."""
+    return (
+        f'<{tag} joint="left_jaw_joint" multiplier="{multiplier}" offset="{offset}"/>'
+    )
+
+
 def mimic_gripper_urdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
     """A parallel gripper whose right jaw follows the left by URDF ``<mimic>``.
 
@@ -335,12 +342,7 @@ def mimic_gripper_urdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
     """
     joints = ""
     for side, sign in (("left", -1.0), ("right", 1.0)):
-        mimic = (
-            f'<mimic joint="left_jaw_joint" multiplier="{multiplier}" '
-            f'offset="{offset}"/>'
-            if side == "right"
-            else ""
-        )
+        mimic = _follows_left("mimic", multiplier, offset) if side == "right" else ""
         joints += (
             f'<joint name="{side}_jaw_joint" type="prismatic"><parent link="palm"/>'
             f'<child link="{side}_jaw"/><origin xyz="{_v(0, sign * JAW_Y0, 0.05)}"/>'
@@ -358,19 +360,10 @@ def mimic_gripper_urdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
 
 def mimic_gripper_sdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
     """The gripper of :func:`mimic_gripper_urdf`, coupled by ``<drake:mimic>``."""
-    palm = (
-        '<link name="palm">'
-        + _inertial(0.5, 1e-3)
-        + _collision("palm_box", _box(0.04, 0.12, 0.02))
-        + "</link>"
-    )
-    body = palm
+    body = _palm((0.04, 0.12, 0.02), z=0)
     for side, sign in (("left", -1.0), ("right", 1.0)):
         mimic = (
-            f'<drake:mimic joint="left_jaw_joint" multiplier="{multiplier}" '
-            f'offset="{offset}"/>'
-            if side == "right"
-            else ""
+            _follows_left("drake:mimic", multiplier, offset) if side == "right" else ""
         )
         body += (
             f'<link name="{side}_jaw">'
