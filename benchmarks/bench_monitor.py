@@ -36,41 +36,26 @@ from pick_support import DURATION, build_pick  # noqa: E402
 
 from drakegrasp.systems.monitor import GraspMonitor  # noqa: E402
 
+# The two plant set-ups the cases vary: point contact with soft fingers read from
+# the geometry, and hydroelastic contact on flat pads read from contact results.
+SOFT_POINT = dict(
+    plant_contact="point", contact_model="soft_finger", torsional_friction=0.1
+)
+FLAT_HYDRO = dict(
+    plant_contact="hydroelastic_with_fallback", flat=True, contacts="contact_results"
+)
 CASES = {
-    "point contact, geometry, soft fingers": dict(
-        plant_contact="point",
-        contact_model="soft_finger",
-        torsional_friction=0.1,
-    ),
-    "hydroelastic, contact results, flat pads": dict(
-        plant_contact="hydroelastic_with_fallback",
-        flat=True,
-        contacts="contact_results",
-    ),
-    "hydroelastic, contact results, with epsilon": dict(
-        plant_contact="hydroelastic_with_fallback",
-        flat=True,
-        contacts="contact_results",
-        compute_epsilon=True,
-    ),
+    "point contact, geometry, soft fingers": SOFT_POINT,
+    "hydroelastic, contact results, flat pads": FLAT_HYDRO,
+    "hydroelastic, contact results, with epsilon": {
+        **FLAT_HYDRO,
+        "compute_epsilon": True,
+    },
 }
 SLIP_CASES = {
-    "point, contact results": dict(
-        plant_contact="point",
-        contact_model="soft_finger",
-        torsional_friction=0.1,
-        contacts="contact_results",
-    ),
-    "point, geometry": dict(
-        plant_contact="point",
-        contact_model="soft_finger",
-        torsional_friction=0.1,
-    ),
-    "hydroelastic, contact results": dict(
-        plant_contact="hydroelastic_with_fallback",
-        flat=True,
-        contacts="contact_results",
-    ),
+    "point, contact results": {**SOFT_POINT, "contacts": "contact_results"},
+    "point, geometry": SOFT_POINT,
+    "hydroelastic, contact results": FLAT_HYDRO,
 }
 
 

@@ -245,24 +245,26 @@ def _cmd_batch(args: argparse.Namespace) -> int:
     return 0
 
 
-def _workers(text: str) -> int:
+def _parsed(text: str, convert, noun: str, ok, must: str):
+    """``convert(text)`` when ``ok`` of it, else an argparse error saying why."""
     try:
-        n = int(text)
+        x = convert(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {text!r}")
-    return n
+        raise argparse.ArgumentTypeError(f"not {noun}: {text!r}") from None
+    if not ok(x):
+        raise argparse.ArgumentTypeError(f"must be {must}, got {text!r}")
+    return x
+
+
+def _workers(text: str) -> int:
+    return _parsed(text, int, "an integer", lambda n: n >= 1, ">= 1")
 
 
 def _positive_float(text: str) -> float:
-    try:
-        x = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not (x >= 0.0) or x == float("inf"):
-        raise argparse.ArgumentTypeError(f"must be finite and >= 0, got {text!r}")
-    return x
+    return _parsed(
+        text, float, "a number", lambda x: x >= 0.0 and x != float("inf"),
+        "finite and >= 0",
+    )  # fmt: skip
 
 
 def _package(text: str) -> tuple[str, str]:

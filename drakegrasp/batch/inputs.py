@@ -120,6 +120,21 @@ def chunk_unit_normals(Nrm: np.ndarray, start: int) -> np.ndarray:
         ) from None
 
 
+def _refuse_grasp(
+    bad: np.ndarray, values: np.ndarray, start: int, what: str, must: str
+) -> None:
+    """Raise :class:`~drakegrasp.InvalidGraspError` for the first grasp ``bad`` flags.
+
+    ``bad`` is (k,) bool over a chunk that starts at grasp ``start``; the message
+    names that grasp's ``what``, its value in ``values`` and what it ``must`` be.
+    """
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise InvalidGraspError(
+            f"{what} of grasp {start + k} is {values[k].tolist()}; it must be {must}"
+        )
+
+
 def _reference_points(value, K: int, d: int):
     if value is None:
         return lambda sl: np.zeros((sl.stop - sl.start, d))
@@ -136,12 +151,10 @@ def _reference_points(value, K: int, d: int):
     def get(sl):
         p = real_array("reference_points", value[sl], error=InvalidGraspError)
         bad = ~(np.abs(p) <= POSITION_BOUND).all(axis=1)
-        if bad.any():
-            k = int(np.flatnonzero(bad)[0])
-            raise InvalidGraspError(
-                f"reference point of grasp {sl.start + k} is {p[k].tolist()}; it "
-                f"must be finite with |x| <= {POSITION_BOUND:g} m"
-            )
+        _refuse_grasp(
+            bad, p, sl.start, "reference point",
+            f"finite with |x| <= {POSITION_BOUND:g} m",
+        )  # fmt: skip
         return p
 
     return get
@@ -167,12 +180,10 @@ def _characteristic_lengths(value, K: int):
             (sl.stop - sl.start,),
         )
         bad = ~(b > 0.0) | ~(b <= LENGTH_BOUND)
-        if bad.any():
-            k = int(np.flatnonzero(bad)[0])
-            raise InvalidGraspError(
-                f"characteristic length of grasp {sl.start + k} is {float(b[k])}; it "
-                f"must be finite and in (0, {LENGTH_BOUND:g}] m"
-            )
+        _refuse_grasp(
+            bad, b, sl.start, "characteristic length",
+            f"finite and in (0, {LENGTH_BOUND:g}] m",
+        )  # fmt: skip
         return b
 
     return get

@@ -49,7 +49,6 @@ much the witness holds.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -65,6 +64,7 @@ from drakegrasp.certificates.kinds import (
     UNRESISTED_WRENCH,
     CertificateCheck,
     Witness,
+    check_kind_and_cones,
 )
 from drakegrasp.certificates.text import describe_certificate
 from drakegrasp.core.contact import ContactModel
@@ -161,12 +161,7 @@ class Certificate:
     __hash__ = object.__hash__
 
     def __post_init__(self):
-        if self.kind not in _KINDS:
-            raise InvalidOptionError(f"kind must be one of {_KINDS}, got {self.kind!r}")
-        if self.cones not in _CONES:
-            raise InvalidOptionError(
-                f"cones must be one of {_CONES}, got {self.cones!r}"
-            )
+        check_kind_and_cones(self.kind, self.cones, _KINDS, _CONES)
 
     @property
     def two_sided(self) -> bool:
@@ -266,15 +261,7 @@ def check_certificate(
     else:
         assert read.kind == BALANCE
         violation, slack, detail = _check_balance(read, grasp)
-    if not math.isfinite(violation):  # NaN never passes a comparison, inf fails
-        violation, slack = np.inf, 0.0
-    return CertificateCheck(
-        holds=bool(violation <= tol),
-        violation=float(violation),
-        slack=float(slack),
-        tol=float(tol),
-        detail=detail,
-    )
+    return CertificateCheck.evaluated(violation, slack, tol, detail)
 
 
 def _unit_scaled(x: np.ndarray) -> np.ndarray:

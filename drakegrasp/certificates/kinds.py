@@ -9,12 +9,14 @@ protocol, and only the certificate type imports the text.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, fields
 from typing import Protocol
 
 import numpy as np
 
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
     "BALANCE",
@@ -75,6 +77,25 @@ class CertificateCheck:
     tol: float
     detail: str
 
+    @classmethod
+    def evaluated(
+        cls, violation: float, slack: float, tol: float, detail: str
+    ) -> CertificateCheck:
+        """The report of a check that computed ``violation`` and ``slack``.
+
+        A non-finite violation (NaN never passes a comparison) is reported as
+        ``inf`` with slack 0, so that it fails.
+        """
+        if not math.isfinite(violation):
+            violation, slack = math.inf, 0.0
+        return cls(
+            holds=bool(violation <= tol),
+            violation=float(violation),
+            slack=float(slack),
+            tol=float(tol),
+            detail=detail,
+        )
+
     def __bool__(self) -> bool:
         return self.holds
 
@@ -88,6 +109,16 @@ class CertificateCheck:
             f"witness {verdict}: violation {self.violation:.2g}, "
             f"slack {self.slack + 0.0:.3g} (tol {self.tol:g}); {self.detail}"
         )
+
+
+def check_kind_and_cones(
+    kind: str, cones: str, kinds: tuple[str, ...], cone_kinds: tuple[str, ...]
+) -> None:
+    """Raise :class:`~drakegrasp.InvalidOptionError` unless both are known."""
+    if kind not in kinds:
+        raise InvalidOptionError(f"kind must be one of {kinds}, got {kind!r}")
+    if cones not in cone_kinds:
+        raise InvalidOptionError(f"cones must be one of {cone_kinds}, got {cones!r}")
 
 
 class Witness(Protocol):

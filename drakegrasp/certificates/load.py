@@ -46,7 +46,11 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from drakegrasp.certificates.kinds import DEFAULT_CHECK_TOL, CertificateCheck
+from drakegrasp.certificates.kinds import (
+    DEFAULT_CHECK_TOL,
+    CertificateCheck,
+    check_kind_and_cones,
+)
 from drakegrasp.core.friction_cone import ConeLayout, support_of
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.core.serialize import jsonable
@@ -114,12 +118,7 @@ class LoadCertificate:
     bound: float
 
     def __post_init__(self):
-        if self.kind not in _KINDS:
-            raise InvalidOptionError(f"kind must be one of {_KINDS}, got {self.kind!r}")
-        if self.cones not in _CONES:
-            raise InvalidOptionError(
-                f"cones must be one of {_CONES}, got {self.cones!r}"
-            )
+        check_kind_and_cones(self.kind, self.cones, _KINDS, _CONES)
 
     def power_budget(self) -> float:
         """``B``: the most power the motors and force bounds absorb along ``y`` (W)."""
@@ -282,10 +281,4 @@ def check_load_certificate(
         f"max over the {cert.cones} cones of a_iᵀ f_i (f_n = 1) and the power "
         f"budget: α·w cannot be held for α > {bound:.6g}{caveat}"
     )
-    return CertificateCheck(
-        holds=bool(violation <= tol),
-        violation=float(violation),
-        slack=float(slack),
-        tol=float(tol),
-        detail=detail,
-    )
+    return CertificateCheck.evaluated(violation, slack, tol, detail)

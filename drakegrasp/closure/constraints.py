@@ -8,6 +8,10 @@ Constructing the ``LinearConstraint`` / ``LinearEqualityConstraint`` from a
 dense array and binding it with ``AddConstraint`` adds exactly the same
 constraint (same rows, same bounds, same solver attribute) and never touches
 the sparse caster.  Core layer: ``pydrake.solvers`` and numpy only.
+
+The Lorentz-cone rows of an exact spatial friction cone with a margin
+(:func:`exact_cone_rows`) live here too, so that the exact force-closure
+program and the grasp-force and payload programs write them once.
 """
 
 from __future__ import annotations
@@ -15,7 +19,15 @@ from __future__ import annotations
 import numpy as np
 from pydrake.solvers import LinearConstraint, LinearEqualityConstraint
 
-__all__ = ["add_linear_constraint", "add_linear_equality_constraint"]
+__all__ = [
+    "EXACT_CONE_COMPONENTS",
+    "add_linear_constraint",
+    "add_linear_equality_constraint",
+    "exact_cone_rows",
+]
+
+EXACT_CONE_COMPONENTS = ((0, 1, 2), (0, 1, 2, 3))
+"""Components of the cones written exactly as Lorentz cones (spatial hard, soft)."""
 
 
 def add_linear_constraint(prog, A, lb, ub, x):
@@ -31,3 +43,46 @@ def add_linear_equality_constraint(prog, A, b, x):
     A = np.atleast_2d(np.asarray(A, dtype=float))
     b = np.asarray(b, dtype=float).reshape(-1)
     return prog.AddConstraint(LinearEqualityConstraint(A, b), np.asarray(x).reshape(-1))
+
+
+def exact_cone_rows(contact, scales: np.ndarray, b: float) -> list[np.ndarray]:
+    r"""Lorentz-cone rows of a spatial contact's exact friction cone with a margin.
+
+    For each sign ``σ`` (0 for a hard finger, ``±1`` for a soft finger),
+    ``z = A [f_i; d]`` in the Lorentz cone (``z_0 >= ‖z_{1:3}‖``) says
+
+    .. math:: \|f_t\| \le \mu (f_n - \sigma m_n / (b \nu)) - \sqrt{1 + \mu^2}\, d ,
+
+    the hard-cone margin ``d`` of the normal force left after torsion (as the
+    polyhedral soft rows of :func:`~drakegrasp.core.friction_cone.soft_finger_facets`),
+    divided by ``sqrt(1 + μ²)``: coefficients at most 1, so ``μ = 1e12`` does
+    not make Clarabel stall or SCS answer inaccurately.
+
+    Parameters
+    ----------
+    contact : Contact
+        Its ``mu`` and ``torsional_friction`` (``ν``).
+    scales : (3,) or (4,) float
+        The contact's entries of ``ConeLayout.scales``: the variables are
+        ``f_i / scales`` (a soft finger's ``m_n = scales[3] x_3``).
+    b : float
+        Characteristic length, metres.
+
+    Returns
+    -------
+    list of (3, k + 1) float
+        One ``A`` per sign; drop the last column for ``d = 0``.
+    """
+    k = len(scales)
+    mu = contact.mu
+    rows = []
+    for sign in [0.0] if k == 3 else [1.0, -1.0]:
+        A = np.zeros((3, k + 1))
+        A[0, 0] = mu
+        if k == 4:
+            A[0, 3] = -sign * mu * scales[3] / (b * contact.torsional_friction)
+        A[0, -1] = -np.sqrt(1.0 + mu * mu)
+        A[1, 1] = A[2, 2] = 1.0
+        A /= np.hypot(1.0, mu)
+        rows.append(A)
+    return rows

@@ -38,8 +38,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.closure.constraints import (
+    EXACT_CONE_COMPONENTS,
     add_linear_constraint,
     add_linear_equality_constraint,
+    exact_cone_rows,
 )
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
@@ -51,6 +53,7 @@ __all__ = [
     "CONES",
     "SATURATION_TOL",
     "LoadProblem",
+    "check_direction",
     "check_wrench",
     "load_problem",
     "saturating_joints",
@@ -61,8 +64,6 @@ SATURATION_TOL = 1e-6
 
 CONES = ("exact", "polyhedral")
 """The cones a load problem may use: exact Coulomb / soft-finger, or inscribed."""
-
-_SPATIAL_FRICTION = ((0, 1, 2), (0, 1, 2, 3))
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,7 +118,7 @@ class LoadProblem:
     def needs_socp(self) -> bool:
         """True when an exact spatial friction cone makes the program an SOCP."""
         return self.cones == "exact" and any(
-            c.components in _SPATIAL_FRICTION for c in self.layout.cones
+            c.components in EXACT_CONE_COMPONENTS for c in self.layout.cones
         )
 
     @property
@@ -189,6 +190,14 @@ def check_wrench(grasp: Grasp, wrench, name: str = "wrench") -> np.ndarray:
             f"), got {np.asarray(wrench).tolist()}"
         )
     return w
+
+
+def check_direction(grasp: Grasp, direction, name: str = "direction") -> np.ndarray:
+    """A load direction: a :func:`check_wrench` that is not all zeros."""
+    d = check_wrench(grasp, direction, name)
+    if not np.any(d):
+        raise InvalidOptionError(f"{name} must be a non-zero wrench, got zeros")
+    return d
 
 
 def _check_cones(cones) -> str:
@@ -362,7 +371,7 @@ def _add_cones(prog, P: LoadProblem, x, d) -> None:
     for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
         xi = x[starts[i] : starts[i + 1]]
         scale = layout.scales[starts[i] : starts[i + 1]]
-        exact = P.cones == "exact" and cone.components in _SPATIAL_FRICTION
+        exact = P.cones == "exact" and cone.components in EXACT_CONE_COMPONENTS
         if not exact:
             F = cone.facets * scale
             if d is None:
@@ -378,18 +387,7 @@ def _add_cones(prog, P: LoadProblem, x, d) -> None:
                     np.append(xi, d),
                 )
             continue
-        mu = contact.mu
-        signs = [0.0] if cone.components == (0, 1, 2) else [1.0, -1.0]
-        for sign in signs:
-            # ‖f_t‖ <= μ (f_n - σ m_n / (b ν)) - sqrt(1 + μ²) d, divided by
-            # sqrt(1 + μ²) (the exact-cone closure program's rows).
-            A = np.zeros((3, len(xi) + 1))
-            A[0, 0] = mu
-            if len(xi) == 4:
-                A[0, 3] = -sign * mu * scale[3] / (b * contact.torsional_friction)
-            A[0, -1] = -np.sqrt(1.0 + mu * mu)
-            A[1, 1] = A[2, 2] = 1.0
-            A /= np.hypot(1.0, mu)
+        for A in exact_cone_rows(contact, scale, b):
             if d is None:
                 prog.AddLorentzConeConstraint(A[:, :-1], np.zeros(3), xi)
             else:

@@ -33,14 +33,14 @@ from drakegrasp.closure.load_problem import (
     LoadProblem,
     add_balance,
     add_force_constraints,
-    check_wrench,
+    check_direction,
     load_problem,
     saturating_joints,
 )
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.errors import InvalidOptionError, SolverError
+from drakegrasp.errors import SolverError
 
 __all__ = ["ALPHA_CAP", "MaxLoadResult", "build_max_load_program", "max_load"]
 
@@ -144,9 +144,7 @@ def build_max_load_program(
     scales : (float, float)
         ``(F0, α unit)``: ``α* = alpha_unit * alpha``.
     """
-    d = check_wrench(grasp, direction, "direction")
-    if not np.any(d):
-        raise InvalidOptionError("direction must be a non-zero wrench, got zeros")
+    d = check_direction(grasp, direction)
     P = load_problem(
         grasp,
         hand_jacobian=hand_jacobian,
@@ -217,9 +215,7 @@ def max_load(
     SolverError
         The program (always feasible: ``α = 0``, ``f = 0``) was not solved.
     """
-    d = check_wrench(grasp, direction, "direction")
-    if not np.any(d):
-        raise InvalidOptionError("direction must be a non-zero wrench, got zeros")
+    d = check_direction(grasp, direction)
     prog, x, alpha, P, (F0, unit) = build_max_load_program(
         grasp,
         d,

@@ -36,8 +36,10 @@ import numpy as np
 from pydrake.solvers import MathematicalProgram
 
 from drakegrasp.closure.constraints import (
+    EXACT_CONE_COMPONENTS,
     add_linear_constraint,
     add_linear_equality_constraint,
+    exact_cone_rows,
 )
 from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
@@ -437,27 +439,11 @@ def build_exact_force_closure_program(
     starts = list(layout.normal_positions) + [len(layout.columns)]
     for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
         fi = f[starts[i] : starts[i + 1]]
-        if cone.components not in ((0, 1, 2), (0, 1, 2, 3)):
-            scale = layout.scales[starts[i] : starts[i + 1]]
+        scale = layout.scales[starts[i] : starts[i + 1]]
+        if cone.components not in EXACT_CONE_COMPONENTS:
             _add_margin_rows(prog, cone.facets * scale, fi, d)  # exact already
             continue
-        mu = contact.mu
-        signs = [0.0] if cone.components == (0, 1, 2) else [1.0, -1.0]
-        for sign in signs:
-            # z = A [fi; d]: z0 = μ f_n - σ μ m_n/(b ν) - sqrt(1+μ²) d,
-            # z1:3 = f_t, with m_n = s m̃ (s = ConeLayout.scales): d is the
-            # hard-cone margin of (f_n - |m_n| / (b ν), f_t), as the polyhedral
-            # soft rows (friction_cone.soft_finger_facets).
-            A = np.zeros((3, len(fi) + 1))
-            A[0, 0] = mu
-            if len(fi) == 4:
-                s = layout.scales[starts[i] + 3]
-                A[0, 3] = -sign * mu * s / (b * contact.torsional_friction)
-            A[0, -1] = -np.sqrt(1.0 + mu * mu)
-            A[1, 1] = A[2, 2] = 1.0
-            # The same cone divided by sqrt(1 + μ²): coefficients at most 1, so
-            # μ = 1e12 no longer makes Clarabel stall or SCS answer inaccurately.
-            A /= np.hypot(1.0, mu)
+        for A in exact_cone_rows(contact, scale, b):
             prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(fi, d))
     return prog, _scaled_variables(d, f, layout)
 

@@ -333,28 +333,30 @@ def check_coefficient_array(
     return x
 
 
+def _threshold(value, name: str, low: float, high: float, must: str) -> float:
+    """``value`` as a real in ``[low, high]``; the error says it ``must`` be so."""
+    x = real_scalar(name, value)
+    if not (low <= x <= high):
+        raise InvalidOptionError(f"{name} must be {must}, got {_describe(value)}")
+    return x
+
+
 def check_tol(value, name: str = "tol") -> float:
     """Threshold on ``d*``: real in ``[TOL_MIN, TOL_MAX]``."""
-    x = real_scalar(name, value)
-    if not (TOL_MIN <= x <= TOL_MAX):
-        raise InvalidOptionError(
-            f"{name} must be finite and > 0, a real number in [{TOL_MIN:g}, "
-            f"{TOL_MAX:g}] "
-            f"(d* is at most 1 and resolved to about 1e-10), got {_describe(value)}"
-        )
-    return x
+    return _threshold(
+        value, name, TOL_MIN, TOL_MAX,
+        f"finite and > 0, a real number in [{TOL_MIN:g}, {TOL_MAX:g}] "
+        "(d* is at most 1 and resolved to about 1e-10)",
+    )  # fmt: skip
 
 
 def check_rank_tol(value, name: str = "rank_tol") -> float:
     """Relative singular-value threshold: real in ``[RANK_TOL_MIN, RANK_TOL_MAX]``."""
-    x = real_scalar(name, value)
-    if not (RANK_TOL_MIN <= x <= RANK_TOL_MAX):
-        raise InvalidOptionError(
-            f"{name} must be a real number in [{RANK_TOL_MIN:g}, {RANK_TOL_MAX:g}] "
-            f"(singular values below rank_tol * sigma_max count as zero), got "
-            f"{_describe(value)}"
-        )
-    return x
+    return _threshold(
+        value, name, RANK_TOL_MIN, RANK_TOL_MAX,
+        f"a real number in [{RANK_TOL_MIN:g}, {RANK_TOL_MAX:g}] "
+        "(singular values below rank_tol * sigma_max count as zero)",
+    )  # fmt: skip
 
 
 def integer_or_none(value, *, integral_floats: bool = False) -> int | None:

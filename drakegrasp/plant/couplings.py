@@ -40,7 +40,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.plant.fingers import find_joint
+from drakegrasp.plant.fingers import coupled_joints
 
 __all__ = [
     "JointCoupling",
@@ -336,12 +336,7 @@ def coupling_map(
     row = {vi: k for k, vi in enumerate(v)}
     follows: dict[int, tuple[int, float]] = {}
     for entry in couplings:
-        if isinstance(entry, str) or len(entry) != 4:
-            raise InvalidOptionError(
-                "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
-                f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
-            )
-        j0, j1 = find_joint(plant, entry[0]), find_joint(plant, entry[1])
+        j0, j1 = coupled_joints(plant, entry)
         for j in (j0, j1):
             if j.num_velocities() != 1:
                 raise InvalidOptionError(

@@ -169,6 +169,22 @@ def find_joint(plant: MultibodyPlant, spec) -> Joint:
     )
 
 
+def coupled_joints(plant: MultibodyPlant, entry) -> tuple[Joint, Joint]:
+    """The joints ``(joint_0, joint_1)`` of one coupling entry.
+
+    ``entry`` is ``(joint_0, joint_1, gear_ratio, offset)`` with
+    ``q_0 = gear_ratio * q_1 + offset``; the joints are found by
+    :func:`find_joint`.  Anything else raises
+    :class:`~drakegrasp.InvalidOptionError`.
+    """
+    if isinstance(entry, str) or len(entry) != 4:
+        raise InvalidOptionError(
+            "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
+            f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
+        )
+    return find_joint(plant, entry[0]), find_joint(plant, entry[1])
+
+
 def _closing_joints(plant, bodies, couplings):
     """The closing joints and the couplings as joint index -> (leader, ρ, Δq)."""
     wanted = {int(b.index()) for b in bodies}
@@ -188,12 +204,7 @@ def _closing_joints(plant, bodies, couplings):
     joints = [j for j in one_dof if int(j.index()) in actuated] or one_dof
     follows = {}
     for entry in couplings:
-        if isinstance(entry, str) or len(entry) != 4:
-            raise InvalidOptionError(
-                "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
-                f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
-            )
-        j0, j1 = find_joint(plant, entry[0]), find_joint(plant, entry[1])
+        j0, j1 = coupled_joints(plant, entry)
         rho, off = float(entry[2]), float(entry[3])
         if rho == 0 or not np.isfinite(rho) or not np.isfinite(off):
             raise InvalidOptionError(

@@ -8,6 +8,7 @@ import numpy as np
 from pydrake.solvers import MathematicalProgram
 
 from drakegrasp._solvers import require_solution, solve
+from drakegrasp.closure.load_problem import check_direction
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
@@ -97,20 +98,6 @@ class MaxWrenchResult:
         )
 
 
-def _check_direction(grasp: Grasp, direction: np.ndarray) -> np.ndarray:
-    d = real_array("direction", direction, error=InvalidOptionError).reshape(-1)
-    D = grasp.wrench_dim
-    if d.shape != (D,) or not np.all(np.isfinite(d)):
-        raise InvalidOptionError(
-            f"direction must be a finite {D}-vector wrench [f; m] (the grasp is "
-            f"{'planar' if grasp.planar else 'spatial'}), got "
-            f"{np.asarray(direction).tolist()}"
-        )
-    if not np.any(d):
-        raise InvalidOptionError("direction must be a non-zero wrench, got zeros")
-    return d
-
-
 def _check_max_normal_force(grasp: Grasp, max_normal_force) -> np.ndarray:
     N = grasp.num_contacts
     f = real_array("max_normal_force", max_normal_force, error=InvalidOptionError)
@@ -159,7 +146,7 @@ def build_max_resistible_wrench_program(
     variables : MaxWrenchVariables
     """
     _check_grasp(grasp)
-    d = _check_direction(grasp, direction)
+    d = check_direction(grasp, direction)
     fmax = _check_max_normal_force(grasp, max_normal_force)
     layout = ConeLayout.of(grasp, num_generators)
     columns, normals, G = layout.columns, layout.normal_positions, layout.G
@@ -227,7 +214,7 @@ def max_resistible_wrench(
     result = require_solution(prog, solve(prog, "lp"), "the max-resistible-wrench LP")
     status = result.get_solution_result()
     name = result.get_solver_id().name()
-    d = _check_direction(grasp, direction)
+    d = check_direction(grasp, direction)
     alpha = max(float(result.GetSolution(v.alpha)), 0.0)
     full = np.zeros(grasp.num_components)
     full[v.columns] = result.GetSolution(v.forces)

@@ -15,14 +15,19 @@ def random_rotation(rng: np.random.Generator) -> np.ndarray:
 
 
 def random_inward_contacts(
-    rng, num, dim=3, *, mu=0.5, model="hard_finger", spread=1.0, nu=0.0
+    rng, num, dim=3, *, mu=0.5, model="hard_finger", tilt=0.6, nu=0.0
 ):
-    """Contacts on the unit sphere/circle, normals tilted from the inward radial."""
+    """Contacts on the unit sphere/circle, normals tilted from the inward radial.
+
+    Normal ``-p + tilt * z`` with ``z`` standard normal.  Test modules import it
+    (``from .conftest import random_inward_contacts``) for hypothesis tests,
+    which cannot take function-scoped fixtures.
+    """
     contacts = []
     for _ in range(num):
         p = rng.normal(size=dim)
         p /= np.linalg.norm(p)
-        n = -p + spread * rng.normal(size=dim) * 0.6
+        n = -p + tilt * rng.normal(size=dim)
         contacts.append(
             dg.Contact(p, n, mu=mu, contact_model=model, torsional_friction=nu)
         )

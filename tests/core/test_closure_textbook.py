@@ -38,7 +38,7 @@ def test_hand_built_seven_contacts_on_a_cube_are_in_form_closure():
 @pytest.mark.parametrize(("dim", "num"), [(2, 3), (3, 6)])
 def test_too_few_contacts_never_give_form_closure(rng, make_contacts, dim, num):
     for _ in range(40):
-        grasp = dg.Grasp(make_contacts(rng, num, dim=dim, spread=1.5))
+        grasp = dg.Grasp(make_contacts(rng, num, dim=dim, tilt=0.9))
         result = dg.form_closure(grasp)
         assert not result.is_closure
         assert result.d_star <= 1e-9  # N(G_n) = {0}: not even a near miss
@@ -110,7 +110,7 @@ def test_optimal_forces_satisfy_the_program(make_contacts, rng):
 def test_hard_finger_with_zero_friction_is_exactly_frictionless(rng, make_contacts):
     for num, dim in [(4, 2), (5, 2), (7, 3), (9, 3)]:
         for _ in range(5):
-            hard = dg.Grasp(make_contacts(rng, num, dim=dim, mu=0.0, spread=1.2))
+            hard = dg.Grasp(make_contacts(rng, num, dim=dim, mu=0.0, tilt=0.72))
             smooth = hard.with_friction(contact_model="frictionless")
             a, b = dg.force_closure(hard), dg.force_closure(smooth)
             assert a.is_closure == b.is_closure and a.rank == b.rank

@@ -22,7 +22,7 @@ def _random_grasps(rng, make_contacts, count):
         num = 3 if i % 2 else 4
         model = "soft_finger" if i % 7 == 0 else "hard_finger"
         mu = rng.uniform(0.05, 0.8)
-        yield dg.Grasp(make_contacts(rng, num, mu=mu, model=model, nu=0.3, spread=0.9))
+        yield dg.Grasp(make_contacts(rng, num, mu=mu, model=model, nu=0.3, tilt=0.54))
 
 
 def _certain(result):

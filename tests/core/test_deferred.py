@@ -24,6 +24,8 @@ from drakegrasp.core.deferred import (
     resolve,
 )
 
+from .conftest import random_inward_contacts
+
 SETTINGS = settings(
     max_examples=30,
     derandomize=True,
@@ -123,14 +125,7 @@ def test_defer_parts_and_resolve():
 
 def _grasp(seed, num, model, mu, dim=3):
     rng = np.random.default_rng(seed)
-    contacts = []
-    for _ in range(num):
-        p = rng.normal(size=dim)
-        p /= np.linalg.norm(p)
-        n = -p + 0.6 * rng.normal(size=dim)
-        contacts.append(
-            dg.Contact(p, n, mu=mu, contact_model=model, torsional_friction=0.3)
-        )
+    contacts = random_inward_contacts(rng, num, dim, mu=mu, model=model, nu=0.3)
     return dg.Grasp(contacts, reference_point=0.2 * rng.normal(size=dim))
 
 

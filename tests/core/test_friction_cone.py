@@ -65,14 +65,16 @@ def test_frictionless_and_degenerate_cones():
     assert np.any(F @ [1, 1e-3, 0] < 0)
 
 
-def test_soft_finger_cone_is_the_hull_of_its_generators():
-    c = dg.Contact(
-        [0, 0, 1],
-        [0, 0, -1],
-        mu=0.5,
-        contact_model="soft_finger",
+def _soft_finger_on_top():
+    """A soft finger at (0, 0, 1) pushing down, μ = 0.5, ν = 0.2."""
+    return dg.Contact(
+        [0, 0, 1], [0, 0, -1], mu=0.5, contact_model="soft_finger",
         torsional_friction=0.2,
-    )
+    )  # fmt: skip
+
+
+def test_soft_finger_cone_is_the_hull_of_its_generators():
+    c = _soft_finger_on_top()
     b = 0.1
     S = dg.friction_cone_generators(c, 8, characteristic_length=b)
     F = dg.friction_cone_facets(c, 8, characteristic_length=b)
@@ -103,13 +105,7 @@ def test_soft_finger_cone_is_the_hull_of_its_generators():
 
 
 def test_soft_finger_needs_the_characteristic_length():
-    c = dg.Contact(
-        [0, 0, 1],
-        [0, 0, -1],
-        mu=0.5,
-        contact_model="soft_finger",
-        torsional_friction=0.2,
-    )
+    c = _soft_finger_on_top()
     with pytest.raises(dg.InvalidOptionError, match="characteristic_length"):
         dg.friction_cone_facets(c)
 

@@ -14,6 +14,8 @@ from hypothesis import strategies as st
 import drakegrasp as dg
 from drakegrasp.core import examples as ex
 
+from .conftest import random_inward_contacts
+
 SETTINGS = settings(
     max_examples=30,
     derandomize=True,
@@ -131,14 +133,7 @@ def test_jacobian_columns_in_mixed_units_do_not_change_lp3():
 
 def _random_grasp(seed: int, num: int, dim: int, model: str) -> dg.Grasp:
     rng = np.random.default_rng(seed)
-    contacts = []
-    for _ in range(num):
-        c = rng.normal(size=dim)
-        c /= np.linalg.norm(c)
-        n = -c + 0.6 * rng.normal(size=dim)
-        contacts.append(
-            dg.Contact(c, n, mu=0.5, contact_model=model, torsional_friction=0.3)
-        )
+    contacts = random_inward_contacts(rng, num, dim, model=model, nu=0.3)
     return dg.Grasp(contacts, characteristic_length=1.0)
 
 

@@ -8,6 +8,8 @@ from hypothesis import strategies as st
 import drakegrasp as dg
 from drakegrasp.core import examples as ex
 
+from .conftest import random_inward_contacts
+
 SETTINGS = settings(
     max_examples=25,
     derandomize=True,
@@ -24,14 +26,9 @@ def valid_mu(high):
 
 def _grasp(seed, num=3, dim=3, mu=0.5, model="hard_finger"):
     rng = np.random.default_rng(seed)
-    contacts = []
-    for _ in range(num):
-        p = rng.normal(size=dim)
-        p /= np.linalg.norm(p)
-        n = -p + 0.5 * rng.normal(size=dim)
-        contacts.append(
-            dg.Contact(p, n, mu=mu, contact_model=model, torsional_friction=0.2)
-        )
+    contacts = random_inward_contacts(
+        rng, num, dim, mu=mu, model=model, tilt=0.5, nu=0.2
+    )
     return dg.Grasp(contacts, reference_point=0.2 * rng.normal(size=dim)), rng
 
 

@@ -50,6 +50,38 @@ def step_q(plant, plant_context, dv: np.ndarray) -> np.ndarray:
     return q + qdot
 
 
+def stepped_context(scene, k: int, step: float):
+    """:func:`fresh_context`, moved by ``step`` along generalized velocity ``k``."""
+    plant = scene.plant
+    root, ctx = fresh_context(scene)
+    dv = np.zeros(plant.num_velocities())
+    dv[k] = step
+    plant.SetPositions(ctx, step_q(plant, ctx, dv))
+    return root, ctx
+
+
+def analyze_scene(scene, options=None):
+    """``analyze_grasp`` of a loaded scene with its file's options (or ``options``)."""
+    from drakegrasp import analyze_grasp
+
+    return analyze_grasp(
+        scene.plant,
+        scene.plant_context,
+        scene.object_body,
+        hand=scene.hand,
+        options=scene.options if options is None else options,
+    )
+
+
+def alias_bomb(tail: str) -> str:
+    """YAML whose nested anchors expand to 12**8 strings of 100 bytes, then ``tail``."""
+    lines = ['a0: &a0 ["' + "x" * 100 + '"]']
+    for i in range(1, 9):
+        prev = f"*a{i - 1}"
+        lines.append(f"a{i}: &a{i} [{', '.join([prev] * 12)}]")
+    return "\n".join(lines) + "\n" + tail
+
+
 def make_plant():
     """An empty plant with a scene graph (time step 0)."""
     builder = DiagramBuilder()
@@ -63,7 +95,12 @@ def tools():
     import types
 
     return types.SimpleNamespace(
-        fresh_context=fresh_context, step_q=step_q, make_plant=make_plant
+        fresh_context=fresh_context,
+        step_q=step_q,
+        stepped_context=stepped_context,
+        make_plant=make_plant,
+        analyze_scene=analyze_scene,
+        alias_bomb=alias_bomb,
     )
 
 

@@ -70,6 +70,16 @@ def _revolute(name, parent, child, axis, lower, upper, xyz=(0, 0, 0)) -> str:
     )
 
 
+def _palm(size, z) -> str:
+    """The 0.5 kg link ``palm``: a box of ``size`` (m) centred at height ``z``."""
+    return (
+        '<link name="palm">'
+        + _inertial(0.5, 1e-3)
+        + _collision("palm_box", _box(*size), xyz=(0, 0, z))
+        + "</link>"
+    )
+
+
 def _weld_to_world(child) -> str:
     return (
         f'<joint name="{child}_weld" type="fixed"><parent>world</parent>'
@@ -91,12 +101,7 @@ def one_finger_hand() -> str:
     ``x ∈ [2, 75] mm``; the tip a sphere of radius 4 mm at ``x = 90 mm``.
     """
     x0, x1 = PHALANX
-    palm = (
-        '<link name="palm">'
-        + _inertial(0.5, 1e-3)
-        + _collision("palm_box", _box(0.05, 0.05, 0.01), xyz=(0, 0, -0.03))
-        + "</link>"
-    )
+    palm = _palm((0.05, 0.05, 0.01), z=-0.03)
     finger = (
         '<link name="finger">'
         + _inertial()
@@ -254,12 +259,7 @@ def palm_hand() -> str:
     """
     x, r = PALM_FINGER_X, PALM_TIP_RADIUS
     l1, l2 = PALM_LINKS
-    palm = (
-        '<link name="palm">'
-        + _inertial(0.5, 1e-3)
-        + _collision("palm_box", _box(0.16, 0.08, 0.02), xyz=(0, 0, -0.01))
-        + "</link>"
-    )
+    palm = _palm((0.16, 0.08, 0.02), z=-0.01)
     links, joints = "", ""
     for side, sx, sign in (("left", -x, 1.0), ("right", x, -1.0)):
         lo, hi = sorted((-0.3 * sign, 1.4 * sign))
@@ -330,6 +330,13 @@ def _urdf_box_link(name, size=None, xyz=(0, 0, 0), mass=0.05) -> str:
     )
 
 
+def _follows_left(tag: str, multiplier: float, offset: float) -> str:
+    """The ``<mimic>`` (URDF) or ``<drake:mimic>`` (SDF) that follows the left jaw."""
+    return (
+        f'<{tag} joint="left_jaw_joint" multiplier="{multiplier}" offset="{offset}"/>'
+    )
+
+
 def mimic_gripper_urdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
     """A parallel gripper whose right jaw follows the left by URDF ``<mimic>``.
 
@@ -341,12 +348,7 @@ def mimic_gripper_urdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
     """
     joints = ""
     for side, sign in (("left", -1.0), ("right", 1.0)):
-        mimic = (
-            f'<mimic joint="left_jaw_joint" multiplier="{multiplier}" '
-            f'offset="{offset}"/>'
-            if side == "right"
-            else ""
-        )
+        mimic = _follows_left("mimic", multiplier, offset) if side == "right" else ""
         joints += (
             f'<joint name="{side}_jaw_joint" type="prismatic"><parent link="palm"/>'
             f'<child link="{side}_jaw"/><origin xyz="{_v(0, sign * JAW_Y0, 0.05)}"/>'
@@ -364,19 +366,10 @@ def mimic_gripper_urdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
 
 def mimic_gripper_sdf(multiplier: float = 1.0, offset: float = 0.0) -> str:
     """The gripper of :func:`mimic_gripper_urdf`, coupled by ``<drake:mimic>``."""
-    palm = (
-        '<link name="palm">'
-        + _inertial(0.5, 1e-3)
-        + _collision("palm_box", _box(0.04, 0.12, 0.02))
-        + "</link>"
-    )
-    body = palm
+    body = _palm((0.04, 0.12, 0.02), z=0)
     for side, sign in (("left", -1.0), ("right", 1.0)):
         mimic = (
-            f'<drake:mimic joint="left_jaw_joint" multiplier="{multiplier}" '
-            f'offset="{offset}"/>'
-            if side == "right"
-            else ""
+            _follows_left("drake:mimic", multiplier, offset) if side == "right" else ""
         )
         body += (
             f'<link name="{side}_jaw">'

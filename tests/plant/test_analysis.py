@@ -489,20 +489,14 @@ def test_scene_hand_as_body_list_and_tolerance(tmp_path):
     ]
 
 
-def test_analysis_options_are_one_validated_object(tmp_path):
+def test_analysis_options_are_one_validated_object(tmp_path, tools):
     from drakegrasp import AnalysisOptions, GraspError, InvalidOptionError, load_scene
 
     scene = load_scene("three_finger_sphere")
     keywords = analyze_grasp(
         scene.plant, scene.plant_context, **scene.analysis_options()
     )
-    report = analyze_grasp(
-        scene.plant,
-        scene.plant_context,
-        scene.object_body,
-        hand=scene.hand,
-        options=scene.options,
-    )
+    report = tools.analyze_scene(scene)
     # The same analysis either way, and the report keeps what it used.
     assert report.to_dict() == keywords.to_dict()
     assert report.options == keywords.options == scene.options
@@ -536,13 +530,7 @@ def test_analysis_options_are_one_validated_object(tmp_path):
     with pytest.raises(InvalidOptionError, match="needs mu"):
         analyze_grasp(scene.plant, scene.plant_context, scene.object_body)
     # A changed field changes the analysis.
-    strict = analyze_grasp(
-        scene.plant,
-        scene.plant_context,
-        scene.object_body,
-        hand=scene.hand,
-        options=scene.options.replace(mu=0.0),
-    )
+    strict = tools.analyze_scene(scene, scene.options.replace(mu=0.0))
     assert not strict.force_closure.frictional_closure
     assert strict.options.mu == 0.0 and strict.to_dict()["options"]["mu"] == 0.0
 

@@ -141,10 +141,7 @@ def test_hand_jacobian_matches_finite_differences_of_finger_points(
     for j, k in enumerate(cols):
         positions = []
         for sign in (1.0, -1.0):
-            root, ctx = tools.fresh_context(scene)
-            dv = np.zeros(plant.num_velocities())
-            dv[k] = sign * eps
-            plant.SetPositions(ctx, tools.step_q(plant, ctx, dv))
+            root, ctx = tools.stepped_context(scene, k, sign * eps)
             X_OW = plant.EvalBodyPoseInWorld(ctx, scene.object_body).inverse()
             pts = []
             for c in data.contacts:
@@ -174,10 +171,7 @@ def test_soft_finger_row_is_the_finger_spin_about_the_normal(scene_cache, tools)
     for j, k in enumerate(cols):
         R = []
         for sign in (1.0, -1.0):
-            root, ctx = tools.fresh_context(scene)
-            dv = np.zeros(plant.num_velocities())
-            dv[k] = sign * eps
-            plant.SetPositions(ctx, tools.step_q(plant, ctx, dv))
+            root, ctx = tools.stepped_context(scene, k, sign * eps)
             R_OW = (
                 plant.EvalBodyPoseInWorld(ctx, scene.object_body).rotation().inverse()
             )

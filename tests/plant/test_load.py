@@ -18,6 +18,11 @@ def wsg_closed(real_hands):
     return scene
 
 
+def _analyze(s, **options):
+    """``analyze_grasp`` of scene ``s``'s object and hand."""
+    return dg.analyze_grasp(s.plant, s.ctx, s.object, hand=s.hand, **options)
+
+
 def test_gravity_wrench_matches_the_plants_generalized_gravity(wsg_closed):
     s = wsg_closed
     w = gravity_wrench(s.plant, s.ctx, s.object)
@@ -37,15 +42,7 @@ def test_gravity_wrench_matches_the_plants_generalized_gravity(wsg_closed):
 
 def test_wsg_holds_the_sugar_box_with_its_motors(wsg_closed):
     s = wsg_closed
-    report = dg.analyze_grasp(
-        s.plant,
-        s.ctx,
-        s.object,
-        hand=s.hand,
-        mu=0.5,
-        load="gravity",
-        torque_limits="plant",
-    )
+    report = _analyze(s, mu=0.5, load="gravity", torque_limits="plant")
     load = report.load
     np.testing.assert_array_equal(load.torque_limits, [80.0, 80.0])  # the SDF's
     assert load.torque_limits_source == "plant"
@@ -73,55 +70,29 @@ def test_wsg_holds_the_sugar_box_with_its_motors(wsg_closed):
 
 def test_mu_from_the_plant_and_weak_motors(wsg_closed):
     s = wsg_closed
-    weak = dg.analyze_grasp(
-        s.plant,
-        s.ctx,
-        s.object,
-        hand=s.hand,
-        mu="plant",
-        load="gravity",
-        torque_limits=[1.0, 1.0],
-    )
+    weak = _analyze(s, mu="plant", load="gravity", torque_limits=[1.0, 1.0])
     assert [c.mu for c in weak.grasp.contacts] == pytest.approx([1.0] * 8)
     assert not weak.load.warnings
     assert not weak.load.holds
     cert = weak.load.forces.certificate
     assert cert.check(weak.grasp, hand_jacobian=weak.J).holds
     assert weak.load.payload.alpha < 1.0
-    strong = dg.analyze_grasp(
-        s.plant,
-        s.ctx,
-        s.object,
-        hand=s.hand,
-        mu="plant",
-        load="gravity",
-        torque_limits="plant",
-    )
+    strong = _analyze(s, mu="plant", load="gravity", torque_limits="plant")
     # payload scales with the motors while they are what binds
     if strong.load.payload.saturating_joints:
         assert strong.load.payload.alpha == pytest.approx(
             80.0 * weak.load.payload.alpha, rel=1e-4
         )
     with pytest.raises(dg.InvalidOptionError, match="load"):
-        dg.analyze_grasp(
-            s.plant, s.ctx, s.object, hand=s.hand, mu=0.5, torque_limits="plant"
-        )
+        _analyze(s, mu=0.5, torque_limits="plant")
     with pytest.raises(dg.InvalidOptionError, match="mu"):
-        dg.analyze_grasp(s.plant, s.ctx, s.object, hand=s.hand, mu="model")
+        _analyze(s, mu="model")
 
 
 def test_torque_limits_and_friction_read_from_the_models(real_hands):
     s = real_hands.allegro()
     dg.close_hand(s.plant, s.root, s.object, hand=s.hand)
-    report = dg.analyze_grasp(
-        s.plant,
-        s.ctx,
-        s.object,
-        hand=s.hand,
-        mu=0.8,
-        load="gravity",
-        torque_limits="plant",
-    )
+    report = _analyze(s, mu=0.8, load="gravity", torque_limits="plant")
     limits = report.load.torque_limits
     assert limits.shape == (16,)
     # every Allegro joint has an actuator with the SDF's 0.7 N·m effort limit

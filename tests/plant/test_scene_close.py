@@ -25,7 +25,6 @@ from drakegrasp import (
     JointLimitError,
     PenetrationError,
     SceneError,
-    analyze_grasp,
     close_hand,
     ferrari_canny,
     load_scene,
@@ -67,7 +66,7 @@ def _run(capsys, *argv):
     return code, out, err
 
 
-def test_close_true_closes_as_close_hand_does(tmp_path):
+def test_close_true_closes_as_close_hand_does(tmp_path, tools):
     closed = load_scene(_scene(tmp_path, close="  close: true\n"))
     assert closed.closure is not None
     assert len(closed.closure.touching_fingers) == 2
@@ -83,13 +82,7 @@ def test_close_true_closes_as_close_hand_does(tmp_path):
         opened.plant.GetPositions(opened.plant_context),
     )
     np.testing.assert_array_equal(by_hand.q_start, q_open[by_hand.position_indices])
-    report = analyze_grasp(
-        closed.plant,
-        closed.plant_context,
-        closed.object_body,
-        hand=closed.hand,
-        options=closed.options,
-    )
+    report = tools.analyze_scene(closed)
     assert report.grasp.num_contacts == 3 and report.force_closure.is_closure
     # load_scene(close=False) overrides the file.
     assert (
@@ -181,16 +174,10 @@ def test_object_radius_closed_form_and_pose_invariance():
     assert object_radius(rig.plant, rig.root, rig.object) == r0
 
 
-def test_refused_pose_names_python_options(tmp_path):
+def test_refused_pose_names_python_options(tmp_path, tools):
     scene = load_scene(_scene(tmp_path, z=RADIUS - 1e-3))
     with pytest.raises(PenetrationError) as info:
-        analyze_grasp(
-            scene.plant,
-            scene.plant_context,
-            scene.object_body,
-            hand=scene.hand,
-            options=scene.options,
-        )
+        tools.analyze_scene(scene)
     message = str(info.value)
     assert "check_pose=False" in message and "allow_penetration=True" in message
     assert "--" not in message
@@ -209,18 +196,12 @@ def test_refused_pose_names_cli_flags(tmp_path, capsys):
         assert "epsilon (Ferrari-Canny" in out
 
 
-def test_joint_limit_hint_names_only_no_check_pose(tmp_path, capsys):
+def test_joint_limit_hint_names_only_no_check_pose(tmp_path, capsys, tools):
     joints = "    default_joint_positions:\n      right_distal_joint: [0.5]\n"
     path = _scene(tmp_path, joints=joints)
     scene = load_scene(path)
     with pytest.raises(JointLimitError, match=r"pass check_pose=False to analyse"):
-        analyze_grasp(
-            scene.plant,
-            scene.plant_context,
-            scene.object_body,
-            hand=scene.hand,
-            options=scene.options,
-        )
+        tools.analyze_scene(scene)
     code, _, err = _run(capsys, "analyze", path)
     assert code == 1
     assert "add --no-check-pose to analyse it anyway" in err

@@ -193,6 +193,12 @@ def test_two_files_including_each_other_are_refused(tmp_path, allow_any_file):
     assert "a.yaml -> b.yaml -> a.yaml" in r.stdout
 
 
+def _including(tmp_path: Path, included: Path) -> Path:
+    """The default scene with ``included`` added first to its directives."""
+    line = f"- add_directives:\n    file: file://{included}\n"
+    return _write(tmp_path, DEFAULT.replace("directives:\n", "directives:\n" + line))
+
+
 @pytest.mark.parametrize("allow_any_file", [False, True])
 def test_the_include_limit_counts_loads_not_files(tmp_path, allow_any_file):
     # 31 files, each including the next twice: 2**31 loads of 31 distinct files.
@@ -202,13 +208,7 @@ def test_the_include_limit_counts_loads_not_files(tmp_path, allow_any_file):
     for here, nxt in zip(files, files[1:], strict=False):
         line = f"- add_directives:\n    file: file://{nxt}\n"
         here.write_text("directives:\n" + line * 2)
-    path = _write(
-        tmp_path,
-        DEFAULT.replace(
-            "directives:\n",
-            f"directives:\n- add_directives:\n    file: file://{files[0]}\n",
-        ),
-    )
+    path = _including(tmp_path, files[0])
     start = time.perf_counter()
     with pytest.raises(SceneError, match="loads more than"):
         load_scene(path, allow_any_file=allow_any_file)
@@ -224,24 +224,12 @@ def test_a_diamond_within_the_limit_still_loads_each_time(tmp_path):
     assert load_scene(path).object_body.name() == "box"
 
 
-def _alias_bomb() -> str:
-    lines = ['a0: &a0 ["' + "x" * 100 + '"]']
-    for i in range(1, 9):
-        prev = f"*a{i - 1}"
-        lines.append(f"a{i}: &a{i} [{', '.join([prev] * 12)}]")
-    return "\n".join(lines) + "\ndirectives: []\n"
-
-
 @pytest.mark.parametrize("allow_any_file", [False, True])
-def test_included_files_refuse_aliases_even_when_trusted(tmp_path, allow_any_file):
-    bomb = _write(tmp_path, _alias_bomb(), "bomb.yaml")
-    path = _write(
-        tmp_path,
-        DEFAULT.replace(
-            "directives:\n",
-            f"directives:\n- add_directives:\n    file: file://{bomb}\n",
-        ),
-    )
+def test_included_files_refuse_aliases_even_when_trusted(
+    tmp_path, allow_any_file, tools
+):
+    bomb = _write(tmp_path, tools.alias_bomb("directives: []\n"), "bomb.yaml")
+    path = _including(tmp_path, bomb)
     start = time.perf_counter()
     with pytest.raises(SceneError, match="alias|anchor"):
         load_scene(path, allow_any_file=allow_any_file)

@@ -29,16 +29,8 @@ def _write(tmp_path: Path, text: str, name: str = "scene.yaml") -> Path:
     return path
 
 
-def _alias_bomb() -> str:
-    lines = ['a0: &a0 ["' + "x" * 100 + '"]']
-    for i in range(1, 9):
-        prev = f"*a{i - 1}"
-        lines.append(f"a{i}: &a{i} [{', '.join([prev] * 12)}]")
-    return "\n".join(lines) + "\ndrakegrasp: {object_body: box::box, mu: 0.5}\n"
-
-
-def test_alias_bomb_is_refused_fast(tmp_path):
-    text = _alias_bomb()
+def test_alias_bomb_is_refused_fast(tmp_path, tools):
+    text = tools.alias_bomb("drakegrasp: {object_body: box::box, mu: 0.5}\n")
     assert len(text) < 1300  # expanded: 12**8 strings of 100 bytes, > 40 GB
     path = _write(tmp_path, text)
     start = time.perf_counter()
