@@ -95,7 +95,7 @@ def epsilon_rates(case, N, *, quick=False, seed=0, repeats=3, spread=None):
     mu_c, nu_c = np.full((K, N), MU), np.full((K, N), nu)
     p = np.zeros((K, d))
     b = batched_characteristic_lengths(P, p)
-    opts = {"model": model, "torsional_friction": nu}
+    opts = {"contact_model": model, "torsional_friction": nu}
     batch_epsilon_l1(P[:50], Nrm[:50], mu=MU, workers=1, **opts)  # compile / load
     t_batch, eps = best_cpu(
         lambda: batch_epsilon_l1(P, Nrm, mu=MU, workers=1, **opts), repeats

@@ -111,14 +111,14 @@ def best_rate(fn, n, repeats, clock=time.process_time):
 def bench_one(case, N, *, quick, seed):
     d, model, nu = CASES[case]
     rng = np.random.default_rng(seed)
-    opts = {"model": model, "torsional_friction": nu}
+    opts = {"contact_model": model, "torsional_friction": nu}
     # K: seconds of single-core batch work aimed at per run, from the rate of a
     # pilot stack (enough chunks and work that batch×all measures the engine,
     # not the pool: the fastest cases run two million grasps per second).
     budget = 0.5 if quick else 1.5
     pilot = random_grasps(np.random.default_rng(seed + 1), 4_000, N, d)
-    batch_force_closure(*pilot, MU, workers=1, **opts)  # warm-up
-    rate, _ = best_rate(lambda: batch_force_closure(*pilot, MU, workers=1, **opts),
+    batch_force_closure(*pilot, mu=MU, workers=1, **opts)  # warm-up
+    rate, _ = best_rate(lambda: batch_force_closure(*pilot, mu=MU, workers=1, **opts),
                         4_000, 2)  # fmt: skip
     K = int(np.clip(budget * rate, 2_000, 2_000_000))
     P, Nrm = random_grasps(rng, K, N, d)

@@ -70,7 +70,7 @@ def record(out: str, K: int) -> None:
             "scalar": 0.5,
             "zero": 0.0,
         }[mu_kind]
-        opts = {"model": model, "torsional_friction": nu, "workers": 1}
+        opts = {"contact_model": model, "torsional_friction": nu, "workers": 1}
         r = batch_force_closure(p, n, mu=mu, **opts)
         for key in ("d_star", "rank", "is_closure", "margin", "converged"):
             arrays[f"{name}/{key}"] = np.asarray(getattr(r, key))
