@@ -40,9 +40,9 @@ from drakegrasp.plant.friction import (
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.quality import ferrari_canny
 from drakegrasp.systems.holding import (
+    HoldingMemory,
     HoldingThresholds,
     next_holding_state,
-    speeds_against,
 )
 from drakegrasp.systems.monitor_options import monitor_settings
 from drakegrasp.systems.sample import (
@@ -51,7 +51,12 @@ from drakegrasp.systems.sample import (
     grip_verdicts,
     verdict_names,
 )
-from drakegrasp.systems.sensing import no_loads, sense_contacts
+from drakegrasp.systems.sensing import (
+    hand_clearance,
+    no_loads,
+    sense_contacts,
+    speeds_against,
+)
 
 __all__ = ["GraspMonitor"]
 
@@ -243,14 +248,15 @@ class GraspMonitor(LeafSystem):
         )
 
     def _sample(self, t, status, message, report, epsilon, x, start, *, grip):
-        """A GraspSample; ``grip`` = (holding, loads, speeds, gap, last, normals)."""
+        """A GraspSample; ``grip`` = (memory, loads, speeds, normals)."""
         if grip is None:
-            grip = ("no contact", self._no_loads(), (np.nan, 0.0), 0, "no contact", ())
-        holding, loads, (relative, sliding), gap, last, normals = grip
+            grip = (HoldingMemory(), self._no_loads(), (np.nan, 0.0), ())
+        memory, loads, (relative, sliding), normals = grip
+        gap = memory.bridged(self.settings.thresholds)
         verdicts = np.concatenate(
             [
                 analysis_verdicts(report, _STATUS_CODE[status], epsilon),
-                grip_verdicts(holding, loads, relative, gap),
+                grip_verdicts(memory.state, loads, relative, gap),
             ]
         )
         return GraspSample(
@@ -259,13 +265,13 @@ class GraspMonitor(LeafSystem):
             message=message,
             report=report,
             epsilon=epsilon,
-            holding=holding,
+            holding=memory.state,
             loads=tuple(loads),
             relative_speed=relative,
             sliding_speed=sliding,
             last_normals=normals,
             contact_gap=gap,
-            last_grip=last,
+            memory=memory,
             names=self.verdict_names,
             verdicts=verdicts,
             state=x,
@@ -364,8 +370,8 @@ class GraspMonitor(LeafSystem):
         x = np.array(self._state_port.Eval(context), dtype=float)
         if not np.all(np.isfinite(x)):
             bad = np.flatnonzero(~np.isfinite(x))
-            kept = (previous.holding, previous.loads, (np.nan, 0.0))
-            kept += (previous.contact_gap, previous.last_grip, previous.last_normals)
+            kept = (previous.memory, previous.loads, (np.nan, 0.0))
+            kept += (previous.last_normals,)
             message = (
                 f"the plant state has non-finite entries at indices {bad[:8].tolist()}"
             )
@@ -373,9 +379,9 @@ class GraspMonitor(LeafSystem):
         self._plant.SetPositionsAndVelocities(self._plant_context, x)
         query = self._query_port.Eval(context)
         status, message, report, loads = self._analyse(context, query)
-        grip = self._grip(previous, report, loads)
+        grip = self._grip(previous, report, loads, query)
         epsilon = 0.0
-        if grip[3] > 0 and previous.report is not None:  # bridge the gap
+        if grip[0].bridged(self.settings.thresholds) and previous.report is not None:
             status, report, epsilon = previous.status, previous.report, previous.epsilon
             message = f"no contact in this sample ({message}); the last grip is held"
         elif (
@@ -390,8 +396,16 @@ class GraspMonitor(LeafSystem):
             )
         return self._sample(t, status, message, report, epsilon, x, start, grip=grip)
 
-    def _grip(self, previous: GraspSample, report, loads):
-        """The holding state after ``previous``: (holding, loads, speeds, gap, ...)."""
+    @staticmethod
+    def _grasped(report, loads) -> bool:
+        """Force closure, and every analysed finger presses on the object."""
+        if report is None or not report.is_force_closure:
+            return False
+        pressing = {load.finger_body for load in loads if load.touching}
+        return all(c.finger_body in pressing for c in report.contacts)
+
+    def _grip(self, previous: GraspSample, report, loads, query):
+        """The grip after ``previous``: (memory, loads, speeds, normals)."""
         touching = tuple(
             (k, load.normal_W) for k, load in enumerate(loads) if load.touching
         )
@@ -405,18 +419,31 @@ class GraspMonitor(LeafSystem):
         if not touching:
             relative = np.nan
         uses = [f.friction_use for f in loads if not np.isnan(f.friction_use)]
-        holding, gap, last = next_holding_state(
-            previous.holding,
-            previous.contact_gap,
+        thresholds = self.settings.thresholds
+
+        def clearance() -> float:  # NaN when unmeasurable: never out of reach
+            try:
+                return hand_clearance(
+                    self._plant,
+                    query,
+                    object_body=self._body,
+                    fingers=self._bodies,
+                    horizon=2.0 * thresholds.release_distance,
+                )
+            except ModelError:
+                return np.nan
+
+        memory = next_holding_state(
+            previous.memory,
             touching=bool(touching),
-            grasped=report is not None and report.is_force_closure,
+            grasped=self._grasped(report, loads),
             friction_use=max(uses) if uses else np.nan,
             slip_speed=max(f.slip_speed for f in loads),
-            sliding_away=sliding,
-            last_grip=previous.last_grip,
-            thresholds=self.settings.thresholds,
+            sliding=sliding,
+            clearance=clearance,
+            thresholds=thresholds,
         )
-        return holding, loads, (relative, sliding), gap, last, against
+        return memory, loads, (relative, sliding), against
 
     def _update(self, context: Context, state: State) -> EventStatus:
         sample = self.evaluate(context)
