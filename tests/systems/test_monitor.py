@@ -168,8 +168,9 @@ def test_point_contact_monitor_matches_analyze_grasp(point_pick):
     assert X.shape[1] == round(DURATION / point_pick.monitor.period) + 1
     for k in range(X.shape[1] - 1):
         expected = _second_route(point_pick, X[:, k], **OPTIONS, **SOFT)
-        if V[GraspMonitor.CONTACT_GAP, k + 1] > 0:  # a bridged gap: the last grip
-            expected = _second_route(point_pick, X[:, k - 1], **OPTIONS, **SOFT)
+        gap = int(V[GraspMonitor.CONTACT_GAP, k + 1])
+        if gap > 0:  # a bridged gap: the analysis of the last sample with contact
+            expected = _second_route(point_pick, X[:, k - gap], **OPTIONS, **SOFT)
         np.testing.assert_allclose(
             V[: len(VERDICT_NAMES), k + 1],
             expected,
