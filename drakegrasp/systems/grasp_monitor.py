@@ -128,7 +128,8 @@ class GraspMonitor(LeafSystem):
         at initialization.
     compute_epsilon : bool, optional
         Compute the Ferrari–Canny ε of force-closure samples (default False),
-        with the batch engine's compiled kernel (:func:`epsilon_l1`: about
+        with the batch engine's compiled kernel
+        (:func:`~drakegrasp.systems.grasp_monitor.epsilon_l1`: about
         1 ms for 8 contacts; it compiles once per install unless
         ``drakegrasp warmup`` ran).
     holding : HoldingThresholds, optional
