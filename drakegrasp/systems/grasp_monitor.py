@@ -53,10 +53,11 @@ from drakegrasp.systems.sample import (
     verdict_names,
 )
 from drakegrasp.systems.sensing import (
+    anchor_fingers,
     hand_clearance,
+    motion_against,
     no_loads,
     sense_contacts,
-    speeds_against,
 )
 
 __all__ = ["GraspMonitor", "epsilon_l1"]
@@ -278,7 +279,7 @@ class GraspMonitor(LeafSystem):
         """A GraspSample; ``grip`` = (memory, loads, speeds, normals)."""
         if grip is None:
             grip = (HoldingMemory(), self._no_loads(), (np.nan, 0.0), ())
-        memory, loads, (relative, sliding), normals = grip
+        memory, loads, (relative, sliding), anchors = grip
         gap = memory.bridged(self.settings.thresholds)
         verdicts = np.concatenate(
             [
@@ -296,7 +297,7 @@ class GraspMonitor(LeafSystem):
             loads=tuple(loads),
             relative_speed=relative,
             sliding_speed=sliding,
-            last_normals=normals,
+            anchors=anchors,
             contact_gap=gap,
             memory=memory,
             names=self.verdict_names,
@@ -398,7 +399,7 @@ class GraspMonitor(LeafSystem):
         if not np.all(np.isfinite(x)):
             bad = np.flatnonzero(~np.isfinite(x))
             kept = (previous.memory, previous.loads, (np.nan, 0.0))
-            kept += (previous.last_normals,)
+            kept += (previous.anchors,)
             message = (
                 f"the plant state has non-finite entries at indices {bad[:8].tolist()}"
             )
@@ -430,19 +431,17 @@ class GraspMonitor(LeafSystem):
         return all(c.finger_body in pressing for c in report.contacts)
 
     def _grip(self, previous: GraspSample, report, loads, query):
-        """The grip after ``previous``: (memory, loads, speeds, normals)."""
-        touching = tuple(
-            (k, load.normal_W) for k, load in enumerate(loads) if load.touching
+        """The grip after ``previous``: (memory, loads, speeds, anchors)."""
+        touching = [(k, load.normal_W) for k, load in enumerate(loads) if load.touching]
+        anchors = previous.anchors  # the fingers that touched last, if none now
+        if touching:
+            anchors = anchor_fingers(
+                self._plant, self._plant_context, self._body, self._bodies, touching
+            )
+        motion = motion_against(
+            self._plant, self._plant_context, self._body, self._bodies, anchors
         )
-        against = touching or previous.last_normals  # the last fingers if none now
-        relative, sliding = speeds_against(
-            self._plant,
-            self._plant_context,
-            self._body,
-            [(self._bodies[k], n_W) for k, n_W in against],
-        )
-        if not touching:
-            relative = np.nan
+        relative = motion.relative if touching else np.nan
         uses = [f.friction_use for f in loads if not np.isnan(f.friction_use)]
         thresholds = self.settings.thresholds
 
@@ -464,11 +463,12 @@ class GraspMonitor(LeafSystem):
             grasped=self._grasped(report, loads),
             friction_use=max(uses) if uses else np.nan,
             slip_speed=max(f.slip_speed for f in loads),
-            sliding=sliding,
+            sliding=motion.along,
+            slid=0.0 if touching else motion.slid,
             clearance=clearance,
             thresholds=thresholds,
         )
-        return memory, loads, (relative, sliding), against
+        return memory, loads, (relative, motion.sliding), anchors
 
     def _update(self, context: Context, state: State) -> EventStatus:
         sample = self.evaluate(context)

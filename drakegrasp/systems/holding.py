@@ -19,16 +19,20 @@ and their codes on the vector port follow that order:
 ``at risk``     such a grasp with friction in use above ``risk`` at a contact
 ``slipping``    a contact slips faster than ``slip_speed``, or, without
                 contact, the object moves along the fingers that last held it
-                faster than that
+                faster than that (and more along them than away from them)
 ``dropped``     the object has left the hand: contact has been lost for
                 ``hold_samples + 1`` samples, the object is farther than
-                ``release_distance`` from every hand body, and the grip was
-                failing (at risk or slipping) or the object moved along the
-                fingers as it left
+                ``release_distance`` from every hand body, and it left *along*
+                the fingers that last held it: it moves along them faster
+                than ``slip_speed`` (and more along than away from them), or
+                has moved along them by more than ``release_distance`` since
+                the last contact
 ==============  ==============================================================
 
-A grip whose contact is lost while the object is at rest (the hand opened) is
-a release: ``no contact``, never ``dropped``.
+A hand that opens moves its fingers away along their normals while the object
+stays: that is a release, ``no contact``, never ``dropped``, however the grip
+was doing before (a box set down on the ground loads the fingers' friction
+fully just before they open).
 
 **The hysteresis**, in full (``n = hold_samples``):
 
@@ -49,7 +53,9 @@ A sample's *evidence* is what it alone shows: with contact, ``slipping`` (slip
 above the threshold), else ``touching`` (no force closure), else ``at risk``
 or ``holding`` by friction in use; without contact after a grip, ``dropped``
 or ``no contact`` once the object is out of reach as in the table, else
-``slipping`` when it moves along the fingers, else ``no contact``.
+``slipping`` when it moves along the fingers, else ``no contact``.  Motions
+along the fingers are measured in the frames of the fingers that touched the
+object last (:func:`~drakegrasp.systems.sensing.motion_against`).
 """
 
 from __future__ import annotations
@@ -83,7 +89,6 @@ the vector port (0 … 5); see :mod:`drakegrasp.systems.holding` for their rules
 
 _RANK = {name: k for k, name in enumerate(HOLDING_STATES)}
 _GRIPPED = ("holding", "at risk", "slipping")
-_FAILING = ("at risk", "slipping")
 _STICKY = _GRIPPED + ("dropped",)  # left towards a milder state only by hysteresis
 
 
@@ -112,10 +117,11 @@ class HoldingThresholds:
         evidence for it.  0 turns the hysteresis off.
     release_distance : float
         Metres (default 2 mm): an object farther than this from every hand
-        body has left the hand.  It must exceed every gap at which a contact
-        still counts (the monitor refuses it at or below its
-        ``distance_tolerance``) and the chatter of a sliding finger (~0.3 mm
-        on the WSG-50's pads).
+        body has left the hand, and one that has moved farther than this
+        along the fingers since the last contact left along them (a drop,
+        not a release).  It must exceed every gap at which a contact still
+        counts (the monitor refuses it at or below its ``distance_tolerance``)
+        and the chatter of a sliding finger (~0.3 mm on the WSG-50's pads).
     """
 
     risk: float = 0.8
@@ -182,6 +188,7 @@ def _evidence(
     friction_use: float,
     slip_speed: float,
     sliding: float,
+    slid: float,
     clearance: Callable[[], float],
     thresholds: HoldingThresholds,
 ) -> str:
@@ -201,8 +208,8 @@ def _evidence(
     moving = sliding > thresholds.slip_speed
     if memory.lost + 1 > thresholds.hold_samples:
         if clearance() > thresholds.release_distance:  # out of the hand
-            failing = memory.state in _FAILING or memory.last_grip in _FAILING
-            return "dropped" if failing or moving else "no contact"
+            along = moving or slid > thresholds.release_distance
+            return "dropped" if along else "no contact"  # else: released
     return "slipping" if moving else "no contact"
 
 
@@ -214,6 +221,7 @@ def next_holding_state(
     friction_use: float,
     slip_speed: float,
     sliding: float,
+    slid: float,
     clearance: Callable[[], float],
     thresholds: HoldingThresholds,
 ) -> HoldingMemory:
@@ -233,9 +241,13 @@ def next_holding_state(
     slip_speed : float
         Largest slip speed at a contact, m/s.
     sliding : float
-        Speed of the object's centre of mass along (normal component removed)
-        the touching fingers, or without contact the fingers that touched it
-        last (:func:`~drakegrasp.systems.sensing.speeds_against`), m/s.
+        Speed of the object's centre of mass along the touching fingers, or
+        without contact the fingers that touched it last, counted only where
+        it moves more along a finger than away from it (``Motion.along`` of
+        :func:`~drakegrasp.systems.sensing.motion_against`), m/s.
+    slid : float
+        Without contact: how far the centre of mass has moved along those
+        fingers since the last contact, m (0 with contact).
     clearance : callable () -> float
         The object's distance from the hand, m
         (:func:`~drakegrasp.systems.sensing.hand_clearance`); called only
@@ -258,6 +270,7 @@ def next_holding_state(
         friction_use=friction_use,
         slip_speed=slip_speed,
         sliding=sliding,
+        slid=slid,
         clearance=clearance,
         thresholds=thresholds,
     )

@@ -119,9 +119,9 @@ class GraspSample:
         Largest speed of the object's centre of mass along (normal component
         removed) the touching fingers, or without contact the fingers that
         touched it last, m/s.
-    last_normals : tuple of (int, (3,) float)
-        The touching fingers (index in the hand's bodies) and their contact
-        normals in W, or the last ones while there is no contact.
+    anchors : tuple of FingerAnchor
+        Where the object sat on each touching finger (in the finger's frame),
+        or on the fingers that touched it last while there is no contact.
     contact_gap : int
         Consecutive samples without contact that the hysteresis bridged (the
         analysis shown is then the last one with contact); 0 otherwise.
@@ -149,7 +149,7 @@ class GraspSample:
     sliding_speed: float
     contact_gap: int
     memory: HoldingMemory
-    last_normals: tuple
+    anchors: tuple
     names: tuple[str, ...]
     verdicts: np.ndarray
     state: np.ndarray

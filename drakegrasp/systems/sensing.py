@@ -13,8 +13,9 @@ object (:class:`~drakegrasp.systems.finger_loads.FingerLoad`):
   it applied, so friction in use with the plant's own μ.
 
 The holding state also needs the object's motion against the fingers that
-touch it (:func:`speeds_against`) and, once contact is lost, how far the
-object is from the hand (:func:`hand_clearance`): the evidence that
+touch it, or last touched it (:func:`anchor_fingers`, :func:`motion_against`),
+and, once contact is lost, how far the object is from the hand
+(:func:`hand_clearance`): the evidence that
 :func:`~drakegrasp.systems.holding.next_holding_state` judges.
 """
 
@@ -41,11 +42,14 @@ from drakegrasp.systems.finger_loads import (
 from drakegrasp.systems.holding import HoldingThresholds
 
 __all__ = [
+    "FingerAnchor",
+    "Motion",
     "Sensed",
+    "anchor_fingers",
     "hand_clearance",
+    "motion_against",
     "no_loads",
     "sense_contacts",
-    "speeds_against",
 ]
 
 
@@ -174,41 +178,122 @@ def sense_contacts(
     )
 
 
-def speeds_against(
-    plant: MultibodyPlant, plant_context: Context, object_body, fingers
-) -> tuple[float, float]:
-    """How fast the object's centre of mass moves against the given fingers.
+class FingerAnchor(NamedTuple):
+    """Where the object sat on a finger at the last sample with contact.
 
-    Parameters
+    Attributes
     ----------
-    fingers : sequence of (RigidBody, (3,) float)
-        Finger bodies with their unit contact normal (into the object, in W).
+    finger : int
+        Index of the finger in the monitor's hand bodies.
+    p_FScm : (3,) float
+        The object's centre of mass in the finger's frame F, m.
+    nhat_F : (3,) float
+        The finger's unit contact normal (into the object), in F.
+    """
 
-    Returns
-    -------
+    finger: int
+    p_FScm: np.ndarray
+    nhat_F: np.ndarray
+
+
+class Motion(NamedTuple):
+    """How the object moves against the fingers that touch (or last touched) it.
+
+    Attributes
+    ----------
     relative : float
         Largest speed of the centre of mass measured in a finger's frame
-        (the velocity of the centre of mass minus that of the finger's
-        material point there), m/s; NaN without fingers.
+        (its velocity minus that of the finger's material point there), m/s;
+        NaN without fingers.
     sliding : float
         Largest such speed with its component along the finger's normal
-        removed: the object moving *along* the finger, as when it slides out,
-        not away from it, as when the hand opens.  m/s, 0 without fingers.
+        removed, m/s; 0 without fingers.
+    along : float
+        Largest sliding speed over the fingers against which the object moves
+        more along the finger than away from it (tangential speed at least
+        the normal one): the object sliding out, not the hand opening, which
+        moves its fingers away along their normals.  m/s, 0 without fingers.
+    slid : float
+        Largest displacement of the centre of mass along a finger (normal
+        component removed), in the finger's frame, since the anchors were
+        taken, m; 0 without fingers.
     """
-    p_WScm = np.asarray(
+
+    relative: float
+    sliding: float
+    along: float
+    slid: float
+
+
+def _com_W(plant, plant_context, object_body) -> np.ndarray:
+    return np.asarray(
         plant.EvalBodyPoseInWorld(plant_context, object_body).multiply(
             object_body.CalcCenterOfMassInBodyFrame(plant_context)
         )
     )
+
+
+def anchor_fingers(
+    plant: MultibodyPlant, plant_context: Context, object_body, fingers, touching
+) -> tuple[FingerAnchor, ...]:
+    """The object's place on each touching finger, in the finger's frame.
+
+    Parameters
+    ----------
+    fingers : sequence of RigidBody
+        The hand bodies.
+    touching : sequence of (int, (3,) float)
+        Index into ``fingers`` and unit contact normal in W of each finger
+        that touches.
+    """
+    p_WScm = _com_W(plant, plant_context, object_body)
+    anchors = []
+    for k, n_W in touching:
+        X_FW = plant.EvalBodyPoseInWorld(plant_context, fingers[k]).inverse()
+        anchors.append(
+            FingerAnchor(
+                k,
+                np.asarray(X_FW.multiply(p_WScm)),
+                X_FW.rotation().matrix() @ np.asarray(n_W),
+            )
+        )
+    return tuple(anchors)
+
+
+def motion_against(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    object_body,
+    fingers,
+    anchors: tuple[FingerAnchor, ...],
+) -> Motion:
+    """How the object's centre of mass moves against the anchored fingers.
+
+    Normals turn with their fingers (kept in the finger's frame), so a finger
+    that swings open still measures sliding along itself.
+
+    Parameters
+    ----------
+    fingers : sequence of RigidBody
+        The hand bodies (``FingerAnchor.finger`` indexes them).
+    anchors : tuple of FingerAnchor
+        From :func:`anchor_fingers`, now or at the last sample with contact.
+    """
+    if not anchors:
+        return Motion(np.nan, 0.0, 0.0, 0.0)
+    p_WScm = _com_W(plant, plant_context, object_body)
     v_W = point_velocity(plant, plant_context, object_body, p_WScm)
-    relative, sliding = [], []
-    for finger, n_W in fingers:
-        v_rel = v_W - point_velocity(plant, plant_context, finger, p_WScm)
+    relative, sliding, along, slid = [], [], [], []
+    for k, p_FScm, nhat_F in anchors:
+        X_WF = plant.EvalBodyPoseInWorld(plant_context, fingers[k])
+        v_rel = v_W - point_velocity(plant, plant_context, fingers[k], p_WScm)
         relative.append(float(np.linalg.norm(v_rel)))
-        sliding.append(split_along(v_rel, n_W)[1])
-    if not fingers:
-        return np.nan, 0.0
-    return max(relative), max(sliding)
+        normal, tangential = split_along(v_rel, X_WF.rotation().matrix() @ nhat_F)
+        sliding.append(tangential)
+        along.append(tangential if tangential >= abs(normal) else 0.0)
+        moved_F = np.asarray(X_WF.inverse().multiply(p_WScm)) - p_FScm
+        slid.append(split_along(moved_F, nhat_F)[1])
+    return Motion(max(relative), max(sliding), max(along), max(slid))
 
 
 def hand_clearance(

@@ -32,6 +32,7 @@ def sample(
     use=0.1,
     slip=0.0,
     sliding=0.0,
+    slid=0.0,
     clearance=NEAR,
 ):
     return dict(
@@ -40,6 +41,7 @@ def sample(
         friction_use=use,
         slip_speed=slip,
         sliding=sliding,
+        slid=slid,
         clearance=clearance,
     )
 
@@ -50,8 +52,9 @@ SLIP = sample(slip=0.1, use=1.0)
 TOUCH = sample(grasped=False)
 GONE_AT_REST = sample(touching=False, clearance=FAR)
 NEAR_AT_REST = sample(touching=False)
-GONE_MOVING = sample(touching=False, sliding=0.1, clearance=FAR)
-NEAR_MOVING = sample(touching=False, sliding=0.1)
+GONE_MOVING = sample(touching=False, sliding=0.1, slid=0.01, clearance=FAR)
+NEAR_MOVING = sample(touching=False, sliding=0.1, slid=0.001)
+GONE_SLID = sample(touching=False, slid=0.01, clearance=FAR)  # landed, at rest
 
 
 def run(samples, thresholds=TH, memory=None):
@@ -97,14 +100,20 @@ def test_release_is_no_contact_and_never_dropped():
     # The hand opens around a box at rest: contact gone, the box does not move.
     states, _, _ = run([HOLD] * 3 + [NEAR_AT_REST] + [GONE_AT_REST] * 5)
     assert states == ["holding"] * 4 + ["no contact"] * 5
+    # However the grip was doing: a box set down on the ground loads the
+    # fingers' friction fully (at risk, even slipping) just before they open.
+    for last in (RISK, SLIP):
+        states, _, _ = run([HOLD, last, GONE_AT_REST, GONE_AT_REST, GONE_AT_REST])
+        assert "dropped" not in states and states[-1] == "no contact"
 
 
 def test_a_failing_grip_that_leaves_the_hand_is_dropped_after_the_window():
     states, memory, _ = run([HOLD, SLIP, GONE_MOVING, GONE_MOVING, GONE_AT_REST])
     assert states == ["holding", "slipping", "slipping", "dropped", "dropped"]
     assert memory.last_grip == "slipping"
-    # Out of the hand and at rest, after a grip at risk: still a drop.
-    states, _, _ = run([RISK, GONE_AT_REST, GONE_AT_REST])
+    # Out of the hand and already at rest (it fell and landed between two
+    # samples), but displaced along the fingers since the last contact: a drop.
+    states, _, _ = run([RISK, GONE_SLID, GONE_SLID])
     assert states == ["at risk", "at risk", "dropped"]
     # A holding grip whose object moves away along the fingers: a drop.
     states, _, _ = run([HOLD, GONE_MOVING, GONE_MOVING])
@@ -184,7 +193,7 @@ def test_bad_release_distance_is_refused(kwargs):
 
 
 EVIDENCE = [HOLD, RISK, SLIP, TOUCH, GONE_AT_REST, NEAR_AT_REST, GONE_MOVING]
-EVIDENCE += [NEAR_MOVING]
+EVIDENCE += [NEAR_MOVING, GONE_SLID]
 
 
 @settings(max_examples=300, derandomize=True, deadline=None)
@@ -212,6 +221,7 @@ def test_rules_hold_on_random_evidence(picks, n):
         if state == "dropped" and previous != "dropped":
             assert not s["touching"] and lost >= n + 1
             assert s["clearance"] > th.release_distance
+            assert s["sliding"] > th.slip_speed or s["slid"] > th.release_distance
         if not s["touching"] and state in ("holding", "at risk"):
             assert lost <= n  # a grip without contact only within the window
         if s["touching"] and s["slip_speed"] > th.slip_speed:
@@ -249,3 +259,60 @@ def test_hand_clearance_against_the_geometry_and_pair_by_pair():
     assert hand_clearance(
         plant, query, object_body=box, fingers=hand, horizon=0.005
     ) == float("inf")
+
+
+def test_motion_along_a_finger_is_measured_in_its_frame():
+    # Anchor the box on both fingers, then move it: along the fingers (down,
+    # as in a drop) counts as slid; away from them (as the hand opens, or the
+    # box pushed along the normal) does not.  Speeds: the box falling at 0.3
+    # m/s slides along the fingers at that speed; one moving mostly across
+    # them is not moving "along" them.
+    from pick_support import build_pick
+    from pydrake.math import RigidTransform
+    from pydrake.multibody.math import SpatialVelocity
+
+    from drakegrasp.systems.sensing import anchor_fingers, motion_against
+
+    pick = build_pick(mu=0.5)
+    plant = pick.plant
+    context = plant.CreateDefaultContext()
+    plant.SetPositionsAndVelocities(
+        context,
+        plant.GetPositionsAndVelocities(
+            plant.GetMyContextFromRoot(pick.simulator.get_context())
+        ),
+    )
+    box = plant.GetBodyByName("box", pick.box)
+    hand = [plant.get_body(i) for i in plant.GetBodyIndices(pick.gripper)]
+    fingers = [k for k, b in enumerate(hand) if "finger" in b.name()]
+    # Inward normals: each finger pushes towards the box's axis (world x / y).
+    p_WO = plant.EvalBodyPoseInWorld(context, box).translation()
+    touching = []
+    for k in fingers:
+        p_WF = plant.EvalBodyPoseInWorld(context, hand[k]).translation()
+        d = p_WO - p_WF
+        d[2] = 0.0
+        touching.append((k, d / np.linalg.norm(d)))
+    anchors = anchor_fingers(plant, context, box, hand, touching)
+    assert motion_against(plant, context, box, hand, anchors).slid == pytest.approx(
+        0.0, abs=1e-12
+    )
+    n_W = touching[0][1]
+    for shift, expected in (([0, 0, -0.004], 0.004), (0.003 * n_W, 0.0)):
+        plant.SetFreeBodyPose(context, box, RigidTransform(p_WO + np.array(shift)))
+        motion = motion_against(plant, context, box, hand, anchors)
+        assert motion.slid == pytest.approx(expected, abs=1e-12)
+    plant.SetFreeBodySpatialVelocity(
+        context, box, SpatialVelocity(np.zeros(3), [0.0, 0.0, -0.3])
+    )
+    motion = motion_against(plant, context, box, hand, anchors)
+    assert motion.sliding == pytest.approx(0.3, rel=1e-12)
+    assert motion.along == motion.sliding  # all of it along the fingers
+    assert motion.relative == pytest.approx(0.3, rel=1e-12)
+    # Mostly across a finger (as when the hand opens at 70 mm/s), with a
+    # little along it: the sliding speed is seen, but it is not "along".
+    v = 0.07 * n_W + [0.0, 0.0, -0.0075]
+    plant.SetFreeBodySpatialVelocity(context, box, SpatialVelocity(np.zeros(3), v))
+    motion = motion_against(plant, context, box, hand, anchors)
+    assert motion.sliding == pytest.approx(0.0075, rel=1e-9)
+    assert motion.along == 0.0

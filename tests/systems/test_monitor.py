@@ -228,6 +228,20 @@ def test_hydroelastic_pick_timeline(hydro_pick):
     assert set(V[GraspMonitor.NUM_CONTACTS][closure == 1.0]) == {8.0}
 
 
+@pytest.mark.parametrize("fixture", ["point_pick", "hydro_pick"])
+def test_opening_the_hand_is_a_release_not_a_drop(fixture, request):
+    # The box is set down (1.8 - 2.3 s) and the hand opens (2.3 - 2.6 s): the
+    # grip ends in "no contact", never "dropped" (the box did not fall).
+    pick = request.getfixturevalue(fixture)
+    pick = pick[0] if isinstance(pick, tuple) else pick
+    log = pick.verdict_log.FindLog(pick.simulator.get_context())
+    times, codes = log.sample_times(), log.data()[GraspMonitor.HOLDING]
+    states = [dg.HOLDING_STATES[int(c)] for c in codes]
+    assert "dropped" not in states
+    assert "holding" in states
+    assert {s for t, s in zip(times, states, strict=True) if t > 2.7} == {"no contact"}
+
+
 def test_hydroelastic_patches_match_the_geometry(hydro_pick):
     pick, sample = hydro_pick
     assert sample.status == "ok", sample.message
