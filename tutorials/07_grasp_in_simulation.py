@@ -376,11 +376,12 @@ fig.tight_layout()
 # in use at 1) as the lift starts and `slipping` 10 ms later, before the box has
 # moved 5 mm relative to the fingers, and it stays `slipping` while the pads
 # chatter up the box, touching it only now and then.  It says `dropped` only
-# when the box has left the hand: no contact for `hold_samples + 1` samples
-# *and* the box farther than `release_distance` (2 mm) from every hand body,
-# here when the pads pass the top of the box, about 35 mm of slide later.  A
-# missing frame is not a drop, and a hand that opens around a box at rest is
-# a release (`no contact`), not a drop.  The states only escalate at once; a
+# when the box has left the hand: no contact for `hold_samples + 1` samples,
+# the box farther than `release_distance` (2 mm) from every hand body, and gone
+# *along* the fingers, here when the pads pass the top of the box, about 35 mm
+# of slide later.  A missing frame is not a drop, and a hand that opens around
+# a box at rest (its fingers moving away along their normals) is a release,
+# `no contact`.  The states only escalate at once; a
 # calmer state needs `hold_samples + 1` samples of calmer evidence, so the plot
 # does not flicker.  The thresholds are `drakegrasp.HoldingThresholds`; the
 # systems tests check, on this pick and on Drake's WSG-50 with a YCB box, that

@@ -73,10 +73,11 @@ object that has left the hand.
 ``no contact``, ``touching``, ``holding``, ``at risk`` (friction in use above
 ``risk``), ``slipping`` (a contact slips faster than ``slip_speed``, or the
 object moves along the fingers without contact) or ``dropped`` (the object has
-left the hand: no contact for ``hold_samples + 1`` samples *and* farther than
-``release_distance`` from every hand body, after a failing grip or while
-moving along the fingers; a hand that opens around an object at rest is a
-release, ``no contact``).  The hysteresis: a more alarming state is shown at
+left the hand: no contact for ``hold_samples + 1`` samples, farther than
+``release_distance`` from every hand body, *and* gone along the fingers that
+last held it, moving along them or displaced along them since the last
+contact; a hand that opens around an object at rest moves its fingers away
+along their normals: a release, ``no contact``).  The hysteresis: a more alarming state is shown at
 once (``dropped`` only through its own gate), a less alarming one only after
 ``hold_samples + 1`` consecutive samples whose evidence is less alarming, and
 for up to ``hold_samples`` samples without contact the last grip's analysis is
