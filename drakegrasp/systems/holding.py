@@ -20,13 +20,13 @@ and their codes on the vector port follow that order:
 ``slipping``    a contact slips faster than ``slip_speed``, or, without
                 contact, the object moves along the fingers that last held it
                 faster than that (and more along them than away from them)
-``dropped``     the object has left the hand: contact has been lost for
-                ``hold_samples + 1`` samples, the object is farther than
-                ``release_distance`` from every hand body, and it left *along*
-                the fingers that last held it: it moves along them faster
-                than ``slip_speed`` (and more along than away from them), or
-                has moved along them by more than ``release_distance`` since
-                the last contact
+``dropped``     the object has left the fingers that last held it, *along*
+                them: contact has been lost for ``hold_samples + 1`` samples,
+                and either the object still slides along them (faster than
+                ``slip_speed``, more along than away from them) and is
+                farther than ``release_distance`` from every hand body, or it
+                has come to rest displaced along them by more than
+                ``release_distance`` since the last contact
 ==============  ==============================================================
 
 A hand that opens moves its fingers away along their normals while the object
@@ -51,11 +51,13 @@ fully just before they open).
 
 A sample's *evidence* is what it alone shows: with contact, ``slipping`` (slip
 above the threshold), else ``touching`` (no force closure), else ``at risk``
-or ``holding`` by friction in use; without contact after a grip, ``dropped``
-or ``no contact`` once the object is out of reach as in the table, else
-``slipping`` when it moves along the fingers, else ``no contact``.  Motions
-along the fingers are measured in the frames of the fingers that touched the
-object last (:func:`~drakegrasp.systems.sensing.motion_against`).
+or ``holding`` by friction in use; without contact after a grip, within the
+window ``slipping`` if the object moves along the fingers, else ``no
+contact``; after it, ``dropped`` as in the table, else ``slipping`` if it
+slides along the fingers within reach (a finger chattering along it), else
+``no contact`` (a release: the object at rest where the fingers left it).
+Motions along the fingers are measured in the frames of the fingers that
+touched the object last (:func:`~drakegrasp.systems.sensing.motion_against`).
 """
 
 from __future__ import annotations
@@ -116,12 +118,13 @@ class HoldingThresholds:
         alarming state needs ``hold_samples + 1`` consecutive samples of
         evidence for it.  0 turns the hysteresis off.
     release_distance : float
-        Metres (default 2 mm): an object farther than this from every hand
-        body has left the hand, and one that has moved farther than this
-        along the fingers since the last contact left along them (a drop,
-        not a release).  It must exceed every gap at which a contact still
-        counts (the monitor refuses it at or below its ``distance_tolerance``)
-        and the chatter of a sliding finger (~0.3 mm on the WSG-50's pads).
+        Metres (default 2 mm): an object sliding along the fingers farther
+        than this from every hand body has left the hand, and one that has
+        come to rest farther than this along the fingers from where they last
+        touched it was dropped, not released.  It must exceed every gap at
+        which a contact still counts (the monitor refuses it at or below its
+        ``distance_tolerance``) and the chatter of a sliding finger (~0.3 mm
+        on the WSG-50's pads).
     """
 
     risk: float = 0.8
@@ -206,10 +209,12 @@ def _evidence(
     if memory.state not in _GRIPPED:
         return "no contact"
     moving = sliding > thresholds.slip_speed
-    if memory.lost + 1 > thresholds.hold_samples:
-        if clearance() > thresholds.release_distance:  # out of the hand
-            along = moving or slid > thresholds.release_distance
-            return "dropped" if along else "no contact"  # else: released
+    if memory.lost + 1 > thresholds.hold_samples:  # contact lost for good
+        if moving:  # sliding out: dropped once clear of the hand
+            out = clearance() > thresholds.release_distance
+            return "dropped" if out else "slipping"
+        # At rest: moved off its place along the fingers, or released.
+        return "dropped" if slid > thresholds.release_distance else "no contact"
     return "slipping" if moving else "no contact"
 
 
@@ -251,7 +256,8 @@ def next_holding_state(
     clearance : callable () -> float
         The object's distance from the hand, m
         (:func:`~drakegrasp.systems.sensing.hand_clearance`); called only
-        without contact once a grip's hysteresis window has passed.
+        without contact, once a grip's hysteresis window has passed, while the
+        object slides along the fingers.
     thresholds : HoldingThresholds
 
     Returns

@@ -63,21 +63,23 @@ same instant, so geometry and kinematics agree).
   out-of-reach test bridge.  It depends on a simulator's context: a fresh
   context has no results.
 
-In both modes, once contact is lost the holding state measures the object's
-distance from every hand body (Drake's signed distances, up to twice
-``release_distance``) to tell a grip that is merely missing a frame from an
-object that has left the hand.
+In both modes, once contact is lost the holding state follows the object in
+the frames of the fingers that touched it last, and, while it slides along
+them, measures its distance from every hand body (Drake's signed distances, up
+to twice ``release_distance``), to tell a grip that is merely missing a frame
+from an object that has left the hand.
 
 **Holding.**  Each sample also judges the grip
 (:mod:`drakegrasp.systems.holding`, where the rules are in full):
 ``no contact``, ``touching``, ``holding``, ``at risk`` (friction in use above
 ``risk``), ``slipping`` (a contact slips faster than ``slip_speed``, or the
 object moves along the fingers without contact) or ``dropped`` (the object has
-left the hand: no contact for ``hold_samples + 1`` samples, farther than
-``release_distance`` from every hand body, *and* gone along the fingers that
-last held it, moving along them or displaced along them since the last
-contact; a hand that opens around an object at rest moves its fingers away
-along their normals: a release, ``no contact``).  The hysteresis: a more alarming state is shown at
+left the fingers that last held it, along them: no contact for
+``hold_samples + 1`` samples, and either still sliding along them and farther
+than ``release_distance`` from every hand body, or at rest displaced along them
+by more than ``release_distance`` since the last contact; a hand that opens
+around an object at rest moves its fingers away along their normals: a
+release, ``no contact``).  The hysteresis: a more alarming state is shown at
 once (``dropped`` only through its own gate), a less alarming one only after
 ``hold_samples + 1`` consecutive samples whose evidence is less alarming, and
 for up to ``hold_samples`` samples without contact the last grip's analysis is
