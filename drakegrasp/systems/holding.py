@@ -38,7 +38,8 @@ fully just before they open).
 
 1. A move to a *more* alarming state is immediate: the early warning is the
    point of ``at risk`` and ``slipping``.  The one exception is ``dropped``,
-   gated as above, so a single sample without contact never reads as a drop.
+   gated as above, so with ``n >= 1`` (the default) a single sample without
+   contact never reads as a drop.
 2. A move from ``holding``, ``at risk``, ``slipping`` or ``dropped`` to a
    *less* alarming state needs ``n + 1`` consecutive samples whose evidence is
    less alarming than the state shown; the state then becomes the latest
