@@ -9,8 +9,10 @@ closes on a 0.2 kg box, lifts it 5 cm, lowers it, opens; 3 s simulated, 1 ms
 SAP steps) in three set-ups: point contact with distances from geometry (soft
 fingers), hydroelastic contact with patches from the contact results (flat
 pads, hard fingers), and the same with the monitor's Ferrari–Canny ε (off by
-default).  Then the weak pick's slip-detection times, and those of the
-WSG-50 + YCB sugar box picks (``tests/systems/wsg_pick_support.py``).  For
+default).  Before them: the cost of one sample on 8 contacts with ε off and on
+(and ε alone by Qhull and by the compiled kernel the monitor uses); then the
+weak pick's slip-detection times, and those of the WSG-50 + YCB sugar box
+picks (``tests/systems/wsg_pick_support.py``).  ``--part`` runs one of these.  For
 each it prints the wall time of the whole simulation, of the simulation with a
 monitor that never samples (period 1000 s), the median / 90th percentile / max
 cost of one evaluation (the first excluded: it loads the solvers) and the
@@ -113,6 +115,54 @@ def wsg_slip_times() -> None:
             )
 
 
+def epsilon_cost(repeats: int = 30) -> None:
+    """One sample on 8 contacts (flat pads, hydroelastic), ε off and on."""
+    from drakegrasp.quality import ferrari_canny
+    from drakegrasp.systems.grasp_monitor import epsilon_l1
+
+    print("one sample holding the box in the air (flat pads, 8 contacts):")
+    for flag in (False, True):
+        pick = build_pick(
+            period=0.05,
+            mu="plant",
+            distance_tolerance=1e-3,
+            plant_contact="hydroelastic_with_fallback",
+            flat=True,
+            contacts="contact_results",
+            compute_epsilon=flag,
+        )
+        pick.simulator.AdvanceTo(1.6)
+        monitor = pick.monitor
+        context = monitor.GetMyContextFromRoot(pick.simulator.get_context())
+        sample = monitor.evaluate(context)  # warm: solvers loaded, kernel compiled
+        costs, cpu = [], []
+        for _ in range(repeats):
+            start = time.process_time()
+            costs.append(monitor.evaluate(context).seconds)
+            cpu.append(time.process_time() - start)
+        c, u = 1e3 * np.array(costs), 1e3 * np.array(cpu)
+        print(
+            f"  compute_epsilon={flag}: wall median {np.median(c):.2f} ms (min "
+            f"{c.min():.2f}, p90 {np.percentile(c, 90):.2f}), CPU median "
+            f"{np.median(u):.2f} ms ({sample.report.grasp.num_contacts} contacts, "
+            f"eps = {sample.epsilon:.6g})"
+        )
+    grasp = sample.report.grasp
+    routes = (("Qhull (ferrari_canny)", ferrari_canny), ("kernel", epsilon_l1))
+    for name, route in routes:
+        times, cpu = [], []
+        for _ in range(repeats):
+            start, start_cpu = time.perf_counter(), time.process_time()
+            eps = route(grasp, num_generators=8)
+            times.append(time.perf_counter() - start)
+            cpu.append(time.process_time() - start_cpu)
+        t, u = 1e3 * np.array(times), 1e3 * np.array(cpu)
+        print(
+            f"  eps alone, {name}: wall median {np.median(t):.2f} ms, CPU median "
+            f"{np.median(u):.2f} ms, eps = {eps!r}"
+        )
+
+
 def run(period: float, options: dict) -> tuple[float, list[float], object]:
     pick = build_pick(period=period, mu=0.5, distance_tolerance=1e-3, **options)
     costs: list[float] = []
@@ -146,7 +196,21 @@ def timeline(pick) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--period", type=float, default=0.05)
+    parser.add_argument(
+        "--part",
+        choices=("all", "picks", "epsilon", "slip"),
+        default="all",
+        help="the pick timings, the per-sample cost with and without eps, "
+        "or the slip-detection times (default all)",
+    )
     args = parser.parse_args()
+    if args.part in ("all", "epsilon"):
+        epsilon_cost()
+    if args.part in ("all", "slip"):
+        slip_times()
+        wsg_slip_times()
+    if args.part not in ("all", "picks"):
+        return
     for name, options in CASES.items():
         idle, _, _ = run(1000.0, options)
         wall, costs, pick = run(args.period, options)
@@ -162,8 +226,6 @@ def main() -> None:
             f"({len(costs)} samples; first {1e3 * costs[0]:.1f} ms)"
         )
         print(f"  verdicts: {timeline(pick)}")
-    slip_times()
-    wsg_slip_times()
 
 
 if __name__ == "__main__":

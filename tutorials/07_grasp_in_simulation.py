@@ -372,11 +372,22 @@ fig.tight_layout()
 # %% [markdown]
 # The firm grip reads `holding` through the lift and the box rises 5 cm.  The weak
 # grip has the same $d^*$ while the box is still on the ground, but when the lift
-# starts the fingers slide along the box: the monitor flags `slipping` (or `at
-# risk`, friction in use near 1) and then `dropped`, and the box stays behind.
-# The thresholds are `drakegrasp.HoldingThresholds`; the systems tests check, on
-# this pick and on Drake's WSG-50 with a YCB box, that the flag comes before the
-# box has moved 5 mm relative to the fingers.
+# starts the fingers slide along the box: the monitor flags `at risk` (friction
+# in use at 1) as the lift starts and `slipping` 10 ms later, before the box has
+# moved 5 mm relative to the fingers, and it stays `slipping` while the pads
+# chatter up the box, touching it only now and then.  It says `dropped` only
+# when the box has left the fingers along them: no contact for
+# `hold_samples + 1` samples, and the box sliding along the fingers farther
+# than `release_distance` (2 mm) from every hand body (or at rest more than
+# that along them from where they last touched it), here when the pads pass
+# the top of the box, about 35 mm of slide later.  A missing frame is not a drop, and a hand that opens around
+# a box at rest (its fingers moving away along their normals) is a release,
+# `no contact`.  The states only escalate at once; a
+# calmer state needs `hold_samples + 1` samples of calmer evidence, so the plot
+# does not flicker.  The thresholds are `drakegrasp.HoldingThresholds`; the
+# systems tests check, on this pick and on Drake's WSG-50 with a YCB box, that
+# the flag comes before the box has moved 5 mm relative to the fingers and the
+# drop after it.
 #
 # ## A second opinion
 #

@@ -39,10 +39,11 @@ from drakegrasp.plant.friction import (
 )
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.quality import ferrari_canny
+from drakegrasp.quality.epsilon import L1_MAX_POINTS, primitive_wrenches
 from drakegrasp.systems.holding import (
+    HoldingMemory,
     HoldingThresholds,
     next_holding_state,
-    speeds_against,
 )
 from drakegrasp.systems.monitor_options import monitor_settings
 from drakegrasp.systems.sample import (
@@ -51,11 +52,40 @@ from drakegrasp.systems.sample import (
     grip_verdicts,
     verdict_names,
 )
-from drakegrasp.systems.sensing import no_loads, sense_contacts
+from drakegrasp.systems.sensing import (
+    anchor_fingers,
+    hand_clearance,
+    motion_against,
+    no_loads,
+    sense_contacts,
+)
 
-__all__ = ["GraspMonitor"]
+__all__ = ["GraspMonitor", "epsilon_l1"]
 
 _STATUS_CODE = {"ok": 1.0, "no contact": 0.0, "invalid": -1.0, "not sampled": 0.0}
+
+
+def epsilon_l1(grasp, *, num_generators: int) -> float:
+    """Ferrari–Canny ε (L1) of one grasp, by the batch engine's compiled kernel.
+
+    The same ε as :func:`~drakegrasp.quality.ferrari_canny` (the same primitive
+    wrenches, moments divided by the grasp's characteristic length) found by
+    the expanding polytope of :mod:`drakegrasp.batch.epsilon.kernel`: only the
+    facets near the origin are built, about 1 ms for 8 contacts where Qhull's
+    whole hull takes 20-30 ms.  Its answer agrees with Qhull's to about 1e-13
+    relative; a grasp the kernel flags (round-off could spoil it), a grasp
+    past :data:`~drakegrasp.quality.epsilon.L1_MAX_POINTS` wrenches, or an
+    install without numba takes :func:`~drakegrasp.quality.ferrari_canny`.
+    The kernel compiles on first use unless ``drakegrasp warmup`` ran.
+    """
+    import drakegrasp.batch.epsilon.kernel as kernel
+
+    W = np.vstack(primitive_wrenches(grasp, num_generators=num_generators))
+    if kernel.AVAILABLE and W.shape[0] <= L1_MAX_POINTS:
+        eps, status = kernel.epsilon_l1_stack(W[None])
+        if status[0] <= kernel.FLAT:  # OK, or a flat set: eps = 0
+            return float(eps[0])
+    return float(ferrari_canny(grasp, num_generators=num_generators))
 
 
 class GraspMonitor(LeafSystem):
@@ -98,8 +128,11 @@ class GraspMonitor(LeafSystem):
         Time of the first periodic sample (default 0); a sample is also taken
         at initialization.
     compute_epsilon : bool, optional
-        Compute the Ferrari–Canny ε of force-closure samples (default False:
-        it is the costliest part of a sample).
+        Compute the Ferrari–Canny ε of force-closure samples (default False),
+        with the batch engine's compiled kernel
+        (:func:`~drakegrasp.systems.grasp_monitor.epsilon_l1`: about
+        1 ms for 8 contacts; it compiles once per install unless
+        ``drakegrasp warmup`` ran).
     holding : HoldingThresholds, optional
         Thresholds of the holding state and the hysteresis (default
         ``HoldingThresholds()``).
@@ -243,14 +276,15 @@ class GraspMonitor(LeafSystem):
         )
 
     def _sample(self, t, status, message, report, epsilon, x, start, *, grip):
-        """A GraspSample; ``grip`` = (holding, loads, speeds, gap, last, normals)."""
+        """A GraspSample; ``grip`` = (memory, loads, speeds, normals)."""
         if grip is None:
-            grip = ("no contact", self._no_loads(), (np.nan, 0.0), 0, "no contact", ())
-        holding, loads, (relative, sliding), gap, last, normals = grip
+            grip = (HoldingMemory(), self._no_loads(), (np.nan, 0.0), ())
+        memory, loads, (relative, sliding), anchors = grip
+        gap = memory.bridged(self.settings.thresholds)
         verdicts = np.concatenate(
             [
                 analysis_verdicts(report, _STATUS_CODE[status], epsilon),
-                grip_verdicts(holding, loads, relative, gap),
+                grip_verdicts(memory.state, loads, relative, gap),
             ]
         )
         return GraspSample(
@@ -259,13 +293,13 @@ class GraspMonitor(LeafSystem):
             message=message,
             report=report,
             epsilon=epsilon,
-            holding=holding,
+            holding=memory.state,
             loads=tuple(loads),
             relative_speed=relative,
             sliding_speed=sliding,
-            last_normals=normals,
+            anchors=anchors,
             contact_gap=gap,
-            last_grip=last,
+            memory=memory,
             names=self.verdict_names,
             verdicts=verdicts,
             state=x,
@@ -364,8 +398,8 @@ class GraspMonitor(LeafSystem):
         x = np.array(self._state_port.Eval(context), dtype=float)
         if not np.all(np.isfinite(x)):
             bad = np.flatnonzero(~np.isfinite(x))
-            kept = (previous.holding, previous.loads, (np.nan, 0.0))
-            kept += (previous.contact_gap, previous.last_grip, previous.last_normals)
+            kept = (previous.memory, previous.loads, (np.nan, 0.0))
+            kept += (previous.anchors,)
             message = (
                 f"the plant state has non-finite entries at indices {bad[:8].tolist()}"
             )
@@ -373,9 +407,9 @@ class GraspMonitor(LeafSystem):
         self._plant.SetPositionsAndVelocities(self._plant_context, x)
         query = self._query_port.Eval(context)
         status, message, report, loads = self._analyse(context, query)
-        grip = self._grip(previous, report, loads)
+        grip = self._grip(previous, report, loads, query)
         epsilon = 0.0
-        if grip[3] > 0 and previous.report is not None:  # bridge the gap
+        if grip[0].bridged(self.settings.thresholds) and previous.report is not None:
             status, report, epsilon = previous.status, previous.report, previous.epsilon
             message = f"no contact in this sample ({message}); the last grip is held"
         elif (
@@ -383,40 +417,58 @@ class GraspMonitor(LeafSystem):
             and self.settings.compute_epsilon
             and report.is_force_closure
         ):
-            epsilon = float(
-                ferrari_canny(
-                    report.grasp, num_generators=self.settings.analysis.num_generators
-                )
+            epsilon = epsilon_l1(
+                report.grasp, num_generators=self.settings.analysis.num_generators
             )
         return self._sample(t, status, message, report, epsilon, x, start, grip=grip)
 
-    def _grip(self, previous: GraspSample, report, loads):
-        """The holding state after ``previous``: (holding, loads, speeds, gap, ...)."""
-        touching = tuple(
-            (k, load.normal_W) for k, load in enumerate(loads) if load.touching
+    @staticmethod
+    def _grasped(report, loads) -> bool:
+        """Force closure, and every analysed finger presses on the object."""
+        if report is None or not report.is_force_closure:
+            return False
+        pressing = {load.finger_body for load in loads if load.touching}
+        return all(c.finger_body in pressing for c in report.contacts)
+
+    def _grip(self, previous: GraspSample, report, loads, query):
+        """The grip after ``previous``: (memory, loads, speeds, anchors)."""
+        touching = [(k, load.normal_W) for k, load in enumerate(loads) if load.touching]
+        anchors = previous.anchors  # the fingers that touched last, if none now
+        if touching:
+            anchors = anchor_fingers(
+                self._plant, self._plant_context, self._body, self._bodies, touching
+            )
+        motion = motion_against(
+            self._plant, self._plant_context, self._body, self._bodies, anchors
         )
-        against = touching or previous.last_normals  # the last fingers if none now
-        relative, sliding = speeds_against(
-            self._plant,
-            self._plant_context,
-            self._body,
-            [(self._bodies[k], n_W) for k, n_W in against],
-        )
-        if not touching:
-            relative = np.nan
+        relative = motion.relative if touching else np.nan
         uses = [f.friction_use for f in loads if not np.isnan(f.friction_use)]
-        holding, gap, last = next_holding_state(
-            previous.holding,
-            previous.contact_gap,
+        thresholds = self.settings.thresholds
+
+        def clearance() -> float:  # NaN when unmeasurable: never out of reach
+            try:
+                return hand_clearance(
+                    self._plant,
+                    query,
+                    object_body=self._body,
+                    fingers=self._bodies,
+                    horizon=2.0 * thresholds.release_distance,
+                )
+            except ModelError:
+                return np.nan
+
+        memory = next_holding_state(
+            previous.memory,
             touching=bool(touching),
-            grasped=report is not None and report.is_force_closure,
+            grasped=self._grasped(report, loads),
             friction_use=max(uses) if uses else np.nan,
             slip_speed=max(f.slip_speed for f in loads),
-            sliding_away=sliding,
-            last_grip=previous.last_grip,
-            thresholds=self.settings.thresholds,
+            sliding=motion.along,
+            slid=0.0 if touching else motion.slid,
+            clearance=clearance,
+            thresholds=thresholds,
         )
-        return holding, loads, (relative, sliding), gap, last, against
+        return memory, loads, (relative, motion.sliding), anchors
 
     def _update(self, context: Context, state: State) -> EventStatus:
         sample = self.evaluate(context)

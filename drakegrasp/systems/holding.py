@@ -1,53 +1,82 @@
-r"""Does the hand hold its object?  Loads, slip and the holding state of a grasp.
+r"""Does the hand hold its object?  The holding state of a grasp, with hysteresis.
 
 The closure verdicts of :class:`~drakegrasp.GraspMonitor` are geometric: they
 say what the contact positions, normals and μ *could* resist.  Whether the
-simulated hand *does* hold its object is a question for the plant's physics,
-and this module reads it:
+simulated hand *does* hold its object is read from the plant's physics
+(:mod:`drakegrasp.systems.sensing`: contact forces, slip speeds, the object's
+motion against the fingers and its distance from the hand) and judged here,
+one sample at a time, by :func:`next_holding_state`.
 
-- :func:`finger_loads_from_results` reads, per finger body, the contact force
-  that the plant's contact model applied to the object (``ContactResults``:
-  point pairs and hydroelastic surfaces), the **friction in use**
-  :math:`\|f_t\| / (\mu f_n)` with the plant's own friction coefficient μ of
-  the pair (1 means sliding: the force sits on the cone's boundary), and the
-  slip speed at the contact.
-- :func:`finger_motion_from_contacts` gives what geometry alone can see: the
-  slip and separation speeds of the object's contact points against the
-  fingers' material points, computed from the plant's velocities; forces, and
-  so friction in use, are unknown there (NaN).
-- :func:`next_holding_state` turns one sample's evidence and the previous
-  state into a :data:`HOLDING_STATES` value, holding contacts across a short
-  gap (hysteresis) so that one sample without contact does not read as a drop.
+**The states** (:data:`HOLDING_STATES`) are ordered by how alarming they are,
+and their codes on the vector port follow that order:
 
-Speeds are m/s, forces newtons.  A point pair's slip speed is Drake's own
-(``PointPairContactInfo.slip_speed()``); a hydroelastic surface carries no
-slip speed in a discrete plant's results, so it is computed from the bodies'
-spatial velocities at the surface's centroid, tangent to its mean normal.
+==============  ==============================================================
+``no contact``  no hand body touches the object (before a grasp, after a
+                release)
+``touching``    contact, but not a force-closure grasp
+``holding``     a force-closure grasp whose contacts stick, friction in use at
+                or below ``risk``
+``at risk``     such a grasp with friction in use above ``risk`` at a contact
+``slipping``    a contact slips faster than ``slip_speed``, or, without
+                contact, the object moves along the fingers that last held it
+                faster than that (and more along them than away from them)
+``dropped``     the object has left the fingers that last held it, *along*
+                them: contact has been lost for ``hold_samples + 1`` samples,
+                and either the object still slides along them (faster than
+                ``slip_speed``, more along than away from them) and is
+                farther than ``release_distance`` from every hand body, or it
+                has come to rest displaced along them by more than
+                ``release_distance`` since the last contact
+==============  ==============================================================
+
+A hand that opens moves its fingers away along their normals while the object
+stays: that is a release, ``no contact``, never ``dropped``, however the grip
+was doing before (a box set down on the ground loads the fingers' friction
+fully just before they open).
+
+**The hysteresis**, in full (``n = hold_samples``):
+
+1. A move to a *more* alarming state is immediate: the early warning is the
+   point of ``at risk`` and ``slipping``.  The one exception is ``dropped``,
+   gated as above, so with ``n >= 1`` (the default) a single sample without
+   contact never reads as a drop.
+2. A move from ``holding``, ``at risk``, ``slipping`` or ``dropped`` to a
+   *less* alarming state needs ``n + 1`` consecutive samples whose evidence is
+   less alarming than the state shown; the state then becomes the latest
+   sample's evidence.  So a grip neither flickers to ``no contact`` at one
+   missing frame, nor back to ``holding`` at one sticking frame of a slide,
+   nor out of ``dropped`` at one touch.
+3. While a grip's contact is missing for at most ``n`` samples, the monitor
+   also keeps showing the last analysis with contact (``contact_gap`` counts
+   these bridged samples).
+
+A sample's *evidence* is what it alone shows: with contact, ``slipping`` (slip
+above the threshold), else ``touching`` (no force closure), else ``at risk``
+or ``holding`` by friction in use; without contact after a grip, within the
+window ``slipping`` if the object moves along the fingers, else ``no
+contact``; after it, ``dropped`` as in the table, else ``slipping`` if it
+slides along the fingers within reach (a finger chattering along it), else
+``no contact`` (a release: the object at rest where the fingers left it).
+Motions along the fingers are measured in the frames of the fingers that
+touched the object last (:func:`~drakegrasp.systems.sensing.motion_against`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import QueryObject
-from pydrake.multibody.plant import ContactResults, MultibodyPlant
-from pydrake.systems.framework import Context
 
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.plant.contacts import PlantContact, _scoped_name
-from drakegrasp.plant.friction import pair_friction
 
 __all__ = [
     "HOLDING_STATES",
-    "FingerLoad",
+    "HoldingMemory",
     "HoldingThresholds",
-    "finger_loads_from_results",
-    "finger_motion_from_contacts",
     "holding_code",
     "next_holding_state",
-    "speeds_against",
 ]
 
 HOLDING_STATES = (
@@ -58,31 +87,17 @@ HOLDING_STATES = (
     "slipping",
     "dropped",
 )
-"""The holding states, in the order of their codes on the vector port (0 … 5).
+"""The holding states, least to most alarming, in the order of their codes on
+the vector port (0 … 5); see :mod:`drakegrasp.systems.holding` for their rules."""
 
-``no contact``: no hand body touches the object (before a grasp, or after a
-release where the object is at rest).  ``touching``: contact, but not a
-force-closure grasp.  ``holding``: a force-closure grasp whose contacts stick
-with friction in use at or below the risk threshold.  ``at risk``: such a
-grasp with friction in use above the threshold at some contact.
-``slipping``: some contact slips faster than the slip threshold.  ``dropped``:
-contact was lost while the grip was slipping or at risk, or while the object
-moved along the fingers that last touched it faster than the slip threshold
-(a hand that opens moves its fingers away along their normals: that is a
-release, and the state becomes ``no contact``); it stays until a hand body
-touches the object again.
-"""
-
-_NO_NORMAL = np.full(3, np.nan)
-_CODE = {name: float(k) for k, name in enumerate(HOLDING_STATES)}
+_RANK = {name: k for k, name in enumerate(HOLDING_STATES)}
 _GRIPPED = ("holding", "at risk", "slipping")
-FORCE_FLOOR = 1e-6
-"""Normal force (N) at or below which a reported pair carries no load."""
+_STICKY = _GRIPPED + ("dropped",)  # left towards a milder state only by hysteresis
 
 
 @dataclass(frozen=True)
 class HoldingThresholds:
-    """When a grip is at risk, slips, or has lost contact.
+    """When a grip is at risk, slips, or has left the hand; and the hysteresis.
 
     Attributes
     ----------
@@ -92,24 +107,35 @@ class HoldingThresholds:
     slip_speed : float
         Slip speed above which a contact slips, m/s (default 5 mm/s; a
         regularised friction model such as SAP's creeps at ~1e-4 m/s when it
-        sticks).
+        sticks).  Also the speed of the object along the fingers, without
+        contact, above which it is slipping away.
     separation_speed : float
         In ``contacts="geometry"``, a pair within the distance tolerance whose
         points move apart faster than this (m/s, default 5 mm/s) is not a
         contact.
     hold_samples : int
-        Samples without contact that still count as the previous grip
-        (default 1): contact is lost only at ``hold_samples + 1`` consecutive
-        samples without it.
+        The hysteresis, in samples (default 1): a grip's state is kept through
+        up to ``hold_samples`` samples without contact, and any move to a less
+        alarming state needs ``hold_samples + 1`` consecutive samples of
+        evidence for it.  0 turns the hysteresis off.
+    release_distance : float
+        Metres (default 2 mm): an object sliding along the fingers farther
+        than this from every hand body has left the hand, and one that has
+        come to rest farther than this along the fingers from where they last
+        touched it was dropped, not released.  It must exceed every gap at
+        which a contact still counts (the monitor refuses it at or below its
+        ``distance_tolerance``) and the chatter of a sliding finger (~0.3 mm
+        on the WSG-50's pads).
     """
 
     risk: float = 0.8
     slip_speed: float = 5e-3
     separation_speed: float = 5e-3
     hold_samples: int = 1
+    release_distance: float = 2e-3
 
     def __post_init__(self):
-        for name in ("risk", "slip_speed", "separation_speed"):
+        for name in ("risk", "slip_speed", "separation_speed", "release_distance"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float):
                 raise InvalidOptionError(f"{name} must be a real number, got {value!r}")
@@ -127,359 +153,149 @@ class HoldingThresholds:
 
 
 @dataclass(frozen=True)
-class FingerLoad:
-    """What one finger body does to the object in one sample.
+class HoldingMemory:
+    """What the holding state machine carries from one sample to the next.
 
     Attributes
     ----------
-    finger_body : str
-        Scoped name ``model::body``.
-    touching : bool
-        The finger presses on the object (a reported pair with normal force
-        above ``FORCE_FLOOR`` (1e-6 N); in geometry mode, a contact that is not
-        separating).
-    normal_force : float
-        Total normal force on the object, N (NaN when the source cannot see
-        forces).
-    tangential_force : float
-        Magnitude of the total tangential force on the object, N (NaN likewise).
-    mu : float
-        The plant's friction coefficient of the pair
-        (:func:`~drakegrasp.plant.friction.pair_friction`: Drake's combination of
-        the two geometries' coefficients; the largest ratio's pair when
-        several), NaN when unknown.
-    friction_use : float
-        Largest ``‖f_t‖/(μ f_n)`` over this finger's pairs (0 without load, NaN
-        when forces are unknown).
-    slip_speed : float
-        Largest tangential speed of the object against the finger at a
-        contact, m/s (0 without contact).
-    normal_W : (3,) float
-        Mean unit contact normal into the object, in the world frame W (NaN
-        without contact).
+    state : str
+        The state shown (one of :data:`HOLDING_STATES`).
+    lost : int
+        Consecutive samples without contact (0 in a sample with contact).
+    milder : int
+        Consecutive samples whose evidence was less alarming than ``state``
+        (the hysteresis' count towards leaving it).
+    last_grip : str
+        The state shown at the last sample with contact.
     """
 
-    finger_body: str
-    touching: bool
-    normal_force: float
-    tangential_force: float
-    mu: float
-    friction_use: float
-    slip_speed: float
-    normal_W: np.ndarray = field(default_factory=lambda: _NO_NORMAL.copy())
+    state: str = "no contact"
+    lost: int = 0
+    milder: int = 0
+    last_grip: str = "no contact"
+
+    def bridged(self, thresholds: HoldingThresholds) -> int:
+        """Samples without contact over which a grip's analysis is kept (else 0)."""
+        keep = self.state in _GRIPPED and 0 < self.lost <= thresholds.hold_samples
+        return self.lost if keep else 0
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
         return jsonable(self.__dict__)
 
 
-def _point_velocity(plant, plant_context, body, p_WP: np.ndarray) -> np.ndarray:
-    """Velocity in W of the material point of ``body`` at ``p_WP``, m/s."""
-    V = plant.EvalBodySpatialVelocityInWorld(plant_context, body)
-    p_WBo = plant.EvalBodyPoseInWorld(plant_context, body).translation()
-    return np.asarray(V.translational()) + np.cross(V.rotational(), p_WP - p_WBo)
-
-
-def _unit_or_nan(v: np.ndarray) -> np.ndarray:
-    norm = float(np.linalg.norm(v))
-    return v / norm if norm > 0 else _NO_NORMAL
-
-
-def _split(v: np.ndarray, n: np.ndarray) -> tuple[float, float]:
-    """(component along unit n, magnitude of the rest)."""
-    along = float(v @ n)
-    return along, float(np.linalg.norm(v - along * n))
-
-
-def finger_loads_from_results(
-    plant: MultibodyPlant,
-    plant_context: Context,
-    contact_results: ContactResults,
-    query_object: QueryObject,
-    *,
-    object_body,
-    fingers,
-) -> list[FingerLoad]:
-    """Per finger body, the force, friction in use and slip that a step reported.
-
-    Parameters
-    ----------
-    plant : MultibodyPlant
-    plant_context : Context
-        Holds the step's positions and velocities (slip of hydroelastic
-        surfaces is computed from them).
-    contact_results : ContactResults
-        The plant's contact results of the step.
-    query_object : QueryObject
-        Names the geometries and holds their proximity properties.
-    object_body : RigidBody
-    fingers : sequence of RigidBody
-        The hand bodies, in the order of the output.
-
-    Returns
-    -------
-    list of FingerLoad
-        One per finger body, in ``fingers`` order.  Forces are those the hand
-        applies to the object; pairs with bodies outside the hand are ignored.
-    """
-    inspector = query_object.inspector()
-    index = {b.index(): k for k, b in enumerate(fingers)}
-    # Per finger: force sum, normal-weighted sum, largest ratio (and its mu), slip.
-    f_sum = [np.zeros(3) for _ in fingers]
-    fn_sum = [0.0] * len(fingers)
-    ratio = [0.0] * len(fingers)
-    mus = [np.nan] * len(fingers)
-    slip = [0.0] * len(fingers)
-    pressed = [False] * len(fingers)
-    n_sum = [np.zeros(3) for _ in fingers]
-
-    def body_of(gid):
-        return plant.GetBodyFromFrameId(inspector.GetFrameId(gid))
-
-    def record(k, f_W, n_W, mu, slip_speed):
-        f_n, f_t = _split(f_W, n_W)
-        f_sum[k] += f_W
-        fn_sum[k] += f_n
-        if f_n > FORCE_FLOOR:
-            pressed[k] = True
-            n_sum[k] += f_n * n_W
-            r = f_t / (mu * f_n) if mu > 0 else np.inf
-            if r >= ratio[k]:
-                ratio[k], mus[k] = r, mu
-            slip[k] = max(slip[k], slip_speed)
-        elif np.isnan(mus[k]):
-            mus[k] = mu
-
-    obj = object_body.index()
-    for i in range(contact_results.num_point_pair_contacts()):
-        info = contact_results.point_pair_contact_info(i)
-        pp = info.point_pair()
-        a, b = info.bodyA_index(), info.bodyB_index()
-        if a == obj and b in index:  # force on B is contact_force(); nhat_BA into A
-            k, f_W, n_W = index[b], -np.asarray(info.contact_force()), pp.nhat_BA_W
-        elif b == obj and a in index:
-            k, f_W, n_W = index[a], np.asarray(info.contact_force()), -pp.nhat_BA_W
-        else:
-            continue
-        mu = pair_friction(plant, query_object, pp.id_A, pp.id_B)
-        record(k, f_W, np.asarray(n_W), mu, float(info.slip_speed()))
-    for i in range(contact_results.num_hydroelastic_contacts()):
-        info = contact_results.hydroelastic_contact_info(i)
-        surface = info.contact_surface()
-        m, n = body_of(surface.id_M()), body_of(surface.id_N())
-        F_on_M = np.asarray(info.F_Ac_W().translational())  # on M's body, at c
-        if m.index() == obj and n.index() in index:
-            k, finger, f_W, sign = index[n.index()], n, F_on_M, 1.0
-        elif n.index() == obj and m.index() in index:
-            k, finger, f_W, sign = index[m.index()], m, -F_on_M, -1.0
-        else:
-            continue
-        mesh = surface.tri_mesh_W() if surface.is_triangle() else surface.poly_mesh_W()
-        normal = sum(
-            mesh.area(f) * np.asarray(mesh.face_normal(f))
-            for f in range(mesh.num_faces())
-        )
-        n_W = sign * normal / np.linalg.norm(normal)  # face normals: out of N, into M
-        c_W = np.asarray(surface.centroid())
-        v_rel = _point_velocity(plant, plant_context, object_body, c_W)
-        v_rel = v_rel - _point_velocity(plant, plant_context, finger, c_W)
-        mu = pair_friction(plant, query_object, surface.id_M(), surface.id_N())
-        record(k, f_W, n_W, mu, _split(v_rel, n_W)[1])
-    out = []
-    for k, body in enumerate(fingers):
-        f_n = fn_sum[k]
-        out.append(
-            FingerLoad(
-                finger_body=_scoped_name(plant, body),
-                touching=pressed[k],
-                normal_force=f_n,
-                tangential_force=float(
-                    np.sqrt(max(float(f_sum[k] @ f_sum[k]) - f_n * f_n, 0.0))
-                ),
-                mu=mus[k],
-                friction_use=ratio[k],
-                slip_speed=slip[k],
-                normal_W=_unit_or_nan(n_sum[k]),
-            )
-        )
-    return out
-
-
-def finger_motion_from_contacts(
-    plant: MultibodyPlant,
-    plant_context: Context,
-    contacts: list[PlantContact],
-    *,
-    object_body,
-    fingers,
-    separation_speed: float,
-) -> tuple[list[PlantContact], list[FingerLoad]]:
-    """Keep the contacts that are not separating; per finger, their slip.
-
-    A contact found within the distance tolerance counts only if its object
-    point does not move away from the finger's material point (``p_FC``) along
-    the inward normal faster than ``separation_speed``.
-
-    Parameters
-    ----------
-    plant, plant_context
-        ``plant_context`` holds positions and velocities.
-    contacts : list of PlantContact
-        From :func:`drakegrasp.find_contacts` (positions and normals in O).
-    object_body : RigidBody
-    fingers : sequence of RigidBody
-    separation_speed : float
-        m/s, > 0.
-
-    Returns
-    -------
-    kept : list of PlantContact
-        The contacts that are not separating, in their order.
-    loads : list of FingerLoad
-        Per finger body; forces, μ and friction in use are NaN (geometry sees
-        no force), ``slip_speed`` the largest tangential speed over the kept
-        contacts.
-    """
-    X_WO = plant.EvalBodyPoseInWorld(plant_context, object_body)
-    R_WO = X_WO.rotation().matrix()
-    position = {b.index(): k for k, b in enumerate(fingers)}
-    slip = [0.0] * len(fingers)
-    touching = [False] * len(fingers)
-    n_sum = [np.zeros(3) for _ in fingers]
-    kept = []
-    for c in contacts:
-        finger = plant.get_body(c.finger_body_index)
-        p_WC = np.asarray(X_WO.multiply(c.p_OC))
-        p_WF = np.asarray(
-            plant.EvalBodyPoseInWorld(plant_context, finger).multiply(c.p_FC)
-        )
-        n_W = R_WO @ c.nhat_O  # into the object: from the finger towards it
-        v_rel = _point_velocity(plant, plant_context, object_body, p_WC)
-        v_rel = v_rel - _point_velocity(plant, plant_context, finger, p_WF)
-        apart, sliding = _split(v_rel, n_W)
-        if apart > separation_speed:
-            continue
-        kept.append(c)
-        k = position[c.finger_body_index]
-        touching[k] = True
-        n_sum[k] += n_W
-        slip[k] = max(slip[k], sliding)
-    loads = [
-        FingerLoad(
-            finger_body=_scoped_name(plant, b),
-            touching=touching[k],
-            normal_force=np.nan,
-            tangential_force=np.nan,
-            mu=np.nan,
-            friction_use=np.nan,
-            slip_speed=slip[k],
-            normal_W=_unit_or_nan(n_sum[k]),
-        )
-        for k, b in enumerate(fingers)
-    ]
-    return kept, loads
-
-
-def speeds_against(
-    plant: MultibodyPlant, plant_context: Context, object_body, fingers
-) -> tuple[float, float]:
-    """How fast the object's centre of mass moves against the given fingers.
-
-    Parameters
-    ----------
-    fingers : sequence of (RigidBody, (3,) float)
-        Finger bodies with their unit contact normal (into the object, in W).
-
-    Returns
-    -------
-    relative : float
-        Largest speed of the centre of mass measured in a finger's frame
-        (the velocity of the centre of mass minus that of the finger's
-        material point there), m/s; NaN without fingers.
-    sliding : float
-        Largest such speed with its component along the finger's normal
-        removed: the object moving *along* the finger, as when it slides out,
-        not away from it, as when the hand opens.  m/s, 0 without fingers.
-    """
-    p_WScm = np.asarray(
-        plant.EvalBodyPoseInWorld(plant_context, object_body).multiply(
-            object_body.CalcCenterOfMassInBodyFrame(plant_context)
-        )
-    )
-    v_W = _point_velocity(plant, plant_context, object_body, p_WScm)
-    relative, sliding = [], []
-    for finger, n_W in fingers:
-        v_rel = v_W - _point_velocity(plant, plant_context, finger, p_WScm)
-        relative.append(float(np.linalg.norm(v_rel)))
-        sliding.append(_split(v_rel, n_W)[1])
-    if not fingers:
-        return np.nan, 0.0
-    return max(relative), max(sliding)
-
-
-def next_holding_state(
-    previous: str,
-    gap: int,
+def _evidence(
+    memory: HoldingMemory,
     *,
     touching: bool,
     grasped: bool,
     friction_use: float,
     slip_speed: float,
-    sliding_away: float,
-    last_grip: str,
+    sliding: float,
+    slid: float,
+    clearance: Callable[[], float],
     thresholds: HoldingThresholds,
-) -> tuple[str, int, str]:
-    """One step of the holding state machine.
+) -> str:
+    """What this sample alone shows (rules in the module docstring)."""
+    if touching:
+        if slip_speed > thresholds.slip_speed:
+            return "slipping"
+        if not grasped:
+            return "touching"
+        if friction_use > thresholds.risk:  # False for NaN: geometry sees no force
+            return "at risk"
+        return "holding"
+    if memory.state == "dropped":
+        return "dropped"
+    if memory.state not in _GRIPPED:
+        return "no contact"
+    moving = sliding > thresholds.slip_speed
+    if memory.lost + 1 > thresholds.hold_samples:  # contact lost for good
+        if moving:  # sliding out: dropped once clear of the hand
+            out = clearance() > thresholds.release_distance
+            return "dropped" if out else "slipping"
+        # At rest: moved off its place along the fingers, or released.
+        return "dropped" if slid > thresholds.release_distance else "no contact"
+    return "slipping" if moving else "no contact"
+
+
+def next_holding_state(
+    memory: HoldingMemory,
+    *,
+    touching: bool,
+    grasped: bool,
+    friction_use: float,
+    slip_speed: float,
+    sliding: float,
+    slid: float,
+    clearance: Callable[[], float],
+    thresholds: HoldingThresholds,
+) -> HoldingMemory:
+    """One step of the holding state machine (rules in the module docstring).
 
     Parameters
     ----------
-    previous : str
-        The state of the previous sample (one of :data:`HOLDING_STATES`).
-    gap : int
-        Consecutive samples without contact bridged so far.
+    memory : HoldingMemory
+        After the previous sample (``HoldingMemory()`` before the first).
     touching : bool
-        Some finger touches the object in this sample.
+        Some hand body touches the object in this sample.
     grasped : bool
         The analysed contacts are in force closure.
-    friction_use, slip_speed : float
-        Largest over the fingers (``friction_use`` NaN when unknown: then
+    friction_use : float
+        Largest ``‖f_t‖/(μ f_n)`` over the fingers; NaN when unknown (then
         never at risk).
-    sliding_away : float
-        Without contact: how fast the object's centre of mass moves along the
-        fingers that touched it last (:func:`speeds_against`), m/s.
-    last_grip : str
-        The last state with contact (what a lost contact is judged by).
+    slip_speed : float
+        Largest slip speed at a contact, m/s.
+    sliding : float
+        Speed of the object's centre of mass along the touching fingers, or
+        without contact the fingers that touched it last, counted only where
+        it moves more along a finger than away from it (``Motion.along`` of
+        :func:`~drakegrasp.systems.sensing.motion_against`), m/s.
+    slid : float
+        Without contact: how far the centre of mass has moved along those
+        fingers since the last contact, m (0 with contact).
+    clearance : callable () -> float
+        The object's distance from the hand, m
+        (:func:`~drakegrasp.systems.sensing.hand_clearance`); called only
+        without contact, once a grip's hysteresis window has passed, while the
+        object slides along the fingers.
     thresholds : HoldingThresholds
 
     Returns
     -------
-    state : str
-    gap : int
-        Samples without contact bridged, including this one (0 with contact).
-    last_grip : str
-        Updated.
+    HoldingMemory
+        The state of this sample and the counts carried to the next.
     """
-    if touching:
-        if slip_speed > thresholds.slip_speed:
-            state = "slipping"
-        elif not grasped:
-            state = "touching"
-        elif friction_use > thresholds.risk:  # False for NaN
-            state = "at risk"
+    if memory.state not in _RANK:
+        raise InvalidOptionError(
+            f"unknown holding state {memory.state!r}; one of {HOLDING_STATES}"
+        )
+    evidence = _evidence(
+        memory,
+        touching=touching,
+        grasped=grasped,
+        friction_use=friction_use,
+        slip_speed=slip_speed,
+        sliding=sliding,
+        slid=slid,
+        clearance=clearance,
+        thresholds=thresholds,
+    )
+    state, milder = evidence, 0
+    if memory.state in _STICKY and _RANK[evidence] < _RANK[memory.state]:
+        milder = memory.milder + 1
+        if milder <= thresholds.hold_samples:
+            state = memory.state
         else:
-            state = "holding"
-        return state, 0, state
-    moving = sliding_away > thresholds.slip_speed
-    if previous in _GRIPPED and gap < thresholds.hold_samples:
-        return ("slipping" if moving else previous), gap + 1, last_grip
-    if previous == "dropped":
-        return "dropped", 0, last_grip
-    lost_grip = last_grip in ("slipping", "at risk") or previous == "slipping"
-    if last_grip in _GRIPPED and (lost_grip or moving):
-        return "dropped", 0, last_grip
-    return "no contact", 0, "no contact"
+            milder = 0
+    return HoldingMemory(
+        state=state,
+        lost=0 if touching else memory.lost + 1,
+        milder=milder,
+        last_grip=state if touching else memory.last_grip,
+    )
 
 
 def holding_code(state: str) -> float:
     """The vector-port code of a holding state (its index in HOLDING_STATES)."""
-    return _CODE[state]
+    return float(_RANK[state])

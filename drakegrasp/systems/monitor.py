@@ -39,10 +39,14 @@ same instant, so geometry and kinematics agree).
   ``separation_speed``.  A simulated contact penetrates a little (point
   contact: ~0.1 mm for newtons of squeeze), so choose ``distance_tolerance``
   above that (1e-3 m is a good start) or pass ``allow_penetration=True``.
-  *It sees* positions, normals and velocities, hence slip; *it cannot see*
-  forces: a finger within the tolerance that carries no load still counts, and
-  friction in use is NaN, so a grip is never "at risk", only "slipping" once it
-  moves.
+  *It sees* positions, normals and velocities, hence slip, and whether a
+  finger's geometry touches the object's (``ψ <= 0``: the plant pushes only
+  there); *it cannot see* forces.  So the analysis counts a finger within the
+  tolerance that carries no load (the contact geometry is there), but the
+  holding state counts only fingers that touch: fingers stopped 0.5 mm short
+  of a box are analysed in force closure and are ``no contact``, never
+  ``holding``.  Friction in use is NaN, so a grip is never "at risk", only
+  "slipping" once it moves.
 - ``"contact_results"``: the contacts the plant's contact model used in the
   last step, read from the ``contact_results`` input
   (:func:`drakegrasp.plant.contacts_from_results`): with hydroelastic contact
@@ -52,16 +56,37 @@ same instant, so geometry and kinematics agree).
   properties, :func:`~drakegrasp.plant.friction.pair_friction`, not the ``mu``
   option), and a grip nearing its friction limit is
   "at risk" before it slips.  *It cannot see* contacts the step did not
-  compute (a hydroelastic surface has one net force, not a distribution), and
-  it depends on a simulator's context: a fresh context has no results.
+  compute (a hydroelastic surface has one net force, not a distribution), nor
+  a contact between two steps: a finger chattering along the object is in
+  the results only at some samples (the WSG-50's pads sliding up a box: about
+  one 10 ms sample in eight), which the holding state's hysteresis and its
+  out-of-reach test bridge.  It depends on a simulator's context: a fresh
+  context has no results.
+
+In both modes, once contact is lost the holding state follows the object in
+the frames of the fingers that touched it last, and, while it slides along
+them, measures its distance from every hand body (Drake's signed distances, up
+to twice ``release_distance``), to tell a grip that is merely missing a frame
+from an object that has left the hand.
 
 **Holding.**  Each sample also judges the grip
-(:mod:`drakegrasp.systems.holding`): ``no contact``, ``touching``, ``holding``,
-``at risk`` (friction in use above ``risk``), ``slipping`` (a contact slips
-faster than ``slip_speed``) or ``dropped``.  A sample without contact after a
-grip keeps the last grip's analysis and state for ``hold_samples`` samples
-(hysteresis), so one frame without contact is not a drop.  These thresholds
-are a :class:`~drakegrasp.systems.holding.HoldingThresholds` (``holding=``).
+(:mod:`drakegrasp.systems.holding`, where the rules are in full):
+``no contact``, ``touching``, ``holding``, ``at risk`` (friction in use above
+``risk``), ``slipping`` (a contact slips faster than ``slip_speed``, or the
+object moves along the fingers without contact) or ``dropped`` (the object has
+left the fingers that last held it, along them: no contact for
+``hold_samples + 1`` samples, and either still sliding along them and farther
+than ``release_distance`` from every hand body, or at rest displaced along them
+by more than ``release_distance`` since the last contact; a hand that opens
+around an object at rest moves its fingers away along their normals: a
+release, ``no contact``).  The hysteresis: a more alarming state is shown at
+once (``dropped`` only through its own gate), a less alarming one only after
+``hold_samples + 1`` consecutive samples whose evidence is less alarming, and
+for up to ``hold_samples`` samples without contact the last grip's analysis is
+kept.  So one frame without contact is not a drop, and the state does not
+flicker between ``slipping``, ``dropped`` and ``holding`` on consecutive
+samples.  These thresholds are a
+:class:`~drakegrasp.systems.holding.HoldingThresholds` (``holding=``).
 
 **What d* is.**  LP2's ``d*`` is the geometric distance of the best internal
 force to the boundaries of the friction cones: it depends on the contacts'
@@ -96,12 +121,15 @@ speed:
 ``num_contacts``     number of contacts analysed
 ``d_star``           LP2's ``d*``, 0 without contact (see "What d* is")
 ``epsilon``          Ferrari–Canny ε (L1), 0 when not in force closure or not
-                     asked for (``compute_epsilon=False``, the default)
+                     asked for (``compute_epsilon=False``, the default; when
+                     asked, the batch engine's compiled kernel computes it,
+                     about 1 ms on 8 contacts)
 ``holding``          code of the holding state (index in ``HOLDING_STATES``)
 ``friction_use``     largest ``‖f_t‖/(μ f_n)``; NaN in geometry mode
 ``slip_speed``       largest slip speed at a contact, m/s
 ``relative_speed``   object's centre of mass relative to a touching finger, m/s
-``contact_gap``      samples without contact bridged by the hysteresis
+``contact_gap``      samples without contact bridged by the hysteresis (the
+                     analysis shown is then the last one with contact)
 ===================  ===========================================================
 
 ``report`` is an abstract port holding a :class:`GraspSample`: the time, the

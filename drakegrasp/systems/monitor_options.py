@@ -130,8 +130,9 @@ def monitor_settings(
     InvalidOptionError
         For a missing ``mu`` (or a soft finger's ``ν``), any invalid analysis
         option, an unknown contact source, a period or offset that is not
-        finite seconds in range, a flag that is not a bool, or ``holding``
-        that is not a :class:`~drakegrasp.HoldingThresholds`.
+        finite seconds in range, a flag that is not a bool, ``holding``
+        that is not a :class:`~drakegrasp.HoldingThresholds`, or its
+        ``release_distance`` at or below ``distance_tolerance``.
     """
     if not isinstance(contacts, str) or contacts not in CONTACT_SOURCES:
         raise InvalidOptionError(
@@ -142,8 +143,15 @@ def monitor_settings(
         raise InvalidOptionError(
             f"holding must be a HoldingThresholds, got {type(holding).__name__}"
         )
+    analysis = resolve_options(options, **analysis_keywords).require_friction()
+    if holding.release_distance <= analysis.distance_tolerance:
+        raise InvalidOptionError(
+            f"holding.release_distance = {holding.release_distance:g} m must exceed "
+            f"distance_tolerance = {analysis.distance_tolerance:g} m: a gap at which "
+            "a contact still counts cannot mean the object has left the hand"
+        )
     return MonitorSettings(
-        analysis=resolve_options(options, **analysis_keywords).require_friction(),
+        analysis=analysis,
         contacts=contacts,
         period=seconds("period", period, least=MIN_PERIOD),
         offset=seconds("offset", offset, least=0.0),

@@ -8,7 +8,8 @@ from typing import Any
 import numpy as np
 
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.systems.holding import FingerLoad, holding_code
+from drakegrasp.systems.finger_loads import FingerLoad
+from drakegrasp.systems.holding import HoldingMemory, holding_code
 
 __all__ = ["HOLDING_NAMES", "VERDICT_NAMES", "GraspSample", "verdict_names"]
 
@@ -118,15 +119,15 @@ class GraspSample:
         Largest speed of the object's centre of mass along (normal component
         removed) the touching fingers, or without contact the fingers that
         touched it last, m/s.
-    last_normals : tuple of (int, (3,) float)
-        The touching fingers (index in the hand's bodies) and their contact
-        normals in W, or the last ones while there is no contact.
+    anchors : tuple of FingerAnchor
+        Where the object sat on each touching finger (in the finger's frame),
+        or on the fingers that touched it last while there is no contact.
     contact_gap : int
         Consecutive samples without contact that the hysteresis bridged (the
-        analysis and holding state shown are then the last sample's with
-        contact).
-    last_grip : str
-        The holding state of the last sample with contact.
+        analysis shown is then the last one with contact); 0 otherwise.
+    memory : HoldingMemory
+        What the holding state machine carries to the next sample (the
+        state, samples without contact, the hysteresis count, the last grip).
     names : tuple of str
         Names of ``verdicts``' elements.
     verdicts : (len(names),) float
@@ -147,8 +148,8 @@ class GraspSample:
     relative_speed: float
     sliding_speed: float
     contact_gap: int
-    last_grip: str
-    last_normals: tuple
+    memory: HoldingMemory
+    anchors: tuple
     names: tuple[str, ...]
     verdicts: np.ndarray
     state: np.ndarray
@@ -180,6 +181,7 @@ class GraspSample:
             "relative_speed": jsonable(self.relative_speed),
             "sliding_speed": jsonable(self.sliding_speed),
             "contact_gap": self.contact_gap,
+            "memory": self.memory.to_dict(),
             "state": jsonable(self.state),
             "seconds": self.seconds,
             "report": None if self.report is None else self.report.to_dict(),

@@ -34,6 +34,16 @@ class Timeline:
                 return float(t)
         return np.inf
 
+    def codes(self, start: float, stop: float) -> np.ndarray:
+        """Holding-state codes (HOLDING_STATES indices) of samples in [start, stop)."""
+        return np.array(
+            [
+                HOLDING_STATES.index(s)
+                for t, s in zip(self.times, self.states, strict=True)
+                if start <= t < stop
+            ]
+        )
+
     def moved(self, distance: float, after: float) -> float:
         """First sample time at or after ``after`` with displacement >= distance."""
         hit = np.flatnonzero((self.times >= after) & (self.displacement >= distance))

@@ -9,12 +9,16 @@ the monitor: its displacement in the left finger's frame since the lift began
 (t = 1.0 s) and its height.
 """
 
+import numpy as np
 import pytest
 from holding_support import FLAGS, timeline
 from pick_support import OPEN, build_pick
 
+from drakegrasp.systems.holding import HOLDING_STATES
+
 LIFT_START = 1.0
 MOVED = 5e-3  # m
+NEAR = 0.0255  # fingers 0.5 mm short of the 50 mm box: within the 1 mm tolerance
 POINT = {
     "plant_contact": "point",
     "contact_model": "soft_finger",
@@ -56,17 +60,18 @@ def test_weak_pick_is_flagged_before_it_moves_5_mm_and_dropped_after(case):
         f"{case}: flagged {flagged:.3f} s, moved 5 mm {moved:.3f} s, "
         f"dropped {dropped:.3f} s"
     )
-    assert moved < 1.3  # the box did slip out of the fingers
-    assert flagged < moved
-    assert flagged <= dropped < 1.5  # and the drop follows the flag
-    # Once dropped, never holding again while the hand stays up.
-    up = (line.times >= dropped) & (line.times < 1.8)
-    assert "holding" not in [s for s, u in zip(line.states, up, strict=True) if u]
+    assert moved < 1.3  # the fingers did slide along the box
+    assert flagged < moved < dropped < 1.5  # dropped: the pads left the box
+    # No flicker: from the lift until the hand stops, the state only grows
+    # more alarming, and it stays dropped while the hand is up.
+    codes = line.codes(LIFT_START, 1.8)  # the hand goes down again from 1.8 s
+    assert np.all(np.diff(codes) >= 0), line.states
+    assert codes[-1] == HOLDING_STATES.index("dropped")
 
 
+@pytest.mark.parametrize("closed", [OPEN, NEAR], ids=["open", "0.5 mm short"])
 @pytest.mark.parametrize("case", list(CASES))
-def test_box_at_rest_between_open_fingers_is_never_holding(case):
-    line = _run(OPEN, CASES[case], until=1.6)
+def test_box_at_rest_between_open_fingers_is_never_holding(case, closed):
+    line = _run(closed, CASES[case], until=1.6)
     assert line.displacement.max() < 1e-3 or line.height.max() < 0.0505
-    assert "holding" not in line.states
-    assert set(line.states) <= {"no contact", "touching"}
+    assert set(line.states) == {"no contact"}, set(line.states)

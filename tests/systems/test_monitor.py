@@ -168,8 +168,9 @@ def test_point_contact_monitor_matches_analyze_grasp(point_pick):
     assert X.shape[1] == round(DURATION / point_pick.monitor.period) + 1
     for k in range(X.shape[1] - 1):
         expected = _second_route(point_pick, X[:, k], **OPTIONS, **SOFT)
-        if V[GraspMonitor.CONTACT_GAP, k + 1] > 0:  # a bridged gap: the last grip
-            expected = _second_route(point_pick, X[:, k - 1], **OPTIONS, **SOFT)
+        gap = int(V[GraspMonitor.CONTACT_GAP, k + 1])
+        if gap > 0:  # a bridged gap: the analysis of the last sample with contact
+            expected = _second_route(point_pick, X[:, k - gap], **OPTIONS, **SOFT)
         np.testing.assert_allclose(
             V[: len(VERDICT_NAMES), k + 1],
             expected,
@@ -225,6 +226,20 @@ def test_hydroelastic_pick_timeline(hydro_pick):
     assert _runs(closure) == [0.0, 1.0, 0.0]
     # Hard fingers: two flat patches (a 4-vertex polygon each) resist torsion.
     assert set(V[GraspMonitor.NUM_CONTACTS][closure == 1.0]) == {8.0}
+
+
+@pytest.mark.parametrize("fixture", ["point_pick", "hydro_pick"])
+def test_opening_the_hand_is_a_release_not_a_drop(fixture, request):
+    # The box is set down (1.8 - 2.3 s) and the hand opens (2.3 - 2.6 s): the
+    # grip ends in "no contact", never "dropped" (the box did not fall).
+    pick = request.getfixturevalue(fixture)
+    pick = pick[0] if isinstance(pick, tuple) else pick
+    log = pick.verdict_log.FindLog(pick.simulator.get_context())
+    times, codes = log.sample_times(), log.data()[GraspMonitor.HOLDING]
+    states = [dg.HOLDING_STATES[int(c)] for c in codes]
+    assert "dropped" not in states
+    assert "holding" in states
+    assert {s for t, s in zip(times, states, strict=True) if t > 2.7} == {"no contact"}
 
 
 def test_hydroelastic_patches_match_the_geometry(hydro_pick):

@@ -79,6 +79,22 @@ def test_holding_must_be_thresholds(pick):
         GraspMonitor(pick.plant, object_body=BOX, mu=0.5, holding={"risk": 0.5})
 
 
+def test_release_distance_must_exceed_the_distance_tolerance(pick):
+    # A gap at which a contact still counts cannot mean the object has left.
+    holding = HoldingThresholds(release_distance=1e-3)
+    with pytest.raises(InvalidOptionError, match="release_distance"):
+        GraspMonitor(
+            pick.plant,
+            object_body=BOX,
+            mu=0.5,
+            distance_tolerance=1e-3,
+            holding=holding,
+        )
+    GraspMonitor(  # just above it is fine
+        pick.plant, object_body=BOX, mu=0.5, distance_tolerance=9e-4, holding=holding
+    )
+
+
 def test_two_monitors_in_one_diagram_have_unique_names():
     pick = build_pick(mu=0.5, distance_tolerance=1e-3)  # one monitor already
     builder = DiagramBuilder()

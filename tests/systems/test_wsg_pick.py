@@ -8,6 +8,7 @@ plant states, apart from the monitor (``holding_support.timeline``).  The
 monitor reads μ from the plant (``mu="plant"``).
 """
 
+import numpy as np
 import pytest
 from holding_support import FLAGS, timeline
 from wsg_pick_support import (
@@ -19,7 +20,10 @@ from wsg_pick_support import (
     build_wsg_pick,
 )
 
+from drakegrasp.systems.monitor import GraspMonitor
+
 MOVED = 5e-3  # m
+NEAR = -5e-4  # squeeze: the fingers stop 0.5 mm short of the box faces
 PADS_OFF = 1.45  # s: by then the weak pick's pads have slid off the box top
 MODES = ["contact_results", "geometry"]
 
@@ -61,8 +65,22 @@ def test_weak_wsg_pick_is_flagged_before_it_moves_5_mm_and_dropped_after(
     )
     assert line.height.max() < BOX_HALF_HEIGHT + 5e-4  # it never left the ground
     assert moved < LIFT_START + 0.2  # the fingers slid along it
-    assert flagged < moved
-    assert flagged <= dropped < PADS_OFF
-    after = [s for t, s in zip(line.times, line.states, strict=True) if t >= flagged]
-    assert "holding" not in after
+    assert flagged < moved < dropped < PADS_OFF
+    # The pads chatter along the box (contact in ~1 sample of 8), yet the state
+    # never flickers: it only grows more alarming from the lift to the end.
+    codes = line.codes(LIFT_START, 2.0)
+    assert np.all(np.diff(codes) >= 0), line.states
     assert line.states[-1] == "dropped"  # the pads have left the box
+
+
+@pytest.mark.parametrize("contacts", MODES)
+def test_box_between_fingers_that_stop_short_of_it_is_never_holding(
+    drake_models_dir, contacts
+):
+    # The pads stop 0.5 mm short of the box: within the 1 mm distance
+    # tolerance, so the geometric analysis sees contacts, but nothing presses.
+    line = _run(drake_models_dir, NEAR, contacts)
+    assert line.height.max() < BOX_HALF_HEIGHT + 5e-4  # it stays on the ground
+    assert set(line.states) == {"no contact"}, set(line.states)
+    if contacts == "geometry":
+        assert line.verdicts[GraspMonitor.NUM_CONTACTS].max() > 0
