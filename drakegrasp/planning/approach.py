@@ -254,9 +254,14 @@ def multi_finger_hand(
     else:
         q0 = _vector("preshape", preshape, n)
     q0 = np.clip(structure.coupling.apply(q0), structure.lower, structure.upper)
+    curl_synergy = isinstance(synergy, str)
+    if curl_synergy and synergy != "curl":
+        raise InvalidOptionError(
+            f"synergy must be n_h = {n} numbers or 'curl', got {synergy!r}"
+        )
     syn = (
         None
-        if synergy is None
+        if synergy is None or curl_synergy
         else structure.coupling.project(_vector("synergy", synergy, n))
     )
     if syn is not None and not np.any(syn):
@@ -281,7 +286,12 @@ def multi_finger_hand(
             ]
         )
 
-    centre = tips(_curl(tips, q0, structure)).mean(axis=0)
+    q_curled = _curl(tips, q0, structure)
+    centre = tips(q_curled).mean(axis=0)
+    if curl_synergy:
+        syn = q_curled - q0
+        if not np.any(syn):
+            raise ModelError("the hand's fingertips cannot move towards each other")
     palm = _centres(plant, ctx, inspector, H, [base])
     p_palm = np.mean(palm, axis=0) if palm else np.zeros(3)
     if approach is None:
