@@ -12,15 +12,24 @@ fingers and closing joints are those of :mod:`drakegrasp.plant.fingers`.
 **Pre-shape.**  The closing joints' values from which ``close_hand`` starts:
 the *open hand* (the joint values in the context given to the planner), a
 user's ``preshape`` vector, or either moved along a *synergy* direction ``s``
-by an amount drawn per pose, ``q = clip(q_0 + σ s)``, ``σ ~ U[σ_lo, σ_hi]``.
-Couplings are applied and the result is clipped to the joint limits.
+by an amount drawn per pose, ``q = clip(q_0 + σ s)``, ``σ ~ U[σ_lo, σ_hi]``
+(``synergy="curl"`` takes ``s = q_c − q_0``, the curl below).  Couplings are
+applied and the result is clipped to the joint limits.
 
-**The grasp frame K** (fixed in H, at the base pre-shape ``q_0``): its x axis
-is the *approach* ``u``, from the palm towards the fingers' grasp centre ``c``
-(the mean of the fingertips' collision-geometry centres; a user may give
-``u``); its origin the point of the palm's centre line through ``c`` (``c``
-minus its reach ``L = (c − p_palm)·u`` along ``u``).  ``p_palm`` is the mean
-centre of the base's collision geometries (the base origin without any).
+**The curl** ``q_c``: the fingers drawn together from ``q_0`` by projected
+gradient descent of the fingertips' spread ``Σ_f |t_f(q) − t̄|²`` (``t_f`` the
+mean centre of finger ``f``'s tip collision geometries in H), within the
+limits: where the fingers meet when the hand closes on nothing, whatever the
+signs of its joints.
+
+**The grasp frame K** (fixed in H): its x axis is the *approach* ``u``, from
+the palm towards the *grasp centre* ``c`` (the fingertips' mean at the curl;
+a user may give ``u``); its origin the point of the palm's centre line
+through ``c`` (``c`` minus its reach ``L = (c − p_palm)·u`` along ``u``).
+``p_palm`` is the mean centre of the base's collision geometries (the base
+origin without any).  For the Allegro hand with its thumb opposed, ``u``
+leans from the fingers' direction towards the palm's face; for a hand whose
+fingers surround an axis (drakegrasp's three-finger hand), it is that axis.
 
 **Poses.**  For a surface point ``p`` with outward normal ``n`` (area-uniform
 over the object's collision geometry, :mod:`drakegrasp.planning.surface`), the
@@ -222,9 +231,9 @@ def multi_finger_hand(
     preshape : (n_h,) float, optional
         The pre-shape over the closing joints (order of
         ``structure.names``); default the context's.
-    synergy : (n_h,) float, optional
+    synergy : (n_h,) float or "curl", optional
         A direction the pre-shape moves along by an amount drawn in
-        ``synergy_range`` per pose.
+        ``synergy_range`` per pose (``"curl"``: towards the curl).
     synergy_range : (2,) float, optional
     approach : (3,) float, optional
         The approach direction in H; default from the palm to the grasp
