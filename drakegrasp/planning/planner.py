@@ -43,7 +43,7 @@ from drakegrasp.core.validation import (
     check_distance_tolerance,
     real_scalar,
 )
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.candidates import GraspCandidates
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
@@ -308,6 +308,12 @@ def plan_grasps(
         points, normals, dropped = read_cloud(
             point_cloud, cloud_normals, viewpoint=viewpoint
         )
+        if not hand_is_parallel_jaw(plant, ctx, plant.world_body(), hand):
+            raise ModelError(
+                "a point cloud is planned for with a parallel jaw (two fingers of "
+                "one prismatic joint each); multi-finger hands plan on an object "
+                "body (object_body=...)"
+            )
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface = CloudSurface(points, normals, viewpoint=viewpoint)
         X_WO = RigidTransform(surface.centroid)

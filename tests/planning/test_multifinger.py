@@ -321,3 +321,14 @@ def test_three_finger_top_candidates_hold_and_random_ones_less(three_result):
     )  # fmt: skip
     assert top == 1.0
     assert rand < top
+
+
+def test_a_multi_finger_hand_on_a_point_cloud_is_refused():
+    scene = planning_scene(None, hand_url=THREE)
+    cloud = np.random.default_rng(0).standard_normal((200, 3))
+    cloud = 0.03 * cloud / np.linalg.norm(cloud, axis=1, keepdims=True)
+    with pytest.raises(ModelError, match="object body"):
+        plan_grasps(
+            scene.plant, scene.context, None, hand=scene.hand, num_candidates=5,
+            mu=MU, point_cloud=cloud,
+        )  # fmt: skip
