@@ -101,7 +101,9 @@ def is_parallel_jaw(structure) -> bool:
 class _Placer:
     """Stages 2-3 for one hand and object in a plant context (scratch)."""
 
-    def __init__(self, plant, ctx, body, hand_spec, hand: MultiFingerHand, tol):
+    def __init__(
+        self, plant, ctx, body, hand_spec, hand: MultiFingerHand, tol, min_fingers
+    ):
         self.plant, self.ctx, self.body, self.spec = plant, ctx, body, hand_spec
         self.hand, self.tol = hand, tol
         self.port = plant.get_geometry_query_input_port()
@@ -119,10 +121,10 @@ class _Placer:
         for f, finger in enumerate(hand.structure.fingers):
             for b in finger.bodies:
                 self.label[scoped_name(plant, b)] = f
-        self.min_fingers = 2
+        self.min_fingers = int(min_fingers)
 
     def _penetration(self):
-        """None, or the rejection reason of the deepest hand penetration."""
+        """None, or what a hand geometry penetrates: ``"object"`` or ``"scene"``."""
         query = self.port.Eval(self.ctx)
         for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.0):
             a, b = pair.id_A, pair.id_B
@@ -152,8 +154,11 @@ class _Placer:
             return None, None, "fingers miss the object"
         except PenetrationError:  # only an inaccurate distance gets here
             return None, None, "hand collides with the object"
-        if self._penetration() is not None:
+        hit = self._penetration()
+        if hit == "scene":
             return None, None, "finger blocked by the scene"
+        if hit == "object":  # only an inaccurate distance gets here
+            return None, None, "hand collides with the object"
         try:
             found = find_contacts(
                 plant, ctx, self.body, hand=self.spec, distance_tolerance=self.tol
@@ -173,8 +178,7 @@ def close_candidates(
 
     ``kept`` holds ``(sample, X_WH, q_pre, q, contacts)``.
     """
-    placer = _Placer(plant, ctx, body, hand_spec, hand, tol)
-    placer.min_fingers = int(min_fingers)
+    placer = _Placer(plant, ctx, body, hand_spec, hand, tol, min_fingers)
     rejections = Counter()
     order = range(len(poses["q"]))
     if progress:
