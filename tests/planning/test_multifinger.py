@@ -332,3 +332,83 @@ def test_a_multi_finger_hand_on_a_point_cloud_is_refused():
             scene.plant, scene.context, None, hand=scene.hand, num_candidates=5,
             mu=MU, point_cloud=cloud,
         )  # fmt: skip
+
+
+def _coupled_hand_sdf() -> str:
+    """Three two-link fingers 120° apart around the palm's z axis; each distal
+    joint follows its proximal one (``<drake:mimic>``, ratio 1): three motors."""
+    links, joints = [], []
+    for k in range(3):
+        a = 2 * np.pi * k / 3
+        c, s = np.cos(a), np.sin(a)
+        x, y = 0.045 * c, 0.045 * s
+        for part, z, length in (("prox", 0.0, 0.05), ("dist", 0.05, 0.04)):
+            links.append(
+                f"<link name='f{k}_{part}'><pose>{x} {y} {z} 0 0 {a}</pose>"
+                "<inertial><mass>0.03</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy>"
+                "<izz>1e-6</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia>"
+                f"</inertial><collision name='c'><pose>0 0 {length / 2} 0 0 0</pose>"
+                f"<geometry><capsule><radius>0.007</radius><length>{length}</length>"
+                "</capsule></geometry></collision></link>"
+            )
+        mimic = f"<drake:mimic joint='f{k}_prox_joint' multiplier='1' offset='0'/>"
+        for part, parent, extra in (
+            ("prox", "palm", ""),
+            ("dist", f"f{k}_prox", mimic),
+        ):
+            joints.append(
+                f"<joint name='f{k}_{part}_joint' type='revolute'>"
+                f"<parent>{parent}</parent><child>f{k}_{part}</child>"
+                "<axis><xyz>0 -1 0</xyz><limit><lower>-0.6</lower><upper>1.5</upper>"
+                f"<effort>2</effort></limit></axis>{extra}</joint>"
+            )
+    return (
+        '<?xml version="1.0"?><sdf version="1.9" xmlns:drake="http://drake.mit.edu">'
+        "<model name='coupled_hand'><link name='palm'><inertial><mass>0.5</mass>"
+        "<inertia><ixx>1e-3</ixx><iyy>1e-3</iyy><izz>1e-3</izz><ixy>0</ixy>"
+        "<ixz>0</ixz><iyz>0</iyz></inertia></inertial><collision name='c'>"
+        "<pose>0 0 -0.01 0 0 0</pose><geometry><cylinder><radius>0.055</radius>"
+        "<length>0.02</length></cylinder></geometry></collision></link>"
+        + "".join(links)
+        + "".join(joints)
+        + "</model></sdf>"
+    )
+
+
+def test_a_coupled_hand_of_our_own_closes_with_the_plants_couplings():
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drakegrasp.plant.couplings import add_models
+    from drakegrasp.plant.models import register_models
+
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    parser = Parser(plant)
+    register_models(parser)
+    (hand,) = add_models(parser, text=_coupled_hand_sdf(), kind="sdf")
+    (obj,) = parser.AddModels(url="package://drakegrasp/objects/cylinder.sdf")
+    plant.Finalize()
+    assert plant.num_constraints() == 3  # Drake's coupler constraints
+    diagram = builder.Build()
+    root = diagram.CreateDefaultContext()
+    body = plant.get_body(plant.GetBodyIndices(obj)[0])
+    result = plan_grasps(
+        plant, root, body, hand=hand, num_candidates=30, mu=MU, seed=0,
+        robustness_samples=8, preshape=[-0.5] * 6,
+    )  # fmt: skip
+    assert len(result) > 0 and result[0].is_closure, result
+    assert len(result.settings["hand"]["fingers"]) == 3
+    names = list(result[0].joint_names)
+    for c in result:
+        for k in range(3):  # the distal joint follows the proximal one
+            prox = c.q_hand[names.index(f"coupled_hand::f{k}_prox_joint")]
+            dist = c.q_hand[names.index(f"coupled_hand::f{k}_dist_joint")]
+            assert dist == pytest.approx(prox, abs=1e-12)
+    ctx = root.Clone()
+    for c in result[:3]:
+        c.apply(plant, ctx, object_body=body)
+        report = analyze_grasp(plant, ctx, body, hand=hand, mu=MU)
+        assert report.force_closure.is_closure == c.is_closure
+        assert np.allclose(report.grasp.positions, c.grasp.positions)
