@@ -15,9 +15,9 @@ rejection reason (:data:`REASONS`).
 3. **Closing**: :func:`~drakegrasp.close_hand` (couplings read from the
    plant) from the pre-shape; fewer than ``min_fingers`` fingers touching
    rejects it, and so does a closed finger that penetrates the rest of the
-   scene (``close_hand`` watches the object only).  The contacts are those of
-   :func:`~drakegrasp.find_contacts`, which :func:`~drakegrasp.analyze_grasp`
-   reads on the applied candidate.
+   scene or another finger (``close_hand`` watches the object only).  The
+   contacts are those of :func:`~drakegrasp.find_contacts`, which
+   :func:`~drakegrasp.analyze_grasp` reads on the applied candidate.
 4. **Ranking** as for the parallel jaw (:mod:`drakegrasp.planning.ranking`):
    LP2 verdicts and ε with the object's torque scale, robustness under noise
    that moves each finger's contacts rigidly (the palm's stay), the weight
@@ -74,6 +74,8 @@ REASONS = {
     "fingers miss the object": "fewer than min_fingers fingers reach the object",
     "finger blocked by the scene": "a closed finger penetrates another body",
     "one finger touches": "the contacts come from fewer than two fingers",
+    "fingers collide with each other": "two fingers (or a finger and the palm) "
+    "penetrate each other, in the pre-shape or after closing",
 }
 """Every rejection reason of the multi-finger route, with what it means."""
 
@@ -124,16 +126,24 @@ class _Placer:
         self.min_fingers = int(min_fingers)
 
     def _penetration(self):
-        """None, or what a hand geometry penetrates: ``"object"`` or ``"scene"``."""
+        """None, or what a hand geometry penetrates.
+
+        ``"object"``, ``"scene"`` or ``"hand"`` (two hand geometries whose pair
+        the scene graph does not filter: fingers that cross each other).
+        """
         query = self.port.Eval(self.ctx)
+        found = None
         for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.0):
             a, b = pair.id_A, pair.id_B
-            if (a in self.hand_geoms) == (b in self.hand_geoms):
+            in_a, in_b = a in self.hand_geoms, b in self.hand_geoms
+            if not (in_a or in_b) or pair.distance >= -self.tol:
                 continue
-            if pair.distance < -self.tol:
-                other = b if a in self.hand_geoms else a
-                return "object" if other in self.object_geoms else "scene"
-        return None
+            if in_a and in_b:
+                found = "hand"  # reported unless the hand hits something else
+                continue
+            other = b if in_a else a
+            return "object" if other in self.object_geoms else "scene"
+        return found
 
     def run(self, X_WH, q_pre):
         """(contacts, closed q, None) or (None, None, reason)."""
@@ -143,6 +153,8 @@ class _Placer:
         q_all[s.position_indices] = q_pre
         plant.SetPositions(ctx, q_all)
         hit = self._penetration()
+        if hit == "hand":
+            return None, None, "fingers collide with each other"
         if hit is not None:
             return None, None, f"hand collides with the {hit}"
         try:
@@ -159,6 +171,8 @@ class _Placer:
             return None, None, "finger blocked by the scene"
         if hit == "object":  # only an inaccurate distance gets here
             return None, None, "hand collides with the object"
+        if hit == "hand":  # close_hand watches the object only
+            return None, None, "fingers collide with each other"
         try:
             found = find_contacts(
                 plant, ctx, self.body, hand=self.spec, distance_tolerance=self.tol

@@ -107,13 +107,13 @@ def _check_valid(scene, result, picks, mu=MU):
 
 def test_candidates_are_valid_and_agree_with_analyze_grasp(three_result):
     scene, result = three_result
-    _check_valid(scene, result, list(result[:4]) + list(result[-3:]))
+    _check_valid(scene, result, list(result))  # every candidate
 
 
 def test_allegro_candidates_are_valid_and_agree_with_analyze_grasp(allegro_result):
     scene, result = allegro_result
     assert len(result) > 20 and sum(c.is_closure for c in result) >= 10
-    _check_valid(scene, result, list(result[:3]) + list(result[-2:]))
+    _check_valid(scene, result, list(result))  # every candidate
 
 
 def test_epsilon_and_capacity_are_the_parallel_jaws_measures(three_result):
@@ -304,7 +304,7 @@ ALLEGRO_SHAKE = dict(squeeze=0.5, stiffness=20.0, damping=1.0)
 
 
 def test_allegro_top_candidates_hold_and_random_ones_less(allegro_result):
-    # measured: top 10 hold 8/10, 10 random of the 76 candidates 3/10
+    # measured: top 10 hold 8/10, 10 random of the 69 candidates 3/10
     scene, result = allegro_result
     top, rand = _hold_rates(scene, result, 10, **ALLEGRO_SHAKE)
     assert top >= 0.8
