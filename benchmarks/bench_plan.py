@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_plan.py [--num 1000] [--top 10] [--random 10]
         [--margin 1.2] [--firm 5] [--mu 1] [--seed 0] [--objects NAME ...]
-        [--no-shake]
+        [--no-shake] [--allegro 100]
 
 For each object (the YCB boxes and can of ``drake_models``, when present, and
 drakegrasp's own box, cylinder, sphere and hexagonal prism), with Drake's
@@ -26,6 +26,10 @@ WSG-50 as a free gripper:
   *firm* one, ``--firm`` (5) times the object's weight, at which almost any
   two-sided grasp holds.  The planner uses ``--mu`` 1.0, the friction
   coefficient of the models' proximity properties (what the simulation uses).
+
+Then the multi-finger route: the Allegro hand on the soup can, ``--allegro``
+samples, candidates/s with one and two workers, and the hold rates of the top
+and random candidates (:func:`allegro`).
 """
 
 from __future__ import annotations
@@ -116,6 +120,13 @@ def main(argv=None) -> int:
     ap.add_argument("--objects", nargs="*", default=None)
     ap.add_argument("--no-shake", action="store_true")
     ap.add_argument(
+        "--allegro",
+        type=int,
+        default=100,
+        help="samples for the Allegro hand on the soup can (multi-finger route); "
+        "0 skips it",
+    )
+    ap.add_argument(
         "--loop",
         type=int,
         default=50,
@@ -129,7 +140,7 @@ def main(argv=None) -> int:
             "drake_models not found (set DRAKEGRASP_DRAKE_MODELS): the WSG-50 is needed"
         )
         return 1
-    names = args.objects or [*YCB, *OWN]
+    names = [*YCB, *OWN] if args.objects is None else args.objects  # none: Allegro only
     print(f"load {os.getloadavg()[0]:.2f}; WSG-50, mu = {args.mu}")
     print(
         f"{'object':<20} {'samples/s':>10} {'cands/s':>8} {'cands':>6} {'FC':>5}"
@@ -184,7 +195,69 @@ def main(argv=None) -> int:
             for k, v in sorted(result.rejections.items(), key=lambda kv: -kv[1])
         )
         print(f"    rejected: {reasons or 'none'}")
+    if args.allegro:
+        allegro(models, args)
     return 0
+
+
+ALLEGRO_URL = (
+    "package://drake_models/allegro_hand_description/sdf/"
+    "allegro_hand_description_right.sdf"
+)
+ALLEGRO_SHAKE = dict(squeeze=0.5, stiffness=20.0, damping=1.0)
+"""Revolute fingers: squeeze in N·m (effort limit 0.7), PD gains per radian."""
+
+
+def allegro(models: Path, args) -> None:
+    """The multi-finger route: the Allegro hand (thumb opposed) on the soup can.
+
+    Candidates/s (approach + pre-shape + ``close_hand`` + scored) with one and
+    two batch workers (the closing is one Python loop either way), then the
+    hold rates of the ``--top`` best and ``--random`` random candidates.
+    """
+    scene = planning_scene(
+        object_url("005_tomato_soup_can"), hand_url=ALLEGRO_URL, models_dir=models
+    )
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    scene.plant.GetJointByName("joint_12").set_angle(ctx, 1.0)
+
+    def run(n, seed, workers):
+        return plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=n, mu=args.mu, seed=seed, workers=workers,
+        )  # fmt: skip
+
+    run(10, 1, 1)  # warm-up
+    print(f"Allegro hand on 005_tomato_soup_can, {args.allegro} samples")
+    for workers in (1, 2):
+        t = time.perf_counter()
+        result = run(args.allegro, args.seed, workers)
+        wall = time.perf_counter() - t
+        fc = sum(c.is_closure for c in result)
+        print(
+            f"    workers {workers}: {args.allegro / wall:.1f} samples/s, "
+            f"{len(result) / wall:.1f} candidates/s ({len(result)} candidates, "
+            f"{fc} force closure, {wall:.1f} s)",
+            flush=True,
+        )
+    reasons = ", ".join(f"{k} {v}" for k, v in result.rejections.items())
+    print(f"    rejected: {reasons or 'none'}")
+    if args.no_shake or not len(result):
+        return
+    pick = np.random.default_rng(args.seed).choice(
+        len(result), size=min(args.random, len(result)), replace=False
+    )
+    top = [
+        shake_test(scene.add_models, c, **ALLEGRO_SHAKE).held
+        for c in result[: args.top]
+    ]
+    rand = [
+        shake_test(scene.add_models, result[int(i)], **ALLEGRO_SHAKE).held for i in pick
+    ]
+    print(
+        f"    hold at {ALLEGRO_SHAKE['squeeze']} N·m per joint: top "
+        f"{sum(top)}/{len(top)}, random {sum(rand)}/{len(rand)}"
+    )
 
 
 if __name__ == "__main__":

@@ -2,7 +2,10 @@
 
 :func:`plan_grasps` samples antipodal parallel-jaw grasps on an object's
 collision geometry (:mod:`~drakegrasp.planning.surface`), places the gripper
-whose geometry it learns from the plant (:mod:`~drakegrasp.planning.gripper`),
+whose geometry it learns from the plant (:mod:`~drakegrasp.planning.gripper`;
+a multi-finger hand takes approach directions, palm stand-offs and a
+pre-shape, :mod:`~drakegrasp.planning.approach`, and closes with
+``close_hand``, :mod:`~drakegrasp.planning.multifinger`),
 rejects colliding poses and closes the fingers with Drake's distance queries
 (:mod:`~drakegrasp.planning.placement`) or on a point cloud
 (:mod:`~drakegrasp.planning.cloud`), and ranks the grasps
@@ -16,6 +19,7 @@ the package imports it except the command line.
 from drakegrasp._lazy import lazy_exports
 
 _SOURCES = {
+    "drakegrasp.planning.approach": ("MultiFingerHand", "multi_finger_hand"),
     "drakegrasp.planning.candidates": ("GraspCandidate", "GraspCandidates"),
     "drakegrasp.planning.gripper": ("ParallelJaw", "parallel_jaw"),
     "drakegrasp.planning.planner": ("REASONS", "object_surface", "plan_grasps"),
@@ -25,9 +29,11 @@ _SOURCES = {
 }
 
 _SUBMODULES = (
+    "approach",
     "candidates",
     "cloud",
     "gripper",
+    "multifinger",
     "placement",
     "planner",
     "ranking",
@@ -45,10 +51,12 @@ __all__ = [
     "REASONS",
     "GraspCandidate",
     "GraspCandidates",
+    "MultiFingerHand",
     "ObjectSurface",
     "ParallelJaw",
     "PlanningScene",
     "ShakeResult",
+    "multi_finger_hand",
     "object_surface",
     "parallel_jaw",
     "plan_grasps",

@@ -52,15 +52,17 @@ class GraspCandidate:
         Pose of the hand's base frame H in the world.
     X_WO : RigidTransform
         Pose of the object's body frame O when the grasp was planned.
-    q_hand : (2,) float
-        Closing joints' values of the closed hand (metres), in the order of
-        ``joint_names``.
+    q_hand : (n_h,) float
+        Closing joints' values of the closed hand (metres or radians), in the
+        order of ``joint_names`` (two for a parallel jaw).
     joint_names : tuple of str
         Scoped names ``model::joint`` of the closing joints.
     closing_signs : tuple of float
-        The sign of each joint's motion that closes the gripper (±1).
+        The sign of each joint's motion that closes the gripper (±1; 0 for a
+        joint of a multi-finger hand that closing did not move).
     opening : float
-        Pad-to-pad width of the pre-grasp (open) hand, metres.
+        Pad-to-pad width of the pre-grasp (open) hand, metres (NaN for a
+        multi-finger hand: see ``q_preshape``).
     contacts : tuple of PlantContact
         Contacts of the closed hand (object frame O).
     contact_options : dict
@@ -94,6 +96,9 @@ class GraspCandidate:
     closure : ClosureResult or None
         The single-grasp verdict with its certificate (witness), for the top
         candidates (``certify`` of ``plan_grasps``); None for the rest.
+    q_preshape : (n_h,) float or None
+        A multi-finger hand's pre-shape, from which ``close_hand`` closed it
+        (None for a parallel jaw, whose pre-grasp is ``opening``).
     """
 
     sample: int
@@ -115,6 +120,7 @@ class GraspCandidate:
     weight_capacity: float = float("nan")
     squeeze_needed: float = float("nan")
     closure: ClosureResult | None = None
+    q_preshape: np.ndarray | None = None
 
     @cached_property
     def grasp(self) -> Grasp:
@@ -149,8 +155,10 @@ class GraspCandidate:
         base = resolve_body(plant, self.hand_base)
         if base.is_floating_base_body():  # else welded (at X_WH, the caller's word)
             plant.SetFreeBodyPose(ctx, base, self.X_WH)
-        for j, q in zip(joints, self.q_hand, strict=True):
-            j.set_translation(ctx, float(q))
+        q_all = plant.GetPositions(ctx)
+        for j, q in zip(joints, self.q_hand, strict=True):  # one-dof joints
+            q_all[j.position_start()] = float(q)
+        plant.SetPositions(ctx, q_all)
         if object_body is not None and object_body.is_floating_base_body():
             plant.SetFreeBodyPose(ctx, object_body, self.X_WO)
 
@@ -163,7 +171,7 @@ class GraspCandidate:
             "X_WO": pose_dict(self.X_WO),
             "q_hand": jsonable(self.q_hand),
             "joint_names": list(self.joint_names),
-            "opening": self.opening,
+            "opening": jsonable(self.opening),
             "num_contacts": self.num_contacts,
             "contacts": [
                 {
@@ -183,17 +191,24 @@ class GraspCandidate:
             "weight_capacity": jsonable(self.weight_capacity),
             "squeeze_needed": jsonable(self.squeeze_needed),
             "closure": None if self.closure is None else self.closure.to_dict(),
+            "q_preshape": None
+            if self.q_preshape is None
+            else jsonable(self.q_preshape),
         }
 
     def __str__(self) -> str:
         p = self.X_WH.translation() * 1e3
+        shape = (
+            f"opening {self.opening * 1e3:.1f} mm"
+            if np.isfinite(self.opening)
+            else f"{len(self.q_hand)} closing joints"
+        )
         return (
             f"sample {self.sample}: "
             f"{'force closure' if self.is_closure else 'no closure'}"
             f", {self.num_contacts} contacts, eps = {self.epsilon:.4f}, robustness "
             f"{self.robustness:.2f}, holds {self.weight_capacity:.3f} N/N "
-            f"(squeeze {self.squeeze_needed:.1f} N), score {self.score:.4f}; opening "
-            f"{self.opening * 1e3:.1f} mm, "
+            f"(squeeze {self.squeeze_needed:.1f} N), score {self.score:.4f}; {shape}, "
             f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
         )
 

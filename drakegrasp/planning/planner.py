@@ -43,7 +43,7 @@ from drakegrasp.core.validation import (
     check_distance_tolerance,
     real_scalar,
 )
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.candidates import GraspCandidates
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
@@ -52,6 +52,11 @@ from drakegrasp.planning.cloud import (
     read_cloud,
 )
 from drakegrasp.planning.gripper import parallel_jaw
+from drakegrasp.planning.multifinger import (
+    DEFAULT_TILT,
+    hand_is_parallel_jaw,
+    plan_multifinger,
+)
 from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
 from drakegrasp.planning.ranking import DEFAULT_NOISE, rank_candidates
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
@@ -137,8 +142,21 @@ def plan_grasps(
     cloud_normals=None,
     viewpoint=None,
     object_mass: float | None = None,
+    preshape=None,
+    synergy=None,
+    synergy_range=(0.0, 1.0),
+    approach=None,
+    standoff=None,
+    tilt: float = DEFAULT_TILT,
+    min_fingers: int = 2,
 ) -> GraspCandidates:
-    """Sample, filter, close and rank parallel-jaw grasps of an object body.
+    """Sample, filter, close and rank grasps of an object body.
+
+    A parallel jaw (two prismatic fingers) gets antipodal grasps (this
+    module); any other hand (the Allegro hand, a three-finger hand) takes the
+    multi-finger route of :mod:`drakegrasp.planning.multifinger`: approach
+    directions and palm stand-offs over the surface, a pre-shape, then
+    :func:`~drakegrasp.close_hand`, ranked alike.
 
     Parameters
     ----------
@@ -152,8 +170,9 @@ def plan_grasps(
     object_body : RigidBody, BodyIndex, str or None
         The object to grasp (frame O); None with ``point_cloud``.
     hand : ModelInstanceIndex, str or iterable of RigidBody
-        The gripper: two prismatic fingers (see
-        :mod:`drakegrasp.planning.gripper`).
+        The hand, its base a free body: a parallel jaw (two prismatic
+        fingers, see :mod:`drakegrasp.planning.gripper`) or a multi-finger
+        hand (:mod:`drakegrasp.planning.approach`).
     num_candidates : int
         Poses to sample, ``0 <= num_candidates <= MAX_CANDIDATES``; each
         becomes a candidate or a counted rejection.
@@ -201,6 +220,17 @@ def plan_grasps(
     object_mass : float, optional
         The object's mass (kg) for ``squeeze_needed``; default the body's mass
         (a cloud has none: NaN).
+    preshape, synergy, synergy_range, approach, standoff : optional
+        Multi-finger hands only
+        (:func:`~drakegrasp.planning.approach.multi_finger_hand`): the
+        pre-shape over the closing joints (default the context's open hand), a
+        synergy direction and the range of its amount drawn per
+        pose, the approach in the base frame H, the palm stand-off range (m).
+    tilt : float, optional
+        Multi-finger hands: largest tilt (rad) of the approach from the
+        surface's inward normal.
+    min_fingers : int, optional
+        Multi-finger hands: fingers that must touch (at least 2).
 
     Returns
     -------
@@ -214,8 +244,8 @@ def plan_grasps(
         Bad options (``num_candidates`` negative, not an integer or above
         :data:`MAX_CANDIDATES`; ``mu`` negative...).
     ModelError
-        A hand that is not a free-based parallel jaw, an object without
-        graspable collision geometry.
+        A hand without a free base or without fingers, a multi-finger hand
+        with a point cloud, an object without graspable collision geometry.
     """
     t0 = time.perf_counter()
     n = _check_count(num_candidates)
@@ -257,6 +287,17 @@ def plan_grasps(
     }
     if point_cloud is None:
         body = resolve_object_body(plant, object_body)
+        if not hand_is_parallel_jaw(plant, ctx, body, hand):
+            mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
+            return plan_multifinger(
+                plant, ctx, body, hand=hand, n=n, mu=mu,
+                rng=np.random.default_rng(seed),
+                surface=object_surface(plant, ctx, body), settings=settings, t0=t0,
+                name=scoped_name(plant, body), preshape=preshape, synergy=synergy,
+                synergy_range=synergy_range, approach=approach, standoff=standoff,
+                tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
+                progress=progress, weight=mass * GRAVITY,
+            )  # fmt: skip
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
         X_WO = plant.EvalBodyPoseInWorld(ctx, body)
@@ -267,6 +308,12 @@ def plan_grasps(
         points, normals, dropped = read_cloud(
             point_cloud, cloud_normals, viewpoint=viewpoint
         )
+        if not hand_is_parallel_jaw(plant, ctx, plant.world_body(), hand):
+            raise ModelError(
+                "a point cloud is planned for with a parallel jaw (two fingers of "
+                "one prismatic joint each); multi-finger hands plan on an object "
+                "body (object_body=...)"
+            )
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface = CloudSurface(points, normals, viewpoint=viewpoint)
         X_WO = RigidTransform(surface.centroid)

@@ -96,6 +96,7 @@ def perturbed_copies(
     position: float,
     angle_deg: float,
     friction: float,
+    groups=(0, 1),
 ):
     """``samples`` perturbed copies of each of ``K`` grasps (module docstring).
 
@@ -110,6 +111,10 @@ def perturbed_copies(
     rng : numpy.random.Generator
     position, angle_deg, friction : float
         σ_p (m), σ_θ (degrees), σ_μ.
+    groups : sequence of int, optional
+        The finger labels whose contacts move (default the two jaws; a
+        multi-finger hand passes all its fingers).  Contacts with other labels
+        (a palm) stay put.
 
     Returns
     -------
@@ -122,7 +127,7 @@ def perturbed_copies(
     Nrm = np.repeat(normals, samples, axis=0)
     F = np.repeat(fingers, samples, axis=0)
     M = K * samples
-    for f in (0, 1):
+    for f in groups:
         mask = (F == f)[..., None]
         count = np.maximum(mask.sum(axis=1), 1)
         centre = (P * mask).sum(axis=1) / count  # (M, 3)
@@ -196,13 +201,19 @@ def robustness(
     model: str,
     torsional_friction,
     workers: int | None,
+    groups=(0, 1),
 ) -> np.ndarray:
-    """(K,) fraction of perturbed copies that stay force closure (LP2)."""
+    """(K,) fraction of perturbed copies that stay force closure (LP2).
+
+    ``groups``: the finger labels whose contacts move (see
+    :func:`perturbed_copies`).
+    """
     if samples == 0 or len(positions) == 0:
         return np.zeros(len(positions))
     P, Nrm, mus = perturbed_copies(
-        positions, normals, fingers, mu, samples=samples, rng=rng, **noise
-    )
+        positions, normals, fingers, mu, samples=samples, rng=rng, groups=groups,
+        **noise,
+    )  # fmt: skip
     res = batch_force_closure(
         P,
         Nrm,

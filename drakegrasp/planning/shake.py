@@ -193,10 +193,14 @@ def shake_test(
         From :func:`~drakegrasp.planning.planner.plan_grasps`.
     squeeze : float, optional
         Force with which each finger presses, newtons (default 20 N; at most
-        the actuator's effort limit).
+        the actuator's effort limit); for a revolute joint (a multi-finger
+        hand) the torque on each closing joint that closing moved, N·m.
     stiffness, damping : float, optional
-        Gains of the fingers' position control (N/m, N·s/m): each finger is
-        aimed ``squeeze / stiffness`` past where it touches.
+        Gains of the fingers' position control (N/m, N·s/m; per radian for
+        revolute joints): each finger is aimed ``squeeze / stiffness`` past
+        where it touches.  Light revolute fingers need far lower gains than
+        the default (the Allegro hand: ``squeeze=0.5, stiffness=20,
+        damping=1``; at the defaults Drake's SAP solver diverges).
     directions : sequence of (3,) float, optional
         World gravity directions after the settling phase along −z.
     settle, phase, blend : float, optional

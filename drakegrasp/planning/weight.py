@@ -12,7 +12,8 @@ capacity**
 
     \alpha(u) = \max \alpha \;\text{s.t.}\;
     \sum_{i,k} \lambda_{ik} w_{ik} + \alpha \begin{bmatrix} u \\ 0 \end{bmatrix} = 0,
-    \quad \sum_{i \in \text{finger } f} \sum_k \lambda_{ik} \le 1 \;(f = 0, 1),
+    \quad \sum_{i \in \text{finger } f} \sum_k \lambda_{ik} \le 1
+    \;(\text{every finger } f),
     \quad \lambda \ge 0,
 
 with ``w_ik`` the primitive wrenches about O (unit normal force, generator
@@ -45,6 +46,7 @@ from drakegrasp.errors import InvalidOptionError
 __all__ = [
     "WEIGHT_DIRECTIONS",
     "build_weight_capacity_program",
+    "num_groups",
     "weight_capacity",
 ]
 
@@ -71,8 +73,9 @@ def build_weight_capacity_program(
     W : (M, 6) float
         Primitive wrenches of the grasp about O (contact-major).
     groups : (M,) int
-        The finger (0, 1; 2 for any other hand body, a palm, bounded alike)
-        of each wrench.
+        The finger of each wrench (0, 1; 2 for any other hand body, a palm,
+        bounded alike; a multi-finger hand numbers its fingers 0 to F - 1 and
+        its palm F).  Each label is one group with its own bound.
     directions : (D, 3) float
         Unit weight directions, frame O.
 
@@ -86,18 +89,24 @@ def build_weight_capacity_program(
     return prog, alpha
 
 
-def _memberships(groups: np.ndarray) -> np.ndarray:
-    return (np.clip(groups, 0, 2)[None, :] == np.arange(3)[:, None]).astype(float)
+def num_groups(groups: np.ndarray) -> int:
+    """Groups of squeeze-bounded forces: 3 (two jaws and a palm) or more."""
+    return max(3, int(np.max(groups, initial=0)) + 1)
 
 
-def _program(W, groups, directions):
+def _memberships(groups: np.ndarray, G: int) -> np.ndarray:
+    return (np.clip(groups, 0, G - 1)[None, :] == np.arange(G)[:, None]).astype(float)
+
+
+def _program(W, groups, directions, G=None):
     """The program, its α variables and the (equality, bound) bindings per block."""
     M, w = W.shape
     D = len(directions)
+    G = num_groups(groups) if G is None else G
     prog = MathematicalProgram()
     lam = prog.NewContinuousVariables(D, M, "lambda")
     alpha = prog.NewContinuousVariables(D, "alpha")
-    member = _memberships(groups)
+    member = _memberships(groups, G)
     bindings = []
     for d, A in enumerate(_equalities(W, directions)):
         bindings.append(
@@ -106,7 +115,7 @@ def _program(W, groups, directions):
                     A, np.zeros(w), np.r_[lam[d], alpha[d]]
                 ),
                 prog.AddLinearConstraint(
-                    member, np.full(3, -np.inf), np.ones(3), lam[d]
+                    member, np.full(G, -np.inf), np.ones(G), lam[d]
                 ),
             )
         )
@@ -149,7 +158,8 @@ def weight_capacity(
         Contacts (metres) and inward unit normals in O; moments about O.
     fingers : (K, N) int
         Finger (0 or 1) of each contact, 2 for another hand body (a palm,
-        whose normal forces are bounded by the squeeze too).
+        whose normal forces are bounded by the squeeze too); a multi-finger
+        hand numbers its ``F`` fingers 0 to ``F - 1`` and its palm ``F``.
     mu : float
     torque_scale : float
         Metres dividing the moments (conditioning only; a soft finger's
@@ -196,16 +206,17 @@ def _drake_capacity(W: np.ndarray, groups: np.ndarray, directions) -> np.ndarray
     """The primal LP of each grasp through the solver gateway (one program)."""
     K, _, w = W.shape
     out = np.zeros((K, len(directions)))
-    prog, alpha, bindings = _program(W[0], groups[0], directions)
+    G = num_groups(groups)
+    prog, alpha, bindings = _program(W[0], groups[0], directions, G)
     for k in range(K):  # one program, its coefficients updated per grasp
         if k:
-            member = _memberships(groups[k])
+            member = _memberships(groups[k], G)
             for (eq, bound), A in zip(
                 bindings, _equalities(W[k], directions), strict=True
             ):
                 eq.evaluator().UpdateCoefficients(A, np.zeros(w))
                 bound.evaluator().UpdateCoefficients(
-                    member, np.full(3, -np.inf), np.ones(3)
+                    member, np.full(G, -np.inf), np.ones(G)
                 )
         result = require_solution(prog, solve(prog, "lp"), "the weight-capacity LP")
         out[k] = np.maximum(result.GetSolution(alpha), 0.0)
@@ -228,33 +239,36 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     The dual of the capacity LP, with ``y = v + P z`` (``P`` a basis of the
     complement of ``v = (u; 0)``, so ``yᵀv = 1``), is
     ``min Σ_f s_f`` s.t. ``s_f >= -yᵀw_j`` (``j`` in group ``f``), ``s >= 0``:
-    nine variables ``(z, s, ζ)`` with ``ζ <= -Σ s`` maximised, the form of
+    ``w - 1 + G + 1`` variables ``(z, s, ζ)`` (nine for a parallel jaw, ``G``
+    the groups) with ``ζ <= -Σ s`` maximised, the form of
     :func:`~drakegrasp.batch.lp.ipm.solve_max_last`.  ``α = -ζ*``.  A grasp with a
     direction whose dual does not converge (degenerate: coplanar pad contacts)
     is solved again as the primal through the solver gateway.
     """
     K, M, w = W.shape
     D = len(directions)
+    G = num_groups(groups)
     v = np.hstack([directions, np.zeros((D, w - 3))])  # (D, w)
     P = _complement(v)  # (D, w, w-1)
-    n = (w - 1) + 3 + 1
-    B = np.zeros((K, D, M + 4, n))
-    h = np.zeros((K, D, M + 4))
+    n = (w - 1) + G + 1
+    B = np.zeros((K, D, M + G + 1, n))
+    h = np.zeros((K, D, M + G + 1))
     # generator rows: -(Pᵀ w_j)·z - s_f <= v·w_j
     B[:, :, :M, : w - 1] = -np.einsum("kmi,dij->kdmj", W, P)
-    g = np.clip(groups, 0, 2)
-    onehot = (g[..., None] == np.arange(3)).astype(float)  # (K, M, 3)
-    B[:, :, :M, w - 1 : w + 2] = -onehot[:, None]
+    g = np.clip(groups, 0, G - 1)
+    onehot = (g[..., None] == np.arange(G)).astype(float)  # (K, M, G)
+    B[:, :, :M, w - 1 : w - 1 + G] = -onehot[:, None]
     h[:, :, :M] = np.einsum("kmi,di->kdm", W, v)
     # s >= 0
-    for f in range(3):
+    for f in range(G):
         B[:, :, M + f, w - 1 + f] = -1.0
     # ζ + Σ s <= 0
-    B[:, :, M + 3, w - 1 : w + 2] = 1.0
-    B[:, :, M + 3, n - 1] = 1.0
+    B[:, :, M + G, w - 1 : w - 1 + G] = 1.0
+    B[:, :, M + G, n - 1] = 1.0
+    rows = M + G + 1
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         # a degenerate dual may diverge (overflow); it is re-solved below
-        sol = solve_max_last(B.reshape(K * D, M + 4, n), h.reshape(K * D, M + 4))
+        sol = solve_max_last(B.reshape(K * D, rows, n), h.reshape(K * D, rows))
     alpha = np.maximum(-sol.value, 0.0).reshape(K, D)
     stuck = np.flatnonzero(~sol.converged.reshape(K, D).all(axis=1))
     if len(stuck):  # degenerate duals (coplanar pads): the primal through Clp

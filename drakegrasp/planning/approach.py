@@ -1,0 +1,394 @@
+r"""A multi-finger hand's approach, learnt from the plant, and sampled hand poses.
+
+Stage 1 of the multi-finger route of :func:`~drakegrasp.planning.planner.plan_grasps`
+(:mod:`drakegrasp.planning.multifinger`).  Nothing here is a constant of one
+hand: the fingers, the pre-shape, the palm and the approach direction are read
+from the hand's joints and collision geometry (Drake's Allegro hand,
+drakegrasp's ``three_finger_hand`` or a user's model).
+
+**The hand.**  Its base ``H`` is a free body placed by its pose ``X_WH``; its
+fingers and closing joints are those of :mod:`drakegrasp.plant.fingers`.
+
+**Pre-shape.**  The closing joints' values from which ``close_hand`` starts:
+the *open hand* (the joint values in the context given to the planner), a
+user's ``preshape`` vector, or either moved along a *synergy* direction ``s``
+by an amount drawn per pose, ``q = clip(q_0 + σ s)``, ``σ ~ U[σ_lo, σ_hi]``
+(``synergy="curl"`` takes ``s = q_c − q_0``, the curl below).  Couplings are
+applied and the result is clipped to the joint limits.
+
+**The curl** ``q_c``: the fingers drawn together from ``q_0`` by projected
+gradient descent of the fingertips' spread ``Σ_f |t_f(q) − t̄|²`` (``t_f`` the
+mean centre of finger ``f``'s tip collision geometries in H), within the
+limits: where the fingers meet when the hand closes on nothing, whatever the
+signs of its joints.
+
+**The grasp frame K** (fixed in H): its x axis is the *approach* ``u``, from
+the palm towards the *grasp centre* ``c`` (the fingertips' mean at the curl;
+a user may give ``u``); its origin the point of the palm's centre line
+through ``c`` (``c`` minus its reach ``L = (c − p_palm)·u`` along ``u``).
+``p_palm`` is the mean centre of the base's collision geometries (the base
+origin without any).  For the Allegro hand with its thumb opposed, ``u``
+leans from the fingers' direction towards the palm's face; for a hand whose
+fingers surround an axis (drakegrasp's three-finger hand), it is that axis.
+
+**Poses.**  For a surface point ``p`` with outward normal ``n`` (area-uniform
+over the object's collision geometry, :mod:`drakegrasp.planning.surface`), the
+approach is ``d = −n`` tilted by an angle uniform in ``[0, tilt]`` about a
+random axis across it; the palm's centre line is put through ``p`` along
+``d``, with the palm's front face a *stand-off* ``s`` from ``p``
+(``s ~ U[s_lo, s_hi]``, default from 0 to the reach ``L``: from the palm
+touching the surface to the grasp centre on it), and the hand is rolled about
+``d`` by an angle uniform in ``[0, 2π)``.  Everything is drawn in the object
+frame O, so a rigid motion of the scene moves every pose with it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.tree import RigidBody
+
+from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.planning.gripper import _free_base
+from drakegrasp.planning.placement import axis_frames
+from drakegrasp.planning.surface import piece_of_shape
+from drakegrasp.plant.couplings import plant_couplings
+from drakegrasp.plant.fingers import HandStructure, hand_structure
+from drakegrasp.plant.validation import HandSpec, hand_bodies
+
+__all__ = ["MultiFingerHand", "multi_finger_hand", "sample_approaches"]
+
+_MIN_REACH = 1e-3
+"""The grasp centre must lie this far (m) in front of the palm."""
+
+_CURL_STEPS = 15
+_CURL_STEP = (0.1, 0.005)
+"""Steps, and largest change of a revolute (rad) and a prismatic (m) joint per
+step, of the curl (:func:`_curl`)."""
+
+
+@dataclass(frozen=True, eq=False)
+class MultiFingerHand:
+    """A multi-finger hand as the planner sees it, in its base frame H.
+
+    Attributes
+    ----------
+    base : RigidBody
+        The free base (frame H).
+    structure : HandStructure
+        Closing joints, limits, fingers and couplings
+        (:func:`~drakegrasp.plant.fingers.hand_structure`).
+    preshape : (n_h,) float
+        The base pre-shape ``q_0`` over the closing joints (radians or
+        metres), within the limits and the couplings.
+    synergy : (n_h,) float or None
+        The synergy direction the pre-shape moves along per pose.
+    synergy_range : (2,) float
+        ``(σ_lo, σ_hi)`` of the synergy amount.
+    X_HK : RigidTransform
+        The grasp frame K in H (x axis the approach ``u``; see the module
+        docstring).
+    reach : float
+        ``L``, metres from K's origin to the grasp centre along ``u``.
+    palm_depth : float
+        Support of the base's collision geometry along ``u`` beyond K's
+        origin (the palm's front face), metres.
+    standoff : (2,) float
+        ``(s_lo, s_hi)``, metres from the sampled surface point to the palm's
+        front face.
+    """
+
+    base: RigidBody
+    structure: HandStructure
+    preshape: np.ndarray
+    synergy: np.ndarray | None
+    synergy_range: np.ndarray
+    X_HK: RigidTransform
+    reach: float
+    palm_depth: float
+    standoff: np.ndarray
+
+    @property
+    def num_fingers(self) -> int:
+        """Number of fingers."""
+        return len(self.structure.fingers)
+
+    def preshapes(self, amounts: np.ndarray) -> np.ndarray:
+        """(K, n_h) pre-shapes at synergy amounts ``amounts`` (K,)."""
+        s = self.structure
+        if self.synergy is None:
+            return np.tile(self.preshape, (len(amounts), 1))
+        q = self.preshape + np.asarray(amounts, float)[:, None] * self.synergy
+        q = np.array([s.coupling.apply(row) for row in q])
+        return np.clip(q, s.lower, s.upper)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary."""
+        return {
+            "base": self.base.name(),
+            "joints": list(self.structure.names),
+            "fingers": [f.name for f in self.structure.fingers],
+            "preshape": self.preshape.tolist(),
+            "synergy": None if self.synergy is None else self.synergy.tolist(),
+            "synergy_range": self.synergy_range.tolist(),
+            "approach_H": self.X_HK.rotation().matrix()[:, 0].tolist(),
+            "p_HK": self.X_HK.translation().tolist(),
+            "reach": self.reach,
+            "palm_depth": self.palm_depth,
+            "standoff": self.standoff.tolist(),
+        }
+
+
+def _vector(name, value, n) -> np.ndarray:
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        v = np.full(0, np.nan)
+    if v.shape != (n,) or not np.all(np.isfinite(v)):
+        raise InvalidOptionError(f"{name} must be {n} finite numbers, got {value!r}")
+    return v
+
+
+def _range(name, value) -> np.ndarray:
+    r = _vector(name, value, 2)
+    if not r[0] <= r[1]:
+        raise InvalidOptionError(
+            f"{name} must be (low, high) with low <= high, got {value!r}"
+        )
+    return r
+
+
+def _centres(plant, ctx, inspector, H, bodies) -> list[np.ndarray]:
+    """Centres in H of the collision geometries of ``bodies``."""
+    out = []
+    for body in bodies:
+        X_HB = plant.CalcRelativeTransform(ctx, H, body.body_frame())
+        out.extend(
+            (X_HB @ inspector.GetPoseInFrame(g)).translation()
+            for g in plant.GetCollisionGeometriesForBody(body)
+        )
+    return out
+
+
+def _curl(tips, q0, structure, steps=_CURL_STEPS) -> np.ndarray:
+    """The closed hand: ``q0`` moved to draw the fingertips together.
+
+    Projected gradient descent of the fingertips' spread
+    ``Σ_f |t_f(q) − t̄|²`` (central differences, each joint's step capped at
+    :data:`_CURL_STEP`), within the joint limits and couplings.
+    """
+    lower, upper = structure.lower, structure.upper
+    cap = np.array([_CURL_STEP[j.type_name() == "prismatic"] for j in structure.joints])
+    q = q0.copy()
+    h = 1e-4
+    for _ in range(steps):
+        t = tips(q)
+        grad = np.zeros_like(q)
+        for j in range(len(q)):
+            e = np.zeros_like(q)
+            e[j] = h
+            tp, tm = (
+                tips(np.clip(q + e, lower, upper)),
+                tips(np.clip(q - e, lower, upper)),
+            )
+            spread_p = np.sum((tp - t.mean(axis=0)) ** 2)
+            spread_m = np.sum((tm - t.mean(axis=0)) ** 2)
+            grad[j] = (spread_p - spread_m) / (2 * h)
+        grad = structure.coupling.pull_back(grad)
+        scale = np.max(np.abs(grad), initial=0.0)
+        if scale <= 1e-12:
+            break
+        q = np.clip(q - cap * grad / scale, lower, upper)
+    return q
+
+
+def multi_finger_hand(
+    plant,
+    plant_context,
+    object_body: RigidBody,
+    hand: HandSpec,
+    *,
+    preshape=None,
+    synergy=None,
+    synergy_range=(0.0, 1.0),
+    approach=None,
+    standoff=None,
+) -> MultiFingerHand:
+    """Learn a multi-finger hand's pre-shape and grasp frame from the plant.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized, registered with a ``SceneGraph``.
+    plant_context : Context
+        The plant's context: its hand joint values are the open hand (used
+        when ``preshape`` is None); not changed.
+    object_body : RigidBody
+        The object (the fingers' geometry pairs are read against it).
+    hand : HandSpec
+    preshape : (n_h,) float, optional
+        The pre-shape over the closing joints (order of
+        ``structure.names``); default the context's.
+    synergy : (n_h,) float or "curl", optional
+        A direction the pre-shape moves along by an amount drawn in
+        ``synergy_range`` per pose (``"curl"``: towards the curl).
+    synergy_range : (2,) float, optional
+    approach : (3,) float, optional
+        The approach direction in H; default from the palm to the grasp
+        centre.
+    standoff : (2,) float, optional
+        Palm stand-off range (m); default ``(0, reach)``.
+
+    Raises
+    ------
+    ModelError
+        A hand without a free base, without fingers (closing joints), or
+        whose fingertips do not lie in front of the palm along the approach.
+    InvalidOptionError
+        A malformed pre-shape, synergy, approach or stand-off.
+    """
+    bodies = hand_bodies(plant, object_body, hand)
+    base = _free_base(plant, bodies)
+    inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
+    structure = hand_structure(
+        plant, object_body, bodies, plant_couplings(plant), inspector=inspector
+    )
+    if not structure.fingers:
+        raise ModelError("the hand has no fingers (no closing joint moves a body)")
+    n = len(structure.names)
+    if preshape is None:
+        q0 = plant.GetPositions(plant_context)[structure.position_indices]
+    else:
+        q0 = _vector("preshape", preshape, n)
+    q0 = np.clip(structure.coupling.apply(q0), structure.lower, structure.upper)
+    curl_synergy = isinstance(synergy, str)
+    if curl_synergy and synergy != "curl":
+        raise InvalidOptionError(
+            f"synergy must be n_h = {n} numbers or 'curl', got {synergy!r}"
+        )
+    syn = (
+        None
+        if synergy is None or curl_synergy
+        else structure.coupling.project(_vector("synergy", synergy, n))
+    )
+    if syn is not None and not np.any(syn):
+        raise InvalidOptionError("synergy must move at least one closing joint")
+    ctx = plant.CreateDefaultContext()
+    H = base.body_frame()
+    tip_bodies = [
+        list({id(b): b for _, _, b in f.tip_pairs}.values()) for f in structure.fingers
+    ]
+    if not any(tip_bodies):
+        raise ModelError("the hand's fingers have no collision geometry to grasp with")
+
+    def tips(q):  # (F', 3) fingertip centres in H at closing-joint values q
+        q_all = plant.GetPositions(ctx)
+        q_all[structure.position_indices] = structure.coupling.apply(q)
+        plant.SetPositions(ctx, q_all)
+        return np.array(
+            [
+                np.mean(_centres(plant, ctx, inspector, H, b), axis=0)
+                for b in tip_bodies
+                if b
+            ]
+        )
+
+    q_curled = _curl(tips, q0, structure)
+    centre = tips(q_curled).mean(axis=0)
+    if curl_synergy:
+        syn = q_curled - q0
+        if not np.any(syn):
+            raise ModelError("the hand's fingertips cannot move towards each other")
+    palm = _centres(plant, ctx, inspector, H, [base])
+    p_palm = np.mean(palm, axis=0) if palm else np.zeros(3)
+    if approach is None:
+        u = centre - p_palm
+    else:
+        u = _vector("approach", approach, 3)
+    if np.linalg.norm(u) < _MIN_REACH:
+        raise ModelError(
+            "cannot tell the hand's approach: its grasp centre "
+            f"{np.round(centre, 4).tolist()} lies within {_MIN_REACH * 1e3:g} mm of "
+            f"its palm's {np.round(p_palm, 4).tolist()} (give approach=)"
+        )
+    u = u / np.linalg.norm(u)
+    reach = float((centre - p_palm) @ u)
+    if reach < _MIN_REACH:
+        raise ModelError(
+            f"the fingertips lie {reach * 1e3:.1f} mm along the approach "
+            f"{np.round(u, 3).tolist()} from the palm: they must lie in front of it"
+        )
+    origin = centre - reach * u
+    helper = np.eye(3)[np.argmin(np.abs(u))]
+    e1 = np.cross(helper, u)
+    e1 /= np.linalg.norm(e1)
+    X_HK = RigidTransform(
+        RotationMatrix(np.column_stack([u, e1, np.cross(u, e1)])), origin
+    )
+    depth = 0.0
+    for g in plant.GetCollisionGeometriesForBody(base):
+        X_HG = inspector.GetPoseInFrame(g)
+        piece = piece_of_shape(inspector.GetShape(g), X_HG, inspector.GetName(g))
+        u_G = X_HG.rotation().inverse().multiply(u)
+        depth = max(depth, (X_HG.translation() - origin) @ u + piece.support(u_G))
+    span = np.array([0.0, reach]) if standoff is None else _range("standoff", standoff)
+    if span[0] < 0:
+        raise InvalidOptionError(f"standoff must be >= 0 metres, got {standoff!r}")
+    return MultiFingerHand(
+        base=base,
+        structure=structure,
+        preshape=q0,
+        synergy=syn,
+        synergy_range=_range("synergy_range", synergy_range),
+        X_HK=X_HK,
+        reach=reach,
+        palm_depth=float(depth),
+        standoff=span,
+    )
+
+
+def sample_approaches(surface, hand: MultiFingerHand, X_WO, n, rng, tilt):
+    """Stage 1: ``n`` hand poses and pre-shapes over the object's surface.
+
+    Parameters
+    ----------
+    surface : ObjectSurface
+        ``sample(n, rng) -> (p_O, nout_O, piece)`` in frame O.
+    hand : MultiFingerHand
+    X_WO : RigidTransform
+    n : int
+    rng : numpy.random.Generator
+    tilt : float
+        Largest tilt (radians) of the approach from the inward normal.
+
+    Returns
+    -------
+    dict of arrays
+        ``R_WH`` (n, 3, 3), ``p_WH`` (n, 3), ``q`` (n, n_h) pre-shapes,
+        ``standoff`` (n,) metres.
+    """
+    p_O, nout_O, _ = surface.sample(n, rng)
+    # tilt: rotate -n about a random axis across it by an angle in [0, tilt]
+    across = axis_frames(-nout_O, rng.uniform(0.0, 2 * np.pi, n))[:, :, 1]
+    angle = rng.uniform(0.0, tilt, n)
+    d_O = np.cos(angle)[:, None] * -nout_O + np.sin(angle)[:, None] * np.cross(
+        across, -nout_O
+    )
+    roll = rng.uniform(0.0, 2 * np.pi, n)
+    s = rng.uniform(hand.standoff[0], hand.standoff[1], n)
+    amounts = rng.uniform(hand.synergy_range[0], hand.synergy_range[1], n)
+    R_OK = axis_frames(d_O, roll)  # x along d
+    # K's origin: the palm's front face (palm_depth ahead of it) s before p
+    p_OK = p_O - (s + hand.palm_depth)[:, None] * d_O
+    R_WO = X_WO.rotation().matrix()
+    R_WK = R_WO @ R_OK
+    p_WK = p_OK @ R_WO.T + X_WO.translation()
+    X_KH = hand.X_HK.inverse()
+    return {
+        "R_WH": R_WK @ X_KH.rotation().matrix(),
+        "p_WH": p_WK + R_WK @ X_KH.translation(),
+        "q": hand.preshapes(amounts),
+        "standoff": s,
+    }

@@ -1,0 +1,365 @@
+r"""Plan multi-finger grasps: approach, pre-shape, ``close_hand``, rank.
+
+The route :func:`~drakegrasp.planning.planner.plan_grasps` takes for a hand
+that is not a parallel jaw (the Allegro hand, drakegrasp's three-finger hand,
+a user's).  Every sampled pose becomes a candidate or is counted under one
+rejection reason (:data:`REASONS`).
+
+1. **Approach and pre-shape** (numpy, all samples at once,
+   :mod:`drakegrasp.planning.approach`): a surface point, the approach along
+   its inward normal (tilted), a palm stand-off, a roll, and a pre-shape (the
+   open hand, a user's, or a synergy direction).
+2. **Collision filter** (Drake): the hand at ``X_WH`` in its pre-shape; a
+   hand geometry with signed distance below ``−distance_tolerance`` to the
+   object or anything else rejects the pose.
+3. **Closing**: :func:`~drakegrasp.close_hand` (couplings read from the
+   plant) from the pre-shape; fewer than ``min_fingers`` fingers touching
+   rejects it, and so does a closed finger that penetrates the rest of the
+   scene or another finger (``close_hand`` watches the object only).  The
+   contacts are those of :func:`~drakegrasp.find_contacts`, which
+   :func:`~drakegrasp.analyze_grasp` reads on the applied candidate.
+4. **Ranking** as for the parallel jaw (:mod:`drakegrasp.planning.ranking`):
+   LP2 verdicts and ε with the object's torque scale, robustness under noise
+   that moves each finger's contacts rigidly (the palm's stay), the weight
+   capacity with one squeeze bound per finger and one for the palm
+   (:mod:`drakegrasp.planning.weight`), ``score = robustness × capacity``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from dataclasses import replace
+
+import numpy as np
+from pydrake.math import RigidTransform, RotationMatrix
+
+from drakegrasp.closure.verdicts import force_closure
+from drakegrasp.errors import (
+    InvalidOptionError,
+    ModelError,
+    NoContactsError,
+    PenetrationError,
+    UnreachableError,
+)
+from drakegrasp.planning.approach import (
+    MultiFingerHand,
+    multi_finger_hand,
+    sample_approaches,
+)
+from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
+from drakegrasp.planning.ranking import group_by_count, robustness, verdicts
+from drakegrasp.planning.weight import weight_capacity
+from drakegrasp.plant.closing import close_hand
+from drakegrasp.plant.contacts import find_contacts
+from drakegrasp.plant.fingers import hand_structure
+from drakegrasp.plant.validation import hand_bodies, scoped_name
+
+__all__ = [
+    "DEFAULT_TILT",
+    "REASONS",
+    "close_candidates",
+    "hand_is_parallel_jaw",
+    "is_parallel_jaw",
+    "plan_multifinger",
+    "rank_multifinger",
+]
+
+DEFAULT_TILT = np.radians(20.0)
+"""Default largest tilt of the approach from the surface's inward normal."""
+
+REASONS = {
+    "hand collides with the object": "the pre-shaped hand penetrates the object",
+    "hand collides with the scene": "the pre-shaped hand penetrates another body",
+    "fingers miss the object": "fewer than min_fingers fingers reach the object",
+    "finger blocked by the scene": "a closed finger penetrates another body",
+    "one finger touches": "the contacts come from fewer than two fingers",
+    "fingers collide with each other": "two fingers (or a finger and the palm) "
+    "penetrate each other, in the pre-shape or after closing",
+}
+"""Every rejection reason of the multi-finger route, with what it means."""
+
+
+def hand_is_parallel_jaw(plant, plant_context, object_body, hand) -> bool:
+    """Whether ``hand`` is two fingers of one prismatic joint each (in the plant)."""
+    bodies = hand_bodies(plant, object_body, hand)
+    inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
+    try:
+        structure = hand_structure(plant, object_body, bodies, inspector=inspector)
+    except ModelError:  # no closing joint: the multi-finger route says why
+        return False
+    return is_parallel_jaw(structure)
+
+
+def is_parallel_jaw(structure) -> bool:
+    """Whether a hand's structure is two fingers of one prismatic joint each."""
+    fingers = structure.fingers
+    return len(fingers) == 2 and all(
+        len(f.joints) == 1 and structure.joints[f.joints[0]].type_name() == "prismatic"
+        for f in fingers
+    )
+
+
+class _Placer:
+    """Stages 2-3 for one hand and object in a plant context (scratch)."""
+
+    def __init__(
+        self, plant, ctx, body, hand_spec, hand: MultiFingerHand, tol, min_fingers
+    ):
+        self.plant, self.ctx, self.body, self.spec = plant, ctx, body, hand_spec
+        self.hand, self.tol = hand, tol
+        self.port = plant.get_geometry_query_input_port()
+        instances = {hand.base.model_instance()} | {
+            j.model_instance() for j in hand.structure.joints
+        }
+        self.hand_geoms = {
+            g
+            for i in instances
+            for b in plant.GetBodyIndices(i)
+            for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))
+        }
+        self.object_geoms = set(plant.GetCollisionGeometriesForBody(body))
+        self.label = {}
+        for f, finger in enumerate(hand.structure.fingers):
+            for b in finger.bodies:
+                self.label[scoped_name(plant, b)] = f
+        self.min_fingers = int(min_fingers)
+
+    def _penetration(self):
+        """None, or what a hand geometry penetrates.
+
+        ``"object"``, ``"scene"`` or ``"hand"`` (two hand geometries whose pair
+        the scene graph does not filter: fingers that cross each other).
+        """
+        query = self.port.Eval(self.ctx)
+        found = None
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.0):
+            a, b = pair.id_A, pair.id_B
+            in_a, in_b = a in self.hand_geoms, b in self.hand_geoms
+            if not (in_a or in_b) or pair.distance >= -self.tol:
+                continue
+            if in_a and in_b:
+                found = "hand"  # reported unless the hand hits something else
+                continue
+            other = b if in_a else a
+            return "object" if other in self.object_geoms else "scene"
+        return found
+
+    def run(self, X_WH, q_pre):
+        """(contacts, closed q, None) or (None, None, reason)."""
+        plant, ctx, s = self.plant, self.ctx, self.hand.structure
+        plant.SetFreeBodyPose(ctx, self.hand.base, X_WH)
+        q_all = plant.GetPositions(ctx)
+        q_all[s.position_indices] = q_pre
+        plant.SetPositions(ctx, q_all)
+        hit = self._penetration()
+        if hit == "hand":
+            return None, None, "fingers collide with each other"
+        if hit is not None:
+            return None, None, f"hand collides with the {hit}"
+        try:
+            closure = close_hand(
+                plant, ctx, self.body, hand=self.spec, distance_tolerance=self.tol,
+                min_fingers=self.min_fingers,
+            )  # fmt: skip
+        except UnreachableError:
+            return None, None, "fingers miss the object"
+        except PenetrationError:  # only an inaccurate distance gets here
+            return None, None, "hand collides with the object"
+        hit = self._penetration()
+        if hit == "scene":
+            return None, None, "finger blocked by the scene"
+        if hit == "object":  # only an inaccurate distance gets here
+            return None, None, "hand collides with the object"
+        if hit == "hand":  # close_hand watches the object only
+            return None, None, "fingers collide with each other"
+        try:
+            found = find_contacts(
+                plant, ctx, self.body, hand=self.spec, distance_tolerance=self.tol
+            )
+        except (NoContactsError, PenetrationError):
+            return None, None, "one finger touches"
+        fingers = {self.label.get(c.finger_body, -1) for c in found} - {-1}
+        if len(fingers) < 2:
+            return None, None, "one finger touches"
+        return found, closure.q.copy(), None
+
+
+def close_candidates(
+    plant, ctx, body, hand_spec, hand, poses, tol, progress, min_fingers=2
+):
+    """Stages 2-3 over sampled poses: (kept, rejection counts).
+
+    ``kept`` holds ``(sample, X_WH, q_pre, q, contacts)``.
+    """
+    placer = _Placer(plant, ctx, body, hand_spec, hand, tol, min_fingers)
+    rejections = Counter()
+    order = range(len(poses["q"]))
+    if progress:
+        from tqdm.auto import tqdm
+
+        order = tqdm(order, desc="closing", unit="pose")
+    kept = []
+    for k in order:
+        X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
+        found, q, reason = placer.run(X_WH, poses["q"][k])
+        if reason is not None:
+            rejections[reason] += 1
+            continue
+        kept.append((k, X_WH, poses["q"][k], q, found))
+    return kept, rejections, placer.label
+
+
+def _labels(found, label, palm) -> list[int]:
+    return [label.get(c.finger_body, palm) for c in found]
+
+
+def rank_multifinger(
+    kept, *, label, hand: MultiFingerHand, plant, mu, model, nu, torque_scale,
+    samples, noise, rng, certify, workers, X_WO, weight,
+):  # fmt: skip
+    """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
+
+    ``label`` maps a finger body's scoped name to its finger; other hand
+    bodies (the palm) are labelled ``F``, the number of fingers.
+    """
+    if not kept:
+        return ()
+    F = hand.num_fingers
+    counts = np.array([len(k[4]) for k in kept])
+    K = len(kept)
+    is_closure, d_star = np.zeros(K, bool), np.zeros(K)
+    rank, eps, rho = np.zeros(K, int), np.zeros(K), np.zeros(K)
+    alpha = np.full(K, np.nan)
+    for idx in group_by_count(counts).values():
+        P = np.array([[c.p_OC for c in kept[i][4]] for i in idx])
+        Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
+        L = np.array([_labels(kept[i][4], label, F) for i in idx])
+        fc, ds, rk, ep = verdicts(
+            P, Nrm, mu, torque_scale=torque_scale, model=model,
+            torsional_friction=nu, workers=workers,
+        )  # fmt: skip
+        is_closure[idx], d_star[idx], rank[idx], eps[idx] = fc, ds, rk, ep
+        closed = idx[fc]
+        if len(closed):
+            rho[closed] = robustness(
+                P[fc], Nrm[fc], L[fc], mu, samples=samples, rng=rng, noise=noise,
+                model=model, torsional_friction=nu, workers=workers,
+                groups=tuple(range(F)),
+            )  # fmt: skip
+            alpha[closed] = weight_capacity(
+                P[fc], Nrm[fc], L[fc], mu, torque_scale=torque_scale, model=model,
+                torsional_friction=nu,
+            ).min(axis=1)  # fmt: skip
+    score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
+    sample = np.array([k[0] for k in kept])
+    order = np.lexsort((sample, -d_star, -(eps * rho), -score))
+    s = hand.structure
+    base = scoped_name(plant, hand.base)
+    out = []
+    for place, i in enumerate(order):
+        k, X_WH, q_pre, q, found = kept[i]
+        a = alpha[i]
+        squeeze = (
+            float("nan")
+            if not np.isfinite(a)
+            else (float(weight / a) if a > 0 else float("inf"))
+        )
+        out.append(
+            GraspCandidate(
+                sample=int(k),
+                hand_base=base,
+                X_WH=X_WH,
+                X_WO=X_WO,
+                q_hand=np.asarray(q, float),
+                joint_names=s.names,
+                closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
+                opening=float("nan"),
+                contacts=tuple(found),
+                contact_options={"mu": mu, "model": model, "torsional_friction": nu},
+                is_closure=bool(is_closure[i]),
+                d_star=float(d_star[i]),
+                rank=int(rank[i]),
+                epsilon=float(eps[i]),
+                robustness=float(rho[i]),
+                score=float(score[i]),
+                weight_capacity=float(a),
+                squeeze_needed=squeeze,
+                q_preshape=np.asarray(q_pre, float),
+            )
+        )
+        if place < certify:
+            out[-1] = replace(out[-1], closure=force_closure(out[-1].grasp))
+    return tuple(out)
+
+
+def plan_multifinger(
+    plant, ctx, body, *, hand, n, mu, rng, surface, settings, t0, name,
+    preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
+    standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
+    progress=False, weight=None,
+):  # fmt: skip
+    """The multi-finger route of :func:`~drakegrasp.planning.planner.plan_grasps`.
+
+    Called by ``plan_grasps`` once the options are checked (``settings`` holds
+    them); ``weight`` is the object's weight (N).  Returns its
+    :class:`~drakegrasp.planning.candidates.GraspCandidates`.
+    """
+    tilt = float(tilt)
+    if not 0.0 <= tilt <= np.pi / 2:
+        raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
+    if (
+        isinstance(min_fingers, bool)
+        or not isinstance(min_fingers, int | np.integer)
+        or min_fingers < 2
+    ):
+        raise InvalidOptionError(
+            f"min_fingers must be an integer >= 2, got {min_fingers!r}"
+        )
+    hand_model = multi_finger_hand(
+        plant, ctx, body, hand, preshape=preshape, synergy=synergy,
+        synergy_range=synergy_range, approach=approach, standoff=standoff,
+    )  # fmt: skip
+    if min_fingers > hand_model.num_fingers:
+        raise InvalidOptionError(
+            f"min_fingers = {min_fingers} exceeds the hand's "
+            f"{hand_model.num_fingers} fingers"
+        )
+    settings = {**settings, "hand": hand_model.to_dict(), "tilt": tilt,
+                "min_fingers": int(min_fingers)}  # fmt: skip
+    X_WO = plant.EvalBodyPoseInWorld(ctx, body)
+    torque_scale = surface.radius_about(np.zeros(3))
+    poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
+    saved = plant.GetPositions(ctx).copy()
+    try:
+        kept, rejections, label = close_candidates(
+            plant, ctx, body, hand, hand_model, poses, settings["distance_tolerance"],
+            progress, min_fingers,
+        )  # fmt: skip
+    finally:
+        plant.SetPositions(ctx, saved)
+    candidates = rank_multifinger(
+        kept, label=label, hand=hand_model, plant=plant, mu=mu,
+        model=settings["contact_model"], nu=settings["torsional_friction"],
+        torque_scale=torque_scale, samples=settings["robustness_samples"],
+        noise=settings["noise"], rng=rng, certify=certify, workers=workers,
+        X_WO=X_WO, weight=weight,
+    )  # fmt: skip
+    reason = ""
+    if not candidates:
+        reason = (
+            "num_candidates is 0"
+            if n == 0
+            else f"all {n} sampled poses were rejected (see rejections)"
+        )
+    return GraspCandidates(
+        candidates=candidates,
+        rejections=dict(rejections),
+        num_sampled=n,
+        object_body=name,
+        mu=mu,
+        torque_scale=torque_scale,
+        reason=reason,
+        settings=settings,
+        time=time.perf_counter() - t0,
+    )
