@@ -24,7 +24,9 @@ def _grasp(seed, num, dim, model, mu):
         p /= np.linalg.norm(p)
         n = -p + 0.5 * rng.normal(size=dim)
         nu = 0.05 if model == "soft_finger" else None
-        contacts.append(dg.Contact(p, n, mu=mu, model=model, torsional_friction=nu))
+        contacts.append(
+            dg.Contact(p, n, mu=mu, contact_model=model, torsional_friction=nu)
+        )
     return dg.Grasp(contacts)
 
 
