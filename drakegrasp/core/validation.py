@@ -436,10 +436,7 @@ def check_distance_tolerance(value) -> float:
     InvalidOptionError
         For anything else (also a string or None), naming the value.
     """
-    try:
-        tol = float(value)
-    except (TypeError, ValueError):
-        tol = float("nan")
+    tol = real_scalar("distance_tolerance", value)  # float("1e-4") read strings
     if not tol > 0 or tol == float("inf"):
         raise InvalidOptionError(
             f"distance_tolerance must be finite and > 0 (metres), got {value!r}"

@@ -40,7 +40,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.plant.fingers import find_joint
+from drakegrasp.plant.fingers import coupling_entries, coupling_entry
 
 __all__ = [
     "JointCoupling",
@@ -289,7 +289,7 @@ def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
         constraint added in code): names the ways to tell drakegrasp.
     """
     if couplings is not None:
-        return tuple(couplings)
+        return coupling_entries(couplings)
     known = tuple(_RECORDED.get(plant, ()))
     if plant.num_constraints() > len(known):
         raise InvalidOptionError(
@@ -335,13 +335,8 @@ def coupling_map(
     v = [int(i) for i in velocity_indices]
     row = {vi: k for k, vi in enumerate(v)}
     follows: dict[int, tuple[int, float]] = {}
-    for entry in couplings:
-        if isinstance(entry, str) or len(entry) != 4:
-            raise InvalidOptionError(
-                "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
-                f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
-            )
-        j0, j1 = find_joint(plant, entry[0]), find_joint(plant, entry[1])
+    for entry in coupling_entries(couplings):
+        j0, j1, rho, _ = coupling_entry(plant, entry)
         for j in (j0, j1):
             if j.num_velocities() != 1:
                 raise InvalidOptionError(
@@ -350,7 +345,7 @@ def coupling_map(
                 )
         f, lead = j0.velocity_start(), j1.velocity_start()
         if f in row and lead in row:
-            follows[f] = (lead, float(entry[2]))
+            follows[f] = (lead, rho)
     if set(follows) & {lead for lead, _ in follows.values()}:
         raise InvalidOptionError("a joint may not both lead and follow a coupling")
     independent = [vi for vi in v if vi not in follows]

@@ -43,6 +43,7 @@ from drakegrasp.batch.run.shared_arrays import (
     resolve,
     store_result,
 )
+from drakegrasp.core.validation import integer_or_none
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["available_cores", "map_ordered", "resolve_workers", "shutdown_pool"]
@@ -65,11 +66,8 @@ def resolve_workers(workers) -> int:
     """``workers`` as a positive int: None means every available core."""
     if workers is None:
         return available_cores()
-    try:
-        n = int(workers)
-    except (TypeError, ValueError):
-        n = None
-    if n is None or n != workers or n < 1:
+    n = integer_or_none(workers)  # bools are not counts (True was one worker)
+    if n is None or n < 1:
         raise InvalidOptionError(
             f"workers must be None (every core) or an integer >= 1, got {workers!r}"
         )
