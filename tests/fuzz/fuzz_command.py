@@ -13,7 +13,9 @@ A run must exit 0 with a right result, or non-zero with exactly one
 grasp's verdict by ``fuzz_oracles.closure_verdict`` (a scipy LP).
 
 Signal cases start ``python -m drakegrasp batch --workers 2`` on a slow file,
-send SIGTERM, SIGHUP or SIGINT after a random delay, and require a non-zero
+send SIGTERM, SIGHUP or SIGINT after a random delay (from the imports to the
+pool's start and its work) to the process or its whole process group (a
+terminal's Ctrl-C or hang-up), and require a non-zero
 exit with one line, no process of the run left alive, no scratch file left
 in the output folder, and either no output or a complete right one.
 """
@@ -215,13 +217,18 @@ def _alive(pid: int) -> bool:
     return state != "Z"
 
 
-def signal_run(src: Path, out: Path, sig: int, delay: float) -> dict:
-    """Start the batch command, signal it after ``delay`` s; what it left."""
+def signal_run(src: Path, out: Path, sig: int, delay: float, group: bool) -> dict:
+    """Start the batch command, signal it after ``delay`` s; what it left.
+
+    ``group``: signal its whole process group, as a terminal does for Ctrl-C
+    and a hang-up; else the command's process alone, as ``kill`` does.
+    """
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     proc = subprocess.Popen(
         [sys.executable, "-m", "drakegrasp", "batch", str(src), str(out),
          "--workers", "2", "--mu", "0.5"],
         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env,
+        start_new_session=True,
     )  # fmt: skip
     seen: set[int] = set()
     end = time.monotonic() + delay
@@ -229,7 +236,10 @@ def signal_run(src: Path, out: Path, sig: int, delay: float) -> dict:
         seen |= _descendants(proc.pid)
         time.sleep(0.05)
     if proc.poll() is None:
-        proc.send_signal(sig)
+        if group:
+            os.killpg(proc.pid, sig)  # its own session: our group is not touched
+        else:
+            proc.send_signal(sig)
     try:
         _, err = proc.communicate(timeout=60)
     except subprocess.TimeoutExpired:
@@ -260,14 +270,15 @@ def signal_cases(root: Path, seed: int = 220, count: int = 2) -> Iterator[Case]:
     sigs = (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)
     for i in range(count):
         sig = sigs[i % 3]
-        delay = float(rng.uniform(1.0, 4.0))
+        delay = float(rng.uniform(0.3, 4.0))
+        group = bool(rng.random() < 0.5)
         run_dir = folder / f"run{i}"
         run_dir.mkdir()
         (run_dir / src.name).write_bytes(src.read_bytes())
         out = run_dir / "out.npz"
 
-        def call(run_dir=run_dir, out=out, sig=sig, delay=delay):
-            got = signal_run(run_dir / src.name, out, sig, delay)
+        def call(run_dir=run_dir, out=out, sig=sig, delay=delay, group=group):
+            got = signal_run(run_dir / src.name, out, sig, delay, group)
             if got.get("hang"):
                 raise TimeoutError("the run did not end within 60 s of the signal")
             if got["orphans"] or got["scratch"]:
@@ -284,7 +295,8 @@ def signal_cases(root: Path, seed: int = 220, count: int = 2) -> Iterator[Case]:
 
         yield Case(
             "CLI",
-            f"{signal.Signals(sig).name} after {delay:.1f} s#{i}",
+            f"{signal.Signals(sig).name} to the {'group' if group else 'process'} "
+            f"after {delay:.1f} s#{i}",
             call,
             "either",
             right,
