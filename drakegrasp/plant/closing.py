@@ -47,6 +47,7 @@ from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
     InvalidOptionError,
+    JointLimitError,
     PenetrationError,
     UnreachableError,
 )
@@ -57,7 +58,7 @@ from drakegrasp.plant.advancement import (
 )
 from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import Finger, HandStructure, hand_structure
-from drakegrasp.plant.pose import find_penetrations
+from drakegrasp.plant.pose import find_penetrations, joint_limit_violations
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -87,7 +88,8 @@ class FingerClosure:
     bodies : tuple of str
         Scoped names of its bodies.
     status : str
-        ``"touching"`` (``0 <= ψ <= tol``), ``"at limit"`` (the path ended
+        ``"touching"`` (``0 <= ψ <= tol``; ``-tol <= ψ`` for a finger that
+        already touched at the pre-shape), ``"at limit"`` (the path ended
         with ``ψ > tol``), ``"not converged"`` (``max_iterations`` reached) or
         ``"fixed"`` (its direction is zero).
     psi : float
@@ -291,6 +293,9 @@ def close_hand(
     PenetrationError
         A body of the hand's model instances penetrates the object at the
         pre-shape (open the hand first).
+    JointLimitError
+        A joint of the hand's model instances is outside its limits at the
+        pre-shape.
     InvalidOptionError, ModelError, InvalidContextError
         Bad options, a hand without closing joints, a bad context.
     """
@@ -312,14 +317,20 @@ def close_hand(
     couplings = plant_couplings(plant, couplings)
     query = query_object_of(plant, plant_context)
     hand_ = hand_structure(plant, body, bodies, couplings, inspector=query.inspector())
-    found = find_penetrations(
-        plant, plant_context, body, hand_model_instances(plant, bodies, body), tol
-    )
+    instance_bodies = hand_model_instances(plant, bodies, body)
+    found = find_penetrations(plant, plant_context, body, instance_bodies, tol)
     if found:
         raise PenetrationError(
             "the pre-shape already penetrates the object: "
             + "; ".join(map(str, found))
             + " (open the hand or move the object before closing)"
+        )
+    beyond = joint_limit_violations(plant, plant_context, instance_bodies)
+    if beyond:  # it was accepted, and a finger that did not move stayed there
+        raise JointLimitError(
+            "the pre-shape is outside the joint limits: "
+            + "; ".join(map(str, beyond))
+            + " (set the hand's joints within their limits before closing)"
         )
     if min_fingers > len(hand_.fingers):  # unreachable before any search
         raise UnreachableError(
@@ -389,6 +400,9 @@ def _user_direction(direction, n: int, hand: HandStructure) -> np.ndarray | None
             f"direction must be {n} finite numbers (one per closing joint, in "
             f"the order of HandClosure.joints {list(hand.names)}), got {direction!r}"
         )
+    scale = np.max(np.abs(d), initial=0.0)
+    if scale > 0.0:  # a positive multiple closes alike (1e-13 was read as zero)
+        d = d / scale
     return hand.coupling.project(d)
 
 

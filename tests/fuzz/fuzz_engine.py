@@ -257,7 +257,7 @@ def engine_cases(sandbox: Sandbox, seed: int = 214, count: int = 300) -> Iterato
                 value = pick(rng, good)
             else:
                 value, expect = pick(rng, bad), "refuse"
-            if option == "model":
+            if option in ("model", "num_generators"):  # force closure's options
                 if kind == "form":
                     kind = "force"
                 if value == "frictionless":

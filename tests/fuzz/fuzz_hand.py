@@ -257,7 +257,9 @@ def _closed_right(out: dict) -> bool:
         return False
     for f in out["fingers"]:
         if f["status"] == "touching":
-            if not (-1e-12 <= f["psi"] <= tol and abs(f["drake"] - f["psi"]) <= 1e-9):
+            # |ψ| <= tol: a finger within tol of the surface at the pre-shape
+            # (inside by less than the pose check's tol) touches where it is
+            if not (-tol <= f["psi"] <= tol and abs(f["drake"] - f["psi"]) <= 1e-9):
                 return False
         elif f["drake"] <= tol:
             return False

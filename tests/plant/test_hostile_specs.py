@@ -74,3 +74,34 @@ def test_a_valid_coupling_still_closes_as_one(scene):
 def test_distance_tolerance_must_be_a_real_number(scene, tol):
     with pytest.raises(InvalidOptionError, match="distance_tolerance"):
         _close(scene, distance_tolerance=tol)
+
+
+@pytest.mark.parametrize("q", [[0.05, 0.03], [0.03, 0.0426], [0.0576, 0.034]])
+def test_a_pre_shape_beyond_the_joint_limits_is_refused(scene, q):
+    # It was accepted, and a finger that did not move (max_iterations=1, or a
+    # direction that left it) was returned beyond its limit.
+    plant, ctx = scene.plant, scene.plant_context
+    q_all = plant.GetPositions(ctx)
+    q_all[:2] = q
+    plant.SetPositions(ctx, q_all)
+    with pytest.raises(dg.JointLimitError, match="outside the joint limits"):
+        _close(scene, max_iterations=1)
+    np.testing.assert_array_equal(plant.GetPositions(ctx), q_all)
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-92, 1e-13, 1.0, 3.5e42, 1e300])
+def test_a_positive_multiple_of_a_direction_closes_alike(scale):
+    # [1e-13, -1e-13] was read as no direction: the fingers stopped "at limit".
+    def closed(direction):
+        s = dg.load_scene()
+        q = s.plant.GetPositions(s.plant_context)
+        q[:2] = [0.0287, 0.0283]
+        s.plant.SetPositions(s.plant_context, q)
+        return _close(s, direction=direction)
+
+    unit = np.array([-0.9726361996160886, 0.23233343107777749])
+    want = closed(unit)
+    got = closed(scale * unit)
+    np.testing.assert_array_equal(got.q, want.q)
+    assert [f.status for f in got.fingers] == [f.status for f in want.fingers]
+    assert "touching" in [f.status for f in got.fingers]
