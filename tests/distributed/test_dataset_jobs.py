@@ -243,3 +243,16 @@ def test_analyze_poses_gives_a_refused_configuration_its_own_row(client):
     want = analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
     assert got["d_star"][0] == want.force_closure.d_star
     assert got["is_force_closure"][0] == want.is_force_closure
+
+
+@pytest.mark.parametrize(
+    "bad", [None, 5, object(), "nonsense", "", "127.0.0.1:99999", "tcp://h:70000"]
+)
+def test_a_client_that_is_none_is_refused_at_once(bad):
+    # None or a number failed later with a raw AttributeError; a malformed
+    # address raised Dask's ValueError, a port out of range waited 30 s.
+    P, Nrm, _ = _grasps(6, 4)
+    with pytest.raises(InvalidOptionError, match="client must be|scheduler"):
+        evaluate_on_cluster(bad, P, Nrm, 0.5)
+    with pytest.raises(InvalidOptionError, match="client must be|scheduler"):
+        analyze_poses(bad, "parallel_jaw_box", np.zeros((1, 9)))

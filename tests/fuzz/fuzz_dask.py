@@ -3,7 +3,8 @@
 The sandbox worker keeps one in-process Dask cluster (one worker thread) and
 runs each case there: random batches (1..40 grasps of 2..4 contacts) with a
 random friction shape (scalar, per grasp, per contact, wrong), partitioning
-(``partition_chunks`` and ``chunk_size``, valid or hostile), options (valid,
+(``partition_chunks`` and ``chunk_size``, valid or hostile), clients that
+are none (``None``, numbers, malformed addresses), options (valid,
 hostile, or decided by the cluster), and dataset directories put through
 reruns of the same job, of another job with or without ``overwrite``, of a
 subset of the grasps, with a truncated or a foreign shard; and
@@ -25,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 from fuzz_cases import Case
-from hostile import pick
+from hostile import opaque, pick
 from sandbox import Sandbox
 
 _CLIENT = []
@@ -78,7 +79,7 @@ def dask_case(spec: dict) -> dict:
     import drakegrasp as dg
     from drakegrasp.distributed import evaluate_on_cluster, read_dataset
 
-    client = _client()
+    client = spec["client"] if "client" in spec else _client()
     P, Nrm, rng = _batch(spec["seed"], spec["K"], spec["N"], 3)
     mu = _mu(spec["mu"], spec["K"], spec["N"], rng)
     kind, options = spec["kind"], dict(spec["options"])
@@ -167,6 +168,7 @@ _OPTIONS = {
     "progress": ((), (True,)),
     "kind": (("force", "form"), ("both", None, 1)),
 }
+_CLIENTS = (None, 5, "nonsense", "", "127.0.0.1:99999", "tcp://:0x", opaque(), [])
 _DATASETS = (
     None,
     None,
@@ -203,7 +205,10 @@ def dask_cases(sandbox: Sandbox, seed: int = 217, count: int = 60) -> Iterator[C
         }
         expect = "answer"
         r = rng.random()
-        if r < 0.15:
+        if r < 0.08:  # no client, or an address that is none
+            spec["client"] = pick(rng, _CLIENTS)
+            expect = "refuse"
+        elif r < 0.15:
             spec["mu"] = pick(rng, ("wrong", "nan"))
             expect = "refuse"
         elif r < 0.55:
@@ -220,6 +225,8 @@ def dask_cases(sandbox: Sandbox, seed: int = 217, count: int = 60) -> Iterator[C
         if spec["dataset"] in ("other mu", "subset") and expect == "answer":
             expect = "refuse"  # another job in the directory, without overwrite
         name = f"K={K} N={N} mu={spec['mu']} {spec['options']} kind={spec['kind']}"
+        if "client" in spec:
+            name += f" client={spec['client']!r}"
         yield Case(
             "Dask driver",
             f"{name} dataset={spec['dataset']}#{i}",
