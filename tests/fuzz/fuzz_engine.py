@@ -49,6 +49,48 @@ OPTIONS = {
 }
 
 
+def _geometry_option(rng, K, N, d):
+    """(option, value, expect, soft): reference points, lengths, torsion.
+
+    Force closure does not depend on the reference point nor, for hard
+    fingers, on the characteristic length: a valid value must give the
+    oracle's verdict.  Soft fingers get no oracle verdict (bitwise only).
+    """
+    option = pick(rng, ("reference_points", "characteristic_lengths", "torsion"))
+    good = rng.random() < 0.5
+    if option == "reference_points":
+        if good:
+            return (
+                option,
+                rng.normal(size=(K, d) if rng.random() < 0.5 else d),
+                "answer",
+                False,
+            )
+        bad = (np.full(d, np.nan), np.zeros(d + 1), np.zeros((K + 1, d)), "x", 1j)
+        return option, pick(rng, bad), "refuse", False
+    if option == "characteristic_lengths":
+        if good:
+            return (
+                option,
+                pick(rng, (0.5, 1e-3, rng.uniform(0.1, 2, K))),
+                "answer",
+                False,
+            )
+        bad = (-1.0, 0.0, np.nan, np.inf, np.full(K + 1, 0.5), "1", True)
+        return "characteristic_lengths", pick(rng, bad), "refuse", False
+    if d == 2:  # soft fingers are spatial only
+        return "torsional_friction", 0.1, "refuse", True
+    if good:
+        return (
+            "torsional_friction",
+            pick(rng, (0.1, 0.0, rng.uniform(0, 0.5, (K, N)))),
+            "answer",
+            True,
+        )
+    bad = (np.nan, -0.1, "x", 1j, np.full((K, N + 1), 0.1))
+    return "torsional_friction", pick(rng, bad), "refuse", True
+
+
 def _grasps(rng, K, N, d):
     """Random positions and inward normals, (K, N, d) each."""
     P = rng.normal(size=(K, N, d))
@@ -99,12 +141,12 @@ def _same(a, b) -> bool:
     )
 
 
-def _checker(P, Nrm, mus, K, *, verdicts: bool):
+def _checker(P, Nrm, mus, K, *, verdicts: bool, n_g=8):
     """The answer agrees with scipy's LP per grasp and bitwise with float64 C."""
     truth = []
     if verdicts:
         for k in range(K):
-            v = oracle.closure_verdict(P[k], Nrm[k], mus[k])
+            v = oracle.closure_verdict(P[k], Nrm[k], mus[k], n_g=n_g)
             truth.append(None if v is None else v[0])
 
     def check(out):
@@ -133,7 +175,7 @@ def engine_cases(sandbox: Sandbox, seed: int = 214, count: int = 300) -> Iterato
         mu = mu_value
         mus = np.full((K, N), 0.0 if kind == "form" else mu_value)
         options = {"workers": 1}
-        what = ("layout", "dtype", "value", "mu", "shape", "option")[i % 6]
+        what = ("layout", "dtype", "value", "mu", "shape", "option", "geometry")[i % 7]
         expect, name = "answer", what
         p_in, n_in = P, Nrm
         if what == "layout":
@@ -250,6 +292,16 @@ def engine_cases(sandbox: Sandbox, seed: int = 214, count: int = 300) -> Iterato
                 p_in = P[None]
             expect = "refuse" if K or choice == 5 else "either"
             name = f"shape {np.shape(p_in)} / {np.shape(n_in)}"
+        elif what == "geometry":
+            option, value, expect, soft = _geometry_option(rng, K, N, d)
+            if kind == "form" and option == "torsional_friction":
+                kind, mus = "force", np.full((K, N), mu_value)
+            if soft:
+                options["model"] = "soft_finger"
+            options[option] = value
+            if K == 0 and expect == "refuse":
+                expect = "either"
+            name = f"{option}={value!r}"[:80]
         else:
             option = pick(rng, tuple(OPTIONS))
             good, bad = OPTIONS[option]
@@ -259,15 +311,20 @@ def engine_cases(sandbox: Sandbox, seed: int = 214, count: int = 300) -> Iterato
                 value, expect = pick(rng, bad), "refuse"
             if option in ("model", "num_generators"):  # force closure's options
                 if kind == "form":
-                    kind = "force"
+                    kind, mus = "force", np.full((K, N), mu_value)
                 if value == "frictionless":
                     mus = np.zeros((K, N))
             options[option] = value
             if K == 0 and expect == "refuse":
                 expect = "either"
             name = f"{option}={value!r}"
-        verdicts = expect != "refuse" and options.get("tol", 1e-6) == 1e-6
-        check = _checker(P, Nrm, mus, K, verdicts=verdicts)
+        verdicts = (
+            expect != "refuse"
+            and options.get("tol", 1e-6) == 1e-6
+            and options.get("model") != "soft_finger"  # no soft cones in the oracle
+        )
+        n_g = options.get("num_generators", 8)
+        check = _checker(P, Nrm, mus, K, verdicts=verdicts, n_g=n_g)
         yield Case(
             "batch engine",
             f"{kind} K={K} N={N} d={d} {name}#{i}",
