@@ -140,6 +140,22 @@ def _build(spec: dict) -> np.ndarray:
     return m if a.size else a
 
 
+def describe(a) -> dict:
+    """Worker side: what arrived (for the codec's own test)."""
+    return {
+        "dtype": a.dtype.str if a.dtype.kind != "O" else "O",
+        "shape": list(a.shape),
+        "c": bool(a.flags.c_contiguous),
+        "f": bool(a.flags.f_contiguous),
+        "writeable": bool(a.flags.writeable),
+        "strides": list(a.strides),
+        "memmap": isinstance(a, np.memmap),
+        "values": np.asarray(a, dtype=float).ravel().tolist()
+        if a.dtype.kind in "iuf"
+        else None,
+    }
+
+
 def _strided(a: np.ndarray) -> np.ndarray:
     """A copy of ``a`` viewed with a step of 2 in its last axis."""
     big = np.zeros((*a.shape[:-1], 2 * a.shape[-1]), dtype=a.dtype)

@@ -76,10 +76,10 @@ SANDBOXED = {"scene YAML", "batch engine", "close_hand", "pose validation",
 
 
 def has_dask() -> bool:
-    """Whether the optional Dask extra is installed (its surface runs only then)."""
+    """Whether the optional Dask extra (and pyarrow, for its datasets) is here."""
     import importlib.util
 
-    return importlib.util.find_spec("distributed") is not None
+    return all(importlib.util.find_spec(m) for m in ("distributed", "pyarrow"))
 
 
 def cases(root: Path, box: Sandbox, dask_box: Sandbox, *, small: bool):

@@ -8,6 +8,7 @@ table.
 
 import os
 
+import numpy as np
 import pytest
 import report_surfaces
 
@@ -54,3 +55,30 @@ def test_the_sandbox_counts_crashes_hangs_and_raw_errors():
         assert box.call("operator:add", 2, 3) == 5  # a fresh worker after the crash
     with Sandbox(timeout=1.0) as box, pytest.raises(SandboxTimeout):
         box.call("time:sleep", 30)
+
+
+def test_hostile_arrays_arrive_with_the_layout_they_claim():
+    # The engine surface's layouts are only covered if the worker really gets
+    # them: same numbers, and the dtype, contiguity, strides and flags named.
+    from hostile import LAYOUTS, array
+    from sandbox import Sandbox
+
+    values = np.arange(24.0).reshape(2, 3, 4)
+    with Sandbox(timeout=60.0) as box:
+        got = {
+            layout: box.call("hostile:describe", array(values, layout=layout))
+            for layout in LAYOUTS
+        }
+        same = np.repeat(values[:1], 2, axis=0)
+        broadcast = box.call("hostile:describe", array(same, layout="broadcast"))
+        f32 = box.call("hostile:describe", array(values, dtype="<f4", layout="F"))
+    for layout, d in got.items():
+        assert d["values"] == values.ravel().tolist(), layout
+        assert d["shape"] == [2, 3, 4] and d["dtype"] == "<f8", layout
+    assert got["C"]["c"] and got["readonly"]["c"] and got["memmap"]["memmap"]
+    assert got["F"]["f"] and not got["F"]["c"]
+    assert not got["noncontiguous"]["c"] and not got["noncontiguous"]["f"]
+    assert got["reversed"]["strides"][0] < 0
+    assert not got["readonly"]["writeable"]
+    assert broadcast["strides"][0] == 0 and not broadcast["writeable"]
+    assert f32["dtype"] == "<f4" and f32["f"]
