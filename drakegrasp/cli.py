@@ -732,15 +732,55 @@ _TERMINATING = tuple(
 )
 
 
+def _importing(frame) -> bool:
+    """Whether the interrupted Python code runs inside an import or a fork.
+
+    An exception raised there is caught before it can unwind the run: module
+    initialisers catch it (pydrake's logs a many-line CRITICAL report and
+    fails the import, exit 1), and the at-fork hooks that run while the
+    worker pool starts (``logging``'s lock release) print "Exception ignored"
+    and drop it, so the run carried on after Ctrl-C or SIGTERM.
+    """
+    while frame is not None:
+        name = frame.f_code.co_filename
+        if name.startswith("<frozen importlib") or (
+            frame.f_code.co_name == "_launch" and name.endswith("popen_fork.py")
+        ):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _later(signum: int) -> None:
+    """Deliver ``signum`` to this process again in 50 ms (after the import)."""
+    timer = threading.Timer(0.05, os.kill, (os.getpid(), signum))
+    timer.daemon = True
+    timer.start()
+
+
 def _raise_terminated(signum: int, frame) -> None:
+    if _importing(frame):
+        _later(signum)
+        return
     for sig in _TERMINATING:  # a second signal must not interrupt the cleanup
         signal.signal(sig, signal.SIG_IGN)
     raise Terminated(signum)
 
 
+def _raise_interrupt(signum: int, frame) -> None:
+    """Ctrl-C as Python's own handler, deferred while an import runs."""
+    if _importing(frame):
+        _later(signum)
+        return
+    raise KeyboardInterrupt
+
+
 @contextlib.contextmanager
 def _terminable():
     """Turn SIGTERM and SIGHUP into :class:`Terminated` while the command runs.
+
+    These and Ctrl-C (when Python's default handler has it) wait while an
+    import runs (see :func:`_importing`) and land right after it.
 
     Without this, either signal kills the interpreter at once: no ``finally``
     runs, ``.partial`` files and ``.batch-*`` scratch folders stay, and the
@@ -751,6 +791,8 @@ def _terminable():
         yield
         return
     previous = {sig: signal.signal(sig, _raise_terminated) for sig in _TERMINATING}
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, _raise_interrupt)
     try:
         yield
     finally:

@@ -438,12 +438,11 @@ def check_distance_tolerance(value) -> float:
     InvalidOptionError
         For anything else (also a string or None), naming the value.
     """
-    try:
-        tol = float(value)
-    except (TypeError, ValueError):
-        tol = float("nan")
+    message = f"distance_tolerance must be finite and > 0 (metres), got {value!r}"
+    try:  # a real number only: float() would also read "1e-4" and True
+        tol = real_scalar("distance_tolerance", value)
+    except InvalidOptionError:
+        raise InvalidOptionError(message) from None
     if not tol > 0 or tol == float("inf"):
-        raise InvalidOptionError(
-            f"distance_tolerance must be finite and > 0 (metres), got {value!r}"
-        )
+        raise InvalidOptionError(message)
     return tol

@@ -11,7 +11,15 @@ __all__ = ["client_for", "connected"]
 
 
 def client_for(client_or_address):
-    """A ``distributed.Client``: the one given, or one connected to an address."""
+    """A ``distributed.Client``: the one given, or one connected to an address.
+
+    Raises
+    ------
+    InvalidOptionError
+        Neither a client nor an address, an address with a port outside
+        1..65535, or a scheduler that cannot be reached (Dask's own
+        connection timeout, 30 s by default), naming the address.
+    """
     try:
         from distributed import Client
     except ImportError as exc:
@@ -20,7 +28,24 @@ def client_for(client_or_address):
             "distributed (pip install drakegrasp[dask])"
         ) from exc
     if isinstance(client_or_address, str):
-        return Client(client_or_address)
+        port = client_or_address.rpartition(":")[2]
+        if port.isdigit() and not 0 < int(port) < 65536:  # Dask waited 30 s
+            raise InvalidOptionError(
+                f"the scheduler address {client_or_address!r} has port {port}; "
+                "a port is in 1..65535"
+            )
+        try:
+            return Client(client_or_address)
+        except (OSError, TimeoutError, ValueError) as e:
+            raise InvalidOptionError(
+                f"could not connect to the Dask scheduler at {client_or_address!r}: "
+                f"{' '.join(str(e).split())}"
+            ) from None
+    if not isinstance(client_or_address, Client):
+        raise InvalidOptionError(
+            "client must be a distributed.Client or a scheduler address such as "
+            f"'tcp://host:8786', got {client_or_address!r}"
+        )
     return client_or_address
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from drakegrasp.core.validation import integer_or_none
 from drakegrasp.distributed.client import connected
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import GraspError, InvalidOptionError
 from drakegrasp.plant.options import AnalysisOptions
 
 __all__ = ["analyze_poses", "cached_scenes"]
@@ -47,13 +47,19 @@ def _analyze_block(scene_name: str, q_block: np.ndarray, options: dict):
         )
     out = {"is_force_closure": np.zeros(len(q_block), dtype=bool),
            "d_star": np.zeros(len(q_block)),
-           "num_contacts": np.zeros(len(q_block), dtype=int)}  # fmt: skip
+           "num_contacts": np.zeros(len(q_block), dtype=int),
+           "error": [""] * len(q_block)}  # fmt: skip
     analysis = scene.options.replace(**options)
     for i, q in enumerate(q_block):
         plant.SetPositions(ctx, q)
-        report = analyze_grasp(
-            plant, ctx, scene.object_body, hand=scene.hand, options=analysis
-        )
+        try:
+            report = analyze_grasp(
+                plant, ctx, scene.object_body, hand=scene.hand, options=analysis
+            )
+        except GraspError as e:  # a refusal is this row's, not the job's
+            out["d_star"][i] = np.nan
+            out["error"][i] = f"{type(e).__name__}: {e}"
+            continue
         out["is_force_closure"][i] = report.is_force_closure
         out["d_star"][i] = report.force_closure.d_star
         out["num_contacts"][i] = len(report.contacts)
@@ -86,8 +92,13 @@ def analyze_poses(
     Returns
     -------
     dict of str to (P,) array
-        ``is_force_closure``, ``d_star`` (LP2 of the report's force closure)
-        and ``num_contacts`` (empty arrays for ``P = 0``).
+        ``is_force_closure``, ``d_star`` (LP2 of the report's force closure),
+        ``num_contacts`` and ``error`` (empty arrays for ``P = 0``).  A
+        configuration the analysis refuses (no contact, an impossible pose,
+        ...) is a row of its own: not in force closure, ``d_star`` NaN, no
+        contacts, and ``error`` the refusal (``"NoContactsError: ..."``); the
+        others' ``error`` is ``""``, so one such configuration does not end
+        the whole job.
 
     Raises
     ------
@@ -107,9 +118,12 @@ def analyze_poses(
         futs = [client.submit(_analyze_block, scene, q[s:s + block], options,
                               pure=False) for s in range(0, len(q), block)]  # fmt: skip
         parts = client.gather(futs)
-    names = {"is_force_closure": bool, "d_star": float, "num_contacts": int}
+    names = {"is_force_closure": bool, "d_star": float, "num_contacts": int,
+             "error": str}  # fmt: skip
     return {
-        k: np.concatenate([p[k] for p in parts]) if parts else np.zeros(0, dtype)
+        k: np.concatenate([np.asarray(p[k], dtype) for p in parts])
+        if parts
+        else np.zeros(0, dtype)
         for k, dtype in names.items()
     }
 

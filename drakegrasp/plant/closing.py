@@ -60,6 +60,7 @@ from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
     InvalidOptionError,
+    JointLimitError,
     PenetrationError,
     UnreachableError,
 )
@@ -68,7 +69,7 @@ from drakegrasp.plant.advancement import reach
 from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import HandStructure, hand_structure
 from drakegrasp.plant.jaws import JawContact, jaw_contacts, parallel_jaws
-from drakegrasp.plant.pose import find_penetrations
+from drakegrasp.plant.pose import find_penetrations, joint_limit_violations
 from drakegrasp.plant.settle import SettleResult, settle_object
 from drakegrasp.plant.validation import (
     HandSpec,
@@ -99,7 +100,8 @@ class FingerClosure:
     bodies : tuple of str
         Scoped names of its bodies.
     status : str
-        ``"touching"`` (``0 <= ψ <= tol``), ``"at limit"`` (the path ended
+        ``"touching"`` (``0 <= ψ <= tol``; ``-tol <= ψ`` for a finger that
+        already touched at the pre-shape), ``"at limit"`` (the path ended
         with ``ψ > tol``), ``"not converged"`` (``max_iterations`` reached) or
         ``"fixed"`` (its direction is zero).
     psi : float
@@ -328,6 +330,9 @@ def close_hand(
     PenetrationError
         A body of the hand's model instances penetrates the object at the
         pre-shape (open the hand first).
+    JointLimitError
+        A joint of the hand's model instances is outside its limits at the
+        pre-shape.
     InvalidOptionError, ModelError, InvalidContextError
         Bad options (``symmetric=True`` for a hand that is not a parallel
         gripper, ``settle=True`` for an object that is not a free body), a
@@ -359,6 +364,13 @@ def close_hand(
             "the pre-shape already penetrates the object: "
             + "; ".join(map(str, found))
             + " (open the hand or move the object before closing)"
+        )
+    beyond = joint_limit_violations(plant, plant_context, instance_bodies)
+    if beyond:  # it was accepted, and a finger that did not move stayed there
+        raise JointLimitError(
+            "the pre-shape is outside the joint limits: "
+            + "; ".join(map(str, beyond))
+            + " (set the hand's joints within their limits before closing)"
         )
     q_all = plant.GetPositions(plant_context)
     q0 = q_all[hand_.position_indices].copy()
@@ -517,6 +529,9 @@ def _user_direction(direction, n: int, hand: HandStructure) -> np.ndarray | None
             f"direction must be {n} finite numbers (one per closing joint, in "
             f"the order of HandClosure.joints {list(hand.names)}), got {direction!r}"
         )
+    scale = np.max(np.abs(d), initial=0.0)
+    if scale > 0.0:  # a positive multiple closes alike (1e-13 was read as zero)
+        d = d / scale
     return hand.coupling.project(d)
 
 

@@ -40,7 +40,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.plant.fingers import coupled_joints
+from drakegrasp.plant.fingers import coupling_entries, coupling_entry
 
 __all__ = [
     "JointCoupling",
@@ -289,7 +289,7 @@ def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
         constraint added in code): names the ways to tell drakegrasp.
     """
     if couplings is not None:
-        return tuple(couplings)
+        return coupling_entries(couplings)
     known = tuple(_RECORDED.get(plant, ()))
     if plant.num_constraints() > len(known):
         raise InvalidOptionError(
@@ -335,8 +335,8 @@ def coupling_map(
     v = [int(i) for i in velocity_indices]
     row = {vi: k for k, vi in enumerate(v)}
     follows: dict[int, tuple[int, float]] = {}
-    for entry in couplings:
-        j0, j1 = coupled_joints(plant, entry)
+    for entry in coupling_entries(couplings):
+        j0, j1, rho, _ = coupling_entry(plant, entry)
         for j in (j0, j1):
             if j.num_velocities() != 1:
                 raise InvalidOptionError(
@@ -345,7 +345,7 @@ def coupling_map(
                 )
         f, lead = j0.velocity_start(), j1.velocity_start()
         if f in row and lead in row:
-            follows[f] = (lead, float(entry[2]))
+            follows[f] = (lead, rho)
     if set(follows) & {lead for lead, _ in follows.values()}:
         raise InvalidOptionError("a joint may not both lead and follow a coupling")
     independent = [vi for vi in v if vi not in follows]

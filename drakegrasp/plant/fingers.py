@@ -24,6 +24,7 @@ plant (:mod:`drakegrasp.plant.couplings`).
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -169,20 +170,58 @@ def find_joint(plant: MultibodyPlant, spec) -> Joint:
     )
 
 
-def coupled_joints(plant: MultibodyPlant, entry) -> tuple[Joint, Joint]:
-    """The joints ``(joint_0, joint_1)`` of one coupling entry.
+def coupling_entries(couplings) -> tuple:
+    """``couplings`` as a tuple of entries, refusing what is not a sequence."""
+    if isinstance(couplings, str | bytes | dict) or not isinstance(
+        couplings, Sequence | np.ndarray
+    ):
+        raise InvalidOptionError(
+            "couplings must be a sequence of (joint_0, joint_1, gear_ratio, offset) "
+            f"entries (() for none), got {couplings!r}"
+        )
+    return tuple(couplings)
 
-    ``entry`` is ``(joint_0, joint_1, gear_ratio, offset)`` with
-    ``q_0 = gear_ratio * q_1 + offset``; the joints are found by
-    :func:`find_joint`.  Anything else raises
-    :class:`~drakegrasp.InvalidOptionError`.
+
+def coupling_entry(plant: MultibodyPlant, entry) -> tuple[Joint, Joint, float, float]:
+    """One coupling ``(joint_0, joint_1, gear_ratio, offset)``, checked.
+
+    ``q_0 = gear_ratio * q_1 + offset`` joins two different joints; the gear
+    ratio is a finite non-zero real number, the offset a finite real number.
+
+    Raises
+    ------
+    InvalidOptionError
+        For an entry that is not a 4-sequence, an unknown joint, a joint
+        coupled to itself, or a gear ratio or offset that is not a finite real
+        number (``None``, complex, strings, bools included).
     """
-    if isinstance(entry, str) or len(entry) != 4:
+    if (
+        isinstance(entry, str | bytes)
+        or not isinstance(entry, Sequence)
+        or len(entry) != 4
+    ):
         raise InvalidOptionError(
             "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
             f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
         )
-    return find_joint(plant, entry[0]), find_joint(plant, entry[1])
+    j0, j1 = find_joint(plant, entry[0]), find_joint(plant, entry[1])
+    if j0.index() == j1.index():
+        raise InvalidOptionError(
+            f"coupling {entry!r} couples joint {joint_name(plant, j0)} to itself; "
+            "a coupling joins two different joints"
+        )
+    values = []
+    for value in entry[2:]:
+        if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+            value = np.nan
+        values.append(float(value))
+    rho, off = values
+    if rho == 0 or not np.isfinite(rho) or not np.isfinite(off):
+        raise InvalidOptionError(
+            "coupling gear_ratio must be a finite non-zero real number and offset "
+            f"a finite real number, got {entry[2]!r}, {entry[3]!r}"
+        )
+    return j0, j1, rho, off
 
 
 def _closing_joints(plant, bodies, couplings):
@@ -203,14 +242,8 @@ def _closing_joints(plant, bodies, couplings):
     }
     joints = [j for j in one_dof if int(j.index()) in actuated] or one_dof
     follows = {}
-    for entry in couplings:
-        j0, j1 = coupled_joints(plant, entry)
-        rho, off = float(entry[2]), float(entry[3])
-        if rho == 0 or not np.isfinite(rho) or not np.isfinite(off):
-            raise InvalidOptionError(
-                f"coupling gear_ratio must be finite and non-zero and offset finite, "
-                f"got {entry[2]!r}, {entry[3]!r}"
-            )
+    for entry in coupling_entries(couplings):
+        j0, j1, rho, off = coupling_entry(plant, entry)
         follows[int(j0.index())] = (int(j1.index()), rho, off)
         for j in (j0, j1):
             if not of_hand(j):

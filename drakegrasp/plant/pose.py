@@ -237,9 +237,14 @@ def find_penetrations(
     return out
 
 
-def _joint_violations(
+def joint_limit_violations(
     plant: MultibodyPlant, plant_context: Context, bodies: Sequence[RigidBody]
 ) -> list[JointLimitViolation]:
+    """Every position of a joint of the bodies' model instances off its limits.
+
+    A position counts when it is more than ``JOINT_LIMIT_TOL`` outside
+    ``[lower, upper]`` as the plant's joints state them.
+    """
     instances = {int(b.model_instance()) for b in bodies}
     q = plant.GetPositions(plant_context)
     out = []
@@ -296,5 +301,5 @@ def check_pose(
         distance_tolerance,
         query_object,
     )
-    joints = _joint_violations(plant, plant_context, hand_instance_bodies)
+    joints = joint_limit_violations(plant, plant_context, hand_instance_bodies)
     return PoseCheck(tuple(pens), tuple(joints))

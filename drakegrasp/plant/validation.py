@@ -319,6 +319,16 @@ def hand_bodies(
     return _hand_bodies(plant, object_body, hand)
 
 
+def _listed(hand) -> Iterable:
+    """A hand given as bodies, or a clear error for what is no spec at all (99)."""
+    if isinstance(hand, bytes | dict) or not isinstance(hand, Iterable):
+        raise InvalidOptionError(
+            "hand must be a model instance (ModelInstanceIndex or name), an "
+            f"iterable of bodies or scoped body names, or None; got {hand!r}"
+        )
+    return hand
+
+
 def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
     welded = _welded_to_world(plant)
     if isinstance(hand, str | ModelInstanceIndex):
@@ -335,7 +345,7 @@ def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
             b for b in bodies if b.model_instance() != object_body.model_instance()
         ]
     else:
-        listed = [resolve_object_body(plant, b) for b in hand]
+        listed = [resolve_object_body(plant, b) for b in _listed(hand)]
         bodies = [b for b in listed if int(b.index()) not in welded]
         if listed and not bodies:
             raise ModelError(
@@ -389,7 +399,7 @@ def hand_contact_bodies(
         instance = model_instance(plant, hand)
         bodies = [plant.get_body(i) for i in plant.GetBodyIndices(instance)]
     else:
-        bodies = [resolve_object_body(plant, b) for b in hand]
+        bodies = [resolve_object_body(plant, b) for b in _listed(hand)]
     bodies = [b for b in bodies if int(b.index()) not in (0, obj)]
     if not bodies:
         raise ModelError(

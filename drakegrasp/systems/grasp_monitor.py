@@ -318,7 +318,7 @@ class GraspMonitor(LeafSystem):
             raise InvalidOptionError(
                 "this context belongs to another system; pass "
                 "monitor.GetMyContextFromRoot(root_context) or "
-                f"monitor.CreateDefaultContext() ({e})"
+                f"monitor.CreateDefaultContext() ({' '.join(str(e).split())})"
             ) from None
 
     def _check_friction(self, contacts, query) -> None:

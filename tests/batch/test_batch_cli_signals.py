@@ -127,6 +127,105 @@ def test_a_signal_leaves_no_worker_file_or_segment(slow_file, tmp_path, sig):
         proc.wait(timeout=30)
 
 
+@linux_only
+@pytest.mark.parametrize("sig", [signal.SIGHUP, signal.SIGTERM, signal.SIGINT])
+def test_a_signal_to_the_whole_process_group(slow_file, tmp_path, sig):
+    # A closed terminal hangs up (and Ctrl-C interrupts) the whole foreground
+    # group, the pool workers and Python's resource tracker included: a
+    # worker killed by SIGHUP broke the pool under the cleanup (once it hung),
+    # and the killed tracker was restarted and printed a page of KeyErrors.
+    out = tmp_path / "out.npz"
+    before = _shm()
+    cmd = [sys.executable, "-m", "drakegrasp", "batch", str(slow_file),
+           str(out), "--workers", "2", "--chunk-size", "200"]  # fmt: skip
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=_env(),
+        start_new_session=True,  # its own group: ours is never signalled
+    )
+    workers: set[int] = set()
+    try:
+        end = time.monotonic() + 120
+        while time.monotonic() < end and proc.poll() is None:
+            workers |= _children(proc.pid)
+            if len(workers) >= 2 and list(tmp_path.glob(".batch-*")):
+                break
+            time.sleep(0.05)
+        assert proc.poll() is None, "the run ended before it could be signalled"
+        ours = _shm() - before
+        os.killpg(proc.pid, sig)
+        _, stderr = proc.communicate(timeout=60)
+        want = (
+            "drakegrasp: interrupted"
+            if sig == signal.SIGINT
+            else f"drakegrasp: terminated by {signal.Signals(sig).name}"
+        )
+        assert proc.returncode == 128 + sig, stderr
+        assert stderr.decode().strip() == want  # one line, no tracker's noise
+        assert _gone(workers, 10), "a pool worker outlived the command"
+        assert sorted(p.name for p in tmp_path.iterdir()) == []
+        assert not (ours & _shm()), "shared-memory segments were left in /dev/shm"
+    finally:
+        _kill([proc.pid, *workers])
+        proc.wait(timeout=30)
+
+
+_DEFERRED = """
+import os, signal, sys, time, types
+import multiprocessing
+from drakegrasp.cli import Terminated, _terminable
+
+where = sys.argv[1]
+done = []
+try:
+    with _terminable():
+        if where == "import":
+            # a module whose import is signalled half-way
+            sys.modules.pop("slow_module", None)
+            path = os.path.join(sys.argv[2], "slow_module.py")
+            with open(path, "w") as f:
+                f.write("import os, signal, time\\n"
+                        "os.kill(os.getpid(), signal.SIGTERM)\\n"
+                        "time.sleep(0.3)\\nFINISHED = True\\n")
+            sys.path.insert(0, sys.argv[2])
+            import slow_module
+            done.append(slow_module.FINISHED)
+        else:
+            os.register_at_fork(
+                after_in_parent=lambda: os.kill(os.getpid(), signal.SIGTERM)
+            )
+            fork = multiprocessing.get_context("fork")
+            p = fork.Process(target=time.sleep, args=(0,))
+            p.start()  # signalled inside the fork's hooks
+            done.append(p.pid is not None)
+            p.join()
+        time.sleep(5)  # the signal lands here, right after
+        print("never terminated")
+except Terminated as t:
+    print(t.name, done)
+"""
+
+
+@linux_only
+@pytest.mark.parametrize("where", ["import", "fork"])
+def test_a_signal_during_an_import_or_a_fork_lands_after_it(tmp_path, where):
+    # Raised inside pydrake's initialisation, SIGTERM became a 45-line CRITICAL
+    # report and exit 1; raised in a fork's hooks it was printed as "Exception
+    # ignored" and dropped, and the run went on.  Now it waits for the import
+    # or the fork to end and unwinds the run from there.
+    proc = subprocess.run(
+        [sys.executable, "-c", _DEFERRED, where, str(tmp_path)],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=60,
+    )
+    assert proc.stdout.strip() == "SIGTERM [True]", proc.stdout + proc.stderr
+    assert "Exception ignored" not in proc.stderr and "Traceback" not in proc.stderr
+
+
 _ABNORMAL = """
 import os, sys
 import numpy as np

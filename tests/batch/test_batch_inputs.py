@@ -273,3 +273,11 @@ def test_soft_fingers_need_torsional_friction_explicit_zero_acts_hard():
     hard = batch_force_closure(P, Nrm, mu=0.5)
     np.testing.assert_array_equal(soft0.is_closure, hard.is_closure)
     np.testing.assert_allclose(soft0.d_star, hard.d_star, atol=1e-9)
+
+
+@pytest.mark.parametrize("workers", [True, False, np.bool_(True), 1.0, "1"])
+def test_workers_must_be_a_count(grasps, workers):
+    # workers=True ran as one worker: a bool is not a count
+    P, Nrm = grasps
+    with pytest.raises(InvalidOptionError, match="workers"):
+        batch_force_closure(P, Nrm, 0.5, workers=workers)

@@ -216,4 +216,43 @@ def test_analyze_poses_refuses_bad_configurations_clearly(client):
         "is_force_closure": (0,),
         "d_star": (0,),
         "num_contacts": (0,),
+        "error": (0,),
     }
+
+
+def test_analyze_poses_gives_a_refused_configuration_its_own_row(client):
+    # The first configuration without contact used to end the whole job.
+    from drakegrasp import analyze_grasp
+    from drakegrasp.plant.scene import DEFAULT_SCENE, load_scene
+
+    scene = load_scene(DEFAULT_SCENE)
+    q0 = scene.plant.GetPositions(scene.plant_context)
+    q = np.repeat(q0[None], 3, axis=0)
+    q[1, :2] = 0.035  # fingers open: no contact
+    q[2, 0] = 0.022  # a finger 3 mm inside the box: an impossible pose
+    got = analyze_poses(client, DEFAULT_SCENE, q, block=2)
+    assert got["error"][0] == ""
+    assert got["error"][1].startswith("NoContactsError: ")
+    assert got["error"][2].startswith("PenetrationError: ")
+    assert got["is_force_closure"].tolist()[1:] == [False, False]
+    assert np.isnan(got["d_star"][1:]).all() and got["num_contacts"][1:].tolist() == [
+        0,
+        0,
+    ]
+    scene.plant.SetPositions(scene.plant_context, q[0])
+    want = analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
+    assert got["d_star"][0] == want.force_closure.d_star
+    assert got["is_force_closure"][0] == want.is_force_closure
+
+
+@pytest.mark.parametrize(
+    "bad", [None, 5, object(), "nonsense", "", "127.0.0.1:99999", "tcp://h:70000"]
+)
+def test_a_client_that_is_none_is_refused_at_once(bad):
+    # None or a number failed later with a raw AttributeError; a malformed
+    # address raised Dask's ValueError, a port out of range waited 30 s.
+    P, Nrm, _ = _grasps(6, 4)
+    with pytest.raises(InvalidOptionError, match="client must be|scheduler"):
+        evaluate_on_cluster(bad, P, Nrm, 0.5)
+    with pytest.raises(InvalidOptionError, match="client must be|scheduler"):
+        analyze_poses(bad, "parallel_jaw_box", np.zeros((1, 9)))

@@ -71,6 +71,10 @@ class _Timeout(Exception):
     pass
 
 
+class ValidRefused(Exception):
+    """Raised by a case whose worker judged a refusal illegitimate (a valid input)."""
+
+
 def _alarm(signum, frame):
     raise _Timeout
 
@@ -93,6 +97,8 @@ def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:
         result = case.call()
     except (_Timeout, SandboxTimeout):
         outcome, detail = "hang", f"over {limit:g} s"
+    except ValidRefused as e:
+        outcome, detail = "valid input refused", str(e)[:200]
     except dg.GraspError as e:
         text = str(e)
         if case.expect == "answer":

@@ -1,7 +1,8 @@
 """Run fuzz calls that may hang or crash in a child process with limits.
 
 A :class:`Sandbox` keeps one worker process (``python sandbox.py``) that reads a
-call per line (``{"fn": "module:function", "args": [...]}``), runs it under an
+call per line (``{"fn": "module:function", "args": [...]}``, the arguments in the tagged
+JSON of :mod:`hostile`, so arrays keep their dtype and layout), runs it under an
 address-space limit, and writes its outcome as one JSON line.  The parent waits
 at most ``timeout`` seconds: a worker that overruns is killed (a hang), one that
 dies is a crash; either way a fresh worker starts for the next call, so one bad
@@ -74,7 +75,10 @@ class Sandbox:
         if self._proc is None or self._proc.poll() is not None:
             self._proc = self._start()
         proc = self._proc
-        proc.stdin.write(json.dumps({"fn": fn, "args": list(args)}) + "\n")
+        from hostile import encode
+
+        request = {"fn": fn, "args": [encode(a) for a in args]}
+        proc.stdin.write(json.dumps(request) + "\n")
         proc.stdin.flush()
         ready, _, _ = select.select([proc.stdout], [], [], self.timeout)
         if not ready:
@@ -110,13 +114,16 @@ def _serve() -> None:
     resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
     import importlib
 
+    from hostile import decode
+
     from drakegrasp.errors import GraspError
 
     for line in sys.stdin:
         request = json.loads(line)
         module, _, name = request["fn"].partition(":")
         try:
-            value = getattr(importlib.import_module(module), name)(*request["args"])
+            value = getattr(importlib.import_module(module), name)
+            value = value(*[decode(a) for a in request["args"]])
             out = {"kind": "value", "value": value}
         except GraspError as e:
             out = {"kind": "grasp_error", "type": type(e).__name__, "message": str(e)}

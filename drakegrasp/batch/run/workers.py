@@ -19,8 +19,8 @@ exits as soon as the parent is gone, however it ended (killed, ``os._exit``,
 a crash), so no orphan keeps the program's stdout open (``| tee`` would wait
 for ever) or its memory; the shared-memory segments are then unlinked by
 Python's resource tracker, which exits with the last of them.  Workers ignore
-a Ctrl-C sent to the whole process group: the parent decides, stops them and
-cleans up.
+a Ctrl-C or a hang-up sent to the whole process group: the parent decides,
+stops them and cleans up.
 """
 
 from __future__ import annotations
@@ -43,6 +43,7 @@ from drakegrasp.batch.run.shared_arrays import (
     resolve,
     store_result,
 )
+from drakegrasp.core.validation import integer_or_none
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["available_cores", "map_ordered", "resolve_workers", "shutdown_pool"]
@@ -65,11 +66,8 @@ def resolve_workers(workers) -> int:
     """``workers`` as a positive int: None means every available core."""
     if workers is None:
         return available_cores()
-    try:
-        n = int(workers)
-    except (TypeError, ValueError):
-        n = None
-    if n is None or n != workers or n < 1:
+    n = integer_or_none(workers)  # bools are not counts (True was one worker)
+    if n is None or n < 1:
         raise InvalidOptionError(
             f"workers must be None (every core) or an integer >= 1, got {workers!r}"
         )
@@ -178,6 +176,7 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     # fork where the OS has it: workers start in milliseconds with the parent's
     # modules loaded, and scripts need no ``if __name__ == "__main__"`` guard
     # (forkserver and spawn re-run the main module in every worker).
+    _start_resource_tracker()
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     pool = ProcessPoolExecutor(
@@ -190,6 +189,30 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     return pool
 
 
+def _start_resource_tracker() -> None:
+    """Start Python's resource tracker now, deaf to a hang-up of the group.
+
+    The tracker (one process per program) unlinks the shared-memory segments
+    of a program that died.  It ignores SIGINT and SIGTERM but not SIGHUP: a
+    closed terminal killed it, the program started another that knew none of
+    the segments, and the run ended with a page of tracebacks on stderr.  An
+    ignored signal stays ignored across ``exec``, so the tracker is started
+    here with SIGHUP ignored (main thread only: elsewhere it starts as Python
+    starts it, on the first segment).
+    """
+    from multiprocessing import resource_tracker
+
+    if not hasattr(signal, "SIGHUP") or (
+        threading.current_thread() is not threading.main_thread()
+    ):
+        return
+    previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.signal(signal.SIGHUP, previous)
+
+
 def _init_worker(parent: int) -> None:
     """Run in each worker as it starts: outlive no parent, leave signals to it.
 
@@ -199,14 +222,15 @@ def _init_worker(parent: int) -> None:
     ``PR_SET_PDEATHSIG``, this does not fire when the thread that started the
     worker ends while the program goes on, and it works on every POSIX system.
     """
-    # A Ctrl-C reaches the whole process group: the parent stops the pool.
-    # SIGTERM and SIGHUP end a worker at once (the parent's handlers, which a
-    # fork copies, are for the parent; the pool itself stops workers with
-    # SIGTERM when one died).
+    # A Ctrl-C or a hang-up (a closed terminal) reaches the whole process
+    # group: the parent decides and stops the pool (a worker killed by SIGHUP
+    # broke the pool under the parent's cleanup).  SIGTERM ends a worker at
+    # once (the parent's handler, which a fork copies, is for the parent; the
+    # pool itself stops workers with SIGTERM when one died).
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    for name in ("SIGTERM", "SIGHUP"):
-        if hasattr(signal, name):
-            signal.signal(getattr(signal, name), signal.SIG_DFL)
+    if hasattr(signal, "SIGHUP"):
+        signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
     def watch() -> None:
         while os.getppid() == parent:

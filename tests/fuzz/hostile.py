@@ -1,0 +1,175 @@
+"""Hostile values that cross into a sandboxed worker, and the pools they come from.
+
+The sandbox speaks JSON, which carries NaN, ±inf, huge integers, strings,
+``None`` and nesting, but not complex numbers, arrays of a given dtype and
+memory layout, or arbitrary objects.  :func:`encode` wraps those in tagged
+dictionaries and :func:`decode` rebuilds them on the worker side, so an array
+arrives there as a Fortran-ordered, non-contiguous, read-only, negatively
+strided, broadcast (zero-stride) or memory-mapped array of the dtype the
+generator chose, exactly what the public function receives.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+
+import numpy as np
+
+LAYOUTS = ("C", "F", "noncontiguous", "readonly", "reversed", "broadcast", "memmap")
+TAG = "__hostile__"
+
+
+def encode(value):
+    """A JSON-able description of ``value`` (see the module docstring)."""
+    if isinstance(value, Hostile):
+        return value.spec
+    if isinstance(value, complex):
+        return {TAG: "complex", "re": value.real, "im": value.imag}
+    if isinstance(value, np.ndarray):
+        return array(value).spec
+    if isinstance(value, np.generic):
+        return {TAG: "scalar", "dtype": value.dtype.str, "value": encode(value.item())}
+    if isinstance(value, list | tuple):
+        out = [encode(v) for v in value]
+        return out if isinstance(value, list) else {TAG: "tuple", "items": out}
+    if isinstance(value, dict):
+        return {k: encode(v) for k, v in value.items()}
+    return value
+
+
+def decode(value):
+    """The worker-side value of an :func:`encode` description."""
+    if isinstance(value, list):
+        return [decode(v) for v in value]
+    if not isinstance(value, dict):
+        return value
+    kind = value.get(TAG)
+    if kind is None:
+        return {k: decode(v) for k, v in value.items()}
+    if kind == "complex":
+        return complex(value["re"], value["im"])
+    if kind == "tuple":
+        return tuple(decode(v) for v in value["items"])
+    if kind == "object":
+        return object()
+    if kind == "scalar":
+        return np.dtype(value["dtype"]).type(decode(value["value"]))
+    assert kind == "array", kind
+    return _build(value)
+
+
+class Hostile:
+    """A value that only the worker can build (an array of a given layout...)."""
+
+    def __init__(self, spec: dict):
+        self.spec = spec
+
+    def __repr__(self) -> str:
+        s = self.spec
+        if s.get(TAG) == "array":
+            return f"array({s['dtype']}, {s['layout']}, shape={s['shape']})"
+        return f"Hostile({s.get(TAG)})"
+
+
+def opaque() -> Hostile:
+    """A plain ``object()`` on the worker side."""
+    return Hostile({TAG: "object"})
+
+
+def array(values, *, dtype=None, layout: str = "C") -> Hostile:
+    """``values`` as an array of ``dtype`` with the given memory layout."""
+    a = np.asarray(values)
+    dtype = np.dtype(dtype or a.dtype)
+    flat = a.ravel().tolist()
+    if dtype.kind == "c":
+        flat = [encode(complex(x)) for x in flat]
+    elif dtype.kind == "O":
+        flat = [encode(x) for x in flat]
+    return Hostile(
+        {
+            TAG: "array",
+            "dtype": dtype.str if dtype.kind != "O" else "O",
+            "shape": list(a.shape),
+            "values": flat,
+            "layout": layout,
+        }
+    )
+
+
+def _build(spec: dict) -> np.ndarray:
+    dtype = np.dtype(spec["dtype"])
+    shape = tuple(spec["shape"])
+    values = [decode(v) for v in spec["values"]]
+    if dtype.kind == "O":
+        a = np.empty(len(values), dtype=object)
+        a[:] = values
+        a = a.reshape(shape)
+    else:
+        a = np.array(values, dtype=dtype).reshape(shape)
+    layout = spec["layout"]
+    if layout == "C":
+        return np.ascontiguousarray(a)
+    if layout == "F":
+        return np.asfortranarray(a)
+    if layout == "noncontiguous":  # every other element of a twice-longer array
+        big = np.zeros((2 * a.size,) if a.ndim else (2,), dtype=dtype)
+        big[::2] = a.ravel()
+        return big[::2].reshape(shape) if a.ndim <= 1 else _strided(a)
+    if layout == "readonly":
+        a = np.ascontiguousarray(a)
+        a.flags.writeable = False
+        return a
+    if layout == "reversed":  # negative strides along the first axis
+        if a.ndim == 0 or a.shape[0] == 0:
+            return a
+        return np.ascontiguousarray(a[::-1])[::-1]
+    if layout == "broadcast":  # zero strides where a leading axis repeats
+        if a.ndim == 0 or a.shape[0] == 0 or not np.all(a == a[:1]):
+            return a
+        return np.broadcast_to(a[:1], a.shape)
+    assert layout == "memmap", layout
+    fd, path = tempfile.mkstemp(suffix=".dat", prefix="drakegrasp-fuzz-")
+    os.close(fd)
+    m = np.memmap(path, dtype=dtype, mode="w+", shape=shape if a.size else (1,))
+    if a.size:
+        m[...] = a
+        m.flush()
+    os.unlink(path)  # the mapping stays valid; nothing is left behind
+    return m if a.size else a
+
+
+def describe(a) -> dict:
+    """Worker side: what arrived (for the codec's own test)."""
+    return {
+        "dtype": a.dtype.str if a.dtype.kind != "O" else "O",
+        "shape": list(a.shape),
+        "c": bool(a.flags.c_contiguous),
+        "f": bool(a.flags.f_contiguous),
+        "writeable": bool(a.flags.writeable),
+        "strides": list(a.strides),
+        "memmap": isinstance(a, np.memmap),
+        "values": np.asarray(a, dtype=float).ravel().tolist()
+        if a.dtype.kind in "iuf"
+        else None,
+    }
+
+
+def _strided(a: np.ndarray) -> np.ndarray:
+    """A copy of ``a`` viewed with a step of 2 in its last axis."""
+    big = np.zeros((*a.shape[:-1], 2 * a.shape[-1]), dtype=a.dtype)
+    big[..., ::2] = a
+    return big[..., ::2]
+
+
+# ------------------------------------------------------------------ pools
+
+NAN, INF = math.nan, math.inf
+BAD_REALS = (NAN, INF, -INF, "0.5", None, 1j, [0.5], True, opaque())
+BAD_COUNTS = (0, -1, 1.5, "2", None, True, NAN, 1j, 10**30, [2])
+
+
+def pick(rng: np.random.Generator, pool):
+    """One element of ``pool``, chosen by ``rng``."""
+    return pool[int(rng.integers(len(pool)))]
