@@ -337,14 +337,7 @@ def plan_grasps(
 
 def _close_on_body(closer: BodyCloser, X_WH, opening):
     """Stages 2-3 on the object body: (contacts, q, reason)."""
-    reason = closer.place(X_WH, opening)
-    if reason is not None:
-        return None, None, reason
-    q, reason = closer.close(opening)
-    if reason is not None:
-        return None, None, reason
-    found, reason = closer.contacts()
-    return found, q, reason
+    return closer.close_on_body(X_WH, opening)
 
 
 def _close_on_cloud(closer: BodyCloser, cloud: CloudFingers, X_WH, opening):
