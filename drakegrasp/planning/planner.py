@@ -181,7 +181,8 @@ def plan_grasps(
         its certificate (``GraspCandidate.closure``).
     weight_check : int or None, optional
         How many force-closure candidates get their weight capacity and a
-        score: None (default) all of them; a number limits the LPs (one per
+        score: None (default) all of them with robustness > 0 (the score is
+        robustness times capacity); a number limits the LPs (one per
         grasp) to the best by ``ε × robustness``, which is faster but may miss
         good grasps (see :mod:`drakegrasp.planning.ranking`).
     workers : int, optional

@@ -30,9 +30,10 @@ which for two pads is the torsion about the grasp axis, the same for every
 placement of the pads; the weight capacity asks for the wrenches that gravity
 and shaking apply, and falls as the pads move away from the centre of mass
 (tested against Drake simulations in ``tests/planning/test_shake.py``).  The
-weight capacity is computed for every force-closure candidate (or, with
-``weight_check``, for that many, the best by :math:`\varepsilon \rho`; the
-others score 0).  Candidates are
+weight capacity is computed for every force-closure candidate with
+:math:`\rho > 0` (the others score 0 whatever their capacity, which is left
+NaN), or, with ``weight_check``, for that many, the best by
+:math:`\varepsilon \rho`; the others score 0.  Candidates are
 ordered by score, then :math:`\varepsilon \rho`, ``d*`` and the sample index,
 so a ranking is reproducible.
 """
@@ -273,7 +274,8 @@ def rank_candidates(
     samples_of = np.array([k[0] for k in kept])
     pre = eps * rho
     checked = rank_order(pre, d_star, samples_of)
-    checked = checked[is_closure[checked]][:weight_check]
+    # score = α ρ: a candidate with ρ = 0 scores 0 whatever its α, so no LP
+    checked = checked[is_closure[checked] & (rho[checked] > 0)][:weight_check]
     alpha = np.full(K, np.nan)
     for idx in group_by_count(counts[checked]).values():
         idx = checked[idx]

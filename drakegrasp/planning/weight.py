@@ -254,7 +254,9 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     B[:, :, M + 3, n - 1] = 1.0
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         # a degenerate dual may diverge (overflow); it is re-solved below
-        sol = solve_max_last(B.reshape(K * D, M + 4, n), h.reshape(K * D, M + 4))
+        sol = solve_max_last(
+            B.reshape(K * D, M + 4, n), h.reshape(K * D, M + 4), kernel="auto"
+        )
     alpha = np.maximum(-sol.value, 0.0).reshape(K, D)
     stuck = np.flatnonzero(~sol.converged.reshape(K, D).all(axis=1))
     if len(stuck):  # degenerate duals (coplanar pads): the primal through Clp
