@@ -1,6 +1,7 @@
 r"""The interior-point method of :mod:`~drakegrasp.batch.lp.ipm`, one LP at a time.
 
 Compiled with numba.
+
 :func:`~drakegrasp.batch.lp.ipm.solve_max_last` runs Mehrotra's
 predictor–corrector method on a whole stack of LPs
 :math:`\max x_{n-1}` s.t. :math:`B x \le h` with numpy, one vector operation
