@@ -175,7 +175,11 @@ def plan_grasps(
         Perturbed copies per force-closure candidate (0: robustness 0).
     noise : dict, optional
         ``{"position": m, "angle_deg": deg, "friction": relative}``; default
-        :data:`~drakegrasp.planning.ranking.DEFAULT_NOISE`.
+        :data:`~drakegrasp.planning.ranking.DEFAULT_NOISE`.  On an object body
+        the object's pose error (translation, and rotation about the grasp
+        axis), the jaws closing again on the moved object
+        (:mod:`drakegrasp.planning.reclose`); on a cloud, each finger's
+        contacts moved rigidly (:mod:`drakegrasp.planning.ranking`).
     certify : int, optional
         The best ``certify`` candidates also get the single-grasp verdict with
         its certificate (``GraspCandidate.closure``).
@@ -315,6 +319,7 @@ def plan_grasps(
         model=model, nu=torsional_friction, torque_scale=torque_scale,
         samples=robustness_samples, noise=noise, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
+        surface=None if body is None else surface, tol=tol,
     )  # fmt: skip
     reason = ""
     if not candidates:
