@@ -262,7 +262,7 @@ class BodyCloser:
             step = np.where(psi > tol, psi - 0.5 * tol, 0.0)
             q_new = q + toward * step / g.pad_rate
             beyond = (q_new - closed_limit) * np.sign(toward / g.pad_rate) > 0
-            at_limit = np.isclose(q, closed_limit, rtol=0, atol=1e-12)
+            at_limit = np.abs(q - closed_limit) <= 1e-12
             if np.any(beyond & at_limit & (psi > tol)):
                 return None, None, "finger misses the object"
             q = np.where(beyond, closed_limit, q_new)

@@ -381,11 +381,12 @@ def contacts_of_distances(
     names = {}
     for finger, kf, ko, r in results:
         if finger.index() not in names:
+            X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
             names[finger.index()] = (
                 _scoped_name(plant, finger),
-                plant.EvalBodyPoseInWorld(plant_context, finger),
+                X_WF.inverse().multiply(X_WO),
             )
-        finger_name, X_WF = names[finger.index()]
+        finger_name, X_FO = names[finger.index()]
         if r.id_A in object_geometries:
             go, gf = r.id_A, r.id_B
             p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
@@ -413,7 +414,7 @@ def contacts_of_distances(
             psi=psi,
             to_O=to_O,
             R_OW=R_OW,
-            X_FO=X_WF.inverse().multiply(X_WO),
+            X_FO=X_FO,
             finger=finger,
             finger_name=finger_name,
             indices=(kf, ko),
