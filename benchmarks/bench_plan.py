@@ -13,10 +13,15 @@ WSG-50 as a free gripper:
 * **planning**: ``plan_grasps`` on ``--num`` sampled poses (one warm-up call
   first, so numba's compilation is not timed), the wall time, samples/s and
   candidates/s (candidates are the samples that survive the collision filter
-  and the closing), and the rejections by reason;
+  and the closing), candidates per CPU second (the machine's load skews wall
+  time), the same with ``--workers`` (2) batch workers, and the rejections by
+  reason;
 * **the user's loop**: ``--loop`` candidates closed and analysed one at a
   time with ``close_hand``, ``analyze_grasp`` and ``ferrari_canny`` from the
   open hand at the candidate's pose (the baseline of issue 18), candidates/s;
+* **the course's cost**: a per-candidate re-implementation of the
+  manipulation course's ``GraspCandidateCost`` (one signed-distance query per
+  cloud point, ``--cloud`` points), candidates/s on the same candidates;
 * **hold rates**: :func:`drakegrasp.planning.shake_test` on the ``--top``
   best candidates and on ``--random`` candidates drawn uniformly (seeded)
   from all collision-free closed antipodal candidates of the same run (the
@@ -97,6 +102,65 @@ def user_loop(scene, candidates, mu: float) -> float:
     return len(candidates) / (time.perf_counter() - t)
 
 
+def course_cost_loop(scene, candidates, cloud_points: int, seed: int) -> float:
+    """Candidates/s of a per-candidate re-implementation of the course's cost.
+
+    The manipulation course's ``GraspCandidateCost`` on a cloud of the object:
+    for each candidate, the open gripper at ``X_WH``, one
+    ``ComputeSignedDistanceToPoint`` per cloud point (a point inside any hand
+    geometry makes the candidate infeasible), then the antipodal term
+    ``-Σ (n̂ᵢ · a)²`` over the points between the jaws and the course's
+    orientation term; here on ``cloud_points`` area-uniform surface samples
+    with their normals (the course's cloud after downsampling).
+    """
+    from drakegrasp.planning.gripper import parallel_jaw
+    from drakegrasp.planning.planner import object_surface
+
+    plant = scene.plant
+    ctx = scene.context.Clone()
+    pctx = plant.GetMyContextFromRoot(ctx)
+    surface = object_surface(plant, pctx, scene.object_body)
+    p_O, n_O, _ = surface.sample(cloud_points, np.random.default_rng(seed))
+    X_WO = plant.EvalBodyPoseInWorld(pctx, scene.object_body)
+    R_WO = X_WO.rotation().matrix()
+    p_W = p_O @ R_WO.T + X_WO.translation()
+    n_W = n_O @ R_WO.T
+    base = plant.GetBodyByName(candidates[0].hand_base.rpartition("::")[2])
+    joints = [
+        plant.GetJointByName(n.rpartition("::")[2]) for n in candidates[0].joint_names
+    ]
+    port = plant.get_geometry_query_input_port()
+    X_HK = parallel_jaw(plant, pctx, scene.object_body, scene.hand).X_HK
+    costs = []
+    t = time.perf_counter()
+    for c in candidates:
+        plant.SetFreeBodyPose(pctx, base, c.X_WH)
+        for j, sign in zip(joints, c.closing_signs, strict=True):
+            lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
+            j.set_translation(pctx, lo if sign > 0 else hi)  # wide open
+        query = port.Eval(pctx)
+        hand = {
+            g
+            for b in plant.GetBodyIndices(base.model_instance())
+            for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))
+        }
+        cost = 0.0
+        for p in p_W:
+            if any(d.id_G in hand for d in query.ComputeSignedDistanceToPoint(p, 0.0)):
+                cost = np.inf
+                break
+        if np.isfinite(cost):
+            X_WK = c.X_WH.multiply(X_HK)  # x: the jaw axis, y: the approach
+            R_WK = X_WK.rotation().matrix()
+            p_K = (p_W - X_WK.translation()) @ R_WK
+            between = (np.abs(p_K[:, 0]) < 0.5 * c.opening) & (
+                np.abs(p_K[:, 1:]).max(axis=1) < 0.02
+            )
+            cost = -np.sum((n_W[between] @ R_WK[:, 0]) ** 2) + 20.0 * R_WK[2, 0]
+        costs.append(cost)
+    return len(candidates) / (time.perf_counter() - t)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--num", type=int, default=1500)
@@ -127,6 +191,18 @@ def main(argv=None) -> int:
         "0 skips it",
     )
     ap.add_argument(
+        "--cloud",
+        type=int,
+        default=1000,
+        help="cloud points of the course-cost re-implementation (0 skips it)",
+    )
+    ap.add_argument(
+        "--workers",
+        type=int,
+        default=2,
+        help="also plan with this many workers (0 or 1 skips it)",
+    )
+    ap.add_argument(
         "--loop",
         type=int,
         default=50,
@@ -154,12 +230,13 @@ def main(argv=None) -> int:
             scene.plant, scene.context, scene.object_body, num_candidates=50, seed=1,
             **kwargs,
         )  # fmt: skip
-        t = time.perf_counter()
+        t, cpu = time.perf_counter(), time.process_time()
         result = plan_grasps(
             scene.plant, scene.context, scene.object_body, num_candidates=args.num,
             seed=args.seed, **kwargs,
         )  # fmt: skip
         wall = time.perf_counter() - t
+        cpu = time.process_time() - cpu
         rng = np.random.default_rng(args.seed)
         pick = rng.choice(
             len(result), size=min(args.random, len(result)), replace=False
@@ -185,10 +262,34 @@ def main(argv=None) -> int:
             f"{len(result):>6} {fc:>5}" + cells,
             flush=True,
         )
+        print(
+            f"    one core: {len(result) / wall:.0f} candidates/s wall, "
+            f"{len(result) / cpu:.0f} per CPU second (load "
+            f"{os.getloadavg()[0]:.1f})"
+        )
+        if args.workers > 1:
+            t = time.perf_counter()
+            two = plan_grasps(
+                scene.plant, scene.context, scene.object_body,
+                num_candidates=args.num, seed=args.seed,
+                **{**kwargs, "workers": args.workers},
+            )  # fmt: skip
+            wall2 = time.perf_counter() - t
+            same = [c.sample for c in two] == [c.sample for c in result]
+            print(
+                f"    {args.workers} workers: {len(two) / wall2:.0f} candidates/s "
+                f"wall (same ranking: {same})"
+            )
         if args.loop and len(result):
             rate = user_loop(scene, result[: args.loop], args.mu)
             print(
                 f"    the user's loop: {rate:.0f} candidates/s ({args.loop} candidates)"
+            )
+        if args.cloud and len(result):
+            rate = course_cost_loop(scene, result[: args.loop or 50], args.cloud, 0)
+            print(
+                f"    the course's cost, per candidate ({args.cloud} cloud points): "
+                f"{rate:.0f} candidates/s"
             )
         reasons = ", ".join(
             f"{k} {v}"

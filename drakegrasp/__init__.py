@@ -155,8 +155,12 @@ _SOURCES = {
     ),
     "drakegrasp.visualization": (
         "clear_grasp",
+        "draw_candidates",
+        "draw_candidates",
         "draw_grasp",
         "plot_planar_grasp",
+        "plot_score_distribution",
+        "plot_score_distribution",
         "plot_wrench_space",
     ),
 }

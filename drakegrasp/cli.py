@@ -12,8 +12,9 @@ Usage::
                      [--num-generators NG] [--metrics NAME ...] [--progress]
                      [--overwrite]
     drakegrasp warmup [--json]
-    drakegrasp plan [OBJECT] [--hand HAND] [--num N] [--top K] [--seed S]
-                    [--mu M] [--json | --out FILE.parquet]
+    drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
+                    [--seed S] [--mu M] [--package NAME=DIR ...]
+                    [--allow-any-file] [--json | --out FILE.parquet]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
@@ -30,10 +31,16 @@ the vectorised batch engine and writes the verdicts to another file.
 later processes load them from numba's cache) and prints what it compiled and
 how long each step took.
 
-``plan`` finds grasps: a free-floating parallel-jaw gripper (``--hand``: a
-model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
-jaw) sampled, filtered, closed and ranked on an object (a shipped object's
-name, a model URL or a file; default ``box``), and prints the best ``--top``.
+``plan`` finds grasps: a free-floating parallel-jaw gripper sampled,
+filtered, closed and ranked on an object, and prints the best ``--top``.  Given
+a scene (a YAML file ending ``.yaml``/``.yml`` or a shipped scene's name), it
+plans for the hand and object that the scene's ``drakegrasp:`` section names
+(``hand:``, ``object_body:``), with the scene's μ, contact model and tolerance,
+against everything else the scene holds (a table, other objects); the hand's
+base must be free in the scene (no ``add_weld`` to the world).  Given an
+object (a shipped object's name, a model URL or a file; default ``box``), it
+plans for ``--hand`` (a model URL or file, ``wsg`` for Drake's WSG-50; default
+drakegrasp's flat-pad jaw) in a scene of the two alone.
 
 One interface: both commands name the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
@@ -588,22 +595,62 @@ def _plan_url(spec: str, folder: str) -> str:
     return f"package://drakegrasp/{folder}/{spec}.sdf"
 
 
+def _is_scene(target: str) -> bool:
+    """Whether ``plan``'s argument names a scene (a YAML file or a shipped one)."""
+    from drakegrasp.plant.scene import list_scenes
+
+    if target.endswith((".yaml", ".yml")):
+        return True
+    return target in {info.name for info in list_scenes()}
+
+
+def _plan_setup(args: argparse.Namespace):
+    """(plant, context, object body, hand, options) of ``plan``'s target."""
+    from drakegrasp.planning import planning_scene
+
+    if _is_scene(args.object):
+        from drakegrasp.plant.scene import load_scene
+
+        if args.hand is not None:
+            raise InvalidOptionError(
+                "--hand is for an object; a scene names its own hand (its "
+                "drakegrasp: section's 'hand:')"
+            )
+        scene = load_scene(
+            args.object,
+            package_map=dict(args.package) or None,
+            allow_any_file=args.allow_any_file,
+            close=False,
+        )
+        info = scene.info
+        options = {
+            "mu": info.mu if args.mu is None else args.mu,
+            "contact_model": info.contact_model,
+            "torsional_friction": info.torsional_friction,
+            "distance_tolerance": info.distance_tolerance,
+        }
+        return scene.plant, scene.plant_context, scene.object_body, scene.hand, options
+    hand = PLAN_HANDS.get(args.hand or "flat", args.hand)
+    scene = planning_scene(_plan_url(args.object, "objects"), hand_url=hand)
+    options = {"mu": 0.5 if args.mu is None else args.mu}
+    return scene.plant, scene.context, scene.object_body, scene.hand, options
+
+
 def _cmd_plan(args: argparse.Namespace) -> int:
-    from drakegrasp.planning import plan_grasps, planning_scene
+    from drakegrasp.planning import plan_grasps
 
     if args.out is not None and not args.out.endswith(".parquet"):
         raise InvalidOptionError(f"--out must name a .parquet file, got {args.out!r}")
-    hand = PLAN_HANDS.get(args.hand, args.hand)
-    scene = planning_scene(_plan_url(args.object, "objects"), hand_url=hand)
+    plant, context, object_body, hand, options = _plan_setup(args)
     result = plan_grasps(
-        scene.plant,
-        scene.context,
-        scene.object_body,
-        hand=scene.hand,
+        plant,
+        context,
+        object_body,
+        hand=hand,
         num_candidates=args.num,
-        mu=args.mu,
         seed=args.seed,
         progress=args.progress,
+        **options,
     )
     if args.out is not None:
         _write_plan_parquet(result, args.out)
@@ -652,19 +699,39 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         "object",
         nargs="?",
         default="box",
-        help="shipped object name (box, cylinder, sphere, hex_prism), a "
-        "package:// URL or a model file (default: box)",
+        help="a scene YAML file (or a shipped scene's name) whose drakegrasp: "
+        "section names the object and the hand (its base free, not welded), or "
+        "a shipped object name (box, cylinder, sphere, hex_prism), a "
+        "package:// URL or a model file, planned for --hand (default: box)",
     )
     plan.add_argument(
         "--hand",
-        default="flat",
-        help=f"gripper: {', '.join(PLAN_HANDS)} or a model URL/file (default: flat)",
+        default=None,
+        help=f"gripper for an object: {', '.join(PLAN_HANDS)} or a model "
+        "URL/file (default: flat; a scene names its own)",
     )
     plan.add_argument("--num", type=int, default=500, help="poses to sample (500)")
     plan.add_argument("--top", type=int, default=10, help="candidates to print (10)")
     plan.add_argument("--seed", type=int, default=0, help="random seed (0)")
     plan.add_argument(
-        "--mu", type=_positive_float, default=0.5, help="friction coefficient (0.5)"
+        "--mu",
+        type=_positive_float,
+        default=None,
+        help="friction coefficient (default: the scene's, else 0.5)",
+    )
+    plan.add_argument(
+        "--package",
+        action="append",
+        type=_package,
+        default=[],
+        metavar="NAME=DIR",
+        help="for a scene: resolve package://NAME/... to DIR (repeatable)",
+    )
+    plan.add_argument(
+        "--allow-any-file",
+        action="store_true",
+        help="trust the scene: let it reference files outside its packages and "
+        "its own directory",
     )
     plan.add_argument("--progress", action="store_true", help="show a progress bar")
     out = plan.add_mutually_exclusive_group()

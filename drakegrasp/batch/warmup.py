@@ -125,6 +125,7 @@ def _grasps(K: int, N: int, d: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
 def _steps() -> list[tuple[str, Callable[[], object]]]:
     from drakegrasp.batch.api import batch_force_closure, batch_form_closure
     from drakegrasp.batch.epsilon.driver import batch_epsilon_l1
+    from drakegrasp.batch.lp.ipm import solve_max_last
 
     K = 64
     out: list[tuple[str, Callable[[], object]]] = []
@@ -157,6 +158,16 @@ def _steps() -> list[tuple[str, Callable[[], object]]]:
         )
     p, n = _grasps(K, 7, 3, seed=7)
     out.append(("form closure, N = 7", lambda: batch_form_closure(p, n, workers=1)))
+    rng = np.random.default_rng(9)
+    B = rng.normal(size=(K, 12, 9))
+    B[:, :, -1] = np.abs(B[:, :, -1]) + 0.2
+    h = rng.uniform(1.0, 2.0, (K, 12))
+    out.append(
+        (
+            "interior point, one LP at a time (the planner's weight capacity)",
+            lambda: solve_max_last(B, h, kernel="compiled"),
+        )
+    )
     return out
 
 

@@ -15,13 +15,27 @@ import numpy as np
 
 from drakegrasp.errors import NoContactsError, PenetrationError
 from drakegrasp.planning.gripper import ParallelJaw
-from drakegrasp.plant.contacts import find_contacts
-from drakegrasp.plant.validation import hand_bodies, scoped_name
+from drakegrasp.plant.contacts import contacts_of_distances
+from drakegrasp.plant.validation import hand_bodies, hand_contact_bodies, scoped_name
 
-__all__ = ["MAX_CLOSING_STEPS", "BodyCloser", "axis_frames", "sample_poses"]
+__all__ = [
+    "MAX_CLOSING_STEPS",
+    "PAIR_REACH",
+    "BodyCloser",
+    "axis_frames",
+    "sample_poses",
+]
 
 MAX_CLOSING_STEPS = 50
 """Bound on the conservative-advancement steps of one closing."""
+
+PAIR_REACH = 0.02
+"""Metres a closing step's distance query reaches: a finger with nothing
+nearer advances by this much (minus half the tolerance), and fewer far pairs
+cross from Drake into Python."""
+
+# geometry roles in BodyCloser.role: outside the hand, then inside it
+_SCENE, _OBJECT, _HAND, _FINGER = 0, 1, 2, 3
 
 
 def axis_frames(d: np.ndarray, theta: np.ndarray) -> np.ndarray:
@@ -157,6 +171,16 @@ class BodyCloser:
         self.finger_names = [
             {scoped_name(plant, b) for b in bodies} for bodies in gripper.finger_bodies
         ]
+        self.role = dict.fromkeys(self.object_geoms, _OBJECT)
+        self.role.update(dict.fromkeys(self.hand_geoms, _HAND))
+        self.role.update({g: _FINGER + f for g, f in self.finger_of.items()})
+        self.hand_slot, self.object_slot = {}, {}
+        if object_body is not None:  # find_contacts' order: body, k_f, k_o
+            for b in hand_contact_bodies(plant, object_body, hand):
+                for kf, g in enumerate(plant.GetCollisionGeometriesForBody(b)):
+                    self.hand_slot[g] = (int(b.index()), kf, b)
+            for ko, g in enumerate(plant.GetCollisionGeometriesForBody(object_body)):
+                self.object_slot[g] = ko
 
     def _set(self, X_WH, q):
         self.plant.SetFreeBodyPose(self.ctx, self.g.base, X_WH)
@@ -169,10 +193,6 @@ class BodyCloser:
             in_a, in_b = a in self.hand_geoms, b in self.hand_geoms
             if in_a != in_b:
                 yield (a, b) if in_a else (b, a), pair.distance
-
-    def place(self, X_WH, opening):
-        """Stage 2: None when clear, else the rejection reason."""
-        return self.clear_at(X_WH, self.g.q_for_opening(opening))
 
     def clear_at(self, X_WH, q):
         """Put the hand at ``X_WH`` and ``q``; None when it penetrates nothing.
@@ -188,44 +208,86 @@ class BodyCloser:
                 return "hand collides with the scene"
         return None
 
-    def close(self, opening):
-        """Stage 3 from the placed open hand: (q, reason or None)."""
-        g, tol = self.g, self.tol
+    def close_on_body(self, X_WH, opening):
+        """Stages 2 and 3: place the open hand, close it, read the contacts.
+
+        One ``ComputeSignedDistancePairwiseClosestPoints`` (reaching
+        :data:`PAIR_REACH`) per closing step serves all three: at the open
+        pose it rejects penetration, at each step it gives each finger's
+        smallest distance ``ψ`` to the geometry outside the hand (at least
+        ``PAIR_REACH`` when nothing is nearer), and at the closed pose its
+        pairs within the tolerance are those :func:`~drakegrasp.find_contacts`
+        computes one by one (bitwise: the same Drake routine), so the contacts
+        are exactly what :func:`~drakegrasp.analyze_grasp` reads on the
+        applied candidate.
+
+        Returns
+        -------
+        contacts : list of PlantContact or None
+        q : (2,) float or None
+            The closed joint values.
+        reason : str or None
+            The rejection reason, None when the hand closed on the object.
+        """
+        g, tol, reach = self.g, self.tol, PAIR_REACH
         q = g.q_for_opening(opening).astype(float)
+        self._set(X_WH, q)
         toward = np.array([1.0, -1.0])  # finger 0 closes along +a, finger 1 along -a
         closed_limit = np.where(toward / g.pad_rate > 0, g.upper, g.lower)
-        for _ in range(MAX_CLOSING_STEPS):
+        role = self.role
+        for step_count in range(MAX_CLOSING_STEPS):
             query = self.port.Eval(self.ctx)
-            psi = np.full(2, np.inf)
+            pairs = query.ComputeSignedDistancePairwiseClosestPoints(reach)
+            psi = np.full(2, reach)
             hit_object = [False, False]
-            for (mine, other), distance in self._outside_pairs(query, g.max_opening):
-                f = self.finger_of.get(mine)
-                if f is not None and distance < psi[f]:
+            for pair in pairs:
+                ra, rb = role.get(pair.id_A, _SCENE), role.get(pair.id_B, _SCENE)
+                if (ra >= _HAND) == (rb >= _HAND):
+                    continue  # both in the hand, or both outside it
+                mine, other = (ra, rb) if ra >= _HAND else (rb, ra)
+                distance = pair.distance
+                if step_count == 0 and distance < -tol:
+                    if other == _OBJECT:
+                        return None, None, "hand collides with the object"
+                    return None, None, "hand collides with the scene"
+                f = mine - _FINGER
+                if f >= 0 and distance < psi[f]:
                     psi[f] = distance
-                    hit_object[f] = other in self.object_geoms
+                    hit_object[f] = other == _OBJECT
             if np.all(psi <= tol):
                 if not all(hit_object):
-                    return q, "finger blocked by the scene"
-                return q, None
+                    return None, None, "finger blocked by the scene"
+                found, reason = self._contacts(query, pairs)
+                return found, q, reason
             step = np.where(psi > tol, psi - 0.5 * tol, 0.0)
             q_new = q + toward * step / g.pad_rate
             beyond = (q_new - closed_limit) * np.sign(toward / g.pad_rate) > 0
-            at_limit = np.isclose(q, closed_limit, rtol=0, atol=1e-12)
+            at_limit = np.abs(q - closed_limit) <= 1e-12
             if np.any(beyond & at_limit & (psi > tol)):
-                return q, "finger misses the object"
+                return None, None, "finger misses the object"
             q = np.where(beyond, closed_limit, q_new)
             for j, v in zip(g.joints, q, strict=True):
                 j.set_translation(self.ctx, float(v))
-        return q, "closing did not converge"
+        return None, None, "closing did not converge"
 
-    def contacts(self):
-        """The closed hand's contacts, or (None, reason)."""
+    def _contacts(self, query, pairs):
+        """The closed hand's contacts from the last step's pairs: (found, reason)."""
+        results = []
+        for pair in pairs:
+            a, b = pair.id_A, pair.id_B
+            key = self.hand_slot.get(a) or self.hand_slot.get(b)
+            ko = self.object_slot.get(b if a in self.hand_slot else a)
+            if key is None or ko is None:
+                continue
+            results.append((key[0], key[1], ko, key[2], pair))
+        results.sort(key=lambda r: r[:3])
         try:
-            found = find_contacts(
+            found = contacts_of_distances(
                 self.plant,
                 self.ctx,
                 self.object,
-                hand=self.hand,
+                query,
+                [(r[3], r[1], r[2], r[4]) for r in results],
                 distance_tolerance=self.tol,
             )
         except NoContactsError:

@@ -194,13 +194,18 @@ def plan_grasps(
         Perturbed copies per force-closure candidate (0: robustness 0).
     noise : dict, optional
         ``{"position": m, "angle_deg": deg, "friction": relative}``; default
-        :data:`~drakegrasp.planning.ranking.DEFAULT_NOISE`.
+        :data:`~drakegrasp.planning.ranking.DEFAULT_NOISE`.  On an object body
+        the object's pose error (translation, and rotation about the grasp
+        axis), the jaws closing again on the moved object
+        (:mod:`drakegrasp.planning.reclose`); on a cloud, each finger's
+        contacts moved rigidly (:mod:`drakegrasp.planning.ranking`).
     certify : int, optional
         The best ``certify`` candidates also get the single-grasp verdict with
         its certificate (``GraspCandidate.closure``).
     weight_check : int or None, optional
         How many force-closure candidates get their weight capacity and a
-        score: None (default) all of them; a number limits the LPs (one per
+        score: None (default) all of them with robustness > 0 (the score is
+        robustness times capacity); a number limits the LPs (one per
         grasp) to the best by ``ε × robustness``, which is faster but may miss
         good grasps (see :mod:`drakegrasp.planning.ranking`).
     workers : int, optional
@@ -361,6 +366,7 @@ def plan_grasps(
         model=model, nu=torsional_friction, torque_scale=torque_scale,
         samples=robustness_samples, noise=noise, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
+        surface=None if body is None else surface, tol=tol,
     )  # fmt: skip
     reason = ""
     if not candidates:
@@ -384,14 +390,7 @@ def plan_grasps(
 
 def _close_on_body(closer: BodyCloser, X_WH, opening):
     """Stages 2-3 on the object body: (contacts, q, reason)."""
-    reason = closer.place(X_WH, opening)
-    if reason is not None:
-        return None, None, reason
-    q, reason = closer.close(opening)
-    if reason is not None:
-        return None, None, reason
-    found, reason = closer.contacts()
-    return found, q, reason
+    return closer.close_on_body(X_WH, opening)
 
 
 def _close_on_cloud(closer: BodyCloser, cloud: CloudFingers, X_WH, opening):

@@ -12,8 +12,11 @@ object uses the same ``torque_scale`` (the radius of a ball about the object's
 origin holding its collision geometry), so ε compares across candidates.
 
 **Robustness** is the fraction of ``S`` perturbed copies of a grasp that stay
-force closure (LP2).  A copy moves each finger's contacts rigidly, as a
-misplaced pad would: a rotation by an angle drawn from
+force closure (LP2).  On an object body, a copy moves the object by a sampled
+pose error and closes the jaws on it again
+(:mod:`drakegrasp.planning.reclose`), and scales μ as below.  On a point
+cloud (no surface to close on), a copy moves each finger's contacts rigidly,
+as a misplaced pad would: a rotation by an angle drawn from
 :math:`\mathcal N(0, \sigma_\theta^2)` about a uniformly random axis through the
 finger's contact centroid, then a translation drawn from
 :math:`\mathcal N(0, \sigma_p^2 I_3)`; and it scales μ by
@@ -30,9 +33,10 @@ which for two pads is the torsion about the grasp axis, the same for every
 placement of the pads; the weight capacity asks for the wrenches that gravity
 and shaking apply, and falls as the pads move away from the centre of mass
 (tested against Drake simulations in ``tests/planning/test_shake.py``).  The
-weight capacity is computed for every force-closure candidate (or, with
-``weight_check``, for that many, the best by :math:`\varepsilon \rho`; the
-others score 0).  Candidates are
+weight capacity is computed for every force-closure candidate with
+:math:`\rho > 0` (the others score 0 whatever their capacity, which is left
+NaN), or, with ``weight_check``, for that many, the best by
+:math:`\varepsilon \rho`; the others score 0.  Candidates are
 ordered by score, then :math:`\varepsilon \rho`, ``d*`` and the sample index,
 so a ranking is reproducible.
 """
@@ -46,6 +50,7 @@ import numpy as np
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
 from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.planning.candidates import GraspCandidate
+from drakegrasp.planning.reclose import reclosed_robustness
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.validation import scoped_name
 
@@ -217,7 +222,7 @@ def robustness(
     res = batch_force_closure(
         P,
         Nrm,
-        mus,
+        mus[:, None],  # one μ per copy, (K S, 1): never ambiguous with N
         model=model,
         torsional_friction=torsional_friction,
         workers=workers,
@@ -240,6 +245,13 @@ def _finger_label(contact, names) -> int:
     return 2
 
 
+def _axes_O(kept, rows, gripper, X_WO) -> np.ndarray:
+    """(K, 3) grasp axes (K's x axis) of ``kept[rows]`` in the object frame O."""
+    R_OW = X_WO.rotation().matrix().T
+    a_H = gripper.X_HK.rotation().matrix()[:, 0]
+    return np.array([R_OW @ kept[i][1].rotation().matrix() @ a_H for i in rows])
+
+
 def _squeeze(weight: float, alpha: float) -> float:
     if not np.isfinite(alpha):
         return float("nan")
@@ -248,13 +260,17 @@ def _squeeze(weight: float, alpha: float) -> float:
 
 def rank_candidates(
     kept, *, finger_names, gripper, plant, mu, model, nu, torque_scale, samples,
-    noise, rng, certify, workers, X_WO, weight, weight_check,
+    noise, rng, certify, workers, X_WO, weight, weight_check, surface=None,
+    tol=None,
 ):  # fmt: skip
     """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
 
     ``kept`` holds ``(sample, X_WH, q, opening, contacts)`` of every closed
     pose; contacts have ``p_OC``, ``nhat_O`` and ``finger_body``.  ``weight``
-    is the object's weight (N), NaN when unknown.
+    is the object's weight (N), NaN when unknown.  With the object's
+    ``surface`` (an object body), robustness re-closes the jaws on the moved
+    object (:mod:`drakegrasp.planning.reclose`, within ``tol``); without (a
+    point cloud) it moves each finger's contacts (:func:`perturbed_copies`).
     """
     if not kept:
         return ()
@@ -276,7 +292,13 @@ def rank_candidates(
         )  # fmt: skip
         is_closure[idx], d_star[idx], rank[idx], eps[idx] = fc, ds, rk, ep
         closed = idx[fc]
-        if len(closed):
+        if len(closed) and surface is not None:
+            rho[closed] = reclosed_robustness(
+                surface, P[fc], F[fc], _axes_O(kept, closed, gripper, X_WO), mu,
+                samples=samples, rng=rng, **noise, tol=tol, model=model,
+                torsional_friction=nu, workers=workers,
+            )  # fmt: skip
+        elif len(closed):
             rho[closed] = robustness(
                 P[fc], Nrm[fc], F[fc], mu, samples=samples, rng=rng, noise=noise,
                 model=model, torsional_friction=nu, workers=workers,
@@ -284,7 +306,8 @@ def rank_candidates(
     samples_of = np.array([k[0] for k in kept])
     pre = eps * rho
     checked = rank_order(pre, d_star, samples_of)
-    checked = checked[is_closure[checked]][:weight_check]
+    # score = α ρ: a candidate with ρ = 0 scores 0 whatever its α, so no LP
+    checked = checked[is_closure[checked] & (rho[checked] > 0)][:weight_check]
     alpha = np.full(K, np.nan)
     for idx in group_by_count(counts[checked]).values():
         idx = checked[idx]

@@ -268,7 +268,9 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     rows = M + G + 1
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         # a degenerate dual may diverge (overflow); it is re-solved below
-        sol = solve_max_last(B.reshape(K * D, rows, n), h.reshape(K * D, rows))
+        sol = solve_max_last(
+            B.reshape(K * D, rows, n), h.reshape(K * D, rows), kernel="auto"
+        )
     alpha = np.maximum(-sol.value, 0.0).reshape(K, D)
     stuck = np.flatnonzero(~sol.converged.reshape(K, D).all(axis=1))
     if len(stuck):  # degenerate duals (coplanar pads): the primal through Clp

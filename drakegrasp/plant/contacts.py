@@ -64,6 +64,7 @@ __all__ = [
     "DEFAULT_DISTANCE_TOLERANCE",
     "PATCH_ANGLE_TOL",
     "PlantContact",
+    "contacts_of_distances",
     "find_contacts",
     "hand_bodies",
     "resolve_object_body",
@@ -277,6 +278,86 @@ def find_contacts(
     object_name = _scoped_name(plant, body)
     if not object_geometries:
         raise ModelError(f"the object body {object_name!r} has no collision geometry")
+    results = []
+    for finger in fingers:
+        for kf, gf in enumerate(plant.GetCollisionGeometriesForBody(finger)):
+            for ko, go in enumerate(object_geometries):
+                if inspector.CollisionFiltered(go, gf):
+                    continue
+                try:
+                    r = query.ComputeSignedDistancePairClosestPoints(go, gf)
+                except RuntimeError as e:
+                    shapes = [type(inspector.GetShape(g)).__name__ for g in (go, gf)]
+                    raise ModelError(
+                        "Drake cannot compute the signed distance between "
+                        f"{inspector.GetName(go)!r} ({shapes[0]}) and "
+                        f"{inspector.GetName(gf)!r} ({shapes[1]}): {e}"
+                    ) from None
+                results.append((finger, kf, ko, r))
+    return contacts_of_distances(
+        plant,
+        plant_context,
+        body,
+        query,
+        results,
+        distance_tolerance=tol,
+        allow_penetration=allow_penetration,
+        patches=patches,
+    )
+
+
+def contacts_of_distances(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    body,
+    query: QueryObject,
+    results,
+    *,
+    distance_tolerance: float,
+    allow_penetration: bool = False,
+    patches: str = "vertices",
+) -> list[PlantContact]:
+    """The contacts of :func:`find_contacts` from signed distances already computed.
+
+    :func:`find_contacts` computes one ``SignedDistancePair`` per (hand
+    geometry, object geometry) pair and reads them here; a caller that already
+    holds them (a planner's ``ComputeSignedDistancePairwiseClosestPoints``
+    with ``max_distance >= distance_tolerance``, whose pairs are bitwise those
+    of the pair query) passes them instead of querying again.  Pairs farther
+    than the tolerance may be left out; they only name the closest geometry in
+    :class:`~drakegrasp.NoContactsError`.
+
+    Parameters
+    ----------
+    plant, plant_context : MultibodyPlant, Context
+        As in :func:`find_contacts` (the plant's own context).
+    body : RigidBody
+        The object.
+    query : QueryObject
+        The query object the distances were computed with (geometry poses).
+    results : iterable of (RigidBody, int, int, SignedDistancePair)
+        ``(hand body, k_f, k_o, pair)``: the body holding the hand geometry,
+        its geometry's and the object geometry's place among their bodies'
+        collision geometries, and Drake's pair (either order of ids), in the
+        order of :func:`find_contacts` (hand body index, ``k_f``, ``k_o``).
+    distance_tolerance : float, metres
+    allow_penetration : bool, optional
+    patches : {"vertices", "witness"}, optional
+
+    Returns
+    -------
+    list of PlantContact
+        As :func:`find_contacts` returns.
+
+    Raises
+    ------
+    NoContactsError, PenetrationError
+        As :func:`find_contacts`.
+    """
+    tol = distance_tolerance
+    inspector = query.inspector()
+    object_name = _scoped_name(plant, body)
+    object_geometries = set(plant.GetCollisionGeometriesForBody(body))
     X_WO = plant.EvalBodyPoseInWorld(plant_context, body)
     X_OW = X_WO.inverse()
     R_OW = _rotation(X_OW)
@@ -297,62 +378,57 @@ def find_contacts(
             f"{finger_geom(finger_name, gf)}"
         )
 
-    for finger in fingers:
-        finger_name = _scoped_name(plant, finger)
-        X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
-        for kf, gf in enumerate(plant.GetCollisionGeometriesForBody(finger)):
-            for ko, go in enumerate(object_geometries):
-                if inspector.CollisionFiltered(go, gf):
-                    continue
-                try:
-                    r = query.ComputeSignedDistancePairClosestPoints(go, gf)
-                except RuntimeError as e:
-                    shapes = [type(inspector.GetShape(g)).__name__ for g in (go, gf)]
-                    raise ModelError(
-                        "Drake cannot compute the signed distance between "
-                        f"{inspector.GetName(go)!r} ({shapes[0]}) and "
-                        f"{inspector.GetName(gf)!r} ({shapes[1]}): {e}"
-                    ) from None
-                if r.id_A == go:
-                    p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
-                else:  # Drake swapped the pair: normal now points into the finger
-                    p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
-                psi = float(r.distance)
-                if closest is None or psi < closest[0]:
-                    closest = (psi, finger_name, gf)
-                if psi < -tol and not allow_penetration:
-                    penetrations.append(
-                        f"{pair(go, finger_name, gf)} penetrate by {-psi * 1e3:.4g} mm"
-                    )
-                    continue
-                if abs(psi) > tol and not (allow_penetration and psi < 0):
-                    continue
-                found = _pair_contacts(
-                    query=query,
-                    inspector=inspector,
-                    go=go,
-                    gf=gf,
-                    p_GaCa=np.asarray(p_GaCa),
-                    p_GbCb=np.asarray(p_GbCb),
-                    nhat_W=np.asarray(nhat_W),
-                    psi=psi,
-                    to_O=to_O,
-                    R_OW=R_OW,
-                    X_FO=X_WF.inverse().multiply(X_WO),
-                    finger=finger,
-                    finger_name=finger_name,
-                    indices=(kf, ko),
-                    tol=tol,
-                    patches=patches,
-                )
-                deepest = min(c.psi for c in found)
-                if deepest < -tol and not allow_penetration:  # a tilted patch
-                    penetrations.append(
-                        f"{pair(go, finger_name, gf)} penetrate by "
-                        f"{-deepest * 1e3:.4g} mm at a patch corner"
-                    )
-                    continue
-                contacts += found
+    names = {}
+    for finger, kf, ko, r in results:
+        if finger.index() not in names:
+            X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
+            names[finger.index()] = (
+                _scoped_name(plant, finger),
+                X_WF.inverse().multiply(X_WO),
+            )
+        finger_name, X_FO = names[finger.index()]
+        if r.id_A in object_geometries:
+            go, gf = r.id_A, r.id_B
+            p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
+        else:  # Drake swapped the pair: normal now points into the finger
+            go, gf = r.id_B, r.id_A
+            p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
+        psi = float(r.distance)
+        if closest is None or psi < closest[0]:
+            closest = (psi, finger_name, gf)
+        if psi < -tol and not allow_penetration:
+            penetrations.append(
+                f"{pair(go, finger_name, gf)} penetrate by {-psi * 1e3:.4g} mm"
+            )
+            continue
+        if abs(psi) > tol and not (allow_penetration and psi < 0):
+            continue
+        found = _pair_contacts(
+            query=query,
+            inspector=inspector,
+            go=go,
+            gf=gf,
+            p_GaCa=np.asarray(p_GaCa),
+            p_GbCb=np.asarray(p_GbCb),
+            nhat_W=np.asarray(nhat_W),
+            psi=psi,
+            to_O=to_O,
+            R_OW=R_OW,
+            X_FO=X_FO,
+            finger=finger,
+            finger_name=finger_name,
+            indices=(kf, ko),
+            tol=tol,
+            patches=patches,
+        )
+        deepest = min(c.psi for c in found)
+        if deepest < -tol and not allow_penetration:  # a tilted patch
+            penetrations.append(
+                f"{pair(go, finger_name, gf)} penetrate by "
+                f"{-deepest * 1e3:.4g} mm at a patch corner"
+            )
+            continue
+        contacts += found
     if penetrations:
         raise PenetrationError(
             f"penetration deeper than distance_tolerance = {tol:g} m: "

@@ -3,6 +3,8 @@
 - :func:`draw_grasp` / :func:`clear_grasp`: contacts, contact frames, friction
   cones and contact forces in Drake's Meshcat, framed by the camera
   (:func:`frame_points`).
+- :func:`draw_candidates` / :func:`plot_score_distribution`: planned grasps as
+  ghost hands coloured by score in Meshcat, and their scores' histogram.
 - :func:`plot_planar_grasp`: a planar grasp with its outline, normals, exact
   cones and forces (matplotlib).
 - :func:`plot_wrench_space`: the primitive wrenches of a planar grasp and their
@@ -12,6 +14,12 @@ matplotlib and scipy are imported only when a plot is made, so importing this
 package needs neither.
 """
 
+from drakegrasp.visualization.candidates import (
+    CandidateDrawing,
+    draw_candidates,
+    plot_score_distribution,
+    score_colors,
+)
 from drakegrasp.visualization.geometry import (
     cone_edge_directions,
     contact_forces_in_grasp_frame,
@@ -45,6 +53,7 @@ from drakegrasp.visualization.wrench_space import (
 __all__ = [
     "CameraView",
     "DEFAULT_PREFIX",
+    "CandidateDrawing",
     "MESHCAT_COLORS",
     "PLOT_COLORS",
     "GraspDrawing",
@@ -55,14 +64,17 @@ __all__ = [
     "cone_edge_directions",
     "contact_forces_in_grasp_frame",
     "contact_pose_3d",
+    "draw_candidates",
     "draw_grasp",
     "exact_cone_mesh",
     "frame_points",
     "grasp_pose",
     "normalize_contact_forces",
     "plot_planar_grasp",
+    "plot_score_distribution",
     "plot_wrench_space",
     "pyramid_mesh",
+    "score_colors",
     "set_translucent",
     "visualizer_paths",
     "wrench_hull",

@@ -100,6 +100,7 @@ def _kernel_dispatchers():
         "drakegrasp.batch.lp.block_ops",
         "drakegrasp.batch.lp.fused_kernel",
         "drakegrasp.batch.lp.householder",
+        "drakegrasp.batch.lp.ipm_kernel",
         "drakegrasp.batch.epsilon.kernel",
         "drakegrasp.batch.epsilon.polytope",
     ]

@@ -43,3 +43,59 @@ def test_plan_errors_are_one_line(capsys, tmp_path):
     assert ".parquet" in capsys.readouterr().err
     assert main(["plan", "--num", "-3"]) == 1
     assert "num_candidates" in capsys.readouterr().err
+
+
+_PLAN_SCENE = """
+directives:
+- add_model:
+    name: gripper
+    file: package://drakegrasp/hands/parallel_jaw_flat.sdf
+- add_model:
+    name: box
+    file: package://drakegrasp/objects/box.sdf
+    default_free_body_pose:
+      box:
+        translation: [0.0, 0.0, 0.1]
+- add_model:
+    name: table
+    file: package://drakegrasp/objects/box.sdf
+    default_free_body_pose:
+      box:
+        translation: [0.0, 0.0, {table_z}]
+drakegrasp:
+  description: a free flat jaw, the box, and a second box as a table under it
+  object_body: box::box
+  hand: gripper
+  mu: 0.7
+"""
+
+
+def _scene_file(tmp_path, table_z):
+    path = tmp_path / "plan_scene.yaml"
+    path.write_text(_PLAN_SCENE.format(table_z=table_z))
+    return str(path)
+
+
+def test_plan_a_scene_uses_its_hand_object_mu_and_surroundings(tmp_path, capsys):
+    far = _scene_file(tmp_path, -5.0)  # the second box far away: no obstacle
+    assert main(["plan", far, "--num", "80", "--seed", "1", "--json"]) == 0
+    alone = json.loads(capsys.readouterr().out)
+    assert alone["object_body"] == "box::box" and alone["mu"] == 0.7
+    assert alone["rejections"].get("hand collides with the scene", 0) == 0
+    # the other box just below the object: poses from below now hit the scene
+    assert main(["plan", _scene_file(tmp_path, 0.0), "--num", "80", "--seed", "1",
+                 "--json", "--mu", "0.4"]) == 0  # fmt: skip
+    near = json.loads(capsys.readouterr().out)
+    assert near["mu"] == 0.4
+    assert near["rejections"].get("hand collides with the scene", 0) > 0
+    assert near["num_sampled"] == alone["num_sampled"] == 80
+
+
+def test_plan_a_scene_refuses_hand_and_a_welded_hand(tmp_path, capsys):
+    path = _scene_file(tmp_path, -5.0)
+    assert main(["plan", path, "--hand", "wsg", "--num", "5"]) == 1
+    assert "--hand is for an object" in capsys.readouterr().err
+    # a shipped analysis scene welds its gripper to the world: said in one line
+    assert main(["plan", "parallel_jaw_flat_box", "--num", "5"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "free" in err

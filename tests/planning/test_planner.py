@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from pydrake.math import RigidTransform, RollPitchYaw
 
-from drakegrasp import analyze_grasp
+from drakegrasp import analyze_grasp, find_contacts
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning import REASONS, plan_grasps, planning_scene
 from drakegrasp.planning.planner import MAX_CANDIDATES
@@ -87,6 +87,20 @@ def test_candidates_are_valid_and_agree_with_analyze_grasp(wsg_result):
         assert len(report.contacts) == c.num_contacts
         assert report.force_closure.is_closure == c.is_closure
         assert np.allclose(report.grasp.positions, c.grasp.positions)
+
+
+def test_contacts_are_bitwise_those_of_find_contacts(wsg_result):
+    # the planner reads contacts from its closing query's pairs, not pair by pair
+    scene, result = wsg_result
+    ctx = scene.context.Clone()
+    for c in result:
+        c.apply(scene.plant, ctx, object_body=scene.object_body)
+        found = find_contacts(scene.plant, ctx, scene.object_body, hand=scene.hand)
+        assert [k.finger_geometry_label for k in found] == [
+            k.finger_geometry_label for k in c.contacts
+        ]
+        assert np.array_equal([k.p_OC for k in found], [k.p_OC for k in c.contacts])
+        assert np.array_equal([k.nhat_O for k in found], [k.nhat_O for k in c.contacts])
 
 
 def test_epsilon_uses_one_torque_scale(wsg_result):

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.planning import plan_grasps, shake_test
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 
 MU = 1.0  # the friction of the models' proximity properties (what Drake simulates)
 MARGIN = 1.2  # the squeeze tried: 1.2 x what the planner says its top ones need
@@ -40,6 +40,18 @@ def _rates(scene, result, k=5):
 def test_top_candidates_hold_and_random_ones_less(wsg_scene, name):
     # at the squeeze the planner predicts for its best five (with 20 % margin)
     scene = wsg_scene(name)
+    top, rand = _rates(scene, _plan(scene))
+    assert top >= 0.8
+    assert rand <= top - 0.4
+
+
+def test_the_wsg_on_the_cylinder_holds_with_its_best_candidates(drake_models_dir):
+    # the shipped cylinder: grasps whose two pad tips touch it at different
+    # azimuths (within the tolerance, by accident of the approach angle) pivot
+    # and drop; robustness by re-closing on the moved cylinder ranks them low
+    scene = planning_scene(
+        "package://drakegrasp/objects/cylinder.sdf", models_dir=drake_models_dir
+    )
     top, rand = _rates(scene, _plan(scene))
     assert top >= 0.8
     assert rand <= top - 0.4

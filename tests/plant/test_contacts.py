@@ -23,6 +23,7 @@ from pydrake.systems.framework import DiagramBuilder
 from drakegrasp import ModelError, NoContactsError, PenetrationError
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant import find_contacts, models_dir
+from drakegrasp.plant.contacts import contacts_of_distances
 
 X_WO = RigidTransform(RollPitchYaw(0.3, -0.2, 0.5), [0.1, 0.2, 0.3])
 R_TIP = 0.01
@@ -368,3 +369,39 @@ def test_object_without_collision_geometry():
     ctx = plant.GetMyContextFromRoot(diagram.CreateDefaultContext())
     with pytest.raises(ModelError, match="no collision geometry"):
         find_contacts(plant, ctx, object_body=obj)
+
+
+def test_contacts_of_distances_from_the_pairwise_query_equal_find_contacts():
+    # a flat pad patch, a sphere tip on an edge-free face and a far finger: the
+    # pairwise query's pairs (within any reach >= the tolerance) give find_contacts'
+    # contacts, in its order, bitwise
+    rig = Rig(
+        Box(0.1, 0.06, 0.04),
+        [
+            (Box(0.01, 0.02, 0.02), at([0.055 + GAP, 0.0, 0.0])),
+            (Sphere(R_TIP), at([-0.05 - R_TIP, 0.01, 0.0])),
+            (Sphere(R_TIP), at([0.0, 0.03 + R_TIP + 0.004, 0.0])),
+        ],
+    )
+    expected = rig.contacts()
+    query = rig.plant.get_geometry_query_input_port().Eval(rig.ctx)
+    slot = {rig.plant.GetCollisionGeometriesForBody(b)[0]: b for b in rig.fingers}
+    for reach in (1e-4, 0.01):
+        results = []
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(reach):
+            body = slot.get(pair.id_A) or slot.get(pair.id_B)
+            results.append((body, 0, 0, pair))
+        results.sort(key=lambda r: int(r[0].index()))
+        got = contacts_of_distances(
+            rig.plant, rig.ctx, rig.object, query, results, distance_tolerance=1e-4
+        )
+        assert len(got) == len(expected) == 5  # four patch corners and one tip
+        for a, b in zip(got, expected, strict=True):
+            assert a.finger_geometry_label == b.finger_geometry_label
+            assert np.array_equal(a.p_OC, b.p_OC)
+            assert np.array_equal(a.nhat_O, b.nhat_O)
+            assert a.psi == b.psi and a.normal_source == b.normal_source
+    with pytest.raises(NoContactsError, match="closest finger geometry"):
+        contacts_of_distances(
+            rig.plant, rig.ctx, rig.object, query, results[2:], distance_tolerance=1e-4
+        )

@@ -1,0 +1,219 @@
+"""Planned grasps as pictures: ghost hands in Meshcat, the score distribution.
+
+:func:`draw_candidates` draws the best ``top`` candidates of a ranked planning
+result as translucent copies of the hand, each at its planned pose and finger
+opening, coloured by score (:func:`score_colors`: red for the lowest score
+drawn, through yellow, to green for the highest), so one look shows where the
+good grasps sit on the object.  :func:`plot_score_distribution` draws the
+histogram of every candidate's score (matplotlib), force-closure candidates
+apart from the others, with the score of the ``top``-th best marked.
+
+Candidates are read by their attributes only (``X_WH``, ``q_hand``,
+``joint_names``, ``hand_base``, ``score``, ``is_closure`` and ``apply``, as
+:class:`~drakegrasp.planning.candidates.GraspCandidate` has them): this layer
+sits inside the planning one and does not import it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.geometry import Meshcat, Rgba, Role
+
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.plant.validation import plant_context_of, resolve_body
+from drakegrasp.visualization.plots import import_pyplot
+
+__all__ = [
+    "CANDIDATES_PREFIX",
+    "CandidateDrawing",
+    "draw_candidates",
+    "plot_score_distribution",
+    "score_colors",
+]
+
+CANDIDATES_PREFIX = "drakegrasp/candidates"
+"""Meshcat path under which :func:`draw_candidates` draws."""
+
+_STOPS = np.array(
+    [[0.85, 0.2, 0.15], [0.95, 0.8, 0.2], [0.2, 0.7, 0.3]]
+)  # red, yellow, green
+
+
+def score_colors(scores, *, alpha: float = 0.4) -> np.ndarray:
+    """(K, 4) RGBA colours of scores: red (lowest) → yellow → green (highest).
+
+    Linear in the score between the lowest and the highest of ``scores``; all
+    green when they are equal.  ``alpha`` is the opacity (0 to 1).
+    """
+    s = np.asarray(scores, dtype=float).reshape(-1)
+    if not 0.0 <= alpha <= 1.0:
+        raise InvalidOptionError(f"alpha must be in [0, 1], got {alpha}")
+    if not np.all(np.isfinite(s)):
+        raise InvalidOptionError(f"scores must be finite, got {s.tolist()}")
+    span = s.max() - s.min() if len(s) else 0.0
+    t = np.ones_like(s) if span <= 0 else (s - s.min()) / span
+    x = 2.0 * t  # [0, 2] over the two segments of _STOPS
+    k = np.minimum(x.astype(int), 1)
+    f = (x - k)[:, None]
+    rgb = (1 - f) * _STOPS[k] + f * _STOPS[k + 1]
+    return np.column_stack([rgb, np.full(len(s), alpha)])
+
+
+@dataclass(frozen=True)
+class CandidateDrawing:
+    """What :func:`draw_candidates` drew.
+
+    Attributes
+    ----------
+    paths : tuple of str
+        One Meshcat path per drawn candidate, best first.
+    scores : (K,) float
+        Their scores.
+    colors : (K, 4) float
+        Their RGBA colours.
+    """
+
+    paths: tuple[str, ...]
+    scores: np.ndarray
+    colors: np.ndarray
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return jsonable(
+            {"paths": list(self.paths), "scores": self.scores, "colors": self.colors}
+        )
+
+    def __str__(self) -> str:
+        if not self.paths:
+            return "no candidates drawn"
+        return (
+            f"{len(self.paths)} ghost hands under {self.paths[0].rsplit('/', 1)[0]}, "
+            f"scores {self.scores.max():.4g} (green) to {self.scores.min():.4g} (red)"
+        )
+
+
+def _hand_bodies(plant, candidate):
+    base = resolve_body(plant, candidate.hand_base)
+    instances = {base.model_instance()}
+    for name in candidate.joint_names:
+        model, _, joint = name.rpartition("::")
+        j = plant.GetJointByName(joint, plant.GetModelInstanceByName(model))
+        instances.add(j.child_body().model_instance())
+    return [
+        plant.get_body(b) for i in sorted(instances) for b in plant.GetBodyIndices(i)
+    ]
+
+
+def draw_candidates(
+    meshcat: Meshcat,
+    plant,
+    plant_context,
+    candidates,
+    *,
+    top: int = 10,
+    alpha: float = 0.4,
+    prefix: str = CANDIDATES_PREFIX,
+) -> CandidateDrawing:
+    """Draw the best ``top`` candidates as ghost hands coloured by score.
+
+    Parameters
+    ----------
+    meshcat : pydrake.geometry.Meshcat
+    plant : MultibodyPlant
+        The plant the candidates were planned in.
+    plant_context : Context
+        Its context (or the diagram's root); read, never changed (the hands
+        are posed in a copy).
+    candidates : sequence of GraspCandidate
+        Ranked best first, e.g. :func:`~drakegrasp.plan_grasps`'s result.
+    top : int, optional
+        How many to draw (the first ``top``).
+    alpha : float, optional
+        Opacity of the ghosts.
+    prefix : str, optional
+        Meshcat path; what was under it is deleted first.
+
+    Returns
+    -------
+    CandidateDrawing
+        Candidate ``k`` is under ``{prefix}/{k}``, each hand body under
+        ``{prefix}/{k}/{body}`` at its pose ``X_WB`` (world frame).
+    """
+    if not isinstance(meshcat, Meshcat):
+        raise InvalidOptionError(
+            f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
+        )
+    if isinstance(top, bool) or not isinstance(top, int | np.integer) or top < 0:
+        raise InvalidOptionError(f"top must be an integer >= 0, got {top!r}")
+    ctx = plant_context_of(plant, plant_context)
+    inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
+    scratch = plant.CreateDefaultContext()  # a copy of the user's configuration
+    plant.SetPositions(scratch, plant.GetPositions(ctx))
+    shown = list(candidates)[: int(top)]
+    scores = np.array([float(c.score) for c in shown])
+    colors = score_colors(scores, alpha=alpha) if shown else np.zeros((0, 4))
+    meshcat.Delete(prefix)
+    paths = []
+    for k, (c, rgba) in enumerate(zip(shown, colors, strict=True)):
+        c.apply(plant, scratch)
+        color = Rgba(*rgba)
+        path = f"{prefix}/{k}"
+        for body in _hand_bodies(plant, c):
+            frame = plant.GetBodyFrameIdOrThrow(body.index())
+            geoms = inspector.GetGeometries(frame, Role.kIllustration)
+            geoms = geoms or inspector.GetGeometries(frame, Role.kProximity)
+            body_path = f"{path}/{body.name()}"
+            for n, g in enumerate(geoms):
+                meshcat.SetObject(f"{body_path}/g{n}", inspector.GetShape(g), color)
+                meshcat.SetTransform(f"{body_path}/g{n}", inspector.GetPoseInFrame(g))
+            meshcat.SetTransform(body_path, plant.EvalBodyPoseInWorld(scratch, body))
+        paths.append(path)
+    return CandidateDrawing(tuple(paths), scores, colors)
+
+
+def plot_score_distribution(candidates, *, ax=None, bins: int = 30, top: int = 10):
+    """Histogram of the candidates' scores (matplotlib).
+
+    Force-closure candidates and the others are stacked in two colours; a
+    dashed line marks the score of the ``top``-th best candidate (the cut of
+    :func:`draw_candidates`).
+
+    Parameters
+    ----------
+    candidates : sequence of GraspCandidate
+    ax : matplotlib Axes, optional
+        Default: a new figure's.
+    bins : int, optional
+    top : int, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    plt = import_pyplot()
+    if isinstance(bins, bool) or not isinstance(bins, int | np.integer) or bins < 1:
+        raise InvalidOptionError(f"bins must be an integer >= 1, got {bins!r}")
+    rows = list(candidates)
+    scores = np.array([float(c.score) for c in rows])
+    closure = np.array([bool(c.is_closure) for c in rows], dtype=bool)
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6, 3.5))
+    edges = np.histogram_bin_edges(scores if len(scores) else [0.0, 1.0], bins=bins)
+    ax.hist(
+        [scores[closure], scores[~closure]],
+        bins=edges,
+        stacked=True,
+        color=["tab:green", "tab:gray"],
+        label=["force closure", "not force closure"],
+    )
+    if len(rows) and top > 0:
+        cut = np.sort(scores)[::-1][min(top, len(scores)) - 1]
+        ax.axvline(cut, color="k", linestyle="--", label=f"top {min(top, len(rows))}")
+    ax.set_xlabel("score (robustness × weight capacity)")
+    ax.set_ylabel("candidates")
+    ax.set_title(f"{len(rows)} candidates")
+    ax.legend(loc="upper right")
+    return ax
