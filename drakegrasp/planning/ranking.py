@@ -169,8 +169,8 @@ def verdicts(
     res = batch_force_closure(
         positions,
         normals,
-        mu,
-        model=model,
+        mu=mu,
+        contact_model=model,
         torsional_friction=torsional_friction,
         workers=workers,
     )
@@ -180,8 +180,8 @@ def verdicts(
         eps[closed] = batch_epsilon_l1(
             positions[closed],
             normals[closed],
-            mu,
-            model=model,
+            mu=mu,
+            contact_model=model,
             torsional_friction=torsional_friction,
             characteristic_lengths=torque_scale,
             workers=workers,
@@ -222,8 +222,8 @@ def robustness(
     res = batch_force_closure(
         P,
         Nrm,
-        mus[:, None],  # one μ per copy, (K S, 1): never ambiguous with N
-        model=model,
+        mu=mus[:, None],  # one μ per copy, (K S, 1): never ambiguous with N
+        contact_model=model,
         torsional_friction=torsional_friction,
         workers=workers,
     )
@@ -341,7 +341,11 @@ def rank_candidates(
                 ),
                 opening=opening,
                 contacts=tuple(found),
-                contact_options={"mu": mu, "model": model, "torsional_friction": nu},
+                contact_options={
+                    "mu": mu,
+                    "contact_model": model,
+                    "torsional_friction": nu,
+                },
                 is_closure=bool(is_closure[i]),
                 d_star=float(d_star[i]),
                 rank=int(rank[i]),

@@ -196,8 +196,8 @@ def reclosed_robustness(
         res = batch_force_closure(
             p_OC[take],
             nhat[take],
-            mus[rows, None],  # one μ per copy (K, 1): never read per contact
-            model=model,
+            mu=mus[rows, None],  # one μ per copy (K, 1): never read per contact
+            contact_model=model,
             torsional_friction=torsional_friction,
             workers=workers,
         )

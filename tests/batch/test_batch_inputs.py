@@ -280,4 +280,4 @@ def test_workers_must_be_a_count(grasps, workers):
     # workers=True ran as one worker: a bool is not a count
     P, Nrm = grasps
     with pytest.raises(InvalidOptionError, match="workers"):
-        batch_force_closure(P, Nrm, 0.5, workers=workers)
+        batch_force_closure(P, Nrm, mu=0.5, workers=workers)

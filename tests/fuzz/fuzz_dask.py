@@ -88,7 +88,7 @@ def dask_case(spec: dict) -> dict:
         keep = {k: v for k, v in options.items() if k not in ("partition_chunks",)}
         if kind == "form":
             return dg.batch_form_closure(P, Nrm, workers=1, **keep)
-        return dg.batch_force_closure(P, Nrm, mu, workers=1, **keep)
+        return dg.batch_force_closure(P, Nrm, mu=mu, workers=1, **keep)
 
     def remote(P, Nrm, mu, **extra):
         m = None if kind == "form" else mu
@@ -163,7 +163,7 @@ _OPTIONS = {
     "partition_chunks": ((1, 2, 7), (0, -1, 0.5, True, "2", None, math.nan)),
     "chunk_size": ((None, 1, 3, 50), (0, -1, 1.5, "4", True)),
     "tol": ((1e-6, 1e-7), (math.nan, -1.0, "x")),
-    "model": (("hard_finger", "frictionless"), ("soft", 3)),
+    "contact_model": (("hard_finger", "frictionless"), ("soft", 3)),
     "workers": ((), (1, 2, None)),
     "progress": ((), (True,)),
     "kind": (("force", "form"), ("both", None, 1)),

@@ -45,7 +45,7 @@ OPTIONS = {
         (("bogus",), [None], 5, [1j]),
     ),
     "progress": ((False,), ("yes", 1, None, math.nan)),
-    "model": (("hard_finger", "frictionless"), ("soft", None, 1, "")),
+    "contact_model": (("hard_finger", "frictionless"), ("soft", None, 1, "")),
 }
 
 
@@ -106,7 +106,7 @@ def engine_call(kind, positions, normals, mu, options):
     def run(P, Nrm, mu):
         if kind == "form":
             return dg.batch_form_closure(P, Nrm, **options)
-        return dg.batch_force_closure(P, Nrm, mu, **options)
+        return dg.batch_force_closure(P, Nrm, mu=mu, **options)
 
     r = run(positions, normals, mu)
     out = {
@@ -297,7 +297,7 @@ def engine_cases(sandbox: Sandbox, seed: int = 214, count: int = 300) -> Iterato
             if kind == "form" and option == "torsional_friction":
                 kind, mus = "force", np.full((K, N), mu_value)
             if soft:
-                options["model"] = "soft_finger"
+                options["contact_model"] = "soft_finger"
             options[option] = value
             if K == 0 and expect == "refuse":
                 expect = "either"
@@ -309,7 +309,7 @@ def engine_cases(sandbox: Sandbox, seed: int = 214, count: int = 300) -> Iterato
                 value = pick(rng, good)
             else:
                 value, expect = pick(rng, bad), "refuse"
-            if option in ("model", "num_generators"):  # force closure's options
+            if option in ("contact_model", "num_generators"):  # force closure's options
                 if kind == "form":
                     kind, mus = "force", np.full((K, N), mu_value)
                 if value == "frictionless":
@@ -321,7 +321,8 @@ def engine_cases(sandbox: Sandbox, seed: int = 214, count: int = 300) -> Iterato
         verdicts = (
             expect != "refuse"
             and options.get("tol", 1e-6) == 1e-6
-            and options.get("model") != "soft_finger"  # no soft cones in the oracle
+            and options.get("contact_model")
+            != "soft_finger"  # no soft cones in the oracle
         )
         n_g = options.get("num_generators", 8)
         check = _checker(P, Nrm, mus, K, verdicts=verdicts, n_g=n_g)
