@@ -26,9 +26,9 @@ a hint naming ``--allow-penetration`` and ``--no-check-pose``, which analyse
 it anyway.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
 ``positions`` and ``normals`` of shape (K, N, d), optionally ``mu``, ...) with
 the vectorised batch engine and writes the verdicts to another file.
-``warmup`` compiles the batch engine's numba kernels now (once per install;
-later processes load them from numba's cache) and prints what it compiled and
-how long each step took.
+``warmup`` compiles the batch engine's numba kernels now, where the install did
+not compile them ahead of time (once per install; later processes load them
+from numba's cache), and prints what it compiled and how long each step took.
 
 ``plan`` finds grasps: a free-floating parallel-jaw gripper (``--hand``: a
 model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
@@ -293,7 +293,7 @@ def _cmd_warmup(args: argparse.Namespace) -> int:
         where = report.cache_dir or "numba's default cache"
         print(
             f"done: {report.compiled} functions compiled in {report.seconds:.1f} s "
-            f"(cache: {where})"
+            f"(kernels: {report.route}; cache: {where})"
         )
     return 0
 
