@@ -129,7 +129,7 @@ def parse_signature(text: str) -> tuple[ArgSpec, ...]:
         else:
             ndim = 0
         if readonly and not ndim:
-            raise ValueError(f"only an array can be readonly: {raw!r}")
+            raise ValueError(f"only a kernel array can be readonly: {raw!r}")
         specs.append(ArgSpec(code=code, dtype=dtype, ndim=ndim, readonly=readonly))
     return tuple(specs)
 

@@ -171,6 +171,10 @@ for seed, N, d, model in ((0, 3, 3, "hard_finger"), (1, 4, 2, "hard_finger"),
     e = b.batch_epsilon_l1(p, n, mu, **opts)
     for a in (r.d_star, r.rank, r.is_closure, r.margin, r.converged, e):
         out["hash"].append(np.ascontiguousarray(a).tobytes().hex())
+if sys.argv[1:] == ["warmup"]:
+    from drakegrasp.batch.warmup import warmup
+    report = warmup()
+    out["warmup"] = [report.compiled, report.route]
 out["numba_imported"] = "numba" in sys.modules
 out["compiled"] = compiled.compile_count()
 out["aot_calls"] = sum(k.aot_calls for k in compiled.kernels())
@@ -179,11 +183,11 @@ print(json.dumps(out))
 """
 
 
-def _child(root: Path, cache: Path, **env) -> dict:
+def _child(root: Path, cache: Path, *args: str, **env) -> dict:
     environ = {k: v for k, v in os.environ.items() if k != aot.ENV}
     environ.update(NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(root), **env)
     done = subprocess.run(
-        [sys.executable, "-c", _CHILD],
+        [sys.executable, "-c", _CHILD, *args],
         env=environ,
         capture_output=True,
         text=True,
@@ -219,14 +223,18 @@ def test_a_built_extension_runs_bitwise_as_the_jit_without_importing_numba(tmp_p
     assert fast["route"].startswith("ahead-of-time kernels"), fast["route"]
     assert not fast["numba_imported"]  # nothing to import, nothing to compile
     assert fast["compiled"] == 0 and fast["jit_calls"] == 0 and fast["aot_calls"] > 0
+    # Every route of `drakegrasp warmup` is served: nothing to compile.
+    warm = _child(root, tmp_path / "c1", "warmup")
+    assert warm["warmup"] == [0, fast["route"]] and warm["jit_calls"] == 0
 
-    jit = _child(root, tmp_path / "c2", **{aot.ENV: "jit"})
-    assert jit["numba_imported"] and jit["aot_calls"] == 0 and jit["compiled"] > 0
+    # The JIT, from the cache the build left (it typed the entries with the JIT).
+    jit = _child(root, tmp_path / "b", **{aot.ENV: "jit"})
+    assert jit["numba_imported"] and jit["aot_calls"] == 0 and jit["jit_calls"] > 0
     assert fast["hash"] == jit["hash"]  # bit for bit
 
     # Edited kernel sources are never served the stale extension.
     kernel = batch / "epsilon" / "kernel.py"
     kernel.write_text(kernel.read_text() + "\n# edited\n")
-    stale = _child(root, tmp_path / "c2")
+    stale = _child(root, tmp_path / "b")
     assert "other sources" in stale["route"] and stale["aot_calls"] == 0
     assert stale["hash"] == jit["hash"]
