@@ -256,6 +256,17 @@ class Kernel:
     def __repr__(self) -> str:
         return f"<drakegrasp kernel {self.key}>"
 
+    def __reduce__(self):
+        # By reference, as a function pickles: the kernel of that module.
+        return (_kernel, (self.py_func.__module__, self.py_func.__qualname__))
+
+
+def _kernel(module: str, qualname: str) -> Kernel:
+    """The kernel ``qualname`` of ``module`` (unpickling a :class:`Kernel`)."""
+    import importlib
+
+    return getattr(importlib.import_module(module), qualname)
+
 
 def njit(*args, entry: str | None = None, **options):
     """Decorate a batch kernel: ``@njit(cache=True, error_model="numpy", entry=...)``.

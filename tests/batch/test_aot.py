@@ -155,7 +155,7 @@ import numpy as np
 import drakegrasp.batch as b
 from drakegrasp.batch import aot, compiled
 K = 300
-out = {"route": aot.status(), "hash": []}
+out = {"route": aot.status(), "hash": [], "file": aot.__file__}
 for seed, N, d, model in ((0, 3, 3, "hard_finger"), (1, 4, 2, "hard_finger"),
                           (2, 3, 3, "soft_finger"), (3, 12, 3, "hard_finger")):
     rng = np.random.default_rng(seed)
@@ -189,6 +189,7 @@ def _child(root: Path, cache: Path, *args: str, **env) -> dict:
     done = subprocess.run(
         [sys.executable, "-c", _CHILD, *args],
         env=environ,
+        cwd=root,  # not the checkout, which `-c` would put first on the path
         capture_output=True,
         text=True,
         timeout=1200,
@@ -208,6 +209,7 @@ def test_a_built_extension_runs_bitwise_as_the_jit_without_importing_numba(tmp_p
     batch = root / "drakegrasp" / "batch"
     build = subprocess.run(
         [sys.executable, "-m", "drakegrasp.batch.aot_build", str(batch)],
+        cwd=root,
         env=dict(os.environ, PYTHONPATH=str(root), NUMBA_CACHE_DIR=str(tmp_path / "b")),
         capture_output=True,
         text=True,
@@ -220,6 +222,7 @@ def test_a_built_extension_runs_bitwise_as_the_jit_without_importing_numba(tmp_p
     assert set(manifest["kernels"]) == {k.key for k in _entries()}, build.stdout
 
     fast = _child(root, tmp_path / "c1")
+    assert fast["file"].startswith(str(root)), fast["file"]
     assert fast["route"].startswith("ahead-of-time kernels"), fast["route"]
     assert not fast["numba_imported"]  # nothing to import, nothing to compile
     assert fast["compiled"] == 0 and fast["jit_calls"] == 0 and fast["aot_calls"] > 0

@@ -206,3 +206,16 @@ def test_warmup_prints_its_steps(capsys):
     assert out[0].startswith("compiling the batch kernels")
     assert any(line.startswith("  force closure, spatial hard fingers") for line in out)
     assert out[-1].startswith("done: ")
+
+
+def test_a_kernel_is_a_named_callable_that_pickles_by_reference():
+    import pickle
+
+    from drakegrasp.batch.lp import block_kernel
+
+    kernel = block_kernel._stack
+    assert isinstance(kernel, compiled.Kernel)
+    assert kernel.key == "drakegrasp.batch.lp.block_kernel._stack"
+    assert kernel.__name__ == "_stack" and kernel.__wrapped__ is kernel.py_func
+    assert pickle.loads(pickle.dumps(kernel)) is kernel
+    assert kernel in compiled.kernels()
