@@ -275,10 +275,13 @@ def _package(text: str) -> tuple[str, str]:
 
 
 def _cmd_warmup(args: argparse.Namespace) -> int:
+    from drakegrasp.batch.aot import status
     from drakegrasp.batch.warmup import warmup
 
     if not args.json:
-        print("compiling the batch kernels (a minute or two on a fresh install) ...")
+        route = status()
+        wait = "" if route.startswith("ahead-of-time") else ": a minute or two"
+        print(f"compiling the batch kernels where needed{wait} ({route}) ...")
 
     def show(step) -> None:
         if not args.json:
