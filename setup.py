@@ -23,6 +23,23 @@ HERE = Path(__file__).resolve().parent
 KERNELS = "drakegrasp.batch._aot_kernels"
 
 
+def _kernel_package_only() -> None:
+    """Import ``drakegrasp.batch``'s kernel modules without its ``__init__``.
+
+    The build environment holds numba and numpy, not the runtime dependencies
+    (Drake, scipy, ...) that ``drakegrasp/batch/__init__.py`` imports for the
+    engine's API; the kernels need none of them.
+    """
+    import types
+
+    import drakegrasp  # light: lazy exports only
+
+    batch = types.ModuleType("drakegrasp.batch")
+    batch.__path__ = [str(HERE / "drakegrasp" / "batch")]
+    sys.modules["drakegrasp.batch"] = batch
+    drakegrasp.batch = batch
+
+
 class BuildKernels(build_ext):
     """``build_ext`` that compiles the kernels with numba instead of a C source."""
 
@@ -40,6 +57,7 @@ class BuildKernels(build_ext):
             # The JIT's cache of this build process is of no use afterwards.
             os.environ.setdefault("NUMBA_CACHE_DIR", cache)
             try:
+                _kernel_package_only()
                 from drakegrasp.batch.aot_build import build
 
                 build(target, log=lambda line: print(f"drakegrasp: {line}"))
