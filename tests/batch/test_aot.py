@@ -241,3 +241,38 @@ def test_a_built_extension_runs_bitwise_as_the_jit_without_importing_numba(tmp_p
     stale = _child(root, tmp_path / "b")
     assert "other sources" in stale["route"] and stale["aot_calls"] == 0
     assert stale["hash"] == jit["hash"]
+
+
+_ISOLATED = r"""
+import importlib, sys
+for name in ("pydrake", "scipy", "yaml"):  # not in pip's build environment
+    sys.modules[name] = None
+root = sys.argv[1]
+source = open(root + "/setup.py").read().split("\nsetup(")[0]
+scope = {"__file__": root + "/setup.py", "__name__": "setup_helpers"}
+exec(compile(source, "setup.py", "exec"), scope)
+sys.path.insert(0, root)
+scope["_kernel_package_only"]()
+from drakegrasp.batch.aot_build import KERNEL_MODULES
+for name in KERNEL_MODULES:
+    importlib.import_module(name)
+from drakegrasp.batch import compiled
+print(sum(k.entry is not None for k in compiled.kernels()), "numba" in sys.modules)
+"""
+
+
+def test_the_install_build_needs_only_numba_and_numpy(tmp_path):
+    """setup.py reaches every entry kernel without Drake, scipy or PyYAML."""
+    root = Path(compiled.__file__).resolve().parents[2]
+    if not (root / "setup.py").exists():
+        pytest.skip("an installed copy: setup.py is in the source tree only")
+    done = subprocess.run(
+        [sys.executable, "-c", _ISOLATED, str(root)],
+        cwd=tmp_path,
+        env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert done.stdout.split() == [str(len(_entries())), "False"]
