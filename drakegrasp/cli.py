@@ -27,9 +27,9 @@ a hint naming ``--allow-penetration`` and ``--no-check-pose``, which analyse
 it anyway.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
 ``positions`` and ``normals`` of shape (K, N, d), optionally ``mu``, ...) with
 the vectorised batch engine and writes the verdicts to another file.
-``warmup`` compiles the batch engine's numba kernels now (once per install;
-later processes load them from numba's cache) and prints what it compiled and
-how long each step took.
+``warmup`` compiles the batch engine's numba kernels now, where the install did
+not compile them ahead of time (once per install; later processes load them
+from numba's cache), and prints what it compiled and how long each step took.
 
 ``plan`` finds grasps: a free-floating parallel-jaw gripper sampled,
 filtered, closed and ranked on an object, and prints the best ``--top``.  Given
@@ -284,10 +284,13 @@ def _package(text: str) -> tuple[str, str]:
 
 
 def _cmd_warmup(args: argparse.Namespace) -> int:
+    from drakegrasp.batch.aot import status
     from drakegrasp.batch.warmup import warmup
 
     if not args.json:
-        print("compiling the batch kernels (a minute or two on a fresh install) ...")
+        route = status()
+        wait = "" if route.startswith("ahead-of-time") else ": a minute or two"
+        print(f"compiling the batch kernels where needed{wait} ({route}) ...")
 
     def show(step) -> None:
         if not args.json:
@@ -302,7 +305,7 @@ def _cmd_warmup(args: argparse.Namespace) -> int:
         where = report.cache_dir or "numba's default cache"
         print(
             f"done: {report.compiled} functions compiled in {report.seconds:.1f} s "
-            f"(cache: {where})"
+            f"(kernels: {report.route}; cache: {where})"
         )
     return 0
 

@@ -1,6 +1,9 @@
 """Compile every batch kernel up front (``drakegrasp warmup``).
 
-The batch kernels compile on first use and are then cached on disk
+An install normally compiles the engine's entry kernels ahead of time
+(:mod:`drakegrasp.batch.aot`); then this has nothing to compile and says
+so.  Where it could not (or ``DRAKEGRASP_KERNELS=jit``), the batch kernels
+compile on first use and are then cached on disk
 (:mod:`drakegrasp.batch.compiled`).  A course or a cluster job that does not
 want its first real call to wait runs :func:`warmup` once after installing:
 it drives every route of the engine (the fused full-rank pass with the
@@ -58,11 +61,16 @@ class WarmupReport:
     cache_dir : str or None
         ``NUMBA_CACHE_DIR`` when set, else None (numba then writes beside the
         sources, or in its user-wide cache when they are read-only).
+    route : str
+        Which code the entry kernels run (:func:`drakegrasp.batch.aot.status`):
+        the install's ahead-of-time kernels (nothing to compile), or numba's
+        JIT and why.
     """
 
     available: bool
     steps: tuple[WarmupStep, ...]
     cache_dir: str | None
+    route: str = ""
 
     @property
     def seconds(self) -> float:
@@ -80,6 +88,7 @@ class WarmupReport:
             {
                 "available": self.available,
                 "cache_dir": self.cache_dir,
+                "route": self.route,
                 "seconds": self.seconds,
                 "compiled": self.compiled,
                 "steps": [
@@ -98,6 +107,7 @@ class WarmupReport:
             for s in self.steps
         ]
         where = self.cache_dir or "numba's default cache"
+        lines.insert(0, f"  kernels: {self.route}")
         lines.append(
             f"  {'total':<{width}}  {self.seconds:7.2f} s  {self.compiled:4d} "
             f"compiled (cache: {where})"
@@ -188,11 +198,12 @@ def warmup(*, progress: Callable[[WarmupStep], None] | None = None) -> WarmupRep
     """
     import os
 
-    from drakegrasp.batch import compiled
+    from drakegrasp.batch import aot, compiled
 
     cache_dir = os.environ.get("NUMBA_CACHE_DIR") or None
     if not compiled.AVAILABLE:
         return WarmupReport(available=False, steps=(), cache_dir=cache_dir)
+    route = aot.status()
     compiled.quiet_notice()  # the steps are the report
     steps = []
     for name, run in _steps():
@@ -207,4 +218,6 @@ def warmup(*, progress: Callable[[WarmupStep], None] | None = None) -> WarmupRep
         steps.append(step)
         if progress is not None:
             progress(step)
-    return WarmupReport(available=True, steps=tuple(steps), cache_dir=cache_dir)
+    return WarmupReport(
+        available=True, steps=tuple(steps), cache_dir=cache_dir, route=route
+    )

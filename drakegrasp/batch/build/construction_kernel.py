@@ -32,7 +32,11 @@ __all__ = [
 ]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(
+    cache=True,
+    error_model="numpy",
+    entry="f8[:, :, ::1], f8[:, :, ::1], f8[::1]",
+)
 def _normalise(P, Pn, spread):
     """``Pn = (c_i - c̄) / L`` and ``L`` per grasp, as ``normalised_positions``."""
     K, N, d = P.shape
@@ -105,7 +109,14 @@ def _column3(G, k, m, r0, r1, r2, u0, u1, u2):
     G[k, 5, m] = r0 * u1 - r1 * u0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(
+    cache=True,
+    error_model="numpy",
+    entry=(
+        "f8[:, :, ::1], f8[:, :, ::1], f8[:, ::1], i8[::1], "
+        "i8[::1], i8[::1], b1[::1], f8[:, :, ::1]"
+    ),
+)
 def _grasp_stack3(P, Nrm, p, rows, start, component, tangent, G):
     """Spatial ``G[k]`` of grasp ``rows[k]``.
 
@@ -139,7 +150,14 @@ def _grasp_stack3(P, Nrm, p, rows, start, component, tangent, G):
                     G[k, 5, m] = n2
 
 
-@njit(cache=True, error_model="numpy")
+@njit(
+    cache=True,
+    error_model="numpy",
+    entry=(
+        "f8[:, :, ::1], f8[:, :, ::1], f8[:, ::1], i8[::1], "
+        "i8[::1], i8[::1], f8[:, :, ::1]"
+    ),
+)
 def _grasp_stack2(P, Nrm, p, rows, start, component, G):
     """Planar ``G[k]`` (columns ``[u; r_x u_y - r_y u_x]``, ``t = (-n_y, n_x)``)."""
     K = rows.shape[0]
@@ -160,7 +178,11 @@ def _grasp_stack2(P, Nrm, p, rows, start, component, G):
 _EPS = 2.0**-52
 
 
-@njit(cache=True, error_model="numpy")
+@njit(
+    cache=True,
+    error_model="numpy",
+    entry="f8[:, :, ::1], f8[:, :, ::1], i8[::1], f8, b1[::1]",
+)
 def _normal_rank(P, Nrm, rows, rank_tol, out):
     """Whether ``G_n`` (from ``P``, ``p = 0``; w × N, N <= w) has full column rank.
 

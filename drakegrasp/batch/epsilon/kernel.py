@@ -250,7 +250,10 @@ def _epsilon(W, ws, simplex, res, c, inserted, heap, key, vis, hor, info):
         inserted[s] = True
 
 
-@njit(cache=True)
+@njit(
+    cache=True,
+    entry="readonly f8[:, :, ::1], i8[::1], i8, f8[::1], i1[::1], i8[:, ::1]",
+)
 def _stack(W, hashes, cap, eps, status, info):
     K, M, D = W.shape
     verts = np.zeros((cap, D), dtype=np.int64)

@@ -358,7 +358,10 @@ def reduced_lp(AT, nz, R, ct, cn2, max_iter, work):
     return _active_set(AT, nz, R, ct, cn2, max_iter, work)
 
 
-@njit(cache=True)
+@njit(
+    cache=True,
+    entry="f8[:, :, ::1], f8[:, ::1], i8, b1, f8[::1], b1[::1], i8[::1]",
+)
 def _solve_stack(AT, ct, max_iter, general, out_t, out_ok, out_steps):
     K, nz, R = AT.shape
     work = active_set_work(nz, R)

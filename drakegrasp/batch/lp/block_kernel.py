@@ -242,7 +242,16 @@ def work_arrays(R, M, e, N):
     return wr, wm, we, WT, Hs, S
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(
+    cache=True,
+    fastmath=_FAST,
+    error_model="numpy",
+    entry=(
+        "f8[:, ::1], b1, f8[:, :, ::1], f8[:, ::1], f8[:, ::1], "
+        "i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8, i8, f8, "
+        "b1, f8[::1], b1[::1], b1[::1], i8[::1]"
+    ),
+)
 def _stack(F, shared, A, kap, f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
            stop, use_stop, out_t, out_conv, out_below, out_it):  # fmt: skip
     N = coff.shape[0]

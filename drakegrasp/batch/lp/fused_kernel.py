@@ -64,7 +64,12 @@ def _certain(XT, cols, fro, rank_tol, RI):
     return inv_fro * rank_tol * fro < 1.0
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(
+    cache=True,
+    fastmath=_FAST,
+    error_model="numpy",
+    entry="f8[:, :, ::1], f8, b1[::1]",
+)
 def _column_rank_stack(Gn, rank_tol, out):
     K, w, N = Gn.shape
     XT = np.empty((N, w))
@@ -91,7 +96,16 @@ def full_column_rank_certain(Gn: np.ndarray, rank_tol: float) -> np.ndarray:
     return out
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(
+    cache=True,
+    fastmath=_FAST,
+    error_model="numpy",
+    entry=(
+        "f8[:, :, ::1], i8[::1], f8, f8[:, ::1], b1, f8[:, ::1], "
+        "i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8, i8, b1, "
+        "f8[::1], b1[::1]"
+    ),
+)
 def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nrow,
                      roff, tol, max_iter, active_set, out_d, out_done):  # fmt: skip
     K, w, M = G.shape

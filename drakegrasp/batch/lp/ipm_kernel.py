@@ -227,7 +227,14 @@ def _one(B, h, tol, max_iter, step, x, lam):
     return False, max_iter
 
 
-@njit(cache=True, error_model="numpy")
+@njit(
+    cache=True,
+    error_model="numpy",
+    entry=(
+        "f8[:, :, ::1], f8[:, ::1], f8, i8, f8, f8[:, ::1], f8[:, ::1], b1[::1], "
+        "i8[::1]"
+    ),
+)
 def _stack(B, h, tol, max_iter, step, X, LAM, conv, its):
     for k in range(B.shape[0]):
         ok, it = _one(B[k], h[k], tol, max_iter, step, X[k], LAM[k])
