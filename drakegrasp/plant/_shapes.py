@@ -239,7 +239,9 @@ def bounding_sphere(shape: Shape) -> tuple[np.ndarray, float]:
     )
 
 
-def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
+def surface_pieces(
+    shape: Shape, p_GQ: np.ndarray, *, tol: float = ON_SURFACE_TOL
+) -> list[SurfacePiece]:
     """Outward normals (and flat faces) of ``shape`` at the surface point ``Q``.
 
     Parameters
@@ -249,6 +251,9 @@ def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
         (a Mesh is treated as its convex hull, as Drake's distance queries do).
     p_GQ : (3,) float
         A point on the surface, metres, in the geometry frame ``G``.
+    tol : float, optional
+        Metres: the point lies on every face whose plane is this near
+        (default :data:`ON_SURFACE_TOL`, the accuracy of GJK witnesses).
 
     Returns
     -------
@@ -278,10 +283,10 @@ def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
         r, half = shape.radius(), 0.5 * shape.length()
         rho = float(np.hypot(p[0], p[1]))
         pieces = []
-        if abs(rho - r) < ON_SURFACE_TOL and rho > 0:
+        if abs(rho - r) < tol and rho > 0:
             pieces.append(SurfacePiece(np.array([p[0] / rho, p[1] / rho, 0.0])))
         for sign in (1.0, -1.0):
-            if abs(p[2] - sign * half) < ON_SURFACE_TOL:
+            if abs(p[2] - sign * half) < tol:
                 pieces.append(SurfacePiece(np.array([0.0, 0.0, sign])))
         if not pieces:  # off the surface numerically: nearest piece
             if r - rho < half - abs(p[2]) and rho > 0:
@@ -296,7 +301,7 @@ def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
             "geometry; use Box, Sphere, Cylinder, Capsule, Ellipsoid or Convex"
         )
     gaps = np.array([n @ p - d for n, d, _ in faces])
-    on = np.flatnonzero(np.abs(gaps) < ON_SURFACE_TOL)
+    on = np.flatnonzero(np.abs(gaps) < tol)
     if on.size == 0:
         on = np.array([int(np.argmax(gaps))])
     return [SurfacePiece(faces[i][0], faces[i][2]) for i in on]

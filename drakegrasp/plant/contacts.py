@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import GeometryId, QueryObject, SceneGraphInspector, Sphere
+from pydrake.geometry import GeometryId, QueryObject, SceneGraphInspector
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context
@@ -39,6 +39,8 @@ from drakegrasp.errors import (
     NoContactsError,
     PenetrationError,
 )
+from drakegrasp.plant._closest import closest_pair
+from drakegrasp.plant._projection import PosedShape
 from drakegrasp.plant._shapes import (
     ON_SURFACE_TOL,
     SurfacePiece,
@@ -47,7 +49,7 @@ from drakegrasp.plant._shapes import (
 from drakegrasp.plant.contact_normals import (
     choose_normal,
     clean_unit,
-    refine_sphere_tip,
+    normal_source,
 )
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
 from drakegrasp.plant.validation import (
@@ -462,28 +464,36 @@ def _pair_contacts(
                         )
                         for k, (p, gap) in enumerate(verts)
                     ]
-    n_O, source = choose_normal(
-        obj=[-(R_OGa @ p.normal_G) for p in obj_pieces],
-        obj_flat=all(p.polygon_G is not None for p in obj_pieces),
-        fin=[R_OGb @ p.normal_G for p in fin_pieces],
-        fin_flat=all(p.polygon_G is not None for p in fin_pieces),
-        witness=p_OCa - p_OCb,
+    exact = closest_pair(
+        PosedShape(inspector.GetShape(go), R_OGa, to_O(X_WGa.translation())),
+        PosedShape(inspector.GetShape(gf), R_OGb, to_O(X_WGb.translation())),
+        p_a=p_OCa,
+        p_b=p_OCb,
+        nhat=R_OW @ nhat_W,
         psi=psi,
-        drake=R_OW @ nhat_W,
     )
-    n_O = clean_unit(n_O)
-    finger_shape = inspector.GetShape(gf)
-    if isinstance(finger_shape, Sphere):
-        flat = [p.polygon_G for p in obj_pieces if p.polygon_G is not None]
-        n_O, source, psi, p_OCa, p_OCb = refine_sphere_tip(
-            radius=finger_shape.radius(),
-            centre_O=to_O(X_WGb.translation()),
-            object_faces_G=flat if len(flat) == len(obj_pieces) else None,
-            G_to_O=lambda p_G: to_O(X_WGa.multiply(p_G)),
-            n_O=n_O,
-            source=source,
-            psi=psi,
+    if exact is not None:
+        n_O = clean_unit(exact.nhat_O)
+        psi, p_OCa, p_OCb = exact.psi, exact.p_OCa, exact.p_OCb
+        source = normal_source(
+            obj=surface_pieces(
+                inspector.GetShape(go), _to_G(X_WGa, to_O, p_OCa, R_OGa), tol=1e-9
+            ),
+            fin=surface_pieces(
+                inspector.GetShape(gf), _to_G(X_WGb, to_O, p_OCb, R_OGb), tol=1e-9
+            ),
         )
+    else:  # no certified exact contact: Drake's witness points
+        n_O, source = choose_normal(
+            obj=[-(R_OGa @ p.normal_G) for p in obj_pieces],
+            obj_flat=all(p.polygon_G is not None for p in obj_pieces),
+            fin=[R_OGb @ p.normal_G for p in fin_pieces],
+            fin_flat=all(p.polygon_G is not None for p in fin_pieces),
+            witness=p_OCa - p_OCb,
+            psi=psi,
+            drake=R_OW @ nhat_W,
+        )
+        n_O = clean_unit(n_O)
     return [
         PlantContact(
             p_OC=p_OCa,
@@ -494,6 +504,11 @@ def _pair_contacts(
             **common,
         )
     ]
+
+
+def _to_G(X_WG, to_O, p_O: np.ndarray, R_OG: np.ndarray) -> np.ndarray:
+    """A point from the object frame O to the geometry frame G."""
+    return R_OG.T @ (p_O - to_O(X_WG.translation()))
 
 
 def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
