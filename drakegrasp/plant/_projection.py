@@ -36,7 +36,7 @@ from pydrake.geometry import (
     Sphere,
 )
 
-from drakegrasp.plant._shapes import flat_faces
+from drakegrasp.plant._shapes import face_arrays, flat_faces
 
 __all__ = ["PosedShape", "closest_on_polygon", "closest_on_segment"]
 
@@ -222,25 +222,37 @@ class PosedShape:
         return _project_ellipsoid(abc, p)
 
     def _project_Convex(self, p):
-        faces = self.faces
-        gaps = np.array([n @ p - d for n, d, _ in faces])
-        if gaps.max() <= 0.0:  # inside: the nearest face plane
-            k = int(np.argmax(gaps))
-            n = faces[k][0]
-            return float(gaps[k]), p - gaps[k] * n, np.array(n)
-        best = None
-        for k in np.flatnonzero(gaps > 0):  # the closest point is on a visible face
-            n, _, poly = faces[k]
-            q = closest_on_polygon(p, poly, n)
-            d2 = float(np.sum((p - q) ** 2))
-            if best is None or d2 < best[0]:
-                best = (d2, q, k)
-        d2, q, k = best
-        d = float(np.sqrt(d2))
-        n = faces[k][0]
-        if abs(gaps[k] - d) <= 1e-12 * max(d, 1e-3):  # inside the face: its normal
-            return d, q, np.array(n)
-        return d, q, (p - q) / d
+        N, D, EA, EB, EF = face_arrays(self.faces)
+        gaps = N @ p - D
+        k = int(np.argmax(gaps))
+        if gaps[k] <= 0.0:  # inside: the nearest face plane
+            return float(gaps[k]), p - gaps[k] * N[k], N[k].copy()
+        # Outside, the closest point lies on a face that p sees: in its
+        # interior (where p projects inside every edge), or on one of its edges.
+        visible = gaps > 0
+        q = p - gaps[:, None] * N  # projections on every face plane
+        e_vis = visible[EF]
+        side = np.einsum("ij,ij->i", np.cross(EB - EA, q[EF] - EA), N[EF])
+        outside = np.zeros(len(N), dtype=bool)
+        np.logical_or.at(outside, EF, side < 0)
+        inner = np.flatnonzero(visible & ~outside)
+        best_d, best_q, best_face = np.inf, None, False
+        if inner.size:
+            f = inner[np.argmin(gaps[inner])]
+            best_d, best_q, best_face = float(gaps[f]), q[f], True
+            n_face = N[f]
+        A, B = EA[e_vis], EB[e_vis]
+        if len(A):
+            AB = B - A
+            t = np.clip(np.einsum("ij,ij->i", p - A, AB) / np.sum(AB**2, axis=1), 0, 1)
+            C = A + t[:, None] * AB
+            dist = np.linalg.norm(p - C, axis=1)
+            j = int(np.argmin(dist))
+            if dist[j] < best_d:
+                best_d, best_q, best_face = float(dist[j]), C[j], False
+        if best_face:
+            return best_d, best_q, n_face.copy()
+        return best_d, best_q, (p - best_q) / best_d
 
     # --- support ----------------------------------------------------------------
     def support(self, v_O: np.ndarray, near_O: np.ndarray | None = None) -> np.ndarray:

@@ -1,8 +1,11 @@
 """Contacts on a mesh's convex hull near its rim (issue 20, point 4).
 
-A plate-like mesh (a flat bottom and a wider rim, written as an OBJ in a
-temporary folder) is queried by Drake as its convex hull.  Spherical tips
-touch it near the rim, where the hull's narrow side facets meet the top face.
+A plate-like mesh (a flat foot and a wider rounded rim of 24 rings of 256
+vertices, written as an OBJ in a temporary folder) is queried by Drake as its
+convex hull.  Spherical tips touch it near the rim, where the hull's narrow
+facets meet at small angles: the planes of several facets then pass within
+GJK's 1e-5 m of Drake's witness point, which misled the witness-based normals
+by up to 0.4 mm and 2°.
 The reference is an independent hull computation: scipy's ``ConvexHull`` of
 the OBJ's vertices, and the closest point of the tip's centre on its
 triangles.
@@ -26,7 +29,8 @@ from drakegrasp import find_contacts
 
 spatial = pytest.importorskip("scipy.spatial", reason="the reference hull is scipy's")
 
-R_RIM, R_FOOT, HEIGHT, N_SIDES = 0.12, 0.072, 0.02, 48
+N_SIDES, N_RIM = 256, 24  # finely meshed, as kitchen meshes are
+R_FOOT, R_RIM, RIM_R, RIM_Z = 0.07, 0.11, 0.01, 0.012
 R_TIP = 0.01
 X_WO = RigidTransform(RollPitchYaw(0.2, 0.4, -0.3), [0.05, -0.1, 0.4])
 DRAKE_WITNESS = 5e-4
@@ -34,23 +38,36 @@ DRAKE_WITNESS = 5e-4
 hull (measured: 1.6e-4 m at worst at the rim); the contact must be as near."""
 
 
+def plate_rings() -> list[tuple[float, float]]:
+    """(radius, height) of each ring: the foot, then the rounded rim."""
+    phi = np.linspace(-np.pi / 2, np.pi / 2, N_RIM)
+    rim = zip(
+        R_RIM + RIM_R * np.cos(phi), RIM_Z + 0.8 * RIM_R * np.sin(phi), strict=True
+    )
+    return [(R_FOOT, 0.0), *rim]
+
+
 def plate_vertices() -> np.ndarray:
     a = 2 * np.pi * np.arange(N_SIDES) / N_SIDES
-    foot = np.column_stack([R_FOOT * np.cos(a), R_FOOT * np.sin(a), 0 * a])
-    rim = np.column_stack([R_RIM * np.cos(a), R_RIM * np.sin(a), 0 * a + HEIGHT])
-    return np.vstack([foot, rim])
+    rings = [
+        np.column_stack([R * np.cos(a), R * np.sin(a), 0 * a + z])
+        for R, z in plate_rings()
+    ]
+    return np.vstack(rings)
 
 
 @pytest.fixture(scope="module")
 def plate_obj(tmp_path_factory):
     V = plate_vertices()
-    n = N_SIDES
+    n, rings = N_SIDES, len(plate_rings())
     faces = []
-    for k in range(n):
-        k1 = (k + 1) % n
-        faces += [(k, k1, n + k1), (k, n + k1, n + k)]
-    faces += [(0, k + 1, k) for k in range(1, n - 1)]
-    faces += [(n, n + k, n + k + 1) for k in range(1, n - 1)]
+    for r in range(rings - 1):  # quads between rings, as two triangles
+        for k in range(n):
+            a, b = r * n + k, r * n + (k + 1) % n
+            faces += [(a, b, b + n), (a, b + n, a + n)]
+    top = (rings - 1) * n
+    faces += [(0, k + 1, k) for k in range(1, n - 1)]  # the foot
+    faces += [(top, top + k, top + k + 1) for k in range(1, n - 1)]  # the well
     path = tmp_path_factory.mktemp("plate") / "plate.obj"
     lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in V]
     lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces]
@@ -93,20 +110,37 @@ REF = ReferenceHull()
 
 def tip_centre(azimuth, direction, gap):
     """A tip centre near the rim at ``azimuth``, moved along ``direction`` until
-    its sphere is ``gap`` from the reference hull (bisection)."""
-    rim = np.array([R_RIM * math.cos(azimuth), R_RIM * math.sin(azimuth), HEIGHT])
+    its sphere is ``gap`` from the reference hull (Newton on the distance)."""
+    R, z = R_RIM + RIM_R, RIM_Z  # the rim's outermost ring
+    rim = np.array([R * math.cos(azimuth), R * math.sin(azimuth), z])
     d = np.asarray(direction, float) / np.linalg.norm(direction)
-    lo, hi = 0.0, 0.05
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if REF.distance(rim + mid * d) < R_TIP + gap:
-            lo = mid
-        else:
-            hi = mid
-    return rim + 0.5 * (lo + hi) * d
+    t = R_TIP
+    for _ in range(30):
+        c = rim + t * d
+        q = REF.closest(c)
+        dist = float(np.linalg.norm(c - q))
+        step = (R_TIP + gap - dist) / (((c - q) / dist) @ d)
+        t += step
+        if abs(step) < 1e-15:
+            break
+    return rim + t * d
+
+
+_RIGS: dict = {}
 
 
 def rig(shape, centres_O):
+    """The plate and free tips at the given centres (plants cached per shape)."""
+    key = (type(shape).__name__, len(centres_O))
+    if key not in _RIGS:
+        _RIGS[key] = _build(shape, len(centres_O))
+    plant, ctx, obj, tips, _ = _RIGS[key]
+    for body, c in zip(tips, centres_O, strict=True):
+        plant.SetFreeBodyPose(ctx, body, X_WO.multiply(RigidTransform(c)))
+    return plant, ctx, obj, tips
+
+
+def _build(shape, num_tips):
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     inertia = SpatialInertia.SolidSphereWithMass(0.1, 0.01)
@@ -116,7 +150,7 @@ def rig(shape, centres_O):
     )
     hand = plant.AddModelInstance("hand")
     tips = []
-    for k in range(len(centres_O)):
+    for k in range(num_tips):
         body = plant.AddRigidBody(f"tip{k}", hand, inertia)
         plant.RegisterCollisionGeometry(
             body, RigidTransform(), Sphere(R_TIP), f"tip{k}", ProximityProperties()
@@ -126,9 +160,7 @@ def rig(shape, centres_O):
     diagram = builder.Build()
     ctx = plant.GetMyContextFromRoot(diagram.CreateDefaultContext())
     plant.SetFreeBodyPose(ctx, obj, X_WO)
-    for body, c in zip(tips, centres_O, strict=True):
-        plant.SetFreeBodyPose(ctx, body, X_WO.multiply(RigidTransform(c)))
-    return plant, ctx, obj, tips
+    return plant, ctx, obj, tips, diagram
 
 
 def drake_witness(plant, ctx, obj, tip):
