@@ -75,6 +75,7 @@ _SUBMODULES = (
     "contacts",
     "couplings",
     "curvature",
+    "exact_contact",
     "finger_antipodal",
     "fingers",
     "jacobians",
@@ -85,6 +86,7 @@ _SUBMODULES = (
     "scene",
     "scene_file",
     "scene_refs",
+    "shape_queries",
     "validation",
 )
 

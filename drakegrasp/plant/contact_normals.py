@@ -1,7 +1,7 @@
 """The normal of a contact: its name, and the choice when no exact one exists.
 
 :func:`drakegrasp.plant.contacts.find_contacts` computes every pair's witness
-points and normal exactly where it can (:mod:`drakegrasp.plant._closest`: closed
+points and normal exactly where it can (:mod:`drakegrasp.plant.exact_contact`: closed
 forms for spheres and capsules, the face's normal for a flat face, edges and
 cylinder sides as segments, Newton's method for two smooth pieces), and
 :func:`normal_source` names the surface the normal belongs to.  When no exact

@@ -6,14 +6,23 @@ scene-graph query port gives the signed distance ``ψ`` and the witness points
 ``p_Ca − p_Cb = ψ n̂`` and ``n̂`` pointing from the finger into the object.  A
 pair is a contact when ``|ψ| <= distance_tolerance``.
 
-The query loop lives here; the choice of the normal (and the exact contact
-of a spherical fingertip) in :mod:`drakegrasp.plant.contact_normals`, and the
-corners of a flat pad's patch in :mod:`drakegrasp.plant.contact_patches`.
+The query loop lives here; the exact contact of a pair in
+:mod:`drakegrasp.plant.exact_contact` (on the point queries of
+:mod:`drakegrasp.plant.shape_queries`), the name of the normal's source and the
+fallback choice in :mod:`drakegrasp.plant.contact_normals`, and the corners of
+a flat pad's patch in :mod:`drakegrasp.plant.contact_patches`.
 
-**Normals.**  Drake guarantees the witness normal at ``ψ = 0`` only for a few
-shape pairs, so the normal is derived from the shapes themselves (see
-:mod:`~drakegrasp.plant.contact_normals`); ``PlantContact.normal_source`` says
-which surface gave it.
+**Exact contacts.**  Drake decides which pairs touch (its ``ψ`` within the
+tolerance, the rule :func:`~drakegrasp.plant.closing.close_hand` closes to),
+but its GJK/EPA witness points on curved shapes and convex hulls can be
+0.1–0.4 mm off, and a normal taken there a degree or more off.  Each touching
+pair is therefore recomputed from Drake's witness by an exact, certified route
+(:mod:`drakegrasp.plant.exact_contact`): the reported ``p_OC``, ``nhat_O``, ``ψ``
+and ``p_FC`` are exact to round-off (``PlantContact.exact``), and
+``PlantContact.normal_source`` names the surface the normal belongs to.  Only
+a pair that no route certifies keeps Drake's witness points, with the normal
+chosen as :mod:`~drakegrasp.plant.contact_normals` describes.  The guide's
+*Contacts* page lists the accuracy of every shape pair.
 
 **Flat patches.**  A flat pad on a flat face is reported as one contact at
 **each vertex** of its patch polygon (same normal; ``ψ`` the gap at the
@@ -39,8 +48,6 @@ from drakegrasp.errors import (
     NoContactsError,
     PenetrationError,
 )
-from drakegrasp.plant._closest import closest_pair
-from drakegrasp.plant._projection import PosedShape
 from drakegrasp.plant._shapes import (
     ON_SURFACE_TOL,
     SurfacePiece,
@@ -52,6 +59,8 @@ from drakegrasp.plant.contact_normals import (
     normal_source,
 )
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
+from drakegrasp.plant.exact_contact import closest_pair
+from drakegrasp.plant.shape_queries import PosedShape
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -89,12 +98,10 @@ class PlantContact:
         Signed distance ``ψ`` (metres): > 0 separated, < 0 penetrating.
     p_FC : (3,) float
         The finger's witness point in the finger body's frame F: the material
-        point of the finger that touches the object.  It is Drake's closest
-        point on the finger geometry (``centre + r nhat`` for a spherical tip;
-        ``p_OC − ψ nhat`` at a patch vertex), so ``p_OC − p_FC`` (in a common
-        frame) equals ``ψ nhat`` only where the normal is Drake's own: when the
-        normal comes from a surface (``normal_source``), the two witness
-        points need not lie on it.
+        point of the finger that touches the object (``centre + r nhat`` for a
+        spherical tip; ``p_OC − ψ nhat`` at a patch vertex).  When ``exact``,
+        ``p_OC − p_FC`` (in a common frame) equals ``ψ nhat``; otherwise it is
+        Drake's witness point, which need not lie on the normal.
     finger_body : str
         Scoped name ``model::body`` of the finger body.
     finger_body_index : BodyIndex
@@ -103,12 +110,20 @@ class PlantContact:
     object_geometry_name, finger_geometry_name : str
         Their names in the scene graph.
     normal_source : str
-        Where the normal came from: ``"object"``, ``"finger"``, ``"patch"``,
-        ``"edge"`` or ``"corner"`` (a spherical tip on an edge or corner of flat
-        faces), ``"witness points"`` or ``"drake"`` (see the module docstring).
+        Which surface the normal belongs to: ``"object"``, ``"finger"`` (a
+        finger's face on an edge or corner of the object), ``"patch"``,
+        ``"edge"`` or ``"corner"`` (a curved finger on an edge or corner of the
+        object, a cylinder's rim included), and, for a contact that is not
+        ``exact``, ``"witness points"`` or ``"drake"`` (see
+        :mod:`~drakegrasp.plant.contact_normals`).
     patch_vertex : int or None
         Index of this contact among the vertices of a flat patch, or None for a
         point contact.
+    exact : bool
+        True when the point, normal and ``ψ`` were computed exactly (to
+        round-off) and certified (:mod:`drakegrasp.plant.exact_contact`; the
+        accuracy of each shape pair is listed in the guide's *Contacts* page);
+        False when they come from Drake's witness points.
     finger_geometry_index, object_geometry_index : int or None
         Place of each geometry among its body's collision geometries (None
         when not known, e.g. contacts read from contact results); they make
@@ -129,6 +144,7 @@ class PlantContact:
     patch_vertex: int | None = None
     finger_geometry_index: int | None = None
     object_geometry_index: int | None = None
+    exact: bool = False
 
     @property
     def finger_geometry_label(self) -> str:
@@ -167,6 +183,7 @@ class PlantContact:
             "finger_geometry_label": self.finger_geometry_label,
             "normal_source": self.normal_source,
             "patch_vertex": self.patch_vertex,
+            "exact": self.exact,
         }
 
     def __repr__(self) -> str:
@@ -460,6 +477,7 @@ def _pair_contacts(
                             p_FC=finger_point(p - gap * n_O),
                             normal_source="patch",
                             patch_vertex=k,
+                            exact=True,
                             **common,
                         )
                         for k, (p, gap) in enumerate(verts)
@@ -501,6 +519,7 @@ def _pair_contacts(
             psi=psi,
             p_FC=finger_point(p_OCb),
             normal_source=source,
+            exact=exact is not None,
             **common,
         )
     ]

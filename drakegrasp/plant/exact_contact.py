@@ -10,7 +10,7 @@ by one of these routes (``ExactPair.method``):
     A sphere is a point and a capsule a segment inflated by a radius ``r``, so
     ``ψ = min_s sd_X(a + s(b − a)) − r`` over the core segment ``ab`` of one
     shape and the exact signed distance ``sd_X`` of the other
-    (:meth:`~drakegrasp.plant._projection.PosedShape.project`).  ``sd_X`` is
+    (:meth:`~drakegrasp.plant.shape_queries.PosedShape.project`).  ``sd_X`` is
     convex along a line, so bisection on the sign of its derivative
     ``n_X·(b − a)`` finds the minimum to the last bit.
 ``"face"``
@@ -43,8 +43,8 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.geometry import Box, Convex, Cylinder, HalfSpace, Mesh
 
-from drakegrasp.plant._projection import PosedShape, closest_on_polygon
 from drakegrasp.plant._shapes import surface_pieces
+from drakegrasp.plant.shape_queries import PosedShape, closest_on_polygon
 
 __all__ = ["CERTIFY_TOL", "ExactPair", "closest_pair"]
 

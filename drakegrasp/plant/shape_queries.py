@@ -14,7 +14,7 @@ its pose ``X_OG``.  It answers, to round-off,
   farthest points form a face or an edge;
 - :meth:`~PosedShape.support_hessian`: ``∇²h(v)``, the radii of curvature of a
   smooth, curved support point (ellipsoid, cylinder rim), used by the Newton
-  iteration of :mod:`drakegrasp.plant._closest`.
+  iteration of :mod:`drakegrasp.plant.exact_contact`.
 
 A sphere is a point inflated by its radius and a capsule a segment inflated by
 its radius (:meth:`~PosedShape.core`): every distance to them reduces to a
