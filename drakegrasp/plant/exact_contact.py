@@ -17,10 +17,10 @@ by one of these routes (``ExactPair.method``):
     A flat face (box, convex hull, cylinder cap, half space) touching the other
     shape inside the face: the normal is the face's, ``ψ`` the other shape's
     support value along it.
-``"cylinder side"``, ``"edge"``, ``"vertex"``
+``"cylinder side"``, ``"edge"``
     A cylinder touching with its side is, there, its axis inflated by its
-    radius; an edge or a vertex of a box or convex hull is a segment or a point
-    inflated by zero: each then goes the ``"core"`` route.
+    radius; an edge of a box or convex hull (a vertex being an edge's end) is a
+    segment inflated by zero: each then goes the ``"core"`` route.
 ``"newton"``
     Two smooth curved pieces (ellipsoids, spheres, a cylinder's rim): Newton's
     method on the unit normal ``u`` for the maximum of
@@ -33,7 +33,12 @@ normal separates, or for ``ψ < 0`` locally minimises the overlap), and
 ``p_Ca − p_Cb = ψ n̂``, all to :data:`CERTIFY_TOL`.  Of the certified
 candidates the one with the largest ``ψ`` is the signed distance
 (``ψ = max_u f(u)``).  When none certifies :func:`closest_pair` returns None
-and the caller keeps Drake's witness points.  numpy only.
+and the caller keeps Drake's witness points.
+
+For a penetrating pair (``ψ < 0``) the certificate is local: the result is
+the maximum of ``f`` nearest Drake's normal, and for a capsule the overlap of
+its deepest core point, both the penetration depth for the shallow overlaps a
+grasp meets.  numpy only, plus the shape classes of ``pydrake.geometry``.
 """
 
 from __future__ import annotations
@@ -43,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.geometry import Box, Convex, Cylinder, HalfSpace, Mesh
 
-from drakegrasp.plant._shapes import surface_pieces
+from drakegrasp.plant._shapes import face_arrays, surface_pieces
 from drakegrasp.plant.shape_queries import PosedShape, closest_on_polygon
 
 __all__ = ["CERTIFY_TOL", "ExactPair", "closest_pair"]
@@ -214,27 +219,32 @@ def _minimise_along(Y: PosedShape, a, b, near) -> float:
 # --- the face route --------------------------------------------------------------
 
 
-def _faces_O(X: PosedShape):
-    """Flat faces of X in O: ``(outward normal, a point, polygon or None, disc)``.
+def _faces_O(X: PosedShape, out_dir: np.ndarray):
+    """X's flat faces whose outward normal is within ``_FACE_ANGLE`` of ``out_dir``.
 
-    ``disc`` is ``(centre, radius)`` for a cylinder's cap; the polygon is None
-    for a half space and a cap.
+    Yields ``(outward normal, a point of the face, polygon or None, cap
+    radius or None)``, frame O: a polygon for a box's or a hull's face, a cap
+    radius for a cylinder's cap, neither for a half space.
     """
     s = X.shape
+    cos = np.cos(_FACE_ANGLE)
     if isinstance(s, HalfSpace):
-        return [(X.R[:, 2], X.t, None, None)]
-    if isinstance(s, Cylinder):
+        faces = [(X.R[:, 2], X.t, None, None)]
+    elif isinstance(s, Cylinder):
         half, r = 0.5 * s.length(), s.radius()
-        return [
-            (sign * X.R[:, 2], X.t + sign * half * X.R[:, 2], None, (r, sign))
+        faces = [
+            (sign * X.R[:, 2], X.t + sign * half * X.R[:, 2], None, r)
             for sign in (1.0, -1.0)
         ]
-    if isinstance(s, (Box, Convex, Mesh)):
-        return [
-            (X.R @ n, X.to_O(poly[0]), np.array([X.to_O(v) for v in poly]), None)
-            for n, _, poly in X.faces
-        ]
-    return []
+    elif isinstance(s, (Box, Convex, Mesh)):
+        N = face_arrays(X.faces)[0] @ X.R.T  # outward normals in O
+        faces = []
+        for k in np.flatnonzero(N @ out_dir >= cos):
+            poly = X.faces[k][2] @ X.R.T + X.t
+            faces.append((N[k], poly[0], poly, None))
+    else:
+        faces = []
+    return [f for f in faces if f[0] @ out_dir >= cos]
 
 
 def _face_routes(A, B, *, p_a, p_b, nhat):
@@ -244,20 +254,15 @@ def _face_routes(A, B, *, p_a, p_b, nhat):
         (A, B, p_b, -nhat, True),
         (B, A, p_a, nhat, False),
     ):
-        for m, point, poly, disc in _faces_O(X):
-            if m @ out_dir < np.cos(_FACE_ANGLE):
-                continue
+        for m, point, poly, cap in _faces_O(X, out_dir):
             y = Y.support(-m, near_y)
             psi = float(m @ (y - point))
             foot = y - psi * m  # on the face's plane
             if poly is not None:
                 if np.linalg.norm(closest_on_polygon(foot, poly, m) - foot) > 1e-12:
                     continue
-            elif disc is not None:
-                r, _ = disc
-                radial = X.to_G(foot)[:2]
-                if np.hypot(*radial) > r:
-                    continue
+            elif cap is not None and np.hypot(*X.to_G(foot)[:2]) > cap:
+                continue
             if on_a:
                 out.append(ExactPair(psi, foot, y, -m, "face"))
             else:
@@ -276,20 +281,18 @@ def _feature_cores(X: PosedShape, near: np.ndarray):
         return [((X.t - half, X.t + half, float(s.radius())), "cylinder side")]
     if not isinstance(s, (Box, Convex, Mesh)):
         return []
-    cores = []
-    seen = set()
-    for _, _, poly in X.faces:
-        P = np.array([X.to_O(v) for v in poly])
-        for i in range(len(P)):
-            a, b = P[i], P[(i + 1) % len(P)]
-            key = tuple(sorted((tuple(np.round(a, 12)), tuple(np.round(b, 12)))))
-            if key in seen:
-                continue
+    _, _, EA, EB, _ = face_arrays(X.faces)
+    A = EA @ X.R.T + X.t  # every face's edges, in O (each edge twice)
+    B = EB @ X.R.T + X.t
+    AB = B - A
+    t = np.clip(np.einsum("ij,ij->i", near - A, AB) / np.sum(AB**2, axis=1), 0, 1)
+    reach = np.linalg.norm(A + t[:, None] * AB - near, axis=1) <= _FEATURE_REACH
+    cores, seen = [], set()
+    for a, b in zip(A[reach], B[reach], strict=True):
+        key = tuple(sorted((tuple(np.round(a, 12)), tuple(np.round(b, 12)))))
+        if key not in seen:
             seen.add(key)
-            ab = b - a
-            t = float(np.clip((near - a) @ ab / (ab @ ab), 0.0, 1.0))
-            if np.linalg.norm(a + t * ab - near) <= _FEATURE_REACH:
-                cores.append(((a, b, 0.0), "edge"))
+            cores.append(((a, b, 0.0), "edge"))
     return cores
 
 

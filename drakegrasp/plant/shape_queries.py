@@ -291,9 +291,10 @@ class PosedShape:
         return self.to_O(x)
 
     def _support_convex(self, v: np.ndarray, near: np.ndarray) -> np.ndarray:
-        for n, _, poly in self.faces:  # a face facing v: its nearest point
-            if n @ v > 1 - _FLAT:
-                return closest_on_polygon(near, poly, n)
+        N = face_arrays(self.faces)[0]
+        k = int(np.argmax(N @ v))
+        if N[k] @ v > 1 - _FLAT:  # a face facing v: its point nearest ``near``
+            return closest_on_polygon(near, self.faces[k][2], N[k])
         V = self.vertices_G
         h = V @ v
         top = np.flatnonzero(h >= h.max() - _FLAT * np.max(np.abs(V)))
