@@ -154,7 +154,7 @@ def _core_route(core, Y: PosedShape, *, flip: bool, near, method: str):
     c = a + s * (b - a)
     sd, q, m = Y.project(c)  # m: Y's outward normal, towards the core
     if r == 0.0 and abs(sd) < _TOUCHING:
-        m = _touching_normal(Y, q, b - a, m)
+        m = _touching_normal(Y, q, b - a)
         if m is None:
             return None
     psi = sd - r
@@ -164,8 +164,8 @@ def _core_route(core, Y: PosedShape, *, flip: bool, near, method: str):
     return ExactPair(psi, p_x, q, m, method)
 
 
-def _touching_normal(Y: PosedShape, q, d, m_noisy):
-    """Y's outward normal where a segment (direction ``d``) or a point touches it.
+def _touching_normal(Y: PosedShape, q, d):
+    """Y's outward normal where a segment (direction ``d``) touches it.
 
     ``(c − q)/|c − q|`` is round-off when the core touches Y, so the normal
     comes from Y's surface at ``q``: its own where it has one; on an edge (a
