@@ -70,6 +70,7 @@ _SUBMODULES = (
     "analysis",
     "closing",
     "contact_normals",
+    "contact_pair",
     "contact_patches",
     "contact_results",
     "contacts",

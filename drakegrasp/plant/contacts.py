@@ -6,7 +6,8 @@ scene-graph query port gives the signed distance ``ψ`` and the witness points
 ``p_Ca − p_Cb = ψ n̂`` and ``n̂`` pointing from the finger into the object.  A
 pair is a contact when ``|ψ| <= distance_tolerance``.
 
-The query loop lives here; the exact contact of a pair in
+The query loop lives here; the points of one touching pair in
+:mod:`drakegrasp.plant.contact_pair`, which draws on the exact contact of
 :mod:`drakegrasp.plant.exact_contact` (on the point queries of
 :mod:`drakegrasp.plant.shape_queries`), the name of the normal's source and the
 fallback choice in :mod:`drakegrasp.plant.contact_normals`, and the corners of
@@ -35,7 +36,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import GeometryId, QueryObject, SceneGraphInspector
+from pydrake.geometry import GeometryId, QueryObject
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context
@@ -48,19 +49,9 @@ from drakegrasp.errors import (
     NoContactsError,
     PenetrationError,
 )
-from drakegrasp.plant._shapes import (
-    ON_SURFACE_TOL,
-    SurfacePiece,
-    surface_pieces,
-)
-from drakegrasp.plant.contact_normals import (
-    choose_normal,
-    clean_unit,
-    normal_source,
-)
-from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
-from drakegrasp.plant.exact_contact import closest_pair
-from drakegrasp.plant.shape_queries import PosedShape
+from drakegrasp.plant._shapes import ON_SURFACE_TOL
+from drakegrasp.plant.contact_pair import pair_points
+from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -206,12 +197,6 @@ def _rotation(X) -> np.ndarray:
     return X.rotation().matrix()
 
 
-def _pieces_in(
-    inspector: SceneGraphInspector, gid: GeometryId, p_GC: np.ndarray
-) -> list[SurfacePiece]:
-    return surface_pieces(inspector.GetShape(gid), p_GC)
-
-
 def find_contacts(
     plant: MultibodyPlant,
     plant_context: Context,
@@ -346,24 +331,43 @@ def find_contacts(
                     continue
                 if abs(psi) > tol and not (allow_penetration and psi < 0):
                     continue
-                found = _pair_contacts(
-                    query=query,
-                    inspector=inspector,
-                    go=go,
-                    gf=gf,
-                    p_GaCa=np.asarray(p_GaCa),
-                    p_GbCb=np.asarray(p_GbCb),
-                    nhat_W=np.asarray(nhat_W),
-                    psi=psi,
-                    to_O=to_O,
-                    R_OW=R_OW,
-                    X_FO=X_WF.inverse().multiply(X_WO),
-                    finger=finger,
-                    finger_name=finger_name,
-                    indices=(kf, ko),
-                    tol=tol,
-                    patches=patches,
-                )
+                X_FO = X_WF.inverse().multiply(X_WO)
+                common = {
+                    "finger_body": finger_name,
+                    "finger_body_index": finger.index(),
+                    "object_geometry": go,
+                    "finger_geometry": gf,
+                    "object_geometry_name": inspector.GetName(go),
+                    "finger_geometry_name": inspector.GetName(gf),
+                    "finger_geometry_index": kf,
+                    "object_geometry_index": ko,
+                }
+                found = [
+                    PlantContact(
+                        p_OC=pp.p_OC,
+                        nhat_O=pp.nhat_O,
+                        psi=pp.psi,
+                        p_FC=np.asarray(X_FO.multiply(pp.p_OF)),
+                        normal_source=pp.normal_source,
+                        patch_vertex=pp.patch_vertex,
+                        exact=pp.exact,
+                        **common,
+                    )
+                    for pp in pair_points(
+                        query=query,
+                        inspector=inspector,
+                        go=go,
+                        gf=gf,
+                        p_GaCa=np.asarray(p_GaCa),
+                        p_GbCb=np.asarray(p_GbCb),
+                        nhat_W=np.asarray(nhat_W),
+                        psi=psi,
+                        to_O=to_O,
+                        R_OW=R_OW,
+                        tol=tol,
+                        patches=patches,
+                    )
+                ]
                 deepest = min(c.psi for c in found)
                 if deepest < -tol and not allow_penetration:  # a tilted patch
                     penetrations.append(
@@ -402,134 +406,3 @@ def _dedupe_contacts(contacts: list[PlantContact]) -> list[PlantContact]:
             continue
         out.append(c)
     return out
-
-
-def _pair_contacts(
-    *,
-    query,
-    inspector,
-    go,
-    gf,
-    p_GaCa,
-    p_GbCb,
-    nhat_W,
-    psi,
-    to_O,
-    R_OW,
-    X_FO,
-    finger,
-    finger_name,
-    indices,
-    tol,
-    patches,
-) -> list[PlantContact]:
-    X_WGa = query.GetPoseInWorld(go)
-    X_WGb = query.GetPoseInWorld(gf)
-    R_OGa = R_OW @ _rotation(X_WGa)
-    R_OGb = R_OW @ _rotation(X_WGb)
-    p_OCa = to_O(X_WGa.multiply(p_GaCa))
-    p_OCb = to_O(X_WGb.multiply(p_GbCb))
-    obj_pieces = _pieces_in(inspector, go, p_GaCa)
-    fin_pieces = _pieces_in(inspector, gf, p_GbCb)
-
-    def finger_point(p_O):
-        return np.asarray(X_FO.multiply(p_O))
-
-    common = {
-        "finger_body": finger_name,
-        "finger_body_index": finger.index(),
-        "object_geometry": go,
-        "finger_geometry": gf,
-        "object_geometry_name": inspector.GetName(go),
-        "finger_geometry_name": inspector.GetName(gf),
-        "finger_geometry_index": indices[0],
-        "object_geometry_index": indices[1],
-    }
-    if patches == "vertices":
-        for po in obj_pieces:
-            if po.polygon_G is None:
-                continue
-            m_O = R_OGa @ po.normal_G  # object's outward face normal
-            for pf in fin_pieces:
-                if pf.polygon_G is None:
-                    continue
-                f_O = R_OGb @ pf.normal_G  # finger's outward face normal
-                if m_O @ f_O > -np.cos(PATCH_ANGLE_TOL):
-                    continue
-                poly_obj = _to_O_points(po.polygon_G, X_WGa, to_O)
-                poly_fin = _to_O_points(pf.polygon_G, X_WGb, to_O)
-                n_O = clean_unit(-m_O)
-                verts = patch_vertices(
-                    n_O=n_O,
-                    poly_obj_O=poly_obj,
-                    poly_fin_O=poly_fin,
-                    plane_point_obj_O=poly_obj[0],
-                    finger_normal_O=f_O,
-                    plane_point_fin_O=poly_fin[0],
-                    tol=tol,
-                )
-                if len(verts) >= 2:
-                    return [
-                        PlantContact(
-                            p_OC=p,
-                            nhat_O=n_O,
-                            psi=gap,
-                            p_FC=finger_point(p - gap * n_O),
-                            normal_source="patch",
-                            patch_vertex=k,
-                            exact=True,
-                            **common,
-                        )
-                        for k, (p, gap) in enumerate(verts)
-                    ]
-    exact = closest_pair(
-        PosedShape(inspector.GetShape(go), R_OGa, to_O(X_WGa.translation())),
-        PosedShape(inspector.GetShape(gf), R_OGb, to_O(X_WGb.translation())),
-        p_a=p_OCa,
-        p_b=p_OCb,
-        nhat=R_OW @ nhat_W,
-        psi=psi,
-    )
-    if exact is not None:
-        n_O = clean_unit(exact.nhat_O)
-        psi, p_OCa, p_OCb = exact.psi, exact.p_OCa, exact.p_OCb
-        source = normal_source(
-            obj=surface_pieces(
-                inspector.GetShape(go), _to_G(X_WGa, to_O, p_OCa, R_OGa), tol=1e-9
-            ),
-            fin=surface_pieces(
-                inspector.GetShape(gf), _to_G(X_WGb, to_O, p_OCb, R_OGb), tol=1e-9
-            ),
-        )
-    else:  # no certified exact contact: Drake's witness points
-        n_O, source = choose_normal(
-            obj=[-(R_OGa @ p.normal_G) for p in obj_pieces],
-            obj_flat=all(p.polygon_G is not None for p in obj_pieces),
-            fin=[R_OGb @ p.normal_G for p in fin_pieces],
-            fin_flat=all(p.polygon_G is not None for p in fin_pieces),
-            witness=p_OCa - p_OCb,
-            psi=psi,
-            drake=R_OW @ nhat_W,
-        )
-        n_O = clean_unit(n_O)
-    return [
-        PlantContact(
-            p_OC=p_OCa,
-            nhat_O=n_O,
-            psi=psi,
-            p_FC=finger_point(p_OCb),
-            normal_source=source,
-            exact=exact is not None,
-            **common,
-        )
-    ]
-
-
-def _to_G(X_WG, to_O, p_O: np.ndarray, R_OG: np.ndarray) -> np.ndarray:
-    """A point from the object frame O to the geometry frame G."""
-    return R_OG.T @ (p_O - to_O(X_WG.translation()))
-
-
-def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
-    """Polygon vertices from a geometry frame to the object frame."""
-    return np.array([to_O(X_WG.multiply(p)) for p in poly_G])
