@@ -44,7 +44,7 @@ class PairPoint:
     p_OF : (3,) float
         The finger's touching point, metres, frame O.
     normal_source : str
-        See :attr:`drakegrasp.PlantContact.normal_source`.
+        As in :class:`~drakegrasp.PlantContact` (``normal_source``).
     patch_vertex : int or None
         Index among the patch's corners, or None for a point contact.
     exact : bool
