@@ -79,11 +79,13 @@ _SUBMODULES = (
     "analysis",
     "closing",
     "contact_normals",
+    "contact_pair",
     "contact_patches",
     "contact_results",
     "contacts",
     "couplings",
     "curvature",
+    "exact_contact",
     "finger_antipodal",
     "fingers",
     "jacobians",
@@ -96,6 +98,7 @@ _SUBMODULES = (
     "scene_file",
     "scene_refs",
     "settle",
+    "shape_queries",
     "validation",
 )
 

@@ -130,28 +130,41 @@ def plane_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _hull_faces(vertices: np.ndarray, triangles) -> list:
-    """Merge coplanar hull triangles into polygon faces (normal, offset, polygon)."""
+    """Merge coplanar hull triangles into polygon faces (normal, offset, polygon).
+
+    Triangles join the first group whose normal is within ``1e-9`` and whose
+    offset within ``1e-9 · scale``; the comparison against every group at once
+    keeps a hull of thousands of faces (a finely meshed plate) to a second.
+    """
     scale = float(np.max(np.linalg.norm(vertices - vertices.mean(axis=0), axis=1)))
-    groups: list[list] = []  # [normal, offset, set of vertex indices]
-    for tri in triangles:
-        a, b, c = (vertices[i] for i in tri)
-        cr = np.cross(b - a, c - a)
-        if np.linalg.norm(cr) < 1e-14 * scale * scale:
-            continue
-        n = _unit(cr)
-        d = float(n @ a)
-        for g in groups:
-            if g[0] @ n > 1 - 1e-9 and abs(g[1] - d) < 1e-9 * max(scale, 1.0):
-                g[2].update(tri)
-                break
+    tris = np.asarray(triangles, dtype=int).reshape(-1, 3)
+    a, b, c = (vertices[tris[:, k]] for k in range(3))
+    cr = np.cross(b - a, c - a)
+    size = np.linalg.norm(cr, axis=1)
+    keep = size >= 1e-14 * scale * scale
+    tris, a, cr, size = tris[keep], a[keep], cr[keep], size[keep]
+    normals = cr / size[:, None]
+    offsets = np.einsum("ij,ij->i", normals, a)
+    group_n = np.empty((len(tris), 3))
+    group_d = np.empty(len(tris))
+    members: list[set] = []
+    for n, d, tri in zip(normals, offsets, tris, strict=True):
+        g = len(members)
+        same = np.flatnonzero(
+            (group_n[:g] @ n > 1 - 1e-9)
+            & (np.abs(group_d[:g] - d) < 1e-9 * max(scale, 1.0))
+        )
+        if same.size:
+            members[same[0]].update(tri.tolist())
         else:
-            groups.append([n, d, set(tri)])
+            group_n[g], group_d[g] = n, d
+            members.append(set(tri.tolist()))
     faces = []
-    for n, d, idx in groups:
+    for n, d, idx in zip(group_n, group_d, members, strict=False):
         pts = vertices[sorted(idx)]
         u, w = plane_basis(n)
         hull = _convex_hull_2d(np.column_stack([pts @ u, pts @ w]))
-        faces.append((n, d, pts[hull]))
+        faces.append((n.copy(), float(d), pts[hull]))
     return faces
 
 
@@ -188,6 +201,29 @@ def flat_faces(shape: Shape) -> list[tuple[np.ndarray, float, np.ndarray]] | Non
     if isinstance(shape, (Convex, Mesh)):
         return _convex_faces(shape)
     return None
+
+
+_FACE_ARRAYS: dict[int, tuple] = {}
+
+
+def face_arrays(faces: list) -> tuple:
+    """Face normals and offsets, and every face's edges with their face index.
+
+    Cached by the (cached, hence long-lived) face list of a hull.
+    """
+    hit = _FACE_ARRAYS.get(id(faces))
+    if hit is not None and hit[0] is faces:
+        return hit[1]
+    N = np.array([n for n, _, _ in faces])
+    D = np.array([d for _, d, _ in faces])
+    EA = np.vstack([poly for _, _, poly in faces])
+    EB = np.vstack([np.roll(poly, -1, axis=0) for _, _, poly in faces])
+    EF = np.concatenate([np.full(len(poly), k) for k, (_, _, poly) in enumerate(faces)])
+    arrays = (N, D, EA, EB, EF)
+    if len(_FACE_ARRAYS) >= 256:
+        _FACE_ARRAYS.clear()
+    _FACE_ARRAYS[id(faces)] = (faces, arrays)
+    return arrays
 
 
 def _hull_vertices(shape: Convex | Mesh) -> np.ndarray:
@@ -239,7 +275,9 @@ def bounding_sphere(shape: Shape) -> tuple[np.ndarray, float]:
     )
 
 
-def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
+def surface_pieces(
+    shape: Shape, p_GQ: np.ndarray, *, tol: float = ON_SURFACE_TOL
+) -> list[SurfacePiece]:
     """Outward normals (and flat faces) of ``shape`` at the surface point ``Q``.
 
     Parameters
@@ -249,6 +287,9 @@ def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
         (a Mesh is treated as its convex hull, as Drake's distance queries do).
     p_GQ : (3,) float
         A point on the surface, metres, in the geometry frame ``G``.
+    tol : float, optional
+        Metres: the point lies on every face whose plane is this near
+        (default :data:`ON_SURFACE_TOL`, the accuracy of GJK witnesses).
 
     Returns
     -------
@@ -278,10 +319,10 @@ def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
         r, half = shape.radius(), 0.5 * shape.length()
         rho = float(np.hypot(p[0], p[1]))
         pieces = []
-        if abs(rho - r) < ON_SURFACE_TOL and rho > 0:
+        if abs(rho - r) < tol and rho > 0:
             pieces.append(SurfacePiece(np.array([p[0] / rho, p[1] / rho, 0.0])))
         for sign in (1.0, -1.0):
-            if abs(p[2] - sign * half) < ON_SURFACE_TOL:
+            if abs(p[2] - sign * half) < tol:
                 pieces.append(SurfacePiece(np.array([0.0, 0.0, sign])))
         if not pieces:  # off the surface numerically: nearest piece
             if r - rho < half - abs(p[2]) and rho > 0:
@@ -295,8 +336,9 @@ def surface_pieces(shape: Shape, p_GQ: np.ndarray) -> list[SurfacePiece]:
             f"drakegrasp cannot compute surface normals of a {type(shape).__name__} "
             "geometry; use Box, Sphere, Cylinder, Capsule, Ellipsoid or Convex"
         )
-    gaps = np.array([n @ p - d for n, d, _ in faces])
-    on = np.flatnonzero(np.abs(gaps) < ON_SURFACE_TOL)
+    N, D = face_arrays(faces)[:2]
+    gaps = N @ p - D
+    on = np.flatnonzero(np.abs(gaps) < tol)
     if on.size == 0:
         on = np.array([int(np.argmax(gaps))])
     return [SurfacePiece(faces[i][0], faces[i][2]) for i in on]

@@ -1,29 +1,23 @@
-"""The normal of a contact: which surface's normal to trust, and exact fingertips.
+"""The normal of a contact: its name, and the choice when no exact one exists.
 
-Drake guarantees the witness normal at ``ψ = 0`` only for a few shape pairs, so
-the normal is derived from the shapes themselves (:func:`choose_normal`): the
-object's outward face normal at ``Ca`` (negated) when the object is smooth or on
-a face there; else the finger's outward normal at ``Cb`` when the finger is
-smooth there (a rounded fingertip on a box edge); else the direction
-``Ca − Cb`` when ``ψ`` is clearly non-zero; else Drake's ``nhat_BA_W``.
-``PlantContact.normal_source`` says which.
-
-**Spherical fingertips** (:func:`refine_sphere_tip`).  Drake computes some
-pairs in closed form (sphere–sphere, sphere–box, sphere–cylinder...) and the
-others with GJK/EPA, whose witness points are accurate to about 1e-5 m (convex
-meshes, ellipsoids).  For a spherical fingertip drakegrasp recomputes the
-finger's contact point as ``centre + r n̂`` and, on a flat face, ``ψ`` exactly
-as the centre's distance to the face plane minus ``r``; on an edge or a corner
-of flat faces (boxes, convex meshes) the normal runs from the centre to the
-closest point of that edge or corner.  Other pairs keep Drake's values.
-numpy only.
+:func:`drakegrasp.plant.contacts.find_contacts` computes every pair's witness
+points and normal exactly where it can (:mod:`drakegrasp.plant.exact_contact`: closed
+forms for spheres and capsules, the face's normal for a flat face, edges and
+cylinder sides as segments, Newton's method for two smooth pieces), and
+:func:`normal_source` names the surface the normal belongs to.  When no exact
+route certifies, :func:`choose_normal` derives the normal from the shapes at
+Drake's witness points: the object's outward face normal at ``Ca`` (negated)
+when the object is smooth or on a face there; else the finger's outward normal
+at ``Cb`` when the finger is smooth there; else the direction ``Ca − Cb`` when
+``ψ`` is clearly non-zero; else Drake's ``nhat_BA_W``.
+``PlantContact.normal_source`` says which.  numpy only.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["NORMAL_AGREEMENT", "choose_normal", "clean_unit", "refine_sphere_tip"]
+__all__ = ["NORMAL_AGREEMENT", "choose_normal", "clean_unit", "normal_source"]
 
 NORMAL_AGREEMENT = np.cos(np.radians(5.0))
 """Object and finger normals within 5 degrees of each other agree."""
@@ -82,74 +76,27 @@ def choose_normal(*, obj, obj_flat, fin, fin_flat, witness, psi, drake):
     return drake, "drake"
 
 
-def refine_sphere_tip(
-    *,
-    radius: float,
-    centre_O: np.ndarray,
-    object_faces_G: list[np.ndarray] | None,
-    G_to_O,
-    n_O: np.ndarray,
-    source: str,
-    psi: float,
-):
-    """Exact contact of a spherical fingertip on a flat face, edge or corner.
+def normal_source(*, obj: list, fin: list) -> str:
+    """Name the surface that the exact normal belongs to (``normal_source``).
 
     Parameters
     ----------
-    radius : float
-        The tip's radius, metres.
-    centre_O : (3,) float
-        The tip's centre, in frame O.
-    object_faces_G : list of (k, 3) float, or None
-        The object's flat face polygons through its witness point, in the
-        object geometry's frame G (one on a face, two on an edge, three at a
-        corner); None when a piece there is curved.
-    G_to_O : callable
-        Maps a point from G to O.
-    n_O, source, psi
-        The normal chosen so far (:func:`choose_normal`), its source and ψ.
+    obj, fin : list of SurfacePiece
+        The pieces of the object's and the finger's surface through their
+        exact witness points (one on a smooth point or a face, two on an edge,
+        three or more at a corner).
 
     Returns
     -------
-    n_O : (3,) float
-    source : str
-        ``"edge"`` or ``"corner"`` when the tip sits on one, else unchanged.
-    psi : float
-    p_OCa, p_OCb : (3,) float
-        The object's and the finger's contact points, frame O.
+    str
+        ``"object"`` when the object's surface has one normal there;
+        ``"finger"`` when the object touches with an edge or corner and the
+        finger with one flat face; else ``"edge"`` or ``"corner"`` (a curved
+        finger on an edge or a corner of the object, the normal running from
+        the feature to the finger).
     """
-    r = radius
-    faces = object_faces_G or []
-    feature = _shared_feature(faces) if object_faces_G is not None else None
-    if len(faces) == 1 and source == "object":
-        psi = float(-n_O @ (centre_O - G_to_O(faces[0][0]))) - r
-    elif feature is not None and len(faces) > 1:
-        closest_O = _closest_on_segment(centre_O, *(G_to_O(v) for v in feature))
-        d = closest_O - centre_O
-        if np.linalg.norm(d) > r / 2:  # the centre is outside the object
-            n_O, source = clean_unit(d), "edge" if len(feature) == 2 else "corner"
-            psi = float(np.linalg.norm(d)) - r
-    p_OCb = centre_O + r * n_O
-    p_OCa = p_OCb + psi * n_O
-    return n_O, source, psi, p_OCa, p_OCb
-
-
-def _shared_feature(polygons: list[np.ndarray]) -> tuple[np.ndarray, ...] | None:
-    """The edge (two vertices) or corner (one) that several faces share."""
-    if len(polygons) < 2:
-        return None
-    shared = [
-        v
-        for v in polygons[0]
-        if all(np.min(np.linalg.norm(P - v, axis=1)) < 1e-9 for P in polygons[1:])
-    ]
-    return tuple(shared) if len(shared) in (1, 2) else None
-
-
-def _closest_on_segment(x: np.ndarray, a: np.ndarray, b: np.ndarray | None = None):
-    """Closest point to ``x`` on the segment ``ab`` (or the point ``a``)."""
-    if b is None:
-        return np.asarray(a)
-    ab = b - a
-    s = float(np.clip((x - a) @ ab / (ab @ ab), 0.0, 1.0))
-    return a + s * ab
+    if len(obj) == 1:
+        return "object"
+    if len(fin) == 1 and fin[0].polygon_G is not None:
+        return "finger"
+    return "edge" if len(obj) == 2 else "corner"

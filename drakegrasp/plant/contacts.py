@@ -6,14 +6,24 @@ scene-graph query port gives the signed distance ``ψ`` and the witness points
 ``p_Ca − p_Cb = ψ n̂`` and ``n̂`` pointing from the finger into the object.  A
 pair is a contact when ``|ψ| <= distance_tolerance``.
 
-The query loop lives here; the choice of the normal (and the exact contact
-of a spherical fingertip) in :mod:`drakegrasp.plant.contact_normals`, and the
-corners of a flat pad's patch in :mod:`drakegrasp.plant.contact_patches`.
+The query loop lives here; the points of one touching pair in
+:mod:`drakegrasp.plant.contact_pair`, which draws on the exact contact of
+:mod:`drakegrasp.plant.exact_contact` (on the point queries of
+:mod:`drakegrasp.plant.shape_queries`), the name of the normal's source and the
+fallback choice in :mod:`drakegrasp.plant.contact_normals`, and the corners of
+a flat pad's patch in :mod:`drakegrasp.plant.contact_patches`.
 
-**Normals.**  Drake guarantees the witness normal at ``ψ = 0`` only for a few
-shape pairs, so the normal is derived from the shapes themselves (see
-:mod:`~drakegrasp.plant.contact_normals`); ``PlantContact.normal_source`` says
-which surface gave it.
+**Exact contacts.**  Drake decides which pairs touch (its ``ψ`` within the
+tolerance, the rule :func:`~drakegrasp.plant.closing.close_hand` closes to),
+but its GJK/EPA witness points on curved shapes and convex hulls can be
+0.1–0.4 mm off, and a normal taken there a degree or more off.  Each touching
+pair is therefore recomputed from Drake's witness by an exact, certified route
+(:mod:`drakegrasp.plant.exact_contact`): the reported ``p_OC``, ``nhat_O``, ``ψ``
+and ``p_FC`` are exact to round-off (``PlantContact.exact``), and
+``PlantContact.normal_source`` names the surface the normal belongs to.  Only
+a pair that no route certifies keeps Drake's witness points, with the normal
+chosen as :mod:`~drakegrasp.plant.contact_normals` describes.  The guide's
+*Contacts* page lists the accuracy of every shape pair.
 
 **Flat patches.**  A flat pad on a flat face is reported as one contact at
 **each vertex** of its patch polygon (same normal; ``ψ`` the gap at the
@@ -26,7 +36,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import GeometryId, QueryObject, SceneGraphInspector, Sphere
+from pydrake.geometry import GeometryId, QueryObject
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context
@@ -39,17 +49,9 @@ from drakegrasp.errors import (
     NoContactsError,
     PenetrationError,
 )
-from drakegrasp.plant._shapes import (
-    ON_SURFACE_TOL,
-    SurfacePiece,
-    surface_pieces,
-)
-from drakegrasp.plant.contact_normals import (
-    choose_normal,
-    clean_unit,
-    refine_sphere_tip,
-)
-from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
+from drakegrasp.plant._shapes import ON_SURFACE_TOL
+from drakegrasp.plant.contact_pair import pair_points
+from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -88,12 +90,10 @@ class PlantContact:
         Signed distance ``ψ`` (metres): > 0 separated, < 0 penetrating.
     p_FC : (3,) float
         The finger's witness point in the finger body's frame F: the material
-        point of the finger that touches the object.  It is Drake's closest
-        point on the finger geometry (``centre + r nhat`` for a spherical tip;
-        ``p_OC − ψ nhat`` at a patch vertex), so ``p_OC − p_FC`` (in a common
-        frame) equals ``ψ nhat`` only where the normal is Drake's own: when the
-        normal comes from a surface (``normal_source``), the two witness
-        points need not lie on it.
+        point of the finger that touches the object (``centre + r nhat`` for a
+        spherical tip; ``p_OC − ψ nhat`` at a patch vertex).  When ``exact``,
+        ``p_OC − p_FC`` (in a common frame) equals ``ψ nhat``; otherwise it is
+        Drake's witness point, which need not lie on the normal.
     finger_body : str
         Scoped name ``model::body`` of the finger body.
     finger_body_index : BodyIndex
@@ -102,12 +102,20 @@ class PlantContact:
     object_geometry_name, finger_geometry_name : str
         Their names in the scene graph.
     normal_source : str
-        Where the normal came from: ``"object"``, ``"finger"``, ``"patch"``,
-        ``"edge"`` or ``"corner"`` (a spherical tip on an edge or corner of flat
-        faces), ``"witness points"`` or ``"drake"`` (see the module docstring).
+        Which surface the normal belongs to: ``"object"``, ``"finger"`` (a
+        finger's face on an edge or corner of the object), ``"patch"``,
+        ``"edge"`` or ``"corner"`` (a curved finger on an edge or corner of the
+        object, a cylinder's rim included), and, for a contact that is not
+        ``exact``, ``"witness points"`` or ``"drake"`` (see
+        :mod:`~drakegrasp.plant.contact_normals`).
     patch_vertex : int or None
         Index of this contact among the vertices of a flat patch, or None for a
         point contact.
+    exact : bool
+        True when the point, normal and ``ψ`` were computed exactly (to
+        round-off) and certified (:mod:`drakegrasp.plant.exact_contact`; the
+        accuracy of each shape pair is listed in the guide's *Contacts* page);
+        False when they come from Drake's witness points.
     finger_geometry_index, object_geometry_index : int or None
         Place of each geometry among its body's collision geometries (None
         when not known, e.g. contacts read from contact results); they make
@@ -128,6 +136,7 @@ class PlantContact:
     patch_vertex: int | None = None
     finger_geometry_index: int | None = None
     object_geometry_index: int | None = None
+    exact: bool = False
 
     @property
     def finger_geometry_label(self) -> str:
@@ -166,6 +175,7 @@ class PlantContact:
             "finger_geometry_label": self.finger_geometry_label,
             "normal_source": self.normal_source,
             "patch_vertex": self.patch_vertex,
+            "exact": self.exact,
         }
 
     def __repr__(self) -> str:
@@ -186,12 +196,6 @@ def _label(body: str, name: str, index: int | None) -> str:
 
 def _rotation(X) -> np.ndarray:
     return X.rotation().matrix()
-
-
-def _pieces_in(
-    inspector: SceneGraphInspector, gid: GeometryId, p_GC: np.ndarray
-) -> list[SurfacePiece]:
-    return surface_pieces(inspector.GetShape(gid), p_GC)
 
 
 def find_contacts(
@@ -403,24 +407,42 @@ def contacts_of_distances(
             continue
         if abs(psi) > tol and not (allow_penetration and psi < 0):
             continue
-        found = _pair_contacts(
-            query=query,
-            inspector=inspector,
-            go=go,
-            gf=gf,
-            p_GaCa=np.asarray(p_GaCa),
-            p_GbCb=np.asarray(p_GbCb),
-            nhat_W=np.asarray(nhat_W),
-            psi=psi,
-            to_O=to_O,
-            R_OW=R_OW,
-            X_FO=X_FO,
-            finger=finger,
-            finger_name=finger_name,
-            indices=(kf, ko),
-            tol=tol,
-            patches=patches,
-        )
+        common = {
+            "finger_body": finger_name,
+            "finger_body_index": finger.index(),
+            "object_geometry": go,
+            "finger_geometry": gf,
+            "object_geometry_name": inspector.GetName(go),
+            "finger_geometry_name": inspector.GetName(gf),
+            "finger_geometry_index": kf,
+            "object_geometry_index": ko,
+        }
+        found = [
+            PlantContact(
+                p_OC=pp.p_OC,
+                nhat_O=pp.nhat_O,
+                psi=pp.psi,
+                p_FC=np.asarray(X_FO.multiply(pp.p_OF)),
+                normal_source=pp.normal_source,
+                patch_vertex=pp.patch_vertex,
+                exact=pp.exact,
+                **common,
+            )
+            for pp in pair_points(
+                query=query,
+                inspector=inspector,
+                go=go,
+                gf=gf,
+                p_GaCa=np.asarray(p_GaCa),
+                p_GbCb=np.asarray(p_GbCb),
+                nhat_W=np.asarray(nhat_W),
+                psi=psi,
+                to_O=to_O,
+                R_OW=R_OW,
+                tol=tol,
+                patches=patches,
+            )
+        ]
         deepest = min(c.psi for c in found)
         if deepest < -tol and not allow_penetration:  # a tilted patch
             penetrations.append(
@@ -459,119 +481,3 @@ def _dedupe_contacts(contacts: list[PlantContact]) -> list[PlantContact]:
             continue
         out.append(c)
     return out
-
-
-def _pair_contacts(
-    *,
-    query,
-    inspector,
-    go,
-    gf,
-    p_GaCa,
-    p_GbCb,
-    nhat_W,
-    psi,
-    to_O,
-    R_OW,
-    X_FO,
-    finger,
-    finger_name,
-    indices,
-    tol,
-    patches,
-) -> list[PlantContact]:
-    X_WGa = query.GetPoseInWorld(go)
-    X_WGb = query.GetPoseInWorld(gf)
-    R_OGa = R_OW @ _rotation(X_WGa)
-    R_OGb = R_OW @ _rotation(X_WGb)
-    p_OCa = to_O(X_WGa.multiply(p_GaCa))
-    p_OCb = to_O(X_WGb.multiply(p_GbCb))
-    obj_pieces = _pieces_in(inspector, go, p_GaCa)
-    fin_pieces = _pieces_in(inspector, gf, p_GbCb)
-
-    def finger_point(p_O):
-        return np.asarray(X_FO.multiply(p_O))
-
-    common = {
-        "finger_body": finger_name,
-        "finger_body_index": finger.index(),
-        "object_geometry": go,
-        "finger_geometry": gf,
-        "object_geometry_name": inspector.GetName(go),
-        "finger_geometry_name": inspector.GetName(gf),
-        "finger_geometry_index": indices[0],
-        "object_geometry_index": indices[1],
-    }
-    if patches == "vertices":
-        for po in obj_pieces:
-            if po.polygon_G is None:
-                continue
-            m_O = R_OGa @ po.normal_G  # object's outward face normal
-            for pf in fin_pieces:
-                if pf.polygon_G is None:
-                    continue
-                f_O = R_OGb @ pf.normal_G  # finger's outward face normal
-                if m_O @ f_O > -np.cos(PATCH_ANGLE_TOL):
-                    continue
-                poly_obj = _to_O_points(po.polygon_G, X_WGa, to_O)
-                poly_fin = _to_O_points(pf.polygon_G, X_WGb, to_O)
-                n_O = clean_unit(-m_O)
-                verts = patch_vertices(
-                    n_O=n_O,
-                    poly_obj_O=poly_obj,
-                    poly_fin_O=poly_fin,
-                    plane_point_obj_O=poly_obj[0],
-                    finger_normal_O=f_O,
-                    plane_point_fin_O=poly_fin[0],
-                    tol=tol,
-                )
-                if len(verts) >= 2:
-                    return [
-                        PlantContact(
-                            p_OC=p,
-                            nhat_O=n_O,
-                            psi=gap,
-                            p_FC=finger_point(p - gap * n_O),
-                            normal_source="patch",
-                            patch_vertex=k,
-                            **common,
-                        )
-                        for k, (p, gap) in enumerate(verts)
-                    ]
-    n_O, source = choose_normal(
-        obj=[-(R_OGa @ p.normal_G) for p in obj_pieces],
-        obj_flat=all(p.polygon_G is not None for p in obj_pieces),
-        fin=[R_OGb @ p.normal_G for p in fin_pieces],
-        fin_flat=all(p.polygon_G is not None for p in fin_pieces),
-        witness=p_OCa - p_OCb,
-        psi=psi,
-        drake=R_OW @ nhat_W,
-    )
-    n_O = clean_unit(n_O)
-    finger_shape = inspector.GetShape(gf)
-    if isinstance(finger_shape, Sphere):
-        flat = [p.polygon_G for p in obj_pieces if p.polygon_G is not None]
-        n_O, source, psi, p_OCa, p_OCb = refine_sphere_tip(
-            radius=finger_shape.radius(),
-            centre_O=to_O(X_WGb.translation()),
-            object_faces_G=flat if len(flat) == len(obj_pieces) else None,
-            G_to_O=lambda p_G: to_O(X_WGa.multiply(p_G)),
-            n_O=n_O,
-            source=source,
-            psi=psi,
-        )
-    return [
-        PlantContact(
-            p_OC=p_OCa,
-            nhat_O=n_O,
-            psi=psi,
-            p_FC=finger_point(p_OCb),
-            normal_source=source,
-            **common,
-        )
-    ]
-
-
-def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
-    """Polygon vertices from a geometry frame to the object frame."""
-    return np.array([to_O(X_WG.multiply(p)) for p in poly_G])

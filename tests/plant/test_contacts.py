@@ -107,7 +107,7 @@ SPHERE_TIP_CASES = [
         "object",
     ),
     ("cylinder-cap", Cylinder(0.03, 0.1), [0.01, 0.005, 0.05], [0, 0, -1], "object"),
-    ("cylinder-rim", Cylinder(0.03, 0.1), [0.03, 0.0, 0.05], [-1, 0, -1], "finger"),
+    ("cylinder-rim", Cylinder(0.03, 0.1), [0.03, 0.0, 0.05], [-1, 0, -1], "edge"),
     ("sphere", Sphere(0.04), 0.04 * U, -U, "object"),
     (
         "ellipsoid",

@@ -1,0 +1,189 @@
+"""The contact points of one touching geometry pair, in the object frame.
+
+:func:`pair_points` turns Drake's answer for a pair (its witness points,
+normal and ψ) into the pair's contact points: the corners of the patch when a
+flat pad lies on a flat face (:mod:`~drakegrasp.plant.contact_patches`), else
+the exact contact (:mod:`~drakegrasp.plant.exact_contact`), else Drake's
+witness points with the normal that
+:func:`~drakegrasp.plant.contact_normals.choose_normal` picks.
+:func:`drakegrasp.plant.contacts.find_contacts` runs the query loop and turns
+each :class:`PairPoint` into a :class:`~drakegrasp.PlantContact`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from drakegrasp.plant._shapes import surface_pieces
+from drakegrasp.plant.contact_normals import (
+    choose_normal,
+    clean_unit,
+    normal_source,
+)
+from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
+from drakegrasp.plant.exact_contact import closest_pair
+from drakegrasp.plant.shape_queries import PosedShape
+
+__all__ = ["PairPoint", "pair_points"]
+
+
+@dataclass(frozen=True)
+class PairPoint:
+    """One contact point of a geometry pair, frame O (the object body's).
+
+    Attributes
+    ----------
+    p_OC : (3,) float
+        The point on the object's surface, metres.
+    nhat_O : (3,) float
+        Unit normal into the object.
+    psi : float
+        Signed distance, metres.
+    p_OF : (3,) float
+        The finger's touching point, metres, frame O.
+    normal_source : str
+        As in :class:`~drakegrasp.PlantContact` (``normal_source``).
+    patch_vertex : int or None
+        Index among the patch's corners, or None for a point contact.
+    exact : bool
+        Computed exactly (a patch corner or a certified exact contact).
+    """
+
+    p_OC: np.ndarray
+    nhat_O: np.ndarray
+    psi: float
+    p_OF: np.ndarray
+    normal_source: str
+    patch_vertex: int | None
+    exact: bool
+
+
+def _rotation(X) -> np.ndarray:
+    return X.rotation().matrix()
+
+
+def pair_points(
+    *,
+    query,
+    inspector,
+    go,
+    gf,
+    p_GaCa: np.ndarray,
+    p_GbCb: np.ndarray,
+    nhat_W: np.ndarray,
+    psi: float,
+    to_O,
+    R_OW: np.ndarray,
+    tol: float,
+    patches: str,
+) -> list[PairPoint]:
+    """The contact points of the pair (object geometry ``go``, finger ``gf``).
+
+    Parameters
+    ----------
+    query, inspector
+        The scene graph's query object and its inspector.
+    go, gf : GeometryId
+        The object's and the finger's geometry.
+    p_GaCa, p_GbCb : (3,) float
+        Drake's witness points, each in its geometry's frame.
+    nhat_W : (3,) float
+        Drake's normal from the finger into the object, world frame.
+    psi : float
+        Drake's signed distance, metres.
+    to_O : callable
+        Maps a world point to frame O.
+    R_OW : (3, 3) float
+        Rotation of the world in O.
+    tol : float
+        The distance tolerance, metres (a patch keeps the part within it).
+    patches : {"vertices", "witness"}
+        Whether a flat pad on a flat face gives its patch's corners.
+
+    Returns
+    -------
+    list of PairPoint
+    """
+    X_WGa = query.GetPoseInWorld(go)
+    X_WGb = query.GetPoseInWorld(gf)
+    R_OGa = R_OW @ _rotation(X_WGa)
+    R_OGb = R_OW @ _rotation(X_WGb)
+    p_OCa = to_O(X_WGa.multiply(p_GaCa))
+    p_OCb = to_O(X_WGb.multiply(p_GbCb))
+    obj_pieces = _pieces_in(inspector, go, p_GaCa)
+    fin_pieces = _pieces_in(inspector, gf, p_GbCb)
+    if patches == "vertices":
+        for po in obj_pieces:
+            if po.polygon_G is None:
+                continue
+            m_O = R_OGa @ po.normal_G  # object's outward face normal
+            for pf in fin_pieces:
+                if pf.polygon_G is None:
+                    continue
+                f_O = R_OGb @ pf.normal_G  # finger's outward face normal
+                if m_O @ f_O > -np.cos(PATCH_ANGLE_TOL):
+                    continue
+                poly_obj = _to_O_points(po.polygon_G, X_WGa, to_O)
+                poly_fin = _to_O_points(pf.polygon_G, X_WGb, to_O)
+                n_O = clean_unit(-m_O)
+                verts = patch_vertices(
+                    n_O=n_O,
+                    poly_obj_O=poly_obj,
+                    poly_fin_O=poly_fin,
+                    plane_point_obj_O=poly_obj[0],
+                    finger_normal_O=f_O,
+                    plane_point_fin_O=poly_fin[0],
+                    tol=tol,
+                )
+                if len(verts) >= 2:
+                    return [
+                        PairPoint(p, n_O, gap, p - gap * n_O, "patch", k, True)
+                        for k, (p, gap) in enumerate(verts)
+                    ]
+    exact = closest_pair(
+        PosedShape(inspector.GetShape(go), R_OGa, to_O(X_WGa.translation())),
+        PosedShape(inspector.GetShape(gf), R_OGb, to_O(X_WGb.translation())),
+        p_a=p_OCa,
+        p_b=p_OCb,
+        nhat=R_OW @ nhat_W,
+        psi=psi,
+    )
+    if exact is not None:
+        n_O = clean_unit(exact.nhat_O)
+        psi, p_OCa, p_OCb = exact.psi, exact.p_OCa, exact.p_OCb
+        source = normal_source(
+            obj=surface_pieces(
+                inspector.GetShape(go), _to_G(X_WGa, to_O, p_OCa, R_OGa), tol=1e-9
+            ),
+            fin=surface_pieces(
+                inspector.GetShape(gf), _to_G(X_WGb, to_O, p_OCb, R_OGb), tol=1e-9
+            ),
+        )
+    else:  # no certified exact contact: Drake's witness points
+        n_O, source = choose_normal(
+            obj=[-(R_OGa @ p.normal_G) for p in obj_pieces],
+            obj_flat=all(p.polygon_G is not None for p in obj_pieces),
+            fin=[R_OGb @ p.normal_G for p in fin_pieces],
+            fin_flat=all(p.polygon_G is not None for p in fin_pieces),
+            witness=p_OCa - p_OCb,
+            psi=psi,
+            drake=R_OW @ nhat_W,
+        )
+        n_O = clean_unit(n_O)
+    return [PairPoint(p_OCa, n_O, psi, p_OCb, source, None, exact is not None)]
+
+
+def _pieces_in(inspector, gid, p_GC: np.ndarray):
+    return surface_pieces(inspector.GetShape(gid), p_GC)
+
+
+def _to_G(X_WG, to_O, p_O: np.ndarray, R_OG: np.ndarray) -> np.ndarray:
+    """A point from the object frame O to the geometry frame G."""
+    return R_OG.T @ (p_O - to_O(X_WG.translation()))
+
+
+def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
+    """Polygon vertices from a geometry frame to the object frame."""
+    return np.array([to_O(X_WG.multiply(p)) for p in poly_G])
