@@ -264,7 +264,7 @@ class Contact:
 
     @property
     def model(self) -> ContactModel:
-        """Deprecated alias of :attr:`contact_model`."""
+        """Deprecated alias of ``contact_model`` (the attribute)."""
         warn_deprecated("Contact.model is deprecated; use Contact.contact_model")
         return self.contact_model
 

@@ -26,7 +26,7 @@ F = TypeVar("F", bound=Callable)
 def warn_deprecated(message: str, *, stacklevel: int | None = 3) -> None:
     """Warn with a :class:`DeprecationWarning` attributed to the user's line.
 
-    ``stacklevel`` counts as :func:`warnings.warn` does, from this function
+    ``stacklevel`` counts as ``warnings.warn`` does, from this function
     (3: the caller of the function that calls this one).  ``None`` (used by the
     decorators here) attributes the warning to the first frame outside this
     module, however many of its wrappers are stacked.
