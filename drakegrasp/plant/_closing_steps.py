@@ -33,6 +33,37 @@ class FingerState:
     iterations: int = 0
 
 
+def pair_distances(query, pairs) -> tuple[list, np.ndarray]:
+    """Drake's closest points of every pair, and their signed distances (metres)."""
+    f = query.ComputeSignedDistancePairClosestPoints
+    results = [f(go, gf) for go, gf, _ in pairs]
+    every = np.fromiter((r.distance for r in results), float, len(results))
+    return results, every
+
+
+def nearest(every: np.ndarray, subset: np.ndarray | None = None) -> int | None:
+    """The first pair (of ``subset``) at the smallest finite distance, or None."""
+    ks = np.arange(len(every)) if subset is None else subset
+    if len(ks) == 0:
+        return None
+    psi = every[ks]
+    psi = np.where(np.isnan(psi), np.inf, psi)
+    k = int(np.argmin(psi))  # the first of equal distances, as a loop with <
+    return int(ks[k]) if psi[k] < np.inf else None
+
+
+def witness(query, plant, context, pair, result):
+    """(ψ, n̂_W from finger to object, finger body, witness p_BC) of one pair."""
+    go, gf, body = pair
+    if result.id_A == go:
+        n_W, p_GC = np.asarray(result.nhat_BA_W), result.p_BCb
+    else:  # Drake swapped the pair
+        n_W, p_GC = -np.asarray(result.nhat_BA_W), result.p_ACa
+    p_WC = query.GetPoseInWorld(gf).multiply(p_GC)
+    p_BC = plant.EvalBodyPoseInWorld(context, body).inverse().multiply(p_WC)
+    return float(result.distance), n_W, body, np.asarray(p_BC)
+
+
 def closest(query, plant, context, pairs):
     """The closest pair and the distance of every pair.
 
@@ -41,23 +72,11 @@ def closest(query, plant, context, pairs):
     (ψ, n̂_W from finger to object, finger body, witness p_BCb, ψ of every pair)
         ``(inf, None, None, None, ψs)`` when there is no pair.
     """
-    best = (np.inf, None, None, None, None)
-    every = np.empty(len(pairs))
-    for k, (go, gf, body) in enumerate(pairs):
-        r = query.ComputeSignedDistancePairClosestPoints(go, gf)
-        every[k] = r.distance
-        if r.distance < best[0]:
-            if r.id_A == go:
-                n_W, p_GC = np.asarray(r.nhat_BA_W), r.p_BCb
-            else:  # Drake swapped the pair
-                n_W, p_GC = -np.asarray(r.nhat_BA_W), r.p_ACa
-            best = (float(r.distance), n_W, body, gf, p_GC)
-    psi, n_W, body, gf, p_GC = best
-    if body is None:
-        return psi, None, None, None, every
-    p_WC = query.GetPoseInWorld(gf).multiply(p_GC)
-    p_BC = plant.EvalBodyPoseInWorld(context, body).inverse().multiply(p_WC)
-    return psi, n_W, body, np.asarray(p_BC), every
+    results, every = pair_distances(query, pairs)
+    k = nearest(every)
+    if k is None:
+        return np.inf, None, None, None, every
+    return (*witness(query, plant, context, pairs[k], results[k]), every)
 
 
 def _path_end(q, d, lower, upper) -> float:
@@ -75,6 +94,7 @@ class Search:
         self.plant, self.context, self.hand = plant, context, hand
         self.tol, self.target = tol, 0.5 * tol
         self.user_d, self.max_iterations = user_d, max_it
+        self._tips: dict[int, np.ndarray | None] = {}  # id(finger) -> tip rows
 
     def run(self, states: list[FingerState], q_all: np.ndarray, q0: np.ndarray) -> int:
         """Step until every finger has a status; the number of steps."""
@@ -101,9 +121,11 @@ class Search:
 
     def advance(self, st: FingerState, query) -> None:
         """Classify the finger's trial point, then aim its next one."""
-        psi, _, body, _, every = closest(
-            query, self.plant, self.context, st.finger.pairs
-        )
+        pairs = st.finger.pairs
+        results, every = pair_distances(query, pairs)
+        k = nearest(every)
+        psi = np.inf if k is None else float(every[k])
+        body = None if k is None else pairs[k][2]
         st.psi, st.closest_body = psi, body
         first = st.iterations == 0
         if body is None:  # no collision geometry that can touch the object
@@ -120,7 +142,7 @@ class Search:
             st.iterations += 1
         else:  # clear of the object: accept the point, aim the next step
             st.q_good, st.psi_good = st.q_trial.copy(), psi
-            st.d = self.direction(st, query)
+            st.d = self.direction(st, query, (results, every))
             alpha_end = _path_end(st.q_good, st.d, self.hand.lower, self.hand.upper)
             if alpha_end <= 1e-12:
                 mine = list(st.finger.joints)
@@ -132,6 +154,18 @@ class Search:
             st.alpha = min(alpha_ca, st.finger.max_step, alpha_end)
             st.q_trial = self._at(st, st.alpha)
             st.iterations += 1
+
+    def _tip_rows(self, finger) -> np.ndarray | None:
+        """Rows of ``finger.pairs`` that are its ``tip_pairs``, in order.
+
+        None when a tip pair is not among the pairs (then it is measured apart).
+        """
+        if id(finger) not in self._tips:
+            where = {(p[0], p[1]): k for k, p in enumerate(finger.pairs)}
+            rows = [where.get((p[0], p[1])) for p in finger.tip_pairs]
+            ok = None not in rows and rows == sorted(rows)
+            self._tips[id(finger)] = np.array(rows, dtype=int) if ok else None
+        return self._tips[id(finger)]
 
     def _at(self, st: FingerState, alpha: float) -> np.ndarray:
         return np.clip(st.q_good + alpha * st.d, self.hand.lower, self.hand.upper)
@@ -148,17 +182,35 @@ class Search:
         )
         return -(n_W @ J[:, self.hand.velocity_indices])
 
-    def direction(self, st: FingerState, query) -> np.ndarray:
-        """The finger's direction, zero on joints blocked by a limit."""
-        hand = self.hand
-        mine = np.isin(np.arange(len(hand.lower)), st.finger.joints)
+    def direction(self, st: FingerState, query, measured=None) -> np.ndarray:
+        """The finger's direction, zero on joints blocked by a limit.
+
+        ``measured``: :func:`pair_distances` of the finger's pairs at
+        ``st.q_good`` when the caller has them (the tip's are among them).
+        """
+        hand, finger = self.hand, st.finger
+        mine = np.zeros(len(hand.lower), dtype=bool)
+        mine[list(finger.joints)] = True
         if self.user_d is not None:
             d = np.where(mine, self.user_d, 0.0)
         else:  # steepest descent of the fingertip's distance, here
-            tip = closest(query, self.plant, self.context, st.finger.tip_pairs)
-            if tip[2] is None:
-                return np.zeros(len(mine))
-            d = np.where(mine, -hand.coupling.pull_back(self._dpsi(*tip[1:4])), 0.0)
+            rows = None if measured is None else self._tip_rows(finger)
+            if rows is None:
+                tip = closest(query, self.plant, self.context, finger.tip_pairs)
+                if tip[2] is None:
+                    return np.zeros(len(mine))
+                n_W, body, p_BC = tip[1:4]
+            else:
+                results, every = measured
+                k = nearest(every, rows)
+                if k is None:
+                    return np.zeros(len(mine))
+                _, n_W, body, p_BC = witness(
+                    query, self.plant, self.context, finger.pairs[k], results[k]
+                )
+            d = np.where(
+                mine, -hand.coupling.pull_back(self._dpsi(n_W, body, p_BC)), 0.0
+            )
         q = st.q_good
         blocked = ((d > 0) & (q >= hand.upper)) | ((d < 0) & (q <= hand.lower))
         d = np.where(blocked, 0.0, d)
