@@ -31,6 +31,73 @@ class FingerState:
     psi: float = np.inf
     closest_body: object = None
     iterations: int = 0
+    lower_good: np.ndarray | None = None  # (n_pairs,) ψ_p at q_good, or below it
+    speed: np.ndarray | None = None  # (n_pairs,) V_p along d
+
+
+class Measured:
+    """A finger's pair distances at its trial point, measured where they matter.
+
+    ``lower`` bounds every pair's distance from below (conservative
+    advancement: ``ψ_p >= ψ_p(q_good) − α V_p``); a pair is measured (one
+    Drake call) only when its bound, less ``margin``, does not prove it
+    irrelevant to the answer asked for (:meth:`nearest`,
+    :meth:`advancement`).  The answers are those of measuring every pair.
+    ``lower=None`` measures every pair at once.
+    """
+
+    def __init__(self, query, pairs, lower: np.ndarray | None, margin: float):
+        self.query, self.pairs, self.margin = query, pairs, margin
+        n = len(pairs)
+        self.results: list = [None] * n
+        self.every = np.full(n, np.inf)
+        self.known = np.zeros(n, dtype=bool)
+        self.rows = np.arange(n)
+        self.lower = np.full(n, -np.inf) if lower is None else lower
+        if lower is None:
+            self.measure(np.arange(n))
+
+    def measure(self, ks) -> None:
+        """Ask Drake for the pairs ``ks``."""
+        f = self.query.ComputeSignedDistancePairClosestPoints
+        for k in ks:
+            go, gf, _ = self.pairs[k]
+            r = self.results[k] = f(go, gf)
+            self.every[k] = r.distance
+        self.known[ks] = True
+
+    def nearest(self, subset: np.ndarray | None = None) -> int | None:
+        """:func:`nearest` of every pair (of ``subset``), as if all were measured."""
+        ks = self.rows if subset is None else subset
+        if not len(ks):
+            return None
+        known, every, lower = self.known, self.every, self.lower
+        if not known[ks].any():
+            self.measure([ks[lower[ks].argmin()]])
+        while True:  # unmeasured pairs count as inf in every
+            j = every[ks].argmin()
+            need = ks[~known[ks] & (lower[ks] - self.margin <= every[ks[j]])]
+            if not len(need):
+                k = int(ks[j])
+                return k if every[k] < np.inf else None
+            self.measure(need)
+
+    def advancement(self, speed: np.ndarray, target: float) -> float:
+        """:func:`advancement_bound` over every pair, as if all were measured."""
+        moving = speed > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = np.maximum(self.lower - self.margin - target, 0.0) / speed
+        while True:
+            k = self.known
+            alpha = advancement_bound(self.every[k], speed[k], target)
+            need = np.flatnonzero(~k & moving & (bound < alpha))
+            if not len(need):
+                return alpha
+            self.measure(need)
+
+    def lower_bounds(self) -> np.ndarray:
+        """(n_pairs,) the measured distances, the bounds elsewhere."""
+        return np.where(self.known, self.every, self.lower)
 
 
 def pair_distances(query, pairs) -> tuple[list, np.ndarray]:
@@ -122,9 +189,14 @@ class Search:
     def advance(self, st: FingerState, query) -> None:
         """Classify the finger's trial point, then aim its next one."""
         pairs = st.finger.pairs
-        results, every = pair_distances(query, pairs)
-        k = nearest(every)
-        psi = np.inf if k is None else float(every[k])
+        lower = None
+        if st.lower_good is not None:  # every pair moved at most α V_p nearer
+            lower = st.lower_good - st.alpha * st.speed
+        # A pair is skipped only when its bound, less the contact tolerance,
+        # shows it cannot change the answer.
+        seen = Measured(query, pairs, lower, self.tol)
+        k = seen.nearest()
+        psi = np.inf if k is None else float(seen.every[k])
         body = None if k is None else pairs[k][2]
         st.psi, st.closest_body = psi, body
         first = st.iterations == 0
@@ -142,7 +214,7 @@ class Search:
             st.iterations += 1
         else:  # clear of the object: accept the point, aim the next step
             st.q_good, st.psi_good = st.q_trial.copy(), psi
-            st.d = self.direction(st, query, (results, every))
+            st.d = self.direction(st, query, seen)
             alpha_end = _path_end(st.q_good, st.d, self.hand.lower, self.hand.upper)
             if alpha_end <= 1e-12:
                 mine = list(st.finger.joints)
@@ -150,7 +222,8 @@ class Search:
                 st.status = "fixed" if unmoved else "at limit"
                 return
             speed = finger_speed_bound(st.reach, self.hand.coupling.tangent(st.d))
-            alpha_ca = advancement_bound(every, speed, self.target)
+            alpha_ca = seen.advancement(speed, self.target)
+            st.lower_good, st.speed = seen.lower_bounds(), speed
             st.alpha = min(alpha_ca, st.finger.max_step, alpha_end)
             st.q_trial = self._at(st, st.alpha)
             st.iterations += 1
@@ -182,11 +255,13 @@ class Search:
         )
         return -(n_W @ J[:, self.hand.velocity_indices])
 
-    def direction(self, st: FingerState, query, measured=None) -> np.ndarray:
+    def direction(
+        self, st: FingerState, query, measured: Measured | None = None
+    ) -> np.ndarray:
         """The finger's direction, zero on joints blocked by a limit.
 
-        ``measured``: :func:`pair_distances` of the finger's pairs at
-        ``st.q_good`` when the caller has them (the tip's are among them).
+        ``measured``: the finger's pairs at ``st.q_good`` when the caller has
+        them (the tip's are among them).
         """
         hand, finger = self.hand, st.finger
         mine = np.zeros(len(hand.lower), dtype=bool)
@@ -201,13 +276,13 @@ class Search:
                     return np.zeros(len(mine))
                 n_W, body, p_BC = tip[1:4]
             else:
-                results, every = measured
-                k = nearest(every, rows)
+                k = measured.nearest(rows)
                 if k is None:
                     return np.zeros(len(mine))
                 _, n_W, body, p_BC = witness(
-                    query, self.plant, self.context, finger.pairs[k], results[k]
-                )
+                    query, self.plant, self.context, finger.pairs[k],
+                    measured.results[k],
+                )  # fmt: skip
             d = np.where(
                 mine, -hand.coupling.pull_back(self._dpsi(n_W, body, p_BC)), 0.0
             )
