@@ -276,7 +276,11 @@ def rank_multifinger(
                 closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
                 opening=float("nan"),
                 contacts=tuple(found),
-                contact_options={"mu": mu, "model": model, "torsional_friction": nu},
+                contact_options={
+                    "mu": mu,
+                    "contact_model": model,
+                    "torsional_friction": nu,
+                },
                 is_closure=bool(is_closure[i]),
                 d_star=float(d_star[i]),
                 rank=int(rank[i]),

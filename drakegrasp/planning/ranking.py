@@ -164,8 +164,8 @@ def verdicts(
     res = batch_force_closure(
         positions,
         normals,
-        mu,
-        model=model,
+        mu=mu,
+        contact_model=model,
         torsional_friction=torsional_friction,
         workers=workers,
     )
@@ -175,8 +175,8 @@ def verdicts(
         eps[closed] = batch_epsilon_l1(
             positions[closed],
             normals[closed],
-            mu,
-            model=model,
+            mu=mu,
+            contact_model=model,
             torsional_friction=torsional_friction,
             characteristic_lengths=torque_scale,
             workers=workers,
@@ -217,8 +217,8 @@ def robustness(
     res = batch_force_closure(
         P,
         Nrm,
-        mus,
-        model=model,
+        mu=mus,
+        contact_model=model,
         torsional_friction=torsional_friction,
         workers=workers,
     )
@@ -318,7 +318,11 @@ def rank_candidates(
                 ),
                 opening=opening,
                 contacts=tuple(found),
-                contact_options={"mu": mu, "model": model, "torsional_friction": nu},
+                contact_options={
+                    "mu": mu,
+                    "contact_model": model,
+                    "torsional_friction": nu,
+                },
                 is_closure=bool(is_closure[i]),
                 d_star=float(d_star[i]),
                 rank=int(rank[i]),
