@@ -15,6 +15,15 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from drakegrasp.plant.advancement import advancement_bound, finger_speed_bound
 from drakegrasp.plant.fingers import Finger, HandStructure
 
+STALL_STEPS = 20
+"""A finger stalls after this many accepted steps without progress (see below)."""
+STALL_PROGRESS = 0.01
+"""Progress: ``ψ − ψ*`` falls below this fraction of itself under the best so far."""
+STALL_DISTANCE = 10.0
+"""Only a finger farther than this many contact tolerances from the object stalls."""
+STALL_WANDER = 0.5
+"""A stalled finger's net motion over those steps is below this fraction of its path."""
+
 
 @dataclass
 class FingerState:
@@ -32,6 +41,9 @@ class FingerState:
     closest_body: object = None
     iterations: int = 0
     lower_good: np.ndarray | None = None  # (n_pairs,) ψ_p at q_good, or below it
+    best: float = np.inf  # smallest ψ of an accepted point
+    since_best: int = 0  # accepted points since ψ last fell clearly below best
+    trail: list = field(default_factory=list)  # the last accepted points, oldest first
     speed: np.ndarray | None = None  # (n_pairs,) V_p along d
 
 
@@ -214,6 +226,9 @@ class Search:
             st.iterations += 1
         else:  # clear of the object: accept the point, aim the next step
             st.q_good, st.psi_good = st.q_trial.copy(), psi
+            if self._stalled(st, psi):
+                st.status = "not converged"
+                return
             st.d = self.direction(st, query, seen)
             alpha_end = _path_end(st.q_good, st.d, self.hand.lower, self.hand.upper)
             if alpha_end <= 1e-12:
@@ -227,6 +242,34 @@ class Search:
             st.alpha = min(alpha_ca, st.finger.max_step, alpha_end)
             st.q_trial = self._at(st, st.alpha)
             st.iterations += 1
+
+    def _stalled(self, st: FingerState, psi: float) -> bool:
+        """Whether the finger circles a point where its distance stopped shrinking.
+
+        A steepest-descent path that reaches a stationary point of the tip's
+        distance (a finger curled past the object, or pressed to a limit
+        beside it) steps back and forth around it without coming nearer; it
+        would end with ``max_iterations``, at another clear point of the same
+        neighbourhood.  It stops when, over the last :data:`STALL_STEPS`
+        accepted points, ``ψ − ψ*`` never fell below ``1 − STALL_PROGRESS``
+        times its best, the finger's net motion (largest joint change) was
+        below :data:`STALL_WANDER` times the length of its path (it turned
+        back), and ``ψ > STALL_DISTANCE · tol``.  A finger that sweeps on
+        (a fixed direction, or a curl past a thin obstacle that bounds its
+        steps) or converges onto the object is never stopped.
+        """
+        st.trail = [*st.trail[-STALL_STEPS:], st.q_good]
+        first = st.best == np.inf
+        if first or psi < st.best - STALL_PROGRESS * (st.best - self.target):
+            st.best, st.since_best = psi, 0
+            return False
+        st.since_best += 1
+        if st.since_best < STALL_STEPS or psi <= STALL_DISTANCE * self.tol:
+            return False
+        trail = np.array(st.trail)
+        path = np.sum(np.max(np.abs(np.diff(trail, axis=0)), axis=1))
+        net = np.max(np.abs(trail[-1] - trail[0]))
+        return bool(net < STALL_WANDER * path)
 
     def _tip_rows(self, finger) -> np.ndarray | None:
         """Rows of ``finger.pairs`` that are its ``tip_pairs``, in order.
