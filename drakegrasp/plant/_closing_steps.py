@@ -15,6 +15,15 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from drakegrasp.plant.advancement import advancement_bound, finger_speed_bound
 from drakegrasp.plant.fingers import Finger, HandStructure
 
+STALL_STEPS = 20
+"""A finger stalls after this many accepted steps without progress (see below)."""
+STALL_PROGRESS = 0.01
+"""Progress: ``ψ − ψ*`` falls below this fraction of itself under the best so far."""
+STALL_DISTANCE = 10.0
+"""Only a finger farther than this many contact tolerances from the object stalls."""
+STALL_WANDER = 0.5
+"""A stalled finger's net motion over those steps is below this fraction of its path."""
+
 
 @dataclass
 class FingerState:
@@ -31,6 +40,107 @@ class FingerState:
     psi: float = np.inf
     closest_body: object = None
     iterations: int = 0
+    lower_good: np.ndarray | None = None  # (n_pairs,) ψ_p at q_good, or below it
+    best: float = np.inf  # smallest ψ of an accepted point
+    since_best: int = 0  # accepted points since ψ last fell clearly below best
+    trail: list = field(default_factory=list)  # the last accepted points, oldest first
+    speed: np.ndarray | None = None  # (n_pairs,) V_p along d
+
+
+class Measured:
+    """A finger's pair distances at its trial point, measured where they matter.
+
+    ``lower`` bounds every pair's distance from below (conservative
+    advancement: ``ψ_p >= ψ_p(q_good) − α V_p``); a pair is measured (one
+    Drake call) only when its bound, less ``margin``, does not prove it
+    irrelevant to the answer asked for (:meth:`nearest`,
+    :meth:`advancement`).  The answers are those of measuring every pair.
+    ``lower=None`` measures every pair at once.
+    """
+
+    def __init__(self, query, pairs, lower: np.ndarray | None, margin: float):
+        self.query, self.pairs, self.margin = query, pairs, margin
+        n = len(pairs)
+        self.results: list = [None] * n
+        self.every = np.full(n, np.inf)
+        self.known = np.zeros(n, dtype=bool)
+        self.rows = np.arange(n)
+        self.lower = np.full(n, -np.inf) if lower is None else lower
+        if lower is None:
+            self.measure(np.arange(n))
+
+    def measure(self, ks) -> None:
+        """Ask Drake for the pairs ``ks``."""
+        f = self.query.ComputeSignedDistancePairClosestPoints
+        for k in ks:
+            go, gf, _ = self.pairs[k]
+            r = self.results[k] = f(go, gf)
+            self.every[k] = r.distance
+        self.known[ks] = True
+
+    def nearest(self, subset: np.ndarray | None = None) -> int | None:
+        """:func:`nearest` of every pair (of ``subset``), as if all were measured."""
+        ks = self.rows if subset is None else subset
+        if not len(ks):
+            return None
+        known, every, lower = self.known, self.every, self.lower
+        if not known[ks].any():
+            self.measure([ks[lower[ks].argmin()]])
+        while True:  # unmeasured pairs count as inf in every
+            j = every[ks].argmin()
+            need = ks[~known[ks] & (lower[ks] - self.margin <= every[ks[j]])]
+            if not len(need):
+                k = int(ks[j])
+                return k if every[k] < np.inf else None
+            self.measure(need)
+
+    def advancement(self, speed: np.ndarray, target: float) -> float:
+        """:func:`advancement_bound` over every pair, as if all were measured."""
+        moving = speed > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = np.maximum(self.lower - self.margin - target, 0.0) / speed
+        while True:
+            k = self.known
+            alpha = advancement_bound(self.every[k], speed[k], target)
+            need = np.flatnonzero(~k & moving & (bound < alpha))
+            if not len(need):
+                return alpha
+            self.measure(need)
+
+    def lower_bounds(self) -> np.ndarray:
+        """(n_pairs,) the measured distances, the bounds elsewhere."""
+        return np.where(self.known, self.every, self.lower)
+
+
+def pair_distances(query, pairs) -> tuple[list, np.ndarray]:
+    """Drake's closest points of every pair, and their signed distances (metres)."""
+    f = query.ComputeSignedDistancePairClosestPoints
+    results = [f(go, gf) for go, gf, _ in pairs]
+    every = np.fromiter((r.distance for r in results), float, len(results))
+    return results, every
+
+
+def nearest(every: np.ndarray, subset: np.ndarray | None = None) -> int | None:
+    """The first pair (of ``subset``) at the smallest finite distance, or None."""
+    ks = np.arange(len(every)) if subset is None else subset
+    if len(ks) == 0:
+        return None
+    psi = every[ks]
+    psi = np.where(np.isnan(psi), np.inf, psi)
+    k = int(np.argmin(psi))  # the first of equal distances, as a loop with <
+    return int(ks[k]) if psi[k] < np.inf else None
+
+
+def witness(query, plant, context, pair, result):
+    """(ψ, n̂_W from finger to object, finger body, witness p_BC) of one pair."""
+    go, gf, body = pair
+    if result.id_A == go:
+        n_W, p_GC = np.asarray(result.nhat_BA_W), result.p_BCb
+    else:  # Drake swapped the pair
+        n_W, p_GC = -np.asarray(result.nhat_BA_W), result.p_ACa
+    p_WC = query.GetPoseInWorld(gf).multiply(p_GC)
+    p_BC = plant.EvalBodyPoseInWorld(context, body).inverse().multiply(p_WC)
+    return float(result.distance), n_W, body, np.asarray(p_BC)
 
 
 def closest(query, plant, context, pairs):
@@ -41,23 +151,11 @@ def closest(query, plant, context, pairs):
     (ψ, n̂_W from finger to object, finger body, witness p_BCb, ψ of every pair)
         ``(inf, None, None, None, ψs)`` when there is no pair.
     """
-    best = (np.inf, None, None, None, None)
-    every = np.empty(len(pairs))
-    for k, (go, gf, body) in enumerate(pairs):
-        r = query.ComputeSignedDistancePairClosestPoints(go, gf)
-        every[k] = r.distance
-        if r.distance < best[0]:
-            if r.id_A == go:
-                n_W, p_GC = np.asarray(r.nhat_BA_W), r.p_BCb
-            else:  # Drake swapped the pair
-                n_W, p_GC = -np.asarray(r.nhat_BA_W), r.p_ACa
-            best = (float(r.distance), n_W, body, gf, p_GC)
-    psi, n_W, body, gf, p_GC = best
-    if body is None:
-        return psi, None, None, None, every
-    p_WC = query.GetPoseInWorld(gf).multiply(p_GC)
-    p_BC = plant.EvalBodyPoseInWorld(context, body).inverse().multiply(p_WC)
-    return psi, n_W, body, np.asarray(p_BC), every
+    results, every = pair_distances(query, pairs)
+    k = nearest(every)
+    if k is None:
+        return np.inf, None, None, None, every
+    return (*witness(query, plant, context, pairs[k], results[k]), every)
 
 
 def _path_end(q, d, lower, upper) -> float:
@@ -75,6 +173,7 @@ class Search:
         self.plant, self.context, self.hand = plant, context, hand
         self.tol, self.target = tol, 0.5 * tol
         self.user_d, self.max_iterations = user_d, max_it
+        self._tips: dict[int, np.ndarray | None] = {}  # id(finger) -> tip rows
 
     def run(self, states: list[FingerState], q_all: np.ndarray, q0: np.ndarray) -> int:
         """Step until every finger has a status; the number of steps."""
@@ -101,9 +200,16 @@ class Search:
 
     def advance(self, st: FingerState, query) -> None:
         """Classify the finger's trial point, then aim its next one."""
-        psi, _, body, _, every = closest(
-            query, self.plant, self.context, st.finger.pairs
-        )
+        pairs = st.finger.pairs
+        lower = None
+        if st.lower_good is not None:  # every pair moved at most α V_p nearer
+            lower = st.lower_good - st.alpha * st.speed
+        # A pair is skipped only when its bound, less the contact tolerance,
+        # shows it cannot change the answer.
+        seen = Measured(query, pairs, lower, self.tol)
+        k = seen.nearest()
+        psi = np.inf if k is None else float(seen.every[k])
+        body = None if k is None else pairs[k][2]
         st.psi, st.closest_body = psi, body
         first = st.iterations == 0
         if body is None:  # no collision geometry that can touch the object
@@ -120,7 +226,10 @@ class Search:
             st.iterations += 1
         else:  # clear of the object: accept the point, aim the next step
             st.q_good, st.psi_good = st.q_trial.copy(), psi
-            st.d = self.direction(st, query)
+            if self._stalled(st, psi):
+                st.status = "not converged"
+                return
+            st.d = self.direction(st, query, seen)
             alpha_end = _path_end(st.q_good, st.d, self.hand.lower, self.hand.upper)
             if alpha_end <= 1e-12:
                 mine = list(st.finger.joints)
@@ -128,10 +237,51 @@ class Search:
                 st.status = "fixed" if unmoved else "at limit"
                 return
             speed = finger_speed_bound(st.reach, self.hand.coupling.tangent(st.d))
-            alpha_ca = advancement_bound(every, speed, self.target)
+            alpha_ca = seen.advancement(speed, self.target)
+            st.lower_good, st.speed = seen.lower_bounds(), speed
             st.alpha = min(alpha_ca, st.finger.max_step, alpha_end)
             st.q_trial = self._at(st, st.alpha)
             st.iterations += 1
+
+    def _stalled(self, st: FingerState, psi: float) -> bool:
+        """Whether the finger circles a point where its distance stopped shrinking.
+
+        A steepest-descent path that reaches a stationary point of the tip's
+        distance (a finger curled past the object, or pressed to a limit
+        beside it) steps back and forth around it without coming nearer; it
+        would end with ``max_iterations``, at another clear point of the same
+        neighbourhood.  It stops when, over the last :data:`STALL_STEPS`
+        accepted points, ``ψ − ψ*`` never fell below ``1 − STALL_PROGRESS``
+        times its best, the finger's net motion (largest joint change) was
+        below :data:`STALL_WANDER` times the length of its path (it turned
+        back), and ``ψ > STALL_DISTANCE · tol``.  A finger that sweeps on
+        (a fixed direction, or a curl past a thin obstacle that bounds its
+        steps) or converges onto the object is never stopped.
+        """
+        st.trail = [*st.trail[-STALL_STEPS:], st.q_good]
+        first = st.best == np.inf
+        if first or psi < st.best - STALL_PROGRESS * (st.best - self.target):
+            st.best, st.since_best = psi, 0
+            return False
+        st.since_best += 1
+        if st.since_best < STALL_STEPS or psi <= STALL_DISTANCE * self.tol:
+            return False
+        trail = np.array(st.trail)
+        path = np.sum(np.max(np.abs(np.diff(trail, axis=0)), axis=1))
+        net = np.max(np.abs(trail[-1] - trail[0]))
+        return bool(net < STALL_WANDER * path)
+
+    def _tip_rows(self, finger) -> np.ndarray | None:
+        """Rows of ``finger.pairs`` that are its ``tip_pairs``, in order.
+
+        None when a tip pair is not among the pairs (then it is measured apart).
+        """
+        if id(finger) not in self._tips:
+            where = {(p[0], p[1]): k for k, p in enumerate(finger.pairs)}
+            rows = [where.get((p[0], p[1])) for p in finger.tip_pairs]
+            ok = None not in rows and rows == sorted(rows)
+            self._tips[id(finger)] = np.array(rows, dtype=int) if ok else None
+        return self._tips[id(finger)]
 
     def _at(self, st: FingerState, alpha: float) -> np.ndarray:
         return np.clip(st.q_good + alpha * st.d, self.hand.lower, self.hand.upper)
@@ -148,17 +298,37 @@ class Search:
         )
         return -(n_W @ J[:, self.hand.velocity_indices])
 
-    def direction(self, st: FingerState, query) -> np.ndarray:
-        """The finger's direction, zero on joints blocked by a limit."""
-        hand = self.hand
-        mine = np.isin(np.arange(len(hand.lower)), st.finger.joints)
+    def direction(
+        self, st: FingerState, query, measured: Measured | None = None
+    ) -> np.ndarray:
+        """The finger's direction, zero on joints blocked by a limit.
+
+        ``measured``: the finger's pairs at ``st.q_good`` when the caller has
+        them (the tip's are among them).
+        """
+        hand, finger = self.hand, st.finger
+        mine = np.zeros(len(hand.lower), dtype=bool)
+        mine[list(finger.joints)] = True
         if self.user_d is not None:
             d = np.where(mine, self.user_d, 0.0)
         else:  # steepest descent of the fingertip's distance, here
-            tip = closest(query, self.plant, self.context, st.finger.tip_pairs)
-            if tip[2] is None:
-                return np.zeros(len(mine))
-            d = np.where(mine, -hand.coupling.pull_back(self._dpsi(*tip[1:4])), 0.0)
+            rows = None if measured is None else self._tip_rows(finger)
+            if rows is None:
+                tip = closest(query, self.plant, self.context, finger.tip_pairs)
+                if tip[2] is None:
+                    return np.zeros(len(mine))
+                n_W, body, p_BC = tip[1:4]
+            else:
+                k = measured.nearest(rows)
+                if k is None:
+                    return np.zeros(len(mine))
+                _, n_W, body, p_BC = witness(
+                    query, self.plant, self.context, finger.pairs[k],
+                    measured.results[k],
+                )  # fmt: skip
+            d = np.where(
+                mine, -hand.coupling.pull_back(self._dpsi(n_W, body, p_BC)), 0.0
+            )
         q = st.q_good
         blocked = ((d > 0) & (q >= hand.upper)) | ((d < 0) & (q <= hand.lower))
         d = np.where(blocked, 0.0, d)

@@ -32,11 +32,23 @@ touched on the way, however thin the geometry it passes: nothing is skipped.
 ``ψ^*`` is the closing's target distance (half the contact tolerance).  Every
 geometry pair of the finger counts, not only the closest, so a thin wire
 behind a bead bounds the step as much as the bead does.
+
+**Kept per plant.**  The reach depends on the plant's kinematic tree (fixed
+after ``Finalize``), the closing joints' limits, the finger geometries' shapes
+and poses (the scene graph's proximity version) and, only when a joint that
+does not close sits between two closing joints of a chain, the context.
+:func:`reach` keeps its answer per finalized plant and finger, checked against
+the limits and the proximity version at every call, and recomputes it every
+time for a finger whose reach reads the context.
 """
 
 from __future__ import annotations
 
+import copy
+import weakref
+
 import numpy as np
+from pydrake.geometry import Role
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JointIndex
 from pydrake.systems.framework import Context
@@ -46,6 +58,12 @@ from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.fingers import Finger, HandStructure, joint_name
 
 __all__ = ["advancement_bound", "finger_speed_bound", "reach"]
+
+_KEPT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""Finalized plant -> {finger key: (proximity version, reach rows)}.
+
+Values hold ids, indices and arrays only, never a body or joint (that would
+keep the plant alive)."""
 
 
 def _inboard_joints(plant: MultibodyPlant) -> dict[int, object]:
@@ -105,10 +123,37 @@ def reach(
     ModelError
         For a closing joint of another type than revolute, prismatic or screw.
     """
+    key = (
+        tuple(
+            (go.get_value(), gf.get_value(), int(body.index()))
+            for go, gf, body in finger.pairs
+        ),
+        tuple(int(j.index()) for j in hand.joints),
+        hand.lower.tobytes(),
+        hand.upper.tobytes(),
+    )
+    version = inspector.geometry_version()
+    kept = _KEPT.get(plant) if plant.is_finalized() else None
+    if kept is not None and key in kept:
+        old_version, rows = kept[key]
+        if old_version.IsSameAs(version, Role.kProximity):
+            return rows.copy()
+    rows, reads_context = _reach(plant, plant_context, hand, finger, inspector)
+    if plant.is_finalized() and not reads_context:
+        # A copy: the inspector's version is a live reference that changes
+        # with the context it came from.
+        _KEPT.setdefault(plant, {})[key] = (copy.copy(version), rows.copy())
+    return rows
+
+
+def _reach(plant, plant_context, hand, finger, inspector):
+    """:func:`reach`, and whether it read the context."""
     inboard = _inboard_joints(plant)
     column = {int(j.index()): k for k, j in enumerate(hand.joints)}
     rows = np.zeros((len(finger.pairs), len(hand.joints)))
+    reads_context = False  # a row set after a context-dependent offset
     for p, (_, gf, body) in enumerate(finger.pairs):
+        offset_read = False
         centre_G, radius = bounding_sphere(inspector.GetShape(gf))
         point = np.asarray(inspector.GetPoseInFrame(gf).multiply(centre_G))
         bound = radius  # every point x of g has |x - point| <= bound
@@ -123,6 +168,7 @@ def reach(
             if k is not None:
                 turn, slide = _closing_rate(joint)
                 rows[p, k] = turn * bound + slide
+                reads_context |= offset_read
                 travel = max(abs(hand.lower[k]), abs(hand.upper[k]))
                 if slide and not np.isfinite(travel):
                     raise ModelError(
@@ -136,11 +182,12 @@ def reach(
                     plant_context, joint.frame_on_parent()
                 )
                 bound += float(np.linalg.norm(X_PC.translation()))
+                offset_read = True
             point = np.asarray(
                 joint.frame_on_parent().GetFixedPoseInBodyFrame().translation()
             )
             b = int(joint.parent_body().index())
-    return rows
+    return rows, reads_context
 
 
 def finger_speed_bound(reach_rows: np.ndarray, rates: np.ndarray) -> np.ndarray:

@@ -29,8 +29,16 @@ distance can produce) is cut back by regula falsi towards the last clear point.
 All fingers step at once, one kinematics update per step.  A finger is
 **touching** when ``0 <= ψ_f <= tol`` (no finger geometry penetrates), **at
 limit** when every joint it would move is at a limit with ``ψ_f > tol``; the
-loop is bounded by ``max_iterations`` steps per finger.  The loop itself is
-in ``drakegrasp.plant._closing_steps``.
+loop is bounded by ``max_iterations`` steps per finger.  A re-aimed finger
+that reaches a stationary point of its tip's distance away from the object
+(it circles it: twenty steps without getting nearer and with little net
+motion) stops there, **not converged**, as it would after
+``max_iterations``.  Drake is asked only for the pairs whose distance can
+matter: every pair's distance is bounded from below by conservative
+advancement since it was last measured, and a pair whose bound shows it can
+be neither the nearest nor bound the next step is not measured (the answers
+are those of measuring every pair).  The loop itself is in
+``drakegrasp.plant._closing_steps``.
 
 **Parallel grippers.**  A hand whose closing joints are two prismatic jaws
 facing each other (:mod:`drakegrasp.plant.jaws`) gets each jaw's distance in
@@ -102,7 +110,9 @@ class FingerClosure:
     status : str
         ``"touching"`` (``0 <= ψ <= tol``; ``-tol <= ψ`` for a finger that
         already touched at the pre-shape), ``"at limit"`` (the path ended
-        with ``ψ > tol``), ``"not converged"`` (``max_iterations`` reached) or
+        with ``ψ > tol``), ``"not converged"`` (``max_iterations`` reached,
+        or the finger's descent circles a point where its distance stopped
+        shrinking, far from the object) or
         ``"fixed"`` (its direction is zero).
     psi : float
         Smallest signed distance from the finger to the object, metres.
