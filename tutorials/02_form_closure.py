@@ -124,7 +124,7 @@ for x, r in zip(xs[::4], runs[::4], strict=True):
 
 # %%
 a, b = 1.5, 1.0
-frictionless = dict(model="frictionless")
+frictionless = dict(contact_model="frictionless")
 ellipse4 = dg.Grasp(
     [
         dg.Contact([a, 0], [-1, 0], **frictionless),

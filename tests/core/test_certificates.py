@@ -38,7 +38,7 @@ def _random_grasps(rng, make_contacts, count):
         model, mu, nu = models[k % len(models)]
         num = int(rng.integers(2, 5 if planar else 6))
         contacts = make_contacts(
-            rng, num, 2 if planar else 3, mu=mu, model=model, nu=nu, spread=1.5
+            rng, num, 2 if planar else 3, mu=mu, model=model, nu=nu, tilt=0.6 * 1.5
         )
         # a reference point away from the contacts exercises the frame mapping
         p = rng.normal(size=2 if planar else 3) * 0.7
@@ -160,7 +160,7 @@ def test_every_yes_certificate_balances_inside_the_cones(rng, make_contacts):
     count = 0
     for mu in (0.4, 0.8):
         for _ in range(60):
-            g = dg.Grasp(make_contacts(rng, 4, 3, mu=mu, spread=0.3))
+            g = dg.Grasp(make_contacts(rng, 4, 3, mu=mu, tilt=0.6 * 0.3))
             for fn in (dg.force_closure, dg.force_closure_exact):
                 r = fn(g)
                 if not r.is_closure:
@@ -309,7 +309,7 @@ def test_two_hard_fingers_cannot_resist_a_moment_about_their_line():
 
 def test_certificates_are_invariant_to_units_and_reference_point(rng, make_contacts):
     for _ in range(20):
-        contacts = make_contacts(rng, 3, 3, mu=0.3, spread=1.5)
+        contacts = make_contacts(rng, 3, 3, mu=0.3, tilt=0.6 * 1.5)
         g = dg.Grasp(contacts)
         r = dg.force_closure(g)
         if r.is_closure:
