@@ -22,6 +22,7 @@ __all__ = [
     "equilibrated",
     "left_null_space",
     "matrix_rank",
+    "rotations_about",
     "row_space",
     "unit_columns",
 ]
@@ -165,3 +166,33 @@ def unit_columns(J: np.ndarray) -> np.ndarray:
         return J[:, :0]
     keep = norms > ZERO_COLUMN * norms.max()
     return J[:, keep] / norms[keep]
+
+
+def rotations_about(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rotation matrices about unit axes by angles (Rodrigues' formula).
+
+    Parameters
+    ----------
+    axes : (..., 3) float
+        Unit rotation axes.
+    angles : (...) float
+        Angles, radians, right-handed about each axis.
+
+    Returns
+    -------
+    R : (..., 3, 3) float
+        ``I + sin θ K + (1 - cos θ) K²`` with ``K`` the cross-product matrix of
+        the axis.
+    """
+    x, y, z = axes[..., 0], axes[..., 1], axes[..., 2]
+    zero = np.zeros_like(x)
+    K = np.stack(
+        [
+            np.stack([zero, -z, y], -1),
+            np.stack([z, zero, -x], -1),
+            np.stack([-y, x, zero], -1),
+        ],
+        -2,
+    )
+    s, c = np.sin(angles)[..., None, None], np.cos(angles)[..., None, None]
+    return np.eye(3) + s * K + (1 - c) * (K @ K)

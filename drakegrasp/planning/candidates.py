@@ -12,6 +12,7 @@ num_sampled``.
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -27,7 +28,7 @@ from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import plant_context_of, resolve_body
 
-__all__ = ["GraspCandidate", "GraspCandidates", "pose_dict"]
+__all__ = ["GraspCandidate", "GraspCandidates", "planning_result", "pose_dict"]
 
 
 def pose_dict(X: RigidTransform) -> dict:
@@ -320,3 +321,38 @@ class GraspCandidates(Sequence):
         if len(self) > 10:
             lines.append(f"  ... {len(self) - 10} more")
         return "\n".join(lines)
+
+
+def planning_result(
+    candidates: Sequence[GraspCandidate],
+    *,
+    rejections,
+    num_sampled: int,
+    object_body: str,
+    mu: float,
+    torque_scale: float,
+    settings: dict,
+    started: float,
+) -> GraspCandidates:
+    """The ranked result of one planning run, saying why it is empty when it is.
+
+    ``started`` is the run's :func:`time.perf_counter` at its start (seconds).
+    """
+    reason = ""
+    if not candidates:
+        reason = (
+            "num_candidates is 0"
+            if num_sampled == 0
+            else f"all {num_sampled} sampled poses were rejected (see rejections)"
+        )
+    return GraspCandidates(
+        candidates=candidates,
+        rejections=dict(rejections),
+        num_sampled=num_sampled,
+        object_body=object_body,
+        mu=mu,
+        torque_scale=torque_scale,
+        reason=reason,
+        settings=settings,
+        time=time.perf_counter() - started,
+    )

@@ -27,7 +27,6 @@ rejection reason (:data:`REASONS`).
 
 from __future__ import annotations
 
-import time
 from collections import Counter
 from dataclasses import replace
 
@@ -47,7 +46,7 @@ from drakegrasp.planning.approach import (
     multi_finger_hand,
     sample_approaches,
 )
-from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
+from drakegrasp.planning.candidates import GraspCandidate, planning_result
 from drakegrasp.planning.ranking import group_by_count, robustness, verdicts
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.closing import close_hand
@@ -349,21 +348,13 @@ def plan_multifinger(
         noise=settings["noise"], rng=rng, certify=certify, workers=workers,
         X_WO=X_WO, weight=weight,
     )  # fmt: skip
-    reason = ""
-    if not candidates:
-        reason = (
-            "num_candidates is 0"
-            if n == 0
-            else f"all {n} sampled poses were rejected (see rejections)"
-        )
-    return GraspCandidates(
-        candidates=candidates,
-        rejections=dict(rejections),
+    return planning_result(
+        candidates,
+        rejections=rejections,
         num_sampled=n,
         object_body=name,
         mu=mu,
         torque_scale=torque_scale,
-        reason=reason,
         settings=settings,
-        time=time.perf_counter() - t0,
+        started=t0,
     )

@@ -44,7 +44,7 @@ from drakegrasp.core.validation import (
     real_scalar,
 )
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.planning.candidates import GraspCandidates
+from drakegrasp.planning.candidates import GraspCandidates, planning_result
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
     CloudFingers,
@@ -368,23 +368,15 @@ def plan_grasps(
         workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
         surface=None if body is None else surface, tol=tol,
     )  # fmt: skip
-    reason = ""
-    if not candidates:
-        reason = (
-            "num_candidates is 0"
-            if n == 0
-            else f"all {n} sampled poses were rejected (see rejections)"
-        )
-    return GraspCandidates(
-        candidates=candidates,
-        rejections=dict(rejections),
+    return planning_result(
+        candidates,
+        rejections=rejections,
         num_sampled=n,
         object_body=name,
         mu=mu,
         torque_scale=torque_scale,
-        reason=reason,
         settings=settings,
-        time=time.perf_counter() - t0,
+        started=t0,
     )
 
 

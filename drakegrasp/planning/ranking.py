@@ -49,6 +49,7 @@ import numpy as np
 
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
 from drakegrasp.closure.verdicts import force_closure
+from drakegrasp.core.linalg import rotations_about
 from drakegrasp.planning.candidates import GraspCandidate
 from drakegrasp.planning.reclose import reclosed_robustness
 from drakegrasp.planning.weight import weight_capacity
@@ -72,22 +73,6 @@ def group_by_count(counts: np.ndarray) -> dict[int, np.ndarray]:
     """Candidate indices by their number of contacts, ``{N: indices}``."""
     counts = np.asarray(counts)
     return {int(n): np.flatnonzero(counts == n) for n in np.unique(counts)}
-
-
-def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """(…, 3, 3) rotations about unit ``axes`` (…, 3) by ``angles`` (…) (Rodrigues)."""
-    x, y, z = axes[..., 0], axes[..., 1], axes[..., 2]
-    zero = np.zeros_like(x)
-    K = np.stack(
-        [
-            np.stack([zero, -z, y], -1),
-            np.stack([z, zero, -x], -1),
-            np.stack([-y, x, zero], -1),
-        ],
-        -2,
-    )
-    s, c = np.sin(angles)[..., None, None], np.cos(angles)[..., None, None]
-    return np.eye(3) + s * K + (1 - c) * (K @ K)
 
 
 def perturbed_copies(
@@ -138,7 +123,7 @@ def perturbed_copies(
         centre = (P * mask).sum(axis=1) / count  # (M, 3)
         axes = rng.standard_normal((M, 3))
         axes /= np.linalg.norm(axes, axis=1, keepdims=True)
-        R = _rotations(axes, np.radians(angle_deg) * rng.standard_normal(M))
+        R = rotations_about(axes, np.radians(angle_deg) * rng.standard_normal(M))
         shift = position * rng.standard_normal((M, 3))
         moved = (
             np.einsum("mij,mnj->mni", R, P - centre[:, None])

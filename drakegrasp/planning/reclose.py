@@ -48,24 +48,9 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.batch import batch_force_closure
+from drakegrasp.core.linalg import rotations_about
 
 __all__ = ["reclosed_copies", "reclosed_robustness"]
-
-
-def _about_axis(a: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """(M, 3, 3) rotations about unit axes ``a`` (M, 3) by ``theta`` (M,)."""
-    x, y, z = a[:, 0], a[:, 1], a[:, 2]
-    zero = np.zeros_like(x)
-    K = np.stack(
-        [
-            np.stack([zero, -z, y], -1),
-            np.stack([z, zero, -x], -1),
-            np.stack([-y, x, zero], -1),
-        ],
-        -2,
-    )
-    s, c = np.sin(theta)[:, None, None], np.cos(theta)[:, None, None]
-    return np.eye(3) + s * K + (1 - c) * (K @ K)
 
 
 def reclosed_copies(
@@ -116,7 +101,7 @@ def reclosed_copies(
         mask = (fingers == f)[..., None]
         centre += (positions * mask).sum(1) / np.maximum(mask.sum(1), 1)
     centre /= 2.0
-    R = _about_axis(axes, angles)
+    R = rotations_about(axes, angles)
     # the object moved by δ; in its frame the hand moved by δ⁻¹:
     # q = Rᵀ (p - c - t) + c, closing directions unchanged (R fixes a)
     q = np.einsum("mji,mnj->mni", R, positions - (centre + translations)[:, None])
