@@ -3,9 +3,9 @@
 import sys
 
 try:
-    from drakegrasp.cli import main
+    from drakegrasp.cli import run
 except KeyboardInterrupt:  # Ctrl-C while Drake is still importing
     print("drakegrasp: interrupted", file=sys.stderr)
     sys.exit(130)
 
-sys.exit(main())
+run()

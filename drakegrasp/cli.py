@@ -76,7 +76,7 @@ from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.errors import GraspError, InvalidOptionError, InvalidPoseError
 
-__all__ = ["Terminated", "build_parser", "main", "printable"]
+__all__ = ["Terminated", "build_parser", "main", "printable", "run"]
 
 EXIT_ERROR = 1
 EXIT_INTERRUPTED = 130
@@ -759,8 +759,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Terminated as t:
         # SIGTERM or SIGHUP: unwound like Ctrl-C, so partial files and scratch
         # folders are removed; the worker pool stops here, not at exit.
-        _stop_workers()
+        _stop_workers(abandon=True)
         _say(f"drakegrasp: terminated by {t.name}")
+        _SIGNALLED.append(t.signum)
         return 128 + t.signum
     except KeyboardInterrupt:
         # Ctrl-C: one line and the conventional status 128 + SIGINT; batch
@@ -834,6 +835,7 @@ def _raise_terminated(signum: int, frame) -> None:
         return
     for sig in _TERMINATING:  # a second signal must not interrupt the cleanup
         signal.signal(sig, signal.SIG_IGN)
+    threading.excepthook = _quiet_pool_thread_race
     raise Terminated(signum)
 
 
@@ -870,11 +872,34 @@ def _terminable():
             signal.signal(sig, handler)
 
 
-def _stop_workers() -> None:
-    """Stop the batch engine's kept worker pool, if this process started one."""
+def _stop_workers(*, abandon: bool = False) -> None:
+    """Stop the batch engine's kept worker pool, if this process started one.
+
+    ``abandon=True`` after a signal: the workers are killed, not waited for.
+    """
     workers = sys.modules.get("drakegrasp.batch.run.workers")
-    if workers is not None:
-        workers.shutdown_pool()
+    if workers is None:
+        return
+    workers.shutdown_pool(abandon=abandon)
+
+
+def _quiet_pool_thread_race(args) -> None:
+    """``threading.excepthook`` that drops the pool thread's cancelled-future race.
+
+    After a signal to the whole process group the workers die while this
+    process cancels their chunks; CPython 3.11's pool thread can then fail on a
+    cancelled future (``InvalidStateError`` in ``terminate_broken``) and print a
+    traceback that says nothing the one-line message does not.  Installed when
+    the signal arrives; every other thread exception is printed as before.
+    """
+    from concurrent.futures import InvalidStateError
+    from concurrent.futures.process import _ExecutorManagerThread
+
+    if isinstance(args.thread, _ExecutorManagerThread) and issubclass(
+        args.exc_type, InvalidStateError
+    ):
+        return
+    threading.__excepthook__(args)
 
 
 def _say(line: str) -> None:
@@ -909,5 +934,27 @@ def _error(message: str) -> int:
     return EXIT_ERROR
 
 
+_SIGNALLED: list[int] = []  # the signals that ended a run of main(), for run()
+
+
+def run() -> None:
+    """The ``drakegrasp`` program: :func:`main`, then exit with its status.
+
+    After SIGTERM or SIGHUP the run has already cleaned up (partial files,
+    scratch folders, the worker pool and its shared memory) and said so in one
+    line; the process then ends at once, without the interpreter's exit-time
+    joins.  A signal to the whole process group can leave a pool worker that
+    was being started as the others died, and waiting for it would hang the
+    program (and a ``| tee`` reading its output).  Such a worker ends by itself
+    once it sees its parent gone.
+    """
+    code = main()
+    if _SIGNALLED:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()

@@ -152,7 +152,7 @@ def draw_candidates(
     inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
     scratch = plant.CreateDefaultContext()  # a copy of the user's configuration
     plant.SetPositions(scratch, plant.GetPositions(ctx))
-    shown = list(candidates)[: int(top)]
+    shown = _candidate_rows(candidates)[: int(top)]
     scores = np.array([float(c.score) for c in shown])
     colors = score_colors(scores, alpha=alpha) if shown else np.zeros((0, 4))
     meshcat.Delete(prefix)
@@ -172,6 +172,36 @@ def draw_candidates(
             meshcat.SetTransform(body_path, plant.EvalBodyPoseInWorld(scratch, body))
         paths.append(path)
     return CandidateDrawing(tuple(paths), scores, colors)
+
+
+def _candidate_rows(candidates) -> list:
+    """``candidates`` as a list of planned grasps, or a clear error.
+
+    Each item needs a real ``score`` and a boolean ``is_closure``, as
+    :class:`~drakegrasp.planning.candidates.GraspCandidate` has (duck-typed:
+    the planner's layer sits above this one).
+    """
+    try:
+        rows = list(candidates)
+    except TypeError:
+        rows = None
+    if rows is None or isinstance(candidates, str | bytes):
+        raise InvalidOptionError(
+            "candidates must be a sequence of GraspCandidate (plan_grasps's result), "
+            f"got {type(candidates).__name__}"
+        )
+    for i, c in enumerate(rows):
+        score = getattr(c, "score", None)
+        if (
+            isinstance(score, bool)
+            or not isinstance(score, int | float | np.integer | np.floating)
+            or not isinstance(getattr(c, "is_closure", None), bool | np.bool_)
+        ):
+            raise InvalidOptionError(
+                f"candidates[{i}] is a {type(c).__name__}, not a GraspCandidate "
+                "(it needs a real score and a boolean is_closure)"
+            )
+    return rows
 
 
 def plot_score_distribution(candidates, *, ax=None, bins: int = 30, top: int = 10):
@@ -196,7 +226,9 @@ def plot_score_distribution(candidates, *, ax=None, bins: int = 30, top: int = 1
     plt = import_pyplot()
     if isinstance(bins, bool) or not isinstance(bins, int | np.integer) or bins < 1:
         raise InvalidOptionError(f"bins must be an integer >= 1, got {bins!r}")
-    rows = list(candidates)
+    if isinstance(top, bool) or not isinstance(top, int | np.integer) or top < 0:
+        raise InvalidOptionError(f"top must be an integer >= 0, got {top!r}")
+    rows = _candidate_rows(candidates)
     scores = np.array([float(c.score) for c in rows])
     closure = np.array([bool(c.is_closure) for c in rows], dtype=bool)
     if ax is None:

@@ -520,6 +520,10 @@ class Flow(list):
     """A list written in flow style (``[x, y, z]``): vectors and joint values."""
 
 
+class Quoted(str):
+    """A string written double-quoted (the scenes' free-text descriptions)."""
+
+
 class SceneDumper(yaml.SafeDumper):
     """``yaml.SafeDumper`` that knows Drake's ``!Rpy`` tag and flow vectors."""
 
@@ -527,6 +531,9 @@ class SceneDumper(yaml.SafeDumper):
 SceneDumper.add_representer(
     Rpy,
     lambda d, r: d.represent_mapping("!Rpy", {"deg": Flow(r.deg)}, flow_style=True),
+)
+SceneDumper.add_representer(
+    Quoted, lambda d, v: d.represent_scalar("tag:yaml.org,2002:str", v, style='"')
 )
 SceneDumper.add_representer(
     Flow, lambda d, v: d.represent_sequence("tag:yaml.org,2002:seq", v, flow_style=True)
@@ -551,7 +558,7 @@ def scene(
 ) -> str:
     """Text of a scene file: Drake's directives plus the drakegrasp section."""
     section = {
-        "description": description,
+        "description": Quoted(description),
         "object_body": object_body,
         "hand": hand,
         "mu": float(mu),

@@ -186,12 +186,18 @@ def test_warmup_compiles_every_route_then_a_new_process_compiles_nothing(
     assert json.loads(capsys.readouterr().out)["compiled"] == 0
     # A new process with the same cache loads everything from disk: the
     # package this test imports, a checkout or an installed copy (numba's
-    # index is keyed by the sources' content, which an install keeps).
+    # index is keyed by the sources' content, which an install keeps).  A
+    # first new process writes the cache (this one may hold kernels compiled
+    # by earlier tests under another NUMBA_CACHE_DIR, which it never writes
+    # again); the second must compile nothing.
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(
         [str(ROOT)] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
     )
-    fresh = _run("from drakegrasp.cli import main; main()", env, "warmup", "--json")
+    code = "from drakegrasp.cli import main; main()"
+    writer = _run(code, env, "warmup", "--json")
+    assert json.loads(writer.stdout)["available"] is True, writer.stderr
+    fresh = _run(code, env, "warmup", "--json")
     again = json.loads(fresh.stdout)
     assert [s["name"] for s in again["steps"]] == names
     assert again["compiled"] == 0, again

@@ -255,19 +255,42 @@ def _healthy(pool: ProcessPoolExecutor) -> bool:
     return all(p.exitcode is None for p in processes.values())
 
 
-def _stop_pool() -> None:
+def _stop_pool(*, abandon: bool = False) -> None:
     pool = _POOL.pop("pool", None)
     _POOL.pop("workers", None)
     if pool is not None:
+        if abandon or not _healthy(pool):
+            _abandon(pool)
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def shutdown_pool() -> None:
+def _abandon(pool: ProcessPoolExecutor) -> None:
+    """Stop a pool whose workers died without waiting on its queues.
+
+    When a signal to the whole process group kills the workers while this
+    process cancels its futures, the pool's own thread can fail on a cancelled
+    future before it closes the task queue (CPython 3.11's ``terminate_broken``
+    sets an exception on every pending future).  The queue's feeder thread then
+    stays blocked on a pipe that no worker reads, and the interpreter waits for
+    it at exit: the program hung after its cleanup.  So the surviving workers
+    are killed here and the queue is told not to be waited for.
+    """
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        if process.exitcode is None:
+            process.kill()
+    queue = getattr(pool, "_call_queue", None)
+    if queue is not None:
+        queue.cancel_join_thread()
+
+
+def shutdown_pool(*, abandon: bool = False) -> None:
     """Stop the kept worker processes (if any); the next call starts new ones.
 
-    Their shared-memory segments are unlinked too.
+    Their shared-memory segments are unlinked too.  ``abandon=True`` (a program
+    that was signalled to stop) kills the workers instead of letting them finish
+    their chunks, and does not wait on the pool's task queue.
     """
-    _stop_pool()
+    _stop_pool(abandon=abandon)
     _SLABS.close()
 
 
