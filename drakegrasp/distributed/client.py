@@ -28,6 +28,12 @@ def client_for(client_or_address):
             "distributed (pip install drakegrasp[dask])"
         ) from exc
     if isinstance(client_or_address, str):
+        if not client_or_address.strip():
+            # Client("") starts a local cluster instead of connecting anywhere.
+            raise InvalidOptionError(
+                "the scheduler address is empty; give one such as 'tcp://host:8786' "
+                "or a distributed.Client"
+            )
         port = client_or_address.rpartition(":")[2]
         if port.isdigit() and not 0 < int(port) < 65536:  # Dask waited 30 s
             raise InvalidOptionError(
