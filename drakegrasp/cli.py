@@ -765,8 +765,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 128 + t.signum
     except KeyboardInterrupt:
         # Ctrl-C: one line and the conventional status 128 + SIGINT; batch
-        # output is written atomically, so nothing half-written is left.
+        # output is written atomically, so nothing half-written is left.  The
+        # workers ignore SIGINT (the parent decides): they are stopped here.
+        _stop_workers(abandon=True)
         print("drakegrasp: interrupted", file=sys.stderr)
+        _SIGNALLED.append(signal.SIGINT)
         return EXIT_INTERRUPTED
     except BrokenPipeError:  # e.g. `drakegrasp analyze | head`
         return 0
@@ -844,6 +847,7 @@ def _raise_interrupt(signum: int, frame) -> None:
     if _importing(frame):
         _later(signum)
         return
+    threading.excepthook = _quiet_pool_thread_race
     raise KeyboardInterrupt
 
 
@@ -940,7 +944,7 @@ _SIGNALLED: list[int] = []  # the signals that ended a run of main(), for run()
 def run() -> None:
     """The ``drakegrasp`` program: :func:`main`, then exit with its status.
 
-    After SIGTERM or SIGHUP the run has already cleaned up (partial files,
+    After SIGTERM, SIGHUP or Ctrl-C the run has already cleaned up (partial files,
     scratch folders, the worker pool and its shared memory) and said so in one
     line; the process then ends at once, without the interpreter's exit-time
     joins.  A signal to the whole process group can leave a pool worker that

@@ -261,7 +261,14 @@ def _stop_pool(*, abandon: bool = False) -> None:
     if pool is not None:
         if abandon or not _healthy(pool):
             _abandon(pool)
-        pool.shutdown(wait=True, cancel_futures=True)
+        try:
+            # An abandoned pool is not waited for: its workers are dead and a
+            # signal may have landed between creating its thread and starting
+            # it ("cannot join thread before it is started").
+            pool.shutdown(wait=not abandon, cancel_futures=True)
+        except RuntimeError:
+            if not abandon:
+                raise
 
 
 def _abandon(pool: ProcessPoolExecutor) -> None:
