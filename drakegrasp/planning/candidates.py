@@ -336,7 +336,7 @@ def planning_result(
 ) -> GraspCandidates:
     """The ranked result of one planning run, saying why it is empty when it is.
 
-    ``started`` is the run's :func:`time.perf_counter` at its start (seconds).
+    ``started`` is the run's ``time.perf_counter()`` at its start (seconds).
     """
     reason = ""
     if not candidates:
