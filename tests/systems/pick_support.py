@@ -10,6 +10,7 @@ the fingers hold the box, no contact after they open.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -70,6 +71,100 @@ class Pick:
         self.simulator.AdvanceTo(duration)
 
 
+def add_ground(plant, *, hydroelastic: bool = False) -> None:
+    """Weld a 1 m x 1 m ground slab (top face at z = 0, μ = 0.5) to the world."""
+    ground = ProximityProperties()
+    AddContactMaterial(friction=CoulombFriction(0.5, 0.5), properties=ground)
+    if hydroelastic:
+        AddRigidHydroelasticProperties(properties=ground)  # cheaper than compliant
+    plant.RegisterCollisionGeometry(
+        plant.world_body(),
+        RigidTransform([0.0, 0.0, -0.05]),
+        Box(1.0, 1.0, 0.1),
+        "ground",
+        ground,
+    )
+
+
+def add_lift(plant, body, X_WB: RigidTransform, axis) -> None:
+    """Hang ``body`` from the world on an actuated prismatic joint ``lift``.
+
+    ``X_WB`` places the joint's parent frame ``lift_base``; ``axis`` is the
+    joint axis in that frame.
+    """
+    base = plant.AddFrame(FixedOffsetFrame("lift_base", plant.world_frame(), X_WB))
+    lift = plant.AddJoint(PrismaticJoint("lift", base, body.body_frame(), axis))
+    plant.AddJointActuator("lift", lift, 200.0)
+
+
+def drive(builder, plant, gripper, times, columns, *, finger_gains) -> None:
+    """Track ``columns`` (joint name -> desired positions at ``times``) by PD.
+
+    The ``lift`` actuator gets stiff gains (20000, 400), every other actuator
+    of ``gripper`` ``finger_gains`` ``(p, d)``.  Call after ``Finalize``.
+    """
+    for index in plant.GetJointActuatorIndices(gripper):
+        actuator = plant.get_mutable_joint_actuator(index)
+        gains = (20000.0, 400.0) if actuator.name() == "lift" else finger_gains
+        actuator.set_controller_gains(PdControllerGains(p=gains[0], d=gains[1]))
+    names = [
+        plant.get_joint_actuator(i).joint().name()
+        for i in plant.GetJointActuatorIndices(gripper)
+    ]
+    q_desired = PiecewisePolynomial.FirstOrderHold(
+        times, np.array([columns[n] for n in names])
+    )
+    source = builder.AddSystem(TrajectorySource(q_desired, output_derivative_order=1))
+    builder.Connect(
+        source.get_output_port(), plant.get_desired_state_input_port(gripper)
+    )
+
+
+def monitored_pick(
+    builder,
+    plant,
+    scene_graph,
+    gripper,
+    box,
+    object_body,
+    *,
+    period: float,
+    initial_state: Callable[[object], None],
+    **monitor_options,
+) -> Pick:
+    """Add a GraspMonitor on ``object_body`` and logs at ``period``; build.
+
+    ``initial_state(plant_context)`` sets the plant's state before the
+    simulator is initialised.
+    """
+    monitor = add_grasp_monitor(
+        builder,
+        plant,
+        scene_graph,
+        object_body=object_body,
+        hand=gripper,
+        period=period,
+        **monitor_options,
+    )
+    state_log = LogVectorOutput(plant.get_state_output_port(), builder, period)
+    verdict_log = LogVectorOutput(monitor.get_verdicts_output_port(), builder, period)
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    initial_state(plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()))
+    simulator.Initialize()
+    return Pick(
+        diagram,
+        plant,
+        scene_graph,
+        gripper,
+        box,
+        monitor,
+        state_log,
+        verdict_log,
+        simulator,
+    )
+
+
 def build_pick(
     *,
     flat: bool = False,
@@ -95,81 +190,38 @@ def build_pick(
     hand = "parallel_jaw_flat" if flat else "parallel_jaw"
     (gripper,) = parser.AddModels(url=f"package://drakegrasp/hands/{hand}.sdf")
     (box,) = parser.AddModels(url="package://drakegrasp/objects/box.sdf")
-    ground = ProximityProperties()
-    AddContactMaterial(friction=CoulombFriction(0.5, 0.5), properties=ground)
-    if plant_contact != "point":
-        AddRigidHydroelasticProperties(properties=ground)  # cheaper than compliant
-    plant.RegisterCollisionGeometry(
-        plant.world_body(),
-        RigidTransform([0.0, 0.0, -0.05]),
-        Box(1.0, 1.0, 0.1),
-        "ground",
-        ground,
+    add_ground(plant, hydroelastic=plant_contact != "point")
+    add_lift(
+        plant,
+        plant.GetBodyByName("palm", gripper),
+        RigidTransform(RollPitchYaw(np.pi, 0.0, 0.0), [0.0, 0.0, PALM_HEIGHT]),
+        [0, 0, -1],
     )
-    palm = plant.GetBodyByName("palm", gripper)
-    base = plant.AddFrame(
-        FixedOffsetFrame(
-            "lift_base",
-            plant.world_frame(),
-            RigidTransform(RollPitchYaw(np.pi, 0.0, 0.0), [0.0, 0.0, PALM_HEIGHT]),
-        )
-    )
-    lift = plant.AddJoint(PrismaticJoint("lift", base, palm.body_frame(), [0, 0, -1]))
-    plant.AddJointActuator("lift", lift, 200.0)
     plant.Finalize()
-    for index in plant.GetJointActuatorIndices(gripper):
-        actuator = plant.get_mutable_joint_actuator(index)
-        gains = (20000.0, 400.0) if actuator.name() == "lift" else (300.0, 10.0)
-        actuator.set_controller_gains(PdControllerGains(p=gains[0], d=gains[1]))
-
-    names = [
-        plant.get_joint_actuator(i).joint().name()
-        for i in plant.GetJointActuatorIndices(gripper)
-    ]
-    times = [t for t, _, _ in SCHEDULE]
     fingers = [closed if f == CLOSED else f for _, f, _ in SCHEDULE]
-    values = {
+    columns = {
         "left_finger_joint": fingers,
         "right_finger_joint": fingers,
         "lift": [z for _, _, z in SCHEDULE],
     }
-    q_desired = PiecewisePolynomial.FirstOrderHold(
-        times, np.array([values[n] for n in names])
-    )
-    source = builder.AddSystem(TrajectorySource(q_desired, output_derivative_order=1))
-    builder.Connect(
-        source.get_output_port(), plant.get_desired_state_input_port(gripper)
-    )
+    times = [t for t, _, _ in SCHEDULE]
+    drive(builder, plant, gripper, times, columns, finger_gains=(300.0, 10.0))
 
-    monitor = add_grasp_monitor(
+    def initial_state(plant_context):
+        for name in ("left_finger_joint", "right_finger_joint"):
+            plant.GetJointByName(name, gripper).set_translation(plant_context, OPEN)
+        plant.SetFreeBodyPose(
+            plant_context, plant.GetBodyByName("box", box), RigidTransform([0, 0, 0.05])
+        )
+
+    return monitored_pick(
         builder,
-        plant,
-        scene_graph,
-        object_body=plant.GetBodyByName("box", box),
-        hand=gripper,
-        period=period,
-        **monitor_options,
-    )
-    state_log = LogVectorOutput(plant.get_state_output_port(), builder, period)
-    verdict_log = LogVectorOutput(monitor.get_verdicts_output_port(), builder, period)
-    diagram = builder.Build()
-    simulator = Simulator(diagram)
-    context = simulator.get_mutable_context()
-    plant_context = plant.GetMyMutableContextFromRoot(context)
-    for name in ("left_finger_joint", "right_finger_joint"):
-        plant.GetJointByName(name, gripper).set_translation(plant_context, OPEN)
-    plant.SetFreeBodyPose(
-        plant_context, plant.GetBodyByName("box", box), RigidTransform([0, 0, 0.05])
-    )
-    simulator.Initialize()
-    return Pick(
-        diagram,
         plant,
         scene_graph,
         gripper,
         box,
-        monitor,
-        state_log,
-        verdict_log,
-        simulator,
+        plant.GetBodyByName("box", box),
+        period=period,
+        initial_state=initial_state,
+        **monitor_options,
     )

@@ -13,25 +13,14 @@ pads with μ = 1 carry the box's 5.04 N weight only above ~2.5 N each.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
-from pydrake.geometry import AddContactMaterial, Box, ProximityProperties
+from pick_support import Pick, add_ground, add_lift, drive, monitored_pick
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import (
-    AddMultibodyPlant,
-    CoulombFriction,
-    MultibodyPlantConfig,
-)
-from pydrake.multibody.tree import FixedOffsetFrame, PdControllerGains, PrismaticJoint
-from pydrake.systems.analysis import Simulator
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
-from pydrake.trajectories import PiecewisePolynomial
 
 from drakegrasp.plant.models import use_local_drake_models
-from drakegrasp.systems.monitor import add_grasp_monitor
 
 WSG_URL = "package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf"
 SUGAR_URL = "package://drake_models/ycb/004_sugar_box.sdf"
@@ -54,25 +43,9 @@ DURATION = SCHEDULE[-1][0]
 FIRM, WEAK = 0.010, 0.0015  # squeeze: metres past the box faces
 
 
-@dataclass
-class WsgPick:
-    diagram: object
-    plant: object
-    scene_graph: object
-    gripper: object
-    box: object
-    monitor: object
-    state_log: object
-    verdict_log: object
-    simulator: Simulator
-
-    def run(self, duration: float = DURATION) -> None:
-        self.simulator.AdvanceTo(duration)
-
-
 def build_wsg_pick(
     models_dir, *, squeeze: float, period: float = 0.01, **monitor_options
-) -> WsgPick:
+) -> Pick:
     """The pick, a GraspMonitor (``monitor_options``) and logs at ``period``."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlant(
@@ -85,30 +58,18 @@ def build_wsg_pick(
     use_local_drake_models(parser, models_dir)
     (gripper,) = parser.AddModels(url=WSG_URL)
     (box,) = parser.AddModels(url=SUGAR_URL)
-    ground = ProximityProperties()
-    AddContactMaterial(friction=CoulombFriction(0.5, 0.5), properties=ground)
-    plant.RegisterCollisionGeometry(
-        plant.world_body(),
-        RigidTransform([0, 0, -0.05]),
-        Box(1, 1, 0.1),
-        "ground",
-        ground,
-    )
+    add_ground(plant)
     # The body's y (towards the finger tips) points down: a rotation of -90 deg
     # about x.  The box centre is BOX_IN_BODY below the body origin.
     R_WB = RollPitchYaw(-np.pi / 2, 0.0, 0.0).ToRotationMatrix()
     p_WB = [0.0, 0.0, BOX_HALF_HEIGHT + BOX_IN_BODY]
-    base = plant.AddFrame(
-        FixedOffsetFrame("lift_base", plant.world_frame(), RigidTransform(R_WB, p_WB))
+    add_lift(
+        plant,
+        plant.GetBodyByName("body", gripper),
+        RigidTransform(R_WB, p_WB),
+        [0, -1, 0],
     )
-    body = plant.GetBodyByName("body", gripper)
-    lift = plant.AddJoint(PrismaticJoint("lift", base, body.body_frame(), [0, -1, 0]))
-    plant.AddJointActuator("lift", lift, 200.0)
     plant.Finalize()
-    for index in plant.GetJointActuatorIndices(gripper):
-        actuator = plant.get_mutable_joint_actuator(index)
-        gains = (20000.0, 400.0) if actuator.name() == "lift" else (1000.0, 20.0)
-        actuator.set_controller_gains(PdControllerGains(p=gains[0], d=gains[1]))
     closed = TOUCH - squeeze
     opening = {"open": OPEN, "closed": closed}
     columns = {
@@ -116,52 +77,31 @@ def build_wsg_pick(
         "right_finger_sliding_joint": [opening[w] for _, w, _ in SCHEDULE],
         "lift": [z for _, _, z in SCHEDULE],
     }
-    names = [
-        plant.get_joint_actuator(i).joint().name()
-        for i in plant.GetJointActuatorIndices(gripper)
-    ]
-    q_desired = PiecewisePolynomial.FirstOrderHold(
-        [t for t, _, _ in SCHEDULE], np.array([columns[n] for n in names])
-    )
-    source = builder.AddSystem(TrajectorySource(q_desired, output_derivative_order=1))
-    builder.Connect(
-        source.get_output_port(), plant.get_desired_state_input_port(gripper)
-    )
+    times = [t for t, _, _ in SCHEDULE]
+    drive(builder, plant, gripper, times, columns, finger_gains=(1000.0, 20.0))
     sugar = plant.get_body(plant.GetBodyIndices(box)[0])
-    monitor = add_grasp_monitor(
+
+    def initial_state(plant_context):
+        plant.GetJointByName("left_finger_sliding_joint", gripper).set_translation(
+            plant_context, -OPEN
+        )
+        plant.GetJointByName("right_finger_sliding_joint", gripper).set_translation(
+            plant_context, OPEN
+        )
+        # Box x up, its z (39.1 mm) across the fingers (world x).
+        R_WO = RotationMatrix(np.array([[0.0, 0, 1], [0, -1, 0], [1, 0, 0]]))
+        plant.SetFreeBodyPose(
+            plant_context, sugar, RigidTransform(R_WO, [0, 0, BOX_HALF_HEIGHT])
+        )
+
+    return monitored_pick(
         builder,
-        plant,
-        scene_graph,
-        object_body=sugar,
-        hand=gripper,
-        period=period,
-        **monitor_options,
-    )
-    state_log = LogVectorOutput(plant.get_state_output_port(), builder, period)
-    verdict_log = LogVectorOutput(monitor.get_verdicts_output_port(), builder, period)
-    diagram = builder.Build()
-    simulator = Simulator(diagram)
-    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
-    plant.GetJointByName("left_finger_sliding_joint", gripper).set_translation(
-        plant_context, -OPEN
-    )
-    plant.GetJointByName("right_finger_sliding_joint", gripper).set_translation(
-        plant_context, OPEN
-    )
-    # Box x up, its z (39.1 mm) across the fingers (world x).
-    R_WO = RotationMatrix(np.array([[0.0, 0, 1], [0, -1, 0], [1, 0, 0]]))
-    plant.SetFreeBodyPose(
-        plant_context, sugar, RigidTransform(R_WO, [0, 0, BOX_HALF_HEIGHT])
-    )
-    simulator.Initialize()
-    return WsgPick(
-        diagram,
         plant,
         scene_graph,
         gripper,
         box,
-        monitor,
-        state_log,
-        verdict_log,
-        simulator,
+        sugar,
+        period=period,
+        initial_state=initial_state,
+        **monitor_options,
     )
