@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from free_rig import X_WO, FreeRig
 from pydrake.geometry import (
     Box,
     Capsule,
@@ -15,7 +16,7 @@ from pydrake.geometry import (
     ProximityProperties,
     Sphere,
 )
-from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
+from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import SpatialInertia
 from pydrake.systems.framework import DiagramBuilder
@@ -25,41 +26,18 @@ from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant import find_contacts, models_dir
 from drakegrasp.plant.contacts import contacts_of_distances
 
-X_WO = RigidTransform(RollPitchYaw(0.3, -0.2, 0.5), [0.1, 0.2, 0.3])
 R_TIP = 0.01
 GAP = 5e-5  # inside the default tolerance, so both sides of an FD stay separated
 HEX = str(models_dir() / "objects" / "hex_prism.obj")
 
 
-class Rig:
+class Rig(FreeRig):
     """An object and free-floating fingers of given shapes, at given poses."""
 
     def __init__(self, object_shape, fingers, X_WO=X_WO):
-        builder = DiagramBuilder()
-        plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-        inertia = SpatialInertia.SolidSphereWithMass(0.1, 0.01)
-        obj_instance = plant.AddModelInstance("object")
-        hand_instance = plant.AddModelInstance("hand")
-        self.object = plant.AddRigidBody("object", obj_instance, inertia)
-        plant.RegisterCollisionGeometry(
-            self.object, RigidTransform(), object_shape, "object", ProximityProperties()
-        )
-        self.fingers = []
-        for k, (shape, _) in enumerate(fingers):
-            body = plant.AddRigidBody(f"finger{k}", hand_instance, inertia)
-            plant.RegisterCollisionGeometry(
-                body, RigidTransform(), shape, f"tip{k}", ProximityProperties()
-            )
-            self.fingers.append(body)
-        plant.Finalize()
-        self.plant = plant
-        self.diagram = builder.Build()
-        self.root = self.diagram.CreateDefaultContext()
-        self.ctx = plant.GetMyContextFromRoot(self.root)
+        super().__init__(object_shape, [shape for shape, _ in fingers])
         self.X_WO = X_WO
-        plant.SetFreeBodyPose(self.ctx, self.object, X_WO)
-        for body, (_, X_OF) in zip(self.fingers, fingers, strict=True):
-            plant.SetFreeBodyPose(self.ctx, body, X_WO.multiply(X_OF))
+        self.place(X_WO, [X_OF for _, X_OF in fingers])
 
     def contacts(self, **kwargs):
         return find_contacts(self.plant, self.ctx, object_body=self.object, **kwargs)

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from free_rig import X_WO, FreeRig
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from pydrake.geometry import (
@@ -15,13 +16,9 @@ from pydrake.geometry import (
     Ellipsoid,
     HalfSpace,
     MeshcatCone,
-    ProximityProperties,
     Sphere,
 )
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.multibody.tree import SpatialInertia
-from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp import ModelError
 from drakegrasp.plant import contact_curvatures, find_contacts
@@ -97,30 +94,9 @@ def test_sphere_capsule_cylinder_box_halfspace():
 
 
 def _rig(object_shape, fingers):
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    inertia = SpatialInertia.SolidSphereWithMass(0.1, 0.01)
-    obj = plant.AddRigidBody("object", plant.AddModelInstance("object"), inertia)
-    plant.RegisterCollisionGeometry(
-        obj, RigidTransform(), object_shape, "object", ProximityProperties()
-    )
-    hand = plant.AddModelInstance("hand")
-    bodies = []
-    for k, (shape, _) in enumerate(fingers):
-        body = plant.AddRigidBody(f"finger{k}", hand, inertia)
-        plant.RegisterCollisionGeometry(
-            body, RigidTransform(), shape, f"tip{k}", ProximityProperties()
-        )
-        bodies.append(body)
-    plant.Finalize()
-    diagram = builder.Build()
-    root = diagram.CreateDefaultContext()
-    ctx = plant.GetMyContextFromRoot(root)
-    X_WO = RigidTransform(RollPitchYaw(0.3, -0.2, 0.5), [0.1, 0.2, 0.3])
-    plant.SetFreeBodyPose(ctx, obj, X_WO)
-    for body, (_, X_OF) in zip(bodies, fingers, strict=True):
-        plant.SetFreeBodyPose(ctx, body, X_WO.multiply(X_OF))
-    return plant, ctx, obj, (diagram, root)
+    rig = FreeRig(object_shape, [shape for shape, _ in fingers])
+    rig.place(X_WO, [X_OF for _, X_OF in fingers])
+    return rig.plant, rig.ctx, rig.object, (rig.diagram, rig.root)
 
 
 def test_patch_vertices_are_finger_corners_on_the_object_face():

@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 import pytest
+from free_rig import X_WO, FreeRig
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from pydrake.geometry import (
@@ -23,18 +24,13 @@ from pydrake.geometry import (
     Convex,
     Cylinder,
     Ellipsoid,
-    ProximityProperties,
     Sphere,
 )
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.multibody.tree import SpatialInertia
-from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp import Contact, find_contacts, is_antipodal
 from drakegrasp.plant import models_dir
 
-X_WO = RigidTransform(RollPitchYaw(0.3, -0.2, 0.5), [0.1, 0.2, 0.3])
 HEX = str(models_dir() / "objects" / "hex_prism.obj")
 MAX_ANGLE = math.radians(1e-4)  # the issue's bound: 1e-4 degrees
 EXACT = 1e-9  # what the exact routes reach (metres; radians for angles)
@@ -74,34 +70,12 @@ def finger_pose(x, m, y_F, m_F, *, gap, spin):
     return RigidTransform(RotationMatrix(R), p)
 
 
-class PairRig:
+class PairRig(FreeRig):
     """An object and free fingers of given shapes at given poses (frame O)."""
 
     def __init__(self, object_shape, fingers, X_WO=X_WO):
-        builder = DiagramBuilder()
-        plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-        inertia = SpatialInertia.SolidSphereWithMass(0.1, 0.01)
-        self.object = plant.AddRigidBody(
-            "object", plant.AddModelInstance("object"), inertia
-        )
-        plant.RegisterCollisionGeometry(
-            self.object, RigidTransform(), object_shape, "object", ProximityProperties()
-        )
-        hand = plant.AddModelInstance("hand")
-        self.fingers = []
-        for k, (shape, _) in enumerate(fingers):
-            body = plant.AddRigidBody(f"finger{k}", hand, inertia)
-            plant.RegisterCollisionGeometry(
-                body, RigidTransform(), shape, f"tip{k}", ProximityProperties()
-            )
-            self.fingers.append(body)
-        plant.Finalize()
-        self.plant = plant
-        self.diagram = builder.Build()
-        self.ctx = plant.GetMyContextFromRoot(self.diagram.CreateDefaultContext())
-        plant.SetFreeBodyPose(self.ctx, self.object, X_WO)
-        for body, (_, X_OF) in zip(self.fingers, fingers, strict=True):
-            plant.SetFreeBodyPose(self.ctx, body, X_WO.multiply(X_OF))
+        super().__init__(object_shape, [shape for shape, _ in fingers])
+        self.place(X_WO, [X_OF for _, X_OF in fingers])
 
     def contacts(self, **kwargs):
         return find_contacts(self.plant, self.ctx, self.object, **kwargs)

@@ -17,13 +17,11 @@ import math
 
 import numpy as np
 import pytest
+from free_rig import FreeRig
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from pydrake.geometry import Convex, Mesh, ProximityProperties, Sphere
+from pydrake.geometry import Convex, Mesh, Sphere
 from pydrake.math import RigidTransform, RollPitchYaw
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.multibody.tree import SpatialInertia
-from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp import find_contacts
 
@@ -141,26 +139,11 @@ def rig(shape, centres_O):
 
 
 def _build(shape, num_tips):
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    inertia = SpatialInertia.SolidSphereWithMass(0.1, 0.01)
-    obj = plant.AddRigidBody("plate", plant.AddModelInstance("plate"), inertia)
-    plant.RegisterCollisionGeometry(
-        obj, RigidTransform(), shape, "plate", ProximityProperties()
+    rig = FreeRig(
+        shape, [Sphere(R_TIP)] * num_tips, object_name="plate", finger_name="tip"
     )
-    hand = plant.AddModelInstance("hand")
-    tips = []
-    for k in range(num_tips):
-        body = plant.AddRigidBody(f"tip{k}", hand, inertia)
-        plant.RegisterCollisionGeometry(
-            body, RigidTransform(), Sphere(R_TIP), f"tip{k}", ProximityProperties()
-        )
-        tips.append(body)
-    plant.Finalize()
-    diagram = builder.Build()
-    ctx = plant.GetMyContextFromRoot(diagram.CreateDefaultContext())
-    plant.SetFreeBodyPose(ctx, obj, X_WO)
-    return plant, ctx, obj, tips, diagram
+    rig.plant.SetFreeBodyPose(rig.ctx, rig.object, X_WO)
+    return rig.plant, rig.ctx, rig.object, rig.fingers, rig.diagram
 
 
 def drake_witness(plant, ctx, obj, tip):

@@ -15,12 +15,10 @@ import json
 
 import numpy as np
 import pytest
+from free_rig import X_WO, FreeRig
 from pydrake.common.eigen_geometry import AngleAxis
-from pydrake.geometry import Ellipsoid, ProximityProperties, Sphere
-from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.multibody.tree import SpatialInertia
-from pydrake.systems.framework import DiagramBuilder
+from pydrake.geometry import Ellipsoid, Sphere
+from pydrake.math import RigidTransform, RotationMatrix
 
 from drakegrasp import (
     Contact,
@@ -33,7 +31,6 @@ from drakegrasp import (
 from drakegrasp.closure.second_order import build_second_order_program
 from drakegrasp.plant import contact_curvatures
 
-X_WO = RigidTransform(RollPitchYaw(0.3, -0.2, 0.5), [0.1, 0.2, 0.3])
 R_TIP = 0.01
 GAP = 2e-5
 NOISE = 1e-5  # Drake's error while a pair penetrates is below ~8e-6 m
@@ -41,40 +38,15 @@ PENETRATION = 2e-5
 AXES = np.array([0.06, 0.045, 0.03])
 
 
-class EllipsoidRig:
+class EllipsoidRig(FreeRig):
     """An ellipsoid object and fixed spherical fingertips just off its surface."""
 
     def __init__(self, axes, tips, *, r=R_TIP):
-        builder = DiagramBuilder()
-        plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-        inertia = SpatialInertia.SolidSphereWithMass(0.1, 0.01)
-        self.object = plant.AddRigidBody(
-            "object", plant.AddModelInstance("object"), inertia
-        )
-        plant.RegisterCollisionGeometry(
-            self.object,
-            RigidTransform(),
-            Ellipsoid(*axes),
-            "object",
-            ProximityProperties(),
-        )
-        hand = plant.AddModelInstance("hand")
-        poses = []
-        for k, (x, n) in enumerate(tips):
-            body = plant.AddRigidBody(f"finger{k}", hand, inertia)
-            plant.RegisterCollisionGeometry(
-                body, RigidTransform(), Sphere(r), f"tip{k}", ProximityProperties()
-            )
-            centre = np.asarray(x, float) - (r + GAP) * np.asarray(n, float)
-            poses.append((body, X_WO.multiply(RigidTransform(centre))))
-        plant.Finalize()
-        self.plant = plant
-        self.diagram = builder.Build()
-        self.root = self.diagram.CreateDefaultContext()
-        self.ctx = plant.GetMyContextFromRoot(self.root)
-        plant.SetFreeBodyPose(self.ctx, self.object, X_WO)
-        for body, X in poses:
-            plant.SetFreeBodyPose(self.ctx, body, X)
+        super().__init__(Ellipsoid(*axes), [Sphere(r)] * len(tips))
+        centres = [
+            np.asarray(x, float) - (r + GAP) * np.asarray(n, float) for x, n in tips
+        ]
+        self.place(X_WO, [RigidTransform(centre) for centre in centres])
 
     def analyze(self, **kwargs):
         return analyze_grasp(
