@@ -33,3 +33,16 @@ def own_scene():
         )
 
     return make
+
+
+@pytest.fixture
+def fingerless_scene(tmp_path):
+    """The shipped box and a "hand" that is a bare palm: no one-dof finger joint."""
+    paddle = tmp_path / "nofinger.sdf"
+    paddle.write_text(
+        '<?xml version="1.0"?><sdf version="1.9"><model name="paddle">'
+        '<link name="palm">'
+        "<collision name='c'><geometry><box><size>0.05 0.05 0.05</size></box>"
+        "</geometry></collision></link></model></sdf>"
+    )
+    return planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(paddle))

@@ -251,19 +251,9 @@ def test_unreachable_object_gives_an_empty_result_that_says_why(tmp_path):
     assert "rejected" in result.reason
 
 
-def test_a_hand_without_fingers_is_refused(tmp_path):
-    nofinger = tmp_path / "nofinger.sdf"
-    nofinger.write_text(
-        '<?xml version="1.0"?><sdf version="1.9"><model name="paddle">'
-        '<link name="palm">'
-        "<collision name='c'><geometry><box><size>0.05 0.05 0.05</size></box>"
-        "</geometry></collision></link></model></sdf>"
-    )
-    scene = planning_scene(
-        "package://drakegrasp/objects/box.sdf", hand_url=str(nofinger)
-    )
+def test_a_hand_without_fingers_is_refused(fingerless_scene):
     with pytest.raises(ModelError, match="one-dof joint"):
-        plan(scene, n=5)
+        plan(fingerless_scene, n=5)
 
 
 @pytest.mark.parametrize(
