@@ -184,27 +184,32 @@ class HoldingMemory:
         return jsonable(self.__dict__)
 
 
-def _evidence(
-    memory: HoldingMemory,
+def _evidence_in_contact(
     *,
-    touching: bool,
     grasped: bool,
     friction_use: float,
     slip_speed: float,
+    thresholds: HoldingThresholds,
+) -> str:
+    """What a sample with contact alone shows (rules in the module docstring)."""
+    if slip_speed > thresholds.slip_speed:
+        return "slipping"
+    if not grasped:
+        return "touching"
+    if friction_use > thresholds.risk:  # False for NaN: geometry sees no force
+        return "at risk"
+    return "holding"
+
+
+def _evidence_without_contact(
+    memory: HoldingMemory,
+    *,
     sliding: float,
     slid: float,
     clearance: Callable[[], float],
     thresholds: HoldingThresholds,
 ) -> str:
-    """What this sample alone shows (rules in the module docstring)."""
-    if touching:
-        if slip_speed > thresholds.slip_speed:
-            return "slipping"
-        if not grasped:
-            return "touching"
-        if friction_use > thresholds.risk:  # False for NaN: geometry sees no force
-            return "at risk"
-        return "holding"
+    """What a sample without contact shows, after ``memory`` (module docstring)."""
     if memory.state == "dropped":
         return "dropped"
     if memory.state not in _GRIPPED:
@@ -270,17 +275,18 @@ def next_holding_state(
         raise InvalidOptionError(
             f"unknown holding state {memory.state!r}; one of {HOLDING_STATES}"
         )
-    evidence = _evidence(
-        memory,
-        touching=touching,
-        grasped=grasped,
-        friction_use=friction_use,
-        slip_speed=slip_speed,
-        sliding=sliding,
-        slid=slid,
-        clearance=clearance,
-        thresholds=thresholds,
-    )
+    if touching:
+        evidence = _evidence_in_contact(
+            grasped=grasped,
+            friction_use=friction_use,
+            slip_speed=slip_speed,
+            thresholds=thresholds,
+        )
+    else:
+        evidence = _evidence_without_contact(
+            memory, sliding=sliding, slid=slid, clearance=clearance,
+            thresholds=thresholds,
+        )  # fmt: skip
     state, milder = evidence, 0
     if memory.state in _STICKY and _RANK[evidence] < _RANK[memory.state]:
         milder = memory.milder + 1
