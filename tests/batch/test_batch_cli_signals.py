@@ -87,6 +87,21 @@ def slow_file(tmp_path_factory):
     return path
 
 
+def _await_workers(proc, scratch_dir, workers: set[int]) -> None:
+    """Wait (120 s at most) until ``proc`` runs two pool workers and a scratch file.
+
+    The workers seen are added to ``workers`` as they appear, so that the
+    caller can kill them whatever happens; the run must still be going.
+    """
+    end = time.monotonic() + 120
+    while time.monotonic() < end and proc.poll() is None:
+        workers |= _children(proc.pid)
+        if len(workers) >= 2 and list(scratch_dir.glob(".batch-*")):
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the run ended before it could be signalled"
+
+
 @linux_only
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
 def test_a_signal_leaves_no_worker_file_or_segment(slow_file, tmp_path, sig):
@@ -100,13 +115,7 @@ def test_a_signal_leaves_no_worker_file_or_segment(slow_file, tmp_path, sig):
     )
     workers: set[int] = set()
     try:
-        end = time.monotonic() + 120
-        while time.monotonic() < end and proc.poll() is None:
-            workers |= _children(proc.pid)
-            if len(workers) >= 2 and list(tmp_path.glob(".batch-*")):
-                break
-            time.sleep(0.05)
-        assert proc.poll() is None, "the run ended before it could be signalled"
+        _await_workers(proc, tmp_path, workers)
         assert len(workers) >= 2 and list(tmp_path.glob(".batch-*"))
         ours = _shm() - before
         proc.send_signal(sig)
@@ -147,13 +156,7 @@ def test_a_signal_to_the_whole_process_group(slow_file, tmp_path, sig):
     )
     workers: set[int] = set()
     try:
-        end = time.monotonic() + 120
-        while time.monotonic() < end and proc.poll() is None:
-            workers |= _children(proc.pid)
-            if len(workers) >= 2 and list(tmp_path.glob(".batch-*")):
-                break
-            time.sleep(0.05)
-        assert proc.poll() is None, "the run ended before it could be signalled"
+        _await_workers(proc, tmp_path, workers)
         ours = _shm() - before
         os.killpg(proc.pid, sig)
         _, stderr = proc.communicate(timeout=60)
