@@ -1,10 +1,11 @@
-"""Headless matplotlib for the picture tests; figures closed after each test."""
+"""Headless matplotlib and Meshcat for the picture tests (figures closed after each)."""
 
 import os
 import sys
 from pathlib import Path
 
 import pytest
+from pydrake.geometry import Meshcat, MeshcatParams
 
 _HERE = str(Path(__file__).resolve().parent)
 if _HERE not in sys.path:  # the browser tests share browser_support.py
@@ -22,3 +23,11 @@ def plt():
 
     yield pyplot
     pyplot.close("all")
+
+
+@pytest.fixture(scope="module")
+def meshcat():
+    """A local Meshcat server (no browser needed), one per test module."""
+    params = MeshcatParams()
+    params.show_stats_plot = False
+    return Meshcat(params)

@@ -18,7 +18,6 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-import pytest
 from browser_support import (
     CAMERA,
     HEIGHT,
@@ -31,7 +30,7 @@ from browser_support import (
     project,
     screenshot,
 )
-from pydrake.geometry import Meshcat, MeshcatParams, Rgba, Sphere
+from pydrake.geometry import Rgba, Sphere
 from pydrake.math import RigidTransform
 
 from drakegrasp import Contact, Grasp
@@ -39,13 +38,6 @@ from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.visualization import MESHCAT_COLORS, clear_grasp, draw_grasp
 
 pytestmark = SKIP_WITHOUT_CHROMIUM
-
-
-@pytest.fixture(scope="module")
-def meshcat():
-    params = MeshcatParams()
-    params.show_stats_plot = False
-    return Meshcat(params)
 
 
 def test_chromium_shows_the_drawn_grasp(meshcat, tmp_path):

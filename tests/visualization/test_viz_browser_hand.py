@@ -10,7 +10,6 @@ Drake's WSG-50 (meshes) runs when ``drake_models`` is present.
 """
 
 import numpy as np
-import pytest
 from browser_support import (
     SKIP_WITHOUT_CHROMIUM,
     colour_mask,
@@ -18,7 +17,7 @@ from browser_support import (
     project,
     screenshot,
 )
-from pydrake.geometry import Meshcat, MeshcatParams, MeshcatVisualizer
+from pydrake.geometry import MeshcatVisualizer
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
@@ -30,13 +29,6 @@ from drakegrasp.visualization import MESHCAT_COLORS, set_translucent, visualizer
 pytestmark = SKIP_WITHOUT_CHROMIUM
 
 FORCE = MESHCAT_COLORS["force"]
-
-
-@pytest.fixture(scope="module")
-def meshcat():
-    params = MeshcatParams()
-    params.show_stats_plot = False
-    return Meshcat(params)
 
 
 def _scene(meshcat, url, *, drake_models=None, **joints):
@@ -75,6 +67,17 @@ def _scene(meshcat, url, *, drake_models=None, **joints):
     assert report.is_force_closure
     X_WO = plant.EvalBodyPoseInWorld(plant_context, body)
     return plant, scene_graph, hand, report, X_WO
+
+
+def _look(meshcat, report, X_WO, camera, target):
+    """Point the camera at ``target``; the draw_grasp options that keep it there."""
+    meshcat.SetCameraPose(camera, target)
+    return {
+        "X_WG": X_WO,
+        "result": report.force_closure,
+        "cone": "exact",
+        "keep_camera": True,
+    }
 
 
 def _force_pixels(meshcat, tmp_path, name):
@@ -124,13 +127,7 @@ def test_shipped_hand_on_top_and_translucent(meshcat, tmp_path):
         box_at=[0.0, 0.0, 0.065],
     )
     camera, target = np.array([0.07, 0.0, 0.075]), np.array([0.0, 0.0, 0.055])
-    meshcat.SetCameraPose(camera, target)
-    options = {
-        "X_WG": X_WO,
-        "result": report.force_closure,
-        "cone": "exact",
-        "keep_camera": True,
-    }
+    options = _look(meshcat, report, X_WO, camera, target)
 
     hand_only, _ = _force_pixels(meshcat, tmp_path, "hand")
     assert colour_mask(hand_only, FORCE).sum() == 0
@@ -163,13 +160,7 @@ def test_wsg50_meshes_do_not_hide_an_on_top_drawing(
         box_at=[0.0, 0.108, 0.0],
     )
     camera, target = np.array([0.0, 0.05, 0.07]), np.array([0.0, 0.108, 0.0])
-    meshcat.SetCameraPose(camera, target)
-    options = {
-        "X_WG": X_WO,
-        "result": report.force_closure,
-        "cone": "exact",
-        "keep_camera": True,
-    }
+    options = _look(meshcat, report, X_WO, camera, target)
     _hidden_then_on_top(
         meshcat, tmp_path, "wsg50", report, X_WO, camera, target, options, each=False
     )

@@ -12,7 +12,7 @@ import struct
 
 import numpy as np
 import pytest
-from pydrake.geometry import Meshcat, MeshcatParams
+from pydrake.geometry import Meshcat
 from pydrake.math import RigidTransform, RollPitchYaw
 
 import drakegrasp as dg
@@ -20,13 +20,6 @@ from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.view import MESHCAT_FOV
 
 CAMERA_PROPERTY = ("/Cameras/default/rotated/<object>", "position")
-
-
-@pytest.fixture(scope="module")
-def meshcat():
-    params = MeshcatParams()
-    params.show_stats_plot = False
-    return Meshcat(params)
 
 
 @pytest.fixture

@@ -7,7 +7,6 @@ import json
 
 import numpy as np
 import pytest
-from pydrake.geometry import Meshcat
 
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning import plan_grasps, planning_scene
@@ -27,11 +26,6 @@ def planned():
         num_candidates=60, mu=0.5, seed=4, robustness_samples=4,
     )  # fmt: skip
     return scene, result
-
-
-@pytest.fixture(scope="module")
-def meshcat():
-    return Meshcat()
 
 
 def test_score_colors_run_red_to_green():

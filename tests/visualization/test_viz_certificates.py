@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-from pydrake.geometry import Meshcat
 
 import drakegrasp as dg
 from drakegrasp.core import examples as ex
@@ -10,11 +9,6 @@ from drakegrasp.visualization.certificate_plots import planar_motion
 from drakegrasp.visualization.escape import animate_escape, escape_transform
 
 SQUARE = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], float)
-
-
-@pytest.fixture(scope="module")
-def meshcat():
-    return Meshcat()
 
 
 def test_draw_grasp_draws_the_unresisted_moment_of_two_hard_fingers(meshcat):

@@ -2,17 +2,11 @@
 
 import numpy as np
 import pytest
-from pydrake.geometry import Meshcat
 from pydrake.math import RigidTransform
 
 from drakegrasp import Contact, Grasp, InvalidOptionError
 from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.visualization import clear_grasp, draw_grasp
-
-
-@pytest.fixture(scope="module")
-def meshcat():
-    return Meshcat()
 
 
 def _ring(n=3, mu=0.5, radius=0.1):

@@ -1,18 +1,11 @@
 """draw_grasp options for real hands: on_top, size, translucent (no browser)."""
 
 import pytest
-from pydrake.geometry import Meshcat, MeshcatParams, Sphere
+from pydrake.geometry import Meshcat, Sphere
 
 import drakegrasp as dg
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization import set_translucent, visualizer_paths
-
-
-@pytest.fixture(scope="module")
-def meshcat():
-    params = MeshcatParams()
-    params.show_stats_plot = False
-    return Meshcat(params)
 
 
 @pytest.fixture
