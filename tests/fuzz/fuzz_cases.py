@@ -86,6 +86,19 @@ def _digest(path: Path) -> str | None:
         return None
 
 
+def print_bad(bad, *, details: bool = False) -> int:
+    """List the bad outcomes (all of them when ``details``); the exit status.
+
+    ``bad`` holds ``(family, name, outcome, detail)`` rows; the status is 1
+    when there is any, else 0.
+    """
+    if details or bad:
+        print()
+        for family, name, outcome, detail in bad:
+            print(f"{outcome}: [{family}] {name}: {detail}")
+    return 1 if bad else 0
+
+
 def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:
     """Run one case; return (outcome, detail)."""
     before = {p: _digest(p) for p in case.files}

@@ -340,6 +340,18 @@ def _draw_common(rng, spec: dict) -> str | None:
     return None
 
 
+def _spec(rng, pose, far, *, kwargs) -> dict:
+    """A case on the default models at ``pose``, through a root or plant context."""
+    return {
+        "pose": pose,
+        "far": far,
+        "context": pick(rng, ("root", "plant")),
+        "object": "default",
+        "hand": "default",
+        "kwargs": kwargs,
+    }
+
+
 def close_hand_cases(
     sandbox: Sandbox, seed: int = 215, count: int = 150
 ) -> Iterator[Case]:
@@ -347,15 +359,7 @@ def close_hand_cases(
     rng = np.random.default_rng(seed)
     for i in range(count):
         pose, far = _random_pose(rng, wild=rng.random() < 0.35)
-        spec = {
-            "pose": pose,
-            "far": far,
-            "context": pick(rng, ("root", "plant")),
-            "object": "default",
-            "hand": "default",
-            "kwargs": {},
-            "unit": None,
-        }
+        spec = _spec(rng, pose, far, kwargs={}) | {"unit": None}
         hostile = _draw_common(rng, spec)
         if hostile is None:
             r = rng.random()
@@ -411,14 +415,7 @@ def pose_cases(sandbox: Sandbox, seed: int = 216, count: int = 100) -> Iterator[
         pose["q"] = [float(0.025 + rng.uniform(-0.004, 0.004)) for _ in range(2)]
         if rng.random() < 0.3:
             pose["q"][int(rng.integers(2))] = float(pick(rng, (-0.003, 0.05, 0.07)))
-        spec = {
-            "pose": pose,
-            "far": far,
-            "context": pick(rng, ("root", "plant")),
-            "object": "default",
-            "hand": "default",
-            "kwargs": {"allow_penetration": True},
-        }
+        spec = _spec(rng, pose, far, kwargs={"allow_penetration": True})
         hostile = _draw_common(rng, spec)
         r = rng.random()
         if hostile is None and r < 0.2:

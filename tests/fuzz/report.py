@@ -56,11 +56,7 @@ def main() -> int:
     for family, c in families.items():
         cells = " | ".join(str(c[o]) for o in fuzz_cases.OUTCOMES)
         print(f"| {family} | {sum(c.values())} | {cells} |")
-    if args.details or bad:
-        print()
-        for family, name, outcome, detail in bad:
-            print(f"{outcome}: [{family}] {name}: {detail}")
-    return 1 if bad else 0
+    return fuzz_cases.print_bad(bad, details=args.details)
 
 
 if __name__ == "__main__":

@@ -144,11 +144,7 @@ def main() -> int:
     families, bad = run(small=not args.full)
     print(f"generated inputs run in {time.perf_counter() - start:.0f} s\n")
     print(table(families))
-    if args.details or bad:
-        print()
-        for family, name, outcome, detail in bad:
-            print(f"{outcome}: [{family}] {name}: {detail}")
-    return 1 if bad else 0
+    return fuzz_cases.print_bad(bad, details=args.details)
 
 
 if __name__ == "__main__":
