@@ -30,7 +30,7 @@ from drakegrasp.errors import (
     ModelError,
     PenetrationError,
 )
-from drakegrasp.plant.validation import query_object_of, scoped_name
+from drakegrasp.plant.validation import pair_distance, query_object_of, scoped_name
 
 __all__ = [
     "JOINT_LIMIT_REMEDY",
@@ -216,16 +216,8 @@ def find_penetrations(
     for body in bodies:
         for gh in plant.GetCollisionGeometriesForBody(body):
             for go in object_geometries:
-                if inspector.CollisionFiltered(go, gh):
-                    continue
-                try:
-                    psi = query.ComputeSignedDistancePairClosestPoints(go, gh).distance
-                except RuntimeError as e:
-                    raise ModelError(
-                        "Drake cannot compute the signed distance between "
-                        f"{inspector.GetName(go)!r} and {inspector.GetName(gh)!r}: {e}"
-                    ) from None
-                if psi < -tol:
+                psi = pair_distance(query, inspector, go, gh)
+                if psi is not None and psi < -tol:
                     out.append(
                         Penetration(
                             hand_body=scoped_name(plant, body),

@@ -32,6 +32,7 @@ __all__ = [
     "hand_contact_bodies",
     "hand_model_instances",
     "model_instance",
+    "pair_distance",
     "plant_context_of",
     "query_object_of",
     "resolve_body",
@@ -168,6 +169,34 @@ def query_object_of(plant: MultibodyPlant, plant_context: Context):
 def scoped_name(plant: MultibodyPlant, body: RigidBody) -> str:
     """``"model::body"`` of a body."""
     return f"{plant.GetModelInstanceName(body.model_instance())}::{body.name()}"
+
+
+def pair_distance(query, inspector, go, gh) -> float | None:
+    """Drake's signed distance ψ (m) between two geometries; None if filtered.
+
+    Parameters
+    ----------
+    query : QueryObject
+        The scene graph's query object.
+    inspector : SceneGraphInspector
+        ``query.inspector()``.
+    go, gh : GeometryId
+        An object geometry and a hand geometry.
+
+    Raises
+    ------
+    ModelError
+        If Drake cannot compute the distance of this pair of shapes.
+    """
+    if inspector.CollisionFiltered(go, gh):
+        return None
+    try:
+        return query.ComputeSignedDistancePairClosestPoints(go, gh).distance
+    except RuntimeError as e:
+        raise ModelError(
+            "Drake cannot compute the signed distance between "
+            f"{inspector.GetName(go)!r} and {inspector.GetName(gh)!r}: {e}"
+        ) from None
 
 
 def _instance_names(plant: MultibodyPlant) -> list[str]:

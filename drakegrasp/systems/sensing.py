@@ -28,10 +28,11 @@ from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import ContactResults, MultibodyPlant
 from pydrake.systems.framework import Context
 
-from drakegrasp.errors import ModelError, NoContactsError
+from drakegrasp.errors import NoContactsError
 from drakegrasp.plant.contact_results import contacts_from_results
 from drakegrasp.plant.contacts import PlantContact, _scoped_name, find_contacts
 from drakegrasp.plant.options import AnalysisOptions
+from drakegrasp.plant.validation import pair_distance
 from drakegrasp.systems.finger_loads import (
     FingerLoad,
     finger_loads_from_results,
@@ -354,15 +355,7 @@ def hand_clearance(
         return nearest
     for go in object_geometries:
         for gh in hand_geometries:
-            if inspector.CollisionFiltered(go, gh):
-                continue
-            try:
-                d = query_object.ComputeSignedDistancePairClosestPoints(go, gh).distance
-            except RuntimeError as e:
-                raise ModelError(
-                    "Drake cannot measure the distance between "
-                    f"{inspector.GetName(go)!r} and {inspector.GetName(gh)!r}: {e}"
-                ) from None
-            if d <= horizon:
+            d = pair_distance(query_object, inspector, go, gh)
+            if d is not None and d <= horizon:
                 nearest = min(nearest, float(d))
     return nearest
