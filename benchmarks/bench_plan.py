@@ -70,6 +70,22 @@ def object_url(name: str) -> str:
     return f"package://drakegrasp/objects/{name}.sdf"
 
 
+def _hand_of(plant, candidate):
+    """The hand's free base body and its finger joints, as a candidate names them."""
+    base = plant.GetBodyByName(candidate.hand_base.rpartition("::")[2])
+    names = candidate.joint_names
+    joints = [plant.GetJointByName(n.rpartition("::")[2]) for n in names]
+    return base, joints
+
+
+def _open_at(plant, pctx, base, joints, candidate) -> None:
+    """Put the hand at the candidate's pose, its fingers wide open."""
+    plant.SetFreeBodyPose(pctx, base, candidate.X_WH)
+    for j, sign in zip(joints, candidate.closing_signs, strict=True):
+        lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
+        j.set_translation(pctx, lo if sign > 0 else hi)
+
+
 def user_loop(scene, candidates, mu: float) -> float:
     """Candidates/s of the one-at-a-time loop a user writes without the planner.
 
@@ -81,16 +97,10 @@ def user_loop(scene, candidates, mu: float) -> float:
     plant = scene.plant
     ctx = scene.context.Clone()
     pctx = plant.GetMyContextFromRoot(ctx)
-    base = plant.GetBodyByName(candidates[0].hand_base.rpartition("::")[2])
-    joints = [
-        plant.GetJointByName(n.rpartition("::")[2]) for n in candidates[0].joint_names
-    ]
+    base, joints = _hand_of(plant, candidates[0])
     t = time.perf_counter()
     for c in candidates:
-        plant.SetFreeBodyPose(pctx, base, c.X_WH)
-        for j, sign in zip(joints, c.closing_signs, strict=True):
-            lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
-            j.set_translation(pctx, lo if sign > 0 else hi)  # wide open
+        _open_at(plant, pctx, base, joints, c)
         try:
             close_hand(plant, ctx, scene.object_body, hand=scene.hand)
             report = analyze_grasp(
@@ -125,19 +135,13 @@ def course_cost_loop(scene, candidates, cloud_points: int, seed: int) -> float:
     R_WO = X_WO.rotation().matrix()
     p_W = p_O @ R_WO.T + X_WO.translation()
     n_W = n_O @ R_WO.T
-    base = plant.GetBodyByName(candidates[0].hand_base.rpartition("::")[2])
-    joints = [
-        plant.GetJointByName(n.rpartition("::")[2]) for n in candidates[0].joint_names
-    ]
+    base, joints = _hand_of(plant, candidates[0])
     port = plant.get_geometry_query_input_port()
     X_HK = parallel_jaw(plant, pctx, scene.object_body, scene.hand).X_HK
     costs = []
     t = time.perf_counter()
     for c in candidates:
-        plant.SetFreeBodyPose(pctx, base, c.X_WH)
-        for j, sign in zip(joints, c.closing_signs, strict=True):
-            lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
-            j.set_translation(pctx, lo if sign > 0 else hi)  # wide open
+        _open_at(plant, pctx, base, joints, c)
         query = port.Eval(pctx)
         hand = {
             g
