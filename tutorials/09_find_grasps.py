@@ -118,16 +118,26 @@ plt.show()
 #
 # `candidate.apply(plant, context)` puts the hand where the candidate says.
 
+
 # %%
-builder = DiagramBuilder()
-plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-hand, name = scene.add_models(plant, Parser(plant))
-plant.Finalize()
-meshcat.Delete()
-MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat)
-diagram = builder.Build()
-root = diagram.CreateDefaultContext()
-best.apply(plant, root, object_body=plant.GetBodyByName(name.rpartition("::")[2]))
+def shown(scene):
+    """The scene's models in a new diagram drawn in Meshcat.
+
+    Returns the plant, the diagram, its default context and the object body.
+    """
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    _, name = scene.add_models(plant, Parser(plant))
+    plant.Finalize()
+    meshcat.Delete()
+    MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat)
+    diagram = builder.Build()
+    body = plant.GetBodyByName(name.rpartition("::")[2])
+    return plant, diagram, diagram.CreateDefaultContext(), body
+
+
+plant, diagram, root, object_body = shown(scene)
+best.apply(plant, root, object_body=object_body)
 diagram.ForcedPublish(root)
 
 # %% [markdown]
@@ -196,15 +206,7 @@ print(
 # alike.
 
 # %%
-builder = DiagramBuilder()
-plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-hand, name = can.add_models(plant, Parser(plant))
-plant.Finalize()
-meshcat.Delete()
-MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat)
-diagram = builder.Build()
-root = diagram.CreateDefaultContext()
-can_body = plant.GetBodyByName(name.rpartition("::")[2])
+plant, diagram, root, can_body = shown(can)
 for c in allegro[:3]:
     c.apply(plant, root, object_body=can_body)
     diagram.ForcedPublish(root)
