@@ -63,7 +63,7 @@ SLIP_CASES = {
 
 def slip_times() -> None:
     """Weak pick: when the monitor flagged slip against when the box moved 5 mm."""
-    from holding_support import FLAGS, timeline
+    from holding_support import timeline
 
     print("weak pick (fingers 3 mm past the box), 10 ms samples, lift at 1.0 s:")
     for name, options in SLIP_CASES.items():
@@ -72,17 +72,16 @@ def slip_times() -> None:
         )
         pick.run(2.0)
         line = timeline(pick, finger="left_finger", t_ref=1.0)
+        flagged, moved, dropped = line.slip_times(after=1.0)
         print(
-            f"  {name}: flagged {line.first(FLAGS, after=1.0):.3f} s, moved 5 mm "
-            f"{line.moved(5e-3, after=1.0):.3f} s, dropped "
-            f"{line.first(('dropped',), after=1.0):.3f} s"
+            f"  {name}: flagged {flagged:.3f} s, moved 5 mm {moved:.3f} s, "
+            f"dropped {dropped:.3f} s"
         )
 
 
 def wsg_slip_times() -> None:
     """WSG-50 + YCB sugar box: firm and weak picks, slip flagged against 5 mm moved."""
-    from holding_support import FLAGS, timeline
-    from wsg_pick_support import FIRM, LIFT_START, WEAK, build_wsg_pick
+    from wsg_pick_support import FIRM, LIFT_START, WEAK, wsg_pick_timeline
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
     from conftest import local_drake_models
@@ -96,20 +95,11 @@ def wsg_slip_times() -> None:
     print(f"WSG-50 + sugar box (mu='plant'), 10 ms samples, lift at {LIFT_START} s:")
     for contacts in ("contact_results", "geometry"):
         for name, squeeze in (("firm", FIRM), ("weak", WEAK)):
-            pick = build_wsg_pick(
-                models,
-                squeeze=squeeze,
-                mu="plant",
-                distance_tolerance=1e-3,
-                contacts=contacts,
-            )
-            pick.run()
-            line = timeline(pick, finger="left_finger", t_ref=LIFT_START)
+            line = wsg_pick_timeline(models, squeeze=squeeze, contacts=contacts)
+            flagged, moved, dropped = line.slip_times(after=LIFT_START)
             print(
-                f"  {contacts}, {name}: flagged "
-                f"{line.first(FLAGS, after=LIFT_START):.3f} s, moved 5 mm "
-                f"{line.moved(5e-3, after=LIFT_START):.3f} s, dropped "
-                f"{line.first(('dropped',), after=LIFT_START):.3f} s, box moved "
+                f"  {contacts}, {name}: flagged {flagged:.3f} s, moved 5 mm "
+                f"{moved:.3f} s, dropped {dropped:.3f} s, box moved "
                 f"{1e3 * line.displacement[line.times >= LIFT_START].max():.1f} mm "
                 "in the fingers after the lift began"
             )

@@ -17,6 +17,7 @@ from drakegrasp.systems.holding import HOLDING_STATES
 from drakegrasp.systems.monitor import GraspMonitor
 
 FLAGS = ("slipping", "at risk")
+MOVED = 5e-3  # m: the box has moved in the fingers (the issue's 5 mm)
 
 
 @dataclass
@@ -33,6 +34,17 @@ class Timeline:
             if t >= after and s in names:
                 return float(t)
         return np.inf
+
+    def slip_times(self, after: float) -> tuple[float, float, float]:
+        """First times at or after ``after``: flagged, moved ``MOVED``, dropped.
+
+        Flagged is a state of ``FLAGS``; each is ``inf`` if it never happens.
+        """
+        return (
+            self.first(FLAGS, after=after),
+            self.moved(MOVED, after=after),
+            self.first(("dropped",), after=after),
+        )
 
     def codes(self, start: float, stop: float) -> np.ndarray:
         """Holding-state codes (HOLDING_STATES indices) of samples in [start, stop)."""

@@ -11,13 +11,12 @@ the monitor: its displacement in the left finger's frame since the lift began
 
 import numpy as np
 import pytest
-from holding_support import FLAGS, timeline
+from holding_support import timeline
 from pick_support import OPEN, build_pick
 
 from drakegrasp.systems.holding import HOLDING_STATES
 
 LIFT_START = 1.0
-MOVED = 5e-3  # m
 NEAR = 0.0255  # fingers 0.5 mm short of the 50 mm box: within the 1 mm tolerance
 POINT = {
     "plant_contact": "point",
@@ -53,9 +52,7 @@ def test_firm_pick_is_holding_throughout_the_lift(case):
 @pytest.mark.parametrize("case", list(CASES))
 def test_weak_pick_is_flagged_before_it_moves_5_mm_and_dropped_after(case):
     line = _run(0.022, CASES[case])
-    moved = line.moved(MOVED, after=LIFT_START)
-    flagged = line.first(FLAGS, after=LIFT_START)
-    dropped = line.first(("dropped",), after=LIFT_START)
+    flagged, moved, dropped = line.slip_times(after=LIFT_START)
     print(
         f"{case}: flagged {flagged:.3f} s, moved 5 mm {moved:.3f} s, "
         f"dropped {dropped:.3f} s"

@@ -10,34 +10,24 @@ monitor reads μ from the plant (``mu="plant"``).
 
 import numpy as np
 import pytest
-from holding_support import FLAGS, timeline
 from wsg_pick_support import (
     BOX_HALF_HEIGHT,
     FIRM,
     LIFT,
     LIFT_START,
     WEAK,
-    build_wsg_pick,
+    wsg_pick_timeline,
 )
 
 from drakegrasp.systems.monitor import GraspMonitor
 
-MOVED = 5e-3  # m
 NEAR = -5e-4  # squeeze: the fingers stop 0.5 mm short of the box faces
 PADS_OFF = 1.45  # s: by then the weak pick's pads have slid off the box top
 MODES = ["contact_results", "geometry"]
 
 
 def _run(models_dir, squeeze, contacts):
-    pick = build_wsg_pick(
-        models_dir,
-        squeeze=squeeze,
-        mu="plant",
-        distance_tolerance=1e-3,
-        contacts=contacts,
-    )
-    pick.run()
-    return timeline(pick, finger="left_finger", t_ref=LIFT_START)
+    return wsg_pick_timeline(models_dir, squeeze=squeeze, contacts=contacts)
 
 
 @pytest.mark.parametrize("contacts", MODES)
@@ -56,9 +46,7 @@ def test_weak_wsg_pick_is_flagged_before_it_moves_5_mm_and_dropped_after(
     drake_models_dir, contacts
 ):
     line = _run(drake_models_dir, WEAK, contacts)
-    moved = line.moved(MOVED, after=LIFT_START)
-    flagged = line.first(FLAGS, after=LIFT_START)
-    dropped = line.first(("dropped",), after=LIFT_START)
+    flagged, moved, dropped = line.slip_times(after=LIFT_START)
     print(
         f"WSG-50 + sugar box, {contacts}: flagged {flagged:.3f} s, moved 5 mm "
         f"{moved:.3f} s, dropped {dropped:.3f} s"

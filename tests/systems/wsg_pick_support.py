@@ -14,6 +14,7 @@ pads with μ = 1 carry the box's 5.04 N weight only above ~2.5 N each.
 from __future__ import annotations
 
 import numpy as np
+from holding_support import timeline
 from pick_support import Pick, add_ground, add_lift, drive, monitored_pick
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
@@ -105,3 +106,20 @@ def build_wsg_pick(
         initial_state=initial_state,
         **monitor_options,
     )
+
+
+def wsg_pick_timeline(models_dir, *, squeeze: float, contacts: str):
+    """Run the pick to its end (μ read from the plant, 1 mm distance tolerance).
+
+    Returns its :func:`holding_support.timeline` in the left finger's frame,
+    displacements from the start of the lift.
+    """
+    pick = build_wsg_pick(
+        models_dir,
+        squeeze=squeeze,
+        mu="plant",
+        distance_tolerance=1e-3,
+        contacts=contacts,
+    )
+    pick.run()
+    return timeline(pick, finger="left_finger", t_ref=LIFT_START)
