@@ -133,6 +133,26 @@ def _outline_patch(outline: Any, colors: Mapping[str, Any]):
     return Polygon(pts, closed=True, **style)
 
 
+def _arrows(ax, tails, vectors, color, width: float, *, zorder: int):
+    """Arrows from ``tails`` along ``vectors`` ((M, 2), data units), none hidden.
+
+    ``minlength=0``: a short arrow is drawn as an arrow, never as a dot.
+    """
+    return ax.quiver(
+        tails[:, 0],
+        tails[:, 1],
+        vectors[:, 0],
+        vectors[:, 1],
+        angles="xy",
+        scale_units="xy",
+        scale=1.0,
+        color=color,
+        width=width,
+        minlength=0.0,
+        zorder=zorder,
+    )
+
+
 def plot_planar_grasp(
     grasp: Grasp,
     *,
@@ -263,38 +283,14 @@ def plot_planar_grasp(
     normals = None
     if show_normals:
         tails = C if sign > 0 else C - L * Nrm
-        normals = ax.quiver(
-            tails[:, 0],
-            tails[:, 1],
-            L * Nrm[:, 0],
-            L * Nrm[:, 1],
-            angles="xy",
-            scale_units="xy",
-            scale=1.0,
-            color=palette["normal"],
-            width=0.006,
-            minlength=0.0,
-            zorder=3,
-        )
+        normals = _arrows(ax, tails, L * Nrm, palette["normal"], 0.006, zorder=3)
         extent.append(tails)
 
     force_artist = None
     if f_G is not None and scale > 0:
         vec = scale * f_G
         tails = C if sign > 0 else C - vec
-        force_artist = ax.quiver(
-            tails[:, 0],
-            tails[:, 1],
-            vec[:, 0],
-            vec[:, 1],
-            angles="xy",
-            scale_units="xy",
-            scale=1.0,
-            color=palette["force"],
-            width=0.009,
-            minlength=0.0,
-            zorder=4,
-        )
+        force_artist = _arrows(ax, tails, vec, palette["force"], 0.009, zorder=4)
         extent += [tails, tails + vec]
 
     points = ax.scatter(C[:, 0], C[:, 1], color=palette["contact"], s=25, zorder=5)
