@@ -363,6 +363,12 @@ def _scene_piece(kind: str, rng, root: Path, outside: Path, i: int):
     scene_dir = root / "scene"
     allow = bool(rng.random() < 0.25)
     no_evil = lambda s: "evil" not in s["instances"]  # noqa: E731
+
+    def evil_first(line):
+        """``line`` first of the directives: loaded only with ``allow_any_file``."""
+        text = base.replace("directives:\n", "directives:\n" + line, 1)
+        return text, allow, "either" if allow else "refuse", None if allow else no_evil
+
     if kind == "url":
         host = ["", "localhost", "evil.example", "127.0.0.1", "tmp"][
             int(rng.integers(5))
@@ -376,13 +382,7 @@ def _scene_piece(kind: str, rng, root: Path, outside: Path, i: int):
             + "../" * int(rng.integers(1, 9))
             + str(outside).lstrip("/"),
         ][form]
-        text = base.replace("directives:\n", "directives:\n" + _evil_line(url), 1)
-        return (
-            text,
-            allow,
-            "either" if allow else "refuse",
-            no_evil if not allow else None,
-        )
+        return evil_first(_evil_line(url))
     if kind == "tag":
         tag = ["!!set", "!!omap", "!x", "!!map", "!Rpy", "!!python/object"][
             int(rng.integers(6))
@@ -395,13 +395,7 @@ def _scene_piece(kind: str, rng, root: Path, outside: Path, i: int):
             if which == "add_model"
             else f"- add_directives: {tag} {{file: 'file://{inner}'}}\n"
         )
-        text = base.replace("directives:\n", "directives:\n" + line, 1)
-        return (
-            text,
-            allow,
-            "either" if allow else "refuse",
-            no_evil if not allow else None,
-        )
+        return evil_first(line)
     if kind == "duplicate":
         hidden = textwrap.dedent(
             f"""\
