@@ -12,7 +12,8 @@ The folder reads as the pipeline, one stage per room:
 * :mod:`~drakegrasp.batch.api`: the public functions and
   :class:`BatchClosureResult`;
 * :mod:`~drakegrasp.batch.inputs`: arrays and options checked, once, and the
-  kernel choice resolved;
+  kernel choice resolved; :mod:`~drakegrasp.batch.ragged`: grasps with
+  different numbers of contacts grouped by count;
 * :mod:`~drakegrasp.batch.run`: the chunk stream, one chunk start to finish,
   worker processes and shared memory;
 * :mod:`~drakegrasp.batch.build`: frames, grasp matrices, facets, ranks and

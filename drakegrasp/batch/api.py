@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drakegrasp.batch.inputs import METRICS, shape_of
+from drakegrasp.batch.ragged import is_ragged, run_groups
 from drakegrasp.batch.run.chunk import force_task, form_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
@@ -149,7 +150,7 @@ class BatchClosureResult:
 
 
 def collect(K: int, d: int, kind: str, tol: float, names, chunks):
-    """One :class:`BatchClosureResult` from streamed chunk results."""
+    """One :class:`BatchClosureResult` from ``(slice or indices, arrays)`` parts."""
     out = {
         "is_closure": np.zeros(K, dtype=bool),
         "d_star": np.zeros(K),
@@ -177,6 +178,25 @@ def collect(K: int, d: int, kind: str, tol: float, names, chunks):
         metrics=out_metrics,
         normal_certificate=out.get("normal_certificate"),
     )
+
+
+def merge_results(
+    K: int, d: int, kind: str, parts: Sequence[tuple[np.ndarray, BatchClosureResult]]
+) -> BatchClosureResult:
+    """One result in input order from the results of a ragged batch's groups.
+
+    Parameters
+    ----------
+    K, d : int
+        Number of grasps and dimension (2 or 3).
+    kind : {"form", "force"}
+    parts : sequence of (indices, BatchClosureResult)
+        Each group's positions in the input and its result
+        (:func:`drakegrasp.batch.ragged.run_groups`).
+    """
+    names = tuple(parts[0][1].metrics)
+    chunks = ((idx, result.to_arrays()) for idx, result in parts)
+    return collect(K, d, kind, parts[0][1].tol, names, chunks)
 
 
 @renamed_keyword("model", "contact_model")
@@ -279,18 +299,22 @@ def batch_force_closure(
 
     Parameters
     ----------
-    positions : (K, N, 3) or (K, N, 2) float
+    positions : (K, N, 3) or (K, N, 2) float, or list of K (N_k, d) float
         Contact points ``c_i``, metres, in each grasp's frame.  Any array-like
         that supports slicing along the first axis (e.g. ``numpy.memmap``).
-    normals : (K, N, d) float
+        Grasps with different numbers of contacts come as a list of per-grasp
+        arrays (ragged; :mod:`drakegrasp.batch.ragged`): they are run in groups
+        of equal ``N_k`` and returned in input order.
+    normals : (K, N, d) float, or list of K (N_k, d) float
         Contact normals pointing into the object; normalised here.  A zero or
         non-finite normal raises :class:`~drakegrasp.InvalidContactError`
         naming the grasp and contact.
-    mu : float, (K,) or (K, N) float
+    mu : float, (K,) or (K, N) float, or list of K (N_k,) float
         Coulomb friction coefficients: 0 or in ``[1e-12, 1e12]`` (the range of
         :mod:`drakegrasp.core.validation`, the same as the single-grasp path).  A
         hard finger with ``μ = 0`` acts as frictionless, as in the single-grasp
-        path.
+        path.  With ragged positions: a scalar, one per grasp (K,), or one
+        array per grasp.
     contact_model : {"hard_finger", "frictionless", "soft_finger"}, optional
         Contact model of every contact (soft fingers are spatial only).
     num_generators : int, optional
@@ -354,6 +378,17 @@ def batch_force_closure(
     :mod:`drakegrasp.batch.lp` (an exact active-set method for small null
     spaces, a block interior-point method for the rest).
     """
+    if is_ragged(positions):
+        K, d, parts = run_groups(
+            batch_force_closure, positions, normals,
+            per_contact={"mu": mu, "torsional_friction": torsional_friction},
+            per_grasp={"reference_points": reference_points,
+                       "characteristic_lengths": characteristic_lengths},
+            contact_model=contact_model, num_generators=num_generators, tol=tol,
+            rank_tol=rank_tol, chunk_size=chunk_size, progress=progress,
+            metrics=metrics, workers=workers, kernel=kernel,
+        )  # fmt: skip
+        return merge_results(K, d, "force", parts)
     K, N, d = shape_of("positions", positions)
     task, options = force_task(
         positions, mu, contact_model, num_generators, torsional_friction,
@@ -384,9 +419,9 @@ def batch_form_closure(
 
     Parameters
     ----------
-    positions, normals : (K, N, d) float
-        Contact points (metres) and inward normals (normalised here), as in
-        :func:`batch_force_closure`.
+    positions, normals : (K, N, d) float, or lists of K (N_k, d) float
+        Contact points (metres) and inward normals (normalised here), stacked
+        or ragged, as in :func:`batch_force_closure`.
     reference_points : (d,) or (K, d) float, optional
         Moment reference ``p``; default the origin.
     characteristic_lengths : float or (K,) float, optional
@@ -411,6 +446,15 @@ def batch_form_closure(
         \max d \;\text{s.t.}\; G_n f_n = 0,\; f_n - \mathbf 1 d \ge 0,\;
         d \ge 0,\; \mathbf 1^T f_n \le N .
     """
+    if is_ragged(positions):
+        K, d, parts = run_groups(
+            batch_form_closure, positions, normals, per_contact={},
+            per_grasp={"reference_points": reference_points,
+                       "characteristic_lengths": characteristic_lengths},
+            tol=tol, rank_tol=rank_tol, chunk_size=chunk_size, progress=progress,
+            metrics=metrics, workers=workers, kernel=kernel,
+        )  # fmt: skip
+        return merge_results(K, d, "form", parts)
     K, N, d = shape_of("positions", positions)
     task, options = form_task(
         positions, reference_points, characteristic_lengths, tol, rank_tol, metrics,

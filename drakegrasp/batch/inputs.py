@@ -56,7 +56,13 @@ def _check_tol(name: str, value) -> float:
 
 def shape_of(name: str, a) -> tuple[int, int, int]:
     """``(K, N, d)`` of a stacked input, or a clear error naming ``name``."""
-    shape = np.shape(a) if a is not None else ()
+    try:
+        shape = np.shape(a) if a is not None else ()
+    except (ValueError, TypeError):  # inhomogeneous nested sequences
+        raise InvalidContactError(
+            f"{name} must be a (K, N, 2) or (K, N, 3) array, or a list of per-grasp "
+            "(N_k, d) arrays; got a nested sequence of uneven shape"
+        ) from None
     if len(shape) != 3 or shape[2] not in (2, 3) or shape[1] < 1:
         raise InvalidContactError(
             f"{name} must have shape (K, N, 2) or (K, N, 3) with N >= 1, got {shape}"

@@ -494,6 +494,55 @@ OPTION_POOLS = {
 }
 
 
+def _ragged_batch_cases(P, N) -> Iterator[Case]:
+    """Ragged batches (a list of per-grasp arrays) with hostile pieces."""
+    Pr = [P[0], P[1, :2], P[2, :1]]
+    Nr = [N[0], N[1, :2], N[2, :1]]
+    alone = [
+        dg.batch_force_closure(p[None], n[None], mu=0.5).d_star[0]
+        for p, n in zip(Pr, Nr, strict=True)
+    ]
+    yield Case(
+        "batch",
+        "ragged-agrees",
+        lambda: dg.batch_force_closure(Pr, Nr, mu=0.5),
+        "answer",
+        lambda r: bool(np.array_equal(r.d_star, alone)),
+    )
+    hostile = {
+        "ragged-nan": ([Pr[0], np.full((2, 3), NAN), Pr[2]], Nr, 0.5),
+        "ragged-zero-normal": (Pr, [Nr[0], np.zeros((2, 3)), Nr[2]], 0.5),
+        "ragged-empty-grasp": ([Pr[0], np.zeros((0, 3)), Pr[2]], Nr, 0.5),
+        "ragged-mixed-dim": ([Pr[0], Pr[1][:, :2], Pr[2]], Nr, 0.5),
+        "ragged-short-normals": (Pr, Nr[:2], 0.5),
+        "ragged-normals-array": (Pr, N, 0.5),
+        "ragged-mu-rows": (Pr, Nr, [np.ones(3), np.ones(3), np.ones(3)]),
+        "ragged-mu-nan": (Pr, Nr, [0.5, NAN, 0.5]),
+        "ragged-mu-strings": (Pr, Nr, ["a", "b", "c"]),
+        "ragged-strings": ([Pr[0], "abc", Pr[2]], Nr, 0.5),
+        "ragged-nested": ([Pr[0], [[0.0, 1.0], [2.0]], Pr[2]], Nr, 0.5),
+    }
+    for name, (p, n, mu) in hostile.items():
+        yield Case(
+            "batch",
+            name,
+            lambda p=p, n=n, mu=mu: dg.batch_force_closure(p, n, mu=mu),
+            "refuse",
+        )
+        yield Case(
+            "batch",
+            f"{name}-epsilon",
+            lambda p=p, n=n, mu=mu: dg.batch_epsilon_l1(p, n, mu=mu),
+            "refuse",
+        )
+    yield Case(
+        "batch",
+        "uneven-stream",
+        lambda: next(dg.batch.stream_form_closure([[[0.0, 0, 1]], [[1.0, 2]]], N)),
+        "refuse",
+    )
+
+
 def _accepts(fn, option: str) -> bool:
     import inspect
 
@@ -707,6 +756,7 @@ def batch_cases() -> Iterator[Case]:
             lambda v=v: dg.batch_force_closure(P, N, mu=0.5, metrics=v),
             "refuse",
         )
+    yield from _ragged_batch_cases(P, N)
     bad_positions = P.copy()
     bad_positions[2, 1] = [1.5e308, -1.5e308, 0]
     yield Case(

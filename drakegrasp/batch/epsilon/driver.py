@@ -39,6 +39,7 @@ import numpy as np
 
 from drakegrasp.batch.build.construction import batched_characteristic_lengths
 from drakegrasp.batch.metrics import epsilon_l1_batch
+from drakegrasp.batch.ragged import is_ragged, run_groups
 from drakegrasp.batch.run.chunk import force_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
@@ -82,7 +83,8 @@ def batch_epsilon_l1(
     positions, normals, mu, contact_model, num_generators, torsional_friction
         The contacts, as in :func:`~drakegrasp.batch.batch_force_closure`:
         (K, N, 3) or (K, N, 2) points (metres) and inward normals, ``μ`` and
-        ``ν`` as scalars, (K,), (1, N) or (K, N).
+        ``ν`` as scalars, (K,), (1, N) or (K, N); or ragged, as lists of
+        per-grasp arrays.
     reference_points : (d,) or (K, d) float, optional
         Point ``p`` about which moments are taken; default the origin.
     characteristic_lengths : float or (K,) float, optional
@@ -110,6 +112,20 @@ def batch_epsilon_l1(
         \varepsilon = \min_{\text{facets } F \text{ of } P} \operatorname{dist}(0, F),
         \qquad P = \operatorname{conv}\{\operatorname{diag}(I, I/b)\, G_i s_k\}
     """
+    if is_ragged(positions):
+        K, _, parts = run_groups(
+            batch_epsilon_l1, positions, normals,
+            per_contact={"mu": mu, "torsional_friction": torsional_friction},
+            per_grasp={"reference_points": reference_points,
+                       "characteristic_lengths": characteristic_lengths},
+            contact_model=contact_model, num_generators=num_generators,
+            chunk_size=chunk_size, progress=progress, workers=workers, kernel=kernel,
+        )  # fmt: skip
+        out = np.zeros(K)
+        for idx, eps in parts:
+            out[idx] = eps
+        out.flags.writeable = False
+        return out
     task, options = force_task(
         positions, mu, contact_model, num_generators, torsional_friction,
         reference_points, characteristic_lengths, 1e-6, 1e-9, (), kernel,
