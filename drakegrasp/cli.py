@@ -310,6 +310,18 @@ def _cmd_warmup(args: argparse.Namespace) -> int:
     return 0
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line refusals, as every other error of the command.
+
+    argparse prints the whole usage block before its error; a script reading
+    stderr, or a user scanning it, gets one line naming the bad argument and
+    where the help is.  Subcommands' parsers are of this class too.
+    """
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see: {self.prog} --help)\n")
+
+
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
     """The argument parser and its subparsers (other subcommands add themselves).
 
@@ -321,7 +333,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
         ``set_defaults(func=handler)``; the handler takes the parsed namespace
         and returns the exit status.
     """
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="drakegrasp",
         description="Grasp analysis on top of Drake: contacts, grasp matrix, "
         "form and force closure.",

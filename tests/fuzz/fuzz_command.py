@@ -65,8 +65,8 @@ def _judged(out: dict):
     lines = [line for line in text.splitlines() if line.strip()]
     if "Traceback" in text or not lines or not lines[-1].startswith("drakegrasp"):
         raise RuntimeError(f"exit {out['code']} with stderr {text[-300:]!r}")
-    # argparse prints its usage before the one error line; ours prints one line
-    if len(lines) != 1 and not lines[0].startswith("usage:"):
+    # argparse's refusals too are one line (cli._Parser)
+    if len(lines) != 1:
         raise RuntimeError(f"exit {out['code']} with {len(lines)} lines: {text!r}")
     raise dg.InvalidOptionError(lines[-1])
 

@@ -57,6 +57,24 @@ def _one_line_error(proc, code=1):
     return lines[0]
 
 
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        ((), "required: COMMAND"),
+        (("bogus",), "invalid choice: 'bogus'"),
+        (("plan", "--top", "abc"), "argument --top: invalid int value"),
+        (("plan", "--num", "1e9"), "argument --num"),
+        (("analyze", "--tol", "abc"), "argument --tol"),
+        (("batch",), "required: input, output"),
+        (("plan", "--json", "--out", "x.parquet"), "not allowed with argument"),
+    ],
+)
+def test_argument_errors_are_one_line_too(argv, message):
+    line = _one_line_error(_run(*argv), code=2)
+    assert line.startswith("drakegrasp") and message in line, line
+    assert line.endswith("--help)"), line
+
+
 def test_bad_inputs_one_line_each(tmp_path):
     good = _grasps(tmp_path / "good.npz", 5)
     truncated = tmp_path / "truncated.npz"
