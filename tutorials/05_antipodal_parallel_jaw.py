@@ -44,27 +44,6 @@ import drakegrasp as dg
 TEST_MODE = os.environ.get("DRAKEGRASP_TUTORIAL_TEST") == "1"
 np.set_printoptions(precision=4, suppress=True, linewidth=110)
 
-# %%
-from pydrake.geometry import Meshcat, Rgba, Role
-
-
-def draw_scene(meshcat, scene, *, prefix="scene", alpha=None):
-    """Send every illustration shape of ``scene`` to Meshcat at its world pose."""
-    scene_graph = scene.diagram.GetSubsystemByName("scene_graph")
-    query = scene_graph.get_query_output_port().Eval(
-        scene_graph.GetMyContextFromRoot(scene.context)
-    )
-    inspector = query.inspector()
-    for gid in inspector.GetAllGeometryIds(Role.kIllustration):
-        props = inspector.GetIllustrationProperties(gid)
-        rgba = props.GetPropertyOrDefault("phong", "diffuse", Rgba(0.7, 0.7, 0.7))
-        if alpha is not None:
-            rgba = Rgba(rgba.r(), rgba.g(), rgba.b(), alpha)
-        path = f"{prefix}/{gid.get_value()}"
-        meshcat.SetObject(path, inspector.GetShape(gid), rgba)
-        meshcat.SetTransform(path, query.GetPoseInWorld(gid))
-
-
 # %% [markdown]
 # ## The gripper and a tilted box
 #
@@ -224,9 +203,12 @@ print(
 from drakegrasp.visualization import draw_grasp
 
 tilt_box(np.radians(20.0))
+from pydrake.geometry import Meshcat
+
 meshcat = Meshcat()
 print("Meshcat:", meshcat.web_url())
-draw_scene(meshcat, scene, alpha=0.5)
+scene_graph = scene.diagram.GetSubsystemByName("scene_graph")
+dg.draw_scene_geometry(meshcat, scene_graph, scene.context, opacity=0.5)
 soft = read_grasp(0.5).grasp
 result = dg.force_closure_exact(soft)
 print(result)

@@ -3,6 +3,8 @@
 - :func:`draw_grasp` / :func:`clear_grasp`: contacts, contact frames, friction
   cones and contact forces in Drake's Meshcat, framed by the camera
   (:func:`frame_points`).
+- :func:`draw_scene_geometry`: a snapshot of a scene's hand and object in
+  Meshcat, for a diagram built without a ``MeshcatVisualizer``.
 - :func:`draw_candidates` / :func:`plot_score_distribution`: planned grasps as
   ghost hands coloured by score in Meshcat, and their scores' histogram.
 - :func:`plot_planar_grasp`: a planar grasp with its outline, normals, exact
@@ -41,6 +43,7 @@ from drakegrasp.visualization.plots import (
     plot_planar_grasp,
 )
 from drakegrasp.visualization.robot import set_translucent, visualizer_paths
+from drakegrasp.visualization.snapshot import draw_scene_geometry
 from drakegrasp.visualization.view import CameraView, frame_points, grasp_pose
 from drakegrasp.visualization.wrench_space import (
     WrenchHull,
@@ -66,6 +69,7 @@ __all__ = [
     "contact_pose_3d",
     "draw_candidates",
     "draw_grasp",
+    "draw_scene_geometry",
     "exact_cone_mesh",
     "frame_points",
     "grasp_pose",
