@@ -9,7 +9,10 @@ import sys
 import textwrap
 from pathlib import Path
 
-import tomllib
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10: the test extras install tomli
+    import tomli as tomllib
 
 ROOT = Path(__file__).resolve().parents[2]
 
