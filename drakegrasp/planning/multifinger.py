@@ -27,6 +27,7 @@ rejection reason (:data:`REASONS`).
 
 from __future__ import annotations
 
+import time
 from collections import Counter
 from dataclasses import replace
 
@@ -49,7 +50,7 @@ from drakegrasp.planning.approach import (
 from drakegrasp.planning.candidates import GraspCandidate, planning_result
 from drakegrasp.planning.ranking import group_by_count, robustness, verdicts
 from drakegrasp.planning.weight import weight_capacity
-from drakegrasp.plant.closing import close_hand
+from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
 from drakegrasp.plant.fingers import hand_structure
 from drakegrasp.plant.validation import hand_bodies, scoped_name
@@ -156,10 +157,10 @@ class _Placer:
             return None, None, "fingers collide with each other"
         if hit is not None:
             return None, None, f"hand collides with the {hit}"
-        try:
-            closure = close_hand(
-                plant, ctx, self.body, hand=self.spec, distance_tolerance=self.tol,
-                min_fingers=self.min_fingers,
+        try:  # the pre-shape is clear, within the limits and the couplings
+            closure = close_checked_hand(
+                plant, ctx, self.body, s, tol=self.tol,
+                min_fingers=self.min_fingers, t0=time.perf_counter(),
             )  # fmt: skip
         except UnreachableError:
             return None, None, "fingers miss the object"
