@@ -98,6 +98,8 @@ class MultiFingerHand:
     standoff : (2,) float
         ``(s_lo, s_hi)``, metres from the sampled surface point to the palm's
         front face.
+    curl : (n_h,) float or None
+        The curl ``q_c`` (the fingertips drawn together from the pre-shape).
     """
 
     base: RigidBody
@@ -109,6 +111,7 @@ class MultiFingerHand:
     reach: float
     palm_depth: float
     standoff: np.ndarray
+    curl: np.ndarray | None = None
 
     @property
     def num_fingers(self) -> int:
@@ -170,6 +173,20 @@ def _centres(plant, ctx, inspector, H, bodies) -> list[np.ndarray]:
             for g in plant.GetCollisionGeometriesForBody(body)
         )
     return out
+
+
+def _geometric_tip(plant, structure: HandStructure, finger) -> list:
+    """A finger's bodies with collision geometry that the most of its joints move.
+
+    The tip of :mod:`drakegrasp.plant.fingers` without an object to pair with
+    (a point cloud).
+    """
+    joints = [structure.joints[k].index() for k in finger.joints]
+    moved = [set(map(int, plant.GetBodiesKinematicallyAffectedBy([j]))) for j in joints]
+    shaped = [b for b in finger.bodies if plant.GetCollisionGeometriesForBody(b)]
+    depth = {id(b): sum(int(b.index()) in m for m in moved) for b in shaped}
+    deepest = max(depth.values(), default=0)
+    return [b for b in shaped if depth[id(b)] == deepest]
 
 
 def _curl(tips, q0, structure, steps=_CURL_STEPS) -> np.ndarray:
@@ -278,7 +295,9 @@ def multi_finger_hand(
     ctx = plant.CreateDefaultContext()
     H = base.body_frame()
     tip_bodies = [
-        list({id(b): b for _, _, b in f.tip_pairs}.values()) for f in structure.fingers
+        list({id(b): b for _, _, b in f.tip_pairs}.values())
+        or _geometric_tip(plant, structure, f)  # no object geometry (a cloud)
+        for f in structure.fingers
     ]
     if not any(tip_bodies):
         raise ModelError("the hand's fingers have no collision geometry to grasp with")
@@ -337,6 +356,7 @@ def multi_finger_hand(
     if span[0] < 0:
         raise InvalidOptionError(f"standoff must be >= 0 metres, got {standoff!r}")
     return MultiFingerHand(
+        curl=q_curled,
         base=base,
         structure=structure,
         preshape=q0,
