@@ -23,18 +23,17 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    between fingers: Drake's signed distances, as on a body.  With a
    ``viewpoint``, a hand that reaches behind the seen surface (the unseen
    side may hold the object) is rejected, open and closed.
-3. **Closing**: each finger moves from the pre-shape along the straight
-   joint-space path towards the hand's curl, ``q(α) = clip(q_pre + α d)``
-   with ``d`` its part of ``q_curl − q_pre`` scaled to a largest entry of 1
-   (followers of couplings follow), joints stopping at their limits, until its
+3. **Closing**, as :func:`~drakegrasp.close_hand` closes on a body: each
+   finger steps from the pre-shape along the steepest descent of its tip's
+   distance to the cloud, ``d = −∂ψ_tip/∂q`` (re-aimed after every step,
+   blocked joints dropped, followers of couplings following), until its
    distance ``ψ_f`` to the cloud (the smallest signed distance of a cloud
    point to one of its geometries) is within the tolerance.  Each step is
    bounded by conservative advancement (:mod:`drakegrasp.plant.advancement`:
    ``α <= (ψ_g − tol/2) / V_g`` over every finger geometry ``g``), so no step
-   carries a finger through a cloud point.  A finger that reaches the end of
-   its path, or takes :data:`~drakegrasp.plant.closing.DEFAULT_MAX_ITERATIONS`
-   steps, misses and goes back to its pre-shape (it would only cross the
-   others).
+   carries a finger through a cloud point.  A finger that reaches its limits,
+   or takes :data:`~drakegrasp.plant.closing.DEFAULT_MAX_ITERATIONS` steps,
+   misses and goes back to its pre-shape (it would only cross the others).
 4. **Contacts** are the cloud points each touching geometry reaches within
    :data:`~drakegrasp.planning.cloud.CONTACT_BAND` of its first, with the
    cloud's normals: the nearest for a sphere (a fingertip), the corners of
@@ -48,8 +47,10 @@ from __future__ import annotations
 
 import numpy as np
 from pydrake.geometry import Box, Capsule, Cylinder, Sphere
+from pydrake.multibody.tree import JacobianWrtVariable
 from scipy.spatial import cKDTree
 
+from drakegrasp.planning.approach import _geometric_tip
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
     SHADOW_PROBES,
@@ -77,9 +78,13 @@ REASONS = {
 }
 """Every rejection reason of the multi-finger cloud route, with what it means."""
 
-_EXACT_WITHIN = 0.02
-"""A geometry farther (m, by its bounding sphere) from the cloud gets a lower
-bound of its distance instead of the exact one: enough for a step's bound."""
+_FD = 1e-7
+"""Step (m) of the central differences of a signed distance's gradient."""
+
+_EXACT_WITHIN = 5e-3
+"""Distances (m) of finger geometries are exact below this, lower bounds
+above it (enough to bound a closing step), so only the cloud points near a
+geometry are measured."""
 
 
 def signed_distances(shape, q_G: np.ndarray) -> np.ndarray | None:
@@ -126,8 +131,11 @@ class _Geometry:
         self.id, self.body = gid, body
         self.shape = inspector.GetShape(gid)
         self.X_BG = inspector.GetPoseInFrame(gid)
+        self.R_BG = self.X_BG.rotation().matrix()
+        self.p_BG = self.X_BG.translation()
         centre, self.radius = bounding_sphere(self.shape)
         self.centre_G = np.asarray(centre, float)
+        self.centre_B = self.R_BG @ self.centre_G + self.p_BG
         self.is_sphere = isinstance(self.shape, Sphere)
         piece = piece_of_shape(self.shape, self.X_BG, inspector.GetName(gid))
         self.probes_G = piece.sample(SHADOW_PROBES, rng)[0] if piece.area > 0 else None
@@ -186,6 +194,17 @@ class CloudHand:
             geometry_reach(plant, ctx, s, [(g.id, g.body) for g in geoms], inspector)
             for geoms in self.fingers
         ]
+        tips = [
+            {int(b.index()) for b in _geometric_tip(plant, s, f)} for f in s.fingers
+        ]
+        self.tips = [
+            [k for k, g in enumerate(geoms) if int(g.body.index()) in tip]
+            or list(range(len(geoms)))
+            for geoms, tip in zip(self.fingers, tips, strict=True)
+        ]
+        self.mask = [
+            np.isin(np.arange(len(s.names)), list(f.joints)) for f in s.fingers
+        ]
         self.label = {}
         for f, finger in enumerate(s.fingers):
             for b in finger.bodies:
@@ -194,24 +213,85 @@ class CloudHand:
     # -- distances -------------------------------------------------------------
 
     def _pose(self, g: _Geometry):
-        X_WG = self.plant.EvalBodyPoseInWorld(self.ctx, g.body) @ g.X_BG
-        return X_WG.rotation().matrix(), X_WG.translation()
+        X_WB = self.plant.EvalBodyPoseInWorld(self.ctx, g.body)
+        R_WB = X_WB.rotation().matrix()
+        return R_WB @ g.R_BG, R_WB @ g.p_BG + X_WB.translation()
 
-    def distance(self, g: _Geometry, exact_within=_EXACT_WITHIN):
-        """(ψ_g, cloud indices near g, their signed distances) at the context.
+    def distance(self, g: _Geometry, within=_EXACT_WITHIN):
+        """(ψ_g, its witness, cloud indices near g, their signed distances).
 
-        ``ψ_g`` is exact when the bounding sphere lies within ``exact_within``
-        of the cloud, else a lower bound (and no points).
+        ``ψ_g`` (m) is exact when it is below ``within``, else a lower bound
+        (at least ``within``).  Only the points within ``r + within`` of the
+        bounding sphere's centre ``c`` (radius ``r``) are measured: any other
+        point ``x`` has ``ψ(x) >= |x − c| − r``.  The witness is the index of
+        the nearest measured point (of the point nearest ``c`` when none is).
         """
+        psi, witness, near = self.distances([g], within)
+        idx, sd = near[0]
+        return psi[0], witness[0], idx, sd
+
+    def distances(self, geoms, within=_EXACT_WITHIN):
+        """:meth:`distance` of several geometries: ψ (G,), witnesses, near points."""
+        poses = {}
+        for g in geoms:
+            if id(g.body) not in poses:
+                X_WB = self.plant.EvalBodyPoseInWorld(self.ctx, g.body)
+                poses[id(g.body)] = (X_WB.rotation().matrix(), X_WB.translation())
+        centres = np.array(
+            [poses[id(g.body)][0] @ g.centre_B + poses[id(g.body)][1] for g in geoms]
+        )
+        d0, i0 = self.tree.query(centres)
+        psi = d0 - np.array([g.radius for g in geoms])
+        witness = [int(i) for i in i0]
+        near = [(None, None)] * len(geoms)
+        for k in np.flatnonzero(psi < within):
+            g = geoms[k]
+            R_WB, p_WB = poses[id(g.body)]
+            idx = self.tree.query_ball_point(centres[k], g.radius + within)
+            idx = np.asarray(idx, dtype=int)
+            sd = self._signed(
+                g, R_WB @ g.R_BG, R_WB @ g.p_BG + p_WB, self.points_W[idx]
+            )
+            j = int(np.argmin(sd))
+            psi[k], witness[k], near[k] = min(sd[j], within), int(idx[j]), (idx, sd)
+        return psi, witness, near
+
+    def _descent(self, f: int, psi, witness, q) -> np.ndarray:
+        """Steepest descent of finger ``f``'s tip distance to the cloud.
+
+        ``d = −∂ψ_tip/∂q = n̂ᵀ J`` at the tip geometry's closest point ``y`` to
+        its witness ``x`` (``n̂`` the signed distance's gradient at ``x``, by
+        central differences of the closed form, and ``y = x − ψ(x) n̂``), over
+        the finger's joints (a follower's part pulled back to its leader),
+        zero on joints blocked by a limit, scaled to a largest entry of 1.
+        """
+        s, plant, ctx = self.hand.structure, self.plant, self.ctx
+        k = min(self.tips[f], key=lambda j: psi[j])
+        g = self.fingers[f][k]
         R, p = self._pose(g)
-        c = R @ g.centre_G + p
-        d0 = float(self.tree.query(c)[0])
-        if d0 - g.radius > exact_within:
-            return d0 - g.radius, None, None
-        # every point nearer to g than the one nearest c lies within d0 + 2r of c
-        idx = np.asarray(self.tree.query_ball_point(c, d0 + 2 * g.radius), dtype=int)
-        sd = self._signed(g, R, p, self.points_W[idx])
-        return float(sd.min()), idx, sd
+        x_W = self.points_W[witness[k]]
+        probe = np.vstack([np.zeros(3), _FD * np.eye(3), -_FD * np.eye(3)])
+        sd = self._signed(g, R, p, x_W + probe @ R.T)
+        grad = (sd[1:4] - sd[4:7]) / (2 * _FD)
+        norm = np.linalg.norm(grad)
+        if not norm > 0:
+            return np.zeros_like(q)
+        n_G = grad / norm
+        y_W = x_W - sd[0] * (R @ n_G)
+        p_BY = plant.EvalBodyPoseInWorld(ctx, g.body).inverse().multiply(y_W)
+        J = plant.CalcJacobianTranslationalVelocity(
+            ctx, JacobianWrtVariable.kV, g.body.body_frame(), p_BY,
+            plant.world_frame(), plant.world_frame(),
+        )  # fmt: skip
+        d = s.coupling.pull_back((R @ n_G) @ J[:, s.velocity_indices])
+        d = np.where(self.mask[f], d, 0.0)
+        blocked = ((d > 0) & (q >= s.upper)) | ((d < 0) & (q <= s.lower))
+        d = np.where(blocked, 0.0, d)
+        scale = np.max(np.abs(d), initial=0.0)
+        if scale <= 1e-12:
+            return np.zeros_like(q)
+        d = d / scale
+        return np.where(np.abs(d) < 1e-9, 0.0, d)
 
     def _signed(self, g: _Geometry, R, p, points_W) -> np.ndarray:
         sd = signed_distances(g.shape, (points_W - p) @ R)
@@ -231,11 +311,8 @@ class CloudHand:
 
     def collides(self) -> bool:
         """Whether a cloud point lies deeper than ``tol`` inside a hand geometry."""
-        for g in (*self.palm, *(g for f in self.fingers for g in f)):
-            psi = self.distance(g, exact_within=self.tol)[0]
-            if psi < -self.tol:
-                return True
-        return False
+        every = [*self.palm, *(g for f in self.fingers for g in f)]
+        return bool(np.any(self.distances(every, 2 * self.tol)[0] < -self.tol))
 
     def in_shadow(self) -> bool:
         """Whether the hand reaches behind a one-sided cloud's seen surface.
@@ -297,17 +374,8 @@ class CloudHand:
         lower, upper, target = s.lower, s.upper, 0.5 * self.tol
         q_all = self.plant.GetPositions(self.ctx)
         q = q_pre.copy()
-        towards = s.coupling.project(self.hand.curl - q_pre)
         F = len(s.fingers)
-        dirs, status = [], [""] * F
-        for f, finger in enumerate(s.fingers):
-            d = np.zeros_like(q)
-            mine = list(finger.joints)
-            d[mine] = towards[mine]
-            scale = np.max(np.abs(d), initial=0.0)
-            dirs.append(d / scale if scale > 1e-12 else d)
-            if scale <= 1e-12 or not self.fingers[f]:
-                status[f] = "fixed"
+        status = ["" if self.fingers[f] else "fixed" for f in range(F)]
         for _ in range(DEFAULT_MAX_ITERATIONS):
             if all(status):
                 break
@@ -315,12 +383,11 @@ class CloudHand:
             for f, finger in enumerate(s.fingers):
                 if status[f]:
                     continue
-                psi = np.array([self.distance(g)[0] for g in self.fingers[f]])
+                psi, witness, _ = self.distances(self.fingers[f])
                 if psi.min() <= self.tol:
                     status[f] = "touching"
                     continue
-                d = dirs[f]
-                d = np.where(((d > 0) & (q >= upper)) | ((d < 0) & (q <= lower)), 0, d)
+                d = self._descent(f, psi, witness, q)
                 with np.errstate(divide="ignore", invalid="ignore"):
                     t = np.where(d > 0, (upper - q) / d, (lower - q) / d)
                 t = np.where(d != 0, np.where(np.isfinite(t), t, 1e3), 0.0)
@@ -335,12 +402,11 @@ class CloudHand:
                     initial=np.inf,
                 )
                 alpha = min(float(alpha), finger.max_step, alpha_end)
-                mine = list(finger.joints)
-                q[mine] = np.clip(q + alpha * d, lower, upper)[mine]
+                q = np.where(self.mask[f], np.clip(q + alpha * d, lower, upper), q)
         touching = [f for f in range(F) if status[f] == "touching"]
-        for f, finger in enumerate(s.fingers):  # a finger that misses stays open
+        for f in range(F):  # a finger that misses stays open
             if f not in touching:
-                q[list(finger.joints)] = q_pre[list(finger.joints)]
+                q = np.where(self.mask[f], q_pre, q)
         self._set(q_all, q)
         return q, touching
 
@@ -350,7 +416,7 @@ class CloudHand:
         groups = [self.fingers[f] for f in touching] + [self.palm]
         for geoms in groups:
             for g in geoms:
-                psi, idx, sd = self.distance(g, exact_within=self.tol)
+                psi, _, idx, sd = self.distance(g, within=self.tol + CONTACT_BAND)
                 if idx is None or psi > self.tol:
                     continue
                 near = sd <= psi + CONTACT_BAND
