@@ -7,6 +7,7 @@ one kinematics update per step, each step bounded by conservative advancement
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -159,11 +160,25 @@ def closest(query, plant, context, pairs):
 
 
 def _path_end(q, d, lower, upper) -> float:
-    """Largest α at which a joint with d != 0 still moves (capped at 1e3)."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        t = np.where(d > 0, (upper - q) / d, np.where(d < 0, (lower - q) / d, 0.0))
-    t = np.where(np.isfinite(t), t, 1e3)
-    return float(max(np.max(t, initial=0.0), 0.0))
+    """Largest α at which a joint with d != 0 still moves (capped at 1e3).
+
+    Python floats over the few joints of a hand (IEEE arithmetic, as numpy's):
+    called once per step of every finger.
+    """
+    best = 0.0
+    rows = zip(q.tolist(), d.tolist(), lower.tolist(), upper.tolist(), strict=True)
+    for qj, dj, lo, hi in rows:
+        if dj > 0:
+            t = (hi - qj) / dj  # inf on overflow, as numpy
+        elif dj < 0:
+            t = (lo - qj) / dj
+        else:
+            continue
+        if not math.isfinite(t):
+            t = 1e3
+        if t > best:
+            best = t
+    return best
 
 
 class Search:
