@@ -138,8 +138,7 @@ def reach(
         old_version, rows = kept[key]
         if old_version.IsSameAs(version, Role.kProximity):
             return rows.copy()
-    geometries = [(gf, body) for _, gf, body in finger.pairs]
-    rows, reads_context = _reach(plant, plant_context, hand, geometries, inspector)
+    rows, reads_context = _reach(plant, plant_context, hand, finger, inspector)
     if plant.is_finalized() and not reads_context:
         # A copy: the inspector's version is a live reference that changes
         # with the context it came from.
@@ -159,10 +158,16 @@ def geometry_reach(
     For a finger that closes on something other than a body's geometry (a
     point cloud): every collision geometry ``gf`` of the finger's ``body``.
     """
-    return _reach(plant, plant_context, hand, list(geometries), inspector)[0]
+    return _reach_rows(plant, plant_context, hand, list(geometries), inspector)[0]
 
 
-def _reach(plant, plant_context, hand, geometries, inspector):
+def _reach(plant, plant_context, hand, finger, inspector):
+    """:func:`reach`, and whether it read the context."""
+    geometries = [(gf, body) for _, gf, body in finger.pairs]
+    return _reach_rows(plant, plant_context, hand, geometries, inspector)
+
+
+def _reach_rows(plant, plant_context, hand, geometries, inspector):
     """:func:`reach` of ``(gf, body)`` rows, and whether it read the context."""
     inboard = _inboard_joints(plant)
     column = {int(j.index()): k for k, j in enumerate(hand.joints)}
