@@ -23,6 +23,10 @@ rejection reason (:data:`REASONS`).
    that moves each finger's contacts rigidly (the palm's stay), the weight
    capacity with one squeeze bound per finger and one for the palm
    (:mod:`drakegrasp.planning.weight`), ``score = robustness × capacity``.
+
+On a point cloud (:func:`plan_multifinger_cloud`), stages 2 and 3 are those
+of :mod:`drakegrasp.planning.cloud_hand` (the hand against the cloud's points,
+the fingers closed onto them); stages 1 and 4 are the same.
 """
 
 from __future__ import annotations
