@@ -189,6 +189,13 @@ class Search:
         self.tol, self.target = tol, 0.5 * tol
         self.user_d, self.max_iterations = user_d, max_it
         self._tips: dict[int, np.ndarray | None] = {}  # id(finger) -> tip rows
+        self._joints = {}  # id(finger) -> its joints' positions in q
+        self._mine = {}  # id(finger) -> (n_h,) bool, its joints
+        for f in hand.fingers:
+            self._joints[id(f)] = np.array(f.joints, dtype=int)
+            mine = np.zeros(len(hand.lower), dtype=bool)
+            mine[list(f.joints)] = True
+            self._mine[id(f)] = mine
 
     def run(self, states: list[FingerState], q_all: np.ndarray, q0: np.ndarray) -> int:
         """Step until every finger has a status; the number of steps."""
@@ -196,7 +203,8 @@ class Search:
         while not all(st.status for st in states):
             q = q0.copy()
             for st in states:
-                q[list(st.finger.joints)] = st.q_trial[list(st.finger.joints)]
+                j = self._joints[id(st.finger)]
+                q[j] = st.q_trial[j]
             q_all[hand.position_indices] = hand.coupling.apply(q)
             self.plant.SetPositions(self.context, q_all)
             query = self.plant.get_geometry_query_input_port().Eval(self.context)
@@ -322,8 +330,7 @@ class Search:
         them (the tip's are among them).
         """
         hand, finger = self.hand, st.finger
-        mine = np.zeros(len(hand.lower), dtype=bool)
-        mine[list(finger.joints)] = True
+        mine = self._mine[id(finger)]
         if self.user_d is not None:
             d = np.where(mine, self.user_d, 0.0)
         else:  # steepest descent of the fingertip's distance, here
