@@ -60,9 +60,9 @@ MAX_STEP = {"revolute": 0.2, "prismatic": 0.01}
 _KEPT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 """Finalized plant -> {(object, bodies, couplings): (proximity version, recipe)}.
 
-A recipe holds indices, names, geometry ids and numbers only, never a body or
-a joint (that would keep the plant alive); :func:`_rebuild` turns it back into
-a :class:`HandStructure`."""
+A recipe holds indices, names, geometry id values and numbers only, never a
+body, a joint or a ``GeometryId`` (each would keep the plant alive);
+:func:`_rebuild` turns it back into a :class:`HandStructure`."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -377,7 +377,7 @@ def hand_structure(
         if kept is not None and key in kept:
             old_version, recipe = kept[key]
             if old_version.IsSameAs(version, Role.kProximity):
-                return _rebuild(plant, recipe)
+                return _rebuild(plant, key[0], recipe)
     structure = _build(plant, object_body, bodies, couplings, inspector)
     if key is not None:
         # A copy: the inspector's version is a live reference that changes
@@ -402,7 +402,10 @@ def _recipe(s: HandStructure) -> tuple:
             f.name,
             f.joints,
             tuple(int(b.index()) for b in f.bodies),
-            tuple((go, gf, int(b.index())) for go, gf, b in f.pairs),
+            tuple(
+                (go.get_value(), gf.get_value(), int(b.index()))
+                for go, gf, b in f.pairs
+            ),
             tuple(k for k, p in enumerate(f.pairs) if any(p is t for t in f.tip_pairs)),
             f.max_step,
         )
@@ -418,25 +421,29 @@ def _recipe(s: HandStructure) -> tuple:
     )
 
 
-def _rebuild(plant, recipe) -> HandStructure:
+def _rebuild(plant, object_index: int, recipe) -> HandStructure:
     """The :class:`HandStructure` of a recipe, its limits read afresh."""
     joint_ids, names, position, velocity, follows, fingers = recipe
     joints = tuple(plant.get_joint(JointIndex(i)) for i in joint_ids)
-    body = {}
+    body, geometry = {}, {}
 
     def get(i):
         if i not in body:
             body[i] = plant.get_body(BodyIndex(i))
+            for g in plant.GetCollisionGeometriesForBody(body[i]):
+                geometry[g.get_value()] = g
         return body[i]
 
+    get(object_index)
     built = []
     for name, members, body_ids, pairs, tips, max_step in fingers:
-        pairs = tuple((go, gf, get(b)) for go, gf, b in pairs)
+        bodies = tuple(get(b) for b in body_ids)  # and their geometries
+        pairs = tuple((geometry[go], geometry[gf], get(b)) for go, gf, b in pairs)
         built.append(
             Finger(
                 name=name,
                 joints=members,
-                bodies=tuple(get(b) for b in body_ids),
+                bodies=bodies,
                 pairs=pairs,
                 tip_pairs=tuple(pairs[k] for k in tips),
                 max_step=max_step,
