@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pydrake.geometry import Box, Capsule, Cylinder, Sphere
 from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.parsing import Parser
@@ -226,6 +228,20 @@ def test_hostile_clouds(can):
     assert set(result.rejections) <= set(REASONS)
 
 
+def _drake_point_distances(shape, X, p_W):
+    """Drake's ComputeSignedDistanceToPoint of points to one posed shape."""
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    plant.RegisterCollisionGeometry(
+        plant.world_body(), X, shape, "g", CoulombFriction(1.0, 1.0)
+    )
+    plant.Finalize()
+    diagram = builder.Build()
+    ctx = plant.GetMyContextFromRoot(diagram.CreateDefaultContext())
+    query = plant.get_geometry_query_input_port().Eval(ctx)
+    return [query.ComputeSignedDistanceToPoint(p, np.inf)[0].distance for p in p_W]
+
+
 @pytest.mark.parametrize(
     "shape, inside, outside",
     [
@@ -237,23 +253,38 @@ def test_hostile_clouds(can):
 )
 def test_closed_form_distances_match_drakes(shape, inside, outside):
     """The planner's signed distances equal Drake's ComputeSignedDistanceToPoint."""
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     X = RigidTransform(RollPitchYaw(0.2, 0.4, -0.3), [0.1, -0.05, 0.2])
-    plant.RegisterCollisionGeometry(
-        plant.world_body(), X, shape, "g", CoulombFriction(1.0, 1.0)
-    )
-    plant.Finalize()
-    diagram = builder.Build()
-    ctx = plant.GetMyContextFromRoot(diagram.CreateDefaultContext())
-    query = plant.get_geometry_query_input_port().Eval(ctx)
     rng = np.random.default_rng(0)
     q_G = np.vstack([inside, outside, rng.uniform(-0.06, 0.06, (200, 3))])
     ours = signed_distances(shape, q_G)
     p_W = q_G @ X.rotation().matrix().T + X.translation()
-    theirs = [query.ComputeSignedDistanceToPoint(p, np.inf)[0].distance for p in p_W]
-    np.testing.assert_allclose(ours, theirs, atol=1e-12)
+    np.testing.assert_allclose(ours, _drake_point_distances(shape, X, p_W), atol=1e-12)
     assert ours[0] < 0 < ours[1]
+
+
+@settings(derandomize=True, max_examples=25, deadline=None)
+@given(
+    kind=st.sampled_from(["sphere", "box", "cylinder", "capsule"]),
+    size=st.tuples(*[st.floats(0.002, 0.08)] * 3),
+    rpy=st.tuples(*[st.floats(-3.0, 3.0)] * 3),
+    seed=st.integers(0, 2**16),
+)
+def test_closed_form_distances_match_drakes_for_any_shape_and_pose(
+    kind, size, rpy, seed
+):
+    a, b, c = size
+    shape = {
+        "sphere": lambda: Sphere(a),
+        "box": lambda: Box(a, b, c),
+        "cylinder": lambda: Cylinder(a, b),
+        "capsule": lambda: Capsule(a, b),
+    }[kind]()
+    X = RigidTransform(RollPitchYaw(*rpy), [0.3, -0.1, 0.05])
+    q_G = np.random.default_rng(seed).uniform(-0.1, 0.1, (60, 3))
+    p_W = q_G @ X.rotation().matrix().T + X.translation()
+    np.testing.assert_allclose(
+        signed_distances(shape, q_G), _drake_point_distances(shape, X, p_W), atol=1e-12
+    )
 
 
 def _coupled_hand_sdf() -> str:
