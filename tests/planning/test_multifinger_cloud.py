@@ -352,3 +352,35 @@ def test_a_cloud_the_coupled_hand_cannot_reach_is_an_empty_result(coupled):
     result = _plan_coupled(coupled, 0.25 * u, u, n=15, standoff=(0.2, 0.3))
     assert len(result) == 0 and "rejected" in result.reason
     assert result.rejections == {"fingers miss the object": 15}
+
+
+def test_a_table_under_the_cloud_is_an_obstacle(coupled):
+    """The plant's other geometry (a table the cylinder stands on) is checked
+    with Drake's distances: no candidate's hand goes into it."""
+    _, _, _, p, nrm, _ = coupled
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    parser = Parser(plant)
+    register_models(parser)
+    (hand,) = add_models(parser, text=_coupled_hand_sdf(), kind="sdf")
+    top = p[:, 2].min()  # the cylinder's bottom cap
+    plant.RegisterCollisionGeometry(
+        plant.world_body(), RigidTransform([0.0, 0.0, top - 0.01]),
+        Box(1.0, 1.0, 0.02), "table", CoulombFriction(1.0, 1.0),
+    )  # fmt: skip
+    plant.Finalize()
+    root = builder.Build().CreateDefaultContext()
+    result = _plan_coupled((plant, root, hand), p, nrm, n=40)
+    assert len(result) + sum(result.rejections.values()) == 40
+    assert result.rejections.get("hand collides with the scene", 0) > 0
+    assert len(result) > 0
+    table = plant.GetCollisionGeometriesForBody(plant.world_body())
+    for c in result:
+        ctx = root.Clone()
+        c.apply(plant, ctx)
+        query = plant.get_geometry_query_input_port().Eval(
+            plant.GetMyContextFromRoot(ctx)
+        )
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.0):
+            if pair.id_A in table or pair.id_B in table:
+                assert pair.distance >= -TOL - 1e-9
