@@ -32,8 +32,11 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    bounded by conservative advancement (:mod:`drakegrasp.plant.advancement`:
    ``α <= (ψ_g − tol/2) / V_g`` over every finger geometry ``g``), so no step
    carries a finger through a cloud point.  A finger that reaches its limits,
-   or takes :data:`~drakegrasp.plant.closing.DEFAULT_MAX_ITERATIONS` steps,
-   misses and goes back to its pre-shape (it would only cross the others).
+   circles a point where its distance stopped shrinking far from the cloud
+   (:func:`~drakegrasp.plant._closing_steps.stalled`, as ``close_hand``
+   stops it), or takes
+   :data:`~drakegrasp.plant.closing.DEFAULT_MAX_ITERATIONS` steps, misses and
+   goes back to its pre-shape (it would only cross the others).
 4. **Contacts** are the cloud points each touching geometry reaches within
    :data:`~drakegrasp.planning.cloud.CONTACT_BAND` of its first, with the
    cloud's normals: the nearest for a sphere (a fingertip), the corners of
@@ -44,6 +47,8 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
 """
 
 from __future__ import annotations
+
+from types import SimpleNamespace
 
 import numpy as np
 from pydrake.geometry import Box, Capsule, Cylinder, Sphere
@@ -59,6 +64,7 @@ from drakegrasp.planning.cloud import (
     _hull_corners,
 )
 from drakegrasp.planning.surface import piece_of_shape
+from drakegrasp.plant._closing_steps import stalled
 from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.advancement import geometry_reach
 from drakegrasp.plant.closing import DEFAULT_MAX_ITERATIONS
@@ -376,6 +382,7 @@ class CloudHand:
         q = q_pre.copy()
         F = len(s.fingers)
         status = ["" if self.fingers[f] else "fixed" for f in range(F)]
+        watch = [SimpleNamespace(trail=[], best=np.inf, since_best=0) for _ in range(F)]
         for _ in range(DEFAULT_MAX_ITERATIONS):
             if all(status):
                 break
@@ -386,6 +393,9 @@ class CloudHand:
                 psi, witness, _ = self.distances(self.fingers[f])
                 if psi.min() <= self.tol:
                     status[f] = "touching"
+                    continue
+                if stalled(watch[f], q.copy(), float(psi.min()), target, self.tol):
+                    status[f] = "not converged"  # it circles, far from the cloud
                     continue
                 d = self._descent(f, psi, witness, q)
                 with np.errstate(divide="ignore", invalid="ignore"):

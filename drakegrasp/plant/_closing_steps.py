@@ -159,6 +159,28 @@ def closest(query, plant, context, pairs):
     return (*witness(query, plant, context, pairs[k], results[k]), every)
 
 
+def stalled(st, q, psi: float, target: float, tol: float) -> bool:
+    """Whether a finger circles a point where its distance stopped shrinking.
+
+    The test of :meth:`Search._stalled` for a finger accepted at ``q`` with
+    distance ``psi``; ``st`` holds its ``trail`` (list), ``best`` (start
+    inf) and ``since_best`` (start 0), and is updated.  ``target`` is the
+    closing's target distance, ``tol`` the contact tolerance (metres).
+    """
+    st.trail = [*st.trail[-STALL_STEPS:], q]
+    first = st.best == np.inf
+    if first or psi < st.best - STALL_PROGRESS * (st.best - target):
+        st.best, st.since_best = psi, 0
+        return False
+    st.since_best += 1
+    if st.since_best < STALL_STEPS or psi <= STALL_DISTANCE * tol:
+        return False
+    trail = np.array(st.trail)
+    path = np.sum(np.max(np.abs(np.diff(trail, axis=0)), axis=1))
+    net = np.max(np.abs(trail[-1] - trail[0]))
+    return bool(net < STALL_WANDER * path)
+
+
 def _path_end(q, d, lower, upper) -> float:
     """Largest α at which a joint with d != 0 still moves (capped at 1e3).
 
@@ -281,18 +303,7 @@ class Search:
         (a fixed direction, or a curl past a thin obstacle that bounds its
         steps) or converges onto the object is never stopped.
         """
-        st.trail = [*st.trail[-STALL_STEPS:], st.q_good]
-        first = st.best == np.inf
-        if first or psi < st.best - STALL_PROGRESS * (st.best - self.target):
-            st.best, st.since_best = psi, 0
-            return False
-        st.since_best += 1
-        if st.since_best < STALL_STEPS or psi <= STALL_DISTANCE * self.tol:
-            return False
-        trail = np.array(st.trail)
-        path = np.sum(np.max(np.abs(np.diff(trail, axis=0)), axis=1))
-        net = np.max(np.abs(trail[-1] - trail[0]))
-        return bool(net < STALL_WANDER * path)
+        return stalled(st, st.q_good, psi, self.target, self.tol)
 
     def _tip_rows(self, finger) -> np.ndarray | None:
         """Rows of ``finger.pairs`` that are its ``tip_pairs``, in order.
