@@ -33,8 +33,7 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    ``α <= (ψ_g − tol/2) / V_g`` over every finger geometry ``g``), so no step
    carries a finger through a cloud point.  A finger that reaches its limits,
    circles a point where its distance stopped shrinking far from the cloud
-   (:func:`~drakegrasp.plant._closing_steps.stalled`, as ``close_hand``
-   stops it), or takes
+   (the stall test ``close_hand`` applies), or takes
    :data:`~drakegrasp.plant.closing.DEFAULT_MAX_ITERATIONS` steps, misses and
    goes back to its pre-shape (it would only cross the others).
 4. **Contacts** are the cloud points each touching geometry reaches within

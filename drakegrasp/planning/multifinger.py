@@ -68,6 +68,7 @@ __all__ = [
     "hand_is_parallel_jaw",
     "is_parallel_jaw",
     "plan_multifinger",
+    "plan_multifinger_cloud",
     "rank_multifinger",
 ]
 
