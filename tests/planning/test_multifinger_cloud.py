@@ -21,7 +21,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
 from pydrake.systems.framework import DiagramBuilder
 
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning import object_surface, plan_grasps, planning_scene
 from drakegrasp.planning.cloud_hand import REASONS, signed_distances
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
@@ -384,3 +384,37 @@ def test_a_table_under_the_cloud_is_an_obstacle(coupled):
         for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.0):
             if pair.id_A in table or pair.id_B in table:
                 assert pair.distance >= -TOL - 1e-9
+
+
+def test_a_hand_without_fingers_is_refused_on_a_cloud(tmp_path, coupled):
+    _, _, _, p, nrm, _ = coupled
+    paddle = tmp_path / "paddle.sdf"
+    paddle.write_text(
+        '<?xml version="1.0"?><sdf version="1.9"><model name="paddle">'
+        "<link name='palm'><collision name='c'><geometry><box>"
+        "<size>0.05 0.05 0.05</size></box></geometry></collision></link>"
+        "</model></sdf>"
+    )
+    scene = planning_scene(None, hand_url=str(paddle))
+    with pytest.raises(ModelError, match="one-dof joint"):
+        _plan(scene, p, nrm, n=5)
+
+
+@pytest.mark.parametrize(
+    "bad, match",
+    [
+        ({"min_fingers": 1}, "min_fingers"),
+        ({"min_fingers": 4}, "min_fingers"),
+        ({"tilt": 2.0}, "tilt"),
+        ({"preshape": [0.0] * 4}, "preshape"),
+        ({"num_candidates": -1}, "num_candidates"),
+    ],
+)
+def test_bad_options_on_a_cloud(coupled, bad, match):
+    plant, root, hand, p, nrm, _ = coupled
+    kw = {"num_candidates": 5, "preshape": [-0.5] * 6, **bad}
+    with pytest.raises(InvalidOptionError, match=match):
+        plan_grasps(
+            plant, root, None, hand=hand, mu=MU, point_cloud=p, cloud_normals=nrm,
+            **kw,
+        )  # fmt: skip
