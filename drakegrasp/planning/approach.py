@@ -98,8 +98,6 @@ class MultiFingerHand:
     standoff : (2,) float
         ``(s_lo, s_hi)``, metres from the sampled surface point to the palm's
         front face.
-    curl : (n_h,) float or None
-        The curl ``q_c`` (the fingertips drawn together from the pre-shape).
     """
 
     base: RigidBody
@@ -111,7 +109,6 @@ class MultiFingerHand:
     reach: float
     palm_depth: float
     standoff: np.ndarray
-    curl: np.ndarray | None = None
 
     @property
     def num_fingers(self) -> int:
@@ -356,7 +353,6 @@ def multi_finger_hand(
     if span[0] < 0:
         raise InvalidOptionError(f"standoff must be >= 0 metres, got {standoff!r}")
     return MultiFingerHand(
-        curl=q_curled,
         base=base,
         structure=structure,
         preshape=q0,
