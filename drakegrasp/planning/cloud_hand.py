@@ -28,7 +28,8 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    distance to the cloud, ``d = −∂ψ_tip/∂q`` (re-aimed after every step,
    blocked joints dropped, followers of couplings following), until its
    distance ``ψ_f`` to the cloud (the smallest signed distance of a cloud
-   point to one of its geometries) is within the tolerance.  Each step is
+   point to one of its geometries) is within the tolerance of
+   :data:`GAP_SPACINGS` cloud spacings.  Each step is
    bounded by conservative advancement (:mod:`drakegrasp.plant.advancement`:
    ``α <= (ψ_g − tol/2) / V_g`` over every finger geometry ``g``), so no step
    carries a finger through a cloud point.  A finger that reaches its limits,
@@ -69,7 +70,7 @@ from drakegrasp.plant.advancement import geometry_reach
 from drakegrasp.plant.closing import DEFAULT_MAX_ITERATIONS
 from drakegrasp.plant.validation import scoped_name
 
-__all__ = ["REASONS", "CloudHand", "signed_distances"]
+__all__ = ["GAP_SPACINGS", "REASONS", "CloudHand", "signed_distances"]
 
 REASONS = {
     "hand collides with the cloud": "a cloud point lies inside the pre-shaped hand",
@@ -82,6 +83,13 @@ REASONS = {
     "penetrate each other, in the pre-shape or after closing",
 }
 """Every rejection reason of the multi-finger cloud route, with what it means."""
+
+GAP_SPACINGS = 0.5
+"""Fingers stop this many cloud spacings (median nearest-neighbour distance)
+short of the nearest cloud point: between sampled points a finger sinks into
+the surface the cloud samples (on 3,000 points of the YCB soup can, 1.4 mm
+apart, the best candidates' fingers went up to 1.5 mm into the true can when
+they stopped at the points; 0.8 mm at half a spacing)."""
 
 _FD = 1e-7
 """Step (m) of the central differences of a signed distance's gradient."""
@@ -163,6 +171,7 @@ class CloudHand:
     def __init__(self, plant, ctx, hand, surface: CloudSurface, tol, min_fingers):
         self.plant, self.ctx, self.hand, self.surface = plant, ctx, hand, surface
         self.tol, self.min_fingers = tol, int(min_fingers)
+        self.margin = GAP_SPACINGS * surface.spacing
         self.points_W = surface.points + surface.centroid
         self.tree = cKDTree(self.points_W)
         self.port = plant.get_geometry_query_input_port()
@@ -376,7 +385,8 @@ class CloudHand:
     def close(self, q_pre):
         """Close every finger onto the cloud: (q, touching finger indices)."""
         s = self.hand.structure
-        lower, upper, target = s.lower, s.upper, 0.5 * self.tol
+        lower, upper = s.lower, s.upper
+        touch, target = self.margin + self.tol, self.margin + 0.5 * self.tol
         q_all = self.plant.GetPositions(self.ctx)
         q = q_pre.copy()
         F = len(s.fingers)
@@ -390,10 +400,10 @@ class CloudHand:
                 if status[f]:
                     continue
                 psi, witness, _ = self.distances(self.fingers[f])
-                if psi.min() <= self.tol:
+                if psi.min() <= touch:
                     status[f] = "touching"
                     continue
-                if stalled(watch[f], q.copy(), float(psi.min()), target, self.tol):
+                if stalled(watch[f], q.copy(), float(psi.min()), target, touch):
                     status[f] = "not converged"  # it circles, far from the cloud
                     continue
                 d = self._descent(f, psi, witness, q)
@@ -425,8 +435,9 @@ class CloudHand:
         groups = [self.fingers[f] for f in touching] + [self.palm]
         for geoms in groups:
             for g in geoms:
-                psi, _, idx, sd = self.distance(g, within=self.tol + CONTACT_BAND)
-                if idx is None or psi > self.tol:
+                touch = self.margin + self.tol
+                psi, _, idx, sd = self.distance(g, within=touch + CONTACT_BAND)
+                if idx is None or psi > touch:
                     continue
                 near = sd <= psi + CONTACT_BAND
                 idx, sd = idx[near], sd[near]
