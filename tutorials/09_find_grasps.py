@@ -235,3 +235,44 @@ if TEST_MODE:
 print("best:  ", dg.shake_test(can.add_models, allegro[0], **shake))
 pick = int(np.random.default_rng(1).integers(len(allegro)))
 print(f"random (#{pick}):", dg.shake_test(can.add_models, allegro[pick], **shake))
+
+# %% [markdown]
+# ### The Allegro hand on a one-sided point cloud
+#
+# The perception route: the plant holds the hand alone and the object is a
+# cloud with normals.  Here a camera on +x sees the near half of the can
+# (points sampled on its collision geometry, kept where they face the camera).
+# The approaches come from the seen points; each finger closes until it
+# reaches the cloud; the contacts are the cloud points it touches, with the
+# cloud's normals.  With `viewpoint=`, a hand that reaches behind the seen
+# surface (where the unseen half of the can may be) is rejected.
+
+# %%
+from drakegrasp.planning import object_surface  # noqa: E402
+
+hand_only = dg.planning_scene(None, hand_url=ALLEGRO)
+hand_only.plant.GetJointByName("joint_12").set_angle(
+    hand_only.plant.GetMyContextFromRoot(hand_only.context), 1.0
+)
+p_W, n_W, _ = object_surface(can.plant, can.context, can.object_body).sample(
+    3000, np.random.default_rng(0)
+)
+camera = np.array([0.5, 0.0, 0.0])
+seen = np.sum(n_W * (camera - p_W), axis=1) > 0
+from_cloud = dg.plan_grasps(
+    hand_only.plant,
+    hand_only.context,
+    None,
+    hand=hand_only.hand,
+    num_candidates=60 if TEST_MODE else 200,
+    mu=1.0,
+    seed=0,
+    point_cloud=p_W[seen],
+    cloud_normals=n_W[seen],
+    viewpoint=camera,
+)
+print(from_cloud)
+best = from_cloud[0]
+best.apply(plant, root)  # the hand on the true can (still where it was)
+diagram.ForcedPublish(root)
+print(best)

@@ -8,7 +8,8 @@ pre-shape, :mod:`~drakegrasp.planning.approach`, and closes with
 ``close_hand``, :mod:`~drakegrasp.planning.multifinger`),
 rejects colliding poses and closes the fingers with Drake's distance queries
 (:mod:`~drakegrasp.planning.placement`) or on a point cloud
-(:mod:`~drakegrasp.planning.cloud`), and ranks the grasps
+(:mod:`~drakegrasp.planning.cloud`; multi-finger hands,
+:mod:`~drakegrasp.planning.cloud_hand`), and ranks the grasps
 (:mod:`~drakegrasp.planning.ranking`, :mod:`~drakegrasp.planning.weight`);
 the results are :mod:`~drakegrasp.planning.candidates`, and
 :mod:`~drakegrasp.planning.shake` checks them in a Drake simulation.  This
@@ -32,6 +33,7 @@ _SUBMODULES = (
     "approach",
     "candidates",
     "cloud",
+    "cloud_hand",
     "gripper",
     "multifinger",
     "placement",

@@ -172,6 +172,20 @@ def _centres(plant, ctx, inspector, H, bodies) -> list[np.ndarray]:
     return out
 
 
+def _geometric_tip(plant, structure: HandStructure, finger) -> list:
+    """A finger's bodies with collision geometry that the most of its joints move.
+
+    The tip of :mod:`drakegrasp.plant.fingers` without an object to pair with
+    (a point cloud).
+    """
+    joints = [structure.joints[k].index() for k in finger.joints]
+    moved = [set(map(int, plant.GetBodiesKinematicallyAffectedBy([j]))) for j in joints]
+    shaped = [b for b in finger.bodies if plant.GetCollisionGeometriesForBody(b)]
+    depth = {id(b): sum(int(b.index()) in m for m in moved) for b in shaped}
+    deepest = max(depth.values(), default=0)
+    return [b for b in shaped if depth[id(b)] == deepest]
+
+
 def _curl(tips, q0, structure, steps=_CURL_STEPS) -> np.ndarray:
     """The closed hand: ``q0`` moved to draw the fingertips together.
 
@@ -278,7 +292,9 @@ def multi_finger_hand(
     ctx = plant.CreateDefaultContext()
     H = base.body_frame()
     tip_bodies = [
-        list({id(b): b for _, _, b in f.tip_pairs}.values()) for f in structure.fingers
+        list({id(b): b for _, _, b in f.tip_pairs}.values())
+        or _geometric_tip(plant, structure, f)  # no object geometry (a cloud)
+        for f in structure.fingers
     ]
     if not any(tip_bodies):
         raise ModelError("the hand's fingers have no collision geometry to grasp with")

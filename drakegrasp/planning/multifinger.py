@@ -23,10 +23,15 @@ rejection reason (:data:`REASONS`).
    that moves each finger's contacts rigidly (the palm's stay), the weight
    capacity with one squeeze bound per finger and one for the palm
    (:mod:`drakegrasp.planning.weight`), ``score = robustness × capacity``.
+
+On a point cloud (:func:`plan_multifinger_cloud`), stages 2 and 3 are those
+of :mod:`drakegrasp.planning.cloud_hand` (the hand against the cloud's points,
+the fingers closed onto them); stages 1 and 4 are the same.
 """
 
 from __future__ import annotations
 
+import time
 from collections import Counter
 from dataclasses import replace
 
@@ -47,9 +52,11 @@ from drakegrasp.planning.approach import (
     sample_approaches,
 )
 from drakegrasp.planning.candidates import GraspCandidate, planning_result
+from drakegrasp.planning.cloud import CONTACT_BAND, CloudSurface
+from drakegrasp.planning.cloud_hand import CloudHand
 from drakegrasp.planning.ranking import group_by_count, robustness, verdicts
 from drakegrasp.planning.weight import weight_capacity
-from drakegrasp.plant.closing import close_hand
+from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
 from drakegrasp.plant.fingers import hand_structure
 from drakegrasp.plant.validation import hand_bodies, scoped_name
@@ -61,6 +68,7 @@ __all__ = [
     "hand_is_parallel_jaw",
     "is_parallel_jaw",
     "plan_multifinger",
+    "plan_multifinger_cloud",
     "rank_multifinger",
 ]
 
@@ -156,10 +164,10 @@ class _Placer:
             return None, None, "fingers collide with each other"
         if hit is not None:
             return None, None, f"hand collides with the {hit}"
-        try:
-            closure = close_hand(
-                plant, ctx, self.body, hand=self.spec, distance_tolerance=self.tol,
-                min_fingers=self.min_fingers,
+        try:  # the pre-shape is clear, within the limits and the couplings
+            closure = close_checked_hand(
+                plant, ctx, self.body, s, tol=self.tol,
+                min_fingers=self.min_fingers, t0=time.perf_counter(),
             )  # fmt: skip
         except UnreachableError:
             return None, None, "fingers miss the object"
@@ -353,6 +361,92 @@ def plan_multifinger(
         rejections=rejections,
         num_sampled=n,
         object_body=name,
+        mu=mu,
+        torque_scale=torque_scale,
+        settings=settings,
+        started=t0,
+    )
+
+
+def plan_multifinger_cloud(
+    plant, ctx, *, hand, points, normals, viewpoint, n, mu, rng, settings, t0,
+    preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
+    standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
+    progress=False, weight=float("nan"),
+):  # fmt: skip
+    """The multi-finger cloud route of :func:`~drakegrasp.planning.planner.plan_grasps`.
+
+    Called by ``plan_grasps`` with the cloud read
+    (:func:`~drakegrasp.planning.cloud.read_cloud`: world frame, outward unit
+    normals) and the options checked (``settings``); ``weight`` is the
+    object's weight (N, NaN when unknown).  Returns its
+    :class:`~drakegrasp.planning.candidates.GraspCandidates`.
+    """
+    tilt = float(tilt)
+    if not 0.0 <= tilt <= np.pi / 2:
+        raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
+    if (
+        isinstance(min_fingers, bool)
+        or not isinstance(min_fingers, int | np.integer)
+        or min_fingers < 2
+    ):
+        raise InvalidOptionError(
+            f"min_fingers must be an integer >= 2, got {min_fingers!r}"
+        )
+    hand_model = multi_finger_hand(
+        plant, ctx, plant.world_body(), hand, preshape=preshape, synergy=synergy,
+        synergy_range=synergy_range, approach=approach, standoff=standoff,
+    )  # fmt: skip
+    if min_fingers > hand_model.num_fingers:
+        raise InvalidOptionError(
+            f"min_fingers = {min_fingers} exceeds the hand's "
+            f"{hand_model.num_fingers} fingers"
+        )
+    surface = CloudSurface(points, normals, viewpoint=viewpoint)
+    X_WO = RigidTransform(surface.centroid)
+    settings = {
+        **settings,
+        "hand": hand_model.to_dict(),
+        "tilt": tilt,
+        "min_fingers": int(min_fingers),
+        "cloud_points": len(points),
+        "contact_band": CONTACT_BAND,
+    }
+    torque_scale = surface.radius_about(np.zeros(3))
+    poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
+    saved = plant.GetPositions(ctx).copy()
+    closer = CloudHand(
+        plant, ctx, hand_model, surface, settings["distance_tolerance"], min_fingers
+    )
+    rejections = Counter()
+    order = range(len(poses["q"]))
+    if progress:
+        from tqdm.auto import tqdm
+
+        order = tqdm(order, desc="closing", unit="pose")
+    kept = []
+    try:
+        for k in order:
+            X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
+            found, q, reason = closer.run(X_WH, poses["q"][k])
+            if reason is not None:
+                rejections[reason] += 1
+                continue
+            kept.append((k, X_WH, poses["q"][k], q, found))
+    finally:
+        plant.SetPositions(ctx, saved)
+    candidates = rank_multifinger(
+        kept, label=closer.label, hand=hand_model, plant=plant, mu=mu,
+        model=settings["contact_model"], nu=settings["torsional_friction"],
+        torque_scale=torque_scale, samples=settings["robustness_samples"],
+        noise=settings["noise"], rng=rng, certify=certify, workers=workers,
+        X_WO=X_WO, weight=weight,
+    )  # fmt: skip
+    return planning_result(
+        candidates,
+        rejections=rejections,
+        num_sampled=n,
+        object_body="point cloud",
         mu=mu,
         torque_scale=torque_scale,
         settings=settings,

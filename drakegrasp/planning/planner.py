@@ -43,7 +43,7 @@ from drakegrasp.core.validation import (
     check_distance_tolerance,
     real_scalar,
 )
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidates, planning_result
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
@@ -56,6 +56,7 @@ from drakegrasp.planning.multifinger import (
     DEFAULT_TILT,
     hand_is_parallel_jaw,
     plan_multifinger,
+    plan_multifinger_cloud,
 )
 from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
 from drakegrasp.planning.ranking import DEFAULT_NOISE, rank_candidates
@@ -314,11 +315,16 @@ def plan_grasps(
             point_cloud, cloud_normals, viewpoint=viewpoint
         )
         if not hand_is_parallel_jaw(plant, ctx, plant.world_body(), hand):
-            raise ModelError(
-                "a point cloud is planned for with a parallel jaw (two fingers of "
-                "one prismatic joint each); multi-finger hands plan on an object "
-                "body (object_body=...)"
-            )
+            mass = np.nan if object_mass is None else float(object_mass)
+            settings.update(cloud_dropped=dropped)
+            return plan_multifinger_cloud(
+                plant, ctx, hand=hand, points=points, normals=normals,
+                viewpoint=viewpoint, n=n, mu=mu, rng=np.random.default_rng(seed),
+                settings=settings, t0=t0, preshape=preshape, synergy=synergy,
+                synergy_range=synergy_range, approach=approach, standoff=standoff,
+                tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
+                progress=progress, weight=mass * GRAVITY,
+            )  # fmt: skip
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface = CloudSurface(points, normals, viewpoint=viewpoint)
         X_WO = RigidTransform(surface.centroid)

@@ -7,6 +7,7 @@ one kinematics update per step, each step bounded by conservative advancement
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -158,12 +159,48 @@ def closest(query, plant, context, pairs):
     return (*witness(query, plant, context, pairs[k], results[k]), every)
 
 
+def stalled(st, q, psi: float, target: float, tol: float) -> bool:
+    """Whether a finger circles a point where its distance stopped shrinking.
+
+    The test of :meth:`Search._stalled` for a finger accepted at ``q`` with
+    distance ``psi``; ``st`` holds its ``trail`` (list), ``best`` (start
+    inf) and ``since_best`` (start 0), and is updated.  ``target`` is the
+    closing's target distance, ``tol`` the contact tolerance (metres).
+    """
+    st.trail = [*st.trail[-STALL_STEPS:], q]
+    first = st.best == np.inf
+    if first or psi < st.best - STALL_PROGRESS * (st.best - target):
+        st.best, st.since_best = psi, 0
+        return False
+    st.since_best += 1
+    if st.since_best < STALL_STEPS or psi <= STALL_DISTANCE * tol:
+        return False
+    trail = np.array(st.trail)
+    path = np.sum(np.max(np.abs(np.diff(trail, axis=0)), axis=1))
+    net = np.max(np.abs(trail[-1] - trail[0]))
+    return bool(net < STALL_WANDER * path)
+
+
 def _path_end(q, d, lower, upper) -> float:
-    """Largest α at which a joint with d != 0 still moves (capped at 1e3)."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        t = np.where(d > 0, (upper - q) / d, np.where(d < 0, (lower - q) / d, 0.0))
-    t = np.where(np.isfinite(t), t, 1e3)
-    return float(max(np.max(t, initial=0.0), 0.0))
+    """Largest α at which a joint with d != 0 still moves (capped at 1e3).
+
+    Python floats over the few joints of a hand (IEEE arithmetic, as numpy's):
+    called once per step of every finger.
+    """
+    best = 0.0
+    rows = zip(q.tolist(), d.tolist(), lower.tolist(), upper.tolist(), strict=True)
+    for qj, dj, lo, hi in rows:
+        if dj > 0:
+            t = (hi - qj) / dj  # inf on overflow, as numpy
+        elif dj < 0:
+            t = (lo - qj) / dj
+        else:
+            continue
+        if not math.isfinite(t):
+            t = 1e3
+        if t > best:
+            best = t
+    return best
 
 
 class Search:
@@ -174,6 +211,13 @@ class Search:
         self.tol, self.target = tol, 0.5 * tol
         self.user_d, self.max_iterations = user_d, max_it
         self._tips: dict[int, np.ndarray | None] = {}  # id(finger) -> tip rows
+        self._joints = {}  # id(finger) -> its joints' positions in q
+        self._mine = {}  # id(finger) -> (n_h,) bool, its joints
+        for f in hand.fingers:
+            self._joints[id(f)] = np.array(f.joints, dtype=int)
+            mine = np.zeros(len(hand.lower), dtype=bool)
+            mine[list(f.joints)] = True
+            self._mine[id(f)] = mine
 
     def run(self, states: list[FingerState], q_all: np.ndarray, q0: np.ndarray) -> int:
         """Step until every finger has a status; the number of steps."""
@@ -181,7 +225,8 @@ class Search:
         while not all(st.status for st in states):
             q = q0.copy()
             for st in states:
-                q[list(st.finger.joints)] = st.q_trial[list(st.finger.joints)]
+                j = self._joints[id(st.finger)]
+                q[j] = st.q_trial[j]
             q_all[hand.position_indices] = hand.coupling.apply(q)
             self.plant.SetPositions(self.context, q_all)
             query = self.plant.get_geometry_query_input_port().Eval(self.context)
@@ -258,18 +303,7 @@ class Search:
         (a fixed direction, or a curl past a thin obstacle that bounds its
         steps) or converges onto the object is never stopped.
         """
-        st.trail = [*st.trail[-STALL_STEPS:], st.q_good]
-        first = st.best == np.inf
-        if first or psi < st.best - STALL_PROGRESS * (st.best - self.target):
-            st.best, st.since_best = psi, 0
-            return False
-        st.since_best += 1
-        if st.since_best < STALL_STEPS or psi <= STALL_DISTANCE * self.tol:
-            return False
-        trail = np.array(st.trail)
-        path = np.sum(np.max(np.abs(np.diff(trail, axis=0)), axis=1))
-        net = np.max(np.abs(trail[-1] - trail[0]))
-        return bool(net < STALL_WANDER * path)
+        return stalled(st, st.q_good, psi, self.target, self.tol)
 
     def _tip_rows(self, finger) -> np.ndarray | None:
         """Rows of ``finger.pairs`` that are its ``tip_pairs``, in order.
@@ -307,8 +341,7 @@ class Search:
         them (the tip's are among them).
         """
         hand, finger = self.hand, st.finger
-        mine = np.zeros(len(hand.lower), dtype=bool)
-        mine[list(finger.joints)] = True
+        mine = self._mine[id(finger)]
         if self.user_d is not None:
             d = np.where(mine, self.user_d, 0.0)
         else:  # steepest descent of the fingertip's distance, here

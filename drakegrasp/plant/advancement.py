@@ -57,7 +57,7 @@ from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.fingers import Finger, HandStructure, joint_name
 
-__all__ = ["advancement_bound", "finger_speed_bound", "reach"]
+__all__ = ["advancement_bound", "finger_speed_bound", "geometry_reach", "reach"]
 
 _KEPT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 """Finalized plant -> {finger key: (proximity version, reach rows)}.
@@ -146,13 +146,34 @@ def reach(
     return rows
 
 
+def geometry_reach(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    hand: HandStructure,
+    geometries,
+    inspector,
+) -> np.ndarray:
+    """:func:`reach` of given geometries (not kept): rows ``(gf, body)``.
+
+    For a finger that closes on something other than a body's geometry (a
+    point cloud): every collision geometry ``gf`` of the finger's ``body``.
+    """
+    return _reach_rows(plant, plant_context, hand, list(geometries), inspector)[0]
+
+
 def _reach(plant, plant_context, hand, finger, inspector):
     """:func:`reach`, and whether it read the context."""
+    geometries = [(gf, body) for _, gf, body in finger.pairs]
+    return _reach_rows(plant, plant_context, hand, geometries, inspector)
+
+
+def _reach_rows(plant, plant_context, hand, geometries, inspector):
+    """:func:`reach` of ``(gf, body)`` rows, and whether it read the context."""
     inboard = _inboard_joints(plant)
     column = {int(j.index()): k for k, j in enumerate(hand.joints)}
-    rows = np.zeros((len(finger.pairs), len(hand.joints)))
+    rows = np.zeros((len(geometries), len(hand.joints)))
     reads_context = False  # a row set after a context-dependent offset
-    for p, (_, gf, body) in enumerate(finger.pairs):
+    for p, (gf, body) in enumerate(geometries):
         offset_read = False
         centre_G, radius = bounding_sphere(inspector.GetShape(gf))
         point = np.asarray(inspector.GetPoseInFrame(gf).multiply(centre_G))

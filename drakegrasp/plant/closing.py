@@ -89,7 +89,13 @@ from drakegrasp.plant.validation import (
     scoped_name,
 )
 
-__all__ = ["DEFAULT_MAX_ITERATIONS", "FingerClosure", "HandClosure", "close_hand"]
+__all__ = [
+    "DEFAULT_MAX_ITERATIONS",
+    "FingerClosure",
+    "HandClosure",
+    "close_checked_hand",
+    "close_hand",
+]
 
 DEFAULT_MAX_ITERATIONS = 100
 """Default bound on the steps of each finger."""
@@ -403,6 +409,47 @@ def close_hand(
         )
     _check_coupled(hand_, q0)
     user_d = _user_direction(direction, len(q0), hand_)
+    return _close(
+        plant, plant_context, body, hand_, q_all, q0, tol=tol,
+        min_fingers=min_fingers, user_d=user_d, max_iterations=max_iterations,
+        inspector=inspector, jaws=jaws, symmetric=symmetric, settle=settle,
+        instance_bodies=instance_bodies, t0=t0,
+    )  # fmt: skip
+
+
+def close_checked_hand(
+    plant, plant_context, body, structure: HandStructure, *, tol, min_fingers, t0
+) -> HandClosure:
+    """:func:`close_hand` for a caller that has checked what it checks.
+
+    For a planner that closes one hand many times: ``structure`` is the hand's
+    (with the plant's couplings), the tolerance and ``min_fingers`` are valid,
+    the pre-shape in ``plant_context`` is within the limits and couplings and
+    clear of the object, and the hand is not a parallel gripper closed as one.
+    The fingers close along their steepest descent and the object does not
+    move; the result and errors are those of :func:`close_hand`.
+    """
+    q_all = plant.GetPositions(plant_context)
+    q0 = q_all[structure.position_indices].copy()
+    if min_fingers > len(structure.fingers):
+        raise UnreachableError(
+            f"min_fingers = {min_fingers} exceeds the hand's "
+            f"{len(structure.fingers)} fingers"
+        )
+    inspector = query_object_of(plant, plant_context).inspector()
+    return _close(
+        plant, plant_context, body, structure, q_all, q0, tol=tol,
+        min_fingers=min_fingers, user_d=None, max_iterations=DEFAULT_MAX_ITERATIONS,
+        inspector=inspector, jaws=None, symmetric=False, settle=False,
+        instance_bodies=None, t0=t0,
+    )  # fmt: skip
+
+
+def _close(
+    plant, plant_context, body, hand_, q_all, q0, *, tol, min_fingers, user_d,
+    max_iterations, inspector, jaws, symmetric, settle, instance_bodies, t0,
+):  # fmt: skip
+    """The search, the settling and the result of :func:`close_hand`."""
     search = Search(plant, plant_context, hand_, tol, user_d, max_iterations)
     states = [
         FingerState(

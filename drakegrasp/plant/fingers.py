@@ -20,17 +20,27 @@ joint moves (the palm) stay where they are.
 *coupling* is the same four numbers ``(joint_0, joint_1, ρ, Δq)``:
 ``joint_0`` follows ``joint_1``.  They are read where the models enter the
 plant (:mod:`drakegrasp.plant.couplings`).
+
+**Kept per plant.**  The structure depends on the plant's kinematic tree and
+actuators (fixed after ``Finalize``), the hand's bodies, the object, the
+couplings and the collision filters (the scene graph's proximity version).
+:func:`hand_structure` keeps what it found per finalized plant and reads it
+again while the proximity version is the same; the joint limits are read
+afresh at every call.
 """
 
 from __future__ import annotations
 
+import copy
 import numbers
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.geometry import Role
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import Joint, JointIndex, RigidBody
+from pydrake.multibody.tree import BodyIndex, Joint, JointIndex, RigidBody
 
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.validation import scoped_name
@@ -46,6 +56,13 @@ __all__ = [
 
 MAX_STEP = {"revolute": 0.2, "prismatic": 0.01}
 """Largest change of any joint of a finger in one closing step: radians, metres."""
+
+_KEPT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""Finalized plant -> {(object, bodies, couplings): (proximity version, recipe)}.
+
+A recipe holds indices, names, geometry id values and numbers only, never a
+body, a joint or a ``GeometryId`` (each would keep the plant alive);
+:func:`_rebuild` turns it back into a :class:`HandStructure`."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -348,6 +365,111 @@ def hand_structure(
     InvalidOptionError
         For a malformed coupling.
     """
+    kept = _KEPT.get(plant) if plant.is_finalized() else None
+    key = None
+    if plant.is_finalized():
+        key = (
+            int(object_body.index()),
+            tuple(int(b.index()) for b in bodies),
+            _couplings_key(plant, couplings),
+        )
+        version = inspector.geometry_version()
+        if kept is not None and key in kept:
+            old_version, recipe = kept[key]
+            if old_version.IsSameAs(version, Role.kProximity):
+                return _rebuild(plant, key[0], recipe)
+    structure = _build(plant, object_body, bodies, couplings, inspector)
+    if key is not None:
+        # A copy: the inspector's version is a live reference that changes
+        # with the context it came from.
+        _KEPT.setdefault(plant, {})[key] = (copy.copy(version), _recipe(structure))
+    return structure
+
+
+def _couplings_key(plant, couplings) -> tuple:
+    """The couplings as ``(joint_0 index, joint_1 index, ρ, Δq)``, checked."""
+    out = []
+    for entry in coupling_entries(couplings):
+        j0, j1, rho, off = coupling_entry(plant, entry)
+        out.append((int(j0.index()), int(j1.index()), rho, off))
+    return tuple(out)
+
+
+def _recipe(s: HandStructure) -> tuple:
+    """What :func:`_rebuild` needs, holding no body or joint."""
+    fingers = tuple(
+        (
+            f.name,
+            f.joints,
+            tuple(int(b.index()) for b in f.bodies),
+            tuple(
+                (go.get_value(), gf.get_value(), int(b.index()))
+                for go, gf, b in f.pairs
+            ),
+            tuple(k for k, p in enumerate(f.pairs) if any(p is t for t in f.tip_pairs)),
+            f.max_step,
+        )
+        for f in s.fingers
+    )
+    return (
+        tuple(int(j.index()) for j in s.joints),
+        s.names,
+        s.position_indices.copy(),
+        s.velocity_indices.copy(),
+        dict(s.coupling.follows),
+        fingers,
+    )
+
+
+def _rebuild(plant, object_index: int, recipe) -> HandStructure:
+    """The :class:`HandStructure` of a recipe, its limits read afresh."""
+    joint_ids, names, position, velocity, follows, fingers = recipe
+    joints = tuple(plant.get_joint(JointIndex(i)) for i in joint_ids)
+    body, geometry = {}, {}
+
+    def get(i):
+        if i not in body:
+            body[i] = plant.get_body(BodyIndex(i))
+            for g in plant.GetCollisionGeometriesForBody(body[i]):
+                geometry[g.get_value()] = g
+        return body[i]
+
+    get(object_index)
+    built = []
+    for name, members, body_ids, pairs, tips, max_step in fingers:
+        bodies = tuple(get(b) for b in body_ids)  # and their geometries
+        pairs = tuple((geometry[go], geometry[gf], get(b)) for go, gf, b in pairs)
+        built.append(
+            Finger(
+                name=name,
+                joints=members,
+                bodies=bodies,
+                pairs=pairs,
+                tip_pairs=tuple(pairs[k] for k in tips),
+                max_step=max_step,
+            )
+        )
+    coupling = Coupling(dict(follows))
+    return HandStructure(
+        joints=joints,
+        names=names,
+        position_indices=position.copy(),
+        velocity_indices=velocity.copy(),
+        **_limits(joints, coupling),
+        fingers=tuple(built),
+        coupling=coupling,
+    )
+
+
+def _limits(joints, coupling: Coupling) -> dict:
+    lower = np.array([j.position_lower_limits()[0] for j in joints])
+    upper = np.array([j.position_upper_limits()[0] for j in joints])
+    lower, upper = coupling.leader_limits(lower, upper)
+    return {"lower": lower, "upper": upper}
+
+
+def _build(plant, object_body, bodies, couplings, inspector) -> HandStructure:
+    """:func:`hand_structure` from the plant (not kept)."""
     joints, follows = _closing_joints(plant, bodies, couplings)
     if not joints:
         raise ModelError(
@@ -375,16 +497,12 @@ def hand_structure(
             raise InvalidOptionError("a joint may not both lead and follow a coupling")
         mapped[f] = (lead, rho, off)
     coupling = Coupling(mapped)
-    lower = np.array([j.position_lower_limits()[0] for j in joints])
-    upper = np.array([j.position_upper_limits()[0] for j in joints])
-    lower, upper = coupling.leader_limits(lower, upper)
     return HandStructure(
         joints=tuple(joints),
         names=tuple(joint_name(plant, j) for j in joints),
         position_indices=np.array([j.position_start() for j in joints]),
         velocity_indices=np.array([j.velocity_start() for j in joints]),
-        lower=lower,
-        upper=upper,
+        **_limits(joints, coupling),
         fingers=fingers,
         coupling=coupling,
     )

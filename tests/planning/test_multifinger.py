@@ -313,15 +313,18 @@ def test_three_finger_top_candidates_hold_and_random_ones_less(three_result):
     assert rand < top
 
 
-def test_a_multi_finger_hand_on_a_point_cloud_is_refused():
+def test_a_multi_finger_hand_plans_on_a_point_cloud():
+    """The cloud route (tests/planning/test_multifinger_cloud.py checks it)."""
     scene = planning_scene(None, hand_url=THREE)
-    cloud = np.random.default_rng(0).standard_normal((200, 3))
-    cloud = 0.03 * cloud / np.linalg.norm(cloud, axis=1, keepdims=True)
-    with pytest.raises(ModelError, match="object body"):
-        plan_grasps(
-            scene.plant, scene.context, None, hand=scene.hand, num_candidates=5,
-            mu=MU, point_cloud=cloud,
-        )  # fmt: skip
+    u = np.random.default_rng(0).standard_normal((1500, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    result = plan_grasps(
+        scene.plant, scene.context, None, hand=scene.hand, num_candidates=10,
+        mu=MU, seed=0, point_cloud=0.03 * u, cloud_normals=u, robustness_samples=8,
+        preshape=THREE_OPEN,
+    )  # fmt: skip
+    assert len(result) + sum(result.rejections.values()) == 10
+    assert len(result) > 0 and result.object_body == "point cloud"
 
 
 def _coupled_hand_sdf() -> str:

@@ -1,0 +1,500 @@
+r"""Multi-finger hands on a point cloud: collisions, closing, contacts.
+
+The stages of the perception route of
+:func:`~drakegrasp.planning.planner.plan_grasps` for a hand that is not a
+parallel jaw (the Allegro hand, a three-finger hand).  The
+plant holds the hand and the surroundings; the object is a cloud with outward
+normals (:func:`~drakegrasp.planning.cloud.read_cloud`), in its centroid frame
+O (:class:`~drakegrasp.planning.cloud.CloudSurface`); the driver is
+:func:`~drakegrasp.planning.multifinger.plan_multifinger_cloud`.  Every
+sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
+
+1. **Approach and pre-shape** as on a body
+   (:func:`~drakegrasp.planning.approach.sample_approaches`): a cloud point,
+   the approach along its inward normal (tilted), a palm stand-off, a roll
+   and a pre-shape.  With a ``viewpoint`` the normals face the camera, so
+   every approach comes from the seen side of a one-sided cloud.
+2. **Collisions** with the cloud: a hand geometry with a cloud point deeper
+   than the distance tolerance inside it collides.  The depth is the
+   geometry's own closed-form signed distance (sphere, box, cylinder,
+   capsule; Drake's ``QueryObject.ComputeSignedDistanceToPoint`` for other
+   shapes) of the cloud points near it (a k-d tree ball about its bounding
+   sphere: only those can be nearest).  With the rest of the plant and
+   between fingers: Drake's signed distances, as on a body.  With a
+   ``viewpoint``, a hand that reaches behind the seen surface (the unseen
+   side may hold the object) is rejected, open and closed.
+3. **Closing**, as :func:`~drakegrasp.close_hand` closes on a body: each
+   finger steps from the pre-shape along the steepest descent of its tip's
+   distance to the cloud, ``d = −∂ψ_tip/∂q`` (re-aimed after every step,
+   blocked joints dropped, followers of couplings following), until its
+   distance ``ψ_f`` to the cloud (the smallest signed distance of a cloud
+   point to one of its geometries) is within the tolerance of
+   :data:`GAP_SPACINGS` cloud spacings.  Each step is
+   bounded by conservative advancement (:mod:`drakegrasp.plant.advancement`:
+   ``α <= (ψ_g − tol/2) / V_g`` over every finger geometry ``g``), so no step
+   carries a finger through a cloud point.  A finger that reaches its limits,
+   circles a point where its distance stopped shrinking far from the cloud
+   (the stall test ``close_hand`` applies), or takes
+   :data:`~drakegrasp.plant.closing.DEFAULT_MAX_ITERATIONS` steps, misses and
+   goes back to its pre-shape (it would only cross the others).
+4. **Contacts** are the cloud points each touching geometry reaches within
+   :data:`~drakegrasp.planning.cloud.CONTACT_BAND` of its first, with the
+   cloud's normals: the nearest for a sphere (a fingertip), the corners of
+   the touched set's convex hull across the contact normal for other shapes
+   (a pad), and those of the palm's geometries likewise.
+5. **Ranking** as on a body
+   (:func:`~drakegrasp.planning.multifinger.rank_multifinger`).
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+from pydrake.geometry import Box, Capsule, Cylinder, Sphere
+from pydrake.multibody.tree import JacobianWrtVariable
+from scipy.spatial import cKDTree
+
+from drakegrasp.planning.approach import _geometric_tip
+from drakegrasp.planning.cloud import (
+    CONTACT_BAND,
+    SHADOW_PROBES,
+    CloudContact,
+    CloudSurface,
+    _hull_corners,
+)
+from drakegrasp.planning.surface import piece_of_shape
+from drakegrasp.plant._closing_steps import stalled
+from drakegrasp.plant._shapes import bounding_sphere
+from drakegrasp.plant.advancement import geometry_reach
+from drakegrasp.plant.closing import DEFAULT_MAX_ITERATIONS
+from drakegrasp.plant.validation import scoped_name
+
+__all__ = ["GAP_SPACINGS", "REASONS", "CloudHand", "signed_distances"]
+
+REASONS = {
+    "hand collides with the cloud": "a cloud point lies inside the pre-shaped hand",
+    "hand enters the unseen side": "the hand reaches behind a one-sided cloud",
+    "hand collides with the scene": "the pre-shaped hand penetrates another body",
+    "fingers miss the object": "fewer than min_fingers fingers reach the cloud",
+    "finger blocked by the scene": "a closed finger penetrates another body",
+    "one finger touches": "the contacts come from fewer than two fingers",
+    "fingers collide with each other": "two fingers (or a finger and the palm) "
+    "penetrate each other, in the pre-shape or after closing",
+}
+"""Every rejection reason of the multi-finger cloud route, with what it means."""
+
+GAP_SPACINGS = 0.5
+"""Fingers stop this many cloud spacings (median nearest-neighbour distance)
+short of the nearest cloud point: between sampled points a finger sinks into
+the surface the cloud samples (on 3,000 points of the YCB soup can, 1.4 mm
+apart, the best candidates' fingers went up to 1.5 mm into the true can when
+they stopped at the points; 0.8 mm at half a spacing)."""
+
+_FD = 1e-7
+"""Step (m) of the central differences of a signed distance's gradient."""
+
+_EXACT_WITHIN = 5e-3
+"""Distances (m) of finger geometries are exact below this, lower bounds
+above it (enough to bound a closing step), so only the cloud points near a
+geometry are measured."""
+
+
+def signed_distances(shape, q_G: np.ndarray) -> np.ndarray | None:
+    """Signed distances (m) of points to a shape, closed form, or None.
+
+    Parameters
+    ----------
+    shape : pydrake.geometry.Shape
+        Sphere, Box, Cylinder or Capsule (None for any other shape).
+    q_G : (k, 3) float
+        Points in the shape's geometry frame G, metres.
+
+    Returns
+    -------
+    (k,) float or None
+        Negative inside.
+    """
+    if isinstance(shape, Sphere):
+        return np.linalg.norm(q_G, axis=1) - shape.radius()
+    if isinstance(shape, Capsule):
+        h = 0.5 * shape.length()
+        axis = np.zeros_like(q_G)
+        axis[:, 2] = np.clip(q_G[:, 2], -h, h)
+        return np.linalg.norm(q_G - axis, axis=1) - shape.radius()
+    if isinstance(shape, Box):
+        a = np.abs(q_G) - 0.5 * np.array([shape.width(), shape.depth(), shape.height()])
+    elif isinstance(shape, Cylinder):
+        a = np.column_stack(
+            [
+                np.hypot(q_G[:, 0], q_G[:, 1]) - shape.radius(),
+                np.abs(q_G[:, 2]) - 0.5 * shape.length(),
+            ]
+        )
+    else:
+        return None
+    outside = np.linalg.norm(np.maximum(a, 0.0), axis=1)
+    return outside + np.minimum(a.max(axis=1), 0.0)
+
+
+class _Geometry:
+    """One hand geometry: its body, pose in the body, shape and bounding sphere."""
+
+    def __init__(self, plant, inspector, gid, body, rng):
+        self.id, self.body = gid, body
+        self.shape = inspector.GetShape(gid)
+        self.X_BG = inspector.GetPoseInFrame(gid)
+        self.R_BG = self.X_BG.rotation().matrix()
+        self.p_BG = self.X_BG.translation()
+        centre, self.radius = bounding_sphere(self.shape)
+        self.centre_G = np.asarray(centre, float)
+        self.centre_B = self.R_BG @ self.centre_G + self.p_BG
+        self.is_sphere = isinstance(self.shape, Sphere)
+        piece = piece_of_shape(self.shape, self.X_BG, inspector.GetName(gid))
+        self.probes_G = piece.sample(SHADOW_PROBES, rng)[0] if piece.area > 0 else None
+
+
+class CloudHand:
+    """Stages 2-4 on a cloud for one hand (scratch: the plant context).
+
+    Parameters
+    ----------
+    plant, ctx : MultibodyPlant, Context
+        The plant (hand and surroundings) and its context (scratch).
+    hand : MultiFingerHand
+    surface : CloudSurface
+    tol : float
+        Distance tolerance, metres.
+    min_fingers : int
+    """
+
+    def __init__(self, plant, ctx, hand, surface: CloudSurface, tol, min_fingers):
+        self.plant, self.ctx, self.hand, self.surface = plant, ctx, hand, surface
+        self.tol, self.min_fingers = tol, int(min_fingers)
+        self.margin = GAP_SPACINGS * surface.spacing
+        self.points_W = surface.points + surface.centroid
+        self.tree = cKDTree(self.points_W)
+        self.port = plant.get_geometry_query_input_port()
+        inspector = self.port.Eval(ctx).inspector()
+        s = hand.structure
+        rng = np.random.default_rng(0)  # fixed: the same probe points every call
+        in_finger = {int(b.index()) for f in s.fingers for b in f.bodies}
+        instances = {hand.base.model_instance()} | {
+            j.model_instance() for j in s.joints
+        }
+        bodies = [
+            plant.get_body(b)
+            for i in sorted(instances)
+            for b in plant.GetBodyIndices(i)
+        ]
+        self.hand_geoms = {
+            g for b in bodies for g in plant.GetCollisionGeometriesForBody(b)
+        }
+        self.fingers = [
+            [
+                _Geometry(plant, inspector, g, b, rng)
+                for b in f.bodies
+                for g in plant.GetCollisionGeometriesForBody(b)
+            ]
+            for f in s.fingers
+        ]
+        self.palm = [
+            _Geometry(plant, inspector, g, b, rng)
+            for b in bodies
+            if int(b.index()) not in in_finger
+            for g in plant.GetCollisionGeometriesForBody(b)
+        ]
+        self.reach = [
+            geometry_reach(plant, ctx, s, [(g.id, g.body) for g in geoms], inspector)
+            for geoms in self.fingers
+        ]
+        tips = [
+            {int(b.index()) for b in _geometric_tip(plant, s, f)} for f in s.fingers
+        ]
+        self.tips = [
+            [k for k, g in enumerate(geoms) if int(g.body.index()) in tip]
+            or list(range(len(geoms)))
+            for geoms, tip in zip(self.fingers, tips, strict=True)
+        ]
+        self.mask = [
+            np.isin(np.arange(len(s.names)), list(f.joints)) for f in s.fingers
+        ]
+        self.label = {}
+        for f, finger in enumerate(s.fingers):
+            for b in finger.bodies:
+                self.label[scoped_name(plant, b)] = f
+
+    # -- distances -------------------------------------------------------------
+
+    def _pose(self, g: _Geometry):
+        X_WB = self.plant.EvalBodyPoseInWorld(self.ctx, g.body)
+        R_WB = X_WB.rotation().matrix()
+        return R_WB @ g.R_BG, R_WB @ g.p_BG + X_WB.translation()
+
+    def distance(self, g: _Geometry, within=_EXACT_WITHIN):
+        """(ψ_g, its witness, cloud indices near g, their signed distances).
+
+        ``ψ_g`` (m) is exact when it is below ``within``, else a lower bound
+        (at least ``within``).  Only the points within ``r + within`` of the
+        bounding sphere's centre ``c`` (radius ``r``) are measured: any other
+        point ``x`` has ``ψ(x) >= |x − c| − r``.  The witness is the index of
+        the nearest measured point (of the point nearest ``c`` when none is).
+        """
+        psi, witness, near = self.distances([g], within)
+        idx, sd = near[0]
+        return psi[0], witness[0], idx, sd
+
+    def distances(self, geoms, within=_EXACT_WITHIN):
+        """:meth:`distance` of several geometries: ψ (G,), witnesses, near points."""
+        poses = {}
+        for g in geoms:
+            if id(g.body) not in poses:
+                X_WB = self.plant.EvalBodyPoseInWorld(self.ctx, g.body)
+                poses[id(g.body)] = (X_WB.rotation().matrix(), X_WB.translation())
+        centres = np.array(
+            [poses[id(g.body)][0] @ g.centre_B + poses[id(g.body)][1] for g in geoms]
+        )
+        d0, i0 = self.tree.query(centres)
+        psi = d0 - np.array([g.radius for g in geoms])
+        witness = [int(i) for i in i0]
+        near = [(None, None)] * len(geoms)
+        for k in np.flatnonzero(psi < within):
+            g = geoms[k]
+            R_WB, p_WB = poses[id(g.body)]
+            idx = self.tree.query_ball_point(centres[k], g.radius + within)
+            idx = np.asarray(idx, dtype=int)
+            sd = self._signed(
+                g, R_WB @ g.R_BG, R_WB @ g.p_BG + p_WB, self.points_W[idx]
+            )
+            j = int(np.argmin(sd))
+            psi[k], witness[k], near[k] = min(sd[j], within), int(idx[j]), (idx, sd)
+        return psi, witness, near
+
+    def _descent(self, f: int, psi, witness, q) -> np.ndarray:
+        """Steepest descent of finger ``f``'s tip distance to the cloud.
+
+        ``d = −∂ψ_tip/∂q = n̂ᵀ J`` at the tip geometry's closest point ``y`` to
+        its witness ``x`` (``n̂`` the signed distance's gradient at ``x``, by
+        central differences of the closed form, and ``y = x − ψ(x) n̂``), over
+        the finger's joints (a follower's part pulled back to its leader),
+        zero on joints blocked by a limit, scaled to a largest entry of 1.
+        """
+        s, plant, ctx = self.hand.structure, self.plant, self.ctx
+        k = min(self.tips[f], key=lambda j: psi[j])
+        g = self.fingers[f][k]
+        R, p = self._pose(g)
+        x_W = self.points_W[witness[k]]
+        probe = np.vstack([np.zeros(3), _FD * np.eye(3), -_FD * np.eye(3)])
+        sd = self._signed(g, R, p, x_W + probe @ R.T)
+        grad = (sd[1:4] - sd[4:7]) / (2 * _FD)
+        norm = np.linalg.norm(grad)
+        if not norm > 0:
+            return np.zeros_like(q)
+        n_G = grad / norm
+        y_W = x_W - sd[0] * (R @ n_G)
+        p_BY = plant.EvalBodyPoseInWorld(ctx, g.body).inverse().multiply(y_W)
+        J = plant.CalcJacobianTranslationalVelocity(
+            ctx, JacobianWrtVariable.kV, g.body.body_frame(), p_BY,
+            plant.world_frame(), plant.world_frame(),
+        )  # fmt: skip
+        d = s.coupling.pull_back((R @ n_G) @ J[:, s.velocity_indices])
+        d = np.where(self.mask[f], d, 0.0)
+        blocked = ((d > 0) & (q >= s.upper)) | ((d < 0) & (q <= s.lower))
+        d = np.where(blocked, 0.0, d)
+        scale = np.max(np.abs(d), initial=0.0)
+        if scale <= 1e-12:
+            return np.zeros_like(q)
+        d = d / scale
+        return np.where(np.abs(d) < 1e-9, 0.0, d)
+
+    def _signed(self, g: _Geometry, R, p, points_W) -> np.ndarray:
+        sd = signed_distances(g.shape, (points_W - p) @ R)
+        if sd is None:  # another shape: Drake's distance to each point
+            query = self.port.Eval(self.ctx)
+            sd = np.array(
+                [
+                    next(
+                        r.distance
+                        for r in query.ComputeSignedDistanceToPoint(x, np.inf)
+                        if r.id_G == g.id
+                    )
+                    for x in points_W
+                ]
+            )
+        return sd
+
+    def collides(self) -> bool:
+        """Whether a cloud point lies deeper than ``tol`` inside a hand geometry."""
+        every = [*self.palm, *(g for f in self.fingers for g in f)]
+        return bool(np.any(self.distances(every, 2 * self.tol)[0] < -self.tol))
+
+    def in_shadow(self) -> bool:
+        """Whether the hand reaches behind a one-sided cloud's seen surface.
+
+        As :meth:`drakegrasp.planning.cloud.CloudFingers.in_shadow`: a probe
+        point of a hand geometry farther along a camera ray than a cloud point
+        within one spacing of that ray, by more than two spacings plus the
+        tolerance, lies where the unseen object may be.
+        """
+        view = self.surface.viewpoint
+        if view is None:
+            return False
+        camera = view + self.surface.centroid
+        rho = self.surface.spacing
+        for g in (*self.palm, *(g for f in self.fingers for g in f)):
+            if g.probes_G is None:
+                continue
+            R, p = self._pose(g)
+            h = g.probes_G @ R.T + p - camera
+            dist = np.linalg.norm(h, axis=1)
+            u = h / dist[:, None]
+            c = R @ g.centre_G + p
+            idx = self.tree.query_ball_point(c, g.radius + rho)
+            if not idx:
+                continue
+            q = self.points_W[np.asarray(idx, dtype=int)] - camera
+            along = u @ q.T
+            perp2 = np.sum(q * q, axis=1)[None, :] - along**2
+            if np.any(
+                (perp2 <= rho * rho) & (along < dist[:, None] - self.tol - 2 * rho)
+            ):
+                return True
+        return False
+
+    def penetration(self):
+        """None, ``"scene"`` or ``"hand"``: what a hand geometry penetrates."""
+        query = self.port.Eval(self.ctx)
+        found = None
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.0):
+            in_a, in_b = pair.id_A in self.hand_geoms, pair.id_B in self.hand_geoms
+            if not (in_a or in_b) or pair.distance >= -self.tol:
+                continue
+            if in_a and in_b:
+                found = "hand"
+                continue
+            return "scene"
+        return found
+
+    # -- closing ---------------------------------------------------------------
+
+    def _set(self, q_all, q):
+        s = self.hand.structure
+        q_all[s.position_indices] = s.coupling.apply(q)
+        self.plant.SetPositions(self.ctx, q_all)
+
+    def close(self, q_pre):
+        """Close every finger onto the cloud: (q, touching finger indices)."""
+        s = self.hand.structure
+        lower, upper = s.lower, s.upper
+        touch, target = self.margin + self.tol, self.margin + 0.5 * self.tol
+        q_all = self.plant.GetPositions(self.ctx)
+        q = q_pre.copy()
+        F = len(s.fingers)
+        status = ["" if self.fingers[f] else "fixed" for f in range(F)]
+        watch = [SimpleNamespace(trail=[], best=np.inf, since_best=0) for _ in range(F)]
+        for _ in range(DEFAULT_MAX_ITERATIONS):
+            if all(status):
+                break
+            self._set(q_all, q)
+            for f, finger in enumerate(s.fingers):
+                if status[f]:
+                    continue
+                psi, witness, _ = self.distances(self.fingers[f])
+                if psi.min() <= touch:
+                    status[f] = "touching"
+                    continue
+                if stalled(watch[f], q.copy(), float(psi.min()), target, touch):
+                    status[f] = "not converged"  # it circles, far from the cloud
+                    continue
+                d = self._descent(f, psi, witness, q)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    t = np.where(d > 0, (upper - q) / d, (lower - q) / d)
+                t = np.where(d != 0, np.where(np.isfinite(t), t, 1e3), 0.0)
+                alpha_end = float(t.max(initial=0.0))
+                if alpha_end <= 1e-12:
+                    status[f] = "at limit"
+                    continue
+                speed = self.reach[f] @ np.abs(s.coupling.tangent(d))
+                moving = speed > 0
+                alpha = np.min(
+                    np.maximum(psi[moving] - target, 0.0) / speed[moving],
+                    initial=np.inf,
+                )
+                alpha = min(float(alpha), finger.max_step, alpha_end)
+                q = np.where(self.mask[f], np.clip(q + alpha * d, lower, upper), q)
+        touching = [f for f in range(F) if status[f] == "touching"]
+        for f in range(F):  # a finger that misses stays open
+            if f not in touching:
+                q = np.where(self.mask[f], q_pre, q)
+        self._set(q_all, q)
+        return q, touching
+
+    def contacts(self, touching) -> list[CloudContact]:
+        """The cloud points the touching fingers and the palm reach."""
+        out = []
+        groups = [self.fingers[f] for f in touching] + [self.palm]
+        for geoms in groups:
+            for g in geoms:
+                touch = self.margin + self.tol
+                psi, _, idx, sd = self.distance(g, within=touch + CONTACT_BAND)
+                if idx is None or psi > touch:
+                    continue
+                near = sd <= psi + CONTACT_BAND
+                idx, sd = idx[near], sd[near]
+                normals = self.surface.normals[idx]
+                if g.is_sphere:  # a fingertip: its nearest point
+                    keep = [int(np.argmin(sd))]
+                else:  # a pad: the corners of what it touches
+                    axis = normals.mean(axis=0)
+                    if np.linalg.norm(axis) < 1e-9:
+                        axis = normals[int(np.argmin(sd))]
+                    keep = _hull_corners(
+                        self.points_W[idx], axis / np.linalg.norm(axis)
+                    )
+                name = scoped_name(self.plant, g.body)
+                out += [
+                    CloudContact(
+                        p_OC=self.surface.points[idx[k]].copy(),
+                        nhat_O=-self.surface.normals[idx[k]],
+                        psi=float(sd[k]),
+                        finger_body=name,
+                    )
+                    for k in keep
+                ]
+        return out
+
+    def run(self, X_WH, q_pre):
+        """(contacts, closed q, None) or (None, None, reason)."""
+        plant, ctx, s = self.plant, self.ctx, self.hand.structure
+        plant.SetFreeBodyPose(ctx, self.hand.base, X_WH)
+        self._set(plant.GetPositions(ctx), q_pre)
+        hit = self.penetration()
+        if hit is not None:
+            return (
+                None,
+                None,
+                (
+                    "fingers collide with each other"
+                    if hit == "hand"
+                    else "hand collides with the scene"
+                ),
+            )
+        if self.collides():
+            return None, None, "hand collides with the cloud"
+        if self.in_shadow():
+            return None, None, "hand enters the unseen side"
+        q, touching = self.close(q_pre)
+        if len(touching) < self.min_fingers:
+            return None, None, "fingers miss the object"
+        hit = self.penetration()
+        if hit == "scene":
+            return None, None, "finger blocked by the scene"
+        if hit == "hand":
+            return None, None, "fingers collide with each other"
+        if self.in_shadow():
+            return None, None, "hand enters the unseen side"
+        found = self.contacts(touching)
+        fingers = {self.label.get(c.finger_body, -1) for c in found} - {-1}
+        if len(fingers) < 2:
+            return None, None, "one finger touches"
+        return found, s.coupling.apply(q), None

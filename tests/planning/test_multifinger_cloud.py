@@ -1,0 +1,427 @@
+"""plan_grasps with multi-finger hands on point clouds: Drake's Allegro hand on
+full and one-sided clouds of the YCB soup can, and a coupled three-finger hand
+of our own on a cylinder's cloud.  Every candidate is clear of the cloud
+(checked with Drake's point distances, not the planner's closed forms), within
+its joint limits, touches the true object where its contacts say, is
+reproducible and moves with the cloud; hostile clouds are refused or answered
+with a reason."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from pydrake.geometry import Box, Capsule, Cylinder, Sphere
+from pydrake.math import RigidTransform, RollPitchYaw
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
+from pydrake.systems.framework import DiagramBuilder
+
+from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.planning import object_surface, plan_grasps, planning_scene
+from drakegrasp.planning.cloud_hand import REASONS, signed_distances
+from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
+from drakegrasp.plant.couplings import add_models
+from drakegrasp.plant.models import register_models
+
+ALLEGRO = (
+    "package://drake_models/allegro_hand_description/sdf/"
+    "allegro_hand_description_right.sdf"
+)
+THREE = "package://drakegrasp/hands/three_finger_hand.sdf"
+CAN = "package://drake_models/ycb/005_tomato_soup_can.sdf"
+VIEW = [0.5, 0.0, 0.0]  # a camera on +x sees the near half of the can's side
+MU = 1.0
+
+
+def _cloud(full, n=3000, seed=0, view=None):
+    surface = object_surface(full.plant, full.context, full.object_body)
+    p, nrm, _ = surface.sample(n, np.random.default_rng(seed))
+    if view is not None:  # keep what a camera at `view` sees (convex object)
+        seen = np.sum(nrm * (np.asarray(view) - p), axis=1) > 0
+        p, nrm = p[seen], nrm[seen]
+    return p, nrm
+
+
+def _allegro(models_dir, object_url=None):
+    scene = planning_scene(object_url, hand_url=ALLEGRO, models_dir=models_dir)
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    scene.plant.GetJointByName("joint_12").set_angle(ctx, 1.0)  # thumb opposed
+    return scene
+
+
+def _plan(scene, cloud, normals=None, n=40, seed=0, **kw):
+    return plan_grasps(
+        scene.plant, scene.context, None, hand=scene.hand, num_candidates=n,
+        mu=MU, seed=seed, robustness_samples=8, point_cloud=cloud,
+        cloud_normals=normals, **kw,
+    )  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def can(drake_models_dir):
+    """(the can with the hand, the hand alone, the full cloud, a one-sided one)."""
+    full = _allegro(drake_models_dir, CAN)
+    return full, _allegro(drake_models_dir), _cloud(full), _cloud(full, view=VIEW)
+
+
+@pytest.fixture(scope="module")
+def full_result(can):
+    _, hand, (p, nrm), _ = can
+    return _plan(hand, p, nrm)
+
+
+@pytest.fixture(scope="module")
+def partial_result(can):
+    _, hand, _, (p, nrm) = can
+    return _plan(hand, p, nrm, n=100, viewpoint=VIEW)
+
+
+def _deepest_cloud_point(scene, candidate, points) -> float:
+    """Deepest signed distance (m) of a cloud point inside a hand geometry,
+    by Drake's ComputeSignedDistanceToPoint on the applied candidate."""
+    ctx = scene.context.Clone()
+    candidate.apply(scene.plant, ctx)
+    pctx = scene.plant.GetMyContextFromRoot(ctx)
+    query = scene.plant.get_geometry_query_input_port().Eval(pctx)
+    deepest = np.inf
+    for p in points:
+        for r in query.ComputeSignedDistanceToPoint(p, 0.0):
+            deepest = min(deepest, r.distance)
+    return deepest
+
+
+def _check_valid(scene, result, points):
+    plant = scene.plant
+    for c in result:
+        assert _deepest_cloud_point(scene, c, points) >= -TOL - 1e-9
+        for name, q in zip(c.joint_names, c.q_hand, strict=True):
+            joint = plant.GetJointByName(name.split("::")[-1])
+            lo, hi = joint.position_lower_limits()[0], joint.position_upper_limits()[0]
+            assert lo - 1e-9 <= q <= hi + 1e-9, (name, q)
+        fingers = {k.finger_body for k in c.contacts}
+        assert len(fingers) >= 2
+
+
+def _check_on_the_true_can(full, result, band):
+    """Each contact's finger body lies within ``band`` of the true can, and no
+    hand geometry penetrates it deeper than ``band``."""
+    plant, obj = full.plant, full.object_body
+    object_geoms = set(plant.GetCollisionGeometriesForBody(obj))
+    for c in result:
+        ctx = full.context.Clone()
+        c.apply(plant, ctx)
+        pctx = plant.GetMyContextFromRoot(ctx)
+        query = plant.get_geometry_query_input_port().Eval(pctx)
+        inspector = query.inspector()
+        psi = {}
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.05):
+            for a, b in ((pair.id_A, pair.id_B), (pair.id_B, pair.id_A)):
+                if a in object_geoms and b not in object_geoms:
+                    body = plant.GetBodyFromFrameId(inspector.GetFrameId(b))
+                    name = f"allegro_hand_right::{body.name()}"
+                    psi[name] = min(psi.get(name, np.inf), pair.distance)
+        assert min(psi.values()) >= -band, psi
+        for k in c.contacts:
+            assert psi.get(k.finger_body, np.inf) <= band, (k.finger_body, psi)
+
+
+def test_every_sample_is_a_candidate_or_a_counted_rejection(full_result):
+    result = full_result
+    assert len(result) + sum(result.rejections.values()) == result.num_sampled == 40
+    assert set(result.rejections) <= set(REASONS)
+    assert len(result) >= 8 and result[0].is_closure
+    scores = [c.score for c in result]
+    assert scores == sorted(scores, reverse=True)
+    assert result.object_body == "point cloud"
+    assert np.isnan(result[0].squeeze_needed)  # a cloud has no mass
+
+
+def test_full_cloud_candidates_are_clear_of_the_cloud_and_within_limits(
+    can, full_result
+):
+    _, hand, (p, _), _ = can
+    _check_valid(hand, full_result[:6], p)
+
+
+def test_full_cloud_contacts_lie_on_the_true_can(can, full_result):
+    full, _, (p, _), _ = can
+    spacing = np.sqrt(0.0276 / len(p))  # the can's area over its points
+    _check_on_the_true_can(full, full_result[:6], band=max(spacing, 2e-3))
+    for c in full_result[:6]:  # the contacts are cloud points, with its normals
+        p_W = np.array([k.p_OC for k in c.contacts]) + c.X_WO.translation()
+        assert (
+            np.min(np.linalg.norm(p_W[:, None] - p[None], axis=2), axis=1).max() < 1e-12
+        )
+
+
+def test_one_sided_cloud_of_the_can(can, partial_result):
+    full, hand, (p_full, _), (p, _) = can
+    assert len(p) < 0.7 * len(p_full)
+    result = partial_result
+    assert len(result) + sum(result.rejections.values()) == 100
+    assert result.rejections["hand enters the unseen side"] > 0
+    assert len(result) > 0 and result[0].is_closure
+    _check_valid(hand, result[:4], p)
+    _check_on_the_true_can(full, result[:4], band=3e-3)
+
+
+def test_same_seed_same_candidates(can, full_result):
+    _, hand, (p, nrm), _ = can
+    again = _plan(hand, p, nrm)
+    assert len(again) == len(full_result)
+    for a, b in zip(again, full_result, strict=True):
+        assert a.sample == b.sample and a.score == b.score
+        np.testing.assert_array_equal(a.q_hand, b.q_hand)
+        np.testing.assert_array_equal(a.X_WH.GetAsMatrix4(), b.X_WH.GetAsMatrix4())
+
+
+def test_planning_moves_with_a_translated_cloud(can, full_result):
+    """The same poses, moved; the same closed hands, but for round-off that
+    can tip a discrete decision of a finger (the nearest point it aims at, a
+    stop far from the cloud) at most once in ten candidates."""
+    _, hand, (p, nrm), _ = can
+    t = np.array([0.25, -0.5, 0.125])
+    moved = _plan(hand, p + t, nrm)
+    by_sample = {c.sample: c for c in full_result}
+    assert {c.sample for c in moved} == set(by_sample)
+    same = 0
+    for a in moved:
+        b = by_sample[a.sample]
+        np.testing.assert_allclose(
+            a.X_WH.translation(), b.X_WH.translation() + t, atol=1e-9
+        )
+        np.testing.assert_allclose(
+            a.X_WH.rotation().matrix(), b.X_WH.rotation().matrix(), atol=1e-12
+        )
+        np.testing.assert_array_equal(a.q_preshape, b.q_preshape)
+        if np.allclose(a.q_hand, b.q_hand, atol=1e-3):
+            same += 1
+            assert a.is_closure == b.is_closure
+    assert same >= 0.9 * len(moved)
+
+
+def test_a_rotated_cloud_gives_valid_candidates(can):
+    """The cloud's frame O has the world's axes, so a rotated cloud gives
+    other draws: as many valid candidates, not the same ones."""
+    _, hand, (p, nrm), _ = can
+    R = RollPitchYaw(0.3, -0.5, 1.1).ToRotationMatrix().matrix()
+    result = _plan(hand, p @ R.T, nrm @ R.T, n=20, seed=5)
+    assert len(result) > 0 and result[0].is_closure
+    _check_valid(hand, result[:3], p @ R.T)
+
+
+def test_hostile_clouds(can):
+    _, hand, (p, nrm), _ = can
+    with pytest.raises(InvalidOptionError, match="empty"):
+        _plan(hand, np.zeros((0, 3)))
+    with pytest.raises(InvalidOptionError, match="finite"):
+        _plan(hand, np.full((50, 3), np.nan))
+    holes = p.copy()
+    holes[::10] = np.nan  # missing depth, as Drake marks it
+    result = _plan(hand, holes, nrm, n=10)
+    assert result.settings["cloud_dropped"] == len(p[::10])
+    assert len(result) + sum(result.rejections.values()) == 10
+    empty = _plan(hand, p, nrm, n=0)
+    assert len(empty) == 0 and "num_candidates is 0" in empty.reason
+    # the palm held 0.3-0.4 m off the can: no finger reaches it
+    result = _plan(hand, p, nrm, n=15, standoff=(0.3, 0.4))
+    assert len(result) == 0 and "rejected" in result.reason
+    assert result.rejections == {"fingers miss the object": 15}
+    assert set(result.rejections) <= set(REASONS)
+
+
+def _drake_point_distances(shape, X, p_W):
+    """Drake's ComputeSignedDistanceToPoint of points to one posed shape."""
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    plant.RegisterCollisionGeometry(
+        plant.world_body(), X, shape, "g", CoulombFriction(1.0, 1.0)
+    )
+    plant.Finalize()
+    diagram = builder.Build()
+    ctx = plant.GetMyContextFromRoot(diagram.CreateDefaultContext())
+    query = plant.get_geometry_query_input_port().Eval(ctx)
+    return [query.ComputeSignedDistanceToPoint(p, np.inf)[0].distance for p in p_W]
+
+
+@pytest.mark.parametrize(
+    "shape, inside, outside",
+    [
+        (Sphere(0.02), [0.01, 0, 0], [0, 0.03, 0]),
+        (Box(0.02, 0.04, 0.06), [0.009, 0.0, 0.0], [0.02, 0.03, 0.0]),
+        (Cylinder(0.02, 0.1), [0.0, 0.0, 0.049], [0.03, 0.0, 0.06]),
+        (Capsule(0.01, 0.05), [0.0, 0.0, 0.03], [0.0, 0.0, 0.045]),
+    ],
+)
+def test_closed_form_distances_match_drakes(shape, inside, outside):
+    """The planner's signed distances equal Drake's ComputeSignedDistanceToPoint."""
+    X = RigidTransform(RollPitchYaw(0.2, 0.4, -0.3), [0.1, -0.05, 0.2])
+    rng = np.random.default_rng(0)
+    q_G = np.vstack([inside, outside, rng.uniform(-0.06, 0.06, (200, 3))])
+    ours = signed_distances(shape, q_G)
+    p_W = q_G @ X.rotation().matrix().T + X.translation()
+    np.testing.assert_allclose(ours, _drake_point_distances(shape, X, p_W), atol=1e-12)
+    assert ours[0] < 0 < ours[1]
+
+
+@settings(derandomize=True, max_examples=25, deadline=None)
+@given(
+    kind=st.sampled_from(["sphere", "box", "cylinder", "capsule"]),
+    size=st.tuples(*[st.floats(0.002, 0.08)] * 3),
+    rpy=st.tuples(*[st.floats(-3.0, 3.0)] * 3),
+    seed=st.integers(0, 2**16),
+)
+def test_closed_form_distances_match_drakes_for_any_shape_and_pose(
+    kind, size, rpy, seed
+):
+    a, b, c = size
+    shape = {
+        "sphere": lambda: Sphere(a),
+        "box": lambda: Box(a, b, c),
+        "cylinder": lambda: Cylinder(a, b),
+        "capsule": lambda: Capsule(a, b),
+    }[kind]()
+    X = RigidTransform(RollPitchYaw(*rpy), [0.3, -0.1, 0.05])
+    q_G = np.random.default_rng(seed).uniform(-0.1, 0.1, (60, 3))
+    p_W = q_G @ X.rotation().matrix().T + X.translation()
+    np.testing.assert_allclose(
+        signed_distances(shape, q_G), _drake_point_distances(shape, X, p_W), atol=1e-12
+    )
+
+
+def _coupled_hand_sdf() -> str:
+    """The coupled three-finger hand that test_multifinger writes."""
+    path = Path(__file__).with_name("test_multifinger.py")
+    spec = importlib.util.spec_from_file_location("_test_multifinger", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module._coupled_hand_sdf()
+
+
+@pytest.fixture(scope="module")
+def coupled():
+    """(the coupled hand alone in a plant, root context, hand, cylinder cloud)."""
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    parser = Parser(plant)
+    register_models(parser)
+    (hand,) = add_models(parser, text=_coupled_hand_sdf(), kind="sdf")
+    plant.Finalize()
+    root = builder.Build().CreateDefaultContext()
+    cylinder = planning_scene(
+        "package://drakegrasp/objects/cylinder.sdf", hand_url=THREE
+    )
+    p, nrm = _cloud(cylinder, n=2000)
+    return plant, root, hand, p + [0.0, 0.0, 0.3], nrm, cylinder
+
+
+def _plan_coupled(coupled, p, nrm, n=30, seed=0, **kw):
+    plant, root, hand = coupled[:3]
+    return plan_grasps(
+        plant, root, None, hand=hand, num_candidates=n, mu=MU, seed=seed,
+        robustness_samples=8, point_cloud=p, cloud_normals=nrm,
+        preshape=[-0.5] * 6, **kw,
+    )  # fmt: skip
+
+
+def test_a_coupled_three_finger_hand_on_a_cylinder_cloud(coupled):
+    plant, root, hand, p, nrm, _ = coupled
+    result = _plan_coupled(coupled, p, nrm)
+    assert len(result) + sum(result.rejections.values()) == 30
+    assert set(result.rejections) <= set(REASONS)
+    assert len(result) > 0 and result[0].is_closure
+    ctx = plant.GetMyContextFromRoot(root)
+    query = plant.get_geometry_query_input_port().Eval(ctx)
+    for c in result[:5]:
+        # every follower follows its leader (ratio 1, offset 0)
+        q = dict(zip(c.joint_names, c.q_hand, strict=True))
+        for k in range(3):
+            lead = q[f"coupled_hand::f{k}_prox_joint"]
+            assert q[f"coupled_hand::f{k}_dist_joint"] == pytest.approx(lead)
+        assert len(c.contacts) >= 2
+    scene = type("S", (), {"plant": plant, "context": root})
+    _check_valid(scene, result[:5], p)
+    again = _plan_coupled(coupled, p, nrm)
+    assert [c.sample for c in again] == [c.sample for c in result]
+    assert query is not None
+
+
+def test_a_cloud_the_coupled_hand_cannot_reach_is_an_empty_result(coupled):
+    # the palm held 0.2-0.3 m off a ball 0.5 m across: no finger reaches it
+    rng = np.random.default_rng(2)
+    u = rng.standard_normal((3000, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    result = _plan_coupled(coupled, 0.25 * u, u, n=15, standoff=(0.2, 0.3))
+    assert len(result) == 0 and "rejected" in result.reason
+    assert result.rejections == {"fingers miss the object": 15}
+
+
+def test_a_table_under_the_cloud_is_an_obstacle(coupled):
+    """The plant's other geometry (a table the cylinder stands on) is checked
+    with Drake's distances: no candidate's hand goes into it."""
+    _, _, _, p, nrm, _ = coupled
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    parser = Parser(plant)
+    register_models(parser)
+    (hand,) = add_models(parser, text=_coupled_hand_sdf(), kind="sdf")
+    top = p[:, 2].min()  # the cylinder's bottom cap
+    plant.RegisterCollisionGeometry(
+        plant.world_body(), RigidTransform([0.0, 0.0, top - 0.01]),
+        Box(1.0, 1.0, 0.02), "table", CoulombFriction(1.0, 1.0),
+    )  # fmt: skip
+    plant.Finalize()
+    root = builder.Build().CreateDefaultContext()
+    result = _plan_coupled((plant, root, hand), p, nrm, n=40)
+    assert len(result) + sum(result.rejections.values()) == 40
+    assert result.rejections.get("hand collides with the scene", 0) > 0
+    assert len(result) > 0
+    table = plant.GetCollisionGeometriesForBody(plant.world_body())
+    for c in result:
+        ctx = root.Clone()
+        c.apply(plant, ctx)
+        query = plant.get_geometry_query_input_port().Eval(
+            plant.GetMyContextFromRoot(ctx)
+        )
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.0):
+            if pair.id_A in table or pair.id_B in table:
+                assert pair.distance >= -TOL - 1e-9
+
+
+def test_a_hand_without_fingers_is_refused_on_a_cloud(tmp_path, coupled):
+    _, _, _, p, nrm, _ = coupled
+    paddle = tmp_path / "paddle.sdf"
+    paddle.write_text(
+        '<?xml version="1.0"?><sdf version="1.9"><model name="paddle">'
+        "<link name='palm'><collision name='c'><geometry><box>"
+        "<size>0.05 0.05 0.05</size></box></geometry></collision></link>"
+        "</model></sdf>"
+    )
+    scene = planning_scene(None, hand_url=str(paddle))
+    with pytest.raises(ModelError, match="one-dof joint"):
+        _plan(scene, p, nrm, n=5)
+
+
+@pytest.mark.parametrize(
+    "bad, match",
+    [
+        ({"min_fingers": 1}, "min_fingers"),
+        ({"min_fingers": 4}, "min_fingers"),
+        ({"tilt": 2.0}, "tilt"),
+        ({"preshape": [0.0] * 4}, "preshape"),
+        ({"num_candidates": -1}, "num_candidates"),
+    ],
+)
+def test_bad_options_on_a_cloud(coupled, bad, match):
+    plant, root, hand, p, nrm, _ = coupled
+    kw = {"num_candidates": 5, "preshape": [-0.5] * 6, **bad}
+    with pytest.raises(InvalidOptionError, match=match):
+        plan_grasps(
+            plant, root, None, hand=hand, mu=MU, point_cloud=p, cloud_normals=nrm,
+            **kw,
+        )  # fmt: skip
