@@ -250,8 +250,8 @@ def plan_grasps(
         Bad options (``num_candidates`` negative, not an integer or above
         :data:`MAX_CANDIDATES`; ``mu`` negative...).
     ModelError
-        A hand without a free base or without fingers, a multi-finger hand
-        with a point cloud, an object without graspable collision geometry.
+        A hand without a free base or without fingers, an object without
+        graspable collision geometry.
     """
     t0 = time.perf_counter()
     n = _check_count(num_candidates)
