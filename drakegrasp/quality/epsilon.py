@@ -190,14 +190,17 @@ def _below_every_facet(points: np.ndarray, eq: np.ndarray, tol: float) -> bool:
     return True
 
 
-def _origin_distance_residual(points: np.ndarray, scale: float) -> float:
-    r"""Residual of ``min ‖Pᵀλ‖² + ρ²(1ᵀλ - 1)²`` over ``λ >= 0`` (NNLS).
+def _separated_from_origin(points: np.ndarray, scale: float) -> bool:
+    r"""Whether a checked hyperplane separates the origin from ``conv(points)``.
 
-    Zero (to round-off) exactly when some convex combination of the points is
-    the origin, i.e. when the origin lies in their hull; positive otherwise.
-    Lawson–Hanson NNLS on ``K`` points costs tens of microseconds, so it lets
-    :func:`_ball_radius` skip Qhull for grasps that are not in force closure.
-    A residual at round-off level is never trusted: Qhull then decides.
+    Lawson–Hanson NNLS on ``min ‖Pᵀλ‖² + ρ²(1ᵀλ - 1)²``, ``λ >= 0`` (tens of
+    microseconds for ``K`` points) proposes ``y = Pᵀλ / 1ᵀλ``, the hull's point
+    nearest the origin; the answer is trusted only through its certificate:
+    every point ``x`` with ``x·y > HULL_TOL · scale · ‖y‖`` puts the whole hull
+    strictly beyond the plane ``x·y = 0``, so the origin is outside and ε = 0
+    without Qhull.  Otherwise (the origin inside or on the hull, a wrong NNLS
+    answer — scipy 1.15's ``nnls`` stops short of the optimum on some inputs,
+    the last release for Python 3.10 —, or its iteration limit) Qhull decides.
     """
     rho = max(scale, 1e-300)
     A = np.vstack([points.T, np.full((1, points.shape[0]), rho)])
@@ -207,9 +210,15 @@ def _origin_distance_residual(points: np.ndarray, scale: float) -> float:
         # Imported here: scipy.optimize alone doubles `import drakegrasp`'s time.
         from scipy.optimize import nnls
 
-        return float(nnls(A, rhs)[1])
+        lam = nnls(A, rhs)[0]
     except RuntimeError:  # iteration limit: let Qhull decide
-        return 0.0
+        return False
+    total = float(np.sum(lam))
+    if not total > 0.0:
+        return False
+    y = points.T @ lam / total
+    norm = float(np.linalg.norm(y))
+    return bool(norm > 0.0 and np.min(points @ y) > HULL_TOL * rho * norm)
 
 
 FLAT_TOL = 1e-14
@@ -242,7 +251,8 @@ def _ball_radius(points: np.ndarray, A: np.ndarray | None = None) -> float:
     """Radius of the largest origin-centred ball in ``conv(points)``; 0 if none.
 
     Qhull is called only when needed: a hull that does not contain the origin
-    (NNLS residual above round-off) or whose affine hull is lower-dimensional
+    (a separating plane proposed by NNLS and checked, see
+    :func:`_separated_from_origin`) or whose affine hull is lower-dimensional
     than the space (no interior) has radius 0 without it.  Everything runs on
     the whitened points (see :func:`_whitening`); the facets are measured in the
     original coordinates.
@@ -256,7 +266,7 @@ def _ball_radius(points: np.ndarray, A: np.ndarray | None = None) -> float:
             return 0.0  # the points span less than the wrench space
     X = points @ A.T
     scale = float(np.max(np.abs(X)))
-    if _origin_distance_residual(X, scale) > HULL_TOL * scale:
+    if _separated_from_origin(X, scale):
         return 0.0  # the origin is outside the hull: no hull needed
     s = np.linalg.svd(X - X.mean(axis=0), compute_uv=False)
     if s[-1] <= RANK_TOL * max(s[0], scale):
@@ -555,7 +565,7 @@ def ferrari_canny(
 
     Cost.  L1: one Qhull hull of ``Σ_i m_i`` points (24 for three hard fingers
     with 8 generators: about a millisecond in 6-D); a grasp that is not in force
-    closure is settled before Qhull by an NNLS test.  L∞: the Minkowski sum of
+    closure is settled before Qhull (NNLS, checked).  L∞: the Minkowski sum of
     ``N`` sets of ``n_g + 1`` points has up to ``(n_g + 1)^N`` vertices and tens
     of thousands of facets in 6-D (about a second in Qhull for three hard
     fingers), so ε_∞ is computed through the sum's normal fan instead: every

@@ -91,13 +91,23 @@ def test_projection_is_the_signed_distance_and_its_gradient(
     assert abs(np.linalg.norm(n) - 1) < 1e-12
     np.testing.assert_allclose(q, p - sd * n, atol=1e-12)
     assert surface_residual(name, X.to_G(q)) < 1e-12
-    if abs(sd) > 1e-5:  # away from the surface the gradient is defined
-        h = 1e-7
+    if abs(sd) > 1e-5:  # away from the surface
+        # A step small against |sd|: near an edge the distance curves at 1/sd,
+        # so a central difference is off by up to h/(2|sd|) where the point is
+        # on the border of a face's and an edge's regions (C1, not C2).
+        h = 1e-4 * abs(sd)
         grad = [
             (X.project(p + h * e)[0] - X.project(p - h * e)[0]) / (2 * h)
             for e in np.eye(3)
         ]
-        np.testing.assert_allclose(grad, n, atol=1e-6)
+        if sd > 0 or np.allclose(grad, n, atol=1e-4):
+            # Outside a convex shape the distance is differentiable.
+            np.testing.assert_allclose(grad, n, atol=1e-4)
+        else:
+            # Inside, on the set of points with two nearest faces (hypothesis
+            # found one at a hex prism's vertex) sd has a kink: n must then be
+            # the gradient of one nearest face, along which sd grows at rate 1.
+            assert (X.project(p + h * n)[0] - sd) / h == pytest.approx(1, abs=1e-6)
 
 
 def _surface_samples(X, name, k=4000, seed=0):

@@ -426,3 +426,29 @@ def test_property_l1_matches_facet_enumeration(helpers, angles, mu):
     assert e1 == pytest.approx(helpers.brute_force_ball_radius(W), abs=1e-9)
     einf = ferrari_canny(g, norm="Linf", num_generators=4)
     assert e1 - 1e-12 <= einf <= len(contacts) * e1 + 1e-12
+
+
+def test_a_wrong_nnls_answer_never_zeroes_epsilon(monkeypatch):
+    """NNLS only proposes a separating plane; Qhull decides unless it checks out.
+
+    scipy 1.15's ``nnls`` (the last release for Python 3.10) stops short of the
+    optimum on some inputs, and ε read from its residual was 0 for a force-
+    closure grasp (found by the ε agreement tests on Python 3.10).  Here nnls
+    returns a vertex of the hull instead of its point nearest the origin.
+    """
+    import scipy.optimize
+
+    grasp = dg.examples.equator_fingers(0.5)
+    want = dg.ferrari_canny(grasp, norm="L1")
+    assert want > 0
+
+    def wrong(A, b, *args, **kwargs):
+        lam = np.zeros(A.shape[1])
+        lam[0] = 1.0
+        return lam, float(np.linalg.norm(A @ lam - b))
+
+    monkeypatch.setattr(scipy.optimize, "nnls", wrong)
+    assert dg.ferrari_canny(grasp, norm="L1") == want
+    # and a grasp that is not force closure still reads 0 (Qhull decides it)
+    two = dg.examples.spatial_two_fingers(0.5)
+    assert dg.ferrari_canny(two, norm="L1") == 0.0
