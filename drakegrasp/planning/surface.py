@@ -32,6 +32,7 @@ geometry's frame.  numpy only, plus Drake's shape classes.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from pydrake.geometry import (
@@ -102,6 +103,20 @@ class Piece:
     normals: np.ndarray
     offsets: np.ndarray
     triangles: np.ndarray
+
+    @cached_property
+    def bounding_ball(self) -> tuple[np.ndarray, float]:
+        """``(centre_G, radius)``: a ball (frame G, metres) holding the piece."""
+        if self.kind == "hull":
+            v = self.triangles.reshape(-1, 3)
+            centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+            return centre, float(np.max(np.linalg.norm(v - centre, axis=1)))
+        r, _, h = self.semi_axes
+        if self.kind == "ellipsoid":
+            return np.zeros(3), float(self.semi_axes.max())
+        if self.kind == "cylinder":
+            return np.zeros(3), float(np.hypot(r, h))
+        return np.zeros(3), float(r + h)
 
     # -- area and sampling ---------------------------------------------------
 
@@ -291,6 +306,21 @@ class Piece:
         return float(centre + h + r)
 
 
+def _near_lines(p: np.ndarray, d: np.ndarray, centre: np.ndarray, radius: float):
+    """Rows whose line ``p + t d`` (``d`` unit) passes within the ball, or None.
+
+    None when every row does (no subset to take).  The test is loose by a
+    relative 1e-9 and 1e-12 m, so a line it drops misses the ball, hence the
+    piece, by more than round-off.
+    """
+    w = centre - p
+    along = w @ d if w.ndim == 1 else np.einsum("ij,ij->i", w, d)
+    gap2 = np.einsum("ij,ij->i", w, w) - along * along
+    reach = radius * (1.0 + 1e-9) + 1e-12
+    near = gap2 <= reach * reach
+    return None if near.all() else np.flatnonzero(near)
+
+
 def _hull_piece(X_OG, name, vertices, polygons) -> Piece:
     tris, normals, offsets = [], [], []
     centroid = vertices.mean(axis=0)
@@ -439,11 +469,21 @@ class ObjectSurface:
         for piece in self.pieces:
             R = piece.X_OG.rotation().matrix()
             p_G = (p_O - piece.X_OG.translation()) @ R
-            a, b, n = piece.chord(p_G, d_O @ R)
+            d_G = d_O @ R
+            near = _near_lines(p_G, d_G, *piece.bounding_ball)
+            if near is None:  # every line passes near the piece
+                a, b, n = piece.chord(p_G, d_G)
+                n = n @ R.T
+            else:  # a line that misses the piece's ball misses the piece
+                a, b = np.full(K, np.nan), np.full(K, np.nan)
+                n = np.zeros((K, 3))
+                if len(near):
+                    a[near], b[near], n_near = piece.chord(p_G[near], d_G[near])
+                    n[near] = n_near @ R.T
             t_in = np.fmin(t_in, a)
             later = ~np.isnan(b) & ~(b <= t_out)
             t_out = np.where(later, b, t_out)
-            n_out = np.where(later[:, None], n @ R.T, n_out)
+            n_out = np.where(later[:, None], n, n_out)
         return t_in, t_out, n_out
 
     def radius_about(self, p_O: np.ndarray) -> float:

@@ -15,7 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.geometry import Sphere
 
+from drakegrasp.errors import NoContactsError, PenetrationError
 from drakegrasp.plant._shapes import surface_pieces
 from drakegrasp.plant.contact_normals import (
     choose_normal,
@@ -25,8 +27,16 @@ from drakegrasp.plant.contact_normals import (
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
 from drakegrasp.plant.exact_contact import closest_pair
 from drakegrasp.plant.shape_queries import PosedShape
+from drakegrasp.plant.sphere_tips import SOURCES, shape_key, sphere_tip_pairs
 
-__all__ = ["PairPoint", "pair_points"]
+__all__ = [
+    "PairPoint",
+    "PendingPair",
+    "StagedContacts",
+    "pair_points",
+    "pending_pair",
+    "resolve_pairs",
+]
 
 
 @dataclass(frozen=True)
@@ -187,3 +197,205 @@ def _to_G(X_WG, to_O, p_O: np.ndarray, R_OG: np.ndarray) -> np.ndarray:
 def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
     """Polygon vertices from a geometry frame to the object frame."""
     return np.array([to_O(X_WG.multiply(p)) for p in poly_G])
+
+
+# --- pairs read now, their points computed later in one batch ------------------------
+
+
+class _PosesAt:
+    """The two geometry poses a pair's query gave, for the scalar route later."""
+
+    def __init__(self, poses: dict):
+        self._poses = poses
+
+    def GetPoseInWorld(self, gid):  # noqa: N802 (QueryObject's name)
+        return self._poses[gid]
+
+
+class PendingPair:
+    """A touching pair read from Drake, its points still to come.
+
+    Made by :func:`pending_pair` while the query object describes the pair's
+    configuration; :func:`resolve_pairs` fills :attr:`points` (a spherical tip
+    on a box, cylinder or sphere in one vectorised batch with every other such
+    pair, anything else at once by :func:`pair_points`).
+    """
+
+    __slots__ = ("args", "points", "tip")
+
+    def __init__(self, args: dict, tip: tuple | None):
+        self.args = args
+        self.tip = tip
+        self.points: list[PairPoint] | None = None
+
+
+def pending_pair(
+    *,
+    query,
+    inspector,
+    go,
+    gf,
+    p_GaCa: np.ndarray,
+    p_GbCb: np.ndarray,
+    nhat_W: np.ndarray,
+    psi: float,
+    X_OW,
+    tol: float,
+    patches: str,
+) -> PendingPair:
+    """Read the pair (object geometry ``go``, finger ``gf``) from the query now.
+
+    The arguments are those of :func:`pair_points`, with the transform
+    ``X_OW`` (world to object frame) for ``to_O`` and ``R_OW``.  The points
+    are those :func:`pair_points` returns (to round-off, 1e-12 m, for a
+    spherical tip, whose closed form runs over arrays in
+    :mod:`~drakegrasp.plant.sphere_tips`), once :func:`resolve_pairs` ran.
+    """
+    X_WGa = query.GetPoseInWorld(go)
+    X_WGb = query.GetPoseInWorld(gf)
+    R_OW = _rotation(X_OW)
+
+    def to_O(p_W):
+        return np.asarray(X_OW.multiply(p_W))
+
+    args = dict(
+        query=_PosesAt({go: X_WGa, gf: X_WGb}),
+        inspector=inspector,
+        go=go,
+        gf=gf,
+        p_GaCa=p_GaCa,
+        p_GbCb=p_GbCb,
+        nhat_W=nhat_W,
+        psi=psi,
+        to_O=to_O,
+        R_OW=R_OW,
+        tol=tol,
+        patches=patches,
+    )
+    fin = inspector.GetShape(gf)
+    key = shape_key(inspector.GetShape(go)) if isinstance(fin, Sphere) else None
+    if key is None:
+        pending = PendingPair(args, None)
+        pending.points = pair_points(**args)
+        return pending
+    tip = (
+        key,
+        R_OW @ _rotation(X_WGa),
+        to_O(X_WGa.translation()),
+        to_O(X_WGb.translation()),
+        float(fin.radius()),
+    )
+    return PendingPair(args, tip)
+
+
+def resolve_pairs(pending) -> None:
+    """Compute the points of every unresolved :class:`PendingPair`, in batches."""
+    groups: dict[tuple, list[PendingPair]] = {}
+    for p in pending:
+        if p.points is None:
+            kind, dims = p.tip[0]
+            groups.setdefault((kind, dims), []).append(p)
+    for (kind, dims), rows in groups.items():
+        ok, psi, p_a, p_b, n, source = sphere_tip_pairs(
+            kind,
+            dims,
+            np.array([p.tip[1] for p in rows]),
+            np.array([p.tip[2] for p in rows]),
+            np.array([p.tip[3] for p in rows]),
+            np.array([p.tip[4] for p in rows]),
+            np.array([p.args["psi"] for p in rows]),
+        )
+        for k, p in enumerate(rows):
+            if not ok[k]:  # the scalar route decides (Drake's witness then)
+                p.points = pair_points(**p.args)
+                continue
+            p.points = [
+                PairPoint(
+                    p_a[k],
+                    clean_unit(n[k]),
+                    float(psi[k]),
+                    p_b[k],
+                    SOURCES[source[k]],
+                    None,
+                    True,
+                )
+            ]
+
+
+class StagedContacts:
+    """One configuration's touching pairs, read from Drake, points pending.
+
+    :func:`~drakegrasp.plant.contacts.stage_contacts` reads everything the
+    contacts need from the query object and the plant while they describe the
+    configuration;
+    :func:`~drakegrasp.plant.contacts.resolve_staged` computes the points of
+    many staged configurations in one batch (a planner stages each closed
+    candidate and resolves them all at once);
+    :func:`~drakegrasp.plant.contacts.staged_contacts` then gives what
+    :func:`~drakegrasp.plant.contacts.contacts_of_distances` returns, or
+    raises what it raises.
+    """
+
+    def __init__(self, object_name, tol, allow_penetration, closest, items, inspector):
+        self.object_name = object_name
+        self.tol = tol
+        self.allow_penetration = allow_penetration
+        self.closest = closest  # (ψ, finger body's name, GeometryId) or None
+        self.items = items  # ("penetration", message) or ("pair", ...)
+        self.inspector = inspector
+
+    def pending(self):
+        """The staged pairs (:class:`PendingPair`)."""
+        return [it[1] for it in self.items if it[0] == "pair"]
+
+    def rows(self) -> list[tuple]:
+        """``(PairPoint, X_FO, fields)`` of every contact point, once resolved.
+
+        In :func:`~drakegrasp.find_contacts`' order, before duplicates are
+        dropped; ``fields`` are the pair's :class:`~drakegrasp.PlantContact`
+        fields other than the point's.
+
+        Raises
+        ------
+        NoContactsError, PenetrationError
+            As :func:`~drakegrasp.find_contacts`.
+        """
+        tol = self.tol
+        rows: list[tuple] = []
+        penetrations: list[str] = []
+        for item in self.items:
+            if item[0] == "penetration":
+                penetrations.append(item[1])
+                continue
+            _, pending, X_FO, common, where = item
+            deepest = min(pp.psi for pp in pending.points)
+            if deepest < -tol and not self.allow_penetration:  # a tilted patch
+                go, finger, gf = where
+                penetrations.append(
+                    f"{self.object_name} ({self.inspector.GetName(go)}) and "
+                    f"{self._finger_geom(finger, gf)} penetrate by "
+                    f"{-deepest * 1e3:.4g} mm at a patch corner"
+                )
+                continue
+            rows += [(pp, X_FO, common) for pp in pending.points]
+        if penetrations:
+            raise PenetrationError(
+                f"penetration deeper than distance_tolerance = {tol:g} m: "
+                + "; ".join(penetrations)
+            )
+        if not rows:
+            if self.closest is None:
+                raise NoContactsError(
+                    "the hand has no collision geometry that can touch "
+                    f"{self.object_name!r}"
+                )
+            psi, finger, gf = self.closest
+            raise NoContactsError(
+                f"the hand does not touch {self.object_name!r}: the closest finger "
+                f"geometry is {self._finger_geom(finger, gf)} at {psi * 1e3:.4g} mm "
+                f"(distance_tolerance {tol * 1e3:g} mm)"
+            )
+        return rows
+
+    def _finger_geom(self, finger_name, gf) -> str:
+        return f"{finger_name} ({self.inspector.GetName(gf)})"

@@ -46,11 +46,13 @@ from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
     InvalidOptionError,
     ModelError,
-    NoContactsError,
-    PenetrationError,
 )
 from drakegrasp.plant._shapes import ON_SURFACE_TOL
-from drakegrasp.plant.contact_pair import pair_points
+from drakegrasp.plant.contact_pair import (
+    StagedContacts,
+    pending_pair,
+    resolve_pairs,
+)
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
 from drakegrasp.plant.validation import (
     HandSpec,
@@ -66,10 +68,14 @@ __all__ = [
     "DEFAULT_DISTANCE_TOLERANCE",
     "PATCH_ANGLE_TOL",
     "PlantContact",
+    "StagedContacts",
     "contacts_of_distances",
     "find_contacts",
     "hand_bodies",
     "resolve_object_body",
+    "resolve_staged",
+    "stage_contacts",
+    "staged_contacts",
 ]
 
 
@@ -192,10 +198,6 @@ def _label(body: str, name: str, index: int | None) -> str:
     short = name.rpartition("::")[2]
     where = f"{body}/{short}" if body else name
     return where if index is None else f"{where}#{index}"
-
-
-def _rotation(X) -> np.ndarray:
-    return X.rotation().matrix()
 
 
 def find_contacts(
@@ -358,28 +360,80 @@ def contacts_of_distances(
     NoContactsError, PenetrationError
         As :func:`find_contacts`.
     """
+    staged = stage_contacts(
+        plant,
+        plant_context,
+        body,
+        query,
+        results,
+        distance_tolerance=distance_tolerance,
+        allow_penetration=allow_penetration,
+        patches=patches,
+    )
+    resolve_staged([staged])
+    return staged_contacts(staged)
+
+
+def staged_contacts(staged: StagedContacts) -> list[PlantContact]:
+    """The contacts of a resolved :class:`StagedContacts`, as :func:`find_contacts`.
+
+    Raises
+    ------
+    NoContactsError, PenetrationError
+        As :func:`find_contacts`.
+    """
+    return _dedupe_contacts(
+        [
+            PlantContact(
+                p_OC=pp.p_OC,
+                nhat_O=pp.nhat_O,
+                psi=pp.psi,
+                p_FC=np.asarray(X_FO.multiply(pp.p_OF)),
+                normal_source=pp.normal_source,
+                patch_vertex=pp.patch_vertex,
+                exact=pp.exact,
+                **common,
+            )
+            for pp, X_FO, common in staged.rows()
+        ]
+    )
+
+
+def resolve_staged(staged) -> None:
+    """Compute the contact points of every staged configuration, in one batch."""
+    resolve_pairs([p for s in staged for p in s.pending()])
+
+
+def stage_contacts(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    body,
+    query: QueryObject,
+    results,
+    *,
+    distance_tolerance: float,
+    allow_penetration: bool = False,
+    patches: str = "vertices",
+) -> StagedContacts:
+    """Read the touching pairs of :func:`contacts_of_distances` from Drake now.
+
+    The arguments are those of :func:`contacts_of_distances`; the query and
+    the context may change once this returns.  :func:`resolve_staged` and
+    :meth:`StagedContacts.contacts` finish the work.
+    """
     tol = distance_tolerance
     inspector = query.inspector()
     object_name = _scoped_name(plant, body)
     object_geometries = set(plant.GetCollisionGeometriesForBody(body))
     X_WO = plant.EvalBodyPoseInWorld(plant_context, body)
     X_OW = X_WO.inverse()
-    R_OW = _rotation(X_OW)
-
-    def to_O(p_W):
-        return np.asarray(X_OW.multiply(p_W))
-
-    contacts: list[PlantContact] = []
-    penetrations: list[str] = []
+    items: list[tuple] = []
     closest: tuple[float, str] | None = None
-
-    def finger_geom(finger_name, gf):
-        return f"{finger_name} ({inspector.GetName(gf)})"
 
     def pair(go, finger_name, gf):
         return (
             f"{object_name} ({inspector.GetName(go)}) and "
-            f"{finger_geom(finger_name, gf)}"
+            f"{finger_name} ({inspector.GetName(gf)})"
         )
 
     names = {}
@@ -401,8 +455,11 @@ def contacts_of_distances(
         if closest is None or psi < closest[0]:
             closest = (psi, finger_name, gf)
         if psi < -tol and not allow_penetration:
-            penetrations.append(
-                f"{pair(go, finger_name, gf)} penetrate by {-psi * 1e3:.4g} mm"
+            items.append(
+                (
+                    "penetration",
+                    f"{pair(go, finger_name, gf)} penetrate by {-psi * 1e3:.4g} mm",
+                )
             )
             continue
         if abs(psi) > tol and not (allow_penetration and psi < 0):
@@ -417,56 +474,23 @@ def contacts_of_distances(
             "finger_geometry_index": kf,
             "object_geometry_index": ko,
         }
-        found = [
-            PlantContact(
-                p_OC=pp.p_OC,
-                nhat_O=pp.nhat_O,
-                psi=pp.psi,
-                p_FC=np.asarray(X_FO.multiply(pp.p_OF)),
-                normal_source=pp.normal_source,
-                patch_vertex=pp.patch_vertex,
-                exact=pp.exact,
-                **common,
-            )
-            for pp in pair_points(
-                query=query,
-                inspector=inspector,
-                go=go,
-                gf=gf,
-                p_GaCa=np.asarray(p_GaCa),
-                p_GbCb=np.asarray(p_GbCb),
-                nhat_W=np.asarray(nhat_W),
-                psi=psi,
-                to_O=to_O,
-                R_OW=R_OW,
-                tol=tol,
-                patches=patches,
-            )
-        ]
-        deepest = min(c.psi for c in found)
-        if deepest < -tol and not allow_penetration:  # a tilted patch
-            penetrations.append(
-                f"{pair(go, finger_name, gf)} penetrate by "
-                f"{-deepest * 1e3:.4g} mm at a patch corner"
-            )
-            continue
-        contacts += found
-    if penetrations:
-        raise PenetrationError(
-            f"penetration deeper than distance_tolerance = {tol:g} m: "
-            + "; ".join(penetrations)
+        pending = pending_pair(
+            query=query,
+            inspector=inspector,
+            go=go,
+            gf=gf,
+            p_GaCa=np.asarray(p_GaCa),
+            p_GbCb=np.asarray(p_GbCb),
+            nhat_W=np.asarray(nhat_W),
+            psi=psi,
+            X_OW=X_OW,
+            tol=tol,
+            patches=patches,
         )
-    if not contacts:
-        if closest is None:
-            raise NoContactsError(
-                f"the hand has no collision geometry that can touch {object_name!r}"
-            )
-        raise NoContactsError(
-            f"the hand does not touch {object_name!r}: the closest finger geometry "
-            f"is {finger_geom(*closest[1:])} at {closest[0] * 1e3:.4g} mm "
-            f"(distance_tolerance {tol * 1e3:g} mm)"
-        )
-    return _dedupe_contacts(contacts)
+        items.append(("pair", pending, X_FO, common, (go, finger_name, gf)))
+    return StagedContacts(
+        object_name, tol, allow_penetration, closest, items, inspector
+    )
 
 
 def _dedupe_contacts(contacts: list[PlantContact]) -> list[PlantContact]:
