@@ -180,6 +180,7 @@ class BodyCloser:
         self.role.update(dict.fromkeys(self.hand_geoms, _HAND))
         self.role.update({g: _FINGER + f for g, f in self.finger_of.items()})
         self.hand_slot, self.object_slot = {}, {}
+        self._cache = {}  # names and shapes of the plant's geometries
         if object_body is not None:  # find_contacts' order: body, k_f, k_o
             for b in hand_contact_bodies(plant, object_body, hand):
                 for kf, g in enumerate(plant.GetCollisionGeometriesForBody(b)):
@@ -300,6 +301,7 @@ class BodyCloser:
             query,
             [(r[3], r[1], r[2], r[4]) for r in results],
             distance_tolerance=self.tol,
+            cache=self._cache,
         )
         return staged, None
 

@@ -130,9 +130,9 @@ def _equalities(W: np.ndarray, directions: np.ndarray) -> list[np.ndarray]:
     w = W.shape[1]
     out = []
     for u in directions:
-        A = np.empty((w, W.shape[0] + 1))
+        A = np.zeros((w, W.shape[0] + 1))
         A[:, :-1] = W.T
-        A[:, -1] = np.r_[u, np.zeros(w - 3)]
+        A[:3, -1] = u
         out.append(A)
     return out
 

@@ -242,6 +242,8 @@ def pending_pair(
     X_OW,
     tol: float,
     patches: str,
+    cache: dict | None = None,
+    frame: dict | None = None,
 ) -> PendingPair:
     """Read the pair (object geometry ``go``, finger ``gf``) from the query now.
 
@@ -250,10 +252,15 @@ def pending_pair(
     are those :func:`pair_points` returns (to round-off, 1e-12 m, for a
     spherical tip, whose closed form runs over arrays in
     :mod:`~drakegrasp.plant.sphere_tips`), once :func:`resolve_pairs` ran.
+    ``cache`` (kept by the caller across calls on one scene graph) holds the
+    geometries' shapes; ``frame`` (kept for one configuration, with ``X_OW``
+    and its rotation ``R_OW``) the object geometries' poses in O.
     """
+    cache = {} if cache is None else cache
+    frame = {"X_OW": X_OW, "R_OW": _rotation(X_OW)} if frame is None else frame
+    R_OW = frame["R_OW"]
     X_WGa = query.GetPoseInWorld(go)
     X_WGb = query.GetPoseInWorld(gf)
-    R_OW = _rotation(X_OW)
 
     def to_O(p_W):
         return np.asarray(X_OW.multiply(p_W))
@@ -272,20 +279,22 @@ def pending_pair(
         tol=tol,
         patches=patches,
     )
-    fin = inspector.GetShape(gf)
-    key = shape_key(inspector.GetShape(go)) if isinstance(fin, Sphere) else None
-    if key is None:
+    if ("tip", go, gf) not in cache:
+        fin = inspector.GetShape(gf)
+        key = shape_key(inspector.GetShape(go)) if isinstance(fin, Sphere) else None
+        cache["tip", go, gf] = None if key is None else (key, float(fin.radius()))
+    tip = cache["tip", go, gf]
+    if tip is None:
         pending = PendingPair(args, None)
         pending.points = pair_points(**args)
         return pending
-    tip = (
-        key,
-        R_OW @ _rotation(X_WGa),
-        to_O(X_WGa.translation()),
-        to_O(X_WGb.translation()),
-        float(fin.radius()),
-    )
-    return PendingPair(args, tip)
+    if ("pose", go) not in frame:
+        frame["pose", go] = (
+            R_OW @ _rotation(X_WGa),
+            to_O(X_WGa.translation()),
+        )
+    R_OGa, p_OGa = frame["pose", go]
+    return PendingPair(args, (tip[0], R_OGa, p_OGa, to_O(X_WGb.translation()), tip[1]))
 
 
 def resolve_pairs(pending) -> None:

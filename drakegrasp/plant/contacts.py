@@ -414,37 +414,48 @@ def stage_contacts(
     distance_tolerance: float,
     allow_penetration: bool = False,
     patches: str = "vertices",
+    cache: dict | None = None,
 ) -> StagedContacts:
     """Read the touching pairs of :func:`contacts_of_distances` from Drake now.
 
     The arguments are those of :func:`contacts_of_distances`; the query and
-    the context may change once this returns.  :func:`resolve_staged` and
-    :meth:`StagedContacts.contacts` finish the work.
+    the context may change once this returns: :func:`resolve_staged` and
+    :func:`staged_contacts` finish the work.  ``cache`` is a dict the caller
+    keeps across calls on one plant and scene graph (names and shapes are
+    then read once).
     """
     tol = distance_tolerance
+    cache = {} if cache is None else cache
     inspector = query.inspector()
-    object_name = _scoped_name(plant, body)
-    object_geometries = set(plant.GetCollisionGeometriesForBody(body))
+    key = ("object", int(body.index()))
+    if key not in cache:
+        cache[key] = (
+            _scoped_name(plant, body),
+            set(plant.GetCollisionGeometriesForBody(body)),
+        )
+    object_name, object_geometries = cache[key]
     X_WO = plant.EvalBodyPoseInWorld(plant_context, body)
     X_OW = X_WO.inverse()
+    frame = {"X_OW": X_OW, "R_OW": X_OW.rotation().matrix()}  # this call's
     items: list[tuple] = []
     closest: tuple[float, str] | None = None
 
-    def pair(go, finger_name, gf):
-        return (
-            f"{object_name} ({inspector.GetName(go)}) and "
-            f"{finger_name} ({inspector.GetName(gf)})"
-        )
+    def name(gid):
+        if ("name", gid) not in cache:
+            cache["name", gid] = inspector.GetName(gid)
+        return cache["name", gid]
 
-    names = {}
+    fingers = {}
     for finger, kf, ko, r in results:
-        if finger.index() not in names:
+        if finger.index() not in fingers:
             X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
-            names[finger.index()] = (
-                _scoped_name(plant, finger),
+            if ("body", finger.index()) not in cache:
+                cache["body", finger.index()] = _scoped_name(plant, finger)
+            fingers[finger.index()] = (
+                cache["body", finger.index()],
                 X_WF.inverse().multiply(X_WO),
             )
-        finger_name, X_FO = names[finger.index()]
+        finger_name, X_FO = fingers[finger.index()]
         if r.id_A in object_geometries:
             go, gf = r.id_A, r.id_B
             p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
@@ -458,7 +469,8 @@ def stage_contacts(
             items.append(
                 (
                     "penetration",
-                    f"{pair(go, finger_name, gf)} penetrate by {-psi * 1e3:.4g} mm",
+                    f"{object_name} ({name(go)}) and {finger_name} ({name(gf)}) "
+                    f"penetrate by {-psi * 1e3:.4g} mm",
                 )
             )
             continue
@@ -469,8 +481,8 @@ def stage_contacts(
             "finger_body_index": finger.index(),
             "object_geometry": go,
             "finger_geometry": gf,
-            "object_geometry_name": inspector.GetName(go),
-            "finger_geometry_name": inspector.GetName(gf),
+            "object_geometry_name": name(go),
+            "finger_geometry_name": name(gf),
             "finger_geometry_index": kf,
             "object_geometry_index": ko,
         }
@@ -486,6 +498,8 @@ def stage_contacts(
             X_OW=X_OW,
             tol=tol,
             patches=patches,
+            cache=cache,
+            frame=frame,
         )
         items.append(("pair", pending, X_FO, common, (go, finger_name, gf)))
     return StagedContacts(
@@ -494,14 +508,27 @@ def stage_contacts(
 
 
 def _dedupe_contacts(contacts: list[PlantContact]) -> list[PlantContact]:
-    out: list[PlantContact] = []
-    for c in contacts:
-        if any(
-            c.finger_body_index == k.finger_body_index
-            and np.linalg.norm(c.p_OC - k.p_OC) < ON_SURFACE_TOL
-            and c.nhat_O @ k.nhat_O > 1 - 1e-9
-            for k in out
-        ):
-            continue
-        out.append(c)
-    return out
+    """Drop a contact that repeats an earlier kept one of the same finger body.
+
+    Repeats: within :data:`ON_SURFACE_TOL` and with normals within 1e-9 of
+    each other (two geometries of one body touching at one point).
+    """
+    if len(contacts) < 2:
+        return list(contacts)
+    P = np.array([c.p_OC for c in contacts])
+    N = np.array([c.nhat_O for c in contacts])
+    body = np.array([int(c.finger_body_index) for c in contacts])
+    gap = P[:, None, :] - P[None, :, :]
+    same = (
+        (body[:, None] == body[None, :])
+        & (np.sqrt(np.sum(gap * gap, axis=2)) < ON_SURFACE_TOL)
+        & (N @ N.T > 1 - 1e-9)
+    )
+    np.fill_diagonal(same, False)
+    if not same.any():
+        return list(contacts)
+    kept: list[int] = []
+    for i in range(len(contacts)):
+        if not same[i, kept].any():
+            kept.append(i)
+    return [contacts[i] for i in kept]
