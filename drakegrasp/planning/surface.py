@@ -307,15 +307,15 @@ class Piece:
 
 
 def _near_lines(p: np.ndarray, d: np.ndarray, centre: np.ndarray, radius: float):
-    """Rows whose line ``p + t d`` (``d`` unit) passes within the ball, or None.
+    """Rows whose line ``p + t d`` passes within the ball, or None.
 
     None when every row does (no subset to take).  The test is loose by a
     relative 1e-9 and 1e-12 m, so a line it drops misses the ball, hence the
     piece, by more than round-off.
     """
     w = centre - p
-    along = w @ d if w.ndim == 1 else np.einsum("ij,ij->i", w, d)
-    gap2 = np.einsum("ij,ij->i", w, w) - along * along
+    along = np.einsum("ij,ij->i", w, d)
+    gap2 = np.einsum("ij,ij->i", w, w) - along * along / np.einsum("ij,ij->i", d, d)
     reach = radius * (1.0 + 1e-9) + 1e-12
     near = gap2 <= reach * reach
     return None if near.all() else np.flatnonzero(near)
@@ -467,23 +467,22 @@ class ObjectSurface:
         t_out = np.full(K, np.nan)
         n_out = np.zeros((K, 3))
         for piece in self.pieces:
+            # a line that misses the piece's ball misses the piece: only the
+            # others are cast (a corner sphere of a YCB box meets few lines)
+            centre, radius = piece.bounding_ball
+            near = _near_lines(p_O, d_O, piece.X_OG.multiply(centre), radius)
+            if near is None:
+                rows, p, d = slice(None), p_O, d_O
+            elif len(near):
+                rows, p, d = near, p_O[near], d_O[near]
+            else:
+                continue
             R = piece.X_OG.rotation().matrix()
-            p_G = (p_O - piece.X_OG.translation()) @ R
-            d_G = d_O @ R
-            near = _near_lines(p_G, d_G, *piece.bounding_ball)
-            if near is None:  # every line passes near the piece
-                a, b, n = piece.chord(p_G, d_G)
-                n = n @ R.T
-            else:  # a line that misses the piece's ball misses the piece
-                a, b = np.full(K, np.nan), np.full(K, np.nan)
-                n = np.zeros((K, 3))
-                if len(near):
-                    a[near], b[near], n_near = piece.chord(p_G[near], d_G[near])
-                    n[near] = n_near @ R.T
-            t_in = np.fmin(t_in, a)
-            later = ~np.isnan(b) & ~(b <= t_out)
-            t_out = np.where(later, b, t_out)
-            n_out = np.where(later[:, None], n, n_out)
+            a, b, n = piece.chord((p - piece.X_OG.translation()) @ R, d @ R)
+            t_in[rows] = np.fmin(t_in[rows], a)
+            later = ~np.isnan(b) & ~(b <= t_out[rows])
+            t_out[rows] = np.where(later, b, t_out[rows])
+            n_out[rows] = np.where(later[:, None], n @ R.T, n_out[rows])
         return t_in, t_out, n_out
 
     def radius_about(self, p_O: np.ndarray) -> float:
