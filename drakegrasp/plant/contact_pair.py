@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.geometry import Sphere
+from pydrake.math import RigidTransform
 
 from drakegrasp.errors import NoContactsError, PenetrationError
 from drakegrasp.plant._shapes import surface_pieces
@@ -27,7 +28,12 @@ from drakegrasp.plant.contact_normals import (
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
 from drakegrasp.plant.exact_contact import closest_pair
 from drakegrasp.plant.shape_queries import PosedShape
-from drakegrasp.plant.sphere_tips import SOURCES, shape_key, sphere_tip_pairs
+from drakegrasp.plant.sphere_tips import (
+    SOURCES,
+    shape_key,
+    sphere_tip_pairs,
+    transform_rows,
+)
 
 __all__ = [
     "PairPoint",
@@ -259,8 +265,10 @@ def pending_pair(
     cache = {} if cache is None else cache
     frame = {"X_OW": X_OW, "R_OW": _rotation(X_OW)} if frame is None else frame
     R_OW = frame["R_OW"]
-    X_WGa = query.GetPoseInWorld(go)
-    X_WGb = query.GetPoseInWorld(gf)
+    # copies: the query's poses are views of its state, which the next
+    # configuration overwrites
+    X_WGa = RigidTransform(query.GetPoseInWorld(go))
+    X_WGb = RigidTransform(query.GetPoseInWorld(gf))
 
     def to_O(p_W):
         return np.asarray(X_OW.multiply(p_W))
@@ -294,7 +302,10 @@ def pending_pair(
             to_O(X_WGa.translation()),
         )
     R_OGa, p_OGa = frame["pose", go]
-    return PendingPair(args, (tip[0], R_OGa, p_OGa, to_O(X_WGb.translation()), tip[1]))
+    if "p_OW" not in frame:
+        frame["p_OW"] = np.array(X_OW.translation())
+    tip_W = np.array(X_WGb.translation())  # the tip's centre, to O in the batch
+    return PendingPair(args, (tip[0], R_OGa, p_OGa, tip_W, tip[1], R_OW, frame["p_OW"]))
 
 
 def resolve_pairs(pending) -> None:
@@ -310,7 +321,11 @@ def resolve_pairs(pending) -> None:
             dims,
             np.array([p.tip[1] for p in rows]),
             np.array([p.tip[2] for p in rows]),
-            np.array([p.tip[3] for p in rows]),
+            transform_rows(
+                np.array([p.tip[5] for p in rows]),
+                np.array([p.tip[6] for p in rows]),
+                np.array([p.tip[3] for p in rows]),
+            ),
             np.array([p.tip[4] for p in rows]),
             np.array([p.args["psi"] for p in rows]),
         )

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SOURCES", "TIP_KINDS", "shape_key", "sphere_tip_pairs"]
+__all__ = ["SOURCES", "TIP_KINDS", "shape_key", "sphere_tip_pairs", "transform_rows"]
 
 TIP_KINDS = ("Box", "Cylinder", "Sphere")
 """Object shapes whose projection is in closed form here."""
@@ -83,6 +83,14 @@ def _mtv(R: np.ndarray, v: np.ndarray) -> np.ndarray:
         + R[:, 1, :] * v[:, 1, None]
         + R[:, 2, :] * v[:, 2, None]
     )
+
+
+def transform_rows(R: np.ndarray, t: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``R p + t`` row by row: points (P, 3) by poses (P, 3, 3), (P, 3).
+
+    Element by element, so a row's result does not depend on the others.
+    """
+    return _mv(np.asarray(R, float), np.asarray(p, float)) + np.asarray(t, float)
 
 
 def _project(kind: str, dims: tuple, p: np.ndarray):
