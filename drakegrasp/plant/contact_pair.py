@@ -223,7 +223,7 @@ class PendingPair:
 
     Made by :func:`pending_pair` while the query object describes the pair's
     configuration; :func:`resolve_pairs` fills :attr:`points` (a spherical tip
-    on a box, cylinder or sphere in one vectorised batch with every other such
+    on a box, cylinder, sphere or hull in one vectorised batch with every other such
     pair, anything else at once by :func:`pair_points`).
     """
 

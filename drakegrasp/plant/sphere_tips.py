@@ -1,7 +1,8 @@
 r"""Exact contacts of spherical finger tips, vectorised over many pairs.
 
 A spherical finger geometry (the WSG-50's four tip spheres, a fingertip ball)
-touching a box, a cylinder or a sphere of the object is the ``"core"`` route
+touching a box, a cylinder, a sphere or a convex hull (``Convex``, ``Mesh``)
+of the object is the ``"core"`` route
 of :mod:`drakegrasp.plant.exact_contact` with a core of one point: the tip's
 centre ``c`` projected onto the object's shape gives the signed distance
 ``sd``, the closest surface point ``q`` and the outward normal ``m`` in closed
@@ -32,9 +33,18 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SOURCES", "TIP_KINDS", "shape_key", "sphere_tip_pairs", "transform_rows"]
+from drakegrasp.plant._shapes import face_arrays, flat_faces
 
-TIP_KINDS = ("Box", "Cylinder", "Sphere")
+__all__ = [
+    "SOURCES",
+    "TIP_KINDS",
+    "Hull",
+    "shape_key",
+    "sphere_tip_pairs",
+    "transform_rows",
+]
+
+TIP_KINDS = ("Box", "Convex", "Cylinder", "Sphere")
 """Object shapes whose projection is in closed form here."""
 
 SOURCES = ("object", "edge", "corner")
@@ -45,11 +55,52 @@ _CERTIFY_TOL = 1e-10  # exact_contact.CERTIFY_TOL
 _DRAKE_AGREEMENT = 1e-3  # exact_contact._DRAKE_AGREEMENT
 _SOURCE_TOL = 1e-9  # the tolerance contact_pair gives normal_source's pieces
 _FLAT = 1e-12  # shape_queries._FLAT
+_CHUNK = 1_000_000  # pairs × hull edges in one array
+
+
+class Hull:
+    """A convex hull's faces and edges as arrays (frame G), hashable by its source.
+
+    ``N`` (F, 3) outward unit normals, ``D`` (F,) offsets, ``EA``/``EB`` (E, 3)
+    every face's edges (counter-clockwise, face by face), ``starts`` (F,) each
+    face's first edge, ``V`` (M, 3) the vertices.
+    """
+
+    def __init__(self, key, faces):
+        self.key = key
+        self.N, self.D, self.EA, self.EB, EF = face_arrays(faces)
+        self.starts = np.flatnonzero(np.r_[True, EF[1:] != EF[:-1]])
+        self.EF = EF
+        self.V = np.unique(self.EA, axis=0)
+
+    def __hash__(self):
+        return hash(self.key)
+
+    def __eq__(self, other):
+        return isinstance(other, Hull) and other.key == self.key
+
+
+_HULLS: dict[tuple, Hull] = {}
 
 
 def shape_key(shape) -> tuple | None:
-    """``(kind, dimensions)`` of a Drake shape this module projects onto, or None."""
+    """``(kind, dimensions)`` of a Drake shape this module projects onto, or None.
+
+    A ``Convex`` or ``Mesh`` (its convex hull, as Drake's queries see it) has
+    a :class:`Hull` for dimensions.
+    """
     kind = type(shape).__name__
+    if kind in ("Convex", "Mesh"):
+        source = shape.source()
+        key = (
+            str(source.path()) if source.is_path() else source.description(),
+            tuple(np.asarray(shape.scale3()).tolist()),
+        )
+        if key not in _HULLS:
+            if len(_HULLS) >= 256:
+                _HULLS.clear()
+            _HULLS[key] = Hull(key, flat_faces(shape))
+        return "Convex", _HULLS[key]
     if kind == "Box":
         return kind, (shape.width(), shape.depth(), shape.height())
     if kind == "Cylinder":
@@ -170,7 +221,57 @@ def _project(kind: str, dims: tuple, p: np.ndarray):
             cap_n,
         )
         return sd, q, n
+    if kind == "Convex":
+        return _project_convex(dims, p)
     raise ValueError(f"no closed-form projection onto a {kind}")
+
+
+def _planes(H: Hull, p: np.ndarray) -> np.ndarray:
+    """(P, F) signed gaps of the points to the hull's face planes."""
+    N = H.N
+    return p[:, 0:1] * N[:, 0] + p[:, 1:2] * N[:, 1] + p[:, 2:3] * N[:, 2] - H.D
+
+
+def _project_convex(H: Hull, p: np.ndarray):
+    """PosedShape's projection onto a hull, over rows.
+
+    Inside, the nearest face plane; outside, the nearest visible face whose
+    interior the point projects into, or the nearest point of a visible edge.
+    """
+    P = len(p)
+    rows = np.arange(P)
+    N, EA, EB, EF = H.N, H.EA, H.EB, H.EF
+    gaps = _planes(H, p)
+    k = np.argmax(gaps, axis=1)
+    gk = gaps[rows, k]
+    q_all = p[:, None, :] - gaps[:, :, None] * N[None]  # on every face plane
+    visible = gaps > 0
+    side = np.sum(np.cross(EB - EA, q_all[:, EF] - EA) * N[EF], axis=2)
+    outside = np.logical_or.reduceat(side < 0, H.starts, axis=1)
+    inner = visible & ~outside
+    face_gap = np.where(inner, gaps, np.inf)
+    f = np.argmin(face_gap, axis=1)
+    face_d = face_gap[rows, f]
+    AB = EB - EA
+    s = np.clip(np.sum((p[:, None, :] - EA) * AB, axis=2) / np.sum(AB**2, axis=1), 0, 1)
+    C = EA + s[:, :, None] * AB
+    dist = np.where(
+        visible[:, EF], np.sqrt(np.sum((p[:, None, :] - C) ** 2, 2)), np.inf
+    )
+    j = np.argmin(dist, axis=1)
+    edge_d = dist[rows, j]
+    edge = (edge_d < face_d)[:, None]
+    Cj = C[rows, j]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n_edge = (p - Cj) / edge_d[:, None]
+    d = np.where(edge[:, 0], edge_d, face_d)
+    q = np.where(edge, Cj, q_all[rows, f])
+    n = np.where(edge, n_edge, N[f])
+    inside = (gk <= 0.0)[:, None]
+    sd = np.where(inside[:, 0], gk, d)
+    q = np.where(inside, p - gk[:, None] * N[k], q)
+    n = np.where(inside, N[k], n)
+    return sd, q, n
 
 
 def _pieces_at(kind: str, dims: tuple, p: np.ndarray) -> np.ndarray:
@@ -182,6 +283,8 @@ def _pieces_at(kind: str, dims: tuple, p: np.ndarray) -> np.ndarray:
     if kind == "Sphere":
         return np.ones(len(p), dtype=int)
     tol = _SOURCE_TOL
+    if kind == "Convex":
+        return np.maximum((np.abs(_planes(dims, p)) < tol).sum(axis=1), 1)
     if kind == "Box":
         h = 0.5 * np.array(dims, dtype=float)
         on = (np.abs(p - h) < tol).sum(axis=1) + (np.abs(-p - h) < tol).sum(axis=1)
@@ -201,6 +304,10 @@ def _support_value(kind: str, dims: tuple, R, t, v_O) -> np.ndarray:
     ``near`` point (a face or edge then gives its centre's point).
     """
     v = _mtv(R, v_O)
+    if kind == "Convex":  # the top vertex (a face's or an edge's, as high)
+        V = dims.V
+        top = np.max(v[:, 0:1] * V[:, 0] + v[:, 1:2] * V[:, 1] + v[:, 2:3] * V[:, 2], 1)
+        return top + _dot(v_O, t)
     v = v / _norm(v)[:, None]
     if kind == "Sphere":
         x = dims[0] * v
@@ -227,11 +334,11 @@ def sphere_tip_pairs(
     radius: np.ndarray,
     psi_drake: np.ndarray,
 ):
-    """Exact contacts of ``P`` spherical tips with one kind of object shape.
+    """Exact contacts of ``P`` spherical tips with one object shape.
 
     Parameters
     ----------
-    kind, dims : str, tuple
+    kind, dims : str, tuple or Hull
         The object geometry's shape (:func:`shape_key`).
     R_OG : (P, 3, 3) float
         Each pair's object geometry rotation in the common frame O.
@@ -262,6 +369,22 @@ def sphere_tip_pairs(
     """
     R, t, c = (np.asarray(a, dtype=float) for a in (R_OG, p_OG, c_O))
     r = np.asarray(radius, dtype=float)
+    psi_drake = np.asarray(psi_drake, dtype=float)
+    chunk = max(1, _CHUNK // len(dims.EA)) if kind == "Convex" else len(c)
+    if len(c) > chunk:  # a hull of many edges: (pairs × edges) arrays in chunks
+        parts = [
+            sphere_tip_pairs(
+                kind,
+                dims,
+                R[i : i + chunk],
+                t[i : i + chunk],
+                c[i : i + chunk],
+                r[i : i + chunk],
+                psi_drake[i : i + chunk],
+            )  # fmt: skip
+            for i in range(0, len(c), chunk)
+        ]
+        return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
     sd, q, m_G = _project(kind, dims, _mtv(R, c - t))
     q_O = _mv(R, q) + t
     m = _mv(R, m_G)
@@ -271,7 +394,7 @@ def sphere_tip_pairs(
     tol = _CERTIFY_TOL
     with np.errstate(invalid="ignore", divide="ignore"):
         ok = np.all(np.isfinite(n), axis=1) & (np.abs(_norm(n) - 1.0) <= 1e-12)
-        ok &= np.abs(psi - np.asarray(psi_drake, float)) <= _DRAKE_AGREEMENT
+        ok &= np.abs(psi - psi_drake) <= _DRAKE_AGREEMENT
         ok &= _norm(q_O - p_b - psi[:, None] * n) <= tol
         on_a = _project(kind, dims, _mtv(R, q_O - t))[0]
         ok &= np.abs(on_a) <= tol

@@ -13,9 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pydrake.geometry import Box, Cylinder, Sphere
+from pydrake.geometry import Box, Convex, Cylinder, Sphere
 from scipy.spatial.transform import Rotation
 
+from drakegrasp.plant import models_dir
 from drakegrasp.plant._shapes import surface_pieces
 from drakegrasp.plant.contact_normals import clean_unit, normal_source
 from drakegrasp.plant.exact_contact import closest_pair
@@ -26,6 +27,7 @@ SHAPES = {
     "box": Box(0.06, 0.09, 0.17),
     "cylinder": Cylinder(0.033, 0.1),
     "sphere": Sphere(0.04),
+    "hull": Convex(str(models_dir() / "objects" / "hex_prism.obj"), 1.3),
 }
 TIP = 0.002
 
@@ -127,6 +129,20 @@ def test_a_far_drake_distance_is_not_certified():
     )[0]  # fmt: skip
     assert not ok.any()
     assert all(_scalar(shape, R, t, c[k], psi[k] + 0.01) is None for k in range(10))
+
+
+def test_a_large_hull_is_taken_in_chunks(monkeypatch):
+    from drakegrasp.plant import sphere_tips
+
+    shape = SHAPES["hull"]
+    R, t, c, psi = _cases(shape, np.random.default_rng(9), n=40)
+    kind, dims = shape_key(shape)
+    args = (np.repeat(R[None], 40, 0), np.repeat(t[None], 40, 0), c, np.full(40, TIP))
+    whole = sphere_tip_pairs(kind, dims, *args, psi)
+    monkeypatch.setattr(sphere_tips, "_CHUNK", 7 * len(dims.EA))  # 7 pairs a chunk
+    chunked = sphere_tip_pairs(kind, dims, *args, psi)
+    for a, b in zip(whole, chunked, strict=True):
+        assert np.array_equal(a, b)
 
 
 def test_other_shapes_have_no_closed_form_here():
