@@ -287,6 +287,8 @@ class BodyCloser:
         """
         results = []
         for pair in pairs:
+            if pair.distance > self.tol:  # no contact (names no closest pair)
+                continue
             a, b = pair.id_A, pair.id_B
             key = self.hand_slot.get(a) or self.hand_slot.get(b)
             ko = self.object_slot.get(b if a in self.hand_slot else a)

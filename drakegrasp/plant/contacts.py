@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.geometry import GeometryId, QueryObject
+from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context
@@ -434,7 +435,7 @@ def stage_contacts(
             set(plant.GetCollisionGeometriesForBody(body)),
         )
     object_name, object_geometries = cache[key]
-    X_WO = plant.EvalBodyPoseInWorld(plant_context, body)
+    X_WO = RigidTransform(plant.EvalBodyPoseInWorld(plant_context, body))  # a copy
     X_OW = X_WO.inverse()
     frame = {"X_OW": X_OW, "R_OW": X_OW.rotation().matrix()}  # this call's
     items: list[tuple] = []
@@ -447,21 +448,13 @@ def stage_contacts(
 
     fingers = {}
     for finger, kf, ko, r in results:
-        if finger.index() not in fingers:
-            X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
-            if ("body", finger.index()) not in cache:
-                cache["body", finger.index()] = _scoped_name(plant, finger)
-            fingers[finger.index()] = (
-                cache["body", finger.index()],
-                X_WF.inverse().multiply(X_WO),
-            )
-        finger_name, X_FO = fingers[finger.index()]
-        if r.id_A in object_geometries:
-            go, gf = r.id_A, r.id_B
-            p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
-        else:  # Drake swapped the pair: normal now points into the finger
-            go, gf = r.id_B, r.id_A
-            p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
+        index = finger.index()
+        if ("body", index) not in cache:
+            cache["body", index] = _scoped_name(plant, finger)
+        finger_name = cache["body", index]
+        id_A = r.id_A
+        swapped = id_A not in object_geometries  # the normal points into the finger
+        go, gf = (r.id_B, id_A) if swapped else (id_A, r.id_B)
         psi = float(r.distance)
         if closest is None or psi < closest[0]:
             closest = (psi, finger_name, gf)
@@ -476,9 +469,17 @@ def stage_contacts(
             continue
         if abs(psi) > tol and not (allow_penetration and psi < 0):
             continue
+        if swapped:
+            p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
+        else:
+            p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
+        if index not in fingers:
+            X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
+            fingers[index] = X_WF.inverse().multiply(X_WO)
+        X_FO = fingers[index]
         common = {
             "finger_body": finger_name,
-            "finger_body_index": finger.index(),
+            "finger_body_index": index,
             "object_geometry": go,
             "finger_geometry": gf,
             "object_geometry_name": name(go),
