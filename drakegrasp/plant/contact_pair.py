@@ -30,6 +30,7 @@ from drakegrasp.plant.exact_contact import closest_pair
 from drakegrasp.plant.shape_queries import PosedShape
 from drakegrasp.plant.sphere_tips import (
     SOURCES,
+    clean_rows,
     shape_key,
     sphere_tip_pairs,
     transform_rows,
@@ -329,20 +330,14 @@ def resolve_pairs(pending) -> None:
             np.array([p.tip[4] for p in rows]),
             np.array([p.args["psi"] for p in rows]),
         )
+        n = clean_rows(n)
+        psi = psi.tolist()
         for k, p in enumerate(rows):
             if not ok[k]:  # the scalar route decides (Drake's witness then)
                 p.points = pair_points(**p.args)
                 continue
             p.points = [
-                PairPoint(
-                    p_a[k],
-                    clean_unit(n[k]),
-                    float(psi[k]),
-                    p_b[k],
-                    SOURCES[source[k]],
-                    None,
-                    True,
-                )
+                PairPoint(p_a[k], n[k], psi[k], p_b[k], SOURCES[source[k]], None, True)
             ]
 
 

@@ -39,6 +39,7 @@ __all__ = [
     "SOURCES",
     "TIP_KINDS",
     "Hull",
+    "clean_rows",
     "shape_key",
     "sphere_tip_pairs",
     "transform_rows",
@@ -134,6 +135,15 @@ def _mtv(R: np.ndarray, v: np.ndarray) -> np.ndarray:
         + R[:, 1, :] * v[:, 1, None]
         + R[:, 2, :] * v[:, 2, None]
     )
+
+
+def clean_rows(n: np.ndarray) -> np.ndarray:
+    """Unit rows with round-off components (< 1e-12) set to exactly zero.
+
+    :func:`~drakegrasp.plant.contact_normals.clean_unit` over rows (P, 3).
+    """
+    n = np.where(np.abs(n) < 1e-12, 0.0, np.asarray(n, dtype=float))
+    return n / _norm(n)[:, None]
 
 
 def transform_rows(R: np.ndarray, t: np.ndarray, p: np.ndarray) -> np.ndarray:
