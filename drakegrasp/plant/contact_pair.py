@@ -224,16 +224,43 @@ class PendingPair:
 
     Made by :func:`pending_pair` while the query object describes the pair's
     configuration; :func:`resolve_pairs` fills :attr:`points` (a spherical tip
-    on a box, cylinder, sphere or hull in one vectorised batch with every other such
-    pair, anything else at once by :func:`pair_points`).
+    on a box, cylinder, sphere or hull in one vectorised batch with every
+    other such pair, anything else at once by :func:`pair_points`).
     """
 
-    __slots__ = ("args", "points", "tip")
+    __slots__ = ("_read", "points", "tip")
 
-    def __init__(self, args: dict, tip: tuple | None):
-        self.args = args
+    def __init__(self, read: tuple, tip: tuple | None):
+        self._read = read
         self.tip = tip
         self.points: list[PairPoint] | None = None
+
+    @property
+    def args(self) -> dict:
+        """The keyword arguments of :func:`pair_points` for this pair."""
+        inspector, go, gf, r, swapped, psi, X_OW, R_OW, poses, tol, patches = self._read
+        if swapped:  # Drake's pair (finger, object): its normal into the finger
+            p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
+        else:
+            p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
+
+        def to_O(p_W):
+            return np.asarray(X_OW.multiply(p_W))
+
+        return dict(
+            query=_PosesAt(poses),
+            inspector=inspector,
+            go=go,
+            gf=gf,
+            p_GaCa=np.asarray(p_GaCa),
+            p_GbCb=np.asarray(p_GbCb),
+            nhat_W=np.asarray(nhat_W),
+            psi=psi,
+            to_O=to_O,
+            R_OW=R_OW,
+            tol=tol,
+            patches=patches,
+        )
 
 
 def pending_pair(
@@ -242,10 +269,8 @@ def pending_pair(
     inspector,
     go,
     gf,
-    p_GaCa: np.ndarray,
-    p_GbCb: np.ndarray,
-    nhat_W: np.ndarray,
-    psi: float,
+    pair,
+    swapped: bool,
     X_OW,
     tol: float,
     patches: str,
@@ -254,59 +279,47 @@ def pending_pair(
 ) -> PendingPair:
     """Read the pair (object geometry ``go``, finger ``gf``) from the query now.
 
-    The arguments are those of :func:`pair_points`, with the transform
-    ``X_OW`` (world to object frame) for ``to_O`` and ``R_OW``.  The points
-    are those :func:`pair_points` returns (to round-off, 1e-12 m, for a
-    spherical tip, whose closed form runs over arrays in
+    ``pair`` is Drake's ``SignedDistancePair``, ``swapped`` True when its
+    ``A`` is the finger's geometry; ``X_OW`` maps the world to the object
+    frame; ``tol`` and ``patches`` are those of :func:`pair_points`.  The
+    points are those :func:`pair_points` returns (to round-off, 1e-12 m, for
+    a spherical tip, whose closed form runs over arrays in
     :mod:`~drakegrasp.plant.sphere_tips`), once :func:`resolve_pairs` ran.
     ``cache`` (kept by the caller across calls on one scene graph) holds the
     geometries' shapes; ``frame`` (kept for one configuration, with ``X_OW``
-    and its rotation ``R_OW``) the object geometries' poses in O.
+    and its rotation ``R_OW``) the object geometries' poses.
     """
     cache = {} if cache is None else cache
     frame = {"X_OW": X_OW, "R_OW": _rotation(X_OW)} if frame is None else frame
     R_OW = frame["R_OW"]
     # copies: the query's poses are views of its state, which the next
     # configuration overwrites
-    X_WGa = RigidTransform(query.GetPoseInWorld(go))
-    X_WGb = RigidTransform(query.GetPoseInWorld(gf))
-
-    def to_O(p_W):
-        return np.asarray(X_OW.multiply(p_W))
-
-    args = dict(
-        query=_PosesAt({go: X_WGa, gf: X_WGb}),
-        inspector=inspector,
-        go=go,
-        gf=gf,
-        p_GaCa=p_GaCa,
-        p_GbCb=p_GbCb,
-        nhat_W=nhat_W,
-        psi=psi,
-        to_O=to_O,
-        R_OW=R_OW,
-        tol=tol,
-        patches=patches,
-    )
-    if ("tip", go, gf) not in cache:
-        fin = inspector.GetShape(gf)
-        key = shape_key(inspector.GetShape(go)) if isinstance(fin, Sphere) else None
-        cache["tip", go, gf] = None if key is None else (key, float(fin.radius()))
-    tip = cache["tip", go, gf]
-    if tip is None:
-        pending = PendingPair(args, None)
-        pending.points = pair_points(**args)
-        return pending
-    if ("pose", go) not in frame:
+    if ("X_WG", go) not in frame:
+        X_WGa = RigidTransform(query.GetPoseInWorld(go))
+        frame["X_WG", go] = X_WGa
         frame["pose", go] = (
             R_OW @ _rotation(X_WGa),
-            to_O(X_WGa.translation()),
+            np.asarray(X_OW.multiply(X_WGa.translation())),
         )
+    X_WGb = RigidTransform(query.GetPoseInWorld(gf))
+    read = (
+        inspector, go, gf, pair, swapped, float(pair.distance), X_OW, R_OW,
+        {go: frame["X_WG", go], gf: X_WGb}, tol, patches,
+    )  # fmt: skip
+    tip = cache.get(("tip", go, gf), False)
+    if tip is False:
+        fin = inspector.GetShape(gf)
+        key = shape_key(inspector.GetShape(go)) if isinstance(fin, Sphere) else None
+        tip = cache["tip", go, gf] = None if key is None else (key, fin.radius())
+    if tip is None:
+        pending = PendingPair(read, None)
+        pending.points = pair_points(**pending.args)
+        return pending
     R_OGa, p_OGa = frame["pose", go]
     if "p_OW" not in frame:
         frame["p_OW"] = np.array(X_OW.translation())
     tip_W = np.array(X_WGb.translation())  # the tip's centre, to O in the batch
-    return PendingPair(args, (tip[0], R_OGa, p_OGa, tip_W, tip[1], R_OW, frame["p_OW"]))
+    return PendingPair(read, (tip[0], R_OGa, p_OGa, tip_W, tip[1], R_OW, frame["p_OW"]))
 
 
 def resolve_pairs(pending) -> None:
@@ -328,7 +341,7 @@ def resolve_pairs(pending) -> None:
                 np.array([p.tip[3] for p in rows]),
             ),
             np.array([p.tip[4] for p in rows]),
-            np.array([p.args["psi"] for p in rows]),
+            np.array([p._read[5] for p in rows]),
         )
         n = clean_rows(n)
         psi = psi.tolist()

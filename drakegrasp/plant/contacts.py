@@ -469,10 +469,6 @@ def stage_contacts(
             continue
         if abs(psi) > tol and not (allow_penetration and psi < 0):
             continue
-        if swapped:
-            p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
-        else:
-            p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
         if index not in fingers:
             X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
             fingers[index] = X_WF.inverse().multiply(X_WO)
@@ -492,10 +488,8 @@ def stage_contacts(
             inspector=inspector,
             go=go,
             gf=gf,
-            p_GaCa=np.asarray(p_GaCa),
-            p_GbCb=np.asarray(p_GbCb),
-            nhat_W=np.asarray(nhat_W),
-            psi=psi,
+            pair=r,
+            swapped=swapped,
             X_OW=X_OW,
             tol=tol,
             patches=patches,
