@@ -19,7 +19,7 @@ from pydrake.geometry import Sphere
 from pydrake.math import RigidTransform
 
 from drakegrasp.errors import NoContactsError, PenetrationError
-from drakegrasp.plant._shapes import surface_pieces
+from drakegrasp.plant._shapes import ON_SURFACE_TOL, surface_pieces
 from drakegrasp.plant.contact_normals import (
     choose_normal,
     clean_unit,
@@ -40,6 +40,7 @@ __all__ = [
     "PairPoint",
     "PendingPair",
     "StagedContacts",
+    "dedupe_contacts",
     "pair_points",
     "pending_pair",
     "resolve_pairs",
@@ -223,7 +224,7 @@ class PendingPair:
     """A touching pair read from Drake, its points still to come.
 
     Made by :func:`pending_pair` while the query object describes the pair's
-    configuration; :func:`resolve_pairs` fills :attr:`points` (a spherical tip
+    configuration; :func:`resolve_pairs` fills ``points`` (a spherical tip
     on a box, cylinder, sphere or hull in one vectorised batch with every
     other such pair, anything else at once by :func:`pair_points`).
     """
@@ -431,3 +432,30 @@ class StagedContacts:
 
     def _finger_geom(self, finger_name, gf) -> str:
         return f"{finger_name} ({self.inspector.GetName(gf)})"
+
+
+def dedupe_contacts(contacts: list) -> list:
+    """Drop a contact (``PlantContact``) that repeats a kept one of its finger body.
+
+    Repeats: within ``ON_SURFACE_TOL`` (1e-5 m) and with normals within 1e-9 of
+    each other (two geometries of one body touching at one point).
+    """
+    if len(contacts) < 2:
+        return list(contacts)
+    P = np.array([c.p_OC for c in contacts])
+    N = np.array([c.nhat_O for c in contacts])
+    body = np.array([int(c.finger_body_index) for c in contacts])
+    gap = P[:, None, :] - P[None, :, :]
+    same = (
+        (body[:, None] == body[None, :])
+        & (np.sqrt(np.sum(gap * gap, axis=2)) < ON_SURFACE_TOL)
+        & (N @ N.T > 1 - 1e-9)
+    )
+    np.fill_diagonal(same, False)
+    if not same.any():
+        return list(contacts)
+    kept: list[int] = []
+    for i in range(len(contacts)):
+        if not same[i, kept].any():
+            kept.append(i)
+    return [contacts[i] for i in kept]

@@ -25,6 +25,15 @@ a pair that no route certifies keeps Drake's witness points, with the normal
 chosen as :mod:`~drakegrasp.plant.contact_normals` describes.  The guide's
 *Contacts* page lists the accuracy of every shape pair.
 
+**Many configurations at once.**  :func:`contacts_of_distances` is three
+steps, which a planner runs apart: :func:`stage_contacts` reads the touching
+pairs of one configuration from Drake, :func:`resolve_staged` computes the
+points of any number of staged configurations in one batch (a spherical
+finger tip on a box, cylinder, sphere or convex hull over arrays,
+:mod:`~drakegrasp.plant.sphere_tips`; every other pair by
+:func:`~drakegrasp.plant.contact_pair.pair_points` as it is read), and
+:func:`staged_contacts` gives each configuration's contacts.
+
 **Flat patches.**  A flat pad on a flat face is reported as one contact at
 **each vertex** of its patch polygon (same normal; ``ψ`` the gap at the
 vertex), see :mod:`~drakegrasp.plant.contact_patches`.  A square pad on a box
@@ -48,9 +57,9 @@ from drakegrasp.errors import (
     InvalidOptionError,
     ModelError,
 )
-from drakegrasp.plant._shapes import ON_SURFACE_TOL
 from drakegrasp.plant.contact_pair import (
     StagedContacts,
+    dedupe_contacts,
     pending_pair,
     resolve_pairs,
 )
@@ -376,14 +385,17 @@ def contacts_of_distances(
 
 
 def staged_contacts(staged: StagedContacts) -> list[PlantContact]:
-    """The contacts of a resolved :class:`StagedContacts`, as :func:`find_contacts`.
+    """The contacts of resolved staged pairs, as :func:`find_contacts` returns them.
+
+    ``staged`` is a :class:`~drakegrasp.plant.contact_pair.StagedContacts`
+    that :func:`resolve_staged` resolved.
 
     Raises
     ------
     NoContactsError, PenetrationError
         As :func:`find_contacts`.
     """
-    return _dedupe_contacts(
+    return dedupe_contacts(
         [
             PlantContact(
                 p_OC=pp.p_OC,
@@ -500,30 +512,3 @@ def stage_contacts(
     return StagedContacts(
         object_name, tol, allow_penetration, closest, items, inspector
     )
-
-
-def _dedupe_contacts(contacts: list[PlantContact]) -> list[PlantContact]:
-    """Drop a contact that repeats an earlier kept one of the same finger body.
-
-    Repeats: within :data:`ON_SURFACE_TOL` and with normals within 1e-9 of
-    each other (two geometries of one body touching at one point).
-    """
-    if len(contacts) < 2:
-        return list(contacts)
-    P = np.array([c.p_OC for c in contacts])
-    N = np.array([c.nhat_O for c in contacts])
-    body = np.array([int(c.finger_body_index) for c in contacts])
-    gap = P[:, None, :] - P[None, :, :]
-    same = (
-        (body[:, None] == body[None, :])
-        & (np.sqrt(np.sum(gap * gap, axis=2)) < ON_SURFACE_TOL)
-        & (N @ N.T > 1 - 1e-9)
-    )
-    np.fill_diagonal(same, False)
-    if not same.any():
-        return list(contacts)
-    kept: list[int] = []
-    for i in range(len(contacts)):
-        if not same[i, kept].any():
-            kept.append(i)
-    return [contacts[i] for i in kept]

@@ -287,7 +287,7 @@ def _project_convex(H: Hull, p: np.ndarray):
 def _pieces_at(kind: str, dims: tuple, p: np.ndarray) -> np.ndarray:
     """How many surface pieces meet at ``p`` (frame G): 1 smooth, 2 edge, 3 corner.
 
-    :func:`~drakegrasp.plant._shapes.surface_pieces` with ``tol`` 1e-9,
+    ``surface_pieces`` with ``tol`` 1e-9,
     counted (never fewer than one).
     """
     if kind == "Sphere":
