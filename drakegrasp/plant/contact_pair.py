@@ -378,7 +378,7 @@ class StagedContacts:
         self.inspector = inspector
 
     def pending(self):
-        """The staged pairs (:class:`PendingPair`)."""
+        """The staged pairs (:class:`~drakegrasp.plant.contact_pair.PendingPair`)."""
         return [it[1] for it in self.items if it[0] == "pair"]
 
     def rows(self) -> list[tuple]:
