@@ -246,15 +246,18 @@ class BodyCloser:
         for step_count in range(MAX_CLOSING_STEPS):
             query = self.port.Eval(self.ctx)
             pairs = query.ComputeSignedDistancePairwiseClosestPoints(reach)
-            psi = np.full(2, reach)
+            psi = [reach, reach]
             hit_object = [False, False]
+            colliding = -tol if step_count == 0 else -np.inf  # ψ below: rejected
             for pair in pairs:
+                distance = pair.distance
+                if distance >= max(psi) and distance >= colliding:
+                    continue  # lowers no finger's ψ, penetrates nothing
                 ra, rb = role.get(pair.id_A, _SCENE), role.get(pair.id_B, _SCENE)
                 if (ra >= _HAND) == (rb >= _HAND):
                     continue  # both in the hand, or both outside it
                 mine, other = (ra, rb) if ra >= _HAND else (rb, ra)
-                distance = pair.distance
-                if step_count == 0 and distance < -tol:
+                if distance < colliding:
                     if other == _OBJECT:
                         return None, None, "hand collides with the object"
                     return None, None, "hand collides with the scene"
@@ -262,6 +265,7 @@ class BodyCloser:
                 if f >= 0 and distance < psi[f]:
                     psi[f] = distance
                     hit_object[f] = other == _OBJECT
+            psi = np.array(psi)
             if np.all(psi <= tol):
                 if not all(hit_object):
                     return None, None, "finger blocked by the scene"
