@@ -14,8 +14,9 @@ WSG-50 as a free gripper:
   first, so numba's compilation is not timed), the wall time, samples/s and
   candidates/s (candidates are the samples that survive the collision filter
   and the closing), candidates per CPU second (the machine's load skews wall
-  time), the same with ``--workers`` (2) batch workers, and the rejections by
-  reason;
+  time), the same with ``--workers`` (2) batch workers (wall time, after a
+  warm-up call that starts the pool, which is kept between calls), and the
+  rejections by reason;
 * **the user's loop**: ``--loop`` candidates closed and analysed one at a
   time with ``close_hand``, ``analyze_grasp`` and ``ferrari_canny`` from the
   open hand at the candidate's pose (the baseline of issue 18), candidates/s;
@@ -32,6 +33,11 @@ WSG-50 as a free gripper:
   two-sided grasp holds.  The planner uses ``--mu`` 1.0, the friction
   coefficient of the models' proximity properties (what the simulation uses).
 
+With ``--stages``, each object's one-core run also prints the CPU seconds of
+each stage (:func:`stage_timer`): sampling, the closing in Drake (with the
+reading of the touching pairs), the contacts' batch, verdicts and ε,
+robustness, weight capacity, and the rest.
+
 Then the multi-finger route: the Allegro hand on the soup can, ``--allegro``
 samples, candidates/s with one and two workers, and the hold rates of the top
 and random candidates (:func:`allegro`).
@@ -43,6 +49,7 @@ import argparse
 import os
 import sys
 import time
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
 import numpy as np
@@ -84,6 +91,54 @@ def _open_at(plant, pctx, base, joints, candidate) -> None:
     for j, sign in zip(joints, candidate.closing_signs, strict=True):
         lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
         j.set_translation(pctx, lo if sign > 0 else hi)
+
+
+STAGES = (
+    ("drakegrasp.planning.planner", "sample_poses", "sample"),
+    ("drakegrasp.planning.planner", "_close_on_body", "close (Drake)"),
+    ("drakegrasp.planning.placement", "stage_contacts", "of which pairs read"),
+    ("drakegrasp.planning.placement", "BodyCloser.finish", "contacts"),
+    ("drakegrasp.planning.ranking", "verdicts", "verdicts + ε"),
+    ("drakegrasp.planning.ranking", "reclosed_robustness", "robustness"),
+    ("drakegrasp.planning.ranking", "weight_capacity", "weight"),
+)
+"""(module, function, label) of the stages :func:`stage_timer` times."""
+
+
+@contextmanager
+def stage_timer():
+    """CPU seconds per stage of ``plan_grasps`` (parallel jaw), while inside.
+
+    Wraps the stage functions of :data:`STAGES` where the planner looks them
+    up and yields a dict ``{label: seconds}`` filled as they run (a nested
+    stage, ``of which ...``, is also counted in its parent).
+    """
+    import importlib
+
+    spent = dict.fromkeys([label for *_, label in STAGES], 0.0)
+    undo = []
+    for module, name, label in STAGES:
+        owner = importlib.import_module(module)
+        attr = name
+        if "." in name:
+            cls, attr = name.split(".")
+            owner = getattr(owner, cls)
+        original = getattr(owner, attr)
+
+        def timed(*args, _f=original, _label=label, **kwargs):
+            t = time.process_time()
+            try:
+                return _f(*args, **kwargs)
+            finally:
+                spent[_label] += time.process_time() - t
+
+        setattr(owner, attr, timed)
+        undo.append((owner, attr, original))
+    try:
+        yield spent
+    finally:
+        for owner, attr, original in undo:
+            setattr(owner, attr, original)
 
 
 def user_loop(scene, candidates, mu: float) -> float:
@@ -188,6 +243,11 @@ def main(argv=None) -> int:
     ap.add_argument("--objects", nargs="*", default=None)
     ap.add_argument("--no-shake", action="store_true")
     ap.add_argument(
+        "--stages",
+        action="store_true",
+        help="print the CPU seconds of each planning stage (one core)",
+    )
+    ap.add_argument(
         "--allegro",
         type=int,
         default=100,
@@ -234,13 +294,14 @@ def main(argv=None) -> int:
             scene.plant, scene.context, scene.object_body, num_candidates=50, seed=1,
             **kwargs,
         )  # fmt: skip
-        t, cpu = time.perf_counter(), time.process_time()
-        result = plan_grasps(
-            scene.plant, scene.context, scene.object_body, num_candidates=args.num,
-            seed=args.seed, **kwargs,
-        )  # fmt: skip
-        wall = time.perf_counter() - t
-        cpu = time.process_time() - cpu
+        with stage_timer() if args.stages else nullcontext() as spent:
+            t, cpu = time.perf_counter(), time.process_time()
+            result = plan_grasps(
+                scene.plant, scene.context, scene.object_body,
+                num_candidates=args.num, seed=args.seed, **kwargs,
+            )  # fmt: skip
+            wall = time.perf_counter() - t
+            cpu = time.process_time() - cpu
         rng = np.random.default_rng(args.seed)
         pick = rng.choice(
             len(result), size=min(args.random, len(result)), replace=False
@@ -271,7 +332,19 @@ def main(argv=None) -> int:
             f"{len(result) / cpu:.0f} per CPU second (load "
             f"{os.getloadavg()[0]:.1f})"
         )
+        if spent is not None:
+            top = sum(v for k, v in spent.items() if not k.startswith("of which"))
+            print(
+                f"    CPU s by stage ({cpu:.2f} in all): "
+                + ", ".join(f"{k} {v:.2f}" for k, v in spent.items())
+                + f", rest {cpu - top:.2f}"
+            )
         if args.workers > 1:
+            # the pool's start-up (it is kept between calls) is not timed
+            plan_grasps(
+                scene.plant, scene.context, scene.object_body, num_candidates=50,
+                seed=1, **{**kwargs, "workers": args.workers},
+            )  # fmt: skip
             t = time.perf_counter()
             two = plan_grasps(
                 scene.plant, scene.context, scene.object_body,

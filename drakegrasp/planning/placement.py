@@ -15,7 +15,12 @@ import numpy as np
 
 from drakegrasp.errors import NoContactsError, PenetrationError
 from drakegrasp.planning.gripper import ParallelJaw
-from drakegrasp.plant.contacts import contacts_of_distances
+from drakegrasp.plant.contacts import (
+    StagedContacts,
+    resolve_staged,
+    stage_contacts,
+    staged_contacts,
+)
 from drakegrasp.plant.validation import hand_bodies, hand_contact_bodies, scoped_name
 
 __all__ = [
@@ -175,6 +180,7 @@ class BodyCloser:
         self.role.update(dict.fromkeys(self.hand_geoms, _HAND))
         self.role.update({g: _FINGER + f for g, f in self.finger_of.items()})
         self.hand_slot, self.object_slot = {}, {}
+        self._cache = {}  # names and shapes of the plant's geometries
         if object_body is not None:  # find_contacts' order: body, k_f, k_o
             for b in hand_contact_bodies(plant, object_body, hand):
                 for kf, g in enumerate(plant.GetCollisionGeometriesForBody(b)):
@@ -219,11 +225,13 @@ class BodyCloser:
         pairs within the tolerance are those :func:`~drakegrasp.find_contacts`
         computes one by one (bitwise: the same Drake routine), so the contacts
         are exactly what :func:`~drakegrasp.analyze_grasp` reads on the
-        applied candidate.
+        applied candidate (once :meth:`finish` resolved them).
 
         Returns
         -------
-        contacts : list of PlantContact or None
+        contacts : StagedContacts or None
+            The contacts read from Drake, their points computed by
+            :meth:`finish` for every candidate at once.
         q : (2,) float or None
             The closed joint values.
         reason : str or None
@@ -238,15 +246,18 @@ class BodyCloser:
         for step_count in range(MAX_CLOSING_STEPS):
             query = self.port.Eval(self.ctx)
             pairs = query.ComputeSignedDistancePairwiseClosestPoints(reach)
-            psi = np.full(2, reach)
+            psi = [reach, reach]
             hit_object = [False, False]
+            colliding = -tol if step_count == 0 else -np.inf  # ψ below: rejected
             for pair in pairs:
+                distance = pair.distance
+                if distance >= max(psi) and distance >= colliding:
+                    continue  # lowers no finger's ψ, penetrates nothing
                 ra, rb = role.get(pair.id_A, _SCENE), role.get(pair.id_B, _SCENE)
                 if (ra >= _HAND) == (rb >= _HAND):
                     continue  # both in the hand, or both outside it
                 mine, other = (ra, rb) if ra >= _HAND else (rb, ra)
-                distance = pair.distance
-                if step_count == 0 and distance < -tol:
+                if distance < colliding:
                     if other == _OBJECT:
                         return None, None, "hand collides with the object"
                     return None, None, "hand collides with the scene"
@@ -254,6 +265,7 @@ class BodyCloser:
                 if f >= 0 and distance < psi[f]:
                     psi[f] = distance
                     hit_object[f] = other == _OBJECT
+            psi = np.array(psi)
             if np.all(psi <= tol):
                 if not all(hit_object):
                     return None, None, "finger blocked by the scene"
@@ -271,9 +283,16 @@ class BodyCloser:
         return None, None, "closing did not converge"
 
     def _contacts(self, query, pairs):
-        """The closed hand's contacts from the last step's pairs: (found, reason)."""
+        """The closed hand's contacts from the last step's pairs, staged.
+
+        Returns ``(StagedContacts, None)``: the pairs within the tolerance are
+        read from Drake now, their points computed for all candidates at once
+        by :meth:`finish`.
+        """
         results = []
         for pair in pairs:
+            if pair.distance > self.tol:  # no contact (names no closest pair)
+                continue
             a, b = pair.id_A, pair.id_B
             key = self.hand_slot.get(a) or self.hand_slot.get(b)
             ko = self.object_slot.get(b if a in self.hand_slot else a)
@@ -281,15 +300,41 @@ class BodyCloser:
                 continue
             results.append((key[0], key[1], ko, key[2], pair))
         results.sort(key=lambda r: r[:3])
+        staged = stage_contacts(
+            self.plant,
+            self.ctx,
+            self.object,
+            query,
+            [(r[3], r[1], r[2], r[4]) for r in results],
+            distance_tolerance=self.tol,
+            cache=self._cache,
+        )
+        return staged, None
+
+    def finish(self, kept: list, rejections: Counter) -> list:
+        """Resolve the staged contacts of ``kept`` in one batch; drop the failures.
+
+        ``kept`` holds ``(sample, X_WH, q, opening, contacts)`` with contacts
+        staged by :meth:`close_on_body` (or already a list); the result holds
+        the lists, as :func:`~drakegrasp.find_contacts` reads them on the
+        applied candidate, and ``rejections`` counts the candidates dropped
+        (one finger touching, or a patch corner penetrating).
+        """
+        staged = [k[4] for k in kept if isinstance(k[4], StagedContacts)]
+        resolve_staged(staged)
+        out = []
+        for sample, X_WH, q, opening, found in kept:
+            if isinstance(found, StagedContacts):
+                found, reason = self._finished(found)
+                if reason is not None:
+                    rejections[reason] += 1
+                    continue
+            out.append((sample, X_WH, q, opening, found))
+        return out
+
+    def _finished(self, staged):
         try:
-            found = contacts_of_distances(
-                self.plant,
-                self.ctx,
-                self.object,
-                query,
-                [(r[3], r[1], r[2], r[4]) for r in results],
-                distance_tolerance=self.tol,
-            )
+            found = staged_contacts(staged)
         except NoContactsError:
             return None, "one finger touches"
         except PenetrationError:

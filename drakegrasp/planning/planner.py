@@ -367,6 +367,7 @@ def plan_grasps(
             kept.append((int(poses["sample"][k]), X_WH, q, opening, found))
     finally:
         plant.SetPositions(ctx, saved)
+    kept = closer.finish(kept, rejections)  # every closed pose's contacts at once
     candidates = rank_candidates(
         kept, finger_names=closer.finger_names, gripper=gripper, plant=plant, mu=mu,
         model=model, nu=torsional_friction, torque_scale=torque_scale,

@@ -301,6 +301,7 @@ def rank_candidates(
             np.array([[c.nhat_O for c in kept[i][4]] for i in idx]),
             np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx]),
             mu, torque_scale=torque_scale, model=model, torsional_friction=nu,
+            workers=workers,
         ).min(axis=1)  # fmt: skip
     score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
     order = np.lexsort((samples_of, -d_star, -pre, -score))

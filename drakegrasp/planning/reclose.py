@@ -40,7 +40,8 @@ estimate errs towards fewer contacts.
 
 Everything is vectorised over all copies and probes (one chord query); the
 copies' verdicts are then the batch engine's LP2, grouped by their (ragged)
-contact counts.
+contact counts, except for copies with too few contacts to be force closure
+at all (:data:`NEVER_CLOSURE`).
 """
 
 from __future__ import annotations
@@ -50,7 +51,14 @@ import numpy as np
 from drakegrasp.batch import batch_force_closure
 from drakegrasp.core.linalg import rotations_about
 
-__all__ = ["reclosed_copies", "reclosed_robustness"]
+__all__ = ["NEVER_CLOSURE", "reclosed_copies", "reclosed_robustness"]
+
+NEVER_CLOSURE = {"hard_finger": 2, "frictionless": 6}
+"""Contacts at most this many are never force closure in space, by model: two
+hard fingers' forces all meet the line through their points, so no moment
+about it is resisted; six normals cannot positively span the six wrench
+dimensions.  Such re-closed copies count as slipping without an LP (a cylinder
+or a sphere between two pads leaves many with one contact per pad)."""
 
 
 def reclosed_copies(
@@ -174,7 +182,8 @@ def reclosed_robustness(
     touch, p_OC, nhat, ok = reclosed_copies(surface, P, F, A, t, theta, tol=tol)
     held = np.zeros(M, bool)
     counts = np.where(ok, touch.sum(axis=1), 0)
-    for n in np.unique(counts[counts > 0]):
+    never = NEVER_CLOSURE.get(str(getattr(model, "value", model)), 0)
+    for n in np.unique(counts[counts > never]):  # the others need no LP
         rows = np.flatnonzero(counts == n)
         order = np.argsort(~touch[rows], axis=1, kind="stable")[:, :n]
         take = rows[:, None], order

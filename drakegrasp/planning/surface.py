@@ -32,6 +32,7 @@ geometry's frame.  numpy only, plus Drake's shape classes.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from pydrake.geometry import (
@@ -102,6 +103,20 @@ class Piece:
     normals: np.ndarray
     offsets: np.ndarray
     triangles: np.ndarray
+
+    @cached_property
+    def bounding_ball(self) -> tuple[np.ndarray, float]:
+        """``(centre_G, radius)``: a ball (frame G, metres) holding the piece."""
+        if self.kind == "hull":
+            v = self.triangles.reshape(-1, 3)
+            centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+            return centre, float(np.max(np.linalg.norm(v - centre, axis=1)))
+        r, _, h = self.semi_axes
+        if self.kind == "ellipsoid":
+            return np.zeros(3), float(self.semi_axes.max())
+        if self.kind == "cylinder":
+            return np.zeros(3), float(np.hypot(r, h))
+        return np.zeros(3), float(r + h)
 
     # -- area and sampling ---------------------------------------------------
 
@@ -291,6 +306,21 @@ class Piece:
         return float(centre + h + r)
 
 
+def _near_lines(p: np.ndarray, d: np.ndarray, centre: np.ndarray, radius: float):
+    """Rows whose line ``p + t d`` passes within the ball, or None.
+
+    None when every row does (no subset to take).  The test is loose by a
+    relative 1e-9 and 1e-12 m, so a line it drops misses the ball, hence the
+    piece, by more than round-off.
+    """
+    w = centre - p
+    along = np.einsum("ij,ij->i", w, d)
+    gap2 = np.einsum("ij,ij->i", w, w) - along * along / np.einsum("ij,ij->i", d, d)
+    reach = radius * (1.0 + 1e-9) + 1e-12
+    near = gap2 <= reach * reach
+    return None if near.all() else np.flatnonzero(near)
+
+
 def _hull_piece(X_OG, name, vertices, polygons) -> Piece:
     tris, normals, offsets = [], [], []
     centroid = vertices.mean(axis=0)
@@ -437,13 +467,22 @@ class ObjectSurface:
         t_out = np.full(K, np.nan)
         n_out = np.zeros((K, 3))
         for piece in self.pieces:
+            # a line that misses the piece's ball misses the piece: only the
+            # others are cast (a corner sphere of a YCB box meets few lines)
+            centre, radius = piece.bounding_ball
+            near = _near_lines(p_O, d_O, piece.X_OG.multiply(centre), radius)
+            if near is None:
+                rows, p, d = slice(None), p_O, d_O
+            elif len(near):
+                rows, p, d = near, p_O[near], d_O[near]
+            else:
+                continue
             R = piece.X_OG.rotation().matrix()
-            p_G = (p_O - piece.X_OG.translation()) @ R
-            a, b, n = piece.chord(p_G, d_O @ R)
-            t_in = np.fmin(t_in, a)
-            later = ~np.isnan(b) & ~(b <= t_out)
-            t_out = np.where(later, b, t_out)
-            n_out = np.where(later[:, None], n @ R.T, n_out)
+            a, b, n = piece.chord((p - piece.X_OG.translation()) @ R, d @ R)
+            t_in[rows] = np.fmin(t_in[rows], a)
+            later = ~np.isnan(b) & ~(b <= t_out[rows])
+            t_out[rows] = np.where(later, b, t_out[rows])
+            n_out[rows] = np.where(later[:, None], n @ R.T, n_out[rows])
         return t_in, t_out, n_out
 
     def radius_about(self, p_O: np.ndarray) -> float:

@@ -41,9 +41,11 @@ from pydrake.solvers import MathematicalProgram
 from drakegrasp._solvers import require_solution, solve
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
 from drakegrasp.batch.lp.ipm import solve_max_last
+from drakegrasp.batch.run.workers import map_ordered, resolve_workers
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
+    "WEIGHT_CHUNK",
     "WEIGHT_DIRECTIONS",
     "build_weight_capacity_program",
     "num_groups",
@@ -61,6 +63,9 @@ def _directions() -> np.ndarray:
 
 WEIGHT_DIRECTIONS = _directions()
 """The 14 weight directions in O: the axes and the cube's diagonals."""
+
+WEIGHT_CHUNK = 512
+"""Grasps per task of :func:`weight_capacity` (the same for any worker count)."""
 
 
 def build_weight_capacity_program(
@@ -130,9 +135,9 @@ def _equalities(W: np.ndarray, directions: np.ndarray) -> list[np.ndarray]:
     w = W.shape[1]
     out = []
     for u in directions:
-        A = np.empty((w, W.shape[0] + 1))
+        A = np.zeros((w, W.shape[0] + 1))
         A[:, :-1] = W.T
-        A[:, -1] = np.r_[u, np.zeros(w - 3)]
+        A[:3, -1] = u
         out.append(A)
     return out
 
@@ -149,6 +154,7 @@ def weight_capacity(
     directions: np.ndarray = WEIGHT_DIRECTIONS,
     num_generators: int = 8,
     solver: str = "batch",
+    workers: int | None = 1,
 ) -> np.ndarray:
     """(K, D) weight capacities ``α(u)`` of ``K`` grasps of ``N`` contacts.
 
@@ -174,6 +180,10 @@ def weight_capacity(
         (:func:`~drakegrasp.batch.lp.ipm.solve_max_last`); ``"drake"``: the LP of
         :func:`build_weight_capacity_program` per grasp through the solver
         gateway (Clp; slower, about 1 ms per direction).
+    workers : int or None, optional
+        Worker processes of the batch engine's pool (default 1; None: every
+        core) over chunks of :data:`WEIGHT_CHUNK` grasps.  Each grasp's LPs
+        are solved alone, so the numbers are the same for any count.
 
     Returns
     -------
@@ -183,6 +193,27 @@ def weight_capacity(
     K, N, _ = positions.shape
     if K == 0:
         return np.zeros((0, len(directions)))
+    if solver not in ("batch", "drake"):
+        raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
+    options = dict(
+        mu=mu, torque_scale=torque_scale, model=model,
+        torsional_friction=torsional_friction, directions=directions,
+        num_generators=num_generators, solver=solver,
+    )  # fmt: skip
+    if K <= WEIGHT_CHUNK:
+        return _capacity(positions, normals, fingers, **options)
+    tasks = (
+        (_capacity, (positions[i : i + WEIGHT_CHUNK], normals[i : i + WEIGHT_CHUNK],
+                     fingers[i : i + WEIGHT_CHUNK]), options)
+        for i in range(0, K, WEIGHT_CHUNK)
+    )  # fmt: skip
+    return np.vstack(list(map_ordered(tasks, resolve_workers(workers))))
+
+
+def _capacity(positions, normals, fingers, *, mu, torque_scale, model,
+              torsional_friction, directions, num_generators, solver):  # fmt: skip
+    """:func:`weight_capacity` of one chunk of grasps, in this process."""
+    K, N, _ = positions.shape
     W = batched_primitive_wrenches(
         positions,
         normals,
@@ -197,8 +228,6 @@ def weight_capacity(
     groups = np.repeat(fingers, per, axis=1)
     if solver == "batch":
         return _batch_capacity(W, groups, np.asarray(directions, float))
-    if solver != "drake":
-        raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
     return _drake_capacity(W, groups, directions)
 
 

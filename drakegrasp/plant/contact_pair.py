@@ -15,8 +15,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.geometry import Sphere
+from pydrake.math import RigidTransform
 
-from drakegrasp.plant._shapes import surface_pieces
+from drakegrasp.errors import NoContactsError, PenetrationError
+from drakegrasp.plant._shapes import ON_SURFACE_TOL, surface_pieces
 from drakegrasp.plant.contact_normals import (
     choose_normal,
     clean_unit,
@@ -25,8 +28,23 @@ from drakegrasp.plant.contact_normals import (
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
 from drakegrasp.plant.exact_contact import closest_pair
 from drakegrasp.plant.shape_queries import PosedShape
+from drakegrasp.plant.sphere_tips import (
+    SOURCES,
+    clean_rows,
+    shape_key,
+    sphere_tip_pairs,
+    transform_rows,
+)
 
-__all__ = ["PairPoint", "pair_points"]
+__all__ = [
+    "PairPoint",
+    "PendingPair",
+    "StagedContacts",
+    "dedupe_contacts",
+    "pair_points",
+    "pending_pair",
+    "resolve_pairs",
+]
 
 
 @dataclass(frozen=True)
@@ -187,3 +205,257 @@ def _to_G(X_WG, to_O, p_O: np.ndarray, R_OG: np.ndarray) -> np.ndarray:
 def _to_O_points(poly_G: np.ndarray, X_WG, to_O) -> np.ndarray:
     """Polygon vertices from a geometry frame to the object frame."""
     return np.array([to_O(X_WG.multiply(p)) for p in poly_G])
+
+
+# --- pairs read now, their points computed later in one batch ------------------------
+
+
+class _PosesAt:
+    """The two geometry poses a pair's query gave, for the scalar route later."""
+
+    def __init__(self, poses: dict):
+        self._poses = poses
+
+    def GetPoseInWorld(self, gid):  # noqa: N802 (QueryObject's name)
+        return self._poses[gid]
+
+
+class PendingPair:
+    """A touching pair read from Drake, its points still to come.
+
+    Made by :func:`pending_pair` while the query object describes the pair's
+    configuration; :func:`resolve_pairs` fills ``points`` (a spherical tip
+    on a box, cylinder, sphere or hull in one vectorised batch with every
+    other such pair, anything else at once by :func:`pair_points`).
+    """
+
+    __slots__ = ("_read", "points", "tip")
+
+    def __init__(self, read: tuple, tip: tuple | None):
+        self._read = read
+        self.tip = tip
+        self.points: list[PairPoint] | None = None
+
+    @property
+    def args(self) -> dict:
+        """The keyword arguments of :func:`pair_points` for this pair."""
+        inspector, go, gf, r, swapped, psi, X_OW, R_OW, poses, tol, patches = self._read
+        if swapped:  # Drake's pair (finger, object): its normal into the finger
+            p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
+        else:
+            p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
+
+        def to_O(p_W):
+            return np.asarray(X_OW.multiply(p_W))
+
+        return dict(
+            query=_PosesAt(poses),
+            inspector=inspector,
+            go=go,
+            gf=gf,
+            p_GaCa=np.asarray(p_GaCa),
+            p_GbCb=np.asarray(p_GbCb),
+            nhat_W=np.asarray(nhat_W),
+            psi=psi,
+            to_O=to_O,
+            R_OW=R_OW,
+            tol=tol,
+            patches=patches,
+        )
+
+
+def pending_pair(
+    *,
+    query,
+    inspector,
+    go,
+    gf,
+    pair,
+    swapped: bool,
+    X_OW,
+    tol: float,
+    patches: str,
+    cache: dict | None = None,
+    frame: dict | None = None,
+) -> PendingPair:
+    """Read the pair (object geometry ``go``, finger ``gf``) from the query now.
+
+    ``pair`` is Drake's ``SignedDistancePair``, ``swapped`` True when its
+    ``A`` is the finger's geometry; ``X_OW`` maps the world to the object
+    frame; ``tol`` and ``patches`` are those of :func:`pair_points`.  The
+    points are those :func:`pair_points` returns (to round-off, 1e-12 m, for
+    a spherical tip, whose closed form runs over arrays in
+    :mod:`~drakegrasp.plant.sphere_tips`), once :func:`resolve_pairs` ran.
+    ``cache`` (kept by the caller across calls on one scene graph) holds the
+    geometries' shapes; ``frame`` (kept for one configuration, with ``X_OW``
+    and its rotation ``R_OW``) the object geometries' poses.
+    """
+    cache = {} if cache is None else cache
+    frame = {"X_OW": X_OW, "R_OW": _rotation(X_OW)} if frame is None else frame
+    R_OW = frame["R_OW"]
+    # copies: the query's poses are views of its state, which the next
+    # configuration overwrites
+    if ("X_WG", go) not in frame:
+        X_WGa = RigidTransform(query.GetPoseInWorld(go))
+        frame["X_WG", go] = X_WGa
+        frame["pose", go] = (
+            R_OW @ _rotation(X_WGa),
+            np.asarray(X_OW.multiply(X_WGa.translation())),
+        )
+    X_WGb = RigidTransform(query.GetPoseInWorld(gf))
+    read = (
+        inspector, go, gf, pair, swapped, float(pair.distance), X_OW, R_OW,
+        {go: frame["X_WG", go], gf: X_WGb}, tol, patches,
+    )  # fmt: skip
+    tip = cache.get(("tip", go, gf), False)
+    if tip is False:
+        fin = inspector.GetShape(gf)
+        key = shape_key(inspector.GetShape(go)) if isinstance(fin, Sphere) else None
+        tip = cache["tip", go, gf] = None if key is None else (key, fin.radius())
+    if tip is None:
+        pending = PendingPair(read, None)
+        pending.points = pair_points(**pending.args)
+        return pending
+    R_OGa, p_OGa = frame["pose", go]
+    if "p_OW" not in frame:
+        frame["p_OW"] = np.array(X_OW.translation())
+    tip_W = np.array(X_WGb.translation())  # the tip's centre, to O in the batch
+    return PendingPair(read, (tip[0], R_OGa, p_OGa, tip_W, tip[1], R_OW, frame["p_OW"]))
+
+
+def resolve_pairs(pending) -> None:
+    """Compute the points of every unresolved :class:`PendingPair`, in batches."""
+    groups: dict[tuple, list[PendingPair]] = {}
+    for p in pending:
+        if p.points is None:
+            kind, dims = p.tip[0]
+            groups.setdefault((kind, dims), []).append(p)
+    for (kind, dims), rows in groups.items():
+        ok, psi, p_a, p_b, n, source = sphere_tip_pairs(
+            kind,
+            dims,
+            np.array([p.tip[1] for p in rows]),
+            np.array([p.tip[2] for p in rows]),
+            transform_rows(
+                np.array([p.tip[5] for p in rows]),
+                np.array([p.tip[6] for p in rows]),
+                np.array([p.tip[3] for p in rows]),
+            ),
+            np.array([p.tip[4] for p in rows]),
+            np.array([p._read[5] for p in rows]),
+        )
+        n = clean_rows(n)
+        psi = psi.tolist()
+        for k, p in enumerate(rows):
+            if not ok[k]:  # the scalar route decides (Drake's witness then)
+                p.points = pair_points(**p.args)
+                continue
+            p.points = [
+                PairPoint(p_a[k], n[k], psi[k], p_b[k], SOURCES[source[k]], None, True)
+            ]
+
+
+class StagedContacts:
+    """One configuration's touching pairs, read from Drake, points pending.
+
+    :func:`~drakegrasp.plant.contacts.stage_contacts` reads everything the
+    contacts need from the query object and the plant while they describe the
+    configuration;
+    :func:`~drakegrasp.plant.contacts.resolve_staged` computes the points of
+    many staged configurations in one batch (a planner stages each closed
+    candidate and resolves them all at once);
+    :func:`~drakegrasp.plant.contacts.staged_contacts` then gives what
+    :func:`~drakegrasp.plant.contacts.contacts_of_distances` returns, or
+    raises what it raises.
+    """
+
+    def __init__(self, object_name, tol, allow_penetration, closest, items, inspector):
+        self.object_name = object_name
+        self.tol = tol
+        self.allow_penetration = allow_penetration
+        self.closest = closest  # (ψ, finger body's name, GeometryId) or None
+        self.items = items  # ("penetration", message) or ("pair", ...)
+        self.inspector = inspector
+
+    def pending(self):
+        """The staged pairs (:class:`~drakegrasp.plant.contact_pair.PendingPair`)."""
+        return [it[1] for it in self.items if it[0] == "pair"]
+
+    def rows(self) -> list[tuple]:
+        """``(PairPoint, X_FO, fields)`` of every contact point, once resolved.
+
+        In :func:`~drakegrasp.find_contacts`' order, before duplicates are
+        dropped; ``fields`` are the pair's :class:`~drakegrasp.PlantContact`
+        fields other than the point's.
+
+        Raises
+        ------
+        NoContactsError, PenetrationError
+            As :func:`~drakegrasp.find_contacts`.
+        """
+        tol = self.tol
+        rows: list[tuple] = []
+        penetrations: list[str] = []
+        for item in self.items:
+            if item[0] == "penetration":
+                penetrations.append(item[1])
+                continue
+            _, pending, X_FO, common, where = item
+            deepest = min(pp.psi for pp in pending.points)
+            if deepest < -tol and not self.allow_penetration:  # a tilted patch
+                go, finger, gf = where
+                penetrations.append(
+                    f"{self.object_name} ({self.inspector.GetName(go)}) and "
+                    f"{self._finger_geom(finger, gf)} penetrate by "
+                    f"{-deepest * 1e3:.4g} mm at a patch corner"
+                )
+                continue
+            rows += [(pp, X_FO, common) for pp in pending.points]
+        if penetrations:
+            raise PenetrationError(
+                f"penetration deeper than distance_tolerance = {tol:g} m: "
+                + "; ".join(penetrations)
+            )
+        if not rows:
+            if self.closest is None:
+                raise NoContactsError(
+                    "the hand has no collision geometry that can touch "
+                    f"{self.object_name!r}"
+                )
+            psi, finger, gf = self.closest
+            raise NoContactsError(
+                f"the hand does not touch {self.object_name!r}: the closest finger "
+                f"geometry is {self._finger_geom(finger, gf)} at {psi * 1e3:.4g} mm "
+                f"(distance_tolerance {tol * 1e3:g} mm)"
+            )
+        return rows
+
+    def _finger_geom(self, finger_name, gf) -> str:
+        return f"{finger_name} ({self.inspector.GetName(gf)})"
+
+
+def dedupe_contacts(contacts: list) -> list:
+    """Drop a contact (``PlantContact``) that repeats a kept one of its finger body.
+
+    Repeats: within ``ON_SURFACE_TOL`` (1e-5 m) and with normals within 1e-9 of
+    each other (two geometries of one body touching at one point).
+    """
+    if len(contacts) < 2:
+        return list(contacts)
+    P = np.array([c.p_OC for c in contacts])
+    N = np.array([c.nhat_O for c in contacts])
+    body = np.array([int(c.finger_body_index) for c in contacts])
+    gap = P[:, None, :] - P[None, :, :]
+    same = (
+        (body[:, None] == body[None, :])
+        & (np.sqrt(np.sum(gap * gap, axis=2)) < ON_SURFACE_TOL)
+        & (N @ N.T > 1 - 1e-9)
+    )
+    np.fill_diagonal(same, False)
+    if not same.any():
+        return list(contacts)
+    kept: list[int] = []
+    for i in range(len(contacts)):
+        if not same[i, kept].any():
+            kept.append(i)
+    return [contacts[i] for i in kept]

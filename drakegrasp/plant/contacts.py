@@ -25,6 +25,15 @@ a pair that no route certifies keeps Drake's witness points, with the normal
 chosen as :mod:`~drakegrasp.plant.contact_normals` describes.  The guide's
 *Contacts* page lists the accuracy of every shape pair.
 
+**Many configurations at once.**  :func:`contacts_of_distances` is three
+steps, which a planner runs apart: :func:`stage_contacts` reads the touching
+pairs of one configuration from Drake, :func:`resolve_staged` computes the
+points of any number of staged configurations in one batch (a spherical
+finger tip on a box, cylinder, sphere or convex hull over arrays,
+:mod:`~drakegrasp.plant.sphere_tips`; every other pair by
+:func:`~drakegrasp.plant.contact_pair.pair_points` as it is read), and
+:func:`staged_contacts` gives each configuration's contacts.
+
 **Flat patches.**  A flat pad on a flat face is reported as one contact at
 **each vertex** of its patch polygon (same normal; ``ψ`` the gap at the
 vertex), see :mod:`~drakegrasp.plant.contact_patches`.  A square pad on a box
@@ -37,6 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.geometry import GeometryId, QueryObject
+from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context
@@ -46,11 +56,13 @@ from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
     InvalidOptionError,
     ModelError,
-    NoContactsError,
-    PenetrationError,
 )
-from drakegrasp.plant._shapes import ON_SURFACE_TOL
-from drakegrasp.plant.contact_pair import pair_points
+from drakegrasp.plant.contact_pair import (
+    StagedContacts,
+    dedupe_contacts,
+    pending_pair,
+    resolve_pairs,
+)
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
 from drakegrasp.plant.validation import (
     HandSpec,
@@ -66,10 +78,14 @@ __all__ = [
     "DEFAULT_DISTANCE_TOLERANCE",
     "PATCH_ANGLE_TOL",
     "PlantContact",
+    "StagedContacts",
     "contacts_of_distances",
     "find_contacts",
     "hand_bodies",
     "resolve_object_body",
+    "resolve_staged",
+    "stage_contacts",
+    "staged_contacts",
 ]
 
 
@@ -192,10 +208,6 @@ def _label(body: str, name: str, index: int | None) -> str:
     short = name.rpartition("::")[2]
     where = f"{body}/{short}" if body else name
     return where if index is None else f"{where}#{index}"
-
-
-def _rotation(X) -> np.ndarray:
-    return X.rotation().matrix()
 
 
 def find_contacts(
@@ -358,66 +370,33 @@ def contacts_of_distances(
     NoContactsError, PenetrationError
         As :func:`find_contacts`.
     """
-    tol = distance_tolerance
-    inspector = query.inspector()
-    object_name = _scoped_name(plant, body)
-    object_geometries = set(plant.GetCollisionGeometriesForBody(body))
-    X_WO = plant.EvalBodyPoseInWorld(plant_context, body)
-    X_OW = X_WO.inverse()
-    R_OW = _rotation(X_OW)
+    staged = stage_contacts(
+        plant,
+        plant_context,
+        body,
+        query,
+        results,
+        distance_tolerance=distance_tolerance,
+        allow_penetration=allow_penetration,
+        patches=patches,
+    )
+    resolve_staged([staged])
+    return staged_contacts(staged)
 
-    def to_O(p_W):
-        return np.asarray(X_OW.multiply(p_W))
 
-    contacts: list[PlantContact] = []
-    penetrations: list[str] = []
-    closest: tuple[float, str] | None = None
+def staged_contacts(staged: StagedContacts) -> list[PlantContact]:
+    """The contacts of resolved staged pairs, as :func:`find_contacts` returns them.
 
-    def finger_geom(finger_name, gf):
-        return f"{finger_name} ({inspector.GetName(gf)})"
+    ``staged`` is a :class:`~drakegrasp.plant.contact_pair.StagedContacts`
+    that :func:`resolve_staged` resolved.
 
-    def pair(go, finger_name, gf):
-        return (
-            f"{object_name} ({inspector.GetName(go)}) and "
-            f"{finger_geom(finger_name, gf)}"
-        )
-
-    names = {}
-    for finger, kf, ko, r in results:
-        if finger.index() not in names:
-            X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
-            names[finger.index()] = (
-                _scoped_name(plant, finger),
-                X_WF.inverse().multiply(X_WO),
-            )
-        finger_name, X_FO = names[finger.index()]
-        if r.id_A in object_geometries:
-            go, gf = r.id_A, r.id_B
-            p_GaCa, p_GbCb, nhat_W = r.p_ACa, r.p_BCb, r.nhat_BA_W
-        else:  # Drake swapped the pair: normal now points into the finger
-            go, gf = r.id_B, r.id_A
-            p_GaCa, p_GbCb, nhat_W = r.p_BCb, r.p_ACa, -r.nhat_BA_W
-        psi = float(r.distance)
-        if closest is None or psi < closest[0]:
-            closest = (psi, finger_name, gf)
-        if psi < -tol and not allow_penetration:
-            penetrations.append(
-                f"{pair(go, finger_name, gf)} penetrate by {-psi * 1e3:.4g} mm"
-            )
-            continue
-        if abs(psi) > tol and not (allow_penetration and psi < 0):
-            continue
-        common = {
-            "finger_body": finger_name,
-            "finger_body_index": finger.index(),
-            "object_geometry": go,
-            "finger_geometry": gf,
-            "object_geometry_name": inspector.GetName(go),
-            "finger_geometry_name": inspector.GetName(gf),
-            "finger_geometry_index": kf,
-            "object_geometry_index": ko,
-        }
-        found = [
+    Raises
+    ------
+    NoContactsError, PenetrationError
+        As :func:`find_contacts`.
+    """
+    return dedupe_contacts(
+        [
             PlantContact(
                 p_OC=pp.p_OC,
                 nhat_O=pp.nhat_O,
@@ -428,56 +407,108 @@ def contacts_of_distances(
                 exact=pp.exact,
                 **common,
             )
-            for pp in pair_points(
-                query=query,
-                inspector=inspector,
-                go=go,
-                gf=gf,
-                p_GaCa=np.asarray(p_GaCa),
-                p_GbCb=np.asarray(p_GbCb),
-                nhat_W=np.asarray(nhat_W),
-                psi=psi,
-                to_O=to_O,
-                R_OW=R_OW,
-                tol=tol,
-                patches=patches,
-            )
+            for pp, X_FO, common in staged.rows()
         ]
-        deepest = min(c.psi for c in found)
-        if deepest < -tol and not allow_penetration:  # a tilted patch
-            penetrations.append(
-                f"{pair(go, finger_name, gf)} penetrate by "
-                f"{-deepest * 1e3:.4g} mm at a patch corner"
-            )
-            continue
-        contacts += found
-    if penetrations:
-        raise PenetrationError(
-            f"penetration deeper than distance_tolerance = {tol:g} m: "
-            + "; ".join(penetrations)
-        )
-    if not contacts:
-        if closest is None:
-            raise NoContactsError(
-                f"the hand has no collision geometry that can touch {object_name!r}"
-            )
-        raise NoContactsError(
-            f"the hand does not touch {object_name!r}: the closest finger geometry "
-            f"is {finger_geom(*closest[1:])} at {closest[0] * 1e3:.4g} mm "
-            f"(distance_tolerance {tol * 1e3:g} mm)"
-        )
-    return _dedupe_contacts(contacts)
+    )
 
 
-def _dedupe_contacts(contacts: list[PlantContact]) -> list[PlantContact]:
-    out: list[PlantContact] = []
-    for c in contacts:
-        if any(
-            c.finger_body_index == k.finger_body_index
-            and np.linalg.norm(c.p_OC - k.p_OC) < ON_SURFACE_TOL
-            and c.nhat_O @ k.nhat_O > 1 - 1e-9
-            for k in out
-        ):
+def resolve_staged(staged) -> None:
+    """Compute the contact points of every staged configuration, in one batch."""
+    resolve_pairs([p for s in staged for p in s.pending()])
+
+
+def stage_contacts(
+    plant: MultibodyPlant,
+    plant_context: Context,
+    body,
+    query: QueryObject,
+    results,
+    *,
+    distance_tolerance: float,
+    allow_penetration: bool = False,
+    patches: str = "vertices",
+    cache: dict | None = None,
+) -> StagedContacts:
+    """Read the touching pairs of :func:`contacts_of_distances` from Drake now.
+
+    The arguments are those of :func:`contacts_of_distances`; the query and
+    the context may change once this returns: :func:`resolve_staged` and
+    :func:`staged_contacts` finish the work.  ``cache`` is a dict the caller
+    keeps across calls on one plant and scene graph (names and shapes are
+    then read once).
+    """
+    tol = distance_tolerance
+    cache = {} if cache is None else cache
+    inspector = query.inspector()
+    key = ("object", int(body.index()))
+    if key not in cache:
+        cache[key] = (
+            _scoped_name(plant, body),
+            set(plant.GetCollisionGeometriesForBody(body)),
+        )
+    object_name, object_geometries = cache[key]
+    X_WO = RigidTransform(plant.EvalBodyPoseInWorld(plant_context, body))  # a copy
+    X_OW = X_WO.inverse()
+    frame = {"X_OW": X_OW, "R_OW": X_OW.rotation().matrix()}  # this call's
+    items: list[tuple] = []
+    closest: tuple[float, str] | None = None
+
+    def name(gid):
+        if ("name", gid) not in cache:
+            cache["name", gid] = inspector.GetName(gid)
+        return cache["name", gid]
+
+    fingers = {}
+    for finger, kf, ko, r in results:
+        index = finger.index()
+        if ("body", index) not in cache:
+            cache["body", index] = _scoped_name(plant, finger)
+        finger_name = cache["body", index]
+        id_A = r.id_A
+        swapped = id_A not in object_geometries  # the normal points into the finger
+        go, gf = (r.id_B, id_A) if swapped else (id_A, r.id_B)
+        psi = float(r.distance)
+        if closest is None or psi < closest[0]:
+            closest = (psi, finger_name, gf)
+        if psi < -tol and not allow_penetration:
+            items.append(
+                (
+                    "penetration",
+                    f"{object_name} ({name(go)}) and {finger_name} ({name(gf)}) "
+                    f"penetrate by {-psi * 1e3:.4g} mm",
+                )
+            )
             continue
-        out.append(c)
-    return out
+        if abs(psi) > tol and not (allow_penetration and psi < 0):
+            continue
+        if index not in fingers:
+            X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
+            fingers[index] = X_WF.inverse().multiply(X_WO)
+        X_FO = fingers[index]
+        common = {
+            "finger_body": finger_name,
+            "finger_body_index": index,
+            "object_geometry": go,
+            "finger_geometry": gf,
+            "object_geometry_name": name(go),
+            "finger_geometry_name": name(gf),
+            "finger_geometry_index": kf,
+            "object_geometry_index": ko,
+        }
+        pending = pending_pair(
+            query=query,
+            inspector=inspector,
+            go=go,
+            gf=gf,
+            pair=r,
+            swapped=swapped,
+            X_OW=X_OW,
+            tol=tol,
+            patches=patches,
+            cache=cache,
+            frame=frame,
+        )
+        items.append(("pair", pending, X_FO, common, (go, finger_name, gf)))
+    return StagedContacts(
+        object_name, tol, allow_penetration, closest, items, inspector
+    )

@@ -103,6 +103,39 @@ def test_contacts_are_bitwise_those_of_find_contacts(wsg_result):
         assert np.array_equal([k.nhat_O for k in found], [k.nhat_O for k in c.contacts])
 
 
+def test_batched_contacts_equal_the_scalar_route(wsg_result, monkeypatch):
+    # the planner's contacts (spherical tips resolved over arrays, all
+    # candidates at once) against pair_points pair by pair, to 1e-12
+    from drakegrasp.plant import contact_pair, contacts
+
+    def scalar(pending):
+        for p in pending:
+            if p.points is None:
+                p.points = contact_pair.pair_points(**p.args)
+
+    scene, result = wsg_result
+    ctx = scene.context.Clone()
+    monkeypatch.setattr(contacts, "resolve_pairs", scalar)
+    batched = 0
+    for c in result:
+        c.apply(scene.plant, ctx, object_body=scene.object_body)
+        ref = find_contacts(scene.plant, ctx, scene.object_body, hand=scene.hand)
+        assert len(ref) == len(c.contacts)
+        for a, b in zip(c.contacts, ref, strict=True):
+            assert (a.finger_geometry, a.object_geometry) == (
+                b.finger_geometry,
+                b.object_geometry,
+            )
+            assert (a.normal_source, a.exact) == (b.normal_source, b.exact)
+            for f in ("p_OC", "nhat_O", "p_FC"):
+                np.testing.assert_allclose(
+                    getattr(a, f), getattr(b, f), rtol=0, atol=1e-12
+                )
+            assert abs(a.psi - b.psi) <= 1e-12
+            batched += a.finger_geometry_name.rpartition("::")[2] != "collision"
+    assert batched > 100  # the WSG's tip spheres took the batched route
+
+
 def test_epsilon_uses_one_torque_scale(wsg_result):
     from drakegrasp.quality import ferrari_canny
 

@@ -135,3 +135,49 @@ def test_robustness_is_seeded_and_in_range(samples):
     assert run(1) == run(1) and 0.0 <= run(1)[0] <= 1.0
     if samples == 0:
         assert run(1)[0] == 0.0
+
+
+@pytest.mark.parametrize("model", ["hard_finger", "frictionless", "soft_finger"])
+def test_copies_too_few_to_hold_skip_the_lp_and_nothing_else(model, monkeypatch):
+    # a cylinder between two pads of two probes each: many copies keep one
+    # contact per pad; skipping their LPs changes no robustness
+    from drakegrasp.planning import reclose
+
+    cyl = _surface(Cylinder(R, 0.1))
+    z = 0.004
+    P = np.array(
+        [
+            [[-R, 0.0, z], [-R, 0.0, -z], [R, 0.0, z], [R, 0.0, -z]],
+            [[-R, 0.0, 0.02], [-R, 0.0, -0.02], [R, 0.0, 0.02], [R, 0.0, -0.02]],
+        ]
+    )
+    F = np.array([[0, 0, 1, 1], [0, 0, 1, 1]])
+    a = np.array([[1.0, 0, 0], [1.0, 0, 0]])
+
+    def run():
+        return reclosed_robustness(
+            cyl, P, F, a, 0.8, samples=64, rng=np.random.default_rng(4),
+            position=3e-3, angle_deg=8.0, friction=0.1, tol=TOL, model=model,
+            torsional_friction=0.05 if model == "soft_finger" else None, workers=1,
+        )  # fmt: skip
+
+    lps = []
+    solve = reclose.batch_force_closure
+
+    def counted(positions, *args, **kwargs):
+        lps.append(len(positions))
+        return solve(positions, *args, **kwargs)
+
+    monkeypatch.setattr(reclose, "batch_force_closure", counted)
+    fast = run()
+    skipped = sum(lps)
+    touch, _, _, ok = reclosed_copies(
+        cyl, np.repeat(P, 64, 0), np.repeat(F, 64, 0), np.repeat(a, 64, 0),
+        np.zeros((128, 3)), np.zeros(128), tol=TOL,
+    )  # fmt: skip
+    monkeypatch.setattr(reclose, "NEVER_CLOSURE", {})
+    lps.clear()
+    assert np.array_equal(run(), fast)
+    assert (skipped < sum(lps)) == (model != "soft_finger")  # soft: no skip
+    if model == "hard_finger":  # the unperturbed copies hold with four contacts
+        assert touch.sum(axis=1).max() == 4 and fast.max() > 0

@@ -82,3 +82,42 @@ def test_the_batch_dual_and_the_primal_program_agree_on_many_grasps():
     a = weight_capacity(P, N, F, 0.7, torque_scale=0.05)
     b = weight_capacity(P, N, F, 0.7, torque_scale=0.05, solver="drake")
     assert a == pytest.approx(b, rel=1e-6, abs=1e-8)
+
+
+# a WSG grasp of the shipped box (two tip spheres per pad on opposite faces)
+# whose dual the interior-point method does not converge on: the primal solves it
+STUCK_P = np.array(
+    [
+        [0.0081496997684664, -0.01291709425002098, -0.05],
+        [-0.00595025839012233, -0.01400850614570803, -0.05],
+        [0.00814973082117587, -0.01291712084081603, 0.05],
+        [-0.00595022733741124, -0.01400853273650447, 0.05],
+    ]
+)
+STUCK_N = np.array([[0.0, 0, 1], [0, 0, 1], [0, 0, -1], [0, 0, -1]])
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_chunks_and_workers_change_no_number(workers, monkeypatch):
+    # the grasps go in chunks of WEIGHT_CHUNK, each solved alone (the
+    # degenerate ones again as the primal): the numbers are those of one call
+    # on all grasps, for any number of workers
+    from drakegrasp.planning import weight
+
+    rng = np.random.default_rng(14)
+    P = np.repeat(STUCK_P[None], 23, axis=0)
+    N = np.repeat(STUCK_N[None], 23, axis=0)
+    P[6:] += rng.normal(0, 0.01, (17, 4, 3))
+    N[6:] += rng.normal(0, 0.2, (17, 4, 3))
+    N /= np.linalg.norm(N, axis=2, keepdims=True)
+    F = np.tile([0, 0, 1, 1], (23, 1))
+    primal = []
+    solve = weight._drake_capacity
+    monkeypatch.setattr(
+        weight, "_drake_capacity", lambda W, *a: primal.append(len(W)) or solve(W, *a)
+    )
+    whole = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    assert primal and primal[0] >= 6  # the stuck copies took the primal
+    monkeypatch.setattr(weight, "WEIGHT_CHUNK", 5)
+    chunked = weight_capacity(P, N, F, 1.0, torque_scale=0.06, workers=workers)
+    assert np.array_equal(chunked, whole)

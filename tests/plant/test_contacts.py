@@ -383,3 +383,58 @@ def test_contacts_of_distances_from_the_pairwise_query_equal_find_contacts():
         contacts_of_distances(
             rig.plant, rig.ctx, rig.object, query, results[2:], distance_tolerance=1e-4
         )
+
+
+def test_staged_contacts_are_those_of_their_configuration():
+    # stage_contacts reads a configuration; the context then moves on (a
+    # planner's next candidate) before resolve_staged computes the points:
+    # they must be the staged configuration's, for the batched tip route, the
+    # scalar patch route and the scalar fallback of an uncertified tip alike
+    from drakegrasp.plant import contact_pair
+    from drakegrasp.plant.contacts import (
+        resolve_staged,
+        stage_contacts,
+        staged_contacts,
+    )
+
+    rig = Rig(
+        Box(0.1, 0.06, 0.04),
+        [
+            (Box(0.01, 0.02, 0.02), at([0.055 + GAP, 0.0, 0.0])),
+            (Sphere(R_TIP), at([-0.05 - R_TIP, 0.01, 0.0])),
+        ],
+    )
+    expected = rig.contacts()
+    query = rig.plant.get_geometry_query_input_port().Eval(rig.ctx)
+    slot = {rig.plant.GetCollisionGeometriesForBody(b)[0]: b for b in rig.fingers}
+    results = sorted(
+        (
+            (slot.get(p.id_A) or slot.get(p.id_B), 0, 0, p)
+            for p in query.ComputeSignedDistancePairwiseClosestPoints(1e-4)
+        ),
+        key=lambda r: int(r[0].index()),
+    )
+    staged = stage_contacts(
+        rig.plant, rig.ctx, rig.object, query, results, distance_tolerance=1e-4
+    )
+    staged_scalar = stage_contacts(
+        rig.plant, rig.ctx, rig.object, query, results, distance_tolerance=1e-4
+    )
+    for pending in staged_scalar.pending():  # as if the certificate failed
+        pending.tip = None
+    rig.translate_object([0.013, -0.02, 0.007])  # the next configuration
+    rig.plant.SetFreeBodyPose(rig.ctx, rig.fingers[1], RigidTransform([0.3, -0.1, 0.2]))
+    query = rig.plant.get_geometry_query_input_port().Eval(rig.ctx)
+    query.ComputeSignedDistancePairwiseClosestPoints(0.0)  # the new poses
+    resolve_staged([staged])
+    for p in staged_scalar.pending():
+        if p.points is None:
+            p.points = contact_pair.pair_points(**p.args)
+    for got in (staged_contacts(staged), staged_contacts(staged_scalar)):
+        assert len(got) == len(expected) == 5
+        for a, b in zip(got, expected, strict=True):
+            assert a.finger_geometry_label == b.finger_geometry_label
+            np.testing.assert_allclose(a.p_OC, b.p_OC, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(a.nhat_O, b.nhat_O, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(a.p_FC, b.p_FC, rtol=0, atol=1e-12)
+            assert a.normal_source == b.normal_source
