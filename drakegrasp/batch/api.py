@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drakegrasp.batch.inputs import METRICS, shape_of
-from drakegrasp.batch.ragged import is_ragged, run_groups
+from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_task, form_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
@@ -181,7 +181,7 @@ def collect(K: int, d: int, kind: str, tol: float, names, chunks):
 
 
 def merge_results(
-    K: int, d: int, kind: str, parts: Sequence[tuple[np.ndarray, BatchClosureResult]]
+    K: int, d: int, parts: Sequence[tuple[np.ndarray, BatchClosureResult]]
 ) -> BatchClosureResult:
     """One result in input order from the results of a ragged batch's groups.
 
@@ -189,14 +189,14 @@ def merge_results(
     ----------
     K, d : int
         Number of grasps and dimension (2 or 3).
-    kind : {"form", "force"}
     parts : sequence of (indices, BatchClosureResult)
         Each group's positions in the input and its result
         (:func:`drakegrasp.batch.ragged.run_groups`).
     """
     names = tuple(parts[0][1].metrics)
     chunks = ((idx, result.to_arrays()) for idx, result in parts)
-    return collect(K, d, kind, parts[0][1].tol, names, chunks)
+    first = parts[0][1]
+    return collect(K, d, first.kind, first.tol, names, chunks)
 
 
 @renamed_keyword("model", "contact_model")
@@ -277,6 +277,7 @@ def stream_form_closure(
 
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
+@accepts_ragged(merge_results)
 def batch_force_closure(
     positions: np.ndarray,
     normals: np.ndarray,
@@ -378,17 +379,6 @@ def batch_force_closure(
     :mod:`drakegrasp.batch.lp` (an exact active-set method for small null
     spaces, a block interior-point method for the rest).
     """
-    if is_ragged(positions):
-        K, d, parts = run_groups(
-            batch_force_closure, positions, normals,
-            per_contact={"mu": mu, "torsional_friction": torsional_friction},
-            per_grasp={"reference_points": reference_points,
-                       "characteristic_lengths": characteristic_lengths},
-            contact_model=contact_model, num_generators=num_generators, tol=tol,
-            rank_tol=rank_tol, chunk_size=chunk_size, progress=progress,
-            metrics=metrics, workers=workers, kernel=kernel,
-        )  # fmt: skip
-        return merge_results(K, d, "force", parts)
     K, N, d = shape_of("positions", positions)
     task, options = force_task(
         positions, mu, contact_model, num_generators, torsional_friction,
@@ -401,6 +391,7 @@ def batch_force_closure(
     return collect(K, d, "force", options["tol"], options["metrics"], chunks)
 
 
+@accepts_ragged(merge_results)
 def batch_form_closure(
     positions: np.ndarray,
     normals: np.ndarray,
@@ -446,15 +437,6 @@ def batch_form_closure(
         \max d \;\text{s.t.}\; G_n f_n = 0,\; f_n - \mathbf 1 d \ge 0,\;
         d \ge 0,\; \mathbf 1^T f_n \le N .
     """
-    if is_ragged(positions):
-        K, d, parts = run_groups(
-            batch_form_closure, positions, normals, per_contact={},
-            per_grasp={"reference_points": reference_points,
-                       "characteristic_lengths": characteristic_lengths},
-            tol=tol, rank_tol=rank_tol, chunk_size=chunk_size, progress=progress,
-            metrics=metrics, workers=workers, kernel=kernel,
-        )  # fmt: skip
-        return merge_results(K, d, "form", parts)
     K, N, d = shape_of("positions", positions)
     task, options = form_task(
         positions, reference_points, characteristic_lengths, tol, rank_tol, metrics,

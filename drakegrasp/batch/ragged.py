@@ -22,7 +22,8 @@ by grasp, bitwise what the stacked call of its group gives
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -38,7 +39,15 @@ from drakegrasp.batch.inputs import (
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidContactError
 
-__all__ = ["RaggedGroup", "is_ragged", "ragged_groups", "run_groups"]
+__all__ = [
+    "PER_CONTACT",
+    "PER_GRASP",
+    "RaggedGroup",
+    "accepts_ragged",
+    "is_ragged",
+    "ragged_groups",
+    "run_groups",
+]
 
 
 @dataclass(frozen=True)
@@ -213,14 +222,35 @@ def _per_grasp(name: str, value, K: int, d: int):
     return np.asarray(value), True
 
 
+PER_CONTACT = ("mu", "torsional_friction")
+"""Options with one value per contact: sliced and stacked per group."""
+
+PER_GRASP = ("reference_points", "characteristic_lengths")
+"""Options with one value (or row) per grasp: sliced per group."""
+
+
+def accepts_ragged(merge: Callable[[int, int, list], Any]):
+    """Let a stacked batch function take ragged lists of per-grasp arrays too.
+
+    ``fn(positions, normals, **options)`` runs unchanged on stacked input; on
+    a ragged one (:func:`is_ragged`) it runs once per contact-count group
+    (:func:`run_groups`) and ``merge(K, d, parts)`` makes the one result.
+    """
+
+    def decorate(fn):
+        @functools.wraps(fn)
+        def batch(positions, normals, **options):
+            if not is_ragged(positions):
+                return fn(positions, normals, **options)
+            return merge(*run_groups(fn, positions, normals, **options))
+
+        return batch
+
+    return decorate
+
+
 def run_groups(
-    call: Callable[..., Any],
-    positions,
-    normals,
-    *,
-    per_contact: Mapping[str, Any],
-    per_grasp: Mapping[str, Any],
-    **options,
+    call: Callable[..., Any], positions, normals, **options
 ) -> tuple[int, int, list[tuple[np.ndarray, Any]]]:
     """Run a stacked batch function once per contact-count group.
 
@@ -230,13 +260,9 @@ def run_groups(
         ``call(positions, normals, **options)`` on a stacked group.
     positions, normals : sequence of (N_k, d) float
         The ragged batch.
-    per_contact : mapping
-        Per-contact options by keyword (``mu``, ``torsional_friction``).
-    per_grasp : mapping
-        Per-grasp options by keyword (``reference_points``,
-        ``characteristic_lengths``).
     **options
-        Passed to every call unchanged.
+        Passed to every call; those of :data:`PER_CONTACT` and
+        :data:`PER_GRASP` restricted to the group's grasps.
 
     Returns
     -------
@@ -252,11 +278,14 @@ def run_groups(
         for k in group.indices:
             counts[k] = group.num_contacts
     contact_rows = {
-        name: _per_contact(name, value, K, counts)
-        for name, value in per_contact.items()
+        name: _per_contact(name, options.pop(name), K, counts)
+        for name in PER_CONTACT
+        if name in options
     }
     grasp_values = {
-        name: _per_grasp(name, value, K, d) for name, value in per_grasp.items()
+        name: _per_grasp(name, options.pop(name), K, d)
+        for name in PER_GRASP
+        if name in options
     }
     parts = []
     for group in groups:

@@ -39,7 +39,7 @@ import numpy as np
 
 from drakegrasp.batch.build.construction import batched_characteristic_lengths
 from drakegrasp.batch.metrics import epsilon_l1_batch
-from drakegrasp.batch.ragged import is_ragged, run_groups
+from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
@@ -59,8 +59,18 @@ def epsilon_chunk(P, Nrm, mu_c, nu_c, p, b, *, model, num_generators, kernel):
     return {"epsilon_l1": eps}
 
 
+def _merge_epsilon(K: int, d: int, parts) -> np.ndarray:
+    """ε of a ragged batch's groups, in input order (read-only)."""
+    out = np.zeros(K)
+    for idx, eps in parts:
+        out[idx] = eps
+    out.flags.writeable = False
+    return out
+
+
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
+@accepts_ragged(_merge_epsilon)
 def batch_epsilon_l1(
     positions: np.ndarray,
     normals: np.ndarray,
@@ -112,20 +122,6 @@ def batch_epsilon_l1(
         \varepsilon = \min_{\text{facets } F \text{ of } P} \operatorname{dist}(0, F),
         \qquad P = \operatorname{conv}\{\operatorname{diag}(I, I/b)\, G_i s_k\}
     """
-    if is_ragged(positions):
-        K, _, parts = run_groups(
-            batch_epsilon_l1, positions, normals,
-            per_contact={"mu": mu, "torsional_friction": torsional_friction},
-            per_grasp={"reference_points": reference_points,
-                       "characteristic_lengths": characteristic_lengths},
-            contact_model=contact_model, num_generators=num_generators,
-            chunk_size=chunk_size, progress=progress, workers=workers, kernel=kernel,
-        )  # fmt: skip
-        out = np.zeros(K)
-        for idx, eps in parts:
-            out[idx] = eps
-        out.flags.writeable = False
-        return out
     task, options = force_task(
         positions, mu, contact_model, num_generators, torsional_friction,
         reference_points, characteristic_lengths, 1e-6, 1e-9, (), kernel,
