@@ -74,8 +74,8 @@ from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant._closing_steps import stalled
 from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.advancement import geometry_reach
-from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
 from drakegrasp.plant.closing import DEFAULT_MAX_ITERATIONS
+from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = ["GAP_SPACINGS", "REASONS", "CloudHand", "signed_distances"]
