@@ -39,10 +39,8 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    goes back to its pre-shape (it would only cross the others).
 4. **Contacts**: one per touching geometry (of a touching finger or the
    palm), as :func:`~drakegrasp.find_contacts` reports one per touching pair
-   of geometries on a body.  Its normal is the mean of the cloud's normals
-   over the touched patch (the points within
-   :data:`~drakegrasp.planning.cloud.CONTACT_BAND` of the nearest), its point
-   the cloud point where the geometry is closest.  Only a box's face lying
+   of geometries on a body: the cloud point where the geometry is closest,
+   with the mean of the cloud's normals there.  Only a box's face lying
    flat on a flat patch touches along an area and reports the patch's
    corners, as a pad on a body's flat face does.  (Every touched point of
    the band, or its hull's corners, made 11-28 contacts where the body
@@ -453,30 +451,29 @@ class CloudHand:
         """The contacts of one hand geometry with the cloud (none if it is clear).
 
         The geometry touches when its distance ``ψ_g`` to the cloud is within
-        ``margin + tol``.  Its *patch* is the cloud points within
-        :data:`~drakegrasp.planning.cloud.CONTACT_BAND` of ``ψ_g``; the contact
-        normal is their normals' mean (the surface's normal at the contact,
-        denoised), the contact point is the cloud point nearest the centroid
-        of the points within ``tol`` of ``ψ_g`` (where the geometry is closest,
-        well defined along a line contact).  A box's face flat on a flat patch
-        (every patch normal and the face's within
-        :data:`~drakegrasp.plant.contact_patches.PATCH_ANGLE_TOL` of the mean)
-        touches along an area, as a pad on a body's flat face: the corners of
-        the closest points' convex hull across the normal, each with the mean
-        normal.
+        ``margin + tol``.  Its *closest points* are the cloud points within
+        ``tol`` of ``ψ_g``: the contact point is the one nearest their
+        centroid (well defined along a line contact), the contact normal
+        their normals' mean (the mean over the whole touched patch tilts by
+        6° where a box's edge touches the can's side).  A box's face flat on
+        a flat patch (every normal of the *patch*, the points within
+        :data:`~drakegrasp.planning.cloud.CONTACT_BAND` of ``ψ_g``, and the
+        face's within :data:`~drakegrasp.plant.contact_patches.PATCH_ANGLE_TOL`
+        of the mean) touches along an area, as a pad on a body's flat face:
+        the corners of the closest points' convex hull across the normal, each
+        with the mean normal.
         """
         touch = self.margin + self.tol
         psi, _, idx, sd = self.distance(g, within=touch + CONTACT_BAND)
         if idx is None or psi > touch:
             return []
-        patch = sd <= psi + CONTACT_BAND
-        normals = self.surface.normals[idx[patch]]
-        n_O = normals.mean(axis=0)
+        closest = np.flatnonzero(sd <= psi + self.tol)
+        p_closest = self.surface.points[idx[closest]]
+        n_O = self.surface.normals[idx[closest]].mean(axis=0)
         if not np.linalg.norm(n_O) > 1e-9:  # opposite normals cancel (a thin wall)
             n_O = self.surface.normals[idx[int(np.argmin(sd))]]
         n_O = n_O / np.linalg.norm(n_O)
-        closest = np.flatnonzero(sd <= psi + self.tol)
-        p_closest = self.surface.points[idx[closest]]
+        normals = self.surface.normals[idx[sd <= psi + CONTACT_BAND]]
         if isinstance(g.shape, Box) and self._flat(g, normals, n_O):
             keep = [closest[k] for k in _hull_corners(p_closest, n_O)]
         else:
