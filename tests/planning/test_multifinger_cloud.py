@@ -9,6 +9,7 @@ with a reason."""
 from __future__ import annotations
 
 import importlib.util
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +26,7 @@ from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning import object_surface, plan_grasps, planning_scene
 from drakegrasp.planning.cloud_hand import REASONS, signed_distances
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
+from drakegrasp.plant.contacts import find_contacts
 from drakegrasp.plant.couplings import add_models
 from drakegrasp.plant.models import register_models
 
@@ -152,11 +154,63 @@ def test_full_cloud_contacts_lie_on_the_true_can(can, full_result):
     full, _, (p, _), _ = can
     spacing = np.sqrt(0.0276 / len(p))  # the can's area over its points
     _check_on_the_true_can(full, full_result[:6], band=max(spacing, 2e-3))
-    for c in full_result[:6]:  # the contacts are cloud points, with its normals
+    for c in full_result[:6]:  # the contacts are cloud points
         p_W = np.array([k.p_OC for k in c.contacts]) + c.X_WO.translation()
         assert (
             np.min(np.linalg.norm(p_W[:, None] - p[None], axis=2), axis=1).max() < 1e-12
         )
+
+
+CAN_RADIUS, CAN_HALF_LENGTH = 0.03185, 0.04995  # its collision cylinder (axis y)
+
+
+def _can_normal(p_W):
+    """The true can's outward unit normal at a surface point (the can at the
+    world origin, axis y), or None within 3 mm of a rim (no single normal)."""
+    r = np.hypot(p_W[0], p_W[2])
+    side = abs(p_W[1]) < CAN_HALF_LENGTH - 3e-3
+    cap = r < CAN_RADIUS - 3e-3
+    if side and not cap:
+        return np.array([p_W[0], 0.0, p_W[2]]) / r
+    if cap and not side:
+        return np.array([0.0, np.sign(p_W[1]), 0.0])
+    return None
+
+
+def test_one_contact_per_touching_geometry_as_on_the_true_can(can, full_result):
+    """Each touching geometry gives one contact (a box flat on the cap its
+    patch's corners), as find_contacts on the true can gives one per touching
+    geometry pair, with the true surface's normal: the band's every point
+    made 11-28 contacts where the true can's analysis finds 3-7."""
+    full, _, _, _ = can
+    plant, obj = full.plant, full.object_body
+    flat = 0
+    for c in full_result:
+        ctx = full.context.Clone()
+        c.apply(plant, ctx)
+        pctx = plant.GetMyContextFromRoot(ctx)
+        on_body = find_contacts(
+            plant, pctx, obj, hand=full.hand, distance_tolerance=2e-3
+        )
+        per_body = Counter(k.finger_body for k in c.contacts)
+        normals = {}
+        for k in c.contacts:
+            p_W = k.p_OC + c.X_WO.translation()
+            n = _can_normal(p_W)
+            if n is not None:  # the patch's mean normal is the surface's
+                assert np.degrees(np.arccos(np.clip(-k.nhat_O @ n, -1, 1))) < 5.0
+            normals.setdefault(k.finger_body, []).append(k.nhat_O)
+        for body, count in per_body.items():
+            geometries = plant.GetCollisionGeometriesForBody(
+                plant.GetBodyByName(body.split("::")[-1])
+            )
+            if count > len(geometries):  # only a pad flat on the flat cap
+                nrm = np.array(normals[body])
+                assert np.all(np.abs(nrm[:, 1]) > np.cos(np.radians(2.0))), body
+                flat += 1
+        if not flat:
+            assert len(c.contacts) <= len(on_body)
+    assert np.mean([len(c.contacts) for c in full_result]) < 5
 
 
 def test_one_sided_cloud_of_the_can(can, partial_result):
