@@ -30,10 +30,11 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from pydrake.common.value import AbstractValue
+from pydrake.math import RigidTransform
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import (
     AddMultibodyPlantSceneGraph,
@@ -179,6 +180,7 @@ def shake_test(
     max_displacement: float = 0.01,
     max_rotation: float = np.radians(10.0),
     object_body=None,
+    X_WO: RigidTransform | None = None,
 ) -> ShakeResult:
     """Simulate a planned grasp in Drake and report whether the object stays put.
 
@@ -212,6 +214,11 @@ def shake_test(
         Bounds on the object's motion in the hand frame: metres, radians.
     object_body : optional
         Overrides the object that ``add_models`` returns.
+    X_WO : RigidTransform, optional
+        The object's pose in the world at the start (default the candidate's
+        ``X_WO``).  A candidate planned on a point cloud has the cloud's frame
+        there (its centroid, with the world's axes), not the object's: give the
+        true pose of the object the cloud was taken from.
 
     Returns
     -------
@@ -234,6 +241,12 @@ def shake_test(
             "candidate must be a GraspCandidate from plan_grasps, got "
             f"{type(candidate).__name__}"
         )
+    if X_WO is not None:
+        if not isinstance(X_WO, RigidTransform):
+            raise InvalidOptionError(
+                f"X_WO must be a pydrake RigidTransform, got {type(X_WO).__name__}"
+            )
+        candidate = replace(candidate, X_WO=X_WO)
     for name, value in (
         ("squeeze", squeeze),
         ("stiffness", stiffness),

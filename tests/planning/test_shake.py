@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 import pytest
+from pydrake.math import RigidTransform
 
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
@@ -67,6 +68,21 @@ def test_shake_result_reports_motion(wsg_scene):
     assert data["held"] is True and "held" in str(result)
 
 
+def test_the_object_starts_where_x_wo_says(wsg_scene):
+    # the planned pose by default; 30 cm away from the hand, nothing holds it
+    scene = wsg_scene()
+    best = _plan(scene, n=60)[0]
+    same = shake_test(scene.add_models, best, squeeze=20.0, X_WO=best.X_WO, **QUICK)
+    assert same.held
+    assert (
+        same.max_displacement
+        == shake_test(scene.add_models, best, squeeze=20.0, **QUICK).max_displacement
+    )
+    away = RigidTransform(best.X_WO.rotation(), best.X_WO.translation() + [0, 0, 0.3])
+    alone = shake_test(scene.add_models, best, squeeze=20.0, X_WO=away, **QUICK)
+    assert not alone.held and alone.max_displacement > 0.1
+
+
 def test_a_grasp_with_nothing_to_squeeze_drops(wsg_scene):
     scene = wsg_scene()
     best = _plan(scene, n=60)[0]
@@ -82,6 +98,7 @@ def test_a_grasp_with_nothing_to_squeeze_drops(wsg_scene):
         {"time_step": -1e-3},
         {"directions": [(0, 0, 0)]},
         {"phase": np.nan},
+        {"X_WO": np.eye(4)},
     ],
 )
 def test_bad_options(wsg_scene, kw):
