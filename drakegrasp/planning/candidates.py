@@ -20,6 +20,7 @@ from functools import cached_property
 import numpy as np
 from pydrake.math import RigidTransform
 
+from drakegrasp.batch.run.stream import progress_bar
 from drakegrasp.closure.results import ClosureResult
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
@@ -28,7 +29,13 @@ from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import plant_context_of, resolve_body
 
-__all__ = ["GraspCandidate", "GraspCandidates", "planning_result", "pose_dict"]
+__all__ = [
+    "GraspCandidate",
+    "GraspCandidates",
+    "closing_order",
+    "planning_result",
+    "pose_dict",
+]
 
 
 def pose_dict(X: RigidTransform) -> dict:
@@ -321,6 +328,22 @@ class GraspCandidates(Sequence):
         if len(self) > 10:
             lines.append(f"  ... {len(self) - 10} more")
         return "\n".join(lines)
+
+
+def closing_order(n: int, progress: bool):
+    """The indices of ``n`` sampled poses, under a tqdm bar when ``progress``.
+
+    The closing stage (Drake's distance queries, pose by pose) is the long one
+    of every route, so the bar counts its poses.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``progress`` with the optional package tqdm not installed.
+    """
+    if not progress:
+        return range(n)
+    return progress_bar(range(n), desc="closing", unit="pose")
 
 
 def planning_result(

@@ -51,7 +51,11 @@ from drakegrasp.planning.approach import (
     multi_finger_hand,
     sample_approaches,
 )
-from drakegrasp.planning.candidates import GraspCandidate, planning_result
+from drakegrasp.planning.candidates import (
+    GraspCandidate,
+    closing_order,
+    planning_result,
+)
 from drakegrasp.planning.cloud import CONTACT_BAND, CloudSurface
 from drakegrasp.planning.cloud_hand import CloudHand
 from drakegrasp.planning.ranking import group_by_count, robustness, verdicts
@@ -201,11 +205,7 @@ def close_candidates(
     """
     placer = _Placer(plant, ctx, body, hand_spec, hand, tol, min_fingers)
     rejections = Counter()
-    order = range(len(poses["q"]))
-    if progress:
-        from tqdm.auto import tqdm
-
-        order = tqdm(order, desc="closing", unit="pose")
+    order = closing_order(len(poses["q"]), progress)
     kept = []
     for k in order:
         X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
@@ -304,18 +304,35 @@ def rank_multifinger(
     return tuple(out)
 
 
-def plan_multifinger(
-    plant, ctx, body, *, hand, n, mu, rng, surface, settings, t0, name,
-    preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
-    standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
-    progress=False, weight=None,
+def _ranked_result(
+    kept, *, label, hand_model, plant, mu, settings, torque_scale, rng, certify,
+    workers, X_WO, weight, rejections, num_sampled, object_body, started,
 ):  # fmt: skip
-    """The multi-finger route of :func:`~drakegrasp.planning.planner.plan_grasps`.
+    """Both routes' last stage: the kept closings ranked, as GraspCandidates."""
+    candidates = rank_multifinger(
+        kept, label=label, hand=hand_model, plant=plant, mu=mu,
+        model=settings["contact_model"], nu=settings["torsional_friction"],
+        torque_scale=torque_scale, samples=settings["robustness_samples"],
+        noise=settings["noise"], rng=rng, certify=certify, workers=workers,
+        X_WO=X_WO, weight=weight,
+    )  # fmt: skip
+    return planning_result(
+        candidates,
+        rejections=rejections,
+        num_sampled=num_sampled,
+        object_body=object_body,
+        mu=mu,
+        torque_scale=torque_scale,
+        settings=settings,
+        started=started,
+    )
 
-    Called by ``plan_grasps`` once the options are checked (``settings`` holds
-    them); ``weight`` is the object's weight (N).  Returns its
-    :class:`~drakegrasp.planning.candidates.GraspCandidates`.
-    """
+
+def _checked_hand(
+    plant, ctx, body, hand, *, tilt, min_fingers, preshape, synergy,
+    synergy_range, approach, standoff,
+):  # fmt: skip
+    """Both routes' options checked and the hand read: ``(tilt, MultiFingerHand)``."""
     tilt = float(tilt)
     if not 0.0 <= tilt <= np.pi / 2:
         raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
@@ -336,6 +353,26 @@ def plan_multifinger(
             f"min_fingers = {min_fingers} exceeds the hand's "
             f"{hand_model.num_fingers} fingers"
         )
+    return tilt, hand_model
+
+
+def plan_multifinger(
+    plant, ctx, body, *, hand, n, mu, rng, surface, settings, t0, name,
+    preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
+    standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
+    progress=False, weight=None,
+):  # fmt: skip
+    """The multi-finger route of :func:`~drakegrasp.planning.planner.plan_grasps`.
+
+    Called by ``plan_grasps`` once the options are checked (``settings`` holds
+    them); ``weight`` is the object's weight (N).  Returns its
+    :class:`~drakegrasp.planning.candidates.GraspCandidates`.
+    """
+    tilt, hand_model = _checked_hand(
+        plant, ctx, body, hand, tilt=tilt, min_fingers=min_fingers,
+        preshape=preshape, synergy=synergy, synergy_range=synergy_range,
+        approach=approach, standoff=standoff,
+    )  # fmt: skip
     settings = {**settings, "hand": hand_model.to_dict(), "tilt": tilt,
                 "min_fingers": int(min_fingers)}  # fmt: skip
     X_WO = plant.EvalBodyPoseInWorld(ctx, body)
@@ -349,23 +386,12 @@ def plan_multifinger(
         )  # fmt: skip
     finally:
         plant.SetPositions(ctx, saved)
-    candidates = rank_multifinger(
-        kept, label=label, hand=hand_model, plant=plant, mu=mu,
-        model=settings["contact_model"], nu=settings["torsional_friction"],
-        torque_scale=torque_scale, samples=settings["robustness_samples"],
-        noise=settings["noise"], rng=rng, certify=certify, workers=workers,
-        X_WO=X_WO, weight=weight,
+    return _ranked_result(
+        kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
+        settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
+        workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
+        num_sampled=n, object_body=name, started=t0,
     )  # fmt: skip
-    return planning_result(
-        candidates,
-        rejections=rejections,
-        num_sampled=n,
-        object_body=name,
-        mu=mu,
-        torque_scale=torque_scale,
-        settings=settings,
-        started=t0,
-    )
 
 
 def plan_multifinger_cloud(
@@ -382,26 +408,11 @@ def plan_multifinger_cloud(
     object's weight (N, NaN when unknown).  Returns its
     :class:`~drakegrasp.planning.candidates.GraspCandidates`.
     """
-    tilt = float(tilt)
-    if not 0.0 <= tilt <= np.pi / 2:
-        raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
-    if (
-        isinstance(min_fingers, bool)
-        or not isinstance(min_fingers, int | np.integer)
-        or min_fingers < 2
-    ):
-        raise InvalidOptionError(
-            f"min_fingers must be an integer >= 2, got {min_fingers!r}"
-        )
-    hand_model = multi_finger_hand(
-        plant, ctx, plant.world_body(), hand, preshape=preshape, synergy=synergy,
-        synergy_range=synergy_range, approach=approach, standoff=standoff,
+    tilt, hand_model = _checked_hand(
+        plant, ctx, plant.world_body(), hand, tilt=tilt, min_fingers=min_fingers,
+        preshape=preshape, synergy=synergy, synergy_range=synergy_range,
+        approach=approach, standoff=standoff,
     )  # fmt: skip
-    if min_fingers > hand_model.num_fingers:
-        raise InvalidOptionError(
-            f"min_fingers = {min_fingers} exceeds the hand's "
-            f"{hand_model.num_fingers} fingers"
-        )
     surface = CloudSurface(points, normals, viewpoint=viewpoint)
     X_WO = RigidTransform(surface.centroid)
     settings = {
@@ -419,11 +430,7 @@ def plan_multifinger_cloud(
         plant, ctx, hand_model, surface, settings["distance_tolerance"], min_fingers
     )
     rejections = Counter()
-    order = range(len(poses["q"]))
-    if progress:
-        from tqdm.auto import tqdm
-
-        order = tqdm(order, desc="closing", unit="pose")
+    order = closing_order(len(poses["q"]), progress)
     kept = []
     try:
         for k in order:
@@ -435,20 +442,9 @@ def plan_multifinger_cloud(
             kept.append((k, X_WH, poses["q"][k], q, found))
     finally:
         plant.SetPositions(ctx, saved)
-    candidates = rank_multifinger(
-        kept, label=closer.label, hand=hand_model, plant=plant, mu=mu,
-        model=settings["contact_model"], nu=settings["torsional_friction"],
-        torque_scale=torque_scale, samples=settings["robustness_samples"],
-        noise=settings["noise"], rng=rng, certify=certify, workers=workers,
-        X_WO=X_WO, weight=weight,
+    return _ranked_result(
+        kept, label=closer.label, hand_model=hand_model, plant=plant, mu=mu,
+        settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
+        workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
+        num_sampled=n, object_body="point cloud", started=t0,
     )  # fmt: skip
-    return planning_result(
-        candidates,
-        rejections=rejections,
-        num_sampled=n,
-        object_body="point cloud",
-        mu=mu,
-        torque_scale=torque_scale,
-        settings=settings,
-        started=t0,
-    )

@@ -44,7 +44,11 @@ from drakegrasp.core.validation import (
     real_scalar,
 )
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.planning.candidates import GraspCandidates, planning_result
+from drakegrasp.planning.candidates import (
+    GraspCandidates,
+    closing_order,
+    planning_result,
+)
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
     CloudFingers,
@@ -347,11 +351,7 @@ def plan_grasps(
         cloud = CloudFingers(
             plant, ctx, gripper, closer.hand_instance_bodies, surface, tol, CONTACT_BAND
         )
-    order = range(len(poses["sample"]))
-    if progress:
-        from tqdm.auto import tqdm
-
-        order = tqdm(order, desc="closing", unit="pose")
+    order = closing_order(len(poses["sample"]), progress)
     kept = []
     try:
         for k in order:

@@ -1,12 +1,22 @@
-"""Fixtures of the planning tests: planning scenes, built once per session."""
+"""Fixtures of the planning tests: planning scenes, built once per session.
+
+Also makes the shared helpers of tests/planning importable (``cloud_support``).
+"""
 
 from __future__ import annotations
+
+import sys
+from pathlib import Path
 
 import pytest
 
 from drakegrasp.planning import planning_scene
 
 OWN_HAND = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+
+_HERE = str(Path(__file__).resolve().parent)
+if _HERE not in sys.path:
+    sys.path.insert(0, _HERE)
 
 
 @pytest.fixture(scope="session")

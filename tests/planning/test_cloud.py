@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from cloud_support import sample_cloud
 from pydrake.perception import BaseField, Fields, PointCloud
 
 from drakegrasp import analyze_grasp
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.planning import object_surface, plan_grasps, planning_scene
+from drakegrasp.planning import plan_grasps, planning_scene
 
 
 @pytest.fixture(scope="module")
@@ -23,12 +24,7 @@ def scenes(drake_models_dir):
 
 
 def _cloud(full, n=4000, seed=0, view=None):
-    surface = object_surface(full.plant, full.context, full.object_body)
-    p, nrm, _ = surface.sample(n, np.random.default_rng(seed))
-    if view is not None:  # keep what a camera at `view` sees (convex object)
-        seen = np.sum(nrm * (np.asarray(view) - p), axis=1) > 0
-        p, nrm = p[seen], nrm[seen]
-    return p, nrm
+    return sample_cloud(full, n, seed, view)
 
 
 def _plan(hand_only, cloud, normals=None, n=200, **kw):

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cloud_support import sample_cloud
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from pydrake.geometry import Box, Capsule, Cylinder, Sphere
@@ -23,7 +24,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.planning import object_surface, plan_grasps, planning_scene
+from drakegrasp.planning import plan_grasps, planning_scene
 from drakegrasp.planning.cloud_hand import REASONS, signed_distances
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
 from drakegrasp.plant.contacts import find_contacts
@@ -41,12 +42,7 @@ MU = 1.0
 
 
 def _cloud(full, n=3000, seed=0, view=None):
-    surface = object_surface(full.plant, full.context, full.object_body)
-    p, nrm, _ = surface.sample(n, np.random.default_rng(seed))
-    if view is not None:  # keep what a camera at `view` sees (convex object)
-        seen = np.sum(nrm * (np.asarray(view) - p), axis=1) > 0
-        p, nrm = p[seen], nrm[seen]
-    return p, nrm
+    return sample_cloud(full, n, seed, view)
 
 
 def _allegro(models_dir, object_url=None):

@@ -30,6 +30,7 @@ __all__ = [
     "PARALLEL_MIN_WORK",
     "TARGET_CHUNKS",
     "chunk_size_for",
+    "progress_bar",
     "stream",
 ]
 
@@ -73,17 +74,28 @@ def _bounded_chunk_size(chunk_size: int, N: int, n_g: int) -> int:
 _CHUNK_BYTES = 64 * 2**20
 
 
+def progress_bar(iterable=None, *, total: int | None = None, desc: str, unit: str):
+    """A tqdm progress bar, or a clear error when the optional tqdm is missing.
+
+    Raises
+    ------
+    InvalidOptionError
+        tqdm is not installed (``pip install "drakegrasp[progress]"``).
+    """
+    try:
+        from tqdm.auto import tqdm
+    except ImportError as exc:
+        raise InvalidOptionError(
+            "progress=True needs the optional package tqdm, which is not "
+            'installed: pip install "drakegrasp[progress]"'
+        ) from exc
+    return tqdm(iterable, total=total, desc=desc, unit=unit)
+
+
 def _chunks(K: int, chunk_size: int, progress: bool, desc: str) -> Iterator[slice]:
     bar = None
     if check_flag("progress", progress):
-        try:
-            from tqdm.auto import tqdm
-        except ImportError as exc:
-            raise InvalidOptionError(
-                "progress=True needs the optional package tqdm, which is not "
-                'installed: pip install "drakegrasp[progress]"'
-            ) from exc
-        bar = tqdm(total=K, desc=desc, unit="grasp")
+        bar = progress_bar(total=K, desc=desc, unit="grasp")
     try:
         for start in range(0, K, chunk_size):
             stop = min(K, start + chunk_size)
