@@ -12,6 +12,7 @@ results are bitwise the same for 1 and 2 worker processes.
 from __future__ import annotations
 
 import inspect
+import time
 
 import numpy as np
 import pytest
@@ -311,7 +312,15 @@ def test_the_worker_pool_is_kept_and_replaced_when_a_worker_dies():
     assert set(parallel._POOL["pool"]._processes) == pids
     for res in (first, again):
         assert res.d_star.tobytes() == one.d_star.tobytes()
-    os.kill(next(iter(pids)), signal.SIGKILL)
+    victim = next(iter(pids))
+    process = parallel._POOL["pool"]._processes[victim]
+    os.kill(victim, signal.SIGKILL)
+    # SIGKILL is delivered asynchronously: wait until the worker has exited
+    # (a call that starts first may finish on the survivor alone, CI saw it)
+    deadline = time.monotonic() + 10.0
+    while process.exitcode is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert process.exitcode is not None
     fresh = batch_force_closure(P, Nrm, mu=0.5, chunk_size=200, workers=2)
     assert set(parallel._POOL["pool"]._processes).isdisjoint(pids)
     assert fresh.d_star.tobytes() == one.d_star.tobytes()
