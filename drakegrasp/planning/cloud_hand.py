@@ -69,7 +69,7 @@ from drakegrasp.planning.cloud import (
     _hull_corners,
 )
 from drakegrasp.planning.surface import piece_of_shape
-from drakegrasp.plant._closing_steps import stalled
+from drakegrasp.plant._closing_steps import stalled, unit_step
 from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.advancement import geometry_reach
 from drakegrasp.plant.closing import DEFAULT_MAX_ITERATIONS
@@ -304,14 +304,7 @@ class CloudHand:
             plant.world_frame(), plant.world_frame(),
         )  # fmt: skip
         d = s.coupling.pull_back((R @ n_G) @ J[:, s.velocity_indices])
-        d = np.where(self.mask[f], d, 0.0)
-        blocked = ((d > 0) & (q >= s.upper)) | ((d < 0) & (q <= s.lower))
-        d = np.where(blocked, 0.0, d)
-        scale = np.max(np.abs(d), initial=0.0)
-        if scale <= 1e-12:
-            return np.zeros_like(q)
-        d = d / scale
-        return np.where(np.abs(d) < 1e-9, 0.0, d)
+        return unit_step(np.where(self.mask[f], d, 0.0), q, s.lower, s.upper)
 
     def _signed(self, g: _Geometry, R, p, points_W) -> np.ndarray:
         sd = signed_distances(g.shape, (points_W - p) @ R)

@@ -204,17 +204,26 @@ def close_candidates(
     ``kept`` holds ``(sample, X_WH, q_pre, q, contacts)``.
     """
     placer = _Placer(plant, ctx, body, hand_spec, hand, tol, min_fingers)
+    return close_each(placer, poses, progress)
+
+
+def close_each(closer, poses, progress):
+    """Close the hand at every sampled pose: (kept, rejection counts, labels).
+
+    ``closer.run(X_WH, q_pre)`` gives ``(contacts, q, reason)`` (a body's
+    placer or a cloud's :class:`~drakegrasp.planning.cloud_hand.CloudHand`);
+    ``kept`` holds ``(sample, X_WH, q_pre, q, contacts)``.
+    """
     rejections = Counter()
-    order = closing_order(len(poses["q"]), progress)
     kept = []
-    for k in order:
+    for k in closing_order(len(poses["q"]), progress):
         X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
-        found, q, reason = placer.run(X_WH, poses["q"][k])
+        found, q, reason = closer.run(X_WH, poses["q"][k])
         if reason is not None:
             rejections[reason] += 1
             continue
         kept.append((k, X_WH, poses["q"][k], q, found))
-    return kept, rejections, placer.label
+    return kept, rejections, closer.label
 
 
 def _labels(found, label, palm) -> list[int]:
@@ -429,21 +438,12 @@ def plan_multifinger_cloud(
     closer = CloudHand(
         plant, ctx, hand_model, surface, settings["distance_tolerance"], min_fingers
     )
-    rejections = Counter()
-    order = closing_order(len(poses["q"]), progress)
-    kept = []
     try:
-        for k in order:
-            X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
-            found, q, reason = closer.run(X_WH, poses["q"][k])
-            if reason is not None:
-                rejections[reason] += 1
-                continue
-            kept.append((k, X_WH, poses["q"][k], q, found))
+        kept, rejections, label = close_each(closer, poses, progress)
     finally:
         plant.SetPositions(ctx, saved)
     return _ranked_result(
-        kept, label=closer.label, hand_model=hand_model, plant=plant, mu=mu,
+        kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
         settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
         num_sampled=n, object_body="point cloud", started=t0,

@@ -181,6 +181,23 @@ def stalled(st, q, psi: float, target: float, tol: float) -> bool:
     return bool(net < STALL_WANDER * path)
 
 
+def unit_step(d, q, lower, upper) -> np.ndarray:
+    """A closing direction over the hand's joints, ready to step along.
+
+    Components that would push a joint at ``q`` past its limit (``lower``,
+    ``upper``, rad or m) are dropped, the rest scaled to a largest component
+    of 1, and round-off (below 1e-9 of it) set to 0; all zeros when nothing is
+    left to move (largest component at most 1e-12).
+    """
+    blocked = ((d > 0) & (q >= upper)) | ((d < 0) & (q <= lower))
+    d = np.where(blocked, 0.0, d)
+    scale = np.max(np.abs(d), initial=0.0)
+    if scale <= 1e-12:
+        return np.zeros_like(d)
+    d = d / scale
+    return np.where(np.abs(d) < 1e-9, 0.0, d)  # round-off, not a motion
+
+
 def _path_end(q, d, lower, upper) -> float:
     """Largest α at which a joint with d != 0 still moves (capped at 1e3).
 
@@ -362,11 +379,4 @@ class Search:
             d = np.where(
                 mine, -hand.coupling.pull_back(self._dpsi(n_W, body, p_BC)), 0.0
             )
-        q = st.q_good
-        blocked = ((d > 0) & (q >= hand.upper)) | ((d < 0) & (q <= hand.lower))
-        d = np.where(blocked, 0.0, d)
-        scale = np.max(np.abs(d), initial=0.0)
-        if scale <= 1e-12:
-            return np.zeros_like(d)
-        d = d / scale
-        return np.where(np.abs(d) < 1e-9, 0.0, d)  # round-off, not a motion
+        return unit_step(d, st.q_good, hand.lower, hand.upper)
