@@ -815,31 +815,22 @@ def geometry_cases(seed: int = 0, count: int = 120) -> Iterator[Case]:
         contacts = [dg.Contact(P[i], n[i], mu=mu) for i in range(num)]
         grasp = dg.Grasp(contacts, reference_point=ref * unit)
         want = oracle.closure_verdict(P, n, [mu] * num)
-        check = None if want is None else (lambda r, want=want: r.is_closure == want[0])
-        yield Case(
-            "geometry",
-            f"force#{k} unit={unit:.1e} mu={mu:g}",
-            lambda g=grasp: dg.force_closure(g),
-            "answer",
-            check,
-        )
+        # The programs run on this grasp, each with the oracle's verdict for it.
+        programs = [(f"force#{k} unit={unit:.1e} mu={mu:g}", dg.force_closure, want)]
         if k % 3 == 0:
-            yield Case(
-                "geometry",
-                f"exact#{k}",
-                lambda g=grasp: dg.force_closure_exact(g),
-                "answer",
-                check,
-            )
+            programs.append((f"exact#{k}", dg.force_closure_exact, want))
         if k % 3 == 1:
             wf = oracle.form_closure_verdict(P, n)
-            fcheck = None if wf is None else (lambda r, wf=wf: r.is_closure == wf[0])
+            programs.append((f"form#{k}", dg.form_closure, wf))
+        for name, program, verdict in programs:
             yield Case(
                 "geometry",
-                f"form#{k}",
-                lambda g=grasp: dg.form_closure(g),
+                name,
+                lambda g=grasp, program=program: program(g),
                 "answer",
-                fcheck,
+                None
+                if verdict is None
+                else (lambda r, v=verdict: r.is_closure == v[0]),
             )
         if k % 4 == 0:
             Pb, Nb = P[None], n[None]
