@@ -345,12 +345,16 @@ def _closing_names(plant, scene):
     return hand_structure(plant, scene.object_body, bodies, inspector=inspector).names
 
 
-@settings(
+# Both "anywhere" properties: fixed examples, few (each closes a real hand).
+anywhere_examples = settings(
     derandomize=True,
     max_examples=8,
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
+
+
+@anywhere_examples
 @given(
     x=st.floats(-0.04, 0.04),
     y=st.floats(0.05, 0.16),
@@ -366,12 +370,7 @@ def test_wsg_anywhere_either_closes_truthfully_or_says_why(real_hands, x, y, yaw
         assert all(f.status in ("touching", "at limit") for f in closure.fingers)
 
 
-@settings(
-    derandomize=True,
-    max_examples=8,
-    deadline=None,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+@anywhere_examples
 @given(
     x=st.floats(0.06, 0.12),
     y=st.floats(-0.03, 0.03),
