@@ -8,9 +8,10 @@ import time
 import weakref
 
 import numpy as np
+import pytest
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
 
-from drakegrasp import close_hand
+from drakegrasp import UnreachableError, close_hand
 from drakegrasp.plant import fingers
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.couplings import plant_couplings
@@ -148,3 +149,25 @@ def test_the_checked_closing_equals_close_hand(drake_models_dir):
         assert [(f.status, f.psi, f.iterations) for f in checked.fingers] == [
             (f.status, f.psi, f.iterations) for f in plain.fingers
         ]
+
+
+def test_the_checked_closing_refuses_too_many_fingers_as_close_hand(drake_models_dir):
+    """min_fingers above the hand's fingers: the same UnreachableError, same words."""
+    scene = _scene(drake_models_dir)
+    q0 = scene.plant.GetPositions(scene.ctx).copy()
+    with pytest.raises(UnreachableError) as plain:
+        close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand, min_fingers=9)
+    inspector = query_object_of(scene.plant, scene.ctx).inspector()
+    structure = hand_structure(
+        scene.plant, scene.object,
+        hand_bodies(scene.plant, scene.object, scene.hand),
+        plant_couplings(scene.plant), inspector=inspector,
+    )  # fmt: skip
+    with pytest.raises(UnreachableError) as checked:
+        close_checked_hand(
+            scene.plant, scene.ctx, scene.object, structure, tol=1e-4, min_fingers=9,
+            t0=time.perf_counter(),
+        )  # fmt: skip
+    assert str(checked.value) == str(plain.value)
+    assert "exceeds the hand's 4 fingers" in str(plain.value)
+    np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
