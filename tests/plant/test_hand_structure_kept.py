@@ -33,6 +33,16 @@ def _scene(models_dir, p_WO=(0.08, 0.0, 0.1)):
     return scene
 
 
+def _fresh_structure(scene):
+    """The scene's hand structure computed anew, as a planner passes it."""
+    inspector = query_object_of(scene.plant, scene.ctx).inspector()
+    return hand_structure(
+        scene.plant, scene.object,
+        hand_bodies(scene.plant, scene.object, scene.hand),
+        plant_couplings(scene.plant), inspector=inspector,
+    )  # fmt: skip
+
+
 def _summary(s) -> tuple:
     """Everything a structure says, as plain values."""
     return (
@@ -126,12 +136,7 @@ def test_the_checked_closing_equals_close_hand(drake_models_dir):
             plain = type(e)
         q_plain = scene.plant.GetPositions(scene.ctx).copy()
         scene.plant.SetPositions(scene.ctx, q0)
-        inspector = query_object_of(scene.plant, scene.ctx).inspector()
-        structure = hand_structure(
-            scene.plant, scene.object,
-            hand_bodies(scene.plant, scene.object, scene.hand),
-            plant_couplings(scene.plant), inspector=inspector,
-        )  # fmt: skip
+        structure = _fresh_structure(scene)
         try:
             checked = close_checked_hand(
                 scene.plant, scene.ctx, scene.object, structure,
@@ -157,12 +162,7 @@ def test_the_checked_closing_refuses_too_many_fingers_as_close_hand(drake_models
     q0 = scene.plant.GetPositions(scene.ctx).copy()
     with pytest.raises(UnreachableError) as plain:
         close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand, min_fingers=9)
-    inspector = query_object_of(scene.plant, scene.ctx).inspector()
-    structure = hand_structure(
-        scene.plant, scene.object,
-        hand_bodies(scene.plant, scene.object, scene.hand),
-        plant_couplings(scene.plant), inspector=inspector,
-    )  # fmt: skip
+    structure = _fresh_structure(scene)
     with pytest.raises(UnreachableError) as checked:
         close_checked_hand(
             scene.plant, scene.ctx, scene.object, structure, tol=1e-4, min_fingers=9,
