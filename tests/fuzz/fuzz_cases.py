@@ -624,23 +624,22 @@ def option_cases() -> Iterator[Case]:
             )
     # Valid extremes are answered (and agree with the default where they should).
     ref = dg.force_closure(g)
+
+    def force_closure_with(option, value, expect, check=None):
+        return Case(
+            "options",
+            f"force_closure({option}={value:g})",
+            lambda: dg.force_closure(g, **{option: value}),
+            expect,
+            check,
+        )
+
     # Equator fingers: LP2's d* = 0.4194 and LP1's d* = 1 (three unit normal
     # forces balance), so closure holds for every tol in the valid range.
     for tol in (V.TOL_MIN, 1e-3, V.TOL_MAX):
-        yield Case(
-            "options",
-            f"force_closure(tol={tol:g})",
-            lambda tol=tol: dg.force_closure(g, tol=tol),
-            "answer",
-            lambda r: r.is_closure,
-        )
+        yield force_closure_with("tol", tol, "answer", lambda r: r.is_closure)
     for tol in (1.0, 2.0):
-        yield Case(
-            "options",
-            f"force_closure(tol={tol:g})",
-            lambda tol=tol: dg.force_closure(g, tol=tol),
-            "refuse",
-        )
+        yield force_closure_with("tol", tol, "refuse")
     J = np.eye(9)
     for name, fn in (
         ("internal_forces", dg.internal_forces),
@@ -656,17 +655,15 @@ def option_cases() -> Iterator[Case]:
                 "refuse",
             )
     for rt in (V.RANK_TOL_MIN, 1e-6, V.RANK_TOL_MAX):
-        yield Case(
-            "options",
-            f"force_closure(rank_tol={rt:g})",
-            lambda rt=rt: dg.force_closure(g, rank_tol=rt),
+        yield force_closure_with(
+            "rank_tol",
+            rt,
             "answer",
             lambda r: r.is_closure and abs(r.d_star - ref.d_star) < 1e-7,
         )
-    yield Case(
-        "options",
-        "force_closure(num_generators=256)",
-        lambda: dg.force_closure(g, num_generators=V.MAX_NUM_GENERATORS),
+    yield force_closure_with(
+        "num_generators",
+        V.MAX_NUM_GENERATORS,
         "answer",
         lambda r: r.is_closure and r.d_star >= ref.d_star - 1e-7,
     )
