@@ -902,6 +902,29 @@ def file_cases(root: Path) -> Iterator[Case]:
     from drakegrasp import cli
 
     P, N = _valid_batch(6)
+
+    def refused(name, source, out, *, cli_name=None, files=None):
+        """Cases: ``evaluate_file(source, out)`` refused (``cli_name``: the CLI too).
+
+        ``files`` (default: the input) must be left as they were.
+        """
+        files = (source,) if files is None else files
+        yield Case(
+            "files",
+            name,
+            lambda: dg.evaluate_file(source, out),
+            "refuse",
+            files=files,
+        )
+        if cli_name is not None:
+            yield Case(
+                "files",
+                cli_name,
+                lambda: _cli(cli, "batch", str(source), str(out)),
+                "refuse",
+                files=files,
+            )
+
     good = _save(root / "good.npz", positions=P, normals=N, mu=np.full((6, 3), 0.5))
     payload = good.read_bytes()
     damaged = {
@@ -918,38 +941,13 @@ def file_cases(root: Path) -> Iterator[Case]:
         path = root / f"{name}.npz"
         path.write_bytes(data)
         out = root / f"out-{name}.npz"
-        yield Case(
-            "files",
-            f"evaluate_file({name})",
-            lambda p=path, o=out: dg.evaluate_file(p, o),
-            "refuse",
-            files=(path,),
-        )
-        yield Case(
-            "files",
-            f"cli({name})",
-            lambda p=path, o=out: _cli(cli, "batch", str(p), str(o)),
-            "refuse",
-            files=(path,),
-        )
+        yield from refused(f"evaluate_file({name})", path, out, cli_name=f"cli({name})")
     npy = root / "lone.npz"
     np.save(open(npy, "wb"), P)
-    yield Case(
-        "files",
-        "lone-npy",
-        lambda: dg.evaluate_file(npy, root / "o1.npz"),
-        "refuse",
-        files=(npy,),
-    )
+    yield from refused("lone-npy", npy, root / "o1.npz")
     pickled = root / "pickled.npz"
     np.savez(open(pickled, "wb"), positions=np.array([object()] * 3), normals=N)
-    yield Case(
-        "files",
-        "pickled",
-        lambda: dg.evaluate_file(pickled, root / "o2.npz"),
-        "refuse",
-        files=(pickled,),
-    )
+    yield from refused("pickled", pickled, root / "o2.npz")
     for i, arrays in enumerate(
         [
             {"positions": P},
@@ -962,13 +960,7 @@ def file_cases(root: Path) -> Iterator[Case]:
         ]
     ):
         path = _save(root / f"bad{i}.npz", **arrays)
-        yield Case(
-            "files",
-            f"bad-arrays#{i}",
-            lambda p=path, i=i: dg.evaluate_file(p, root / f"o-bad{i}.npz"),
-            "refuse",
-            files=(path,),
-        )
+        yield from refused(f"bad-arrays#{i}", path, root / f"o-bad{i}.npz")
     # The output is the input: directly, through a symlink, through a hard link.
     link = root / "link.npz"
     link.symlink_to(good)
@@ -982,34 +974,19 @@ def file_cases(root: Path) -> Iterator[Case]:
     ):
         if name == "upper" and not (root / "GOOD.npz").exists():
             continue  # case-sensitive file system: a different file
-        yield Case(
-            "files",
+        yield from refused(
             f"output-is-input({name})",
-            lambda o=out: dg.evaluate_file(good, o),
-            "refuse",
-            files=(good,),
-        )
-        yield Case(
-            "files",
-            f"cli-output-is-input({name})",
-            lambda o=out: _cli(cli, "batch", str(good), str(o)),
-            "refuse",
-            files=(good,),
+            good,
+            out,
+            cli_name=f"cli-output-is-input({name})",
         )
     # An existing output is kept unless --overwrite; then it is replaced whole.
     existing = _save(root / "existing.npz", kept=np.arange(3))
-    yield Case(
-        "files",
+    yield from refused(
         "existing-output",
-        lambda: dg.evaluate_file(good, existing),
-        "refuse",
-        files=(good, existing),
-    )
-    yield Case(
-        "files",
-        "cli-existing-output",
-        lambda: _cli(cli, "batch", str(good), str(existing)),
-        "refuse",
+        good,
+        existing,
+        cli_name="cli-existing-output",
         files=(good, existing),
     )
     upper = root / "OUT.NPZ"
@@ -1041,33 +1018,10 @@ def file_cases(root: Path) -> Iterator[Case]:
         lambda r: _readable(replaced) and len(r) == 6,
         files=(good,),
     )
-    yield Case(
-        "files",
-        "output-dir",
-        lambda: dg.evaluate_file(good, root),
-        "refuse",
-        files=(good,),
-    )
-    yield Case(
-        "files",
-        "output-missing-dir",
-        lambda: dg.evaluate_file(good, root / "nope" / "o.npz"),
-        "refuse",
-        files=(good,),
-    )
-    yield Case(
-        "files",
-        "output-suffix",
-        lambda: dg.evaluate_file(good, root / "o.txt"),
-        "refuse",
-        files=(good,),
-    )
-    yield Case(
-        "files",
-        "input-missing",
-        lambda: dg.evaluate_file(root / "missing.npz", root / "o3.npz"),
-        "refuse",
-    )
+    yield from refused("output-dir", good, root)
+    yield from refused("output-missing-dir", good, root / "nope" / "o.npz")
+    yield from refused("output-suffix", good, root / "o.txt")
+    yield from refused("input-missing", root / "missing.npz", root / "o3.npz", files=())
     # A failure while writing leaves the earlier output intact (atomic write).
     earlier = _save(root / "earlier.npz", kept=np.arange(3))
 
