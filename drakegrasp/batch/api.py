@@ -199,6 +199,43 @@ def merge_results(
     return collect(K, d, first.kind, first.tol, names, chunks)
 
 
+def force_chunks(
+    positions, normals, mu, contact_model, num_generators, torsional_friction,
+    reference_points, characteristic_lengths, tol, rank_tol, metrics, kernel,
+    chunk_size, progress, workers,
+) -> tuple[dict, Iterator[tuple[slice, dict[str, np.ndarray]]]]:  # fmt: skip
+    """Validate the LP2 options once; return them and the stream of chunk results.
+
+    The arguments are those of :func:`batch_force_closure`, in its order; the
+    chunks are ``(slice, arrays)`` as :func:`stream_force_closure` yields them.
+    """
+    task, options = force_task(
+        positions, mu, contact_model, num_generators, torsional_friction,
+        reference_points, characteristic_lengths, tol, rank_tol, metrics, kernel,
+    )  # fmt: skip
+    chunks = stream(
+        positions, normals, kind="force", task=task, chunk_size=chunk_size,
+        progress=progress, workers=workers, n_g=options["num_generators"],
+    )  # fmt: skip
+    return options, chunks
+
+
+def form_chunks(
+    positions, normals, reference_points, characteristic_lengths, tol, rank_tol,
+    metrics, kernel, chunk_size, progress, workers,
+) -> tuple[dict, Iterator[tuple[slice, dict[str, np.ndarray]]]]:  # fmt: skip
+    """:func:`force_chunks` for LP1 (:func:`batch_form_closure`'s arguments)."""
+    task, options = form_task(
+        positions, reference_points, characteristic_lengths, tol, rank_tol, metrics,
+        kernel,
+    )  # fmt: skip
+    chunks = stream(
+        positions, normals, kind="form", task=task, chunk_size=chunk_size,
+        progress=progress, workers=workers,
+    )  # fmt: skip
+    return options, chunks
+
+
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
 def stream_force_closure(
@@ -226,20 +263,12 @@ def stream_force_closure(
     writer can stream any number of grasps in bounded memory.  Options are
     validated before the first chunk is read.
     """
-    task, options = force_task(
-        positions, mu, contact_model, num_generators, torsional_friction,
+    _, chunks = force_chunks(
+        positions, normals, mu, contact_model, num_generators, torsional_friction,
         reference_points, characteristic_lengths, tol, rank_tol, metrics, kernel,
+        chunk_size, progress, workers,
     )  # fmt: skip
-    return stream(
-        positions,
-        normals,
-        kind="force",
-        task=task,
-        chunk_size=chunk_size,
-        progress=progress,
-        workers=workers,
-        n_g=options["num_generators"],
-    )
+    return chunks
 
 
 def stream_form_closure(
@@ -260,19 +289,11 @@ def stream_form_closure(
 
     See :func:`stream_force_closure`.
     """
-    task, _ = form_task(
-        positions, reference_points, characteristic_lengths, tol, rank_tol, metrics,
-        kernel,
+    _, chunks = form_chunks(
+        positions, normals, reference_points, characteristic_lengths, tol, rank_tol,
+        metrics, kernel, chunk_size, progress, workers,
     )  # fmt: skip
-    return stream(
-        positions,
-        normals,
-        kind="form",
-        task=task,
-        chunk_size=chunk_size,
-        progress=progress,
-        workers=workers,
-    )
+    return chunks
 
 
 @renamed_keyword("model", "contact_model")
@@ -380,13 +401,10 @@ def batch_force_closure(
     spaces, a block interior-point method for the rest).
     """
     K, N, d = shape_of("positions", positions)
-    task, options = force_task(
-        positions, mu, contact_model, num_generators, torsional_friction,
+    options, chunks = force_chunks(
+        positions, normals, mu, contact_model, num_generators, torsional_friction,
         reference_points, characteristic_lengths, tol, rank_tol, metrics, kernel,
-    )  # fmt: skip
-    chunks = stream(
-        positions, normals, kind="force", task=task, chunk_size=chunk_size,
-        progress=progress, workers=workers, n_g=options["num_generators"],
+        chunk_size, progress, workers,
     )  # fmt: skip
     return collect(K, d, "force", options["tol"], options["metrics"], chunks)
 
@@ -438,13 +456,9 @@ def batch_form_closure(
         d \ge 0,\; \mathbf 1^T f_n \le N .
     """
     K, N, d = shape_of("positions", positions)
-    task, options = form_task(
-        positions, reference_points, characteristic_lengths, tol, rank_tol, metrics,
-        kernel,
-    )  # fmt: skip
-    chunks = stream(
-        positions, normals, kind="form", task=task, chunk_size=chunk_size,
-        progress=progress, workers=workers,
+    options, chunks = form_chunks(
+        positions, normals, reference_points, characteristic_lengths, tol, rank_tol,
+        metrics, kernel, chunk_size, progress, workers,
     )  # fmt: skip
     return collect(K, d, "form", options["tol"], options["metrics"], chunks)
 

@@ -401,12 +401,7 @@ def close_hand(
             "a free body (it is welded or jointed); settle=False closes onto it "
             "where it is"
         )
-    if min_fingers > len(hand_.fingers):  # unreachable before any search
-        raise UnreachableError(
-            f"min_fingers = {min_fingers} exceeds the hand's {len(hand_.fingers)} "
-            f"fingers ({', '.join(f.name for f in hand_.fingers)}); at most "
-            f"{len(hand_.fingers)} can touch"
-        )
+    _check_min_fingers(min_fingers, hand_)
     _check_coupled(hand_, q0)
     user_d = _user_direction(direction, len(q0), hand_)
     return _close(
@@ -415,6 +410,16 @@ def close_hand(
         inspector=inspector, jaws=jaws, symmetric=symmetric, settle=settle,
         instance_bodies=instance_bodies, t0=t0,
     )  # fmt: skip
+
+
+def _check_min_fingers(min_fingers: int, structure: HandStructure) -> None:
+    """Refuse, before any search, more touching fingers than the hand has."""
+    n = len(structure.fingers)
+    if min_fingers > n:
+        raise UnreachableError(
+            f"min_fingers = {min_fingers} exceeds the hand's {n} fingers "
+            f"({', '.join(f.name for f in structure.fingers)}); at most {n} can touch"
+        )
 
 
 def close_checked_hand(
@@ -431,11 +436,7 @@ def close_checked_hand(
     """
     q_all = plant.GetPositions(plant_context)
     q0 = q_all[structure.position_indices].copy()
-    if min_fingers > len(structure.fingers):
-        raise UnreachableError(
-            f"min_fingers = {min_fingers} exceeds the hand's "
-            f"{len(structure.fingers)} fingers"
-        )
+    _check_min_fingers(min_fingers, structure)
     inspector = query_object_of(plant, plant_context).inspector()
     return _close(
         plant, plant_context, body, structure, q_all, q0, tol=tol,

@@ -624,23 +624,22 @@ def option_cases() -> Iterator[Case]:
             )
     # Valid extremes are answered (and agree with the default where they should).
     ref = dg.force_closure(g)
+
+    def force_closure_with(option, value, expect, check=None):
+        return Case(
+            "options",
+            f"force_closure({option}={value:g})",
+            lambda: dg.force_closure(g, **{option: value}),
+            expect,
+            check,
+        )
+
     # Equator fingers: LP2's d* = 0.4194 and LP1's d* = 1 (three unit normal
     # forces balance), so closure holds for every tol in the valid range.
     for tol in (V.TOL_MIN, 1e-3, V.TOL_MAX):
-        yield Case(
-            "options",
-            f"force_closure(tol={tol:g})",
-            lambda tol=tol: dg.force_closure(g, tol=tol),
-            "answer",
-            lambda r: r.is_closure,
-        )
+        yield force_closure_with("tol", tol, "answer", lambda r: r.is_closure)
     for tol in (1.0, 2.0):
-        yield Case(
-            "options",
-            f"force_closure(tol={tol:g})",
-            lambda tol=tol: dg.force_closure(g, tol=tol),
-            "refuse",
-        )
+        yield force_closure_with("tol", tol, "refuse")
     J = np.eye(9)
     for name, fn in (
         ("internal_forces", dg.internal_forces),
@@ -656,17 +655,15 @@ def option_cases() -> Iterator[Case]:
                 "refuse",
             )
     for rt in (V.RANK_TOL_MIN, 1e-6, V.RANK_TOL_MAX):
-        yield Case(
-            "options",
-            f"force_closure(rank_tol={rt:g})",
-            lambda rt=rt: dg.force_closure(g, rank_tol=rt),
+        yield force_closure_with(
+            "rank_tol",
+            rt,
             "answer",
             lambda r: r.is_closure and abs(r.d_star - ref.d_star) < 1e-7,
         )
-    yield Case(
-        "options",
-        "force_closure(num_generators=256)",
-        lambda: dg.force_closure(g, num_generators=V.MAX_NUM_GENERATORS),
+    yield force_closure_with(
+        "num_generators",
+        V.MAX_NUM_GENERATORS,
         "answer",
         lambda r: r.is_closure and r.d_star >= ref.d_star - 1e-7,
     )
@@ -815,31 +812,22 @@ def geometry_cases(seed: int = 0, count: int = 120) -> Iterator[Case]:
         contacts = [dg.Contact(P[i], n[i], mu=mu) for i in range(num)]
         grasp = dg.Grasp(contacts, reference_point=ref * unit)
         want = oracle.closure_verdict(P, n, [mu] * num)
-        check = None if want is None else (lambda r, want=want: r.is_closure == want[0])
-        yield Case(
-            "geometry",
-            f"force#{k} unit={unit:.1e} mu={mu:g}",
-            lambda g=grasp: dg.force_closure(g),
-            "answer",
-            check,
-        )
+        # The programs run on this grasp, each with the oracle's verdict for it.
+        programs = [(f"force#{k} unit={unit:.1e} mu={mu:g}", dg.force_closure, want)]
         if k % 3 == 0:
-            yield Case(
-                "geometry",
-                f"exact#{k}",
-                lambda g=grasp: dg.force_closure_exact(g),
-                "answer",
-                check,
-            )
+            programs.append((f"exact#{k}", dg.force_closure_exact, want))
         if k % 3 == 1:
             wf = oracle.form_closure_verdict(P, n)
-            fcheck = None if wf is None else (lambda r, wf=wf: r.is_closure == wf[0])
+            programs.append((f"form#{k}", dg.form_closure, wf))
+        for name, program, verdict in programs:
             yield Case(
                 "geometry",
-                f"form#{k}",
-                lambda g=grasp: dg.form_closure(g),
+                name,
+                lambda g=grasp, program=program: program(g),
                 "answer",
-                fcheck,
+                None
+                if verdict is None
+                else (lambda r, v=verdict: r.is_closure == v[0]),
             )
         if k % 4 == 0:
             Pb, Nb = P[None], n[None]
@@ -914,6 +902,29 @@ def file_cases(root: Path) -> Iterator[Case]:
     from drakegrasp import cli
 
     P, N = _valid_batch(6)
+
+    def refused(name, source, out, *, cli_name=None, files=None):
+        """Cases: ``evaluate_file(source, out)`` refused (``cli_name``: the CLI too).
+
+        ``files`` (default: the input) must be left as they were.
+        """
+        files = (source,) if files is None else files
+        yield Case(
+            "files",
+            name,
+            lambda: dg.evaluate_file(source, out),
+            "refuse",
+            files=files,
+        )
+        if cli_name is not None:
+            yield Case(
+                "files",
+                cli_name,
+                lambda: _cli(cli, "batch", str(source), str(out)),
+                "refuse",
+                files=files,
+            )
+
     good = _save(root / "good.npz", positions=P, normals=N, mu=np.full((6, 3), 0.5))
     payload = good.read_bytes()
     damaged = {
@@ -930,38 +941,13 @@ def file_cases(root: Path) -> Iterator[Case]:
         path = root / f"{name}.npz"
         path.write_bytes(data)
         out = root / f"out-{name}.npz"
-        yield Case(
-            "files",
-            f"evaluate_file({name})",
-            lambda p=path, o=out: dg.evaluate_file(p, o),
-            "refuse",
-            files=(path,),
-        )
-        yield Case(
-            "files",
-            f"cli({name})",
-            lambda p=path, o=out: _cli(cli, "batch", str(p), str(o)),
-            "refuse",
-            files=(path,),
-        )
+        yield from refused(f"evaluate_file({name})", path, out, cli_name=f"cli({name})")
     npy = root / "lone.npz"
     np.save(open(npy, "wb"), P)
-    yield Case(
-        "files",
-        "lone-npy",
-        lambda: dg.evaluate_file(npy, root / "o1.npz"),
-        "refuse",
-        files=(npy,),
-    )
+    yield from refused("lone-npy", npy, root / "o1.npz")
     pickled = root / "pickled.npz"
     np.savez(open(pickled, "wb"), positions=np.array([object()] * 3), normals=N)
-    yield Case(
-        "files",
-        "pickled",
-        lambda: dg.evaluate_file(pickled, root / "o2.npz"),
-        "refuse",
-        files=(pickled,),
-    )
+    yield from refused("pickled", pickled, root / "o2.npz")
     for i, arrays in enumerate(
         [
             {"positions": P},
@@ -974,13 +960,7 @@ def file_cases(root: Path) -> Iterator[Case]:
         ]
     ):
         path = _save(root / f"bad{i}.npz", **arrays)
-        yield Case(
-            "files",
-            f"bad-arrays#{i}",
-            lambda p=path, i=i: dg.evaluate_file(p, root / f"o-bad{i}.npz"),
-            "refuse",
-            files=(path,),
-        )
+        yield from refused(f"bad-arrays#{i}", path, root / f"o-bad{i}.npz")
     # The output is the input: directly, through a symlink, through a hard link.
     link = root / "link.npz"
     link.symlink_to(good)
@@ -994,34 +974,19 @@ def file_cases(root: Path) -> Iterator[Case]:
     ):
         if name == "upper" and not (root / "GOOD.npz").exists():
             continue  # case-sensitive file system: a different file
-        yield Case(
-            "files",
+        yield from refused(
             f"output-is-input({name})",
-            lambda o=out: dg.evaluate_file(good, o),
-            "refuse",
-            files=(good,),
-        )
-        yield Case(
-            "files",
-            f"cli-output-is-input({name})",
-            lambda o=out: _cli(cli, "batch", str(good), str(o)),
-            "refuse",
-            files=(good,),
+            good,
+            out,
+            cli_name=f"cli-output-is-input({name})",
         )
     # An existing output is kept unless --overwrite; then it is replaced whole.
     existing = _save(root / "existing.npz", kept=np.arange(3))
-    yield Case(
-        "files",
+    yield from refused(
         "existing-output",
-        lambda: dg.evaluate_file(good, existing),
-        "refuse",
-        files=(good, existing),
-    )
-    yield Case(
-        "files",
-        "cli-existing-output",
-        lambda: _cli(cli, "batch", str(good), str(existing)),
-        "refuse",
+        good,
+        existing,
+        cli_name="cli-existing-output",
         files=(good, existing),
     )
     upper = root / "OUT.NPZ"
@@ -1053,33 +1018,10 @@ def file_cases(root: Path) -> Iterator[Case]:
         lambda r: _readable(replaced) and len(r) == 6,
         files=(good,),
     )
-    yield Case(
-        "files",
-        "output-dir",
-        lambda: dg.evaluate_file(good, root),
-        "refuse",
-        files=(good,),
-    )
-    yield Case(
-        "files",
-        "output-missing-dir",
-        lambda: dg.evaluate_file(good, root / "nope" / "o.npz"),
-        "refuse",
-        files=(good,),
-    )
-    yield Case(
-        "files",
-        "output-suffix",
-        lambda: dg.evaluate_file(good, root / "o.txt"),
-        "refuse",
-        files=(good,),
-    )
-    yield Case(
-        "files",
-        "input-missing",
-        lambda: dg.evaluate_file(root / "missing.npz", root / "o3.npz"),
-        "refuse",
-    )
+    yield from refused("output-dir", good, root)
+    yield from refused("output-missing-dir", good, root / "nope" / "o.npz")
+    yield from refused("output-suffix", good, root / "o.txt")
+    yield from refused("input-missing", root / "missing.npz", root / "o3.npz", files=())
     # A failure while writing leaves the earlier output intact (atomic write).
     earlier = _save(root / "earlier.npz", kept=np.arange(3))
 

@@ -153,65 +153,53 @@ def certificate_cases(seed: int = 210, count: int = 300) -> Iterator[Case]:
         base = cert.check(g)
         what = int(rng.integers(4))
         name = f"{cert.kind}#{made}"
+        # Each case checks a witness on a grasp: (label, witness, grasp,
+        # check options, expected outcome, judge of the answer).
         if what == 0:
             forged, value = _forged(cert, rng)
             if math.isfinite(value):  # a huge entry: the witness of a new vector
-                check = None
+                judge = None
                 if forged.kind == "escape twist" and not forged.two_sided:
 
-                    def check(c, g=g, f=forged):
+                    def judge(c, g=g, f=forged):
                         return c.holds == _escape_truth(g, f)
 
-                yield Case(
-                    "certificates",
-                    f"huge {name}",
-                    lambda f=forged, g=g: f.check(g),
-                    "answer",
-                    check,
-                )
+                case = (f"huge {name}", forged, g, {}, "answer", judge)
             else:
-                yield Case(
-                    "certificates",
-                    f"non-finite {name}",
-                    lambda f=forged, g=g: f.check(g),
-                    "answer",
-                    lambda c: not c.holds and c.violation == math.inf,
-                )
+
+                def judge(c):
+                    return not c.holds and c.violation == math.inf
+
+                case = (f"non-finite {name}", forged, g, {}, "answer", judge)
         elif what == 1:
             s = float(10.0 ** rng.uniform(-250, 250))
-            scaled = _scaled(cert, s)
 
-            def agrees(c, base=base):
+            def judge(c, base=base):
                 return c.holds == base.holds and math.isclose(
                     c.violation, base.violation, rel_tol=1e-6, abs_tol=1e-12
                 )
 
-            yield Case(
-                "certificates",
-                f"scaled {s:.1e} {name}",
-                lambda c=scaled, g=g: c.check(g),
-                "answer",
-                agrees,
-            )
+            case = (f"scaled {s:.1e} {name}", _scaled(cert, s), g, {}, "answer", judge)
         elif what == 2:
+
+            def judge(c):
+                return isinstance(c.holds, bool) and not math.isnan(c.violation)
+
             h = random_grasp(rng)
-            yield Case(
-                "certificates",
-                f"foreign {name}",
-                lambda c=cert, h=h: c.check(h),
-                "either",
-                lambda c: isinstance(c.holds, bool) and not math.isnan(c.violation),
-            )
+            case = (f"foreign {name}", cert, h, {}, "either", judge)
         else:
             tol = [math.inf, math.nan, 0.0, -1e-7, 1.0, 3.0, "1e-7", None, True, 1j][
                 int(rng.integers(10))
             ]
-            yield Case(
-                "certificates",
-                f"tol={tol!r} {name}",
-                lambda c=cert, g=g, t=tol: c.check(g, tol=t),
-                "refuse",
-            )
+            case = (f"tol={tol!r} {name}", cert, g, {"tol": tol}, "refuse", None)
+        label, witness, grasp, options, expect, judge = case
+        yield Case(
+            "certificates",
+            label,
+            lambda c=witness, h=grasp, o=options: c.check(h, **o),
+            expect,
+            judge,
+        )
         made += 1
 
 

@@ -71,6 +71,27 @@ def check_closed(scene, closure):
             assert min(mine) > TOL
 
 
+def close_truthfully_or_say_why(scene):
+    """Close the scene's hand; check the closure, or that the refusal is true.
+
+    A penetrating start must really penetrate; an unreachable object must leave
+    the context as it was with no finger touching.  Returns the checked
+    closure, or None after a checked refusal.
+    """
+    q0 = scene.plant.GetPositions(scene.ctx).copy()
+    try:
+        closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
+    except PenetrationError:
+        assert min(all_pair_distances(scene).values()) < -TOL
+        return None
+    except UnreachableError as e:
+        np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
+        assert all(f.status != "touching" for f in e.closure.fingers)
+        return None
+    check_closed(scene, closure)
+    return closure
+
+
 def test_wsg_closes_on_the_sugar_box(real_hands):
     scene = real_hands.wsg()
     X_WO = scene.plant.EvalBodyPoseInWorld(scene.ctx, scene.object)
@@ -324,12 +345,16 @@ def _closing_names(plant, scene):
     return hand_structure(plant, scene.object_body, bodies, inspector=inspector).names
 
 
-@settings(
+# Both "anywhere" properties: fixed examples, few (each closes a real hand).
+anywhere_examples = settings(
     derandomize=True,
     max_examples=8,
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
+
+
+@anywhere_examples
 @given(
     x=st.floats(-0.04, 0.04),
     y=st.floats(0.05, 0.16),
@@ -340,41 +365,16 @@ def test_wsg_anywhere_either_closes_truthfully_or_says_why(real_hands, x, y, yaw
 
     R = RollPitchYaw(np.pi / 2, yaw, np.pi / 2).ToRotationMatrix()
     scene = real_hands.wsg(X_WO=RigidTransform(R, [x, y, 0.0]))
-    q0 = scene.plant.GetPositions(scene.ctx).copy()
-    try:
-        closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
-    except PenetrationError:
-        assert min(all_pair_distances(scene).values()) < -TOL
-        return
-    except UnreachableError as e:
-        np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
-        assert all(f.status != "touching" for f in e.closure.fingers)
-        return
-    assert all(f.status in ("touching", "at limit") for f in closure.fingers)
-    check_closed(scene, closure)
+    closure = close_truthfully_or_say_why(scene)
+    if closure is not None:
+        assert all(f.status in ("touching", "at limit") for f in closure.fingers)
 
 
-@settings(
-    derandomize=True,
-    max_examples=8,
-    deadline=None,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+@anywhere_examples
 @given(
     x=st.floats(0.06, 0.12),
     y=st.floats(-0.03, 0.03),
     z=st.floats(0.06, 0.16),
 )
 def test_allegro_anywhere_either_closes_truthfully_or_says_why(real_hands, x, y, z):
-    scene = real_hands.allegro(p_ball=(x, y, z))
-    q0 = scene.plant.GetPositions(scene.ctx).copy()
-    try:
-        closure = close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
-    except PenetrationError:
-        assert min(all_pair_distances(scene).values()) < -TOL
-        return
-    except UnreachableError as e:
-        np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)
-        assert all(f.status != "touching" for f in e.closure.fingers)
-        return
-    check_closed(scene, closure)
+    close_truthfully_or_say_why(real_hands.allegro(p_ball=(x, y, z)))

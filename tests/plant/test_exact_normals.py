@@ -108,6 +108,9 @@ FELL_Y, FELL_M = _ell_point(FELL, [-0.3, 0.2, 0.9])
 PAD = Box(0.02, 0.004, 0.03)  # a PR2-like pad: its face y = +0.002 touches
 PAD_Y, PAD_M = [0.003, 0.002, -0.004], [0, 1, 0]
 LINK = Box(0.02, 0.03, 0.04)  # a LEAP-like box link
+LINK_EDGE_Y, LINK_EDGE_M = [0.01, 0.015, 0.006], unit([0.8, 0.6, 0])
+CYL25 = Cylinder(0.025, 0.1)
+CYL25_X, CYL25_M = [0.025 * C7, 0.025 * S7, 0.02], [C7, S7, 0]  # on its side
 rim_m = unit([C7 * math.cos(0.6), S7 * math.cos(0.6), math.sin(0.6)])
 
 # (id, object shape, x (O), m (O), finger shape, y (F), m_F (F), line contact)
@@ -154,9 +157,9 @@ CASES = [
     ),
     (
         "box link face on cylinder r25",
-        Cylinder(0.025, 0.1),
-        [0.025 * C7, 0.025 * S7, 0.02],
-        [C7, S7, 0],
+        CYL25,
+        CYL25_X,
+        CYL25_M,
         LINK,
         [0.004, 0.015, 0.01],
         [0, 1, 0],
@@ -164,22 +167,22 @@ CASES = [
     ),
     (
         "box link edge on cylinder r25",
-        Cylinder(0.025, 0.1),
-        [0.025 * C7, 0.025 * S7, 0.02],
-        [C7, S7, 0],
+        CYL25,
+        CYL25_X,
+        CYL25_M,
         LINK,
-        [0.01, 0.015, 0.006],
-        unit([0.8, 0.6, 0]),
+        LINK_EDGE_Y,
+        LINK_EDGE_M,
         False,
     ),
     (
         "box link edge on cylinder r25 rim",
-        Cylinder(0.025, 0.1),
+        CYL25,
         [0.025 * C7, 0.025 * S7, 0.05],
         rim_m,
         LINK,
-        [0.01, 0.015, 0.006],
-        unit([0.8, 0.6, 0]),
+        LINK_EDGE_Y,
+        LINK_EDGE_M,
         False,
     ),
     (
@@ -214,9 +217,9 @@ CASES = [
     ),
     (
         "cylinder side across cylinder side",
-        Cylinder(0.025, 0.1),
-        [0.025 * C7, 0.025 * S7, 0.02],
-        [C7, S7, 0],
+        CYL25,
+        CYL25_X,
+        CYL25_M,
         Cylinder(0.008, 0.05),
         [0.008, 0.0, 0.004],
         [1, 0, 0],

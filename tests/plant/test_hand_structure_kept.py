@@ -8,9 +8,10 @@ import time
 import weakref
 
 import numpy as np
+import pytest
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
 
-from drakegrasp import close_hand
+from drakegrasp import UnreachableError, close_hand
 from drakegrasp.plant import fingers
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.couplings import plant_couplings
@@ -30,6 +31,16 @@ def _scene(models_dir, p_WO=(0.08, 0.0, 0.1)):
     )
     scene.plant.GetJointByName("joint_12").set_angle(scene.ctx, 1.0)
     return scene
+
+
+def _fresh_structure(scene):
+    """The scene's hand structure computed anew, as a planner passes it."""
+    inspector = query_object_of(scene.plant, scene.ctx).inspector()
+    return hand_structure(
+        scene.plant, scene.object,
+        hand_bodies(scene.plant, scene.object, scene.hand),
+        plant_couplings(scene.plant), inspector=inspector,
+    )  # fmt: skip
 
 
 def _summary(s) -> tuple:
@@ -125,12 +136,7 @@ def test_the_checked_closing_equals_close_hand(drake_models_dir):
             plain = type(e)
         q_plain = scene.plant.GetPositions(scene.ctx).copy()
         scene.plant.SetPositions(scene.ctx, q0)
-        inspector = query_object_of(scene.plant, scene.ctx).inspector()
-        structure = hand_structure(
-            scene.plant, scene.object,
-            hand_bodies(scene.plant, scene.object, scene.hand),
-            plant_couplings(scene.plant), inspector=inspector,
-        )  # fmt: skip
+        structure = _fresh_structure(scene)
         try:
             checked = close_checked_hand(
                 scene.plant, scene.ctx, scene.object, structure,
@@ -148,3 +154,20 @@ def test_the_checked_closing_equals_close_hand(drake_models_dir):
         assert [(f.status, f.psi, f.iterations) for f in checked.fingers] == [
             (f.status, f.psi, f.iterations) for f in plain.fingers
         ]
+
+
+def test_the_checked_closing_refuses_too_many_fingers_as_close_hand(drake_models_dir):
+    """min_fingers above the hand's fingers: the same UnreachableError, same words."""
+    scene = _scene(drake_models_dir)
+    q0 = scene.plant.GetPositions(scene.ctx).copy()
+    with pytest.raises(UnreachableError) as plain:
+        close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand, min_fingers=9)
+    structure = _fresh_structure(scene)
+    with pytest.raises(UnreachableError) as checked:
+        close_checked_hand(
+            scene.plant, scene.ctx, scene.object, structure, tol=1e-4, min_fingers=9,
+            t0=time.perf_counter(),
+        )  # fmt: skip
+    assert str(checked.value) == str(plain.value)
+    assert "exceeds the hand's 4 fingers" in str(plain.value)
+    np.testing.assert_array_equal(scene.plant.GetPositions(scene.ctx), q0)

@@ -97,16 +97,23 @@ FLAT_TOL = 1e-13
 
 
 @njit(cache=True)
+def _longest_row(X):
+    """``(i, ‖X_i‖²)`` of the first longest row of ``X``; ``(0, -1.0)`` if none."""
+    pick, top = 0, -1.0
+    for i in range(X.shape[0]):
+        s = 0.0
+        for a in range(X.shape[1]):
+            s += X[i, a] * X[i, a]
+        if s > top:
+            pick, top = i, s
+    return pick, top
+
+
+@njit(cache=True)
 def _greedy_simplex(W, simplex, B, res):
     """Indices of ``D + 1`` affinely independent points; (min height, status)."""
     M, D = W.shape
-    i0, best = 0, -1.0
-    for i in range(M):
-        s = 0.0
-        for a in range(D):
-            s += W[i, a] * W[i, a]
-        if s > best:
-            i0, best = i, s
+    i0, _ = _longest_row(W)
     simplex[0] = i0
     for i in range(M):
         for a in range(D):
@@ -114,13 +121,7 @@ def _greedy_simplex(W, simplex, B, res):
     hmin = math.inf
     for j in range(D):
         # res holds each point's offset from v0 with the chosen directions removed.
-        pick, top = -1, -1.0
-        for i in range(M):
-            s = 0.0
-            for a in range(D):
-                s += res[i, a] * res[i, a]
-            if s > top:
-                pick, top = i, s
+        pick, top = _longest_row(res)
         h = math.sqrt(top)
         hmin = min(hmin, h)
         if not h > 0.0:

@@ -15,7 +15,12 @@ import os
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from drakegrasp.batch.api import BatchClosureResult, collect
+from drakegrasp.batch.api import (
+    BatchClosureResult,
+    collect,
+    force_chunks,
+    form_chunks,
+)
 from drakegrasp.batch.files.reader import (
     as_path,
     engine_options,
@@ -30,8 +35,7 @@ from drakegrasp.batch.files.writer import (
     write_chunks,
 )
 from drakegrasp.batch.inputs import shape_of
-from drakegrasp.batch.run.chunk import force_task, form_task
-from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
+from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
@@ -63,23 +67,18 @@ def _file_run(
         data, input_path, kind=kind, mu=mu, torsional_friction=torsional_friction
     )
     K, _, d = shape_of("positions", positions)
-    common = {"chunk_size": chunk_size, "progress": progress, "workers": workers}
+    p, b = extra["reference_points"], extra["characteristic_lengths"]
     if kind == "force":
-        task, options = force_task(
-            positions, extra["mu"], model, num_generators,
-            extra["torsional_friction"], extra["reference_points"],
-            extra["characteristic_lengths"], tol, rank_tol, metrics, kernel,
-        )  # fmt: skip
-        chunks = stream(
-            positions, normals, kind=kind, task=task,
-            n_g=options["num_generators"], **common,
+        options, chunks = force_chunks(
+            positions, normals, extra["mu"], model, num_generators,
+            extra["torsional_friction"], p, b, tol, rank_tol, metrics, kernel,
+            chunk_size, progress, workers,
         )  # fmt: skip
     else:
-        task, options = form_task(
-            positions, extra["reference_points"], extra["characteristic_lengths"],
-            tol, rank_tol, metrics, kernel,
+        options, chunks = form_chunks(
+            positions, normals, p, b, tol, rank_tol, metrics, kernel, chunk_size,
+            progress, workers,
         )  # fmt: skip
-        chunks = stream(positions, normals, kind=kind, task=task, **common)
     return output, K, d, options, chunks
 
 
