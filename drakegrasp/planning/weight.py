@@ -27,7 +27,8 @@ will, a rigid pad as its geometry and compliance dictate.
 
 The LPs of all grasps and directions are solved at once by the batch engine's
 interior-point method, in their dual form (nine variables each, see
-:func:`weight_capacity`); :func:`build_weight_capacity_program` builds the
+:func:`weight_capacity`), the degenerate ones that it does not converge on by an
+exact active-set method; :func:`build_weight_capacity_program` builds the
 primal LP of one grasp (its directions as independent blocks: the sum of their
 ``α`` is maximised, which maximises each) for inspection, for a second route
 through drakegrasp's solver gateway and for the tests.
@@ -40,7 +41,7 @@ from pydrake.solvers import MathematicalProgram
 
 from drakegrasp._solvers import require_solution, solve
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
-from drakegrasp.batch.lp.ipm import solve_max_last
+from drakegrasp.batch.lp.ipm import solve_max_last, solve_max_last_active
 from drakegrasp.batch.run.workers import map_ordered, resolve_workers
 from drakegrasp.errors import InvalidOptionError
 
@@ -63,6 +64,10 @@ def _directions() -> np.ndarray:
 
 WEIGHT_DIRECTIONS = _directions()
 """The 14 weight directions in O: the axes and the cube's diagonals."""
+
+_FALLBACKS = {"clp": 0}
+"""Grasps whose weight LPs neither the IPM nor the active-set method settled and
+were solved through Clp, since import (read by the tests)."""
 
 WEIGHT_CHUNK = 512
 """Grasps per task of :func:`weight_capacity` (the same for any worker count)."""
@@ -270,9 +275,14 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     ``min Σ_f s_f`` s.t. ``s_f >= -yᵀw_j`` (``j`` in group ``f``), ``s >= 0``:
     ``w - 1 + G + 1`` variables ``(z, s, ζ)`` (nine for a parallel jaw, ``G``
     the groups) with ``ζ <= -Σ s`` maximised, the form of
-    :func:`~drakegrasp.batch.lp.ipm.solve_max_last`.  ``α = -ζ*``.  A grasp with a
-    direction whose dual does not converge (degenerate: coplanar pad contacts)
-    is solved again as the primal through the solver gateway.
+    :func:`~drakegrasp.batch.lp.ipm.solve_max_last`.  ``α = -ζ*``.  A dual the
+    interior-point method does not converge on (degenerate: coplanar or
+    duplicated pad contacts, whose normal matrices grow too ill-conditioned)
+    is solved exactly by the active-set method
+    (:func:`~drakegrasp.batch.lp.ipm.solve_max_last_active`) from the feasible
+    point of :func:`_feasible_start`; only a grasp that method cannot certify
+    is solved again as the primal through the solver gateway (counted in
+    ``_FALLBACKS``).
     """
     K, M, w = W.shape
     D = len(directions)
@@ -295,13 +305,46 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     B[:, :, M + G, w - 1 : w - 1 + G] = 1.0
     B[:, :, M + G, n - 1] = 1.0
     rows = M + G + 1
+    B = B.reshape(K * D, rows, n)
+    h = h.reshape(K * D, rows)
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         # a degenerate dual may diverge (overflow); it is re-solved below
-        sol = solve_max_last(
-            B.reshape(K * D, rows, n), h.reshape(K * D, rows), kernel="auto"
-        )
-    alpha = np.maximum(-sol.value, 0.0).reshape(K, D)
-    stuck = np.flatnonzero(~sol.converged.reshape(K, D).all(axis=1))
-    if len(stuck):  # degenerate duals (coplanar pads): the primal through Clp
-        alpha[stuck] = _drake_capacity(W[stuck], groups[stuck], directions)
+        sol = solve_max_last(B, h, kernel="auto")
+    value = sol.value
+    stuck = np.flatnonzero(~sol.converged)
+    if len(stuck):  # degenerate duals (coplanar pads): exact vertex method
+        start = _feasible_start(h[stuck], onehot[stuck // D], n)
+        exact = solve_max_last_active(B[stuck], h[stuck], start)
+        value = value.copy()
+        value[stuck] = exact.value
+        stuck = stuck[~exact.converged]
+    alpha = np.maximum(-value, 0.0).reshape(K, D)
+    grasps = np.unique(stuck // D)
+    if len(grasps):  # not certified either: the primal through Clp
+        _FALLBACKS["clp"] += len(grasps)
+        alpha[grasps] = _drake_capacity(W[grasps], groups[grasps], directions)
     return alpha
+
+
+def _feasible_start(h: np.ndarray, member: np.ndarray, n: int) -> np.ndarray:
+    """A feasible point ``(z, s, ζ)`` of each dual LP of :func:`_batch_capacity`.
+
+    ``z = 0`` (``y = v``), each ``s_f`` the largest ``-v·w_j`` of its group
+    (at least 0) and ``ζ = -Σ s``: every row holds, with equality where the
+    maximum is attained.
+
+    Parameters
+    ----------
+    h : (L, M + G + 1) float
+        Right-hand sides; the first ``M`` are ``v·w_j``.
+    member : (L, M, G) float
+        One-hot group of each wrench.
+    n : int
+        Variables ``w - 1 + G + 1``.
+    """
+    L, M, G = member.shape
+    x0 = np.zeros((L, n))
+    worst = np.where(member > 0, -h[:, :M, None], -np.inf).max(axis=1)  # (L, G)
+    x0[:, n - 1 - G : n - 1] = np.maximum(worst, 0.0)
+    x0[:, n - 1] = -x0[:, n - 1 - G : n - 1].sum(axis=1)
+    return x0
