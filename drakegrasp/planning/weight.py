@@ -26,9 +26,9 @@ squeeze a real pad needs: the LP shares a finger's force among its contacts at
 will, a rigid pad as its geometry and compliance dictate.
 
 The LPs of all grasps and directions are solved at once by the batch engine's
-interior-point method, in their dual form (nine variables each, see
-:func:`weight_capacity`), the degenerate ones that it does not converge on by an
-exact active-set method; :func:`build_weight_capacity_program` builds the
+exact active-set method (its interior-point method where that cannot certify),
+in their dual form (nine variables each, see :func:`weight_capacity`);
+:func:`build_weight_capacity_program` builds the
 primal LP of one grasp (its directions as independent blocks: the sum of their
 ``α`` is maximised, which maximises each) for inspection, for a second route
 through drakegrasp's solver gateway and for the tests.
@@ -181,8 +181,9 @@ def weight_capacity(
     num_generators : int, optional
     solver : {"batch", "drake"}, optional
         ``"batch"`` (default): the dual LPs of all grasps and directions at
-        once in the batch engine's interior-point method
-        (:func:`~drakegrasp.batch.lp.ipm.solve_max_last`); ``"drake"``: the LP of
+        once in the batch engine, exactly by its active-set method
+        (:func:`~drakegrasp.batch.lp.ipm.solve_max_last_active`; its
+        interior-point method where that cannot certify); ``"drake"``: the LP of
         :func:`build_weight_capacity_program` per grasp through the solver
         gateway (Clp; slower, about 1 ms per direction).
     workers : int or None, optional
@@ -268,20 +269,22 @@ def _complement(v: np.ndarray) -> np.ndarray:
 
 
 def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
-    """The dual LPs of every grasp and direction in the batch engine's IPM.
+    """The dual LPs of every grasp and direction, solved in the compiled path.
 
     The dual of the capacity LP, with ``y = v + P z`` (``P`` a basis of the
     complement of ``v = (u; 0)``, so ``yᵀv = 1``), is
     ``min Σ_f s_f`` s.t. ``s_f >= -yᵀw_j`` (``j`` in group ``f``), ``s >= 0``:
     ``w - 1 + G + 1`` variables ``(z, s, ζ)`` (nine for a parallel jaw, ``G``
     the groups) with ``ζ <= -Σ s`` maximised, the form of
-    :func:`~drakegrasp.batch.lp.ipm.solve_max_last`.  ``α = -ζ*``.  A dual the
-    interior-point method does not converge on (degenerate: coplanar or
-    duplicated pad contacts, whose normal matrices grow too ill-conditioned)
-    is solved exactly by the active-set method
+    :func:`~drakegrasp.batch.lp.ipm.solve_max_last`.  ``α = -ζ*``.  Each LP is
+    solved exactly by the active-set method
     (:func:`~drakegrasp.batch.lp.ipm.solve_max_last_active`) from the feasible
-    point of :func:`_feasible_start`; only a grasp that method cannot certify
-    is solved again as the primal through the solver gateway (counted in
+    point of :func:`_feasible_start`: about half the interior-point method's
+    time on these LPs, and exact on the degenerate ones (pads on opposite flat
+    faces, coplanar or duplicated contacts) whose normal matrices grow too
+    ill-conditioned for the interior-point method to converge.  An LP it does
+    not certify goes to the interior-point method, and a grasp neither
+    settles to the primal through the solver gateway (counted in
     ``_FALLBACKS``).
     """
     K, M, w = W.shape
@@ -307,20 +310,19 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     rows = M + G + 1
     B = B.reshape(K * D, rows, n)
     h = h.reshape(K * D, rows)
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-        # a degenerate dual may diverge (overflow); it is re-solved below
-        sol = solve_max_last(B, h, kernel="auto")
+    member = np.repeat(onehot, D, axis=0)  # (K D, M, G)
+    sol = solve_max_last_active(B, h, _feasible_start(h, member, n))
     value = sol.value
-    stuck = np.flatnonzero(~sol.converged)
-    if len(stuck):  # degenerate duals (coplanar pads): exact vertex method
-        start = _feasible_start(h[stuck], onehot[stuck // D], n)
-        exact = solve_max_last_active(B[stuck], h[stuck], start)
-        value = value.copy()
-        value[stuck] = exact.value
-        stuck = stuck[~exact.converged]
+    left = np.flatnonzero(~sol.converged)
+    if len(left):  # not certified (rare): the interior-point method
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            # a degenerate dual may diverge (overflow); it is re-solved below
+            ipm = solve_max_last(B[left], h[left], kernel="auto")
+        value[left] = ipm.value
+        left = left[~ipm.converged]
     alpha = np.maximum(-value, 0.0).reshape(K, D)
-    grasps = np.unique(stuck // D)
-    if len(grasps):  # not certified either: the primal through Clp
+    grasps = np.unique(left // D)
+    if len(grasps):  # neither settled it: the primal through Clp
         _FALLBACKS["clp"] += len(grasps)
         alpha[grasps] = _drake_capacity(W[grasps], groups[grasps], directions)
     return alpha

@@ -290,14 +290,15 @@ Gram–Schmidt basis would reject)."""
 
 
 @njit(cache=True, error_model="numpy")
-def _orthonormal_rows(B, work, k, Q, R):
+def _orthonormal_rows(B, work, k0, k, Q, R):
     """Modified Gram–Schmidt (twice) of the rows ``B[work[:k]]``: ``B_W = R Q``.
 
-    ``Q`` (k, n) gets orthonormal rows, ``R`` (k, k) is lower triangular.
-    Returns False when a row is (numerically) in the span of the earlier ones.
+    ``Q`` (k, n) gets orthonormal rows, ``R`` (k, k) is lower triangular; rows
+    before ``k0`` are taken as already done.  Returns False when a row is
+    (numerically) in the span of the earlier ones.
     """
     n = B.shape[1]
-    for i in range(k):
+    for i in range(k0, k):
         row = work[i]
         for c in range(n):
             Q[i, c] = B[row, c]
@@ -340,6 +341,7 @@ def _active_one(B, h, x, lam, max_steps):
     c = np.zeros(n)
     mult = np.zeros(n)
     s = np.empty(r)
+    rates = np.zeros(r)
     rown = np.empty(r)
     hscale = 1.0
     for q in range(r):
@@ -348,10 +350,25 @@ def _active_one(B, h, x, lam, max_steps):
         for i in range(n):
             acc += B[q, i] * B[q, i]
         rown[q] = math.sqrt(acc)
+    # start with the rows tight at x (independent ones, lowest index first)
     k = 0
+    for q in range(r):
+        if k == n:
+            break
+        acc = h[q]
+        for i in range(n):
+            acc -= B[q, i] * x[i]
+        if acc <= _ACTIVE_TOL * hscale:
+            work[k] = q
+            if _orthonormal_rows(B, work, k, k + 1, Q, R):
+                inset[q] = True
+                k += 1
+    done = k
+    fresh = True
     for step in range(max_steps):
-        if not _orthonormal_rows(B, work, k, Q, R):
+        if not _orthonormal_rows(B, work, done, k, Q, R):
             return False, step
+        done = k
         # back onto the active rows (B_W x = h_W; B_W = R Q): rounding in the
         # projected directions of nearly dependent rows would otherwise pile up
         for j in range(k):
@@ -364,11 +381,13 @@ def _active_one(B, h, x, lam, max_steps):
         for j in range(k):
             for i in range(n):
                 x[i] += mult[j] * Q[j, i]
-        for q in range(r):
-            acc = 0.0
-            for i in range(n):
-                acc += B[q, i] * x[i]
-            s[q] = h[q] - acc
+        if fresh:  # slacks from scratch now and then, else updated by the steps
+            for q in range(r):
+                acc = 0.0
+                for i in range(n):
+                    acc += B[q, i] * x[i]
+                s[q] = h[q] - acc
+            fresh = False
         # d: the objective e_{n-1} projected onto the null space of the active rows
         for i in range(n):
             d[i] = 0.0
@@ -392,6 +411,7 @@ def _active_one(B, h, x, lam, max_steps):
                 rate = 0.0
                 for i in range(n):
                     rate += B[q, i] * d[i]
+                rates[q] = rate
                 if rate > _BLOCK_TOL * rown[q]:
                     t = max(s[q], 0.0) / rate
                     if t < best:
@@ -401,6 +421,11 @@ def _active_one(B, h, x, lam, max_steps):
                 return False, step  # unbounded along d, or no room
             for i in range(n):
                 x[i] += best * d[i]
+            for q in range(r):
+                if not inset[q]:
+                    s[q] -= best * rates[q]
+            s[block] = 0.0
+            fresh = (step + 1) % 8 == 0
             work[k] = block
             inset[block] = True
             k += 1
@@ -425,7 +450,10 @@ def _active_one(B, h, x, lam, max_steps):
         if leave < 0:  # optimal: certify from scratch
             for q in range(r):
                 lam[q] = 0.0
-                if s[q] < -_ACTIVE_TOL * hscale:
+                acc = h[q]
+                for i in range(n):
+                    acc -= B[q, i] * x[i]
+                if acc < -_ACTIVE_TOL * hscale:
                     return False, step
             for j in range(k):
                 lam[work[j]] = max(mult[j], 0.0)
@@ -440,6 +468,7 @@ def _active_one(B, h, x, lam, max_steps):
         for j in range(leave, k - 1):
             work[j] = work[j + 1]
         k -= 1
+        done = leave  # the rows after it are orthogonalised again
     return False, max_steps
 
 
