@@ -296,11 +296,11 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     B = np.zeros((K, D, M + G + 1, n))
     h = np.zeros((K, D, M + G + 1))
     # generator rows: -(Pᵀ w_j)·z - s_f <= v·w_j
-    B[:, :, :M, : w - 1] = -np.einsum("kmi,dij->kdmj", W, P)
+    B[:, :, :M, : w - 1] = -(W[:, None] @ P[None])  # (K, D, M, w - 1)
     g = np.clip(groups, 0, G - 1)
     onehot = (g[..., None] == np.arange(G)).astype(float)  # (K, M, G)
     B[:, :, :M, w - 1 : w - 1 + G] = -onehot[:, None]
-    h[:, :, :M] = np.einsum("kmi,di->kdm", W, v)
+    h[:, :, :M] = (W @ v.T).transpose(0, 2, 1)
     # s >= 0
     for f in range(G):
         B[:, :, M + f, w - 1 + f] = -1.0
