@@ -40,6 +40,7 @@ import numpy as np
 from pydrake.solvers import MathematicalProgram
 
 from drakegrasp._solvers import require_solution, solve
+from drakegrasp.batch import compiled
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
 from drakegrasp.batch.lp.ipm import solve_max_last, solve_max_last_active
 from drakegrasp.batch.run.workers import map_ordered, resolve_workers
@@ -283,9 +284,9 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     time on these LPs, and exact on the degenerate ones (pads on opposite flat
     faces, coplanar or duplicated contacts) whose normal matrices grow too
     ill-conditioned for the interior-point method to converge.  An LP it does
-    not certify goes to the interior-point method, and a grasp neither
-    settles to the primal through the solver gateway (counted in
-    ``_FALLBACKS``).
+    not certify goes to the interior-point method (without numba the two
+    swap roles: :func:`_solve_duals`), and a grasp neither settles to the
+    primal through the solver gateway (counted in ``_FALLBACKS``).
     """
     K, M, w = W.shape
     D = len(directions)
@@ -311,21 +312,42 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     B = B.reshape(K * D, rows, n)
     h = h.reshape(K * D, rows)
     member = np.repeat(onehot, D, axis=0)  # (K D, M, G)
-    sol = solve_max_last_active(B, h, _feasible_start(h, member, n))
-    value = sol.value
-    left = np.flatnonzero(~sol.converged)
-    if len(left):  # not certified (rare): the interior-point method
-        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-            # a degenerate dual may diverge (overflow); it is re-solved below
-            ipm = solve_max_last(B[left], h[left], kernel="auto")
-        value[left] = ipm.value
-        left = left[~ipm.converged]
+    value, left = _solve_duals(
+        B, h, lambda rows: _feasible_start(h[rows], member[rows], n)
+    )
     alpha = np.maximum(-value, 0.0).reshape(K, D)
     grasps = np.unique(left // D)
     if len(grasps):  # neither settled it: the primal through Clp
         _FALLBACKS["clp"] += len(grasps)
         alpha[grasps] = _drake_capacity(W[grasps], groups[grasps], directions)
     return alpha
+
+
+def _solve_duals(B: np.ndarray, h: np.ndarray, start):
+    """``(value, unsettled rows)`` of the stacked dual LPs (see below).
+
+    Compiled: the active-set method on every LP (exact, about half the
+    interior-point method's time here), the interior-point method on those it
+    does not certify.  Without numba (its kernels would run in Python): the
+    numpy interior-point method on all, the active-set method on the few it
+    does not converge on.  ``start(rows)`` gives feasible points of ``rows``.
+    """
+    rows = np.arange(len(B))
+    routes = ("active", "ipm") if compiled.AVAILABLE else ("ipm", "active")
+    value = np.zeros(len(B))
+    for route in routes:
+        if not len(rows):
+            break
+        Bs, hs = (B, h) if len(rows) == len(B) else (B[rows], h[rows])
+        if route == "active":
+            sol = solve_max_last_active(Bs, hs, start(rows))
+        else:
+            with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+                # a degenerate dual may diverge (overflow): it is not converged
+                sol = solve_max_last(Bs, hs, kernel="auto")
+        value[rows] = sol.value
+        rows = rows[~sol.converged]
+    return value, rows
 
 
 def _feasible_start(h: np.ndarray, member: np.ndarray, n: int) -> np.ndarray:

@@ -189,3 +189,28 @@ def test_degenerate_pads_are_solved_in_the_compiled_path():
             assert a[k, d] == pytest.approx(
                 _highs_capacity(W[k], groups[k], u), rel=1e-8, abs=1e-9
             )
+
+
+def test_the_route_without_numba_gives_the_same_capacities(monkeypatch):
+    # without numba the interior-point method (numpy) goes first and the
+    # active-set method (then a Python loop) takes only what it leaves
+    from drakegrasp.planning import weight
+
+    P, N, F = _degenerate_grasps(np.random.default_rng(22), K=6)
+    P = np.vstack([P, STUCK_P[None, [0, 1, 1, 2, 3, 3]]])
+    N = np.vstack([N, STUCK_N[None, [0, 1, 1, 2, 3, 3]]])
+    F = np.vstack([F, [[0, 0, 0, 1, 1, 1]]])
+    compiled = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    routes = []
+    solve = weight.solve_max_last_active
+    monkeypatch.setattr(weight.compiled, "AVAILABLE", False)
+    monkeypatch.setattr(
+        weight,
+        "solve_max_last_active",
+        lambda B, *a, **k: routes.append(len(B)) or solve(B, *a, **k),
+    )
+    before = weight._FALLBACKS["clp"]
+    numpy_first = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    assert weight._FALLBACKS["clp"] == before
+    assert routes and routes[0] < P.shape[0] * len(WEIGHT_DIRECTIONS)  # only some
+    np.testing.assert_allclose(numpy_first, compiled, rtol=1e-9, atol=1e-10)
