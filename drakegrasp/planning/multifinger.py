@@ -58,7 +58,7 @@ from drakegrasp.planning.candidates import (
 )
 from drakegrasp.planning.cloud import CONTACT_BAND, CloudSurface
 from drakegrasp.planning.cloud_hand import CloudHand
-from drakegrasp.planning.ranking import group_by_count, robustness, verdicts
+from drakegrasp.planning.ranking import group_by_count, robustness, tie_key, verdicts
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
@@ -269,7 +269,7 @@ def rank_multifinger(
             ).min(axis=1)  # fmt: skip
     score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
     sample = np.array([k[0] for k in kept])
-    order = np.lexsort((sample, -d_star, -(eps * rho), -score))
+    order = np.lexsort((sample, -tie_key(d_star), -tie_key(eps * rho), -tie_key(score)))
     s = hand.structure
     base = scoped_name(plant, hand.base)
     out = []

@@ -38,7 +38,9 @@ weight capacity is computed for every force-closure candidate with
 NaN), or, with ``weight_check``, for that many, the best by
 :math:`\varepsilon \rho`; the others score 0.  Candidates are
 ordered by score, then :math:`\varepsilon \rho`, ``d*`` and the sample index,
-so a ranking is reproducible.
+so a ranking is reproducible; scores, :math:`\varepsilon \rho` and ``d*`` are
+compared to :data:`TIE_DECIMALS` decimals (:func:`tie_key`), so exact ties (symmetric
+grasps) are broken by the next key and not by rounding.
 """
 
 from __future__ import annotations
@@ -57,11 +59,13 @@ from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
     "DEFAULT_NOISE",
+    "TIE_DECIMALS",
     "group_by_count",
     "perturbed_copies",
     "rank_candidates",
     "rank_order",
     "robustness",
+    "tie_key",
     "verdicts",
 ]
 
@@ -217,9 +221,24 @@ def robustness(
     )
 
 
+TIE_DECIMALS = 9
+"""Scores, ``ε ρ`` and ``d*`` are compared rounded to this many decimals: below the
+accuracy the LPs certify, so grasps that tie in exact arithmetic (symmetric
+placements on a symmetric object) are ordered by the next key, not by the last
+bits of their LPs' rounding (which a rigid motion of the scene changes)."""
+
+
+def tie_key(values) -> np.ndarray:
+    """``values`` rounded to :data:`TIE_DECIMALS` decimals, for ordering."""
+    return np.round(np.asarray(values, float), TIE_DECIMALS)
+
+
 def rank_order(score, d_star, sample) -> np.ndarray:
-    """Indices best first: highest score, then highest ``d*``, then lowest sample."""
-    return np.lexsort((np.asarray(sample), -np.asarray(d_star), -np.asarray(score)))
+    """Indices best first: highest score, then highest ``d*``, then lowest sample.
+
+    Scores and ``d*`` are compared by :func:`tie_key`.
+    """
+    return np.lexsort((np.asarray(sample), -tie_key(d_star), -tie_key(score)))
 
 
 def _finger_label(contact, names) -> int:
@@ -304,7 +323,7 @@ def rank_candidates(
             workers=workers,
         ).min(axis=1)  # fmt: skip
     score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
-    order = np.lexsort((samples_of, -d_star, -pre, -score))
+    order = np.lexsort((samples_of, -tie_key(d_star), -tie_key(pre), -tie_key(score)))
     base = scoped_name(plant, gripper.base)
     joint_names = tuple(
         f"{plant.GetModelInstanceName(j.model_instance())}::{j.name()}"

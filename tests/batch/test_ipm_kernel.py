@@ -80,3 +80,53 @@ def test_kernel_option():
         solve_max_last(B, h, kernel="gpu")
     with pytest.raises(InvalidOptionError, match="stop_below"):
         solve_max_last(B, h, kernel="compiled", stop_below=0.0)
+
+
+def _degenerate_stack(rng, K=40):
+    """Dual weight LPs (two groups) with coplanar, duplicated generators."""
+    rows = []
+    for _ in range(K):
+        n = 8
+        gen = rng.normal(size=(12, n - 3))
+        gen[6:] = gen[:6] * rng.choice([1.0, 2.0], size=(6, 1))  # parallel rows
+        B = np.zeros((12 + 3, n))
+        B[:12, : n - 3] = -gen
+        B[:6, n - 3] = -1.0
+        B[6:12, n - 2] = -1.0
+        B[12, n - 3] = B[13, n - 2] = -1.0
+        B[14, n - 3 : n - 1] = 1.0
+        B[14, n - 1] = 1.0
+        h = np.r_[rng.uniform(-1, 1, 12), 0.0, 0.0, 0.0]
+        rows.append((B, h))
+    B = np.array([b for b, _ in rows])
+    h = np.array([c for _, c in rows])
+    x0 = np.zeros((K, B.shape[2]))
+    x0[:, -3] = np.maximum(0, (-h[:, :6]).max(axis=1))
+    x0[:, -2] = np.maximum(0, (-h[:, 6:12]).max(axis=1))
+    x0[:, -1] = -x0[:, -3:-1].sum(axis=1)
+    return B, h, x0
+
+
+def test_the_active_set_method_equals_highs_on_degenerate_lps():
+    from drakegrasp.batch.lp.ipm import solve_max_last_active
+
+    B, h, x0 = _degenerate_stack(np.random.default_rng(5))
+    assert (np.einsum("krn,kn->kr", B, x0) <= h + 1e-15).all()
+    sol = solve_max_last_active(B, h, x0)
+    ref = _highs(B, h)
+    bounded = np.isfinite(ref)
+    assert sol.converged[bounded].all()
+    np.testing.assert_allclose(sol.value[bounded], ref[bounded], rtol=0, atol=1e-9)
+    # its certificate: λ >= 0, Bᵀλ = e, and hᵀλ (an upper bound) = the value
+    lam = sol.dual[bounded]
+    assert (lam >= 0).all()
+    e = np.zeros(B.shape[2])
+    e[-1] = 1.0
+    np.testing.assert_allclose(
+        np.einsum("krn,kr->kn", B[bounded], lam),
+        np.broadcast_to(e, lam.shape[:1] + e.shape),
+        atol=1e-9,
+    )
+    np.testing.assert_allclose(
+        np.einsum("kr,kr->k", h[bounded], lam), sol.value[bounded], atol=1e-9
+    )

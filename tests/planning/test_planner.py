@@ -259,3 +259,20 @@ def test_progress_bar(own_scene, capsys):
     result = plan(own_scene(), n=10, progress=True)
     assert len(result) + sum(result.rejections.values()) == 10
     assert "closing" in capsys.readouterr().err
+
+
+def test_rank_order_breaks_rounding_ties_by_the_next_key():
+    # symmetric grasps tie in exact arithmetic; their LPs' last bits (which a
+    # rigid motion of the scene changes) must not order them: d*, then the sample
+    from drakegrasp.planning.ranking import TIE_DECIMALS, rank_order
+
+    tiny = 10.0 ** -(TIE_DECIMALS + 4)
+    score = np.array([0.5, 0.5 + tiny, 0.5 - tiny, 0.7, 0.5 + 10.0**-TIE_DECIMALS * 5])
+    d_star = np.array([0.2, 0.1, 0.2, 0.0, 0.0])
+    sample = np.array([4, 1, 2, 3, 0])
+    assert list(rank_order(score, d_star, sample)) == [3, 4, 2, 0, 1]
+    assert list(rank_order(score[[2, 0, 1]], d_star[[2, 0, 1]], sample[[2, 0, 1]])) == [
+        0,
+        1,
+        2,
+    ]

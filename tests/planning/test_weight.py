@@ -85,7 +85,8 @@ def test_the_batch_dual_and_the_primal_program_agree_on_many_grasps():
 
 
 # a WSG grasp of the shipped box (two tip spheres per pad on opposite faces)
-# whose dual the interior-point method does not converge on: the primal solves it
+# whose dual the interior-point method does not converge on (its normal
+# matrices grow too ill-conditioned): the exact active-set method settles it
 STUCK_P = np.array(
     [
         [0.0081496997684664, -0.01291709425002098, -0.05],
@@ -99,9 +100,9 @@ STUCK_N = np.array([[0.0, 0, 1], [0, 0, 1], [0, 0, -1], [0, 0, -1]])
 
 @pytest.mark.parametrize("workers", [1, 2])
 def test_chunks_and_workers_change_no_number(workers, monkeypatch):
-    # the grasps go in chunks of WEIGHT_CHUNK, each solved alone (the
-    # degenerate ones again as the primal): the numbers are those of one call
-    # on all grasps, for any number of workers
+    # the grasps go in chunks of WEIGHT_CHUNK, each solved alone (by the
+    # active-set method, the degenerate ones too): the numbers are those of
+    # one call on all grasps, for any number of workers
     from drakegrasp.planning import weight
 
     rng = np.random.default_rng(14)
@@ -111,13 +112,105 @@ def test_chunks_and_workers_change_no_number(workers, monkeypatch):
     N[6:] += rng.normal(0, 0.2, (17, 4, 3))
     N /= np.linalg.norm(N, axis=2, keepdims=True)
     F = np.tile([0, 0, 1, 1], (23, 1))
-    primal = []
-    solve = weight._drake_capacity
+    exact = []
+    solve = weight.solve_max_last_active
     monkeypatch.setattr(
-        weight, "_drake_capacity", lambda W, *a: primal.append(len(W)) or solve(W, *a)
+        weight,
+        "solve_max_last_active",
+        lambda B, *a, **k: exact.append(len(B)) or solve(B, *a, **k),
     )
+    before = weight._FALLBACKS["clp"]
     whole = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
-    assert primal and primal[0] >= 6  # the stuck copies took the primal
+    assert exact and exact[0] == 23 * len(WEIGHT_DIRECTIONS)  # every LP
     monkeypatch.setattr(weight, "WEIGHT_CHUNK", 5)
     chunked = weight_capacity(P, N, F, 1.0, torque_scale=0.06, workers=workers)
     assert np.array_equal(chunked, whole)
+    if workers == 1:  # (a worker process counts in its own module)
+        assert weight._FALLBACKS["clp"] == before
+
+
+def _highs_capacity(W, groups, u, G=3):
+    """α(u) of the primal LP by scipy's HiGHS at tight tolerances."""
+    M = len(W)
+    c = np.zeros(M + 1)
+    c[-1] = -1.0
+    A_eq = np.zeros((W.shape[1], M + 1))
+    A_eq[:, :M] = W.T
+    A_eq[:3, -1] = u
+    A_ub = (np.clip(groups, 0, G - 1)[None, :] == np.arange(G)[:, None]).astype(float)
+    A_ub = np.hstack([A_ub, np.zeros((G, 1))])
+    res = linprog(
+        c, A_ub=A_ub, b_ub=np.ones(G), A_eq=A_eq, b_eq=np.zeros(len(A_eq)),
+        bounds=[(0, None)] * (M + 1), method="highs",
+        options={"primal_feasibility_tolerance": 1e-10,
+                 "dual_feasibility_tolerance": 1e-10},
+    )  # fmt: skip
+    assert res.status == 0
+    return res.x[-1]
+
+
+def _degenerate_grasps(rng, K=12):
+    """Pads on opposite flat faces: coplanar contacts, some duplicated."""
+    P, N = [], []
+    for k in range(K):
+        xy = rng.uniform(-0.03, 0.03, (3, 2))
+        if k % 3 == 0:
+            xy[1] = xy[0]  # a duplicate contact on each pad
+        top = np.column_stack([xy, np.full(3, 0.05)])
+        bottom = top * [1, 1, -1]
+        P.append(np.vstack([bottom, top]))
+        N.append(np.repeat([[0.0, 0, 1], [0, 0, -1]], 3, axis=0))
+    P = np.array(P)
+    P[1::2] += rng.normal(0, 1e-7, P[1::2].shape)  # nearly coplanar too
+    return P, np.array(N), np.tile([0, 0, 0, 1, 1, 1], (K, 1))
+
+
+def test_degenerate_pads_are_solved_in_the_compiled_path():
+    # coplanar and duplicated pad contacts: α(u) equals the primal through
+    # HiGHS (tight) and Clp, and none of them needs the Clp fallback
+    from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
+    from drakegrasp.planning import weight
+
+    P, N, F = _degenerate_grasps(np.random.default_rng(21))
+    before = weight._FALLBACKS["clp"]
+    a = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    assert weight._FALLBACKS["clp"] == before
+    clp = weight_capacity(P, N, F, 1.0, torque_scale=0.06, solver="drake")
+    # Clp stops at its own tolerances (about 1e-6 here); HiGHS is run tighter
+    assert a == pytest.approx(clp, rel=5e-6, abs=1e-8)
+    K, n, _ = P.shape
+    W = batched_primitive_wrenches(
+        P, N, np.ones((K, n)), np.zeros((K, n)), np.zeros((K, 3)),
+        np.full(K, 0.06), model="hard_finger", num_generators=8,
+    )  # fmt: skip
+    groups = np.repeat(F, 8, axis=1)
+    for k in range(K):
+        for d, u in enumerate(WEIGHT_DIRECTIONS):
+            assert a[k, d] == pytest.approx(
+                _highs_capacity(W[k], groups[k], u), rel=1e-8, abs=1e-9
+            )
+
+
+def test_the_route_without_numba_gives_the_same_capacities(monkeypatch):
+    # without numba the interior-point method (numpy) goes first and the
+    # active-set method (then a Python loop) takes only what it leaves
+    from drakegrasp.planning import weight
+
+    P, N, F = _degenerate_grasps(np.random.default_rng(22), K=6)
+    P = np.vstack([P, STUCK_P[None, [0, 1, 1, 2, 3, 3]]])
+    N = np.vstack([N, STUCK_N[None, [0, 1, 1, 2, 3, 3]]])
+    F = np.vstack([F, [[0, 0, 0, 1, 1, 1]]])
+    compiled = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    routes = []
+    solve = weight.solve_max_last_active
+    monkeypatch.setattr(weight.compiled, "AVAILABLE", False)
+    monkeypatch.setattr(
+        weight,
+        "solve_max_last_active",
+        lambda B, *a, **k: routes.append(len(B)) or solve(B, *a, **k),
+    )
+    before = weight._FALLBACKS["clp"]
+    numpy_first = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    assert weight._FALLBACKS["clp"] == before
+    assert routes and routes[0] < P.shape[0] * len(WEIGHT_DIRECTIONS)  # only some
+    np.testing.assert_allclose(numpy_first, compiled, rtol=1e-9, atol=1e-10)
