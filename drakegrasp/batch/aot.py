@@ -73,6 +73,7 @@ SOURCES = (
     "lp/fused_kernel.py",
     "lp/householder.py",
     "lp/ipm_kernel.py",
+    "lp/vertex_kernel.py",
     "epsilon/kernel.py",
     "epsilon/polytope.py",
 )

@@ -36,7 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.batch import compiled
-from drakegrasp.batch.lp.ipm_kernel import active_set_stack, solve_max_last_stack
+from drakegrasp.batch.lp.ipm_kernel import solve_max_last_stack
+from drakegrasp.batch.lp.vertex_kernel import active_set_stack
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["MaxLPSolution", "solve_max_last", "solve_max_last_active"]
@@ -307,7 +308,7 @@ def solve_max_last_active(
     to reach the tolerance (the multipliers drift off :math:`B^T\lambda = e`
     while the iterate is already optimal to about ``1e-7``).  This is the
     primal active-set (simplex) method of
-    :func:`~drakegrasp.batch.lp.ipm_kernel.active_set_stack`, compiled with
+    :func:`~drakegrasp.batch.lp.vertex_kernel.active_set_stack`, compiled with
     numba (without it, a Python loop: use it on few problems).  On the
     planner's weight-capacity LPs (``n = 9``, a few dozen rows) it takes
     about half the interior-point method's time.  It needs a feasible
