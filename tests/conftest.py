@@ -1,8 +1,12 @@
-"""Fixtures shared by every test folder: where Drake's real models are."""
+"""Fixtures shared by every test folder: where Drake's real models are, and the
+tutorial notebooks executed once per session."""
 
 from __future__ import annotations
 
+import contextlib
+import copy
 import os
+import sys
 from pathlib import Path
 
 import pytest
@@ -53,3 +57,119 @@ def drake_models_dir() -> Path:
 def local_drake_models_or_none() -> Path | None:
     """Folder of ``drake_models``, or None when absent (no skip)."""
     return local_drake_models()
+
+
+# -- the tutorials, executed once ---------------------------------------------------
+
+TUTORIALS = ROOT / "tutorials"
+
+WARNINGS_AS_ERRORS = """\
+import warnings
+
+import pydrake.common.deprecation  # noqa: F401  (installs Drake's filter first)
+
+warnings.simplefilter("error", DeprecationWarning)
+"""
+"""The cell prepended to every executed notebook (see tests/tutorials)."""
+
+CELL_TIMEOUT = 600  # seconds per cell: a hang fails, a slow machine does not
+
+
+@contextlib.contextmanager
+def _environment(**values):
+    """``os.environ`` with ``values`` set (None: unset), restored on exit."""
+    old = {k: os.environ.get(k) for k in values}
+    try:
+        for k, v in values.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+        yield
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+class TutorialRuns:
+    """Executes notebooks in kernels of this interpreter, each tutorial at most once.
+
+    Each run is a copy of the notebook with :data:`WARNINGS_AS_ERRORS` prepended,
+    executed in ``tutorials/`` with ``DRAKEGRASP_TUTORIAL_TEST=1`` (short loops),
+    ``_DRAKE_DEPRECATION_IS_ERROR=1`` and matplotlib's inline backend (so the
+    figures are outputs the documentation can show).  The documentation build
+    renders these runs instead of executing the tutorials a second time.
+    """
+
+    def __init__(self, kernels: Path):
+        from ipykernel.kernelspec import write_kernel_spec
+        from jupyter_client.kernelspec import KernelSpecManager
+
+        write_kernel_spec(path=str(kernels / "python3"))
+        self._specs = KernelSpecManager(
+            kernel_dirs=[str(kernels)], ensure_native_kernel=False
+        )
+        self._runs: dict[Path, tuple[object, Exception | None]] = {}
+
+    @staticmethod
+    def needs_drake_models(notebook: Path) -> bool:
+        """True for a tutorial that loads Drake's real hands or YCB objects."""
+        return "drake_models" in notebook.read_text(encoding="utf-8")
+
+    def execute(self, nb):
+        """Execute a copy of ``nb`` (warnings cell first); raise on a failing cell."""
+        import nbclient
+        import nbformat
+        from jupyter_client.manager import KernelManager
+
+        executed = copy.deepcopy(nb)
+        executed.cells.insert(0, nbformat.v4.new_code_cell(WARNINGS_AS_ERRORS))
+        with _environment(
+            DRAKEGRASP_TUTORIAL_TEST="1", _DRAKE_DEPRECATION_IS_ERROR="1",
+            MPLBACKEND=None,
+        ):  # fmt: skip
+            km = KernelManager(kernel_name="python3", kernel_spec_manager=self._specs)
+            assert km.kernel_spec.argv[0] == sys.executable
+            nbclient.NotebookClient(
+                executed,
+                km=km,
+                timeout=CELL_TIMEOUT,
+                resources={"metadata": {"path": str(TUTORIALS)}},
+            ).execute()
+        return executed
+
+    def run(self, notebook: Path):
+        """``(executed notebook, None)``, or ``(None, the error)``; cached per path.
+
+        The executed notebook has the warnings cell removed again, and its
+        execution counts renumbered from 1, as a reader's run shows them.
+        """
+        import nbformat
+
+        notebook = notebook.resolve()
+        if notebook not in self._runs:
+            try:
+                executed = self.execute(nbformat.read(notebook, as_version=4))
+            except Exception as error:  # noqa: BLE001  (reported by the caller)
+                self._runs[notebook] = (None, error)
+            else:
+                executed.cells.pop(0)
+                for cell in executed.cells:
+                    if cell.get("execution_count"):
+                        cell.execution_count -= 1
+                    for out in cell.get("outputs", []):
+                        if out.get("execution_count"):
+                            out["execution_count"] -= 1
+                self._runs[notebook] = (executed, None)
+        return self._runs[notebook]
+
+
+@pytest.fixture(scope="session")
+def tutorial_runs(tmp_path_factory) -> TutorialRuns:
+    """The session's :class:`TutorialRuns` (skips without nbclient or ipykernel)."""
+    for module in ("nbformat", "nbclient", "ipykernel"):
+        pytest.importorskip(module)
+    return TutorialRuns(tmp_path_factory.mktemp("kernels"))

@@ -2,8 +2,10 @@
 
 One Sphinx build (HTML, nitpicky, warnings as errors, ``--keep-going`` so one
 run lists every problem) into a temporary directory, shared by the tests below.
-It executes the tutorials and the guide's code cells once (the tutorials in
-their short test mode), so a broken example fails here.  The docstring examples
+It executes the guide's code cells, and renders the tutorials as the session's
+tutorial runs left them (``tests/conftest.py``: each tutorial executes once, in
+its short test mode, for this build and ``tests/tutorials`` alike), so a broken
+example fails here.  The docstring examples
 run through Sphinx's doctest builder on the same sources.
 """
 
@@ -25,9 +27,10 @@ pytest.importorskip("sphinxarg")
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
+RUNS = "tutorial_runs"  # where the build's folder keeps the tutorial runs it renders
 
 
-def _sphinx(builder: str, out: Path) -> subprocess.CompletedProcess:
+def _sphinx(builder: str, out: Path, **env: str) -> subprocess.CompletedProcess:
     return subprocess.run(
         [
             sys.executable,
@@ -45,16 +48,39 @@ def _sphinx(builder: str, out: Path) -> subprocess.CompletedProcess:
             str(out / builder),
         ],
         cwd=ROOT,
+        env={**os.environ, **env},
         capture_output=True,
         text=True,
     )
 
 
+def _tutorial_runs(tutorial_runs, folder: Path) -> Path:
+    """Write the session's successful tutorial runs into ``folder``.
+
+    A tutorial that needs ``drake_models`` runs only with a local copy (without
+    one, docs/conf.py renders it unexecuted); a failed run is left out, so the
+    build executes that tutorial itself and fails on it here too.
+    """
+    import nbformat
+
+    folder.mkdir()
+    for notebook in sorted((ROOT / "tutorials").glob("[0-9][0-9]_*.ipynb")):
+        if tutorial_runs.needs_drake_models(notebook) and not os.environ.get(
+            "DRAKEGRASP_DRAKE_MODELS"
+        ):
+            continue
+        executed, error = tutorial_runs.run(notebook)
+        if error is None:
+            nbformat.write(executed, folder / notebook.name)
+    return folder
+
+
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
+def built(tmp_path_factory, tutorial_runs):
     """The output directory of one HTML build (its doctrees are reused below)."""
     out = tmp_path_factory.mktemp("docs")
-    run = _sphinx("html", out)
+    runs = _tutorial_runs(tutorial_runs, out / RUNS)
+    run = _sphinx("html", out, DRAKEGRASP_DOCS_EXECUTED=str(runs))
     assert run.returncode == 0, run.stdout + run.stderr
     return out
 
@@ -181,8 +207,9 @@ def test_links_stay_inside_the_site(html):
 def test_docstring_examples_run(built):
     # Sphinx's doctest builder on the environment the HTML build pickled (no
     # second execution of the notebooks): every ``>>>`` example of every
-    # docstring in the API reference runs and must print what it shows.
-    run = _sphinx("doctest", built)
+    # docstring in the API reference runs and must print what it shows.  It
+    # gets the same tutorial runs, so the doctrees stay current.
+    run = _sphinx("doctest", built, DRAKEGRASP_DOCS_EXECUTED=str(built / RUNS))
     assert run.returncode == 0, run.stdout + run.stderr
     report = (built / "doctest" / "output.txt").read_text()
     tested = re.search(r"(\d+) tests?\b", report)
