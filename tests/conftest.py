@@ -3,11 +3,11 @@ tutorial notebooks executed once per session."""
 
 from __future__ import annotations
 
-import contextlib
 import copy
 import os
 import sys
 from pathlib import Path
+from unittest import mock
 
 import pytest
 
@@ -75,25 +75,6 @@ warnings.simplefilter("error", DeprecationWarning)
 CELL_TIMEOUT = 600  # seconds per cell: a hang fails, a slow machine does not
 
 
-@contextlib.contextmanager
-def _environment(**values):
-    """``os.environ`` with ``values`` set (None: unset), restored on exit."""
-    old = {k: os.environ.get(k) for k in values}
-    try:
-        for k, v in values.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-        yield
-    finally:
-        for k, v in old.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
 class TutorialRuns:
     """Executes notebooks in kernels of this interpreter, each tutorial at most once.
 
@@ -127,10 +108,9 @@ class TutorialRuns:
 
         executed = copy.deepcopy(nb)
         executed.cells.insert(0, nbformat.v4.new_code_cell(WARNINGS_AS_ERRORS))
-        with _environment(
-            DRAKEGRASP_TUTORIAL_TEST="1", _DRAKE_DEPRECATION_IS_ERROR="1",
-            MPLBACKEND=None,
-        ):  # fmt: skip
+        test_mode = dict(DRAKEGRASP_TUTORIAL_TEST="1", _DRAKE_DEPRECATION_IS_ERROR="1")
+        with mock.patch.dict(os.environ, test_mode):  # the kernel inherits it
+            os.environ.pop("MPLBACKEND", None)  # inline figures
             km = KernelManager(kernel_name="python3", kernel_spec_manager=self._specs)
             assert km.kernel_spec.argv[0] == sys.executable
             nbclient.NotebookClient(
