@@ -50,6 +50,7 @@ from dataclasses import replace
 import numpy as np
 
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
+from drakegrasp.batch.run.chunk import force_verdicts
 from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.linalg import rotations_about
 from drakegrasp.planning.candidates import GraspCandidate
@@ -208,7 +209,8 @@ def robustness(
         positions, normals, fingers, mu, samples=samples, rng=rng, groups=groups,
         **noise,
     )  # fmt: skip
-    res = batch_force_closure(
+    # verdicts only: each LP stops once its verdict is proved (force_verdicts)
+    held = force_verdicts(
         P,
         Nrm,
         mu=mus[:, None],  # one μ per copy, (K S, 1): never ambiguous with N
@@ -216,9 +218,7 @@ def robustness(
         torsional_friction=torsional_friction,
         workers=workers,
     )
-    return (
-        np.asarray(res.is_closure, float).reshape(len(positions), samples).mean(axis=1)
-    )
+    return held.astype(float).reshape(len(positions), samples).mean(axis=1)
 
 
 TIE_DECIMALS = 9

@@ -102,12 +102,13 @@ def full_column_rank_certain(Gn: np.ndarray, rank_tol: float) -> np.ndarray:
     error_model="numpy",
     entry=(
         "f8[:, :, ::1], i8[::1], f8, f8[:, ::1], b1, f8[:, ::1], "
-        "i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8, i8, b1, "
+        "i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8, i8, b1, f8, f8, "
         "f8[::1], b1[::1]"
     ),
 )
 def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nrow,
-                     roff, tol, max_iter, active_set, out_d, out_done):  # fmt: skip
+                     roff, tol, max_iter, active_set, stop, above, out_d,
+                     out_done):  # fmt: skip
     K, w, M = G.shape
     N = coff.shape[0]
     e = w + 1
@@ -154,6 +155,19 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
                 out_done[k] = True
                 out_d[k] = 0.0  # no balanced force pushes
                 continue
+            if above < math.inf:
+                # f0 = Z Zᵀ e / ‖Zᵀ e‖² is feasible (Gf0 = 0, eᵀf0 = 1): its
+                # min C f0 = min (C Z) Zᵀ e / ‖Zᵀ e‖² bounds t* from below.
+                lo = math.inf
+                for j in range(R):
+                    acc = 0.0
+                    for i in range(nz):
+                        acc += AT[i, j] * ct[i]
+                    lo = min(lo, acc / cn2)
+                if lo > above:
+                    out_done[k] = True
+                    out_d[k] = N * lo
+                    continue
             t, ok, _ = reduced_lp(AT, nz, R, ct, cn2, 10 * R + 50, aswork)
             if ok:
                 out_done[k] = True
@@ -200,7 +214,7 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
         else:
             t, ok, _, _ = _one(
                 Fk, A, kap[k], f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
-                0.0, True, wr, wm, we, WT, Hs, S,
+                stop, True, above, wr, wm, we, WT, Hs, S,
             )  # fmt: skip
             if not ok:
                 out_done[k] = False  # the numpy path retries, then HiGHS
@@ -218,6 +232,7 @@ def solve_full_rank_stack(
     tol: float,
     max_iter: int,
     active_set: bool = True,
+    between: tuple[float, float] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``d*`` of the grasps of one layout whose full row rank a QR certifies.
 
@@ -236,11 +251,18 @@ def solve_full_rank_stack(
     active_set : bool, optional
         Solve the LPs of small null spaces (``drakegrasp.batch.lp.active_set.worth_it``)
         with the exact active-set method first (default); False: the IPM only.
+    between : (float, float), optional
+        Verdicts only (:func:`drakegrasp.batch.lp.dstar.solve_margin_blocks`'s
+        ``verdict_tol``): a grasp stops once ``t*`` is proved below the first
+        bound (its ``d_star`` is then an upper bound ``N max(0, t) < N`` that)
+        or above the second (``d_star`` is a feasible point's ``N t``, a lower
+        bound).  None (default): every ``d*`` to the IPM's accuracy.
 
     Returns
     -------
     d_star : (K,) float
-        ``N max(0, t*)`` where ``done``; 0 elsewhere.
+        ``N max(0, t*)`` where ``done`` (with ``between``: a bound, as above);
+        0 elsewhere.
     done : (K,) bool
         Rank ``w`` certified and the LP solved; the rest is left to the caller.
     """
@@ -252,6 +274,8 @@ def solve_full_rank_stack(
         np.ascontiguousarray(G, dtype=float),
         np.ascontiguousarray(normal_columns, dtype=np.int64), float(rank_tol),
         flat, shared, np.ascontiguousarray(kappa, dtype=float), *offsets,
-        float(tol), int(max_iter), bool(active_set), out_d, out_done,
+        float(tol), int(max_iter), bool(active_set),
+        0.0 if between is None else float(between[0]),
+        math.inf if between is None else float(between[1]), out_d, out_done,
     )  # fmt: skip
     return out_d, out_done
