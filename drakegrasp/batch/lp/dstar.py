@@ -113,14 +113,18 @@ def _highs(Q, facets, slices, normal_columns, c, fallback):
 def _verdict_band(tol: float, N: int) -> tuple[float, float]:
     """``(t_no, t_yes)``: proving ``t* < t_no`` or ``t* > t_yes`` decides a verdict.
 
-    ``d* = N max(0, t*) > tol`` is the verdict; a proof stops at half or twice
-    the threshold, not at it, so every grasp it stops is one whose ``d*`` the
-    full solve (IPM to ``1e-10``, or HiGHS to its feasibility tolerance
-    ``1e-7``) puts on the same side of ``tol``: the verdicts are those of the
-    full solve, not merely those of exact arithmetic.  Grasps within the band
-    are solved as in the full solve, to the same iterate.
+    ``d* = N max(0, t*) > tol`` is the verdict.  A proof stops at a quarter or
+    four times the threshold, not at it, so that every grasp it stops is one
+    whose ``d*`` the full solve also puts on the same side of ``tol``: the
+    full solve's ``d*`` is accurate to about ``4e-7`` at worst (an IPM that
+    reaches its iteration cap is accepted within ``1e3`` times its tolerance
+    on ``t``, ``1e-7 min(1, 4/N)``; HiGHS, the last resort, to its ``1e-7``
+    feasibility tolerance), well inside the ``7.5e-7`` and ``3e-6`` margins
+    at the default ``tol``.  Grasps within the band are solved as in the full
+    solve, to the same iterate, so the verdicts are the full solve's, not
+    merely those of exact arithmetic.
     """
-    return 0.5 * tol / N, 2.0 * tol / N
+    return 0.25 * tol / N, 4.0 * tol / N
 
 
 def solve_margin_blocks(
@@ -167,7 +171,9 @@ def solve_margin_blocks(
         its verdict ``d* > verdict_tol`` is proved either way (:func:`_verdict_band`);
         ``d_star`` is then a bound on the same side of ``verdict_tol`` as
         ``d*``, and a rank-deficient grasp gets no LP (``d_star`` 0; its
-        verdict is No by its rank).  None (default): ``d*`` itself.
+        verdict is No by its rank).  The early exits are those of the compiled
+        kernels; the numpy IPM (whose last bits depend on the stack it solves)
+        runs as in the full solve.  None (default): ``d*`` itself.
 
     Returns
     -------
@@ -221,7 +227,12 @@ def solve_margin_blocks(
         if sel.size == 0:
             continue
         f0 = c / cnorm2
-        if M - r == 1 or band is not None:
+        compiled = use_numba or kernel == "unfused"
+        # The numpy IPM's last bits depend on its stack (the problems solved
+        # together), so with it every grasp of the full solve stays in the stack
+        # and the verdicts stay those of the full solve; the compiled IPM solves
+        # each problem on its own, and may drop the ones f0 proves.
+        if M - r == 1 or (band is not None and compiled):
             t = np.full(sel.size, np.inf)  # min F f0: t* itself when M - r = 1
             for F, s in zip(facets, component_slices, strict=True):
                 if F.shape[0] == 1:
@@ -242,7 +253,7 @@ def solve_margin_blocks(
                 sel, Q, c, f0 = sel[keep], Q[:, :, keep], c[:, keep], f0[:, keep]
         A = np.concatenate([np.transpose(Q, (1, 0, 2)), np.zeros((1, M, sel.size))])
         A[-1, normal_columns] = 1.0  # (e, M, k)
-        if use_numba or kernel == "unfused":
+        if compiled:
             from drakegrasp.batch.lp.block_kernel import solve_block_stack  # numba
 
             t, ok, _, _ = solve_block_stack(
@@ -266,10 +277,7 @@ def solve_margin_blocks(
                 for members, cols in contact_groups
             ]
             sol = solve_block_lp(
-                groups,
-                tol=tol_t,
-                max_iter=ipm_max_iter,
-                stop_below=0.0 if band is None else band[0],
+                groups, tol=tol_t, max_iter=ipm_max_iter, stop_below=0.0
             )
             t, ok = sol.value, sol.converged
         if not ok.all():
