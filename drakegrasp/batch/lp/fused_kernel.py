@@ -15,6 +15,11 @@ in ``f = Z v`` by the active-set method of :mod:`drakegrasp.batch.lp.active_set`
 with ``Z`` the trailing columns of the same Householder ``Q``: 0.7–1.8 µs per
 LP where the IPM took 4–6 µs.  An LP it cannot certify goes on to the IPM.
 
+In verdict-only mode (``between``, for robustness) a grasp whose ``f_0``
+(computed from the QR's reflectors alone) already clears the upper bound is
+finished before any ``Q`` is formed: on the planner's robustness copies that
+is nearly all of them.
+
 Only grasps whose full row rank the QR certifies (``‖R⁻¹‖_F rank_tol ‖G̃‖_F < 1``,
 as :func:`drakegrasp.batch.build.rowspace.row_spaces`) and whose IPM converges are
 finished here; the caller sends the others (rank-deficient or nearly so, or an
@@ -119,6 +124,7 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
     RI = np.empty((w, w))
     A = np.empty((e, M))
     f0 = np.empty(M)
+    E = np.empty((1, M))
     Qte = np.empty(w)
     wr, wm, we, WT, Hs, S = work_arrays(R, M, e, N)
     Cf = np.empty(R)
@@ -136,6 +142,35 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
         if not _certain(XT, w, fro, rank_tol, RI):
             continue  # rank not certified: the numpy path decides
         Fk = F[0] if shared else F[k]
+        if above < math.inf and M > w:
+            # Verdicts only: f0 = Z Zᵀ e / ‖Zᵀ e‖² straight from the reflectors
+            # (Zᵀ e is the tail of H_{w-1} … H_0 e; O(w M), no Q formed) is
+            # feasible (G f0 = 0, eᵀ f0 = 1), so min C f0 > above proves t* > above.
+            for m in range(M):
+                E[0, m] = 0.0
+            for i in range(N):
+                E[0, normal[i]] = 1.0
+            for j in range(w):
+                _reflect(V, j, beta[j], E, 0, M)
+            cn2 = 0.0
+            for m in range(M):
+                if m < w:
+                    E[0, m] = 0.0
+                else:
+                    cn2 += E[0, m] * E[0, m]
+            if cn2 > 4.0 * _PUSH_TOL * _PUSH_TOL:  # else: as the full solve
+                for j in range(w - 1, -1, -1):
+                    _reflect(V, j, beta[j], E, 0, M)
+                for m in range(M):
+                    f0[m] = E[0, m] / cn2
+                _cmul(Fk, foff, nrow, ncomp, roff, coff, N, f0, Cf)
+                lo = Cf[0]
+                for j in range(R):
+                    lo = min(lo, Cf[j])
+                if lo > above:
+                    out_done[k] = True
+                    out_d[k] = N * lo
+                    continue
         if reduced:
             # Z = H_0 … H_{w-1} [0; I]: an orthonormal basis of N(G); the LP
             # in f = Z v goes to the active-set method, the IPM if it fails.
@@ -155,19 +190,6 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
                 out_done[k] = True
                 out_d[k] = 0.0  # no balanced force pushes
                 continue
-            if above < math.inf:
-                # f0 = Z Zᵀ e / ‖Zᵀ e‖² is feasible (Gf0 = 0, eᵀf0 = 1): its
-                # min C f0 = min (C Z) Zᵀ e / ‖Zᵀ e‖² bounds t* from below.
-                lo = math.inf
-                for j in range(R):
-                    acc = 0.0
-                    for i in range(nz):
-                        acc += AT[i, j] * ct[i]
-                    lo = min(lo, acc / cn2)
-                if lo > above:
-                    out_done[k] = True
-                    out_d[k] = N * lo
-                    continue
             t, ok, _ = reduced_lp(AT, nz, R, ct, cn2, 10 * R + 50, aswork)
             if ok:
                 out_done[k] = True
