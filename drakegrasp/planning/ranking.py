@@ -23,7 +23,11 @@ finger's contact centroid, then a translation drawn from
 :math:`\max(0, 1 + \sigma_\mu \xi)`, :math:`\xi \sim \mathcal N(0, 1)`, one
 draw per copy.  A rigid motion of the whole grasp changes no verdict, so the
 noise is per finger: it models the object's pose error and the fingers'
-placement error relative to each other.
+placement error relative to each other.  Only each copy's verdict counts, so
+both routes solve their copies' LPs in verdict-only mode
+(:func:`drakegrasp.batch.run.chunk.force_verdicts`): each LP stops once its
+verdict is proved, and the verdicts are those of
+:func:`~drakegrasp.batch.batch_force_closure`.
 
 **Score** :math:`= \rho \cdot \alpha_{\min}` (robustness times the weight
 capacity of :mod:`drakegrasp.planning.weight`: the object's weight, per newton

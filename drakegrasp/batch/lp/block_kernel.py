@@ -52,7 +52,7 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
 
     ``above`` (``inf``: never) stops the problem once a feasible point with
     ``min C f > above`` is in hand, which proves ``t* > above``: ``f`` itself,
-    or an iterate whose ``t`` passed ``above`` (:func:`_proves_above`).  The
+    or an iterate whose ``t`` passed ``above`` (``_proves_above``).  The
     value returned is then that point's ``min C f``, a lower bound on ``t*``.
     """
     N = coff.shape[0]

@@ -168,7 +168,8 @@ def solve_margin_blocks(
         preparation (what the fused pass hands its leftovers to).
     verdict_tol : float, optional
         Internal (robustness counts verdicts only): solve each LP only until
-        its verdict ``d* > verdict_tol`` is proved either way (:func:`_verdict_band`);
+        its verdict ``d* > verdict_tol`` is proved either way (at a quarter or four
+        times the threshold: ``_verdict_band``);
         ``d_star`` is then a bound on the same side of ``verdict_tol`` as
         ``d*``, and a rank-deficient grasp gets no LP (``d_star`` 0; its
         verdict is No by its rank).  The early exits are those of the compiled
