@@ -23,7 +23,11 @@ finger's contact centroid, then a translation drawn from
 :math:`\max(0, 1 + \sigma_\mu \xi)`, :math:`\xi \sim \mathcal N(0, 1)`, one
 draw per copy.  A rigid motion of the whole grasp changes no verdict, so the
 noise is per finger: it models the object's pose error and the fingers'
-placement error relative to each other.
+placement error relative to each other.  Only each copy's verdict counts, so
+both routes solve their copies' LPs in verdict-only mode
+(:func:`drakegrasp.batch.run.chunk.force_verdicts`): each LP stops once its
+verdict is proved, and the verdicts are those of
+:func:`~drakegrasp.batch.batch_force_closure`.
 
 **Score** :math:`= \rho \cdot \alpha_{\min}` (robustness times the weight
 capacity of :mod:`drakegrasp.planning.weight`: the object's weight, per newton
@@ -50,6 +54,7 @@ from dataclasses import replace
 import numpy as np
 
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
+from drakegrasp.batch.run.chunk import force_verdicts
 from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.linalg import rotations_about
 from drakegrasp.planning.candidates import GraspCandidate
@@ -208,7 +213,8 @@ def robustness(
         positions, normals, fingers, mu, samples=samples, rng=rng, groups=groups,
         **noise,
     )  # fmt: skip
-    res = batch_force_closure(
+    # verdicts only: each LP stops once its verdict is proved (force_verdicts)
+    held = force_verdicts(
         P,
         Nrm,
         mu=mus[:, None],  # one μ per copy, (K S, 1): never ambiguous with N
@@ -216,9 +222,7 @@ def robustness(
         torsional_friction=torsional_friction,
         workers=workers,
     )
-    return (
-        np.asarray(res.is_closure, float).reshape(len(positions), samples).mean(axis=1)
-    )
+    return held.astype(float).reshape(len(positions), samples).mean(axis=1)
 
 
 TIE_DECIMALS = 9

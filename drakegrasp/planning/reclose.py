@@ -39,7 +39,8 @@ that slid off an edge may lose contacts a larger pad would have kept: the
 estimate errs towards fewer contacts.
 
 Everything is vectorised over all copies and probes (one chord query); the
-copies' verdicts are then the batch engine's LP2, grouped by their (ragged)
+copies' verdicts are then the batch engine's LP2 (verdicts only:
+:func:`drakegrasp.batch.run.chunk.force_verdicts`), grouped by their (ragged)
 contact counts, except for copies with too few contacts to be force closure
 at all (:data:`NEVER_CLOSURE`).
 """
@@ -48,7 +49,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.batch import batch_force_closure
+from drakegrasp.batch.run.chunk import force_verdicts
 from drakegrasp.core.linalg import rotations_about
 
 __all__ = ["NEVER_CLOSURE", "reclosed_copies", "reclosed_robustness"]
@@ -187,7 +188,9 @@ def reclosed_robustness(
         rows = np.flatnonzero(counts == n)
         order = np.argsort(~touch[rows], axis=1, kind="stable")[:, :n]
         take = rows[:, None], order
-        res = batch_force_closure(
+        # verdicts only (each LP stops once its verdict is proved): those of
+        # batch_force_closure, at a fraction of the cost
+        held[rows] = force_verdicts(
             p_OC[take],
             nhat[take],
             mu=mus[rows, None],  # one μ per copy (K, 1): never read per contact
@@ -195,5 +198,4 @@ def reclosed_robustness(
             torsional_friction=torsional_friction,
             workers=workers,
         )
-        held[rows] = np.asarray(res.is_closure, bool)
     return held.reshape(K, samples).mean(axis=1)

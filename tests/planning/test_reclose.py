@@ -162,13 +162,13 @@ def test_copies_too_few_to_hold_skip_the_lp_and_nothing_else(model, monkeypatch)
         )  # fmt: skip
 
     lps = []
-    solve = reclose.batch_force_closure
+    solve = reclose.force_verdicts
 
     def counted(positions, *args, **kwargs):
         lps.append(len(positions))
         return solve(positions, *args, **kwargs)
 
-    monkeypatch.setattr(reclose, "batch_force_closure", counted)
+    monkeypatch.setattr(reclose, "force_verdicts", counted)
     fast = run()
     skipped = sum(lps)
     touch, _, _, ok = reclosed_copies(

@@ -44,11 +44,16 @@ _FLOOR = 0.1
 
 @njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_stop,
-         wr, wm, we, WT, Hs, S):  # fmt: skip
+         above, wr, wm, we, WT, Hs, S):  # fmt: skip
     """Solve one problem from ``f`` (which satisfies ``A f = b``); work arrays given.
 
     ``WT`` (e, M) holds ``H⁻¹ Aᵀ`` transposed, so every product with ``A`` or
     ``WT`` runs along contiguous rows of length ``M``.
+
+    ``above`` (``inf``: never) stops the problem once a feasible point with
+    ``min C f > above`` is in hand, which proves ``t* > above``: ``f`` itself,
+    or an iterate whose ``t`` passed ``above`` (``_proves_above``).  The
+    value returned is then that point's ``min C f``, a lower bound on ``t*``.
     """
     N = coff.shape[0]
     e, M = A.shape
@@ -87,6 +92,11 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
     for i in range(N):
         ah[coff[i]] = 1.0 / F[foff[i]]
         g[coff[i]] -= t * ah[coff[i]]
+    if lo > above:  # f may prove it already (checked on its exact projection)
+        proved = _proves_above(F, A, f, 0.0, ah, coff, ncomp, foff, nrow, roff,
+                               wm[5], ds)  # fmt: skip
+        if proved > above:
+            return proved, True, False, 0
     _ctmul(F, foff, nrow, ncomp, roff, coff, N, lam, z)
     for i in range(e):
         y[i] = _dotrow(A, i, z, M)
@@ -133,6 +143,11 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
             bound = (y[e - 1] + worst) / lsum
             if bound < stop:
                 return bound, True, True, it
+        if t > above and not done:
+            proved = _proves_above(F, A, g, t, ah, coff, ncomp, foff, nrow, roff,
+                                   wm[5], ds)  # fmt: skip
+            if proved > above:
+                return proved, True, False, it
         if done:
             return t, True, False, it
         if it == max_iter:
@@ -226,6 +241,37 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
     return t, False, False, max_iter
 
 
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _proves_above(F, A, g, t, ah, coff, ncomp, foff, nrow, roff, f, Cf):
+    """``min C f`` of the iterate ``f = g + t â`` made exactly feasible, or -inf.
+
+    The iterate satisfies ``A f = b`` only up to the Newton steps' rounding;
+    here its components along ``A``'s orthonormal rows ``Qᵀ`` (all rows but
+    the last) are removed and it is scaled to ``eᵀ f = 1`` (the last row), so
+    the ``min C f`` returned is the value of a feasible point: ``t*`` is at
+    least that.  ``f`` (M) and ``Cf`` (R) are scratch.
+    """
+    N = coff.shape[0]
+    e, M = A.shape
+    R = roff[N - 1] + nrow[N - 1]
+    for m in range(M):
+        f[m] = g[m] + t * ah[m]
+    for i in range(e - 1):
+        acc = _dotrow(A, i, f, M)
+        for m in range(M):
+            f[m] -= acc * A[i, m]
+    total = _dotrow(A, e - 1, f, M)
+    if not total > 0.0:
+        return -math.inf
+    for m in range(M):
+        f[m] /= total
+    _cmul(F, foff, nrow, ncomp, roff, coff, N, f, Cf)
+    lo = Cf[0]
+    for j in range(R):
+        lo = min(lo, Cf[j])
+    return lo
+
+
 @njit(cache=True)
 def work_arrays(R, M, e, N):
     """Work arrays of :func:`_one`.
@@ -234,7 +280,7 @@ def work_arrays(R, M, e, N):
     contacts of at most 4 components each.
     """
     wr = np.empty((13, R))
-    wm = np.empty((5, M))
+    wm = np.empty((6, M))
     we = np.empty((6, e))
     WT = np.empty((e, M))
     Hs = np.empty((N, 4, 4))
@@ -249,11 +295,11 @@ def work_arrays(R, M, e, N):
     entry=(
         "f8[:, ::1], b1, f8[:, :, ::1], f8[:, ::1], f8[:, ::1], "
         "i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8, i8, f8, "
-        "b1, f8[::1], b1[::1], b1[::1], i8[::1]"
+        "b1, f8, f8[::1], b1[::1], b1[::1], i8[::1]"
     ),
 )
 def _stack(F, shared, A, kap, f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
-           stop, use_stop, out_t, out_conv, out_below, out_it):  # fmt: skip
+           stop, use_stop, above, out_t, out_conv, out_below, out_it):  # fmt: skip
     N = coff.shape[0]
     e, M = A.shape[1], A.shape[2]
     R = roff[N - 1] + nrow[N - 1]
@@ -262,7 +308,7 @@ def _stack(F, shared, A, kap, f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
         Fk = F[0] if shared else F[k]
         t, ok, below, it = _one(
             Fk, A[k], kap[k], f0[k], coff, ncomp, foff, nrow, roff, tol, max_iter,
-            stop, use_stop, wr, wm, we, WT, Hs, S,
+            stop, use_stop, above, wr, wm, we, WT, Hs, S,
         )  # fmt: skip
         out_t[k] = t
         out_conv[k] = ok
@@ -306,6 +352,7 @@ def solve_block_stack(
     tol: float = 1e-10,
     max_iter: int = 60,
     stop_below: float | None = None,
+    prove_above: float | None = None,
 ):
     """The compiled block IPM on a stack of LPs of one layout.
 
@@ -321,6 +368,11 @@ def solve_block_stack(
         Starting ``f`` with ``A f = b``.
     tol, max_iter, stop_below : optional
         As in :func:`drakegrasp.batch.lp.block_ipm.solve_block_lp`.
+    prove_above : float, optional
+        Stop a problem once a feasible point proves ``t* > prove_above`` (its
+        ``value`` is then that point's ``t``, a lower bound, with
+        ``converged`` True and ``below`` False); the rows ``A`` but the last
+        must be orthonormal (``Qᵀ``).  None: solve to the end.
 
     Returns
     -------
@@ -337,6 +389,7 @@ def solve_block_stack(
         np.ascontiguousarray(kappa, dtype=float), np.ascontiguousarray(start),
         coff, ncomp, foff, nrow, roff, float(tol), int(max_iter),
         0.0 if stop_below is None else float(stop_below), stop_below is not None,
+        math.inf if prove_above is None else float(prove_above),
         out_t, out_conv, out_below, out_it,
     )  # fmt: skip
     return out_t, out_conv, out_below, out_it

@@ -110,6 +110,23 @@ def _highs(Q, facets, slices, normal_columns, c, fallback):
     return -float(res.fun), True
 
 
+def _verdict_band(tol: float, N: int) -> tuple[float, float]:
+    """``(t_no, t_yes)``: proving ``t* < t_no`` or ``t* > t_yes`` decides a verdict.
+
+    ``d* = N max(0, t*) > tol`` is the verdict.  A proof stops at a quarter or
+    four times the threshold, not at it, so that every grasp it stops is one
+    whose ``d*`` the full solve also puts on the same side of ``tol``: the
+    full solve's ``d*`` is accurate to about ``4e-7`` at worst (an IPM that
+    reaches its iteration cap is accepted within ``1e3`` times its tolerance
+    on ``t``, ``1e-7 min(1, 4/N)``; HiGHS, the last resort, to its ``1e-7``
+    feasibility tolerance), well inside the ``7.5e-7`` and ``3e-6`` margins
+    at the default ``tol``.  Grasps within the band are solved as in the full
+    solve, to the same iterate, so the verdicts are the full solve's, not
+    merely those of exact arithmetic.
+    """
+    return 0.25 * tol / N, 4.0 * tol / N
+
+
 def solve_margin_blocks(
     G: np.ndarray,
     facets: list[np.ndarray],
@@ -121,6 +138,7 @@ def solve_margin_blocks(
     ipm_tol: float = 1e-10,
     ipm_max_iter: int = 60,
     kernel: str = "auto",
+    verdict_tol: float | None = None,
 ) -> MarginSolution:
     """Solve LP1/LP2 for a stack of grasps that share one layout.
 
@@ -148,6 +166,15 @@ def solve_margin_blocks(
         (:mod:`~drakegrasp.batch.lp.block_ipm`); ``"auto"`` takes numba when it is
         installed.  ``"unfused"``: the compiled IPM after the numpy
         preparation (what the fused pass hands its leftovers to).
+    verdict_tol : float, optional
+        Internal (robustness counts verdicts only): solve each LP only until
+        its verdict ``d* > verdict_tol`` is proved either way (at a quarter or four
+        times the threshold: ``_verdict_band``);
+        ``d_star`` is then a bound on the same side of ``verdict_tol`` as
+        ``d*``, and a rank-deficient grasp gets no LP (``d_star`` 0; its
+        verdict is No by its rank).  The early exits are those of the compiled
+        kernels; the numpy IPM (whose last bits depend on the stack it solves)
+        runs as in the full solve.  None (default): ``d*`` itself.
 
     Returns
     -------
@@ -158,6 +185,7 @@ def solve_margin_blocks(
     # d* = N t: tighten the tolerance on t beyond 4 contacts so that d* keeps
     # about 4 ipm_tol absolute accuracy at any N.
     tol_t = ipm_tol * min(1.0, 4.0 / N)
+    band = None if verdict_tol is None else _verdict_band(verdict_tol, N)
     use_numba = kernel == "numba" or (kernel == "auto" and numba_available())
     if use_numba and M >= w and K > 0:
         # Certified full-rank grasps are prepared and solved in one compiled
@@ -166,7 +194,7 @@ def solve_margin_blocks(
 
         d_fused, done = solve_full_rank_stack(
             G, facets, normal_columns, kappa, rank_tol=rank_tol, tol=tol_t,
-            max_iter=ipm_max_iter,
+            max_iter=ipm_max_iter, between=band,
         )  # fmt: skip
         rest = np.flatnonzero(~done)
         if rest.size == 0:
@@ -175,6 +203,7 @@ def solve_margin_blocks(
             G[rest], [F if F.shape[0] == 1 else F[rest] for F in facets],
             component_slices, normal_columns, kappa[rest], rank_tol=rank_tol,
             ipm_tol=ipm_tol, ipm_max_iter=ipm_max_iter, kernel="unfused",
+            verdict_tol=verdict_tol,
         )  # fmt: skip
         rank = np.full(K, w)
         converged = np.ones(K, dtype=bool)
@@ -188,6 +217,8 @@ def solve_margin_blocks(
         r = Q.shape[1]
         if r >= M:
             continue  # no null space: only f = 0 balances
+        if band is not None and r < w:
+            continue  # rank deficient: No whatever d* (chunk.finish)
         c = -np.einsum("mrk,rk->mk", Q, Q[normal_columns].sum(axis=0))
         c[normal_columns] += 1.0  # c = e - Q Qᵀ e, (M, k)
         cnorm2 = np.einsum("mk,mk->k", c, c)
@@ -197,19 +228,33 @@ def solve_margin_blocks(
         if sel.size == 0:
             continue
         f0 = c / cnorm2
-        if M - r == 1:
-            t = np.full(sel.size, np.inf)
+        compiled = use_numba or kernel == "unfused"
+        # The numpy IPM's last bits depend on its stack (the problems solved
+        # together), so with it every grasp of the full solve stays in the stack
+        # and the verdicts stay those of the full solve; the compiled IPM solves
+        # each problem on its own, and may drop the ones f0 proves.
+        if M - r == 1 or (band is not None and compiled):
+            t = np.full(sel.size, np.inf)  # min F f0: t* itself when M - r = 1
             for F, s in zip(facets, component_slices, strict=True):
                 if F.shape[0] == 1:
                     vals = np.einsum("rc,ck->rk", F[0], f0[s])
                 else:
                     vals = np.einsum("krc,ck->rk", F[sel], f0[s])
                 t = np.minimum(t, vals.min(axis=0))
-            d_star[sel] = N * np.maximum(t, 0.0)
-            continue
+            if M - r == 1:
+                d_star[sel] = N * np.maximum(t, 0.0)
+                continue
+            # f0 is feasible (Qᵀ f0 = 0, eᵀ f0 = 1): t* >= min F f0
+            proved = t > band[1]
+            d_star[sel[proved]] = N * t[proved]
+            if proved.all():
+                continue
+            if proved.any():
+                keep = ~proved
+                sel, Q, c, f0 = sel[keep], Q[:, :, keep], c[:, keep], f0[:, keep]
         A = np.concatenate([np.transpose(Q, (1, 0, 2)), np.zeros((1, M, sel.size))])
         A[-1, normal_columns] = 1.0  # (e, M, k)
-        if use_numba or kernel == "unfused":
+        if compiled:
             from drakegrasp.batch.lp.block_kernel import solve_block_stack  # numba
 
             t, ok, _, _ = solve_block_stack(
@@ -219,7 +264,8 @@ def solve_margin_blocks(
                 np.ascontiguousarray(f0.T),
                 tol=tol_t,
                 max_iter=ipm_max_iter,
-                stop_below=0.0,
+                stop_below=0.0 if band is None else band[0],
+                prove_above=None if band is None else band[1],
             )
         else:
             groups = [

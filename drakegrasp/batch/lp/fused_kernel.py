@@ -15,6 +15,11 @@ in ``f = Z v`` by the active-set method of :mod:`drakegrasp.batch.lp.active_set`
 with ``Z`` the trailing columns of the same Householder ``Q``: 0.7–1.8 µs per
 LP where the IPM took 4–6 µs.  An LP it cannot certify goes on to the IPM.
 
+In verdict-only mode (``between``, for robustness) a grasp whose ``f_0``
+(computed from the QR's reflectors alone) already clears the upper bound is
+finished before any ``Q`` is formed: on the planner's robustness copies that
+is nearly all of them.
+
 Only grasps whose full row rank the QR certifies (``‖R⁻¹‖_F rank_tol ‖G̃‖_F < 1``,
 as :func:`drakegrasp.batch.build.rowspace.row_spaces`) and whose IPM converges are
 finished here; the caller sends the others (rank-deficient or nearly so, or an
@@ -102,12 +107,13 @@ def full_column_rank_certain(Gn: np.ndarray, rank_tol: float) -> np.ndarray:
     error_model="numpy",
     entry=(
         "f8[:, :, ::1], i8[::1], f8, f8[:, ::1], b1, f8[:, ::1], "
-        "i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8, i8, b1, "
+        "i8[::1], i8[::1], i8[::1], i8[::1], i8[::1], f8, i8, b1, f8, f8, "
         "f8[::1], b1[::1]"
     ),
 )
 def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nrow,
-                     roff, tol, max_iter, active_set, out_d, out_done):  # fmt: skip
+                     roff, tol, max_iter, active_set, stop, above, out_d,
+                     out_done):  # fmt: skip
     K, w, M = G.shape
     N = coff.shape[0]
     e = w + 1
@@ -118,6 +124,7 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
     RI = np.empty((w, w))
     A = np.empty((e, M))
     f0 = np.empty(M)
+    E = np.empty((1, M))
     Qte = np.empty(w)
     wr, wm, we, WT, Hs, S = work_arrays(R, M, e, N)
     Cf = np.empty(R)
@@ -135,6 +142,35 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
         if not _certain(XT, w, fro, rank_tol, RI):
             continue  # rank not certified: the numpy path decides
         Fk = F[0] if shared else F[k]
+        if above < math.inf and M > w:
+            # Verdicts only: f0 = Z Zᵀ e / ‖Zᵀ e‖² straight from the reflectors
+            # (Zᵀ e is the tail of H_{w-1} … H_0 e; O(w M), no Q formed) is
+            # feasible (G f0 = 0, eᵀ f0 = 1), so min C f0 > above proves t* > above.
+            for m in range(M):
+                E[0, m] = 0.0
+            for i in range(N):
+                E[0, normal[i]] = 1.0
+            for j in range(w):
+                _reflect(V, j, beta[j], E, 0, M)
+            cn2 = 0.0
+            for m in range(M):
+                if m < w:
+                    E[0, m] = 0.0
+                else:
+                    cn2 += E[0, m] * E[0, m]
+            if cn2 > 4.0 * _PUSH_TOL * _PUSH_TOL:  # else: as the full solve
+                for j in range(w - 1, -1, -1):
+                    _reflect(V, j, beta[j], E, 0, M)
+                for m in range(M):
+                    f0[m] = E[0, m] / cn2
+                _cmul(Fk, foff, nrow, ncomp, roff, coff, N, f0, Cf)
+                lo = Cf[0]
+                for j in range(R):
+                    lo = min(lo, Cf[j])
+                if lo > above:
+                    out_done[k] = True
+                    out_d[k] = N * lo
+                    continue
         if reduced:
             # Z = H_0 … H_{w-1} [0; I]: an orthonormal basis of N(G); the LP
             # in f = Z v goes to the active-set method, the IPM if it fails.
@@ -200,7 +236,7 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
         else:
             t, ok, _, _ = _one(
                 Fk, A, kap[k], f0, coff, ncomp, foff, nrow, roff, tol, max_iter,
-                0.0, True, wr, wm, we, WT, Hs, S,
+                stop, True, above, wr, wm, we, WT, Hs, S,
             )  # fmt: skip
             if not ok:
                 out_done[k] = False  # the numpy path retries, then HiGHS
@@ -218,6 +254,7 @@ def solve_full_rank_stack(
     tol: float,
     max_iter: int,
     active_set: bool = True,
+    between: tuple[float, float] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``d*`` of the grasps of one layout whose full row rank a QR certifies.
 
@@ -236,11 +273,18 @@ def solve_full_rank_stack(
     active_set : bool, optional
         Solve the LPs of small null spaces (``drakegrasp.batch.lp.active_set.worth_it``)
         with the exact active-set method first (default); False: the IPM only.
+    between : (float, float), optional
+        Verdicts only (:func:`drakegrasp.batch.lp.dstar.solve_margin_blocks`'s
+        ``verdict_tol``): a grasp stops once ``t*`` is proved below the first
+        bound (its ``d_star`` is then an upper bound ``N max(0, t) < N`` that)
+        or above the second (``d_star`` is a feasible point's ``N t``, a lower
+        bound).  None (default): every ``d*`` to the IPM's accuracy.
 
     Returns
     -------
     d_star : (K,) float
-        ``N max(0, t*)`` where ``done``; 0 elsewhere.
+        ``N max(0, t*)`` where ``done`` (with ``between``: a bound, as above);
+        0 elsewhere.
     done : (K,) bool
         Rank ``w`` certified and the LP solved; the rest is left to the caller.
     """
@@ -252,6 +296,8 @@ def solve_full_rank_stack(
         np.ascontiguousarray(G, dtype=float),
         np.ascontiguousarray(normal_columns, dtype=np.int64), float(rank_tol),
         flat, shared, np.ascontiguousarray(kappa, dtype=float), *offsets,
-        float(tol), int(max_iter), bool(active_set), out_d, out_done,
+        float(tol), int(max_iter), bool(active_set),
+        0.0 if between is None else float(between[0]),
+        math.inf if between is None else float(between[1]), out_d, out_done,
     )  # fmt: skip
     return out_d, out_done

@@ -52,7 +52,9 @@ from drakegrasp.batch.inputs import (
 )
 from drakegrasp.batch.lp.dstar import solve_margin_blocks
 from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
+from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
@@ -60,6 +62,7 @@ __all__ = [
     "finish",
     "force_chunk",
     "force_task",
+    "force_verdicts",
     "form_chunk",
     "form_task",
 ]
@@ -192,17 +195,19 @@ def _shared_cone(kind: int, mu: float, n_g: int) -> np.ndarray:
     return F
 
 
-def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, rows):
+def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, rows,
+               verdict_tol=None):  # fmt: skip
     """LP2 for the grasps ``rows`` (None: all) that share one layout.
 
     Returns (d_star, rank, converged) of those grasps; ``torsion`` (None when
-    no contact is soft) is ``b ν`` per contact.
+    no contact is soft) is ``b ν`` per contact.  ``verdict_tol``: see
+    :func:`~drakegrasp.batch.lp.dstar.solve_margin_blocks`.
     """
     G, normal_cols = _grasp_matrices(Pn, Nrm, None, layout, rows, _compiled(kernel))
     if rows is not None:
         spread, mu_c = spread[rows], mu_c[rows]
         torsion = None if torsion is None else torsion[rows]
-    facets, slices, start = [], [], 0
+    facets, slices, start, built = [], [], 0, []
     # Contacts with one μ for all grasps (whole-array test first: it is cheaper).
     if (mu_c == mu_c[:1, :1]).all():
         uniform = np.ones(mu_c.shape[1], dtype=bool)
@@ -220,13 +225,26 @@ def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, ro
         elif uniform[i]:  # one cone for all grasps
             F = _shared_cone(kind, float(mu_i[0]), n_g)
         else:
-            F = kind_facets(kind, mu_i, None, n_g)
+            # one μ per grasp, often the same for all its contacts (robustness
+            # copies): an earlier contact's rows of the same kind and μ serve
+            F = next(
+                (
+                    Fj
+                    for kj, mu_j, Fj in built
+                    if kj == kind and np.array_equal(mu_j, mu_i)
+                ),
+                None,
+            )
+            if F is None:
+                F = kind_facets(kind, mu_i, None, n_g)
+                built.append((kind, mu_i, F))
         facets.append(F)
         slices.append(slice(start, start + k_i))
         start += k_i
     sol = solve_margin_blocks(
-        G, facets, slices, normal_cols, kappa, rank_tol=rank_tol, kernel=kernel
-    )
+        G, facets, slices, normal_cols, kappa, rank_tol=rank_tol, kernel=kernel,
+        verdict_tol=verdict_tol,
+    )  # fmt: skip
     return sol.d_star, sol.rank, sol.converged
 
 
@@ -244,6 +262,7 @@ def force_chunk(
     rank_tol: float,
     metrics: Sequence[str],
     kernel: str = "auto",
+    verdict_only: bool = False,
 ) -> dict[str, np.ndarray]:
     """LP2 (force closure) of one chunk of validated grasps.
 
@@ -259,6 +278,10 @@ def force_chunk(
         Characteristic lengths (None: the default of :class:`~drakegrasp.Grasp`).
     model, num_generators, tol, rank_tol, metrics, kernel
         As in :func:`drakegrasp.batch.batch_force_closure`.
+    verdict_only : bool, optional
+        Internal (:func:`force_verdicts`): each LP stops once its verdict is
+        proved, so ``is_closure`` is exact but ``d_star`` and ``margin`` are
+        only bounds on the right side of ``tol``.
 
     Returns
     -------
@@ -288,6 +311,7 @@ def force_chunk(
             rank_tol,
             kernel,
             rows if rows.size < k else None,
+            tol if verdict_only else None,
         )
     normal = _normal_certificates(
         Pn, Nrm, kinds, rank, d_star, tol=tol, rank_tol=rank_tol, kernel=kernel
@@ -431,3 +455,60 @@ def form_task(positions, reference_points, characteristic_lengths, tol, rank_tol
         return form_chunk, (P, Nrm, p, b), options
 
     return task, options
+
+
+def force_verdicts(
+    positions,
+    normals,
+    *,
+    mu,
+    contact_model="hard_finger",
+    torsional_friction=None,
+    num_generators: int = 8,
+    workers=None,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+    kernel: str = "auto",
+) -> np.ndarray:
+    """``is_closure`` of LP2 for ``K`` grasps of ``N`` contacts, verdicts only.
+
+    Internal, for counts of verdicts (:func:`drakegrasp.planning.ranking.robustness`
+    and :func:`drakegrasp.planning.reclose.reclosed_robustness`): the same
+    validation, chunks, workers and rules as
+    :func:`drakegrasp.batch.batch_force_closure` (rank, normal-force
+    certificate), whose ``is_closure`` it returns, but each LP stops as soon
+    as its verdict is proved either way (a feasible point above the
+    threshold, a dual bound below it, a rank-deficient ``G``: see
+    :func:`drakegrasp.batch.lp.dstar.solve_margin_blocks`'s ``verdict_tol``).
+
+    Parameters
+    ----------
+    positions, normals : (K, N, d) float
+        Contact points (metres) and unit inward normals, one frame per grasp.
+    mu, contact_model, torsional_friction, num_generators
+        As :func:`drakegrasp.batch.batch_force_closure`.
+    workers, tol, rank_tol, kernel
+        As :func:`drakegrasp.batch.batch_force_closure`.
+
+    Returns
+    -------
+    (K,) bool
+    """
+    K = shape_of("positions", positions)[0]
+    task, options = force_task(
+        positions, mu, contact_model, num_generators, torsional_friction, None,
+        None, tol, rank_tol, (), kernel,
+    )  # fmt: skip
+
+    def verdict_task(P, Nrm, sl):
+        fn, args, opts = task(P, Nrm, sl)
+        return fn, args, {**opts, "verdict_only": True}
+
+    out = np.zeros(K, dtype=bool)
+    for sl, arrays in stream(
+        positions, normals, kind="force", task=verdict_task,
+        chunk_size=DEFAULT_CHUNK_SIZE,
+        progress=False, workers=workers, n_g=options["num_generators"],
+    ):  # fmt: skip
+        out[sl] = arrays["is_closure"]
+    return out
