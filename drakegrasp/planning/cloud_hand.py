@@ -118,7 +118,7 @@ _DISC = np.vstack(
 """Sample points of the unit disc (its centre, rings of 6 and 12): a surfel's
 distance is the smallest over its samples, within ``r/2`` of the exact one."""
 
-EDGE_SPACINGS = 2.0
+EDGE_SPACINGS = 3.0
 """Radius, in cloud spacings, of the neighbourhood whose normals tell an edge."""
 
 EDGE_ANGLE = np.radians(20.0)
