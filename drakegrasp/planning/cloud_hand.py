@@ -12,8 +12,10 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
 1. **Approach and pre-shape** as on a body
    (:func:`~drakegrasp.planning.approach.sample_approaches`): a cloud point,
    the approach along its inward normal (tilted), a palm stand-off, a roll
-   and a pre-shape.  With a ``viewpoint`` the normals face the camera, so
-   every approach comes from the seen side of a one-sided cloud.
+   and a pre-shape.  With a ``viewpoint`` the normals face the camera; the
+   unseen side is completed by point symmetry
+   (:func:`~drakegrasp.planning.cloud.complete_unseen`, an assumption the
+   caller can turn off), and approaches come from either side.
 2. **Collisions** with the cloud: a hand geometry with a cloud point deeper
    than the distance tolerance inside it collides.  The depth is the
    geometry's own closed-form signed distance (sphere, box, cylinder,
@@ -21,18 +23,23 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    shapes) of the cloud points near it (a k-d tree ball about its bounding
    sphere: only those can be nearest).  With the rest of the plant and
    between fingers: Drake's signed distances, as on a body.  With a
-   ``viewpoint``, a hand that reaches behind the seen surface (the unseen
-   side may hold the object) is rejected, open and closed.
+   completed cloud, a hand that reaches into its interior
+   (:meth:`CloudHand.inside`) is rejected; with a ``viewpoint`` and no
+   completion, one that reaches behind the seen surface (the unseen side
+   may hold the object), open and closed.
 3. **Closing**, as :func:`~drakegrasp.close_hand` closes on a body: each
    finger steps from the pre-shape along the steepest descent of its tip's
    distance to the cloud, ``d = −∂ψ_tip/∂q`` (re-aimed after every step,
    blocked joints dropped, followers of couplings following), until its
-   distance ``ψ_f`` to the cloud (the smallest signed distance of a cloud
-   point to one of its geometries) is within the tolerance of
-   :data:`GAP_SPACINGS` cloud spacings.  Each step is
+   distance ``ψ_f`` to the cloud's surface is within the tolerance (of
+   :data:`GAP_SPACINGS` spacings, 0).  The surface is the cloud's *surfels*:
+   each point's tangent disc of :data:`SURFEL_SPACINGS` spacings' radius,
+   which close the gaps between sampled points that a finger would sink
+   into; ``ψ_f`` is the smallest signed distance of a surfel to one of the
+   finger's geometries.  Each step is
    bounded by conservative advancement (:mod:`drakegrasp.plant.advancement`:
    ``α <= (ψ_g − tol/2) / V_g`` over every finger geometry ``g``), so no step
-   carries a finger through a cloud point.  A finger that reaches its limits,
+   carries a finger through a surfel.  A finger that reaches its limits,
    circles a point where its distance stopped shrinking far from the cloud
    (the stall test ``close_hand`` applies), or takes
    :data:`~drakegrasp.plant.closing.DEFAULT_MAX_ITERATIONS` steps, misses and
@@ -40,7 +47,9 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
 4. **Contacts**: one per touching geometry (of a touching finger or the
    palm), as :func:`~drakegrasp.find_contacts` reports one per touching pair
    of geometries on a body: the cloud point where the geometry is closest,
-   with the mean of the cloud's normals there.  Only a box's face lying
+   with the mean of the cloud's normals there, or, on an edge (where the
+   normals near it disagree, :data:`EDGE_ANGLE`), the finger's own normal
+   there, as on a body where a smooth finger meets an edge.  Only a box's face lying
    flat on a flat patch touches along an area and reports the patch's
    corners, as a pad on a body's flat face does.  (Every touched point of
    the band, or its hull's corners, made 11-28 contacts where the body
@@ -76,11 +85,20 @@ from drakegrasp.plant.closing import DEFAULT_MAX_ITERATIONS
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
 from drakegrasp.plant.validation import scoped_name
 
-__all__ = ["GAP_SPACINGS", "REASONS", "CloudHand", "signed_distances"]
+__all__ = [
+    "EDGE_ANGLE",
+    "EDGE_SPACINGS",
+    "GAP_SPACINGS",
+    "REASONS",
+    "SURFEL_SPACINGS",
+    "CloudHand",
+    "signed_distances",
+]
 
 REASONS = {
     "hand collides with the cloud": "a cloud point lies inside the pre-shaped hand",
-    "hand enters the unseen side": "the hand reaches behind a one-sided cloud",
+    "hand enters the unseen side": "the hand reaches behind a one-sided cloud "
+    "(into a completed one)",
     "hand collides with the scene": "the pre-shaped hand penetrates another body",
     "fingers miss the object": "fewer than min_fingers fingers reach the cloud",
     "finger blocked by the scene": "a closed finger penetrates another body",
@@ -96,8 +114,10 @@ tangent discs, :data:`SURFEL_SPACINGS`): on them, within the distance
 tolerance.  Stopped at the bare points instead, a finger sinks between them
 (on 3,000 points of the YCB soup can, 1.4 mm apart, up to 1.5 mm into the
 true can); stopped half a spacing short of them, it stood 0.07-0.8 mm off the
-true can and pressed with less than the shake test's squeeze (the ten best
-held 7 times in 10 where, on the surfels, they hold 8)."""
+true can and pressed with less than the shake test's squeeze.  On the
+surfels the touching links of the best candidates lie -0.5 to +0.6 mm from
+the true can (benchmarks/bench_cloud_hold.py: with the edge normals of
+:data:`EDGE_ANGLE`, the ten best held 8 times in 10, 7 before)."""
 
 SURFEL_SPACINGS = 0.5
 """Radius of each cloud point's surfel, in cloud spacings (median
@@ -106,7 +126,8 @@ stands for the surface around it.  The discs cover the gaps between sampled
 points that a finger would otherwise sink into; on a convex surface of
 curvature radius ``R`` a disc of radius ``r`` lies at most ``r²/2R`` outside it
 (0.03 mm on the soup can's side), and at an edge it overhangs by up to
-``r``."""
+``r``: at a whole spacing the rims' overhang kept fingers off the can (5 of
+the ten best held)."""
 
 _DISC = np.vstack(
     [
