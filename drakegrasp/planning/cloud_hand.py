@@ -126,8 +126,9 @@ stands for the surface around it.  The discs cover the gaps between sampled
 points that a finger would otherwise sink into; on a convex surface of
 curvature radius ``R`` a disc of radius ``r`` lies at most ``r²/2R`` outside it
 (0.03 mm on the soup can's side), and at an edge it overhangs by up to
-``r``: at a whole spacing the rims' overhang kept fingers off the can (5 of
-the ten best held)."""
+``r``.  At a whole spacing 41 of 164 candidates were force closure on the
+soup can's full cloud, at half a spacing 59 of 185 (before the edge normals
+of :data:`EDGE_ANGLE` the ten best held 5 times in 10 at either radius)."""
 
 _DISC = np.vstack(
     [
