@@ -47,8 +47,8 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
 4. **Contacts**: one per touching geometry (of a touching finger or the
    palm), as :func:`~drakegrasp.find_contacts` reports one per touching pair
    of geometries on a body: the cloud point where the geometry is closest,
-   with the mean of the cloud's normals there, or, on an edge (where the
-   normals near it disagree, :data:`EDGE_ANGLE`), the finger's own normal
+   with the mean of the cloud's normals there, or, across an edge (where the
+   normals it nearly touches disagree, :data:`EDGE_ANGLE`), the finger's own normal
    there, as on a body where a smooth finger meets an edge.  Only a box's face lying
    flat on a flat patch touches along an area and reports the patch's
    corners, as a pad on a body's flat face does.  (Every touched point of
@@ -87,7 +87,6 @@ from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
     "EDGE_ANGLE",
-    "EDGE_SPACINGS",
     "GAP_SPACINGS",
     "REASONS",
     "SURFEL_SPACINGS",
@@ -140,12 +139,10 @@ _DISC = np.vstack(
 """Sample points of the unit disc (its centre, rings of 6 and 12): a surfel's
 distance is the smallest over its samples, within ``r/2`` of the exact one."""
 
-EDGE_SPACINGS = 3.0
-"""Radius, in cloud spacings, of the neighbourhood whose normals tell an edge."""
-
 EDGE_ANGLE = np.radians(20.0)
-"""A cloud point lies on an edge when a neighbour's normal (within
-:data:`EDGE_SPACINGS`) turns more than this from their mean.  There the
+"""A finger lies across an edge when the normals of the cloud points it
+nearly touches (within :data:`~drakegrasp.planning.cloud.CONTACT_BAND` of its
+distance) turn more than this from their mean.  There the
 cloud's normal is the wrong one: a finger touching a can's rim from the side
 pushes along its own surface's normal (the true can's analysis found
 ``(0.63, −0.08, −0.77)`` where the rim's cap points said ``(0, −1, 0)``), so
@@ -584,7 +581,7 @@ class CloudHand:
         else:
             centre = p_closest.mean(axis=0)
             keep = [closest[int(np.argmin(np.sum((p_closest - centre) ** 2, 1)))]]
-            if self._on_edge(self.surface.points[idx[keep[0]]]):
+            if _spread(normals) > EDGE_ANGLE:  # the finger lies across an edge
                 n_O = self._hand_normal(g, self.points_W[idx[keep[0]]])
         name = scoped_name(self.plant, g.body)
         return [
@@ -596,23 +593,6 @@ class CloudHand:
             )
             for k in keep
         ]
-
-    def _on_edge(self, p_O: np.ndarray) -> bool:
-        """Whether a cloud point lies on an edge: its neighbours' normals disagree.
-
-        The normals of the cloud points within :data:`EDGE_SPACINGS` spacings
-        of it spread by more than :data:`EDGE_ANGLE` from their mean (the rim
-        of a can, a box's edge).
-        """
-        near = self.tree.query_ball_point(
-            p_O + self.surface.centroid, EDGE_SPACINGS * self.surface.spacing
-        )
-        n = self.surface.normals[np.asarray(near, dtype=int)]
-        mean = n.mean(axis=0)
-        norm = np.linalg.norm(mean)
-        if not norm > 1e-9:
-            return True
-        return bool(np.min(n @ (mean / norm)) < np.cos(EDGE_ANGLE))
 
     def _hand_normal(self, g: _Geometry, x_W: np.ndarray) -> np.ndarray:
         """The hand geometry's outward normal towards a cloud point, world frame.
@@ -671,3 +651,12 @@ class CloudHand:
         if len(fingers) < 2:
             return None, None, "one finger touches"
         return found, s.coupling.apply(q), None
+
+
+def _spread(normals: np.ndarray) -> float:
+    """Largest angle (rad) of unit normals (k, 3) from their mean (π if it is 0)."""
+    mean = normals.mean(axis=0)
+    norm = np.linalg.norm(mean)
+    if not norm > 1e-9:
+        return np.pi
+    return float(np.arccos(np.clip(np.min(normals @ (mean / norm)), -1.0, 1.0)))
