@@ -50,6 +50,8 @@ from drakegrasp.plant.validation import scoped_name
 __all__ = [
     "CONTACT_BAND",
     "LINE_RADIUS_SPACINGS",
+    "UNSEEN_DEPTH_ANGLE",
+    "UNSEEN_WEAK",
     "CloudContact",
     "CloudFingers",
     "CloudSurface",
