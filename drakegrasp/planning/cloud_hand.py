@@ -350,6 +350,8 @@ class CloudHand:
         if len(sd) == 0:
             return sd
         near = np.flatnonzero(sd - self.surfel < sd.min())
+        if len(near) == 0:  # zero-radius surfels (a cloud of repeated points)
+            return sd
         offsets = self.surfel * np.einsum(
             "dk,mki->mdi", _DISC, self.disc_axes[idx[near]]
         )

@@ -277,6 +277,9 @@ def test_hostile_clouds(can):
     result = _plan(hand, holes, nrm, n=10)
     assert result.settings["cloud_dropped"] == len(p[::10])
     assert len(result) + sum(result.rejections.values()) == 10
+    # every point twice (a merged scan): spacing 0, surfels of radius 0
+    doubled = _plan(hand, np.vstack([p, p]), np.vstack([nrm, nrm]), n=10)
+    assert len(doubled) + sum(doubled.rejections.values()) == 10
     empty = _plan(hand, p, nrm, n=0)
     assert len(empty) == 0 and "num_candidates is 0" in empty.reason
     # the palm held 0.3-0.4 m off the can: no finger reaches it
