@@ -50,9 +50,12 @@ from drakegrasp.plant.validation import scoped_name
 __all__ = [
     "CONTACT_BAND",
     "LINE_RADIUS_SPACINGS",
+    "UNSEEN_DEPTH_ANGLE",
+    "UNSEEN_WEAK",
     "CloudContact",
     "CloudFingers",
     "CloudSurface",
+    "complete_unseen",
     "read_cloud",
 ]
 
@@ -72,6 +75,14 @@ that is there is found (at 1.5 spacings one line in five found none)."""
 
 SHADOW_PROBES = 64
 """Surface points per hand shape tested against a one-sided cloud's shadow."""
+
+UNSEEN_WEAK = 0.05
+"""A direction along which the cloud's normal lines fix the centre less than
+this (an eigenvalue of ``Σ(I − n nᵀ)/M``, at most 1) is undetermined."""
+
+UNSEEN_DEPTH_ANGLE = np.radians(60.0)
+"""The completion is skipped when an undetermined direction lies within this
+angle of the line of sight (a face seen head-on tells nothing of the depth)."""
 
 _CHUNK = 64
 """Sampled lines processed at once (memory: chunk × points × 3 floats)."""
@@ -182,6 +193,66 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     flip = np.sum(normals * towards, axis=1) < 0
     normals[flip] *= -1
     return points, normals, total - len(points)
+
+
+def complete_unseen(points, normals, viewpoint):
+    r"""The unseen side of a one-sided cloud, by point symmetry: an assumption.
+
+    **Assumption** (``plan_grasps(..., complete_unseen=False)`` turns it
+    off): the object is centrally symmetric about a centre ``c`` (a can, a
+    box, a bottle's body, a ball), so its unseen surface is the seen one
+    reflected through ``c``: points ``2c − p`` with normals ``−n``.  ``c`` is
+    the point nearest, in least squares, to every normal line ``p + t n``:
+
+    .. math::
+
+        c = \arg\min_c \sum_i \lVert (I - n_i n_i^\top)(c - p_i) \rVert^2,
+
+    the axis of a cylinder (its seen half's normals all cross it; along the
+    axis the mean of the points), the centre of a sphere, and of a box seen
+    with two faces.  Along a direction the normals leave undetermined
+    (eigenvalue of ``Σ(I − n nᵀ)/M`` below :data:`UNSEEN_WEAK`) ``c`` takes
+    the points' mean; when such a direction lies within
+    :data:`UNSEEN_DEPTH_ANGLE` of the line of sight (one face seen head-on:
+    its depth is unknown), nothing is completed.  Reflected points within one
+    spacing of a seen point (where the two halves meet) are dropped.
+
+    Parameters
+    ----------
+    points, normals : (M, 3) float
+        The seen cloud, world frame, outward unit normals (towards the camera).
+    viewpoint : (3,) float
+        The camera, world frame.
+
+    Returns
+    -------
+    added_points, added_normals : (K, 3) float
+        The reflected points and their outward normals, world frame (K = 0
+        when skipped).
+    info : dict
+        ``centre`` (3,) world frame or None, ``added`` K, and ``skipped``: the
+        reason it was skipped, or None.
+    """
+    points, normals = np.asarray(points, float), np.asarray(normals, float)
+    M = len(points)
+    mean = points.mean(axis=0)
+    A = np.eye(3) - normals.T @ normals / M
+    b = mean - normals.T @ np.sum(normals * points, axis=1) / M
+    evals, V = np.linalg.eigh(A)
+    strong = evals >= UNSEEN_WEAK
+    y = V.T @ b
+    centre = V @ np.where(strong, y / np.where(strong, evals, 1.0), V.T @ mean)
+    sight = centre - np.asarray(viewpoint, float)
+    sight /= np.linalg.norm(sight)
+    if np.any(~strong & (np.abs(V.T @ sight) > np.cos(UNSEEN_DEPTH_ANGLE))):
+        empty = np.zeros((0, 3))
+        info = {"centre": None, "added": 0, "skipped": "depth undetermined"}
+        return empty, empty, info
+    mirrored = 2 * centre - points
+    spacing = float(np.median(cKDTree(points).query(points, k=2)[0][:, 1]))
+    keep = cKDTree(points).query(mirrored)[0] > spacing
+    info = {"centre": centre, "added": int(keep.sum()), "skipped": None}
+    return mirrored[keep], -normals[keep], info
 
 
 class CloudSurface:

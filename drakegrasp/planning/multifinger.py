@@ -56,7 +56,7 @@ from drakegrasp.planning.candidates import (
     closing_order,
     planning_result,
 )
-from drakegrasp.planning.cloud import CONTACT_BAND, CloudSurface
+from drakegrasp.planning.cloud import CONTACT_BAND, CloudSurface, complete_unseen
 from drakegrasp.planning.cloud_hand import CloudHand
 from drakegrasp.planning.ranking import group_by_count, robustness, tie_key, verdicts
 from drakegrasp.planning.weight import weight_capacity
@@ -407,14 +407,18 @@ def plan_multifinger_cloud(
     plant, ctx, *, hand, points, normals, viewpoint, n, mu, rng, settings, t0,
     preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
     standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
-    progress=False, weight=float("nan"),
+    progress=False, weight=float("nan"), complete=True,
 ):  # fmt: skip
     """The multi-finger cloud route of :func:`~drakegrasp.planning.planner.plan_grasps`.
 
     Called by ``plan_grasps`` with the cloud read
     (:func:`~drakegrasp.planning.cloud.read_cloud`: world frame, outward unit
     normals) and the options checked (``settings``); ``weight`` is the
-    object's weight (N, NaN when unknown).  Returns its
+    object's weight (N, NaN when unknown).  With a ``viewpoint`` and
+    ``complete`` the unseen side is the seen one reflected through the
+    object's estimated centre (:func:`~drakegrasp.planning.cloud.complete_unseen`,
+    an assumption: a centrally symmetric object), and the hand may reach
+    around the object but not into it.  Returns its
     :class:`~drakegrasp.planning.candidates.GraspCandidates`.
     """
     tilt, hand_model = _checked_hand(
@@ -422,7 +426,15 @@ def plan_multifinger_cloud(
         preshape=preshape, synergy=synergy, synergy_range=synergy_range,
         approach=approach, standoff=standoff,
     )  # fmt: skip
-    surface = CloudSurface(points, normals, viewpoint=viewpoint)
+    completion = None
+    if viewpoint is not None and complete:
+        added, added_normals, completion = complete_unseen(points, normals, viewpoint)
+    if completion is not None and completion["skipped"] is None:
+        surface = CloudSurface(
+            np.vstack([points, added]), np.vstack([normals, added_normals])
+        )
+    else:
+        surface = CloudSurface(points, normals, viewpoint=viewpoint)
     X_WO = RigidTransform(surface.centroid)
     settings = {
         **settings,
@@ -431,13 +443,15 @@ def plan_multifinger_cloud(
         "min_fingers": int(min_fingers),
         "cloud_points": len(points),
         "contact_band": CONTACT_BAND,
+        "unseen_completion": completion,
     }
     torque_scale = surface.radius_about(np.zeros(3))
     poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
     saved = plant.GetPositions(ctx).copy()
     closer = CloudHand(
-        plant, ctx, hand_model, surface, settings["distance_tolerance"], min_fingers
-    )
+        plant, ctx, hand_model, surface, settings["distance_tolerance"], min_fingers,
+        completed=surface.viewpoint is None and completion is not None,
+    )  # fmt: skip
     try:
         kept, rejections, label = close_each(closer, poses, progress)
     finally:

@@ -146,6 +146,7 @@ def plan_grasps(
     point_cloud=None,
     cloud_normals=None,
     viewpoint=None,
+    complete_unseen: bool = True,
     object_mass: float | None = None,
     preshape=None,
     synergy=None,
@@ -227,6 +228,11 @@ def plan_grasps(
     viewpoint : (3,) float, optional
         Where the cloud was seen from (normals are turned towards it); default
         normals point away from the cloud's centroid.
+    complete_unseen : bool, optional
+        Multi-finger hands with a ``viewpoint``: assume the object centrally
+        symmetric and complete its unseen side by reflecting the seen one
+        (:func:`~drakegrasp.planning.cloud.complete_unseen`), so the hand may
+        wrap around it; ``False`` keeps the hand on the seen side.
     object_mass : float, optional
         The object's mass (kg) for ``squeeze_needed``; default the body's mass
         (a cloud has none: NaN).
@@ -328,6 +334,7 @@ def plan_grasps(
                 synergy_range=synergy_range, approach=approach, standoff=standoff,
                 tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY,
+                complete=bool(complete_unseen),
             )  # fmt: skip
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface = CloudSurface(points, normals, viewpoint=viewpoint)

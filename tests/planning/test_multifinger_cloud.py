@@ -24,7 +24,8 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.planning import plan_grasps, planning_scene
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.cloud import complete_unseen
 from drakegrasp.planning.cloud_hand import REASONS, signed_distances
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
 from drakegrasp.plant.contacts import find_contacts
@@ -276,6 +277,9 @@ def test_hostile_clouds(can):
     result = _plan(hand, holes, nrm, n=10)
     assert result.settings["cloud_dropped"] == len(p[::10])
     assert len(result) + sum(result.rejections.values()) == 10
+    # every point twice (a merged scan): spacing 0, surfels of radius 0
+    doubled = _plan(hand, np.vstack([p, p]), np.vstack([nrm, nrm]), n=10)
+    assert len(doubled) + sum(doubled.rejections.values()) == 10
     empty = _plan(hand, p, nrm, n=0)
     assert len(empty) == 0 and "num_candidates is 0" in empty.reason
     # the palm held 0.3-0.4 m off the can: no finger reaches it
@@ -475,3 +479,97 @@ def test_bad_options_on_a_cloud(coupled, bad, match):
             plant, root, None, hand=hand, mu=MU, point_cloud=p, cloud_normals=nrm,
             **kw,
         )  # fmt: skip
+
+
+# Revolute fingers: the squeeze is a joint torque (N·m) and the gains per radian.
+ALLEGRO_SHAKE = dict(squeeze=0.5, stiffness=20.0, damping=1.0)
+
+
+def _true_pose(full):
+    """The true can's pose in the world (the cloud's frame O is its centroid)."""
+    ctx = full.plant.GetMyContextFromRoot(full.context)
+    return full.plant.EvalBodyPoseInWorld(ctx, full.object_body)
+
+
+def test_one_sided_cloud_grasps_hold_the_true_can(can):
+    """The five best of a one-sided cloud's candidates hold the true can in
+    Drake (shake_test at the can's real pose).  Measured
+    (benchmarks/bench_cloud_hold.py, 300 samples, seed 0): the ten best held
+    7/10 and ten random candidates 4/10; these five held 5/5 (seeds 1 and 2:
+    2/10 and 7/10).  Before the unseen side was completed (the hand kept on
+    the seen side) none of the ten best held at seed 0."""
+    full, hand, _, (p, nrm) = can
+    result = plan_grasps(
+        hand.plant, hand.context, None, hand=hand.hand, num_candidates=300,
+        mu=MU, seed=0, point_cloud=p, cloud_normals=nrm, viewpoint=VIEW,
+    )  # fmt: skip
+    completion = result.settings["unseen_completion"]
+    assert completion["skipped"] is None and completion["added"] > 0
+    # the centre the normal lines meet is the can's axis (x = z = 0)
+    assert np.hypot(completion["centre"][0], completion["centre"][2]) < 1e-3
+    held = [
+        shake_test(full.add_models, c, X_WO=_true_pose(full), **ALLEGRO_SHAKE).held
+        for c in result[:5]
+    ]
+    assert sum(held) >= 4, held
+
+
+def test_full_cloud_grasps_hold_the_true_can(can):
+    """The ten best of a full cloud's candidates hold the true can at least 8
+    times in 10 (issue 18's target).  Measured (benchmarks/bench_cloud_hold.py,
+    300 samples, seed 0): 8/10, ten random candidates 2/10.  A regression
+    guard on one draw: seeds 1 and 2 held 2/10 and 6/10 (the planning
+    guide's table)."""
+    full, hand, (p, nrm), _ = can
+    result = plan_grasps(
+        hand.plant, hand.context, None, hand=hand.hand, num_candidates=300,
+        mu=MU, seed=0, point_cloud=p, cloud_normals=nrm,
+    )  # fmt: skip
+    assert result.settings["unseen_completion"] is None  # no viewpoint
+    held = [
+        shake_test(full.add_models, c, X_WO=_true_pose(full), **ALLEGRO_SHAKE).held
+        for c in result[:10]
+    ]
+    assert sum(held) >= 8, held
+
+
+def _hemisphere(centre, n=800, seed=0):
+    u = np.random.default_rng(seed).standard_normal((n, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    u[:, 0] = np.abs(u[:, 0])  # the half facing a camera on +x
+    return centre + 0.04 * u, u
+
+
+@pytest.mark.parametrize("centre", [[0.0, 0.0, 0.0], [0.3, -0.2, 0.5]])
+def test_completion_reflects_a_hemisphere_through_the_sphere_centre(centre):
+    """Every normal line of a sphere meets its centre: the completion finds it
+    (to round-off) wherever the sphere is, and adds the far half."""
+    centre = np.array(centre)
+    p, n = _hemisphere(centre)
+    added, added_n, info = complete_unseen(p, n, centre + [0.5, 0.0, 0.0])
+    assert info["skipped"] is None
+    np.testing.assert_allclose(info["centre"], centre, atol=1e-12)
+    assert len(added) > 0.9 * len(p) and np.all(added[:, 0] <= centre[0] + 1e-3)
+    # the added points lie on the sphere, with its outward normals
+    r = added - centre
+    np.testing.assert_allclose(np.linalg.norm(r, axis=1), 0.04, atol=1e-12)
+    np.testing.assert_allclose(added_n, r / 0.04, atol=1e-12)
+
+
+def test_completion_is_skipped_for_a_face_seen_head_on():
+    """A flat face seen head-on tells nothing of the depth: nothing is added."""
+    g = np.random.default_rng(1).uniform(-0.03, 0.03, (400, 2))
+    p = np.column_stack([np.full(len(g), 0.02), g])
+    n = np.tile([1.0, 0.0, 0.0], (len(g), 1))
+    added, _, info = complete_unseen(p, n, [0.5, 0.0, 0.0])
+    assert len(added) == 0 and info["skipped"] == "depth undetermined"
+
+
+def test_completion_can_be_turned_off(can, partial_result):
+    """complete_unseen=False keeps the hand on the seen side (the shadow test)."""
+    _, hand, _, (p, nrm) = can
+    off = _plan(hand, p, nrm, n=100, viewpoint=VIEW, complete_unseen=False)
+    assert off.settings["unseen_completion"] is None
+    assert partial_result.settings["unseen_completion"]["added"] > 0
+    assert off.rejections["hand enters the unseen side"] > 0
+    assert {c.sample for c in off} != {c.sample for c in partial_result}

@@ -1,0 +1,160 @@
+"""How often the Allegro hand's point-cloud grasps hold the YCB soup can.
+
+Usage::
+
+    python benchmarks/bench_cloud_hold.py [--num 300] [--points 3000] [--top 10]
+        [--random 10] [--seed 0] [--clouds full one-sided] [--verbose]
+
+The multi-finger cloud route of :func:`drakegrasp.plan_grasps` (Drake's
+Allegro hand, thumb opposed, free base) on two clouds sampled from the soup
+can's collision geometry (``--points`` area-uniform points, seed 0, as
+``tests/planning/cloud_support.py`` samples them):
+
+* **full**: every point, normals given;
+* **one-sided**: the points a camera at ``(0.5, 0, 0)`` m sees (normals
+  facing it), planned with ``viewpoint=`` the camera.
+
+For each cloud it prints the candidates (of ``--num`` sampled poses), how many
+are force closure, and the hold rates in Drake
+(:func:`drakegrasp.shake_test` on the true can, ``X_WO`` its real pose, the
+Allegro's revolute fingers at 0.5 N·m, PD gains 20 N·m/rad and 1 N·m·s/rad)
+of the ``--top`` best candidates and of ``--random`` candidates drawn
+uniformly (seeded) from all of them, as held / tried.  ``--verbose`` prints
+each shaken candidate's largest displacement and rotation and its contacts
+per finger.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from drakegrasp.planning import object_surface, plan_grasps, planning_scene, shake_test
+
+ROOT = Path(__file__).resolve().parents[1]
+ALLEGRO = (
+    "package://drake_models/allegro_hand_description/sdf/"
+    "allegro_hand_description_right.sdf"
+)
+CAN = "package://drake_models/ycb/005_tomato_soup_can.sdf"
+VIEW = np.array([0.5, 0.0, 0.0])
+SHAKE = dict(squeeze=0.5, stiffness=20.0, damping=1.0)
+
+
+def drake_models() -> Path | None:
+    for p in (
+        os.environ.get("DRAKEGRASP_DRAKE_MODELS"),
+        ROOT.parent / "shared" / "drake_models",
+    ):
+        if p and Path(p).is_dir():
+            return Path(p)
+    return None
+
+
+def allegro_scene(models, object_url=None):
+    """A planning scene with the Allegro hand (thumb opposed), the can optional."""
+    scene = planning_scene(object_url, hand_url=ALLEGRO, models_dir=models)
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    scene.plant.GetJointByName("joint_12").set_angle(ctx, 1.0)
+    return scene
+
+
+def sample_cloud(full, n, seed=0, view=None):
+    """``(points, normals)`` on the can, world frame; ``view``: the seen ones."""
+    surface = object_surface(full.plant, full.context, full.object_body)
+    p, nrm, _ = surface.sample(n, np.random.default_rng(seed))
+    if view is not None:
+        seen = np.sum(nrm * (np.asarray(view) - p), axis=1) > 0
+        p, nrm = p[seen], nrm[seen]
+    return p, nrm
+
+
+def _describe(c, s) -> str:
+    fingers = Counter(k.finger_body.split("::")[-1] for k in c.contacts)
+    return (
+        f"      #{c.sample:<4} score {c.score:8.4f} rho {c.robustness:4.2f} "
+        f"{'held' if s.held else 'fell'}: {s.max_displacement * 1e3:6.1f} mm "
+        f"{np.degrees(s.max_rotation):6.1f} deg  contacts {dict(fingers)}"
+    )
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--num", type=int, default=300)
+    parser.add_argument("--points", type=int, default=3000)
+    parser.add_argument("--top", type=int, default=10)
+    parser.add_argument("--random", type=int, default=10)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--clouds", nargs="+", default=["full", "one-sided"],
+        choices=["full", "one-sided"],
+    )  # fmt: skip
+    parser.add_argument("--verbose", action="store_true")
+    args = parser.parse_args(argv)
+    models = drake_models()
+    if models is None:
+        print("drake_models not found (set DRAKEGRASP_DRAKE_MODELS)")
+        return 1
+    full = allegro_scene(models, CAN)
+    hand = allegro_scene(models)
+    X_WO = full.plant.EvalBodyPoseInWorld(
+        full.plant.GetMyContextFromRoot(full.context), full.object_body
+    )
+    print(
+        f"load {os.getloadavg()[0]:.2f}; Allegro on the YCB soup can, "
+        f"{args.points} points, {args.num} samples, seed {args.seed}"
+    )
+    print(
+        f"{'cloud':<10} {'points':>6} {'cands':>6} {'FC':>4} {'plan s':>7}"
+        f" {'top':>6} {'random':>7} {'shake s':>8}"
+    )
+    for name in args.clouds:
+        view = VIEW if name == "one-sided" else None
+        p, nrm = sample_cloud(full, args.points, 0, view)
+        t = time.perf_counter()
+        result = plan_grasps(
+            hand.plant, hand.context, None, hand=hand.hand,
+            num_candidates=args.num, mu=1.0, seed=args.seed, point_cloud=p,
+            cloud_normals=nrm, viewpoint=view,
+        )  # fmt: skip
+        plan_s = time.perf_counter() - t
+        pick = np.random.default_rng(args.seed).choice(
+            len(result), size=min(args.random, len(result)), replace=False
+        )
+        top = list(result[: args.top])
+        rand = [result[int(i)] for i in pick]
+        t = time.perf_counter()
+        shaken = []
+        for group in (top, rand):
+            shaken.append(
+                [shake_test(full.add_models, c, X_WO=X_WO, **SHAKE) for c in group]
+            )
+        shake_s = time.perf_counter() - t
+        held = [sum(s.held for s in g) for g in shaken]
+        fc = sum(c.is_closure for c in result)
+        print(
+            f"{name:<10} {len(p):>6} {len(result):>6} {fc:>4} {plan_s:>7.1f}"
+            f" {f'{held[0]}/{len(top)}':>6} {f'{held[1]}/{len(rand)}':>7}"
+            f" {shake_s:>8.1f}",
+            flush=True,
+        )
+        print(f"    rejections: {dict(result.rejections)}")
+        if args.verbose:
+            for label, group, shakes in (
+                ("top", top, shaken[0]),
+                ("random", rand, shaken[1]),
+            ):
+                print(f"    {label}:")
+                for c, s in zip(group, shakes, strict=True):
+                    print(_describe(c, s))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
