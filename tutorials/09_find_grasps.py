@@ -243,9 +243,13 @@ print(f"random (#{pick}):", dg.shake_test(can.add_models, allegro[pick], **shake
 # cloud with normals.  Here a camera on +x sees the near half of the can
 # (points sampled on its collision geometry, kept where they face the camera).
 # The approaches come from the seen points; each finger closes until it
-# reaches the cloud; the contacts are the cloud points it touches, with the
-# cloud's normals.  With `viewpoint=`, a hand that reaches behind the seen
-# surface (where the unseen half of the can may be) is rejected.
+# reaches the cloud's surface (each point a small tangent disc); the contacts
+# are the cloud points it touches, with the cloud's normals (the finger's own
+# normal on an edge).  With `viewpoint=`, the unseen half is filled in by an
+# assumption, stated and switchable: the object is symmetric about the centre
+# its seen normals point to (the axis, for a can).  The hand may then wrap
+# around the can but not enter it; `complete_unseen=False` drops the
+# assumption, and a hand that reaches behind the seen surface is rejected.
 
 # %%
 from drakegrasp.planning import object_surface  # noqa: E402
