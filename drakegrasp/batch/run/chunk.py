@@ -52,9 +52,7 @@ from drakegrasp.batch.inputs import (
 )
 from drakegrasp.batch.lp.dstar import solve_margin_blocks
 from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
-from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
@@ -62,7 +60,6 @@ __all__ = [
     "finish",
     "force_chunk",
     "force_task",
-    "force_verdicts",
     "form_chunk",
     "form_task",
 ]
@@ -279,9 +276,9 @@ def force_chunk(
     model, num_generators, tol, rank_tol, metrics, kernel
         As in :func:`drakegrasp.batch.batch_force_closure`.
     verdict_only : bool, optional
-        Internal (:func:`force_verdicts`): each LP stops once its verdict is
-        proved, so ``is_closure`` is exact but ``d_star`` and ``margin`` are
-        only bounds on the right side of ``tol``.
+        Internal (:func:`~drakegrasp.batch.run.verdicts.force_verdicts`): each
+        LP stops once its verdict is proved, so ``is_closure`` is exact but
+        ``d_star`` and ``margin`` are only bounds on the right side of ``tol``.
 
     Returns
     -------
@@ -455,60 +452,3 @@ def form_task(positions, reference_points, characteristic_lengths, tol, rank_tol
         return form_chunk, (P, Nrm, p, b), options
 
     return task, options
-
-
-def force_verdicts(
-    positions,
-    normals,
-    *,
-    mu,
-    contact_model="hard_finger",
-    torsional_friction=None,
-    num_generators: int = 8,
-    workers=None,
-    tol: float = DEFAULT_TOL,
-    rank_tol: float = DEFAULT_RANK_TOL,
-    kernel: str = "auto",
-) -> np.ndarray:
-    """``is_closure`` of LP2 for ``K`` grasps of ``N`` contacts, verdicts only.
-
-    Internal, for counts of verdicts (:func:`drakegrasp.planning.ranking.robustness`
-    and :func:`drakegrasp.planning.reclose.reclosed_robustness`): the same
-    validation, chunks, workers and rules as
-    :func:`drakegrasp.batch.batch_force_closure` (rank, normal-force
-    certificate), whose ``is_closure`` it returns, but each LP stops as soon
-    as its verdict is proved either way (a feasible point above the
-    threshold, a dual bound below it, a rank-deficient ``G``: see
-    :func:`drakegrasp.batch.lp.dstar.solve_margin_blocks`'s ``verdict_tol``).
-
-    Parameters
-    ----------
-    positions, normals : (K, N, d) float
-        Contact points (metres) and unit inward normals, one frame per grasp.
-    mu, contact_model, torsional_friction, num_generators
-        As :func:`drakegrasp.batch.batch_force_closure`.
-    workers, tol, rank_tol, kernel
-        As :func:`drakegrasp.batch.batch_force_closure`.
-
-    Returns
-    -------
-    (K,) bool
-    """
-    K = shape_of("positions", positions)[0]
-    task, options = force_task(
-        positions, mu, contact_model, num_generators, torsional_friction, None,
-        None, tol, rank_tol, (), kernel,
-    )  # fmt: skip
-
-    def verdict_task(P, Nrm, sl):
-        fn, args, opts = task(P, Nrm, sl)
-        return fn, args, {**opts, "verdict_only": True}
-
-    out = np.zeros(K, dtype=bool)
-    for sl, arrays in stream(
-        positions, normals, kind="force", task=verdict_task,
-        chunk_size=DEFAULT_CHUNK_SIZE,
-        progress=False, workers=workers, n_g=options["num_generators"],
-    ):  # fmt: skip
-        out[sl] = arrays["is_closure"]
-    return out
