@@ -39,6 +39,7 @@ import warnings
 from drakegrasp.batch import aot
 
 __all__ = [
+    "FASTMATH",
     "AVAILABLE",
     "PROGRESS_EVERY",
     "Kernel",
@@ -49,6 +50,14 @@ __all__ = [
     "njit",
     "quiet_notice",
 ]
+
+FASTMATH = False
+"""The LP kernels' ``fastmath`` flag: off.  With ``contract`` (FMA) or ``reassoc``
+the rounding of the compiled code depended on how numba compiled it (fresh in
+this process, with the callees inlined, or loaded from its on-disk cache), so a
+cold cache gave results that differed in the last bit between the local engine,
+its worker processes and Dask workers.  IEEE arithmetic keeps them bitwise
+equal."""
 
 PROGRESS_EVERY = 5.0
 """Seconds between progress lines of a long compile (stderr)."""

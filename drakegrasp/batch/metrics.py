@@ -12,6 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from drakegrasp.core.tolerances import L1_MAX_POINTS
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -99,8 +100,6 @@ def epsilon_l1_per_grasp(
 
 
 def _check_point_count(W_counts: np.ndarray) -> None:
-    from drakegrasp.quality.epsilon import L1_MAX_POINTS
-
     if W_counts.size and int(W_counts.max()) > L1_MAX_POINTS:
         raise InvalidOptionError(
             f"the Ferrari–Canny metric of a grasp here needs the hull of "

@@ -18,6 +18,7 @@ from drakegrasp.core.friction_cone import (
     friction_cone_generators,
 )
 from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.tolerances import L1_MAX_POINTS
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidOptionError, SolverError
 from drakegrasp.quality._common import (
@@ -43,15 +44,6 @@ HULL_TOL = 1e-9
 
 LINF_MAX_CANDIDATES = 2_000_000
 """Most candidate facet normals the L∞ ε may test (about 6 s per million)."""
-
-L1_MAX_POINTS = 2_000
-"""Most primitive wrenches whose hull the L1 ε may build.
-
-A 6-D hull's facets grow about linearly with its points here: 2,000 points
-(250 spatial hard fingers with 8 generators) make about 230,000 facets and
-take about 9 s; 8,000 points (1,000 fingers) took 150 s, and a facet check on
-them once asked for 57 GiB.  Beyond this bound ε is refused, not attempted.
-"""
 
 _NORMS = ("L1", "Linf")
 
@@ -576,7 +568,8 @@ def ferrari_canny(
     (166,188); five need 1.8 million candidates (about 15 s).  Grasps that
     need more than ``LINF_MAX_CANDIDATES`` (six hard fingers do) raise
     :class:`~drakegrasp.InvalidOptionError`, checked before any enumeration,
-    and so do grasps with more than :data:`L1_MAX_POINTS` primitive wrenches
+    and so do grasps with more than
+    :data:`~drakegrasp.core.tolerances.L1_MAX_POINTS` primitive wrenches
     (either norm).
     """
     if not isinstance(norm, str) or norm not in _NORMS:

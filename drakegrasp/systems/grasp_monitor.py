@@ -74,7 +74,7 @@ def epsilon_l1(grasp, *, num_generators: int) -> float:
     facets near the origin are built, about 1 ms for 8 contacts where Qhull's
     whole hull takes 20-30 ms.  Its answer agrees with Qhull's to about 1e-13
     relative; a grasp the kernel flags (round-off could spoil it), a grasp
-    past :data:`~drakegrasp.quality.epsilon.L1_MAX_POINTS` wrenches, or an
+    past :data:`~drakegrasp.core.tolerances.L1_MAX_POINTS` wrenches, or an
     install without numba takes :func:`~drakegrasp.quality.ferrari_canny`.
     The kernel compiles on first use unless ``drakegrasp warmup`` ran.
     """

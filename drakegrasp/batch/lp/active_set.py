@@ -44,8 +44,7 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.compiled import njit
-from drakegrasp.batch.lp.block_ops import _FAST
+from drakegrasp.batch.compiled import FASTMATH, njit
 from drakegrasp.batch.lp.householder import _qr, _reflect
 from drakegrasp.errors import InvalidOptionError
 
@@ -90,7 +89,7 @@ def active_set_work(nz, R):
     return BT, V, beta, y, d, mu, v, slack, gnorm, rates, active, inW
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _project(AT, nz, ct, active, k, BT, V, beta, y, d, mu):
     """QR of the ``k`` active gradients, the projected ``e_t`` and the multipliers.
 
@@ -130,7 +129,7 @@ def _project(AT, nz, ct, active, k, BT, V, beta, y, d, mu):
     return math.sqrt(norm)
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _active_set(AT, nz, R, ct, cn2, max_iter, work):
     """``(t*, ok, steps)`` of the reduced LP; ``AT`` (nz, R) holds the ``a_j``."""
     BT, V, beta, y, d, mu, v, slack, gnorm, rates, active, inW = work
@@ -221,13 +220,13 @@ def _active_set(AT, nz, R, ct, cn2, max_iter, work):
     return t, lo >= -_FEAS_TOL * max(1.0, scale), steps
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _cross2(bx, by, i, j):
     """``β_i × β_j`` (the z component of the 2-D cross product)."""
     return bx[i] * by[j] - by[i] * bx[j]
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _plane_lp(AT, R, ct, cn2, al, bx, by, max_iter):
     """:func:`_active_set` for ``nz = 3``, in the plane ``c̃ᵀv = 1``.
 
@@ -349,7 +348,7 @@ def _plane_lp(AT, R, ct, cn2, al, bx, by, max_iter):
     return t, lo >= -_FEAS_TOL * max(1.0, scale), steps
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def reduced_lp(AT, nz, R, ct, cn2, max_iter, work):
     """``(t*, ok, steps)`` by :func:`_plane_lp` (``nz = 3``) or :func:`_active_set`."""
     if nz == 3:  # the planar form's α, β_x, β_y live in three R-long work rows

@@ -19,9 +19,8 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.compiled import AVAILABLE, njit
+from drakegrasp.batch.compiled import AVAILABLE, FASTMATH, njit
 from drakegrasp.batch.lp.block_ops import (
-    _FAST,
     _chol,
     _cmul,
     _ctmul,
@@ -42,7 +41,7 @@ _STEP = 0.9995
 _FLOOR = 0.1
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_stop,
          above, wr, wm, we, WT, Hs, S):  # fmt: skip
     """Solve one problem from ``f`` (which satisfies ``A f = b``); work arrays given.
@@ -241,7 +240,7 @@ def _one(F, A, kap, f, coff, ncomp, foff, nrow, roff, tol, max_iter, stop, use_s
     return t, False, False, max_iter
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _proves_above(F, A, g, t, ah, coff, ncomp, foff, nrow, roff, f, Cf):
     """``min C f`` of the iterate ``f = g + t â`` made exactly feasible, or -inf.
 
@@ -290,7 +289,7 @@ def work_arrays(R, M, e, N):
 
 @njit(
     cache=True,
-    fastmath=_FAST,
+    fastmath=FASTMATH,
     error_model="numpy",
     entry=(
         "f8[:, ::1], b1, f8[:, :, ::1], f8[:, ::1], f8[:, ::1], "

@@ -14,21 +14,15 @@ from __future__ import annotations
 
 import math
 
-from drakegrasp.batch.compiled import njit
+from drakegrasp.batch.compiled import FASTMATH, njit
 
 __all__: list[str] = []  # helpers of the compiled kernels only
 
-# No fast-math: with ``contract`` (FMA) or ``reassoc`` the rounding of the
-# compiled code depended on how numba compiled it (fresh in this process, with
-# the callees inlined, or loaded from its on-disk cache), so a cold cache gave
-# results that differed in the last bit between the local engine, its worker
-# processes and Dask workers.  IEEE arithmetic keeps them bitwise equal.
-_FAST = False
 # error_model="numpy": x / 0 gives inf or NaN (IEEE) instead of raising; every
 # such value is caught by the tests it feeds (isfinite, comparisons).
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _chol3(H, i):
     """:func:`_chol` unrolled for the 3 × 3 blocks of spatial hard fingers."""
     h00, h10, h11, h20, h21, h22 = (
@@ -45,7 +39,7 @@ def _chol3(H, i):
     H[i, 2, 0], H[i, 2, 1], H[i, 2, 2] = l20, l21, d2
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _solve3(L, i, b, off):
     """:func:`_solve` unrolled for 3 × 3 blocks."""
     d0, l10, d1, l20, l21, d2 = (
@@ -60,7 +54,7 @@ def _solve3(L, i, b, off):
     b[off], b[off + 1], b[off + 2] = x0, x1, x2
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _solve3_rows(L, i, A, WT, c0, e):
     """``WT[:, c0:c0 + 3] = (L_i L_iᵀ)⁻¹ A[:, c0:c0 + 3]ᵀ`` row by row."""
     d0, l10, d1, l20, l21, d2 = (
@@ -77,7 +71,7 @@ def _solve3_rows(L, i, A, WT, c0, e):
         WT[j, c0] = (x0 - l10 * x1 - l20 * x2) * d0
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _solve_rows(L, i, n, A, WT, c0, e):
     """:func:`_solve3_rows` for blocks of any size ``n``."""
     for j in range(e):
@@ -93,7 +87,7 @@ def _solve_rows(L, i, n, A, WT, c0, e):
             WT[j, c0 + r] = acc * L[i, r, r]
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _gram3(F, o, nr, D, r0, H, i):
     """Lower triangle of ``C_iᵀ diag(D_i) C_i`` for 3 components, into H[i]."""
     h00 = h10 = h11 = h20 = h21 = h22 = 0.0
@@ -112,7 +106,7 @@ def _gram3(F, o, nr, D, r0, H, i):
     H[i, 2, 0], H[i, 2, 1], H[i, 2, 2] = h20, h21, h22
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _gram4(F, o, nr, D, r0, H, i):
     """:func:`_gram3` for the 4 components of soft fingers."""
     h00 = h10 = h11 = h20 = h21 = h22 = h30 = h31 = h32 = h33 = 0.0
@@ -136,7 +130,7 @@ def _gram4(F, o, nr, D, r0, H, i):
     H[i, 3, 0], H[i, 3, 1], H[i, 3, 2], H[i, 3, 3] = h30, h31, h32, h33
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _chol(H, i, n):
     """In-place lower Cholesky of H[i, :n, :n]; the diagonal holds 1/L_jj."""
     if n == 3:
@@ -159,7 +153,7 @@ def _chol(H, i, n):
             H[i, r, j] = s * inv
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _solve(L, i, n, b, off):
     """In-place solve of ``L_i L_iᵀ z = b[off:off + n]``, factors from :func:`_chol`."""
     if n == 3:
@@ -177,7 +171,7 @@ def _solve(L, i, n, b, off):
         b[off + r] = acc * L[i, r, r]
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _cmul(F, foff, nrow, ncomp, roff, coff, N, f, out):
     """Out = C f (block-diagonal facets)."""
     for i in range(N):
@@ -201,7 +195,7 @@ def _cmul(F, foff, nrow, ncomp, roff, coff, N, f, out):
             out[r0 + r] = acc
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _ctmul(F, foff, nrow, ncomp, roff, coff, N, v, out):
     """Out = Cᵀ v."""
     for i in range(N):
@@ -234,7 +228,7 @@ def _ctmul(F, foff, nrow, ncomp, roff, coff, N, v, out):
             out[c0 + c] = acc
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _dot(x, y, n):
     acc = 0.0
     for m in range(n):
@@ -242,7 +236,7 @@ def _dot(x, y, n):
     return acc
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _dotrow(A, i, y, n):
     """``A[i, :n] · y[:n]`` without forming the row view."""
     acc = 0.0
@@ -251,7 +245,7 @@ def _dotrow(A, i, y, n):
     return acc
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _dot2(A, i, B, b, n):
     """``A[i, :n] · B[b, :n]``."""
     acc = 0.0
@@ -260,7 +254,7 @@ def _dot2(A, i, B, b, n):
     return acc
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _max_step(vinv, dv, R):
     """``max(0, max_j -dv_j / v_j)`` given ``1 / v``."""
     q = 0.0

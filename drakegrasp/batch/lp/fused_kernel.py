@@ -33,10 +33,10 @@ import math
 
 import numpy as np
 
-from drakegrasp.batch.compiled import njit
+from drakegrasp.batch.compiled import FASTMATH, njit
 from drakegrasp.batch.lp.active_set import active_set_work, reduced_lp, worth_it
 from drakegrasp.batch.lp.block_kernel import _one, flat_facets, work_arrays
-from drakegrasp.batch.lp.block_ops import _FAST, _cmul
+from drakegrasp.batch.lp.block_ops import _cmul
 from drakegrasp.batch.lp.householder import _qr, _reflect
 
 __all__ = ["full_column_rank_certain", "solve_full_rank_stack"]
@@ -44,7 +44,7 @@ __all__ = ["full_column_rank_certain", "solve_full_rank_stack"]
 _PUSH_TOL = 1e-10  # as drakegrasp.batch.lp.dstar
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _certain(XT, cols, fro, rank_tol, RI):
     """Whether ``R`` (from :func:`_qr`) certifies full column rank.
 
@@ -71,7 +71,7 @@ def _certain(XT, cols, fro, rank_tol, RI):
 
 @njit(
     cache=True,
-    fastmath=_FAST,
+    fastmath=FASTMATH,
     error_model="numpy",
     entry="f8[:, :, ::1], f8, b1[::1]",
 )
@@ -103,7 +103,7 @@ def full_column_rank_certain(Gn: np.ndarray, rank_tol: float) -> np.ndarray:
 
 @njit(
     cache=True,
-    fastmath=_FAST,
+    fastmath=FASTMATH,
     error_model="numpy",
     entry=(
         "f8[:, :, ::1], i8[::1], f8, f8[:, ::1], b1, f8[:, ::1], "

@@ -11,13 +11,12 @@ from __future__ import annotations
 
 import math
 
-from drakegrasp.batch.compiled import njit
-from drakegrasp.batch.lp.block_ops import _FAST
+from drakegrasp.batch.compiled import FASTMATH, njit
 
 __all__: list[str] = []  # helpers of the compiled kernels only
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _qr(XT, rows, cols, V, beta):
     """Householder QR of ``X`` (rows × cols, rows >= cols) stored transposed.
 
@@ -44,7 +43,7 @@ def _qr(XT, rows, cols, V, beta):
     return math.sqrt(fro)
 
 
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _reflect(V, j, b, Y, r, n):
     """Apply reflector ``j`` (``I - b v vᵀ``, ``v = V[j, j:n]``) to ``Y[r, j:n]``."""
     acc = 0.0
