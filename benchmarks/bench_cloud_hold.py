@@ -37,7 +37,9 @@ import numpy as np
 
 from drakegrasp.planning import object_surface, plan_grasps, planning_scene, shake_test
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_plan import drake_models  # noqa: E402  (the same local copy)
+
 ALLEGRO = (
     "package://drake_models/allegro_hand_description/sdf/"
     "allegro_hand_description_right.sdf"
@@ -45,16 +47,6 @@ ALLEGRO = (
 CAN = "package://drake_models/ycb/005_tomato_soup_can.sdf"
 VIEW = np.array([0.5, 0.0, 0.0])
 SHAKE = dict(squeeze=0.5, stiffness=20.0, damping=1.0)
-
-
-def drake_models() -> Path | None:
-    for p in (
-        os.environ.get("DRAKEGRASP_DRAKE_MODELS"),
-        ROOT.parent / "shared" / "drake_models",
-    ):
-        if p and Path(p).is_dir():
-            return Path(p)
-    return None
 
 
 def allegro_scene(models, object_url=None):

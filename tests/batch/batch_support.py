@@ -73,3 +73,32 @@ def scipy_form_closure(grasp):
     Gn = normal_grasp_matrix(grasp)
     N = grasp.num_contacts
     return _lp_margin(Gn, np.eye(N), list(range(N)), N), _rank(Gn)
+
+
+def degenerate_families(rng, K, *, spread=0.4):
+    """``[(name, P, Nrm, mu)]``: ``K`` grasps of four spatial contacts per family.
+
+    The degeneracies the batch LPs must survive: a tiny and a huge ``mu``, a
+    duplicated contact, metres scaled by 1e±3, coplanar and collinear points,
+    all contacts at one point, normals exactly inward.
+    """
+    P, Nrm = random_grasps(rng, K, 4, 3, spread=spread)
+    dup_P, dup_N = P.copy(), Nrm.copy()
+    dup_P[:, 3], dup_N[:, 3] = P[:, 0], Nrm[:, 0]
+    flat = P.copy()
+    flat[:, :, 2] = 0.0
+    line = np.zeros_like(P)
+    line[:, :, 0] = rng.normal(size=(K, 4))
+    one_point = np.repeat(P[:, :1], 4, axis=1)
+    exact_P, exact_N = random_grasps(rng, K, 4, 3, spread=0.0)
+    return [
+        ("tiny mu", P, Nrm, 1e-6),
+        ("huge mu", P, Nrm, 50.0),
+        ("duplicate contact", dup_P, dup_N, 0.5),
+        ("metres x1e3", 1e3 * P, Nrm, 0.5),
+        ("metres x1e-3", 1e-3 * P, Nrm, 0.5),
+        ("coplanar points", flat, Nrm, 0.5),
+        ("collinear points", line, Nrm, 0.5),
+        ("all at one point", one_point, Nrm, 0.5),
+        ("exactly inward", exact_P, exact_N, 0.2),
+    ]

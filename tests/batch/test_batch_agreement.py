@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from batch_support import (
+    degenerate_families,
     make_grasp,
     random_grasps,
     scipy_force_closure,
@@ -152,33 +153,9 @@ def test_form_closure_matches_highs_planar():
     assert 0 < verdict.sum() < K
 
 
-def _edge_cases(rng):
-    K = 40
-    P, Nrm = random_grasps(rng, K, 4, 3)
-    dup_P, dup_N = P.copy(), Nrm.copy()
-    dup_P[:, 3], dup_N[:, 3] = P[:, 0], Nrm[:, 0]
-    flat = P.copy()
-    flat[:, :, 2] = 0.0
-    line = np.zeros_like(P)
-    line[:, :, 0] = rng.normal(size=(K, 4))
-    one_point = np.repeat(P[:, :1], 4, axis=1)
-    exact_P, exact_N = random_grasps(rng, K, 4, 3, spread=0.0)
-    return [
-        ("tiny mu", P, Nrm, 1e-6),
-        ("huge mu", P, Nrm, 50.0),
-        ("duplicate contact", dup_P, dup_N, 0.5),
-        ("metres x1e3", 1e3 * P, Nrm, 0.5),
-        ("metres x1e-3", 1e-3 * P, Nrm, 0.5),
-        ("coplanar points", flat, Nrm, 0.5),
-        ("collinear points", line, Nrm, 0.5),
-        ("all at one point", one_point, Nrm, 0.5),
-        ("exactly inward", exact_P, exact_N, 0.2),
-    ]
-
-
 def test_degenerate_and_badly_scaled_grasps_match_highs():
     rng = np.random.default_rng(5000)
-    for what, P, Nrm, mu in _edge_cases(rng):
+    for what, P, Nrm, mu in degenerate_families(rng, 40):
         K, N, _ = P.shape
         batch = batch_force_closure(P, Nrm, mu=mu)
         refs = [scipy_force_closure(make_grasp(P[k], Nrm[k], mu)) for k in range(K)]

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from batch_support import random_grasps
+from batch_support import degenerate_families, random_grasps
 
 from drakegrasp.batch import batch_force_closure
 from drakegrasp.batch.build.construction import SPATIAL_HARD, kind_facets
@@ -78,29 +78,9 @@ def test_verdicts_equal_the_full_solve_on_random_grasps(N, d, model, K, spread, 
 
 
 def _degenerate(rng):
-    K = 60
-    P, Nrm = random_grasps(rng, K, 4, 3, spread=0.3)
-    dup_P, dup_N = P.copy(), Nrm.copy()
-    dup_P[:, 3], dup_N[:, 3] = P[:, 0], Nrm[:, 0]
-    flat = P.copy()
-    flat[:, :, 2] = 0.0
-    line = np.zeros_like(P)
-    line[:, :, 0] = rng.normal(size=(K, 4))
-    one_point = np.repeat(P[:, :1], 4, axis=1)
-    exact_P, exact_N = random_grasps(rng, K, 4, 3, spread=0.0)
-    pair_P, pair_N = random_grasps(rng, K, 2, 3, spread=0.0)  # rank 5 < 6
-    return [
-        ("tiny mu", P, Nrm, 1e-6),
-        ("huge mu", P, Nrm, 50.0),
-        ("duplicate contact", dup_P, dup_N, 0.5),
-        ("metres x1e3", 1e3 * P, Nrm, 0.5),
-        ("metres x1e-3", 1e-3 * P, Nrm, 0.5),
-        ("coplanar points", flat, Nrm, 0.5),
-        ("collinear points", line, Nrm, 0.5),
-        ("all at one point", one_point, Nrm, 0.5),
-        ("exactly inward", exact_P, exact_N, 0.2),
-        ("two antipodal hard fingers", pair_P, pair_N, 0.8),
-    ]
+    families = degenerate_families(rng, 60, spread=0.3)
+    pair_P, pair_N = random_grasps(rng, 60, 2, 3, spread=0.0)  # rank 5 < 6
+    return [*families, ("two antipodal hard fingers", pair_P, pair_N, 0.8)]
 
 
 @pytest.mark.parametrize("kernel", KERNELS)

@@ -9,8 +9,20 @@ from scipy.optimize import linprog
 
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
+from drakegrasp.planning import weight
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, weight_capacity
 from drakegrasp.quality import primitive_wrenches
+
+
+def _stack_sizes(monkeypatch) -> list[int]:
+    """The number of LPs of each call to the active-set method, as it runs."""
+    sizes, solve = [], weight.solve_max_last_active
+    monkeypatch.setattr(
+        weight,
+        "solve_max_last_active",
+        lambda B, *a, **k: sizes.append(len(B)) or solve(B, *a, **k),
+    )
+    return sizes
 
 
 @pytest.mark.parametrize("solver", ["batch", "drake"])
@@ -103,8 +115,6 @@ def test_chunks_and_workers_change_no_number(workers, monkeypatch):
     # the grasps go in chunks of WEIGHT_CHUNK, each solved alone (by the
     # active-set method, the degenerate ones too): the numbers are those of
     # one call on all grasps, for any number of workers
-    from drakegrasp.planning import weight
-
     rng = np.random.default_rng(14)
     P = np.repeat(STUCK_P[None], 23, axis=0)
     N = np.repeat(STUCK_N[None], 23, axis=0)
@@ -112,13 +122,7 @@ def test_chunks_and_workers_change_no_number(workers, monkeypatch):
     N[6:] += rng.normal(0, 0.2, (17, 4, 3))
     N /= np.linalg.norm(N, axis=2, keepdims=True)
     F = np.tile([0, 0, 1, 1], (23, 1))
-    exact = []
-    solve = weight.solve_max_last_active
-    monkeypatch.setattr(
-        weight,
-        "solve_max_last_active",
-        lambda B, *a, **k: exact.append(len(B)) or solve(B, *a, **k),
-    )
+    exact = _stack_sizes(monkeypatch)
     before = weight._FALLBACKS["clp"]
     whole = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
     assert exact and exact[0] == 23 * len(WEIGHT_DIRECTIONS)  # every LP
@@ -169,7 +173,6 @@ def test_degenerate_pads_are_solved_in_the_compiled_path():
     # coplanar and duplicated pad contacts: α(u) equals the primal through
     # HiGHS (tight) and Clp, and none of them needs the Clp fallback
     from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
-    from drakegrasp.planning import weight
 
     P, N, F = _degenerate_grasps(np.random.default_rng(21))
     before = weight._FALLBACKS["clp"]
@@ -194,21 +197,13 @@ def test_degenerate_pads_are_solved_in_the_compiled_path():
 def test_the_route_without_numba_gives_the_same_capacities(monkeypatch):
     # without numba the interior-point method (numpy) goes first and the
     # active-set method (then a Python loop) takes only what it leaves
-    from drakegrasp.planning import weight
-
     P, N, F = _degenerate_grasps(np.random.default_rng(22), K=6)
     P = np.vstack([P, STUCK_P[None, [0, 1, 1, 2, 3, 3]]])
     N = np.vstack([N, STUCK_N[None, [0, 1, 1, 2, 3, 3]]])
     F = np.vstack([F, [[0, 0, 0, 1, 1, 1]]])
     compiled = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
-    routes = []
-    solve = weight.solve_max_last_active
     monkeypatch.setattr(weight.compiled, "AVAILABLE", False)
-    monkeypatch.setattr(
-        weight,
-        "solve_max_last_active",
-        lambda B, *a, **k: routes.append(len(B)) or solve(B, *a, **k),
-    )
+    routes = _stack_sizes(monkeypatch)
     before = weight._FALLBACKS["clp"]
     numpy_first = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
     assert weight._FALLBACKS["clp"] == before
