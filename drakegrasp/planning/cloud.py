@@ -42,12 +42,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
+from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.gripper import ParallelJaw
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
+    "MAX_COORDINATE",
     "CONTACT_BAND",
     "LINE_RADIUS_SPACINGS",
     "UNSEEN_DEPTH_ANGLE",
@@ -119,6 +121,12 @@ class CloudContact:
         }
 
 
+MAX_COORDINATE = 1e6
+"""Largest cloud coordinate (metres) accepted: a million metres is no object a
+hand grasps, and a larger one would overflow the squared distances the route
+sums."""
+
+
 def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     """Points and outward unit normals of a cloud, world frame, finite only.
 
@@ -149,14 +157,20 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
         if normals is None and point_cloud.has_normals():
             normals = np.asarray(point_cloud.normals(), float).T.copy()
     else:
-        points = np.asarray(point_cloud, dtype=float)
+        points = real_array("point_cloud", point_cloud, error=InvalidOptionError)
     if points.ndim != 2 or points.shape[1] != 3:
         raise InvalidOptionError(
             f"point_cloud must be a PointCloud or an (M, 3) array, got shape "
             f"{points.shape}"
         )
+    if viewpoint is not None:
+        viewpoint = real_array("viewpoint", viewpoint, error=InvalidOptionError)
+        if viewpoint.shape != (3,) or not np.all(np.abs(viewpoint) < MAX_COORDINATE):
+            raise InvalidOptionError(
+                f"viewpoint must be a finite point (3,) in metres, got {viewpoint!r}"
+            )
     if normals is not None:
-        normals = np.asarray(normals, dtype=float)
+        normals = real_array("cloud_normals", normals, error=InvalidOptionError)
         if normals.shape != points.shape:
             raise InvalidOptionError(
                 f"normals must have the cloud's shape {points.shape}, got "
@@ -165,6 +179,14 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     if len(points) == 0:
         raise InvalidOptionError("point_cloud is empty: there is nothing to grasp")
     total = len(points)
+    far = np.any(np.abs(points) >= MAX_COORDINATE, axis=1) & np.all(
+        np.isfinite(points), axis=1
+    )
+    if far.any():
+        raise InvalidOptionError(
+            f"point_cloud has {int(far.sum())} points farther than "
+            f"{MAX_COORDINATE:g} m along an axis (a cloud is in metres)"
+        )
     finite = np.all(np.isfinite(points), axis=1)
     if normals is not None:
         finite &= np.all(np.isfinite(normals), axis=1)
@@ -185,11 +207,12 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     norm = np.linalg.norm(normals, axis=1)
     ok = norm > 0
     points, normals = points[ok], normals[ok] / norm[ok, None]
-    towards = (
-        points - points.mean(axis=0)
-        if viewpoint is None
-        else np.asarray(viewpoint, float) - points
-    )
+    if len(points) < 3:
+        raise InvalidOptionError(
+            f"point_cloud has {len(points)} points of {total} with a finite, "
+            "non-zero normal: too few to grasp"
+        )
+    towards = points - points.mean(axis=0) if viewpoint is None else viewpoint - points
     flip = np.sum(normals * towards, axis=1) < 0
     normals[flip] *= -1
     return points, normals, total - len(points)

@@ -41,6 +41,7 @@ from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import (
     check_coefficient,
     check_distance_tolerance,
+    check_flag,
     real_scalar,
 )
 from drakegrasp.errors import InvalidOptionError
@@ -112,16 +113,60 @@ def object_surface(plant, plant_context, object_body) -> ObjectSurface:
 
 
 def _check_count(value) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise InvalidOptionError(
-            f"num_candidates must be an integer >= 0, got {value!r}"
-        )
-    if not 0 <= int(value) <= MAX_CANDIDATES:
+    n = _check_int("num_candidates", value)
+    if n > MAX_CANDIDATES:
         raise InvalidOptionError(
             f"num_candidates must be in [0, {MAX_CANDIDATES}] (one call; call again "
             f"with another seed for more), got {value}"
         )
+    return n
+
+
+def _check_int(name: str, value, minimum: int = 0) -> int:
+    """``value`` as an int ``>= minimum``; a bool, float or string is refused."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise InvalidOptionError(
+            f"{name} must be an integer >= {minimum}, got {value!r}"
+        )
+    if int(value) < minimum:
+        raise InvalidOptionError(f"{name} must be an integer >= {minimum}, got {value}")
     return int(value)
+
+
+def _check_seed(seed):
+    """None or an integer >= 0 (what numpy's generators take)."""
+    return None if seed is None else _check_int("seed", seed)
+
+
+def _check_noise(noise) -> dict:
+    """:data:`DEFAULT_NOISE` updated by ``noise`` (a dict of finite values >= 0)."""
+    if noise is not None and not isinstance(noise, dict):
+        raise InvalidOptionError(
+            f"noise must be a dict of {sorted(DEFAULT_NOISE)} or None, got "
+            f"{type(noise).__name__}"
+        )
+    noise = {**DEFAULT_NOISE, **(noise or {})}
+    if set(noise) != set(DEFAULT_NOISE):
+        raise InvalidOptionError(
+            f"noise takes non-negative {sorted(DEFAULT_NOISE)}, got {noise!r}"
+        )
+    for key, value in noise.items():
+        value = real_scalar(f"noise[{key!r}]", value)
+        if not 0 <= value < np.inf:
+            raise InvalidOptionError(
+                f"noise takes non-negative {sorted(DEFAULT_NOISE)}, got {noise!r}"
+            )
+        noise[key] = value
+    return noise
+
+
+def _check_positive(name: str, value, unit: str) -> float:
+    value = real_scalar(name, value)
+    if not 0 < value < np.inf:
+        raise InvalidOptionError(
+            f"{name} must be a finite number > 0 {unit}, got {value}"
+        )
+    return value
 
 
 def plan_grasps(
@@ -232,7 +277,8 @@ def plan_grasps(
         Multi-finger hands with a ``viewpoint``: assume the object centrally
         symmetric and complete its unseen side by reflecting the seen one
         (:func:`~drakegrasp.planning.cloud.complete_unseen`), so the hand may
-        wrap around it; ``False`` keeps the hand on the seen side.
+        wrap around it; ``False`` keeps the hand on the seen side.  Parallel
+        jaws plan on the seen points alone either way.
     object_mass : float, optional
         The object's mass (kg) for ``squeeze_needed``; default the body's mass
         (a cloud has none: NaN).
@@ -268,13 +314,22 @@ def plan_grasps(
     mu = check_coefficient("mu", mu, error=InvalidOptionError)
     tol = check_distance_tolerance(distance_tolerance)
     clearance = real_scalar("clearance", clearance)
-    if not clearance >= 0:
-        raise InvalidOptionError(f"clearance must be >= 0 metres, got {clearance}")
-    noise = {**DEFAULT_NOISE, **(noise or {})}
-    if set(noise) != set(DEFAULT_NOISE) or any(not v >= 0 for v in noise.values()):
+    complete_unseen = check_flag("complete_unseen", complete_unseen)
+    progress = check_flag("progress", progress)
+    if not 0 <= clearance < np.inf:
         raise InvalidOptionError(
-            f"noise takes non-negative {sorted(DEFAULT_NOISE)}, got {noise!r}"
+            f"clearance must be a finite number >= 0 metres, got {clearance}"
         )
+    seed = _check_seed(seed)
+    robustness_samples = _check_int("robustness_samples", robustness_samples)
+    certify = _check_int("certify", certify)
+    min_fingers = _check_int("min_fingers", min_fingers, minimum=1)
+    tilt = real_scalar("tilt", tilt)
+    if not 0 <= tilt <= np.pi / 2:
+        raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
+    if object_mass is not None:
+        object_mass = _check_positive("object_mass", object_mass, "kg")
+    noise = _check_noise(noise)
     if weight_check is not None and (
         isinstance(weight_check, bool)
         or not isinstance(weight_check, int | np.integer)
@@ -283,7 +338,13 @@ def plan_grasps(
         raise InvalidOptionError(
             f"weight_check must be an integer >= 0 or None, got {weight_check!r}"
         )
-    model = ContactModel(contact_model).value
+    try:
+        model = ContactModel(contact_model).value
+    except ValueError:
+        raise InvalidOptionError(
+            f"contact_model must be one of {[m.value for m in ContactModel]}, got "
+            f"{contact_model!r}"
+        ) from None
     ctx = plant_context_of(plant, plant_context)
     if (object_body is None) == (point_cloud is None):
         raise InvalidOptionError(
@@ -334,7 +395,7 @@ def plan_grasps(
                 synergy_range=synergy_range, approach=approach, standoff=standoff,
                 tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY,
-                complete=bool(complete_unseen),
+                complete=complete_unseen,
             )  # fmt: skip
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface = CloudSurface(points, normals, viewpoint=viewpoint)

@@ -1214,6 +1214,111 @@ def _meshcat(cls):
     return _MESHCAT[0]
 
 
+# ----------------------------------------------------------------- planning
+
+OWN_GRIPPER = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+PLAN_POOLS = {
+    "mu": [v for v in BAD_SCALARS if v is not True],
+    "num_candidates": [-1, 1.5, NAN, "10", None, True, 10**12, [3]],
+    "seed": [-1, 1.5, "abc", NAN, [1, -2], object()],
+    "clearance": [-1e-3, NAN, INF, "abc", None, 1j],
+    "distance_tolerance": [0.0, -1e-4, NAN, INF, "abc", None],
+    "robustness_samples": [-1, 2.5, "8", NAN, True],
+    "certify": [-1, 2.5, "all", NAN],
+    "weight_check": [-1, 2.5, True, "3"],
+    "workers": [0, -2, 1.5, "two", True],
+    "progress": ["yes", 1, None],
+    "noise": [{"wobble": 1}, {"position_mm": -1.0}, {"position_mm": NAN}, "loud", 3],
+    "contact_model": ["sticky", 3, None],
+    "torsional_friction": [-0.1, NAN, "abc"],
+    "complete_unseen": ["no", 1, None],
+    "object_mass": [-1.0, 0.0, NAN, INF, "abc"],
+    "tilt": [NAN, -1.0, "abc"],
+    "min_fingers": [0, -1, 2.5, "2"],
+}
+"""Hostile values of :func:`drakegrasp.plan_grasps`'s options, one at a time."""
+
+
+def planning_cases() -> Iterator[Case]:
+    """``plan_grasps`` on drakegrasp's own gripper and box: hostile options,
+    hostile clouds, and two valid calls whose ranking is checked."""
+    scene = dg.planning_scene(
+        "package://drakegrasp/objects/box.sdf", hand_url=OWN_GRIPPER
+    )
+    hand_only = dg.planning_scene(None, hand_url=OWN_GRIPPER)
+    base = dict(hand=scene.hand, num_candidates=8, mu=0.5, seed=0,
+                robustness_samples=4)  # fmt: skip
+
+    def plan(**kw):
+        return dg.plan_grasps(
+            scene.plant, scene.context, scene.object_body, **{**base, **kw}
+        )
+
+    def ranked(r) -> bool:
+        scores = [c.score for c in r]
+        return len(r) <= 8 and scores == sorted(scores, reverse=True)
+
+    yield Case("planning", "valid", plan, "answer", ranked)
+    yield Case(
+        "planning", "zero-candidates", lambda: plan(num_candidates=0), "either",
+        lambda r: len(r) == 0,
+    )  # fmt: skip
+    for option, values in PLAN_POOLS.items():
+        for i, value in enumerate(values):
+            yield Case(
+                "planning",
+                f"{option}={_short(value)}#{i}",
+                lambda o=option, v=value: plan(**{o: v}),
+                "refuse",
+            )
+    # hand=None: every body but the object's (valid here: the gripper).
+    yield Case("planning", "hand=None", lambda: plan(hand=None), "either", ranked)
+    for name, kw in {
+        "hand-is-object": {"hand": [scene.object_body]},
+        "object-and-cloud": {"point_cloud": np.zeros((10, 3))},
+    }.items():
+        yield Case("planning", name, lambda kw=kw: plan(**kw), "refuse")
+    # Clouds: the plant holds the hand alone.
+    rng = np.random.default_rng(5)
+    cloud = rng.normal(size=(200, 3))
+    cloud = 0.04 * cloud / np.linalg.norm(cloud, axis=1, keepdims=True)
+    holes = cloud.copy()
+    holes[::7] = NAN
+
+    def on_cloud(points, **kw):
+        return dg.plan_grasps(
+            hand_only.plant, hand_only.context, None,
+            **{**base, "hand": hand_only.hand, "point_cloud": points, **kw},
+        )  # fmt: skip
+
+    hostile_clouds = {
+        "cloud-empty": (np.zeros((0, 3)), {}),
+        "cloud-all-nan": (np.full((50, 3), NAN), {}),
+        "cloud-2d": (cloud[:, :2], {}),
+        "cloud-strings": ([["a", "b", "c"]] * 20, {}),
+        "cloud-huge": (cloud * 1e300, {}),
+        "cloud-one-point": (cloud[:1], {}),
+        "cloud-normals-short": (cloud, {"cloud_normals": -cloud[:10]}),
+        "cloud-normals-zero": (cloud, {"cloud_normals": np.zeros_like(cloud)}),
+        "cloud-viewpoint-nan": (cloud, {"viewpoint": [NAN, 0, 0]}),
+        "cloud-viewpoint-short": (cloud, {"viewpoint": [1.0, 0.0]}),
+        "cloud-complete-unseen-str": (cloud, {"viewpoint": [0.5, 0, 0],
+                                              "complete_unseen": "no"}),
+    }  # fmt: skip
+    for name, (points, kw) in hostile_clouds.items():
+        yield Case(
+            "planning", name, lambda p=points, kw=kw: on_cloud(p, **kw), "refuse"
+        )
+    for name, kw in {
+        "cloud-valid": {"cloud_normals": -cloud},
+        # NaN marks a depth camera's missing points: they are dropped.
+        "cloud-nan-holes": {"point_cloud": holes},
+    }.items():
+        yield Case(
+            "planning", name, lambda kw=kw: on_cloud(cloud, **kw), "either", ranked
+        )
+
+
 def all_cases(root: Path | None = None) -> Iterator[Case]:
     """Every family, in a fixed order."""
     yield from api_walk_cases()
@@ -1225,6 +1330,7 @@ def all_cases(root: Path | None = None) -> Iterator[Case]:
     yield from geometry_cases()
     yield from monotonicity_cases()
     yield from picture_cases()
+    yield from planning_cases()
     if root is None:
         root = Path(tempfile.mkdtemp(prefix="drakegrasp-fuzz-"))
     yield from file_cases(root)

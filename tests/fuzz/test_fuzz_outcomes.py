@@ -21,6 +21,7 @@ FAMILIES = {
     "batch": fuzz_cases.batch_cases,
     "monotone": fuzz_cases.monotonicity_cases,
     "pictures": fuzz_cases.picture_cases,
+    "planning": fuzz_cases.planning_cases,
 }
 
 

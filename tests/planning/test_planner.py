@@ -234,6 +234,9 @@ def test_bad_mu_and_noise(own_scene):
         plan(scene, n=5, mu=-1)
     with pytest.raises(InvalidOptionError, match="noise"):
         plan(scene, n=5, noise={"wobble": 1})
+    # A string is not a flag ("no" would read as True).
+    with pytest.raises(InvalidOptionError, match="complete_unseen must be True or"):
+        plan(scene, n=5, complete_unseen="no")
 
 
 @settings(max_examples=4, deadline=None, derandomize=True)
