@@ -247,21 +247,49 @@ def shake_test(
                 f"X_WO must be a pydrake RigidTransform, got {type(X_WO).__name__}"
             )
         candidate = replace(candidate, X_WO=X_WO)
-    for name, value in (
-        ("squeeze", squeeze),
-        ("stiffness", stiffness),
-        ("damping", damping),
-        ("time_step", time_step),
-        ("phase", phase),
+    for name, value, low, unit in (
+        ("squeeze", squeeze, 0.0, "N"),
+        ("stiffness", stiffness, 0.0, "N/m or N·m/rad"),
+        ("damping", damping, None, "N·s/m"),
+        ("time_step", time_step, 0.0, "s"),
+        ("phase", phase, 0.0, "s"),
+        ("settle", settle, None, "s"),
+        ("blend", blend, None, "s"),
+        ("max_displacement", max_displacement, None, "m"),
+        ("max_rotation", max_rotation, None, "rad"),
     ):
-        if not (isinstance(value, int | float) and np.isfinite(value) and value > 0):
+        # low 0.0: must be > 0; None: must be >= 0.
+        if not (
+            isinstance(value, int | float | np.floating | np.integer)
+            and not isinstance(value, bool)
+            and np.isfinite(value)
+            and (value > 0 if low is not None else value >= 0)
+        ):
+            relation = "> 0" if low is not None else ">= 0"
             raise InvalidOptionError(
-                f"{name} must be a finite number > 0, got {value!r}"
+                f"{name} must be a finite number {relation} ({unit}), got {value!r}"
             )
-    dirs = np.asarray(directions, dtype=float).reshape(-1, 3)
-    if not np.all(np.isfinite(dirs)) or np.any(np.linalg.norm(dirs, axis=1) == 0):
+    if time_step > phase / 10:
         raise InvalidOptionError(
-            f"directions must be finite non-zero 3-vectors, got {directions!r}"
+            f"time_step must be at most a tenth of a phase ({phase / 10:g} s) to "
+            f"resolve the shake, got {time_step!r}"
+        )
+    try:
+        dirs = np.asarray(directions, dtype=float)
+        if dirs.shape == (3,):
+            dirs = dirs[None]  # one direction
+    except (TypeError, ValueError):
+        dirs = np.zeros((0, 0))
+    if (
+        dirs.ndim != 2
+        or dirs.shape[0] == 0
+        or dirs.shape[1] != 3
+        or not np.all(np.isfinite(dirs))
+        or np.any(np.linalg.norm(dirs, axis=1) == 0)
+    ):
+        raise InvalidOptionError(
+            "directions must be one or more finite non-zero 3-vectors, got "
+            f"{directions!r}"
         )
     t0 = time.perf_counter()
     from pydrake.multibody.parsing import Parser

@@ -1239,6 +1239,50 @@ PLAN_POOLS = {
 """Hostile values of :func:`drakegrasp.plan_grasps`'s options, one at a time."""
 
 
+SHAKE_POOLS = {
+    "squeeze": [-1.0, 0.0, NAN, INF, "abc", None, True],
+    "stiffness": [-1.0, NAN, INF, "x"],
+    "damping": [-1.0, NAN, "x"],
+    "directions": [[], [[0, 0, 0]], [[NAN, 0, 1]], "down", [[1, 2]], None],
+    "settle": [-1.0, NAN, INF],
+    "phase": [0.0, -1.0, NAN, INF],
+    "blend": [-1.0, NAN],
+    "time_step": [0.0, -1e-3, NAN, 10.0],
+    "max_displacement": [-1.0, NAN],
+    "max_rotation": [-1.0, NAN],
+    "X_WO": ["x", np.eye(4)],
+}
+"""Hostile values of :func:`drakegrasp.shake_test`'s options, one at a time."""
+
+
+def _shake_cases(scene) -> Iterator[Case]:
+    """``shake_test`` refusals (before any simulation) on the scene's best grasp."""
+    best = dg.plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=8, mu=0.5, seed=0, robustness_samples=4,
+    )[0]  # fmt: skip
+    for option, values in SHAKE_POOLS.items():
+        for i, value in enumerate(values):
+            yield Case(
+                "planning",
+                f"shake {option}={_short(value)}#{i}",
+                lambda o=option, v=value: dg.shake_test(
+                    scene.add_models, best, **{o: v}
+                ),
+                "refuse",
+            )
+    for name, models, candidate in (
+        ("shake no candidate", scene.add_models, "x"),
+        ("shake no models", None, best),
+    ):
+        yield Case(
+            "planning",
+            name,
+            lambda m=models, c=candidate: dg.shake_test(m, c),
+            "refuse",
+        )
+
+
 def planning_cases() -> Iterator[Case]:
     """``plan_grasps`` on drakegrasp's own gripper and box: hostile options,
     hostile clouds, and two valid calls whose ranking is checked."""
@@ -1309,6 +1353,7 @@ def planning_cases() -> Iterator[Case]:
         yield Case(
             "planning", name, lambda p=points, kw=kw: on_cloud(p, **kw), "refuse"
         )
+    yield from _shake_cases(scene)
     for name, kw in {
         "cloud-valid": {"cloud_normals": -cloud},
         # NaN marks a depth camera's missing points: they are dropped.
