@@ -341,18 +341,12 @@ def _checked_hand(
     plant, ctx, body, hand, *, tilt, min_fingers, preshape, synergy,
     synergy_range, approach, standoff,
 ):  # fmt: skip
-    """Both routes' options checked and the hand read: ``(tilt, MultiFingerHand)``."""
-    tilt = float(tilt)
-    if not 0.0 <= tilt <= np.pi / 2:
-        raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
-    if (
-        isinstance(min_fingers, bool)
-        or not isinstance(min_fingers, int | np.integer)
-        or min_fingers < 2
-    ):
-        raise InvalidOptionError(
-            f"min_fingers must be an integer >= 2, got {min_fingers!r}"
-        )
+    """The hand read and checked against ``min_fingers``: ``(tilt, MultiFingerHand)``.
+
+    ``tilt`` and ``min_fingers`` arrive checked by
+    :func:`~drakegrasp.planning.planner.plan_grasps` (a float in ``[0, π/2]``,
+    an integer ``>= 2``); what needs the hand is checked here.
+    """
     hand_model = multi_finger_hand(
         plant, ctx, body, hand, preshape=preshape, synergy=synergy,
         synergy_range=synergy_range, approach=approach, standoff=standoff,

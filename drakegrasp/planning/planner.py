@@ -323,7 +323,7 @@ def plan_grasps(
     seed = _check_seed(seed)
     robustness_samples = _check_int("robustness_samples", robustness_samples)
     certify = _check_int("certify", certify)
-    min_fingers = _check_int("min_fingers", min_fingers, minimum=1)
+    min_fingers = _check_int("min_fingers", min_fingers, minimum=2)
     tilt = real_scalar("tilt", tilt)
     if not 0 <= tilt <= np.pi / 2:
         raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
