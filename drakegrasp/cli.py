@@ -283,6 +283,26 @@ def _package(text: str) -> tuple[str, str]:
     return name, folder
 
 
+def _add_scene_file_options(
+    parser: argparse.ArgumentParser, *, package_help: str
+) -> None:
+    """``--package NAME=DIR`` and ``--allow-any-file``: where a scene's files may be."""
+    parser.add_argument(
+        "--package",
+        action="append",
+        type=_package,
+        default=[],
+        metavar="NAME=DIR",
+        help=package_help,
+    )
+    parser.add_argument(
+        "--allow-any-file",
+        action="store_true",
+        help="trust the scene: let it reference files outside its packages and "
+        "its own directory",
+    )
+
+
 def _cmd_warmup(args: argparse.Namespace) -> int:
     from drakegrasp.batch.aot import status
     from drakegrasp.batch.warmup import warmup
@@ -360,20 +380,10 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
         help="close the hand onto the object before analysing (from the "
         "scene's joint values; default: the scene's 'close:', else no)",
     )
-    analyze.add_argument(
-        "--package",
-        action="append",
-        type=_package,
-        default=[],
-        metavar="NAME=DIR",
-        help="resolve package://NAME/... to DIR (repeatable; ROS_PACKAGE_PATH "
-        "is honoured too)",
-    )
-    analyze.add_argument(
-        "--allow-any-file",
-        action="store_true",
-        help="trust the scene: let it reference files outside its packages and "
-        "its own directory",
+    _add_scene_file_options(
+        analyze,
+        package_help="resolve package://NAME/... to DIR (repeatable; "
+        "ROS_PACKAGE_PATH is honoured too)",
     )
     analyze.add_argument("--json", action="store_true", help="print JSON")
     analyze.set_defaults(func=_cmd_analyze)
@@ -734,19 +744,9 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="friction coefficient (default: the scene's, else 0.5)",
     )
-    plan.add_argument(
-        "--package",
-        action="append",
-        type=_package,
-        default=[],
-        metavar="NAME=DIR",
-        help="for a scene: resolve package://NAME/... to DIR (repeatable)",
-    )
-    plan.add_argument(
-        "--allow-any-file",
-        action="store_true",
-        help="trust the scene: let it reference files outside its packages and "
-        "its own directory",
+    _add_scene_file_options(
+        plan,
+        package_help="for a scene: resolve package://NAME/... to DIR (repeatable)",
     )
     plan.add_argument("--progress", action="store_true", help="show a progress bar")
     out = plan.add_mutually_exclusive_group()

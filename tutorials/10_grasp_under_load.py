@@ -141,11 +141,28 @@ print(f"closed form 2 μ τ_max / (m g) = {2 * 0.5 * 20.0 / (m * g):.6g}")
 # larger multiple can be held; its bound agrees with α*.  The figure puts the
 # two closed forms beside the programs' answers.
 
+
 # %%
+def payload_factors(grasp, wrench, J, limits):
+    """``max_load``'s α* with the same limit on both motors, for each limit."""
+    return np.array(
+        [
+            dg.max_load(grasp, wrench, hand_jacobian=J, torque_limits=[t, t]).alpha
+            for t in limits
+        ]
+    )
+
+
+def plot_payload(ax, limits, alpha, closed_form, closed_label, *, xlabel, weight):
+    """α* against the motor limit, beside a closed form; α* = 1 holds ``weight``."""
+    ax.plot(limits, closed_form, color="0.6", label=closed_label)
+    ax.plot(limits, alpha, "o", color="tab:orange", label="max_load")
+    ax.axhline(1.0, color="tab:red", lw=0.8, ls="--", label=weight)
+    ax.set(xlabel=xlabel, ylabel="payload factor α*")
+
+
 tau_max = np.linspace(0.0, 40.0, 5 if TEST_MODE else 21)
-alpha = [
-    dg.max_load(grasp, w, hand_jacobian=J, torque_limits=[t, t]).alpha for t in tau_max
-]
+alpha = payload_factors(grasp, w, J, tau_max)
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
 fine = np.linspace(mus[0], mus[-1], 200)
 ax1.plot(fine, m * g / fine, color="0.6", label="m g / μ (closed form)")
@@ -153,10 +170,10 @@ ax1.plot(mus, squeeze, "o", color="tab:blue", label="grasp_forces")
 ax1.set(xlabel="friction coefficient μ", ylabel="least squeeze Σ f_n (N)")
 ax1.set_title("two fingers, weight 5.04 N")
 ax1.legend()
-ax2.plot(tau_max, 2 * 0.5 * tau_max / (m * g), color="0.6", label="2 μ τ_max / m g")
-ax2.plot(tau_max, alpha, "o", color="tab:orange", label="max_load")
-ax2.axhline(1.0, color="tab:red", lw=0.8, ls="--", label="the weight itself")
-ax2.set(xlabel="motor limit τ_max per finger (N)", ylabel="payload factor α*")
+plot_payload(
+    ax2, tau_max, alpha, 2 * 0.5 * tau_max / (m * g), "2 μ τ_max / m g",
+    xlabel="motor limit τ_max per finger (N)", weight="the weight itself",
+)  # fmt: skip
 ax2.set_title("two fingers, μ = 0.5")
 ax2.legend()
 plt.tight_layout()
@@ -343,22 +360,15 @@ tau_1 = np.max(
     )
 )
 limits = np.linspace(0.0, 80.0, 5 if TEST_MODE else 17)
-alpha = np.array(
-    [
-        dg.max_load(
-            report.grasp, load.wrench, hand_jacobian=report.J, torque_limits=[t, t]
-        ).alpha
-        for t in limits
-    ]
-)
+alpha = payload_factors(report.grasp, load.wrench, report.J, limits)
 print(f"τ_1 = {tau_1:.4f} N; at the SDF's 80 N: α* = {alpha[-1]:.4f}, "
       f"80 / τ_1 = {80 / tau_1:.4f}")  # fmt: skip
 fig, ax = plt.subplots(figsize=(6, 3.6))
-ax.plot(limits, limits / tau_1, color="0.6", label="τ_max / τ_1 (min_torque)")
-ax.plot(limits, alpha, "o", color="tab:orange", label="max_load")
-ax.axhline(1.0, color="tab:red", lw=0.8, ls="--", label="the box itself")
+plot_payload(
+    ax, limits, alpha, limits / tau_1, "τ_max / τ_1 (min_torque)",
+    xlabel="finger force limit τ_max (N)", weight="the box itself",
+)  # fmt: skip
 ax.axvline(80.0, color="0.3", lw=0.8, ls=":", label="the SDF's effort limit")
-ax.set(xlabel="finger force limit τ_max (N)", ylabel="payload factor α*")
 ax.set_title("WSG-50 and the sugar box, μ from the plant")
 ax.legend()
 plt.tight_layout()

@@ -76,22 +76,14 @@ def _set_pose(s, pose: dict) -> None:
 
 def _distances(s) -> dict[str, float]:
     """Drake's smallest signed distance per hand body to the object."""
-    from pydrake.multibody.tree import BodyIndex
+    from drake_distances import hand_object_distances  # tests/plant, on the path
 
-    plant, ctx = s.plant, s.plant_context
-    query = plant.get_geometry_query_input_port().Eval(ctx)
-    inspector = query.inspector()
+    plant = s.plant
+    query = plant.get_geometry_query_input_port().Eval(s.plant_context)
     out = {}
-    for i in range(plant.num_bodies()):
-        body = plant.get_body(BodyIndex(i))
-        if body.model_instance() != s.hand:
-            continue
+    for body, _, _, d in hand_object_distances(plant, query, s.hand, s.object_body):
         name = f"{plant.GetModelInstanceName(body.model_instance())}::{body.name()}"
-        for gh in plant.GetCollisionGeometriesForBody(body):
-            for go in plant.GetCollisionGeometriesForBody(s.object_body):
-                if not inspector.CollisionFiltered(go, gh):
-                    d = query.ComputeSignedDistancePairClosestPoints(go, gh).distance
-                    out[name] = min(out.get(name, math.inf), d)
+        out[name] = min(out.get(name, math.inf), d)
     return out
 
 

@@ -24,9 +24,7 @@ non-finite state must be an "invalid" sample naming the index.
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Iterator
-from pathlib import Path
 
 import fuzz_oracles as oracle
 import numpy as np
@@ -41,8 +39,7 @@ _PICK = []
 
 def _pick():
     if not _PICK:
-        sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "systems"))
-        from pick_support import build_pick
+        from pick_support import build_pick  # tests/systems, on the path
 
         p = build_pick(mu=0.5, distance_tolerance=TOL)
         _PICK.append((p, p.simulator.get_context().Clone()))
@@ -63,8 +60,8 @@ def construct(options: dict) -> dict:
 
 def evaluate(state: dict) -> dict:
     """Worker side: the pick's monitor on one state; the oracle's data."""
+    from drake_distances import hand_object_distances  # tests/plant, on the path
     from pydrake.math import RigidTransform, RollPitchYaw
-    from pydrake.multibody.tree import BodyIndex
 
     p, root0 = _pick()
     plant, sg = p.plant, p.scene_graph
@@ -97,17 +94,10 @@ def evaluate(state: dict) -> dict:
         "none": None,
     }.get(which, own)
     sample = p.monitor.evaluate(context)
-    inspector = query.inspector()
-    deepest = math.inf
-    for i in range(plant.num_bodies()):
-        body = plant.get_body(BodyIndex(i))
-        if body.model_instance() != p.gripper:
-            continue
-        for gh in plant.GetCollisionGeometriesForBody(body):
-            for go in plant.GetCollisionGeometriesForBody(box):
-                if not inspector.CollisionFiltered(go, gh):
-                    d = query.ComputeSignedDistancePairClosestPoints(go, gh).distance
-                    deepest = min(deepest, d)
+    deepest = min(
+        (d for *_, d in hand_object_distances(plant, query, p.gripper, box)),
+        default=math.inf,
+    )
     out = {
         "status": sample.status,
         "message": sample.message,

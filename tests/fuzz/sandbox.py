@@ -27,6 +27,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 MEMORY_LIMIT = 3 << 30  # bytes of address space per worker (pydrake maps ~1.5 GB)
+WORKER_FOLDERS = (HERE, HERE.parent / "plant", HERE.parent / "systems")
+"""Test folders on a worker's path: the fuzz helpers, and the plant and systems
+tests' support modules (``drake_distances``, ``pick_support``) the workers use."""
 
 
 class SandboxTimeout(Exception):
@@ -45,7 +48,7 @@ class Sandbox:
         env = dict(os.environ)
         root = str(HERE.parents[1])
         env["PYTHONPATH"] = os.pathsep.join(
-            [root, str(HERE), env.get("PYTHONPATH", "")]
+            [root, *map(str, WORKER_FOLDERS), env.get("PYTHONPATH", "")]
         )
         env["DRAKEGRASP_SANDBOX_MEMORY"] = str(self.memory)
         return subprocess.Popen(

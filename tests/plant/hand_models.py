@@ -17,6 +17,7 @@ the diagram, its root context and the plant context.
 from __future__ import annotations
 
 import numpy as np
+from drake_distances import hand_object_distances
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
@@ -229,17 +230,14 @@ class Rig:
 
     def pair_distances(self) -> dict[tuple[str, str], float]:
         """ψ of every unfiltered (hand geometry, object geometry) pair."""
-        plant, query = self.plant, self.query()
-        inspector = query.inspector()
-        out = {}
-        for i in plant.GetBodyIndices(self.hand):
-            for gh in plant.GetCollisionGeometriesForBody(plant.get_body(i)):
-                for go in plant.GetCollisionGeometriesForBody(self.object):
-                    if not inspector.CollisionFiltered(go, gh):
-                        r = query.ComputeSignedDistancePairClosestPoints(go, gh)
-                        key = (inspector.GetName(gh), inspector.GetName(go))
-                        out[key] = r.distance
-        return out
+        query = self.query()
+        name = query.inspector().GetName
+        return {
+            (name(gh), name(go)): d
+            for _, gh, go, d in hand_object_distances(
+                self.plant, query, self.hand, self.object
+            )
+        }
 
 
 PALM_FINGER_X = 0.05

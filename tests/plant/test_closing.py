@@ -13,9 +13,9 @@ import json
 import numpy as np
 import pytest
 from closure_oracle import independent_force_closure
+from drake_distances import hand_object_distances
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from pydrake.multibody.tree import BodyIndex
 
 from drakegrasp import (
     InvalidOptionError,
@@ -30,20 +30,14 @@ from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as TOL
 
 def all_pair_distances(scene):
     """ψ of every (hand-instance body geometry, object geometry) pair."""
-    plant, ctx = scene.plant, scene.ctx
-    query = plant.get_geometry_query_input_port().Eval(ctx)
-    inspector = query.inspector()
-    out = {}
-    for i in range(plant.num_bodies()):
-        body = plant.get_body(BodyIndex(i))
-        if body.model_instance() != scene.hand:
-            continue
-        for gh in plant.GetCollisionGeometriesForBody(body):
-            for go in plant.GetCollisionGeometriesForBody(scene.object):
-                if not inspector.CollisionFiltered(go, gh):
-                    r = query.ComputeSignedDistancePairClosestPoints(go, gh)
-                    out[(body.name(), inspector.GetName(gh), go)] = r.distance
-    return out
+    query = scene.plant.get_geometry_query_input_port().Eval(scene.ctx)
+    name = query.inspector().GetName
+    return {
+        (body.name(), name(gh), go): d
+        for body, gh, go, d in hand_object_distances(
+            scene.plant, query, scene.hand, scene.object
+        )
+    }
 
 
 def check_closed(scene, closure):
