@@ -242,7 +242,8 @@ class GraspCandidates(Sequence):
         Length (m) dividing moments in ε: the radius of a ball about O's
         origin that holds the object, the same for every candidate.
     reason : str
-        Why the result is empty (empty string otherwise).
+        Why the result is empty, or why none of its candidates is force
+        closure (empty string otherwise).
     settings : dict
         The options of the run (noise, seed, tolerances), for the record.
     time : float
@@ -320,7 +321,7 @@ class GraspCandidates(Sequence):
         )
         lines = [head]
         if self.reason:
-            lines.append(f"  empty: {self.reason}")
+            lines.append(f"  {self.reason}" if self else f"  empty: {self.reason}")
         for reason, n in sorted(self.rejections.items(), key=lambda kv: -kv[1]):
             lines.append(f"  rejected {n:>6}  {reason}")
         for k, c in enumerate(self.candidates[:10]):
@@ -368,6 +369,8 @@ def planning_result(
             if num_sampled == 0
             else f"all {num_sampled} sampled poses were rejected (see rejections)"
         )
+    elif not any(c.is_closure for c in candidates):
+        reason = _why_no_closure(candidates, settings.get("contact_model"))
     return GraspCandidates(
         candidates=candidates,
         rejections=dict(rejections),
@@ -379,3 +382,38 @@ def planning_result(
         settings=settings,
         time=time.perf_counter() - started,
     )
+
+
+def _why_no_closure(candidates: Sequence[GraspCandidate], model: str | None) -> str:
+    """Why no candidate is force closure, from their ranks and contact counts.
+
+    A grasp matrix of rank below 6 leaves a wrench that no contact force
+    meets; with hard fingers, two point contacts (one per finger of a
+    parallel jaw whose fingertips are spheres) leave the torque about the line
+    through them.
+    """
+    n = len(candidates)
+    rank = max(c.rank for c in candidates)
+    most = max(c.num_contacts for c in candidates)
+    if rank >= 6:
+        best = max(
+            (c.d_star for c in candidates if np.isfinite(c.d_star)), default=np.nan
+        )
+        return (
+            f"none of the {n} candidates is force closure: their grasp matrices "
+            f"have full rank, but no internal force lies inside every friction "
+            f"cone (best d* {best:.3g}); a larger mu or other poses may help"
+        )
+    why = (
+        f"none of the {n} candidates is force closure: every grasp matrix has "
+        f"rank <= {rank} < 6 (at most {most} contacts per candidate), so some "
+        "wrench on the object meets no contact force"
+    )
+    if model == "hard_finger" and most <= 2:
+        why += (
+            "; two point contacts never resist a torque about the line through "
+            "them: contact_model='soft_finger' with torsional_friction models "
+            "fingertips that do, or give the fingers pads that touch at more "
+            "points"
+        )
+    return why

@@ -345,6 +345,12 @@ def plan_grasps(
             f"contact_model must be one of {[m.value for m in ContactModel]}, got "
             f"{contact_model!r}"
         ) from None
+    if model == ContactModel.SOFT_FINGER.value and torsional_friction is None:
+        raise InvalidOptionError(
+            "contact_model='soft_finger' needs torsional_friction (nu >= 0: the "
+            "moment about each contact normal is bounded by b * nu * f_n); give "
+            "it, or use contact_model='hard_finger'"
+        )
     ctx = plant_context_of(plant, plant_context)
     if (object_body is None) == (point_cloud is None):
         raise InvalidOptionError(

@@ -8,7 +8,8 @@ What the plant already knows is read from it, never re-derived:
 * :func:`plant_torque_limits`: per hand velocity, the effort limit of the
   joint actuator that drives it (``JointActuator.effort_limit()``; ``inf``
   when an actuator has none); a hand joint without an actuator is passive and
-  gets 0 (it can carry no torque).
+  gets 0 (it can carry no torque), except the floating joint of a free hand
+  base, which is held where it is placed (``inf``).
 * the plant's friction, per contact (:mod:`drakegrasp.plant.friction`).
 
 :func:`analyze_load` puts them together for
@@ -51,6 +52,10 @@ __all__ = [
     "gravity_wrench",
     "plant_torque_limits",
 ]
+
+
+FLOATING_JOINTS = ("quaternion_floating", "rpy_floating")
+"""Drake joint types of a free body: six velocities that no actuator drives."""
 
 
 def gravity_wrench(plant: MultibodyPlant, plant_context, object_body, *, plane=None):
@@ -101,9 +106,23 @@ def plant_torque_limits(
     -------
     (n_h,) float
         ``effort_limit()`` of the actuator on each velocity (N·m or N; ``inf``
-        for an actuator without one), 0 for a velocity no actuator drives.
+        for an actuator without one), 0 for a velocity no actuator drives,
+        ``inf`` for the velocities of a floating joint (a free hand base).
+
+    Notes
+    -----
+    A hand whose base is a free body (the floating gripper of grasp planning)
+    is placed by setting its pose: whatever holds it there (an arm, a weld in
+    simulation) supplies the base's wrench, so no limit bounds it.  Counting
+    the floating joint as passive would make every grasp of such a hand fail
+    to hold any load.
     """
     limit_of = {}
+    for index in plant.GetJointIndices():
+        joint = plant.get_joint(index)
+        if joint.type_name() in FLOATING_JOINTS:
+            for j in range(joint.num_velocities()):
+                limit_of[joint.velocity_start() + j] = math.inf
     for k in range(plant.num_actuators()):
         actuator = plant.get_joint_actuator(JointActuatorIndex(k))
         joint = actuator.joint()

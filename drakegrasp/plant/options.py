@@ -110,7 +110,10 @@ class AnalysisOptions:
         An external wrench on the object, (6,) or planar (3,), in frame O about
         its origin, or the object's weight: the report then has a load section.
     torque_limits : None, "plant" or tuple of float
-        Motor limits of the load section (N·m or N per hand velocity).
+        Motor limits of the load section (N·m or N per hand velocity; ``inf``
+        for none).  ``"plant"`` reads the actuators' effort limits, a free hand
+        base's velocities unbounded
+        (:func:`~drakegrasp.plant.load.plant_torque_limits`).
     """
 
     mu: float | None = None
@@ -178,7 +181,7 @@ class AnalysisOptions:
         put("load", _named_or_values("load", self.load, "gravity"))
         put(
             "torque_limits",
-            _named_or_values("torque_limits", self.torque_limits, "plant"),
+            _named_or_values("torque_limits", self.torque_limits, "plant", limits=True),
         )
 
     def replace(self, **changes: Any) -> AnalysisOptions:
@@ -215,8 +218,11 @@ class AnalysisOptions:
         return jsonable(out)
 
 
-def _named_or_values(name: str, value: Any, word: str):
-    """None, ``word``, or a finite 1-D sequence of numbers as a tuple."""
+def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
+    """None, ``word``, or a finite 1-D sequence of numbers as a tuple.
+
+    With ``limits``, ``+inf`` is allowed too (a joint with no limit).
+    """
     if value is None or (isinstance(value, str) and value == word):
         return value
     if isinstance(value, str):
@@ -229,9 +235,11 @@ def _named_or_values(name: str, value: Any, word: str):
         raise InvalidOptionError(
             f"{name} must be {word!r}, numbers or None, got {value!r}"
         ) from None
-    if values.ndim != 1 or not np.all(np.isfinite(values)):
+    ok = np.isfinite(values) | (limits & (values == np.inf))
+    if values.ndim != 1 or not np.all(ok):
+        what = "numbers (inf: no limit)" if limits else "finite numbers"
         raise InvalidOptionError(
-            f"{name} must be a finite 1-D sequence of numbers, got {value!r}"
+            f"{name} must be a 1-D sequence of {what}, got {value!r}"
         )
     return tuple(float(x) for x in values)
 

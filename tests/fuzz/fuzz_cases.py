@@ -1319,6 +1319,7 @@ def planning_cases() -> Iterator[Case]:
     yield Case("planning", "hand=None", lambda: plan(hand=None), "either", ranked)
     for name, kw in {
         "hand-is-object": {"hand": [scene.object_body]},
+        "soft-finger-without-nu": {"contact_model": "soft_finger"},
         "object-and-cloud": {"point_cloud": np.zeros((10, 3))},
     }.items():
         yield Case("planning", name, lambda kw=kw: plan(**kw), "refuse")
