@@ -254,7 +254,8 @@ class GraspCandidates(Sequence):
         origin that holds the object, the same for every candidate.
     reason : str
         Why the result is empty, or why none of its candidates is force
-        closure (empty string otherwise).
+        closure or (multi-finger hands) held by the hand's actuators (empty
+        string otherwise).
     settings : dict
         The options of the run (noise, seed, tolerances), for the record.
     time : float

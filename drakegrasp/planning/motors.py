@@ -184,8 +184,38 @@ def with_torques_needed(
         else c
         for c in result.candidates[:top]
     ]
+    reason = result.reason or _too_weak(plant, head)
     return dataclasses.replace(
         result,
         candidates=(*head, *result.candidates[top:]),
+        reason=reason,
         time=time.perf_counter() - started,
     )
+
+
+def _too_weak(plant, head) -> str:
+    """Why no candidate of ``head`` holds with the actuators, or ""."""
+    needed = [c.torque_needed for c in head if not np.isnan(c.torque_needed)]
+    if not needed:
+        return ""
+    limits = [
+        float(a.effort_limit())
+        for name in head[0].joint_names
+        for a in _actuators(plant, find_joint(plant, name))
+    ]
+    if not limits or min(needed) <= min(limits):
+        return ""
+    return (
+        f"the hand's actuators (effort limits from {min(limits):.3g} N·m) hold "
+        f"none of the {len(needed)} best force-closure candidates against the "
+        f"object's weight in every direction: they need at least "
+        f"{min(needed):.3g} N·m per joint (torque_needed)"
+    )
+
+
+def _actuators(plant, joint):
+    return [
+        plant.get_joint_actuator(i)
+        for i in plant.GetJointActuatorIndices()
+        if plant.get_joint_actuator(i).joint().index() == joint.index()
+    ]

@@ -20,6 +20,7 @@ from drakegrasp.planning.motors import (
     finger_jacobian,
     torque_capacity,
     torque_needed,
+    with_torques_needed,
 )
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
 
@@ -41,7 +42,7 @@ def allegro_on_soup(drake_models_dir):
         num_candidates=100, mu=1.0, seed=0, robustness_samples=8,
     )  # fmt: skip
     weight = scene.object_body.get_mass(ctx) * 9.81
-    return scene, [c for c in result if c.is_closure], weight
+    return scene, [c for c in result if c.is_closure], weight, result
 
 
 def _beta_by_generators(candidate, J, u) -> float:
@@ -70,7 +71,7 @@ def _beta_by_generators(candidate, J, u) -> float:
 
 
 def test_torque_capacity_matches_a_second_lp(allegro_on_soup):
-    scene, closed, _ = allegro_on_soup
+    scene, closed, _, _ = allegro_on_soup
     for candidate in closed[:3]:
         J = finger_jacobian(scene.plant, scene.context, candidate, scene.object_body)
         assert J.shape == (3 * candidate.num_contacts, 16)
@@ -82,7 +83,7 @@ def test_torque_capacity_matches_a_second_lp(allegro_on_soup):
 def test_torque_needed_scales_with_the_weight_and_leaves_the_context(
     allegro_on_soup,
 ):
-    scene, closed, weight = allegro_on_soup
+    scene, closed, weight, result = allegro_on_soup
     q = scene.plant.GetPositions(scene.plant.GetMyContextFromRoot(scene.context))
     one = torque_needed(scene.plant, scene.context, closed[0], scene.object_body,
                         weight=weight)  # fmt: skip
@@ -106,7 +107,7 @@ def test_torque_needed_scales_with_the_weight_and_leaves_the_context(
 
 
 def test_plan_grasps_sets_it_on_the_best(allegro_on_soup):
-    scene, closed, weight = allegro_on_soup
+    scene, closed, weight, result = allegro_on_soup
     top = [c for c in closed if not np.isnan(c.torque_needed)]
     assert 0 < len(top) <= 10
     assert top == closed[: len(top)]  # the best force-closure candidates
@@ -122,7 +123,7 @@ def test_plan_grasps_sets_it_on_the_best(allegro_on_soup):
 
 
 def test_torque_needed_predicts_the_shake_test(allegro_on_soup):
-    scene, closed, weight = allegro_on_soup
+    scene, closed, weight, result = allegro_on_soup
     needed = [
         torque_needed(scene.plant, scene.context, c, scene.object_body, weight=weight)
         for c in closed[:20]
@@ -132,3 +133,17 @@ def test_torque_needed_predicts_the_shake_test(allegro_on_soup):
     heavy = next(c for c, t in pairs if 1.5 < t < np.inf)
     assert shake_test(scene.add_models, light, squeeze=0.5, **SHAKE).held
     assert not shake_test(scene.add_models, heavy, squeeze=0.5, **SHAKE).held
+
+
+def test_a_weight_the_actuators_cannot_hold_is_said(allegro_on_soup):
+    scene, closed, weight, result = allegro_on_soup
+    assert result.reason == ""  # the can holds at 0.7 N·m
+    heavy = with_torques_needed(
+        result, scene.plant, scene.context, scene.object_body,
+        weight=20 * weight, top=10, started=0.0,
+    )  # fmt: skip
+    needed = [c.torque_needed for c in heavy[:10] if c.is_closure]
+    assert min(needed) > 0.7  # the Allegro SDF's effort limit
+    assert "hold none of the" in heavy.reason
+    assert f"{min(needed):.3g} N·m" in heavy.reason
+    assert heavy.reason in str(heavy)
