@@ -10,7 +10,8 @@ rejects colliding poses and closes the fingers with Drake's distance queries
 (:mod:`~drakegrasp.planning.placement`) or on a point cloud
 (:mod:`~drakegrasp.planning.cloud`; multi-finger hands,
 :mod:`~drakegrasp.planning.cloud_hand`), and ranks the grasps
-(:mod:`~drakegrasp.planning.ranking`, :mod:`~drakegrasp.planning.weight`);
+(:mod:`~drakegrasp.planning.ranking`, :mod:`~drakegrasp.planning.weight`,
+:mod:`~drakegrasp.planning.motors`);
 the results are :mod:`~drakegrasp.planning.candidates`, and
 :mod:`~drakegrasp.planning.shake` checks them in a Drake simulation.  This
 folder imports the plant, quality, batch and closure layers; nothing inside
@@ -35,6 +36,7 @@ _SUBMODULES = (
     "cloud",
     "cloud_hand",
     "gripper",
+    "motors",
     "multifinger",
     "placement",
     "planner",

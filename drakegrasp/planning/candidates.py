@@ -107,6 +107,13 @@ class GraspCandidate:
     q_preshape : (n_h,) float or None
         A multi-finger hand's pre-shape, from which ``close_hand`` closed it
         (None for a parallel jaw, whose pre-grasp is ``opening``).
+    torque_needed : float
+        A multi-finger hand's torque (N·m) at every finger joint that holds
+        the object's weight in all the weight directions
+        (:func:`~drakegrasp.planning.motors.torque_needed`; a lower bound),
+        for the top candidates (``certify``) planned on a body; inf: none
+        does; NaN: not computed.  Compare it with the actuators' effort
+        limits, or use it as ``shake_test``'s squeeze.
     """
 
     sample: int
@@ -129,6 +136,7 @@ class GraspCandidate:
     squeeze_needed: float = float("nan")
     closure: ClosureResult | None = None
     q_preshape: np.ndarray | None = None
+    torque_needed: float = float("nan")
 
     @cached_property
     def grasp(self) -> Grasp:
@@ -202,6 +210,7 @@ class GraspCandidate:
             "q_preshape": None
             if self.q_preshape is None
             else jsonable(self.q_preshape),
+            "torque_needed": jsonable(self.torque_needed),
         }
 
     def __str__(self) -> str:
@@ -211,6 +220,8 @@ class GraspCandidate:
             if np.isfinite(self.opening)
             else f"{len(self.q_hand)} closing joints"
         )
+        if not np.isnan(self.torque_needed):
+            shape += f", torque {self.torque_needed:.3g} N·m per joint"
         return (
             f"sample {self.sample}: "
             f"{'force closure' if self.is_closure else 'no closure'}"
@@ -243,7 +254,8 @@ class GraspCandidates(Sequence):
         origin that holds the object, the same for every candidate.
     reason : str
         Why the result is empty, or why none of its candidates is force
-        closure (empty string otherwise).
+        closure or (multi-finger hands) held by the hand's actuators (empty
+        string otherwise).
     settings : dict
         The options of the run (noise, seed, tolerances), for the record.
     time : float
@@ -302,6 +314,7 @@ class GraspCandidates(Sequence):
             "score": np.array([c.score for c in rows]),
             "weight_capacity": np.array([c.weight_capacity for c in rows]),
             "squeeze_needed": np.array([c.squeeze_needed for c in rows]),
+            "torque_needed": np.array([c.torque_needed for c in rows]),
             "epsilon": np.array([c.epsilon for c in rows]),
             "robustness": np.array([c.robustness for c in rows]),
             "is_closure": np.array([c.is_closure for c in rows], dtype=bool),

@@ -58,6 +58,7 @@ from drakegrasp.planning.candidates import (
 )
 from drakegrasp.planning.cloud import CONTACT_BAND, CloudSurface, complete_unseen
 from drakegrasp.planning.cloud_hand import CloudHand
+from drakegrasp.planning.motors import with_torques_needed
 from drakegrasp.planning.ranking import group_by_count, robustness, tie_key, verdicts
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.closing import close_checked_hand
@@ -389,12 +390,15 @@ def plan_multifinger(
         )  # fmt: skip
     finally:
         plant.SetPositions(ctx, saved)
-    return _ranked_result(
+    result = _ranked_result(
         kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
         settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
         num_sampled=n, object_body=name, started=t0,
     )  # fmt: skip
+    return with_torques_needed(
+        result, plant, ctx, body, weight=weight, top=certify, started=t0
+    )
 
 
 def plan_multifinger_cloud(

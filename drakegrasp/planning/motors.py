@@ -1,0 +1,221 @@
+r"""How much joint torque a multi-finger grasp needs to hold the object's weight.
+
+A parallel jaw's motor sets a squeeze, so :mod:`~drakegrasp.planning.weight`
+bounds each finger's normal forces.  A hand with revolute fingers sets joint
+torques instead, each capped by its actuator's effort limit (the Allegro
+hand's 0.7 N·m), and a fingertip far from its knuckles presses with less force
+for the same torque.  For a candidate with hand Jacobian ``J`` (contact frames,
+finger joints only: the hand's base is placed and held, so nothing bounds its
+wrench) the **torque capacity** in a weight direction ``u`` is
+
+.. math::
+
+    \beta(u) = \max \beta \;\text{s.t.}\;
+    G f + \beta \begin{bmatrix} u \\ 0 \end{bmatrix} = 0,\quad
+    f \in \text{the polyhedral cones},\quad
+    |(J^\top f)_j| \le 1 \;\text{(every finger joint } j\text{)},
+
+the weight (N) held along ``u`` per N·m allowed at every finger joint, moments
+about O's origin (the centre of mass of the shipped objects).  By linearity
+the hand holds a weight ``m g`` in every one of the directions
+:data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS` when each joint may
+apply :math:`m g / \min_u \beta(u)`: the **torque needed**.  Like the squeeze
+needed, it is a lower bound: the program shares the torques among the
+contacts at will, and a real finger presses as its controller dictates.
+
+Each direction is one :func:`~drakegrasp.closure.payload.max_load` program
+(through drakegrasp's solver gateway), about 1.5 ms.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+
+from drakegrasp.closure.payload import max_load
+from drakegrasp.errors import InvalidOptionError
+from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
+from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
+from drakegrasp.plant.fingers import find_joint
+from drakegrasp.plant.jacobians import hand_jacobian
+from drakegrasp.plant.validation import plant_context_of, resolve_object_body
+
+__all__ = ["finger_jacobian", "torque_capacity", "torque_needed", "with_torques_needed"]
+
+
+def finger_jacobian(plant, plant_context, candidate: GraspCandidate, object_body):
+    """``J`` of a candidate over its finger joints, at the candidate's pose.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        The plant the candidate was planned in.
+    plant_context : Context
+        Its context (or the diagram's root context); left as it was.
+    candidate : GraspCandidate
+    object_body : RigidBody, BodyIndex or str
+        The object (frame O); put at the candidate's planned pose.
+
+    Returns
+    -------
+    (M, n_j) float
+        Rows in the contact frames of ``candidate.grasp`` (its components),
+        columns the candidate's joints (``candidate.joint_names``), m/s per
+        rad/s (or per m/s for a prismatic finger).
+    """
+    ctx = plant_context_of(plant, plant_context)
+    body = resolve_object_body(plant, object_body)
+    joints = [find_joint(plant, name) for name in candidate.joint_names]
+    columns = np.array([j.velocity_start() for j in joints], dtype=int)
+    saved = plant.GetPositions(ctx).copy()
+    try:
+        candidate.apply(plant, ctx, object_body=body)
+        return hand_jacobian(
+            plant, ctx, candidate.contacts, candidate.grasp, body,
+            velocity_indices=columns,
+        )  # fmt: skip
+    finally:
+        plant.SetPositions(ctx, saved)
+
+
+def torque_capacity(
+    plant,
+    plant_context,
+    candidate: GraspCandidate,
+    object_body,
+    *,
+    directions: np.ndarray = WEIGHT_DIRECTIONS,
+) -> np.ndarray:
+    """``β(u)`` per direction: weight held per N·m at every finger joint.
+
+    Parameters
+    ----------
+    plant, plant_context, candidate, object_body
+        As for :func:`finger_jacobian`.
+    directions : (D, 3) float, optional
+        Unit weight directions in frame O (default the 14 of the weight
+        capacity).
+
+    Returns
+    -------
+    (D,) float
+        N per N·m (N per N for prismatic fingers); 0 where the grasp cannot
+        hold a weight along the direction at all, ``inf`` where no joint bounds
+        it.
+    """
+    u = np.asarray(directions, dtype=float)
+    if u.ndim != 2 or u.shape[1] != 3 or not np.all(np.isfinite(u)):
+        raise InvalidOptionError(
+            f"directions must be finite 3-vectors in frame O, got shape {u.shape}"
+        )
+    J = finger_jacobian(plant, plant_context, candidate, object_body)
+    grasp = candidate.grasp
+    return np.array(
+        [
+            max_load(
+                grasp,
+                np.concatenate([d, np.zeros(3)]),
+                hand_jacobian=J,
+                torque_limits=1.0,
+                cones="polyhedral",
+                certify=False,
+            ).alpha  # fmt: skip
+            for d in u / np.linalg.norm(u, axis=1, keepdims=True)
+        ]
+    )
+
+
+def torque_needed(
+    plant, plant_context, candidate: GraspCandidate, object_body, *, weight: float
+) -> float:
+    """The torque (N·m per finger joint) that holds ``weight`` in every direction.
+
+    Parameters
+    ----------
+    plant, plant_context, candidate, object_body
+        As for :func:`finger_jacobian`.
+    weight : float
+        The object's weight ``m g`` (N).
+
+    Returns
+    -------
+    float
+        ``weight / min_u β(u)`` over the 14 weight directions: ``inf`` when
+        some direction cannot be held, NaN for a NaN weight (a point cloud
+        without ``object_mass``).
+    """
+    if math.isnan(weight):
+        return math.nan
+    if not math.isfinite(weight) or weight < 0:
+        raise InvalidOptionError(f"weight must be finite and >= 0 (N), got {weight!r}")
+    beta = float(np.min(torque_capacity(plant, plant_context, candidate, object_body)))
+    return math.inf if beta <= 0 else weight / beta
+
+
+def with_torques_needed(
+    result: GraspCandidates,
+    plant,
+    plant_context,
+    object_body,
+    *,
+    weight: float,
+    top: int,
+    started: float,
+) -> GraspCandidates:
+    """``result`` with :func:`torque_needed` set on its best ``top`` candidates.
+
+    Only force-closure candidates get it (the others hold no weight in some
+    direction: inf would say nothing new).  ``started`` is the run's
+    ``time.perf_counter()`` at its start, so ``result.time`` counts this stage.
+    """
+    if math.isnan(weight):
+        return result
+    head = [
+        dataclasses.replace(
+            c,
+            torque_needed=torque_needed(
+                plant, plant_context, c, object_body, weight=weight
+            ),
+        )
+        if c.is_closure
+        else c
+        for c in result.candidates[:top]
+    ]
+    reason = result.reason or _too_weak(plant, head)
+    return dataclasses.replace(
+        result,
+        candidates=(*head, *result.candidates[top:]),
+        reason=reason,
+        time=time.perf_counter() - started,
+    )
+
+
+def _too_weak(plant, head) -> str:
+    """Why no candidate of ``head`` holds with the actuators, or ""."""
+    needed = [c.torque_needed for c in head if not np.isnan(c.torque_needed)]
+    if not needed:
+        return ""
+    limits = [
+        float(a.effort_limit())
+        for name in head[0].joint_names
+        for a in _actuators(plant, find_joint(plant, name))
+    ]
+    if not limits or min(needed) <= min(limits):
+        return ""
+    return (
+        f"the hand's actuators (effort limits from {min(limits):.3g} N·m) hold "
+        f"none of the {len(needed)} best force-closure candidates against the "
+        f"object's weight in every direction: they need at least "
+        f"{min(needed):.3g} N·m per joint (torque_needed)"
+    )
+
+
+def _actuators(plant, joint):
+    return [
+        plant.get_joint_actuator(i)
+        for i in plant.GetJointActuatorIndices()
+        if plant.get_joint_actuator(i).joint().index() == joint.index()
+    ]

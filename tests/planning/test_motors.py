@@ -1,0 +1,149 @@
+"""The torque a multi-finger grasp needs: a second LP, and the shake test.
+
+The torque capacity ``β(u)`` is checked against the same program written here
+over the cones' generators and solved by scipy's HiGHS; the torque needed
+against physics: on the YCB soup can, Drake's Allegro hand at 0.5 N·m per
+joint holds a candidate that needs well below that and drops one that needs
+well above.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+import drakegrasp as dg
+from drakegrasp.core.friction_cone import friction_cone_generators
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.motors import (
+    finger_jacobian,
+    torque_capacity,
+    torque_needed,
+    with_torques_needed,
+)
+from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
+
+ALLEGRO = (
+    "package://drake_models/allegro_hand_description/sdf/"
+    "allegro_hand_description_right.sdf"
+)
+SOUP = "package://drake_models/ycb/005_tomato_soup_can.sdf"
+SHAKE = dict(stiffness=20.0, damping=1.0)
+
+
+@pytest.fixture(scope="module")
+def allegro_on_soup(drake_models_dir):
+    scene = planning_scene(SOUP, hand_url=ALLEGRO, models_dir=drake_models_dir)
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    scene.plant.GetJointByName("joint_12").set_angle(ctx, 1.0)  # thumb opposed
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=100, mu=1.0, seed=0, robustness_samples=8,
+    )  # fmt: skip
+    weight = scene.object_body.get_mass(ctx) * 9.81
+    return scene, [c for c in result if c.is_closure], weight, result
+
+
+def _beta_by_generators(candidate, J, u) -> float:
+    """max β: G S λ + β [u; 0] = 0, |Jᵀ S λ| <= 1, λ >= 0 (scipy HiGHS)."""
+    grasp = candidate.grasp
+    G = dg.grasp_matrix(grasp)
+    blocks = [friction_cone_generators(c, 8) for c in grasp.contacts]
+    S = np.zeros((G.shape[1], sum(b.shape[1] for b in blocks)))
+    r = c = 0
+    for b in blocks:
+        S[r : r + b.shape[0], c : c + b.shape[1]] = b
+        r, c = r + b.shape[0], c + b.shape[1]
+    n = S.shape[1]
+    A_eq = np.hstack([G @ S, np.concatenate([u, np.zeros(3)])[:, None]])
+    T = J.T @ S
+    A_ub = np.vstack([np.hstack([T, np.zeros((len(T), 1))]),
+                      np.hstack([-T, np.zeros((len(T), 1))])])  # fmt: skip
+    cost = np.zeros(n + 1)
+    cost[-1] = -1.0
+    res = linprog(
+        cost, A_ub=A_ub, b_ub=np.ones(len(A_ub)), A_eq=A_eq, b_eq=np.zeros(6),
+        bounds=[(0, None)] * (n + 1), method="highs",
+    )  # fmt: skip
+    assert res.status == 0
+    return float(res.x[-1])
+
+
+def test_torque_capacity_matches_a_second_lp(allegro_on_soup):
+    scene, closed, _, _ = allegro_on_soup
+    for candidate in closed[:3]:
+        J = finger_jacobian(scene.plant, scene.context, candidate, scene.object_body)
+        assert J.shape == (3 * candidate.num_contacts, 16)
+        beta = torque_capacity(scene.plant, scene.context, candidate, scene.object_body)
+        expected = [_beta_by_generators(candidate, J, u) for u in WEIGHT_DIRECTIONS]
+        np.testing.assert_allclose(beta, expected, rtol=1e-6, atol=1e-9)
+
+
+def test_torque_needed_scales_with_the_weight_and_leaves_the_context(
+    allegro_on_soup,
+):
+    scene, closed, weight, result = allegro_on_soup
+    q = scene.plant.GetPositions(scene.plant.GetMyContextFromRoot(scene.context))
+    one = torque_needed(scene.plant, scene.context, closed[0], scene.object_body,
+                        weight=weight)  # fmt: skip
+    two = torque_needed(scene.plant, scene.context, closed[0], scene.object_body,
+                        weight=2 * weight)  # fmt: skip
+    assert two == pytest.approx(2 * one, rel=1e-9)
+    after = scene.plant.GetPositions(scene.plant.GetMyContextFromRoot(scene.context))
+    np.testing.assert_array_equal(after, q)
+    assert np.isnan(
+        torque_needed(
+            scene.plant,
+            scene.context,
+            closed[0],
+            scene.object_body,
+            weight=float("nan"),
+        )  # fmt: skip
+    )
+    with pytest.raises(dg.InvalidOptionError, match="weight"):
+        torque_needed(scene.plant, scene.context, closed[0], scene.object_body,
+                      weight=-1.0)  # fmt: skip
+
+
+def test_plan_grasps_sets_it_on_the_best(allegro_on_soup):
+    scene, closed, weight, result = allegro_on_soup
+    top = [c for c in closed if not np.isnan(c.torque_needed)]
+    assert 0 < len(top) <= 10
+    assert top == closed[: len(top)]  # the best force-closure candidates
+    for c in top[:2]:
+        assert c.torque_needed == pytest.approx(
+            torque_needed(
+                scene.plant, scene.context, c, scene.object_body, weight=weight
+            ),  # fmt: skip
+            rel=1e-9,
+        )
+        assert "N·m per joint" in str(c)
+        assert c.to_dict()["torque_needed"] == pytest.approx(c.torque_needed)
+
+
+def test_torque_needed_predicts_the_shake_test(allegro_on_soup):
+    scene, closed, weight, result = allegro_on_soup
+    needed = [
+        torque_needed(scene.plant, scene.context, c, scene.object_body, weight=weight)
+        for c in closed[:20]
+    ]
+    pairs = list(zip(closed[:20], needed, strict=True))
+    light = next(c for c, t in pairs if t < 0.35)
+    heavy = next(c for c, t in pairs if 1.5 < t < np.inf)
+    assert shake_test(scene.add_models, light, squeeze=0.5, **SHAKE).held
+    assert not shake_test(scene.add_models, heavy, squeeze=0.5, **SHAKE).held
+
+
+def test_a_weight_the_actuators_cannot_hold_is_said(allegro_on_soup):
+    scene, closed, weight, result = allegro_on_soup
+    assert result.reason == ""  # the can holds at 0.7 N·m
+    heavy = with_torques_needed(
+        result, scene.plant, scene.context, scene.object_body,
+        weight=20 * weight, top=10, started=0.0,
+    )  # fmt: skip
+    needed = [c.torque_needed for c in heavy[:10] if c.is_closure]
+    assert min(needed) > 0.7  # the Allegro SDF's effort limit
+    assert "hold none of the" in heavy.reason
+    assert f"{min(needed):.3g} N·m" in heavy.reason
+    assert heavy.reason in str(heavy)
