@@ -36,6 +36,7 @@ import time
 import numpy as np
 
 from drakegrasp.closure.payload import max_load
+from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
@@ -66,6 +67,11 @@ def finger_jacobian(plant, plant_context, candidate: GraspCandidate, object_body
         columns the candidate's joints (``candidate.joint_names``), m/s per
         rad/s (or per m/s for a prismatic finger).
     """
+    if not isinstance(candidate, GraspCandidate):
+        raise InvalidOptionError(
+            f"candidate must be a GraspCandidate of plan_grasps, got "
+            f"{type(candidate).__name__}"
+        )
     ctx = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
     joints = [find_joint(plant, name) for name in candidate.joint_names]
@@ -147,6 +153,7 @@ def torque_needed(
         some direction cannot be held, NaN for a NaN weight (a point cloud
         without ``object_mass``).
     """
+    weight = real_scalar("weight", weight)
     if math.isnan(weight):
         return math.nan
     if not math.isfinite(weight) or weight < 0:

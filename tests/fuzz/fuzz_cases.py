@@ -41,6 +41,7 @@ from sandbox import SandboxTimeout
 import drakegrasp as dg
 from drakegrasp.core import examples as ex
 from drakegrasp.core import validation as V
+from drakegrasp.planning.motors import torque_needed
 
 OUTCOMES = (
     "clear GraspError",
@@ -1315,6 +1316,23 @@ def planning_cases() -> Iterator[Case]:
                 lambda o=option, v=value: plan(**{o: v}),
                 "refuse",
             )
+    # torque_needed of the best candidate: hostile weights and candidates.
+    best = plan()[0]
+
+    def torque(candidate=best, weight=1.0):
+        return torque_needed(
+            scene.plant, scene.context, candidate, scene.object_body, weight=weight
+        )
+
+    for i, w in enumerate(["abc", None, -1.0, INF, [1.0], True]):
+        yield Case("planning", f"torque_needed(weight#{i})",
+                   lambda w=w: torque(weight=w), "refuse")  # fmt: skip
+    yield Case("planning", "torque_needed(candidate)",
+               lambda: torque(candidate="x"), "refuse")  # fmt: skip
+    yield Case(
+        "planning", "torque_needed(weight=nan)", lambda: torque(weight=NAN),
+        "answer", lambda t: np.isnan(t),
+    )  # fmt: skip
     # hand=None: every body but the object's (valid here: the gripper).
     yield Case("planning", "hand=None", lambda: plan(hand=None), "either", ranked)
     for name, kw in {
