@@ -614,10 +614,36 @@ PLAN_HANDS = {
 """``plan --hand`` short names: drakegrasp's two jaws and Drake's WSG-50."""
 
 
-def _plan_url(spec: str, folder: str) -> str:
-    if "://" in spec or spec.endswith((".sdf", ".urdf", ".xml")):
+MODEL_SUFFIXES = (".sdf", ".urdf", ".xml")
+"""File endings of the model files Drake's parser reads (``plan`` checks them)."""
+
+
+def _plan_url(spec: str) -> str:
+    """``plan``'s object: a URL or model file as it is, or a shipped name's URL."""
+    from drakegrasp.plant.models import models_dir
+
+    if "://" in spec or spec.endswith(MODEL_SUFFIXES):
         return spec
-    return f"package://drakegrasp/{folder}/{spec}.sdf"
+    shipped = sorted(p.stem for p in (models_dir() / "objects").glob("*.sdf"))
+    if spec not in shipped:
+        raise InvalidOptionError(
+            f"object {spec!r} is not a shipped object ({', '.join(shipped)}), a "
+            f"scene, a package:// URL or a model file ({', '.join(MODEL_SUFFIXES)})"
+        )
+    return f"package://drakegrasp/objects/{spec}.sdf"
+
+
+def _plan_hand(spec: str | None) -> str:
+    """``plan --hand``: a short name's URL, or a URL or model file as it is."""
+    spec = spec or "flat"
+    if spec in PLAN_HANDS:
+        return PLAN_HANDS[spec]
+    if "://" in spec or spec.endswith(MODEL_SUFFIXES):
+        return spec
+    raise InvalidOptionError(
+        f"--hand {spec!r} is not one of {', '.join(PLAN_HANDS)}, a package:// URL "
+        f"or a model file ({', '.join(MODEL_SUFFIXES)})"
+    )
 
 
 def _is_scene(target: str) -> bool:
@@ -655,8 +681,8 @@ def _plan_setup(args: argparse.Namespace):
             "distance_tolerance": info.distance_tolerance,
         }
         return scene.plant, scene.plant_context, scene.object_body, scene.hand, options
-    hand = PLAN_HANDS.get(args.hand or "flat", args.hand)
-    scene = planning_scene(_plan_url(args.object, "objects"), hand_url=hand)
+    hand = _plan_hand(args.hand)
+    scene = planning_scene(_plan_url(args.object), hand_url=hand)
     options = {"mu": 0.5 if args.mu is None else args.mu}
     return scene.plant, scene.context, scene.object_body, scene.hand, options
 
