@@ -14,6 +14,7 @@ import pytest
 from scipy.optimize import linprog
 
 import drakegrasp as dg
+from drakegrasp.closure.payload import max_load
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.motors import (
@@ -78,6 +79,20 @@ def test_torque_capacity_matches_a_second_lp(allegro_on_soup):
         beta = torque_capacity(scene.plant, scene.context, candidate, scene.object_body)
         expected = [_beta_by_generators(candidate, J, u) for u in WEIGHT_DIRECTIONS]
         np.testing.assert_allclose(beta, expected, rtol=1e-6, atol=1e-9)
+        # A second formulation: drakegrasp's payload program (facet rows,
+        # normalised), one direction at a time.
+        payload = [
+            max_load(
+                candidate.grasp,
+                np.concatenate([u, np.zeros(3)]),
+                hand_jacobian=J,
+                torque_limits=1.0,
+                cones="polyhedral",
+                certify=False,
+            ).alpha  # fmt: skip
+            for u in WEIGHT_DIRECTIONS
+        ]
+        np.testing.assert_allclose(beta, payload, rtol=1e-6, atol=1e-9)
 
 
 def test_torque_needed_scales_with_the_weight_and_leaves_the_context(
