@@ -49,7 +49,11 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    of geometries on a body: the cloud point where the geometry is closest,
    with the mean of the cloud's normals there, or, across an edge (where the
    normals it nearly touches disagree, :data:`EDGE_ANGLE`), the finger's own normal
-   there, as on a body where a smooth finger meets an edge.  Only a box's face lying
+   there, as on a body where a smooth finger meets an edge.  Each contact
+   also carries its *fan* (:data:`FAN_SIGMAS`): where the cloud within reach
+   of the finger folds, the arc of normals between the faces it may meet,
+   over which the ranking averages the weight capacity
+   (:func:`~drakegrasp.planning.multifinger.fan_capacity`).  Only a box's face lying
    flat on a flat patch touches along an area and reports the patch's
    corners, as a pad on a body's flat face does.  (Every touched point of
    the band, or its hull's corners, made 11-28 contacts where the body
@@ -230,6 +234,11 @@ class CloudHand:
     tol : float
         Distance tolerance, metres.
     min_fingers : int
+    completed : bool, optional
+        The cloud's unseen side was completed (keep the hand out of it).
+    fan_reach : float, optional
+        Metres: a contact's fan holds the normals of the cloud points within
+        this distance of the finger's surface (0: no fans).
     """
 
     def __init__(

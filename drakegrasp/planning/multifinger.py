@@ -26,7 +26,9 @@ rejection reason (:data:`REASONS`).
 
 On a point cloud (:func:`plan_multifinger_cloud`), stages 2 and 3 are those
 of :mod:`drakegrasp.planning.cloud_hand` (the hand against the cloud's points,
-the fingers closed onto them); stages 1 and 4 are the same.
+the fingers closed onto them); stage 1 is the same, and in stage 4 the weight
+capacity of a candidate with a contact at an edge of the cloud is averaged
+over the edge's normal fan (:func:`fan_capacity`).
 """
 
 from __future__ import annotations
