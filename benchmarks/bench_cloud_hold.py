@@ -20,8 +20,9 @@ are force closure, and the hold rates in Drake
 Allegro's revolute fingers at 0.5 N·m, PD gains 20 N·m/rad and 1 N·m·s/rad)
 of the ``--top`` best candidates and of ``--random`` candidates drawn
 uniformly (seeded) from all of them, as held / tried.  ``--verbose`` prints
-each shaken candidate's largest displacement and rotation and its contacts
-per finger.
+each shaken candidate's largest displacement and rotation, its contacts per
+finger and how many carry an edge's normal fan (the planning guide's "Edges:
+the normal fan").
 """
 
 from __future__ import annotations
@@ -69,10 +70,12 @@ def sample_cloud(full, n, seed=0, view=None):
 
 def _describe(c, s) -> str:
     fingers = Counter(k.finger_body.split("::")[-1] for k in c.contacts)
+    fans = sum(getattr(k, "fan", None) is not None for k in c.contacts)
     return (
         f"      #{c.sample:<4} score {c.score:8.4f} rho {c.robustness:4.2f} "
         f"{'held' if s.held else 'fell'}: {s.max_displacement * 1e3:6.1f} mm "
         f"{np.degrees(s.max_rotation):6.1f} deg  contacts {dict(fingers)}"
+        f" ({fans} with an edge fan)"
     )
 
 

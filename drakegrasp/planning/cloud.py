@@ -104,12 +104,17 @@ class CloudContact:
         Gap left between the shape and the point along the closing direction, m.
     finger_body : str
         Scoped name of the finger body.
+    fan : (2, 3) float or None
+        At an edge of the cloud, the ends of the arc of inward normals the
+        finger may meet there (:data:`~drakegrasp.planning.cloud_hand.FAN_SIGMAS`),
+        frame O; None on a smooth patch.
     """
 
     p_OC: np.ndarray
     nhat_O: np.ndarray
     psi: float
     finger_body: str
+    fan: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
@@ -118,6 +123,7 @@ class CloudContact:
             "nhat_O": self.nhat_O.tolist(),
             "psi": self.psi,
             "finger_body": self.finger_body,
+            "fan": None if self.fan is None else self.fan.tolist(),
         }
 
 

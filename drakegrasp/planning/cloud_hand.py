@@ -49,7 +49,11 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    of geometries on a body: the cloud point where the geometry is closest,
    with the mean of the cloud's normals there, or, across an edge (where the
    normals it nearly touches disagree, :data:`EDGE_ANGLE`), the finger's own normal
-   there, as on a body where a smooth finger meets an edge.  Only a box's face lying
+   there, as on a body where a smooth finger meets an edge.  Each contact
+   also carries its *fan* (:data:`FAN_SIGMAS`): where the cloud within reach
+   of the finger folds, the arc of normals between the faces it may meet,
+   over which the ranking averages the weight capacity
+   (:func:`~drakegrasp.planning.multifinger.fan_capacity`).  Only a box's face lying
    flat on a flat patch touches along an area and reports the patch's
    corners, as a pad on a body's flat face does.  (Every touched point of
    the band, or its hull's corners, made 11-28 contacts where the body
@@ -87,6 +91,7 @@ from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
     "EDGE_ANGLE",
+    "FAN_SIGMAS",
     "GAP_SPACINGS",
     "REASONS",
     "SURFEL_SPACINGS",
@@ -147,6 +152,12 @@ cloud's normal is the wrong one: a finger touching a can's rim from the side
 pushes along its own surface's normal (the true can's analysis found
 ``(0.63, −0.08, −0.77)`` where the rim's cap points said ``(0, −1, 0)``), so
 a contact on an edge takes the hand geometry's normal."""
+
+FAN_SIGMAS = 2.0
+"""A contact's normal fan holds the normals of the cloud points within this
+many robustness position noises ``σ_p`` of the finger (the noise's
+``"position"``; 4 mm by default): the surface a finger misplaced by up to
+``2 σ_p`` may meet.  See :func:`~drakegrasp.planning.multifinger.fan_capacity`."""
 
 _FD = 1e-7
 """Step (m) of the central differences of a signed distance's gradient."""
@@ -223,13 +234,20 @@ class CloudHand:
     tol : float
         Distance tolerance, metres.
     min_fingers : int
+    completed : bool, optional
+        The cloud's unseen side was completed (keep the hand out of it).
+    fan_reach : float, optional
+        Metres: a contact's fan holds the normals of the cloud points within
+        this distance of the finger's surface (0: no fans).
     """
 
     def __init__(
-        self, plant, ctx, hand, surface: CloudSurface, tol, min_fingers, completed=False
-    ):
+        self, plant, ctx, hand, surface: CloudSurface, tol, min_fingers,
+        completed=False, fan_reach=0.0,
+    ):  # fmt: skip
         self.plant, self.ctx, self.hand, self.surface = plant, ctx, hand, surface
         self.completed = bool(completed)
+        self.fan_reach = float(fan_reach)
         self.tol, self.min_fingers = tol, int(min_fingers)
         self.margin = GAP_SPACINGS * surface.spacing
         self.points_W = surface.points + surface.centroid
@@ -578,6 +596,7 @@ class CloudHand:
             n_O = self.surface.normals[idx[int(np.argmin(sd))]]
         n_O = n_O / np.linalg.norm(n_O)
         normals = self.surface.normals[idx[sd <= psi + CONTACT_BAND]]
+        fan = self._fan(g, psi, n_O)
         if isinstance(g.shape, Box) and self._flat(g, normals, n_O):
             keep = [closest[k] for k in _hull_corners(p_closest, n_O)]
         else:
@@ -592,9 +611,17 @@ class CloudHand:
                 nhat_O=-n_O,
                 psi=float(sd[k]),
                 finger_body=name,
+                fan=fan,
             )
             for k in keep
         ]
+
+    def _fan(self, g: _Geometry, psi: float, n_O: np.ndarray):
+        """The contact's normal fan (:func:`_fan`): the normals within reach."""
+        if not self.fan_reach > 0:
+            return None
+        _, _, idx, sd = self.distance(g, within=psi + self.fan_reach + self.tol)
+        return _fan(self.surface.normals[idx[sd <= psi + self.fan_reach]], n_O)
 
     def _hand_normal(self, g: _Geometry, x_W: np.ndarray) -> np.ndarray:
         """The hand geometry's outward normal towards a cloud point, world frame.
@@ -653,6 +680,27 @@ class CloudHand:
         if len(fingers) < 2:
             return None, None, "one finger touches"
         return found, s.coupling.apply(q), None
+
+
+def _fan(normals: np.ndarray, n_O: np.ndarray) -> np.ndarray | None:
+    """The arc of normals at an edge: its inward ends ``(2, 3)``, or None.
+
+    ``normals`` are the outward normals of the cloud points within
+    :data:`FAN_SIGMAS` placement noise of the finger, ``n_O`` the contact's
+    outward normal.  None when none turns more than :data:`EDGE_ANGLE` from
+    ``n_O`` (a smooth patch); else the ends ``a``, the normal turned most
+    from ``n_O``, and ``b``, the one turned most from ``a`` (an edge's two
+    faces), negated.
+    """
+    if len(normals) == 0:
+        return None
+    cos = normals @ n_O
+    i = int(np.argmin(cos))
+    if not cos[i] < np.cos(EDGE_ANGLE):
+        return None
+    a = normals[i]
+    b = normals[int(np.argmin(normals @ a))]
+    return -np.array([a, b])
 
 
 def _spread(normals: np.ndarray) -> float:
