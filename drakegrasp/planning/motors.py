@@ -129,8 +129,9 @@ def torque_capacity(
     -----
     One program for all directions (their blocks share nothing, so maximising
     ``Σ β(u)`` maximises each): the contact forces are the cones' generators
-    ``f = S λ``, ``λ >= 0`` (:data:`DEFAULT_NUM_GENERATORS` per Coulomb cone),
-    and ``β(u) <= BETA_CAP`` keeps it bounded.
+    ``f = S λ``, ``λ >= 0``
+    (:data:`~drakegrasp.core.friction_cone.DEFAULT_NUM_GENERATORS` per Coulomb
+    cone), and :data:`BETA_CAP` keeps it bounded.
     """
     u = np.asarray(directions, dtype=float)
     if u.ndim != 2 or u.shape[1] != 3 or not np.all(np.isfinite(u)):
