@@ -129,9 +129,8 @@ def torque_capacity(
     -----
     One program for all directions (their blocks share nothing, so maximising
     ``Σ β(u)`` maximises each): the contact forces are the cones' generators
-    ``f = S λ``, ``λ >= 0``
-    (:data:`~drakegrasp.core.friction_cone.DEFAULT_NUM_GENERATORS` per Coulomb
-    cone), and :data:`BETA_CAP` keeps it bounded.
+    ``f = S λ``, ``λ >= 0`` (eight per Coulomb cone, the default of the
+    verdicts), and :data:`BETA_CAP` keeps it bounded.
     """
     u = np.asarray(directions, dtype=float)
     if u.ndim != 2 or u.shape[1] != 3 or not np.all(np.isfinite(u)):
