@@ -57,7 +57,13 @@ BETA_CAP = 1e6
 """Bound on ``β(u)`` (N per N·m) that keeps the program bounded; reaching it
 reads as ``inf`` (no finger joint bounds the load: contacts on the palm)."""
 
-__all__ = ["finger_jacobian", "torque_capacity", "torque_needed", "with_torques_needed"]
+__all__ = [
+    "BETA_CAP",
+    "finger_jacobian",
+    "torque_capacity",
+    "torque_needed",
+    "with_torques_needed",
+]
 
 
 def finger_jacobian(plant, plant_context, candidate: GraspCandidate, object_body):
