@@ -45,16 +45,21 @@ and random candidates (:func:`allegro`).
 
 from __future__ import annotations
 
-import argparse
 import os
-import sys
-import time
-from contextlib import contextmanager, nullcontext
-from pathlib import Path
 
-import numpy as np
+# one core: numpy's BLAS must not spin threads of its own (their CPU time counts)
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+import argparse  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from contextlib import contextmanager, nullcontext  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 YCB = ("003_cracker_box", "004_sugar_box", "005_tomato_soup_can")
