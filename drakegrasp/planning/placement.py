@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
+from pydrake.geometry import Box, Sphere
 
 from drakegrasp.errors import NoContactsError, PenetrationError
 from drakegrasp.planning.gripper import ParallelJaw
@@ -26,6 +27,7 @@ from drakegrasp.plant.validation import hand_bodies, hand_contact_bodies, scoped
 __all__ = [
     "MAX_CLOSING_STEPS",
     "PAIR_REACH",
+    "SURE_PENETRATION",
     "BodyCloser",
     "axis_frames",
     "sample_poses",
@@ -38,6 +40,11 @@ PAIR_REACH = 0.02
 """Metres a closing step's distance query reaches: a finger with nothing
 nearer advances by this much (minus half the tolerance), and fewer far pairs
 cross from Drake into Python."""
+
+SURE_PENETRATION = 1e-3
+"""Metres beyond the distance tolerance by which :meth:`BodyCloser.sure_collisions`
+needs a hand geometry to penetrate the object before it rejects a pose without
+Drake (far above the error of Drake's penetration depths)."""
 
 # geometry roles in BodyCloser.role: outside the hand, then inside it
 _SCENE, _OBJECT, _HAND, _FINGER = 0, 1, 2, 3
@@ -213,6 +220,117 @@ class BodyCloser:
                     return "hand collides with the object"
                 return "hand collides with the scene"
         return None
+
+    def _witnesses(self):
+        """Balls inside the hand's geometries, affine in the finger joints.
+
+        Returns ``(p0, v, r)``: ball ``i`` is centred at ``p0[i] + v[i] @ q``
+        in H (``v`` (W, 2, 3): the prismatic joints move a finger rigidly)
+        with radius ``r[i]``; a sphere gives its own ball, a box its centre
+        with its smallest half-size, and its corners, edge midpoints and face
+        centres (radius 0); other shapes none.  None when the geometry is not
+        affine in ``q`` (or the other geometries in the plant are not only the
+        object, or a hand-object pair is collision filtered), so no pose is
+        rejected without Drake.
+        """
+        plant, g = self.plant, self.g
+        inspector = self.port.Eval(self.ctx).inspector()
+        others = set(inspector.GetAllGeometryIds()) - self.hand_geoms
+        others = {o for o in others if inspector.GetProximityProperties(o)}
+        if not self.object_geoms or others - self.object_geoms:
+            return None  # a scene: its collisions have their own reason
+        if any(
+            inspector.CollisionFiltered(a, b)
+            for a in self.hand_geoms
+            for b in self.object_geoms
+            if inspector.GetProximityProperties(a)
+        ):
+            return None
+        ctx = plant.CreateDefaultContext()  # scratch, the hand as in self.ctx
+        plant.SetPositions(ctx, plant.GetPositions(self.ctx))
+        H = g.base.body_frame()
+        configurations = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+        poses = []  # per configuration, {geometry: X_HG}
+        for q in configurations:
+            for j, v in zip(g.joints, q, strict=True):
+                j.set_translation(ctx, float(v))
+            poses.append(
+                {
+                    geom: plant.CalcRelativeTransform(ctx, H, body.body_frame())
+                    @ inspector.GetPoseInFrame(geom)
+                    for body in self.hand_instance_bodies
+                    for geom in plant.GetCollisionGeometriesForBody(body)
+                }
+            )
+        p0, v, r = [], [], []
+        for geom, X0 in poses[0].items():
+            R = X0.rotation().matrix()
+            moved = [poses[i][geom] for i in (1, 2)]
+            turned = [X.rotation().matrix() for X in moved]
+            if any(not np.allclose(R1, R, atol=1e-12) for R1 in turned):
+                return None  # not a rigid translation per joint
+            rate = np.array([X.translation() - X0.translation() for X in moved])
+            shape = inspector.GetShape(geom)
+            if isinstance(shape, Sphere):
+                local, radius = np.zeros((1, 3)), [shape.radius()]
+            elif isinstance(shape, Box):  # centre; corners, edge and face midpoints
+                h = np.array([shape.width(), shape.depth(), shape.height()]) / 2
+                grid = np.array(np.meshgrid(*[[-1, 0, 1]] * 3)).reshape(3, -1).T
+                local = grid * h
+                radius = np.where(np.all(grid == 0, axis=1), h.min(), 0.0).tolist()
+            else:
+                continue
+            p0.append(local @ R.T + X0.translation())
+            v += [rate] * len(local)
+            r += radius
+        if not r:
+            return None
+        return np.vstack(p0), np.array(v), np.array(r)
+
+    def sure_collisions(self, poses, surface, X_WO) -> np.ndarray:
+        """(K,) bool: open hands at ``poses`` that surely penetrate the object.
+
+        Decided in numpy for all poses at once, before any Drake query: a ball
+        inside a hand geometry (:meth:`_witnesses`) whose centre lies inside
+        one of the object's convex hull pieces, at depth ``δ`` (the least
+        distance to a face plane, exact inside a convex polyhedron), makes the
+        two penetrate by at least ``δ + r``; past ``tol +``
+        :data:`SURE_PENETRATION` Drake's signed distance of the pair is below
+        ``-tol``, which :meth:`close_on_body` rejects as "hand collides with
+        the object" (the plant holds no other geometry).  False where unsure.
+
+        Parameters
+        ----------
+        poses : dict
+            :func:`sample_poses`' ``R_WH`` (K, 3, 3), ``p_WH`` (K, 3) and
+            ``opening`` (K,).
+        surface : ObjectSurface
+            The object's pieces, frame O.
+        X_WO : RigidTransform
+        """
+        K = len(poses["opening"])
+        sure = np.zeros(K, bool)
+        hulls = [p for p in getattr(surface, "pieces", ()) if p.kind == "hull"]
+        if not K or not hulls:
+            return sure
+        if not hasattr(self, "_witness_balls"):
+            self._witness_balls = self._witnesses()
+        if self._witness_balls is None:
+            return sure
+        p0, v, r = self._witness_balls
+        q = self.g.q_for_opening(poses["opening"])  # (K, 2)
+        p_H = p0[None] + np.einsum("kf,wfi->kwi", q, v)  # (K, W, 3)
+        R_OW = X_WO.rotation().matrix().T
+        R_OH = R_OW @ poses["R_WH"]  # (K, 3, 3)
+        p_OH = (poses["p_WH"] - X_WO.translation()) @ R_OW.T
+        p_O = np.einsum("kij,kwj->kwi", R_OH, p_H) + p_OH[:, None]
+        for piece in hulls:
+            R_OG = piece.X_OG.rotation().matrix()
+            x = (p_O - piece.X_OG.translation()) @ R_OG  # (K, W, 3), frame G
+            height = (x @ piece.normals.T - piece.offsets).max(axis=2)  # (K, W)
+            deep = (height <= 0) & (r - height > self.tol + SURE_PENETRATION)
+            sure |= deep.any(axis=1)
+        return sure
 
     def close_on_body(self, X_WH, opening):
         """Stages 2 and 3: place the open hand, close it, read the contacts.
