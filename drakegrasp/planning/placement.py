@@ -356,20 +356,26 @@ class BodyCloser:
             The rejection reason, None when the hand closed on the object.
         """
         g, tol, reach = self.g, self.tol, PAIR_REACH
-        q = g.q_for_opening(opening).astype(float)
-        self._set(X_WH, q)
-        toward = np.array([1.0, -1.0])  # finger 0 closes along +a, finger 1 along -a
-        closed_limit = np.where(toward / g.pad_rate > 0, g.upper, g.lower)
-        role = self.role
+        q0, q1 = (float(v) for v in g.q_for_opening(opening))
+        self._set(X_WH, (q0, q1))
+        # Python floats, not 2-vectors: the same IEEE arithmetic, without
+        # numpy's per-call cost.  Finger 0 closes along +a, finger 1 along -a.
+        rate0, rate1 = (float(r) for r in g.pad_rate)
+        way0, way1 = 1.0 / rate0 > 0, -1.0 / rate1 > 0  # q grows while closing
+        limit0 = float(g.upper[0] if way0 else g.lower[0])
+        limit1 = float(g.upper[1] if way1 else g.lower[1])
+        joint0, joint1 = g.joints
+        ctx, port, role = self.ctx, self.port, self.role
+        half = 0.5 * tol
         for step_count in range(MAX_CLOSING_STEPS):
-            query = self.port.Eval(self.ctx)
+            query = port.Eval(ctx)
             pairs = query.ComputeSignedDistancePairwiseClosestPoints(reach)
-            psi = [reach, reach]
-            hit_object = [False, False]
+            psi0 = psi1 = reach
+            hit0 = hit1 = False
             colliding = -tol if step_count == 0 else -np.inf  # ψ below: rejected
             for pair in pairs:
                 distance = pair.distance
-                if distance >= max(psi) and distance >= colliding:
+                if distance >= colliding and distance >= psi0 and distance >= psi1:
                     continue  # lowers no finger's ψ, penetrates nothing
                 ra, rb = role.get(pair.id_A, _SCENE), role.get(pair.id_B, _SCENE)
                 if (ra >= _HAND) == (rb >= _HAND):
@@ -379,25 +385,31 @@ class BodyCloser:
                     if other == _OBJECT:
                         return None, None, "hand collides with the object"
                     return None, None, "hand collides with the scene"
-                f = mine - _FINGER
-                if f >= 0 and distance < psi[f]:
-                    psi[f] = distance
-                    hit_object[f] = other == _OBJECT
-            psi = np.array(psi)
-            if np.all(psi <= tol):
-                if not all(hit_object):
+                if mine == _FINGER:
+                    if distance < psi0:
+                        psi0, hit0 = distance, other == _OBJECT
+                elif mine == _FINGER + 1 and distance < psi1:
+                    psi1, hit1 = distance, other == _OBJECT
+            if psi0 <= tol and psi1 <= tol:
+                if not (hit0 and hit1):
                     return None, None, "finger blocked by the scene"
                 found, reason = self._contacts(query, pairs)
-                return found, q, reason
-            step = np.where(psi > tol, psi - 0.5 * tol, 0.0)
-            q_new = q + toward * step / g.pad_rate
-            beyond = (q_new - closed_limit) * np.sign(toward / g.pad_rate) > 0
-            at_limit = np.abs(q - closed_limit) <= 1e-12
-            if np.any(beyond & at_limit & (psi > tol)):
+                return found, np.array([q0, q1]), reason
+            # each finger advances by ψ - tol/2 (a translation by ψ cannot
+            # penetrate), stopping at its closed limit; one already there
+            # with ψ > tol misses the object
+            new0 = q0 + (psi0 - half) / rate0 if psi0 > tol else q0 + 0.0 / rate0
+            new1 = q1 + -(psi1 - half) / rate1 if psi1 > tol else q1 + -0.0 / rate1
+            beyond0 = (new0 - limit0 > 0) if way0 else (new0 - limit0 < 0)
+            beyond1 = (new1 - limit1 > 0) if way1 else (new1 - limit1 < 0)
+            if (beyond0 and abs(q0 - limit0) <= 1e-12 and psi0 > tol) or (
+                beyond1 and abs(q1 - limit1) <= 1e-12 and psi1 > tol
+            ):
                 return None, None, "finger misses the object"
-            q = np.where(beyond, closed_limit, q_new)
-            for j, v in zip(g.joints, q, strict=True):
-                j.set_translation(self.ctx, float(v))
+            q0 = limit0 if beyond0 else new0
+            q1 = limit1 if beyond1 else new1
+            joint0.set_translation(ctx, q0)
+            joint1.set_translation(ctx, q1)
         return None, None, "closing did not converge"
 
     def _contacts(self, query, pairs):
