@@ -186,6 +186,9 @@ class BodyCloser:
         self.role = dict.fromkeys(self.object_geoms, _OBJECT)
         self.role.update(dict.fromkeys(self.hand_geoms, _HAND))
         self.role.update({g: _FINGER + f for g, f in self.finger_of.items()})
+        # keyed by the ids' integer values: hashing a GeometryId is a Python
+        # call into Drake, an int's is not (the closing loop reads every pair)
+        self._role_of_value = {g.get_value(): r for g, r in self.role.items()}
         self.hand_slot, self.object_slot = {}, {}
         self._cache = {}  # names and shapes of the plant's geometries
         if object_body is not None:  # find_contacts' order: body, k_f, k_o
@@ -319,15 +322,18 @@ class BodyCloser:
             return sure
         p0, v, r = self._witness_balls
         q = self.g.q_for_opening(poses["opening"])  # (K, 2)
-        p_H = p0[None] + np.einsum("kf,wfi->kwi", q, v)  # (K, W, 3)
+        p_H = p0 + q[:, 0, None, None] * v[:, 0] + q[:, 1, None, None] * v[:, 1]
         R_OW = X_WO.rotation().matrix().T
         R_OH = R_OW @ poses["R_WH"]  # (K, 3, 3)
         p_OH = (poses["p_WH"] - X_WO.translation()) @ R_OW.T
-        p_O = np.einsum("kij,kwj->kwi", R_OH, p_H) + p_OH[:, None]
+        p_O = p_H @ R_OH.transpose(0, 2, 1) + p_OH[:, None]  # (K, W, 3)
         for piece in hulls:
             R_OG = piece.X_OG.rotation().matrix()
-            x = (p_O - piece.X_OG.translation()) @ R_OG  # (K, W, 3), frame G
-            height = (x @ piece.normals.T - piece.offsets).max(axis=2)  # (K, W)
+            N_O = piece.normals @ R_OG.T  # the faces in O
+            o_O = piece.offsets + N_O @ piece.X_OG.translation()
+            height = np.full(p_O.shape[:2], -np.inf)  # (K, W): max over faces
+            for n_j, o_j in zip(N_O, o_O, strict=True):
+                np.maximum(height, p_O @ n_j - o_j, out=height)
             deep = (height <= 0) & (r - height > self.tol + SURE_PENETRATION)
             sure |= deep.any(axis=1)
         return sure
@@ -365,7 +371,7 @@ class BodyCloser:
         limit0 = float(g.upper[0] if way0 else g.lower[0])
         limit1 = float(g.upper[1] if way1 else g.lower[1])
         joint0, joint1 = g.joints
-        ctx, port, role = self.ctx, self.port, self.role
+        ctx, port, role = self.ctx, self.port, self._role_of_value
         half = 0.5 * tol
         for step_count in range(MAX_CLOSING_STEPS):
             query = port.Eval(ctx)
@@ -377,7 +383,8 @@ class BodyCloser:
                 distance = pair.distance
                 if distance >= colliding and distance >= psi0 and distance >= psi1:
                     continue  # lowers no finger's ψ, penetrates nothing
-                ra, rb = role.get(pair.id_A, _SCENE), role.get(pair.id_B, _SCENE)
+                ra = role.get(pair.id_A.get_value(), _SCENE)
+                rb = role.get(pair.id_B.get_value(), _SCENE)
                 if (ra >= _HAND) == (rb >= _HAND):
                     continue  # both in the hand, or both outside it
                 mine, other = (ra, rb) if ra >= _HAND else (rb, ra)
