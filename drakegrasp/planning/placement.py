@@ -294,7 +294,7 @@ class BodyCloser:
         """(K,) bool: open hands at ``poses`` that surely penetrate the object.
 
         Decided in numpy for all poses at once, before any Drake query: a ball
-        inside a hand geometry (:meth:`_witnesses`) whose centre lies inside
+        inside a hand geometry (see ``_witnesses``) whose centre lies inside
         one of the object's convex hull pieces, at depth ``δ`` (the least
         distance to a face plane, exact inside a convex polyhedron), makes the
         two penetrate by at least ``δ + r``; past ``tol +``

@@ -481,7 +481,7 @@ class ObjectSurface:
         t_out = np.full(K, np.nan)
         n_out = np.zeros((K, 3))
         dd = np.einsum("ij,ij->i", d_O, d_O)
-        for piece, (centre, radius) in zip(self.pieces, self.balls_O, strict=True):
+        for piece, (centre, radius) in zip(self.pieces, self._balls_O, strict=True):
             # a line that misses the piece's ball misses the piece: only the
             # others are cast (a corner sphere of a YCB box meets few lines)
             near = _near_lines(p_O, d_O, centre, radius, dd)
@@ -500,7 +500,7 @@ class ObjectSurface:
         return t_in, t_out, n_out
 
     @cached_property
-    def balls_O(self) -> tuple[tuple[np.ndarray, float], ...]:
+    def _balls_O(self) -> tuple[tuple[np.ndarray, float], ...]:
         """Each piece's bounding ball ``(centre_O, radius)`` (frame O, metres)."""
         return tuple(
             (piece.X_OG.multiply(centre), radius)
