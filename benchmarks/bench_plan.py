@@ -14,9 +14,11 @@ WSG-50 as a free gripper:
   first, so numba's compilation is not timed), the wall time, samples/s and
   candidates/s (candidates are the samples that survive the collision filter
   and the closing), candidates per CPU second (the machine's load skews wall
-  time), the same with ``--workers`` (2) batch workers (wall time, after a
-  warm-up call that starts the pool, which is kept between calls), and the
-  rejections by reason;
+  time; numpy's BLAS is held to one thread, whose spinning helpers would
+  otherwise count, unless ``OPENBLAS_NUM_THREADS`` is set), the same with
+  ``--workers`` (2) batch workers (wall time, after a warm-up call that
+  starts the pool, which is kept between calls), and the rejections by
+  reason;
 * **the user's loop**: ``--loop`` candidates closed and analysed one at a
   time with ``close_hand``, ``analyze_grasp`` and ``ferrari_canny`` from the
   open hand at the candidate's pose (the baseline of issue 18), candidates/s;
