@@ -11,7 +11,9 @@ drakegrasp's own box, cylinder, sphere and hexagonal prism), with Drake's
 WSG-50 as a free gripper:
 
 * **planning**: ``plan_grasps`` on ``--num`` sampled poses (one warm-up call
-  first, so numba's compilation is not timed), the wall time, samples/s and
+  of the same size first, with another seed, so numba's compilation and the
+  first imports of its fallbacks, scipy's Qhull among them, are not timed),
+  the wall time, samples/s and
   candidates/s (candidates are the samples that survive the collision filter
   and the closing), candidates per CPU second (the machine's load skews wall
   time; numpy's BLAS is held to one thread, whose spinning helpers would
@@ -298,8 +300,8 @@ def main(argv=None) -> int:
         scene = planning_scene(object_url(name), models_dir=models)
         kwargs = dict(hand=scene.hand, mu=args.mu, workers=1)
         plan_grasps(
-            scene.plant, scene.context, scene.object_body, num_candidates=50, seed=1,
-            **kwargs,
+            scene.plant, scene.context, scene.object_body,
+            num_candidates=args.num, seed=args.seed + 1, **kwargs,
         )  # fmt: skip
         with stage_timer() if args.stages else nullcontext() as spent:
             t, cpu = time.perf_counter(), time.process_time()
