@@ -11,12 +11,16 @@ drakegrasp's own box, cylinder, sphere and hexagonal prism), with Drake's
 WSG-50 as a free gripper:
 
 * **planning**: ``plan_grasps`` on ``--num`` sampled poses (one warm-up call
-  first, so numba's compilation is not timed), the wall time, samples/s and
+  of the same size first, with another seed, so numba's compilation and the
+  first imports of its fallbacks, scipy's Qhull among them, are not timed),
+  the wall time, samples/s and
   candidates/s (candidates are the samples that survive the collision filter
   and the closing), candidates per CPU second (the machine's load skews wall
-  time), the same with ``--workers`` (2) batch workers (wall time, after a
-  warm-up call that starts the pool, which is kept between calls), and the
-  rejections by reason;
+  time; numpy's BLAS is held to one thread, whose spinning helpers would
+  otherwise count, unless ``OPENBLAS_NUM_THREADS`` is set), the same with
+  ``--workers`` (2) batch workers (wall time, after a warm-up call that
+  starts the pool, which is kept between calls), and the rejections by
+  reason;
 * **the user's loop**: ``--loop`` candidates closed and analysed one at a
   time with ``close_hand``, ``analyze_grasp`` and ``ferrari_canny`` from the
   open hand at the candidate's pose (the baseline of issue 18), candidates/s;
@@ -45,16 +49,21 @@ and random candidates (:func:`allegro`).
 
 from __future__ import annotations
 
-import argparse
 import os
-import sys
-import time
-from contextlib import contextmanager, nullcontext
-from pathlib import Path
 
-import numpy as np
+# one core: numpy's BLAS must not spin threads of its own (their CPU time counts)
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+import argparse  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from contextlib import contextmanager, nullcontext  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 YCB = ("003_cracker_box", "004_sugar_box", "005_tomato_soup_can")
@@ -291,8 +300,8 @@ def main(argv=None) -> int:
         scene = planning_scene(object_url(name), models_dir=models)
         kwargs = dict(hand=scene.hand, mu=args.mu, workers=1)
         plan_grasps(
-            scene.plant, scene.context, scene.object_body, num_candidates=50, seed=1,
-            **kwargs,
+            scene.plant, scene.context, scene.object_body,
+            num_candidates=args.num, seed=args.seed + 1, **kwargs,
         )  # fmt: skip
         with stage_timer() if args.stages else nullcontext() as spent:
             t, cpu = time.perf_counter(), time.process_time()

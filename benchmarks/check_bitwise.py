@@ -5,6 +5,7 @@ Usage::
     NUMBA_CACHE_DIR=$(mktemp -d) PYTHONPATH=TREE python benchmarks/check_bitwise.py \
         record OUT.npz [--grasps 3000]
     python benchmarks/check_bitwise.py compare A.npz B.npz
+    PYTHONPATH=TREE python benchmarks/check_bitwise.py plan [--num 1500] [--seed 0]
 
 ``record`` runs, in this process, ``batch_force_closure`` (d*, rank, verdict,
 margin, converged, normal certificate) and ``batch_epsilon_l1`` (ε) on
@@ -15,6 +16,13 @@ with a per-grasp μ and a per-contact μ on the hard fingers.  Run it once per
 tree, each in a fresh process with an empty ``NUMBA_CACHE_DIR`` (so each tree's
 kernels are compiled from its own sources), then ``compare`` prints, per array,
 the number of elements that differ in any bit (NaNs equal where both are NaN).
+
+``plan`` runs ``plan_grasps`` with the WSG-50 on the seven objects of
+``bench_plan.py`` (``--num`` samples, ``--seed``, one core) and prints, per
+object, a SHA-256 of the ranked candidates (in rank order: sample, ``X_WH``,
+``q_hand``, verdict, rank, d*, ε, robustness, weight capacity α, squeeze
+needed and score, each as its exact bytes), the candidate count and the
+rejections by reason; two trees agree bit for bit when the hashes do.
 """
 
 from __future__ import annotations
@@ -105,6 +113,37 @@ def compare(a: str, b: str) -> int:
     return 1 if bad else 0
 
 
+def plan_hashes(num: int, seed: int) -> None:
+    import hashlib
+
+    from bench_plan import OWN, YCB, drake_models, object_url
+
+    from drakegrasp.planning import plan_grasps, planning_scene
+
+    models = drake_models()
+    if models is None:
+        raise SystemExit("drake_models not found (set DRAKEGRASP_DRAKE_MODELS)")
+    for name in (*YCB, *OWN):
+        scene = planning_scene(object_url(name), models_dir=models)
+        result = plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=num, mu=1.0, seed=seed, workers=1,
+        )  # fmt: skip
+        h = hashlib.sha256()
+        for c in result:
+            h.update(np.int64(c.sample).tobytes())
+            h.update(c.X_WH.GetAsMatrix34().tobytes())
+            h.update(np.asarray(c.q_hand, float).tobytes())
+            h.update(np.array([c.is_closure, c.rank], np.int64).tobytes())
+            values = (
+                c.d_star, c.epsilon, c.robustness, c.weight_capacity,
+                c.squeeze_needed, c.score,
+            )  # fmt: skip
+            h.update(np.array(values, float).tobytes())
+        reasons = ", ".join(f"{k} {v}" for k, v in sorted(result.rejections.items()))
+        print(f"{name:<20} {h.hexdigest()[:16]} {len(result):5d} candidates; {reasons}")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="cmd", required=True)
@@ -114,7 +153,13 @@ def main() -> int:
     c = sub.add_parser("compare")
     c.add_argument("a")
     c.add_argument("b")
+    pl = sub.add_parser("plan")
+    pl.add_argument("--num", type=int, default=1500)
+    pl.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
+    if args.cmd == "plan":
+        plan_hashes(args.num, args.seed)
+        return 0
     if args.cmd == "record":
         record(args.out, args.grasps)
         return 0

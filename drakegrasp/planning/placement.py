@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
+from pydrake.geometry import Box, Sphere
 
 from drakegrasp.errors import NoContactsError, PenetrationError
 from drakegrasp.planning.gripper import ParallelJaw
@@ -26,6 +27,7 @@ from drakegrasp.plant.validation import hand_bodies, hand_contact_bodies, scoped
 __all__ = [
     "MAX_CLOSING_STEPS",
     "PAIR_REACH",
+    "SURE_PENETRATION",
     "BodyCloser",
     "axis_frames",
     "sample_poses",
@@ -38,6 +40,11 @@ PAIR_REACH = 0.02
 """Metres a closing step's distance query reaches: a finger with nothing
 nearer advances by this much (minus half the tolerance), and fewer far pairs
 cross from Drake into Python."""
+
+SURE_PENETRATION = 1e-3
+"""Metres beyond the distance tolerance by which :meth:`BodyCloser.sure_collisions`
+needs a hand geometry to penetrate the object before it rejects a pose without
+Drake (far above the error of Drake's penetration depths)."""
 
 # geometry roles in BodyCloser.role: outside the hand, then inside it
 _SCENE, _OBJECT, _HAND, _FINGER = 0, 1, 2, 3
@@ -179,6 +186,9 @@ class BodyCloser:
         self.role = dict.fromkeys(self.object_geoms, _OBJECT)
         self.role.update(dict.fromkeys(self.hand_geoms, _HAND))
         self.role.update({g: _FINGER + f for g, f in self.finger_of.items()})
+        # keyed by the ids' integer values: hashing a GeometryId is a Python
+        # call into Drake, an int's is not (the closing loop reads every pair)
+        self._role_of_value = {g.get_value(): r for g, r in self.role.items()}
         self.hand_slot, self.object_slot = {}, {}
         self._cache = {}  # names and shapes of the plant's geometries
         if object_body is not None:  # find_contacts' order: body, k_f, k_o
@@ -214,6 +224,120 @@ class BodyCloser:
                 return "hand collides with the scene"
         return None
 
+    def _witnesses(self):
+        """Balls inside the hand's geometries, affine in the finger joints.
+
+        Returns ``(p0, v, r)``: ball ``i`` is centred at ``p0[i] + v[i] @ q``
+        in H (``v`` (W, 2, 3): the prismatic joints move a finger rigidly)
+        with radius ``r[i]``; a sphere gives its own ball, a box its centre
+        with its smallest half-size, and its corners, edge midpoints and face
+        centres (radius 0); other shapes none.  None when the geometry is not
+        affine in ``q`` (or the other geometries in the plant are not only the
+        object, or a hand-object pair is collision filtered), so no pose is
+        rejected without Drake.
+        """
+        plant, g = self.plant, self.g
+        inspector = self.port.Eval(self.ctx).inspector()
+        others = set(inspector.GetAllGeometryIds()) - self.hand_geoms
+        others = {o for o in others if inspector.GetProximityProperties(o)}
+        if not self.object_geoms or others - self.object_geoms:
+            return None  # a scene: its collisions have their own reason
+        if any(
+            inspector.CollisionFiltered(a, b)
+            for a in self.hand_geoms
+            for b in self.object_geoms
+            if inspector.GetProximityProperties(a)
+        ):
+            return None
+        ctx = plant.CreateDefaultContext()  # scratch, the hand as in self.ctx
+        plant.SetPositions(ctx, plant.GetPositions(self.ctx))
+        H = g.base.body_frame()
+        configurations = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+        poses = []  # per configuration, {geometry: X_HG}
+        for q in configurations:
+            for j, v in zip(g.joints, q, strict=True):
+                j.set_translation(ctx, float(v))
+            poses.append(
+                {
+                    geom: plant.CalcRelativeTransform(ctx, H, body.body_frame())
+                    @ inspector.GetPoseInFrame(geom)
+                    for body in self.hand_instance_bodies
+                    for geom in plant.GetCollisionGeometriesForBody(body)
+                }
+            )
+        p0, v, r = [], [], []
+        for geom, X0 in poses[0].items():
+            R = X0.rotation().matrix()
+            moved = [poses[i][geom] for i in (1, 2)]
+            turned = [X.rotation().matrix() for X in moved]
+            if any(not np.allclose(R1, R, atol=1e-12) for R1 in turned):
+                return None  # not a rigid translation per joint
+            rate = np.array([X.translation() - X0.translation() for X in moved])
+            shape = inspector.GetShape(geom)
+            if isinstance(shape, Sphere):
+                local, radius = np.zeros((1, 3)), [shape.radius()]
+            elif isinstance(shape, Box):  # centre; corners, edge and face midpoints
+                h = np.array([shape.width(), shape.depth(), shape.height()]) / 2
+                grid = np.array(np.meshgrid(*[[-1, 0, 1]] * 3)).reshape(3, -1).T
+                local = grid * h
+                radius = np.where(np.all(grid == 0, axis=1), h.min(), 0.0).tolist()
+            else:
+                continue
+            p0.append(local @ R.T + X0.translation())
+            v += [rate] * len(local)
+            r += radius
+        if not r:
+            return None
+        return np.vstack(p0), np.array(v), np.array(r)
+
+    def sure_collisions(self, poses, surface, X_WO) -> np.ndarray:
+        """(K,) bool: open hands at ``poses`` that surely penetrate the object.
+
+        Decided in numpy for all poses at once, before any Drake query: a ball
+        inside a hand geometry (see ``_witnesses``) whose centre lies inside
+        one of the object's convex hull pieces, at depth ``δ`` (the least
+        distance to a face plane, exact inside a convex polyhedron), makes the
+        two penetrate by at least ``δ + r``; past ``tol +``
+        :data:`SURE_PENETRATION` Drake's signed distance of the pair is below
+        ``-tol``, which :meth:`close_on_body` rejects as "hand collides with
+        the object" (the plant holds no other geometry).  False where unsure.
+
+        Parameters
+        ----------
+        poses : dict
+            :func:`sample_poses`' ``R_WH`` (K, 3, 3), ``p_WH`` (K, 3) and
+            ``opening`` (K,).
+        surface : ObjectSurface
+            The object's pieces, frame O.
+        X_WO : RigidTransform
+        """
+        K = len(poses["opening"])
+        sure = np.zeros(K, bool)
+        hulls = [p for p in getattr(surface, "pieces", ()) if p.kind == "hull"]
+        if not K or not hulls:
+            return sure
+        if not hasattr(self, "_witness_balls"):
+            self._witness_balls = self._witnesses()
+        if self._witness_balls is None:
+            return sure
+        p0, v, r = self._witness_balls
+        q = self.g.q_for_opening(poses["opening"])  # (K, 2)
+        p_H = p0 + q[:, 0, None, None] * v[:, 0] + q[:, 1, None, None] * v[:, 1]
+        R_OW = X_WO.rotation().matrix().T
+        R_OH = R_OW @ poses["R_WH"]  # (K, 3, 3)
+        p_OH = (poses["p_WH"] - X_WO.translation()) @ R_OW.T
+        p_O = p_H @ R_OH.transpose(0, 2, 1) + p_OH[:, None]  # (K, W, 3)
+        for piece in hulls:
+            R_OG = piece.X_OG.rotation().matrix()
+            N_O = piece.normals @ R_OG.T  # the faces in O
+            o_O = piece.offsets + N_O @ piece.X_OG.translation()
+            height = np.full(p_O.shape[:2], -np.inf)  # (K, W): max over faces
+            for n_j, o_j in zip(N_O, o_O, strict=True):
+                np.maximum(height, p_O @ n_j - o_j, out=height)
+            deep = (height <= 0) & (r - height > self.tol + SURE_PENETRATION)
+            sure |= deep.any(axis=1)
+        return sure
+
     def close_on_body(self, X_WH, opening):
         """Stages 2 and 3: place the open hand, close it, read the contacts.
 
@@ -238,22 +362,29 @@ class BodyCloser:
             The rejection reason, None when the hand closed on the object.
         """
         g, tol, reach = self.g, self.tol, PAIR_REACH
-        q = g.q_for_opening(opening).astype(float)
-        self._set(X_WH, q)
-        toward = np.array([1.0, -1.0])  # finger 0 closes along +a, finger 1 along -a
-        closed_limit = np.where(toward / g.pad_rate > 0, g.upper, g.lower)
-        role = self.role
+        q0, q1 = (float(v) for v in g.q_for_opening(opening))
+        self._set(X_WH, (q0, q1))
+        # Python floats, not 2-vectors: the same IEEE arithmetic, without
+        # numpy's per-call cost.  Finger 0 closes along +a, finger 1 along -a.
+        rate0, rate1 = (float(r) for r in g.pad_rate)
+        way0, way1 = 1.0 / rate0 > 0, -1.0 / rate1 > 0  # q grows while closing
+        limit0 = float(g.upper[0] if way0 else g.lower[0])
+        limit1 = float(g.upper[1] if way1 else g.lower[1])
+        joint0, joint1 = g.joints
+        ctx, port, role = self.ctx, self.port, self._role_of_value
+        half = 0.5 * tol
         for step_count in range(MAX_CLOSING_STEPS):
-            query = self.port.Eval(self.ctx)
+            query = port.Eval(ctx)
             pairs = query.ComputeSignedDistancePairwiseClosestPoints(reach)
-            psi = [reach, reach]
-            hit_object = [False, False]
+            psi0 = psi1 = reach
+            hit0 = hit1 = False
             colliding = -tol if step_count == 0 else -np.inf  # ψ below: rejected
             for pair in pairs:
                 distance = pair.distance
-                if distance >= max(psi) and distance >= colliding:
+                if distance >= colliding and distance >= psi0 and distance >= psi1:
                     continue  # lowers no finger's ψ, penetrates nothing
-                ra, rb = role.get(pair.id_A, _SCENE), role.get(pair.id_B, _SCENE)
+                ra = role.get(pair.id_A.get_value(), _SCENE)
+                rb = role.get(pair.id_B.get_value(), _SCENE)
                 if (ra >= _HAND) == (rb >= _HAND):
                     continue  # both in the hand, or both outside it
                 mine, other = (ra, rb) if ra >= _HAND else (rb, ra)
@@ -261,25 +392,31 @@ class BodyCloser:
                     if other == _OBJECT:
                         return None, None, "hand collides with the object"
                     return None, None, "hand collides with the scene"
-                f = mine - _FINGER
-                if f >= 0 and distance < psi[f]:
-                    psi[f] = distance
-                    hit_object[f] = other == _OBJECT
-            psi = np.array(psi)
-            if np.all(psi <= tol):
-                if not all(hit_object):
+                if mine == _FINGER:
+                    if distance < psi0:
+                        psi0, hit0 = distance, other == _OBJECT
+                elif mine == _FINGER + 1 and distance < psi1:
+                    psi1, hit1 = distance, other == _OBJECT
+            if psi0 <= tol and psi1 <= tol:
+                if not (hit0 and hit1):
                     return None, None, "finger blocked by the scene"
                 found, reason = self._contacts(query, pairs)
-                return found, q, reason
-            step = np.where(psi > tol, psi - 0.5 * tol, 0.0)
-            q_new = q + toward * step / g.pad_rate
-            beyond = (q_new - closed_limit) * np.sign(toward / g.pad_rate) > 0
-            at_limit = np.abs(q - closed_limit) <= 1e-12
-            if np.any(beyond & at_limit & (psi > tol)):
+                return found, np.array([q0, q1]), reason
+            # each finger advances by ψ - tol/2 (a translation by ψ cannot
+            # penetrate), stopping at its closed limit; one already there
+            # with ψ > tol misses the object
+            new0 = q0 + (psi0 - half) / rate0 if psi0 > tol else q0 + 0.0 / rate0
+            new1 = q1 + -(psi1 - half) / rate1 if psi1 > tol else q1 + -0.0 / rate1
+            beyond0 = (new0 - limit0 > 0) if way0 else (new0 - limit0 < 0)
+            beyond1 = (new1 - limit1 > 0) if way1 else (new1 - limit1 < 0)
+            if (beyond0 and abs(q0 - limit0) <= 1e-12 and psi0 > tol) or (
+                beyond1 and abs(q1 - limit1) <= 1e-12 and psi1 > tol
+            ):
                 return None, None, "finger misses the object"
-            q = np.where(beyond, closed_limit, q_new)
-            for j, v in zip(g.joints, q, strict=True):
-                j.set_translation(self.ctx, float(v))
+            q0 = limit0 if beyond0 else new0
+            q1 = limit1 if beyond1 else new1
+            joint0.set_translation(ctx, q0)
+            joint1.set_translation(ctx, q1)
         return None, None, "closing did not converge"
 
     def _contacts(self, query, pairs):

@@ -425,10 +425,17 @@ def plan_grasps(
         cloud = CloudFingers(
             plant, ctx, gripper, closer.hand_instance_bodies, surface, tol, CONTACT_BAND
         )
+    sure = np.zeros(len(poses["sample"]), bool)
+    if cloud is None:  # penetrations certain without Drake: rejected at once
+        sure = closer.sure_collisions(poses, surface, X_WO)
+        if sure.any():
+            rejections["hand collides with the object"] += int(sure.sum())
     order = closing_order(len(poses["sample"]), progress)
     kept = []
     try:
         for k in order:
+            if sure[k]:
+                continue
             X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
             opening = float(poses["opening"][k])
             if cloud is None:

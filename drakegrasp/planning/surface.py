@@ -236,17 +236,29 @@ class Piece:
         return t_in, t_out, _unit_rows(x / s**2 + 1e-300)
 
     def _hull_chord(self, p, d):
-        nd = d @ self.normals.T  # (K, F)
-        gap = self.offsets[None, :] - p @ self.normals.T
-        parallel = np.abs(nd) < _PARALLEL
-        t = np.where(parallel, np.nan, gap / np.where(parallel, 1.0, nd))
-        t_in = np.max(np.where(nd < -_PARALLEL, t, -np.inf), axis=1)
-        t_out_all = np.where(nd > _PARALLEL, t, np.inf)
-        j = np.argmin(t_out_all, axis=1)
-        t_out = t_out_all[np.arange(len(p)), j]
-        miss = (t_in > t_out) | np.any(parallel & (gap < 0), axis=1)
+        # Face by face over contiguous (K,) columns: numpy's reductions over a
+        # short last axis are slow.  t = gap / nd is read only where the line
+        # crosses face j (|nd| > _PARALLEL), so no masked division is needed;
+        # the exit is the first face of least t (argmin's choice).
+        nd = (d @ self.normals.T).T.copy()  # (F, K)
+        gap = (self.offsets[None, :] - p @ self.normals.T).T.copy()
+        K = len(p)
+        t_in = np.full(K, -np.inf)
+        t_out = np.full(K, np.inf)
+        j = np.zeros(K, dtype=np.intp)
+        outside = np.zeros(K, bool)  # parallel to a face and outside it
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            for f in range(len(nd)):
+                t = gap[f] / nd[f]
+                np.maximum(t_in, np.where(nd[f] < -_PARALLEL, t, -np.inf), out=t_in)
+                earlier = (nd[f] > _PARALLEL) & (t < t_out)
+                t_out[earlier] = t[earlier]
+                j[earlier] = f
+                outside |= (np.abs(nd[f]) < _PARALLEL) & (gap[f] < 0)
+        miss = (t_in > t_out) | outside
         miss |= ~np.isfinite(t_in) | ~np.isfinite(t_out)
-        t_in, t_out = np.where(miss, np.nan, t_in), np.where(miss, np.nan, t_out)
+        t_in[miss] = np.nan
+        t_out[miss] = np.nan
         return t_in, t_out, self.normals[j]
 
     def _cylinder_chord(self, p, d):
@@ -306,16 +318,18 @@ class Piece:
         return float(centre + h + r)
 
 
-def _near_lines(p: np.ndarray, d: np.ndarray, centre: np.ndarray, radius: float):
+def _near_lines(p: np.ndarray, d: np.ndarray, centre, radius: float, dd=None):
     """Rows whose line ``p + t d`` passes within the ball, or None.
 
     None when every row does (no subset to take).  The test is loose by a
     relative 1e-9 and 1e-12 m, so a line it drops misses the ball, hence the
-    piece, by more than round-off.
+    piece, by more than round-off.  ``dd``: the rows' ``d·d`` if known.
     """
     w = centre - p
     along = np.einsum("ij,ij->i", w, d)
-    gap2 = np.einsum("ij,ij->i", w, w) - along * along / np.einsum("ij,ij->i", d, d)
+    if dd is None:
+        dd = np.einsum("ij,ij->i", d, d)
+    gap2 = np.einsum("ij,ij->i", w, w) - along * along / dd
     reach = radius * (1.0 + 1e-9) + 1e-12
     near = gap2 <= reach * reach
     return None if near.all() else np.flatnonzero(near)
@@ -466,11 +480,11 @@ class ObjectSurface:
         t_in = np.full(K, np.nan)
         t_out = np.full(K, np.nan)
         n_out = np.zeros((K, 3))
-        for piece in self.pieces:
+        dd = np.einsum("ij,ij->i", d_O, d_O)
+        for piece, (centre, radius) in zip(self.pieces, self._balls_O, strict=True):
             # a line that misses the piece's ball misses the piece: only the
             # others are cast (a corner sphere of a YCB box meets few lines)
-            centre, radius = piece.bounding_ball
-            near = _near_lines(p_O, d_O, piece.X_OG.multiply(centre), radius)
+            near = _near_lines(p_O, d_O, centre, radius, dd)
             if near is None:
                 rows, p, d = slice(None), p_O, d_O
             elif len(near):
@@ -484,6 +498,15 @@ class ObjectSurface:
             t_out[rows] = np.where(later, b, t_out[rows])
             n_out[rows] = np.where(later[:, None], n @ R.T, n_out[rows])
         return t_in, t_out, n_out
+
+    @cached_property
+    def _balls_O(self) -> tuple[tuple[np.ndarray, float], ...]:
+        """Each piece's bounding ball ``(centre_O, radius)`` (frame O, metres)."""
+        return tuple(
+            (piece.X_OG.multiply(centre), radius)
+            for piece in self.pieces
+            for centre, radius in [piece.bounding_ball]
+        )
 
     def radius_about(self, p_O: np.ndarray) -> float:
         """Radius of a ball about ``p_O`` that holds the object (an upper bound), m."""

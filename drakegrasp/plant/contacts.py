@@ -453,17 +453,18 @@ def stage_contacts(
     items: list[tuple] = []
     closest: tuple[float, str] | None = None
 
-    def name(gid):
-        if ("name", gid) not in cache:
-            cache["name", gid] = inspector.GetName(gid)
-        return cache["name", gid]
+    def name(gid):  # one look-up when cached (hashing an id calls into Drake)
+        found = cache.get(("name", gid))
+        if found is None:
+            found = cache["name", gid] = inspector.GetName(gid)
+        return found
 
     fingers = {}
     for finger, kf, ko, r in results:
         index = finger.index()
-        if ("body", index) not in cache:
-            cache["body", index] = _scoped_name(plant, finger)
-        finger_name = cache["body", index]
+        finger_name = cache.get(("body", index))
+        if finger_name is None:
+            finger_name = cache["body", index] = _scoped_name(plant, finger)
         id_A = r.id_A
         swapped = id_A not in object_geometries  # the normal points into the finger
         go, gf = (r.id_B, id_A) if swapped else (id_A, r.id_B)
