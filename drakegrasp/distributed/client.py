@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import gc
 from collections.abc import Iterator
 
 from drakegrasp.errors import InvalidOptionError
@@ -43,10 +44,17 @@ def client_for(client_or_address):
         try:
             return Client(client_or_address)
         except (OSError, TimeoutError, ValueError) as e:
-            raise InvalidOptionError(
-                f"could not connect to the Dask scheduler at {client_or_address!r}: "
-                f"{' '.join(str(e).split())}"
-            ) from None
+            reason = " ".join(str(e).split())
+        # The half-made Client is cyclic garbage, held until now by the error's
+        # traceback.  Left to a later collection, its __del__ may run inside
+        # another Client's start, where its close waits on the loop lock that
+        # start holds: a deadlock (seen in the test suite).  Finalise it here,
+        # and raise outside the except block so nothing keeps it alive.
+        gc.collect()
+        raise InvalidOptionError(
+            f"could not connect to the Dask scheduler at {client_or_address!r}: "
+            f"{reason}"
+        )
     if not isinstance(client_or_address, Client):
         raise InvalidOptionError(
             "client must be a distributed.Client or a scheduler address such as "

@@ -9,6 +9,7 @@ Every verdict is compared bitwise with the local engine.
 
 from __future__ import annotations
 
+import gc
 import shutil
 import sys
 from pathlib import Path
@@ -256,3 +257,20 @@ def test_a_client_that_is_none_is_refused_at_once(bad):
         evaluate_on_cluster(bad, P, Nrm, 0.5)
     with pytest.raises(InvalidOptionError, match="client must be|scheduler"):
         analyze_poses(bad, "parallel_jaw_box", np.zeros((1, 9)))
+
+
+def test_a_failed_connection_leaves_no_client_for_a_later_collection():
+    # A half-made Client collected later, inside another Client's start, deadlocked
+    # the suite (its close waits on the loop lock that the start holds).
+    distributed = pytest.importorskip("distributed")
+    from drakegrasp.distributed.client import client_for
+
+    def clients():
+        return sum(isinstance(o, distributed.Client) for o in gc.get_objects())
+
+    gc.collect()
+    before = clients()
+    for address in ("nonsense", "also nonsense"):
+        with pytest.raises(InvalidOptionError):
+            client_for(address)
+    assert clients() == before
