@@ -30,10 +30,17 @@ linux_only = pytest.mark.skipif(
 )
 
 
+_ENV: dict = {}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _checkout(checkout_env):
+    """Every run below: the checkout's drakegrasp, its kernels warm."""
+    _ENV.update(checkout_env)
+
+
 def _env() -> dict:
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
-    return env
+    return dict(_ENV)
 
 
 def _children(pid: int) -> set[int]:

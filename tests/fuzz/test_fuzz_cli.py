@@ -139,7 +139,7 @@ def test_upper_case_suffix_overwrite_and_the_deprecated_alias(tmp_path):
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
-def test_sigint_during_a_long_batch(tmp_path):
+def test_sigint_during_a_long_batch(tmp_path, checkout_env):
     # 80,000 random grasps of 16 contacts with the ε metric: about 20 s of work
     # on two cores (the batch ε kernel runs ~3,000 grasps/s per core at N = 16),
     # so the signal lands mid-run, in the LPs or in the ε kernel.
@@ -152,7 +152,7 @@ def test_sigint_during_a_long_batch(tmp_path):
         np.savez(f, positions=P, normals=-P + 0.3 * rng.normal(size=P.shape), mu=0.5)
     digest = _digest(big)
     out = tmp_path / "out.npz"
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    env = checkout_env  # kernels warm: no compile notice on stderr
     argv = ["batch", str(big), str(out), "--metrics", "epsilon_l1"]
     proc = subprocess.Popen(
         [sys.executable, "-m", "drakegrasp", *argv],

@@ -16,7 +16,7 @@ FULL = os.environ.get("DRAKEGRASP_FUZZ_FULL") == "1"
 
 
 @pytest.fixture(scope="module")
-def outcomes():
+def outcomes(checkout_env):  # the CLI signal case reads stderr: kernels warm
     return report_surfaces.run(small=not FULL)
 
 
