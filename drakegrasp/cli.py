@@ -274,6 +274,10 @@ def _positive_float(text: str) -> float:
     )  # fmt: skip
 
 
+def _count(text: str) -> int:
+    return _parsed(text, int, "a whole number", lambda k: k >= 0, ">= 0")
+
+
 def _package(text: str) -> tuple[str, str]:
     name, sep, folder = text.partition("=")
     if not sep or not name or not folder or "/" in name:
@@ -762,7 +766,7 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         "URL/file (default: flat; a scene names its own)",
     )
     plan.add_argument("--num", type=int, default=500, help="poses to sample (500)")
-    plan.add_argument("--top", type=int, default=10, help="candidates to print (10)")
+    plan.add_argument("--top", type=_count, default=10, help="candidates to print (10)")
     plan.add_argument("--seed", type=int, default=0, help="random seed (0)")
     plan.add_argument(
         "--mu",

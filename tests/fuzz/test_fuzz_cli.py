@@ -62,7 +62,8 @@ def _one_line_error(proc, code=1):
     [
         ((), "required: COMMAND"),
         (("bogus",), "invalid choice: 'bogus'"),
-        (("plan", "--top", "abc"), "argument --top: invalid int value"),
+        (("plan", "--top", "abc"), "argument --top: not a whole number"),
+        (("plan", "--top", "-2"), "argument --top: must be >= 0"),  # was all but 2
         (("plan", "--num", "1e9"), "argument --num"),
         (("analyze", "--tol", "abc"), "argument --tol"),
         (("batch",), "required: input, output"),
