@@ -38,9 +38,10 @@ plans for the hand and object that the scene's ``drakegrasp:`` section names
 (``hand:``, ``object_body:``), with the scene's μ, contact model and tolerance,
 against everything else the scene holds (a table, other objects); the hand's
 base must be free in the scene (no ``add_weld`` to the world).  Given an
-object (a shipped object's name, a model URL or a file; default ``box``), it
-plans for ``--hand`` (a model URL or file, ``wsg`` for Drake's WSG-50; default
-drakegrasp's flat-pad jaw) in a scene of the two alone.
+object (a shipped object's name, a model URL or a file, or a mesh ``.obj``
+file, which Drake's parser makes one body with the mass of water filling it;
+default ``box``), it plans for ``--hand`` (a model URL or file, ``wsg`` for
+Drake's WSG-50; default drakegrasp's flat-pad jaw) in a scene of the two alone.
 
 One interface: both commands name the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
@@ -621,18 +622,30 @@ PLAN_HANDS = {
 MODEL_SUFFIXES = (".sdf", ".urdf", ".xml")
 """File endings of the model files Drake's parser reads (``plan`` checks them)."""
 
+OBJECT_SUFFIXES = (*MODEL_SUFFIXES, ".obj")
+"""``plan``'s object may also be a mesh: Drake's parser makes an ``.obj`` file one
+body, the mesh its collision geometry, with the mass of water filling it."""
+
+
+def _model_file(spec: str, what: str) -> str:
+    """``spec`` as it is: a URL, or a model file that exists."""
+    if "://" not in spec and not os.path.isfile(spec):
+        raise InvalidOptionError(f"{what} file {spec!r} not found")
+    return spec
+
 
 def _plan_url(spec: str) -> str:
     """``plan``'s object: a URL or model file as it is, or a shipped name's URL."""
     from drakegrasp.plant.models import models_dir
 
-    if "://" in spec or spec.endswith(MODEL_SUFFIXES):
-        return spec
+    if "://" in spec or spec.endswith(OBJECT_SUFFIXES):
+        return _model_file(spec, "object")
     shipped = sorted(p.stem for p in (models_dir() / "objects").glob("*.sdf"))
     if spec not in shipped:
         raise InvalidOptionError(
             f"object {spec!r} is not a shipped object ({', '.join(shipped)}), a "
-            f"scene, a package:// URL or a model file ({', '.join(MODEL_SUFFIXES)})"
+            f"scene, a package:// URL, a model file ({', '.join(MODEL_SUFFIXES)}) "
+            "or a mesh (.obj)"
         )
     return f"package://drakegrasp/objects/{spec}.sdf"
 
@@ -643,7 +656,7 @@ def _plan_hand(spec: str | None) -> str:
     if spec in PLAN_HANDS:
         return PLAN_HANDS[spec]
     if "://" in spec or spec.endswith(MODEL_SUFFIXES):
-        return spec
+        return _model_file(spec, "--hand")
     raise InvalidOptionError(
         f"--hand {spec!r} is not one of {', '.join(PLAN_HANDS)}, a package:// URL "
         f"or a model file ({', '.join(MODEL_SUFFIXES)})"
@@ -757,7 +770,8 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         help="a scene YAML file (or a shipped scene's name) whose drakegrasp: "
         "section names the object and the hand (its base free, not welded), or "
         "a shipped object name (box, cylinder, sphere, hex_prism), a "
-        "package:// URL or a model file, planned for --hand (default: box)",
+        "package:// URL, a model file or a mesh (.obj: one body with the mass "
+        "of water filling it), planned for --hand (default: box)",
     )
     plan.add_argument(
         "--hand",

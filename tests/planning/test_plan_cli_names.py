@@ -7,7 +7,7 @@ import pytest
 from drakegrasp.cli import PLAN_HANDS, main
 
 
-@pytest.mark.parametrize("name", ["boxx", "/etc/passwd", "cylinder.obj"])
+@pytest.mark.parametrize("name", ["boxx", "/etc/passwd", "cylinder.step"])
 def test_an_unknown_object_lists_the_shipped_ones(capsys, name):
     assert main(["plan", name, "--num", "5"]) == 1
     err = capsys.readouterr().err
