@@ -25,14 +25,15 @@ class InternalForceResult:
     Attributes
     ----------
     passes : bool
-        True when ``d* <= tol``: the hand can control every internal force, so
-        the check of ``N(G) ∩ N(Jᵀ) = {0}`` (as LP3 poses it) passes.
+        True when ``d* <= max(tol, resolution)``: the hand can control every
+        internal force, so the check of ``N(G) ∩ N(Jᵀ) = {0}`` (as LP3 poses
+        it) passes.
     d_star : float
         Optimal ``d`` of LP3 (dimensionless; the normal forces are normalised by
         ``Σ f_n <= N``).
     margin : float
-        ``(tol - d*) / tol``: positive when passing; uncertain when
-        ``tol/1000 < d* < 2 tol``.
+        ``(t - d*) / t`` with ``t = max(tol, resolution)``: positive when
+        passing; uncertain when ``t/1000 < d* < 2 t``.
     null_space_dim : int
         ``dim(N(G) ∩ N(Jᵀ))`` from the rank of ``[G; Jᵀ]`` (over the force
         components the cones allow).
@@ -46,6 +47,16 @@ class InternalForceResult:
     certificate : Certificate or None
         When LP3 fails, the uncontrollable internal force (LP3's optimal forces:
         ``f ∈ N(G) ∩ N(Jᵀ)`` with every ``f_n > 0``); None when it passes.
+    resolution : float
+        The smallest normal component LP3's optimal force resolves:
+        ``rank_tol`` times its largest component.  LP3 leaves the tangential
+        components free, and on a nearly degenerate grasp the solver can
+        return a "squeeze" whose tangential components are 1e11 and whose
+        normals are 1e-6: normals 1e-17 of the force's size, below the
+        round-off of the force itself and far below the numerical null space's
+        resolution (``rank_tol``).  Such a ``d*`` says nothing, and whether it
+        fell above or below ``tol`` depended on the machine; a squeeze must
+        have normals above both ``tol`` and this to fail LP3.
 
     Notes
     -----
@@ -72,10 +83,16 @@ class InternalForceResult:
     status: str
     tol: float
     certificate: Certificate | None = None
+    resolution: float = 0.0
+
+    @property
+    def threshold(self) -> float:
+        """``max(tol, resolution)``: LP3 passes when ``d*`` is at most this."""
+        return max(self.tol, self.resolution)
 
     @property
     def near_boundary(self) -> bool:
-        """True when ``tol/1000 < d* < 2 tol``: the verdict is not certain."""
+        """True when ``t/1000 < d* < 2 t`` (``t``: :attr:`threshold`): not certain."""
         return near_threshold(-self.margin)
 
     @property
@@ -95,7 +112,14 @@ class InternalForceResult:
 
     def report_lines(self) -> list[str]:
         """Two lines: LP3's verdict, and the null-space dimension under its name."""
-        if self.passes:
+        if self.passes and self.d_star > self.tol:
+            lp3 = (
+                f"LP3 (uncontrollable squeezing): passes, decided by d* = "
+                f"{self.d_star:.3g} <= {self.resolution:.3g}, the resolution of "
+                "its optimal force (rank_tol times its largest component): "
+                "normals that small are round-off, not a squeeze"
+            )
+        elif self.passes:
             zero = _zero_text(self.d_star, self.tol)
             lp3 = (
                 f"LP3 (uncontrollable squeezing): passes, decided by d* = {zero} "

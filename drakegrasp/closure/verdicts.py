@@ -178,9 +178,11 @@ def internal_forces(
     hand_jacobian : (M, n_v) float
         Rows in the order of the columns of ``G``; columns the hand's velocities.
     tol : float, optional
-        LP3 passes when ``d* <= tol``.
+        LP3 passes when ``d* <= tol``, or when ``d*`` is below the resolution
+        of LP3's optimal force (:attr:`InternalForceResult.resolution`).
     rank_tol : float, optional
-        Relative singular-value threshold for ``dim(N(G) ∩ N(Jᵀ))``.
+        Relative singular-value threshold for ``dim(N(G) ∩ N(Jᵀ))``, and the
+        relative resolution of the optimal force's normal components.
 
     Returns
     -------
@@ -195,18 +197,24 @@ def internal_forces(
     (equalities,) = prog.linear_equality_constraints() or (None,)
     rank = 0 if equalities is None else equalities.evaluator().num_constraints()
     null_dim = len(variables.columns) - rank
-    passes = not (d_star > tol)  # NaN (infeasible) passes: no such force exists
+    # Normals below rank_tol of the force's size are round-off, not a squeeze
+    # (InternalForceResult.resolution).
+    size = 0.0 if forces is None else float(np.max(np.abs(forces), initial=0.0))
+    resolution = rank_tol * size
+    threshold = max(tol, resolution)
+    passes = not (d_star > threshold)  # NaN (infeasible) passes: no such force
     contact_forces = _split_forces(grasp, variables.columns, forces)
     return InternalForceResult(
         passes=bool(passes),
         d_star=d_star,
-        margin=-relative_margin(d_star, tol) if np.isfinite(d_star) else np.inf,
+        margin=(-relative_margin(d_star, threshold) if np.isfinite(d_star) else np.inf),
         null_space_dim=int(null_dim),
         contact_forces=contact_forces,
         solver=solver,
         status=status,
         tol=tol,
         certificate=None if passes else uncontrollable_force(grasp, contact_forces),
+        resolution=resolution,
     )
 
 

@@ -90,3 +90,34 @@ def test_lp3_and_the_null_space_count_agree_on_noisy_jacobians(rng):
     # Above rank_tol the noise is a real change of J: the squeeze is controlled.
     r = dg.internal_forces(grasp, J + 1e-3 * rng.normal(size=J.shape))
     assert r.null_space_dim == 0 and r.passes
+
+
+def test_a_squeeze_whose_normals_are_round_off_does_not_fail_lp3(monkeypatch):
+    # A nearly degenerate WSG-50 grasp of the sugar box (pads and palm
+    # touching) gave, on one machine, LP3's optimum with tangential components
+    # of 1.7e11 and normals of 1.29e-6: d* above tol by round-off of a force
+    # 1e17 times larger, and the verdict flipped between machines.  Normals
+    # below rank_tol of the force's size are not a squeeze.
+    from drakegrasp.closure import verdicts
+
+    grasp = ex.equator_fingers(0.5)
+    J = _jacobian(grasp, [1.0, 0.0, 0.0])
+    real = verdicts._solve_margin
+
+    def pathological(prog, variables, *, conic):
+        d, f, solver, status = real(prog, variables, conic=conic)
+        f = f.copy()
+        f[grasp.normal_indices()] = 1.29e-6
+        f[1] = 1.7e11  # a tangential component
+        return 1.29e-6, f, solver, status
+
+    monkeypatch.setattr(verdicts, "_solve_margin", pathological)
+    lp3 = dg.internal_forces(grasp, J)
+    assert lp3.d_star > lp3.tol and lp3.passes and lp3.certificate is None
+    assert lp3.resolution == pytest.approx(1.7e11 * 1e-9)
+    assert lp3.threshold == lp3.resolution and not lp3.near_boundary
+    assert "round-off, not a squeeze" in str(lp3)
+    # a real failure is resolved: its normals are a fair part of its size
+    monkeypatch.setattr(verdicts, "_solve_margin", real)
+    bad = dg.internal_forces(grasp, _jacobian(grasp, [0.0, 1.0, 0.0]))
+    assert not bad.passes and bad.resolution < 1e-8 < 0.1 < bad.d_star
