@@ -109,7 +109,7 @@ def finger_jacobian(plant, plant_context, candidate: GraspCandidate, object_body
         candidate planned on a point cloud (frame O is then the candidate's
         ``X_WO``, the cloud's centroid frame): each contact's point on its
         finger is the contact's point, ``p_FC = X_WF⁻¹ X_WO p_OC``, with the
-        candidate applied to the hand (:func:`_cloud_finger_jacobian`).
+        candidate applied to the hand.
 
     Returns
     -------
@@ -306,7 +306,7 @@ def with_torques_needed(
         leaves ``result`` as it is.
     top : int
         The ``certify`` of the run: the best ``top`` candidates carry the
-        single-grasp verdict (:attr:`GraspCandidate.closure`), after the
+        single-grasp verdict (``closure``), after the
         re-ranking too.
     started : float
         The run's ``time.perf_counter()`` at its start, so ``result.time``
