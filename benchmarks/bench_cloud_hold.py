@@ -3,7 +3,8 @@
 Usage::
 
     python benchmarks/bench_cloud_hold.py [--num 300] [--points 3000] [--top 10]
-        [--random 10] [--seed 0] [--clouds full one-sided] [--verbose]
+        [--random 10] [--seed 0] [--clouds full one-sided] [--no-mass]
+        [--verbose]
 
 The multi-finger cloud route of :func:`drakegrasp.plan_grasps` (Drake's
 Allegro hand, thumb opposed, free base) on two clouds sampled from the soup
@@ -14,15 +15,21 @@ can's collision geometry (``--points`` area-uniform points, seed 0, as
 * **one-sided**: the points a camera at ``(0.5, 0, 0)`` m sees (normals
   facing it), planned with ``viewpoint=`` the camera.
 
+Both are planned with ``object_mass=`` the can's mass (from its model), as a
+user who knows it would: the candidates then carry ``torque_needed`` and those
+the Allegro's actuators hold (at most their 0.7 N·m) are ranked first
+(:func:`~drakegrasp.planning.motors.with_torques_needed`); ``--no-mass``
+plans without it (no torque_needed, the score's order alone).
+
 For each cloud it prints the candidates (of ``--num`` sampled poses), how many
 are force closure, and the hold rates in Drake
 (:func:`drakegrasp.shake_test` on the true can, ``X_WO`` its real pose, the
 Allegro's revolute fingers at 0.5 N·m, PD gains 20 N·m/rad and 1 N·m·s/rad)
 of the ``--top`` best candidates and of ``--random`` candidates drawn
 uniformly (seeded) from all of them, as held / tried.  ``--verbose`` prints
-each shaken candidate's largest displacement and rotation, its contacts per
-finger and how many carry an edge's normal fan (the planning guide's "Edges:
-the normal fan").
+each shaken candidate's torque needed (N·m), largest displacement and
+rotation, its contacts per finger and how many carry an edge's normal fan
+(the planning guide's "Edges: the normal fan").
 """
 
 from __future__ import annotations
@@ -73,6 +80,7 @@ def _describe(c, s) -> str:
     fans = sum(getattr(k, "fan", None) is not None for k in c.contacts)
     return (
         f"      #{c.sample:<4} score {c.score:8.4f} rho {c.robustness:4.2f} "
+        f"torque {c.torque_needed:6.3f} "
         f"{'held' if s.held else 'fell'}: {s.max_displacement * 1e3:6.1f} mm "
         f"{np.degrees(s.max_rotation):6.1f} deg  contacts {dict(fingers)}"
         f" ({fans} with an edge fan)"
@@ -90,6 +98,11 @@ def main(argv=None) -> int:
         "--clouds", nargs="+", default=["full", "one-sided"],
         choices=["full", "one-sided"],
     )  # fmt: skip
+    parser.add_argument(
+        "--no-mass",
+        action="store_true",
+        help="plan without object_mass (no torque_needed, no motors-first ranking)",
+    )
     parser.add_argument("--verbose", action="store_true")
     args = parser.parse_args(argv)
     models = drake_models()
@@ -98,12 +111,13 @@ def main(argv=None) -> int:
         return 1
     full = allegro_scene(models, CAN)
     hand = allegro_scene(models)
-    X_WO = full.plant.EvalBodyPoseInWorld(
-        full.plant.GetMyContextFromRoot(full.context), full.object_body
-    )
+    full_ctx = full.plant.GetMyContextFromRoot(full.context)
+    X_WO = full.plant.EvalBodyPoseInWorld(full_ctx, full.object_body)
+    mass = None if args.no_mass else full.object_body.get_mass(full_ctx)
     print(
         f"load {os.getloadavg()[0]:.2f}; Allegro on the YCB soup can, "
-        f"{args.points} points, {args.num} samples, seed {args.seed}"
+        f"{args.points} points, {args.num} samples, seed {args.seed}, "
+        f"object_mass {mass}"
     )
     print(
         f"{'cloud':<10} {'points':>6} {'cands':>6} {'FC':>4} {'plan s':>7}"
@@ -116,7 +130,7 @@ def main(argv=None) -> int:
         result = plan_grasps(
             hand.plant, hand.context, None, hand=hand.hand,
             num_candidates=args.num, mu=1.0, seed=args.seed, point_cloud=p,
-            cloud_normals=nrm, viewpoint=view,
+            cloud_normals=nrm, viewpoint=view, object_mass=mass,
         )  # fmt: skip
         plan_s = time.perf_counter() - t
         pick = np.random.default_rng(args.seed).choice(

@@ -111,9 +111,12 @@ class GraspCandidate:
         A multi-finger hand's torque (N·m) at every finger joint that holds
         the object's weight in all the weight directions
         (:func:`~drakegrasp.planning.motors.torque_needed`; a lower bound),
-        for the top candidates (``certify``) planned on a body; inf: none
-        does; NaN: not computed.  Compare it with the actuators' effort
-        limits, or use it as ``shake_test``'s squeeze.
+        for the best force-closure candidates (the first
+        ``max(certify, TORQUE_CHECK)``,
+        :data:`~drakegrasp.planning.motors.TORQUE_CHECK`) when the weight is
+        known: planned on a body, or on a point cloud with ``object_mass``;
+        inf: none does; NaN: not computed.  Compare it with the actuators'
+        effort limits, or use it as ``shake_test``'s squeeze.
     """
 
     sample: int
@@ -240,7 +243,10 @@ class GraspCandidates(Sequence):
     ----------
     candidates : tuple of GraspCandidate
         Best first (highest score, then ``ε × robustness``, ``d*`` and the
-        sample index).
+        sample index); for a multi-finger hand with a known weight, the
+        candidates whose ``torque_needed`` is within the hand's smallest
+        effort limit come first, in that order
+        (:func:`~drakegrasp.planning.motors.with_torques_needed`).
     rejections : dict of str to int
         Sampled poses dropped, by reason.
     num_sampled : int

@@ -27,6 +27,19 @@ All directions of a candidate are one LP (through drakegrasp's solver
 gateway), about 3 ms for the Allegro hand (5 ms with its Jacobian); the tests
 check it against :func:`~drakegrasp.closure.payload.max_load`, direction by
 direction.
+
+On a point cloud there is no object body: each contact names its finger body
+and carries its cloud point, which lies on the finger within the distance
+tolerance, so the finger's point is that point seen from the finger with the
+candidate applied to the hand (``object_body=None``; frame O is the
+candidate's ``X_WO``).  On the same contacts given both ways the two routes
+agree to 3 % (the finger's witness point and the object's lie up to the
+tolerance apart), and exactly with the finger's points.
+
+When the weight is known (an object body's mass, or ``object_mass=``),
+:func:`with_torques_needed` computes it for the best :data:`TORQUE_CHECK`
+candidates and ranks those the hand's actuators hold (``torque_needed`` at
+most the smallest effort limit of the candidate's joints) ahead of the rest.
 """
 
 from __future__ import annotations
@@ -36,10 +49,13 @@ import math
 import time
 
 import numpy as np
+from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.solvers import MathematicalProgram
 from scipy.linalg import block_diag
 
 from drakegrasp._solvers import require_solution, solve
+from drakegrasp.closure.verdicts import force_closure
+from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.friction_cone import (
     DEFAULT_NUM_GENERATORS,
     friction_cone_generators,
@@ -51,7 +67,17 @@ from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.jacobians import hand_jacobian
-from drakegrasp.plant.validation import plant_context_of, resolve_object_body
+from drakegrasp.plant.validation import (
+    plant_context_of,
+    resolve_body,
+    resolve_object_body,
+)
+
+TORQUE_CHECK = 50
+"""How many of the best candidates get ``torque_needed`` (the force-closure
+ones) when the object's weight is known: enough that the re-ranking of
+:func:`with_torques_needed` finds candidates the motors hold beyond the
+``certify`` head (about 5 ms each for the Allegro hand)."""
 
 BETA_CAP = 1e6
 """Bound on ``β(u)`` (N per N·m) that keeps the program bounded; reaching it
@@ -59,7 +85,9 @@ reads as ``inf`` (no finger joint bounds the load: contacts on the palm)."""
 
 __all__ = [
     "BETA_CAP",
+    "TORQUE_CHECK",
     "finger_jacobian",
+    "motor_limit",
     "torque_capacity",
     "torque_needed",
     "with_torques_needed",
@@ -76,8 +104,12 @@ def finger_jacobian(plant, plant_context, candidate: GraspCandidate, object_body
     plant_context : Context
         Its context (or the diagram's root context); left as it was.
     candidate : GraspCandidate
-    object_body : RigidBody, BodyIndex or str
-        The object (frame O); put at the candidate's planned pose.
+    object_body : RigidBody, BodyIndex, str or None
+        The object (frame O); put at the candidate's planned pose.  None for a
+        candidate planned on a point cloud (frame O is then the candidate's
+        ``X_WO``, the cloud's centroid frame): each contact's point on its
+        finger is the contact's point, ``p_FC = X_WF⁻¹ X_WO p_OC``, with the
+        candidate applied to the hand.
 
     Returns
     -------
@@ -92,18 +124,58 @@ def finger_jacobian(plant, plant_context, candidate: GraspCandidate, object_body
             f"{type(candidate).__name__}"
         )
     ctx = plant_context_of(plant, plant_context)
-    body = resolve_object_body(plant, object_body)
+    body = None if object_body is None else resolve_object_body(plant, object_body)
     joints = [find_joint(plant, name) for name in candidate.joint_names]
     columns = np.array([j.velocity_start() for j in joints], dtype=int)
     saved = plant.GetPositions(ctx).copy()
     try:
         candidate.apply(plant, ctx, object_body=body)
+        if body is None:
+            return _cloud_finger_jacobian(plant, ctx, candidate, columns)
         return hand_jacobian(
             plant, ctx, candidate.contacts, candidate.grasp, body,
             velocity_indices=columns,
         )  # fmt: skip
     finally:
         plant.SetPositions(ctx, saved)
+
+
+def _cloud_finger_jacobian(plant, ctx, candidate: GraspCandidate, columns):
+    """``J`` (M, n_j) of a point-cloud candidate, the candidate applied in ``ctx``.
+
+    A cloud contact names its finger body and carries the cloud point
+    ``p_OC`` (frame O = ``candidate.X_WO``), which lies on the finger within
+    the distance tolerance: the finger's point ``C`` is taken there,
+    ``p_FC = X_WF⁻¹ X_WO p_OC``.  Each row block is the translational velocity
+    of ``C`` (fixed in F) in the world, expressed in O and then in the
+    contact's frame ``[n, t1, t2]`` (a soft finger adds the normal component
+    of F's angular velocity), as :func:`~drakegrasp.plant.jacobians.hand_jacobian`
+    builds it on a body.
+    """
+    R_OW = candidate.X_WO.rotation().matrix().T
+    blocks = []
+    for pc, c in zip(candidate.contacts, candidate.grasp.contacts, strict=True):
+        finger = resolve_body(plant, pc.finger_body)
+        X_WF = plant.EvalBodyPoseInWorld(ctx, finger)
+        p_FC = X_WF.inverse().multiply(candidate.X_WO.multiply(pc.p_OC))
+        Jv = R_OW @ plant.CalcJacobianTranslationalVelocity(
+            ctx, JacobianWrtVariable.kV, finger.body_frame(), p_FC,
+            plant.world_frame(), plant.world_frame(),
+        )[:, columns]  # fmt: skip
+        R = c.frame
+        if c.contact_model is ContactModel.FRICTIONLESS:
+            blocks.append(R[:, :1].T @ Jv)
+            continue
+        block = R.T @ Jv
+        if c.num_components == 4:
+            Jw = R_OW @ plant.CalcJacobianAngularVelocity(
+                ctx, JacobianWrtVariable.kV, finger.body_frame(),
+                plant.world_frame(), plant.world_frame(),
+            )[:, columns]  # fmt: skip
+            block = np.vstack([block, np.asarray(pc.nhat_O) @ Jw])
+        blocks.append(block)
+    grasp = candidate.grasp
+    return np.vstack(blocks).reshape(grasp.num_components, len(columns))
 
 
 def torque_capacity(
@@ -218,15 +290,46 @@ def with_torques_needed(
     weight: float,
     top: int,
     started: float,
+    check: int = TORQUE_CHECK,
+    motors_first: bool = True,
 ) -> GraspCandidates:
-    """``result`` with :func:`torque_needed` set on its best ``top`` candidates.
+    """``result`` with :func:`torque_needed` on its best candidates, re-ranked.
 
-    Only force-closure candidates get it (the others hold no weight in some
-    direction: inf would say nothing new).  ``started`` is the run's
-    ``time.perf_counter()`` at its start, so ``result.time`` counts this stage.
+    Parameters
+    ----------
+    result : GraspCandidates
+        Ranked by score (:func:`~drakegrasp.planning.multifinger.rank_multifinger`).
+    plant, plant_context, object_body
+        As for :func:`finger_jacobian` (``object_body`` None on a point cloud).
+    weight : float
+        The object's weight ``m g`` (N); NaN (a cloud without ``object_mass``)
+        leaves ``result`` as it is.
+    top : int
+        The ``certify`` of the run: the best ``top`` candidates carry the
+        single-grasp verdict (``closure``), after the
+        re-ranking too.
+    started : float
+        The run's ``time.perf_counter()`` at its start, so ``result.time``
+        counts this stage.
+    check : int, optional
+        The first ``max(top, check)`` candidates get ``torque_needed`` (the
+        force-closure ones: the others hold no weight in some direction), about
+        5 ms each for the Allegro hand.
+    motors_first : bool, optional
+        Put the checked candidates that the hand's actuators hold
+        (``torque_needed <=`` the smallest effort limit of the candidate's
+        joints, :func:`motor_limit`) ahead of all others, each group in its
+        score order.  Nothing moves when the plant gives no finite limit.
+
+    Returns
+    -------
+    GraspCandidates
+        With ``reason`` saying so when no checked candidate is held by the
+        actuators.
     """
     if math.isnan(weight):
         return result
+    n = max(int(top), int(check))
     head = [
         dataclasses.replace(
             c,
@@ -236,15 +339,41 @@ def with_torques_needed(
         )
         if c.is_closure
         else c
-        for c in result.candidates[:top]
+        for c in result.candidates[:n]
     ]
     reason = result.reason or _too_weak(plant, head)
+    ranked = [*head, *result.candidates[n:]]
+    limit = motor_limit(plant, ranked[0]) if ranked else math.inf
+    if motors_first and math.isfinite(limit):
+        # a stable sort keeps the score order in each group; NaN compares False
+        ranked.sort(key=lambda c: not c.torque_needed <= limit)
+        ranked[:top] = [
+            c if c.closure is not None else dataclasses.replace(
+                c, closure=force_closure(c.grasp)
+            )
+            for c in ranked[:top]
+        ]  # fmt: skip
     return dataclasses.replace(
         result,
-        candidates=(*head, *result.candidates[top:]),
+        candidates=tuple(ranked),
         reason=reason,
         time=time.perf_counter() - started,
     )
+
+
+def motor_limit(plant, candidate: GraspCandidate) -> float:
+    """The smallest effort limit (N·m, N) of a candidate's joints' actuators.
+
+    ``inf`` when the plant gives none of them an actuator (or no finite
+    limit): then nothing says which torques the hand can apply.
+    """
+    limits = [
+        float(a.effort_limit())
+        for name in candidate.joint_names
+        for a in _actuators(plant, find_joint(plant, name))
+    ]
+    finite = [v for v in limits if math.isfinite(v) and v > 0]
+    return min(finite, default=math.inf)
 
 
 def _too_weak(plant, head) -> str:

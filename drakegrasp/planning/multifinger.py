@@ -23,12 +23,16 @@ rejection reason (:data:`REASONS`).
    that moves each finger's contacts rigidly (the palm's stay), the weight
    capacity with one squeeze bound per finger and one for the palm
    (:mod:`drakegrasp.planning.weight`), ``score = robustness × capacity``.
+   With the object's weight, the best force-closure candidates get the
+   joint torque that holds it (:mod:`drakegrasp.planning.motors`), and those
+   the actuators' effort limits allow are ranked first.
 
 On a point cloud (:func:`plan_multifinger_cloud`), stages 2 and 3 are those
 of :mod:`drakegrasp.planning.cloud_hand` (the hand against the cloud's points,
 the fingers closed onto them); stage 1 is the same, and in stage 4 the weight
 capacity of a candidate with a contact at an edge of the cloud is averaged
-over the edge's normal fan (:func:`fan_capacity`).
+over the edge's normal fan (:func:`fan_capacity`); the torque needed (with
+``object_mass``) takes each contact's finger point at its cloud point.
 """
 
 from __future__ import annotations
@@ -559,9 +563,13 @@ def plan_multifinger_cloud(
         kept, rejections, label = close_each(closer, poses, progress)
     finally:
         plant.SetPositions(ctx, saved)
-    return _ranked_result(
+    result = _ranked_result(
         kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
         settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
         num_sampled=n, object_body="point cloud", started=t0,
     )  # fmt: skip
+    # no object body: each contact's finger point is its cloud point
+    return with_torques_needed(
+        result, plant, ctx, None, weight=weight, top=certify, started=t0
+    )

@@ -280,8 +280,10 @@ def plan_grasps(
         wrap around it; ``False`` keeps the hand on the seen side.  Parallel
         jaws plan on the seen points alone either way.
     object_mass : float, optional
-        The object's mass (kg) for ``squeeze_needed``; default the body's mass
-        (a cloud has none: NaN).
+        The object's mass (kg) for ``squeeze_needed`` and (multi-finger hands)
+        ``torque_needed`` and the ranking by it; default the body's mass (a
+        cloud has none: NaN, and neither is computed).  Finite and > 0, else
+        ``InvalidOptionError``.
     preshape, synergy, synergy_range, approach, standoff : optional
         Multi-finger hands only
         (:func:`~drakegrasp.planning.approach.multi_finger_hand`): the

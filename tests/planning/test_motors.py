@@ -9,6 +9,8 @@ well above.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.optimize import linprog
@@ -17,8 +19,11 @@ import drakegrasp as dg
 from drakegrasp.closure.payload import max_load
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.cloud import CloudContact
 from drakegrasp.planning.motors import (
+    TORQUE_CHECK,
     finger_jacobian,
+    motor_limit,
     torque_capacity,
     torque_needed,
     with_torques_needed,
@@ -124,8 +129,9 @@ def test_torque_needed_scales_with_the_weight_and_leaves_the_context(
 def test_plan_grasps_sets_it_on_the_best(allegro_on_soup):
     scene, closed, weight, result = allegro_on_soup
     top = [c for c in closed if not np.isnan(c.torque_needed)]
-    assert 0 < len(top) <= 10
-    assert top == closed[: len(top)]  # the best force-closure candidates
+    assert 0 < len(top) <= TORQUE_CHECK
+    checked = result.candidates[:TORQUE_CHECK]  # every force-closure one of them
+    assert [c.sample for c in top] == [c.sample for c in checked if c.is_closure]
     for c in top[:2]:
         assert c.torque_needed == pytest.approx(
             torque_needed(
@@ -162,3 +168,99 @@ def test_a_weight_the_actuators_cannot_hold_is_said(allegro_on_soup):
     assert "hold none of the" in heavy.reason
     assert f"{min(needed):.3g} N·m" in heavy.reason
     assert heavy.reason in str(heavy)
+
+
+def _as_cloud_candidate(scene, candidate, at_finger=False):
+    """The candidate with cloud contacts (no finger body index, no ``p_FC``).
+
+    ``at_finger``: each contact's point is its finger's witness point (in O)
+    instead of the object's, so the cloud route's finger point is exactly the
+    body route's.
+    """
+    plant = scene.plant
+    ctx = plant.GetMyContextFromRoot(scene.context)
+    saved = plant.GetPositions(ctx).copy()
+    candidate.apply(plant, ctx, object_body=scene.object_body)
+    contacts = []
+    for k in candidate.contacts:
+        p_OC = k.p_OC
+        if at_finger:
+            X_WF = plant.EvalBodyPoseInWorld(ctx, plant.get_body(k.finger_body_index))
+            p_OC = candidate.X_WO.inverse().multiply(X_WF.multiply(k.p_FC))
+        contacts.append(
+            CloudContact(
+                p_OC=np.array(p_OC),
+                nhat_O=np.array(k.nhat_O),
+                psi=k.psi,
+                finger_body=k.finger_body,
+            )  # fmt: skip
+        )
+    plant.SetPositions(ctx, saved)
+    return dataclasses.replace(candidate, contacts=tuple(contacts))
+
+
+def test_a_cloud_candidates_jacobian_is_the_body_routes(allegro_on_soup):
+    """Frame O given as the candidate's X_WO (object_body=None, the cloud
+    route): with each contact at its finger's point, J is hand_jacobian's."""
+    scene, closed, _, _ = allegro_on_soup
+    for candidate in closed[:3]:
+        cloudlike = _as_cloud_candidate(scene, candidate, at_finger=True)
+        J_body = finger_jacobian(
+            scene.plant, scene.context, candidate, scene.object_body
+        )
+        J_cloud = finger_jacobian(scene.plant, scene.context, cloudlike, None)
+        np.testing.assert_allclose(J_cloud, J_body, rtol=1e-9, atol=1e-12)
+
+
+def test_a_cloud_candidates_torque_needed_is_the_body_routes(allegro_on_soup):
+    """The same contacts as cloud contacts (the object's points, the finger
+    bodies' names, X_WO): torque_needed within 3 % of the body route's (the
+    finger point moves by at most the distance tolerance)."""
+    scene, closed, weight, _ = allegro_on_soup
+    for candidate in closed[:5]:
+        body = torque_needed(
+            scene.plant, scene.context, candidate, scene.object_body, weight=weight
+        )
+        cloud = torque_needed(
+            scene.plant, scene.context, _as_cloud_candidate(scene, candidate), None,
+            weight=weight,
+        )  # fmt: skip
+        assert cloud == pytest.approx(body, rel=0.03)
+
+
+def test_candidates_the_motors_hold_come_first(allegro_on_soup):
+    """with_torques_needed moves the checked candidates whose torque_needed is
+    within the smallest effort limit (the Allegro SDF's 0.7 N·m) ahead of the
+    others, each group in the order it came, and certifies the new head."""
+    scene, _, weight, result = allegro_on_soup
+    head = list(result.candidates[:30])[::-1]  # the weakest first
+    shuffled = dataclasses.replace(
+        result,
+        candidates=(
+            *(dataclasses.replace(c, closure=None) for c in head),
+            *result.candidates[30:],
+        ),
+    )  # fmt: skip
+    kw = dict(weight=weight, top=10, started=0.0, check=30)
+    plain = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body,
+        motors_first=False, **kw,
+    )  # fmt: skip
+    assert [c.sample for c in plain] == [c.sample for c in shuffled]
+    ranked = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body, **kw
+    )
+    assert motor_limit(scene.plant, ranked[0]) == pytest.approx(0.7)
+    held = [c.torque_needed <= 0.7 for c in ranked]
+    assert 0 < sum(held) < 30
+    assert held == sorted(held, reverse=True)  # every held one first
+    order = {c.sample: k for k, c in enumerate(shuffled)}
+    for group in ([c for c in ranked if c.torque_needed <= 0.7],
+                  [c for c in ranked if not c.torque_needed <= 0.7]):  # fmt: skip
+        assert [order[c.sample] for c in group] == sorted(
+            order[c.sample] for c in group
+        )
+    # an infeasible candidate that came first is now behind a feasible one
+    first_bad = next(k for k, c in enumerate(shuffled) if c.torque_needed > 0.7)
+    assert first_bad < order[ranked[0].sample]
+    assert all(c.closure is not None for c in ranked[:10])
