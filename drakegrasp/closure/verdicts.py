@@ -179,7 +179,8 @@ def internal_forces(
         Rows in the order of the columns of ``G``; columns the hand's velocities.
     tol : float, optional
         LP3 passes when ``d* <= tol``, or when ``d*`` is below the resolution
-        of LP3's optimal force (:attr:`InternalForceResult.resolution`).
+        of LP3's optimal force (``resolution`` of
+        :class:`~drakegrasp.InternalForceResult`).
     rank_tol : float, optional
         Relative singular-value threshold for ``dim(N(G) ∩ N(Jᵀ))``, and the
         relative resolution of the optimal force's normal components.
