@@ -56,3 +56,24 @@ def test_a_hand_file_that_is_not_there_is_named(capsys, hand):
     assert main(["plan", "box", "--hand", hand, "--num", "5"]) == 1
     err = capsys.readouterr().err
     assert err == f"drakegrasp: error: --hand file {hand!r} not found\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("", "contains no objects"),
+        ("\x00\x17garbage\xff", "contains no objects"),
+        # Drake's parser would read these vertices at finite places
+        ("v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\n", "line 1: a vertex must"),
+        ("v 0 0 0\nv inf 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\n", "line 2: a vertex must"),
+        ("v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1: a vertex must"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "volume"),  # flat: no inside
+    ],
+)
+def test_a_hostile_mesh_is_refused_in_one_line(tmp_path, capsys, text, message):
+    obj = tmp_path / "bad.obj"
+    obj.write_text(text, encoding="latin-1")
+    assert main(["plan", str(obj), "--num", "5"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("drakegrasp: error: ")
+    assert message in err, err
