@@ -9,7 +9,6 @@ writes the same kind of function and builds the plant themselves.
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass
 from typing import Any
@@ -20,7 +19,11 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.plant.models import register_models, use_local_drake_models
+from drakegrasp.plant.models import (
+    check_obj_vertices,
+    register_models,
+    use_local_drake_models,
+)
 
 __all__ = ["WSG_URL", "PlanningScene", "planning_scene"]
 
@@ -127,41 +130,5 @@ def _add(parser, url: str):
     if "://" in url:
         return parser.AddModels(url=url)[0]
     if str(url).lower().endswith(".obj"):
-        _check_obj_vertices(url)
+        check_obj_vertices(url)
     return parser.AddModels(str(url))[0]
-
-
-def _check_obj_vertices(path) -> None:
-    """Refuse a Wavefront OBJ file with a vertex that is not three finite numbers.
-
-    Drake's parser reads ``v nan 0 0`` as a vertex at a finite place (the
-    planner then ran on a mesh the file does not describe), so the ``v``
-    lines are read here first: about 0.15 s for 100,000 vertices.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The ``.obj`` file.
-
-    Raises
-    ------
-    ModelError
-        Naming the first bad vertex's line.
-    """
-    try:
-        with open(path, encoding="utf-8", errors="replace") as f:
-            for number, line in enumerate(f, 1):
-                if not line.startswith("v "):
-                    continue
-                fields = line.split()[1:4]
-                try:
-                    values = [float(x) for x in fields]
-                except ValueError:
-                    values = []
-                if len(values) < 3 or not all(math.isfinite(v) for v in values):
-                    raise ModelError(
-                        f"mesh {os.fspath(path)!r}, line {number}: a vertex must be "
-                        f"three finite numbers, got {line.strip()[:80]!r}"
-                    )
-    except OSError:
-        return  # Drake's parser says what is wrong with the file

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import importlib.util
+import math
 import os
 from pathlib import Path
 
@@ -21,6 +22,7 @@ __all__ = [
     "DRAKE_MODELS_ENV",
     "DRAKE_MODELS_HINT",
     "PACKAGE_NAME",
+    "check_obj_vertices",
     "explain_drake_models",
     "models_dir",
     "register_models",
@@ -189,3 +191,41 @@ def _package_map_of(parser_or_package_map, caller: str) -> PackageMap:
         f"{caller} expects a pydrake Parser or PackageMap, got "
         f"{type(parser_or_package_map).__name__}"
     )
+
+
+def check_obj_vertices(path) -> None:
+    """Refuse a Wavefront OBJ file with a vertex that is not three finite numbers.
+
+    Drake's parser reads ``v nan 0 0`` as a vertex at a finite place, and the
+    planner or a scene then works on a mesh the file does not describe, so
+    :func:`~drakegrasp.planning.scenes.planning_scene` and a scene's
+    ``add_model`` of an ``.obj`` read its ``v`` lines first (about 0.15 s for
+    100,000 vertices).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.obj`` file.
+
+    Raises
+    ------
+    ModelError
+        Naming the first bad vertex's line.
+    """
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for number, line in enumerate(f, 1):
+                if not line.startswith("v "):
+                    continue
+                fields = line.split()[1:4]
+                try:
+                    values = [float(x) for x in fields]
+                except ValueError:
+                    values = []
+                if len(values) < 3 or not all(math.isfinite(v) for v in values):
+                    raise ModelError(
+                        f"mesh {os.fspath(path)!r}, line {number}: a vertex must be "
+                        f"three finite numbers, got {line.strip()[:80]!r}"
+                    )
+    except OSError:
+        return  # Drake's parser says what is wrong with the file

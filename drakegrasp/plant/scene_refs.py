@@ -46,8 +46,9 @@ from pathlib import Path
 
 from pydrake.multibody.parsing import LoadModelDirectives, PackageMap, Parser
 
-from drakegrasp.errors import SceneError
+from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.models import (
+    check_obj_vertices,
     explain_drake_models,
     register_models,
     use_local_drake_models,
@@ -363,10 +364,12 @@ def check_references(
             try:
                 if not allow_any_file:
                     _check_url(url, scene_dir=scene_dir, package_map=package_map)
+                if kind == "add_model" and url.lower().endswith(".obj"):
+                    check_obj_vertices(_resolve(url, package_map))
                 if kind != "add_directives":
                     continue
                 local = os.path.realpath(_resolve(url, package_map))
-            except SceneError as e:
+            except ModelError as e:  # SceneError, or a mesh with a bad vertex
                 raise SceneError(f"scene {str(current)!r}: {e}") from None
             if local in chain:
                 names = " -> ".join(Path(p).name for p in (*chain, local))
