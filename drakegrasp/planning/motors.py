@@ -55,7 +55,6 @@ from scipy.linalg import block_diag
 
 from drakegrasp._solvers import require_solution, solve
 from drakegrasp.closure.verdicts import force_closure
-from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.friction_cone import (
     DEFAULT_NUM_GENERATORS,
     friction_cone_generators,
@@ -66,7 +65,7 @@ from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
 from drakegrasp.plant.fingers import find_joint
-from drakegrasp.plant.jacobians import hand_jacobian
+from drakegrasp.plant.jacobians import contact_rows, hand_jacobian
 from drakegrasp.plant.validation import (
     plant_context_of,
     resolve_body,
@@ -162,18 +161,14 @@ def _cloud_finger_jacobian(plant, ctx, candidate: GraspCandidate, columns):
             ctx, JacobianWrtVariable.kV, finger.body_frame(), p_FC,
             plant.world_frame(), plant.world_frame(),
         )[:, columns]  # fmt: skip
-        R = c.frame
-        if c.contact_model is ContactModel.FRICTIONLESS:
-            blocks.append(R[:, :1].T @ Jv)
-            continue
-        block = R.T @ Jv
-        if c.num_components == 4:
-            Jw = R_OW @ plant.CalcJacobianAngularVelocity(
+
+        def angular(finger=finger):
+            return R_OW @ plant.CalcJacobianAngularVelocity(
                 ctx, JacobianWrtVariable.kV, finger.body_frame(),
                 plant.world_frame(), plant.world_frame(),
             )[:, columns]  # fmt: skip
-            block = np.vstack([block, np.asarray(pc.nhat_O) @ Jw])
-        blocks.append(block)
+
+        blocks.append(contact_rows(c, Jv, pc.nhat_O, angular))
     grasp = candidate.grasp
     return np.vstack(blocks).reshape(grasp.num_components, len(columns))
 
@@ -341,9 +336,9 @@ def with_torques_needed(
         else c
         for c in result.candidates[:n]
     ]
-    reason = result.reason or _too_weak(plant, head)
     ranked = [*head, *result.candidates[n:]]
     limit = motor_limit(plant, ranked[0]) if ranked else math.inf
+    reason = result.reason or _too_weak(head, limit)
     if motors_first and math.isfinite(limit):
         # a stable sort keeps the score order in each group; NaN compares False
         ranked.sort(key=lambda c: not c.torque_needed <= limit)
@@ -376,20 +371,13 @@ def motor_limit(plant, candidate: GraspCandidate) -> float:
     return min(finite, default=math.inf)
 
 
-def _too_weak(plant, head) -> str:
-    """Why no candidate of ``head`` holds with the actuators, or ""."""
+def _too_weak(head, limit: float) -> str:
+    """Why no candidate of ``head`` holds with actuators limited to ``limit``, or ""."""
     needed = [c.torque_needed for c in head if not np.isnan(c.torque_needed)]
-    if not needed:
-        return ""
-    limits = [
-        float(a.effort_limit())
-        for name in head[0].joint_names
-        for a in _actuators(plant, find_joint(plant, name))
-    ]
-    if not limits or min(needed) <= min(limits):
+    if not needed or min(needed) <= limit:
         return ""
     return (
-        f"the hand's actuators (effort limits from {min(limits):.3g} N·m) hold "
+        f"the hand's actuators (effort limits from {limit:.3g} N·m) hold "
         f"none of the {len(needed)} best force-closure candidates against the "
         f"object's weight in every direction: they need at least "
         f"{min(needed):.3g} N·m per joint (torque_needed)"

@@ -21,14 +21,14 @@ All vectors are expressed in the object body frame O.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable, JointIndex, RigidBody
 from pydrake.systems.framework import Context
 
-from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.options import PLANES
@@ -40,6 +40,7 @@ from drakegrasp.plant.validation import (
 
 __all__ = [
     "PLANES",
+    "contact_rows",
     "hand_jacobian",
     "hand_velocity_indices",
     "signed_distance_jacobian",
@@ -186,21 +187,52 @@ def hand_jacobian(
         Jv = J_fin[i][:, cols]
         if plane is not None:
             Jv = Jv[list(PLANES[plane]), :]
-        R = c.frame
-        k = c.num_components
-        if c.contact_model is ContactModel.FRICTIONLESS:
-            blocks.append(R[:, :1].T @ Jv)
-            continue
-        block = R.T @ Jv
-        if k == 4:
-            body = plant.get_body(pc.finger_body_index)
-            Jw = plant.CalcJacobianAngularVelocity(
+
+        def angular(pc=pc):  # a soft finger's row only
+            return plant.CalcJacobianAngularVelocity(
                 plant_context,
                 JacobianWrtVariable.kV,
-                body.body_frame(),
+                plant.get_body(pc.finger_body_index).body_frame(),
                 plant.world_frame(),
                 frame_O,
             )[:, cols]
-            block = np.vstack([block, pc.nhat_O @ Jw])
-        blocks.append(block)
+
+        blocks.append(contact_rows(c, Jv, pc.nhat_O, angular))
     return np.vstack(blocks).reshape(grasp.num_components, cols.size)
+
+
+def contact_rows(
+    contact: Contact,
+    Jv: np.ndarray,
+    normal: np.ndarray,
+    angular: Callable[[], np.ndarray],
+) -> np.ndarray:
+    """One contact's block of rows of ``J``, in its components.
+
+    Parameters
+    ----------
+    contact : Contact
+        The grasp's contact (its frame ``[n, t1, t2]`` in O, and its model).
+    Jv : (3, n_h) or (2, n_h) float
+        Translational velocity of the finger's contact point, expressed in O
+        (planar: the plane's two components), m/s per unit hand velocity.
+    normal : (3,) float
+        The contact normal in O, for a soft finger's row.
+    angular : callable
+        Returns the finger's angular velocity Jacobian (3, n_h), expressed
+        in O; called for a soft finger only.
+
+    Returns
+    -------
+    (k, n_h) float
+        ``[n]`` (frictionless), ``R^T Jv`` (hard finger: ``[n, t1, t2]``,
+        planar ``[n, t]``), and for a soft finger the normal component of
+        the finger's angular velocity below it (rad/s).
+    """
+    R = contact.frame
+    if contact.contact_model is ContactModel.FRICTIONLESS:
+        return R[:, :1].T @ Jv
+    block = R.T @ Jv
+    if contact.num_components == 4:
+        block = np.vstack([block, np.asarray(normal) @ angular()])
+    return block
