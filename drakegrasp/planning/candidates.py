@@ -388,6 +388,13 @@ def planning_result(
             if num_sampled == 0
             else f"all {num_sampled} sampled poses were rejected (see rejections)"
         )
+        completion = settings.get("unseen_completion") or {}
+        if num_sampled and completion.get("skipped"):
+            reason += (
+                f"; the cloud's unseen side was not completed: "
+                f"{completion['skipped']} (a face seen head-on; a view of two "
+                "or more faces gives the object's depth)"
+            )
     elif not any(c.is_closure for c in candidates):
         reason = _why_no_closure(candidates, settings.get("contact_model"))
     return GraspCandidates(

@@ -273,7 +273,7 @@ class CloudHand:
         self.fan_reach = float(fan_reach)
         self.tol, self.min_fingers = tol, int(min_fingers)
         self.margin = GAP_SPACINGS * surface.spacing
-        self.points_W = surface.points + surface.centroid
+        self.points_W = surface.points + surface.origin
         self.tree = cKDTree(self.points_W)
         self.surfel = SURFEL_SPACINGS * surface.spacing
         n = surface.normals
@@ -465,7 +465,7 @@ class CloudHand:
         view = self.surface.viewpoint
         if view is None:
             return False
-        camera = view + self.surface.centroid
+        camera = view + self.surface.origin
         rho = self.surface.spacing
         for g in (*self.palm, *(g for f in self.fingers for g in f)):
             if g.probes_G is None:

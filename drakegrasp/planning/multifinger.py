@@ -541,7 +541,7 @@ def plan_multifinger_cloud(
         )
     else:
         surface = CloudSurface(points, normals, viewpoint=viewpoint)
-    X_WO = RigidTransform(surface.centroid)
+    X_WO = RigidTransform(surface.origin)
     settings = {
         **settings,
         "hand": hand_model.to_dict(),

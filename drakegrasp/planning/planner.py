@@ -51,11 +51,12 @@ from drakegrasp.planning.candidates import (
     planning_result,
 )
 from drakegrasp.planning.cloud import (
-    CONTACT_BAND,
+    PAD_CONTACT_BAND,
     CloudFingers,
     CloudSurface,
     read_cloud,
 )
+from drakegrasp.planning.cloud import complete_unseen as complete_cloud
 from drakegrasp.planning.gripper import parallel_jaw
 from drakegrasp.planning.multifinger import (
     DEFAULT_TILT,
@@ -274,11 +275,19 @@ def plan_grasps(
         Where the cloud was seen from (normals are turned towards it); default
         normals point away from the cloud's centroid.
     complete_unseen : bool, optional
-        Multi-finger hands with a ``viewpoint``: assume the object centrally
-        symmetric and complete its unseen side by reflecting the seen one
-        (:func:`~drakegrasp.planning.cloud.complete_unseen`), so the hand may
-        wrap around it; ``False`` keeps the hand on the seen side.  Parallel
-        jaws plan on the seen points alone either way.
+        With a ``viewpoint``: assume the object centrally symmetric and
+        complete its unseen side by reflecting the seen one through the point
+        its seen normals aim at
+        (:func:`~drakegrasp.planning.cloud.complete_unseen`, reported in
+        ``settings["unseen_completion"]``), so a multi-finger hand may wrap
+        around it and parallel jaws may pinch across it, and plan on the
+        whole cloud, its frame O (``X_WO``: the centre of mass of the weight
+        capacity, ``squeeze_needed`` and the torque scale) at that centre of
+        symmetry (a multi-finger hand: the completed cloud's centroid, within
+        0.02 mm of it on the YCB objects' clouds).  ``False`` keeps the hand on the seen side, O at the seen
+        points' centroid, which lies towards the camera (by ``2r/π`` on a can
+        of radius ``r``).  A face seen head-on gives no depth: nothing is
+        completed, and an empty result's ``reason`` says so.
     object_mass : float, optional
         The object's mass (kg) for ``squeeze_needed`` and (multi-finger hands)
         ``torque_needed`` and the ranking by it; default the body's mass (a
@@ -406,15 +415,29 @@ def plan_grasps(
                 complete=complete_unseen,
             )  # fmt: skip
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
-        surface = CloudSurface(points, normals, viewpoint=viewpoint)
-        X_WO = RigidTransform(surface.centroid)
+        completion = None
+        if viewpoint is not None and complete_unseen:
+            added, added_normals, completion = complete_cloud(
+                points, normals, viewpoint
+            )
+        if completion is not None and completion["skipped"] is None:
+            # planned as a whole cloud about the centre of symmetry
+            surface = CloudSurface(
+                np.vstack([points, added]),
+                np.vstack([normals, added_normals]),
+                origin=completion["centre"],
+            )
+        else:
+            surface = CloudSurface(points, normals, viewpoint=viewpoint)
+        X_WO = RigidTransform(surface.origin)
         name = "point cloud"
         mass = np.nan if object_mass is None else float(object_mass)
         settings.update(
             cloud_points=len(points),
             cloud_dropped=dropped,
             line_radius=surface.line_radius,
-            contact_band=CONTACT_BAND,
+            contact_band=PAD_CONTACT_BAND,
+            unseen_completion=completion,
         )
     settings["gripper"] = gripper.to_dict()
     torque_scale = surface.radius_about(np.zeros(3))
@@ -425,7 +448,13 @@ def plan_grasps(
     cloud = None
     if body is None:
         cloud = CloudFingers(
-            plant, ctx, gripper, closer.hand_instance_bodies, surface, tol, CONTACT_BAND
+            plant,
+            ctx,
+            gripper,
+            closer.hand_instance_bodies,
+            surface,
+            tol,
+            PAD_CONTACT_BAND,
         )
     sure = np.zeros(len(poses["sample"]), bool)
     if cloud is None:  # penetrations certain without Drake: rejected at once
