@@ -187,13 +187,14 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
         viewpoint = real_array("viewpoint", viewpoint, error=InvalidOptionError)
         if viewpoint.shape != (3,) or not np.all(np.abs(viewpoint) < MAX_COORDINATE):
             raise InvalidOptionError(
-                f"viewpoint must be a finite point (3,) in metres, got {viewpoint!r}"
+                f"viewpoint must be a point (3,) in metres, each coordinate "
+                f"finite and within {MAX_COORDINATE:g} m, got {viewpoint!r}"
             )
     if normals is not None:
         normals = real_array("cloud_normals", normals, error=InvalidOptionError)
         if normals.shape != points.shape:
             raise InvalidOptionError(
-                f"normals must have the cloud's shape {points.shape}, got "
+                f"cloud_normals must have the cloud's shape {points.shape}, got "
                 f"{normals.shape}"
             )
     if len(points) == 0:

@@ -284,10 +284,11 @@ def plan_grasps(
         whole cloud, its frame O (``X_WO``: the centre of mass of the weight
         capacity, ``squeeze_needed`` and the torque scale) at that centre of
         symmetry (a multi-finger hand: the completed cloud's centroid, within
-        0.02 mm of it on the YCB objects' clouds).  ``False`` keeps the hand on the seen side, O at the seen
-        points' centroid, which lies towards the camera (by ``2r/π`` on a can
-        of radius ``r``).  A face seen head-on gives no depth: nothing is
-        completed, and an empty result's ``reason`` says so.
+        0.02 mm of it on the YCB objects' clouds).  ``False`` keeps the hand
+        on the seen side, O at the seen points' centroid, which lies towards
+        the camera (by ``2r/π`` on a can of radius ``r``).  A face seen
+        head-on gives no depth: nothing is completed, and an empty result's
+        ``reason`` says so.
     object_mass : float, optional
         The object's mass (kg) for ``squeeze_needed`` and (multi-finger hands)
         ``torque_needed`` and the ranking by it; default the body's mass (a

@@ -181,6 +181,11 @@ def test_hostile_clouds(scenes):
             hand_only.plant, hand_only.context, None, hand=hand_only.hand,
             num_candidates=5, mu=0.5,
         )  # fmt: skip
+    p = np.random.default_rng(2).normal(0, 0.02, (50, 3))
+    with pytest.raises(InvalidOptionError, match=r"viewpoint .* within 1e\+06 m"):
+        _plan(hand_only, p, viewpoint=[2e6, 0.0, 0.0])
+    with pytest.raises(InvalidOptionError, match=r"cloud_normals must have"):
+        _plan(hand_only, p, np.ones((49, 3)))
     # a cloud far out of the gripper's reach on every side: a reason, no error
     far = np.random.default_rng(1).normal(0, 0.3, (500, 3))
     result = _plan(hand_only, far, -far / np.linalg.norm(far, axis=1, keepdims=True))
