@@ -38,22 +38,13 @@ from pathlib import Path
 
 import numpy as np
 
-from drakegrasp.planning import object_surface, plan_grasps, planning_scene, shake_test
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_cloud_hold import sample_cloud  # noqa: E402  (the same clouds)
 from bench_plan import YCB, drake_models  # noqa: E402  (the same local copy)
 
 VIEWS = {"full": None, "side": (0.5, 0.0, 0.0), "oblique": (0.4, 0.25, 0.3)}
-
-
-def sample_cloud(full, n, seed=0, view=None):
-    """``(points, normals)`` on the object, world frame; ``view``: the seen ones."""
-    surface = object_surface(full.plant, full.context, full.object_body)
-    p, nrm, _ = surface.sample(n, np.random.default_rng(seed))
-    if view is not None:
-        seen = np.sum(nrm * (np.asarray(view) - p), axis=1) > 0
-        p, nrm = p[seen], nrm[seen]
-    return p, nrm
 
 
 def _held(group, full, X_WO, squeeze):
