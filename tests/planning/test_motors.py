@@ -348,3 +348,28 @@ def test_a_parallel_jaw_takes_no_torque_limit(wsg_scene):
             scene.plant, scene.context, scene.object_body, hand=scene.hand,
             num_candidates=5, mu=0.5, torque_limit=0.5,
         )  # fmt: skip
+
+
+def test_a_torque_limit_orders_a_hand_without_effort_limits(
+    allegro_on_soup, monkeypatch
+):
+    """A plant whose actuators give no finite limit (motor_limit inf) keeps
+    the score's order, unless torque_limit says what the hand applies."""
+    scene, _, weight, result = allegro_on_soup
+    monkeypatch.setattr(
+        "drakegrasp.planning.motors.motor_limit", lambda plant, c: np.inf
+    )
+    head = list(result.candidates[:30])[::-1]  # the weakest first
+    shuffled = dataclasses.replace(result, candidates=(*head, *result.candidates[30:]))
+    kw = dict(weight=weight, top=10, started=0.0, check=30)
+    free = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body, **kw
+    )
+    assert [c.sample for c in free] == [c.sample for c in shuffled]
+    assert free.reason == ""
+    ranked = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body,
+        torque_limit=0.5, **kw,
+    )  # fmt: skip
+    held = [c.torque_needed <= 0.5 for c in ranked]
+    assert held == sorted(held, reverse=True) and 0 < sum(held) < 30
