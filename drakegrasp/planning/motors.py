@@ -39,7 +39,9 @@ tolerance apart), and exactly with the finger's points.
 When the weight is known (an object body's mass, or ``object_mass=``),
 :func:`with_torques_needed` computes it for the best :data:`TORQUE_CHECK`
 candidates and ranks those the hand's actuators hold (``torque_needed`` at
-most the smallest effort limit of the candidate's joints) ahead of the rest.
+most the smallest effort limit of the candidate's joints) ahead of the rest;
+``plan_grasps(..., torque_limit=)`` puts the torque the user will apply (N·m,
+capped by the effort limit) in the limit's place.
 """
 
 from __future__ import annotations
@@ -85,6 +87,7 @@ reads as ``inf`` (no finger joint bounds the load: contacts on the palm)."""
 __all__ = [
     "BETA_CAP",
     "TORQUE_CHECK",
+    "check_torque_limit",
     "finger_jacobian",
     "motor_limit",
     "torque_capacity",
@@ -287,6 +290,7 @@ def with_torques_needed(
     started: float,
     check: int = TORQUE_CHECK,
     motors_first: bool = True,
+    torque_limit: float | None = None,
 ) -> GraspCandidates:
     """``result`` with :func:`torque_needed` on its best candidates, re-ranked.
 
@@ -315,6 +319,12 @@ def with_torques_needed(
         (``torque_needed <=`` the smallest effort limit of the candidate's
         joints, :func:`motor_limit`) ahead of all others, each group in its
         score order.  Nothing moves when the plant gives no finite limit.
+    torque_limit : float or None, optional
+        The torque (N·m per finger joint; N for a prismatic one) the user will
+        apply, used instead of :func:`motor_limit` for ``motors_first`` and
+        the ``reason``; capped by the effort limit (an actuator applies no
+        more).  None (default): the effort limit.  Finite and > 0, else
+        ``InvalidOptionError``.
 
     Returns
     -------
@@ -322,6 +332,8 @@ def with_torques_needed(
         With ``reason`` saying so when no checked candidate is held by the
         actuators.
     """
+    if torque_limit is not None:
+        torque_limit = check_torque_limit(torque_limit)
     if math.isnan(weight):
         return result
     n = max(int(top), int(check))
@@ -338,7 +350,10 @@ def with_torques_needed(
     ]
     ranked = [*head, *result.candidates[n:]]
     limit = motor_limit(plant, ranked[0]) if ranked else math.inf
-    reason = result.reason or _too_weak(head, limit)
+    applied = torque_limit is not None and torque_limit < limit
+    if applied:
+        limit = torque_limit
+    reason = result.reason or _too_weak(head, limit, applied)
     if motors_first and math.isfinite(limit):
         # a stable sort keeps the score order in each group; NaN compares False
         ranked.sort(key=lambda c: not c.torque_needed <= limit)
@@ -356,6 +371,24 @@ def with_torques_needed(
     )
 
 
+def check_torque_limit(torque_limit) -> float:
+    """``torque_limit`` (N·m) checked: a finite number > 0.
+
+    Raises
+    ------
+    InvalidOptionError
+        Not a real number, or not finite and > 0; the message names
+        ``torque_limit``.
+    """
+    value = real_scalar("torque_limit", torque_limit)
+    if not 0 < value < math.inf:
+        raise InvalidOptionError(
+            f"torque_limit must be a finite number > 0 (N·m per finger joint), "
+            f"got {torque_limit!r}"
+        )
+    return value
+
+
 def motor_limit(plant, candidate: GraspCandidate) -> float:
     """The smallest effort limit (N·m, N) of a candidate's joints' actuators.
 
@@ -371,13 +404,21 @@ def motor_limit(plant, candidate: GraspCandidate) -> float:
     return min(finite, default=math.inf)
 
 
-def _too_weak(head, limit: float) -> str:
-    """Why no candidate of ``head`` holds with actuators limited to ``limit``, or ""."""
+def _too_weak(head, limit: float, applied: bool = False) -> str:
+    """Why no candidate of ``head`` holds with actuators limited to ``limit``, or "".
+
+    ``applied``: the limit is the user's ``torque_limit``, not the effort limit.
+    """
     needed = [c.torque_needed for c in head if not np.isnan(c.torque_needed)]
     if not needed or min(needed) <= limit:
         return ""
+    who = (
+        f"the hand at torque_limit {limit:.3g} N·m holds"
+        if applied
+        else f"the hand's actuators (effort limits from {limit:.3g} N·m) hold"
+    )
     return (
-        f"the hand's actuators (effort limits from {limit:.3g} N·m) hold "
+        f"{who} "
         f"none of the {len(needed)} best force-closure candidates against the "
         f"object's weight in every direction: they need at least "
         f"{min(needed):.3g} N·m per joint (torque_needed)"

@@ -472,12 +472,13 @@ def plan_multifinger(
     plant, ctx, body, *, hand, n, mu, rng, surface, settings, t0, name,
     preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
     standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
-    progress=False, weight=None,
+    progress=False, weight=None, torque_limit=None,
 ):  # fmt: skip
     """The multi-finger route of :func:`~drakegrasp.planning.planner.plan_grasps`.
 
     Called by ``plan_grasps`` once the options are checked (``settings`` holds
-    them); ``weight`` is the object's weight (N).  Returns its
+    them); ``weight`` is the object's weight (N), ``torque_limit`` the
+    torque applied (N·m, None: the effort limits).  Returns its
     :class:`~drakegrasp.planning.candidates.GraspCandidates`.
     """
     tilt, hand_model = _checked_hand(
@@ -505,22 +506,24 @@ def plan_multifinger(
         num_sampled=n, object_body=name, started=t0,
     )  # fmt: skip
     return with_torques_needed(
-        result, plant, ctx, body, weight=weight, top=certify, started=t0
-    )
+        result, plant, ctx, body, weight=weight, top=certify, started=t0,
+        torque_limit=torque_limit,
+    )  # fmt: skip
 
 
 def plan_multifinger_cloud(
     plant, ctx, *, hand, points, normals, viewpoint, n, mu, rng, settings, t0,
     preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
     standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
-    progress=False, weight=float("nan"), complete=True,
+    progress=False, weight=float("nan"), complete=True, torque_limit=None,
 ):  # fmt: skip
     """The multi-finger cloud route of :func:`~drakegrasp.planning.planner.plan_grasps`.
 
     Called by ``plan_grasps`` with the cloud read
     (:func:`~drakegrasp.planning.cloud.read_cloud`: world frame, outward unit
     normals) and the options checked (``settings``); ``weight`` is the
-    object's weight (N, NaN when unknown).  With a ``viewpoint`` and
+    object's weight (N, NaN when unknown), ``torque_limit`` the torque
+    applied (N·m, None: the effort limits).  With a ``viewpoint`` and
     ``complete`` the unseen side is the seen one reflected through the
     object's estimated centre (:func:`~drakegrasp.planning.cloud.complete_unseen`,
     an assumption: a centrally symmetric object), and the hand may reach
@@ -571,5 +574,6 @@ def plan_multifinger_cloud(
     )  # fmt: skip
     # no object body: each contact's finger point is its cloud point
     return with_torques_needed(
-        result, plant, ctx, None, weight=weight, top=certify, started=t0
-    )
+        result, plant, ctx, None, weight=weight, top=certify, started=t0,
+        torque_limit=torque_limit,
+    )  # fmt: skip

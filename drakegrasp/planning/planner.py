@@ -58,6 +58,7 @@ from drakegrasp.planning.cloud import (
 )
 from drakegrasp.planning.cloud import complete_unseen as complete_cloud
 from drakegrasp.planning.gripper import parallel_jaw
+from drakegrasp.planning.motors import check_torque_limit
 from drakegrasp.planning.multifinger import (
     DEFAULT_TILT,
     hand_is_parallel_jaw,
@@ -194,6 +195,7 @@ def plan_grasps(
     viewpoint=None,
     complete_unseen: bool = True,
     object_mass: float | None = None,
+    torque_limit: float | None = None,
     preshape=None,
     synergy=None,
     synergy_range=(0.0, 1.0),
@@ -294,6 +296,17 @@ def plan_grasps(
         ``torque_needed`` and the ranking by it; default the body's mass (a
         cloud has none: NaN, and neither is computed).  Finite and > 0, else
         ``InvalidOptionError``.
+    torque_limit : float, optional
+        Multi-finger hands with a known weight: the torque (N·m per finger
+        joint; N for a prismatic one) you will apply when grasping.  The
+        candidates whose ``torque_needed`` is at most this are ranked first
+        (:func:`~drakegrasp.planning.motors.with_torques_needed`); capped by the
+        actuators' effort limits, the default (an actuator applies no more).
+        Give it when the hand will squeeze with less than its motors allow (a
+        gentler controller, the shake test's ``squeeze``), so the ranking
+        assumes the torque actually applied.  Finite and > 0, else
+        ``InvalidOptionError``, which a parallel jaw (no ``torque_needed``:
+        its ``squeeze_needed`` is in N) raises too.
     preshape, synergy, synergy_range, approach, standoff : optional
         Multi-finger hands only
         (:func:`~drakegrasp.planning.approach.multi_finger_hand`): the
@@ -341,6 +354,8 @@ def plan_grasps(
         raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
     if object_mass is not None:
         object_mass = _check_positive("object_mass", object_mass, "kg")
+    if torque_limit is not None:
+        torque_limit = check_torque_limit(torque_limit)
     noise = _check_noise(noise)
     if weight_check is not None and (
         isinstance(weight_check, bool)
@@ -380,6 +395,8 @@ def plan_grasps(
         "robustness_samples": robustness_samples,
         "noise": noise,
     }
+    if torque_limit is not None:
+        settings["torque_limit"] = torque_limit
     if point_cloud is None:
         body = resolve_object_body(plant, object_body)
         if not hand_is_parallel_jaw(plant, ctx, body, hand):
@@ -391,8 +408,9 @@ def plan_grasps(
                 name=scoped_name(plant, body), preshape=preshape, synergy=synergy,
                 synergy_range=synergy_range, approach=approach, standoff=standoff,
                 tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
-                progress=progress, weight=mass * GRAVITY,
+                progress=progress, weight=mass * GRAVITY, torque_limit=torque_limit,
             )  # fmt: skip
+        _no_torque_limit(torque_limit)
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
         X_WO = plant.EvalBodyPoseInWorld(ctx, body)
@@ -413,8 +431,9 @@ def plan_grasps(
                 synergy_range=synergy_range, approach=approach, standoff=standoff,
                 tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY,
-                complete=complete_unseen,
+                complete=complete_unseen, torque_limit=torque_limit,
             )  # fmt: skip
+        _no_torque_limit(torque_limit)
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         completion = None
         if viewpoint is not None and complete_unseen:
@@ -498,6 +517,16 @@ def plan_grasps(
         settings=settings,
         started=t0,
     )
+
+
+def _no_torque_limit(torque_limit) -> None:
+    """A parallel jaw takes no ``torque_limit``: say so."""
+    if torque_limit is not None:
+        raise InvalidOptionError(
+            "torque_limit applies to multi-finger hands (their torque_needed, "
+            "N·m per joint); a parallel jaw's squeeze_needed is in N: leave "
+            f"torque_limit out (got {torque_limit!r})"
+        )
 
 
 def _close_on_body(closer: BodyCloser, X_WH, opening):

@@ -18,6 +18,7 @@ from scipy.optimize import linprog
 import drakegrasp as dg
 from drakegrasp.closure.payload import max_load
 from drakegrasp.core.friction_cone import friction_cone_generators
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.cloud import CloudContact
 from drakegrasp.planning.motors import (
@@ -264,3 +265,111 @@ def test_candidates_the_motors_hold_come_first(allegro_on_soup):
     first_bad = next(k for k, c in enumerate(shuffled) if c.torque_needed > 0.7)
     assert first_bad < order[ranked[0].sample]
     assert all(c.closure is not None for c in ranked[:10])
+
+
+def test_a_torque_limit_ranks_by_the_torque_applied(allegro_on_soup):
+    """torque_limit= (N·m): the candidates whose torque_needed is within the
+    torque the user will apply come first, not those within the 0.7 N·m effort
+    limit; a limit above the effort limit is capped by it; a limit no
+    candidate meets is said in the reason."""
+    scene, _, weight, result = allegro_on_soup
+    head = list(result.candidates[:30])[::-1]  # the weakest first
+    shuffled = dataclasses.replace(
+        result,
+        candidates=(
+            *(dataclasses.replace(c, closure=None) for c in head),
+            *result.candidates[30:],
+        ),
+    )  # fmt: skip
+    kw = dict(weight=weight, top=10, started=0.0, check=30)
+    effort = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body, **kw
+    )
+    needed = sorted(c.torque_needed for c in effort if c.torque_needed <= 0.7)
+    limit = needed[len(needed) // 2]  # half of the motors' candidates need more
+    assert 0 < limit < 0.7 and needed[-1] > limit
+    ranked = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body,
+        torque_limit=limit, **kw,
+    )  # fmt: skip
+    held = [c.torque_needed <= limit for c in ranked]
+    assert held == sorted(held, reverse=True) and 0 < sum(held) < len(needed)
+    assert [c.sample for c in ranked] != [c.sample for c in effort]
+    assert all(c.closure is not None for c in ranked[:10])
+    capped = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body,
+        torque_limit=5.0, **kw,
+    )  # fmt: skip
+    assert [c.sample for c in capped] == [c.sample for c in effort]
+    tiny = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body,
+        torque_limit=1e-3, **kw,
+    )  # fmt: skip
+    assert "torque_limit 0.001 N·m holds none of the" in tiny.reason
+
+
+def test_plan_grasps_takes_the_torque_applied(allegro_on_soup):
+    """plan_grasps(..., torque_limit=) ranks by it (and records it); without
+    it the effort limit ranks, and the candidates are the same."""
+    scene, closed, weight, result = allegro_on_soup
+    needed = [c.torque_needed for c in result if c.torque_needed <= 0.7]
+    # a candidate that needs less than the one ranked before it: at its
+    # torque, the one before goes behind it
+    limit = next(t for a, t in zip(needed[:-1], needed[1:], strict=True) if t < a)
+    gentle = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=100, mu=1.0, seed=0, robustness_samples=8,
+        torque_limit=limit,
+    )  # fmt: skip
+    held = [c.torque_needed <= limit for c in gentle]
+    assert held == sorted(held, reverse=True) and sum(held) > 0
+    assert [c.sample for c in gentle] != [c.sample for c in result]
+    assert sorted(c.sample for c in gentle) == sorted(c.sample for c in result)
+    assert gentle.settings["torque_limit"] == limit
+    assert "torque_limit" not in result.settings
+
+
+@pytest.mark.parametrize(
+    "bad", [0.0, -0.5, float("nan"), float("inf"), True, "0.5", [0.5]]
+)
+def test_a_bad_torque_limit_is_refused(allegro_on_soup, bad):
+    scene = allegro_on_soup[0]
+    with pytest.raises(InvalidOptionError, match="torque_limit"):
+        plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=5, mu=1.0, torque_limit=bad,
+        )  # fmt: skip
+
+
+def test_a_parallel_jaw_takes_no_torque_limit(wsg_scene):
+    scene = wsg_scene()
+    with pytest.raises(InvalidOptionError, match="torque_limit applies to multi"):
+        plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=5, mu=0.5, torque_limit=0.5,
+        )  # fmt: skip
+
+
+def test_a_torque_limit_orders_a_hand_without_effort_limits(
+    allegro_on_soup, monkeypatch
+):
+    """A plant whose actuators give no finite limit (motor_limit inf) keeps
+    the score's order, unless torque_limit says what the hand applies."""
+    scene, _, weight, result = allegro_on_soup
+    monkeypatch.setattr(
+        "drakegrasp.planning.motors.motor_limit", lambda plant, c: np.inf
+    )
+    head = list(result.candidates[:30])[::-1]  # the weakest first
+    shuffled = dataclasses.replace(result, candidates=(*head, *result.candidates[30:]))
+    kw = dict(weight=weight, top=10, started=0.0, check=30)
+    free = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body, **kw
+    )
+    assert [c.sample for c in free] == [c.sample for c in shuffled]
+    assert free.reason == ""
+    ranked = with_torques_needed(
+        shuffled, scene.plant, scene.context, scene.object_body,
+        torque_limit=0.5, **kw,
+    )  # fmt: skip
+    held = [c.torque_needed <= 0.5 for c in ranked]
+    assert held == sorted(held, reverse=True) and 0 < sum(held) < 30
