@@ -275,6 +275,12 @@ def _positive_float(text: str) -> float:
     )  # fmt: skip
 
 
+def _strictly_positive(text: str) -> float:
+    return _parsed(
+        text, float, "a number", lambda x: 0.0 < x < float("inf"), "finite and > 0"
+    )
+
+
 def _count(text: str) -> int:
     return _parsed(text, int, "a whole number", lambda k: k >= 0, ">= 0")
 
@@ -718,6 +724,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         num_candidates=args.num,
         seed=args.seed,
         progress=args.progress,
+        object_mass=args.mass,
+        torque_limit=args.torque_limit,
         **options,
     )
     if args.out is not None:
@@ -757,11 +765,12 @@ def _write_plan_parquet(result, path: str) -> None:
 def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
     plan = sub.add_parser(
         "plan",
-        help="find ranked parallel-jaw grasps of an object",
-        description="Sample antipodal grasps of a free parallel-jaw gripper on an "
-        "object's collision geometry, reject colliding poses, close the fingers "
-        "and rank the grasps (force closure, epsilon on one torque scale, "
-        "robustness).",
+        help="find ranked grasps of an object",
+        description="Sample grasps of a free hand on an object's collision "
+        "geometry (antipodal pinches for a parallel jaw, approaches and "
+        "pre-shapes for a multi-finger hand), reject colliding poses, close the "
+        "fingers and rank the grasps (force closure, epsilon on one torque "
+        "scale, robustness, the weight they hold).",
     )
     plan.add_argument(
         "object",
@@ -787,6 +796,23 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         type=_positive_float,
         default=None,
         help="friction coefficient (default: the scene's, else 0.5)",
+    )
+    plan.add_argument(
+        "--mass",
+        type=_strictly_positive,
+        default=None,
+        metavar="KG",
+        help="the object's mass in kg, for squeeze_needed and torque_needed "
+        "(default: the model's; a mesh has the mass of water filling it)",
+    )
+    plan.add_argument(
+        "--torque-limit",
+        type=_strictly_positive,
+        default=None,
+        metavar="NM",
+        help="multi-finger hands: the torque per finger joint (N·m) the hand "
+        "will apply; candidates held within it rank first (default: the "
+        "actuators' effort limits)",
     )
     _add_scene_file_options(
         plan,

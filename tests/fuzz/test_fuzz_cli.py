@@ -65,6 +65,9 @@ def _one_line_error(proc, code=1):
         (("plan", "--top", "abc"), "argument --top: not a whole number"),
         (("plan", "--top", "-2"), "argument --top: must be >= 0"),  # was all but 2
         (("plan", "--num", "1e9"), "argument --num"),
+        (("plan", "--mass", "0"), "argument --mass: must be finite and > 0"),
+        (("plan", "--mass", "inf"), "argument --mass: must be finite and > 0"),
+        (("plan", "--torque-limit", "nan"), "argument --torque-limit: must be"),
         (("analyze", "--tol", "abc"), "argument --tol"),
         (("batch",), "required: input, output"),
         (("plan", "--json", "--out", "x.parquet"), "not allowed with argument"),

@@ -35,6 +35,44 @@ def test_plan_parquet_round_trip(tmp_path, capsys):
     assert {"p_WH_0", "R_WH_8", "q_hand_1"} <= set(table)
 
 
+def test_plan_mass_scales_the_squeeze_needed(capsys):
+    # squeeze_needed is the weight over the weight capacity: linear in the mass
+    runs = []
+    for mass in ("0.1", "0.4"):
+        argv = ["plan", "--num", "60", "--top", "3", "--json", "--mass", mass]
+        assert main(argv) == 0
+        runs.append(json.loads(capsys.readouterr().out)["candidates"])
+    light, heavy = ([c["squeeze_needed"] for c in run] for run in runs)
+    assert light and heavy == pytest.approx([4 * v for v in light], rel=1e-9)
+
+
+def test_plan_torque_limit_is_for_multi_finger_hands(capsys):
+    # the default hand is a parallel jaw: its squeeze is in newtons
+    assert main(["plan", "--num", "20", "--torque-limit", "0.5"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "torque_limit applies to multi-finger hands" in err[0]
+
+
+def test_plan_a_multi_finger_hand_within_a_torque(
+    capsys, drake_models_dir, monkeypatch
+):
+    monkeypatch.setenv("DRAKEGRASP_DRAKE_MODELS", str(drake_models_dir))
+    allegro = (
+        "package://drake_models/allegro_hand_description/sdf/"
+        "allegro_hand_description_right.sdf"
+    )
+    argv = [
+        "plan", "package://drake_models/ycb/005_tomato_soup_can.sdf",
+        "--hand", allegro, "--num", "60", "--mass", "0.35",
+        "--torque-limit", "0.5", "--json",
+    ]  # fmt: skip
+    assert main(argv) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["settings"]["torque_limit"] == 0.5
+    needed = [c["torque_needed"] for c in data["candidates"] if c["is_closure"]]
+    assert needed and all(v > 0 for v in needed)
+
+
 def test_plan_errors_are_one_line(capsys, tmp_path):
     assert main(["plan", "no_such_object", "--num", "5"]) == 1
     err = capsys.readouterr().err
