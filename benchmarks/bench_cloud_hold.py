@@ -83,6 +83,20 @@ def sample_cloud(full, n, seed=0, view=None):
     return p, nrm
 
 
+def plan_cloud(hand, points, normals, view, *, num, seed, mass, **options):
+    """``plan_grasps`` for ``hand`` (a planning scene) on a cloud, μ = 1.
+
+    Returns the result and the seconds it took.
+    """
+    t = time.perf_counter()
+    result = plan_grasps(
+        hand.plant, hand.context, None, hand=hand.hand, num_candidates=num,
+        mu=1.0, seed=seed, point_cloud=points, cloud_normals=normals,
+        viewpoint=view, object_mass=mass, **options,
+    )  # fmt: skip
+    return result, time.perf_counter() - t
+
+
 def _describe(c, s) -> str:
     fingers = Counter(k.finger_body.split("::")[-1] for k in c.contacts)
     fans = sum(getattr(k, "fan", None) is not None for k in c.contacts)
@@ -140,14 +154,10 @@ def main(argv=None) -> int:
     for name in args.clouds:
         view = VIEW if name == "one-sided" else None
         p, nrm = sample_cloud(full, args.points, 0, view)
-        t = time.perf_counter()
-        result = plan_grasps(
-            hand.plant, hand.context, None, hand=hand.hand,
-            num_candidates=args.num, mu=1.0, seed=args.seed, point_cloud=p,
-            cloud_normals=nrm, viewpoint=view, object_mass=mass,
+        result, plan_s = plan_cloud(
+            hand, p, nrm, view, num=args.num, seed=args.seed, mass=mass,
             torque_limit=limit,
         )  # fmt: skip
-        plan_s = time.perf_counter() - t
         pick = np.random.default_rng(args.seed).choice(
             len(result), size=min(args.random, len(result)), replace=False
         )

@@ -33,15 +33,14 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
-from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning import planning_scene, shake_test
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_cloud_hold import sample_cloud  # noqa: E402  (the same clouds)
+from bench_cloud_hold import plan_cloud, sample_cloud  # noqa: E402  (the same clouds)
 from bench_plan import YCB, drake_models  # noqa: E402  (the same local copy)
 
 VIEWS = {"full": None, "side": (0.5, 0.0, 0.0), "oblique": (0.4, 0.25, 0.3)}
@@ -90,13 +89,9 @@ def main(argv=None) -> int:
         for view_name in args.views:
             view = VIEWS[view_name]
             p, nrm = sample_cloud(full, args.points, 0, view)
-            t = time.perf_counter()
-            result = plan_grasps(
-                hand.plant, hand.context, None, hand=hand.hand,
-                num_candidates=args.num, mu=1.0, seed=args.seed, point_cloud=p,
-                cloud_normals=nrm, viewpoint=view, object_mass=mass,
-            )  # fmt: skip
-            plan_s = time.perf_counter() - t
+            result, plan_s = plan_cloud(
+                hand, p, nrm, view, num=args.num, seed=args.seed, mass=mass
+            )
             fc = sum(c.is_closure for c in result)
             head = f"{name:<20} {view_name:<8} {len(p):>6} {len(result):>6} {fc:>4}"
             if not len(result):

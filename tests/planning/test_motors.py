@@ -229,19 +229,24 @@ def test_a_cloud_candidates_torque_needed_is_the_body_routes(allegro_on_soup):
         assert cloud == pytest.approx(body, rel=0.03)
 
 
-def test_candidates_the_motors_hold_come_first(allegro_on_soup):
-    """with_torques_needed moves the checked candidates whose torque_needed is
-    within the smallest effort limit (the Allegro SDF's 0.7 N·m) ahead of the
-    others, each group in the order it came, and certifies the new head."""
-    scene, _, weight, result = allegro_on_soup
-    head = list(result.candidates[:30])[::-1]  # the weakest first
-    shuffled = dataclasses.replace(
+def _weakest_first(result):
+    """``result`` with its 30 best in reverse order, uncertified."""
+    head = list(result.candidates[:30])[::-1]
+    return dataclasses.replace(
         result,
         candidates=(
             *(dataclasses.replace(c, closure=None) for c in head),
             *result.candidates[30:],
         ),
-    )  # fmt: skip
+    )
+
+
+def test_candidates_the_motors_hold_come_first(allegro_on_soup):
+    """with_torques_needed moves the checked candidates whose torque_needed is
+    within the smallest effort limit (the Allegro SDF's 0.7 N·m) ahead of the
+    others, each group in the order it came, and certifies the new head."""
+    scene, _, weight, result = allegro_on_soup
+    shuffled = _weakest_first(result)
     kw = dict(weight=weight, top=10, started=0.0, check=30)
     plain = with_torques_needed(
         shuffled, scene.plant, scene.context, scene.object_body,
@@ -273,14 +278,7 @@ def test_a_torque_limit_ranks_by_the_torque_applied(allegro_on_soup):
     limit; a limit above the effort limit is capped by it; a limit no
     candidate meets is said in the reason."""
     scene, _, weight, result = allegro_on_soup
-    head = list(result.candidates[:30])[::-1]  # the weakest first
-    shuffled = dataclasses.replace(
-        result,
-        candidates=(
-            *(dataclasses.replace(c, closure=None) for c in head),
-            *result.candidates[30:],
-        ),
-    )  # fmt: skip
+    shuffled = _weakest_first(result)
     kw = dict(weight=weight, top=10, started=0.0, check=30)
     effort = with_torques_needed(
         shuffled, scene.plant, scene.context, scene.object_body, **kw
