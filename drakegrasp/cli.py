@@ -13,8 +13,9 @@ Usage::
                      [--overwrite]
     drakegrasp warmup [--json]
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
-                    [--seed S] [--mu M] [--package NAME=DIR ...]
-                    [--allow-any-file] [--json | --out FILE.parquet]
+                    [--seed S] [--mu M] [--mass KG] [--torque-limit NM]
+                    [--package NAME=DIR ...] [--allow-any-file]
+                    [--json | --out FILE.parquet]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
@@ -31,17 +32,19 @@ the vectorised batch engine and writes the verdicts to another file.
 not compile them ahead of time (once per install; later processes load them
 from numba's cache), and prints what it compiled and how long each step took.
 
-``plan`` finds grasps: a free-floating parallel-jaw gripper sampled,
-filtered, closed and ranked on an object, and prints the best ``--top``.  Given
-a scene (a YAML file ending ``.yaml``/``.yml`` or a shipped scene's name), it
-plans for the hand and object that the scene's ``drakegrasp:`` section names
-(``hand:``, ``object_body:``), with the scene's μ, contact model and tolerance,
-against everything else the scene holds (a table, other objects); the hand's
-base must be free in the scene (no ``add_weld`` to the world).  Given an
-object (a shipped object's name, a model URL or a file, or a mesh ``.obj``
-file, which Drake's parser makes one body with the mass of water filling it;
-default ``box``), it plans for ``--hand`` (a model URL or file, ``wsg`` for
-Drake's WSG-50; default drakegrasp's flat-pad jaw) in a scene of the two alone.
+``plan`` finds grasps: a free-floating hand (a parallel jaw or a multi-finger
+hand) sampled, filtered, closed and ranked on an object, and prints the best
+``--top``.  Given a scene (a YAML file ending ``.yaml``/``.yml`` or a shipped
+scene's name), it plans for the hand and object that the scene's
+``drakegrasp:`` section names (``hand:``, ``object_body:``), with the scene's
+μ, contact model and tolerance, against everything else the scene holds (a
+table, other objects); the hand's base must be free in the scene (no
+``add_weld`` to the world).  Given an object (a shipped object's name, a model
+URL or a file, or a mesh ``.obj`` file, which Drake's parser makes one body
+with the mass of water filling it; default ``box``), it plans for ``--hand`` (a
+model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
+jaw) in a scene of the two alone; ``--mass`` gives the object's mass and
+``--torque-limit`` the torque a multi-finger hand will apply.
 
 One interface: both commands name the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
@@ -716,6 +719,17 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if args.out is not None and not args.out.endswith(".parquet"):
         raise InvalidOptionError(f"--out must name a .parquet file, got {args.out!r}")
     plant, context, object_body, hand, options = _plan_setup(args)
+    if args.torque_limit is not None:
+        from drakegrasp.planning.multifinger import hand_is_parallel_jaw
+        from drakegrasp.plant.validation import plant_context_of
+
+        if hand_is_parallel_jaw(
+            plant, plant_context_of(plant, context), object_body, hand
+        ):
+            raise InvalidOptionError(
+                "--torque-limit is for multi-finger hands (N·m per joint); this "
+                "hand is a parallel jaw, whose squeeze is in N: leave it out"
+            )
     result = plan_grasps(
         plant,
         context,

@@ -7,8 +7,9 @@ world frame, with normals given or estimated as Drake does
 centroid, or towards a ``viewpoint``: the camera, for a one-sided cloud).
 Points that are not finite (Drake marks missing depth with NaN) are dropped.
 
-**Frame O** of a cloud is the world frame moved to the cloud's centroid
-(moments about the centroid, the best guess of the centre of mass).
+**Frame O** of a cloud is the world frame moved to the cloud's centroid, or
+to the centre of symmetry of a completed one-sided cloud (:func:`complete_unseen`):
+moments are about it, the best guess of the centre of mass.
 
 **Chords.**  A grasp line through a sampled point ``p`` along its inward normal
 ``d`` (with a ``viewpoint``, the inward normal turned across the line of sight,
@@ -72,7 +73,7 @@ of its first touch.
 A rigid pad stops where it first touches; another of its tip shapes presses
 only if the surface lies within the contacts' give.  With
 :data:`CONTACT_BAND` (1 mm) a pad's four tip spheres all counted on the
-curve of a can, where the two off its axis stay 0.2-0.8 mm clear in Drake,
+curve of a can, where two of them stay 0.2-0.8 mm clear in Drake,
 and the weight capacity counted torsion they do not resist.  On five clouds
 of the YCB soup can (whole, seed 0; seen from the side and obliquely, seeds 0
 and 1) the ten best held 22 of 50 times at the predicted squeeze and ten
@@ -111,7 +112,7 @@ class CloudContact:
     Attributes
     ----------
     p_OC : (3,) float
-        The cloud point, metres, frame O (the cloud's centroid frame).
+        The cloud point, metres, frame O (:class:`CloudSurface`'s).
     nhat_O : (3,) float
         Inward unit normal (the cloud's normal, negated).
     psi : float

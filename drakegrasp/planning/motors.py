@@ -109,7 +109,7 @@ def finger_jacobian(plant, plant_context, candidate: GraspCandidate, object_body
     object_body : RigidBody, BodyIndex, str or None
         The object (frame O); put at the candidate's planned pose.  None for a
         candidate planned on a point cloud (frame O is then the candidate's
-        ``X_WO``, the cloud's centroid frame): each contact's point on its
+        ``X_WO``, the cloud's frame): each contact's point on its
         finger is the contact's point, ``p_FC = X_WF⁻¹ X_WO p_OC``, with the
         candidate applied to the hand.
 

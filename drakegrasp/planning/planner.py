@@ -286,7 +286,7 @@ def plan_grasps(
         whole cloud, its frame O (``X_WO``: the centre of mass of the weight
         capacity, ``squeeze_needed`` and the torque scale) at that centre of
         symmetry (a multi-finger hand: the completed cloud's centroid, within
-        0.02 mm of it on the YCB objects' clouds).  ``False`` keeps the hand
+        0.03 mm of it on the YCB objects' clouds).  ``False`` keeps the hand
         on the seen side, O at the seen points' centroid, which lies towards
         the camera (by ``2r/π`` on a can of radius ``r``).  A face seen
         head-on gives no depth: nothing is completed, and an empty result's
@@ -306,7 +306,8 @@ def plan_grasps(
         gentler controller, the shake test's ``squeeze``), so the ranking
         assumes the torque actually applied.  Finite and > 0, else
         ``InvalidOptionError``, which a parallel jaw (no ``torque_needed``:
-        its ``squeeze_needed`` is in N) raises too.
+        its ``squeeze_needed`` is in N) and a point cloud without
+        ``object_mass`` (no weight, no ``torque_needed``) raise too.
     preshape, synergy, synergy_range, approach, standoff : optional
         Multi-finger hands only
         (:func:`~drakegrasp.planning.approach.multi_finger_hand`): the
@@ -356,6 +357,11 @@ def plan_grasps(
         object_mass = _check_positive("object_mass", object_mass, "kg")
     if torque_limit is not None:
         torque_limit = check_torque_limit(torque_limit)
+        if point_cloud is not None and object_mass is None:
+            raise InvalidOptionError(
+                "torque_limit ranks by torque_needed, which needs the object's "
+                "weight: give object_mass= (kg) with a point_cloud"
+            )
     noise = _check_noise(noise)
     if weight_check is not None and (
         isinstance(weight_check, bool)

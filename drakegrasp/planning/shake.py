@@ -217,8 +217,9 @@ def shake_test(
     X_WO : RigidTransform, optional
         The object's pose in the world at the start (default the candidate's
         ``X_WO``).  A candidate planned on a point cloud has the cloud's frame
-        there (its centroid, with the world's axes), not the object's: give the
-        true pose of the object the cloud was taken from.
+        there (its centroid or, completed, its centre of symmetry, with the
+        world's axes), not the object's: give the true pose of the object the
+        cloud was taken from.
 
     Returns
     -------
