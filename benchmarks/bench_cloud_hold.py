@@ -141,7 +141,8 @@ def main(argv=None) -> int:
     full_ctx = full.plant.GetMyContextFromRoot(full.context)
     X_WO = full.plant.EvalBodyPoseInWorld(full_ctx, full.object_body)
     mass = None if args.no_mass else full.object_body.get_mass(full_ctx)
-    limit = None if args.effort_limit else SHAKE["squeeze"]
+    # without the mass there is no torque_needed to rank by
+    limit = None if args.effort_limit or mass is None else SHAKE["squeeze"]
     print(
         f"load {os.getloadavg()[0]:.2f}; Allegro on the YCB soup can, "
         f"{args.points} points, {args.num} samples, seed {args.seed}, "
