@@ -719,17 +719,6 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if args.out is not None and not args.out.endswith(".parquet"):
         raise InvalidOptionError(f"--out must name a .parquet file, got {args.out!r}")
     plant, context, object_body, hand, options = _plan_setup(args)
-    if args.torque_limit is not None:
-        from drakegrasp.planning.multifinger import hand_is_parallel_jaw
-        from drakegrasp.plant.validation import plant_context_of
-
-        if hand_is_parallel_jaw(
-            plant, plant_context_of(plant, context), object_body, hand
-        ):
-            raise InvalidOptionError(
-                "--torque-limit is for multi-finger hands (N·m per joint); this "
-                "hand is a parallel jaw, whose squeeze is in N: leave it out"
-            )
     result = plan_grasps(
         plant,
         context,

@@ -50,7 +50,7 @@ def test_plan_torque_limit_is_for_multi_finger_hands(capsys):
     # the default hand is a parallel jaw: its squeeze is in newtons
     assert main(["plan", "--num", "20", "--torque-limit", "0.5"]) == 1
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "--torque-limit is for multi-finger hands" in err[0]
+    assert len(err) == 1 and "torque_limit applies to multi-finger hands" in err[0]
 
 
 def test_plan_a_multi_finger_hand_within_a_torque(
