@@ -540,7 +540,9 @@ def plan_multifinger_cloud(
         added, added_normals, completion = complete_unseen(points, normals, viewpoint)
     if completion is not None and completion["skipped"] is None:
         surface = CloudSurface(
-            np.vstack([points, added]), np.vstack([normals, added_normals])
+            np.vstack([points, added]),
+            np.vstack([normals, added_normals]),
+            origin=completion["centre"],
         )
     else:
         surface = CloudSurface(points, normals, viewpoint=viewpoint)

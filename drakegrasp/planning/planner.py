@@ -285,8 +285,7 @@ def plan_grasps(
         around it and parallel jaws may pinch across it, and plan on the
         whole cloud, its frame O (``X_WO``: the centre of mass of the weight
         capacity, ``squeeze_needed`` and the torque scale) at that centre of
-        symmetry (a multi-finger hand: the completed cloud's centroid, within
-        0.03 mm of it on the YCB objects' clouds).  ``False`` keeps the hand
+        symmetry.  ``False`` keeps the hand
         on the seen side, O at the seen points' centroid, which lies towards
         the camera (by ``2r/π`` on a can of radius ``r``).  A face seen
         head-on gives no depth: nothing is completed, and an empty result's
