@@ -59,6 +59,7 @@ __all__ = [
     "CloudContact",
     "CloudFingers",
     "CloudSurface",
+    "cloud_surface",
     "complete_unseen",
     "read_cloud",
 ]
@@ -298,6 +299,43 @@ def complete_unseen(points, normals, viewpoint):
     keep = cKDTree(points).query(mirrored)[0] > spacing
     info = {"centre": centre, "added": int(keep.sum()), "skipped": None}
     return mirrored[keep], -normals[keep], info
+
+
+def cloud_surface(points, normals, viewpoint=None, complete: bool = True):
+    """The surface a hand is planned on: the cloud, completed when it can be.
+
+    With a ``viewpoint`` and ``complete``, the unseen side is reflected in
+    (:func:`complete_unseen`) and the whole cloud is planned on, frame O at the
+    centre of symmetry; otherwise (no viewpoint, ``complete`` False, or a face
+    seen head-on) the cloud as given, O at its centroid, the viewpoint kept.
+
+    Parameters
+    ----------
+    points, normals : (M, 3) float
+        World frame, metres; outward unit normals.
+    viewpoint : (3,) float or None
+        The camera, world frame.
+    complete : bool
+        Whether to complete a one-sided cloud.
+
+    Returns
+    -------
+    surface : CloudSurface
+    completion : dict or None
+        :func:`complete_unseen`'s ``info``; None when it was not tried.
+    """
+    completion = None
+    if viewpoint is not None and complete:
+        added, added_normals, completion = complete_unseen(points, normals, viewpoint)
+    if completion is not None and completion["skipped"] is None:
+        surface = CloudSurface(
+            np.vstack([points, added]),
+            np.vstack([normals, added_normals]),
+            origin=completion["centre"],
+        )
+    else:
+        surface = CloudSurface(points, normals, viewpoint=viewpoint)
+    return surface, completion
 
 
 class CloudSurface:

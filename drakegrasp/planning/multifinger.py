@@ -62,7 +62,7 @@ from drakegrasp.planning.candidates import (
     closing_order,
     planning_result,
 )
-from drakegrasp.planning.cloud import CONTACT_BAND, CloudSurface, complete_unseen
+from drakegrasp.planning.cloud import CONTACT_BAND, cloud_surface
 from drakegrasp.planning.cloud_hand import FAN_SIGMAS, CloudHand
 from drakegrasp.planning.motors import with_torques_needed
 from drakegrasp.planning.ranking import group_by_count, robustness, tie_key, verdicts
@@ -535,17 +535,7 @@ def plan_multifinger_cloud(
         preshape=preshape, synergy=synergy, synergy_range=synergy_range,
         approach=approach, standoff=standoff,
     )  # fmt: skip
-    completion = None
-    if viewpoint is not None and complete:
-        added, added_normals, completion = complete_unseen(points, normals, viewpoint)
-    if completion is not None and completion["skipped"] is None:
-        surface = CloudSurface(
-            np.vstack([points, added]),
-            np.vstack([normals, added_normals]),
-            origin=completion["centre"],
-        )
-    else:
-        surface = CloudSurface(points, normals, viewpoint=viewpoint)
+    surface, completion = cloud_surface(points, normals, viewpoint, complete)
     X_WO = RigidTransform(surface.origin)
     settings = {
         **settings,

@@ -53,10 +53,9 @@ from drakegrasp.planning.candidates import (
 from drakegrasp.planning.cloud import (
     PAD_CONTACT_BAND,
     CloudFingers,
-    CloudSurface,
+    cloud_surface,
     read_cloud,
 )
-from drakegrasp.planning.cloud import complete_unseen as complete_cloud
 from drakegrasp.planning.gripper import parallel_jaw
 from drakegrasp.planning.motors import check_torque_limit
 from drakegrasp.planning.multifinger import (
@@ -440,20 +439,7 @@ def plan_grasps(
             )  # fmt: skip
         _no_torque_limit(torque_limit)
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
-        completion = None
-        if viewpoint is not None and complete_unseen:
-            added, added_normals, completion = complete_cloud(
-                points, normals, viewpoint
-            )
-        if completion is not None and completion["skipped"] is None:
-            # planned as a whole cloud about the centre of symmetry
-            surface = CloudSurface(
-                np.vstack([points, added]),
-                np.vstack([normals, added_normals]),
-                origin=completion["centre"],
-            )
-        else:
-            surface = CloudSurface(points, normals, viewpoint=viewpoint)
+        surface, completion = cloud_surface(points, normals, viewpoint, complete_unseen)
         X_WO = RigidTransform(surface.origin)
         name = "point cloud"
         mass = np.nan if object_mass is None else float(object_mass)
