@@ -8,15 +8,21 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
 - the fingers are position-controlled by Drake's PD-controlled actuators
   (``JointActuator.set_controller_gains``, stiffness ``k``) aimed
   ``squeeze / k`` past the place where they touch, so each presses with
-  about ``squeeze`` newtons (within its effort limit) and resists being
+  ``squeeze`` newtons (within its effort limit) and resists being
   pushed open with stiffness ``k``, as a position-controlled gripper does (two
   force-controlled fingers would let gravity along the grasp axis carry
-  object and fingers to a joint limit);
+  object and fingers to a joint limit).  Where they touch is found in
+  Drake, not taken from the plan: for ``seat`` seconds without gravity the
+  fingers close on the object and, half-way, are re-aimed from where they
+  stopped.  (Aimed from the planned joint values instead, a finger planned
+  0.5 mm inside the object would press ``0.5 mm · k`` harder: 2 N more at
+  the WSG-50's default gains);
 - the object is free; gravity (``9.81 m/s²``, the plant's own gravity field is
   set to zero) acts on the object only, as an external force at its centre of
-  mass whose direction is held for ``settle`` seconds along the world's
-  ``−z`` and then turned through ``directions`` (each held for ``phase``
-  seconds, blended over the first ``blend`` seconds of a phase);
+  mass, zero while the fingers seat, whose direction is then held for
+  ``settle`` seconds along the world's ``−z`` and then turned through
+  ``directions`` (each held for ``phase`` seconds, blended over the first
+  ``blend`` seconds of a phase);
 - contact, friction and stiffness are the plant's (point contact, the models'
   proximity properties).
 
@@ -85,6 +91,11 @@ class ShakeResult:
         ``rotation`` at the end of the phase.
     squeeze : float
         Actuator force per finger joint, newtons.
+    efforts : tuple of float
+        What each closing joint's actuator applied once the fingers had
+        seated (newtons, or N·m for a revolute joint), in actuator order:
+        ``squeeze`` (within its effort limit) when seating found the object.
+        Read at the end of seating (with ``seat=0``, of settling).
     time_step, duration : float
         Seconds (simulated).
     wall_time : float
@@ -98,6 +109,7 @@ class ShakeResult:
     max_rotation: float
     phases: tuple
     squeeze: float
+    efforts: tuple[float, ...]
     time_step: float
     duration: float
     wall_time: float
@@ -141,12 +153,15 @@ class _TurnedGravity(LeafSystem):
         output.set_value([force])
 
 
-def _schedule(settle, phase, blend, directions):
+def _schedule(seat, settle, phase, blend, directions):
     dirs = [np.array([0.0, 0.0, -1.0])] + [
         np.asarray(d, float) / np.linalg.norm(d) for d in directions
     ]
 
     def g(t: float) -> np.ndarray:
+        if t < seat:
+            return np.zeros(3)  # the fingers seat on the object first
+        t -= seat
         if t < settle:
             return dirs[0]
         k = min(int((t - settle) // phase), len(dirs) - 2)
@@ -175,6 +190,7 @@ def shake_test(
     directions: Sequence[Sequence[float]] = DEFAULT_DIRECTIONS,
     settle: float = 0.3,
     phase: float = 0.4,
+    seat: float = 0.1,
     blend: float = 0.1,
     time_step: float = 1e-3,
     max_displacement: float = 0.01,
@@ -208,6 +224,13 @@ def shake_test(
     settle, phase, blend : float, optional
         Seconds: settling under −z gravity, each direction's hold, the blend
         between directions.
+    seat : float, optional
+        Seconds without gravity, before settling, in which the fingers close
+        on the object: each is aimed ``squeeze / k`` past where it stands
+        (the candidate's joint values), and after ``seat / 2`` re-aimed from
+        where it stopped, so that it presses with
+        ``squeeze`` whether the plan left it short of the surface or inside
+        it.  0: aimed from the candidate's joint values.
     time_step : float, optional
         The discrete plant's step, seconds.
     max_displacement, max_rotation : float, optional
@@ -256,6 +279,7 @@ def shake_test(
         ("phase", phase, 0.0, "s"),
         ("settle", settle, None, "s"),
         ("blend", blend, None, "s"),
+        ("seat", seat, None, "s"),
         ("max_displacement", max_displacement, None, "m"),
         ("max_rotation", max_rotation, None, "rad"),
     ):
@@ -316,7 +340,7 @@ def shake_test(
     plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
     plant.Finalize()
     body = resolve_object_body(plant, obj)
-    schedule = _schedule(settle, phase, blend, dirs)
+    schedule = _schedule(seat, settle, phase, blend, dirs)
     gravity = builder.AddSystem(
         _TurnedGravity(body.index(), body.default_mass(), body.default_com(), schedule)
     )
@@ -328,38 +352,62 @@ def shake_test(
     root = simulator.get_mutable_context()
     ctx = plant.GetMyContextFromRoot(root)
     candidate.apply(plant, ctx, object_body=body)
-    q_now = plant.GetPositions(ctx)
-    desired = {}
-    for actuator in actuators:
-        joint = actuator.joint()
-        desired.setdefault(joint.model_instance(), []).append(
-            (
-                int(actuator.index()),
-                q_now[joint.position_start()] + targets.get(int(joint.index()), 0.0),
+    q_held = plant.GetPositions(ctx)
+
+    def aim() -> None:
+        # closing joints squeeze/k past where they stand now; others hold
+        q_now = plant.GetPositions(ctx)
+        desired = {}
+        for actuator in actuators:
+            joint = actuator.joint()
+            i, start = int(joint.index()), joint.position_start()
+            q_d = q_now[start] + targets[i] if i in targets else q_held[start]
+            desired.setdefault(joint.model_instance(), []).append(
+                (int(actuator.index()), q_d)
             )
-        )
-    for instance, entries in desired.items():
-        entries.sort()
-        q_d = np.array([q for _, q in entries])
-        plant.get_desired_state_input_port(instance).FixValue(
-            ctx, np.concatenate([q_d, np.zeros_like(q_d)])
-        )
+        for instance, entries in desired.items():
+            entries.sort()
+            q_d = np.array([q for _, q in entries])
+            plant.get_desired_state_input_port(instance).FixValue(
+                ctx, np.concatenate([q_d, np.zeros_like(q_d)])
+            )
+
+    aim()
     plant.get_actuation_input_port().FixValue(ctx, np.zeros(plant.num_actuated_dofs()))
     H = base.body_frame()
     X_HO0 = plant.CalcRelativeTransform(ctx, H, body.body_frame())
-    ends = [settle + (k + 1) * phase for k in range(len(dirs))]
+    ends = [seat + settle + (k + 1) * phase for k in range(len(dirs))]
     duration = ends[-1]
     max_d = max_r = 0.0
     phases = []
     t, dt_check = 0.0, 0.01
-    for end in ends:
-        while t < end - 1e-12:
-            t = min(t + dt_check, end)
+
+    def advance(to: float) -> tuple[float, float]:
+        nonlocal t, max_d, max_r
+        d = r = 0.0
+        while t < to - 1e-12:
+            t = min(t + dt_check, to)
             simulator.AdvanceTo(t)
             X_HO = plant.CalcRelativeTransform(ctx, H, body.body_frame())
             d = float(np.linalg.norm(X_HO.translation() - X_HO0.translation()))
             r = _angle(X_HO0.rotation().matrix().T @ X_HO.rotation().matrix())
             max_d, max_r = max(max_d, d), max(max_r, r)
+        return d, r
+
+    if seat > 0:
+        advance(seat / 2)
+        aim()  # from where the fingers stopped on the object
+        advance(seat)
+    else:
+        advance(settle)  # efforts are read once something has been simulated
+    u = plant.get_net_actuation_output_port().Eval(ctx)
+    efforts = tuple(
+        abs(float(u[a.input_start()]))
+        for a in actuators
+        if int(a.joint().index()) in targets
+    )
+    for end in ends:
+        d, r = advance(end)
         phases.append(
             {
                 "direction": schedule(end - 1e-9).tolist(),
@@ -373,6 +421,7 @@ def shake_test(
         max_rotation=max_r,
         phases=tuple(phases),
         squeeze=float(squeeze),
+        efforts=efforts,
         time_step=float(time_step),
         duration=duration,
         wall_time=time.perf_counter() - t0,

@@ -3,6 +3,7 @@ best ranked clearly more often than random collision-free antipodal ones."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -91,10 +92,39 @@ def test_a_grasp_with_nothing_to_squeeze_drops(wsg_scene):
     assert not result.held and result.max_displacement > 0.01
 
 
+def _moved_in(candidate, metres):
+    # each closing joint moved ``metres`` further closed (into the object)
+    q = candidate.q_hand + metres * np.asarray(candidate.closing_signs)
+    return dataclasses.replace(candidate, q_hand=q)
+
+
+@pytest.mark.parametrize("inward", [0.0, 5e-4, -3e-4])
+def test_the_fingers_press_with_the_set_squeeze_wherever_the_plan_left_them(
+    wsg_scene, inward
+):
+    # planned 0.5 mm inside the box or 0.3 mm short of it, the fingers seat on
+    # it and press with the squeeze asked for (the net actuation Drake applied)
+    scene = wsg_scene()
+    best = _moved_in(_plan(scene, n=60)[0], inward)
+    result = shake_test(scene.add_models, best, squeeze=6.0, **QUICK)
+    assert len(result.efforts) == 2
+    np.testing.assert_allclose(result.efforts, 6.0, rtol=0.02)
+
+
+def test_without_seating_a_finger_planned_inside_presses_harder(wsg_scene):
+    # what seating removes: aimed from the planned joint values, 0.5 mm inside
+    # adds 0.5 mm x 4000 N/m = 2 N to the 6 N asked for
+    scene = wsg_scene()
+    best = _moved_in(_plan(scene, n=60)[0], 5e-4)
+    result = shake_test(scene.add_models, best, squeeze=6.0, seat=0.0, **QUICK)
+    assert min(result.efforts) > 7.0
+
+
 @pytest.mark.parametrize(
     "kw",
     [
         {"squeeze": 0.0},
+        {"seat": -0.1},
         {"time_step": -1e-3},
         {"directions": [(0, 0, 0)]},
         {"phase": np.nan},
