@@ -53,6 +53,7 @@ from drakegrasp.planning.candidates import (
 from drakegrasp.planning.cloud import (
     PAD_CONTACT_BAND,
     CloudFingers,
+    FittedCloud,
     cloud_surface,
     read_cloud,
 )
@@ -250,8 +251,9 @@ def plan_grasps(
         :data:`~drakegrasp.planning.ranking.DEFAULT_NOISE`.  On an object body
         the object's pose error (translation, and rotation about the grasp
         axis), the jaws closing again on the moved object
-        (:mod:`drakegrasp.planning.reclose`); on a cloud, each finger's
-        contacts moved rigidly (:mod:`drakegrasp.planning.ranking`).
+        (:mod:`drakegrasp.planning.reclose`); on a cloud too, on the cloud's
+        surface fitted where the jaws meet it
+        (:class:`~drakegrasp.planning.cloud.FittedCloud`).
     certify : int, optional
         The best ``certify`` candidates also get the single-grasp verdict with
         its certificate (``GraspCandidate.closure``).
@@ -496,7 +498,7 @@ def plan_grasps(
         model=model, nu=torsional_friction, torque_scale=torque_scale,
         samples=robustness_samples, noise=noise, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
-        surface=None if body is None else surface, tol=tol,
+        surface=FittedCloud(surface) if body is None else surface, tol=tol,
     )  # fmt: skip
     return planning_result(
         candidates,

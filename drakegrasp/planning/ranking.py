@@ -268,17 +268,17 @@ def _squeeze(weight: float, alpha: float) -> float:
 
 def rank_candidates(
     kept, *, finger_names, gripper, plant, mu, model, nu, torque_scale, samples,
-    noise, rng, certify, workers, X_WO, weight, weight_check, surface=None,
-    tol=None,
+    noise, rng, certify, workers, X_WO, weight, weight_check, surface, tol,
 ):  # fmt: skip
     """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
 
     ``kept`` holds ``(sample, X_WH, q, opening, contacts)`` of every closed
     pose; contacts have ``p_OC``, ``nhat_O`` and ``finger_body``.  ``weight``
-    is the object's weight (N), NaN when unknown.  With the object's
-    ``surface`` (an object body), robustness re-closes the jaws on the moved
-    object (:mod:`drakegrasp.planning.reclose`, within ``tol``); without (a
-    point cloud) it moves each finger's contacts (:func:`perturbed_copies`).
+    is the object's weight (N), NaN when unknown.  Robustness re-closes the
+    jaws on the moved object's ``surface`` (:mod:`drakegrasp.planning.reclose`,
+    within ``tol``): an object body's
+    (:class:`~drakegrasp.planning.surface.ObjectSurface`) or a cloud's
+    (:class:`~drakegrasp.planning.cloud.FittedCloud`).
     """
     if not kept:
         return ()
@@ -300,16 +300,11 @@ def rank_candidates(
         )  # fmt: skip
         is_closure[idx], d_star[idx], rank[idx], eps[idx] = fc, ds, rk, ep
         closed = idx[fc]
-        if len(closed) and surface is not None:
+        if len(closed):
             rho[closed] = reclosed_robustness(
                 surface, P[fc], F[fc], _axes_O(kept, closed, gripper, X_WO), mu,
                 samples=samples, rng=rng, **noise, tol=tol, model=model,
                 torsional_friction=nu, workers=workers,
-            )  # fmt: skip
-        elif len(closed):
-            rho[closed] = robustness(
-                P[fc], Nrm[fc], F[fc], mu, samples=samples, rng=rng, noise=noise,
-                model=model, torsional_friction=nu, workers=workers,
             )  # fmt: skip
     samples_of = np.array([k[0] for k in kept])
     pre = eps * rho

@@ -119,7 +119,10 @@ def test_one_sided_cloud_on_the_seen_side_only(scenes):
 def test_one_sided_cloud_grasps_hold_the_true_can(scenes):
     # the seen side alone left only pinches in front of the can's axis, which
     # a squeeze pushes out of the hand: the five best all fell, even at five
-    # times the weight; completed, they pinch across the axis and hold
+    # times the weight; completed, they pinch across the axis and hold, at
+    # the squeeze the planner predicts (with 20 % margin) once the tips meet
+    # the fitted surface and robustness re-closes the jaws on the cloud (the
+    # five best held 3 of 5 without either)
     full, hand_only = scenes("005_tomato_soup_can")
     p, nrm = _cloud(full, n=3000, view=[0.5, 0.0, 0.0])
     ctx = full.plant.GetMyContextFromRoot(full.context)
@@ -128,8 +131,10 @@ def test_one_sided_cloud_grasps_hold_the_true_can(scenes):
     result = _plan(
         hand_only, p, nrm, n=300, viewpoint=[0.5, 0.0, 0.0], object_mass=mass
     )
+    squeeze = 1.2 * max(c.squeeze_needed for c in result[:5])
+    assert squeeze < 2 * 9.81 * mass  # a squeeze a user would choose
     held = [
-        shake_test(full.add_models, c, X_WO=X_WO, squeeze=5 * 9.81 * mass).held
+        shake_test(full.add_models, c, X_WO=X_WO, squeeze=squeeze).held
         for c in result[:5]
     ]
     assert sum(held) >= 4, held
