@@ -34,10 +34,10 @@ each shaken candidate's torque needed (N·m), largest displacement and
 rotation, its contacts per finger and how many carry an edge's normal fan
 (the planning guide's "Edges: the normal fan").
 
-Measured (the ten best held out of ten, seeds 0, 1, 2; benchmarks/README.md
-has the rest): 600 samples, full 10, 8, 9 and one-sided 9, 10, 6 (random
-1, 1, 1 and 2, 1, 0); with ``--effort-limit`` 10, 8, 10 and 9, 9, 6.  At
-300 samples, full 8, 4, 7 and one-sided 8, 5, 9 (7, 2, 7 and 8, 5, 9).
+Measured (the ten best held out of ten, seeds 0, 1, 2, the seated shake
+test; benchmarks/README.md has the rest): 600 samples, full 10, 8, 8 and
+one-sided 9, 10, 8 (random 1, 1, 1 and 2, 1, 0).  At 300 samples, full 8, 4,
+7 and one-sided 8, 6, 10.
 """
 
 from __future__ import annotations

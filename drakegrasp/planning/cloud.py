@@ -55,6 +55,11 @@ from drakegrasp.plant.validation import scoped_name
 __all__ = [
     "MAX_COORDINATE",
     "CONTACT_BAND",
+    "EDGE_LINES",
+    "FACING_NEIGHBOURS",
+    "FIT_FACE_COS",
+    "FIT_MIN_POINTS",
+    "FIT_RADIUS_LINES",
     "LINE_RADIUS_SPACINGS",
     "PAD_CONTACT_BAND",
     "UNSEEN_DEPTH_ANGLE",
