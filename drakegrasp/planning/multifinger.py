@@ -39,12 +39,10 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from dataclasses import replace
 
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
-from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.errors import (
     InvalidOptionError,
     ModelError,
@@ -58,14 +56,19 @@ from drakegrasp.planning.approach import (
     sample_approaches,
 )
 from drakegrasp.planning.candidates import (
-    GraspCandidate,
     closing_order,
     planning_result,
 )
 from drakegrasp.planning.cloud import CONTACT_BAND, cloud_surface
 from drakegrasp.planning.cloud_hand import FAN_SIGMAS, CloudHand
 from drakegrasp.planning.motors import with_torques_needed
-from drakegrasp.planning.ranking import group_by_count, robustness, tie_key, verdicts
+from drakegrasp.planning.ranking import (
+    group_by_count,
+    ranked_candidate,
+    robustness,
+    tie_key,
+    verdicts,
+)
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
@@ -381,17 +384,22 @@ def rank_multifinger(
     order = np.lexsort((sample, -tie_key(d_star), -tie_key(eps * rho), -tie_key(score)))
     s = hand.structure
     base = scoped_name(plant, hand.base)
+    scores = {
+        "is_closure": is_closure, "d_star": d_star, "rank": rank, "eps": eps,
+        "rho": rho, "score": score, "alpha": alpha,
+    }  # fmt: skip
     out = []
     for place, i in enumerate(order):
         k, X_WH, q_pre, q, found = kept[i]
-        a = alpha[i]
-        squeeze = (
-            float("nan")
-            if not np.isfinite(a)
-            else (float(weight / a) if a > 0 else float("inf"))
-        )
         out.append(
-            GraspCandidate(
+            ranked_candidate(
+                i,
+                scores,
+                weight=weight,
+                certified=place < certify,
+                mu=mu,
+                model=model,
+                nu=nu,
                 sample=int(k),
                 hand_base=base,
                 X_WH=X_WH,
@@ -401,24 +409,9 @@ def rank_multifinger(
                 closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
                 opening=float("nan"),
                 contacts=tuple(found),
-                contact_options={
-                    "mu": mu,
-                    "contact_model": model,
-                    "torsional_friction": nu,
-                },
-                is_closure=bool(is_closure[i]),
-                d_star=float(d_star[i]),
-                rank=int(rank[i]),
-                epsilon=float(eps[i]),
-                robustness=float(rho[i]),
-                score=float(score[i]),
-                weight_capacity=float(a),
-                squeeze_needed=squeeze,
                 q_preshape=np.asarray(q_pre, float),
-            )
+            )  # fmt: skip
         )
-        if place < certify:
-            out[-1] = replace(out[-1], closure=force_closure(out[-1].grasp))
     return tuple(out)
 
 

@@ -63,6 +63,7 @@ from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
+    "ranked_candidate",
     "DEFAULT_NOISE",
     "TIE_DECIMALS",
     "group_by_count",
@@ -266,6 +267,36 @@ def _squeeze(weight: float, alpha: float) -> float:
     return float(weight / alpha) if alpha > 0 else float("inf")
 
 
+def ranked_candidate(
+    i: int, scores: dict, *, weight: float, certified: bool, mu, model, nu, **pose
+) -> GraspCandidate:
+    """The candidate of row ``i`` of a ranking, either hand's route.
+
+    ``scores`` holds the ranking's arrays ``is_closure``, ``d_star``, ``rank``,
+    ``eps``, ``rho``, ``score`` and ``alpha`` (weight capacity, N per N of
+    squeeze); ``pose`` the candidate's own fields (``sample``, ``X_WH``,
+    ``q_hand``, ``contacts``...).  ``squeeze_needed`` is ``weight / α`` (NaN
+    without a capacity, inf at 0); a ``certified`` candidate also gets the
+    single-grasp verdict with its certificate.
+    """
+    alpha = scores["alpha"][i]
+    candidate = GraspCandidate(
+        **pose,
+        contact_options={"mu": mu, "contact_model": model, "torsional_friction": nu},
+        is_closure=bool(scores["is_closure"][i]),
+        d_star=float(scores["d_star"][i]),
+        rank=int(scores["rank"][i]),
+        epsilon=float(scores["eps"][i]),
+        robustness=float(scores["rho"][i]),
+        score=float(scores["score"][i]),
+        weight_capacity=float(alpha),
+        squeeze_needed=_squeeze(weight, alpha),
+    )
+    if certified:
+        candidate = replace(candidate, closure=force_closure(candidate.grasp))
+    return candidate
+
+
 def rank_candidates(
     kept, *, finger_names, gripper, plant, mu, model, nu, torque_scale, samples,
     noise, rng, certify, workers, X_WO, weight, weight_check, surface, tol,
@@ -328,38 +359,35 @@ def rank_candidates(
         f"{plant.GetModelInstanceName(j.model_instance())}::{j.name()}"
         for j in gripper.joints
     )
+    scores = {
+        "is_closure": is_closure, "d_star": d_star, "rank": rank, "eps": eps,
+        "rho": rho, "score": score, "alpha": alpha,
+    }  # fmt: skip
+    signs = (
+        float(np.sign(1 / gripper.pad_rate[0])),
+        float(np.sign(-1 / gripper.pad_rate[1])),
+    )
     out = []
     for place, i in enumerate(order):
         sample, X_WH, q, opening, found = kept[i]
         out.append(
-            GraspCandidate(
+            ranked_candidate(
+                i,
+                scores,
+                weight=weight,
+                certified=place < certify,
+                mu=mu,
+                model=model,
+                nu=nu,
                 sample=sample,
                 hand_base=base,
                 X_WH=X_WH,
                 X_WO=X_WO,
                 q_hand=np.asarray(q, float),
                 joint_names=joint_names,
-                closing_signs=(
-                    float(np.sign(1 / gripper.pad_rate[0])),
-                    float(np.sign(-1 / gripper.pad_rate[1])),
-                ),
+                closing_signs=signs,
                 opening=opening,
                 contacts=tuple(found),
-                contact_options={
-                    "mu": mu,
-                    "contact_model": model,
-                    "torsional_friction": nu,
-                },
-                is_closure=bool(is_closure[i]),
-                d_star=float(d_star[i]),
-                rank=int(rank[i]),
-                epsilon=float(eps[i]),
-                robustness=float(rho[i]),
-                score=float(score[i]),
-                weight_capacity=float(alpha[i]),
-                squeeze_needed=_squeeze(weight, alpha[i]),
-            )
+            )  # fmt: skip
         )
-        if place < certify:  # the certificate of the best few
-            out[-1] = replace(out[-1], closure=force_closure(out[-1].grasp))
     return tuple(out)
