@@ -93,9 +93,13 @@ class ShakeResult:
         Actuator force per finger joint, newtons.
     efforts : tuple of float
         What each closing joint's actuator applied once the fingers had
-        seated (newtons, or N·m for a revolute joint), in actuator order:
-        ``squeeze`` (within its effort limit) when seating found the object.
-        Read at the end of seating (with ``seat=0``, of settling).
+        seated (newtons, or N·m for a revolute joint), in actuator order,
+        read at the end of seating (with ``seat=0``, of settling).  A
+        parallel jaw's fingers press with ``squeeze`` (within their effort
+        limits).  A multi-finger hand's joints share each finger's contact
+        force through its chain (``τ = Jᵀ f``), so theirs differ: a joint
+        the contact pushes back presses harder, up to its effort limit, and
+        one whose link moves freely presses with none.
     time_step, duration : float
         Seconds (simulated).
     wall_time : float
