@@ -1373,13 +1373,30 @@ def planning_cases() -> Iterator[Case]:
             "planning", name, lambda p=points, kw=kw: on_cloud(p, **kw), "refuse"
         )
     yield from _shake_cases(scene)
+    flat = np.c_[rng.uniform(-0.03, 0.03, (300, 2)), np.zeros(300)]
+    line = np.c_[np.linspace(-0.03, 0.03, 100), np.zeros((100, 2))]
     for name, kw in {
         "cloud-valid": {"cloud_normals": -cloud},
         # NaN marks a depth camera's missing points: they are dropped.
         "cloud-nan-holes": {"point_cloud": holes},
+        # degenerate but finite: the fitted surface (a quadric per point, a
+        # fingertip's first touch) must not break on them
+        "cloud-every-point-five-times": {"point_cloud": np.repeat(cloud, 5, axis=0)},
+        "cloud-nine-points": {"point_cloud": cloud[:9]},
+        "cloud-flat-plate": {
+            "point_cloud": flat,
+            "cloud_normals": np.tile([0.0, 0.0, 1.0], (300, 1)),
+        },
+        "cloud-one-line": {"point_cloud": line},
+        "cloud-seen-from-one-side": {"viewpoint": [0.5, 0.0, 0.0]},
     }.items():
+        points = kw.pop("point_cloud", cloud)
         yield Case(
-            "planning", name, lambda kw=kw: on_cloud(cloud, **kw), "either", ranked
+            "planning",
+            name,
+            lambda p=points, kw=kw: on_cloud(p, **kw),
+            "either",
+            ranked,
         )
 
 
