@@ -4,7 +4,8 @@ Usage::
 
     python benchmarks/bench_cloud_jaw.py [--objects NAME ...]
         [--views full side oblique] [--num 600] [--points 3000] [--top 10]
-        [--random 10] [--seed 0] [--margin 1.2] [--firm 5] [--verbose]
+        [--random 10] [--seed 0] [--margin 1.2] [--firm 5] [--noise MM]
+        [--verbose]
 
 The parallel-jaw cloud route of :func:`drakegrasp.plan_grasps` (Drake's WSG-50,
 free base, μ = 1, the models' friction) on clouds sampled from each object's
@@ -50,6 +51,19 @@ from bench_plan import YCB, drake_models  # noqa: E402  (the same local copy)
 VIEWS = {"full": None, "side": (0.5, 0.0, 0.0), "oblique": (0.4, 0.25, 0.3)}
 
 
+def _noisy(points, view, sigma):
+    """Points moved by N(0, σ²) along the line of sight (seed 0): a depth camera.
+
+    A whole cloud (no view) is seen from afar along each point's own direction
+    from the cloud's centre.
+    """
+    rng = np.random.default_rng(0)
+    centre = points.mean(axis=0)
+    eye = points - (centre if view is None else np.asarray(view, float))
+    ray = eye / np.linalg.norm(eye, axis=1, keepdims=True)
+    return points + rng.normal(0.0, sigma, len(points))[:, None] * ray
+
+
 def _held(group, full, X_WO, squeeze):
     return [shake_test(full.add_models, c, X_WO=X_WO, squeeze=squeeze) for c in group]
 
@@ -67,6 +81,13 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--margin", type=float, default=1.2)
     parser.add_argument("--firm", type=float, default=5.0)
+    parser.add_argument(
+        "--noise",
+        type=float,
+        default=0.0,
+        help="depth noise, mm (σ along each point's line of sight; normals "
+        "then estimated from the points, as Drake does)",
+    )
     parser.add_argument("--verbose", action="store_true")
     args = parser.parse_args(argv)
     models = drake_models()
@@ -93,6 +114,8 @@ def main(argv=None) -> int:
         for view_name in args.views:
             view = VIEWS[view_name]
             p, nrm = sample_cloud(full, args.points, 0, view)
+            if args.noise > 0:
+                p, nrm = _noisy(p, view, args.noise * 1e-3), None
             result, plan_s = plan_cloud(
                 hand, p, nrm, view, num=args.num, seed=args.seed, mass=mass
             )
