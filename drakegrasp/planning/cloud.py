@@ -59,6 +59,7 @@ __all__ = [
     "FACING_NEIGHBOURS",
     "FIT_FACE_COS",
     "FIT_MIN_POINTS",
+    "FIT_NEIGHBOURS",
     "FIT_RADIUS_LINES",
     "LINE_RADIUS_SPACINGS",
     "PAD_CONTACT_BAND",
@@ -659,6 +660,11 @@ EDGE_LINES = 1.5
 from every point has slid past the cloud's edge (on a random sample, a disc of
 one line radius holds no point 0.7 % of the time, of 1.5 once in 60,000)."""
 
+FIT_NEIGHBOURS = 64
+"""A point's quadric fits at most this many of its nearest neighbours (within
+its radius): about three times what a random sample puts there, and a bound
+on memory where a cloud is far denser (10,000 points in one spot)."""
+
 FIT_RADIUS_LINES = 2.0
 """A fingertip's quadric fits the face's points within this many line radii
 (plus its own radius) of its line: about 25 points of a random sample."""
@@ -771,6 +777,9 @@ class FittedCloud:
     :data:`FIT_RADIUS_LINES` line radii, and a probe meets the quadric of the
     facing point nearest it, then of the point nearest that meeting (where a
     face has fewer than :data:`FIT_MIN_POINTS` points, its tangent plane).
+    A point's quadric is fitted when a probe first meets it (a cloud of
+    200,000 points fits only those near the grasps), on at most
+    :data:`FIT_NEIGHBOURS` neighbours.
 
     Parameters
     ----------
@@ -779,40 +788,53 @@ class FittedCloud:
 
     def __init__(self, surface: CloudSurface):
         self.surface = surface
-        points, normals = surface.points, surface.normals
-        self.tree = cKDTree(points)
-        self.fit = fit = FIT_RADIUS_LINES * surface.line_radius
-        self.a, self.b = _basis_across(normals)  # (a, b, n) right-handed
-        lists = self.tree.query_ball_point(points, fit)
-        M = len(points)
-        width = max(len(x) for x in lists)
-        idx = np.zeros((M, width), dtype=int)
-        valid = np.zeros((M, width), bool)
-        for i, x in enumerate(lists):
-            idx[i, : len(x)] = x
-            valid[i, : len(x)] = True
-        v = points[idx] - points[:, None, :]
-        u = np.einsum("mwi,mi->mw", v, self.a) / fit  # in units of ρ
-        w = np.einsum("mwi,mi->mw", v, self.b) / fit
-        z = np.einsum("mwi,mi->mw", v, normals)
-        face = valid & (np.einsum("mwi,mi->mw", normals[idx], normals) >= FIT_FACE_COS)
+        self.tree = cKDTree(surface.points)
+        self.fit = FIT_RADIUS_LINES * surface.line_radius
+        M = len(surface.points)
+        self.coef = np.zeros((M, 6))  # too few points: the tangent plane h = 0
+        self._done = np.zeros(M, bool)  # fitted when first met (big clouds)
+
+    def _quadrics(self, j: np.ndarray) -> np.ndarray:
+        """``(L, 6)`` quadric coefficients of points ``j``, fitted once each."""
+        todo = np.unique(j[~self._done[j]])
+        if len(todo):
+            self.coef[todo] = self._fit(todo)
+            self._done[todo] = True
+        return self.coef[j]
+
+    def _fit(self, rows: np.ndarray) -> np.ndarray:
+        points, normals = self.surface.points, self.surface.normals
+        fit, L = self.fit, len(rows)
+        k = min(FIT_NEIGHBOURS, len(points))  # bounded memory however dense
+        dist, idx = self.tree.query(points[rows], k=k, distance_upper_bound=fit)
+        dist, idx = dist.reshape(L, k), idx.reshape(L, k)
+        valid = np.isfinite(dist)
+        idx = np.where(valid, idx, 0)
+        a, b = _basis_across(normals[rows])  # (a, b, n) right-handed
+        n = normals[rows]
+        v = points[idx] - points[rows][:, None, :]
+        u = np.einsum("lwi,li->lw", v, a) / fit  # in units of ρ
+        w = np.einsum("lwi,li->lw", v, b) / fit
+        z = np.einsum("lwi,li->lw", v, n)
+        face = valid & (np.einsum("lwi,li->lw", normals[idx], n) >= FIT_FACE_COS)
         A = np.stack([np.ones_like(u), u, w, u * u, u * w, w * w], axis=2)
         weight = face.astype(float)
-        AtA = np.einsum("mw,mwi,mwj->mij", weight, A, A)
-        Atb = np.einsum("mw,mwi,mw->mi", weight, A, z)
+        AtA = np.einsum("lw,lwi,lwj->lij", weight, A, A)
+        Atb = np.einsum("lw,lwi,lw->li", weight, A, z)
         eig = np.linalg.eigvalsh(AtA)
         ok = (face.sum(axis=1) >= FIT_MIN_POINTS) & (
             eig[:, 0] > 1e-9 * np.maximum(eig[:, -1], 1e-300)
         )
-        self.coef = np.zeros((M, 6))  # too few: the tangent plane h = 0
+        coef = np.zeros((L, 6))
         if np.any(ok):
-            self.coef[ok] = np.linalg.solve(AtA[ok], Atb[ok][..., None])[..., 0]
+            coef[ok] = np.linalg.solve(AtA[ok], Atb[ok][..., None])[..., 0]
+        return coef
 
     def _meet(self, p: np.ndarray, d: np.ndarray, j: np.ndarray):
         """Travel along ``d`` from ``p`` to point ``j``'s quadric, and its normal."""
-        fit, c = self.fit, self.coef[j].T
+        fit, c = self.fit, self._quadrics(j).T
         x, n = self.surface.points[j], self.surface.normals[j]
-        a, b = self.a[j], self.b[j]
+        a, b = _basis_across(n)
         w0 = p - x
         u0, v0, z0 = (
             np.einsum("li,li->l", w0, a) / fit,

@@ -187,3 +187,24 @@ def test_re_closing_on_the_cloud_moves_with_the_cloud():
     _, after, n_after = FittedCloud(moved).chord(p @ R.T + shift, -d @ R.T)
     np.testing.assert_allclose(after, before, atol=1e-9)
     np.testing.assert_allclose(n_after, n_before @ R.T, atol=1e-7)
+
+
+def test_a_dense_spot_in_the_cloud_costs_no_more_than_its_neighbours():
+    # 20,000 points within 10 µm of one spot: each fit takes at most
+    # FIT_NEIGHBOURS neighbours (padding every point to the densest one's
+    # neighbour count wanted 20,000 x 20,000 x 3 floats, 9.6 GB)
+    rng = np.random.default_rng(10)
+    surface = _can_cloud(rng)
+    spot = surface.points[0] + rng.normal(0, 1e-5, (20000, 3))
+    dense = CloudSurface(
+        np.vstack([surface.points, spot]),
+        np.vstack([surface.normals, np.tile(surface.normals[0], (20000, 1))]),
+        line_radius=surface.line_radius,  # the median spacing would be the spot's
+        origin=np.zeros(3),
+    )
+    p, d = _probes(rng, count=50)
+    p[0] = surface.points[0] + 1e-3 * surface.normals[0]  # a probe at the spot
+    d[0] = -surface.normals[0]
+    _, t_out, _ = FittedCloud(dense).chord(p, -d)
+    assert np.all(np.isfinite(t_out))
+    assert abs(-t_out[0] - 1e-3) < 1e-4
