@@ -1388,6 +1388,14 @@ def planning_cases() -> Iterator[Case]:
             "cloud_normals": np.tile([0.0, 0.0, 1.0], (300, 1)),
         },
         "cloud-one-line": {"point_cloud": line},
+        # 10,000 points within 10 µm of one spot: bounded memory (the fits
+        # once padded every point to the densest one's neighbours: 2.9 GiB)
+        "cloud-dense-spot": {
+            "point_cloud": np.vstack(
+                [cloud, cloud[0] + rng.normal(0.0, 1e-5, (10000, 3))]
+            ),
+            "cloud_normals": np.vstack([-cloud, np.tile(-cloud[0], (10000, 1))]),
+        },
         "cloud-seen-from-one-side": {"viewpoint": [0.5, 0.0, 0.0]},
     }.items():
         points = kw.pop("point_cloud", cloud)
