@@ -64,7 +64,7 @@ from drakegrasp.planning.cloud_hand import FAN_SIGMAS, CloudHand
 from drakegrasp.planning.motors import with_torques_needed
 from drakegrasp.planning.ranking import (
     group_by_count,
-    ranked_candidate,
+    ranked_candidates,
     robustness,
     tie_key,
     verdicts,
@@ -388,31 +388,21 @@ def rank_multifinger(
         "is_closure": is_closure, "d_star": d_star, "rank": rank, "eps": eps,
         "rho": rho, "score": score, "alpha": alpha,
     }  # fmt: skip
-    out = []
-    for place, i in enumerate(order):
+
+    def pose(i: int) -> dict:
         k, X_WH, q_pre, q, found = kept[i]
-        out.append(
-            ranked_candidate(
-                i,
-                scores,
-                weight=weight,
-                certified=place < certify,
-                mu=mu,
-                model=model,
-                nu=nu,
-                sample=int(k),
-                hand_base=base,
-                X_WH=X_WH,
-                X_WO=X_WO,
-                q_hand=np.asarray(q, float),
-                joint_names=s.names,
-                closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
-                opening=float("nan"),
-                contacts=tuple(found),
-                q_preshape=np.asarray(q_pre, float),
-            )  # fmt: skip
-        )
-    return tuple(out)
+        return dict(
+            sample=int(k), hand_base=base, X_WH=X_WH, X_WO=X_WO,
+            q_hand=np.asarray(q, float), joint_names=s.names,
+            closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
+            opening=float("nan"), contacts=tuple(found),
+            q_preshape=np.asarray(q_pre, float),
+        )  # fmt: skip
+
+    return ranked_candidates(
+        order, scores, pose, weight=weight, certify=certify, mu=mu, model=model,
+        nu=nu,
+    )  # fmt: skip
 
 
 def _ranked_result(

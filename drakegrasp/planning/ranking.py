@@ -63,13 +63,13 @@ from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
-    "ranked_candidate",
     "DEFAULT_NOISE",
     "TIE_DECIMALS",
     "group_by_count",
     "perturbed_copies",
     "rank_candidates",
     "rank_order",
+    "ranked_candidates",
     "robustness",
     "tie_key",
     "verdicts",
@@ -267,34 +267,42 @@ def _squeeze(weight: float, alpha: float) -> float:
     return float(weight / alpha) if alpha > 0 else float("inf")
 
 
-def ranked_candidate(
-    i: int, scores: dict, *, weight: float, certified: bool, mu, model, nu, **pose
-) -> GraspCandidate:
-    """The candidate of row ``i`` of a ranking, either hand's route.
+def ranked_candidates(
+    order, scores: dict, pose, *, weight: float, certify: int, mu, model, nu
+) -> tuple[GraspCandidate, ...]:
+    """The candidates of a ranking, best first, either hand's route.
 
-    ``scores`` holds the ranking's arrays ``is_closure``, ``d_star``, ``rank``,
-    ``eps``, ``rho``, ``score`` and ``alpha`` (weight capacity, N per N of
-    squeeze); ``pose`` the candidate's own fields (``sample``, ``X_WH``,
-    ``q_hand``, ``contacts``...).  ``squeeze_needed`` is ``weight / α`` (NaN
-    without a capacity, inf at 0); a ``certified`` candidate also gets the
-    single-grasp verdict with its certificate.
+    ``order`` gives the rows best first; ``scores`` holds the ranking's
+    arrays ``is_closure``, ``d_star``, ``rank``, ``eps``, ``rho``, ``score``
+    and ``alpha`` (weight capacity, N per N of squeeze); ``pose(i)`` the
+    fields of row ``i``'s own (``sample``, ``X_WH``, ``q_hand``,
+    ``contacts``...).  ``squeeze_needed`` is ``weight / α`` (NaN without a
+    capacity, inf at 0); the first ``certify`` also get the single-grasp
+    verdict with its certificate.
     """
-    alpha = scores["alpha"][i]
-    candidate = GraspCandidate(
-        **pose,
-        contact_options={"mu": mu, "contact_model": model, "torsional_friction": nu},
-        is_closure=bool(scores["is_closure"][i]),
-        d_star=float(scores["d_star"][i]),
-        rank=int(scores["rank"][i]),
-        epsilon=float(scores["eps"][i]),
-        robustness=float(scores["rho"][i]),
-        score=float(scores["score"][i]),
-        weight_capacity=float(alpha),
-        squeeze_needed=_squeeze(weight, alpha),
-    )
-    if certified:
-        candidate = replace(candidate, closure=force_closure(candidate.grasp))
-    return candidate
+    out = []
+    for place, i in enumerate(order):
+        alpha = scores["alpha"][i]
+        candidate = GraspCandidate(
+            **pose(i),
+            contact_options={
+                "mu": mu,
+                "contact_model": model,
+                "torsional_friction": nu,
+            },
+            is_closure=bool(scores["is_closure"][i]),
+            d_star=float(scores["d_star"][i]),
+            rank=int(scores["rank"][i]),
+            epsilon=float(scores["eps"][i]),
+            robustness=float(scores["rho"][i]),
+            score=float(scores["score"][i]),
+            weight_capacity=float(alpha),
+            squeeze_needed=_squeeze(weight, alpha),
+        )
+        if place < certify:
+            candidate = replace(candidate, closure=force_closure(candidate.grasp))
+        out.append(candidate)
+    return tuple(out)
 
 
 def rank_candidates(
@@ -367,27 +375,16 @@ def rank_candidates(
         float(np.sign(1 / gripper.pad_rate[0])),
         float(np.sign(-1 / gripper.pad_rate[1])),
     )
-    out = []
-    for place, i in enumerate(order):
+
+    def pose(i: int) -> dict:
         sample, X_WH, q, opening, found = kept[i]
-        out.append(
-            ranked_candidate(
-                i,
-                scores,
-                weight=weight,
-                certified=place < certify,
-                mu=mu,
-                model=model,
-                nu=nu,
-                sample=sample,
-                hand_base=base,
-                X_WH=X_WH,
-                X_WO=X_WO,
-                q_hand=np.asarray(q, float),
-                joint_names=joint_names,
-                closing_signs=signs,
-                opening=opening,
-                contacts=tuple(found),
-            )  # fmt: skip
-        )
-    return tuple(out)
+        return dict(
+            sample=sample, hand_base=base, X_WH=X_WH, X_WO=X_WO,
+            q_hand=np.asarray(q, float), joint_names=joint_names,
+            closing_signs=signs, opening=opening, contacts=tuple(found),
+        )  # fmt: skip
+
+    return ranked_candidates(
+        order, scores, pose, weight=weight, certify=certify, mu=mu, model=model,
+        nu=nu,
+    )  # fmt: skip
