@@ -64,10 +64,10 @@ from drakegrasp.planning.cloud_hand import FAN_SIGMAS, CloudHand
 from drakegrasp.planning.motors import with_torques_needed
 from drakegrasp.planning.ranking import (
     group_by_count,
+    grouped_verdicts,
     ranked_candidates,
     robustness,
     tie_key,
-    verdicts,
 )
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.closing import close_checked_hand
@@ -343,18 +343,14 @@ def rank_multifinger(
     F = hand.num_fingers
     counts = np.array([len(k[4]) for k in kept])
     K = len(kept)
-    is_closure, d_star = np.zeros(K, bool), np.zeros(K)
-    rank, eps, rho = np.zeros(K, int), np.zeros(K), np.zeros(K)
+    rho = np.zeros(K)
     alpha = np.full(K, np.nan)
-    for idx in group_by_count(counts).values():
-        P = np.array([[c.p_OC for c in kept[i][4]] for i in idx])
-        Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
-        L = np.array([_labels(kept[i][4], label, F) for i in idx])
-        fc, ds, rk, ep = verdicts(
-            P, Nrm, mu, torque_scale=torque_scale, model=model,
-            torsional_friction=nu, workers=workers,
-        )  # fmt: skip
-        is_closure[idx], d_star[idx], rank[idx], eps[idx] = fc, ds, rk, ep
+    verdict, groups = grouped_verdicts(
+        kept, lambda found: _labels(found, label, F), mu,
+        torque_scale=torque_scale, model=model, nu=nu, workers=workers,
+    )  # fmt: skip
+    is_closure, d_star, rank, eps = verdict.values()
+    for idx, P, Nrm, L, fc in groups:
         closed = idx[fc]
         if len(closed):
             rho[closed] = robustness(

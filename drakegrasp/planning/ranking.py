@@ -66,6 +66,7 @@ __all__ = [
     "DEFAULT_NOISE",
     "TIE_DECIMALS",
     "group_by_count",
+    "grouped_verdicts",
     "perturbed_copies",
     "rank_candidates",
     "rank_order",
@@ -305,6 +306,42 @@ def ranked_candidates(
     return tuple(out)
 
 
+def grouped_verdicts(kept, labels, mu, *, torque_scale, model, nu, workers):
+    """Stage 4a, either hand's route: every kept grasp's LP2 verdict, by count.
+
+    ``kept[i][4]`` are row ``i``'s contacts (``p_OC``, ``nhat_O``);
+    ``labels(contacts)`` numbers their fingers.  Grasps with equal contact
+    counts go to the batch engine together (:func:`verdicts`).
+
+    Returns
+    -------
+    verdict : dict of (K,) arrays
+        ``is_closure``, ``d_star``, ``rank``, ``eps``.
+    groups : list of tuple
+        Per count: ``(idx, P, Nrm, L, fc)``, the rows, their contacts
+        ``(n, N, 3)``, normals, finger labels ``(n, N)`` and closure mask.
+    """
+    K = len(kept)
+    verdict = {
+        "is_closure": np.zeros(K, bool), "d_star": np.zeros(K),
+        "rank": np.zeros(K, int), "eps": np.zeros(K),
+    }  # fmt: skip
+    groups = []
+    counts = np.array([len(k[4]) for k in kept])
+    for idx in group_by_count(counts).values():
+        P = np.array([[c.p_OC for c in kept[i][4]] for i in idx])
+        Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
+        L = np.array([labels(kept[i][4]) for i in idx])
+        fc, ds, rk, ep = verdicts(
+            P, Nrm, mu, torque_scale=torque_scale, model=model,
+            torsional_friction=nu, workers=workers,
+        )  # fmt: skip
+        for key, value in zip(verdict, (fc, ds, rk, ep), strict=True):
+            verdict[key][idx] = value
+        groups.append((idx, P, Nrm, L, fc))
+    return verdict, groups
+
+
 def rank_candidates(
     kept, *, finger_names, gripper, plant, mu, model, nu, torque_scale, samples,
     noise, rng, certify, workers, X_WO, weight, weight_check, surface, tol,
@@ -323,21 +360,14 @@ def rank_candidates(
         return ()
     counts = np.array([len(k[4]) for k in kept])
     K = len(kept)
-    is_closure = np.zeros(K, bool)
-    d_star = np.zeros(K)
-    rank = np.zeros(K, int)
-    eps = np.zeros(K)
     rho = np.zeros(K)
     names = finger_names
-    for idx in group_by_count(counts).values():
-        P = np.array([[c.p_OC for c in kept[i][4]] for i in idx])
-        Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
-        F = np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx])
-        fc, ds, rk, ep = verdicts(
-            P, Nrm, mu, torque_scale=torque_scale, model=model,
-            torsional_friction=nu, workers=workers,
-        )  # fmt: skip
-        is_closure[idx], d_star[idx], rank[idx], eps[idx] = fc, ds, rk, ep
+    verdict, groups = grouped_verdicts(
+        kept, lambda found: [_finger_label(c, names) for c in found], mu,
+        torque_scale=torque_scale, model=model, nu=nu, workers=workers,
+    )  # fmt: skip
+    is_closure, d_star, rank, eps = verdict.values()
+    for idx, P, _, F, fc in groups:
         closed = idx[fc]
         if len(closed):
             rho[closed] = reclosed_robustness(
