@@ -7,6 +7,7 @@ import copy
 import os
 import subprocess
 import sys
+import uuid
 from pathlib import Path
 from unittest import mock
 
@@ -118,6 +119,7 @@ class TutorialRuns:
         from jupyter_client.kernelspec import KernelSpecManager
 
         write_kernel_spec(path=str(kernels / "python3"))
+        self._kernels = kernels
         self._specs = KernelSpecManager(
             kernel_dirs=[str(kernels)], ensure_native_kernel=False
         )
@@ -139,7 +141,13 @@ class TutorialRuns:
         test_mode = dict(DRAKEGRASP_TUTORIAL_TEST="1", _DRAKE_DEPRECATION_IS_ERROR="1")
         with mock.patch.dict(os.environ, test_mode):  # the kernel inherits it
             os.environ.pop("MPLBACKEND", None)  # inline figures
-            km = KernelManager(kernel_name="python3", kernel_spec_manager=self._specs)
+            # the connection file beside the kernelspec, not a mkstemp file in
+            # /tmp that jupyter_client leaves behind (14 per CI run)
+            km = KernelManager(
+                kernel_name="python3",
+                kernel_spec_manager=self._specs,
+                connection_file=str(self._kernels / f"kernel-{uuid.uuid4().hex}.json"),
+            )
             assert km.kernel_spec.argv[0] == sys.executable
             nbclient.NotebookClient(
                 executed,
