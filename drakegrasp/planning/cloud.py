@@ -666,8 +666,9 @@ its radius): about three times what a random sample puts there, and a bound
 on memory where a cloud is far denser (10,000 points in one spot)."""
 
 FIT_RADIUS_LINES = 2.0
-"""A fingertip's quadric fits the face's points within this many line radii
-(plus its own radius) of its line: about 25 points of a random sample."""
+"""Quadrics fit the points within this many line radii: of a fingertip's line
+(plus its radius, :func:`sphere_entry`) or of a point (:class:`FittedCloud`);
+about 20 points of a random sample."""
 
 FIT_FACE_COS = np.cos(np.radians(45.0))
 """Points whose normals lie within this angle of the first-met point's are
