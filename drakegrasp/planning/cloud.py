@@ -714,7 +714,9 @@ def sphere_entry(
         quadric ``s(x, y)`` (travel over the plane across the line); the
         sphere meets it at the smallest ``s(x, y) − sqrt(r² − x² − y²)`` over
         its disc, reported at the fitted point nearest the line.
-        Points of another face (an edge's) keep their own travel
+        The first face is that of the first point met among those not
+        already behind the centre by more than ``r``.  Points of another face
+        (an edge's, the far side's, one passed) keep their own travel
         ``s − sqrt(max(r² − δ², 0))`` (``δ`` their distance from the line), as
         do faces with fewer than :data:`FIT_MIN_POINTS` points.
     """
@@ -723,9 +725,10 @@ def sphere_entry(
     delta = np.linalg.norm(lateral, axis=1)
     reach = delta <= r + line_radius
     t = np.where(reach, s - np.sqrt(np.maximum(r * r - delta * delta, 0.0)), np.nan)
-    if not np.any(np.isfinite(t)):
+    ahead = np.where(s >= -r, t, np.nan)  # not a point the sphere has passed
+    if not np.any(np.isfinite(ahead)):
         return t
-    first = int(np.nanargmin(t))
+    first = int(np.nanargmin(ahead))
     fit = r + FIT_RADIUS_LINES * line_radius
     face = (
         (delta <= fit)

@@ -93,20 +93,27 @@ def test_too_few_points_of_a_face_are_met_one_by_one():
     np.testing.assert_array_equal(got, _per_point(q[keep], u, R_TIP, LINE))
 
 
-@pytest.mark.parametrize("other", ["edge", "far side"])
+@pytest.mark.parametrize("other", ["edge", "far side", "behind"])
 def test_points_off_the_first_face_keep_their_own_travel(other):
-    # a second face at an edge, or the object's far side along the line, is
-    # not fitted with the first; a point there keeps its own travel
+    # a second face at an edge, the object's far side along the line, or a
+    # point the tip has passed is not the first face; it keeps its own travel
     rng = np.random.default_rng(5)
     q, n, _ = _cylinder(rng)
     u = np.array([1.0, 0.0, 0.0])
     if other == "edge":
         extra_q, extra_n = np.array([[-0.02, 0.0005, 0.0]]), np.array([[0, 0, 1.0]])
-    else:
-        extra_q, extra_n = np.array([[0.06, 0.0005, 0.0]]), np.array([[-1.0, 0, 0]])
+    elif other == "far side":
+        extra_q, extra_n = np.array([[-0.08, 0.0005, 0.0]]), np.array([[-1.0, 0, 0]])
+    else:  # passed, facing the tip: met first by its own travel before the fix
+        extra_q, extra_n = np.array([[0.06, 0.0005, 0.0]]), np.array([[1.0, 0, 0]])
     t = sphere_entry(R_TIP, np.vstack([q, extra_q]), u, np.vstack([n, extra_n]), LINE)
     alone = _per_point(extra_q, u, R_TIP, LINE)[0]
     assert t[-1] == alone
+    if other != "edge":  # (at the edge, its point is met first)
+        # the can's face is still the one fitted: its points' own travels
+        # gave way to one value
+        merged = np.isnan(t[:-1]) & np.isfinite(_per_point(q, u, R_TIP, LINE))
+        assert merged.any()
 
 
 # ------------------------------------------------ re-closing on a cloud
