@@ -55,6 +55,7 @@ from drakegrasp.plant.validation import scoped_name
 __all__ = [
     "MAX_COORDINATE",
     "CONTACT_BAND",
+    "DISTINCT",
     "EDGE_LINES",
     "FACING_NEIGHBOURS",
     "FIT_FACE_COS",
@@ -350,6 +351,24 @@ def cloud_surface(points, normals, viewpoint=None, complete: bool = True):
     return surface, completion
 
 
+DISTINCT = 1e-9
+"""Points closer than this (m) are one point repeated, for the spacing."""
+
+
+def _spacing(points: np.ndarray) -> float:
+    """Median distance (m) from a point to its nearest distinct neighbour.
+
+    A point repeated (merged camera frames repeat the points they share) is
+    one point: the points are taken once each (on a grid of
+    :data:`DISTINCT`), then each one's nearest neighbour.
+    """
+    _, keep = np.unique(np.round(points / DISTINCT), axis=0, return_index=True)
+    distinct = points[np.sort(keep)]
+    if len(distinct) < 2:
+        return 0.0
+    return float(np.median(cKDTree(distinct).query(distinct, k=2)[0][:, 1]))
+
+
 class CloudSurface:
     """A cloud in its frame O (at its centroid or a given origin), sampled and cut.
 
@@ -363,7 +382,8 @@ class CloudSurface:
     line_radius : float, optional
         Points this close (m) to a grasp line are on it; default
         :data:`LINE_RADIUS_SPACINGS` times the median distance from a point to
-        its nearest neighbour, at least 1 mm.
+        its nearest distinct neighbour (repeated points, as merged frames
+        give, do not count), at least 1 mm.
     viewpoint : (3,) float, optional
         The camera, world frame (a one-sided cloud).
     origin : (3,) float, optional
@@ -390,8 +410,7 @@ class CloudSurface:
         self.viewpoint = (
             None if viewpoint is None else np.asarray(viewpoint, float) - self.origin
         )
-        gaps = cKDTree(self.points).query(self.points, k=2)[0][:, 1]
-        self.spacing = float(np.median(gaps))
+        self.spacing = _spacing(self.points)
         if line_radius is None:
             line_radius = max(LINE_RADIUS_SPACINGS * self.spacing, 1e-3)
         self.line_radius = float(line_radius)

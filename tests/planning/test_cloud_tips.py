@@ -215,3 +215,24 @@ def test_a_dense_spot_in_the_cloud_costs_no_more_than_its_neighbours():
     _, t_out, _ = FittedCloud(dense).chord(p, -d)
     assert np.all(np.isfinite(t_out))
     assert abs(-t_out[0] - 1e-3) < 1e-4
+
+
+def test_repeated_points_do_not_shrink_the_spacing():
+    # merged camera frames repeat the points they share: the spacing (and the
+    # line radius built on it) is that of the distinct points
+    rng = np.random.default_rng(11)
+    surface = _can_cloud(rng)
+    for times in (2, 5, 20):
+        repeated = CloudSurface(
+            np.repeat(surface.points, times, axis=0),
+            np.repeat(surface.normals, times, axis=0),
+            origin=np.zeros(3),
+        )
+        assert repeated.spacing == surface.spacing
+        assert repeated.line_radius == surface.line_radius
+    half = CloudSurface(  # half the points twice: still the distinct spacing
+        np.vstack([surface.points, surface.points[:1500]]),
+        np.vstack([surface.normals, surface.normals[:1500]]),
+        origin=np.zeros(3),
+    )
+    assert half.spacing == surface.spacing
