@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
+from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.gripper import ParallelJaw
@@ -79,7 +80,7 @@ __all__ = [
 CONTACT_BAND = 1e-3
 """A finger shape touches the cloud points within this travel (m) of its first."""
 
-PAD_CONTACT_BAND = 1e-4
+PAD_CONTACT_BAND = DEFAULT_DISTANCE_TOLERANCE
 """A parallel jaw's band (m): its pad's other shapes touch within this travel
 of its first touch, the default distance tolerance within which the body
 route counts contacts.
@@ -610,8 +611,7 @@ class CloudFingers:
                     if not len(idx):
                         continue
                     q_G = (self.points_W[idx] - p) @ R
-                    n_G = self.surface.normals[idx] @ R
-                    t_in = self._entry(piece, q_G, -c_W @ R, n_G)
+                    t_in = self._entry(piece, q_G, -c_W @ R, idx, R)
                     ok = np.isfinite(t_in) & (t_in >= -self.tol) & (t_in <= reach[f])
                     if np.any(ok):
                         hits[f].append((body, piece, idx[ok], t_in[ok], c_W))
@@ -622,7 +622,7 @@ class CloudFingers:
         q = q_open + toward * step / g.pad_rate
         return q, (travel, hits), None
 
-    def _entry(self, piece, q_G, u_G, n_G) -> np.ndarray:
+    def _entry(self, piece, q_G, u_G, idx, R) -> np.ndarray:
         """Travel at which each point, moving along ``u_G``, meets the piece.
 
         A sphere (a fingertip, often smaller than the cloud's spacing) meets
@@ -630,6 +630,7 @@ class CloudFingers:
         Other shapes meet a point where it enters them (the chord's entry).
         """
         if piece.kind == "ellipsoid" and np.ptp(piece.semi_axes) == 0:
+            n_G = self.surface.normals[idx] @ R  # the points' normals, frame G
             return sphere_entry(
                 piece.semi_axes[0], q_G, u_G, n_G, self.surface.line_radius
             )
@@ -756,11 +757,8 @@ def sphere_entry(
     )
     if np.count_nonzero(face) < FIT_MIN_POINTS:
         return t
-    helper = np.eye(3)[int(np.argmin(np.abs(u_G)))]
-    e1 = np.cross(u_G, helper)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(u_G, e1)
-    x, y = lateral[face] @ e1, lateral[face] @ e2
+    e1, e2 = _basis_across(u_G[None, :])
+    x, y = lateral[face] @ e1[0], lateral[face] @ e2[0]
     xs, ys = x / fit, y / fit  # in units of the neighbourhood: conditioning
     A = np.column_stack([np.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys])
     coef, _, rank, _ = np.linalg.lstsq(A, s[face], rcond=None)
@@ -906,9 +904,10 @@ class FittedCloud:
         t_out : (L,) float
             Minus the travel along ``−d_O`` (metres) at which each probe meets
             the surface; NaN where no facing point lies within
-            :data:`FACING_NEIGHBOURS` of it or the meeting is more than
-            :data:`EDGE_LINES` line radii from the nearest point (the probe
-            slid past the cloud's edge).
+            :data:`FACING_NEIGHBOURS` of it or its first meeting (with the
+            nearest facing point's quadric) is more than :data:`EDGE_LINES`
+            line radii from every point (the probe slid past the cloud's
+            edge).
         n_out : (L, 3) float
             Outward unit normal there, frame O.
         """

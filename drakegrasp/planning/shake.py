@@ -92,8 +92,9 @@ class ShakeResult:
     squeeze : float
         Actuator force per finger joint, newtons.
     efforts : tuple of float
-        What each closing joint's actuator applied once the fingers had
-        seated (newtons, or N·m for a revolute joint), in actuator order,
+        The magnitude of what each closing joint's actuator applied once the
+        fingers had seated (newtons, or N·m for a revolute joint), in
+        actuator order,
         read at the end of seating (with ``seat=0``, of settling).  A
         parallel jaw's fingers press with ``squeeze`` (within their effort
         limits).  A multi-finger hand's joints share each finger's contact
