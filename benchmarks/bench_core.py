@@ -130,7 +130,7 @@ def main() -> None:
             print(f"{'batch_force_closure, per grasp':<44}{verdict * 1e3:>8.3f}ms")
         elif fn in ("bare_poly", "bare_exact"):
             real = closure.unresisted_wrench
-            closure.unresisted_wrench = lambda *a, **k: None
+            closure.unresisted_wrench = lambda *_args, **_kwargs: None
             try:
                 call = dg.force_closure if fn == "bare_poly" else dg.force_closure_exact
                 t = timed(call, grasps)

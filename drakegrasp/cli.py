@@ -179,7 +179,7 @@ def _epsilon(report, torque_scale: float) -> dict:
     return {"epsilon": float(value)}
 
 
-def _cmd_scenes(args: argparse.Namespace) -> int:
+def _cmd_scenes(_args: argparse.Namespace) -> int:
     from drakegrasp.plant.scene import DEFAULT_SCENE, list_scenes
 
     infos = list_scenes()

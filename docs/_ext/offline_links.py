@@ -105,7 +105,7 @@ def _locate(target: str) -> tuple[str, str] | None:
 
 
 def _resolve(
-    app: Sphinx, env: BuildEnvironment, node: pending_xref, contnode: nodes.Node
+    _app: Sphinx, _env: BuildEnvironment, node: pending_xref, contnode: nodes.Node
 ) -> nodes.reference | None:
     target = node["reftarget"]
     if target in PYTHON_AND_NUMPY:

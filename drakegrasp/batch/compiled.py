@@ -181,7 +181,7 @@ def _numba():
                     _NOTICE.on_end(ev)
 
             @typeof_impl.register(Kernel)
-            def _typeof_kernel(val, c):
+            def _typeof_kernel(val, _context):
                 return types.Dispatcher(val.dispatcher)
 
             event.register("numba:compile", _Listener())

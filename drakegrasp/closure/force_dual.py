@@ -168,13 +168,13 @@ def find_load_certificate(
     value = float(result.get_optimal_cost())
     if mode == "refute" and not value < -REFUTE_THRESHOLD:
         return None, value * force_scale
-    cert = _certificate(P, wrench, zv, blocks, force_scale, mode)
+    cert = _certificate(P, wrench, zv, blocks, mode)
     if mode == "bound":
         return cert, cert.bound
     return cert, value * force_scale
 
 
-def _certificate(P, wrench, zv, blocks, force_scale, mode) -> LoadCertificate:
+def _certificate(P, wrench, zv, blocks, mode) -> LoadCertificate:
     y = P.T.T @ zv[blocks[0]]
     n_v = P.Jt.shape[0]
     eta = np.zeros(n_v)

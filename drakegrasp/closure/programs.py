@@ -131,9 +131,7 @@ def check_formulation(formulation: str) -> str:
     return formulation
 
 
-def _margin_program(
-    num_forces: int, num_contacts: int
-) -> tuple[MathematicalProgram, np.ndarray, object]:
+def _margin_program(num_forces: int) -> tuple[MathematicalProgram, np.ndarray, object]:
     """Program with forces ``f`` (m,), ``d >= 0``, cost ``-OBJECTIVE_SCALE d``."""
     prog = MathematicalProgram()
     f = prog.NewContinuousVariables(num_forces, "f")
@@ -341,7 +339,7 @@ def build_form_closure_program(
     """
     rank_tol = check_program_options(grasp, rank_tol)
     N = grasp.num_contacts
-    prog, f, d = _margin_program(N, N)
+    prog, f, d = _margin_program(N)
     add_balance(prog, normal_balance_matrix(grasp), f, rank_tol)
     _add_margin_rows(prog, _selection(np.arange(N), N), f, d)
     _add_normal_budget(prog, f, N)
@@ -383,14 +381,14 @@ def build_force_closure_program(
     layout = cone_layout(grasp, num_generators)
     N = grasp.num_contacts
     if formulation == "facets":
-        prog, f, d = _margin_program(len(layout.columns), N)
+        prog, f, d = _margin_program(len(layout.columns))
         rows = _shared_balance_rows(grasp, layout, rank_tol)
         add_balance(prog, None, f, rank_tol, rows=rows)
         _add_margin_rows(prog, _margin_facets(layout), f, d)
         _add_normal_budget(prog, f[layout.normal_positions], N)
         return prog, _scaled_variables(d, f, layout)
     S = layout.generator_matrix()
-    prog, lam, d = _margin_program(S.shape[1], N)
+    prog, lam, d = _margin_program(S.shape[1])
     add_balance(prog, balance_matrix(grasp, layout.columns) @ S, lam, rank_tol)
     _add_margin_rows(prog, _selection(np.arange(S.shape[1]), S.shape[1]), lam, d)
     # Every generator has unit normal component, so Σ f_n = Σ λ.
@@ -430,7 +428,7 @@ def build_exact_force_closure_program(
     rank_tol = check_program_options(grasp, rank_tol)
     layout = cone_layout(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
-    prog, f, d = _margin_program(len(layout.columns), N)
+    prog, f, d = _margin_program(len(layout.columns))
     # f holds scaled components (a soft finger's m_n / (b ν)): ConeLayout.scales.
     rows = _shared_balance_rows(grasp, layout, rank_tol)
     add_balance(prog, None, f, rank_tol, rows=rows)
@@ -486,7 +484,7 @@ def build_internal_force_program(
     J = check_hand_jacobian(grasp, hand_jacobian)
     layout = cone_layout(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
-    prog, f, d = _margin_program(len(layout.columns), N)
+    prog, f, d = _margin_program(len(layout.columns))
     A = np.vstack(
         [balance_matrix(grasp, layout.columns), unit_columns(J[layout.columns]).T]
     )

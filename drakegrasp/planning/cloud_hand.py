@@ -231,7 +231,7 @@ def signed_distances(shape, q_G: np.ndarray) -> np.ndarray | None:
 class _Geometry:
     """One hand geometry: its body, pose in the body, shape and bounding sphere."""
 
-    def __init__(self, plant, inspector, gid, body, rng):
+    def __init__(self, inspector, gid, body, rng):
         self.id, self.body = gid, body
         self.shape = inspector.GetShape(gid)
         self.X_BG = inspector.GetPoseInFrame(gid)
@@ -301,14 +301,14 @@ class CloudHand:
         }
         self.fingers = [
             [
-                _Geometry(plant, inspector, g, b, rng)
+                _Geometry(inspector, g, b, rng)
                 for b in f.bodies
                 for g in plant.GetCollisionGeometriesForBody(b)
             ]
             for f in s.fingers
         ]
         self.palm = [
-            _Geometry(plant, inspector, g, b, rng)
+            _Geometry(inspector, g, b, rng)
             for b in bodies
             if int(b.index()) not in in_finger
             for g in plant.GetCollisionGeometriesForBody(b)

@@ -274,7 +274,7 @@ def _closing_joints(plant, bodies, couplings):
     return joints, follows
 
 
-def _group(plant, joints, follows, moved) -> list[list[Joint]]:
+def _group(joints, follows, moved) -> list[list[Joint]]:
     """Union-find: a joint joins the finger of the joint that moves its parent."""
     parent = {int(j.index()): int(j.index()) for j in joints}
 
@@ -488,7 +488,7 @@ def _build(plant, object_body, bodies, couplings, inspector) -> HandStructure:
     object_geometries = plant.GetCollisionGeometriesForBody(object_body)
     fingers = tuple(
         _finger(plant, members, moved, bodies, position, object_geometries, inspector)
-        for members in _group(plant, joints, follows, moved)
+        for members in _group(joints, follows, moved)
     )
     mapped = {}
     for follower, (leader, rho, off) in follows.items():

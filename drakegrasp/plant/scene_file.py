@@ -140,7 +140,7 @@ _SceneLoader.yaml_implicit_resolvers.setdefault("", []).insert(
 _SceneLoader.add_constructor("tag:yaml.org,2002:int", _SceneLoader.construct_yaml_int)
 
 
-def _construct_tagged(loader, suffix, node):
+def _construct_tagged(loader, _suffix, node):
     if isinstance(node, yaml.MappingNode):
         return loader.construct_mapping(node, deep=True)
     if isinstance(node, yaml.SequenceNode):

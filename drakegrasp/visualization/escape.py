@@ -126,7 +126,7 @@ def _unpack(scene_or_plant, result, plant_context, object_body, plane):
     return plant, context, body, cert, plane
 
 
-def _draw_body(meshcat, inspector, plant, context, body, path, rgba) -> None:
+def _draw_body(meshcat, inspector, plant, body, path, rgba) -> None:
     frame_id = plant.GetBodyFrameIdOrThrow(body.index())
     geometries = inspector.GetGeometries(frame_id, Role.kIllustration)
     if not geometries:
@@ -195,9 +195,9 @@ def animate_escape(
             continue
         path = f"{prefix}/held/{b_other.name()}_{int(b_other.index())}"
         meshcat.SetTransform(path, plant.EvalBodyPoseInWorld(context, b_other))
-        _draw_body(meshcat, inspector, plant, context, b_other, path, _HAND)
+        _draw_body(meshcat, inspector, plant, b_other, path, _HAND)
     obj = f"{prefix}/object"
-    _draw_body(meshcat, inspector, plant, context, body, obj, _OBJECT)
+    _draw_body(meshcat, inspector, plant, body, obj, _OBJECT)
     X_WO = plant.EvalBodyPoseInWorld(context, body)
     t_max = amount * cert.characteristic_length
     ramp = np.linspace(0.0, 1.0, frames)

@@ -59,7 +59,7 @@ def epsilon_chunk(P, Nrm, mu_c, nu_c, p, b, *, model, num_generators, kernel):
     return {"epsilon_l1": eps}
 
 
-def _merge_epsilon(K: int, d: int, parts) -> np.ndarray:
+def _merge_epsilon(K: int, _dim: int, parts) -> np.ndarray:
     """ε of a ragged batch's groups, in input order (read-only)."""
     out = np.zeros(K)
     for idx, eps in parts:

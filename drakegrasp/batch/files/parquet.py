@@ -19,7 +19,9 @@ __all__ = ["ParquetWriter"]
 class ParquetWriter:
     """Write result arrays to ``path`` as Parquet, one row group per chunk."""
 
-    def __init__(self, path: Path, K: int, meta: dict):
+    def __init__(self, path: Path, K: int, meta: dict):  # noqa: ARG002
+        # K (the row count) keeps one constructor for both writers; Parquet
+        # needs none, as row groups are appended chunk by chunk.
         try:
             import pyarrow as pa
             import pyarrow.parquet as pq

@@ -53,7 +53,7 @@ class MarginSolution:
 _PUSH_TOL = 1e-10  # ‖c‖ below this: no balanced force has a normal component
 
 
-def _contact_groups(facets, slices, kappa):
+def _contact_groups(facets, slices):
     """Contacts with the same cone shape, as (indices, component columns)."""
     by_shape: dict[tuple, list[int]] = {}
     for i, F in enumerate(facets):
@@ -78,7 +78,7 @@ def _stack_facets(facets, members, sel, everyone):
     return np.ascontiguousarray(np.transpose(stacked[:, sel], (2, 3, 0, 1)))
 
 
-def _highs(Q, facets, slices, normal_columns, c, fallback):
+def _highs(Q, facets, slices, normal_columns, fallback):
     """``t*`` of one LP with HiGHS (``scipy.optimize.linprog``): (value, ok)."""
     from scipy.optimize import linprog
 
@@ -212,7 +212,7 @@ def solve_margin_blocks(
     rank, spaces = row_spaces(G, rank_tol=rank_tol)
     d_star = np.zeros(K)
     converged = np.ones(K, dtype=bool)
-    contact_groups = _contact_groups(facets, component_slices, kappa)
+    contact_groups = _contact_groups(facets, component_slices)
     for sel, Q in spaces:
         r = Q.shape[1]
         if r >= M:
@@ -287,7 +287,7 @@ def solve_margin_blocks(
                 k = sel[j]
                 Fk = [F[0] if F.shape[0] == 1 else F[k] for F in facets]
                 t[j], ok[j] = _highs(
-                    Q[:, :, j], Fk, component_slices, normal_columns, c[:, j], t[j]
+                    Q[:, :, j], Fk, component_slices, normal_columns, t[j]
                 )
         converged[sel] = ok
         d_star[sel] = N * np.maximum(t, 0.0)
