@@ -65,7 +65,10 @@ OBJECTIVES = ("min_squeeze", "min_torque", "max_margin")
 
 
 _TIE = 1e-7
-"""``min_torque`` re-solves for the least squeeze at a ratio ``<= t* (1 + _TIE)``."""
+"""``min_torque`` re-solves for the least squeeze at a ratio ``<= t* (1 + _TIE)``,
+plus ``_TIE`` of the ratio's natural size (that of one unit of the program's
+force variables on the most sensitive joint), so the slack never depends on the
+size of the load or of the limits."""
 
 
 @dataclass(frozen=True)
@@ -87,7 +90,10 @@ class GraspForceVariables:
     force_scale : float
         ``F0``, N: the load's size (``max |T w|``), the program's unit of force.
     ratio : Variable or None
-        ``min_torque``: the largest ``|τ_j| / τ_max,j`` (minimised).
+        ``min_torque``: the largest ``|τ_j| / τ_max,j`` (minimised) over
+        ``force_scale``, so that the program's entries do not grow or shrink
+        with the load: ``force_scale * ratio`` is the ratio (1 without limits,
+        where ``τ_max,j`` is 1 N·m).
     margin : Variable or None
         ``max_margin``: ``d / F0``, each force's distance inside its cone.
     """
@@ -314,8 +320,10 @@ def _build(P: LoadProblem, w: np.ndarray, objective: str, *, ratio_cap=None):
         if ratio_cap is None:
             prog.AddLinearCost(1.0 * ratio)
         if use.size:
-            # |τ_j| <= t w_j with τ_j = c_j F0 (A_τ x)_j.
-            k = (weight / (P.jscale[use] * F0))[:, None]
+            # |τ_j| <= t w_j with τ_j = c_j F0 (A_τ x)_j and t = F0 r (r is
+            # the variable): F0 cancels, so a load of any size gives the
+            # same rows (a subnormal F0 made k infinite, a large one tiny).
+            k = (weight / P.jscale[use])[:, None]
             rows = np.vstack(
                 [np.hstack([A_tau[use], -k]), np.hstack([-A_tau[use], -k])]
             )
@@ -477,7 +485,9 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
         return _infeasible(P, w, objective, prog, result, v.force_scale)
     if objective == "min_torque":
         t = float(result.GetSolution(v.ratio))
-        cap = t * (1.0 + _TIE) + _TIE
+        use, weight = _torque_weights(P)
+        unit = 1.0 / float(np.max(weight / P.jscale[use])) if use.size else 1.0
+        cap = t * (1.0 + _TIE) + _TIE * unit
         prog2, v2 = _build(P, w, objective, ratio_cap=cap)
         result2 = solve(prog2, P.kind, retry=True)
         if result2.get_solution_result() == SolutionResult.kSolutionFound:

@@ -270,6 +270,57 @@ def test_min_torque_and_max_margin_do_what_they_say(helpers):
         dg.grasp_forces(g, w, objective="least")
 
 
+def _least_largest_torque(g, w, J, num_generators=8):
+    """min max_j |τ_j| over polyhedral cones with G f = -w, τ = Jᵀ f (HiGHS)."""
+    S = [dg.friction_cone_generators(c, num_generators) for c in g.contacts]
+    gen = np.zeros((g.num_components, sum(s.shape[1] for s in S)))
+    col = 0
+    for s, sl in zip(S, g.component_slices(), strict=True):
+        gen[sl, col : col + s.shape[1]] = s
+        col += s.shape[1]
+    GS, JS = dg.grasp_matrix(g) @ gen, J.T @ gen
+    n, m = gen.shape[1], J.shape[1]
+    cost = np.zeros(n + 1)
+    cost[-1] = 1.0
+    ones = np.ones((m, 1))
+    res = linprog(
+        cost,
+        A_ub=np.vstack([np.hstack([JS, -ones]), np.hstack([-JS, -ones])]),
+        b_ub=np.zeros(2 * m),
+        A_eq=np.hstack([GS, np.zeros((GS.shape[0], 1))]),
+        b_eq=-w,
+        bounds=[(0, None)] * (n + 1),
+    )
+    assert res.status == 0
+    return res.fun
+
+
+@pytest.mark.parametrize("limits", [None, 100.0])
+def test_min_torque_is_the_least_largest_torque_at_every_load_size(helpers, limits):
+    # The ratio and its tie-break slack scale with the load: a subnormal load
+    # made the program's rows infinite (SystemExit from Drake), 1e8 x the
+    # weight read as infeasible, and an absolute slack of 1e-7 let the
+    # least-squeeze forces through once the torques were that small.
+    g = helpers.equator_grasp(0.5, radius=0.04)
+    J = np.random.default_rng(7).normal(size=(g.num_components, 4)) * 0.04
+    w = weight(0.3)
+    ref = _least_largest_torque(g, w, J)
+    # With 100 N·m limits the load is held up to about 67 times the weight.
+    for scale in (1e-320, 1e-300, 1e-8, 1.0, 10.0 if limits else 1e8):
+        r = dg.grasp_forces(
+            g,
+            scale * w,
+            hand_jacobian=J,
+            torque_limits=limits,
+            objective="min_torque",
+            cones="polyhedral",
+        )
+        assert r.feasible, scale
+        if scale > 1e-310:  # a subnormal load keeps too few digits to compare
+            largest = np.max(np.abs(r.joint_torques))
+            assert largest == pytest.approx(scale * ref, rel=1e-6), scale
+
+
 def test_build_twin_returns_the_program():
     g = pinch(0.5)
     prog, v = dg.build_grasp_forces_program(g, weight(1.0))
