@@ -108,7 +108,7 @@ def build_load_dual_program(
 ):
     """The dual program in ``z = [ȳ, η⁺, η⁻, ρ, σ]`` (see the module docstring).
 
-    ``target`` is ``T w / F0`` (refute) or ``T d`` (bound).
+    ``target`` is ``T w / F0`` (refute) or ``T d / max|T d|`` (bound).
     """
     A, blocks = _dual_matrix(P)
     weights = _weights(P, force_scale, blocks)
@@ -155,8 +155,13 @@ def find_load_certificate(
         refute, the payload bound for bound (``inf`` when no dual exists).
     """
     target = P.normalised(wrench)
-    if mode == "refute":
-        target = target / force_scale
+    # Refute: the load in units of the primal's F0.  Bound: the direction's
+    # size is no part of the question, so the normalisation ȳᵀ T d = -1 is
+    # made on a unit direction (on T d itself, ȳ grew or shrank with |d| past
+    # the solver's tolerances: a bound below the achieved α at 1e5 x the
+    # weight, 0 at 1e200).  The certificate keeps the caller's d, so its bound
+    # B / (-yᵀ d) is for d.
+    target = target / (force_scale if mode == "refute" else np.max(np.abs(target)))
     prog, z, blocks, weights = build_load_dual_program(
         P, target, force_scale, mode=mode
     )

@@ -426,6 +426,21 @@ def test_payload_of_a_pinch_with_motors_is_the_closed_form(cones):
     assert above.certificate.check(g, hand_jacobian=J).holds
 
 
+@pytest.mark.parametrize("size", [1e-200, 1e-5, 1.0, 1e5, 1e10, 1e200])
+def test_payload_and_its_bound_do_not_depend_on_the_direction_s_length(size):
+    # max_squeeze = 100 N: friction carries 2 μ 50 N = 50 N of the weight.
+    g = pinch(0.5)
+    J = pinch_jacobian(g)
+    for kw in ({"max_squeeze": 100.0}, {"hand_jacobian": J, "torque_limits": 15.0}):
+        r = dg.max_load(g, size * weight(1.0), **kw)
+        want = (50.0 if "max_squeeze" in kw else 15.0) / G_EARTH
+        assert r.alpha * size == pytest.approx(want, rel=1e-6)
+        # The certified bound was normalised on T d itself: below the
+        # achieved α at 1e5 x the weight, 200 x loose at 1e10, 0 at 1e200.
+        assert r.upper_bound * size == pytest.approx(want, rel=1e-6)
+        assert r.certificate.check(g, hand_jacobian=J).holds
+
+
 def test_payload_without_limits_is_infinite_and_exact_beats_polyhedral():
     g = pinch(0.5)
     assert dg.max_load(g, weight(1.0)).alpha == math.inf
