@@ -46,6 +46,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from drakegrasp.certificates._matching import _foreign, check_tolerance
 from drakegrasp.certificates.kinds import (
     DEFAULT_CHECK_TOL,
     CertificateCheck,
@@ -54,6 +55,12 @@ from drakegrasp.certificates.kinds import (
 from drakegrasp.core.friction_cone import ConeLayout, support_of
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import (
+    check_grasp,
+    check_num_generators,
+    real_array,
+    real_scalar,
+)
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["LOAD_NOT_HELD", "PAYLOAD_BOUND", "LoadCertificate"]
@@ -215,18 +222,85 @@ def _supports(cert: LoadCertificate, grasp: Grasp, J: np.ndarray | None):
     return np.array(support), float(size)
 
 
+def _array(cert: LoadCertificate, name: str, shape, grasp: Grasp) -> np.ndarray:
+    """The certificate's ``name`` as a real array of ``shape`` (None: any length)."""
+    a = real_array(
+        f"the certificate's {name}", getattr(cert, name), error=InvalidOptionError
+    )
+    if a.ndim != 1 or (shape is not None and a.shape != shape):
+        want = f"({shape[0]},)" if shape is not None else "(n_v,)"
+        raise _foreign(name, a.shape, want, grasp)
+    return a
+
+
+def _limits(cert: LoadCertificate, name: str, n: int, grasp: Grasp) -> np.ndarray:
+    """A limit array of the certificate; None means no limit (``inf``)."""
+    if getattr(cert, name) is None:
+        return np.full(n, math.inf)
+    return _array(cert, name, (n,), grasp)
+
+
+def _read(cert: LoadCertificate, grasp: Grasp) -> LoadCertificate:
+    """``cert`` with every array real and shaped for ``grasp``.
+
+    Raises
+    ------
+    InvalidGraspError
+        When ``grasp`` is not a Grasp.
+    InvalidOptionError
+        When a field is not real, or has the shape of another grasp or hand.
+    """
+    check_grasp(grasp)
+    D, N = grasp.wrench_dim, grasp.num_contacts
+    eta = _array(cert, "joint_multipliers", None, grasp)
+    return LoadCertificate(
+        kind=cert.kind,
+        cones=cert.cones,
+        num_generators=check_num_generators(cert.num_generators),
+        wrench=_array(cert, "wrench", (D,), grasp),
+        twist=_array(cert, "twist", (D,), grasp),
+        joint_multipliers=eta,
+        normal_multipliers=_array(cert, "normal_multipliers", (N,), grasp),
+        squeeze_multiplier=real_scalar(
+            "the certificate's squeeze_multiplier", cert.squeeze_multiplier
+        ),
+        torque_limits=_limits(cert, "torque_limits", eta.size, grasp),
+        max_normal_force=_limits(cert, "max_normal_force", N, grasp),
+        max_squeeze=real_scalar("the certificate's max_squeeze", cert.max_squeeze),
+        bound=real_scalar("the certificate's bound", cert.bound),
+    )
+
+
+def _impossible(cert: LoadCertificate) -> str | None:
+    """Why the certificate's own numbers cannot be a proof, or None."""
+    arrays = (cert.wrench, cert.twist, cert.joint_multipliers, cert.normal_multipliers)
+    if not all(np.all(np.isfinite(a)) for a in arrays) or not math.isfinite(
+        cert.squeeze_multiplier
+    ):
+        return "its wrench, twist or multipliers are not finite"
+    if np.any(cert.normal_multipliers < 0.0) or cert.squeeze_multiplier < 0.0:
+        return "a bound's multiplier is negative"
+    limits = np.concatenate(
+        [cert.torque_limits, cert.max_normal_force, [cert.max_squeeze]]
+    )
+    if np.any(np.isnan(limits) | (limits < 0.0)):
+        return "a limit it relies on is negative or NaN (no force meets it)"
+    if not (math.isfinite(cert.bound) and cert.bound >= 0.0):
+        return (
+            f"its claimed bound {cert.bound!r} is not a finite number >= 0 (the "
+            "grasp always holds α = 0 with no force)"
+        )
+    return None
+
+
 def check_load_certificate(
     cert: LoadCertificate, grasp: Grasp, hand_jacobian, tol: float
 ) -> CertificateCheck:
     """See :meth:`LoadCertificate.check`."""
-    w = np.asarray(cert.wrench, dtype=float)
-    y = np.asarray(cert.twist, dtype=float)
-    if w.shape != (grasp.wrench_dim,) or y.shape != w.shape:
-        raise InvalidOptionError(
-            f"the certificate's wrench and twist must have {grasp.wrench_dim} "
-            f"entries like the grasp's wrenches, got {w.shape} and {y.shape}"
-        )
-    eta = np.asarray(cert.joint_multipliers, dtype=float)
+    tol = check_tolerance(tol)
+    cert = _read(cert, grasp)
+    w, y = cert.wrench, cert.twist
+    eta = cert.joint_multipliers
     J = None
     if eta.size and np.any(eta != 0.0):
         if hand_jacobian is None:
@@ -240,11 +314,9 @@ def check_load_certificate(
                 f"hand_jacobian has {J.shape[1]} columns but the certificate has "
                 f"{eta.size} joint multipliers"
             )
-    rho = np.asarray(cert.normal_multipliers, dtype=float)
-    if np.any(rho < 0.0) or cert.squeeze_multiplier < 0.0:
-        return CertificateCheck(
-            False, math.inf, 0.0, tol, "a bound's multiplier is negative"
-        )
+    why = _impossible(cert)
+    if why is not None:
+        return CertificateCheck(False, math.inf, 0.0, tol, f"nothing is proven: {why}")
     power = -float(y @ w)
     budget = _budget(cert)
     if not (power > 0.0 and math.isfinite(budget)):

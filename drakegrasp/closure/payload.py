@@ -40,6 +40,7 @@ from drakegrasp.closure.load_problem import (
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import SolverError
 
 __all__ = ["ALPHA_CAP", "MaxLoadResult", "build_max_load_program", "max_load"]
@@ -216,6 +217,7 @@ def max_load(
         The program (always feasible: ``α = 0``, ``f = 0``) was not solved.
     """
     d = check_direction(grasp, direction)
+    certify = check_flag("certify", certify)
     prog, x, alpha, P, (F0, unit) = build_max_load_program(
         grasp,
         d,
