@@ -17,6 +17,7 @@ import numpy as np
 
 from drakegrasp.core.validation import (
     LENGTH_BOUND,
+    LENGTH_MIN,
     POSITION_BOUND,
     check_coefficient,
     check_coefficient_array,
@@ -185,10 +186,10 @@ def _characteristic_lengths(value, K: int):
             ),
             (sl.stop - sl.start,),
         )
-        bad = ~(b > 0.0) | ~(b <= LENGTH_BOUND)
+        bad = ~(b >= LENGTH_MIN) | ~(b <= LENGTH_BOUND)
         _refuse_grasp(
             bad, b, sl.start, "characteristic length",
-            f"finite and in (0, {LENGTH_BOUND:g}] m",
+            f"finite and in [{LENGTH_MIN:.3g}, {LENGTH_BOUND:g}] m",
         )  # fmt: skip
         return b
 

@@ -15,6 +15,7 @@ from drakegrasp.certificates.kinds import (
     UNRESISTED_WRENCH,
     Witness,
 )
+from drakegrasp.core.validation import safe_norm
 
 __all__ = ["axis_name", "describe_certificate", "screw_point"]
 
@@ -25,7 +26,7 @@ _SMALL = 1e-6
 def axis_name(u: np.ndarray, *, both_signs: bool = False) -> str:
     """``"x"``, ``"−z"``, ``"±y"``... along an axis, else the unit vector."""
     u = np.asarray(u, dtype=float)
-    u = u / np.linalg.norm(u)
+    u = u / safe_norm(u)
     names = "xyz"[: len(u)]
     k = int(np.argmax(np.abs(u)))
     if abs(u[k]) > 1.0 - _SMALL:

@@ -48,6 +48,7 @@ from drakegrasp.certificates.certificate import (
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp, grasp_matrix, invariant_grasp_matrix
 from drakegrasp.core.linalg import left_null_space
+from drakegrasp.core.validation import safe_norm
 
 __all__ = [
     "GraspFrame",
@@ -98,12 +99,12 @@ def _where(grasp: Grasp) -> dict:
 
 def _scale_twist(grasp: Grasp, v: np.ndarray) -> np.ndarray:
     b, d = grasp.characteristic_length, grasp.dim
-    return v / np.linalg.norm(np.concatenate([v[:d], b * v[d:]]))
+    return v / safe_norm(np.concatenate([v[:d], b * v[d:]]))
 
 
 def _scale_wrench(grasp: Grasp, w: np.ndarray) -> np.ndarray:
     b, d = grasp.characteristic_length, grasp.dim
-    return w / np.linalg.norm(np.concatenate([w[:d], w[d:] / b]))
+    return w / safe_norm(np.concatenate([w[:d], w[d:] / b]))
 
 
 def _readable(N: np.ndarray) -> np.ndarray:

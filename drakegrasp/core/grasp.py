@@ -22,6 +22,7 @@ from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deprecation import renamed_keyword, warn_deprecated
 from drakegrasp.core.validation import (
     JACOBIAN_BOUND,
+    LENGTH_MIN,
     check_length,
     check_positions,
     real_array,
@@ -62,7 +63,7 @@ class Grasp:
         ``contacts`` not an iterable of :class:`Contact`, or empty; a
         reference point that is not a real finite ``d``-vector within
         :data:`~drakegrasp.core.validation.POSITION_BOUND`; a characteristic length
-        outside ``(0, 1e30]`` m.
+        outside ``[2.2e-308, 1e30]`` m.
     InvalidContactError
         Mixed planar and spatial contacts, or an item that is not a Contact.
     """
@@ -119,7 +120,7 @@ class Grasp:
         if characteristic_length is None:
             offsets = np.array([c.position for c in contacts]) - p
             b = float(np.max(safe_norm(offsets, axis=-1)))
-            b = b if b > 0.0 else 1.0
+            b = b if b >= LENGTH_MIN else 1.0
         else:
             b = check_length("characteristic_length", characteristic_length)
         object.__setattr__(self, "contacts", contacts)

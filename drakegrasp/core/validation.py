@@ -34,7 +34,9 @@ normals                     real, finite, not all zero; normalised without
                             (256 generators inscribe the Coulomb cone to 0.008 %;
                             10**9 once allocated 7.45 GiB).
 ``angle_tol``               real in [0, :data:`MAX_ANGLE_TOL`] = [0, 0.01] rad.
-lengths (``b``, scales)     real, finite, in (0, :data:`LENGTH_BOUND`] = (0, 1e30].
+lengths (``b``, scales)     real in [:data:`LENGTH_MIN`, :data:`LENGTH_BOUND`]
+                            = [2.2e-308, 1e30] (below, a length is subnormal:
+                            a moment over it overflows).
 hand Jacobian entries       real, finite, ``|J_ij| <=`` :data:`JACOBIAN_BOUND`.
 ==========================  ===================================================
 
@@ -45,7 +47,6 @@ object arrays.
 
 from __future__ import annotations
 
-import math
 import numbers
 import operator
 import sys
@@ -63,6 +64,7 @@ __all__ = [
     "COEFFICIENT_MIN",
     "JACOBIAN_BOUND",
     "LENGTH_BOUND",
+    "LENGTH_MIN",
     "MAX_ANGLE_TOL",
     "MAX_NUM_GENERATORS",
     "POSITION_BOUND",
@@ -117,6 +119,11 @@ MAX_ANGLE_TOL = 1e-2
 
 LENGTH_BOUND = 1e30
 """Largest characteristic length or torque scale (metres)."""
+
+LENGTH_MIN = sys.float_info.min
+"""Smallest characteristic length or torque scale (metres): the smallest normal
+double, 2.2e-308.  Below it ``m / b`` overflows for a moment of 1 N·m, and a
+certificate's direction scaled by ``b`` came out NaN."""
 
 JACOBIAN_BOUND = 1e100
 """Largest absolute entry of a hand Jacobian."""
@@ -400,12 +407,12 @@ def check_angle_tol(value, name: str = "angle_tol") -> float:
 
 
 def check_length(name: str, value, *, error: type = InvalidGraspError) -> float:
-    """A length (metres): real, finite, in ``(0, LENGTH_BOUND]``."""
+    """A length (metres): real, in ``[LENGTH_MIN, LENGTH_BOUND]``."""
     x = real_scalar(name, value, error=error)
-    if not (0.0 < x <= LENGTH_BOUND) or not math.isfinite(x):
+    if not (LENGTH_MIN <= x <= LENGTH_BOUND):
         raise error(
-            f"{name} must be a finite length in (0, {LENGTH_BOUND:g}] metres, got "
-            f"{_describe(value)}"
+            f"{name} must be a finite length in [{LENGTH_MIN:.3g}, "
+            f"{LENGTH_BOUND:g}] metres, got {_describe(value)}"
         )
     return x
 

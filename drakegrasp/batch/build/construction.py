@@ -33,6 +33,7 @@ from drakegrasp.batch.build.kinds import (
 )
 from drakegrasp.core.contact import contact_frames
 from drakegrasp.core.friction_cone import soft_finger_facets, torsion_only_facets
+from drakegrasp.core.validation import LENGTH_MIN, safe_norm
 
 __all__ = [
     "KIND_COMPONENTS",
@@ -90,10 +91,15 @@ def batched_characteristic_lengths(
     Returns
     -------
     b : (K,) float
-        Largest ``‖c_i - p‖``; 1 m when every contact sits at ``p``.
+        Largest ``‖c_i - p‖``; 1 m when every contact sits at ``p`` (below
+        the smallest valid length, ``LENGTH_MIN``).
     """
-    b = np.linalg.norm(positions - reference_points[:, None, :], axis=-1).max(axis=1)
-    return np.where(b > 1e-12, b, 1.0)
+    offsets = positions - reference_points[:, None, :]
+    b = np.linalg.norm(offsets, axis=-1).max(axis=1)
+    tiny = b < 1e-150  # squares may have underflowed: a scaled norm, as Grasp's
+    if np.any(tiny):
+        b[tiny] = safe_norm(offsets[tiny], axis=-1).max(axis=1)
+    return np.where(b >= LENGTH_MIN, b, 1.0)
 
 
 def _wrench_columns(r: np.ndarray, u: np.ndarray) -> np.ndarray:
