@@ -146,9 +146,10 @@ class LoadReport:
     forces : GraspForceResult
         The least-squeeze forces and their joint torques (or the certificate
         that none exist).
-    payload : MaxLoadResult
+    payload : MaxLoadResult or None
         The largest multiple of the load the hand holds (the payload factor
-        ``payload.alpha``; ``>= 1`` when it holds).
+        ``payload.alpha``; ``>= 1`` when it holds); None for a zero load,
+        which has no direction to grow along (and is held with no force).
     torque_limits : (n_h,) float or None
         The limits used, per hand velocity (``inf`` = none).
     torque_limits_source : str
@@ -171,7 +172,7 @@ class LoadReport:
     source: str
     holds: bool
     forces: GraspForceResult
-    payload: MaxLoadResult
+    payload: MaxLoadResult | None
     torque_limits: np.ndarray | None
     torque_limits_source: str
     joint_names: tuple[str, ...]
@@ -203,12 +204,15 @@ class LoadReport:
                 lines.append(f"  joint torques: {tau}")
         elif f.certificate is not None:
             lines.append(f"  why not: {f.certificate}")
-        alpha = self.payload.alpha
-        lines.append(
-            f"  payload factor {alpha:.4g} (largest multiple of the load held)"
-            if math.isfinite(alpha)
-            else "  payload factor unbounded (no limit binds along the load)"
-        )
+        alpha = math.nan if self.payload is None else self.payload.alpha
+        if self.payload is None:
+            lines.append("  payload factor: none (a zero load has no direction)")
+        elif math.isfinite(alpha):
+            lines.append(
+                f"  payload factor {alpha:.4g} (largest multiple of the load held)"
+            )
+        else:
+            lines.append("  payload factor unbounded (no limit binds along the load)")
         lines.append(
             f"  torque limits: {self.torque_limits_source}; first to saturate: "
             f"{self.first_saturating_joint or 'none'}"
@@ -297,9 +301,17 @@ def analyze_load(
     limits, source = _torque_limits(plant, data, torque_limits)
     J = data.hand_jacobian
     forces = grasp_forces(data.grasp, w, hand_jacobian=J, torque_limits=limits)
-    payload = max_load(data.grasp, w, hand_jacobian=J, torque_limits=limits)
+    payload = (
+        max_load(data.grasp, w, hand_jacobian=J, torque_limits=limits)
+        if np.any(w != 0.0)
+        else None
+    )
     names = _joint_names(plant, data.hand_velocity_indices)
-    first = names[payload.saturating_joints[0]] if payload.saturating_joints else None
+    first = (
+        names[payload.saturating_joints[0]]
+        if payload is not None and payload.saturating_joints
+        else None
+    )
     disagreement = friction_disagreement(plant, mu_given, mu_plant)
     warnings = [] if disagreement is None else [disagreement]
     return LoadReport(

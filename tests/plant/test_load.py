@@ -112,3 +112,16 @@ def test_torque_limits_and_friction_read_from_the_models(real_hands):
     else:
         assert f.certificate.check(report.grasp, hand_jacobian=report.J).holds
     json.dumps(report.load.to_dict())
+
+
+def test_a_zero_load_is_held_and_has_no_payload_factor():
+    # A zero wrench was refused with "direction must be a non-zero wrench",
+    # naming an argument of max_load the caller never gave.
+    s = dg.load_scene("three_finger_sphere")
+    r = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load=[0.0] * 6
+    )
+    assert r.load.holds and r.load.payload is None
+    assert r.load.forces.squeeze == pytest.approx(0.0, abs=1e-8)
+    assert "payload factor: none" in str(r.load)
+    assert json.loads(json.dumps(r.to_dict()))["load"]["payload"] is None
