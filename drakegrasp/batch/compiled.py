@@ -12,7 +12,10 @@ numba is a core dependency: the batch kernels
 2. else numba's JIT dispatcher, created on first need (numba itself is
    imported only then), with ``cache=True``: a process compiles each kernel
    once per install and later processes load it from numba's on-disk cache
-   (``NUMBA_CACHE_DIR``, or ``__pycache__`` beside the sources when writable).
+   (``NUMBA_CACHE_DIR`` when set, else numba's user-wide cache folder, e.g.
+   ``~/.cache/numba``; never ``__pycache__`` beside the installed sources,
+   where pip's uninstall left it behind: the leftover ``drakegrasp`` folder
+   then shadowed the next install as an empty namespace package).
 
 Where numba cannot be installed, :data:`AVAILABLE` is False, :func:`njit` is
 a stand-in and the engine takes its numpy route, the reference the compiled
@@ -31,6 +34,7 @@ pays the whole cost up front.
 from __future__ import annotations
 
 import importlib.util
+import os
 import sys
 import threading
 import time
@@ -185,8 +189,41 @@ def _numba():
                 return types.Dispatcher(val.dispatcher)
 
             event.register("numba:compile", _Listener())
+            _cache_outside_the_package()
             _numba_module = numba
         return _numba_module
+
+
+def _cache_outside_the_package() -> None:
+    """Send numba's cache of drakegrasp's kernels to its user-wide folder.
+
+    numba's default puts it in ``__pycache__`` beside the sources when that is
+    writable, i.e. inside ``site-packages`` of a venv, where no uninstall
+    removes it.  A locator placed before numba's in-tree one claims the files
+    of this package (unless ``NUMBA_CACHE_DIR`` is set, which numba honours
+    first); the user's own kernels keep numba's usual places.
+    """
+    try:
+        from numba.core import caching, config
+    except ImportError:  # another numba layout: its default places stay
+        return
+    impl = getattr(caching, "CacheImpl", None)
+    base = getattr(caching, "UserWideCacheLocator", None)
+    if impl is None or base is None or not hasattr(impl, "_locator_classes"):
+        return
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+    class _PackageCacheLocator(base):
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            inside = os.path.abspath(py_file).startswith(package + os.sep)
+            if config.CACHE_DIR or not inside:
+                return None
+            return super().from_function(py_func, py_file)
+
+    classes = impl._locator_classes
+    if not any(c.__name__ == "_PackageCacheLocator" for c in classes):
+        classes.insert(0, _PackageCacheLocator)
 
 
 _KERNELS: list[Kernel] = []

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import drakegrasp as dg
 from drakegrasp.batch import aot, compiled
 from drakegrasp.batch.aot_build import KERNEL_MODULES
 
@@ -114,6 +115,28 @@ def test_the_routes_call_kernels_from_python_only_through_their_entries(monkeypa
         assert any(key.endswith(name) for key in served), (name, served)
     assert "drakegrasp.batch.epsilon.kernel._stack" in served
     assert "drakegrasp.batch.lp.block_kernel._stack" in served
+
+
+def test_read_only_inputs_are_served_by_the_entries(monkeypatch):
+    """Dask hands its workers read-only arrays: they take the entries too.
+
+    ``_normalise`` declared a writable ``P``, so read-only positions took the
+    JIT: numba was imported, compiled for a second and wrote its cache.
+    """
+    _entries()
+    kernels = list(compiled.kernels())
+    for k in kernels:
+        monkeypatch.setattr(k, "_aot", k.dispatcher if k.entry else None)
+        monkeypatch.setattr(k, "jit_calls", 0)
+    rng = np.random.default_rng(5)
+    P = rng.normal(size=(40, 3, 3))
+    N = -P + 0.3 * rng.normal(size=P.shape)
+    R, mu = 0.1 * rng.normal(size=(40, 3)), np.full(40, 0.5)
+    for a in (P, N, R, mu):
+        a.flags.writeable = False
+    dg.batch_force_closure(P, N, mu=mu, reference_points=R, metrics=("epsilon_l1",))
+    dg.batch_epsilon_l1(P, N, mu=mu, reference_points=R)
+    assert {k.key: k.jit_calls for k in kernels if k.jit_calls} == {}
 
 
 # -- the manifest ----------------------------------------------------------------

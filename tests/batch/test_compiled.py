@@ -114,6 +114,38 @@ def test_every_kernel_is_cached_on_disk():
     assert uncached == []
 
 
+def test_the_cache_of_the_package_s_kernels_is_kept_outside_it(monkeypatch):
+    # numba's default writes __pycache__/*.nbi beside the installed sources;
+    # pip's uninstall left them, and the leftover drakegrasp folder shadowed
+    # the next (editable) install as an empty namespace package.
+    from numba.core import caching, config
+
+    from drakegrasp.batch.build import construction_kernel as ck
+
+    compiled._numba()
+    monkeypatch.setattr(config, "CACHE_DIR", "")
+    source = ck._normalise.py_func
+    path = source.__code__.co_filename
+    found = None
+    for cls in caching.CacheImpl._locator_classes:
+        found = cls.from_function(source, path)
+        if found is not None:
+            break
+    package = Path(compiled.__file__).resolve().parents[1]
+    assert type(found).__name__ == "_PackageCacheLocator"
+    assert package not in Path(found.get_cache_path()).resolve().parents
+    # NUMBA_CACHE_DIR still wins, and a user's own kernel keeps numba's rules.
+    monkeypatch.setattr(config, "CACHE_DIR", "/tmp/elsewhere")
+    first = caching.CacheImpl._locator_classes[0]
+    assert first.from_function(source, path) is None
+
+    def user_kernel():
+        return 1
+
+    monkeypatch.setattr(config, "CACHE_DIR", "")
+    assert first.from_function(user_kernel, __file__) is None
+
+
 def test_the_numpy_route_is_announced_once(monkeypatch):
     import drakegrasp.batch.inputs as inputs
 

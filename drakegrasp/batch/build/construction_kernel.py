@@ -35,7 +35,7 @@ __all__ = [
 @njit(
     cache=True,
     error_model="numpy",
-    entry="f8[:, :, ::1], f8[:, :, ::1], f8[::1]",
+    entry="readonly f8[:, :, ::1], f8[:, :, ::1], f8[::1]",
 )
 def _normalise(P, Pn, spread):
     """``Pn = (c_i - c̄) / L`` and ``L`` per grasp, as ``normalised_positions``."""
@@ -113,8 +113,8 @@ def _column3(G, k, m, r0, r1, r2, u0, u1, u2):
     cache=True,
     error_model="numpy",
     entry=(
-        "f8[:, :, ::1], f8[:, :, ::1], f8[:, ::1], i8[::1], "
-        "i8[::1], i8[::1], b1[::1], f8[:, :, ::1]"
+        "readonly f8[:, :, ::1], readonly f8[:, :, ::1], readonly f8[:, ::1], "
+        "i8[::1], i8[::1], i8[::1], b1[::1], f8[:, :, ::1]"
     ),
 )
 def _grasp_stack3(P, Nrm, p, rows, start, component, tangent, G):
@@ -154,8 +154,8 @@ def _grasp_stack3(P, Nrm, p, rows, start, component, tangent, G):
     cache=True,
     error_model="numpy",
     entry=(
-        "f8[:, :, ::1], f8[:, :, ::1], f8[:, ::1], i8[::1], "
-        "i8[::1], i8[::1], f8[:, :, ::1]"
+        "readonly f8[:, :, ::1], readonly f8[:, :, ::1], readonly f8[:, ::1], "
+        "i8[::1], i8[::1], i8[::1], f8[:, :, ::1]"
     ),
 )
 def _grasp_stack2(P, Nrm, p, rows, start, component, G):
@@ -181,7 +181,7 @@ _EPS = 2.0**-52
 @njit(
     cache=True,
     error_model="numpy",
-    entry="f8[:, :, ::1], f8[:, :, ::1], i8[::1], f8, b1[::1]",
+    entry="readonly f8[:, :, ::1], readonly f8[:, :, ::1], i8[::1], f8, b1[::1]",
 )
 def _normal_rank(P, Nrm, rows, rank_tol, out):
     """Whether ``G_n`` (from ``P``, ``p = 0``; w × N, N <= w) has full column rank.
