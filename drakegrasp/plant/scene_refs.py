@@ -253,8 +253,8 @@ def _check_url(
             known = sorted(package_map.GetPackageNames())
             raise SceneError(
                 f"unknown package {name!r} in {url!r} (known packages: {known}); "
-                f"register it with load_scene(..., packages={{{name!r}: DIR}}), "
-                f"`drakegrasp analyze --package {name}=DIR`, or ROS_PACKAGE_PATH"
+                f"register it with load_scene(..., package_map={{{name!r}: DIR}}), "
+                f"`--package {name}=DIR` on the command line, or ROS_PACKAGE_PATH"
             )
         normal = posixpath.normpath(rel) if rel else ""
         if (

@@ -185,6 +185,10 @@ def test_unknown_package_says_how_to_register_it(user_package, monkeypatch):
     with pytest.raises(SceneError, match="unknown package 'mypkg'") as info:
         load_scene(scene)
     assert "--package mypkg=DIR" in str(info.value)
+    # The advice works as written (it once named a keyword load_scene lacks).
+    assert "load_scene(..., package_map={'mypkg': DIR})" in str(info.value)
+    folder, _ = user_package
+    assert load_scene(scene, package_map={"mypkg": folder}) is not None
 
 
 @pytest.mark.parametrize("kind", ["mapping", "directory", "package_map"])
