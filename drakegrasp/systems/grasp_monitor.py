@@ -131,8 +131,9 @@ class GraspMonitor(LeafSystem):
         Compute the Ferrari–Canny ε of force-closure samples (default False),
         with the batch engine's compiled kernel
         (:func:`~drakegrasp.systems.grasp_monitor.epsilon_l1`: about
-        1 ms for 8 contacts; it compiles once per install unless
-        ``drakegrasp warmup`` ran).
+        1 ms for 8 contacts, compiled when the package was installed; an
+        install without those kernels compiles it once, or ``drakegrasp
+        warmup`` does up front).
     holding : HoldingThresholds, optional
         Thresholds of the holding state and the hysteresis (default
         ``HoldingThresholds()``).

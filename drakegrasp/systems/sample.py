@@ -201,9 +201,14 @@ class GraspSample:
             )
             return f"{head}; {grip}"
         yes = {True: "YES", False: "no"}
+        # ε of a force-closure grasp is positive: 0 there means not computed.
+        eps = (
+            "eps not computed"
+            if v["force_closure"] and v["epsilon"] == 0.0
+            else f"eps = {v['epsilon']:.4g}"
+        )
         return (
             f"t = {self.time:.4g} s: {grip}; {int(v['num_contacts'])} contacts, "
             f"force closure {yes[bool(v['force_closure'])]}, form closure "
-            f"{yes[bool(v['form_closure'])]}, d* = {v['d_star']:.4g}, "
-            f"eps = {v['epsilon']:.4g}"
+            f"{yes[bool(v['form_closure'])]}, d* = {v['d_star']:.4g}, {eps}"
         )
