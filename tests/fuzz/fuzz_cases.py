@@ -1406,6 +1406,16 @@ def planning_cases() -> Iterator[Case]:
             "either",
             ranked,
         )
+    # Only a normal's direction counts: any finite length plans as unit normals
+    # (1e200 once overflowed the norm into zero normals, all poses rejected).
+    for scale in (1e200, 1e-310):
+        yield Case(
+            "planning",
+            f"cloud-normals-times-{scale:g}",
+            lambda s=scale: on_cloud(cloud, cloud_normals=-cloud * s),
+            "answer",
+            lambda r: len(r) > 0 and ranked(r),
+        )
 
 
 def all_cases(root: Path | None = None) -> Iterator[Case]:
