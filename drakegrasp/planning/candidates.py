@@ -12,6 +12,7 @@ num_sampled``.
 from __future__ import annotations
 
 import json
+import reprlib
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -25,13 +26,21 @@ from drakegrasp.closure.results import ClosureResult
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import real_array
+from drakegrasp.errors import InvalidGraspError
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
-from drakegrasp.plant.validation import plant_context_of, resolve_body
+from drakegrasp.plant.validation import (
+    check_rigid_transform,
+    plant_context_of,
+    resolve_body,
+    resolve_object_body,
+)
 
 __all__ = [
     "GraspCandidate",
     "GraspCandidates",
+    "check_candidate",
     "closing_order",
     "planning_result",
     "pose_dict",
@@ -166,17 +175,30 @@ class GraspCandidate:
             a hand base welded there is left where the weld puts it).
         context : Context
             The plant's context or its diagram's root context; changed.
-        object_body : RigidBody, optional
-            When given (and free), set to the planned pose ``X_WO`` too.
+        object_body : RigidBody, BodyIndex or str, optional
+            The object body (or its scoped name ``"model::body"``); when given
+            (and free), set to the planned pose ``X_WO`` too.
+
+        Raises
+        ------
+        InvalidGraspError
+            The candidate's ``q_hand`` (its length or a non-finite value),
+            ``X_WH`` or ``X_WO`` is not what Drake can be given
+            (:func:`check_candidate`); the context is unchanged.
+        ModelError, InvalidOptionError
+            ``object_body`` is not a body of the plant.
         """
+        q_hand = check_candidate(self)
         ctx = plant_context_of(plant, context)
+        if object_body is not None:
+            object_body = resolve_object_body(plant, object_body)
         joints = [find_joint(plant, n) for n in self.joint_names]
         base = resolve_body(plant, self.hand_base)
         if base.is_floating_base_body():  # else welded (at X_WH, the caller's word)
             plant.SetFreeBodyPose(ctx, base, self.X_WH)
         q_all = plant.GetPositions(ctx)
-        for j, q in zip(joints, self.q_hand, strict=True):  # one-dof joints
-            q_all[j.position_start()] = float(q)
+        for j, q in zip(joints, q_hand, strict=True):  # one-dof joints
+            q_all[j.position_start()] = q
         plant.SetPositions(ctx, q_all)
         if object_body is not None and object_body.is_floating_base_body():
             plant.SetFreeBodyPose(ctx, object_body, self.X_WO)
@@ -233,6 +255,49 @@ class GraspCandidate:
             f"(squeeze {self.squeeze_needed:.1f} N), score {self.score:.4f}; {shape}, "
             f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
         )
+
+
+def check_candidate(candidate: GraspCandidate) -> np.ndarray:
+    """Check what :meth:`GraspCandidate.apply` gives Drake; return ``q_hand``.
+
+    A planned candidate always passes; one edited or read back from a file may
+    not, and Drake would end the program (``SystemExit``) on a NaN position.
+
+    Parameters
+    ----------
+    candidate : GraspCandidate
+
+    Returns
+    -------
+    (n_h,) float
+        ``q_hand`` as floats, one per joint of ``joint_names``.
+
+    Raises
+    ------
+    InvalidGraspError
+        ``q_hand`` or ``closing_signs`` is not ``len(joint_names)`` finite real
+        numbers, or ``X_WH`` / ``X_WO`` is not a pydrake ``RigidTransform``
+        with a finite translation and a proper rotation
+        (:func:`~drakegrasp.plant.validation.check_rigid_transform`).
+    """
+    names = list(candidate.joint_names)
+    values = {}
+    for field_name in ("q_hand", "closing_signs"):
+        value = getattr(candidate, field_name)
+        a = real_array(field_name, value, error=InvalidGraspError)
+        if a.shape != (len(names),) or not np.all(np.isfinite(a)):
+            raise InvalidGraspError(
+                f"the candidate's {field_name} must be {len(names)} finite "
+                f"numbers, one per closing joint {names}, got {reprlib.repr(value)}"
+            )
+        values[field_name] = a
+    for field_name in ("X_WH", "X_WO"):
+        check_rigid_transform(
+            f"the candidate's {field_name}",
+            getattr(candidate, field_name),
+            error=InvalidGraspError,
+        )
+    return values["q_hand"]
 
 
 @dataclass(frozen=True, eq=False)

@@ -52,8 +52,12 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.planning.candidates import GraspCandidate
-from drakegrasp.plant.validation import resolve_body, resolve_object_body
+from drakegrasp.planning.candidates import GraspCandidate, check_candidate
+from drakegrasp.plant.validation import (
+    check_rigid_transform,
+    resolve_body,
+    resolve_object_body,
+)
 
 __all__ = ["DEFAULT_DIRECTIONS", "ShakeResult", "shake_test"]
 
@@ -256,7 +260,11 @@ def shake_test(
     Raises
     ------
     InvalidOptionError
-        Bad options (non-positive time step or squeeze, a zero direction...).
+        Bad options (non-positive time step or squeeze, a zero direction, an
+        ``X_WO`` that is not a finite rigid pose...).
+    InvalidGraspError
+        The candidate's joint values or poses are not finite or do not match
+        its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`).
     ModelError
         ``add_models`` did not add the candidate's hand base or closing joints.
     """
@@ -271,11 +279,8 @@ def shake_test(
             f"{type(candidate).__name__}"
         )
     if X_WO is not None:
-        if not isinstance(X_WO, RigidTransform):
-            raise InvalidOptionError(
-                f"X_WO must be a pydrake RigidTransform, got {type(X_WO).__name__}"
-            )
-        candidate = replace(candidate, X_WO=X_WO)
+        candidate = replace(candidate, X_WO=check_rigid_transform("X_WO", X_WO))
+    check_candidate(candidate)
     for name, value, low, unit in (
         ("squeeze", squeeze, 0.0, "N"),
         ("stiffness", stiffness, 0.0, "N/m or N·m/rad"),

@@ -30,12 +30,13 @@ import signal
 import tempfile
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import fuzz_oracles as oracle
 import numpy as np
+from pydrake.math import RigidTransform
 from sandbox import SandboxTimeout
 
 import drakegrasp as dg
@@ -121,7 +122,8 @@ def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:
             outcome, detail = "raw exception", f"unclear GraspError message {text!r}"
         else:
             outcome, detail = "clear GraspError", text[:200]
-    except Exception as e:  # noqa: BLE001 - this is what the fuzz counts
+    except (Exception, SystemExit) as e:  # noqa: BLE001 - what the fuzz counts
+        # SystemExit: a failed Drake assertion, which ends a user's program
         outcome, detail = "raw exception", f"{type(e).__name__}: {str(e)[:200]}"
     else:
         if case.expect == "refuse":
@@ -146,7 +148,7 @@ def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:
 
 
 def _short(x) -> str:
-    text = repr(x)
+    text = " ".join(repr(x).split())  # one line (a numpy or pydrake repr)
     return text if len(text) < 160 else text[:157] + "..."
 
 
@@ -1251,9 +1253,22 @@ SHAKE_POOLS = {
     "time_step": [0.0, -1e-3, NAN, 10.0],
     "max_displacement": [-1.0, NAN],
     "max_rotation": [-1.0, NAN],
-    "X_WO": ["x", np.eye(4)],
+    "X_WO": [
+        "x",
+        np.eye(4),
+        RigidTransform([NAN, 0.0, 0.0]),
+        RigidTransform(np.diag([2.0, 2.0, 2.0, 1.0])),
+    ],
 }
 """Hostile values of :func:`drakegrasp.shake_test`'s options, one at a time."""
+
+CANDIDATE_POOLS = {
+    "q_hand": [np.array([NAN, NAN]), np.array([0.01]), np.array([0.01, INF]), "ab"],
+    "closing_signs": [(1.0,), (NAN, 1.0)],
+    "X_WH": [RigidTransform([NAN, 0.0, 0.0]), np.eye(4)],
+    "X_WO": [RigidTransform(np.diag([2.0, 2.0, 2.0, 1.0]))],
+}
+"""Hostile fields of a planned candidate (flat jaw: two closing joints)."""
 
 
 def _shake_cases(scene) -> Iterator[Case]:
@@ -1282,6 +1297,38 @@ def _shake_cases(scene) -> Iterator[Case]:
             lambda m=models, c=candidate: dg.shake_test(m, c),
             "refuse",
         )
+    # An edited or deserialised candidate: refused before Drake sees it.
+    for field, values in CANDIDATE_POOLS.items():
+        for i, value in enumerate(values):
+            edited = replace(best, **{field: value})
+            yield Case(
+                "planning",
+                f"apply {field}={_short(value)}#{i}",
+                lambda c=edited: c.apply(scene.plant, scene.context.Clone()),
+                "refuse",
+            )
+            yield Case(
+                "planning",
+                f"shake {field}={_short(value)}#{i}",
+                lambda c=edited: dg.shake_test(scene.add_models, c),
+                "refuse",
+            )
+    for i, body in enumerate(["box::nope", 3.5, None]):
+        yield Case(
+            "planning",
+            f"apply object_body={_short(body)}#{i}",
+            lambda b=body: best.apply(
+                scene.plant, scene.context.Clone(), object_body=b
+            ),
+            "either" if body is None else "refuse",
+        )
+    # the object body by its scoped name, as every other function takes it
+    yield Case(
+        "planning",
+        "apply object_body='box::box'",
+        lambda: best.apply(scene.plant, scene.context.Clone(), object_body="box::box"),
+        "answer",
+    )
 
 
 def planning_cases() -> Iterator[Case]:

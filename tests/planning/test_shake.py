@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from pydrake.math import RigidTransform
 
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import GraspError, InvalidGraspError, InvalidOptionError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 
 MU = 1.0  # the friction of the models' proximity properties (what Drake simulates)
@@ -136,3 +136,29 @@ def test_bad_options(wsg_scene, kw):
     best = _plan(scene, n=30)[0]
     with pytest.raises(InvalidOptionError):
         shake_test(scene.add_models, best, **kw)
+
+
+@pytest.mark.parametrize(
+    ("edit", "kw", "error"),
+    [
+        ({"q_hand": np.array([np.nan, np.nan])}, {}, InvalidGraspError),
+        ({"q_hand": np.array([0.01])}, {}, InvalidGraspError),
+        ({"closing_signs": (1.0,)}, {}, InvalidGraspError),
+        ({"closing_signs": (np.nan, 1.0)}, {}, InvalidGraspError),
+        ({"X_WH": RigidTransform([np.nan, 0.0, 0.0])}, {}, InvalidGraspError),
+        ({}, {"X_WO": RigidTransform([0.0, np.inf, 0.0])}, InvalidOptionError),
+    ],
+)
+def test_an_edited_candidate_is_refused_before_simulating(own_scene, edit, kw, error):
+    # A NaN q_hand once ended the program (SystemExit from Drake); a short
+    # closing_signs raised a bare ValueError, a NaN one a raw RuntimeError.
+    scene = own_scene()
+    best = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=8, mu=0.5, seed=0, robustness_samples=4,
+    )[0]  # fmt: skip
+    with pytest.raises(error) as info:
+        shake_test(scene.add_models, dataclasses.replace(best, **edit), **kw)
+    assert isinstance(info.value, GraspError)
+    name = next(iter(edit or kw))
+    assert name in str(info.value)
