@@ -377,25 +377,44 @@ class GraspCandidates(Sequence):
         return json.dumps(self.to_dict(), **kwargs)
 
     def table(self) -> dict[str, np.ndarray]:
-        """One row per candidate (columns of equal length), for Parquet or pandas."""
+        """One row per candidate (columns of equal length), for Parquet or pandas.
+
+        An empty result has the same columns, dtypes and widths with zero
+        rows: ``p_WH`` is (0, 3), ``R_WH`` (0, 9) and ``q_hand`` (0, n_h), with
+        n_h the closing joints of the hand in ``settings`` (0 if it names
+        none).
+        """
         rows = self.candidates
+        n = len(rows)
+
+        def column(value, dtype=float) -> np.ndarray:
+            return np.array([value(c) for c in rows], dtype=dtype)
+
         return {
-            "rank_in_result": np.arange(len(rows)),
-            "sample": np.array([c.sample for c in rows], dtype=np.int64),
-            "score": np.array([c.score for c in rows]),
-            "weight_capacity": np.array([c.weight_capacity for c in rows]),
-            "squeeze_needed": np.array([c.squeeze_needed for c in rows]),
-            "torque_needed": np.array([c.torque_needed for c in rows]),
-            "epsilon": np.array([c.epsilon for c in rows]),
-            "robustness": np.array([c.robustness for c in rows]),
-            "is_closure": np.array([c.is_closure for c in rows], dtype=bool),
-            "d_star": np.array([c.d_star for c in rows]),
-            "num_contacts": np.array([c.num_contacts for c in rows], dtype=np.int64),
-            "opening": np.array([c.opening for c in rows]),
-            "p_WH": np.array([c.X_WH.translation() for c in rows]).reshape(-1, 3),
-            "R_WH": np.array([c.X_WH.rotation().matrix() for c in rows]).reshape(-1, 9),
-            "q_hand": np.array([c.q_hand for c in rows]).reshape(len(rows), -1),
+            "rank_in_result": np.arange(n, dtype=np.int64),
+            "sample": column(lambda c: c.sample, np.int64),
+            "score": column(lambda c: c.score),
+            "weight_capacity": column(lambda c: c.weight_capacity),
+            "squeeze_needed": column(lambda c: c.squeeze_needed),
+            "torque_needed": column(lambda c: c.torque_needed),
+            "epsilon": column(lambda c: c.epsilon),
+            "robustness": column(lambda c: c.robustness),
+            "is_closure": column(lambda c: c.is_closure, bool),
+            "d_star": column(lambda c: c.d_star),
+            "num_contacts": column(lambda c: c.num_contacts, np.int64),
+            "opening": column(lambda c: c.opening),
+            # explicit widths: reshape(0, -1) cannot infer them for no rows
+            "p_WH": column(lambda c: c.X_WH.translation()).reshape(n, 3),
+            "R_WH": column(lambda c: c.X_WH.rotation().matrix()).reshape(n, 9),
+            "q_hand": column(lambda c: c.q_hand).reshape(n, self._q_hand_width()),
         }
+
+    def _q_hand_width(self) -> int:
+        """Columns of ``q_hand``: -1 (the candidates'), or for none the hand's."""
+        if self.candidates:
+            return -1
+        hand = self.settings.get("gripper") or self.settings.get("hand") or {}
+        return len(hand.get("joints", ()))
 
     def __str__(self) -> str:
         head = (

@@ -1353,7 +1353,7 @@ def planning_cases() -> Iterator[Case]:
     yield Case("planning", "valid", plan, "answer", ranked)
     yield Case(
         "planning", "zero-candidates", lambda: plan(num_candidates=0), "either",
-        lambda r: len(r) == 0,
+        lambda r: len(r) == 0 and r.table()["p_WH"].shape == (0, 3),
     )  # fmt: skip
     for option, values in PLAN_POOLS.items():
         for i, value in enumerate(values):

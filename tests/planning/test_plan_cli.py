@@ -35,6 +35,20 @@ def test_plan_parquet_round_trip(tmp_path, capsys):
     assert {"p_WH_0", "R_WH_8", "q_hand_1"} <= set(table)
 
 
+@pytest.mark.parametrize("argv", [["--num", "0"], ["--num", "1", "--seed", "3"]])
+def test_plan_parquet_of_an_empty_result(tmp_path, capsys, argv):
+    # an empty result (no samples, or all rejected) is a normal outcome: a
+    # zero-row file with the columns and types of a full one, exit status 0
+    pq = pytest.importorskip("pyarrow.parquet")
+    full, empty = tmp_path / "full.parquet", tmp_path / "empty.parquet"
+    assert main(["plan", "--num", "20", "--out", str(full)]) == 0
+    assert main(["plan", *argv, "--out", str(empty)]) == 0
+    assert "wrote 0 candidates" in capsys.readouterr().out
+    table = pq.read_table(empty)
+    assert table.num_rows == 0
+    assert table.schema == pq.read_table(full).schema
+
+
 def test_plan_mass_scales_the_squeeze_needed(capsys):
     # squeeze_needed is the weight over the weight capacity: linear in the mass
     runs = []

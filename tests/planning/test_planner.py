@@ -260,6 +260,18 @@ def test_zero_candidates_is_empty_with_a_reason(own_scene):
     assert len(result) == 0 and result.reason == "num_candidates is 0"
 
 
+def test_an_empty_result_has_the_columns_of_a_full_one(own_scene):
+    # reshape(0, -1) of the pose and joint columns once raised ValueError
+    scene = own_scene()
+    table = plan(scene, n=8, seed=0, robustness_samples=4).table()
+    empty = plan(scene, n=0).table()
+    assert empty.keys() == table.keys()
+    for name, column in table.items():
+        assert empty[name].dtype == column.dtype, name
+        assert empty[name].shape == (0, *column.shape[1:]), name
+    assert empty["p_WH"].shape == (0, 3) and empty["q_hand"].shape == (0, 2)
+
+
 def test_unreachable_object_gives_an_empty_result_that_says_why(tmp_path, own_scene):
     big = tmp_path / "big.sdf"
     big.write_text(
