@@ -1297,6 +1297,21 @@ def _shake_cases(scene) -> Iterator[Case]:
             lambda m=models, c=candidate: dg.shake_test(m, c),
             "refuse",
         )
+    # Valid directions that once made NaN gravity (a raw RuntimeError from
+    # Drake): a norm that overflows, and a blend from the settling -z to +z.
+    for name, kw in {
+        "shake directions=[[1e308, 1e308, 0]]": {"directions": [[1e308, 1e308, 0]]},
+        "shake directions=[[0, 0, 1]] (opposite -z)": {
+            "directions": [[0.0, 0.0, 1.0]], "seat": 0.0, "settle": 0.0, "blend": 0.2
+        },
+    }.items():  # fmt: skip
+        yield Case(
+            "planning",
+            name,
+            lambda kw=kw: dg.shake_test(scene.add_models, best, phase=0.3, **kw),
+            "answer",
+            lambda r: np.isfinite(r.max_displacement),
+        )
     # An edited or deserialised candidate: refused before Drake sees it.
     for field, values in CANDIDATE_POOLS.items():
         for i, value in enumerate(values):
