@@ -1072,6 +1072,16 @@ def file_cases(root: Path) -> Iterator[Case]:
             "refuse",
             files=(good,),
         )
+    # plan --out follows batch: an existing file is kept unless --overwrite.
+    planned = root / "earlier-plan.parquet"
+    planned.write_bytes(b"earlier plan")
+    yield Case(
+        "files",
+        "cli-plan-out-existing",
+        lambda: _cli(cli, "plan", "--num", "2", "--out", str(planned)),
+        "refuse",
+        files=(planned,),
+    )
 
 
 def _readable(path: Path) -> bool:
