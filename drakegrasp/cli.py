@@ -15,7 +15,7 @@ Usage::
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
                     [--seed S] [--mu M] [--mass KG] [--torque-limit NM]
                     [--package NAME=DIR ...] [--allow-any-file]
-                    [--json | --out FILE.parquet]
+                    [--json | --out FILE.parquet [--overwrite]]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
@@ -57,10 +57,10 @@ Exit status: 0 on success, 1 on an error (one line on stderr, never a
 traceback), 2 for a bad command line (argparse), 130 on Ctrl-C (SIGINT) with
 one line ``drakegrasp: interrupted``, 143 on SIGTERM and 129 on SIGHUP with one
 line ``drakegrasp: terminated by SIGTERM`` (the run unwinds as on Ctrl-C: no
-partial file, scratch folder or worker process is left).  ``batch`` refuses
-an output that is its input or that exists, unless ``--overwrite``; it writes
-atomically (a temporary file renamed into place), so an interrupted run loses
-nothing.
+partial file, scratch folder or worker process is left).  ``batch`` and
+``plan --out`` refuse an output that exists unless ``--overwrite`` (``batch``
+also one that is its input), checked before any work; both write atomically
+(a temporary file renamed into place), so an interrupted run loses nothing.
 Set ``DRAKEGRASP_DEBUG=1`` to see the traceback of an unexpected error.
 """
 
@@ -75,6 +75,7 @@ import sys
 import threading
 import unicodedata
 from collections.abc import Sequence
+from pathlib import Path
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import DEFAULT_TOL
@@ -716,8 +717,19 @@ def _plan_setup(args: argparse.Namespace):
 def _cmd_plan(args: argparse.Namespace) -> int:
     from drakegrasp.planning import plan_grasps
 
-    if args.out is not None and not args.out.endswith(".parquet"):
-        raise InvalidOptionError(f"--out must name a .parquet file, got {args.out!r}")
+    if args.out is not None:
+        from drakegrasp.batch.files.writer import check_output
+
+        if not args.out.endswith(".parquet"):
+            raise InvalidOptionError(
+                f"--out must name a .parquet file, got {args.out!r}"
+            )
+        # before planning: refuse an existing file unless --overwrite, as batch
+        check_output(
+            Path(args.out), (), overwrite=args.overwrite, remedy="pass --overwrite"
+        )
+    elif args.overwrite:
+        raise InvalidOptionError("--overwrite is for --out FILE.parquet")
     plant, context, object_body, hand, options = _plan_setup(args)
     result = plan_grasps(
         plant,
@@ -732,7 +744,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         **options,
     )
     if args.out is not None:
-        _write_plan_parquet(result, args.out)
+        _write_plan_parquet(result, args.out, overwrite=args.overwrite)
     if args.json:
         data = result.to_dict()
         data["candidates"] = data["candidates"][: args.top]
@@ -747,7 +759,15 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     return 0
 
 
-def _write_plan_parquet(result, path: str) -> None:
+def _write_plan_parquet(result, path: str, *, overwrite: bool) -> None:
+    """Write ``result.table()`` to ``path`` atomically, as ``batch`` does.
+
+    A temporary file beside ``path`` is renamed into place
+    (:func:`~drakegrasp.batch.files.writer.placed`): an interrupted run leaves
+    no partial file and any earlier one intact.
+    """
+    from drakegrasp.batch.files.writer import placed
+
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq
@@ -762,7 +782,8 @@ def _write_plan_parquet(result, path: str) -> None:
         else:
             for j in range(values.shape[1]):
                 columns[f"{name}_{j}"] = values[:, j]
-    pq.write_table(pa.table(columns), path)
+    with placed(Path(path), overwrite=overwrite) as tmp:
+        pq.write_table(pa.table(columns), tmp)
 
 
 def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
@@ -824,7 +845,18 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
     plan.add_argument("--progress", action="store_true", help="show a progress bar")
     out = plan.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print JSON")
-    out.add_argument("--out", default=None, help="write every candidate to a .parquet")
+    out.add_argument(
+        "--out",
+        default=None,
+        help="write every candidate to a .parquet (an empty result: zero rows); "
+        "an existing file is refused unless --overwrite",
+    )
+    plan.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="with --out: replace an existing file (default: refuse); it is "
+        "written to a temporary file and renamed into place",
+    )
     plan.set_defaults(func=_cmd_plan)
 
 

@@ -12,6 +12,7 @@ num_sampled``.
 from __future__ import annotations
 
 import json
+import reprlib
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -25,13 +26,21 @@ from drakegrasp.closure.results import ClosureResult
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import real_array
+from drakegrasp.errors import InvalidGraspError
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
-from drakegrasp.plant.validation import plant_context_of, resolve_body
+from drakegrasp.plant.validation import (
+    check_rigid_transform,
+    plant_context_of,
+    resolve_body,
+    resolve_object_body,
+)
 
 __all__ = [
     "GraspCandidate",
     "GraspCandidates",
+    "check_candidate",
     "closing_order",
     "planning_result",
     "pose_dict",
@@ -166,17 +175,30 @@ class GraspCandidate:
             a hand base welded there is left where the weld puts it).
         context : Context
             The plant's context or its diagram's root context; changed.
-        object_body : RigidBody, optional
-            When given (and free), set to the planned pose ``X_WO`` too.
+        object_body : RigidBody, BodyIndex or str, optional
+            The object body (or its scoped name ``"model::body"``); when given
+            (and free), set to the planned pose ``X_WO`` too.
+
+        Raises
+        ------
+        InvalidGraspError
+            The candidate's ``q_hand`` (its length or a non-finite value),
+            ``X_WH`` or ``X_WO`` is not what Drake can be given
+            (:func:`check_candidate`); the context is unchanged.
+        ModelError, InvalidOptionError
+            ``object_body`` is not a body of the plant.
         """
+        q_hand = check_candidate(self)
         ctx = plant_context_of(plant, context)
+        if object_body is not None:
+            object_body = resolve_object_body(plant, object_body)
         joints = [find_joint(plant, n) for n in self.joint_names]
         base = resolve_body(plant, self.hand_base)
         if base.is_floating_base_body():  # else welded (at X_WH, the caller's word)
             plant.SetFreeBodyPose(ctx, base, self.X_WH)
         q_all = plant.GetPositions(ctx)
-        for j, q in zip(joints, self.q_hand, strict=True):  # one-dof joints
-            q_all[j.position_start()] = float(q)
+        for j, q in zip(joints, q_hand, strict=True):  # one-dof joints
+            q_all[j.position_start()] = q
         plant.SetPositions(ctx, q_all)
         if object_body is not None and object_body.is_floating_base_body():
             plant.SetFreeBodyPose(ctx, object_body, self.X_WO)
@@ -233,6 +255,49 @@ class GraspCandidate:
             f"(squeeze {self.squeeze_needed:.1f} N), score {self.score:.4f}; {shape}, "
             f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
         )
+
+
+def check_candidate(candidate: GraspCandidate) -> np.ndarray:
+    """Check what :meth:`GraspCandidate.apply` gives Drake; return ``q_hand``.
+
+    A planned candidate always passes; one edited or read back from a file may
+    not, and Drake would end the program (``SystemExit``) on a NaN position.
+
+    Parameters
+    ----------
+    candidate : GraspCandidate
+
+    Returns
+    -------
+    (n_h,) float
+        ``q_hand`` as floats, one per joint of ``joint_names``.
+
+    Raises
+    ------
+    InvalidGraspError
+        ``q_hand`` or ``closing_signs`` is not ``len(joint_names)`` finite real
+        numbers, or ``X_WH`` / ``X_WO`` is not a pydrake ``RigidTransform``
+        with a finite translation and a proper rotation
+        (:func:`~drakegrasp.plant.validation.check_rigid_transform`).
+    """
+    names = list(candidate.joint_names)
+    values = {}
+    for field_name in ("q_hand", "closing_signs"):
+        value = getattr(candidate, field_name)
+        a = real_array(field_name, value, error=InvalidGraspError)
+        if a.shape != (len(names),) or not np.all(np.isfinite(a)):
+            raise InvalidGraspError(
+                f"the candidate's {field_name} must be {len(names)} finite "
+                f"numbers, one per closing joint {names}, got {reprlib.repr(value)}"
+            )
+        values[field_name] = a
+    for field_name in ("X_WH", "X_WO"):
+        check_rigid_transform(
+            f"the candidate's {field_name}",
+            getattr(candidate, field_name),
+            error=InvalidGraspError,
+        )
+    return values["q_hand"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -312,25 +377,44 @@ class GraspCandidates(Sequence):
         return json.dumps(self.to_dict(), **kwargs)
 
     def table(self) -> dict[str, np.ndarray]:
-        """One row per candidate (columns of equal length), for Parquet or pandas."""
+        """One row per candidate (columns of equal length), for Parquet or pandas.
+
+        An empty result has the same columns, dtypes and widths with zero
+        rows: ``p_WH`` is (0, 3), ``R_WH`` (0, 9) and ``q_hand`` (0, n_h), with
+        n_h the closing joints of the hand in ``settings`` (0 if it names
+        none).
+        """
         rows = self.candidates
+        n = len(rows)
+
+        def column(value, dtype=float) -> np.ndarray:
+            return np.array([value(c) for c in rows], dtype=dtype)
+
         return {
-            "rank_in_result": np.arange(len(rows)),
-            "sample": np.array([c.sample for c in rows], dtype=np.int64),
-            "score": np.array([c.score for c in rows]),
-            "weight_capacity": np.array([c.weight_capacity for c in rows]),
-            "squeeze_needed": np.array([c.squeeze_needed for c in rows]),
-            "torque_needed": np.array([c.torque_needed for c in rows]),
-            "epsilon": np.array([c.epsilon for c in rows]),
-            "robustness": np.array([c.robustness for c in rows]),
-            "is_closure": np.array([c.is_closure for c in rows], dtype=bool),
-            "d_star": np.array([c.d_star for c in rows]),
-            "num_contacts": np.array([c.num_contacts for c in rows], dtype=np.int64),
-            "opening": np.array([c.opening for c in rows]),
-            "p_WH": np.array([c.X_WH.translation() for c in rows]).reshape(-1, 3),
-            "R_WH": np.array([c.X_WH.rotation().matrix() for c in rows]).reshape(-1, 9),
-            "q_hand": np.array([c.q_hand for c in rows]).reshape(len(rows), -1),
+            "rank_in_result": np.arange(n, dtype=np.int64),
+            "sample": column(lambda c: c.sample, np.int64),
+            "score": column(lambda c: c.score),
+            "weight_capacity": column(lambda c: c.weight_capacity),
+            "squeeze_needed": column(lambda c: c.squeeze_needed),
+            "torque_needed": column(lambda c: c.torque_needed),
+            "epsilon": column(lambda c: c.epsilon),
+            "robustness": column(lambda c: c.robustness),
+            "is_closure": column(lambda c: c.is_closure, bool),
+            "d_star": column(lambda c: c.d_star),
+            "num_contacts": column(lambda c: c.num_contacts, np.int64),
+            "opening": column(lambda c: c.opening),
+            # explicit widths: reshape(0, -1) cannot infer them for no rows
+            "p_WH": column(lambda c: c.X_WH.translation()).reshape(n, 3),
+            "R_WH": column(lambda c: c.X_WH.rotation().matrix()).reshape(n, 9),
+            "q_hand": column(lambda c: c.q_hand).reshape(n, self._q_hand_width()),
         }
+
+    def _q_hand_width(self) -> int:
+        """Columns of ``q_hand``: -1 (the candidates'), or for none the hand's."""
+        if self.candidates:
+            return -1
+        hand = self.settings.get("gripper") or self.settings.get("hand") or {}
+        return len(hand.get("joints", ()))
 
     def __str__(self) -> str:
         head = (

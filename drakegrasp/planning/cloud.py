@@ -47,7 +47,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
-from drakegrasp.core.validation import real_array
+from drakegrasp.core.validation import real_array, unit_vectors
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.gripper import ParallelJaw
 from drakegrasp.planning.surface import piece_of_shape
@@ -170,7 +170,9 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     ----------
     point_cloud : pydrake.perception.PointCloud or (M, 3) array
     normals : (M, 3) array, optional
-        Overrides the cloud's; estimated when neither gives them.
+        Overrides the cloud's; estimated when neither gives them.  Only
+        their directions count (any finite length, however large or small);
+        points whose normal is zero or not finite are dropped.
     viewpoint : (3,) array, optional
         Normals are turned towards it (the camera); default away from the
         centroid.
@@ -241,9 +243,13 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
         normals = np.asarray(cloud.normals(), float).T.copy()
         ok = np.all(np.isfinite(normals), axis=1)
         points, normals = points[ok], normals[ok]
-    norm = np.linalg.norm(normals, axis=1)
-    ok = norm > 0
-    points, normals = points[ok], normals[ok] / norm[ok, None]
+    # Only the direction of a normal counts: ``unit_vectors`` divides each by
+    # its largest |component| before its norm, so a normal of any finite
+    # length (1e200 or subnormal) keeps its direction; ``np.linalg.norm``
+    # overflowed to inf there and turned the normal into a zero vector.
+    ok = np.any(normals != 0.0, axis=1)
+    points = points[ok]
+    normals = unit_vectors("cloud_normals", normals[ok], error=InvalidOptionError)
     if len(points) < 3:
         raise InvalidOptionError(
             f"point_cloud has {len(points)} points of {total} with a finite, "

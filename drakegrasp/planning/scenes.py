@@ -24,6 +24,7 @@ from drakegrasp.plant.models import (
     register_models,
     use_local_drake_models,
 )
+from drakegrasp.plant.validation import check_rigid_transform
 
 __all__ = ["WSG_URL", "PlanningScene", "planning_scene"]
 
@@ -74,7 +75,8 @@ def planning_scene(
         The gripper's model (default Drake's WSG-50 with tip spheres); its
         base is left free.
     X_WO : RigidTransform, optional
-        The object's pose (default the identity).
+        The object's pose (default the identity): a finite translation and a
+        proper rotation.
     models_dir : path, optional
         Local ``drake_models`` folder
         (:func:`~drakegrasp.plant.models.use_local_drake_models`).
@@ -83,6 +85,9 @@ def planning_scene(
     ------
     ModelError
         A model that does not load.
+    InvalidOptionError
+        A URL that is not a string or path, or an ``X_WO`` that is not a
+        finite rigid pose.
     """
     for name, url in (("object_url", object_url), ("hand_url", hand_url)):
         if not (
@@ -93,11 +98,7 @@ def planning_scene(
                 f"{name} must be a package:// URL or a file path, got "
                 f"{type(url).__name__} {url!r}"
             )
-    if X_WO is not None and not isinstance(X_WO, RigidTransform):
-        raise InvalidOptionError(
-            f"X_WO must be a pydrake RigidTransform, got {type(X_WO).__name__}"
-        )
-    X_WO = RigidTransform() if X_WO is None else X_WO
+    X_WO = RigidTransform() if X_WO is None else check_rigid_transform("X_WO", X_WO)
 
     def add_models(plant, parser):
         use_local_drake_models(parser, models_dir)

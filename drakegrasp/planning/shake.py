@@ -21,8 +21,11 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
   set to zero) acts on the object only, as an external force at its centre of
   mass, zero while the fingers seat, whose direction is then held for
   ``settle`` seconds along the world's ``−z`` and then turned through
-  ``directions`` (each held for ``phase`` seconds, blended over the first
-  ``blend`` seconds of a phase);
+  ``directions`` (each held for ``phase`` seconds; over the first ``blend``
+  seconds of a phase gravity turns from the previous direction to the next
+  at a constant rate along the great circle through them, about an axis
+  perpendicular to both when they are opposite, so its magnitude stays
+  ``m g``);
 - contact, friction and stiffness are the plant's (point contact, the models'
   proximity properties).
 
@@ -51,9 +54,14 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import unit_vectors
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.planning.candidates import GraspCandidate
-from drakegrasp.plant.validation import resolve_body, resolve_object_body
+from drakegrasp.planning.candidates import GraspCandidate, check_candidate
+from drakegrasp.plant.validation import (
+    check_rigid_transform,
+    resolve_body,
+    resolve_object_body,
+)
 
 __all__ = ["DEFAULT_DIRECTIONS", "ShakeResult", "shake_test"]
 
@@ -69,7 +77,7 @@ DEFAULT_DIRECTIONS = (
     (0.0, 0.0, -1.0),
 )
 """World directions gravity turns through after settling along −z (each
-consecutive pair orthogonal, so a blend never passes through zero)."""
+consecutive pair orthogonal: every blend turns gravity by 90°)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -158,10 +166,42 @@ class _TurnedGravity(LeafSystem):
         output.set_value([force])
 
 
+def _turned(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
+    """Unit vector ``a`` turned towards unit ``b`` by the fraction ``s`` of the angle.
+
+    Along the great circle through both (spherical linear interpolation), at a
+    constant rate; for opposite vectors, about an axis perpendicular to ``a``
+    (the world axis least aligned with ``a``, made perpendicular).  The result
+    is a unit vector for every ``s`` in [0, 1], never the zero vector that a
+    linear blend of opposite vectors passes through.
+    """
+    if s >= 1.0:
+        return b
+    cos = float(np.clip(a @ b, -1.0, 1.0))
+    across = b - cos * a  # b's part perpendicular to a, of length sin(angle)
+    sin = float(np.linalg.norm(across))
+    if sin > 1e-8:
+        u = across / sin
+    elif cos > 0.0:
+        return b  # the same direction
+    else:  # opposite: any perpendicular turns a onto b
+        e = np.zeros(3)
+        e[int(np.argmin(np.abs(a)))] = 1.0
+        u = e - (e @ a) * a
+        u /= np.linalg.norm(u)
+    angle = s * float(np.arctan2(sin, cos))
+    v = np.cos(angle) * a + np.sin(angle) * u
+    return v / np.linalg.norm(v)
+
+
 def _schedule(seat, settle, phase, blend, directions):
-    dirs = [np.array([0.0, 0.0, -1.0])] + [
-        np.asarray(d, float) / np.linalg.norm(d) for d in directions
-    ]
+    """Gravity's unit direction at time t (zero while the fingers seat).
+
+    ``directions`` are unit vectors; from each to the next, gravity turns over
+    ``blend`` seconds along the great circle (:func:`_turned`), so its
+    magnitude stays ``m g`` throughout.
+    """
+    dirs = [np.array([0.0, 0.0, -1.0]), *np.asarray(directions, float)]
 
     def g(t: float) -> np.ndarray:
         if t < seat:
@@ -171,8 +211,7 @@ def _schedule(seat, settle, phase, blend, directions):
             return dirs[0]
         k = min(int((t - settle) // phase), len(dirs) - 2)
         s = min((t - settle - k * phase) / blend, 1.0) if blend > 0 else 1.0
-        v = (1 - s) * dirs[k] + s * dirs[k + 1]
-        return v / np.linalg.norm(v)
+        return _turned(dirs[k], dirs[k + 1], s)
 
     return g
 
@@ -225,10 +264,13 @@ def shake_test(
         the default (the Allegro hand: ``squeeze=0.5, stiffness=20,
         damping=1``; at the defaults Drake's SAP solver diverges).
     directions : sequence of (3,) float, optional
-        World gravity directions after the settling phase along −z.
+        World gravity directions after the settling phase along −z (any
+        finite, non-zero length: only the direction counts; consecutive ones
+        may be opposite).
     settle, phase, blend : float, optional
         Seconds: settling under −z gravity, each direction's hold, the blend
-        between directions.
+        between directions (gravity turns along the great circle from one
+        direction to the next, its magnitude constant).
     seat : float, optional
         Seconds without gravity, before settling, in which the fingers close
         on the object: each is aimed ``squeeze / k`` past where it stands
@@ -256,7 +298,11 @@ def shake_test(
     Raises
     ------
     InvalidOptionError
-        Bad options (non-positive time step or squeeze, a zero direction...).
+        Bad options (non-positive time step or squeeze, a zero direction, an
+        ``X_WO`` that is not a finite rigid pose...).
+    InvalidGraspError
+        The candidate's joint values or poses are not finite or do not match
+        its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`).
     ModelError
         ``add_models`` did not add the candidate's hand base or closing joints.
     """
@@ -271,11 +317,8 @@ def shake_test(
             f"{type(candidate).__name__}"
         )
     if X_WO is not None:
-        if not isinstance(X_WO, RigidTransform):
-            raise InvalidOptionError(
-                f"X_WO must be a pydrake RigidTransform, got {type(X_WO).__name__}"
-            )
-        candidate = replace(candidate, X_WO=X_WO)
+        candidate = replace(candidate, X_WO=check_rigid_transform("X_WO", X_WO))
+    check_candidate(candidate)
     for name, value, low, unit in (
         ("squeeze", squeeze, 0.0, "N"),
         ("stiffness", stiffness, 0.0, "N/m or N·m/rad"),
@@ -315,12 +358,14 @@ def shake_test(
         or dirs.shape[0] == 0
         or dirs.shape[1] != 3
         or not np.all(np.isfinite(dirs))
-        or np.any(np.linalg.norm(dirs, axis=1) == 0)
+        or not np.all(np.any(dirs != 0.0, axis=1))
     ):
         raise InvalidOptionError(
             "directions must be one or more finite non-zero 3-vectors, got "
             f"{directions!r}"
         )
+    # Only their directions count, whatever their length (no overflow).
+    dirs = unit_vectors("directions", dirs, error=InvalidOptionError)
     t0 = time.perf_counter()
     from pydrake.multibody.parsing import Parser
 

@@ -16,8 +16,11 @@ by keyword; every option after it is keyword-only.
 
 from __future__ import annotations
 
+import reprlib
 from collections.abc import Iterable
 
+import numpy as np
+from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context
@@ -26,8 +29,10 @@ from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.errors import InvalidContextError, InvalidOptionError, ModelError
 
 __all__ = [
+    "ROTATION_TOL",
     "HandSpec",
     "check_plant",
+    "check_rigid_transform",
     "hand_bodies",
     "hand_contact_bodies",
     "hand_model_instances",
@@ -41,6 +46,9 @@ __all__ = [
 ]
 
 HandSpec = ModelInstanceIndex | str | Iterable[RigidBody] | None
+
+ROTATION_TOL = 1e-6
+"""Largest entry of ``RᵀR − I`` of a pose's rotation (a proper rotation)."""
 
 _TOPOLOGY = WeakMemo()
 """Per finalized plant: answers that depend on its bodies, welds and instances."""
@@ -78,6 +86,51 @@ def check_plant(plant) -> MultibodyPlant:
             "the plant is not finalized; call plant.Finalize() before analysing it"
         )
     return plant
+
+
+def check_rigid_transform(
+    name: str, X, *, error: type = InvalidOptionError
+) -> RigidTransform:
+    """A pose Drake may be given: a finite translation and a proper rotation.
+
+    pydrake builds a ``RigidTransform`` from NaN or from a scaled matrix
+    without complaint, and Drake then ends the program (``SystemExit``) or
+    fills the state with NaN.
+
+    Parameters
+    ----------
+    name : str
+        Name of the pose, for the message.
+    X : RigidTransform
+    error : type, optional
+        The :class:`~drakegrasp.GraspError` subclass to raise.
+
+    Returns
+    -------
+    RigidTransform
+        ``X`` itself.
+
+    Raises
+    ------
+    GraspError
+        Of type ``error``: ``X`` is not a ``RigidTransform``, or its
+        translation is not finite, or its rotation ``R`` is not proper
+        (``RᵀR = I`` within :data:`ROTATION_TOL`, ``det R = +1``).
+    """
+    if not isinstance(X, RigidTransform):
+        raise error(f"{name} must be a pydrake RigidTransform, got {type(X).__name__}")
+    R = X.rotation().matrix()
+    if not (
+        np.all(np.isfinite(X.translation()))
+        and np.all(np.isfinite(R))
+        and np.max(np.abs(R.T @ R - np.eye(3))) <= ROTATION_TOL
+        and np.linalg.det(R) > 0
+    ):
+        raise error(
+            f"{name} must be a pose with a finite translation and a proper "
+            f"rotation, got {reprlib.repr(X.GetAsMatrix4().tolist())}"
+        )
+    return X
 
 
 def plant_context_of(plant, context) -> Context:

@@ -30,12 +30,13 @@ import signal
 import tempfile
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import fuzz_oracles as oracle
 import numpy as np
+from pydrake.math import RigidTransform
 from sandbox import SandboxTimeout
 
 import drakegrasp as dg
@@ -121,7 +122,8 @@ def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:
             outcome, detail = "raw exception", f"unclear GraspError message {text!r}"
         else:
             outcome, detail = "clear GraspError", text[:200]
-    except Exception as e:  # noqa: BLE001 - this is what the fuzz counts
+    except (Exception, SystemExit) as e:  # noqa: BLE001 - what the fuzz counts
+        # SystemExit: a failed Drake assertion, which ends a user's program
         outcome, detail = "raw exception", f"{type(e).__name__}: {str(e)[:200]}"
     else:
         if case.expect == "refuse":
@@ -146,7 +148,7 @@ def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:
 
 
 def _short(x) -> str:
-    text = repr(x)
+    text = " ".join(repr(x).split())  # one line (a numpy or pydrake repr)
     return text if len(text) < 160 else text[:157] + "..."
 
 
@@ -1070,6 +1072,16 @@ def file_cases(root: Path) -> Iterator[Case]:
             "refuse",
             files=(good,),
         )
+    # plan --out follows batch: an existing file is kept unless --overwrite.
+    planned = root / "earlier-plan.parquet"
+    planned.write_bytes(b"earlier plan")
+    yield Case(
+        "files",
+        "cli-plan-out-existing",
+        lambda: _cli(cli, "plan", "--num", "2", "--out", str(planned)),
+        "refuse",
+        files=(planned,),
+    )
 
 
 def _readable(path: Path) -> bool:
@@ -1251,9 +1263,22 @@ SHAKE_POOLS = {
     "time_step": [0.0, -1e-3, NAN, 10.0],
     "max_displacement": [-1.0, NAN],
     "max_rotation": [-1.0, NAN],
-    "X_WO": ["x", np.eye(4)],
+    "X_WO": [
+        "x",
+        np.eye(4),
+        RigidTransform([NAN, 0.0, 0.0]),
+        RigidTransform(np.diag([2.0, 2.0, 2.0, 1.0])),
+    ],
 }
 """Hostile values of :func:`drakegrasp.shake_test`'s options, one at a time."""
+
+CANDIDATE_POOLS = {
+    "q_hand": [np.array([NAN, NAN]), np.array([0.01]), np.array([0.01, INF]), "ab"],
+    "closing_signs": [(1.0,), (NAN, 1.0)],
+    "X_WH": [RigidTransform([NAN, 0.0, 0.0]), np.eye(4)],
+    "X_WO": [RigidTransform(np.diag([2.0, 2.0, 2.0, 1.0]))],
+}
+"""Hostile fields of a planned candidate (flat jaw: two closing joints)."""
 
 
 def _shake_cases(scene) -> Iterator[Case]:
@@ -1282,6 +1307,53 @@ def _shake_cases(scene) -> Iterator[Case]:
             lambda m=models, c=candidate: dg.shake_test(m, c),
             "refuse",
         )
+    # Valid directions that once made NaN gravity (a raw RuntimeError from
+    # Drake): a norm that overflows, and a blend from the settling -z to +z.
+    for name, kw in {
+        "shake directions=[[1e308, 1e308, 0]]": {"directions": [[1e308, 1e308, 0]]},
+        "shake directions=[[0, 0, 1]] (opposite -z)": {
+            "directions": [[0.0, 0.0, 1.0]], "seat": 0.0, "settle": 0.0, "blend": 0.2
+        },
+    }.items():  # fmt: skip
+        yield Case(
+            "planning",
+            name,
+            lambda kw=kw: dg.shake_test(scene.add_models, best, phase=0.3, **kw),
+            "answer",
+            lambda r: np.isfinite(r.max_displacement),
+        )
+    # An edited or deserialised candidate: refused before Drake sees it.
+    for field, values in CANDIDATE_POOLS.items():
+        for i, value in enumerate(values):
+            edited = replace(best, **{field: value})
+            yield Case(
+                "planning",
+                f"apply {field}={_short(value)}#{i}",
+                lambda c=edited: c.apply(scene.plant, scene.context.Clone()),
+                "refuse",
+            )
+            yield Case(
+                "planning",
+                f"shake {field}={_short(value)}#{i}",
+                lambda c=edited: dg.shake_test(scene.add_models, c),
+                "refuse",
+            )
+    for i, body in enumerate(["box::nope", 3.5, None]):
+        yield Case(
+            "planning",
+            f"apply object_body={_short(body)}#{i}",
+            lambda b=body: best.apply(
+                scene.plant, scene.context.Clone(), object_body=b
+            ),
+            "either" if body is None else "refuse",
+        )
+    # the object body by its scoped name, as every other function takes it
+    yield Case(
+        "planning",
+        "apply object_body='box::box'",
+        lambda: best.apply(scene.plant, scene.context.Clone(), object_body="box::box"),
+        "answer",
+    )
 
 
 def planning_cases() -> Iterator[Case]:
@@ -1306,7 +1378,7 @@ def planning_cases() -> Iterator[Case]:
     yield Case("planning", "valid", plan, "answer", ranked)
     yield Case(
         "planning", "zero-candidates", lambda: plan(num_candidates=0), "either",
-        lambda r: len(r) == 0,
+        lambda r: len(r) == 0 and r.table()["p_WH"].shape == (0, 3),
     )  # fmt: skip
     for option, values in PLAN_POOLS.items():
         for i, value in enumerate(values):
@@ -1405,6 +1477,16 @@ def planning_cases() -> Iterator[Case]:
             lambda p=points, kw=kw: on_cloud(p, **kw),
             "either",
             ranked,
+        )
+    # Only a normal's direction counts: any finite length plans as unit normals
+    # (1e200 once overflowed the norm into zero normals, all poses rejected).
+    for scale in (1e200, 1e-310):
+        yield Case(
+            "planning",
+            f"cloud-normals-times-{scale:g}",
+            lambda s=scale: on_cloud(cloud, cloud_normals=-cloud * s),
+            "answer",
+            lambda r: len(r) > 0 and ranked(r),
         )
 
 

@@ -11,6 +11,7 @@ from pydrake.perception import BaseField, Fields, PointCloud
 from drakegrasp import analyze_grasp
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.cloud import read_cloud
 
 
 @pytest.fixture(scope="module")
@@ -199,3 +200,32 @@ def test_hostile_clouds(scenes):
     far = np.random.default_rng(1).normal(0, 0.3, (500, 3))
     result = _plan(hand_only, far, -far / np.linalg.norm(far, axis=1, keepdims=True))
     assert len(result) == 0 and "rejected" in result.reason
+
+
+@pytest.mark.parametrize(
+    "hand", ["parallel_jaw_flat.sdf", "three_finger_hand.sdf"], ids=["jaw", "three"]
+)
+def test_normals_of_any_finite_length_plan_as_unit_normals(hand):
+    # Only a normal's direction counts: 1e200 overflowed np.linalg.norm into
+    # zero normals (SystemExit from Drake for a multi-finger hand, every pose
+    # silently rejected for a parallel jaw), and a subnormal length is as good.
+    c = np.random.default_rng(5).normal(size=(300, 3))
+    unit = c / np.linalg.norm(c, axis=1, keepdims=True)
+    cloud = 0.035 * unit
+    for scale in (1e200, 1e-310):
+        points, normals, dropped = read_cloud(cloud, unit * scale)
+        assert dropped == 0
+        np.testing.assert_allclose(normals, unit, atol=1e-13)
+    scene = planning_scene(None, hand_url=f"package://drakegrasp/hands/{hand}")
+
+    def plan(scale):
+        return plan_grasps(
+            scene.plant, scene.context, None, hand=scene.hand, num_candidates=6,
+            mu=0.5, seed=0, point_cloud=cloud, cloud_normals=unit * scale,
+            robustness_samples=2,
+        )  # fmt: skip
+
+    results = [plan(scale) for scale in (1.0, 1e200, 1e-310)]
+    assert len(results[0]) > 0
+    for r in results[1:]:
+        assert [c.sample for c in r] == [c.sample for c in results[0]]

@@ -35,6 +35,54 @@ def test_plan_parquet_round_trip(tmp_path, capsys):
     assert {"p_WH_0", "R_WH_8", "q_hand_1"} <= set(table)
 
 
+@pytest.mark.parametrize("argv", [["--num", "0"], ["--num", "1", "--seed", "3"]])
+def test_plan_parquet_of_an_empty_result(tmp_path, capsys, argv):
+    # an empty result (no samples, or all rejected) is a normal outcome: a
+    # zero-row file with the columns and types of a full one, exit status 0
+    pq = pytest.importorskip("pyarrow.parquet")
+    full, empty = tmp_path / "full.parquet", tmp_path / "empty.parquet"
+    assert main(["plan", "--num", "20", "--out", str(full)]) == 0
+    assert main(["plan", *argv, "--out", str(empty)]) == 0
+    assert "wrote 0 candidates" in capsys.readouterr().out
+    table = pq.read_table(empty)
+    assert table.num_rows == 0
+    assert table.schema == pq.read_table(full).schema
+
+
+def test_plan_out_refuses_an_existing_file_unless_overwrite(tmp_path, capsys):
+    # --out once replaced an existing file silently (batch's policy now)
+    pq = pytest.importorskip("pyarrow.parquet")
+    out = tmp_path / "results.parquet"
+    out.write_text("precious results")
+    assert main(["plan", "--num", "5", "--out", str(out)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "exists; pass --overwrite to replace it" in err[0]
+    assert out.read_text() == "precious results"
+    assert main(["plan", "--num", "5", "--out", str(out), "--overwrite"]) == 0
+    assert pq.read_table(out).num_rows == int(capsys.readouterr().out.split()[1])
+    assert [p.name for p in tmp_path.iterdir()] == ["results.parquet"]
+    assert main(["plan", "--num", "5", "--overwrite"]) == 1
+    assert "--overwrite is for --out" in capsys.readouterr().err
+
+
+def test_plan_out_is_written_atomically(tmp_path, capsys, monkeypatch):
+    # a write that fails half-way leaves the earlier file and no partial one
+    pq = pytest.importorskip("pyarrow.parquet")
+    out = tmp_path / "results.parquet"
+    out.write_text("precious results")
+
+    def fail(table, where, **kw):
+        with open(where, "w") as f:
+            f.write("half a file")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(pq, "write_table", fail)
+    assert main(["plan", "--num", "5", "--out", str(out), "--overwrite"]) == 1
+    assert "disk full" in capsys.readouterr().err
+    assert out.read_text() == "precious results"
+    assert [p.name for p in tmp_path.iterdir()] == ["results.parquet"]
+
+
 def test_plan_mass_scales_the_squeeze_needed(capsys):
     # squeeze_needed is the weight over the weight capacity: linear in the mass
     runs = []

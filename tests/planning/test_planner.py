@@ -4,6 +4,7 @@ hostile inputs refused or answered with a reason."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -13,10 +14,11 @@ from hypothesis import strategies as st
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from drakegrasp import analyze_grasp, find_contacts
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.planning import REASONS, plan_grasps, planning_scene
 from drakegrasp.planning.planner import MAX_CANDIDATES
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE
+from drakegrasp.plant.validation import scoped_name
 
 
 def plan(scene, n=120, seed=7, **kw):
@@ -176,6 +178,63 @@ def test_json_and_table(wsg_result):
     assert "grasp candidates" in str(result)
 
 
+@pytest.fixture(scope="module")
+def own_best(own_scene):
+    scene = own_scene()
+    return scene, plan(scene, n=8, seed=0, robustness_samples=4)[0]
+
+
+def test_apply_takes_the_object_body_as_everywhere_else(own_best):
+    scene, best = own_best
+    plant, body = scene.plant, scene.object_body
+    moved = dataclasses.replace(best, X_WO=RigidTransform([0.01, 0.02, 0.03]))
+    for spec in (body, body.index(), scoped_name(plant, body)):
+        ctx = scene.context.Clone()
+        moved.apply(plant, ctx, object_body=spec)
+        X_WO = plant.EvalBodyPoseInWorld(plant.GetMyContextFromRoot(ctx), body)
+        np.testing.assert_allclose(X_WO.translation(), [0.01, 0.02, 0.03])
+    with pytest.raises(ModelError, match="no body named 'box::nope'"):
+        best.apply(plant, scene.context.Clone(), object_body="box::nope")
+    with pytest.raises(InvalidOptionError, match="object_body must be"):
+        best.apply(plant, scene.context.Clone(), object_body=3.5)
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "match"),
+    [
+        ("q_hand", np.array([np.nan, np.nan]), "q_hand must be 2 finite numbers"),
+        ("q_hand", np.array([0.01, np.inf]), "q_hand must be 2 finite numbers"),
+        ("q_hand", np.array([0.01]), "q_hand must be 2 finite numbers"),
+        ("q_hand", "abc", "q_hand must be an array of real numbers"),
+        ("X_WH", RigidTransform([np.nan, 0.0, 0.0]), "X_WH must be a pose"),
+        ("X_WO", RigidTransform(np.diag([2.0, 2.0, 2.0, 1.0])), "X_WO must be a pose"),
+        ("X_WH", np.eye(4), "X_WH must be a pydrake RigidTransform"),
+    ],
+)
+def test_apply_refuses_a_candidate_drake_cannot_take(own_best, field, value, match):
+    # An edited or deserialised candidate: a NaN joint value once reached
+    # plant.SetPositions (SystemExit), a short q_hand a bare ValueError.
+    scene, best = own_best
+    plant = scene.plant
+    ctx = scene.context.Clone()
+    before = plant.GetPositions(plant.GetMyContextFromRoot(ctx)).copy()
+    edited = dataclasses.replace(best, **{field: value})
+    with pytest.raises(InvalidGraspError, match=match):
+        edited.apply(plant, ctx, object_body=scene.object_body)
+    np.testing.assert_array_equal(
+        plant.GetPositions(plant.GetMyContextFromRoot(ctx)), before
+    )
+
+
+def test_planning_scene_refuses_a_pose_drake_cannot_take():
+    with pytest.raises(InvalidOptionError, match="X_WO must be a pose"):
+        planning_scene(
+            "package://drakegrasp/objects/box.sdf",
+            hand_url="package://drakegrasp/hands/parallel_jaw_flat.sdf",
+            X_WO=RigidTransform([np.nan, 0.0, 0.0]),
+        )
+
+
 def test_own_flat_jaw_on_own_objects(own_scene):
     for name in ("box", "hex_prism"):  # flat pads on flat faces: patches of 4+
         result = plan(own_scene(name), n=80)
@@ -199,6 +258,18 @@ def test_bad_num_candidates(own_scene, bad):
 def test_zero_candidates_is_empty_with_a_reason(own_scene):
     result = plan(own_scene(), n=0)
     assert len(result) == 0 and result.reason == "num_candidates is 0"
+
+
+def test_an_empty_result_has_the_columns_of_a_full_one(own_scene):
+    # reshape(0, -1) of the pose and joint columns once raised ValueError
+    scene = own_scene()
+    table = plan(scene, n=8, seed=0, robustness_samples=4).table()
+    empty = plan(scene, n=0).table()
+    assert empty.keys() == table.keys()
+    for name, column in table.items():
+        assert empty[name].dtype == column.dtype, name
+        assert empty[name].shape == (0, *column.shape[1:]), name
+    assert empty["p_WH"].shape == (0, 3) and empty["q_hand"].shape == (0, 2)
 
 
 def test_unreachable_object_gives_an_empty_result_that_says_why(tmp_path, own_scene):

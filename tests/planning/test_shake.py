@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 from pydrake.math import RigidTransform
 
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import GraspError, InvalidGraspError, InvalidOptionError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.shake import DEFAULT_DIRECTIONS, _schedule
 
 MU = 1.0  # the friction of the models' proximity properties (what Drake simulates)
 MARGIN = 1.2  # the squeeze tried: 1.2 x what the planner says its top ones need
@@ -136,3 +137,75 @@ def test_bad_options(wsg_scene, kw):
     best = _plan(scene, n=30)[0]
     with pytest.raises(InvalidOptionError):
         shake_test(scene.add_models, best, **kw)
+
+
+@pytest.mark.parametrize(
+    ("edit", "kw", "error"),
+    [
+        ({"q_hand": np.array([np.nan, np.nan])}, {}, InvalidGraspError),
+        ({"q_hand": np.array([0.01])}, {}, InvalidGraspError),
+        ({"closing_signs": (1.0,)}, {}, InvalidGraspError),
+        ({"closing_signs": (np.nan, 1.0)}, {}, InvalidGraspError),
+        ({"X_WH": RigidTransform([np.nan, 0.0, 0.0])}, {}, InvalidGraspError),
+        ({}, {"X_WO": RigidTransform([0.0, np.inf, 0.0])}, InvalidOptionError),
+    ],
+)
+def test_an_edited_candidate_is_refused_before_simulating(own_scene, edit, kw, error):
+    # A NaN q_hand once ended the program (SystemExit from Drake); a short
+    # closing_signs raised a bare ValueError, a NaN one a raw RuntimeError.
+    scene = own_scene()
+    best = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=8, mu=0.5, seed=0, robustness_samples=4,
+    )[0]  # fmt: skip
+    with pytest.raises(error) as info:
+        shake_test(scene.add_models, dataclasses.replace(best, **edit), **kw)
+    assert isinstance(info.value, GraspError)
+    name = next(iter(edit or kw))
+    assert name in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "directions",
+    [
+        DEFAULT_DIRECTIONS,
+        [(0.0, 0.0, 1.0)],  # opposite to the settling gravity -z
+        [(1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (1e308, 1e308, 0.0)],
+        [(0.0, 1e-300, -1.0), (1e-320, 0.0, 0.0)],  # nearly -z; subnormal
+    ],
+)
+def test_gravity_turns_at_constant_magnitude(directions):
+    # A linear blend of opposite directions passed through zero (NaN force),
+    # and a norm that overflowed made NaN directions: Drake's raw RuntimeError.
+    unit = [np.asarray(d, float) / max(map(abs, d)) for d in directions]
+    unit = [u / np.linalg.norm(u) for u in unit]
+    g = _schedule(0.0, 0.1, 0.4, 0.2, np.array(unit))
+    t = np.arange(0.0, 0.1 + 0.4 * len(unit), 1e-3)
+    v = np.array([g(x) for x in t])
+    np.testing.assert_allclose(np.linalg.norm(v, axis=1), 1.0, rtol=1e-12)
+    steps = np.arccos(np.clip(np.sum(v[1:] * v[:-1], axis=1), -1.0, 1.0))
+    assert steps.max() <= np.pi / 0.2 * 1e-3 * (1 + 1e-6)  # constant rate, no jump
+    for k, u in enumerate(unit):  # each direction is held once its blend is over
+        np.testing.assert_allclose(g(0.1 + 0.4 * k + 0.3), u, atol=1e-15)
+    if directions is DEFAULT_DIRECTIONS:  # the same arcs as before, halfway too
+        mid = g(0.1 + 0.1)
+        np.testing.assert_allclose(mid, np.array([1.0, 0.0, -1.0]) / np.sqrt(2))
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"directions": [[1e308, 1e308, 0.0]]},
+        {"directions": [[0.0, 0.0, 1.0]], "seat": 0.0, "settle": 0.0, "blend": 0.2},
+    ],
+)
+def test_directions_that_once_made_nan_gravity_are_simulated(own_scene, kw):
+    scene = own_scene()
+    best = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=8, mu=0.5, seed=0, robustness_samples=4,
+    )[0]  # fmt: skip
+    result = shake_test(scene.add_models, best, phase=0.3, **kw)
+    d = np.asarray(kw["directions"][0]) / np.max(np.abs(kw["directions"][0]))
+    np.testing.assert_allclose(result.phases[-1]["direction"], d / np.linalg.norm(d))
+    assert np.isfinite(result.max_displacement)

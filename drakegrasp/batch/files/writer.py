@@ -124,9 +124,17 @@ def format_of(path: str | os.PathLike, fmt: str | None = None) -> str:
 
 
 def check_output(
-    output: Path, inputs: Sequence[Path], *, overwrite: bool
+    output: Path,
+    inputs: Sequence[Path],
+    *,
+    overwrite: bool,
+    remedy: str = "pass overwrite=True (drakegrasp batch --overwrite)",
 ) -> tuple[Path, str]:
-    """Refuse an output that is an input or exists (unless overwrite); its suffix."""
+    """Refuse an output that is an input or exists (unless overwrite); its suffix.
+
+    ``remedy`` completes the message that refuses an existing output ("...
+    exists; {remedy} to replace it"): the caller's own way to allow it.
+    """
     suffix = output.suffix.lower()
     if suffix not in (".npz", ".parquet"):
         raise BatchFileError(
@@ -146,8 +154,7 @@ def check_output(
         raise BatchFileError(f"output {str(output)!r} is a directory, not a file")
     if output.exists() and not overwrite:
         raise BatchFileError(
-            f"output file {str(output)!r} exists; pass overwrite=True "
-            "(drakegrasp batch --overwrite) to replace it"
+            f"output file {str(output)!r} exists; {remedy} to replace it"
         )
     if not output.parent.is_dir():
         raise BatchFileError(f"output directory {str(output.parent)!r} does not exist")
