@@ -949,7 +949,32 @@ def _later(signum: int) -> None:
     timer.start()
 
 
+_HANDLERS_OWNER = {"pid": None}  # the process whose run the handlers unwind
+
+
+def _in_forked_child(signum: int) -> bool:
+    """Handle ``signum`` as a pool worker would, if this is a forked child.
+
+    A fork copies the handlers, and a worker resets them only once it runs its
+    initialiser.  A signal to the whole group can land before that, even in the
+    fork's own hooks, where starting the deferral's timer thread raced
+    ``threading``'s after-fork reset (a ``KeyError`` traceback on stderr).  So
+    a child never defers: SIGTERM ends it at once, as its default does, and
+    SIGHUP and Ctrl-C are left to the parent, as the worker's initialiser does.
+    """
+    if _HANDLERS_OWNER["pid"] in (None, os.getpid()):
+        return False
+    if signum == signal.SIGTERM:
+        signal.signal(signum, signal.SIG_DFL)
+        os.kill(os.getpid(), signum)
+    else:
+        signal.signal(signum, signal.SIG_IGN)
+    return True
+
+
 def _raise_terminated(signum: int, frame) -> None:
+    if _in_forked_child(signum):
+        return
     if _importing(frame):
         _later(signum)
         return
@@ -961,6 +986,8 @@ def _raise_terminated(signum: int, frame) -> None:
 
 def _raise_interrupt(signum: int, frame) -> None:
     """Ctrl-C as Python's own handler, deferred while an import runs."""
+    if _in_forked_child(signum):
+        return
     if _importing(frame):
         _later(signum)
         return
@@ -983,6 +1010,7 @@ def _terminable():
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _HANDLERS_OWNER["pid"] = os.getpid()
     previous = {sig: signal.signal(sig, _raise_terminated) for sig in _TERMINATING}
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
         previous[signal.SIGINT] = signal.signal(signal.SIGINT, _raise_interrupt)

@@ -236,6 +236,51 @@ def test_a_signal_during_an_import_or_a_fork_lands_after_it(tmp_path, where):
     assert "Exception ignored" not in proc.stderr and "Traceback" not in proc.stderr
 
 
+_CHILD = """
+import os, signal, sys, threading, time
+import multiprocessing
+from drakegrasp.cli import _terminable
+
+sig = getattr(signal, sys.argv[1])
+
+
+def target():
+    time.sleep(0.3)  # a deferred signal would land here
+    sys.exit(threading.active_count())  # 1: no deferral thread was started
+
+
+with _terminable():
+    # the signal reaches the child in the fork's hooks, before any initialiser
+    os.register_at_fork(after_in_child=lambda: os.kill(os.getpid(), sig))
+    p = multiprocessing.get_context("fork").Process(target=target)
+    p.start()
+    p.join()
+    print(p.exitcode)
+"""
+
+
+@linux_only
+@pytest.mark.parametrize(
+    ("sig", "exitcode"),
+    [("SIGTERM", -signal.SIGTERM), ("SIGHUP", 1), ("SIGINT", 1)],
+)
+def test_a_forked_child_signalled_in_its_fork_hooks_does_not_defer(sig, exitcode):
+    # A group signal reached a pool worker before its initialiser reset the
+    # handlers it inherited: the deferral's timer thread raced threading's
+    # after-fork reset and printed a KeyError traceback into the command's
+    # one-line stderr.  A child now never defers: SIGTERM ends it, as by
+    # default; SIGHUP and Ctrl-C are left to the parent, as in a worker.
+    proc = subprocess.run(
+        [sys.executable, "-c", _CHILD, sig],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=60,
+    )
+    assert proc.stdout.strip() == str(exitcode), proc.stdout + proc.stderr
+    assert proc.stderr == ""
+
+
 _ABNORMAL = """
 import os, sys
 import numpy as np
