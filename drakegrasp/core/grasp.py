@@ -56,6 +56,9 @@ class Grasp:
         Length ``b`` > 0 (metres) that turns moments into forces in soft-finger
         cones and quality metrics.  Default: the largest distance from ``p`` to a
         contact (1 m if every contact is at ``p``), computed without overflow.
+        The default follows ``p``, and a soft finger's torsion limit
+        ``b ν f_n`` with it: pass a length to compare soft-finger answers about
+        different reference points.
 
     Raises
     ------

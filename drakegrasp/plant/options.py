@@ -59,7 +59,8 @@ OPTION_HELP = {
     "distance_tolerance": "signed distance below which a pair touches (metres)",
     "plane": "planar analysis in this plane of the object frame (xy, yz or zx)",
     "characteristic_length": "length b that makes moments comparable with "
-    "forces (metres)",
+    "forces and sets a soft finger's torsion limit b nu f_n (metres; default: "
+    "the farthest contact from the reference point)",
     "num_generators": "generators of each polyhedral Coulomb cone",
     "tol": "threshold on d*: closure needs d* > tol",
     "allow_penetration": "analyse a penetrating pose anyway (contacts still "
@@ -95,7 +96,9 @@ class AnalysisOptions:
     plane : {"xy", "yz", "zx"} or None
         Planar analysis in this plane of the object frame O.
     characteristic_length : float or None
-        Length ``b`` (metres) scaling moments; None: from the contacts.
+        Length ``b`` (metres) scaling moments and setting a soft finger's
+        torsion limit ``b ν f_n``; None: the farthest contact from the reference
+        point (the object's origin), so it moves with that point.
     num_generators : int
         Generators of each polyhedral Coulomb cone (default 8).
     tol : float

@@ -359,6 +359,33 @@ def test_invariant_to_reference_point_and_units(seed, helpers):
         assert mm.squeeze == pytest.approx(base.squeeze, rel=1e-5, abs=1e-8)
 
 
+@given(seed=seeds, far=st.sampled_from([0.0, 0.5, 3.0]))
+@SETTINGS
+def test_soft_fingers_invariant_to_reference_point_at_a_fixed_length(
+    seed, far, helpers
+):
+    # A soft finger's torsion limit is b nu f_n: with b held, moving p moves
+    # only the moments; with the default b (the farthest contact from p), b
+    # follows p and so may the answer -- the documented model, not a verdict.
+    rng = np.random.default_rng(seed)
+    g0 = helpers.random_grasp(rng, 3, mu=0.3, model="soft_finger", nu=0.4)
+    g = dg.Grasp(g0.contacts, characteristic_length=0.7)
+    w = np.concatenate([rng.normal(size=3), 0.2 * rng.normal(size=3)])
+    base = dg.grasp_forces(g, w)
+    p = far * rng.normal(size=3)
+    f, m = w[:3], w[3:]
+    moved = dg.grasp_forces(
+        dg.Grasp(g.contacts, reference_point=p, characteristic_length=0.7),
+        np.concatenate([f, m - np.cross(p, f)]),
+    )
+    assert moved.feasible == base.feasible
+    if base.feasible:
+        assert moved.squeeze == pytest.approx(base.squeeze, rel=1e-5, abs=1e-8)
+    default = dg.Grasp(g.contacts, reference_point=p)
+    farthest = max(np.linalg.norm(c.position - p) for c in g.contacts)
+    assert default.characteristic_length == pytest.approx(farthest, rel=1e-12)
+
+
 @given(seed=seeds, factor=st.floats(1.0, 10.0))
 @SETTINGS
 def test_monotone_in_mu_motor_strength_and_load(seed, factor):
