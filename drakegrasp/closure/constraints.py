@@ -64,7 +64,8 @@ def exact_cone_rows(contact, scales: np.ndarray, b: float) -> list[np.ndarray]:
         Its ``mu`` and ``torsional_friction`` (``ν``).
     scales : (3,) or (4,) float
         The contact's entries of ``ConeLayout.scales``: the variables are
-        ``f_i / scales`` (a soft finger's ``m_n = scales[3] x_3``).
+        ``f_i / scales`` (a soft finger's ``m_n = scales[3] x_3``; the
+        tangential entries are 1 except in a friction-scaled load problem).
     b : float
         Characteristic length, metres.
 
@@ -83,6 +84,11 @@ def exact_cone_rows(contact, scales: np.ndarray, b: float) -> list[np.ndarray]:
             A[0, 3] = -sign * mu * scales[3] / (b * contact.torsional_friction)
         A[0, -1] = -np.sqrt(1.0 + mu * mu)
         A[1, 1] = A[2, 2] = 1.0
+        # A tangential variable may be scaled too (``f_t = scales x_t``, see
+        # LoadProblem.friction_scaled): at μ = 1e12 the row is then μ [x_n, x_t]
+        # instead of [μ x_n, x_t], whose x_t coefficient a solver reads as 0.
+        A[1, 1] *= scales[1]
+        A[2, 2] *= scales[2]
         A /= np.hypot(1.0, mu)
         rows.append(A)
     return rows

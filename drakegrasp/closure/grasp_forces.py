@@ -40,6 +40,7 @@ from drakegrasp.certificates.load import LoadCertificate
 from drakegrasp.closure.constraints import add_linear_constraint
 from drakegrasp.closure.force_dual import find_load_certificate
 from drakegrasp.closure.load_problem import (
+    FEASIBILITY_TOL,
     LoadProblem,
     add_balance,
     add_force_constraints,
@@ -286,7 +287,9 @@ def build_grasp_forces_program(
 
 
 def _build(P: LoadProblem, w: np.ndarray, objective: str, *, ratio_cap=None):
-    F0 = P.force_scale(w)
+    # Friction-scaled (μ >> 1): tangential forces of the load's size are
+    # μ F0 x_t, so F0 is the load over μ (tangent_scale is 1 otherwise).
+    F0 = P.force_scale(w) / P.tangent_scale
     prog = MathematicalProgram()
     x = prog.NewContinuousVariables(P.num_forces, "f")
     normals = P.layout.normal_positions
@@ -478,7 +481,43 @@ def grasp_forces(
 
 
 def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResult:
-    """Build, solve and read the program of a validated problem."""
+    """Build, solve and read the program of a validated problem.
+
+    The returned forces are re-checked against the cones, the limits and the
+    balance (:meth:`~drakegrasp.closure.load_problem.LoadProblem.violation`).
+    When they fail, the problem is solved again friction-scaled (the cure at
+    ``μ >> 1``); a second failure is a :class:`~drakegrasp.SolverError`, never
+    forces that break a limit reported as feasible.
+    """
+    first = _solve_load(P, w, objective)
+    if _holds(P, w, first):
+        return first
+    Ps = P.friction_scaled()
+    second = None if Ps is P else _solve_load(Ps, w, objective)
+    if second is not None and (not second.feasible or _holds(P, w, second)):
+        # The friction-scaled program's proof of infeasibility is trusted.
+        return second
+    bad = second or first
+    if not bad.feasible:
+        found = f"status {bad.status} without a certificate"
+    else:
+        excess, what = P.violation(bad.stacked_forces(), w)
+        found = f"forces violating the constraints by {excess:.2g} (at {what})"
+    raise SolverError(
+        f"{bad.solver} returned {found} for the load {np.round(w, 9).tolist()}, "
+        "even friction-scaled: the answer is not known to the solvers' accuracy"
+    )
+
+
+def _holds(P: LoadProblem, w: np.ndarray, r: GraspForceResult) -> bool:
+    """A result to trust: an infeasibility proof, or forces that re-check."""
+    if not r.feasible:
+        # A certificate is re-checkable; a bare status at μ >> 1 is not.
+        return r.certificate is not None or P.friction_scaled() is P
+    return P.violation(r.stacked_forces(), w)[0] <= FEASIBILITY_TOL
+
+
+def _solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResult:
     prog, v = _build(P, w, objective)
     result = solve(prog, P.kind, retry=True)
     if result.get_solution_result() != SolutionResult.kSolutionFound:

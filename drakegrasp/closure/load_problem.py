@@ -24,7 +24,12 @@ solver tolerance:
 * torques on the unit columns of ``J``: ``τ̃_j = τ_j / (c_j F0)`` with ``c_j``
   the column norm, against ``τ_max,j / (c_j F0)``;
 * a soft finger's ``m_n`` scaled as in
-  :class:`~drakegrasp.core.friction_cone.ConeLayout`.
+  :class:`~drakegrasp.core.friction_cone.ConeLayout`;
+* the tangential components of a contact with ``μ > FRICTION_SCALING`` in
+  units of ``μ F0`` (:data:`FRICTION_SCALING`): its cone is then
+  ``‖x_t‖ <= x_n``, where written in newtons (``μ = 1e12``) a solver read the
+  ``x_t`` coefficient ``1/μ`` as 0 and returned forces far outside the cone or
+  past the motors' limits.
 
 Only the components a cone allows are variables (a hard finger with ``μ = 0``
 has ``f_n`` alone).
@@ -33,7 +38,7 @@ has ``f_n`` alone).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -51,6 +56,8 @@ from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
     "CONES",
+    "FEASIBILITY_TOL",
+    "FRICTION_SCALING",
     "SATURATION_TOL",
     "LoadProblem",
     "check_direction",
@@ -61,6 +68,18 @@ __all__ = [
 
 SATURATION_TOL = 1e-6
 """A joint saturates when ``|τ_j| >= (1 - SATURATION_TOL) τ_max,j``."""
+
+FRICTION_SCALING = 1e3
+"""A contact with ``μ`` above this has tangential variables ``f_t / (μ F0)``.
+
+Below it (every ordinary coefficient) the programs are those written in
+newtons, so their answers do not move."""
+
+FEASIBILITY_TOL = 1e-6
+"""Relative tolerance of :meth:`LoadProblem.violation` (solvers reach ~1e-8)."""
+
+_SUBNORMAL_SIZE = 1e-280
+"""Sizes (N) below which :meth:`LoadProblem.violation` stops being relative."""
 
 CONES = ("exact", "polyhedral")
 """The cones a load problem may use: exact Coulomb / soft-finger, or inscribed."""
@@ -94,6 +113,10 @@ class LoadProblem:
         Per-contact bounds on ``f_n`` (``inf`` = none).
     max_squeeze : float
         Bound on ``Σ f_n`` (``inf`` = none).
+    tangent_scale : float
+        The largest ``μ`` that scales tangential variables (1 when none is
+        above :data:`FRICTION_SCALING`): the size of a load the contacts hold
+        per unit of normal force.
     """
 
     grasp: Grasp
@@ -108,6 +131,7 @@ class LoadProblem:
     torque_limits: np.ndarray | None
     max_normal_force: np.ndarray
     max_squeeze: float
+    tangent_scale: float = 1.0
 
     @property
     def num_forces(self) -> int:
@@ -172,6 +196,107 @@ class LoadProblem:
         if self.hand_jacobian is None:
             return None
         return self.hand_jacobian.T @ full
+
+    def friction_scaled(self) -> LoadProblem:
+        """The same problem with tangential variables in units of ``μ``.
+
+        Every contact with ``μ > FRICTION_SCALING`` has ``f_t = μ F0 x_t``, so
+        its cone reads ``‖x_t‖ <= x_n``; ``self`` when no contact has.  Use it
+        with a force unit ``F0`` of the load's size over ``tangent_scale``.
+        """
+        big = [c.mu for c in self.grasp.contacts if c.mu > FRICTION_SCALING]
+        if not big:
+            return self
+        layout = self.layout
+        scales = layout.scales.copy()
+        for contact, cone, start in zip(
+            self.grasp.contacts, layout.cones, layout.normal_positions, strict=True
+        ):
+            if contact.mu > FRICTION_SCALING:
+                for j, component in enumerate(cone.components):
+                    if component in (1, 2):
+                        scales[start + j] *= contact.mu
+        return replace(
+            self, layout=replace(layout, scales=scales), tangent_scale=max(big)
+        )
+
+    def violation(self, full: np.ndarray, wrench: np.ndarray) -> tuple[float, str]:
+        """The largest relative violation of the constraints by forces ``full``.
+
+        Each constraint's violation is divided by the size of the terms it
+        sums (``|a|ᵀ|f|`` of its row, or its bound), so the answer does not
+        depend on units or on ``μ``: a solver's answer is of order 1e-8.
+
+        Parameters
+        ----------
+        full : (M,) float
+            Stacked contact forces, N, contact frames.
+        wrench : (D,) float
+            The external wrench they must balance (``G f = -wrench``).
+
+        Returns
+        -------
+        violation : float
+            0 when every constraint holds exactly.
+        what : str
+            The constraint violated most ("balance", "cone 1", "joint 0", ...).
+        """
+        worst = [(0.0, "none")]
+
+        def note(excess, size, what):
+            # Below _SUBNORMAL_SIZE a float keeps too few digits for a
+            # relative test (a 1e-320 N load): measure against that size.
+            excess, size = float(excess), max(float(size), _SUBNORMAL_SIZE)
+            if excess > 0.0:
+                worst.append((excess / size, what))
+
+        Gbar = self.T @ grasp_matrix(self.grasp)
+        Tw = self.T @ wrench
+        terms = np.abs(Gbar) @ np.abs(full) + np.abs(Tw)
+        res = np.abs(Gbar @ full + Tw)
+        note(np.max(res), max(float(np.max(terms)), 1e-300), "balance")
+        # A cone is measured in tangential-force units (μ f_n against ‖f_t‖),
+        # against the larger of its own terms and the problem's force size:
+        # a near-zero force off by 1e-8 N is no violation, and at μ = 1e12 an
+        # ‖f_t‖ of twice μ f_n is one whatever f_n is.
+        ref = max(float(np.max(np.abs(full), initial=0.0)), float(np.max(np.abs(Tw))))
+        b = self.grasp.characteristic_length
+        for i, (contact, sl) in enumerate(
+            zip(self.grasp.contacts, self.grasp.component_slices(), strict=True)
+        ):
+            f = full[sl]
+            note(-f[0], max(np.linalg.norm(f), ref), f"cone {i}")
+            mu = contact.mu
+            if len(f) == 1 or mu == 0.0:
+                continue
+            if self.cones == "polyhedral":
+                cone = self.layout.cones[i]
+                fc = f[list(cone.components)]
+                rows = cone.facets * max(1.0, mu)
+                size = max(float(np.max(np.abs(rows) @ np.abs(fc))), ref)
+                note(np.max(-(rows @ fc)), size, f"cone {i}")
+                continue
+            ft = np.linalg.norm(f[1 : min(len(f), 3)])
+            tors = 0.0
+            if len(f) == 4 and f[3] != 0.0:
+                tors = mu * abs(f[3]) / (b * contact.torsional_friction)
+            # ‖f_t‖ + μ |m_n|/(b ν) <= μ f_n.
+            size = max(ft + tors + mu * abs(f[0]), ref)
+            note(ft + tors - mu * f[0], size, f"cone {i}")
+        if self.torque_limits is not None:
+            tau = self.hand_jacobian.T @ full
+            size = np.abs(self.hand_jacobian.T) @ np.abs(full)
+            for j in self.limited_joints():
+                lim = self.torque_limits[j]
+                note(abs(tau[j]) - lim, max(lim, size[j]), f"joint {j}")
+        fn = full[self.grasp.normal_indices()]
+        for i in self.bounded_contacts():
+            fmax = self.max_normal_force[i]
+            note(fn[i] - fmax, max(fmax, abs(fn[i])), f"contact {i} bound")
+        if math.isfinite(self.max_squeeze):
+            size = max(self.max_squeeze, np.sum(np.abs(fn)))
+            note(np.sum(fn) - self.max_squeeze, size, "squeeze")
+        return max(worst)
 
     def normalised(self, wrench: np.ndarray) -> np.ndarray:
         """``T w``: a wrench about the centroid, moments over the spread."""
@@ -331,21 +456,22 @@ def add_force_constraints(prog, P: LoadProblem, x, force_scale: float, d=None):
     scales = P.layout.scales
     A_tau = P.Jt * scales
     lim = P.limited_joints()
-    if lim.size:
-        bound = P.torque_limits[lim] / (P.jscale[lim] * force_scale)
-        add_linear_constraint(prog, A_tau[lim], -bound, bound, x)
     normals = P.layout.normal_positions
     bounded = P.bounded_contacts()
     upper = np.full(len(normals), np.inf)
-    upper[bounded] = P.max_normal_force[bounded] / force_scale
+    # A limit over a tiny (subnormal) F0 is past the largest float: inf, "no
+    # bound", is its meaning, as forces of that size never reach it.  Dividing
+    # by c_j first keeps c_j F0 from underflowing to 0 (0 / 0 for τ_max = 0).
+    with np.errstate(over="ignore"):
+        if lim.size:
+            bound = (P.torque_limits[lim] / P.jscale[lim]) / force_scale
+            add_linear_constraint(prog, A_tau[lim], -bound, bound, x)
+        upper[bounded] = P.max_normal_force[bounded] / force_scale
+        squeeze = P.max_squeeze / force_scale
     prog.AddBoundingBoxConstraint(np.zeros(len(normals)), upper, x[normals])
-    if math.isfinite(P.max_squeeze):
+    if math.isfinite(squeeze):
         add_linear_constraint(
-            prog,
-            np.ones((1, len(normals))),
-            [-np.inf],
-            [P.max_squeeze / force_scale],
-            x[normals],
+            prog, np.ones((1, len(normals))), [-np.inf], [squeeze], x[normals]
         )
     return A_tau
 

@@ -30,6 +30,7 @@ from drakegrasp._solvers import solve
 from drakegrasp.certificates.load import LoadCertificate
 from drakegrasp.closure.force_dual import find_load_certificate
 from drakegrasp.closure.load_problem import (
+    FEASIBILITY_TOL,
     LoadProblem,
     add_balance,
     add_force_constraints,
@@ -46,7 +47,10 @@ from drakegrasp.errors import SolverError
 __all__ = ["ALPHA_CAP", "MaxLoadResult", "build_max_load_program", "max_load"]
 
 ALPHA_CAP = 1e8
-"""In the program's units, ``α`` is capped here; reaching it reports ``inf``."""
+"""In the program's units, ``α`` is capped here; the dual decides an answer at it."""
+
+_AGREE = 1e-6
+"""Relative gap allowed between the rescaled ``α*`` and its dual bound."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -158,19 +162,72 @@ def build_max_load_program(
     return _build(P, d)
 
 
-def _build(P: LoadProblem, d: np.ndarray):
-    F0 = P.force_scale(None)
+def _build(P: LoadProblem, d: np.ndarray, alpha_unit: float | None = None):
+    """The program; ``α`` in units of ``alpha_unit`` (default ``F0 / size``)."""
     target = P.normalised(d)
     size = float(np.max(np.abs(target)))
+    if alpha_unit is None:
+        F0 = P.force_scale(None)
+        column, unit = target / size, F0 / size
+    else:
+        # Forces in units of the load α_unit d over the largest μ (the forces
+        # of a friction-scaled problem, see LoadProblem.friction_scaled).
+        unit = alpha_unit
+        F0 = unit * size / P.tangent_scale
+        column = target * (P.tangent_scale / size)
     prog = MathematicalProgram()
     x = prog.NewContinuousVariables(P.num_forces, "f")
     alpha = prog.NewContinuousVariables(1, "alpha")[0]
     prog.AddBoundingBoxConstraint(0.0, ALPHA_CAP, alpha)
     prog.AddLinearCost(-1.0 * alpha)
     add_force_constraints(prog, P, x, F0)
-    # Ḡ f + α T d = 0 with f = F0 x and α = (F0 / size) α̃.
-    add_balance(prog, P, x, target / size, alpha=alpha)
-    return prog, x, alpha, P, (F0, F0 / size)
+    # Ḡ f + α T d = 0 with f = F0 x and α = unit α̃.
+    add_balance(prog, P, x, column, alpha=alpha)
+    return prog, x, alpha, P, (F0, unit)
+
+
+def _solved(prog, result, what: str):
+    status = result.get_solution_result()
+    if status != SolutionResult.kSolutionFound:
+        raise SolverError(
+            f"{result.get_solver_id().name()} failed with status {status.name} on "
+            f"the payload program{what} (always feasible with α = 0, f = 0): a "
+            "numerical failure, not a verdict",
+            program=prog,
+            result=result,
+        )
+    return result
+
+
+def _rescaled(P: LoadProblem, d: np.ndarray, alpha_unit: float, bound: float):
+    """Re-solve with ``α`` in units of ``alpha_unit``, friction-scaled.
+
+    For ``μ`` far above 1 the newton-unit program is ill-conditioned (the
+    tangential forces are ``μ`` times the normal ones) and ``α`` may pass
+    :data:`ALPHA_CAP`; here the cones read ``‖x_t‖ <= x_n`` and ``α̃`` is
+    about 1 when ``alpha_unit`` is the dual ``bound``.  The forces are
+    re-checked against every constraint and ``α`` against a finite ``bound``.
+    Returns ``(result, α, forces, capped)``; ``capped``: ``α̃`` at the cap.
+    """
+    Ps = P.friction_scaled()
+    prog, x, alpha, _, (F0, unit) = _build(Ps, d, alpha_unit=alpha_unit)
+    result = _solved(prog, solve(prog, Ps.kind, retry=True), " (rescaled)")
+    a_tilde = max(float(result.GetSolution(alpha)), 0.0)
+    capped = a_tilde >= ALPHA_CAP * (1.0 - 1e-6)
+    a = a_tilde * unit
+    full = Ps.stacked(result.GetSolution(x), F0)
+    excess, what = P.violation(full, a * d)
+    gap = abs(a - bound) if math.isfinite(bound) else 0.0
+    if not capped and (excess > FEASIBILITY_TOL or gap > _AGREE * bound):
+        raise SolverError(
+            f"{result.get_solver_id().name()} found α = {a:.9g} on the rescaled "
+            f"payload program, its dual bound is {bound:.9g}, and the forces "
+            f"violate the constraints by {excess:.2g} (relative, at {what}): the "
+            "payload is not known to the solvers' accuracy",
+            program=prog,
+            result=result,
+        )
+    return result, a, full, capped
 
 
 def max_load(
@@ -186,6 +243,12 @@ def max_load(
     certify: bool = True,
 ) -> MaxLoadResult:
     """The largest ``α`` such that the grasp holds the load ``α · direction``.
+
+    The program is solved with ``α`` capped at :data:`ALPHA_CAP` in its
+    units; an answer at the cap, or any answer with a ``μ`` above
+    :data:`~drakegrasp.closure.load_problem.FRICTION_SCALING`, is settled by
+    the dual: none (no limit binds) is ``α = inf``; a finite bound is
+    re-solved in units of that bound, friction-scaled, and re-checked.
 
     Parameters
     ----------
@@ -228,29 +291,51 @@ def max_load(
         cones=cones,
         num_generators=num_generators,
     )
-    result = solve(prog, P.kind, retry=True)
-    status = result.get_solution_result()
-    if status != SolutionResult.kSolutionFound:
-        raise SolverError(
-            f"{result.get_solver_id().name()} failed with status {status.name} on "
-            "the payload program (always feasible with α = 0, f = 0): a numerical "
-            "failure, not a verdict",
-            program=prog,
-            result=result,
-        )
+    result = _solved(prog, solve(prog, P.kind, retry=True), "")
     a = max(float(result.GetSolution(alpha)), 0.0)
     full = P.stacked(result.GetSolution(x), F0)
-    unbounded = a >= ALPHA_CAP * (1.0 - 1e-6)
-    value = math.inf if unbounded else a * unit
+    capped = a >= ALPHA_CAP * (1.0 - 1e-6)
+    value = a * unit
+    big_mu = P.friction_scaled() is not P
+    cert, bound = None, math.inf
+    if (certify and not capped) or capped or big_mu:
+        # Reaching the cap is no proof of unboundedness (at μ = 1e8 the
+        # payload passes it), nor is a solution at μ >> 1 right: the dual
+        # decides.  No dual direction: no limit binds, α is unbounded.
+        cert, bound = find_load_certificate(P, d, mode="bound", force_scale=F0)
+    unbounded = False
+    if math.isfinite(bound) and (capped or big_mu):
+        if (
+            capped
+            or P.violation(full, value * d)[0] > FEASIBILITY_TOL
+            or (abs(value - bound) > _AGREE * bound)
+        ):
+            result, value, full, _ = _rescaled(P, d, bound, bound)
+    elif capped or big_mu:
+        # No dual found (none exists, or the conic solver missed it at a huge
+        # μ): the primal decides, with a cap ALPHA_CAP times higher.  An α
+        # that reaches that cap too tracks the cap: it is unbounded.
+        result, value, full, unbounded = _rescaled(P, d, unit * ALPHA_CAP, math.inf)
+        if not unbounded:
+            raise SolverError(
+                f"the payload program reached α = {value:.9g} below its cap and "
+                "no dual bound was found: whether the payload is finite is not "
+                "known to the solvers' accuracy (a friction coefficient of "
+                f"{P.friction_scaled().tangent_scale:.3g} is far past what the "
+                "conic solvers resolve)",
+                program=prog,
+                result=result,
+            )
+    if unbounded:
+        value = math.inf
+    if not certify:
+        cert, bound = None, math.inf
     tau = P.joint_torques(full)
     sat, _ = saturating_joints(tau, P.torque_limits)
     normals = P.grasp.normal_indices()
     fn = full[normals]
     fmax = P.max_normal_force
     at = np.flatnonzero(np.isfinite(fmax) & (fn >= fmax * (1 - 1e-6)) & (fmax > 0))
-    cert, bound = None, math.inf
-    if certify and not unbounded:
-        cert, bound = find_load_certificate(P, d, mode="bound", force_scale=F0)
     return MaxLoadResult(
         alpha=value,
         direction=d.copy(),
@@ -266,6 +351,6 @@ def max_load(
         solver=result.get_solver_id().name(),
         status="unbounded (no limit binds along the direction)"
         if unbounded
-        else status.name,
+        else result.get_solution_result().name,
         certificate=cert,
     )
