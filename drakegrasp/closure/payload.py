@@ -21,7 +21,7 @@ forces, torques and the joints that limit it at ``α*``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from pydrake.solvers import MathematicalProgram, SolutionResult
@@ -230,6 +230,39 @@ def _rescaled(P: LoadProblem, d: np.ndarray, alpha_unit: float, bound: float):
     return result, a, full, capped
 
 
+def _held_without_limits(P: LoadProblem, d: np.ndarray) -> bool:
+    """Whether the grasp provably holds ``d`` with every finite limit at zero.
+
+    These are the limits' recession cone: ``α d`` is held for every ``α``
+    exactly when ``d`` is.  The program is homogeneous, so its ``α̃`` is 0 or
+    :data:`ALPHA_CAP`; it is solved in newtons and friction-scaled (each
+    scaling fails somewhere past ``μ = 1e10``), and "held" needs forces that
+    re-check (:meth:`LoadProblem.violation`): a feasible point is its proof.
+    """
+    finite = np.isfinite
+    zero = replace(
+        P,
+        torque_limits=None
+        if P.torque_limits is None
+        else np.where(finite(P.torque_limits), 0.0, np.inf),
+        max_normal_force=np.where(finite(P.max_normal_force), 0.0, np.inf),
+        max_squeeze=0.0 if math.isfinite(P.max_squeeze) else math.inf,
+    )
+    scaled = zero.friction_scaled()
+    for Q in (zero,) if scaled is zero else (zero, scaled):
+        prog, x, alpha, _, (F0, unit) = _build(Q, d, alpha_unit=1.0)
+        result = solve(prog, Q.kind, retry=True)
+        if result.get_solution_result() != SolutionResult.kSolutionFound:
+            continue
+        a = float(result.GetSolution(alpha))
+        full = Q.stacked(result.GetSolution(x), F0)
+        if a >= 0.5 * ALPHA_CAP and Q.violation(full, a * unit * d)[0] <= (
+            FEASIBILITY_TOL
+        ):
+            return True
+    return False
+
+
 def max_load(
     grasp: Grasp,
     direction: np.ndarray,
@@ -312,17 +345,17 @@ def max_load(
         ):
             result, value, full, _ = _rescaled(P, d, bound, bound)
     elif capped or big_mu:
-        # No dual found (none exists, or the conic solver missed it at a huge
-        # μ): the primal decides, with a cap ALPHA_CAP times higher.  An α
-        # that reaches that cap too tracks the cap: it is unbounded.
-        result, value, full, unbounded = _rescaled(P, d, unit * ALPHA_CAP, math.inf)
+        # No dual bound: none exists, or the conic solver missed it at a huge
+        # μ.  Unbounded needs its proof (:func:`_held_without_limits`); a
+        # finite answer needs the dual's, so without one it is refused.
+        unbounded = _held_without_limits(P, d)
         if not unbounded:
             raise SolverError(
-                f"the payload program reached α = {value:.9g} below its cap and "
-                "no dual bound was found: whether the payload is finite is not "
-                "known to the solvers' accuracy (a friction coefficient of "
-                f"{P.friction_scaled().tangent_scale:.3g} is far past what the "
-                "conic solvers resolve)",
+                f"the payload program reached α = {value:.9g}, no dual bound was "
+                "found and the load is not held with the limits at zero: the "
+                "payload is not known to the solvers' accuracy (a friction "
+                f"coefficient of {P.friction_scaled().tangent_scale:.3g} is past "
+                "what the conic solvers resolve)",
                 program=prog,
                 result=result,
             )

@@ -135,3 +135,17 @@ def test_a_subnormal_load_computes_no_overflow(helpers, limits):
     assert r.feasible
     assert np.all(np.isfinite(r.joint_torques))
     assert abs(r.joint_torques[0]) <= limits + 1e-300
+
+
+@pytest.mark.parametrize("mu", [0.5, 1e4, 1e8, 1e10, 1e12])
+def test_max_load_without_limits_is_unbounded_at_any_mu(mu):
+    # No limit at all: the payload is 0 or inf.  At mu = 1e12 the friction-
+    # scaled program stopped at 4e15 below its cap, and the fallback first
+    # raised SolverError, then (trusting an infeasible-looking homogeneous
+    # program) reported 4.2e7 -- below the inf it gives at every smaller mu.
+    from drakegrasp.core import examples as ex
+
+    g = ex.equator_fingers(mu=mu)
+    r = dg.max_load(g, [0.0, 0.0, -MG, 0.0, 0.0, 0.0])
+    assert r.alpha == np.inf
+    assert r.status.startswith("unbounded")
