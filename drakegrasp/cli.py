@@ -38,8 +38,10 @@ hand) sampled, filtered, closed and ranked on an object, and prints the best
 scene's name), it plans for the hand and object that the scene's
 ``drakegrasp:`` section names (``hand:``, ``object_body:``), with the scene's
 μ, contact model and tolerance, against everything else the scene holds (a
-table, other objects); the hand's base must be free in the scene (no
-``add_weld`` to the world).  Given an object (a shipped object's name, a model
+table, other objects).  The scene's welds of the hand to the world (which
+place it for ``analyze``, as in every shipped scene) are left out, since plan
+places the hand itself; a planar scene (``plane:``) is refused, as plan samples
+spatial grasps.  Given an object (a shipped object's name, a model
 URL or a file, or a mesh ``.obj`` file, which Drake's parser makes one body
 with the mass of water filling it; default ``box``), it plans for ``--hand`` (a
 model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
@@ -687,31 +689,52 @@ def _plan_setup(args: argparse.Namespace):
     from drakegrasp.planning import planning_scene
 
     if _is_scene(args.object):
-        from drakegrasp.plant.scene import load_scene
+        from drakegrasp.plant.scene import load_scene, read_scene_info, scene_path
 
         if args.hand is not None:
             raise InvalidOptionError(
                 "--hand is for an object; a scene names its own hand (its "
                 "drakegrasp: section's 'hand:')"
             )
+        info = read_scene_info(scene_path(args.object))
+        if info.plane is not None:
+            raise InvalidOptionError(
+                f"scene {info.name!r} is planar (plane: {info.plane}); plan "
+                "samples spatial grasps of a free hand: analyse it with "
+                f"`drakegrasp analyze {info.name}`"
+            )
+        # plan places the hand itself: a weld of the hand to the world, which
+        # places it for analyze, is left out
         scene = load_scene(
             args.object,
             package_map=dict(args.package) or None,
             allow_any_file=args.allow_any_file,
             close=False,
+            free_hand=True,
         )
         info = scene.info
         options = {
-            "mu": info.mu if args.mu is None else args.mu,
             "contact_model": info.contact_model,
             "torsional_friction": info.torsional_friction,
             "distance_tolerance": info.distance_tolerance,
         }
-        return scene.plant, scene.plant_context, scene.object_body, scene.hand, options
-    hand = _plan_hand(args.hand)
-    scene = planning_scene(_plan_url(args.object), hand_url=hand)
-    options = {"mu": 0.5 if args.mu is None else args.mu}
-    return scene.plant, scene.context, scene.object_body, scene.hand, options
+        plant, context, body, hand = (
+            scene.plant, scene.plant_context, scene.object_body, scene.hand
+        )  # fmt: skip
+        default_mu = info.mu
+    else:
+        scene = planning_scene(_plan_url(args.object), hand_url=_plan_hand(args.hand))
+        plant, context, body, hand = (
+            scene.plant, scene.context, scene.object_body, scene.hand
+        )  # fmt: skip
+        options = {}
+        default_mu = PLAN_DEFAULT_MU
+    options["mu"] = default_mu if args.mu is None else args.mu
+    return plant, context, body, hand, options
+
+
+PLAN_DEFAULT_MU = 0.5
+"""``plan``'s friction coefficient for an object when ``--mu`` is not given."""
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
@@ -800,11 +823,14 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         "object",
         nargs="?",
         default="box",
-        help="a scene YAML file (or a shipped scene's name) whose drakegrasp: "
-        "section names the object and the hand (its base free, not welded), or "
-        "a shipped object name (box, cylinder, sphere, hex_prism), a "
-        "package:// URL, a model file or a mesh (.obj: one body with the mass "
-        "of water filling it), planned for --hand (default: box)",
+        help="a scene: a YAML file or a shipped scene's name (`drakegrasp "
+        "scenes`; not a planar one), planned for the hand and object its "
+        "drakegrasp: section names, with its mu, against the rest of it (a weld "
+        "of the hand to the world, which places it for analyze, is left out: "
+        "plan places the hand); or an object: a shipped object name (box, "
+        "cylinder, sphere, hex_prism), a package:// URL, a model file or a mesh "
+        "(.obj: one body with the mass of water filling it), planned for --hand "
+        "(default: box)",
     )
     plan.add_argument(
         "--hand",
@@ -819,7 +845,7 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         "--mu",
         type=_positive_float,
         default=None,
-        help="friction coefficient (default: the scene's, else 0.5)",
+        help=f"friction coefficient (default: the scene's, else {PLAN_DEFAULT_MU})",
     )
     plan.add_argument(
         "--mass",

@@ -1,0 +1,101 @@
+"""``drakegrasp plan`` on a shipped scene.
+
+What its help promises: a shipped scene's name plans for the scene's hand and
+object (the weld that places the hand for ``analyze`` is left out), and a
+planar scene is refused in one line.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from drakegrasp.cli import build_parser, main
+from drakegrasp.plant.scene import list_scenes, load_scene
+
+
+def _help(*command: str) -> str:
+    parser, sub = build_parser()
+    return " ".join(sub.choices[command[0]].format_help().split())
+
+
+def _plan_json(capsys, *argv: str) -> dict:
+    assert main(["plan", *argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+# -- a shipped scene --------------------------------------------------------
+
+
+def test_the_help_names_the_scenes_plan_takes():
+    text = _help("plan")
+    assert "a shipped scene's name" in text
+    assert "not a planar one" in text
+    assert "is left out" in text  # what becomes of the weld that places the hand
+
+
+@pytest.mark.parametrize(
+    "name",
+    sorted(i.name for i in list_scenes() if i.plane is None and i.hand is not None),
+)
+def test_every_spatial_shipped_scene_welds_its_hand_yet_plans(name):
+    """Each spatial shipped scene welds its hand to the world; freed, it plans."""
+    welded = load_scene(name)
+    freed = load_scene(name, free_hand=True)
+    assert welded.plant.num_positions() < freed.plant.num_positions()
+    # the freed hand's base is one free body: what the planner needs
+    plant = freed.plant
+    free = [
+        i
+        for i in plant.GetFloatingBaseBodies()
+        if plant.get_body(i).model_instance() == freed.hand
+    ]
+    assert len(free) == 1
+
+
+def test_a_shipped_scene_plans_with_its_hand_object_and_mu(capsys):
+    data = _plan_json(capsys, "parallel_jaw_flat_box", "--num", "40", "--top", "3")
+    assert data["object_body"] == "box::box" and data["mu"] == 0.5
+    assert data["num_sampled"] == 40
+    assert any(c["is_closure"] for c in data["candidates"])  # flat pads: patches
+    # the same as planning the scene's object for its hand by name
+    same = _plan_json(capsys, "box", "--hand", "flat", "--num", "40", "--top", "3")
+    assert [c["is_closure"] for c in same["candidates"]] == [
+        c["is_closure"] for c in data["candidates"]
+    ]
+
+
+def test_a_planar_shipped_scene_is_refused_in_one_line(capsys):
+    assert main(["plan", "planar_gripper_brick", "--num", "5"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "planar" in err and "drakegrasp analyze planar_gripper_brick" in err
+
+
+def test_a_scene_without_a_welded_hand_keeps_its_welds(tmp_path):
+    """Only welds of the hand's instances to the world are left out."""
+    scene = tmp_path / "s.yaml"
+    scene.write_text(
+        """
+directives:
+- add_model:
+    name: gripper
+    file: package://drakegrasp/hands/parallel_jaw_flat.sdf
+- add_model:
+    name: table
+    file: package://drakegrasp/objects/box.sdf
+- add_weld:
+    parent: world
+    child: table::box
+- add_model:
+    name: box
+    file: package://drakegrasp/objects/box.sdf
+drakegrasp:
+  object_body: box::box
+  hand: gripper
+  mu: 0.5
+"""
+    )
+    kept = load_scene(scene, free_hand=True).plant
+    assert kept.num_positions() == load_scene(scene).plant.num_positions()
