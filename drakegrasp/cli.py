@@ -2,7 +2,7 @@
 
 Usage::
 
-    drakegrasp analyze [SCENE] [--mu M] [--contact-model MODEL]
+    drakegrasp analyze [SCENE] [--mu M|plant] [--contact-model MODEL]
                        [--torsional-friction NU] [--close | --no-close]
                        [--allow-penetration] [--no-check-pose]
                        [--package NAME=DIR ...] [--allow-any-file] [--json]
@@ -13,7 +13,7 @@ Usage::
                      [--overwrite]
     drakegrasp warmup [--json]
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
-                    [--seed S] [--mu M] [--mass KG] [--torque-limit NM]
+                    [--seed S] [--mu M|plant] [--mass KG] [--torque-limit NM]
                     [--package NAME=DIR ...] [--allow-any-file]
                     [--json | --out FILE.parquet [--overwrite]]
 
@@ -46,7 +46,9 @@ URL or a file, or a mesh ``.obj`` file, which Drake's parser makes one body
 with the mass of water filling it; default ``box``), it plans for ``--hand`` (a
 model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
 jaw) in a scene of the two alone; ``--mass`` gives the object's mass and
-``--torque-limit`` the torque a multi-finger hand will apply.
+``--torque-limit`` the torque a multi-finger hand will apply.  ``--mu plant``
+plans with the friction the plant gives the hand's and the object's geometries
+(the smallest, where pairs differ, said on stderr) instead of a number.
 
 One interface: both commands name the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
@@ -729,12 +731,44 @@ def _plan_setup(args: argparse.Namespace):
         )  # fmt: skip
         options = {}
         default_mu = PLAN_DEFAULT_MU
-    options["mu"] = default_mu if args.mu is None else args.mu
+    options["mu"] = (
+        default_mu
+        if args.mu is None
+        else _plant_mu(plant, context, body, hand)
+        if args.mu == "plant"
+        else args.mu
+    )
     return plant, context, body, hand, options
 
 
 PLAN_DEFAULT_MU = 0.5
 """``plan``'s friction coefficient for an object when ``--mu`` is not given."""
+
+
+def _plant_mu(plant, context, object_body, hand) -> float:
+    """``plan --mu plant``: one coefficient from the plant's geometries.
+
+    The planner takes one μ for every contact; the plant gives one per pair of
+    a hand and an object geometry.  Where they differ, the smallest is used (a
+    grasp in force closure with the narrowest cones is one with wider cones
+    too), and a note on stderr says so.
+    """
+    from drakegrasp.plant.friction import friction_rule, hand_object_friction
+
+    values = hand_object_friction(plant, context, object_body, hand)
+    if values.size == 0:
+        raise InvalidOptionError(
+            "--mu plant: the hand or the object has no collision geometry to "
+            "read a friction from; give --mu as a number"
+        )
+    mu = float(values[0])
+    if values[-1] - mu > 1e-6 * max(mu, 1.0):
+        _say(
+            f"drakegrasp: note: --mu plant: the plant's {friction_rule(plant)} "
+            f"friction of hand and object geometries ranges from {mu:g} to "
+            f"{values[-1]:g}; planning with the smallest, {mu:g}"
+        )
+    return mu
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
@@ -843,9 +877,12 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
     plan.add_argument("--seed", type=int, default=0, help="random seed (0)")
     plan.add_argument(
         "--mu",
-        type=_positive_float,
+        type=_mu,
         default=None,
-        help=f"friction coefficient (default: the scene's, else {PLAN_DEFAULT_MU})",
+        help="friction coefficient of every contact, or 'plant': the plant's "
+        "friction of the hand's and the object's geometries (Drake's combined "
+        "coefficient, as analyze --mu plant; the smallest where pairs differ) "
+        f"(default: the scene's, else {PLAN_DEFAULT_MU})",
     )
     plan.add_argument(
         "--mass",

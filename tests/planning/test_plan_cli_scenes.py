@@ -1,8 +1,9 @@
-"""``drakegrasp plan`` on a shipped scene.
+"""``drakegrasp plan`` on a shipped scene, and with ``--mu plant``.
 
 What its help promises: a shipped scene's name plans for the scene's hand and
-object (the weld that places the hand for ``analyze`` is left out), and a
-planar scene is refused in one line.
+object (the weld that places the hand for ``analyze`` is left out), a planar
+scene is refused in one line, and ``--mu plant`` reads the plant's friction as
+``analyze --mu plant`` does.
 """
 
 from __future__ import annotations
@@ -99,3 +100,60 @@ drakegrasp:
     )
     kept = load_scene(scene, free_hand=True).plant
     assert kept.num_positions() == load_scene(scene).plant.num_positions()
+
+
+# -- --mu plant --------------------------------------------------------------
+
+
+def test_mu_plant_is_the_plants_friction(capsys):
+    # Drake's default friction (no material given) is 1 for every geometry
+    for target in (["box"], ["parallel_jaw_box"]):
+        data = _plan_json(capsys, *target, "--mu", "plant", "--num", "10")
+        assert data["mu"] == 1.0
+    assert "'plant'" in _help("plan")
+
+
+_TWO_FRICTIONS = """<?xml version="1.0"?>
+<sdf version="1.9" xmlns:drake="http://drake.mit.edu">
+  <model name="slab">
+    <link name="slab">
+      <inertial><mass>0.2</mass></inertial>
+      <collision name="low">
+        <pose>0 0 -0.02 0 0 0</pose>
+        <geometry><box><size>0.04 0.04 0.04</size></box></geometry>
+        <drake:proximity_properties>
+          <drake:mu_static>0.3</drake:mu_static>
+          <drake:mu_dynamic>0.3</drake:mu_dynamic>
+        </drake:proximity_properties>
+      </collision>
+      <collision name="high">
+        <pose>0 0 0.02 0 0 0</pose>
+        <geometry><box><size>0.04 0.04 0.04</size></box></geometry>
+        <drake:proximity_properties>
+          <drake:mu_static>0.6</drake:mu_static>
+          <drake:mu_dynamic>0.6</drake:mu_dynamic>
+        </drake:proximity_properties>
+      </collision>
+    </link>
+  </model>
+</sdf>
+"""
+
+
+def test_mu_plant_takes_the_smallest_pair_and_says_so(tmp_path, capsys):
+    model = tmp_path / "slab.sdf"
+    model.write_text(_TWO_FRICTIONS)
+    assert main(["plan", str(model), "--mu", "plant", "--num", "10", "--json"]) == 0
+    captured = capsys.readouterr()
+    low, high = 2 * 0.3 / 1.3, 2 * 0.6 / 1.6  # Drake's combination with μ = 1
+    assert json.loads(captured.out)["mu"] == pytest.approx(low)
+    notes = [x for x in captured.err.splitlines() if x.startswith("drakegrasp: note")]
+    assert len(notes) == 1  # (beside any notice of numba compiling)
+    assert f"from {low:g} to {high:g}" in notes[0] and "smallest" in notes[0]
+
+
+def test_mu_still_refuses_a_bad_word(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["plan", "--mu", "plants"])
+    assert exit_.value.code == 2
+    assert "argument --mu" in capsys.readouterr().err
