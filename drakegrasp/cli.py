@@ -14,7 +14,7 @@ Usage::
     drakegrasp warmup [--json]
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
                     [--seed S] [--mu M|plant] [--mass KG] [--torque-limit NM]
-                    [--package NAME=DIR ...] [--allow-any-file]
+                    [--package NAME=DIR ...] [--allow-any-file] [--progress]
                     [--json | --out FILE.parquet [--overwrite]]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
@@ -49,6 +49,9 @@ jaw) in a scene of the two alone; ``--mass`` gives the object's mass and
 ``--torque-limit`` the torque a multi-finger hand will apply.  ``--mu plant``
 plans with the friction the plant gives the hand's and the object's geometries
 (the smallest, where pairs differ, said on stderr) instead of a number.
+``plan --progress`` and ``batch --progress`` need the optional tqdm
+(``pip install "drakegrasp[progress]"``); without it they are refused before
+any work.
 
 One interface: both commands name the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
@@ -253,6 +256,8 @@ def _cmd_batch(args: argparse.Namespace) -> int:
             **options,
         )
     else:
+        if args.progress:
+            _check_progress()
         summary = stream_file(
             args.input, args.output, overwrite=args.overwrite, **options
         )
@@ -771,6 +776,17 @@ def _plant_mu(plant, context, object_body, hand) -> float:
     return mu
 
 
+def _check_progress() -> None:
+    """``--progress`` needs tqdm: refuse it up front, before any work, if missing."""
+    try:
+        import tqdm.auto  # noqa: F401
+    except ImportError:
+        raise InvalidOptionError(
+            "--progress needs the optional package tqdm, which is not installed: "
+            'pip install "drakegrasp[progress]", or leave out --progress'
+        ) from None
+
+
 def _cmd_plan(args: argparse.Namespace) -> int:
     from drakegrasp.planning import plan_grasps
 
@@ -787,6 +803,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         )
     elif args.overwrite:
         raise InvalidOptionError("--overwrite is for --out FILE.parquet")
+    if args.progress:
+        _check_progress()
     plant, context, object_body, hand, options = _plan_setup(args)
     result = plan_grasps(
         plant,
@@ -905,7 +923,11 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         plan,
         package_help="for a scene: resolve package://NAME/... to DIR (repeatable)",
     )
-    plan.add_argument("--progress", action="store_true", help="show a progress bar")
+    plan.add_argument(
+        "--progress",
+        action="store_true",
+        help='show a progress bar (needs: pip install "drakegrasp[progress]")',
+    )
     out = plan.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print JSON")
     out.add_argument(

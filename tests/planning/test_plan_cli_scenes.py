@@ -1,17 +1,20 @@
-"""``drakegrasp plan`` on a shipped scene, and with ``--mu plant``.
+"""``drakegrasp plan`` on a shipped scene, with ``--mu plant`` and ``--progress``.
 
 What its help promises: a shipped scene's name plans for the scene's hand and
 object (the weld that places the hand for ``analyze`` is left out), a planar
-scene is refused in one line, and ``--mu plant`` reads the plant's friction as
-``analyze --mu plant`` does.
+scene is refused in one line, ``--mu plant`` reads the plant's friction as
+``analyze --mu plant`` does, and ``--progress`` without tqdm is refused before
+any work, as ``batch --progress`` is.
 """
 
 from __future__ import annotations
 
 import json
+import sys
 
 import pytest
 
+import drakegrasp.planning
 from drakegrasp.cli import build_parser, main
 from drakegrasp.plant.scene import list_scenes, load_scene
 
@@ -157,3 +160,40 @@ def test_mu_still_refuses_a_bad_word(capsys):
         main(["plan", "--mu", "plants"])
     assert exit_.value.code == 2
     assert "argument --mu" in capsys.readouterr().err
+
+
+# -- --progress without tqdm -------------------------------------------------
+
+
+def test_progress_help_names_the_extra():
+    assert 'pip install "drakegrasp[progress]"' in _help("plan")
+
+
+def test_progress_without_tqdm_is_refused_before_any_work(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "tqdm", None)  # import tqdm fails
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("planned without the progress bar it was asked for")
+
+    monkeypatch.setattr(drakegrasp.planning, "planning_scene", no_work)
+    assert main(["plan", "box", "--num", "5", "--progress"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "--progress needs the optional package tqdm" in err
+    assert 'pip install "drakegrasp[progress]"' in err
+
+
+def test_batch_progress_without_tqdm_says_the_same(monkeypatch, capsys, tmp_path):
+    import numpy as np
+
+    monkeypatch.setitem(sys.modules, "tqdm", None)
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)
+    p = np.random.default_rng(0).normal(size=(4, 3, 3))
+    np.savez(tmp_path / "in.npz", positions=p, normals=-p)
+    out = tmp_path / "out.npz"
+    argv = ["batch", str(tmp_path / "in.npz"), str(out), "--mu", "0.5", "--progress"]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--progress needs the optional package tqdm" in err
+    assert not out.exists()
