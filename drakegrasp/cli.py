@@ -28,9 +28,11 @@ a hint naming ``--allow-penetration`` and ``--no-check-pose``, which analyse
 it anyway.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
 ``positions`` and ``normals`` of shape (K, N, d), optionally ``mu``, ...) with
 the vectorised batch engine and writes the verdicts to another file.
-``warmup`` compiles the batch engine's numba kernels now, where the install did
-not compile them ahead of time (once per install; later processes load them
-from numba's cache), and prints what it compiled and how long each step took.
+``warmup`` runs every route of the batch engine now and prints each step, its
+time and what it compiled: where the install compiled the kernels ahead of time
+(:mod:`drakegrasp.batch.aot`) it loads them and compiles nothing; elsewhere
+numba's JIT compiles them into numba's on-disk cache (once per install; later
+processes load them from there); without numba there is nothing to compile.
 
 ``plan`` finds grasps: a free-floating hand (a parallel jaw or a multi-finger
 hand) sampled, filtered, closed and ranked on an object, and prints the best
@@ -621,10 +623,18 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
 
     warm = sub.add_parser(
         "warmup",
-        help="compile the batch engine's kernels now (once per install)",
-        description="Compile every numba kernel of the batch engine into numba's "
-        "on-disk cache, so that the first batch call of later processes does "
-        "not wait; print each step and its time.",
+        help="get the batch engine's kernels ready now (once per install)",
+        description="Run every route of the batch engine on a few seeded grasps "
+        "and print each step, its time and what it compiled; the first line "
+        "names the route the kernels take.  Where the install compiled the "
+        "kernels ahead of time (for this CPU and these sources), they are "
+        "loaded and nothing is compiled: the run only checks that they serve "
+        "every route, in seconds.  Otherwise (no such kernels, another CPU, "
+        "edited sources, or DRAKEGRASP_KERNELS=jit) numba's JIT compiles every "
+        "kernel into its on-disk cache (NUMBA_CACHE_DIR, else numba's user-wide "
+        "cache), a minute or two, so that the first batch call of later "
+        "processes does not wait.  Without numba there is nothing to compile: "
+        "the engine runs its numpy route.",
     )
     warm.add_argument("--json", action="store_true", help="print the report as JSON")
     warm.set_defaults(func=_cmd_warmup)
