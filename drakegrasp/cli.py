@@ -2,7 +2,7 @@
 
 Usage::
 
-    drakegrasp analyze [SCENE] [--mu M] [--contact-model MODEL]
+    drakegrasp analyze [SCENE] [--mu M|plant] [--contact-model MODEL]
                        [--torsional-friction NU] [--close | --no-close]
                        [--allow-penetration] [--no-check-pose]
                        [--package NAME=DIR ...] [--allow-any-file] [--json]
@@ -13,8 +13,8 @@ Usage::
                      [--overwrite]
     drakegrasp warmup [--json]
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
-                    [--seed S] [--mu M] [--mass KG] [--torque-limit NM]
-                    [--package NAME=DIR ...] [--allow-any-file]
+                    [--seed S] [--mu M|plant] [--mass KG] [--torque-limit NM]
+                    [--package NAME=DIR ...] [--allow-any-file] [--progress]
                     [--json | --out FILE.parquet [--overwrite]]
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
@@ -28,9 +28,11 @@ a hint naming ``--allow-penetration`` and ``--no-check-pose``, which analyse
 it anyway.  ``batch`` decides closure for every grasp of an ``.npz`` file (arrays
 ``positions`` and ``normals`` of shape (K, N, d), optionally ``mu``, ...) with
 the vectorised batch engine and writes the verdicts to another file.
-``warmup`` compiles the batch engine's numba kernels now, where the install did
-not compile them ahead of time (once per install; later processes load them
-from numba's cache), and prints what it compiled and how long each step took.
+``warmup`` runs every route of the batch engine now and prints each step, its
+time and what it compiled: where the install compiled the kernels ahead of time
+(:mod:`drakegrasp.batch.aot`) it loads them and compiles nothing; elsewhere
+numba's JIT compiles them into numba's on-disk cache (once per install; later
+processes load them from there); without numba there is nothing to compile.
 
 ``plan`` finds grasps: a free-floating hand (a parallel jaw or a multi-finger
 hand) sampled, filtered, closed and ranked on an object, and prints the best
@@ -38,13 +40,20 @@ hand) sampled, filtered, closed and ranked on an object, and prints the best
 scene's name), it plans for the hand and object that the scene's
 ``drakegrasp:`` section names (``hand:``, ``object_body:``), with the scene's
 μ, contact model and tolerance, against everything else the scene holds (a
-table, other objects); the hand's base must be free in the scene (no
-``add_weld`` to the world).  Given an object (a shipped object's name, a model
+table, other objects).  The scene's welds of the hand to the world (which
+place it for ``analyze``, as in every shipped scene) are left out, since plan
+places the hand itself; a planar scene (``plane:``) is refused, as plan samples
+spatial grasps.  Given an object (a shipped object's name, a model
 URL or a file, or a mesh ``.obj`` file, which Drake's parser makes one body
 with the mass of water filling it; default ``box``), it plans for ``--hand`` (a
 model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
 jaw) in a scene of the two alone; ``--mass`` gives the object's mass and
-``--torque-limit`` the torque a multi-finger hand will apply.
+``--torque-limit`` the torque a multi-finger hand will apply.  ``--mu plant``
+plans with the friction the plant gives the hand's and the object's geometries
+(the smallest, where pairs differ, said on stderr) instead of a number.
+``plan --progress`` and ``batch --progress`` need the optional tqdm
+(``pip install "drakegrasp[progress]"``); without it they are refused before
+any work.
 
 One interface: both commands name the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
@@ -249,6 +258,8 @@ def _cmd_batch(args: argparse.Namespace) -> int:
             **options,
         )
     else:
+        if args.progress:
+            _check_progress()
         summary = stream_file(
             args.input, args.output, overwrite=args.overwrite, **options
         )
@@ -612,10 +623,18 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
 
     warm = sub.add_parser(
         "warmup",
-        help="compile the batch engine's kernels now (once per install)",
-        description="Compile every numba kernel of the batch engine into numba's "
-        "on-disk cache, so that the first batch call of later processes does "
-        "not wait; print each step and its time.",
+        help="get the batch engine's kernels ready now (once per install)",
+        description="Run every route of the batch engine on a few seeded grasps "
+        "and print each step, its time and what it compiled; the first line "
+        "names the route the kernels take.  Where the install compiled the "
+        "kernels ahead of time (for this CPU and these sources), they are "
+        "loaded and nothing is compiled: the run only checks that they serve "
+        "every route, in seconds.  Otherwise (no such kernels, another CPU, "
+        "edited sources, or DRAKEGRASP_KERNELS=jit) numba's JIT compiles every "
+        "kernel into its on-disk cache (NUMBA_CACHE_DIR, else numba's user-wide "
+        "cache), a minute or two, so that the first batch call of later "
+        "processes does not wait.  Without numba there is nothing to compile: "
+        "the engine runs its numpy route.",
     )
     warm.add_argument("--json", action="store_true", help="print the report as JSON")
     warm.set_defaults(func=_cmd_warmup)
@@ -687,31 +706,95 @@ def _plan_setup(args: argparse.Namespace):
     from drakegrasp.planning import planning_scene
 
     if _is_scene(args.object):
-        from drakegrasp.plant.scene import load_scene
+        from drakegrasp.plant.scene import load_scene, read_scene_info, scene_path
 
         if args.hand is not None:
             raise InvalidOptionError(
                 "--hand is for an object; a scene names its own hand (its "
                 "drakegrasp: section's 'hand:')"
             )
+        info = read_scene_info(scene_path(args.object))
+        if info.plane is not None:
+            raise InvalidOptionError(
+                f"scene {info.name!r} is planar (plane: {info.plane}); plan "
+                "samples spatial grasps of a free hand: analyse it with "
+                f"`drakegrasp analyze {info.name}`"
+            )
+        # plan places the hand itself: a weld of the hand to the world, which
+        # places it for analyze, is left out
         scene = load_scene(
             args.object,
             package_map=dict(args.package) or None,
             allow_any_file=args.allow_any_file,
             close=False,
+            free_hand=True,
         )
         info = scene.info
         options = {
-            "mu": info.mu if args.mu is None else args.mu,
             "contact_model": info.contact_model,
             "torsional_friction": info.torsional_friction,
             "distance_tolerance": info.distance_tolerance,
         }
-        return scene.plant, scene.plant_context, scene.object_body, scene.hand, options
-    hand = _plan_hand(args.hand)
-    scene = planning_scene(_plan_url(args.object), hand_url=hand)
-    options = {"mu": 0.5 if args.mu is None else args.mu}
-    return scene.plant, scene.context, scene.object_body, scene.hand, options
+        plant, context, body, hand = (
+            scene.plant, scene.plant_context, scene.object_body, scene.hand
+        )  # fmt: skip
+        default_mu = info.mu
+    else:
+        scene = planning_scene(_plan_url(args.object), hand_url=_plan_hand(args.hand))
+        plant, context, body, hand = (
+            scene.plant, scene.context, scene.object_body, scene.hand
+        )  # fmt: skip
+        options = {}
+        default_mu = PLAN_DEFAULT_MU
+    options["mu"] = (
+        default_mu
+        if args.mu is None
+        else _plant_mu(plant, context, body, hand)
+        if args.mu == "plant"
+        else args.mu
+    )
+    return plant, context, body, hand, options
+
+
+PLAN_DEFAULT_MU = 0.5
+"""``plan``'s friction coefficient for an object when ``--mu`` is not given."""
+
+
+def _plant_mu(plant, context, object_body, hand) -> float:
+    """``plan --mu plant``: one coefficient from the plant's geometries.
+
+    The planner takes one μ for every contact; the plant gives one per pair of
+    a hand and an object geometry.  Where they differ, the smallest is used (a
+    grasp in force closure with the narrowest cones is one with wider cones
+    too), and a note on stderr says so.
+    """
+    from drakegrasp.plant.friction import friction_rule, hand_object_friction
+
+    values = hand_object_friction(plant, context, object_body, hand)
+    if values.size == 0:
+        raise InvalidOptionError(
+            "--mu plant: the hand or the object has no collision geometry to "
+            "read a friction from; give --mu as a number"
+        )
+    mu = float(values[0])
+    if values[-1] - mu > 1e-6 * max(mu, 1.0):
+        _say(
+            f"drakegrasp: note: --mu plant: the plant's {friction_rule(plant)} "
+            f"friction of hand and object geometries ranges from {mu:g} to "
+            f"{values[-1]:g}; planning with the smallest, {mu:g}"
+        )
+    return mu
+
+
+def _check_progress() -> None:
+    """``--progress`` needs tqdm: refuse it up front, before any work, if missing."""
+    try:
+        import tqdm.auto  # noqa: F401
+    except ImportError:
+        raise InvalidOptionError(
+            "--progress needs the optional package tqdm, which is not installed: "
+            'pip install "drakegrasp[progress]", or leave out --progress'
+        ) from None
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
@@ -730,6 +813,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         )
     elif args.overwrite:
         raise InvalidOptionError("--overwrite is for --out FILE.parquet")
+    if args.progress:
+        _check_progress()
     plant, context, object_body, hand, options = _plan_setup(args)
     result = plan_grasps(
         plant,
@@ -800,11 +885,14 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         "object",
         nargs="?",
         default="box",
-        help="a scene YAML file (or a shipped scene's name) whose drakegrasp: "
-        "section names the object and the hand (its base free, not welded), or "
-        "a shipped object name (box, cylinder, sphere, hex_prism), a "
-        "package:// URL, a model file or a mesh (.obj: one body with the mass "
-        "of water filling it), planned for --hand (default: box)",
+        help="a scene: a YAML file or a shipped scene's name (`drakegrasp "
+        "scenes`; not a planar one), planned for the hand and object its "
+        "drakegrasp: section names, with its mu, against the rest of it (a weld "
+        "of the hand to the world, which places it for analyze, is left out: "
+        "plan places the hand); or an object: a shipped object name (box, "
+        "cylinder, sphere, hex_prism), a package:// URL, a model file or a mesh "
+        "(.obj: one body with the mass of water filling it), planned for --hand "
+        "(default: box)",
     )
     plan.add_argument(
         "--hand",
@@ -817,9 +905,12 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
     plan.add_argument("--seed", type=int, default=0, help="random seed (0)")
     plan.add_argument(
         "--mu",
-        type=_positive_float,
+        type=_mu,
         default=None,
-        help="friction coefficient (default: the scene's, else 0.5)",
+        help="friction coefficient of every contact, or 'plant': the plant's "
+        "friction of the hand's and the object's geometries (Drake's combined "
+        "coefficient, as analyze --mu plant; the smallest where pairs differ) "
+        f"(default: the scene's, else {PLAN_DEFAULT_MU})",
     )
     plan.add_argument(
         "--mass",
@@ -842,7 +933,11 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         plan,
         package_help="for a scene: resolve package://NAME/... to DIR (repeatable)",
     )
-    plan.add_argument("--progress", action="store_true", help="show a progress bar")
+    plan.add_argument(
+        "--progress",
+        action="store_true",
+        help='show a progress bar (needs: pip install "drakegrasp[progress]")',
+    )
     out = plan.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print JSON")
     out.add_argument(

@@ -8,6 +8,9 @@ Drake stores a Coulomb friction per geometry (the proximity property
   step's contact results name them;
 * :func:`plant_friction`: the same per contact of a grasp read from the plant
   (``mu="plant"`` in :func:`~drakegrasp.analyze_grasp` and the grasp monitor);
+* :func:`hand_object_friction`: the coefficients of every pair of a hand and
+  an object geometry, before any contact is known (``drakegrasp plan --mu
+  plant``);
 * :func:`friction_disagreement`: why a ``μ`` typed by hand is not the plant's
   (the load report's warning, the monitor's
   :class:`FrictionMismatchWarning`).
@@ -28,13 +31,19 @@ from pydrake.multibody.plant import (
 )
 
 from drakegrasp.errors import ModelError
-from drakegrasp.plant.validation import plant_context_of, query_object_of
+from drakegrasp.plant.validation import (
+    hand_contact_bodies,
+    plant_context_of,
+    query_object_of,
+    resolve_object_body,
+)
 
 __all__ = [
     "MU_RELATIVE_TOL",
     "FrictionMismatchWarning",
     "friction_disagreement",
     "friction_rule",
+    "hand_object_friction",
     "pair_friction",
     "plant_friction",
 ]
@@ -125,6 +134,52 @@ def plant_friction(
         ],
         dtype=float,
     )
+
+
+def hand_object_friction(
+    plant: MultibodyPlant, plant_context, object_body, hand=None
+) -> np.ndarray:
+    """The plant's friction of every pair of a hand and an object geometry.
+
+    What :func:`plant_friction` would give a contact between any collision
+    geometry of the hand (every body that can touch,
+    :func:`~drakegrasp.plant.validation.hand_contact_bodies`) and any of the
+    object, before a grasp is known.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    plant_context : Context
+    object_body : RigidBody or str
+        The object's body, or its scoped name.
+    hand : HandSpec, optional
+        The hand as :func:`~drakegrasp.plant.validation.hand_bodies` takes it.
+
+    Returns
+    -------
+    (M,) float
+        The distinct coefficients (dimensionless), ascending; empty when the
+        hand or the object has no collision geometry.
+
+    Raises
+    ------
+    ModelError
+        If a geometry has no ``material/coulomb_friction`` property.
+    """
+    ctx = plant_context_of(plant, plant_context)
+    body = resolve_object_body(plant, object_body)
+    query_object = query_object_of(plant, ctx)
+    hand_ids = [
+        g
+        for b in hand_contact_bodies(plant, body, hand)
+        for g in plant.GetCollisionGeometriesForBody(b)
+    ]
+    values = {
+        pair_friction(plant, query_object, o, h)
+        for o in plant.GetCollisionGeometriesForBody(body)
+        for h in hand_ids
+    }
+    return np.array(sorted(values), dtype=float)
 
 
 def friction_disagreement(

@@ -337,6 +337,21 @@ def _resolve_hand(plant: MultibodyPlant, hand) -> ModelInstanceIndex | tuple | N
     return tuple(resolve_body(plant, h) for h in hand)
 
 
+def _drop_hand_welds(directives, hand) -> None:
+    """Remove ``directives``' welds of the world to a body of ``hand``'s instances."""
+    if hand is None:
+        return
+    names = (hand,) if isinstance(hand, str) else hand
+    instances = {name.partition("::")[0] for name in names}
+    directives.directives = [
+        d
+        for d in directives.directives
+        if d.add_weld is None
+        or d.add_weld.parent != "world"
+        or d.add_weld.child.partition("::")[0] not in instances
+    ]
+
+
 def load_scene(
     path_or_name: str | Path | None = None,
     *,
@@ -344,6 +359,7 @@ def load_scene(
     ros_package_path: bool = True,
     allow_any_file: bool = False,
     close: bool | None = None,
+    free_hand: bool = False,
 ) -> Scene:
     """Build the plant of a scene file and set the configuration it describes.
 
@@ -413,6 +429,8 @@ def load_scene(
         read_yaml=read_yaml,
         allow_any_file=check_flag("allow_any_file", allow_any_file),
     )
+    if check_flag("free_hand", free_hand):
+        _drop_hand_welds(directives, info.hand)
     try:
         added = ProcessModelDirectives(directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError

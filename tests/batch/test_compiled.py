@@ -246,6 +246,20 @@ def test_warmup_prints_its_steps(capsys):
     assert out[-1].startswith("done: ")
 
 
+def test_warmup_help_says_what_it_does_on_each_route():
+    """The help names the ahead-of-time, JIT and numpy routes, as warmup runs them."""
+    from drakegrasp.batch import aot
+    from drakegrasp.cli import build_parser
+
+    _, sub = build_parser()
+    text = " ".join(sub.choices["warmup"].format_help().split())
+    assert "compiled the kernels ahead of time" in text
+    assert "nothing is compiled" in text  # the AOT route: tests/batch/test_aot.py
+    assert f"{aot.ENV}=jit" in text and "numba's JIT compiles" in text
+    assert "NUMBA_CACHE_DIR" in text
+    assert "numpy route" in text  # WarmupReport(available=False)
+
+
 def test_a_kernel_is_a_named_callable_that_pickles_by_reference():
     import pickle
 
