@@ -381,6 +381,11 @@ def load_scene(
         Close the hand onto the object (:func:`~drakegrasp.close_hand`, from
         the file's joint values, along the file's ``close: {direction: ...}``
         if it gives one).  Default: what the file's ``close:`` says.
+    free_hand : bool, optional
+        Leave out the file's welds of the world to a body of the ``hand:``
+        model instances, so that the hand floats free (what a grasp planner
+        places itself; ``drakegrasp plan`` on a scene).  Welds inside included
+        model files stay.  Default False.
 
     Returns
     -------
