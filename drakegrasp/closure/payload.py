@@ -230,6 +230,11 @@ def _rescaled(P: LoadProblem, d: np.ndarray, alpha_unit: float, bound: float):
     return result, a, full, capped
 
 
+def _verified(P: LoadProblem, cert: LoadCertificate) -> bool:
+    """Whether a payload certificate of the dual holds on the problem's grasp."""
+    return cert.check(P.grasp, hand_jacobian=P.hand_jacobian).holds
+
+
 def _held_without_limits(P: LoadProblem, d: np.ndarray) -> bool:
     """Whether the grasp provably holds ``d`` with every finite limit at zero.
 
@@ -336,8 +341,28 @@ def max_load(
         # payload passes it), nor is a solution at μ >> 1 right: the dual
         # decides.  No dual direction: no limit binds, α is unbounded.
         cert, bound = find_load_certificate(P, d, mode="bound", force_scale=F0)
+        if bound == 0.0 and not _verified(P, cert):
+            # At μ = 1e12 the dual returned "α <= 0" for a load a finger
+            # pushes without limit: a zero bound decides only if it re-checks.
+            cert, bound = None, math.inf
     unbounded = False
-    if math.isfinite(bound) and (capped or big_mu):
+    if bound == 0.0 and (capped or big_mu):
+        # A re-checked proof that no multiple is held has no program in units
+        # of the bound (0) to solve, so α = 0 with no forces, unless the
+        # friction-scaled program holds some (at μ = 1e-12 the check passed a
+        # dual that missed a bound of 2 μ f_max): then nothing is known.
+        if value > 0.0:
+            result, again, _, _ = _rescaled(P, d, value, math.inf)
+            if again > _AGREE * value:
+                raise SolverError(
+                    f"the payload's dual bound is 0 but the friction-scaled "
+                    f"program holds α = {again:.9g}: the payload is not known to "
+                    "the solvers' accuracy",
+                    program=prog,
+                    result=result,
+                )
+        value, full = 0.0, np.zeros_like(full)
+    elif math.isfinite(bound) and (capped or big_mu):
         if (
             capped
             or P.violation(full, value * d)[0] > FEASIBILITY_TOL
