@@ -213,6 +213,27 @@ def test_lp3_invariant_to_the_scale_of_j(seed, scale_exp):
     assert a.null_space_dim == b.null_space_dim and a.passes == b.passes
 
 
+@pytest.mark.parametrize("scale", [1e-200, 1e-300, 1e-160])
+def test_a_jacobian_whose_squares_underflow_keeps_its_joints(scale):
+    # |J_ij| ~ 1e-200: the column norms (sums of squares) underflowed to 0, so
+    # internal_forces dropped every joint (d* = 1 where J gives 0) and
+    # max_load read the torque rows 1e-200 x <= 2e-200 as no limit, holding
+    # 2.6 times the payload with torques past the limits.
+    rng = np.random.default_rng(5)
+    g = fuzz_cases._valid_grasp()
+    J = rng.normal(size=(g.num_components, 4))
+    a, b = dg.internal_forces(g, J), dg.internal_forces(g, J * scale)
+    assert a.null_space_dim == b.null_space_dim and a.passes == b.passes
+    assert b.d_star == pytest.approx(a.d_star, abs=1e-6)
+    d = rng.normal(size=6)
+    ref = dg.max_load(g, d, hand_jacobian=J, torque_limits=2.0, max_normal_force=5)
+    tiny = dg.max_load(
+        g, d, hand_jacobian=J * scale, torque_limits=2.0 * scale, max_normal_force=5
+    )
+    assert tiny.alpha == pytest.approx(ref.alpha, rel=1e-5)
+    assert np.all(np.abs(tiny.joint_torques) <= 2.0 * scale * (1 + 1e-6))
+
+
 @SETTINGS
 @given(seed=st.integers(0, 2**32 - 1), mu=log_mu, num=st.integers(2, 5))
 def test_single_path_agrees_with_the_scipy_lp_for_every_mu(seed, mu, num):
