@@ -336,3 +336,17 @@ def test_batch_agrees_with_the_single_path_across_the_mu_range(mu):
     assert batch.converged.all()
     np.testing.assert_array_equal(batch.is_closure, [r.is_closure for r in single])
     np.testing.assert_allclose(batch.d_star, [r.d_star for r in single], atol=1e-6)
+
+
+def test_a_jacobian_without_torque_limits_gets_a_certificate():
+    # hand_jacobian with no torque_limits: the dual's certificate priced its
+    # joint multipliers against torque_limits=None and raised IndexError.
+    rng = np.random.default_rng(1)
+    g = fuzz_cases._valid_grasp()
+    J = rng.normal(size=(g.num_components, 4))
+    w = [0.0, 0.0, -9.81, 0.01, 0.0, 0.0]
+    r = dg.max_load(g, w, hand_jacobian=J, max_squeeze=1.0)
+    assert r.alpha == pytest.approx(dg.max_load(g, w, max_squeeze=1.0).alpha)
+    assert r.certificate.check(g, hand_jacobian=J).holds
+    f = dg.grasp_forces(g, w, hand_jacobian=J, max_squeeze=1.0)
+    assert not f.feasible and f.certificate.check(g, hand_jacobian=J).holds
