@@ -230,6 +230,19 @@ def _rescaled(P: LoadProblem, d: np.ndarray, alpha_unit: float, bound: float):
     return result, a, full, capped
 
 
+def _homogeneous(P: LoadProblem) -> bool:
+    """Whether every finite limit of the problem is 0 (its α is 0 or inf).
+
+    A torque limit counts as the force it allows, ``τ_max / ‖J_j‖``: 5e-324
+    N·m on a column of norm 2 is 0 N.
+    """
+    limits = [P.max_normal_force, [P.max_squeeze]]
+    if P.torque_limits is not None:
+        limits.append(P.torque_limits / P.jscale)
+    values = np.concatenate([np.asarray(x, dtype=float) for x in limits])
+    return not np.any(np.isfinite(values) & (values > 0.0))
+
+
 def _verified(P: LoadProblem, cert: LoadCertificate) -> bool:
     """Whether a payload certificate of the dual holds on the problem's grasp."""
     return cert.check(P.grasp, hand_jacobian=P.hand_jacobian).holds
@@ -384,6 +397,12 @@ def max_load(
                 program=prog,
                 result=result,
             )
+    if not unbounded and value > 0.0 and _homogeneous(P):
+        # Every finite limit 0 (passive joints, max_squeeze = 0): α is 0 or
+        # inf, never the 1e-10 of the solvers' tolerance it was reported as.
+        unbounded = _held_without_limits(P, d)
+        if not unbounded:
+            value, full = 0.0, np.zeros_like(full)
     if unbounded:
         value = math.inf
     if not certify:

@@ -338,6 +338,30 @@ def test_batch_agrees_with_the_single_path_across_the_mu_range(mu):
     np.testing.assert_allclose(batch.d_star, [r.d_star for r in single], atol=1e-6)
 
 
+@pytest.mark.parametrize(
+    "limits",
+    [
+        {"torque_limits": 0.0},
+        {"torque_limits": 5e-324},
+        {"max_squeeze": 0.0},
+        {"max_squeeze": 0.0, "torque_limits": 0.0},
+    ],
+    ids=["passive", "subnormal torque", "no squeeze", "both"],
+)
+def test_max_load_with_every_limit_zero_is_zero_or_inf(limits):
+    # Homogeneous: α d held for one α > 0 is held for all.  Passive joints
+    # or max_squeeze = 0 gave α = 9.6e-11 and 4.1e-11 (solver noise), and a
+    # 5e-324 N·m limit (0 N on its column) the same, where 1e-300 scales.
+    rng = np.random.default_rng(1)
+    g = fuzz_cases._valid_grasp()
+    J = rng.normal(size=(g.num_components, 4))
+    w = np.array([0.0, 0.0, -9.81, 0.01, 0.0, 0.0])
+    r = dg.max_load(g, w, hand_jacobian=J, **limits)
+    assert r.alpha == 0.0
+    small = dg.max_load(g, w, hand_jacobian=J, torque_limits=1e-300)
+    assert 0.0 < small.alpha < 1e-299
+
+
 def test_a_jacobian_without_torque_limits_gets_a_certificate():
     # hand_jacobian with no torque_limits: the dual's certificate priced its
     # joint multipliers against torque_limits=None and raised IndexError.
