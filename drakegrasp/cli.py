@@ -730,9 +730,11 @@ def _plan_setup(args: argparse.Namespace):
             free_hand=True,
         )
         info = scene.info
+        # scene.options, as analyze reads the file: a soft finger the file
+        # gives no ν is refused, not planned as a soft finger with ν = 0
         options = {
             "contact_model": info.contact_model,
-            "torsional_friction": info.torsional_friction,
+            "torsional_friction": scene.options.torsional_friction,
             "distance_tolerance": info.distance_tolerance,
         }
         plant, context, body, hand = (

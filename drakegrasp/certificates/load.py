@@ -180,7 +180,14 @@ def _budget(cert: LoadCertificate) -> float:
     total = 0.0
     eta = np.asarray(cert.joint_multipliers, dtype=float)
     if eta.size:
-        limits = np.asarray(cert.torque_limits, dtype=float)
+        # No torque limits (a Jacobian without them): every joint unlimited,
+        # so a multiplier on one prices an infinite budget (it was an
+        # IndexError on the 0-d array of None).
+        limits = (
+            np.full(eta.shape, np.inf)
+            if cert.torque_limits is None
+            else np.asarray(cert.torque_limits, dtype=float)
+        )
         used = eta != 0.0
         total += float(np.sum(np.abs(eta[used]) * limits[used]))
     rho = np.asarray(cert.normal_multipliers, dtype=float)

@@ -90,5 +90,9 @@ def exact_cone_rows(contact, scales: np.ndarray, b: float) -> list[np.ndarray]:
         A[1, 1] *= scales[1]
         A[2, 2] *= scales[2]
         A /= np.hypot(1.0, mu)
+        # At μ = 1e-12 with x_t scaled too the row is μ [x_n, x_t]: to 1.
+        size = np.max(np.abs(A[:, :k]))
+        if 0.0 < size < 0.5:
+            A /= size
         rows.append(A)
     return rows

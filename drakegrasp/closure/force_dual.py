@@ -162,6 +162,11 @@ def find_load_certificate(
     # weight, 0 at 1e200).  The certificate keeps the caller's d, so its bound
     # B / (-yᵀ d) is for d.
     target = target / (force_scale if mode == "refute" else np.max(np.abs(target)))
+    if mode == "bound":
+        # Every μ tiny (1e-12): the bound is about μ times the limits, its
+        # multipliers ρ, σ that small, under the solvers' tolerances; ȳ of
+        # size 1/μ makes them about 1 (the bound, B / -yᵀ d, is the same).
+        target = target * min(P.friction_scaled().tangent_scale, 1.0)
     prog, z, blocks, weights = build_load_dual_program(
         P, target, force_scale, mode=mode
     )

@@ -490,10 +490,15 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
     forces that break a limit reported as feasible.
     """
     first = _solve_load(P, w, objective)
-    if _holds(P, w, first):
-        return first
     Ps = P.friction_scaled()
+    if _holds(P, w, first) and (first.feasible or Ps is P):
+        return first
+    # A μ far from 1: forces that fail, or a refusal, in newtons are not the
+    # answer (at μ = 1e-12 a held load was "refuted" by a certificate that
+    # re-checked): the friction-scaled program decides.
     second = None if Ps is P else _solve_load(Ps, w, objective)
+    if second is not None and not second.feasible and not first.feasible:
+        return first if first.certificate is not None else second
     if second is not None and (not second.feasible or _holds(P, w, second)):
         # The friction-scaled program's proof of infeasibility is trusted.
         return second

@@ -204,20 +204,25 @@ class LoadProblem:
         its cone reads ``‖x_t‖ <= x_n``; ``self`` when no contact has.  Use it
         with a force unit ``F0`` of the load's size over ``tangent_scale``.
         """
-        big = [c.mu for c in self.grasp.contacts if c.mu > FRICTION_SCALING]
-        if not big:
+        mus = [c.mu for c in self.grasp.contacts]
+        if not any(_far_from_one(mu) for mu in mus):
             return self
         layout = self.layout
         scales = layout.scales.copy()
         for contact, cone, start in zip(
             self.grasp.contacts, layout.cones, layout.normal_positions, strict=True
         ):
-            if contact.mu > FRICTION_SCALING:
+            if _far_from_one(contact.mu):
                 for j, component in enumerate(cone.components):
                     if component in (1, 2):
                         scales[start + j] *= contact.mu
+        # The size of a load held per unit of normal force: the largest μ when
+        # it is far from 1 (both ways: every μ tiny, or one huge), else 1.
+        top = max(mus)
         return replace(
-            self, layout=replace(layout, scales=scales), tangent_scale=max(big)
+            self,
+            layout=replace(layout, scales=scales),
+            tangent_scale=top if _far_from_one(top) else 1.0,
         )
 
     def violation(self, full: np.ndarray, wrench: np.ndarray) -> tuple[float, str]:
@@ -301,6 +306,11 @@ class LoadProblem:
     def normalised(self, wrench: np.ndarray) -> np.ndarray:
         """``T w``: a wrench about the centroid, moments over the spread."""
         return self.T @ wrench
+
+
+def _far_from_one(mu: float) -> bool:
+    """Whether a contact's tangential variables are in units of ``μ``."""
+    return mu > FRICTION_SCALING or 0.0 < mu < 1.0 / FRICTION_SCALING
 
 
 def check_wrench(grasp: Grasp, wrench, name: str = "wrench") -> np.ndarray:
@@ -410,7 +420,13 @@ def load_problem(
     if hand_jacobian is not None:
         J = check_hand_jacobian(grasp, hand_jacobian)
         Jc = J[cols]
-        norms = np.linalg.norm(Jc, axis=0)
+        # Each column's norm, taken on the column over its largest entry: at
+        # |J_ij| ~ 1e-200 the squares underflow, the norm came out 0, the
+        # column kept its size and the limit rows (1e-200 x <= 2e-200) read
+        # as none: a payload past the motors' limits.
+        big = np.max(np.abs(Jc), axis=0, initial=0.0)
+        unit = np.where(big > 0.0, big, 1.0)
+        norms = big * np.linalg.norm(Jc / unit, axis=0)
         jscale = np.where(norms > 0.0, norms, 1.0)
         Jt = (Jc / jscale).T
         if torque_limits is not None:

@@ -230,6 +230,24 @@ def _rescaled(P: LoadProblem, d: np.ndarray, alpha_unit: float, bound: float):
     return result, a, full, capped
 
 
+def _homogeneous(P: LoadProblem) -> bool:
+    """Whether every finite limit of the problem is 0 (its α is 0 or inf).
+
+    A torque limit counts as the force it allows, ``τ_max / ‖J_j‖``: 5e-324
+    N·m on a column of norm 2 is 0 N.
+    """
+    limits = [P.max_normal_force, [P.max_squeeze]]
+    if P.torque_limits is not None:
+        limits.append(P.torque_limits / P.jscale)
+    values = np.concatenate([np.asarray(x, dtype=float) for x in limits])
+    return not np.any(np.isfinite(values) & (values > 0.0))
+
+
+def _verified(P: LoadProblem, cert: LoadCertificate) -> bool:
+    """Whether a payload certificate of the dual holds on the problem's grasp."""
+    return cert.check(P.grasp, hand_jacobian=P.hand_jacobian).holds
+
+
 def _held_without_limits(P: LoadProblem, d: np.ndarray) -> bool:
     """Whether the grasp provably holds ``d`` with every finite limit at zero.
 
@@ -336,8 +354,28 @@ def max_load(
         # payload passes it), nor is a solution at μ >> 1 right: the dual
         # decides.  No dual direction: no limit binds, α is unbounded.
         cert, bound = find_load_certificate(P, d, mode="bound", force_scale=F0)
+        if bound == 0.0 and not _verified(P, cert):
+            # At μ = 1e12 the dual returned "α <= 0" for a load a finger
+            # pushes without limit: a zero bound decides only if it re-checks.
+            cert, bound = None, math.inf
     unbounded = False
-    if math.isfinite(bound) and (capped or big_mu):
+    if bound == 0.0 and (capped or big_mu):
+        # A re-checked proof that no multiple is held has no program in units
+        # of the bound (0) to solve, so α = 0 with no forces, unless the
+        # friction-scaled program holds some (at μ = 1e-12 the check passed a
+        # dual that missed a bound of 2 μ f_max): then nothing is known.
+        if value > 0.0:
+            result, again, _, _ = _rescaled(P, d, value, math.inf)
+            if again > _AGREE * value:
+                raise SolverError(
+                    f"the payload's dual bound is 0 but the friction-scaled "
+                    f"program holds α = {again:.9g}: the payload is not known to "
+                    "the solvers' accuracy",
+                    program=prog,
+                    result=result,
+                )
+        value, full = 0.0, np.zeros_like(full)
+    elif math.isfinite(bound) and (capped or big_mu):
         if (
             capped
             or P.violation(full, value * d)[0] > FEASIBILITY_TOL
@@ -359,6 +397,12 @@ def max_load(
                 program=prog,
                 result=result,
             )
+    if not unbounded and value > 0.0 and _homogeneous(P):
+        # Every finite limit 0 (passive joints, max_squeeze = 0): α is 0 or
+        # inf, never the 1e-10 of the solvers' tolerance it was reported as.
+        unbounded = _held_without_limits(P, d)
+        if not unbounded:
+            value, full = 0.0, np.zeros_like(full)
     if unbounded:
         value = math.inf
     if not certify:

@@ -161,7 +161,10 @@ def unit_columns(J: np.ndarray) -> np.ndarray:
     -------
     (m, k) float, k <= n
     """
-    norms = np.linalg.norm(J, axis=0)
+    # Norms of columns over their largest entry, then scaled back: at
+    # |J_ij| ~ 1e-200 the squares underflow and every joint was dropped.
+    big = np.max(np.abs(J), axis=0, initial=0.0)
+    norms = big * np.linalg.norm(J / np.where(big > 0.0, big, 1.0), axis=0)
     if norms.size == 0 or not norms.max() > 0.0:
         return J[:, :0]
     keep = norms > ZERO_COLUMN * norms.max()

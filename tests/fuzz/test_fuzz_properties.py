@@ -213,6 +213,27 @@ def test_lp3_invariant_to_the_scale_of_j(seed, scale_exp):
     assert a.null_space_dim == b.null_space_dim and a.passes == b.passes
 
 
+@pytest.mark.parametrize("scale", [1e-200, 1e-300, 1e-160])
+def test_a_jacobian_whose_squares_underflow_keeps_its_joints(scale):
+    # |J_ij| ~ 1e-200: the column norms (sums of squares) underflowed to 0, so
+    # internal_forces dropped every joint (d* = 1 where J gives 0) and
+    # max_load read the torque rows 1e-200 x <= 2e-200 as no limit, holding
+    # 2.6 times the payload with torques past the limits.
+    rng = np.random.default_rng(5)
+    g = fuzz_cases._valid_grasp()
+    J = rng.normal(size=(g.num_components, 4))
+    a, b = dg.internal_forces(g, J), dg.internal_forces(g, J * scale)
+    assert a.null_space_dim == b.null_space_dim and a.passes == b.passes
+    assert b.d_star == pytest.approx(a.d_star, abs=1e-6)
+    d = rng.normal(size=6)
+    ref = dg.max_load(g, d, hand_jacobian=J, torque_limits=2.0, max_normal_force=5)
+    tiny = dg.max_load(
+        g, d, hand_jacobian=J * scale, torque_limits=2.0 * scale, max_normal_force=5
+    )
+    assert tiny.alpha == pytest.approx(ref.alpha, rel=1e-5)
+    assert np.all(np.abs(tiny.joint_torques) <= 2.0 * scale * (1 + 1e-6))
+
+
 @SETTINGS
 @given(seed=st.integers(0, 2**32 - 1), mu=log_mu, num=st.integers(2, 5))
 def test_single_path_agrees_with_the_scipy_lp_for_every_mu(seed, mu, num):
@@ -315,3 +336,41 @@ def test_batch_agrees_with_the_single_path_across_the_mu_range(mu):
     assert batch.converged.all()
     np.testing.assert_array_equal(batch.is_closure, [r.is_closure for r in single])
     np.testing.assert_allclose(batch.d_star, [r.d_star for r in single], atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "limits",
+    [
+        {"torque_limits": 0.0},
+        {"torque_limits": 5e-324},
+        {"max_squeeze": 0.0},
+        {"max_squeeze": 0.0, "torque_limits": 0.0},
+    ],
+    ids=["passive", "subnormal torque", "no squeeze", "both"],
+)
+def test_max_load_with_every_limit_zero_is_zero_or_inf(limits):
+    # Homogeneous: α d held for one α > 0 is held for all.  Passive joints
+    # or max_squeeze = 0 gave α = 9.6e-11 and 4.1e-11 (solver noise), and a
+    # 5e-324 N·m limit (0 N on its column) the same, where 1e-300 scales.
+    rng = np.random.default_rng(1)
+    g = fuzz_cases._valid_grasp()
+    J = rng.normal(size=(g.num_components, 4))
+    w = np.array([0.0, 0.0, -9.81, 0.01, 0.0, 0.0])
+    r = dg.max_load(g, w, hand_jacobian=J, **limits)
+    assert r.alpha == 0.0
+    small = dg.max_load(g, w, hand_jacobian=J, torque_limits=1e-300)
+    assert 0.0 < small.alpha < 1e-299
+
+
+def test_a_jacobian_without_torque_limits_gets_a_certificate():
+    # hand_jacobian with no torque_limits: the dual's certificate priced its
+    # joint multipliers against torque_limits=None and raised IndexError.
+    rng = np.random.default_rng(1)
+    g = fuzz_cases._valid_grasp()
+    J = rng.normal(size=(g.num_components, 4))
+    w = [0.0, 0.0, -9.81, 0.01, 0.0, 0.0]
+    r = dg.max_load(g, w, hand_jacobian=J, max_squeeze=1.0)
+    assert r.alpha == pytest.approx(dg.max_load(g, w, max_squeeze=1.0).alpha)
+    assert r.certificate.check(g, hand_jacobian=J).holds
+    f = dg.grasp_forces(g, w, hand_jacobian=J, max_squeeze=1.0)
+    assert not f.feasible and f.certificate.check(g, hand_jacobian=J).holds

@@ -105,6 +105,24 @@ drakegrasp:
     assert kept.num_positions() == load_scene(scene).plant.num_positions()
 
 
+def test_a_soft_finger_scene_without_nu_is_refused_as_analyze_refuses_it(
+    tmp_path, capsys
+):
+    """plan read ν = 0 from a file that gives none and planned soft fingers."""
+    text = (load_scene().info.path).read_text()
+    scene = tmp_path / "soft.yaml"
+    scene.write_text(
+        text.replace(
+            "contact_model: hard_finger", "contact_model: soft_finger"
+        ).replace("torsional_friction: 0.1", "")
+    )
+    for command in ("analyze", "plan"):
+        extra = ["--num", "5"] if command == "plan" else []
+        assert main([command, str(scene), *extra]) == 1
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "torsional_friction" in err, err
+
+
 # -- --mu plant --------------------------------------------------------------
 
 

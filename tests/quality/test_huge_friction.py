@@ -149,3 +149,15 @@ def test_max_load_without_limits_is_unbounded_at_any_mu(mu):
     r = dg.max_load(g, [0.0, 0.0, -MG, 0.0, 0.0, 0.0])
     assert r.alpha == np.inf
     assert r.status.startswith("unbounded")
+
+
+@pytest.mark.parametrize("mu", [1e4, 1e6, 1e12])
+def test_max_load_without_limits_at_huge_mu(mu):
+    # A torque about the line through two hard fingers is never held (α = 0);
+    # a push along a finger's normal is held without bound.  Both raised
+    # ZeroDivisionError: a dual bound of 0 became the unit of a re-solve (and
+    # at 1e12 the push got a "bound" of 0 whose certificate did not re-check).
+    g, _, _ = _setup(mu, 0.0, planar=False)
+    r = dg.max_load(g, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
+    assert r.alpha == 0.0
+    assert dg.max_load(g, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]).alpha == np.inf
