@@ -86,7 +86,7 @@ def main(argv=None) -> int:
         type=float,
         default=0.0,
         help="depth noise, mm (σ along each point's line of sight; normals "
-        "then estimated from the points, as Drake does)",
+        "then estimated from the points, as read_cloud does)",
     )
     parser.add_argument("--verbose", action="store_true")
     args = parser.parse_args(argv)
