@@ -491,7 +491,8 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
     """
     first = _solve_load(P, w, objective)
     Ps = P.friction_scaled()
-    if _holds(P, w, first) and (first.feasible or Ps is P):
+    scaled = Ps is not P
+    if _holds(P, w, first, scaled) and (first.feasible or not scaled):
         return first
     # A μ far from 1: forces that fail, or a refusal, in newtons are not the
     # answer (at μ = 1e-12 a held load was "refuted" by a certificate that
@@ -499,7 +500,7 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
     second = None if Ps is P else _solve_load(Ps, w, objective)
     if second is not None and not second.feasible and not first.feasible:
         return first if first.certificate is not None else second
-    if second is not None and (not second.feasible or _holds(P, w, second)):
+    if second is not None and (not second.feasible or _holds(P, w, second, scaled)):
         # The friction-scaled program's proof of infeasibility is trusted.
         return second
     bad = second or first
@@ -514,11 +515,14 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
     )
 
 
-def _holds(P: LoadProblem, w: np.ndarray, r: GraspForceResult) -> bool:
-    """A result to trust: an infeasibility proof, or forces that re-check."""
+def _holds(P: LoadProblem, w: np.ndarray, r: GraspForceResult, scaled: bool) -> bool:
+    """A result to trust: an infeasibility proof, or forces that re-check.
+
+    ``scaled``: ``P`` has a friction-scaled twin (a μ far from 1).
+    """
     if not r.feasible:
         # A certificate is re-checkable; a bare status at μ >> 1 is not.
-        return r.certificate is not None or P.friction_scaled() is P
+        return r.certificate is not None or not scaled
     return P.violation(r.stacked_forces(), w)[0] <= FEASIBILITY_TOL
 
 

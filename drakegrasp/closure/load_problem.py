@@ -51,7 +51,7 @@ from drakegrasp.closure.constraints import (
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.core.validation import check_grasp as _check_grasp
-from drakegrasp.core.validation import check_num_generators, real_array
+from drakegrasp.core.validation import check_num_generators, real_array, safe_norm
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -420,13 +420,10 @@ def load_problem(
     if hand_jacobian is not None:
         J = check_hand_jacobian(grasp, hand_jacobian)
         Jc = J[cols]
-        # Each column's norm, taken on the column over its largest entry: at
-        # |J_ij| ~ 1e-200 the squares underflow, the norm came out 0, the
-        # column kept its size and the limit rows (1e-200 x <= 2e-200) read
-        # as none: a payload past the motors' limits.
-        big = np.max(np.abs(Jc), axis=0, initial=0.0)
-        unit = np.where(big > 0.0, big, 1.0)
-        norms = big * np.linalg.norm(Jc / unit, axis=0)
+        # A scaled norm: at |J_ij| ~ 1e-200 the squares underflowed, the
+        # norm came out 0, the column kept its size and the limit rows
+        # (1e-200 x <= 2e-200) read as none: a payload past the motors' limits.
+        norms = safe_norm(Jc, axis=0) if Jc.size else np.zeros(Jc.shape[1])
         jscale = np.where(norms > 0.0, norms, 1.0)
         Jt = (Jc / jscale).T
         if torque_limits is not None:

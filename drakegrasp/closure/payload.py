@@ -349,7 +349,7 @@ def max_load(
     value = a * unit
     big_mu = P.friction_scaled() is not P
     cert, bound = None, math.inf
-    if (certify and not capped) or capped or big_mu:
+    if certify or capped or big_mu:
         # Reaching the cap is no proof of unboundedness (at μ = 1e8 the
         # payload passes it), nor is a solution at μ >> 1 right: the dual
         # decides.  No dual direction: no limit binds, α is unbounded.

@@ -161,10 +161,9 @@ def unit_columns(J: np.ndarray) -> np.ndarray:
     -------
     (m, k) float, k <= n
     """
-    # Norms of columns over their largest entry, then scaled back: at
-    # |J_ij| ~ 1e-200 the squares underflow and every joint was dropped.
-    big = np.max(np.abs(J), axis=0, initial=0.0)
-    norms = big * np.linalg.norm(J / np.where(big > 0.0, big, 1.0), axis=0)
+    # A scaled norm: at |J_ij| ~ 1e-200 the squares underflow and every
+    # joint was dropped.
+    norms = safe_norm(J, axis=0) if J.size else np.zeros(J.shape[1])
     if norms.size == 0 or not norms.max() > 0.0:
         return J[:, :0]
     keep = norms > ZERO_COLUMN * norms.max()
