@@ -12,7 +12,10 @@ A fuzz pass found these answered wrongly or refused with a misleading cause:
 - ``hand: box`` (the object's own model instance) said "the hand has no
   bodies that can move (hand=ModelInstanceIndex(3))";
 - ``hand: gripper::left_finger`` (a body written where a model instance goes)
-  said only "no model instance named ...".
+  said only "no model instance named ...";
+- ``load_scene(..., free_hand=True)`` left a hand welded to a table (only welds
+  to the world were dropped), left a scene without ``hand:`` welded, and kept a
+  ``hand:`` of finger bodies as it was (the planner then found no free base).
 """
 
 from __future__ import annotations
@@ -21,15 +24,17 @@ import numpy as np
 import pytest
 from odd_scenes import (
     BOX,
+    BOX_ON_WORLD,
     GRIPPER,
     PALM_ON_WORLD,
+    SECOND_BOX,
     TABLE_AND_PALM,
     jaw_scene,
 )
-from pydrake.multibody.tree import BodyIndex
+from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex
 
 import drakegrasp as dg
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
 from drakegrasp.plant.friction import hand_object_friction
 from drakegrasp.plant.scene import load_scene
 from drakegrasp.plant.validation import hand_bodies, hand_contact_bodies, resolve_body
@@ -181,3 +186,116 @@ def test_attachment_reads_how_each_body_is_held(tmp_path):
     f = _body(freed, "gripper::left_finger")
     assert free_carrier(freed.plant, f).name() == "palm"
     assert how_held(freed.plant, f) == "carried by the free body gripper::palm"
+
+
+# -- load_scene(..., free_hand=True) -------------------------------------------
+
+
+def _free_hand_positions(scene) -> int:
+    """Positions of the hand's free base (7) and fingers, and of the object."""
+    return scene.plant.num_positions()
+
+
+def test_a_hand_welded_to_a_table_is_freed(tmp_path):
+    """Only welds to the world were left out: the palm stayed on the table."""
+    path = jaw_scene(tmp_path, "table", directives=GRIPPER + TABLE_AND_PALM + BOX)
+    freed = load_scene(path, free_hand=True)
+    palm = _body(freed, "gripper::palm")
+    assert palm.is_floating_base_body()
+    table = _body(freed, "table::box")  # the table stays where it was
+    assert table in freed.plant.GetBodiesWeldedTo(freed.plant.world_body())
+    shipped = load_scene("parallel_jaw_box", free_hand=True)
+    assert _free_hand_positions(freed) == _free_hand_positions(shipped)
+
+
+def test_welds_inside_the_hand_and_onto_it_stay(tmp_path):
+    """A camera welded onto the palm rides with the freed hand."""
+    camera = (
+        "- add_model:\n    name: camera\n    file: package://drakegrasp/objects/"
+        "sphere.sdf\n- add_weld:\n    parent: gripper::palm\n    child: "
+        "camera::sphere\n    X_PC:\n      translation: [0.0, 0.1, 0.0]\n"
+    )
+    path = jaw_scene(tmp_path, "cam", directives=GRIPPER + PALM_ON_WORLD + camera + BOX)
+    freed = load_scene(path, free_hand=True)
+    palm = _body(freed, "gripper::palm")
+    assert palm.is_floating_base_body()
+    assert _body(freed, "camera::sphere") in freed.plant.GetBodiesWeldedTo(palm)
+
+
+def test_a_scene_without_hand_frees_the_one_instance_that_moves(tmp_path):
+    path = jaw_scene(tmp_path, "nohand", hand=None)
+    freed = load_scene(path, free_hand=True)
+    assert freed.info.hand is None
+    assert freed.hand == freed.plant.GetModelInstanceByName("gripper")
+    assert _body(freed, "gripper::palm").is_floating_base_body()
+    # without free_hand the file is read as before: hand None, palm welded
+    kept = load_scene(path)
+    assert kept.hand is None
+    assert not _body(kept, "gripper::palm").is_floating_base_body()
+
+
+def test_a_scene_without_hand_and_two_moving_instances_is_refused(tmp_path):
+    path = jaw_scene(
+        tmp_path,
+        "two",
+        hand=None,
+        directives=GRIPPER + PALM_ON_WORLD + BOX + SECOND_BOX,
+    )
+    with pytest.raises(SceneError, match="names no hand") as e:
+        load_scene(path, free_hand=True)
+    assert "2 model instances ['gripper', 'box2']" in str(e.value)
+    assert "'hand: gripper'" in str(e.value)
+    load_scene(path)  # analyze reads it as before
+
+
+def test_a_scene_without_hand_where_nothing_moves_is_refused(tmp_path):
+    path = jaw_scene(tmp_path, "still", hand=None, directives=BOX)
+    with pytest.raises(SceneError, match="no body besides the object can move"):
+        load_scene(path, free_hand=True)
+
+
+def test_a_hand_of_finger_bodies_is_freed_as_its_instance(tmp_path):
+    path = jaw_scene(
+        tmp_path, "fingers", hand="[gripper::left_finger, gripper::right_finger]"
+    )
+    freed = load_scene(path, free_hand=True)
+    assert isinstance(freed.hand, ModelInstanceIndex)
+    assert freed.plant.GetModelInstanceName(freed.hand) == "gripper"
+    assert _body(freed, "gripper::palm").is_floating_base_body()
+    kept = load_scene(path)
+    assert [b.name() for b in kept.hand] == ["left_finger", "right_finger"]
+
+
+def test_a_freed_hand_listing_the_object_is_refused(tmp_path):
+    """Widened to its instances, the list once dropped the object silently."""
+    path = jaw_scene(tmp_path, "listed", hand="[gripper::palm, box::box]")
+    with pytest.raises(InvalidOptionError, match="also listed as a body of the hand"):
+        load_scene(path, free_hand=True)
+
+
+def test_an_object_welded_to_the_world_loads(tmp_path):
+    """Loading is not planning: analyze may read a fixture; plan refuses it."""
+    path = jaw_scene(
+        tmp_path, "fixed", directives=GRIPPER + PALM_ON_WORLD + BOX_ON_WORLD
+    )
+    s = load_scene(path, free_hand=True)
+    assert s.object_body in s.plant.GetBodiesWeldedTo(s.plant.world_body())
+
+
+@pytest.mark.parametrize(
+    "key, value, match",
+    [
+        ("object_body", "nope::x", "object_body: no body named 'nope::x'"),
+        ("hand", "nope", "hand: no model instance named 'nope'"),
+        ("hand", "[gripper::nope]", "hand: no body named 'gripper::nope'"),
+    ],
+)
+def test_an_unknown_name_is_refused_naming_the_file_and_key(
+    tmp_path, key, value, match
+):
+    kwargs = {key: value}
+    path = jaw_scene(tmp_path, "unknown", **kwargs)
+    for free in (False, True):
+        with pytest.raises(ModelError, match=match) as e:
+            load_scene(path, free_hand=free)
+        assert str(e.value).startswith(f"scene {str(path)!r}: ")
