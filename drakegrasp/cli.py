@@ -40,10 +40,15 @@ hand) sampled, filtered, closed and ranked on an object, and prints the best
 scene's name), it plans for the hand and object that the scene's
 ``drakegrasp:`` section names (``hand:``, ``object_body:``), with the scene's
 μ, contact model and tolerance, against everything else the scene holds (a
-table, other objects).  The scene's welds of the hand to the world (which
-place it for ``analyze``, as in every shipped scene) are left out, since plan
-places the hand itself; a planar scene (``plane:``) is refused, as plan samples
-spatial grasps.  Given an object (a shipped object's name, a model
+table, other objects).  The scene's welds that attach the hand to the world or
+to anything else (which place it for ``analyze``, as in every shipped scene;
+a table, a mount) are left out, since plan places the hand itself; a ``hand:``
+of finger bodies plans for their whole model instance, and a scene without
+``hand:`` for the one model instance that moves besides the object.  An
+object that is welded or jointed to the world cannot be lifted and is refused
+before any work, as are the world, a body of the hand or the hand's own
+instance as the object; a planar scene (``plane:``) is refused, as plan
+samples spatial grasps.  Given an object (a shipped object's name, a model
 URL or a file, or a mesh ``.obj`` file, which Drake's parser makes one body
 with the mass of water filling it; default ``box``), it plans for ``--hand`` (a
 model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
@@ -890,8 +895,9 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         help="a scene: a YAML file or a shipped scene's name (`drakegrasp "
         "scenes`; not a planar one), planned for the hand and object its "
         "drakegrasp: section names, with its mu, against the rest of it (a weld "
-        "of the hand to the world, which places it for analyze, is left out: "
-        "plan places the hand); or an object: a shipped object name (box, "
+        "of the hand to the world or a table, which places it for analyze, is "
+        "left out: plan places the hand; an object welded to the world is "
+        "refused); or an object: a shipped object name (box, "
         "cylinder, sphere, hex_prism), a package:// URL, a model file or a mesh "
         "(.obj: one body with the mass of water filling it), planned for --hand "
         "(default: box)",

@@ -264,7 +264,7 @@ def multi_finger_hand(
         A malformed pre-shape, synergy, approach or stand-off.
     """
     bodies = hand_bodies(plant, object_body, hand)
-    base = _free_base(plant, bodies)
+    base = _free_base(plant, bodies, hand=hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     structure = hand_structure(
         plant, object_body, bodies, plant_couplings(plant), inspector=inspector

@@ -31,10 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import Joint, RigidBody
+from pydrake.multibody.tree import BodyIndex, Joint, RigidBody
 
 from drakegrasp.errors import ModelError
 from drakegrasp.planning.surface import piece_of_shape
+from drakegrasp.plant.attachment import chain_to_world, free_carrier, how_held
 from drakegrasp.plant.fingers import hand_structure
 from drakegrasp.plant.validation import HandSpec, hand_bodies, scoped_name
 
@@ -111,16 +112,73 @@ class ParallelJaw:
         }
 
 
-def _free_base(plant: MultibodyPlant, bodies) -> RigidBody:
-    free = [b for b in bodies if b.is_floating_base_body()]
-    if len(free) != 1:
-        raise ModelError(
-            "the hand's base must be one free body (a floating gripper placed by "
-            "its pose X_WH); the hand's bodies "
-            f"{[scoped_name(plant, b) for b in bodies]} "
-            f"have {len(free)} free bodies: add the hand without welding it"
+def _free_base(plant: MultibodyPlant, bodies, *, hand: HandSpec = None) -> RigidBody:
+    """The hand's base: the one free body of ``bodies`` that carries them all.
+
+    Raises
+    ------
+    ModelError
+        Naming why there is none: the hand's base is welded or jointed to
+        the world or to another body (a table, an arm), the free base is not
+        among ``bodies``, or ``bodies`` ride on several free bodies (other
+        objects taken for the hand).
+    """
+    carriers: dict[int | None, list[RigidBody]] = {}
+    for b in bodies:
+        c = free_carrier(plant, b)
+        carriers.setdefault(None if c is None else int(c.index()), []).append(b)
+    if len(carriers) == 1 and None not in carriers:
+        base = plant.get_body(BodyIndex(next(iter(carriers))))
+        if any(b.index() == base.index() for b in bodies):
+            return base
+    raise ModelError(_why_not_free(plant, bodies, carriers, hand))
+
+
+def _why_not_free(plant, bodies, carriers, hand) -> str:
+    """One line: why ``bodies`` (grouped by their free carrier) have no free base."""
+    names = [scoped_name(plant, b) for b in bodies]
+    if None in carriers:  # held by the world: say by what, at the hand's base
+        base = _held_base(plant, carriers[None])
+        return (
+            f"the hand is not free to place: its base {scoped_name(plant, base)} "
+            f"is {how_held(plant, base)}; plan_grasps places a free-floating hand "
+            "by its base's pose X_WH: add the hand without attaching it "
+            "(load_scene(..., free_hand=True) and `drakegrasp plan` leave out a "
+            "scene's own welds of its hand, not those inside model files or "
+            "included directive files)"
         )
-    return free[0]
+    free = [plant.get_body(BodyIndex(i)) for i in carriers]
+    if len(free) == 1:
+        base = scoped_name(plant, free[0])
+        instance = plant.GetModelInstanceName(free[0].model_instance())
+        return (
+            f"the hand's bodies {names} ride on the free body {base}, which is "
+            f"not one of them: name the hand's model instance ({instance!r}) or "
+            "list its base too"
+        )
+    shown = [scoped_name(plant, b) for b in free]
+    hint = (
+        "hand=None takes every body that can move outside the object's model "
+        "instance, other objects too: name the hand's model instance"
+        if hand is None
+        else "name the hand's model instance, or list the bodies of one hand"
+    )
+    return (
+        f"the hand's bodies move with {len(free)} free bodies {shown}, not one "
+        f"free base: {hint}"
+    )
+
+
+def _held_base(plant, held) -> RigidBody:
+    """The topmost body of the hand's model instances above a held body."""
+    instances = {int(b.model_instance()) for b in held}
+    base = held[0]
+    for joint in chain_to_world(plant, base):
+        parent = joint.parent_body()
+        if int(parent.index()) == 0 or int(parent.model_instance()) not in instances:
+            break
+        base = parent
+    return base
 
 
 def _finger_supports(plant, ctx, inspector, finger, base, a_H, sign):
@@ -226,7 +284,7 @@ def parallel_jaw(
 def _two_prismatic_fingers(plant, plant_context, object_body, hand):
     """(free base, the two fingers, their prismatic joints), or a ModelError."""
     bodies = hand_bodies(plant, object_body, hand)
-    base = _free_base(plant, bodies)
+    base = _free_base(plant, bodies, hand=hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     structure = hand_structure(plant, object_body, bodies, inspector=inspector)
     fingers = structure.fingers

@@ -35,6 +35,7 @@ import time
 
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.tree import RigidBody
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
@@ -44,7 +45,7 @@ from drakegrasp.core.validation import (
     check_flag,
     real_scalar,
 )
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.candidates import (
     GraspCandidates,
     closing_order,
@@ -57,7 +58,7 @@ from drakegrasp.planning.cloud import (
     cloud_surface,
     read_cloud,
 )
-from drakegrasp.planning.gripper import parallel_jaw
+from drakegrasp.planning.gripper import _free_base, parallel_jaw
 from drakegrasp.planning.motors import check_torque_limit
 from drakegrasp.planning.multifinger import (
     DEFAULT_TILT,
@@ -68,9 +69,12 @@ from drakegrasp.planning.multifinger import (
 from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
 from drakegrasp.planning.ranking import DEFAULT_NOISE, rank_candidates
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
+from drakegrasp.plant.attachment import free_carrier, how_held
 from drakegrasp.plant.validation import (
     HandSpec,
+    hand_bodies,
     plant_context_of,
+    resolve_grasped_body,
     resolve_object_body,
     scoped_name,
 )
@@ -222,7 +226,9 @@ def plan_grasps(
         scene's) is read from it; the hand's configuration is used as scratch
         and restored on return.
     object_body : RigidBody, BodyIndex, str or None
-        The object to grasp (frame O); None with ``point_cloud``.
+        The object to grasp (frame O): a body free to move in space (a free
+        body, or one carried by a free body), apart from the hand; None with
+        ``point_cloud``.
     hand : ModelInstanceIndex, str or iterable of RigidBody
         The hand, its base a free body: a parallel jaw (two prismatic
         fingers, see :mod:`drakegrasp.planning.gripper`) or a multi-finger
@@ -331,10 +337,14 @@ def plan_grasps(
     ------
     InvalidOptionError
         Bad options (``num_candidates`` negative, not an integer or above
-        :data:`MAX_CANDIDATES`; ``mu`` negative...).
+        :data:`MAX_CANDIDATES`; ``mu`` negative...); ``object_body`` the world
+        body or a body of the hand.
     ModelError
-        A hand without a free base or without fingers, an object without
-        graspable collision geometry.
+        A hand without a free base (welded or jointed to the world or to
+        another body, its base not among ``hand``'s bodies, or bodies of
+        several free bodies) or without fingers; an object without graspable
+        collision geometry, one that is not free to move (welded or jointed
+        to the world: it cannot be lifted), or one attached to the hand.
     """
     t0 = time.perf_counter()
     n = _check_count(num_candidates)
@@ -405,7 +415,7 @@ def plan_grasps(
     if torque_limit is not None:
         settings["torque_limit"] = torque_limit
     if point_cloud is None:
-        body = resolve_object_body(plant, object_body)
+        body = _graspable(plant, object_body, hand)
         if not hand_is_parallel_jaw(plant, ctx, body, hand):
             mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
             return plan_multifinger(
@@ -425,6 +435,7 @@ def plan_grasps(
         mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
     else:
         body = None
+        _free_base(plant, hand_bodies(plant, plant.world_body(), hand), hand=hand)
         points, normals, dropped = read_cloud(
             point_cloud, cloud_normals, viewpoint=viewpoint
         )
@@ -511,6 +522,40 @@ def plan_grasps(
         settings=settings,
         started=t0,
     )
+
+
+def _graspable(plant, object_body, hand) -> RigidBody:
+    """The object's body, once it is known that the hand can pick it up.
+
+    The object must be free to move in space (a free body, or carried by
+    one), apart from the hand, and the hand a free base that carries its
+    fingers (:func:`~drakegrasp.planning.gripper._free_base`): a planner that
+    ranks grasps by the weight they lift and by how they survive the
+    object's pose error has nothing to say about an object welded to the
+    world or jointed to it (a fixture, a drawer), nor about one the hand
+    carries already.
+    """
+    body = resolve_grasped_body(plant, object_body)
+    bodies = hand_bodies(plant, body, hand)  # refuses an object of the hand
+    name = scoped_name(plant, body)
+    carrier = free_carrier(plant, body)
+    if carrier is None:
+        held = how_held(plant, body)
+        what = "weld" if held.startswith("welded") else "joint"
+        raise ModelError(
+            f"object_body {name} is {held}: no grasp can lift it, so the "
+            "planner's holds (weight held, robustness to the object's pose) would "
+            f"mean nothing; plan on a free object: load it without that {what} "
+            "(in a scene, default_free_body_pose instead of add_weld)"
+        )
+    base = _free_base(plant, bodies, hand=hand)
+    if carrier.index() == base.index():
+        raise ModelError(
+            f"object_body {name} is attached to the hand: it rides on the hand's "
+            f"base {scoped_name(plant, base)}; plan on a free object, apart from "
+            "the hand"
+        )
+    return body
 
 
 def _no_torque_limit(torque_limit) -> None:

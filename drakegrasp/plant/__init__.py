@@ -77,6 +77,7 @@ _SUBMODULES = (
     "_shapes",
     "advancement",
     "analysis",
+    "attachment",
     "closing",
     "contact_normals",
     "contact_pair",

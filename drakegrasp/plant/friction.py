@@ -35,7 +35,7 @@ from drakegrasp.plant.validation import (
     hand_contact_bodies,
     plant_context_of,
     query_object_of,
-    resolve_object_body,
+    resolve_grasped_body,
 )
 
 __all__ = [
@@ -150,8 +150,10 @@ def hand_object_friction(
     ----------
     plant : MultibodyPlant
     plant_context : Context
-    object_body : RigidBody or str
-        The object's body, or its scoped name.
+    object_body : RigidBody, BodyIndex or str
+        The object's body, or its scoped name: not the world body, nor a
+        body of the hand.  A body welded to the world (a fixture) has the
+        friction of its geometries like any other.
     hand : HandSpec, optional
         The hand as :func:`~drakegrasp.plant.validation.hand_bodies` takes it.
 
@@ -163,11 +165,15 @@ def hand_object_friction(
 
     Raises
     ------
+    InvalidOptionError
+        If ``object_body`` is the world body, or a body of the hand (listed
+        in ``hand`` or joined to its bodies).
     ModelError
-        If a geometry has no ``material/coulomb_friction`` property.
+        If a geometry has no ``material/coulomb_friction`` property, or for
+        an unknown body or hand.
     """
     ctx = plant_context_of(plant, plant_context)
-    body = resolve_object_body(plant, object_body)
+    body = resolve_grasped_body(plant, object_body)
     query_object = query_object_of(plant, ctx)
     hand_ids = [
         g

@@ -142,7 +142,12 @@ from drakegrasp.plant.models import explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import check_section, directives_text, read_yaml
 from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
-from drakegrasp.plant.validation import resolve_body
+from drakegrasp.plant.validation import (
+    hand_bodies,
+    hand_contact_bodies,
+    model_instance,
+    resolve_body,
+)
 
 if TYPE_CHECKING:  # closing is imported only when a scene closes its hand
     from drakegrasp.plant.closing import HandClosure
@@ -228,6 +233,8 @@ class Scene:
     object_body : pydrake.multibody.tree.RigidBody
     hand : ModelInstanceIndex or tuple of RigidBody or None
         Argument to pass as ``hand=`` to :func:`drakegrasp.find_contacts`.
+        Loaded with ``free_hand``, the hand's whole model instance (see
+        :func:`load_scene`).
     closure : HandClosure or None
         How the hand was closed when the scene was loaded with closing (the
         file's ``close:`` or ``load_scene(..., close=True)``); the context
@@ -323,33 +330,138 @@ def read_scene_info(path: str | Path) -> SceneInfo:
     return SceneInfo(name=path.stem, path=path.resolve(), **section)
 
 
+def _new_plant(path: Path, package_map: PackagesSpec, ros_package_path: bool):
+    """(builder, plant, parser, packages) of an empty scene, packages registered."""
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    try:
+        parser = Parser(plant)
+    except RuntimeError as e:  # its default PackageMap could not add drake_models
+        raise ModelError(
+            f"scene {str(path)!r}: cannot make Drake's parser: "
+            + explain_drake_models(str(e))
+        ) from None
+    packages = add_packages(parser, package_map, ros_package_path=ros_package_path)
+    return builder, plant, parser, packages
+
+
+def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
+    """Process the (checked) directives into ``plant`` and finalize it."""
+    try:
+        added = ProcessModelDirectives(directives, plant, parser)
+    except Exception as e:  # Drake reports parse errors as RuntimeError
+        msg = explain_drake_models(str(e))
+        raise ModelError(
+            f"scene {str(path)!r}: cannot load the models: {msg}"
+        ) from None
+    record_model_couplings(plant, added)
+    plant.Finalize()
+
+
+def _scene_body(path: Path, plant: MultibodyPlant, name: str) -> RigidBody:
+    """The file's ``object_body``; an unknown name is refused naming the file."""
+    try:
+        return resolve_body(plant, name)
+    except ModelError as e:
+        raise ModelError(f"scene {str(path)!r}: object_body: {e}") from None
+
+
+def _scene_hand(path: Path, plant: MultibodyPlant, hand):
+    """The file's ``hand:`` in the plant; an unknown name is refused naming the file."""
+    try:
+        return _resolve_hand(plant, hand)
+    except ModelError as e:
+        raise ModelError(f"scene {str(path)!r}: hand: {e}") from None
+
+
 def _resolve_hand(plant: MultibodyPlant, hand) -> ModelInstanceIndex | tuple | None:
     if hand is None:
         return None
     if isinstance(hand, str):
-        if not plant.HasModelInstanceNamed(hand):
-            names = [
-                plant.GetModelInstanceName(ModelInstanceIndex(i))
-                for i in range(plant.num_model_instances())
-            ]
-            raise ModelError(f"no model instance named {hand!r}; instances are {names}")
-        return plant.GetModelInstanceByName(hand)
+        return model_instance(plant, hand)
     return tuple(resolve_body(plant, h) for h in hand)
 
 
-def _drop_hand_welds(directives, hand) -> None:
-    """Remove ``directives``' welds of the world to a body of ``hand``'s instances."""
-    if hand is None:
-        return
+def _hand_instances(hand) -> set[str]:
+    """Names of the model instances the file's ``hand:`` names."""
     names = (hand,) if isinstance(hand, str) else hand
-    instances = {name.partition("::")[0] for name in names}
-    directives.directives = [
+    return {name.partition("::")[0] for name in names}
+
+
+def _drop_hand_welds(directives, instances: set[str]) -> bool:
+    """Remove ``directives``' welds that attach the hand to anything else.
+
+    A weld whose child is a body of the hand's model ``instances`` and whose
+    parent is not (the world, a table, an arm's flange, a frame) places the
+    hand; welds inside the hand (one of its instances to another) stay.
+    Returns whether a weld was removed.
+    """
+    kept = [
         d
         for d in directives.directives
         if d.add_weld is None
-        or d.add_weld.parent != "world"
         or d.add_weld.child.partition("::")[0] not in instances
+        or d.add_weld.parent.partition("::")[0] in instances
     ]
+    dropped = len(kept) != len(directives.directives)
+    directives.directives = kept
+    return dropped
+
+
+def _whole_hand(plant: MultibodyPlant, hand, object_body: RigidBody):
+    """``Scene.hand`` for ``free_hand``: the hand's whole model instances.
+
+    A ``hand:`` of bodies (the fingers of a palm welded to the world, as
+    ``analyze`` reads them) becomes their model instance, or every body of
+    their instances when they are several (the object left out): the planner
+    places the hand by its base, which must be part of it.
+    """
+    if not isinstance(hand, tuple):
+        return hand
+    hand_contact_bodies(plant, object_body, hand)  # refuses the object listed
+    instances = sorted({b.model_instance() for b in hand}, key=int)
+    if len(instances) == 1:
+        return instances[0]
+    return tuple(
+        plant.get_body(i)
+        for m in instances
+        for i in plant.GetBodyIndices(m)
+        if i != object_body.index()
+    )
+
+
+def _infer_hand(path: Path, plant: MultibodyPlant, object_body: RigidBody) -> str:
+    """The one model instance that moves besides the object, for ``free_hand``.
+
+    The instance of the bodies that ``hand=None`` takes for the hand
+    (:func:`~drakegrasp.plant.validation.hand_bodies`).
+
+    Raises
+    ------
+    SceneError
+        If no body but the object can move, or bodies of several model
+        instances can (a hand and another free object): the file must say
+        which is the hand.
+    """
+    try:
+        bodies = hand_bodies(plant, object_body, None)
+    except ModelError:
+        bodies = []
+    found = sorted({b.model_instance() for b in bodies}, key=int)
+    names = [plant.GetModelInstanceName(m) for m in found]
+    if len(names) == 1:
+        return names[0]
+    where = (
+        f"the bodies that can move besides the object belong to {len(names)} "
+        f"model instances {names}: say which is the hand, e.g. 'hand: {names[0]}'"
+        if names
+        else "no body besides the object can move (a hand needs joints): add the "
+        "hand and name it with 'hand: NAME'"
+    )
+    raise SceneError(
+        f"scene {str(path)!r} names no hand (no 'hand:' in its drakegrasp: "
+        f"section) and {where}"
+    )
 
 
 def load_scene(
@@ -382,10 +494,16 @@ def load_scene(
         the file's joint values, along the file's ``close: {direction: ...}``
         if it gives one).  Default: what the file's ``close:`` says.
     free_hand : bool, optional
-        Leave out the file's welds of the world to a body of the ``hand:``
-        model instances, so that the hand floats free (what a grasp planner
-        places itself; ``drakegrasp plan`` on a scene).  Welds inside included
-        model files stay.  Default False.
+        Leave out the file's welds that attach a body of the hand's model
+        instances to anything outside them (the world, a table, an arm's
+        flange), so that the hand floats free: what a grasp planner places
+        itself (``drakegrasp plan`` on a scene).  The hand is then its whole
+        model instances: ``Scene.hand`` is the instance of a ``hand:`` of
+        bodies (a palm welded to the world and its fingers, as ``analyze``
+        reads them), and a file without ``hand:`` frees the one model instance
+        whose bodies can move besides the object (the hand ``analyze`` would
+        take).  Welds inside the hand, and those of included directive files
+        and model files, stay.  Default False.
 
     Returns
     -------
@@ -395,9 +513,12 @@ def load_scene(
     Raises
     ------
     SceneError
-        For a malformed file or a reference the policy refuses.
+        For a malformed file or a reference the policy refuses; with
+        ``free_hand``, a file without ``hand:`` whose movable bodies (the
+        object's left out) are of several model instances, or of none.
     ModelError
-        For a model that does not parse, or an unknown body or model instance.
+        For a model that does not parse, or an unknown body or model instance
+        (the message names the file and the key).
     UnreachableError, PenetrationError
         Closing asked for, and no finger reaches the object, or the file's
         pre-shape already penetrates it.
@@ -407,16 +528,8 @@ def load_scene(
     path = scene_path(DEFAULT_SCENE if path_or_name is None else path_or_name)
     text, data = read_yaml(path)
     info = SceneInfo(name=path.stem, path=path.resolve(), **check_section(path, data))
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    try:
-        parser = Parser(plant)
-    except RuntimeError as e:  # its default PackageMap could not add drake_models
-        raise ModelError(
-            f"scene {str(path)!r}: cannot make Drake's parser: "
-            + explain_drake_models(str(e))
-        ) from None
-    packages = add_packages(parser, package_map, ros_package_path=ros_package_path)
+    free_hand = check_flag("free_hand", free_hand)
+    builder, plant, parser, packages = _new_plant(path, package_map, ros_package_path)
     try:
         directives = LoadModelDirectivesFromString(directives_text(path, text))
     except SceneError:
@@ -434,19 +547,23 @@ def load_scene(
         read_yaml=read_yaml,
         allow_any_file=check_flag("allow_any_file", allow_any_file),
     )
-    if check_flag("free_hand", free_hand):
-        _drop_hand_welds(directives, info.hand)
-    try:
-        added = ProcessModelDirectives(directives, plant, parser)
-    except Exception as e:  # Drake reports parse errors as RuntimeError
-        msg = explain_drake_models(str(e))
-        raise ModelError(
-            f"scene {str(path)!r}: cannot load the models: {msg}"
-        ) from None
-    record_model_couplings(plant, added)
-    plant.Finalize()
-    object_body = resolve_body(plant, info.object_body)
-    hand = _resolve_hand(plant, info.hand)
+    if free_hand and info.hand is not None:
+        _drop_hand_welds(directives, _hand_instances(info.hand))
+    _load_models(path, directives, plant, parser)
+    object_body = _scene_body(path, plant, info.object_body)
+    if free_hand and info.hand is None:
+        # the hand analyze would take, by its model instance; freed, the
+        # plant is built again without the welds that placed it
+        inferred = _infer_hand(path, plant, object_body)
+        if _drop_hand_welds(directives, {inferred}):
+            builder, plant, parser, _ = _new_plant(path, package_map, ros_package_path)
+            _load_models(path, directives, plant, parser)
+            object_body = _scene_body(path, plant, info.object_body)
+        hand = plant.GetModelInstanceByName(inferred)
+    else:
+        hand = _scene_hand(path, plant, info.hand)
+        if free_hand:
+            hand = _whole_hand(plant, hand, object_body)
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     plant_context = plant.GetMyContextFromRoot(context)

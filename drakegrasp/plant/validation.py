@@ -27,6 +27,7 @@ from pydrake.systems.framework import Context
 
 from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.errors import InvalidContextError, InvalidOptionError, ModelError
+from drakegrasp.plant.attachment import joined
 
 __all__ = [
     "ROTATION_TOL",
@@ -41,6 +42,7 @@ __all__ = [
     "plant_context_of",
     "query_object_of",
     "resolve_body",
+    "resolve_grasped_body",
     "resolve_object_body",
     "scoped_name",
 ]
@@ -272,7 +274,7 @@ def model_instance(plant: MultibodyPlant, spec) -> ModelInstanceIndex:
         if not plant.HasModelInstanceNamed(spec):
             raise ModelError(
                 f"no model instance named {spec!r}; instances are "
-                f"{_instance_names(plant)}"
+                f"{_instance_names(plant)}" + _body_hint(plant, spec)
             )
         return plant.GetModelInstanceByName(spec)
     if isinstance(spec, ModelInstanceIndex):
@@ -287,6 +289,19 @@ def model_instance(plant: MultibodyPlant, spec) -> ModelInstanceIndex:
     raise InvalidOptionError(
         "a model instance must be a ModelInstanceIndex or a name, got "
         f"{type(spec).__name__}"
+    )
+
+
+def _body_hint(plant: MultibodyPlant, name: str) -> str:
+    """A hint when a model-instance name is a body's scoped name instead."""
+    model, _, body = name.rpartition("::")
+    if not (model and plant.HasModelInstanceNamed(model)):
+        return ""
+    if not plant.HasBodyNamed(body, plant.GetModelInstanceByName(model)):
+        return ""
+    return (
+        f" ({name!r} is a body: a hand of bodies is a list of them, "
+        f"[{name!r}, ...], and its model instance is {model!r})"
     )
 
 
@@ -350,6 +365,34 @@ def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
     )
 
 
+def resolve_grasped_body(plant: MultibodyPlant, object_body) -> RigidBody:
+    """:func:`resolve_object_body`, refusing the world body: it is no object.
+
+    For what only means something for an object a hand can touch and hold
+    (the friction of its pairs with the hand, grasp planning).
+
+    Raises
+    ------
+    InvalidOptionError
+        For the world body (``"world"``, ``BodyIndex(0)``,
+        ``plant.world_body()``), and for a value of another type.
+    ModelError
+        As :func:`resolve_object_body`.
+    """
+    body = resolve_object_body(plant, object_body)
+    if int(body.index()) == 0:
+        bodies = [
+            scoped_name(plant, plant.get_body(BodyIndex(i)))
+            for i in range(1, min(plant.num_bodies(), 9))
+        ]
+        more = ", ..." if plant.num_bodies() > 9 else ""
+        raise InvalidOptionError(
+            "object_body is the world body ('world'), which is not an object; "
+            f"name the body to grasp (bodies are {str(bodies)[:-1]}{more}])"
+        )
+    return body
+
+
 def _welded_to_world(plant: MultibodyPlant) -> frozenset[int]:
     return _per_plant(
         plant,
@@ -411,11 +454,54 @@ def _listed(hand) -> Iterable:
     return hand
 
 
+def _hand_repr(plant: MultibodyPlant, hand) -> str:
+    """``hand`` as a message shows it: an instance by name, bodies by scoped name."""
+    if isinstance(hand, ModelInstanceIndex):
+        return repr(plant.GetModelInstanceName(hand))
+    if isinstance(hand, str) or hand is None:
+        return repr(hand)
+    return repr(
+        [scoped_name(plant, b) if isinstance(b, RigidBody) else b for b in hand]
+    )
+
+
+def _check_apart(
+    plant: MultibodyPlant, object_body: RigidBody, hand, bodies: list[RigidBody]
+) -> None:
+    """Refuse an object that is one of the hand's bodies.
+
+    ``bodies`` are every body ``hand`` names (a model instance's, or the
+    listed ones).  An object listed in the hand, or joined by joints to another
+    body of the hand's model instance (a finger, a palm), is part of it; an
+    object that only shares the hand's model instance (one model file holding
+    a hand and a free object) is not.
+    """
+    obj = int(object_body.index())
+    if obj == 0 or all(int(b.index()) != obj for b in bodies):
+        return
+    name = scoped_name(plant, object_body)
+    if not isinstance(hand, str | ModelInstanceIndex):
+        raise InvalidOptionError(
+            f"object_body {name} is also listed as a body of the hand "
+            f"(hand={_hand_repr(plant, hand)}); the object and the hand must be "
+            "apart: leave it out of the hand"
+        )
+    others = [b for b in bodies if int(b.index()) != obj]
+    partner = next((b for b in others if joined(plant, object_body, b)), None)
+    if partner is not None:
+        raise InvalidOptionError(
+            f"object_body {name} is part of the hand {_hand_repr(plant, hand)}: "
+            f"it is joined to the hand's {scoped_name(plant, partner)}; name the "
+            "body to grasp, apart from the hand"
+        )
+
+
 def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
     welded = _welded_to_world(plant)
     if isinstance(hand, str | ModelInstanceIndex):
         instance = model_instance(plant, hand)
         bodies = [plant.get_body(i) for i in plant.GetBodyIndices(instance)]
+        _check_apart(plant, object_body, hand, bodies)
         bodies = [b for b in bodies if int(b.index()) not in welded]
     elif hand is None:
         bodies = [
@@ -428,6 +514,7 @@ def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
         ]
     else:
         listed = [resolve_object_body(plant, b) for b in _listed(hand)]
+        _check_apart(plant, object_body, hand, listed)
         bodies = [b for b in listed if int(b.index()) not in welded]
         if listed and not bodies:
             raise ModelError(
@@ -437,11 +524,26 @@ def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
             )
     bodies = [b for b in bodies if b.index() != object_body.index()]
     if not bodies:
-        raise ModelError(
-            f"the hand has no bodies that can move (hand={hand!r}); name its model "
-            "instance or list its bodies"
-        )
+        raise _no_bodies(plant, object_body, hand, " that can move")
     return sorted(bodies, key=lambda b: int(b.index()))
+
+
+def _no_bodies(plant, object_body, hand, which: str) -> ModelError:
+    """The error of a hand left with no body (``which``: " that can move", "")."""
+    shown = _hand_repr(plant, hand)
+    if (
+        isinstance(hand, str | ModelInstanceIndex)
+        and model_instance(plant, hand) == object_body.model_instance()
+    ):
+        return ModelError(
+            f"hand={shown} is the model instance of the object "
+            f"{scoped_name(plant, object_body)}, which holds no other body"
+            f"{which}; name the hand's own model instance or list its bodies"
+        )
+    return ModelError(
+        f"the hand has no bodies{which} (hand={shown}); name its model "
+        "instance or list its bodies"
+    )
 
 
 def hand_contact_bodies(
@@ -482,12 +584,10 @@ def hand_contact_bodies(
         bodies = [plant.get_body(i) for i in plant.GetBodyIndices(instance)]
     else:
         bodies = [resolve_object_body(plant, b) for b in _listed(hand)]
+    _check_apart(plant, object_body, hand, bodies)
     bodies = [b for b in bodies if int(b.index()) not in (0, obj)]
     if not bodies:
-        raise ModelError(
-            f"the hand has no bodies (hand={hand!r}); name its model instance or "
-            "list its bodies"
-        )
+        raise _no_bodies(plant, object_body, hand, "")
     unique = {int(b.index()): b for b in bodies}
     return [unique[i] for i in sorted(unique)]
 

@@ -1413,6 +1413,7 @@ def planning_cases() -> Iterator[Case]:
         "object-and-cloud": {"point_cloud": np.zeros((10, 3))},
     }.items():
         yield Case("planning", name, lambda kw=kw: plan(**kw), "refuse")
+    yield from _odd_plant_cases(scene)
     # Clouds: the plant holds the hand alone.
     rng = np.random.default_rng(5)
     cloud = rng.normal(size=(200, 3))
@@ -1487,6 +1488,126 @@ def planning_cases() -> Iterator[Case]:
             lambda s=scale: on_cloud(cloud, cloud_normals=-cloud * s),
             "answer",
             lambda r: len(r) > 0 and ranked(r),
+        )
+
+
+def _odd_rig(edit):
+    """A free flat-pad jaw and a free box, edited before ``Finalize``.
+
+    ``edit(plant, parser, hand, obj)`` welds or joins bodies; it may return
+    keyword arguments of ``plan_grasps`` (another ``hand``).
+    """
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drakegrasp.plant.models import register_models
+
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    parser = Parser(plant)
+    register_models(parser)
+    parser.SetAutoRenaming(True)
+    hand = parser.AddModels(url=OWN_GRIPPER)[0]
+    obj = parser.AddModels(url="package://drakegrasp/objects/box.sdf")[0]
+    kw = edit(plant, parser, hand, obj) or {}
+    plant.Finalize()
+    context = builder.Build().CreateDefaultContext()
+    body = plant.GetBodyByName("box", obj)
+    return lambda: dg.plan_grasps(
+        plant, context, body, **{"hand": hand, "num_candidates": 4, "mu": 0.5, **kw}
+    )
+
+
+def _odd_plant_cases(scene) -> Iterator[Case]:
+    """Objects no hand can pick up and hands the planner cannot place.
+
+    Each was planned on, or refused naming another cause: a welded object (held
+    "nan N/N"), a hinged one, one welded to the palm; a palm welded to the
+    world or a table ("add the hand without welding it", where the weld is the
+    table's); fingers without their free palm; ``hand=None`` taking a second
+    free box for the hand's base; the world or a finger as the object.
+    """
+    from pydrake.multibody.tree import RevoluteJoint
+
+    from drakegrasp.plant.friction import hand_object_friction
+
+    def palm(p, h):
+        return p.GetBodyByName("palm", h).body_frame()
+
+    def box(p, o):
+        return p.GetBodyByName("box", o).body_frame()
+
+    def other_box(p, parser):
+        return p.GetBodyByName(
+            "box", parser.AddModels(url="package://drakegrasp/objects/box.sdf")[0]
+        )
+
+    def object_welded(p, parser, h, o):
+        p.WeldFrames(p.world_frame(), box(p, o))
+
+    def object_hinged(p, parser, h, o):
+        p.AddJoint(RevoluteJoint("hinge", p.world_frame(), box(p, o), [0, 0, 1]))
+
+    def object_on_palm(p, parser, h, o):
+        p.WeldFrames(palm(p, h), box(p, o), RigidTransform([0, 0.1, 0]))
+
+    def hand_welded(p, parser, h, o):
+        p.WeldFrames(p.world_frame(), palm(p, h))
+
+    def hand_on_table(p, parser, h, o):
+        t = other_box(p, parser).body_frame()
+        p.WeldFrames(p.world_frame(), t, RigidTransform([0.3, 0, 0]))
+        p.WeldFrames(t, palm(p, h), RigidTransform([-0.3, 0, 0.2]))
+
+    def fingers_only(p, parser, h, o):
+        return {
+            "hand": [p.GetBodyByName(f, h) for f in ("left_finger", "right_finger")]
+        }
+
+    def second_box(p, parser, h, o):
+        p.SetDefaultFloatingBaseBodyPose(
+            other_box(p, parser), RigidTransform([0.5, 0, 0])
+        )
+        return {"hand": None}
+
+    def welded_and_second_box(p, parser, h, o):
+        hand_welded(p, parser, h, o)
+        return second_box(p, parser, h, o)
+
+    edits = {
+        "object-welded-to-world": object_welded,
+        "object-on-a-hinge": object_hinged,
+        "object-welded-to-palm": object_on_palm,
+        "hand-welded-to-world": hand_welded,
+        "hand-welded-to-table": hand_on_table,
+        "hand-fingers-palm-free": fingers_only,
+        "hand-none-second-free-box": second_box,
+        "hand-none-welded-palm-second-box": welded_and_second_box,
+    }
+    for name, edit in edits.items():
+        yield Case("planning", name, lambda e=edit: _odd_rig(e)(), "refuse")
+    finger = f"{scene.plant.GetModelInstanceName(scene.hand)}::left_finger"
+
+    def plan_on(obj):
+        return dg.plan_grasps(
+            scene.plant, scene.context, obj, hand=scene.hand, num_candidates=4, mu=0.5
+        )
+
+    for name, obj in {"object-world": "world", "object-is-finger": finger}.items():
+        yield Case("planning", name, lambda o=obj: plan_on(o), "refuse")
+    for name, obj in {
+        "friction-of-world": "world",
+        "friction-of-world-index": scene.plant.world_body().index(),
+        "friction-of-finger": finger,
+    }.items():
+        yield Case(
+            "planning",
+            name,
+            lambda o=obj: hand_object_friction(
+                scene.plant, scene.context, o, scene.hand
+            ),
+            "refuse",
         )
 
 

@@ -124,6 +124,80 @@ def test_bad_inputs_one_line_each(tmp_path):
     assert not list(tmp_path.glob(".*.partial"))
 
 
+_BOX_POSE = """\
+    default_free_body_pose:
+      box:
+        translation: [0.0, 0.0, 0.065]
+        rotation: !Rpy {deg: [0.0, 0.0, 0.0]}
+"""
+_BOX_WELD = """\
+- add_weld:
+    parent: world
+    child: box::box
+    X_PC:
+      translation: [0.0, 0.0, 0.065]
+"""
+_BOX2 = """\
+- add_model:
+    name: box2
+    file: package://drakegrasp/objects/box.sdf
+    default_free_body_pose:
+      box:
+        translation: [0.3, 0.0, 0.065]
+"""
+# Edits of the shipped parallel_jaw_box that `plan` refuses, and the cause the
+# one line must name (before: a misleading cause, or a plan on nonsense)
+HOSTILE_SCENES = {
+    "object welded": (
+        [(_BOX_POSE, ""), ("drakegrasp:\n", _BOX_WELD + "drakegrasp:\n")],
+        "object_body box::box is welded to the world",
+    ),
+    "object world": (
+        [("object_body: box::box", "object_body: world")],
+        "is the world body",
+    ),
+    "object palm": (
+        [("object_body: box::box", "object_body: gripper::palm")],
+        "is part of the hand",
+    ),
+    "hand object's instance": (
+        [("  hand: gripper\n", "  hand: box\n")],
+        "is the model instance of the object",
+    ),
+    "no hand, second free box": (
+        [("  hand: gripper\n", ""), ("drakegrasp:\n", _BOX2 + "drakegrasp:\n")],
+        "names no hand",
+    ),
+    "object unknown": (
+        [("object_body: box::box", "object_body: box::lid")],
+        "object_body: no body named 'box::lid'",
+    ),
+    "hand a body": (
+        [("  hand: gripper\n", "  hand: gripper::palm\n")],
+        "'gripper::palm' is a body",
+    ),
+    "hand of no model": (
+        [("  hand: gripper\n", "  hand: [gripper::palm, box::box]\n")],
+        "also listed as a body of the hand",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE_SCENES))
+def test_hostile_scenes_one_line_each(tmp_path, case):
+    from drakegrasp.plant.scene import scene_path
+
+    edits, cause = HOSTILE_SCENES[case]
+    text = scene_path("parallel_jaw_box").read_text()
+    for old, new in edits:
+        assert old in text, old
+        text = text.replace(old, new)
+    scene = tmp_path / "hostile.yaml"
+    scene.write_text(text)
+    line = _one_line_error(_run("plan", str(scene), "--num", "5"))
+    assert line.startswith("drakegrasp: error:") and cause in line, line
+
+
 def test_upper_case_suffix_overwrite_and_the_deprecated_alias(tmp_path):
     good = _grasps(tmp_path / "good.npz", 5)
     out = tmp_path / "OUT.NPZ"

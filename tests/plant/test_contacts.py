@@ -307,8 +307,11 @@ def test_bad_options_and_bodies():
     with pytest.raises(ModelError, match="no body named 'nope'"):
         find_contacts(rig.plant, rig.ctx, object_body="nope")
     assert find_contacts(rig.plant, rig.ctx, object_body="object::object")
-    with pytest.raises(ModelError, match="hand has no bodies"):
+    # the object as the hand: once "the hand has no bodies", now the cause
+    with pytest.raises(InvalidOptionError, match="also listed as a body of the hand"):
         rig.contacts(hand=[rig.object])
+    with pytest.raises(ModelError, match="hand has no bodies"):
+        rig.contacts(hand=[])
     # The diagram's root context resolves to the plant's; object_body positional.
     from_root = find_contacts(rig.plant, rig.root, rig.object)
     assert [c.psi for c in from_root] == [c.psi for c in rig.contacts()]
