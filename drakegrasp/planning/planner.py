@@ -273,7 +273,7 @@ def plan_grasps(
         the surroundings only.
     cloud_normals : (M, 3) float, optional
         Outward normals of the cloud's points; default the cloud's own, else
-        estimated from the flattest nearby plane
+        estimated from the flattest nearby patch, plane or quadric
         (:func:`~drakegrasp.planning.cloud.estimate_normals`).
     viewpoint : (3,) float, optional
         Where the cloud was seen from (normals are turned towards it); default
