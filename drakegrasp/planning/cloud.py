@@ -309,8 +309,12 @@ def estimate_normals(points: np.ndarray) -> np.ndarray:
     -------
     normals : (M, 3) float
         Unit normals (either sign); NaN where a neighbourhood spans no plane
-        (fewer than 3 distinct points, or all on a line).
+        (fewer than 3 distinct points, or all on a line).  A point given
+        twice counts once, and both copies get its normal.
     """
+    unique, inverse = np.unique(points, axis=0, return_inverse=True)
+    if len(unique) < len(points):  # repeated points (fused frames) count once
+        return estimate_normals(unique)[inverse.reshape(-1)]
     M = len(points)
     k = min(NORMAL_NEIGHBOURS, M)
     tree = cKDTree(points)

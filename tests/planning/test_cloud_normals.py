@@ -167,3 +167,13 @@ def test_curved_normals_do_not_depend_on_rigid_motion_or_units(seed):
     base = estimate_normals(points)
     err = _angles(estimate_normals(moved), base @ R.T)
     assert err.max() < 1e-3
+
+
+def test_repeated_points_count_once():
+    # Fused frames of a still camera repeat points: ten copies of each filled
+    # every neighbourhood with two places (a line) and left no normal at all.
+    points, true = _cylinder_side(600, seed=3)
+    repeated = np.repeat(points, 10, axis=0)
+    normals = estimate_normals(repeated)
+    np.testing.assert_array_equal(normals, np.repeat(estimate_normals(points), 10, 0))
+    assert _angles(normals, np.repeat(true, 10, axis=0)).max() < 2.0
