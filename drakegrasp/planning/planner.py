@@ -68,6 +68,7 @@ from drakegrasp.planning.multifinger import (
 from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
 from drakegrasp.planning.ranking import DEFAULT_NOISE, rank_candidates
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
+from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.validation import (
     HandSpec,
     plant_context_of,
@@ -421,6 +422,7 @@ def plan_grasps(
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
         X_WO = plant.EvalBodyPoseInWorld(ctx, body)
+        reference = centre_of_mass(ctx, body)
         name = scoped_name(plant, body)
         mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
     else:
@@ -444,6 +446,7 @@ def plan_grasps(
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface, completion = cloud_surface(points, normals, viewpoint, complete_unseen)
         X_WO = RigidTransform(surface.origin)
+        reference = np.zeros(3)  # the cloud's centre, the assumed centre of mass
         name = "point cloud"
         mass = np.nan if object_mass is None else float(object_mass)
         settings.update(
@@ -454,7 +457,7 @@ def plan_grasps(
             unseen_completion=completion,
         )
     settings["gripper"] = gripper.to_dict()
-    torque_scale = surface.radius_about(np.zeros(3))
+    torque_scale = surface.radius_about(reference)
     rng = np.random.default_rng(seed)
     poses, rejections = sample_poses(surface, gripper, X_WO, n, mu, clearance, rng, tol)
     saved = plant.GetPositions(ctx).copy()
@@ -500,6 +503,7 @@ def plan_grasps(
         samples=robustness_samples, noise=noise, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
         surface=FittedCloud(surface) if body is None else surface, tol=tol,
+        reference=reference,
     )  # fmt: skip
     return planning_result(
         candidates,
