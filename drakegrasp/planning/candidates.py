@@ -82,6 +82,11 @@ class GraspCandidate:
         multi-finger hand: see ``q_preshape``).
     contacts : tuple of PlantContact
         Contacts of the closed hand (object frame O).
+    reference_point : (3,) float
+        The point of frame O (metres) that every moment of the candidate is
+        taken about: ``grasp``, ``epsilon``, ``weight_capacity`` and
+        ``torque_needed``.  The object's centre of mass, where its weight
+        acts (on a point cloud, the cloud's centre: O's origin).
     contact_options : dict
         ``mu``, ``model`` and ``torsional_friction`` of the contacts.
     is_closure : bool
@@ -137,6 +142,7 @@ class GraspCandidate:
     closing_signs: tuple[float, ...]
     opening: float
     contacts: tuple[PlantContact, ...]
+    reference_point: np.ndarray
     contact_options: dict
     is_closure: bool
     d_star: float
@@ -152,12 +158,13 @@ class GraspCandidate:
 
     @cached_property
     def grasp(self) -> Grasp:
-        """The core grasp of the contacts (frame O, moments about O's origin).
+        """The core grasp of the contacts (frame O, moments about ``reference_point``).
 
         Built on first access (thousands of candidates rarely need it).
         """
         return Grasp(
-            [Contact(c.p_OC, c.nhat_O, **self.contact_options) for c in self.contacts]
+            [Contact(c.p_OC, c.nhat_O, **self.contact_options) for c in self.contacts],
+            reference_point=self.reference_point,
         )
 
     @property
@@ -214,6 +221,7 @@ class GraspCandidate:
             "joint_names": list(self.joint_names),
             "opening": jsonable(self.opening),
             "num_contacts": self.num_contacts,
+            "reference_point": jsonable(self.reference_point),
             "contacts": [
                 {
                     "finger_body": c.finger_body,
@@ -321,8 +329,9 @@ class GraspCandidates(Sequence):
     mu : float
         Friction coefficient of the verdicts.
     torque_scale : float
-        Length (m) dividing moments in ε: the radius of a ball about O's
-        origin that holds the object, the same for every candidate.
+        Length (m) dividing moments in ε: the radius of a ball about the
+        candidates' ``reference_point`` (the centre of mass) that holds the
+        object, the same for every candidate.
     reason : str
         Why the result is empty, or why none of its candidates is force
         closure or (multi-finger hands) held by the hand's actuators (empty

@@ -16,7 +16,8 @@ wrench) the **torque capacity** in a weight direction ``u`` is
     |(J^\top f)_j| \le 1 \;\text{(every finger joint } j\text{)},
 
 the weight (N) held along ``u`` per N·m allowed at every finger joint, moments
-about O's origin (the centre of mass of the shipped objects).  By linearity
+about the candidate's ``reference_point`` (the object's centre of mass, where
+its weight acts).  By linearity
 the hand holds a weight ``m g`` in every one of the directions
 :data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS` when each joint may
 apply :math:`m g / \min_u \beta(u)`: the **torque needed**.  Like the squeeze

@@ -69,7 +69,7 @@ from drakegrasp.planning.ranking import (
     robustness,
     tie_key,
 )
-from drakegrasp.planning.weight import weight_capacity
+from drakegrasp.planning.weight import centre_of_mass, weight_capacity
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
 from drakegrasp.plant.fingers import hand_structure
@@ -331,12 +331,13 @@ def fan_capacity(
 
 def rank_multifinger(
     kept, *, label, hand: MultiFingerHand, plant, mu, model, nu, torque_scale,
-    samples, noise, rng, certify, workers, X_WO, weight,
+    samples, noise, rng, certify, workers, X_WO, weight, reference,
 ):  # fmt: skip
     """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
 
     ``label`` maps a finger body's scoped name to its finger; other hand
-    bodies (the palm) are labelled ``F``, the number of fingers.
+    bodies (the palm) are labelled ``F``, the number of fingers.  Moments are
+    about ``reference`` ((3,) in O, metres), where the weight acts.
     """
     if not kept:
         return ()
@@ -348,19 +349,20 @@ def rank_multifinger(
     verdict, groups = grouped_verdicts(
         kept, lambda found: _labels(found, label, F), mu,
         torque_scale=torque_scale, model=model, nu=nu, workers=workers,
+        reference=reference,
     )  # fmt: skip
     is_closure, d_star, rank, eps = verdict.values()
     for idx, P, Nrm, L, fc in groups:
         closed = idx[fc]
         if len(closed):
             rho[closed] = robustness(
-                P[fc], Nrm[fc], L[fc], mu, samples=samples, rng=rng, noise=noise,
-                model=model, torsional_friction=nu, workers=workers,
+                P[fc] - reference, Nrm[fc], L[fc], mu, samples=samples, rng=rng,
+                noise=noise, model=model, torsional_friction=nu, workers=workers,
                 groups=tuple(range(F)),
             )  # fmt: skip
             alpha[closed] = weight_capacity(
-                P[fc], Nrm[fc], L[fc], mu, torque_scale=torque_scale, model=model,
-                torsional_friction=nu,
+                P[fc] - reference, Nrm[fc], L[fc], mu, torque_scale=torque_scale,
+                model=model, torsional_friction=nu,
             ).min(axis=1)  # fmt: skip
     fanned = np.flatnonzero(
         np.isfinite(alpha) & (rho > 0) & [_has_fan(k[4]) for k in kept]
@@ -368,7 +370,7 @@ def rank_multifinger(
     for idx in group_by_count(counts[fanned]).values():
         rows = fanned[idx]
         alpha[rows] = fan_capacity(
-            np.array([[c.p_OC for c in kept[i][4]] for i in rows]),
+            np.array([[c.p_OC for c in kept[i][4]] for i in rows]) - reference,
             np.array([[c.nhat_O for c in kept[i][4]] for i in rows]),
             np.array([_fans(kept[i][4]) for i in rows]),
             np.array([_labels(kept[i][4], label, F) for i in rows]),
@@ -392,7 +394,7 @@ def rank_multifinger(
             q_hand=np.asarray(q, float), joint_names=s.names,
             closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
             opening=float("nan"), contacts=tuple(found),
-            q_preshape=np.asarray(q_pre, float),
+            q_preshape=np.asarray(q_pre, float), reference_point=reference.copy(),
         )  # fmt: skip
 
     return ranked_candidates(
@@ -404,6 +406,7 @@ def rank_multifinger(
 def _ranked_result(
     kept, *, label, hand_model, plant, mu, settings, torque_scale, rng, certify,
     workers, X_WO, weight, rejections, num_sampled, object_body, started,
+    reference,
 ):  # fmt: skip
     """Both routes' last stage: the kept closings ranked, as GraspCandidates."""
     candidates = rank_multifinger(
@@ -411,7 +414,7 @@ def _ranked_result(
         model=settings["contact_model"], nu=settings["torsional_friction"],
         torque_scale=torque_scale, samples=settings["robustness_samples"],
         noise=settings["noise"], rng=rng, certify=certify, workers=workers,
-        X_WO=X_WO, weight=weight,
+        X_WO=X_WO, weight=weight, reference=reference,
     )  # fmt: skip
     return planning_result(
         candidates,
@@ -468,7 +471,8 @@ def plan_multifinger(
     settings = {**settings, "hand": hand_model.to_dict(), "tilt": tilt,
                 "min_fingers": int(min_fingers)}  # fmt: skip
     X_WO = plant.EvalBodyPoseInWorld(ctx, body)
-    torque_scale = surface.radius_about(np.zeros(3))
+    reference = centre_of_mass(ctx, body)
+    torque_scale = surface.radius_about(reference)
     poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
     saved = plant.GetPositions(ctx).copy()
     try:
@@ -482,7 +486,7 @@ def plan_multifinger(
         kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
         settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
-        num_sampled=n, object_body=name, started=t0,
+        num_sampled=n, object_body=name, started=t0, reference=reference,
     )  # fmt: skip
     return with_torques_needed(
         result, plant, ctx, body, weight=weight, top=certify, started=t0,
@@ -542,6 +546,7 @@ def plan_multifinger_cloud(
         settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
         num_sampled=n, object_body="point cloud", started=t0,
+        reference=np.zeros(3),
     )  # fmt: skip
     # no object body: each contact's finger point is its cloud point
     return with_torques_needed(

@@ -69,6 +69,7 @@ from drakegrasp.planning.multifinger import (
 from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
 from drakegrasp.planning.ranking import DEFAULT_NOISE, rank_candidates
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
+from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.attachment import free_carrier, how_held
 from drakegrasp.plant.validation import (
     HandSpec,
@@ -279,7 +280,7 @@ def plan_grasps(
         the surroundings only.
     cloud_normals : (M, 3) float, optional
         Outward normals of the cloud's points; default the cloud's own, else
-        estimated from the flattest nearby plane
+        estimated from the flattest nearby patch, plane or quadric
         (:func:`~drakegrasp.planning.cloud.estimate_normals`).
     viewpoint : (3,) float, optional
         Where the cloud was seen from (normals are turned towards it); default
@@ -431,6 +432,7 @@ def plan_grasps(
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
         X_WO = plant.EvalBodyPoseInWorld(ctx, body)
+        reference = centre_of_mass(ctx, body)
         name = scoped_name(plant, body)
         mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
     else:
@@ -455,6 +457,7 @@ def plan_grasps(
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface, completion = cloud_surface(points, normals, viewpoint, complete_unseen)
         X_WO = RigidTransform(surface.origin)
+        reference = np.zeros(3)  # the cloud's centre, the assumed centre of mass
         name = "point cloud"
         mass = np.nan if object_mass is None else float(object_mass)
         settings.update(
@@ -465,7 +468,7 @@ def plan_grasps(
             unseen_completion=completion,
         )
     settings["gripper"] = gripper.to_dict()
-    torque_scale = surface.radius_about(np.zeros(3))
+    torque_scale = surface.radius_about(reference)
     rng = np.random.default_rng(seed)
     poses, rejections = sample_poses(surface, gripper, X_WO, n, mu, clearance, rng, tol)
     saved = plant.GetPositions(ctx).copy()
@@ -511,6 +514,7 @@ def plan_grasps(
         samples=robustness_samples, noise=noise, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
         surface=FittedCloud(surface) if body is None else surface, tol=tol,
+        reference=reference,
     )  # fmt: skip
     return planning_result(
         candidates,

@@ -306,12 +306,16 @@ def ranked_candidates(
     return tuple(out)
 
 
-def grouped_verdicts(kept, labels, mu, *, torque_scale, model, nu, workers):
+def grouped_verdicts(
+    kept, labels, mu, *, torque_scale, model, nu, workers, reference=None
+):  # fmt: skip
     """Stage 4a, either hand's route: every kept grasp's LP2 verdict, by count.
 
     ``kept[i][4]`` are row ``i``'s contacts (``p_OC``, ``nhat_O``);
     ``labels(contacts)`` numbers their fingers.  Grasps with equal contact
-    counts go to the batch engine together (:func:`verdicts`).
+    counts go to the batch engine together (:func:`verdicts`), with moments
+    about ``reference`` ((3,) in O, metres: the object's centre of mass;
+    default O's origin).
 
     Returns
     -------
@@ -319,8 +323,10 @@ def grouped_verdicts(kept, labels, mu, *, torque_scale, model, nu, workers):
         ``is_closure``, ``d_star``, ``rank``, ``eps``.
     groups : list of tuple
         Per count: ``(idx, P, Nrm, L, fc)``, the rows, their contacts
-        ``(n, N, 3)``, normals, finger labels ``(n, N)`` and closure mask.
+        ``(n, N, 3)`` (frame O, about its origin), normals, finger labels
+        ``(n, N)`` and closure mask.
     """
+    reference = np.zeros(3) if reference is None else reference
     K = len(kept)
     verdict = {
         "is_closure": np.zeros(K, bool), "d_star": np.zeros(K),
@@ -333,7 +339,7 @@ def grouped_verdicts(kept, labels, mu, *, torque_scale, model, nu, workers):
         Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
         L = np.array([labels(kept[i][4]) for i in idx])
         fc, ds, rk, ep = verdicts(
-            P, Nrm, mu, torque_scale=torque_scale, model=model,
+            P - reference, Nrm, mu, torque_scale=torque_scale, model=model,
             torsional_friction=nu, workers=workers,
         )  # fmt: skip
         for key, value in zip(verdict, (fc, ds, rk, ep), strict=True):
@@ -345,12 +351,14 @@ def grouped_verdicts(kept, labels, mu, *, torque_scale, model, nu, workers):
 def rank_candidates(
     kept, *, finger_names, gripper, plant, mu, model, nu, torque_scale, samples,
     noise, rng, certify, workers, X_WO, weight, weight_check, surface, tol,
+    reference,
 ):  # fmt: skip
     """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
 
     ``kept`` holds ``(sample, X_WH, q, opening, contacts)`` of every closed
     pose; contacts have ``p_OC``, ``nhat_O`` and ``finger_body``.  ``weight``
-    is the object's weight (N), NaN when unknown.  Robustness re-closes the
+    is the object's weight (N), NaN when unknown, acting at ``reference``
+    ((3,) in O: every moment is about it).  Robustness re-closes the
     jaws on the moved object's ``surface`` (:mod:`drakegrasp.planning.reclose`,
     within ``tol``): an object body's
     (:class:`~drakegrasp.planning.surface.ObjectSurface`) or a cloud's
@@ -365,6 +373,7 @@ def rank_candidates(
     verdict, groups = grouped_verdicts(
         kept, lambda found: [_finger_label(c, names) for c in found], mu,
         torque_scale=torque_scale, model=model, nu=nu, workers=workers,
+        reference=reference,
     )  # fmt: skip
     is_closure, d_star, rank, eps = verdict.values()
     for idx, P, _, F, fc in groups:
@@ -373,7 +382,7 @@ def rank_candidates(
             rho[closed] = reclosed_robustness(
                 surface, P[fc], F[fc], _axes_O(kept, closed, gripper, X_WO), mu,
                 samples=samples, rng=rng, **noise, tol=tol, model=model,
-                torsional_friction=nu, workers=workers,
+                torsional_friction=nu, workers=workers, reference=reference,
             )  # fmt: skip
     samples_of = np.array([k[0] for k in kept])
     pre = eps * rho
@@ -384,7 +393,7 @@ def rank_candidates(
     for idx in group_by_count(counts[checked]).values():
         idx = checked[idx]
         alpha[idx] = weight_capacity(
-            np.array([[c.p_OC for c in kept[i][4]] for i in idx]),
+            np.array([[c.p_OC for c in kept[i][4]] for i in idx]) - reference,
             np.array([[c.nhat_O for c in kept[i][4]] for i in idx]),
             np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx]),
             mu, torque_scale=torque_scale, model=model, torsional_friction=nu,
@@ -412,6 +421,7 @@ def rank_candidates(
             sample=sample, hand_base=base, X_WH=X_WH, X_WO=X_WO,
             q_hand=np.asarray(q, float), joint_names=joint_names,
             closing_signs=signs, opening=opening, contacts=tuple(found),
+            reference_point=reference.copy(),
         )  # fmt: skip
 
     return ranked_candidates(

@@ -150,6 +150,7 @@ def reclosed_robustness(
     model: str,
     torsional_friction,
     workers: int | None,
+    reference: np.ndarray | None = None,
 ) -> np.ndarray:
     """(K,) fraction of ``samples`` re-closed copies of each grasp in force closure.
 
@@ -169,7 +170,12 @@ def reclosed_robustness(
     tol : float
     model, torsional_friction, workers
         As :func:`~drakegrasp.batch.batch_force_closure`.
+    reference : (3,) float, optional
+        The point of O that moments are taken about (the object's centre of
+        mass; default O's origin): a soft finger's torsion scale ``b`` is the
+        farthest contact from it.
     """
+    reference = np.zeros(3) if reference is None else reference
     K, N, _ = positions.shape
     if samples == 0 or K == 0:
         return np.zeros(K)
@@ -191,7 +197,7 @@ def reclosed_robustness(
         # verdicts only (each LP stops once its verdict is proved): those of
         # batch_force_closure, at a fraction of the cost
         held[rows] = force_verdicts(
-            p_OC[take],
+            p_OC[take] - reference,
             nhat[take],
             mu=mus[rows, None],  # one μ per copy (K, 1): never read per contact
             contact_model=model,

@@ -1,8 +1,9 @@
 r"""How much weight a parallel-jaw grasp holds per newton of squeeze, in one LP.
 
 A gripper presses each finger with a set force ``S``; the object's weight
-``m g`` acts at its origin O (the centre of mass of the shipped objects) in a
-direction ``u`` that a shake test turns around.  The grasp holds when the
+``m g`` acts at its centre of mass (:func:`centre_of_mass`; the planner gives
+the contacts relative to it, whatever the model's body frame) in a direction
+``u`` that a shake test turns around.  The grasp holds when the
 contact forces, inside their (polyhedral) friction cones and with each
 finger's normal forces summing to at most ``S``, can balance ``m g u``.  By
 linearity the answer scales with ``S``, so each grasp has a **weight
@@ -50,9 +51,31 @@ __all__ = [
     "WEIGHT_CHUNK",
     "WEIGHT_DIRECTIONS",
     "build_weight_capacity_program",
+    "centre_of_mass",
     "num_groups",
     "weight_capacity",
 ]
+
+
+def centre_of_mass(plant_context, body) -> np.ndarray:
+    """Where an object body's weight acts: its centre of mass in its frame O.
+
+    The planner takes every moment about this point (a model's body frame
+    need not sit there: a mesh's origin, a link's joint).
+
+    Parameters
+    ----------
+    plant_context : Context
+        The plant's own context.
+    body : RigidBody
+
+    Returns
+    -------
+    (3,) float
+        ``p_OBcm``, frame O, metres (O's origin for a massless body).
+    """
+    p = np.asarray(body.CalcCenterOfMassInBodyFrame(plant_context), dtype=float)
+    return p if np.all(np.isfinite(p)) else np.zeros(3)
 
 
 def _directions() -> np.ndarray:
@@ -167,7 +190,9 @@ def weight_capacity(
     Parameters
     ----------
     positions, normals : (K, N, 3) float
-        Contacts (metres) and inward unit normals in O; moments about O.
+        Contacts (metres) and inward unit normals in O; moments about O's
+        origin, where the weight acts (the planner passes the contacts
+        relative to the centre of mass).
     fingers : (K, N) int
         Finger (0 or 1) of each contact, 2 for another hand body (a palm,
         whose normal forces are bounded by the squeeze too); a multi-finger

@@ -1479,6 +1479,15 @@ def planning_cases() -> Iterator[Case]:
             "either",
             ranked,
         )
+    # Fused frames repeat points; estimated normals once saw every
+    # neighbourhood as a line and refused the cloud.
+    yield Case(
+        "planning",
+        "cloud-estimated-normals-every-point-ten-times",
+        lambda: on_cloud(np.repeat(cloud, 10, axis=0)),
+        "answer",
+        lambda r: len(r) > 0 and ranked(r),
+    )
     # Only a normal's direction counts: any finite length plans as unit normals
     # (1e200 once overflowed the norm into zero normals, all poses rejected).
     for scale in (1e200, 1e-310):
