@@ -51,7 +51,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import RigidBody
 
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.planning.gripper import _free_base
+from drakegrasp.planning.gripper import free_base
 from drakegrasp.planning.placement import axis_frames
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.couplings import plant_couplings
@@ -264,7 +264,7 @@ def multi_finger_hand(
         A malformed pre-shape, synergy, approach or stand-off.
     """
     bodies = hand_bodies(plant, object_body, hand)
-    base = _free_base(plant, bodies, hand=hand)
+    base = free_base(plant, bodies, hand=hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     structure = hand_structure(
         plant, object_body, bodies, plant_couplings(plant), inspector=inspector

@@ -39,7 +39,7 @@ from drakegrasp.plant.attachment import chain_to_world, free_carrier, how_held
 from drakegrasp.plant.fingers import hand_structure
 from drakegrasp.plant.validation import HandSpec, hand_bodies, scoped_name
 
-__all__ = ["PAD_DEPTH", "ParallelJaw", "parallel_jaw"]
+__all__ = ["PAD_DEPTH", "ParallelJaw", "free_base", "parallel_jaw"]
 
 PAD_DEPTH = 5e-4
 """Geometries this close (m) to a finger's innermost support make its pad."""
@@ -112,8 +112,22 @@ class ParallelJaw:
         }
 
 
-def _free_base(plant: MultibodyPlant, bodies, *, hand: HandSpec = None) -> RigidBody:
+def free_base(plant: MultibodyPlant, bodies, *, hand: HandSpec = None) -> RigidBody:
     """The hand's base: the one free body of ``bodies`` that carries them all.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized.
+    bodies : sequence of RigidBody
+        The hand's bodies (:func:`~drakegrasp.plant.validation.hand_bodies`).
+    hand : HandSpec, optional
+        How the caller named the hand, for the message.
+
+    Returns
+    -------
+    RigidBody
+        The free body (its floating joint places the hand) among ``bodies``.
 
     Raises
     ------
@@ -284,7 +298,7 @@ def parallel_jaw(
 def _two_prismatic_fingers(plant, plant_context, object_body, hand):
     """(free base, the two fingers, their prismatic joints), or a ModelError."""
     bodies = hand_bodies(plant, object_body, hand)
-    base = _free_base(plant, bodies, hand=hand)
+    base = free_base(plant, bodies, hand=hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     structure = hand_structure(plant, object_body, bodies, inspector=inspector)
     fingers = structure.fingers

@@ -58,7 +58,7 @@ from drakegrasp.planning.cloud import (
     cloud_surface,
     read_cloud,
 )
-from drakegrasp.planning.gripper import _free_base, parallel_jaw
+from drakegrasp.planning.gripper import free_base, parallel_jaw
 from drakegrasp.planning.motors import check_torque_limit
 from drakegrasp.planning.multifinger import (
     DEFAULT_TILT,
@@ -437,7 +437,7 @@ def plan_grasps(
         mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
     else:
         body = None
-        _free_base(plant, hand_bodies(plant, plant.world_body(), hand), hand=hand)
+        free_base(plant, hand_bodies(plant, plant.world_body(), hand), hand=hand)
         points, normals, dropped = read_cloud(
             point_cloud, cloud_normals, viewpoint=viewpoint
         )
@@ -533,7 +533,7 @@ def _graspable(plant, object_body, hand) -> RigidBody:
 
     The object must be free to move in space (a free body, or carried by
     one), apart from the hand, and the hand a free base that carries its
-    fingers (:func:`~drakegrasp.planning.gripper._free_base`): a planner that
+    fingers (:func:`~drakegrasp.planning.gripper.free_base`): a planner that
     ranks grasps by the weight they lift and by how they survive the
     object's pose error has nothing to say about an object welded to the
     world or jointed to it (a fixture, a drawer), nor about one the hand
@@ -552,7 +552,7 @@ def _graspable(plant, object_body, hand) -> RigidBody:
             f"mean nothing; plan on a free object: load it without that {what} "
             "(in a scene, default_free_body_pose instead of add_weld)"
         )
-    base = _free_base(plant, bodies, hand=hand)
+    base = free_base(plant, bodies, hand=hand)
     if carrier.index() == base.index():
         raise ModelError(
             f"object_body {name} is attached to the hand: it rides on the hand's "
