@@ -78,6 +78,8 @@ newtons, so their answers do not move."""
 FEASIBILITY_TOL = 1e-6
 """Relative tolerance of :meth:`LoadProblem.violation` (solvers reach ~1e-8)."""
 
+_EPS = float(np.finfo(float).eps)
+
 _SUBNORMAL_SIZE = 1e-280
 """Sizes (N) below which :meth:`LoadProblem.violation` stops being relative."""
 
@@ -257,13 +259,18 @@ class LoadProblem:
 
         Gbar = self.T @ grasp_matrix(self.grasp)
         Tw = self.T @ wrench
-        terms = np.abs(Gbar) @ np.abs(full) + np.abs(Tw)
-        res = np.abs(Gbar @ full + Tw)
-        note(np.max(res), max(float(np.max(terms)), 1e-300), "balance")
+        if any(_far_from_one(c.mu) for c in self.grasp.contacts):
+            note(*self._balance_excess(Gbar, full, Tw), "balance")
+        else:
+            terms = np.abs(Gbar) @ np.abs(full) + np.abs(Tw)
+            res = np.abs(Gbar @ full + Tw)
+            note(np.max(res), max(float(np.max(terms)), 1e-300), "balance")
         # A cone is measured in tangential-force units (μ f_n against ‖f_t‖),
-        # against the larger of its own terms and the problem's force size:
-        # a near-zero force off by 1e-8 N is no violation, and at μ = 1e12 an
-        # ‖f_t‖ of twice μ f_n is one whatever f_n is.
+        # against the larger of its own terms and the problem's force size
+        # (in friction-scaled units: μ times it for a tiny μ): a near-zero
+        # force off by 1e-8 N is no violation, at μ = 1e12 an ‖f_t‖ of twice
+        # μ f_n is one whatever f_n is, and at μ = 1e-12 so is an ‖f_t‖ of
+        # twice μ f_n that is 1e-12 of the normal forces.
         ref = max(float(np.max(np.abs(full), initial=0.0)), float(np.max(np.abs(Tw))))
         b = self.grasp.characteristic_length
         for i, (contact, sl) in enumerate(
@@ -274,11 +281,12 @@ class LoadProblem:
             mu = contact.mu
             if len(f) == 1 or mu == 0.0:
                 continue
+            cref = mu * ref if mu < 1.0 and _far_from_one(mu) else ref
             if self.cones == "polyhedral":
                 cone = self.layout.cones[i]
                 fc = f[list(cone.components)]
                 rows = cone.facets * max(1.0, mu)
-                size = max(float(np.max(np.abs(rows) @ np.abs(fc))), ref)
+                size = max(float(np.max(np.abs(rows) @ np.abs(fc))), cref)
                 note(np.max(-(rows @ fc)), size, f"cone {i}")
                 continue
             ft = np.linalg.norm(f[1 : min(len(f), 3)])
@@ -286,7 +294,7 @@ class LoadProblem:
             if len(f) == 4 and f[3] != 0.0:
                 tors = mu * abs(f[3]) / (b * contact.torsional_friction)
             # ‖f_t‖ + μ |m_n|/(b ν) <= μ f_n.
-            size = max(ft + tors + mu * abs(f[0]), ref)
+            size = max(ft + tors + mu * abs(f[0]), cref)
             note(ft + tors - mu * f[0], size, f"cone {i}")
         if self.torque_limits is not None:
             tau = self.hand_jacobian.T @ full
@@ -303,6 +311,46 @@ class LoadProblem:
             note(np.sum(fn) - self.max_squeeze, size, "squeeze")
         return max(worst)
 
+    def _balance_excess(self, Gbar, full, Tw) -> tuple[float, float]:
+        """The balance's worst ``(excess, size)`` on the rows of :meth:`balanced`.
+
+        Row ``k`` of ``Uᵀ (Ḡ f + T w)`` against its own terms, or, when they
+        are smaller, against the row's coefficients on one unit of the
+        friction-scaled program's forces (a solver's residual there is that
+        size); the rounding of the residual's own computation is no excess.
+        At ``μ = 1e-12`` the rows that only friction balances are 1e-12 of the
+        others: measured against all of them a payload 4 % high passed.
+        """
+        Q = self.friction_scaled()
+        U = _rotation(Gbar, self.grasp.normal_indices())
+        M = U.T @ Gbar
+        UTw = U.T @ Tw
+        f = np.abs(full)
+        res = np.abs(M @ full + UTw)
+        terms = np.abs(M) @ f + np.abs(UTw)
+        allow = (
+            _rounding(U, Gbar) @ f
+            + _rounding(U, Tw[:, None])[:, 0]
+            + (2.0 * len(f) * _EPS) * terms
+        )
+        unit = np.ones(len(full))
+        unit[Q.layout.columns] = Q.layout.scales
+        fn = f[self.grasp.normal_indices()]
+        load = float(np.max(np.abs(Tw)))
+        ts = Q.tangent_scale
+        fref = max(float(np.max(fn)), load / ts)
+        # One force unit of the program, and the load it holds (ts of it):
+        # a row no force reaches (torsion about two fingers' line) still has
+        # the load's share as its noise, not 0.
+        reach = np.max(np.abs(M) * unit, axis=1)
+        if load > 0.0:
+            reach = reach + ts * np.abs(UTw) / load
+        size = np.maximum(terms, reach * fref)
+        size = np.maximum(size, _SUBNORMAL_SIZE)
+        ratio = np.maximum(res - allow, 0.0) / size
+        k = int(np.argmax(ratio))
+        return float(max(res[k] - allow[k], 0.0)), float(size[k])
+
     def normalised(self, wrench: np.ndarray) -> np.ndarray:
         """``T w``: a wrench about the centroid, moments over the spread."""
         return self.T @ wrench
@@ -311,6 +359,16 @@ class LoadProblem:
 def _far_from_one(mu: float) -> bool:
     """Whether a contact's tangential variables are in units of ``μ``."""
     return mu > FRICTION_SCALING or 0.0 < mu < 1.0 / FRICTION_SCALING
+
+
+def _rotation(Gbar: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """``U``: left singular vectors of the normal columns (the wrenches they make)."""
+    return np.linalg.svd(Gbar[:, normals], full_matrices=True)[0]
+
+
+def _rounding(U: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """A bound on the rounding error of each entry of ``Uᵀ A`` as computed."""
+    return (2.0 * U.shape[0] * _EPS) * (np.abs(U).T @ np.abs(A))
 
 
 def check_wrench(grasp: Grasp, wrench, name: str = "wrench") -> np.ndarray:
