@@ -122,6 +122,24 @@ def test_payload_with_motors_matches_the_exact_rational_lp(mu, c):
     assert r.alpha == pytest.approx(expected, rel=1e-6, abs=0.0)
 
 
+@pytest.mark.parametrize("mu", [1e6, 1e8, 1e10, 1e12])
+def test_exact_payload_with_motors_binding_friction_at_huge_mu(mu):
+    # The motors bind the tangential forces (c = 1), the normal forces are
+    # nearly free: an interior point squeezed 80 units of them, 1e-6 of a
+    # motor's row, and the friction-scaled payload fell 1.3e-6 short of its
+    # dual bound (SolverError at mu = 1e8).  The exact cone holds at least
+    # the inscribed one's payload and, at these mu, no more than 1e-6 above.
+    g, J = _pinch(mu), _pinch_hand(1.0)
+    d = np.array([0.0, 0.3, -1.0, 0.0, 0.01, 0.02])
+    poly = exact_lp.polyhedral_max_load(
+        g, d, num_generators=4, hand_jacobian=J, torque_limits=2.0
+    )
+    r = dg.max_load(g, d, hand_jacobian=J, torque_limits=2.0)
+    assert poly * (1 - 1e-6) <= r.alpha <= r.upper_bound * (1 + 1e-9)
+    assert r.alpha == pytest.approx(poly, rel=1e-6, abs=0.0)
+    assert r.upper_bound == pytest.approx(r.alpha, rel=1e-6, abs=0.0)
+
+
 @pytest.mark.parametrize("limit", LIMITS, ids=["f_max", "squeeze"])
 @pytest.mark.parametrize("mu", [1e-12, 1e-9, 1e-6])
 def test_grasp_forces_agree_with_the_payload_at_tiny_mu(mu, limit):
