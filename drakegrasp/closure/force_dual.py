@@ -17,6 +17,13 @@ The cone conditions, per contact over the components its cone allows: on a
 polyhedral (or planar, or frictionless) cone ``S_iᵀ a_i <= 0`` (its
 generators); on an exact Coulomb cone ``μ ‖a_t‖ <= -a_n`` (a Lorentz cone); a
 soft finger adds ``a_n ± b ν a_m <= 0``.
+
+With a ``μ`` far from 1 the program is solved on the friction-scaled twin
+(:meth:`~drakegrasp.closure.load_problem.LoadProblem.friction_scaled`): its
+balance rows ``B`` make ``ȳ = Bᵀ z_y`` and the multipliers about 1 at
+``μ = 1e-12`` and ``1e12`` alike; a payload bound is also solved in newtons
+(better scaled when the motors bind a huge ``μ``'s tangential forces) and the
+least bound whose certificate re-checks is returned.
 """
 
 from __future__ import annotations
@@ -140,7 +147,9 @@ def build_load_dual_program(
 ):
     """The dual program in ``z = [ȳ, η⁺, η⁻, ρ, σ]`` (see the module docstring).
 
-    ``target`` is ``T w / F0`` (refute) or ``T d / max|T d|`` (bound).
+    ``target`` is ``T w / F0`` (refute) or ``T d / max|T d|`` (bound), on the
+    balance rows ``B`` of :meth:`LoadProblem.balanced` (times ``B``, and the
+    twist variables are ``z_y`` with ``ȳ = Bᵀ z_y``).
     """
     A, blocks = _dual_matrix(P)
     weights = _weights(P, force_scale, blocks)
