@@ -65,6 +65,9 @@ from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["LOAD_NOT_HELD", "PAYLOAD_BOUND", "LoadCertificate"]
 
+_TINY_BOUND = 1e-300
+"""Bounds below this are compared absolutely (nothing is relative to 0)."""
+
 LOAD_NOT_HELD = "load not held"
 """Kind of the witness that the wrench ``w`` itself cannot be held (bound < 1)."""
 PAYLOAD_BOUND = "payload bound"
@@ -152,9 +155,21 @@ class LoadCertificate:
         Returns
         -------
         CertificateCheck
-            ``violation``: the largest cone support over the size of its terms
+            ``violation``: the larger of the largest cone support (less the
+            rounding of its own computation) over the largest contact's
+            terms, and the claimed bound's shortfall relative to the bound
             (``inf`` when ``-yᵀ w <= B``, i.e. nothing is proven); ``slack``:
             the relative power deficit ``(-yᵀ w - B) / (|yᵀ w| + B)``.
+
+        Notes
+        -----
+        A contact's terms are its support evaluated on the absolute values of
+        what ``a_i`` sums (``|G_i|ᵀ|y| + |J_i||η| + (ρ_i + σ) e_n``), so the
+        friction term is ``μ`` times the tangential ones: the measure holds
+        for ``μ`` from 1e-12 to 1e12, where ``‖G‖ ‖y‖`` is up to 1e12 times
+        the inequality's own terms.  A certificate that prices no limit
+        (``B = 0``) is measured against ``min(1, μ) ‖G‖ ‖y‖`` too, what the
+        twist could make a contact absorb.
         """
         return check_load_certificate(self, grasp, hand_jacobian, tol)
 
@@ -201,10 +216,14 @@ def _budget(cert: LoadCertificate) -> float:
 
 
 def _supports(cert: LoadCertificate, grasp: Grasp, J: np.ndarray | None):
-    """Per contact the support ``max a_iᵀ f_i`` (``f_n = 1``); and the terms' size.
+    """Per contact the support ``max a_iᵀ f_i`` (``f_n = 1``), its terms, its rounding.
 
-    The size ``‖G‖ ‖y‖ + ‖J‖ ‖η‖ + max ρ + σ`` scales the supports into a
-    relative violation (as the unresisted-wrench check scales by ``‖G‖ ‖y‖``).
+    The terms of contact ``i`` are its support evaluated on the absolute
+    values of what ``a_i`` sums, ``t = |G_i|ᵀ|y| + |J_i||η| + (ρ_i + σ) e_n``
+    (``t_n + μ ‖t_t‖`` on an exact cone): friction-scaled, so that at
+    ``μ = 1e-12`` the 1e-12 of ``a_t`` that friction weighs is not measured
+    against ``‖G‖ ‖y‖``, 1e12 times larger (a payload bound 2 % low passed).
+    The rounding is a bound on the error of computing the support in floats.
     """
     G = grasp_matrix(grasp)
     layout = ConeLayout.of(grasp, cert.num_generators)
@@ -212,21 +231,34 @@ def _supports(cert: LoadCertificate, grasp: Grasp, J: np.ndarray | None):
     y = np.asarray(cert.twist, dtype=float)
     eta = np.asarray(cert.joint_multipliers, dtype=float)
     rho = np.asarray(cert.normal_multipliers, dtype=float)
-    support = []
+    n_terms = G.shape[0] + (0 if J is None else J.shape[1]) + 2
+    gamma = 4.0 * n_terms * np.finfo(float).eps
+    support, terms = [], []
     for i, (s, cone, c) in enumerate(
         zip(grasp.component_slices(), layout.cones, grasp.contacts, strict=True)
     ):
         a = G[:, s].T @ y
+        t = np.abs(G[:, s]).T @ np.abs(y)
         if J is not None:
             a = a - J[s] @ eta
+            t = t + np.abs(J[s]) @ np.abs(eta)
         a[0] -= rho[i] + cert.squeeze_multiplier
-        support.append(support_of(a[list(cone.components)], cone, c, cert.cones, b))
-    size = np.linalg.norm(G, 2) * np.linalg.norm(y) + cert.squeeze_multiplier
-    if J is not None:
-        size += np.linalg.norm(J, 2) * np.linalg.norm(eta)
-    if rho.size:
-        size += float(rho.max())
-    return np.array(support), float(size)
+        t[0] += abs(rho[i]) + abs(cert.squeeze_multiplier)
+        comps = list(cone.components)
+        support.append(support_of(a[comps], cone, c, cert.cones, b))
+        terms.append(_support_terms(t[comps], cone, c, cert.cones, b))
+    terms = np.array(terms)
+    return np.array(support), terms, gamma * terms
+
+
+def _support_terms(t: np.ndarray, cone, contact, cones: str, b: float) -> float:
+    """:func:`support_of` on the absolute terms ``t`` (>= 0) of ``a``."""
+    if not (cones == "exact" and cone.components in ((0, 1, 2), (0, 1, 2, 3))):
+        return float(np.max(np.abs(cone.generators).T @ t))
+    value = contact.mu * np.linalg.norm(t[1:3])
+    if len(t) == 4:
+        value = max(value, b * contact.torsional_friction * t[3])
+    return float(t[0] + value)
 
 
 def _array(cert: LoadCertificate, name: str, shape, grasp: Grasp) -> np.ndarray:
@@ -335,17 +367,36 @@ def check_load_certificate(
             f"the load delivers power {power:.3g} along y against a budget "
             f"{budget:.3g}: nothing is proven",
         )
-    support, size = _supports(cert, grasp, J)
-    excess = np.maximum(support, 0.0)
-    cone_violation = float(excess.max()) / size if size > 0.0 else math.inf
+    support, terms, rounding = _supports(cert, grasp, J)
+    excess = np.maximum(support - rounding, 0.0)
+    # Against the largest contact's terms: a support eps_i > 0 weakens the
+    # bound by eps_i f_n,i over the power, and the budget is about that size.
+    size = float(terms.max())
+    if budget == 0.0:
+        # No limit priced (a load no force balances): the proof is y alone,
+        # and a support is measured against what y could make a contact
+        # absorb, friction-scaled (y's share that no contact feels, a
+        # torsion about two fingers' line, leaves the terms at round-off).
+        mu = min([1.0] + [c.mu for c in grasp.contacts if c.mu > 0.0])
+        size = max(
+            size, mu * np.linalg.norm(grasp_matrix(grasp), 2) * float(np.linalg.norm(y))
+        )
+    if not excess.any():
+        cone_violation = 0.0
+    else:
+        cone_violation = float(excess.max()) / size if size > 0.0 else math.inf
     bound = budget / power
-    bound_violation = max(0.0, bound - cert.bound) / max(1.0, abs(cert.bound))
+    # Relative to the bound itself: at μ = 1e-12 a bound of 1e-12 claimed
+    # for a true 1e-11 passed a test against max(1, bound).
+    bound_violation = max(0.0, bound - cert.bound) / max(
+        abs(cert.bound), bound, _TINY_BOUND
+    )
     if cert.kind == LOAD_NOT_HELD and not bound < 1.0:
         bound_violation = math.inf
     violation = max(cone_violation, bound_violation)
     # A support eps > 0 (round-off) weakens the proof to forces whose total
     # normal force stays below (α power - budget) / eps; said per unit of α.
-    eps = float(excess.max())
+    eps = float(np.maximum(support, 0.0).max())
     if eps == 0.0:
         caveat = ""
     elif cert.kind == LOAD_NOT_HELD:

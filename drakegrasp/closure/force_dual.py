@@ -17,6 +17,13 @@ The cone conditions, per contact over the components its cone allows: on a
 polyhedral (or planar, or frictionless) cone ``S_iᵀ a_i <= 0`` (its
 generators); on an exact Coulomb cone ``μ ‖a_t‖ <= -a_n`` (a Lorentz cone); a
 soft finger adds ``a_n ± b ν a_m <= 0``.
+
+With a ``μ`` far from 1 the program is solved on the friction-scaled twin
+(:meth:`~drakegrasp.closure.load_problem.LoadProblem.friction_scaled`): its
+balance rows ``B`` make ``ȳ = Bᵀ z_y`` and the multipliers about 1 at
+``μ = 1e-12`` and ``1e12`` alike; a payload bound is also solved in newtons
+(better scaled when the motors bind a huge ``μ``'s tangential forces) and the
+least bound whose certificate re-checks is returned.
 """
 
 from __future__ import annotations
@@ -56,12 +63,28 @@ def _dual_matrix(P: LoadProblem):
     e_all = np.zeros((m, 1 if squeeze else 0))
     if squeeze:
         e_all[normals, 0] = 1.0
-    Jl = P.Jt[lim].T  # (m, n_lim)
-    A = np.hstack([P.Gbar.T, -Jl, Jl, -E, -e_all])
+    Jl = (P.Jt[lim] / _joint_rows(P)[:, None]).T  # (m, n_lim)
+    A = np.hstack([P.balanced()[0].T, -Jl, Jl, -E, -e_all])
     sizes = [D, len(lim), len(lim), len(bounded), int(squeeze)]
     edges = np.cumsum([0, *sizes])
     blocks = [slice(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
     return A, blocks
+
+
+def _joint_rows(P: LoadProblem) -> np.ndarray:
+    """Per limited joint, the scale of its multiplier (1 unless friction-scaled).
+
+    Friction-scaled, a joint that a huge μ's tangential force turns has
+    coefficients μ on the scaled variables: its multiplier is taken in units
+    of that row's largest coefficient, as the balance rows are (else, at
+    ``μ = 1e8``, the polar rows mixed ``μ η`` with the twist's 1 and the
+    solvers stopped at a bound 6 times too high).
+    """
+    lim = P.limited_joints()
+    if P.balance_rows is None or not lim.size:
+        return np.ones(len(lim))
+    r = np.max(np.abs(P.Jt[lim]) * P.layout.scales, axis=1)
+    return np.where(r > 0.0, r, 1.0)
 
 
 def _weights(P: LoadProblem, force_scale: float, blocks) -> np.ndarray:
@@ -69,7 +92,11 @@ def _weights(P: LoadProblem, force_scale: float, blocks) -> np.ndarray:
     lim = P.limited_joints()
     bounded = P.bounded_contacts()
     w = np.zeros(blocks[-1].stop)
-    tau = P.torque_limits[lim] / (P.jscale[lim] * force_scale) if lim.size else []
+    tau = (
+        P.torque_limits[lim] / (P.jscale[lim] * force_scale * _joint_rows(P))
+        if lim.size
+        else []
+    )
     w[blocks[1]] = tau
     w[blocks[2]] = tau
     w[blocks[3]] = P.max_normal_force[bounded] / force_scale
@@ -81,6 +108,10 @@ def _weights(P: LoadProblem, force_scale: float, blocks) -> np.ndarray:
 def _add_polar_conditions(prog, P: LoadProblem, A: np.ndarray, z) -> None:
     """Every contact's ``a_i = A_i z`` in the negative polar of its cone."""
     b = P.grasp.characteristic_length
+    # Friction-scaled (balance rows B): ȳ = Bᵀ z_y, so a tiny μ's ‖a_t‖ is
+    # 1/μ times a_n and μ ‖a_t‖ about 1; each cone is divided by its largest
+    # coefficient (dividing by max(1, μ) left a huge μ's rows at 1/μ).
+    balanced = P.balance_rows is not None
     starts = list(P.layout.normal_positions) + [P.num_forces]
     for i, (contact, cone) in enumerate(
         zip(P.grasp.contacts, P.layout.cones, strict=True)
@@ -95,12 +126,20 @@ def _add_polar_conditions(prog, P: LoadProblem, A: np.ndarray, z) -> None:
             continue
         mu = contact.mu
         # μ ‖a_t‖ <= -a_n, divided by max(1, μ) to keep coefficients near 1.
-        L = np.vstack([-Ai[0], mu * Ai[1], mu * Ai[2]]) / max(1.0, mu)
+        L = np.vstack([-Ai[0], mu * Ai[1], mu * Ai[2]])
+        L = L / (_largest(L) if balanced else max(1.0, mu))
         prog.AddLorentzConeConstraint(L, np.zeros(3), z)
         if len(Ai) == 4:
             tau = b * contact.torsional_friction
-            rows = np.vstack([Ai[0] + tau * Ai[3], Ai[0] - tau * Ai[3]]) / max(1.0, tau)
+            rows = np.vstack([Ai[0] + tau * Ai[3], Ai[0] - tau * Ai[3]])
+            rows = rows / (_largest(rows) if balanced else max(1.0, tau))
             add_linear_constraint(prog, rows, [-np.inf] * 2, [0.0, 0.0], z)
+
+
+def _largest(A: np.ndarray) -> float:
+    """The largest ``|A_ij|`` (1 for a zero matrix)."""
+    size = float(np.max(np.abs(A)))
+    return size if size > 0.0 else 1.0
 
 
 def build_load_dual_program(
@@ -108,7 +147,9 @@ def build_load_dual_program(
 ):
     """The dual program in ``z = [ȳ, η⁺, η⁻, ρ, σ]`` (see the module docstring).
 
-    ``target`` is ``T w / F0`` (refute) or ``T d / max|T d|`` (bound).
+    ``target`` is ``T w / F0`` (refute) or ``T d / max|T d|`` (bound), on the
+    balance rows ``B`` of :meth:`LoadProblem.balanced` (times ``B``, and the
+    twist variables are ``z_y`` with ``ȳ = Bᵀ z_y``).
     """
     A, blocks = _dual_matrix(P)
     weights = _weights(P, force_scale, blocks)
@@ -154,7 +195,17 @@ def find_load_certificate(
         The optimum in newton-scaled units: ``F0 (ȳᵀ w̄/F0 + B/F0)`` for
         refute, the payload bound for bound (``inf`` when no dual exists).
     """
-    target = P.normalised(wrench)
+    # Friction-scaled twin (a μ far from 1): its balance rows B make ȳ = Bᵀ z_y
+    # and the multipliers all about 1 (LoadProblem.balanced); in newtons at
+    # μ = 1e-12 a twist of size 1/μ had to cancel on G_n to 1 part in 1e12.
+    Q = P.friction_scaled()
+    if Q is not P:
+        force_scale = (
+            Q.force_scale(wrench) / Q.tangent_scale
+            if mode == "refute"
+            else Q.force_scale(None)
+        )
+    target = Q.normalised(wrench)
     # Refute: the load in units of the primal's F0.  Bound: the direction's
     # size is no part of the question, so the normalisation ȳᵀ T d = -1 is
     # made on a unit direction (on T d itself, ȳ grew or shrank with |d| past
@@ -162,11 +213,33 @@ def find_load_certificate(
     # weight, 0 at 1e200).  The certificate keeps the caller's d, so its bound
     # B / (-yᵀ d) is for d.
     target = target / (force_scale if mode == "refute" else np.max(np.abs(target)))
-    if mode == "bound":
-        # Every μ tiny (1e-12): the bound is about μ times the limits, its
-        # multipliers ρ, σ that small, under the solvers' tolerances; ȳ of
-        # size 1/μ makes them about 1 (the bound, B / -yᵀ d, is the same).
-        target = target * min(P.friction_scaled().tangent_scale, 1.0)
+    B = Q.balanced()[1]
+    if mode == "refute" or Q is P:
+        return _solve_dual(Q, wrench, B @ target, force_scale, mode)
+    # Bound, friction-scaled: the bound in program units is about
+    # tangent_scale (μ f_max for every μ tiny; μ τ_max / ‖J‖ when the motors
+    # bind a huge μ's normal forces), and a twist whose power is its inverse
+    # makes the multipliers about 1 (the bound, B / -yᵀ d, is the same).  When
+    # the motors bind a huge μ's tangential forces it is about 1, and the
+    # newton program's dual is the better scaled: both are solved, and the
+    # least bound whose certificate re-checks is the answer.
+    found = [
+        _solve_dual(Q, wrench, Q.tangent_scale * (B @ target), force_scale, mode),
+        _solve_dual(
+            P, wrench, target * min(Q.tangent_scale, 1.0), P.force_scale(None), mode
+        ),
+    ]
+    found = [(c, v) for c, v in found if c is not None]
+    checked = [
+        (c, v)
+        for c, v in found
+        if c.check(P.grasp, hand_jacobian=P.hand_jacobian).holds
+    ]
+    return min(checked or found, key=lambda cv: cv[1], default=(None, np.inf))
+
+
+def _solve_dual(P, wrench, target, force_scale, mode):
+    """Build and solve the dual on ``P``'s balance rows; see find_load_certificate."""
     prog, z, blocks, weights = build_load_dual_program(
         P, target, force_scale, mode=mode
     )
@@ -185,11 +258,11 @@ def find_load_certificate(
 
 
 def _certificate(P, wrench, zv, blocks, mode) -> LoadCertificate:
-    y = P.T.T @ zv[blocks[0]]
+    y = P.T.T @ (P.balanced()[1].T @ zv[blocks[0]])
     n_v = P.Jt.shape[0]
     eta = np.zeros(n_v)
     lim = P.limited_joints()
-    eta[lim] = (zv[blocks[1]] - zv[blocks[2]]) / P.jscale[lim]
+    eta[lim] = (zv[blocks[1]] - zv[blocks[2]]) / (P.jscale[lim] * _joint_rows(P))
     rho = np.zeros(P.grasp.num_contacts)
     rho[P.bounded_contacts()] = np.maximum(zv[blocks[3]], 0.0)
     sigma = (

@@ -29,7 +29,10 @@ solver tolerance:
   units of ``μ F0`` (:data:`FRICTION_SCALING`): its cone is then
   ``‖x_t‖ <= x_n``, where written in newtons (``μ = 1e12``) a solver read the
   ``x_t`` coefficient ``1/μ`` as 0 and returned forces far outside the cone or
-  past the motors' limits.
+  past the motors' limits; and its balance rows turned and scaled
+  (:meth:`LoadProblem.balanced`): at ``μ = 1e-12`` the rows that only
+  friction can balance have coefficients ``μ``, under every solver's
+  tolerance, and a payload came out 4 % high.
 
 Only the components a cone allows are variables (a hard finger with ``μ = 0``
 has ``f_n`` alone).
@@ -78,6 +81,8 @@ newtons, so their answers do not move."""
 FEASIBILITY_TOL = 1e-6
 """Relative tolerance of :meth:`LoadProblem.violation` (solvers reach ~1e-8)."""
 
+_EPS = float(np.finfo(float).eps)
+
 _SUBNORMAL_SIZE = 1e-280
 """Sizes (N) below which :meth:`LoadProblem.violation` stops being relative."""
 
@@ -117,6 +122,12 @@ class LoadProblem:
         The largest ``μ`` that scales tangential variables (1 when none is
         above :data:`FRICTION_SCALING`): the size of a load the contacts hold
         per unit of normal force.
+    balance_rows : (D, D) float or None
+        ``B``: the balance is imposed as ``B Ḡ f = -B T w`` (None: ``B = I``).
+        Set by :meth:`friction_scaled`; see :meth:`balanced`.
+    balance_matrix : (D, m) float or None
+        ``B Ḡ`` on the layout's columns, entries below the rounding of their
+        own computation set to 0 (None: ``Ḡ``).
     """
 
     grasp: Grasp
@@ -132,6 +143,8 @@ class LoadProblem:
     max_normal_force: np.ndarray
     max_squeeze: float
     tangent_scale: float = 1.0
+    balance_rows: np.ndarray | None = None
+    balance_matrix: np.ndarray | None = None
 
     @property
     def num_forces(self) -> int:
@@ -200,12 +213,15 @@ class LoadProblem:
     def friction_scaled(self) -> LoadProblem:
         """The same problem with tangential variables in units of ``μ``.
 
-        Every contact with ``μ > FRICTION_SCALING`` has ``f_t = μ F0 x_t``, so
-        its cone reads ``‖x_t‖ <= x_n``; ``self`` when no contact has.  Use it
-        with a force unit ``F0`` of the load's size over ``tangent_scale``.
+        Every contact with ``μ`` far from 1 (above :data:`FRICTION_SCALING` or
+        below its inverse) has ``f_t = μ F0 x_t``, so its cone reads
+        ``‖x_t‖ <= x_n``, and the balance rows are turned and scaled
+        (:meth:`balanced`); ``self`` when no contact has such a ``μ`` (or
+        ``self`` is already the scaled twin).  Use it with a force unit ``F0``
+        of the load's size over ``tangent_scale``.
         """
         mus = [c.mu for c in self.grasp.contacts]
-        if not any(_far_from_one(mu) for mu in mus):
+        if self.balance_rows is not None or not any(_far_from_one(mu) for mu in mus):
             return self
         layout = self.layout
         scales = layout.scales.copy()
@@ -219,11 +235,29 @@ class LoadProblem:
         # The size of a load held per unit of normal force: the largest μ when
         # it is far from 1 (both ways: every μ tiny, or one huge), else 1.
         top = max(mus)
+        ts = top if _far_from_one(top) else 1.0
+        B, GB = _balance_rows(self.Gbar, scales, layout.normal_positions, ts)
         return replace(
             self,
             layout=replace(layout, scales=scales),
-            tangent_scale=top if _far_from_one(top) else 1.0,
+            tangent_scale=ts,
+            balance_rows=B,
+            balance_matrix=GB,
         )
+
+    def balanced(self) -> tuple[np.ndarray, np.ndarray]:
+        r"""``(B Ḡ, B)``: the balance rows a program imposes, on unscaled columns.
+
+        ``B = diag(1/s) Uᵀ`` with ``U`` the left singular vectors of the
+        normal columns ``Ḡ_n``: the rows ``Uᵀ Ḡ`` separate the wrenches the
+        normal forces produce from those only friction produces (whose
+        coefficients are ``μ`` times smaller), and ``s_k`` is the largest
+        coefficient of row ``k`` on the scaled variables, so every row has
+        coefficients of size 1.  Identity (``(Ḡ, I)``) unless friction-scaled.
+        """
+        if self.balance_rows is None:
+            return self.Gbar, np.eye(self.Gbar.shape[0])
+        return self.balance_matrix, self.balance_rows
 
     def violation(self, full: np.ndarray, wrench: np.ndarray) -> tuple[float, str]:
         """The largest relative violation of the constraints by forces ``full``.
@@ -257,13 +291,18 @@ class LoadProblem:
 
         Gbar = self.T @ grasp_matrix(self.grasp)
         Tw = self.T @ wrench
-        terms = np.abs(Gbar) @ np.abs(full) + np.abs(Tw)
-        res = np.abs(Gbar @ full + Tw)
-        note(np.max(res), max(float(np.max(terms)), 1e-300), "balance")
+        if any(_far_from_one(c.mu) for c in self.grasp.contacts):
+            note(*self._balance_excess(Gbar, full, Tw), "balance")
+        else:
+            terms = np.abs(Gbar) @ np.abs(full) + np.abs(Tw)
+            res = np.abs(Gbar @ full + Tw)
+            note(np.max(res), max(float(np.max(terms)), 1e-300), "balance")
         # A cone is measured in tangential-force units (μ f_n against ‖f_t‖),
-        # against the larger of its own terms and the problem's force size:
-        # a near-zero force off by 1e-8 N is no violation, and at μ = 1e12 an
-        # ‖f_t‖ of twice μ f_n is one whatever f_n is.
+        # against the larger of its own terms and the problem's force size
+        # (in friction-scaled units: μ times it for a tiny μ): a near-zero
+        # force off by 1e-8 N is no violation, at μ = 1e12 an ‖f_t‖ of twice
+        # μ f_n is one whatever f_n is, and at μ = 1e-12 so is an ‖f_t‖ of
+        # twice μ f_n that is 1e-12 of the normal forces.
         ref = max(float(np.max(np.abs(full), initial=0.0)), float(np.max(np.abs(Tw))))
         b = self.grasp.characteristic_length
         for i, (contact, sl) in enumerate(
@@ -274,11 +313,12 @@ class LoadProblem:
             mu = contact.mu
             if len(f) == 1 or mu == 0.0:
                 continue
+            cref = mu * ref if mu < 1.0 and _far_from_one(mu) else ref
             if self.cones == "polyhedral":
                 cone = self.layout.cones[i]
                 fc = f[list(cone.components)]
                 rows = cone.facets * max(1.0, mu)
-                size = max(float(np.max(np.abs(rows) @ np.abs(fc))), ref)
+                size = max(float(np.max(np.abs(rows) @ np.abs(fc))), cref)
                 note(np.max(-(rows @ fc)), size, f"cone {i}")
                 continue
             ft = np.linalg.norm(f[1 : min(len(f), 3)])
@@ -286,7 +326,7 @@ class LoadProblem:
             if len(f) == 4 and f[3] != 0.0:
                 tors = mu * abs(f[3]) / (b * contact.torsional_friction)
             # ‖f_t‖ + μ |m_n|/(b ν) <= μ f_n.
-            size = max(ft + tors + mu * abs(f[0]), ref)
+            size = max(ft + tors + mu * abs(f[0]), cref)
             note(ft + tors - mu * f[0], size, f"cone {i}")
         if self.torque_limits is not None:
             tau = self.hand_jacobian.T @ full
@@ -303,6 +343,46 @@ class LoadProblem:
             note(np.sum(fn) - self.max_squeeze, size, "squeeze")
         return max(worst)
 
+    def _balance_excess(self, Gbar, full, Tw) -> tuple[float, float]:
+        """The balance's worst ``(excess, size)`` on the rows of :meth:`balanced`.
+
+        Row ``k`` of ``Uᵀ (Ḡ f + T w)`` against its own terms, or, when they
+        are smaller, against the row's coefficients on one unit of the
+        friction-scaled program's forces (a solver's residual there is that
+        size); the rounding of the residual's own computation is no excess.
+        At ``μ = 1e-12`` the rows that only friction balances are 1e-12 of the
+        others: measured against all of them a payload 4 % high passed.
+        """
+        Q = self.friction_scaled()
+        U = _rotation(Gbar, self.grasp.normal_indices())
+        M = U.T @ Gbar
+        UTw = U.T @ Tw
+        f = np.abs(full)
+        res = np.abs(M @ full + UTw)
+        terms = np.abs(M) @ f + np.abs(UTw)
+        allow = (
+            _rounding(U, Gbar) @ f
+            + _rounding(U, Tw[:, None])[:, 0]
+            + (2.0 * len(f) * _EPS) * terms
+        )
+        unit = np.ones(len(full))
+        unit[Q.layout.columns] = Q.layout.scales
+        fn = f[self.grasp.normal_indices()]
+        load = float(np.max(np.abs(Tw)))
+        ts = Q.tangent_scale
+        fref = max(float(np.max(fn)), load / ts)
+        # One force unit of the program, and the load it holds (ts of it):
+        # a row no force reaches (torsion about two fingers' line) still has
+        # the load's share as its noise, not 0.
+        reach = np.max(np.abs(M) * unit, axis=1)
+        if load > 0.0:
+            reach = reach + ts * np.abs(UTw) / load
+        size = np.maximum(terms, reach * fref)
+        size = np.maximum(size, _SUBNORMAL_SIZE)
+        ratio = np.maximum(res - allow, 0.0) / size
+        k = int(np.argmax(ratio))
+        return float(max(res[k] - allow[k], 0.0)), float(size[k])
+
     def normalised(self, wrench: np.ndarray) -> np.ndarray:
         """``T w``: a wrench about the centroid, moments over the spread."""
         return self.T @ wrench
@@ -311,6 +391,36 @@ class LoadProblem:
 def _far_from_one(mu: float) -> bool:
     """Whether a contact's tangential variables are in units of ``μ``."""
     return mu > FRICTION_SCALING or 0.0 < mu < 1.0 / FRICTION_SCALING
+
+
+def _rotation(Gbar: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """``U``: left singular vectors of the normal columns (the wrenches they make)."""
+    return np.linalg.svd(Gbar[:, normals], full_matrices=True)[0]
+
+
+def _rounding(U: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """A bound on the rounding error of each entry of ``Uᵀ A`` as computed."""
+    return (2.0 * U.shape[0] * _EPS) * (np.abs(U).T @ np.abs(A))
+
+
+def _balance_rows(
+    Gbar: np.ndarray, scales: np.ndarray, normals: np.ndarray, tangent_scale: float
+):
+    """``(B, B Ḡ)`` of :meth:`LoadProblem.balanced` for variables ``f / scales``.
+
+    An entry of ``Uᵀ Ḡ`` no larger than the rounding of its own computation is
+    set to 0: a normal column's 1e-17 on a row that only friction reaches
+    would, over the row's ``μ = 1e-12``, weigh 1e-5 of it.  A row no force
+    reaches is divided by ``tangent_scale``, the size of a load in program
+    units (at ``μ = 1e-12`` a torsion about two fingers' line was a 1e-12 in
+    a row of zeros, under the solvers' tolerance: "held").
+    """
+    U = _rotation(Gbar, normals)
+    M = U.T @ Gbar
+    M[np.abs(M) <= _rounding(U, Gbar)] = 0.0
+    s = np.max(np.abs(M) * scales, axis=1)
+    s = np.where(s > 0.0, s, tangent_scale)
+    return U.T / s[:, None], M / s[:, None]
 
 
 def check_wrench(grasp: Grasp, wrench, name: str = "wrench") -> np.ndarray:
@@ -490,8 +600,14 @@ def add_force_constraints(prog, P: LoadProblem, x, force_scale: float, d=None):
 
 
 def add_balance(prog, P: LoadProblem, x, rhs: np.ndarray, alpha=None) -> None:
-    """``Ḡ f = rhs`` in program units; with ``alpha``: ``Ḡ f + α rhs' = 0``."""
-    A = P.Gbar * P.layout.scales
+    """``Ḡ f = rhs`` in program units; with ``alpha``: ``Ḡ f + α rhs' = 0``.
+
+    Imposed on the rows ``B`` of :meth:`LoadProblem.balanced`.
+    """
+    GB, B = P.balanced()
+    A = GB * P.layout.scales
+    if P.balance_rows is not None:
+        rhs = B @ rhs
     if alpha is None:
         add_linear_equality_constraint(prog, A, rhs, x)
     else:

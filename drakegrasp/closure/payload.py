@@ -28,6 +28,7 @@ from pydrake.solvers import MathematicalProgram, SolutionResult
 
 from drakegrasp._solvers import solve
 from drakegrasp.certificates.load import LoadCertificate
+from drakegrasp.closure.constraints import add_linear_constraint
 from drakegrasp.closure.force_dual import find_load_certificate
 from drakegrasp.closure.load_problem import (
     FEASIBILITY_TOL,
@@ -218,6 +219,19 @@ def _rescaled(P: LoadProblem, d: np.ndarray, alpha_unit: float, bound: float):
     full = Ps.stacked(result.GetSolution(x), F0)
     excess, what = P.violation(full, a * d)
     gap = abs(a - bound) if math.isfinite(bound) else 0.0
+    if not capped and excess <= FEASIBILITY_TOL and gap > _AGREE * bound:
+        # Forces that hold α short of the bound: at a huge μ whose motors
+        # bind the tangential forces the normal forces are nearly free, an
+        # interior point squeezed 80 units of them (1e-6 of a motor's row)
+        # and α came out that much short.  The least squeeze at that α, then
+        # the most α at that squeeze, take the slack back.
+        polished = _polished(Ps, d, alpha_unit, a_tilde)
+        if polished is not None:
+            result, a2, full2 = polished
+            excess2, what2 = P.violation(full2, a2 * d)
+            if excess2 <= FEASIBILITY_TOL and a2 > a:
+                a, full, excess, what = a2, full2, excess2, what2
+                gap = abs(a - bound)
     if not capped and (excess > FEASIBILITY_TOL or gap > _AGREE * bound):
         raise SolverError(
             f"{result.get_solver_id().name()} found α = {a:.9g} on the rescaled "
@@ -228,6 +242,35 @@ def _rescaled(P: LoadProblem, d: np.ndarray, alpha_unit: float, bound: float):
             result=result,
         )
     return result, a, full, capped
+
+
+def _polished(Ps: LoadProblem, d, alpha_unit: float, a_tilde: float):
+    """``(result, α, forces)`` of :func:`_rescaled`'s two-stage polish, or None.
+
+    The least squeeze that holds ``α̃ >= a_tilde``, then the largest ``α̃``
+    within that squeeze and 1e-3 of it (a larger ``α`` needs a little more).
+    """
+    normals = Ps.layout.normal_positions
+    prog, x1, alpha, _, (F0, unit) = _build(Ps, d, alpha_unit=alpha_unit)
+    prog.AddBoundingBoxConstraint(a_tilde, ALPHA_CAP, alpha)
+    prog.AddLinearCost(np.ones(len(normals)), 0.0, x1[normals])
+    first = solve(prog, Ps.kind, retry=True)
+    if first.get_solution_result() != SolutionResult.kSolutionFound:
+        return None
+    squeeze = float(np.sum(first.GetSolution(x1)[normals]))
+    prog, x2, alpha, _, (F0, unit) = _build(Ps, d, alpha_unit=alpha_unit)
+    add_linear_constraint(
+        prog,
+        np.ones((1, len(normals))),
+        [-np.inf],
+        [squeeze * (1.0 + 1e-3)],
+        x2[normals],
+    )
+    second = solve(prog, Ps.kind, retry=True)
+    if second.get_solution_result() != SolutionResult.kSolutionFound:
+        return None
+    a = max(float(second.GetSolution(alpha)), 0.0) * unit
+    return second, a, Ps.stacked(second.GetSolution(x2), F0)
 
 
 def _homogeneous(P: LoadProblem) -> bool:

@@ -1,11 +1,18 @@
 """Shared builders and independent reference routes for the quality-metric tests."""
 
 import itertools
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import drakegrasp as dg
+
+# The exact rational LP (``exact_lp``) is a module beside this file.
+_HERE = str(Path(__file__).resolve().parent)
+if _HERE not in sys.path:
+    sys.path.insert(0, _HERE)
 
 
 def equator_grasp(mu=0.5, *, radius=1.0, model="hard_finger", **kwargs):

@@ -60,8 +60,8 @@ def test_max_load_matches_the_closed_form_at_any_mu(mu, c):
     if np.isinf(expected):
         assert r.alpha == np.inf
     else:
-        assert r.alpha == pytest.approx(expected, rel=1e-6)
-        assert r.upper_bound == pytest.approx(expected, rel=1e-6)
+        assert r.alpha == pytest.approx(expected, rel=1e-6, abs=0.0)
+        assert r.upper_bound == pytest.approx(expected, rel=1e-6, abs=0.0)
         tau = np.abs(r.joint_torques)
         assert np.all(tau <= TAU * (1 + 1e-6))
 
@@ -70,19 +70,28 @@ def test_max_load_matches_the_closed_form_at_any_mu(mu, c):
 def test_max_load_spatial_matches_the_closed_form_where_the_limit_binds_f_t(mu):
     g, J, w = _setup(mu, 1.0, planar=False)
     r = dg.max_load(g, w, hand_jacobian=J, torque_limits=TAU)
-    assert r.alpha == pytest.approx(_closed_form(mu, 1.0), rel=1e-6)
+    assert r.alpha == pytest.approx(_closed_form(mu, 1.0), rel=1e-6, abs=0.0)
 
 
-@pytest.mark.parametrize("mu", [1e8, 1e9, 1e12])
-def test_max_load_spatial_past_the_cap_is_never_a_wrong_inf(mu):
-    # The exact-cone dual is missed by Clarabel at these mu: the answer is
-    # right or a SolverError, never the old inf for a finite payload.
-    g, J, w = _setup(mu, 0.0, planar=False)
-    try:
-        r = dg.max_load(g, w, hand_jacobian=J, torque_limits=TAU)
-    except dg.SolverError:
+@pytest.mark.parametrize("mu", [1e8, 1e9, 1e10, 1e12])
+@pytest.mark.parametrize("c", [0.0, -3e-10])
+def test_max_load_spatial_past_the_cap_matches_the_closed_form(mu, c):
+    # The motors bind the normal forces (tau = f_n): the exact-cone dual's
+    # multipliers were mu times its twist, Clarabel and SCS missed it from
+    # mu = 1e8 on, and max_load raised SolverError for the finite 4e7 .. 4e11.
+    g, J, w = _setup(mu, c, planar=False)
+    r = dg.max_load(g, w, hand_jacobian=J, torque_limits=TAU)
+    expected = _closed_form(mu, c)
+    if np.isinf(expected):
+        assert r.alpha == np.inf
         return
-    assert r.alpha == pytest.approx(_closed_form(mu, 0.0), rel=1e-6)
+    assert r.alpha == pytest.approx(expected, rel=1e-6, abs=0.0)
+    assert r.upper_bound == pytest.approx(expected, rel=1e-6, abs=0.0)
+    assert r.certificate.check(g, hand_jacobian=J).holds
+    # The polyhedral cones have a generator along the load (the contact
+    # frames' second tangent is ±z): the same payload by an LP.
+    poly = dg.max_load(g, w, hand_jacobian=J, torque_limits=TAU, cones="polyhedral")
+    assert poly.alpha == pytest.approx(expected, rel=1e-6, abs=0.0)
 
 
 def _check_forces(g, J, w, r):
