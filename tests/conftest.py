@@ -17,6 +17,10 @@ from drakegrasp.plant.models import DRAKE_MODELS_ENV
 
 ROOT = Path(__file__).resolve().parents[1]
 
+_SUPPORT = str(Path(__file__).resolve().parent / "support")
+if _SUPPORT not in sys.path:  # helpers shared across test folders (odd_scenes)
+    sys.path.insert(0, _SUPPORT)
+
 
 def local_drake_models() -> Path | None:
     """The local ``drake_models`` copy: ``$DRAKEGRASP_DRAKE_MODELS``, else

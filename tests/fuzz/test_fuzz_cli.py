@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from odd_scenes import BOX_WELD, SECOND_BOX, SHIPPED_BOX_POSE, edited_shipped
 
 from drakegrasp.core import examples as ex
 
@@ -124,32 +125,11 @@ def test_bad_inputs_one_line_each(tmp_path):
     assert not list(tmp_path.glob(".*.partial"))
 
 
-_BOX_POSE = """\
-    default_free_body_pose:
-      box:
-        translation: [0.0, 0.0, 0.065]
-        rotation: !Rpy {deg: [0.0, 0.0, 0.0]}
-"""
-_BOX_WELD = """\
-- add_weld:
-    parent: world
-    child: box::box
-    X_PC:
-      translation: [0.0, 0.0, 0.065]
-"""
-_BOX2 = """\
-- add_model:
-    name: box2
-    file: package://drakegrasp/objects/box.sdf
-    default_free_body_pose:
-      box:
-        translation: [0.3, 0.0, 0.065]
-"""
 # Edits of the shipped parallel_jaw_box that `plan` refuses, and the cause the
 # one line must name (before: a misleading cause, or a plan on nonsense)
 HOSTILE_SCENES = {
     "object welded": (
-        [(_BOX_POSE, ""), ("drakegrasp:\n", _BOX_WELD + "drakegrasp:\n")],
+        [(SHIPPED_BOX_POSE, ""), ("drakegrasp:\n", BOX_WELD + "drakegrasp:\n")],
         "object_body box::box is welded to the world",
     ),
     "object world": (
@@ -165,7 +145,7 @@ HOSTILE_SCENES = {
         "is the model instance of the object",
     ),
     "no hand, second free box": (
-        [("  hand: gripper\n", ""), ("drakegrasp:\n", _BOX2 + "drakegrasp:\n")],
+        [("  hand: gripper\n", ""), ("drakegrasp:\n", SECOND_BOX + "drakegrasp:\n")],
         "names no hand",
     ),
     "object unknown": (
@@ -185,13 +165,8 @@ HOSTILE_SCENES = {
 
 @pytest.mark.parametrize("case", sorted(HOSTILE_SCENES))
 def test_hostile_scenes_one_line_each(tmp_path, case):
-    from drakegrasp.plant.scene import scene_path
-
     edits, cause = HOSTILE_SCENES[case]
-    text = scene_path("parallel_jaw_box").read_text()
-    for old, new in edits:
-        assert old in text, old
-        text = text.replace(old, new)
+    text = edited_shipped("parallel_jaw_box", *edits)
     scene = tmp_path / "hostile.yaml"
     scene.write_text(text)
     line = _one_line_error(_run("plan", str(scene), "--num", "5"))

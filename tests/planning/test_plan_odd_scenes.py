@@ -20,6 +20,15 @@ from __future__ import annotations
 import json
 
 import pytest
+from odd_scenes import (
+    BOX_WELD,
+    HAND_LINE,
+    PALM_ON_WORLD,
+    SECOND_BOX,
+    SHIPPED_BOX_POSE,
+    TABLE_AND_PALM,
+    edited_shipped,
+)
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
@@ -30,57 +39,6 @@ import drakegrasp as dg
 from drakegrasp.cli import main
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.models import register_models
-from drakegrasp.plant.scene import scene_path
-
-HAND_LINE = "  hand: gripper\n"
-PALM_WELD = "- add_weld:\n    parent: world\n    child: gripper::palm\n"
-TABLE = """\
-- add_model:
-    name: table
-    file: package://drakegrasp/objects/box.sdf
-- add_weld:
-    parent: world
-    child: table::box
-    X_PC:
-      translation: [0.3, 0.0, 0.0]
-- add_weld:
-    parent: table::box
-    child: gripper::palm
-    X_PC:
-      translation: [-0.3, 0.0, 0.0]
-"""
-SECOND_BOX = """\
-- add_model:
-    name: box2
-    file: package://drakegrasp/objects/box.sdf
-    default_free_body_pose:
-      box:
-        translation: [0.3, 0.0, 0.065]
-"""
-BOX_FREE = """\
-    default_free_body_pose:
-      box:
-        translation: [0.0, 0.0, 0.065]
-        rotation: !Rpy {deg: [0.0, 0.0, 0.0]}
-"""
-BOX_WELD = """\
-- add_weld:
-    parent: world
-    child: box::box
-    X_PC:
-      translation: [0.0, 0.0, 0.065]
-"""
-
-
-def _shipped(name: str) -> str:
-    return scene_path(name).read_text()
-
-
-def _edit(text: str, *pairs: tuple[str, str]) -> str:
-    for old, new in pairs:
-        assert old in text, old
-        text = text.replace(old, new)
-    return text
 
 
 def _write(tmp_path, name: str, text: str) -> str:
@@ -118,7 +76,7 @@ JAW_VARIANTS = {
     "hand: finger bodies": (
         (HAND_LINE, "  hand: [gripper::left_finger, gripper::right_finger]\n"),
     ),
-    "hand welded to a table": ((PALM_WELD, TABLE),),
+    "hand welded to a table": ((PALM_ON_WORLD, TABLE_AND_PALM),),
 }
 
 
@@ -126,7 +84,7 @@ JAW_VARIANTS = {
 def test_a_parallel_jaw_scene_variant_plans_as_the_shipped_scene(
     tmp_path, capsys, variant
 ):
-    text = _edit(_shipped("parallel_jaw_box"), *JAW_VARIANTS[variant])
+    text = edited_shipped("parallel_jaw_box", *JAW_VARIANTS[variant])
     got = _plan_json(capsys, _write(tmp_path, "variant", text), 20)
     want = _plan_json(capsys, "parallel_jaw_box", 20)
     assert want["candidates"]  # the comparison compares something
@@ -148,7 +106,7 @@ def test_a_parallel_jaw_scene_variant_plans_as_the_shipped_scene(
 def test_a_multi_finger_scene_variant_plans_as_the_shipped_scene(
     tmp_path, capsys, edit
 ):
-    text = _edit(_shipped("three_finger_sphere"), edit)
+    text = edited_shipped("three_finger_sphere", edit)
     got = _plan_json(capsys, _write(tmp_path, "variant", text), 12)
     want = _plan_json(capsys, "three_finger_sphere", 12)
     assert want["candidates"]
@@ -160,7 +118,7 @@ def test_a_multi_finger_scene_variant_plans_as_the_shipped_scene(
 
 REFUSED = {
     "object welded to the world": (
-        ((BOX_FREE, ""), ("drakegrasp:\n", BOX_WELD + "drakegrasp:\n")),
+        ((SHIPPED_BOX_POSE, ""), ("drakegrasp:\n", BOX_WELD + "drakegrasp:\n")),
         "object_body box::box is welded to the world: no grasp can lift it",
     ),
     "object_body: world": (
@@ -199,7 +157,7 @@ REFUSED = {
 @pytest.mark.parametrize("case", sorted(REFUSED))
 def test_an_odd_scene_is_refused_in_one_line_naming_the_cause(tmp_path, capsys, case):
     edits, message = REFUSED[case]
-    path = _write(tmp_path, "odd", _edit(_shipped("parallel_jaw_box"), *edits))
+    path = _write(tmp_path, "odd", edited_shipped("parallel_jaw_box", *edits))
     assert message in _one_line(capsys, path, "--num", "5")
     # the same with --mu plant, which reads the plant's friction first
     assert message in _one_line(capsys, path, "--num", "5", "--mu", "plant")

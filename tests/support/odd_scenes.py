@@ -1,9 +1,10 @@
 """Small scene files of odd shapes, modelled on the shipped parallel-jaw box.
 
-Shared by the plant and planning tests of odd scenes (a hand without
+Shared by the plant, planning and fuzz tests of odd scenes (a hand without
 ``hand:``, a hand of finger bodies, a hand welded to a table, an object welded
 to the world...).  :func:`jaw_scene` writes one into a folder and returns its
-path.
+path; :func:`edited_shipped` edits a shipped scene's text with the snippets
+here (``HAND_LINE``, ``PALM_ON_WORLD``, ``SHIPPED_BOX_POSE``...).
 """
 
 from __future__ import annotations
@@ -34,16 +35,33 @@ BOX = """\
         translation: [0.0, 0.0, 0.065]
 """
 
-BOX_ON_WORLD = """\
-- add_model:
-    name: box
-    file: package://drakegrasp/objects/box.sdf
+BOX_WELD = """\
 - add_weld:
     parent: world
     child: box::box
     X_PC:
       translation: [0.0, 0.0, 0.065]
 """
+
+BOX_ON_WORLD = (
+    """\
+- add_model:
+    name: box
+    file: package://drakegrasp/objects/box.sdf
+"""
+    + BOX_WELD
+)
+
+HAND_LINE = "  hand: gripper\n"
+"""The shipped parallel_jaw_box's ``hand:`` line."""
+
+SHIPPED_BOX_POSE = """\
+    default_free_body_pose:
+      box:
+        translation: [0.0, 0.0, 0.065]
+        rotation: !Rpy {deg: [0.0, 0.0, 0.0]}
+"""
+"""The shipped parallel_jaw_box's free pose of its box."""
 
 SECOND_BOX = """\
 - add_model:
@@ -92,3 +110,14 @@ def jaw_scene(
     path = Path(folder) / f"{name}.yaml"
     path.write_text("directives:\n" + directives + section)
     return path
+
+
+def edited_shipped(name: str, *pairs: tuple[str, str]) -> str:
+    """A shipped scene's text with each ``(old, new)`` replaced (``old`` must occur)."""
+    from drakegrasp.plant.scene import scene_path
+
+    text = scene_path(name).read_text()
+    for old, new in pairs:
+        assert old in text, old
+        text = text.replace(old, new)
+    return text
