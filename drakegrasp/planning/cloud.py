@@ -109,7 +109,9 @@ NORMAL_CURVED_F = 5.6
 """A neighbourhood is fitted with a quadric, and a point takes the quadric's
 normal at itself, where the quadric explains the points better than the plane
 beyond chance: the F statistic of the three added terms exceeds this (the 1 %
-point of F(3, 14), 20 points less six coefficients)."""
+point of F(3, 14), 20 points less six coefficients).  A cloud of fewer than
+:data:`NORMAL_NEIGHBOURS` points has fewer residual degrees of freedom, and
+its test the 1 % point of F(3, k - 6) instead, when that is higher."""
 
 _NORMAL_CHUNK = 50_000
 """Points whose neighbourhoods are fitted at once (memory: chunk × 20 × 3)."""
@@ -358,6 +360,20 @@ def estimate_normals(points: np.ndarray) -> np.ndarray:
     return normals
 
 
+def _curved_threshold(k: int) -> float:
+    """The F statistic a patch of ``k`` points must exceed to take its quadric.
+
+    :data:`NORMAL_CURVED_F` is the 1 % point for 20 points; a smaller patch
+    (a cloud of 7-19 points) leaves the quadric fewer residual degrees of
+    freedom, ``k - 6``, and chance alone gives far larger F: the 1 % point of
+    F(3, 1) is 5403.  With 5.6 there, seven points on a noisy plane took a
+    quadric fitted to the noise, normals up to 18° off.
+    """
+    from scipy.stats import f as f_distribution
+
+    return max(NORMAL_CURVED_F, float(f_distribution.ppf(0.99, 3, k - 6)))
+
+
 def _quadric_normals(p, Q, centre, frame, plane_var, spacing) -> np.ndarray:
     """Normals at ``p`` of quadrics fitted to patches, or the patches' planes.
 
@@ -410,7 +426,7 @@ def _quadric_normals(p, Q, centre, frame, plane_var, spacing) -> np.ndarray:
     local_n = np.stack([np.ones(L), -du, -dv], axis=1)
     local_n /= np.linalg.norm(local_n, axis=1, keepdims=True)
     curved = np.einsum("lij,lj->li", frame, local_n)
-    better = posed & (F > NORMAL_CURVED_F)
+    better = posed & (F > _curved_threshold(k))
     return np.where(better[:, None], curved, frame[:, :, 0])
 
 

@@ -177,3 +177,23 @@ def test_repeated_points_count_once():
     normals = estimate_normals(repeated)
     np.testing.assert_array_equal(normals, np.repeat(estimate_normals(points), 10, 0))
     assert _angles(normals, np.repeat(true, 10, axis=0)).max() < 2.0
+
+
+@pytest.mark.parametrize("size", [8, 9, 10])
+def test_a_small_noisy_plane_is_not_taken_for_a_quadric_by_chance(size):
+    # A cloud of fewer than twenty points fits each patch with fewer residual
+    # degrees of freedom, and chance alone exceeds the 20-point F threshold
+    # (5.6) far more often: eight points on a plane with 0.1 mm noise took
+    # quadrics fitted to the noise, normals on average 1.8 times as far off
+    # as the plane's (up to 12 deg).  The test's own F(3, k - 6) point keeps
+    # them within a few percent of the plane.
+    tilt, plane_tilt = [], []
+    for seed in range(100):
+        rng = np.random.default_rng(seed)
+        xy = rng.uniform(0.0, 0.01 * np.sqrt(size), (size, 2))
+        points = np.c_[xy, rng.normal(0.0, 1e-4, size)]
+        up = np.tile([0.0, 0.0, 1.0], (size, 1))
+        tilt.append(_angles(estimate_normals(points), up))
+        plane_tilt.append(_angles(_flattest_plane_only(points), up))
+    ratio = np.mean(tilt) / np.mean(plane_tilt)
+    assert ratio < 1.15, ratio
