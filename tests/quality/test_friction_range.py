@@ -261,3 +261,33 @@ def test_a_true_payload_bound_passes_and_a_low_one_fails(
     for forged in low:
         check = forged.check(grasp, hand_jacobian=J)
         assert not check.holds, check
+
+
+@pytest.mark.parametrize("tiny", [1e-9, 1e-12])
+def test_forces_that_leave_the_load_unbalanced_are_never_held(tiny):
+    # A pinch with μ = 0.5 on one finger and a tiny μ on the other and on a
+    # third: the z load needs equal friction at both pinch fingers, so normal
+    # forces of 0.1 / μ.  Clarabel returned forces of 3e8 N that balanced
+    # only two thirds of the 0.2 N load; the balance check weighed the
+    # residual against a solver's noise on 3e8 N (1e-6 of it) and said
+    # "held".  Held forces now balance the load to 1e-3 of it, or no answer
+    # is claimed.
+    g = dg.Grasp(
+        [
+            dg.Contact([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], mu=0.5),
+            dg.Contact([1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], mu=tiny),
+            dg.Contact([0.0, -1.0, 0.0], [0.0, 1.0, 0.0], mu=tiny),
+        ]
+    )
+    w = np.array([0.0, 0.0, 0.2, 0.0, 0.0, 0.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            r = dg.grasp_forces(g, w)
+        except dg.SolverError:
+            return
+    if r.feasible:
+        f = np.concatenate(r.contact_forces)
+        residual = np.abs(dg.grasp_matrix(g) @ f + w)
+        assert residual.max() <= 1e-3 * 0.2, residual
+
