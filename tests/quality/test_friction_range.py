@@ -291,3 +291,45 @@ def test_forces_that_leave_the_load_unbalanced_are_never_held(tiny):
         residual = np.abs(dg.grasp_matrix(g) @ f + w)
         assert residual.max() <= 1e-3 * 0.2, residual
 
+
+def _two_fingers(mu1, mu2):
+    return dg.Grasp(
+        [
+            dg.Contact([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], mu=mu1),
+            dg.Contact([1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], mu=mu2),
+        ]
+    )
+
+
+def test_a_load_of_1e300_newtons_warns_of_no_overflow():
+    # The result's balance residual took np.linalg.norm of 1e300-sized
+    # vectors (RuntimeWarning: overflow in dot), and at μ = 1e12 the check
+    # multiplied μ by the load before dividing.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        r = dg.grasp_forces(_two_fingers(1e12, 1e12), [0.0, 0.0, 1e300, 0.0, 0.0, 0.0])
+    assert r.feasible and np.isfinite(r.squeeze)
+    assert np.isfinite(r.balance_residual) and r.balance_residual < 1e-6
+
+
+def test_forces_past_the_largest_float_are_refused_not_held():
+    # 1e300 N at μ = 1e-12 needs normal forces of 5e311 N: once "held" with
+    # forces inf and nan (or a RuntimeWarning before that).
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(dg.SolverError, match="largest float"):
+            dg.grasp_forces(
+                _two_fingers(1e-12, 1e-12), [0.0, 0.0, 1e300, 0.0, 0.0, 0.0]
+            )
+
+
+def test_a_limit_past_the_largest_float_in_load_units_warns_of_no_overflow():
+    # 1 N over a force unit of 1e-312 N (a load of 1e-300 N at μ = 1e12)
+    # overflowed the dual's cost (RuntimeWarning) on its way to a weight inf.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        dg.grasp_forces(
+            _two_fingers(1e-12, 1e12),
+            [0.0, 0.0, 1e-300, 0.0, 0.0, 0.0],
+            max_normal_force=1.0,
+        )
