@@ -29,6 +29,7 @@ import os
 import signal
 import tempfile
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -1540,6 +1541,60 @@ def _estimated_normal_cases() -> Iterator[Case]:
     rng = np.random.default_rng(125)
     eight = np.c_[rng.uniform(0, 0.01 * np.sqrt(8), (8, 2)), rng.normal(0, 1e-4, 8)]
     yield vertical("eight-noisy-plane-points", eight, 5.0)
+
+
+def load_cases() -> Iterator[Case]:
+    """Grasp forces at extreme μ mixes and loads of 1e-300 / 1e300 N.
+
+    A RuntimeWarning counts as a raw exception here.  Forces said to hold a
+    load must balance it (to 1e-3 of it), and none may be inf or NaN.
+    """
+
+    def pinch(*mus):
+        spots = ([-1.0, 0, 0], [1.0, 0, 0], [0, -1.0, 0])
+        return dg.Grasp(
+            [
+                dg.Contact(p, -np.array(p), mu=mu)
+                for p, mu in zip(spots[: len(mus)], mus, strict=True)
+            ]
+        )
+
+    def strict(call):
+        def run():
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", RuntimeWarning)
+                return call()
+
+        return run
+
+    def balanced(g, w):
+        def check(r) -> bool:
+            if not r.feasible:
+                return True
+            f = np.concatenate(r.contact_forces)
+            if not np.all(np.isfinite(f)):
+                return False
+            res = dg.grasp_matrix(g) @ f + w
+            return bool(np.max(np.abs(res)) <= 1e-3 * np.max(np.abs(w)))
+
+        return check
+
+    up = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+    cases = {
+        # forces of 3e8 N that balanced two thirds of the load were "held"
+        "mu-0.5-1e-12-1e-12": (pinch(0.5, 1e-12, 1e-12), 0.2 * up, {}),
+        "mu-1e12-load-1e300": (pinch(1e12, 1e12), 1e300 * up, {}),
+        "mu-1e-12-load-1e300": (pinch(1e-12, 1e-12), 1e300 * up, {}),
+        "mu-1e-12-1e12-load-1e-300": (
+            pinch(1e-12, 1e12),
+            1e-300 * up,
+            {"max_normal_force": 1.0},
+        ),
+        "mu-1e-12-load-1e-300": (pinch(1e-12, 1e-12), 1e-300 * up, {}),
+    }
+    for name, (g, w, kw) in cases.items():
+        call = strict(lambda g=g, w=w, kw=kw: dg.grasp_forces(g, w, **kw))
+        yield Case("load", f"grasp_forces {name}", call, "either", balanced(g, w))
 
 
 def _odd_rig(edit):
