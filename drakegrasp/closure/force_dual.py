@@ -152,12 +152,19 @@ def build_load_dual_program(
     twist variables are ``z_y`` with ``ȳ = Bᵀ z_y``).
     """
     A, blocks = _dual_matrix(P)
-    weights = _weights(P, force_scale, blocks)
+    with np.errstate(over="ignore"):
+        weights = _weights(P, force_scale, blocks)
+    # A limit past the largest float in units of a tiny load (1 N over a
+    # load of 1e-300 N at μ = 1e12) binds nothing: its multiplier is 0.
+    unbinding = ~np.isfinite(weights)
+    weights[unbinding] = 0.0
     prog = MathematicalProgram()
     z = prog.NewContinuousVariables(A.shape[1], "z")
     y = z[blocks[0]]
     if blocks[0].stop < len(z):
         prog.AddBoundingBoxConstraint(0.0, np.inf, z[blocks[0].stop :])
+    if unbinding.any():
+        prog.AddBoundingBoxConstraint(0.0, 0.0, z[unbinding])
     _add_polar_conditions(prog, P, A, z)
     if mode == "refute":
         prog.AddBoundingBoxConstraint(-1.0, 1.0, y)

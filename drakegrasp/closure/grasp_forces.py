@@ -51,6 +51,7 @@ from drakegrasp.closure.load_problem import (
 from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp, grasp_matrix
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import safe_norm
 from drakegrasp.errors import InvalidOptionError, SolverError
 
 __all__ = [
@@ -352,13 +353,35 @@ def add_linear_constraint_rows(prog, rows: np.ndarray, z) -> None:
     )
 
 
+def _load_text(w: np.ndarray) -> str:
+    """A load for a message, to 9 significant digits.
+
+    ``np.round(w, 9)`` overflowed, with a RuntimeWarning, past 1e299 N.
+    """
+    return "[" + ", ".join(f"{x:.9g}" for x in w) + "]"
+
+
 def _solved(P, w, objective, result, v, F0) -> GraspForceResult:
     xv = result.GetSolution(v.x)
-    full = P.stacked(xv, F0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        full = P.stacked(xv, F0)
+    if not np.all(np.isfinite(full)):
+        # 1e300 N at μ = 1e-12 needs normal forces of 1e312 N: "held" with
+        # forces inf and nan was no answer
+        raise SolverError(
+            f"the forces that hold the load {_load_text(w)} pass the "
+            "largest float (1.8e308 N): the load is too large for this grasp's "
+            "friction to compute"
+        )
     tau = P.joint_torques(full)
     sat, usage = saturating_joints(tau, P.torque_limits)
     G = grasp_matrix(P.grasp)
-    scale = max(np.linalg.norm(w), np.linalg.norm(G, 2) * np.linalg.norm(full), 1e-300)
+    # safe norms: a load of 1e300 N has a norm, not an overflow warning
+    scale = max(
+        float(safe_norm(w)),
+        float(np.linalg.norm(G, 2)) * float(safe_norm(full)),
+        1e-300,
+    )
     normals = P.grasp.normal_indices()
     return GraspForceResult(
         feasible=True,
@@ -374,7 +397,7 @@ def _solved(P, w, objective, result, v, F0) -> GraspForceResult:
         if v.margin is not None
         else math.nan,
         torque_limits=None if P.torque_limits is None else P.torque_limits.copy(),
-        balance_residual=float(np.linalg.norm(G @ full + w) / scale),
+        balance_residual=float(safe_norm(G @ full + w)) / scale,
         num_generators=P.num_generators,
         solver=result.get_solver_id().name(),
         status=result.get_solution_result().name,
@@ -510,7 +533,7 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
         excess, what = P.violation(bad.stacked_forces(), w)
         found = f"forces violating the constraints by {excess:.2g} (at {what})"
     raise SolverError(
-        f"{bad.solver} returned {found} for the load {np.round(w, 9).tolist()}, "
+        f"{bad.solver} returned {found} for the load {_load_text(w)}, "
         "even friction-scaled: the answer is not known to the solvers' accuracy"
     )
 

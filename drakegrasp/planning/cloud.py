@@ -109,7 +109,9 @@ NORMAL_CURVED_F = 5.6
 """A neighbourhood is fitted with a quadric, and a point takes the quadric's
 normal at itself, where the quadric explains the points better than the plane
 beyond chance: the F statistic of the three added terms exceeds this (the 1 %
-point of F(3, 14), 20 points less six coefficients)."""
+point of F(3, 14), 20 points less six coefficients).  A cloud of fewer than
+:data:`NORMAL_NEIGHBOURS` points has fewer residual degrees of freedom, and
+its test the 1 % point of F(3, k - 6) instead, when that is higher."""
 
 _NORMAL_CHUNK = 50_000
 """Points whose neighbourhoods are fitted at once (memory: chunk × 20 × 3)."""
@@ -310,11 +312,13 @@ def estimate_normals(points: np.ndarray) -> np.ndarray:
     normals : (M, 3) float
         Unit normals (either sign); NaN where a neighbourhood spans no plane
         (fewer than 3 distinct points, or all on a line).  A point given
-        twice counts once, and both copies get its normal.
+        twice counts once, and both copies get its normal; so do points
+        closer than single precision resolves at the cloud's extent.
     """
-    unique, inverse = np.unique(points, axis=0, return_inverse=True)
-    if len(unique) < len(points):  # repeated points (fused frames) count once
-        return estimate_normals(unique)[inverse.reshape(-1)]
+    same = _same_point(points)
+    if same is not None:  # repeated points (fused frames) count once
+        first, inverse = np.unique(same, return_index=True, return_inverse=True)[1:]
+        return estimate_normals(points[first])[inverse.reshape(-1)]
     M = len(points)
     k = min(NORMAL_NEIGHBOURS, M)
     tree = cKDTree(points)
@@ -356,6 +360,55 @@ def estimate_normals(points: np.ndarray) -> np.ndarray:
             )
     normals[~np.isfinite(variation[chosen])] = np.nan
     return normals
+
+
+def _same_point(points: np.ndarray):
+    """Which points are one point given more than once, or None if none are.
+
+    Points closer than a single-precision float resolves at the cloud's
+    extent (or than a few units of round-off of its coordinates) are one
+    point: fused frames repeat points with such jitter, and twenty copies of
+    a point 1e-12 m apart once filled its neighbourhood with the jitter, whose
+    "plane" is any direction (normals 55-60 deg off on a flat grid).
+
+    Returns
+    -------
+    labels : (M,) int or None
+        Equal for points that are one; None when every point is apart.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    extent = float(np.max(np.ptp(points, axis=0)))
+    size = float(np.max(np.abs(points)))
+    tol = max(np.finfo(np.float32).eps * extent, 8 * np.finfo(float).eps * size)
+    if tol == 0.0:  # one point, or none
+        return np.zeros(len(points), int) if len(points) > 1 else None
+    # cells of side tol first (a cluster of 10^5 copies is one cell, not 10^10
+    # pairs), then cells whose points are within tol across a cell boundary
+    cell = np.floor((points - points.min(axis=0)) / tol)
+    _, first, label = np.unique(cell, axis=0, return_index=True, return_inverse=True)
+    label = label.reshape(-1)
+    pairs = cKDTree(points[first]).query_pairs(tol, output_type="ndarray")
+    if len(pairs):
+        n = len(first)
+        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), (n, n))
+        label = connected_components(graph, directed=False)[1][label]
+    return label if len(np.unique(label)) < len(points) else None
+
+
+def _curved_threshold(k: int) -> float:
+    """The F statistic a patch of ``k`` points must exceed to take its quadric.
+
+    :data:`NORMAL_CURVED_F` is the 1 % point for 20 points; a smaller patch
+    (a cloud of 7-19 points) leaves the quadric fewer residual degrees of
+    freedom, ``k - 6``, and chance alone gives far larger F: the 1 % point of
+    F(3, 1) is 5403.  With 5.6 there, seven points on a noisy plane took a
+    quadric fitted to the noise, normals up to 18° off.
+    """
+    from scipy.stats import f as f_distribution
+
+    return max(NORMAL_CURVED_F, float(f_distribution.ppf(0.99, 3, k - 6)))
 
 
 def _quadric_normals(p, Q, centre, frame, plane_var, spacing) -> np.ndarray:
@@ -410,7 +463,7 @@ def _quadric_normals(p, Q, centre, frame, plane_var, spacing) -> np.ndarray:
     local_n = np.stack([np.ones(L), -du, -dv], axis=1)
     local_n /= np.linalg.norm(local_n, axis=1, keepdims=True)
     curved = np.einsum("lij,lj->li", frame, local_n)
-    better = posed & (F > NORMAL_CURVED_F)
+    better = posed & (F > _curved_threshold(k))
     return np.where(better[:, None], curved, frame[:, :, 0])
 
 

@@ -29,6 +29,7 @@ import os
 import signal
 import tempfile
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -1488,6 +1489,7 @@ def planning_cases() -> Iterator[Case]:
         "answer",
         lambda r: len(r) > 0 and ranked(r),
     )
+    yield from _estimated_normal_cases()
     # Only a normal's direction counts: any finite length plans as unit normals
     # (1e200 once overflowed the norm into zero normals, all poses rejected).
     for scale in (1e200, 1e-310):
@@ -1498,6 +1500,101 @@ def planning_cases() -> Iterator[Case]:
             "answer",
             lambda r: len(r) > 0 and ranked(r),
         )
+
+
+def _estimated_normal_cases() -> Iterator[Case]:
+    """``read_cloud``'s estimated normals on hostile clouds of easy shapes: a
+    flat grid's normals must stay vertical."""
+    from drakegrasp.planning.cloud import read_cloud
+
+    def vertical(name, points, tol_deg):
+        def check(r) -> bool:
+            _, n, dropped = r
+            cos = np.cos(np.radians(tol_deg))
+            return dropped == 0 and bool(np.all(np.abs(n[:, 2]) >= cos))
+
+        call = lambda: read_cloud(points)  # noqa: E731
+        return Case("planning", f"read_cloud-{name}", call, "answer", check)
+
+    g = np.stack(np.meshgrid(np.arange(10), np.arange(10)), -1).reshape(-1, 2)
+    grid = np.c_[0.005 * g, np.zeros(100)]
+    rng = np.random.default_rng(11)
+    clouds = {
+        # fused frames: each point 25 times, round-off apart (its copies once
+        # filled its neighbourhood, normals up to 90 deg off)
+        "jittered-copies-1e-12": np.repeat(grid, 25, axis=0)
+        + rng.normal(0.0, 1e-12, (2500, 3)),
+        "jittered-copies-1e-9": np.repeat(grid, 25, axis=0)
+        + rng.normal(0.0, 1e-9, (2500, 3)),
+        # 10^5 copies of one spot: merged without listing 10^10 pairs
+        "one-spot-100k-times": np.vstack(
+            [grid, grid[0] + rng.normal(0.0, 1e-12, (100_000, 3))]
+        ),
+        "far-1e6-m-spacing-5e-6": 1e-3 * grid + [999_999.0, 0.0, 0.0],
+        "float32": grid.astype(np.float32),
+        "integer-mm": np.round(1000 * grid).astype(int),
+    }
+    for name, points in clouds.items():
+        yield vertical(f"grid-{name}", points, 1.0)
+    # eight points on a plane with 0.1 mm noise: a quadric fitted to the
+    # noise once passed the 20-point F threshold (12 deg off here)
+    rng = np.random.default_rng(125)
+    eight = np.c_[rng.uniform(0, 0.01 * np.sqrt(8), (8, 2)), rng.normal(0, 1e-4, 8)]
+    yield vertical("eight-noisy-plane-points", eight, 5.0)
+
+
+def load_cases() -> Iterator[Case]:
+    """Grasp forces at extreme μ mixes and loads of 1e-300 / 1e300 N.
+
+    A RuntimeWarning counts as a raw exception here.  Forces said to hold a
+    load must balance it (to 1e-3 of it), and none may be inf or NaN.
+    """
+
+    def pinch(*mus):
+        spots = ([-1.0, 0, 0], [1.0, 0, 0], [0, -1.0, 0])
+        return dg.Grasp(
+            [
+                dg.Contact(p, -np.array(p), mu=mu)
+                for p, mu in zip(spots[: len(mus)], mus, strict=True)
+            ]
+        )
+
+    def strict(call):
+        def run():
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", RuntimeWarning)
+                return call()
+
+        return run
+
+    def balanced(g, w):
+        def check(r) -> bool:
+            if not r.feasible:
+                return True
+            f = np.concatenate(r.contact_forces)
+            if not np.all(np.isfinite(f)):
+                return False
+            res = dg.grasp_matrix(g) @ f + w
+            return bool(np.max(np.abs(res)) <= 1e-3 * np.max(np.abs(w)))
+
+        return check
+
+    up = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+    cases = {
+        # forces of 3e8 N that balanced two thirds of the load were "held"
+        "mu-0.5-1e-12-1e-12": (pinch(0.5, 1e-12, 1e-12), 0.2 * up, {}),
+        "mu-1e12-load-1e300": (pinch(1e12, 1e12), 1e300 * up, {}),
+        "mu-1e-12-load-1e300": (pinch(1e-12, 1e-12), 1e300 * up, {}),
+        "mu-1e-12-1e12-load-1e-300": (
+            pinch(1e-12, 1e12),
+            1e-300 * up,
+            {"max_normal_force": 1.0},
+        ),
+        "mu-1e-12-load-1e-300": (pinch(1e-12, 1e-12), 1e-300 * up, {}),
+    }
+    for name, (g, w, kw) in cases.items():
+        call = strict(lambda g=g, w=w, kw=kw: dg.grasp_forces(g, w, **kw))
+        yield Case("load", f"grasp_forces {name}", call, "either", balanced(g, w))
 
 
 def _odd_rig(edit):

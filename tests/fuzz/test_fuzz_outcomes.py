@@ -22,6 +22,7 @@ FAMILIES = {
     "monotone": fuzz_cases.monotonicity_cases,
     "pictures": fuzz_cases.picture_cases,
     "planning": fuzz_cases.planning_cases,
+    "load": fuzz_cases.load_cases,
 }
 
 

@@ -177,3 +177,45 @@ def test_repeated_points_count_once():
     normals = estimate_normals(repeated)
     np.testing.assert_array_equal(normals, np.repeat(estimate_normals(points), 10, 0))
     assert _angles(normals, np.repeat(true, 10, axis=0)).max() < 2.0
+
+
+@pytest.mark.parametrize("size", [8, 9, 10])
+def test_a_small_noisy_plane_is_not_taken_for_a_quadric_by_chance(size):
+    # A cloud of fewer than twenty points fits each patch with fewer residual
+    # degrees of freedom, and chance alone exceeds the 20-point F threshold
+    # (5.6) far more often: eight points on a plane with 0.1 mm noise took
+    # quadrics fitted to the noise, normals on average 1.8 times as far off
+    # as the plane's (up to 12 deg).  The test's own F(3, k - 6) point keeps
+    # them within a few percent of the plane.
+    tilt, plane_tilt = [], []
+    for seed in range(100):
+        rng = np.random.default_rng(seed)
+        xy = rng.uniform(0.0, 0.01 * np.sqrt(size), (size, 2))
+        points = np.c_[xy, rng.normal(0.0, 1e-4, size)]
+        up = np.tile([0.0, 0.0, 1.0], (size, 1))
+        tilt.append(_angles(estimate_normals(points), up))
+        plane_tilt.append(_angles(_flattest_plane_only(points), up))
+    ratio = np.mean(tilt) / np.mean(plane_tilt)
+    assert ratio < 1.15, ratio
+
+
+@pytest.mark.parametrize("jitter", [1e-12, 1e-9])
+def test_points_repeated_with_round_off_jitter_count_once(jitter):
+    # Twenty-five copies of each point of a flat grid, 1e-12 m apart: every
+    # neighbourhood held one point's copies, whose "plane" fitted the jitter
+    # (normals 55-60 deg off on average, up to 90).  Points closer than
+    # single precision resolves at the cloud's extent are one point.
+    g = np.stack(np.meshgrid(np.arange(10), np.arange(10)), -1).reshape(-1, 2)
+    points = np.repeat(np.c_[0.005 * g, np.zeros(100)], 25, axis=0)
+    points += np.random.default_rng(0).normal(0.0, jitter, points.shape)
+    up = np.tile([0.0, 0.0, 1.0], (len(points), 1))
+    assert _angles(estimate_normals(points), up).max() < 1e-3
+
+
+def test_a_hundred_thousand_copies_of_one_spot_stay_cheap():
+    # Merging near copies must not list every pair of them (10^10 here).
+    g = np.stack(np.meshgrid(np.arange(20), np.arange(20)), -1).reshape(-1, 2)
+    grid = np.c_[0.005 * g, np.zeros(400)]
+    spot = grid[0] + np.random.default_rng(1).normal(0.0, 1e-12, (100_000, 3))
+    normals = estimate_normals(np.vstack([grid, spot]))
+    assert np.abs(normals[:, 2]).min() > 1.0 - 1e-9
