@@ -406,6 +406,8 @@ def _curved_threshold(k: int) -> float:
     F(3, 1) is 5403.  With 5.6 there, seven points on a noisy plane took a
     quadric fitted to the noise, normals up to 18° off.
     """
+    if k >= NORMAL_NEIGHBOURS:  # the constant's own case (scipy.stats is slow to load)
+        return NORMAL_CURVED_F
     from scipy.stats import f as f_distribution
 
     return max(NORMAL_CURVED_F, float(f_distribution.ppf(0.99, 3, k - 6)))
