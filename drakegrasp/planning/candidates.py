@@ -86,7 +86,8 @@ class GraspCandidate:
         The point of frame O (metres) that every moment of the candidate is
         taken about: ``grasp``, ``epsilon``, ``weight_capacity`` and
         ``torque_needed``.  The object's centre of mass, where its weight
-        acts (on a point cloud, the cloud's centre: O's origin).
+        acts (a massless model's, planned with ``object_mass``: its collision
+        surface's centroid; on a point cloud, the cloud's centre: O's origin).
     contact_options : dict
         ``mu``, ``model`` and ``torsional_friction`` of the contacts.
     is_closure : bool

@@ -471,7 +471,7 @@ def plan_multifinger(
     settings = {**settings, "hand": hand_model.to_dict(), "tilt": tilt,
                 "min_fingers": int(min_fingers)}  # fmt: skip
     X_WO = plant.EvalBodyPoseInWorld(ctx, body)
-    reference = centre_of_mass(ctx, body)
+    reference = centre_of_mass(ctx, body, surface)
     torque_scale = surface.radius_about(reference)
     poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
     saved = plant.GetPositions(ctx).copy()

@@ -432,7 +432,7 @@ def plan_grasps(
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
         X_WO = plant.EvalBodyPoseInWorld(ctx, body)
-        reference = centre_of_mass(ctx, body)
+        reference = centre_of_mass(ctx, body, surface)
         name = scoped_name(plant, body)
         mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
     else:

@@ -440,6 +440,26 @@ class ObjectSurface:
             raise ModelError("the object has no collision geometry with a surface")
         return cls(pieces, areas)
 
+    def centroid(self) -> np.ndarray:
+        """The area centroid of the pieces' surfaces, frame O, metres.
+
+        A hull's is its triangles' centroids weighted by their areas; an
+        ellipsoid's, cylinder's or capsule's is its centre (each is centrally
+        symmetric).  Overlaps of pieces count twice.
+        """
+        centres = []
+        for piece in self.pieces:
+            if piece.kind == "hull" and len(piece.triangles):
+                t = piece.triangles
+                a = 0.5 * np.linalg.norm(
+                    np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1
+                )
+                c_G = (a @ t.mean(axis=1)) / max(float(a.sum()), 1e-300)
+            else:
+                c_G = np.zeros(3)
+            centres.append(piece.X_OG.multiply(c_G))
+        return (self.areas @ np.array(centres)) / float(self.areas.sum())
+
     def sample(self, n: int, rng: np.random.Generator):
         """``n`` area-uniform points on the pieces' surfaces, frame O.
 

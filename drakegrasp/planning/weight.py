@@ -57,25 +57,33 @@ __all__ = [
 ]
 
 
-def centre_of_mass(plant_context, body) -> np.ndarray:
+def centre_of_mass(plant_context, body, surface=None) -> np.ndarray:
     """Where an object body's weight acts: its centre of mass in its frame O.
 
     The planner takes every moment about this point (a model's body frame
-    need not sit there: a mesh's origin, a link's joint).
+    need not sit there: a mesh's origin, a link's joint).  A massless model
+    (planned with ``object_mass=``) has none: the area centroid of its
+    collision ``surface`` stands in for it.
 
     Parameters
     ----------
     plant_context : Context
         The plant's own context.
     body : RigidBody
+    surface : ObjectSurface, optional
+        The body's collision surface (frame O), for a massless body.
 
     Returns
     -------
     (3,) float
-        ``p_OBcm``, frame O, metres (O's origin for a massless body).
+        ``p_OBcm``, frame O, metres: the model's; for a massless body the
+        surface's centroid (O's origin without a ``surface``).
     """
-    p = np.asarray(body.CalcCenterOfMassInBodyFrame(plant_context), dtype=float)
-    return p if np.all(np.isfinite(p)) else np.zeros(3)
+    if body.get_mass(plant_context) > 0.0:
+        p = np.asarray(body.CalcCenterOfMassInBodyFrame(plant_context), dtype=float)
+        if np.all(np.isfinite(p)):
+            return p
+    return np.zeros(3) if surface is None else surface.centroid()
 
 
 def _directions() -> np.ndarray:

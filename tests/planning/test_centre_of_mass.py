@@ -22,15 +22,17 @@ THREE = "package://drakegrasp/hands/three_finger_hand.sdf"
 THREE_OPEN = [-0.4, 0.0, 0.0] * 3
 
 
-def _object(path, offset, size=(0.05, 0.04, 0.12)):
+def _object(path, offset, size=(0.05, 0.04, 0.12), mass=0.3):
     """A box whose geometry and centre of mass sit at ``offset`` in its frame."""
     pose = " ".join(repr(float(v)) for v in (*offset, 0.0, 0.0, 0.0))
+    inertia = ("4e-4", "4e-4", "1e-4") if mass > 0 else ("0", "0", "0")
     geometry = "<box><size>{} {} {}</size></box>".format(*size)
     path.write_text(
         '<?xml version="1.0"?><sdf version="1.9"><model name="tall_box">'
         "<link name='body'><inertial>"
-        f"<pose>{pose}</pose><mass>0.3</mass><inertia><ixx>4e-4</ixx>"
-        "<iyy>4e-4</iyy><izz>1e-4</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz>"
+        f"<pose>{pose}</pose><mass>{mass}</mass><inertia><ixx>{inertia[0]}</ixx>"
+        f"<iyy>{inertia[1]}</iyy><izz>{inertia[2]}</izz><ixy>0</ixy><ixz>0</ixz>"
+        "<iyz>0</iyz>"
         "</inertia></inertial>"
         f"<collision name='c'><pose>{pose}</pose><geometry>{geometry}</geometry>"
         "<drake:proximity_properties><drake:mu_dynamic>1.0</drake:mu_dynamic>"
@@ -41,14 +43,16 @@ def _object(path, offset, size=(0.05, 0.04, 0.12)):
     return str(path)
 
 
-def _framed(tmp_path, offset, hand=FLAT, models_dir=None):
+def _framed(tmp_path, offset, hand=FLAT, models_dir=None, mass=0.3):
     """The same box at the same world pose, its body frame moved by ``offset``.
 
     The box's geometry and centre of mass sit at ``offset`` in its frame O; O
     is put at ``-offset`` so the box is at the world's origin.  ``hand`` None:
     Drake's WSG-50 (from ``models_dir``).
     """
-    url = _object(tmp_path / f"box_{len(list(tmp_path.iterdir()))}.sdf", offset)
+    url = _object(
+        tmp_path / f"box_{len(list(tmp_path.iterdir()))}.sdf", offset, mass=mass
+    )
     X_WO = RigidTransform(-np.array(offset))
     if hand is None:
         return planning_scene(url, X_WO=X_WO, models_dir=models_dir)
@@ -122,3 +126,37 @@ def test_a_multi_finger_plan_does_not_depend_on_where_the_body_frame_sits(tmp_pa
     finite = [(a, b) for a, b in needed if np.isfinite(a) or np.isfinite(b)]
     assert finite
     np.testing.assert_allclose(*np.array(finite).T, rtol=1e-6)
+
+
+def test_a_massless_model_takes_moments_about_its_surface_centroid(tmp_path):
+    # Planned with object_mass= (the model has none), its body frame 20 cm
+    # from its geometry: the best guess of its centre of mass is the
+    # geometry's centroid, as for the same box with its mass.
+    massive = _plan(_framed(tmp_path, (0.2, 0.0, 0.0)), object_mass=0.3)
+    massless = _plan(_framed(tmp_path, (0.2, 0.0, 0.0), mass=0.0), object_mass=0.3)
+    np.testing.assert_allclose(massless[0].reference_point, (0.2, 0.0, 0.0), atol=1e-12)
+    np.testing.assert_allclose(_summary(massless), _summary(massive), rtol=1e-6)
+    s = [c.squeeze_needed for c in massless[:10]]
+    np.testing.assert_allclose(s, [c.squeeze_needed for c in massive[:10]], rtol=1e-6)
+
+
+def test_a_surface_centroid_is_the_area_weighted_centre_of_its_pieces():
+    from drakegrasp.planning.surface import ObjectSurface, Piece
+
+    def piece(kind, at, **kw):
+        zero = np.zeros((0, 3))
+        return Piece(
+            kind=kind, X_OG=RigidTransform(at), name=kind,
+            semi_axes=kw.get("semi_axes", np.zeros(3)), normals=zero,
+            offsets=np.zeros(0), triangles=kw.get("triangles", np.zeros((0, 3, 3))),
+        )  # fmt: skip
+
+    # a unit square's two triangles (area 1, centroid (0.5, 0.5, 0)), shifted
+    square = np.array(
+        [[[0, 0, 0], [1, 0, 0], [1, 1, 0]], [[0, 0, 0], [1, 1, 0], [0, 1, 0]]]
+    )
+    hull = piece("hull", [0.0, 0.0, 2.0], triangles=square.astype(float))
+    ball = piece("ellipsoid", [4.0, 0.0, 0.0], semi_axes=np.ones(3))
+    surface = ObjectSurface((hull, ball), np.array([1.0, 3.0]))
+    want = (1.0 * np.array([0.5, 0.5, 2.0]) + 3.0 * np.array([4.0, 0.0, 0.0])) / 4.0
+    np.testing.assert_allclose(surface.centroid(), want, atol=1e-15)
