@@ -173,6 +173,30 @@ class LoadCertificate:
         """
         return check_load_certificate(self, grasp, hand_jacobian, tol)
 
+    def force_reach(
+        self, grasp: Grasp, *, hand_jacobian: np.ndarray | None = None
+    ) -> float:
+        """The total normal force (N) up to which the certificate proves its claim.
+
+        A cone support that round-off leaves a little above 0 proves the
+        claim only for forces whose ``Σ f_n`` stays below this (the check's
+        caveat; per unit of α past the bound for a payload bound): ``inf``
+        when every support is at most 0, 0 when nothing is proven.  At a
+        tiny ``μ`` a load may need ``|w| / μ`` of normal force, beyond it.
+
+        Parameters
+        ----------
+        grasp : Grasp
+        hand_jacobian : (M, n_v) float, optional
+            Needed when the certificate has joint multipliers.
+
+        Returns
+        -------
+        float
+            Newtons (``Σ f_n``).
+        """
+        return certificate_force_reach(self, grasp, hand_jacobian)
+
     def to_dict(self) -> dict:
         """JSON-ready dictionary (``inf`` limits become ``None``)."""
         return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
@@ -332,6 +356,52 @@ def _impossible(cert: LoadCertificate) -> str | None:
     return None
 
 
+def _jacobian_for(cert: LoadCertificate, grasp: Grasp, hand_jacobian):
+    """The checked hand Jacobian when ``cert`` has joint multipliers, else None."""
+    eta = cert.joint_multipliers
+    if not (eta.size and np.any(eta != 0.0)):
+        return None
+    if hand_jacobian is None:
+        raise InvalidOptionError(
+            "this certificate has joint multipliers: checking it needs the "
+            "hand_jacobian (τ = Jᵀ f)"
+        )
+    J = check_hand_jacobian(grasp, hand_jacobian)
+    if J.shape[1] != eta.size:
+        raise InvalidOptionError(
+            f"hand_jacobian has {J.shape[1]} columns but the certificate has "
+            f"{eta.size} joint multipliers"
+        )
+    return J
+
+
+def _reach(cert: LoadCertificate, support, power: float, budget: float) -> float:
+    """Total normal force (N) below which the proof holds (see ``force_reach``).
+
+    A support ``eps > 0`` (round-off) weakens the proof to forces whose total
+    normal force stays below ``(power - budget) / eps`` (a refutation) or
+    ``power / eps`` per unit of α past the bound (a payload bound).
+    """
+    eps = float(np.maximum(support, 0.0).max(initial=0.0))
+    if eps == 0.0:
+        return math.inf
+    return (power - budget) / eps if cert.kind == LOAD_NOT_HELD else power / eps
+
+
+def certificate_force_reach(
+    cert: LoadCertificate, grasp: Grasp, hand_jacobian=None
+) -> float:
+    """See :meth:`LoadCertificate.force_reach`."""
+    cert = _read(cert, grasp)
+    J = _jacobian_for(cert, grasp, hand_jacobian)
+    power = -float(cert.twist @ cert.wrench)
+    budget = _budget(cert)
+    if _impossible(cert) is not None or not (power > 0.0 and math.isfinite(budget)):
+        return 0.0
+    support = _supports(cert, grasp, J)[0]
+    return _reach(cert, support, power, budget)
+
+
 def check_load_certificate(
     cert: LoadCertificate, grasp: Grasp, hand_jacobian, tol: float
 ) -> CertificateCheck:
@@ -339,20 +409,7 @@ def check_load_certificate(
     tol = check_tolerance(tol)
     cert = _read(cert, grasp)
     w, y = cert.wrench, cert.twist
-    eta = cert.joint_multipliers
-    J = None
-    if eta.size and np.any(eta != 0.0):
-        if hand_jacobian is None:
-            raise InvalidOptionError(
-                "this certificate has joint multipliers: checking it needs the "
-                "hand_jacobian (τ = Jᵀ f)"
-            )
-        J = check_hand_jacobian(grasp, hand_jacobian)
-        if J.shape[1] != eta.size:
-            raise InvalidOptionError(
-                f"hand_jacobian has {J.shape[1]} columns but the certificate has "
-                f"{eta.size} joint multipliers"
-            )
+    J = _jacobian_for(cert, grasp, hand_jacobian)
     why = _impossible(cert)
     if why is not None:
         return CertificateCheck(False, math.inf, 0.0, tol, f"nothing is proven: {why}")
@@ -394,15 +451,13 @@ def check_load_certificate(
     if cert.kind == LOAD_NOT_HELD and not bound < 1.0:
         bound_violation = math.inf
     violation = max(cone_violation, bound_violation)
-    # A support eps > 0 (round-off) weakens the proof to forces whose total
-    # normal force stays below (α power - budget) / eps; said per unit of α.
-    eps = float(np.maximum(support, 0.0).max())
-    if eps == 0.0:
+    reach = _reach(cert, support, power, budget)
+    if not math.isfinite(reach):
         caveat = ""
     elif cert.kind == LOAD_NOT_HELD:
-        caveat = f" (by any forces with Σ f_n < {(power - budget) / eps:.3g} N)"
+        caveat = f" (by any forces with Σ f_n < {reach:.3g} N)"
     else:
-        caveat = f" (by forces with Σ f_n < {power / eps:.3g} N per unit α − bound)"
+        caveat = f" (by forces with Σ f_n < {reach:.3g} N per unit α − bound)"
     if cert.kind == LOAD_NOT_HELD:
         slack = (power - budget) / (abs(power) + budget)
     else:

@@ -404,6 +404,43 @@ def _solved(P, w, objective, result, v, F0) -> GraspForceResult:
     )
 
 
+def _refutation_reaches(P, w, cert, prog, result) -> None:
+    """Refuse a "not held" whose proof stops short of the forces friction needs.
+
+    A refutation proves the load cannot be held by forces whose total normal
+    force stays below its reach (:meth:`LoadCertificate.force_reach`; round-off
+    in the twist's cone supports).  With a tiny ``μ`` a load may need
+    ``|w| / μ`` of normal force: at ``μ = (0.5, 1e-12)`` a planar pinch holds
+    1 N with 1e12 N, and a refutation reaching 5e11 N said "not held".
+    """
+    mus = [c.mu for c in P.grasp.contacts if c.mu > 0.0]
+    if not mus:
+        return
+    D = len(w)
+    f, m = (w[:2], w[2:]) if D == 3 else (w[:3], w[3:])
+    size = max(float(safe_norm(f)), float(safe_norm(m)) / P.grasp.characteristic_length)
+    need = size / min(mus)
+    reach = cert.force_reach(P.grasp, hand_jacobian=P.hand_jacobian)
+    if not reach > 0.0:
+        raise SolverError(
+            f"{result.get_solver_id().name()} found no forces that hold the load, "
+            "and the dual's refutation proves nothing (the load's power along "
+            "its twist does not exceed the limits' budget): undecided",
+            program=prog,
+            result=result,
+        )
+    if reach < need:
+        raise SolverError(
+            f"{result.get_solver_id().name()} found no forces that hold the load, "
+            f"but the refutation is proven only for total normal force below "
+            f"{reach:.3g} N, and at mu = {min(mus):g} the load may need "
+            f"{need:.3g} N (|w| / mu): undecided; a mu this far from 1 is past "
+            "what the solvers resolve",
+            program=prog,
+            result=result,
+        )
+
+
 def _infeasible(P, w, objective, prog, result, F0) -> GraspForceResult:
     cert, _ = find_load_certificate(P, w, mode="refute", force_scale=F0)
     status = result.get_solution_result()
@@ -418,6 +455,8 @@ def _infeasible(P, w, objective, prog, result, F0) -> GraspForceResult:
             program=prog,
             result=result,
         )
+    if cert is not None:
+        _refutation_reaches(P, w, cert, prog, result)
     return GraspForceResult(
         feasible=False,
         objective=objective,
