@@ -435,9 +435,10 @@ def _quadric_normals(p, Q, centre, frame, plane_var, spacing) -> np.ndarray:
     Returns
     -------
     normals : (L, 3) float
-        Unit normals: the quadric's at ``p`` where :data:`NORMAL_CURVED_F` is
-        exceeded, the plane's elsewhere and where the patch's points leave
-        the quadric undetermined (all on one conic of the plane).
+        Unit normals: the quadric's at ``p`` where the F statistic exceeds
+        :func:`_curved_threshold` of the patch size (:data:`NORMAL_CURVED_F`
+        for 20 points), the plane's elsewhere and where the patch's points
+        leave the quadric undetermined (all on one conic of the plane).
     """
     L, k, _ = Q.shape
     local = np.einsum("lki,lij->lkj", Q - centre[:, None, :], frame)

@@ -437,6 +437,7 @@ def plan_grasps(
         mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
     else:
         body = None
+        # a hand that cannot be placed is refused before the cloud is read
         free_base(plant, hand_bodies(plant, plant.world_body(), hand), hand=hand)
         points, normals, dropped = read_cloud(
             point_cloud, cloud_normals, viewpoint=viewpoint
