@@ -19,8 +19,11 @@ from drakegrasp.visualization.candidates import (
 
 
 @pytest.fixture(scope="module")
-def planned():
-    scene = planning_scene("package://drakegrasp/objects/box.sdf")
+def planned(drake_models_dir):
+    # the default hand is Drake's WSG-50: skip, not download, without drake_models
+    scene = planning_scene(
+        "package://drakegrasp/objects/box.sdf", models_dir=drake_models_dir
+    )
     result = plan_grasps(
         scene.plant, scene.context, scene.object_body, hand=scene.hand,
         num_candidates=60, mu=0.5, seed=4, robustness_samples=4,
