@@ -219,3 +219,57 @@ def test_a_hundred_thousand_copies_of_one_spot_stay_cheap():
     spot = grid[0] + np.random.default_rng(1).normal(0.0, 1e-12, (100_000, 3))
     normals = estimate_normals(np.vstack([grid, spot]))
     assert np.abs(normals[:, 2]).min() > 1.0 - 1e-9
+
+
+def _noisy_box(n, sigma, seed=0):
+    """The box's points moved along their face normals by N(0, σ²), metres."""
+    points, normals = _box_surface(n, seed=seed)
+    rng = np.random.default_rng(seed + 100)
+    return points + rng.normal(0.0, sigma, n)[:, None] * normals, normals
+
+
+def _inner(points, normals, margin=0.012):
+    """Points at least ``margin`` (m) from every edge of their face."""
+    room = np.where(normals != 0.0, np.inf, HALF - np.abs(points))
+    return room.min(axis=1) >= margin
+
+
+def test_noisy_cloud_grows_its_neighbourhoods_to_the_target_error():
+    # 3,000 points (about 3 mm apart) with 0.1 mm of noise across the faces:
+    # 20-point planes are 0.3 deg off, and a parallel jaw closing along such
+    # a normal touches a face along its pad's edge.  The patches grow until
+    # the expected error is NORMAL_ANGLE_TARGET (0.1 deg).
+    from drakegrasp.planning import cloud
+
+    points, true = _noisy_box(3000, 1e-4)
+    inner = _inner(points, true)
+    fixed, fixed_error = cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)
+    before = _angles(fixed[inner], true[inner])
+    after = _angles(estimate_normals(points)[inner], true[inner])
+    # the error estimated from the quadrics' residuals is the measured one
+    assert np.degrees(fixed_error) == pytest.approx(np.median(before), rel=0.3)
+    assert np.median(before) > 0.25
+    assert np.median(after) < np.degrees(cloud.NORMAL_ANGLE_TARGET)
+    assert np.percentile(after, 90) < 0.5 * np.percentile(before, 90)
+
+
+def test_noise_free_cloud_keeps_twenty_point_patches():
+    from drakegrasp.planning import cloud
+
+    points, _ = _box_surface(3000, seed=3)
+    fixed, error = cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)
+    assert np.degrees(error) < 1e-3
+    np.testing.assert_array_equal(estimate_normals(points), fixed)
+
+
+def test_noise_estimate_scales_with_the_noise_not_the_units():
+    from drakegrasp.planning import cloud
+
+    errors = []
+    for sigma in (1e-4, 2e-4, 4e-4):
+        points, _ = _noisy_box(3000, sigma, seed=4)
+        errors.append(cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)[1])
+        millimetres = cloud._patch_normals(1e3 * points, cloud.NORMAL_NEIGHBOURS)[1]
+        assert millimetres == pytest.approx(errors[-1], rel=1e-6)  # radians
+    ratios = np.array(errors[1:]) / np.array(errors[:-1])
+    np.testing.assert_allclose(ratios, 2.0, rtol=0.15)
