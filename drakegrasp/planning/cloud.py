@@ -387,15 +387,25 @@ def _patch_normals(points: np.ndarray, k: int) -> tuple[np.ndarray, float]:
     flat = eig[:, 1] > 1e-12 * eig[:, 2]  # spans a plane, not a line or a point
     variation = np.where(flat, eig[:, 0] / np.where(total > 0, total, 1.0), np.inf)
     spacing = float(np.median(dist[:, 1])) if k > 1 else 0.0
-    off = np.abs(np.einsum("lki,lki->lk", points[:, None, :] - centre[idx], plane[idx]))
-    # within a quarter spacing, plus three times the plane's own scatter
-    near = off <= 0.25 * spacing + 3.0 * np.sqrt(eig[idx, 0])
-    # flattest first; among equally flat planes (two faces at an edge) the
-    # one the point lies on
-    closeness = (off / spacing) ** 2 if spacing > 0 else np.zeros_like(off)
-    score = np.where(near, variation[idx] + 1e-3 * closeness, np.inf)
-    j = np.argmin(score, axis=1)
-    best = idx[np.arange(M), j]
+    best = np.empty(M, dtype=int)
+    for start in range(0, M, chunk):
+        rows = slice(start, start + chunk)
+        near_idx = idx[rows]
+        off = np.abs(
+            np.einsum(
+                "lki,lki->lk",
+                points[rows, None, :] - centre[near_idx],
+                plane[near_idx],
+            )
+        )
+        # within a quarter spacing, plus three times the plane's own scatter
+        near = off <= 0.25 * spacing + 3.0 * np.sqrt(eig[near_idx, 0])
+        # flattest first; among equally flat planes (two faces at an edge)
+        # the one the point lies on
+        closeness = (off / spacing) ** 2 if spacing > 0 else np.zeros_like(off)
+        score = np.where(near, variation[near_idx] + 1e-3 * closeness, np.inf)
+        j = np.argmin(score, axis=1)
+        best[rows] = near_idx[np.arange(len(j)), j]
     own = variation <= NORMAL_OWN_FACTOR * variation[best] + 1e-4
     chosen = np.where(own, np.arange(M), best)
     normals = plane[chosen]
