@@ -349,7 +349,8 @@ def estimate_normals(points: np.ndarray) -> np.ndarray:
     k = min(NORMAL_NEIGHBOURS, M)
     normals, error = _patch_normals(points, k)
     # error ~ 1/k: the patch's in-plane variances grow with its size
-    grown = min(M, NORMAL_MAX_NEIGHBOURS, int(np.ceil(k * error / NORMAL_ANGLE_TARGET)))
+    wanted = np.nan_to_num(k * error / NORMAL_ANGLE_TARGET, nan=0.0, posinf=M)
+    grown = min(M, NORMAL_MAX_NEIGHBOURS, int(np.ceil(wanted)))
     if grown > k:
         normals, _ = _patch_normals(points, grown)
     return normals
@@ -422,9 +423,9 @@ def _patch_normals(points: np.ndarray, k: int) -> tuple[np.ndarray, float]:
     error = 0.0
     fitted = ~bad & np.isfinite(noise)
     if fitted.any():
-        lam = eig[chosen[fitted]][:, 1:]  # in-plane variances, m²
-        spread = np.sqrt(np.sum(1.0 / np.maximum(lam, 1e-300), axis=1) / k)
-        error = float(np.median(np.sqrt(np.median(noise[fitted])) * spread))
+        lam = eig[chosen[fitted]][:, 1:]  # in-plane variances (> 0: flat), m²
+        ratio = np.median(noise[fitted]) / lam  # dimensionless: no overflow
+        error = float(np.median(np.sqrt(np.sum(ratio, axis=1) / k)))
     return normals, error
 
 

@@ -273,3 +273,20 @@ def test_noise_estimate_scales_with_the_noise_not_the_units():
         assert millimetres == pytest.approx(errors[-1], rel=1e-6)  # radians
     ratios = np.array(errors[1:]) / np.array(errors[:-1])
     np.testing.assert_allclose(ratios, 2.0, rtol=0.15)
+
+
+@pytest.mark.parametrize("scale", [1e-150, 1e-30, 1.0, 1e5])
+def test_noisy_cloud_at_any_scale_grows_the_same_patches(scale):
+    # The error estimate is a ratio of squares (noise over in-plane spread):
+    # at 1e-150 m their products would underflow and ask for no growth, or
+    # overflow into an inf that no neighbourhood size can hold.
+    from drakegrasp.planning import cloud
+
+    points, _ = _noisy_box(1500, 2e-4, seed=5)
+    base = estimate_normals(points)
+    err = _angles(estimate_normals(points * scale), base)
+    error = cloud._patch_normals(points * scale, cloud.NORMAL_NEIGHBOURS)[1]
+    assert error == pytest.approx(
+        cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)[1], rel=1e-6
+    )
+    assert np.all(np.isfinite(base)) and np.percentile(err, 99) < 1e-3
