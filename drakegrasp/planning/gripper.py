@@ -158,8 +158,8 @@ def _why_not_free(plant, bodies, carriers, hand) -> str:
             f"is {how_held(plant, base)}; plan_grasps places a free-floating hand "
             "by its base's pose X_WH: add the hand without attaching it "
             "(load_scene(..., free_hand=True) and `drakegrasp plan` leave out a "
-            "scene's own welds of its hand, not those inside model files or "
-            "included directive files)"
+            "scene's welds of its hand, those of its included directive files "
+            "too, but not the fixed joints inside model files)"
         )
     free = [plant.get_body(BodyIndex(i)) for i in carriers]
     if len(free) == 1:

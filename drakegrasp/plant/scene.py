@@ -126,6 +126,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pydrake.multibody.parsing import (
+    FlattenModelDirectives,
     LoadModelDirectivesFromString,
     Parser,
     ProcessModelDirectives,
@@ -383,9 +384,38 @@ def _resolve_hand(plant: MultibodyPlant, hand) -> ModelInstanceIndex | tuple | N
 
 
 def _hand_instances(hand) -> set[str]:
-    """Names of the model instances the file's ``hand:`` names."""
-    names = (hand,) if isinstance(hand, str) else hand
-    return {name.partition("::")[0] for name in names}
+    """Names of the model instances the file's ``hand:`` names.
+
+    ``hand: NAME`` is a model instance's name, which may itself be scoped
+    (``left::gripper`` of an ``add_directives`` with ``model_namespace:
+    left``); a list names bodies, ``INSTANCE::BODY``.
+    """
+    if isinstance(hand, str):
+        return {hand}
+    return {name.rpartition("::")[0] for name in hand}
+
+
+def _instance_of(frame: str) -> str:
+    """The model instance of a scoped frame or body name ('' for ``world``)."""
+    return frame.rpartition("::")[0]
+
+
+def _flattened(path: Path, directives, parser):
+    """``directives`` with each ``add_directives`` replaced by what it includes.
+
+    Drake's ``FlattenModelDirectives`` (the same scene, its names scoped by
+    each include's ``model_namespace``): a weld that places the hand may sit
+    in an included directive file.
+    """
+    if all(d.add_directives is None for d in directives.directives):
+        return directives
+    try:
+        return FlattenModelDirectives(directives, parser.package_map())
+    except Exception as e:  # Drake raises RuntimeError on a file it cannot read
+        msg = " ".join(explain_drake_models(str(e)).split())
+        raise SceneError(
+            f"scene {str(path)!r}: cannot follow its add_directives: {msg}"
+        ) from None
 
 
 def _drop_hand_welds(directives, instances: set[str]) -> bool:
@@ -394,14 +424,15 @@ def _drop_hand_welds(directives, instances: set[str]) -> bool:
     A weld whose child is a body of the hand's model ``instances`` and whose
     parent is not (the world, a table, an arm's flange, a frame) places the
     hand; welds inside the hand (one of its instances to another) stay.
-    Returns whether a weld was removed.
+    ``directives`` are flattened (:func:`_flattened`).  Returns whether a
+    weld was removed.
     """
     kept = [
         d
         for d in directives.directives
         if d.add_weld is None
-        or d.add_weld.child.partition("::")[0] not in instances
-        or d.add_weld.parent.partition("::")[0] in instances
+        or _instance_of(d.add_weld.child) not in instances
+        or _instance_of(d.add_weld.parent) in instances
     ]
     dropped = len(kept) != len(directives.directives)
     directives.directives = kept
@@ -502,8 +533,10 @@ def load_scene(
         bodies (a palm welded to the world and its fingers, as ``analyze``
         reads them), and a file without ``hand:`` frees the one model instance
         whose bodies can move besides the object (the hand ``analyze`` would
-        take).  Welds inside the hand, and those of included directive files
-        and model files, stay.  Default False.
+        take).  Welds of included directive files (``add_directives``) count
+        as the file's own; welds inside the hand, and those written in model
+        files (an SDFormat ``<joint type="fixed">`` to the world), stay.
+        Default False.
 
     Returns
     -------
@@ -547,6 +580,8 @@ def load_scene(
         read_yaml=read_yaml,
         allow_any_file=check_flag("allow_any_file", allow_any_file),
     )
+    if free_hand:
+        directives = _flattened(path, directives, parser)
     if free_hand and info.hand is not None:
         _drop_hand_welds(directives, _hand_instances(info.hand))
     _load_models(path, directives, plant, parser)

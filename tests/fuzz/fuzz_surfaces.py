@@ -333,6 +333,18 @@ def load_scene_summary(path: str, allow_any_file: bool) -> dict:
         plant.GetModelInstanceName(ModelInstanceIndex(i))
         for i in range(plant.num_model_instances())
     ]
+    # Freeing the hand flattens the includes first: the same models load (a
+    # scene whose hand cannot be freed is refused with its reason)
+    try:
+        free = dg.load_scene(path, allow_any_file=allow_any_file, free_hand=True)
+    except dg.GraspError:
+        pass
+    else:
+        freed = {
+            free.plant.GetModelInstanceName(ModelInstanceIndex(i))
+            for i in range(free.plant.num_model_instances())
+        }
+        assert freed == set(names), (sorted(freed), names)
     return {
         "instances": names,
         "mu": scene.info.mu,

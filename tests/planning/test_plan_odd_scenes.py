@@ -22,6 +22,7 @@ import json
 import pytest
 from odd_scenes import (
     BOX_WELD,
+    GRIPPER,
     HAND_LINE,
     PALM_ON_WORLD,
     SECOND_BOX,
@@ -88,6 +89,18 @@ def test_a_parallel_jaw_scene_variant_plans_as_the_shipped_scene(
     got = _plan_json(capsys, _write(tmp_path, "variant", text), 20)
     want = _plan_json(capsys, "parallel_jaw_box", 20)
     assert want["candidates"]  # the comparison compares something
+    _same_plan(got, want)
+
+
+def test_a_hand_welded_in_an_included_file_plans_as_the_shipped_scene(tmp_path, capsys):
+    """``plan`` refused it: the include's weld to the world stayed."""
+    inner = tmp_path / "gripper.yaml"
+    inner.write_text("directives:\n" + GRIPPER + PALM_ON_WORLD)
+    include = f"- add_directives:\n    file: file://{inner}\n"
+    text = edited_shipped("parallel_jaw_box", (GRIPPER + PALM_ON_WORLD, include))
+    got = _plan_json(capsys, _write(tmp_path, "included", text), 20)
+    want = _plan_json(capsys, "parallel_jaw_box", 20)
+    assert want["candidates"]
     _same_plan(got, want)
 
 

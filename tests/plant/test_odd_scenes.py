@@ -208,6 +208,54 @@ def test_a_hand_welded_to_a_table_is_freed(tmp_path):
     assert _free_hand_positions(freed) == _free_hand_positions(shipped)
 
 
+def _included(tmp_path, text: str, namespace: str | None = None) -> str:
+    """Directives that include ``text`` from a file, under ``namespace``."""
+    inner = tmp_path / "inner.yaml"
+    inner.write_text("directives:\n" + text)
+    include = f"- add_directives:\n    file: file://{inner}\n"
+    if namespace is None:
+        return include
+    return (
+        f"- add_model_instance:\n    name: {namespace}\n"
+        + include
+        + f"    model_namespace: {namespace}\n"
+    )
+
+
+@pytest.mark.parametrize("namespace", [None, "left"])
+@pytest.mark.parametrize("named", [True, False], ids=["hand named", "no hand:"])
+def test_a_hand_welded_in_an_included_file_is_freed(tmp_path, namespace, named):
+    """The weld that placed the hand sat in an add_directives file, and stayed."""
+    gripper = "gripper" if namespace is None else f"{namespace}::gripper"
+    directives = _included(tmp_path, GRIPPER + PALM_ON_WORLD, namespace) + BOX
+    path = jaw_scene(
+        tmp_path, "outer", hand=gripper if named else None, directives=directives
+    )
+    kept = load_scene(path)
+    assert not _body(kept, f"{gripper}::palm").is_floating_base_body()
+    freed = load_scene(path, free_hand=True)
+    assert _body(freed, f"{gripper}::palm").is_floating_base_body()
+    assert freed.hand == freed.plant.GetModelInstanceByName(gripper)
+    shipped = load_scene("parallel_jaw_box", free_hand=True)
+    assert _free_hand_positions(freed) == _free_hand_positions(shipped)
+
+
+def test_a_namespace_shared_with_the_hand_keeps_its_other_welds(tmp_path):
+    """Welds were matched by the first part of a scoped name: ``left::gripper``
+    freed ``left::stand`` too, another model of the same include."""
+    stand = (
+        "- add_model:\n    name: stand\n    file: package://drakegrasp/objects/"
+        "box.sdf\n- add_weld:\n    parent: world\n    child: stand::box\n"
+        "    X_PC:\n      translation: [0.3, 0.0, 0.0]\n"
+    )
+    directives = _included(tmp_path, GRIPPER + PALM_ON_WORLD + stand, "left") + BOX
+    path = jaw_scene(tmp_path, "outer", hand="left::gripper", directives=directives)
+    freed = load_scene(path, free_hand=True)
+    world = freed.plant.GetBodiesWeldedTo(freed.plant.world_body())
+    assert _body(freed, "left::stand::box") in world
+    assert _body(freed, "left::gripper::palm").is_floating_base_body()
+
+
 def test_welds_inside_the_hand_and_onto_it_stay(tmp_path):
     """A camera welded onto the palm rides with the freed hand."""
     camera = (
