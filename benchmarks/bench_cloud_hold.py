@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_cloud_hold.py [--num 600] [--points 3000] [--top 10]
         [--random 10] [--seed 0] [--clouds full one-sided] [--no-mass]
-        [--effort-limit] [--verbose]
+        [--effort-limit] [--noise MM] [--verbose]
 
 The multi-finger cloud route of :func:`drakegrasp.plan_grasps` (Drake's
 Allegro hand, thumb opposed, free base) on two clouds sampled from the soup
@@ -22,7 +22,9 @@ and those held at that torque are ranked first
 (:func:`~drakegrasp.planning.motors.with_torques_needed`).
 ``--effort-limit`` ranks by the Allegro's effort limit (0.7 N·m) instead, as
 before ``torque_limit`` existed; ``--no-mass`` plans without the mass (no
-torque_needed, the score's order alone).
+torque_needed, the score's order alone).  ``--noise MM`` moves the points
+along their lines of sight by N(0, σ²), as ``bench_cloud_jaw.py --noise``
+does, and estimates the normals from them.
 
 For each cloud it prints the candidates (of ``--num`` sampled poses), how many
 are force closure, and the hold rates in Drake
@@ -97,6 +99,19 @@ def plan_cloud(hand, points, normals, view, *, num, seed, mass, **options):
     return result, time.perf_counter() - t
 
 
+def noisy(points, view, sigma):
+    """Points moved by N(0, σ²) along the line of sight (seed 0): a depth camera.
+
+    A whole cloud (no view) is seen from afar along each point's own direction
+    from the cloud's centre.
+    """
+    rng = np.random.default_rng(0)
+    centre = points.mean(axis=0)
+    eye = points - (centre if view is None else np.asarray(view, float))
+    ray = eye / np.linalg.norm(eye, axis=1, keepdims=True)
+    return points + rng.normal(0.0, sigma, len(points))[:, None] * ray
+
+
 def _describe(c, s) -> str:
     fingers = Counter(k.finger_body.split("::")[-1] for k in c.contacts)
     fans = sum(getattr(k, "fan", None) is not None for k in c.contacts)
@@ -130,6 +145,13 @@ def main(argv=None) -> int:
         action="store_true",
         help="rank by the actuators' effort limit, not the shake's squeeze",
     )
+    parser.add_argument(
+        "--noise",
+        type=float,
+        default=0.0,
+        help="depth noise, mm (σ along each point's line of sight; normals "
+        "then estimated from the points)",
+    )
     parser.add_argument("--verbose", action="store_true")
     args = parser.parse_args(argv)
     models = drake_models()
@@ -155,6 +177,8 @@ def main(argv=None) -> int:
     for name in args.clouds:
         view = VIEW if name == "one-sided" else None
         p, nrm = sample_cloud(full, args.points, 0, view)
+        if args.noise > 0:
+            p, nrm = noisy(p, view, args.noise * 1e-3), None
         result, plan_s = plan_cloud(
             hand, p, nrm, view, num=args.num, seed=args.seed, mass=mass,
             torque_limit=limit,

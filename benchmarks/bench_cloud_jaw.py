@@ -45,23 +45,10 @@ import numpy as np
 from drakegrasp.planning import planning_scene, shake_test
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_cloud_hold import plan_cloud, sample_cloud  # noqa: E402  (the same clouds)
+from bench_cloud_hold import noisy, plan_cloud, sample_cloud  # noqa: E402  (the same clouds)
 from bench_plan import YCB, drake_models  # noqa: E402  (the same local copy)
 
 VIEWS = {"full": None, "side": (0.5, 0.0, 0.0), "oblique": (0.4, 0.25, 0.3)}
-
-
-def _noisy(points, view, sigma):
-    """Points moved by N(0, σ²) along the line of sight (seed 0): a depth camera.
-
-    A whole cloud (no view) is seen from afar along each point's own direction
-    from the cloud's centre.
-    """
-    rng = np.random.default_rng(0)
-    centre = points.mean(axis=0)
-    eye = points - (centre if view is None else np.asarray(view, float))
-    ray = eye / np.linalg.norm(eye, axis=1, keepdims=True)
-    return points + rng.normal(0.0, sigma, len(points))[:, None] * ray
 
 
 def _held(group, full, X_WO, squeeze):
@@ -115,7 +102,7 @@ def main(argv=None) -> int:
             view = VIEWS[view_name]
             p, nrm = sample_cloud(full, args.points, 0, view)
             if args.noise > 0:
-                p, nrm = _noisy(p, view, args.noise * 1e-3), None
+                p, nrm = noisy(p, view, args.noise * 1e-3), None
             result, plan_s = plan_cloud(
                 hand, p, nrm, view, num=args.num, seed=args.seed, mass=mass
             )
