@@ -212,6 +212,20 @@ def test_points_repeated_with_round_off_jitter_count_once(jitter):
     assert _angles(estimate_normals(points), up).max() < 1e-3
 
 
+@pytest.mark.parametrize("jitter", [1e-7, 1e-6, 1e-5])
+def test_copies_farther_apart_than_round_off_read_as_noise(jitter):
+    # The same 25 copies 1e-7 to 1e-5 m apart are distinct points, and each
+    # 20-point neighbourhood still held one point's copies (median 59 deg
+    # off).  Their scatter reads as noise against the patch's spread, and the
+    # patches grow past the copies (NORMAL_ANGLE_TARGET) to span the grid.
+    g = np.stack(np.meshgrid(np.arange(10), np.arange(10)), -1).reshape(-1, 2)
+    points = np.repeat(np.c_[0.005 * g, np.zeros(100)], 25, axis=0)
+    points += np.random.default_rng(0).normal(0.0, jitter, points.shape)
+    up = np.tile([0.0, 0.0, 1.0], (len(points), 1))
+    err = _angles(estimate_normals(points), up)
+    assert np.median(err) < 0.1 and np.percentile(err, 99) < 1.0
+
+
 def test_a_hundred_thousand_copies_of_one_spot_stay_cheap():
     # Merging near copies must not list every pair of them (10^10 here).
     g = np.stack(np.meshgrid(np.arange(20), np.arange(20)), -1).reshape(-1, 2)
