@@ -169,7 +169,8 @@ print("   ", dg.shake_test(scene.add_models, worst, squeeze=squeeze, **kw))
 # A camera sees part of an object.  With `dg.plan_grasps(plant, context, None,
 # hand=..., point_cloud=..., viewpoint=camera)` the plant holds the gripper
 # alone and the object is the cloud (a pydrake `PointCloud` or an `(M, 3)`
-# array; normals given, or estimated from the points).  The unseen side is
+# array; normals given, or estimated from the points over patches that grow
+# with a depth camera's noise).  The unseen side is
 # filled in by an assumption, stated and switchable: the object is
 # symmetric about the point its seen normals aim at, which also becomes the
 # object frame O, the centre of mass the ranking assumes
