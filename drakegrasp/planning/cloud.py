@@ -121,7 +121,8 @@ the box's weight, with closing axes 0.3-0.6° off the faces; with 60 points
 NORMAL_MAX_NEIGHBOURS = 100
 """Most points of a neighbourhood grown for noise (:data:`NORMAL_ANGLE_TARGET`):
 a patch must still fit on one face to be flat (100 points of a 3,000-point
-cracker-box cloud span about 70 mm, its narrowest face)."""
+cloud of the YCB cracker box span about 70 mm; its narrowest face is 66 mm
+wide)."""
 
 NORMAL_OWN_FACTOR = 1.5
 """A point keeps its own neighbourhood's plane unless that plane's surface
