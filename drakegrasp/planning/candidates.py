@@ -433,6 +433,13 @@ class GraspCandidates(Sequence):
             f"torque scale {self.torque_scale * 1e3:.1f} mm"
         )
         lines = [head]
+        fit = self.settings.get("cloud_normals")
+        if fit:
+            lines.append(
+                f"  cloud normals estimated over {fit['neighbours']} points a patch "
+                f"(noise {fit['noise'] * 1e3:.3g} mm, about "
+                f"{fit['error_deg']:.2g} deg off)"
+            )
         if self.reason:
             lines.append(f"  {self.reason}" if self else f"  empty: {self.reason}")
         for reason, n in sorted(self.rejections.items(), key=lambda kv: -kv[1]):

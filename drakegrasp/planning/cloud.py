@@ -81,6 +81,7 @@ __all__ = [
     "complete_unseen",
     "estimate_normals",
     "read_cloud",
+    "read_cloud_fit",
 ]
 
 CONTACT_BAND = 1e-3
@@ -227,6 +228,23 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     InvalidOptionError
         An empty cloud, one with no finite point, or malformed arrays.
     """
+    return read_cloud_fit(point_cloud, normals, viewpoint=viewpoint)[:3]
+
+
+def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
+    """:func:`read_cloud`, and how the normals were estimated.
+
+    Returns
+    -------
+    points, normals, dropped
+        As :func:`read_cloud` returns them.
+    fit : dict or None
+        None when the normals were given; else ``neighbours`` (points a
+        patch), ``noise`` (metres: the RMS residual of the patches' quadric
+        fits, the cloud's noise across its surface) and ``error_deg`` (the
+        normals' expected standard error, degrees); see
+        :func:`estimate_normals`.
+    """
     from pydrake.perception import PointCloud
 
     if isinstance(point_cloud, PointCloud):
@@ -275,8 +293,9 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
             f"point_cloud has {len(points)} finite points of {total}: too few to "
             "grasp (NaN marks missing points)"
         )
+    fit = None
     if normals is None:
-        normals = estimate_normals(points)
+        normals, fit = _estimate_normals(points)
         ok = np.all(np.isfinite(normals), axis=1)
         points, normals = points[ok], normals[ok]
     # Only the direction of a normal counts: ``unit_vectors`` divides each by
@@ -294,7 +313,7 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     towards = points - points.mean(axis=0) if viewpoint is None else viewpoint - points
     flip = np.sum(normals * towards, axis=1) < 0
     normals[flip] *= -1
-    return points, normals, total - len(points)
+    return points, normals, total - len(points), fit
 
 
 def estimate_normals(points: np.ndarray) -> np.ndarray:
@@ -342,22 +361,30 @@ def estimate_normals(points: np.ndarray) -> np.ndarray:
         twice counts once, and both copies get its normal; so do points
         closer than single precision resolves at the cloud's extent.
     """
+    return _estimate_normals(points)[0]
+
+
+def _estimate_normals(points: np.ndarray) -> tuple[np.ndarray, dict]:
+    """:func:`estimate_normals`, and the fit :func:`read_cloud_fit` reports."""
     same = _same_point(points)
     if same is not None:  # repeated points (fused frames) count once
         first, inverse = np.unique(same, return_index=True, return_inverse=True)[1:]
-        return estimate_normals(points[first])[inverse.reshape(-1)]
+        normals, fit = _estimate_normals(points[first])
+        return normals[inverse.reshape(-1)], fit
     M = len(points)
     k = min(NORMAL_NEIGHBOURS, M)
-    normals, error = _patch_normals(points, k)
+    normals, error, noise = _patch_normals(points, k)
     # error ~ 1/k: the patch's in-plane variances grow with its size
     wanted = np.nan_to_num(k * error / NORMAL_ANGLE_TARGET, nan=0.0, posinf=M)
     grown = min(M, NORMAL_MAX_NEIGHBOURS, int(np.ceil(wanted)))
     if grown > k:
-        normals, _ = _patch_normals(points, grown)
-    return normals
+        k = grown
+        normals, error, noise = _patch_normals(points, k)
+    fit = {"neighbours": k, "noise": noise, "error_deg": float(np.degrees(error))}
+    return normals, fit
 
 
-def _patch_normals(points: np.ndarray, k: int) -> tuple[np.ndarray, float]:
+def _patch_normals(points: np.ndarray, k: int) -> tuple[np.ndarray, float, float]:
     """:func:`estimate_normals` with ``k`` points a patch, and its typical error.
 
     Returns
@@ -368,6 +395,8 @@ def _patch_normals(points: np.ndarray, k: int) -> tuple[np.ndarray, float]:
         Median over the points of the standard error (radians) of their
         chosen plane's normal, with the noise taken as the median residual
         of the patches' quadric fits (0 when ``k <= 6``).
+    noise : float
+        That residual, metres (RMS about the quadric; 0 when ``k <= 6``).
     """
     M = len(points)
     tree = cKDTree(points)
@@ -421,13 +450,14 @@ def _patch_normals(points: np.ndarray, k: int) -> tuple[np.ndarray, float]:
             )
     bad = ~np.isfinite(variation[chosen])
     normals[bad] = np.nan
-    error = 0.0
+    error = spread = 0.0
     fitted = ~bad & np.isfinite(noise)
     if fitted.any():
         lam = eig[chosen[fitted]][:, 1:]  # in-plane variances (> 0: flat), m²
-        ratio = np.median(noise[fitted]) / lam  # dimensionless: no overflow
+        spread = float(np.median(noise[fitted]))
+        ratio = spread / lam  # dimensionless: no overflow
         error = float(np.median(np.sqrt(np.sum(ratio, axis=1) / k)))
-    return normals, error
+    return normals, error, float(np.sqrt(spread))
 
 
 def _same_point(points: np.ndarray):

@@ -56,7 +56,7 @@ from drakegrasp.planning.cloud import (
     CloudFingers,
     FittedCloud,
     cloud_surface,
-    read_cloud,
+    read_cloud_fit,
 )
 from drakegrasp.planning.gripper import free_base, parallel_jaw
 from drakegrasp.planning.motors import check_torque_limit
@@ -280,8 +280,10 @@ def plan_grasps(
         the surroundings only.
     cloud_normals : (M, 3) float, optional
         Outward normals of the cloud's points; default the cloud's own, else
-        estimated from the flattest nearby patch, plane or quadric
-        (:func:`~drakegrasp.planning.cloud.estimate_normals`).
+        estimated from the flattest nearby patch, plane or quadric, grown with
+        the cloud's noise (:func:`~drakegrasp.planning.cloud.estimate_normals`;
+        the result's ``settings["cloud_normals"]`` says how: points a patch,
+        the noise read, the normals' expected error; None when given).
     viewpoint : (3,) float, optional
         Where the cloud was seen from (normals are turned towards it); default
         normals point away from the cloud's centroid.
@@ -439,9 +441,10 @@ def plan_grasps(
         body = None
         # a hand that cannot be placed is refused before the cloud is read
         free_base(plant, hand_bodies(plant, plant.world_body(), hand), hand=hand)
-        points, normals, dropped = read_cloud(
+        points, normals, dropped, fit = read_cloud_fit(
             point_cloud, cloud_normals, viewpoint=viewpoint
         )
+        settings.update(cloud_normals=fit)
         if not hand_is_parallel_jaw(plant, ctx, plant.world_body(), hand):
             mass = np.nan if object_mass is None else float(object_mass)
             settings.update(cloud_dropped=dropped)

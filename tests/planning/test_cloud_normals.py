@@ -257,7 +257,7 @@ def test_noisy_cloud_grows_its_neighbourhoods_to_the_target_error():
 
     points, true = _noisy_box(3000, 1e-4)
     inner = _inner(points, true)
-    fixed, fixed_error = cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)
+    fixed, fixed_error, _ = cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)
     before = _angles(fixed[inner], true[inner])
     after = _angles(estimate_normals(points)[inner], true[inner])
     # the error estimated from the quadrics' residuals is the measured one
@@ -271,7 +271,7 @@ def test_noise_free_cloud_keeps_twenty_point_patches():
     from drakegrasp.planning import cloud
 
     points, _ = _box_surface(3000, seed=3)
-    fixed, error = cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)
+    fixed, error, _ = cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)
     assert np.degrees(error) < 1e-3
     np.testing.assert_array_equal(estimate_normals(points), fixed)
 
@@ -304,3 +304,28 @@ def test_noisy_cloud_at_any_scale_grows_the_same_patches(scale):
         cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)[1], rel=1e-6
     )
     assert np.all(np.isfinite(base)) and np.percentile(err, 99) < 1e-3
+
+
+@pytest.mark.parametrize("given", [False, True], ids=["estimated", "given"])
+def test_a_plan_on_a_cloud_says_how_its_normals_were_estimated(given):
+    # A user planning from a camera sees the noise read from the cloud and
+    # the patches it asked for (the shipped gripper: no drake_models needed).
+    from drakegrasp.planning import plan_grasps, planning_scene
+
+    sigma = 2e-4
+    points, normals = _noisy_box(3000, sigma, seed=6)
+    hand = planning_scene(None, hand_url="package://drakegrasp/hands/parallel_jaw.sdf")
+    result = plan_grasps(
+        hand.plant, hand.context, None, hand=hand.hand, num_candidates=5,
+        mu=0.5, seed=0, point_cloud=points,
+        cloud_normals=normals if given else None,
+    )  # fmt: skip
+    fit = result.settings["cloud_normals"]
+    if given:
+        assert fit is None and "cloud normals estimated" not in str(result)
+        return
+    assert fit["noise"] == pytest.approx(sigma, rel=0.25)  # metres
+    assert 20 < fit["neighbours"] <= 100
+    assert fit["error_deg"] < 0.2
+    line = f"cloud normals estimated over {fit['neighbours']} points a patch"
+    assert line in str(result)
