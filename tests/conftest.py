@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import os
+import signal
 import subprocess
 import sys
 import uuid
@@ -20,6 +21,14 @@ ROOT = Path(__file__).resolve().parents[1]
 _SUPPORT = str(Path(__file__).resolve().parent / "support")
 if _SUPPORT not in sys.path:  # helpers shared across test folders (odd_scenes)
     sys.path.insert(0, _SUPPORT)
+
+# A shell starts a background job (``pytest &``, a CI step run beside another)
+# with SIGINT ignored, and its children inherit that: the commands the signal
+# tests start then ignored their Ctrl-C, as ``drakegrasp`` rightly does when
+# started so (exit 0 where 130 was asked).  Those tests stand for a command run
+# from a terminal: a handled SIGINT here becomes the default in every child.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def local_drake_models() -> Path | None:
