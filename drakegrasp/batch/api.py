@@ -27,7 +27,12 @@ from drakegrasp.batch.run.chunk import force_task, form_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL, ZERO_FRACTION
+from drakegrasp.core.tolerances import (
+    DEFAULT_NUM_GENERATORS,
+    DEFAULT_RANK_TOL,
+    DEFAULT_TOL,
+    ZERO_FRACTION,
+)
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -244,7 +249,7 @@ def stream_force_closure(
     *,
     mu: float | np.ndarray,
     contact_model: ContactModel | str = "hard_finger",
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
     torsional_friction=None,
     reference_points=None,
     characteristic_lengths=None,
@@ -305,7 +310,7 @@ def batch_force_closure(
     *,
     mu: float | np.ndarray,
     contact_model: ContactModel | str = "hard_finger",
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
     torsional_friction: float | np.ndarray | None = None,
     reference_points: np.ndarray | None = None,
     characteristic_lengths: float | np.ndarray | None = None,

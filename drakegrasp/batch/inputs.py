@@ -220,6 +220,17 @@ def numba_available() -> bool:
     return importlib.util.find_spec("numba") is not None
 
 
+def compiled_route(kernel: str) -> bool:
+    """Whether the LP and construction loops of ``kernel`` are numba's.
+
+    ``"numba"`` and ``"unfused"`` (the compiled loops without the fused
+    kernel) are; ``"auto"``, which an internal function may still be given when
+    called directly, is where numba is installed.  The entry points pass
+    :func:`resolve_kernel`'s answer, never ``"auto"``.
+    """
+    return kernel in ("numba", "unfused") or (kernel == "auto" and numba_available())
+
+
 def resolve_kernel(kernel: str) -> str:
     """``kernel`` checked, and ``"auto"`` resolved to ``"numba"`` or ``"numpy"``."""
     if kernel not in ("auto", "numba", "numpy"):

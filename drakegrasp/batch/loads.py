@@ -18,9 +18,9 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from drakegrasp.closure.grasp_forces import GraspForceResult, grasp_forces
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import check_grasp, real_array
 from drakegrasp.errors import InvalidOptionError
 

@@ -38,7 +38,7 @@ from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_RANK_TOL
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["BatchCertificates", "batch_certificates", "grasp_at"]
@@ -249,7 +249,7 @@ def batch_certificates(
     *,
     mu=0.0,
     contact_model: ContactModel | str = "hard_finger",
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
     torsional_friction=0.0,
     reference_points=None,
     characteristic_lengths=None,

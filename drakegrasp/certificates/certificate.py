@@ -76,7 +76,7 @@ from drakegrasp.core.grasp import (
     invariant_grasp_matrix,
 )
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_RANK_TOL
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -84,11 +84,21 @@ __all__ = [
     "ESCAPE_TWIST",
     "UNCONTROLLABLE",
     "UNRESISTED_WRENCH",
+    "CONTACT_RATE_TOL",
     "Certificate",
     "CertificateCheck",
     "cone_support",
     "support_of",
 ]
+
+CONTACT_RATE_TOL = 1e-9
+"""Default threshold on the normal rates ``G_nᵀ v`` of an escape twist ``v``.
+
+A contact separates where its rate exceeds it and slides where ``|rate|`` does
+not; the twist has unit size (its linear part and ``b`` times its angular
+part, ``b`` the grasp's characteristic length), so the rates are of order one
+and 1e-9 is their round-off.
+"""
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,7 +155,7 @@ class Certificate:
     contact_rates: np.ndarray | None = None
     contact_forces: tuple[np.ndarray, ...] | None = None
     internal_basis: np.ndarray | None = None
-    num_generators: int = 8
+    num_generators: int = DEFAULT_NUM_GENERATORS
     reference_point: np.ndarray | None = None
     characteristic_length: float = 1.0
 
@@ -168,13 +178,13 @@ class Certificate:
         """True when both ``±direction`` are witnesses (rank-deficient case)."""
         return self.null_basis.shape[-1] > 0
 
-    def separating(self, tol: float = 1e-9) -> np.ndarray:
+    def separating(self, tol: float = CONTACT_RATE_TOL) -> np.ndarray:
         """Escape twist: (N,) bool, contacts that separate (``G_nᵀ v > tol``)."""
         if self.contact_rates is None:
             return np.zeros(0, dtype=bool)
         return self.contact_rates > tol
 
-    def sliding(self, tol: float = 1e-9) -> np.ndarray:
+    def sliding(self, tol: float = CONTACT_RATE_TOL) -> np.ndarray:
         """Escape twist: (N,) bool, contacts that slide (``|G_nᵀ v| <= tol``)."""
         if self.contact_rates is None:
             return np.zeros(0, dtype=bool)

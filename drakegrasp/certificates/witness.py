@@ -48,6 +48,7 @@ from drakegrasp.certificates.certificate import (
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp, grasp_matrix, invariant_grasp_matrix
 from drakegrasp.core.linalg import left_null_space
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import safe_norm
 
 __all__ = [
@@ -172,7 +173,7 @@ def null_space_certificate(
     *,
     G_n: np.ndarray | None = None,
     cones: str = "normals",
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
 ) -> Certificate:
     """The witness of a rank-deficient "no": a basis of ``N(Aᵀ)``, both signs.
 
@@ -293,7 +294,7 @@ def _finish(prog, x, grasp, *, conic, kind, G=None, cones="normals", ng=8):
 
 
 def unresisted_wrench(
-    grasp: Grasp, rank: int, *, cones: str, num_generators: int = 8
+    grasp: Grasp, rank: int, *, cones: str, num_generators: int = DEFAULT_NUM_GENERATORS
 ) -> Certificate | None:
     """Unresisted wrench of a grasp that is not in force closure.
 
@@ -384,7 +385,7 @@ def balance_certificate(
     *,
     cones: str,
     rank: int,
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
 ) -> Certificate:
     """A "yes": the balancing forces and the basis of ``N(G)`` they came from.
 

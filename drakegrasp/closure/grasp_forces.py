@@ -48,9 +48,9 @@ from drakegrasp.closure.load_problem import (
     load_problem,
     saturating_joints,
 )
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp, grasp_matrix
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import safe_norm
 from drakegrasp.errors import InvalidOptionError, SolverError
 

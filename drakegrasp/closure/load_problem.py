@@ -51,8 +51,9 @@ from drakegrasp.closure.constraints import (
     add_linear_equality_constraint,
     exact_cone_rows,
 )
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
+from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import check_grasp as _check_grasp
 from drakegrasp.core.validation import check_num_generators, real_array, safe_norm
 from drakegrasp.errors import InvalidOptionError

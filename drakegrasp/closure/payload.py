@@ -39,9 +39,9 @@ from drakegrasp.closure.load_problem import (
     load_problem,
     saturating_joints,
 )
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import SolverError
 

@@ -42,7 +42,7 @@ from drakegrasp.closure.constraints import (
     exact_cone_rows,
 )
 from drakegrasp.core.deferred import WeakMemo
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
+from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import (
     Grasp,
     check_hand_jacobian,
@@ -54,7 +54,7 @@ from drakegrasp.core.linalg import (
     row_space,
     unit_columns,
 )
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_RANK_TOL
 from drakegrasp.core.validation import (
     check_grasp,
     check_rank_tol,

@@ -33,12 +33,16 @@ from drakegrasp.closure.programs import (
 )
 from drakegrasp.closure.results import ClosureResult, InternalForceResult
 from drakegrasp.core.deferred import defer, parts, replace, resolve
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import (
     Grasp,
     check_hand_jacobian,
 )
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL, relative_margin
+from drakegrasp.core.tolerances import (
+    DEFAULT_NUM_GENERATORS,
+    DEFAULT_RANK_TOL,
+    DEFAULT_TOL,
+    relative_margin,
+)
 from drakegrasp.core.validation import (
     check_tol,
 )

@@ -22,6 +22,7 @@ import numpy as np
 
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp, grasp_matrix
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import check_grasp, check_length, check_num_generators
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
@@ -37,8 +38,6 @@ __all__ = [
     "support_of",
     "torsion_only_facets",
 ]
-
-DEFAULT_NUM_GENERATORS = 8
 
 
 @dataclass(frozen=True)
@@ -405,7 +404,11 @@ def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
 
 
 def cone_support(
-    grasp: Grasp, w: np.ndarray, *, cones: str, num_generators: int = 8
+    grasp: Grasp,
+    w: np.ndarray,
+    *,
+    cones: str,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
 ) -> np.ndarray:
     r"""Per contact, the largest ``wᵀ G_i f_i`` over its cone with ``f_n = 1``.
 

@@ -1,4 +1,4 @@
-"""Every default tolerance and shared size limit of drakegrasp, defined once.
+"""Every default tolerance, cone size and shared size limit of drakegrasp, defined once.
 
 The programs, the batch engine, the plant layer, the monitor and the command
 line all read their defaults from here, so a threshold means the same in each
@@ -12,6 +12,7 @@ import math
 __all__ = [
     "L1_MAX_POINTS",
     "DEFAULT_DISTANCE_TOLERANCE",
+    "DEFAULT_NUM_GENERATORS",
     "DEFAULT_RANK_TOL",
     "DEFAULT_TOL",
     "ZERO_FRACTION",
@@ -32,6 +33,9 @@ DEFAULT_RANK_TOL = 1e-9
 
 DEFAULT_DISTANCE_TOLERANCE = 1e-4
 """Default ``|ψ|`` (metres) below which a geometry pair counts as a contact."""
+
+DEFAULT_NUM_GENERATORS = 8
+"""Default generators ``n_g`` of each polyhedral (inscribed) spatial Coulomb cone."""
 
 ZERO_FRACTION = 1e-3
 """``d*`` below ``ZERO_FRACTION * tol`` is the solver's zero, not a near miss."""

@@ -58,11 +58,9 @@ from scipy.linalg import block_diag
 
 from drakegrasp._solvers import require_solution, solve
 from drakegrasp.closure.verdicts import force_closure
-from drakegrasp.core.friction_cone import (
-    DEFAULT_NUM_GENERATORS,
-    friction_cone_generators,
-)
+from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import grasp_matrix
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates

@@ -45,6 +45,7 @@ from drakegrasp.batch import compiled
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
 from drakegrasp.batch.lp.ipm import solve_max_last, solve_max_last_active
 from drakegrasp.batch.run.workers import map_ordered, resolve_workers
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -189,7 +190,7 @@ def weight_capacity(
     model: str = "hard_finger",
     torsional_friction: float | None = None,
     directions: np.ndarray = WEIGHT_DIRECTIONS,
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
     solver: str = "batch",
     workers: int | None = 1,
 ) -> np.ndarray:

@@ -37,6 +37,15 @@ be on the edge, where :func:`drakegrasp.plant.contacts.find_contacts` then uses
 the other surface's normal.
 """
 
+EXACT_SURFACE_TOL = 1e-9
+"""A point within this distance (m) of a surface touches it, for exact points.
+
+For points computed in closed form on a primitive (the exact closest pairs of
+:mod:`~drakegrasp.plant.exact_contact`, fingertip spheres), where round-off,
+not GJK's 1e-5 m, is the error: a core this near the other shape touches it,
+and the faces within it meet at the point (edge, corner).
+"""
+
 
 @dataclass(frozen=True)
 class SurfacePiece:

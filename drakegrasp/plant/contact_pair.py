@@ -19,7 +19,7 @@ from pydrake.geometry import Sphere
 from pydrake.math import RigidTransform
 
 from drakegrasp.errors import NoContactsError, PenetrationError
-from drakegrasp.plant._shapes import ON_SURFACE_TOL, surface_pieces
+from drakegrasp.plant._shapes import EXACT_SURFACE_TOL, ON_SURFACE_TOL, surface_pieces
 from drakegrasp.plant.contact_normals import (
     choose_normal,
     clean_unit,
@@ -173,10 +173,14 @@ def pair_points(
         psi, p_OCa, p_OCb = exact.psi, exact.p_OCa, exact.p_OCb
         source = normal_source(
             obj=surface_pieces(
-                inspector.GetShape(go), _to_G(X_WGa, to_O, p_OCa, R_OGa), tol=1e-9
+                inspector.GetShape(go),
+                _to_G(X_WGa, to_O, p_OCa, R_OGa),
+                tol=EXACT_SURFACE_TOL,
             ),
             fin=surface_pieces(
-                inspector.GetShape(gf), _to_G(X_WGb, to_O, p_OCb, R_OGb), tol=1e-9
+                inspector.GetShape(gf),
+                _to_G(X_WGb, to_O, p_OCb, R_OGb),
+                tol=EXACT_SURFACE_TOL,
             ),
         )
     else:  # no certified exact contact: Drake's witness points

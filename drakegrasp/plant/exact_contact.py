@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.geometry import Box, Convex, Cylinder, HalfSpace, Mesh
 
-from drakegrasp.plant._shapes import face_arrays, surface_pieces
+from drakegrasp.plant._shapes import EXACT_SURFACE_TOL, face_arrays, surface_pieces
 from drakegrasp.plant.shape_queries import PosedShape, closest_on_polygon
 
 __all__ = ["CERTIFY_TOL", "ExactPair", "closest_pair"]
@@ -59,7 +59,7 @@ CERTIFY_TOL = 1e-10
 _FEATURE_REACH = 2e-3
 """Metres: edges and vertices this near Drake's witness are tried as cores."""
 
-_TOUCHING = 1e-9
+_TOUCHING = EXACT_SURFACE_TOL
 """Metres: a core this near the other shape touches it (its normal is then
 taken from the surface, not from round-off)."""
 

@@ -19,9 +19,12 @@ from typing import Any
 import numpy as np
 
 from drakegrasp.core.contact import ContactModel
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE, DEFAULT_TOL
+from drakegrasp.core.tolerances import (
+    DEFAULT_DISTANCE_TOLERANCE,
+    DEFAULT_NUM_GENERATORS,
+    DEFAULT_TOL,
+)
 from drakegrasp.core.validation import (
     check_coefficient,
     check_distance_tolerance,

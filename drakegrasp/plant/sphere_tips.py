@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.plant._shapes import face_arrays, flat_faces
+from drakegrasp.plant._shapes import EXACT_SURFACE_TOL, face_arrays, flat_faces
 
 __all__ = [
     "SOURCES",
@@ -54,7 +54,7 @@ smooth point, else it runs from the object's edge or corner to the tip."""
 
 _CERTIFY_TOL = 1e-10  # exact_contact.CERTIFY_TOL
 _DRAKE_AGREEMENT = 1e-3  # exact_contact._DRAKE_AGREEMENT
-_SOURCE_TOL = 1e-9  # the tolerance contact_pair gives normal_source's pieces
+_SOURCE_TOL = EXACT_SURFACE_TOL  # what contact_pair gives normal_source's pieces
 _FLAT = 1e-12  # shape_queries._FLAT
 _CHUNK = 1_000_000  # pairs × hull edges in one array
 
@@ -287,7 +287,7 @@ def _project_convex(H: Hull, p: np.ndarray):
 def _pieces_at(kind: str, dims: tuple, p: np.ndarray) -> np.ndarray:
     """How many surface pieces meet at ``p`` (frame G): 1 smooth, 2 edge, 3 corner.
 
-    ``surface_pieces`` with ``tol`` 1e-9,
+    ``surface_pieces`` with ``tol`` ``EXACT_SURFACE_TOL``,
     counted (never fewer than one).
     """
     if kind == "Sphere":

@@ -13,12 +13,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from drakegrasp.core.friction_cone import (
-    DEFAULT_NUM_GENERATORS,
-    friction_cone_generators,
-)
+from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.tolerances import L1_MAX_POINTS
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, L1_MAX_POINTS
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidOptionError, SolverError
 from drakegrasp.quality._common import (

@@ -9,9 +9,10 @@ from pydrake.solvers import MathematicalProgram
 
 from drakegrasp._solvers import require_solution, solve
 from drakegrasp.closure.load_problem import check_direction
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS, ConeLayout
+from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.quality._common import _check_grasp

@@ -17,8 +17,11 @@ from pydrake.multibody.plant import ContactResults, MultibodyPlant
 from pydrake.systems.framework import Context, EventStatus, LeafSystem, State
 
 from drakegrasp.core.contact import ContactModel
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE, DEFAULT_TOL
+from drakegrasp.core.tolerances import (
+    DEFAULT_DISTANCE_TOLERANCE,
+    DEFAULT_NUM_GENERATORS,
+    DEFAULT_TOL,
+)
 from drakegrasp.errors import (
     GraspError,
     InvalidOptionError,

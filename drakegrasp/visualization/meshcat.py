@@ -32,8 +32,8 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.certificates import draw_result_certificate
 from drakegrasp.visualization.geometry import (

@@ -20,11 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from drakegrasp.core.friction_cone import (
-    DEFAULT_NUM_GENERATORS,
-    friction_cone_generators,
-)
+from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp, wrench_columns
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.plots import import_pyplot
@@ -36,6 +34,10 @@ __all__ = [
     "wrench_space_points",
     "wrench_hull",
 ]
+
+HULL_TOL = 1e-9
+"""Default distance (in the wrench space's units) by which every facet of the
+primitive wrenches' hull must clear the origin for it to count as inside."""
 
 
 def wrench_space_points(
@@ -116,7 +118,7 @@ class WrenchHull:
     rank: int
 
 
-def wrench_hull(W: np.ndarray, *, tol: float = 1e-9) -> WrenchHull:
+def wrench_hull(W: np.ndarray, *, tol: float = HULL_TOL) -> WrenchHull:
     """Convex hull of the columns of ``W`` and whether it contains the origin.
 
     Parameters
@@ -198,7 +200,7 @@ def plot_wrench_space(
     ax: Any = None,
     hull: bool = True,
     rays: bool = True,
-    tol: float = 1e-9,
+    tol: float = HULL_TOL,
     result: Any = None,
 ) -> WrenchSpacePlot:
     """Plot the primitive wrenches of a planar grasp and their convex hull.

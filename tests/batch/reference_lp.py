@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.batch.build.rowspace import _householder, _inverse_frobenius
-from drakegrasp.batch.lp.dstar import MarginSolution
+from drakegrasp.batch.lp.dstar import DStarSolution
 from drakegrasp.batch.lp.ipm import solve_max_last
 
 __all__ = ["null_spaces", "solve_margin_lp"]
@@ -150,7 +150,7 @@ def solve_margin_lp(
     rank_tol: float,
     ipm_tol: float = 1e-10,
     ipm_max_iter: int = 60,
-) -> MarginSolution:
+) -> DStarSolution:
     """Solve LP1/LP2 for a stack of grasps that share one layout.
 
     Parameters
@@ -175,7 +175,7 @@ def solve_margin_lp(
 
     Returns
     -------
-    MarginSolution
+    DStarSolution
     """
     K, _, M = G.shape
     N = len(normal_columns)
@@ -215,4 +215,4 @@ def solve_margin_lp(
                     t[j], ok[j] = _highs_max_last(B[j], h[j], t[j])
             converged[sel] = ok
         d_star[sel] = N * np.maximum(t, 0.0)
-    return MarginSolution(d_star, rank, converged)
+    return DStarSolution(d_star, rank, converged)

@@ -174,13 +174,13 @@ def test_driver_reads_and_builds_one_chunk_at_a_time(monkeypatch):
     P, Nrm = random_grasps(rng, K, 3, 3)
     mu = rng.uniform(0.2, 0.8, (K, 3))
     sizes = []
-    real = chunks.solve_margin_blocks
+    real = chunks.solve_dstar_blocks
 
     def spy(G, *args, **kwargs):
         sizes.append(G.shape[0])
         return real(G, *args, **kwargs)
 
-    monkeypatch.setattr(chunks, "solve_margin_blocks", spy)
+    monkeypatch.setattr(chunks, "solve_dstar_blocks", spy)
     arrays = [_RecordingArray(a) for a in (P, Nrm, mu)]
     res = batch_force_closure(arrays[0], arrays[1], mu=arrays[2], chunk_size=cs)
     assert max(sizes) <= cs and sum(sizes) == K

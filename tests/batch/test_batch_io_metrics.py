@@ -223,10 +223,10 @@ def test_lps_that_hit_the_iteration_cap_are_finished_by_highs(monkeypatch):
         return real_highs(*args)
 
     def capped(*args, **kwargs):
-        return margin.solve_margin_blocks(*args, ipm_max_iter=2, **kwargs)
+        return margin.solve_dstar_blocks(*args, ipm_max_iter=2, **kwargs)
 
     monkeypatch.setattr(margin, "_highs", counting)
-    monkeypatch.setattr(chunks, "solve_margin_blocks", capped)
+    monkeypatch.setattr(chunks, "solve_dstar_blocks", capped)
     res = batch_force_closure(P, Nrm, mu=0.5)
     assert len(calls) > 50  # most LPs need more than two iterations
     assert res.converged.all()

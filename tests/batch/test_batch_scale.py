@@ -32,7 +32,7 @@ from drakegrasp.batch.build.construction import (
 from drakegrasp.batch.build.rowspace import normalised_positions
 from drakegrasp.batch.lp import block_kernel
 from drakegrasp.batch.lp.block_ipm import solve_block_lp
-from drakegrasp.batch.lp.dstar import solve_margin_blocks
+from drakegrasp.batch.lp.dstar import solve_dstar_blocks
 from drakegrasp.closure.verdicts import force_closure, form_closure
 from drakegrasp.core.grasp import invariant_grasp_matrix
 from drakegrasp.errors import InvalidContactError
@@ -200,7 +200,7 @@ def test_block_ipm_matches_the_null_space_reduction(N):
     G, F, sl, nc = _stack(N, 400, 7300 + N)
     kappa = np.full((G.shape[0], N), np.sqrt(1.25))
     ref = solve_margin_lp(G, F, sl, nc, rank_tol=1e-9)
-    new = solve_margin_blocks(G, F, sl, nc, kappa, rank_tol=1e-9, kernel="numpy")
+    new = solve_dstar_blocks(G, F, sl, nc, kappa, rank_tol=1e-9, kernel="numpy")
     np.testing.assert_array_equal(new.rank, ref.rank)
     np.testing.assert_allclose(new.d_star, ref.d_star, atol=1e-8, rtol=0)
     assert new.converged.all() and 0 < (ref.d_star > 1e-6).sum()
@@ -211,8 +211,8 @@ def test_block_ipm_matches_the_null_space_reduction(N):
 def test_numba_kernel_matches_the_numpy_reference(N):
     G, F, sl, nc = _stack(N, 300, 7400 + N)
     kappa = np.full((G.shape[0], N), np.sqrt(1.25))
-    ref = solve_margin_blocks(G, F, sl, nc, kappa, rank_tol=1e-9, kernel="numpy")
-    new = solve_margin_blocks(G, F, sl, nc, kappa, rank_tol=1e-9, kernel="numba")
+    ref = solve_dstar_blocks(G, F, sl, nc, kappa, rank_tol=1e-9, kernel="numpy")
+    new = solve_dstar_blocks(G, F, sl, nc, kappa, rank_tol=1e-9, kernel="numba")
     # both stop at 1e-10 on t = d*/N, in a different summation order
     np.testing.assert_allclose(new.d_star, ref.d_star, atol=1e-8, rtol=0)
     np.testing.assert_array_equal(new.converged, ref.converged)
@@ -264,8 +264,8 @@ def test_fused_pass_matches_the_numpy_reference_on_mixed_ranks(N, d, kind, mu):
     k_i = F.shape[2]
     sl = [slice(k_i * i, k_i * i + k_i) for i in range(N)]
     kappa = np.full((K, N), np.sqrt(1.0 + mu**2))
-    ref = solve_margin_blocks(G, [F] * N, sl, nc, kappa, rank_tol=1e-9, kernel="numpy")
-    new = solve_margin_blocks(G, [F] * N, sl, nc, kappa, rank_tol=1e-9, kernel="numba")
+    ref = solve_dstar_blocks(G, [F] * N, sl, nc, kappa, rank_tol=1e-9, kernel="numpy")
+    new = solve_dstar_blocks(G, [F] * N, sl, nc, kappa, rank_tol=1e-9, kernel="numba")
     np.testing.assert_array_equal(new.rank, ref.rank)
     np.testing.assert_allclose(new.d_star, ref.d_star, atol=1e-8, rtol=0)
     np.testing.assert_array_equal(new.converged, ref.converged)

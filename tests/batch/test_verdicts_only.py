@@ -1,7 +1,7 @@
 """LP2 in verdict-only mode (``force_verdicts``) against the full solve's verdicts.
 
 Robustness counts verdicts, so :func:`drakegrasp.batch.run.verdicts.force_verdicts`
-stops each LP once its verdict is proved (``solve_margin_blocks``'s
+stops each LP once its verdict is proved (``solve_dstar_blocks``'s
 ``verdict_tol``).  Its verdicts must equal ``batch_force_closure``'s exactly, on
 random grasps of every contact model, on degenerate ones (rank deficient, one
 point, collinear, duplicated contacts, extreme μ) and on grasps whose ``d*``

@@ -44,6 +44,7 @@ from drakegrasp.batch.run.chunk import force_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 
 __all__ = ["batch_epsilon_l1", "epsilon_chunk"]
 
@@ -77,7 +78,7 @@ def batch_epsilon_l1(
     *,
     mu: float | np.ndarray,
     contact_model: ContactModel | str = "hard_finger",
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
     torsional_friction: float | np.ndarray | None = None,
     reference_points: np.ndarray | None = None,
     characteristic_lengths: float | np.ndarray | None = None,

@@ -38,7 +38,11 @@ from drakegrasp.batch.inputs import shape_of
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
+from drakegrasp.core.tolerances import (
+    DEFAULT_NUM_GENERATORS,
+    DEFAULT_RANK_TOL,
+    DEFAULT_TOL,
+)
 from drakegrasp.core.validation import check_flag
 from drakegrasp.errors import BatchFileError, InvalidOptionError
 
@@ -90,7 +94,7 @@ def evaluate_file(
     kind: str = "force",
     mu: float | None = None,
     contact_model: ContactModel | str = "hard_finger",
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
     torsional_friction: float | None = None,
     tol: float = DEFAULT_TOL,
     rank_tol: float = DEFAULT_RANK_TOL,
@@ -154,7 +158,7 @@ def stream_file(
     kind: str = "force",
     mu: float | None = None,
     contact_model: str = "hard_finger",
-    num_generators: int = 8,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
     torsional_friction: float | None = None,
     tol: float = DEFAULT_TOL,
     rank_tol: float = DEFAULT_RANK_TOL,

@@ -46,13 +46,13 @@ import numpy as np
 
 from drakegrasp.batch.compiled import FASTMATH, njit
 from drakegrasp.batch.lp.householder import _qr, _reflect
+from drakegrasp.batch.lp.tolerances import BLOCK_TOL
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["solve_reduced_lp", "worth_it"]
 
 
 _D_TOL = 1e-12  # ‖d‖ (d a projection of a unit vector) below this: stationary
-_BLOCK_TOL = 1e-9  # a facet blocks when its gradient's rate along d is below -this
 _DUAL_TOL = 1e-12  # multipliers above -this count as non-negative
 _FEAS_TOL = 1e-12  # slacks above -this (relative to the largest |a_jᵀv|) are feasible
 
@@ -169,7 +169,7 @@ def _active_set(AT, nz, R, ct, cn2, max_iter, work):
                 for i in range(nz):
                     rate += AT[i, j] * d[i]
                 rates[j] = rate
-                if rate < -_BLOCK_TOL * dn * gnorm[j]:
+                if rate < -BLOCK_TOL * dn * gnorm[j]:
                     alpha = max(slack[j], 0.0) / -rate
                     if alpha < best:
                         best = alpha
@@ -320,7 +320,7 @@ def _plane_lp(AT, R, ct, cn2, al, bx, by, max_iter):
                 continue
             rate = bx[j] * dx + by[j] * dy - dt
             if rate < 0.0 and rate * rate > (
-                _BLOCK_TOL * _BLOCK_TOL * dd * (1.0 + bx[j] * bx[j] + by[j] * by[j])
+                BLOCK_TOL * BLOCK_TOL * dd * (1.0 + bx[j] * bx[j] + by[j] * by[j])
             ):
                 slack = al[j] + bx[j] * ux + by[j] * uy - t
                 alpha = max(slack, 0.0) / -rate

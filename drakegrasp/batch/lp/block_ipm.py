@@ -42,6 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakegrasp.batch.lp.tolerances import IPM_MAX_ITER, IPM_TOL
+
 __all__ = ["BlockSolution", "ContactGroup", "solve_block_lp"]
 
 _STEP = 0.9995  # fraction of the distance to the boundary taken per step
@@ -265,8 +267,8 @@ class _Newton:
 def solve_block_lp(
     groups: list[ContactGroup],
     *,
-    tol: float = 1e-10,
-    max_iter: int = 60,
+    tol: float = IPM_TOL,
+    max_iter: int = IPM_MAX_ITER,
     stop_below: float | None = None,
 ) -> BlockSolution:
     r"""Solve a stack of closure LPs in block form (module docstring).

@@ -34,6 +34,7 @@ from drakegrasp.batch.lp.block_ops import (
     _solve3_rows,
     _solve_rows,
 )
+from drakegrasp.batch.lp.tolerances import IPM_MAX_ITER, IPM_TOL
 
 __all__ = ["AVAILABLE", "solve_block_stack"]
 
@@ -348,8 +349,8 @@ def solve_block_stack(
     kappa: np.ndarray,
     start: np.ndarray,
     *,
-    tol: float = 1e-10,
-    max_iter: int = 60,
+    tol: float = IPM_TOL,
+    max_iter: int = IPM_MAX_ITER,
     stop_below: float | None = None,
     prove_above: float | None = None,
 ):

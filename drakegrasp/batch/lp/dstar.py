@@ -25,20 +25,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.batch.build.rowspace import row_spaces
-from drakegrasp.batch.inputs import numba_available
+from drakegrasp.batch.inputs import compiled_route
 from drakegrasp.batch.lp.block_ipm import ContactGroup, solve_block_lp
+from drakegrasp.batch.lp.tolerances import IPM_MAX_ITER, IPM_TOL, PUSH_TOL
 
-__all__ = ["solve_margin_blocks"]
+__all__ = ["solve_dstar_blocks"]
 
 
 @dataclass(frozen=True)
-class MarginSolution:
+class DStarSolution:
     """``d*`` and ranks of a stack of closure LPs.
 
     Attributes
     ----------
     d_star : (K,) float
-        Optimal margin of the LP, ``>= 0``.
+        Optimal value of the LP, ``>= 0``.
     rank : (K,) int
         Numerical rank of ``G``.
     converged : (K,) bool
@@ -48,9 +49,6 @@ class MarginSolution:
     d_star: np.ndarray
     rank: np.ndarray
     converged: np.ndarray
-
-
-_PUSH_TOL = 1e-10  # ‖c‖ below this: no balanced force has a normal component
 
 
 def _contact_groups(facets, slices):
@@ -127,7 +125,7 @@ def _verdict_band(tol: float, N: int) -> tuple[float, float]:
     return 0.25 * tol / N, 4.0 * tol / N
 
 
-def solve_margin_blocks(
+def solve_dstar_blocks(
     G: np.ndarray,
     facets: list[np.ndarray],
     component_slices: list[slice],
@@ -135,11 +133,11 @@ def solve_margin_blocks(
     kappa: np.ndarray,
     *,
     rank_tol: float,
-    ipm_tol: float = 1e-10,
-    ipm_max_iter: int = 60,
+    ipm_tol: float = IPM_TOL,
+    ipm_max_iter: int = IPM_MAX_ITER,
     kernel: str = "auto",
     verdict_tol: float | None = None,
-) -> MarginSolution:
+) -> DStarSolution:
     """Solve LP1/LP2 for a stack of grasps that share one layout.
 
     Parameters
@@ -178,7 +176,7 @@ def solve_margin_blocks(
 
     Returns
     -------
-    MarginSolution
+    DStarSolution
     """
     K, w, M = G.shape
     N = len(normal_columns)
@@ -186,7 +184,7 @@ def solve_margin_blocks(
     # about 4 ipm_tol absolute accuracy at any N.
     tol_t = ipm_tol * min(1.0, 4.0 / N)
     band = None if verdict_tol is None else _verdict_band(verdict_tol, N)
-    use_numba = kernel == "numba" or (kernel == "auto" and numba_available())
+    use_numba = compiled_route(kernel) and kernel != "unfused"
     if use_numba and M >= w and K > 0:
         # Certified full-rank grasps are prepared and solved in one compiled
         # pass (drakegrasp.batch.lp.fused_kernel); the rest take the path below.
@@ -198,8 +196,8 @@ def solve_margin_blocks(
         )  # fmt: skip
         rest = np.flatnonzero(~done)
         if rest.size == 0:
-            return MarginSolution(d_fused, np.full(K, w), np.ones(K, dtype=bool))
-        sub = solve_margin_blocks(
+            return DStarSolution(d_fused, np.full(K, w), np.ones(K, dtype=bool))
+        sub = solve_dstar_blocks(
             G[rest], [F if F.shape[0] == 1 else F[rest] for F in facets],
             component_slices, normal_columns, kappa[rest], rank_tol=rank_tol,
             ipm_tol=ipm_tol, ipm_max_iter=ipm_max_iter, kernel="unfused",
@@ -208,7 +206,7 @@ def solve_margin_blocks(
         rank = np.full(K, w)
         converged = np.ones(K, dtype=bool)
         d_fused[rest], rank[rest], converged[rest] = sub.d_star, sub.rank, sub.converged
-        return MarginSolution(d_fused, rank, converged)
+        return DStarSolution(d_fused, rank, converged)
     rank, spaces = row_spaces(G, rank_tol=rank_tol)
     d_star = np.zeros(K)
     converged = np.ones(K, dtype=bool)
@@ -222,13 +220,13 @@ def solve_margin_blocks(
         c = -np.einsum("mrk,rk->mk", Q, Q[normal_columns].sum(axis=0))
         c[normal_columns] += 1.0  # c = e - Q Qᵀ e, (M, k)
         cnorm2 = np.einsum("mk,mk->k", c, c)
-        push = cnorm2 > _PUSH_TOL**2
+        push = cnorm2 > PUSH_TOL**2
         if not push.all():
             sel, Q, c, cnorm2 = sel[push], Q[:, :, push], c[:, push], cnorm2[push]
         if sel.size == 0:
             continue
         f0 = c / cnorm2
-        compiled = use_numba or kernel == "unfused"
+        compiled = compiled_route(kernel)
         # The numpy IPM's last bits depend on its stack (the problems solved
         # together), so with it every grasp of the full solve stays in the stack
         # and the verdicts stay those of the full solve; the compiled IPM solves
@@ -291,4 +289,4 @@ def solve_margin_blocks(
                 )
         converged[sel] = ok
         d_star[sel] = N * np.maximum(t, 0.0)
-    return MarginSolution(d_star, rank, converged)
+    return DStarSolution(d_star, rank, converged)

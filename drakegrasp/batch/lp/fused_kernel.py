@@ -1,6 +1,6 @@
 """Row space, starting point and block IPM of a stack of grasps in one compiled pass.
 
-:func:`drakegrasp.batch.lp.dstar.solve_margin_blocks` prepares each LP of a chunk
+:func:`drakegrasp.batch.lp.dstar.solve_dstar_blocks` prepares each LP of a chunk
 with vectorised numpy (a Householder QR of ``G̃ᵀ`` to certify full rank and
 give ``Q``, then ``c = e - Q Qᵀ e``, ``f_0 = c / ‖c‖²`` and ``A = [Qᵀ; eᵀ]``)
 before the compiled IPM runs.  On a few contacts that preparation costs about
@@ -38,10 +38,9 @@ from drakegrasp.batch.lp.active_set import active_set_work, reduced_lp, worth_it
 from drakegrasp.batch.lp.block_kernel import _one, flat_facets, work_arrays
 from drakegrasp.batch.lp.block_ops import _cmul
 from drakegrasp.batch.lp.householder import _qr, _reflect
+from drakegrasp.batch.lp.tolerances import PUSH_TOL
 
 __all__ = ["full_column_rank_certain", "solve_full_rank_stack"]
-
-_PUSH_TOL = 1e-10  # as drakegrasp.batch.lp.dstar
 
 
 @njit(cache=True, fastmath=FASTMATH, error_model="numpy")
@@ -158,7 +157,7 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
                     E[0, m] = 0.0
                 else:
                     cn2 += E[0, m] * E[0, m]
-            if cn2 > 4.0 * _PUSH_TOL * _PUSH_TOL:  # else: as the full solve
+            if cn2 > 4.0 * PUSH_TOL * PUSH_TOL:  # else: as the full solve
                 for j in range(w - 1, -1, -1):
                     _reflect(V, j, beta[j], E, 0, M)
                 for m in range(M):
@@ -186,7 +185,7 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
                 ct[i] = acc
                 cn2 += acc * acc
                 _cmul(Fk, foff, nrow, ncomp, roff, coff, N, ZT[i], AT[i])
-            if not (cn2 > _PUSH_TOL * _PUSH_TOL):
+            if not (cn2 > PUSH_TOL * PUSH_TOL):
                 out_done[k] = True
                 out_d[k] = 0.0  # no balanced force pushes
                 continue
@@ -223,7 +222,7 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
                 acc -= A[i, m] * Qte[i]
             f0[m] = acc
             cn2 += acc * acc
-        if not (cn2 > _PUSH_TOL * _PUSH_TOL):
+        if not (cn2 > PUSH_TOL * PUSH_TOL):
             out_d[k] = 0.0  # no balanced force pushes
             continue
         for m in range(M):
@@ -274,7 +273,7 @@ def solve_full_rank_stack(
         Solve the LPs of small null spaces (``drakegrasp.batch.lp.active_set.worth_it``)
         with the exact active-set method first (default); False: the IPM only.
     between : (float, float), optional
-        Verdicts only (:func:`drakegrasp.batch.lp.dstar.solve_margin_blocks`'s
+        Verdicts only (:func:`drakegrasp.batch.lp.dstar.solve_dstar_blocks`'s
         ``verdict_tol``): a grasp stops once ``t*`` is proved below the first
         bound (its ``d_star`` is then an upper bound ``N max(0, t) < N`` that)
         or above the second (``d_star`` is a feasible point's ``N t``, a lower

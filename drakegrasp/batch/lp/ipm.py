@@ -37,6 +37,7 @@ import numpy as np
 
 from drakegrasp.batch import compiled
 from drakegrasp.batch.lp.ipm_kernel import solve_max_last_stack
+from drakegrasp.batch.lp.tolerances import IPM_MAX_ITER, IPM_TOL
 from drakegrasp.batch.lp.vertex_kernel import active_set_stack
 from drakegrasp.errors import InvalidOptionError
 
@@ -151,8 +152,8 @@ def solve_max_last(
     B: np.ndarray,
     h: np.ndarray,
     *,
-    tol: float = 1e-10,
-    max_iter: int = 60,
+    tol: float = IPM_TOL,
+    max_iter: int = IPM_MAX_ITER,
     stop_below: float | None = None,
     kernel: str = "numpy",
 ) -> MaxLPSolution:

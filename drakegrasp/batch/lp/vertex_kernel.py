@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from drakegrasp.batch.compiled import njit
+from drakegrasp.batch.lp.tolerances import BLOCK_TOL
 
 __all__ = ["active_set_stack"]
 
@@ -28,7 +29,6 @@ least-squares multipliers satisfy ``Bᵀλ = e`` to this (what is certified);
 a shorter ``d`` is mostly rounding and would lead the steps astray."""
 _ACTIVE_TOL = 1e-12
 """Multipliers and slacks beyond ``-this`` (relative) count as zero."""
-_BLOCK_TOL = 1e-9
 """A row blocks a step along the unit ``d`` when its rate exceeds this times its
 norm; a smaller rate is rounding of a row in the active rows' span (which the
 Gram–Schmidt basis would reject)."""
@@ -157,7 +157,7 @@ def _active_one(B, h, x, lam, max_steps):
                 for i in range(n):
                     rate += B[q, i] * d[i]
                 rates[q] = rate
-                if rate > _BLOCK_TOL * rown[q]:
+                if rate > BLOCK_TOL * rown[q]:
                     t = max(s[q], 0.0) / rate
                     if t < best:
                         best = t

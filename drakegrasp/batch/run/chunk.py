@@ -45,12 +45,12 @@ from drakegrasp.batch.inputs import (
     _reference_points,
     check_chunk_coefficients,
     check_metrics,
-    numba_available,
+    compiled_route,
     per_contact_getter,
     resolve_kernel,
     shape_of,
 )
-from drakegrasp.batch.lp.dstar import solve_margin_blocks
+from drakegrasp.batch.lp.dstar import solve_dstar_blocks
 from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.validation import check_num_generators
@@ -86,7 +86,7 @@ def _lp1(Gn: np.ndarray, rank_tol: float, kernel: str):
     K, _, N = Gn.shape
     slices = [slice(i, i + 1) for i in range(N)]
     ones = np.ones((1, 1, 1))
-    return solve_margin_blocks(
+    return solve_dstar_blocks(
         Gn,
         [ones] * N,
         slices,
@@ -99,7 +99,7 @@ def _lp1(Gn: np.ndarray, rank_tol: float, kernel: str):
 
 def _compiled(kernel: str) -> bool:
     """Whether a chunk's arrays are built by the compiled loops (numba)."""
-    return kernel in ("numba", "unfused") or (kernel == "auto" and numba_available())
+    return compiled_route(kernel)
 
 
 def _positions(P, compiled: bool):
@@ -198,7 +198,7 @@ def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, ro
 
     Returns (d_star, rank, converged) of those grasps; ``torsion`` (None when
     no contact is soft) is ``b ν`` per contact.  ``verdict_tol``: see
-    :func:`~drakegrasp.batch.lp.dstar.solve_margin_blocks`.
+    :func:`~drakegrasp.batch.lp.dstar.solve_dstar_blocks`.
     """
     G, normal_cols = _grasp_matrices(Pn, Nrm, None, layout, rows, _compiled(kernel))
     if rows is not None:
@@ -238,7 +238,7 @@ def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, ro
         facets.append(F)
         slices.append(slice(start, start + k_i))
         start += k_i
-    sol = solve_margin_blocks(
+    sol = solve_dstar_blocks(
         G, facets, slices, normal_cols, kappa, rank_tol=rank_tol, kernel=kernel,
         verdict_tol=verdict_tol,
     )  # fmt: skip

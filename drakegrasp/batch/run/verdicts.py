@@ -13,8 +13,11 @@ import numpy as np
 from drakegrasp.batch.inputs import shape_of
 from drakegrasp.batch.run.chunk import force_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
+from drakegrasp.core.tolerances import (
+    DEFAULT_NUM_GENERATORS,
+    DEFAULT_RANK_TOL,
+    DEFAULT_TOL,
+)
 
 __all__ = ["force_verdicts"]
 
@@ -41,7 +44,7 @@ def force_verdicts(
     certificate), whose ``is_closure`` it returns, but each LP stops as soon
     as its verdict is proved either way (a feasible point above the
     threshold, a dual bound below it, a rank-deficient ``G``: see
-    :func:`drakegrasp.batch.lp.dstar.solve_margin_blocks`'s ``verdict_tol``).
+    :func:`drakegrasp.batch.lp.dstar.solve_dstar_blocks`'s ``verdict_tol``).
 
     Parameters
     ----------
