@@ -3,19 +3,27 @@
 Usage::
 
     drakegrasp analyze [SCENE] [--mu M|plant] [--contact-model MODEL]
-                       [--torsional-friction NU] [--close | --no-close]
-                       [--allow-penetration] [--no-check-pose]
+                       [--torsional-friction NU] [--distance-tolerance D]
+                       [--plane PLANE] [--characteristic-length B]
+                       [--num-generators NG] [--tol TOL] [--patches MODE]
+                       [--close | --no-close] [--allow-penetration]
+                       [--check-pose | --no-check-pose]
                        [--package NAME=DIR ...] [--allow-any-file] [--json]
     drakegrasp scenes
     drakegrasp batch IN.npz OUT.npz [--kind force|form] [--mu M]
                      [--contact-model MODEL] [--torsional-friction NU]
-                     [--num-generators NG] [--metrics NAME ...] [--progress]
-                     [--overwrite]
+                     [--num-generators NG] [--tol TOL] [--metrics NAME ...]
+                     [--chunk-size K] [--workers W] [--format npz|parquet]
+                     [--scheduler ADDRESS] [--progress] [--overwrite]
     drakegrasp warmup [--json]
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
                     [--seed S] [--mu M|plant] [--mass KG] [--torque-limit NM]
                     [--package NAME=DIR ...] [--allow-any-file] [--progress]
                     [--json | --out FILE.parquet [--overwrite]]
+
+Every option's default and meaning: ``drakegrasp COMMAND --help`` (read from
+the library's own defaults), or the generated reference in the CLI guide.
+``--model`` is a deprecated alias of ``batch --contact-model``.
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
@@ -92,7 +100,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from drakegrasp.core.contact import ContactModel
-from drakegrasp.core.tolerances import DEFAULT_TOL
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
 from drakegrasp.errors import GraspError, InvalidOptionError, InvalidPoseError
 
 __all__ = ["Terminated", "build_parser", "main", "printable", "run"]
@@ -566,7 +574,10 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         help="deprecated alias of --contact-model",
     )
     batch.add_argument(
-        "--num-generators", type=int, default=8, help="cone generators (default 8)"
+        "--num-generators",
+        type=int,
+        default=DEFAULT_NUM_GENERATORS,
+        help="generators of each polyhedral friction cone (default %(default)s)",
     )
     batch.add_argument(
         "--torsional-friction",
@@ -576,7 +587,10 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "the file has it (0 makes soft fingers act as hard ones)",
     )
     batch.add_argument(
-        "--tol", type=_positive_float, default=DEFAULT_TOL, help="threshold on d*"
+        "--tol",
+        type=_positive_float,
+        default=DEFAULT_TOL,
+        help="threshold on d* (default %(default)g)",
     )
     batch.add_argument(
         "--metrics",
@@ -775,7 +789,11 @@ def _plant_mu(plant, context, object_body, hand) -> float:
     grasp in force closure with the narrowest cones is one with wider cones
     too), and a note on stderr says so.
     """
-    from drakegrasp.plant.friction import friction_rule, hand_object_friction
+    from drakegrasp.plant.friction import (
+        MU_RELATIVE_TOL,
+        friction_rule,
+        hand_object_friction,
+    )
 
     values = hand_object_friction(plant, context, object_body, hand)
     if values.size == 0:
@@ -784,7 +802,7 @@ def _plant_mu(plant, context, object_body, hand) -> float:
             "read a friction from; give --mu as a number"
         )
     mu = float(values[0])
-    if values[-1] - mu > 1e-6 * max(mu, 1.0):
+    if values[-1] - mu > MU_RELATIVE_TOL * max(mu, 1.0):
         _say(
             f"drakegrasp: note: --mu plant: the plant's {friction_rule(plant)} "
             f"friction of hand and object geometries ranges from {mu:g} to "
