@@ -37,6 +37,7 @@ from drakegrasp.batch.inputs import (
     shape_of,
 )
 from drakegrasp.batch.run.stream import chunk_size_for
+from drakegrasp.core.deprecation import keyword_only
 from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.distributed.client import connected
@@ -101,12 +102,13 @@ def _partition(kind, positions, normals, arrays, options, shard, chunk_size, job
     return write_shard(Path(shard), out, job)
 
 
+@keyword_only("mu", after=3)
 def evaluate_on_cluster(
     client,
     positions,
     normals,
-    mu=None,
     *,
+    mu=None,
     kind: str = "force",
     output_dir: str | os.PathLike | None = None,
     overwrite: bool = False,
@@ -256,7 +258,7 @@ def stream_file_on_cluster(
     mu = extra.pop("mu", None)
     options.update({k: v for k, v in extra.items() if v is not None})
     options = {k: v for k, v in options.items() if v is not None}
-    evaluate_on_cluster(scheduler, data["positions"], data["normals"], mu,
+    evaluate_on_cluster(scheduler, data["positions"], data["normals"], mu=mu,
                         kind=kind, output_dir=as_path("output", output_path),
                         overwrite=overwrite, **options)  # fmt: skip
     arrays = read_dataset(output_path)

@@ -33,7 +33,12 @@ def cached_scenes() -> list[str]:
     return sorted(_SCENES)
 
 
-def _analyze_block(scene_name: str, q_block: np.ndarray, options: dict):
+def _analyze_block(
+    scene_name: str,
+    q_block: np.ndarray,
+    options: AnalysisOptions | None,
+    overrides: dict,
+):
     from drakegrasp.plant.analysis import analyze_grasp
 
     scene = _scene(scene_name)
@@ -49,7 +54,8 @@ def _analyze_block(scene_name: str, q_block: np.ndarray, options: dict):
            "d_star": np.zeros(len(q_block)),
            "num_contacts": np.zeros(len(q_block), dtype=int),
            "error": [""] * len(q_block)}  # fmt: skip
-    analysis = scene.options.replace(**options)
+    # the scene's own options are known here only; given options come checked
+    analysis = scene.options.replace(**overrides) if options is None else options
     for i, q in enumerate(q_block):
         plant.SetPositions(ctx, q)
         try:
@@ -72,7 +78,8 @@ def analyze_poses(
     positions: np.ndarray,
     *,
     block: int = 64,
-    **options,
+    options: AnalysisOptions | None = None,
+    **overrides,
 ) -> dict[str, np.ndarray]:
     """:func:`drakegrasp.analyze_grasp` for many plant configurations of a scene.
 
@@ -86,8 +93,12 @@ def analyze_poses(
         Plant positions ``q`` (the scene plant's ``GetPositions`` order).
     block : int, optional
         Configurations per task (an integer >= 1).
-    **options
-        Overrides of the scene's analysis options (e.g. ``mu``).
+    options : AnalysisOptions, optional
+        The analysis options, instead of the scene file's (checked once, here,
+        and shipped to the workers as they are).
+    **overrides
+        Changes to the options (e.g. ``mu=0.8``): to ``options`` when given,
+        else to each scene's own (read on the worker).
 
     Returns
     -------
@@ -106,7 +117,15 @@ def analyze_poses(
         A bad option or ``block``; positions that are not a finite (P, n_q)
         array, or whose ``n_q`` is not the scene plant's number of positions.
     """
-    AnalysisOptions().replace(**options)  # a bad option fails here, not on a worker
+    if options is not None:
+        if not isinstance(options, AnalysisOptions):
+            raise InvalidOptionError(
+                "options must be a drakegrasp.AnalysisOptions, got "
+                f"{type(options).__name__}"
+            )
+        options, overrides = options.replace(**overrides), {}
+    else:
+        AnalysisOptions().replace(**overrides)  # a bad one fails here, not remotely
     n = integer_or_none(block)
     if n is None or n < 1:
         raise InvalidOptionError(
@@ -116,7 +135,8 @@ def analyze_poses(
     q = _configurations(positions)
     with connected(client) as client:
         futs = [client.submit(_analyze_block, scene, q[s:s + block], options,
-                              pure=False) for s in range(0, len(q), block)]  # fmt: skip
+                              overrides, pure=False)
+                for s in range(0, len(q), block)]  # fmt: skip
         parts = client.gather(futs)
     names = {"is_force_closure": bool, "d_star": float, "num_contacts": int,
              "error": str}  # fmt: skip

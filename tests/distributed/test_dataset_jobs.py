@@ -68,13 +68,13 @@ def test_a_rerun_resumes_only_its_own_job(client, tmp_path):
     P, Nrm, mu = _grasps(2, 53)
     out = tmp_path / "ds"
     kw = {"chunk_size": 10, "partition_chunks": 1, "output_dir": out}
-    first = evaluate_on_cluster(client, P, Nrm, mu, **kw)
+    first = evaluate_on_cluster(client, P, Nrm, mu=mu, **kw)
     assert len(first) == 6 and (out / MANIFEST).exists()
     # another mu, fewer grasps, another tol, form closure: all refused
     others = [
-        ((P, Nrm, 0.5), {}),
-        ((P[:12], Nrm[:12], mu[:12]), {}),
-        ((P, Nrm, mu), {"tol": 1e-6}),
+        ((P, Nrm), {"mu": 0.5}),
+        ((P[:12], Nrm[:12]), {"mu": mu[:12]}),
+        ((P, Nrm), {"mu": mu, "tol": 1e-6}),
         ((P, Nrm), {"kind": "form"}),
     ]
     for args, extra in others:
@@ -82,7 +82,7 @@ def test_a_rerun_resumes_only_its_own_job(client, tmp_path):
             evaluate_on_cluster(client, *args, **kw, **extra)
     assert sorted(p.name for p in out.glob("part-*")) == [Path(p).name for p in first]
     # with overwrite the 12-grasp job replaces the 53-grasp one entirely
-    evaluate_on_cluster(client, P[:12], Nrm[:12], mu[:12], overwrite=True, **kw)
+    evaluate_on_cluster(client, P[:12], Nrm[:12], mu=mu[:12], overwrite=True, **kw)
     _same(read_dataset(out), batch_force_closure(P[:12], Nrm[:12], mu=mu[:12]))
     assert len(list(out.glob("part-*.parquet"))) == 2
 
@@ -111,8 +111,8 @@ def test_shards_without_a_manifest_are_refused(client, tmp_path):
     out.mkdir()
     write_shard(out / "part-00000.parquet", {"d_star": np.zeros(3)}, "old")
     with pytest.raises(BatchFileError, match="unknown job"):
-        evaluate_on_cluster(client, P, Nrm, mu, output_dir=out)
-    evaluate_on_cluster(client, P, Nrm, mu, output_dir=out, overwrite=True)
+        evaluate_on_cluster(client, P, Nrm, mu=mu, output_dir=out)
+    evaluate_on_cluster(client, P, Nrm, mu=mu, output_dir=out, overwrite=True)
     _same(read_dataset(out), batch_force_closure(P, Nrm, mu=mu))
 
 
@@ -120,8 +120,8 @@ def test_truncated_and_foreign_shards_are_computed_again(client, tmp_path):
     P, Nrm, mu = _grasps(5, 60)
     kw = {"chunk_size": 10, "partition_chunks": 2}
     out, other = tmp_path / "ds", tmp_path / "other"
-    paths = evaluate_on_cluster(client, P, Nrm, mu, output_dir=out, **kw)
-    evaluate_on_cluster(client, P, Nrm, 0.5, output_dir=other, **kw)
+    paths = evaluate_on_cluster(client, P, Nrm, mu=mu, output_dir=out, **kw)
+    evaluate_on_cluster(client, P, Nrm, mu=0.5, output_dir=other, **kw)
     # a truncated shard, and a shard of another job under the right name
     data = Path(paths[0]).read_bytes()
     Path(paths[0]).write_bytes(data[: len(data) // 2])
@@ -129,14 +129,14 @@ def test_truncated_and_foreign_shards_are_computed_again(client, tmp_path):
     with pytest.raises(BatchFileError, match="truncated"):
         read_dataset(out)
     untouched = Path(paths[2]).stat().st_mtime_ns
-    again = evaluate_on_cluster(client, P, Nrm, mu, output_dir=out, **kw)
+    again = evaluate_on_cluster(client, P, Nrm, mu=mu, output_dir=out, **kw)
     assert again == paths
     assert Path(paths[2]).stat().st_mtime_ns == untouched  # a good shard is kept
     _same(read_dataset(out), batch_force_closure(P, Nrm, mu=mu))
     shutil.copy(other / "part-00001.parquet", paths[1])
     with pytest.raises(BatchFileError, match="another job"):
         read_dataset(out)
-    evaluate_on_cluster(client, P, Nrm, mu, output_dir=out, **kw)
+    evaluate_on_cluster(client, P, Nrm, mu=mu, output_dir=out, **kw)
     _same(read_dataset(out), batch_force_closure(P, Nrm, mu=mu))
     # a missing shard is named, not silently skipped
     Path(paths[1]).unlink()
@@ -157,13 +157,13 @@ def test_read_dataset_orders_shards_by_number(tmp_path):
 def test_partition_chunks_is_validated(client, bad):
     P, Nrm, _ = _grasps(6, 20)
     with pytest.raises(InvalidOptionError, match="partition_chunks"):
-        evaluate_on_cluster(client, P, Nrm, 0.5, partition_chunks=bad)
+        evaluate_on_cluster(client, P, Nrm, mu=0.5, partition_chunks=bad)
 
 
 def test_options_the_cluster_decides_are_refused(client):
     P, Nrm, _ = _grasps(6, 20)
     with pytest.raises(InvalidOptionError, match="workers"):
-        evaluate_on_cluster(client, P, Nrm, 0.5, workers=2)
+        evaluate_on_cluster(client, P, Nrm, mu=0.5, workers=2)
 
 
 @pytest.mark.parametrize("name", ["mu", "torsional_friction"])
@@ -177,7 +177,7 @@ def test_per_grasp_friction_whatever_the_last_partition(client, name):
     if name == "torsional_friction":
         extra = {"contact_model": "soft_finger", "torsional_friction": per_grasp}
     want = batch_force_closure(P, Nrm, mu=mu, workers=1, **extra)
-    got = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=10,
+    got = evaluate_on_cluster(client, P, Nrm, mu=mu, chunk_size=10,
                               partition_chunks=1, **extra)  # fmt: skip
     _same(got.to_arrays(), want)
     # K == N: the same refusal as the local engine's
@@ -187,7 +187,7 @@ def test_per_grasp_friction_whatever_the_last_partition(client, name):
     with pytest.raises(InvalidOptionError, match="ambiguous"):
         batch_force_closure(P3, N3, mu=args[0], **args[1])
     with pytest.raises(InvalidOptionError, match="ambiguous"):
-        evaluate_on_cluster(client, P3, N3, args[0], **args[1])
+        evaluate_on_cluster(client, P3, N3, mu=args[0], **args[1])
 
 
 @pytest.mark.parametrize("bad", [-1, 0, 0.5, True, None])
@@ -254,7 +254,7 @@ def test_a_client_that_is_none_is_refused_at_once(bad):
     # address raised Dask's ValueError, a port out of range waited 30 s.
     P, Nrm, _ = _grasps(6, 4)
     with pytest.raises(InvalidOptionError, match="client must be|scheduler"):
-        evaluate_on_cluster(bad, P, Nrm, 0.5)
+        evaluate_on_cluster(bad, P, Nrm, mu=0.5)
     with pytest.raises(InvalidOptionError, match="client must be|scheduler"):
         analyze_poses(bad, "parallel_jaw_box", np.zeros((1, 9)))
 

@@ -44,7 +44,7 @@ def grasps():
 def test_results_are_bitwise_the_local_engine(client, grasps):
     P, Nrm, mu = grasps
     local = batch_force_closure(P, Nrm, mu=mu, chunk_size=300, workers=1)
-    remote = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=300,
+    remote = evaluate_on_cluster(client, P, Nrm, mu=mu, chunk_size=300,
                                  partition_chunks=3)  # fmt: skip
     for name, a in local.to_arrays().items():
         assert a.tobytes() == remote.to_arrays()[name].tobytes(), name
@@ -53,12 +53,25 @@ def test_results_are_bitwise_the_local_engine(client, grasps):
     assert form.d_star.tobytes() == want.d_star.tobytes()
 
 
+def test_positional_mu_warns_and_means_the_same(client, grasps):
+    """``mu`` is keyword-only after the arrays, as in the batch functions."""
+    from drakegrasp import InvalidOptionError
+
+    P, Nrm, mu = (a[:200] for a in grasps)
+    new = evaluate_on_cluster(client, P, Nrm, mu=mu, chunk_size=100)
+    with pytest.warns(DeprecationWarning, match="mu="):
+        old = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=100)
+    assert old.d_star.tobytes() == new.d_star.tobytes()
+    with pytest.raises(InvalidOptionError, match="both by position"):
+        evaluate_on_cluster(client, P, Nrm, mu, mu=mu)
+
+
 def test_dask_array_input(client, grasps):
     da = pytest.importorskip("dask.array")
     P, Nrm, mu = grasps
     local = batch_force_closure(P, Nrm, mu=0.5, chunk_size=500, workers=1)
     remote = evaluate_on_cluster(client, da.from_array(P, chunks=(1000, 5, 3)),
-                                 da.from_array(Nrm, chunks=(1000, 5, 3)), 0.5,
+                                 da.from_array(Nrm, chunks=(1000, 5, 3)), mu=0.5,
                                  chunk_size=500)  # fmt: skip
     assert remote.d_star.tobytes() == local.d_star.tobytes()
 
@@ -66,7 +79,7 @@ def test_dask_array_input(client, grasps):
 def test_dataset_shards_and_restart(client, grasps, tmp_path):
     P, Nrm, mu = grasps
     out = tmp_path / "ds"
-    paths = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=250,
+    paths = evaluate_on_cluster(client, P, Nrm, mu=mu, chunk_size=250,
                                 partition_chunks=4, output_dir=out)  # fmt: skip
     assert len(paths) == 5 and all(Path(p).exists() for p in paths)
     local = batch_force_closure(P, Nrm, mu=mu, chunk_size=250, workers=1)
@@ -75,7 +88,7 @@ def test_dataset_shards_and_restart(client, grasps, tmp_path):
     # a rerun recomputes only the missing shard
     Path(paths[2]).unlink()
     before = {p: os.stat(p).st_mtime_ns for p in paths if Path(p).exists()}
-    again = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=250,
+    again = evaluate_on_cluster(client, P, Nrm, mu=mu, chunk_size=250,
                                 partition_chunks=4, output_dir=out)  # fmt: skip
     assert again == paths
     assert all(os.stat(p).st_mtime_ns == t for p, t in before.items())
@@ -100,7 +113,7 @@ def test_a_worker_killed_mid_run_loses_and_duplicates_nothing(client, tmp_path):
     t = threading.Thread(target=kill_one, daemon=True)
     t0 = time.perf_counter()
     t.start()
-    paths = evaluate_on_cluster(client, P, Nrm, 0.5, chunk_size=500,
+    paths = evaluate_on_cluster(client, P, Nrm, mu=0.5, chunk_size=500,
                                 partition_chunks=2, output_dir=out)  # fmt: skip
     t.join(timeout=60)
     assert killed, "the worker was not killed during the run"
@@ -131,3 +144,29 @@ def test_plant_scenes_are_built_once_per_worker(client):
     loaded = client.run(cached_scenes)  # every worker loaded it at most once
     assert all(names in ([], [DEFAULT_SCENE]) for names in loaded.values())
     assert any(loaded.values())
+
+
+def test_plant_side_takes_an_options_object(client):
+    """``options=`` replaces the scene's; keywords change whichever is used."""
+    from drakegrasp import AnalysisOptions, InvalidOptionError
+    from drakegrasp.plant.analysis import analyze_grasp
+    from drakegrasp.plant.scene import DEFAULT_SCENE, load_scene
+
+    scene = load_scene(DEFAULT_SCENE)
+    q0 = scene.plant.GetPositions(scene.plant_context)
+    Q = np.repeat(q0[None], 2, axis=0)
+    opts = scene.options.replace(mu=0.2, num_generators=4)
+    want = analyze_grasp(scene.plant, scene.plant_context, scene.object_body,
+                         hand=scene.hand, options=opts)  # fmt: skip
+    got = analyze_poses(client, DEFAULT_SCENE, Q, options=opts)
+    assert got["d_star"].tolist() == [want.force_closure.d_star] * 2
+    again = analyze_poses(
+        client, DEFAULT_SCENE, Q, options=scene.options.replace(mu=0.9), mu=0.2,
+        num_generators=4,
+    )  # fmt: skip
+    assert again["d_star"].tobytes() == got["d_star"].tobytes()
+    # checked before any task is sent
+    with pytest.raises(InvalidOptionError, match="AnalysisOptions"):
+        analyze_poses(client, DEFAULT_SCENE, Q, options={"mu": 0.2})
+    with pytest.raises(InvalidOptionError, match="unknown analysis option"):
+        analyze_poses(client, DEFAULT_SCENE, Q, options=AnalysisOptions(), mew=0.2)

@@ -92,7 +92,7 @@ def dask_case(spec: dict) -> dict:
 
     def remote(P, Nrm, mu, **extra):
         m = None if kind == "form" else mu
-        return evaluate_on_cluster(client, P, Nrm, m, kind=kind, **options, **extra)
+        return evaluate_on_cluster(client, P, Nrm, mu=m, kind=kind, **options, **extra)
 
     dataset = spec["dataset"]
     if dataset is None:
