@@ -102,7 +102,7 @@ def main() -> None:
 
     print("  other metrics (all grasps):")
     row("grasp_singular_values", per_grasp(q.grasp_singular_values, grasps))
-    row("lp2_margin (Drake + Clp)", per_grasp(q.lp2_margin, grasps[:100], repeat=1))
+    row("lp2_d_star (Drake + Clp)", per_grasp(q.lp2_d_star, grasps[:100], repeat=1))
     down = np.array([0.0, 0.0, -1.0, 0.0, 0.0, 0.0])
     row(
         "max_resistible_wrench (Drake + Clp)",

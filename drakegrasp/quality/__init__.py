@@ -18,7 +18,7 @@ The metrics:
 
 * :func:`ferrari_canny`: the Ferrari–Canny ε (L1 form with a Qhull hull, L∞
   form through the normal fan of a Minkowski sum);
-* :func:`lp2_margin`: the ``d*`` of the force-closure program LP2, the
+* :func:`lp2_d_star`: the ``d*`` of the force-closure program LP2, the
   geometric distance of the best internal force (no load) to the cones'
   boundaries; it does not measure the load a grasp carries (that is
   :func:`grasp_forces` and :func:`max_load`);
@@ -79,7 +79,12 @@ from drakegrasp.quality.resistible import (
     build_max_resistible_wrench_program,
     max_resistible_wrench,
 )
-from drakegrasp.quality.summary import GraspQuality, grasp_quality, lp2_margin
+from drakegrasp.quality.summary import (
+    GraspQuality,
+    grasp_quality,
+    lp2_d_star,
+    lp2_margin,
+)
 
 __all__ = [
     "HULL_TOL",
@@ -103,6 +108,7 @@ __all__ = [
     "hand_object_matrix",
     "hand_object_singular_values",
     "isotropy",
+    "lp2_d_star",
     "lp2_margin",
     "manipulability_volume",
     "max_load",

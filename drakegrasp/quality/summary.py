@@ -1,4 +1,4 @@
-r"""All quality metrics of a grasp at once, and the LP2 margin."""
+r"""All quality metrics of a grasp at once, and LP2's ``d*`` as a metric."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.deprecation import warn_deprecated
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.tolerances import DEFAULT_TOL
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
 from drakegrasp.core.validation import check_flag
 from drakegrasp.quality._common import _check_grasp, _torque_scale
 from drakegrasp.quality.epsilon import ferrari_canny
@@ -19,10 +19,10 @@ from drakegrasp.quality.indices import (
     hand_object_singular_values,
 )
 
-__all__ = ["GraspQuality", "grasp_quality", "lp2_margin"]
+__all__ = ["GraspQuality", "grasp_quality", "lp2_d_star", "lp2_margin"]
 
 
-def lp2_margin(
+def lp2_d_star(
     grasp: Grasp,
     *,
     num_generators: int = DEFAULT_NUM_GENERATORS,
@@ -65,6 +65,23 @@ def lp2_margin(
     return d if math.isfinite(d) else 0.0
 
 
+def lp2_margin(
+    grasp: Grasp,
+    *,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    tol: float = DEFAULT_TOL,
+) -> float:
+    """Deprecated name of :func:`lp2_d_star` (it returns ``d*``, not a margin).
+
+    Elsewhere a margin is ``(d* - tol) / tol`` (``ClosureResult.margin``).
+    """
+    warn_deprecated(
+        "lp2_margin is deprecated; use lp2_d_star (it returns LP2's d*, while a "
+        "result's margin is (d* - tol) / tol)"
+    )
+    return lp2_d_star(grasp, num_generators=num_generators, tol=tol)
+
+
 @dataclass(frozen=True)
 class GraspQuality:
     """All quality metrics of one grasp (see the functions named in each field).
@@ -75,8 +92,8 @@ class GraspQuality:
         :func:`ferrari_canny` with ``norm="L1"``.
     ferrari_canny_linf : float or None
         :func:`ferrari_canny` with ``norm="Linf"`` (None when not computed).
-    lp2_margin : float
-        :func:`lp2_margin`, LP2's ``d*``.
+    lp2_d_star : float
+        :func:`lp2_d_star`, LP2's ``d*`` (``lp2_margin``: its deprecated name).
     is_force_closure : bool
         Frictional force closure on the polyhedral cones: ``rank(G)`` full and
         ``d* > tol`` (and, with a hand Jacobian, LP3 passes).
@@ -100,7 +117,7 @@ class GraspQuality:
 
     ferrari_canny_l1: float
     ferrari_canny_linf: float | None
-    lp2_margin: float
+    lp2_d_star: float
     is_force_closure: bool
     singular_values: np.ndarray
     min_singular_value: float
@@ -114,6 +131,12 @@ class GraspQuality:
     uniformity_of_transformation: float | None = field(default=None)
     manipulability_volume: float | None = field(default=None)
 
+    @property
+    def lp2_margin(self) -> float:
+        """Deprecated name of :attr:`lp2_d_star`."""
+        warn_deprecated("GraspQuality.lp2_margin is deprecated; use lp2_d_star")
+        return self.lp2_d_star
+
     def to_dict(self) -> dict:
         """JSON-ready dictionary (non-finite numbers become ``None``)."""
         return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
@@ -126,7 +149,7 @@ class GraspQuality:
             f"grasp quality ({self.num_generators} generators, torque scale "
             f"{self.torque_scale:g} m)",
             f"  force closure: {'YES' if self.is_force_closure else 'no'}, "
-            f"LP2 d* = {self.lp2_margin:.6g}",
+            f"LP2 d* = {self.lp2_d_star:.6g}",
             f"  Ferrari-Canny eps: L1 {fmt(self.ferrari_canny_l1)}, "
             f"Linf {fmt(self.ferrari_canny_linf)}",
             f"  G: sigma_min {self.min_singular_value:.6g}, isotropy "
@@ -209,7 +232,7 @@ def grasp_quality(
             if linf or (linf is None and (grasp.planar or grasp.num_contacts <= 3))
             else None
         ),
-        lp2_margin=d_star if math.isfinite(d_star) else 0.0,
+        lp2_d_star=d_star if math.isfinite(d_star) else 0.0,
         is_force_closure=bool(closure.is_closure),
         singular_values=s,
         min_singular_value=float(s[-1]),

@@ -373,7 +373,7 @@ def _functions_of_a_grasp():
         "internal_forces": lambda g, **k: dg.internal_forces(g, J, **k),
         "ferrari_canny": lambda g, **k: dg.ferrari_canny(g, **k),
         "ferrari_canny_linf": lambda g, **k: dg.ferrari_canny(g, norm="Linf", **k),
-        "lp2_margin": lambda g, **k: dg.lp2_margin(g, **k),
+        "lp2_d_star": lambda g, **k: dg.lp2_d_star(g, **k),
         "grasp_quality": lambda g, **k: dg.grasp_quality(g, **k),
         "grasp_singular_values": lambda g, **k: dg.grasp_singular_values(g, **k),
         "min_singular_value": lambda g, **k: dg.min_singular_value(g, **k),

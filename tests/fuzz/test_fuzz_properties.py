@@ -114,7 +114,7 @@ def test_coefficients_in_range_or_refused(mu, nu):
     ),
     option=st.sampled_from(["tol", "rank_tol", "num_generators"]),
     fn=st.sampled_from(
-        [dg.force_closure, dg.form_closure, dg.force_closure_exact, dg.lp2_margin]
+        [dg.force_closure, dg.form_closure, dg.force_closure_exact, dg.lp2_d_star]
     ),
 )
 def test_options_refused_or_answered_in_range(value, option, fn):

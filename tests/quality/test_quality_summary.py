@@ -1,4 +1,4 @@
-"""GraspQuality / grasp_quality and the LP2 margin."""
+"""GraspQuality / grasp_quality and LP2's d* as a metric."""
 
 import json
 
@@ -14,6 +14,7 @@ from drakegrasp.quality import (
     grasp_quality,
     grasp_singular_values,
     hand_object_singular_values,
+    lp2_d_star,
     lp2_margin,
 )
 
@@ -50,17 +51,17 @@ def _lp2_by_linprog(grasp, n_g=8):
     return res.x[-1]
 
 
-def test_lp2_margin_against_scipy(helpers, rng):
+def test_lp2_d_star_against_scipy(helpers, rng):
     grasps = [helpers.equator_grasp(0.5)] + [
         helpers.random_grasp(rng, 3, 3, mu=0.6, spread=0.3) for _ in range(4)
     ]
     for g in grasps:
-        assert lp2_margin(g) == pytest.approx(_lp2_by_linprog(g), abs=1e-7)
+        assert lp2_d_star(g) == pytest.approx(_lp2_by_linprog(g), abs=1e-7)
 
 
-def test_lp2_margin_grows_with_mu(helpers):
+def test_lp2_d_star_grows_with_mu(helpers):
     g = helpers.equator_grasp(0.5)
-    values = [lp2_margin(g.with_friction(mu)) for mu in (0.0, 0.2, 0.5, 1.0)]
+    values = [lp2_d_star(g.with_friction(mu)) for mu in (0.0, 0.2, 0.5, 1.0)]
     # μ = 0: frictionless, LP2 is LP1, and the three normals balance with
     # f_n = 1 each, so d* = 1.  For μ > 0, d* is the distance to the cone
     # boundaries (0 at μ -> 0+) and grows with μ.
@@ -74,7 +75,7 @@ def test_summary_matches_individual_metrics(helpers):
     assert isinstance(q, GraspQuality)
     assert q.ferrari_canny_l1 == pytest.approx(ferrari_canny(g))
     assert q.ferrari_canny_linf == pytest.approx(ferrari_canny(g, norm="Linf"))
-    assert q.lp2_margin == pytest.approx(force_closure(g).d_star)
+    assert q.lp2_d_star == pytest.approx(force_closure(g).d_star)
     assert q.is_force_closure
     assert np.allclose(q.singular_values, grasp_singular_values(g))
     assert q.min_singular_value == pytest.approx(np.sqrt(1.5))
@@ -124,4 +125,16 @@ def test_summary_bad_inputs(helpers):
     with pytest.raises(dg.InvalidOptionError, match="torque_scale"):
         grasp_quality(g, torque_scale=0.0)
     with pytest.raises(dg.InvalidGraspError):
-        lp2_margin("not a grasp")
+        lp2_d_star("not a grasp")
+
+
+def test_lp2_margin_is_a_warning_name_of_lp2_d_star(helpers):
+    """It returns ``d*``, while a result's ``margin`` is ``(d* - tol) / tol``."""
+    g = helpers.equator_grasp(0.5)
+    q = grasp_quality(g)
+    with pytest.warns(DeprecationWarning, match="lp2_d_star"):
+        assert lp2_margin(g) == lp2_d_star(g) == q.lp2_d_star
+    with pytest.warns(DeprecationWarning, match="lp2_d_star"):
+        assert q.lp2_margin == q.lp2_d_star
+    assert "lp2_d_star" in q.to_dict() and "lp2_margin" not in q.to_dict()
+    assert q.lp2_d_star != force_closure(g).margin
