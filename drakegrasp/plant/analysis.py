@@ -33,10 +33,9 @@ from drakegrasp.closure.verdicts import (
 from drakegrasp.core.antipodal import AntipodalResult, is_antipodal
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deferred import defer, deferrable
-from drakegrasp.core.friction_cone import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.tolerances import DEFAULT_TOL
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
 from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import GraspError, InvalidOptionError, NoContactsError
 from drakegrasp.plant.contacts import (
@@ -61,9 +60,9 @@ from drakegrasp.plant.options import AnalysisOptions, resolve_options
 from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.pose import check_pose as _check_pose
 from drakegrasp.plant.validation import (
+    checked_context,
     hand_contact_bodies,
     hand_model_instances,
-    plant_context_of,
 )
 
 __all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
@@ -281,84 +280,90 @@ def grasp_from_plant(
         patches=patches,
         check_pose=check_pose,
     ).require_friction()
-    plant_context = plant_context_of(plant, plant_context)
-    plane, model = opts.plane, opts.contact_model
-    distance_tolerance, allow_penetration = (
-        opts.distance_tolerance,
-        opts.allow_penetration,
-    )
-    check_pose = opts.check_pose
-    torsional_friction = opts.torsional_friction or 0.0
-    body = resolve_object_body(plant, object_body)
-    bodies = hand_contact_bodies(plant, body, hand)
-    couplings = plant_couplings(plant, couplings)
-    pose = _pose_of(
-        plant,
-        plant_context,
-        body,
-        bodies,
-        distance_tolerance=distance_tolerance,
-        refuse=check_pose,
-        allow_penetration=allow_penetration,
-        query_object=query_object,
-    )
-    if contacts is None:
-        contacts = find_contacts(
+    with checked_context(plant, plant_context) as plant_context:
+        plane, model = opts.plane, opts.contact_model
+        distance_tolerance, allow_penetration = (
+            opts.distance_tolerance,
+            opts.allow_penetration,
+        )
+        check_pose = opts.check_pose
+        torsional_friction = opts.torsional_friction or 0.0
+        body = resolve_object_body(plant, object_body)
+        bodies = hand_contact_bodies(plant, body, hand)
+        couplings = plant_couplings(plant, couplings)
+        pose = _pose_of(
             plant,
             plant_context,
-            object_body=body,
-            hand=bodies,
+            body,
+            bodies,
             distance_tolerance=distance_tolerance,
-            allow_penetration=allow_penetration or not check_pose,
-            patches=opts.patches,
+            refuse=check_pose,
+            allow_penetration=allow_penetration,
             query_object=query_object,
         )
-    elif not contacts:
-        raise NoContactsError(f"no contacts given for {_scoped_name(plant, body)!r}")
-    if opts.mu == "plant":
-        from drakegrasp.plant.friction import plant_friction
+        if contacts is None:
+            contacts = find_contacts(
+                plant,
+                plant_context,
+                object_body=body,
+                hand=bodies,
+                distance_tolerance=distance_tolerance,
+                allow_penetration=allow_penetration or not check_pose,
+                patches=opts.patches,
+                query_object=query_object,
+            )
+        elif not contacts:
+            raise NoContactsError(
+                f"no contacts given for {_scoped_name(plant, body)!r}"
+            )
+        if opts.mu == "plant":
+            from drakegrasp.plant.friction import plant_friction
 
-        mus = plant_friction(plant, plant_context, contacts, query_object=query_object)
-    else:
-        mus = [opts.mu] * len(contacts)
-    core = [
-        _core_contact(
-            c, plane=plane, mu=m, model=model, torsional_friction=torsional_friction
+            mus = plant_friction(
+                plant, plant_context, contacts, query_object=query_object
+            )
+        else:
+            mus = [opts.mu] * len(contacts)
+        core = [
+            _core_contact(
+                c, plane=plane, mu=m, model=model, torsional_friction=torsional_friction
+            )
+            for c, m in zip(contacts, mus, strict=True)
+        ]
+        dim = 2 if plane is not None else 3
+        grasp = Grasp(
+            core,
+            reference_point=np.zeros(dim),
+            characteristic_length=opts.characteristic_length,
         )
-        for c, m in zip(contacts, mus, strict=True)
-    ]
-    dim = 2 if plane is not None else 3
-    grasp = Grasp(
-        core,
-        reference_point=np.zeros(dim),
-        characteristic_length=opts.characteristic_length,
-    )
-    indices = hand_velocity_indices(plant, bodies)
-    J = hand_jacobian(
-        plant,
-        plant_context,
-        contacts,
-        grasp,
-        object_body=body,
-        velocity_indices=indices,
-        plane=plane,
-    )
-    C, indices = coupling_map(plant, indices, couplings)
-    J = J @ C
-    dpsi = signed_distance_jacobian(plant, plant_context, contacts, object_body=body)
-    return GraspFromPlant(
-        grasp=grasp,
-        contacts=tuple(contacts),
-        hand_jacobian=J,
-        hand_velocity_indices=indices,
-        psi=np.array([c.psi for c in contacts]),
-        dpsi_dv=dpsi,
-        object_body=_scoped_name(plant, body),
-        hand_bodies=tuple(_scoped_name(plant, b) for b in bodies),
-        plane=plane,
-        pose=pose,
-        couplings=couplings,
-    )
+        indices = hand_velocity_indices(plant, bodies)
+        J = hand_jacobian(
+            plant,
+            plant_context,
+            contacts,
+            grasp,
+            object_body=body,
+            velocity_indices=indices,
+            plane=plane,
+        )
+        C, indices = coupling_map(plant, indices, couplings)
+        J = J @ C
+        dpsi = signed_distance_jacobian(
+            plant, plant_context, contacts, object_body=body
+        )
+        return GraspFromPlant(
+            grasp=grasp,
+            contacts=tuple(contacts),
+            hand_jacobian=J,
+            hand_velocity_indices=indices,
+            psi=np.array([c.psi for c in contacts]),
+            dpsi_dv=dpsi,
+            object_body=_scoped_name(plant, body),
+            hand_bodies=tuple(_scoped_name(plant, b) for b in bodies),
+            plane=plane,
+            pose=pose,
+            couplings=couplings,
+        )
 
 
 def _pose_of(
@@ -630,62 +635,65 @@ def analyze_grasp(
         load=load,
         torque_limits=torque_limits,
     ).require_friction()
-    data = grasp_from_plant(
-        plant,
-        plant_context,
-        object_body=object_body,
-        hand=hand,
-        options=opts.replace(mu=1.0) if opts.mu == "plant" else opts,
-        query_object=query_object,
-        contacts=contacts,
-        couplings=couplings,
-    )
-    data, load_report = load_section(
-        plant,
-        plant_context,
-        data,
-        mu=opts.mu,
-        load=None if opts.load is None else _as_load(opts.load),
-        torque_limits=None
-        if opts.torque_limits is None
-        else _as_load(opts.torque_limits),
-        query_object=query_object,
-    )
-    tol, num_generators = opts.tol, opts.num_generators
-    grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)
-    if grasp.num_contacts == 2:
-        antipodal = is_antipodal(grasp)
-    else:
-        antipodal = finger_antipodal(
+    with checked_context(plant, plant_context) as plant_context:
+        data = grasp_from_plant(
             plant,
-            data.contacts,
-            grasp,
-            hand_contact_bodies(plant, resolve_object_body(plant, object_body), hand),
+            plant_context,
+            object_body=object_body,
+            hand=hand,
+            options=opts.replace(mu=1.0) if opts.mu == "plant" else opts,
+            query_object=query_object,
+            contacts=contacts,
+            couplings=couplings,
         )
-    first_order = form_closure(grasp, tol=tol)
-    polyhedral = force_closure(grasp, num_generators=num_generators, tol=tol)
-    exact = force_closure_exact(grasp, tol=tol)
-    # One LP3 serves both verdicts: it depends on G and J, not on the cones.
-    # Without frictional closure neither verdict needs it: solved when read.
-    if polyhedral.frictional_closure or exact.frictional_closure:
-        lp3 = internal_forces(grasp, J, tol=tol)
-    else:
-        check_hand_jacobian(grasp, J)
-        lp3 = defer(internal_forces, grasp, J, tol=tol)
-    return GraspReport(
-        data=data,
-        G=grasp_matrix(grasp),
-        form_closure=first_order,
-        force_closure=with_internal_forces(polyhedral, lp3),
-        force_closure_exact=with_internal_forces(exact, lp3),
-        antipodal=antipodal,
-        pose=data.pose,
-        second_order=None
-        if first_order.is_closure
-        else _second_order(plant, plant_context, data, first_order, query_object),
-        load=load_report,
-        options=opts,
-    )
+        data, load_report = load_section(
+            plant,
+            plant_context,
+            data,
+            mu=opts.mu,
+            load=None if opts.load is None else _as_load(opts.load),
+            torque_limits=None
+            if opts.torque_limits is None
+            else _as_load(opts.torque_limits),
+            query_object=query_object,
+        )
+        tol, num_generators = opts.tol, opts.num_generators
+        grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)
+        if grasp.num_contacts == 2:
+            antipodal = is_antipodal(grasp)
+        else:
+            antipodal = finger_antipodal(
+                plant,
+                data.contacts,
+                grasp,
+                hand_contact_bodies(
+                    plant, resolve_object_body(plant, object_body), hand
+                ),
+            )
+        first_order = form_closure(grasp, tol=tol)
+        polyhedral = force_closure(grasp, num_generators=num_generators, tol=tol)
+        exact = force_closure_exact(grasp, tol=tol)
+        # One LP3 serves both verdicts: it depends on G and J, not on the cones.
+        # Without frictional closure neither verdict needs it: solved when read.
+        if polyhedral.frictional_closure or exact.frictional_closure:
+            lp3 = internal_forces(grasp, J, tol=tol)
+        else:
+            check_hand_jacobian(grasp, J)
+            lp3 = defer(internal_forces, grasp, J, tol=tol)
+        return GraspReport(
+            data=data,
+            G=grasp_matrix(grasp),
+            form_closure=first_order,
+            force_closure=with_internal_forces(polyhedral, lp3),
+            force_closure_exact=with_internal_forces(exact, lp3),
+            antipodal=antipodal,
+            pose=data.pose,
+            second_order=None
+            if first_order.is_closure
+            else _second_order(plant, plant_context, data, first_order, query_object),
+            load=load_report,
+            options=opts,
+        )
 
 
 def _as_load(value):

@@ -16,8 +16,10 @@ by keyword; every option after it is keyword-only.
 
 from __future__ import annotations
 
+import contextlib
 import reprlib
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextvars import ContextVar
 
 import numpy as np
 from pydrake.math import RigidTransform
@@ -33,6 +35,7 @@ __all__ = [
     "ROTATION_TOL",
     "HandSpec",
     "check_plant",
+    "checked_context",
     "check_rigid_transform",
     "hand_bodies",
     "hand_contact_bodies",
@@ -51,6 +54,11 @@ HandSpec = ModelInstanceIndex | str | Iterable[RigidBody] | None
 
 ROTATION_TOL = 1e-6
 """Largest entry of ``RᵀR − I`` of a pose's rotation (a proper rotation)."""
+
+_CHECKED: ContextVar[tuple[MultibodyPlant, Context] | None] = ContextVar(
+    "drakegrasp_checked_context", default=None
+)
+"""The (plant, plant context) pair that :func:`checked_context` has checked."""
 
 _TOPOLOGY = WeakMemo()
 """Per finalized plant: answers that depend on its bodies, welds and instances."""
@@ -159,6 +167,9 @@ def plant_context_of(plant, context) -> Context:
     InvalidContextError
         If ``context`` is not a Context, or belongs to another system.
     """
+    checked = _CHECKED.get()
+    if checked is not None and checked[0] is plant and checked[1] is context:
+        return context
     check_plant(plant)
     if not isinstance(context, Context):
         raise InvalidContextError(
@@ -181,6 +192,36 @@ def plant_context_of(plant, context) -> Context:
             f"holds it (pass plant.GetMyContextFromRoot(root) or the root); "
             f"Drake says: {msg}"
         ) from None
+
+
+@contextlib.contextmanager
+def checked_context(plant: MultibodyPlant, context: Context) -> Iterator[Context]:
+    """Check ``plant`` and ``context`` once for every step of one analysis.
+
+    Inside the ``with`` block, :func:`plant_context_of` returns the checked
+    plant context at once when given it again with the same plant (the
+    contacts, Jacobians, friction and curvatures of one
+    :func:`~drakegrasp.analyze_grasp` call each ask for it).  Any other plant
+    or context is checked as usual.  The pair is held in a ``ContextVar``: other
+    threads and tasks do not see it.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    context : Context
+        The plant's context or its diagram's root context.
+
+    Yields
+    ------
+    Context
+        The plant's context (:func:`plant_context_of`).
+    """
+    plant_context = plant_context_of(plant, context)
+    token = _CHECKED.set((plant, plant_context))
+    try:
+        yield plant_context
+    finally:
+        _CHECKED.reset(token)
 
 
 def query_object_of(plant: MultibodyPlant, plant_context: Context):
