@@ -56,7 +56,7 @@ VERDICT_STATUSES = (
 def _available(kind: str) -> list:
     try:
         order = _ORDER[kind]
-    except KeyError:
+    except (KeyError, TypeError):  # TypeError: an unhashable kind, e.g. a list
         raise InvalidOptionError(
             f"solver kind must be one of {KINDS}, got {kind!r}"
         ) from None
