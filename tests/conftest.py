@@ -101,6 +101,25 @@ def local_drake_models_or_none() -> Path | None:
     return local_drake_models()
 
 
+# -- seeded random grasps (core, closure and certificate tests) ---------------------
+
+
+@pytest.fixture
+def rng():
+    """A seeded generator, the same sequence in every test that asks for it."""
+    import numpy as np
+
+    return np.random.default_rng(20261122)
+
+
+@pytest.fixture
+def make_contacts():
+    """The function ``random_grasps.random_inward_contacts`` (tests/support)."""
+    from random_grasps import random_inward_contacts
+
+    return random_inward_contacts
+
+
 # -- the tutorials, executed once ---------------------------------------------------
 
 TUTORIALS = ROOT / "tutorials"

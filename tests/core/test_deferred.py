@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from random_grasps import random_inward_contacts
 
 import drakegrasp as dg
 from drakegrasp.closure.results import ClosureResult
@@ -23,8 +24,6 @@ from drakegrasp.core.deferred import (
     replace,
     resolve,
 )
-
-from .conftest import random_inward_contacts
 
 SETTINGS = settings(
     max_examples=30,

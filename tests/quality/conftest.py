@@ -94,11 +94,6 @@ def moved_grasp(grasp, R, t):
 
 
 @pytest.fixture
-def rng():
-    return np.random.default_rng(20261122)
-
-
-@pytest.fixture
 def helpers():
     """The builders above (fixtures are how test files share them)."""
 

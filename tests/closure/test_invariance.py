@@ -10,11 +10,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from random_grasps import random_inward_contacts
 
 import drakegrasp as dg
 from drakegrasp.core import examples as ex
-
-from .conftest import random_inward_contacts
 
 SETTINGS = settings(
     max_examples=30,
