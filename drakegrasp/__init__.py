@@ -26,6 +26,7 @@ _SOURCES = {
     "drakegrasp.core.antipodal": ("AntipodalResult", "is_antipodal"),
     "drakegrasp.batch": (
         "BatchClosureResult",
+        "BatchOptions",
         "batch_epsilon_l1",
         "batch_force_closure",
         "batch_form_closure",
@@ -195,6 +196,7 @@ __all__ = [
     "AntipodalResult",
     "BatchClosureResult",
     "BatchFileError",
+    "BatchOptions",
     "ClosureResult",
     "Contact",
     "ContactCurvature",

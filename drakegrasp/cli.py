@@ -230,6 +230,18 @@ def _cmd_batch(args: argparse.Namespace) -> int:
                 f"{args.contact_model} disagree; give --contact-model only"
             )
     model = args.contact_model or args.deprecated_model or "hard_finger"
+    from drakegrasp.batch.options import BatchOptions
+
+    # the engine's choices, checked here once (one line on stderr if bad)
+    engine = BatchOptions(
+        contact_model=model,
+        num_generators=args.num_generators,
+        tol=args.tol,
+        chunk_size=args.chunk_size,
+        progress=args.progress,
+        metrics=tuple(args.metrics),
+        workers=args.workers,
+    )
     options = {
         "kind": args.kind,
         "mu": args.mu,
@@ -274,7 +286,14 @@ def _cmd_batch(args: argparse.Namespace) -> int:
         if args.progress:
             _check_progress()
         summary = stream_file(
-            args.input, args.output, overwrite=args.overwrite, **options
+            args.input,
+            args.output,
+            kind=args.kind,
+            mu=args.mu,
+            torsional_friction=args.torsional_friction,
+            fmt=args.format,
+            overwrite=args.overwrite,
+            options=engine,
         )
     print(summary)
     print(f"wrote {printable(args.output)}")

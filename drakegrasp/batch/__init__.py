@@ -10,7 +10,8 @@ chunks lazily; :func:`evaluate_file` and :func:`stream_file` run them on a file
 The folder reads as the pipeline, one stage per room:
 
 * :mod:`~drakegrasp.batch.api`: the public functions and
-  :class:`BatchClosureResult`;
+  :class:`BatchClosureResult`; :mod:`~drakegrasp.batch.options`: their
+  options as one object, :class:`BatchOptions`;
 * :mod:`~drakegrasp.batch.inputs`: arrays and options checked, once, and the
   kernel choice resolved; :mod:`~drakegrasp.batch.ragged`: grasps with
   different numbers of contacts grouped by count;
@@ -42,11 +43,13 @@ from drakegrasp.batch.files.driver import evaluate_file, stream_file, write_resu
 from drakegrasp.batch.files.reader import read_grasps
 from drakegrasp.batch.files.writer import BatchSummary, write_chunks
 from drakegrasp.batch.loads import batch_grasp_forces
+from drakegrasp.batch.options import BatchOptions
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
     "METRICS",
     "BatchClosureResult",
+    "BatchOptions",
     "BatchSummary",
     "batch_epsilon_l1",
     "batch_force_closure",

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drakegrasp.batch.inputs import METRICS, shape_of
+from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_task, form_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
@@ -243,6 +244,7 @@ def form_chunks(
 
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
+@takes_batch_options
 def stream_force_closure(
     positions,
     normals,
@@ -276,6 +278,7 @@ def stream_force_closure(
     return chunks
 
 
+@takes_batch_options
 def stream_form_closure(
     positions,
     normals,
@@ -304,6 +307,7 @@ def stream_form_closure(
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
 @accepts_ragged(merge_results)
+@takes_batch_options
 def batch_force_closure(
     positions: np.ndarray,
     normals: np.ndarray,
@@ -415,6 +419,7 @@ def batch_force_closure(
 
 
 @accepts_ragged(merge_results)
+@takes_batch_options
 def batch_form_closure(
     positions: np.ndarray,
     normals: np.ndarray,

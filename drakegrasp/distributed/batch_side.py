@@ -36,9 +36,11 @@ from drakegrasp.batch.inputs import (
     positive_int,
     shape_of,
 )
+from drakegrasp.batch.options import FRICTION_OPTIONS, OPTION_NAMES, BatchOptions
 from drakegrasp.batch.run.stream import chunk_size_for
+from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only
-from drakegrasp.core.tolerances import DEFAULT_TOL
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.distributed.client import connected
 from drakegrasp.distributed.dataset import (
@@ -114,7 +116,8 @@ def evaluate_on_cluster(
     overwrite: bool = False,
     partition_chunks: int = 4,
     chunk_size: int | None = None,
-    **options,
+    options: BatchOptions | None = None,
+    **keywords,
 ):
     """Decide closure for ``K`` grasps on a Dask cluster.
 
@@ -143,7 +146,11 @@ def evaluate_on_cluster(
         Engine chunks per partition (an integer >= 1, default 4).
     chunk_size : int, optional
         The engine's chunk size (default: sized by bytes, as locally).
-    **options
+    options : BatchOptions, optional
+        The engine's options as one object, instead of their keywords (its
+        ``workers`` and ``progress`` must stay at their defaults: the
+        cluster's workers are the parallelism).
+    **keywords
         The other keyword options of :func:`drakegrasp.batch_force_closure`
         (or :func:`~drakegrasp.batch_form_closure`), e.g. ``contact_model``, ``tol``,
         ``torsional_friction``, ``reference_points``.
@@ -163,6 +170,7 @@ def evaluate_on_cluster(
     """
     if kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
+    options, chunk_size = _engine_options(options, keywords, kind, chunk_size)
     if kind == "force" and mu is None:
         raise InvalidOptionError("force closure needs mu")
     reserved = sorted(set(_RESERVED) & set(options))
@@ -181,7 +189,9 @@ def evaluate_on_cluster(
     # the local engine's chunks (same n_g and K), so partitions align with them
     n_g = 1
     if kind == "force":
-        n_g = check_num_generators(options.get("num_generators", 8))
+        n_g = check_num_generators(
+            options.get("num_generators", DEFAULT_NUM_GENERATORS)
+        )
     size = chunk_size_for(N, d, chunk_size, n_g, K)
     step = size * per_partition
     arrays = {k: options.pop(k) for k in _ARRAY_OPTIONS if k in options}
@@ -226,6 +236,43 @@ def evaluate_on_cluster(
     tol = float(options.get("tol", DEFAULT_TOL))
     names = check_metrics(options.get("metrics", ()))
     return collect(K, d, kind, tol, names, chunks)
+
+
+def _engine_options(
+    options: BatchOptions | None, keywords: dict, kind: str, chunk_size
+) -> tuple[dict, int | None]:
+    """The engine's keywords of a cluster run: ``keywords``, or ``options``'s.
+
+    Only the options that differ from :class:`BatchOptions`'s defaults are
+    passed on, as if given as keywords (a job's fingerprint does not change
+    with the way its options were given); form closure drops the friction
+    options.  ``workers`` and ``progress`` other than their defaults are
+    refused by the caller, as keywords are.
+    """
+    if options is None:
+        return keywords, chunk_size
+    if not isinstance(options, BatchOptions):
+        raise InvalidOptionError(
+            f"options must be a drakegrasp.BatchOptions, got {type(options).__name__}"
+        )
+    given = set(keywords) | ({"chunk_size"} if chunk_size is not None else set())
+    both = sorted(set(OPTION_NAMES) & given)
+    if both:
+        raise InvalidOptionError(
+            f"{both} given both as keywords and in options; give each option one way"
+        )
+    merged = dict(keywords)
+    default = BatchOptions()
+    for name, value in options.keywords().items():
+        if value == getattr(default, name):
+            continue
+        if kind == "form" and name in FRICTION_OPTIONS:
+            continue
+        if name == "chunk_size":
+            chunk_size = value
+            continue
+        merged[name] = value.value if isinstance(value, ContactModel) else value
+    return merged, chunk_size
 
 
 def stream_file_on_cluster(

@@ -170,3 +170,32 @@ def test_plant_side_takes_an_options_object(client):
         analyze_poses(client, DEFAULT_SCENE, Q, options={"mu": 0.2})
     with pytest.raises(InvalidOptionError, match="unknown analysis option"):
         analyze_poses(client, DEFAULT_SCENE, Q, options=AnalysisOptions(), mew=0.2)
+
+
+def test_batch_side_takes_a_batch_options(client, grasps, tmp_path):
+    """Bitwise the keywords' run, and the same job (a rerun resumes it)."""
+    from drakegrasp import BatchOptions, InvalidOptionError
+
+    P, Nrm, mu = (a[:300] for a in grasps)
+    opts = BatchOptions(tol=1e-5, metrics=("sigma_min",), chunk_size=100)
+    a = evaluate_on_cluster(client, P, Nrm, mu=mu, options=opts)
+    b = evaluate_on_cluster(client, P, Nrm, mu=mu, tol=1e-5,
+                            metrics=("sigma_min",), chunk_size=100)  # fmt: skip
+    for name, x in a.to_arrays().items():
+        assert x.tobytes() == b.to_arrays()[name].tobytes(), name
+    out = tmp_path / "ds"
+    first = evaluate_on_cluster(client, P, Nrm, mu=mu, options=opts, output_dir=out)
+    again = evaluate_on_cluster(client, P, Nrm, mu=mu, tol=1e-5, output_dir=out,
+                                metrics=("sigma_min",), chunk_size=100)  # fmt: skip
+    assert again == first  # the keywords' job is the options' job
+    form = evaluate_on_cluster(client, P, Nrm, kind="form", options=opts)
+    assert (
+        form.d_star.tobytes()
+        == batch_form_closure(
+            P, Nrm, tol=1e-5, metrics=("sigma_min",), chunk_size=100, workers=1
+        ).d_star.tobytes()
+    )
+    with pytest.raises(InvalidOptionError, match="cannot be given on a cluster"):
+        evaluate_on_cluster(client, P, Nrm, mu=mu, options=opts.replace(workers=2))
+    with pytest.raises(InvalidOptionError, match="given both"):
+        evaluate_on_cluster(client, P, Nrm, mu=mu, options=opts, chunk_size=50)

@@ -39,6 +39,7 @@ import numpy as np
 
 from drakegrasp.batch.build.construction import batched_characteristic_lengths
 from drakegrasp.batch.metrics import epsilon_l1_batch
+from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
@@ -72,6 +73,7 @@ def _merge_epsilon(K: int, _dim: int, parts) -> np.ndarray:
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
 @accepts_ragged(_merge_epsilon)
+@takes_batch_options
 def batch_epsilon_l1(
     positions: np.ndarray,
     normals: np.ndarray,

@@ -35,6 +35,7 @@ from drakegrasp.batch.files.writer import (
     write_chunks,
 )
 from drakegrasp.batch.inputs import shape_of
+from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
@@ -87,6 +88,7 @@ def _file_run(
 
 
 @renamed_keyword("model", "contact_model")
+@takes_batch_options
 def evaluate_file(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
@@ -151,6 +153,7 @@ def evaluate_file(
 
 
 @renamed_keyword("model", "contact_model")
+@takes_batch_options
 def stream_file(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
