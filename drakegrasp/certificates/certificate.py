@@ -75,6 +75,7 @@ from drakegrasp.core.grasp import (
     grasp_matrix,
     invariant_grasp_matrix,
 )
+from drakegrasp.core.linalg import equilibrated
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_RANK_TOL
 from drakegrasp.errors import InvalidOptionError
@@ -396,9 +397,8 @@ def _check_balance(cert: ReadWitness, grasp: Grasp):
     if not total > 0.0:
         return np.inf, 0.0, "the internal force is zero"
     inside = _cone_slack(grasp, cert, forces).min() / total
-    A = invariant_grasp_matrix(grasp)[:, cols]
-    norms = np.linalg.norm(A, axis=0)
-    s = np.linalg.svd(A / np.where(norms > 0, norms, 1.0), compute_uv=False)
+    A_s, _ = equilibrated(invariant_grasp_matrix(grasp)[:, cols])
+    s = np.linalg.svd(A_s, compute_uv=False)
     ratio = s[-1] / s[0] if s.size >= grasp.wrench_dim else 0.0
     rank_short = 0.0 if ratio > DEFAULT_RANK_TOL else 1.0
     violation = max(_relative_residual(G, f), max(0.0, -inside), rank_short)

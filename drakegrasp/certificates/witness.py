@@ -47,7 +47,7 @@ from drakegrasp.certificates.certificate import (
 )
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp, grasp_matrix, invariant_grasp_matrix
-from drakegrasp.core.linalg import left_null_space
+from drakegrasp.core.linalg import equilibrated, left_null_space
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import safe_norm
 
@@ -409,11 +409,9 @@ def balance_certificate(
         cols = grasp.normal_indices()
     else:
         cols = ConeLayout.of(grasp, num_generators).columns
-    A = invariant_grasp_matrix(grasp)[:, cols]
-    norms = np.linalg.norm(A, axis=0)
-    scale = np.where(norms > 0.0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
+    A_s, scale = equilibrated(invariant_grasp_matrix(grasp)[:, cols])
     # N(A) = D N(A D): the null space of the equilibrated matrix, pulled back.
-    null = scale[:, None] * np.linalg.svd(A * scale)[2][rank:].T
+    null = scale[:, None] * np.linalg.svd(A_s)[2][rank:].T
     basis = np.zeros((grasp.num_components, null.shape[1]))
     if null.shape[1]:
         basis[cols] = np.linalg.qr(null)[0]
