@@ -35,7 +35,6 @@ from pydrake.systems.framework import Context
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.visualization.certificates import draw_result_certificate
 from drakegrasp.visualization.geometry import (
     contact_pose_3d,
     exact_cone_mesh,
@@ -46,6 +45,7 @@ from drakegrasp.visualization.geometry import (
     pyramid_mesh,
     side_sign,
 )
+from drakegrasp.visualization.meshcat_certificates import draw_result_certificate
 from drakegrasp.visualization.primitives import _draw_arrow, _set_mesh
 from drakegrasp.visualization.robot import set_translucent
 from drakegrasp.visualization.view import CameraView, frame_points, grasp_pose
@@ -173,7 +173,7 @@ def draw_grasp(
         Contact forces to draw as arrows: a result with ``contact_forces``, or
         one array per contact in that contact's frame, normal first (newtons).
         A "no" result's certificate is drawn too (the unresisted wrench or
-        the escape axis, see :mod:`drakegrasp.visualization.certificates`).
+        the escape axis, see :mod:`drakegrasp.visualization.meshcat_certificates`).
     prefix : str, optional
         Meshcat path holding the drawing; an existing drawing there is deleted
         first.
