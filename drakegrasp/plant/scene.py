@@ -392,7 +392,7 @@ def _hand_instances(hand) -> set[str]:
     """
     if isinstance(hand, str):
         return {hand}
-    return {name.rpartition("::")[0] for name in hand}
+    return {_instance_of(name) for name in hand}
 
 
 def _instance_of(frame: str) -> str:
