@@ -120,6 +120,14 @@ def make_contacts():
     return random_inward_contacts
 
 
+@pytest.fixture
+def helpers():
+    """The grasp builders and reference routes of ``grasp_builders`` (tests/support)."""
+    import grasp_builders
+
+    return grasp_builders
+
+
 # -- the tutorials, executed once ---------------------------------------------------
 
 TUTORIALS = ROOT / "tutorials"

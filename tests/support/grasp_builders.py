@@ -1,18 +1,15 @@
-"""Shared builders and independent reference routes for the quality-metric tests."""
+"""Grasps to test on and independent reference routes, shared by test folders.
+
+The closure tests (payloads, grasp forces) and the quality tests build the same
+grasps and check against the same brute-force routes; the ``helpers`` fixture
+of ``tests/conftest.py`` hands these functions to a test.
+"""
 
 import itertools
-import sys
-from pathlib import Path
 
 import numpy as np
-import pytest
 
 import drakegrasp as dg
-
-# The exact rational LP (``exact_lp``) is a module beside this file.
-_HERE = str(Path(__file__).resolve().parent)
-if _HERE not in sys.path:
-    sys.path.insert(0, _HERE)
 
 
 def equator_grasp(mu=0.5, *, radius=1.0, model="hard_finger", **kwargs):
@@ -91,19 +88,3 @@ def moved_grasp(grasp, R, t):
         reference_point=R @ grasp.reference_point + t,
         characteristic_length=grasp.characteristic_length,
     )
-
-
-@pytest.fixture
-def helpers():
-    """The builders above (fixtures are how test files share them)."""
-
-    class H:
-        pass
-
-    h = H()
-    h.equator_grasp = equator_grasp
-    h.random_grasp = random_grasp
-    h.brute_force_ball_radius = brute_force_ball_radius
-    h.signed_permutation_rotations = signed_permutation_rotations
-    h.moved_grasp = moved_grasp
-    return h
