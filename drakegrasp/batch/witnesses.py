@@ -38,6 +38,7 @@ from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.linalg import equilibrated
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_RANK_TOL
 from drakegrasp.errors import InvalidOptionError
 
@@ -148,8 +149,7 @@ def _null_space_witnesses(
             Ag = A[group]
         Ag = Ag.copy()
         Ag[:, d:, :] /= spread[group, None, None]
-        norms = np.linalg.norm(Ag, axis=1, keepdims=True)
-        sv = np.linalg.svd(Ag / np.where(norms > 0, norms, 1.0), compute_uv=False)
+        sv = np.linalg.svd(equilibrated(Ag)[0], compute_uv=False)
         for j, row in zip(group, rows[group], strict=True):
             rank = int(result.rank[row])
             tail = sv[j, rank:] if rank < sv.shape[1] else np.zeros(0)

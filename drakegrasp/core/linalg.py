@@ -70,21 +70,22 @@ def equilibrated(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    A : (m, n) float
+    A : (..., m, n) float
+        A matrix, or a stack of matrices (each scaled on its own).
 
     Returns
     -------
-    A_s : (m, n) float
+    A_s : (..., m, n) float
         ``A`` with every non-zero column scaled to unit length.
-    scale : (n,) float
+    scale : (..., n) float
         ``1 / ‖A_j‖`` per column (1 for a zero column).
     """
     # safe_norm: a soft finger's torsion column of a grasp 1e-168 m across holds
     # 1/spread ~ 1e168, whose square overflowed the plain norm to inf (scale 0)
-    norms = safe_norm(A, axis=0) if A.size else np.zeros(A.shape[1])
+    norms = safe_norm(A, axis=-2) if A.size else np.zeros(A.shape[:-2] + A.shape[-1:])
     scale = np.ones_like(norms)
     np.divide(1.0, norms, out=scale, where=norms > 0.0)
-    return A * scale, scale
+    return A * scale[..., None, :], scale
 
 
 def row_space(A: np.ndarray, rank_tol: float = DEFAULT_RANK_TOL) -> np.ndarray:

@@ -20,3 +20,24 @@ def test_rotations_about_agree_with_scipy_and_are_rotations():
     # Batched shapes: (2, 25) axes and angles give (2, 25, 3, 3), the same values.
     batched = rotations_about(axes.reshape(2, 25, 3), angles.reshape(2, 25))
     np.testing.assert_array_equal(batched.reshape(50, 3, 3), R)
+
+
+def test_equilibrated_gives_unit_columns_keeps_zero_ones_and_stacks():
+    from drakegrasp.core.linalg import equilibrated
+
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(6, 5)) * np.array([1e-150, 1.0, 1e160, 0.0, 3.0])
+    A_s, scale = equilibrated(A)
+    norms = np.linalg.norm(A_s, axis=0)
+    np.testing.assert_allclose(norms[[0, 1, 2, 4]], 1.0, rtol=1e-14)
+    assert norms[3] == 0.0 and scale[3] == 1.0
+    np.testing.assert_allclose(A_s, A * scale, rtol=0, atol=0)
+    # a stack is each matrix on its own, bit for bit
+    stack = rng.normal(size=(4, 6, 5)) * rng.uniform(1e-3, 1e3, size=(4, 1, 5))
+    S, scales = equilibrated(stack)
+    for k in range(4):
+        one, s_one = equilibrated(stack[k])
+        np.testing.assert_array_equal(S[k], one)
+        np.testing.assert_array_equal(scales[k], s_one)
+    empty, s_empty = equilibrated(np.zeros((3, 0, 4)))
+    assert empty.shape == (3, 0, 4) and np.all(s_empty == 1.0)
