@@ -101,20 +101,20 @@ def epsilon_rates(case, N, *, quick=False, seed=0, repeats=3, spread=None):
         lambda: batch_epsilon_l1(P, Nrm, mu=MU, workers=1, **opts), repeats
     )
     W = batched_primitive_wrenches(
-        P, Nrm, mu_c, nu_c, p, b, model=model, num_generators=N_GEN
+        P, Nrm, mu_c, nu_c, p, b, contact_model=model, num_generators=N_GEN
     )
     t_kernel, (_, status, info) = best_cpu(
         lambda: epsilon_kernel.epsilon_l1_stack(W, return_info=True), repeats
     )
     _, qhull = epsilon_l1_routes(
-        P, Nrm, mu_c, nu_c, p, b, model=model, num_generators=N_GEN
+        P, Nrm, mu_c, nu_c, p, b, contact_model=model, num_generators=N_GEN
     )
     budget = 1.0 if quick else 4.0  # CPU seconds aimed at per Qhull route
     probe = min(K, 20)
     t_probe, _ = best_cpu(
         lambda: epsilon_l1_per_grasp(
             P[:probe], Nrm[:probe], mu_c[:probe], nu_c[:probe], p[:probe],
-            b[:probe], model=model, num_generators=N_GEN,
+            b[:probe], contact_model=model, num_generators=N_GEN,
         ),
         1,
     )  # fmt: skip
@@ -122,7 +122,7 @@ def epsilon_rates(case, N, *, quick=False, seed=0, repeats=3, spread=None):
     t_loop, ref = best_cpu(
         lambda: epsilon_l1_per_grasp(
             P[:Kq], Nrm[:Kq], mu_c[:Kq], nu_c[:Kq], p[:Kq], b[:Kq],
-            model=model, num_generators=N_GEN,
+            contact_model=model, num_generators=N_GEN,
         ),
         1,
     )  # fmt: skip

@@ -353,7 +353,7 @@ def batch_force_closure(
     torsional_friction : float, (K,) or (K, N) float, optional
         ``ν`` of soft fingers (moment bound ``b ν f_n``), 0 or in
         ``[1e-12, 1e12]``.  ``None`` (default) means not given: required with
-        ``model="soft_finger"`` (an explicit 0 makes soft fingers act as hard
+        ``contact_model="soft_finger"`` (an explicit 0 makes soft fingers act as hard
         ones), 0 otherwise, as :class:`~drakegrasp.Contact` does.
     reference_points : (d,) or (K, d) float, optional
         Point ``p`` about which moments are taken; default the origin.

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import L1_MAX_POINTS
 from drakegrasp.errors import InvalidOptionError
 
@@ -65,8 +66,9 @@ def singular_value_metrics(
     return out
 
 
+@renamed_keyword("model", "contact_model")
 def epsilon_l1_per_grasp(
-    P, Nrm, mu, nu, p, b, *, model: str, num_generators: int
+    P, Nrm, mu, nu, p, b, *, contact_model: str, num_generators: int
 ) -> np.ndarray:
     """Ferrari–Canny L1 ε of each grasp through :func:`drakegrasp.ferrari_canny`.
 
@@ -89,7 +91,7 @@ def epsilon_l1_per_grasp(
                 P[k, i],
                 Nrm[k, i],
                 mu=mu[k, i],
-                contact_model=model,
+                contact_model=contact_model,
                 torsional_friction=nu[k, i],
             )
             for i in range(P.shape[1])
@@ -108,21 +110,31 @@ def _check_point_count(W_counts: np.ndarray) -> None:
         )
 
 
-def _point_counts(mu, nu, *, model: str, dim: int, num_generators: int):
+def _point_counts(mu, nu, *, contact_model: str, dim: int, num_generators: int):
     """Primitive wrenches of each grasp, as :func:`primitive_wrenches` counts them."""
-    if model == "frictionless":
+    if contact_model == "frictionless":
         per = np.ones(mu.shape)
     elif dim == 2:
         per = np.where(mu > 0.0, 2.0, 1.0)
     else:
         per = np.where(mu > 0.0, float(num_generators), 1.0)
-        if model == "soft_finger":
+        if contact_model == "soft_finger":
             per = np.where(nu > 0.0, np.where(mu > 0.0, per + 2.0, 2.0), per)
     return per.sum(axis=1)
 
 
+@renamed_keyword("model", "contact_model")
 def epsilon_l1_routes(
-    P, Nrm, mu, nu, p, b, *, model: str, num_generators: int, kernel: str = "auto"
+    P,
+    Nrm,
+    mu,
+    nu,
+    p,
+    b,
+    *,
+    contact_model: str,
+    num_generators: int,
+    kernel: str = "auto",
 ) -> tuple[np.ndarray, np.ndarray]:
     """Ferrari–Canny L1 ε of each grasp and which grasps took the Qhull route.
 
@@ -131,7 +143,7 @@ def epsilon_l1_routes(
     P, Nrm, mu, nu, p, b
         Validated chunk arrays, as :func:`drakegrasp.batch.run.chunk.force_chunk`
         takes them (``b`` the characteristic lengths, not None).
-    model : str
+    contact_model : str
         Contact model name.
     num_generators : int
     kernel : {"auto", "numba", "numpy"}, optional
@@ -151,18 +163,29 @@ def epsilon_l1_routes(
 
     _check_point_count(
         _point_counts(
-            mu, nu, model=model, dim=P.shape[2], num_generators=num_generators
+            mu,
+            nu,
+            contact_model=contact_model,
+            dim=P.shape[2],
+            num_generators=num_generators,
         )
     )
     k = P.shape[0]
     compiled = kernel == "numba" or (kernel == "auto" and epsilon_kernel.AVAILABLE)
     if not compiled or k == 0:
         eps = epsilon_l1_per_grasp(
-            P, Nrm, mu, nu, p, b, model=model, num_generators=num_generators
+            P,
+            Nrm,
+            mu,
+            nu,
+            p,
+            b,
+            contact_model=contact_model,
+            num_generators=num_generators,
         )
         return eps, np.ones(k, dtype=bool)
     W = batched_primitive_wrenches(
-        P, Nrm, mu, nu, p, b, model=model, num_generators=num_generators
+        P, Nrm, mu, nu, p, b, contact_model=contact_model, num_generators=num_generators
     )
     eps, status = epsilon_kernel.epsilon_l1_stack(W)
     qhull = status > epsilon_kernel.FLAT
@@ -170,16 +193,26 @@ def epsilon_l1_routes(
     if rows.size:
         eps[rows] = epsilon_l1_per_grasp(
             P[rows], Nrm[rows], mu[rows], nu[rows], p[rows], b[rows],
-            model=model, num_generators=num_generators,
+            contact_model=contact_model, num_generators=num_generators,
         )  # fmt: skip
     return eps, qhull
 
 
+@renamed_keyword("model", "contact_model")
 def epsilon_l1_batch(
-    P, Nrm, mu, nu, p, b, *, model: str, num_generators: int, kernel: str = "auto"
+    P,
+    Nrm,
+    mu,
+    nu,
+    p,
+    b,
+    *,
+    contact_model: str,
+    num_generators: int,
+    kernel: str = "auto",
 ) -> np.ndarray:
     """Ferrari–Canny L1 ε of each grasp of a chunk; see :func:`epsilon_l1_routes`."""
     return epsilon_l1_routes(
-        P, Nrm, mu, nu, p, b, model=model, num_generators=num_generators,
-        kernel=kernel,
+        P, Nrm, mu, nu, p, b, contact_model=contact_model,
+        num_generators=num_generators, kernel=kernel,
     )[0]  # fmt: skip

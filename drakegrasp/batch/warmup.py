@@ -148,10 +148,14 @@ def _steps() -> list[tuple[str, Callable[[], object]]]:
         ("soft fingers", 3, 3, "soft_finger", 0.1),
         ("frictionless contacts", 7, 3, "frictionless", None),
     ]
-    for label, N, d, model, nu in cases:
+    for label, N, d, contact_model, nu in cases:
         p, n = _grasps(K, N, d, seed=N * 10 + d)
-        mu = 0.0 if model == "frictionless" else np.linspace(0.2, 0.8, K)
-        options = {"contact_model": model, "torsional_friction": nu, "workers": 1}
+        mu = 0.0 if contact_model == "frictionless" else np.linspace(0.2, 0.8, K)
+        options = {
+            "contact_model": contact_model,
+            "torsional_friction": nu,
+            "workers": 1,
+        }
         out.append(
             (
                 f"force closure, {label}, N = {N}",

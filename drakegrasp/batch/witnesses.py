@@ -136,8 +136,8 @@ def _null_space_witnesses(
     else:
         mus = per_contact_getter(options["mu"], K_all, N, "mu")[rows]
         nus = per_contact_getter(options["torsional_friction"], K_all, N, "nu")[rows]
-        model = ContactModel.parse(options["model"]).value
-        layouts = contact_kinds(mus, nus, model=model, dim=d)
+        contact_model = ContactModel.parse(options["contact_model"]).value
+        layouts = contact_kinds(mus, nus, contact_model=contact_model, dim=d)
     out: dict[int, Certificate] = {}
     for layout in np.unique(layouts, axis=0):
         group = np.flatnonzero((layouts == layout).all(axis=1))
@@ -287,7 +287,7 @@ def batch_certificates(
     form = result.kind == "form"
     options = {
         "mu": mu,
-        "model": contact_model,
+        "contact_model": contact_model,
         "torsional_friction": torsional_friction,
         "reference_points": reference_points,
         "characteristic_lengths": characteristic_lengths,

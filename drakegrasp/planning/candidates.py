@@ -89,7 +89,7 @@ class GraspCandidate:
         acts (a massless model's, planned with ``object_mass``: its collision
         surface's centroid; on a point cloud, the cloud's centre: O's origin).
     contact_options : dict
-        ``mu``, ``model`` and ``torsional_friction`` of the contacts.
+        ``mu``, ``contact_model`` and ``torsional_friction`` of the contacts.
     is_closure : bool
         Frictional force closure on the polyhedral cones (LP2).
     d_star : float
@@ -511,7 +511,9 @@ def planning_result(
     )
 
 
-def _why_no_closure(candidates: Sequence[GraspCandidate], model: str | None) -> str:
+def _why_no_closure(
+    candidates: Sequence[GraspCandidate], contact_model: str | None
+) -> str:
     """Why no candidate is force closure, from their ranks and contact counts.
 
     A grasp matrix of rank below 6 leaves a wrench that no contact force
@@ -536,7 +538,7 @@ def _why_no_closure(candidates: Sequence[GraspCandidate], model: str | None) -> 
         f"rank <= {rank} < 6 (at most {most} contacts per candidate), so some "
         "wrench on the object meets no contact force"
     )
-    if model == "hard_finger" and most <= 2:
+    if contact_model == "hard_finger" and most <= 2:
         why += (
             "; two point contacts never resist a torque about the line through "
             "them: contact_model='soft_finger' with torsional_friction models "

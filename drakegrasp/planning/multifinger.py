@@ -43,6 +43,7 @@ from collections import Counter
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
+from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.errors import (
     InvalidOptionError,
     ModelError,
@@ -270,8 +271,10 @@ def _slerp(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> np.ndarray:
     return wa[..., None] * a + wb[..., None] * b
 
 
+@keyword_only("mu", after=4)
+@renamed_keyword("model", "contact_model")
 def fan_capacity(
-    positions, normals, fans, fingers, mu, *, samples, rng, torque_scale, model,
+    positions, normals, fans, fingers, *, mu, samples, rng, torque_scale, contact_model,
     torsional_friction,
 ):  # fmt: skip
     r"""(K,) weight capacity of grasps whose edge contacts' normals are unknown.
@@ -323,14 +326,15 @@ def fan_capacity(
         Nrm = np.broadcast_to(normals[:, None], Nrm.shape)
     alpha = weight_capacity(
         np.repeat(positions, S, axis=0), Nrm.reshape(K * S, N, 3),
-        np.repeat(fingers, S, axis=0), mu, torque_scale=torque_scale,
-        model=model, torsional_friction=torsional_friction,
+        np.repeat(fingers, S, axis=0), mu=mu, torque_scale=torque_scale,
+        contact_model=contact_model, torsional_friction=torsional_friction,
     ).min(axis=1)  # fmt: skip
     return np.where(np.isfinite(alpha), alpha, 0.0).reshape(K, S).mean(axis=1)
 
 
+@renamed_keyword("model", "contact_model")
 def rank_multifinger(
-    kept, *, label, hand: MultiFingerHand, plant, mu, model, nu, torque_scale,
+    kept, *, label, hand: MultiFingerHand, plant, mu, contact_model, nu, torque_scale,
     samples, noise, rng, certify, workers, X_WO, weight, reference,
 ):  # fmt: skip
     """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
@@ -347,22 +351,23 @@ def rank_multifinger(
     rho = np.zeros(K)
     alpha = np.full(K, np.nan)
     verdict, groups = grouped_verdicts(
-        kept, lambda found: _labels(found, label, F), mu,
-        torque_scale=torque_scale, model=model, nu=nu, workers=workers,
-        reference=reference,
+        kept, lambda found: _labels(found, label, F), mu=mu,
+        torque_scale=torque_scale, contact_model=contact_model, nu=nu,
+        workers=workers, reference=reference,
     )  # fmt: skip
     is_closure, d_star, rank, eps = verdict.values()
     for idx, P, Nrm, L, fc in groups:
         closed = idx[fc]
         if len(closed):
             rho[closed] = robustness(
-                P[fc] - reference, Nrm[fc], L[fc], mu, samples=samples, rng=rng,
-                noise=noise, model=model, torsional_friction=nu, workers=workers,
-                groups=tuple(range(F)),
+                P[fc] - reference, Nrm[fc], L[fc], mu=mu, samples=samples,
+                rng=rng, noise=noise, contact_model=contact_model,
+                torsional_friction=nu, workers=workers, groups=tuple(range(F)),
             )  # fmt: skip
             alpha[closed] = weight_capacity(
-                P[fc] - reference, Nrm[fc], L[fc], mu, torque_scale=torque_scale,
-                model=model, torsional_friction=nu,
+                P[fc] - reference, Nrm[fc], L[fc], mu=mu,
+                torque_scale=torque_scale, contact_model=contact_model,
+                torsional_friction=nu,
             ).min(axis=1)  # fmt: skip
     fanned = np.flatnonzero(
         np.isfinite(alpha) & (rho > 0) & [_has_fan(k[4]) for k in kept]
@@ -374,8 +379,8 @@ def rank_multifinger(
             np.array([[c.nhat_O for c in kept[i][4]] for i in rows]),
             np.array([_fans(kept[i][4]) for i in rows]),
             np.array([_labels(kept[i][4], label, F) for i in rows]),
-            mu, samples=samples, rng=rng, torque_scale=torque_scale, model=model,
-            torsional_friction=nu,
+            mu=mu, samples=samples, rng=rng, torque_scale=torque_scale,
+            contact_model=contact_model, torsional_friction=nu,
         )  # fmt: skip
     score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
     sample = np.array([k[0] for k in kept])
@@ -398,8 +403,8 @@ def rank_multifinger(
         )  # fmt: skip
 
     return ranked_candidates(
-        order, scores, pose, weight=weight, certify=certify, mu=mu, model=model,
-        nu=nu,
+        order, scores, pose, weight=weight, certify=certify, mu=mu,
+        contact_model=contact_model, nu=nu,
     )  # fmt: skip
 
 
@@ -411,7 +416,7 @@ def _ranked_result(
     """Both routes' last stage: the kept closings ranked, as GraspCandidates."""
     candidates = rank_multifinger(
         kept, label=label, hand=hand_model, plant=plant, mu=mu,
-        model=settings["contact_model"], nu=settings["torsional_friction"],
+        contact_model=settings["contact_model"], nu=settings["torsional_friction"],
         torque_scale=torque_scale, samples=settings["robustness_samples"],
         noise=settings["noise"], rng=rng, certify=certify, workers=workers,
         X_WO=X_WO, weight=weight, reference=reference,

@@ -386,13 +386,13 @@ def plan_grasps(
             f"weight_check must be an integer >= 0 or None, got {weight_check!r}"
         )
     try:
-        model = ContactModel(contact_model).value
+        contact_model = ContactModel(contact_model).value
     except ValueError:
         raise InvalidOptionError(
             f"contact_model must be one of {[m.value for m in ContactModel]}, got "
             f"{contact_model!r}"
         ) from None
-    if model == ContactModel.SOFT_FINGER.value and torsional_friction is None:
+    if contact_model == ContactModel.SOFT_FINGER.value and torsional_friction is None:
         raise InvalidOptionError(
             "contact_model='soft_finger' needs torsional_friction (nu >= 0: the "
             "moment about each contact normal is bounded by b * nu * f_n); give "
@@ -408,7 +408,7 @@ def plan_grasps(
         )
     settings = {
         "seed": seed,
-        "contact_model": model,
+        "contact_model": contact_model,
         "torsional_friction": torsional_friction,
         "clearance": clearance,
         "distance_tolerance": tol,
@@ -514,7 +514,7 @@ def plan_grasps(
     kept = closer.finish(kept, rejections)  # every closed pose's contacts at once
     candidates = rank_candidates(
         kept, finger_names=closer.finger_names, gripper=gripper, plant=plant, mu=mu,
-        model=model, nu=torsional_friction, torque_scale=torque_scale,
+        contact_model=contact_model, nu=torsional_friction, torque_scale=torque_scale,
         samples=robustness_samples, noise=noise, rng=rng, certify=certify,
         workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
         surface=FittedCloud(surface) if body is None else surface, tol=tol,

@@ -56,6 +56,7 @@ import numpy as np
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
 from drakegrasp.batch.run.verdicts import force_verdicts
 from drakegrasp.closure.verdicts import force_closure
+from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.linalg import rotations_about
 from drakegrasp.planning.candidates import GraspCandidate
 from drakegrasp.planning.reclose import reclosed_robustness
@@ -86,12 +87,13 @@ def group_by_count(counts: np.ndarray) -> dict[int, np.ndarray]:
     return {int(n): np.flatnonzero(counts == n) for n in np.unique(counts)}
 
 
+@keyword_only("mu", after=3)
 def perturbed_copies(
     positions: np.ndarray,
     normals: np.ndarray,
     fingers: np.ndarray,
-    mu: float,
     *,
+    mu: float,
     samples: int,
     rng: np.random.Generator,
     position: float,
@@ -146,13 +148,15 @@ def perturbed_copies(
     return P, Nrm, mus
 
 
+@keyword_only("mu", after=2)
+@renamed_keyword("model", "contact_model")
 def verdicts(
     positions,
     normals,
-    mu,
     *,
+    mu,
     torque_scale: float,
-    model: str,
+    contact_model: str,
     torsional_friction,
     workers: int | None,
 ):
@@ -166,7 +170,7 @@ def verdicts(
         positions,
         normals,
         mu=mu,
-        contact_model=model,
+        contact_model=contact_model,
         torsional_friction=torsional_friction,
         workers=workers,
     )
@@ -177,7 +181,7 @@ def verdicts(
             positions[closed],
             normals[closed],
             mu=mu,
-            contact_model=model,
+            contact_model=contact_model,
             torsional_friction=torsional_friction,
             characteristic_lengths=torque_scale,
             workers=workers,
@@ -190,16 +194,18 @@ def verdicts(
     )
 
 
+@keyword_only("mu", after=3)
+@renamed_keyword("model", "contact_model")
 def robustness(
     positions,
     normals,
     fingers,
-    mu: float,
     *,
+    mu: float,
     samples: int,
     rng: np.random.Generator,
     noise: dict,
-    model: str,
+    contact_model: str,
     torsional_friction,
     workers: int | None,
     groups=(0, 1),
@@ -212,15 +218,15 @@ def robustness(
     if samples == 0 or len(positions) == 0:
         return np.zeros(len(positions))
     P, Nrm, mus = perturbed_copies(
-        positions, normals, fingers, mu, samples=samples, rng=rng, groups=groups,
-        **noise,
+        positions, normals, fingers, mu=mu, samples=samples, rng=rng,
+        groups=groups, **noise,
     )  # fmt: skip
     # verdicts only: each LP stops once its verdict is proved (force_verdicts)
     held = force_verdicts(
         P,
         Nrm,
         mu=mus[:, None],  # one μ per copy, (K S, 1): never ambiguous with N
-        contact_model=model,
+        contact_model=contact_model,
         torsional_friction=torsional_friction,
         workers=workers,
     )
@@ -268,8 +274,9 @@ def _squeeze(weight: float, alpha: float) -> float:
     return float(weight / alpha) if alpha > 0 else float("inf")
 
 
+@renamed_keyword("model", "contact_model")
 def ranked_candidates(
-    order, scores: dict, pose, *, weight: float, certify: int, mu, model, nu
+    order, scores: dict, pose, *, weight: float, certify: int, mu, contact_model, nu
 ) -> tuple[GraspCandidate, ...]:
     """The candidates of a ranking, best first, either hand's route.
 
@@ -288,7 +295,7 @@ def ranked_candidates(
             **pose(i),
             contact_options={
                 "mu": mu,
-                "contact_model": model,
+                "contact_model": contact_model,
                 "torsional_friction": nu,
             },
             is_closure=bool(scores["is_closure"][i]),
@@ -306,8 +313,10 @@ def ranked_candidates(
     return tuple(out)
 
 
+@keyword_only("mu", after=2)
+@renamed_keyword("model", "contact_model")
 def grouped_verdicts(
-    kept, labels, mu, *, torque_scale, model, nu, workers, reference=None
+    kept, labels, *, mu, torque_scale, contact_model, nu, workers, reference=None
 ):  # fmt: skip
     """Stage 4a, either hand's route: every kept grasp's LP2 verdict, by count.
 
@@ -339,8 +348,8 @@ def grouped_verdicts(
         Nrm = np.array([[c.nhat_O for c in kept[i][4]] for i in idx])
         L = np.array([labels(kept[i][4]) for i in idx])
         fc, ds, rk, ep = verdicts(
-            P - reference, Nrm, mu, torque_scale=torque_scale, model=model,
-            torsional_friction=nu, workers=workers,
+            P - reference, Nrm, mu=mu, torque_scale=torque_scale,
+            contact_model=contact_model, torsional_friction=nu, workers=workers,
         )  # fmt: skip
         for key, value in zip(verdict, (fc, ds, rk, ep), strict=True):
             verdict[key][idx] = value
@@ -348,8 +357,9 @@ def grouped_verdicts(
     return verdict, groups
 
 
+@renamed_keyword("model", "contact_model")
 def rank_candidates(
-    kept, *, finger_names, gripper, plant, mu, model, nu, torque_scale, samples,
+    kept, *, finger_names, gripper, plant, mu, contact_model, nu, torque_scale, samples,
     noise, rng, certify, workers, X_WO, weight, weight_check, surface, tol,
     reference,
 ):  # fmt: skip
@@ -371,18 +381,19 @@ def rank_candidates(
     rho = np.zeros(K)
     names = finger_names
     verdict, groups = grouped_verdicts(
-        kept, lambda found: [_finger_label(c, names) for c in found], mu,
-        torque_scale=torque_scale, model=model, nu=nu, workers=workers,
-        reference=reference,
+        kept, lambda found: [_finger_label(c, names) for c in found], mu=mu,
+        torque_scale=torque_scale, contact_model=contact_model, nu=nu,
+        workers=workers, reference=reference,
     )  # fmt: skip
     is_closure, d_star, rank, eps = verdict.values()
     for idx, P, _, F, fc in groups:
         closed = idx[fc]
         if len(closed):
             rho[closed] = reclosed_robustness(
-                surface, P[fc], F[fc], _axes_O(kept, closed, gripper, X_WO), mu,
-                samples=samples, rng=rng, **noise, tol=tol, model=model,
-                torsional_friction=nu, workers=workers, reference=reference,
+                surface, P[fc], F[fc], _axes_O(kept, closed, gripper, X_WO), mu=mu,
+                samples=samples, rng=rng, **noise, tol=tol,
+                contact_model=contact_model, torsional_friction=nu, workers=workers,
+                reference=reference,
             )  # fmt: skip
     samples_of = np.array([k[0] for k in kept])
     pre = eps * rho
@@ -396,8 +407,8 @@ def rank_candidates(
             np.array([[c.p_OC for c in kept[i][4]] for i in idx]) - reference,
             np.array([[c.nhat_O for c in kept[i][4]] for i in idx]),
             np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx]),
-            mu, torque_scale=torque_scale, model=model, torsional_friction=nu,
-            workers=workers,
+            mu=mu, torque_scale=torque_scale, contact_model=contact_model,
+            torsional_friction=nu, workers=workers,
         ).min(axis=1)  # fmt: skip
     score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
     order = np.lexsort((samples_of, -tie_key(d_star), -tie_key(pre), -tie_key(score)))
@@ -425,6 +436,6 @@ def rank_candidates(
         )  # fmt: skip
 
     return ranked_candidates(
-        order, scores, pose, weight=weight, certify=certify, mu=mu, model=model,
-        nu=nu,
+        order, scores, pose, weight=weight, certify=certify, mu=mu,
+        contact_model=contact_model, nu=nu,
     )  # fmt: skip

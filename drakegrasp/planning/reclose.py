@@ -50,6 +50,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.batch.run.verdicts import force_verdicts
+from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.linalg import rotations_about
 
 __all__ = ["NEVER_CLOSURE", "reclosed_copies", "reclosed_robustness"]
@@ -134,20 +135,22 @@ def reclosed_copies(
     return touch, p_OC, nhat, ok
 
 
+@keyword_only("mu", after=4)
+@renamed_keyword("model", "contact_model")
 def reclosed_robustness(
     surface,
     positions: np.ndarray,
     fingers: np.ndarray,
     axes: np.ndarray,
-    mu: float,
     *,
+    mu: float,
     samples: int,
     rng: np.random.Generator,
     position: float,
     angle_deg: float,
     friction: float,
     tol: float,
-    model: str,
+    contact_model: str,
     torsional_friction,
     workers: int | None,
     reference: np.ndarray | None = None,
@@ -189,7 +192,7 @@ def reclosed_robustness(
     touch, p_OC, nhat, ok = reclosed_copies(surface, P, F, A, t, theta, tol=tol)
     held = np.zeros(M, bool)
     counts = np.where(ok, touch.sum(axis=1), 0)
-    never = NEVER_CLOSURE.get(str(getattr(model, "value", model)), 0)
+    never = NEVER_CLOSURE.get(str(getattr(contact_model, "value", contact_model)), 0)
     for n in np.unique(counts[counts > never]):  # the others need no LP
         rows = np.flatnonzero(counts == n)
         order = np.argsort(~touch[rows], axis=1, kind="stable")[:, :n]
@@ -200,7 +203,7 @@ def reclosed_robustness(
             p_OC[take] - reference,
             nhat[take],
             mu=mus[rows, None],  # one μ per copy (K, 1): never read per contact
-            contact_model=model,
+            contact_model=contact_model,
             torsional_friction=torsional_friction,
             workers=workers,
         )

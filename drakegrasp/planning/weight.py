@@ -45,6 +45,7 @@ from drakegrasp.batch import compiled
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
 from drakegrasp.batch.lp.ipm import solve_max_last, solve_max_last_active
 from drakegrasp.batch.run.workers import map_ordered, resolve_workers
+from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.errors import InvalidOptionError
 
@@ -180,14 +181,16 @@ def _equalities(W: np.ndarray, directions: np.ndarray) -> list[np.ndarray]:
     return out
 
 
+@keyword_only("mu", after=3)
+@renamed_keyword("model", "contact_model")
 def weight_capacity(
     positions: np.ndarray,
     normals: np.ndarray,
     fingers: np.ndarray,
-    mu: float,
     *,
+    mu: float,
     torque_scale: float,
-    model: str = "hard_finger",
+    contact_model: str = "hard_finger",
     torsional_friction: float | None = None,
     directions: np.ndarray = WEIGHT_DIRECTIONS,
     num_generators: int = DEFAULT_NUM_GENERATORS,
@@ -210,7 +213,7 @@ def weight_capacity(
     torque_scale : float
         Metres dividing the moments (conditioning only; a soft finger's
         torsion bound is ``torque_scale · ν``, as in ε).
-    model : str, optional
+    contact_model : str, optional
     torsional_friction : float, optional
     directions : (D, 3) float, optional
     num_generators : int, optional
@@ -237,7 +240,7 @@ def weight_capacity(
     if solver not in ("batch", "drake"):
         raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
     options = dict(
-        mu=mu, torque_scale=torque_scale, model=model,
+        mu=mu, torque_scale=torque_scale, contact_model=contact_model,
         torsional_friction=torsional_friction, directions=directions,
         num_generators=num_generators, solver=solver,
     )  # fmt: skip
@@ -251,7 +254,7 @@ def weight_capacity(
     return np.vstack(list(map_ordered(tasks, resolve_workers(workers))))
 
 
-def _capacity(positions, normals, fingers, *, mu, torque_scale, model,
+def _capacity(positions, normals, fingers, *, mu, torque_scale, contact_model,
               torsional_friction, directions, num_generators, solver):  # fmt: skip
     """:func:`weight_capacity` of one chunk of grasps, in this process."""
     K, N, _ = positions.shape
@@ -262,7 +265,7 @@ def _capacity(positions, normals, fingers, *, mu, torque_scale, model,
         np.full((K, N), float(torsional_friction or 0.0)),
         np.zeros((K, 3)),
         np.full(K, float(torque_scale)),
-        model=model,
+        contact_model=contact_model,
         num_generators=num_generators,
     )
     per = W.shape[1] // N

@@ -121,7 +121,7 @@ def test_compiled_grasp_matrix_matches_single_grasp_objects(model):
     P, Nrm = P[25 : 25 + K], Nrm[25 : 25 + K]  # collinear, shared, axis-aligned, ties
     mu = rng.uniform(0, 1, (K, N)) * (rng.random((K, N)) > 0.3)
     nu = rng.uniform(0, 0.5, (K, N)) * (rng.random((K, N)) > 0.3)
-    kinds = contact_kinds(mu, nu, model=model, dim=d)
+    kinds = contact_kinds(mu, nu, contact_model=model, dim=d)
     for k in range(K):
         g = make_grasp(P[k], Nrm[k], mu[k], model=model, nu=nu[k], b=1.0)
         layout = tuple(int(x) for x in kinds[k])
@@ -187,7 +187,7 @@ def test_gram_certificate_on_prescribed_singular_values(w):
 def _chunk(P, Nrm, mu, nu, model, kernel, metrics=()):
     K = P.shape[0]
     return chunks.force_chunk(
-        P, Nrm, mu, nu, np.zeros((K, P.shape[2])), None, model=model,
+        P, Nrm, mu, nu, np.zeros((K, P.shape[2])), None, contact_model=model,
         num_generators=8, tol=1e-9, rank_tol=1e-9, metrics=metrics, kernel=kernel,
     )  # fmt: skip
 

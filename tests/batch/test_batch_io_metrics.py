@@ -133,7 +133,7 @@ def test_construction_matches_single_grasp_objects(model):
     Nrm /= np.linalg.norm(Nrm, axis=-1, keepdims=True)
     mu = rng.uniform(0, 1, (K, N)) * (rng.random((K, N)) > 0.3)
     nu = rng.uniform(0, 0.5, (K, N)) * (rng.random((K, N)) > 0.3)
-    kinds = contact_kinds(mu, nu, model=model, dim=d)
+    kinds = contact_kinds(mu, nu, contact_model=model, dim=d)
     b = 1.3
     for k in range(K):
         g = make_grasp(P[k], Nrm[k], mu[k], model=model, nu=nu[k], b=b)

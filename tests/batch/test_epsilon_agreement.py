@@ -28,7 +28,9 @@ REL, ABS = 1e-9, 1e-12
 
 
 def _reference(P, Nrm, mu, nu, p, b, model, n_g=8):
-    return epsilon_l1_per_grasp(P, Nrm, mu, nu, p, b, model=model, num_generators=n_g)
+    return epsilon_l1_per_grasp(
+        P, Nrm, mu, nu, p, b, contact_model=model, num_generators=n_g
+    )
 
 
 def _check(P, Nrm, mu, *, model="hard_finger", nu=0.0, p=None, n_g=8):
@@ -40,7 +42,7 @@ def _check(P, Nrm, mu, *, model="hard_finger", nu=0.0, p=None, n_g=8):
     p = np.zeros((K, d)) if p is None else p
     b = batched_characteristic_lengths(P, p)
     eps, qhull = epsilon_l1_routes(
-        P, Nrm, mu, nu, p, b, model=model, num_generators=n_g, kernel="numba"
+        P, Nrm, mu, nu, p, b, contact_model=model, num_generators=n_g, kernel="numba"
     )
     want = _reference(P, Nrm, mu, nu, p, b, model, n_g)
     err = np.abs(eps - want)
@@ -182,7 +184,7 @@ def test_two_hard_fingers_are_flat_and_zero():
     W = batched_primitive_wrenches(
         P, Nrm / np.linalg.norm(Nrm, axis=-1, keepdims=True), np.ones((200, 2)),
         np.zeros((200, 2)), np.zeros((200, 3)), batched_characteristic_lengths(
-            P, np.zeros((200, 3))), model="hard_finger", num_generators=8,
+            P, np.zeros((200, 3))), contact_model="hard_finger", num_generators=8,
     )  # fmt: skip
     _, status = epsilon_kernel.epsilon_l1_stack(W)
     assert (status == epsilon_kernel.FLAT).all()

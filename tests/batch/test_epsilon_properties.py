@@ -57,7 +57,7 @@ def _hard_wrenches(P, Nrm, mu):
     return batched_primitive_wrenches(
         P, Nn, np.full((K, N), mu), np.zeros((K, N)), np.zeros((K, 3)),
         batched_characteristic_lengths(P, np.zeros((K, 3))),
-        model="hard_finger", num_generators=8,
+        contact_model="hard_finger", num_generators=8,
     )  # fmt: skip
 
 
@@ -129,12 +129,12 @@ def test_thin_cones_are_flagged_and_answered_by_qhull():
     mu, nu = np.full((K, 6), 1e-9), np.zeros((K, 6))
     p, b = np.zeros((K, 3)), batched_characteristic_lengths(P, np.zeros((K, 3)))
     W = batched_primitive_wrenches(
-        P, Nrm, mu, nu, p, b, model="hard_finger", num_generators=8
+        P, Nrm, mu, nu, p, b, contact_model="hard_finger", num_generators=8
     )
     _, status = epsilon_kernel.epsilon_l1_stack(W)
     assert (status == epsilon_kernel.ILL).all()
     eps, qhull = epsilon_l1_routes(
-        P, Nrm, mu, nu, p, b, model="hard_finger", num_generators=8
+        P, Nrm, mu, nu, p, b, contact_model="hard_finger", num_generators=8
     )
     assert qhull.all()
     want = [ferrari_canny(make_grasp(P[k], Nrm[k], 1e-9)) for k in range(K)]
@@ -231,7 +231,8 @@ def test_without_numba_every_grasp_takes_the_qhull_route(monkeypatch):
     p = np.zeros((K, 3))
     slow, qhull = epsilon_l1_routes(
         P, Nn, np.full((K, 3), 0.5), np.zeros((K, 3)), p,
-        batched_characteristic_lengths(P, p), model="hard_finger", num_generators=8,
+        batched_characteristic_lengths(P, p), contact_model="hard_finger",
+        num_generators=8,
     )  # fmt: skip
     assert qhull.all()
     _close(slow, eps)

@@ -132,7 +132,7 @@ def _single(P, Nrm, mu, tol, kernel, verdict_only):
     K, N, _ = P.shape
     return force_chunk(
         P, Nrm, np.broadcast_to(mu, (K, N)).copy(), np.zeros((K, N)),
-        np.zeros((K, 3)), None, model="hard_finger", num_generators=8, tol=tol,
+        np.zeros((K, 3)), None, contact_model="hard_finger", num_generators=8, tol=tol,
         rank_tol=DEFAULT_RANK_TOL, metrics=(), kernel=kernel,
         verdict_only=verdict_only,
     )  # fmt: skip

@@ -103,3 +103,100 @@ def test_warnings_point_at_the_callers_line():
     with pytest.warns(DeprecationWarning) as record:
         dg.Contact([0, 0, 0], [1, 0, 0], model="frictionless").model  # noqa: B018
     assert {w.filename for w in record} == {__file__}
+
+
+def _public_functions():
+    """``(module, name, function)`` of every public function of the package."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    names = [
+        info.name
+        for info in pkgutil.walk_packages(dg.__path__, "drakegrasp.")
+        if not info.name.endswith("__main__") and ".models" not in info.name
+    ]
+    for module_name in sorted(names):
+        module = importlib.import_module(module_name)
+        for name in getattr(module, "__all__", ()):
+            obj = getattr(module, name)
+            if inspect.isfunction(obj):
+                yield module_name, name, obj
+
+
+def test_no_public_function_spells_the_contact_model_model():
+    import inspect
+
+    found = [
+        f"{module}.{name}"
+        for module, name, function in _public_functions()
+        if "model" in inspect.signature(function).parameters
+    ]
+    assert found == []
+
+
+def test_no_public_function_takes_a_scalar_mu_by_position_after_other_arguments():
+    import inspect
+
+    found = []
+    for module, name, function in _public_functions():
+        parameters = list(inspect.signature(function).parameters.values())
+        for i, p in enumerate(parameters):
+            if p.name == "mu" and i > 0 and p.kind is not p.KEYWORD_ONLY:
+                if p.annotation in ("float", float):
+                    found.append(f"{module}.{name}")
+    assert found == []
+
+
+@pytest.mark.parametrize(
+    "module, name, after",
+    [
+        ("drakegrasp.planning.weight", "weight_capacity", 3),
+        ("drakegrasp.planning.ranking", "verdicts", 2),
+        ("drakegrasp.planning.ranking", "robustness", 3),
+        ("drakegrasp.planning.ranking", "perturbed_copies", 3),
+        ("drakegrasp.planning.ranking", "grouped_verdicts", 2),
+        ("drakegrasp.planning.reclose", "reclosed_robustness", 4),
+        ("drakegrasp.planning.multifinger", "fan_capacity", 4),
+    ],
+)
+def test_planning_stages_take_mu_by_keyword_after_their_arrays(module, name, after):
+    import importlib
+    import inspect
+
+    function = getattr(importlib.import_module(module), name)
+    parameters = list(inspect.signature(function).parameters.values())
+    assert parameters[after].name == "mu"
+    assert parameters[after].kind is inspect.Parameter.KEYWORD_ONLY
+    assert all(p.kind is p.POSITIONAL_OR_KEYWORD for p in parameters[:after])
+
+
+def test_planning_and_batch_stages_accept_the_old_spellings_with_a_warning():
+    from drakegrasp.batch.build.construction import batched_characteristic_lengths
+    from drakegrasp.batch.metrics import epsilon_l1_batch
+    from drakegrasp.planning.weight import weight_capacity
+
+    P, N, _ = _arrays(2)
+    fingers = np.tile(np.arange(P.shape[1]), (2, 1))
+    new = weight_capacity(
+        P, N, fingers, mu=0.5, torque_scale=0.05, contact_model="hard_finger"
+    )
+    with pytest.warns(DeprecationWarning) as record:
+        old = weight_capacity(
+            P, N, fingers, 0.5, torque_scale=0.05, model="hard_finger"
+        )
+    messages = " ".join(str(w.message) for w in record)
+    assert "mu=" in messages and "contact_model=" in messages
+    assert np.array_equal(old, new)
+    mu, nu = np.full(P.shape[:2], 0.5), np.zeros(P.shape[:2])
+    p = np.zeros((2, 3))
+    b = batched_characteristic_lengths(P, p)
+    args = (P, N, mu, nu, p, b)
+    new = epsilon_l1_batch(*args, contact_model="hard_finger", num_generators=8)
+    with pytest.warns(DeprecationWarning, match="contact_model="):
+        old = epsilon_l1_batch(*args, model="hard_finger", num_generators=8)
+    assert np.array_equal(old, new) and np.all(new > 0)
+    with pytest.raises(dg.InvalidOptionError, match="contact_model= only"):
+        epsilon_l1_batch(
+            *args, model="hard_finger", contact_model="hard_finger", num_generators=8
+        )

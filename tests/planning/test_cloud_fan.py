@@ -33,7 +33,7 @@ def _box_grasp():
 
 
 def _nominal(P, N, L):
-    return weight_capacity(P, N, L, MU, torque_scale=SCALE).min(axis=1)
+    return weight_capacity(P, N, L, mu=MU, torque_scale=SCALE).min(axis=1)
 
 
 @settings(max_examples=60, deadline=None, derandomize=True)
@@ -63,13 +63,13 @@ def test_without_fans_the_capacity_is_the_nominal_one():
     one = np.stack([N, N], axis=2)  # arcs of a single normal each
     for fans in (none, one):
         got = fan_capacity(
-            P, N, fans, L, MU, samples=6, rng=np.random.default_rng(0),
-            torque_scale=SCALE, model="hard_finger", torsional_friction=None,
+            P, N, fans, L, mu=MU, samples=6, rng=np.random.default_rng(0),
+            torque_scale=SCALE, contact_model="hard_finger", torsional_friction=None,
         )  # fmt: skip
         assert np.allclose(got, nominal, rtol=1e-9, atol=1e-12)
     zero = fan_capacity(
-        P, N, none, L, MU, samples=0, rng=np.random.default_rng(0),
-        torque_scale=SCALE, model="hard_finger", torsional_friction=None,
+        P, N, none, L, mu=MU, samples=0, rng=np.random.default_rng(0),
+        torque_scale=SCALE, contact_model="hard_finger", torsional_friction=None,
     )  # fmt: skip
     assert np.allclose(zero, nominal)
 
@@ -87,8 +87,8 @@ def test_the_capacity_is_the_mean_over_normals_drawn_along_the_arcs():
     fans[0, 0] = [a, b]
     S = 12
     got = fan_capacity(
-        P, N, fans, L, MU, samples=S, rng=np.random.default_rng(3),
-        torque_scale=SCALE, model="hard_finger", torsional_friction=None,
+        P, N, fans, L, mu=MU, samples=S, rng=np.random.default_rng(3),
+        torque_scale=SCALE, contact_model="hard_finger", torsional_friction=None,
     )  # fmt: skip
     t = np.random.default_rng(3).uniform(size=(1, S, 4))[0, :, 0]
     R = rotations_about(np.tile(_unit(np.cross(a, b)), (S, 1)), t * np.pi / 2)

@@ -202,12 +202,12 @@ def test_weight_capacity_with_one_group_per_finger_matches_the_primal_lp():
     n /= np.linalg.norm(n, axis=2, keepdims=True)
     p = -0.04 * n + 0.005 * rng.standard_normal((K, N, 3))  # about a ball
     labels = np.tile([0, 1, 2, 3, 4, 1], (K, 1))
-    batch = weight_capacity(p, n, labels, 0.8, torque_scale=0.05)
-    drake = weight_capacity(p, n, labels, 0.8, torque_scale=0.05, solver="drake")
+    batch = weight_capacity(p, n, labels, mu=0.8, torque_scale=0.05)
+    drake = weight_capacity(p, n, labels, mu=0.8, torque_scale=0.05, solver="drake")
     assert np.allclose(batch, drake, rtol=1e-5, atol=1e-7)
     # merging fingers 2 and 3 into one bound can only lower the capacity
     merged = weight_capacity(
-        p, n, np.minimum(labels, 2), 0.8, torque_scale=0.05, solver="drake"
+        p, n, np.minimum(labels, 2), mu=0.8, torque_scale=0.05, solver="drake"
     )
     assert np.all(merged <= drake + 1e-9)
 
@@ -219,7 +219,7 @@ def test_perturbed_copies_move_each_finger_rigidly_and_leave_the_palm():
     Nrm /= np.linalg.norm(Nrm, axis=2, keepdims=True)
     F = np.array([[0, 0, 1, 2, 3]] * 2)
     Pc, Nc, _ = perturbed_copies(
-        P, Nrm, F, 0.5, samples=4, rng=rng, position=2e-3, angle_deg=3.0,
+        P, Nrm, F, mu=0.5, samples=4, rng=rng, position=2e-3, angle_deg=3.0,
         friction=0.1, groups=(0, 1, 2),
     )  # fmt: skip
     orig = np.repeat(P, 4, axis=0)

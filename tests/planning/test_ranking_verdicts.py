@@ -47,8 +47,8 @@ def test_moved_contacts_robustness_equals_the_full_solve(model, nu, monkeypatch)
 
     def run():
         return robustness(
-            P, Nrm, F, 0.5, samples=48, rng=np.random.default_rng(1), noise=noise,
-            model=model, torsional_friction=nu, workers=1,
+            P, Nrm, F, mu=0.5, samples=48, rng=np.random.default_rng(1), noise=noise,
+            contact_model=model, torsional_friction=nu, workers=1,
         )  # fmt: skip
 
     fast = run()
@@ -70,9 +70,9 @@ def test_reclosed_robustness_equals_the_full_solve(shape, monkeypatch):
 
     def run():
         return reclosed_robustness(
-            surface, P, F, axes, 0.6, samples=64, rng=np.random.default_rng(2),
+            surface, P, F, axes, mu=0.6, samples=64, rng=np.random.default_rng(2),
             **{**DEFAULT_NOISE, "angle_deg": 10.0, "friction": 0.8}, tol=1e-4,
-            model="hard_finger",
+            contact_model="hard_finger",
             torsional_friction=None, workers=1,
         )  # fmt: skip
 

@@ -110,9 +110,9 @@ def test_unmoved_copies_are_the_planned_grasp_and_hold(wsg_scene):
         np.testing.assert_allclose(p, P, atol=2 * TOL)
         np.testing.assert_allclose(n, Nrm, atol=1e-6)
         rho = reclosed_robustness(
-            surface, P[None], F[None], a[None], 0.5, samples=3,
+            surface, P[None], F[None], a[None], mu=0.5, samples=3,
             rng=np.random.default_rng(0), position=0.0, angle_deg=0.0,
-            friction=0.0, tol=TOL, model="hard_finger", torsional_friction=None,
+            friction=0.0, tol=TOL, contact_model="hard_finger", torsional_friction=None,
             workers=1,
         )  # fmt: skip
         assert rho[0] == 1.0
@@ -127,9 +127,9 @@ def test_robustness_is_seeded_and_in_range(samples):
 
     def run(seed):
         return reclosed_robustness(
-            cyl, P, F, a, 0.5, samples=samples, rng=np.random.default_rng(seed),
+            cyl, P, F, a, mu=0.5, samples=samples, rng=np.random.default_rng(seed),
             position=3e-3, angle_deg=5.0, friction=0.1, tol=TOL,
-            model="hard_finger", torsional_friction=None, workers=1,
+            contact_model="hard_finger", torsional_friction=None, workers=1,
         )  # fmt: skip
 
     assert run(1) == run(1) and 0.0 <= run(1)[0] <= 1.0
@@ -156,8 +156,8 @@ def test_copies_too_few_to_hold_skip_the_lp_and_nothing_else(model, monkeypatch)
 
     def run():
         return reclosed_robustness(
-            cyl, P, F, a, 0.8, samples=64, rng=np.random.default_rng(4),
-            position=3e-3, angle_deg=8.0, friction=0.1, tol=TOL, model=model,
+            cyl, P, F, a, mu=0.8, samples=64, rng=np.random.default_rng(4),
+            position=3e-3, angle_deg=8.0, friction=0.1, tol=TOL, contact_model=model,
             torsional_friction=0.05 if model == "soft_finger" else None, workers=1,
         )  # fmt: skip
 

@@ -32,7 +32,7 @@ def test_two_opposed_contacts_closed_form(solver):
     N = np.array([[[1.0, 0, 0], [-1.0, 0, 0]]])
     dirs = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, 0, -1]])
     a = weight_capacity(
-        P, N, np.array([[0, 1]]), mu, torque_scale=r, directions=dirs, solver=solver
+        P, N, np.array([[0, 1]]), mu=mu, torque_scale=r, directions=dirs, solver=solver
     )
     # along the axis one finger's normal force (<= 1); across it both frictions
     assert a[0] == pytest.approx([1.0, 1.0, 2 * mu, 2 * mu], abs=1e-7)
@@ -68,7 +68,7 @@ def test_agrees_with_a_second_formulation(solver):
         N = (N + tilt) / np.linalg.norm(N + tilt, axis=1, keepdims=True)
         fingers = np.array([0, 0, 0, 1, 1, 1])
         a = weight_capacity(
-            P[None], N[None], fingers[None], 0.5, torque_scale=0.05, solver=solver
+            P[None], N[None], fingers[None], mu=0.5, torque_scale=0.05, solver=solver
         )[0]
         grasp = Grasp([Contact(p, n, mu=0.5) for p, n in zip(P, N, strict=True)])
         ref = [_scipy_capacity(grasp, fingers, u, 0.05) for u in WEIGHT_DIRECTIONS]
@@ -80,8 +80,8 @@ def test_independent_of_units_and_torque_scale():
     P = rng.normal(0, 0.02, (1, 6, 3))
     N = -P / np.linalg.norm(P, axis=2, keepdims=True)
     F = np.array([[0, 0, 0, 1, 1, 1]])
-    a = weight_capacity(P, N, F, 0.6, torque_scale=0.05)
-    b = weight_capacity(P * 1000, N, F, 0.6, torque_scale=3.0)
+    a = weight_capacity(P, N, F, mu=0.6, torque_scale=0.05)
+    b = weight_capacity(P * 1000, N, F, mu=0.6, torque_scale=3.0)
     assert a == pytest.approx(b, rel=1e-6, abs=1e-9)
 
 
@@ -91,8 +91,8 @@ def test_the_batch_dual_and_the_primal_program_agree_on_many_grasps():
     N = -P / np.linalg.norm(P, axis=2, keepdims=True) + rng.normal(0, 0.3, P.shape)
     N /= np.linalg.norm(N, axis=2, keepdims=True)
     F = np.repeat([[0, 0, 0, 0, 1, 1, 1, 2]], 30, axis=0)  # one palm contact
-    a = weight_capacity(P, N, F, 0.7, torque_scale=0.05)
-    b = weight_capacity(P, N, F, 0.7, torque_scale=0.05, solver="drake")
+    a = weight_capacity(P, N, F, mu=0.7, torque_scale=0.05)
+    b = weight_capacity(P, N, F, mu=0.7, torque_scale=0.05, solver="drake")
     assert a == pytest.approx(b, rel=1e-6, abs=1e-8)
 
 
@@ -124,10 +124,10 @@ def test_chunks_and_workers_change_no_number(workers, monkeypatch):
     F = np.tile([0, 0, 1, 1], (23, 1))
     exact = _stack_sizes(monkeypatch)
     before = weight._FALLBACKS["clp"]
-    whole = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    whole = weight_capacity(P, N, F, mu=1.0, torque_scale=0.06)
     assert exact and exact[0] == 23 * len(WEIGHT_DIRECTIONS)  # every LP
     monkeypatch.setattr(weight, "WEIGHT_CHUNK", 5)
-    chunked = weight_capacity(P, N, F, 1.0, torque_scale=0.06, workers=workers)
+    chunked = weight_capacity(P, N, F, mu=1.0, torque_scale=0.06, workers=workers)
     assert np.array_equal(chunked, whole)
     if workers == 1:  # (a worker process counts in its own module)
         assert weight._FALLBACKS["clp"] == before
@@ -176,15 +176,15 @@ def test_degenerate_pads_are_solved_in_the_compiled_path():
 
     P, N, F = _degenerate_grasps(np.random.default_rng(21))
     before = weight._FALLBACKS["clp"]
-    a = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    a = weight_capacity(P, N, F, mu=1.0, torque_scale=0.06)
     assert weight._FALLBACKS["clp"] == before
-    clp = weight_capacity(P, N, F, 1.0, torque_scale=0.06, solver="drake")
+    clp = weight_capacity(P, N, F, mu=1.0, torque_scale=0.06, solver="drake")
     # Clp stops at its own tolerances (about 1e-6 here); HiGHS is run tighter
     assert a == pytest.approx(clp, rel=5e-6, abs=1e-8)
     K, n, _ = P.shape
     W = batched_primitive_wrenches(
         P, N, np.ones((K, n)), np.zeros((K, n)), np.zeros((K, 3)),
-        np.full(K, 0.06), model="hard_finger", num_generators=8,
+        np.full(K, 0.06), contact_model="hard_finger", num_generators=8,
     )  # fmt: skip
     groups = np.repeat(F, 8, axis=1)
     for k in range(K):
@@ -201,11 +201,11 @@ def test_the_route_without_numba_gives_the_same_capacities(monkeypatch):
     P = np.vstack([P, STUCK_P[None, [0, 1, 1, 2, 3, 3]]])
     N = np.vstack([N, STUCK_N[None, [0, 1, 1, 2, 3, 3]]])
     F = np.vstack([F, [[0, 0, 0, 1, 1, 1]]])
-    compiled = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    compiled = weight_capacity(P, N, F, mu=1.0, torque_scale=0.06)
     monkeypatch.setattr(weight.compiled, "AVAILABLE", False)
     routes = _stack_sizes(monkeypatch)
     before = weight._FALLBACKS["clp"]
-    numpy_first = weight_capacity(P, N, F, 1.0, torque_scale=0.06)
+    numpy_first = weight_capacity(P, N, F, mu=1.0, torque_scale=0.06)
     assert weight._FALLBACKS["clp"] == before
     assert routes and routes[0] < P.shape[0] * len(WEIGHT_DIRECTIONS)  # only some
     np.testing.assert_allclose(numpy_first, compiled, rtol=1e-9, atol=1e-10)

@@ -32,6 +32,7 @@ from drakegrasp.batch.build.kinds import (
     SPATIAL_HARD,
 )
 from drakegrasp.core.contact import contact_frames
+from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.friction_cone import soft_finger_facets, torsion_only_facets
 from drakegrasp.core.validation import LENGTH_MIN, safe_norm
 
@@ -45,8 +46,9 @@ __all__ = [
 ]
 
 
+@renamed_keyword("model", "contact_model")
 def contact_kinds(
-    mu: np.ndarray, torsional_friction: np.ndarray, *, model: str, dim: int
+    mu: np.ndarray, torsional_friction: np.ndarray, *, contact_model: str, dim: int
 ) -> np.ndarray:
     """Kind code of every contact from its model and coefficients.
 
@@ -54,7 +56,7 @@ def contact_kinds(
     ----------
     mu, torsional_friction : (K, N) float
         Friction coefficients ``μ >= 0`` and ``ν >= 0``.
-    model : {"frictionless", "hard_finger", "soft_finger"}
+    contact_model : {"frictionless", "hard_finger", "soft_finger"}
     dim : {2, 3}
 
     Returns
@@ -63,13 +65,13 @@ def contact_kinds(
         Codes ``FRICTIONLESS`` … ``SOFT_FULL``; see ``KIND_COMPONENTS``.
     """
     shape = np.shape(mu)
-    if model == "frictionless":
+    if contact_model == "frictionless":
         return np.full(shape, FRICTIONLESS, dtype=np.int8)
     friction = mu > 0.0
     if dim == 2:  # soft fingers are rejected upstream in the plane
         return np.where(friction, PLANAR_HARD, FRICTIONLESS).astype(np.int8)
     kinds = np.where(friction, SPATIAL_HARD, FRICTIONLESS).astype(np.int8)
-    if model == "soft_finger":
+    if contact_model == "soft_finger":
         torsion = torsional_friction > 0.0
         kinds[torsion & friction] = SOFT_FULL
         kinds[torsion & ~friction] = SOFT_TORSION

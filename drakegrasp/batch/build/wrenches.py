@@ -19,23 +19,26 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.core.contact import contact_frames
+from drakegrasp.core.deprecation import renamed_keyword
+from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["batched_primitive_wrenches", "wrenches_per_contact"]
 
 _MODELS = ("frictionless", "hard_finger", "soft_finger")
 
 
-def wrenches_per_contact(model: str, dim: int, num_generators: int) -> int:
+@renamed_keyword("model", "contact_model")
+def wrenches_per_contact(contact_model: str, dim: int, num_generators: int) -> int:
     """Rows per contact of :func:`batched_primitive_wrenches`.
 
     ``1`` (frictionless), ``2`` (planar hard finger), ``n_g`` (spatial hard
     finger) or ``n_g + 2`` (soft finger).
     """
-    if model == "frictionless":
+    if contact_model == "frictionless":
         return 1
     if dim == 2:
         return 2
-    return num_generators + (2 if model == "soft_finger" else 0)
+    return num_generators + (2 if contact_model == "soft_finger" else 0)
 
 
 def _moments(r: np.ndarray, F: np.ndarray) -> np.ndarray:
@@ -47,6 +50,7 @@ def _moments(r: np.ndarray, F: np.ndarray) -> np.ndarray:
     return np.stack([ry * fz - rz * fy, rz * fx - rx * fz, rx * fy - ry * fx], -1)
 
 
+@renamed_keyword("model", "contact_model")
 def batched_primitive_wrenches(
     positions: np.ndarray,
     normals: np.ndarray,
@@ -55,7 +59,7 @@ def batched_primitive_wrenches(
     reference_points: np.ndarray,
     torque_scales: np.ndarray,
     *,
-    model: str,
+    contact_model: str,
     num_generators: int,
 ) -> np.ndarray:
     r"""Scaled primitive wrenches of ``k`` grasps of ``N`` contacts.
@@ -71,7 +75,7 @@ def batched_primitive_wrenches(
     torque_scales : (k,) float
         ``b > 0`` metres: moments are divided by it, and a soft finger's
         torsion bound is ``b ν`` (the grasp's characteristic length).
-    model : {"frictionless", "hard_finger", "soft_finger"}
+    contact_model : {"frictionless", "hard_finger", "soft_finger"}
     num_generators : int
         ``n_g`` of each spatial cone.
 
@@ -87,15 +91,17 @@ def batched_primitive_wrenches(
     -----
     .. math:: w_{i,k} = \operatorname{diag}(I, I / b)\, G_i\, s_k
     """
-    if model not in _MODELS:
-        raise ValueError(f"model must be one of {_MODELS}, got {model!r}")
+    if contact_model not in _MODELS:
+        raise InvalidOptionError(
+            f"contact_model must be one of {_MODELS}, got {contact_model!r}"
+        )
     k, N, d = positions.shape
-    m = wrenches_per_contact(model, d, num_generators)
+    m = wrenches_per_contact(contact_model, d, num_generators)
     R = contact_frames(normals)  # (k, N, d, d), columns n, t1 (, t2)
     n = R[..., 0]
     r = (positions - reference_points[:, None, :]) / torque_scales[:, None, None]
-    mu_eff = np.zeros_like(mu) if model == "frictionless" else mu
-    if model == "frictionless":
+    mu_eff = np.zeros_like(mu) if contact_model == "frictionless" else mu
+    if contact_model == "frictionless":
         F = n[:, :, None, :]
     elif d == 2:
         sign = np.array([1.0, -1.0])
@@ -110,7 +116,7 @@ def batched_primitive_wrenches(
             + np.sin(theta)[:, None] * R[:, :, None, :, 2]
         )
     ring = np.concatenate([F, _moments(r[:, :, None, :], F)], axis=-1)
-    if model != "soft_finger":
+    if contact_model != "soft_finger":
         return np.ascontiguousarray(
             np.broadcast_to(ring, (k, N, m, ring.shape[-1])).reshape(k, N * m, -1)
         )

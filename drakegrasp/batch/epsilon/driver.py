@@ -45,18 +45,23 @@ from drakegrasp.batch.run.chunk import force_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
-from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.tolerances import (
+    DEFAULT_NUM_GENERATORS,
+    DEFAULT_RANK_TOL,
+    DEFAULT_TOL,
+)
 
 __all__ = ["batch_epsilon_l1", "epsilon_chunk"]
 
 
-def epsilon_chunk(P, Nrm, mu_c, nu_c, p, b, *, model, num_generators, kernel):
+@renamed_keyword("model", "contact_model")
+def epsilon_chunk(P, Nrm, mu_c, nu_c, p, b, *, contact_model, num_generators, kernel):
     """ε L1 of one validated chunk (a worker task); ``b`` None: the default."""
     if b is None:
         b = batched_characteristic_lengths(P, p)
     eps = epsilon_l1_batch(
-        P, Nrm, mu_c, nu_c, p, b, model=model, num_generators=num_generators,
-        kernel=kernel,
+        P, Nrm, mu_c, nu_c, p, b, contact_model=contact_model,
+        num_generators=num_generators, kernel=kernel,
     )  # fmt: skip
     return {"epsilon_l1": eps}
 
@@ -127,10 +132,11 @@ def batch_epsilon_l1(
     """
     task, options = force_task(
         positions, mu, contact_model, num_generators, torsional_friction,
-        reference_points, characteristic_lengths, 1e-6, 1e-9, (), kernel,
+        reference_points, characteristic_lengths, DEFAULT_TOL, DEFAULT_RANK_TOL, (),
+        kernel,
     )  # fmt: skip
     eps_options = {
-        "model": options["model"],
+        "contact_model": options["contact_model"],
         "num_generators": options["num_generators"],
         "kernel": options["kernel"],
     }

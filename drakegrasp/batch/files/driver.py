@@ -51,7 +51,7 @@ __all__ = ["evaluate_file", "stream_file", "write_result"]
 
 
 def _file_run(
-    input_path, output_path, *, kind, mu, model, num_generators,
+    input_path, output_path, *, kind, mu, contact_model, num_generators,
     torsional_friction, tol, rank_tol, chunk_size, progress, metrics, workers,
     kernel="auto", overwrite,
 ) -> tuple[Path, int, int, dict, Iterator]:  # fmt: skip
@@ -75,7 +75,7 @@ def _file_run(
     p, b = extra["reference_points"], extra["characteristic_lengths"]
     if kind == "force":
         options, chunks = force_chunks(
-            positions, normals, extra["mu"], model, num_generators,
+            positions, normals, extra["mu"], contact_model, num_generators,
             extra["torsional_friction"], p, b, tol, rank_tol, metrics, kernel,
             chunk_size, progress, workers,
         )  # fmt: skip
@@ -142,7 +142,7 @@ def evaluate_file(
         Any invalid grasp or option (see :mod:`drakegrasp.core.validation`).
     """
     output, K, d, options, chunks = _file_run(
-        input_path, output_path, kind=kind, mu=mu, model=contact_model,
+        input_path, output_path, kind=kind, mu=mu, contact_model=contact_model,
         num_generators=num_generators, torsional_friction=torsional_friction,
         tol=tol, rank_tol=rank_tol, chunk_size=chunk_size, progress=progress,
         metrics=metrics, workers=None, overwrite=overwrite,
@@ -188,7 +188,7 @@ def stream_file(
         Counts and ``d*`` range of what was written.
     """
     output, K, d, options, chunks = _file_run(
-        input_path, output_path, kind=kind, mu=mu, model=contact_model,
+        input_path, output_path, kind=kind, mu=mu, contact_model=contact_model,
         num_generators=num_generators, torsional_friction=torsional_friction,
         tol=tol, rank_tol=rank_tol, chunk_size=chunk_size, progress=progress,
         metrics=metrics, workers=workers, overwrite=overwrite,

@@ -53,6 +53,7 @@ from drakegrasp.batch.inputs import (
 from drakegrasp.batch.lp.dstar import solve_dstar_blocks
 from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
@@ -245,6 +246,7 @@ def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, ro
     return sol.d_star, sol.rank, sol.converged
 
 
+@renamed_keyword("model", "contact_model")
 def force_chunk(
     P: np.ndarray,
     Nrm: np.ndarray,
@@ -253,7 +255,7 @@ def force_chunk(
     p: np.ndarray,
     b: np.ndarray | None,
     *,
-    model: str,
+    contact_model: str,
     num_generators: int,
     tol: float,
     rank_tol: float,
@@ -288,14 +290,14 @@ def force_chunk(
     """
     k, N, d = P.shape
     compiled = _compiled(kernel)
-    if b is None and (model == "soft_finger" or metrics):  # else b is unused
+    if b is None and (contact_model == "soft_finger" or metrics):  # else b is unused
         b = batched_characteristic_lengths(P, p)
     Pn, spread = _positions(P, compiled)
-    kinds = contact_kinds(mu_c, nu_c, model=model, dim=d)
+    kinds = contact_kinds(mu_c, nu_c, contact_model=contact_model, dim=d)
     d_star = np.zeros(k)
     rank = np.zeros(k, dtype=int)
     converged = np.ones(k, dtype=bool)
-    torsion = b[:, None] * nu_c if model == "soft_finger" else None
+    torsion = b[:, None] * nu_c if contact_model == "soft_finger" else None
     for layout, rows in group_layouts(kinds):
         d_star[rows], rank[rows], converged[rows] = _layout_lp(
             Pn,
@@ -319,13 +321,13 @@ def force_chunk(
             "frictionless": FRICTIONLESS,
             "hard_finger": SPATIAL_HARD if d == 3 else PLANAR_HARD,
             "soft_finger": SOFT_FULL,
-        }[model]
+        }[contact_model]
         Gfull, _ = _grasp_matrices(P, Nrm, p, (full,) * N, None, compiled)
         out.update(singular_value_metrics(Gfull, b, metrics))
         if "epsilon_l1" in metrics:
             out["epsilon_l1"] = epsilon_l1_batch(
-                P, Nrm, mu_c, nu_c, p, b, model=model, num_generators=num_generators,
-                kernel=kernel,
+                P, Nrm, mu_c, nu_c, p, b, contact_model=contact_model,
+                num_generators=num_generators, kernel=kernel,
             )  # fmt: skip
     return out
 
@@ -383,19 +385,20 @@ def finish(d_star, rank, converged, normal_d_star, *, tol: float, required: int)
 # ------------------------------------------------ a run's task builders
 
 
-def force_task(positions, mu, model, num_generators, torsional_friction,
+@renamed_keyword("model", "contact_model")
+def force_task(positions, mu, contact_model, num_generators, torsional_friction,
                 reference_points, characteristic_lengths, tol, rank_tol, metrics,
                 kernel):  # fmt: skip
     """Validate options once; return the chunk-task builder of LP2 and options."""
-    model = ContactModel.parse(model).value
+    contact_model = ContactModel.parse(contact_model).value
     K, N, d = shape_of("positions", positions)
-    if model == "soft_finger" and d == 2:
+    if contact_model == "soft_finger" and d == 2:
         raise InvalidContactError(
             "a soft-finger contact is spatial only; planar contacts are "
             "'frictionless' or 'hard_finger'"
         )
     options = {
-        "model": model,
+        "contact_model": contact_model,
         "num_generators": check_num_generators(num_generators),
         "tol": _check_tol("tol", tol),
         "rank_tol": _check_tol("rank_tol", rank_tol),
@@ -404,17 +407,17 @@ def force_task(positions, mu, model, num_generators, torsional_friction,
     }
     get_mu = per_contact_getter("mu", mu, K, N)
     if torsional_friction is None:
-        if model == "soft_finger":
+        if contact_model == "soft_finger":
             raise InvalidContactError(
-                "model='soft_finger' needs torsional_friction (nu: the moment "
-                "about the normal is bounded by b * nu * f_n); pass nu > 0, or 0 "
-                "for soft fingers that act as hard fingers"
+                "contact_model='soft_finger' needs torsional_friction (nu: the "
+                "moment about the normal is bounded by b * nu * f_n); pass nu > 0, "
+                "or 0 for soft fingers that act as hard fingers"
             )
         torsional_friction = 0.0
     get_nu = per_contact_getter("torsional_friction", torsional_friction, K, N)
     get_p = _reference_points(reference_points, K, d)
     get_b = _characteristic_lengths(characteristic_lengths, K)
-    soft = model == "soft_finger"
+    soft = contact_model == "soft_finger"
 
     def task(P, Nrm, sl):
         mu_c = get_mu(sl)
