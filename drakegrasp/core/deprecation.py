@@ -81,49 +81,63 @@ def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
     return decorate
 
 
-def keyword_only(name: str, *, after: int) -> Callable[[F], F]:
-    """Accept ``name`` positionally (deprecated) where it is now keyword-only.
+def keyword_only(*names: str, after: int) -> Callable[[F], F]:
+    """Accept ``names`` positionally (deprecated) where they are now keyword-only.
 
     Parameters
     ----------
-    name : str
-        The keyword-only parameter that used to be positional.
+    *names : str
+        The keyword-only parameters that used to be positional, in their old
+        order.
     after : int
-        How many positional parameters come before it.
+        How many positional parameters come before them.
 
     Returns
     -------
     decorator
-        Wraps a function so that a positional argument in place ``after``
-        warns and is passed as ``name=``; more positional arguments than
-        that, or the value given both ways, raise
+        Wraps a function so that positional arguments from place ``after`` on
+        warn and are passed as ``names[0]=``, ``names[1]=``, ...; more
+        positional arguments than that, or a value given both ways, raise
         :class:`~drakegrasp.InvalidOptionError`.
     """
+    if not names:
+        raise TypeError("keyword_only needs at least one parameter name")
 
     def decorate(function: F) -> F:
-        parameter = inspect.signature(function).parameters.get(name)
-        if parameter is None or parameter.kind is not inspect.Parameter.KEYWORD_ONLY:
-            raise TypeError(f"{function.__qualname__}: {name!r} is not keyword-only")
+        parameters = inspect.signature(function).parameters
+        for name in names:
+            parameter = parameters.get(name)
+            if (
+                parameter is None
+                or parameter.kind is not inspect.Parameter.KEYWORD_ONLY
+            ):
+                raise TypeError(
+                    f"{function.__qualname__}: {name!r} is not keyword-only"
+                )
         where = f"{function.__qualname__}()"
+        spelled = ", ".join(f"{name}=" for name in names)
 
         @functools.wraps(function)
         def wrapper(*args, **kwargs):
             if len(args) > after:
-                if len(args) > after + 1:
+                extra = args[after:]
+                if len(extra) > len(names):
                     raise InvalidOptionError(
                         f"{where} takes {after} positional arguments and "
-                        f"{name}= by keyword; got {len(args)} positional"
+                        f"{spelled} by keyword; got {len(args)} positional"
                     )
-                if name in kwargs:
-                    raise InvalidOptionError(
-                        f"{where} got {name} both by position and as {name}="
-                    )
+                moved = names[: len(extra)]
+                for name in moved:
+                    if name in kwargs:
+                        raise InvalidOptionError(
+                            f"{where} got {name} both by position and as {name}="
+                        )
                 warn_deprecated(
-                    f"{where}: passing {name} by position is deprecated; "
-                    f"write {name}=...",
+                    f"{where}: passing {', '.join(moved)} by position is "
+                    f"deprecated; write {', '.join(f'{n}=...' for n in moved)}",
                     stacklevel=None,
                 )
-                kwargs[name] = args[after]
+                kwargs.update(zip(moved, extra, strict=True))
                 args = args[:after]
             return function(*args, **kwargs)
 

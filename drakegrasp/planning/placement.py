@@ -14,6 +14,7 @@ from collections import Counter
 import numpy as np
 from pydrake.geometry import Box, Sphere
 
+from drakegrasp.core.deprecation import keyword_only
 from drakegrasp.errors import NoContactsError, PenetrationError
 from drakegrasp.planning.gripper import ParallelJaw
 from drakegrasp.plant.contacts import (
@@ -65,7 +66,8 @@ def axis_frames(d: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return np.stack([d, y, np.cross(d, y)], axis=-1)
 
 
-def sample_poses(surface, gripper: ParallelJaw, X_WO, n, mu, clearance, rng, tol):
+@keyword_only("mu", "clearance", "rng", "tol", after=4)
+def sample_poses(surface, gripper: ParallelJaw, X_WO, n, *, mu, clearance, rng, tol):
     """Stage 1: antipodal hand poses from a surface's samples and chords.
 
     Parameters

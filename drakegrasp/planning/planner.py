@@ -474,7 +474,9 @@ def plan_grasps(
     settings["gripper"] = gripper.to_dict()
     torque_scale = surface.radius_about(reference)
     rng = np.random.default_rng(seed)
-    poses, rejections = sample_poses(surface, gripper, X_WO, n, mu, clearance, rng, tol)
+    poses, rejections = sample_poses(
+        surface, gripper, X_WO, n, mu=mu, clearance=clearance, rng=rng, tol=tol
+    )
     saved = plant.GetPositions(ctx).copy()
     closer = BodyCloser(plant, ctx, body, hand, gripper, tol)
     cloud = None

@@ -200,3 +200,33 @@ def test_planning_and_batch_stages_accept_the_old_spellings_with_a_warning():
         epsilon_l1_batch(
             *args, model="hard_finger", contact_model="hard_finger", num_generators=8
         )
+
+
+def test_keyword_only_moves_a_whole_old_positional_tail():
+    @keyword_only("mu", "clearance", after=1)
+    def f(x, *, mu, clearance=0.0):
+        return x, mu, clearance
+
+    assert f(1, mu=0.5, clearance=2.0) == (1, 0.5, 2.0)
+    with pytest.warns(DeprecationWarning, match="mu, clearance by position"):
+        assert f(1, 0.5, 2.0) == (1, 0.5, 2.0)
+    with pytest.warns(DeprecationWarning, match="passing mu by position"):
+        assert f(1, 0.5, clearance=3.0) == (1, 0.5, 3.0)
+    with pytest.raises(dg.InvalidOptionError, match="clearance both"):
+        f(1, 0.5, 2.0, clearance=3.0)
+    with pytest.raises(dg.InvalidOptionError, match="got 4 positional"):
+        f(1, 0.5, 2.0, 4.0)
+    with pytest.raises(TypeError):
+        keyword_only(after=0)
+    with pytest.raises(TypeError):
+        keyword_only("mu", "x", after=1)(f.__wrapped__)
+
+
+def test_sample_poses_takes_its_scalars_by_keyword():
+    import inspect
+
+    from drakegrasp.planning.placement import sample_poses
+
+    params = inspect.signature(sample_poses).parameters
+    for name in ("mu", "clearance", "rng", "tol"):
+        assert params[name].kind is inspect.Parameter.KEYWORD_ONLY

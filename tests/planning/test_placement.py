@@ -29,7 +29,9 @@ def _closer_and_poses(scene, n=600, seed=3):
     surface = object_surface(plant, ctx, body)
     X_WO = plant.EvalBodyPoseInWorld(ctx, body)
     rng = np.random.default_rng(seed)
-    poses, _ = sample_poses(surface, gripper, X_WO, n, 1.0, 5e-3, rng, TOL)
+    poses, _ = sample_poses(
+        surface, gripper, X_WO, n, mu=1.0, clearance=5e-3, rng=rng, tol=TOL
+    )
     closer = BodyCloser(plant, ctx, body, scene.hand, gripper, TOL)
     return closer, poses, surface, X_WO
 
