@@ -125,17 +125,9 @@ def _point_counts(mu, nu, *, contact_model: str, dim: int, num_generators: int):
 
 @renamed_keyword("model", "contact_model")
 def epsilon_l1_routes(
-    P,
-    Nrm,
-    mu,
-    nu,
-    p,
-    b,
-    *,
-    contact_model: str,
-    num_generators: int,
+    P, Nrm, mu, nu, p, b, *, contact_model: str, num_generators: int,
     kernel: str = "auto",
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Ferrari–Canny L1 ε of each grasp and which grasps took the Qhull route.
 
     Parameters
@@ -200,17 +192,9 @@ def epsilon_l1_routes(
 
 @renamed_keyword("model", "contact_model")
 def epsilon_l1_batch(
-    P,
-    Nrm,
-    mu,
-    nu,
-    p,
-    b,
-    *,
-    contact_model: str,
-    num_generators: int,
+    P, Nrm, mu, nu, p, b, *, contact_model: str, num_generators: int,
     kernel: str = "auto",
-) -> np.ndarray:
+) -> np.ndarray:  # fmt: skip
     """Ferrari–Canny L1 ε of each grasp of a chunk; see :func:`epsilon_l1_routes`."""
     return epsilon_l1_routes(
         P, Nrm, mu, nu, p, b, contact_model=contact_model,
