@@ -74,10 +74,10 @@ def tilt_box(theta):
         plant.GetJointByName(name).set_translation(context, q)
 
 
-def read_grasp(mu, model="soft_finger"):
-    nu = 0.1 if model == "soft_finger" else None
+def read_grasp(mu, contact_model="soft_finger"):
+    nu = 0.1 if contact_model == "soft_finger" else None
     data = grasp_from_plant(plant, context, object_body=box, hand=scene.hand, mu=mu,
-                            contact_model=model, torsional_friction=nu)  # fmt: skip
+                            contact_model=contact_model, torsional_friction=nu)  # fmt: skip
     return data
 
 
