@@ -308,7 +308,7 @@ def fan_capacity(
         Copies per grasp (the robustness samples); 0 gives the nominal
         capacity.
     rng : numpy.random.Generator
-    torque_scale, model, torsional_friction
+    torque_scale, contact_model, torsional_friction
         As for :func:`~drakegrasp.planning.weight.weight_capacity`.
 
     Returns

@@ -171,7 +171,7 @@ def reclosed_robustness(
     position, angle_deg, friction : float
         σ_p (m), σ_θ (degrees, about the axis), σ_μ (relative).
     tol : float
-    model, torsional_friction, workers
+    contact_model, torsional_friction, workers
         As :func:`~drakegrasp.batch.batch_force_closure`.
     reference : (3,) float, optional
         The point of O that moments are taken about (the object's centre of

@@ -275,7 +275,7 @@ def force_chunk(
         Reference points.
     b : (k,) float or None
         Characteristic lengths (None: the default of :class:`~drakegrasp.Grasp`).
-    model, num_generators, tol, rank_tol, metrics, kernel
+    contact_model, num_generators, tol, rank_tol, metrics, kernel
         As in :func:`drakegrasp.batch.batch_force_closure`.
     verdict_only : bool, optional
         Internal (:func:`~drakegrasp.batch.run.verdicts.force_verdicts`): each
