@@ -157,7 +157,7 @@ def _core_contact(
     *,
     plane: str | None,
     mu: float,
-    model: ContactModel,
+    contact_model: ContactModel,
     torsional_friction: float,
 ) -> Contact:
     position, normal = pc.p_OC, pc.nhat_O
@@ -176,7 +176,7 @@ def _core_contact(
         position,
         normal,
         mu=mu,
-        contact_model=model,
+        contact_model=contact_model,
         torsional_friction=torsional_friction,
     )
 
@@ -281,7 +281,7 @@ def grasp_from_plant(
         check_pose=check_pose,
     ).require_friction()
     with checked_context(plant, plant_context) as plant_context:
-        plane, model = opts.plane, opts.contact_model
+        plane = opts.plane
         distance_tolerance, allow_penetration = (
             opts.distance_tolerance,
             opts.allow_penetration,
@@ -326,7 +326,11 @@ def grasp_from_plant(
             mus = [opts.mu] * len(contacts)
         core = [
             _core_contact(
-                c, plane=plane, mu=m, model=model, torsional_friction=torsional_friction
+                c,
+                plane=plane,
+                mu=m,
+                contact_model=opts.contact_model,
+                torsional_friction=torsional_friction,
             )
             for c, m in zip(contacts, mus, strict=True)
         ]
