@@ -31,7 +31,9 @@ from drakegrasp.core.validation import (
 from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOptionError
 
 __all__ = [
+    "KERNELS",
     "METRICS",
+    "check_kernel",
     "check_metrics",
     "per_contact_getter",
     "resolve_kernel",
@@ -231,12 +233,22 @@ def compiled_route(kernel: str) -> bool:
     return kernel in ("numba", "unfused") or (kernel == "auto" and numba_available())
 
 
-def resolve_kernel(kernel: str) -> str:
-    """``kernel`` checked, and ``"auto"`` resolved to ``"numba"`` or ``"numpy"``."""
-    if kernel not in ("auto", "numba", "numpy"):
+KERNELS = ("auto", "numba", "numpy")
+"""The kernel choices of the batch engine (``"auto"``: numba when installed)."""
+
+
+def check_kernel(kernel: str) -> str:
+    """``kernel`` if it is one of :data:`KERNELS` (not resolved)."""
+    if kernel not in KERNELS:
         raise InvalidOptionError(
             f"kernel must be 'auto', 'numba' or 'numpy', got {kernel!r}"
         )
+    return kernel
+
+
+def resolve_kernel(kernel: str) -> str:
+    """``kernel`` checked, and ``"auto"`` resolved to ``"numba"`` or ``"numpy"``."""
+    check_kernel(kernel)
     if kernel == "numba":
         if not numba_available():
             raise InvalidOptionError(

@@ -3,7 +3,9 @@
 The twin of :class:`~drakegrasp.AnalysisOptions` for the batch engine: the
 options every batch entry point shares (contact model, cone size, thresholds,
 metrics, kernel, chunking, workers, progress), checked when the object is
-made and then passed as they are.  The per-grasp data (positions, normals,
+made, so a bad choice is refused before any array is read (the engine checks
+its keywords again when a run starts: the same checks, which pass them
+unchanged).  The per-grasp data (positions, normals,
 ``mu``, ``torsional_friction``, reference points, characteristic lengths)
 stay arguments of the call: they are arrays, not choices.
 
@@ -21,21 +23,29 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields
 from typing import Any, TypeVar
 
-from drakegrasp.batch.inputs import _check_tol, check_metrics, positive_int
+from drakegrasp.batch.inputs import (
+    _check_tol,
+    check_kernel,
+    check_metrics,
+    positive_int,
+)
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE
+from drakegrasp.batch.run.workers import check_workers
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import (
     DEFAULT_NUM_GENERATORS,
     DEFAULT_RANK_TOL,
     DEFAULT_TOL,
 )
-from drakegrasp.core.validation import check_flag, check_num_generators, integer_or_none
+from drakegrasp.core.validation import check_flag, check_num_generators
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["KERNELS", "BatchOptions", "takes_batch_options"]
-
-KERNELS = ("auto", "numba", "numpy")
-"""The kernel choices of the batch engine (``"auto"``: numba when installed)."""
+__all__ = [
+    "BatchOptions",
+    "checked_options",
+    "refuse_given_twice",
+    "takes_batch_options",
+]
 
 F = TypeVar("F", bound=Callable)
 
@@ -84,18 +94,6 @@ class BatchOptions:
     progress: bool = False
 
     def __post_init__(self) -> None:
-        if self.kernel not in KERNELS:
-            raise InvalidOptionError(
-                f"kernel must be one of {KERNELS}, got {self.kernel!r}"
-            )
-        workers = self.workers
-        if workers is not None:
-            workers = integer_or_none(workers)  # a bool is not a count
-            if workers is None or workers < 1:
-                raise InvalidOptionError(
-                    "workers must be None (every core) or an integer >= 1, got "
-                    f"{self.workers!r}"
-                )
         checked = {
             "contact_model": ContactModel.parse(self.contact_model),
             "num_generators": check_num_generators(self.num_generators),
@@ -105,7 +103,8 @@ class BatchOptions:
             "chunk_size": None
             if self.chunk_size is None
             else positive_int("chunk_size", self.chunk_size, 1),
-            "workers": workers,
+            "kernel": check_kernel(self.kernel),
+            "workers": check_workers(self.workers),
             "progress": check_flag("progress", self.progress),
         }
         for name, value in checked.items():
@@ -134,6 +133,26 @@ FRICTION_OPTIONS = ("contact_model", "num_generators")
 _DEFAULT = BatchOptions()
 
 
+def checked_options(options: Any, where: str) -> BatchOptions:
+    """``options`` if it is a :class:`BatchOptions`; refused, naming ``where``."""
+    if not isinstance(options, BatchOptions):
+        raise InvalidOptionError(
+            f"{where}: options must be a drakegrasp.BatchOptions, got "
+            f"{type(options).__name__}"
+        )
+    return options
+
+
+def refuse_given_twice(names: Sequence[str], given: Sequence[str], where: str) -> None:
+    """Refuse options ``names`` of an options object also given as keywords."""
+    both = sorted(set(names) & set(given))
+    if both:
+        raise InvalidOptionError(
+            f"{where}: {both} given both as keywords and in options; give "
+            "each option one way (options.replace(...) changes a copy)"
+        )
+
+
 def takes_batch_options(function: F) -> F:
     """Let a batch entry point take ``options=BatchOptions(...)``.
 
@@ -154,23 +173,14 @@ def takes_batch_options(function: F) -> F:
     def wrapper(*args, options: BatchOptions | None = None, **kwargs):
         if options is None:
             return function(*args, **kwargs)
-        if not isinstance(options, BatchOptions):
-            raise InvalidOptionError(
-                f"{where}: options must be a drakegrasp.BatchOptions, got "
-                f"{type(options).__name__}"
-            )
+        checked_options(options, where)
         unused = [n for n in absent if getattr(options, n) != getattr(_DEFAULT, n)]
         if unused:
             raise InvalidOptionError(
                 f"{where} does not take {unused}; leave them at their defaults "
                 "in options (options.replace(...))"
             )
-        both = sorted(set(names) & set(kwargs))
-        if both:
-            raise InvalidOptionError(
-                f"{where}: {both} given both as keywords and in options; give "
-                "each option one way (options.replace(...) changes a copy)"
-            )
+        refuse_given_twice(names, kwargs, where)
         return function(*args, **kwargs, **{n: getattr(options, n) for n in names})
 
     option = inspect.Parameter(

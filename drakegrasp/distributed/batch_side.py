@@ -36,7 +36,13 @@ from drakegrasp.batch.inputs import (
     positive_int,
     shape_of,
 )
-from drakegrasp.batch.options import FRICTION_OPTIONS, OPTION_NAMES, BatchOptions
+from drakegrasp.batch.options import (
+    FRICTION_OPTIONS,
+    OPTION_NAMES,
+    BatchOptions,
+    checked_options,
+    refuse_given_twice,
+)
 from drakegrasp.batch.run.stream import chunk_size_for
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only
@@ -94,9 +100,8 @@ def _slice_option(value, sl: slice, K: int):
 def _partition(kind, positions, normals, arrays, options, shard, chunk_size, job):
     """One partition through the local engine; write its shard or return arrays."""
     run = stream_force_closure if kind == "force" else stream_form_closure
-    args = (positions, normals) + ((arrays.pop("mu"),) if kind == "force" else ())
-    parts = [a for _, a in run(*args, **arrays, **options, chunk_size=chunk_size,
-                               workers=1)]  # fmt: skip
+    parts = [a for _, a in run(positions, normals, **arrays, **options,
+                               chunk_size=chunk_size, workers=1)]  # fmt: skip
     names = parts[0].keys() if parts else ()
     out = {n: np.concatenate([p[n] for p in parts]) for n in names}
     if shard is None:
@@ -251,16 +256,10 @@ def _engine_options(
     """
     if options is None:
         return keywords, chunk_size
-    if not isinstance(options, BatchOptions):
-        raise InvalidOptionError(
-            f"options must be a drakegrasp.BatchOptions, got {type(options).__name__}"
-        )
-    given = set(keywords) | ({"chunk_size"} if chunk_size is not None else set())
-    both = sorted(set(OPTION_NAMES) & given)
-    if both:
-        raise InvalidOptionError(
-            f"{both} given both as keywords and in options; give each option one way"
-        )
+    where = "evaluate_on_cluster()"
+    checked_options(options, where)
+    given = [*keywords, *(["chunk_size"] if chunk_size is not None else [])]
+    refuse_given_twice(OPTION_NAMES, given, where)
     merged = dict(keywords)
     default = BatchOptions()
     for name, value in options.keywords().items():

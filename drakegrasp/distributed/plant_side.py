@@ -12,7 +12,7 @@ import numpy as np
 from drakegrasp.core.validation import integer_or_none
 from drakegrasp.distributed.client import connected
 from drakegrasp.errors import GraspError, InvalidOptionError
-from drakegrasp.plant.options import AnalysisOptions
+from drakegrasp.plant.options import AnalysisOptions, checked_options
 
 __all__ = ["analyze_poses", "cached_scenes"]
 
@@ -118,12 +118,7 @@ def analyze_poses(
         array, or whose ``n_q`` is not the scene plant's number of positions.
     """
     if options is not None:
-        if not isinstance(options, AnalysisOptions):
-            raise InvalidOptionError(
-                "options must be a drakegrasp.AnalysisOptions, got "
-                f"{type(options).__name__}"
-            )
-        options, overrides = options.replace(**overrides), {}
+        options, overrides = checked_options(options).replace(**overrides), {}
     else:
         AnalysisOptions().replace(**overrides)  # a bad one fails here, not remotely
     n = integer_or_none(block)

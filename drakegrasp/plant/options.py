@@ -40,6 +40,7 @@ __all__ = [
     "PATCH_MODES",
     "PLANES",
     "AnalysisOptions",
+    "checked_options",
     "resolve_options",
 ]
 
@@ -250,6 +251,15 @@ def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
     return tuple(float(x) for x in values)
 
 
+def checked_options(options: Any) -> AnalysisOptions:
+    """``options`` if it is an :class:`AnalysisOptions`; refused otherwise."""
+    if not isinstance(options, AnalysisOptions):
+        raise InvalidOptionError(
+            f"options must be an AnalysisOptions, got {type(options).__name__}"
+        )
+    return options
+
+
 def resolve_options(
     options: AnalysisOptions | None, **keywords: Any
 ) -> AnalysisOptions:
@@ -261,10 +271,7 @@ def resolve_options(
     """
     if options is None:
         return AnalysisOptions(**keywords)
-    if not isinstance(options, AnalysisOptions):
-        raise InvalidOptionError(
-            f"options must be an AnalysisOptions, got {type(options).__name__}"
-        )
+    checked_options(options)
     defaults = AnalysisOptions()
     given = sorted(
         name

@@ -46,7 +46,13 @@ from drakegrasp.batch.run.shared_arrays import (
 from drakegrasp.core.validation import integer_or_none
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["available_cores", "map_ordered", "resolve_workers", "shutdown_pool"]
+__all__ = [
+    "available_cores",
+    "check_workers",
+    "map_ordered",
+    "resolve_workers",
+    "shutdown_pool",
+]
 
 PARENT_WATCH_PERIOD = 0.2
 """Seconds between a worker's checks that its parent is alive."""
@@ -62,16 +68,22 @@ def available_cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def resolve_workers(workers) -> int:
-    """``workers`` as a positive int: None means every available core."""
+def check_workers(workers) -> int | None:
+    """``workers`` checked: None (every core) or an int >= 1 (not resolved)."""
     if workers is None:
-        return available_cores()
+        return None
     n = integer_or_none(workers)  # bools are not counts (True was one worker)
     if n is None or n < 1:
         raise InvalidOptionError(
             f"workers must be None (every core) or an integer >= 1, got {workers!r}"
         )
     return n
+
+
+def resolve_workers(workers) -> int:
+    """``workers`` as a positive int: None means every available core."""
+    n = check_workers(workers)
+    return available_cores() if n is None else n
 
 
 def _call(fn: Callable, args: tuple, kwargs: dict):
