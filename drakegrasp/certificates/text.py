@@ -76,10 +76,11 @@ def _more(cert: Witness, what: str) -> str:
 
 
 def _contacts_text(cert: Witness) -> str:
-    sep = np.flatnonzero(cert.separating(1e-9))
+    separating = cert.separating()  # the certificate's CONTACT_RATE_TOL
+    sep = np.flatnonzero(separating)
     if sep.size == 0:
         return "every contact slides"
-    slide = np.flatnonzero(~cert.separating(1e-9))
+    slide = np.flatnonzero(~separating)
     text = f"contact{'s' if sep.size > 1 else ''} {', '.join(map(str, sep))} separate"
     if slide.size:
         text += f"; {', '.join(map(str, slide))} slide{'s' if slide.size == 1 else ''}"

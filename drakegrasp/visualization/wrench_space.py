@@ -35,7 +35,7 @@ __all__ = [
     "wrench_hull",
 ]
 
-HULL_TOL = 1e-9
+ORIGIN_CLEARANCE_TOL = 1e-9
 """Default distance (in the wrench space's units) by which every facet of the
 primitive wrenches' hull must clear the origin for it to count as inside."""
 
@@ -118,7 +118,7 @@ class WrenchHull:
     rank: int
 
 
-def wrench_hull(W: np.ndarray, *, tol: float = HULL_TOL) -> WrenchHull:
+def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHull:
     """Convex hull of the columns of ``W`` and whether it contains the origin.
 
     Parameters
@@ -200,7 +200,7 @@ def plot_wrench_space(
     ax: Any = None,
     hull: bool = True,
     rays: bool = True,
-    tol: float = HULL_TOL,
+    tol: float = ORIGIN_CLEARANCE_TOL,
     result: Any = None,
 ) -> WrenchSpacePlot:
     """Plot the primitive wrenches of a planar grasp and their convex hull.

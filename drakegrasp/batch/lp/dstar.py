@@ -184,7 +184,8 @@ def solve_dstar_blocks(
     # about 4 ipm_tol absolute accuracy at any N.
     tol_t = ipm_tol * min(1.0, 4.0 / N)
     band = None if verdict_tol is None else _verdict_band(verdict_tol, N)
-    use_numba = compiled_route(kernel) and kernel != "unfused"
+    compiled = compiled_route(kernel)  # "unfused" too: the loops, not the fused pass
+    use_numba = compiled and kernel != "unfused"
     if use_numba and M >= w and K > 0:
         # Certified full-rank grasps are prepared and solved in one compiled
         # pass (drakegrasp.batch.lp.fused_kernel); the rest take the path below.
@@ -226,7 +227,6 @@ def solve_dstar_blocks(
         if sel.size == 0:
             continue
         f0 = c / cnorm2
-        compiled = compiled_route(kernel)
         # The numpy IPM's last bits depend on its stack (the problems solved
         # together), so with it every grasp of the full solve stays in the stack
         # and the verdicts stay those of the full solve; the compiled IPM solves

@@ -29,9 +29,6 @@ least-squares multipliers satisfy ``Bᵀλ = e`` to this (what is certified);
 a shorter ``d`` is mostly rounding and would lead the steps astray."""
 _ACTIVE_TOL = 1e-12
 """Multipliers and slacks beyond ``-this`` (relative) count as zero."""
-"""A row blocks a step along the unit ``d`` when its rate exceeds this times its
-norm; a smaller rate is rounding of a row in the active rows' span (which the
-Gram–Schmidt basis would reject)."""
 
 
 @njit(cache=True, error_model="numpy")
