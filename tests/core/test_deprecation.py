@@ -143,7 +143,9 @@ def test_no_public_function_takes_a_scalar_mu_by_position_after_other_arguments(
         parameters = list(inspect.signature(function).parameters.values())
         for i, p in enumerate(parameters):
             if p.name == "mu" and i > 0 and p.kind is not p.KEYWORD_ONLY:
-                if p.annotation in ("float", float):
+                scalar = p.annotation in ("float", float)
+                # an unannotated mu with a default is a choice, not a data array
+                if scalar or (p.annotation is p.empty and p.default is not p.empty):
                     found.append(f"{module}.{name}")
     assert found == []
 

@@ -189,12 +189,14 @@ def test_batch_side_takes_a_batch_options(client, grasps, tmp_path):
                                 metrics=("sigma_min",), chunk_size=100)  # fmt: skip
     assert again == first  # the keywords' job is the options' job
     form = evaluate_on_cluster(client, P, Nrm, kind="form", options=opts)
-    assert (
-        form.d_star.tobytes()
-        == batch_form_closure(
-            P, Nrm, tol=1e-5, metrics=("sigma_min",), chunk_size=100, workers=1
-        ).d_star.tobytes()
+    ref = batch_form_closure(
+        P, Nrm, tol=1e-5, metrics=("sigma_min",), chunk_size=100, workers=1
     )
+    assert form.d_star.tobytes() == ref.d_star.tobytes()
+    # tol and metrics reach form closure too (margin reads tol; sigma_min is there)
+    assert form.to_arrays().keys() == ref.to_arrays().keys()
+    for name, x in form.to_arrays().items():
+        assert x.tobytes() == ref.to_arrays()[name].tobytes(), name
     with pytest.raises(InvalidOptionError, match="cannot be given on a cluster"):
         evaluate_on_cluster(client, P, Nrm, mu=mu, options=opts.replace(workers=2))
     with pytest.raises(InvalidOptionError, match="given both"):
