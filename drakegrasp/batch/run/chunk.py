@@ -98,6 +98,11 @@ def _lp1(Gn: np.ndarray, rank_tol: float, kernel: str):
     )
 
 
+def _compiled(kernel: str) -> bool:
+    """Whether a chunk's arrays are built by the compiled loops (numba)."""
+    return compiled_route(kernel)
+
+
 def _positions(P, compiled: bool):
     if compiled:
         from drakegrasp.batch.build.construction_kernel import (
@@ -146,7 +151,7 @@ def _normal_certificates(Pn, Nrm, kinds, rank, d_star, *, tol, rank_tol, kernel)
     rows = np.flatnonzero((rank == w) & frictional & ~(d_star > tol))
     if rows.size == 0:
         return out
-    compiled = compiled_route(kernel)
+    compiled = _compiled(kernel)
     if N <= w:
         # Balancing normal forces need N(G_n) != {0}; with no more contacts than
         # wrench rows that is rare.  A QR (as in rowspace; compiled: a Cholesky
@@ -196,9 +201,7 @@ def _layout_lp(Pn, Nrm, spread, mu_c, torsion, layout, n_g, rank_tol, kernel, ro
     no contact is soft) is ``b ν`` per contact.  ``verdict_tol``: see
     :func:`~drakegrasp.batch.lp.dstar.solve_dstar_blocks`.
     """
-    G, normal_cols = _grasp_matrices(
-        Pn, Nrm, None, layout, rows, compiled_route(kernel)
-    )
+    G, normal_cols = _grasp_matrices(Pn, Nrm, None, layout, rows, _compiled(kernel))
     if rows is not None:
         spread, mu_c = spread[rows], mu_c[rows]
         torsion = None if torsion is None else torsion[rows]
@@ -286,7 +289,7 @@ def force_chunk(
         ``normal_certificate`` and the metrics.
     """
     k, N, d = P.shape
-    compiled = compiled_route(kernel)
+    compiled = _compiled(kernel)
     if b is None and (contact_model == "soft_finger" or metrics):  # else b is unused
         b = batched_characteristic_lengths(P, p)
     Pn, spread = _positions(P, compiled)
@@ -342,7 +345,7 @@ def form_chunk(
 ) -> dict[str, np.ndarray]:
     """LP1 (first-order form closure) of one chunk; see :func:`force_chunk`."""
     k, N, d = P.shape
-    compiled = compiled_route(kernel)
+    compiled = _compiled(kernel)
     Pn, _ = _positions(P, compiled)
     sol = _lp1(_normal_matrices(Pn, Nrm, None, None, compiled), rank_tol, kernel)
     out = finish(
