@@ -55,7 +55,7 @@ from drakegrasp.planning.gripper import free_base
 from drakegrasp.planning.placement import axis_frames
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import HandStructure, hand_structure
+from drakegrasp.plant.fingers import HandStructure, hand_structure, tip_bodies
 from drakegrasp.plant.validation import HandSpec, hand_bodies
 
 __all__ = ["MultiFingerHand", "multi_finger_hand", "sample_approaches"]
@@ -172,20 +172,6 @@ def _centres(plant, ctx, inspector, H, bodies) -> list[np.ndarray]:
     return out
 
 
-def _geometric_tip(plant, structure: HandStructure, finger) -> list:
-    """A finger's bodies with collision geometry that the most of its joints move.
-
-    The tip of :mod:`drakegrasp.plant.fingers` without an object to pair with
-    (a point cloud).
-    """
-    joints = [structure.joints[k].index() for k in finger.joints]
-    moved = [set(map(int, plant.GetBodiesKinematicallyAffectedBy([j]))) for j in joints]
-    shaped = [b for b in finger.bodies if plant.GetCollisionGeometriesForBody(b)]
-    depth = {id(b): sum(int(b.index()) in m for m in moved) for b in shaped}
-    deepest = max(depth.values(), default=0)
-    return [b for b in shaped if depth[id(b)] == deepest]
-
-
 def _curl(tips, q0, structure, steps=_CURL_STEPS) -> np.ndarray:
     """The closed hand: ``q0`` moved to draw the fingertips together.
 
@@ -291,12 +277,12 @@ def multi_finger_hand(
         raise InvalidOptionError("synergy must move at least one closing joint")
     ctx = plant.CreateDefaultContext()
     H = base.body_frame()
-    tip_bodies = [
+    finger_tips = [
         list({id(b): b for _, _, b in f.tip_pairs}.values())
-        or _geometric_tip(plant, structure, f)  # no object geometry (a cloud)
+        or tip_bodies(plant, structure, f)  # no object geometry (a cloud)
         for f in structure.fingers
     ]
-    if not any(tip_bodies):
+    if not any(finger_tips):
         raise ModelError("the hand's fingers have no collision geometry to grasp with")
 
     def tips(q):  # (F', 3) fingertip centres in H at closing-joint values q
@@ -306,7 +292,7 @@ def multi_finger_hand(
         return np.array(
             [
                 np.mean(_centres(plant, ctx, inspector, H, b), axis=0)
-                for b in tip_bodies
+                for b in finger_tips
                 if b
             ]
         )

@@ -75,7 +75,6 @@ from pydrake.geometry import Box, Capsule, Cylinder, Sphere
 from pydrake.multibody.tree import JacobianWrtVariable
 from scipy.spatial import cKDTree
 
-from drakegrasp.planning.approach import _geometric_tip
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
     SHADOW_PROBES,
@@ -89,6 +88,7 @@ from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.advancement import geometry_reach
 from drakegrasp.plant.closing import DEFAULT_MAX_ITERATIONS
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
+from drakegrasp.plant.fingers import tip_bodies
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
@@ -317,9 +317,7 @@ class CloudHand:
             geometry_reach(plant, ctx, s, [(g.id, g.body) for g in geoms], inspector)
             for geoms in self.fingers
         ]
-        tips = [
-            {int(b.index()) for b in _geometric_tip(plant, s, f)} for f in s.fingers
-        ]
+        tips = [{int(b.index()) for b in tip_bodies(plant, s, f)} for f in s.fingers]
         self.tips = [
             [k for k, g in enumerate(geoms) if int(g.body.index()) in tip]
             or list(range(len(geoms)))

@@ -46,7 +46,7 @@ from drakegrasp.core.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import flat_faces, surface_pieces
 from drakegrasp.plant.contacts import PlantContact, resolve_object_body
-from drakegrasp.plant.jacobians import PLANES
+from drakegrasp.plant.options import PLANES
 from drakegrasp.plant.validation import plant_context_of, query_object_of
 
 __all__ = ["SECOND_ORDER_RANK_TOL", "contact_curvatures", "shape_curvature"]

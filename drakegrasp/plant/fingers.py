@@ -52,6 +52,7 @@ __all__ = [
     "MAX_STEP",
     "find_joint",
     "hand_structure",
+    "tip_bodies",
 ]
 
 MAX_STEP = {"revolute": 0.2, "prismatic": 0.01}
@@ -384,6 +385,35 @@ def hand_structure(
         # with the context it came from.
         _KEPT.setdefault(plant, {})[key] = (copy.copy(version), _recipe(structure))
     return structure
+
+
+def tip_bodies(
+    plant: MultibodyPlant, structure: HandStructure, finger: Finger
+) -> list[RigidBody]:
+    """A finger's tip from the plant alone: no object to pair its geometry with.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        The finalized plant ``structure`` was found in.
+    structure : HandStructure
+    finger : Finger
+        One of ``structure.fingers``.
+
+    Returns
+    -------
+    list of RigidBody
+        The finger's bodies with collision geometry that the most of its joints
+        move (the module docstring's tip), in ``finger.bodies`` order.
+        ``finger.tip_pairs`` holds the same bodies' pairs with an object's
+        geometry; this is the tip where there is none (a point cloud).
+    """
+    joints = [structure.joints[k].index() for k in finger.joints]
+    moved = [set(map(int, plant.GetBodiesKinematicallyAffectedBy([j]))) for j in joints]
+    shaped = [b for b in finger.bodies if plant.GetCollisionGeometriesForBody(b)]
+    depth = {id(b): sum(int(b.index()) in m for m in moved) for b in shaped}
+    deepest = max(depth.values(), default=0)
+    return [b for b in shaped if depth[id(b)] == deepest]
 
 
 def _couplings_key(plant, couplings) -> tuple:

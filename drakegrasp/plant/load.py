@@ -39,7 +39,7 @@ from drakegrasp.plant.friction import (
     friction_rule,
     plant_friction,
 )
-from drakegrasp.plant.jacobians import PLANES
+from drakegrasp.plant.options import PLANES
 from drakegrasp.plant.validation import (
     plant_context_of,
     resolve_object_body,

@@ -32,7 +32,7 @@ import yaml
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.errors import GraspError, SceneError
-from drakegrasp.plant.jacobians import PLANES
+from drakegrasp.plant.options import PLANES
 
 __all__ = [
     "KEYS",

@@ -30,7 +30,7 @@ from pydrake.multibody.tree import BodyIndex
 
 from drakegrasp.certificates.certificate import ESCAPE_TWIST, Certificate
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.plant.jacobians import PLANES
+from drakegrasp.plant.options import PLANES
 
 __all__ = ["EscapeAnimation", "animate_escape", "escape_transform"]
 
