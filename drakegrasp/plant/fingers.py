@@ -316,17 +316,17 @@ def _finger(plant, members, moved, bodies, position, object_geometries, inspecto
         for go in object_geometries
         if not inspector.CollisionFiltered(go, gf)
     )
-    depth = {
-        int(b.index()): sum(int(b.index()) in moved[int(j.index())] for j in members)
-        for b in finger_bodies
+    paired = list({int(b.index()): b for _, _, b in pairs}.values())
+    tip = {
+        int(b.index())
+        for b in _deepest(paired, [moved[int(j.index())] for j in members])
     }
-    deepest = max((depth[int(b.index())] for _, _, b in pairs), default=0)
     return Finger(
         name=" + ".join(joint_name(plant, j) for j in roots),
         joints=tuple(sorted(position[int(j.index())] for j in members)),
         bodies=finger_bodies,
         pairs=pairs,
-        tip_pairs=tuple(p for p in pairs if depth[int(p[2].index())] == deepest),
+        tip_pairs=tuple(p for p in pairs if int(p[2].index()) in tip),
         max_step=min(
             MAX_STEP["revolute" if j.type_name() == "revolute" else "prismatic"]
             for j in members
@@ -411,9 +411,17 @@ def tip_bodies(
     joints = [structure.joints[k].index() for k in finger.joints]
     moved = [set(map(int, plant.GetBodiesKinematicallyAffectedBy([j]))) for j in joints]
     shaped = [b for b in finger.bodies if plant.GetCollisionGeometriesForBody(b)]
-    depth = {id(b): sum(int(b.index()) in m for m in moved) for b in shaped}
-    deepest = max(depth.values(), default=0)
-    return [b for b in shaped if depth[id(b)] == deepest]
+    return _deepest(shaped, moved)
+
+
+def _deepest(bodies: list, moved: list[set[int]]) -> list:
+    """A finger's tip: the ``bodies`` that the most of the joints move, in order.
+
+    ``moved`` holds, per joint, the indices of the bodies that joint moves.
+    """
+    depth = [sum(int(b.index()) in m for m in moved) for b in bodies]
+    top = max(depth, default=0)
+    return [b for b, d in zip(bodies, depth, strict=True) if d == top]
 
 
 def _couplings_key(plant, couplings) -> tuple:

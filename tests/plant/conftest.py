@@ -148,6 +148,20 @@ class RealScene:
         self.plant.SetPositions(self.ctx, self.hand, np.asarray(q, dtype=float))
 
 
+def structure_of(scene):
+    """The scene's hand structure computed anew, as a planner passes it."""
+    from drakegrasp.plant.couplings import plant_couplings
+    from drakegrasp.plant.fingers import hand_structure
+    from drakegrasp.plant.validation import hand_bodies, query_object_of
+
+    inspector = query_object_of(scene.plant, scene.ctx).inspector()
+    return hand_structure(
+        scene.plant, scene.object,
+        hand_bodies(scene.plant, scene.object, scene.hand),
+        plant_couplings(scene.plant), inspector=inspector,
+    )  # fmt: skip
+
+
 def _rt(R, p):
     from pydrake.math import RigidTransform, RotationMatrix
 

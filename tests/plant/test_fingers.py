@@ -10,18 +10,9 @@ from __future__ import annotations
 
 import pytest
 
-from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import hand_structure, tip_bodies
-from drakegrasp.plant.validation import hand_bodies, query_object_of
+from drakegrasp.plant.fingers import tip_bodies
 
-
-def _structure(scene):
-    inspector = query_object_of(scene.plant, scene.ctx).inspector()
-    return hand_structure(
-        scene.plant, scene.object,
-        hand_bodies(scene.plant, scene.object, scene.hand),
-        plant_couplings(scene.plant), inspector=inspector,
-    )  # fmt: skip
+from .conftest import structure_of
 
 
 @pytest.mark.parametrize(
@@ -36,7 +27,7 @@ def test_the_tip_from_the_plant_alone_is_the_tip_of_the_pairs(
     real_hands, hand, fingers, tip_names
 ):
     scene = getattr(real_hands, hand)()
-    structure = _structure(scene)
+    structure = structure_of(scene)
     assert len(structure.fingers) == fingers
     names = set()
     for finger in structure.fingers:

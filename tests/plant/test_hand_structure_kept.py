@@ -14,11 +14,10 @@ from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
 from drakegrasp import UnreachableError, close_hand
 from drakegrasp.plant import fingers
 from drakegrasp.plant.closing import close_checked_hand
-from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import hand_structure
 from drakegrasp.plant.validation import hand_bodies, query_object_of
 
-from .conftest import ALLEGRO_URL, RealScene
+from .conftest import ALLEGRO_URL, RealScene, structure_of
 
 CAN_URL = "package://drake_models/ycb/005_tomato_soup_can.sdf"
 
@@ -31,16 +30,6 @@ def _scene(models_dir, p_WO=(0.08, 0.0, 0.1)):
     )
     scene.plant.GetJointByName("joint_12").set_angle(scene.ctx, 1.0)
     return scene
-
-
-def _fresh_structure(scene):
-    """The scene's hand structure computed anew, as a planner passes it."""
-    inspector = query_object_of(scene.plant, scene.ctx).inspector()
-    return hand_structure(
-        scene.plant, scene.object,
-        hand_bodies(scene.plant, scene.object, scene.hand),
-        plant_couplings(scene.plant), inspector=inspector,
-    )  # fmt: skip
 
 
 def _summary(s) -> tuple:
@@ -136,7 +125,7 @@ def test_the_checked_closing_equals_close_hand(drake_models_dir):
             plain = type(e)
         q_plain = scene.plant.GetPositions(scene.ctx).copy()
         scene.plant.SetPositions(scene.ctx, q0)
-        structure = _fresh_structure(scene)
+        structure = structure_of(scene)
         try:
             checked = close_checked_hand(
                 scene.plant, scene.ctx, scene.object, structure,
@@ -162,7 +151,7 @@ def test_the_checked_closing_refuses_too_many_fingers_as_close_hand(drake_models
     q0 = scene.plant.GetPositions(scene.ctx).copy()
     with pytest.raises(UnreachableError) as plain:
         close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand, min_fingers=9)
-    structure = _fresh_structure(scene)
+    structure = structure_of(scene)
     with pytest.raises(UnreachableError) as checked:
         close_checked_hand(
             scene.plant, scene.ctx, scene.object, structure, tol=1e-4, min_fingers=9,
