@@ -86,7 +86,8 @@ def solve(
     Raises
     ------
     SolverError
-        No solver of this kind is available.
+        No solver of this kind is available, or the solver raised (out of
+        memory on a huge program, say).
     """
     solvers = _available(kind)
     if not solvers:
@@ -96,13 +97,31 @@ def solve(
             "(they ship with Drake's wheel)",
             program=prog,
         )
-    result = solvers[0].Solve(prog)
+    result = _run(solvers[0], prog, kind)
     if retry:
         for solver in solvers[1:]:
             if result.get_solution_result() in VERDICT_STATUSES:
                 break
-            result = solver.Solve(prog)
+            result = _run(solver, prog, kind)
     return result
+
+
+def _run(solver, prog: MathematicalProgram, kind: str) -> MathematicalProgramResult:
+    """``solver.Solve(prog)``, a solver's own exception turned into a SolverError.
+
+    A solver that cannot hold the program (Clp's ``vector::reserve`` on an LP
+    of tens of thousands of variables, an out-of-memory) raises from C++; the
+    caller gets a :class:`SolverError` naming the solver and the program's size.
+    """
+    try:
+        return solver.Solve(prog)
+    except (RuntimeError, ValueError, MemoryError) as err:
+        raise SolverError(
+            f"{solver.solver_id().name()} failed on this {kind.upper()} of "
+            f"{prog.num_vars()} variables and {len(prog.GetAllConstraints())} "
+            f"constraints: {type(err).__name__}: {err}",
+            program=prog,
+        ) from err
 
 
 def require_solution(

@@ -316,3 +316,19 @@ def test_require_solution_on_a_real_infeasible_lp():
     ) as info:
         _solvers.require_solution(prog, result, "LP3")
     assert info.value.result is result
+
+
+@pytest.mark.parametrize("raised", [ValueError("vector::reserve"), MemoryError()])
+def test_a_solver_that_raises_is_a_solver_error_naming_it_and_the_size(
+    monkeypatch, raised
+):
+    class Raising(_fake_solver([], "Huge")):
+        def Solve(self, prog):
+            raise raised
+
+    monkeypatch.setitem(_solvers._ORDER, "lp", (Raising,))
+    prog = MathematicalProgram()
+    prog.NewContinuousVariables(7)
+    with pytest.raises(dg.SolverError, match=r"Huge failed on this LP of 7 var") as e:
+        _solvers.solve(prog, "lp")
+    assert e.value.program is prog and e.value.__cause__ is raised

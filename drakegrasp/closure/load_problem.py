@@ -410,7 +410,10 @@ def _far_from_one(mu: float) -> bool:
 
 def _rotation(Gbar: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """``U``: left singular vectors of the normal columns (the wrenches they make)."""
-    return np.linalg.svd(Gbar[:, normals], full_matrices=True)[0]
+    A = Gbar[:, normals]
+    # All m left vectors are needed; the full right factor (n x n, gigabytes
+    # for thousands of contacts) only when there are fewer columns than rows.
+    return np.linalg.svd(A, full_matrices=A.shape[1] < A.shape[0])[0]
 
 
 def _rounding(U: np.ndarray, A: np.ndarray) -> np.ndarray:

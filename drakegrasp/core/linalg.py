@@ -71,21 +71,46 @@ def equilibrated(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     A : (..., m, n) float
-        A matrix, or a stack of matrices (each scaled on its own).
+        A finite real matrix, or a stack of matrices (each scaled on its own).
 
     Returns
     -------
     A_s : (..., m, n) float
         ``A`` with every non-zero column scaled to unit length.
     scale : (..., n) float
-        ``1 / ‖A_j‖`` per column (1 for a zero column).
+        ``1 / ‖A_j‖`` per column (1 for a zero column; ``inf`` for a column
+        whose norm is subnormal, below 2.2e-308, whose reciprocal no double
+        holds: ``A_s`` still has it as a unit column).
+
+    Raises
+    ------
+    InvalidOptionError
+        ``A`` not a real array of at least two dimensions, or not finite.
     """
-    # safe_norm: a soft finger's torsion column of a grasp 1e-168 m across holds
-    # 1/spread ~ 1e168, whose square overflowed the plain norm to inf (scale 0)
-    norms = safe_norm(A, axis=-2) if A.size else np.zeros(A.shape[:-2] + A.shape[-1:])
+    A = real_array("A", A, error=InvalidOptionError)
+    if A.ndim < 2:
+        raise InvalidOptionError(
+            f"equilibrated needs a matrix or a stack of matrices, got shape {A.shape}"
+        )
+    if A.size == 0:
+        return A.copy(), np.ones(A.shape[:-2] + A.shape[-1:])
+    # The norm of each column divided by its largest |entry| first (safe_norm):
+    # a soft finger's torsion column of a grasp 1e-168 m across holds
+    # 1/spread ~ 1e168, whose square overflows the plain norm to inf.
+    peak = np.max(np.abs(A), axis=-2)
+    if not np.all(np.isfinite(peak)):
+        raise InvalidOptionError("equilibrated needs a finite matrix, got inf or NaN")
+    norms = safe_norm(A, axis=-2)
     scale = np.ones_like(norms)
-    np.divide(1.0, norms, out=scale, where=norms > 0.0)
-    return A * scale[..., None, :], scale
+    with np.errstate(over="ignore", divide="ignore"):
+        np.divide(1.0, norms, out=scale, where=norms > 0.0)
+    A_s = A * scale[..., None, :]
+    tiny = np.isinf(scale)  # a subnormal column: scaled in two steps instead
+    if tiny.any():
+        reduced = A / np.where(tiny, peak, 1.0)[..., None, :]
+        unit = reduced / np.linalg.norm(reduced, axis=-2, keepdims=True)
+        A_s = np.where(tiny[..., None, :], unit, A_s)
+    return A_s, scale
 
 
 def row_space(A: np.ndarray, rank_tol: float = DEFAULT_RANK_TOL) -> np.ndarray:
@@ -102,7 +127,7 @@ def row_space(A: np.ndarray, rank_tol: float = DEFAULT_RANK_TOL) -> np.ndarray:
         The right singular vectors whose singular values exceed
         ``rank_tol σ_max`` (``r = 0`` for a zero matrix).
     """
-    _, s, vt = np.linalg.svd(A)
+    _, s, vt = np.linalg.svd(A, full_matrices=False)  # (min(m, n), n) suffice
     if s.size == 0 or s[0] == 0.0:
         return np.zeros((0, A.shape[1]))
     return vt[: int(np.sum(s > rank_tol * s[0]))]

@@ -1,8 +1,10 @@
-"""core.linalg's rotations against an independent route (scipy's rotation vectors)."""
+"""core.linalg against independent routes (scipy's rotation vectors, norms)."""
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
+import drakegrasp as dg
 from drakegrasp.core.linalg import rotations_about
 
 
@@ -41,3 +43,44 @@ def test_equilibrated_gives_unit_columns_keeps_zero_ones_and_stacks():
         np.testing.assert_array_equal(scales[k], s_one)
     empty, s_empty = equilibrated(np.zeros((3, 0, 4)))
     assert empty.shape == (3, 0, 4) and np.all(s_empty == 1.0)
+
+
+@pytest.mark.parametrize(
+    ("A", "message"),
+    [
+        (np.array([1.0, 2.0]), "shape"),
+        (np.float64(1.0), "shape"),
+        (np.array([[np.inf, 1.0], [0.0, 1.0]]), "finite"),
+        (np.array([[np.nan, 1.0], [0.0, 1.0]]), "finite"),
+        (np.array([[1j, 1.0], [0.0, 1.0]]), "complex"),
+        ("matrix", "real"),
+    ],
+)
+def test_equilibrated_refuses_what_is_not_a_finite_real_matrix(A, message):
+    from drakegrasp.core.linalg import equilibrated
+
+    with pytest.raises(dg.InvalidOptionError, match=message):
+        equilibrated(A)
+
+
+@pytest.mark.parametrize("tiny", [1e-310, 5e-324])
+def test_equilibrated_keeps_a_subnormal_column_a_unit_column(tiny):
+    from drakegrasp.core.linalg import equilibrated
+
+    with np.errstate(over="raise", invalid="raise", divide="raise"):
+        A_s, scale = equilibrated(np.array([[tiny, 0.0], [tiny, 2.0]]))
+    np.testing.assert_allclose(A_s, [[2**-0.5, 0.0], [2**-0.5, 1.0]], rtol=1e-15)
+    assert scale[0] == np.inf and scale[1] == 0.5  # 1/|col| holds in no double
+    lists, _ = equilibrated([[3.0, 0.0], [4.0, 1.0]])  # a nested list is a matrix
+    np.testing.assert_allclose(lists, [[0.6, 0.0], [0.8, 1.0]], rtol=1e-15)
+
+
+def test_row_space_of_a_wide_matrix_needs_no_square_factor():
+    from drakegrasp.core.linalg import row_space
+
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(6, 4)) @ rng.normal(size=(4, 30_000))  # rank 4
+    R = row_space(A)  # a full V would be 30,000 x 30,000: 7.2 GB
+    assert R.shape == (4, 30_000)
+    np.testing.assert_allclose(R @ R.T, np.eye(4), atol=1e-12)
+    np.testing.assert_allclose(A @ R.T @ R, A, atol=1e-9 * np.abs(A).max())
