@@ -492,7 +492,7 @@ def _add_analysis_options(parser: argparse.ArgumentParser) -> None:
         shown = (
             "the scene's"
             if name in _SCENE_OPTIONS
-            else "the farthest contact from O's origin"
+            else "the farthest contact from the reference point, O's origin"
             if default is None
             else f"{default}"
         )
@@ -562,8 +562,9 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "stored as arrays positions (K, N, d) and normals (K, N, d) [, mu, "
         "torsional_friction, reference_points, characteristic_lengths] in an "
         ".npz file or a directory of .npy files (read chunk by chunk), and "
-        "write is_closure, d_star, rank, margin, converged and "
-        "the requested metrics to OUT (.npz, or .parquet with pyarrow).",
+        "write is_closure, d_star, margin, converged, rank, required_rank, "
+        "kind, tol, normal_certificate (--kind force) and the requested "
+        "metrics to OUT (.npz, or .parquet with pyarrow).",
     )
     batch.add_argument(
         "input", help="input .npz file, or a directory of .npy files (memory-mapped)"

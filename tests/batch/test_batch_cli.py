@@ -110,3 +110,25 @@ def test_scheduler_refuses_options_it_would_ignore(
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"{named} cannot be used with --scheduler" in err
     assert not out.exists()
+
+
+def test_an_unwritable_output_names_the_users_path_not_a_temporary_one(
+    grasp_file, tmp_path, capsys, monkeypatch
+):
+    import os
+
+    path, _, _ = grasp_file
+    out = tmp_path / "out.npz"
+    real_open = os.open
+
+    def refuse(name, flags, *args):  # a read-only folder, even for root
+        if str(name).endswith(".partial"):
+            raise PermissionError(13, "Permission denied", str(name))
+        return real_open(name, flags, *args)
+
+    monkeypatch.setattr(os, "open", refuse)
+    code = main(["batch", str(path), str(out)])
+    err = capsys.readouterr().err
+    assert code == 1 and f"cannot write '{out}': Permission denied" in err
+    assert ".partial" not in err and err.count("\n") == 1
+    assert not list(tmp_path.glob(".out.npz*"))

@@ -188,6 +188,11 @@ def _new_sibling(path: Path) -> str:
             fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
         except FileExistsError:
             continue
+        except OSError as err:  # the user's path, not our temporary name
+            raise BatchFileError(
+                f"cannot write {str(path)!r}: {err.strerror or err} (the output "
+                f"is written beside it first, in {str(path.parent)!r})"
+            ) from None
         os.close(fd)
         return str(tmp)
     raise BatchFileError(  # pragma: no cover - 100 collisions of 48 random bits
