@@ -32,12 +32,13 @@ from drakegrasp.batch.inputs import (
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE
 from drakegrasp.batch.run.workers import check_workers
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import (
     DEFAULT_NUM_GENERATORS,
     DEFAULT_RANK_TOL,
     DEFAULT_TOL,
 )
-from drakegrasp.core.validation import check_flag, check_num_generators
+from drakegrasp.core.validation import check_flag, check_num_generators, checked_fields
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -50,6 +51,8 @@ __all__ = [
 F = TypeVar("F", bound=Callable)
 
 
+@renamed_keyword("model", "contact_model")
+@checked_fields("batch option")
 @dataclass(frozen=True)
 class BatchOptions:
     """Every choice of a batch run besides its arrays, checked once.

@@ -134,7 +134,21 @@ def _unit_normal(normal: np.ndarray) -> np.ndarray:
     return unit_vectors("normal", n)
 
 
-def _deprecated_model(contact_model, deprecated: dict, where: str):
+class _DefaultModel:
+    """The default of ``contact_model=``: a hard finger, told apart from one given.
+
+    ``model=`` (deprecated) may replace the default but not a model the caller
+    wrote, even a hard finger.
+    """
+
+    def __repr__(self) -> str:
+        return "ContactModel.HARD_FINGER"
+
+
+_DEFAULT_MODEL = _DefaultModel()
+
+
+def _deprecated_model(contact_model, deprecated: dict, where: str) -> ContactModel:
     """``contact_model``, or the deprecated ``model=`` of ``deprecated`` (warned)."""
     unknown = set(deprecated) - {"model"}
     if unknown:
@@ -142,10 +156,10 @@ def _deprecated_model(contact_model, deprecated: dict, where: str):
             f"{where} got unexpected keyword(s) {sorted(unknown)}"
         )
     if "model" not in deprecated:
+        if contact_model is _DEFAULT_MODEL:
+            return ContactModel.HARD_FINGER
         return contact_model
-    # The default is the one value model= may be combined with (it cannot be
-    # told apart from an explicit hard finger, which model= then overrides).
-    if contact_model is not ContactModel.HARD_FINGER:
+    if contact_model is not _DEFAULT_MODEL:
         raise InvalidContactError(
             f"{where} got both model= (deprecated) and contact_model=; give "
             "contact_model= only"
@@ -214,7 +228,7 @@ class Contact:
         normal: np.ndarray,
         *,
         mu: float = 0.0,
-        contact_model: ContactModel | str = ContactModel.HARD_FINGER,
+        contact_model: ContactModel | str = _DEFAULT_MODEL,  # type: ignore[assignment]
         torsional_friction: float | None = None,
         **deprecated,
     ) -> None:
@@ -326,7 +340,7 @@ class Contact:
         if "model" in changes:
             changes = dict(changes)
             changes["contact_model"] = _deprecated_model(
-                changes.pop("contact_model", ContactModel.HARD_FINGER),
+                changes.pop("contact_model", _DEFAULT_MODEL),
                 {"model": changes.pop("model")},
                 "Contact.with_()",
             )

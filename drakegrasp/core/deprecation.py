@@ -53,32 +53,52 @@ def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
     -------
     decorator
         Wraps a function so that ``f(..., old=x)`` warns and calls
-        ``f(..., new=x)``; ``f(..., old=x, new=y)`` raises
-        :class:`~drakegrasp.InvalidOptionError`.
+        ``f(..., new=x)``; ``f(..., old=x, new=y)`` (``new`` by position or by
+        name) raises :class:`~drakegrasp.InvalidOptionError`.  A class gets its
+        ``__init__`` wrapped.
     """
 
     def decorate(function: F) -> F:
-        if new not in inspect.signature(function).parameters:
-            raise TypeError(f"{function.__qualname__} has no parameter {new!r}")
-        where = f"{function.__qualname__}()"
-
-        @functools.wraps(function)
-        def wrapper(*args, **kwargs):
-            if old in kwargs:
-                if new in kwargs:
-                    raise InvalidOptionError(
-                        f"{where} got both {old}= (deprecated) and {new}=; give "
-                        f"{new}= only"
-                    )
-                warn_deprecated(
-                    f"{where}: {old}= is deprecated; use {new}=", stacklevel=None
-                )
-                kwargs[new] = kwargs.pop(old)
-            return function(*args, **kwargs)
-
-        return wrapper  # type: ignore[return-value]
+        if inspect.isclass(function):
+            cls = function
+            cls.__init__ = _renamed(cls.__init__, old, new, f"{cls.__qualname__}()")
+            return cls
+        return _renamed(function, old, new, f"{function.__qualname__}()")
 
     return decorate
+
+
+def _renamed(function: F, old: str, new: str, where: str) -> F:
+    """``function`` taking ``old=`` for ``new=`` (see :func:`renamed_keyword`)."""
+    parameters = list(inspect.signature(function).parameters.values())
+    names = [p.name for p in parameters]
+    if new not in names:
+        raise TypeError(f"{function.__qualname__} has no parameter {new!r}")
+    # Where ``new`` sits among the positional parameters (None if it cannot
+    # be given by position): a call may give it there and ``old=`` as well.
+    place = names.index(new)
+    positional = (
+        inspect.Parameter.POSITIONAL_ONLY,
+        inspect.Parameter.POSITIONAL_OR_KEYWORD,
+    )
+    if parameters[place].kind not in positional:
+        place = None
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        if old in kwargs:
+            if new in kwargs or (place is not None and len(args) > place):
+                raise InvalidOptionError(
+                    f"{where} got both {old}= (deprecated) and {new}= (or "
+                    f"{new} by position); give {new}= only"
+                )
+            warn_deprecated(
+                f"{where}: {old}= is deprecated; use {new}=", stacklevel=None
+            )
+            kwargs[new] = kwargs.pop(old)
+        return function(*args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
 
 
 def keyword_only(*names: str, after: int) -> Callable[[F], F]:

@@ -385,13 +385,7 @@ def plan_grasps(
         raise InvalidOptionError(
             f"weight_check must be an integer >= 0 or None, got {weight_check!r}"
         )
-    try:
-        contact_model = ContactModel(contact_model).value
-    except ValueError:
-        raise InvalidOptionError(
-            f"contact_model must be one of {[m.value for m in ContactModel]}, got "
-            f"{contact_model!r}"
-        ) from None
+    contact_model = ContactModel.parse(contact_model).value
     if contact_model == ContactModel.SOFT_FINGER.value and torsional_friction is None:
         raise InvalidOptionError(
             "contact_model='soft_finger' needs torsional_friction (nu >= 0: the "

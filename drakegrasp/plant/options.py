@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import (
     DEFAULT_DISTANCE_TOLERANCE,
@@ -32,6 +33,8 @@ from drakegrasp.core.validation import (
     check_length,
     check_num_generators,
     check_tol,
+    checked_fields,
+    real_array,
 )
 from drakegrasp.errors import InvalidOptionError
 
@@ -63,8 +66,7 @@ OPTION_HELP = {
     "distance_tolerance": "signed distance below which a pair touches (metres)",
     "plane": "planar analysis in this plane of the object frame (xy, yz or zx)",
     "characteristic_length": "length b that makes moments comparable with "
-    "forces and sets a soft finger's torsion limit b nu f_n (metres; default: "
-    "the farthest contact from the reference point)",
+    "forces and sets a soft finger's torsion limit b nu f_n (metres)",
     "num_generators": "generators of each polyhedral Coulomb cone",
     "tol": "threshold on d*: closure needs d* > tol",
     "allow_penetration": "analyse a penetrating pose anyway (contacts still "
@@ -79,6 +81,8 @@ OPTION_HELP = {
 """One line per option: the docstring below and the command line's help."""
 
 
+@renamed_keyword("model", "contact_model")
+@checked_fields("analysis option")
 @dataclass(frozen=True)
 class AnalysisOptions:
     """How a grasp is read from a plant and judged (validated when made).
@@ -186,6 +190,13 @@ class AnalysisOptions:
                 f"patches must be one of {list(PATCH_MODES)}, got {self.patches!r}"
             )
         put("load", _named_or_values("load", self.load, "gravity"))
+        dim = 6 if self.plane is None else 3
+        if isinstance(self.load, tuple) and len(self.load) != dim:
+            where = "a spatial" if self.plane is None else "a planar"
+            raise InvalidOptionError(
+                f"load must be 'gravity' or {where} wrench [f; m] of {dim} numbers "
+                f"(frame O about its origin), got {len(self.load)}: {list(self.load)}"
+            )
         put(
             "torque_limits",
             _named_or_values("torque_limits", self.torque_limits, "plant", limits=True),
@@ -213,8 +224,9 @@ class AnalysisOptions:
             and self.torsional_friction is None
         ):
             raise InvalidOptionError(
-                "contact_model='soft_finger' needs torsional_friction > 0 (the "
-                "moment about the normal is bounded by b * nu * f_n)"
+                "contact_model='soft_finger' needs torsional_friction >= 0 (the "
+                "moment about the normal is bounded by b * nu * f_n; 0 makes it "
+                "a hard finger)"
             )
         return self
 
@@ -236,15 +248,18 @@ def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
         raise InvalidOptionError(
             f"{name} must be {word!r}, numbers or None, got {value!r}"
         )
-    try:
-        values = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    try:  # real numbers only: not "1.0" or True read as numbers
+        values = real_array(name, value, error=InvalidOptionError)
+    except InvalidOptionError:
         raise InvalidOptionError(
             f"{name} must be {word!r}, numbers or None, got {value!r}"
         ) from None
-    ok = np.isfinite(values) | (limits & (values == np.inf))
+    if limits:  # a motor's limit is a magnitude: >= 0, inf for none
+        ok = (values >= 0.0) & ~np.isnan(values)
+    else:
+        ok = np.isfinite(values)
     if values.ndim != 1 or not np.all(ok):
-        what = "numbers (inf: no limit)" if limits else "finite numbers"
+        what = "numbers >= 0 (inf: no limit)" if limits else "finite numbers"
         raise InvalidOptionError(
             f"{name} must be a 1-D sequence of {what}, got {value!r}"
         )

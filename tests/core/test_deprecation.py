@@ -232,3 +232,75 @@ def test_sample_poses_takes_its_scalars_by_keyword():
     params = inspect.signature(sample_poses).parameters
     for name in ("mu", "clearance", "rng", "tol"):
         assert params[name].kind is inspect.Parameter.KEYWORD_ONLY
+
+
+def test_the_new_keyword_by_position_and_the_old_one_is_refused():
+    from drakegrasp.batch.build.wrenches import wrenches_per_contact
+
+    with pytest.raises(dg.InvalidOptionError, match="both model= .* contact_model"):
+        wrenches_per_contact("hard_finger", 3, 8, model="soft_finger")
+    with pytest.warns(DeprecationWarning):
+        assert wrenches_per_contact(dim=3, num_generators=8, model="soft_finger") == 10
+
+
+@pytest.mark.parametrize("given", [dg.ContactModel.HARD_FINGER, "hard_finger"])
+def test_model_does_not_replace_a_hard_finger_the_caller_wrote(given):
+    with pytest.raises(dg.InvalidContactError, match="contact_model= only"):
+        dg.Contact([0, 0, 0], [1, 0, 0], contact_model=given, model="frictionless")
+    c = dg.Contact([0, 0, 0], [1, 0, 0], mu=0.5)
+    with pytest.raises(dg.InvalidContactError, match="contact_model= only"):
+        c.with_(contact_model=given, model="frictionless")
+    assert c.contact_model is dg.ContactModel.HARD_FINGER  # the default unchanged
+
+
+@pytest.mark.parametrize("cls", [dg.AnalysisOptions, dg.BatchOptions])
+def test_options_objects_take_model_as_the_deprecated_alias(cls):
+    with pytest.warns(DeprecationWarning, match=rf"{cls.__name__}\(\): model="):
+        old = cls(model="frictionless")
+    assert old == cls(contact_model="frictionless")
+    with pytest.raises(dg.InvalidOptionError, match="both model="):
+        cls(model="frictionless", contact_model="hard_finger")
+
+
+@pytest.mark.parametrize(
+    "spelling",
+    ["SOFT_FINGER", "Soft-Finger", " soft_finger", dg.ContactModel.SOFT_FINGER],
+)
+def test_every_entry_point_reads_a_contact_model_as_contact_model_parse_does(spelling):
+    from drakegrasp.batch.build.construction import contact_kinds
+    from drakegrasp.batch.build.wrenches import (
+        batched_primitive_wrenches,
+        wrenches_per_contact,
+    )
+
+    P, N, g = _arrays(2)
+    mu, nu = np.full((2, 3), 0.5), np.full((2, 3), 0.1)
+    args = (P, N, mu, nu, np.zeros((2, 3)), np.ones(2))
+    expected = batched_primitive_wrenches(
+        *args, contact_model="soft_finger", num_generators=8
+    )
+    got = batched_primitive_wrenches(*args, contact_model=spelling, num_generators=8)
+    np.testing.assert_array_equal(got, expected)
+    assert wrenches_per_contact(spelling, 3, 8) == 10
+    np.testing.assert_array_equal(
+        contact_kinds(mu, nu, contact_model=spelling, dim=3),
+        contact_kinds(mu, nu, contact_model="soft_finger", dim=3),
+    )
+    assert dg.ContactModel.parse(spelling) is dg.ContactModel.SOFT_FINGER
+
+
+def test_every_entry_point_refuses_an_unknown_contact_model_by_name():
+    from drakegrasp.batch.build.construction import contact_kinds
+    from drakegrasp.batch.build.wrenches import wrenches_per_contact
+
+    mu = np.full((1, 3), 0.5)
+    for call in (
+        lambda: wrenches_per_contact("sticky", 3, 8),
+        lambda: contact_kinds(mu, mu, contact_model="sticky", dim=3),
+        lambda: dg.AnalysisOptions(contact_model="sticky"),
+        lambda: dg.BatchOptions(contact_model="sticky"),
+    ):
+        with pytest.raises(
+            dg.InvalidContactError, match="unknown contact model 'sticky'"
+        ):
+            call()

@@ -31,7 +31,7 @@ from drakegrasp.batch.build.kinds import (
     SOFT_TORSION,
     SPATIAL_HARD,
 )
-from drakegrasp.core.contact import contact_frames
+from drakegrasp.core.contact import ContactModel, contact_frames
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.friction_cone import soft_finger_facets, torsion_only_facets
 from drakegrasp.core.validation import LENGTH_MIN, safe_norm
@@ -56,7 +56,9 @@ def contact_kinds(
     ----------
     mu, torsional_friction : (K, N) float
         Friction coefficients ``μ >= 0`` and ``ν >= 0``.
-    contact_model : {"frictionless", "hard_finger", "soft_finger"}
+    contact_model : ContactModel or str
+        ``"frictionless"``, ``"hard_finger"`` or ``"soft_finger"``, read as
+        :meth:`ContactModel.parse <drakegrasp.ContactModel.parse>` reads it.
     dim : {2, 3}
 
     Returns
@@ -64,6 +66,7 @@ def contact_kinds(
     kinds : (K, N) int8
         Codes ``FRICTIONLESS`` … ``SOFT_FULL``; see ``KIND_COMPONENTS``.
     """
+    contact_model = ContactModel.parse(contact_model).value
     shape = np.shape(mu)
     if contact_model == "frictionless":
         return np.full(shape, FRICTIONLESS, dtype=np.int8)

@@ -18,13 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.core.contact import contact_frames
+from drakegrasp.core.contact import ContactModel, contact_frames
 from drakegrasp.core.deprecation import renamed_keyword
-from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["batched_primitive_wrenches", "wrenches_per_contact"]
-
-_MODELS = ("frictionless", "hard_finger", "soft_finger")
 
 
 @renamed_keyword("model", "contact_model")
@@ -32,8 +29,10 @@ def wrenches_per_contact(contact_model: str, dim: int, num_generators: int) -> i
     """Rows per contact of :func:`batched_primitive_wrenches`.
 
     ``1`` (frictionless), ``2`` (planar hard finger), ``n_g`` (spatial hard
-    finger) or ``n_g + 2`` (soft finger).
+    finger) or ``n_g + 2`` (soft finger).  ``contact_model`` is read as
+    :meth:`ContactModel.parse <drakegrasp.ContactModel.parse>` reads it.
     """
+    contact_model = ContactModel.parse(contact_model).value
     if contact_model == "frictionless":
         return 1
     if dim == 2:
@@ -91,10 +90,7 @@ def batched_primitive_wrenches(
     -----
     .. math:: w_{i,k} = \operatorname{diag}(I, I / b)\, G_i\, s_k
     """
-    if contact_model not in _MODELS:
-        raise InvalidOptionError(
-            f"contact_model must be one of {_MODELS}, got {contact_model!r}"
-        )
+    contact_model = ContactModel.parse(contact_model).value
     k, N, d = positions.shape
     m = wrenches_per_contact(contact_model, d, num_generators)
     R = contact_frames(normals)  # (k, N, d, d), columns n, t1 (, t2)
