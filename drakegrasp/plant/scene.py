@@ -188,8 +188,9 @@ class SceneInfo:
     mu : float
         Friction coefficient.
     contact_model : ContactModel
-    torsional_friction : float
-        Torsional friction coefficient of soft fingers.
+    torsional_friction : float or None
+        Torsional friction coefficient ``ν >= 0`` of soft fingers; None when the
+        file does not give it (a soft finger then needs it).
     plane : str or None
         ``"xy"``, ``"yz"`` or ``"zx"`` for a planar analysis in that plane of the
         object frame, None for a spatial one.
@@ -209,7 +210,7 @@ class SceneInfo:
     hand: str | tuple[str, ...] | None
     mu: float
     contact_model: ContactModel
-    torsional_friction: float
+    torsional_friction: float | None
     plane: str | None
     distance_tolerance: float
     close: bool = False
@@ -260,13 +261,10 @@ class Scene:
     def options(self) -> AnalysisOptions:
         """The scene file's analysis options (friction, model, plane, tolerance)."""
         info = self.info
-        torsion = info.torsional_friction
-        if info.contact_model is ContactModel.SOFT_FINGER and not torsion:
-            torsion = None  # the file gives no ν: the analysis says what is missing
         return AnalysisOptions(
             mu=info.mu,
             contact_model=info.contact_model,
-            torsional_friction=torsion,
+            torsional_friction=info.torsional_friction,
             plane=info.plane,
             distance_tolerance=info.distance_tolerance,
         )

@@ -320,9 +320,11 @@ def check_section(path: Path, data: dict) -> dict:
         "hand": hand,
         "mu": _number(path, "mu", section["mu"]),
         "contact_model": model,
-        "torsional_friction": _number(
-            path, "torsional_friction", section.get("torsional_friction", 0.0)
-        ),
+        # Absent is not 0: a soft finger without a given nu is refused by the
+        # analysis, one given nu = 0 acts as a hard finger.
+        "torsional_friction": None
+        if "torsional_friction" not in section
+        else _number(path, "torsional_friction", section["torsional_friction"]),
         "plane": plane,
         "distance_tolerance": _number(
             path,

@@ -255,3 +255,33 @@ def test_cli_allow_any_file(tmp_path, capsys):
     assert "leaves the package 'drakegrasp'" in err and err.count("\n") == 1
     assert main(["analyze", str(path), "--allow-any-file"]) == 0
     assert "box::box" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("torsion", "given"), [("", None), ("\n  torsional_friction: 0", 0.0)]
+)
+def test_a_files_absent_nu_is_not_given_and_its_zero_is_a_valid_nu(
+    tmp_path, torsion, given
+):
+    text = DEFAULT.replace("  torsional_friction: 0.1\n", "").replace(
+        "contact_model: hard_finger", "contact_model: soft_finger" + torsion
+    )
+    info = read_scene_info(_write(tmp_path, text))
+    assert info.torsional_friction == given
+    scene = load_scene(_write(tmp_path, text))
+    if given is None:  # both routes of the scene say what is missing
+        with pytest.raises(GraspError, match="needs torsional_friction"):
+            scene.options.require_friction()
+        with pytest.raises(GraspError, match="needs torsional_friction"):
+            analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
+    else:  # nu = 0: the soft fingers act as hard ones, by either route
+        report = analyze_grasp(
+            scene.plant, scene.plant_context, **scene.analysis_options()
+        )
+        assert scene.options.torsional_friction == 0.0
+        hard = analyze_grasp(
+            scene.plant,
+            scene.plant_context,
+            **{**scene.analysis_options(), "contact_model": "hard_finger"},
+        )
+        assert report.force_closure.is_closure == hard.force_closure.is_closure
