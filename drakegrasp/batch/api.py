@@ -269,6 +269,58 @@ def stream_force_closure(
     ``slice`` of the input, in order; only the chunks in flight are held, so a
     writer can stream any number of grasps in bounded memory.  Options are
     validated before the first chunk is read.
+
+    Parameters
+    ----------
+    positions : (K, N, 3) or (K, N, 2) float
+        Contact points ``c_i``, metres, in each grasp's frame.  Any array-like
+        that supports slicing along the first axis (e.g. ``numpy.memmap``); it
+        is read one chunk at a time.  Stacked only: a list of per-grasp arrays
+        with different ``N_k`` is refused (:func:`batch_force_closure` takes
+        those).
+    normals : (K, N, d) float
+        Contact normals pointing into the object; normalised here.
+    mu : float, (K,) or (K, N) float
+        Coulomb friction coefficients (dimensionless), as in
+        :func:`batch_force_closure`.
+    contact_model : {"hard_finger", "frictionless", "soft_finger"}, optional
+        Contact model of every contact (default ``"hard_finger"``).
+    num_generators : int, optional
+        Generators ``n_g >= 3`` of each linearised spatial cone (default 8).
+    torsional_friction : float, (K,) or (K, N) float, optional
+        ``ν`` of soft fingers (dimensionless; moment bound ``b ν f_n``);
+        required with ``contact_model="soft_finger"``.
+    reference_points : (d,) or (K, d) float, optional
+        Point ``p`` (metres) about which moments are taken; default the origin.
+    characteristic_lengths : float or (K,) float, optional
+        ``b > 0`` (metres); default the largest ``‖c_i - p‖`` of each grasp.
+    tol, rank_tol : float, optional
+        Closure needs ``d* > tol`` (default 1e-6); relative threshold of the
+        rank test (default 1e-9).
+    chunk_size : int, optional
+        Grasps per chunk, the unit that is yielded; default (None) sized by
+        the engine's memory budget.
+    progress : bool, optional
+        Show a tqdm progress bar (needs ``tqdm``).
+    metrics : sequence of str, optional
+        Metrics to add to each chunk's arrays, as in
+        :func:`batch_force_closure`.
+    workers : int, optional
+        Worker processes; default (None) every available core.
+    kernel : {"auto", "numba", "numpy"}, optional
+        The LP and ε kernels (default ``"auto"``: numba when installed).
+    options : BatchOptions, optional
+        The run's choices (``contact_model``, ``num_generators``, ``tol``,
+        ``rank_tol``, ``metrics``, ``kernel``, ``chunk_size``, ``workers``,
+        ``progress``) as one object instead of those keywords; an option
+        given both ways raises :class:`~drakegrasp.InvalidOptionError`.
+
+    Yields
+    ------
+    slice, dict of str to (k,) ndarray
+        The grasps of the input that the chunk covers, and their
+        ``is_closure``, ``d_star``, ``rank``, ``margin``, ``converged``,
+        ``normal_certificate`` and requested metrics.
     """
     _, chunks = force_chunks(
         positions, normals, mu, contact_model, num_generators, torsional_friction,
@@ -296,6 +348,33 @@ def stream_form_closure(
     """:func:`batch_form_closure` one chunk at a time.
 
     See :func:`stream_force_closure`.
+
+    Parameters
+    ----------
+    positions, normals : (K, N, 3) or (K, N, 2) float
+        Contact points (metres) and inward normals (normalised here), stacked
+        (not ragged), any array-like that slices along the first axis.
+    reference_points : (d,) or (K, d) float, optional
+        Moment reference ``p`` (metres); default the origin.
+    characteristic_lengths : float or (K,) float, optional
+        ``b > 0`` (metres) for the scaled singular-value metrics (default as
+        :class:`~drakegrasp.Grasp`).
+    tol, rank_tol, chunk_size, progress, workers, kernel : optional
+        As in :func:`stream_force_closure`.
+    metrics : sequence of str, optional
+        ``"sigma_min"``, ``"isotropy"``, ``"ellipsoid_volume"`` of ``G_n``.
+    options : BatchOptions, optional
+        The run's choices as one object instead of the keywords above (an
+        option given both ways raises
+        :class:`~drakegrasp.InvalidOptionError`); its friction options
+        ``contact_model`` and ``num_generators`` are ignored.
+
+    Yields
+    ------
+    slice, dict of str to (k,) ndarray
+        The grasps of the input that the chunk covers, and their
+        ``is_closure``, ``d_star``, ``rank`` (of ``G_n``), ``margin``,
+        ``converged`` and requested metrics.
     """
     _, chunks = form_chunks(
         positions, normals, reference_points, characteristic_lengths, tol, rank_tol,
@@ -389,12 +468,19 @@ def batch_force_closure(
         Interior-point implementation: the compiled one (needs numba) or the
         numpy reference; ``"auto"`` takes numba when installed.  The same
         choice for ``"epsilon_l1"``.
+    options : BatchOptions, optional
+        The run's choices (``contact_model``, ``num_generators``, ``tol``,
+        ``rank_tol``, ``metrics``, ``kernel``, ``chunk_size``, ``workers``,
+        ``progress``) as one :class:`~drakegrasp.BatchOptions`, checked when
+        it was made, instead of those keywords; an option given both ways
+        raises :class:`~drakegrasp.InvalidOptionError`.
 
     Returns
     -------
     BatchClosureResult
         ``is_closure``, ``d_star``, ``rank`` (of ``G`` over the effective
-        components), ``margin``, ``converged`` and the metrics, all (K,).
+        components), ``margin``, ``converged``, ``normal_certificate`` and the
+        metrics, all (K,).
 
     Notes
     -----
@@ -450,11 +536,17 @@ def batch_form_closure(
         As in :func:`batch_force_closure`.
     metrics : sequence of str, optional
         ``"sigma_min"``, ``"isotropy"``, ``"ellipsoid_volume"`` of ``G_n``.
+    options : BatchOptions, optional
+        The run's choices as one :class:`~drakegrasp.BatchOptions` instead of
+        the keywords above (an option given both ways raises
+        :class:`~drakegrasp.InvalidOptionError`); its friction options
+        ``contact_model`` and ``num_generators`` are ignored.
 
     Returns
     -------
     BatchClosureResult
-        ``kind = "form"``; ``rank`` is ``rank(G_n)``.
+        ``kind = "form"``; ``rank`` is ``rank(G_n)``; no
+        ``normal_certificate``.
 
     Notes
     -----
@@ -495,7 +587,8 @@ def iter_batch_closure(
     kind : {"force", "form"}, optional
         :func:`batch_force_closure` (needs ``mu``) or :func:`batch_form_closure`.
     **options
-        Keyword options of that function, applied to every chunk.
+        Keyword options of that function (``options=BatchOptions(...)``
+        included), applied to every chunk.
 
     Yields
     ------

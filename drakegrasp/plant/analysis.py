@@ -227,7 +227,8 @@ def grasp_from_plant(
     contact_model : ContactModel or str, optional
         ``"frictionless"``, ``"hard_finger"`` (default) or ``"soft_finger"``.
     torsional_friction : float, optional
-        ``ν`` of soft fingers; required (> 0) with ``"soft_finger"``.
+        ``ν`` of soft fingers; required (>= 0) with ``"soft_finger"``, where
+        0 makes a soft finger act as a hard one.
     distance_tolerance : float, optional
         Contact when ``|ψ| <=`` this (metres, default 1e-4).
     plane : {"xy", "yz", "zx"}, optional
