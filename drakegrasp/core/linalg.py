@@ -80,7 +80,8 @@ def equilibrated(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     scale : (..., n) float
         ``1 / ‖A_j‖`` per column (1 for a zero column; ``inf`` for a column
         whose norm is subnormal, below 2.2e-308, whose reciprocal no double
-        holds: ``A_s`` still has it as a unit column).
+        holds: ``A_s`` still has it as a unit column, as it has a column whose
+        norm exceeds the largest double).
 
     Raises
     ------
@@ -105,11 +106,16 @@ def equilibrated(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     with np.errstate(over="ignore", divide="ignore"):
         np.divide(1.0, norms, out=scale, where=norms > 0.0)
     A_s = A * scale[..., None, :]
-    tiny = np.isinf(scale)  # a subnormal column: scaled in two steps instead
-    if tiny.any():
-        reduced = A / np.where(tiny, peak, 1.0)[..., None, :]
-        unit = reduced / np.linalg.norm(reduced, axis=-2, keepdims=True)
-        A_s = np.where(tiny[..., None, :], unit, A_s)
+    # A subnormal column (1/norm overflows) or one whose norm exceeds the
+    # largest double (its scale underflowed to 0): scaled in two steps instead.
+    odd = np.isinf(scale) | np.isinf(norms)
+    if odd.any():
+        reduced = A / np.where(odd, peak, 1.0)[..., None, :]
+        length = np.linalg.norm(reduced, axis=-2)
+        with np.errstate(over="ignore", under="ignore"):
+            two_step = (1.0 / np.where(odd, peak, 1.0)) / length
+        scale = np.where(odd, two_step, scale)
+        A_s = np.where(odd[..., None, :], reduced / length[..., None, :], A_s)
     return A_s, scale
 
 

@@ -154,7 +154,9 @@ class AnalysisOptions:
             put("mu", check_coefficient("mu", self.mu))
         model = ContactModel.parse(self.contact_model)
         put("contact_model", model)
-        if self.plane is not None and self.plane not in PLANES:
+        if self.plane is not None and (
+            not isinstance(self.plane, str) or self.plane not in PLANES
+        ):
             raise InvalidOptionError(
                 f"plane must be one of {sorted(PLANES)} (object-frame axes) or "
                 f"None, got {self.plane!r}"

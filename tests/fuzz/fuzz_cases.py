@@ -1717,6 +1717,141 @@ def _odd_plant_cases(scene) -> Iterator[Case]:
         )
 
 
+MODEL_SPELLINGS = [
+    "SOFT_FINGER",
+    "Soft-Finger",
+    " soft_finger ",
+    dg.ContactModel.SOFT_FINGER,
+]
+BAD_MODELS = ["sticky", "", None, 3, 1j, ["soft_finger"], b"soft_finger"]
+
+
+def value_cases() -> Iterator[Case]:
+    """Option objects, core linear algebra and the batch builders, value by value.
+
+    Each field of ``AnalysisOptions`` and ``BatchOptions`` gets the hostile
+    values of its kind (refused when the object is made), unknown and doubled
+    arguments are refused; ``equilibrated`` gets what is not a finite real
+    matrix; the batch builders get every spelling of a contact model
+    (answered alike) and names that are none.
+    """
+    from drakegrasp.batch.build.construction import contact_kinds
+    from drakegrasp.batch.build.wrenches import (
+        batched_primitive_wrenches,
+        wrenches_per_contact,
+    )
+    from drakegrasp.core.linalg import equilibrated
+
+    bad_flags = ["yes", 1, None, [True], NAN]
+    analysis = {
+        "mu": [NAN, INF, -1.0, True, "0.5", [0.5], 1j, "plants"],
+        "contact_model": BAD_MODELS,
+        "torsional_friction": [NAN, INF, -0.1, True, "0.1", [0.1]],
+        "distance_tolerance": [NAN, INF, 0.0, -1e-4, "1e-4", True, None],
+        "plane": ["xz", "XY", 0, ["xy"], ""],
+        "characteristic_length": [NAN, INF, 0.0, -1.0, 1e-310, 1e31, "1", True],
+        "num_generators": OPTION_POOLS["num_generators"],
+        "tol": OPTION_POOLS["tol"],
+        "allow_penetration": bad_flags,
+        "patches": ["all", None, 1, ["vertices"]],
+        "check_pose": bad_flags,
+        "load": ["weight", [1, 2], np.zeros(7), [NAN] * 6, [INF] * 6, ["1"] * 6, 1j],
+        "torque_limits": ["motors", [-1.0], [NAN], [-INF], [[1.0]], [True], 1j],
+    }
+    batch = {
+        "contact_model": BAD_MODELS,
+        "num_generators": OPTION_POOLS["num_generators"],
+        "tol": OPTION_POOLS["tol"],
+        "rank_tol": OPTION_POOLS["rank_tol"],
+        "metrics": ["sigma", ["volume"], [None], 3, [["sigma_min"]]],
+        "kernel": ["fortran", None, 1],
+        "chunk_size": [0, -1, 2.5, "8", True, INF],
+        "workers": [0, -2, 2.5, "2", True],
+        "progress": bad_flags,
+    }
+    for cls, pools in ((dg.AnalysisOptions, analysis), (dg.BatchOptions, batch)):
+        for field, pool in pools.items():
+            for i, value in enumerate(pool):
+                yield Case(
+                    "values",
+                    f"{cls.__name__}({field}#{i})",
+                    lambda cls=cls, f=field, v=value: cls(**{f: v}),
+                    "refuse",
+                )
+        yield Case(
+            "values", f"{cls.__name__}(bogus)", lambda c=cls: c(bogus=1), "refuse"
+        )
+        yield Case(
+            "values", f"{cls.__name__}(*too many)",
+            lambda c=cls: c(*([None] * 20)), "refuse",
+        )  # fmt: skip
+        yield Case(
+            "values", f"{cls.__name__}(model+contact_model)",
+            lambda c=cls: c(model="frictionless", contact_model="hard_finger"),
+            "refuse",
+        )  # fmt: skip
+        yield Case(
+            "values", f"{cls.__name__}()", cls, "answer",
+            lambda o: o.contact_model is dg.ContactModel.HARD_FINGER,
+        )  # fmt: skip
+    # equilibrated: what is not a finite real matrix, and extreme columns
+    for i, A in enumerate(
+        [[1.0, 2.0], 1.0, [[NAN, 1.0], [0, 1]], [[INF, 0], [0, 1]],
+         [[1j, 0], [0, 1]], "A", None, [[1, 2], [3]], np.array([["a"]])]
+    ):  # fmt: skip
+        yield Case("values", f"equilibrated#{i}", lambda A=A: equilibrated(A), "refuse")
+    for v in [1e-320, 1e-310, 1e-200, 1e154, 1e300, 1.7e308]:
+        A = np.array([[v, 0.0], [-v, 3.0], [v, 4.0]])
+
+        def unit(r):
+            A_s, scale = r
+            return np.allclose(np.linalg.norm(A_s, axis=0), 1.0, rtol=1e-14) and (
+                np.all(np.isfinite(A_s)) and scale[1] == 0.2
+            )
+
+        yield Case("values", f"equilibrated(col {v:g})", lambda A=A: equilibrated(A),
+                   "answer", unit)  # fmt: skip
+    # The batch builders read a model as ContactModel.parse does, or refuse it.
+    g = _valid_grasp()
+    P, N = np.repeat(g.positions[None], 2, 0), np.repeat(g.normals[None], 2, 0)
+    mu, nu = np.full((2, 3), 0.5), np.full((2, 3), 0.1)
+    args = (P, N, mu, nu, np.zeros((2, 3)), np.ones(2))
+    soft = batched_primitive_wrenches(*args, contact_model="soft_finger",
+                                      num_generators=8)  # fmt: skip
+    kinds = contact_kinds(mu, nu, contact_model="soft_finger", dim=3)
+    for i, m in enumerate(MODEL_SPELLINGS):
+        yield Case(
+            "values", f"batched_primitive_wrenches(model#{i})",
+            lambda m=m: batched_primitive_wrenches(*args, contact_model=m,
+                                                   num_generators=8),
+            "answer", lambda W: np.array_equal(W, soft),
+        )  # fmt: skip
+        yield Case(
+            "values", f"contact_kinds(model#{i})",
+            lambda m=m: contact_kinds(mu, nu, contact_model=m, dim=3),
+            "answer", lambda k: np.array_equal(k, kinds),
+        )  # fmt: skip
+        yield Case("values", f"wrenches_per_contact(model#{i})",
+                   lambda m=m: wrenches_per_contact(m, 3, 8), "answer",
+                   lambda n: n == 10)  # fmt: skip
+    for i, m in enumerate(BAD_MODELS):
+        for name, call in (
+            ("batched_primitive_wrenches", lambda m=m: batched_primitive_wrenches(
+                *args, contact_model=m, num_generators=8)),
+            ("contact_kinds", lambda m=m: contact_kinds(
+                mu, nu, contact_model=m, dim=3)),
+            ("wrenches_per_contact", lambda m=m: wrenches_per_contact(m, 3, 8)),
+            ("batch_force_closure", lambda m=m: dg.batch_force_closure(
+                P, N, mu=0.5, contact_model=m, torsional_friction=0.1)),
+        ):  # fmt: skip
+            yield Case("values", f"{name}(bad model#{i})", call, "refuse")
+    yield Case(
+        "values", "wrenches_per_contact(position and model=)",
+        lambda: wrenches_per_contact("hard_finger", 3, 8, model="soft_finger"),
+        "refuse",
+    )  # fmt: skip
+
+
 def all_cases(root: Path | None = None) -> Iterator[Case]:
     """Every family, in a fixed order."""
     yield from api_walk_cases()
@@ -1724,6 +1859,7 @@ def all_cases(root: Path | None = None) -> Iterator[Case]:
     yield from grasp_cases()
     yield from wrong_type_cases()
     yield from option_cases()
+    yield from value_cases()
     yield from batch_cases()
     yield from geometry_cases()
     yield from monotonicity_cases()

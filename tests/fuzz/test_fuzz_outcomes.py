@@ -18,6 +18,7 @@ FAMILIES = {
     "Grasp": fuzz_cases.grasp_cases,
     "wrong type": fuzz_cases.wrong_type_cases,
     "options": fuzz_cases.option_cases,
+    "values": fuzz_cases.value_cases,
     "batch": fuzz_cases.batch_cases,
     "monotone": fuzz_cases.monotonicity_cases,
     "pictures": fuzz_cases.picture_cases,
