@@ -44,7 +44,9 @@ import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
+from drakegrasp.core.validation import check_length, real_array, unit_vectors
 from drakegrasp.errors import (
+    InvalidContactError,
     InvalidOptionError,
     ModelError,
     NoContactsError,
@@ -59,6 +61,13 @@ from drakegrasp.planning.approach import (
 from drakegrasp.planning.candidates import (
     closing_order,
     planning_result,
+)
+from drakegrasp.planning.checks import (
+    checked_contacts,
+    checked_count,
+    checked_fingers,
+    checked_friction,
+    checked_rng,
 )
 from drakegrasp.planning.cloud import CONTACT_BAND, cloud_surface
 from drakegrasp.planning.cloud_hand import FAN_SIGMAS, CloudHand
@@ -297,17 +306,21 @@ def fan_capacity(
     Parameters
     ----------
     positions, normals : (K, N, 3) float
-        Contacts (m) and inward unit normals, frame O.
+        Contacts (m, finite) and inward normals (finite, non-zero; normalised
+        here), frame O.
     fans : (K, N, 2, 3) float
-        Each contact's fan ends (inward unit normals), NaN for a contact
-        without one (its normal stays).
+        Each contact's fan ends (inward normals, finite and non-zero;
+        normalised here), all NaN for a contact without one (its normal
+        stays).
     fingers : (K, N) int
         Finger labels (the palm ``F``), as for ``weight_capacity``.
     mu : float
+        0 or in ``[1e-12, 1e12]``, as for ``weight_capacity``.
     samples : int
-        Copies per grasp (the robustness samples); 0 gives the nominal
-        capacity.
+        Copies per grasp (the robustness samples), an integer ``>= 0``; 0
+        gives the nominal capacity.
     rng : numpy.random.Generator
+        Draws the fans' normals (only with ``samples > 0``).
     torque_scale, contact_model, torsional_friction
         As for :func:`~drakegrasp.planning.weight.weight_capacity`.
 
@@ -315,9 +328,23 @@ def fan_capacity(
     -------
     (K,) float
         Newtons of weight held per newton of squeeze on each finger.
+
+    Raises
+    ------
+    GraspError
+        An argument out of its range, naming it (checked before any draw).
     """
+    positions, normals = checked_contacts(positions, normals)
     K, N, _ = positions.shape
-    S = max(int(samples), 1)
+    fans = _checked_fans(fans, (K, N, 2, 3))
+    fingers = checked_fingers(fingers, (K, N))
+    mu, contact_model, torsional_friction = checked_friction(
+        mu, contact_model, torsional_friction
+    )
+    samples = checked_count("samples", samples)
+    rng = checked_rng(rng)
+    torque_scale = check_length("torque_scale", torque_scale, error=InvalidOptionError)
+    S = max(samples, 1)
     has = np.all(np.isfinite(fans), axis=(2, 3))  # (K, N)
     t = rng.uniform(size=(K, S, N)) if samples else np.zeros((K, S, N))
     drawn = _slerp(fans[:, None, :, 0], fans[:, None, :, 1], t)  # (K, S, N, 3)
@@ -330,6 +357,30 @@ def fan_capacity(
         contact_model=contact_model, torsional_friction=torsional_friction,
     ).min(axis=1)  # fmt: skip
     return np.where(np.isfinite(alpha), alpha, 0.0).reshape(K, S).mean(axis=1)
+
+
+def _checked_fans(fans, shape: tuple) -> np.ndarray:
+    """``fans`` of :func:`fan_capacity`: unit ends, or all NaN (no fan)."""
+    a = real_array("fans", fans)
+    if a.shape != shape:
+        raise InvalidContactError(
+            f"fans must have shape (K, N, 2, 3) = {shape}, two ends per contact, "
+            f"got shape {a.shape}"
+        )
+    none = np.all(np.isnan(a), axis=(2, 3))
+    has = np.all(np.isfinite(a), axis=(2, 3))
+    has &= np.all(np.any(a != 0.0, axis=3), axis=2)
+    bad = ~(none | has)
+    if bad.any():
+        k, i = (int(j) for j in np.argwhere(bad)[0])
+        raise InvalidContactError(
+            f"fans of grasp {k}, contact {i} is {a[k, i].tolist()}; a fan is two "
+            "finite, non-zero normals, or all NaN for a contact without one"
+        )
+    out = np.full(shape, np.nan)
+    if has.any():
+        out[has] = unit_vectors("fans", a[has])
+    return out
 
 
 @renamed_keyword("model", "contact_model")

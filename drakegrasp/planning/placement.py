@@ -13,9 +13,12 @@ from collections import Counter
 
 import numpy as np
 from pydrake.geometry import Box, Sphere
+from pydrake.math import RigidTransform
 
 from drakegrasp.core.deprecation import keyword_only
-from drakegrasp.errors import NoContactsError, PenetrationError
+from drakegrasp.core.validation import check_coefficient, check_length
+from drakegrasp.errors import InvalidOptionError, NoContactsError, PenetrationError
+from drakegrasp.planning.checks import checked_count, checked_nonnegative, checked_rng
 from drakegrasp.planning.gripper import ParallelJaw
 from drakegrasp.plant.contacts import (
     StagedContacts,
@@ -81,9 +84,22 @@ def sample_poses(surface, gripper: ParallelJaw, X_WO, n, *, mu, clearance, rng, 
         within ±60°, instead of all round the axis).
     gripper : ParallelJaw
     X_WO : RigidTransform
+        The object's pose in the world.
     n : int
-    mu, clearance, tol : float
+        Samples to draw, an integer ``>= 0``.
+    mu : float
+        Friction coefficient, 0 or in ``[1e-12, 1e12]``
+        (:mod:`drakegrasp.core.validation`): an axis is kept when both its
+        normals lie within ``atan μ`` of it.
+    clearance : float
+        Metres, finite and ``>= 0``, added on each side of the chord to the
+        pre-grasp opening (at most the stroke).
     rng : numpy.random.Generator
+        Draws the samples and approach angles.
+    tol : float
+        Metres, a length ``> 0``: the distance tolerance (a sample whose
+        axis enters the object more than ``tol`` before its point is
+        occluded).
 
     Returns
     -------
@@ -91,7 +107,30 @@ def sample_poses(surface, gripper: ParallelJaw, X_WO, n, *, mu, clearance, rng, 
         ``sample`` (kept sample indices), ``R_WH`` (K, 3, 3), ``p_WH`` (K, 3),
         ``opening`` (K,) for the kept samples.
     rejections : Counter
+
+    Raises
+    ------
+    GraspError
+        An argument out of its range, naming it (checked before any draw).
     """
+    if not all(callable(getattr(surface, f, None)) for f in ("sample", "chord")):
+        raise InvalidOptionError(
+            "surface must have sample(n, rng) and chord(p_O, d_O) (an "
+            f"ObjectSurface or a CloudSurface), got {type(surface).__name__}"
+        )
+    if not isinstance(gripper, ParallelJaw):
+        raise InvalidOptionError(
+            f"gripper must be a ParallelJaw, got {type(gripper).__name__}"
+        )
+    if not isinstance(X_WO, RigidTransform):
+        raise InvalidOptionError(
+            f"X_WO must be a pydrake RigidTransform, got {type(X_WO).__name__}"
+        )
+    n = checked_count("n", n)
+    mu = check_coefficient("mu", mu)
+    clearance = checked_nonnegative("clearance", clearance, "metres")
+    rng = checked_rng(rng)
+    tol = check_length("tol", tol, error=InvalidOptionError)
     p_O, nout_O, _ = surface.sample(n, rng)
     theta = rng.uniform(0.0, 2 * np.pi, n)
     d_O = surface.axes(p_O, nout_O) if hasattr(surface, "axes") else -nout_O

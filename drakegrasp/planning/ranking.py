@@ -49,17 +49,33 @@ grasps) are broken by the next key and not by rounding.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import replace
 
 import numpy as np
 
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
 from drakegrasp.batch.run.verdicts import force_verdicts
+from drakegrasp.batch.run.workers import check_workers
 from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.linalg import rotations_about
+from drakegrasp.core.validation import (
+    check_coefficient,
+    check_length,
+    integer_or_none,
+)
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate
-from drakegrasp.planning.reclose import reclosed_robustness
+from drakegrasp.planning.checks import (
+    checked_contacts,
+    checked_count,
+    checked_fingers,
+    checked_friction,
+    checked_nonnegative,
+    checked_rng,
+)
+from drakegrasp.planning.reclose import perturbed_mu, reclosed_robustness
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.validation import scoped_name
 
@@ -79,6 +95,33 @@ __all__ = [
 
 DEFAULT_NOISE = {"position": 2e-3, "angle_deg": 3.0, "friction": 0.1}
 """Default robustness noise: σ_p (m), σ_θ (degrees), σ_μ (relative)."""
+
+_NOISE_UNITS = {"position": "metres", "angle_deg": "degrees", "friction": "relative"}
+
+
+def _checked_noise(sigmas, name: str = "{}") -> dict[str, float]:
+    """The three noise σ of ``sigmas``, each a finite number >= 0.
+
+    ``name`` spells an argument's name in a message from its key (``"{}"``:
+    ``position``; ``"noise[{!r}]"``: ``noise['position']``).
+    """
+    return {
+        key: checked_nonnegative(name.format(key), value, _NOISE_UNITS[key])
+        for key, value in sigmas.items()
+    }
+
+
+def _checked_groups(groups) -> tuple[int, ...]:
+    """``groups`` of :func:`perturbed_copies`: a sequence of integer labels."""
+    try:
+        labels = tuple(integer_or_none(g) for g in groups)
+    except TypeError:
+        labels = (None,)
+    if isinstance(groups, (str, bytes)) or None in labels:
+        raise InvalidOptionError(
+            f"groups must be a sequence of integer finger labels, got {groups!r}"
+        )
+    return labels
 
 
 def group_by_count(counts: np.ndarray) -> dict[int, np.ndarray]:
@@ -103,17 +146,35 @@ def perturbed_copies(
 ):
     """``samples`` perturbed copies of each of ``K`` grasps (module docstring).
 
+    Every argument is checked first, before any draw from ``rng``; a bad one
+    raises a :class:`~drakegrasp.GraspError` naming it.
+
     Parameters
     ----------
-    positions, normals : (K, N, 3) float
-        Contacts (metres) and inward unit normals, one frame per grasp.
+    positions : (K, N, 3) float
+        Contact points, metres (finite), one frame per grasp; ``K >= 0``
+        grasps of ``N >= 1`` contacts.
+    normals : (K, N, 3) float
+        Inward contact normals (finite, non-zero; normalised here), same frame.
     fingers : (K, N) int
-        Which finger (0 or 1) made each contact.
+        Which finger made each contact: 0 or 1 for the jaws, any integer label
+        in ``[0, 63]`` (:data:`~drakegrasp.planning.checks.MAX_FINGER_LABEL`)
+        for a multi-finger hand and its palm.
     mu : float
+        Nominal friction coefficient: 0 or in ``[1e-12, 1e12]``
+        (:mod:`drakegrasp.core.validation`).
     samples : int
+        Copies per grasp, an integer ``>= 0``.
     rng : numpy.random.Generator
-    position, angle_deg, friction : float
-        σ_p (m), σ_θ (degrees), σ_μ.
+        Draws the noise (``numpy.random.default_rng(seed)``).
+    position : float
+        σ_p, metres, finite and ``>= 0``: each finger's translation.
+    angle_deg : float
+        σ_θ, degrees, finite and ``>= 0``: each finger's rotation about a
+        random axis through its contacts' centroid.
+    friction : float
+        σ_μ, relative, finite and ``>= 0``: each copy's μ is
+        ``mu · max(0, 1 + σ_μ ξ)``.
     groups : sequence of int, optional
         The finger labels whose contacts move (default the two jaws; a
         multi-finger hand passes all its fingers).  Contacts with other labels
@@ -122,9 +183,20 @@ def perturbed_copies(
     Returns
     -------
     P, Nrm : (K * samples, N, 3) float
-        Copies, grasp-major (copy ``s`` of grasp ``k`` at row ``k * samples + s``).
+        Copies' contacts (metres) and unit normals, grasp-major (copy ``s``
+        of grasp ``k`` at row ``k * samples + s``).
     mu : (K * samples,) float
+        Each copy's friction coefficient; a positive one is kept within
+        ``[1e-12, 1e12]``, the range the batch engine takes.
     """
+    positions, normals = checked_contacts(positions, normals)
+    fingers = checked_fingers(fingers, positions.shape[:2])
+    mu = check_coefficient("mu", mu)
+    samples = checked_count("samples", samples)
+    rng = checked_rng(rng)
+    sigma = {"position": position, "angle_deg": angle_deg, "friction": friction}
+    position, angle_deg, friction = _checked_noise(sigma).values()
+    groups = _checked_groups(groups)
     K, N, _ = positions.shape
     P = np.repeat(positions, samples, axis=0)
     Nrm = np.repeat(normals, samples, axis=0)
@@ -145,7 +217,7 @@ def perturbed_copies(
         P = np.where(mask, moved, P)
         Nrm = np.where(mask, np.einsum("mij,mnj->mni", R, Nrm), Nrm)
     mus = mu * np.maximum(0.0, 1.0 + friction * rng.standard_normal(M))
-    return P, Nrm, mus
+    return P, Nrm, perturbed_mu(mus)
 
 
 @keyword_only("mu", after=2)
@@ -162,10 +234,32 @@ def verdicts(
 ):
     """LP2 verdicts and ε (one torque scale) of ``K`` grasps of ``N`` contacts.
 
+    Parameters
+    ----------
+    positions, normals : (K, N, 3) float
+        Contact points (metres) and inward normals (normalised by the batch
+        engine), each grasp in its own frame, moments about its origin.
+    mu : float or array
+        Friction coefficients, as :func:`~drakegrasp.batch.batch_force_closure`
+        takes them (0 or in ``[1e-12, 1e12]``).
+    torque_scale : float
+        Metres dividing every grasp's moments in ε (one scale, so ε compares
+        across grasps), a length in ``[2.2e-308, 1e30]``.
+    contact_model : {"hard_finger", "frictionless", "soft_finger"}
+    torsional_friction : float or None
+        ``ν`` of soft fingers, as :func:`~drakegrasp.batch.batch_force_closure`.
+    workers : int or None
+        Worker processes of the batch engine (None: every core).
+
     Returns
     -------
     is_closure, d_star, rank, epsilon : (K,) arrays
+        The LP2 verdict, its ``d*`` and the rank of ``G``
+        (:func:`~drakegrasp.batch.batch_force_closure`), and the L1 ε about
+        each grasp's origin with moments divided by ``torque_scale`` (0 where
+        not force closure).
     """
+    torque_scale = check_length("torque_scale", torque_scale, error=InvalidOptionError)
     res = batch_force_closure(
         positions,
         normals,
@@ -212,9 +306,62 @@ def robustness(
 ) -> np.ndarray:
     """(K,) fraction of perturbed copies that stay force closure (LP2).
 
-    ``groups``: the finger labels whose contacts move (see
-    :func:`perturbed_copies`).
+    The copies are those of :func:`perturbed_copies` (each finger's contacts
+    moved rigidly, μ scaled); their verdicts come from the batch engine in
+    verdict-only mode.  Every argument is checked first, before any draw from
+    ``rng``; a bad one raises a :class:`~drakegrasp.GraspError` naming it.
+
+    Parameters
+    ----------
+    positions : (K, N, 3) float
+        Contact points, metres (finite), one frame per grasp, moments about
+        its origin; ``K >= 0`` grasps of ``N >= 1`` contacts.
+    normals : (K, N, 3) float
+        Inward contact normals (finite, non-zero; normalised here).
+    fingers : (K, N) int
+        Finger label of each contact (0, 1 for the jaws; a multi-finger hand's
+        fingers and palm), integers in ``[0, 63]``.
+    mu : float
+        Nominal friction coefficient: 0 or in ``[1e-12, 1e12]``
+        (:mod:`drakegrasp.core.validation`).
+    samples : int
+        Perturbed copies per grasp, an integer ``>= 0`` (0: robustness 0).
+    rng : numpy.random.Generator
+        Draws the noise (``numpy.random.default_rng(seed)``).
+    noise : dict
+        The three σ of :data:`DEFAULT_NOISE`, each finite and ``>= 0``:
+        ``"position"`` (metres), ``"angle_deg"`` (degrees) and
+        ``"friction"`` (relative); exactly these keys.
+    contact_model : {"hard_finger", "frictionless", "soft_finger"}
+    torsional_friction : float or None
+        ``ν`` of soft fingers, 0 or in ``[1e-12, 1e12]``; None is 0, and
+        refused for soft fingers (as
+        :func:`~drakegrasp.batch.batch_force_closure` refuses it).
+    workers : int or None
+        Worker processes of the batch engine (None: every core).
+    groups : sequence of int, optional
+        The finger labels whose contacts move (see :func:`perturbed_copies`).
+
+    Returns
+    -------
+    (K,) float
+        Fraction in ``[0, 1]`` of each grasp's copies in force closure.
     """
+    positions, normals = checked_contacts(positions, normals)
+    fingers = checked_fingers(fingers, positions.shape[:2])
+    mu, contact_model, torsional_friction = checked_friction(
+        mu, contact_model, torsional_friction
+    )
+    samples = checked_count("samples", samples)
+    rng = checked_rng(rng)
+    if not isinstance(noise, Mapping) or set(noise) != set(DEFAULT_NOISE):
+        raise InvalidOptionError(
+            f"noise must be a dict of the three σ {sorted(DEFAULT_NOISE)} (as "
+            f"DEFAULT_NOISE), got {noise!r}"
+        )
+    noise = _checked_noise(noise, "noise[{!r}]")
+    check_workers(workers)
+    groups = _checked_groups(groups)
     if samples == 0 or len(positions) == 0:
         return np.zeros(len(positions))
     P, Nrm, mus = perturbed_copies(
@@ -280,13 +427,36 @@ def ranked_candidates(
 ) -> tuple[GraspCandidate, ...]:
     """The candidates of a ranking, best first, either hand's route.
 
-    ``order`` gives the rows best first; ``scores`` holds the ranking's
-    arrays ``is_closure``, ``d_star``, ``rank``, ``eps``, ``rho``, ``score``
-    and ``alpha`` (weight capacity, N per N of squeeze); ``pose(i)`` the
-    fields of row ``i``'s own (``sample``, ``X_WH``, ``q_hand``,
-    ``contacts``...).  ``squeeze_needed`` is ``weight / α`` (NaN without a
-    capacity, inf at 0); the first ``certify`` also get the single-grasp
-    verdict with its certificate.
+    Parameters
+    ----------
+    order : (K,) int
+        The rows of ``scores`` best first (any subset, in that order).
+    scores : dict of str to (K,) array
+        The ranking's arrays: ``is_closure`` (bool), ``d_star``
+        (dimensionless), ``rank`` (int), ``eps`` (ε, dimensionless with the
+        object's torque scale), ``rho`` (robustness in ``[0, 1]``),
+        ``score`` and ``alpha`` (weight capacity, N of weight per N of
+        squeeze; NaN where not computed).
+    pose : callable
+        ``pose(i)`` gives the fields of row ``i``'s own
+        :class:`~drakegrasp.planning.candidates.GraspCandidate` (``sample``,
+        ``X_WH``, ``q_hand``, ``contacts``...).
+    weight : float
+        The object's weight, newtons (NaN when unknown).
+    certify : int
+        The first ``certify`` candidates also get the single-grasp verdict
+        with its certificate (:func:`~drakegrasp.force_closure`).
+    mu : float
+    contact_model : str
+    nu : float or None
+        The contacts' ``mu``, ``contact_model`` and ``torsional_friction``
+        (each candidate's ``contact_options``).
+
+    Returns
+    -------
+    tuple of GraspCandidate
+        In the order of ``order``; ``squeeze_needed`` is ``weight / α``
+        (newtons per finger; NaN without a capacity, inf at 0).
     """
     out = []
     for place, i in enumerate(order):
@@ -320,11 +490,28 @@ def grouped_verdicts(
 ):  # fmt: skip
     """Stage 4a, either hand's route: every kept grasp's LP2 verdict, by count.
 
-    ``kept[i][4]`` are row ``i``'s contacts (``p_OC``, ``nhat_O``);
-    ``labels(contacts)`` numbers their fingers.  Grasps with equal contact
-    counts go to the batch engine together (:func:`verdicts`), with moments
-    about ``reference`` ((3,) in O, metres: the object's centre of mass;
-    default O's origin).
+    Grasps with equal contact counts go to the batch engine together
+    (:func:`verdicts`).
+
+    Parameters
+    ----------
+    kept : sequence of tuple
+        One closed pose per row; ``kept[i][4]`` are row ``i``'s contacts,
+        with ``p_OC`` (metres) and ``nhat_O`` (unit) in the object frame O.
+    labels : callable
+        ``labels(contacts)`` numbers their fingers (a list of int).
+    mu : float
+        Friction coefficient, as :func:`verdicts` takes it.
+    torque_scale : float
+        Metres dividing the moments in ε (one scale for every grasp).
+    contact_model : str
+    nu : float or None
+        ``torsional_friction`` of soft fingers.
+    workers : int or None
+        Worker processes of the batch engine (None: every core).
+    reference : (3,) float, optional
+        The point of O (metres) moments are taken about: the object's centre
+        of mass; default O's origin.
 
     Returns
     -------
@@ -365,14 +552,60 @@ def rank_candidates(
 ):  # fmt: skip
     """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
 
-    ``kept`` holds ``(sample, X_WH, q, opening, contacts)`` of every closed
-    pose; contacts have ``p_OC``, ``nhat_O`` and ``finger_body``.  ``weight``
-    is the object's weight (N), NaN when unknown, acting at ``reference``
-    ((3,) in O: every moment is about it).  Robustness re-closes the
-    jaws on the moved object's ``surface`` (:mod:`drakegrasp.planning.reclose`,
-    within ``tol``): an object body's
-    (:class:`~drakegrasp.planning.surface.ObjectSurface`) or a cloud's
-    (:class:`~drakegrasp.planning.cloud.FittedCloud`).
+    The parallel-jaw route of :func:`~drakegrasp.planning.planner.plan_grasps`,
+    which checks the options before it calls this.
+
+    Parameters
+    ----------
+    kept : sequence of tuple
+        ``(sample, X_WH, q, opening, contacts)`` of every closed pose;
+        contacts have ``p_OC`` (metres), ``nhat_O`` (unit, inward) in the
+        object frame O and ``finger_body``.
+    finger_names : sequence of set of str
+        Scoped body names of finger 0 and of finger 1 (other hand bodies are
+        the palm, label 2).
+    gripper : ParallelJaw
+        The gripper (its grasp frame K gives each grasp's axis).
+    plant : MultibodyPlant
+    mu : float
+        Friction coefficient (0 or in ``[1e-12, 1e12]``).
+    contact_model : str
+    nu : float or None
+        ``torsional_friction`` of soft fingers.
+    torque_scale : float
+        Metres dividing the moments in ε and the weight capacity (the
+        object's radius about ``reference``).
+    samples : int
+        Robustness copies per candidate.
+    noise : dict
+        The σ of :data:`DEFAULT_NOISE` (``position`` metres, ``angle_deg``
+        degrees about the grasp axis, ``friction`` relative).
+    rng : numpy.random.Generator
+    certify : int
+        How many of the best get the single-grasp verdict and certificate.
+    workers : int or None
+        Worker processes of the batch engine (None: every core).
+    X_WO : RigidTransform
+        The object's pose in the world.
+    weight : float
+        The object's weight (N), NaN when unknown.
+    weight_check : int or None
+        Compute the weight capacity for only this many candidates, the best
+        by ``ε ρ`` (None: every force-closure candidate with ``ρ > 0``).
+    surface : ObjectSurface or FittedCloud
+        Robustness re-closes the jaws on the moved object's surface
+        (:mod:`drakegrasp.planning.reclose`): an object body's
+        (:class:`~drakegrasp.planning.surface.ObjectSurface`) or a cloud's
+        (:class:`~drakegrasp.planning.cloud.FittedCloud`).
+    tol : float
+        The distance tolerance (metres) of the re-closing.
+    reference : (3,) float
+        Where the weight acts, in O (metres): every moment is about it.
+
+    Returns
+    -------
+    tuple of GraspCandidate
+        Ranked best first (:func:`ranked_candidates`).
     """
     if not kept:
         return ()

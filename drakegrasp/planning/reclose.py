@@ -50,8 +50,25 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.batch.run.verdicts import force_verdicts
+from drakegrasp.batch.run.workers import check_workers
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.linalg import rotations_about
+from drakegrasp.core.validation import (
+    COEFFICIENT_MAX,
+    COEFFICIENT_MIN,
+    check_length,
+    check_positions,
+)
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError
+from drakegrasp.planning.checks import (
+    checked_count,
+    checked_directions,
+    checked_fingers,
+    checked_friction,
+    checked_nonnegative,
+    checked_points,
+    checked_rng,
+)
 
 __all__ = ["NEVER_CLOSURE", "reclosed_copies", "reclosed_robustness"]
 
@@ -61,6 +78,17 @@ hard fingers' forces all meet the line through their points, so no moment
 about it is resisted; six normals cannot positively span the six wrench
 dimensions.  Such re-closed copies count as slipping without an LP (a cylinder
 or a sphere between two pads leaves many with one contact per pad)."""
+
+
+def perturbed_mu(mus: np.ndarray) -> np.ndarray:
+    """Perturbed friction coefficients kept in the range the batch engine takes.
+
+    A copy's ``μ`` is the user's (checked) times ``max(0, 1 + σ_μ ξ)``; a
+    positive product below ``COEFFICIENT_MIN`` or above ``COEFFICIENT_MAX``
+    (a user's ``μ`` near either bound) is moved to the bound, 0 stays 0, so a
+    valid ``mu`` never gets a copy refused by the engine.
+    """
+    return np.where(mus > 0.0, np.clip(mus, COEFFICIENT_MIN, COEFFICIENT_MAX), 0.0)
 
 
 def reclosed_copies(
@@ -157,29 +185,76 @@ def reclosed_robustness(
 ) -> np.ndarray:
     """(K,) fraction of ``samples`` re-closed copies of each grasp in force closure.
 
+    Every argument is checked first, before any draw from ``rng``; a bad one
+    raises a :class:`~drakegrasp.GraspError` naming it.
+
     Parameters
     ----------
     surface : ObjectSurface
+        The object's surface in O, anything with ``chord(p_O, d_O)``
+        (:class:`~drakegrasp.planning.surface.ObjectSurface`, a cloud's
+        :class:`~drakegrasp.planning.cloud.FittedCloud`).
     positions : (K, N, 3) float
-        Contacts of ``K`` grasps (O, metres).
+        Contacts of ``K >= 0`` grasps of ``N >= 1`` contacts (O, metres,
+        finite): each finger's probes.
     fingers : (K, N) int
+        Finger of each contact: 0 and 1 are probed, any other label in
+        ``[0, 63]`` (a palm) is not.
     axes : (K, 3) float
-        Grasp axes in O.
+        Grasp axes in O, from finger 0 towards finger 1; finite, non-zero,
+        normalised here.
     mu : float
+        Nominal friction coefficient: 0 or in ``[1e-12, 1e12]``
+        (:mod:`drakegrasp.core.validation`).
     samples : int
+        Copies per grasp, an integer ``>= 0`` (0: robustness 0).
     rng : numpy.random.Generator
+        Draws the motions and μ (``numpy.random.default_rng(seed)``).
     position, angle_deg, friction : float
-        σ_p (m), σ_θ (degrees, about the axis), σ_μ (relative).
+        σ_p (metres), σ_θ (degrees, about the axis), σ_μ (relative); each
+        finite and ``>= 0``.
     tol : float
+        Metres, a length ``> 0``: probes within ``tol`` of a finger's first
+        touch touch too (the planner's distance tolerance).
     contact_model, torsional_friction, workers
         As :func:`~drakegrasp.batch.batch_force_closure`.
     reference : (3,) float, optional
         The point of O that moments are taken about (the object's centre of
         mass; default O's origin): a soft finger's torsion scale ``b`` is the
         farthest contact from it.
+
+    Returns
+    -------
+    (K,) float
+        Fraction in ``[0, 1]`` of each grasp's copies in force closure.
     """
-    reference = np.zeros(3) if reference is None else reference
+    if not callable(getattr(surface, "chord", None)):
+        raise InvalidOptionError(
+            "surface must have chord(p_O, d_O) (an ObjectSurface or a "
+            f"FittedCloud), got {type(surface).__name__}"
+        )
+    positions = checked_points(positions)
     K, N, _ = positions.shape
+    fingers = checked_fingers(fingers, (K, N))
+    axes = checked_directions("axes", axes, count=K)
+    mu, contact_model, torsional_friction = checked_friction(
+        mu, contact_model, torsional_friction
+    )
+    samples = checked_count("samples", samples)
+    rng = checked_rng(rng)
+    position = checked_nonnegative("position", position, "metres")
+    angle_deg = checked_nonnegative("angle_deg", angle_deg, "degrees")
+    friction = checked_nonnegative("friction", friction, "relative")
+    tol = check_length("tol", tol, error=InvalidOptionError)
+    check_workers(workers)
+    if reference is None:
+        reference = np.zeros(3)
+    else:
+        reference = check_positions("reference", reference, error=InvalidGraspError)
+        if reference.shape != (3,):
+            raise InvalidGraspError(
+                f"reference must be a point (3,) of O, got shape {reference.shape}"
+            )
     if samples == 0 or K == 0:
         return np.zeros(K)
     M = K * samples
@@ -188,11 +263,11 @@ def reclosed_robustness(
     A = np.repeat(axes, samples, axis=0)
     t = position * rng.standard_normal((M, 3))
     theta = np.radians(angle_deg) * rng.standard_normal(M)
-    mus = mu * np.maximum(0.0, 1.0 + friction * rng.standard_normal(M))
+    mus = perturbed_mu(mu * np.maximum(0.0, 1.0 + friction * rng.standard_normal(M)))
     touch, p_OC, nhat, ok = reclosed_copies(surface, P, F, A, t, theta, tol=tol)
     held = np.zeros(M, bool)
     counts = np.where(ok, touch.sum(axis=1), 0)
-    never = NEVER_CLOSURE.get(str(getattr(contact_model, "value", contact_model)), 0)
+    never = NEVER_CLOSURE.get(contact_model, 0)
     for n in np.unique(counts[counts > never]):  # the others need no LP
         rows = np.flatnonzero(counts == n)
         order = np.argsort(~touch[rows], axis=1, kind="stable")[:, :n]

@@ -44,10 +44,20 @@ from drakegrasp._solvers import require_solution, solve
 from drakegrasp.batch import compiled
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
 from drakegrasp.batch.lp.ipm import solve_max_last, solve_max_last_active
-from drakegrasp.batch.run.workers import map_ordered, resolve_workers
+from drakegrasp.batch.run.workers import check_workers, map_ordered, resolve_workers
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.validation import (
+    check_length,
+    check_num_generators,
+)
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.planning.checks import (
+    checked_contacts,
+    checked_directions,
+    checked_fingers,
+    checked_friction,
+)
 
 __all__ = [
     "WEIGHT_CHUNK",
@@ -105,6 +115,14 @@ were solved through Clp, since import (read by the tests)."""
 
 WEIGHT_CHUNK = 512
 """Grasps per task of :func:`weight_capacity` (the same for any worker count)."""
+
+_MOMENT_ARMS = (1e-4, 1e12)
+"""Range of a grasp's extent (its largest contact coordinate) over
+``torque_scale`` in :func:`weight_capacity`, for a grasp not all at O.  Below it
+the moments, divided by ``torque_scale``, are too small for the LPs'
+tolerances, and the capacities came out wrong without a word (by 5e-5 at a
+ratio of 2.4e-5, by 0.66 at 2.4e-7, on random grasps); far above it Clp fails
+(at 2.4e21)."""
 
 
 def build_weight_capacity_program(
@@ -199,24 +217,42 @@ def weight_capacity(
 ) -> np.ndarray:
     """(K, D) weight capacities ``α(u)`` of ``K`` grasps of ``N`` contacts.
 
+    Every argument is checked here, before any LP, and a bad one raises a
+    :class:`~drakegrasp.GraspError` naming it.
+
     Parameters
     ----------
     positions, normals : (K, N, 3) float
-        Contacts (metres) and inward unit normals in O; moments about O's
-        origin, where the weight acts (the planner passes the contacts
-        relative to the centre of mass).
+        Contacts (metres, finite) and inward normals (finite, non-zero;
+        normalised here) in O; moments about O's origin, where the weight acts
+        (the planner passes the contacts relative to the centre of mass).
+        ``K >= 0`` grasps of ``N >= 1`` contacts.
     fingers : (K, N) int
         Finger (0 or 1) of each contact, 2 for another hand body (a palm,
         whose normal forces are bounded by the squeeze too); a multi-finger
         hand numbers its ``F`` fingers 0 to ``F - 1`` and its palm ``F``.
+        Integers in ``[0,`` :data:`~drakegrasp.planning.checks.MAX_FINGER_LABEL` ``]``.
     mu : float
+        Coulomb friction coefficient, 0 or in ``[1e-12, 1e12]`` (the range of
+        :mod:`drakegrasp.core.validation`); a larger ``μ`` never lowers a
+        capacity.
     torque_scale : float
-        Metres dividing the moments (conditioning only; a soft finger's
-        torsion bound is ``torque_scale · ν``, as in ε).
-    contact_model : str, optional
+        Metres dividing the moments (conditioning only; a soft finger's torsion
+        bound is ``torque_scale · ν``, as in ε): a length in ``[2.2e-308,
+        1e30]``, and each grasp's extent (its largest contact coordinate) over
+        it in ``[1e-4, 1e12]`` unless all its contacts are at O (the moments
+        must stay within the LPs' resolution).
+    contact_model : {"hard_finger", "frictionless", "soft_finger"}, optional
     torsional_friction : float, optional
+        ``ν`` of soft fingers, 0 or in ``[1e-12, 1e12]``; ``None`` (default):
+        0, and refused with ``contact_model="soft_finger"``, as
+        :func:`~drakegrasp.batch.batch_force_closure` does.
     directions : (D, 3) float, optional
+        Weight directions in O, ``D >= 1``, finite and non-zero; normalised
+        here (a capacity is per unit weight: only the direction counts).
+        Default :data:`WEIGHT_DIRECTIONS`.
     num_generators : int, optional
+        Generators of each linearised cone, in ``[3, 256]``.
     solver : {"batch", "drake"}, optional
         ``"batch"`` (default): the dual LPs of all grasps and directions at
         once in the batch engine, exactly by its active-set method
@@ -233,12 +269,45 @@ def weight_capacity(
     -------
     alpha : (K, D) float
         Newtons of weight held per newton of squeeze on each finger.
+
+    Raises
+    ------
+    InvalidContactError
+        Bad ``positions``, ``normals``, ``fingers``, ``mu``,
+        ``contact_model`` or ``torsional_friction``.
+    InvalidOptionError
+        Bad ``torque_scale``, ``directions``, ``num_generators``, ``solver``
+        or ``workers``, or moments that overflow (positions far beyond
+        ``torque_scale``).
     """
+    positions, normals = checked_contacts(positions, normals)
     K, N, _ = positions.shape
+    fingers = checked_fingers(fingers, (K, N))
+    mu, contact_model, torsional_friction = checked_friction(
+        mu, contact_model, torsional_friction
+    )
+    torque_scale = check_length("torque_scale", torque_scale, error=InvalidOptionError)
+    reach = np.max(np.abs(positions), axis=(1, 2))  # (K,) each grasp's extent
+    low, high = _MOMENT_ARMS
+    off = (reach > 0.0) & ~(
+        (reach >= low * torque_scale) & (reach <= high * torque_scale)
+    )
+    if off.any():
+        k = int(np.flatnonzero(off)[0])
+        raise InvalidOptionError(
+            f"torque_scale = {torque_scale:g} m is out of scale with grasp {k}, "
+            f"whose contacts lie within {reach[k]:g} m of O: the moments divided "
+            f"by torque_scale must stay within [{low:g}, {high:g}] (beyond, they "
+            "are below the LPs' resolution or overflow their arithmetic); give a "
+            "torque_scale near the grasps' size"
+        )
+    directions = checked_directions("directions", directions)
+    num_generators = check_num_generators(num_generators)
+    if not isinstance(solver, str) or solver not in ("batch", "drake"):
+        raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
+    check_workers(workers)
     if K == 0:
         return np.zeros((0, len(directions)))
-    if solver not in ("batch", "drake"):
-        raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
     options = dict(
         mu=mu, torque_scale=torque_scale, contact_model=contact_model,
         torsional_friction=torsional_friction, directions=directions,
@@ -258,16 +327,24 @@ def _capacity(positions, normals, fingers, *, mu, torque_scale, contact_model,
               torsional_friction, directions, num_generators, solver):  # fmt: skip
     """:func:`weight_capacity` of one chunk of grasps, in this process."""
     K, N, _ = positions.shape
-    W = batched_primitive_wrenches(
-        positions,
-        normals,
-        np.full((K, N), float(mu)),
-        np.full((K, N), float(torsional_friction or 0.0)),
-        np.zeros((K, 3)),
-        np.full(K, float(torque_scale)),
-        contact_model=contact_model,
-        num_generators=num_generators,
-    )
+    with np.errstate(over="ignore", invalid="ignore"):  # checked below
+        W = batched_primitive_wrenches(
+            positions,
+            normals,
+            np.full((K, N), float(mu)),
+            np.full((K, N), float(torsional_friction or 0.0)),
+            np.zeros((K, 3)),
+            np.full(K, float(torque_scale)),
+            contact_model=contact_model,
+            num_generators=num_generators,
+        )
+    if not np.all(np.isfinite(W)):  # Drake aborts on a non-finite coefficient
+        raise InvalidOptionError(
+            f"the moments overflow: contacts up to "
+            f"{float(np.max(np.abs(positions))):g} m from O over torque_scale = "
+            f"{torque_scale:g} m (with mu = {mu:g}) exceed the float range; give "
+            "a torque_scale nearer the grasp's size"
+        )
     per = W.shape[1] // N
     groups = np.repeat(fingers, per, axis=1)
     if solver == "batch":
