@@ -212,9 +212,14 @@ def evaluate_on_cluster(
             options=options, step=step, chunk_size=size,
             rows=[min(K, s + step) - s for s in starts],
         )  # fmt: skip
-        output_dir = prepare_dataset(output_dir, manifest, overwrite=overwrite)
+        prepare_dataset(output_dir, manifest, overwrite=overwrite, create=False)
         job = manifest["job"]
+    # The output is checked before connecting and opened after: a scheduler
+    # that cannot be reached leaves no dataset directory behind (an empty one
+    # named like the output blocked every later run).
     with connected(client) as client:
+        if output_dir is not None:
+            output_dir = prepare_dataset(output_dir, manifest, overwrite=overwrite)
         futures, done_paths = [], {}
         run = uuid.uuid4().hex  # task keys unique to this call
         for j, start in enumerate(starts):

@@ -143,13 +143,17 @@ def _differences(old: dict, new: dict) -> str:
     return "another job (differs in " + ", ".join(changed) + ")"
 
 
-def prepare_dataset(output_dir, manifest: dict, *, overwrite: bool) -> Path:
+def prepare_dataset(
+    output_dir, manifest: dict, *, overwrite: bool, create: bool = True
+) -> Path:
     """Open ``output_dir`` for the job of ``manifest``; return it as a Path.
 
     A new directory, or one holding this job's manifest, is kept as it is
     (its complete shards are resumed).  One holding another job's manifest,
     or shards without a manifest, is refused, or with ``overwrite`` its
-    shards are removed and the new manifest written.
+    shards are removed and the new manifest written.  With ``create=False``
+    only the refusals are checked: nothing is created, removed or written
+    (a run checks its output before it connects, and opens it after).
 
     Raises
     ------
@@ -164,7 +168,10 @@ def prepare_dataset(output_dir, manifest: dict, *, overwrite: bool) -> Path:
             f"output {str(output_dir)!r} is a file; a cluster run writes a "
             "dataset directory of Parquet shards: name a directory"
         )
-    output_dir.mkdir(parents=True, exist_ok=True)
+    if not create and not output_dir.exists():
+        return output_dir
+    if create:
+        output_dir.mkdir(parents=True, exist_ok=True)
     old = _read_manifest(output_dir)
     if old is not None and old.get("job") == manifest["job"]:
         return output_dir
@@ -181,10 +188,13 @@ def prepare_dataset(output_dir, manifest: dict, *, overwrite: bool) -> Path:
                 "overwrite=True (drakegrasp batch --overwrite) to replace its "
                 "shards, or choose another directory"
             )
-        for p in shards.values():
-            p.unlink()
-        for p in output_dir.glob(".part-*.tmp"):
-            p.unlink()
+        if create:
+            for p in shards.values():
+                p.unlink()
+            for p in output_dir.glob(".part-*.tmp"):
+                p.unlink()
+    if not create:
+        return output_dir
     tmp = output_dir / f".{MANIFEST}.{os.getpid()}.tmp"
     tmp.write_text(json.dumps(manifest, indent=1, sort_keys=True))
     os.replace(tmp, output_dir / MANIFEST)

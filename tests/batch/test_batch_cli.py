@@ -132,3 +132,28 @@ def test_an_unwritable_output_names_the_users_path_not_a_temporary_one(
     assert code == 1 and f"cannot write '{out}': Permission denied" in err
     assert ".partial" not in err and err.count("\n") == 1
     assert not list(tmp_path.glob(".out.npz*"))
+
+
+@pytest.mark.parametrize(
+    "name, fmt, ok",
+    [
+        ("o.npz", "parquet", False),
+        ("o.PARQUET", "npz", False),
+        ("o.npz", "npz", True),
+    ],
+)
+def test_format_contradicting_the_suffix_is_refused(
+    grasp_file, tmp_path, capsys, name, fmt, ok
+):
+    # A Parquet file named .npz fooled every reader that trusts the suffix.
+    if fmt == "parquet":
+        pytest.importorskip("pyarrow", reason="pyarrow is an optional extra")
+    path, _, _ = grasp_file
+    out = tmp_path / name
+    code = main(["batch", str(path), str(out), "--format", fmt])
+    err = capsys.readouterr().err
+    if ok:
+        assert code == 0 and out.exists()
+    else:
+        assert code == 1 and not out.exists()
+        assert err.count("\n") == 1 and f"but the format is {fmt!r}" in err

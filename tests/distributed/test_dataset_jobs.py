@@ -274,3 +274,35 @@ def test_a_failed_connection_leaves_no_client_for_a_later_collection():
         with pytest.raises(InvalidOptionError):
             client_for(address)
     assert clients() == before
+
+
+def test_an_unreachable_scheduler_leaves_no_directory(tmp_path, monkeypatch):
+    # The output used to be created before connecting: an empty directory
+    # named like the output was left behind by every failed connection.
+    from drakegrasp.distributed import batch_side
+
+    def refuse(_client):
+        raise GraspError("cannot reach the scheduler at tcp://nowhere:1")
+
+    monkeypatch.setattr(batch_side, "connected", refuse)
+    P, Nrm, mu = _grasps(3, 20)
+    out = tmp_path / "nested" / "ds"
+    with pytest.raises(GraspError, match="cannot reach"):
+        evaluate_on_cluster("tcp://nowhere:1", P, Nrm, mu=mu, output_dir=out)
+    assert not (tmp_path / "nested").exists()
+
+
+def test_a_foreign_dataset_is_refused_before_connecting(tmp_path, monkeypatch):
+    from drakegrasp.distributed import batch_side
+
+    def unexpected(_client):
+        raise AssertionError("connected before checking the output")
+
+    out = tmp_path / "ds"
+    out.mkdir()
+    (out / MANIFEST).write_text('{"job": "another"}')
+    monkeypatch.setattr(batch_side, "connected", unexpected)
+    P, Nrm, mu = _grasps(4, 20)
+    with pytest.raises(BatchFileError, match="overwrite=True"):
+        evaluate_on_cluster("tcp://nowhere:1", P, Nrm, mu=mu, output_dir=out)
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST]

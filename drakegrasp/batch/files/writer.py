@@ -107,14 +107,23 @@ class BatchSummary:
 
 
 def format_of(path: str | os.PathLike, fmt: str | None = None) -> str:
-    """``fmt``, or the format the suffix of ``path`` names (``.npz``/``.parquet``)."""
+    """``fmt``, or the format the suffix of ``path`` names (``.npz``/``.parquet``).
+
+    A ``fmt`` that contradicts the suffix is refused, not obeyed: a Parquet
+    file called ``.npz`` would fool every reader that trusts the name.
+    """
+    suffix = Path(path).suffix.lower().lstrip(".")
     if fmt is not None:
         if fmt not in FORMATS:
             raise InvalidOptionError(
                 f"format must be one of {', '.join(FORMATS)}, got {fmt!r}"
             )
+        if suffix in FORMATS and suffix != fmt:
+            raise InvalidOptionError(
+                f"output file {str(path)!r} ends in .{suffix} but the format is "
+                f"{fmt!r} (--format {fmt}); name it .{fmt} or leave the format out"
+            )
         return fmt
-    suffix = Path(path).suffix.lower().lstrip(".")
     if suffix not in FORMATS:
         raise InvalidOptionError(
             f"output file {str(path)!r} must end in .npz or .parquet (or pass "
