@@ -53,6 +53,7 @@ from drakegrasp.closure.constraints import (
 )
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
+from drakegrasp.core.linalg import FULL_SVD_MAX_COLUMNS
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import check_grasp as _check_grasp
 from drakegrasp.core.validation import check_num_generators, real_array, safe_norm
@@ -412,8 +413,10 @@ def _rotation(Gbar: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """``U``: left singular vectors of the normal columns (the wrenches they make)."""
     A = Gbar[:, normals]
     # All m left vectors are needed; the full right factor (n x n, gigabytes
-    # for thousands of contacts) only when there are fewer columns than rows.
-    return np.linalg.svd(A, full_matrices=A.shape[1] < A.shape[0])[0]
+    # for thousands of contacts) only for the usual small grasps, whose bits
+    # it keeps, or when there are fewer columns than rows.
+    full = A.shape[1] <= FULL_SVD_MAX_COLUMNS or A.shape[1] < A.shape[0]
+    return np.linalg.svd(A, full_matrices=full)[0]
 
 
 def _rounding(U: np.ndarray, A: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ from drakegrasp.core.validation import check_rank_tol, real_array, safe_norm
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
+    "FULL_SVD_MAX_COLUMNS",
     "ZERO_COLUMN",
     "equilibrated",
     "left_null_space",
@@ -29,6 +30,14 @@ __all__ = [
 
 ZERO_COLUMN = 1e-12
 """Relative norm below which :func:`unit_columns` drops a column as zero."""
+
+FULL_SVD_MAX_COLUMNS = 2048
+"""Columns up to which an SVD computes the full square factor (32 MiB at 2048).
+
+Beyond it the thin factor is taken: a full ``V`` of a 6 x 30,000 matrix is
+7.2 GB.  Below it the full factor keeps LAPACK on the path every recorded
+d* was computed with (the thin path differs in the last bits, 1e-11).
+"""
 
 
 def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
@@ -133,7 +142,10 @@ def row_space(A: np.ndarray, rank_tol: float = DEFAULT_RANK_TOL) -> np.ndarray:
         The right singular vectors whose singular values exceed
         ``rank_tol σ_max`` (``r = 0`` for a zero matrix).
     """
-    _, s, vt = np.linalg.svd(A, full_matrices=False)  # (min(m, n), n) suffice
+    # The full factor's LAPACK path for the usual small grasps (its bits are
+    # the ones every verdict was recorded with); the thin one past
+    # FULL_SVD_MAX_COLUMNS, where the n x n factor would take gigabytes.
+    _, s, vt = np.linalg.svd(A, full_matrices=A.shape[-1] <= FULL_SVD_MAX_COLUMNS)
     if s.size == 0 or s[0] == 0.0:
         return np.zeros((0, A.shape[1]))
     return vt[: int(np.sum(s > rank_tol * s[0]))]

@@ -44,7 +44,7 @@ import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
-from drakegrasp.core.validation import check_length, real_array, unit_vectors
+from drakegrasp.core.validation import real_array, unit_vectors
 from drakegrasp.errors import (
     InvalidContactError,
     InvalidOptionError,
@@ -68,6 +68,7 @@ from drakegrasp.planning.checks import (
     checked_fingers,
     checked_friction,
     checked_rng,
+    checked_torque_scale,
 )
 from drakegrasp.planning.cloud import CONTACT_BAND, cloud_surface
 from drakegrasp.planning.cloud_hand import FAN_SIGMAS, CloudHand
@@ -343,7 +344,7 @@ def fan_capacity(
     )
     samples = checked_count("samples", samples)
     rng = checked_rng(rng)
-    torque_scale = check_length("torque_scale", torque_scale, error=InvalidOptionError)
+    torque_scale = checked_torque_scale(torque_scale, positions)  # before any draw
     S = max(samples, 1)
     has = np.all(np.isfinite(fans), axis=(2, 3))  # (K, N)
     t = rng.uniform(size=(K, S, N)) if samples else np.zeros((K, S, N))

@@ -48,7 +48,6 @@ from drakegrasp.batch.run.workers import check_workers, map_ordered, resolve_wor
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import (
-    check_length,
     check_num_generators,
 )
 from drakegrasp.errors import InvalidOptionError
@@ -57,6 +56,7 @@ from drakegrasp.planning.checks import (
     checked_directions,
     checked_fingers,
     checked_friction,
+    checked_torque_scale,
 )
 
 __all__ = [
@@ -115,14 +115,6 @@ were solved through Clp, since import (read by the tests)."""
 
 WEIGHT_CHUNK = 512
 """Grasps per task of :func:`weight_capacity` (the same for any worker count)."""
-
-_MOMENT_ARMS = (1e-4, 1e12)
-"""Range of a grasp's extent (its largest contact coordinate) over
-``torque_scale`` in :func:`weight_capacity`, for a grasp not all at O.  Below it
-the moments, divided by ``torque_scale``, are too small for the LPs'
-tolerances, and the capacities came out wrong without a word (by 5e-5 at a
-ratio of 2.4e-5, by 0.66 at 2.4e-7, on random grasps); far above it Clp fails
-(at 2.4e21)."""
 
 
 def build_weight_capacity_program(
@@ -286,21 +278,7 @@ def weight_capacity(
     mu, contact_model, torsional_friction = checked_friction(
         mu, contact_model, torsional_friction
     )
-    torque_scale = check_length("torque_scale", torque_scale, error=InvalidOptionError)
-    reach = np.max(np.abs(positions), axis=(1, 2))  # (K,) each grasp's extent
-    low, high = _MOMENT_ARMS
-    off = (reach > 0.0) & ~(
-        (reach >= low * torque_scale) & (reach <= high * torque_scale)
-    )
-    if off.any():
-        k = int(np.flatnonzero(off)[0])
-        raise InvalidOptionError(
-            f"torque_scale = {torque_scale:g} m is out of scale with grasp {k}, "
-            f"whose contacts lie within {reach[k]:g} m of O: the moments divided "
-            f"by torque_scale must stay within [{low:g}, {high:g}] (beyond, they "
-            "are below the LPs' resolution or overflow their arithmetic); give a "
-            "torque_scale near the grasps' size"
-        )
+    torque_scale = checked_torque_scale(torque_scale, positions)
     directions = checked_directions("directions", directions)
     num_generators = check_num_generators(num_generators)
     if not isinstance(solver, str) or solver not in ("batch", "drake"):

@@ -157,3 +157,24 @@ def test_format_contradicting_the_suffix_is_refused(
     else:
         assert code == 1 and not out.exists()
         assert err.count("\n") == 1 and f"but the format is {fmt!r}" in err
+
+
+def test_an_output_name_near_the_length_limit_is_written(grasp_file, tmp_path):
+    # The temporary sibling added 22 characters to the name: an output named
+    # with 234-255 bytes could not be written at all.
+    path, _, _ = grasp_file
+    out = tmp_path / ("r" * 251 + ".npz")
+    assert main(["batch", str(path), str(out)]) == 0
+    assert out.exists() and [p.name for p in tmp_path.iterdir() if p != path] == [
+        out.name
+    ]
+
+
+def test_an_output_under_a_file_says_so(grasp_file, tmp_path, capsys):
+    path, _, _ = grasp_file
+    (tmp_path / "plain").write_text("")
+    assert main(["batch", str(path), str(tmp_path / "plain" / "o.npz")]) == 1
+    assert (
+        "'" + str(tmp_path / "plain") + "' is not a directory"
+        in capsys.readouterr().err
+    )

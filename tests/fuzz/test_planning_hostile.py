@@ -265,7 +265,7 @@ FAN_BAD = (
     _cases("mu", BAD_MU)
     + _cases("samples", BAD_COUNT)
     + _cases("rng", BAD_RNG)
-    + _cases("torque_scale", BAD_LENGTH)
+    + _cases("torque_scale", [*BAD_LENGTH, 1e9, 1e-300])  # out of scale, undrawn
     + _cases("fans", [_partial, _zero_end, FANS[0], "fan", None])
     + _cases("fingers", [L_BOX[0], -L_BOX])
     + _cases("positions", [P_EDGE[0], P_EDGE + np.inf])

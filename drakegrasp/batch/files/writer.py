@@ -166,7 +166,8 @@ def check_output(
             f"output file {str(output)!r} exists; {remedy} to replace it"
         )
     if not output.parent.is_dir():
-        raise BatchFileError(f"output directory {str(output.parent)!r} does not exist")
+        what = "is not a directory" if output.parent.exists() else "does not exist"
+        raise BatchFileError(f"output directory {str(output.parent)!r} {what}")
     return output, suffix
 
 
@@ -184,6 +185,10 @@ def _link_or_rename(tmp: str, path: Path) -> None:
     os.unlink(tmp)
 
 
+_NAME_MAX = 255
+"""Bytes in a file name on the usual file systems (ext4, APFS, NTFS)."""
+
+
 def _new_sibling(path: Path) -> str:
     """Create an empty ``.NAME.XXXX.partial`` beside ``path``; return its name.
 
@@ -191,8 +196,15 @@ def _new_sibling(path: Path) -> str:
     mode an ordinary file gets, 0666 less the umask (0644 under umask 022):
     mkstemp's 0600 would make the results unreadable to the user's group.
     """
+    # The name is cut so the temporary one fits where the output's does: a
+    # name of 234-255 bytes (the usual limit) gained 22 and could not be made.
+    name = path.name
+    while (
+        name and len(os.fsencode(name)) > _NAME_MAX - len(".0123456789ab.partial") - 1
+    ):
+        name = name[:-1]
     for _ in range(100):
-        tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.partial"
+        tmp = path.parent / f".{name}.{secrets.token_hex(6)}.partial"
         try:
             fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
         except FileExistsError:
