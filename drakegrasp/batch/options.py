@@ -115,7 +115,8 @@ class BatchOptions:
 
     def replace(self, **changes: Any) -> BatchOptions:
         """A copy with ``changes`` (checked again); unknown names are refused."""
-        unknown = sorted(set(changes) - set(OPTION_NAMES))
+        # model= (deprecated) reaches the constructor, which warns and renames it
+        unknown = sorted(set(changes) - set(OPTION_NAMES) - {"model"})
         if unknown:
             raise InvalidOptionError(
                 f"unknown batch option(s) {unknown}; valid: {list(OPTION_NAMES)}"

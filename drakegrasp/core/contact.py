@@ -20,7 +20,7 @@ from drakegrasp.core.validation import (
     real_array,
     unit_vectors,
 )
-from drakegrasp.errors import InvalidContactError
+from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
 __all__ = ["Contact", "ContactModel", "contact_frame", "contact_frames"]
 
@@ -49,7 +49,8 @@ class ContactModel(str, enum.Enum):
         except ValueError:
             valid = ", ".join(repr(m.value) for m in cls)
             raise InvalidContactError(
-                f"unknown contact model {value!r}; valid models are {valid}"
+                f"unknown contact model {value!r} (contact_model=); valid "
+                f"models are {valid}"
             ) from None
 
     def __str__(self) -> str:
@@ -152,15 +153,13 @@ def _deprecated_model(contact_model, deprecated: dict, where: str) -> ContactMod
     """``contact_model``, or the deprecated ``model=`` of ``deprecated`` (warned)."""
     unknown = set(deprecated) - {"model"}
     if unknown:
-        raise InvalidContactError(
-            f"{where} got unexpected keyword(s) {sorted(unknown)}"
-        )
+        raise InvalidOptionError(f"{where} got unexpected keyword(s) {sorted(unknown)}")
     if "model" not in deprecated:
         if contact_model is _DEFAULT_MODEL:
             return ContactModel.HARD_FINGER
         return contact_model
     if contact_model is not _DEFAULT_MODEL:
-        raise InvalidContactError(
+        raise InvalidOptionError(
             f"{where} got both model= (deprecated) and contact_model=; give "
             "contact_model= only"
         )

@@ -9,6 +9,7 @@ page.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import inspect
 import sys
@@ -28,16 +29,23 @@ def warn_deprecated(message: str, *, stacklevel: int | None = 3) -> None:
 
     ``stacklevel`` counts as ``warnings.warn`` does, from this function
     (3: the caller of the function that calls this one).  ``None`` (used by the
-    decorators here) attributes the warning to the first frame outside this
-    module, however many of its wrappers are stacked.
+    decorators here) attributes the warning to the first frame outside
+    drakegrasp and ``dataclasses``, however many wrappers are stacked (a
+    ``dataclasses.replace`` or an internal call that passes the user's keyword
+    on is not where the old spelling was written).
     """
     if stacklevel is None:
         stacklevel = 2
         frame = sys._getframe(1)
-        while frame is not None and frame.f_globals.get("__name__") == __name__:
+        while frame is not None and _inside(frame.f_globals.get("__name__", "")):
             frame = frame.f_back
             stacklevel += 1
     warnings.warn(message, DeprecationWarning, stacklevel=stacklevel)
+
+
+def _inside(module: str) -> bool:
+    """Whether a frame of ``module`` is drakegrasp's or dataclasses' own."""
+    return module == "dataclasses" or module.split(".")[0] == "drakegrasp"
 
 
 def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
@@ -61,15 +69,28 @@ def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
     def decorate(function: F) -> F:
         if inspect.isclass(function):
             cls = function
-            cls.__init__ = _renamed(cls.__init__, old, new, f"{cls.__qualname__}()")
+            fields = (
+                [f.name for f in dataclasses.fields(cls) if f.init]
+                if dataclasses.is_dataclass(cls)
+                else None
+            )
+            where = f"{cls.__qualname__}()"
+            cls.__init__ = _renamed(cls.__init__, old, new, where, fields=fields)
             return cls
         return _renamed(function, old, new, f"{function.__qualname__}()")
 
     return decorate
 
 
-def _renamed(function: F, old: str, new: str, where: str) -> F:
-    """``function`` taking ``old=`` for ``new=`` (see :func:`renamed_keyword`)."""
+def _renamed(
+    function: F, old: str, new: str, where: str, *, fields: list[str] | None = None
+) -> F:
+    """``function`` taking ``old=`` for ``new=`` (see :func:`renamed_keyword`).
+
+    ``fields`` are a dataclass's init fields: ``dataclasses.replace(x, old=v)``
+    passes every one of them by name, ``new`` included, and is told apart from
+    a call that gives both spellings by that (``old`` then replaces ``new``).
+    """
     parameters = list(inspect.signature(function).parameters.values())
     names = [p.name for p in parameters]
     if new not in names:
@@ -87,6 +108,13 @@ def _renamed(function: F, old: str, new: str, where: str) -> F:
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
         if old in kwargs:
+            replacing = (
+                fields is not None
+                and len(args) <= 1  # self only
+                and set(fields) <= set(kwargs)
+            )
+            if replacing:
+                kwargs.pop(new)
             if new in kwargs or (place is not None and len(args) > place):
                 raise InvalidOptionError(
                     f"{where} got both {old}= (deprecated) and {new}= (or "

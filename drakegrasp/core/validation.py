@@ -479,7 +479,7 @@ def checked_fields(what: str):
         init = cls.__init__
 
         @functools.wraps(init)
-        def __init__(self, *args, **kwargs):
+        def __init__(self, /, *args, **kwargs):  # self=1 is an unknown field
             unknown = sorted(set(kwargs) - set(names))
             if unknown:
                 raise InvalidOptionError(f"unknown {what}(s) {unknown}; valid: {names}")

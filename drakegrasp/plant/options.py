@@ -150,6 +150,7 @@ class AnalysisOptions:
                 raise InvalidOptionError(
                     f"mu must be a number or 'plant', got {self.mu!r}"
                 )
+            put("mu", "plant")  # a plain str, whatever str subclass came in
         elif self.mu is not None:
             put("mu", check_coefficient("mu", self.mu))
         model = ContactModel.parse(self.contact_model)
@@ -161,6 +162,8 @@ class AnalysisOptions:
                 f"plane must be one of {sorted(PLANES)} (object-frame axes) or "
                 f"None, got {self.plane!r}"
             )
+        if self.plane is not None:
+            put("plane", str(self.plane))  # numpy.str_ and other subclasses
         if self.plane is not None and model is ContactModel.SOFT_FINGER:
             raise InvalidOptionError(
                 "a planar analysis has no soft fingers (no moment about an in-plane "
@@ -206,7 +209,8 @@ class AnalysisOptions:
 
     def replace(self, **changes: Any) -> AnalysisOptions:
         """A copy with ``changes`` (validated again); unknown names are refused."""
-        unknown = sorted(set(changes) - {f.name for f in fields(self)})
+        # model= (deprecated) reaches the constructor, which warns and renames it
+        unknown = sorted(set(changes) - {f.name for f in fields(self)} - {"model"})
         if unknown:
             raise InvalidOptionError(
                 f"unknown analysis option(s) {unknown}; valid: "
@@ -245,7 +249,7 @@ def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
     With ``limits``, ``+inf`` is allowed too (a joint with no limit).
     """
     if value is None or (isinstance(value, str) and value == word):
-        return value
+        return None if value is None else word  # a plain str
     if isinstance(value, str):
         raise InvalidOptionError(
             f"{name} must be {word!r}, numbers or None, got {value!r}"
@@ -260,8 +264,9 @@ def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
         ok = (values >= 0.0) & ~np.isnan(values)
     else:
         ok = np.isfinite(values)
-    if values.ndim != 1 or not np.all(ok):
+    if values.ndim != 1 or values.size == 0 or not np.all(ok):
         what = "numbers >= 0 (inf: no limit)" if limits else "finite numbers"
+        what = f"one or more {what}"
         raise InvalidOptionError(
             f"{name} must be a 1-D sequence of {what}, got {value!r}"
         )

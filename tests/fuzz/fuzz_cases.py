@@ -1726,6 +1726,16 @@ MODEL_SPELLINGS = [
 BAD_MODELS = ["sticky", "", None, 3, 1j, ["soft_finger"], b"soft_finger"]
 
 
+def _replaced_model(options):
+    """``dataclasses.replace(options, model="frictionless")``, its warning caught."""
+    import dataclasses
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        return dataclasses.replace(options, model="frictionless")
+
+
 def value_cases() -> Iterator[Case]:
     """Option objects, core linear algebra and the batch builders, value by value.
 
@@ -1756,7 +1766,7 @@ def value_cases() -> Iterator[Case]:
         "patches": ["all", None, 1, ["vertices"]],
         "check_pose": bad_flags,
         "load": ["weight", [1, 2], np.zeros(7), [NAN] * 6, [INF] * 6, ["1"] * 6, 1j],
-        "torque_limits": ["motors", [-1.0], [NAN], [-INF], [[1.0]], [True], 1j],
+        "torque_limits": ["motors", [-1.0], [NAN], [-INF], [[1.0]], [True], 1j, []],
     }
     batch = {
         "contact_model": BAD_MODELS,
@@ -1791,9 +1801,23 @@ def value_cases() -> Iterator[Case]:
             "refuse",
         )  # fmt: skip
         yield Case(
+            "values", f"{cls.__name__}(self=)", lambda c=cls: c(self=1), "refuse"
+        )
+        yield Case(
             "values", f"{cls.__name__}()", cls, "answer",
             lambda o: o.contact_model is dg.ContactModel.HARD_FINGER,
         )  # fmt: skip
+        yield Case(
+            "values", f"dataclasses.replace({cls.__name__}, model=)",
+            lambda c=cls: _replaced_model(c()), "answer",
+            lambda o: o.contact_model is dg.ContactModel.FRICTIONLESS,
+        )  # fmt: skip
+    # A str subclass is kept as the plain str it spells.
+    yield Case(
+        "values", "AnalysisOptions(numpy str_)",
+        lambda: dg.AnalysisOptions(plane=np.str_("xy"), mu=np.str_("plant")),
+        "answer", lambda o: type(o.plane) is str and type(o.mu) is str,
+    )  # fmt: skip
     # equilibrated: what is not a finite real matrix, and extreme columns
     for i, A in enumerate(
         [[1.0, 2.0], 1.0, [[NAN, 1.0], [0, 1]], [[INF, 0], [0, 1]],
