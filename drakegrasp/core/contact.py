@@ -22,7 +22,13 @@ from drakegrasp.core.validation import (
 )
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
-__all__ = ["Contact", "ContactModel", "contact_frame", "contact_frames"]
+__all__ = [
+    "Contact",
+    "ContactModel",
+    "contact_frame",
+    "contact_frames",
+    "missing_torsional_friction",
+]
 
 
 class ContactModel(str, enum.Enum):
@@ -55,6 +61,20 @@ class ContactModel(str, enum.Enum):
 
     def __str__(self) -> str:
         return self.value
+
+
+def missing_torsional_friction(error: type = InvalidContactError) -> Exception:
+    """The error for a soft finger given no torsional friction ``ν``.
+
+    One wording wherever a soft finger is asked for (a contact, the options
+    objects, the batch engine, the planner); ``error`` is the caller's kind.
+    """
+    return error(
+        "contact_model='soft_finger' needs torsional_friction (nu >= 0: the "
+        "moment about each contact normal is bounded by b * nu * f_n); pass "
+        "it (0 makes a soft finger act as a hard one), or use "
+        "contact_model='hard_finger'"
+    )
 
 
 def contact_frames(normals: np.ndarray) -> np.ndarray:
@@ -256,11 +276,7 @@ class Contact:
             )
         if torsional_friction is None:
             if contact_model is ContactModel.SOFT_FINGER:
-                raise InvalidContactError(
-                    "a soft-finger contact needs torsional_friction (nu: the "
-                    "moment about the normal is bounded by b * nu * f_n); pass "
-                    "nu > 0, or 0 for a soft finger that acts as a hard finger"
-                )
+                raise missing_torsional_friction()
             torsional_friction = 0.0
         nu_value = check_coefficient("torsional_friction", torsional_friction)
         object.__setattr__(self, "position", _frozen(p))

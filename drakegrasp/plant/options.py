@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import (
@@ -229,11 +229,7 @@ class AnalysisOptions:
             self.contact_model is ContactModel.SOFT_FINGER
             and self.torsional_friction is None
         ):
-            raise InvalidOptionError(
-                "contact_model='soft_finger' needs torsional_friction >= 0 (the "
-                "moment about the normal is bounded by b * nu * f_n; 0 makes it "
-                "a hard finger)"
-            )
+            raise missing_torsional_friction(InvalidOptionError)
         return self
 
     def to_dict(self) -> dict:

@@ -52,7 +52,7 @@ from drakegrasp.batch.inputs import (
 )
 from drakegrasp.batch.lp.dstar import solve_dstar_blocks
 from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
-from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
@@ -408,11 +408,7 @@ def force_task(positions, mu, contact_model, num_generators, torsional_friction,
     get_mu = per_contact_getter("mu", mu, K, N)
     if torsional_friction is None:
         if contact_model == "soft_finger":
-            raise InvalidContactError(
-                "contact_model='soft_finger' needs torsional_friction (nu: the "
-                "moment about the normal is bounded by b * nu * f_n); pass nu > 0, "
-                "or 0 for soft fingers that act as hard fingers"
-            )
+            raise missing_torsional_friction()
         torsional_friction = 0.0
     get_nu = per_contact_getter("torsional_friction", torsional_friction, K, N)
     get_p = _reference_points(reference_points, K, d)
