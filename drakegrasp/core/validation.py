@@ -86,6 +86,7 @@ __all__ = [
     "check_rank_tol",
     "check_tol",
     "checked_fields",
+    "describe",
     "integer_or_none",
     "real_array",
     "real_scalar",
@@ -132,7 +133,8 @@ JACOBIAN_BOUND = 1e100
 """Largest absolute entry of a hand Jacobian."""
 
 
-def _describe(value) -> str:
+def describe(value) -> str:
+    """``repr(value)`` on one line, cut to 120 characters, for a message."""
     text = " ".join(repr(value).split())
     return text if len(text) <= 120 else text[:117] + "..."
 
@@ -155,7 +157,7 @@ def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
         May be non-finite; range checks are the caller's.
     """
     if isinstance(value, (bool, np.bool_)) or value is None:
-        raise error(f"{name} must be a real number, got {_describe(value)}")
+        raise error(f"{name} must be a real number, got {describe(value)}")
     if isinstance(value, np.ndarray):
         if value.shape != () or value.dtype.kind not in "iuf":
             raise error(
@@ -165,13 +167,13 @@ def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
         return float(value)
     if not isinstance(value, numbers.Real):
         raise error(
-            f"{name} must be a real number, got {_describe(value)} "
+            f"{name} must be a real number, got {describe(value)} "
             f"({type(value).__name__})"
         )
     try:
         return float(value)
     except (TypeError, ValueError, OverflowError):
-        raise error(f"{name} must be a real number, got {_describe(value)}") from None
+        raise error(f"{name} must be a real number, got {describe(value)}") from None
 
 
 def real_array(name: str, value, *, error: type = InvalidContactError) -> np.ndarray:
@@ -191,7 +193,7 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
         non-finite values, which the caller checks.
     """
     if value is None or isinstance(value, (str, bytes)):
-        raise error(f"{name} must be an array of real numbers, got {_describe(value)}")
+        raise error(f"{name} must be an array of real numbers, got {describe(value)}")
     try:
         a = np.asarray(value)
     except (TypeError, ValueError) as err:  # ragged nested sequences
@@ -203,7 +205,7 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
             a = np.asarray(a.tolist(), dtype=float)
         except (TypeError, ValueError, OverflowError):
             raise error(
-                f"{name} must be an array of real numbers, got {_describe(value)}"
+                f"{name} must be an array of real numbers, got {describe(value)}"
             ) from None
     if a.dtype.kind == "c":
         raise error(
@@ -213,7 +215,7 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
     if a.dtype.kind not in "iuf":
         raise error(
             f"{name} must be an array of real numbers, got dtype {a.dtype} "
-            f"({_describe(value)})"
+            f"({describe(value)})"
         )
     return a.astype(float, copy=False)
 
@@ -347,7 +349,7 @@ def _threshold(value, name: str, low: float, high: float, must: str) -> float:
     """``value`` as a real in ``[low, high]``; the error says it ``must`` be so."""
     x = real_scalar(name, value)
     if not (low <= x <= high):
-        raise InvalidOptionError(f"{name} must be {must}, got {_describe(value)}")
+        raise InvalidOptionError(f"{name} must be {must}, got {describe(value)}")
     return x
 
 
@@ -393,7 +395,7 @@ def check_num_generators(value, name: str = "num_generators") -> int:
     if n is None or not (3 <= n <= MAX_NUM_GENERATORS):
         raise InvalidOptionError(
             f"{name} must be an integer >= 3 and <= {MAX_NUM_GENERATORS} "
-            f"(drakegrasp.core.validation.MAX_NUM_GENERATORS), got {_describe(value)}"
+            f"(drakegrasp.core.validation.MAX_NUM_GENERATORS), got {describe(value)}"
         )
     return int(n)
 
@@ -404,7 +406,7 @@ def check_angle_tol(value, name: str = "angle_tol") -> float:
     if not (0.0 <= x <= MAX_ANGLE_TOL):
         raise InvalidOptionError(
             f"{name} must be a real number in [0, {MAX_ANGLE_TOL:g}] rad, got "
-            f"{_describe(value)}"
+            f"{describe(value)}"
         )
     return x
 
@@ -415,7 +417,7 @@ def check_length(name: str, value, *, error: type = InvalidGraspError) -> float:
     if not (LENGTH_MIN <= x <= LENGTH_BOUND):
         raise error(
             f"{name} must be a finite length in [{LENGTH_MIN:.3g}, "
-            f"{LENGTH_BOUND:g}] metres, got {_describe(value)}"
+            f"{LENGTH_BOUND:g}] metres, got {describe(value)}"
         )
     return x
 
@@ -427,7 +429,7 @@ def check_grasp(value, name: str = "grasp"):
     grasp_module = sys.modules.get("drakegrasp.core.grasp")
     if grasp_module is None or not isinstance(value, grasp_module.Grasp):
         raise InvalidGraspError(
-            f"{name} must be a drakegrasp.Grasp, got {_describe(value)} "
+            f"{name} must be a drakegrasp.Grasp, got {describe(value)} "
             f"({type(value).__name__})"
         )
     return value
@@ -437,7 +439,7 @@ def check_flag(name: str, value) -> bool:
     """A boolean option: ``True``/``False`` (numpy booleans too), nothing else."""
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
-    raise InvalidOptionError(f"{name} must be True or False, got {_describe(value)}")
+    raise InvalidOptionError(f"{name} must be True or False, got {describe(value)}")
 
 
 def check_distance_tolerance(value) -> float:

@@ -7,12 +7,11 @@ argument, and is built on :mod:`drakegrasp.core.validation`.
 
 from __future__ import annotations
 
-import reprlib
-
 import numpy as np
 
-from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.validation import (
+    describe,
     check_coefficient,
     check_length,
     check_positions,
@@ -24,6 +23,7 @@ from drakegrasp.core.validation import (
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
 __all__ = [
+    "MAX_COPY_BYTES",
     "MAX_FINGER_LABEL",
     "MOMENT_ARMS",
     "checked_contacts",
@@ -34,6 +34,7 @@ __all__ = [
     "checked_nonnegative",
     "checked_points",
     "checked_rng",
+    "checked_samples",
     "checked_torque_scale",
 ]
 
@@ -43,9 +44,18 @@ and its palm.  Each label up to the largest is one squeeze-bounded group, with
 a variable in every LP of
 :func:`~drakegrasp.planning.weight.weight_capacity`, so the LPs grow with it."""
 
-
-def _describe(value) -> str:
-    return reprlib.repr(value)
+MAX_COPY_BYTES = 2**29
+"""Bytes the perturbed copies' contact points may take, ``K * samples * N * 3``
+float64 (:func:`checked_samples`): 512 MiB.  A stage holds several arrays of
+that size at its peak (the copies' points and normals, rotations, the
+re-closing's chord query: measured 8 times it in
+:func:`~drakegrasp.planning.ranking.perturbed_copies`, 11 in
+:func:`~drakegrasp.planning.ranking.robustness`, 16 in
+:func:`~drakegrasp.planning.reclose.reclosed_robustness`), so about 8 GiB,
+a third of the project's 24 GiB machine.  Unbounded, ``samples=10**12`` ended
+in a MemoryError, and a count just small enough to be allocated could swap
+or be killed.  The planner's largest runs (1,500 poses, the default 32 copies,
+20 contacts: 23 MB) stay 23 times below it."""
 
 
 def checked_points(positions) -> np.ndarray:
@@ -187,17 +197,10 @@ def checked_friction(mu, contact_model, torsional_friction):
     :func:`~drakegrasp.batch.batch_force_closure` refuses it) stays None.
     """
     mu = check_coefficient("mu", mu)
-    try:
-        contact_model = ContactModel.parse(contact_model).value
-    except InvalidContactError as err:  # its message names the value, not the argument
-        raise InvalidContactError(f"contact_model: {err}") from None
+    contact_model = ContactModel.parse(contact_model).value  # names contact_model=
     if torsional_friction is None:
         if contact_model == "soft_finger":
-            raise InvalidContactError(
-                "contact_model='soft_finger' needs torsional_friction (nu: the "
-                "moment about the normal is bounded by b * nu * f_n); pass nu > 0, "
-                "or 0 for soft fingers that act as hard fingers"
-            )
+            raise missing_torsional_friction()
         return mu, contact_model, None
     nu = check_coefficient("torsional_friction", torsional_friction)
     return mu, contact_model, nu
@@ -223,12 +226,44 @@ def checked_directions(name: str, value, *, count=None, error=InvalidOptionError
     return _unit_rows(name, a, error=error)
 
 
-def checked_count(name: str, value) -> int:
-    """``value`` as an int ``>= 0`` (a bool, float or string is refused)."""
+def checked_count(name: str, value, minimum: int = 0) -> int:
+    """``value`` as an int ``>= minimum`` (a bool, float or string is refused)."""
     n = integer_or_none(value)
-    if n is None or n < 0:
+    if n is None or n < minimum:
         raise InvalidOptionError(
-            f"{name} must be an integer >= 0, got {_describe(value)}"
+            f"{name} must be an integer >= {minimum}, got {describe(value)}"
+        )
+    return n
+
+
+def checked_samples(value, grasps: int, contacts: int, name: str = "samples") -> int:
+    """Copies per grasp: an int ``>= 0`` whose copies fit :data:`MAX_COPY_BYTES`.
+
+    Parameters
+    ----------
+    value : int
+        Copies of each grasp (perturbed, or drawn along a fan).
+    grasps, contacts : int
+        ``K`` grasps of ``N`` contacts each, copied ``value`` times: the
+        copies' points are ``K * value * N * 3`` float64.
+    name : str, optional
+        The argument's name in a message.
+
+    Raises
+    ------
+    InvalidOptionError
+        Naming ``name``: not an integer ``>= 0``, or copies over
+        :data:`MAX_COPY_BYTES`.
+    """
+    n = checked_count(name, value)
+    size = n * int(grasps) * int(contacts) * 3 * 8  # Python ints: no overflow
+    if size > MAX_COPY_BYTES:
+        raise InvalidOptionError(
+            f"{name} = {n} copies of {grasps} grasp(s) of {contacts} contacts "
+            f"would take {size / 2**30:.3g} GiB for their points alone, above "
+            f"{MAX_COPY_BYTES / 2**20:g} MiB "
+            f"(drakegrasp.planning.checks.MAX_COPY_BYTES); give fewer {name}"
+            + (", or fewer grasps a call" if grasps > 1 else "")
         )
     return n
 
@@ -238,7 +273,7 @@ def checked_nonnegative(name: str, value, unit: str) -> float:
     x = real_scalar(name, value)
     if not 0.0 <= x < np.inf:
         raise InvalidOptionError(
-            f"{name} must be a finite number >= 0 ({unit}), got {_describe(value)}"
+            f"{name} must be a finite number >= 0 ({unit}), got {describe(value)}"
         )
     return x
 
@@ -248,6 +283,6 @@ def checked_rng(rng) -> np.random.Generator:
     if not isinstance(rng, np.random.Generator):
         raise InvalidOptionError(
             "rng must be a numpy.random.Generator (numpy.random.default_rng(seed)), "
-            f"got {_describe(rng)} ({type(rng).__name__})"
+            f"got {describe(rng)} ({type(rng).__name__})"
         )
     return rng

@@ -64,10 +64,10 @@ from drakegrasp.planning.candidates import (
 )
 from drakegrasp.planning.checks import (
     checked_contacts,
-    checked_count,
     checked_fingers,
     checked_friction,
     checked_rng,
+    checked_samples,
     checked_torque_scale,
 )
 from drakegrasp.planning.cloud import CONTACT_BAND, cloud_surface
@@ -319,7 +319,8 @@ def fan_capacity(
         0 or in ``[1e-12, 1e12]``, as for ``weight_capacity``.
     samples : int
         Copies per grasp (the robustness samples), an integer ``>= 0``; 0
-        gives the nominal capacity.
+        gives the nominal capacity.  The copies' points (``K * samples * N *
+        3`` floats) at most :data:`~drakegrasp.planning.checks.MAX_COPY_BYTES`.
     rng : numpy.random.Generator
         Draws the fans' normals (only with ``samples > 0``).
     torque_scale, contact_model, torsional_friction
@@ -342,7 +343,7 @@ def fan_capacity(
     mu, contact_model, torsional_friction = checked_friction(
         mu, contact_model, torsional_friction
     )
-    samples = checked_count("samples", samples)
+    samples = checked_samples(samples, K, N)
     rng = checked_rng(rng)
     torque_scale = checked_torque_scale(torque_scale, positions)  # before any draw
     S = max(samples, 1)
@@ -368,20 +369,14 @@ def _checked_fans(fans, shape: tuple) -> np.ndarray:
             f"fans must have shape (K, N, 2, 3) = {shape}, two ends per contact, "
             f"got shape {a.shape}"
         )
-    none = np.all(np.isnan(a), axis=(2, 3))
-    has = np.all(np.isfinite(a), axis=(2, 3))
-    has &= np.all(np.any(a != 0.0, axis=3), axis=2)
-    bad = ~(none | has)
-    if bad.any():
-        k, i = (int(j) for j in np.argwhere(bad)[0])
+    none = np.all(np.isnan(a), axis=(2, 3))[..., None, None]  # (K, N, 1, 1)
+    try:  # each end a contact normal: the message names grasp, contact, end
+        ends = unit_vectors("fans", np.where(none, 1.0, a))
+    except InvalidContactError as err:
         raise InvalidContactError(
-            f"fans of grasp {k}, contact {i} is {a[k, i].tolist()}; a fan is two "
-            "finite, non-zero normals, or all NaN for a contact without one"
-        )
-    out = np.full(shape, np.nan)
-    if has.any():
-        out[has] = unit_vectors("fans", a[has])
-    return out
+            f"{err}; a contact without a fan has both ends all NaN"
+        ) from None
+    return np.where(none, np.nan, ends)
 
 
 @renamed_keyword("model", "contact_model")

@@ -37,7 +37,7 @@ import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import RigidBody
 
-from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import (
     check_coefficient,
@@ -50,6 +50,11 @@ from drakegrasp.planning.candidates import (
     GraspCandidates,
     closing_order,
     planning_result,
+)
+from drakegrasp.planning.checks import (
+    checked_count,
+    checked_nonnegative,
+    checked_samples,
 )
 from drakegrasp.planning.cloud import (
     PAD_CONTACT_BAND,
@@ -67,7 +72,11 @@ from drakegrasp.planning.multifinger import (
     plan_multifinger_cloud,
 )
 from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
-from drakegrasp.planning.ranking import DEFAULT_NOISE, rank_candidates
+from drakegrasp.planning.ranking import (
+    DEFAULT_NOISE,
+    checked_noise,
+    rank_candidates,
+)
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
 from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.attachment import free_carrier, how_held
@@ -120,29 +129,13 @@ def object_surface(plant, plant_context, object_body) -> ObjectSurface:
 
 
 def _check_count(value) -> int:
-    n = _check_int("num_candidates", value)
+    n = checked_count("num_candidates", value)
     if n > MAX_CANDIDATES:
         raise InvalidOptionError(
             f"num_candidates must be in [0, {MAX_CANDIDATES}] (one call; call again "
             f"with another seed for more), got {value}"
         )
     return n
-
-
-def _check_int(name: str, value, minimum: int = 0) -> int:
-    """``value`` as an int ``>= minimum``; a bool, float or string is refused."""
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise InvalidOptionError(
-            f"{name} must be an integer >= {minimum}, got {value!r}"
-        )
-    if int(value) < minimum:
-        raise InvalidOptionError(f"{name} must be an integer >= {minimum}, got {value}")
-    return int(value)
-
-
-def _check_seed(seed):
-    """None or an integer >= 0 (what numpy's generators take)."""
-    return None if seed is None else _check_int("seed", seed)
 
 
 def _check_noise(noise) -> dict:
@@ -157,14 +150,7 @@ def _check_noise(noise) -> dict:
         raise InvalidOptionError(
             f"noise takes non-negative {sorted(DEFAULT_NOISE)}, got {noise!r}"
         )
-    for key, value in noise.items():
-        value = real_scalar(f"noise[{key!r}]", value)
-        if not 0 <= value < np.inf:
-            raise InvalidOptionError(
-                f"noise takes non-negative {sorted(DEFAULT_NOISE)}, got {noise!r}"
-            )
-        noise[key] = value
-    return noise
+    return checked_noise(noise, "noise[{!r}]")
 
 
 def _check_positive(name: str, value, unit: str) -> float:
@@ -252,7 +238,12 @@ def plan_grasps(
         Contact and penetration tolerance (m), as in
         :func:`~drakegrasp.find_contacts`.
     robustness_samples : int, optional
-        Perturbed copies per force-closure candidate (0: robustness 0).
+        Perturbed copies per force-closure candidate (0: robustness 0).  The
+        copies' points are bounded by
+        :data:`~drakegrasp.planning.checks.MAX_COPY_BYTES`: a count over it
+        for one candidate of two contacts (about 11 million) is refused here,
+        and one over it for the candidates that close is refused when they
+        are ranked.
     noise : dict, optional
         ``{"position": m, "angle_deg": deg, "friction": relative}``; default
         :data:`~drakegrasp.planning.ranking.DEFAULT_NOISE`.  On an object body
@@ -353,17 +344,17 @@ def plan_grasps(
     n = _check_count(num_candidates)
     mu = check_coefficient("mu", mu, error=InvalidOptionError)
     tol = check_distance_tolerance(distance_tolerance)
-    clearance = real_scalar("clearance", clearance)
+    clearance = checked_nonnegative("clearance", clearance, "metres")
     complete_unseen = check_flag("complete_unseen", complete_unseen)
     progress = check_flag("progress", progress)
-    if not 0 <= clearance < np.inf:
-        raise InvalidOptionError(
-            f"clearance must be a finite number >= 0 metres, got {clearance}"
-        )
-    seed = _check_seed(seed)
-    robustness_samples = _check_int("robustness_samples", robustness_samples)
-    certify = _check_int("certify", certify)
-    min_fingers = _check_int("min_fingers", min_fingers, minimum=2)
+    seed = None if seed is None else checked_count("seed", seed)
+    # a force-closure candidate has two contacts or more: copies that would
+    # not fit for one are refused before any sampling
+    robustness_samples = checked_samples(
+        robustness_samples, 1, 2, name="robustness_samples"
+    )
+    certify = checked_count("certify", certify)
+    min_fingers = checked_count("min_fingers", min_fingers, minimum=2)
     tilt = real_scalar("tilt", tilt)
     if not 0 <= tilt <= np.pi / 2:
         raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
@@ -377,21 +368,15 @@ def plan_grasps(
                 "weight: give object_mass= (kg) with a point_cloud"
             )
     noise = _check_noise(noise)
-    if weight_check is not None and (
-        isinstance(weight_check, bool)
-        or not isinstance(weight_check, int | np.integer)
-        or weight_check < 0
-    ):
-        raise InvalidOptionError(
-            f"weight_check must be an integer >= 0 or None, got {weight_check!r}"
-        )
+    if weight_check is not None:
+        weight_check = checked_count("weight_check", weight_check)
     contact_model = ContactModel.parse(contact_model).value
-    if contact_model == ContactModel.SOFT_FINGER.value and torsional_friction is None:
-        raise InvalidOptionError(
-            "contact_model='soft_finger' needs torsional_friction (nu >= 0: the "
-            "moment about each contact normal is bounded by b * nu * f_n); give "
-            "it, or use contact_model='hard_finger'"
+    if torsional_friction is not None:  # checked, recorded as given
+        check_coefficient(
+            "torsional_friction", torsional_friction, error=InvalidOptionError
         )
+    if contact_model == ContactModel.SOFT_FINGER.value and torsional_friction is None:
+        raise missing_torsional_friction(InvalidOptionError)
     ctx = plant_context_of(plant, plant_context)
     if (object_body is None) == (point_cloud is None):
         raise InvalidOptionError(

@@ -61,6 +61,7 @@ from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.linalg import rotations_about
 from drakegrasp.core.validation import (
+    describe,
     check_coefficient,
     check_length,
     integer_or_none,
@@ -68,12 +69,13 @@ from drakegrasp.core.validation import (
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate
 from drakegrasp.planning.checks import (
+    MAX_FINGER_LABEL,
     checked_contacts,
-    checked_count,
     checked_fingers,
     checked_friction,
     checked_nonnegative,
     checked_rng,
+    checked_samples,
 )
 from drakegrasp.planning.reclose import perturbed_mu, reclosed_robustness
 from drakegrasp.planning.weight import weight_capacity
@@ -99,7 +101,7 @@ DEFAULT_NOISE = {"position": 2e-3, "angle_deg": 3.0, "friction": 0.1}
 _NOISE_UNITS = {"position": "metres", "angle_deg": "degrees", "friction": "relative"}
 
 
-def _checked_noise(sigmas, name: str = "{}") -> dict[str, float]:
+def checked_noise(sigmas, name: str = "{}") -> dict[str, float]:
     """The three noise σ of ``sigmas``, each a finite number >= 0.
 
     ``name`` spells an argument's name in a message from its key (``"{}"``:
@@ -112,14 +114,32 @@ def _checked_noise(sigmas, name: str = "{}") -> dict[str, float]:
 
 
 def _checked_groups(groups) -> tuple[int, ...]:
-    """``groups`` of :func:`perturbed_copies`: a sequence of integer labels."""
+    """``groups`` of :func:`perturbed_copies`: distinct finger labels.
+
+    Each an integer in ``[0, MAX_FINGER_LABEL]`` (a label outside matches no
+    contact: a slip of the caller's), none twice (its contacts would move
+    twice a copy, their noise doubled).  Empty: no contact moves.
+    """
     try:
         labels = tuple(integer_or_none(g) for g in groups)
     except TypeError:
         labels = (None,)
     if isinstance(groups, (str, bytes)) or None in labels:
         raise InvalidOptionError(
-            f"groups must be a sequence of integer finger labels, got {groups!r}"
+            "groups must be a sequence of integer finger labels, got "
+            f"{describe(groups)}"
+        )
+    for g in labels:
+        if not 0 <= g <= MAX_FINGER_LABEL:
+            raise InvalidOptionError(
+                f"groups holds {g}; a finger label is an integer in "
+                f"[0, {MAX_FINGER_LABEL}] (drakegrasp.planning.checks.MAX_FINGER_LABEL)"
+            )
+    if len(set(labels)) < len(labels):
+        twice = next(g for g in labels if labels.count(g) > 1)
+        raise InvalidOptionError(
+            f"groups names finger {twice} more than once; each finger's contacts "
+            "move once a copy"
         )
     return labels
 
@@ -164,7 +184,9 @@ def perturbed_copies(
         Nominal friction coefficient: 0 or in ``[1e-12, 1e12]``
         (:mod:`drakegrasp.core.validation`).
     samples : int
-        Copies per grasp, an integer ``>= 0``.
+        Copies per grasp, an integer ``>= 0``; the copies' points
+        (``K * samples * N * 3`` floats) at most
+        :data:`~drakegrasp.planning.checks.MAX_COPY_BYTES`.
     rng : numpy.random.Generator
         Draws the noise (``numpy.random.default_rng(seed)``).
     position : float
@@ -176,9 +198,10 @@ def perturbed_copies(
         σ_μ, relative, finite and ``>= 0``: each copy's μ is
         ``mu · max(0, 1 + σ_μ ξ)``.
     groups : sequence of int, optional
-        The finger labels whose contacts move (default the two jaws; a
-        multi-finger hand passes all its fingers).  Contacts with other labels
-        (a palm) stay put.
+        The finger labels whose contacts move, each in ``[0, 63]`` and none
+        twice (default the two jaws; a multi-finger hand passes all its
+        fingers).  Contacts with other labels (a palm) stay put; an empty
+        sequence moves no contact (only μ is perturbed).
 
     Returns
     -------
@@ -192,10 +215,10 @@ def perturbed_copies(
     positions, normals = checked_contacts(positions, normals)
     fingers = checked_fingers(fingers, positions.shape[:2])
     mu = check_coefficient("mu", mu)
-    samples = checked_count("samples", samples)
+    samples = checked_samples(samples, *positions.shape[:2])
     rng = checked_rng(rng)
     sigma = {"position": position, "angle_deg": angle_deg, "friction": friction}
-    position, angle_deg, friction = _checked_noise(sigma).values()
+    position, angle_deg, friction = checked_noise(sigma).values()
     groups = _checked_groups(groups)
     K, N, _ = positions.shape
     P = np.repeat(positions, samples, axis=0)
@@ -325,7 +348,9 @@ def robustness(
         Nominal friction coefficient: 0 or in ``[1e-12, 1e12]``
         (:mod:`drakegrasp.core.validation`).
     samples : int
-        Perturbed copies per grasp, an integer ``>= 0`` (0: robustness 0).
+        Perturbed copies per grasp, an integer ``>= 0`` (0: robustness 0),
+        within :data:`~drakegrasp.planning.checks.MAX_COPY_BYTES` as for
+        :func:`perturbed_copies`.
     rng : numpy.random.Generator
         Draws the noise (``numpy.random.default_rng(seed)``).
     noise : dict
@@ -352,14 +377,14 @@ def robustness(
     mu, contact_model, torsional_friction = checked_friction(
         mu, contact_model, torsional_friction
     )
-    samples = checked_count("samples", samples)
+    samples = checked_samples(samples, *positions.shape[:2])
     rng = checked_rng(rng)
     if not isinstance(noise, Mapping) or set(noise) != set(DEFAULT_NOISE):
         raise InvalidOptionError(
             f"noise must be a dict of the three σ {sorted(DEFAULT_NOISE)} (as "
-            f"DEFAULT_NOISE), got {noise!r}"
+            f"DEFAULT_NOISE), got {describe(noise)}"
         )
-    noise = _checked_noise(noise, "noise[{!r}]")
+    noise = checked_noise(noise, "noise[{!r}]")
     check_workers(workers)
     groups = _checked_groups(groups)
     if samples == 0 or len(positions) == 0:

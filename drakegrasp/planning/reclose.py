@@ -61,13 +61,13 @@ from drakegrasp.core.validation import (
 )
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError
 from drakegrasp.planning.checks import (
-    checked_count,
     checked_directions,
     checked_fingers,
     checked_friction,
     checked_nonnegative,
     checked_points,
     checked_rng,
+    checked_samples,
 )
 
 __all__ = ["NEVER_CLOSURE", "reclosed_copies", "reclosed_robustness"]
@@ -207,7 +207,9 @@ def reclosed_robustness(
         Nominal friction coefficient: 0 or in ``[1e-12, 1e12]``
         (:mod:`drakegrasp.core.validation`).
     samples : int
-        Copies per grasp, an integer ``>= 0`` (0: robustness 0).
+        Copies per grasp, an integer ``>= 0`` (0: robustness 0); the copies'
+        points (``K * samples * N * 3`` floats) at most
+        :data:`~drakegrasp.planning.checks.MAX_COPY_BYTES`.
     rng : numpy.random.Generator
         Draws the motions and μ (``numpy.random.default_rng(seed)``).
     position, angle_deg, friction : float
@@ -240,7 +242,7 @@ def reclosed_robustness(
     mu, contact_model, torsional_friction = checked_friction(
         mu, contact_model, torsional_friction
     )
-    samples = checked_count("samples", samples)
+    samples = checked_samples(samples, K, N)
     rng = checked_rng(rng)
     position = checked_nonnegative("position", position, "metres")
     angle_deg = checked_nonnegative("angle_deg", angle_deg, "degrees")

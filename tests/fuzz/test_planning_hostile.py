@@ -16,16 +16,19 @@ Everything here is numpy and small LPs: no plant, no simulation.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 from pydrake.geometry import Box
 from pydrake.math import RigidTransform
 
 import drakegrasp as dg
-from drakegrasp.planning import multifinger, ranking, reclose, weight
+from drakegrasp.planning import checks, multifinger, planner, ranking, reclose, weight
 from drakegrasp.planning.gripper import ParallelJaw
 from drakegrasp.planning.multifinger import fan_capacity
 from drakegrasp.planning.placement import sample_poses
+from drakegrasp.planning.planner import plan_grasps
 from drakegrasp.planning.ranking import perturbed_copies, robustness, verdicts
 from drakegrasp.planning.reclose import reclosed_robustness
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
@@ -50,6 +53,8 @@ BAD_MU = [
     0.5 + 0.1j,
 ]
 BAD_COUNT = [-1, 2.5, 4.0, True, "4", None, [4]]
+# copies whose points exceed checks.MAX_COPY_BYTES: a MemoryError before the cap
+BAD_SAMPLES = [*BAD_COUNT, 10**12, 2**40]
 BAD_RNG = [None, 0, "seed", object()]
 BAD_SIGMA = [-1e-3, np.nan, np.inf, "0.1", None, True]
 BAD_LENGTH = [0.0, -1e-4, np.nan, np.inf, "1e-4", None, True]
@@ -124,6 +129,19 @@ def _refused_up_front(call, name, kwargs, monkeypatch, *backends):
         assert rng.bit_generator.state == state, f"{name}: rng drawn before the check"
 
 
+def _stage_refuses(stage, build, name, value, monkeypatch, *backends):
+    """``stage`` with ``build(name=value)``'s arguments: :func:`_refused_up_front`."""
+    args, kwargs = build(**{name: value})
+    call = functools.partial(stage, *args, **kwargs)
+    _refused_up_front(call, name, kwargs, monkeypatch, *backends)
+
+
+def _split(args, change, positional):
+    """``(positional values, keyword arguments)``: ``args`` updated by ``change``."""
+    args = {**args, **change}
+    return [args.pop(k) for k in positional], args
+
+
 def _cases(name, values):
     """``(name, value)`` parameters, with short one-line ids."""
     return [
@@ -170,17 +188,14 @@ def _weight_args(**change):
     args = dict(
         positions=P_BOX, normals=N_BOX, fingers=L_BOX, mu=0.5, torque_scale=0.05
     )
-    args.update(change)
-    return (args.pop("positions"), args.pop("normals"), args.pop("fingers")), args
+    return _split(args, change, ("positions", "normals", "fingers"))
 
 
 @pytest.mark.parametrize(("name", "value"), WEIGHT_BAD)
 def test_weight_capacity_names_a_bad_argument(name, value, monkeypatch):
-    args, kwargs = _weight_args(**{name: value})
-    _refused_up_front(
-        lambda: weight_capacity(*args, **kwargs), name, kwargs, monkeypatch,
-        (weight, "_capacity"),
-    )  # fmt: skip
+    _stage_refuses(
+        weight_capacity, _weight_args, name, value, monkeypatch, (weight, "_capacity")
+    )
 
 
 def test_weight_capacity_soft_finger_needs_torsional_friction():
@@ -263,7 +278,7 @@ _zero_end[0, 0, 1] = 0.0
 
 FAN_BAD = (
     _cases("mu", BAD_MU)
-    + _cases("samples", BAD_COUNT)
+    + _cases("samples", BAD_SAMPLES)
     + _cases("rng", BAD_RNG)
     + _cases("torque_scale", [*BAD_LENGTH, 1e9, 1e-300])  # out of scale, undrawn
     + _cases("fans", [_partial, _zero_end, FANS[0], "fan", None])
@@ -287,16 +302,13 @@ def _fan_args(**change):
         contact_model="hard_finger",
         torsional_friction=None,
     )
-    args.update(change)
-    positional = [args.pop(k) for k in ("positions", "normals", "fans", "fingers")]
-    return positional, args
+    return _split(args, change, ("positions", "normals", "fans", "fingers"))
 
 
 @pytest.mark.parametrize(("name", "value"), FAN_BAD)
 def test_fan_capacity_names_a_bad_argument(name, value, monkeypatch):
-    args, kwargs = _fan_args(**{name: value})
-    _refused_up_front(
-        lambda: fan_capacity(*args, **kwargs), name, kwargs, monkeypatch,
+    _stage_refuses(
+        fan_capacity, _fan_args, name, value, monkeypatch,
         (multifinger, "weight_capacity"),
     )  # fmt: skip
 
@@ -317,12 +329,15 @@ P_PADS, N_PADS, F_PADS = _pads()
 
 COPIES_BAD = (
     _cases("mu", BAD_MU)
-    + _cases("samples", BAD_COUNT)
+    + _cases("samples", BAD_SAMPLES)
     + _cases("rng", BAD_RNG)
     + _cases("position", BAD_SIGMA)
     + _cases("angle_deg", BAD_SIGMA)
     + _cases("friction", BAD_SIGMA)
-    + _cases("groups", ["01", 5, [0.5], [None]])
+    + _cases(
+        "groups",
+        ["01", 5, [0.5], [None], [-5, 99], [64], [0, 0], (1, 0, 1), [np.int64(-1)]],
+    )
     + _cases("positions", [P_PADS[0], P_PADS * np.nan, None])
     + _cases("normals", [N_PADS * 0.0, N_PADS[:, :1]])
     + _cases("fingers", [F_PADS[0], F_PADS - 1, F_PADS + 0.5, F_PADS > 0])
@@ -339,22 +354,17 @@ def _copies_args(**change):
         rng=np.random.default_rng(7),
         **NOISE,
     )
-    args.update(change)
-    positional = [args.pop(k) for k in ("positions", "normals", "fingers")]
-    return positional, args
+    return _split(args, change, ("positions", "normals", "fingers"))
 
 
 @pytest.mark.parametrize(("name", "value"), COPIES_BAD)
 def test_perturbed_copies_names_a_bad_argument(name, value, monkeypatch):
-    args, kwargs = _copies_args(**{name: value})
-    _refused_up_front(
-        lambda: perturbed_copies(*args, **kwargs), name, kwargs, monkeypatch
-    )
+    _stage_refuses(perturbed_copies, _copies_args, name, value, monkeypatch)
 
 
 ROBUST_BAD = (
     _cases("mu", BAD_MU)
-    + _cases("samples", BAD_COUNT)
+    + _cases("samples", BAD_SAMPLES)
     + _cases("rng", BAD_RNG)
     + _cases(
         "noise",
@@ -372,7 +382,7 @@ ROBUST_BAD = (
     + _cases("contact_model", ["finger", None])
     + _cases("torsional_friction", [-0.1, np.nan, "0.05"])
     + _cases("workers", [0, True, "1"])
-    + _cases("groups", ["01", 5])
+    + _cases("groups", ["01", 5, [-5, 99], [0, 0]])
     + _cases("fingers", [F_PADS[0], F_PADS - 1])
     + _cases("normals", [N_PADS * np.nan])
 )
@@ -395,16 +405,13 @@ def _robust_args(**change):
         torsional_friction=None,
         workers=1,
     )
-    args.update(change)
-    positional = [args.pop(k) for k in ("positions", "normals", "fingers")]
-    return positional, args
+    return _split(args, change, ("positions", "normals", "fingers"))
 
 
 @pytest.mark.parametrize(("name", "value"), ROBUST_BAD)
 def test_robustness_names_a_bad_argument(name, value, monkeypatch):
-    args, kwargs = _robust_args(**{name: value})
-    _refused_up_front(
-        lambda: robustness(*args, **kwargs), name, kwargs, monkeypatch,
+    _stage_refuses(
+        robustness, _robust_args, name, value, monkeypatch,
         (ranking, "perturbed_copies"), (ranking, "force_verdicts"),
     )  # fmt: skip
 
@@ -441,6 +448,27 @@ def test_robustness_and_copies_keep_their_numbers():
     np.testing.assert_array_equal(robustness(*args, **kwargs), np.zeros(3))
 
 
+def test_empty_groups_move_no_contact_and_perturb_mu_only():
+    # no finger moves: the copies keep the contacts; only their mu is drawn
+    args, kwargs = _copies_args(groups=())
+    P, Nrm, mus = perturbed_copies(*args, **kwargs)
+    np.testing.assert_array_equal(P, np.repeat(P_PADS, 4, axis=0))
+    np.testing.assert_array_equal(Nrm, np.repeat(N_PADS, 4, axis=0))
+    xi = np.random.default_rng(7).standard_normal(12)
+    np.testing.assert_array_equal(mus, 0.5 * np.maximum(0.0, 1.0 + 0.3 * xi))
+
+
+def test_the_copies_bound_is_exact_and_far_above_the_planners_use():
+    K, N = 3, 4
+    most = checks.MAX_COPY_BYTES // (K * N * 3 * 8)
+    assert checks.checked_samples(most, K, N) == most
+    with pytest.raises(dg.InvalidOptionError, match=r"^samples = .*MAX_COPY_BYTES"):
+        checks.checked_samples(most + 1, K, N)
+    assert checks.checked_samples(10**15, 0, N) == 10**15  # no grasp: no copies
+    # 1,500 poses, the default 32 copies, 20 contacts: 23 times below the bound
+    assert 1500 * 32 * 20 * 24 * 23 < checks.MAX_COPY_BYTES
+
+
 @pytest.mark.parametrize(("name", "value"), _cases("torque_scale", BAD_LENGTH))
 def test_verdicts_name_a_bad_torque_scale(name, value):
     # it reached batch_epsilon_l1 as characteristic_lengths (or nothing at all
@@ -460,7 +488,7 @@ AXES = np.tile([1.0, 0, 0], (3, 1))
 
 RECLOSE_BAD = (
     _cases("mu", BAD_MU)
-    + _cases("samples", BAD_COUNT)
+    + _cases("samples", BAD_SAMPLES)
     + _cases("rng", BAD_RNG)
     + _cases("tol", BAD_LENGTH)
     + _cases("position", BAD_SIGMA)
@@ -494,16 +522,13 @@ def _reclose_args(**change):
         torsional_friction=None,
         workers=1,
     )
-    args.update(change)
-    positional = [args.pop(k) for k in ("surface", "positions", "fingers", "axes")]
-    return positional, args
+    return _split(args, change, ("surface", "positions", "fingers", "axes"))
 
 
 @pytest.mark.parametrize(("name", "value"), RECLOSE_BAD)
 def test_reclosed_robustness_names_a_bad_argument(name, value, monkeypatch):
-    args, kwargs = _reclose_args(**{name: value})
-    _refused_up_front(
-        lambda: reclosed_robustness(*args, **kwargs), name, kwargs, monkeypatch,
+    _stage_refuses(
+        reclosed_robustness, _reclose_args, name, value, monkeypatch,
         (reclose, "reclosed_copies"), (reclose, "force_verdicts"),
     )  # fmt: skip
 
@@ -542,15 +567,12 @@ def _poses_args(**change):
         rng=np.random.default_rng(3),
         tol=1e-4,
     )
-    args.update(change)
-    positional = [args.pop(k) for k in ("surface", "gripper", "X_WO", "n")]
-    return positional, args
+    return _split(args, change, ("surface", "gripper", "X_WO", "n"))
 
 
 @pytest.mark.parametrize(("name", "value"), POSES_BAD)
 def test_sample_poses_names_a_bad_argument(name, value, monkeypatch):
-    args, kwargs = _poses_args(**{name: value})
-    _refused_up_front(lambda: sample_poses(*args, **kwargs), name, kwargs, monkeypatch)
+    _stage_refuses(sample_poses, _poses_args, name, value, monkeypatch)
 
 
 def test_sample_poses_keeps_its_numbers():
@@ -564,3 +586,40 @@ def test_sample_poses_keeps_its_numbers():
     args, kwargs = _poses_args(n=0)
     poses, rejections = sample_poses(*args, **kwargs)
     assert len(poses["sample"]) == 0 and not rejections
+
+
+# -------------------------------------------------------------- plan_grasps options
+
+PLAN_BAD = (
+    _cases("robustness_samples", [10**12, checks.MAX_COPY_BYTES // 48 + 1, -1, True])
+    + _cases("torsional_friction", [-0.1, np.nan, "0.1", True, [0.1]])
+    + _cases("clearance", BAD_SIGMA)
+    + _cases("seed", [-1, 1.5, "1", True])
+    + _cases("certify", BAD_COUNT)
+    + _cases("weight_check", [-1, 2.5, True, "3"])
+    + _cases("min_fingers", [1, 0, 2.0, True])
+    + _cases(
+        "noise",
+        [{"wobble": 1}, {"position": -1.0}, {"angle_deg": np.nan}, "loud", 3],
+    )
+)
+
+
+def _plan_args(**change):
+    """No plant, object or hand: every option is checked before they are read."""
+    args = dict(plant=None, plant_context=None, object_body=None, hand=None)
+    args.update(num_candidates=4, mu=0.5)
+    return _split(args, change, ("plant", "plant_context", "object_body"))
+
+
+@pytest.mark.parametrize(("name", "value"), PLAN_BAD)
+def test_plan_grasps_names_a_bad_option_before_reading_the_plant(
+    name, value, monkeypatch
+):
+    # robustness_samples = 10**12 and torsional_friction = nan were taken: the
+    # first ended in a MemoryError once the candidates were closed, the second
+    # was refused by the ranking, or never when no candidate closed
+    _stage_refuses(
+        plan_grasps, _plan_args, name, value, monkeypatch,
+        (planner, "plant_context_of"),
+    )  # fmt: skip
