@@ -20,6 +20,7 @@ import functools
 
 import numpy as np
 import pytest
+from grasp_builders import two_pads
 from pydrake.geometry import Box
 from pydrake.math import RigidTransform
 
@@ -71,15 +72,7 @@ def _box_grasp():
 
 def _pads(K=3, half=2, seed=8000):
     """``K`` grasps of two pads of ``half`` contacts each across x = ±0.03."""
-    rng = np.random.default_rng(seed)
-    y = rng.uniform(-0.02, 0.02, (K, 2 * half))
-    z = rng.uniform(-0.02, 0.02, (K, 2 * half))
-    x = np.where(np.arange(2 * half) < half, -0.03, 0.03) * np.ones((K, 1))
-    P = np.stack([x, y, z], axis=-1)
-    Nrm = np.zeros_like(P)
-    Nrm[..., 0] = -np.sign(x)
-    F = np.repeat((np.arange(2 * half) >= half)[None].astype(int), K, axis=0)
-    return P, Nrm, F
+    return two_pads(np.random.default_rng(seed), K, half)
 
 
 def _box_surface():

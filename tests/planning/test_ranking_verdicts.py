@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from grasp_builders import two_pads
 from pydrake.geometry import Box, Cylinder
 from pydrake.math import RigidTransform
 
@@ -25,24 +26,12 @@ def _full_verdicts(positions, normals, **options):
     return np.asarray(batch_force_closure(positions, normals, **options).is_closure)
 
 
-def _two_pads(rng, K, half):
-    """``K`` grasps of two pads of ``half`` contacts each across x = ±0.03."""
-    y = rng.uniform(-0.02, 0.02, (K, 2 * half))
-    z = rng.uniform(-0.02, 0.02, (K, 2 * half))
-    x = np.where(np.arange(2 * half) < half, -0.03, 0.03) * np.ones((K, 1))
-    P = np.stack([x, y, z], axis=-1)
-    Nrm = np.zeros_like(P)
-    Nrm[..., 0] = -np.sign(x)
-    F = np.repeat((np.arange(2 * half) >= half)[None].astype(int), K, axis=0)
-    return P, Nrm, F
-
-
 @pytest.mark.parametrize(
     ("model", "nu"), [("hard_finger", None), ("soft_finger", 0.05)]
 )
 def test_moved_contacts_robustness_equals_the_full_solve(model, nu, monkeypatch):
     rng = np.random.default_rng(8000)
-    P, Nrm, F = _two_pads(rng, 40, 2)
+    P, Nrm, F = two_pads(rng, 40, 2)
     noise = {"position": 4e-3, "angle_deg": 8.0, "friction": 0.3}
 
     def run():
@@ -63,7 +52,7 @@ def test_moved_contacts_robustness_equals_the_full_solve(model, nu, monkeypatch)
 def test_reclosed_robustness_equals_the_full_solve(shape, monkeypatch):
     surface = ObjectSurface.from_pieces([piece_of_shape(shape, RigidTransform(), "o")])
     rng = np.random.default_rng(8100)
-    P, _, F = _two_pads(rng, 30, 3)
+    P, _, F = two_pads(rng, 30, 3)
     if isinstance(shape, Cylinder):
         P[..., 1] *= 0.1  # near the line of contact of the two pads
     axes = np.tile([1.0, 0.0, 0.0], (30, 1))

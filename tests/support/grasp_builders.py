@@ -88,3 +88,20 @@ def moved_grasp(grasp, R, t):
         reference_point=R @ grasp.reference_point + t,
         characteristic_length=grasp.characteristic_length,
     )
+
+
+def two_pads(rng, K, half):
+    """``K`` grasps of two pads of ``half`` contacts each across x = ±0.03 m.
+
+    Returns ``(P, Nrm, F)``: (K, 2 half, 3) points drawn from ``rng`` on the
+    faces x = ∓0.03 of a 6 cm cube, their inward normals, and finger labels
+    0 and 1.
+    """
+    y = rng.uniform(-0.02, 0.02, (K, 2 * half))
+    z = rng.uniform(-0.02, 0.02, (K, 2 * half))
+    x = np.where(np.arange(2 * half) < half, -0.03, 0.03) * np.ones((K, 1))
+    P = np.stack([x, y, z], axis=-1)
+    Nrm = np.zeros_like(P)
+    Nrm[..., 0] = -np.sign(x)
+    F = np.repeat((np.arange(2 * half) >= half)[None].astype(int), K, axis=0)
+    return P, Nrm, F
