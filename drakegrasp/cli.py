@@ -2,6 +2,7 @@
 
 Usage::
 
+    drakegrasp --version
     drakegrasp analyze [SCENE] [--mu M|plant] [--contact-model MODEL]
                        [--torsional-friction NU] [--distance-tolerance D]
                        [--plane PLANE] [--characteristic-length B]
@@ -23,7 +24,9 @@ Usage::
 
 Every option's default and meaning: ``drakegrasp COMMAND --help`` (read from
 the library's own defaults), or the generated reference in the CLI guide.
-``--model`` is a deprecated alias of ``batch --contact-model``.
+``--model`` is a deprecated alias of ``batch --contact-model``.  ``--metrics``
+takes every word up to the next option: put it after ``IN OUT`` or before
+another option, or end it with ``--`` followed by ``IN OUT`` alone.
 
 ``analyze`` loads a scene (a shipped scene's name or a YAML file; default: the
 default scene), finds the contacts and prints the full report: contacts, ranks,
@@ -84,14 +87,19 @@ partial file, scratch folder or worker process is left).  ``batch`` and
 also one that is its input), checked before any work; both write atomically
 (a temporary file renamed into place), so an interrupted run loses nothing.
 Set ``DRAKEGRASP_DEBUG=1`` to see the traceback of an unexpected error.
+Messages name the command's flags (``--num``, ``--overwrite``), not the Python
+keywords of the library calls behind them.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
+import difflib
 import json
 import os
+import re
 import signal
 import sys
 import threading
@@ -233,15 +241,18 @@ def _cmd_batch(args: argparse.Namespace) -> int:
     from drakegrasp.batch.options import BatchOptions
 
     # the engine's choices, checked here once (one line on stderr if bad)
-    engine = BatchOptions(
-        contact_model=model,
-        num_generators=args.num_generators,
-        tol=args.tol,
-        chunk_size=args.chunk_size,
-        progress=args.progress,
-        metrics=tuple(args.metrics),
-        workers=args.workers,
-    )
+    try:
+        engine = BatchOptions(
+            contact_model=model,
+            num_generators=args.num_generators,
+            tol=args.tol,
+            chunk_size=args.chunk_size,
+            progress=args.progress,
+            metrics=tuple(args.metrics),
+            workers=args.workers,
+        )
+    except GraspError as e:
+        raise _in_flag_words(e, {name: _flag(name) for name in _BATCH_FLAGS}) from None
     options = {
         "kind": args.kind,
         "mu": args.mu,
@@ -298,6 +309,118 @@ def _cmd_batch(args: argparse.Namespace) -> int:
     print(summary)
     print(f"wrote {printable(args.output)}")
     return 0
+
+
+_BATCH_FLAGS = ("contact_model", "num_generators", "tol", "chunk_size", "workers")
+"""``BatchOptions`` fields that ``batch`` sets from the flag of the same name."""
+
+
+def _flag(name: str) -> str:
+    """The flag of the Python keyword ``name``: ``--num-generators``."""
+    return "--" + name.replace("_", "-")
+
+
+def _in_flag_words(error: GraspError, flags: dict[str, str]) -> GraspError:
+    """``error`` in flags, if its message starts with a keyword of ``flags``.
+
+    The library's validators start their message with the keyword they check
+    (``num_candidates must be ...``); ``flags`` maps the keywords the command
+    set from its flags to those flags (``{"num_candidates": "--num"}``).  Such
+    a message names every keyword of ``flags`` as its flag ("call again with
+    another --seed"); any other message is kept as it is.
+    """
+    text = str(error)
+    if not any(text.startswith(f"{keyword} ") for keyword in flags):
+        return error
+    for keyword, flag in flags.items():
+        text = re.sub(rf"(?<![\w.'=-]){keyword}(?![\w'=])", flag, text)
+    return InvalidOptionError(text)
+
+
+def _value_checks() -> dict:
+    """The library's validator of each option that a command takes as a flag."""
+    from drakegrasp.core.validation import (
+        check_coefficient,
+        check_distance_tolerance,
+        check_length,
+        check_num_generators,
+        check_tol,
+    )
+
+    def coefficient(name: str):
+        return lambda value: (
+            value == "plant" or check_coefficient(name, value, error=InvalidOptionError)
+        )
+
+    return {
+        "mu": coefficient("mu"),
+        "torsional_friction": coefficient("torsional_friction"),
+        "distance_tolerance": check_distance_tolerance,
+        "characteristic_length": lambda value: check_length(
+            "characteristic_length", value, error=InvalidOptionError
+        ),
+        "num_generators": check_num_generators,
+        "tol": check_tol,
+    }
+
+
+def _check_values(args: argparse.Namespace) -> None:
+    """Refuse a flag's value outside the library's range, naming the flag.
+
+    The ranges are the library's own (:mod:`drakegrasp.core.validation`),
+    checked before any work so that the one line says ``--tol must be ...``
+    where the library, given the keyword, says ``tol must be ...``.
+    """
+    for name, check in _value_checks().items():
+        value = getattr(args, name, None)
+        if value is None:
+            continue
+        try:
+            check(value)
+        except GraspError as e:
+            raise _in_flag_words(e, {name: _flag(name)}) from None
+
+
+_SOFT_FINGER_NEEDS_NU = "contact_model='soft_finger' needs torsional_friction"
+"""How the library's refusal of soft fingers without a ``ν`` starts."""
+
+_SOFT_FINGER_REMEDY = {
+    "analyze": "soft fingers (--contact-model soft_finger, or the scene's "
+    "contact_model:) need a torsional friction nu: give --torsional-friction NU "
+    "or the scene's torsional_friction: (0 makes soft fingers act as hard ones)",
+    "batch": "--contact-model soft_finger needs a torsional friction nu: give "
+    "--torsional-friction NU or the input's array torsional_friction (0 makes "
+    "soft fingers act as hard ones)",
+    "plan": "the scene's contact_model: soft_finger needs a torsional friction "
+    "nu: give torsional_friction: in its drakegrasp: section (0 makes soft "
+    "fingers act as hard ones); plan has no flag for it",
+}
+"""The refusal of soft fingers without a ``ν``, in each command's words."""
+
+
+def _cli_words(message: str, command: str | None) -> str:
+    """A library ``message`` with its Python remedies given as flags.
+
+    ``overwrite=True`` is ``--overwrite`` (``batch`` and ``plan --out``);
+    soft fingers without a ``ν`` name ``--torsional-friction`` or the scene's
+    key; a ``DRAKEGRASP_DRAKE_MODELS`` folder that lacks a model is named.
+    """
+    message = re.sub(
+        r"overwrite=True(?: \(drakegrasp batch --overwrite\))?", "--overwrite", message
+    )
+    if message.startswith(_SOFT_FINGER_NEEDS_NU) and command in _SOFT_FINGER_REMEDY:
+        return _SOFT_FINGER_REMEDY[command]
+    if "package://drake_models/" in message and "does not exist" in message:
+        from drakegrasp.plant.models import DRAKE_MODELS_ENV
+
+        folder = os.environ.get(DRAKE_MODELS_ENV)
+        if folder:
+            message += (
+                f" ({DRAKE_MODELS_ENV} is set to {folder!r}, which does not hold "
+                "this model: point it at a local copy of the drake_models "
+                "package, or unset it to let Drake download the package)"
+            )
+    return message
 
 
 def _parsed(text: str, convert, noun: str, ok, must: str):
@@ -361,14 +484,22 @@ def _add_scene_file_options(
     )
 
 
+_JIT_TIME = "under a minute, about 40 s of one CPU core"
+"""How long numba's JIT takes to compile every kernel (``warmup``).
+
+Measured with an empty ``NUMBA_CACHE_DIR``: 86 functions in 42 s on a shared
+two-core machine under load (one core busy).
+"""
+
+
 def _cmd_warmup(args: argparse.Namespace) -> int:
     from drakegrasp.batch.aot import status
     from drakegrasp.batch.warmup import warmup
 
     if not args.json:
         route = status()
-        wait = "" if route.startswith("ahead-of-time") else ": a minute or two"
-        print(f"compiling the batch kernels where needed{wait} ({route}) ...")
+        wait = "" if route.startswith("ahead-of-time") else f": {_JIT_TIME}"
+        print(f"compiling the batch kernels where needed ({route}){wait} ...")
 
     def show(step) -> None:
         if not args.json:
@@ -388,6 +519,14 @@ def _cmd_warmup(args: argparse.Namespace) -> int:
     return 0
 
 
+_METRICS_HINT = (
+    "--metrics takes every word after it up to the next option: put it after "
+    "the positional arguments or before another option, or end it with -- and "
+    "give only the positional arguments after that"
+)
+"""Where ``batch --metrics NAME ...`` goes on the line (it would take IN OUT)."""
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line refusals, as every other error of the command.
 
@@ -397,7 +536,39 @@ class _Parser(argparse.ArgumentParser):
     """
 
     def error(self, message: str):
+        if message.startswith("argument --metrics: invalid choice"):
+            message += f"; {_METRICS_HINT}"
         self.exit(2, f"{self.prog}: error: {message} (see: {self.prog} --help)\n")
+
+
+def _version() -> str:
+    """The version of drakegrasp: the installed distribution's, else ``__version__``."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as installed
+
+    try:
+        return installed("drakegrasp")
+    except PackageNotFoundError:  # run from a source tree that is not installed
+        import drakegrasp
+
+        return str(getattr(drakegrasp, "__version__", "unknown"))
+
+
+class _Version(argparse.Action):
+    """``--version``: print ``drakegrasp VERSION`` and exit 0.
+
+    argparse's own ``version`` action needs the text when the parser is built;
+    this one looks the version up only when the flag is given.
+    """
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, help=None):
+        super().__init__(
+            option_strings, dest=dest, default=argparse.SUPPRESS, nargs=0, help=help
+        )
+
+    def __call__(self, parser, _namespace, _values, _option_string=None):
+        print(f"drakegrasp {_version()}")
+        parser.exit()
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
@@ -415,6 +586,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
         prog="drakegrasp",
         description="Grasp analysis on top of Drake: contacts, grasp matrix, "
         "form and force closure.",
+    )
+    parser.add_argument(
+        "--version", action=_Version, help="print drakegrasp's version and exit"
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
@@ -618,7 +792,7 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         default=[],
         choices=_BatchMetrics(),
         metavar="NAME",
-        help="metrics to add: %(choices)s",
+        help=f"metrics to add: %(choices)s; {_METRICS_HINT}",
     )
     batch.add_argument(
         "--chunk-size",
@@ -671,7 +845,7 @@ def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
         "every route, in seconds.  Otherwise (no such kernels, another CPU, "
         "edited sources, or DRAKEGRASP_KERNELS=jit) numba's JIT compiles every "
         "kernel into its on-disk cache (NUMBA_CACHE_DIR, else numba's user-wide "
-        "cache), a minute or two, so that the first batch call of later "
+        f"cache), {_JIT_TIME}, so that the first batch call of later "
         "processes does not wait.  Without numba there is nothing to compile: "
         "the engine runs its numpy route.",
     )
@@ -725,9 +899,11 @@ def _plan_hand(spec: str | None) -> str:
         return PLAN_HANDS[spec]
     if "://" in spec or spec.endswith(MODEL_SUFFIXES):
         return _model_file(spec, "--hand")
+    close = difflib.get_close_matches(spec.lower(), PLAN_HANDS, n=1)
+    guess = f" (did you mean {close[0]!r}?)" if close else ""
     raise InvalidOptionError(
-        f"--hand {spec!r} is not one of {', '.join(PLAN_HANDS)}, a package:// URL "
-        f"or a model file ({', '.join(MODEL_SUFFIXES)})"
+        f"--hand {spec!r} is not one of the hand aliases {', '.join(PLAN_HANDS)}"
+        f"{guess}, a package:// URL or a model file ({', '.join(MODEL_SUFFIXES)})"
     )
 
 
@@ -861,18 +1037,22 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if args.progress:
         _check_progress()
     plant, context, object_body, hand, options = _plan_setup(args)
-    result = plan_grasps(
-        plant,
-        context,
-        object_body,
-        hand=hand,
-        num_candidates=args.num,
-        seed=args.seed,
-        progress=args.progress,
-        object_mass=args.mass,
-        torque_limit=args.torque_limit,
-        **options,
-    )
+    try:
+        result = plan_grasps(
+            plant,
+            context,
+            object_body,
+            hand=hand,
+            num_candidates=args.num,
+            seed=args.seed,
+            progress=args.progress,
+            object_mass=args.mass,
+            torque_limit=args.torque_limit,
+            **options,
+        )
+    except GraspError as e:
+        raise _in_flag_words(e, _PLAN_FLAGS) from None
+    result = _in_plan_words(result)
     if args.out is not None:
         _write_plan_parquet(result, args.out, overwrite=args.overwrite)
     if args.json:
@@ -887,6 +1067,36 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     else:
         print(f"wrote {len(result)} candidates to {args.out}")
     return 0
+
+
+_PLAN_FLAGS = {
+    "num_candidates": "--num",
+    "seed": "--seed",
+    "object_mass": "--mass",
+    "torque_limit": "--torque-limit",
+}
+"""``plan_grasps`` keywords that ``plan`` sets from a flag, and that flag."""
+
+_PLAN_REASON_WORDS = {
+    "contact_model='soft_finger' with torsional_friction models fingertips that do": (
+        "soft fingers model fingertips that do (plan has no flag for them: a "
+        "scene's contact_model: soft_finger with its torsional_friction:, or "
+        "drakegrasp.plan_grasps(..., contact_model='soft_finger', "
+        "torsional_friction=NU) in Python)"
+    ),
+    "num_candidates is 0": "--num is 0",
+}
+"""Phrases of a plan result's ``reason`` that name what ``plan`` cannot set."""
+
+
+def _in_plan_words(result):
+    """``result`` with its ``reason`` naming only what ``plan`` can set."""
+    reason = result.reason
+    for phrase, words in _PLAN_REASON_WORDS.items():
+        reason = reason.replace(phrase, words)
+    if reason == result.reason:
+        return result
+    return dataclasses.replace(result, reason=reason)
 
 
 def _write_plan_parquet(result, path: str, *, overwrite: bool) -> None:
@@ -1013,6 +1223,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         with _terminable():
+            _check_values(args)
             return int(args.func(args))
     except Terminated as t:
         # SIGTERM or SIGHUP: unwound like Ctrl-C, so partial files and scratch
@@ -1032,7 +1243,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # e.g. `drakegrasp analyze | head`
         return 0
     except GraspError as e:
-        return _error(str(e))
+        return _error(_cli_words(str(e), getattr(args, "command", None)))
     except (OSError, ValueError, RuntimeError, MemoryError) as e:
         # File or Drake errors that were not already wrapped.
         return _error(f"{type(e).__name__}: {e}" if not str(e) else str(e))

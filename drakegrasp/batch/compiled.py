@@ -141,7 +141,7 @@ class _CompileNotice:
             self.announced = True
             self._write(
                 "compiling the batch kernels with numba (once per install, "
-                "about a minute; cached for later runs; `drakegrasp warmup` "
+                "under a minute; cached for later runs; `drakegrasp warmup` "
                 "does it up front) ..."
             )
 

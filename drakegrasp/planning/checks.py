@@ -11,10 +11,10 @@ import numpy as np
 
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.validation import (
-    describe,
     check_coefficient,
     check_length,
     check_positions,
+    describe,
     integer_or_none,
     real_array,
     real_scalar,

@@ -61,9 +61,9 @@ from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.linalg import rotations_about
 from drakegrasp.core.validation import (
-    describe,
     check_coefficient,
     check_length,
+    describe,
     integer_or_none,
 )
 from drakegrasp.errors import InvalidOptionError

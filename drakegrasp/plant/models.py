@@ -161,6 +161,7 @@ def use_local_drake_models(
         If ``parser_or_package_map`` is neither a Parser nor a PackageMap.
     """
     package_map = _package_map_of(parser_or_package_map, "use_local_drake_models")
+    from_env = path is None
     if path is None:
         path = os.environ.get(DRAKE_MODELS_ENV)
         if not path:
@@ -172,6 +173,13 @@ def use_local_drake_models(
         )
     folder = Path(path).expanduser().resolve()
     if not folder.is_dir():
+        if from_env:
+            raise ModelError(
+                f"{DRAKE_MODELS_ENV} is set to {str(path)!r}, which is not a "
+                "directory, so it does not hold the drake_models package: point "
+                "it at a local copy of drake_models (the folder that holds "
+                "wsg_50_description/, ...), or unset it to let Drake download it"
+            )
         raise ModelError(
             f"drake_models folder {str(path)!r} is not a directory (set "
             f"{DRAKE_MODELS_ENV} or pass path= to a local copy of drake_models)"

@@ -105,7 +105,7 @@ def test_bad_inputs_one_line_each(tmp_path):
                 "--num-generators",
                 "100000000",
             ],
-            "num_generators",
+            "--num-generators",
         ),
         (
             [

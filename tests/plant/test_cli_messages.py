@@ -1,0 +1,160 @@
+"""The command's messages speak its own language: flags, not Python keywords.
+
+A newcomer's walkthrough found messages that named ``num_candidates`` for
+``--num`` or ``overwrite=True`` for ``--overwrite``, a ``plan`` hint about a
+contact model plan has no flag for, no ``--version``, a wrong
+``DRAKEGRASP_DRAKE_MODELS`` reported as unset, and a warmup estimate twice the
+measured time.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from drakegrasp.cli import PLAN_HANDS, build_parser, main
+from drakegrasp.plant.scene import DEFAULT_SCENE, scene_path
+
+
+def _one_line(capsys, *argv, code=1):
+    assert main(list(argv)) == code
+    captured = capsys.readouterr()
+    assert captured.err.count("\n") == 1, captured.err
+    assert captured.err.startswith("drakegrasp: error: "), captured.err
+    return captured.err
+
+
+@pytest.fixture
+def grasps(tmp_path):
+    rng = np.random.default_rng(0)
+    p = rng.normal(size=(4, 3, 3))
+    path = tmp_path / "in.npz"
+    np.savez(path, positions=p, normals=-p)
+    return str(path), str(tmp_path / "out.npz")
+
+
+@pytest.mark.parametrize(
+    ("argv", "flag"),
+    [
+        (("analyze", "--num-generators", "2"), "--num-generators"),
+        (("analyze", "--distance-tolerance", "0"), "--distance-tolerance"),
+        (("analyze", "--tol", "0.9"), "--tol"),
+        (("analyze", "--characteristic-length", "1e40"), "--characteristic-length"),
+        (("analyze", "--torsional-friction", "1e40"), "--torsional-friction"),
+        (("analyze", "--mu", "1e13"), "--mu"),
+    ],
+)
+def test_an_analyze_value_out_of_range_names_its_flag(capsys, argv, flag):
+    err = _one_line(capsys, *argv)
+    assert err.startswith(f"drakegrasp: error: {flag} must be"), err
+
+
+@pytest.mark.parametrize(
+    ("extra", "flag"),
+    [
+        (("--num-generators", "2"), "--num-generators"),
+        (("--chunk-size", "0"), "--chunk-size"),
+        (("--tol", "2"), "--tol"),
+        (("--mu", "1e13"), "--mu"),
+        (("--mu", "0.5", "--torsional-friction", "1e13"), "--torsional-friction"),
+    ],
+)
+def test_a_batch_value_out_of_range_names_its_flag(capsys, grasps, extra, flag):
+    err = _one_line(capsys, "batch", *grasps, *extra)
+    assert err.startswith(f"drakegrasp: error: {flag} must be"), err
+
+
+@pytest.mark.parametrize(
+    ("extra", "flag"),
+    [(("--num", "-5"), "--num"), (("--num", "3", "--seed", "-1"), "--seed")],
+)
+def test_a_plan_value_out_of_range_names_its_flag(capsys, extra, flag):
+    err = _one_line(capsys, "plan", *extra)
+    assert err.startswith(f"drakegrasp: error: {flag} must be"), err
+    assert "num_candidates" not in err
+
+
+def test_an_existing_output_asks_for_the_overwrite_flag(capsys, grasps):
+    src, out = grasps
+    assert main(["batch", src, out, "--mu", "0.5"]) == 0
+    capsys.readouterr()
+    err = _one_line(capsys, "batch", src, out, "--mu", "0.5")
+    assert "pass --overwrite to replace it" in err
+    assert "overwrite=True" not in err
+
+
+def test_soft_fingers_without_nu_ask_for_the_flag(capsys, grasps, tmp_path):
+    err = _one_line(
+        capsys, "batch", *grasps, "--mu", "0.5", "--contact-model", "soft_finger"
+    )
+    assert "--contact-model soft_finger needs" in err
+    assert "--torsional-friction NU" in err and "torsional_friction" in err
+    assert "contact_model=" not in err
+    scene = tmp_path / "no_nu.yaml"  # the default scene without its nu
+    text = scene_path(DEFAULT_SCENE).read_text()
+    scene.write_text(text.replace("torsional_friction: 0.1", ""))
+    err = _one_line(capsys, "analyze", str(scene), "--contact-model", "soft_finger")
+    assert "--torsional-friction NU" in err and "contact_model=" not in err
+
+
+def test_a_wrong_hand_alias_lists_the_aliases_and_suggests_one(capsys):
+    err = _one_line(capsys, "plan", "box", "--hand", "WSG", "--num", "1")
+    assert "did you mean 'wsg'?" in err
+    assert all(alias in err for alias in PLAN_HANDS)
+
+
+def test_metrics_warns_that_it_takes_the_words_after_it(capsys, grasps):
+    _, sub = build_parser()
+    metrics = next(
+        a for a in sub.choices["batch"]._actions if "--metrics" in a.option_strings
+    )
+    assert "after the positional arguments or before another option" in metrics.help
+    assert "end it with --" in metrics.help
+    with pytest.raises(SystemExit) as exit_:
+        main(["batch", "--metrics", "sigma_min", *grasps])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "end it with --" in err
+
+
+def test_plan_suggests_soft_fingers_only_where_they_can_be_had(capsys):
+    """Two point contacts: the hint named contact_model=, which plan has no flag for."""
+    assert main(["plan", "sphere", "--hand", "rounded", "--num", "4"]) == 0
+    out = capsys.readouterr().out
+    assert "torque about the line" in out  # the reason is still given
+    assert "contact_model='soft_finger' with torsional_friction models" not in out
+    assert "plan has no flag for them" in out and "plan_grasps" in out
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["--version"])
+    assert exit_.value.code == 0
+    version = importlib.metadata.version("drakegrasp")
+    assert capsys.readouterr().out == f"drakegrasp {version}\n"
+
+
+def test_a_wrong_drake_models_variable_is_reported_as_set(capsys, monkeypatch):
+    monkeypatch.setenv("DRAKEGRASP_DRAKE_MODELS", "/nope")
+    err = _one_line(capsys, "plan", "box", "--hand", "wsg", "--num", "1")
+    assert "DRAKEGRASP_DRAKE_MODELS is set to '/nope'" in err
+    assert "set DRAKEGRASP_DRAKE_MODELS or" not in err
+
+
+def test_warmup_promises_what_it_measured(capsys, monkeypatch):
+    """86 functions compiled in 42 s of one core (2 shared cores, under load)."""
+    from drakegrasp.batch import aot, warmup
+
+    monkeypatch.setattr(aot, "status", lambda: "numba's JIT runs")
+    report = SimpleNamespace(available=True, compiled=86, seconds=41.7)
+    report.cache_dir, report.route = None, "numba's JIT runs"
+    monkeypatch.setattr(warmup, "warmup", lambda progress: report)
+    assert main(["warmup"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert "under a minute" in first and "minute or two" not in first
+    _, sub = build_parser()
+    description = sub.choices["warmup"].description
+    assert "under a minute" in description and "minute or two" not in description
