@@ -72,6 +72,8 @@ class AntipodalResult:
         )
         if self.min_mu == 0.0:
             mu_text = "the fingers are collinear: antipodal for every mu >= 0"
+        elif np.isinf(self.min_mu):
+            mu_text = _no_mu_text(self.angles)
         else:
             mu_text = f"antipodal for mu >= {self.min_mu:.4g}"
         if np.all(np.abs(self.margins) < 1e-9):
@@ -81,6 +83,32 @@ class AntipodalResult:
             "space two hard fingers never resist a moment about the line "
             "between them, and with mu = 0 nothing resists sliding"
         )
+
+
+def _no_mu_text(angles: np.ndarray) -> str:
+    """Why no friction coefficient makes the pair antipodal (an angle >= 90°)."""
+    outward = [i + 1 for i in range(2) if angles[i] > np.pi / 2]
+    if len(outward) == 2:
+        return (
+            "not antipodal for any mu: both normals point away from the other "
+            "contact (away from each other, out of the object); drakegrasp's "
+            "normals point into the object, the direction the finger pushes "
+            "(docs/conventions.md, Contacts): negate them if they came from an "
+            "outward-normal source"
+        )
+    if outward:
+        return (
+            f"not antipodal for any mu: the normal of contact {outward[0]} points "
+            "away from the other contact (out of the object); drakegrasp's "
+            "normals point into the object, the direction the finger pushes "
+            "(docs/conventions.md, Contacts): check its sign"
+        )
+    square = [i + 1 for i in range(2) if angles[i] >= np.pi / 2]
+    which = " and ".join(f"contact {i}" for i in square)
+    return (
+        f"not antipodal for any mu: the normal of {which} is perpendicular to "
+        "the line between the contacts"
+    )
 
 
 def _two_contacts(grasp_or_contacts: Grasp | Sequence[Contact]) -> tuple[Contact, ...]:

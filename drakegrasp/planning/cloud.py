@@ -5,7 +5,10 @@ the object is a cloud, a pydrake ``PointCloud`` or an ``(M, 3)`` array in the
 world frame, with normals given or estimated from the flattest nearby patch
 (:func:`estimate_normals`) and turned outwards (away from the cloud's
 centroid, or towards a ``viewpoint``: the camera, for a one-sided cloud).
-Points that are not finite (Drake marks missing depth with NaN) are dropped.
+Points that are not finite (Drake marks missing depth with NaN) are dropped,
+with a :class:`PointCloudWarning` that counts them (the result's
+``settings["cloud_dropped"]`` counts every point left out); so is a cloud
+too large to be in metres (:data:`CLOUD_UNITS_EXTENT`).
 
 **Frame O** of a cloud is the world frame moved to the cloud's centroid, or
 to the centre of symmetry of a completed one-sided cloud (:func:`complete_unseen`):
@@ -41,6 +44,7 @@ body, meeting a quadric fitted at each point (:class:`FittedCloud`).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,6 +58,7 @@ from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
+    "CLOUD_UNITS_EXTENT",
     "MAX_COORDINATE",
     "CONTACT_BAND",
     "DISTINCT",
@@ -76,6 +81,7 @@ __all__ = [
     "CloudFingers",
     "CloudSurface",
     "FittedCloud",
+    "PointCloudWarning",
     "cloud_surface",
     "sphere_entry",
     "complete_unseen",
@@ -202,6 +208,26 @@ MAX_COORDINATE = 1e6
 hand grasps, and a larger one would overflow the squared distances the route
 sums."""
 
+CLOUD_UNITS_EXTENT = 5.0
+"""A cloud whose bounding box (its finite points', world axes) is more than this
+many metres long on a side gets a :class:`PointCloudWarning` that it may be in
+millimetres.
+
+The largest things a robot hand grasps (a long pipe, a ladder's rail) are a
+few metres long; in millimetres, anything more than 5 mm across exceeds 5
+"metres" (the YCB sugar box, 0.19 m, reads 194), and the planner then finds
+every chord "wider than the stroke".  Only a warning: a long thin object is
+graspable across its thickness."""
+
+
+class PointCloudWarning(UserWarning):
+    """Planning went on with a point cloud that may not be what was meant.
+
+    Points left out (not finite: a depth camera's missing depth), or an
+    extent too large for metres (:data:`CLOUD_UNITS_EXTENT`).  Silence it
+    with ``warnings.simplefilter("ignore", PointCloudWarning)``.
+    """
+
 
 def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     """Points and outward unit normals of a cloud, world frame, finite only.
@@ -227,6 +253,12 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     ------
     InvalidOptionError
         An empty cloud, one with no finite point, or malformed arrays.
+
+    Warns
+    -----
+    PointCloudWarning
+        When points that are not finite were left out (how many), or the
+        cloud is more than :data:`CLOUD_UNITS_EXTENT` across (millimetres?).
     """
     return read_cloud_fit(point_cloud, normals, viewpoint=viewpoint)[:3]
 
@@ -281,7 +313,8 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
     if far.any():
         raise InvalidOptionError(
             f"point_cloud has {int(far.sum())} points farther than "
-            f"{MAX_COORDINATE:g} m along an axis (a cloud is in metres)"
+            f"{MAX_COORDINATE:g} m along an axis (a cloud is in metres: divide "
+            "one in millimetres by 1000)"
         )
     finite = np.all(np.isfinite(points), axis=1)
     if normals is not None:
@@ -293,6 +326,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
             f"point_cloud has {len(points)} finite points of {total}: too few to "
             "grasp (NaN marks missing points)"
         )
+    _warn_of(points, total)
     fit = None
     if normals is None:
         normals, fit = _estimate_normals(points)
@@ -314,6 +348,28 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
     flip = np.sum(normals * towards, axis=1) < 0
     normals[flip] *= -1
     return points, normals, total - len(points), fit
+
+
+def _warn_of(points: np.ndarray, total: int) -> None:
+    """Warn of the non-finite points left out and of an extent beyond metres."""
+    left_out = total - len(points)
+    if left_out:
+        warnings.warn(
+            f"point_cloud: left out {left_out} of {total} points that are not "
+            "finite (NaN marks missing depth; with cloud_normals, a point whose "
+            f"normal is not finite too); planning on the other {len(points)}",
+            PointCloudWarning,
+            stacklevel=4,
+        )
+    extent = float(np.max(np.ptp(points, axis=0)))
+    if extent > CLOUD_UNITS_EXTENT:
+        warnings.warn(
+            f"point_cloud is {extent:.4g} m across (its bounding box's longest side), "
+            f"more than {CLOUD_UNITS_EXTENT:g} m: a cloud is in metres; if this "
+            f"one is in millimetres, divide it by 1000 ({extent / 1000:.4g} m)",
+            PointCloudWarning,
+            stacklevel=4,
+        )
 
 
 def estimate_normals(points: np.ndarray) -> np.ndarray:

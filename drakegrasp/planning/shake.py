@@ -8,8 +8,9 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
 - the fingers are position-controlled by Drake's PD-controlled actuators
   (``JointActuator.set_controller_gains``, stiffness ``k``) aimed
   ``squeeze / k`` past the place where they touch, so each presses with
-  ``squeeze`` newtons (within its effort limit) and resists being
-  pushed open with stiffness ``k``, as a position-controlled gripper does (two
+  ``squeeze`` newtons, or N·m for a revolute joint (within its effort
+  limit), and resists being pushed open with stiffness ``k``, as a
+  position-controlled gripper does (two
   force-controlled fingers would let gravity along the grasp axis carry
   object and fingers to a joint limit).  Where they touch is found in
   Drake, not taken from the plan: for ``seat`` seconds without gravity the
@@ -98,7 +99,9 @@ class ShakeResult:
         Per gravity direction: ``direction`` (world), ``displacement`` and
         ``rotation`` at the end of the phase.
     squeeze : float
-        Actuator force per finger joint, newtons.
+        What each closing joint's actuator presses with: a force in newtons
+        for a prismatic joint (a parallel jaw), a torque in N·m for a revolute
+        one (a multi-finger hand); see ``effort_units``.
     efforts : tuple of float
         The magnitude of what each closing joint's actuator applied once the
         fingers had seated (newtons, or N·m for a revolute joint), in
@@ -115,6 +118,10 @@ class ShakeResult:
         Seconds.
     bounds : tuple of float
         ``(max_displacement, max_rotation)`` allowed.
+    effort_units : tuple of str
+        The unit of ``squeeze`` and of each entry of ``efforts``, per closing
+        joint in actuator order: ``"N"`` for a prismatic joint, ``"N·m"`` for
+        a revolute one (empty: newtons assumed).
     """
 
     held: bool
@@ -127,6 +134,7 @@ class ShakeResult:
     duration: float
     wall_time: float
     bounds: tuple[float, float]
+    effort_units: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
@@ -139,9 +147,23 @@ class ShakeResult:
             f"{np.degrees(self.max_rotation):.2f}"
             f" deg (bounds {self.bounds[0] * 1e3:g} mm, "
             f"{np.degrees(self.bounds[1]):g} deg)"
-            f" over {self.duration:g} s, squeeze {self.squeeze:g} N, "
+            f" over {self.duration:g} s, squeeze {self.squeeze:g} "
+            f"{_squeeze_unit(self.effort_units)}, "
             f"{len(self.phases)} gravity directions; {self.wall_time:.2f} s wall"
         )
+
+
+def _effort_unit(joint) -> str:
+    """Unit of an actuator's effort on ``joint``: N if it slides, else N·m."""
+    return "N" if joint.type_name() == "prismatic" else "N·m"
+
+
+def _squeeze_unit(units: tuple[str, ...]) -> str:
+    """The squeeze's unit for a summary line: one unit, or both when mixed."""
+    kinds = set(units) or {"N"}
+    if len(kinds) == 1:
+        return kinds.pop()
+    return "(N on prismatic, N·m on revolute joints)"
 
 
 class _TurnedGravity(LeafSystem):
@@ -320,9 +342,9 @@ def shake_test(
         candidate = replace(candidate, X_WO=check_rigid_transform("X_WO", X_WO))
     check_candidate(candidate)
     for name, value, low, unit in (
-        ("squeeze", squeeze, 0.0, "N"),
+        ("squeeze", squeeze, 0.0, "N, or N·m for revolute joints"),
         ("stiffness", stiffness, 0.0, "N/m or N·m/rad"),
-        ("damping", damping, None, "N·s/m"),
+        ("damping", damping, None, "N·s/m or N·m·s/rad"),
         ("time_step", time_step, 0.0, "s"),
         ("phase", phase, 0.0, "s"),
         ("settle", settle, None, "s"),
@@ -451,11 +473,9 @@ def shake_test(
     else:
         advance(settle)  # efforts are read once something has been simulated
     u = plant.get_net_actuation_output_port().Eval(ctx)
-    efforts = tuple(
-        abs(float(u[a.input_start()]))
-        for a in actuators
-        if int(a.joint().index()) in targets
-    )
+    squeezing = [a for a in actuators if int(a.joint().index()) in targets]
+    efforts = tuple(abs(float(u[a.input_start()])) for a in squeezing)
+    effort_units = tuple(_effort_unit(a.joint()) for a in squeezing)
     for end in ends:
         d, r = advance(end)
         phases.append(
@@ -476,4 +496,5 @@ def shake_test(
         duration=duration,
         wall_time=time.perf_counter() - t0,
         bounds=(float(max_displacement), float(max_rotation)),
+        effort_units=effort_units,
     )

@@ -67,6 +67,14 @@ from drakegrasp.plant.validation import (
 
 __all__ = ["GraspFromPlant", "GraspReport", "analyze_grasp", "grasp_from_plant"]
 
+CLOSE_HINT = (
+    "if the hand is open, close it onto the object first: "
+    "`drakegrasp analyze SCENE --close`, 'close: true' in the scene file's "
+    "drakegrasp: section, load_scene(..., close=True) or "
+    "drakegrasp.close_hand(plant, context, object_body, hand=...)"
+)
+"""What a :class:`~drakegrasp.NoContactsError` of a hand that stops short adds."""
+
 PLANE_NORMAL_TOL = 1e-6
 """A planar analysis needs every normal's out-of-plane component below this."""
 
@@ -303,16 +311,21 @@ def grasp_from_plant(
             query_object=query_object,
         )
         if contacts is None:
-            contacts = find_contacts(
-                plant,
-                plant_context,
-                object_body=body,
-                hand=bodies,
-                distance_tolerance=distance_tolerance,
-                allow_penetration=allow_penetration or not check_pose,
-                patches=opts.patches,
-                query_object=query_object,
-            )
+            try:
+                contacts = find_contacts(
+                    plant,
+                    plant_context,
+                    object_body=body,
+                    hand=bodies,
+                    distance_tolerance=distance_tolerance,
+                    allow_penetration=allow_penetration or not check_pose,
+                    patches=opts.patches,
+                    query_object=query_object,
+                )
+            except NoContactsError as e:
+                if "does not touch" not in str(e):  # no geometry: closing won't help
+                    raise
+                raise NoContactsError(f"{e}; {CLOSE_HINT}") from None
         elif not contacts:
             raise NoContactsError(
                 f"no contacts given for {_scoped_name(plant, body)!r}"

@@ -155,7 +155,12 @@ class LoadReport:
     torque_limits_source : str
         ``"plant"`` (actuator effort limits), ``"given"`` or ``"none"``.
     joint_names : tuple of str
-        The joint of each hand velocity.
+        What each hand velocity is: its joint's name for a one-dof joint; for
+        a free hand base's floating joint, ``"free base NAME mx"`` ...
+        ``"free base NAME fz"`` (the moment about the base body's origin and
+        the force, in world axes, that its six velocities carry: Drake names
+        that joint after the body); another multi-dof joint's
+        ``"NAME SUFFIX"`` with Drake's velocity suffix (``wx``, ``vy``...).
     first_saturating_joint : str or None
         The joint whose limit binds first as the load grows (at the payload).
     mu : (N,) float
@@ -166,6 +171,10 @@ class LoadReport:
         ``"dynamic"`` (discrete plant) or ``"static"`` (continuous plant).
     warnings : tuple of str
         E.g. a given ``μ`` that disagrees with the plant's.
+    torque_units : tuple of str
+        The unit of each hand velocity's torque: ``"N"`` along a prismatic
+        joint or a linear velocity, ``"N·m"`` about a revolute joint or an
+        angular velocity (empty: not known).
     """
 
     wrench: np.ndarray
@@ -181,6 +190,7 @@ class LoadReport:
     mu_plant: np.ndarray | None
     friction_rule: str
     warnings: tuple[str, ...] = ()
+    torque_units: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
@@ -197,9 +207,12 @@ class LoadReport:
         if f.feasible:
             lines.append(f"  least squeeze {f.squeeze:.4g} N")
             if f.joint_torques is not None:
+                units = self.torque_units or ("",) * len(self.joint_names)
                 tau = ", ".join(
-                    f"{n} {t:+.3g}"
-                    for n, t in zip(self.joint_names, f.joint_torques, strict=True)
+                    f"{n} {t:+.3g}" + (f" {u}" if u else "")
+                    for n, t, u in zip(
+                        self.joint_names, f.joint_torques, units, strict=True
+                    )
                 )
                 lines.append(f"  joint torques: {tau}")
         elif f.certificate is not None:
@@ -233,13 +246,39 @@ class LoadReport:
         return "\n".join(self.report_lines())
 
 
-def _joint_names(plant: MultibodyPlant, velocity_indices) -> tuple[str, ...]:
-    names = {}
+def _velocity_labels(
+    plant: MultibodyPlant, velocity_indices
+) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(label, torque unit) of each hand velocity.
+
+    A one-dof joint's label is its name; a floating joint (a free hand base,
+    whose joint Drake names after its body) reads ``"free base NAME mx"``
+    ... ``"free base NAME fz"``: Drake orders its velocities ``[w; v]``, so
+    its generalized forces are a moment (N·m) and a force (N).  Another
+    multi-dof joint's velocity is ``"NAME SUFFIX"`` (Drake's
+    ``velocity_suffix``).  The unit follows the suffix: an angular velocity
+    (``w...``) carries N·m, a linear one (``v...``) N.
+    """
+    labels, units = {}, {}
     for j in plant.GetJointIndices():
         joint = plant.get_joint(j)
-        for k in range(joint.num_velocities()):
-            names[joint.velocity_start() + k] = joint.name()
-    return tuple(names.get(int(v), f"v[{int(v)}]") for v in velocity_indices)
+        n = joint.num_velocities()
+        for k in range(n):
+            suffix = joint.velocity_suffix(k)
+            if joint.type_name() in FLOATING_JOINTS:
+                part = {"w": "m", "v": "f"}.get(suffix[:1], suffix[:1]) + suffix[1:]
+                label = f"free base {joint.name()} {part}"
+            elif n == 1:
+                label = joint.name()
+            else:
+                label = f"{joint.name()} {suffix}"
+            i = joint.velocity_start() + k
+            labels[i] = label
+            units[i] = {"w": "N·m", "v": "N"}.get(suffix[:1], "")
+    return (
+        tuple(labels.get(int(v), f"v[{int(v)}]") for v in velocity_indices),
+        tuple(units.get(int(v), "") for v in velocity_indices),
+    )
 
 
 def _load_wrench(plant, plant_context, data, load):
@@ -306,7 +345,7 @@ def analyze_load(
         if np.any(w != 0.0)
         else None
     )
-    names = _joint_names(plant, data.hand_velocity_indices)
+    names, units = _velocity_labels(plant, data.hand_velocity_indices)
     first = (
         names[payload.saturating_joints[0]]
         if payload is not None and payload.saturating_joints
@@ -328,6 +367,7 @@ def analyze_load(
         mu_plant=mu_plant,
         friction_rule=friction_rule(plant),
         warnings=tuple(warnings),
+        torque_units=units,
     )
 
 

@@ -41,13 +41,15 @@ The format
 ``add_collision_filter_group``...): Drake checks its schema and reports
 unknown keys.  ``drakegrasp:`` keys (see :data:`drakegrasp.plant.scene_file.KEYS`):
 
-- ``object_body`` (required): the grasped body, ``"model::body"``;
+- ``object_body`` (required): the grasped body, ``"model::body"`` (an
+  unscoped name is refused, listing the scoped names it could mean);
 - ``mu`` (required): friction coefficient of every contact;
 - ``hand``: a model-instance name (all its bodies not welded to the world) or
   a list of ``"model::body"`` names; absent: every body that is not the
   object, not welded to the world and not in the object's model instance;
 - ``contact_model`` (default ``hard_finger``), ``torsional_friction``
-  (default 0; needed > 0 by ``soft_finger``), ``plane`` (absent: spatial),
+  (``ν >= 0``; absent is not 0, and a ``soft_finger`` file without it is
+  refused when read), ``plane`` (absent: spatial),
   ``distance_tolerance`` (default 1e-4 m), ``description`` (default empty);
 - ``close`` (default false): ``true`` closes the hand onto the object when
   the scene is loaded (:func:`~drakegrasp.plant.closing.close_hand` from the
@@ -132,7 +134,7 @@ from pydrake.multibody.parsing import (
     ProcessModelDirectives,
 )
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
-from pydrake.multibody.tree import ModelInstanceIndex, RigidBody
+from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.core.contact import ContactModel
@@ -141,13 +143,19 @@ from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.couplings import record_model_couplings
 from drakegrasp.plant.models import explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
-from drakegrasp.plant.scene_file import check_section, directives_text, read_yaml
+from drakegrasp.plant.scene_file import (
+    check_directives,
+    check_section,
+    directives_text,
+    read_yaml,
+)
 from drakegrasp.plant.scene_refs import PackagesSpec, add_packages, check_references
 from drakegrasp.plant.validation import (
     hand_bodies,
     hand_contact_bodies,
     model_instance,
     resolve_body,
+    scoped_name,
 )
 
 if TYPE_CHECKING:  # closing is imported only when a scene closes its hand
@@ -359,14 +367,50 @@ def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
 
 def _scene_body(path: Path, plant: MultibodyPlant, name: str) -> RigidBody:
     """The file's ``object_body``; an unknown name is refused naming the file."""
+    _require_scoped(path, plant, "object_body", name)
     try:
         return resolve_body(plant, name)
     except ModelError as e:
         raise ModelError(f"scene {str(path)!r}: object_body: {e}") from None
 
 
+def _require_scoped(path: Path, plant: MultibodyPlant, key: str, name: str) -> None:
+    """Refuse a body name of the file without its model scope (``model::body``).
+
+    The Python API takes an unscoped name used by one body; a file does not:
+    it is shared and grows (a second object, an included directive file), and
+    a name unique today would then become ambiguous, far from the edit that
+    made it so.  Drake's own directives
+    (``add_weld``) take scoped names too.  ``world`` is let through, to be
+    refused as no object by the checks that follow.
+
+    Raises
+    ------
+    SceneError
+        Naming the file, the key and the scoped names of the bodies called
+        ``name`` (all the plant's bodies when none is).
+    """
+    if "::" in name or name == "world":
+        return
+    bodies = [plant.get_body(BodyIndex(i)) for i in range(1, plant.num_bodies())]
+    same = [scoped_name(plant, b) for b in bodies if b.name() == name]
+    shown = same or [scoped_name(plant, b) for b in bodies]
+    which = (
+        f"the bodies named {name!r}: {same}"
+        if same
+        else f"no body is named {name!r}; the bodies are {shown}"
+    )
+    raise SceneError(
+        f"scene {str(path)!r}: {key} {name!r} has no model scope; a scene file "
+        f"names a body 'model::body' ({which})"
+    )
+
+
 def _scene_hand(path: Path, plant: MultibodyPlant, hand):
     """The file's ``hand:`` in the plant; an unknown name is refused naming the file."""
+    if isinstance(hand, tuple):
+        for name in hand:
+            _require_scoped(path, plant, "hand", name)
     try:
         return _resolve_hand(plant, hand)
     except ModelError as e:
@@ -559,6 +603,7 @@ def load_scene(
     path = scene_path(DEFAULT_SCENE if path_or_name is None else path_or_name)
     text, data = read_yaml(path)
     info = SceneInfo(name=path.stem, path=path.resolve(), **check_section(path, data))
+    check_directives(path, data)
     free_hand = check_flag("free_hand", free_hand)
     builder, plant, parser, packages = _new_plant(path, package_map, ros_package_path)
     try:

@@ -38,6 +38,8 @@ __all__ = [
     "KEYS",
     "MAX_DEPTH",
     "MAX_SCENE_BYTES",
+    "TOP_LEVEL_KEYS",
+    "check_directives",
     "check_section",
     "directives_text",
     "read_yaml",
@@ -62,6 +64,9 @@ KEYS = {
     "joint]}: close the hand onto the object when the scene is loaded",
 }
 """The keys of the ``drakegrasp:`` section and what each must be."""
+
+TOP_LEVEL_KEYS = ("directives", "drakegrasp")
+"""The keys of a scene file: Drake's model directives and drakegrasp's section."""
 
 
 class _SceneLoader(yaml.SafeLoader):
@@ -255,6 +260,39 @@ def _close(path: Path, value) -> tuple[bool, tuple[float, ...] | None]:
     )
 
 
+def check_directives(path: Path, data: dict) -> None:
+    """Refuse a file without a ``directives:`` list, or with another top-level key.
+
+    Drake's own message for these ("the top level element should be a
+    Mapping", "key 'directive' did not match any visited value entry") names
+    neither the file nor what is missing.
+
+    Raises
+    ------
+    SceneError
+        Naming the file, the key and what is valid.
+    """
+    unknown = [k for k in data if k not in TOP_LEVEL_KEYS]
+    if unknown:
+        raise SceneError(
+            f"scene {str(path)!r}: unknown top-level key(s) "
+            f"{', '.join(repr(k) for k in unknown)}; a scene file has exactly "
+            "'directives:' (Drake's model directives) and 'drakegrasp:'"
+        )
+    if "directives" not in data:
+        raise SceneError(
+            f"scene {str(path)!r} has no 'directives:' key: it needs a list of "
+            "Drake model directives (add_model, add_weld, ...) that adds the hand "
+            "and the object (docs/scene_format.md)"
+        )
+    if not isinstance(data["directives"], list):
+        raise SceneError(
+            f"scene {str(path)!r}: 'directives:' must be a list of Drake model "
+            "directives (- add_model: ..., - add_weld: ...), got "
+            f"{type(data['directives']).__name__}"
+        )
+
+
 def check_section(path: Path, data: dict) -> dict:
     """The checked ``drakegrasp:`` section, with defaults filled in.
 
@@ -270,8 +308,9 @@ def check_section(path: Path, data: dict) -> dict:
     Raises
     ------
     SceneError
-        Missing section, missing or unknown key, or a value of the wrong type
-        or range; the message names the key and what is valid.
+        Missing section, missing or unknown key (a soft finger's
+        ``torsional_friction`` included), or a value of the wrong type or
+        range; the message names the key and what is valid.
     """
     section = data.get("drakegrasp")
     if not isinstance(section, dict):
@@ -310,6 +349,16 @@ def check_section(path: Path, data: dict) -> dict:
             f"scene {str(path)!r}: drakegrasp.plane must be {KEYS['plane']} or "
             f"absent, got {plane!r}"
         )
+    if model is ContactModel.SOFT_FINGER and "torsional_friction" not in section:
+        # Refused here, as a missing mu is: the file is incomplete on its own
+        # (absent is not 0, see below), and here its name and key are known.
+        raise SceneError(
+            f"scene {str(path)!r}: drakegrasp.contact_model is soft_finger but "
+            "drakegrasp.torsional_friction is absent; add 'torsional_friction: "
+            "NU' (nu >= 0: the moment about each contact normal is bounded by "
+            "b * nu * f_n; 0 makes a soft finger act as a hard one), or use "
+            "'contact_model: hard_finger'"
+        )
     description = section.get("description", "")
     close, close_direction = _close(path, section.get("close", False))
     return {
@@ -320,8 +369,9 @@ def check_section(path: Path, data: dict) -> dict:
         "hand": hand,
         "mu": _number(path, "mu", section["mu"]),
         "contact_model": model,
-        # Absent is not 0: a soft finger without a given nu is refused by the
-        # analysis, one given nu = 0 acts as a hard finger.
+        # Absent is not 0: a soft finger without a given nu is refused above
+        # (and by the analysis, when --contact-model soft_finger asks for one),
+        # one given nu = 0 acts as a hard finger.
         "torsional_friction": None
         if "torsional_friction" not in section
         else _number(path, "torsional_friction", section["torsional_friction"]),

@@ -58,3 +58,33 @@ def test_symmetric_in_contact_order():
         np.allclose(r1.angles, r2.angles[::-1]) and r1.is_antipodal == r2.is_antipodal
     )
     assert "antipodal" in str(r1) and r1.to_dict()["mu"] == [0.3, 0.5]
+
+
+@pytest.mark.parametrize(
+    ("normals", "said"),
+    [
+        (([-1, 0, 0], [1, 0, 0]), "both normals point away from the other contact"),
+        (([-1, 0.1, 0], [-1, 0, 0]), "the normal of contact 1 points away"),
+        (([1, 0, 0], [0.2, 1, 0]), "the normal of contact 2 points away"),
+    ],
+)
+def test_outward_normals_are_named_not_reported_as_mu_inf(normals, said):
+    # "antipodal for mu >= inf" hid a sign convention mistake: drakegrasp's
+    # normals point into the object (docs/conventions.md).
+    pair = [dg.Contact([-1, 0, 0], normals[0]), dg.Contact([1, 0, 0], normals[1])]
+    r = dg.is_antipodal(pair, mu=0.5)
+    text = str(r)
+    assert not r.is_antipodal and r.min_mu == np.inf  # the numbers are unchanged
+    assert said in text and "point into the object" in text
+    assert "conventions.md" in text and "mu >= inf" not in text
+    # the same pair with the normals flipped into the object is antipodal
+    if "both" in said:
+        flipped = [dg.Contact(c.position, -c.normal) for c in pair]
+        assert dg.is_antipodal(flipped, mu=0.5).is_antipodal
+
+
+def test_a_normal_square_to_the_line_needs_infinite_friction():
+    pair = [dg.Contact([-1, 0, 0], [0, 1, 0]), dg.Contact([1, 0, 0], [-1, 0, 0])]
+    text = str(dg.is_antipodal(pair, mu=0.5))
+    assert "the normal of contact 1 is perpendicular to the line" in text
+    assert "mu >= inf" not in text and "points away" not in text

@@ -25,7 +25,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
-from drakegrasp.planning.cloud import complete_unseen
+from drakegrasp.planning.cloud import PointCloudWarning, complete_unseen
 from drakegrasp.planning.cloud_hand import (
     OPEN_END_OFFSET,
     REASONS,
@@ -332,7 +332,8 @@ def test_hostile_clouds(can):
         _plan(hand, np.full((50, 3), np.nan))
     holes = p.copy()
     holes[::10] = np.nan  # missing depth, as Drake marks it
-    result = _plan(hand, holes, nrm, n=10)
+    with pytest.warns(PointCloudWarning, match=f"left out {len(p[::10])} of"):
+        result = _plan(hand, holes, nrm, n=10)
     assert result.settings["cloud_dropped"] == len(p[::10])
     assert len(result) + sum(result.rejections.values()) == 10
     # every point twice (a merged scan): spacing 0, surfels of radius 0

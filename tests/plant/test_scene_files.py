@@ -266,22 +266,26 @@ def test_a_files_absent_nu_is_not_given_and_its_zero_is_a_valid_nu(
     text = DEFAULT.replace("  torsional_friction: 0.1\n", "").replace(
         "contact_model: hard_finger", "contact_model: soft_finger" + torsion
     )
-    info = read_scene_info(_write(tmp_path, text))
+    path = _write(tmp_path, text)
+    if given is None:  # refused when read, naming the file and the key
+        for read in (read_scene_info, load_scene):
+            with pytest.raises(SceneError) as info:
+                read(path)
+            assert str(path) in str(info.value)
+            assert "drakegrasp.torsional_friction is absent" in str(info.value)
+        # a hard-finger file without nu: absent, not 0
+        hard = DEFAULT.replace("  torsional_friction: 0.1\n", "")
+        assert read_scene_info(_write(tmp_path, hard)).torsional_friction is None
+        return
+    info = read_scene_info(path)
     assert info.torsional_friction == given
-    scene = load_scene(_write(tmp_path, text))
-    if given is None:  # both routes of the scene say what is missing
-        with pytest.raises(GraspError, match="needs torsional_friction"):
-            scene.options.require_friction()
-        with pytest.raises(GraspError, match="needs torsional_friction"):
-            analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
-    else:  # nu = 0: the soft fingers act as hard ones, by either route
-        report = analyze_grasp(
-            scene.plant, scene.plant_context, **scene.analysis_options()
-        )
-        assert scene.options.torsional_friction == 0.0
-        hard = analyze_grasp(
-            scene.plant,
-            scene.plant_context,
-            **{**scene.analysis_options(), "contact_model": "hard_finger"},
-        )
-        assert report.force_closure.is_closure == hard.force_closure.is_closure
+    scene = load_scene(path)
+    # nu = 0: the soft fingers act as hard ones, by either route
+    report = analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
+    assert scene.options.torsional_friction == 0.0
+    hard = analyze_grasp(
+        scene.plant,
+        scene.plant_context,
+        **{**scene.analysis_options(), "contact_model": "hard_finger"},
+    )
+    assert report.force_closure.is_closure == hard.force_closure.is_closure

@@ -1,0 +1,79 @@
+"""A point cloud in millimetres gets a hint, and points left out are counted.
+
+Planning on a YCB-sized cloud given in millimetres returned an empty result
+("wider than the stroke") with no word of units; NaN points (a depth
+camera's missing depth) were left out without a word.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from drakegrasp.planning import plan_grasps, planning_scene
+from drakegrasp.planning.cloud import (
+    CLOUD_UNITS_EXTENT,
+    PointCloudWarning,
+    read_cloud,
+)
+
+OWN_HAND = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+
+
+def _ball(n=1500, radius=0.04, seed=0):
+    u = np.random.default_rng(seed).standard_normal((n, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    return radius * u, u
+
+
+def _quietly(*args, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PointCloudWarning)
+        return read_cloud(*args, **kw)
+
+
+def test_a_cloud_in_metres_without_nan_reads_without_a_warning():
+    p, n = _ball()
+    points, normals, dropped = _quietly(p, n)
+    assert dropped == 0 and len(points) == len(p)
+
+
+def test_nan_points_left_out_are_counted_in_a_warning():
+    p, n = _ball()
+    p[::10] = np.nan
+    with pytest.warns(PointCloudWarning, match="left out 150 of 1500 points") as w:
+        points, normals, dropped = read_cloud(p, n)
+    assert "planning on the other 1350" in str(w[0].message)
+    assert dropped == 150 and len(points) == 1350
+    # the same points and normals as the finite ones read alone
+    alone = _quietly(p[np.isfinite(p[:, 0])], n[np.isfinite(p[:, 0])])
+    np.testing.assert_array_equal(points, alone[0])
+    np.testing.assert_array_equal(normals, alone[1])
+
+
+def test_a_cloud_in_millimetres_gets_a_units_hint():
+    p, n = _ball(radius=40.0)  # an 80 mm ball, in millimetres
+    with pytest.warns(PointCloudWarning, match="millimetres, divide it by 1000"):
+        points, normals, _ = read_cloud(p, n)
+    np.testing.assert_array_equal(points, p)  # read as given, only warned of
+    # at the threshold's scale: 5 m across is still metres
+    edge = CLOUD_UNITS_EXTENT / 2
+    box = np.array([[x, y, z] for x in (-edge, edge) for y in (-edge, edge)
+                    for z in (-edge, edge)])  # fmt: skip
+    _quietly(box * 0.999, box)
+
+
+def test_planning_on_a_millimetre_cloud_says_why_it_is_empty():
+    scene = planning_scene(None, hand_url=OWN_HAND)
+    p, n = _ball(radius=40.0)
+    with pytest.warns(PointCloudWarning, match="millimetres") as w:
+        result = plan_grasps(
+            scene.plant, scene.context, None, hand=scene.hand, num_candidates=10,
+            mu=0.5, seed=0, robustness_samples=2, point_cloud=p, cloud_normals=n,
+        )  # fmt: skip
+    assert len(result) == 0
+    (units,) = [str(x.message) for x in w if "millimetres" in str(x.message)]
+    assert units.startswith("point_cloud is 79.9")  # an 80 mm ball, sampled
+    assert w[0].filename == __file__  # points at the caller's line

@@ -1,0 +1,59 @@
+"""The shake test's summary names the squeeze's unit: N for the prismatic
+fingers of a parallel jaw, N·m for the revolute joints of a multi-finger hand."""
+
+from __future__ import annotations
+
+import pytest
+
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.shake import ShakeResult
+
+THREE = "package://drakegrasp/hands/three_finger_hand.sdf"
+JAW = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+THREE_OPEN = [-0.4, 0.0, 0.0] * 3
+SHORT = dict(settle=0.05, phase=0.05, blend=0.02, seat=0.05, directions=[(1, 0, 0)])
+
+
+def _best(hand_url, **kw):
+    scene = planning_scene(
+        "package://drakegrasp/objects/cylinder.sdf", hand_url=hand_url
+    )
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=20, mu=1.0, seed=3, robustness_samples=4, **kw,
+    )  # fmt: skip
+    assert len(result) > 0
+    return scene, result[0]
+
+
+def test_a_revolute_hand_squeezes_in_newton_metres():
+    scene, best = _best(THREE, preshape=THREE_OPEN)
+    result = shake_test(
+        scene.add_models, best, squeeze=1.0, stiffness=20.0, damping=1.0, **SHORT
+    )
+    assert result.effort_units == ("N·m",) * len(best.joint_names)
+    assert "squeeze 1 N·m," in str(result)
+    assert result.to_dict()["effort_units"] == ["N·m"] * len(best.joint_names)
+
+
+def test_a_parallel_jaw_squeezes_in_newtons():
+    scene, best = _best(JAW)
+    result = shake_test(scene.add_models, best, squeeze=5.0, **SHORT)
+    assert set(result.effort_units) == {"N"}
+    assert "squeeze 5 N," in str(result)
+
+
+@pytest.mark.parametrize(
+    ("units", "text"),
+    [
+        ((), "squeeze 2 N,"),
+        (("N", "N·m"), "squeeze 2 (N on prismatic, N·m on revolute joints),"),
+    ],
+)
+def test_the_summary_unit_of_an_older_or_mixed_result(units, text):
+    result = ShakeResult(
+        held=True, max_displacement=0.0, max_rotation=0.0, phases=(), squeeze=2.0,
+        efforts=(2.0,) * len(units), time_step=1e-3, duration=1.0, wall_time=0.1,
+        bounds=(0.01, 0.1), **({"effort_units": units} if units else {}),
+    )  # fmt: skip
+    assert text in str(result)

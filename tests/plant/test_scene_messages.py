@@ -1,0 +1,125 @@
+"""Scene-file mistakes a newcomer makes, each answered in our own words.
+
+A file without ``directives:`` got Drake's "the top level element should be a
+Mapping"; a soft finger without ``torsional_friction`` a message naming
+neither the file nor the key; a hand short of the object no word of
+``--close``; and ``object_body: box`` was taken although a file names bodies
+``model::body``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import drakegrasp as dg
+from drakegrasp.cli import main
+from drakegrasp.errors import NoContactsError, SceneError
+from drakegrasp.plant.scene import DEFAULT_SCENE, read_scene_info, scene_path
+
+DEFAULT = scene_path(DEFAULT_SCENE).read_text()
+SECTION = DEFAULT[DEFAULT.index("drakegrasp:") :]
+
+
+def _write(tmp_path: Path, text: str, name: str = "scene.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _cli_error(capsys, *argv) -> str:
+    assert main(list(argv)) == 1
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.count("\n") == 1
+    return captured.err
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        (SECTION, "has no 'directives:' key"),
+        ("directives:\n" + SECTION, "'directives:' must be a list"),
+        (DEFAULT.replace("directives:", "directive:"), "unknown top-level key"),
+    ],
+)
+def test_a_file_without_a_directives_list_is_refused_naming_file_and_key(
+    tmp_path, capsys, text, said
+):
+    path = _write(tmp_path, text)
+    with pytest.raises(SceneError) as info:
+        dg.load_scene(path)
+    message = str(info.value)
+    assert str(path) in message and said in message
+    assert "top level element" not in message and "did not match" not in message
+    assert said in _cli_error(capsys, "analyze", str(path))
+
+
+def test_a_soft_finger_file_without_nu_names_the_file_and_the_key(tmp_path, capsys):
+    text = DEFAULT.replace("  torsional_friction: 0.1\n", "").replace(
+        "contact_model: hard_finger", "contact_model: soft_finger"
+    )
+    path = _write(tmp_path, text, "soft.yaml")
+    with pytest.raises(SceneError) as info:
+        read_scene_info(path)
+    for message in (
+        str(info.value),
+        _cli_error(capsys, "analyze", str(path)),
+        _cli_error(capsys, "plan", str(path), "--num", "5"),
+    ):
+        assert str(path) in message
+        assert "drakegrasp.torsional_friction is absent" in message
+        assert "soft_finger" in message and "hard_finger" in message
+
+
+def test_a_hand_short_of_the_object_is_told_about_closing(tmp_path, capsys):
+    path = _write(tmp_path, DEFAULT.replace("[0.025]", "[0.04]"), "open.yaml")
+    scene = dg.load_scene(path)
+    with pytest.raises(NoContactsError) as info:
+        dg.analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
+    message = str(info.value)
+    assert message.startswith("the hand does not touch 'box::box'")
+    assert "--close" in message and "close_hand" in message
+    err = _cli_error(capsys, "analyze", str(path))
+    assert "drakegrasp analyze SCENE --close" in err
+    # and the flag named does close it
+    assert main(["analyze", str(path), "--close"]) == 0
+    assert "force closure" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "said"),
+    [
+        (
+            "object_body: box::box",
+            "object_body: box",
+            "object_body 'box' has no model scope; a scene file names a body "
+            "'model::body' (the bodies named 'box': ['box::box'])",
+        ),
+        (
+            "object_body: box::box",
+            "object_body: lid",
+            "object_body 'lid' has no model scope; a scene file names a body "
+            "'model::body' (no body is named 'lid'; the bodies are "
+            "['gripper::palm', 'gripper::left_finger', 'gripper::right_finger', "
+            "'box::box'])",
+        ),
+        (
+            "  hand: gripper",
+            "  hand: [left_finger, gripper::right_finger]",
+            "hand 'left_finger' has no model scope",
+        ),
+    ],
+)
+def test_an_unscoped_body_name_is_refused_with_the_scoped_names(
+    tmp_path, capsys, old, new, said
+):
+    path = _write(tmp_path, DEFAULT.replace(old, new))
+    with pytest.raises(SceneError) as info:
+        dg.load_scene(path)
+    assert str(path) in str(info.value) and said in str(info.value)
+    assert said in _cli_error(capsys, "analyze", str(path))
+    if "hand" in old:  # the scoped name it shows is accepted
+        fixed = DEFAULT.replace(old, new.replace("[left", "[gripper::left"))
+        scene = dg.load_scene(_write(tmp_path, fixed, "fixed.yaml"))
+        assert [b.name() for b in scene.hand] == ["left_finger", "right_finger"]
