@@ -196,7 +196,7 @@ class GraspForceResult:
         ]
         if self.joint_torques is not None:
             tau = ", ".join(f"{t:.4g}" for t in self.joint_torques)
-            lines.append(f"  joint torques [{tau}]")
+            lines.append(f"  joint torques [{tau}] (N·m revolute, N prismatic)")
         if not math.isnan(self.torque_usage):
             sat = list(self.saturating_joints) or "none"
             lines.append(
