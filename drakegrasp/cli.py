@@ -19,6 +19,7 @@ Usage::
     drakegrasp warmup [--json]
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
                     [--seed S] [--mu M|plant] [--mass KG] [--torque-limit NM]
+                    [--preshape JOINT=VALUE ...]
                     [--package NAME=DIR ...] [--allow-any-file] [--progress]
                     [--json | --out FILE.parquet [--overwrite]]
 
@@ -62,9 +63,11 @@ instance as the object; a planar scene (``plane:``) is refused, as plan
 samples spatial grasps.  Given an object (a shipped object's name, a model
 URL or a file, or a mesh ``.obj`` file, which Drake's parser makes one body
 with the mass of water filling it; default ``box``), it plans for ``--hand`` (a
-model URL or file, ``wsg`` for Drake's WSG-50; default drakegrasp's flat-pad
-jaw) in a scene of the two alone; ``--mass`` gives the object's mass and
-``--torque-limit`` the torque a multi-finger hand will apply.  ``--mu plant``
+model URL or file, ``wsg`` for Drake's WSG-50, ``allegro`` for Drake's Allegro
+right hand with its thumb opposed; default drakegrasp's flat-pad jaw) in a
+scene of the two alone; ``--mass`` gives the object's mass,
+``--torque-limit`` the torque a multi-finger hand will apply and
+``--preshape JOINT=VALUE`` its open shape.  ``--mu plant``
 plans with the friction the plant gives the hand's and the object's geometries
 (the smallest, where pairs differ, said on stderr) instead of a number.
 ``plan --progress`` and ``batch --progress`` need the optional tqdm
@@ -98,6 +101,7 @@ import contextlib
 import dataclasses
 import difflib
 import json
+import math
 import os
 import re
 import signal
@@ -857,8 +861,21 @@ PLAN_HANDS = {
     "flat": "package://drakegrasp/hands/parallel_jaw_flat.sdf",
     "rounded": "package://drakegrasp/hands/parallel_jaw.sdf",
     "wsg": "package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf",
+    "allegro": "package://drake_models/allegro_hand_description/sdf/"
+    "allegro_hand_description_right.sdf",
 }
-"""``plan --hand`` short names: drakegrasp's two jaws and Drake's WSG-50."""
+"""``plan --hand`` short names: drakegrasp's two jaws, Drake's WSG-50 and
+Drake's Allegro right hand."""
+
+PLAN_PRESHAPES = {"allegro": {"joint_12": 1.0}}
+"""The open hand an alias starts from, joint name to value (rad or m), where
+the model's zero is not one to grasp with; ``--preshape`` overrides it.
+
+The Allegro's zero puts its thumb beside the index finger, and outside the
+thumb joint's limits (``joint_12`` in [0.263, 1.396] rad); at 1.0 rad it
+opposes the fingers.  Measured (100 poses, seed 0, mu 0.5): the YCB soup can
+gets 69 candidates, 10 in force closure, against 15 and 1 from the zero
+clipped to the limits; drakegrasp's box 58 and 2 against 15 and 0."""
 
 
 MODEL_SUFFIXES = (".sdf", ".urdf", ".xml")
@@ -897,6 +914,8 @@ def _plan_hand(spec: str | None) -> str:
     spec = spec or "flat"
     if spec in PLAN_HANDS:
         return PLAN_HANDS[spec]
+    if spec.lower() in PLAN_HANDS:  # "WSG", "Allegro"
+        return PLAN_HANDS[spec.lower()]
     if "://" in spec or spec.endswith(MODEL_SUFFIXES):
         return _model_file(spec, "--hand")
     close = difflib.get_close_matches(spec.lower(), PLAN_HANDS, n=1)
@@ -963,6 +982,10 @@ def _plan_setup(args: argparse.Namespace):
         )  # fmt: skip
         options = {}
         default_mu = PLAN_DEFAULT_MU
+    alias = (args.hand or "").lower()
+    preshape = {**PLAN_PRESHAPES.get(alias, {}), **dict(args.preshape)}
+    if preshape:
+        _apply_preshape(plant, context, body, hand, preshape, given=dict(args.preshape))
     options["mu"] = (
         default_mu
         if args.mu is None
@@ -971,6 +994,84 @@ def _plan_setup(args: argparse.Namespace):
         else args.mu
     )
     return plant, context, body, hand, options
+
+
+def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
+    """Set the hand's open shape in ``context``: ``values`` maps joints to positions.
+
+    A joint is named as in the model (``joint_12``) or scoped
+    (``model::joint_12``); it must be a one-degree-of-freedom joint that moves
+    a body of the hand, and the value a finite number within its limits.  A
+    parallel jaw takes none: it opens fully.  ``given`` are the ones the user
+    wrote (``--preshape``), named in a refusal.
+    """
+    import numpy as np
+
+    from drakegrasp.planning.multifinger import hand_is_parallel_jaw
+    from drakegrasp.plant.validation import hand_bodies, plant_context_of
+
+    ctx = plant_context_of(plant, context)
+    if given and hand_is_parallel_jaw(plant, ctx, body, hand):
+        raise InvalidOptionError(
+            "--preshape is for multi-finger hands; a parallel jaw opens fully "
+            "and closes along its chord"
+        )
+    moved = {b.index() for b in hand_bodies(plant, body, hand)}
+    q = plant.GetPositions(ctx)
+    for name, value in values.items():
+        model, sep, joint_name = name.rpartition("::")
+        matches = [
+            j
+            for j in (plant.get_joint(i) for i in plant.GetJointIndices())
+            if j.name() == joint_name
+            and (not sep or plant.GetModelInstanceName(j.model_instance()) == model)
+            and j.child_body().index() in moved
+        ]
+        if len(matches) != 1:
+            how = "no joint of the hand" if not matches else "several joints"
+            raise InvalidOptionError(
+                f"--preshape {name}: {how} is named {name!r}; the hand's joints "
+                f"are {_hand_joint_names(plant, moved)}"
+            )
+        joint = matches[0]
+        if joint.num_positions() != 1:
+            raise InvalidOptionError(
+                f"--preshape {name}: the joint has {joint.num_positions()} "
+                "positions; a pre-shape sets one-degree-of-freedom joints"
+            )
+        low = float(joint.position_lower_limits()[0])
+        high = float(joint.position_upper_limits()[0])
+        if not (np.isfinite(value) and low <= value <= high):
+            raise InvalidOptionError(
+                f"--preshape {name}={value:g} is outside the joint's limits "
+                f"[{low:g}, {high:g}]"
+            )
+        q[joint.position_start()] = value
+    plant.SetPositions(ctx, q)
+
+
+def _hand_joint_names(plant, moved: set) -> list[str]:
+    """The one-degree-of-freedom joints that move a body of the hand."""
+    return [
+        j.name()
+        for j in (plant.get_joint(i) for i in plant.GetJointIndices())
+        if j.child_body().index() in moved and j.num_positions() == 1
+    ]
+
+
+def _joint_value(text: str) -> tuple[str, float]:
+    """``--preshape NAME=VALUE``: a joint's name and a finite position."""
+    name, sep, value = text.partition("=")
+    try:
+        number = float(value)
+    except ValueError:
+        number = float("nan")
+    if not sep or not name or not math.isfinite(number):
+        raise argparse.ArgumentTypeError(
+            f"expected JOINT=VALUE (a joint's name, '=', a finite position in "
+            f"rad or m), got {text!r}"
+        )
+    return name, number
 
 
 PLAN_DEFAULT_MU = 0.5
@@ -1184,6 +1285,17 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         help="multi-finger hands: the torque per finger joint (N·m) the hand "
         "will apply; candidates held within it rank first (default: the "
         "actuators' effort limits)",
+    )
+    plan.add_argument(
+        "--preshape",
+        type=_joint_value,
+        action="append",
+        default=[],
+        metavar="JOINT=VALUE",
+        help="multi-finger hands: the open hand's position of a joint (rad or "
+        "m, within its limits; repeatable; 'model::joint' where names repeat); "
+        "default the model's, and for --hand allegro the thumb opposed "
+        "(joint_12=1.0)",
     )
     _add_scene_file_options(
         plan,

@@ -43,6 +43,7 @@ from drakegrasp.core.validation import (
     check_coefficient,
     check_distance_tolerance,
     check_flag,
+    describe,
     real_scalar,
 )
 from drakegrasp.errors import InvalidOptionError, ModelError
@@ -409,7 +410,12 @@ def plan_grasps(
                 tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY, torque_limit=torque_limit,
             )  # fmt: skip
-        _no_torque_limit(torque_limit)
+        _multifinger_only(
+            torque_limit=(torque_limit, None), preshape=(preshape, None),
+            synergy=(synergy, None), synergy_range=(synergy_range, (0.0, 1.0)),
+            approach=(approach, None), standoff=(standoff, None),
+            tilt=(tilt, DEFAULT_TILT), min_fingers=(min_fingers, 2),
+        )  # fmt: skip
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
         X_WO = plant.EvalBodyPoseInWorld(ctx, body)
@@ -436,7 +442,12 @@ def plan_grasps(
                 progress=progress, weight=mass * GRAVITY,
                 complete=complete_unseen, torque_limit=torque_limit,
             )  # fmt: skip
-        _no_torque_limit(torque_limit)
+        _multifinger_only(
+            torque_limit=(torque_limit, None), preshape=(preshape, None),
+            synergy=(synergy, None), synergy_range=(synergy_range, (0.0, 1.0)),
+            approach=(approach, None), standoff=(standoff, None),
+            tilt=(tilt, DEFAULT_TILT), min_fingers=(min_fingers, 2),
+        )  # fmt: skip
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface, completion = cloud_surface(points, normals, viewpoint, complete_unseen)
         X_WO = RigidTransform(surface.origin)
@@ -547,14 +558,35 @@ def _graspable(plant, object_body, hand) -> RigidBody:
     return body
 
 
-def _no_torque_limit(torque_limit) -> None:
-    """A parallel jaw takes no ``torque_limit``: say so."""
-    if torque_limit is not None:
-        raise InvalidOptionError(
-            "torque_limit applies to multi-finger hands (their torque_needed, "
-            "N·m per joint); a parallel jaw's squeeze_needed is in N: leave "
-            f"torque_limit out (got {torque_limit!r})"
-        )
+def _multifinger_only(**given) -> None:
+    """A parallel jaw takes none of the multi-finger options: say so.
+
+    ``given`` maps each such option to ``(value, default)``; one that is not
+    its default is refused (a parallel jaw opens fully along its stroke and
+    approaches along the chord: a pre-shape, synergy, approach, stand-off,
+    tilt or finger count would be ignored without a word).
+    """
+    for name, (value, default) in given.items():
+        if not _is_default(value, default):
+            remedy = (
+                "a parallel jaw's squeeze_needed is in N"
+                if name == "torque_limit"
+                else "a parallel jaw opens fully and closes along its chord"
+            )
+            raise InvalidOptionError(
+                f"{name} applies to multi-finger hands; {remedy}: leave {name} "
+                f"out (got {describe(value)})"
+            )
+
+
+def _is_default(value, default) -> bool:
+    """Whether ``value`` is ``default`` (None, or equal numbers)."""
+    if default is None or value is None:
+        return value is default
+    try:
+        return bool(np.array_equal(np.asarray(value, float), np.asarray(default)))
+    except (TypeError, ValueError):
+        return False
 
 
 def _close_on_body(closer: BodyCloser, X_WH, opening):

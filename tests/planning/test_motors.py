@@ -371,3 +371,43 @@ def test_a_torque_limit_orders_a_hand_without_effort_limits(
     )  # fmt: skip
     held = [c.torque_needed <= 0.5 for c in ranked]
     assert held == sorted(held, reverse=True) and 0 < sum(held) < 30
+
+
+@pytest.mark.parametrize(
+    "option",
+    [
+        {"preshape": [0.01, 0.01]},
+        {"synergy": "curl"},
+        {"synergy_range": (0.0, 0.5)},
+        {"approach": [0.0, 0.0, 1.0]},
+        {"standoff": (0.0, 0.01)},
+        {"tilt": 0.1},
+        {"min_fingers": 3},
+    ],
+    ids=lambda o: next(iter(o)),
+)
+def test_a_parallel_jaw_refuses_every_multi_finger_option(option):
+    # They were ignored without a word: a jaw opens fully along its chord.
+    from drakegrasp.planning import planning_scene
+
+    scene = planning_scene("package://drakegrasp/objects/box.sdf")
+    name = next(iter(option))
+    with pytest.raises(InvalidOptionError, match=f"{name} applies to multi-finger"):
+        plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=5, mu=0.5, **option,
+        )  # fmt: skip
+
+
+def test_a_parallel_jaw_takes_the_multi_finger_defaults_spelt_out():
+    from drakegrasp.planning import planning_scene
+    from drakegrasp.planning.multifinger import DEFAULT_TILT
+
+    scene = planning_scene("package://drakegrasp/objects/box.sdf")
+    args = (scene.plant, scene.context, scene.object_body)
+    plain = plan_grasps(*args, hand=scene.hand, num_candidates=20, mu=0.5, seed=1)
+    spelt = plan_grasps(
+        *args, hand=scene.hand, num_candidates=20, mu=0.5, seed=1,
+        synergy_range=[0.0, 1.0], tilt=DEFAULT_TILT, min_fingers=2,
+    )  # fmt: skip
+    assert [c.d_star for c in plain] == [c.d_star for c in spelt]

@@ -186,3 +186,68 @@ def test_plan_a_scene_refuses_hand(tmp_path, capsys):
     assert "--hand is for an object" in capsys.readouterr().err
     # (a shipped scene, whose hand is welded to the world, plans:
     # test_plan_cli_scenes.py)
+
+
+def _preshape_seen(monkeypatch):
+    """The thumb's angle in the context ``plan_grasps`` receives, recorded."""
+    import drakegrasp.planning as planning
+    from drakegrasp.plant.validation import plant_context_of
+
+    seen = {}
+    real = planning.plan_grasps
+
+    def spy(plant, context, *args, **kwargs):
+        ctx = plant_context_of(plant, context)
+        seen["joint_12"] = plant.GetJointByName("joint_12").get_angle(ctx)
+        return real(plant, context, *args, **kwargs)
+
+    monkeypatch.setattr(planning, "plan_grasps", spy)
+    return seen
+
+
+@pytest.mark.parametrize(
+    ("extra", "angle"),
+    [([], 1.0), (["--preshape", "joint_12=0.5"], 0.5),
+     (["--preshape", "allegro_hand_right::joint_12=1.2"], 1.2)],
+)  # fmt: skip
+def test_plan_allegro_starts_with_its_thumb_opposed(
+    capsys, drake_models_dir, monkeypatch, extra, angle
+):
+    # The model's zero is outside the thumb joint's limits: clipped, the thumb
+    # lay beside the index finger (box, 100 poses: 0 force closure, now 2).
+    monkeypatch.setenv("DRAKEGRASP_DRAKE_MODELS", str(drake_models_dir))
+    seen = _preshape_seen(monkeypatch)
+    argv = ["plan", "box", "--hand", "Allegro", "--num", "3", *extra]
+    assert main(argv) == 0, capsys.readouterr().err
+    assert seen["joint_12"] == angle
+    assert "grasp candidates of box::box from 3 samples" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("extra", "says"),
+    [
+        (["--hand", "allegro", "--preshape", "joint_12=3"],
+         "--preshape joint_12=3 is outside the joint's limits [0.263, 1.396]"),
+        (["--hand", "allegro", "--preshape", "thumb=1"],
+         "--preshape thumb: no joint of the hand is named 'thumb'"),
+        (["--hand", "allegro", "--preshape", "box::joint_12=1"],
+         "no joint of the hand is named 'box::joint_12'"),
+        (["--hand", "wsg", "--preshape", "left_finger_sliding_joint=0.01"],
+         "--preshape is for multi-finger hands"),
+    ],
+)  # fmt: skip
+def test_plan_preshape_errors_name_the_flag(
+    capsys, drake_models_dir, monkeypatch, extra, says
+):
+    monkeypatch.setenv("DRAKEGRASP_DRAKE_MODELS", str(drake_models_dir))
+    assert main(["plan", "box", "--num", "3", *extra]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and says in err
+
+
+@pytest.mark.parametrize("bad", ["joint_12", "joint_12=nan", "=1", "joint_12=inf"])
+def test_plan_preshape_must_be_joint_equals_a_finite_value(capsys, bad):
+    with pytest.raises(SystemExit) as exit_:
+        main(["plan", "--preshape", bad])
+    assert exit_.value.code == 2
+    assert "expected JOINT=VALUE" in capsys.readouterr().err

@@ -101,7 +101,8 @@ def test_soft_fingers_without_nu_ask_for_the_flag(capsys, grasps, tmp_path):
 
 
 def test_a_wrong_hand_alias_lists_the_aliases_and_suggests_one(capsys):
-    err = _one_line(capsys, "plan", "box", "--hand", "WSG", "--num", "1")
+    # (an alias in other letter case is taken: "WSG", "Allegro")
+    err = _one_line(capsys, "plan", "box", "--hand", "wsg50", "--num", "1")
     assert "did you mean 'wsg'?" in err
     assert all(alias in err for alias in PLAN_HANDS)
 
