@@ -375,9 +375,10 @@ def _check_values(args: argparse.Namespace) -> None:
     checked before any work so that the one line says ``--tol must be ...``
     where the library, given the keyword, says ``tol must be ...``.
     """
+    form = getattr(args, "kind", None) == "form"  # batch --kind form ignores them
     for name, check in _value_checks().items():
         value = getattr(args, name, None)
-        if value is None:
+        if value is None or (form and name in ("mu", "torsional_friction")):
             continue
         try:
             check(value)
@@ -409,8 +410,11 @@ def _cli_words(message: str, command: str | None) -> str:
     soft fingers without a ``ν`` name ``--torsional-friction`` or the scene's
     key; a ``DRAKEGRASP_DRAKE_MODELS`` folder that lacks a model is named.
     """
+    # the library's remedy phrase only: a path may hold any words
     message = re.sub(
-        r"overwrite=True(?: \(drakegrasp batch --overwrite\))?", "--overwrite", message
+        r"pass overwrite=True(?: \(drakegrasp batch --overwrite\))? to replace",
+        "pass --overwrite to replace",
+        message,
     )
     if message.startswith(_SOFT_FINGER_NEEDS_NU) and command in _SOFT_FINGER_REMEDY:
         return _SOFT_FINGER_REMEDY[command]
@@ -418,7 +422,10 @@ def _cli_words(message: str, command: str | None) -> str:
         from drakegrasp.plant.models import DRAKE_MODELS_ENV
 
         folder = os.environ.get(DRAKE_MODELS_ENV)
-        if folder:
+        # the folder is blamed only when it lacks the model's whole directory
+        # (wsg_50_description/), not for a file name misspelt in the URL
+        first = re.search(r"package://drake_models/([^/\s'\"]+)/", message)
+        if folder and first and not (Path(folder) / first.group(1)).is_dir():
             message += (
                 f" ({DRAKE_MODELS_ENV} is set to {folder!r}, which does not hold "
                 "this model: point it at a local copy of the drake_models "
@@ -546,16 +553,14 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _version() -> str:
-    """The version of drakegrasp: the installed distribution's, else ``__version__``."""
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as installed
+    """The version of the drakegrasp that is running (``drakegrasp.__version__``).
 
-    try:
-        return installed("drakegrasp")
-    except PackageNotFoundError:  # run from a source tree that is not installed
-        import drakegrasp
+    Not the installed distribution's metadata: a source tree on ``PYTHONPATH``
+    or a stale editable install would report another version than the code's.
+    """
+    import drakegrasp
 
-        return str(getattr(drakegrasp, "__version__", "unknown"))
+    return drakegrasp.__version__
 
 
 class _Version(argparse.Action):
@@ -1007,7 +1012,7 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
     """
     import numpy as np
 
-    from drakegrasp.planning.multifinger import hand_is_parallel_jaw
+    from drakegrasp.planning import hand_is_parallel_jaw
     from drakegrasp.plant.validation import hand_bodies, plant_context_of
 
     ctx = plant_context_of(plant, context)

@@ -9,11 +9,12 @@ contact.  See ``docs/conventions.md`` for every sign and ordering used here.
 from __future__ import annotations
 
 import enum
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from drakegrasp.core.deprecation import warn_deprecated
+from drakegrasp.core.deprecation import replaced_object, warn_deprecated
 from drakegrasp.core.validation import (
     check_coefficient,
     check_positions,
@@ -183,7 +184,9 @@ def _deprecated_model(contact_model, deprecated: dict, where: str) -> ContactMod
             f"{where} got both model= (deprecated) and contact_model=; give "
             "contact_model= only"
         )
-    warn_deprecated(f"{where}: model= is deprecated; use contact_model=", stacklevel=4)
+    warn_deprecated(
+        f"{where}: model= is deprecated; use contact_model=", stacklevel=None
+    )
     # Parsed here: model=None is refused as it always was, not read as the default.
     return ContactModel.parse(deprecated["model"])
 
@@ -251,6 +254,10 @@ class Contact:
         torsional_friction: float | None = None,
         **deprecated,
     ) -> None:
+        if "model" in deprecated:  # dataclasses.replace(c, model=) passes c's own
+            replaced = replaced_object(sys._getframe(1))
+            if replaced is not None and contact_model is replaced.contact_model:
+                contact_model = _DEFAULT_MODEL
         contact_model = _deprecated_model(contact_model, deprecated, "Contact()")
         p = check_positions("contact position", position)
         if p.ndim > 1 and p.size in (2, 3):

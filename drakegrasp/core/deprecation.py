@@ -19,7 +19,7 @@ from typing import TypeVar
 
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["keyword_only", "renamed_keyword", "warn_deprecated"]
+__all__ = ["keyword_only", "renamed_keyword", "replaced_object", "warn_deprecated"]
 
 F = TypeVar("F", bound=Callable)
 
@@ -88,8 +88,12 @@ def _renamed(
     """``function`` taking ``old=`` for ``new=`` (see :func:`renamed_keyword`).
 
     ``fields`` are a dataclass's init fields: ``dataclasses.replace(x, old=v)``
-    passes every one of them by name, ``new`` included, and is told apart from
-    a call that gives both spellings by that (``old`` then replaces ``new``).
+    passes every one of them by name, ``new`` included (x's own value).  Such
+    a call is recognised by its caller, ``dataclasses``' own frame, and the
+    value of ``new`` by being x's very object: ``old`` then replaces it.  A
+    ``new`` the user gave is another object, refused with ``old`` as in any
+    other call (x's own object given again cannot be told apart: ``old``
+    wins, with its warning).
     """
     parameters = list(inspect.signature(function).parameters.values())
     names = [p.name for p in parameters]
@@ -108,13 +112,12 @@ def _renamed(
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
         if old in kwargs:
-            replacing = (
-                fields is not None
-                and len(args) <= 1  # self only
-                and set(fields) <= set(kwargs)
-            )
-            if replacing:
-                kwargs.pop(new)
+            if fields is not None and new in kwargs:
+                replaced = replaced_object(sys._getframe(1))
+                if replaced is not None and kwargs[new] is getattr(
+                    replaced, new, kwargs
+                ):
+                    kwargs.pop(new)  # x's own value, filled in by replace
             if new in kwargs or (place is not None and len(args) > place):
                 raise InvalidOptionError(
                     f"{where} got both {old}= (deprecated) and {new}= (or "
@@ -127,6 +130,18 @@ def _renamed(
         return function(*args, **kwargs)
 
     return wrapper  # type: ignore[return-value]
+
+
+def replaced_object(frame):
+    """The object a ``dataclasses.replace`` running in ``frame`` copies, or None.
+
+    ``frame`` is the caller of a dataclass's constructor: ``dataclasses.replace``
+    (its local ``obj``) when the constructor is called to replace fields;
+    None for any other caller.
+    """
+    if frame is None or frame.f_globals.get("__name__") != "dataclasses":
+        return None
+    return frame.f_locals.get("obj", frame.f_locals.get("self"))
 
 
 def keyword_only(*names: str, after: int) -> Callable[[F], F]:

@@ -143,6 +143,33 @@ def _differences(old: dict, new: dict) -> str:
     return "another job (differs in " + ", ".join(changed) + ")"
 
 
+def _check_creatable(output_dir: Path) -> None:
+    """Refuse a directory that ``mkdir(parents=True)`` could not make.
+
+    Its nearest existing ancestor must be a directory this process may write
+    in, and the path itself not a dangling symbolic link (which ``exists()``
+    calls absent).
+    """
+    if output_dir.is_symlink():
+        raise BatchFileError(
+            f"output {str(output_dir)!r} is a symbolic link to nothing; name a "
+            "directory"
+        )
+    parent = output_dir.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise BatchFileError(
+            f"cannot create the output directory {str(output_dir)!r}: "
+            f"{str(parent)!r} is not a directory"
+        )
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise BatchFileError(
+            f"cannot create the output directory {str(output_dir)!r}: "
+            f"{str(parent)!r} is not writable"
+        )
+
+
 def prepare_dataset(
     output_dir, manifest: dict, *, overwrite: bool, create: bool = True
 ) -> Path:
@@ -169,6 +196,7 @@ def prepare_dataset(
             "dataset directory of Parquet shards: name a directory"
         )
     if not create and not output_dir.exists():
+        _check_creatable(output_dir)
         return output_dir
     if create:
         output_dir.mkdir(parents=True, exist_ok=True)

@@ -324,3 +324,28 @@ def test_dataclasses_replace_with_the_old_keyword_replaces_the_model(recwarn):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert dataclasses.replace(dg.AnalysisOptions(), mu=0.3).mu == 0.3
+
+
+def test_replace_refuses_both_spellings_and_a_contact_is_replaced_too():
+    # The replace detection dropped a contact_model the user gave with model=.
+    import dataclasses
+
+    o = dg.AnalysisOptions(mu=0.5)
+    for call in (
+        lambda: o.replace(model="frictionless", contact_model="soft_finger"),
+        lambda: dataclasses.replace(
+            o, model="frictionless", contact_model="soft_finger"
+        ),
+        lambda: dg.BatchOptions().replace(
+            model="frictionless", contact_model="soft_finger"
+        ),
+    ):
+        with pytest.raises(dg.InvalidOptionError, match="both model="):
+            call()
+    c = dg.Contact([0, 0, 1], [0, 0, -1], mu=0.5)
+    with pytest.warns(DeprecationWarning) as record:
+        f = dataclasses.replace(c, model="frictionless")
+    assert f.contact_model is dg.ContactModel.FRICTIONLESS
+    assert record[0].filename == __file__
+    with pytest.raises(dg.InvalidOptionError, match="both model="):
+        dataclasses.replace(c, model="frictionless", contact_model="soft_finger")

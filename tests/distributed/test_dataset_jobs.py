@@ -306,3 +306,24 @@ def test_a_foreign_dataset_is_refused_before_connecting(tmp_path, monkeypatch):
     with pytest.raises(BatchFileError, match="overwrite=True"):
         evaluate_on_cluster("tcp://nowhere:1", P, Nrm, mu=mu, output_dir=out)
     assert sorted(p.name for p in out.iterdir()) == [MANIFEST]
+
+
+@pytest.mark.parametrize("where", ["under a file", "dangling link"])
+def test_an_output_that_cannot_be_made_is_refused_before_connecting(
+    tmp_path, monkeypatch, where
+):
+    from drakegrasp.distributed import batch_side
+
+    def unexpected(_client):
+        raise AssertionError("connected before checking the output")
+
+    monkeypatch.setattr(batch_side, "connected", unexpected)
+    if where == "under a file":
+        (tmp_path / "afile").write_text("")
+        out, says = tmp_path / "afile" / "ds", "is not a directory"
+    else:
+        out, says = tmp_path / "link", "symbolic link to nothing"
+        out.symlink_to(tmp_path / "gone")
+    P, Nrm, mu = _grasps(5, 10)
+    with pytest.raises(BatchFileError, match=says):
+        evaluate_on_cluster("tcp://nowhere:1", P, Nrm, mu=mu, output_dir=out)

@@ -15,6 +15,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+import drakegrasp as dg
 from drakegrasp.cli import PLAN_HANDS, build_parser, main
 from drakegrasp.plant.scene import DEFAULT_SCENE, scene_path
 
@@ -134,8 +135,9 @@ def test_version(capsys):
     with pytest.raises(SystemExit) as exit_:
         main(["--version"])
     assert exit_.value.code == 0
-    version = importlib.metadata.version("drakegrasp")
-    assert capsys.readouterr().out == f"drakegrasp {version}\n"
+    # the running code's version, which the installed metadata agrees with
+    assert capsys.readouterr().out == f"drakegrasp {dg.__version__}\n"
+    assert importlib.metadata.version("drakegrasp") == dg.__version__
 
 
 def test_a_wrong_drake_models_variable_is_reported_as_set(capsys, monkeypatch):
@@ -159,3 +161,31 @@ def test_warmup_promises_what_it_measured(capsys, monkeypatch):
     _, sub = build_parser()
     description = sub.choices["warmup"].description
     assert "under a minute" in description and "minute or two" not in description
+
+
+def test_a_path_holding_the_keyword_is_not_rewritten(capsys, grasps, tmp_path):
+    # The rewrite of the library's remedy reached into the user's path.
+    src, _ = grasps
+    odd = tmp_path / "keep overwrite=True"
+    odd.mkdir()
+    out = str(odd / "r.npz")
+    assert main(["batch", src, out, "--mu", "0.5"]) == 0
+    capsys.readouterr()
+    err = _one_line(capsys, "batch", src, out, "--mu", "0.5")
+    assert repr(out) in err and "pass --overwrite to replace it" in err
+
+
+@pytest.mark.parametrize("mu", ["1e-13", "2e12"])
+def test_batch_form_closure_ignores_mu_as_its_help_says(capsys, grasps, mu):
+    # --kind form ignores --mu: refusing its value was a regression.
+    src, out = grasps
+    assert main(["batch", src, out, "--kind", "form", "--mu", mu]) == 0
+
+
+def test_a_misspelt_model_file_does_not_blame_the_folder(
+    capsys, drake_models_dir, monkeypatch
+):
+    monkeypatch.setenv("DRAKEGRASP_DRAKE_MODELS", str(drake_models_dir))
+    url = "package://drake_models/wsg_50_description/sdf/nonexistent.sdf"
+    err = _one_line(capsys, "plan", "box", "--hand", url, "--num", "1")
+    assert "nonexistent.sdf" in err and "DRAKEGRASP_DRAKE_MODELS is set" not in err
