@@ -397,6 +397,11 @@ def plan_grasps(
     }
     if torque_limit is not None:
         settings["torque_limit"] = torque_limit
+    multi = dict(
+        preshape=preshape, synergy=synergy, synergy_range=synergy_range,
+        approach=approach, standoff=standoff, tilt=tilt, min_fingers=min_fingers,
+        torque_limit=torque_limit,
+    )  # fmt: skip
     if point_cloud is None:
         body = _graspable(plant, object_body, hand)
         if not hand_is_parallel_jaw(plant, ctx, body, hand):
@@ -405,17 +410,10 @@ def plan_grasps(
                 plant, ctx, body, hand=hand, n=n, mu=mu,
                 rng=np.random.default_rng(seed),
                 surface=object_surface(plant, ctx, body), settings=settings, t0=t0,
-                name=scoped_name(plant, body), preshape=preshape, synergy=synergy,
-                synergy_range=synergy_range, approach=approach, standoff=standoff,
-                tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
-                progress=progress, weight=mass * GRAVITY, torque_limit=torque_limit,
+                name=scoped_name(plant, body), certify=certify, workers=workers,
+                progress=progress, weight=mass * GRAVITY, **multi,
             )  # fmt: skip
-        _multifinger_only(
-            torque_limit=(torque_limit, None), preshape=(preshape, None),
-            synergy=(synergy, None), synergy_range=(synergy_range, (0.0, 1.0)),
-            approach=(approach, None), standoff=(standoff, None),
-            tilt=(tilt, DEFAULT_TILT), min_fingers=(min_fingers, 2),
-        )  # fmt: skip
+        _multifinger_only(multi)
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
         X_WO = plant.EvalBodyPoseInWorld(ctx, body)
@@ -436,18 +434,11 @@ def plan_grasps(
             return plan_multifinger_cloud(
                 plant, ctx, hand=hand, points=points, normals=normals,
                 viewpoint=viewpoint, n=n, mu=mu, rng=np.random.default_rng(seed),
-                settings=settings, t0=t0, preshape=preshape, synergy=synergy,
-                synergy_range=synergy_range, approach=approach, standoff=standoff,
-                tilt=tilt, min_fingers=min_fingers, certify=certify, workers=workers,
-                progress=progress, weight=mass * GRAVITY,
-                complete=complete_unseen, torque_limit=torque_limit,
+                settings=settings, t0=t0, certify=certify, workers=workers,
+                progress=progress, weight=mass * GRAVITY, complete=complete_unseen,
+                **multi,
             )  # fmt: skip
-        _multifinger_only(
-            torque_limit=(torque_limit, None), preshape=(preshape, None),
-            synergy=(synergy, None), synergy_range=(synergy_range, (0.0, 1.0)),
-            approach=(approach, None), standoff=(standoff, None),
-            tilt=(tilt, DEFAULT_TILT), min_fingers=(min_fingers, 2),
-        )  # fmt: skip
+        _multifinger_only(multi)
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface, completion = cloud_surface(points, normals, viewpoint, complete_unseen)
         X_WO = RigidTransform(surface.origin)
@@ -558,15 +549,31 @@ def _graspable(plant, object_body, hand) -> RigidBody:
     return body
 
 
-def _multifinger_only(**given) -> None:
+_MULTI_FINGER_DEFAULTS = {
+    "preshape": None,
+    "synergy": None,
+    "synergy_range": (0.0, 1.0),
+    "approach": None,
+    "standoff": None,
+    "tilt": DEFAULT_TILT,
+    "min_fingers": 2,
+    "torque_limit": None,
+}
+"""The options of :func:`plan_grasps` that only a multi-finger hand reads, and
+their defaults (a parallel jaw refuses any other value)."""
+
+
+def _multifinger_only(given: dict) -> None:
     """A parallel jaw takes none of the multi-finger options: say so.
 
-    ``given`` maps each such option to ``(value, default)``; one that is not
-    its default is refused (a parallel jaw opens fully along its stroke and
-    approaches along the chord: a pre-shape, synergy, approach, stand-off,
-    tilt or finger count would be ignored without a word).
+    ``given`` maps each option of :data:`_MULTI_FINGER_DEFAULTS` to its
+    value; one that is not its default is refused (a parallel jaw opens fully
+    along its stroke and approaches along the chord: a pre-shape, synergy,
+    approach, stand-off, tilt or finger count would be ignored without a
+    word).
     """
-    for name, (value, default) in given.items():
+    for name, default in _MULTI_FINGER_DEFAULTS.items():
+        value = given[name]
         if not _is_default(value, default):
             remedy = (
                 "a parallel jaw's squeeze_needed is in N"
