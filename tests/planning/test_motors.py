@@ -390,7 +390,10 @@ def test_a_parallel_jaw_refuses_every_multi_finger_option(option):
     # They were ignored without a word: a jaw opens fully along its chord.
     from drakegrasp.planning import planning_scene
 
-    scene = planning_scene("package://drakegrasp/objects/box.sdf")
+    scene = planning_scene(  # drakegrasp's own jaw: no drake_models needed
+        "package://drakegrasp/objects/box.sdf",
+        hand_url="package://drakegrasp/hands/parallel_jaw_flat.sdf",
+    )
     name = next(iter(option))
     with pytest.raises(InvalidOptionError, match=f"{name} applies to multi-finger"):
         plan_grasps(
@@ -403,7 +406,10 @@ def test_a_parallel_jaw_takes_the_multi_finger_defaults_spelt_out():
     from drakegrasp.planning import planning_scene
     from drakegrasp.planning.multifinger import DEFAULT_TILT
 
-    scene = planning_scene("package://drakegrasp/objects/box.sdf")
+    scene = planning_scene(  # drakegrasp's own jaw: no drake_models needed
+        "package://drakegrasp/objects/box.sdf",
+        hand_url="package://drakegrasp/hands/parallel_jaw_flat.sdf",
+    )
     args = (scene.plant, scene.context, scene.object_body)
     plain = plan_grasps(*args, hand=scene.hand, num_candidates=20, mu=0.5, seed=1)
     spelt = plan_grasps(
