@@ -4,6 +4,7 @@ Usage::
 
     NUMBA_CACHE_DIR=$(mktemp -d) PYTHONPATH=TREE python benchmarks/check_bitwise.py \
         record OUT.npz [--grasps 3000]
+    PYTHONPATH=TREE python benchmarks/check_bitwise.py single OUT.npz [--grasps 150]
     python benchmarks/check_bitwise.py compare A.npz B.npz
     PYTHONPATH=TREE python benchmarks/check_bitwise.py plan [--num 1500] [--seed 0]
 
@@ -16,6 +17,10 @@ with a per-grasp μ and a per-contact μ on the hard fingers.  Run it once per
 tree, each in a fresh process with an empty ``NUMBA_CACHE_DIR`` (so each tree's
 kernels are compiled from its own sources), then ``compare`` prints, per array,
 the number of elements that differ in any bit (NaNs equal where both are NaN).
+
+``single`` decides ``--grasps`` seeded single grasps of 2-6 contacts with the
+Drake programs (``force_closure``, ``form_closure``: the route of
+``analyze_grasp``) and records d* and the solver status, for ``compare``.
 
 ``plan`` runs ``plan_grasps`` with the WSG-50 on the seven objects of
 ``bench_plan.py`` (``--num`` samples, ``--seed``, one core) and prints, per
@@ -89,6 +94,42 @@ def record(out: str, K: int) -> None:
     np.savez(out, **arrays)
 
 
+def single(out: str, K: int) -> None:
+    """d* and status of ``K`` seeded single grasps through the Drake programs.
+
+    Grasps of 2 to 6 contacts, cycling hard, soft and frictionless fingers
+    (every fifth planar, hard or frictionless), each decided by
+    ``force_closure`` (``form_closure`` when frictionless): the route of
+    ``analyze_grasp``, with its row space, equilibration and Clp.
+    """
+    import drakegrasp as dg
+
+    rng = np.random.default_rng(0)
+    d_star, status = np.full(K, np.nan), np.zeros(K, dtype="U40")
+    for i in range(K):
+        N, planar = int(rng.integers(2, 7)), i % 5 == 4
+        d = 2 if planar else 3
+        P = rng.normal(size=(N, d)) * 0.05
+        Nr = -P / np.linalg.norm(P, axis=1, keepdims=True)
+        Nr += 0.3 * rng.normal(size=(N, d))
+        Nr /= np.linalg.norm(Nr, axis=1, keepdims=True)
+        models = ("hard_finger", "frictionless") if planar else (
+            "hard_finger", "soft_finger", "frictionless")  # fmt: skip
+        model = models[i % len(models)]
+        kw = {} if model == "frictionless" else {"mu": 0.5}
+        if model == "soft_finger":
+            kw["torsional_friction"] = 0.01
+        contacts = [
+            dg.Contact(p, q, contact_model=model, **kw)
+            for p, q in zip(P, Nr, strict=True)
+        ]
+        g = dg.Grasp(contacts, reference_point=np.zeros(d))
+        r = dg.form_closure(g) if model == "frictionless" else dg.force_closure(g)
+        d_star[i], status[i] = r.d_star, str(r.status)
+    print(f"{K} grasps, {int(np.sum(d_star > 1e-6))} with d* > 1e-6", flush=True)
+    np.savez(out, **{"single/d_star": d_star, "single/status": status})
+
+
 def compare(a: str, b: str) -> int:
     A, B = np.load(a), np.load(b)
     bad = 0
@@ -153,12 +194,18 @@ def main() -> int:
     c = sub.add_parser("compare")
     c.add_argument("a")
     c.add_argument("b")
+    si = sub.add_parser("single")
+    si.add_argument("out")
+    si.add_argument("--grasps", type=int, default=150)
     pl = sub.add_parser("plan")
     pl.add_argument("--num", type=int, default=1500)
     pl.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     if args.cmd == "plan":
         plan_hashes(args.num, args.seed)
+        return 0
+    if args.cmd == "single":
+        single(args.out, args.grasps)
         return 0
     if args.cmd == "record":
         record(args.out, args.grasps)
