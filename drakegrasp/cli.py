@@ -386,9 +386,6 @@ def _check_values(args: argparse.Namespace) -> None:
             raise _in_flag_words(e, {name: _flag(name)}) from None
 
 
-_SOFT_FINGER_NEEDS_NU = "contact_model='soft_finger' needs torsional_friction"
-"""How the library's refusal of soft fingers without a ``ν`` starts."""
-
 _SOFT_FINGER_REMEDY = {
     "analyze": "soft fingers (--contact-model soft_finger, or the scene's "
     "contact_model:) need a torsional friction nu: give --torsional-friction NU "
@@ -396,11 +393,9 @@ _SOFT_FINGER_REMEDY = {
     "batch": "--contact-model soft_finger needs a torsional friction nu: give "
     "--torsional-friction NU or the input's array torsional_friction (0 makes "
     "soft fingers act as hard ones)",
-    "plan": "the scene's contact_model: soft_finger needs a torsional friction "
-    "nu: give torsional_friction: in its drakegrasp: section (0 makes soft "
-    "fingers act as hard ones); plan has no flag for it",
 }
-"""The refusal of soft fingers without a ``ν``, in each command's words."""
+"""The refusal of soft fingers without a ``ν``, in each command's words (a
+scene file's soft finger without one is refused by the file's own check)."""
 
 
 def _cli_words(message: str, command: str | None) -> str:
@@ -416,7 +411,10 @@ def _cli_words(message: str, command: str | None) -> str:
         "pass --overwrite to replace",
         message,
     )
-    if message.startswith(_SOFT_FINGER_NEEDS_NU) and command in _SOFT_FINGER_REMEDY:
+    from drakegrasp.core.contact import missing_torsional_friction
+
+    # the library's one refusal of soft fingers without a ν, in flag words
+    if message == str(missing_torsional_friction()) and command in _SOFT_FINGER_REMEDY:
         return _SOFT_FINGER_REMEDY[command]
     if "package://drake_models/" in message and "does not exist" in message:
         from drakegrasp.plant.models import DRAKE_MODELS_ENV
@@ -1010,8 +1008,6 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
     parallel jaw takes none: it opens fully.  ``given`` are the ones the user
     wrote (``--preshape``), named in a refusal.
     """
-    import numpy as np
-
     from drakegrasp.planning import hand_is_parallel_jaw
     from drakegrasp.plant.validation import hand_bodies, plant_context_of
 
@@ -1022,21 +1018,26 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
             "and closes along its chord"
         )
     moved = {b.index() for b in hand_bodies(plant, body, hand)}
+    joints = [  # the joints that move a body of the hand
+        j
+        for j in (plant.get_joint(i) for i in plant.GetJointIndices())
+        if j.child_body().index() in moved
+    ]
     q = plant.GetPositions(ctx)
     for name, value in values.items():
         model, sep, joint_name = name.rpartition("::")
         matches = [
             j
-            for j in (plant.get_joint(i) for i in plant.GetJointIndices())
+            for j in joints
             if j.name() == joint_name
             and (not sep or plant.GetModelInstanceName(j.model_instance()) == model)
-            and j.child_body().index() in moved
         ]
         if len(matches) != 1:
             how = "no joint of the hand" if not matches else "several joints"
+            names = [j.name() for j in joints if j.num_positions() == 1]
             raise InvalidOptionError(
                 f"--preshape {name}: {how} is named {name!r}; the hand's joints "
-                f"are {_hand_joint_names(plant, moved)}"
+                f"are {names}"
             )
         joint = matches[0]
         if joint.num_positions() != 1:
@@ -1046,22 +1047,13 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
             )
         low = float(joint.position_lower_limits()[0])
         high = float(joint.position_upper_limits()[0])
-        if not (np.isfinite(value) and low <= value <= high):
+        if not low <= value <= high:  # finite: _joint_value or an alias's
             raise InvalidOptionError(
                 f"--preshape {name}={value:g} is outside the joint's limits "
                 f"[{low:g}, {high:g}]"
             )
         q[joint.position_start()] = value
     plant.SetPositions(ctx, q)
-
-
-def _hand_joint_names(plant, moved: set) -> list[str]:
-    """The one-degree-of-freedom joints that move a body of the hand."""
-    return [
-        j.name()
-        for j in (plant.get_joint(i) for i in plant.GetJointIndices())
-        if j.child_body().index() in moved and j.num_positions() == 1
-    ]
 
 
 def _joint_value(text: str) -> tuple[str, float]:

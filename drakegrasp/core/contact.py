@@ -9,12 +9,11 @@ contact.  See ``docs/conventions.md`` for every sign and ordering used here.
 from __future__ import annotations
 
 import enum
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from drakegrasp.core.deprecation import replaced_object, warn_deprecated
+from drakegrasp.core.deprecation import renamed_keyword, warn_deprecated
 from drakegrasp.core.validation import (
     check_coefficient,
     check_positions,
@@ -156,47 +155,13 @@ def _unit_normal(normal: np.ndarray) -> np.ndarray:
     return unit_vectors("normal", n)
 
 
-class _DefaultModel:
-    """The default of ``contact_model=``: a hard finger, told apart from one given.
-
-    ``model=`` (deprecated) may replace the default but not a model the caller
-    wrote, even a hard finger.
-    """
-
-    def __repr__(self) -> str:
-        return "ContactModel.HARD_FINGER"
-
-
-_DEFAULT_MODEL = _DefaultModel()
-
-
-def _deprecated_model(contact_model, deprecated: dict, where: str) -> ContactModel:
-    """``contact_model``, or the deprecated ``model=`` of ``deprecated`` (warned)."""
-    unknown = set(deprecated) - {"model"}
-    if unknown:
-        raise InvalidOptionError(f"{where} got unexpected keyword(s) {sorted(unknown)}")
-    if "model" not in deprecated:
-        if contact_model is _DEFAULT_MODEL:
-            return ContactModel.HARD_FINGER
-        return contact_model
-    if contact_model is not _DEFAULT_MODEL:
-        raise InvalidOptionError(
-            f"{where} got both model= (deprecated) and contact_model=; give "
-            "contact_model= only"
-        )
-    warn_deprecated(
-        f"{where}: model= is deprecated; use contact_model=", stacklevel=None
-    )
-    # Parsed here: model=None is refused as it always was, not read as the default.
-    return ContactModel.parse(deprecated["model"])
-
-
 def _frozen(a: np.ndarray) -> np.ndarray:
     a = np.array(a, dtype=float)
     a.flags.writeable = False
     return a
 
 
+@renamed_keyword("model", "contact_model")
 @dataclass(frozen=True, eq=False)
 class Contact:
     """One contact between a finger and the object.
@@ -250,15 +215,14 @@ class Contact:
         normal: np.ndarray,
         *,
         mu: float = 0.0,
-        contact_model: ContactModel | str = _DEFAULT_MODEL,  # type: ignore[assignment]
+        contact_model: ContactModel | str = ContactModel.HARD_FINGER,
         torsional_friction: float | None = None,
-        **deprecated,
+        **unknown,
     ) -> None:
-        if "model" in deprecated:  # dataclasses.replace(c, model=) passes c's own
-            replaced = replaced_object(sys._getframe(1))
-            if replaced is not None and contact_model is replaced.contact_model:
-                contact_model = _DEFAULT_MODEL
-        contact_model = _deprecated_model(contact_model, deprecated, "Contact()")
+        if unknown:  # an option error, as checked_fields gives the options objects
+            raise InvalidOptionError(
+                f"Contact() got unexpected keyword(s) {sorted(unknown)}"
+            )
         p = check_positions("contact position", position)
         if p.ndim > 1 and p.size in (2, 3):
             p = p.reshape(-1)
@@ -359,13 +323,6 @@ class Contact:
 
     def with_(self, **changes) -> Contact:
         """Return a copy with some fields replaced (``mu``, ``contact_model``, ...)."""
-        if "model" in changes:
-            changes = dict(changes)
-            changes["contact_model"] = _deprecated_model(
-                changes.pop("contact_model", _DEFAULT_MODEL),
-                {"model": changes.pop("model")},
-                "Contact.with_()",
-            )
         kwargs = {
             "position": self.position,
             "normal": self.normal,
@@ -373,12 +330,14 @@ class Contact:
             "contact_model": self.contact_model,
             "torsional_friction": self.torsional_friction,
         }
-        unknown = set(changes) - set(kwargs)
+        unknown = set(changes) - set(kwargs) - {"model"}
         if unknown:
             raise InvalidContactError(
                 f"Contact has no field(s) {sorted(unknown)}; "
                 f"fields are {sorted(kwargs)}"
             )
+        if "model" in changes:  # the deprecated alias replaces this model
+            del kwargs["contact_model"]  # (Contact() warns, or refuses both)
         kwargs.update(changes)
         position = kwargs.pop("position")
         normal = kwargs.pop("normal")

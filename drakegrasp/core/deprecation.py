@@ -19,7 +19,7 @@ from typing import TypeVar
 
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["keyword_only", "renamed_keyword", "replaced_object", "warn_deprecated"]
+__all__ = ["keyword_only", "renamed_keyword", "warn_deprecated"]
 
 F = TypeVar("F", bound=Callable)
 
@@ -69,13 +69,10 @@ def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
     def decorate(function: F) -> F:
         if inspect.isclass(function):
             cls = function
-            fields = (
-                [f.name for f in dataclasses.fields(cls) if f.init]
-                if dataclasses.is_dataclass(cls)
-                else None
-            )
             where = f"{cls.__qualname__}()"
-            cls.__init__ = _renamed(cls.__init__, old, new, where, fields=fields)
+            cls.__init__ = _renamed(
+                cls.__init__, old, new, where, dataclass=dataclasses.is_dataclass(cls)
+            )
             return cls
         return _renamed(function, old, new, f"{function.__qualname__}()")
 
@@ -83,12 +80,13 @@ def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
 
 
 def _renamed(
-    function: F, old: str, new: str, where: str, *, fields: list[str] | None = None
+    function: F, old: str, new: str, where: str, *, dataclass: bool = False
 ) -> F:
     """``function`` taking ``old=`` for ``new=`` (see :func:`renamed_keyword`).
 
-    ``fields`` are a dataclass's init fields: ``dataclasses.replace(x, old=v)``
-    passes every one of them by name, ``new`` included (x's own value).  Such
+    ``dataclass``: ``function`` is a dataclass's ``__init__``, which
+    ``dataclasses.replace(x, old=v)`` calls with every init field by name,
+    ``new`` included (x's own value).  Such
     a call is recognised by its caller, ``dataclasses``' own frame, and the
     value of ``new`` by being x's very object: ``old`` then replaces it.  A
     ``new`` the user gave is another object, refused with ``old`` as in any
@@ -112,16 +110,17 @@ def _renamed(
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
         if old in kwargs:
-            if fields is not None and new in kwargs:
-                replaced = replaced_object(sys._getframe(1))
+            if dataclass and new in kwargs:
+                replaced = _replaced_object(sys._getframe(1))
                 if replaced is not None and kwargs[new] is getattr(
                     replaced, new, kwargs
                 ):
                     kwargs.pop(new)  # x's own value, filled in by replace
             if new in kwargs or (place is not None and len(args) > place):
+                by_position = "" if place is None else f" (or {new} by position)"
                 raise InvalidOptionError(
-                    f"{where} got both {old}= (deprecated) and {new}= (or "
-                    f"{new} by position); give {new}= only"
+                    f"{where} got both {old}= (deprecated) and {new}="
+                    f"{by_position}; give {new}= only"
                 )
             warn_deprecated(
                 f"{where}: {old}= is deprecated; use {new}=", stacklevel=None
@@ -132,7 +131,7 @@ def _renamed(
     return wrapper  # type: ignore[return-value]
 
 
-def replaced_object(frame):
+def _replaced_object(frame):
     """The object a ``dataclasses.replace`` running in ``frame`` copies, or None.
 
     ``frame`` is the caller of a dataclass's constructor: ``dataclasses.replace``

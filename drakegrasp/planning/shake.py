@@ -58,6 +58,7 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import unit_vectors
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.candidates import GraspCandidate, check_candidate
+from drakegrasp.plant.load import effort_unit
 from drakegrasp.plant.validation import (
     check_rigid_transform,
     resolve_body,
@@ -151,11 +152,6 @@ class ShakeResult:
             f"{_squeeze_unit(self.effort_units)}, "
             f"{len(self.phases)} gravity directions; {self.wall_time:.2f} s wall"
         )
-
-
-def _effort_unit(joint) -> str:
-    """Unit of an actuator's effort on ``joint``: N if it slides, else N·m."""
-    return "N" if joint.type_name() == "prismatic" else "N·m"
 
 
 def _squeeze_unit(units: tuple[str, ...]) -> str:
@@ -475,7 +471,7 @@ def shake_test(
     u = plant.get_net_actuation_output_port().Eval(ctx)
     squeezing = [a for a in actuators if int(a.joint().index()) in targets]
     efforts = tuple(abs(float(u[a.input_start()])) for a in squeezing)
-    effort_units = tuple(_effort_unit(a.joint()) for a in squeezing)
+    effort_units = tuple(effort_unit(a.joint()) for a in squeezing)
     for end in ends:
         d, r = advance(end)
         phases.append(

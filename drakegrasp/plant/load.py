@@ -48,6 +48,7 @@ from drakegrasp.plant.validation import (
 __all__ = [
     "LoadReport",
     "analyze_load",
+    "effort_unit",
     "load_section",
     "gravity_wrench",
     "plant_torque_limits",
@@ -246,6 +247,17 @@ class LoadReport:
         return "\n".join(self.report_lines())
 
 
+def effort_unit(joint, k: int = 0) -> str:
+    """Unit of the generalized force along ``joint``'s velocity ``k``.
+
+    Drake names each velocity by its kind (``velocity_suffix``): an angular
+    one (``w``, ``wx``...: a revolute joint, a floating base's rotation)
+    carries a torque in N·m, a linear one (``v``, ``vx``...: a prismatic
+    joint, a floating base's translation) a force in N; "" for another.
+    """
+    return {"w": "N·m", "v": "N"}.get(joint.velocity_suffix(k)[:1], "")
+
+
 def _velocity_labels(
     plant: MultibodyPlant, velocity_indices
 ) -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -274,7 +286,7 @@ def _velocity_labels(
                 label = f"{joint.name()} {suffix}"
             i = joint.velocity_start() + k
             labels[i] = label
-            units[i] = {"w": "N·m", "v": "N"}.get(suffix[:1], "")
+            units[i] = effort_unit(joint, k)
     return (
         tuple(labels.get(int(v), f"v[{int(v)}]") for v in velocity_indices),
         tuple(units.get(int(v), "") for v in velocity_indices),
