@@ -52,3 +52,37 @@ def test_lp1_lp3_and_socp_builders():
     )
     prog, v = dg.build_exact_force_closure_program(soft)
     assert len(prog.lorentz_cone_constraints()) == 4  # two per soft finger
+
+
+def _sphere_grasp(n: int, **contact) -> dg.Grasp:
+    p = np.random.default_rng(n).normal(size=(n, 3))
+    p /= np.linalg.norm(p, axis=1)[:, None]
+    return dg.Grasp([dg.Contact(x, -x, mu=0.3, **contact) for x in p])
+
+
+def test_large_programs_keep_sparse_generators_and_the_same_forces():
+    # 120 contacts: S has 360 x 960 entries, past the dense limit.  The
+    # forces are the product with S, written one contact's block at a time
+    # (the whole product took 8.6 s to build at 400 contacts).
+    grasp = _sphere_grasp(120)
+    _, v = dg.build_force_closure_program(grasp, formulation="generators")
+    assert hasattr(v.generators, "tocsr") and v.generators.shape == (360, 960)
+    S = v.generators.toarray()
+    with np.errstate(invalid="ignore"):
+        whole = S @ v.weights
+    assert all(a.EqualTo(b) for a, b in zip(whole, v.forces, strict=True))
+    facets = dg.force_closure(grasp)
+    generators = dg.force_closure(grasp, formulation="generators")
+    assert facets.is_closure and generators.is_closure
+    assert np.allclose(
+        dg.grasp_matrix(grasp) @ np.concatenate(generators.contact_forces), 0
+    )
+    # Soft fingers: forces = diag(scales) @ weights, entrywise.
+    soft = _sphere_grasp(130, contact_model="soft_finger", torsional_friction=0.1)
+    _, v = dg.build_force_closure_program(soft)
+    D = v.generators
+    assert hasattr(D, "tocsr") and D.shape == (520, 520)
+    with np.errstate(invalid="ignore"):
+        whole = D.toarray() @ v.weights
+    assert all(a.EqualTo(b) for a, b in zip(whole, v.forces, strict=True))
+    assert dg.force_closure(soft).is_closure
