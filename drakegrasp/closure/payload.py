@@ -69,7 +69,7 @@ class MaxLoadResult:
         ``α* w_d`` (zeros when ``α*`` is infinite).
     upper_bound : float
         The bound proven by ``certificate`` (equal to ``alpha`` up to the
-        solvers' accuracy); ``inf`` without a certificate.
+        solvers' accuracy, never below it); ``inf`` without a certificate.
     contact_forces : tuple of ndarray
         The forces at ``α*`` per contact, contact frame, normal first (N).
     joint_torques : (n_v,) float or None
@@ -440,6 +440,13 @@ def max_load(
                 program=prog,
                 result=result,
             )
+    if not unbounded and value > bound and _verified(P, cert):
+        # α above a bound whose certificate re-checks is the solvers' noise
+        # (exact cones whose α* is 0 returned α = 3.5e-6 over a bound of
+        # 2.1e-6): α is the bound, and the forces shrink with it, which keeps
+        # every cone and every limit (they are cones and upper bounds).
+        full = full * (bound / value)
+        value = bound
     if not unbounded and value > 0.0 and _homogeneous(P):
         # Every finite limit 0 (passive joints, max_squeeze = 0): α is 0 or
         # inf, never the 1e-10 of the solvers' tolerance it was reported as.

@@ -475,3 +475,50 @@ def test_payload_without_limits_is_infinite_and_exact_beats_polyhedral():
     exact = dg.max_load(g, d, max_normal_force=10.0)
     poly = dg.max_load(g, d, max_normal_force=10.0, cones="polyhedral")
     assert poly.alpha <= exact.alpha * (1 + 1e-7)
+
+
+def test_payload_never_exceeds_its_re_checked_bound():
+    # Three soft fingers that hold no multiple of w (not even 1e-3 w with
+    # unlimited forces): the exact-cone program returned α = 3.5e-6 of the
+    # solvers' noise over a re-checked bound of 2.1e-6.  α is at most the
+    # bound, and the forces shrink with it: they still balance α w.
+    C = [
+        [-0.027475885771119993, 0.04563900476704882, -0.02814077095408896],
+        [-0.054939882505983875, 0.16191569638947942, 0.04009507755471219],
+        [-0.08958021077905483, -0.03908853490266771, 0.12151149340962408],
+    ]
+    Nrm = [
+        [0.30852842189351587, -0.7173491898503216, 0.6246761982859472],
+        [0.3703370873185339, -0.8391304151128477, -0.3983849748534256],
+        [0.5854085829574258, 0.4709253765006276, -0.6599439982055454],
+    ]
+    mu = [0.658645075602108, 0.7039002993818457, 1.0234029884824485]
+    nu = [0.47724376428936477, 0.40775122695808, 0.28251769708856556]
+    w = np.array(
+        [
+            -1.151230318178498, -0.015398406266117602, 0.3510093686722364,
+            -0.04199892387256275, 0.026843689380272012, -0.016386072642571713,
+        ]
+    )  # fmt: skip
+    g = dg.Grasp(
+        [
+            dg.Contact(c, n, mu=m, contact_model="soft_finger", torsional_friction=v)
+            for c, n, m, v in zip(C, Nrm, mu, nu, strict=True)
+        ],
+        reference_point=[-0.0588072285253192, -0.016942790030690213, 0.101171637184693],
+    )
+    assert not dg.grasp_forces(g, 1e-3 * w, cones="exact").feasible
+    limits = {"max_squeeze": 112.04337058930355}
+    limits["max_normal_force"] = [
+        49.32198583081032,
+        21.34385116078419,
+        14.32477902500028,
+    ]
+    r = dg.max_load(g, w, **limits)
+    assert r.certificate.check(g).holds
+    assert r.alpha <= r.upper_bound
+    assert r.alpha < 1e-5  # of a 112 N squeeze budget
+    G = dg.grasp_matrix(g)
+    np.testing.assert_allclose(
+        G @ np.concatenate(r.contact_forces), -r.alpha * w, atol=1e-9
+    )
