@@ -531,6 +531,10 @@ def ferrari_canny(
         (dimensionless).  0 when the origin is not strictly inside the set (no
         force closure on the polyhedral cones), including wrench sets of lower
         dimension than the wrench space (e.g. two hard fingers in 3-D).
+        Its error is absolute, up to about 1e-15 times the largest primitive
+        wrench (whose size grows with ``μ`` and ``ν``): with ``μ = 1e12`` an ε
+        near 1e-3 is not resolved, and a grasp in force closure may get 0
+        (see the Conventions page, Monotonicity).
 
     Notes
     -----
