@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import importlib.util
+import logging
 import math
 import os
 from pathlib import Path
@@ -23,6 +24,7 @@ __all__ = [
     "DRAKE_MODELS_HINT",
     "PACKAGE_NAME",
     "check_obj_vertices",
+    "drake_reading",
     "explain_drake_models",
     "models_dir",
     "register_models",
@@ -70,6 +72,54 @@ def explain_drake_models(message: str) -> str:
     if "download" in text:
         return f"{text}. {DRAKE_MODELS_HINT}"
     return text
+
+
+class _Collected(logging.Handler):
+    """The records logged while it is attached."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.records: list[logging.LogRecord] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.records.append(record)
+
+
+def drake_reading(read, *args, **kwargs):
+    """``read(*args, **kwargs)``, a Drake reader whose refusal is a RuntimeError.
+
+    Drake checks some of what it reads with ``DRAKE_DEMAND`` (a directive
+    that names no kind, ``file: ''``), which pydrake raises as ``SystemExit``:
+    an ``except Exception`` does not catch it and the program ends.  Its
+    reason goes to the ``drake`` logger first, as a second line on stderr.
+    Here the reason (what was logged at WARNING and above) is kept instead and
+    raised as ``RuntimeError(reason)``, for the caller to name its file; what
+    the reader logs without refusing reaches the logger's handlers afterwards.
+
+    Raises
+    ------
+    RuntimeError
+        Drake refused (its own RuntimeError, or a ``SystemExit`` with the
+        logged reason).
+    """
+    logger = logging.getLogger("drake")
+    collected = _Collected()
+    propagate = logger.propagate
+    logger.addHandler(collected)
+    logger.propagate = False
+    try:
+        return read(*args, **kwargs)
+    except SystemExit as e:
+        said = [
+            r.getMessage() for r in collected.records if r.levelno >= logging.WARNING
+        ]
+        collected.records.clear()
+        raise RuntimeError("; ".join(said) or str(e)) from None
+    finally:
+        logger.removeHandler(collected)
+        logger.propagate = propagate
+        for record in collected.records:
+            logger.handle(record)
 
 
 @functools.cache

@@ -123,6 +123,7 @@ tips touch.)
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -139,9 +140,9 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.validation import check_flag
-from drakegrasp.errors import ModelError, SceneError
+from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
 from drakegrasp.plant.couplings import record_model_couplings
-from drakegrasp.plant.models import explain_drake_models, models_dir
+from drakegrasp.plant.models import drake_reading, explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import (
     check_directives,
@@ -300,15 +301,28 @@ def list_scenes() -> list[SceneInfo]:
     return [read_scene_info(p) for p in sorted(scenes_dir().glob("*.yaml"))]
 
 
+def _path_argument(path) -> Path:
+    """``path`` (a ``str`` or an ``os.PathLike`` of one) as a Path."""
+    if not isinstance(path, str | os.PathLike) or isinstance(os.fspath(path), bytes):
+        raise InvalidOptionError(
+            "a scene is a file path or a shipped scene's name (str or "
+            f"pathlib.Path), got {type(path).__name__} {path!r}"
+        )
+    return Path(path)
+
+
 def scene_path(path_or_name: str | Path) -> Path:
     """The file of a scene given by path or by the name of a shipped scene.
 
     Raises
     ------
+    InvalidOptionError
+        If it is not a ``str`` or an ``os.PathLike`` of one.
     ModelError
-        If it is neither an existing file nor a shipped scene's name.
+        If it is neither an existing file nor a shipped scene's name (a
+        directory is named as one).
     """
-    candidate = Path(path_or_name)
+    candidate = _path_argument(path_or_name)
     if candidate.is_file():
         return candidate
     name = str(path_or_name)
@@ -316,6 +330,10 @@ def scene_path(path_or_name: str | Path) -> Path:
     if "/" not in name and shipped.is_file():
         return shipped
     names = ", ".join(p.stem for p in sorted(scenes_dir().glob("*.yaml")))
+    if candidate.is_dir():
+        raise ModelError(
+            f"scene {name!r} is a directory, not a scene file (shipped scenes: {names})"
+        )
     raise ModelError(
         f"scene {name!r} not found: no such file and no shipped scene of that "
         f"name (shipped scenes: {names})"
@@ -330,8 +348,10 @@ def read_scene_info(path: str | Path) -> SceneInfo:
     SceneError
         On an unreadable, oversized or invalid YAML file, a missing or unknown
         key, or a bad value; the message names the file and the key.
+    InvalidOptionError
+        If ``path`` is not a ``str`` or an ``os.PathLike`` of one.
     """
-    path = Path(path)
+    path = _path_argument(path)
     _, data = read_yaml(path)
     section = check_section(path, data)
     return SceneInfo(name=path.stem, path=path.resolve(), **section)
@@ -355,7 +375,7 @@ def _new_plant(path: Path, package_map: PackagesSpec, ros_package_path: bool):
 def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
     """Process the (checked) directives into ``plant`` and finalize it."""
     try:
-        added = ProcessModelDirectives(directives, plant, parser)
+        added = drake_reading(ProcessModelDirectives, directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError
         msg = explain_drake_models(str(e))
         raise ModelError(
@@ -452,7 +472,7 @@ def _flattened(path: Path, directives, parser):
     if all(d.add_directives is None for d in directives.directives):
         return directives
     try:
-        return FlattenModelDirectives(directives, parser.package_map())
+        return drake_reading(FlattenModelDirectives, directives, parser.package_map())
     except Exception as e:  # Drake raises RuntimeError on a file it cannot read
         msg = " ".join(explain_drake_models(str(e)).split())
         raise SceneError(
@@ -605,9 +625,12 @@ def load_scene(
     info = SceneInfo(name=path.stem, path=path.resolve(), **check_section(path, data))
     check_directives(path, data)
     free_hand = check_flag("free_hand", free_hand)
+    ros_package_path = check_flag("ros_package_path", ros_package_path)
     builder, plant, parser, packages = _new_plant(path, package_map, ros_package_path)
     try:
-        directives = LoadModelDirectivesFromString(directives_text(path, text))
+        directives = drake_reading(
+            LoadModelDirectivesFromString, directives_text(path, text)
+        )
     except SceneError:
         raise
     except Exception as e:  # Drake raises RuntimeError/ValueError on bad schema

@@ -31,6 +31,11 @@ from pathlib import Path
 import yaml
 
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.validation import (
+    COEFFICIENT_MAX,
+    COEFFICIENT_MIN,
+    check_coefficient,
+)
 from drakegrasp.errors import GraspError, SceneError
 from drakegrasp.plant.options import PLANES
 
@@ -55,9 +60,10 @@ KEYS = {
     "description": "a string",
     "object_body": "a 'model::body' name",
     "hand": "a model-instance name or a list of 'model::body' names",
-    "mu": "a number >= 0",
+    "mu": f"0 or a number in [{COEFFICIENT_MIN:g}, {COEFFICIENT_MAX:g}]",
     "contact_model": f"one of {[m.value for m in ContactModel]}",
-    "torsional_friction": "a number >= 0",
+    "torsional_friction": f"0 or a number in [{COEFFICIENT_MIN:g}, "
+    f"{COEFFICIENT_MAX:g}]",
     "plane": f"one of {sorted(PLANES)}",
     "distance_tolerance": "a number > 0 (metres)",
     "close": "true, false, or a mapping {direction: [one number per closing "
@@ -216,6 +222,15 @@ def _string(path: Path, key: str, value) -> str:
     return value
 
 
+def _coefficient(path: Path, key: str, value) -> float:
+    """``mu`` or ``torsional_friction``: in the range every analysis takes."""
+    x = _number(path, key, value)
+    try:
+        return check_coefficient(key, x, error=SceneError)
+    except SceneError as e:
+        raise SceneError(f"scene {str(path)!r}: drakegrasp.{e}") from None
+
+
 def _number(
     path: Path, key: str, value, *, positive: bool = False, signed: bool = False
 ) -> float:
@@ -367,14 +382,14 @@ def check_section(path: Path, data: dict) -> dict:
         else _string(path, "description", description),
         "object_body": _string(path, "object_body", section["object_body"]),
         "hand": hand,
-        "mu": _number(path, "mu", section["mu"]),
+        "mu": _coefficient(path, "mu", section["mu"]),
         "contact_model": model,
         # Absent is not 0: a soft finger without a given nu is refused above
         # (and by the analysis, when --contact-model soft_finger asks for one),
         # one given nu = 0 acts as a hard finger.
         "torsional_friction": None
         if "torsional_friction" not in section
-        else _number(path, "torsional_friction", section["torsional_friction"]),
+        else _coefficient(path, "torsional_friction", section["torsional_friction"]),
         "plane": plane,
         "distance_tolerance": _number(
             path,

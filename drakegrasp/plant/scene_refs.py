@@ -49,6 +49,7 @@ from pydrake.multibody.parsing import LoadModelDirectives, PackageMap, Parser
 from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.models import (
     check_obj_vertices,
+    drake_reading,
     explain_drake_models,
     register_models,
     use_local_drake_models,
@@ -115,6 +116,11 @@ def add_packages(
     elif packages is not None:
         if isinstance(packages, str | os.PathLike):
             packages = [packages]
+        if not isinstance(packages, Iterable) or isinstance(packages, bytes):
+            raise SceneError(
+                "packages must be a PackageMap, a mapping {name: directory} or "
+                f"directories, got {type(packages).__name__} {packages!r}"
+            )
         for folder in packages:
             _add_package_xml(package_map, folder)
     if ros_package_path and os.environ.get(ROS_PACKAGE_PATH):
@@ -127,7 +133,7 @@ def _add_named(package_map: PackageMap, name, folder) -> None:
         raise SceneError(
             f"package name must be a non-empty string without '/', got {name!r}"
         )
-    path = Path(folder).expanduser()
+    path = _folder(f"package {name!r}", folder)
     if not path.is_dir():
         raise SceneError(f"package {name!r}: {str(folder)!r} is not a directory")
     path = str(path.resolve())
@@ -138,8 +144,20 @@ def _add_named(package_map: PackageMap, name, folder) -> None:
     package_map.Add(name, path)
 
 
+def _folder(what: str, folder) -> Path:
+    """``folder`` as a path; anything but a str or an os.PathLike is refused."""
+    if not isinstance(folder, str | os.PathLike) or isinstance(
+        os.fspath(folder), bytes
+    ):
+        raise SceneError(
+            f"{what}: a directory is a str or a pathlib.Path, got "
+            f"{type(folder).__name__} {folder!r}"
+        )
+    return Path(folder).expanduser()
+
+
 def _add_package_xml(package_map: PackageMap, folder) -> None:
-    path = Path(folder).expanduser()
+    path = _folder("package", folder)
     xml = path if path.name == "package.xml" else path / "package.xml"
     if not xml.is_file():
         raise SceneError(
@@ -385,7 +403,7 @@ def check_references(
                 )
             _, included_data = read_yaml(Path(local))
             try:
-                included = LoadModelDirectives(local)
+                included = drake_reading(LoadModelDirectives, local)
             except Exception as e:  # Drake's schema errors: RuntimeError et al.
                 msg = " ".join(str(e).split())
                 raise SceneError(

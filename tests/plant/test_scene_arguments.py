@@ -1,0 +1,79 @@
+"""Arguments of the scene readers that are not what they take, refused in words.
+
+``load_scene(3)`` raised pathlib's TypeError, ``package_map={"foo": 3}``
+another, ``ros_package_path="no"`` was taken as true, a directory was "no such
+file", and a file's ``mu: 1e38`` passed the file's check to be refused by the
+analysis without the file's name.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import drakegrasp as dg
+from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
+from drakegrasp.plant.scene import DEFAULT_SCENE, read_scene_info, scene_path
+
+DEFAULT = scene_path(DEFAULT_SCENE).read_text()
+
+
+@pytest.mark.parametrize(
+    "scene", [3, b"parallel_jaw_box", object(), 1.5, ["parallel_jaw_box"]]
+)
+def test_a_scene_that_is_no_path_is_refused(scene):
+    with pytest.raises(InvalidOptionError, match="a scene is a file path"):
+        dg.load_scene(scene)
+    with pytest.raises(InvalidOptionError, match="a scene is a file path"):
+        read_scene_info(scene)
+
+
+def test_a_directory_is_named_as_one(tmp_path):
+    with pytest.raises(ModelError, match="is a directory, not a scene file"):
+        dg.load_scene(tmp_path)
+
+
+@pytest.mark.parametrize(
+    ("packages", "said"),
+    [
+        ({"foo": 3}, "package 'foo': a directory is a str"),
+        ({"foo": b"/tmp"}, "package 'foo': a directory is a str"),
+        ([3], "package: a directory is a str"),
+        (5, "packages must be a PackageMap"),
+        (b"/tmp", "packages must be a PackageMap"),
+    ],
+)
+def test_packages_that_are_no_directories_are_refused(packages, said):
+    with pytest.raises(SceneError, match=said):
+        dg.load_scene(DEFAULT_SCENE, package_map=packages)
+
+
+@pytest.mark.parametrize("flag", ["no", 1, None])
+def test_ros_package_path_is_a_flag(flag):
+    with pytest.raises(InvalidOptionError, match="ros_package_path"):
+        dg.load_scene(DEFAULT_SCENE, ros_package_path=flag)
+
+
+@pytest.mark.parametrize("key", ["mu", "torsional_friction"])
+@pytest.mark.parametrize("value", ["1e38", "1e-13", "1.0e+13"])
+def test_a_coefficient_out_of_range_is_refused_by_the_file(tmp_path, key, value):
+    path = tmp_path / "scene.yaml"
+    text = DEFAULT.replace(
+        "  mu: 0.5", f"  mu: {value}" if key == "mu" else "  mu: 0.5"
+    )
+    text = text.replace(
+        "  torsional_friction: 0.1",
+        f"  torsional_friction: {value}"
+        if key != "mu"
+        else "  torsional_friction: 0.1",
+    )
+    path.write_text(text)
+    match = rf"scene '.*scene\.yaml': drakegrasp\.{key} must be finite and 0 or in"
+    with pytest.raises(SceneError, match=match):
+        read_scene_info(path)
+
+
+@pytest.mark.parametrize("value", ["0", "0.0", "1e-12", "1e12"])
+def test_the_range_s_ends_and_zero_are_taken(tmp_path, value):
+    path = tmp_path / "scene.yaml"
+    path.write_text(DEFAULT.replace("  mu: 0.5", f"  mu: {value}"))
+    assert read_scene_info(path).mu == float(value)
