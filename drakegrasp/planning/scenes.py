@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from pydrake.math import RigidTransform
@@ -84,7 +85,7 @@ def planning_scene(
     Raises
     ------
     ModelError
-        A model that does not load.
+        A model that does not load, or a path (not a URL) that is not a file.
     InvalidOptionError
         A URL that is not a string or path, or an ``X_WO`` that is not a
         finite rigid pose.
@@ -97,6 +98,14 @@ def planning_scene(
             raise InvalidOptionError(
                 f"{name} must be a package:// URL or a file path, got "
                 f"{type(url).__name__} {url!r}"
+            )
+        if url is not None and "://" not in str(url) and not Path(url).is_file():
+            # Checked before the hand loads: a wrong object name was reported
+            # as the hand's failure to download drake_models, offline.
+            what = "a directory" if Path(url).is_dir() else "not a file"
+            raise ModelError(
+                f"{name} {str(url)!r} is {what}: give a model file (.sdf, .urdf, "
+                ".obj, ...) or a package:// URL"
             )
     X_WO = RigidTransform() if X_WO is None else check_rigid_transform("X_WO", X_WO)
 
