@@ -316,10 +316,12 @@ def _held_without_limits(P: LoadProblem, d: np.ndarray) -> bool:
         if result.get_solution_result() != SolutionResult.kSolutionFound:
             continue
         a = float(result.GetSolution(alpha))
-        full = Q.stacked(result.GetSolution(x), F0)
-        if a >= 0.5 * ALPHA_CAP and Q.violation(full, a * unit * d)[0] <= (
-            FEASIBILITY_TOL
-        ):
+        # α at the cap times a huge load's force scale (1e300 N) may overflow
+        # to inf: such forces re-check as no proof, and say so by their value.
+        with np.errstate(over="ignore", invalid="ignore"):
+            full = Q.stacked(result.GetSolution(x), F0)
+            excess = Q.violation(full, a * unit * d)[0]
+        if a >= 0.5 * ALPHA_CAP and excess <= FEASIBILITY_TOL:
             return True
     return False
 

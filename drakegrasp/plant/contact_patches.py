@@ -34,7 +34,7 @@ def _clip(poly: np.ndarray, a: np.ndarray, b: float) -> np.ndarray:
         fp, fq = a @ p - b, a @ q - b
         if fp <= 0:
             out.append(p)
-        if fp * fq < 0:
+        if fp < 0 < fq or fq < 0 < fp:  # fp * fq < 0, which can overflow
             t = fp / (fp - fq)
             out.append(p + t * (q - p))
     return np.array(out).reshape(-1, 2)
