@@ -226,21 +226,38 @@ def _cmd_scenes(_args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_batch(args: argparse.Namespace) -> int:
-    from drakegrasp.batch import stream_file
+_MODEL_NOTE = "--model is deprecated; use --contact-model"
+"""What ``batch --model`` (the deprecated alias) says: after a run that
+succeeds, or inside the one error line of a run that fails."""
 
-    if args.deprecated_model is not None:
-        print(
-            "drakegrasp: warning: --model is deprecated; use --contact-model",
-            file=sys.stderr,
-        )
+
+def _cmd_batch(args: argparse.Namespace) -> int:
+    if args.deprecated_model is None:
+        summary = _batch(args)
+    else:
         if args.contact_model is not None and args.contact_model != (
             args.deprecated_model
         ):
             raise InvalidOptionError(
                 f"--model {args.deprecated_model} and --contact-model "
-                f"{args.contact_model} disagree; give --contact-model only"
+                f"{args.contact_model} disagree; give --contact-model only "
+                "(--model is its deprecated alias)"
             )
+        try:
+            summary = _batch(args)
+        except GraspError as e:  # one line: the error, then the note
+            message = _cli_words(str(e), "batch")
+            raise InvalidOptionError(f"{message} ({_MODEL_NOTE})") from None
+        print(f"drakegrasp: warning: {_MODEL_NOTE}", file=sys.stderr)
+    print(summary)
+    print(f"wrote {printable(args.output)}")
+    return 0
+
+
+def _batch(args: argparse.Namespace):
+    """``batch``'s run: the summary of what it wrote."""
+    from drakegrasp.batch import stream_file
+
     model = args.contact_model or args.deprecated_model or "hard_finger"
     from drakegrasp.batch.options import BatchOptions
 
@@ -310,9 +327,7 @@ def _cmd_batch(args: argparse.Namespace) -> int:
             overwrite=args.overwrite,
             options=engine,
         )
-    print(summary)
-    print(f"wrote {printable(args.output)}")
-    return 0
+    return summary
 
 
 _BATCH_FLAGS = ("contact_model", "num_generators", "tol", "chunk_size", "workers")
@@ -411,6 +426,11 @@ def _cli_words(message: str, command: str | None) -> str:
         "pass --overwrite to replace",
         message,
     )
+    if command == "batch":  # batch --kind form: the friction program's flag
+        message = re.sub(
+            r"(needs friction); use batch_force_closure\b", r"\1; use --kind force",
+            message,
+        )  # fmt: skip
     from drakegrasp.core.contact import missing_torsional_friction
 
     # the library's one refusal of soft fingers without a ν, in flag words
@@ -913,8 +933,19 @@ def _plan_url(spec: str) -> str:
 
 
 def _plan_hand(spec: str | None) -> str:
-    """``plan --hand``: a short name's URL, or a URL or model file as it is."""
-    spec = spec or "flat"
+    """``plan --hand``: a short name's URL, or a URL or model file as it is.
+
+    ``None`` (no ``--hand``) is the flat jaw; an empty ``--hand ""`` is
+    refused, as an empty object or scene is.
+    """
+    if spec is None:
+        spec = "flat"
+    elif not spec.strip():
+        raise InvalidOptionError(
+            f"--hand is empty; give one of the hand aliases {', '.join(PLAN_HANDS)}"
+            f", a package:// URL or a model file ({', '.join(MODEL_SUFFIXES)}), "
+            "or leave --hand out for the flat jaw"
+        )
     if spec in PLAN_HANDS:
         return PLAN_HANDS[spec]
     if spec.lower() in PLAN_HANDS:  # "WSG", "Allegro"

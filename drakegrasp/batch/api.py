@@ -155,8 +155,20 @@ class BatchClosureResult:
         return "\n".join(lines)
 
 
-def collect(K: int, d: int, kind: str, tol: float, names, chunks):
-    """One :class:`BatchClosureResult` from ``(slice or indices, arrays)`` parts."""
+def result_arrays(K: int, kind: str, metrics: Sequence[str] = ()):
+    """The per-grasp arrays of a ``kind`` result, ``K`` rows of their fill values.
+
+    The one list of a result's columns (names, dtypes, per-grasp shapes) in
+    the order of :meth:`BatchClosureResult.to_arrays`: :func:`collect` fills
+    them, and a writer given no grasps (``K = 0``) writes them empty, so a
+    file has the same columns for every ``K``.
+
+    Returns
+    -------
+    (dict of str to (K,) array, dict of str to (K,) array)
+        The result arrays (``normal_certificate`` for ``kind="force"`` only)
+        and the metrics, NaN until filled.
+    """
     out = {
         "is_closure": np.zeros(K, dtype=bool),
         "d_star": np.zeros(K),
@@ -166,7 +178,12 @@ def collect(K: int, d: int, kind: str, tol: float, names, chunks):
     }
     if kind == "force":
         out["normal_certificate"] = np.zeros(K, dtype=bool)
-    out_metrics = {name: np.full(K, np.nan) for name in names}
+    return out, {name: np.full(K, np.nan) for name in metrics}
+
+
+def collect(K: int, d: int, kind: str, tol: float, names, chunks):
+    """One :class:`BatchClosureResult` from ``(slice or indices, arrays)`` parts."""
+    out, out_metrics = result_arrays(K, kind, names)
     for sl, arrays in chunks:
         for name, target in (*out.items(), *out_metrics.items()):
             target[sl] = arrays[name]

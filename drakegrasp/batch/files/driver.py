@@ -203,6 +203,7 @@ def stream_file(
             tol=float(options["tol"]),
             required_rank=6 if d == 3 else 3,
             fmt=fmt,
+            metrics=options["metrics"],
         )
     return summary
 
@@ -246,7 +247,7 @@ def write_result(
     K = len(result.d_star)
     with placed(path, overwrite=overwrite) as tmp:
         write_chunks(
-            [(slice(0, K), arrays)] if K else [],
+            [(slice(0, K), arrays)],
             tmp,
             K=K,
             kind=result.kind,

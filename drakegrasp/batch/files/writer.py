@@ -9,7 +9,8 @@ same way, as one chunk.  Only the chunk in hand is held, plus a few running
 totals for the summary.
 
 Output: the per-grasp arrays of the result (``is_closure``, ``d_star``,
-``rank``, ``margin``, ``converged`` and the metrics) plus ``kind``, ``tol`` and
+``rank``, ``margin``, ``converged``, force closure's ``normal_certificate``
+and the metrics; the same columns for no grasps) plus ``kind``, ``tol`` and
 ``required_rank``.  The suffix is matched case-insensitively and the file is
 written under exactly the name given (``OUT.NPZ`` stays ``OUT.NPZ``).
 
@@ -35,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from drakegrasp.batch.api import result_arrays
 from drakegrasp.batch.files.npz import NpzWriter
 from drakegrasp.batch.files.parquet import ParquetWriter
 from drakegrasp.errors import BatchFileError, InvalidOptionError
@@ -257,6 +259,7 @@ def write_chunks(
     tol: float,
     required_rank: int,
     fmt: str | None = None,
+    metrics: Sequence[str] = (),
 ) -> BatchSummary:
     """Write a stream of chunk results to ``path``; return the summary.
 
@@ -273,6 +276,11 @@ def write_chunks(
         Stored beside the arrays.
     fmt : {"npz", "parquet"}, optional
         Default: from the suffix of ``path``.
+    metrics : sequence of str, optional
+        The run's metrics (default none), for a file of no grasps (``K = 0``),
+        which then holds the columns a run of ``K > 0`` would (those that
+        ``drakegrasp.batch.api.result_arrays`` lists: ``normal_certificate``
+        for force closure, and the metrics).
 
     Returns
     -------
@@ -284,6 +292,7 @@ def write_chunks(
     writer = (NpzWriter if fmt == "npz" else ParquetWriter)(path, K, meta)
     summary = BatchSummary(kind=kind, tol=tol)
     expected = 0
+    written = False
     try:
         for sl, arrays in chunks:
             if sl.start != expected:
@@ -291,18 +300,12 @@ def write_chunks(
             expected = sl.stop
             writer.write(arrays)
             summary.add(arrays)
+            written = True
         if expected != K:
             raise ValueError(f"the chunks covered {expected} of {K} grasps")
-        if K == 0:
-            writer.write(
-                {
-                    "is_closure": np.zeros(0, dtype=bool),
-                    "d_star": np.zeros(0),
-                    "rank": np.zeros(0, dtype=int),
-                    "margin": np.zeros(0),
-                    "converged": np.zeros(0, dtype=bool),
-                }
-            )
+        if not written:  # no grasps: the columns of any K, with no rows
+            out, out_metrics = result_arrays(0, kind, metrics)
+            writer.write({**out, **out_metrics})
         writer.close()
     except BaseException:
         writer.abort()

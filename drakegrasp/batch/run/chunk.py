@@ -413,14 +413,12 @@ def force_task(positions, mu, contact_model, num_generators, torsional_friction,
     get_nu = per_contact_getter("torsional_friction", torsional_friction, K, N)
     get_p = _reference_points(reference_points, K, d)
     get_b = _characteristic_lengths(characteristic_lengths, K)
-    soft = contact_model == "soft_finger"
 
     def task(P, Nrm, sl):
         mu_c = get_mu(sl)
         check_chunk_coefficients("mu", mu_c, sl.start)
-        nu_c = get_nu(sl)
-        if soft:
-            check_chunk_coefficients("torsional_friction", nu_c, sl.start)
+        nu_c = get_nu(sl)  # checked for every model, as mu and a scalar nu are
+        check_chunk_coefficients("torsional_friction", nu_c, sl.start)
         p = np.ascontiguousarray(get_p(sl))
         b = None if get_b is None else np.ascontiguousarray(get_b(sl))
         return force_chunk, (P, Nrm, mu_c, nu_c, p, b), options
