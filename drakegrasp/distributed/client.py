@@ -2,24 +2,59 @@
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import gc
+import math
+import numbers
+import threading
+import traceback
 from collections.abc import Iterator
 
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["client_for", "connected"]
+__all__ = ["HANDSHAKE_GRACE", "client_for", "connected"]
+
+HANDSHAKE_GRACE = 2.0
+"""Seconds the handshake may take beyond the connection timeout.
+
+Dask's own connect gives up on an unreachable address after the timeout; an
+address still silent this much later has accepted the connection but not
+answered Dask's handshake (a web server, say), which Dask alone would wait on
+forever.
+"""
+
+_CONNECT_SETTING = "distributed.comm.timeouts.connect"
 
 
-def client_for(client_or_address):
+class _NoHandshake(Exception):
+    """The address accepted a connection but did not answer Dask's handshake."""
+
+
+def client_for(client_or_address, *, timeout: float | None = None):
     """A ``distributed.Client``: the one given, or one connected to an address.
+
+    Parameters
+    ----------
+    client_or_address : distributed.Client or str
+        A client, returned as it is, or a scheduler address such as
+        ``"tcp://host:8786"``.
+    timeout : float, optional
+        Seconds to wait for a scheduler at the address: Dask's connection
+        timeout (the setting ``distributed.comm.timeouts.connect``, 30 s by
+        default) when not given.  An address that accepts the connection but
+        does not complete Dask's handshake is given :data:`HANDSHAKE_GRACE`
+        seconds more, so a connection is given up after about the timeout.
 
     Raises
     ------
     InvalidOptionError
         Neither a client nor an address, an address with a port outside
-        1..65535, or a scheduler that cannot be reached (Dask's own
-        connection timeout, 30 s by default), naming the address.
+        1..65535, a timeout that is not a positive number of seconds, a
+        scheduler that cannot be reached within the timeout, or an address
+        that answers but is not a Dask scheduler (no or a foreign reply to
+        Dask's handshake), naming the address.  Whatever Dask raised is the
+        error's ``__cause__``.
     """
     try:
         from distributed import Client
@@ -41,20 +76,27 @@ def client_for(client_or_address):
                 f"the scheduler address {client_or_address!r} has port {port}; "
                 "a port is in 1..65535"
             )
+        seconds = _connect_timeout(timeout)
+        shook_hands = False
         try:
-            return Client(client_or_address)
-        except (OSError, TimeoutError, ValueError) as e:
-            reason = " ".join(str(e).split())
-        # The half-made Client is cyclic garbage, held until now by the error's
-        # traceback.  Left to a later collection, its __del__ may run inside
-        # another Client's start, where its close waits on the loop lock that
-        # start holds: a deadlock (seen in the test suite).  Finalise it here,
-        # and raise outside the except block so nothing keeps it alive.
+            _check_handshake(client_or_address, seconds)
+            shook_hands = True
+            return Client(client_or_address, timeout=seconds)
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BaseException as e:  # any failure to connect, kept as the cause
+            error = e
+            _clear_frames(e)
+        # A half-made Client is cyclic garbage, held until now by the locals of
+        # the error's traceback (cleared above; the traceback itself is kept).
+        # Left to a later collection, its __del__ may run inside another
+        # Client's start, where its close waits on the loop lock that start
+        # holds: a deadlock (seen in the test suite).  Finalise it here.
         gc.collect()
         raise InvalidOptionError(
             f"could not connect to the Dask scheduler at {client_or_address!r}: "
-            f"{reason}"
-        )
+            f"{_failure(error, seconds, shook_hands)}"
+        ) from error
     if not isinstance(client_or_address, Client):
         raise InvalidOptionError(
             "client must be a distributed.Client or a scheduler address such as "
@@ -64,15 +106,147 @@ def client_for(client_or_address):
 
 
 @contextlib.contextmanager
-def connected(client_or_address) -> Iterator:
+def connected(client_or_address, *, timeout: float | None = None) -> Iterator:
     """:func:`client_for` as a context: a client made from an address is closed.
 
     A client the caller passed stays open; one this call connected is closed on
     exit, so a command line run leaves no client reconnecting to a scheduler.
+    ``timeout`` is :func:`client_for`'s.
     """
-    client = client_for(client_or_address)
+    client = client_for(client_or_address, timeout=timeout)
     try:
         yield client
     finally:
         if client is not client_or_address:
             client.close()
+
+
+def _connect_timeout(timeout) -> float:
+    """The connection timeout in seconds: the one given, or Dask's setting."""
+    name = "timeout"
+    if timeout is None:
+        import dask
+        from dask.utils import parse_timedelta
+
+        timeout = dask.config.get(_CONNECT_SETTING)
+        name = f"Dask's setting {_CONNECT_SETTING}"
+        with contextlib.suppress(TypeError, ValueError, KeyError):
+            timeout = parse_timedelta(timeout, "s")
+    if (
+        isinstance(timeout, bool)
+        or not isinstance(timeout, numbers.Real)
+        or not 0 < timeout < math.inf
+    ):
+        raise InvalidOptionError(
+            f"{name} must be a positive number of seconds, got {timeout!r}"
+        )
+    return float(timeout)
+
+
+def _check_handshake(address: str, seconds: float) -> None:
+    """Connect to ``address`` and complete Dask's handshake, or raise.
+
+    ``distributed.Client`` bounds only the connection by its timeout: a reply
+    that never comes to its handshake is waited for forever, and a foreign
+    reply is read as a Dask frame (an ``SSH-2.0-`` banner asks for an array of
+    exabytes).  So the handshake is tried first, under an overall deadline, by
+    Dask's own ``connect`` with the connection arguments a Client would use.
+    It runs on an event loop in a thread of its own, as the caller may be on a
+    running loop (a notebook's).  Raises :class:`_NoHandshake` when no
+    handshake came within the timeout and :data:`HANDSHAKE_GRACE`, and
+    whatever ``connect`` raised otherwise.
+    """
+    from distributed import Security
+    from distributed.comm import connect
+
+    deadline = seconds + HANDSHAKE_GRACE
+    connection_args = Security().get_connection_args("client")
+
+    async def handshake():
+        attempt = asyncio.ensure_future(
+            connect(address, timeout=seconds, **connection_args)
+        )
+        done, _ = await asyncio.wait({attempt}, timeout=deadline)
+        if not done:
+            attempt.cancel()  # aborts the connection Dask was reading from
+            with contextlib.suppress(asyncio.CancelledError, Exception):
+                await attempt
+            raise _NoHandshake(f"no reply to Dask's handshake in {deadline:g} s")
+        await attempt.result().close()
+
+    outcome: list[BaseException] = []
+
+    def run():
+        try:
+            asyncio.run(handshake())
+        except BaseException as e:  # handed to the caller's thread
+            outcome.append(e)
+
+    thread = threading.Thread(target=run, name="drakegrasp-dask-handshake",
+                              daemon=True)  # fmt: skip
+    thread.start()
+    thread.join(deadline + HANDSHAKE_GRACE)  # the loop keeps the deadline itself
+    if thread.is_alive():
+        raise _NoHandshake(f"no reply to Dask's handshake in {deadline:g} s")
+    if outcome:
+        raise outcome[0]
+
+
+def _failure(error: BaseException, seconds: float, shook_hands: bool) -> str:
+    """Why a connection failed, for the error naming the address.
+
+    ``shook_hands``: the address completed Dask's handshake, and the Client
+    failed after it.
+    """
+    from distributed.comm import CommClosedError
+    from distributed.comm.core import FatalCommClosedError
+
+    if isinstance(error, _NoHandshake):
+        return (
+            "the address accepted the connection but did not complete Dask's "
+            f"handshake within {seconds + HANDSHAKE_GRACE:g} s: it is not a Dask "
+            "scheduler (a scheduler listens on port 8786 unless told otherwise)"
+        )
+    reason = " ".join(str(error).split())
+    # connect retries every error of the connection itself until the timeout
+    # and raises OSError then; a closed comm comes from the handshake.
+    closed = isinstance(error, CommClosedError) and not isinstance(
+        error, FatalCommClosedError
+    )
+    if isinstance(error, (OSError, ValueError)) and not closed:
+        return _short(reason) or type(error).__name__  # unreachable, malformed
+    typed = type(error).__name__ + (f": {_short(reason)}" if reason else "")
+    if shook_hands:  # a worker's address, say
+        return (
+            "the address completed Dask's handshake but did not take a client "
+            f"as a scheduler does ({typed})"
+        )
+    if closed:
+        return (
+            "the address accepted the connection but closed it during Dask's "
+            f"handshake: it is not a Dask scheduler ({typed})"
+        )
+    return (
+        "the address answered but is not a Dask scheduler: its reply is not "
+        f"Dask's handshake ({typed})"
+    )
+
+
+def _short(reason: str) -> str:
+    return reason if len(reason) <= 160 else reason[:157] + "..."
+
+
+def _clear_frames(error: BaseException) -> None:
+    """Drop the locals of the tracebacks of ``error`` and of its chained errors.
+
+    The tracebacks stay (file, line and code for the report); only the objects
+    their frames held, such as a half-made Client, are let go.
+    """
+    seen, pending = set(), [error]
+    while pending:
+        error = pending.pop()
+        if error is None or id(error) in seen:
+            continue
+        seen.add(id(error))
+        traceback.clear_frames(error.__traceback__)
+        pending += [error.__cause__, error.__context__]
