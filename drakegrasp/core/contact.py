@@ -336,8 +336,14 @@ class Contact:
                 f"Contact has no field(s) {sorted(unknown)}; "
                 f"fields are {sorted(kwargs)}"
             )
-        if "model" in changes:  # the deprecated alias replaces this model
-            del kwargs["contact_model"]  # (Contact() warns, or refuses both)
+        if "model" in changes:  # the deprecated alias of contact_model
+            if "contact_model" in changes:
+                raise InvalidOptionError(
+                    "Contact.with_() got both model= (deprecated) and "
+                    "contact_model=; give contact_model= only"
+                )
+            warn_deprecated("Contact.with_(): model= is deprecated; use contact_model=")
+            changes["contact_model"] = changes.pop("model")
         kwargs.update(changes)
         position = kwargs.pop("position")
         normal = kwargs.pop("normal")

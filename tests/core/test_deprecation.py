@@ -25,10 +25,11 @@ def test_contact_model_alias_warns_and_means_the_same():
     assert old.contact_model is new.contact_model is dg.ContactModel.FRICTIONLESS
     with pytest.warns(DeprecationWarning, match="Contact.contact_model"):
         assert old.model is dg.ContactModel.FRICTIONLESS
-    with pytest.warns(DeprecationWarning):
+    with pytest.warns(DeprecationWarning, match=r"^Contact\.with_\(\): model=") as w:
         assert new.with_(model="hard_finger").contact_model is (
             dg.ContactModel.HARD_FINGER
         )
+    assert w[0].filename == __file__  # the user's line
 
 
 def test_both_spellings_at_once_are_refused():
