@@ -120,6 +120,9 @@ class GraspMonitor(LeafSystem):
         As in :func:`drakegrasp.analyze_grasp`: a pose that the check refuses
         (penetration deeper than ``distance_tolerance`` by any hand body, a
         joint off its limits) gives an ``"invalid"`` sample, not an exception.
+        With ``contacts="contact_results"`` penetration is allowed
+        (``allow_penetration`` is True): the simulator's contacts penetrate to
+        make their force.
     contacts : {"geometry", "contact_results"}, optional
         Signed distances (default), or the plant's contact results (then the
         ``contact_results`` input port exists and must be connected).  See

@@ -55,7 +55,12 @@ same instant, so geometry and kinematics agree).
   ``‖f_t‖/(μ f_n)`` with the plant's own μ (read from the geometries' proximity
   properties, :func:`~drakegrasp.plant.friction.pair_friction`, not the ``mu``
   option), and a grip nearing its friction limit is
-  "at risk" before it slips.  *It cannot see* contacts the step did not
+  "at risk" before it slips.  These contacts penetrate to make their force
+  (point contact: 0.2 mm at 20 N between the WSG-50's tips and a box), so
+  the analysis allows penetration whatever ``distance_tolerance`` is (a pose
+  is invalid only for a joint off its limits): at the default 0.1 mm a firm
+  grip was "invalid", shown as "touching", until it slipped.  *It cannot see*
+  contacts the step did not
   compute (a hydroelastic surface has one net force, not a distribution), nor
   a contact between two steps: a finger chattering along the object is in
   the results only at some samples (the WSG-50's pads sliding up a box: about

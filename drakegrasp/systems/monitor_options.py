@@ -41,7 +41,10 @@ class MonitorSettings:
     ----------
     analysis : AnalysisOptions
         What each sample's :func:`~drakegrasp.analyze_grasp` is given (``mu`` is
-        set: a number or ``"plant"``).
+        set: a number or ``"plant"``).  With ``contacts="contact_results"``
+        its ``allow_penetration`` is True: the simulator's contacts penetrate
+        to make their force, so only joints off their limits make a pose
+        invalid.
     contacts : {"geometry", "contact_results"}
         Where the contacts come from.
     period : float
@@ -144,6 +147,12 @@ def monitor_settings(
             f"holding must be a HoldingThresholds, got {type(holding).__name__}"
         )
     analysis = resolve_options(options, **analysis_keywords).require_friction()
+    if contacts == "contact_results" and not analysis.allow_penetration:
+        # The simulator's compliant contact makes its force by penetrating
+        # (Drake's point contact: 0.2 mm at 20 N between WSG tips and a box),
+        # and these contacts are the simulator's own: a penetration deeper
+        # than distance_tolerance is the grip, not an impossible pose.
+        analysis = analysis.replace(allow_penetration=True)
     if holding.release_distance <= analysis.distance_tolerance:
         raise InvalidOptionError(
             f"holding.release_distance = {holding.release_distance:g} m must exceed "

@@ -78,3 +78,22 @@ def test_box_at_rest_between_open_fingers_is_never_holding(case, closed):
     line = _run(closed, CASES[case], until=1.6)
     assert line.displacement.max() < 1e-3 or line.height.max() < 0.0505
     assert set(line.states) == {"no contact"}, set(line.states)
+
+
+@pytest.mark.parametrize("closed", [0.015, -0.05], ids=["3 N", "23 N"])
+def test_a_firm_grip_in_contact_results_is_holding_at_the_default_tolerance(closed):
+    # The simulator's point contacts penetrate to make their force (0.2 mm at
+    # 20 N); at the default 0.1 mm tolerance the pose check called the grip
+    # invalid, shown as "touching", until it slipped.  With the contact
+    # results penetration is the grip: only a joint off its limits is invalid.
+    pick = build_pick(
+        mu=0.5, period=0.01, closed=closed, contacts="contact_results", **POINT
+    )
+    assert pick.monitor.settings.analysis.allow_penetration
+    pick.run(2.0)
+    line = timeline(pick, finger="left_finger", t_ref=LIFT_START)
+    airborne = line.height > 0.0505
+    assert airborne.sum() > 30
+    assert line.displacement[line.times >= LIFT_START].max() < 2e-3
+    held = [s for s, up in zip(line.states, airborne, strict=True) if up]
+    assert set(held) == {"holding"}, held
