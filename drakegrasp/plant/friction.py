@@ -30,7 +30,7 @@ from pydrake.multibody.plant import (
     MultibodyPlant,
 )
 
-from drakegrasp.errors import ModelError
+from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.validation import (
     hand_contact_bodies,
     plant_context_of,
@@ -74,17 +74,22 @@ def _coulomb(inspector, geometry_id):
     return props.GetProperty("material", "coulomb_friction")
 
 
-def pair_friction(plant: MultibodyPlant, query_object, id_a, id_b) -> float:
+def pair_friction(
+    plant: MultibodyPlant, query_object, id_a, id_b, *, rule: str | None = None
+) -> float:
     """The plant's combined friction coefficient of one geometry pair.
 
     Parameters
     ----------
     plant : MultibodyPlant
-        Decides which coefficient (:func:`friction_rule`).
+        Decides which coefficient (:func:`friction_rule`) unless ``rule``.
     query_object : QueryObject
         Holds the geometries' proximity properties.
     id_a, id_b : GeometryId
         The two geometries, in either order.
+    rule : {"static", "dynamic"}, optional
+        Which coefficient, whatever the plant simulates (default: the
+        plant's rule).
 
     Returns
     -------
@@ -101,9 +106,18 @@ def pair_friction(plant: MultibodyPlant, query_object, id_a, id_b) -> float:
     pair = CalcContactFrictionFromSurfaceProperties(
         _coulomb(inspector, id_a), _coulomb(inspector, id_b)
     )
-    if friction_rule(plant) == "dynamic":
+    rule = friction_rule(plant) if rule is None else _check_rule(rule)
+    if rule == "dynamic":
         return float(pair.dynamic_friction())
     return float(pair.static_friction())
+
+
+def _check_rule(rule) -> str:
+    if rule not in ("static", "dynamic"):
+        raise InvalidOptionError(
+            f"rule must be 'static', 'dynamic' or None, got {rule!r}"
+        )
+    return rule
 
 
 def plant_friction(
@@ -137,7 +151,12 @@ def plant_friction(
 
 
 def hand_object_friction(
-    plant: MultibodyPlant, plant_context, object_body, hand=None
+    plant: MultibodyPlant,
+    plant_context,
+    object_body,
+    hand=None,
+    *,
+    rule: str | None = None,
 ) -> np.ndarray:
     """The plant's friction of every pair of a hand and an object geometry.
 
@@ -156,6 +175,8 @@ def hand_object_friction(
         friction of its geometries like any other.
     hand : HandSpec, optional
         The hand as :func:`~drakegrasp.plant.validation.hand_bodies` takes it.
+    rule : {"static", "dynamic"}, optional
+        As in :func:`pair_friction` (default: the plant's rule).
 
     Returns
     -------
@@ -167,11 +188,12 @@ def hand_object_friction(
     ------
     InvalidOptionError
         If ``object_body`` is the world body, or a body of the hand (listed
-        in ``hand`` or joined to its bodies).
+        in ``hand`` or joined to its bodies), or for an unknown ``rule``.
     ModelError
         If a geometry has no ``material/coulomb_friction`` property, or for
         an unknown body or hand.
     """
+    rule = None if rule is None else _check_rule(rule)
     ctx = plant_context_of(plant, plant_context)
     body = resolve_grasped_body(plant, object_body)
     query_object = query_object_of(plant, ctx)
@@ -181,7 +203,7 @@ def hand_object_friction(
         for g in plant.GetCollisionGeometriesForBody(b)
     ]
     values = {
-        pair_friction(plant, query_object, o, h)
+        pair_friction(plant, query_object, o, h, rule=rule)
         for o in plant.GetCollisionGeometriesForBody(body)
         for h in hand_ids
     }
