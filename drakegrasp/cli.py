@@ -152,6 +152,7 @@ def _analyze(args: argparse.Namespace) -> int:
         package_map=dict(args.package) or None,
         allow_any_file=args.allow_any_file,
         close=args.close,
+        torsional_friction=args.torsional_friction,
     )
     changes = {
         name: getattr(args, name)
@@ -432,7 +433,13 @@ def _cli_words(message: str, command: str | None) -> str:
             message,
         )  # fmt: skip
     from drakegrasp.core.contact import missing_torsional_friction
+    from drakegrasp.plant.scene_file import LOADER_NU_REMEDY
 
+    # a scene file's soft fingers without a ν: analyze's flag gives one
+    message = message.replace(
+        f"{LOADER_NU_REMEDY}, ",
+        "give --torsional-friction NU, " if command == "analyze" else "",
+    )
     # the library's one refusal of soft fingers without a ν, in flag words
     if message == str(missing_torsional_friction()) and command in _SOFT_FINGER_REMEDY:
         return _SOFT_FINGER_REMEDY[command]

@@ -139,7 +139,7 @@ from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.core.contact import ContactModel
-from drakegrasp.core.validation import check_flag
+from drakegrasp.core.validation import check_coefficient, check_flag
 from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
 from drakegrasp.plant.couplings import record_model_couplings
 from drakegrasp.plant.models import drake_reading, explain_drake_models, models_dir
@@ -565,6 +565,7 @@ def load_scene(
     allow_any_file: bool = False,
     close: bool | None = None,
     free_hand: bool = False,
+    torsional_friction: float | None = None,
 ) -> Scene:
     """Build the plant of a scene file and set the configuration it describes.
 
@@ -599,6 +600,11 @@ def load_scene(
         as the file's own; welds inside the hand, and those written in model
         files (an SDFormat ``<joint type="fixed">`` to the world), stay.
         Default False.
+    torsional_friction : float, optional
+        The soft fingers' ``ν`` (0 or in [1e-12, 1e12]), in place of the
+        file's ``torsional_friction:``, which a file of soft fingers may then
+        leave out (``drakegrasp analyze --torsional-friction``).  Default:
+        the file's.
 
     Returns
     -------
@@ -622,7 +628,12 @@ def load_scene(
         close = check_flag("close", close)
     path = scene_path(DEFAULT_SCENE if path_or_name is None else path_or_name)
     text, data = read_yaml(path)
-    info = SceneInfo(name=path.stem, path=path.resolve(), **check_section(path, data))
+    if torsional_friction is not None:
+        torsional_friction = check_coefficient(
+            "torsional_friction", torsional_friction, error=InvalidOptionError
+        )
+    section = check_section(path, data, torsional_friction=torsional_friction)
+    info = SceneInfo(name=path.stem, path=path.resolve(), **section)
     check_directives(path, data)
     free_hand = check_flag("free_hand", free_hand)
     ros_package_path = check_flag("ros_package_path", ros_package_path)

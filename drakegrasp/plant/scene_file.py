@@ -41,6 +41,7 @@ from drakegrasp.plant.options import PLANES
 
 __all__ = [
     "KEYS",
+    "LOADER_NU_REMEDY",
     "MAX_DEPTH",
     "MAX_SCENE_BYTES",
     "TOP_LEVEL_KEYS",
@@ -308,8 +309,18 @@ def check_directives(path: Path, data: dict) -> None:
         )
 
 
-def check_section(path: Path, data: dict) -> dict:
+LOADER_NU_REMEDY = "give it to the loader (load_scene(..., torsional_friction=NU))"
+"""The refusal's remedy of a soft finger without ``ν`` naming the loader's keyword
+(the command line names ``--torsional-friction`` instead)."""
+
+
+def check_section(
+    path: Path, data: dict, *, torsional_friction: float | None = None
+) -> dict:
     """The checked ``drakegrasp:`` section, with defaults filled in.
+
+    ``torsional_friction``, when given, replaces the file's (checked as the
+    file's is): a file of soft fingers may then leave it out.
 
     Returns
     -------
@@ -364,6 +375,8 @@ def check_section(path: Path, data: dict) -> dict:
             f"scene {str(path)!r}: drakegrasp.plane must be {KEYS['plane']} or "
             f"absent, got {plane!r}"
         )
+    if torsional_friction is not None:
+        section = {**section, "torsional_friction": torsional_friction}
     if model is ContactModel.SOFT_FINGER and "torsional_friction" not in section:
         # Refused here, as a missing mu is: the file is incomplete on its own
         # (absent is not 0, see below), and here its name and key are known.
@@ -371,8 +384,8 @@ def check_section(path: Path, data: dict) -> dict:
             f"scene {str(path)!r}: drakegrasp.contact_model is soft_finger but "
             "drakegrasp.torsional_friction is absent; add 'torsional_friction: "
             "NU' (nu >= 0: the moment about each contact normal is bounded by "
-            "b * nu * f_n; 0 makes a soft finger act as a hard one), or use "
-            "'contact_model: hard_finger'"
+            f"b * nu * f_n; 0 makes a soft finger act as a hard one), "
+            f"{LOADER_NU_REMEDY}, or use 'contact_model: hard_finger'"
         )
     description = section.get("description", "")
     close, close_direction = _close(path, section.get("close", False))

@@ -77,3 +77,45 @@ def test_the_range_s_ends_and_zero_are_taken(tmp_path, value):
     path = tmp_path / "scene.yaml"
     path.write_text(DEFAULT.replace("  mu: 0.5", f"  mu: {value}"))
     assert read_scene_info(path).mu == float(value)
+
+
+SOFT = DEFAULT.replace("contact_model: hard_finger", "contact_model: soft_finger")
+SOFT_WITHOUT_NU = SOFT.replace("  torsional_friction: 0.1\n", "")
+
+
+def test_the_loader_s_nu_completes_a_soft_finger_file_without_one(tmp_path):
+    path = tmp_path / "soft.yaml"
+    path.write_text(SOFT_WITHOUT_NU)
+    with pytest.raises(
+        SceneError, match=r"load_scene\(\.\.\., torsional_friction=NU\)"
+    ):
+        dg.load_scene(path)
+    scene = dg.load_scene(path, torsional_friction=0.05)
+    assert scene.options.torsional_friction == scene.info.torsional_friction == 0.05
+    # and replaces a file's own
+    path.write_text(SOFT)
+    assert dg.load_scene(path, torsional_friction=0.0).options.torsional_friction == 0
+
+
+@pytest.mark.parametrize("nu", [-1.0, float("nan"), 1e13, "0.1", True])
+def test_the_loader_s_nu_is_checked(tmp_path, nu):
+    path = tmp_path / "soft.yaml"
+    path.write_text(SOFT_WITHOUT_NU)
+    with pytest.raises(InvalidOptionError, match="torsional_friction"):
+        dg.load_scene(path, torsional_friction=nu)
+
+
+def test_analyze_completes_the_file_with_its_flag(tmp_path, capsys):
+    from drakegrasp.cli import main
+
+    path = tmp_path / "soft.yaml"
+    path.write_text(SOFT_WITHOUT_NU)
+    assert main(["analyze", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "give --torsional-friction NU" in err
+    assert "load_scene" not in err
+    assert main(["analyze", str(path), "--torsional-friction", "0.05"]) == 0
+    assert "nu = 0.05" in capsys.readouterr().out
+    assert main(["plan", str(path), "--num", "5"]) == 1  # plan has no such flag
+    err = capsys.readouterr().err
+    assert "load_scene" not in err and "--torsional-friction" not in err
