@@ -316,15 +316,29 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
             f"{MAX_COORDINATE:g} m along an axis (a cloud is in metres: divide "
             "one in millimetres by 1000)"
         )
-    finite = np.all(np.isfinite(points), axis=1)
+    finite_points = np.all(np.isfinite(points), axis=1)
+    finite = finite_points.copy()
     if normals is not None:
         finite &= np.all(np.isfinite(normals), axis=1)
     points = points[finite]
     normals = None if normals is None else normals[finite]
     if len(points) < 3:
+        bad_normals = int(np.sum(finite_points & ~finite))
+        if bad_normals:  # the points are there: their normals are not
+            raise InvalidOptionError(
+                f"point_cloud has {len(points)} points of {total} with a finite "
+                f"normal: {bad_normals} of its {int(finite_points.sum())} finite "
+                "points have a cloud_normals row that is not finite; too few "
+                "to grasp"
+            )
         raise InvalidOptionError(
             f"point_cloud has {len(points)} finite points of {total}: too few to "
             "grasp (NaN marks missing points)"
+        )
+    if not np.any(np.ptp(points, axis=0) > 0.0):
+        raise InvalidOptionError(
+            f"point_cloud's {len(points)} finite points all lie at one place "
+            f"({points[0].tolist()}): there is no surface to grasp"
         )
     _warn_of(points, total)
     fit = None

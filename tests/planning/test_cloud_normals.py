@@ -329,3 +329,25 @@ def test_a_plan_on_a_cloud_says_how_its_normals_were_estimated(given):
     assert fit["error_deg"] < 0.2
     line = f"cloud normals estimated over {fit['neighbours']} points a patch"
     assert line in str(result)
+
+
+def test_finite_points_with_non_finite_normals_are_named_as_such():
+    # All 300 points were finite; the refusal said "0 finite points of 300".
+    points, normals = _box_surface(300)
+    with pytest.raises(
+        InvalidOptionError, match="cloud_normals row that is not finite"
+    ):
+        read_cloud(points, normals * np.nan)
+    missing = points.copy()
+    missing[2:] = np.nan  # the points themselves missing: as before
+    with pytest.raises(InvalidOptionError, match="finite points of 300"):
+        read_cloud(missing)
+
+
+@pytest.mark.parametrize("normals", [None, "given"])
+def test_a_cloud_of_one_point_repeated_is_refused(normals):
+    # It passed the three-point check and planned nothing, with no reason.
+    points = np.tile([0.01, 0.02, 0.03], (100, 1))
+    given = None if normals is None else np.tile([0.0, 0.0, 1.0], (100, 1))
+    with pytest.raises(InvalidOptionError, match="all lie at one place"):
+        read_cloud(points, given)
