@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from drakegrasp.batch.columns import result_arrays
 from drakegrasp.batch.inputs import METRICS, shape_of
 from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
@@ -153,32 +154,6 @@ class BatchClosureResult:
         for name, v in self.metrics.items():
             lines.append(f"{name}: mean {np.nanmean(v) if K else np.nan:.6g}")
         return "\n".join(lines)
-
-
-def result_arrays(K: int, kind: str, metrics: Sequence[str] = ()):
-    """The per-grasp arrays of a ``kind`` result, ``K`` rows of their fill values.
-
-    The one list of a result's columns (names, dtypes, per-grasp shapes) in
-    the order of :meth:`BatchClosureResult.to_arrays`: :func:`collect` fills
-    them, and a writer given no grasps (``K = 0``) writes them empty, so a
-    file has the same columns for every ``K``.
-
-    Returns
-    -------
-    (dict of str to (K,) array, dict of str to (K,) array)
-        The result arrays (``normal_certificate`` for ``kind="force"`` only)
-        and the metrics, NaN until filled.
-    """
-    out = {
-        "is_closure": np.zeros(K, dtype=bool),
-        "d_star": np.zeros(K),
-        "rank": np.zeros(K, dtype=int),
-        "margin": np.zeros(K),
-        "converged": np.ones(K, dtype=bool),
-    }
-    if kind == "force":
-        out["normal_certificate"] = np.zeros(K, dtype=bool)
-    return out, {name: np.full(K, np.nan) for name in metrics}
 
 
 def collect(K: int, d: int, kind: str, tol: float, names, chunks):

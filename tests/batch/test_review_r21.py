@@ -75,7 +75,7 @@ def test_an_empty_batch_file_has_the_columns_of_any_other(tmp_path, kind, fmt):
 
 
 def test_the_empty_columns_are_those_a_result_is_collected_in():
-    from drakegrasp.batch.api import result_arrays
+    from drakegrasp.batch.columns import result_arrays
 
     out, metrics = result_arrays(0, "force", ("sigma_min",))
     P = np.zeros((0, 3, 3))

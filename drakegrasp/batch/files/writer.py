@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drakegrasp.batch.api import result_arrays
+from drakegrasp.batch.columns import result_arrays
 from drakegrasp.batch.files.npz import NpzWriter
 from drakegrasp.batch.files.parquet import ParquetWriter
 from drakegrasp.errors import BatchFileError, InvalidOptionError
@@ -279,7 +279,7 @@ def write_chunks(
     metrics : sequence of str, optional
         The run's metrics (default none), for a file of no grasps (``K = 0``),
         which then holds the columns a run of ``K > 0`` would (those that
-        ``drakegrasp.batch.api.result_arrays`` lists: ``normal_certificate``
+        ``drakegrasp.batch.columns.result_arrays`` lists: ``normal_certificate``
         for force closure, and the metrics).
 
     Returns
