@@ -24,12 +24,18 @@ Pairs between the object and bodies outside the hand (a table) are ignored.
 from __future__ import annotations
 
 import numpy as np
-from pydrake.geometry import ContactSurface, GeometryId, QueryObject
+from pydrake.geometry import ContactSurface, GeometryId, QueryObject, SceneGraph
 from pydrake.multibody.plant import ContactResults, MultibodyPlant
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.validation import real_array, unit_vectors
-from drakegrasp.errors import InvalidContactError, InvalidOptionError, NoContactsError
+from drakegrasp.errors import (
+    InvalidContactError,
+    InvalidOptionError,
+    InvalidPoseError,
+    ModelError,
+    NoContactsError,
+)
 from drakegrasp.plant._shapes import plane_basis
 from drakegrasp.plant.contact_normals import clean_unit as _clean_unit
 from drakegrasp.plant.contacts import (
@@ -120,6 +126,33 @@ def _surface_points_and_normal(
     return vertices, np.asarray(normal, dtype=float)
 
 
+def _checked_inspector(plant: MultibodyPlant, query_object: QueryObject):
+    """The query object's inspector, once it is known to serve ``plant``."""
+    source = plant.get_source_id()
+    if source is None:
+        raise ModelError("the plant is not registered with a SceneGraph; no geometry")
+    try:  # a default-constructed QueryObject answers no query
+        query_object.GetPoseInWorld(SceneGraph.world_frame_id())
+    except RuntimeError as e:
+        text = " ".join(str(e).split())
+        if "invalid QueryObject" in text:
+            raise InvalidOptionError(
+                f"query_object holds no scene graph's query ({text}); pass the "
+                "value of scene_graph.get_query_output_port()"
+            ) from None
+        raise InvalidPoseError(  # its poses: a bad state of the plant it reads
+            f"Drake cannot compute the geometry poses of query_object: {text}"
+        ) from None
+    inspector = query_object.inspector()
+    if not inspector.SourceIsRegistered(source):
+        raise InvalidOptionError(
+            "query_object comes from a scene graph that the plant "
+            f"{plant.get_name()!r} is not registered with; pass the query of the "
+            "plant's own scene graph"
+        )
+    return inspector
+
+
 def contacts_from_results(
     plant: MultibodyPlant,
     plant_context: Context,
@@ -157,18 +190,37 @@ def contacts_from_results(
     ------
     NoContactsError
         If no hand body touches the object in these results.
+    InvalidPoseError
+        If Drake cannot place the bodies at the context's state (a free
+        body's quaternion of zeros).
+    InvalidOptionError
+        If ``contact_results`` or ``query_object`` has the wrong type, or the
+        query object is not that of the plant's scene graph.
+    ModelError
+        If the plant is not registered with a SceneGraph.
     """
     if not isinstance(contact_results, ContactResults):
         raise InvalidOptionError(
             "contact_results must be pydrake ContactResults, got "
             f"{type(contact_results).__name__}"
         )
+    if not isinstance(query_object, QueryObject):
+        raise InvalidOptionError(
+            "query_object must be a pydrake.geometry.QueryObject, got "
+            f"{type(query_object).__name__}"
+        )
     plant.ValidateContext(plant_context)
     body = resolve_object_body(plant, object_body)
     fingers = {b.index(): b for b in hand_contact_bodies(plant, body, hand)}
-    inspector = query_object.inspector()
-    X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
+    try:  # every body's pose at once: a finite state can still be degenerate
+        X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
+    except RuntimeError as e:
+        raise InvalidPoseError(
+            "Drake cannot compute the body poses of this plant context (a free "
+            f"body's quaternion of zeros?): {' '.join(str(e).split())}"
+        ) from None
     R_OW = X_OW.rotation().matrix()
+    inspector = _checked_inspector(plant, query_object)
 
     def body_of(gid: GeometryId):
         return plant.GetBodyFromFrameId(inspector.GetFrameId(gid))

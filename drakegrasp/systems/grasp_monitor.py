@@ -12,8 +12,9 @@ import warnings
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.geometry import QueryObject
+from pydrake.geometry import QueryObject, SceneGraph
 from pydrake.multibody.plant import ContactResults, MultibodyPlant
+from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context, EventStatus, LeafSystem, State
 
 from drakegrasp.core.contact import ContactModel
@@ -64,6 +65,12 @@ from drakegrasp.systems.sensing import (
 )
 
 __all__ = ["GraspMonitor", "epsilon_l1"]
+
+
+def _one_line(error: BaseException) -> str:
+    """An exception's text on one line (Drake's are often several)."""
+    return " ".join(str(error).split())
+
 
 _STATUS_CODE = {"ok": 1.0, "no contact": 0.0, "invalid": -1.0, "not sampled": 0.0}
 
@@ -324,9 +331,82 @@ class GraspMonitor(LeafSystem):
         except RuntimeError as e:
             raise InvalidOptionError(
                 "this context belongs to another system; pass "
-                "monitor.GetMyContextFromRoot(root_context) or "
-                f"monitor.CreateDefaultContext() ({' '.join(str(e).split())})"
+                "monitor.GetMyContextFromRoot(root_context) (the root context of "
+                "the diagram that holds the monitor), or a "
+                "monitor.CreateDefaultContext() whose input ports were given "
+                f"values with FixValue ({_one_line(e)})"
             ) from None
+        ports = [self._state_port, self._query_port]
+        if self._results_port is not None:
+            ports.append(self._results_port)
+        missing = [port.get_name() for port in ports if not port.HasValue(context)]
+        if missing:
+            values = {
+                "plant_state": "the plant's [q; v]",
+                "query_object": "the scene graph's QueryObject",
+                "contact_results": "the plant's ContactResults",
+            }
+            several = len(missing) > 1
+            raise InvalidOptionError(
+                f"GraspMonitor {self.get_name()!r}: input port"
+                f"{'s' if several else ''} {', '.join(missing)} "
+                f"{'are' if several else 'is'} neither connected nor fixed in "
+                "this context; connect the monitor in a diagram "
+                "(add_grasp_monitor(builder, plant, scene_graph, ...) does) and "
+                "pass monitor.GetMyContextFromRoot(root_context), or give "
+                f"{'each' if several else 'it'} a value with "
+                "port.FixValue(context, value) ("
+                + "; ".join(f"{name}: {values[name]}" for name in missing)
+                + ")"
+            )
+
+    def _pose_problem(self, x: np.ndarray) -> str | None:
+        """Why Drake cannot place the bodies at the plant state ``x`` (or None).
+
+        A finite state can still be degenerate: a free body's quaternion of
+        zeros has no rotation.  Every body's pose is computed at once, so one
+        bad quaternion anywhere makes the whole sample unmeasurable.
+        """
+        try:
+            self._plant.EvalBodyPoseInWorld(self._plant_context, self._body)
+        except RuntimeError as e:
+            plant = self._plant
+            zero = []
+            for i in range(plant.num_bodies()):
+                body = plant.get_body(BodyIndex(i))
+                if body.is_floating_base_body() and body.has_quaternion_dofs():
+                    k = body.floating_positions_start()
+                    if not np.any(x[k : k + 4]):
+                        zero.append(_scoped_name(plant, body))
+            which = f" (the quaternion of {', '.join(map(repr, zero))} is zero)"
+            return (
+                "Drake cannot compute the body poses of this plant state"
+                f"{which if zero else ''}: {_one_line(e)}"
+            )
+        return None
+
+    def _query_problem(self, query) -> str | None:
+        """Why the ``query_object`` input cannot serve this plant (or None)."""
+        try:  # a default-constructed QueryObject answers no query
+            query.GetPoseInWorld(SceneGraph.world_frame_id())
+        except RuntimeError as e:
+            if "invalid QueryObject" in str(e):
+                return (
+                    "the query_object input holds no scene graph's query "
+                    f"({_one_line(e)}); connect scene_graph.get_query_output_port() "
+                    "to it, or fix it to a value of that port"
+                )
+            return (  # its scene graph's poses: a bad state of the plant it reads
+                f"Drake cannot answer the query_object input's queries: {_one_line(e)}"
+            )
+        source = self._plant.get_source_id()
+        if source is not None and not query.inspector().SourceIsRegistered(source):
+            return (
+                "the query_object input comes from a scene graph that the plant "
+                f"{self._plant.get_name()!r} is not registered with; connect the "
+                "query output port of the plant's own scene graph"
+            )
+        return None
 
     def _check_friction(self, contacts, query) -> None:
         """Warn, once, when the given ``mu`` is not the plant's at ``contacts``."""
@@ -384,6 +464,11 @@ class GraspMonitor(LeafSystem):
             status, message = "invalid", str(e)
         except (ValueError, ArithmeticError) as e:  # degenerate contact data
             status, message = "invalid", f"{type(e).__name__}: {e}"
+        except RuntimeError as e:  # Drake refused the sample's inputs
+            if type(e) is not RuntimeError:  # NotImplementedError, RecursionError
+                raise
+            status = "invalid"
+            message = f"Drake cannot sense this sample: {_one_line(e)}"
         loads = self._no_loads() if sensed is None else sensed.loads
         return status, message, None, loads
 
@@ -391,28 +476,36 @@ class GraspMonitor(LeafSystem):
         """Analyse the grasp at the inputs of ``context`` (one sample).
 
         The holding state continues from the sample held in ``context``'s
-        state (the previous sample).
+        state (the previous sample).  A plant state that Drake cannot place
+        (non-finite entries, a free body's quaternion of zeros) or a
+        ``query_object`` input that is not the plant's scene graph's gives an
+        ``"invalid"`` sample that says why and keeps the holding state before
+        it; so does a Drake error while sensing the contacts.
 
         Raises
         ------
         InvalidOptionError
-            If ``context`` is not a context of this monitor.
+            If ``context`` is not a context of this monitor, or one of its
+            input ports is neither connected nor fixed in it.
         """
         start = _time.perf_counter()
         self._validate(context)
         previous = context.get_abstract_state(self._report_index).get_value()
         t = context.get_time()
         x = np.array(self._state_port.Eval(context), dtype=float)
+        # A sample that cannot be sensed keeps the grip before it.
+        kept = (previous.memory, previous.loads, (np.nan, 0.0), previous.anchors)
         if not np.all(np.isfinite(x)):
             bad = np.flatnonzero(~np.isfinite(x))
-            kept = (previous.memory, previous.loads, (np.nan, 0.0))
-            kept += (previous.anchors,)
             message = (
                 f"the plant state has non-finite entries at indices {bad[:8].tolist()}"
             )
             return self._sample(t, "invalid", message, None, 0.0, x, start, grip=kept)
         self._plant.SetPositionsAndVelocities(self._plant_context, x)
         query = self._query_port.Eval(context)
+        problem = self._pose_problem(x) or self._query_problem(query)
+        if problem is not None:
+            return self._sample(t, "invalid", problem, None, 0.0, x, start, grip=kept)
         status, message, report, loads = self._analyse(context, query)
         grip = self._grip(previous, report, loads, query)
         epsilon = 0.0

@@ -69,6 +69,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -136,9 +137,8 @@ class HoldingThresholds:
 
     def __post_init__(self):
         for name in ("risk", "slip_speed", "separation_speed", "release_distance"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise InvalidOptionError(f"{name} must be a real number, got {value!r}")
+            value = real_scalar(name, getattr(self, name))  # numpy reals too
+            object.__setattr__(self, name, value)  # a float, whatever was given
             if not (np.isfinite(value) and value > 0):
                 raise InvalidOptionError(f"{name} must be finite and > 0, got {value}")
         if not 0 < self.risk <= 1:

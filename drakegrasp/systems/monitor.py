@@ -5,9 +5,12 @@ on the plant's configuration at a declared period (an analysis costs
 milliseconds, so not every simulation step) and holds the answer until the next
 sample::
 
-    plant state ──────────────▶ ┌──────────────┐ ──▶ verdicts (vector, 7)
+    plant state ──────────────▶ ┌──────────────┐ ──▶ verdicts (vector, 12 + 2 n)
     scene graph query ────────▶ │ GraspMonitor │
     contact results (optional) ▶└──────────────┘ ──▶ report (GraspSample)
+
+where ``n`` is the number of hand bodies: 18 entries for the parallel jaw's
+palm and two fingers, named by ``monitor.verdict_names`` (see "Outputs").
 
 Wiring: :func:`add_grasp_monitor` adds one to a ``DiagramBuilder`` and
 connects it to the plant and the scene graph.  This module is the monitor's
@@ -206,8 +209,10 @@ def add_grasp_monitor(
     Raises
     ------
     InvalidOptionError
-        If an argument has the wrong type, the builder was already built, or
-        the plant or scene graph is not in this builder.
+        If an argument has the wrong type, the builder was already built,
+        the plant or scene graph is not in this builder, or the plant is not
+        registered with this scene graph (two plants and scene graphs in one
+        builder: pass the pair that ``AddMultibodyPlantSceneGraph`` returned).
     """
     for arg, value, kind in (
         ("builder", builder, DiagramBuilder),
@@ -229,6 +234,14 @@ def add_grasp_monitor(
                 f"add_grasp_monitor: the {arg} {value.get_name()!r} is not in this "
                 "builder; pass the builder that holds the plant and scene graph"
             )
+    source = plant.get_source_id()
+    if source is None or not scene_graph.model_inspector().SourceIsRegistered(source):
+        raise InvalidOptionError(
+            f"add_grasp_monitor: the plant {plant.get_name()!r} is not registered "
+            f"with the scene graph {scene_graph.get_name()!r}, so that scene "
+            "graph's queries know none of its geometries; pass the plant's own "
+            "scene graph (the pair AddMultibodyPlantSceneGraph returned)"
+        )
     monitor = GraspMonitor(plant, **options)
     monitor.set_name(_unique_name(builder, name))
     builder.AddSystem(monitor)

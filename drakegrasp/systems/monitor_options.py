@@ -12,14 +12,13 @@ bad value stops there and not in the middle of a simulation.
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import check_flag
+from drakegrasp.core.validation import check_flag, describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.options import AnalysisOptions, resolve_options
 from drakegrasp.systems.holding import HoldingThresholds
@@ -89,12 +88,13 @@ class MonitorSettings:
 
 def seconds(name: str, value: Any, *, least: float) -> float:
     """``value`` as finite seconds >= ``least``, or an InvalidOptionError."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    try:  # numpy real scalars as HoldingThresholds takes them; never a bool
+        value = real_scalar(name, value)
+    except InvalidOptionError:
         raise InvalidOptionError(
-            f"{name} must be a real number of seconds, got {value!r} "
+            f"{name} must be a real number of seconds, got {describe(value)} "
             f"({type(value).__name__})"
-        )
-    value = float(value)
+        ) from None
     if not np.isfinite(value) or value < least:
         raise InvalidOptionError(
             f"{name} must be finite and >= {least:g} s, got {value!r}"
