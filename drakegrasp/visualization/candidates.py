@@ -22,6 +22,7 @@ import numpy as np
 from pydrake.geometry import Meshcat, Rgba, Role
 
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import describe, real_array, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.validation import plant_context_of, resolve_body
 from drakegrasp.visualization.plots import import_pyplot
@@ -46,20 +47,43 @@ def score_colors(scores, *, alpha: float = 0.4) -> np.ndarray:
     """(K, 4) RGBA colours of scores: red (lowest) → yellow → green (highest).
 
     Linear in the score between the lowest and the highest of ``scores``; all
-    green when they are equal.  ``alpha`` is the opacity (0 to 1).
+    green when they are equal.
+
+    Parameters
+    ----------
+    scores : array_like of real numbers
+        Any shape (flattened), every score finite; may be empty.
+    alpha : float, optional
+        The opacity, a real number in [0, 1].
+
+    Returns
+    -------
+    (K, 4) float
+        One RGBA row per score, in [0, 1].
+
+    Raises
+    ------
+    InvalidOptionError
+        For scores that are not real numbers (a string, complex, None) or not
+        finite, or an ``alpha`` that is not a real number in [0, 1].
     """
-    s = np.asarray(scores, dtype=float).reshape(-1)
-    if not 0.0 <= alpha <= 1.0:
-        raise InvalidOptionError(f"alpha must be in [0, 1], got {alpha}")
+    s = real_array("scores", scores, error=InvalidOptionError).reshape(-1)
+    a = real_scalar("alpha", alpha)
+    if not 0.0 <= a <= 1.0:
+        raise InvalidOptionError(f"alpha must be in [0, 1], got {describe(alpha)}")
     if not np.all(np.isfinite(s)):
-        raise InvalidOptionError(f"scores must be finite, got {s.tolist()}")
-    span = s.max() - s.min() if len(s) else 0.0
+        raise InvalidOptionError(f"scores must be finite, got {describe(s.tolist())}")
+    with np.errstate(over="ignore"):
+        span = s.max() - s.min() if len(s) else 0.0
+    if not np.isfinite(span):  # scores near ±1.8e308: compare them scaled down
+        s = s / np.max(np.abs(s))
+        span = s.max() - s.min()
     t = np.ones_like(s) if span <= 0 else (s - s.min()) / span
     x = 2.0 * t  # [0, 2] over the two segments of _STOPS
     k = np.minimum(x.astype(int), 1)
     f = (x - k)[:, None]
     rgb = (1 - f) * _STOPS[k] + f * _STOPS[k + 1]
-    return np.column_stack([rgb, np.full(len(s), alpha)])
+    return np.column_stack([rgb, np.full(len(s), a)])
 
 
 @dataclass(frozen=True)

@@ -26,13 +26,51 @@ from typing import Any
 import numpy as np
 from pydrake.geometry import Meshcat, MeshcatAnimation, Rgba, Role
 from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 
 from drakegrasp.certificates.certificate import ESCAPE_TWIST, Certificate
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.core.validation import (
+    check_length,
+    describe,
+    integer_or_none,
+    real_array,
+    real_scalar,
+)
+from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.options import PLANES
+from drakegrasp.plant.validation import (
+    check_plant,
+    plant_context_of,
+    resolve_body,
+    resolve_object_body,
+    scoped_name,
+)
+from drakegrasp.visualization.primitives import check_meshcat, check_path
 
-__all__ = ["EscapeAnimation", "animate_escape", "escape_transform"]
+__all__ = [
+    "MAX_AMOUNT",
+    "MAX_DURATION",
+    "MAX_FRAMES",
+    "MIN_DURATION",
+    "EscapeAnimation",
+    "animate_escape",
+    "escape_transform",
+]
+
+MAX_FRAMES = 3600
+"""Most frames of one sweep: a minute at 60 frames per second.  Recording is
+linear in the frames (10**5 frames took 6 to 10 s)."""
+
+MIN_DURATION = 0.01
+"""Shortest sweep, seconds (a shorter one is not seen)."""
+
+MAX_DURATION = 3600.0
+"""Longest sweep, seconds (an hour; ``inf`` made a frame rate of 0)."""
+
+MAX_AMOUNT = 100.0
+"""Largest ``amount``: the object moves by at most about 100 times the grasp's
+characteristic length ``b`` (the poses stay finite)."""
 
 _OBJECT = Rgba(0.95, 0.6, 0.1, 0.9)
 _HAND = Rgba(0.55, 0.55, 0.6, 1.0)
@@ -82,15 +120,15 @@ def escape_transform(twist: np.ndarray, p: np.ndarray, t: float) -> RigidTransfo
     return RigidTransform(R, pos)
 
 
-def _twist_3d(cert: Certificate, plane: str | None) -> tuple[np.ndarray, np.ndarray]:
-    x = np.asarray(cert.direction, float)
-    p = np.asarray(cert.reference_point, float)
+def _twist_3d(
+    x: np.ndarray, p: np.ndarray, plane: str | None
+) -> tuple[np.ndarray, np.ndarray]:
     if x.size == 6:
         return x, p
-    if plane not in PLANES:
+    if not isinstance(plane, str) or plane not in PLANES:
         raise InvalidOptionError(
             f"a planar escape twist needs its plane, one of {sorted(PLANES)}; "
-            f"got {plane!r}"
+            f"got {describe(plane)}"
         )
     i, j = PLANES[plane]
     k = 3 - i - j
@@ -100,30 +138,122 @@ def _twist_3d(cert: Certificate, plane: str | None) -> tuple[np.ndarray, np.ndar
     return twist, p3
 
 
+def _escape_twist(cert: Any) -> tuple[np.ndarray, np.ndarray, float, bool]:
+    """(direction, reference point, b, two_sided) of an escape twist, checked.
+
+    The direction keeps the certificate's scaling ``‖[v; b ω]‖ = 1`` (rescaled
+    to it only when it is off by more than round-off), so the poses stay finite.
+    """
+    if not isinstance(cert, Certificate) or cert.kind != ESCAPE_TWIST:
+        raise InvalidOptionError(
+            "animate_escape needs a form-closure 'no' (a result or report whose "
+            f"certificate is an escape twist); got {type(cert).__name__}"
+            + (f" of kind {cert.kind!r}" if isinstance(cert, Certificate) else "")
+        )
+    x = real_array(
+        "the certificate's direction", cert.direction, error=InvalidOptionError
+    )
+    if x.shape not in ((3,), (6,)) or not np.all(np.isfinite(x)) or not x.any():
+        raise InvalidOptionError(
+            "the escape twist must be a finite, non-zero (3,) or (6,) vector, got "
+            f"{describe(x.tolist())}"
+        )
+    d = 3 if x.size == 6 else 2  # the point's (and the linear part's) dimension
+    if cert.reference_point is None:
+        raise InvalidOptionError(
+            "the escape twist needs its reference_point (the point it is about)"
+        )
+    p = real_array(
+        "the certificate's reference_point",
+        cert.reference_point,
+        error=InvalidOptionError,
+    )
+    if p.shape != (d,) or not np.all(np.isfinite(p)):
+        raise InvalidOptionError(
+            f"the certificate's reference_point must be a finite ({d},) "
+            f"point for a ({x.size},) twist, got {describe(p.tolist())}"
+        )
+    b = check_length(
+        "the certificate's characteristic_length",
+        cert.characteristic_length,
+        error=InvalidOptionError,
+    )
+    top = float(np.max(np.abs(x)))
+    unit = x / top  # its norms cannot overflow
+    size = float(np.linalg.norm(np.concatenate([unit[:d], b * unit[d:]])))
+    if not abs(top * size - 1.0) <= 1e-9:  # the motion is proportional to x
+        x = unit / size
+    null_basis = real_array(
+        "the certificate's null_basis", cert.null_basis, error=InvalidOptionError
+    )
+    two_sided = null_basis.ndim > 0 and null_basis.shape[-1] > 0
+    return x, p, b, two_sided
+
+
 def _unpack(scene_or_plant, result, plant_context, object_body, plane):
-    """(plant, context, object body, certificate, plane) from the arguments."""
+    """(plant, context, object body, certificate arrays, plane), all checked."""
     plant = getattr(scene_or_plant, "plant", scene_or_plant)
-    context = plant_context or getattr(scene_or_plant, "plant_context", None)
-    body = object_body or getattr(scene_or_plant, "object_body", None)
+    if not isinstance(plant, MultibodyPlant):
+        raise InvalidOptionError(
+            "scene_or_plant must be a drakegrasp Scene (load_scene's) or a "
+            f"finalized MultibodyPlant, got {describe(scene_or_plant)} "
+            f"({type(scene_or_plant).__name__})"
+        )
+    check_plant(plant)
+    context = plant_context
+    if context is None:
+        context = getattr(scene_or_plant, "plant_context", None)
+    body = object_body
+    if body is None:
+        body = getattr(scene_or_plant, "object_body", None)
+    if plane is not None and (not isinstance(plane, str) or plane not in PLANES):
+        raise InvalidOptionError(
+            f"plane must be one of {sorted(PLANES)} or None, got {describe(plane)}"
+        )
     data = getattr(result, "data", None)  # a GraspReport
-    if data is not None:
-        plane = plane or data.plane
-        body = body or plant.GetBodyByName(*reversed(data.object_body.split("::")))
+    if data is not None and hasattr(result, "form_closure"):
+        analysed = getattr(data, "object_body", None)
+        if not isinstance(analysed, str):
+            raise InvalidOptionError(
+                "result looks like a GraspReport but names no object body; pass "
+                "analyze_grasp's report, its form_closure or a Certificate"
+            )
+        try:
+            report_body = resolve_body(plant, analysed)
+        except ModelError as e:
+            raise InvalidOptionError(
+                f"the report is of object body {analysed!r}, which this plant does "
+                f"not have ({e}); animate the report with the scene or plant it "
+                "was analysed in"
+            ) from None
+        if body is None:
+            body = report_body
+        else:
+            body = resolve_object_body(plant, body)
+            if body.index() != report_body.index():
+                raise InvalidOptionError(
+                    f"the report is of object body {analysed!r}, but the object "
+                    f"body to move is {scoped_name(plant, body)!r}; animate the "
+                    "report with the scene it was analysed in"
+                )
+        report_plane = getattr(data, "plane", None)
+        if plane is not None and report_plane is not None and plane != report_plane:
+            raise InvalidOptionError(
+                f"plane={plane!r}, but the report was analysed in the "
+                f"{report_plane!r} plane"
+            )
+        plane = plane or report_plane
         result = result.form_closure
-    cert = getattr(result, "certificate", result)
     if context is None or body is None:
         raise InvalidOptionError(
             "animate_escape needs a Scene, or a plant with plant_context= and "
             "object_body="
         )
-    if isinstance(body, str):
-        body = plant.GetBodyByName(body)
-    if not isinstance(cert, Certificate) or cert.kind != ESCAPE_TWIST:
-        raise InvalidOptionError(
-            "animate_escape needs a form-closure 'no' (a result or report whose "
-            f"certificate is an escape twist); got {type(cert).__name__}"
-        )
-    return plant, context, body, cert, plane
+    context = plant_context_of(plant, context)
+    body = resolve_object_body(plant, body)
+    if not isinstance(result, Certificate):
+        result = getattr(result, "certificate", result)
+    return plant, context, body, _escape_twist(result), plane
 
 
 def _draw_body(meshcat, inspector, plant, body, path, rgba) -> None:
@@ -156,37 +286,73 @@ def animate_escape(
     meshcat : Meshcat
     scene_or_plant : Scene or MultibodyPlant
         A :class:`~drakegrasp.Scene` (its plant, context and object body), or
-        a plant with ``plant_context`` and ``object_body``.
+        a finalized plant with ``plant_context`` and ``object_body``.
     result : GraspReport, ClosureResult or Certificate
         A form-closure "no" whose certificate is an escape twist (a report's
-        ``form_closure``).
+        ``form_closure``).  A report must be of this plant's object body: its
+        ``data.object_body`` must name a body of the plant, the one moved.
     plant_context, object_body : optional
-        For a bare plant (``object_body``: a body or its name).
+        For a bare plant (``object_body``: a body, ``BodyIndex`` or name);
+        ``plant_context`` may be the diagram's root context.
     plane : str, optional
-        Plane of a planar analysis (``"yz"``...); a report gives its own.
+        Plane of a planar analysis (``"xy"``, ``"yz"`` or ``"zx"``); a report
+        gives its own (a different one is refused).
     amount : float, optional
         Largest twist parameter over ``b`` (the unit twist moves points by
-        about 1 m/s, so ``amount · b`` moves them by about ``amount · b``).
+        about 1 m/s, so ``amount · b`` moves them by about ``amount · b``): a
+        real number in ``(0, MAX_AMOUNT]`` = (0, 100].
     duration : float, optional
-        Seconds of one sweep.
+        Seconds of one sweep: a real number in ``[MIN_DURATION, MAX_DURATION]``
+        = [0.01, 3600].
     frames : int, optional
-        Frames of one sweep.
+        Frames of one sweep: an integer in ``[2, MAX_FRAMES]`` = [2, 3600]
+        (not a float: ``2.5`` frames is refused).
     prefix : str, optional
-        Meshcat path of the drawing (deleted first).
+        Meshcat path of the drawing (deleted first), non-empty.
 
     Returns
     -------
     EscapeAnimation
+
+    Raises
+    ------
+    InvalidOptionError
+        For ``frames``, ``duration`` or ``amount`` out of range (or not
+        numbers), a ``scene_or_plant`` that is neither a Scene nor a plant
+        (None too), a report whose object body is not in the plant or is not
+        the body to move, a result without an escape twist (or a twist that
+        is not finite and non-zero), a planar twist without its plane, an
+        empty ``prefix`` or a ``meshcat`` that is not a Meshcat.
+    ModelError
+        For a plant that is not finalized, or an ``object_body`` that is not
+        one of its bodies.
+    InvalidContextError
+        For a ``plant_context`` of another system.
     """
-    plant, context, body, cert, plane = _unpack(
+    check_meshcat(meshcat)
+    check_path("prefix", prefix)
+    frames_n = integer_or_none(frames)
+    if frames_n is None or not (2 <= frames_n <= MAX_FRAMES):
+        raise InvalidOptionError(
+            f"frames must be an integer >= 2 and <= {MAX_FRAMES} "
+            "(drakegrasp.visualization.escape.MAX_FRAMES), got "
+            f"{describe(frames)}"
+        )
+    duration = real_scalar("duration", duration)
+    if not (MIN_DURATION <= duration <= MAX_DURATION):
+        raise InvalidOptionError(
+            f"duration must be a real number of seconds in [{MIN_DURATION:g}, "
+            f"{MAX_DURATION:g}], got {duration!r}"
+        )
+    amount = real_scalar("amount", amount)
+    if not (0.0 < amount <= MAX_AMOUNT):
+        raise InvalidOptionError(
+            f"amount must be a real number > 0 and <= {MAX_AMOUNT:g}, got {amount!r}"
+        )
+    plant, context, body, (x, p_cert, b, two_sided), plane = _unpack(
         scene_or_plant, result, plant_context, object_body, plane
     )
-    if not (frames >= 2 and duration > 0 and amount > 0):
-        raise InvalidOptionError(
-            f"need frames >= 2, duration > 0 and amount > 0; got {frames}, "
-            f"{duration}, {amount}"
-        )
-    twist, p = _twist_3d(cert, plane)
+    twist, p = _twist_3d(x, p_cert, plane)
     inspector = plant.get_geometry_query_input_port().Eval(context).inspector()
     meshcat.Delete(prefix)
     for other in range(plant.num_bodies()):
@@ -199,10 +365,10 @@ def animate_escape(
     obj = f"{prefix}/object"
     _draw_body(meshcat, inspector, plant, body, obj, _OBJECT)
     X_WO = plant.EvalBodyPoseInWorld(context, body)
-    t_max = amount * cert.characteristic_length
-    ramp = np.linspace(0.0, 1.0, frames)
-    times = t_max * (np.concatenate([ramp, -ramp]) if cert.two_sided else ramp)
-    animation = MeshcatAnimation(frames_per_second=frames / duration)
+    t_max = amount * b
+    ramp = np.linspace(0.0, 1.0, frames_n)
+    times = t_max * (np.concatenate([ramp, -ramp]) if two_sided else ramp)
+    animation = MeshcatAnimation(frames_per_second=frames_n / duration)
     transforms = []
     for n, t in enumerate(times):
         X = X_WO @ escape_transform(twist, p, float(t))

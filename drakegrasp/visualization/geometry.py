@@ -24,7 +24,7 @@ Either way an arrow's direction is the force ``f`` itself (in the grasp frame).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -32,19 +32,54 @@ import numpy as np
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.validation import (
+    COEFFICIENT_MAX,
+    LENGTH_BOUND,
+    LENGTH_MIN,
+    check_coefficient,
+    describe,
+    integer_or_none,
+    real_array,
+    real_scalar,
+)
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
+    "DRAW_LENGTH_MAX",
+    "DRAW_LENGTH_MIN",
+    "MAX_CONE_SEGMENTS",
     "contact_forces_in_grasp_frame",
     "contact_pose_3d",
     "cone_edge_directions",
     "exact_cone_mesh",
     "normalize_contact_forces",
+    "positive_length",
     "pyramid_mesh",
     "side_sign",
 ]
 
 SIDES = ("outside", "inside")
+
+DRAW_LENGTH_MAX = LENGTH_BOUND
+"""Largest length (metres) a drawing takes: 1e30, the largest characteristic
+length a grasp may have (:data:`drakegrasp.core.validation.LENGTH_BOUND`).
+
+Sizes, heights, radii, arrow lengths and a camera's padding are refused above
+it, so every default (a fraction of a valid ``b``) is in range and every number
+a drawing computes stays finite: positions are at most
+:data:`~drakegrasp.core.validation.POSITION_BOUND` (1e20 m) and ``μ`` at most
+1e12, so a drawn vertex is below 1e43 m and its square below 1e87 (a size of
+1e300 overflowed a norm to ``inf`` and Drake refused the arrow)."""
+
+DRAW_LENGTH_MIN = LENGTH_MIN
+"""Smallest length (metres) a drawing takes: the smallest normal double,
+2.2e-308 (:data:`drakegrasp.core.validation.LENGTH_MIN`).  The fractions of a
+length that a drawing uses (a triad's radius is 0.2 times a sphere's) then stay
+> 0, which Drake's shapes demand."""
+
+MAX_CONE_SEGMENTS = 1024
+"""Most triangles around the axis of :func:`exact_cone_mesh` (the drawings use
+16 and 48; 10**9 once tried to allocate 48 GB)."""
 
 
 def merge_palette(
@@ -81,19 +116,55 @@ def side_sign(side: str) -> float:
     InvalidOptionError
         If ``side`` is neither.
     """
-    if side not in SIDES:
-        raise InvalidOptionError(f"side must be 'outside' or 'inside', got {side!r}")
+    if not isinstance(side, str) or side not in SIDES:
+        raise InvalidOptionError(
+            f"side must be 'outside' or 'inside', got {describe(side)}"
+        )
     return -1.0 if side == "outside" else 1.0
 
 
-def positive_length(name: str, value: Any) -> float:
-    """Return ``value`` as a finite positive float or raise InvalidOptionError."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidOptionError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(x) or x <= 0.0:
-        raise InvalidOptionError(f"{name} must be finite and > 0, got {value!r}")
+def positive_length(name: str, value: Any, *, unit: str = "metres") -> float:
+    """``value`` as a length a drawing can take, or InvalidOptionError.
+
+    Parameters
+    ----------
+    name : str
+        Name of the argument, for the message.
+    value : int or float
+        A real number (numpy real scalars too; not a string, a bool or None).
+    unit : str, optional
+        Its unit, for the message (a force scale is in m/N).
+
+    Returns
+    -------
+    float
+        In ``[DRAW_LENGTH_MIN, DRAW_LENGTH_MAX]`` = [2.2e-308, 1e30] metres.
+
+    Raises
+    ------
+    InvalidOptionError
+        For anything else (NaN, ``inf``, 0, a negative number, a string...),
+        naming ``name`` and the valid range.
+    """
+    x = real_scalar(name, value)
+    if not (DRAW_LENGTH_MIN <= x <= DRAW_LENGTH_MAX):
+        raise InvalidOptionError(
+            f"{name} must be finite and > 0, a real number in [{DRAW_LENGTH_MIN:.3g}, "
+            f"{DRAW_LENGTH_MAX:g}] {unit} "
+            "(drakegrasp.visualization.geometry.DRAW_LENGTH_MIN/MAX), got "
+            f"{describe(value)}"
+        )
+    return x
+
+
+def check_sign(value: Any) -> float:
+    """``sign`` of a cone drawing: ``+1.0`` or ``-1.0`` (InvalidOptionError else)."""
+    x = real_scalar("sign", value)
+    if x not in (1.0, -1.0):
+        raise InvalidOptionError(
+            f"sign must be +1 (the cone opens along +x) or -1 (reflected through "
+            f"the apex), got {describe(value)}"
+        )
     return x
 
 
@@ -156,6 +227,11 @@ def normalize_contact_forces(grasp: Grasp, forces: Any) -> list[np.ndarray] | No
         forces = forces.contact_forces
         if forces is None:
             return None
+    if isinstance(forces, (str, bytes)) or not isinstance(forces, Iterable):
+        raise InvalidOptionError(
+            "forces must be a ClosureResult or one array of force components per "
+            f"contact, got {describe(forces)} ({type(forces).__name__})"
+        )
     forces = list(forces)
     if not forces:
         return None
@@ -166,7 +242,7 @@ def normalize_contact_forces(grasp: Grasp, forces: Any) -> list[np.ndarray] | No
         )
     out = []
     for i, (f, contact) in enumerate(zip(forces, grasp.contacts, strict=True)):
-        a = np.asarray(f, dtype=float).reshape(-1)
+        a = real_array(f"force of contact {i}", f, error=InvalidOptionError).reshape(-1)
         k = contact.num_components
         if a.size > k or a.size == 0:
             raise InvalidOptionError(
@@ -244,14 +320,18 @@ def exact_cone_mesh(
     Parameters
     ----------
     mu : float
-        Friction coefficient, ``> 0``.
+        Friction coefficient: ``> 0``, in [1e-12, 1e12] (0, a ray, is accepted
+        too), the range of a contact's ``μ``
+        (:data:`drakegrasp.core.validation.COEFFICIENT_MIN`/``MAX``).
     height : float
-        Extent along the cone's axis, metres.
+        Extent along the cone's axis, metres, in ``[DRAW_LENGTH_MIN,
+        DRAW_LENGTH_MAX]`` (see :func:`positive_length`).
     num_segments : int, optional
-        Triangles around the axis (>= 3).
+        Triangles around the axis, an integer in ``[3, MAX_CONE_SEGMENTS]`` =
+        [3, 1024].
     sign : float, optional
         ``+1`` opens the cone along ``+x``, ``-1`` reflects it through the apex
-        (see the module notes on ``side``).
+        (see the module notes on ``side``); nothing else.
 
     Returns
     -------
@@ -260,10 +340,23 @@ def exact_cone_mesh(
         the origin, then the rim points ``sign · h [1, μ cos θ_k, μ sin θ_k]``.
     faces : (num_segments, 3) int
         Triangles ``(apex, k, k+1)`` indexing ``vertices``.
+
+    Raises
+    ------
+    InvalidOptionError
+        For a ``mu``, ``height``, ``num_segments`` or ``sign`` outside its
+        range (NaN, a negative ``mu``, a string...), naming it.
     """
-    n = int(num_segments)
-    if n < 3:
-        raise InvalidOptionError(f"num_segments must be >= 3, got {num_segments!r}")
+    mu = check_coefficient("mu", mu, error=InvalidOptionError)
+    height = positive_length("height", height)
+    n = integer_or_none(num_segments, integral_floats=True)
+    if n is None or not (3 <= n <= MAX_CONE_SEGMENTS):
+        raise InvalidOptionError(
+            f"num_segments must be an integer >= 3 and <= {MAX_CONE_SEGMENTS} "
+            "(drakegrasp.visualization.geometry.MAX_CONE_SEGMENTS), got "
+            f"{describe(num_segments)}"
+        )
+    sign = check_sign(sign)
     theta = 2.0 * np.pi * np.arange(n) / n
     rim = np.column_stack([np.full(n, 1.0), mu * np.cos(theta), mu * np.sin(theta)]) * (
         sign * height
@@ -301,10 +394,12 @@ def pyramid_mesh(
     Parameters
     ----------
     generators : (3, m) float
-        Generators ``s_k`` in the contact frame, ordered around the axis, each
-        with first component 1.
+        ``m >= 3`` generators ``s_k`` in the contact frame, ordered around the
+        axis, each with first component 1 (any finite first component > 0:
+        each is divided by it; the others at most 1e12 times it).
     height : float
-        Extent along the axis, metres: edge ``k`` ends at ``sign · h s_k``.
+        Extent along the axis, metres: edge ``k`` ends at ``sign · h s_k``
+        (a length as :func:`positive_length` takes).
     sign : float, optional
         ``+1`` or ``-1`` (reflection through the apex).
 
@@ -314,10 +409,35 @@ def pyramid_mesh(
         Apex (row 0) then the edge ends, in the contact frame.
     faces : (m, 3) int
         Triangles ``(apex, k, k+1)``.
+
+    Raises
+    ------
+    InvalidOptionError
+        For generators that are not a finite (3, m) array with first row > 0,
+        or a bad ``height`` or ``sign``.
     """
-    S = np.asarray(generators, dtype=float)
+    S = real_array("generators", generators, error=InvalidOptionError)
+    if S.ndim != 2 or S.shape[0] != 3 or S.shape[1] < 3:
+        raise InvalidOptionError(
+            "generators must be a (3, m) array with m >= 3 (one column per edge "
+            f"of the pyramid), got shape {S.shape}"
+        )
+    with np.errstate(all="ignore"):
+        edges = S / S[0]
+    if not (
+        np.all(np.isfinite(S))
+        and np.all(S[0] > 0.0)
+        and np.all(np.abs(edges) <= COEFFICIENT_MAX)
+    ):
+        raise InvalidOptionError(
+            "generators must be finite, each with a first (normal) component > 0 "
+            f"and the others at most {COEFFICIENT_MAX:g} times it (mu <= "
+            f"{COEFFICIENT_MAX:g}), got {describe(S.tolist())}"
+        )
+    height = positive_length("height", height)
+    sign = check_sign(sign)
     m = S.shape[1]
-    vertices = np.vstack([np.zeros(3), (sign * height) * (S / S[0]).T])
+    vertices = np.vstack([np.zeros(3), (sign * height) * edges.T])
     k = np.arange(m)
     faces = np.column_stack([np.zeros(m, dtype=int), 1 + k, 1 + (k + 1) % m])
     return vertices, faces

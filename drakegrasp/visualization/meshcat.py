@@ -34,8 +34,10 @@ from pydrake.systems.framework import Context
 
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
+from drakegrasp.core.validation import check_flag, check_num_generators, safe_norm
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.geometry import (
+    DRAW_LENGTH_MAX,
     contact_pose_3d,
     exact_cone_mesh,
     merge_palette,
@@ -45,10 +47,18 @@ from drakegrasp.visualization.geometry import (
     pyramid_mesh,
     side_sign,
 )
-from drakegrasp.visualization.meshcat_certificates import draw_result_certificate
-from drakegrasp.visualization.primitives import _draw_arrow, _set_mesh
-from drakegrasp.visualization.robot import set_translucent
-from drakegrasp.visualization.view import CameraView, frame_points, grasp_pose
+from drakegrasp.visualization.meshcat_certificates import (
+    draw_certificate,
+    result_certificate,
+)
+from drakegrasp.visualization.primitives import (
+    _draw_arrow,
+    _set_mesh,
+    check_meshcat,
+    check_path,
+)
+from drakegrasp.visualization.robot import set_translucent, translucent_arguments
+from drakegrasp.visualization.view import CameraView, camera_view, grasp_pose
 
 __all__ = [
     "DEFAULT_PREFIX",
@@ -184,13 +194,19 @@ def draw_grasp(
         or none.  Planar cones are exact wedges in the plane either way; a
         frictionless contact's cone is the ray along its normal.
     num_generators : int, optional
-        Edges of the pyramid (spatial contacts).
+        Edges of the pyramid (spatial contacts), an integer in [3, 256].
     cone_height : float, optional
         Extent of each cone along its normal, metres.  Default: 0.4 b, with b
-        the grasp's characteristic length.
+        the grasp's characteristic length.  Like every length given here, a
+        real number (numpy's too; not a string or a bool) in
+        ``[DRAW_LENGTH_MIN, DRAW_LENGTH_MAX]`` = [2.2e-308, 1e30] metres
+        (:mod:`drakegrasp.visualization.geometry`), so that everything drawn
+        stays finite.
     force_scale : float, optional
-        Arrow length per newton (m/N).  Default: the largest force is drawn
-        0.6 b long.
+        Arrow length per newton (m/N), in the same range.  Default: the
+        largest force is drawn 0.6 b long.  The largest force's arrow,
+        ``force_scale`` times its magnitude, must not exceed
+        ``DRAW_LENGTH_MAX`` either.
     point_radius : float, optional
         Radius of the contact spheres, metres.  Default 0.04 b.
     frame_length : float, optional
@@ -209,11 +225,13 @@ def draw_grasp(
         Draw over everything else in the scene (no depth test), so that a
         robot drawn by ``MeshcatVisualizer`` never hides the drawing: with
         ``side="outside"`` the cones and arrows lie inside the finger meshes,
-        with ``"inside"`` inside the object.  Default False.
+        with ``"inside"`` inside the object.  Default False.  ``show_frames``,
+        ``on_top`` and ``keep_camera`` are True or False (numpy booleans too).
     size : float, optional
         Length (metres) that the default sizes are fractions of: pass the
         object's size (e.g. the diagonal of its bounding box) to draw to the
-        object's scale.  Default: the grasp's characteristic length b.
+        object's scale.  Default: the grasp's characteristic length b (which
+        is in range: a grasp's b is at most 1e30 m).
     translucent : str or sequence of str, optional
         Meshcat paths to make translucent with :func:`set_translucent` (e.g.
         ``"visualizer/gripper"``, a hand drawn by ``MeshcatVisualizer``).
@@ -246,9 +264,16 @@ def draw_grasp(
     Raises
     ------
     InvalidOptionError
-        For an unknown ``cone``, ``side`` or colour key, a non-positive size,
-        forces that do not match the grasp's contacts, or both ``X_WG`` and a
-        plant (or a plant without its context and object body).
+        For an unknown ``cone``, ``side`` or colour key, a length that is not
+        a real number in ``[DRAW_LENGTH_MIN, DRAW_LENGTH_MAX]`` (NaN, 0, a
+        negative one, 1e300, the string ``"1"``...), a force arrow longer
+        than ``DRAW_LENGTH_MAX``, forces that are not real or do not match the
+        grasp's contacts, a result whose certificate belongs to another grasp,
+        a flag that is not a boolean, bad ``translucent`` paths or opacity,
+        contact points the camera cannot frame
+        (:func:`~drakegrasp.visualization.view.frame_points`), or both
+        ``X_WG`` and a plant (or a plant without its context and object body).
+        Everything is checked before anything is drawn.
     """
     _check_meshcat(meshcat)
     if not isinstance(grasp, Grasp):
@@ -260,27 +285,28 @@ def draw_grasp(
         raise InvalidOptionError(
             f"cone must be 'exact', 'pyramid', 'both' or None, got {cone!r}"
         )
-    if not isinstance(prefix, str) or not prefix.strip("/"):
-        raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
+    check_path("prefix", prefix)
     sign = side_sign(side)
     palette = merge_palette(MESHCAT_COLORS, colors)
-    b = grasp.characteristic_length if size is None else positive_length("size", size)
-    h = positive_length("cone_height", 0.4 * b if cone_height is None else cone_height)
-    r = positive_length(
-        "point_radius", 0.04 * b if point_radius is None else point_radius
-    )
-    axis_len = positive_length(
-        "frame_length", 0.2 * b if frame_length is None else frame_length
-    )
+    # Given lengths are checked; the defaults are fractions of b (or of size),
+    # which is itself in range, so they are > 0 and finite too.
+    b = _length("size", size, grasp.characteristic_length)
+    h = _length("cone_height", cone_height, 0.4 * b)
+    r = _length("point_radius", point_radius, 0.04 * b)
+    axis_len = _length("frame_length", frame_length, 0.2 * b)
     X_WG = grasp_pose(X_WG, plant, plant_context, object_body)
-    if not isinstance(keep_camera, bool | np.bool_):
-        raise InvalidOptionError(
-            f"keep_camera must be True or False, got {keep_camera!r}"
-        )
+    translucent, translucent_opacity = translucent_arguments(
+        translucent, translucent_opacity
+    )
+    num_generators = check_num_generators(num_generators)
+    show_frames = check_flag("show_frames", show_frames)
+    on_top = check_flag("on_top", on_top)
+    keep_camera = check_flag("keep_camera", keep_camera)
 
     forces = normalize_contact_forces(grasp, result)
     forces_G = None
     scale = 0.0
+    longest = 0.0
     if forces is not None:
         forces_G = np.zeros((grasp.num_contacts, 3))
         for i, (contact, f) in enumerate(zip(grasp.contacts, forces, strict=True)):
@@ -289,11 +315,26 @@ def draw_grasp(
             m = min(contact.dim, f.size)
             local[:m] = f[:m]
             forces_G[i] = R3 @ local
-        largest = float(np.max(np.linalg.norm(forces_G, axis=1)))
+        largest = float(np.max(safe_norm(forces_G, axis=1)))  # no overflow
         if force_scale is not None:
-            scale = positive_length("force_scale", force_scale)
+            scale = positive_length("force_scale", force_scale, unit="m/N")
         elif largest > 0:
             scale = 0.6 * b / largest
+        longest = scale * largest
+        if not longest <= DRAW_LENGTH_MAX:
+            raise InvalidOptionError(
+                f"force_scale {scale!r} m/N draws the largest force ({largest:.6g} "
+                f"N) {longest:.6g} m long, beyond the longest arrow drawn, "
+                f"{DRAW_LENGTH_MAX:g} m "
+                "(drakegrasp.visualization.geometry.DRAW_LENGTH_MAX); pass a "
+                "smaller force_scale"
+            )
+    certificate = result_certificate(grasp, result)  # why "no"; None for a "yes"
+    view = None
+    if not keep_camera:  # checked before anything is drawn
+        reach = max(h if cone is not None else 0.0, axis_len, r, longest)
+        points_W = [X_WG.multiply(contact_pose_3d(c)[1]) for c in grasp.contacts]
+        view = camera_view(np.array(points_W), pad=reach)
 
     meshcat.Delete(prefix)
     meshcat.SetTransform(prefix, X_WG)
@@ -339,7 +380,7 @@ def draw_grasp(
 
         if forces_G is not None and scale > 0:
             f_C = R3.T @ forces_G[i]
-            if np.linalg.norm(f_C) * scale > 1e-9 * b:
+            if float(safe_norm(f_C)) * scale > 1e-9 * b:
                 vec = scale * f_C
                 tail = np.zeros(3) if sign > 0 else -vec
                 leaves += _draw_arrow(
@@ -351,7 +392,10 @@ def draw_grasp(
                     rgba=_rgba(palette, "force"),
                 )
                 paths.append(f"{base}/force")
-    certificate = draw_result_certificate(meshcat, grasp, result, prefix)  # why "no"
+    if certificate is not None:
+        certificate = draw_certificate(meshcat, grasp, certificate, prefix=prefix)
+    else:
+        certificate = ()
     paths += certificate
     if on_top:
         # Arrows are groups (shaft, head): their parts carry the materials.
@@ -368,13 +412,15 @@ def draw_grasp(
     if translucent:
         set_translucent(meshcat, translucent, translucent_opacity)
     camera = None
-    if not keep_camera:
-        reach = max(h if cone is not None else 0.0, axis_len, r)
-        if forces_G is not None:
-            reach = max(reach, scale * float(np.max(np.linalg.norm(forces_G, axis=1))))
-        points_W = [X_WG.multiply(contact_pose_3d(c)[1]) for c in grasp.contacts]
-        camera = frame_points(meshcat, np.array(points_W), pad=reach)
+    if view is not None:
+        meshcat.SetCameraPose(view.position_W, view.target_W)
+        camera = view
     return GraspDrawing(prefix, tuple(paths), h, scale, forces_G, camera)
+
+
+def _length(name: str, value: Any, default: float) -> float:
+    """A given length, checked; else the default (a fraction of a valid b)."""
+    return default if value is None else positive_length(name, value)
 
 
 def _draw_cone(
@@ -432,20 +478,11 @@ def _draw_cone(
 def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
     """Delete a drawing made by :func:`draw_grasp` (everything under ``prefix``)."""
     _check_meshcat(meshcat)
-    if not isinstance(prefix, str) or not prefix.strip("/"):
-        raise InvalidOptionError(f"prefix must be a non-empty path, got {prefix!r}")
+    check_path("prefix", prefix)
     meshcat.Delete(prefix)
 
 
-def _check_meshcat(meshcat) -> None:
-    # Duck-typed, so wrappers of a Meshcat (recorders in tests) still work.
-    if not isinstance(meshcat, Meshcat) and not all(
-        callable(getattr(meshcat, name, None))
-        for name in ("SetObject", "SetTransform", "Delete")
-    ):
-        raise InvalidOptionError(
-            f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
-        )
+_check_meshcat = check_meshcat  # the name this module used
 
 
 def _check_rgba_colors(colors) -> None:

@@ -18,9 +18,10 @@ from typing import Any
 import numpy as np
 
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.validation import check_length
+from drakegrasp.core.validation import check_length, safe_norm
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.geometry import (
+    DRAW_LENGTH_MAX,
     cone_edge_directions,
     contact_forces_in_grasp_frame,
     merge_palette,
@@ -227,16 +228,24 @@ def plot_planar_grasp(
     sign = side_sign(side)
     palette = merge_palette(PLOT_COLORS, colors)
     b = grasp.characteristic_length
-    L = positive_length("cone_length", 0.3 * b if cone_length is None else cone_length)
+    # A given length is checked; the default is a fraction of a valid b.
+    L = 0.3 * b if cone_length is None else positive_length("cone_length", cone_length)
     forces = normalize_contact_forces(grasp, result)
     f_G = None if forces is None else contact_forces_in_grasp_frame(grasp, forces)
     scale = 0.0
     if f_G is not None:
-        largest = float(np.max(np.linalg.norm(f_G, axis=1)))
+        largest = float(np.max(safe_norm(f_G, axis=1)))  # no overflow
         if force_scale is not None:
-            scale = positive_length("force_scale", force_scale)
+            scale = positive_length("force_scale", force_scale, unit="m/N")
         elif largest > 0:
             scale = 0.6 * b / largest
+        if not scale * largest <= DRAW_LENGTH_MAX:
+            raise InvalidOptionError(
+                f"force_scale {scale!r} m/N draws the largest force ({largest:.6g} "
+                f"N) {scale * largest:.6g} m long, beyond {DRAW_LENGTH_MAX:g} m "
+                "(drakegrasp.visualization.geometry.DRAW_LENGTH_MAX); pass a "
+                "smaller force_scale"
+            )
     plt = import_pyplot()
     from matplotlib.patches import Polygon
 

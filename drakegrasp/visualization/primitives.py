@@ -9,9 +9,33 @@ import numpy as np
 from pydrake.geometry import Cylinder, Meshcat, Rgba
 from pydrake.math import RigidTransform, RotationMatrix
 
+from drakegrasp.core.validation import safe_norm
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.geometry import exact_cone_mesh
 
 __all__: list[str] = []
+
+_UNIT_CONE = exact_cone_mesh(1.0, 1.0, num_segments=16)
+"""An arrow head's cone, 1 high and 1 in radius, opening along +x."""
+
+
+def check_meshcat(meshcat) -> None:
+    """Refuse anything that is not a Meshcat (or quacks like one)."""
+    # Duck-typed, so wrappers of a Meshcat (recorders in tests) still work.
+    if not isinstance(meshcat, Meshcat) and not all(
+        callable(getattr(meshcat, name, None))
+        for name in ("SetObject", "SetTransform", "Delete")
+    ):
+        raise InvalidOptionError(
+            f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
+        )
+
+
+def check_path(name: str, value) -> str:
+    """A Meshcat path: a string with something besides slashes."""
+    if not isinstance(value, str) or not value.strip("/"):
+        raise InvalidOptionError(f"{name} must be a non-empty path, got {value!r}")
+    return value
 
 
 def _set_mesh(meshcat: Meshcat, path: str, vertices, faces, rgba: Rgba, **kw) -> None:
@@ -37,17 +61,22 @@ def _draw_arrow(
 
     Returns the paths of its parts (shaft, head).
     """
-    length = float(np.linalg.norm(vector))
+    vector = np.asarray(vector, dtype=float)
+    length = float(safe_norm(vector))
+    if not (0.0 < length < np.inf):  # the callers draw finite, non-zero arrows
+        return []
     head = min(0.35 * length, 5.0 * radius)
     shaft = length - head
-    R = RotationMatrix.MakeFromOneVector(vector, 2)
+    # The unit vector: Drake refuses to normalise one shorter than 1e-10 itself.
+    R = RotationMatrix.MakeFromOneVector(vector / length, 2)
     meshcat.SetTransform(path, RigidTransform(R, tail))
     if shaft > 0:
         meshcat.SetObject(f"{path}/shaft", Cylinder(radius, shaft), rgba)
         meshcat.SetTransform(f"{path}/shaft", RigidTransform([0.0, 0.0, shaft / 2]))
     # Head: a cone with its apex at the tip, opening back along -z (the mesh
     # opens along +x; a rotation by π/2 about y takes +x to -z).
-    v, f = exact_cone_mesh(2.0 * radius / head, head, num_segments=16)
+    v, f = _UNIT_CONE  # scaled, not built with μ = 2r / head (which overflows)
+    v = v * np.array([head, 2.0 * radius, 2.0 * radius])
     _set_mesh(meshcat, f"{path}/head", v, f, rgba)
     meshcat.SetTransform(
         f"{path}/head",

@@ -8,12 +8,15 @@ their opacity.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
-from pydrake.geometry import Meshcat, Role
+from pydrake.geometry import Meshcat, Role, SceneGraph
 from pydrake.multibody.tree import ModelInstanceIndex
 
+from drakegrasp.core.validation import describe, integer_or_none, real_scalar
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.plant.validation import check_plant
+from drakegrasp.visualization.primitives import check_meshcat, check_path
 
 __all__ = ["set_translucent", "visualizer_paths"]
 
@@ -33,25 +36,43 @@ def visualizer_paths(
     plant : pydrake.multibody.plant.MultibodyPlant
         Finalized, registered with ``scene_graph``.
     scene_graph : pydrake.geometry.SceneGraph
-    model_instances : ModelInstanceIndex or str, or a sequence of them
+    model_instances : ModelInstanceIndex or str, or a list or tuple of them
+        Model instances of ``plant``, by index or name (a bare ``int`` is
+        refused: wrap it as ``ModelInstanceIndex(i)``).
     prefix : str, optional
         The visualizer's prefix (``MeshcatVisualizerParams.prefix``, default
-        ``"visualizer"``).
+        ``"visualizer"``), a non-empty string.
 
     Returns
     -------
     list of str
         One path per illustration geometry, in body order.
+
+    Raises
+    ------
+    InvalidOptionError
+        For a model instance the plant does not have (an unknown name, an
+        index out of range) or that is neither an index nor a name (``99``,
+        None), a ``scene_graph`` that is not a SceneGraph or an empty
+        ``prefix``.
+    ModelError
+        For a ``plant`` that is not a finalized MultibodyPlant.
     """
-    if isinstance(model_instances, ModelInstanceIndex | str):
-        model_instances = [model_instances]
+    check_plant(plant)
+    if not isinstance(scene_graph, SceneGraph) and not callable(
+        getattr(scene_graph, "model_inspector", None)
+    ):  # SceneGraph_[float], or another scalar type's
+        raise InvalidOptionError(
+            "scene_graph must be the pydrake SceneGraph the plant is registered "
+            f"with, got {type(scene_graph).__name__}"
+        )
+    check_path("prefix", prefix)
+    instances = [
+        _model_instance(plant, spec) for spec in _instance_list(model_instances)
+    ]
     inspector = scene_graph.model_inspector()
     paths = []
-    for instance in model_instances:
-        if isinstance(instance, str):
-            if not plant.HasModelInstanceNamed(instance):
-                raise InvalidOptionError(f"no model instance named {instance!r}")
-            instance = plant.GetModelInstanceByName(instance)
+    for instance in instances:
         for index in plant.GetBodyIndices(instance):
             frame = plant.GetBodyFrameIdIfExists(index)
             if frame is None:
@@ -61,6 +82,74 @@ def visualizer_paths(
                 name = inspector.GetName(g).replace("::", "/")
                 paths.append(f"{prefix}/{frame_path}/{name}")
     return paths
+
+
+_INSTANCES = (
+    "model_instances must be a ModelInstanceIndex or a model instance's name, or "
+    "a list of them"
+)
+
+
+def _instance_list(model_instances) -> list:
+    if isinstance(model_instances, ModelInstanceIndex | str):
+        return [model_instances]
+    if isinstance(model_instances, list | tuple):
+        return list(model_instances)
+    raise InvalidOptionError(
+        f"{_INSTANCES}, got {describe(model_instances)}" + _index_hint(model_instances)
+    )
+
+
+def _index_hint(spec) -> str:
+    if integer_or_none(spec) is None:
+        return ""
+    return " (wrap an index as ModelInstanceIndex(i))"
+
+
+def _model_instance(plant, spec) -> ModelInstanceIndex:
+    """A model instance of ``plant`` given by index or name (InvalidOptionError)."""
+    names = [
+        plant.GetModelInstanceName(ModelInstanceIndex(i))
+        for i in range(plant.num_model_instances())
+    ]
+    if isinstance(spec, str):
+        if not plant.HasModelInstanceNamed(spec):
+            raise InvalidOptionError(
+                f"no model instance named {spec!r}; instances are {names}"
+            )
+        return plant.GetModelInstanceByName(spec)
+    if isinstance(spec, ModelInstanceIndex):
+        n = plant.num_model_instances()
+        if not spec.is_valid() or not 0 <= int(spec) < n:
+            shown = int(spec) if spec.is_valid() else "an invalid index"
+            raise InvalidOptionError(
+                f"ModelInstanceIndex({shown}) is not a model instance of the plant: "
+                f"valid indices are 0..{n - 1} ({names})"
+            )
+        return spec
+    raise InvalidOptionError(f"{_INSTANCES}, got {describe(spec)}{_index_hint(spec)}")
+
+
+def translucent_arguments(paths, opacity) -> tuple[list[str], float]:
+    """The paths and opacity of :func:`set_translucent`, checked."""
+    x = real_scalar("opacity", opacity)
+    if not (0.0 < x <= 1.0):
+        raise InvalidOptionError(
+            f"opacity must be a real number in (0, 1], got {describe(opacity)}"
+        )
+    if isinstance(paths, str):
+        listed = [paths]
+    elif isinstance(paths, Iterable) and not isinstance(paths, bytes | Mapping):
+        listed = list(paths)
+    else:
+        raise InvalidOptionError(
+            "paths must be a Meshcat path or a sequence of them (non-empty "
+            f"strings), got {describe(paths)}"
+        )
+    for path in listed:
+        if not isinstance(path, str) or not path.strip("/"):
+            raise InvalidOptionError(f"paths must be non-empty strings, got {path!r}")
+    return [str(p) for p in listed], x
 
 
 def set_translucent(
@@ -77,8 +166,9 @@ def set_translucent(
         :func:`visualizer_paths` (not the model's folder: a browser that
         connects later receives a folder's properties before its children).
     opacity : float, optional
-        Multiplies each material's own opacity (``modulated_opacity``), in
-        (0, 1]; 1 restores the original look.
+        Multiplies each material's own opacity (``modulated_opacity``): a real
+        number (numpy's too, not a bool or a string) in (0, 1]; 1 restores
+        the original look.
 
     Notes
     -----
@@ -90,12 +180,12 @@ def set_translucent(
     Raises
     ------
     InvalidOptionError
-        For an opacity outside (0, 1] or a path that is not a non-empty string.
+        For an opacity that is not a real number in (0, 1] (``True``, ``"0.5"``
+        and NaN too), ``paths`` that are neither a string nor an iterable
+        of them (None, a number, bytes), a path that is not a non-empty
+        string, or a ``meshcat`` that is not a Meshcat.
     """
-    value = float(opacity) if isinstance(opacity, int | float) else float("nan")
-    if not (0.0 < value <= 1.0):
-        raise InvalidOptionError(f"opacity must be in (0, 1], got {opacity!r}")
-    for path in [paths] if isinstance(paths, str) else list(paths):
-        if not isinstance(path, str) or not path.strip("/"):
-            raise InvalidOptionError(f"paths must be non-empty strings, got {path!r}")
+    check_meshcat(meshcat)
+    listed, value = translucent_arguments(paths, opacity)
+    for path in listed:
         meshcat.SetProperty(path, "modulated_opacity", value)

@@ -31,14 +31,19 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.validation import describe, real_array, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.validation import plant_context_of, resolve_object_body
+from drakegrasp.visualization.geometry import DRAW_LENGTH_MAX
+from drakegrasp.visualization.primitives import check_meshcat
 
 __all__ = [
     "MARGIN",
     "MESHCAT_FOV",
+    "VIEW_BOUND",
     "VIEW_DIRECTION",
     "CameraView",
+    "camera_view",
     "frame_points",
     "grasp_pose",
 ]
@@ -51,6 +56,12 @@ VIEW_DIRECTION = np.array([1.0, -1.0, 0.8]) / np.linalg.norm([1.0, -1.0, 0.8])
 
 MARGIN = 1.15
 """Distance factor beyond the tightest fit, so the drawing does not touch the edge."""
+
+VIEW_BOUND = DRAW_LENGTH_MAX
+"""Largest absolute coordinate of a framed point, and largest ``pad`` (metres):
+1e30, the longest length a drawing takes.  The camera's distance is then below
+about 1e31 m and every square computed below 1e63, so the view is finite (points
+at ±1e300 once put the camera at ``inf``)."""
 
 
 @dataclass(frozen=True)
@@ -80,6 +91,42 @@ class CameraView:
         }
 
 
+def camera_view(points_W, *, pad: float = 0.0) -> CameraView:
+    """Where :func:`frame_points` puts the camera, without moving it.
+
+    Parameters and checks are those of :func:`frame_points`.
+
+    Returns
+    -------
+    CameraView
+    """
+    p = real_array("points_W", points_W, error=InvalidOptionError)
+    if p.ndim != 2 or p.shape[1] != 3 or len(p) == 0 or not np.all(np.isfinite(p)):
+        raise InvalidOptionError(
+            f"points_W must be (N, 3) finite world points with N >= 1, got shape "
+            f"{p.shape}"
+        )
+    if float(np.max(np.abs(p))) > VIEW_BOUND:
+        raise InvalidOptionError(
+            f"points_W has a coordinate of {float(np.max(np.abs(p))):.6g} m, beyond "
+            f"|x| <= {VIEW_BOUND:g} m "
+            "(drakegrasp.visualization.view.VIEW_BOUND): the camera would stand at "
+            "an infinite distance"
+        )
+    x = real_scalar("pad", pad)
+    if not (0.0 <= x <= VIEW_BOUND):
+        raise InvalidOptionError(
+            f"pad must be a finite length >= 0 and <= {VIEW_BOUND:g} metres "
+            f"(drakegrasp.visualization.view.VIEW_BOUND), got {describe(pad)}"
+        )
+    lo, hi = p.min(axis=0) - x, p.max(axis=0) + x
+    target = 0.5 * (lo + hi)
+    radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-3)
+    distance = MARGIN * radius / np.sin(0.5 * MESHCAT_FOV)
+    position = target + distance * VIEW_DIRECTION
+    return CameraView(position_W=position, target_W=target, radius=radius)
+
+
 def frame_points(meshcat: Meshcat, points_W, *, pad: float = 0.0) -> CameraView:
     """Aim Meshcat's camera so that every point (and ``pad`` around it) is seen.
 
@@ -87,34 +134,29 @@ def frame_points(meshcat: Meshcat, points_W, *, pad: float = 0.0) -> CameraView:
     ----------
     meshcat : pydrake.geometry.Meshcat
     points_W : (N, 3) float
-        Points in the world frame, metres; ``N >= 1``.
+        Points in the world frame, metres; ``N >= 1``, every coordinate finite
+        with ``|x| <=`` :data:`VIEW_BOUND` (1e30 m).
     pad : float, optional
-        Room (metres) to keep in view around the points' bounding box.
+        Room (metres) to keep in view around the points' bounding box: a real
+        number in ``[0, VIEW_BOUND]``.
 
     Returns
     -------
     CameraView
+        Finite: with both bounds the camera stands within about 1e31 m.
 
     Raises
     ------
     InvalidOptionError
-        For no points, non-finite points or a negative ``pad``.
+        For no points, points that are not real or finite or beyond
+        :data:`VIEW_BOUND`, a ``pad`` that is not a real number in
+        ``[0, VIEW_BOUND]`` (a string, NaN, a negative one), or a ``meshcat``
+        that is not a Meshcat.
     """
-    p = np.asarray(points_W, dtype=float)
-    if p.ndim != 2 or p.shape[1] != 3 or len(p) == 0 or not np.all(np.isfinite(p)):
-        raise InvalidOptionError(
-            f"points_W must be (N, 3) finite world points with N >= 1, got shape "
-            f"{p.shape}"
-        )
-    if not (np.isfinite(pad) and pad >= 0):
-        raise InvalidOptionError(f"pad must be a finite length >= 0, got {pad!r}")
-    lo, hi = p.min(axis=0) - pad, p.max(axis=0) + pad
-    target = 0.5 * (lo + hi)
-    radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-3)
-    distance = MARGIN * radius / np.sin(0.5 * MESHCAT_FOV)
-    position = target + distance * VIEW_DIRECTION
-    meshcat.SetCameraPose(position, target)
-    return CameraView(position_W=position, target_W=target, radius=radius)
+    check_meshcat(meshcat)
+    view = camera_view(points_W, pad=pad)
+    meshcat.SetCameraPose(view.position_W, view.target_W)
+    return view
 
 
 def grasp_pose(

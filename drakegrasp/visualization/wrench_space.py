@@ -23,17 +23,28 @@ import numpy as np
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp, wrench_columns
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import real_scalar
+from drakegrasp.core.validation import real_array, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.plots import import_pyplot
 
 __all__ = [
+    "MAX_HULL_DIM",
+    "ORIGIN_CLEARANCE_TOL",
+    "WRENCH_BOUND",
     "WrenchHull",
     "WrenchSpacePlot",
     "plot_wrench_space",
     "wrench_space_points",
     "wrench_hull",
 ]
+
+MAX_HULL_DIM = 6
+"""Most rows of the wrenches :func:`wrench_hull` takes (a spatial wrench's)."""
+
+WRENCH_BOUND = 1e100
+"""Largest absolute entry of a wrench :func:`wrench_hull` takes, so that the
+rank's SVD and Qhull square nothing beyond ``1e200`` (an array of NaN made the
+SVD fail to converge)."""
 
 ORIGIN_CLEARANCE_TOL = 1e-9
 """Default distance (in the wrench space's units) by which every facet of the
@@ -124,18 +135,42 @@ def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHu
     Parameters
     ----------
     W : (m, K) float
-        Wrenches as columns.
+        Wrenches as columns, ``2 <= m <= MAX_HULL_DIM`` (6, a spatial wrench)
+        and any ``K >= 0``; every entry real, finite and at most
+        :data:`WRENCH_BOUND` (1e100) in absolute value.
     tol : float, optional
         The origin counts as inside only when every facet is farther than
-        ``tol``.
+        ``tol``: a real number, finite and >= 0 (units of ``W``).
 
     Returns
     -------
     WrenchHull
+
+    Raises
+    ------
+    InvalidOptionError
+        For a ``W`` that is not a 2-D real array with 2 to 6 rows (a 1-D or
+        an empty-shaped one), has a NaN or infinite entry or one beyond
+        :data:`WRENCH_BOUND`, or a ``tol`` that is not a finite real >= 0.
     """
     from scipy.spatial import ConvexHull, QhullError
 
-    W = np.asarray(W, dtype=float)
+    W = real_array("W", W, error=InvalidOptionError)
+    if W.ndim != 2 or not (2 <= W.shape[0] <= MAX_HULL_DIM):
+        raise InvalidOptionError(
+            f"W must be an (m, K) array of wrenches as columns with 2 <= m <= "
+            f"{MAX_HULL_DIM} (3 planar, 6 spatial), got shape {W.shape}"
+        )
+    if W.size and not float(np.max(np.abs(W))) <= WRENCH_BOUND:  # NaN fails too
+        raise InvalidOptionError(
+            f"W must be finite with every |w| <= {WRENCH_BOUND:g} "
+            "(drakegrasp.visualization.wrench_space.WRENCH_BOUND), got "
+            + ("a NaN or infinite entry" if not np.all(np.isfinite(W)) else
+               f"an entry of {float(np.max(np.abs(W))):.6g}")
+        )  # fmt: skip
+    tol = real_scalar("tol", tol)
+    if not (0.0 <= tol < np.inf):
+        raise InvalidOptionError(f"tol must be a finite real number >= 0, got {tol!r}")
     m, K = W.shape
     rank = int(np.linalg.matrix_rank(W)) if K else 0
     # The hull has an interior only if the points' affine hull is m-dimensional.
