@@ -28,7 +28,12 @@ from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.deferred import WeakMemo
-from drakegrasp.errors import InvalidContextError, InvalidOptionError, ModelError
+from drakegrasp.errors import (
+    GraspError,
+    InvalidContextError,
+    InvalidOptionError,
+    ModelError,
+)
 from drakegrasp.plant.attachment import joined
 
 __all__ = [
@@ -302,18 +307,29 @@ def _instance_names(plant: MultibodyPlant) -> list[str]:
     ]
 
 
-def model_instance(plant: MultibodyPlant, spec) -> ModelInstanceIndex:
+def model_instance(
+    plant: MultibodyPlant,
+    spec,
+    *,
+    argument: str = "hand",
+    error: type[GraspError] = ModelError,
+) -> ModelInstanceIndex:
     """A model instance given by index or name, checked before Drake sees it.
+
+    ``argument`` names the caller's parameter in the message of a bad index,
+    and ``error`` is what an unknown name or index raises.
 
     Raises
     ------
     ModelError
-        For an unknown name or an index outside ``[0, num_model_instances)``;
-        the message lists the plant's instances.
+        For an unknown name or an index outside ``[0, num_model_instances)``
+        (or ``error``); the message lists the plant's instances.
+    InvalidOptionError
+        For a ``spec`` that is neither an index nor a name.
     """
     if isinstance(spec, str):
         if not plant.HasModelInstanceNamed(spec):
-            raise ModelError(
+            raise error(
                 f"no model instance named {spec!r}; instances are "
                 f"{_instance_names(plant)}" + _body_hint(plant, spec)
             )
@@ -322,9 +338,9 @@ def model_instance(plant: MultibodyPlant, spec) -> ModelInstanceIndex:
         n = plant.num_model_instances()
         if not spec.is_valid() or not 0 <= int(spec) < n:
             shown = int(spec) if spec.is_valid() else "an invalid index"
-            raise ModelError(
-                f"hand=ModelInstanceIndex({shown}) is not a model instance of the "
-                f"plant: valid indices are 0..{n - 1} ({_instance_names(plant)})"
+            raise error(
+                f"{argument}=ModelInstanceIndex({shown}) is not a model instance of "
+                f"the plant: valid indices are 0..{n - 1} ({_instance_names(plant)})"
             )
         return spec
     raise InvalidOptionError(

@@ -15,7 +15,7 @@ from pydrake.multibody.tree import ModelInstanceIndex
 
 from drakegrasp.core.validation import describe, integer_or_none, real_scalar
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.plant.validation import check_plant
+from drakegrasp.plant.validation import check_plant, model_instance
 from drakegrasp.visualization.primitives import check_meshcat, check_path
 
 __all__ = ["set_translucent", "visualizer_paths"]
@@ -108,26 +108,13 @@ def _index_hint(spec) -> str:
 
 def _model_instance(plant, spec) -> ModelInstanceIndex:
     """A model instance of ``plant`` given by index or name (InvalidOptionError)."""
-    names = [
-        plant.GetModelInstanceName(ModelInstanceIndex(i))
-        for i in range(plant.num_model_instances())
-    ]
-    if isinstance(spec, str):
-        if not plant.HasModelInstanceNamed(spec):
-            raise InvalidOptionError(
-                f"no model instance named {spec!r}; instances are {names}"
-            )
-        return plant.GetModelInstanceByName(spec)
-    if isinstance(spec, ModelInstanceIndex):
-        n = plant.num_model_instances()
-        if not spec.is_valid() or not 0 <= int(spec) < n:
-            shown = int(spec) if spec.is_valid() else "an invalid index"
-            raise InvalidOptionError(
-                f"ModelInstanceIndex({shown}) is not a model instance of the plant: "
-                f"valid indices are 0..{n - 1} ({names})"
-            )
-        return spec
-    raise InvalidOptionError(f"{_INSTANCES}, got {describe(spec)}{_index_hint(spec)}")
+    if not isinstance(spec, ModelInstanceIndex | str):
+        raise InvalidOptionError(
+            f"{_INSTANCES}, got {describe(spec)}{_index_hint(spec)}"
+        )
+    return model_instance(
+        plant, spec, argument="model_instances", error=InvalidOptionError
+    )
 
 
 def translucent_arguments(paths, opacity) -> tuple[list[str], float]:
