@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import gc
+import logging
 import math
 import numbers
 import threading
@@ -50,11 +51,14 @@ def client_for(client_or_address, *, timeout: float | None = None):
     ------
     InvalidOptionError
         Neither a client nor an address, an address with a port outside
-        1..65535, a timeout that is not a positive number of seconds, a
-        scheduler that cannot be reached within the timeout, or an address
-        that answers but is not a Dask scheduler (no or a foreign reply to
-        Dask's handshake), naming the address.  Whatever Dask raised is the
-        error's ``__cause__``.
+        1..65535, a TLS address (``tls://``, ``wss://``) when Dask's
+        configuration holds no TLS settings, a timeout that is not a positive
+        number of seconds, a scheduler that cannot be reached within the
+        timeout, or an address that answers but is not a Dask scheduler (no
+        reply to Dask's handshake, a reply that is no Dask message, or one that
+        is not the handshake of this Dask version), naming the address.
+        Whatever Dask raised is the error's ``__cause__``; Dask's own log
+        records of the failed handshake are kept off its handlers.
     """
     try:
         from distributed import Client
@@ -77,6 +81,7 @@ def client_for(client_or_address, *, timeout: float | None = None):
                 "a port is in 1..65535"
             )
         seconds = _connect_timeout(timeout)
+        _check_encryption(client_or_address)
         shook_hands = False
         try:
             _check_handshake(client_or_address, seconds)
@@ -86,16 +91,19 @@ def client_for(client_or_address, *, timeout: float | None = None):
             raise
         except BaseException as e:  # any failure to connect, kept as the cause
             error = e
-            _clear_frames(e)
+        reply = _reply_failure(error)
         # A half-made Client is cyclic garbage, held until now by the locals of
-        # the error's traceback (cleared above; the traceback itself is kept).
+        # the error's traceback (cleared here; the traceback itself is kept).
         # Left to a later collection, its __del__ may run inside another
         # Client's start, where its close waits on the loop lock that start
-        # holds: a deadlock (seen in the test suite).  Finalise it here.
-        gc.collect()
+        # holds: a deadlock (seen in the test suite).  Finalise it here, with
+        # the comm a foreign reply left open (Dask warns of it when finalised).
+        with _quiet(threading.get_ident()):
+            _clear_frames(error)
+            gc.collect()
         raise InvalidOptionError(
             f"could not connect to the Dask scheduler at {client_or_address!r}: "
-            f"{_failure(error, seconds, shook_hands)}"
+            f"{_failure(error, seconds, shook_hands, reply)}"
         ) from error
     if not isinstance(client_or_address, Client):
         raise InvalidOptionError(
@@ -143,6 +151,79 @@ def _connect_timeout(timeout) -> float:
     return float(timeout)
 
 
+def _check_encryption(address: str) -> None:
+    """Refuse a TLS address when Dask's configuration holds no TLS settings.
+
+    Dask would otherwise fail inside its connector, before any connection, with
+    a ``TypeError`` about a missing ``ssl_context``.
+    """
+    from distributed import Security
+
+    scheme = address.partition("://")[0] if "://" in address else "tcp"
+    if scheme not in ("tls", "wss"):
+        return
+    if Security().get_connection_args("client").get("ssl_context") is None:
+        raise InvalidOptionError(
+            f"the scheduler address {address!r} asks for TLS, but Dask's "
+            "configuration has no TLS settings (distributed.comm.tls.*): set them, "
+            "or connect a distributed.Client with your Security and pass it"
+        )
+
+
+def _reply_failure(error: BaseException) -> str:
+    """What of the reply ``error`` was raised on: ``""`` if not on a reply.
+
+    ``"decoding"``: it passed through Dask's ``distributed.protocol``, which
+    decodes what arrived, so the address answered with bytes that are not a
+    Dask message.  ``"handshake"``: the reply decoded but Dask could not match
+    it with its own handshake (``handshake_configuration``: no Dask, or another
+    version of it).
+    """
+    frames = [frame for frame, _ in traceback.walk_tb(error.__traceback__)]
+    if any(
+        str(frame.f_globals.get("__name__", "")).startswith("distributed.protocol")
+        for frame in frames
+    ):
+        return "decoding"
+    if any(frame.f_code.co_name == "handshake_configuration" for frame in frames):
+        return "handshake"
+    return ""
+
+
+class _ThreadFilter(logging.Filter):
+    """Drops the log records of the given threads."""
+
+    def __init__(self, *threads: int) -> None:
+        super().__init__()
+        self.threads = set(threads)
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.thread not in self.threads
+
+
+@contextlib.contextmanager
+def _quiet(*threads: int) -> Iterator[_ThreadFilter]:
+    """Keep Dask's log records of ``threads`` off its handlers for the block.
+
+    A foreign reply makes Dask log its decoding failure (CRITICAL, with a
+    traceback) and, when the comm it left open is collected, a dangling-stream
+    warning: the failure is reported once, by the error this module raises.
+    Records of other threads pass.
+    """
+    keep = _ThreadFilter(*threads)
+    handlers, logger = [], logging.getLogger("distributed")
+    while logger is not None:
+        handlers += logger.handlers
+        logger = logger.parent if logger.propagate else None
+    for handler in handlers:
+        handler.addFilter(keep)
+    try:
+        yield keep
+    finally:
+        for handler in handlers:
+            handler.removeFilter(keep)
+
+
 def _check_handshake(address: str, seconds: float) -> None:
     """Connect to ``address`` and complete Dask's handshake, or raise.
 
@@ -177,6 +258,7 @@ def _check_handshake(address: str, seconds: float) -> None:
     outcome: list[BaseException] = []
 
     def run():
+        quiet.threads.add(threading.get_ident())
         try:
             asyncio.run(handshake())
         except BaseException as e:  # handed to the caller's thread
@@ -184,19 +266,23 @@ def _check_handshake(address: str, seconds: float) -> None:
 
     thread = threading.Thread(target=run, name="drakegrasp-dask-handshake",
                               daemon=True)  # fmt: skip
-    thread.start()
-    thread.join(deadline + HANDSHAKE_GRACE)  # the loop keeps the deadline itself
+    with _quiet() as quiet:
+        thread.start()
+        thread.join(deadline + HANDSHAKE_GRACE)  # the loop keeps the deadline
     if thread.is_alive():
         raise _NoHandshake(f"no reply to Dask's handshake in {deadline:g} s")
     if outcome:
         raise outcome[0]
 
 
-def _failure(error: BaseException, seconds: float, shook_hands: bool) -> str:
+def _failure(
+    error: BaseException, seconds: float, shook_hands: bool, reply: str = ""
+) -> str:
     """Why a connection failed, for the error naming the address.
 
     ``shook_hands``: the address completed Dask's handshake, and the Client
-    failed after it.
+    failed after it.  ``reply``: what of a reply the error was raised on
+    (:func:`_reply_failure`).
     """
     from distributed.comm import CommClosedError
     from distributed.comm.core import FatalCommClosedError
@@ -213,9 +299,15 @@ def _failure(error: BaseException, seconds: float, shook_hands: bool) -> str:
     closed = isinstance(error, CommClosedError) and not isinstance(
         error, FatalCommClosedError
     )
-    if isinstance(error, (OSError, ValueError)) and not closed:
+    if isinstance(error, (OSError, ValueError)) and not (closed or reply):
         return _short(reason) or type(error).__name__  # unreachable, malformed
     typed = type(error).__name__ + (f": {_short(reason)}" if reason else "")
+    if reply == "handshake":
+        return (
+            "the address answered, but its reply is not the handshake of this "
+            f"Dask version: it is not a Dask scheduler, or one of another version "
+            f"({typed})"
+        )
     if shook_hands:  # a worker's address, say
         return (
             "the address completed Dask's handshake but did not take a client "

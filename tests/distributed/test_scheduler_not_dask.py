@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import gc
 import http.server
+import logging
 import socket
+import struct
 import threading
 import time
 
@@ -194,3 +196,99 @@ def test_the_command_line_says_it_is_not_a_scheduler(server, request, tmp_path, 
     assert lines[0].startswith("drakegrasp: error: could not connect to the Dask")
     assert address in lines[0] and "not a Dask scheduler" in lines[0]
     assert not out.exists()
+
+
+def _dask_message(*frames: bytes) -> bytes:
+    """``frames`` in Dask's TCP framing: sizes as little-endian uint64."""
+    sizes = struct.pack(f"<{1 + len(frames)}Q", len(frames), *map(len, frames))
+    body = sizes + b"".join(frames)
+    return struct.pack("<Q", len(body)) + body
+
+
+@pytest.fixture
+def garbage_server():
+    """A framed Dask message whose only frame is not msgpack (0xc1 is unused)."""
+    yield from _socket_server(_dask_message(b"\xc1"), hang_up=False)
+
+
+@pytest.fixture
+def foreign_handshake_server():
+    """A framed message that decodes (an empty map) but is no Dask handshake."""
+    yield from _socket_server(_dask_message(b"\x80"), hang_up=False)
+
+
+def test_a_reply_that_does_not_decode_is_not_a_scheduler(garbage_server):
+    # It raised a ValueError (msgpack's FormatError), which read as a malformed
+    # address: "could not connect ...: FormatError".
+    error, _ = _refusal(garbage_server, timeout=TIMEOUT)
+    message = str(error)
+    assert "the address answered but is not a Dask scheduler" in message
+    assert "its reply is not Dask's handshake (FormatError)" in message
+
+
+def test_a_reply_that_decodes_but_is_no_handshake(foreign_handshake_server):
+    error, _ = _refusal(foreign_handshake_server, timeout=TIMEOUT)
+    message = str(error)
+    assert "its reply is not the handshake of this Dask version" in message
+    assert "it is not a Dask scheduler, or one of another version" in message
+    assert "ValueError: Your Dask versions may not be in sync" in message
+
+
+class _Recorder(logging.Handler):
+    """A handler beside Dask's own on the ``distributed`` logger."""
+
+    def __init__(self):
+        super().__init__()
+        self.messages: list[str] = []
+
+    def emit(self, record):
+        self.messages.append(f"{record.name}: {record.getMessage()}")
+
+
+@pytest.fixture
+def dask_log():
+    recorder = _Recorder()
+    logging.getLogger("distributed").addHandler(recorder)
+    yield recorder.messages
+    logging.getLogger("distributed").removeHandler(recorder)
+
+
+@pytest.mark.parametrize("server", ["garbage_server", "foreign_handshake_server"])
+def test_dask_logs_nothing_of_a_foreign_reply(server, request, dask_log):
+    # Dask logged "Failed to deserialize" (CRITICAL, with a traceback) and a
+    # dangling-stream warning to stderr, beside the one-line error.
+    address = request.getfixturevalue(server)
+    _refusal(address, timeout=TIMEOUT)
+    gc.collect()
+    assert dask_log == []
+
+
+def test_other_threads_still_log_during_a_refusal(garbage_server, dask_log):
+    # The filter drops the records of the threads given only, and is gone
+    # afterwards.
+    from drakegrasp.distributed.client import _quiet
+
+    logger = logging.getLogger("distributed.drakegrasp_test")
+    with _quiet(threading.get_ident()):
+        logger.warning("own thread")  # dropped
+        other = threading.Thread(target=logger.warning, args=("other thread",))
+        other.start()
+        other.join()
+    logger.warning("after")
+    assert dask_log == [f"{logger.name}: other thread", f"{logger.name}: after"]
+    _refusal(garbage_server, timeout=TIMEOUT)
+    assert not any(h.filters for h in logging.getLogger("distributed").handlers)
+
+
+def test_a_tls_address_without_tls_settings_is_refused_at_once():
+    # Dask failed inside its connector with "TLS expects a `ssl_context`",
+    # which read as "the address answered but is not a Dask scheduler".
+    start = time.monotonic()
+    for address in ("tls://127.0.0.1:1", "wss://127.0.0.1:1"):
+        with pytest.raises(InvalidOptionError) as info:
+            client_for(address, timeout=TIMEOUT)
+        message = str(info.value)
+        assert f"{address!r} asks for TLS" in message
+        assert "no TLS settings (distributed.comm.tls.*)" in message
+        assert "answered" not in message
+    assert time.monotonic() - start < 5 * TIMEOUT
