@@ -51,7 +51,13 @@ from drakegrasp.core.grasp import Grasp, normal_grasp_matrix
 from drakegrasp.core.linalg import left_null_space
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, near_threshold, relative_margin
-from drakegrasp.core.validation import check_grasp, check_rank_tol, real_scalar
+from drakegrasp.core.validation import (
+    TOL_MAX,
+    TOL_MIN,
+    check_grasp,
+    check_rank_tol,
+    real_scalar,
+)
 from drakegrasp.errors import (
     GraspError,
     InvalidGraspError,
@@ -61,6 +67,7 @@ from drakegrasp.errors import (
 
 __all__ = [
     "DEFAULT_SECOND_ORDER_TOL",
+    "ESCAPE_TOL",
     "SecondOrderResult",
     "SecondOrderVariables",
     "build_second_order_program",
@@ -70,6 +77,12 @@ __all__ = [
 
 DEFAULT_SECOND_ORDER_TOL = 1e-6
 """Second-order closure needs ``t* > tol`` (``t*`` dimensionless, see above)."""
+
+ESCAPE_TOL = DEFAULT_SECOND_ORDER_TOL
+"""Largest shortfall an escape may have: it holds when ``escape_margin >= -min(tol,
+ESCAPE_TOL)``.  A numerical zero of the margin, not the verdict's ``tol``: a
+larger ``tol`` calls more grasps "not immobilised", but never takes a motion
+that penetrates a finger for an escape."""
 
 _ESCAPE_BOX = 10.0  # bound on the normalised escape acceleration
 
@@ -261,7 +274,8 @@ class SecondOrderResult:
     escape_margin : float
         That bound (dimensionless, times ``b``); NaN without an escape.
     escape_verified : bool
-        True when the escape holds (``escape_margin >= -tol``).
+        True when the escape holds (``escape_margin >= -min(tol, ESCAPE_TOL)``,
+        :data:`ESCAPE_TOL`).
     margin : float
         ``(t* - tol) / tol``.
     tol : float
@@ -335,8 +349,12 @@ class SecondOrderResult:
 
 def _check_tol(tol: float) -> float:
     t = real_scalar("tol", tol)
-    if not math.isfinite(t) or t <= 0:
-        raise InvalidOptionError(f"tol must be finite and > 0, got {tol!r}")
+    if not TOL_MIN <= t <= TOL_MAX:  # NaN fails too
+        raise InvalidOptionError(
+            f"tol must be finite and > 0, a real number in [{TOL_MIN:g}, "
+            f"{TOL_MAX:g}] (a numerical zero for the dimensionless t*, as for d*), "
+            f"got {tol!r}"
+        )
     return t
 
 
@@ -400,7 +418,8 @@ def second_order_form_closure(
         One per contact: object and finger principal curvatures (1/m) and
         directions in the grasp frame (planar: one curvature each).
     tol : float, optional
-        Closure needs ``t* > tol``.
+        Closure needs ``t* > tol``; a real number in [1e-10, 0.5]. An escape
+        motion is reported only when it holds to ``min(tol, ESCAPE_TOL)``.
     rank_tol : float, optional
         Relative singular-value threshold for ranks and ``W``.
     first_order : ClosureResult, optional
@@ -486,12 +505,18 @@ def second_order_form_closure(
             **common,
         )
     dual = _dual_matrix(result.GetDualSolution(var.lmi), k)
-    escape = _find_escape(grasp, var, H, lam, dual, tol)
+    escape = _find_escape(grasp, var, H, lam, dual, min(tol, ESCAPE_TOL))
     if escape is None:
         reason = (
             "not immobilised by any single λ, but no candidate motion escapes "
             "either: inconclusive at second order"
         )
+        if t_star > 0:
+            reason = (
+                f"t* = {t_star:.3g} > 0 but not above tol = {tol:g}: not called "
+                "immobilised at this tolerance, and no motion escapes to second "
+                "order (a smaller tol decides)"
+            )
         return SecondOrderResult(
             is_closure=False,
             order=None,
@@ -527,6 +552,9 @@ def _dual_matrix(values: np.ndarray, k: int) -> np.ndarray:
 
 def _find_escape(grasp, var: SecondOrderVariables, H, lam, dual, tol):
     """A motion in W that no contact resists to second order, or None.
+
+    ``tol``: the shortfall an escape may have, ``min(tol, ESCAPE_TOL)`` of the
+    verdict (a numerical zero).
 
     Candidates: the eigenvectors of ``-Σ λ*_i A_i`` at its least eigenvalue and
     the dual matrix's leading eigenvector.  Each one's sign is chosen so that

@@ -20,6 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
+import drakegrasp as dg
 from drakegrasp import (
     Contact,
     ContactCurvature,
@@ -572,3 +573,46 @@ def test_partial_support_uses_the_larger_w():
     assert r.support == (0, 1) and r.dim_w == 2
     assert not r.is_closure and r.escape_verified
     assert r.escape_twist[1] < 0  # away from the unloaded finger at +y
+
+
+# --------------------------------------------- a large tol claims no escape
+
+
+def test_a_tol_above_t_star_reports_no_escape_that_penetrates():
+    """Review r22: with tol >= t* the escape search took a shortfall of up to
+    tol as an escape, and reported "the motion v = [0, 0, 0.95] penetrates no
+    finger" for the ellipse, which that rotation does penetrate (t* > 0)."""
+    grasp, curv = _ellipse_grasp(1.05, 1.0)
+    t_star = 1.0 * (1.05**2 - 1.0) / 1.05**3
+    assert second_order_form_closure(grasp, curv).is_closure
+    for tol in (0.1, 0.5):
+        r = second_order_form_closure(grasp, curv, tol=tol)
+        assert r.t_star == pytest.approx(t_star, rel=1e-6) and 0 < r.t_star < tol
+        assert not r.is_closure and r.order is None  # the verdict is tol's
+        assert r.escape_twist is None and not r.escape_verified
+        assert "not called immobilised at this tolerance" in r.reason
+        assert "penetrates no finger" not in r.reason
+    # Independent route: the rotation the old result offered, applied to the
+    # ellipse, sinks a finger into it to second order (Σ λ ψ < 0).
+    phi = 1e-3
+    R = np.array([[np.cos(phi), -np.sin(phi)], [np.sin(phi), np.cos(phi)]])
+    sunk = [
+        _point_ellipsoid_distance(R.T @ c.position, [1.05, 1.0]) for c in grasp.contacts
+    ]
+    assert min(sunk) < 0
+
+
+def test_a_true_escape_still_holds_at_a_large_tol():
+    # A disc: t* = 0 and the spin escapes with margin 0 at any tol.
+    grasp, curv = _ellipse_grasp(1.0, 1.0)
+    for tol in (1e-6, 0.1, 0.5):
+        r = second_order_form_closure(grasp, curv, tol=tol)
+        assert not r.is_closure and r.escape_verified and r.escape_margin >= -1e-6
+        assert "penetrates no finger to second order" in r.reason
+
+
+@pytest.mark.parametrize("tol", [0.6, 1e300, 1e-11, math.inf])
+def test_second_order_tol_is_bounded_as_the_first_orders(tol):
+    grasp, curv = _ellipse_grasp(2.0, 1.0)
+    with pytest.raises(dg.InvalidOptionError, match=r"tol must be .* \[1e-10, 0.5\]"):
+        second_order_form_closure(grasp, curv, tol=tol)
