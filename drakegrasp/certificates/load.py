@@ -42,7 +42,7 @@ at least ``(-yᵀ w - B) / max_i ε_i``; the check reports that number.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -140,8 +140,20 @@ class LoadCertificate:
         *,
         hand_jacobian: np.ndarray | None = None,
         tol: float = DEFAULT_CHECK_TOL,
+        wrench: np.ndarray | None = None,
+        torque_limits: np.ndarray | None = None,
+        max_normal_force: np.ndarray | float | None = None,
+        max_squeeze: float | None = None,
     ) -> CertificateCheck:
         """Re-verify the certificate on ``grasp`` with matrix products (no solver).
+
+        The claim is about a load and limits.  By default they are the
+        certificate's own (``wrench``, ``torque_limits``, ...), and the check
+        proves the claim about those: a certificate whose limits were edited
+        proves its bound for the edited limits, which the detail line states.
+        Pass your problem's load and limits to check the claim about them:
+        the same multipliers price your limits (a dual direction is one for
+        any limits), so the bound is re-derived from yours.
 
         Parameters
         ----------
@@ -151,6 +163,15 @@ class LoadCertificate:
             Needed when the certificate has joint multipliers.
         tol : float, optional
             Relative tolerance on the cone condition and on the bound.
+        wrench : (D,) float, optional
+            The load (N, N·m, grasp frame) in place of the certificate's.
+        torque_limits : (n_v,) float, optional
+            ``τ_max`` (``inf``: no limit) in place of the certificate's.
+        max_normal_force : (N,) float or float, optional
+            Per-contact bounds on ``f_n`` (N; a scalar is every contact's; ``inf``:
+            none) in place of the certificate's.
+        max_squeeze : float, optional
+            Bound on ``Σ f_n`` (N; ``inf``: none) in place of the certificate's.
 
         Returns
         -------
@@ -171,7 +192,14 @@ class LoadCertificate:
         (``B = 0``) is measured against ``min(1, μ) ‖G‖ ‖y‖`` too, what the
         twist could make a contact absorb.
         """
-        return check_load_certificate(self, grasp, hand_jacobian, tol)
+        problem = {
+            "wrench": wrench,
+            "torque_limits": torque_limits,
+            "max_normal_force": max_normal_force,
+            "max_squeeze": max_squeeze,
+        }
+        given = {k: v for k, v in problem.items() if v is not None}
+        return check_load_certificate(self, grasp, hand_jacobian, tol, given)
 
     def force_reach(
         self, grasp: Grasp, *, hand_jacobian: np.ndarray | None = None
@@ -198,7 +226,11 @@ class LoadCertificate:
         return certificate_force_reach(self, grasp, hand_jacobian)
 
     def to_dict(self) -> dict:
-        """JSON-ready dictionary (``inf`` limits become ``None``)."""
+        """JSON-ready dictionary (``inf`` limits become ``None``).
+
+        ``LoadCertificate(**d)`` of such a dictionary checks as the original
+        does: a ``None`` limit, or a ``None`` entry of one, is no limit.
+        """
         return {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
 
     def __str__(self) -> str:
@@ -296,11 +328,26 @@ def _array(cert: LoadCertificate, name: str, shape, grasp: Grasp) -> np.ndarray:
     return a
 
 
+def _no_limit_as_inf(value):
+    """``value`` with None, and None entries of a list, as ``inf`` (no limit).
+
+    :meth:`LoadCertificate.to_dict` writes ``inf`` as None (JSON has none).
+    """
+    if value is None:
+        return math.inf
+    if isinstance(value, (list, tuple)):
+        return [math.inf if v is None else v for v in value]
+    return value
+
+
 def _limits(cert: LoadCertificate, name: str, n: int, grasp: Grasp) -> np.ndarray:
     """A limit array of the certificate; None means no limit (``inf``)."""
-    if getattr(cert, name) is None:
+    value = _no_limit_as_inf(getattr(cert, name))
+    if np.ndim(value) == 0 and name == "max_normal_force":
+        value = np.full(n, value)  # one bound for every contact, as max_load's
+    if np.ndim(value) == 0 and value == math.inf:
         return np.full(n, math.inf)
-    return _array(cert, name, (n,), grasp)
+    return _array(replace(cert, **{name: value}), name, (n,), grasp)
 
 
 def _read(cert: LoadCertificate, grasp: Grasp) -> LoadCertificate:
@@ -329,7 +376,9 @@ def _read(cert: LoadCertificate, grasp: Grasp) -> LoadCertificate:
         ),
         torque_limits=_limits(cert, "torque_limits", eta.size, grasp),
         max_normal_force=_limits(cert, "max_normal_force", N, grasp),
-        max_squeeze=real_scalar("the certificate's max_squeeze", cert.max_squeeze),
+        max_squeeze=real_scalar(
+            "the certificate's max_squeeze", _no_limit_as_inf(cert.max_squeeze)
+        ),
         bound=real_scalar("the certificate's bound", cert.bound),
     )
 
@@ -403,10 +452,16 @@ def certificate_force_reach(
 
 
 def check_load_certificate(
-    cert: LoadCertificate, grasp: Grasp, hand_jacobian, tol: float
+    cert: LoadCertificate, grasp: Grasp, hand_jacobian, tol: float, problem=None
 ) -> CertificateCheck:
-    """See :meth:`LoadCertificate.check`."""
+    """See :meth:`LoadCertificate.check`.
+
+    ``problem``: the caller's ``wrench`` and limits, in place of the
+    certificate's (a dict of some of those four fields).
+    """
     tol = check_tolerance(tol)
+    if problem:
+        cert = replace(cert, **problem)
     cert = _read(cert, grasp)
     w, y = cert.wrench, cert.twist
     J = _jacobian_for(cert, grasp, hand_jacobian)
@@ -452,7 +507,7 @@ def check_load_certificate(
         bound_violation = math.inf
     violation = max(cone_violation, bound_violation)
     reach = _reach(cert, support, power, budget)
-    if not math.isfinite(reach):
+    if not math.isfinite(reach) or reach <= 0.0:  # no caveat, or nothing proven
         caveat = ""
     elif cert.kind == LOAD_NOT_HELD:
         caveat = f" (by any forces with Σ f_n < {reach:.3g} N)"
@@ -464,6 +519,28 @@ def check_load_certificate(
         slack = (cert.bound - bound) / max(1.0, abs(cert.bound))
     detail = (
         f"max over the {cert.cones} cones of a_iᵀ f_i (f_n = 1) and the power "
-        f"budget: α·w cannot be held for α > {bound:.6g}{caveat}"
+        f"budget: α·w cannot be held for α > {bound:.6g}{caveat}; "
+        f"{_assumed(cert, bool(problem))}"
     )
     return CertificateCheck.evaluated(violation, slack, tol, detail)
+
+
+def _assumed(cert: LoadCertificate, given: bool) -> str:
+    """The load and limits a check proved its claim about, for its detail line."""
+
+    def show(a) -> str:
+        a = np.atleast_1d(a)
+        if a.size and np.all(a == a[0]):
+            return f"{a[0]:.4g}" + (f" (x{a.size})" if a.size > 1 else "")
+        return "[" + ", ".join(f"{x:.4g}" for x in a) + "]"
+
+    whose = (
+        "the caller's where given, else the certificate's"
+        if given
+        else ("the certificate's own")
+    )
+    return (
+        f"load and limits ({whose}): w = {show(cert.wrench)}, "
+        f"τ_max = {show(cert.torque_limits) if cert.torque_limits.size else 'none'}, "
+        f"f_max = {show(cert.max_normal_force)}, s_max = {cert.max_squeeze:.4g}"
+    )
