@@ -24,11 +24,15 @@ from pydrake.geometry import Meshcat, Rgba, Role
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import describe, real_array, real_scalar
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import plant_context_of, resolve_body
+from drakegrasp.visualization.certificate_plots import check_axes
 from drakegrasp.visualization.plots import import_pyplot
+from drakegrasp.visualization.primitives import check_meshcat, check_path
 
 __all__ = [
     "CANDIDATES_PREFIX",
+    "MAX_BINS",
     "CandidateDrawing",
     "draw_candidates",
     "plot_score_distribution",
@@ -37,6 +41,10 @@ __all__ = [
 
 CANDIDATES_PREFIX = "drakegrasp/candidates"
 """Meshcat path under which :func:`draw_candidates` draws."""
+
+MAX_BINS = 1000
+"""Most bins of :func:`plot_score_distribution`: each is two bar patches; 1000
+drew in about 1 s, 10**5 took 90 s and 2 GB (and more bins hung)."""
 
 _STOPS = np.array(
     [[0.85, 0.2, 0.15], [0.95, 0.8, 0.2], [0.2, 0.7, 0.3]]
@@ -119,13 +127,52 @@ class CandidateDrawing:
         )
 
 
-def _hand_bodies(plant, candidate):
-    base = resolve_body(plant, candidate.hand_base)
-    instances = {base.model_instance()}
+def _check_poseable(candidate, k: int) -> None:
+    """Refuse a candidate :func:`draw_candidates` cannot pose.
+
+    (Its ``apply`` or Drake's name lookups would raise Python's errors.)
+    """
+    if not callable(getattr(candidate, "apply", None)):
+        raise InvalidOptionError(
+            f"candidates[{k}] is a {type(candidate).__name__} without "
+            "apply(plant, context), not a GraspCandidate"
+        )
+    base = getattr(candidate, "hand_base", None)
+    names = getattr(candidate, "joint_names", None)
+    try:
+        named = not isinstance(names, str | bytes) and all(
+            isinstance(n, str) for n in names
+        )
+    except TypeError:  # not iterable
+        named = False
+    if not (isinstance(base, str) and named):
+        raise InvalidOptionError(
+            f"candidates[{k}] must name its hand_base 'model::body' and its "
+            f"joint_names 'model::joint' as strings, got {describe(base)} and "
+            f"{describe(names)}"
+        )
+
+
+def _hand_bodies(plant, candidate, k: int):
+    """The bodies of ``candidate``'s hand: its base's and its joints' instances.
+
+    Raises
+    ------
+    InvalidOptionError
+        For a joint name that is not a joint of ``plant``.
+    ModelError
+        For a ``hand_base`` that is not a body of ``plant``.
+    """
+    instances = {resolve_body(plant, candidate.hand_base).model_instance()}
     for name in candidate.joint_names:
-        model, _, joint = name.rpartition("::")
-        j = plant.GetJointByName(joint, plant.GetModelInstanceByName(model))
-        instances.add(j.child_body().model_instance())
+        try:
+            joint = find_joint(plant, name)
+        except InvalidOptionError:
+            raise InvalidOptionError(
+                f"candidates[{k}] names the joint {name!r}, which is not a joint "
+                "of the plant (was it planned in another plant?)"
+            ) from None
+        instances.add(joint.child_body().model_instance())
     return [
         plant.get_body(b) for i in sorted(instances) for b in plant.GetBodyIndices(i)
     ]
@@ -154,22 +201,40 @@ def draw_candidates(
     candidates : sequence of GraspCandidate
         Ranked best first, e.g. :func:`~drakegrasp.plan_grasps`'s result.
     top : int, optional
-        How many to draw (the first ``top``).
+        How many to draw (the first ``top``): an integer >= 0.
     alpha : float, optional
-        Opacity of the ghosts.
+        Opacity of the ghosts: a real number in [0, 1] (checked also when no
+        candidate is drawn).
     prefix : str, optional
-        Meshcat path; what was under it is deleted first.
+        Meshcat path, non-empty (not ``""`` or ``"/"``, which would delete
+        the whole scene); what was under it is deleted first.
 
     Returns
     -------
     CandidateDrawing
         Candidate ``k`` is under ``{prefix}/{k}``, each hand body under
         ``{prefix}/{k}/{body}`` at its pose ``X_WB`` (world frame).
+
+    Raises
+    ------
+    InvalidOptionError
+        For a ``meshcat`` that is not a Meshcat, a bad ``top``, ``alpha`` or
+        ``prefix``, ``candidates`` that are not planned grasps (a real
+        ``score``, a boolean ``is_closure``, an ``apply`` method, string
+        ``hand_base`` and ``joint_names``), or a candidate that names a joint
+        the plant does not have.
+    InvalidGraspError
+        For a drawn candidate Drake cannot be given (a NaN ``q_hand``, a pose
+        that is not a rigid transform: see its ``apply``).
+    ModelError, InvalidContextError
+        For a plant that is not a finalized MultibodyPlant, a context of
+        another system, or a ``hand_base`` that is not a body of the plant.
+        Every candidate drawn is posed (in a scratch context) before anything
+        is deleted or drawn, so a bad one leaves the previous drawing as it
+        was.
     """
-    if not isinstance(meshcat, Meshcat):
-        raise InvalidOptionError(
-            f"meshcat must be a pydrake.geometry.Meshcat, got {type(meshcat).__name__}"
-        )
+    check_meshcat(meshcat)
+    check_path("prefix", prefix)
     if isinstance(top, bool) or not isinstance(top, int | np.integer) or top < 0:
         raise InvalidOptionError(f"top must be an integer >= 0, got {top!r}")
     ctx = plant_context_of(plant, plant_context)
@@ -178,14 +243,19 @@ def draw_candidates(
     plant.SetPositions(scratch, plant.GetPositions(ctx))
     shown = _candidate_rows(candidates)[: int(top)]
     scores = np.array([float(c.score) for c in shown])
-    colors = score_colors(scores, alpha=alpha) if shown else np.zeros((0, 4))
+    colors = score_colors(scores, alpha=alpha)  # (0, 4) when none is shown
+    posed = []  # per candidate, (body, X_WB) of each hand body
+    for k, c in enumerate(shown):
+        _check_poseable(c, k)
+        c.apply(plant, scratch)
+        bodies = _hand_bodies(plant, c, k)
+        posed.append([(b, plant.EvalBodyPoseInWorld(scratch, b)) for b in bodies])
     meshcat.Delete(prefix)
     paths = []
-    for k, (c, rgba) in enumerate(zip(shown, colors, strict=True)):
-        c.apply(plant, scratch)
+    for k, (bodies, rgba) in enumerate(zip(posed, colors, strict=True)):
         color = Rgba(*rgba)
         path = f"{prefix}/{k}"
-        for body in _hand_bodies(plant, c):
+        for body, X_WB in bodies:
             frame = plant.GetBodyFrameIdOrThrow(body.index())
             geoms = inspector.GetGeometries(frame, Role.kIllustration)
             geoms = geoms or inspector.GetGeometries(frame, Role.kProximity)
@@ -193,7 +263,7 @@ def draw_candidates(
             for n, g in enumerate(geoms):
                 meshcat.SetObject(f"{body_path}/g{n}", inspector.GetShape(g), color)
                 meshcat.SetTransform(f"{body_path}/g{n}", inspector.GetPoseInFrame(g))
-            meshcat.SetTransform(body_path, plant.EvalBodyPoseInWorld(scratch, body))
+            meshcat.SetTransform(body_path, X_WB)
         paths.append(path)
     return CandidateDrawing(tuple(paths), scores, colors)
 
@@ -228,6 +298,25 @@ def _candidate_rows(candidates) -> list:
     return rows
 
 
+def _bin_edges(scores: np.ndarray, bins: int) -> np.ndarray:
+    """``bins + 1`` increasing, finite edges over ``scores`` (numpy's if it can)."""
+    with np.errstate(over="ignore", invalid="ignore"):  # checked below
+        try:
+            return np.histogram_bin_edges(
+                scores if len(scores) else [0.0, 1.0], bins=bins
+            )
+        except ValueError:  # scores a few ulps apart: too narrow for `bins` bins
+            lo, hi = float(scores.min()), float(scores.max())
+            pad = 4 * bins * float(np.spacing(max(abs(lo), abs(hi))))
+            edges = np.linspace(lo - pad, hi + pad, bins + 1)
+    if not (np.all(np.isfinite(edges)) and np.all(np.diff(edges) > 0)):
+        raise InvalidOptionError(
+            f"the candidates' scores, from {lo!r} to {hi!r}, cannot be split into "
+            f"{bins} finite bins (their span is beyond the floating-point range)"
+        )
+    return edges
+
+
 def plot_score_distribution(candidates, *, ax=None, bins: int = 30, top: int = 10):
     """Histogram of the candidates' scores (matplotlib).
 
@@ -238,26 +327,51 @@ def plot_score_distribution(candidates, *, ax=None, bins: int = 30, top: int = 1
     Parameters
     ----------
     candidates : sequence of GraspCandidate
+        Each with a finite real ``score`` and a boolean ``is_closure``.
     ax : matplotlib Axes, optional
-        Default: a new figure's.
+        A 2-D axes (``plt.subplots()``; not a polar or 3-D one).  Default: a
+        new figure's.
     bins : int, optional
+        An integer in ``[1, MAX_BINS]`` = [1, 1000] (:data:`MAX_BINS`).
     top : int, optional
+        An integer >= 0.
 
     Returns
     -------
     matplotlib.axes.Axes
+
+    Raises
+    ------
+    InvalidOptionError
+        For ``candidates`` that are not planned grasps or have a NaN or
+        infinite score (or scores whose span overflows), a ``bins`` or ``top``
+        out of range, or an ``ax`` that is not a 2-D matplotlib axes.  Nothing
+        is drawn then.
     """
     plt = import_pyplot()
-    if isinstance(bins, bool) or not isinstance(bins, int | np.integer) or bins < 1:
-        raise InvalidOptionError(f"bins must be an integer >= 1, got {bins!r}")
+    if (
+        isinstance(bins, bool)
+        or not isinstance(bins, int | np.integer)
+        or not 1 <= bins <= MAX_BINS
+    ):
+        raise InvalidOptionError(
+            f"bins must be an integer >= 1 and <= {MAX_BINS} "
+            f"(drakegrasp.visualization.candidates.MAX_BINS), got {describe(bins)}"
+        )
     if isinstance(top, bool) or not isinstance(top, int | np.integer) or top < 0:
         raise InvalidOptionError(f"top must be an integer >= 0, got {top!r}")
     rows = _candidate_rows(candidates)
     scores = np.array([float(c.score) for c in rows])
+    if not np.all(np.isfinite(scores)):
+        raise InvalidOptionError(
+            f"every candidate's score must be finite, got {describe(scores.tolist())}"
+        )
     closure = np.array([bool(c.is_closure) for c in rows], dtype=bool)
+    edges = _bin_edges(scores, int(bins))
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 3.5))
-    edges = np.histogram_bin_edges(scores if len(scores) else [0.0, 1.0], bins=bins)
+    else:
+        check_axes(ax, "rectilinear")
     ax.hist(
         [scores[closure], scores[~closure]],
         bins=edges,

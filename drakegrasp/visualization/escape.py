@@ -32,6 +32,7 @@ from pydrake.multibody.tree import BodyIndex
 from drakegrasp.certificates.certificate import ESCAPE_TWIST, Certificate
 from drakegrasp.core.validation import (
     check_length,
+    check_positions,
     describe,
     integer_or_none,
     real_array,
@@ -104,19 +105,130 @@ class EscapeAnimation:
     twist_O: np.ndarray
 
 
+def check_amount(amount) -> float:
+    """``amount`` of an escape picture: a real number in ``(0, MAX_AMOUNT]``.
+
+    The largest twist parameter over ``b`` that :func:`animate_escape` and
+    :func:`~drakegrasp.visualization.certificate_plots.plot_escape` move the
+    object by (a negative one would move it into the fingers).
+
+    Raises
+    ------
+    InvalidOptionError
+        For anything else (NaN, 0, a negative number, a string, a bool...).
+    """
+    x = real_scalar("amount", amount)
+    if not (0.0 < x <= MAX_AMOUNT):
+        raise InvalidOptionError(
+            f"amount must be a real number > 0 and <= {MAX_AMOUNT:g} "
+            f"(drakegrasp.visualization.escape.MAX_AMOUNT), got {describe(amount)}"
+        )
+    return x
+
+
+def checked_motion(twist, p, t, *, dim: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """``(twist, p, t)`` of a rigid motion ``exp(t ξ)`` in ``dim`` (2 or 3) D, checked.
+
+    Parameters
+    ----------
+    twist : ((3,) or (6,)) array_like
+        ``[v_p; ω]``: real and finite.
+    p : (dim,) array_like
+        The point the twist is about: a position (real, finite, every
+        ``|x| <=`` :data:`~drakegrasp.core.validation.POSITION_BOUND`).
+    t : float
+        A real, finite number.
+
+    Returns
+    -------
+    twist : (3,) or (6,) float
+    p : (dim,) float
+    t : float
+
+    Raises
+    ------
+    InvalidOptionError
+        Naming the first of ``twist``, ``p`` and ``t`` that is not so.
+    """
+    n = 3 if dim == 2 else 6
+    x = real_array("twist", twist, error=InvalidOptionError)
+    if x.shape != (n,) or not np.all(np.isfinite(x)):
+        raise InvalidOptionError(
+            f"twist must be a finite ({n},) vector [v_p; ω], got {describe(twist)}"
+        )
+    q = check_positions("p", p, error=InvalidOptionError)
+    if q.shape != (dim,):
+        raise InvalidOptionError(
+            f"p must be a ({dim},) point (what the twist is about), got {describe(p)}"
+        )
+    s = real_scalar("t", t)
+    if not np.isfinite(s):
+        raise InvalidOptionError(f"t must be a finite real number, got {describe(t)}")
+    return x, q, s
+
+
+def check_finite_motion(*arrays) -> None:
+    """Refuse a rigid motion ``exp(t ξ)`` some of whose ``arrays`` overflowed.
+
+    Raises
+    ------
+    InvalidOptionError
+        When an entry of ``arrays`` is NaN or infinite.
+    """
+    if not all(np.all(np.isfinite(a)) for a in arrays):
+        raise InvalidOptionError(
+            "the motion exp(t ξ) of this twist, point p and parameter t overflows "
+            "(a speed, an angle or a position beyond the floating-point range): "
+            "give a smaller t or twist"
+        )
+
+
 def escape_transform(twist: np.ndarray, p: np.ndarray, t: float) -> RigidTransform:
-    """``X_OO'(t) = exp(t ξ)`` for a twist ``[v_p; ω]`` about ``p`` in frame O."""
-    v_p, w = np.asarray(twist[:3], float), np.asarray(twist[3:], float)
-    v = v_p - np.cross(w, p)  # the velocity of O's origin
-    speed = float(np.linalg.norm(w))
-    if speed < 1e-12:
-        return RigidTransform(t * v)
-    k, theta = w / speed, t * speed
-    R = RotationMatrix.MakeFromOneVector(k, 2)  # any frame with z = k
-    R = R @ RotationMatrix.MakeZRotation(theta) @ R.inverse()
-    vp = v / speed
-    Rm = R.matrix()
-    pos = (np.eye(3) - Rm) @ np.cross(k, vp) + k * (k @ vp) * theta
+    """``X_OO'(t) = exp(t ξ)`` for a twist ``[v_p; ω]`` about ``p`` in frame O.
+
+    Parameters
+    ----------
+    twist : (6,) array_like
+        ``[v_p; ω]`` (m/s, rad/s): real and finite.
+    p : (3,) array_like
+        The point the twist is about, metres: real, finite, every ``|x| <=``
+        :data:`~drakegrasp.core.validation.POSITION_BOUND` (1e20).
+    t : float
+        The twist parameter (seconds of the twist): a real, finite number.
+
+    Returns
+    -------
+    RigidTransform
+        With a finite translation and rotation.
+
+    Raises
+    ------
+    InvalidOptionError
+        For a ``twist``, ``p`` or ``t`` that is not so (None, a string, a
+        bool, complex, NaN, another shape), naming it, or for a motion that
+        overflows (``|ω|``, ``t |ω|`` or a position beyond the floating-point
+        range, which Drake refused or, for the angle, ended the program on).
+    """
+    return _flow(*checked_motion(twist, p, t, dim=3))
+
+
+def _flow(twist: np.ndarray, p: np.ndarray, t: float) -> RigidTransform:
+    """:func:`escape_transform` of checked arrays (overflow is still refused)."""
+    v_p, w = twist[:3], twist[3:]
+    with np.errstate(over="ignore", invalid="ignore"):  # checked below
+        v = v_p - np.cross(w, p)  # the velocity of O's origin
+        speed = float(np.linalg.norm(w))
+        if speed < 1e-12:
+            check_finite_motion(v, t * v)
+            return RigidTransform(t * v)
+        k, theta = w / speed, t * speed
+        check_finite_motion(v, speed, theta)  # Drake demands a finite angle
+        R = RotationMatrix.MakeFromOneVector(k, 2)  # any frame with z = k
+        R = R @ RotationMatrix.MakeZRotation(theta) @ R.inverse()
+        vp = v / speed
+        Rm = R.matrix()
+        pos = (np.eye(3) - Rm) @ np.cross(k, vp) + k * (k @ vp) * theta
+    check_finite_motion(pos)
     return RigidTransform(R, pos)
 
 
@@ -321,8 +433,9 @@ def animate_escape(
         numbers), a ``scene_or_plant`` that is neither a Scene nor a plant
         (None too), a report whose object body is not in the plant or is not
         the body to move, a result without an escape twist (or a twist that
-        is not finite and non-zero), a planar twist without its plane, an
-        empty ``prefix`` or a ``meshcat`` that is not a Meshcat.
+        is not finite and non-zero, or whose motion overflows: see
+        :func:`escape_transform`), a planar twist without its plane, an empty
+        ``prefix`` or a ``meshcat`` that is not a Meshcat.
     ModelError
         For a plant that is not finalized, or an ``object_body`` that is not
         one of its bodies.
@@ -344,11 +457,7 @@ def animate_escape(
             f"duration must be a real number of seconds in [{MIN_DURATION:g}, "
             f"{MAX_DURATION:g}], got {duration!r}"
         )
-    amount = real_scalar("amount", amount)
-    if not (0.0 < amount <= MAX_AMOUNT):
-        raise InvalidOptionError(
-            f"amount must be a real number > 0 and <= {MAX_AMOUNT:g}, got {amount!r}"
-        )
+    amount = check_amount(amount)
     plant, context, body, (x, p_cert, b, two_sided), plane = _unpack(
         scene_or_plant, result, plant_context, object_body, plane
     )
@@ -371,7 +480,7 @@ def animate_escape(
     animation = MeshcatAnimation(frames_per_second=frames_n / duration)
     transforms = []
     for n, t in enumerate(times):
-        X = X_WO @ escape_transform(twist, p, float(t))
+        X = X_WO @ _flow(twist, p, float(t))
         animation.SetTransform(n, obj, X)
         transforms.append(X)
     meshcat.SetTransform(obj, X_WO)

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 from pydrake.geometry import Meshcat, Rgba, Role, SceneGraph
 
+from drakegrasp.core.validation import describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.visualization.primitives import check_meshcat, check_path
 
 __all__ = ["draw_scene_geometry"]
 
@@ -34,6 +36,7 @@ def draw_scene_geometry(
     Parameters
     ----------
     meshcat : pydrake.geometry.Meshcat
+        (Or an object with its ``SetObject``, ``SetTransform`` and ``Delete``.)
     scene_graph : pydrake.geometry.SceneGraph
         The scene graph of the plant (``diagram.GetSubsystemByName
         ("scene_graph")``).
@@ -43,8 +46,9 @@ def draw_scene_geometry(
     prefix : str, optional
         Meshcat folder to draw in (default ``"scene"``); it is cleared first.
     opacity : float, optional
-        In (0, 1]: replaces each geometry's alpha (a translucent hand lets
-        the contacts show); default the geometry's own.
+        A real number in (0, 1] (numpy reals too; not a bool or a string):
+        replaces each geometry's alpha (a translucent hand lets the contacts
+        show); default the geometry's own.
     role : {"illustration", "proximity"}, optional
         Which geometry to draw: what a viewer shows (default) or what
         Drake's distance queries and contacts see.  Colours come from the
@@ -59,27 +63,30 @@ def draw_scene_geometry(
     ------
     InvalidOptionError
         For a wrong type of ``meshcat`` or ``scene_graph``, a context that is
-        neither the scene graph's nor its diagram's, a bad ``prefix``,
-        ``opacity`` or ``role``.
+        neither the scene graph's nor the root context of a diagram that
+        holds it (None, a plant's context, another diagram's), a ``prefix``
+        that is not a non-empty path, an ``opacity`` that is not a real
+        number in (0, 1], or a ``role`` that is not one of the two names (a
+        list too).  Nothing is drawn then.
     """
-    if not isinstance(meshcat, Meshcat):
-        raise InvalidOptionError(
-            f"meshcat must be a pydrake Meshcat, got {type(meshcat).__name__}"
-        )
+    check_meshcat(meshcat)
     if not isinstance(scene_graph, SceneGraph):
         raise InvalidOptionError(
             "scene_graph must be a pydrake SceneGraph (diagram.GetSubsystemByName"
             f"('scene_graph')), got {type(scene_graph).__name__}"
         )
-    if not isinstance(prefix, str) or not prefix.strip("/"):
-        raise InvalidOptionError(f"prefix must be a non-empty string, got {prefix!r}")
-    if role not in _ROLES:
-        raise InvalidOptionError(f"role must be one of {sorted(_ROLES)}, got {role!r}")
+    check_path("prefix", prefix)
+    if not isinstance(role, str) or role not in _ROLES:
+        raise InvalidOptionError(
+            f"role must be one of {sorted(_ROLES)}, got {describe(role)}"
+        )
     alpha = None
     if opacity is not None:
-        alpha = float(opacity) if isinstance(opacity, int | float) else float("nan")
-        if not (0.0 < alpha <= 1.0) or isinstance(opacity, bool):
-            raise InvalidOptionError(f"opacity must be in (0, 1], got {opacity!r}")
+        alpha = real_scalar("opacity", opacity)
+        if not (0.0 < alpha <= 1.0):
+            raise InvalidOptionError(
+                f"opacity must be a real number in (0, 1], got {describe(opacity)}"
+            )
     query = scene_graph.get_query_output_port().Eval(_own_context(scene_graph, context))
     inspector = query.inspector()
     meshcat.Delete(prefix)
@@ -108,7 +115,9 @@ def _own_context(scene_graph: SceneGraph, context):
     except (RuntimeError, TypeError):
         pass
     try:
-        return scene_graph.GetMyContextFromRoot(context)
+        own = scene_graph.GetMyContextFromRoot(context)
+        scene_graph.ValidateContext(own)  # a scene graph outside that diagram
+        return own
     except (RuntimeError, TypeError) as err:
         raise InvalidOptionError(
             "context must be the scene graph's context or the root context of "

@@ -15,6 +15,7 @@ matplotlib and scipy are imported only when a function here needs them.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,12 +24,13 @@ import numpy as np
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp, wrench_columns
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import real_array, real_scalar
+from drakegrasp.core.validation import check_flag, describe, real_array, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.plots import import_pyplot
 
 __all__ = [
     "MAX_HULL_DIM",
+    "MAX_HULL_FACETS",
     "ORIGIN_CLEARANCE_TOL",
     "WRENCH_BOUND",
     "WrenchHull",
@@ -45,6 +47,18 @@ WRENCH_BOUND = 1e100
 """Largest absolute entry of a wrench :func:`wrench_hull` takes, so that the
 rank's SVD and Qhull square nothing beyond ``1e200`` (an array of NaN made the
 SVD fail to converge)."""
+
+MAX_HULL_FACETS = 10**6
+"""Most facets the hull of :func:`wrench_hull` may have.
+
+Qhull's time and memory grow with the hull's facets, and in 6-D ``K`` points
+can have about ``K**3 / 6`` of them: the wrenches of three contacts with 256
+generators each (768 points) ran for minutes, a cyclic polytope of 400 points
+took 88 s and 4 GB.  :func:`wrench_hull` therefore refuses more columns than
+can have at most this many facets (McMullen's upper bound theorem: the
+cyclic polytope's count): 1,000,000 columns in 2-D,
+500,002 in 3-D, 1,415 in 4-D, 1,003 in 5-D and 184 in 6-D.  A hull of 10**6
+facets took about 5 s and 0.5 GB."""
 
 ORIGIN_CLEARANCE_TOL = 1e-9
 """Default distance (in the wrench space's units) by which every facet of the
@@ -105,6 +119,34 @@ def wrench_space_points(
     return W, np.array(owner, dtype=int)
 
 
+def _most_hull_facets(m: int, K: int) -> int:
+    """Most facets the convex hull of ``K`` points in ``m`` dimensions can have.
+
+    McMullen's upper bound theorem: the cyclic polytope's count,
+    ``K / (K - k) · C(K - k, k)`` for ``m = 2k`` and ``2 C(K - k - 1, k)`` for
+    ``m = 2k + 1`` (0 when ``K <= m``: no interior).  A triangulated hull
+    (Qhull's simplices) has at most as many.
+    """
+    if K <= m:
+        return 0
+    k = m // 2
+    if m % 2 == 0:
+        return K * math.comb(K - k, k) // (K - k)
+    return 2 * math.comb(K - k - 1, k)
+
+
+def _most_hull_columns(m: int) -> int:
+    """Most columns ``K`` with ``_most_hull_facets(m, K) <= MAX_HULL_FACETS``."""
+    low, high = m, 2 * MAX_HULL_FACETS + m  # facets >= K - m + 1 > the bound there
+    while low < high:  # the count grows with K
+        mid = (low + high + 1) // 2
+        if _most_hull_facets(m, mid) <= MAX_HULL_FACETS:
+            low = mid
+        else:
+            high = mid - 1
+    return low
+
+
 @dataclass(frozen=True)
 class WrenchHull:
     """Convex hull of a set of wrenches and where the origin lies.
@@ -136,8 +178,11 @@ def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHu
     ----------
     W : (m, K) float
         Wrenches as columns, ``2 <= m <= MAX_HULL_DIM`` (6, a spatial wrench)
-        and any ``K >= 0``; every entry real, finite and at most
-        :data:`WRENCH_BOUND` (1e100) in absolute value.
+        and ``K >= 0`` columns, at most as many as can have
+        :data:`MAX_HULL_FACETS` facets in ``m`` dimensions (1,000,000 in 2-D,
+        500,002 in 3-D, 1,415 in 4-D, 1,003 in 5-D, 184 in 6-D); every entry
+        real, finite and at most :data:`WRENCH_BOUND` (1e100) in absolute
+        value.
     tol : float, optional
         The origin counts as inside only when every facet is farther than
         ``tol``: a real number, finite and >= 0 (units of ``W``).
@@ -150,8 +195,10 @@ def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHu
     ------
     InvalidOptionError
         For a ``W`` that is not a 2-D real array with 2 to 6 rows (a 1-D or
-        an empty-shaped one), has a NaN or infinite entry or one beyond
-        :data:`WRENCH_BOUND`, or a ``tol`` that is not a finite real >= 0.
+        an empty-shaped one), has more columns than that (whatever their
+        values: Qhull could run for minutes), a NaN or infinite entry or one
+        beyond :data:`WRENCH_BOUND`, or a ``tol`` that is not a finite real
+        >= 0.
     """
     from scipy.spatial import ConvexHull, QhullError
 
@@ -160,6 +207,15 @@ def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHu
         raise InvalidOptionError(
             f"W must be an (m, K) array of wrenches as columns with 2 <= m <= "
             f"{MAX_HULL_DIM} (3 planar, 6 spatial), got shape {W.shape}"
+        )
+    m, K = W.shape
+    if _most_hull_facets(m, K) > MAX_HULL_FACETS:
+        raise InvalidOptionError(
+            f"W has {K} columns in {m} dimensions, whose hull may have "
+            f"{_most_hull_facets(m, K):.3g} facets, more than MAX_HULL_FACETS = "
+            f"{MAX_HULL_FACETS:g} (drakegrasp.visualization.wrench_space; Qhull "
+            f"could run for minutes): pass at most {_most_hull_columns(m)} "
+            f"columns of {m} rows"
         )
     if W.size and not float(np.max(np.abs(W))) <= WRENCH_BOUND:  # NaN fails too
         raise InvalidOptionError(
@@ -171,7 +227,6 @@ def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHu
     tol = real_scalar("tol", tol)
     if not (0.0 <= tol < np.inf):
         raise InvalidOptionError(f"tol must be a finite real number >= 0, got {tol!r}")
-    m, K = W.shape
     rank = int(np.linalg.matrix_rank(W)) if K else 0
     # The hull has an interior only if the points' affine hull is m-dimensional.
     affine_rank = int(np.linalg.matrix_rank(W[:, 1:] - W[:, :1])) if K > 1 else 0
@@ -251,15 +306,18 @@ def plot_wrench_space(
         A 3-D axes (``fig.add_subplot(projection="3d")``); a new figure when
         omitted.
     hull : bool, optional
-        Draw the convex hull's facets (translucent).
+        Draw the convex hull's facets (translucent): True or False.
     rays : bool, optional
-        Draw a segment from the origin to each primitive wrench.
+        Draw a segment from the origin to each primitive wrench: True or
+        False.
     tol : float, optional
         Margin the origin needs to count as inside (see :func:`wrench_hull`).
     result : ClosureResult, optional
-        A force-closure "no" of this grasp: its certificate's separating plane
-        ``yᵀ w = 0`` (every primitive wrench lies on one side) and the
-        unresisted direction are drawn in red.
+        A verdict of this grasp (a result with a boolean ``is_closure``); for
+        a force-closure "no" its certificate's separating plane ``yᵀ w = 0``
+        (every primitive wrench lies on one side) and the unresisted direction
+        are drawn in red (see
+        :func:`~drakegrasp.visualization.certificate_plots.plot_separating_plane`).
 
     Returns
     -------
@@ -268,7 +326,10 @@ def plot_wrench_space(
     Raises
     ------
     InvalidOptionError
-        For a spatial grasp (6-D wrench space) or an ``ax`` that is not 3-D.
+        For a spatial grasp (6-D wrench space), an ``ax`` that is not a 3-D
+        axes, a ``hull`` or ``rays`` that is not a boolean, a ``result`` that
+        is not a verdict, or a "no" whose certificate is of another grasp or
+        has no finite, non-zero separating twist.  Nothing is drawn then.
     ImportError
         When matplotlib (or scipy) is not installed.
     """
@@ -284,17 +345,35 @@ def plot_wrench_space(
             "plot_wrench_space draws planar grasps, whose wrench space is 3-D; "
             "this grasp is spatial (6-D wrenches)"
         )
+    hull, rays = check_flag("hull", hull), check_flag("rays", rays)
     plt = import_pyplot()
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
+    from drakegrasp.visualization.certificate_plots import (
+        check_axes,
+        checked_separating_plane,
+        plot_separating_plane,
+    )
+
+    cert = None
+    if result is not None:
+        is_closure = getattr(result, "is_closure", None)
+        if not isinstance(is_closure, bool | np.bool_):
+            raise InvalidOptionError(
+                "result must be a verdict of this grasp (a ClosureResult such as "
+                f"force_closure(grasp)), got {describe(result)} "
+                f"({type(result).__name__})"
+            )
+        cert = getattr(result, "certificate", None)
+        if getattr(cert, "separating_twist", None) is None or is_closure:
+            cert = None
+        else:
+            checked_separating_plane(grasp, cert)
     if ax is None:
         fig = plt.figure()
         ax = fig.add_subplot(projection="3d")
-    elif getattr(ax, "name", None) != "3d":
-        raise InvalidOptionError(
-            "ax must be a 3-D axes (fig.add_subplot(projection='3d')), got "
-            f"a {getattr(ax, 'name', type(ax).__name__)!r} axes"
-        )
+    else:
+        check_axes(ax, "3d")
     W, owner = wrench_space_points(grasp, num_generators=num_generators)
     info = wrench_hull(W, tol=tol)
     cmap = plt.get_cmap("tab10")
@@ -325,10 +404,7 @@ def plot_wrench_space(
     where = "inside" if info.origin_inside else "NOT inside"
     ax.set_title(f"origin {where} the hull (margin {info.margin:.3g})")
     plane = None
-    cert = getattr(result, "certificate", None)
-    if getattr(cert, "separating_twist", None) is not None and not result.is_closure:
-        from drakegrasp.visualization.certificate_plots import plot_separating_plane
-
+    if cert is not None:
         plane = plot_separating_plane(ax, grasp, cert, extent)
     return WrenchSpacePlot(
         ax, W, owner, points, ray_artist, info, hull_artist, origin, plane
