@@ -1,4 +1,4 @@
-"""Input checks shared by the planning stages: arrays, friction, counts, rngs.
+"""Input checks shared by the planning stages: arrays, friction, counts, noise, rngs.
 
 Weight capacity, robustness, re-closing and placement take the same kinds of
 argument; each check here raises a :class:`~drakegrasp.GraspError` naming the
@@ -26,11 +26,13 @@ __all__ = [
     "MAX_COPY_BYTES",
     "MAX_FINGER_LABEL",
     "MOMENT_ARMS",
+    "NOISE_MAX",
     "checked_contacts",
     "checked_count",
     "checked_directions",
     "checked_fingers",
     "checked_friction",
+    "checked_noise",
     "checked_nonnegative",
     "checked_points",
     "checked_rng",
@@ -269,13 +271,86 @@ def checked_samples(value, grasps: int, contacts: int, name: str = "samples") ->
 
 
 def checked_nonnegative(name: str, value, unit: str) -> float:
-    """``value`` as a finite float ``>= 0`` (a noise σ, a clearance), in ``unit``."""
+    """``value`` as a finite float ``>= 0`` (a clearance, a noise σ), in ``unit``.
+
+    Unbounded above; a noise σ is checked by :func:`checked_noise`, which
+    also bounds it by :data:`NOISE_MAX`.
+    """
     x = real_scalar(name, value)
     if not 0.0 <= x < np.inf:
         raise InvalidOptionError(
             f"{name} must be a finite number >= 0 ({unit}), got {describe(value)}"
         )
     return x
+
+
+NOISE_MAX = {"position": 1e6, "angle_deg": 1e6, "friction": 1e6}
+"""Largest noise σ of the robustness (:func:`checked_noise`): σ_p (metres),
+σ_θ (degrees), σ_μ (relative), each taken in ``[0, NOISE_MAX[key]]``.
+
+Far above any use (the defaults are 2 mm, 3° and 0.1; the bounds are 5e8,
+3.3e5 and 1e7 times them), the bounds keep the copies' arithmetic finite:
+without them a σ of 1e300 scattered the copies' contacts to 1e300 m or
+overflowed (numpy's ``RuntimeWarning``) in the re-closing's chord query.
+
+* ``position``, 1e6 m (a thousand kilometres): a pose error beyond any
+  grasped object's size already leaves every copy without its grasp; the
+  copies' contacts stay far inside the positions' bound
+  (:data:`~drakegrasp.core.validation.POSITION_BOUND`, 1e20 m) and their
+  squares far from overflow.
+* ``angle_deg``, 1e6 degrees (about 2,800 turns): beyond a few turns the
+  drawn rotation angle is already spread evenly over the circle; the angles
+  (radians, a few times 1.7e4 at most) keep their sines and cosines accurate.
+* ``friction``, 1e6: beyond a few units half the copies' μ are already 0
+  (``max(0, 1 + σ_μ ξ)``); ``μ (1 + σ_μ ξ)`` stays below 1e19 for ``μ <= 1e12``
+  before it is clipped to the batch engine's range.
+"""
+
+_NOISE_UNITS = {"position": "metres", "angle_deg": "degrees", "friction": "relative"}
+
+
+def checked_noise(sigmas, name: str = "{}") -> dict[str, float]:
+    """The noise σ of ``sigmas``, each a number in ``[0, NOISE_MAX[key]]``.
+
+    The one check of the robustness noise, for
+    :func:`~drakegrasp.planning.ranking.robustness`,
+    :func:`~drakegrasp.planning.ranking.perturbed_copies`,
+    :func:`~drakegrasp.planning.reclose.reclosed_robustness` and the planner's
+    ``noise=``.
+
+    Parameters
+    ----------
+    sigmas : mapping of str to float
+        Some of the keys of :data:`NOISE_MAX`: ``"position"`` (σ_p, metres),
+        ``"angle_deg"`` (σ_θ, degrees), ``"friction"`` (σ_μ, relative).
+    name : str, optional
+        Spells an argument's name in a message from its key (``"{}"``:
+        ``position``; ``"noise[{!r}]"``: ``noise['position']``).
+
+    Returns
+    -------
+    dict of str to float
+        The σ as floats, in the order of ``sigmas``.
+
+    Raises
+    ------
+    InvalidOptionError
+        Naming the σ: not a real number, negative, not finite, or above its
+        bound in :data:`NOISE_MAX` (the message gives the range).
+    """
+    out = {}
+    for key, value in sigmas.items():
+        label = name.format(key)
+        x = checked_nonnegative(label, value, _NOISE_UNITS[key])
+        if x > NOISE_MAX[key]:
+            raise InvalidOptionError(
+                f"{label} = {x:g} {_NOISE_UNITS[key]} is beyond the bound of a "
+                f"noise σ: it must be in [0, {NOISE_MAX[key]:g}] "
+                f"{_NOISE_UNITS[key]} (drakegrasp.planning.checks.NOISE_MAX; "
+                "far above any pose or friction error a grasp meets)"
+            )
+        out[key] = x
+    return out
 
 
 def checked_rng(rng) -> np.random.Generator:

@@ -64,6 +64,7 @@ from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
+from drakegrasp.planning.checks import checked_directions
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.jacobians import contact_rows, hand_jacobian
@@ -190,8 +191,11 @@ def torque_capacity(
     plant, plant_context, candidate, object_body
         As for :func:`finger_jacobian`.
     directions : (D, 3) float, optional
-        Weight directions in frame O (normalised; default the 14 of the weight
-        capacity).
+        Weight directions in frame O, ``D >= 1`` real, finite, non-zero rows
+        of any magnitude (normalised here, as
+        :func:`~drakegrasp.planning.weight.weight_capacity` does:
+        :func:`~drakegrasp.planning.checks.checked_directions`); default the
+        14 of the weight capacity.
 
     Returns
     -------
@@ -200,6 +204,13 @@ def torque_capacity(
         hold a weight along the direction at all, ``inf`` where no joint bounds
         it (contacts on the palm alone, say).
 
+    Raises
+    ------
+    InvalidOptionError
+        ``directions`` not as above (not real, not ``(D, 3)``, a row not
+        finite or zero), naming ``directions``; checked before the plant is
+        read.
+
     Notes
     -----
     One program for all directions (their blocks share nothing, so maximising
@@ -207,15 +218,7 @@ def torque_capacity(
     ``f = S λ``, ``λ >= 0`` (eight per Coulomb cone, the default of the
     verdicts), and :data:`BETA_CAP` keeps it bounded.
     """
-    u = np.asarray(directions, dtype=float)
-    if u.ndim != 2 or u.shape[1] != 3 or not np.all(np.isfinite(u)):
-        raise InvalidOptionError(
-            f"directions must be finite 3-vectors in frame O, got shape {u.shape}"
-        )
-    norms = np.linalg.norm(u, axis=1, keepdims=True)
-    if np.any(norms == 0):
-        raise InvalidOptionError("directions must be nonzero 3-vectors")
-    u = u / norms
+    u = checked_directions("directions", directions)
     J = finger_jacobian(plant, plant_context, candidate, object_body)
     grasp = candidate.grasp
     S = block_diag(

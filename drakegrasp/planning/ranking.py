@@ -73,7 +73,7 @@ from drakegrasp.planning.checks import (
     checked_contacts,
     checked_fingers,
     checked_friction,
-    checked_nonnegative,
+    checked_noise,
     checked_rng,
     checked_samples,
 )
@@ -98,27 +98,20 @@ __all__ = [
 DEFAULT_NOISE = {"position": 2e-3, "angle_deg": 3.0, "friction": 0.1}
 """Default robustness noise: σ_p (m), σ_θ (degrees), σ_μ (relative)."""
 
-_NOISE_UNITS = {"position": "metres", "angle_deg": "degrees", "friction": "relative"}
 
-
-def checked_noise(sigmas, name: str = "{}") -> dict[str, float]:
-    """The three noise σ of ``sigmas``, each a finite number >= 0.
-
-    ``name`` spells an argument's name in a message from its key (``"{}"``:
-    ``position``; ``"noise[{!r}]"``: ``noise['position']``).
-    """
-    return {
-        key: checked_nonnegative(name.format(key), value, _NOISE_UNITS[key])
-        for key, value in sigmas.items()
-    }
-
-
-def _checked_groups(groups) -> tuple[int, ...]:
-    """``groups`` of :func:`perturbed_copies`: distinct finger labels.
+def _checked_groups(groups, fingers: np.ndarray, *, empty: bool) -> tuple[int, ...]:
+    """``groups`` of :func:`perturbed_copies`: distinct finger labels of ``fingers``.
 
     Each an integer in ``[0, MAX_FINGER_LABEL]`` (a label outside matches no
     contact: a slip of the caller's), none twice (its contacts would move
-    twice a copy, their noise doubled).  Empty: no contact moves.
+    twice a copy, their noise doubled).  With ``K >= 1`` grasps, some label
+    must be carried by some contact of the (checked, (K, N)) ``fingers``:
+    else no contact would move, and the robustness would read the
+    unperturbed grasp's (1.0 for a force closure grasp without μ noise).  A
+    label that only some batches carry is taken (the multi-finger planner
+    passes every finger of its hand, and a batch may lack one).  ``empty``:
+    an empty ``groups`` is taken (no contact moves: ``perturbed_copies``,
+    whose copies show it); else refused.  Nothing is drawn here.
     """
     try:
         labels = tuple(integer_or_none(g) for g in groups)
@@ -140,6 +133,20 @@ def _checked_groups(groups) -> tuple[int, ...]:
         raise InvalidOptionError(
             f"groups names finger {twice} more than once; each finger's contacts "
             "move once a copy"
+        )
+    present = np.unique(fingers).tolist()
+    if not labels and not empty:
+        raise InvalidOptionError(
+            "groups is empty: no contact would move, and the robustness would "
+            "be that of the unperturbed grasp; give the labels of the fingers "
+            f"to perturb, a non-empty sequence of labels of fingers {present}"
+        )
+    if labels and fingers.size and not set(labels) & set(present):
+        raise InvalidOptionError(
+            f"groups {describe(labels)} names no finger of fingers, whose "
+            f"contacts carry the labels {present}: no contact would move, and "
+            "the robustness would be that of the unperturbed grasp; give the "
+            "labels of the fingers to perturb, some of them among these"
         )
     return labels
 
@@ -190,18 +197,32 @@ def perturbed_copies(
     rng : numpy.random.Generator
         Draws the noise (``numpy.random.default_rng(seed)``).
     position : float
-        σ_p, metres, finite and ``>= 0``: each finger's translation.
+        σ_p, metres, in ``[0, 1e6]``: each finger's translation.
     angle_deg : float
-        σ_θ, degrees, finite and ``>= 0``: each finger's rotation about a
+        σ_θ, degrees, in ``[0, 1e6]``: each finger's rotation about a
         random axis through its contacts' centroid.
     friction : float
-        σ_μ, relative, finite and ``>= 0``: each copy's μ is
-        ``mu · max(0, 1 + σ_μ ξ)``.
+        σ_μ, relative, in ``[0, 1e6]``: each copy's μ is
+        ``mu · max(0, 1 + σ_μ ξ)``.  The three bounds are
+        :data:`~drakegrasp.planning.checks.NOISE_MAX`, far above any pose or
+        friction error (:func:`~drakegrasp.planning.checks.checked_noise`).
     groups : sequence of int, optional
         The finger labels whose contacts move, each in ``[0, 63]`` and none
         twice (default the two jaws; a multi-finger hand passes all its
-        fingers).  Contacts with other labels (a palm) stay put; an empty
-        sequence moves no contact (only μ is perturbed).
+        fingers).  With ``K >= 1`` grasps, at least one of them must be a
+        label of ``fingers`` (else no contact would move); a label no contact
+        carries beside ones that some carry is taken and moves nothing.
+        Contacts with other labels (a palm) stay put; an empty sequence moves
+        no contact (only μ is perturbed).
+
+    Raises
+    ------
+    GraspError
+        Naming a bad argument: :class:`~drakegrasp.InvalidContactError` for
+        the contacts (``positions``, ``normals``, ``fingers``) and ``mu``,
+        :class:`~drakegrasp.InvalidOptionError` for the others, among them a
+        σ out of its range and ``groups`` naming no label of ``fingers`` (the
+        message lists the labels there).
 
     Returns
     -------
@@ -219,7 +240,7 @@ def perturbed_copies(
     rng = checked_rng(rng)
     sigma = {"position": position, "angle_deg": angle_deg, "friction": friction}
     position, angle_deg, friction = checked_noise(sigma).values()
-    groups = _checked_groups(groups)
+    groups = _checked_groups(groups, fingers, empty=True)
     K, N, _ = positions.shape
     P = np.repeat(positions, samples, axis=0)
     Nrm = np.repeat(normals, samples, axis=0)
@@ -354,9 +375,10 @@ def robustness(
     rng : numpy.random.Generator
         Draws the noise (``numpy.random.default_rng(seed)``).
     noise : dict
-        The three σ of :data:`DEFAULT_NOISE`, each finite and ``>= 0``:
-        ``"position"`` (metres), ``"angle_deg"`` (degrees) and
-        ``"friction"`` (relative); exactly these keys.
+        The three σ of :data:`DEFAULT_NOISE`, each in ``[0, 1e6]``
+        (:data:`~drakegrasp.planning.checks.NOISE_MAX`, far above any pose or
+        friction error): ``"position"`` (metres), ``"angle_deg"`` (degrees)
+        and ``"friction"`` (relative); exactly these keys.
     contact_model : {"hard_finger", "frictionless", "soft_finger"}
     torsional_friction : float or None
         ``ν`` of soft fingers, 0 or in ``[1e-12, 1e12]``; None is 0, and
@@ -365,12 +387,25 @@ def robustness(
     workers : int or None
         Worker processes of the batch engine (None: every core).
     groups : sequence of int, optional
-        The finger labels whose contacts move (see :func:`perturbed_copies`).
+        The finger labels whose contacts move (see :func:`perturbed_copies`):
+        not empty, and with ``K >= 1`` grasps at least one of them a label of
+        ``fingers`` (else no contact would move and the robustness would be
+        the unperturbed grasp's).
 
     Returns
     -------
     (K,) float
         Fraction in ``[0, 1]`` of each grasp's copies in force closure.
+
+    Raises
+    ------
+    GraspError
+        Naming a bad argument: :class:`~drakegrasp.InvalidContactError` for
+        the contacts (``positions``, ``normals``, ``fingers``) and ``mu``,
+        :class:`~drakegrasp.InvalidOptionError` for the others, among them a
+        σ out of its range (``noise['position']``...) and ``groups`` empty
+        or naming no label of ``fingers`` (the message lists the labels
+        there).
     """
     positions, normals = checked_contacts(positions, normals)
     fingers = checked_fingers(fingers, positions.shape[:2])
@@ -386,7 +421,7 @@ def robustness(
         )
     noise = checked_noise(noise, "noise[{!r}]")
     check_workers(workers)
-    groups = _checked_groups(groups)
+    groups = _checked_groups(groups, fingers, empty=False)
     if samples == 0 or len(positions) == 0:
         return np.zeros(len(positions))
     P, Nrm, mus = perturbed_copies(

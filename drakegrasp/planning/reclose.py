@@ -64,7 +64,7 @@ from drakegrasp.planning.checks import (
     checked_directions,
     checked_fingers,
     checked_friction,
-    checked_nonnegative,
+    checked_noise,
     checked_points,
     checked_rng,
     checked_samples,
@@ -213,8 +213,10 @@ def reclosed_robustness(
     rng : numpy.random.Generator
         Draws the motions and μ (``numpy.random.default_rng(seed)``).
     position, angle_deg, friction : float
-        σ_p (metres), σ_θ (degrees, about the axis), σ_μ (relative); each
-        finite and ``>= 0``.
+        σ_p (metres), σ_θ (degrees, about the axis), σ_μ (relative); each in
+        ``[0, 1e6]`` (:data:`~drakegrasp.planning.checks.NOISE_MAX`: far above
+        any pose or friction error, they keep the re-closing's arithmetic
+        finite).
     tol : float
         Metres, a length ``> 0``: probes within ``tol`` of a finger's first
         touch touch too (the planner's distance tolerance).
@@ -229,6 +231,12 @@ def reclosed_robustness(
     -------
     (K,) float
         Fraction in ``[0, 1]`` of each grasp's copies in force closure.
+
+    Raises
+    ------
+    GraspError
+        Naming a bad argument, among them a σ out of its range
+        (:func:`~drakegrasp.planning.checks.checked_noise`).
     """
     if not callable(getattr(surface, "chord", None)):
         raise InvalidOptionError(
@@ -244,9 +252,8 @@ def reclosed_robustness(
     )
     samples = checked_samples(samples, K, N)
     rng = checked_rng(rng)
-    position = checked_nonnegative("position", position, "metres")
-    angle_deg = checked_nonnegative("angle_deg", angle_deg, "degrees")
-    friction = checked_nonnegative("friction", friction, "relative")
+    sigma = {"position": position, "angle_deg": angle_deg, "friction": friction}
+    position, angle_deg, friction = checked_noise(sigma).values()
     tol = check_length("tol", tol, error=InvalidOptionError)
     check_workers(workers)
     if reference is None:
