@@ -246,7 +246,8 @@ def plan_grasps(
         and one over it for the candidates that close is refused when they
         are ranked.
     noise : dict, optional
-        ``{"position": m, "angle_deg": deg, "friction": relative}``; default
+        ``{"position": m, "angle_deg": deg, "friction": relative}``, each in
+        ``[0, 1e6]`` (:data:`~drakegrasp.planning.checks.NOISE_MAX`); default
         :data:`~drakegrasp.planning.ranking.DEFAULT_NOISE`.  On an object body
         the object's pose error (translation, and rotation about the grasp
         axis), the jaws closing again on the moved object

@@ -370,7 +370,14 @@ def resolve_body(plant: MultibodyPlant, name: str) -> RigidBody:
     ModelError
         If no (or more than one) body has that name; the message lists the
         plant's bodies.
+    InvalidOptionError
+        If ``name`` is not a string.
     """
+    if not isinstance(name, str):
+        raise InvalidOptionError(
+            "a body name must be a string such as 'model::body', got a "
+            f"{type(name).__name__}"
+        )
     try:
         if "::" in name:
             model, body = name.rsplit("::", 1)

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex
 
+import drakegrasp as dg
 from drakegrasp import (
     GraspError,
     InvalidContextError,
@@ -200,3 +201,19 @@ def test_distance_tolerance_is_one_rule_for_every_plant_function(real_hands):
         ):
             with pytest.raises(GraspError, match="distance_tolerance must be finite"):
                 call(bad)
+
+
+@pytest.mark.parametrize("name", [None, 3, b"box::box", ["box"]])
+def test_resolve_body_refuses_a_name_that_is_no_string(name):
+    # It raised a raw TypeError ("argument of type 'int' is not iterable").
+    from pydrake.multibody.plant import MultibodyPlant
+    from pydrake.multibody.tree import SpatialInertia
+
+    from drakegrasp.plant.validation import resolve_body
+
+    plant = MultibodyPlant(0.0)
+    plant.AddRigidBody("box", SpatialInertia.SolidBoxWithMass(1, 0.1, 0.1, 0.1))
+    plant.Finalize()
+    assert resolve_body(plant, "box").name() == "box"
+    with pytest.raises(dg.InvalidOptionError, match="a body name must be a string"):
+        resolve_body(plant, name)
