@@ -30,7 +30,7 @@ boundaries and says nothing of the load a grasp can carry.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from pydrake.solvers import MathematicalProgram, SolutionResult
@@ -542,6 +542,19 @@ def grasp_forces(
     return solve_load(P, w, objective)
 
 
+LIMIT_GAP = 1e8
+"""Limits at least this many times the load's size are first left out.
+
+The program's unit of force is the load's size, so such limits are entries of
+1e8 and more beside the balance's entries of 1: a load of 1e-14 N with 10 N
+bounds was "not held" (the solvers' status on a bound of 1e15).  Leaving the
+limits out is a relaxation: forces of the relaxed problem that re-check within
+the limits are the least squeeze of the limited one too, and a refutation of
+the relaxed problem (which prices no limit) refutes the limited one.  Anything
+else is decided with the limits, as before.
+"""
+
+
 def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResult:
     """Build, solve and read the program of a validated problem.
 
@@ -549,8 +562,62 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
     balance (:meth:`~drakegrasp.closure.load_problem.LoadProblem.violation`).
     When they fail, the problem is solved again friction-scaled (the cure at
     ``μ >> 1``); a second failure is a :class:`~drakegrasp.SolverError`, never
-    forces that break a limit reported as feasible.
+    forces that break a limit reported as feasible.  Limits far above the
+    load (:data:`LIMIT_GAP`) are first left out, for the least squeeze.
     """
+    free = _without_far_limits(P, w, objective)
+    if free is not None:
+        relaxed = _solve_checked(free, w, objective)
+        if not relaxed.feasible:
+            cert = relaxed.certificate
+            if cert is not None:
+                cert = replace(
+                    cert,
+                    torque_limits=P.torque_limits,
+                    max_normal_force=P.max_normal_force,
+                    max_squeeze=P.max_squeeze,
+                )
+            return replace(relaxed, certificate=cert, torque_limits=_limits_copy(P))
+        if P.violation(relaxed.stacked_forces(), w)[0] <= FEASIBILITY_TOL:
+            sat, usage = saturating_joints(relaxed.joint_torques, P.torque_limits)
+            return replace(
+                relaxed,
+                torque_limits=_limits_copy(P),
+                saturating_joints=sat,
+                torque_usage=usage,
+            )
+    return _solve_checked(P, w, objective)
+
+
+def _limits_copy(P: LoadProblem) -> np.ndarray | None:
+    return None if P.torque_limits is None else P.torque_limits.copy()
+
+
+def _without_far_limits(P: LoadProblem, w: np.ndarray, objective: str):
+    """``P`` without its limits when all are :data:`LIMIT_GAP` times the load."""
+    if objective != "min_squeeze":  # the other objectives are shaped by limits
+        return None
+    size = float(np.max(np.abs(P.T @ w)))
+    lim = P.limited_joints()
+    sizes = np.concatenate(
+        [
+            P.max_normal_force[np.isfinite(P.max_normal_force)],
+            [P.max_squeeze] if math.isfinite(P.max_squeeze) else [],
+            P.torque_limits[lim] / P.jscale[lim] if lim.size else [],
+        ]
+    )
+    if not (size > 0.0 and sizes.size and np.min(sizes) >= LIMIT_GAP * size):
+        return None
+    return replace(
+        P,
+        torque_limits=None,
+        max_normal_force=np.full(P.max_normal_force.shape, math.inf),
+        max_squeeze=math.inf,
+    )
+
+
+def _solve_checked(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResult:
+    """:func:`solve_load` with the limits as they are."""
     first = _solve_load(P, w, objective)
     Ps = P.friction_scaled()
     scaled = Ps is not P

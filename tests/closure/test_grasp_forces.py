@@ -522,3 +522,61 @@ def test_payload_never_exceeds_its_re_checked_bound():
     np.testing.assert_allclose(
         G @ np.concatenate(r.contact_forces), -r.alpha * w, atol=1e-9
     )
+
+
+# ------------------------------------------- loads far below the limits (r22)
+
+
+def _pinch(mu=0.5):
+    return dg.Grasp(
+        [
+            dg.Contact([-0.05, 0, 0], [1, 0, 0], mu=mu),
+            dg.Contact([0.05, 0, 0], [-1, 0, 0], mu=mu),
+        ]
+    )
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-6, 1e-13, 1e-14, 1e-15, 1e-100, 1e-300])
+def test_a_tiny_load_is_held_as_a_unit_one_is(scale):
+    """9.81e-15 N with 10 N bounds was "not held" (kInfeasibleConstraints), and
+    1e-13 N raised SolverError: the program's unit of force is the load, so
+    the bounds were entries of 1e15.  Independent route: two fingers with
+    μ = 0.5 hold a weight W with the least squeeze 2 W / (2 μ) = 2 W."""
+    W = 9.81 * scale
+    r = dg.grasp_forces(_pinch(), [0, 0, -W, 0, 0, 0], max_normal_force=10)
+    assert r.feasible
+    assert r.squeeze == pytest.approx(2 * W, rel=1e-6)
+    assert r.balance_residual < 1e-9
+
+
+def test_a_tiny_load_no_force_holds_is_refuted_against_the_limits():
+    # A moment about the fingers' line: no force of two hard fingers resists it.
+    g = _pinch()
+    for scale in (1.0, 1e-14):
+        r = dg.grasp_forces(g, [0, 0, 0, scale, 0, 0], max_normal_force=10)
+        assert not r.feasible and r.certificate is not None
+        assert r.certificate.check(g).holds
+        assert r.certificate.check(g, max_normal_force=10).holds
+        assert list(r.certificate.max_normal_force) == [10, 10]
+
+
+def test_limits_the_relaxed_forces_break_still_decide():
+    """μ = 1e-9: a load of 1e-10 N needs 0.05 N per finger (|w| / 2μ).  Bounds
+    1e8 times the load and more are first left out; forces that then break a
+    bound (0.01 N) send the question back to the limited program."""
+    g = _pinch(mu=1e-9)
+    w = [0, 0, -1e-10, 0, 0, 0]
+    held = dg.grasp_forces(g, w, max_normal_force=10)
+    assert held.feasible
+    assert held.squeeze == pytest.approx(0.1, rel=1e-6)
+    assert not dg.grasp_forces(g, w, max_normal_force=0.01).feasible
+
+
+def test_far_torque_limits_are_reported_with_the_result():
+    g = _pinch()
+    J = np.random.default_rng(0).normal(size=(6, 3))
+    r = dg.grasp_forces(
+        g, [0, 0, -9.81e-14, 0, 0, 0], hand_jacobian=J, torque_limits=[1, 1, 1]
+    )
+    assert r.feasible and list(r.torque_limits) == [1, 1, 1]
+    assert r.saturating_joints == () and 0 < r.torque_usage < 1e-12
