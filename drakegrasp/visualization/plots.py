@@ -17,9 +17,19 @@ from typing import Any
 
 import numpy as np
 
+from drakegrasp.certificates.certificate import (
+    ESCAPE_TWIST,
+    UNRESISTED_WRENCH,
+    Certificate,
+)
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.validation import check_length, safe_norm
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.visualization.certificate_plots import (
+    check_axes,
+    plot_escape,
+    plot_unresisted_wrench,
+)
 from drakegrasp.visualization.geometry import (
     DRAW_LENGTH_MAX,
     cone_edge_directions,
@@ -29,6 +39,7 @@ from drakegrasp.visualization.geometry import (
     positive_length,
     side_sign,
 )
+from drakegrasp.visualization.meshcat_certificates import checked_certificate
 
 __all__ = ["PLOT_COLORS", "PlanarGraspPlot", "import_pyplot", "plot_planar_grasp"]
 
@@ -251,13 +262,11 @@ def plot_planar_grasp(
 
     patch = None if outline is None else _outline_patch(outline, palette)
 
+    if ax is not None:
+        check_axes(ax, "rectilinear")
+    cert = _certificate_to_draw(grasp, result)  # checked before anything is drawn
     if ax is None:
         _, ax = plt.subplots()
-    elif getattr(ax, "name", None) != "rectilinear":
-        raise InvalidOptionError(
-            "ax must be a 2-D axes, got a "
-            f"{getattr(ax, 'name', type(ax).__name__)!r} axes"
-        )
     C = grasp.positions
     Nrm = grasp.normals
     extent = [C]
@@ -314,7 +323,7 @@ def plot_planar_grasp(
                 ax.text(x, y, str(i), fontsize=9, ha="center", va="center", zorder=6)
             )
 
-    cert_artists = _draw_certificate(ax, grasp, result, patch)
+    cert_artists = _draw_certificate(ax, grasp, cert, patch)
     if cert_artists is not None and cert_artists.ghost is not None:
         extent.append(np.asarray(cert_artists.ghost.get_xydata()))
     pts = np.vstack(extent)
@@ -339,26 +348,29 @@ def plot_planar_grasp(
     )
 
 
-def _draw_certificate(ax, grasp: Grasp, result: Any, patch: Any):
-    """Draw a "no" result's certificate (see :func:`plot_planar_grasp`)."""
-    from drakegrasp.certificates.certificate import (
-        ESCAPE_TWIST,
-        UNRESISTED_WRENCH,
-        Certificate,
-    )
-    from drakegrasp.visualization.certificate_plots import (
-        plot_escape,
-        plot_unresisted_wrench,
-    )
+def _certificate_to_draw(grasp: Grasp, result: Any):
+    """A "no" result's certificate that :func:`plot_planar_grasp` draws, or None.
 
+    An escape twist or an unresisted wrench is checked on ``grasp`` here
+    (:func:`~drakegrasp.visualization.meshcat_certificates.checked_certificate`),
+    so that another grasp's is refused before anything is drawn.
+    """
     cert = getattr(result, "certificate", None)
     if not isinstance(cert, Certificate) or getattr(result, "is_closure", True):
         return None
+    if cert.kind not in (ESCAPE_TWIST, UNRESISTED_WRENCH):
+        return None
+    checked_certificate(grasp, cert)
+    return cert
+
+
+def _draw_certificate(ax, grasp: Grasp, cert: Any, patch: Any):
+    """Draw a "no" result's certificate (see :func:`plot_planar_grasp`)."""
+    if cert is None:
+        return None
     if cert.kind == ESCAPE_TWIST:
         return plot_escape(ax, grasp, cert, outline=patch)
-    if cert.kind == UNRESISTED_WRENCH:
-        return plot_unresisted_wrench(ax, grasp, cert)
-    return None
+    return plot_unresisted_wrench(ax, grasp, cert)
 
 
 def _check_plot_options(colors, outline, force_scale) -> None:

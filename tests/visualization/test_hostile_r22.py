@@ -705,3 +705,25 @@ def test_plot_score_distribution_bins_scores_a_few_ulps_apart(plt):
     assert sum(p.get_height() for p in ax.patches) == 2
     ax = plot_score_distribution(ROWS, bins=np.int64(MAX_BINS))
     assert sum(p.get_height() for p in ax.patches) == len(ROWS)
+
+
+def test_plot_planar_grasp_refuses_another_grasps_certificate_before_drawing():
+    # The outline, cones and contacts were drawn, then plot_escape raised.
+    import matplotlib.pyplot as plt
+
+    from drakegrasp.visualization import plot_planar_grasp
+
+    no = dg.form_closure(ex.planar_two_finger_square(0.5))
+    assert not no.is_closure and no.certificate.kind == "escape twist"
+    other = ex.planar_square_four_contacts()
+    fig, ax = plt.subplots()
+    try:
+        with pytest.raises(InvalidOptionError):
+            plot_planar_grasp(
+                other, ax=ax, result=no, outline=[[-1, -1], [1, -1], [1, 1], [-1, 1]]
+            )
+        assert not ax.patches and not ax.collections and not ax.texts
+        with pytest.raises(InvalidOptionError, match="ax must be"):
+            plot_planar_grasp(other, ax="axes")
+    finally:
+        plt.close(fig)
