@@ -71,11 +71,12 @@ class MaxLoadResult:
         The bound proven by ``certificate`` (equal to ``alpha`` up to the
         solvers' accuracy, never below it); ``inf`` without a certificate.
     contact_forces : tuple of ndarray
-        The forces at ``α*`` per contact, contact frame, normal first (N).
+        The forces at ``α*`` per contact, contact frame, normal first (N);
+        zeros when ``α*`` is infinite (as ``wrench``).
     joint_torques : (n_v,) float or None
         ``τ = Jᵀ f`` at ``α*``.
     squeeze : float
-        ``Σ f_n`` at ``α*`` (N).
+        ``Σ f_n`` at ``α*`` (N); 0 when ``α*`` is infinite.
     saturating_joints : tuple of int
         Joints at their torque limit at ``α*`` (the ones that limit the
         payload, with the cones and the force bounds), most loaded first.
@@ -456,7 +457,9 @@ def max_load(
         if not unbounded:
             value, full = 0.0, np.zeros_like(full)
     if unbounded:
-        value = math.inf
+        # The forces of the capped program hold ALPHA_CAP in its units, not α*
+        # (5.7e9 N were reported beside α = inf): none, as the wrench is.
+        value, full = math.inf, np.zeros_like(full)
     if not certify:
         cert, bound = None, math.inf
     tau = P.joint_torques(full)

@@ -580,3 +580,11 @@ def test_far_torque_limits_are_reported_with_the_result():
     )
     assert r.feasible and list(r.torque_limits) == [1, 1, 1]
     assert r.saturating_joints == () and 0 < r.torque_usage < 1e-12
+
+
+def test_an_unbounded_payload_reports_no_forces():
+    # 5.7e9 N (the capped program's forces) were reported beside alpha = inf.
+    r = dg.max_load(dg.examples.equator_fingers(0.5), [0, 0, -9.81, 0, 0, 0])
+    assert r.alpha == np.inf and not r.wrench.any()
+    assert all(not f.any() for f in r.contact_forces) and r.squeeze == 0.0
+    assert r.saturating_joints == () and r.saturating_contacts == ()
