@@ -49,6 +49,7 @@ much the witness holds.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -272,6 +273,17 @@ def check_certificate(
     else:
         assert read.kind == BALANCE
         violation, slack, detail = _check_balance(read, grasp)
+        if math.isfinite(violation) and not slack > 0.0:
+            # "Strictly inside every cone": a force on a cone's boundary (or
+            # outside it by less than tol) proves no force closure; it held for
+            # the boundary grasp whose "no" witness held too.
+            return CertificateCheck(
+                holds=False,
+                violation=float(max(violation, -slack)),
+                slack=float(slack),
+                tol=float(tol),
+                detail=f"{detail}; not strictly inside every cone (slack <= 0)",
+            )
     return CertificateCheck.evaluated(violation, slack, tol, detail)
 
 

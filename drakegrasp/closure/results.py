@@ -266,6 +266,14 @@ class ClosureResult:
                 "no witness exists at this tol (the verdict lies within tol of "
                 "the boundary)"
             )
+        if self.near_boundary:
+            # The witness holds within the check's tolerance, not with room:
+            # the grasp may be barely in closure (μ = 0.5000001 read "cannot
+            # resist a counter-clockwise moment" as a fact).
+            return (
+                f"{self.certificate.describe()} (within tol of the boundary: "
+                f"d* = {self.d_star:.3g}, tol = {self.tol:g}; not certain)"
+            )
         return self.certificate.describe()
 
     def __str__(self) -> str:
