@@ -11,6 +11,7 @@ import math
 
 __all__ = [
     "L1_MAX_POINTS",
+    "MOMENT_ARMS",
     "DEFAULT_DISTANCE_TOLERANCE",
     "DEFAULT_NUM_GENERATORS",
     "DEFAULT_RANK_TOL",
@@ -48,6 +49,21 @@ A 6-D hull's facets grow about linearly with its points here: 2,000 points
 (250 spatial hard fingers with 8 generators) make about 230,000 facets and
 take about 9 s; 8,000 points (1,000 fingers) took 150 s, and a facet check on
 them once asked for 57 GiB.  Beyond this bound ε is refused, not attempted.
+"""
+
+
+MOMENT_ARMS = (1e-4, 1e12)
+"""Range of a grasp's extent over an explicit ``torque_scale`` (metres / metres).
+
+Below it the moments, divided by ``torque_scale``, are too small for the LPs'
+tolerances, and weight capacities came out wrong without a word (by 5e-5 at a
+ratio of 2.4e-5, by 0.66 at 2.4e-7, on random grasps); far above it Clp fails
+(at 2.4e21), and the quality metrics swamp the forces: on the three equator
+fingers (extent 1 m) ``ferrari_canny(..., torque_scale=1e-15)`` returned 0 and
+``grasp_singular_values(..., torque_scale=1e-50)`` a ``σ_min`` of 1.04e19 (1.73
+at 1e-12).  The planner (``planning.checks``) and the quality metrics
+(``quality._common``) check against this one range, each with its grasp's
+extent.
 """
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
+from drakegrasp.core.tolerances import MOMENT_ARMS
 from drakegrasp.core.validation import (
     check_coefficient,
     check_length,
@@ -119,15 +120,6 @@ def _unit_rows(name: str, a: np.ndarray, *, error: type) -> np.ndarray:
     return np.where(unit[..., None], a, u)
 
 
-MOMENT_ARMS = (1e-4, 1e12)
-"""Range of a grasp's extent (its largest contact coordinate) over
-``torque_scale`` for a grasp not all at O (:func:`checked_torque_scale`).
-Below it the moments, divided by ``torque_scale``, are too small for the LPs'
-tolerances, and weight capacities came out wrong without a word (by 5e-5 at a
-ratio of 2.4e-5, by 0.66 at 2.4e-7, on random grasps); far above it Clp fails
-(at 2.4e21)."""
-
-
 def checked_torque_scale(torque_scale, positions: np.ndarray) -> float:
     """``torque_scale`` (metres), checked against the extent of each grasp.
 
@@ -141,8 +133,9 @@ def checked_torque_scale(torque_scale, positions: np.ndarray) -> float:
     Raises
     ------
     InvalidOptionError
-        ``torque_scale`` not a length, or out of :data:`MOMENT_ARMS` with some
-        grasp whose contacts are not all at O (naming the first such grasp).
+        ``torque_scale`` not a length, or out of
+        :data:`~drakegrasp.core.tolerances.MOMENT_ARMS` with some grasp whose
+        contacts are not all at O (naming the first such grasp).
     """
     torque_scale = check_length("torque_scale", torque_scale, error=InvalidOptionError)
     if positions.size == 0:

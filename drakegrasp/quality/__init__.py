@@ -13,6 +13,10 @@ wrench ``[f; m / b_s]`` has the units of a force in every row, so balls and
 singular values in wrench space are measured in newtons (per newton of normal
 contact force: the metrics below are dimensionless).  Equivalently the metric
 is computed with ``S G`` instead of ``G``, where ``S = diag(I, I / b_s)``.
+An explicit ``torque_scale`` must keep the grasp's extent (the largest
+distance from ``p`` to a contact) over it within ``[1e-4, 1e12]``: beyond,
+the scaled moments are below the metrics' resolution or swamp the forces
+(ε of a force-closure grasp came out 0), and it is refused.
 
 The metrics:
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.core.grasp import Grasp, grasp_matrix
-from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
-from drakegrasp.core.validation import check_grasp, check_length
+from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, MOMENT_ARMS
+from drakegrasp.core.validation import check_grasp, check_length, safe_norm
 from drakegrasp.errors import InvalidOptionError
 
 RANK_TOL = DEFAULT_RANK_TOL
@@ -17,10 +17,39 @@ def _check_grasp(grasp: Grasp) -> Grasp:
     return check_grasp(grasp)
 
 
+def grasp_extent(grasp: Grasp) -> float:
+    """The largest distance from the grasp's reference point to a contact, m.
+
+    Computed without overflow (:func:`~drakegrasp.core.validation.safe_norm`);
+    0 when every contact is at the reference point.
+    """
+    offsets = grasp.positions - grasp.reference_point
+    return float(np.max(safe_norm(offsets, axis=-1)))
+
+
 def _torque_scale(grasp: Grasp, torque_scale: float | None) -> float:
+    """``b_s``: the grasp's characteristic length, or a checked ``torque_scale``.
+
+    An explicit ``torque_scale`` is a length (``[2.2e-308, 1e30]`` m) with the
+    grasp's extent over it in :data:`~drakegrasp.core.tolerances.MOMENT_ARMS`
+    (any length when every contact is at the reference point).
+    """
     if torque_scale is None:
         return float(grasp.characteristic_length)
-    return check_length("torque_scale", torque_scale, error=InvalidOptionError)
+    b = check_length("torque_scale", torque_scale, error=InvalidOptionError)
+    extent = grasp_extent(grasp)
+    low, high = MOMENT_ARMS
+    if extent > 0.0 and not (low * b <= extent <= high * b):
+        raise InvalidOptionError(
+            f"torque_scale = {b:g} m is out of scale with the grasp, whose contacts "
+            f"lie within {extent:g} m of its reference point: the extent over "
+            f"torque_scale must stay within [{low:g}, {high:g}], i.e. torque_scale "
+            f"in [{extent / high:g}, {extent / low:g}] m here (beyond, the scaled "
+            "moments are below the metrics' resolution or swamp the forces); give "
+            "a torque_scale near the grasp's size, or None for its characteristic "
+            "length"
+        )
+    return b
 
 
 def _moment_rows(wrench_dim: int) -> slice:

@@ -23,6 +23,7 @@ from drakegrasp.quality._common import (
     _check_grasp,
     _scaled_grasp_matrix,
     _torque_scale,
+    grasp_extent,
 )
 
 if TYPE_CHECKING:
@@ -61,6 +62,10 @@ def primitive_wrenches(
     torque_scale : float, optional
         Length ``b_s`` (metres) by which moments are divided; default the
         grasp's characteristic length, ``1.0`` for unscaled moments.
+        An explicit length must be in ``[2.2e-308, 1e30]`` m with the grasp's
+        extent (the largest distance from ``p`` to a contact) over it in
+        ``[1e-4, 1e12]`` (any length when every contact is at ``p``), else
+        :class:`~drakegrasp.InvalidOptionError`.
 
     Returns
     -------
@@ -78,7 +83,11 @@ def primitive_wrenches(
     """
     _check_grasp(grasp)
     num_generators = check_num_generators(num_generators)
-    b = _torque_scale(grasp, torque_scale)
+    return _wrenches(grasp, num_generators, _torque_scale(grasp, torque_scale))
+
+
+def _wrenches(grasp: Grasp, num_generators: int, b: float) -> tuple[np.ndarray, ...]:
+    """:func:`primitive_wrenches` of checked arguments, moments over ``b``."""
     if not grasp.planar and all(
         c.effective_components() == (0, 1, 2) for c in grasp.contacts
     ):
@@ -236,30 +245,44 @@ def _whitening(points: np.ndarray) -> np.ndarray | None:
     return vt / s[:, None]
 
 
-def _ball_radius(points: np.ndarray, A: np.ndarray | None = None) -> float:
-    """Radius of the largest origin-centred ball in ``conv(points)``; 0 if none.
+def _hull_input(points: np.ndarray, A: np.ndarray | None = None):
+    """``(X, scale, A)`` for Qhull, or None when the ball's radius is 0 without it.
 
-    Qhull is called only when needed: a hull that does not contain the origin
-    (a separating plane proposed by NNLS and checked, see
-    :func:`_separated_from_origin`) or whose affine hull is lower-dimensional
-    than the space (no interior) has radius 0 without it.  Everything runs on
-    the whitened points (see :func:`_whitening`); the facets are measured in the
-    original coordinates.
+    The cheap tests of :func:`_ball_radius` (no Qhull): too few points, all
+    zero, a wrench set of lower dimension than the space, a hull that does
+    not contain the origin (a separating plane proposed by NNLS and checked,
+    see :func:`_separated_from_origin`) or whose affine hull is
+    lower-dimensional than the space.  ``X = points @ A.T`` are the whitened
+    points (see :func:`_whitening`) and ``scale`` their largest coordinate.
     """
     num, dim = points.shape
     if num <= dim or not np.any(points):
-        return 0.0
+        return None
     if A is None:
         A = _whitening(points)
         if A is None:
-            return 0.0  # the points span less than the wrench space
+            return None  # the points span less than the wrench space
     X = points @ A.T
     scale = float(np.max(np.abs(X)))
     if _separated_from_origin(X, scale):
-        return 0.0  # the origin is outside the hull: no hull needed
+        return None  # the origin is outside the hull: no hull needed
     s = np.linalg.svd(X - X.mean(axis=0), compute_uv=False)
     if s[-1] <= RANK_TOL * max(s[0], scale):
-        return 0.0  # flat hull: no interior
+        return None  # flat hull: no interior
+    return X, scale, A
+
+
+def _ball_radius(points: np.ndarray, A: np.ndarray | None = None) -> float:
+    """Radius of the largest origin-centred ball in ``conv(points)``; 0 if none.
+
+    Qhull is called only when needed (see :func:`_hull_input` for the cases
+    settled without it).  Everything runs on the whitened points (see
+    :func:`_whitening`); the facets are measured in the original coordinates.
+    """
+    found = _hull_input(points, A)
+    if found is None:
+        return 0.0
+    X, scale, A = found
     eq = _qhull(X, scale).equations
     # Unit outward normals n' and offsets o' in whitened coordinates: the hull
     # is {x : (Aᵀ n')·x + o' <= 0}; the origin's distance to each facet's
@@ -387,19 +410,26 @@ def _face_tuples(families, target: int, exact: bool):
     yield from walk(0, 0, [])
 
 
-def _candidate_count(families, target: int, exact: bool) -> int:
+def _face_counts(families) -> list[dict[int, int]]:
+    """Faces of each dimension of each summand (from :func:`_face_directions`)."""
+    return [{j: int(bases.shape[0]) for j, bases in f.items()} for f in families]
+
+
+def _candidate_count(counts, target: int, exact: bool) -> int:
     """Number of candidate normals, by polynomial products (no enumeration).
 
-    Contact ``i`` contributes ``1 + Σ_j c_ij x^j`` (``c_ij`` faces of dimension
-    ``j``); the coefficient of ``x^t`` in the product counts the face choices
-    of total dimension ``t`` weighted by their number of bases.
+    ``counts[i]`` maps a face dimension ``j`` to the number ``c_ij`` of faces
+    of summand ``i`` (:func:`_face_counts`, :func:`_model_face_counts`).
+    Contact ``i`` contributes ``1 + Σ_j c_ij x^j``; the coefficient of ``x^t``
+    in the product counts the face choices of total dimension ``t`` weighted
+    by their number of bases.
     """
     top = max(target, 1) + 1
     poly = [1] + [0] * top  # coefficient top collects every degree >= top
-    for family in families:
+    for family in counts:
         term = [1] + [0] * top
-        for j, bases in family.items():
-            term[min(j, top)] += int(bases.shape[0])
+        for j, count in family.items():
+            term[min(j, top)] += count
         new = [0] * (top + 1)
         for a, pa in enumerate(poly):
             if pa:
@@ -417,14 +447,98 @@ def _stacked_bases(families, parts, shape, lo, hi) -> np.ndarray:
     )
 
 
+def _too_many_candidates(total: int) -> InvalidOptionError:
+    return InvalidOptionError(
+        f"the L∞ Ferrari–Canny metric of this grasp needs {total} candidate "
+        f"facet normals (more than LINF_MAX_CANDIDATES = {LINF_MAX_CANDIDATES});"
+        " use norm='L1', fewer contacts or fewer generators"
+    )
+
+
+def _too_many_contacts(num: int, lower: int) -> InvalidOptionError:
+    return InvalidOptionError(
+        f"the L∞ Ferrari–Canny metric of {num} contacts needs at least "
+        f"{lower} candidate facet normals (more than LINF_MAX_CANDIDATES = "
+        f"{LINF_MAX_CANDIDATES}); use norm='L1' or fewer contacts"
+    )
+
+
 def _check_candidate_count(families, target: int, exact: bool) -> None:
-    total = _candidate_count(families, target, exact)
+    total = _candidate_count(_face_counts(families), target, exact)
     if total > LINF_MAX_CANDIDATES:
-        raise InvalidOptionError(
-            f"the L∞ Ferrari–Canny metric of this grasp needs {total} candidate "
-            f"facet normals (more than LINF_MAX_CANDIDATES = {LINF_MAX_CANDIDATES});"
-            " use norm='L1', fewer contacts or fewer generators"
+        raise _too_many_candidates(total)
+
+
+MODEL_FRICTION = (1e-4, 1e2)
+"""Friction coefficients (and soft fingers' ``b ν`` over the grasp's extent:
+:data:`MODEL_TORSION`) for which :func:`_model_face_counts` trusts its counts.
+
+Outside, thin or flat cones may lose faces to the rank tests of
+:func:`_face_directions` (seen at ``μ = 1e-9``, at ``μ = 1e3`` with
+``ν = 1e-6``), so the counts of the models could exceed the ones the metric
+finds."""
+
+MODEL_TORSION = (1e-4, 1e4)
+"""Range of a soft finger's ``b ν`` over the grasp's extent (see
+:data:`MODEL_FRICTION`)."""
+
+
+def _model_face_counts(contact, num_generators: int, b: float, extent: float):
+    """Faces per dimension of ``conv({0} ∪ {w_k})`` from the contact's model.
+
+    ``G_i`` maps the contact's force components one to one into the wrench
+    space, so the set is the cone's generators with the apex, up to a linear
+    map: a segment (frictionless, or ``μ = 0`` without torsion), a triangle
+    (a planar hard finger; a soft finger with ``μ = 0``), a pyramid over the
+    ``n``-gon of generators (a spatial hard finger) or a pyramid over the
+    bipyramid of the ``n``-gon and the two torsion generators (a soft
+    finger).  None when the counts are not to be trusted (see
+    :data:`MODEL_FRICTION`): the metric's own count decides then.
+    """
+    components = contact.effective_components()
+    if components == (0,):
+        return {1: 1}
+    if 1 in components and not (MODEL_FRICTION[0] <= contact.mu <= MODEL_FRICTION[1]):
+        return None
+    if 3 in components:
+        torsion = b * contact.torsional_friction / extent if extent > 0.0 else 0.0
+        if not (MODEL_TORSION[0] <= torsion <= MODEL_TORSION[1]):
+            return None
+    n = num_generators
+    if components in ((0, 1), (0, 3)):
+        return {1: 3, 2: 1}
+    if components == (0, 1, 2):
+        return {1: 2 * n, 2: n + 1, 3: 1}
+    if components == (0, 1, 2, 3):
+        return {1: 4 * n + 2, 2: 5 * n, 3: 2 * n + 1, 4: 1}
+    return None  # pragma: no cover - every contact model is listed above
+
+
+def _linf_refusal(grasp: Grasp, num_generators: int) -> InvalidOptionError | None:
+    """The refusal of an L∞ ε too costly to compute, from the models alone.
+
+    Nothing is built: the lower bound ``C(N, D - 1)`` of :func:`_linf_radius`
+    and the count of its first pass, from the faces of each contact's model
+    (:func:`_model_face_counts`), are checked against
+    :data:`LINF_MAX_CANDIDATES` with the messages :func:`_linf_radius` gives.
+    None when neither exceeds it, or when some contact's counts are not to be
+    trusted: :func:`_linf_radius` checks its own counts then.
+    """
+    D = grasp.wrench_dim
+    lower = math.comb(grasp.num_contacts, D - 1)
+    if lower > LINF_MAX_CANDIDATES:
+        return _too_many_contacts(grasp.num_contacts, lower)
+    extent = grasp_extent(grasp)
+    counts = []
+    for contact in grasp.contacts:
+        count = _model_face_counts(
+            contact, num_generators, grasp.characteristic_length, extent
         )
+        if count is None:
+            return None
+        counts.append(count)
+    total = _candidate_count(counts, D - 1, exact=True)
+    return _too_many_candidates(total) if total > LINF_MAX_CANDIDATES else None
 
 
 def _linf_radius(wrenches: Sequence[np.ndarray], A: np.ndarray | None = None) -> float:
@@ -454,11 +568,7 @@ def _linf_radius(wrenches: Sequence[np.ndarray], A: np.ndarray | None = None) ->
     # candidates: refuse before building N face lattices (40 ms each).
     lower = math.comb(len(wrenches), D - 1)
     if lower > LINF_MAX_CANDIDATES:
-        raise InvalidOptionError(
-            f"the L∞ Ferrari–Canny metric of {len(wrenches)} contacts needs at least "
-            f"{lower} candidate facet normals (more than LINF_MAX_CANDIDATES = "
-            f"{LINF_MAX_CANDIDATES}); use norm='L1' or fewer contacts"
-        )
+        raise _too_many_contacts(len(wrenches), lower)
     mapped = [W @ A.T for W in wrenches]
     sets = [np.vstack([np.zeros((1, D)), W]) for W in mapped]
     families = [_face_directions(P) for P in sets]
@@ -522,6 +632,10 @@ def ferrari_canny(
     torque_scale : float, optional
         Length ``b_s`` (metres) dividing the moments; default the grasp's
         characteristic length ``b``; ``1.0`` means no scaling.
+        An explicit length must be in ``[2.2e-308, 1e30]`` m with the grasp's
+        extent (the largest distance from ``p`` to a contact) over it in
+        ``[1e-4, 1e12]`` (any length when every contact is at ``p``), else
+        :class:`~drakegrasp.InvalidOptionError`.
 
     Returns
     -------
@@ -568,16 +682,57 @@ def ferrari_canny(
     fingers with 8 generators (4,710 candidate normals) and about 1 s for four
     (166,188); five need 1.8 million candidates (about 15 s).  Grasps that
     need more than ``LINF_MAX_CANDIDATES`` (six hard fingers do) raise
-    :class:`~drakegrasp.InvalidOptionError`, checked before any enumeration,
-    and so do grasps with more than
+    :class:`~drakegrasp.InvalidOptionError`, and so do grasps with more than
     :data:`~drakegrasp.core.tolerances.L1_MAX_POINTS` primitive wrenches
-    (either norm).
+    (either norm).  The candidates are counted from ``num_generators`` and
+    the contact models before anything is built (three hard fingers with 128
+    generators need 12,977,670: refused in milliseconds, where the L1 hull
+    alone takes 30 s), unless the grasp is shown out of force closure
+    without Qhull (NNLS, flatness: ε_∞ = 0 then, as always; a grasp whose
+    origin lies on the hull's boundary, which only Qhull shows, is refused
+    too); for friction coefficients outside ``[1e-4, 1e2]`` (soft fingers'
+    ``b ν`` outside ``[1e-4, 1e4]`` times the grasp's extent) the faces are
+    counted once built, before any enumeration.  Symmetric grasps need a
+    second pass over all face choices of total dimension at least ``D - 1``;
+    its count is checked after the first pass.
+
+    Raises
+    ------
+    InvalidOptionError
+        Bad ``norm``, ``num_generators`` or ``torque_scale`` (see
+        :func:`primitive_wrenches`), or a grasp past the limits above.
     """
     if not isinstance(norm, str) or norm not in _NORMS:
         raise InvalidOptionError(f"norm must be one of {_NORMS}, got {norm!r}")
-    wrenches = primitive_wrenches(
-        grasp, num_generators=num_generators, torque_scale=torque_scale
+    eps_1, eps_inf = _epsilons(
+        grasp,
+        num_generators=num_generators,
+        torque_scale=torque_scale,
+        linf=norm == "Linf",
     )
+    return eps_1 if norm == "L1" else eps_inf
+
+
+def _epsilons(
+    grasp: Grasp,
+    *,
+    num_generators: int,
+    torque_scale: float | None,
+    linf: bool | None,
+) -> tuple[float, float | None]:
+    """``(ε_1, ε_∞)`` of :func:`ferrari_canny`, sharing their work.
+
+    ``linf``: True, ``ε_∞`` or the refusal of one too costly (refused before
+    the L1 hull when the contact models show it, see
+    :func:`_linf_refusal`); None, ``ε_∞`` or None when it is too costly;
+    False, None.  ``ε_∞ = 0`` whenever ``ε_1 = 0``, whatever its cost.
+    """
+    _check_grasp(grasp)
+    num_generators = check_num_generators(num_generators)
+    b = _torque_scale(grasp, torque_scale)
+    # From the models alone, before anything is built.
+    refusal = None if linf is False else _linf_refusal(grasp, num_generators)
+    wrenches = _wrenches(grasp, num_generators, b)
     points = np.vstack(wrenches)
     if points.shape[0] > L1_MAX_POINTS:
         raise InvalidOptionError(
@@ -587,12 +742,27 @@ def ferrari_canny(
         )
     A = _whitening(points)
     if A is None:
-        return 0.0  # the wrench set is flat: no interior for either norm
-    if norm == "L1":
-        return _ball_radius(points, A)
+        # The wrench set is flat: no interior for either norm.
+        return 0.0, None if linf is False else 0.0
+    if linf and refusal is not None and _hull_input(points, A) is not None:
+        # ε_∞ was asked for and is too costly, and the grasp is not shown
+        # out of force closure without Qhull: refused before the L1 hull.
+        raise refusal
+    eps_1 = _ball_radius(points, A)
+    if linf is False:
+        return eps_1, None
     # The origin is strictly inside W_∞ exactly when it is strictly inside W_1
     # (both hold iff the primitive wrenches positively span the wrench space),
-    # so the cheap L1 test settles ε_∞ = 0 first.
-    if _ball_radius(points, A) == 0.0:
-        return 0.0
-    return _linf_radius(wrenches, A)
+    # so the L1 test settles ε_∞ = 0 first.
+    if eps_1 == 0.0:
+        return 0.0, 0.0
+    if refusal is not None:
+        return eps_1, None  # linf is None here: an explicit request was refused
+    try:
+        return eps_1, _linf_radius(wrenches, A)
+    except InvalidOptionError:
+        # Past LINF_MAX_CANDIDATES after all (the second pass of a symmetric
+        # grasp, or counts the models could not give): skipped unless asked.
+        if linf:
+            raise
+        return eps_1, None

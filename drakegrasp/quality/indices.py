@@ -39,6 +39,10 @@ def grasp_singular_values(
     torque_scale : float, optional
         Length ``b_s`` (metres) dividing the moment rows; default the grasp's
         characteristic length, ``1.0`` for the unscaled ``G``.
+        An explicit length must be in ``[2.2e-308, 1e30]`` m with the grasp's
+        extent (the largest distance from ``p`` to a contact) over it in
+        ``[1e-4, 1e12]`` (any length when every contact is at ``p``), else
+        :class:`~drakegrasp.InvalidOptionError`.
 
     Returns
     -------
@@ -114,6 +118,10 @@ def hand_object_matrix(
     torque_scale : float, optional
         Length ``b_s`` (metres); default the grasp's characteristic length,
         ``1.0`` for no scaling.
+        An explicit length must be in ``[2.2e-308, 1e30]`` m with the grasp's
+        extent (the largest distance from ``p`` to a contact) over it in
+        ``[1e-4, 1e12]`` (any length when every contact is at ``p``), else
+        :class:`~drakegrasp.InvalidOptionError`.
 
     Returns
     -------

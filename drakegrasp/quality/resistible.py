@@ -2,6 +2,7 @@ r"""The largest external wrench a grasp resists with bounded contact forces (LP)
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -13,7 +14,7 @@ from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import real_array
+from drakegrasp.core.validation import real_array, safe_norm
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.quality._common import _check_grasp
 
@@ -112,6 +113,24 @@ def _check_max_normal_force(grasp: Grasp, max_normal_force) -> np.ndarray:
     return f
 
 
+_PLAIN_NORM = (1e-150, 1e150)
+"""Largest entries of a direction whose squares neither overflow nor lose bits."""
+
+
+def _norm(d: np.ndarray) -> float:
+    """``‖d‖``: numpy's where its squares are plain floats, else scaled.
+
+    In that range ``np.linalg.norm`` is exact to its last bit as before, so a
+    direction of norm 1 gives ``d / 1.0``, the caller's LP; beyond it
+    :func:`~drakegrasp.core.validation.safe_norm` neither overflows
+    (``1e200``) nor underflows.
+    """
+    top = float(np.max(np.abs(d)))
+    if _PLAIN_NORM[0] <= top <= _PLAIN_NORM[1]:
+        return float(np.linalg.norm(d))
+    return float(safe_norm(d))
+
+
 def build_max_resistible_wrench_program(
     grasp: Grasp,
     direction: np.ndarray,
@@ -143,7 +162,9 @@ def build_max_resistible_wrench_program(
         over the force components each cone allows (``F_i`` the unit facet rows
         of the inscribed polyhedral cone; a hard finger with ``mu = 0`` has only
         ``f_n``).  Always feasible (``α = 0``, ``f = 0``) and bounded (the cones
-        are pointed and ``f_n`` is bounded).
+        are pointed and ``f_n`` is bounded).  In the caller's units: the LP is
+        homogeneous, and :func:`max_resistible_wrench` solves it at unit scale
+        (``w_e / ‖w_e‖``, ``f_max / max_i f_max,i``).
     variables : MaxWrenchVariables
     """
     _check_grasp(grasp)
@@ -184,48 +205,95 @@ def max_resistible_wrench(
 ) -> MaxWrenchResult:
     """Largest ``α`` such that the grasp resists the external wrench ``α · direction``.
 
-    Builds the LP of :func:`build_max_resistible_wrench_program` and solves it
-    with Clp.
+    The LP of :func:`build_max_resistible_wrench_program` is homogeneous: ``α``
+    scales as ``max_normal_force / ‖direction‖`` and the forces as
+    ``max_normal_force``.  It is solved with Clp at unit scale (the direction
+    over its norm, the bounds over the largest of them: one LP, whatever the
+    units), and ``α`` and the forces are scaled back, so every scale of the
+    same problem gives the same ``α`` per unit (an unnormalised LP gave
+    ``α / f_max = 1.81`` for 1.5 at ``f_max = 1e-7`` with forces that did not
+    balance, 0 at ``‖direction‖ = 1e7`` and a solver failure at
+    ``f_max = 1e30``).  At ``‖direction‖ = 1`` and ``max f_max = 1`` the LP
+    is the one built in the caller's units.
 
     Parameters
     ----------
     grasp : Grasp
     direction : (6,) or (3,) float
-        External wrench direction ``[f; m]`` about ``p``, in the grasp frame.
+        External wrench direction ``[f; m]`` about ``p``, in the grasp frame:
+        finite, not all zeros.
     max_normal_force : float or (N,) float
-        Bound on each contact's normal force, N.
+        Bound on each contact's normal force, N: finite, ``>= 0``.  All zero:
+        ``α = 0``.
     num_generators : int, optional
         Generators of each spatial Coulomb cone (default 8).
 
     Returns
     -------
     MaxWrenchResult
+        The forces satisfy ``G f = -α · direction`` up to the solver's
+        tolerance, relative to the largest ``max_normal_force``.
 
     Raises
     ------
+    InvalidOptionError
+        A bad ``direction`` or ``max_normal_force``, or one whose answer is
+        past the float range: ``max(max_normal_force) / ‖direction‖`` outside
+        ``[2.2e-308, 1.8e308]``, or ``α``, ``α · direction`` or a force that
+        overflows (e.g. ``max_normal_force = 1e300`` with ``‖direction‖ =
+        1e-300``).
     SolverError
         If Clp is unavailable or fails (the LP is always feasible and bounded).
     """
+    d = check_direction(grasp, direction)
+    fmax = _check_max_normal_force(grasp, max_normal_force)
+    # Units: the direction's norm and the largest bound (1 when all are 0:
+    # the LP is then α = 0 whatever its units).  Exactly 1 at unit scale.
+    size = _norm(d)
+    force = float(np.max(fmax))
+    unit = force if force > 0.0 else 1.0
     prog, v = build_max_resistible_wrench_program(
         grasp,
-        direction,
-        max_normal_force=max_normal_force,
+        d / size,
+        max_normal_force=fmax / unit,
         num_generators=num_generators,
     )
     result = require_solution(prog, solve(prog, "lp"), "the max-resistible-wrench LP")
     status = result.get_solution_result()
     name = result.get_solver_id().name()
-    d = check_direction(grasp, direction)
-    alpha = max(float(result.GetSolution(v.alpha)), 0.0)
     full = np.zeros(grasp.num_components)
-    full[v.columns] = result.GetSolution(v.forces)
+    alpha = 0.0
+    if force > 0.0:  # else f = 0 and α = 0 (the solver's 4e-12 is noise)
+        alpha = max(float(result.GetSolution(v.alpha)), 0.0)
+        full[v.columns] = result.GetSolution(v.forces)
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        # Checked below: an overflow (inf, or inf times 0) is refused.
+        ratio = np.float64(unit) / np.float64(size)
+        alpha = float(alpha * ratio)
+        full = unit * full
+        wrench = alpha * d
+    if not (
+        np.finfo(float).tiny <= ratio <= np.finfo(float).max
+        and math.isfinite(alpha)
+        and np.all(np.isfinite(full))
+        and np.all(np.isfinite(wrench))
+    ):
+        raise InvalidOptionError(
+            f"max(max_normal_force) / ‖direction‖ = {force:g} / {size:g} = "
+            f"{float(ratio):g} puts the answer past the float range (α = "
+            f"{alpha:g}; α scales with that ratio, the forces with "
+            "max_normal_force): the ratio must be within "
+            f"[{np.finfo(float).tiny:g}, {np.finfo(float).max:g}] and α, "
+            "α · direction and the forces finite; give both in units nearer "
+            "each other"
+        )
     forces = tuple(full[sl].copy() for sl in grasp.component_slices())
     return MaxWrenchResult(
         alpha=alpha,
         direction=d,
-        wrench=alpha * d,
+        wrench=wrench,
         contact_forces=forces,
-        max_normal_force=_check_max_normal_force(grasp, max_normal_force),
+        max_normal_force=fmax,
         num_generators=int(num_generators),
         solver=name,
         status=status.name,

@@ -13,7 +13,7 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
 from drakegrasp.core.validation import check_flag
 from drakegrasp.quality._common import _check_grasp, _torque_scale
-from drakegrasp.quality.epsilon import ferrari_canny
+from drakegrasp.quality.epsilon import _epsilons
 from drakegrasp.quality.indices import (
     grasp_singular_values,
     hand_object_singular_values,
@@ -91,7 +91,8 @@ class GraspQuality:
     ferrari_canny_l1 : float
         :func:`ferrari_canny` with ``norm="L1"``.
     ferrari_canny_linf : float or None
-        :func:`ferrari_canny` with ``norm="Linf"`` (None when not computed).
+        :func:`ferrari_canny` with ``norm="Linf"`` (None when not computed: not
+        asked for, or too costly to compute, see :func:`grasp_quality`).
     lp2_d_star : float
         :func:`lp2_d_star`, LP2's ``d*`` (``lp2_margin``: its deprecated name).
     is_force_closure : bool
@@ -186,17 +187,42 @@ def grasp_quality(
     torque_scale : float, optional
         ``b_s`` (metres) dividing moments; default the grasp's characteristic
         length, ``1.0`` for none.
+        An explicit length must be in ``[2.2e-308, 1e30]`` m with the grasp's
+        extent (the largest distance from ``p`` to a contact) over it in
+        ``[1e-4, 1e12]`` (any length when every contact is at ``p``), else
+        :class:`~drakegrasp.InvalidOptionError`.
     tol : float, optional
         Threshold on LP2's ``d*`` for the force-closure verdict.
     linf : bool or None, optional
         Whether to compute the L∞ Ferrari–Canny ε.  None (default): when it is
         cheap, i.e. for planar grasps and spatial grasps with at most three
         contacts (20–60 ms for three hard fingers with 8 generators, against
-        about 1 s for four).
+        about 1 s for four), and when its candidate facet normals stay within
+        :data:`~drakegrasp.quality.epsilon.LINF_MAX_CANDIDATES`: otherwise
+        ``ferrari_canny_linf`` is None.  Their count is estimated from
+        ``num_generators`` and the contact models before anything is built
+        (three hard fingers with 128 generators, soft fingers with 32: skipped
+        at once); the second pass that symmetric grasps need is counted after
+        the first (three equator fingers with 64 generators: skipped after
+        0.1 s).  A grasp not in force closure has ``ε_∞ = 0`` at any cost, as
+        ``ε_1 = 0``.  True: computed, and a grasp past that limit is refused
+        (the same :class:`~drakegrasp.InvalidOptionError` as
+        :func:`ferrari_canny` with ``norm="Linf"``; from the models, before
+        the L1 hull, unless the grasp is provably out of force closure).
+        False: not computed.
 
     Returns
     -------
     GraspQuality
+
+    Raises
+    ------
+    InvalidOptionError
+        A bad option (``linf``, ``torque_scale``, ``num_generators``, ``tol``),
+        or ``linf=True`` on a grasp whose L∞ ε needs more than
+        ``LINF_MAX_CANDIDATES`` candidate normals; either ε of a grasp with
+        more than :data:`~drakegrasp.core.tolerances.L1_MAX_POINTS` primitive
+        wrenches.
     """
     from drakegrasp.closure.verdicts import force_closure  # the closure programs' owner
 
@@ -209,10 +235,17 @@ def grasp_quality(
         grasp, hand_jacobian=J, num_generators=num_generators, tol=tol
     )
     d_star = float(closure.d_star)
-    s = grasp_singular_values(grasp, torque_scale=b)
+    if linf is None:  # when cheap: None skips it where it is too costly
+        linf = None if grasp.planar or grasp.num_contacts <= 3 else False
+    # The caller's torque_scale (None: the characteristic length, unchecked,
+    # as every metric takes it) is passed on, and gives b in each metric.
+    eps_1, eps_inf = _epsilons(
+        grasp, num_generators=num_generators, torque_scale=torque_scale, linf=linf
+    )
+    s = grasp_singular_values(grasp, torque_scale=torque_scale)
     hand = {}
     if J is not None:
-        sh = hand_object_singular_values(grasp, J, torque_scale=b)
+        sh = hand_object_singular_values(grasp, J, torque_scale=torque_scale)
         hand = {
             "hand_singular_values": sh,
             "distance_to_singularity": float(sh[-1]),
@@ -222,16 +255,8 @@ def grasp_quality(
             "manipulability_volume": float(np.prod(sh)),
         }
     return GraspQuality(
-        ferrari_canny_l1=ferrari_canny(
-            grasp, norm="L1", num_generators=num_generators, torque_scale=b
-        ),
-        ferrari_canny_linf=(
-            ferrari_canny(
-                grasp, norm="Linf", num_generators=num_generators, torque_scale=b
-            )
-            if linf or (linf is None and (grasp.planar or grasp.num_contacts <= 3))
-            else None
-        ),
+        ferrari_canny_l1=eps_1,
+        ferrari_canny_linf=eps_inf,
         lp2_d_star=d_star if math.isfinite(d_star) else 0.0,
         is_force_closure=bool(closure.is_closure),
         singular_values=s,
