@@ -24,10 +24,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.geometry import QueryObject
-from pydrake.multibody.plant import ContactResults, MultibodyPlant
+from pydrake.multibody.plant import (
+    ContactResults,
+    DiscreteContactApproximation,
+    MultibodyPlant,
+)
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import ModelError
 from drakegrasp.plant.contacts import PlantContact, _scoped_name
 from drakegrasp.plant.friction import pair_friction
 
@@ -226,6 +231,31 @@ def finger_loads_from_results(
     return out
 
 
+def _opens_sliding_contacts(plant: MultibodyPlant) -> bool:
+    """Whether the plant's contact model opens a sliding contact at ``μ ‖v_t‖``.
+
+    Drake's convex approximations (SAP, similar, lagged) of a discrete plant
+    do; TAMSI and a continuous plant do not.
+    """
+    if not plant.time_step() > 0.0:
+        return False
+    approximation = plant.get_discrete_contact_approximation()
+    return approximation != DiscreteContactApproximation.kTamsi
+
+
+def _dilation(plant, query_object, contact: PlantContact, opens: bool) -> float:
+    """``μ`` of the pair when the contact model opens sliding contacts, else 0."""
+    if not opens:
+        return 0.0
+    try:
+        return pair_friction(
+            plant, query_object, contact.object_geometry, contact.finger_geometry,
+            rule="dynamic",
+        )  # fmt: skip
+    except ModelError:  # no friction property: no allowance
+        return 0.0
+
+
 def finger_motion_from_contacts(
     plant: MultibodyPlant,
     plant_context: Context,
@@ -234,14 +264,20 @@ def finger_motion_from_contacts(
     object_body,
     fingers,
     separation_speed: float,
+    query_object: QueryObject | None = None,
 ) -> tuple[list[PlantContact], list[FingerLoad]]:
     """Keep the contacts that are not separating; per finger, whether it presses.
 
     A contact found within the distance tolerance counts only if its object
     point does not move away from the finger's material point (``p_FC``) along
-    the inward normal faster than ``separation_speed``.  Of those, a finger
-    presses on the object where its geometry touches or overlaps the object's
-    (``ψ <= 0``): a contact model applies force only there.
+    the inward normal faster than ``separation_speed`` plus, on a discrete
+    plant with a convex contact approximation (SAP, similar, lagged), ``μ``
+    times its slip speed: those models let a sliding contact that still pushes
+    open at ``μ ‖v_t‖`` (measured: 0.49 at μ = 0.5, 0.99 at μ = 1; TAMSI: 0),
+    which read as separating and lost a sliding grip ("no contact" under a
+    4.7 N load).  Of those, a finger presses on the object where its geometry
+    touches or overlaps the object's (``ψ <= 0``): a contact model applies
+    force only there.
 
     Parameters
     ----------
@@ -253,6 +289,10 @@ def finger_motion_from_contacts(
     fingers : sequence of RigidBody
     separation_speed : float
         m/s, > 0.
+    query_object : QueryObject, optional
+        For the pairs' friction (:func:`~drakegrasp.plant.friction.pair_friction`)
+        on a plant whose contact approximation opens sliding contacts; without
+        it, or for a pair without friction properties, no allowance.
 
     Returns
     -------
@@ -270,6 +310,7 @@ def finger_motion_from_contacts(
     touching = [False] * len(fingers)
     n_sum = [np.zeros(3) for _ in fingers]
     kept = []
+    opens = query_object is not None and _opens_sliding_contacts(plant)
     for c in contacts:
         finger = plant.get_body(c.finger_body_index)
         p_WC = np.asarray(X_WO.multiply(c.p_OC))
@@ -280,7 +321,8 @@ def finger_motion_from_contacts(
         v_rel = point_velocity(plant, plant_context, object_body, p_WC)
         v_rel = v_rel - point_velocity(plant, plant_context, finger, p_WF)
         apart, sliding = split_along(v_rel, n_W)
-        if apart > separation_speed:
+        opening = _dilation(plant, query_object, c, opens) * sliding
+        if apart > separation_speed + opening:
             continue
         kept.append(c)
         if c.psi > 0.0:  # within the tolerance, but apart: no force there

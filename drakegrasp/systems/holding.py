@@ -25,8 +25,11 @@ and their codes on the vector port follow that order:
                 and either the object still slides along them (faster than
                 ``slip_speed``, more along than away from them) and is
                 farther than ``release_distance`` from every hand body, or it
-                has come to rest displaced along them by more than
-                ``release_distance`` since the last contact
+                is displaced along them by more than ``release_distance``
+                since the last contact and has come to rest against them (or
+                is out of reach); displaced but still moving against fingers
+                within reach (fingers that chatter apart faster than it
+                slides) it is ``slipping``
 ==============  ==============================================================
 
 A hand that opens moves its fingers away along their normals while the object
@@ -206,6 +209,7 @@ def _evidence_without_contact(
     *,
     sliding: float,
     slid: float,
+    relative: float,
     clearance: Callable[[], float],
     thresholds: HoldingThresholds,
 ) -> str:
@@ -219,8 +223,17 @@ def _evidence_without_contact(
         if moving:  # sliding out: dropped once clear of the hand
             out = clearance() > thresholds.release_distance
             return "dropped" if out else "slipping"
-        # At rest: moved off its place along the fingers, or released.
-        return "dropped" if slid > thresholds.release_distance else "no contact"
+        if slid <= thresholds.release_distance:
+            return "no contact"  # released where the fingers left it
+        # Moved off its place along the fingers: dropped once at rest there,
+        # or out of reach.  Still moving against fingers within reach (they
+        # chatter apart faster than it slides, so it slides "away" from them)
+        # it is a grip in trouble, not yet a drop.
+        if relative > thresholds.slip_speed and not (
+            clearance() > thresholds.release_distance
+        ):
+            return "slipping"
+        return "dropped"
     return "slipping" if moving else "no contact"
 
 
@@ -235,6 +248,7 @@ def next_holding_state(
     slid: float,
     clearance: Callable[[], float],
     thresholds: HoldingThresholds,
+    relative: float = 0.0,
 ) -> HoldingMemory:
     """One step of the holding state machine (rules in the module docstring).
 
@@ -263,8 +277,15 @@ def next_holding_state(
         The object's distance from the hand, m
         (:func:`~drakegrasp.systems.sensing.hand_clearance`); called only
         without contact, once a grip's hysteresis window has passed, while the
-        object slides along the fingers.
+        object slides along the fingers, or moves against them having slid
+        along them by more than ``release_distance``.
     thresholds : HoldingThresholds
+    relative : float, optional
+        Without contact: the speed of the centre of mass against those fingers
+        in any direction (``Motion.relative``), m/s; default 0 (at rest).  An
+        object displaced along the fingers is dropped once at rest there; one
+        still moving against them faster than ``slip_speed`` within reach
+        (fingers chattering apart) is slipping.
 
     Returns
     -------
@@ -284,8 +305,8 @@ def next_holding_state(
         )
     else:
         evidence = _evidence_without_contact(
-            memory, sliding=sliding, slid=slid, clearance=clearance,
-            thresholds=thresholds,
+            memory, sliding=sliding, slid=slid, relative=relative,
+            clearance=clearance, thresholds=thresholds,
         )  # fmt: skip
     state, milder = evidence, 0
     if memory.state in _STICKY and _RANK[evidence] < _RANK[memory.state]:

@@ -165,6 +165,7 @@ def sense_contacts(
         object_body=object_body,
         fingers=fingers,
         separation_speed=thresholds.separation_speed,
+        query_object=query_object,
     )
     if found:
         return Sensed(found, tuple(loads), None)

@@ -48,8 +48,12 @@ def _not_separating(plant, plant_context, box, contacts, speed=5e-3):
     """Contacts whose points do not move apart faster than ``speed`` (m/s).
 
     A second route to the monitor's filter: velocities from translational
-    Jacobians (J_v v), not from the bodies' spatial velocities.
+    Jacobians (J_v v), not from the bodies' spatial velocities.  The pick's
+    plant is SAP, which opens a sliding contact at ``μ ‖v_t‖`` while it
+    pushes: that much opening is allowed too, with ``μ`` the pair's dynamic
+    coefficient combined by Drake (``CalcContactFrictionFromSurfaceProperties``).
     """
+    from pydrake.multibody.plant import CalcContactFrictionFromSurfaceProperties
     from pydrake.multibody.tree import JacobianWrtVariable
 
     world = plant.world_frame()
@@ -64,7 +68,19 @@ def _not_separating(plant, plant_context, box, contacts, speed=5e-3):
             )
             for frame, p in ((box.body_frame(), c.p_OC), (finger.body_frame(), c.p_FC))
         ]
-        if ((J[0] - J[1]) @ v) @ (R_WO @ c.nhat_O) <= speed:
+        v_rel = (J[0] - J[1]) @ v
+        n = R_WO @ c.nhat_O
+        apart = v_rel @ n
+        tangential = np.linalg.norm(v_rel - apart * n)
+        query = plant.get_geometry_query_input_port().Eval(plant_context)
+        props = [
+            query.inspector()
+            .GetProximityProperties(g)
+            .GetProperty("material", "coulomb_friction")
+            for g in (c.object_geometry, c.finger_geometry)
+        ]
+        mu = CalcContactFrictionFromSurfaceProperties(*props).dynamic_friction()
+        if apart <= speed + mu * tangential:
             kept.append(c)
     return kept
 
