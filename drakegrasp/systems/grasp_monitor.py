@@ -114,7 +114,9 @@ class GraspMonitor(LeafSystem):
     mu : float or "plant"
         Friction coefficient of the analysis, or ``"plant"``: each contact's
         coefficient from its geometries' proximity properties.  Required (here
-        or in ``options``).  A number that disagrees with the plant's friction
+        or in ``options``) with ``contacts="geometry"``; with
+        ``contacts="contact_results"`` (the simulator's own contacts) it is
+        ``"plant"`` when not given.  A number that disagrees with the plant's friction
         at the contacts is warned about once per monitor
         (:class:`~drakegrasp.plant.friction.FrictionMismatchWarning`) and kept
         in :attr:`friction_warning`.  Friction in use is always computed with

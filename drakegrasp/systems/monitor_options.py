@@ -131,7 +131,9 @@ def monitor_settings(
     Raises
     ------
     InvalidOptionError
-        For a missing ``mu`` (or a soft finger's ``ν``), any invalid analysis
+        For a missing ``mu`` with ``contacts="geometry"`` (with
+        ``"contact_results"`` it is ``"plant"`` when not given) or a soft
+        finger's missing ``ν``, any invalid analysis
         option, an unknown contact source, a period or offset that is not
         finite seconds in range, a flag that is not a bool, ``holding``
         that is not a :class:`~drakegrasp.HoldingThresholds`, or its
@@ -146,7 +148,13 @@ def monitor_settings(
         raise InvalidOptionError(
             f"holding must be a HoldingThresholds, got {type(holding).__name__}"
         )
-    analysis = resolve_options(options, **analysis_keywords).require_friction()
+    analysis = resolve_options(options, **analysis_keywords)
+    if contacts == "contact_results" and analysis.mu is None:
+        # The simulator's own contacts, with the forces its friction made:
+        # their coefficients are the plant's (a number would only be checked
+        # against them).
+        analysis = analysis.replace(mu="plant")
+    analysis = analysis.require_friction()
     if contacts == "contact_results" and not analysis.allow_penetration:
         # The simulator's compliant contact makes its force by penetrating
         # (Drake's point contact: 0.2 mm at 20 N between WSG tips and a box),

@@ -97,6 +97,31 @@ def test_a_monitor_needs_mu_and_a_soft_fingers_nu(gripped):
         )
 
 
+def test_the_simulators_contacts_take_the_plants_mu_when_none_is_given(gripped):
+    # Review r22: mu was required in contact_results mode too, where the
+    # contacts and their forces are the plant's own.
+    monitor = GraspMonitor(gripped.plant, object_body=BOX, contacts="contact_results")
+    assert monitor.settings.analysis.mu == "plant"
+    given = GraspMonitor(
+        gripped.plant, object_body=BOX, contacts="contact_results", mu=0.4
+    )
+    assert given.settings.analysis.mu == 0.4
+    options = GraspMonitor(
+        gripped.plant,
+        object_body=BOX,
+        contacts="contact_results",
+        options=dg.AnalysisOptions(),
+    )
+    assert options.settings.analysis.mu == "plant"
+    with pytest.raises(InvalidOptionError, match="torsional_friction"):
+        GraspMonitor(
+            gripped.plant,
+            object_body=BOX,
+            contacts="contact_results",
+            contact_model="soft_finger",
+        )
+
+
 def test_settings_say_what_the_monitor_does(gripped):
     monitor = GraspMonitor(
         gripped.plant, object_body=BOX, mu="plant", period=0.02, offset=0.01
