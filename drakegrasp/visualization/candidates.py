@@ -16,6 +16,7 @@ sits inside the planning one and does not import it.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,7 @@ from drakegrasp.visualization.primitives import check_meshcat, check_path
 __all__ = [
     "CANDIDATES_PREFIX",
     "MAX_BINS",
+    "MAX_CANDIDATES",
     "CandidateDrawing",
     "draw_candidates",
     "plot_score_distribution",
@@ -45,6 +47,11 @@ CANDIDATES_PREFIX = "drakegrasp/candidates"
 MAX_BINS = 1000
 """Most bins of :func:`plot_score_distribution`: each is two bar patches; 1000
 drew in about 1 s, 10**5 took 90 s and 2 GB (and more bins hung)."""
+
+MAX_CANDIDATES = 10**6
+"""Most candidates :func:`draw_candidates` and :func:`plot_score_distribution`
+take (a planner's result is thousands): an endless iterator is refused, not
+listed until memory runs out."""
 
 _STOPS = np.array(
     [[0.85, 0.2, 0.15], [0.95, 0.8, 0.2], [0.2, 0.7, 0.3]]
@@ -276,13 +283,19 @@ def _candidate_rows(candidates) -> list:
     the planner's layer sits above this one).
     """
     try:
-        rows = list(candidates)
+        # An endless iterator is cut at one past the bound, not listed forever.
+        rows = list(itertools.islice(candidates, MAX_CANDIDATES + 1))
     except TypeError:
         rows = None
     if rows is None or isinstance(candidates, str | bytes):
         raise InvalidOptionError(
             "candidates must be a sequence of GraspCandidate (plan_grasps's result), "
             f"got {type(candidates).__name__}"
+        )
+    if len(rows) > MAX_CANDIDATES:
+        raise InvalidOptionError(
+            f"candidates holds more than MAX_CANDIDATES = {MAX_CANDIDATES:,} grasps "
+            "(or never ends); draw a selection, e.g. candidates[:100]"
         )
     for i, c in enumerate(rows):
         score = getattr(c, "score", None)

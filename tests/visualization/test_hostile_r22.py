@@ -727,3 +727,27 @@ def test_plot_planar_grasp_refuses_another_grasps_certificate_before_drawing():
             plot_planar_grasp(other, ax="axes")
     finally:
         plt.close(fig)
+
+
+def test_an_endless_iterator_of_candidates_is_refused():
+    # list(candidates) never returned.
+    import itertools
+
+    import matplotlib.pyplot as plt
+
+    from drakegrasp.visualization.candidates import (
+        MAX_CANDIDATES,
+        plot_score_distribution,
+    )
+
+    class Row:
+        score, is_closure = 0.5, True
+
+    endless = itertools.repeat(Row())
+    fig, ax = plt.subplots()
+    try:
+        with pytest.raises(InvalidOptionError, match="MAX_CANDIDATES"):
+            plot_score_distribution(endless, ax=ax)
+        assert MAX_CANDIDATES == 10**6
+    finally:
+        plt.close(fig)
