@@ -125,7 +125,9 @@ class GraspCandidate:
     torque_needed : float
         A multi-finger hand's torque (N·m) at every finger joint that holds
         the object's weight in all the weight directions
-        (:func:`~drakegrasp.planning.motors.torque_needed`; a lower bound),
+        (:func:`~drakegrasp.planning.motors.torque_needed`; a lower bound for
+        the planned contacts held still, an estimate of what a simulation
+        needs: see there),
         for the best force-closure candidates (the first
         ``max(certify, TORQUE_CHECK)``,
         :data:`~drakegrasp.planning.motors.TORQUE_CHECK`) when the weight is

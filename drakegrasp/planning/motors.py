@@ -21,8 +21,16 @@ its weight acts).  By linearity
 the hand holds a weight ``m g`` in every one of the directions
 :data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS` when each joint may
 apply :math:`m g / \min_u \beta(u)`: the **torque needed**.  Like the squeeze
-needed, it is a lower bound: the program shares the torques among the
-contacts at will, and a real finger presses as its controller dictates.
+needed, it is a lower bound for the planned contacts held still (rigid,
+quasi-static): the program shares the torques among the contacts at will, and a
+real finger presses as its controller dictates.  It is an estimate of what a
+simulation needs, not a bound on it: an independent simulation of the Allegro
+hand on the YCB soup can (SAP, 1 ms, PD joints capped at the torque, the weight
+in each of the 14 directions; review r22) found the can settling 1-9 mm under
+the squeeze and touching links the plan did not list, so that ranks 7-20 held
+every direction at 0.8 times their torque needed while ranks 1-4 failed one to
+four directions at 1.2 times theirs.  Confirm a choice with
+:func:`~drakegrasp.planning.shake.shake_test`.
 
 All directions of a candidate are one LP (through drakegrasp's solver
 gateway), about 3 ms for the Allegro hand (5 ms with its Jacobian); the tests
