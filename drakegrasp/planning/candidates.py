@@ -231,6 +231,12 @@ class GraspCandidate:
                     "p_OC": jsonable(c.p_OC),
                     "nhat_O": jsonable(c.nhat_O),
                     "psi": c.psi,
+                    # Which geometries touch, and whose surface the normal is
+                    # (None on a point cloud): what tells a contact on a tiny
+                    # marker sphere of a model from one on its faces.
+                    "finger_geometry": getattr(c, "finger_geometry_name", None),
+                    "object_geometry": getattr(c, "object_geometry_name", None),
+                    "normal_source": getattr(c, "normal_source", None),
                 }
                 for c in self.contacts
             ],

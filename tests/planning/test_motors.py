@@ -142,6 +142,13 @@ def test_plan_grasps_sets_it_on_the_best(allegro_on_soup):
         )
         assert "N·m per joint" in str(c)
         assert c.to_dict()["torque_needed"] == pytest.approx(c.torque_needed)
+        # The JSON names the geometries of each contact and whose surface its
+        # normal is (review r22: a contact on a model's marker sphere could
+        # not be told from one on a face without re-planning in Python).
+        for row, contact in zip(c.to_dict()["contacts"], c.contacts, strict=True):
+            assert row["finger_geometry"] == contact.finger_geometry_name
+            assert row["object_geometry"] == contact.object_geometry_name
+            assert row["normal_source"] == contact.normal_source
 
 
 def test_torque_needed_predicts_the_shake_test(allegro_on_soup):
