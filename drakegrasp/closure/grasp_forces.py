@@ -597,15 +597,8 @@ def _without_far_limits(P: LoadProblem, w: np.ndarray, objective: str):
     """``P`` without its limits when all are :data:`LIMIT_GAP` times the load."""
     if objective != "min_squeeze":  # the other objectives are shaped by limits
         return None
-    size = float(np.max(np.abs(P.T @ w)))
-    lim = P.limited_joints()
-    sizes = np.concatenate(
-        [
-            P.max_normal_force[np.isfinite(P.max_normal_force)],
-            [P.max_squeeze] if math.isfinite(P.max_squeeze) else [],
-            P.torque_limits[lim] / P.jscale[lim] if lim.size else [],
-        ]
-    )
+    size = P.load_size(w)
+    sizes = P.limit_sizes()
     if not (size > 0.0 and sizes.size and np.min(sizes) >= LIMIT_GAP * size):
         return None
     return replace(

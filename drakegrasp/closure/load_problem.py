@@ -192,17 +192,35 @@ class LoadProblem:
             The load in the grasp frame.
         """
         if wrench is not None:
-            size = float(np.max(np.abs(self.T @ wrench)))
+            size = self.load_size(wrench)
             if size > 0.0:
                 return size
-        sizes = list(self.max_normal_force[np.isfinite(self.max_normal_force)])
-        if math.isfinite(self.max_squeeze):
-            sizes.append(self.max_squeeze)
+        sizes = self.limit_sizes()
+        sizes = sizes[sizes > 0.0]
+        return float(np.max(sizes)) if sizes.size else 1.0
+
+    def load_size(self, wrench: np.ndarray) -> float:
+        """``max |T w|``: the size of the load ``wrench`` (N), normalised."""
+        return float(np.max(np.abs(self.T @ wrench)))
+
+    def limit_sizes(self) -> np.ndarray:
+        """The finite limits in newtons: ``f_max``, ``s_max``, ``τ_max,j / c_j``.
+
+        Returns
+        -------
+        (K,) float
+            Per-contact bounds, the squeeze bound and the joints' torque
+            limits over their Jacobian column norms (the normal force each
+            allows), in that order; only the finite ones.
+        """
         lim = self.limited_joints()
-        if lim.size:
-            sizes += list(self.torque_limits[lim] / self.jscale[lim])
-        sizes = [s for s in sizes if s > 0.0]
-        return float(max(sizes)) if sizes else 1.0
+        return np.concatenate(
+            [
+                self.max_normal_force[np.isfinite(self.max_normal_force)],
+                [self.max_squeeze] if math.isfinite(self.max_squeeze) else [],
+                self.torque_limits[lim] / self.jscale[lim] if lim.size else [],
+            ]
+        )
 
     def stacked(self, x: np.ndarray, force_scale: float) -> np.ndarray:
         """Program values ``x`` as the (M,) stacked forces of the grasp, N."""

@@ -321,8 +321,9 @@ def finger_motion_from_contacts(
         v_rel = point_velocity(plant, plant_context, object_body, p_WC)
         v_rel = v_rel - point_velocity(plant, plant_context, finger, p_WF)
         apart, sliding = split_along(v_rel, n_W)
-        opening = _dilation(plant, query_object, c, opens) * sliding
-        if apart > separation_speed + opening:
+        if apart > separation_speed and apart > (
+            separation_speed + _dilation(plant, query_object, c, opens) * sliding
+        ):  # the pair's friction is read only for a contact that opens
             continue
         kept.append(c)
         if c.psi > 0.0:  # within the tolerance, but apart: no force there
