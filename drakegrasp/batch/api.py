@@ -23,6 +23,7 @@ import numpy as np
 
 from drakegrasp.batch.columns import result_arrays
 from drakegrasp.batch.inputs import METRICS, shape_of
+from drakegrasp.batch.metrics import metric_moment_arms
 from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_task, form_task
@@ -377,7 +378,7 @@ def stream_form_closure(
 
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
-@accepts_ragged(merge_results)
+@accepts_ragged(merge_results, check=metric_moment_arms)
 @takes_batch_options
 def batch_force_closure(
     positions: np.ndarray,
@@ -496,7 +497,7 @@ def batch_force_closure(
     return collect(K, d, "force", options["tol"], options["metrics"], chunks)
 
 
-@accepts_ragged(merge_results)
+@accepts_ragged(merge_results, check=metric_moment_arms)
 @takes_batch_options
 def batch_form_closure(
     positions: np.ndarray,

@@ -13,17 +13,127 @@ from collections.abc import Sequence
 import numpy as np
 
 from drakegrasp.core.deprecation import renamed_keyword
-from drakegrasp.core.tolerances import L1_MAX_POINTS
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.core.tolerances import L1_MAX_POINTS, MOMENT_ARMS
+from drakegrasp.core.validation import safe_norm
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError
 
 __all__ = [
+    "check_moment_arms",
     "epsilon_l1_batch",
     "epsilon_l1_per_grasp",
     "epsilon_l1_routes",
+    "metric_moment_arms",
+    "moment_arms_in_input_order",
+    "requested_metrics",
     "singular_value_metrics",
 ]
 
 SINGULAR_VALUE_METRICS = ("sigma_min", "isotropy", "ellipsoid_volume")
+
+
+def _out_of_scale(P: np.ndarray, p, b) -> tuple[np.ndarray, np.ndarray]:
+    """Grasps whose extent over ``b`` leaves ``MOMENT_ARMS``, and the extents.
+
+    ``P`` (k, N, d) contacts (metres); ``p`` None, (d,) or (k, d) reference
+    points; ``b`` scalar or (k,) characteristic lengths.  A grasp whose
+    contacts all sit at its reference point takes any ``b``.
+    """
+    k, _, d = P.shape
+    p = np.zeros(d) if p is None else np.asarray(p, dtype=float)
+    p = np.broadcast_to(p, (k, d))
+    b = np.broadcast_to(np.asarray(b, dtype=float), (k,))
+    extent = np.max(safe_norm(P - p[:, None, :], axis=-1), axis=-1)
+    low, high = MOMENT_ARMS
+    bad = (extent > 0.0) & ~((low * b <= extent) & (extent <= high * b))
+    return bad, extent
+
+
+def _refuse_out_of_scale(index: int, b: float, extent: float) -> None:
+    low, high = MOMENT_ARMS
+    raise InvalidGraspError(
+        f"characteristic length of grasp {index} is {b:g} m, out of scale with "
+        f"its contacts, which lie within {extent:g} m of its reference point: "
+        f"for the metrics the extent over it must stay within [{low:g}, "
+        f"{high:g}], i.e. b in [{extent / high:g}, {extent / low:g}] m; give "
+        "characteristic_lengths near the grasps' sizes, or None for their extents"
+    )
+
+
+def check_moment_arms(P: np.ndarray, p, b, start: int = 0) -> None:
+    """Refuse the first grasp whose extent over its ``b`` leaves ``MOMENT_ARMS``.
+
+    Every metric divides moments by ``b``: beyond
+    :data:`~drakegrasp.core.tolerances.MOMENT_ARMS` they are below the LPs'
+    resolution or swamp the forces, and ε came out 0 without a word.  The
+    single-grasp metrics refuse the same lengths.  The closure verdicts
+    take any ``b``.
+
+    Parameters
+    ----------
+    P : (k, N, d) float
+        Contacts of a chunk of grasps, metres.
+    p : None, (d,) or (k, d) float
+        Their reference points (None: the origin).
+    b : float or (k,) float
+        Their characteristic lengths, metres.
+    start : int
+        Index of the chunk's first grasp in the batch, for the message.
+
+    Raises
+    ------
+    InvalidGraspError
+        Naming the first such grasp, its ``b`` and the range it must be in.
+    """
+    bad, extent = _out_of_scale(P, p, b)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        b_k = float(np.broadcast_to(np.asarray(b, dtype=float), bad.shape)[k])
+        _refuse_out_of_scale(start + k, b_k, float(extent[k]))
+
+
+def moment_arms_in_input_order(calls, *, always: bool = True) -> None:
+    """:func:`check_moment_arms` over a ragged batch's groups, in input order.
+
+    ``calls`` is the list of ``(group, options)`` that
+    :func:`~drakegrasp.batch.ragged.run_groups` gives its ``check``; with
+    ``always`` False, only the groups whose options ask for metrics are checked.
+    """
+    worst = None
+    for group, options in calls:
+        b = options.get("characteristic_lengths")
+        if b is None or not (always or requested_metrics(options)):
+            continue
+        bad, extent = _out_of_scale(group.positions, options.get("reference_points"), b)
+        b = np.broadcast_to(np.asarray(b, dtype=float), bad.shape)
+        for k in np.flatnonzero(bad):
+            index = int(group.indices[k])
+            if worst is None or index < worst[0]:
+                worst = (index, float(b[k]), float(extent[k]))
+    if worst is not None:
+        _refuse_out_of_scale(*worst)
+
+
+def requested_metrics(options: dict) -> bool:
+    """Whether a batch call's keyword options ask for metrics.
+
+    Read from ``metrics=`` or a :class:`~drakegrasp.BatchOptions`' ``metrics``
+    before they are checked: anything but None or an empty sequence counts.
+    """
+    given = options.get("options")
+    for names in (options.get("metrics"), getattr(given, "metrics", None)):
+        if names is None:
+            continue
+        try:
+            if np.size(names) > 0:
+                return True
+        except (TypeError, ValueError):  # checked, and refused, later
+            return True
+    return False
+
+
+def metric_moment_arms(calls) -> None:
+    """The ragged ``check`` of the closure functions: metrics need ``MOMENT_ARMS``."""
+    moment_arms_in_input_order(calls, always=False)
 
 
 def singular_value_metrics(

@@ -229,12 +229,17 @@ PER_GRASP = ("reference_points", "characteristic_lengths")
 """Options with one value (or row) per grasp: sliced per group."""
 
 
-def accepts_ragged(merge: Callable[[int, int, list], Any]):
+def accepts_ragged(
+    merge: Callable[[int, int, list], Any],
+    check: Callable[[list[tuple[RaggedGroup, dict]]], None] | None = None,
+):
     """Let a stacked batch function take ragged lists of per-grasp arrays too.
 
     ``fn(positions, normals, **options)`` runs unchanged on stacked input; on
     a ragged one (:func:`is_ragged`) it runs once per contact-count group
     (:func:`run_groups`) and ``merge(K, d, parts)`` makes the one result.
+    ``check``, when given, sees every group with its options before any runs,
+    so that it can name a bad grasp by its place in the input.
     """
 
     def decorate(fn):
@@ -242,7 +247,7 @@ def accepts_ragged(merge: Callable[[int, int, list], Any]):
         def batch(positions, normals, **options):
             if not is_ragged(positions):
                 return fn(positions, normals, **options)
-            return merge(*run_groups(fn, positions, normals, **options))
+            return merge(*run_groups(fn, positions, normals, check, **options))
 
         return batch
 
@@ -250,7 +255,12 @@ def accepts_ragged(merge: Callable[[int, int, list], Any]):
 
 
 def run_groups(
-    call: Callable[..., Any], positions, normals, **options
+    call: Callable[..., Any],
+    positions,
+    normals,
+    check: Callable[[list[tuple[RaggedGroup, dict]]], None] | None = None,
+    /,
+    **options,
 ) -> tuple[int, int, list[tuple[np.ndarray, Any]]]:
     """Run a stacked batch function once per contact-count group.
 
@@ -260,6 +270,10 @@ def run_groups(
         ``call(positions, normals, **options)`` on a stacked group.
     positions, normals : sequence of (N_k, d) float
         The ragged batch.
+    check : callable, optional
+        ``check([(group, options), ...])``: called once with every group and
+        the options its call will get, before any call (positional only, so
+        that no keyword of ``call`` is taken for it).
     **options
         Passed to every call; those of :data:`PER_CONTACT` and
         :data:`PER_GRASP` restricted to the group's grasps.
@@ -287,7 +301,7 @@ def run_groups(
         for name in PER_GRASP
         if name in options
     }
-    parts = []
+    calls = []
     for group in groups:
         kwargs = dict(options)
         for name, rows in contact_rows.items():
@@ -298,5 +312,11 @@ def run_groups(
             )
         for name, (value, per_row) in grasp_values.items():
             kwargs[name] = value[group.indices] if per_row else value
-        parts.append((group.indices, call(group.positions, group.normals, **kwargs)))
+        calls.append((group, kwargs))
+    if check is not None:
+        check(calls)
+    parts = [
+        (group.indices, call(group.positions, group.normals, **kwargs))
+        for group, kwargs in calls
+    ]
     return K, d, parts

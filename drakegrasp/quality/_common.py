@@ -30,24 +30,40 @@ def grasp_extent(grasp: Grasp) -> float:
 def _torque_scale(grasp: Grasp, torque_scale: float | None) -> float:
     """``b_s``: the grasp's characteristic length, or a checked ``torque_scale``.
 
-    An explicit ``torque_scale`` is a length (``[2.2e-308, 1e30]`` m) with the
-    grasp's extent over it in :data:`~drakegrasp.core.tolerances.MOMENT_ARMS`
-    (any length when every contact is at the reference point).
+    Either length is a length (``[2.2e-308, 1e30]`` m) with the grasp's extent
+    over it in :data:`~drakegrasp.core.tolerances.MOMENT_ARMS` (any length when
+    every contact is at the reference point).  The closure verdicts take any
+    characteristic length; the metrics, which divide moments by it, do not.
+
+    Raises
+    ------
+    InvalidOptionError
+        When the length is out of scale with the grasp; the message names
+        ``torque_scale`` or ``characteristic_length``, whichever was used.
     """
     if torque_scale is None:
-        return float(grasp.characteristic_length)
-    b = check_length("torque_scale", torque_scale, error=InvalidOptionError)
+        b, name = float(grasp.characteristic_length), "characteristic_length"
+        remedy = (
+            "build the Grasp with a characteristic_length near its size (or None "
+            "for its extent), or give a torque_scale"
+        )
+    else:
+        b = check_length("torque_scale", torque_scale, error=InvalidOptionError)
+        name = "torque_scale"
+        remedy = (
+            "give a torque_scale near the grasp's size, or None for its "
+            "characteristic length"
+        )
     extent = grasp_extent(grasp)
     low, high = MOMENT_ARMS
     if extent > 0.0 and not (low * b <= extent <= high * b):
         raise InvalidOptionError(
-            f"torque_scale = {b:g} m is out of scale with the grasp, whose contacts "
+            f"{name} = {b:g} m is out of scale with the grasp, whose contacts "
             f"lie within {extent:g} m of its reference point: the extent over "
-            f"torque_scale must stay within [{low:g}, {high:g}], i.e. torque_scale "
+            f"{name} must stay within [{low:g}, {high:g}], i.e. {name} "
             f"in [{extent / high:g}, {extent / low:g}] m here (beyond, the scaled "
-            "moments are below the metrics' resolution or swamp the forces); give "
-            "a torque_scale near the grasp's size, or None for its characteristic "
-            "length"
+            f"moments are below the metrics' resolution or swamp the forces); "
+            f"{remedy}"
         )
     return b
 

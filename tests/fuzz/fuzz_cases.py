@@ -411,6 +411,59 @@ def _functions_of_a_grasp():
     }
 
 
+SCALED_METRICS = (
+    "ferrari_canny", "ferrari_canny_linf", "grasp_quality", "grasp_singular_values",
+    "min_singular_value", "isotropy", "wrench_ellipsoid_volume", "hand_object_matrix",
+    "distance_to_singularity", "uniformity_of_transformation",
+    "manipulability_volume", "primitive_wrenches",
+)  # fmt: skip
+"""The functions that divide moments by the grasp's characteristic length."""
+
+
+def length_scale_cases() -> Iterator[Case]:
+    """Every function of a grasp on a grasp whose length is far from its size.
+
+    The metrics gave ε = 0 and σ_min = 0 at such lengths without a word; they
+    refuse now.  The verdicts and matrices answer at any valid length.
+    """
+    g0 = ex.equator_fingers(mu=0.5)
+    for b in (1e-300, 1e-15, 1e14, 1e30):
+        g = dg.Grasp(
+            g0.contacts, reference_point=g0.reference_point, characteristic_length=b
+        )
+        for name, fn in _functions_of_a_grasp().items():
+            yield Case(
+                name,
+                f"characteristic-length-{b:g}",
+                lambda fn=fn, g=g: fn(g),
+                "refuse" if name in SCALED_METRICS else "either",
+            )
+    P = np.stack([g0.positions] * 3)
+    N = np.stack([g0.normals] * 3)
+    for b in (1e-15, 1e14, [1.0, 1e-15, 1.0]):
+        yield Case(
+            "batch_epsilon_l1",
+            f"characteristic-lengths-{b}",
+            lambda b=b: dg.batch_epsilon_l1(P, N, mu=0.5, characteristic_lengths=b),
+            "refuse",
+        )
+        yield Case(
+            "batch_force_closure",
+            f"metrics-at-lengths-{b}",
+            lambda b=b: dg.batch_force_closure(
+                P, N, mu=0.5, characteristic_lengths=b, metrics=("isotropy",)
+            ),
+            "refuse",
+        )
+        yield Case(
+            "batch_force_closure",
+            f"verdicts-at-lengths-{b}",
+            lambda b=b: dg.batch_force_closure(P, N, mu=0.5, characteristic_lengths=b),
+            "answer",
+            lambda r: bool(np.all(r.is_closure)),
+        )
+
+
 WRONG_GRASPS = [
     None,
     1,
@@ -1881,6 +1934,7 @@ def all_cases(root: Path | None = None) -> Iterator[Case]:
     yield from api_walk_cases()
     yield from contact_cases()
     yield from grasp_cases()
+    yield from length_scale_cases()
     yield from wrong_type_cases()
     yield from option_cases()
     yield from value_cases()

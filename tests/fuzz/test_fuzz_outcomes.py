@@ -16,6 +16,7 @@ import pytest
 FAMILIES = {
     "Contact": fuzz_cases.contact_cases,
     "Grasp": fuzz_cases.grasp_cases,
+    "length scale": fuzz_cases.length_scale_cases,
     "wrong type": fuzz_cases.wrong_type_cases,
     "options": fuzz_cases.option_cases,
     "values": fuzz_cases.value_cases,

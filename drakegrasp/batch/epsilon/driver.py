@@ -38,7 +38,11 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.batch.build.construction import batched_characteristic_lengths
-from drakegrasp.batch.metrics import epsilon_l1_batch
+from drakegrasp.batch.metrics import (
+    check_moment_arms,
+    epsilon_l1_batch,
+    moment_arms_in_input_order,
+)
 from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_task
@@ -77,7 +81,7 @@ def _merge_epsilon(K: int, _dim: int, parts) -> np.ndarray:
 
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
-@accepts_ragged(_merge_epsilon)
+@accepts_ragged(_merge_epsilon, check=moment_arms_in_input_order)
 @takes_batch_options
 def batch_epsilon_l1(
     positions: np.ndarray,
@@ -108,7 +112,9 @@ def batch_epsilon_l1(
     characteristic_lengths : float or (K,) float, optional
         ``b > 0`` metres: moments are divided by it and a soft finger's
         torsion bound is ``b ν``; default the largest ``‖c_i - p‖`` of each
-        grasp, as :class:`~drakegrasp.Grasp` does.
+        grasp, as :class:`~drakegrasp.Grasp` does.  A grasp's extent over
+        its ``b`` must lie in :data:`~drakegrasp.core.tolerances.MOMENT_ARMS`,
+        as in :func:`~drakegrasp.quality.ferrari_canny`.
     chunk_size, progress, workers : optional
         As in :func:`~drakegrasp.batch.batch_force_closure`.
     kernel : {"auto", "numba", "numpy"}, optional
@@ -143,6 +149,8 @@ def batch_epsilon_l1(
 
     def eps_task(P, Nrm, sl):
         _, args, _ = task(P, Nrm, sl)
+        if args[5] is not None:
+            check_moment_arms(args[0], args[4], args[5], sl.start)
         return epsilon_chunk, args, eps_options
 
     out = np.zeros(np.shape(positions)[0])

@@ -51,7 +51,11 @@ from drakegrasp.batch.inputs import (
     shape_of,
 )
 from drakegrasp.batch.lp.dstar import solve_dstar_blocks
-from drakegrasp.batch.metrics import epsilon_l1_batch, singular_value_metrics
+from drakegrasp.batch.metrics import (
+    check_moment_arms,
+    epsilon_l1_batch,
+    singular_value_metrics,
+)
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.validation import check_num_generators
@@ -421,6 +425,8 @@ def force_task(positions, mu, contact_model, num_generators, torsional_friction,
         check_chunk_coefficients("torsional_friction", nu_c, sl.start)
         p = np.ascontiguousarray(get_p(sl))
         b = None if get_b is None else np.ascontiguousarray(get_b(sl))
+        if b is not None and options["metrics"]:
+            check_moment_arms(P, p, b, sl.start)
         return force_chunk, (P, Nrm, mu_c, nu_c, p, b), options
 
     return task, options
@@ -446,6 +452,8 @@ def form_task(positions, reference_points, characteristic_lengths, tol, rank_tol
     def task(P, Nrm, sl):
         p = np.ascontiguousarray(get_p(sl))
         b = None if get_b is None else np.ascontiguousarray(get_b(sl))
+        if b is not None and options["metrics"]:
+            check_moment_arms(P, p, b, sl.start)
         return form_chunk, (P, Nrm, p, b), options
 
     return task, options
