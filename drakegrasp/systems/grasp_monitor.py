@@ -143,8 +143,11 @@ class GraspMonitor(LeafSystem):
         Time of the first periodic sample (default 0); a sample is also taken
         at initialization.
     compute_epsilon : bool, optional
-        Compute the Ferrari–Canny ε of force-closure samples (default False),
-        with the batch engine's compiled kernel
+        Compute the Ferrari–Canny ε of force-closure samples (default False;
+        NaN, and the sample's message says why, when ``characteristic_length``
+        is out of scale with the sample's contacts, see
+        :data:`~drakegrasp.core.tolerances.MOMENT_ARMS`), with the batch
+        engine's compiled kernel
         (:func:`~drakegrasp.systems.grasp_monitor.epsilon_l1`: about
         1 ms for 8 contacts, compiled when the package was installed; an
         install without those kernels compiles it once, or ``drakegrasp
@@ -526,9 +529,14 @@ class GraspMonitor(LeafSystem):
             and self.settings.compute_epsilon
             and report.is_force_closure
         ):
-            epsilon = epsilon_l1(
-                report.grasp, num_generators=self.settings.analysis.num_generators
-            )
+            try:
+                epsilon = epsilon_l1(
+                    report.grasp, num_generators=self.settings.analysis.num_generators
+                )
+            except InvalidOptionError as e:  # a characteristic_length out of scale
+                epsilon = float("nan")
+                why = f"epsilon not computed: {_one_line(e)}"
+                message = f"{message}; {why}" if message else why
         return self._sample(t, status, message, report, epsilon, x, start, grip=grip)
 
     @staticmethod

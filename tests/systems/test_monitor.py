@@ -362,3 +362,23 @@ def test_joint_off_its_limits_is_an_invalid_sample(point_pick):
     assert analysed.status == "ok"
     assert not analysed.report.pose.valid
     assert "left_finger_joint" in str(analysed.report)
+
+
+def test_epsilon_at_a_length_out_of_scale_is_nan_and_said_not_a_crash():
+    """``characteristic_length=1e-15`` with ``compute_epsilon``: the ε of every
+    force-closure sample is refused (contacts ~3 cm apart), which ended the
+    simulation with an ``InvalidOptionError`` at the first grip; now the sample
+    carries ε = NaN and says why, and the rest of the analysis is unchanged."""
+    pick = build_pick(
+        plant_contact="point", **OPTIONS, **SOFT, **EPS, characteristic_length=1e-15
+    )
+    pick.run(1.2)  # gripped and lifting
+    context = pick.monitor.GetMyContextFromRoot(pick.simulator.get_context())
+    sample = pick.monitor.evaluate(context)
+    assert sample.status == "ok"
+    assert sample.report.is_force_closure
+    assert np.isnan(sample.epsilon)
+    assert "epsilon not computed: characteristic_length = 1e-15 m" in sample.message
+    log = pick.verdict_log.FindLog(pick.simulator.get_context()).data()
+    closed = log[GraspMonitor.FORCE_CLOSURE] == 1
+    assert closed.any() and np.isnan(log[GraspMonitor.EPSILON][closed]).all()
