@@ -56,7 +56,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import unit_vectors
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import InvalidOptionError, ModelError, SolverError
 from drakegrasp.planning.candidates import GraspCandidate, check_candidate
 from drakegrasp.plant.load import effort_unit
 from drakegrasp.plant.validation import (
@@ -242,6 +242,19 @@ def _angle(R: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)))
 
 
+def _diverged(error: RuntimeError, t: float, stiffness: float) -> SolverError:
+    """The one-line error of a simulation Drake could not advance past ``t``."""
+    lines = str(error).split("Reasons for")[0].strip().splitlines()  # then advice
+    first = " ".join(lines[0].split()).rstrip(".") if lines else type(error).__name__
+    return SolverError(
+        f"the shake test's simulation stopped at t = {t:.3g} s ({first}): the "
+        f"fingers' position control (stiffness = {stiffness:g}) is likely too "
+        "stiff for their inertia: light revolute fingers need far lower gains "
+        "(the Allegro hand: squeeze=0.5, stiffness=20, damping=1); a smaller "
+        "time_step also helps"
+    )
+
+
 def shake_test(
     add_models: Callable,
     candidate: GraspCandidate,
@@ -318,6 +331,10 @@ def shake_test(
     InvalidOptionError
         Bad options (non-positive time step or squeeze, a zero direction, an
         ``X_WO`` that is not a finite rigid pose...).
+    SolverError
+        Drake's contact solver did not converge during the simulation (gains
+        too stiff for the fingers' inertia, or too long a ``time_step``); the
+        message gives the time and what to lower.
     InvalidGraspError
         The candidate's joint values or poses are not finite or do not match
         its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`).
@@ -455,7 +472,12 @@ def shake_test(
         d = r = 0.0
         while t < to - 1e-12:
             t = min(t + dt_check, to)
-            simulator.AdvanceTo(t)
+            try:
+                simulator.AdvanceTo(t)
+            except RuntimeError as e:  # Drake's contact solver did not converge
+                if type(e) is not RuntimeError:  # RecursionError, NotImplemented...
+                    raise
+                raise _diverged(e, simulator.get_context().get_time(), stiffness) from e
             X_HO = plant.CalcRelativeTransform(ctx, H, body.body_frame())
             d = float(np.linalg.norm(X_HO.translation() - X_HO0.translation()))
             r = _angle(X_HO0.rotation().matrix().T @ X_HO.rotation().matrix())

@@ -57,3 +57,18 @@ def test_the_summary_unit_of_an_older_or_mixed_result(units, text):
         bounds=(0.01, 0.1), **({"effort_units": units} if units else {}),
     )  # fmt: skip
     assert text in str(result)
+
+
+def test_a_simulation_drake_cannot_advance_is_a_solver_error_not_a_raw_one():
+    """Gains far too stiff for light revolute fingers: Drake's SAP solver stops
+    ("failed to converge", a raw ``RuntimeError`` with a page of advice) at the
+    first step.  The shake test says so on one line, with the time and what
+    to lower, as a ``SolverError``."""
+    from drakegrasp.errors import SolverError
+
+    scene, best = _best(THREE, preshape=THREE_OPEN)
+    with pytest.raises(SolverError, match=r"stopped at t = .* s \(.*converge") as info:
+        shake_test(scene.add_models, best, stiffness=1e7, damping=1e4, **SHORT)
+    assert "\n" not in str(info.value)
+    assert "stiffness = 1e+07" in str(info.value)
+    assert isinstance(info.value.__cause__, RuntimeError)
