@@ -18,13 +18,13 @@ from drakegrasp.core.validation import safe_norm
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError
 
 __all__ = [
+    "asks_for_metrics",
     "check_moment_arms",
     "epsilon_l1_batch",
     "epsilon_l1_per_grasp",
     "epsilon_l1_routes",
     "metric_moment_arms",
     "moment_arms_in_input_order",
-    "requested_metrics",
     "singular_value_metrics",
 ]
 
@@ -101,7 +101,7 @@ def moment_arms_in_input_order(calls, *, always: bool = True) -> None:
     worst = None
     for group, options in calls:
         b = options.get("characteristic_lengths")
-        if b is None or not (always or requested_metrics(options)):
+        if b is None or not (always or asks_for_metrics(options)):
             continue
         bad, extent = _out_of_scale(group.positions, options.get("reference_points"), b)
         b = np.broadcast_to(np.asarray(b, dtype=float), bad.shape)
@@ -113,7 +113,7 @@ def moment_arms_in_input_order(calls, *, always: bool = True) -> None:
         _refuse_out_of_scale(*worst)
 
 
-def requested_metrics(options: dict) -> bool:
+def asks_for_metrics(options: dict) -> bool:
     """Whether a batch call's keyword options ask for metrics.
 
     Read from ``metrics=`` or a :class:`~drakegrasp.BatchOptions`' ``metrics``
