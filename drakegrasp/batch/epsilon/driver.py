@@ -149,8 +149,9 @@ def batch_epsilon_l1(
 
     def eps_task(P, Nrm, sl):
         _, args, _ = task(P, Nrm, sl)
-        if args[5] is not None:
-            check_moment_arms(args[0], args[4], args[5], sl.start)
+        P_c, _, _, _, p, b = args
+        if b is not None:
+            check_moment_arms(P_c, p, b, sl.start)
         return epsilon_chunk, args, eps_options
 
     out = np.zeros(np.shape(positions)[0])
