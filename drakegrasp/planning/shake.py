@@ -123,6 +123,16 @@ class ShakeResult:
         The unit of ``squeeze`` and of each entry of ``efforts``, per closing
         joint in actuator order: ``"N"`` for a prismatic joint, ``"N·m"`` for
         a revolute one (empty: newtons assumed).
+    seat_displacement, seat_rotation : float
+        Where seating left the object, before any gravity: distance (m) of
+        its origin from its planned place and rotation angle (rad) from its
+        planned orientation, in the hand frame (NaN with ``seat=0``).
+    seat_speed : float
+        Speed (m/s) of the object's origin at the end of seating.  An object
+        the squeeze holds has settled there (a few mm/s); one the fingers'
+        closing motions push out of the hand is still moving (0.15-0.28 m/s
+        for the Allegro hand's thumbless grasps of the YCB sugar box at
+        0.7 N·m, see the planning guide).  NaN with ``seat=0``.
     """
 
     held: bool
@@ -136,12 +146,24 @@ class ShakeResult:
     wall_time: float
     bounds: tuple[float, float]
     effort_units: tuple[str, ...] = ()
+    seat_displacement: float = float("nan")
+    seat_rotation: float = float("nan")
+    seat_speed: float = float("nan")
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
         return jsonable(dict(vars(self)))
 
     def __str__(self) -> str:
+        seated = (
+            ""
+            if np.isnan(self.seat_displacement)
+            else (
+                f"; seated {self.seat_displacement * 1e3:.2f} mm and "
+                f"{np.degrees(self.seat_rotation):.2f} deg from the plan, "
+                f"moving at {self.seat_speed * 1e3:.3g} mm/s"
+            )
+        )
         return (
             f"{'held' if self.held else 'dropped'}: moved at most "
             f"{self.max_displacement * 1e3:.2f} mm and "
@@ -151,6 +173,7 @@ class ShakeResult:
             f" over {self.duration:g} s, squeeze {self.squeeze:g} "
             f"{_squeeze_unit(self.effort_units)}, "
             f"{len(self.phases)} gravity directions; {self.wall_time:.2f} s wall"
+            f"{seated}"
         )
 
 
@@ -236,6 +259,12 @@ def _schedule(seat, settle, phase, blend, directions):
 
 def _scoped(plant, joint) -> str:
     return f"{plant.GetModelInstanceName(joint.model_instance())}::{joint.name()}"
+
+
+def _speed(plant, context, body) -> float:
+    """Speed (m/s) of ``body``'s origin in the world (the hand's base is welded)."""
+    V = plant.EvalBodySpatialVelocityInWorld(context, body)
+    return float(np.linalg.norm(V.translational()))
 
 
 def _angle(R: np.ndarray) -> float:
@@ -484,10 +513,11 @@ def shake_test(
             max_d, max_r = max(max_d, d), max(max_r, r)
         return d, r
 
+    seated = (float("nan"),) * 3
     if seat > 0:
         advance(seat / 2)
         aim()  # from where the fingers stopped on the object
-        advance(seat)
+        seated = (*advance(seat), _speed(plant, ctx, body))
     else:
         advance(settle)  # efforts are read once something has been simulated
     u = plant.get_net_actuation_output_port().Eval(ctx)
@@ -515,4 +545,7 @@ def shake_test(
         wall_time=time.perf_counter() - t0,
         bounds=(float(max_displacement), float(max_rotation)),
         effort_units=effort_units,
+        seat_displacement=seated[0],
+        seat_rotation=seated[1],
+        seat_speed=seated[2],
     )

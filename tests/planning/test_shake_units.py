@@ -72,3 +72,25 @@ def test_a_simulation_drake_cannot_advance_is_a_solver_error_not_a_raw_one():
     assert "\n" not in str(info.value)
     assert "stiffness = 1e+07" in str(info.value)
     assert isinstance(info.value.__cause__, RuntimeError)
+
+
+def test_the_seat_phase_is_reported_apart_from_the_shake():
+    """``seat_displacement``/``seat_rotation``/``seat_speed``: where seating
+    left the object and how fast it still moved, before any gravity.  A jaw
+    squeezing a cylinder seats it within a millimetre and holds it still; the
+    figures are part of the whole run's maxima, and of its JSON and summary."""
+    import json
+    import math
+
+    scene, best = _best(JAW)
+    result = shake_test(scene.add_models, best, squeeze=5.0, **SHORT)
+    assert 0.0 <= result.seat_displacement <= result.max_displacement
+    assert 0.0 <= result.seat_rotation <= result.max_rotation
+    assert result.seat_displacement < 1e-3
+    assert 0.0 <= result.seat_speed < 5e-3
+    data = json.loads(json.dumps(result.to_dict()))
+    assert math.isclose(data["seat_speed"], result.seat_speed)
+    assert "seated " in str(result) and "mm/s" in str(result)
+    unseated = shake_test(scene.add_models, best, squeeze=5.0, **{**SHORT, "seat": 0.0})
+    assert math.isnan(unseated.seat_displacement) and math.isnan(unseated.seat_speed)
+    assert "seated" not in str(unseated)
