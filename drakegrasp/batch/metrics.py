@@ -8,14 +8,15 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
+from drakegrasp.batch.inputs import check_chunk_positions, check_metrics
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import L1_MAX_POINTS, MOMENT_ARMS
-from drakegrasp.core.validation import safe_norm
-from drakegrasp.errors import InvalidGraspError, InvalidOptionError
+from drakegrasp.core.validation import LENGTH_MIN, real_array, safe_norm
+from drakegrasp.errors import GraspError, InvalidGraspError, InvalidOptionError
 
 __all__ = [
     "asks_for_metrics",
@@ -34,9 +35,10 @@ SINGULAR_VALUE_METRICS = ("sigma_min", "isotropy", "ellipsoid_volume")
 def _out_of_scale(P: np.ndarray, p, b) -> tuple[np.ndarray, np.ndarray]:
     """Grasps whose extent over ``b`` leaves ``MOMENT_ARMS``, and the extents.
 
-    ``P`` (k, N, d) contacts (metres); ``p`` None, (d,) or (k, d) reference
-    points; ``b`` scalar or (k,) characteristic lengths.  A grasp whose
-    contacts all sit at its reference point takes any ``b``.
+    ``P`` (k, N, d) checked contacts (metres); ``p`` None, (d,) or (k, d)
+    reference points; ``b`` scalar or (k,) characteristic lengths.  A grasp
+    whose contacts all sit within ``LENGTH_MIN`` of its reference point takes
+    any ``b``, as :class:`~drakegrasp.Grasp`'s default (1 m) there does.
     """
     k, _, d = P.shape
     p = np.zeros(d) if p is None else np.asarray(p, dtype=float)
@@ -44,7 +46,7 @@ def _out_of_scale(P: np.ndarray, p, b) -> tuple[np.ndarray, np.ndarray]:
     b = np.broadcast_to(np.asarray(b, dtype=float), (k,))
     extent = np.max(safe_norm(P - p[:, None, :], axis=-1), axis=-1)
     low, high = MOMENT_ARMS
-    bad = (extent > 0.0) & ~((low * b <= extent) & (extent <= high * b))
+    bad = (extent >= LENGTH_MIN) & ~((low * b <= extent) & (extent <= high * b))
     return bad, extent
 
 
@@ -59,7 +61,7 @@ def _refuse_out_of_scale(index: int, b: float, extent: float) -> None:
     )
 
 
-def check_moment_arms(P: np.ndarray, p, b, start: int = 0) -> None:
+def check_moment_arms(P, p, b, start: int = 0) -> None:
     """Refuse the first grasp whose extent over its ``b`` leaves ``MOMENT_ARMS``.
 
     Every metric divides moments by ``b``: beyond
@@ -70,20 +72,25 @@ def check_moment_arms(P: np.ndarray, p, b, start: int = 0) -> None:
 
     Parameters
     ----------
-    P : (k, N, d) float
-        Contacts of a chunk of grasps, metres.
+    P : (k, N, d) array-like of float
+        Contacts of a chunk of grasps, metres, as given: checked here first
+        (the messages of the chunk's own check).
     p : None, (d,) or (k, d) float
-        Their reference points (None: the origin).
+        Their reference points (None: the origin), checked.
     b : float or (k,) float
-        Their characteristic lengths, metres.
+        Their characteristic lengths, metres, checked.
     start : int
-        Index of the chunk's first grasp in the batch, for the message.
+        Index of the chunk's first grasp in the batch, for the messages.
 
     Raises
     ------
+    InvalidContactError
+        Positions that are not real, finite and within range.
     InvalidGraspError
-        Naming the first such grasp, its ``b`` and the range it must be in.
+        Naming the first grasp out of scale, its ``b`` and the range.
     """
+    P = real_array("positions", P)
+    check_chunk_positions(P, start)
     bad, extent = _out_of_scale(P, p, b)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
@@ -94,9 +101,19 @@ def check_moment_arms(P: np.ndarray, p, b, start: int = 0) -> None:
 def moment_arms_in_input_order(calls, *, always: bool = True) -> None:
     """:func:`check_moment_arms` over a ragged batch's groups, in input order.
 
-    ``calls`` is the list of ``(group, options)`` that
-    :func:`~drakegrasp.batch.ragged.run_groups` gives its ``check``; with
-    ``always`` False, only the groups whose options ask for metrics are checked.
+    Parameters
+    ----------
+    calls : list of (RaggedGroup, dict)
+        Each group (checked contacts) with the options its call will get, as
+        :func:`~drakegrasp.batch.ragged.run_groups` gives its ``check``.
+    always : bool, optional
+        True (ε): check every group that has ``characteristic_lengths``;
+        False (the closure functions): only when the options ask for metrics.
+
+    Raises
+    ------
+    InvalidGraspError
+        Naming the first grasp of the input out of scale.
     """
     worst = None
     for group, options in calls:
@@ -116,23 +133,37 @@ def moment_arms_in_input_order(calls, *, always: bool = True) -> None:
 def asks_for_metrics(options: dict) -> bool:
     """Whether a batch call's keyword options ask for metrics.
 
-    Read from ``metrics=`` or a :class:`~drakegrasp.BatchOptions`' ``metrics``
-    before they are checked: anything but None or an empty sequence counts.
+    Parameters
+    ----------
+    options : dict
+        The call's keywords, before they are checked: ``metrics`` and
+        ``options`` (a :class:`~drakegrasp.BatchOptions`).
+
+    Returns
+    -------
+    bool
+        True when either names a metric as
+        :func:`~drakegrasp.batch.inputs.check_metrics` reads it (``{}``,
+        ``set()`` and ``()`` name none), and when it is not a valid list of
+        names (refused later, by that check).
     """
     given = options.get("options")
     for names in (options.get("metrics"), getattr(given, "metrics", None)):
-        if names is None:
+        if names is None or isinstance(names, Iterator):  # not used up here
             continue
         try:
-            if np.size(names) > 0:
+            if check_metrics(names):
                 return True
-        except (TypeError, ValueError):  # checked, and refused, later
+        except GraspError:  # refused, with its own message, by the call
             return True
     return False
 
 
 def metric_moment_arms(calls) -> None:
-    """The ragged ``check`` of the closure functions: metrics need ``MOMENT_ARMS``."""
+    """The ragged ``check`` of the closure functions: metrics need ``MOMENT_ARMS``.
+
+    :func:`moment_arms_in_input_order` with ``always=False``.
+    """
     moment_arms_in_input_order(calls, always=False)
 
 

@@ -23,7 +23,7 @@ by grasp, bitwise what the stacked call of its group gives
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -287,6 +287,12 @@ def run_groups(
         ``N``.
     """
     K, d, groups = ragged_groups(positions, normals)
+    # Every group's call reads the options: a one-shot iterator (metrics=iter(...))
+    # would be used up by the first and leave the others without.
+    options = {
+        name: tuple(value) if isinstance(value, Iterator) else value
+        for name, value in options.items()
+    }
     counts = [0] * K
     for group in groups:
         for k in group.indices:

@@ -53,7 +53,10 @@ them once asked for 57 GiB.  Beyond this bound ε is refused, not attempted.
 
 
 MOMENT_ARMS = (1e-4, 1e12)
-"""Range of a grasp's extent over an explicit ``torque_scale`` (metres / metres).
+"""Range of a grasp's extent over the length its moments are divided by (m / m).
+
+That length is an explicit ``torque_scale`` or the grasp's characteristic
+length (``characteristic_lengths`` in the batch engine).
 
 Below it the moments, divided by ``torque_scale``, are too small for the LPs'
 tolerances, and weight capacities came out wrong without a word (by 5e-5 at a
@@ -61,9 +64,11 @@ ratio of 2.4e-5, by 0.66 at 2.4e-7, on random grasps); far above it Clp fails
 (at 2.4e21), and the quality metrics swamp the forces: on the three equator
 fingers (extent 1 m) ``ferrari_canny(..., torque_scale=1e-15)`` returned 0 and
 ``grasp_singular_values(..., torque_scale=1e-50)`` a ``σ_min`` of 1.04e19 (1.73
-at 1e-12).  The planner (``planning.checks``) and the quality metrics
-(``quality._common``) check against this one range, each with its grasp's
-extent.
+at 1e-12).  The planner (``planning.checks``, its extent the largest absolute
+coordinate of a contact in the object's frame), the quality metrics
+(``quality._common``) and the batch engine's metrics (``batch.metrics``, both
+with the largest distance from the reference point to a contact) check against
+this one range.  The closure verdicts take any length.
 """
 
 

@@ -56,7 +56,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import unit_vectors
-from drakegrasp.errors import InvalidOptionError, ModelError, SolverError
+from drakegrasp.errors import GraspError, InvalidOptionError, ModelError, SolverError
 from drakegrasp.planning.candidates import GraspCandidate, check_candidate
 from drakegrasp.plant.load import effort_unit
 from drakegrasp.plant.validation import (
@@ -132,7 +132,7 @@ class ShakeResult:
         the squeeze holds has settled there; one the fingers' closing motions
         push out of the hand is still moving (the Allegro hand's thumbless
         grasps of the YCB sugar box at 0.7 N·m: 0.17-0.53 m/s here, against
-        0.01 and 0.04 m/s for its two best grasps with the thumb; see the
+        0.012 and 0.045 m/s for its two best grasps with the thumb; see the
         planning guide).  NaN with ``seat=0``.
     """
 
@@ -272,16 +272,26 @@ def _angle(R: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)))
 
 
-def _diverged(error: RuntimeError, t: float, stiffness: float) -> SolverError:
-    """The one-line error of a simulation Drake could not advance past ``t``."""
+def _stopped(error: RuntimeError, t: float, stiffness: float) -> GraspError:
+    """The one-line error of a simulation Drake could not advance past ``t``.
+
+    A contact solver that did not converge (SAP, TAMSI) is a ``SolverError``
+    that names the gains; anything else Drake refused there (a contact model
+    the geometries do not support, say) is a ``ModelError`` with Drake's first
+    sentence.
+    """
     lines = str(error).split("Reasons for")[0].strip().splitlines()  # then advice
     first = " ".join(lines[0].split()).rstrip(".") if lines else type(error).__name__
+    where = f"the shake test's simulation stopped at t = {t:.3g} s ({first})"
+    if "converge" not in first.lower():
+        return ModelError(
+            f"{where}: the model that add_models built cannot be simulated"
+        )
     return SolverError(
-        f"the shake test's simulation stopped at t = {t:.3g} s ({first}): the "
-        f"fingers' position control (stiffness = {stiffness:g}) is likely too "
-        "stiff for their inertia: light revolute fingers need far lower gains "
-        "(the Allegro hand: squeeze=0.5, stiffness=20, damping=1); a smaller "
-        "time_step also helps"
+        f"{where}: the fingers' position control (stiffness = {stiffness:g}) is "
+        "likely too stiff for their inertia: light revolute fingers need far "
+        "lower gains (the Allegro hand: squeeze=0.5, stiffness=20, damping=1); "
+        "a smaller time_step also helps"
     )
 
 
@@ -365,11 +375,13 @@ def shake_test(
         Drake's contact solver did not converge during the simulation (gains
         too stiff for the fingers' inertia, or too long a ``time_step``); the
         message gives the time and what to lower.
+    ModelError
+        ``add_models`` did not add the candidate's hand base or closing joints,
+        or Drake refused to advance the model for another reason (its first
+        sentence is in the message).
     InvalidGraspError
         The candidate's joint values or poses are not finite or do not match
         its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`).
-    ModelError
-        ``add_models`` did not add the candidate's hand base or closing joints.
     """
     if not callable(add_models):
         raise InvalidOptionError(
@@ -504,10 +516,10 @@ def shake_test(
             t = min(t + dt_check, to)
             try:
                 simulator.AdvanceTo(t)
-            except RuntimeError as e:  # Drake's contact solver did not converge
+            except RuntimeError as e:  # Drake could not advance (see _stopped)
                 if type(e) is not RuntimeError:  # RecursionError, NotImplemented...
                     raise
-                raise _diverged(e, simulator.get_context().get_time(), stiffness) from e
+                raise _stopped(e, simulator.get_context().get_time(), stiffness) from e
             X_HO = plant.CalcRelativeTransform(ctx, H, body.body_frame())
             d = float(np.linalg.norm(X_HO.translation() - X_HO0.translation()))
             r = _angle(X_HO0.rotation().matrix().T @ X_HO.rotation().matrix())

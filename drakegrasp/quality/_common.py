@@ -6,7 +6,7 @@ import numpy as np
 
 from drakegrasp.core.grasp import Grasp, grasp_matrix
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, MOMENT_ARMS
-from drakegrasp.core.validation import check_grasp, check_length, safe_norm
+from drakegrasp.core.validation import LENGTH_MIN, check_grasp, check_length, safe_norm
 from drakegrasp.errors import InvalidOptionError
 
 RANK_TOL = DEFAULT_RANK_TOL
@@ -32,7 +32,8 @@ def _torque_scale(grasp: Grasp, torque_scale: float | None) -> float:
 
     Either length is a length (``[2.2e-308, 1e30]`` m) with the grasp's extent
     over it in :data:`~drakegrasp.core.tolerances.MOMENT_ARMS` (any length when
-    every contact is at the reference point).  The closure verdicts take any
+    every contact is within ``LENGTH_MIN`` of the reference point, where the
+    Grasp's own default is 1 m).  The closure verdicts take any
     characteristic length; the metrics, which divide moments by it, do not.
 
     Raises
@@ -56,7 +57,7 @@ def _torque_scale(grasp: Grasp, torque_scale: float | None) -> float:
         )
     extent = grasp_extent(grasp)
     low, high = MOMENT_ARMS
-    if extent > 0.0 and not (low * b <= extent <= high * b):
+    if extent >= LENGTH_MIN and not (low * b <= extent <= high * b):
         raise InvalidOptionError(
             f"{name} = {b:g} m is out of scale with the grasp, whose contacts "
             f"lie within {extent:g} m of its reference point: the extent over "

@@ -144,10 +144,11 @@ class GraspMonitor(LeafSystem):
         at initialization.
     compute_epsilon : bool, optional
         Compute the Ferrari–Canny ε of force-closure samples (default False;
-        NaN, and the sample's message says why, when ``characteristic_length``
-        is out of scale with the sample's contacts, see
-        :data:`~drakegrasp.core.tolerances.MOMENT_ARMS`), with the batch
-        engine's compiled kernel
+        NaN, and the sample's message says why, where the metric refuses the
+        sample's grasp: a ``characteristic_length`` out of scale with its
+        contacts, see :data:`~drakegrasp.core.tolerances.MOMENT_ARMS`, or more
+        primitive wrenches than it takes), with the batch engine's compiled
+        kernel
         (:func:`~drakegrasp.systems.grasp_monitor.epsilon_l1`: about
         1 ms for 8 contacts, compiled when the package was installed; an
         install without those kernels compiles it once, or ``drakegrasp
@@ -533,7 +534,7 @@ class GraspMonitor(LeafSystem):
                 epsilon = epsilon_l1(
                     report.grasp, num_generators=self.settings.analysis.num_generators
                 )
-            except InvalidOptionError as e:  # a characteristic_length out of scale
+            except InvalidOptionError as e:  # the metric refuses this grasp
                 epsilon = float("nan")
                 why = f"epsilon not computed: {_one_line(e)}"
                 message = f"{message}; {why}" if message else why

@@ -131,9 +131,9 @@ speed:
 ``epsilon``          Ferrari–Canny ε (L1), 0 when not in force closure or not
                      asked for (``compute_epsilon=False``, the default; when
                      asked, the batch engine's compiled kernel computes it,
-                     about 1 ms on 8 contacts); NaN when the given
-                     ``characteristic_length`` is out of scale with the
-                     contacts (the sample's message says so)
+                     about 1 ms on 8 contacts); NaN where the metric
+                     refuses the grasp (a ``characteristic_length`` out of
+                     scale with the contacts; the sample's message says why)
 ``holding``          code of the holding state (index in ``HOLDING_STATES``)
 ``friction_use``     largest ``‖f_t‖/(μ f_n)``; NaN in geometry mode
 ``slip_speed``       largest slip speed at a contact, m/s

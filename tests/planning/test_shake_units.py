@@ -94,3 +94,24 @@ def test_the_seat_phase_is_reported_apart_from_the_shake():
     unseated = shake_test(scene.add_models, best, squeeze=5.0, **{**SHORT, "seat": 0.0})
     assert math.isnan(unseated.seat_displacement) and math.isnan(unseated.seat_speed)
     assert "seated" not in str(unseated)
+
+
+def test_a_model_drake_refuses_to_advance_is_a_model_error_not_advice_on_gains():
+    """Only a contact solver that did not converge is about the gains: a model
+    Drake cannot simulate (hydroelastic contact between geometries without a
+    hydroelastic representation) is a ``ModelError`` with Drake's sentence."""
+    from pydrake.multibody.plant import ContactModel
+
+    from drakegrasp.errors import ModelError
+
+    scene, best = _best(JAW)
+
+    def hydroelastic(plant, parser):
+        models = scene.add_models(plant, parser)
+        plant.set_contact_model(ContactModel.kHydroelastic)
+        return models
+
+    with pytest.raises(ModelError, match="hydroelastic") as info:
+        shake_test(hydroelastic, best, squeeze=5.0, **SHORT)
+    assert "stiffness" not in str(info.value)
+    assert "\n" not in str(info.value)

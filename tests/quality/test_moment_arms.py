@@ -145,3 +145,62 @@ def test_hostile_metrics_values_still_get_their_own_error():
         dg.batch_force_closure(P, N, mu=0.5, metrics=5)
     with pytest.raises(dg.GraspError):
         dg.batch_force_closure(P, N, mu=0.5, metrics=[["a", "b"], ["c"]])
+
+
+def test_the_batch_check_reads_positions_as_the_engine_does():
+    """Nested lists are positions like arrays (the check ran on the raw input
+    and raised ``AttributeError``); bad positions get the engine's own message,
+    not a numpy error or a moment-arm refusal."""
+    P, N = _stack()
+    eps = dg.batch_epsilon_l1(
+        P.tolist(), N.tolist(), mu=0.5, characteristic_lengths=1.0
+    )
+    np.testing.assert_array_equal(eps, dg.batch_epsilon_l1(P, N, mu=0.5))
+    r = dg.batch_force_closure(
+        P.tolist(),
+        N.tolist(),
+        mu=0.5,
+        characteristic_lengths=1.0,
+        metrics=("isotropy",),
+    )
+    assert r.is_closure.all()
+    for bad in (P.astype(str), P * 1e200):
+        with pytest.raises(dg.InvalidContactError, match="position"):
+            dg.batch_epsilon_l1(bad, N, mu=0.5, characteristic_lengths=1.0)
+
+
+def test_a_subnormal_extent_takes_the_default_length_everywhere():
+    """Contacts within LENGTH_MIN of the reference point: the Grasp's default
+    length is 1 m, which the metrics take (as for contacts at the point), on
+    every route and kernel."""
+    g0 = dg.examples.equator_fingers(mu=0.5)
+    tiny = [dg.Contact(c.position * 1e-310, c.normal, mu=0.5) for c in g0.contacts]
+    g = dg.Grasp(tiny)
+    assert g.characteristic_length == 1.0
+    assert dg.ferrari_canny(g) >= 0.0 and dg.min_singular_value(g) >= 0.0
+    P, N = g.positions[None], g.normals[None]
+    for kernel in ("auto", "numpy"):
+        dg.batch_epsilon_l1(P, N, mu=0.5, kernel=kernel)
+        dg.batch_force_closure(P, N, mu=0.5, metrics=("sigma_min",), kernel=kernel)
+
+
+@pytest.mark.parametrize("empty", [{}, set(), (), []])
+def test_empty_metrics_ask_for_none_on_both_routes(empty):
+    g = dg.examples.equator_fingers(mu=0.5)
+    P = [g.positions[:2], g.positions]
+    N = [g.normals[:2], g.normals]
+    r = dg.batch_force_closure(
+        P, N, mu=0.5, characteristic_lengths=[1.0, 1e-15], metrics=empty
+    )
+    assert list(r.is_closure) == [False, True]
+
+
+def test_a_one_shot_iterator_of_metrics_serves_every_group():
+    """A ragged batch calls the engine once per contact count; ``iter([...])``
+    was used up by the first group and the merge raised ``KeyError``."""
+    g = dg.examples.equator_fingers(mu=0.5)
+    P = [g.positions[:2], g.positions, g.positions]
+    N = [g.normals[:2], g.normals, g.normals]
+    r = dg.batch_force_closure(P, N, mu=0.5, metrics=iter(["isotropy"]))
+    listed = dg.batch_force_closure(P, N, mu=0.5, metrics=["isotropy"])
+    np.testing.assert_array_equal(r.metrics["isotropy"], listed.metrics["isotropy"])
