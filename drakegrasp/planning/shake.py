@@ -134,6 +134,13 @@ class ShakeResult:
         grasps of the YCB sugar box at 0.7 N·m: 0.17-0.53 m/s here, against
         0.012 and 0.045 m/s for its two best grasps with the thumb; see the
         planning guide).  NaN with ``seat=0``.
+    max_displacement_from_seat, max_rotation_from_seat : float
+        Largest distance (m) and rotation angle (rad) of the object, in the
+        hand frame, from where seating left it, over settling and the turned
+        gravity (NaN with ``seat=0``).  ``held`` counts from the planned pose,
+        so a multi-finger hand that seats the object 10 mm away from it is
+        "dropped" whatever follows; these say whether the seated grasp then
+        held still.
     """
 
     held: bool
@@ -150,6 +157,8 @@ class ShakeResult:
     seat_displacement: float = float("nan")
     seat_rotation: float = float("nan")
     seat_speed: float = float("nan")
+    max_displacement_from_seat: float = float("nan")
+    max_rotation_from_seat: float = float("nan")
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
@@ -162,7 +171,9 @@ class ShakeResult:
             else (
                 f"; seated {self.seat_displacement * 1e3:.2f} mm and "
                 f"{np.degrees(self.seat_rotation):.2f} deg from the plan, "
-                f"moving at {self.seat_speed * 1e3:.3g} mm/s"
+                f"moving at {self.seat_speed * 1e3:.3g} mm/s, then at most "
+                f"{self.max_displacement_from_seat * 1e3:.2f} mm and "
+                f"{np.degrees(self.max_rotation_from_seat):.2f} deg from there"
             )
         )
         return (
@@ -509,8 +520,11 @@ def shake_test(
     phases = []
     t, dt_check = 0.0, 0.01
 
+    X_HO_seat = None  # where seating left the object, once it has
+    max_ds = max_rs = float("nan")
+
     def advance(to: float) -> tuple[float, float]:
-        nonlocal t, max_d, max_r
+        nonlocal t, max_d, max_r, max_ds, max_rs
         d = r = 0.0
         while t < to - 1e-12:
             t = min(t + dt_check, to)
@@ -524,6 +538,10 @@ def shake_test(
             d = float(np.linalg.norm(X_HO.translation() - X_HO0.translation()))
             r = _angle(X_HO0.rotation().matrix().T @ X_HO.rotation().matrix())
             max_d, max_r = max(max_d, d), max(max_r, r)
+            if X_HO_seat is not None:
+                ds = float(np.linalg.norm(X_HO.translation() - X_HO_seat.translation()))
+                rs = _angle(X_HO_seat.rotation().matrix().T @ X_HO.rotation().matrix())
+                max_ds, max_rs = max(max_ds, ds), max(max_rs, rs)
         return d, r
 
     seated = (float("nan"),) * 3
@@ -531,6 +549,8 @@ def shake_test(
         advance(seat / 2)
         aim()  # from where the fingers stopped on the object
         seated = (*advance(seat), _speed(plant, ctx, body))
+        X_HO_seat = plant.CalcRelativeTransform(ctx, H, body.body_frame())
+        max_ds = max_rs = 0.0
     else:
         advance(settle)  # efforts are read once something has been simulated
     u = plant.get_net_actuation_output_port().Eval(ctx)
@@ -561,4 +581,6 @@ def shake_test(
         seat_displacement=seated[0],
         seat_rotation=seated[1],
         seat_speed=seated[2],
+        max_displacement_from_seat=max_ds,
+        max_rotation_from_seat=max_rs,
     )

@@ -88,11 +88,24 @@ def test_the_seat_phase_is_reported_apart_from_the_shake():
     assert 0.0 <= result.seat_rotation <= result.max_rotation
     assert result.seat_displacement < 1e-3
     assert 0.0 <= result.seat_speed < 5e-3
+    # From the seated pose: within the triangle inequality of the two others.
+    assert 0.0 <= result.max_displacement_from_seat
+    assert (
+        result.max_displacement - result.seat_displacement - 1e-12
+        <= result.max_displacement_from_seat
+        <= result.max_displacement + result.seat_displacement + 1e-12
+    )
+    assert (
+        0.0
+        <= result.max_rotation_from_seat
+        <= result.max_rotation + result.seat_rotation + 1e-12
+    )
     data = json.loads(json.dumps(result.to_dict()))
     assert math.isclose(data["seat_speed"], result.seat_speed)
     assert "seated " in str(result) and "mm/s" in str(result)
     unseated = shake_test(scene.add_models, best, squeeze=5.0, **{**SHORT, "seat": 0.0})
     assert math.isnan(unseated.seat_displacement) and math.isnan(unseated.seat_speed)
+    assert math.isnan(unseated.max_displacement_from_seat)
     assert "seated" not in str(unseated)
 
 
