@@ -34,14 +34,16 @@ asserted anywhere: they depend on the machine.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-import drakegrasp as dg
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_plan import drake_models  # noqa: E402  (the same local copy)
+
+import drakegrasp as dg  # noqa: E402
 
 ALLEGRO = (
     "package://drake_models/allegro_hand_description/sdf/"
@@ -53,15 +55,6 @@ FINGERS = {  # the Allegro right hand's links, by finger
     "R": ("link_8", "link_9", "link_10", "link_11"),
     "T": ("link_12", "link_13", "link_14", "link_15"),
 }
-
-
-def _models_dir() -> Path | None:
-    env = os.environ.get("DRAKEGRASP_DRAKE_MODELS")
-    here = Path(__file__).resolve().parent.parent.parent / "shared" / "drake_models"
-    for candidate in (env, here):
-        if candidate and Path(candidate).is_dir():
-            return Path(candidate)
-    return None
 
 
 def _finger_of(body: str) -> str:
@@ -130,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--stiffness", type=float, default=10.0)
     parser.add_argument("--damping", type=float, default=0.1)
     args = parser.parse_args(argv)
-    models = _models_dir()
+    models = drake_models()
     if models is None:
         print(
             "drake_models not found: set DRAKEGRASP_DRAKE_MODELS or put a copy at "
