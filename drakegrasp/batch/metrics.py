@@ -12,7 +12,13 @@ from collections.abc import Iterator, Sequence
 
 import numpy as np
 
-from drakegrasp.batch.inputs import check_chunk_positions, check_metrics
+from drakegrasp.batch.inputs import (
+    _characteristic_lengths,
+    _reference_points,
+    check_chunk_positions,
+    check_metrics,
+    shape_of,
+)
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import L1_MAX_POINTS, MOMENT_ARMS
 from drakegrasp.core.validation import LENGTH_MIN, real_array, safe_norm
@@ -21,6 +27,7 @@ from drakegrasp.errors import GraspError, InvalidGraspError, InvalidOptionError
 __all__ = [
     "asks_for_metrics",
     "check_moment_arms",
+    "check_moment_arms_of_batch",
     "epsilon_l1_batch",
     "epsilon_l1_per_grasp",
     "epsilon_l1_routes",
@@ -96,6 +103,43 @@ def check_moment_arms(P, p, b, start: int = 0) -> None:
         k = int(np.flatnonzero(bad)[0])
         b_k = float(np.broadcast_to(np.asarray(b, dtype=float), bad.shape)[k])
         _refuse_out_of_scale(start + k, b_k, float(extent[k]))
+
+
+def check_moment_arms_of_batch(
+    positions, reference_points, characteristic_lengths, *, rows: int = 65_536
+) -> None:
+    """:func:`check_moment_arms` over a whole stacked batch, ``rows`` at a time.
+
+    For a driver that hands the batch out in parts (a Dask cluster's
+    partitions), so that the first grasp out of scale is named by its place
+    in the input and before any part is shipped.  A memory-mapped input is
+    read ``rows`` grasps at a time.
+
+    Parameters
+    ----------
+    positions : (K, N, d) array-like of float
+        The contacts, metres (not a Dask array: it would be computed here).
+    reference_points : None, (d,) or (K, d) float
+        As the batch functions take them.
+    characteristic_lengths : None, float or (K,) float
+        As the batch functions take them; None: nothing to check (the
+        default lengths are the extents).
+    rows : int, optional
+        Grasps read at a time.
+
+    Raises
+    ------
+    InvalidContactError, InvalidGraspError
+        As the batch functions raise them, naming the grasp.
+    """
+    if characteristic_lengths is None:
+        return
+    K, _, d = shape_of("positions", positions)
+    get_p = _reference_points(reference_points, K, d)
+    get_b = _characteristic_lengths(characteristic_lengths, K)
+    for start in range(0, K, rows):
+        sl = slice(start, min(K, start + rows))
+        check_moment_arms(positions[sl], get_p(sl), get_b(sl), start)
 
 
 def moment_arms_in_input_order(calls, *, always: bool = True) -> None:

@@ -36,6 +36,7 @@ from drakegrasp.batch.inputs import (
     positive_int,
     shape_of,
 )
+from drakegrasp.batch.metrics import check_moment_arms_of_batch
 from drakegrasp.batch.options import (
     FRICTION_OPTIONS,
     OPTION_NAMES,
@@ -203,6 +204,12 @@ def evaluate_on_cluster(
     if kind == "force":
         arrays["mu"] = mu
     arrays = _per_grasp_arrays(arrays, K, N)
+    if check_metrics(options.get("metrics", ())) and not hasattr(positions, "dask"):
+        # Named in the input and refused before connecting, not per partition.
+        check_moment_arms_of_batch(
+            positions, arrays.get("reference_points"),
+            arrays.get("characteristic_lengths"),
+        )  # fmt: skip
     starts = list(range(0, K, step))
     job = None
     if output_dir is not None:

@@ -201,3 +201,26 @@ def test_batch_side_takes_a_batch_options(client, grasps, tmp_path):
         evaluate_on_cluster(client, P, Nrm, mu=mu, options=opts.replace(workers=2))
     with pytest.raises(InvalidOptionError, match="given both"):
         evaluate_on_cluster(client, P, Nrm, mu=mu, options=opts, chunk_size=50)
+
+
+def test_a_length_out_of_scale_is_named_in_the_input_before_connecting(grasps):
+    """With metrics, a characteristic length out of scale with its grasp was
+    refused inside a Dask task, after the data had been shipped, naming the
+    grasp by its place in the partition ("grasp 5" for grasp 25).  It is
+    refused before connecting (no client is reached: the address is unused),
+    named as the local engine names it."""
+    import drakegrasp as dg
+
+    P, Nrm, mu = grasps
+    K = 40
+    b = np.full(K, 0.1)
+    b[25] = 1e-15
+    with pytest.raises(dg.InvalidGraspError, match="grasp 25 is 1e-15 m"):
+        evaluate_on_cluster(
+            "tcp://127.0.0.1:1", P[:K], Nrm[:K], mu=mu[:K], chunk_size=10,
+            partition_chunks=1, characteristic_lengths=b, metrics=("isotropy",),
+        )  # fmt: skip
+    with pytest.raises(dg.InvalidGraspError, match="grasp 25 is 1e-15 m"):
+        batch_force_closure(
+            P[:K], Nrm[:K], mu=mu[:K], characteristic_lengths=b, metrics=("isotropy",)
+        )
