@@ -11,7 +11,8 @@ resolved there: the chunks receive ``"numba"`` or ``"numpy"``, never ``"auto"``.
 from __future__ import annotations
 
 import importlib.util
-from collections.abc import Sequence
+import itertools
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
@@ -32,6 +33,7 @@ from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOpt
 
 __all__ = [
     "KERNELS",
+    "MAX_METRIC_NAMES",
     "METRICS",
     "check_kernel",
     "check_metrics",
@@ -198,10 +200,24 @@ def _characteristic_lengths(value, K: int):
     return get
 
 
+MAX_METRIC_NAMES = 1024
+"""Most names an iterator of metrics may yield (an endless one is refused)."""
+
+
 def check_metrics(metrics: Sequence[str]) -> tuple[str, ...]:
-    """``metrics`` as a tuple of known names (:data:`METRICS`), or a clear error."""
+    """``metrics`` as a tuple of known names (:data:`METRICS`), or a clear error.
+
+    An iterator is read once, at most :data:`MAX_METRIC_NAMES` names.
+    """
     if isinstance(metrics, str):
         metrics = (metrics,)
+    if isinstance(metrics, Iterator):
+        metrics = tuple(itertools.islice(metrics, MAX_METRIC_NAMES + 1))
+        if len(metrics) > MAX_METRIC_NAMES:
+            raise InvalidOptionError(
+                f"metrics yields more than {MAX_METRIC_NAMES} names; give a "
+                f"sequence of names from {', '.join(METRICS)}"
+            )
     try:
         names = tuple(metrics)
     except TypeError:

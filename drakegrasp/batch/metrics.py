@@ -17,6 +17,7 @@ from drakegrasp.batch.inputs import (
     _reference_points,
     check_chunk_positions,
     check_metrics,
+    positive_int,
     shape_of,
 )
 from drakegrasp.core.deprecation import renamed_keyword
@@ -125,13 +126,16 @@ def check_moment_arms_of_batch(
         As the batch functions take them; None: nothing to check (the
         default lengths are the extents).
     rows : int, optional
-        Grasps read at a time.
+        Grasps read at a time (an integer >= 1).
 
     Raises
     ------
     InvalidContactError, InvalidGraspError
         As the batch functions raise them, naming the grasp.
+    InvalidOptionError
+        ``rows`` not an integer >= 1.
     """
+    rows = positive_int("rows", rows, 1)
     if characteristic_lengths is None:
         return
     K, _, d = shape_of("positions", positions)

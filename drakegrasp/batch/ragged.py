@@ -34,6 +34,7 @@ from drakegrasp.batch.inputs import (
     _reference_points,
     check_chunk_coefficients,
     check_chunk_positions,
+    check_metrics,
     chunk_unit_normals,
 )
 from drakegrasp.core.validation import real_array
@@ -287,12 +288,11 @@ def run_groups(
         ``N``.
     """
     K, d, groups = ragged_groups(positions, normals)
-    # Every group's call reads the options: a one-shot iterator (metrics=iter(...))
-    # would be used up by the first and leave the others without.
-    options = {
-        name: tuple(value) if isinstance(value, Iterator) else value
-        for name, value in options.items()
-    }
+    # Every group's call reads the options: a one-shot iterator of metrics would
+    # be used up by the first and leave the others without (other options are
+    # arrays, and their checks refuse iterators).
+    if isinstance(options.get("metrics"), Iterator):
+        options = {**options, "metrics": check_metrics(options["metrics"])}
     counts = [0] * K
     for group in groups:
         for k in group.indices:

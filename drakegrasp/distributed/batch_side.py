@@ -44,6 +44,7 @@ from drakegrasp.batch.options import (
     checked_options,
     refuse_given_twice,
 )
+from drakegrasp.batch.run.chunk import check_form_metrics
 from drakegrasp.batch.run.stream import chunk_size_for
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only
@@ -173,10 +174,17 @@ def evaluate_on_cluster(
         A bad option (``partition_chunks``, ``kind``, ``workers``, ...).
     BatchFileError
         ``output_dir`` holds another job and ``overwrite`` is not set.
+    InvalidContactError, InvalidGraspError
+        With metrics, a numpy or memory-mapped input whose positions are bad or
+        whose ``characteristic_lengths`` are out of scale with its grasps
+        (:func:`~drakegrasp.batch.metrics.check_moment_arms_of_batch`), before
+        connecting; other faults of the input come from the partitions.
     """
     if kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
     options, chunk_size = _engine_options(options, keywords, kind, chunk_size)
+    if "metrics" in options:  # read once: an iterator would reach no partition
+        options["metrics"] = check_metrics(options["metrics"])
     if kind == "force" and mu is None:
         raise InvalidOptionError("force closure needs mu")
     reserved = sorted(set(_RESERVED) & set(options))
@@ -204,8 +212,13 @@ def evaluate_on_cluster(
     if kind == "force":
         arrays["mu"] = mu
     arrays = _per_grasp_arrays(arrays, K, N)
-    if check_metrics(options.get("metrics", ())) and not hasattr(positions, "dask"):
-        # Named in the input and refused before connecting, not per partition.
+    names = options.get("metrics", ())
+    if kind == "form":
+        check_form_metrics(names)
+    if names and not hasattr(positions, "dask"):
+        # Named in the input and refused before connecting, not per partition
+        # (an input with several faults may be refused for another one first
+        # than locally, where each chunk is checked in turn).
         check_moment_arms_of_batch(
             positions, arrays.get("reference_points"),
             arrays.get("characteristic_lengths"),

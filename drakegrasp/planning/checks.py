@@ -12,6 +12,7 @@ import numpy as np
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.tolerances import MOMENT_ARMS
 from drakegrasp.core.validation import (
+    LENGTH_MIN,
     check_coefficient,
     check_length,
     check_positions,
@@ -142,7 +143,7 @@ def checked_torque_scale(torque_scale, positions: np.ndarray) -> float:
         return torque_scale
     reach = np.max(np.abs(positions), axis=(1, 2))  # (K,) each grasp's extent
     low, high = MOMENT_ARMS
-    off = (reach > 0.0) & ~(
+    off = (reach >= LENGTH_MIN) & ~(
         (reach >= low * torque_scale) & (reach <= high * torque_scale)
     )
     if off.any():

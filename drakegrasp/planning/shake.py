@@ -171,9 +171,16 @@ class ShakeResult:
             else (
                 f"; seated {self.seat_displacement * 1e3:.2f} mm and "
                 f"{np.degrees(self.seat_rotation):.2f} deg from the plan, "
-                f"moving at {self.seat_speed * 1e3:.3g} mm/s, then at most "
-                f"{self.max_displacement_from_seat * 1e3:.2f} mm and "
-                f"{np.degrees(self.max_rotation_from_seat):.2f} deg from there"
+                f"moving at {self.seat_speed * 1e3:.3g} mm/s"
+                + (
+                    ""
+                    if np.isnan(self.max_displacement_from_seat)  # an older record
+                    else (
+                        f", then at most {self.max_displacement_from_seat * 1e3:.2f}"
+                        f" mm and {np.degrees(self.max_rotation_from_seat):.2f} deg "
+                        "from there"
+                    )
+                )
             )
         )
         return (

@@ -224,3 +224,27 @@ def test_a_length_out_of_scale_is_named_in_the_input_before_connecting(grasps):
         batch_force_closure(
             P[:K], Nrm[:K], mu=mu[:K], characteristic_lengths=b, metrics=("isotropy",)
         )
+
+
+def test_an_iterator_of_metrics_reaches_every_partition(client, grasps):
+    """The early check read ``metrics`` and left the partitions an exhausted
+    iterator: the metric columns vanished without a word."""
+    P, Nrm, mu = grasps
+    K = 60
+    kw = dict(mu=mu[:K], chunk_size=10, partition_chunks=1, characteristic_lengths=0.5)
+    listed = evaluate_on_cluster(client, P[:K], Nrm[:K], metrics=["isotropy"], **kw)
+    once = evaluate_on_cluster(client, P[:K], Nrm[:K], metrics=iter(["isotropy"]), **kw)
+    assert list(once.metrics) == ["isotropy"]
+    np.testing.assert_array_equal(once.metrics["isotropy"], listed.metrics["isotropy"])
+
+
+def test_form_closure_on_a_cluster_refuses_epsilon_before_the_lengths(grasps):
+    """As locally: the metric form closure cannot give is named first."""
+    import drakegrasp as dg
+
+    P, Nrm, _ = grasps
+    with pytest.raises(dg.InvalidOptionError, match="'epsilon_l1' needs friction"):
+        evaluate_on_cluster(
+            "tcp://127.0.0.1:1", P[:20], Nrm[:20], kind="form",
+            characteristic_lengths=1e-15, metrics=["epsilon_l1"],
+        )  # fmt: skip

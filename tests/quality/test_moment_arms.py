@@ -204,3 +204,51 @@ def test_a_one_shot_iterator_of_metrics_serves_every_group():
     r = dg.batch_force_closure(P, N, mu=0.5, metrics=iter(["isotropy"]))
     listed = dg.batch_force_closure(P, N, mu=0.5, metrics=["isotropy"])
     np.testing.assert_array_equal(r.metrics["isotropy"], listed.metrics["isotropy"])
+
+
+def test_an_endless_iterator_of_metrics_is_refused_not_read_forever():
+    import itertools
+
+    g = dg.examples.equator_fingers(mu=0.5)
+    P, N = _stack()
+    ragged_P = [g.positions[:2], g.positions]
+    ragged_N = [g.normals[:2], g.normals]
+    for positions, normals in ((P, N), (ragged_P, ragged_N)):
+        with pytest.raises(dg.InvalidOptionError, match="more than 1024 names"):
+            dg.batch_force_closure(
+                positions, normals, mu=0.5, metrics=itertools.repeat("isotropy")
+            )
+
+
+def test_other_ragged_options_still_refuse_iterators():
+    """Only ``metrics`` is read from an iterator; ``mu=itertools.repeat(0.5)``
+    is refused at once, as on the stacked route (it was read forever when
+    every iterator option was materialised)."""
+    import itertools
+
+    g = dg.examples.equator_fingers(mu=0.5)
+    ragged_P = [g.positions[:2], g.positions]
+    ragged_N = [g.normals[:2], g.normals]
+    with pytest.raises(dg.InvalidContactError, match="mu"):
+        dg.batch_force_closure(ragged_P, ragged_N, mu=itertools.repeat(0.5))
+
+
+@pytest.mark.parametrize("rows", [0, -1, 2.5, "3"])
+def test_the_whole_batch_check_refuses_bad_rows(rows):
+    from drakegrasp.batch.metrics import check_moment_arms_of_batch
+
+    P, _ = _stack(7)
+    with pytest.raises(dg.InvalidOptionError, match="rows"):
+        check_moment_arms_of_batch(P, None, 1e-15, rows=rows)
+
+
+@pytest.mark.parametrize("rows", [1, 3, 6, 7, 8])
+def test_the_whole_batch_check_names_the_first_grasp_for_any_rows(rows):
+    from drakegrasp.batch.metrics import check_moment_arms_of_batch
+
+    P, _ = _stack(7)
+    b = np.ones(7)
+    b[[4, 6]] = 1e-15
+    with pytest.raises(dg.InvalidGraspError, match="grasp 4 is"):
+        check_moment_arms_of_batch(P, None, b, rows=rows)
+    check_moment_arms_of_batch(P[:0], None, 1e-15, rows=rows)  # K = 0

@@ -62,6 +62,7 @@ from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
 __all__ = [
+    "check_form_metrics",
     "finish",
     "force_chunk",
     "force_task",
@@ -432,6 +433,20 @@ def force_task(positions, mu, contact_model, num_generators, torsional_friction,
     return task, options
 
 
+def check_form_metrics(names: Sequence[str]) -> None:
+    """Refuse a metric form closure cannot give (ε needs friction).
+
+    Raises
+    ------
+    InvalidOptionError
+        ``epsilon_l1`` among ``names`` (checked metric names).
+    """
+    if "epsilon_l1" in names:
+        raise InvalidOptionError(
+            "metric 'epsilon_l1' needs friction; use batch_force_closure"
+        )
+
+
 def form_task(positions, reference_points, characteristic_lengths, tol, rank_tol,
                metrics, kernel):  # fmt: skip
     """Validate options once; return the chunk-task builder of LP1 and options."""
@@ -442,10 +457,7 @@ def form_task(positions, reference_points, characteristic_lengths, tol, rank_tol
         "metrics": check_metrics(metrics),
         "kernel": resolve_kernel(kernel),
     }
-    if "epsilon_l1" in options["metrics"]:
-        raise InvalidOptionError(
-            "metric 'epsilon_l1' needs friction; use batch_force_closure"
-        )
+    check_form_metrics(options["metrics"])
     get_p = _reference_points(reference_points, K, d)
     get_b = _characteristic_lengths(characteristic_lengths, K)
 
