@@ -22,7 +22,7 @@ from drakegrasp.batch.inputs import (
 )
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import L1_MAX_POINTS, MOMENT_ARMS
-from drakegrasp.core.validation import LENGTH_MIN, real_array, safe_norm
+from drakegrasp.core.validation import outside_moment_arms, real_array, safe_norm
 from drakegrasp.errors import GraspError, InvalidGraspError, InvalidOptionError
 
 __all__ = [
@@ -53,9 +53,7 @@ def _out_of_scale(P: np.ndarray, p, b) -> tuple[np.ndarray, np.ndarray]:
     p = np.broadcast_to(p, (k, d))
     b = np.broadcast_to(np.asarray(b, dtype=float), (k,))
     extent = np.max(safe_norm(P - p[:, None, :], axis=-1), axis=-1)
-    low, high = MOMENT_ARMS
-    bad = (extent >= LENGTH_MIN) & ~((low * b <= extent) & (extent <= high * b))
-    return bad, extent
+    return outside_moment_arms(extent, b), extent
 
 
 def _refuse_out_of_scale(index: int, b: float, extent: float) -> None:

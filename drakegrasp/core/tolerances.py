@@ -68,7 +68,8 @@ at 1e-12).  The planner (``planning.checks``, its extent the largest absolute
 coordinate of a contact in the object's frame), the quality metrics
 (``quality._common``) and the batch engine's metrics (``batch.metrics``, both
 with the largest distance from the reference point to a contact) check against
-this one range.  The closure verdicts take any length.
+this one range, through :func:`drakegrasp.core.validation.outside_moment_arms`.
+The closure verdicts take any length.
 """
 
 

@@ -55,6 +55,7 @@ import sys
 
 import numpy as np
 
+from drakegrasp.core.tolerances import MOMENT_ARMS
 from drakegrasp.errors import (
     InvalidContactError,
     InvalidGraspError,
@@ -88,6 +89,7 @@ __all__ = [
     "checked_fields",
     "describe",
     "integer_or_none",
+    "outside_moment_arms",
     "real_array",
     "real_scalar",
     "safe_norm",
@@ -242,6 +244,36 @@ def _short(a: np.ndarray) -> str:
     if a.size <= 6:
         return str(a.tolist())
     return f"(shape {a.shape})"
+
+
+def outside_moment_arms(extent, length) -> np.ndarray:
+    """Where a grasp's extent over a length leaves the range ``MOMENT_ARMS``.
+
+    The one rule of every metric that divides moments by a length (an explicit
+    ``torque_scale`` or a characteristic length): the quality metrics, the
+    batch engine's metrics and the planner's torque scale.
+
+    Parameters
+    ----------
+    extent : float or (k,) float
+        Each grasp's extent, metres (how it is measured is the caller's).
+    length : float or (k,) float
+        The length its moments are divided by, metres.
+
+    Returns
+    -------
+    bool or (k,) bool
+        True where ``extent / length`` lies outside
+        :data:`~drakegrasp.core.tolerances.MOMENT_ARMS`; never for an extent
+        below :data:`LENGTH_MIN` (every contact at the reference point: any
+        length does).
+    """
+    low, high = MOMENT_ARMS
+    extent = np.asarray(extent, dtype=float)
+    length = np.asarray(length, dtype=float)
+    return (extent >= LENGTH_MIN) & ~(
+        (low * length <= extent) & (extent <= high * length)
+    )
 
 
 def safe_norm(a: np.ndarray, axis: int = -1) -> np.ndarray:

@@ -264,7 +264,6 @@ def evaluate_on_cluster(
         return [results[j] for j in sorted(results)]
     chunks = ((sl, results[j]) for j, sl, _ in futures)
     tol = float(options.get("tol", DEFAULT_TOL))
-    names = check_metrics(options.get("metrics", ()))
     return collect(K, d, kind, tol, names, chunks)
 
 

@@ -12,12 +12,12 @@ import numpy as np
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.tolerances import MOMENT_ARMS
 from drakegrasp.core.validation import (
-    LENGTH_MIN,
     check_coefficient,
     check_length,
     check_positions,
     describe,
     integer_or_none,
+    outside_moment_arms,
     real_array,
     real_scalar,
     unit_vectors,
@@ -142,12 +142,10 @@ def checked_torque_scale(torque_scale, positions: np.ndarray) -> float:
     if positions.size == 0:
         return torque_scale
     reach = np.max(np.abs(positions), axis=(1, 2))  # (K,) each grasp's extent
-    low, high = MOMENT_ARMS
-    off = (reach >= LENGTH_MIN) & ~(
-        (reach >= low * torque_scale) & (reach <= high * torque_scale)
-    )
+    off = outside_moment_arms(reach, torque_scale)
     if off.any():
         k = int(np.flatnonzero(off)[0])
+        low, high = MOMENT_ARMS
         raise InvalidOptionError(
             f"torque_scale = {torque_scale:g} m is out of scale with grasp {k}, "
             f"whose contacts lie within {reach[k]:g} m of O: the moments divided "

@@ -6,7 +6,12 @@ import numpy as np
 
 from drakegrasp.core.grasp import Grasp, grasp_matrix
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, MOMENT_ARMS
-from drakegrasp.core.validation import LENGTH_MIN, check_grasp, check_length, safe_norm
+from drakegrasp.core.validation import (
+    check_grasp,
+    check_length,
+    outside_moment_arms,
+    safe_norm,
+)
 from drakegrasp.errors import InvalidOptionError
 
 RANK_TOL = DEFAULT_RANK_TOL
@@ -56,8 +61,8 @@ def _torque_scale(grasp: Grasp, torque_scale: float | None) -> float:
             "characteristic length"
         )
     extent = grasp_extent(grasp)
-    low, high = MOMENT_ARMS
-    if extent >= LENGTH_MIN and not (low * b <= extent <= high * b):
+    if outside_moment_arms(extent, b):
+        low, high = MOMENT_ARMS
         raise InvalidOptionError(
             f"{name} = {b:g} m is out of scale with the grasp, whose contacts "
             f"lie within {extent:g} m of its reference point: the extent over "

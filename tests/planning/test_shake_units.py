@@ -128,3 +128,41 @@ def test_a_model_drake_refuses_to_advance_is_a_model_error_not_advice_on_gains()
         shake_test(hydroelastic, best, squeeze=5.0, **SHORT)
     assert "stiffness" not in str(info.value)
     assert "\n" not in str(info.value)
+
+
+def test_seat_speed_tells_a_squeeze_that_pushes_out_from_one_that_holds(
+    drake_models_dir,
+):
+    """The Allegro hand on the YCB sugar box (``mu=1``, seed 0): the squeeze
+    alone pushes its best thumbless candidate out of the hand (an independent
+    seat-only simulation measured 0.15-0.28 m/s), and seats its best candidate
+    with the thumb.  ``seat_speed`` of the object (not of the welded hand,
+    which never moves) tells them apart by far."""
+    allegro = (
+        "package://drake_models/allegro_hand_description/sdf/"
+        "allegro_hand_description_right.sdf"
+    )
+    scene = planning_scene(
+        "package://drake_models/ycb/004_sugar_box.sdf",
+        hand_url=allegro,
+        models_dir=drake_models_dir,
+    )
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    scene.plant.GetJointByName("joint_12").set_angle(ctx, 1.0)  # thumb opposed
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=150, mu=1.0, seed=0,
+    )  # fmt: skip
+    thumb = ("link_12", "link_13", "link_14", "link_15")
+
+    def has_thumb(c) -> bool:
+        return any(k.finger_body.split("::")[-1].startswith(thumb) for k in c.contacts)
+
+    closures = [c for c in result if c.is_closure]
+    with_thumb = next(c for c in closures if has_thumb(c))
+    thumbless = next(c for c in closures if not has_thumb(c))
+    gains = dict(squeeze=0.7, stiffness=10.0, damping=0.1, **{**SHORT, "seat": 0.1})
+    held = shake_test(scene.add_models, with_thumb, **gains)
+    pushed = shake_test(scene.add_models, thumbless, **gains)
+    assert pushed.seat_speed > 0.1  # m/s, still on its way out
+    assert pushed.seat_speed > 5.0 * held.seat_speed
