@@ -13,7 +13,9 @@ rejects colliding poses and closes the fingers with Drake's distance queries
 (:mod:`~drakegrasp.planning.ranking`, :mod:`~drakegrasp.planning.weight`,
 :mod:`~drakegrasp.planning.motors`);
 the results are :mod:`~drakegrasp.planning.candidates`, and
-:mod:`~drakegrasp.planning.shake` checks them in a Drake simulation.  This
+:mod:`~drakegrasp.planning.shake` checks them in a Drake simulation
+(:mod:`~drakegrasp.planning.shake_ranking`: the best ones, those that held
+first).  This
 folder imports the plant, quality, batch and closure layers; nothing inside
 the package imports it except the command line.
 """
@@ -28,6 +30,7 @@ _SOURCES = {
     "drakegrasp.planning.planner": ("REASONS", "object_surface", "plan_grasps"),
     "drakegrasp.planning.scenes": ("PlanningScene", "planning_scene"),
     "drakegrasp.planning.shake": ("ShakeResult", "shake_test"),
+    "drakegrasp.planning.shake_ranking": ("ShakenCandidates", "shake_candidates"),
     "drakegrasp.planning.surface": ("ObjectSurface",),
 }
 
@@ -44,6 +47,7 @@ _SUBMODULES = (
     "ranking",
     "scenes",
     "shake",
+    "shake_ranking",
     "surface",
     "weight",
 )
@@ -61,11 +65,13 @@ __all__ = [
     "ParallelJaw",
     "PlanningScene",
     "ShakeResult",
+    "ShakenCandidates",
     "hand_is_parallel_jaw",
     "multi_finger_hand",
     "object_surface",
     "parallel_jaw",
     "plan_grasps",
     "planning_scene",
+    "shake_candidates",
     "shake_test",
 ]

@@ -24,6 +24,7 @@ seeds), so the counts are reproducible.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import math
 import os
 import signal
@@ -1335,6 +1336,59 @@ CANDIDATE_POOLS = {
 """Hostile fields of a planned candidate (flat jaw: two closing joints)."""
 
 
+SHAKEN_POOLS = {
+    "top": [0, -1, True, 1.5, "3", None, 10**4 + 1, NAN],
+    "held_from": ["x", None, 0, "SEAT"],
+    "stiffnes": [1.0],  # a misspelt shake_test option
+}
+"""Hostile values of :func:`drakegrasp.shake_candidates`' own options."""
+
+
+def _shake_candidates_cases(scene, best) -> Iterator[Case]:
+    """``shake_candidates``: refused before any simulation, or a bounded answer."""
+    for option, values in {**SHAKE_POOLS, **SHAKEN_POOLS}.items():
+        for i, value in enumerate(values):
+            yield Case(
+                "planning",
+                f"shake_candidates {option}={_short(value)}#{i}",
+                lambda o=option, v=value: dg.shake_candidates(
+                    scene.add_models, [best], **{o: v}
+                ),
+                "refuse",
+            )
+    for i, candidates in enumerate(["abc", None, 3.5, best, [best, "x"], [{}]]):
+        yield Case(
+            "planning",
+            f"shake_candidates candidates={_short(candidates)}#{i}",
+            lambda c=candidates: dg.shake_candidates(scene.add_models, c),
+            "refuse",
+        )
+    # Bad options are refused even when there is nothing to shake.
+    yield Case(
+        "planning",
+        "shake_candidates squeeze=-1 on no candidates",
+        lambda: dg.shake_candidates(scene.add_models, [], squeeze=-1.0),
+        "refuse",
+    )
+    # An endless iterator is read top deep, not forever.
+    yield Case(
+        "planning",
+        "shake_candidates endless iterator top=1",
+        lambda: dg.shake_candidates(
+            scene.add_models,
+            itertools.repeat(best),
+            top=1,
+            settle=0.05,
+            phase=0.05,
+            blend=0.02,
+            seat=0.05,
+            directions=[(1, 0, 0)],
+        ),  # fmt: skip
+        "answer",
+        lambda r: len(r) == 1 and r[0].result is not None,
+    )
+
+
 def _shake_cases(scene) -> Iterator[Case]:
     """``shake_test`` refusals (before any simulation) on the scene's best grasp."""
     best = dg.plan_grasps(
@@ -1361,6 +1415,7 @@ def _shake_cases(scene) -> Iterator[Case]:
             lambda m=models, c=candidate: dg.shake_test(m, c),
             "refuse",
         )
+    yield from _shake_candidates_cases(scene, best)
     # Valid directions that once made NaN gravity (a raw RuntimeError from
     # Drake): a norm that overflows, and a blend from the settling -z to +z.
     for name, kw in {

@@ -4,6 +4,7 @@ fingers of a parallel jaw, N·m for the revolute joints of a multi-finger hand."
 from __future__ import annotations
 
 import pytest
+from allegro_support import allegro_scene, has_thumb
 
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.shake import ShakeResult
@@ -138,26 +139,11 @@ def test_seat_speed_tells_a_squeeze_that_pushes_out_from_one_that_holds(
     seat-only simulation measured 0.15-0.28 m/s), and seats its best candidate
     with the thumb.  ``seat_speed`` of the object (not of the welded hand,
     which never moves) tells them apart by far."""
-    allegro = (
-        "package://drake_models/allegro_hand_description/sdf/"
-        "allegro_hand_description_right.sdf"
-    )
-    scene = planning_scene(
-        "package://drake_models/ycb/004_sugar_box.sdf",
-        hand_url=allegro,
-        models_dir=drake_models_dir,
-    )
-    ctx = scene.plant.GetMyContextFromRoot(scene.context)
-    scene.plant.GetJointByName("joint_12").set_angle(ctx, 1.0)  # thumb opposed
+    scene = allegro_scene("004_sugar_box", drake_models_dir)
     result = plan_grasps(
         scene.plant, scene.context, scene.object_body, hand=scene.hand,
         num_candidates=150, mu=1.0, seed=0,
     )  # fmt: skip
-    thumb = ("link_12", "link_13", "link_14", "link_15")
-
-    def has_thumb(c) -> bool:
-        return any(k.finger_body.split("::")[-1].startswith(thumb) for k in c.contacts)
-
     closures = [c for c in result if c.is_closure]
     with_thumb = next(c for c in closures if has_thumb(c))
     thumbless = next(c for c in closures if not has_thumb(c))

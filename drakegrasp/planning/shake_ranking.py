@@ -1,0 +1,323 @@
+r"""Ranking by physics: the planner's best candidates shaken, those that held first.
+
+The planner ranks from the planned contacts (closure, ε, robustness, the
+weight held per newton of squeeze).  What it does not see is what a hand's
+closing motion does to the object once the fingers meet it: the Allegro
+hand's thumbless grasps of the YCB sugar box are force closure and rank high,
+and the squeeze alone pushes the box out of the hand (the planning guide,
+"What the ranking does not see").  :func:`shake_candidates` runs
+:func:`~drakegrasp.planning.shake.shake_test` on the first ``top`` candidates
+and re-orders them: those that held, in the planner's order, then those that
+dropped, then those Drake could not simulate, each with its
+:class:`~drakegrasp.planning.shake.ShakeResult` or the error's one line.
+
+"Held" is :attr:`~drakegrasp.planning.shake.ShakeResult.held_from_seat` by
+default (``held_from="seat"``): the object stays within the bounds of where
+the fingers seated it, which is what holding means for a hand whose fingers do
+not stop where the plan put them; ``held_from="plan"`` counts from the planned
+pose (``ShakeResult.held``).
+"""
+
+from __future__ import annotations
+
+import inspect
+import itertools
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
+from drakegrasp.planning.candidates import (
+    GraspCandidate,
+    GraspCandidates,
+    check_candidate,
+    pose_dict,
+)
+from drakegrasp.planning.shake import ShakeResult, check_shake_options, shake_test
+from drakegrasp.plant.validation import check_rigid_transform
+
+__all__ = ["HELD_FROM", "ShakenCandidate", "ShakenCandidates", "shake_candidates"]
+
+HELD_FROM = ("seat", "plan")
+"""What "held" counts from: where seating left the object, or the planned pose."""
+
+_OPTIONS = {
+    name: p.default
+    for name, p in inspect.signature(shake_test).parameters.items()
+    if p.kind is inspect.Parameter.KEYWORD_ONLY
+}
+"""``shake_test``'s keyword options and their defaults (one source: its signature)."""
+
+
+@dataclass(frozen=True, eq=False)
+class ShakenCandidate:
+    """One candidate and what the shake test made of it.
+
+    Attributes
+    ----------
+    candidate : GraspCandidate
+    planned_rank : int
+        Its place in the planner's order (0: the planner's best).
+    result : ShakeResult or None
+        The simulation's figures; None when Drake could not simulate it.
+    held : bool
+        Whether it held, counted as ``held_from`` says (False when not
+        simulated).
+    error : str
+        Why Drake could not simulate it (its ``SolverError``, one line);
+        empty otherwise.
+    """
+
+    candidate: GraspCandidate
+    planned_rank: int
+    result: ShakeResult | None
+    held: bool
+    error: str = ""
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {
+            "planned_rank": self.planned_rank,
+            "held": self.held,
+            "error": self.error,
+            "result": None if self.result is None else self.result.to_dict(),
+            "candidate": self.candidate.to_dict(),
+        }
+
+    def __str__(self) -> str:
+        if self.result is None:
+            return f"plan #{self.planned_rank}: not simulated ({self.error})"
+        r = self.result
+        seated = (
+            ""
+            if np.isnan(r.seat_displacement)
+            else (
+                f", seated {r.seat_displacement * 1e3:.1f} mm "
+                f"{np.degrees(r.seat_rotation):.1f} deg from the plan, then within "
+                f"{r.max_displacement_from_seat * 1e3:.1f} mm "
+                f"{np.degrees(r.max_rotation_from_seat):.1f} deg"
+            )
+        )
+        return (
+            f"plan #{self.planned_rank}: {'held' if self.held else 'dropped'} "
+            f"(at most {r.max_displacement * 1e3:.1f} mm "
+            f"{np.degrees(r.max_rotation):.1f} deg from the plan{seated})"
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class ShakenCandidates(Sequence):
+    """Shaken candidates: those that held first, each group in the planner's order.
+
+    A sequence of :class:`ShakenCandidate`.
+
+    Attributes
+    ----------
+    shaken : tuple of ShakenCandidate
+        Held (planner's order), then dropped (planner's order), then not
+        simulated (planner's order).
+    held_from : str
+        ``"seat"`` or ``"plan"``: what "held" counts from.
+    options : dict
+        The shake test's options, defaults filled in, for the record.
+    wall_time : float
+        Seconds.
+    """
+
+    shaken: tuple[ShakenCandidate, ...]
+    held_from: str
+    options: dict
+    wall_time: float
+
+    def __getitem__(self, index):
+        return self.shaken[index]
+
+    def __len__(self) -> int:
+        return len(self.shaken)
+
+    @property
+    def held(self) -> tuple[GraspCandidate, ...]:
+        """The candidates that held, in the planner's order."""
+        return tuple(s.candidate for s in self.shaken if s.held)
+
+    @property
+    def best(self) -> GraspCandidate | None:
+        """The planner's best candidate among those that held (None: none held)."""
+        return self.shaken[0].candidate if self.shaken and self.shaken[0].held else None
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary."""
+        return {
+            "held_from": self.held_from,
+            "options": jsonable(self.options),
+            "wall_time": self.wall_time,
+            "shaken": [s.to_dict() for s in self.shaken],
+        }
+
+    def __str__(self) -> str:
+        n_held = sum(s.held for s in self.shaken)
+        lines = [
+            f"{n_held} of {len(self)} shaken candidates held (counted from the "
+            f"{self.held_from}; {self.wall_time:.1f} s)"
+        ]
+        lines += [f"  {s}" for s in self.shaken]
+        return "\n".join(lines)
+
+
+def _checked_top(top) -> int:
+    if (
+        isinstance(top, bool)
+        or not isinstance(top, int | np.integer)
+        or not 0 < int(top) <= 10_000
+    ):
+        raise InvalidOptionError(
+            f"top must be a whole number of candidates from 1 to 10000, got {top!r}"
+        )
+    return int(top)
+
+
+def _first_candidates(candidates, top: int) -> list[GraspCandidate]:
+    """The first ``top`` candidates (an endless iterator is read ``top`` deep)."""
+    if isinstance(candidates, GraspCandidate):
+        raise InvalidOptionError(
+            "candidates must be several candidates (plan_grasps' result or a "
+            "list); for one, call shake_test"
+        )
+    if not isinstance(candidates, Iterable) or isinstance(candidates, str | bytes):
+        raise InvalidOptionError(
+            "candidates must be plan_grasps' result or a sequence of "
+            f"GraspCandidate, got {type(candidates).__name__}"
+        )
+    chosen = list(itertools.islice(candidates, top))
+    for k, c in enumerate(chosen):
+        if not isinstance(c, GraspCandidate):
+            raise InvalidOptionError(
+                f"candidates[{k}] must be a GraspCandidate from plan_grasps, got "
+                f"{type(c).__name__}"
+            )
+        try:  # all of them before any is simulated: no run lost at the fifth
+            check_candidate(c)
+        except InvalidGraspError as e:
+            raise InvalidGraspError(f"candidates[{k}]: {e}") from e
+    return chosen
+
+
+def _recorded(settings: dict) -> dict:
+    """The options as JSON can hold them: a pose as its dictionary, a body by name."""
+    out = dict(settings)
+    if out["X_WO"] is not None:
+        out["X_WO"] = pose_dict(out["X_WO"])
+    body = out["object_body"]
+    if body is not None and not isinstance(body, str | int | np.integer):
+        out["object_body"] = (
+            body.name() if callable(getattr(body, "name", None)) else (repr(body))
+        )
+    return out
+
+
+def shake_candidates(
+    add_models: Callable,
+    candidates: GraspCandidates | Sequence[GraspCandidate],
+    *,
+    top: int = 10,
+    held_from: str = "seat",
+    **options,
+) -> ShakenCandidates:
+    """Shake the planner's best candidates in Drake; put those that held first.
+
+    Parameters
+    ----------
+    add_models : callable
+        ``add_models(plant, parser) -> (hand, object_body)``, as for
+        :func:`~drakegrasp.planning.shake.shake_test` (a
+        :class:`~drakegrasp.planning.scenes.PlanningScene`'s ``add_models``).
+    candidates : GraspCandidates or sequence of GraspCandidate
+        Best first: :func:`~drakegrasp.planning.planner.plan_grasps`' result.
+    top : int, optional
+        How many of the first candidates to shake (default 10; fewer when
+        there are fewer), 1 to 10000.  Each is one simulation of
+        ``seat + settle + len(directions) * phase`` seconds (2.8 s of
+        simulated time at the defaults: about a second of wall time for the
+        Allegro hand at ``time_step=1e-3``).
+    held_from : {"seat", "plan"}, optional
+        What "held" counts from: where seating left the object (default; a
+        multi-finger hand seats it a few millimetres from the plan and holds
+        it there), or the planned pose.
+    **options
+        :func:`~drakegrasp.planning.shake.shake_test`'s keyword options
+        (``squeeze``, ``stiffness``, ``damping``, ``directions``, the phases,
+        the bounds, ``object_body``, ``X_WO``), the same for every candidate;
+        checked before anything is simulated.  Light revolute fingers need
+        light gains (the Allegro hand: ``squeeze=0.7, stiffness=10,
+        damping=0.1``).
+
+    Returns
+    -------
+    ShakenCandidates
+        The shaken candidates: held, then dropped, then those Drake could not
+        simulate (a ``SolverError`` for that candidate is recorded, one line,
+        and the others are still shaken); each group in the planner's order.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``top`` not a whole number from 1 to 10000, ``held_from`` not one of
+        :data:`HELD_FROM`, an option ``shake_test`` does not take, or one it
+        refuses (before any simulation), or ``candidates`` that are not
+        candidates.
+    InvalidGraspError
+        A candidate whose joint values or poses are not finite or do not
+        match its joints, named by its place (all are checked before any is
+        simulated).
+    ModelError
+        As :func:`~drakegrasp.planning.shake.shake_test` raises it: a model
+        that does not match the candidates (the first one's error: the others
+        would share it).
+    """
+    if not callable(add_models):
+        raise InvalidOptionError(
+            "add_models must be a function add_models(plant, parser) -> (hand, "
+            f"object_body), got {type(add_models).__name__}"
+        )
+    top = _checked_top(top)
+    if held_from not in HELD_FROM:
+        raise InvalidOptionError(
+            f"held_from must be one of {', '.join(HELD_FROM)}, got {held_from!r}"
+        )
+    unknown = sorted(set(options) - set(_OPTIONS))
+    if unknown:
+        raise InvalidOptionError(
+            f"shake_test takes no option {', '.join(unknown)} (it takes "
+            f"{', '.join(sorted(_OPTIONS))})"
+        )
+    settings = {**_OPTIONS, **options}
+    check_shake_options(
+        **{k: v for k, v in settings.items() if k not in ("object_body", "X_WO")}
+    )
+    if settings["X_WO"] is not None:
+        check_rigid_transform("X_WO", settings["X_WO"])
+    chosen = _first_candidates(candidates, top)
+    t0 = time.perf_counter()
+    shaken = []
+    for k, c in enumerate(chosen):
+        try:
+            result = shake_test(add_models, c, **options)
+        except SolverError as e:
+            shaken.append(ShakenCandidate(c, k, None, False, str(e)))
+            continue
+        held = result.held_from_seat if held_from == "seat" else result.held
+        shaken.append(ShakenCandidate(c, k, result, bool(held)))
+
+    def group(s: ShakenCandidate) -> int:
+        return 0 if s.held else (1 if s.result is not None else 2)
+
+    shaken.sort(key=lambda s: (group(s), s.planned_rank))
+    return ShakenCandidates(
+        shaken=tuple(shaken),
+        held_from=held_from,
+        options=_recorded(settings),
+        wall_time=time.perf_counter() - t0,
+    )
