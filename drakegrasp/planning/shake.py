@@ -27,8 +27,11 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
   at a constant rate along the great circle through them, about an axis
   perpendicular to both when they are opposite, so its magnitude stays
   ``m g``);
-- contact, friction and stiffness are the plant's (point contact, the models'
-  proximity properties).
+- contact, friction and stiffness are the plant's (the models' proximity
+  properties: point contact where they declare no hydroelastic ones), or with
+  ``hydroelastic_modulus`` the hand's geometries are made compliant
+  hydroelastic and the object's rigid (:mod:`drakegrasp.plant.hydroelastic`),
+  so that a flat pad presses over a patch instead of at one point.
 
 The object *holds* when its pose in the hand frame never moves more than
 ``max_displacement`` (metres) or ``max_rotation`` (radians) from the planned
@@ -58,7 +61,11 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import unit_vectors
 from drakegrasp.errors import GraspError, InvalidOptionError, ModelError, SolverError
 from drakegrasp.planning.candidates import GraspCandidate, check_candidate
-from drakegrasp.plant.load import effort_unit
+from drakegrasp.plant.fingers import effort_unit
+from drakegrasp.plant.hydroelastic import (
+    check_hydroelastic_modulus,
+    use_hydroelastic_contact,
+)
 from drakegrasp.plant.validation import (
     check_rigid_transform,
     resolve_body,
@@ -141,6 +148,9 @@ class ShakeResult:
         so a multi-finger hand that seats the object 10 mm away from it is
         "dropped" whatever follows; these say whether the seated grasp then
         held still.
+    hydroelastic_modulus : float or None
+        The modulus (Pa) of the hand's compliant hydroelastic geometries, or
+        None: the contact the models declare.
     """
 
     held: bool
@@ -159,6 +169,7 @@ class ShakeResult:
     seat_speed: float = float("nan")
     max_displacement_from_seat: float = float("nan")
     max_rotation_from_seat: float = float("nan")
+    hydroelastic_modulus: float | None = None
 
     @property
     def held_from_seat(self) -> bool:
@@ -215,8 +226,13 @@ class ShakeResult:
             f"{np.degrees(self.bounds[1]):g} deg)"
             f" over {self.duration:g} s, squeeze {self.squeeze:g} "
             f"{_squeeze_unit(self.effort_units)}, "
-            f"{len(self.phases)} gravity directions; {self.wall_time:.2f} s wall"
-            f"{seated}"
+            f"{len(self.phases)} gravity directions"
+            + (
+                ""
+                if self.hydroelastic_modulus is None
+                else f", hydroelastic fingers ({self.hydroelastic_modulus:g} Pa)"
+            )
+            + f"; {self.wall_time:.2f} s wall{seated}"
         )
 
 
@@ -350,6 +366,7 @@ def check_shake_options(
     time_step,
     max_displacement,
     max_rotation,
+    hydroelastic_modulus=None,
 ) -> np.ndarray:
     """Check :func:`shake_test`'s options before anything is simulated.
 
@@ -357,7 +374,7 @@ def check_shake_options(
     ----------
     squeeze, stiffness, damping, directions, settle, phase, seat, blend
         As :func:`shake_test` takes them.
-    time_step, max_displacement, max_rotation
+    time_step, max_displacement, max_rotation, hydroelastic_modulus
         As :func:`shake_test` takes them.
 
     Returns
@@ -370,8 +387,10 @@ def check_shake_options(
     InvalidOptionError
         The first option that is not a finite number in its range (naming it
         and its unit), a time step longer than a tenth of a phase, or
-        directions that are not finite non-zero 3-vectors.
+        directions that are not finite non-zero 3-vectors, or a
+        ``hydroelastic_modulus`` that is neither None nor a finite number > 0.
     """
+    check_hydroelastic_modulus(hydroelastic_modulus)
     for name, value, low, unit in (
         ("squeeze", squeeze, 0.0, "N, or N·m for revolute joints"),
         ("stiffness", stiffness, 0.0, "N/m or N·m/rad"),
@@ -439,6 +458,7 @@ def shake_test(
     max_rotation: float = np.radians(10.0),
     object_body=None,
     X_WO: RigidTransform | None = None,
+    hydroelastic_modulus: float | None = None,
 ) -> ShakeResult:
     """Simulate a planned grasp in Drake and report whether the object stays put.
 
@@ -488,6 +508,15 @@ def shake_test(
         there (its centroid or, completed, its centre of symmetry, with the
         world's axes), not the object's: give the true pose of the object the
         cloud was taken from.
+    hydroelastic_modulus : float or None, optional
+        None (default): the contact the models declare (Drake's point contact
+        where they declare no hydroelastic properties: one point per pair of
+        geometries, so a flat pad on a flat face touches at one point and the
+        object pivots between two such pads).  A modulus (Pa, finite > 0):
+        the hand's collision geometries are made compliant hydroelastic with
+        it and the object's rigid, so each pad presses over a patch, as it
+        does on a real object (:mod:`drakegrasp.plant.hydroelastic`; 1e6 suits
+        rubber pads).
 
     Returns
     -------
@@ -527,13 +556,16 @@ def shake_test(
         squeeze=squeeze, stiffness=stiffness, damping=damping,
         directions=directions, settle=settle, phase=phase, seat=seat,
         blend=blend, time_step=time_step, max_displacement=max_displacement,
-        max_rotation=max_rotation,
+        max_rotation=max_rotation, hydroelastic_modulus=hydroelastic_modulus,
     )  # fmt: skip
+    modulus = check_hydroelastic_modulus(hydroelastic_modulus)
     t0 = time.perf_counter()
     from pydrake.multibody.parsing import Parser
 
     builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=float(time_step))
+    plant, scene_graph = AddMultibodyPlantSceneGraph(
+        builder, time_step=float(time_step)
+    )
     hand, obj = add_models(plant, Parser(plant))
     if object_body is not None:
         obj = object_body
@@ -551,8 +583,15 @@ def shake_test(
         actuator.set_controller_gains(PdControllerGains(p=stiffness, d=damping))
     plant.WeldFrames(plant.world_frame(), base.body_frame(), candidate.X_WH)
     plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
-    plant.Finalize()
     body = resolve_object_body(plant, obj)
+    if modulus is not None:  # the hand: the bodies of its base's model instance
+        hand_bodies = [
+            plant.get_body(i) for i in plant.GetBodyIndices(base.model_instance())
+        ]
+        use_hydroelastic_contact(
+            plant, scene_graph, hand_bodies, [body], modulus=modulus
+        )
+    plant.Finalize()
     schedule = _schedule(seat, settle, phase, blend, dirs)
     gravity = builder.AddSystem(
         _TurnedGravity(body.index(), body.default_mass(), body.default_com(), schedule)
@@ -658,4 +697,5 @@ def shake_test(
         seat_speed=seated[2],
         max_displacement_from_seat=max_ds,
         max_rotation_from_seat=max_rs,
+        hydroelastic_modulus=modulus,
     )

@@ -159,9 +159,11 @@ class ShakenCandidates(Sequence):
 
     def __str__(self) -> str:
         n_held = sum(s.held for s in self.shaken)
+        modulus = self.options.get("hydroelastic_modulus")
+        fingers = "" if modulus is None else f"hydroelastic fingers, {modulus:g} Pa; "
         lines = [
             f"{n_held} of {len(self)} shaken candidates held (counted from the "
-            f"{self.held_from}; {self.wall_time:.1f} s)"
+            f"{self.held_from}; {fingers}{self.wall_time:.1f} s)"
         ]
         lines += [f"  {s}" for s in self.shaken]
         return "\n".join(lines)
@@ -216,6 +218,46 @@ def _recorded(settings: dict) -> dict:
             body.name() if callable(getattr(body, "name", None)) else (repr(body))
         )
     return out
+
+
+def check_settings(top, held_from, options: dict) -> dict:
+    """Check :func:`shake_candidates`' settings; return the options, defaults filled in.
+
+    Parameters
+    ----------
+    top, held_from
+        As :func:`shake_candidates` takes them.
+    options : dict
+        Keyword options of :func:`~drakegrasp.planning.shake.shake_test`.
+
+    Returns
+    -------
+    dict
+        Every keyword option of ``shake_test``: ``options`` over its defaults.
+
+    Raises
+    ------
+    InvalidOptionError
+        As :func:`shake_candidates` raises it for its settings.
+    """
+    _checked_top(top)
+    if held_from not in HELD_FROM:
+        raise InvalidOptionError(
+            f"held_from must be one of {', '.join(HELD_FROM)}, got {held_from!r}"
+        )
+    unknown = sorted(set(options) - set(_OPTIONS))
+    if unknown:
+        raise InvalidOptionError(
+            f"shake_test takes no option {', '.join(unknown)} (it takes "
+            f"{', '.join(sorted(_OPTIONS))})"
+        )
+    settings = {**_OPTIONS, **options}
+    check_shake_options(
+        **{k: v for k, v in settings.items() if k not in ("object_body", "X_WO")}
+    )
+    if settings["X_WO"] is not None:
+        check_rigid_transform("X_WO", settings["X_WO"])
+    return settings
 
 
 def shake_candidates(
@@ -282,24 +324,8 @@ def shake_candidates(
             "add_models must be a function add_models(plant, parser) -> (hand, "
             f"object_body), got {type(add_models).__name__}"
         )
-    top = _checked_top(top)
-    if held_from not in HELD_FROM:
-        raise InvalidOptionError(
-            f"held_from must be one of {', '.join(HELD_FROM)}, got {held_from!r}"
-        )
-    unknown = sorted(set(options) - set(_OPTIONS))
-    if unknown:
-        raise InvalidOptionError(
-            f"shake_test takes no option {', '.join(unknown)} (it takes "
-            f"{', '.join(sorted(_OPTIONS))})"
-        )
-    settings = {**_OPTIONS, **options}
-    check_shake_options(
-        **{k: v for k, v in settings.items() if k not in ("object_body", "X_WO")}
-    )
-    if settings["X_WO"] is not None:
-        check_rigid_transform("X_WO", settings["X_WO"])
-    chosen = _first_candidates(candidates, top)
+    settings = check_settings(top, held_from, options)
+    chosen = _first_candidates(candidates, int(top))
     t0 = time.perf_counter()
     shaken = []
     for k, c in enumerate(chosen):

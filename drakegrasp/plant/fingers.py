@@ -50,6 +50,7 @@ __all__ = [
     "Finger",
     "HandStructure",
     "MAX_STEP",
+    "effort_unit",
     "find_joint",
     "hand_structure",
     "tip_bodies",
@@ -57,6 +58,18 @@ __all__ = [
 
 MAX_STEP = {"revolute": 0.2, "prismatic": 0.01}
 """Largest change of any joint of a finger in one closing step: radians, metres."""
+
+
+def effort_unit(joint, k: int = 0) -> str:
+    """Unit of the generalized force along ``joint``'s velocity ``k``.
+
+    Drake names each velocity by its kind (``velocity_suffix``): an angular
+    one (``w``, ``wx``...: a revolute joint, a floating base's rotation)
+    carries a torque in N·m, a linear one (``v``, ``vx``...: a prismatic
+    joint, a floating base's translation) a force in N; "" for another.
+    """
+    return {"w": "N·m", "v": "N"}.get(joint.velocity_suffix(k)[:1], "")
+
 
 _KEPT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 """Finalized plant -> {(object, bodies, couplings): (proximity version, recipe)}.

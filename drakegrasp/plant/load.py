@@ -34,6 +34,7 @@ from drakegrasp.closure.payload import MaxLoadResult, max_load
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.plant.fingers import effort_unit
 from drakegrasp.plant.friction import (
     friction_disagreement,
     friction_rule,
@@ -48,7 +49,6 @@ from drakegrasp.plant.validation import (
 __all__ = [
     "LoadReport",
     "analyze_load",
-    "effort_unit",
     "load_section",
     "gravity_wrench",
     "plant_torque_limits",
@@ -245,17 +245,6 @@ class LoadReport:
 
     def __str__(self) -> str:
         return "\n".join(self.report_lines())
-
-
-def effort_unit(joint, k: int = 0) -> str:
-    """Unit of the generalized force along ``joint``'s velocity ``k``.
-
-    Drake names each velocity by its kind (``velocity_suffix``): an angular
-    one (``w``, ``wx``...: a revolute joint, a floating base's rotation)
-    carries a torque in N·m, a linear one (``v``, ``vx``...: a prismatic
-    joint, a floating base's translation) a force in N; "" for another.
-    """
-    return {"w": "N·m", "v": "N"}.get(joint.velocity_suffix(k)[:1], "")
 
 
 def _velocity_labels(

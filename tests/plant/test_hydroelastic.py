@@ -1,0 +1,121 @@
+"""Hydroelastic fingers in the shake test: a flat pad presses over a patch.
+
+Drake's point contact gives a pad on a face one point, and the object pivots
+between two such points; hydroelastic pads hold it.  The properties are
+checked in the plant Drake builds (an independent route: SceneGraph's
+inspector), and the physics in the simulation itself.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydrake.geometry import Role
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, ContactModel
+from pydrake.systems.framework import DiagramBuilder
+
+import drakegrasp as dg
+from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.plant.hydroelastic import (
+    check_hydroelastic_modulus,
+    use_hydroelastic_contact,
+)
+
+JAW = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+BOX = "package://drakegrasp/objects/box.sdf"
+
+
+@pytest.fixture(scope="module")
+def jaw_on_box():
+    scene = dg.planning_scene(BOX, hand_url=JAW)
+    result = dg.plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=300, mu=0.5, seed=0,
+    )  # fmt: skip
+    return scene, result
+
+
+def _built(scene, modulus):
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=1e-3)
+    hand, name = scene.add_models(plant, Parser(plant))
+    model, _, body_name = name.rpartition("::")
+    body = plant.GetBodyByName(body_name, plant.GetModelInstanceByName(model))
+    hand_bodies = [plant.get_body(i) for i in plant.GetBodyIndices(hand)]
+    inspector = scene_graph.model_inspector()
+    friction = {}  # copied out: the properties are replaced below
+    for b in hand_bodies + [body]:
+        for g in plant.GetCollisionGeometriesForBody(b):
+            mu = inspector.GetProximityProperties(g).GetProperty(
+                "material", "coulomb_friction"
+            )
+            friction[g] = (mu.static_friction(), mu.dynamic_friction())
+    refused = use_hydroelastic_contact(
+        plant, scene_graph, hand_bodies, [body], modulus=modulus
+    )
+    return plant, scene_graph, hand_bodies, body, friction, refused
+
+
+def test_the_hand_becomes_compliant_and_the_object_rigid_friction_kept(jaw_on_box):
+    scene, _ = jaw_on_box
+    plant, sg, hand_bodies, body, friction, refused = _built(scene, 2.5e6)
+    assert refused == 0
+    assert plant.get_contact_model() == ContactModel.kHydroelasticWithFallback
+    inspector = sg.model_inspector()
+    for b, kind in [(b, "compliant") for b in hand_bodies] + [(body, "rigid")]:
+        for g in plant.GetCollisionGeometriesForBody(b):
+            props = inspector.GetProximityProperties(g)
+            assert props.HasGroup("hydroelastic"), inspector.GetName(g)
+            # only a compliant geometry has a modulus (pydrake cannot read the
+            # compliance type itself)
+            has_modulus = props.HasProperty("hydroelastic", "hydroelastic_modulus")
+            assert has_modulus is (kind == "compliant"), inspector.GetName(g)
+            if has_modulus:
+                modulus = props.GetProperty("hydroelastic", "hydroelastic_modulus")
+                assert modulus == 2.5e6
+            same = props.GetProperty("material", "coulomb_friction")
+            assert (same.static_friction(), same.dynamic_friction()) == friction[g]
+            assert inspector.GetProperties(g, Role.kProximity) is not None
+
+
+def test_a_finalized_plant_is_refused(jaw_on_box):
+    scene, _ = jaw_on_box
+    builder = DiagramBuilder()
+    plant, sg = AddMultibodyPlantSceneGraph(builder, time_step=1e-3)
+    scene.add_models(plant, Parser(plant))
+    plant.Finalize()
+    with pytest.raises(ModelError, match="not finalized"):
+        use_hydroelastic_contact(plant, sg, [], [], modulus=1e6)
+
+
+@pytest.mark.parametrize("value", [0.0, -1.0, np.nan, np.inf, "1e6", True, [1e6]])
+def test_a_modulus_that_is_not_positive_and_finite_is_refused(value):
+    with pytest.raises(InvalidOptionError, match="hydroelastic_modulus"):
+        check_hydroelastic_modulus(value)
+
+
+def test_flat_pads_pivot_in_point_contact_and_hold_as_patches(jaw_on_box):
+    """The physics, in Drake: at 20 N (nine times ``squeeze_needed``) point
+    contact lets the box pivot between the pads (most of the top 4 turn past
+    10 degrees); hydroelastic pads hold all four within a millimetre.  Below the
+    planner's ``squeeze_needed`` (0.5 N against 2.2 N) hydroelastic pads drop
+    every one: the patch does not hold what the squeeze cannot."""
+    scene, result = jaw_on_box
+    quick = dict(settle=0.2, phase=0.3, directions=[(1, 0, 0), (0, 1, 0)])
+    point = dg.shake_candidates(scene.add_models, result, top=4, **quick)
+    patch = dg.shake_candidates(
+        scene.add_models, result, top=4, hydroelastic_modulus=1e6, **quick
+    )
+    weak = dg.shake_candidates(
+        scene.add_models, result, top=4, hydroelastic_modulus=1e6, squeeze=0.5, **quick
+    )
+    assert max(c.squeeze_needed for c in result[:4]) < 20.0 / 5
+    assert min(c.squeeze_needed for c in result[:4]) > 0.5
+    assert sum(s.held for s in point) <= 2
+    assert all(s.held for s in patch)
+    assert max(s.result.max_displacement for s in patch) < 1e-3
+    assert not any(s.held for s in weak)
+    assert all(s.result.hydroelastic_modulus == 1e6 for s in patch)
+    assert all(s.result.hydroelastic_modulus is None for s in point)
+    assert "hydroelastic fingers (1e+06 Pa)" in str(patch[0].result)
