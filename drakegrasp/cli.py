@@ -20,6 +20,8 @@ Usage::
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
                     [--seed S] [--mu M|plant] [--mass KG] [--torque-limit NM]
                     [--preshape JOINT=VALUE ...]
+                    [--shake K [--squeeze X] [--stiffness K] [--damping D]
+                     [--hydroelastic PA|none]]
                     [--package NAME=DIR ...] [--allow-any-file] [--progress]
                     [--json | --out FILE.parquet [--overwrite]]
 
@@ -67,7 +69,12 @@ model URL or file, ``wsg`` for Drake's WSG-50, ``allegro`` for Drake's Allegro
 right hand with its thumb opposed; default drakegrasp's flat-pad jaw) in a
 scene of the two alone; ``--mass`` gives the object's mass,
 ``--torque-limit`` the torque a multi-finger hand will apply and
-``--preshape JOINT=VALUE`` its open shape.  ``--mu plant``
+``--preshape JOINT=VALUE`` its open shape, and ``--shake K`` shakes the
+first K candidates in a Drake simulation and lists them again, those that
+held first (:func:`~drakegrasp.planning.shake_ranking.shake_candidates`; the
+gains ``--squeeze``, ``--stiffness`` and ``--damping``, light ones by default
+for ``--hand allegro``; ``--hydroelastic`` compliant fingers, by default for
+drakegrasp's flat-pad jaws and the Allegro hand).  ``--mu plant``
 plans with the friction the plant gives the hand's and the object's geometries
 (the smallest, where pairs differ, said on stderr) instead of a number.
 ``plan --progress`` and ``batch --progress`` need the optional tqdm
@@ -485,6 +492,23 @@ def _strictly_positive(text: str) -> float:
     return _parsed(
         text, float, "a number", lambda x: 0.0 < x < float("inf"), "finite and > 0"
     )
+
+
+def _non_negative(text: str) -> float:
+    return _parsed(
+        text, float, "a number", lambda x: 0.0 <= x < float("inf"), "finite and >= 0"
+    )
+
+
+def _modulus(text: str) -> float | str:
+    if text.strip().lower() == "none":
+        return "none"
+    try:
+        return _strictly_positive(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(
+            f"expected a modulus in Pa (finite, > 0) or none, got {text!r}"
+        ) from None
 
 
 def _count(text: str) -> int:
@@ -908,6 +932,41 @@ gets 69 candidates, 10 in force closure, against 15 and 1 from the zero
 clipped to the limits; drakegrasp's box 58 and 2 against 15 and 0."""
 
 
+PLAN_SHAKE_DEFAULTS = {
+    "flat": {"hydroelastic_modulus": 1e6},
+    "rounded": {"hydroelastic_modulus": 1e6},
+    "allegro": {
+        "squeeze": 0.7,
+        "stiffness": 10.0,
+        "damping": 0.1,
+        "hydroelastic_modulus": 1e6,
+    },
+}
+"""``plan --shake``'s options for a hand alias (``plan``'s default hand is
+``flat``), where the shake test's defaults do not suit it; the flags override
+them.
+
+- Hydroelastic fingers (1e6 Pa, rubber): drakegrasp's jaws have flat pads,
+  which Drake's point contact touches at one point each, so the object pivots
+  between them: on the box, 1 of the top 6 held at 20 N with point contact, 6
+  of 6 with hydroelastic pads (``benchmarks/bench_pad_contact.py``).  The
+  Allegro hand's finger links are boxes too: its best sugar-box grasp held
+  with them and turned 17° with point contact.  The WSG-50 touches with tip
+  spheres and holds either way: the model's own contact.
+- The Allegro hand's gains: each closing joint presses with its effort limit,
+  0.7 N·m, at 10 N·m/rad and 0.1 N·m·s/rad; at the defaults (4000, 50)
+  Drake's SAP solver stopped on 2 of the top 10 sugar-box candidates
+  (``benchmarks/bench_allegro_squeeze.py``)."""
+
+SHAKE_FLAGS = {
+    "squeeze": "--squeeze",
+    "stiffness": "--stiffness",
+    "damping": "--damping",
+    "hydroelastic_modulus": "--hydroelastic",
+}
+"""``shake_test`` keywords that ``plan --shake`` sets from a flag, and that flag."""
+
+
 MODEL_SUFFIXES = (".sdf", ".urdf", ".xml")
 """File endings of the model files Drake's parser reads (``plan`` checks them)."""
 
@@ -977,7 +1036,11 @@ def _is_scene(target: str) -> bool:
 
 
 def _plan_setup(args: argparse.Namespace):
-    """(plant, context, object body, hand, options) of ``plan``'s target."""
+    """(plant, context, object body, hand, options, add_models) of ``plan``'s target.
+
+    ``add_models`` is the recipe the shake test rebuilds an object's scene
+    from; None for a scene file.
+    """
     from drakegrasp.planning import planning_scene
 
     if _is_scene(args.object):
@@ -1016,6 +1079,7 @@ def _plan_setup(args: argparse.Namespace):
             scene.plant, scene.plant_context, scene.object_body, scene.hand
         )  # fmt: skip
         default_mu = info.mu
+        add_models = None
     else:
         scene = planning_scene(_plan_url(args.object), hand_url=_plan_hand(args.hand))
         plant, context, body, hand = (
@@ -1023,6 +1087,7 @@ def _plan_setup(args: argparse.Namespace):
         )  # fmt: skip
         options = {}
         default_mu = PLAN_DEFAULT_MU
+        add_models = scene.add_models
     alias = (args.hand or "").lower()
     preshape = {**PLAN_PRESHAPES.get(alias, {}), **dict(args.preshape)}
     if preshape:
@@ -1034,7 +1099,7 @@ def _plan_setup(args: argparse.Namespace):
         if args.mu == "plant"
         else args.mu
     )
-    return plant, context, body, hand, options
+    return plant, context, body, hand, options, add_models
 
 
 def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
@@ -1174,7 +1239,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         raise InvalidOptionError("--overwrite is for --out FILE.parquet")
     if args.progress:
         _check_progress()
-    plant, context, object_body, hand, options = _plan_setup(args)
+    shake = _shake_options(args)
+    plant, context, object_body, hand, options, add_models = _plan_setup(args)
     try:
         result = plan_grasps(
             plant,
@@ -1191,20 +1257,64 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     except GraspError as e:
         raise _in_flag_words(e, _PLAN_FLAGS) from None
     result = _in_plan_words(result)
+    shaken = None
+    if shake is not None:
+        from drakegrasp.planning.shake_ranking import shake_candidates
+
+        shaken = shake_candidates(add_models, result, top=args.shake, **shake)
     if args.out is not None:
         _write_plan_parquet(result, args.out, overwrite=args.overwrite)
     if args.json:
         data = result.to_dict()
         data["candidates"] = data["candidates"][: args.top]
+        if shaken is not None:
+            data["shaken"] = shaken.to_dict()
         json.dump(data, sys.stdout, indent=2)
         sys.stdout.write("\n")
-    elif args.out is None:
+        return 0
+    if args.out is None:
         print(result.__str__().split("\n  #")[0])
         for k, c in enumerate(result[: args.top]):
             print(f"  #{k:<3} {c}")
     else:
         print(f"wrote {len(result)} candidates to {args.out}")
+    if shaken is not None:
+        print(shaken)
     return 0
+
+
+def _shake_options(args: argparse.Namespace) -> dict | None:
+    """``plan --shake``'s options for ``shake_candidates``, checked before planning.
+
+    None without ``--shake``.  The flags' values, over
+    :data:`PLAN_SHAKE_DEFAULTS` for a hand alias, over the shake test's defaults.
+    """
+    given = {k: getattr(args, k) for k in SHAKE_FLAGS if getattr(args, k) is not None}
+    if args.shake is None:
+        if given:
+            raise InvalidOptionError(
+                f"{SHAKE_FLAGS[next(iter(given))]} is an option of the shake test: "
+                "give it with --shake K"
+            )
+        return None
+    if _is_scene(args.object):
+        raise InvalidOptionError(
+            "--shake is for an object and --hand: the shake test rebuilds the "
+            "hand and the object alone, which a scene file does not give apart "
+            "from its supports (in Python, shake_candidates takes an "
+            "add_models of your own)"
+        )
+    from drakegrasp.planning.shake_ranking import check_settings
+
+    options = {**PLAN_SHAKE_DEFAULTS.get((args.hand or "flat").lower(), {}), **given}
+    if options.get("hydroelastic_modulus") == "none":
+        options["hydroelastic_modulus"] = None  # the models' own contact
+    flags = {"top": "--shake", **SHAKE_FLAGS}
+    try:
+        check_settings(args.shake, "seat", options)
+    except GraspError as e:
+        raise _in_flag_words(e, flags) from None
+    return options
 
 
 _PLAN_FLAGS = {
@@ -1333,6 +1443,54 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         "m, within its limits; repeatable; 'model::joint' where names repeat); "
         "default the model's, and for --hand allegro the thumb opposed "
         "(joint_12=1.0)",
+    )
+    plan.add_argument(
+        "--shake",
+        type=_count,
+        default=None,
+        metavar="K",
+        help="shake the first K candidates in a Drake simulation (squeezed, "
+        "then gravity turned through six directions) and list them again, "
+        "those that held (within 10 mm and 10 deg of where the fingers seated "
+        "the object) first; for an object and --hand, not a scene (default: "
+        "no shake)",
+    )
+    plan.add_argument(
+        "--squeeze",
+        type=_strictly_positive,
+        default=None,
+        metavar="X",
+        help="with --shake: what each closing joint presses with, N for a "
+        "prismatic joint, N·m for a revolute one (default 20, within the "
+        "actuators' effort limits; 0.7 for --hand allegro)",
+    )
+    plan.add_argument(
+        "--stiffness",
+        type=_strictly_positive,
+        default=None,
+        metavar="K",
+        help="with --shake: the fingers' position gain, N/m or N·m/rad "
+        "(default 4000; 10 for --hand allegro: light fingers need light gains)",
+    )
+    plan.add_argument(
+        "--hydroelastic",
+        type=_modulus,
+        default=None,
+        metavar="PA|none",
+        dest="hydroelastic_modulus",
+        help="with --shake: make the hand's geometries compliant hydroelastic "
+        "with this modulus in Pa (the object's rigid), so that a flat pad presses "
+        "over a patch, not at Drake's one contact point; none: the models' own "
+        "contact (default 1e6 for --hand flat, rounded and allegro, none "
+        "otherwise)",
+    )
+    plan.add_argument(
+        "--damping",
+        type=_non_negative,
+        default=None,
+        metavar="D",
+        help="with --shake: the fingers' damping, N·s/m or N·m·s/rad "
+        "(default 50; 0.1 for --hand allegro)",
     )
     _add_scene_file_options(
         plan,
