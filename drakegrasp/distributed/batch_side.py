@@ -24,6 +24,7 @@ the Parquet shards).  See ``docs/distributed.md`` for pointing it at a cluster.
 from __future__ import annotations
 
 import os
+import re
 import uuid
 from pathlib import Path
 
@@ -59,7 +60,7 @@ from drakegrasp.distributed.dataset import (
     shard_path,
     write_shard,
 )
-from drakegrasp.errors import InvalidContactError, InvalidOptionError
+from drakegrasp.errors import GraspError, InvalidContactError, InvalidOptionError
 
 __all__ = [
     "evaluate_on_cluster",
@@ -99,11 +100,36 @@ def _slice_option(value, sl: slice, K: int):
     return np.asarray(value[sl])
 
 
-def _partition(kind, positions, normals, arrays, options, shard, chunk_size, job):
-    """One partition through the local engine; write its shard or return arrays."""
+_GRASP_NAMED = re.compile(r"\bgrasp (\d+)\b")
+"""A grasp named by its index in an engine's message ("grasp 5")."""
+
+
+def _in_the_input(error: GraspError, start: int) -> GraspError:
+    """``error`` naming grasps by their place in the input, not in the partition.
+
+    The engine names a faulty grasp by its index in the arrays it was given;
+    a partition's first grasp is grasp ``start`` of the input.
+    """
+    if start == 0:
+        return error
+    text = _GRASP_NAMED.sub(lambda m: f"grasp {int(m.group(1)) + start}", str(error))
+    return type(error)(text)
+
+
+def _partition(
+    kind, positions, normals, arrays, options, shard, chunk_size, job, start=0
+):
+    """One partition through the local engine; write its shard or return arrays.
+
+    ``start`` is the index of the partition's first grasp in the input: an
+    error names the grasp by its place there.
+    """
     run = stream_force_closure if kind == "force" else stream_form_closure
-    parts = [a for _, a in run(positions, normals, **arrays, **options,
-                               chunk_size=chunk_size, workers=1)]  # fmt: skip
+    try:
+        parts = [a for _, a in run(positions, normals, **arrays, **options,
+                                   chunk_size=chunk_size, workers=1)]  # fmt: skip
+    except GraspError as e:
+        raise _in_the_input(e, start) from e
     names = parts[0].keys() if parts else ()
     out = {n: np.concatenate([p[n] for p in parts]) for n in names}
     if shard is None:
@@ -255,7 +281,7 @@ def evaluate_on_cluster(
                 P, Nrm = np.asarray(P), np.asarray(Nrm)
             part = {k: _slice_option(v, sl, K) for k, v in arrays.items()}
             futures.append((j, sl, client.submit(
-                _partition, kind, P, Nrm, part, options, shard, size, job,
+                _partition, kind, P, Nrm, part, options, shard, size, job, start,
                 key=f"drakegrasp-partition-{j}-{run}", pure=False,
             )))  # fmt: skip
         results = {j: f.result() for j, _, f in futures}

@@ -226,6 +226,37 @@ def test_a_length_out_of_scale_is_named_in_the_input_before_connecting(grasps):
         )
 
 
+@pytest.mark.parametrize("fault", ["length", "position"])
+def test_a_dask_array_input_names_the_faulty_grasp_by_its_place_in_the_input(
+    client, grasps, fault
+):
+    """A Dask array's blocks are checked inside their partitions, where the
+    engine numbers grasps from the partition's start: grasp 25 was named
+    "grasp 5".  The message now names it as the local engine does."""
+    da = pytest.importorskip("dask.array")
+    import drakegrasp as dg
+
+    P, Nrm, mu = grasps
+    K = 40
+    P = np.array(P[:K])
+    b = np.full(K, 0.1)
+    if fault == "length":
+        b[25] = 1e-15
+        error, match = dg.InvalidGraspError, r"grasp 25 is 1e-15 m"
+    else:
+        P[25, 1] = np.nan
+        error, match = dg.InvalidContactError, r"position of grasp 25, contact 1"
+    kw = dict(characteristic_lengths=b, metrics=("isotropy",))
+    with pytest.raises(error, match=match):
+        batch_force_closure(P, Nrm[:K], mu=mu[:K], **kw)
+    with pytest.raises(error, match=match):
+        evaluate_on_cluster(
+            client, da.from_array(P, chunks=(10, -1, -1)),
+            da.from_array(Nrm[:K], chunks=(10, -1, -1)), mu=mu[:K],
+            chunk_size=10, partition_chunks=1, **kw,
+        )  # fmt: skip
+
+
 def test_an_iterator_of_metrics_reaches_every_partition(client, grasps):
     """The early check read ``metrics`` and left the partitions an exhausted
     iterator: the metric columns vanished without a word."""
