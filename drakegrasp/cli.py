@@ -1257,18 +1257,15 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     except GraspError as e:
         raise _in_flag_words(e, _PLAN_FLAGS) from None
     result = _in_plan_words(result)
-    shaken = None
-    if shake is not None:
-        from drakegrasp.planning.shake_ranking import shake_candidates
-
-        shaken = shake_candidates(add_models, result, top=args.shake, **shake)
+    # The plan is written and printed before the shake, so that a shake that
+    # fails or is interrupted leaves it (JSON is one document: shaken first).
     if args.out is not None:
         _write_plan_parquet(result, args.out, overwrite=args.overwrite)
     if args.json:
         data = result.to_dict()
         data["candidates"] = data["candidates"][: args.top]
-        if shaken is not None:
-            data["shaken"] = shaken.to_dict()
+        if shake is not None:
+            data["shaken"] = _shaken(add_models, result, args, shake).to_dict()
         json.dump(data, sys.stdout, indent=2)
         sys.stdout.write("\n")
         return 0
@@ -1278,9 +1275,17 @@ def _cmd_plan(args: argparse.Namespace) -> int:
             print(f"  #{k:<3} {c}")
     else:
         print(f"wrote {len(result)} candidates to {args.out}")
-    if shaken is not None:
-        print(shaken)
+    if shake is not None:
+        sys.stdout.flush()
+        print(_shaken(add_models, result, args, shake))
     return 0
+
+
+def _shaken(add_models, result, args: argparse.Namespace, options: dict):
+    """``plan --shake``: the first ``args.shake`` candidates shaken in Drake."""
+    from drakegrasp.planning.shake_ranking import shake_candidates
+
+    return shake_candidates(add_models, result, top=args.shake, **options)
 
 
 def _shake_options(args: argparse.Namespace) -> dict | None:

@@ -41,6 +41,7 @@ weld and actuators, and the grasp is what is tested.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -72,7 +73,7 @@ from drakegrasp.plant.validation import (
     resolve_object_body,
 )
 
-__all__ = ["DEFAULT_DIRECTIONS", "ShakeResult", "shake_test"]
+__all__ = ["DEFAULT_DIRECTIONS", "ShakeResult", "check_shake_options", "shake_test"]
 
 GRAVITY = 9.81
 """Magnitude of the turned gravity, m/s²."""
@@ -151,6 +152,9 @@ class ShakeResult:
     hydroelastic_modulus : float or None
         The modulus (Pa) of the hand's compliant hydroelastic geometries, or
         None: the contact the models declare.
+    hydroelastic_refused : int
+        Collision geometries of the hand and the object that Drake refused to
+        make hydroelastic (they kept point contact; a half-space, say).
     """
 
     held: bool
@@ -170,6 +174,7 @@ class ShakeResult:
     max_displacement_from_seat: float = float("nan")
     max_rotation_from_seat: float = float("nan")
     hydroelastic_modulus: float | None = None
+    hydroelastic_refused: int = 0
 
     @property
     def held_from_seat(self) -> bool:
@@ -230,7 +235,12 @@ class ShakeResult:
             + (
                 ""
                 if self.hydroelastic_modulus is None
-                else f", hydroelastic fingers ({self.hydroelastic_modulus:g} Pa)"
+                else f", hydroelastic fingers ({self.hydroelastic_modulus:g} Pa"
+                + (
+                    f"; {self.hydroelastic_refused} geometries kept point contact)"
+                    if self.hydroelastic_refused
+                    else ")"
+                )
             )
             + f"; {self.wall_time:.2f} s wall{seated}"
         )
@@ -330,7 +340,9 @@ def _angle(R: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)))
 
 
-def _stopped(error: RuntimeError, t: float, stiffness: float) -> GraspError:
+def _stopped(
+    error: RuntimeError, t: float, stiffness: float, modulus: float | None = None
+) -> GraspError:
     """The one-line error of a simulation Drake could not advance past ``t``.
 
     A contact solver that did not converge (SAP, TAMSI) is a ``SolverError``
@@ -341,6 +353,8 @@ def _stopped(error: RuntimeError, t: float, stiffness: float) -> GraspError:
     lines = str(error).split("Reasons for")[0].strip().splitlines()  # then advice
     first = " ".join(lines[0].split()).rstrip(".") if lines else type(error).__name__
     where = f"the shake test's simulation stopped at t = {t:.3g} s ({first})"
+    if modulus is not None:
+        where += f" with hydroelastic fingers of {modulus:g} Pa"
     if "converge" not in first.lower():
         return ModelError(
             f"{where}: the model that add_models built cannot be simulated"
@@ -348,9 +362,18 @@ def _stopped(error: RuntimeError, t: float, stiffness: float) -> GraspError:
     return SolverError(
         f"{where}: the fingers' position control (stiffness = {stiffness:g}) is "
         "likely too stiff for their inertia: light revolute fingers need far "
-        "lower gains (the Allegro hand: squeeze=0.5, stiffness=20, damping=1); "
+        "lower gains (the Allegro hand: squeeze=0.7, stiffness=10, damping=0.1, "
+        "as plan --shake uses); "
         "a smaller time_step also helps"
     )
+
+
+def _finite(value) -> bool:
+    """Whether a real number is finite (a Python int too large for a float is not)."""
+    try:
+        return math.isfinite(float(value))
+    except OverflowError:
+        return False
 
 
 def check_shake_options(
@@ -407,7 +430,7 @@ def check_shake_options(
         if not (
             isinstance(value, int | float | np.floating | np.integer)
             and not isinstance(value, bool)
-            and np.isfinite(value)
+            and _finite(value)
             and (value > 0 if low is not None else value >= 0)
         ):
             relation = "> 0" if low is not None else ">= 0"
@@ -566,7 +589,12 @@ def shake_test(
     plant, scene_graph = AddMultibodyPlantSceneGraph(
         builder, time_step=float(time_step)
     )
-    hand, obj = add_models(plant, Parser(plant))
+    made = add_models(plant, Parser(plant))
+    if not (isinstance(made, tuple | list) and len(made) == 2):
+        raise ModelError(
+            f"add_models must return (hand, object_body), got {type(made).__name__}"
+        )
+    hand, obj = made
     if object_body is not None:
         obj = object_body
     base = resolve_body(plant, candidate.hand_base)
@@ -584,11 +612,21 @@ def shake_test(
     plant.WeldFrames(plant.world_frame(), base.body_frame(), candidate.X_WH)
     plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
     body = resolve_object_body(plant, obj)
-    if modulus is not None:  # the hand: the bodies of its base's model instance
+    refused = 0
+    if modulus is not None:
+        # the hand: its base's model instance and those of its closing joints
+        instances = {base.model_instance()} | {
+            a.joint().model_instance()
+            for a in actuators
+            if int(a.joint().index()) in targets
+        }
         hand_bodies = [
-            plant.get_body(i) for i in plant.GetBodyIndices(base.model_instance())
+            plant.get_body(i)
+            for instance in sorted(instances, key=int)
+            for i in plant.GetBodyIndices(instance)
+            if i != body.index()
         ]
-        use_hydroelastic_contact(
+        refused = use_hydroelastic_contact(
             plant, scene_graph, hand_bodies, [body], modulus=modulus
         )
     plant.Finalize()
@@ -647,10 +685,17 @@ def shake_test(
             except RuntimeError as e:  # Drake could not advance (see _stopped)
                 if type(e) is not RuntimeError:  # RecursionError, NotImplemented...
                     raise
-                raise _stopped(e, simulator.get_context().get_time(), stiffness) from e
+                t_now = simulator.get_context().get_time()
+                raise _stopped(e, t_now, stiffness, modulus) from e
             X_HO = plant.CalcRelativeTransform(ctx, H, body.body_frame())
             d = float(np.linalg.norm(X_HO.translation() - X_HO0.translation()))
             r = _angle(X_HO0.rotation().matrix().T @ X_HO.rotation().matrix())
+            if not (math.isfinite(d) and math.isfinite(r)):  # max() would skip NaN
+                raise SolverError(
+                    f"the shake test's simulation went unstable at t = {t:.3g} s: "
+                    "the object's pose is no longer finite; lower the gains or "
+                    "the time_step"
+                )
             max_d, max_r = max(max_d, d), max(max_r, r)
             if X_HO_seat is not None:
                 ds = float(np.linalg.norm(X_HO.translation() - X_HO_seat.translation()))
@@ -698,4 +743,5 @@ def shake_test(
         max_displacement_from_seat=max_ds,
         max_rotation_from_seat=max_rs,
         hydroelastic_modulus=modulus,
+        hydroelastic_refused=refused,
     )

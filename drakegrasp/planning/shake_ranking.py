@@ -29,7 +29,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
+from drakegrasp.errors import (
+    InvalidGraspError,
+    InvalidOptionError,
+    ModelError,
+    SolverError,
+)
 from drakegrasp.planning.candidates import (
     GraspCandidate,
     GraspCandidates,
@@ -39,7 +44,13 @@ from drakegrasp.planning.candidates import (
 from drakegrasp.planning.shake import ShakeResult, check_shake_options, shake_test
 from drakegrasp.plant.validation import check_rigid_transform
 
-__all__ = ["HELD_FROM", "ShakenCandidate", "ShakenCandidates", "shake_candidates"]
+__all__ = [
+    "HELD_FROM",
+    "ShakenCandidate",
+    "ShakenCandidates",
+    "check_settings",
+    "shake_candidates",
+]
 
 HELD_FROM = ("seat", "plan")
 """What "held" counts from: where seating left the object, or the planned pose."""
@@ -241,7 +252,7 @@ def check_settings(top, held_from, options: dict) -> dict:
         As :func:`shake_candidates` raises it for its settings.
     """
     _checked_top(top)
-    if held_from not in HELD_FROM:
+    if not isinstance(held_from, str) or held_from not in HELD_FROM:
         raise InvalidOptionError(
             f"held_from must be one of {', '.join(HELD_FROM)}, got {held_from!r}"
         )
@@ -282,8 +293,9 @@ def shake_candidates(
         How many of the first candidates to shake (default 10; fewer when
         there are fewer), 1 to 10000.  Each is one simulation of
         ``seat + settle + len(directions) * phase`` seconds (2.8 s of
-        simulated time at the defaults: about a second of wall time for the
-        Allegro hand at ``time_step=1e-3``).
+        simulated time at the defaults: at ``time_step=1e-3``, about 1 s of
+        wall time for the Allegro hand with point contact and 2.6 s with
+        hydroelastic fingers; 0.6 s and 1.6 s for drakegrasp's flat jaw).
     held_from : {"seat", "plan"}, optional
         What "held" counts from: where seating left the object (default; a
         multi-finger hand seats it a few millimetres from the plan and holds
@@ -291,17 +303,20 @@ def shake_candidates(
     **options
         :func:`~drakegrasp.planning.shake.shake_test`'s keyword options
         (``squeeze``, ``stiffness``, ``damping``, ``directions``, the phases,
-        the bounds, ``object_body``, ``X_WO``), the same for every candidate;
-        checked before anything is simulated.  Light revolute fingers need
-        light gains (the Allegro hand: ``squeeze=0.7, stiffness=10,
-        damping=0.1``).
+        the bounds, ``hydroelastic_modulus``, ``X_WO``, ``object_body`` by
+        name or ``BodyIndex``: each shake builds a fresh plant), the same for
+        every candidate; checked before anything is simulated.  Light
+        revolute fingers need light gains (the Allegro hand:
+        ``squeeze=0.7, stiffness=10, damping=0.1``); flat pads need
+        ``hydroelastic_modulus`` (see :mod:`drakegrasp.plant.hydroelastic`).
 
     Returns
     -------
     ShakenCandidates
         The shaken candidates: held, then dropped, then those Drake could not
-        simulate (a ``SolverError`` for that candidate is recorded, one line,
-        and the others are still shaken); each group in the planner's order.
+        simulate (its ``SolverError``, or a ``ModelError`` past the first
+        candidate, is recorded in one line, and the others are still
+        shaken); each group in the planner's order.
 
     Raises
     ------
@@ -315,9 +330,9 @@ def shake_candidates(
         match its joints, named by its place (all are checked before any is
         simulated).
     ModelError
-        As :func:`~drakegrasp.planning.shake.shake_test` raises it: a model
-        that does not match the candidates (the first one's error: the others
-        would share it).
+        As :func:`~drakegrasp.planning.shake.shake_test` raises it for the
+        first candidate: a model that does not match the candidates (the
+        others would share it).
     """
     if not callable(add_models):
         raise InvalidOptionError(
@@ -331,7 +346,10 @@ def shake_candidates(
     for k, c in enumerate(chosen):
         try:
             result = shake_test(add_models, c, **options)
-        except SolverError as e:
+        except (SolverError, ModelError) as e:
+            if k == 0 and isinstance(e, ModelError):
+                raise  # the models and the candidates do not match: every one
+            # Drake could not simulate this one: recorded, the rest still run
             shaken.append(ShakenCandidate(c, k, None, False, str(e)))
             continue
         held = result.held_from_seat if held_from == "seat" else result.held

@@ -36,35 +36,77 @@ from pydrake.geometry import (
     Sphere,
 )
 from pydrake.multibody.plant import ContactModel
+from pydrake.multibody.tree import RigidBody
 
 from drakegrasp.errors import InvalidOptionError, ModelError
 
-__all__ = ["check_hydroelastic_modulus", "use_hydroelastic_contact"]
+__all__ = ["MODULI", "check_hydroelastic_modulus", "use_hydroelastic_contact"]
 
 _GROUP = "hydroelastic"
 
 
-def check_hydroelastic_modulus(value) -> float | None:
-    """``value`` as a modulus in pascals (finite, > 0), or None for none.
+MODULI = (1e4, 1e12)
+"""Hydroelastic moduli taken, Pa: from a soft gel to five times steel's.
+
+Outside, Drake's contact goes wrong without a word or stops: measured on the
+flat jaw and the box, the object fell through the pads at 1e-3 Pa, SAP did not
+converge at 1e15, Drake could not factorise at 1e20, and at 1e300 the contact
+force vanished and the object fell, reported as an ordinary drop."""
+
+
+def check_hydroelastic_modulus(value, name: str = "hydroelastic_modulus"):
+    """``value`` as a modulus in pascals within :data:`MODULI`, or None for none.
+
+    Parameters
+    ----------
+    value : float or None
+    name : str
+        The keyword named in the error.
+
+    Returns
+    -------
+    float or None
 
     Raises
     ------
     InvalidOptionError
-        Not None and not a finite real number > 0.
+        Not None and not a real number within :data:`MODULI`.
     """
     if value is None:
         return None
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, int | float | np.integer | np.floating)
-        or not np.isfinite(value)
-        or value <= 0
-    ):
-        raise InvalidOptionError(
-            "hydroelastic_modulus must be None (the models' own contact) or a "
-            f"finite number > 0 (Pa), got {value!r}"
+    try:
+        x = (
+            float(value)
+            if isinstance(value, int | float | np.integer | np.floating)
+            and not isinstance(value, bool)
+            else float("nan")
         )
-    return float(value)
+    except OverflowError:  # a Python int past a float's range
+        x = float("inf")
+    if not MODULI[0] <= x <= MODULI[1]:
+        raise InvalidOptionError(
+            f"{name} must be None (the models' own contact) or a number of "
+            f"pascals in [{MODULI[0]:g}, {MODULI[1]:g}] (rubber pads: about "
+            f"1e6), got {value!r}"
+        )
+    return x
+
+
+def _bodies(plant, bodies, what: str) -> list:
+    """``bodies`` as a list of this plant's ``RigidBody``; refused otherwise."""
+    if isinstance(bodies, RigidBody) or not isinstance(bodies, Iterable):
+        raise InvalidOptionError(
+            f"{what} must be an iterable of RigidBody, got {type(bodies).__name__}"
+        )
+    out = list(bodies)
+    for body in out:
+        if not isinstance(body, RigidBody):
+            raise InvalidOptionError(
+                f"{what} must hold RigidBody objects, got {type(body).__name__}"
+            )
+        if body.GetParentPlant() is not plant:
+            raise ModelError(f"body {body.name()!r} of {what} is of another plant")
+    return out
 
 
 def _resolution_hint(shape) -> float:
@@ -134,20 +176,30 @@ def use_hydroelastic_contact(
     -------
     int
         Collision geometries Drake refused to make hydroelastic: they keep
-        point contact (0 for Drake's shapes and convex meshes).
+        point contact (a half-space cannot be compliant).
 
     Raises
     ------
+    InvalidOptionError
+        A modulus outside :data:`MODULI`, or bodies that are not an iterable
+        of ``RigidBody``.
     ModelError
-        The plant is already finalized (its contact model is fixed).
+        The plant is already finalized (its contact model is fixed), is not
+        registered with ``scene_graph``, or a body is of another plant.
     """
-    modulus = check_hydroelastic_modulus(modulus)
     if modulus is None:
         raise InvalidOptionError("modulus must be a number of pascals, got None")
+    modulus = check_hydroelastic_modulus(modulus, "modulus")
     if plant.is_finalized():
         raise ModelError(
             "use_hydroelastic_contact needs a plant that is not finalized yet"
         )
+    if not plant.geometry_source_is_registered() or not (
+        scene_graph.model_inspector().SourceIsRegistered(plant.get_source_id())
+    ):
+        raise ModelError("the plant is not registered with this scene_graph")
+    hand_bodies = _bodies(plant, hand_bodies, "hand_bodies")
+    object_bodies = _bodies(plant, object_bodies, "object_bodies")
     plant.set_contact_model(ContactModel.kHydroelasticWithFallback)
 
     def compliant(props, hint):

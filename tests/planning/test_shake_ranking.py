@@ -12,7 +12,12 @@ import pytest
 from allegro_support import allegro_scene, has_thumb
 
 import drakegrasp as dg
-from drakegrasp.errors import InvalidGraspError, InvalidOptionError, SolverError
+from drakegrasp.errors import (
+    InvalidGraspError,
+    InvalidOptionError,
+    ModelError,
+    SolverError,
+)
 from drakegrasp.planning.shake import ShakeResult
 
 JAW = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
@@ -145,6 +150,9 @@ def test_a_candidate_drake_cannot_simulate_is_recorded_and_the_rest_are_shaken()
         (dict(top=2.0), "top must be"),
         (dict(top=10_001), "top must be"),
         (dict(held_from="object"), "held_from must be"),
+        (dict(held_from=np.array(["seat"])), "held_from must be"),
+        (dict(squeeze=10**400), "squeeze must be"),
+        (dict(hydroelastic_modulus=1e20), "hydroelastic_modulus must be"),
         (dict(stifness=10.0), "no option stifness"),
         (dict(squeeze=-1.0), "squeeze must be"),
         (dict(directions=[(0, 0, 0)]), "directions must be"),
@@ -209,3 +217,33 @@ def test_an_edited_candidate_is_refused_by_place_before_any_is_simulated(jaw):
 
     with pytest.raises(InvalidGraspError, match=r"candidates\[2\]: .*q_hand"):
         dg.shake_candidates(models, [result[0], result[1], edited])
+
+
+def test_a_model_error_past_the_first_candidate_is_recorded_not_raised(jaw):
+    """A candidate of another hand among the jaw's: the first is shaken, the
+    stranger recorded as not simulated with its one line, and a stranger
+    first raises (the models and the candidates do not match)."""
+    scene, result = jaw
+    three = dg.planning_scene(
+        "package://drakegrasp/objects/cylinder.sdf", hand_url=THREE
+    )
+    stranger = dg.plan_grasps(
+        three.plant, three.context, three.object_body, hand=three.hand,
+        num_candidates=20, mu=1.0, seed=3, robustness_samples=4, preshape=THREE_OPEN,
+    )[0]  # fmt: skip
+    ranked = dg.shake_candidates(scene.add_models, [result[0], stranger], **SHORT)
+    assert len(ranked) == 2
+    last = ranked[-1]
+    assert last.candidate is stranger and last.result is None and not last.held
+    assert last.error and "\n" not in last.error
+    assert ranked[0].result is not None
+    with pytest.raises(ModelError):
+        dg.shake_candidates(scene.add_models, [stranger, result[0]], **SHORT)
+
+
+def test_add_models_that_returns_no_pair_is_a_model_error(jaw):
+    _, result = jaw
+    with pytest.raises(
+        ModelError, match=r"add_models must return \(hand, object_body\)"
+    ):
+        dg.shake_test(lambda plant, parser: None, result[0], **SHORT)

@@ -89,10 +89,43 @@ def test_a_finalized_plant_is_refused(jaw_on_box):
         use_hydroelastic_contact(plant, sg, [], [], modulus=1e6)
 
 
-@pytest.mark.parametrize("value", [0.0, -1.0, np.nan, np.inf, "1e6", True, [1e6]])
-def test_a_modulus_that_is_not_positive_and_finite_is_refused(value):
-    with pytest.raises(InvalidOptionError, match="hydroelastic_modulus"):
+@pytest.mark.parametrize(
+    "value",
+    [0.0, -1.0, np.nan, np.inf, "1e6", True, [1e6], 1e-3, 9e3, 2e12, 1e300, 10**30],
+)
+def test_a_modulus_outside_the_physical_range_is_refused(value):
+    """Measured on the flat jaw: at 1e-3 Pa the box fell through the pads, at
+    1e15 SAP did not converge, at 1e300 the contact force vanished and the box
+    fell as if dropped: each was reported as a result, not an error."""
+    with pytest.raises(InvalidOptionError, match=r"hydroelastic_modulus .*\[10000, "):
         check_hydroelastic_modulus(value)
+
+
+@pytest.mark.parametrize("value", [1e4, 1e6, np.float32(1e6), 10**12])
+def test_a_modulus_within_the_range_is_taken(value):
+    assert check_hydroelastic_modulus(value) == float(value)
+
+
+def test_bodies_and_scene_graph_are_checked(jaw_on_box):
+    scene, _ = jaw_on_box
+    builder = DiagramBuilder()
+    plant, sg = AddMultibodyPlantSceneGraph(builder, time_step=1e-3)
+    hand, _ = scene.add_models(plant, Parser(plant))
+    body = plant.get_body(plant.GetBodyIndices(hand)[0])
+    with pytest.raises(InvalidOptionError, match="hand_bodies must be an iterable"):
+        use_hydroelastic_contact(plant, sg, body, [], modulus=1e6)
+    with pytest.raises(InvalidOptionError, match="object_bodies must hold RigidBody"):
+        use_hydroelastic_contact(plant, sg, [], [body.index()], modulus=1e6)
+    other = DiagramBuilder()
+    plant2, sg2 = AddMultibodyPlantSceneGraph(other, time_step=1e-3)
+    scene.add_models(plant2, Parser(plant2))
+    stranger = plant2.get_body(plant2.GetBodyIndices(hand)[0])
+    with pytest.raises(ModelError, match="of another plant"):
+        use_hydroelastic_contact(plant, sg, [stranger], [], modulus=1e6)
+    with pytest.raises(ModelError, match="not registered with this scene_graph"):
+        use_hydroelastic_contact(plant, sg2, [body], [], modulus=1e6)
+    with pytest.raises(InvalidOptionError, match="modulus must be"):
+        use_hydroelastic_contact(plant, sg, [body], [], modulus=1e20)
 
 
 def test_flat_pads_pivot_in_point_contact_and_hold_as_patches(jaw_on_box):
