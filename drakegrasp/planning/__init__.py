@@ -29,7 +29,8 @@ _SOURCES = {
     "drakegrasp.planning.multifinger": ("hand_is_parallel_jaw",),
     "drakegrasp.planning.planner": ("REASONS", "object_surface", "plan_grasps"),
     "drakegrasp.planning.scenes": ("PlanningScene", "planning_scene"),
-    "drakegrasp.planning.shake": ("ShakeResult", "shake_test"),
+    "drakegrasp.planning.shake": ("shake_test",),
+    "drakegrasp.planning.shake_result": ("ShakeResult",),
     "drakegrasp.planning.shake_ranking": ("ShakenCandidates", "shake_candidates"),
     "drakegrasp.planning.surface": ("ObjectSurface",),
 }
@@ -48,7 +49,9 @@ _SUBMODULES = (
     "scenes",
     "shake",
     "shake_ranking",
+    "shake_result",
     "surface",
+    "turned_gravity",
     "weight",
 )
 

@@ -9,9 +9,9 @@ and the squeeze alone pushes the box out of the hand (the planning guide,
 :func:`~drakegrasp.planning.shake.shake_test` on the first ``top`` candidates
 and re-orders them: those that held, in the planner's order, then those that
 dropped, then those Drake could not simulate, each with its
-:class:`~drakegrasp.planning.shake.ShakeResult` or the error's one line.
+:class:`~drakegrasp.planning.shake_result.ShakeResult` or the error's one line.
 
-"Held" is :attr:`~drakegrasp.planning.shake.ShakeResult.held_from_seat` by
+"Held" is :attr:`~drakegrasp.planning.shake_result.ShakeResult.held_from_seat` by
 default (``held_from="seat"``): the object stays within the bounds of where
 the fingers seated it, which is what holding means for a hand whose fingers do
 not stop where the plan put them; ``held_from="plan"`` counts from the planned
@@ -41,7 +41,8 @@ from drakegrasp.planning.candidates import (
     check_candidate,
     pose_dict,
 )
-from drakegrasp.planning.shake import ShakeResult, check_shake_options, shake_test
+from drakegrasp.planning.shake import check_shake_options, shake_test
+from drakegrasp.planning.shake_result import ShakeResult
 from drakegrasp.plant.validation import check_rigid_transform
 
 __all__ = [

@@ -1,0 +1,180 @@
+"""What the shake test saw: :class:`ShakeResult`.
+
+The figures of one :func:`~drakegrasp.planning.shake.shake_test` run: how far
+the object moved from its planned pose and from where the fingers seated it,
+what the actuators pressed with, and the contact model the simulation used.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from drakegrasp.core.serialize import jsonable
+
+__all__ = ["ShakeResult"]
+
+
+@dataclass(frozen=True, eq=False)
+class ShakeResult:
+    """What the shake test saw.
+
+    Attributes
+    ----------
+    held : bool
+        Whether the object stayed within both bounds for the whole run.
+    max_displacement : float
+        Largest distance (m) of the object's origin from its planned place in
+        the hand frame.
+    max_rotation : float
+        Largest rotation angle (rad) of the object from its planned
+        orientation in the hand frame.
+    phases : tuple of dict
+        Per gravity direction: ``direction`` (world), ``displacement`` and
+        ``rotation`` at the end of the phase.
+    squeeze : float
+        What each closing joint's actuator presses with: a force in newtons
+        for a prismatic joint (a parallel jaw), a torque in N·m for a revolute
+        one (a multi-finger hand); see ``effort_units``.
+    efforts : tuple of float
+        The magnitude of what each closing joint's actuator applied once the
+        fingers had seated (newtons, or N·m for a revolute joint), in
+        actuator order,
+        read at the end of seating (with ``seat=0``, of settling).  A
+        parallel jaw's fingers press with ``squeeze`` (within their effort
+        limits).  A multi-finger hand's joints share each finger's contact
+        force through its chain (``τ = Jᵀ f``), so theirs differ: a joint
+        the contact pushes back presses harder, up to its effort limit, and
+        one whose link moves freely presses with none.
+    time_step, duration : float
+        Seconds (simulated).
+    wall_time : float
+        Seconds.
+    bounds : tuple of float
+        ``(max_displacement, max_rotation)`` allowed.
+    effort_units : tuple of str
+        The unit of ``squeeze`` and of each entry of ``efforts``, per closing
+        joint in actuator order: ``"N"`` for a prismatic joint, ``"N·m"`` for
+        a revolute one (empty: newtons assumed).
+    seat_displacement, seat_rotation : float
+        Where seating left the object, before any gravity: distance (m) of
+        its origin from its planned place and rotation angle (rad) from its
+        planned orientation, in the hand frame (NaN with ``seat=0``).
+    seat_speed : float
+        Speed (m/s) of the object's origin at the end of seating.  An object
+        the squeeze holds has settled there; one the fingers' closing motions
+        push out of the hand is still moving (the Allegro hand's thumbless
+        grasps of the YCB sugar box at 0.7 N·m: 0.17-0.53 m/s here, against
+        0.012 and 0.045 m/s for its two best grasps with the thumb; see the
+        planning guide).  NaN with ``seat=0``.
+    max_displacement_from_seat, max_rotation_from_seat : float
+        Largest distance (m) and rotation angle (rad) of the object, in the
+        hand frame, from where seating left it, over settling and the turned
+        gravity (NaN with ``seat=0``).  ``held`` counts from the planned pose,
+        so a multi-finger hand that seats the object 10 mm away from it is
+        "dropped" whatever follows; these say whether the seated grasp then
+        held still.
+    hydroelastic_modulus : float or None
+        The modulus (Pa) of the hand's compliant hydroelastic geometries, or
+        None: the contact the models declare.
+    hydroelastic_refused : int
+        Collision geometries of the hand and the object that Drake refused to
+        make hydroelastic (they kept point contact; a half-space, say).
+    """
+
+    held: bool
+    max_displacement: float
+    max_rotation: float
+    phases: tuple
+    squeeze: float
+    efforts: tuple[float, ...]
+    time_step: float
+    duration: float
+    wall_time: float
+    bounds: tuple[float, float]
+    effort_units: tuple[str, ...] = ()
+    seat_displacement: float = float("nan")
+    seat_rotation: float = float("nan")
+    seat_speed: float = float("nan")
+    max_displacement_from_seat: float = float("nan")
+    max_rotation_from_seat: float = float("nan")
+    hydroelastic_modulus: float | None = None
+    hydroelastic_refused: int = 0
+
+    @property
+    def held_from_seat(self) -> bool:
+        """Whether the object stayed within both bounds of where seating left it.
+
+        Over settling and the turned gravity: whether the seated grasp held.
+
+        A multi-finger hand's fingers do not stop where the plan put them: they
+        seat the object a few millimetres and degrees away (5-20 mm and up to
+        35° for the Allegro hand on YCB objects) and then hold it there, or
+        push it on out of the hand.  ``held`` counts from the plan and calls
+        the first "dropped"; this tells the two apart.  An object the squeeze
+        keeps pushing is not held: it is still moving when the fingers have
+        seated and goes on past the bounds (the Allegro hand's thumbless grasps
+        of the sugar box, moving at 0.15-0.5 m/s when seated, end up metres
+        away under the turned gravity).  With ``seat=0`` (nothing to seat) it
+        is ``held``.
+        """
+        if np.isnan(self.max_displacement_from_seat):
+            return self.held
+        return bool(
+            self.max_displacement_from_seat <= self.bounds[0]
+            and self.max_rotation_from_seat <= self.bounds[1]
+        )
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (``held_from_seat`` included)."""
+        return jsonable(dict(vars(self), held_from_seat=self.held_from_seat))
+
+    def __str__(self) -> str:
+        seated = (
+            ""
+            if np.isnan(self.seat_displacement)
+            else (
+                f"; seated {self.seat_displacement * 1e3:.2f} mm and "
+                f"{np.degrees(self.seat_rotation):.2f} deg from the plan, "
+                f"moving at {self.seat_speed * 1e3:.3g} mm/s"
+                + (
+                    ""
+                    if np.isnan(self.max_displacement_from_seat)  # an older record
+                    else (
+                        f", then at most {self.max_displacement_from_seat * 1e3:.2f}"
+                        f" mm and {np.degrees(self.max_rotation_from_seat):.2f} deg "
+                        "from there"
+                    )
+                )
+            )
+        )
+        return (
+            f"{'held' if self.held else 'dropped'}: moved at most "
+            f"{self.max_displacement * 1e3:.2f} mm and "
+            f"{np.degrees(self.max_rotation):.2f}"
+            f" deg (bounds {self.bounds[0] * 1e3:g} mm, "
+            f"{np.degrees(self.bounds[1]):g} deg)"
+            f" over {self.duration:g} s, squeeze {self.squeeze:g} "
+            f"{_squeeze_unit(self.effort_units)}, "
+            f"{len(self.phases)} gravity directions"
+            + (
+                ""
+                if self.hydroelastic_modulus is None
+                else f", hydroelastic fingers ({self.hydroelastic_modulus:g} Pa"
+                + (
+                    f"; {self.hydroelastic_refused} geometries kept point contact)"
+                    if self.hydroelastic_refused
+                    else ")"
+                )
+            )
+            + f"; {self.wall_time:.2f} s wall{seated}"
+        )
+
+
+def _squeeze_unit(units: tuple[str, ...]) -> str:
+    """The squeeze's unit for a summary line: one unit, or both when mixed."""
+    kinds = set(units) or {"N"}
+    if len(kinds) == 1:
+        return kinds.pop()
+    return "(N on prismatic, N·m on revolute joints)"

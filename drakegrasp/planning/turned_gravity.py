@@ -1,0 +1,106 @@
+"""Gravity turned around a grasped object: the shake test's load schedule.
+
+Gravity (``m g``, on the object only, at its centre of mass) is zero while the
+fingers seat, held along the world's −z while the grasp settles, then turned
+through a sequence of directions, each held for a phase; between two
+directions it turns along the great circle through them at a constant rate,
+so its magnitude stays ``m g`` (``_turned``), opposite directions
+included.  ``_TurnedGravity`` is the Drake ``LeafSystem`` that applies it
+to the plant as an externally applied spatial force.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.plant import ExternallyAppliedSpatialForce
+from pydrake.systems.framework import LeafSystem
+
+__all__ = ["DEFAULT_DIRECTIONS", "GRAVITY"]
+
+GRAVITY = 9.81
+"""Magnitude of the turned gravity, m/s²."""
+
+DEFAULT_DIRECTIONS = (
+    (1.0, 0.0, 0.0),
+    (0.0, -1.0, 0.0),
+    (0.0, 0.0, 1.0),
+    (-1.0, 0.0, 0.0),
+    (0.0, 1.0, 0.0),
+    (0.0, 0.0, -1.0),
+)
+"""World directions gravity turns through after settling along −z (each
+consecutive pair orthogonal: every blend turns gravity by 90°)."""
+
+
+class _TurnedGravity(LeafSystem):
+    """Outputs ``m g(t)`` on one body at its centre of mass (world frame)."""
+
+    def __init__(self, body_index, mass, p_BoBcm_B, schedule):
+        super().__init__()
+        self._body, self._mass, self._com = body_index, mass, np.asarray(p_BoBcm_B)
+        self._schedule = schedule
+        self.DeclareAbstractOutputPort(
+            "spatial_forces",
+            lambda: AbstractValue.Make([ExternallyAppliedSpatialForce()]),
+            self._calc,
+        )
+
+    def _calc(self, context, output):
+        force = ExternallyAppliedSpatialForce()
+        force.body_index = self._body
+        force.p_BoBq_B = self._com
+        g = self._schedule(context.get_time())
+        force.F_Bq_W = SpatialForce(np.zeros(3), self._mass * GRAVITY * g)
+        output.set_value([force])
+
+
+def _turned(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
+    """Unit vector ``a`` turned towards unit ``b`` by the fraction ``s`` of the angle.
+
+    Along the great circle through both (spherical linear interpolation), at a
+    constant rate; for opposite vectors, about an axis perpendicular to ``a``
+    (the world axis least aligned with ``a``, made perpendicular).  The result
+    is a unit vector for every ``s`` in [0, 1], never the zero vector that a
+    linear blend of opposite vectors passes through.
+    """
+    if s >= 1.0:
+        return b
+    cos = float(np.clip(a @ b, -1.0, 1.0))
+    across = b - cos * a  # b's part perpendicular to a, of length sin(angle)
+    sin = float(np.linalg.norm(across))
+    if sin > 1e-8:
+        u = across / sin
+    elif cos > 0.0:
+        return b  # the same direction
+    else:  # opposite: any perpendicular turns a onto b
+        e = np.zeros(3)
+        e[int(np.argmin(np.abs(a)))] = 1.0
+        u = e - (e @ a) * a
+        u /= np.linalg.norm(u)
+    angle = s * float(np.arctan2(sin, cos))
+    v = np.cos(angle) * a + np.sin(angle) * u
+    return v / np.linalg.norm(v)
+
+
+def _schedule(seat, settle, phase, blend, directions):
+    """Gravity's unit direction at time t (zero while the fingers seat).
+
+    ``directions`` are unit vectors; from each to the next, gravity turns over
+    ``blend`` seconds along the great circle (:func:`_turned`), so its
+    magnitude stays ``m g`` throughout.
+    """
+    dirs = [np.array([0.0, 0.0, -1.0]), *np.asarray(directions, float)]
+
+    def g(t: float) -> np.ndarray:
+        if t < seat:
+            return np.zeros(3)  # the fingers seat on the object first
+        t -= seat
+        if t < settle:
+            return dirs[0]
+        k = min(int((t - settle) // phase), len(dirs) - 2)
+        s = min((t - settle - k * phase) / blend, 1.0) if blend > 0 else 1.0
+        return _turned(dirs[k], dirs[k + 1], s)
+
+    return g
