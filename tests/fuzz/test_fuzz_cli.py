@@ -75,12 +75,34 @@ def _one_line_error(proc, code=1):
         (("analyze", "--tol", "abc"), "argument --tol"),
         (("batch",), "required: input, output"),
         (("plan", "--json", "--out", "x.parquet"), "not allowed with argument"),
+        (("plan", "--shake", "abc"), "argument --shake: not a whole number"),
+        (("plan", "--shake", "-1"), "argument --shake: must be >= 0"),
+        (("plan", "--shake", "1", "--squeeze", "0"), "argument --squeeze: must be"),
+        (("plan", "--shake", "1", "--damping", "inf"), "argument --damping: must be"),
+        (("plan", "--shake", "1", "--hydroelastic", "1e400"), "a modulus in Pa"),
+        (("plan", "--shake", "1", "--hydroelastic", "-"), "a modulus in Pa"),
     ],
 )
 def test_argument_errors_are_one_line_too(argv, message):
     line = _one_line_error(_run(*argv), code=2)
     assert line.startswith("drakegrasp") and message in line, line
     assert line.endswith("--help)"), line
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (("--shake", "0"), "--shake must be a whole number of candidates from 1"),
+        (("--shake", "99999"), "--shake must be a whole number of candidates"),
+        (("--stiffness", "5"), "--stiffness is an option of the shake test"),
+        (("--shake", "1", "--hydroelastic", "1e20"), "--hydroelastic must be None"),
+        (("--shake", "1", "--hydroelastic", "1"), "--hydroelastic must be None"),
+        (("parallel_jaw_flat_box", "--shake", "1"), "--shake is for an object"),
+    ],
+)
+def test_plan_shake_refusals_are_one_line_before_planning(argv, message):
+    line = _one_line_error(_run("plan", "--num", "5", *argv), code=1)
+    assert message in line, line
 
 
 def test_bad_inputs_one_line_each(tmp_path):
