@@ -27,7 +27,8 @@
 #    distance queries and ranks the grasps;
 # 3. look at the ranking: what the score is and why it is not ε;
 # 4. check it against physics: `dg.shake_test` squeezes a grasp in a Drake
-#    simulation and turns gravity around it;
+#    simulation and turns gravity around it, and `dg.shake_candidates` ranks
+#    the best few by it;
 # 5. plan from what a camera saw: a one-sided point cloud;
 # 6. do it all again with a multi-finger hand, the Allegro hand, on a can.
 
@@ -162,6 +163,22 @@ print("   ", dg.shake_test(scene.add_models, worst, squeeze=squeeze, **kw))
 # %% [markdown]
 # `benchmarks/bench_plan.py` runs this check on ten top and ten random
 # candidates of several objects, at a light and a firm squeeze.
+#
+# ### Ranking by the shake
+#
+# `dg.shake_candidates` shakes the first `top` candidates with the same options
+# and lists them again: those that held first, then those that dropped, each
+# group in the planner's order, each line naming its place in the plan.
+# "Held" counts from where the fingers seated the object (`held_from="seat"`),
+# which a multi-finger hand moves by millimetres.  The WSG-50 touches with tip
+# spheres; a gripper with flat pads would need `hydroelastic_modulus=1e6`:
+# Drake's point contact touches a flat pad at one point, and the object
+# pivots between two such points.
+
+# %%
+ranked = dg.shake_candidates(scene.add_models, result, top=5, squeeze=squeeze, **kw)
+print(ranked)
+print("use:", ranked.best)
 
 # %% [markdown]
 # ## From a one-sided point cloud
