@@ -1318,7 +1318,11 @@ def _shake_options(args: argparse.Namespace) -> dict | None:
     try:
         check_settings(args.shake, "seat", options)
     except GraspError as e:
-        raise _in_flag_words(e, flags) from None
+        words = _in_flag_words(e, flags)
+        # the flag's spelling of the library's None
+        raise type(words)(
+            str(words).replace("must be None (", "must be none (")
+        ) from None
     return options
 
 
