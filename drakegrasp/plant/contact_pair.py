@@ -2,7 +2,9 @@
 
 :func:`pair_points` turns Drake's answer for a pair (its witness points,
 normal and ψ) into the pair's contact points: the corners of the patch when a
-flat pad lies on a flat face (:mod:`~drakegrasp.plant.contact_patches`), else
+flat pad lies on a flat face or the ends of the line along which a flat face
+touches a cylinder's or capsule's side
+(:mod:`~drakegrasp.plant.contact_patches`), else
 the exact contact (:mod:`~drakegrasp.plant.exact_contact`), else Drake's
 witness points with the normal that
 :func:`~drakegrasp.plant.contact_normals.choose_normal` picks.
@@ -15,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import Sphere
+from pydrake.geometry import Capsule, Cylinder, Sphere
 from pydrake.math import RigidTransform
 
 from drakegrasp.errors import NoContactsError, PenetrationError
@@ -25,7 +27,11 @@ from drakegrasp.plant.contact_normals import (
     clean_unit,
     normal_source,
 )
-from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL, patch_vertices
+from drakegrasp.plant.contact_patches import (
+    PATCH_ANGLE_TOL,
+    line_vertices,
+    patch_vertices,
+)
 from drakegrasp.plant.exact_contact import closest_pair
 from drakegrasp.plant.shape_queries import PosedShape
 from drakegrasp.plant.sphere_tips import (
@@ -160,6 +166,15 @@ def pair_points(
                         PairPoint(p, n_O, gap, p - gap * n_O, "patch", k, True)
                         for k, (p, gap) in enumerate(verts)
                     ]
+        line = _line_points(
+            inspector,
+            (go, obj_pieces, X_WGa, R_OGa),
+            (gf, fin_pieces, X_WGb, R_OGb),
+            to_O,
+            tol,
+        )
+        if line:
+            return line
     exact = closest_pair(
         PosedShape(inspector.GetShape(go), R_OGa, to_O(X_WGa.translation())),
         PosedShape(inspector.GetShape(gf), R_OGb, to_O(X_WGb.translation())),
@@ -195,6 +210,62 @@ def pair_points(
         )
         n_O = clean_unit(n_O)
     return [PairPoint(p_OCa, n_O, psi, p_OCb, source, None, exact is not None)]
+
+
+def _round_side(shape, pieces) -> tuple[float, float] | None:
+    """(radius, half length) of a cylinder's or capsule's straight side.
+
+    None unless ``shape`` is one and every surface piece at the witness point
+    is its side (a normal across the axis, ``z`` of the geometry frame).
+    """
+    if not isinstance(shape, Cylinder | Capsule) or not pieces:
+        return None
+    if any(p.polygon_G is not None or abs(p.normal_G[2]) > 1e-9 for p in pieces):
+        return None
+    return float(shape.radius()), 0.5 * float(shape.length())
+
+
+def _line_points(inspector, obj, fin, to_O, tol: float) -> list[PairPoint]:
+    """A flat face along a cylinder's (capsule's) side: the ends of the line.
+
+    ``obj`` and ``fin`` are each ``(geometry, pieces at the witness, X_WG,
+    R_OG)``.  Either may be the round one (an object cylinder between flat
+    pads, or a finger's cylindrical link on a box's face).  Empty when the
+    pair is not such a line contact
+    (:func:`~drakegrasp.plant.contact_patches.line_vertices`).
+    """
+    for round_, flat, round_is_object in ((obj, fin, True), (fin, obj, False)):
+        g_round, pieces_round, X_round, R_round = round_
+        side = _round_side(inspector.GetShape(g_round), pieces_round)
+        if side is None:
+            continue
+        _, pieces_flat, X_flat, R_flat = flat
+        for piece in pieces_flat:
+            if piece.polygon_G is None:
+                continue
+            w = clean_unit(R_flat @ piece.normal_G)  # towards the round body
+            ends = line_vertices(
+                face_normal_O=w,
+                poly_face_O=_to_O_points(piece.polygon_G, X_flat, to_O),
+                axis_O=R_round[:, 2],
+                centre_O=to_O(X_round.translation()),
+                radius=side[0],
+                half_length=side[1],
+                tol=tol,
+            )
+            if len(ends) != 2:
+                continue
+            if round_is_object:  # points on the object's side, normal into it: w
+                return [
+                    PairPoint(p, w, gap, p - gap * w, "patch", k, True)
+                    for k, (p, gap) in enumerate(ends)
+                ]
+            # points on the object's face below the finger's line, normal -w
+            return [
+                PairPoint(p - gap * w, -w, gap, p, "patch", k, True)
+                for k, (p, gap) in enumerate(ends)
+            ]
+    return []
 
 
 def _pieces_in(inspector, gid, p_GC: np.ndarray):

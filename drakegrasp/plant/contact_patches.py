@@ -9,7 +9,15 @@ tolerance, and returns **each vertex** of that patch polygon with its gap ``ψ``
 :func:`drakegrasp.plant.contacts.find_contacts` reports one contact per vertex
 (same normal), so the pad's resistance to torsion and tilt appears in the
 analysis.  Patches on a cylinder's flat cap (a disc) are not polygons and stay
-a single witness point.  numpy only.
+a single witness point.
+
+A flat face along the side of a cylinder or a capsule (the face parallel to
+the axis within :data:`PATCH_ANGLE_TOL`) touches along a line, which Drake
+also reports as one point: :func:`line_vertices` clips that line to the face
+polygon and to the part within the distance tolerance and returns **its two
+ends**.  Their friction cones span every load the line can carry, as a
+polygon patch's corners span its area's, so a flat pad on a cylinder resists
+turning about the normal, which one point cannot.  numpy only.
 """
 
 from __future__ import annotations
@@ -18,7 +26,7 @@ import numpy as np
 
 from drakegrasp.plant._shapes import plane_basis
 
-__all__ = ["PATCH_ANGLE_TOL", "clip_convex", "patch_vertices"]
+__all__ = ["PATCH_ANGLE_TOL", "clip_convex", "line_vertices", "patch_vertices"]
 
 PATCH_ANGLE_TOL = np.radians(2.0)
 """Two flat faces whose normals are opposite within this angle (rad) form a patch."""
@@ -126,3 +134,80 @@ def patch_vertices(
     inter = _clip(inter, g, tol - g0)
     inter = _dedupe(inter, 1e-9)
     return [(origin + x[0] * u + x[1] * w, g0 + float(g @ x)) for x in inter]
+
+
+def line_vertices(
+    *,
+    face_normal_O: np.ndarray,
+    poly_face_O: np.ndarray,
+    axis_O: np.ndarray,
+    centre_O: np.ndarray,
+    radius: float,
+    half_length: float,
+    tol: float,
+) -> list[tuple[np.ndarray, float]]:
+    """The ends of the line along which a flat face touches a cylinder's side.
+
+    Parameters
+    ----------
+    face_normal_O : (3,) float
+        The flat face's outward unit normal, towards the round body, frame O.
+    poly_face_O : (k, 3) float
+        The flat face's polygon, metres, frame O.
+    axis_O : (3,) float
+        The round body's unit axis, frame O.
+    centre_O : (3,) float
+        The centre of its straight part, metres, frame O.
+    radius, half_length : float
+        Its radius and half the length of its straight part, metres.
+    tol : float
+        Largest gap (metres) kept on the line.
+
+    Returns
+    -------
+    list of ((3,) float, float)
+        Two points of the round body's side, frame O, the ends of the part of
+        the line that lies over the face and within ``tol`` of its plane, each
+        with its gap ``ψ``: the distance along ``face_normal_O`` from the
+        face's plane.  Empty when the face is not parallel to the axis (within
+        :data:`PATCH_ANGLE_TOL`), or the part is shorter than a micrometre.
+    """
+    w = np.asarray(face_normal_O, float)
+    a = np.asarray(axis_O, float)
+    if abs(float(w @ a)) > np.sin(PATCH_ANGLE_TOL):
+        return []
+    across = -w - float(-w @ a) * a  # the round body's side facing the face
+    norm = float(np.linalg.norm(across))
+    if norm < 1e-12:
+        return []
+    start = centre_O + radius * across / norm  # the line: start + t a
+    q = poly_face_O[0]
+    # gap(t) = w · (start + t a - q): affine in t
+    g0, g1 = float(w @ (start - q)), float(w @ a)
+    lo, hi = -half_length, half_length
+    lo, hi = _clip_interval(lo, hi, g1, tol - g0)
+    u, v = plane_basis(w)
+
+    def to2(P):
+        d = np.asarray(P) - q
+        return np.array([d @ u, d @ v])
+
+    poly = _ccw(np.array([to2(P) for P in poly_face_O]))
+    s0, s1 = to2(start), np.array([a @ u, a @ v])  # the line in 2-D: s0 + t s1
+    for i in range(len(poly)):
+        p0, p1 = poly[i], poly[(i + 1) % len(poly)]
+        edge = p1 - p0
+        outward = np.array([edge[1], -edge[0]])
+        lo, hi = _clip_interval(lo, hi, float(outward @ s1), float(outward @ (p0 - s0)))
+    if not hi - lo > 1e-6:
+        return []
+    return [(start + t * a, g0 + g1 * t) for t in (lo, hi)]
+
+
+def _clip_interval(lo: float, hi: float, k: float, b: float) -> tuple[float, float]:
+    """``[lo, hi]`` cut to the ``t`` with ``k t <= b`` (empty: ``lo > hi``)."""
+    if abs(k) < 1e-15:
+        return (lo, hi) if b >= 0 else (1.0, 0.0)
+    if k > 0:
+        return lo, min(hi, b / k)
+    return max(lo, b / k), hi

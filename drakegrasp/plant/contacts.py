@@ -37,7 +37,9 @@ finger tip on a box, cylinder, sphere or convex hull over arrays,
 **Flat patches.**  A flat pad on a flat face is reported as one contact at
 **each vertex** of its patch polygon (same normal; ``ψ`` the gap at the
 vertex), see :mod:`~drakegrasp.plant.contact_patches`.  A square pad on a box
-face thus gives four contacts.  ``patches="witness"`` turns patch handling off.
+face thus gives four contacts, and a flat face along a cylinder's or
+capsule's side two, the ends of its line of contact.  ``patches="witness"``
+turns patch handling off.
 """
 
 from __future__ import annotations
