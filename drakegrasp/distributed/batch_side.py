@@ -110,8 +110,6 @@ def _in_the_input(error: GraspError, start: int) -> GraspError:
     The engine names a faulty grasp by its index in the arrays it was given;
     a partition's first grasp is grasp ``start`` of the input.
     """
-    if start == 0:
-        return error
     text = _GRASP_NAMED.sub(lambda m: f"grasp {int(m.group(1)) + start}", str(error))
     return type(error)(text)
 
@@ -129,6 +127,8 @@ def _partition(
         parts = [a for _, a in run(positions, normals, **arrays, **options,
                                    chunk_size=chunk_size, workers=1)]  # fmt: skip
     except GraspError as e:
+        if start == 0:  # already named by its place in the input
+            raise
         raise _in_the_input(e, start) from e
     names = parts[0].keys() if parts else ()
     out = {n: np.concatenate([p[n] for p in parts]) for n in names}

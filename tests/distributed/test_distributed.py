@@ -226,13 +226,17 @@ def test_a_length_out_of_scale_is_named_in_the_input_before_connecting(grasps):
         )
 
 
+@pytest.mark.parametrize("where", [25, 5])
 @pytest.mark.parametrize("fault", ["length", "position"])
 def test_a_dask_array_input_names_the_faulty_grasp_by_its_place_in_the_input(
-    client, grasps, fault
+    client, grasps, fault, where
 ):
     """A Dask array's blocks are checked inside their partitions, where the
     engine numbers grasps from the partition's start: grasp 25 was named
-    "grasp 5".  The message now names it as the local engine does."""
+    "grasp 5".  The message now names it as the local engine does.  In the
+    first partition (grasp 5) the error is the engine's own: re-raised from
+    itself, it once made a cause cycle that Dask's traceback pickling
+    followed until memory ran out."""
     da = pytest.importorskip("dask.array")
     import drakegrasp as dg
 
@@ -241,20 +245,21 @@ def test_a_dask_array_input_names_the_faulty_grasp_by_its_place_in_the_input(
     P = np.array(P[:K])
     b = np.full(K, 0.1)
     if fault == "length":
-        b[25] = 1e-15
-        error, match = dg.InvalidGraspError, r"grasp 25 is 1e-15 m"
+        b[where] = 1e-15
+        error, match = dg.InvalidGraspError, rf"grasp {where} is 1e-15 m"
     else:
-        P[25, 1] = np.nan
-        error, match = dg.InvalidContactError, r"position of grasp 25, contact 1"
+        P[where, 1] = np.nan
+        error, match = dg.InvalidContactError, rf"position of grasp {where}, contact 1"
     kw = dict(characteristic_lengths=b, metrics=("isotropy",))
     with pytest.raises(error, match=match):
         batch_force_closure(P, Nrm[:K], mu=mu[:K], **kw)
-    with pytest.raises(error, match=match):
+    with pytest.raises(error, match=match) as info:
         evaluate_on_cluster(
             client, da.from_array(P, chunks=(10, -1, -1)),
             da.from_array(Nrm[:K], chunks=(10, -1, -1)), mu=mu[:K],
             chunk_size=10, partition_chunks=1, **kw,
         )  # fmt: skip
+    assert info.value.__cause__ is not info.value
 
 
 def test_an_iterator_of_metrics_reaches_every_partition(client, grasps):
