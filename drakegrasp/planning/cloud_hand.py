@@ -57,7 +57,9 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    over which the ranking averages the weight capacity
    (:func:`~drakegrasp.planning.multifinger.fan_capacity`).  Only a box's face lying
    flat on a flat patch touches along an area and reports the patch's
-   corners, as a pad on a body's flat face does.  (Every touched point of
+   corners, as a pad on a body's flat face does (on a body, a face along a
+   cylinder's side also reports the two ends of its line; a cloud has no
+   axis to find it by).  (Every touched point of
    the band, or its hull's corners, made 11-28 contacts where the body
    route's analysis of the same pose finds 3-7: a finger link lying along
    the can's side became a patch 16 mm wide, resisting torsion and tilt it

@@ -76,8 +76,9 @@ NEVER_CLOSURE = {"hard_finger": 2, "frictionless": 6}
 """Contacts at most this many are never force closure in space, by model: two
 hard fingers' forces all meet the line through their points, so no moment
 about it is resisted; six normals cannot positively span the six wrench
-dimensions.  Such re-closed copies count as slipping without an LP (a cylinder
-or a sphere between two pads leaves many with one contact per pad)."""
+dimensions.  Such re-closed copies count as slipping without an LP (a sphere
+between two pads leaves many with one contact per pad; a cylinder's side
+touched by a flat pad gives two, the ends of the line)."""
 
 
 def perturbed_mu(mus: np.ndarray) -> np.ndarray:

@@ -172,6 +172,7 @@ def pair_points(
             (gf, fin_pieces, X_WGb, R_OGb),
             to_O,
             tol,
+            psi,
         )
         if line:
             return line
@@ -215,24 +216,39 @@ def pair_points(
 def _round_side(shape, pieces) -> tuple[float, float] | None:
     """(radius, half length) of a cylinder's or capsule's straight side.
 
-    None unless ``shape`` is one and every surface piece at the witness point
-    is its side (a normal across the axis, ``z`` of the geometry frame).
+    None unless ``shape`` is one and a surface piece at the witness point is
+    its side or, for a witness that a slight tilt moved off the side, a
+    piece within :data:`~drakegrasp.plant.contact_patches.PATCH_ANGLE_TOL` of
+    it (a cylinder's rim, a capsule's hemisphere near its equator); a
+    cylinder's flat cap alone is not.
     """
     if not isinstance(shape, Cylinder | Capsule) or not pieces:
         return None
-    if any(p.polygon_G is not None or abs(p.normal_G[2]) > 1e-9 for p in pieces):
+    if not any(
+        p.polygon_G is None and abs(p.normal_G[2]) <= np.sin(PATCH_ANGLE_TOL)
+        for p in pieces
+    ):
         return None
     return float(shape.radius()), 0.5 * float(shape.length())
 
 
-def _line_points(inspector, obj, fin, to_O, tol: float) -> list[PairPoint]:
+LINE_PSI_TOL = 1e-4
+"""Largest difference (m) between a line's nearest end and Drake's ψ for the
+pair, past which the line is not the pair's contact (Drake's own ψ is within
+0.05 mm on a box on a cylinder or capsule: the Contacts guide)."""
+
+
+def _line_points(inspector, obj, fin, to_O, tol: float, psi: float) -> list[PairPoint]:
     """A flat face along a cylinder's (capsule's) side: the ends of the line.
 
     ``obj`` and ``fin`` are each ``(geometry, pieces at the witness, X_WG,
     R_OG)``.  Either may be the round one (an object cylinder between flat
-    pads, or a finger's cylindrical link on a box's face).  Empty when the
+    pads, or a finger's cylindrical link on a box's face).  Each end's normal
+    is the object's (the round side's across its axis, or the flat face's)
+    and its ``ψ`` the distance along it to the other surface.  Empty when the
     pair is not such a line contact
-    (:func:`~drakegrasp.plant.contact_patches.line_vertices`).
+    (:func:`~drakegrasp.plant.contact_patches.line_vertices`), or the line's
+    nearest end is not where Drake's ``psi`` says the pair is closest.
     """
     for round_, flat, round_is_object in ((obj, fin, True), (fin, obj, False)):
         g_round, pieces_round, X_round, R_round = round_
@@ -240,6 +256,7 @@ def _line_points(inspector, obj, fin, to_O, tol: float) -> list[PairPoint]:
         if side is None:
             continue
         _, pieces_flat, X_flat, R_flat = flat
+        axis = R_round[:, 2]
         for piece in pieces_flat:
             if piece.polygon_G is None:
                 continue
@@ -247,23 +264,26 @@ def _line_points(inspector, obj, fin, to_O, tol: float) -> list[PairPoint]:
             ends = line_vertices(
                 face_normal_O=w,
                 poly_face_O=_to_O_points(piece.polygon_G, X_flat, to_O),
-                axis_O=R_round[:, 2],
+                axis_O=axis,
                 centre_O=to_O(X_round.translation()),
                 radius=side[0],
                 half_length=side[1],
                 tol=tol,
             )
-            if len(ends) != 2:
+            if len(ends) != 2 or abs(min(g for _, g in ends) - psi) > LINE_PSI_TOL:
                 continue
-            if round_is_object:  # points on the object's side, normal into it: w
+            if round_is_object:
+                # the side's inward normal: w across the axis; psi along it
+                n_O = clean_unit(w - (w @ axis) * axis)
+                cos = float(w @ n_O)
                 return [
-                    PairPoint(p, w, gap, p - gap * w, "patch", k, True)
-                    for k, (p, gap) in enumerate(ends)
+                    PairPoint(p, n_O, g / cos, p - (g / cos) * n_O, "line", k, True)
+                    for k, (p, g) in enumerate(ends)
                 ]
-            # points on the object's face below the finger's line, normal -w
+            # the object's face below the finger's line, its normal -w
             return [
-                PairPoint(p - gap * w, -w, gap, p, "patch", k, True)
-                for k, (p, gap) in enumerate(ends)
+                PairPoint(p - g * w, -w, g, p, "line", k, True)
+                for k, (p, g) in enumerate(ends)
             ]
     return []
 

@@ -170,18 +170,21 @@ def line_vertices(
         the line that lies over the face and within ``tol`` of its plane, each
         with its gap ``ψ``: the distance along ``face_normal_O`` from the
         face's plane.  Empty when the face is not parallel to the axis (within
-        :data:`PATCH_ANGLE_TOL`), or the part is shorter than a micrometre.
+        :data:`PATCH_ANGLE_TOL`), looks away from the round body (a pad's
+        back face), or the part is shorter than a micrometre.
     """
     w = np.asarray(face_normal_O, float)
     a = np.asarray(axis_O, float)
     if abs(float(w @ a)) > np.sin(PATCH_ANGLE_TOL):
+        return []
+    q = poly_face_O[0]
+    if float(w @ (centre_O - q)) <= 0.0:  # the face looks away: a pad's back
         return []
     across = -w - float(-w @ a) * a  # the round body's side facing the face
     norm = float(np.linalg.norm(across))
     if norm < 1e-12:
         return []
     start = centre_O + radius * across / norm  # the line: start + t a
-    q = poly_face_O[0]
     # gap(t) = w · (start + t a - q): affine in t
     g0, g1 = float(w @ (start - q)), float(w @ a)
     lo, hi = -half_length, half_length
@@ -194,19 +197,29 @@ def line_vertices(
 
     poly = _ccw(np.array([to2(P) for P in poly_face_O]))
     s0, s1 = to2(start), np.array([a @ u, a @ v])  # the line in 2-D: s0 + t s1
+    # a line along an edge of the face is on it: offsets below this are round-off
+    slack = 1e-12 * max(1.0, float(np.max(np.abs(poly))), radius, half_length)
     for i in range(len(poly)):
         p0, p1 = poly[i], poly[(i + 1) % len(poly)]
         edge = p1 - p0
-        outward = np.array([edge[1], -edge[0]])
-        lo, hi = _clip_interval(lo, hi, float(outward @ s1), float(outward @ (p0 - s0)))
+        length = float(np.linalg.norm(edge))
+        if length == 0.0:  # a repeated vertex
+            continue
+        outward = np.array([edge[1], -edge[0]]) / length
+        b = float(outward @ (p0 - s0)) + slack
+        lo, hi = _clip_interval(lo, hi, float(outward @ s1), b)
     if not hi - lo > 1e-6:
         return []
     return [(start + t * a, g0 + g1 * t) for t in (lo, hi)]
 
 
 def _clip_interval(lo: float, hi: float, k: float, b: float) -> tuple[float, float]:
-    """``[lo, hi]`` cut to the ``t`` with ``k t <= b`` (empty: ``lo > hi``)."""
-    if abs(k) < 1e-15:
+    """``[lo, hi]`` cut to the ``t`` with ``k t <= b`` (empty: ``lo > hi``).
+
+    ``k`` is a cosine or a unit slope: below 1e-12 the line runs along the
+    boundary, kept when ``b >= 0``.
+    """
+    if abs(k) < 1e-12:
         return (lo, hi) if b >= 0 else (1.0, 0.0)
     if k > 0:
         return lo, min(hi, b / k)

@@ -121,14 +121,17 @@ class PlantContact:
         Their names in the scene graph.
     normal_source : str
         Which surface the normal belongs to: ``"object"``, ``"finger"`` (a
-        finger's face on an edge or corner of the object), ``"patch"``,
-        ``"edge"`` or ``"corner"`` (a curved finger on an edge or corner of the
-        object, a cylinder's rim included), and, for a contact that is not
+        finger's face on an edge or corner of the object), ``"patch"`` (a
+        corner of a flat patch), ``"line"`` (an end of the line along which a
+        flat face touches a cylinder's or capsule's side; the object's
+        normal), ``"edge"`` or ``"corner"`` (a curved finger on an edge or
+        corner of the object, a cylinder's rim included), and, for a contact
+        that is not
         ``exact``, ``"witness points"`` or ``"drake"`` (see
         :mod:`~drakegrasp.plant.contact_normals`).
     patch_vertex : int or None
-        Index of this contact among the vertices of a flat patch, or None for a
-        point contact.
+        Index of this contact among the vertices of a flat patch or the two
+        ends of a line, or None for a point contact.
     exact : bool
         True when the point, normal and ``ψ`` were computed exactly (to
         round-off) and certified (:mod:`drakegrasp.plant.exact_contact`; the
