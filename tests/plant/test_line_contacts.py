@@ -27,6 +27,19 @@ def _face(x0, x1, y0, y1, z):
     return np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]])
 
 
+def _moved_ends(poly, Q, t):
+    """``_ends(poly)`` with the face and the cylinder rotated by Q, moved by t."""
+    return line_vertices(
+        face_normal_O=Q @ np.array([0.0, 0.0, -1.0]),
+        poly_face_O=poly @ Q.T + t,
+        axis_O=Q @ np.array([1.0, 0.0, 0.0]),
+        centre_O=t,
+        radius=R,
+        half_length=H,
+        tol=1e-3,
+    )
+
+
 def _ends(poly, *, normal=(0.0, 0.0, -1.0), tol=1e-3, axis=(1.0, 0.0, 0.0)):
     return line_vertices(
         face_normal_O=np.array(normal),
@@ -106,17 +119,8 @@ def test_a_pads_back_face_gives_no_line():
 def test_a_face_whose_edge_runs_along_the_line_keeps_it(angles, shift):
     """The face's edge y = 0 lies exactly over the line: round-off once gave
     the whole line or nothing at random (1,008 against 992 of 2,000 poses)."""
-    Q = Rotation.from_euler("xyz", angles).as_matrix()
-    t = np.array(shift)
-    ends = line_vertices(
-        face_normal_O=Q @ np.array([0.0, 0.0, -1.0]),
-        poly_face_O=_face(-0.03, 0.03, 0.0, 0.02, R) @ Q.T + t,
-        axis_O=Q @ np.array([1.0, 0.0, 0.0]),
-        centre_O=t,
-        radius=R,
-        half_length=H,
-        tol=1e-3,
-    )
+    Q, t = Rotation.from_euler("xyz", angles).as_matrix(), np.array(shift)
+    ends = _moved_ends(_face(-0.03, 0.03, 0.0, 0.02, R), Q, t)
     assert len(ends) == 2
     np.testing.assert_allclose(
         sorted(float((p - t) @ (Q @ [1.0, 0.0, 0.0])) for p, _ in ends),
@@ -131,19 +135,10 @@ def test_a_face_whose_edge_runs_along_the_line_keeps_it(angles, shift):
     st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3),
 )
 def test_rigid_motion_moves_the_ends_with_it(angles, shift):
-    Q = Rotation.from_euler("xyz", angles).as_matrix()
-    t = np.array(shift)
+    Q, t = Rotation.from_euler("xyz", angles).as_matrix(), np.array(shift)
     poly = _face(-0.01, 0.03, -0.01, 0.01, R + 2e-4)
     here = _ends(poly)
-    there = line_vertices(
-        face_normal_O=Q @ np.array([0.0, 0.0, -1.0]),
-        poly_face_O=poly @ Q.T + t,
-        axis_O=Q @ np.array([1.0, 0.0, 0.0]),
-        centre_O=t,
-        radius=R,
-        half_length=H,
-        tol=1e-3,
-    )
+    there = _moved_ends(poly, Q, t)
     assert len(there) == 2
     for (p, g), (p2, g2) in zip(here, there, strict=True):
         np.testing.assert_allclose(p2, Q @ p + t, atol=1e-12)
