@@ -494,12 +494,6 @@ def _strictly_positive(text: str) -> float:
     )
 
 
-def _non_negative(text: str) -> float:
-    return _parsed(
-        text, float, "a number", lambda x: 0.0 <= x < float("inf"), "finite and >= 0"
-    )
-
-
 def _modulus(text: str) -> float | str:
     if text.strip().lower() == "none":
         return "none"
@@ -1495,7 +1489,7 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
     )
     plan.add_argument(
         "--damping",
-        type=_non_negative,
+        type=_positive_float,
         default=None,
         metavar="D",
         help="with --shake: the fingers' damping, N·s/m or N·m·s/rad "

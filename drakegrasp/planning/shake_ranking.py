@@ -79,8 +79,8 @@ class ShakenCandidate:
         Whether it held, counted as ``held_from`` says (False when not
         simulated).
     error : str
-        Why Drake could not simulate it (its ``SolverError``, one line);
-        empty otherwise.
+        Why Drake could not simulate it (its ``SolverError``, or a
+        ``ModelError`` past the first candidate, one line); empty otherwise.
     """
 
     candidate: GraspCandidate
@@ -220,15 +220,17 @@ def _first_candidates(candidates, top: int) -> list[GraspCandidate]:
 
 
 def _recorded(settings: dict) -> dict:
-    """The options as JSON can hold them: a pose as its dictionary, a body by name."""
+    """The options as JSON can hold them.
+
+    A pose as its dictionary, a ``BodyIndex`` as its repr (a ``RigidBody``
+    never gets here: each shake builds a fresh plant, which refuses it).
+    """
     out = dict(settings)
     if out["X_WO"] is not None:
         out["X_WO"] = pose_dict(out["X_WO"])
     body = out["object_body"]
     if body is not None and not isinstance(body, str | int | np.integer):
-        out["object_body"] = (
-            body.name() if callable(getattr(body, "name", None)) else (repr(body))
-        )
+        out["object_body"] = repr(body)
     return out
 
 

@@ -38,6 +38,7 @@ from pydrake.geometry import (
 from pydrake.multibody.plant import ContactModel
 from pydrake.multibody.tree import RigidBody
 
+from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError, ModelError
 
 __all__ = ["MODULI", "check_hydroelastic_modulus", "use_hydroelastic_contact"]
@@ -75,14 +76,9 @@ def check_hydroelastic_modulus(value, name: str = "hydroelastic_modulus"):
     if value is None:
         return None
     try:
-        x = (
-            float(value)
-            if isinstance(value, int | float | np.integer | np.floating)
-            and not isinstance(value, bool)
-            else float("nan")
-        )
-    except OverflowError:  # a Python int past a float's range
-        x = float("inf")
+        x = real_scalar(name, value)
+    except InvalidOptionError:  # not a real number: refused with the range below
+        x = float("nan")
     if not MODULI[0] <= x <= MODULI[1]:
         raise InvalidOptionError(
             f"{name} must be None (the models' own contact) or a number of "

@@ -247,3 +247,37 @@ def test_add_models_that_returns_no_pair_is_a_model_error(jaw):
         ModelError, match=r"add_models must return \(hand, object_body\)"
     ):
         dg.shake_test(lambda plant, parser: None, result[0], **SHORT)
+
+
+def test_held_from_chooses_the_count_and_the_groups_keep_the_plans_order(
+    jaw, monkeypatch
+):
+    """Results where the two counts disagree (dropped from the plan, still once
+    seated) and one Drake could not simulate, without simulating: the jaw's
+    real shakes agree in both counts, so they cannot tell the two apart."""
+    import drakegrasp.planning.shake_ranking as ranking
+
+    scene, result = jaw
+    given = list(result[:5])
+
+    def fake(add_models, candidate, **options):
+        k = given.index(candidate)
+        if k == 3:
+            raise SolverError("stopped at t = 0.1 s (did not converge)")
+        return _result(
+            held=k == 4,
+            max_displacement_from_seat=0.001 if k in (1, 2) else 0.05,
+            max_rotation_from_seat=0.0,
+        )
+
+    monkeypatch.setattr(ranking, "shake_test", fake)
+    seat = dg.shake_candidates(scene.add_models, given, top=5)
+    plan = dg.shake_candidates(scene.add_models, given, top=5, held_from="plan")
+    assert [(s.planned_rank, s.held) for s in seat] == [
+        (1, True), (2, True), (0, False), (4, False), (3, False)
+    ]  # fmt: skip
+    assert [(s.planned_rank, s.held) for s in plan] == [
+        (4, True), (0, False), (1, False), (2, False), (3, False)
+    ]  # fmt: skip
+    assert seat.best is given[1] and plan.best is given[4]
+    assert seat[-1].result is None and "converge" in seat[-1].error
