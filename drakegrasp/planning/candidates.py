@@ -264,12 +264,17 @@ class GraspCandidate:
         )
         if not np.isnan(self.torque_needed):
             shape += f", torque {self.torque_needed:.3g} N·m per joint"
+        if np.isnan(self.weight_capacity):
+            holds = "weight not checked"
+        else:
+            holds = f"holds {self.weight_capacity:.3f} N/N"
+            if not np.isnan(self.squeeze_needed):  # NaN: the weight is unknown
+                holds += f" (squeeze {self.squeeze_needed:.1f} N)"
         return (
             f"sample {self.sample}: "
             f"{'force closure' if self.is_closure else 'no closure'}"
             f", {self.num_contacts} contacts, eps = {self.epsilon:.4f}, robustness "
-            f"{self.robustness:.2f}, holds {self.weight_capacity:.3f} N/N "
-            f"(squeeze {self.squeeze_needed:.1f} N), score {self.score:.4f}; {shape}, "
+            f"{self.robustness:.2f}, {holds}, score {self.score:.4f}; {shape}, "
             f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
         )
 

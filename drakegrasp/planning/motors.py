@@ -1,4 +1,4 @@
-r"""How much joint torque a multi-finger grasp needs to hold the object's weight.
+r"""What a hand's motors must apply to hold the object's weight: torque, squeeze.
 
 A parallel jaw's motor sets a squeeze, so :mod:`~drakegrasp.planning.weight`
 bounds each finger's normal forces.  A hand with revolute fingers sets joint
@@ -51,6 +51,16 @@ candidates and ranks those the hand's actuators hold (``torque_needed`` at
 most the smallest effort limit of the candidate's joints) ahead of the rest;
 ``plan_grasps(..., torque_limit=)`` puts the torque the user will apply (N·m,
 capped by the effort limit) in the limit's place.
+
+**A parallel jaw** presses each finger with at most its actuator's effort
+limit (N), so :func:`with_squeeze_limit` ranks the candidates whose
+``squeeze_needed`` is within it first, in the same way, and says so when none
+is; ``plan_grasps(..., squeeze_limit=)`` puts the squeeze the user will apply
+in the limit's place.  Checked in Drake (``benchmarks/bench_jaw_squeeze.py``:
+Drake's Franka hand, 20 N fingers, the top six on three YCB objects planned
+at the plant's μ = 1, each shaken at a multiple of its own figure, capped at
+20 N): at 0.5 times none of 18 held, at 0.8 times 1, at 1 times 11 and at 1.5
+times 16.
 """
 
 from __future__ import annotations
@@ -95,11 +105,13 @@ reads as ``inf`` (no finger joint bounds the load: contacts on the palm)."""
 __all__ = [
     "BETA_CAP",
     "TORQUE_CHECK",
+    "check_squeeze_limit",
     "check_torque_limit",
     "finger_jacobian",
     "motor_limit",
     "torque_capacity",
     "torque_needed",
+    "with_squeeze_limit",
     "with_torques_needed",
 ]
 
@@ -364,21 +376,86 @@ def with_torques_needed(
     if applied:
         limit = torque_limit
     reason = result.reason or _too_weak(head, limit, applied)
-    if motors_first and math.isfinite(limit):
-        # a stable sort keeps the score order in each group; NaN compares False
-        ranked.sort(key=lambda c: not c.torque_needed <= limit)
-        ranked[:top] = [
-            c if c.closure is not None else dataclasses.replace(
-                c, closure=force_closure(c.grasp)
-            )
-            for c in ranked[:top]
-        ]  # fmt: skip
+    if motors_first:
+        ranked = _held_first(ranked, "torque_needed", limit, top)
     return dataclasses.replace(
         result,
         candidates=tuple(ranked),
         reason=reason,
         time=time.perf_counter() - started,
     )
+
+
+def with_squeeze_limit(
+    result: GraspCandidates,
+    plant,
+    *,
+    top: int,
+    squeeze_limit: float | None = None,
+) -> GraspCandidates:
+    """A parallel jaw's ``result`` with the candidates its motors hold first.
+
+    The jaw holds a candidate's object against its weight, in every direction
+    of :data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS`, only if each
+    finger can press with ``squeeze_needed`` newtons (a lower bound for the
+    planned contacts, see :class:`~drakegrasp.planning.candidates.GraspCandidate`).
+    The candidates whose ``squeeze_needed`` is at most the limit keep their
+    order and come first; those that need more (or whose weight is unknown,
+    NaN) follow, in their order.
+
+    Parameters
+    ----------
+    result : GraspCandidates
+        A parallel jaw's candidates, ranked by score.
+    plant : MultibodyPlant
+        The plant they were planned in (for the actuators' effort limits).
+    top : int
+        The ``certify`` of the run: the first ``top`` candidates after the
+        re-ranking carry the single-grasp verdict (``closure``).
+    squeeze_limit : float or None, optional
+        The squeeze per finger (N) the jaw will apply, capped by the smallest
+        effort limit of the closing joints' actuators (:func:`motor_limit`),
+        the default.  Finite and > 0, else ``InvalidOptionError``.
+
+    Returns
+    -------
+    GraspCandidates
+        Re-ranked (nothing moves when no limit is known: no actuator with a
+        finite effort limit and no ``squeeze_limit``), with ``reason`` saying
+        so when no force-closure candidate is held within the limit.
+    """
+    if squeeze_limit is not None:
+        squeeze_limit = check_squeeze_limit(squeeze_limit)
+    ranked = list(result.candidates)
+    limit = motor_limit(plant, ranked[0]) if ranked else math.inf
+    applied = squeeze_limit is not None and squeeze_limit < limit
+    if applied:
+        limit = squeeze_limit
+    reason = result.reason or _too_weak_jaw(ranked, limit, applied)
+    return dataclasses.replace(
+        result,
+        candidates=tuple(_held_first(ranked, "squeeze_needed", limit, top)),
+        reason=reason,
+    )
+
+
+def _held_first(ranked: list, needed: str, limit: float, top: int) -> list:
+    """``ranked`` with the candidates whose ``needed`` is within ``limit`` first.
+
+    A stable sort keeps each group's order (NaN compares False: not held);
+    the first ``top`` get their single-grasp verdict if they lack it.
+    Nothing moves when ``limit`` is not finite.
+    """
+    if not math.isfinite(limit):
+        return ranked
+    ranked = sorted(ranked, key=lambda c: not getattr(c, needed) <= limit)
+    ranked[:top] = [
+        c if c.closure is not None else dataclasses.replace(
+            c, closure=force_closure(c.grasp)
+        )
+        for c in ranked[:top]
+    ]  # fmt: skip
+    return ranked
 
 
 def check_torque_limit(torque_limit) -> float:
@@ -395,6 +472,24 @@ def check_torque_limit(torque_limit) -> float:
         raise InvalidOptionError(
             f"torque_limit must be a finite number > 0 (N·m per finger joint), "
             f"got {torque_limit!r}"
+        )
+    return value
+
+
+def check_squeeze_limit(squeeze_limit) -> float:
+    """``squeeze_limit`` (N per finger) checked: a finite number > 0.
+
+    Raises
+    ------
+    InvalidOptionError
+        Not a real number, or not finite and > 0; the message names
+        ``squeeze_limit``.
+    """
+    value = real_scalar("squeeze_limit", squeeze_limit)
+    if not 0 < value < math.inf:
+        raise InvalidOptionError(
+            f"squeeze_limit must be a finite number > 0 (N per finger), got "
+            f"{squeeze_limit!r}"
         )
     return value
 
@@ -432,6 +527,30 @@ def _too_weak(head, limit: float, applied: bool = False) -> str:
         f"none of the {len(needed)} best force-closure candidates against the "
         f"object's weight in every direction: they need at least "
         f"{min(needed):.3g} N·m per joint (torque_needed)"
+    )
+
+
+def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:
+    """Why no force-closure candidate is held by a jaw limited to ``limit`` (N), or "".
+
+    ``applied``: the limit is the user's ``squeeze_limit``, not the effort limit.
+    """
+    needed = [
+        c.squeeze_needed
+        for c in candidates
+        if c.is_closure and not np.isnan(c.squeeze_needed)
+    ]
+    if not needed or min(needed) <= limit:
+        return ""
+    who = (
+        f"the jaw at squeeze_limit {limit:.3g} N holds"
+        if applied
+        else f"the jaw's actuators (effort limits from {limit:.3g} N) hold"
+    )
+    return (
+        f"{who} none of the {len(needed)} force-closure candidates against the "
+        f"object's weight in every direction: they need at least "
+        f"{min(needed):.3g} N per finger (squeeze_needed)"
     )
 
 

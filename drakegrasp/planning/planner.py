@@ -32,6 +32,7 @@ candidate or is counted under one rejection reason.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
@@ -65,7 +66,11 @@ from drakegrasp.planning.cloud import (
     read_cloud_fit,
 )
 from drakegrasp.planning.gripper import free_base, parallel_jaw
-from drakegrasp.planning.motors import check_torque_limit
+from drakegrasp.planning.motors import (
+    check_squeeze_limit,
+    check_torque_limit,
+    with_squeeze_limit,
+)
 from drakegrasp.planning.multifinger import (
     DEFAULT_TILT,
     hand_is_parallel_jaw,
@@ -188,6 +193,7 @@ def plan_grasps(
     complete_unseen: bool = True,
     object_mass: float | None = None,
     torque_limit: float | None = None,
+    squeeze_limit: float | None = None,
     preshape=None,
     synergy=None,
     synergy_range=(0.0, 1.0),
@@ -311,6 +317,15 @@ def plan_grasps(
         ``InvalidOptionError``, which a parallel jaw (no ``torque_needed``:
         its ``squeeze_needed`` is in N) and a point cloud without
         ``object_mass`` (no weight, no ``torque_needed``) raise too.
+    squeeze_limit : float, optional
+        Parallel jaws: the squeeze per finger (N) the jaw will apply.  The
+        candidates whose ``squeeze_needed`` is at most this are ranked first,
+        each group in score order
+        (:func:`~drakegrasp.planning.motors.with_squeeze_limit`), and the
+        result's ``reason`` says so when no force-closure candidate is;
+        capped by the closing joints' effort limits, the default.  Finite and
+        > 0, else ``InvalidOptionError``, which a multi-finger hand (give
+        ``torque_limit``) and a point cloud without ``object_mass`` raise too.
     preshape, synergy, synergy_range, approach, standoff : optional
         Multi-finger hands only
         (:func:`~drakegrasp.planning.approach.multi_finger_hand`): the
@@ -362,6 +377,13 @@ def plan_grasps(
         raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
     if object_mass is not None:
         object_mass = _check_positive("object_mass", object_mass, "kg")
+    if squeeze_limit is not None:
+        squeeze_limit = check_squeeze_limit(squeeze_limit)
+        if point_cloud is not None and object_mass is None:
+            raise InvalidOptionError(
+                "squeeze_limit ranks by squeeze_needed, which needs the "
+                "object's weight: give object_mass= (kg) with a point_cloud"
+            )
     if torque_limit is not None:
         torque_limit = check_torque_limit(torque_limit)
         if point_cloud is not None and object_mass is None:
@@ -398,6 +420,8 @@ def plan_grasps(
     }
     if torque_limit is not None:
         settings["torque_limit"] = torque_limit
+    if squeeze_limit is not None:
+        settings["squeeze_limit"] = squeeze_limit
     multi = dict(
         preshape=preshape, synergy=synergy, synergy_range=synergy_range,
         approach=approach, standoff=standoff, tilt=tilt, min_fingers=min_fingers,
@@ -406,6 +430,7 @@ def plan_grasps(
     if point_cloud is None:
         body = _graspable(plant, object_body, hand)
         if not hand_is_parallel_jaw(plant, ctx, body, hand):
+            _jaw_only(squeeze_limit)
             mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
             return plan_multifinger(
                 plant, ctx, body, hand=hand, n=n, mu=mu,
@@ -430,6 +455,7 @@ def plan_grasps(
         )
         settings.update(cloud_normals=fit)
         if not hand_is_parallel_jaw(plant, ctx, plant.world_body(), hand):
+            _jaw_only(squeeze_limit)
             mass = np.nan if object_mass is None else float(object_mass)
             settings.update(cloud_dropped=dropped)
             return plan_multifinger_cloud(
@@ -504,7 +530,7 @@ def plan_grasps(
         surface=FittedCloud(surface) if body is None else surface, tol=tol,
         reference=reference,
     )  # fmt: skip
-    return planning_result(
+    result = planning_result(
         candidates,
         rejections=rejections,
         num_sampled=n,
@@ -514,6 +540,8 @@ def plan_grasps(
         settings=settings,
         started=t0,
     )
+    result = with_squeeze_limit(result, plant, top=certify, squeeze_limit=squeeze_limit)
+    return replace(result, time=time.perf_counter() - t0)
 
 
 def _graspable(plant, object_body, hand) -> RigidBody:
@@ -577,14 +605,26 @@ def _multifinger_only(given: dict) -> None:
         value = given[name]
         if not _is_default(value, default):
             remedy = (
-                "a parallel jaw's squeeze_needed is in N"
+                "a parallel jaw's squeeze_needed is in N per finger: give "
+                "squeeze_limit instead"
                 if name == "torque_limit"
-                else "a parallel jaw opens fully and closes along its chord"
+                else f"a parallel jaw opens fully and closes along its chord: "
+                f"leave {name} out"
             )
             raise InvalidOptionError(
-                f"{name} applies to multi-finger hands; {remedy}: leave {name} "
-                f"out (got {describe(value)})"
+                f"{name} applies to multi-finger hands; {remedy} (got "
+                f"{describe(value)})"
             )
+
+
+def _jaw_only(squeeze_limit) -> None:
+    """A multi-finger hand takes no ``squeeze_limit``: say so."""
+    if squeeze_limit is not None:
+        raise InvalidOptionError(
+            "squeeze_limit applies to parallel jaws (N per finger); a "
+            "multi-finger hand's fingers apply joint torques: give "
+            f"torque_limit (N·m per finger joint) instead (got {squeeze_limit!r})"
+        )
 
 
 def _is_default(value, default) -> bool:

@@ -1303,6 +1303,7 @@ PLAN_POOLS = {
     "object_mass": [-1.0, 0.0, NAN, INF, "abc"],
     "tilt": [NAN, -1.0, "abc"],
     "min_fingers": [0, -1, 2.5, "2"],
+    "squeeze_limit": [-1.0, 0.0, NAN, INF, "abc", True, [5.0], 10**400],
 }
 """Hostile values of :func:`drakegrasp.plan_grasps`'s options, one at a time."""
 
@@ -1497,6 +1498,11 @@ def planning_cases() -> Iterator[Case]:
                 lambda o=option, v=value: plan(**{o: v}),
                 "refuse",
             )
+    yield Case(
+        "planning", "squeeze_limit-below-every-need",
+        lambda: plan(squeeze_limit=1e-3), "answer",
+        lambda r: len(r) == 0 or "squeeze_limit 0.001 N holds none" in r.reason,
+    )  # fmt: skip
     # torque_needed of the best candidate: hostile weights and candidates.
     best = plan()[0]
 
