@@ -19,7 +19,8 @@ Usage::
     drakegrasp warmup [--json]
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
                     [--seed S] [--mu M|plant] [--mass KG] [--torque-limit NM]
-                    [--preshape JOINT=VALUE ...]
+                    [--squeeze-limit N] [--contact-model MODEL]
+                    [--torsional-friction NU] [--preshape JOINT=VALUE ...]
                     [--shake K [--squeeze X] [--stiffness K] [--damping D]
                      [--hydroelastic PA|none]]
                     [--package NAME=DIR ...] [--allow-any-file] [--progress]
@@ -65,9 +66,13 @@ instance as the object; a planar scene (``plane:``) is refused, as plan
 samples spatial grasps.  Given an object (a shipped object's name, a model
 URL or a file, or a mesh ``.obj`` file, which Drake's parser makes one body
 with the mass of water filling it; default ``box``), it plans for ``--hand`` (a
-model URL or file, ``wsg`` for Drake's WSG-50, ``allegro`` for Drake's Allegro
-right hand with its thumb opposed; default drakegrasp's flat-pad jaw) in a
-scene of the two alone; ``--mass`` gives the object's mass,
+model URL or file, ``wsg`` for Drake's WSG-50, ``franka`` for Drake's Franka
+(Panda) hand, ``allegro`` for Drake's Allegro right hand with its thumb
+opposed; default drakegrasp's flat-pad jaw) in a scene of the two alone;
+``--contact-model`` and ``--torsional-friction`` set the contacts' model (over
+a scene's), ``--mass`` gives the object's mass, ``--squeeze-limit`` the squeeze
+a parallel jaw will apply (default its actuators' effort limits: candidates
+held within it rank first, and the output says when none is),
 ``--torque-limit`` the torque a multi-finger hand will apply and
 ``--preshape JOINT=VALUE`` its open shape, and ``--shake K`` shakes the
 first K candidates in a Drake simulation and lists them again, those that
@@ -81,7 +86,7 @@ plans with the friction the plant gives the hand's and the object's geometries
 (``pip install "drakegrasp[progress]"``); without it they are refused before
 any work.
 
-One interface: both commands name the contact model ``--contact-model``
+One interface: every command names the contact model ``--contact-model``
 (``batch --model`` is a deprecated alias that still works and says so), and
 both follow one rule for soft fingers: ``--contact-model soft_finger`` needs a
 torsional friction ν, from ``--torsional-friction`` or the scene / input file;
@@ -413,6 +418,8 @@ _SOFT_FINGER_REMEDY = {
     "analyze": "soft fingers (--contact-model soft_finger, or the scene's "
     "contact_model:) need a torsional friction nu: give --torsional-friction NU "
     "or the scene's torsional_friction: (0 makes soft fingers act as hard ones)",
+    "plan": "--contact-model soft_finger needs a torsional friction nu: give "
+    "--torsional-friction NU (0 makes soft fingers act as hard ones)",
     "batch": "--contact-model soft_finger needs a torsional friction nu: give "
     "--torsional-friction NU or the input's array torsional_friction (0 makes "
     "soft fingers act as hard ones)",
@@ -909,11 +916,17 @@ PLAN_HANDS = {
     "flat": "package://drakegrasp/hands/parallel_jaw_flat.sdf",
     "rounded": "package://drakegrasp/hands/parallel_jaw.sdf",
     "wsg": "package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf",
+    "franka": "package://drake_models/franka_description/urdf/panda_hand.urdf",
     "allegro": "package://drake_models/allegro_hand_description/sdf/"
     "allegro_hand_description_right.sdf",
 }
-"""``plan --hand`` short names: drakegrasp's two jaws, Drake's WSG-50 and
-Drake's Allegro right hand."""
+"""``plan --hand`` short names: drakegrasp's two jaws, Drake's WSG-50, Drake's
+Franka (Panda) hand and Drake's Allegro right hand.
+
+``franka`` is ``panda_hand.urdf``, whose fingers touch with a 9 mm sphere and
+four 1 mm pad spheres each (Drake's model for grasping); ``hand.urdf`` touches
+with one 12 mm sphere a finger, two point contacts that never resist a torque
+about the line through them."""
 
 PLAN_PRESHAPES = {"allegro": {"joint_12": 1.0}}
 """The open hand an alias starts from, joint name to value (rad or m), where
@@ -1086,6 +1099,11 @@ def _plan_setup(args: argparse.Namespace):
     preshape = {**PLAN_PRESHAPES.get(alias, {}), **dict(args.preshape)}
     if preshape:
         _apply_preshape(plant, context, body, hand, preshape, given=dict(args.preshape))
+    # the flags over the scene's values, as for analyze
+    if args.contact_model is not None:
+        options["contact_model"] = args.contact_model
+    if args.torsional_friction is not None:
+        options["torsional_friction"] = args.torsional_friction
     options["mu"] = (
         default_mu
         if args.mu is None
@@ -1246,6 +1264,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
             progress=args.progress,
             object_mass=args.mass,
             torque_limit=args.torque_limit,
+            squeeze_limit=args.squeeze_limit,
             **options,
         )
     except GraspError as e:
@@ -1325,17 +1344,20 @@ _PLAN_FLAGS = {
     "seed": "--seed",
     "object_mass": "--mass",
     "torque_limit": "--torque-limit",
+    "squeeze_limit": "--squeeze-limit",
+    "contact_model": "--contact-model",
+    "torsional_friction": "--torsional-friction",
 }
 """``plan_grasps`` keywords that ``plan`` sets from a flag, and that flag."""
 
 _PLAN_REASON_WORDS = {
     "contact_model='soft_finger' with torsional_friction models fingertips that do": (
-        "soft fingers model fingertips that do (plan has no flag for them: a "
-        "scene's contact_model: soft_finger with its torsional_friction:, or "
-        "drakegrasp.plan_grasps(..., contact_model='soft_finger', "
-        "torsional_friction=NU) in Python)"
+        "soft fingers model fingertips that do (--contact-model soft_finger "
+        "--torsional-friction NU)"
     ),
     "num_candidates is 0": "--num is 0",
+    "the jaw at squeeze_limit ": "the jaw at --squeeze-limit ",
+    "the hand at torque_limit ": "the hand at --torque-limit ",
 }
 """Phrases of a plan result's ``reason`` that name what ``plan`` cannot set."""
 
@@ -1435,6 +1457,32 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         help="multi-finger hands: the torque per finger joint (N·m) the hand "
         "will apply; candidates held within it rank first (default: the "
         "actuators' effort limits)",
+    )
+    plan.add_argument(
+        "--squeeze-limit",
+        type=_strictly_positive,
+        default=None,
+        metavar="N",
+        help="parallel jaws: the squeeze per finger (N) the jaw will apply; "
+        "candidates held within it rank first (default: the actuators' effort "
+        "limits)",
+    )
+    plan.add_argument(
+        "--contact-model",
+        choices=[m.value for m in ContactModel],
+        default=None,
+        help="contact model of every contact: frictionless, hard_finger or "
+        "soft_finger (default: the scene's, else hard_finger)",
+    )
+    plan.add_argument(
+        "--torsional-friction",
+        type=_positive_float,
+        default=None,
+        metavar="NU",
+        help="soft-finger torsional friction nu (>= 0, dimensionless: a "
+        "contact resists a torque about its normal up to b nu f_n, b the "
+        "object's torque scale); required with --contact-model soft_finger "
+        "(default: the scene's)",
     )
     plan.add_argument(
         "--preshape",
