@@ -134,6 +134,11 @@ class GraspCandidate:
         known: planned on a body, or on a point cloud with ``object_mass``;
         inf: none does; NaN: not computed.  Compare it with the actuators'
         effort limits, or use it as ``shake_test``'s squeeze.
+    torque_scale : float
+        The length (m) the planner divided moments by and bounded a soft
+        finger's torsion with (``GraspCandidates.torque_scale``), and so the
+        characteristic length of ``grasp``; NaN for a candidate built without
+        one (``grasp`` then takes the grasp's default).
     """
 
     sample: int
@@ -158,16 +163,25 @@ class GraspCandidate:
     closure: ClosureResult | None = None
     q_preshape: np.ndarray | None = None
     torque_needed: float = float("nan")
+    torque_scale: float = float("nan")
 
     @cached_property
     def grasp(self) -> Grasp:
         """The core grasp of the contacts (frame O, moments about ``reference_point``).
 
-        Built on first access (thousands of candidates rarely need it).
+        Its characteristic length is the run's ``torque_scale``, the length
+        the planner ranked with (ε, and a soft finger's torsion bound
+        ``b ν f_n``), so that an analysis of this grasp (``force_closure``,
+        ``epsilon_l1``, ``grasp_forces``) answers as the ranking did; NaN
+        (a candidate built by hand): the grasp's default length.  Built on
+        first access (thousands of candidates rarely need it).
         """
         return Grasp(
             [Contact(c.p_OC, c.nhat_O, **self.contact_options) for c in self.contacts],
             reference_point=self.reference_point,
+            characteristic_length=(
+                None if np.isnan(self.torque_scale) else self.torque_scale
+            ),
         )
 
     @property
@@ -253,6 +267,7 @@ class GraspCandidate:
             if self.q_preshape is None
             else jsonable(self.q_preshape),
             "torque_needed": jsonable(self.torque_needed),
+            "torque_scale": jsonable(self.torque_scale),
         }
 
     def __str__(self) -> str:

@@ -447,6 +447,7 @@ def rank_multifinger(
             closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
             opening=float("nan"), contacts=tuple(found),
             q_preshape=np.asarray(q_pre, float), reference_point=reference.copy(),
+            torque_scale=float(torque_scale),
         )  # fmt: skip
 
     return ranked_candidates(

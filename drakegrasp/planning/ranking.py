@@ -725,7 +725,7 @@ def rank_candidates(
             sample=sample, hand_base=base, X_WH=X_WH, X_WO=X_WO,
             q_hand=np.asarray(q, float), joint_names=joint_names,
             closing_signs=signs, opening=opening, contacts=tuple(found),
-            reference_point=reference.copy(),
+            reference_point=reference.copy(), torque_scale=float(torque_scale),
         )  # fmt: skip
 
     return ranked_candidates(
