@@ -468,6 +468,7 @@ def shake_test(
     squeezing = [a for a in actuators if int(a.joint().index()) in targets]
     efforts = tuple(abs(float(u[a.input_start()])) for a in squeezing)
     effort_units = tuple(effort_unit(a.joint()) for a in squeezing)
+    capped = tuple(float(min(squeeze, a.effort_limit())) for a in squeezing)
     for end in ends:
         d, r = advance(end)
         phases.append(
@@ -496,4 +497,5 @@ def shake_test(
         max_rotation_from_seat=max_rs,
         hydroelastic_modulus=modulus,
         hydroelastic_refused=refused,
+        squeeze_caps=capped,
     )

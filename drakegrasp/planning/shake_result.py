@@ -81,6 +81,11 @@ class ShakeResult:
     hydroelastic_refused : int
         Collision geometries of the hand and the object that Drake refused to
         make hydroelastic (they kept point contact; a half-space, say).
+    squeeze_caps : tuple of float
+        What each closing joint was set to press with, in actuator order:
+        ``squeeze``, or its actuator's effort limit where that is smaller (an
+        actuator applies no more; ``squeeze_capped`` says so, and the summary
+        line names the cap).  Empty in a record made before it existed.
     """
 
     held: bool
@@ -101,6 +106,17 @@ class ShakeResult:
     max_rotation_from_seat: float = float("nan")
     hydroelastic_modulus: float | None = None
     hydroelastic_refused: int = 0
+    squeeze_caps: tuple[float, ...] = ()
+
+    @property
+    def squeeze_unit(self) -> str:
+        """The unit of ``squeeze``: "N", "N·m", or both named when mixed."""
+        return _squeeze_unit(self.effort_units)
+
+    @property
+    def squeeze_capped(self) -> bool:
+        """Whether an effort limit held a closing joint below ``squeeze``."""
+        return any(cap < self.squeeze for cap in self.squeeze_caps)
 
     @property
     def held_from_seat(self) -> bool:
@@ -155,9 +171,14 @@ class ShakeResult:
             f"{np.degrees(self.max_rotation):.2f}"
             f" deg (bounds {self.bounds[0] * 1e3:g} mm, "
             f"{np.degrees(self.bounds[1]):g} deg)"
-            f" over {self.duration:g} s, squeeze {self.squeeze:g} "
-            f"{_squeeze_unit(self.effort_units)}, "
-            f"{len(self.phases)} gravity directions"
+            f" over {self.duration:g} s, squeeze {self.squeeze:g} {self.squeeze_unit}"
+            + (
+                f" (capped at the effort limit: {min(self.squeeze_caps):g} "
+                f"{self.squeeze_unit})"
+                if self.squeeze_capped
+                else ""
+            )
+            + f", {len(self.phases)} gravity directions"
             + (
                 ""
                 if self.hydroelastic_modulus is None

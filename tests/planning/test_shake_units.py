@@ -8,6 +8,7 @@ from allegro_support import allegro_scene, has_thumb
 
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.shake import ShakeResult
+from drakegrasp.planning.shake_ranking import shake_candidates
 
 THREE = "package://drakegrasp/hands/three_finger_hand.sdf"
 JAW = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
@@ -152,3 +153,30 @@ def test_seat_speed_tells_a_squeeze_that_pushes_out_from_one_that_holds(
     pushed = shake_test(scene.add_models, thumbless, **gains)
     assert pushed.seat_speed > 0.1  # m/s, still on its way out
     assert pushed.seat_speed > 5.0 * held.seat_speed
+
+
+def test_a_squeeze_past_the_effort_limit_says_it_was_capped():
+    # the shipped jaw's fingers have <effort>140</effort>: asked for 300 N,
+    # each presses with 140 N (Drake's own actuation output agrees), and the
+    # summary once said "squeeze 300 N" with no word of it
+    scene, best = _best(JAW)
+    asked = shake_test(scene.add_models, best, squeeze=300.0, **SHORT)
+    assert asked.squeeze_caps == (140.0, 140.0) and asked.squeeze_capped
+    assert max(asked.efforts) == pytest.approx(140.0, rel=1e-3)
+    assert "squeeze 300 N (capped at the effort limit: 140 N)," in str(asked)
+    within = shake_test(scene.add_models, best, squeeze=5.0, **SHORT)
+    assert within.squeeze_caps == (5.0, 5.0) and not within.squeeze_capped
+    assert "capped" not in str(within)
+    assert within.to_dict()["squeeze_caps"] == [5.0, 5.0]
+
+
+def test_shaken_candidates_name_a_capped_squeeze():
+    scene = planning_scene("package://drakegrasp/objects/cylinder.sdf", hand_url=JAW)
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=20, mu=1.0, seed=3, robustness_samples=4,
+    )  # fmt: skip
+    ranked = shake_candidates(scene.add_models, result, top=1, squeeze=300.0, **SHORT)
+    assert "squeeze 300 capped at the effort limit: 140 N;" in str(ranked)
+    ranked = shake_candidates(scene.add_models, result, top=1, squeeze=5.0, **SHORT)
+    assert "capped" not in str(ranked)
