@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 
@@ -75,7 +76,17 @@ from drakegrasp.plant.validation import (
     resolve_object_body,
 )
 
-__all__ = ["check_shake_options", "shake_test"]
+__all__ = ["SoftFingerShakeWarning", "check_shake_options", "shake_test"]
+
+
+class SoftFingerShakeWarning(UserWarning):
+    """A candidate planned with soft fingers is shaken in point contact.
+
+    The plan counted on each contact resisting a torque about its normal (up
+    to ``b ν f_n``); Drake's point contact resists none, so the shake may
+    drop a grasp that the plan's model holds.  Hydroelastic fingers
+    (``hydroelastic_modulus=``) press over patches, which do resist it.
+    """
 
 
 def _scoped(plant, joint) -> str:
@@ -313,6 +324,13 @@ def shake_test(
     InvalidGraspError
         The candidate's joint values or poses are not finite or do not match
         its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`).
+
+    Warns
+    -----
+    SoftFingerShakeWarning
+        The candidate was planned with soft fingers and the shake runs in
+        point contact (no ``hydroelastic_modulus``), which resists no torque
+        about a contact normal.
     """
     if not callable(add_models):
         raise InvalidOptionError(
@@ -334,6 +352,19 @@ def shake_test(
         max_rotation=max_rotation, hydroelastic_modulus=hydroelastic_modulus,
     )  # fmt: skip
     modulus = check_hydroelastic_modulus(hydroelastic_modulus)
+    if modulus is None and candidate.contact_options.get("contact_model") == (
+        "soft_finger"
+    ):
+        warnings.warn(
+            "the candidate was planned with soft fingers (torsional_friction "
+            f"{candidate.contact_options.get('torsional_friction')!r}), which "
+            "resist a torque about each contact normal; Drake's point contact "
+            "resists none, so this shake may drop a grasp the plan holds: give "
+            "hydroelastic_modulus= (1e6 Pa, rubber) for fingers that press "
+            "over patches",
+            SoftFingerShakeWarning,
+            stacklevel=2,
+        )
     t0 = time.perf_counter()
     from pydrake.multibody.parsing import Parser
 

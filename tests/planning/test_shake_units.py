@@ -3,11 +3,13 @@ fingers of a parallel jaw, N·m for the revolute joints of a multi-finger hand."
 
 from __future__ import annotations
 
+import warnings
+
 import pytest
 from allegro_support import allegro_scene, has_thumb
 
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
-from drakegrasp.planning.shake import ShakeResult
+from drakegrasp.planning.shake import ShakeResult, SoftFingerShakeWarning
 from drakegrasp.planning.shake_ranking import shake_candidates
 
 THREE = "package://drakegrasp/hands/three_finger_hand.sdf"
@@ -180,3 +182,18 @@ def test_shaken_candidates_name_a_capped_squeeze():
     assert "squeeze 300 capped at the effort limit: 140 N;" in str(ranked)
     ranked = shake_candidates(scene.add_models, result, top=1, squeeze=5.0, **SHORT)
     assert "capped" not in str(ranked)
+
+
+def test_soft_fingers_in_point_contact_are_warned_of():
+    # the plan's soft fingers resist a torque about each normal; Drake's point
+    # contact resists none, so the shake may drop what the plan holds
+    scene, best = _best(JAW, contact_model="soft_finger", torsional_friction=0.05)
+    with pytest.warns(SoftFingerShakeWarning, match="hydroelastic_modulus="):
+        shake_test(scene.add_models, best, squeeze=5.0, **SHORT)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SoftFingerShakeWarning)
+        shake_test(
+            scene.add_models, best, squeeze=5.0, hydroelastic_modulus=1e6, **SHORT
+        )
+        hard_scene, hard = _best(JAW)
+        shake_test(hard_scene.add_models, hard, squeeze=5.0, **SHORT)
