@@ -9,6 +9,8 @@ Usage::
                        [--num-generators NG] [--tol TOL] [--patches MODE]
                        [--close | --no-close] [--allow-penetration]
                        [--check-pose | --no-check-pose]
+                       [--load gravity|FX,FY,FZ,MX,MY,MZ]
+                       [--torque-limits plant|T1,T2,...]
                        [--package NAME=DIR ...] [--allow-any-file] [--json]
     drakegrasp scenes
     drakegrasp batch IN.npz OUT.npz [--kind force|form] [--mu M]
@@ -171,7 +173,15 @@ def _analyze(args: argparse.Namespace) -> int:
         for name in _ANALYSIS_FLAGS
         if getattr(args, name, None) is not None
     }
-    options = scene.options.replace(**changes)
+    try:
+        options = scene.options.replace(**changes)
+    except GraspError as e:  # a flag's value the options refuse, in flag words
+        raise _in_flag_words(e, {name: _flag(name) for name in changes}) from None
+    if options.torque_limits is not None and options.load is None:
+        raise InvalidOptionError(
+            "--torque-limits are the motors of the load section: give --load "
+            "gravity (or a wrench FX,FY,FZ,MX,MY,MZ), or the scene's load:"
+        )
     report = analyze_grasp(
         scene.plant,
         scene.plant_context,
@@ -687,7 +697,6 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
 
 
 # AnalysisOptions fields the analyze command sets (None: the scene's value).
-# load and torque_limits take arrays in Python; the command line leaves them out.
 _ANALYSIS_FLAGS = (
     "mu",
     "contact_model",
@@ -700,6 +709,8 @@ _ANALYSIS_FLAGS = (
     "allow_penetration",
     "patches",
     "check_pose",
+    "load",
+    "torque_limits",
 )
 
 
@@ -718,6 +729,14 @@ def _add_analysis_options(parser: argparse.ArgumentParser) -> None:
         "num_generators": {"type": int},
         "tol": {"type": _positive_float},
         "patches": {"choices": list(PATCH_MODES)},
+        "load": {
+            "type": _named_or_numbers("gravity"),
+            "metavar": "gravity|FX,FY,FZ,MX,MY,MZ",
+        },
+        "torque_limits": {
+            "type": _named_or_numbers("plant"),
+            "metavar": "plant|T1,T2,...",
+        },
     }
     for name in _ANALYSIS_FLAGS:
         flag = "--" + name.replace("_", "-")
@@ -748,7 +767,25 @@ _SCENE_OPTIONS = (
     "torsional_friction",
     "plane",
     "distance_tolerance",
+    "load",
+    "torque_limits",
 )
+
+
+def _named_or_numbers(name: str):
+    """``--load`` / ``--torque-limits``: ``name``, or comma-separated numbers."""
+
+    def parse(text: str) -> str | tuple[float, ...]:
+        if text == name:
+            return text
+        try:
+            return tuple(float(v) for v in text.split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"expected {name!r} or comma-separated numbers, got {text!r}"
+            ) from None
+
+    return parse
 
 
 def _analysis_defaults() -> dict:

@@ -210,6 +210,12 @@ class SceneInfo:
     close_direction : tuple of float or None
         The closing direction over the closing joints; None: each fingertip's
         steepest descent.
+    load : None, "gravity" or tuple of float
+        The load the file analyses the grasp under (``AnalysisOptions.load``);
+        None: no load section.
+    torque_limits : None, "plant" or tuple of float
+        The motor limits of that load analysis
+        (``AnalysisOptions.torque_limits``).
     """
 
     name: str
@@ -224,6 +230,8 @@ class SceneInfo:
     distance_tolerance: float
     close: bool = False
     close_direction: tuple[float, ...] | None = None
+    load: str | tuple[float, ...] | None = None
+    torque_limits: str | tuple[float, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -268,7 +276,7 @@ class Scene:
 
     @property
     def options(self) -> AnalysisOptions:
-        """The scene file's analysis options (friction, model, plane, tolerance)."""
+        """The scene file's analysis options (friction, model, plane, load...)."""
         info = self.info
         return AnalysisOptions(
             mu=info.mu,
@@ -276,6 +284,8 @@ class Scene:
             torsional_friction=info.torsional_friction,
             plane=info.plane,
             distance_tolerance=info.distance_tolerance,
+            load=info.load,
+            torque_limits=info.torque_limits,
         )
 
     def analysis_options(self) -> dict:
@@ -288,6 +298,15 @@ class Scene:
             "torsional_friction": self.info.torsional_friction,
             "plane": self.info.plane,
             "distance_tolerance": self.info.distance_tolerance,
+            # only when the file gives them: a caller may add its own
+            **{
+                key: value
+                for key, value in (
+                    ("load", self.info.load),
+                    ("torque_limits", self.info.torque_limits),
+                )
+                if value is not None
+            },
         }
 
 

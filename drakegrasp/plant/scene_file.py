@@ -69,6 +69,12 @@ KEYS = {
     "distance_tolerance": "a number > 0 (metres)",
     "close": "true, false, or a mapping {direction: [one number per closing "
     "joint]}: close the hand onto the object when the scene is loaded",
+    "load": "'gravity' (the object's weight) or a list of 6 numbers (3 with "
+    "plane:), the wrench [f; m] on the object in N and N·m, frame O about its "
+    "origin: analyse the grasp under that load",
+    "torque_limits": "'plant' (the actuators' effort limits) or a list of "
+    "numbers >= 0 (.inf: no limit), one per hand velocity: the motors of the "
+    "load analysis",
 }
 """The keys of the ``drakegrasp:`` section and what each must be."""
 
@@ -327,9 +333,11 @@ def check_section(
     dict
         Keys ``description, object_body, hand, mu, contact_model,
         torsional_friction, plane, distance_tolerance, close,
-        close_direction``; ``hand`` is None, a string or a tuple of strings,
-        ``contact_model`` a ContactModel, ``close`` a bool and
-        ``close_direction`` None or a tuple of floats.
+        close_direction, load, torque_limits``; ``hand`` is None, a string or
+        a tuple of strings, ``contact_model`` a ContactModel, ``close`` a bool,
+        ``close_direction`` None or a tuple of floats, ``load`` None,
+        ``"gravity"`` or a tuple of floats, ``torque_limits`` None,
+        ``"plant"`` or a tuple of floats.
 
     Raises
     ------
@@ -347,7 +355,7 @@ def check_section(
     unknown = [k for k in section if not isinstance(k, str) or k not in KEYS]
     if unknown:
         raise SceneError(
-            f"scene {str(path)!r}: unknown key(s) {[repr(k) for k in unknown]} in "
+            f"scene {str(path)!r}: unknown key(s) {', '.join(map(repr, unknown))} in "
             f"'drakegrasp:'; valid keys are {sorted(KEYS)}"
         )
     for key in ("object_body", "mu"):
@@ -389,6 +397,22 @@ def check_section(
         )
     description = section.get("description", "")
     close, close_direction = _close(path, section.get("close", False))
+    load = _named_or_numbers(path, "load", section.get("load"), "gravity")
+    if isinstance(load, tuple) and len(load) != (3 if plane else 6):
+        raise SceneError(
+            f"scene {str(path)!r}: drakegrasp.load has {len(load)} numbers; a "
+            f"{'planar' if plane else 'spatial'} wrench [f; m] has "
+            f"{3 if plane else 6}"
+        )
+    limits = _named_or_numbers(
+        path, "torque_limits", section.get("torque_limits"), "plant"
+    )
+    if limits is not None and load is None:
+        raise SceneError(
+            f"scene {str(path)!r}: drakegrasp.torque_limits without "
+            "drakegrasp.load: the limits are the motors of the load analysis; "
+            "add 'load: gravity' (or a wrench)"
+        )
     return {
         "description": ""
         if description == ""
@@ -412,7 +436,41 @@ def check_section(
         ),
         "close": close,
         "close_direction": close_direction,
+        "load": load,
+        "torque_limits": limits,
     }
+
+
+def _named_or_numbers(path: Path, key: str, value, name: str):
+    """``load`` or ``torque_limits``: absent (None), ``name``, or a list of numbers.
+
+    A load's numbers are finite; torque limits are >= 0, ``.inf`` (no limit)
+    allowed.
+    """
+    if value is None or value == name:
+        return value
+    if not isinstance(value, list) or not value:
+        raise SceneError(
+            f"scene {str(path)!r}: drakegrasp.{key} must be {KEYS[key]}, got {value!r}"
+        )
+    numbers = []
+    for v in value:
+        if not isinstance(v, int | float) or isinstance(v, bool):
+            raise SceneError(
+                f"scene {str(path)!r}: drakegrasp.{key} holds {v!r} "
+                f"({type(v).__name__}); valid: {KEYS[key]}"
+            )
+        try:
+            x = float(v)
+        except OverflowError:
+            x = math.inf if v > 0 else -math.inf
+        ok = math.isfinite(x) if key == "load" else x >= 0.0  # NaN fails both
+        if not ok:
+            raise SceneError(
+                f"scene {str(path)!r}: drakegrasp.{key} holds {v!r}; valid: {KEYS[key]}"
+            )
+        numbers.append(x)
+    return tuple(numbers)
 
 
 def directives_text(path: Path, text: str) -> str:
