@@ -112,10 +112,15 @@ class GraspCandidate:
     squeeze_needed : float
         The squeeze per finger (N) that holds the object's weight in all those
         directions, ``m g / weight_capacity`` (inf: none does; NaN: not
-        computed).  A lower bound: the LP shares each finger's force among its
-        contacts at will, while a rigid pad shares it as its geometry and
-        compliance dictate (in the shake test, grasps of cylinders with two
-        tip spheres per finger needed up to twice this).
+        computed).  A lower bound for fingers that each press with a set
+        force: the LP shares each finger's force among its contacts at will,
+        while a rigid pad shares it as its geometry and compliance dictate (in
+        the shake test, grasps of cylinders with two tip spheres per finger
+        needed up to twice this).  A position-controlled finger that the
+        object pushes back presses harder, up to its effort limit, so such a
+        hand may hold with less (the shake test's PD fingers: Drake's Franka
+        hand held the sugar box at 0.75 times it, and 1 of 18 YCB candidates
+        at 0.8 times; ``benchmarks/bench_jaw_squeeze.py``).
     closure : ClosureResult or None
         The single-grasp verdict with its certificate (witness), for the top
         candidates (``certify`` of ``plan_grasps``); None for the rest.

@@ -496,9 +496,19 @@ def _checked_hand(
         synergy_range=synergy_range, approach=approach, standoff=standoff,
     )  # fmt: skip
     if min_fingers > hand_model.num_fingers:
+        fingers = [f.name for f in hand_model.structure.fingers]
+        joints = len(hand_model.structure.names)
+        arm = (
+            f"; its one finger {fingers[0]} moves all {joints} closing joints "
+            "from the base: an arm that carries a hand is not a hand (the "
+            "planner places the hand's base and closes its fingers): load the "
+            "hand's own model, or weld the arm's joints"
+            if hand_model.num_fingers == 1 and joints > 2
+            else ""
+        )
         raise InvalidOptionError(
             f"min_fingers = {min_fingers} exceeds the hand's "
-            f"{hand_model.num_fingers} fingers"
+            f"{hand_model.num_fingers} fingers {fingers}{arm}"
         )
     return tilt, hand_model
 

@@ -89,3 +89,14 @@ def test_the_franka_alias_plans_with_its_pads(capsys, drake_models_dir, monkeypa
     # one contact each, so hard fingers reach force closure
     assert best["is_closure"] and best["num_contacts"] > 2
     assert data["reason"] == ""
+
+
+def test_an_arm_with_a_hand_is_named_as_such(capsys, drake_models_dir, monkeypatch):
+    monkeypatch.setenv("DRAKEGRASP_DRAKE_MODELS", str(drake_models_dir))
+    arm = "package://drake_models/franka_description/urdf/panda_arm_hand.urdf"
+    argv = ["plan", "package://drake_models/ycb/004_sugar_box.sdf", "--hand", arm]
+    assert main([*argv, "--num", "5"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert "an arm that carries a hand is not a hand" in err[0]
+    assert "load the hand's own model" in err[0]
