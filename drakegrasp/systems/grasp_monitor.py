@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import time as _time
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -33,15 +34,17 @@ from drakegrasp.plant.analysis import analyze_grasp
 from drakegrasp.plant.contacts import (
     HandSpec,
     _scoped_name,
-    hand_bodies,
     resolve_object_body,
 )
+from drakegrasp.plant.couplings import plant_couplings
+from drakegrasp.plant.fingers import coupling_entry
 from drakegrasp.plant.friction import (
     FrictionMismatchWarning,
     friction_disagreement,
     plant_friction,
 )
 from drakegrasp.plant.options import AnalysisOptions
+from drakegrasp.plant.validation import hand_contact_bodies
 from drakegrasp.quality import ferrari_canny
 from drakegrasp.quality.epsilon import L1_MAX_POINTS, primitive_wrenches
 from drakegrasp.systems.holding import (
@@ -98,6 +101,25 @@ def epsilon_l1(grasp, *, num_generators: int) -> float:
     return float(ferrari_canny(grasp, num_generators=num_generators))
 
 
+def _monitor_couplings(plant: MultibodyPlant, couplings) -> tuple:
+    """The couplings of every sample, checked once against the finalized plant.
+
+    The plant's constraints and the recorded couplings cannot change after
+    ``Finalize``, so a plant that :func:`~drakegrasp.analyze_grasp` would
+    refuse at every sample is refused here, with the way out.
+    """
+    try:
+        resolved = plant_couplings(plant, couplings)
+        for entry in resolved:
+            coupling_entry(plant, entry)
+    except InvalidOptionError as e:
+        raise InvalidOptionError(
+            f"GraspMonitor cannot analyse this plant, every sample would be "
+            f"invalid: {e}"
+        ) from None
+    return resolved
+
+
 class GraspMonitor(LeafSystem):
     """Analyse the grasp of a simulated plant every ``period`` seconds.
 
@@ -106,7 +128,19 @@ class GraspMonitor(LeafSystem):
     plant : MultibodyPlant
         The finalized plant of the simulation (registered with a SceneGraph).
     object_body, hand
-        As in :func:`drakegrasp.analyze_grasp`.
+        As in :func:`drakegrasp.analyze_grasp`, and resolved as it resolves
+        them (:func:`~drakegrasp.plant.validation.hand_contact_bodies`): the
+        hand's bodies include those welded to the world, so a palm that
+        touches the object gives contacts, verdicts and a holding state, as
+        in :func:`~drakegrasp.analyze_grasp` on the same state.
+    couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
+        As in :func:`drakegrasp.analyze_grasp`: the joint couplings of the
+        hand (``()`` for none).  When not given, the couplings recorded as the
+        models entered the plant
+        (:func:`~drakegrasp.plant.couplings.plant_couplings`); a plant with a
+        constraint that was not recorded (a ``<mimic>`` parsed by a bare
+        ``Parser``) is refused here, since every sample's analysis would
+        refuse it.
     options : AnalysisOptions, optional
         The analysis options of every sample, validated when they were made;
         give them or the keywords below, not both.  A ``load`` in them adds the
@@ -170,8 +204,12 @@ class GraspMonitor(LeafSystem):
     ------
     InvalidOptionError
         For an unfinalized plant, a bad period, offset, flag or contact
-        source, ``options`` next to a keyword, or options that
-        :class:`~drakegrasp.AnalysisOptions` refuses.
+        source, ``options`` next to a keyword, options that
+        :class:`~drakegrasp.AnalysisOptions` refuses, a bad coupling, or,
+        without ``couplings``, a plant with constraints that drakegrasp has
+        not recorded as couplings.
+    ModelError
+        For an unknown object or hand body or model instance.
     """
 
     STATUS, FORCE_CLOSURE, FORM_CLOSURE, ANTIPODAL = 0, 1, 2, 3
@@ -184,6 +222,7 @@ class GraspMonitor(LeafSystem):
         *,
         object_body,
         hand: HandSpec = None,
+        couplings: Sequence[tuple] | None = None,
         options: AnalysisOptions | None = None,
         mu: float | str | None = None,
         contact_model: ContactModel | str = ContactModel.HARD_FINGER,
@@ -233,7 +272,10 @@ class GraspMonitor(LeafSystem):
         """Why the given ``mu`` is not the plant's friction (None until seen)."""
         self._plant = plant
         self._body = resolve_object_body(plant, object_body)
-        self._bodies = hand_bodies(plant, self._body, hand)
+        # The hand as analyze_grasp resolves it: a welded palm touches too.
+        self._bodies = hand_contact_bodies(plant, self._body, hand)
+        self.couplings = _monitor_couplings(plant, couplings)
+        """The joint couplings every sample's analysis uses (checked here)."""
         self.verdict_names = verdict_names(
             [_scoped_name(plant, f) for f in self._bodies]
         )
@@ -462,6 +504,7 @@ class GraspMonitor(LeafSystem):
                 options=self.settings.analysis,
                 query_object=query,
                 contacts=sensed.contacts,
+                couplings=self.couplings,
             )
             return "ok", "", report, sensed.loads
         except NoContactsError as e:
@@ -491,7 +534,12 @@ class GraspMonitor(LeafSystem):
         it; so does a sample whose contacts cannot be sensed (a penetration
         deeper than the distance tolerance, a Drake error while sensing): a
         finger pressed that deep into the object has not let it go (a re-grip
-        of a 1.5 kg box at 147 N read "dropped").
+        of a 1.5 kg box at 147 N read "dropped"), and so does a sample whose
+        contacts were sensed but whose analysis failed (a joint off its
+        limits): the holding state judges a grip by its analysis, and without
+        one it would call every grip "touching" (not in force closure).  So
+        the holding state, its loads and its speeds are those of the last
+        valid sample, and "no contact" (the initial state) before any.
 
         Raises
         ------
@@ -504,7 +552,7 @@ class GraspMonitor(LeafSystem):
         previous = context.get_abstract_state(self._report_index).get_value()
         t = context.get_time()
         x = np.array(self._state_port.Eval(context), dtype=float)
-        # A sample that cannot be sensed keeps the grip before it.
+        # An invalid sample keeps the grip before it: it is no evidence.
         kept = (previous.memory, previous.loads, (np.nan, 0.0), previous.anchors)
         if not np.all(np.isfinite(x)):
             bad = np.flatnonzero(~np.isfinite(x))
@@ -518,7 +566,7 @@ class GraspMonitor(LeafSystem):
         if problem is not None:
             return self._sample(t, "invalid", problem, None, 0.0, x, start, grip=kept)
         status, message, report, loads = self._analyse(context, query)
-        if loads is None:  # not sensed: the grip before it is kept, not lost
+        if status == "invalid" or loads is None:  # kept, neither lost nor judged
             return self._sample(t, status, message, None, 0.0, x, start, grip=kept)
         grip = self._grip(previous, report, loads, query)
         epsilon = 0.0

@@ -10,7 +10,10 @@ sample::
     contact results (optional) ▶└──────────────┘ ──▶ report (GraspSample)
 
 where ``n`` is the number of hand bodies: 18 entries for the parallel jaw's
-palm and two fingers, named by ``monitor.verdict_names`` (see "Outputs").
+palm and two fingers, named by ``monitor.verdict_names`` (see "Outputs").  The
+hand bodies are those :func:`~drakegrasp.analyze_grasp` resolves from the same
+``hand`` (:func:`~drakegrasp.plant.validation.hand_contact_bodies`): a palm
+welded to the world is one, and its contacts count as the fingers' do.
 
 Wiring: :func:`add_grasp_monitor` adds one to a ``DiagramBuilder`` and
 connects it to the plant and the scene graph.  This module is the monitor's
@@ -23,7 +26,10 @@ sources in :mod:`~drakegrasp.systems.sensing`, the holding state in
 
 **Options.**  The analysis of every sample takes the options of
 :func:`~drakegrasp.analyze_grasp`: one :class:`~drakegrasp.AnalysisOptions`
-(``options=``) or the same keywords one by one, not both.  ``mu="plant"``
+(``options=``) or the same keywords one by one, not both, and its
+``couplings=`` (checked when the monitor is built: a plant with a constraint
+drakegrasp did not record, such as a ``<mimic>`` loaded by a bare ``Parser``,
+is refused there, not reported invalid at every sample).  ``mu="plant"``
 reads each contact's friction from the plant's proximity properties; a number
 that disagrees with them is warned about once
 (:class:`~drakegrasp.plant.friction.FrictionMismatchWarning`).
@@ -94,7 +100,11 @@ for up to ``hold_samples`` samples without contact the last grip's analysis is
 kept.  So one frame without contact is not a drop, and the state does not
 flicker between ``slipping``, ``dropped`` and ``holding`` on consecutive
 samples.  These thresholds are a
-:class:`~drakegrasp.systems.holding.HoldingThresholds` (``holding=``).
+:class:`~drakegrasp.systems.holding.HoldingThresholds` (``holding=``).  An
+``invalid`` sample is no evidence: the grip is judged from its analysis, so
+a sample without one keeps the last valid sample's holding state (the
+initial ``no contact`` before any) instead of calling a grip it could not
+analyse ``touching``.
 
 **What d* is.**  LP2's ``d*`` is the geometric distance of the best internal
 force to the boundaries of the friction cones: it depends on the contacts'
@@ -122,7 +132,8 @@ speed:
 ===================  ===========================================================
 ``status``           1 analysed, 0 no contact, −1 invalid pose (e.g. penetration
                      deeper than the tolerance, a non-finite state; the report
-                     says why)
+                     says why); an invalid sample judges no grip: its holding
+                     columns are the last valid sample's
 ``force_closure``    1 / 0: polyhedral force closure with the hand check LP3
 ``form_closure``     1 / 0: first-order form closure (LP1)
 ``antipodal``        1 / 0: two contacts that are antipodal (0 for other counts)
@@ -214,7 +225,9 @@ def add_grasp_monitor(
         If an argument has the wrong type, the builder was already built,
         the plant or scene graph is not in this builder, or the plant is not
         registered with this scene graph (two plants and scene graphs in one
-        builder: pass the pair that ``AddMultibodyPlantSceneGraph`` returned).
+        builder: pass the pair that ``AddMultibodyPlantSceneGraph`` returned);
+        and as :class:`GraspMonitor` raises, e.g. for a plant with a
+        constraint drakegrasp has not recorded as a coupling.
     """
     for arg, value, kind in (
         ("builder", builder, DiagramBuilder),

@@ -109,7 +109,9 @@ class GraspSample:
         Ferrari–Canny ε (L1 norm, moments divided by ``b``); 0 when not in
         force closure or not computed.
     holding : str
-        The holding state (:data:`~drakegrasp.systems.holding.HOLDING_STATES`).
+        The holding state (:data:`~drakegrasp.systems.holding.HOLDING_STATES`);
+        an ``"invalid"`` sample keeps that of the last valid sample (the
+        initial ``"no contact"`` before any), as it keeps its loads.
     loads : tuple of FingerLoad
         Per finger body: force, friction in use, slip.
     relative_speed : float
@@ -196,6 +198,8 @@ class GraspSample:
         if self.contact_gap:
             grip += f", contact missing for {self.contact_gap} sample(s), held"
         if self.report is None:
+            if self.status == "invalid":  # no evidence: the grip is kept
+                grip = f"grip of the last valid sample kept: {grip}"
             head = f"t = {self.time:.4g} s: {self.status}" + (
                 f" ({self.message})" if self.message else ""
             )
