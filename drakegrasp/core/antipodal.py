@@ -80,8 +80,9 @@ class AntipodalResult:
             mu_text += "; on the cone boundary (margins 0°), not strictly inside"
         return (
             f"{head}\n  {mu_text}; antipodal is necessary, not sufficient: in "
-            "space two hard fingers never resist a moment about the line "
-            "between them, and with mu = 0 nothing resists sliding"
+            "space two point contacts without torsional friction (hard "
+            "fingers) never resist a moment about the line between them, and "
+            "with mu = 0 nothing resists sliding"
         )
 
 

@@ -241,6 +241,9 @@ class HandClosure:
     def __str__(self) -> str:
         n = len(self.touching_fingers)
         mode = ", jaws closed as one" if self.symmetric else ""
+        if self.jaws:  # coupled jaws are one finger: say how many of them touch
+            jaws = sum(j.touching for j in self.jaws)
+            mode += f"; {jaws} of {len(self.jaws)} jaws touch"
         lines = [
             f"Hand closed: {n} of {len(self.fingers)} fingers touch "
             f"(tol {self.distance_tolerance * 1e3:g} mm{mode}), {self.iterations} "

@@ -88,3 +88,10 @@ def test_a_normal_square_to_the_line_needs_infinite_friction():
     text = str(dg.is_antipodal(pair, mu=0.5))
     assert "the normal of contact 1 is perpendicular to the line" in text
     assert "mu >= inf" not in text and "points away" not in text
+
+
+def test_the_caveat_names_the_contact_model_it_is_about():
+    # a soft-finger report once read "two hard fingers never resist a moment"
+    pair = [dg.Contact([-1, 0, 0], [1, 0, 0]), dg.Contact([1, 0, 0], [-1, 0, 0])]
+    text = str(dg.is_antipodal(pair, mu=0.5))
+    assert "two point contacts without torsional friction (hard fingers)" in text

@@ -124,6 +124,7 @@ def test_centred_box_touches_both_jaws_without_warning():
     assert all(j.touching for j in closure.jaws)
     assert not closure.one_jaw_only and closure.warnings == ()
     assert "WARNING" not in str(closure)
+    assert "jaws closed as one; 2 of 2 jaws touch)" in str(closure)
 
 
 def test_independent_jaws_keep_their_behaviour_and_report_the_jaws():
@@ -139,6 +140,9 @@ def test_mimic_coupled_jaws_are_reported_and_symmetric_adds_nothing():
     rig = gripper(0.003, mimic=True)
     closure = close_hand(rig.plant, rig.ctx, rig.object, hand=rig.hand)
     assert len(closure.fingers) == 1 and closure.one_jaw_only
+    # one coupled finger touches, yet one of its two jaws does not: the
+    # headline once said only "1 of 1 fingers touch"
+    assert "1 of 1 fingers touch (tol 0.1 mm; 1 of 2 jaws touch)" in str(closure)
     again = gripper(0.003, mimic=True)
     same = close_hand(
         again.plant, again.ctx, again.object, hand=again.hand, symmetric=True
