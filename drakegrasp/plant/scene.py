@@ -35,6 +35,8 @@ The format
       plane: yz                      # optional: planar analysis (xy | yz | zx)
       distance_tolerance: 1.0e-4     # optional, metres, > 0
       close: true                    # optional: close the hand when loading
+      load: gravity                  # optional: analyse under the weight
+      torque_limits: plant           # optional: the actuators' effort limits
 
 ``directives`` is any list that Drake's ``LoadModelDirectives`` accepts
 (``add_model``, ``add_weld``, ``add_frame``, ``add_directives``,
@@ -58,7 +60,12 @@ unknown keys.  ``drakegrasp:`` keys (see :data:`drakegrasp.plant.scene_file.KEYS
   {direction: [...]}`` closes along that direction over the closing joints
   (order of ``HandClosure.joints``) instead of each fingertip's steepest
   descent.  ``load_scene(..., close=...)`` and ``drakegrasp analyze
-  --close`` / ``--no-close`` override the file.
+  --close`` / ``--no-close`` override the file;
+- ``load`` (absent: none): ``gravity`` or a wrench ``[f; m]`` (6 numbers, 3
+  with ``plane``; N and N·m, frame O about its origin) the grasp is analysed
+  under, and ``torque_limits`` (needs ``load``): ``plant`` or one limit per
+  hand velocity; ``drakegrasp analyze --load`` / ``--torque-limits``
+  override them.
 
 Packages and files
 ------------------

@@ -123,12 +123,12 @@ def test_metrics_warns_that_it_takes_the_words_after_it(capsys, grasps):
 
 
 def test_plan_suggests_soft_fingers_only_where_they_can_be_had(capsys):
-    """Two point contacts: the hint named contact_model=, which plan has no flag for."""
+    """Two point contacts: the hint named contact_model=; plan now has the flags."""
     assert main(["plan", "sphere", "--hand", "rounded", "--num", "4"]) == 0
     out = capsys.readouterr().out
     assert "torque about the line" in out  # the reason is still given
     assert "contact_model='soft_finger' with torsional_friction models" not in out
-    assert "plan has no flag for them" in out and "plan_grasps" in out
+    assert "(--contact-model soft_finger --torsional-friction NU)" in out
 
 
 def test_version(capsys):
