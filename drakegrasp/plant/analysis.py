@@ -46,7 +46,12 @@ from drakegrasp.plant.contacts import (
     find_contacts,
     resolve_object_body,
 )
-from drakegrasp.plant.couplings import coupling_map, plant_couplings
+from drakegrasp.plant.couplings import (
+    coupling_map,
+    coupling_violations,
+    plant_couplings,
+    recorded_couplings,
+)
 from drakegrasp.plant.curvature import SECOND_ORDER_RANK_TOL, contact_curvatures
 from drakegrasp.plant.finger_antipodal import FingerAntipodal, finger_antipodal
 from drakegrasp.plant.jacobians import (
@@ -114,6 +119,15 @@ class GraspFromPlant:
         with ``check_pose=False`` or ``allow_penetration=True``).
     couplings : tuple of (joint_0, joint_1, gear_ratio, offset)
         The couplings of the hand's joints that shaped ``J``.
+    coupling_matrix : (n_a, n_h) float or None
+        ``C`` of :func:`~drakegrasp.plant.couplings.coupling_map`: the hand's
+        velocities (every one, followers included:
+        ``all_hand_velocity_indices``) are ``C u`` of the independent ones.
+        None: the identity (no coupling known).
+    all_hand_velocity_indices : (n_a,) int or None
+        Plant indices of every hand velocity, the followers of couplings
+        included (each carries its own actuator); None: the same as
+        ``hand_velocity_indices``.
     """
 
     grasp: Grasp
@@ -127,6 +141,8 @@ class GraspFromPlant:
     plane: str | None
     pose: PoseCheck | None = None
     couplings: tuple = ()
+    coupling_matrix: np.ndarray | None = None
+    all_hand_velocity_indices: np.ndarray | None = None
 
     @property
     def G(self) -> np.ndarray:
@@ -147,6 +163,10 @@ class GraspFromPlant:
             "dpsi_dv": jsonable(self.dpsi_dv),
             "pose": None if self.pose is None else self.pose.to_dict(),
             "couplings": [jsonable(list(c)) for c in self.couplings],
+            "coupling_matrix": jsonable(self.coupling_matrix),
+            "all_hand_velocity_indices": None
+            if self.all_hand_velocity_indices is None
+            else self.all_hand_velocity_indices.tolist(),
         }
 
 
@@ -309,6 +329,7 @@ def grasp_from_plant(
             refuse=check_pose,
             allow_penetration=allow_penetration,
             query_object=query_object,
+            couplings=couplings,
         )
         if contacts is None:
             try:
@@ -364,6 +385,7 @@ def grasp_from_plant(
             velocity_indices=indices,
             plane=plane,
         )
+        all_indices = indices
         C, indices = coupling_map(plant, indices, couplings)
         J = J @ C
         dpsi = signed_distance_jacobian(
@@ -381,6 +403,8 @@ def grasp_from_plant(
             plane=plane,
             pose=pose,
             couplings=couplings,
+            coupling_matrix=C,
+            all_hand_velocity_indices=np.asarray(all_indices, dtype=int),
         )
 
 
@@ -394,23 +418,37 @@ def _pose_of(
     refuse,
     allow_penetration,
     query_object=None,
+    couplings=(),
 ) -> PoseCheck:
-    """Check the pose; raise unless the caller opted out."""
+    """Check the pose; raise unless the caller opted out.
+
+    Besides penetration and joint limits, the hand's joints must keep the
+    couplings used (``couplings``) and those recorded on the plant (its coupler
+    constraints, which Drake enforces whatever ``couplings=`` says).
+    """
     tol = check_distance_tolerance(distance_tolerance)
+    hand_bodies = hand_model_instances(plant, bodies, body)
     found = _check_pose(
         plant,
         plant_context,
         body,
-        hand_model_instances(plant, bodies, body),
+        hand_bodies,
         distance_tolerance=tol,
         query_object=query_object,
     )
+    broken = coupling_violations(
+        plant,
+        plant_context,
+        (*couplings, *recorded_couplings(plant)),
+        model_instances={b.model_instance() for b in hand_bodies},
+    )
+    found = PoseCheck(found.penetrations, found.joint_limit_violations, refuse, broken)
     if refuse:
         if allow_penetration:
-            PoseCheck((), found.joint_limit_violations).raise_if_invalid()
+            PoseCheck((), found.joint_limit_violations, True, broken).raise_if_invalid()
         else:
             found.raise_if_invalid()
-    return PoseCheck(found.penetrations, found.joint_limit_violations, refuse)
+    return found
 
 
 @dataclass(frozen=True, eq=False)
@@ -674,6 +712,7 @@ def analyze_grasp(
             if opts.torque_limits is None
             else _as_load(opts.torque_limits),
             query_object=query_object,
+            tol=opts.tol,
         )
         tol, num_generators = opts.tol, opts.num_generators
         grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)

@@ -24,13 +24,26 @@ the *independent* velocities (every hand velocity but the followers') and
 ``C`` the identity on them plus ``ρ`` in the follower's row and the leader's
 column.  The hand Jacobian of a coupled hand is ``J C``: one column per
 independent motion, so LP3 judges the motors the hand has.
+
+**The motors of a coupled hand.**  Every actuator still pushes: with ``τ``
+the actuators' efforts on ``v_h`` (``|τ_k| <= τ_max,k``) and ``λ`` the
+coupler constraint's force, statics reads ``Jᵀ f = τ + λ`` with ``λ`` in
+``N(Cᵀ)`` (a constraint force does no work along ``v_h = C u``), so the
+generalized force on the independent coordinates is
+``(J C)ᵀ f = Cᵀ τ``: on ``u_i``, ``τ_i + Σ_k ρ_k τ_k`` over the joints that
+follow it.  The motors' set is the image of the box of effort limits under
+``Cᵀ``; a follower follows one leader (one nonzero per row of ``C``), so
+that image is again a box, ``|u_i| <= Σ_k |C_ki| τ_max,k``
+(:func:`coupled_torque_limits`).
 """
 
 from __future__ import annotations
 
+import math
 import weakref
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
@@ -43,13 +56,19 @@ from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import coupling_entries, coupling_entry
 
 __all__ = [
+    "COUPLING_TOL",
+    "CouplingViolation",
     "JointCoupling",
     "add_coupler_constraint",
     "add_models",
+    "coupled_torque_limits",
     "coupling_map",
+    "coupling_violations",
     "couplings_in_model",
     "plant_couplings",
     "record_model_couplings",
+    "recorded_couplings",
+    "split_coupled_torque",
 ]
 
 _DRAKE_NS = "{http://drake.mit.edu}"
@@ -156,7 +175,19 @@ def _scoped(plant: MultibodyPlant, instance, local: str) -> str:
 
 
 def _record_text(plant, text: str, kind: str, instances: Sequence) -> None:
-    per_model = couplings_in_model(text, kind)
+    """Record the mimic couplings of models just parsed, if Drake kept them.
+
+    Drake's parser ignores a ``<mimic>`` (with a warning) unless the plant can
+    enforce it (a discrete SAP plant, or a continuous one): then the joints
+    move freely in its simulation, and recording them as coupled would make
+    the analysis, the pose check and the load check judge a hand Drake does
+    not simulate.  So they are recorded only when the plant holds a
+    constraint for each (its constraints at least those recorded plus these).
+    """
+    per_model = list(couplings_in_model(text, kind))[: len(instances)]
+    declared = sum(len(found) for found in per_model)
+    if plant.num_constraints() < len(_RECORDED.get(plant, ())) + declared:
+        return  # Drake dropped them: the joints are free in this plant
     for instance, found in zip(instances, per_model, strict=False):
         _record(
             plant,
@@ -356,3 +387,187 @@ def coupling_map(
     for f, (lead, rho) in follows.items():
         C[row[f], col[lead]] = rho
     return C, np.array(independent, dtype=int)
+
+
+def coupled_torque_limits(C: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    r"""Limits on the independent coordinates' generalized forces, ``|C|ᵀ τ_max``.
+
+    Parameters
+    ----------
+    C : (n_h, n_u) float
+        The coupling map of :func:`coupling_map` (one nonzero per row).
+    limits : (n_h,) float
+        Effort limit of the actuator on each hand velocity (N or N·m;
+        ``inf`` = none, 0 = passive).
+
+    Returns
+    -------
+    (n_u,) float
+        .. math:: \bar\tau_{\max,i} = \sum_k |C_{ki}|\, \tau_{\max,k}
+
+        the box that ``Cᵀ`` maps the actuators' box onto: a coupled joint's
+        actuator adds its effort (times ``|ρ|``) to its leader's.
+
+    Raises
+    ------
+    InvalidOptionError
+        For a ``C`` with a row of more than one nonzero (its image would not
+        be a box) or shapes that do not match.
+    """
+    C = np.asarray(C, dtype=float)
+    lim = np.asarray(limits, dtype=float).reshape(-1)
+    if C.ndim != 2 or C.shape[0] != lim.size:
+        raise InvalidOptionError(
+            f"coupling map of shape {C.shape} and {lim.size} effort limits do not "
+            "match: one limit per hand velocity"
+        )
+    if np.any(np.count_nonzero(C, axis=1) > 1):
+        raise InvalidOptionError(
+            "a hand velocity that follows more than one coordinate: the motors' "
+            "limits are no longer a box"
+        )
+    A = np.abs(C)
+    # 0 * inf is 0 here: a velocity that does not move u_i adds nothing to it
+    return np.array(
+        [
+            float(np.sum(lim[A[:, i] > 0.0] * A[A[:, i] > 0.0, i]))
+            for i in range(C.shape[1])
+        ]
+    )
+
+
+def split_coupled_torque(
+    C: np.ndarray, limits: np.ndarray, generalized: np.ndarray
+) -> np.ndarray:
+    """Actuator efforts ``τ`` with ``Cᵀ τ = generalized``, each within its limit.
+
+    Each coordinate's generalized force is shared among the actuators that
+    drive it in proportion to their limits (every one at the same fraction
+    of its limit); an actuator without a limit takes all of it.
+
+    Parameters
+    ----------
+    C : (n_h, n_u) float
+    limits : (n_h,) float
+    generalized : (n_u,) float
+        Generalized forces on the independent coordinates (``(J C)ᵀ f``).
+
+    Returns
+    -------
+    (n_h,) float
+        One effort per hand velocity (N or N·m).
+    """
+    C = np.asarray(C, dtype=float)
+    lim = np.asarray(limits, dtype=float).reshape(-1)
+    g = np.asarray(generalized, dtype=float).reshape(-1)
+    tau = np.zeros(C.shape[0])
+    for i in range(C.shape[1]):
+        rows = np.flatnonzero(C[:, i])
+        unlimited = [k for k in rows if math.isinf(lim[k])]
+        if unlimited:
+            k = unlimited[0]
+            tau[k] = g[i] / C[k, i]
+            continue
+        total = float(np.sum(np.abs(C[rows, i]) * lim[rows]))
+        if total > 0.0:
+            tau[rows] = np.sign(C[rows, i]) * lim[rows] * (g[i] / total)
+        elif rows.size:  # passive coordinate: whatever it carries, on its own joint
+            k = rows[0]
+            tau[k] = g[i] / C[k, i]
+    return tau
+
+
+COUPLING_TOL = 1e-6
+"""A configuration breaks ``q_0 = ρ q_1 + Δq`` by more than this (m or rad),
+as :func:`~drakegrasp.close_hand` refuses a pre-shape."""
+
+
+@dataclass(frozen=True)
+class CouplingViolation:
+    """A configuration that breaks a coupling ``q_0 = ρ q_1 + Δq``.
+
+    Attributes
+    ----------
+    follower, leader : str
+        Scoped joint names ``model::joint``.
+    gear_ratio, offset : float
+        ``ρ`` and ``Δq`` (m or rad).
+    follower_value, leader_value : float
+        ``q_0`` and ``q_1`` in the context (m or rad).
+    """
+
+    follower: str
+    leader: str
+    gear_ratio: float
+    offset: float
+    follower_value: float
+    leader_value: float
+
+    def __str__(self) -> str:
+        rho, off = self.gear_ratio, self.offset
+        return (
+            f"the configuration breaks the coupling {self.follower} = {rho:g} * "
+            f"{self.leader} + {off:g}: {self.follower_value:.6g} != {rho:g} * "
+            f"{self.leader_value:.6g} + {off:g}"
+        )
+
+
+def recorded_couplings(plant: MultibodyPlant) -> tuple[JointCoupling, ...]:
+    """The couplings recorded on the plant (its coupler constraints we know)."""
+    return tuple(_RECORDED.get(plant, ()))
+
+
+def coupling_violations(
+    plant: MultibodyPlant,
+    plant_context,
+    couplings: Sequence,
+    *,
+    model_instances=None,
+    tol: float = COUPLING_TOL,
+) -> tuple[CouplingViolation, ...]:
+    """The couplings that the plant's configuration breaks.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    plant_context : Context
+        The plant's context (positions).
+    couplings : sequence of (joint_0, joint_1, gear_ratio, offset)
+    model_instances : iterable of ModelInstanceIndex, optional
+        Only couplings with a joint in one of these (the hand's) are checked.
+    tol : float, optional
+        ``|q_0 - (ρ q_1 + Δq)| > tol`` breaks it (default
+        :data:`COUPLING_TOL`, close_hand's).
+
+    Returns
+    -------
+    tuple of CouplingViolation
+    """
+    keep = None if model_instances is None else {int(m) for m in model_instances}
+    found, seen = [], set()
+    for entry in coupling_entries(couplings):
+        j0, j1, rho, off = coupling_entry(plant, entry)
+        key = (int(j0.index()), int(j1.index()), rho, off)
+        if key in seen:
+            continue
+        seen.add(key)
+        if keep is not None and not (
+            int(j0.model_instance()) in keep or int(j1.model_instance()) in keep
+        ):
+            continue
+        if j0.num_positions() != 1 or j1.num_positions() != 1:
+            continue  # coupling_map refuses these where it matters
+        q0 = float(j0.GetOnePosition(plant_context))
+        q1 = float(j1.GetOnePosition(plant_context))
+        if abs(q0 - (rho * q1 + off)) > tol:
+            found.append(
+                CouplingViolation(
+                    _scoped(plant, j0.model_instance(), j0.name()),
+                    _scoped(plant, j1.model_instance(), j1.name()),
+                    float(rho),
+                    float(off),
+                    q0,
+                    q1,
+                )
+            )
+    return tuple(found)

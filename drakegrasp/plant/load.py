@@ -9,7 +9,10 @@ What the plant already knows is read from it, never re-derived:
   joint actuator that drives it (``JointActuator.effort_limit()``; ``inf``
   when an actuator has none); a hand joint without an actuator is passive and
   gets 0 (it can carry no torque), except the floating joint of a free hand
-  base, which is held where it is placed (``inf``).
+  base, which is held where it is placed (``inf``).  In a coupled hand every
+  actuator still pushes: the independent coordinate ``u_i`` carries
+  ``τ_i + Σ_k ρ_k τ_k`` over the joints that follow it, so its limit is
+  ``Σ_k |C_ki| τ_max,k`` (:func:`~drakegrasp.plant.couplings.coupled_torque_limits`).
 * the plant's friction, per contact (:mod:`drakegrasp.plant.friction`).
 
 :func:`analyze_load` puts them together for
@@ -17,11 +20,22 @@ What the plant already knows is read from it, never re-derived:
 ``mu="plant"``): whether the hand holds the load, with which joint torques
 and squeeze, the payload factor and the joint that limits it first, and a
 warning where a given ``μ`` disagrees with the plant's.
+
+**Held by the motors.**  A hand that cannot control a squeeze (LP3 fails:
+an internal force in ``N(G) ∩ N(Jᵀ)`` with every ``f_n > 0``; a *defective*
+hand-object system in Prattichizzo & Trinkle's terms) may balance a load
+with such a squeeze, at zero joint torque: a preload that the motors can
+neither create nor renew.  Such a hold is not called held.  The load is held
+by the motors when the contacts of some set of hand bodies (whole fingers,
+or the palm), on which LP3 passes, hold it alone: the forces there are the
+motors' to make.  The report names those bodies (``motor_bodies``); when no
+such set holds the load, ``holds`` is False and ``needs_preload`` True.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 from dataclasses import dataclass, fields
 
@@ -31,9 +45,12 @@ from pydrake.multibody.tree import JointActuatorIndex
 
 from drakegrasp.closure.grasp_forces import GraspForceResult, grasp_forces
 from drakegrasp.closure.payload import MaxLoadResult, max_load
+from drakegrasp.closure.verdicts import internal_forces
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.plant.couplings import coupled_torque_limits, split_coupled_torque
 from drakegrasp.plant.fingers import effort_unit
 from drakegrasp.plant.friction import (
     friction_disagreement,
@@ -176,6 +193,31 @@ class LoadReport:
         The unit of each hand velocity's torque: ``"N"`` along a prismatic
         joint or a linear velocity, ``"N·m"`` about a revolute joint or an
         angular velocity (empty: not known).
+    actuator_names : tuple of str
+        Coupled hand only (else empty): every hand velocity, followers of
+        couplings included, each with its own actuator.  ``joint_torques``
+        and ``torque_limits`` are then per *independent coordinate*: the
+        generalized force ``Cᵀ τ`` its actuators and its followers' make
+        together, bounded by ``Σ_k |C_ki| τ_max,k``.
+    actuator_torque_limits : (n_a,) float or None
+        Coupled hand: the effort limit of each of ``actuator_names``.
+    actuator_torques : (n_a,) float or None
+        Coupled hand, when held: efforts with ``Cᵀ τ = joint_torques``, each
+        coordinate's force shared in proportion to the limits
+        (:func:`~drakegrasp.plant.couplings.split_coupled_torque`).
+    actuator_units : tuple of str
+        The unit of each of ``actuator_names``' efforts.
+    defective : bool
+        The hand cannot control a squeeze (LP3 fails on the whole grasp).
+    needs_preload : bool
+        Forces in the cones and limits balance the load, but only with a
+        squeeze the motors cannot create (``defective`` and no set of hand
+        bodies on which LP3 passes holds it): ``holds`` is False; ``forces``
+        are those a preload would need.
+    motor_bodies : tuple of str or None
+        ``defective`` and held: the hand bodies whose contacts hold the load
+        alone (``forces`` are zero elsewhere; ``payload`` is the largest over
+        such sets, its certificate on their sub-grasp).  None otherwise.
     """
 
     wrench: np.ndarray
@@ -192,6 +234,13 @@ class LoadReport:
     friction_rule: str
     warnings: tuple[str, ...] = ()
     torque_units: tuple[str, ...] = ()
+    actuator_names: tuple[str, ...] = ()
+    actuator_torque_limits: np.ndarray | None = None
+    actuator_torques: np.ndarray | None = None
+    actuator_units: tuple[str, ...] = ()
+    defective: bool = False
+    needs_preload: bool = False
+    motor_bodies: tuple[str, ...] | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
@@ -204,6 +253,20 @@ class LoadReport:
             f"Load ({self.source}, frame O about its origin): {w}",
             f"  holds: {'yes' if self.holds else 'NO'}",
         ]
+        if self.needs_preload:
+            lines.append(
+                "  only with a preload: every balance found squeezes along "
+                "N(G) ∩ N(Jᵀ), which no motor can create (LP3: the hand cannot "
+                "control a squeeze; a defective grasp); the forces below are what "
+                "that preload would have to supply"
+            )
+        elif self.motor_bodies is not None:
+            lines.append(
+                "  held by the motors through "
+                + ", ".join(self.motor_bodies)
+                + " alone (the hand cannot control a squeeze, LP3; no hold "
+                "leans on one)"
+            )
         f = self.forces
         if f.feasible:
             lines.append(f"  least squeeze {f.squeeze:.4g} N")
@@ -216,10 +279,21 @@ class LoadReport:
                     )
                 )
                 lines.append(f"  joint torques: {tau}")
+            if self.actuator_torques is not None:
+                units = self.actuator_units or ("",) * len(self.actuator_names)
+                tau = ", ".join(
+                    f"{n} {t:+.3g}" + (f" {u}" if u else "")
+                    for n, t, u in zip(
+                        self.actuator_names, self.actuator_torques, units, strict=True
+                    )
+                )
+                lines.append(f"  actuator efforts (coupled, shared by limit): {tau}")
         elif f.certificate is not None:
             lines.append(f"  why not: {f.certificate}")
         alpha = math.nan if self.payload is None else self.payload.alpha
-        if self.payload is None:
+        if self.payload is None and self.needs_preload:
+            lines.append("  payload factor: none without a preload")
+        elif self.payload is None:
             lines.append("  payload factor: none (a zero load has no direction)")
         elif math.isfinite(alpha):
             lines.append(
@@ -227,9 +301,19 @@ class LoadReport:
             )
         else:
             lines.append("  payload factor unbounded (no limit binds along the load)")
+        coupled = ""
+        if self.actuator_torque_limits is not None and self.torque_limits is not None:
+            units = self.torque_units or ("",) * len(self.joint_names)
+            per = ", ".join(
+                f"{n} {t:.4g}" + (f" {u}" if u else "")
+                for n, t, u in zip(
+                    self.joint_names, self.torque_limits, units, strict=True
+                )
+            )
+            coupled = f" (per coordinate, its followers' actuators added: {per})"
         lines.append(
-            f"  torque limits: {self.torque_limits_source}; first to saturate: "
-            f"{self.first_saturating_joint or 'none'}"
+            f"  torque limits: {self.torque_limits_source}{coupled}; first to "
+            f"saturate: {self.first_saturating_joint or 'none'}"
         )
         lines.append(
             f"  friction: mu = {np.round(self.mu, 4).tolist()}"
@@ -299,17 +383,53 @@ def _load_wrench(plant, plant_context, data, load):
     return w
 
 
+def _coupling(data):
+    """``(C, every hand velocity)`` of a coupled hand, or None."""
+    C = getattr(data, "coupling_matrix", None)
+    every = getattr(data, "all_hand_velocity_indices", None)
+    if C is None or every is None or C.shape[0] == C.shape[1]:
+        return None
+    return C, every
+
+
 def _torque_limits(plant, data, torque_limits):
+    """``(per coordinate, source, per actuator or None)``.
+
+    For a coupled hand the plant's limits are read per actuator, followers
+    included, and mapped onto the independent coordinates by
+    :func:`~drakegrasp.plant.couplings.coupled_torque_limits`; given limits
+    may be either, told apart by their length.
+    """
+    coupling = _coupling(data)
     if torque_limits is None:
-        return None, "none"
+        return None, "none", None
+    n_u = len(data.hand_velocity_indices)
     if isinstance(torque_limits, str):
         if torque_limits != "plant":
             raise InvalidOptionError(
                 "torque_limits must be None, 'plant' or one limit per hand "
                 f"velocity, got {torque_limits!r}"
             )
-        return plant_torque_limits(plant, data.hand_velocity_indices), "plant"
-    return np.asarray(torque_limits, dtype=float), "given"
+        if coupling is None:
+            return plant_torque_limits(plant, data.hand_velocity_indices), "plant", None
+        C, every = coupling
+        per_actuator = plant_torque_limits(plant, every)
+        return coupled_torque_limits(C, per_actuator), "plant", per_actuator
+    given = np.asarray(torque_limits, dtype=float)
+    if coupling is not None and given.ndim == 1 and given.size == len(coupling[1]):
+        C, _ = coupling
+        if np.any(given < 0.0) or np.any(np.isnan(given)):
+            raise InvalidOptionError(
+                f"torque_limits must be >= 0 (inf: none), got {given.tolist()}"
+            )
+        return coupled_torque_limits(C, given), "given", given
+    if coupling is not None and not (given.ndim == 0 or given.size == n_u):
+        raise InvalidOptionError(
+            f"torque_limits of a coupled hand take one limit per actuated joint "
+            f"({len(coupling[1])}, followers included) or one per independent "
+            f"coordinate ({n_u}), got {given.size}"
+        )
+    return given, "given", None
 
 
 def analyze_load(
@@ -321,6 +441,7 @@ def analyze_load(
     torque_limits=None,
     mu_given: float | None,
     mu_plant: np.ndarray | None,
+    tol: float = DEFAULT_TOL,
 ) -> LoadReport:
     """The load section of a grasp report (see :class:`LoadReport`).
 
@@ -336,9 +457,11 @@ def analyze_load(
         The ``μ`` the caller typed (None with ``mu="plant"``).
     mu_plant : (N,) float or None
         The plant's friction per contact (None when it cannot be read).
+    tol : float, optional
+        LP3's threshold on ``d*`` (see :func:`~drakegrasp.internal_forces`).
     """
     w = _load_wrench(plant, plant_context, data, load)
-    limits, source = _torque_limits(plant, data, torque_limits)
+    limits, source, per_actuator = _torque_limits(plant, data, torque_limits)
     J = data.hand_jacobian
     forces = grasp_forces(data.grasp, w, hand_jacobian=J, torque_limits=limits)
     payload = (
@@ -346,6 +469,15 @@ def analyze_load(
         if np.any(w != 0.0)
         else None
     )
+    defective, needs_preload, motor_bodies = False, False, None
+    if forces.feasible and np.any(w != 0.0):
+        motors = _held_by_motors(data, w, limits, tol)
+        if motors is not None:
+            defective = True
+            if motors[0] is None:
+                needs_preload, payload = True, None
+            else:
+                motor_bodies, forces, payload = motors
     names, units = _velocity_labels(plant, data.hand_velocity_indices)
     first = (
         names[payload.saturating_joints[0]]
@@ -354,10 +486,19 @@ def analyze_load(
     )
     disagreement = friction_disagreement(plant, mu_given, mu_plant)
     warnings = [] if disagreement is None else [disagreement]
+    coupling = _coupling(data)
+    actuator_names, actuator_units, actuator_torques = (), (), None
+    if coupling is not None and per_actuator is not None:
+        C, every = coupling
+        actuator_names, actuator_units = _velocity_labels(plant, every)
+        if forces.joint_torques is not None:
+            actuator_torques = split_coupled_torque(
+                C, per_actuator, forces.joint_torques
+            )
     return LoadReport(
         wrench=w,
         source="gravity" if isinstance(load, str) else "given",
-        holds=forces.feasible,
+        holds=forces.feasible and not needs_preload,
         forces=forces,
         payload=payload,
         torque_limits=limits,
@@ -369,11 +510,80 @@ def analyze_load(
         friction_rule=friction_rule(plant),
         warnings=tuple(warnings),
         torque_units=units,
+        actuator_names=actuator_names,
+        actuator_torque_limits=per_actuator,
+        actuator_torques=actuator_torques,
+        actuator_units=actuator_units,
+        defective=defective,
+        needs_preload=needs_preload,
+        motor_bodies=motor_bodies,
     )
 
 
+def _lp3_jacobian(J: np.ndarray) -> np.ndarray:
+    return J if J.shape[1] else np.zeros((J.shape[0], 1))
+
+
+MAX_BODY_SETS = 4096
+"""How many sets of hand bodies a defective grasp's load check tries (the
+largest first: all bodies but one, then all but two...), so that a hand with
+many touching bodies cannot hang it; past this, no set found reads as "not
+held by the motors" (the conservative answer)."""
+
+
+def _held_by_motors(data, w, limits, tol):
+    """None for a hand that controls every squeeze, else how the motors hold.
+
+    Returns ``(bodies, forces, payload)`` for the largest set of hand bodies
+    (then the largest payload) whose contacts, on which LP3 passes, hold
+    ``w`` alone, with the forces spread back over every contact; ``(None,
+    None, None)`` when no such set holds it among the first
+    :data:`MAX_BODY_SETS` tried.
+    """
+    grasp, J = data.grasp, data.hand_jacobian
+    if internal_forces(grasp, _lp3_jacobian(J), tol=tol).passes:
+        return None
+    bodies = list(dict.fromkeys(c.finger_body for c in data.contacts))
+    slices = grasp.component_slices()
+    best = None
+    sets = itertools.chain.from_iterable(
+        itertools.combinations(bodies, size) for size in range(len(bodies) - 1, 0, -1)
+    )
+    for chosen in itertools.islice(sets, MAX_BODY_SETS):
+        if best is not None and len(chosen) < len(best[0]):
+            break  # the largest sets come first: a smaller one is not wanted
+        keep = [i for i, c in enumerate(data.contacts) if c.finger_body in chosen]
+        rows = np.concatenate([np.arange(J.shape[0])[slices[i]] for i in keep])
+        sub = grasp.with_contacts([grasp.contacts[i] for i in keep])
+        J_sub = J[rows]
+        if not internal_forces(sub, _lp3_jacobian(J_sub), tol=tol).passes:
+            continue
+        held = grasp_forces(sub, w, hand_jacobian=J_sub, torque_limits=limits)
+        if not held.feasible:
+            continue
+        payload = max_load(sub, w, hand_jacobian=J_sub, torque_limits=limits)
+        if best is None or payload.alpha > best[2].alpha:
+            full = [np.zeros(s_.stop - s_.start) for s_ in slices]
+            for i, f in zip(keep, held.contact_forces, strict=True):
+                full[i] = f
+            best = (
+                chosen,
+                dataclasses.replace(held, contact_forces=tuple(full)),
+                payload,
+            )
+    return (None, None, None) if best is None else best
+
+
 def load_section(
-    plant, plant_context, data, *, mu, load, torque_limits, query_object=None
+    plant,
+    plant_context,
+    data,
+    *,
+    mu,
+    load,
+    torque_limits,
+    query_object=None,
+    tol=DEFAULT_TOL,
 ):
     """What :func:`~drakegrasp.analyze_grasp` adds for ``mu="plant"`` and a load.
 
@@ -422,5 +632,6 @@ def load_section(
         torque_limits=torque_limits,
         mu_given=None if isinstance(mu, str) else float(mu),
         mu_plant=mu_plant,
+        tol=tol,
     )
     return data, report

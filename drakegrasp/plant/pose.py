@@ -115,16 +115,25 @@ class PoseCheck:
     checked : bool
         False when the caller skipped the refusal (``check_pose=False``); the
         findings are still listed.
+    coupling_violations : tuple of CouplingViolation
+        Joint couplings (a ``<mimic>``'s coupler constraint, ``couplings=``)
+        that the configuration breaks
+        (:func:`~drakegrasp.plant.couplings.coupling_violations`).
     """
 
     penetrations: tuple[Penetration, ...] = ()
     joint_limit_violations: tuple[JointLimitViolation, ...] = ()
     checked: bool = True
+    coupling_violations: tuple = ()
 
     @property
     def valid(self) -> bool:
-        """True when the pose has neither penetration nor a joint off limits."""
-        return not self.penetrations and not self.joint_limit_violations
+        """True without penetration, a joint off limits or a broken coupling."""
+        return (
+            not self.penetrations
+            and not self.joint_limit_violations
+            and not self.coupling_violations
+        )
 
     def raise_if_invalid(self) -> None:
         """Raise :class:`PenetrationError` or :class:`JointLimitError` if invalid.
@@ -143,6 +152,11 @@ class PoseCheck:
                 "impossible pose: " + "; ".join(map(str, self.joint_limit_violations)),
                 remedy=JOINT_LIMIT_REMEDY,
             )
+        if self.coupling_violations:
+            raise InvalidPoseError(
+                "impossible pose: " + "; ".join(map(str, self.coupling_violations)),
+                remedy=JOINT_LIMIT_REMEDY,
+            )
 
     def summary(self) -> str:
         """One line for a report."""
@@ -150,6 +164,7 @@ class PoseCheck:
             return "pose: valid (no penetration, joints within limits)"
         found = [str(p) for p in self.penetrations]
         found += [str(v) for v in self.joint_limit_violations]
+        found += [str(v) for v in self.coupling_violations]
         return "pose: INVALID (analysed with check_pose=False): " + "; ".join(found)
 
     def to_dict(self) -> dict:
@@ -159,6 +174,7 @@ class PoseCheck:
             "checked": self.checked,
             "penetrations": [vars(p) for p in self.penetrations],
             "joint_limit_violations": [vars(v) for v in self.joint_limit_violations],
+            "coupling_violations": [vars(v) for v in self.coupling_violations],
         }
 
 

@@ -213,3 +213,33 @@ def test_repeated_urdf_collision_names_get_unique_labels():
     for body, label in labels:
         assert label == body + "/Box#0"
     assert {e["object_geometry_label"] for e in entries} == {"box::box#0"}
+
+
+@pytest.mark.parametrize("kind", sorted(GRIPPERS))
+def test_a_mimic_drake_ignores_is_not_recorded(kind):
+    # A discrete TAMSI plant drops the <mimic> (Drake warns, adds no
+    # constraint): its jaws move freely in the simulation, so drakegrasp must
+    # not analyse, pose-check or load-check them as coupled.
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drakegrasp.plant import add_models
+
+    text, fmt, _ = GRIPPERS[kind]()
+    plants = {}
+    for approximation in ("tamsi", "sap"):
+        builder = DiagramBuilder()
+        config = MultibodyPlantConfig(
+            time_step=1e-3, discrete_contact_approximation=approximation
+        )
+        plant, _ = AddMultibodyPlant(config, builder)
+        add_models(Parser(plant), text=text, kind=fmt)
+        plant.Finalize()
+        plants[approximation] = plant
+    assert plants["tamsi"].num_constraints() == 0
+    assert plant_couplings(plants["tamsi"]) == ()
+    assert plants["sap"].num_constraints() == 1
+    assert plant_couplings(plants["sap"]) == (
+        JointCoupling(FOLLOWER, LEADER, 1.0, 0.0),
+    )
