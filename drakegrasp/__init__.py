@@ -60,6 +60,7 @@ _SOURCES = {
     ),
     "drakegrasp.errors": (
         "BatchFileError",
+        "CouplingError",
         "GraspError",
         "InvalidContactError",
         "InvalidContextError",
@@ -203,6 +204,7 @@ __all__ = [
     "Contact",
     "ContactCurvature",
     "ContactModel",
+    "CouplingError",
     "DEFAULT_TOL",
     "FingerClosure",
     "Grasp",

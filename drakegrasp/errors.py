@@ -80,6 +80,10 @@ class JointLimitError(InvalidPoseError):
     """A joint of the hand is outside its position limits."""
 
 
+class CouplingError(InvalidPoseError):
+    """The hand's joints break a coupling (a ``<mimic>``, or ``couplings=``)."""
+
+
 class ModelError(GraspError):
     """A model, scene file or body could not be found or loaded."""
 

@@ -25,6 +25,7 @@ from pydrake.multibody.tree import JointIndex, RigidBody
 from pydrake.systems.framework import Context
 
 from drakegrasp.errors import (
+    CouplingError,
     InvalidPoseError,
     JointLimitError,
     ModelError,
@@ -153,7 +154,7 @@ class PoseCheck:
                 remedy=JOINT_LIMIT_REMEDY,
             )
         if self.coupling_violations:
-            raise InvalidPoseError(
+            raise CouplingError(
                 "impossible pose: " + "; ".join(map(str, self.coupling_violations)),
                 remedy=JOINT_LIMIT_REMEDY,
             )
