@@ -467,13 +467,7 @@ def check_torque_limit(torque_limit) -> float:
         Not a real number, or not finite and > 0; the message names
         ``torque_limit``.
     """
-    value = real_scalar("torque_limit", torque_limit)
-    if not 0 < value < math.inf:
-        raise InvalidOptionError(
-            f"torque_limit must be a finite number > 0 (N·m per finger joint), "
-            f"got {torque_limit!r}"
-        )
-    return value
+    return _positive_limit("torque_limit", torque_limit, "N·m per finger joint")
 
 
 def check_squeeze_limit(squeeze_limit) -> float:
@@ -485,13 +479,17 @@ def check_squeeze_limit(squeeze_limit) -> float:
         Not a real number, or not finite and > 0; the message names
         ``squeeze_limit``.
     """
-    value = real_scalar("squeeze_limit", squeeze_limit)
-    if not 0 < value < math.inf:
+    return _positive_limit("squeeze_limit", squeeze_limit, "N per finger")
+
+
+def _positive_limit(name: str, value, unit: str) -> float:
+    """``value`` as a finite float > 0, else an error naming ``name`` and ``unit``."""
+    number = real_scalar(name, value)
+    if not 0 < number < math.inf:
         raise InvalidOptionError(
-            f"squeeze_limit must be a finite number > 0 (N per finger), got "
-            f"{squeeze_limit!r}"
+            f"{name} must be a finite number > 0 ({unit}), got {value!r}"
         )
-    return value
+    return number
 
 
 def motor_limit(plant, candidate: GraspCandidate) -> float:

@@ -379,17 +379,16 @@ def plan_grasps(
         object_mass = _check_positive("object_mass", object_mass, "kg")
     if squeeze_limit is not None:
         squeeze_limit = check_squeeze_limit(squeeze_limit)
-        if point_cloud is not None and object_mass is None:
-            raise InvalidOptionError(
-                "squeeze_limit ranks by squeeze_needed, which needs the "
-                "object's weight: give object_mass= (kg) with a point_cloud"
-            )
     if torque_limit is not None:
         torque_limit = check_torque_limit(torque_limit)
-        if point_cloud is not None and object_mass is None:
+    for name, value, needed in (
+        ("squeeze_limit", squeeze_limit, "squeeze_needed"),
+        ("torque_limit", torque_limit, "torque_needed"),
+    ):
+        if value is not None and point_cloud is not None and object_mass is None:
             raise InvalidOptionError(
-                "torque_limit ranks by torque_needed, which needs the object's "
-                "weight: give object_mass= (kg) with a point_cloud"
+                f"{name} ranks by {needed}, which needs the object's weight: "
+                "give object_mass= (kg) with a point_cloud"
             )
     noise = _check_noise(noise)
     if weight_check is not None:

@@ -271,21 +271,11 @@ class LoadReport:
         if f.feasible:
             lines.append(f"  least squeeze {f.squeeze:.4g} N")
             if f.joint_torques is not None:
-                units = self.torque_units or ("",) * len(self.joint_names)
-                tau = ", ".join(
-                    f"{n} {t:+.3g}" + (f" {u}" if u else "")
-                    for n, t, u in zip(
-                        self.joint_names, f.joint_torques, units, strict=True
-                    )
-                )
+                tau = _named(self.joint_names, f.joint_torques, self.torque_units)
                 lines.append(f"  joint torques: {tau}")
             if self.actuator_torques is not None:
-                units = self.actuator_units or ("",) * len(self.actuator_names)
-                tau = ", ".join(
-                    f"{n} {t:+.3g}" + (f" {u}" if u else "")
-                    for n, t, u in zip(
-                        self.actuator_names, self.actuator_torques, units, strict=True
-                    )
+                tau = _named(
+                    self.actuator_names, self.actuator_torques, self.actuator_units
                 )
                 lines.append(f"  actuator efforts (coupled, shared by limit): {tau}")
         elif f.certificate is not None:
@@ -303,12 +293,8 @@ class LoadReport:
             lines.append("  payload factor unbounded (no limit binds along the load)")
         coupled = ""
         if self.actuator_torque_limits is not None and self.torque_limits is not None:
-            units = self.torque_units or ("",) * len(self.joint_names)
-            per = ", ".join(
-                f"{n} {t:.4g}" + (f" {u}" if u else "")
-                for n, t, u in zip(
-                    self.joint_names, self.torque_limits, units, strict=True
-                )
+            per = _named(
+                self.joint_names, self.torque_limits, self.torque_units, signed=False
             )
             coupled = f" (per coordinate, its followers' actuators added: {per})"
         lines.append(
@@ -363,6 +349,16 @@ def _velocity_labels(
     return (
         tuple(labels.get(int(v), f"v[{int(v)}]") for v in velocity_indices),
         tuple(units.get(int(v), "") for v in velocity_indices),
+    )
+
+
+def _named(names, values, units, *, signed: bool = True) -> str:
+    """``"name +1.23 N, ..."``: each value with its name and unit (if known)."""
+    units = units or ("",) * len(names)
+    form = "+.3g" if signed else ".4g"
+    return ", ".join(
+        f"{n} {t:{form}}" + (f" {u}" if u else "")
+        for n, t, u in zip(names, values, units, strict=True)
     )
 
 
