@@ -712,7 +712,6 @@ def analyze_grasp(
             if opts.torque_limits is None
             else _as_load(opts.torque_limits),
             query_object=query_object,
-            tol=opts.tol,
         )
         tol, num_generators = opts.tol, opts.num_generators
         grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)

@@ -21,15 +21,18 @@ What the plant already knows is read from it, never re-derived:
 and squeeze, the payload factor and the joint that limits it first, and a
 warning where a given ``μ`` disagrees with the plant's.
 
-**Held by the motors.**  A hand that cannot control a squeeze (LP3 fails:
-an internal force in ``N(G) ∩ N(Jᵀ)`` with every ``f_n > 0``; a *defective*
-hand-object system in Prattichizzo & Trinkle's terms) may balance a load
-with such a squeeze, at zero joint torque: a preload that the motors can
-neither create nor renew.  Such a hold is not called held.  The load is held
-by the motors when the contacts of some set of hand bodies (whole fingers,
-or the palm), on which LP3 passes, hold it alone: the forces there are the
-motors' to make.  The report names those bodies (``motor_bodies``); when no
-such set holds the load, ``holds`` is False and ``needs_preload`` True.
+**Held by the motors.**  Some contacts may hold a squeeze that loads no
+joint: a force ``h != 0`` in the friction cones with ``G h = 0`` and ``Jᵀ h =
+0`` (:func:`passive_preload`; a *defective* hand-object system in
+Prattichizzo & Trinkle's terms, such as two jaws that a coupling moves the
+same way).  A load balanced with such a squeeze is balanced by a preload that
+the motors can neither create nor renew, and is not called held.  The load is
+held by the motors when the contacts of some set of hand bodies (whole
+fingers, or the palm) that admits no such squeeze hold it alone: the forces
+there are the motors' to make.  The largest such sets are tried first (all
+bodies but one, then all but two..., at most :data:`MAX_BODY_SETS`); the
+report names the set whose payload is largest among them (``motor_bodies``),
+and when none holds the load, ``holds`` is False and ``needs_preload`` True.
 """
 
 from __future__ import annotations
@@ -42,12 +45,14 @@ from dataclasses import dataclass, fields
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JointActuatorIndex
+from pydrake.solvers import MathematicalProgram
 
+from drakegrasp._solvers import require_solution, solve
 from drakegrasp.closure.grasp_forces import GraspForceResult, grasp_forces
 from drakegrasp.closure.payload import MaxLoadResult, max_load
-from drakegrasp.closure.verdicts import internal_forces
+from drakegrasp.core.friction_cone import friction_cone_generators
+from drakegrasp.core.grasp import grasp_matrix
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.tolerances import DEFAULT_TOL
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import coupled_torque_limits, split_coupled_torque
@@ -208,16 +213,19 @@ class LoadReport:
     actuator_units : tuple of str
         The unit of each of ``actuator_names``' efforts.
     defective : bool
-        The hand cannot control a squeeze (LP3 fails on the whole grasp).
+        Some contacts can hold a squeeze that loads no joint
+        (:func:`passive_preload`); decided when the load is balanced and
+        not zero (False otherwise).
     needs_preload : bool
         Forces in the cones and limits balance the load, but only with a
         squeeze the motors cannot create (``defective`` and no set of hand
-        bodies on which LP3 passes holds it): ``holds`` is False; ``forces``
-        are those a preload would need.
+        bodies that admits no such squeeze holds it): ``holds`` is False;
+        ``forces`` are those a preload would need.
     motor_bodies : tuple of str or None
         ``defective`` and held: the hand bodies whose contacts hold the load
-        alone (``forces`` are zero elsewhere; ``payload`` is the largest over
-        such sets, its certificate on their sub-grasp).  None otherwise.
+        alone (``forces`` are zero elsewhere): of the largest sets that do,
+        the one with the largest ``payload`` (its certificate on their
+        sub-grasp).  None otherwise.
     """
 
     wrench: np.ndarray
@@ -256,15 +264,16 @@ class LoadReport:
         if self.needs_preload:
             lines.append(
                 "  only with a preload: every balance found squeezes along "
-                "N(G) ∩ N(Jᵀ), which no motor can create (LP3: the hand cannot "
-                "control a squeeze; a defective grasp); the forces below are what "
-                "that preload would have to supply"
+                "N(G) ∩ N(Jᵀ), which loads no joint, so no motor can create it "
+                "(a defective grasp); the forces below are what that preload "
+                "would have to supply"
             )
         elif self.motor_bodies is not None:
             lines.append(
                 "  held by the motors through "
                 + ", ".join(self.motor_bodies)
-                + " alone (the hand cannot control a squeeze, LP3; no hold "
+                + " alone (some contacts can hold a squeeze no motor creates; "
+                "no hold "
                 "leans on one)"
             )
         f = self.forces
@@ -394,7 +403,8 @@ def _torque_limits(plant, data, torque_limits):
     For a coupled hand the plant's limits are read per actuator, followers
     included, and mapped onto the independent coordinates by
     :func:`~drakegrasp.plant.couplings.coupled_torque_limits`; given limits
-    may be either, told apart by their length.
+    may be either, told apart by their length.  One given limit is every
+    actuator's (the one coordinate's, when the hand has one).
     """
     coupling = _coupling(data)
     if torque_limits is None:
@@ -412,6 +422,9 @@ def _torque_limits(plant, data, torque_limits):
         per_actuator = plant_torque_limits(plant, every)
         return coupled_torque_limits(C, per_actuator), "plant", per_actuator
     given = np.asarray(torque_limits, dtype=float)
+    if given.size == 1 and n_u != 1:  # one limit for every actuator
+        count = n_u if coupling is None else len(coupling[1])
+        given = np.full(count, float(given.reshape(-1)[0]))
     if coupling is not None and given.ndim == 1 and given.size == len(coupling[1]):
         C, _ = coupling
         if np.any(given < 0.0) or np.any(np.isnan(given)):
@@ -437,7 +450,6 @@ def analyze_load(
     torque_limits=None,
     mu_given: float | None,
     mu_plant: np.ndarray | None,
-    tol: float = DEFAULT_TOL,
 ) -> LoadReport:
     """The load section of a grasp report (see :class:`LoadReport`).
 
@@ -453,8 +465,6 @@ def analyze_load(
         The ``μ`` the caller typed (None with ``mu="plant"``).
     mu_plant : (N,) float or None
         The plant's friction per contact (None when it cannot be read).
-    tol : float, optional
-        LP3's threshold on ``d*`` (see :func:`~drakegrasp.internal_forces`).
     """
     w = _load_wrench(plant, plant_context, data, load)
     limits, source, per_actuator = _torque_limits(plant, data, torque_limits)
@@ -467,7 +477,7 @@ def analyze_load(
     )
     defective, needs_preload, motor_bodies = False, False, None
     if forces.feasible and np.any(w != 0.0):
-        motors = _held_by_motors(data, w, limits, tol)
+        motors = _held_by_motors(data, w, limits)
         if motors is not None:
             defective = True
             if motors[0] is None:
@@ -516,28 +526,83 @@ def analyze_load(
     )
 
 
-def _lp3_jacobian(J: np.ndarray) -> np.ndarray:
-    return J if J.shape[1] else np.zeros((J.shape[0], 1))
+PRELOAD_TOL = 1e-7
+"""A passive preload exists when the contact forces below, with their normal
+components summing to 1 (N), meet ``G f = 0`` and ``Jᵀ f = 0`` to this
+residual (N, N·m; an exact one meets them to about 1e-12)."""
 
 
-MAX_BODY_SETS = 4096
+def passive_preload(grasp, hand_jacobian: np.ndarray) -> bool:
+    r"""Whether some contacts can hold a squeeze that no motor creates or renews.
+
+    That is a force ``h != 0`` in the (polyhedral) friction cones with
+    ``G h = 0`` and ``Jᵀ h = 0``: an internal force that loads no joint (a
+    *defective* hand-object system in Prattichizzo & Trinkle's terms).  Unlike
+    LP3, which asks for every ``f_n > 0``, some contacts may carry none, so
+    an extra contact that cannot join such a squeeze does not hide it.  One
+    LP: the least residual ``|G S λ|_1 + |Jᵀ S λ|_1`` over ``λ >= 0`` with the
+    normal components summing to 1; a preload exists when it is at most
+    :data:`PRELOAD_TOL`.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    hand_jacobian : (M, n_q) float
+        Rows in the contact frames of ``grasp`` (its components).
+
+    Returns
+    -------
+    bool
+    """
+    b = grasp.characteristic_length
+    blocks = [
+        friction_cone_generators(c, characteristic_length=b) for c in grasp.contacts
+    ]
+    S = np.zeros((sum(k.shape[0] for k in blocks), sum(k.shape[1] for k in blocks)))
+    row = col = 0
+    for block in blocks:  # block-diagonal (scipy stays out of analyze's imports)
+        S[row : row + block.shape[0], col : col + block.shape[1]] = block
+        row, col = row + block.shape[0], col + block.shape[1]
+    A = np.vstack([grasp_matrix(grasp), np.asarray(hand_jacobian).T]) @ S
+    prog = MathematicalProgram()
+    lam = prog.NewContinuousVariables(S.shape[1], "lambda")
+    slack = prog.NewContinuousVariables(A.shape[0], "slack")
+    prog.AddBoundingBoxConstraint(0.0, np.inf, lam)
+    normals = S[[sl.start for sl in grasp.component_slices()]].sum(axis=0)
+    prog.AddLinearEqualityConstraint(normals.reshape(1, -1), [1.0], lam)
+    eye = np.eye(A.shape[0])
+    # -slack <= A lam <= slack
+    prog.AddLinearConstraint(
+        np.hstack([A, -eye]), np.full(A.shape[0], -np.inf), np.zeros(A.shape[0]),
+        np.concatenate([lam, slack]),
+    )  # fmt: skip
+    prog.AddLinearConstraint(
+        np.hstack([A, eye]), np.zeros(A.shape[0]), np.full(A.shape[0], np.inf),
+        np.concatenate([lam, slack]),
+    )  # fmt: skip
+    prog.AddLinearCost(np.ones(A.shape[0]), 0.0, slack)
+    result = require_solution(prog, solve(prog, "lp"), "the passive-preload LP")
+    return bool(result.get_optimal_cost() <= PRELOAD_TOL)
+
+
+MAX_BODY_SETS = 256
 """How many sets of hand bodies a defective grasp's load check tries (the
 largest first: all bodies but one, then all but two...), so that a hand with
 many touching bodies cannot hang it; past this, no set found reads as "not
 held by the motors" (the conservative answer)."""
 
 
-def _held_by_motors(data, w, limits, tol):
+def _held_by_motors(data, w, limits):
     """None for a hand that controls every squeeze, else how the motors hold.
 
     Returns ``(bodies, forces, payload)`` for the largest set of hand bodies
-    (then the largest payload) whose contacts, on which LP3 passes, hold
-    ``w`` alone, with the forces spread back over every contact; ``(None,
+    (then the largest payload) whose contacts admit no passive preload and
+    hold ``w`` alone, with the forces spread back over every contact; ``(None,
     None, None)`` when no such set holds it among the first
     :data:`MAX_BODY_SETS` tried.
     """
     grasp, J = data.grasp, data.hand_jacobian
-    if internal_forces(grasp, _lp3_jacobian(J), tol=tol).passes:
+    if not passive_preload(grasp, J):
         return None
     bodies = list(dict.fromkeys(c.finger_body for c in data.contacts))
     slices = grasp.component_slices()
@@ -552,7 +617,7 @@ def _held_by_motors(data, w, limits, tol):
         rows = np.concatenate([np.arange(J.shape[0])[slices[i]] for i in keep])
         sub = grasp.with_contacts([grasp.contacts[i] for i in keep])
         J_sub = J[rows]
-        if not internal_forces(sub, _lp3_jacobian(J_sub), tol=tol).passes:
+        if passive_preload(sub, J_sub):
             continue
         held = grasp_forces(sub, w, hand_jacobian=J_sub, torque_limits=limits)
         if not held.feasible:
@@ -579,7 +644,6 @@ def load_section(
     load,
     torque_limits,
     query_object=None,
-    tol=DEFAULT_TOL,
 ):
     """What :func:`~drakegrasp.analyze_grasp` adds for ``mu="plant"`` and a load.
 
@@ -628,6 +692,5 @@ def load_section(
         torque_limits=torque_limits,
         mu_given=None if isinstance(mu, str) else float(mu),
         mu_plant=mu_plant,
-        tol=tol,
     )
     return data, report

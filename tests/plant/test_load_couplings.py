@@ -231,3 +231,67 @@ def test_a_pose_that_breaks_a_models_mimic_is_invalid():
         )
         assert f"{q - 0.002:.6g} != 1 * {q:.6g} + 0" in str(err.value)
     assert f"{q - 0.002:.6g} != 1 * {q:.6g} + 0" in str(closing.value)
+
+
+def _fork(with_top: bool):
+    """Two fixed contacts pinching a box along x (no joint moves them), and
+    optionally a third pressing down from above on a prismatic joint along z."""
+    import types
+
+    contacts = [
+        dg.Contact([-0.05, 0, 0], [1, 0, 0], mu=0.5),
+        dg.Contact([0.05, 0, 0], [-1, 0, 0], mu=0.5),
+    ]
+    bodies = ["fork_left", "fork_right"]
+    if with_top:
+        contacts.append(dg.Contact([0, 0, 0.05], [0, 0, -1], mu=0.5))
+        bodies.append("top")
+    grasp = dg.Grasp(contacts)
+    J = np.zeros((3 * len(contacts), 1))
+    if with_top:  # the top contact's frame components of a motion along +z
+        J[6:9, 0] = np.asarray(contacts[2].frame).T @ np.array([0.0, 0.0, 1.0])
+    data = types.SimpleNamespace(
+        grasp=grasp,
+        hand_jacobian=J,
+        contacts=[types.SimpleNamespace(finger_body=b) for b in bodies],
+    )
+    return grasp, J, data
+
+
+@pytest.mark.parametrize("with_top", [False, True])
+def test_a_pinch_no_motor_makes_is_a_preload_whatever_else_touches(with_top):
+    # Independent route, by hand: the fork's squeeze (+1 N at each fork
+    # contact, along its normal) has G h = 0 (equal and opposite on one line)
+    # and J^T h = 0 (no joint moves the fork).  A third contact that cannot
+    # join that squeeze once hid it: LP3 needs every f_n > 0.
+    from drakegrasp.closure.verdicts import internal_forces
+    from drakegrasp.plant.load import _held_by_motors, passive_preload
+
+    grasp, J, data = _fork(with_top)
+    h = np.zeros(3 * grasp.num_contacts)
+    h[[0, 3]] = 1.0
+    np.testing.assert_allclose(dg.grasp_matrix(grasp) @ h, 0.0, atol=1e-15)
+    np.testing.assert_allclose(J.T @ h, 0.0, atol=1e-15)
+    assert passive_preload(grasp, J)
+    if with_top:  # LP3 passes here: the old test saw no defect
+        assert internal_forces(grasp, J).passes
+    weight = np.array([0.0, 0.0, -4.905, 0.0, 0.0, 0.0])
+    assert dg.grasp_forces(
+        grasp, weight, hand_jacobian=J, torque_limits=[10.0]
+    ).feasible
+    bodies, _, _ = _held_by_motors(data, weight, np.array([10.0]))
+    assert bodies is None  # only the fork's preload holds the weight
+
+
+def test_a_squeeze_that_loads_the_joints_is_no_preload():
+    # Two jaws on their own prismatic joints: their squeeze loads both joints
+    grasp = dg.Grasp(
+        [dg.Contact([-0.05, 0, 0], [1, 0, 0], mu=0.5),
+         dg.Contact([0.05, 0, 0], [-1, 0, 0], mu=0.5)]
+    )  # fmt: skip
+    J = np.zeros((6, 2))
+    J[0:3, 0] = np.asarray(grasp.contacts[0].frame).T @ np.array([1.0, 0.0, 0.0])
+    J[3:6, 1] = np.asarray(grasp.contacts[1].frame).T @ np.array([-1.0, 0.0, 0.0])
+    from drakegrasp.plant.load import passive_preload
+
+    assert not passive_preload(grasp, J)
