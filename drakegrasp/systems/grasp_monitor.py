@@ -36,13 +36,14 @@ from drakegrasp.plant.contacts import (
     _scoped_name,
     resolve_object_body,
 )
-from drakegrasp.plant.couplings import plant_couplings
+from drakegrasp.plant.couplings import coupling_map, plant_couplings
 from drakegrasp.plant.fingers import coupling_entry
 from drakegrasp.plant.friction import (
     FrictionMismatchWarning,
     friction_disagreement,
     plant_friction,
 )
+from drakegrasp.plant.jacobians import hand_velocity_indices
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.validation import hand_contact_bodies
 from drakegrasp.quality import ferrari_canny
@@ -101,22 +102,25 @@ def epsilon_l1(grasp, *, num_generators: int) -> float:
     return float(ferrari_canny(grasp, num_generators=num_generators))
 
 
-def _monitor_couplings(plant: MultibodyPlant, couplings) -> tuple:
+def _monitor_couplings(plant: MultibodyPlant, couplings, bodies) -> tuple:
     """The couplings of every sample, checked once against the finalized plant.
 
-    The plant's constraints and the recorded couplings cannot change after
-    ``Finalize``, so a plant that :func:`~drakegrasp.analyze_grasp` would
-    refuse at every sample is refused here, with the way out.
+    The plant's constraints, the recorded couplings and the hand's joints
+    cannot change after ``Finalize``, so couplings that
+    :func:`~drakegrasp.analyze_grasp` would refuse at every sample are
+    refused here: the plant's with the way out, given ones as they are (a
+    joint that both leads and follows, an unknown joint...).
     """
     try:
         resolved = plant_couplings(plant, couplings)
-        for entry in resolved:
-            coupling_entry(plant, entry)
     except InvalidOptionError as e:
         raise InvalidOptionError(
             f"GraspMonitor cannot analyse this plant, every sample would be "
             f"invalid: {e}"
         ) from None
+    for entry in resolved:
+        coupling_entry(plant, entry)
+    coupling_map(plant, hand_velocity_indices(plant, bodies), resolved)
     return resolved
 
 
@@ -274,7 +278,7 @@ class GraspMonitor(LeafSystem):
         self._body = resolve_object_body(plant, object_body)
         # The hand as analyze_grasp resolves it: a welded palm touches too.
         self._bodies = hand_contact_bodies(plant, self._body, hand)
-        self.couplings = _monitor_couplings(plant, couplings)
+        self.couplings = _monitor_couplings(plant, couplings, self._bodies)
         """The joint couplings every sample's analysis uses (checked here)."""
         self.verdict_names = verdict_names(
             [_scoped_name(plant, f) for f in self._bodies]

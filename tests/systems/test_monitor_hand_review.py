@@ -269,6 +269,18 @@ def test_an_unrecorded_mimic_is_refused_when_the_monitor_is_built():
             couplings=[("parallel_jaw::nothing", COUPLING[1], 1.0, 0.0)],
             **OPTIONS,
         )
+    # given couplings every sample's analysis would refuse are refused when
+    # the monitor is built, as given (a joint that leads and follows)
+    both_ways = [
+        (COUPLING[0], COUPLING[1], 1.0, 0.0),
+        (COUPLING[1], COUPLING[0], 1.0, 0.0),
+    ]
+    with pytest.raises(InvalidOptionError, match="lead and follow") as caught:
+        dg.GraspMonitor(
+            scene.plant, object_body=scene.ball, hand=scene.gripper,
+            couplings=both_ways, **OPTIONS,
+        )  # fmt: skip
+    assert "cannot analyse this plant" not in str(caught.value)
 
 
 @pytest.mark.parametrize("record", [True, False], ids=["add_models", "couplings="])
