@@ -219,7 +219,22 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
             f"{name} must be an array of real numbers, got dtype {a.dtype} "
             f"({describe(value)})"
         )
+    if not isinstance(value, np.ndarray) and _holds_bool(value):
+        # numpy reads [0, True] as [0, 1]: a flag is not a number
+        raise error(
+            f"{name} must be an array of real numbers, got a True/False in "
+            f"{describe(value)}"
+        )
     return a.astype(float, copy=False)
+
+
+def _holds_bool(value) -> bool:
+    """Whether a (nested) list or tuple holds a ``bool`` anywhere."""
+    if isinstance(value, bool | np.bool_):
+        return True
+    if isinstance(value, list | tuple):
+        return any(_holds_bool(v) for v in value)
+    return False
 
 
 def check_positions(name: str, value, *, error: type = InvalidContactError):
