@@ -182,13 +182,16 @@ def _analyze(args: argparse.Namespace) -> int:
             "--torque-limits are the motors of the load section: give --load "
             "gravity (or a wrench FX,FY,FZ,MX,MY,MZ), or the scene's load:"
         )
-    report = analyze_grasp(
-        scene.plant,
-        scene.plant_context,
-        scene.object_body,
-        hand=scene.hand,
-        options=options,
-    )
+    try:
+        report = analyze_grasp(
+            scene.plant,
+            scene.plant_context,
+            scene.object_body,
+            hand=scene.hand,
+            options=options,
+        )
+    except InvalidOptionError as e:  # a flag's value the analysis refuses
+        raise _in_flag_words(e, {name: _flag(name) for name in changes}) from None
     epsilon = {
         "epsilon": None,
         "norm": "L1",
@@ -462,7 +465,7 @@ def _cli_words(message: str, command: str | None) -> str:
     # a scene file's soft fingers without a ν: analyze's flag gives one
     message = message.replace(
         f"{LOADER_NU_REMEDY}, ",
-        "give --torsional-friction NU, " if command == "analyze" else "",
+        "give --torsional-friction NU, " if command in ("analyze", "plan") else "",
     )
     # the library's one refusal of soft fingers without a ν, in flag words
     if message == str(missing_torsional_friction()) and command in _SOFT_FINGER_REMEDY:
@@ -1095,7 +1098,9 @@ def _plan_setup(args: argparse.Namespace):
                 "--hand is for an object; a scene names its own hand (its "
                 "drakegrasp: section's 'hand:')"
             )
-        info = read_scene_info(scene_path(args.object))
+        info = read_scene_info(
+            scene_path(args.object), torsional_friction=args.torsional_friction
+        )
         if info.plane is not None:
             raise InvalidOptionError(
                 f"scene {info.name!r} is planar (plane: {info.plane}); plan "
@@ -1110,6 +1115,8 @@ def _plan_setup(args: argparse.Namespace):
             allow_any_file=args.allow_any_file,
             close=False,
             free_hand=True,
+            # as analyze: a soft-finger file without nu takes the flag's
+            torsional_friction=args.torsional_friction,
         )
         info = scene.info
         # scene.options, as analyze reads the file: a soft finger the file

@@ -76,7 +76,8 @@ OPTION_HELP = {
     "load": "an external wrench on the object (frame O about its origin), or "
     "'gravity' (its weight): adds the load section",
     "torque_limits": "motor limits of the load section: 'plant' (the actuators' "
-    "effort limits) or one per hand velocity",
+    "effort limits), one per hand velocity (a coupled hand: per actuated joint "
+    "or per independent coordinate), or one for all",
 }
 """One line per option: the docstring below and the command line's help."""
 

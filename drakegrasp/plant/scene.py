@@ -366,8 +366,13 @@ def scene_path(path_or_name: str | Path) -> Path:
     )
 
 
-def read_scene_info(path: str | Path) -> SceneInfo:
+def read_scene_info(
+    path: str | Path, *, torsional_friction: float | None = None
+) -> SceneInfo:
     """Read and check the ``drakegrasp:`` section of a scene file.
+
+    ``torsional_friction``, when given, replaces the file's, as
+    :func:`load_scene`'s does (a soft-finger file may then leave it out).
 
     Raises
     ------
@@ -379,7 +384,7 @@ def read_scene_info(path: str | Path) -> SceneInfo:
     """
     path = _path_argument(path)
     _, data = read_yaml(path)
-    section = check_section(path, data)
+    section = check_section(path, data, torsional_friction=torsional_friction)
     return SceneInfo(name=path.stem, path=path.resolve(), **section)
 
 

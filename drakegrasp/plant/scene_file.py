@@ -37,7 +37,7 @@ from drakegrasp.core.validation import (
     check_coefficient,
 )
 from drakegrasp.errors import GraspError, SceneError
-from drakegrasp.plant.options import PLANES
+from drakegrasp.plant.options import PLANES, AnalysisOptions
 
 __all__ = [
     "KEYS",
@@ -73,8 +73,9 @@ KEYS = {
     "plane:), the wrench [f; m] on the object in N and N·m, frame O about its "
     "origin: analyse the grasp under that load",
     "torque_limits": "'plant' (the actuators' effort limits) or a list of "
-    "numbers >= 0 (.inf: no limit), one per hand velocity: the motors of the "
-    "load analysis",
+    "numbers >= 0 (.inf: no limit), one per hand velocity (a coupled hand: per "
+    "actuated joint or per independent coordinate) or one for all: the motors "
+    "of the load analysis",
 }
 """The keys of the ``drakegrasp:`` section and what each must be."""
 
@@ -397,16 +398,7 @@ def check_section(
         )
     description = section.get("description", "")
     close, close_direction = _close(path, section.get("close", False))
-    load = _named_or_numbers(path, "load", section.get("load"), "gravity")
-    if isinstance(load, tuple) and len(load) != (3 if plane else 6):
-        raise SceneError(
-            f"scene {str(path)!r}: drakegrasp.load has {len(load)} numbers; a "
-            f"{'planar' if plane else 'spatial'} wrench [f; m] has "
-            f"{3 if plane else 6}"
-        )
-    limits = _named_or_numbers(
-        path, "torque_limits", section.get("torque_limits"), "plant"
-    )
+    load, limits = _load_options(path, section, plane)
     if limits is not None and load is None:
         raise SceneError(
             f"scene {str(path)!r}: drakegrasp.torque_limits without "
@@ -441,36 +433,21 @@ def check_section(
     }
 
 
-def _named_or_numbers(path: Path, key: str, value, name: str):
-    """``load`` or ``torque_limits``: absent (None), ``name``, or a list of numbers.
+def _load_options(path: Path, section: dict, plane):
+    """``(load, torque_limits)``, checked with the key named.
 
-    A load's numbers are finite; torque limits are >= 0, ``.inf`` (no limit)
-    allowed.
+    :class:`~drakegrasp.AnalysisOptions` checks them: one rule for the file,
+    the command line and Python.
     """
-    if value is None or value == name:
-        return value
-    if not isinstance(value, list) or not value:
-        raise SceneError(
-            f"scene {str(path)!r}: drakegrasp.{key} must be {KEYS[key]}, got {value!r}"
+    try:
+        options = AnalysisOptions(
+            plane=plane,
+            load=section.get("load"),
+            torque_limits=section.get("torque_limits"),
         )
-    numbers = []
-    for v in value:
-        if not isinstance(v, int | float) or isinstance(v, bool):
-            raise SceneError(
-                f"scene {str(path)!r}: drakegrasp.{key} holds {v!r} "
-                f"({type(v).__name__}); valid: {KEYS[key]}"
-            )
-        try:
-            x = float(v)
-        except OverflowError:
-            x = math.inf if v > 0 else -math.inf
-        ok = math.isfinite(x) if key == "load" else x >= 0.0  # NaN fails both
-        if not ok:
-            raise SceneError(
-                f"scene {str(path)!r}: drakegrasp.{key} holds {v!r}; valid: {KEYS[key]}"
-            )
-        numbers.append(x)
-    return tuple(numbers)
+    except GraspError as e:
+        raise SceneError(f"scene {str(path)!r}: drakegrasp.{e}") from None
+    return options.load, options.torque_limits
 
 
 def directives_text(path: Path, text: str) -> str:

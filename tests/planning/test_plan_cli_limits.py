@@ -100,3 +100,25 @@ def test_an_arm_with_a_hand_is_named_as_such(capsys, drake_models_dir, monkeypat
     assert len(err) == 1
     assert "an arm that carries a hand is not a hand" in err[0]
     assert "load the hand's own model" in err[0]
+
+
+def test_a_soft_finger_scene_without_nu_takes_the_flag(tmp_path, capsys):
+    # as analyze does: the file's soft fingers without nu, nu from the flag
+    from drakegrasp.plant.scene import DEFAULT_SCENE, scene_path
+
+    text = scene_path(DEFAULT_SCENE).read_text()
+    text = text.replace("contact_model: hard_finger", "contact_model: soft_finger")
+    text = text.replace("  torsional_friction: 0.1\n", "")
+    path = tmp_path / "soft.yaml"
+    path.write_text(text)
+    assert main(["plan", str(path), "--num", "20"]) == 1
+    err = capsys.readouterr().err
+    assert "torsional_friction is absent" in err
+    assert "give --torsional-friction NU" in err
+    argv = ["plan", str(path), "--num", "20", "--json", "--torsional-friction", "0.05"]
+    assert main(argv) == 0
+    settings = json.loads(capsys.readouterr().out)["settings"]
+    assert (settings["contact_model"], settings["torsional_friction"]) == (
+        "soft_finger",
+        0.05,
+    )

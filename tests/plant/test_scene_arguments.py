@@ -116,6 +116,6 @@ def test_analyze_completes_the_file_with_its_flag(tmp_path, capsys):
     assert "load_scene" not in err
     assert main(["analyze", str(path), "--torsional-friction", "0.05"]) == 0
     assert "nu = 0.05" in capsys.readouterr().out
-    assert main(["plan", str(path), "--num", "5"]) == 1  # plan has no such flag
+    assert main(["plan", str(path), "--num", "5"]) == 1  # plan has the flag too
     err = capsys.readouterr().err
-    assert "load_scene" not in err and "--torsional-friction" not in err
+    assert "load_scene" not in err and "give --torsional-friction NU" in err
