@@ -119,8 +119,8 @@ class GraspCandidate:
         needed up to twice this).  A position-controlled finger that the
         object pushes back presses harder, up to its effort limit, so such a
         hand may hold with less (the shake test's PD fingers: Drake's Franka
-        hand held the sugar box at 0.75 times it, and 1 of 18 YCB candidates
-        at 0.8 times; ``benchmarks/bench_jaw_squeeze.py``).
+        hand held 1 of 18 YCB candidates at 0.8 times it, none at 0.5 times;
+        ``benchmarks/bench_jaw_squeeze.py``).
     closure : ClosureResult or None
         The single-grasp verdict with its certificate (witness), for the top
         candidates (``certify`` of ``plan_grasps``); None for the rest.

@@ -401,7 +401,10 @@ def with_squeeze_limit(
     planned contacts, see :class:`~drakegrasp.planning.candidates.GraspCandidate`).
     The candidates whose ``squeeze_needed`` is at most the limit keep their
     order and come first; those that need more (or whose weight is unknown,
-    NaN) follow, in their order.
+    NaN) follow, in their order.  ``squeeze_needed`` bounds each finger's
+    normal forces, an effort limit the force along the joint's axis: for
+    normals off the axis the comparison is conservative (the joint presses
+    less than the normal force it makes).
 
     Parameters
     ----------

@@ -137,7 +137,10 @@ class PoseCheck:
         )
 
     def raise_if_invalid(self) -> None:
-        """Raise :class:`PenetrationError` or :class:`JointLimitError` if invalid.
+        """Raise an :class:`~drakegrasp.errors.InvalidPoseError` if invalid.
+
+        :class:`PenetrationError`, :class:`JointLimitError` or
+        :class:`CouplingError`, in that order.
 
         The message's remedy names the Python options (:data:`PENETRATION_REMEDY`,
         :data:`JOINT_LIMIT_REMEDY`); the command line swaps in its flags with
