@@ -69,10 +69,13 @@ from drakegrasp.plant.validation import (
 )
 
 __all__ = [
+    "MAX_BODY_SETS",
+    "PRELOAD_TOL",
     "LoadReport",
     "analyze_load",
     "load_section",
     "gravity_wrench",
+    "passive_preload",
     "plant_torque_limits",
 ]
 
