@@ -147,8 +147,9 @@ class GraspMonitor(LeafSystem):
         refuse it.
     options : AnalysisOptions, optional
         The analysis options of every sample, validated when they were made;
-        give them or the keywords below, not both.  A ``load`` in them adds the
-        load section to every sample's report.
+        give them or the keywords below, not both.  A ``load`` in them (or
+        ``load=``) adds the load section to every sample's report, and the
+        holding state then judges a grip by it.
     mu : float or "plant"
         Friction coefficient of the analysis, or ``"plant"``: each contact's
         coefficient from its geometries' proximity properties.  Required (here
@@ -163,6 +164,14 @@ class GraspMonitor(LeafSystem):
         As in :func:`drakegrasp.analyze_grasp` (or ``options``).
     characteristic_length, num_generators, tol, allow_penetration, patches
         As in :func:`drakegrasp.analyze_grasp` (or ``options``).
+    load, torque_limits : optional
+        As in :func:`drakegrasp.analyze_grasp` (or ``options``): the load
+        section of every sample (``load="gravity"``, ``torque_limits="plant"``:
+        the object's weight and the actuators' effort limits).  With it, a
+        grip is ``holding`` when the load section holds (and its contacts
+        stick), whatever force closure with the hand check says: LP3 fails for
+        fingers that touch at several points each (the Franka hand's pads on
+        the YCB soup can), which hold.
     check_pose : bool, optional
         As in :func:`drakegrasp.analyze_grasp`: a pose that the check refuses
         (penetration deeper than ``distance_tolerance`` by any hand body, a
@@ -239,6 +248,8 @@ class GraspMonitor(LeafSystem):
         allow_penetration: bool = False,
         patches: str = "vertices",
         check_pose: bool = True,
+        load: str | Sequence[float] | None = None,
+        torque_limits: str | Sequence[float] | None = None,
         contacts: str = "geometry",
         period: float = 0.05,
         offset: float = 0.0,
@@ -268,6 +279,8 @@ class GraspMonitor(LeafSystem):
             allow_penetration=allow_penetration,
             patches=patches,
             check_pose=check_pose,
+            load=load,
+            torque_limits=torque_limits,
         )
         """The validated options (a ``MonitorSettings``)."""
         self.period = self.settings.period
@@ -276,6 +289,17 @@ class GraspMonitor(LeafSystem):
         """Why the given ``mu`` is not the plant's friction (None until seen)."""
         self._plant = plant
         self._body = resolve_object_body(plant, object_body)
+        if self._body.index() == plant.world_body().index():
+            raise ModelError(
+                "object_body is the world body: monitor the grasped object's body"
+            )
+        if not plant.GetCollisionGeometriesForBody(self._body):
+            # knowable now: every sample would be invalid for it
+            raise ModelError(
+                f"object_body {_scoped_name(plant, self._body)} has no collision "
+                "geometry, so no hand body can touch it: monitor the body that "
+                "carries the object's collision geometry"
+            )
         # The hand as analyze_grasp resolves it: a welded palm touches too.
         self._bodies = hand_contact_bodies(plant, self._body, hand)
         self.couplings = _monitor_couplings(plant, couplings, self._bodies)
@@ -594,8 +618,15 @@ class GraspMonitor(LeafSystem):
 
     @staticmethod
     def _grasped(report, loads) -> bool:
-        """Force closure, and every analysed finger presses on the object."""
-        if report is None or not report.is_force_closure:
+        """A grip that holds, and every analysed finger presses on the object.
+
+        "Holds" is the load section's verdict when the options give a load
+        (the motors hold that load at these contacts), else force closure.
+        """
+        if report is None:
+            return False
+        holds = report.is_force_closure if report.load is None else report.load.holds
+        if not holds:
             return False
         pressing = {load.finger_body for load in loads if load.touching}
         return all(c.finger_body in pressing for c in report.contacts)

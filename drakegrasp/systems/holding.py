@@ -13,8 +13,10 @@ and their codes on the vector port follow that order:
 ==============  ==============================================================
 ``no contact``  no hand body touches the object (before a grasp, after a
                 release)
-``touching``    contact, but not a force-closure grasp
-``holding``     a force-closure grasp whose contacts stick, friction in use at
+``touching``    contact, but not a grip that holds: not force closure, or,
+                when the analysis has a load section (``load=``), one that
+                does not hold that load
+``holding``     a grip that holds whose contacts stick, friction in use at
                 or below ``risk``
 ``at risk``     such a grasp with friction in use above ``risk`` at a contact
 ``slipping``    a contact slips faster than ``slip_speed``, or, without
@@ -54,7 +56,7 @@ fully just before they open).
    these bridged samples).
 
 A sample's *evidence* is what it alone shows: with contact, ``slipping`` (slip
-above the threshold), else ``touching`` (no force closure), else ``at risk``
+above the threshold), else ``touching`` (no grip that holds), else ``at risk``
 or ``holding`` by friction in use; without contact after a grip, within the
 window ``slipping`` if the object moves along the fingers, else ``no
 contact``; after it, ``dropped`` as in the table, else ``slipping`` if it
@@ -259,7 +261,8 @@ def next_holding_state(
     touching : bool
         Some hand body touches the object in this sample.
     grasped : bool
-        The analysed contacts are in force closure.
+        The analysed contacts hold: force closure, or the load section's
+        verdict where the analysis has one.
     friction_use : float
         Largest ``‖f_t‖/(μ f_n)`` over the fingers; NaN when unknown (then
         never at risk).

@@ -85,8 +85,9 @@ from an object that has left the hand.
 
 **Holding.**  Each sample also judges the grip
 (:mod:`drakegrasp.systems.holding`, where the rules are in full):
-``no contact``, ``touching``, ``holding``, ``at risk`` (friction in use above
-``risk``), ``slipping`` (a contact slips faster than ``slip_speed``, or the
+``no contact``, ``touching``, ``holding`` (a grip that holds, by force closure
+or, when the options give a load, by the load section), ``at risk`` (friction
+in use above ``risk``), ``slipping`` (a contact slips faster than ``slip_speed``, or the
 object moves along the fingers without contact) or ``dropped`` (the object has
 left the fingers that last held it, along them: no contact for
 ``hold_samples + 1`` samples, and either still sliding along them and farther
