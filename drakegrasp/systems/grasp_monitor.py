@@ -37,7 +37,6 @@ from drakegrasp.plant.contacts import (
     resolve_object_body,
 )
 from drakegrasp.plant.couplings import coupling_map, plant_couplings
-from drakegrasp.plant.fingers import coupling_entry
 from drakegrasp.plant.friction import (
     FrictionMismatchWarning,
     friction_disagreement,
@@ -114,12 +113,13 @@ def _monitor_couplings(plant: MultibodyPlant, couplings, bodies) -> tuple:
     try:
         resolved = plant_couplings(plant, couplings)
     except InvalidOptionError as e:
+        if couplings is not None:  # a bad given value: its own message
+            raise
         raise InvalidOptionError(
             f"GraspMonitor cannot analyse this plant, every sample would be "
             f"invalid: {e}"
         ) from None
-    for entry in resolved:
-        coupling_entry(plant, entry)
+    # checks every entry against the plant, as each sample's analysis would
     coupling_map(plant, hand_velocity_indices(plant, bodies), resolved)
     return resolved
 

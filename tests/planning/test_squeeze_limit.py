@@ -87,6 +87,15 @@ def test_plan_grasps_takes_squeeze_limit(rounded_on_box):
     assert _samples(limited) == _samples(_partition(result.candidates, limit))
     assert limited.settings["squeeze_limit"] == limit
     assert all(c.squeeze_needed <= limit for c in limited[:4])
+    # the planner applies the limit, not only records it: below every need,
+    # its result says so (the order alone could agree by chance)
+    least = min(c.squeeze_needed for c in result if c.is_closure)
+    weak = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=40, mu=0.5, seed=0, robustness_samples=8,
+        squeeze_limit=least / 2, **SOFT,
+    )  # fmt: skip
+    assert f"the jaw at squeeze_limit {least / 2:.3g} N holds none" in weak.reason
 
 
 @pytest.mark.parametrize(

@@ -281,6 +281,12 @@ def test_an_unrecorded_mimic_is_refused_when_the_monitor_is_built():
             couplings=both_ways, **OPTIONS,
         )  # fmt: skip
     assert "cannot analyse this plant" not in str(caught.value)
+    with pytest.raises(InvalidOptionError) as caught:
+        dg.GraspMonitor(
+            scene.plant, object_body=scene.ball, hand=scene.gripper, couplings=5,
+            **OPTIONS,
+        )  # fmt: skip
+    assert "cannot analyse this plant" not in str(caught.value)
 
 
 @pytest.mark.parametrize("record", [True, False], ids=["add_models", "couplings="])
