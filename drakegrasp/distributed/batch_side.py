@@ -56,6 +56,7 @@ from drakegrasp.distributed.dataset import (
     job_manifest,
     prepare_dataset,
     read_dataset,
+    remove_orphan_temporaries,
     shard_is_done,
     shard_path,
     write_shard,
@@ -287,6 +288,8 @@ def evaluate_on_cluster(
         results = {j: f.result() for j, _, f in futures}
     if output_dir is not None:
         results.update(done_paths)
+        # every shard is complete: a worker killed mid-write left a temporary
+        remove_orphan_temporaries(output_dir, results)
         return [results[j] for j in sorted(results)]
     chunks = ((sl, results[j]) for j, sl, _ in futures)
     tol = float(options.get("tol", DEFAULT_TOL))

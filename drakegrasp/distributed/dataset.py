@@ -38,6 +38,7 @@ __all__ = [
     "job_manifest",
     "prepare_dataset",
     "read_dataset",
+    "remove_orphan_temporaries",
     "shard_is_done",
     "shard_path",
     "write_shard",
@@ -247,6 +248,32 @@ def write_shard(shard: Path, arrays: dict[str, np.ndarray], job: str) -> str:
         if tmp.exists():
             tmp.unlink()
     return str(shard)
+
+
+def remove_orphan_temporaries(output_dir: Path, indices) -> int:
+    """Remove the half-written files left beside finished shards.
+
+    A worker killed while writing partition ``j`` leaves its temporary
+    ``.part-0000j.parquet.<pid>.tmp``; the partition is then recomputed and
+    written by another worker, so once shard ``j`` is complete any such file
+    is an orphan.  Only the temporaries of ``indices`` (partitions whose
+    shards are complete) are touched, never another partition's.
+
+    Returns
+    -------
+    int
+        How many files were removed.
+    """
+    removed = 0
+    for j in indices:
+        shard = shard_path(output_dir, j)
+        for p in output_dir.glob(f".{shard.name}.*.tmp"):
+            try:
+                p.unlink()
+            except FileNotFoundError:  # its writer finished or removed it
+                continue
+            removed += 1
+    return removed
 
 
 def _shard_problem(shard: Path, job: str | None, rows: int | None) -> str | None:

@@ -87,6 +87,26 @@ def test_a_rerun_resumes_only_its_own_job(client, tmp_path):
     assert len(list(out.glob("part-*.parquet"))) == 2
 
 
+def test_a_finished_run_removes_the_temporaries_of_killed_writers(client, tmp_path):
+    # A worker killed mid-write leaves ``.part-j.parquet.<pid>.tmp``; the CI
+    # caught one surviving a run whose shard j had been rewritten elsewhere.
+    P, Nrm, mu = _grasps(3, 40)
+    out = tmp_path / "ds"
+    kw = {"chunk_size": 10, "partition_chunks": 1, "output_dir": out}
+    first = evaluate_on_cluster(client, P, Nrm, mu=mu, **kw)
+    orphans = [out / ".part-00001.parquet.4242.tmp", out / ".part-00003.parquet.7.tmp"]
+    for p in orphans:
+        p.write_bytes(b"PAR1 half a shard")
+    Path(first[1]).unlink()  # a rerun recomputes shard 1 and skips shard 3
+    stranger = out / ".part-00009.parquet.5.tmp"  # no partition of this job
+    stranger.write_bytes(b"")
+    again = evaluate_on_cluster(client, P, Nrm, mu=mu, **kw)
+    assert again == first
+    assert not any(p.exists() for p in orphans)
+    assert stranger.exists()  # only this job's partitions are swept
+    _same(read_dataset(out), batch_force_closure(P, Nrm, mu=mu, workers=1))
+
+
 def test_the_cli_replaces_another_job_only_with_overwrite(client, tmp_path, capsys):
     P, Nrm, mu = _grasps(3, 53)
     big, small = tmp_path / "big.npz", tmp_path / "small.npz"
