@@ -35,6 +35,7 @@ __all__ = [
     "checked_fingers",
     "checked_friction",
     "checked_noise",
+    "checked_palm",
     "checked_nonnegative",
     "checked_points",
     "checked_rng",
@@ -226,6 +227,23 @@ def checked_count(name: str, value, minimum: int = 0) -> int:
     if n is None or n < minimum:
         raise InvalidOptionError(
             f"{name} must be an integer >= {minimum}, got {describe(value)}"
+        )
+    return n
+
+
+def checked_palm(value) -> int | None:
+    """The passive palm's label of a weight capacity: None or a finger label.
+
+    An integer in ``[0, MAX_FINGER_LABEL]`` (a bool, float or string is
+    refused: :class:`~drakegrasp.InvalidOptionError` naming ``palm``).
+    """
+    if value is None:
+        return None
+    n = integer_or_none(value)
+    if n is None or not 0 <= n <= MAX_FINGER_LABEL:
+        raise InvalidOptionError(
+            f"palm must be None or a finger label, an integer in [0, "
+            f"{MAX_FINGER_LABEL}], got {describe(value)}"
         )
     return n
 

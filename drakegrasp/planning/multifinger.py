@@ -66,6 +66,7 @@ from drakegrasp.planning.checks import (
     checked_contacts,
     checked_fingers,
     checked_friction,
+    checked_palm,
     checked_rng,
     checked_samples,
     checked_torque_scale,
@@ -285,7 +286,7 @@ def _slerp(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> np.ndarray:
 @renamed_keyword("model", "contact_model")
 def fan_capacity(
     positions, normals, fans, fingers, *, mu, samples, rng, torque_scale, contact_model,
-    torsional_friction,
+    torsional_friction, palm=None,
 ):  # fmt: skip
     r"""(K,) weight capacity of grasps whose edge contacts' normals are unknown.
 
@@ -323,7 +324,7 @@ def fan_capacity(
         3`` floats) at most :data:`~drakegrasp.planning.checks.MAX_COPY_BYTES`.
     rng : numpy.random.Generator
         Draws the fans' normals (only with ``samples > 0``).
-    torque_scale, contact_model, torsional_friction
+    torque_scale, contact_model, torsional_friction, palm
         As for :func:`~drakegrasp.planning.weight.weight_capacity`.
 
     Returns
@@ -346,6 +347,7 @@ def fan_capacity(
     samples = checked_samples(samples, K, N)
     rng = checked_rng(rng)
     torque_scale = checked_torque_scale(torque_scale, positions)  # before any draw
+    palm = checked_palm(palm)
     S = max(samples, 1)
     has = np.all(np.isfinite(fans), axis=(2, 3))  # (K, N)
     t = rng.uniform(size=(K, S, N)) if samples else np.zeros((K, S, N))
@@ -357,6 +359,7 @@ def fan_capacity(
         np.repeat(positions, S, axis=0), Nrm.reshape(K * S, N, 3),
         np.repeat(fingers, S, axis=0), mu=mu, torque_scale=torque_scale,
         contact_model=contact_model, torsional_friction=torsional_friction,
+        palm=palm,
     ).min(axis=1)  # fmt: skip
     return np.where(np.isfinite(alpha), alpha, 0.0).reshape(K, S).mean(axis=1)
 
@@ -414,7 +417,7 @@ def rank_multifinger(
             alpha[closed] = weight_capacity(
                 P[fc] - reference, Nrm[fc], L[fc], mu=mu,
                 torque_scale=torque_scale, contact_model=contact_model,
-                torsional_friction=nu,
+                torsional_friction=nu, palm=F,
             ).min(axis=1)  # fmt: skip
     fanned = np.flatnonzero(
         np.isfinite(alpha) & (rho > 0) & [_has_fan(k[4]) for k in kept]
@@ -427,7 +430,7 @@ def rank_multifinger(
             np.array([_fans(kept[i][4]) for i in rows]),
             np.array([_labels(kept[i][4], label, F) for i in rows]),
             mu=mu, samples=samples, rng=rng, torque_scale=torque_scale,
-            contact_model=contact_model, torsional_friction=nu,
+            contact_model=contact_model, torsional_friction=nu, palm=F,
         )  # fmt: skip
     score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
     sample = np.array([k[0] for k in kept])

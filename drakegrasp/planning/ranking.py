@@ -701,7 +701,7 @@ def rank_candidates(
             np.array([[c.nhat_O for c in kept[i][4]] for i in idx]),
             np.array([[_finger_label(c, names) for c in kept[i][4]] for i in idx]),
             mu=mu, torque_scale=torque_scale, contact_model=contact_model,
-            torsional_friction=nu, workers=workers,
+            torsional_friction=nu, workers=workers, palm=2,
         ).min(axis=1)  # fmt: skip
     score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
     order = np.lexsort((samples_of, -tie_key(d_star), -tie_key(pre), -tie_key(score)))

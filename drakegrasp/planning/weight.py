@@ -26,9 +26,32 @@ bound of ε: it is what a gripper's actuators set.)  It is a lower bound of the
 squeeze a real pad needs: the LP shares a finger's force among its contacts at
 will, a rigid pad as its geometry and compliance dictate.
 
+**A palm is passive** (``palm=``, the label of the bodies no motor drives:
+the planner's welded palm).  A palm pushes the object only as hard as
+something presses the object into it: the load, or a finger's normal force.
+Friction does not count: a finger's friction may pull the object into the
+palm in the LP, but nothing sets that pull in a real hand (it is a passive
+internal force, as the hand's Jacobian would show), and the palm's friction
+that such a pull would buy is not there.  With :math:`\bar n` the palm
+contacts' mean inward normal, each direction's LP gains
+
+.. math::
+
+    \sum_{i \in \text{palm}} (n_i \cdot \bar n) \sum_k \lambda_{ik}
+    \le \alpha\, (-u \cdot \bar n)_+
+    + \sum_{i \notin \text{palm}} (-n_i \cdot \bar n)_+ \sum_k \lambda_{ik},
+
+beside the palm's squeeze bound, which it keeps (so no capacity rises and
+each stays finite).  For a parallel jaw, whose squeeze is across the palm's
+normal, the palm then holds only the weight's share that presses into it.
+Without it the LP had Drake's Franka hand hold the cracker box by its palm
+at 11.8 N a finger; the box dropped in Drake at 17.7 N and 20 N, and this
+constraint asks for more than 20 N.
+
 The LPs of all grasps and directions are solved at once by the batch engine's
 exact active-set method (its interior-point method where that cannot certify),
-in their dual form (nine variables each, see :func:`weight_capacity`);
+in their dual form (nine variables each for a parallel jaw, ten with a
+passive palm);
 :func:`build_weight_capacity_program` builds the
 primal LP of one grasp (its directions as independent blocks: the sum of their
 ``α`` is maximised, which maximises each) for inspection, for a second route
@@ -56,6 +79,7 @@ from drakegrasp.planning.checks import (
     checked_directions,
     checked_fingers,
     checked_friction,
+    checked_palm,
     checked_torque_scale,
 )
 
@@ -65,6 +89,7 @@ __all__ = [
     "build_weight_capacity_program",
     "centre_of_mass",
     "num_groups",
+    "palm_rows",
     "weight_capacity",
 ]
 
@@ -118,7 +143,11 @@ WEIGHT_CHUNK = 512
 
 
 def build_weight_capacity_program(
-    W: np.ndarray, groups: np.ndarray, directions: np.ndarray = WEIGHT_DIRECTIONS
+    W: np.ndarray,
+    groups: np.ndarray,
+    directions: np.ndarray = WEIGHT_DIRECTIONS,
+    *,
+    passive: tuple[np.ndarray, np.ndarray] | None = None,
 ):
     """The LP of one grasp's weight capacity in every direction (one block each).
 
@@ -132,6 +161,9 @@ def build_weight_capacity_program(
         its palm F).  Each label is one group with its own bound.
     directions : (D, 3) float
         Unit weight directions, frame O.
+    passive : ((M,) float, (D,) float), optional
+        The passive palm's row ``(a, c)`` of :func:`palm_rows` for this grasp:
+        ``a·λ <= c_d α`` in each direction's block.  None: no palm row.
 
     Returns
     -------
@@ -139,8 +171,49 @@ def build_weight_capacity_program(
     alpha : (D,) array of Variable
         ``α`` of each direction.
     """
-    prog, alpha, _ = _program(W, groups, directions)
+    prog, alpha, _ = _program(W, groups, directions, passive=passive)
     return prog, alpha
+
+
+def palm_rows(
+    normals: np.ndarray, fingers: np.ndarray, palm: int, per: int, directions
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The passive palm's row of each grasp's LPs (see the module's note).
+
+    Parameters
+    ----------
+    normals : (K, N, 3) float
+        Unit inward contact normals, frame O.
+    fingers : (K, N) int
+        Finger labels; ``palm`` marks the palm's contacts.
+    palm : int
+        The palm's label.
+    per : int
+        Primitive wrenches per contact (their order is contact-major).
+    directions : (D, 3) float
+        Unit weight directions, frame O.
+
+    Returns
+    -------
+    a : (K, N * per) float
+        Each wrench's coefficient: ``n_i·n̄`` for the palm's, ``-(-n_i·n̄)₊``
+        for the others' (every wrench has a unit normal force).
+    c : (K, D) float
+        ``(-u·n̄)₊``: the share of a unit weight pressing into the palm.
+    has : (K,) bool
+        Grasps with a palm contact whose normals do not cancel; the others
+        have no palm row (``a`` and ``c`` zero).
+    """
+    on = fingers == palm  # (K, N)
+    total = np.einsum("kn,knj->kj", on.astype(float), normals)
+    size = np.linalg.norm(total, axis=1)
+    has = size > 1e-9 * np.maximum(on.sum(axis=1), 1)
+    nbar = np.divide(total, size[:, None], out=np.zeros_like(total),
+                     where=has[:, None])  # fmt: skip
+    along = np.einsum("knj,kj->kn", normals, nbar)  # (K, N)
+    a = np.where(on, along, -np.maximum(-along, 0.0))
+    c = np.maximum(-(nbar @ np.asarray(directions, float).T), 0.0)  # (K, D)
+    return np.repeat(a, per, axis=1), c, has
 
 
 def num_groups(groups: np.ndarray) -> int:
@@ -152,8 +225,12 @@ def _memberships(groups: np.ndarray, G: int) -> np.ndarray:
     return (np.clip(groups, 0, G - 1)[None, :] == np.arange(G)[:, None]).astype(float)
 
 
-def _program(W, groups, directions, G=None):
-    """The program, its α variables and the (equality, bound) bindings per block."""
+def _program(W, groups, directions, G=None, passive=None):
+    """The program, its α variables and the (equality, bound) bindings per block.
+
+    With ``passive = (a, c)`` each block also gets the palm's row
+    ``a·λ - c_d α <= 0`` (:func:`palm_rows`).
+    """
     M, w = W.shape
     D = len(directions)
     G = num_groups(groups) if G is None else G
@@ -173,6 +250,11 @@ def _program(W, groups, directions, G=None):
                 ),
             )
         )
+        if passive is not None:
+            a, c = passive
+            prog.AddLinearConstraint(
+                np.r_[a, -c[d]][None], [-np.inf], [0.0], np.r_[lam[d], alpha[d]]
+            )
     prog.AddBoundingBoxConstraint(0.0, np.inf, lam.ravel())
     prog.AddBoundingBoxConstraint(0.0, np.inf, alpha)
     prog.AddLinearCost(-np.ones(D), 0.0, alpha)
@@ -206,6 +288,7 @@ def weight_capacity(
     num_generators: int = DEFAULT_NUM_GENERATORS,
     solver: str = "batch",
     workers: int | None = 1,
+    palm: int | None = None,
 ) -> np.ndarray:
     """(K, D) weight capacities ``α(u)`` of ``K`` grasps of ``N`` contacts.
 
@@ -221,8 +304,9 @@ def weight_capacity(
         ``K >= 0`` grasps of ``N >= 1`` contacts.
     fingers : (K, N) int
         Finger (0 or 1) of each contact, 2 for another hand body (a palm,
-        whose normal forces are bounded by the squeeze too); a multi-finger
-        hand numbers its ``F`` fingers 0 to ``F - 1`` and its palm ``F``.
+        whose normal forces are bounded by the squeeze too, and passive with
+        ``palm=2``); a multi-finger hand numbers its ``F`` fingers 0 to
+        ``F - 1`` and its palm ``F``.
         Integers in ``[0,`` :data:`~drakegrasp.planning.checks.MAX_FINGER_LABEL` ``]``.
     mu : float
         Coulomb friction coefficient, 0 or in ``[1e-12, 1e12]`` (the range of
@@ -256,6 +340,12 @@ def weight_capacity(
         Worker processes of the batch engine's pool (default 1; None: every
         core) over chunks of :data:`WEIGHT_CHUNK` grasps.  Each grasp's LPs
         are solved alone, so the numbers are the same for any count.
+    palm : int, optional
+        The label of the contacts on bodies no motor drives (the planner
+        passes its palm's: 2 for a parallel jaw, ``F`` for a hand of ``F``
+        fingers): pressed only by the load and the fingers' normal forces
+        (see the module's note), so a capacity never rises with it.  Default
+        None: every label is squeezed alike.
 
     Returns
     -------
@@ -268,8 +358,8 @@ def weight_capacity(
         Bad ``positions``, ``normals``, ``fingers``, ``mu``,
         ``contact_model`` or ``torsional_friction``.
     InvalidOptionError
-        Bad ``torque_scale``, ``directions``, ``num_generators``, ``solver``
-        or ``workers``, or moments that overflow (positions far beyond
+        Bad ``torque_scale``, ``directions``, ``num_generators``, ``solver``,
+        ``workers`` or ``palm``, or moments that overflow (positions far beyond
         ``torque_scale``).
     """
     positions, normals = checked_contacts(positions, normals)
@@ -284,12 +374,13 @@ def weight_capacity(
     if not isinstance(solver, str) or solver not in ("batch", "drake"):
         raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
     check_workers(workers)
+    palm = checked_palm(palm)
     if K == 0:
         return np.zeros((0, len(directions)))
     options = dict(
         mu=mu, torque_scale=torque_scale, contact_model=contact_model,
         torsional_friction=torsional_friction, directions=directions,
-        num_generators=num_generators, solver=solver,
+        num_generators=num_generators, solver=solver, palm=palm,
     )  # fmt: skip
     if K <= WEIGHT_CHUNK:
         return _capacity(positions, normals, fingers, **options)
@@ -302,7 +393,8 @@ def weight_capacity(
 
 
 def _capacity(positions, normals, fingers, *, mu, torque_scale, contact_model,
-              torsional_friction, directions, num_generators, solver):  # fmt: skip
+              torsional_friction, directions, num_generators, solver,
+              palm=None):  # fmt: skip
     """:func:`weight_capacity` of one chunk of grasps, in this process."""
     K, N, _ = positions.shape
     with np.errstate(over="ignore", invalid="ignore"):  # checked below
@@ -325,16 +417,37 @@ def _capacity(positions, normals, fingers, *, mu, torque_scale, contact_model,
         )
     per = W.shape[1] // N
     groups = np.repeat(fingers, per, axis=1)
-    if solver == "batch":
-        return _batch_capacity(W, groups, np.asarray(directions, float))
-    return _drake_capacity(W, groups, directions)
+    directions = np.asarray(directions, float)
+    run = _batch_capacity if solver == "batch" else _drake_capacity
+    if palm is None:
+        return run(W, groups, directions)
+    a, c, has = palm_rows(normals, fingers, palm, per, directions)
+    out = np.empty((K, len(directions)))
+    if not np.all(has):  # no palm row: the LPs and numbers of palm=None
+        out[~has] = run(W[~has], groups[~has], directions)
+    if np.any(has):
+        out[has] = run(W[has], groups[has], directions, (a[has], c[has]))
+    return out
 
 
-def _drake_capacity(W: np.ndarray, groups: np.ndarray, directions) -> np.ndarray:
-    """The primal LP of each grasp through the solver gateway (one program)."""
+def _drake_capacity(
+    W: np.ndarray, groups: np.ndarray, directions, passive=None
+) -> np.ndarray:
+    """The primal LP of each grasp through the solver gateway (one program).
+
+    ``passive``: ``(a, c)`` of :func:`palm_rows` for these grasps, or None.
+    """
     K, _, w = W.shape
     out = np.zeros((K, len(directions)))
     G = num_groups(groups)
+    if passive is not None:  # the palm's row differs per grasp: one program each
+        for k in range(K):
+            prog, alpha, _ = _program(
+                W[k], groups[k], directions, G, (passive[0][k], passive[1][k])
+            )
+            result = require_solution(prog, solve(prog, "lp"), "the weight-capacity LP")
+            out[k] = np.maximum(result.GetSolution(alpha), 0.0)
+        return out
     prog, alpha, bindings = _program(W[0], groups[0], directions, G)
     for k in range(K):  # one program, its coefficients updated per grasp
         if k:
@@ -361,7 +474,9 @@ def _complement(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
+def _batch_capacity(
+    W: np.ndarray, groups: np.ndarray, directions: np.ndarray, passive=None
+):
     """The dual LPs of every grasp and direction, solved in the compiled path.
 
     The dual of the capacity LP, with ``y = v + P z`` (``P`` a basis of the
@@ -379,15 +494,23 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     not certify goes to the interior-point method (without numba the two
     swap roles: :func:`_solve_duals`), and a grasp neither settles to the
     primal through the solver gateway (counted in ``_FALLBACKS``).
+
+    With a passive palm (``passive = (a, c)`` of :func:`palm_rows`) the primal's
+    row ``a·λ - c_u α <= 0`` adds a dual variable ``s_p >= 0`` (not in the
+    objective: the row's bound is 0) before ``ζ``; the α column's condition
+    becomes ``yᵀv = 1 + c_u s_p``, so ``y = (1 + c_u s_p) v + P z`` and each
+    generator row gains ``-(a_j + c_u v·w_j) s_p``.  ``s_p = 0`` keeps the
+    start feasible.
     """
     K, M, w = W.shape
     D = len(directions)
     G = num_groups(groups)
     v = np.hstack([directions, np.zeros((D, w - 3))])  # (D, w)
     P = _complement(v)  # (D, w, w-1)
-    n = (w - 1) + G + 1
-    B = np.zeros((K, D, M + G + 1, n))
-    h = np.zeros((K, D, M + G + 1))
+    extra = 0 if passive is None else 1
+    n = (w - 1) + G + extra + 1
+    B = np.zeros((K, D, M + G + extra + 1, n))
+    h = np.zeros((K, D, M + G + extra + 1))
     # generator rows: -(Pᵀ w_j)·z - s_f <= v·w_j
     B[:, :, :M, : w - 1] = -(W[:, None] @ P[None])  # (K, D, M, w - 1)
     g = np.clip(groups, 0, G - 1)
@@ -397,21 +520,26 @@ def _batch_capacity(W: np.ndarray, groups: np.ndarray, directions: np.ndarray):
     # s >= 0
     for f in range(G):
         B[:, :, M + f, w - 1 + f] = -1.0
-    # ζ + Σ s <= 0
-    B[:, :, M + G, w - 1 : w - 1 + G] = 1.0
-    B[:, :, M + G, n - 1] = 1.0
-    rows = M + G + 1
+    if passive is not None:  # the palm's dual variable s_p >= 0
+        a, c = passive  # (K, M), (K, D)
+        B[:, :, :M, w - 1 + G] = -a[:, None, :] - c[:, :, None] * h[:, :, :M]
+        B[:, :, M + G, w - 1 + G] = -1.0
+    # ζ + Σ s_f <= 0 (the palm's s_p is not in the objective)
+    B[:, :, -1, w - 1 : w - 1 + G] = 1.0
+    B[:, :, -1, n - 1] = 1.0
+    rows = M + G + extra + 1
     B = B.reshape(K * D, rows, n)
     h = h.reshape(K * D, rows)
     member = np.repeat(onehot, D, axis=0)  # (K D, M, G)
     value, left = _solve_duals(
-        B, h, lambda rows: _feasible_start(h[rows], member[rows], n)
+        B, h, lambda rows: _feasible_start(h[rows], member[rows], n, extra)
     )
     alpha = np.maximum(-value, 0.0).reshape(K, D)
     grasps = np.unique(left // D)
     if len(grasps):  # neither settled it: the primal through Clp
         _FALLBACKS["clp"] += len(grasps)
-        alpha[grasps] = _drake_capacity(W[grasps], groups[grasps], directions)
+        some = None if passive is None else (passive[0][grasps], passive[1][grasps])
+        alpha[grasps] = _drake_capacity(W[grasps], groups[grasps], directions, some)
     return alpha
 
 
@@ -442,12 +570,14 @@ def _solve_duals(B: np.ndarray, h: np.ndarray, start):
     return value, rows
 
 
-def _feasible_start(h: np.ndarray, member: np.ndarray, n: int) -> np.ndarray:
+def _feasible_start(
+    h: np.ndarray, member: np.ndarray, n: int, extra: int = 0
+) -> np.ndarray:
     """A feasible point ``(z, s, ζ)`` of each dual LP of :func:`_batch_capacity`.
 
     ``z = 0`` (``y = v``), each ``s_f`` the largest ``-v·w_j`` of its group
-    (at least 0) and ``ζ = -Σ s``: every row holds, with equality where the
-    maximum is attained.
+    (at least 0), the palm's ``s_p = 0`` and ``ζ = -Σ s_f``: every row holds,
+    with equality where the maximum is attained.
 
     Parameters
     ----------
@@ -456,7 +586,9 @@ def _feasible_start(h: np.ndarray, member: np.ndarray, n: int) -> np.ndarray:
     member : (L, M, G) float
         One-hot group of each wrench.
     n : int
-        Variables ``w - 1 + G + 1``.
+        Variables ``w - 1 + G + extra + 1``.
+    extra : int
+        1 with a palm's ``s_p`` (just before ``ζ``), else 0.
     """
     L, M, G = member.shape
     x0 = np.zeros((L, n))
@@ -464,6 +596,7 @@ def _feasible_start(h: np.ndarray, member: np.ndarray, n: int) -> np.ndarray:
     worst = np.zeros((L, G))  # per group, over a contiguous axis (faster)
     for f in range(G):
         worst[:, f] = np.where(member[:, :, f] > 0, neg, -np.inf).max(axis=1)
-    x0[:, n - 1 - G : n - 1] = np.maximum(worst, 0.0)
-    x0[:, n - 1] = -x0[:, n - 1 - G : n - 1].sum(axis=1)
+    s = slice(n - 1 - extra - G, n - 1 - extra)
+    x0[:, s] = np.maximum(worst, 0.0)
+    x0[:, n - 1] = -x0[:, s].sum(axis=1)
     return x0

@@ -174,6 +174,7 @@ WEIGHT_BAD = (
     )
     + _cases("solver", [None, ["batch"], np.array(["batch", "drake"])])
     + _cases("workers", [0, -1, True, 1.5, "2"])
+    + _cases("palm", [-1, 64, 2.0, True, "2", np.nan, [2]])
 )
 
 
@@ -279,6 +280,7 @@ FAN_BAD = (
     + _cases("positions", [P_EDGE[0], P_EDGE + np.inf])
     + _cases("contact_model", ["finger"])
     + _cases("torsional_friction", [-1.0, np.nan])
+    + _cases("palm", [-2, True, "1"])
 )
 
 

@@ -156,3 +156,30 @@ def test_a_jaw_below_its_squeeze_needed_drops_the_object(drake_models_dir):
         high = shake_test(scene.add_models, candidate, squeeze=1.5 * squeeze)
         assert not low.held_from_seat, (candidate.sample, str(low))
         assert high.held_from_seat, (candidate.sample, str(high))
+
+
+def test_a_palm_contact_does_not_lower_the_squeeze_needed(drake_models_dir):
+    # Drake's Franka hand on the cracker box: one of the best candidates
+    # rests an edge of the box on the welded palm.  Counted as a third
+    # squeezed finger, the palm made it hold at 11.8 N a finger and rank
+    # first; in Drake it drops at the fingers' full 20 N.  A passive palm
+    # (weight_capacity(palm=2)) asks for more than 20 N, as Drake does.
+    scene = planning_scene(
+        "package://drake_models/ycb/003_cracker_box.sdf", hand_url=PANDA,
+        models_dir=drake_models_dir,
+    )  # fmt: skip
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=300, mu=1.0, seed=0,
+    )  # fmt: skip
+    palm = "panda_hand::panda_hand"
+    on_palm = [c for c in result[:10] if any(k.finger_body == palm for k in c.contacts)]
+    assert on_palm, [c.sample for c in result[:10]]
+    limit = motor_limit(scene.plant, result[0])
+    for candidate in on_palm:
+        assert candidate.squeeze_needed > limit, candidate.sample
+        shaken = shake_test(scene.add_models, candidate, squeeze=limit)
+        assert not shaken.held_from_seat, (candidate.sample, str(shaken))
+    # and those within the limit rank ahead of it
+    first = [c.squeeze_needed <= limit for c in result[:10]]
+    assert first == sorted(first, reverse=True)
