@@ -45,12 +45,14 @@ fully just before they open).
    point of ``at risk`` and ``slipping``.  The one exception is ``dropped``,
    gated as above, so with ``n >= 1`` (the default) a single sample without
    contact never reads as a drop.
-2. A move from ``holding``, ``at risk``, ``slipping`` or ``dropped`` to a
-   *less* alarming state needs ``n + 1`` consecutive samples whose evidence is
-   less alarming than the state shown; the state then becomes the latest
-   sample's evidence.  So a grip neither flickers to ``no contact`` at one
-   missing frame, nor back to ``holding`` at one sticking frame of a slide,
-   nor out of ``dropped`` at one touch.
+2. A move from ``touching``, ``holding``, ``at risk``, ``slipping`` or
+   ``dropped`` to a *less* alarming state needs ``n + 1`` consecutive samples
+   whose evidence is less alarming than the state shown; the state then
+   becomes the latest sample's evidence.  So neither a grip nor a touch
+   flickers to ``no contact`` at one missing frame (a contact solver may
+   report a resting point contact on one step and not the next), nor a grip
+   back to ``holding`` at one sticking frame of a slide, nor out of
+   ``dropped`` at one touch.
 3. While a grip's contact is missing for at most ``n`` samples, the monitor
    also keeps showing the last analysis with contact (``contact_gap`` counts
    these bridged samples).
@@ -98,7 +100,8 @@ the vector port (0 … 5); see :mod:`drakegrasp.systems.holding` for their rules
 
 _RANK = {name: k for k, name in enumerate(HOLDING_STATES)}
 _GRIPPED = ("holding", "at risk", "slipping")
-_STICKY = _GRIPPED + ("dropped",)  # left towards a milder state only by hysteresis
+# left towards a milder state only by hysteresis
+_STICKY = ("touching", *_GRIPPED, "dropped")
 
 
 @dataclass(frozen=True)
