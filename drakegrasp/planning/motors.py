@@ -516,19 +516,12 @@ def _too_weak(head, limit: float, applied: bool = False) -> str:
     ``applied``: the limit is the user's ``torque_limit``, not the effort limit.
     """
     needed = [c.torque_needed for c in head if not np.isnan(c.torque_needed)]
-    if not needed or min(needed) <= limit:
-        return ""
     who = (
         f"the hand at torque_limit {limit:.3g} N·m holds"
         if applied
         else f"the hand's actuators (effort limits from {limit:.3g} N·m) hold"
     )
-    return (
-        f"{who} "
-        f"none of the {len(needed)} best force-closure candidates against the "
-        f"object's weight in every direction: they need at least "
-        f"{min(needed):.3g} N·m per joint (torque_needed)"
-    )
+    return _none_held(needed, limit, who, "best ", "N·m per joint (torque_needed)")
 
 
 def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:
@@ -541,17 +534,22 @@ def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:
         for c in candidates
         if c.is_closure and not np.isnan(c.squeeze_needed)
     ]
-    if not needed or min(needed) <= limit:
-        return ""
     who = (
         f"the jaw at squeeze_limit {limit:.3g} N holds"
         if applied
         else f"the jaw's actuators (effort limits from {limit:.3g} N) hold"
     )
+    return _none_held(needed, limit, who, "", "N per finger (squeeze_needed)")
+
+
+def _none_held(needed: list, limit: float, who: str, best: str, unit: str) -> str:
+    """The sentence saying that none of ``needed`` is within ``limit``, or ""."""
+    if not needed or min(needed) <= limit:
+        return ""
     return (
-        f"{who} none of the {len(needed)} force-closure candidates against the "
-        f"object's weight in every direction: they need at least "
-        f"{min(needed):.3g} N per finger (squeeze_needed)"
+        f"{who} none of the {len(needed)} {best}force-closure candidates against "
+        f"the object's weight in every direction: they need at least "
+        f"{min(needed):.3g} {unit}"
     )
 
 
