@@ -42,7 +42,7 @@ from drakegrasp.planning.candidates import (
     pose_dict,
 )
 from drakegrasp.planning.shake import check_shake_options, shake_test
-from drakegrasp.planning.shake_result import ShakeResult
+from drakegrasp.planning.shake_result import ShakeResult, motion_text
 from drakegrasp.plant.validation import check_rigid_transform
 
 __all__ = [
@@ -107,16 +107,15 @@ class ShakenCandidate:
             ""
             if np.isnan(r.seat_displacement)
             else (
-                f", seated {r.seat_displacement * 1e3:.1f} mm "
-                f"{np.degrees(r.seat_rotation):.1f} deg from the plan, then within "
-                f"{r.max_displacement_from_seat * 1e3:.1f} mm "
-                f"{np.degrees(r.max_rotation_from_seat):.1f} deg"
+                f", seated {motion_text(r.seat_displacement, r.seat_rotation, 1)} "
+                "from the plan, then within "
+                + motion_text(r.max_displacement_from_seat, r.max_rotation_from_seat, 1)
             )
         )
         return (
             f"plan #{self.planned_rank}: {'held' if self.held else 'dropped'} "
-            f"(at most {r.max_displacement * 1e3:.1f} mm "
-            f"{np.degrees(r.max_rotation):.1f} deg from the plan{seated})"
+            f"(at most {motion_text(r.max_displacement, r.max_rotation, 1)} "
+            f"from the plan{seated})"
         )
 
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from drakegrasp.core.serialize import jsonable
 
-__all__ = ["ShakeResult"]
+__all__ = ["ShakeResult", "motion_text"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,30 +147,37 @@ class ShakeResult:
         return jsonable(dict(vars(self), held_from_seat=self.held_from_seat))
 
     def __str__(self) -> str:
-        seated = (
-            ""
-            if np.isnan(self.seat_displacement)
-            else (
-                f"; seated {self.seat_displacement * 1e3:.2f} mm and "
-                f"{np.degrees(self.seat_rotation):.2f} deg from the plan, "
-                f"moving at {self.seat_speed * 1e3:.3g} mm/s"
-                + (
-                    ""
-                    if np.isnan(self.max_displacement_from_seat)  # an older record
-                    else (
-                        f", then at most {self.max_displacement_from_seat * 1e3:.2f}"
-                        f" mm and {np.degrees(self.max_rotation_from_seat):.2f} deg "
-                        "from there"
-                    )
-                )
-            )
+        """One line, led by the verdict the planner ranks by (``held_from_seat``).
+
+        With seating, the motion from the seat comes first and the motion from
+        the plan's pose after it, so the headline never says "dropped" for a
+        grasp that ``shake_candidates`` lists as held.
+        """
+        bounds = (
+            f"(bounds {self.bounds[0] * 1e3:g} mm, {np.degrees(self.bounds[1]):g} deg)"
         )
+        plan = motion_text(self.max_displacement, self.max_rotation)
+        if np.isnan(self.seat_displacement):
+            motion = f"moved at most {plan} {bounds}"
+            tail = ""
+        else:
+            seated = (
+                f"seated {motion_text(self.seat_displacement, self.seat_rotation)} "
+                f"from the plan, moving at {self.seat_speed * 1e3:.3g} mm/s"
+            )
+            if np.isnan(self.max_displacement_from_seat):  # an older record
+                motion = f"{seated}; moved at most {plan} from the plan {bounds}"
+                tail = ""
+            else:
+                since = motion_text(
+                    self.max_displacement_from_seat, self.max_rotation_from_seat
+                )
+                motion = f"{seated}, then at most {since} from there {bounds}"
+                tail = f"; from the plan's pose at most {plan}" + (
+                    "" if self.held else ", beyond the bounds"
+                )
         return (
-            f"{'held' if self.held else 'dropped'}: moved at most "
-            f"{self.max_displacement * 1e3:.2f} mm and "
-            f"{np.degrees(self.max_rotation):.2f}"
-            f" deg (bounds {self.bounds[0] * 1e3:g} mm, "
-            f"{np.degrees(self.bounds[1]):g} deg)"
+            f"{'held' if self.held_from_seat else 'dropped'}: {motion}"
             f" over {self.duration:g} s, squeeze {self.squeeze:g} {self.squeeze_unit}"
             + (
                 f" (capped at the effort limit: {min(self.squeeze_caps):g} "
@@ -189,8 +196,17 @@ class ShakeResult:
                     else ")"
                 )
             )
-            + f"; {self.wall_time:.2f} s wall{seated}"
+            + f"{tail}; {self.wall_time:.2f} s wall"
         )
+
+
+def motion_text(displacement: float, rotation: float, digits: int = 2) -> str:
+    """A motion as "12.34 mm and 5.67 deg"; beyond a metre, only its distance."""
+    if displacement > 1.0:  # an object that fell: its angle says nothing
+        return f"{displacement:.{digits}f} m (out of the hand)"
+    return (
+        f"{displacement * 1e3:.{digits}f} mm and {np.degrees(rotation):.{digits}f} deg"
+    )
 
 
 def _squeeze_unit(units: tuple[str, ...]) -> str:
