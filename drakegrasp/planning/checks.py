@@ -234,12 +234,13 @@ def checked_count(name: str, value, minimum: int = 0) -> int:
 def checked_palm(value) -> int | None:
     """The passive palm's label of a weight capacity: None or a finger label.
 
-    An integer in ``[0, MAX_FINGER_LABEL]`` (a bool, float or string is
-    refused: :class:`~drakegrasp.InvalidOptionError` naming ``palm``).
+    An integer in ``[0, MAX_FINGER_LABEL]``; integral floats are taken, as in
+    ``fingers`` (a bool, fractional float or string is refused:
+    :class:`~drakegrasp.InvalidOptionError` naming ``palm``).
     """
     if value is None:
         return None
-    n = integer_or_none(value)
+    n = integer_or_none(value, integral_floats=True)  # as fingers takes them
     if n is None or not 0 <= n <= MAX_FINGER_LABEL:
         raise InvalidOptionError(
             f"palm must be None or a finger label, an integer in [0, "

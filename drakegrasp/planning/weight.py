@@ -32,21 +32,25 @@ something presses the object into it: the load, or a finger's normal force.
 Friction does not count: a finger's friction may pull the object into the
 palm in the LP, but nothing sets that pull in a real hand (it is a passive
 internal force, as the hand's Jacobian would show), and the palm's friction
-that such a pull would buy is not there.  With :math:`\bar n` the palm
-contacts' mean inward normal, each direction's LP gains
+that such a pull would buy is not there.  So either the palm carries nothing
+(its wrenches left out), or, over the palm's contacts ``i``,
 
 .. math::
 
-    \sum_{i \in \text{palm}} (n_i \cdot \bar n) \sum_k \lambda_{ik}
-    \le \alpha\, (-u \cdot \bar n)_+
-    + \sum_{i \notin \text{palm}} (-n_i \cdot \bar n)_+ \sum_k \lambda_{ik},
+    \sum_{i \in \text{palm}} \sum_k \lambda_{ik}
+    \le \alpha \max_i (-u \cdot n_i)
+    + \sum_{j \notin \text{palm}} \max_i (-n_j \cdot n_i) \sum_k \lambda_{jk}
 
-beside the palm's squeeze bound, which it keeps (so no capacity rises and
-each stays finite).  For a parallel jaw, whose squeeze is across the palm's
-normal, the palm then holds only the weight's share that presses into it.
-Without it the LP had Drake's Franka hand hold the cracker box by its palm
-at 11.8 N a finger; the box dropped in Drake at 17.7 N and 20 N, and this
-constraint asks for more than 20 N.
+(signed: a finger that pushes the object off the palm takes from what it may
+carry); ``α`` is the better of the two LPs.  The palm keeps its squeeze
+bound too, so no capacity rises and each stays finite.  For a parallel jaw,
+whose squeeze is across the palm's normal, the palm then holds only the
+weight's share that presses into it.  Without it the LP had Drake's Franka
+hand hold the cracker box by its palm at 11.8 N a finger, and the WSG-50 two
+hex-prism grasps at 1.19 N and 1.49 N; in Drake they drop at 20 N and at 1.1
+times those.  The model is conservative where the palm is a lever's stop
+(the load's *moment* turning the object into the palm, as on a handle held
+at one end): that reaction is not counted.
 
 The LPs of all grasps and directions are solved at once by the batch engine's
 exact active-set method (its interior-point method where that cannot certify),
@@ -70,12 +74,11 @@ from drakegrasp.batch.lp.ipm import solve_max_last, solve_max_last_active
 from drakegrasp.batch.run.workers import check_workers, map_ordered, resolve_workers
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import (
-    check_num_generators,
-)
+from drakegrasp.core.validation import check_num_generators, unit_vectors
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.checks import (
     checked_contacts,
+    checked_count,
     checked_directions,
     checked_fingers,
     checked_friction,
@@ -180,39 +183,54 @@ def palm_rows(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The passive palm's row of each grasp's LPs (see the module's note).
 
+    ``a·λ <= c α``: the palm's normal forces sum to at most what presses the
+    object into the palm, friction aside: the load's share
+    ``max_i(-u·n_i)`` and each finger contact's ``max_i(-n_j·n_i)`` per
+    newton of its normal force, ``i`` over the palm's contacts (signed: a
+    finger pushing the object off the palm takes from it).
+
     Parameters
     ----------
     normals : (K, N, 3) float
-        Unit inward contact normals, frame O.
+        Inward contact normals, frame O (finite, non-zero; normalised here).
     fingers : (K, N) int
         Finger labels; ``palm`` marks the palm's contacts.
     palm : int
-        The palm's label.
+        The palm's label (:func:`~drakegrasp.planning.checks.checked_palm`).
     per : int
-        Primitive wrenches per contact (their order is contact-major).
+        Primitive wrenches per contact (their order is contact-major), >= 1.
     directions : (D, 3) float
-        Unit weight directions, frame O.
+        Weight directions, frame O (finite, non-zero; normalised here).
 
     Returns
     -------
     a : (K, N * per) float
-        Each wrench's coefficient: ``n_i·n̄`` for the palm's, ``-(-n_i·n̄)₊``
-        for the others' (every wrench has a unit normal force).
+        Each wrench's coefficient (every wrench has a unit normal force): 1
+        for the palm's, ``-max_i(-n_j·n_i)`` for a finger's.
     c : (K, D) float
-        ``(-u·n̄)₊``: the share of a unit weight pressing into the palm.
+        ``max_i(-u·n_i)``: the share of a unit weight pressing into the palm.
     has : (K,) bool
-        Grasps with a palm contact whose normals do not cancel; the others
-        have no palm row (``a`` and ``c`` zero).
+        Grasps with a palm contact; the others have no palm row (``a`` and
+        ``c`` zero).
     """
+    normals = unit_vectors("normals", normals)
+    K, N, _ = normals.shape
+    fingers = checked_fingers(fingers, (K, N))
+    palm = checked_palm(palm)
+    if palm is None:
+        raise InvalidOptionError("palm_rows needs a palm label, got None")
+    per = checked_count("per", per, 1)
+    directions = checked_directions("directions", directions)
     on = fingers == palm  # (K, N)
-    total = np.einsum("kn,knj->kj", on.astype(float), normals)
-    size = np.linalg.norm(total, axis=1)
-    has = size > 1e-9 * np.maximum(on.sum(axis=1), 1)
-    nbar = np.divide(total, size[:, None], out=np.zeros_like(total),
-                     where=has[:, None])  # fmt: skip
-    along = np.einsum("knj,kj->kn", normals, nbar)  # (K, N)
-    a = np.where(on, along, -np.maximum(-along, 0.0))
-    c = np.maximum(-(nbar @ np.asarray(directions, float).T), 0.0)  # (K, D)
+    has = on.any(axis=1)
+    # share of contact j's normal force pressing into palm contact i: -n_j·n_i
+    into = -np.einsum("kjx,kix->kji", normals, normals)  # (K, N_j, N_i)
+    share = np.where(on[:, None, :], into, -np.inf).max(axis=2)  # (K, N)
+    a = np.where(on, 1.0, -share)
+    load = -np.einsum("dx,kix->kdi", directions, normals)  # (K, D, N_i)
+    c = np.where(on[:, None, :], load, -np.inf).max(axis=2)  # (K, D)
+    a = np.where(has[:, None], a, 0.0)
+    c = np.where(has[:, None], c, 0.0)
     return np.repeat(a, per, axis=1), c, has
 
 
@@ -426,7 +444,15 @@ def _capacity(positions, normals, fingers, *, mu, torque_scale, contact_model,
     if not np.all(has):  # no palm row: the LPs and numbers of palm=None
         out[~has] = run(W[~has], groups[~has], directions)
     if np.any(has):
-        out[has] = run(W[has], groups[has], directions, (a[has], c[has]))
+        # Either the palm carries no force (its wrenches left out), or it
+        # carries at most what presses the object into it: the better of the
+        # two LPs (a palm pushed off by the fingers may still be left idle).
+        Wp = W[has]
+        idle = np.where(groups[has][..., None] == palm, 0.0, Wp)
+        out[has] = np.maximum(
+            run(idle, groups[has], directions),
+            run(Wp, groups[has], directions, (a[has], c[has])),
+        )
     return out
 
 

@@ -174,7 +174,7 @@ WEIGHT_BAD = (
     )
     + _cases("solver", [None, ["batch"], np.array(["batch", "drake"])])
     + _cases("workers", [0, -1, True, 1.5, "2"])
-    + _cases("palm", [-1, 64, 2.0, True, "2", np.nan, [2]])
+    + _cases("palm", [-1, 64, 2.5, True, "2", np.nan, [2]])
 )
 
 
