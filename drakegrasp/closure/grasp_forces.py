@@ -404,6 +404,30 @@ def _solved(P, w, objective, result, v, F0) -> GraspForceResult:
     )
 
 
+def _zero_forces(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResult:
+    """The exact answer to a zero load: every force zero (in every cone)."""
+    full = np.zeros(P.grasp.num_components)
+    tau = P.joint_torques(full)
+    sat, usage = saturating_joints(tau, P.torque_limits)
+    return GraspForceResult(
+        feasible=True,
+        objective=objective,
+        cones=P.cones,
+        wrench=w.copy(),
+        contact_forces=P.per_contact(full),
+        joint_torques=tau,
+        squeeze=0.0,
+        torque_usage=usage,
+        saturating_joints=sat,
+        margin=math.nan,
+        torque_limits=_limits_copy(P),
+        balance_residual=0.0,
+        num_generators=P.num_generators,
+        solver="none (a zero load)",
+        status="kSolutionFound",
+    )
+
+
 def _refutation_reaches(P, w, cert, prog, result) -> None:
     """Refuse a "not held" whose proof stops short of the forces friction needs.
 
@@ -564,7 +588,12 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
     ``μ >> 1``); a second failure is a :class:`~drakegrasp.SolverError`, never
     forces that break a limit reported as feasible.  Limits far above the
     load (:data:`LIMIT_GAP`) are first left out, for the least squeeze.
+    A zero load is held by zero forces, the least squeeze and torque there
+    is, without a solver (whose forces of 1e-11 N were judged against
+    themselves and "violated" a cone by all of their size).
     """
+    if objective != "max_margin" and not np.any(w):
+        return _zero_forces(P, w, objective)
     free = _without_far_limits(P, w, objective)
     if free is not None:
         relaxed = _solve_checked(free, w, objective)

@@ -111,6 +111,27 @@ def test_torques_are_J_transpose_f_and_limits_hold():
     assert r.saturating_joints == ()
 
 
+@pytest.mark.parametrize("objective", ["min_squeeze", "min_torque"])
+@pytest.mark.parametrize("cones", ["exact", "polyhedral"])
+def test_a_zero_load_is_held_by_zero_forces(objective, cones):
+    # Clarabel's 1e-11 N answer for the Allegro hand's zero load was judged
+    # against its own size and raised SolverError; zero is the exact answer
+    g = pinch(0.5)
+    J = pinch_jacobian(g)
+    r = dg.grasp_forces(
+        g, np.zeros(6), hand_jacobian=J, torque_limits=[30, 30],
+        objective=objective, cones=cones,
+    )  # fmt: skip
+    assert r.feasible and r.squeeze == 0.0
+    assert not np.any(r.stacked_forces()) and not np.any(r.joint_torques)
+    assert r.torque_usage == 0.0 and r.balance_residual == 0.0
+    # the least squeeze shrinks to it as the load does
+    tiny = dg.grasp_forces(g, weight(1e-9), hand_jacobian=J, torque_limits=[30, 30])
+    assert tiny.feasible and tiny.squeeze == pytest.approx(
+        dg.grasp_forces(g, weight(1.0)).squeeze * 1e-9, rel=1e-5
+    )
+
+
 # ------------------------------------------------ infeasible, with certificates
 
 
