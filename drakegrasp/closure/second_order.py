@@ -251,8 +251,10 @@ class SecondOrderResult:
 
     Attributes
     ----------
-    is_closure : bool
-        Immobilised to first order (``order == 1``) or to second (``2``).
+    is_closure : bool or None
+        Immobilised to first order (``order == 1``) or to second (``2``);
+        None when nothing was decided (:attr:`decided`: a contact without a
+        curvature model, see :meth:`undecided`).
     order : int or None
         1, 2, or None when not immobilised (or not decided) at second order.
     t_star : float
@@ -284,7 +286,7 @@ class SecondOrderResult:
         One sentence that says why.
     """
 
-    is_closure: bool
+    is_closure: bool | None
     order: int | None
     t_star: float
     multipliers: np.ndarray
@@ -304,9 +306,13 @@ class SecondOrderResult:
     def undecided(
         cls, num_contacts: int, reason: str, *, tol: float = DEFAULT_SECOND_ORDER_TOL
     ) -> SecondOrderResult:
-        """A result that decides nothing, for contacts without a curvature model."""
+        """A result that decides nothing, for contacts without a curvature model.
+
+        Its ``is_closure`` is None, not False: nothing says the grasp is not
+        immobilised.
+        """
         return cls(
-            is_closure=False,
+            is_closure=None,
             order=None,
             t_star=math.nan,
             multipliers=np.zeros(num_contacts),
@@ -324,6 +330,11 @@ class SecondOrderResult:
         )
 
     @property
+    def decided(self) -> bool:
+        """False for a result of :meth:`undecided` (no program was solved)."""
+        return self.is_closure is not None
+
+    @property
     def near_boundary(self) -> bool:
         """True when ``t*`` is within ``tol`` of 0: higher orders decide."""
         return math.isfinite(self.t_star) and near_threshold(self.margin)
@@ -332,9 +343,12 @@ class SecondOrderResult:
         """JSON-ready dictionary."""
         d = {f.name: jsonable(getattr(self, f.name)) for f in fields(self)}
         d["near_boundary"] = self.near_boundary
+        d["decided"] = self.decided
         return d
 
     def __str__(self) -> str:
+        if not self.decided:
+            return f"second-order form closure: not decided\n  {self.reason}"
         verdict = {1: "YES (first order)", 2: "YES (second order)"}.get(
             self.order, "no"
         )

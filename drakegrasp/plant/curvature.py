@@ -49,7 +49,12 @@ from drakegrasp.plant.contacts import PlantContact, resolve_object_body
 from drakegrasp.plant.options import PLANES
 from drakegrasp.plant.validation import plant_context_of, query_object_of
 
-__all__ = ["SECOND_ORDER_RANK_TOL", "contact_curvatures", "shape_curvature"]
+__all__ = [
+    "EDGE_TILT_TOL",
+    "SECOND_ORDER_RANK_TOL",
+    "contact_curvatures",
+    "shape_curvature",
+]
 
 SECOND_ORDER_RANK_TOL = 1e-4
 """Relative singular-value threshold of the second-order test on plant grasps.
@@ -65,8 +70,32 @@ VERTEX_TOL = 1e-8
 """A patch vertex this close (m) to a face polygon's corner is that corner."""
 
 
+EDGE_TILT_TOL = 0.05
+"""How far (cosine) a sharp edge may lean out of the contact's tangent plane
+and still be taken as lying in it.  An edge that touches a surface lies in its
+tangent plane; in a simulated state the bodies interpenetrate by a fraction of
+a millimetre and Drake's contact normal leans off it (by 3.5e-3 for an
+Allegro fingertip seated on the YCB soup can), and the second-order analysis
+said "not decided".  Within this tolerance the edge is projected on the
+tangent plane; beyond it (an edge that crosses the surface) it is left as it
+is, and the analysis refuses it."""
+
+
 def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
+
+
+def _edge(direction_O: np.ndarray, n_O: np.ndarray, curvature: float = 0.0):
+    """A sharp edge along ``direction_O``, in the tangent plane of ``n_O``.
+
+    See :data:`EDGE_TILT_TOL`.
+    """
+    d = _unit(np.asarray(direction_O, dtype=float))
+    n = _unit(np.asarray(n_O, dtype=float))
+    lean = float(d @ n)
+    if abs(lean) <= EDGE_TILT_TOL:
+        d = _unit(d - lean * n)
+    return SurfaceCurvature.edge(d, curvature)
 
 
 def _implicit(form_G: np.ndarray, grad_G: np.ndarray, R_OG, n_O) -> SurfaceCurvature:
@@ -74,12 +103,12 @@ def _implicit(form_G: np.ndarray, grad_G: np.ndarray, R_OG, n_O) -> SurfaceCurva
     return SurfaceCurvature.from_shape_form(form_O, n_O)
 
 
-def _sharp(normals_G: list[np.ndarray], R_OG: np.ndarray) -> SurfaceCurvature:
+def _sharp(normals_G: list[np.ndarray], R_OG: np.ndarray, n_O) -> SurfaceCurvature:
     """Where several flat faces meet: an edge (two) or a corner (three)."""
     if len(normals_G) == 2:
         edge = np.cross(normals_G[0], normals_G[1])
         if np.linalg.norm(edge) > 1e-9:
-            return SurfaceCurvature.edge(R_OG @ _unit(edge))
+            return _edge(R_OG @ _unit(edge), n_O)
     return SurfaceCurvature.point()
 
 
@@ -136,11 +165,11 @@ def shape_curvature(
         along = np.array([-rho[1], rho[0], 0.0])
         m_G = R_OG.T @ np.asarray(n_O)  # the contact normal, in G
         kappa = abs(m_G @ rho) / r  # the rim circle's curvature along m
-        return SurfaceCurvature.edge(R_OG @ along, kappa)
+        return _edge(R_OG @ along, n_O, kappa)
     if isinstance(shape, (Box, Convex, Mesh)):
         if len(pieces) == 1:
             return SurfaceCurvature.flat()
-        return _sharp([q.normal_G for q in pieces], R_OG)
+        return _sharp([q.normal_G for q in pieces], R_OG, n_O)
     raise ModelError(
         f"drakegrasp has no curvature model for a {type(shape).__name__}; use "
         "Sphere, Ellipsoid, Cylinder, Capsule, Box, HalfSpace or Convex"
@@ -183,9 +212,7 @@ def _patch_curvatures(shape_o, p_o, R_OGo, shape_f, p_f, R_OGf, n_O):
     if isinstance(feat_o, str) and not isinstance(feat_f, str):
         return ContactCurvature(SurfaceCurvature.point(), flat)
     if isinstance(feat_o, np.ndarray) and isinstance(feat_f, np.ndarray):
-        return ContactCurvature(
-            SurfaceCurvature.edge(feat_o), SurfaceCurvature.edge(feat_f)
-        )
+        return ContactCurvature(_edge(feat_o, n_O), _edge(feat_f, n_O))
     # Corner on corner (or a vertex inside both faces): the core rejects it.
     return ContactCurvature(SurfaceCurvature.point(), SurfaceCurvature.point())
 

@@ -182,6 +182,9 @@ def test_flat_on_flat_witness_contact_is_reported_undecided(scene_cache):
     options = {**scene.analysis_options(), "patches": "witness"}
     report = analyze_grasp(scene.plant, ctx, **options)
     so = report.second_order
-    assert not so.is_closure and so.order is None and so.dim_w == -1
+    assert so.is_closure is None and not so.decided  # not "no": undecided
+    assert so.order is None and so.dim_w == -1
     assert "not decided" in so.reason and "not positive" in so.reason
-    assert "not decided" in str(report)
+    assert "second-order form closure: not decided" in str(report)
+    assert "second-order form closure: no" not in str(report)
+    assert report.to_dict()["second_order"]["decided"] is False
