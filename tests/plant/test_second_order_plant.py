@@ -186,5 +186,5 @@ def test_flat_on_flat_witness_contact_is_reported_undecided(scene_cache):
     assert so.order is None and so.dim_w == -1
     assert "not decided" in so.reason and "not positive" in so.reason
     assert "second-order form closure: not decided" in str(report)
-    assert "second-order form closure: no" not in str(report)
+    assert "second-order form closure: no," not in str(report)
     assert report.to_dict()["second_order"]["decided"] is False
