@@ -65,7 +65,7 @@ from drakegrasp.planning.turned_gravity import (
     _schedule,
     _TurnedGravity,
 )
-from drakegrasp.plant.fingers import effort_unit
+from drakegrasp.plant.fingers import effort_unit, find_joint
 from drakegrasp.plant.hydroelastic import (
     check_hydroelastic_modulus,
     use_hydroelastic_contact,
@@ -487,12 +487,19 @@ def shake_test(
         return d, r
 
     seated = (float("nan"),) * 3
+    seated_q, seated_X_WO = (), None
     if seat > 0:
         advance(seat / 2)
         aim()  # from where the fingers stopped on the object
         seated = (*advance(seat), _speed(plant, ctx, body))
         X_HO_seat = plant.CalcRelativeTransform(ctx, H, body.body_frame())
         max_ds = max_rs = 0.0
+        q_now = plant.GetPositions(ctx)
+        seated_q = tuple(
+            float(q_now[find_joint(plant, name).position_start()])
+            for name in candidate.joint_names
+        )
+        seated_X_WO = plant.EvalBodyPoseInWorld(ctx, body).GetAsMatrix4()
     else:
         advance(settle)  # efforts are read once something has been simulated
     u = plant.get_net_actuation_output_port().Eval(ctx)
@@ -529,4 +536,6 @@ def shake_test(
         hydroelastic_modulus=modulus,
         hydroelastic_refused=refused,
         squeeze_caps=capped,
+        seated_q_hand=seated_q,
+        seated_X_WO=seated_X_WO,
     )

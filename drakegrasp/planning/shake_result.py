@@ -7,11 +7,13 @@ what the actuators pressed with, and the contact model the simulation used.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+from pydrake.math import RigidTransform
 
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["ShakeResult", "motion_text"]
 
@@ -86,6 +88,13 @@ class ShakeResult:
         ``squeeze``, or its actuator's effort limit where that is smaller (an
         actuator applies no more; ``squeeze_capped`` says so, and the summary
         line names the cap).  Empty in a record made before it existed.
+    seated_q_hand : (n_h,) float
+        The candidate's joints (``joint_names``, its order) where seating
+        left them, rad or m; empty with ``seat=0``.
+    seated_X_WO : (4, 4) float or None
+        The object's pose where seating left it, in the world the candidate
+        was planned in (its hand base welded at ``X_WH``); None with
+        ``seat=0``.  :meth:`seated` makes both a candidate to analyse.
     """
 
     held: bool
@@ -107,6 +116,38 @@ class ShakeResult:
     hydroelastic_modulus: float | None = None
     hydroelastic_refused: int = 0
     squeeze_caps: tuple[float, ...] = ()
+    seated_q_hand: tuple[float, ...] = ()
+    seated_X_WO: np.ndarray | None = None
+
+    def seated(self, candidate):
+        """``candidate`` with the hand's joints and the object where seating left them.
+
+        Its :meth:`~drakegrasp.planning.candidates.GraspCandidate.apply` puts
+        the seated grasp in a context, for
+        :func:`~drakegrasp.analyze_grasp` (the grasp a multi-finger hand
+        really holds, millimetres from the planned one; its ``contacts``
+        and scores stay the plan's).
+
+        Raises
+        ------
+        InvalidOptionError
+            The test ran with ``seat=0`` (nothing seated), or ``candidate``
+            has other joints than the shaken one.
+        """
+        if self.seated_X_WO is None:
+            raise InvalidOptionError(
+                "this shake test ran with seat=0: nothing was seated"
+            )
+        if len(candidate.joint_names) != len(self.seated_q_hand):
+            raise InvalidOptionError(
+                f"the candidate has {len(candidate.joint_names)} joints, the "
+                f"shaken one {len(self.seated_q_hand)}: not the candidate shaken"
+            )
+        return replace(
+            candidate,
+            q_hand=np.array(self.seated_q_hand, dtype=float),
+            X_WO=RigidTransform(np.asarray(self.seated_X_WO, dtype=float)),
+        )
 
     @property
     def squeeze_unit(self) -> str:

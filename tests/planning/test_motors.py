@@ -164,6 +164,43 @@ def test_torque_needed_predicts_the_shake_test(allegro_on_soup):
     assert not shake_test(scene.add_models, heavy, squeeze=0.5, **SHAKE).held
 
 
+def test_the_seated_grasp_is_analysed_as_drake_left_it(allegro_on_soup):
+    # A helper's review: a state read off the shake test's simulation was
+    # refused (joint_13 5e-6 rad past its limit, against a tolerance of
+    # 1e-8), and the seated pose had to be fished out of a private function.
+    scene, closed, weight, result = allegro_on_soup
+    light = next(
+        c
+        for c in closed[:20]
+        if torque_needed(scene.plant, scene.context, c, scene.object_body,
+                         weight=weight) < 0.35
+    )  # fmt: skip
+    shaken = shake_test(scene.add_models, light, squeeze=0.5, **SHAKE)
+    assert shaken.held_from_seat
+    seated = shaken.seated(light)
+    assert len(seated.q_hand) == len(light.q_hand)
+    moved = np.linalg.norm(
+        seated.X_WO.translation() - light.X_WO.translation()
+    )  # fmt: skip
+    assert moved == pytest.approx(shaken.seat_displacement, abs=1e-9)
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    before = scene.plant.GetPositions(ctx).copy()
+    seated.apply(scene.plant, ctx, object_body=scene.object_body)
+    try:
+        report = dg.analyze_grasp(
+            scene.plant, ctx, scene.object_body, hand=scene.hand, mu=1.0,
+            load="gravity", torque_limits="plant",
+        )  # fmt: skip
+        assert report.pose.valid, str(report.pose)
+        assert report.load.holds, str(report.load)  # as Drake held it
+    finally:
+        scene.plant.SetPositions(ctx, before)
+    with pytest.raises(dg.InvalidOptionError, match="seat=0"):
+        shake_test(scene.add_models, light, squeeze=0.5, seat=0.0, **SHAKE).seated(
+            light
+        )
+
+
 def test_a_weight_the_actuators_cannot_hold_is_said(allegro_on_soup):
     scene, closed, weight, result = allegro_on_soup
     assert result.reason == ""  # the can holds at 0.7 N·m

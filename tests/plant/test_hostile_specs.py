@@ -76,7 +76,7 @@ def test_distance_tolerance_must_be_a_real_number(scene, tol):
         _close(scene, distance_tolerance=tol)
 
 
-@pytest.mark.parametrize("q", [[0.05, 0.03], [0.03, 0.0426], [0.0576, 0.034]])
+@pytest.mark.parametrize("q", [[0.05, 0.03], [0.03, 0.043], [0.0576, 0.034]])
 def test_a_pre_shape_beyond_the_joint_limits_is_refused(scene, q):
     # It was accepted, and a finger that did not move (max_iterations=1, or a
     # direction that left it) was returned beyond its limit.

@@ -96,6 +96,21 @@ def test_joint_limits_are_refused(real_hands):
     assert report_ok.pose is None or report_ok.pose.joint_limit_violations == ()
 
 
+def test_a_simulated_overshoot_of_a_limit_is_no_violation(real_hands):
+    # Drake holds a joint at its limit with a stiff constraint: a state read
+    # off a simulation overshoots it a little (the Allegro hand's joint_13 by
+    # 5e-6 rad in the shake test), which is not an impossible pose
+    from drakegrasp.plant.pose import JOINT_LIMIT_TOL, joint_limit_violations
+
+    scene = real_hands.wsg()
+    bodies = [scene.plant.get_body(i) for i in scene.plant.GetBodyIndices(scene.hand)]
+    for past, refused in [(5e-6, False), (0.5 * JOINT_LIMIT_TOL, False),
+                          (2 * JOINT_LIMIT_TOL, True), (1e-2, True)]:  # fmt: skip
+        scene.set_hand([-0.055 - past, 0.055])
+        found = joint_limit_violations(scene.plant, scene.ctx, bodies)
+        assert bool(found) is refused, (past, found)
+
+
 def test_valid_pose_is_reported_valid(real_hands):
     scene = real_hands.wsg()
     close_hand(scene.plant, scene.ctx, scene.object, hand=scene.hand)
