@@ -56,6 +56,7 @@ from drakegrasp.planning.placement import axis_frames
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import HandStructure, hand_structure, tip_bodies
+from drakegrasp.plant.pose import JOINT_LIMIT_TOL
 from drakegrasp.plant.validation import HandSpec, hand_bodies
 
 __all__ = ["MultiFingerHand", "multi_finger_hand", "sample_approaches"]
@@ -139,6 +140,24 @@ class MultiFingerHand:
             "palm_depth": self.palm_depth,
             "standoff": self.standoff.tolist(),
         }
+
+
+def _check_preshape_limits(q: np.ndarray, structure) -> None:
+    """Refuse a given pre-shape that leaves a joint's limits.
+
+    By more than :data:`~drakegrasp.plant.pose.JOINT_LIMIT_TOL`, naming the
+    joint (it was clipped silently, and a pre-shape all beyond its limits was
+    rejected sample by sample as colliding fingers).
+    """
+    lo, hi = np.asarray(structure.lower), np.asarray(structure.upper)
+    out = np.flatnonzero((q < lo - JOINT_LIMIT_TOL) | (q > hi + JOINT_LIMIT_TOL))
+    if out.size:
+        k = int(out[0])
+        raise InvalidOptionError(
+            f"preshape[{k}] ({structure.names[k]}) = {q[k]:g} is outside the "
+            f"joint's limits [{lo[k]:g}, {hi[k]:g}]"
+            + ("" if out.size == 1 else f", and {out.size - 1} more joints are")
+        )
 
 
 def _vector(name, value, n) -> np.ndarray:
@@ -260,9 +279,11 @@ def multi_finger_hand(
     n = len(structure.names)
     if preshape is None:
         q0 = plant.GetPositions(plant_context)[structure.position_indices]
+        q0 = structure.coupling.apply(q0)
     else:
-        q0 = _vector("preshape", preshape, n)
-    q0 = np.clip(structure.coupling.apply(q0), structure.lower, structure.upper)
+        q0 = structure.coupling.apply(_vector("preshape", preshape, n))
+        _check_preshape_limits(q0, structure)  # as --preshape does
+    q0 = np.clip(q0, structure.lower, structure.upper)
     curl_synergy = isinstance(synergy, str)
     if curl_synergy and synergy != "curl":
         raise InvalidOptionError(

@@ -289,7 +289,7 @@ class GraspCandidate:
         else:
             holds = f"holds {self.weight_capacity:.3f} N/N"
             if not np.isnan(self.squeeze_needed):  # NaN: the weight is unknown
-                holds += f" (squeeze {self.squeeze_needed:.1f} N)"
+                holds += f" (squeeze {self.squeeze_needed:.1f} N per finger)"
         return (
             f"sample {self.sample}: "
             f"{'force closure' if self.is_closure else 'no closure'}"

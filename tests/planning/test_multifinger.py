@@ -194,6 +194,17 @@ def test_synergy_moves_the_preshape_within_the_limits():
     assert curl.settings["hand"]["synergy"] is not None
 
 
+def test_a_preshape_beyond_the_joint_limits_is_refused_naming_the_joint():
+    # it was clipped silently (and one all beyond its limits planned 0
+    # candidates, "fingers collide with each other"); --preshape refused it
+    scene = three_scene()
+    q = list(THREE_OPEN)
+    q[4] = 5.0
+    with pytest.raises(InvalidOptionError, match=r"preshape\[4\] .* = 5 is outside"):
+        plan(scene, n=2, preshape=q)
+    assert len(plan(scene, n=2, preshape=THREE_OPEN).settings) > 0  # within
+
+
 def test_weight_capacity_with_one_group_per_finger_matches_the_primal_lp():
     # four fingers and a palm (label 4): the batch dual against the Drake LP
     rng = np.random.default_rng(0)
