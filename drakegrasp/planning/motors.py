@@ -237,26 +237,56 @@ def torque_capacity(
     ``Σ β(u)`` maximises each): the contact forces are the cones' generators
     ``f = S λ``, ``λ >= 0`` (eight per Coulomb cone, the default of the
     verdicts), and :data:`BETA_CAP` keeps it bounded.
+
+    A contact that no finger joint moves (its rows of ``J`` zero: the palm)
+    is passive, as in :func:`~drakegrasp.planning.weight.weight_capacity`
+    (``palm=``): it pushes only as hard as the load and the fingers' normal
+    forces press the object into it, or not at all, whichever holds more;
+    the friction of a finger cannot buy it a push.
     """
     u = checked_directions("directions", directions)
     J = finger_jacobian(plant, plant_context, candidate, object_body)
     grasp = candidate.grasp
-    S = block_diag(
-        *(
-            friction_cone_generators(
-                c,
-                DEFAULT_NUM_GENERATORS,
-                characteristic_length=grasp.characteristic_length,
-            )  # fmt: skip
-            for c in grasp.contacts
+    blocks = [
+        friction_cone_generators(
+            c, DEFAULT_NUM_GENERATORS, characteristic_length=grasp.characteristic_length
         )
-    )
+        for c in grasp.contacts
+    ]
+    S = block_diag(*blocks)
     GS, TS = grasp_matrix(grasp) @ S, J.T @ S
-    D, n = len(u), S.shape[1]
+    slices = grasp.component_slices()
+    palm = np.array([not np.any(J[sl]) for sl in slices])
+    if not palm.any():
+        b = _torque_lp(GS, TS, u)
+    else:
+        # each generator's contact and normal force
+        owner = np.repeat(np.arange(len(blocks)), [b.shape[1] for b in blocks])
+        normal = S[grasp.normal_indices()].sum(axis=0)  # (n,)
+        n_O = grasp.normals  # (N, 3)
+        into = -(n_O @ n_O[palm].T)  # (N, P): contact j's push into palm contact i
+        share = np.where(palm, 1.0, -into.max(axis=1))  # (N,)
+        row = normal * share[owner]
+        c = (-(u @ n_O[palm].T)).max(axis=1)  # (D,)
+        idle = palm[owner]
+        b = np.maximum(
+            _torque_lp(GS, TS, u, idle=idle), _torque_lp(GS, TS, u, row=(row, c))
+        )
+    return np.where(b >= BETA_CAP * (1 - 1e-6), np.inf, b)
+
+
+def _torque_lp(GS, TS, u, *, idle=None, row=None) -> np.ndarray:
+    """``β`` per direction of :func:`torque_capacity`'s program (clipped at 0).
+
+    ``idle``: generators held at zero (the palm's); ``row``: ``(a, c)`` adds
+    ``a·λ <= c_k β_k`` to direction ``k``'s block (the passive palm's row).
+    """
+    D, n = len(u), GS.shape[1]
     prog = MathematicalProgram()
     lam = prog.NewContinuousVariables(n, D, "lambda")
     beta = prog.NewContinuousVariables(D, "beta")
-    prog.AddBoundingBoxConstraint(0.0, np.inf, lam.reshape(-1))
+    upper = np.full(n, np.inf) if idle is None else np.where(idle, 0.0, np.inf)
+    prog.AddBoundingBoxConstraint(np.zeros(n * D), np.repeat(upper, D), lam.reshape(-1))
     prog.AddBoundingBoxConstraint(0.0, BETA_CAP, beta)
     ones = np.ones(len(TS))
     for k in range(D):
@@ -265,12 +295,17 @@ def torque_capacity(
             np.hstack([GS, load[:, None]]), np.zeros(6), np.append(lam[:, k], beta[k])
         )
         prog.AddLinearConstraint(TS, -ones, ones, lam[:, k])
+        if row is not None:
+            a, c = row
+            prog.AddLinearConstraint(
+                np.append(a, -c[k])[None], [-np.inf], [0.0],
+                np.append(lam[:, k], beta[k]),
+            )  # fmt: skip
     prog.AddLinearCost(-np.ones(D), 0.0, beta)
     result = require_solution(
         prog, solve(prog, "lp", retry=True), "the torque-capacity LP"
     )
-    b = np.clip(result.GetSolution(beta), 0.0, None)
-    return np.where(b >= BETA_CAP * (1 - 1e-6), np.inf, b)
+    return np.clip(result.GetSolution(beta), 0.0, None)
 
 
 def torque_needed(

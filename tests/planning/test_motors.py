@@ -164,6 +164,80 @@ def test_torque_needed_predicts_the_shake_test(allegro_on_soup):
     assert not shake_test(scene.add_models, heavy, squeeze=0.5, **SHAKE).held
 
 
+def _with_palm_contact(scene, candidate):
+    """``candidate`` plus a contact of the palm (hand_root) on the object's
+    surface point nearest the palm, its normal pointing from the palm."""
+    plant = scene.plant
+    ctx = plant.GetMyContextFromRoot(scene.context)
+    saved = plant.GetPositions(ctx).copy()
+    try:
+        candidate.apply(plant, ctx, object_body=scene.object_body)
+        palm = plant.GetBodyByName("hand_root")
+        X_WO = candidate.X_WO
+        p_OP = X_WO.inverse().multiply(
+            plant.EvalBodyPoseInWorld(ctx, palm).translation()
+        )
+        centre = np.asarray(candidate.reference_point)
+        n_O = (centre - p_OP) / np.linalg.norm(centre - p_OP)
+        p_OC = centre - 0.03 * n_O  # on the can's side, facing the palm
+        X_WF = plant.EvalBodyPoseInWorld(ctx, palm)
+        p_FC = X_WF.inverse().multiply(X_WO.multiply(p_OC))
+    finally:
+        plant.SetPositions(ctx, saved)
+    first = candidate.contacts[0]
+    contact = dataclasses.replace(
+        first, p_OC=p_OC, nhat_O=n_O, p_FC=p_FC,
+        finger_body=plant.GetModelInstanceName(palm.model_instance()) + "::hand_root",
+        finger_body_index=palm.index(),
+    )  # fmt: skip
+    return dataclasses.replace(candidate, contacts=(*candidate.contacts, contact))
+
+
+def test_a_palm_contact_is_passive_in_the_torque_capacity(allegro_on_soup):
+    # A helper's review: the torque LP let a palm contact (rows of J zero)
+    # push with any force, so finger friction could buy its push, as the
+    # weight capacity's palm did before it was made passive
+    scene, closed, weight, result = allegro_on_soup
+    c = closed[0]
+    with_palm = _with_palm_contact(scene, c)
+    J = finger_jacobian(scene.plant, scene.context, with_palm, scene.object_body)
+    assert not np.any(J[-3:])  # the palm: no finger joint moves it
+    alone = torque_capacity(scene.plant, scene.context, c, scene.object_body)
+    passive = torque_capacity(
+        scene.plant, scene.context, with_palm, scene.object_body
+    )  # fmt: skip
+    # a free palm, solved here: the generators' LP without the palm's row
+    grasp = with_palm.grasp
+    S = np.hstack(
+        [
+            np.vstack([np.zeros((3 * i, 8)), friction_cone_generators(k, 8),
+                       np.zeros((3 * (grasp.num_contacts - i - 1), 8))])
+            for i, k in enumerate(grasp.contacts)
+        ]
+    )  # fmt: skip
+    G = dg.grasp_matrix(grasp)
+    free = []
+    for u in WEIGHT_DIRECTIONS:
+        n = S.shape[1]
+        res = linprog(
+            np.r_[np.zeros(n), -1.0],
+            A_ub=np.vstack([np.c_[J.T @ S, np.zeros(len(J.T))],
+                            np.c_[-J.T @ S, np.zeros(len(J.T))]]),
+            b_ub=np.ones(2 * len(J.T)),
+            A_eq=np.c_[G @ S, np.r_[u, 0, 0, 0]], b_eq=np.zeros(6),
+            bounds=[(0, None)] * n + [(0, 1e6)], method="highs",
+        )  # fmt: skip
+        free.append(-res.fun)
+    free = np.minimum(free, 1e6)
+    assert np.all(passive >= alone * (1 - 1e-6) - 1e-9)  # idle is allowed
+    assert np.all(np.minimum(passive, 1e6) <= free * (1 + 1e-6) + 1e-9)
+    # where the weight pulls the object off the palm, the palm adds nothing
+    n_palm = with_palm.contacts[-1].nhat_O
+    away = [k for k, u in enumerate(WEIGHT_DIRECTIONS) if u @ n_palm > 0.5]
+    assert away and passive[away] == pytest.approx(alone[away], rel=1e-5)
+    assert np.any(free[away] > alone[away] * 1.01)  # what the free palm bought
+
+
 def test_the_seated_grasp_is_analysed_as_drake_left_it(allegro_on_soup):
     # A helper's review: a state read off the shake test's simulation was
     # refused (joint_13 5e-6 rad past its limit, against a tolerance of
