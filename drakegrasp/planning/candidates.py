@@ -473,6 +473,13 @@ class GraspCandidates(Sequence):
                 f"(noise {fit['noise'] * 1e3:.3g} mm, about "
                 f"{fit['error_deg']:.2g} deg off)"
             )
+        first = self.settings.get("held_first")
+        if first and first["held"] and self:  # none held: the reason says so
+            lines.append(
+                f"  ranked first: the {first['held']} with {first['needed']} <= "
+                f"{first['limit']:g} {first['unit']} ({first['source']}), then the "
+                "rest, each in score order"
+            )
         if self.reason:
             lines.append(f"  {self.reason}" if self else f"  empty: {self.reason}")
         for reason, n in sorted(self.rejections.items(), key=lambda kv: -kv[1]):

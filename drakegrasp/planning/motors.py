@@ -411,14 +411,44 @@ def with_torques_needed(
     if applied:
         limit = torque_limit
     reason = result.reason or _too_weak(head, limit, applied)
+    settings = result.settings
     if motors_first:
         ranked = _held_first(ranked, "torque_needed", limit, top)
+        settings = _with_held_first(
+            settings, ranked, "torque_needed", limit, "N·m", applied, torque_limit
+        )
     return dataclasses.replace(
         result,
         candidates=tuple(ranked),
         reason=reason,
         time=time.perf_counter() - started,
+        settings=settings,
     )
+
+
+def _with_held_first(settings, ranked, needed, limit, unit, applied, given) -> dict:
+    """``settings`` with ``"held_first"``: the limit the ranking put first.
+
+    ``{"needed", "limit", "unit", "source", "held"}``: the figure compared,
+    the limit it was compared with, whose limit it is ("effort limit", or the
+    user's value, noting a cap), and how many candidates are within it.
+    Nothing is added when no finite limit is known.
+    """
+    if not math.isfinite(limit):
+        return settings
+    if applied:
+        source = f"{needed.replace('_needed', '_limit')} given"
+    elif given is not None:
+        source = (
+            f"effort limit ({needed.replace('_needed', '_limit')} {given:g} "
+            "capped at it)"
+        )
+    else:
+        source = "effort limit"
+    held = sum(1 for c in ranked if getattr(c, needed) <= limit)
+    entry = dict(needed=needed, limit=float(limit), unit=unit, source=source,
+                 held=held)  # fmt: skip
+    return {**settings, "held_first": entry}
 
 
 def with_squeeze_limit(
@@ -470,11 +500,16 @@ def with_squeeze_limit(
     if applied:
         limit = squeeze_limit
     reason = result.reason or _too_weak_jaw(ranked, limit, applied)
+    ranked = _held_first(ranked, "squeeze_needed", limit, top)
     return dataclasses.replace(
         result,
-        candidates=tuple(_held_first(ranked, "squeeze_needed", limit, top)),
+        candidates=tuple(ranked),
         reason=reason,
-    )
+        settings=_with_held_first(
+            result.settings, ranked, "squeeze_needed", limit, "N per finger",
+            applied, squeeze_limit,
+        ),
+    )  # fmt: skip
 
 
 def _held_first(ranked: list, needed: str, limit: float, top: int) -> list:
@@ -581,6 +616,11 @@ def _none_held(needed: list, limit: float, who: str, best: str, unit: str) -> st
     """The sentence saying that none of ``needed`` is within ``limit``, or ""."""
     if not needed or min(needed) <= limit:
         return ""
+    if len(needed) == 1:
+        return (
+            f"{who} not the one {best}force-closure candidate against the "
+            f"object's weight in every direction: it needs {needed[0]:.3g} {unit}"
+        )
     return (
         f"{who} none of the {len(needed)} {best}force-closure candidates against "
         f"the object's weight in every direction: they need at least "

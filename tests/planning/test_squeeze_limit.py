@@ -96,6 +96,21 @@ def test_plan_grasps_takes_squeeze_limit(rounded_on_box):
         squeeze_limit=least / 2, **SOFT,
     )  # fmt: skip
     assert f"the jaw at squeeze_limit {least / 2:.3g} N holds none" in weak.reason
+    # the summary says which limit ranked the candidates, and how many hold
+    first = limited.settings["held_first"]
+    held = sum(c.squeeze_needed <= limit for c in limited)
+    assert first == dict(needed="squeeze_needed", limit=limit, unit="N per finger",
+                         source="squeeze_limit given", held=held)  # fmt: skip
+    assert f"ranked first: the {held} with squeeze_needed <= {limit:g} N" in str(
+        limited
+    )
+    assert result.settings["held_first"]["source"] == "effort limit"
+    assert "ranked first" not in str(weak)  # none held: the reason says it
+    capped = with_squeeze_limit(result, scene.plant, top=10, squeeze_limit=1e6)
+    assert capped.settings["held_first"]["source"] == (
+        "effort limit (squeeze_limit 1e+06 capped at it)"
+    )
+    assert capped.settings["held_first"]["limit"] == 140.0
 
 
 @pytest.mark.parametrize(
