@@ -172,21 +172,25 @@ class ShakenCandidates(Sequence):
         n_held = sum(s.held for s in self.shaken)
         modulus = self.options.get("hydroelastic_modulus")
         fingers = "" if modulus is None else f"hydroelastic fingers, {modulus:g} Pa; "
-        capped = [
-            s.result
-            for s in self.shaken
-            if s.result is not None and s.result.squeeze_capped
-        ]
-        capped = (
-            f"squeeze {self.options['squeeze']:g} capped at the effort limit: "
-            f"{min(min(r.squeeze_caps) for r in capped):g} "
-            f"{capped[0].squeeze_unit}; "
-            if capped
-            else ""
+        results = [s.result for s in self.shaken if s.result is not None]
+        capped = [r for r in results if r.squeeze_capped]
+        unit = f" {results[0].squeeze_unit}" if results else ""
+        squeeze = self.options.get("squeeze")
+        squeeze = "" if squeeze is None else f"squeeze {squeeze:g}{unit}"
+        if capped:
+            squeeze += (
+                f" capped at the effort limit: "
+                f"{min(min(r.squeeze_caps) for r in capped):g}{unit}"
+            )
+        gains = ", ".join(
+            f"{name} {self.options[name]:g}"
+            for name in ("stiffness", "damping")
+            if self.options.get(name) is not None
         )
+        used = "".join(f"{x}; " for x in (squeeze, gains) if x)
         lines = [
             f"{n_held} of {len(self)} shaken candidates held (counted from the "
-            f"{self.held_from}; {capped}{fingers}{self.wall_time:.1f} s)"
+            f"{self.held_from}; {used}{fingers}{self.wall_time:.1f} s)"
         ]
         lines += [f"  {s}" for s in self.shaken]
         return "\n".join(lines)

@@ -179,7 +179,7 @@ def test_shaken_candidates_name_a_capped_squeeze():
         num_candidates=20, mu=1.0, seed=3, robustness_samples=4,
     )  # fmt: skip
     ranked = shake_candidates(scene.add_models, result, top=1, squeeze=300.0, **SHORT)
-    assert "squeeze 300 capped at the effort limit: 140 N;" in str(ranked)
+    assert "squeeze 300 N capped at the effort limit: 140 N;" in str(ranked)
     ranked = shake_candidates(scene.add_models, result, top=1, squeeze=5.0, **SHORT)
     assert "capped" not in str(ranked)
 
