@@ -593,6 +593,8 @@ def solve_load(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResul
     themselves and "violated" a cone by all of their size).
     """
     if objective != "max_margin" and not np.any(w):
+        if objective == "min_torque" and P.hand_jacobian is None:
+            _build(P, w, objective)  # refuses it, as for any other load
         return _zero_forces(P, w, objective)
     free = _without_far_limits(P, w, objective)
     if free is not None:

@@ -281,8 +281,9 @@ def multi_finger_hand(
         q0 = plant.GetPositions(plant_context)[structure.position_indices]
         q0 = structure.coupling.apply(q0)
     else:
-        q0 = structure.coupling.apply(_vector("preshape", preshape, n))
-        _check_preshape_limits(q0, structure)  # as --preshape does
+        given = _vector("preshape", preshape, n)
+        _check_preshape_limits(given, structure)  # the values given, as --preshape
+        q0 = structure.coupling.apply(given)
     q0 = np.clip(q0, structure.lower, structure.upper)
     curl_synergy = isinstance(synergy, str)
     if curl_synergy and synergy != "curl":

@@ -475,10 +475,11 @@ class GraspCandidates(Sequence):
             )
         first = self.settings.get("held_first")
         if first and first["held"] and self:  # none held: the reason says so
+            rest = ", then the rest, each" if first["held"] < len(self) else ","
             lines.append(
                 f"  ranked first: the {first['held']} with {first['needed']} <= "
-                f"{first['limit']:g} {first['unit']} ({first['source']}), then the "
-                "rest, each in score order"
+                f"{first['limit']:g} {first['unit']} ({first['source']}){rest} in "
+                "score order"
             )
         if self.reason:
             lines.append(f"  {self.reason}" if self else f"  empty: {self.reason}")

@@ -83,7 +83,7 @@ from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.checks import checked_directions
-from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
+from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.jacobians import contact_rows, hand_jacobian
 from drakegrasp.plant.validation import (
@@ -263,23 +263,24 @@ def torque_capacity(
         # each generator's contact and normal force
         owner = np.repeat(np.arange(len(blocks)), [b.shape[1] for b in blocks])
         normal = S[grasp.normal_indices()].sum(axis=0)  # (n,)
-        n_O = grasp.normals  # (N, 3)
-        into = -(n_O @ n_O[palm].T)  # (N, P): contact j's push into palm contact i
-        share = np.where(palm, 1.0, -into.max(axis=1))  # (N,)
-        row = normal * share[owner]
-        c = (-(u @ n_O[palm].T)).max(axis=1)  # (D,)
-        idle = palm[owner]
-        b = np.maximum(
-            _torque_lp(GS, TS, u, idle=idle), _torque_lp(GS, TS, u, row=(row, c))
-        )
+        # one row per distinct palm normal e (a face), for the faces that
+        # carry force: Σ_j (n_j·e) f_n,j + β (u·e) <= 0; the best over them
+        a, c, face, _ = palm_rows(grasp.normals[None], palm[None].astype(int), 1, 1, u)
+        per_generator = face[0][owner]
+        b = np.zeros(len(u))
+        for active in palm_faces(a.shape[1]):
+            idle = (per_generator >= 0) & ~np.isin(per_generator, active)
+            row = (a[0][active][:, owner] * normal, c[0][active]) if active else None
+            b = np.maximum(b, _torque_lp(GS, TS, u, idle=idle, row=row))
     return np.where(b >= BETA_CAP * (1 - 1e-6), np.inf, b)
 
 
 def _torque_lp(GS, TS, u, *, idle=None, row=None) -> np.ndarray:
     """``β`` per direction of :func:`torque_capacity`'s program (clipped at 0).
 
-    ``idle``: generators held at zero (the palm's); ``row``: ``(a, c)`` adds
-    ``a·λ <= c_k β_k`` to direction ``k``'s block (the passive palm's row).
+    ``idle``: generators held at zero (the palm's); ``row``: ``(a, c)``
+    ((R, n), (R, D)) adds ``a_r·λ <= c_rk β_k`` to direction ``k``'s block
+    (the passive palm's rows).
     """
     D, n = len(u), GS.shape[1]
     prog = MathematicalProgram()
@@ -298,8 +299,8 @@ def _torque_lp(GS, TS, u, *, idle=None, row=None) -> np.ndarray:
         if row is not None:
             a, c = row
             prog.AddLinearConstraint(
-                np.append(a, -c[k])[None], [-np.inf], [0.0],
-                np.append(lam[:, k], beta[k]),
+                np.hstack([a, -c[:, k : k + 1]]), np.full(len(a), -np.inf),
+                np.zeros(len(a)), np.append(lam[:, k], beta[k]),
             )  # fmt: skip
     prog.AddLinearCost(-np.ones(D), 0.0, beta)
     result = require_solution(

@@ -99,6 +99,19 @@ def _speed(plant, context, body) -> float:
     return float(np.linalg.norm(V.translational()))
 
 
+def _within_limits(joint, q: np.ndarray) -> float:
+    """A one-dof joint's value in ``q``, clipped to its limits.
+
+    Drake holds a joint at its limit with a stiff constraint and the state
+    overshoots it a little; the seated pose is for an analysis, which
+    refuses a joint beyond its limit.
+    """
+    value = float(q[joint.position_start()])
+    low = float(joint.position_lower_limits()[0])
+    high = float(joint.position_upper_limits()[0])
+    return min(max(value, low), high)
+
+
 def _angle(R: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)))
 
@@ -495,10 +508,8 @@ def shake_test(
         X_HO_seat = plant.CalcRelativeTransform(ctx, H, body.body_frame())
         max_ds = max_rs = 0.0
         q_now = plant.GetPositions(ctx)
-        seated_q = tuple(
-            float(q_now[find_joint(plant, name).position_start()])
-            for name in candidate.joint_names
-        )
+        seated_q = tuple(_within_limits(find_joint(plant, name), q_now)
+                         for name in candidate.joint_names)  # fmt: skip
         seated_X_WO = plant.EvalBodyPoseInWorld(ctx, body).GetAsMatrix4()
     else:
         advance(settle)  # efforts are read once something has been simulated

@@ -90,7 +90,8 @@ class ShakeResult:
         line names the cap).  Empty in a record made before it existed.
     seated_q_hand : (n_h,) float
         The candidate's joints (``joint_names``, its order) where seating
-        left them, rad or m; empty with ``seat=0``.
+        left them, rad or m, clipped to their limits (Drake overshoots a limit
+        by a little); empty with ``seat=0``.
     seated_X_WO : (4, 4) float or None
         The object's pose where seating left it, in the world the candidate
         was planned in (its hand base welded at ``X_WH``); None with
@@ -188,11 +189,11 @@ class ShakeResult:
         return jsonable(dict(vars(self), held_from_seat=self.held_from_seat))
 
     def __str__(self) -> str:
-        """One line, led by the verdict the planner ranks by (``held_from_seat``).
+        """One line, led by ``held_from_seat`` ("held from the seat").
 
         With seating, the motion from the seat comes first and the motion from
-        the plan's pose after it, so the headline never says "dropped" for a
-        grasp that ``shake_candidates`` lists as held.
+        the plan's pose after it (``held``, which ``shake_candidates(
+        held_from="plan")`` ranks by, counts from there).
         """
         bounds = (
             f"(bounds {self.bounds[0] * 1e3:g} mm, {np.degrees(self.bounds[1]):g} deg)"
@@ -217,8 +218,11 @@ class ShakeResult:
                 tail = f"; from the plan's pose at most {plan}" + (
                     "" if self.held else ", beyond the bounds"
                 )
+        verdict = "held" if self.held_from_seat else "dropped"
+        if not np.isnan(self.max_displacement_from_seat):
+            verdict += " from the seat"  # not `held`, which counts from the plan
         return (
-            f"{'held' if self.held_from_seat else 'dropped'}: {motion}"
+            f"{verdict}: {motion}"
             f" over {self.duration:g} s, squeeze {self.squeeze:g} {self.squeeze_unit}"
             + (
                 f" (capped at the effort limit: {min(self.squeeze_caps):g} "

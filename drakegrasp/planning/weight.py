@@ -32,25 +32,32 @@ something presses the object into it: the load, or a finger's normal force.
 Friction does not count: a finger's friction may pull the object into the
 palm in the LP, but nothing sets that pull in a real hand (it is a passive
 internal force, as the hand's Jacobian would show), and the palm's friction
-that such a pull would buy is not there.  So either the palm carries nothing
-(its wrenches left out), or, over the palm's contacts ``i``,
+that such a pull would buy is not there.  So along each distinct normal
+``e`` of the palm's contacts (a face) that carries force, the contacts'
+normal forces and the weight together press the object into that face,
+friction aside:
 
 .. math::
 
-    \sum_{i \in \text{palm}} \sum_k \lambda_{ik}
-    \le \alpha \max_i (-u \cdot n_i)
-    + \sum_{j \notin \text{palm}} \max_i (-n_j \cdot n_i) \sum_k \lambda_{jk}
+    \sum_{j} (n_j \cdot e) \sum_k \lambda_{jk} + \alpha\, (u \cdot e) \le 0
 
-(signed: a finger that pushes the object off the palm takes from what it may
-carry); ``α`` is the better of the two LPs.  The palm keeps its squeeze
-bound too, so no capacity rises and each stays finite.  For a parallel jaw,
-whose squeeze is across the palm's normal, the palm then holds only the
-weight's share that presses into it.  Without it the LP had Drake's Franka
-hand hold the cracker box by its palm at 11.8 N a finger, and the WSG-50 two
-hex-prism grasps at 1.19 N and 1.49 N; in Drake they drop at 20 N and at 1.1
-times those.  The model is conservative where the palm is a lever's stop
-(the load's *moment* turning the object into the palm, as on a handle held
-at one end): that reaction is not counted.
+(``j`` over every contact, palm and fingers: for a flat palm, the palm's
+normal forces are at most the weight's share into it plus the fingers'
+signed pushes into it; a V-shaped palm gets one row per face, so a ball
+resting in the V bears on both faces as it does; two faces that oppose each
+other exactly, a slot's walls, take nothing from each other's rows, so they
+squeeze nothing between them).  A face's row holds only while that face
+carries force, so ``α`` is the best over the sets of faces that carry it
+(:func:`palm_faces`; the empty set: the palm idle).  The
+palm keeps its squeeze bound too, so no capacity rises and each stays
+finite.  For a
+parallel jaw, whose squeeze is across the palm's normal, the palm then holds
+only the weight's share that presses into it.  Without it the LP had Drake's
+Franka hand hold the cracker box by its palm at 11.8 N a finger, and the
+WSG-50 two hex-prism grasps at 1.19 N and 1.49 N; in Drake they drop at
+20 N and at 1.1 times those.  The model is conservative where the palm is a
+lever's stop (the load's *moment* turning the object into the palm, as on a
+handle held at one end): that reaction is not counted.
 
 The LPs of all grasps and directions are solved at once by the batch engine's
 exact active-set method (its interior-point method where that cannot certify),
@@ -74,7 +81,7 @@ from drakegrasp.batch.lp.ipm import solve_max_last, solve_max_last_active
 from drakegrasp.batch.run.workers import check_workers, map_ordered, resolve_workers
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import check_num_generators, unit_vectors
+from drakegrasp.core.validation import check_num_generators, real_array, unit_vectors
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.checks import (
     checked_contacts,
@@ -87,11 +94,13 @@ from drakegrasp.planning.checks import (
 )
 
 __all__ = [
+    "MAX_PALM_FACES",
     "WEIGHT_CHUNK",
     "WEIGHT_DIRECTIONS",
     "build_weight_capacity_program",
     "centre_of_mass",
     "num_groups",
+    "palm_faces",
     "palm_rows",
     "weight_capacity",
 ]
@@ -164,9 +173,10 @@ def build_weight_capacity_program(
         its palm F).  Each label is one group with its own bound.
     directions : (D, 3) float
         Unit weight directions, frame O.
-    passive : ((M,) float, (D,) float), optional
-        The passive palm's row ``(a, c)`` of :func:`palm_rows` for this grasp:
-        ``a·λ <= c_d α`` in each direction's block.  None: no palm row.
+    passive : ((R, M) float, (R, D) float), optional
+        The passive palm's rows ``(a, c)`` of :func:`palm_rows` for this
+        grasp: ``a_r·λ <= c_rd α`` in direction ``d``'s block.  None: no palm
+        rows.
 
     Returns
     -------
@@ -174,20 +184,48 @@ def build_weight_capacity_program(
     alpha : (D,) array of Variable
         ``α`` of each direction.
     """
-    prog, alpha, _ = _program(W, groups, directions, passive=passive)
+    W = real_array("W", W, error=InvalidOptionError)
+    groups = real_array("groups", groups, error=InvalidOptionError)
+    directions = checked_directions("directions", directions)
+    if W.ndim != 2 or W.shape[1] != 6 or groups.shape != (len(W),):
+        raise InvalidOptionError(
+            f"W must be (M, 6) and groups (M,), got {W.shape} and {groups.shape}"
+        )
+    if not np.all(np.isfinite(W)):
+        raise InvalidOptionError("W must be finite")
+    if passive is not None:
+        passive = _checked_passive(passive, len(W), len(directions))
+    prog, alpha, _ = _program(W, groups.astype(int), directions, passive=passive)
     return prog, alpha
+
+
+def _checked_passive(passive, M: int, D: int):
+    """``(a, c)``: (R, M) and (R, D) finite arrays, else InvalidOptionError."""
+    try:
+        a, c = passive
+    except (TypeError, ValueError):
+        raise InvalidOptionError(
+            f"passive must be a pair (a, c) of palm_rows, got {type(passive).__name__}"
+        ) from None
+    a = real_array("passive's a", a, error=InvalidOptionError)
+    c = real_array("passive's c", c, error=InvalidOptionError)
+    if a.ndim != 2 or a.shape[1] != M or c.shape != (len(a), D):
+        raise InvalidOptionError(
+            f"passive must be (a, c) of shapes (R, {M}) and (R, {D}), got "
+            f"{a.shape} and {c.shape}"
+        )
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(c))):
+        raise InvalidOptionError("passive's a and c must be finite")
+    return a, c
 
 
 def palm_rows(
     normals: np.ndarray, fingers: np.ndarray, palm: int, per: int, directions
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The passive palm's row of each grasp's LPs (see the module's note).
+    """The passive palm's rows of each grasp's LPs (see the module's note).
 
-    ``a·λ <= c α``: the palm's normal forces sum to at most what presses the
-    object into the palm, friction aside: the load's share
-    ``max_i(-u·n_i)`` and each finger contact's ``max_i(-n_j·n_i)`` per
-    newton of its normal force, ``i`` over the palm's contacts (signed: a
-    finger pushing the object off the palm takes from it).
+    One row per distinct normal ``e`` of the palm's contacts:
+    ``Σ_j (n_j·e) f_j + α (u·e) <= 0``, written ``a·λ <= c α``.
 
     Parameters
     ----------
@@ -204,14 +242,19 @@ def palm_rows(
 
     Returns
     -------
-    a : (K, N * per) float
-        Each wrench's coefficient (every wrench has a unit normal force): 1
-        for the palm's, ``-max_i(-n_j·n_i)`` for a finger's.
-    c : (K, D) float
-        ``max_i(-u·n_i)``: the share of a unit weight pressing into the palm.
+    a : (K, R, N * per) float
+        Each wrench's coefficient ``n_j·e`` (every wrench has a unit normal
+        force; 0 for a palm contact facing ``e``'s face exactly), ``R`` the
+        most distinct palm normals of any grasp (a grasp with fewer has rows
+        of zeros, which hold trivially).
+    c : (K, R, D) float
+        ``-u·e``: the share of a unit weight pressing into the palm along
+        ``e``.
+    face : (K, N) int
+        The row (face) of each palm contact, -1 for the others: a face's row
+        holds only while the face carries force (:func:`palm_faces`).
     has : (K,) bool
-        Grasps with a palm contact; the others have no palm row (``a`` and
-        ``c`` zero).
+        Grasps with a palm contact; the others have no row.
     """
     normals = unit_vectors("normals", normals)
     K, N, _ = normals.shape
@@ -223,15 +266,33 @@ def palm_rows(
     directions = checked_directions("directions", directions)
     on = fingers == palm  # (K, N)
     has = on.any(axis=1)
-    # share of contact j's normal force pressing into palm contact i: -n_j·n_i
-    into = -np.einsum("kjx,kix->kji", normals, normals)  # (K, N_j, N_i)
-    share = np.where(on[:, None, :], into, -np.inf).max(axis=2)  # (K, N)
-    a = np.where(on, 1.0, -share)
-    load = -np.einsum("dx,kix->kdi", directions, normals)  # (K, D, N_i)
-    c = np.where(on[:, None, :], load, -np.inf).max(axis=2)  # (K, D)
-    a = np.where(has[:, None], a, 0.0)
-    c = np.where(has[:, None], c, 0.0)
-    return np.repeat(a, per, axis=1), c, has
+    distinct = [_distinct(normals[k][on[k]]) for k in range(K)]
+    R = max((len(f) for f in distinct), default=0)
+    E = np.zeros((K, max(R, 1), 3))
+    for k, f in enumerate(distinct):
+        E[k, : len(f)] = f
+    a = np.einsum("kjx,krx->krj", normals, E)  # (K, R, N)
+    # each palm contact's face: the distinct normal it is (-1: not the palm's)
+    face = np.where(on, np.argmax(a, axis=1), -1)
+    # A palm face exactly opposite e (a slot's other wall) would let the two
+    # walls squeeze the object between them, a preload nothing sets: it
+    # takes nothing from e's row.
+    a = np.where(on[:, None, :] & (a < -1.0 + _OPPOSED), 0.0, a)
+    c = -np.einsum("dx,krx->krd", directions, E)  # (K, R, D)
+    return np.repeat(a, per, axis=2), c, face, has
+
+
+_OPPOSED = 1e-6
+"""Palm normals whose dot product is below ``-1 + _OPPOSED`` face each other."""
+
+
+def _distinct(n: np.ndarray, tol: float = 1e-6) -> np.ndarray:
+    """The rows of ``n`` (unit vectors) that differ by more than ``tol``."""
+    out: list[np.ndarray] = []
+    for v in n:
+        if all(float(v @ w) < 1.0 - tol for w in out):
+            out.append(v)
+    return np.array(out).reshape(-1, 3)
 
 
 def num_groups(groups: np.ndarray) -> int:
@@ -246,8 +307,8 @@ def _memberships(groups: np.ndarray, G: int) -> np.ndarray:
 def _program(W, groups, directions, G=None, passive=None):
     """The program, its α variables and the (equality, bound) bindings per block.
 
-    With ``passive = (a, c)`` each block also gets the palm's row
-    ``a·λ - c_d α <= 0`` (:func:`palm_rows`).
+    With ``passive = (a, c)`` ((R, M), (R, D)) each block also gets the
+    palm's rows ``a_r·λ - c_rd α <= 0`` (:func:`palm_rows`).
     """
     M, w = W.shape
     D = len(directions)
@@ -271,8 +332,9 @@ def _program(W, groups, directions, G=None, passive=None):
         if passive is not None:
             a, c = passive
             prog.AddLinearConstraint(
-                np.r_[a, -c[d]][None], [-np.inf], [0.0], np.r_[lam[d], alpha[d]]
-            )
+                np.hstack([a, -c[:, d : d + 1]]), np.full(len(a), -np.inf),
+                np.zeros(len(a)), np.r_[lam[d], alpha[d]],
+            )  # fmt: skip
     prog.AddBoundingBoxConstraint(0.0, np.inf, lam.ravel())
     prog.AddBoundingBoxConstraint(0.0, np.inf, alpha)
     prog.AddLinearCost(-np.ones(D), 0.0, alpha)
@@ -439,21 +501,40 @@ def _capacity(positions, normals, fingers, *, mu, torque_scale, contact_model,
     run = _batch_capacity if solver == "batch" else _drake_capacity
     if palm is None:
         return run(W, groups, directions)
-    a, c, has = palm_rows(normals, fingers, palm, per, directions)
+    a, c, face, has = palm_rows(normals, fingers, palm, per, directions)
     out = np.empty((K, len(directions)))
     if not np.all(has):  # no palm row: the LPs and numbers of palm=None
         out[~has] = run(W[~has], groups[~has], directions)
     if np.any(has):
-        # Either the palm carries no force (its wrenches left out), or it
-        # carries at most what presses the object into it: the better of the
-        # two LPs (a palm pushed off by the fingers may still be left idle).
-        Wp = W[has]
-        idle = np.where(groups[has][..., None] == palm, 0.0, Wp)
-        out[has] = np.maximum(
-            run(idle, groups[has], directions),
-            run(Wp, groups[has], directions, (a[has], c[has])),
-        )
+        best = np.zeros((int(np.sum(has)), len(directions)))
+        faces = np.repeat(face[has], per, axis=1)  # per wrench
+        for active in palm_faces(a.shape[1]):
+            # the faces outside `active` carry nothing (their wrenches left
+            # out); each active one at most what presses the object into it
+            idle = (faces >= 0) & ~np.isin(faces, active)
+            Wa = np.where(idle[..., None], 0.0, W[has])
+            rows = None if not active else (a[has][:, active], c[has][:, active])
+            best = np.maximum(best, run(Wa, groups[has], directions, rows))
+        out[has] = best
     return out
+
+
+MAX_PALM_FACES = 4
+"""Distinct palm normals whose every subset gets its own LP
+(:func:`palm_faces`); beyond it all of them are taken at once or none."""
+
+
+def palm_faces(R: int) -> list[list[int]]:
+    """The sets of palm faces that may carry force, each one LP.
+
+    A face's row holds only while it carries force (an idle face is pressed
+    by nothing), so the capacity is the best over the sets of active faces:
+    every subset of ``R <= MAX_PALM_FACES`` faces (``[]``: the palm idle),
+    else none and all.
+    """
+    if R > MAX_PALM_FACES:
+        return [[], list(range(R))]
+    return [[r for r in range(R) if mask >> r & 1] for mask in range(1 << R)]
 
 
 def _drake_capacity(
@@ -521,19 +602,19 @@ def _batch_capacity(
     swap roles: :func:`_solve_duals`), and a grasp neither settles to the
     primal through the solver gateway (counted in ``_FALLBACKS``).
 
-    With a passive palm (``passive = (a, c)`` of :func:`palm_rows`) the primal's
-    row ``a·λ - c_u α <= 0`` adds a dual variable ``s_p >= 0`` (not in the
-    objective: the row's bound is 0) before ``ζ``; the α column's condition
-    becomes ``yᵀv = 1 + c_u s_p``, so ``y = (1 + c_u s_p) v + P z`` and each
-    generator row gains ``-(a_j + c_u v·w_j) s_p``.  ``s_p = 0`` keeps the
-    start feasible.
+    With a passive palm (``passive = (a, c)`` of :func:`palm_rows`) each of
+    the primal's rows ``a_r·λ - c_r α <= 0`` adds a dual variable
+    ``s_r >= 0`` (not in the objective: the rows' bounds are 0) before ``ζ``;
+    the α column's condition becomes ``yᵀv = 1 + Σ_r c_r s_r``, so
+    ``y = (1 + Σ_r c_r s_r) v + P z`` and each generator row gains
+    ``-(a_rj + c_r v·w_j) s_r``.  ``s = 0`` keeps the start feasible.
     """
     K, M, w = W.shape
     D = len(directions)
     G = num_groups(groups)
     v = np.hstack([directions, np.zeros((D, w - 3))])  # (D, w)
     P = _complement(v)  # (D, w, w-1)
-    extra = 0 if passive is None else 1
+    extra = 0 if passive is None else passive[0].shape[1]
     n = (w - 1) + G + extra + 1
     B = np.zeros((K, D, M + G + extra + 1, n))
     h = np.zeros((K, D, M + G + extra + 1))
@@ -546,10 +627,13 @@ def _batch_capacity(
     # s >= 0
     for f in range(G):
         B[:, :, M + f, w - 1 + f] = -1.0
-    if passive is not None:  # the palm's dual variable s_p >= 0
-        a, c = passive  # (K, M), (K, D)
-        B[:, :, :M, w - 1 + G] = -a[:, None, :] - c[:, :, None] * h[:, :, :M]
-        B[:, :, M + G, w - 1 + G] = -1.0
+    if passive is not None:  # the palm's dual variables s_r >= 0
+        a, c = passive  # (K, R, M), (K, R, D)
+        for r in range(extra):
+            B[:, :, :M, w - 1 + G + r] = (
+                -a[:, r, None, :] - c[:, r, :, None] * h[:, :, :M]
+            )
+            B[:, :, M + G + r, w - 1 + G + r] = -1.0
     # ζ + Σ s_f <= 0 (the palm's s_p is not in the objective)
     B[:, :, -1, w - 1 : w - 1 + G] = 1.0
     B[:, :, -1, n - 1] = 1.0

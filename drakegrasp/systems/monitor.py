@@ -150,8 +150,9 @@ speed:
 ``friction_use``     largest ``‖f_t‖/(μ f_n)``; NaN in geometry mode
 ``slip_speed``       largest slip speed at a contact, m/s
 ``relative_speed``   object's centre of mass relative to a touching finger, m/s
-``contact_gap``      samples without contact bridged by the hysteresis (the
-                     analysis shown is then the last one with contact)
+``contact_gap``      samples without contact over which the hysteresis kept a
+                     grip (the analysis shown is then the last one with
+                     contact)
 ===================  ===========================================================
 
 ``report`` is an abstract port holding a :class:`GraspSample`: the time, the

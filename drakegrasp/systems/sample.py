@@ -38,8 +38,9 @@ HOLDING_NAMES = (
 largest ``‖f_t‖/(μ f_n)`` over the fingers (NaN in geometry mode);
 ``slip_speed``: the largest slip speed, m/s; ``relative_speed``: the largest
 speed of the object's centre of mass relative to a touching finger, m/s (NaN
-without contact); ``contact_gap``: samples without contact bridged by the
-hysteresis (0 when the sample has contact).
+without contact); ``contact_gap``: samples without contact over which the
+hysteresis kept a grip and its analysis (0 when the sample has contact, and
+for a touch kept without its analysis).
 """
 
 
@@ -125,8 +126,9 @@ class GraspSample:
         Where the object sat on each touching finger (in the finger's frame),
         or on the fingers that touched it last while there is no contact.
     contact_gap : int
-        Consecutive samples without contact that the hysteresis bridged (the
-        analysis shown is then the last one with contact); 0 otherwise.
+        Consecutive samples without contact over which the hysteresis kept a
+        grip (the analysis shown is then the last one with contact); 0
+        otherwise, a kept ``touching`` included (its analysis is not kept).
     memory : HoldingMemory
         What the holding state machine carries to the next sample (the
         state, samples without contact, the hysteresis count, the last grip).

@@ -125,6 +125,9 @@ def test_a_zero_load_is_held_by_zero_forces(objective, cones):
     assert r.feasible and r.squeeze == 0.0
     assert not np.any(r.stacked_forces()) and not np.any(r.joint_torques)
     assert r.torque_usage == 0.0 and r.balance_residual == 0.0
+    if objective == "min_torque":  # still refused without the Jacobian
+        with pytest.raises(dg.InvalidOptionError, match="hand_jacobian"):
+            dg.grasp_forces(g, np.zeros(6), objective=objective, cones=cones)
     # the least squeeze shrinks to it as the load does
     tiny = dg.grasp_forces(g, weight(1e-9), hand_jacobian=J, torque_limits=[30, 30])
     assert tiny.feasible and tiny.squeeze == pytest.approx(

@@ -202,7 +202,8 @@ def test_a_preshape_beyond_the_joint_limits_is_refused_naming_the_joint():
     q[4] = 5.0
     with pytest.raises(InvalidOptionError, match=r"preshape\[4\] .* = 5 is outside"):
         plan(scene, n=2, preshape=q)
-    assert len(plan(scene, n=2, preshape=THREE_OPEN).settings) > 0  # within
+    within = plan(scene, n=2, preshape=THREE_OPEN)  # at the values given
+    assert within.settings["hand"]["preshape"] == pytest.approx(THREE_OPEN)
 
 
 def test_weight_capacity_with_one_group_per_finger_matches_the_primal_lp():

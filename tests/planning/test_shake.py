@@ -209,3 +209,37 @@ def test_directions_that_once_made_nan_gravity_are_simulated(own_scene, kw):
     d = np.asarray(kw["directions"][0]) / np.max(np.abs(kw["directions"][0]))
     np.testing.assert_allclose(result.phases[-1]["direction"], d / np.linalg.norm(d))
     assert np.isfinite(result.max_displacement)
+
+
+def test_the_summary_leads_with_the_seat_and_names_the_plans_verdict():
+    # A helper's review: the headline said "dropped" (from the plan's pose)
+    # for a grasp shake_candidates lists as held (from the seat)
+    from drakegrasp.planning.shake_result import ShakeResult
+
+    common = dict(
+        phases=({"direction": [0, 0, -1], "displacement": 0.0, "rotation": 0.0},),
+        squeeze=0.7, efforts=(0.7,), time_step=1e-3, duration=1.0, wall_time=0.5,
+        bounds=(0.01, np.radians(10)), effort_units=("N·m",),
+        seat_displacement=0.0139, seat_rotation=np.radians(26.46), seat_speed=0.002,
+        seated_q_hand=(0.1, 0.2), seated_X_WO=np.eye(4),
+    )  # fmt: skip
+    moved = ShakeResult(
+        held=False, max_displacement=0.0142, max_rotation=np.radians(27.0),
+        max_displacement_from_seat=0.001, max_rotation_from_seat=0.01, **common,
+    )  # fmt: skip
+    assert moved.held_from_seat and not moved.held
+    line = str(moved)
+    assert line.startswith("held from the seat: seated 13.90 mm and 26.46 deg")
+    assert (
+        "from the plan's pose at most 14.20 mm and 27.00 deg, beyond the bounds" in line
+    )
+    fell = ShakeResult(
+        held=False, max_displacement=6.9749, max_rotation=np.radians(179.8),
+        max_displacement_from_seat=6.977, max_rotation_from_seat=3.1, **common,
+    )  # fmt: skip
+    assert str(fell).startswith("dropped from the seat: ")
+    assert "6.98 m (out of the hand) from there" in str(fell)
+    data = json.loads(json.dumps(moved.to_dict()))
+    assert data["seated_X_WO"] == np.eye(4).tolist()
+    assert data["seated_q_hand"] == [0.1, 0.2]
+    assert data["held_from_seat"] is True and data["held"] is False

@@ -31,11 +31,15 @@ from drakegrasp.quality import primitive_wrenches
 def _highs_with_palm(P, N, fingers, palm, u, *, mu, b):
     """α(u) with a passive palm, written from the contacts (scipy's HiGHS).
 
-    The better of two LPs: the palm idle (its forces zero), or its normal
-    forces summing to at most the load's share into its contacts plus each
-    finger's normal force's (signed, the largest over the palm's contacts).
-    Every group, the palm included, is bounded by the squeeze.
+    The best over the sets of palm faces (distinct palm normals) that carry
+    force: the other faces' contacts carry nothing, and along each active
+    face's normal e the contacts' normal forces and the weight press the
+    object into it, friction aside (a palm contact facing e exactly, the
+    other wall of a slot, counts 0).  Every group, the palm included, is
+    bounded by the squeeze.
     """
+    import itertools
+
     grasp = Grasp([Contact(p, n, mu=mu) for p, n in zip(P, N, strict=True)])
     per_contact = primitive_wrenches(grasp, torque_scale=b)
     W = np.vstack(per_contact)
@@ -43,28 +47,42 @@ def _highs_with_palm(P, N, fingers, palm, u, *, mu, b):
     g = np.asarray(fingers)[owner]
     M = len(W)
     on = np.asarray(fingers) == palm
+    faces = []
+    for i in np.flatnonzero(on):
+        if all(N[i] @ e < 1 - 1e-6 for e in faces):
+            faces.append(N[i])
+    face_of = {
+        int(i): next(r for r, e in enumerate(faces) if N[i] @ e >= 1 - 1e-6)
+        for i in np.flatnonzero(on)
+    }
     groups = [np.r_[(g == f).astype(float), 0.0] for f in range(max(3, g.max() + 1))]
-
-    def solve(rows, rhs, idle):
-        bounds = [(0, 0) if idle and on[owner[j]] else (0, None) for j in range(M)]
-        res = linprog(
-            np.r_[np.zeros(M), -1.0], A_ub=np.array(rows), b_ub=rhs,
-            A_eq=np.hstack([W.T, np.r_[u, 0, 0, 0][:, None]]), b_eq=np.zeros(6),
-            bounds=[*bounds, (0, None)], method="highs",
-        )  # fmt: skip
-        assert res.status == 0
-        return -res.fun
-
-    row = np.zeros(M + 1)
-    for j in range(M):
-        i = owner[j]
-        row[j] = 1.0 if on[i] else -max(-(N[i] @ N[k]) for k in np.flatnonzero(on))
-    row[-1] = -max(-(u @ N[k]) for k in np.flatnonzero(on))
-    ones = [1.0] * len(groups)
-    return max(
-        solve(groups, ones, idle=True),
-        solve([*groups, row], [*ones, 0.0], idle=False),
-    )
+    best = 0.0
+    for size in range(len(faces) + 1):
+        for active in itertools.combinations(range(len(faces)), size):
+            rows, rhs = list(groups), [1.0] * len(groups)
+            for r in active:
+                e = faces[r]
+                row = np.zeros(M + 1)
+                for j in range(M):
+                    i = owner[j]
+                    dot = N[i] @ e
+                    row[j] = 0.0 if on[i] and dot < -1 + 1e-6 else dot
+                row[-1] = u @ e
+                rows.append(row)
+                rhs.append(0.0)
+            bounds = [
+                (0, 0) if on[owner[j]] and face_of[int(owner[j])] not in active
+                else (0, None)
+                for j in range(M)
+            ]  # fmt: skip
+            res = linprog(
+                np.r_[np.zeros(M), -1.0], A_ub=np.array(rows), b_ub=rhs,
+                A_eq=np.hstack([W.T, np.r_[u, 0, 0, 0][:, None]]),
+                b_eq=np.zeros(6), bounds=[*bounds, (0, None)], method="highs",
+            )  # fmt: skip
+            assert res.status == 0
+            best = max(best, -res.fun)
+    return best
 
 
 def _jaw_over_palm(rng, K):
@@ -130,7 +148,27 @@ def test_a_palm_alone_holds_nothing_it_is_not_pressed_against():
     kw = dict(mu=1.0, torque_scale=0.05, directions=[[1.0, 0, 0], [0, 0, -1]])
     assert weight_capacity(P, N, F, **kw)[0, 0] > 0.7
     along, down = weight_capacity(P, N, F, **kw, palm=2)[0]
-    assert along == 0.0 and down == pytest.approx(1.0)  # the floor bears it
+    assert along == pytest.approx(0.0, abs=1e-12)
+    assert down == pytest.approx(1.0)  # the floor bears it
+
+
+def test_a_ball_in_a_v_shaped_palm_bears_on_both_faces():
+    # A helper's review of the second form: bounded by the largest single
+    # face's share, a ball resting in a 45-degree V (the weight's reaction
+    # alpha / cos 45 on the faces) held 1.0 where the palm squeezed like a
+    # finger held 1.249; the faces' own rows let it bear as it does
+    r = 0.03
+    s45 = np.sqrt(0.5)
+    P = np.array([[[0, -r, 0], [0, r, 0], [r * s45, 0, -r * s45],
+                   [-r * s45, 0, -r * s45]]])  # fmt: skip
+    N = -P / r
+    F = np.array([[0, 1, 2, 2]])
+    kw = dict(mu=0.2, torque_scale=0.05, directions=[[0.0, 0, -1]])
+    squeezed = weight_capacity(P, N, F, **kw)
+    passive = weight_capacity(P, N, F, **kw, palm=2)
+    assert passive == pytest.approx(squeezed, rel=1e-6)
+    ref = _highs_with_palm(P[0], N[0], F[0], 2, np.array([0.0, 0, -1]), mu=0.2, b=0.05)
+    assert passive[0, 0] == pytest.approx(ref, rel=1e-6)
 
 
 def test_fingers_pushing_off_the_palm_buy_it_no_force():
@@ -249,18 +287,24 @@ def test_the_program_for_inspection_has_the_palms_row():
     W = np.vstack(per_contact)
     per = len(per_contact[0])
     groups = np.repeat(F[0], per)
-    a, c, has = palm_rows(N, F, 2, per, WEIGHT_DIRECTIONS)
-    assert has.tolist() == [True]
+    a, c, face, has = palm_rows(N, F, 2, per, WEIGHT_DIRECTIONS)
+    assert has.tolist() == [True] and a.shape[1] == 2  # the palm's two normals
     prog, alpha = build_weight_capacity_program(
         W, groups, WEIGHT_DIRECTIONS, passive=(a[0], c[0])
     )
     result = Solve(prog)
     assert result.is_success()
-    # the palm idle: its wrenches left out
-    idle, alpha_idle = build_weight_capacity_program(
-        np.where((groups == 2)[:, None], 0.0, W), groups, WEIGHT_DIRECTIONS
-    )
-    best = np.maximum(result.GetSolution(alpha), Solve(idle).GetSolution(alpha_idle))
+    # each set of faces that carry force: the others' wrenches left out
+    faces = np.repeat(face[0], per)
+    best = np.zeros(len(WEIGHT_DIRECTIONS))
+    for active in ([], [0], [1], [0, 1]):
+        idle = (faces >= 0) & ~np.isin(faces, active)
+        prog_a, alpha_a = build_weight_capacity_program(
+            np.where(idle[:, None], 0.0, W), groups, WEIGHT_DIRECTIONS,
+            passive=(a[0][active], c[0][active]) if active else None,
+        )  # fmt: skip
+        best = np.maximum(best, Solve(prog_a).GetSolution(alpha_a))
+    assert np.all(result.GetSolution(alpha) <= best + 1e-7)
     want = weight_capacity(P, N, F, mu=1.0, torque_scale=0.05, palm=2)[0]
     assert best == pytest.approx(want, rel=1e-6, abs=1e-7)
     plain, alpha0 = build_weight_capacity_program(W, groups, WEIGHT_DIRECTIONS)
