@@ -373,6 +373,18 @@ def _solved(P, w, objective, result, v, F0) -> GraspForceResult:
             "largest float (1.8e308 N): the load is too large for this grasp's "
             "friction to compute"
         )
+    margin = (
+        float(F0 * result.GetSolution(v.margin)) if v.margin is not None else math.nan
+    )
+    return _held_by(
+        P, w, objective, full, margin=margin,
+        solver=result.get_solver_id().name(),
+        status=result.get_solution_result().name,
+    )  # fmt: skip
+
+
+def _held_by(P: LoadProblem, w, objective, full, *, margin, solver, status):
+    """The feasible result of stacked forces ``full`` for the load ``w``."""
     tau = P.joint_torques(full)
     sat, usage = saturating_joints(tau, P.torque_limits)
     G = grasp_matrix(P.grasp)
@@ -393,39 +405,22 @@ def _solved(P, w, objective, result, v, F0) -> GraspForceResult:
         squeeze=float(np.sum(full[normals])),
         torque_usage=usage,
         saturating_joints=sat,
-        margin=float(F0 * result.GetSolution(v.margin))
-        if v.margin is not None
-        else math.nan,
-        torque_limits=None if P.torque_limits is None else P.torque_limits.copy(),
+        margin=margin,
+        torque_limits=_limits_copy(P),
         balance_residual=float(safe_norm(G @ full + w)) / scale,
         num_generators=P.num_generators,
-        solver=result.get_solver_id().name(),
-        status=result.get_solution_result().name,
+        solver=solver,
+        status=status,
     )
 
 
 def _zero_forces(P: LoadProblem, w: np.ndarray, objective: str) -> GraspForceResult:
     """The exact answer to a zero load: every force zero (in every cone)."""
     full = np.zeros(P.grasp.num_components)
-    tau = P.joint_torques(full)
-    sat, usage = saturating_joints(tau, P.torque_limits)
-    return GraspForceResult(
-        feasible=True,
-        objective=objective,
-        cones=P.cones,
-        wrench=w.copy(),
-        contact_forces=P.per_contact(full),
-        joint_torques=tau,
-        squeeze=0.0,
-        torque_usage=usage,
-        saturating_joints=sat,
-        margin=math.nan,
-        torque_limits=_limits_copy(P),
-        balance_residual=0.0,
-        num_generators=P.num_generators,
-        solver="none (a zero load)",
+    return _held_by(
+        P, w, objective, full, margin=math.nan, solver="none (a zero load)",
         status="kSolutionFound",
-    )
+    )  # fmt: skip
 
 
 def _refutation_reaches(P, w, cert, prog, result) -> None:
