@@ -240,9 +240,10 @@ def torque_capacity(
 
     A contact that no finger joint moves (its rows of ``J`` zero: the palm)
     is passive, as in :func:`~drakegrasp.planning.weight.weight_capacity`
-    (``palm=``): it pushes only as hard as the load and the fingers' normal
-    forces press the object into it, or not at all, whichever holds more;
-    the friction of a finger cannot buy it a push.
+    (``palm=``): each face of the palm pushes only while, and only as hard
+    as, the load and the contacts' normal forces press the object into it
+    (the best over the sets of faces that do); the friction of a finger
+    cannot buy it a push.
     """
     u = checked_directions("directions", directions)
     J = finger_jacobian(plant, plant_context, candidate, object_body)
