@@ -61,8 +61,8 @@ handle held at one end): that reaction is not counted.
 
 The LPs of all grasps and directions are solved at once by the batch engine's
 exact active-set method (its interior-point method where that cannot certify),
-in their dual form (nine variables each for a parallel jaw, ten with a
-passive palm);
+in their dual form (nine variables each for a parallel jaw, one more for
+each palm face that carries force);
 :func:`build_weight_capacity_program` builds the
 primal LP of one grasp (its directions as independent blocks: the sum of their
 ``α`` is maximised, which maximises each) for inspection, for a second route
@@ -221,7 +221,7 @@ def _checked_passive(passive, M: int, D: int):
 
 def palm_rows(
     normals: np.ndarray, fingers: np.ndarray, palm: int, per: int, directions
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The passive palm's rows of each grasp's LPs (see the module's note).
 
     One row per distinct normal ``e`` of the palm's contacts:
@@ -423,8 +423,9 @@ def weight_capacity(
     palm : int, optional
         The label of the contacts on bodies no motor drives (the planner
         passes its palm's: 2 for a parallel jaw, ``F`` for a hand of ``F``
-        fingers): pressed only by the load and the fingers' normal forces
-        (see the module's note), so a capacity never rises with it.  Default
+        fingers): each of its faces pressed only by the load and the
+        contacts' normal forces (see the module's note), so a capacity never
+        rises with it.  Default
         None: every label is squeezed alike.
 
     Returns
@@ -506,15 +507,16 @@ def _capacity(positions, normals, fingers, *, mu, torque_scale, contact_model,
     if not np.all(has):  # no palm row: the LPs and numbers of palm=None
         out[~has] = run(W[~has], groups[~has], directions)
     if np.any(has):
-        best = np.zeros((int(np.sum(has)), len(directions)))
+        W, groups, a, c = W[has], groups[has], a[has], c[has]
+        best = np.zeros((len(W), len(directions)))
         faces = np.repeat(face[has], per, axis=1)  # per wrench
         for active in palm_faces(a.shape[1]):
             # the faces outside `active` carry nothing (their wrenches left
             # out); each active one at most what presses the object into it
             idle = (faces >= 0) & ~np.isin(faces, active)
-            Wa = np.where(idle[..., None], 0.0, W[has])
-            rows = None if not active else (a[has][:, active], c[has][:, active])
-            best = np.maximum(best, run(Wa, groups[has], directions, rows))
+            Wa = np.where(idle[..., None], 0.0, W)
+            rows = None if not active else (a[:, active], c[:, active])
+            best = np.maximum(best, run(Wa, groups, directions, rows))
         out[has] = best
     return out
 
@@ -634,7 +636,7 @@ def _batch_capacity(
                 -a[:, r, None, :] - c[:, r, :, None] * h[:, :, :M]
             )
             B[:, :, M + G + r, w - 1 + G + r] = -1.0
-    # ζ + Σ s_f <= 0 (the palm's s_p is not in the objective)
+    # ζ + Σ s_f <= 0 (the palm faces' s_r are not in the objective)
     B[:, :, -1, w - 1 : w - 1 + G] = 1.0
     B[:, :, -1, n - 1] = 1.0
     rows = M + G + extra + 1
@@ -686,8 +688,8 @@ def _feasible_start(
     """A feasible point ``(z, s, ζ)`` of each dual LP of :func:`_batch_capacity`.
 
     ``z = 0`` (``y = v``), each ``s_f`` the largest ``-v·w_j`` of its group
-    (at least 0), the palm's ``s_p = 0`` and ``ζ = -Σ s_f``: every row holds,
-    with equality where the maximum is attained.
+    (at least 0), the palm faces' ``s_r = 0`` and ``ζ = -Σ s_f``: every row
+    holds, with equality where the maximum is attained.
 
     Parameters
     ----------
@@ -698,7 +700,7 @@ def _feasible_start(
     n : int
         Variables ``w - 1 + G + extra + 1``.
     extra : int
-        1 with a palm's ``s_p`` (just before ``ζ``), else 0.
+        The palm faces' ``s_r`` (just before ``ζ``); 0 without a palm.
     """
     L, M, G = member.shape
     x0 = np.zeros((L, n))
