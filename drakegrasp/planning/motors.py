@@ -17,7 +17,13 @@ wrench) the **torque capacity** in a weight direction ``u`` is
 
 the weight (N) held along ``u`` per N·m allowed at every finger joint, moments
 about the candidate's ``reference_point`` (the object's centre of mass, where
-its weight acts).  By linearity
+its weight acts).  A hand whose joints are not each a motor is held to the
+motors it has: with a ``<mimic>`` follower moving as ``v_h = C u``
+(:func:`~drakegrasp.plant.couplings.coupling_map`) the rows are those of
+``(J C)ᵀ f``, each within ``Σ_k |C_ki| a_k`` for ``a_k`` 1 at an actuated
+joint and 0 at one without an actuator (a follower's torque then comes
+through the coupling from its leader's motor, as Drake's coupler constraint
+carries it); ``β`` is then per N·m at every actuator.  By linearity
 the hand holds a weight ``m g`` in every one of the directions
 :data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS` when each joint may
 apply :math:`m g / \min_u \beta(u)`: the **torque needed**.  Like the squeeze
@@ -84,6 +90,7 @@ from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.checks import checked_directions
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
+from drakegrasp.plant.couplings import coupling_map, plant_couplings
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.jacobians import contact_rows, hand_jacobian
 from drakegrasp.plant.validation import (
@@ -255,11 +262,16 @@ def torque_capacity(
         for c in grasp.contacts
     ]
     S = block_diag(*blocks)
-    GS, TS = grasp_matrix(grasp) @ S, J.T @ S
     slices = grasp.component_slices()
     palm = np.array([not np.any(J[sl]) for sl in slices])
+    motors = _motor_map(plant, candidate)
+    bound = None
+    if motors is not None:  # a coupled or partly passive hand: its motors' axes
+        C, bound = motors
+        J = J @ C
+    GS, TS = grasp_matrix(grasp) @ S, J.T @ S
     if not palm.any():
-        b = _torque_lp(GS, TS, u)
+        b = _torque_lp(GS, TS, u, bound=bound)
     else:
         # each generator's contact and normal force
         owner = np.repeat(np.arange(len(blocks)), [b.shape[1] for b in blocks])
@@ -272,16 +284,41 @@ def torque_capacity(
         for active in palm_faces(a.shape[1]):
             idle = (per_generator >= 0) & ~np.isin(per_generator, active)
             row = (a[0][active][:, owner] * normal, c[0][active]) if active else None
-            b = np.maximum(b, _torque_lp(GS, TS, u, idle=idle, row=row))
+            b = np.maximum(b, _torque_lp(GS, TS, u, idle=idle, row=row, bound=bound))
     return np.where(b >= BETA_CAP * (1 - 1e-6), np.inf, b)
 
 
-def _torque_lp(GS, TS, u, *, idle=None, row=None) -> np.ndarray:
+def _motor_map(plant, candidate: GraspCandidate):
+    """``(C, w)`` of a hand whose joints are not each a motor, or None.
+
+    ``C`` (n_j, n_u) maps the independent coordinates' velocities onto the
+    candidate's joints (:func:`~drakegrasp.plant.couplings.coupling_map`: a
+    ``<mimic>`` follower moves with its leader); ``w`` (n_u,) is how many N·m
+    each coordinate's generalized force ``(J C)ᵀ f`` may carry per N·m allowed
+    at every actuator: ``|C|ᵀ a``, ``a_k`` 1 for a joint with an actuator and
+    0 for one without (a follower's torque comes through its coupling; an
+    unactuated, uncoupled joint is passive).  A plant that gives none of the
+    candidate's joints an actuator says nothing of its motors: each joint
+    counts as one.  None when every joint is its own motor (``C = I``,
+    ``w = 1``).
+    """
+    joints = [find_joint(plant, name) for name in candidate.joint_names]
+    columns = np.array([j.velocity_start() for j in joints], dtype=int)
+    C, _ = coupling_map(plant, columns, plant_couplings(plant))
+    actuated = np.array([bool(_actuators(plant, j)) for j in joints])
+    a = actuated.astype(float) if actuated.any() else np.ones(len(joints))
+    if C.shape[0] == C.shape[1] and np.all(a == 1.0):
+        return None
+    return C, np.abs(C).T @ a
+
+
+def _torque_lp(GS, TS, u, *, idle=None, row=None, bound=None) -> np.ndarray:
     """``β`` per direction of :func:`torque_capacity`'s program (clipped at 0).
 
     ``idle``: generators held at zero (the palm's); ``row``: ``(a, c)``
     ((R, n), (R, D)) adds ``a_r·λ <= c_rk β_k`` to direction ``k``'s block
-    (the passive palm's rows).
+    (the passive palm's rows); ``bound`` (n_u,): each row of ``TS`` within
+    ``±bound`` instead of ``±1`` (:func:`_motor_map`).
     """
     D, n = len(u), GS.shape[1]
     prog = MathematicalProgram()
@@ -290,13 +327,13 @@ def _torque_lp(GS, TS, u, *, idle=None, row=None) -> np.ndarray:
     upper = np.full(n, np.inf) if idle is None else np.where(idle, 0.0, np.inf)
     prog.AddBoundingBoxConstraint(np.zeros(n * D), np.repeat(upper, D), lam.reshape(-1))
     prog.AddBoundingBoxConstraint(0.0, BETA_CAP, beta)
-    ones = np.ones(len(TS))
+    limit = np.ones(len(TS)) if bound is None else np.asarray(bound, float)
     for k in range(D):
         load = np.concatenate([u[k], np.zeros(3)])
         prog.AddLinearEqualityConstraint(
             np.hstack([GS, load[:, None]]), np.zeros(6), np.append(lam[:, k], beta[k])
         )
-        prog.AddLinearConstraint(TS, -ones, ones, lam[:, k])
+        prog.AddLinearConstraint(TS, -limit, limit, lam[:, k])
         if row is not None:
             a, c = row
             prog.AddLinearConstraint(

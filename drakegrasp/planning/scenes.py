@@ -20,6 +20,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.plant.couplings import add_models as add_coupled_models
 from drakegrasp.plant.models import (
     check_obj_vertices,
     register_models,
@@ -137,8 +138,11 @@ def planning_scene(
 
 
 def _add(parser, url: str):
+    # Through drakegrasp's loader, which records a <mimic>'s coupling on the
+    # plant: a bare Parser leaves a coupled hand's constraints unreadable, and
+    # the planner refuses such a plant.
     if "://" in url:
-        return parser.AddModels(url=url)[0]
+        return add_coupled_models(parser, url=url)[0]
     if str(url).lower().endswith(".obj"):
         check_obj_vertices(url)
-    return parser.AddModels(str(url))[0]
+    return add_coupled_models(parser, str(url))[0]

@@ -10,6 +10,7 @@ import json
 
 import numpy as np
 import pytest
+from coupled_support import coupled_hand_sdf
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from drakegrasp import analyze_grasp
@@ -339,47 +340,6 @@ def test_a_multi_finger_hand_plans_on_a_point_cloud():
     assert len(result) > 0 and result.object_body == "point cloud"
 
 
-def _coupled_hand_sdf() -> str:
-    """Three two-link fingers 120° apart around the palm's z axis; each distal
-    joint follows its proximal one (``<drake:mimic>``, ratio 1): three motors."""
-    links, joints = [], []
-    for k in range(3):
-        a = 2 * np.pi * k / 3
-        c, s = np.cos(a), np.sin(a)
-        x, y = 0.045 * c, 0.045 * s
-        for part, z, length in (("prox", 0.0, 0.05), ("dist", 0.05, 0.04)):
-            links.append(
-                f"<link name='f{k}_{part}'><pose>{x} {y} {z} 0 0 {a}</pose>"
-                "<inertial><mass>0.03</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy>"
-                "<izz>1e-6</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia>"
-                f"</inertial><collision name='c'><pose>0 0 {length / 2} 0 0 0</pose>"
-                f"<geometry><capsule><radius>0.007</radius><length>{length}</length>"
-                "</capsule></geometry></collision></link>"
-            )
-        mimic = f"<drake:mimic joint='f{k}_prox_joint' multiplier='1' offset='0'/>"
-        for part, parent, extra in (
-            ("prox", "palm", ""),
-            ("dist", f"f{k}_prox", mimic),
-        ):
-            joints.append(
-                f"<joint name='f{k}_{part}_joint' type='revolute'>"
-                f"<parent>{parent}</parent><child>f{k}_{part}</child>"
-                "<axis><xyz>0 -1 0</xyz><limit><lower>-0.6</lower><upper>1.5</upper>"
-                f"<effort>2</effort></limit></axis>{extra}</joint>"
-            )
-    return (
-        '<?xml version="1.0"?><sdf version="1.9" xmlns:drake="http://drake.mit.edu">'
-        "<model name='coupled_hand'><link name='palm'><inertial><mass>0.5</mass>"
-        "<inertia><ixx>1e-3</ixx><iyy>1e-3</iyy><izz>1e-3</izz><ixy>0</ixy>"
-        "<ixz>0</ixz><iyz>0</iyz></inertia></inertial><collision name='c'>"
-        "<pose>0 0 -0.01 0 0 0</pose><geometry><cylinder><radius>0.055</radius>"
-        "<length>0.02</length></cylinder></geometry></collision></link>"
-        + "".join(links)
-        + "".join(joints)
-        + "</model></sdf>"
-    )
-
-
 def test_a_coupled_hand_of_our_own_closes_with_the_plants_couplings():
     from pydrake.multibody.parsing import Parser
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
@@ -392,7 +352,7 @@ def test_a_coupled_hand_of_our_own_closes_with_the_plants_couplings():
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     parser = Parser(plant)
     register_models(parser)
-    (hand,) = add_models(parser, text=_coupled_hand_sdf(), kind="sdf")
+    (hand,) = add_models(parser, text=coupled_hand_sdf(), kind="sdf")
     (obj,) = parser.AddModels(url="package://drakegrasp/objects/cylinder.sdf")
     plant.Finalize()
     assert plant.num_constraints() == 3  # Drake's coupler constraints

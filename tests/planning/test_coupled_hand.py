@@ -1,0 +1,197 @@
+"""A hand whose distal joints follow their proximal ones (``<mimic>``), as a
+real linkage does: loaded from a file by the planner, its torque capacity held
+to the motors it has, and shaken in Drake with motors on the leaders only.
+
+The hand is ``coupled_support.coupled_hand_sdf``: three two-link fingers, each
+distal joint a follower (ratio 0.6) of its proximal one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from coupled_support import MODEL, coupled_hand_sdf
+from scipy.optimize import linprog
+
+import drakegrasp as dg
+from drakegrasp.cli import main
+from drakegrasp.core.friction_cone import friction_cone_generators
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.motors import finger_jacobian, torque_capacity
+from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
+from drakegrasp.plant.couplings import recorded_couplings
+from drakegrasp.plant.models import register_models
+
+RATIO = 0.6
+CYLINDER = "package://drakegrasp/objects/cylinder.sdf"
+OPEN = [-0.5, -0.3] * 3  # (prox, dist) per finger: dist = 0.6 prox
+MU = 0.8
+
+
+def _hand_file(tmp_path, **kw):
+    path = tmp_path / "coupled_hand.sdf"
+    path.write_text(coupled_hand_sdf(ratio=RATIO, **kw))
+    return path
+
+
+def _plan(path, num=40):
+    scene = planning_scene(CYLINDER, hand_url=str(path))
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=num, mu=MU, seed=0, robustness_samples=8,
+        preshape=OPEN,
+    )  # fmt: skip
+    return scene, result
+
+
+@pytest.fixture(scope="module")
+def motors_on_leaders(tmp_path_factory):
+    """Planned with actuators on the proximal joints only."""
+    return _plan(_hand_file(tmp_path_factory.mktemp("leaders"), follower_effort=0))
+
+
+def test_a_mimic_hand_from_a_file_is_planned_with_its_couplings(motors_on_leaders):
+    # planning_scene read the file's <drake:mimic> elements: without them the
+    # planner refused the plant (3 constraints, 0 known couplings).
+    scene, result = motors_on_leaders
+    found = {
+        (c.follower, c.leader, c.gear_ratio) for c in recorded_couplings(scene.plant)
+    }
+    assert found == {
+        (f"{MODEL}::f{k}_dist_joint", f"{MODEL}::f{k}_prox_joint", RATIO)
+        for k in range(3)
+    }
+    closed = [c for c in result if c.is_closure]
+    assert closed, result
+    names = list(closed[0].joint_names)
+    for c in result:
+        for k in range(3):
+            prox = c.q_hand[names.index(f"{MODEL}::f{k}_prox_joint")]
+            dist = c.q_hand[names.index(f"{MODEL}::f{k}_dist_joint")]
+            assert dist == pytest.approx(RATIO * prox, abs=1e-9)
+
+
+def test_the_cli_plans_a_mimic_hand_from_a_file(tmp_path, capsys):
+    path = _hand_file(tmp_path, follower_effort=0)
+    args = ["plan", "cylinder", "--hand", str(path), "--num", "30", "--top", "2"]
+    for k in range(3):
+        args += ["--preshape", f"f{k}_prox_joint=-0.5"]
+    assert main(args) == 0, capsys.readouterr().err
+    assert "grasp candidates of" in capsys.readouterr().out
+
+
+def _explicit_beta(candidate, J, C, actuated, u) -> float:
+    """max β with the actuators' torques written out (scipy HiGHS).
+
+    G S λ + β [u; 0] = 0, λ >= 0; the joints' statics Jᵀ S λ = τ + λ_c with
+    the coupler's force λ_c doing no work along v = C w, i.e.
+    Cᵀ (Jᵀ S λ − τ) = 0; |τ_k| <= 1 at an actuated joint, τ_k = 0 elsewhere.
+    """
+    grasp = candidate.grasp
+    G = dg.grasp_matrix(grasp)
+    blocks = [friction_cone_generators(c, 8) for c in grasp.contacts]
+    S = np.zeros((G.shape[1], sum(b.shape[1] for b in blocks)))
+    r = c = 0
+    for b in blocks:
+        S[r : r + b.shape[0], c : c + b.shape[1]] = b
+        r, c = r + b.shape[0], c + b.shape[1]
+    n, m = S.shape[1], J.shape[1]
+    # variables: λ (n), τ (m), β
+    A_eq = np.vstack([
+        np.hstack([G @ S, np.zeros((6, m)), np.concatenate([u, np.zeros(3)])[:, None]]),
+        np.hstack([C.T @ J.T @ S, -C.T, np.zeros((C.shape[1], 1))]),
+    ])  # fmt: skip
+    bounds = (
+        [(0, None)] * n
+        + [(-1.0, 1.0) if a else (0.0, 0.0) for a in actuated]
+        + [(0, None)]
+    )
+    cost = np.zeros(n + m + 1)
+    cost[-1] = -1.0
+    res = linprog(cost, A_eq=A_eq, b_eq=np.zeros(len(A_eq)), bounds=bounds,
+                  method="highs")  # fmt: skip
+    assert res.status == 0
+    return float(res.x[-1])
+
+
+def _coupling_matrix(names):
+    """C (6, 3): each distal joint moves RATIO times its proximal one."""
+    C = np.zeros((len(names), 3))
+    for k in range(3):
+        C[names.index(f"{MODEL}::f{k}_prox_joint"), k] = 1.0
+        C[names.index(f"{MODEL}::f{k}_dist_joint"), k] = RATIO
+    return C
+
+
+@pytest.mark.parametrize("follower_effort", [0.0, 2.0])
+def test_the_torque_capacity_is_that_of_the_motors_the_hand_has(
+    tmp_path, follower_effort
+):
+    scene, result = _plan(_hand_file(tmp_path, follower_effort=follower_effort))
+    closed = [c for c in result if c.is_closure][:3]
+    assert closed
+    differs = False
+    for candidate in closed:
+        names = list(candidate.joint_names)
+        J = finger_jacobian(scene.plant, scene.context, candidate, scene.object_body)
+        actuated = ["prox" in name or follower_effort > 0 for name in names]
+        C = _coupling_matrix(names)
+        beta = torque_capacity(scene.plant, scene.context, candidate, scene.object_body)
+        expected = [
+            _explicit_beta(candidate, J, C, actuated, u) for u in WEIGHT_DIRECTIONS
+        ]
+        np.testing.assert_allclose(beta, expected, rtol=1e-6, atol=1e-9)
+        # the joints taken as six free motors: what the capacity was
+        free = [
+            _explicit_beta(candidate, J, np.eye(6), [True] * 6, u)
+            for u in WEIGHT_DIRECTIONS
+        ]
+        differs |= not np.allclose(beta, free, rtol=1e-4)
+    assert differs  # the couplings change the answer on these grasps
+
+
+def test_fewer_motors_hold_no_more(tmp_path):
+    scene, result = _plan(_hand_file(tmp_path, follower_effort=0))
+    (tmp_path / "every").mkdir()
+    every = _plan(_hand_file(tmp_path / "every", follower_effort=2))[0]
+    for candidate in [c for c in result if c.is_closure][:3]:
+        leaders = torque_capacity(
+            scene.plant, scene.context, candidate, scene.object_body
+        )
+        both = torque_capacity(every.plant, every.context, candidate, every.object_body)
+        assert np.all(leaders <= both * (1 + 1e-7) + 1e-9)
+
+
+def test_a_hand_with_motors_on_its_leaders_only_is_shaken(motors_on_leaders):
+    # Drake's coupler constraint moves the followers; shake_test refused the
+    # hand ("closing joint ...f0_dist_joint has no actuator to squeeze with").
+    scene, result = motors_on_leaders
+    candidate = next(c for c in result if c.is_closure)
+    shaken = shake_test(
+        scene.add_models, candidate, squeeze=0.5, stiffness=20.0, damping=1.0,
+        directions=[[0.0, 0.0, -1.0]], settle=0.1, phase=0.2, seat=0.2,
+    )  # fmt: skip
+    names = list(candidate.joint_names)
+    q = np.asarray(shaken.seated_q_hand)
+    for k in range(3):
+        prox = q[names.index(f"{MODEL}::f{k}_prox_joint")]
+        dist = q[names.index(f"{MODEL}::f{k}_dist_joint")]
+        assert dist == pytest.approx(RATIO * prox, abs=1e-3)
+
+
+def test_a_follower_without_a_known_coupling_is_refused_with_its_remedy(
+    motors_on_leaders,
+):
+    scene, result = motors_on_leaders
+    candidate = next(c for c in result if c.is_closure)
+    text = coupled_hand_sdf(ratio=RATIO, follower_effort=0)
+
+    def bare(plant, parser):  # a <mimic> Drake reads and drakegrasp does not
+        register_models(parser)
+        (hand,) = parser.AddModelsFromString(text, "sdf")
+        (obj,) = parser.AddModels(url=CYLINDER)
+        body = plant.get_body(plant.GetBodyIndices(obj)[0])
+        return hand, body
+
+    with pytest.raises(dg.ModelError, match="no actuator to squeeze with.*mimic"):
+        shake_test(bare, candidate, squeeze=0.5, stiffness=20.0, damping=1.0)
