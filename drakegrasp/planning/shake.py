@@ -65,6 +65,7 @@ from drakegrasp.planning.turned_gravity import (
     _schedule,
     _TurnedGravity,
 )
+from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import effort_unit, find_joint
 from drakegrasp.plant.hydroelastic import (
     check_hydroelastic_modulus,
@@ -240,6 +241,27 @@ def check_shake_options(
     return dirs
 
 
+_MIN_AIM = 1e-9
+"""The least aim ``squeeze / stiffness`` (m or rad) past the touching place: a
+joint position of order 1 carries about 16 digits, so a smaller offset is lost
+in rounding and the finger presses with nothing (stiffness 1e20 at 20 N)."""
+
+
+def _driven_followers(plant, actuated: set) -> set:
+    """Scoped names of the joints a recorded coupling ties to an actuated leader.
+
+    A ``<mimic>`` follower has no actuator of its own in a real hand's model
+    (the linkage moves it); its leader's motor drives it through Drake's
+    coupler constraint.  Couplings that were not recorded (a bare ``Parser``)
+    are not read.
+    """
+    try:
+        couplings = plant_couplings(plant)
+    except InvalidOptionError:
+        return set()
+    return {c[0] for c in couplings if c[1] in actuated}
+
+
 def shake_test(
     add_models: Callable,
     candidate: GraspCandidate,
@@ -397,11 +419,26 @@ def shake_test(
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
     by_name = {_scoped(plant, a.joint()): a for a in actuators}
     targets = {}
+    driven = _driven_followers(plant, set(by_name))
     for name, sign in zip(candidate.joint_names, candidate.closing_signs, strict=True):
         actuator = by_name.get(name)
+        if actuator is None and name in driven:
+            continue  # a <mimic> follower: its coupler moves it with its leader
         if actuator is None:
-            raise ModelError(f"closing joint {name} has no actuator to squeeze with")
+            raise ModelError(
+                f"closing joint {name} has no actuator to squeeze with (give it "
+                "one, a URDF <transmission> or an SDFormat <drake:actuator>, or "
+                "couple it to an actuated joint with a <mimic> that drakegrasp "
+                "reads: drakegrasp.plant.add_models in add_models)"
+            )
         push = min(squeeze, actuator.effort_limit())
+        if 0 < push / stiffness < _MIN_AIM:
+            raise InvalidOptionError(
+                f"stiffness = {stiffness:g} aims joint {name} {push / stiffness:.3g} "
+                f"past where it touches (squeeze {push:g} / stiffness): below what "
+                f"a joint's position resolves ({_MIN_AIM:g}), so it would press "
+                f"with nothing; give a stiffness below {push / _MIN_AIM:.3g}"
+            )
         targets[int(actuator.joint().index())] = sign * push / stiffness
     for actuator in actuators:  # every actuator position-controlled (Drake's PD)
         actuator.set_controller_gains(PdControllerGains(p=stiffness, d=damping))
@@ -549,4 +586,6 @@ def shake_test(
         squeeze_caps=capped,
         seated_q_hand=seated_q,
         seated_X_WO=seated_X_WO,
+        joint_names=tuple(candidate.joint_names),
+        X_WH=candidate.X_WH.GetAsMatrix4(),
     )

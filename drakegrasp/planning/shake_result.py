@@ -13,6 +13,7 @@ import numpy as np
 from pydrake.math import RigidTransform
 
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["ShakeResult", "motion_text"]
@@ -96,6 +97,13 @@ class ShakeResult:
         The object's pose where seating left it, in the world the candidate
         was planned in (its hand base welded at ``X_WH``); None with
         ``seat=0``.  :meth:`seated` makes both a candidate to analyse.
+    joint_names : tuple of str
+        The shaken candidate's joints (scoped names); empty in a record made
+        before it existed.
+    X_WH : (4, 4) float or None
+        The shaken candidate's hand pose (where its base was welded), world
+        frame; None in a record made before it existed.  :meth:`seated`
+        accepts only the candidate with these joints and this pose.
     """
 
     held: bool
@@ -119,6 +127,8 @@ class ShakeResult:
     squeeze_caps: tuple[float, ...] = ()
     seated_q_hand: tuple[float, ...] = ()
     seated_X_WO: np.ndarray | None = None
+    joint_names: tuple[str, ...] = ()
+    X_WH: np.ndarray | None = None
 
     def seated(self, candidate):
         """``candidate`` with the hand's joints and the object where seating left them.
@@ -135,23 +145,35 @@ class ShakeResult:
         Raises
         ------
         InvalidOptionError
-            The test ran with ``seat=0`` (nothing seated), or ``candidate``
-            has other joints than the shaken one.
+            The test ran with ``seat=0`` (nothing seated); ``candidate`` is not
+            the one shaken (other joints, or another hand pose); or the record
+            holds no finite joint values or rigid pose (a record built by
+            hand).
         """
         if self.seated_X_WO is None:
             raise InvalidOptionError(
                 "this shake test ran with seat=0: nothing was seated"
             )
-        if len(candidate.joint_names) != len(self.seated_q_hand):
+        names = tuple(candidate.joint_names)
+        if len(names) != len(self.seated_q_hand) or (
+            self.joint_names and names != tuple(self.joint_names)
+        ):
+            shaken = list(self.joint_names) or f"{len(self.seated_q_hand)} joints"
             raise InvalidOptionError(
-                f"the candidate has {len(candidate.joint_names)} joints, the "
-                f"shaken one {len(self.seated_q_hand)}: not the candidate shaken"
+                f"the candidate's joints {list(names)} are not those of the "
+                f"candidate shaken ({shaken})"
             )
-        return replace(
-            candidate,
-            q_hand=np.array(self.seated_q_hand, dtype=float),
-            X_WO=RigidTransform(np.asarray(self.seated_X_WO, dtype=float)),
-        )
+        if self.X_WH is not None and not np.allclose(
+            candidate.X_WH.GetAsMatrix4(), _pose("X_WH", self.X_WH), rtol=0, atol=1e-9
+        ):
+            raise InvalidOptionError(
+                "the candidate's hand pose X_WH is not that of the candidate shaken"
+            )
+        q = np.array(self.seated_q_hand, dtype=float)
+        if not np.all(np.isfinite(q)):
+            raise InvalidOptionError(f"seated_q_hand must be finite, got {q.tolist()}")
+        X_WO = _pose("seated_X_WO", self.seated_X_WO)
+        return replace(candidate, q_hand=q, X_WO=RigidTransform(X_WO))
 
     @property
     def squeeze_unit(self) -> str:
@@ -249,8 +271,24 @@ class ShakeResult:
 
 
 def motion_text(displacement: float, rotation: float, digits: int = 2) -> str:
-    """A motion as "12.34 mm and 5.67 deg"; beyond a metre, only its distance."""
+    """A motion as "12.34 mm and 5.67 deg"; beyond a metre, only its distance.
+
+    ``displacement`` in metres and ``rotation`` in radians, real and >= 0
+    (else ``InvalidOptionError``); either NaN (not measured: ``seat=0``)
+    reads "not measured".
+    """
+    displacement = real_scalar("displacement", displacement)
+    rotation = real_scalar("rotation", rotation)
+    if np.isnan(displacement) or np.isnan(rotation):
+        return "not measured"
+    if displacement < 0 or rotation < 0:
+        raise InvalidOptionError(
+            f"a motion is >= 0, got displacement {displacement!r} m and rotation "
+            f"{rotation!r} rad"
+        )
     if displacement > 1.0:  # an object that fell: its angle says nothing
+        if displacement >= 1e6:  # a diverged simulation: no 300-digit figure
+            return f"{displacement:.3g} m (out of the hand)"
         return f"{displacement:.{digits}f} m (out of the hand)"
     return (
         f"{displacement * 1e3:.{digits}f} mm and {np.degrees(rotation):.{digits}f} deg"
@@ -263,3 +301,24 @@ def _squeeze_unit(units: tuple[str, ...]) -> str:
     if len(kinds) == 1:
         return kinds.pop()
     return "(N on prismatic, N·m on revolute joints)"
+
+
+def _pose(name: str, X) -> np.ndarray:
+    """``X`` as a (4, 4) homogeneous rigid transform, else an error naming ``name``."""
+    try:
+        M = np.asarray(X, dtype=float)
+    except (TypeError, ValueError):
+        M = np.full(0, np.nan)
+    ok = M.shape == (4, 4) and bool(np.all(np.isfinite(M)))
+    if ok:
+        R = M[:3, :3]
+        ok = (
+            np.allclose(R.T @ R, np.eye(3), atol=1e-6)
+            and np.linalg.det(R) > 0
+            and np.array_equal(M[3], [0.0, 0.0, 0.0, 1.0])
+        )
+    if not ok:
+        raise InvalidOptionError(
+            f"{name} must be a finite (4, 4) rigid transform, got {X!r}"[:200]
+        )
+    return M

@@ -130,6 +130,9 @@ def test_without_seating_a_finger_planned_inside_presses_harder(wsg_scene):
         {"directions": [(0, 0, 0)]},
         {"phase": np.nan},
         {"X_WO": np.eye(4)},
+        # 20 N / 1e20 = 2e-19 m: lost in rounding, the fingers pressed with
+        # nothing and the shake reported a drop (fuzz, round 27)
+        {"stiffness": 1e20},
     ],
 )
 def test_bad_options(wsg_scene, kw):
@@ -243,3 +246,52 @@ def test_the_summary_leads_with_the_seat_and_names_the_plans_verdict():
     assert data["seated_X_WO"] == np.eye(4).tolist()
     assert data["seated_q_hand"] == [0.1, 0.2]
     assert data["held_from_seat"] is True and data["held"] is False
+
+
+@pytest.mark.parametrize(
+    ("record", "other", "match"),
+    [
+        ({}, True, "hand pose X_WH"),  # another candidate of the same hand
+        ({"joint_names": ("a::j0", "a::j1")}, False, "joints"),
+        ({"seated_X_WO": np.full((4, 4), np.nan)}, False, "seated_X_WO"),
+        ({"seated_X_WO": np.diag([2.0, 2.0, 2.0, 1.0])}, False, "seated_X_WO"),
+        ({"seated_X_WO": np.eye(3)}, False, "seated_X_WO"),  # was a RuntimeError
+        ({"seated_q_hand": (np.nan, 0.01)}, False, "seated_q_hand"),
+    ],
+)
+def test_seated_takes_only_the_candidate_shaken_and_a_sound_record(
+    own_scene, record, other, match
+):
+    # Fuzz, round 27: only the number of joints was compared, and a record
+    # built by hand became a candidate's X_WO unchecked.
+    from drakegrasp.planning.shake_result import ShakeResult
+
+    scene = own_scene()
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=8, mu=0.5, seed=0, robustness_samples=4,
+    )  # fmt: skip
+    shaken = result[0]
+    fields = dict(
+        held=True, max_displacement=0.0, max_rotation=0.0, phases=(), squeeze=1.0,
+        efforts=(1.0, 1.0), time_step=1e-3, duration=1.0, wall_time=0.1,
+        bounds=(0.01, 0.17), seated_q_hand=tuple(shaken.q_hand),
+        seated_X_WO=shaken.X_WO.GetAsMatrix4(),
+        joint_names=tuple(shaken.joint_names), X_WH=shaken.X_WH.GetAsMatrix4(),
+    )  # fmt: skip
+    sound = ShakeResult(**fields)
+    assert np.array_equal(sound.seated(shaken).q_hand, shaken.q_hand)
+    with pytest.raises(InvalidOptionError, match=match):
+        ShakeResult(**{**fields, **record}).seated(result[1] if other else shaken)
+
+
+def test_motion_text_reads_any_motion_and_refuses_what_is_not_one():
+    from drakegrasp.planning.shake_result import motion_text
+
+    assert motion_text(0.0123, np.radians(5.0)) == "12.30 mm and 5.00 deg"
+    assert motion_text(2.5, 1.0) == "2.50 m (out of the hand)"
+    assert motion_text(1e300, 0.0) == "1e+300 m (out of the hand)"  # not 301 digits
+    assert motion_text(np.nan, 0.0) == "not measured"  # was "nan mm"
+    for bad in [("a", 1.0), (None, 0.0), (-1.0, 0.1), (0.01, -0.1)]:
+        with pytest.raises(InvalidOptionError):  # was a raw TypeError, or "-1000 mm"
+            motion_text(*bad)
