@@ -506,18 +506,21 @@ def _capacity(positions, normals, fingers, *, mu, torque_scale, contact_model,
     out = np.empty((K, len(directions)))
     if not np.all(has):  # no palm row: the LPs and numbers of palm=None
         out[~has] = run(W[~has], groups[~has], directions)
-    if np.any(has):
-        W, groups, a, c = W[has], groups[has], a[has], c[has]
-        best = np.zeros((len(W), len(directions)))
-        faces = np.repeat(face[has], per, axis=1)  # per wrench
-        for active in palm_faces(a.shape[1]):
+    # Each grasp's sets of active faces are those of its own faces: a grasp
+    # is judged alike whatever grasps share its call.
+    count = face.max(axis=1) + 1  # (K,) distinct palm normals per grasp
+    for R in np.unique(count[has]):
+        k = np.flatnonzero(count == R)
+        faces = np.repeat(face[k], per, axis=1)  # per wrench
+        best = np.zeros((len(k), len(directions)))
+        for active in palm_faces(int(R)):
             # the faces outside `active` carry nothing (their wrenches left
             # out); each active one at most what presses the object into it
             idle = (faces >= 0) & ~np.isin(faces, active)
-            Wa = np.where(idle[..., None], 0.0, W)
-            rows = None if not active else (a[:, active], c[:, active])
-            best = np.maximum(best, run(Wa, groups, directions, rows))
-        out[has] = best
+            Wa = np.where(idle[..., None], 0.0, W[k])
+            rows = None if not active else (a[k][:, active], c[k][:, active])
+            best = np.maximum(best, run(Wa, groups[k], directions, rows))
+        out[k] = best
     return out
 
 

@@ -278,6 +278,50 @@ def test_grasps_without_a_palm_contact_keep_their_numbers_bitwise():
     assert not np.array_equal(new[[0, 3, 4]], old[[0, 3, 4]])
 
 
+@pytest.mark.parametrize("solver", ["batch", "drake"])
+def test_a_grasps_capacity_does_not_depend_on_the_grasps_beside_it(solver):
+    # A jaw over a palm with a floor (+z) and a wall (+y): two faces, so every
+    # set of them is tried.  Beside it in one call, a grasp whose palm has
+    # five faces (more than MAX_PALM_FACES: only none and all are tried) made
+    # the first grasp's sets "none and all" too (fuzz, round 27).
+    P = np.array(
+        [
+            [-0.03, 0, 0.01],
+            [-0.03, 0, -0.01],
+            [0.03, 0, 0.01],
+            [0.03, 0, -0.01],
+            [0, 0, -0.04],
+            [0, -0.03, 0],
+            [-0.03, 0, 0.01],
+        ]
+    )
+    N = np.array(
+        [[1, 0, 0], [1, 0, 0], [-1, 0, 0], [-1, 0, 0], [0, 0, 1], [0, 1, 0], [1, 0, 0]],
+        float,
+    )
+    F = np.array([0, 0, 1, 1, 2, 2, 0])
+    Pb = np.array(
+        [
+            [-0.03, 0, 0],
+            [0.03, 0, 0],
+            [0, 0, -0.03],
+            [0, 0.03, 0],
+            [0, -0.03, 0],
+            [0.02, 0.02, -0.02],
+            [-0.02, -0.02, -0.02],
+        ]
+    )
+    Nb = -Pb / np.linalg.norm(Pb, axis=1, keepdims=True)
+    Fb = np.array([0, 1, 2, 2, 2, 2, 2])  # fmt: skip
+    kw = dict(mu=0.5, torque_scale=0.05, palm=2, solver=solver)
+    alone = weight_capacity(P[None], N[None], F[None], **kw)[0]
+    beside = weight_capacity(np.stack([P, Pb]), np.stack([N, Nb]), np.stack([F, Fb]),
+                             **kw)  # fmt: skip
+    np.testing.assert_allclose(beside[0], alone, rtol=1e-7, atol=1e-9)
+    # a set of one face matters here: 1.316 and 1.184 N/N, not none-or-both's 0.816
+    np.testing.assert_allclose(alone[7:10], [1.3163, 1.1839, 0.8165], atol=1e-4)
+
+
 def test_the_program_for_inspection_has_the_palms_row():
     from pydrake.solvers import Solve
 
