@@ -252,13 +252,15 @@ def _package_map_of(parser_or_package_map, caller: str) -> PackageMap:
 
 
 def check_obj_vertices(path) -> None:
-    """Refuse a Wavefront OBJ file with a vertex that is not three finite numbers.
+    """Refuse a Wavefront OBJ file whose vertices or faces Drake would misread.
 
     Drake's parser reads ``v nan 0 0`` as a vertex at a finite place, and the
-    planner or a scene then works on a mesh the file does not describe, so
-    :func:`~drakegrasp.planning.scenes.planning_scene` and a scene's
-    ``add_model`` of an ``.obj`` read its ``v`` lines first (about 0.15 s for
-    100,000 vertices).
+    planner or a scene then works on a mesh the file does not describe; a face
+    that names a vertex the file does not have stops the interpreter inside
+    Drake.  So :func:`~drakegrasp.planning.scenes.planning_scene` and a
+    scene's ``add_model`` of an ``.obj`` read its ``v`` and ``f`` lines first
+    (under a second for 100,000 vertices and 200,000 faces).  A line is read as
+    Drake reads it: its first word, after any indent, is the keyword.
 
     Parameters
     ----------
@@ -268,22 +270,49 @@ def check_obj_vertices(path) -> None:
     Raises
     ------
     ModelError
-        Naming the first bad vertex's line.
+        Naming the first bad line: a vertex that is not three finite numbers,
+        or a face index that is not an integer naming a vertex of the file
+        (``1 … V``, or ``-1 … -V`` counted back from the vertices read so far).
     """
+
+    def bad(number, line, what):
+        return ModelError(
+            f"mesh {os.fspath(path)!r}, line {number}: {what}, got "
+            f"{line.strip()[:80]!r}"
+        )
+
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
+            count, highest = 0, (0, 0, "")  # vertices read; largest face index
             for number, line in enumerate(f, 1):
-                if not line.startswith("v "):
+                words = line.split("#", 1)[0].split()
+                if not words or words[0] not in ("v", "f"):
                     continue
-                fields = line.split()[1:4]
-                try:
-                    values = [float(x) for x in fields]
-                except ValueError:
-                    values = []
-                if len(values) < 3 or not all(math.isfinite(v) for v in values):
-                    raise ModelError(
-                        f"mesh {os.fspath(path)!r}, line {number}: a vertex must be "
-                        f"three finite numbers, got {line.strip()[:80]!r}"
-                    )
+                if words[0] == "v":
+                    try:
+                        values = [float(x) for x in words[1:4]]
+                    except ValueError:
+                        values = []
+                    if len(values) < 3 or not all(math.isfinite(v) for v in values):
+                        raise bad(number, line, "a vertex must be three finite numbers")
+                    count += 1
+                    continue
+                for word in words[1:]:
+                    try:
+                        index = int(word.split("/")[0])
+                    except ValueError:
+                        raise bad(
+                            number, line, "a face's vertex must be an integer index"
+                        ) from None
+                    if index == 0 or index < -count:
+                        raise bad(number, line, f"a face names vertex {index}")
+                    if index > highest[0]:
+                        highest = (index, number, line)
+            index, number, line = highest  # a forward reference counts the file's V
+            if index > count:
+                raise bad(
+                    number, line,
+                    f"a face names vertex {index} of a file of {count} vertices",
+                )  # fmt: skip
     except OSError:
         return  # Drake's parser says what is wrong with the file

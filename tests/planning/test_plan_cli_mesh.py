@@ -68,6 +68,14 @@ def test_a_hand_file_that_is_not_there_is_named(capsys, hand):
         ("v 0 0 0\nv inf 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\n", "line 2: a vertex must"),
         ("v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1: a vertex must"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "volume"),  # flat: no inside
+        # as Drake reads them: an indented or tab-separated vertex is a vertex
+        ("v 0 0 0\n  v nan 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\n", "line 2: a vertex"),
+        ("v 0 0 0\nv\tnan 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\n", "line 2: a vertex"),
+        # a face naming a vertex the file lacks stopped the interpreter in Drake
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "line 4: a face names vertex 9"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", "line 4: a face names vertex -4"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "line 4: a face names vertex 0"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "line 4: a face's vertex must"),
     ],
 )
 def test_a_hostile_mesh_is_refused_in_one_line(tmp_path, capsys, text, message):
