@@ -377,6 +377,11 @@ def plan_grasps(
         raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
     if object_mass is not None:
         object_mass = _check_positive("object_mass", object_mass, "kg")
+        if not np.isfinite(object_mass * GRAVITY):  # every figure would be inf
+            raise InvalidOptionError(
+                f"object_mass = {object_mass:g} kg weighs more than a float "
+                f"holds (m g = inf N)"
+            )
     if squeeze_limit is not None:
         squeeze_limit = check_squeeze_limit(squeeze_limit)
     if torque_limit is not None:

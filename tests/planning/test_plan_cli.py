@@ -251,3 +251,11 @@ def test_plan_preshape_must_be_joint_equals_a_finite_value(capsys, bad):
         main(["plan", "--preshape", bad])
     assert exit_.value.code == 2
     assert "expected JOINT=VALUE" in capsys.readouterr().err
+
+
+def test_a_mass_whose_weight_overflows_is_refused_in_one_line(capsys):
+    # --mass 1e308: m g = inf, and the plan printed "squeeze inf N per finger"
+    # with exit 0 (fuzz, round 27)
+    assert main(["plan", "--num", "5", "--mass", "1e308"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--mass = 1e+308 kg weighs more" in err[0], err
