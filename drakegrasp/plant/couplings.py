@@ -40,6 +40,7 @@ that image is again a box, ``|u_i| <= Σ_k |C_ki| τ_max,k``
 from __future__ import annotations
 
 import math
+import re
 import weakref
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Sequence
@@ -127,17 +128,17 @@ def couplings_in_model(
     ModelError
         For a document that is not XML or a mimic element without a joint.
     """
+    if kind not in ("urdf", "sdf"):
+        raise InvalidOptionError(f"kind must be 'urdf' or 'sdf', got {kind!r}")
     try:
-        root = ET.fromstring(text)
+        root = ET.fromstring(_with_drake_namespace(text))
     except ET.ParseError as e:
         raise ModelError(f"cannot read the model's couplings: {e}") from None
     if kind == "urdf":
         models, tag = [root], "mimic"
-    elif kind == "sdf":
+    else:
         models = [root] if root.tag == "model" else root.findall("model")
         tag = _DRAKE_NS + "mimic"
-    else:
-        raise InvalidOptionError(f"kind must be 'urdf' or 'sdf', got {kind!r}")
     out = []
     for model in models:
         found = []
@@ -159,6 +160,17 @@ def couplings_in_model(
                 )
         out.append(found)
     return out
+
+
+def _with_drake_namespace(text: str) -> str:
+    """``text``, its root declaring ``xmlns:drake`` if it uses the prefix undeclared.
+
+    Drake's parser reads such a file; an XML parser does not.
+    """
+    if "drake:" not in text or "xmlns:drake" in text:
+        return text
+    declared = f'xmlns:drake="{_DRAKE_NS[1:-1]}"'
+    return re.sub(r"<(?![?!])([\w:.-]+)", rf"<\1 {declared}", text, count=1)
 
 
 def _kind_of(name: str) -> str:

@@ -8,13 +8,12 @@ with a reason."""
 
 from __future__ import annotations
 
-import importlib.util
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
 import pytest
 from cloud_support import sample_cloud
+from coupled_support import coupled_hand_sdf
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from pydrake.geometry import Box, Capsule, Cylinder, Sphere
@@ -407,15 +406,6 @@ def test_closed_form_distances_match_drakes_for_any_shape_and_pose(
     )
 
 
-def _coupled_hand_sdf() -> str:
-    """The coupled three-finger hand that test_multifinger writes."""
-    path = Path(__file__).with_name("test_multifinger.py")
-    spec = importlib.util.spec_from_file_location("_test_multifinger", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module._coupled_hand_sdf()
-
-
 @pytest.fixture(scope="module")
 def coupled():
     """(the coupled hand alone in a plant, root context, hand, cylinder cloud)."""
@@ -423,7 +413,7 @@ def coupled():
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     parser = Parser(plant)
     register_models(parser)
-    (hand,) = add_models(parser, text=_coupled_hand_sdf(), kind="sdf")
+    (hand,) = add_models(parser, text=coupled_hand_sdf(), kind="sdf")
     plant.Finalize()
     root = builder.Build().CreateDefaultContext()
     cylinder = planning_scene(
@@ -482,7 +472,7 @@ def test_a_table_under_the_cloud_is_an_obstacle(coupled):
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     parser = Parser(plant)
     register_models(parser)
-    (hand,) = add_models(parser, text=_coupled_hand_sdf(), kind="sdf")
+    (hand,) = add_models(parser, text=coupled_hand_sdf(), kind="sdf")
     top = p[:, 2].min()  # the cylinder's bottom cap
     plant.RegisterCollisionGeometry(
         plant.world_body(), RigidTransform([0.0, 0.0, top - 0.01]),

@@ -243,3 +243,18 @@ def test_a_mimic_drake_ignores_is_not_recorded(kind):
     assert plant_couplings(plants["sap"]) == (
         JointCoupling(FOLLOWER, LEADER, 1.0, 0.0),
     )
+
+
+def test_a_drake_prefix_the_file_does_not_declare_is_read_as_drake_reads_it():
+    # Drake's parser takes <drake:mimic> (or <drake:proximity_properties>) in a
+    # file without xmlns:drake; XML does not, and planning_scene, now loading
+    # through add_models, refused such an object ("unbound prefix").
+    from drakegrasp.plant.couplings import couplings_in_model
+
+    text, _, _ = GRIPPERS["sdf"](multiplier=2.0, offset=-0.01)
+    bare = text.replace(' xmlns:drake="http://drake.mit.edu"', "").replace(
+        " xmlns:drake='http://drake.mit.edu'", ""
+    )
+    assert "xmlns:drake" not in bare and "drake:mimic" in bare
+    assert couplings_in_model(bare, "sdf") == couplings_in_model(text, "sdf")
+    assert couplings_in_model(bare, "sdf")[0][0][2:] == (2.0, -0.01)
