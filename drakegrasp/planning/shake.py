@@ -9,7 +9,10 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
   (``JointActuator.set_controller_gains``, stiffness ``k``) aimed
   ``squeeze / k`` past the place where they touch, so each presses with
   ``squeeze`` newtons, or N·m for a revolute joint (within its effort
-  limit), and resists being pushed open with stiffness ``k``, as a
+  limit), less ``k`` times however far it closes on after that (pads that
+  give, an object pushed along: ``ShakeResult.efforts`` are what the joints
+  apply once seated, and :class:`SqueezeLostWarning` says when little is
+  left), and resists being pushed open with stiffness ``k``, as a
   position-controlled gripper does (two
   force-controlled fingers would let gravity along the grasp axis carry
   object and fingers to a joint limit).  Where they touch is found in
@@ -59,7 +62,7 @@ from pydrake.systems.framework import DiagramBuilder
 from drakegrasp.core.validation import unit_vectors
 from drakegrasp.errors import GraspError, InvalidOptionError, ModelError, SolverError
 from drakegrasp.planning.candidates import GraspCandidate, check_candidate
-from drakegrasp.planning.shake_result import ShakeResult
+from drakegrasp.planning.shake_result import ShakeResult, squeeze_unit_of
 from drakegrasp.planning.turned_gravity import (
     DEFAULT_DIRECTIONS,
     _schedule,
@@ -77,7 +80,31 @@ from drakegrasp.plant.validation import (
     resolve_object_body,
 )
 
-__all__ = ["SoftFingerShakeWarning", "check_shake_options", "shake_test"]
+__all__ = [
+    "SoftFingerShakeWarning",
+    "SqueezeLostWarning",
+    "check_shake_options",
+    "shake_test",
+]
+
+
+class SqueezeLostWarning(UserWarning):
+    """The shaken fingers press with a small share of the squeeze once seated.
+
+    A position-controlled finger aimed ``squeeze / stiffness`` past where it
+    stopped presses with ``stiffness`` times what is left of that aim: where
+    the fingers close on after aiming by most of it (compliant pads, an object
+    pushed along), the test judges a far weaker grip than asked for.  Drake's
+    Allegro hand on the YCB soup can, at 0.7 N·m: its joints' mean seated
+    effort 0.33-0.38 N·m at stiffness 10 N·m/rad (its five best grasps held),
+    0.03-0.07 N·m at 100 (all five dropped).
+    """
+
+
+_LOST = 0.25
+""":class:`SqueezeLostWarning` when the closing joints' mean seated effort
+(``ShakeResult.efforts``; a joint whose link touches nothing presses with
+none) is under this share of the squeeze aimed for."""
 
 
 class SoftFingerShakeWarning(UserWarning):
@@ -300,8 +327,13 @@ def shake_test(
         Gains of the fingers' position control (N/m, N·s/m; per radian for
         revolute joints): each finger is aimed ``squeeze / stiffness`` past
         where it touches.  Light revolute fingers need far lower gains than
-        the default (the Allegro hand: ``squeeze=0.5, stiffness=20,
-        damping=1``; at the defaults Drake's SAP solver diverges).
+        the default (the Allegro hand: ``squeeze=0.7, stiffness=10,
+        damping=0.1``, as ``plan --shake`` uses; at the defaults Drake's SAP
+        solver diverges).  A finger presses with ``stiffness`` times what is
+        left of its aim: where it closes on after aiming (compliant pads, an
+        object pushed along) it presses with less (``ShakeResult.efforts``),
+        and with nothing once it has closed on by the whole aim
+        (:class:`SqueezeLostWarning`).
     directions : sequence of (3,) float, optional
         World gravity directions after the settling phase along −z (any
         finite, non-zero length: only the direction counts; consecutive ones
@@ -555,6 +587,19 @@ def shake_test(
     efforts = tuple(abs(float(u[a.input_start()])) for a in squeezing)
     effort_units = tuple(effort_unit(a.joint()) for a in squeezing)
     capped = tuple(float(min(squeeze, a.effort_limit())) for a in squeezing)
+    if seat > 0 and efforts and np.mean(efforts) < _LOST * min(capped):
+        warnings.warn(
+            f"at the seat the closing joints press with {np.mean(efforts):.3g} "
+            f"{squeeze_unit_of(effort_units)} on average of the {min(capped):g} "
+            f"aimed for: a position-controlled finger presses with stiffness "
+            f"× (its aim - how far it closed on after aiming), and "
+            f"the aim squeeze / stiffness = {min(capped) / stiffness:.3g} was "
+            f"taken up by the fingers closing on (pads that give, an object "
+            f"pushed along); lower the stiffness (or raise the squeeze) for "
+            f"the squeeze to hold",
+            SqueezeLostWarning,
+            stacklevel=2,
+        )
     for end in ends:
         d, r = advance(end)
         phases.append(

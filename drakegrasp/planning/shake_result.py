@@ -16,7 +16,7 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["ShakeResult", "motion_text"]
+__all__ = ["ShakeResult", "motion_text", "squeeze_unit_of"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,7 +178,7 @@ class ShakeResult:
     @property
     def squeeze_unit(self) -> str:
         """The unit of ``squeeze``: "N", "N·m", or both named when mixed."""
-        return _squeeze_unit(self.effort_units)
+        return squeeze_unit_of(self.effort_units)
 
     @property
     def squeeze_capped(self) -> bool:
@@ -295,7 +295,7 @@ def motion_text(displacement: float, rotation: float, digits: int = 2) -> str:
     )
 
 
-def _squeeze_unit(units: tuple[str, ...]) -> str:
+def squeeze_unit_of(units: tuple[str, ...]) -> str:
     """The squeeze's unit for a summary line: one unit, or both when mixed."""
     kinds = set(units) or {"N"}
     if len(kinds) == 1:

@@ -83,3 +83,24 @@ def test_the_help_quotes_the_shake_tests_own_defaults():
     assert set(SHAKE_FLAGS) <= set(defaults)
     for options in PLAN_SHAKE_DEFAULTS.values():
         assert set(options) <= set(SHAKE_FLAGS)
+
+
+@pytest.mark.parametrize(
+    ("argv", "says"),
+    [
+        # the pads take up the 20 µm aim: the squeeze is lost at the seat
+        (["--stiffness", "1e6"], "at the seat the closing joints press with"),
+        # soft fingers shaken in point contact: the advice in flags
+        (
+            ["--contact-model", "soft_finger", "--torsional-friction", "0.1",
+             "--hydroelastic", "none"],
+            "give --hydroelastic 1e6 (Pa, rubber)",
+        ),
+    ],
+)  # fmt: skip
+def test_a_shakes_warning_is_one_line_in_flags(capsys, argv, says):
+    # Python's form named shake_ranking.py:366 and repeated the calling line
+    assert main(["plan", "--num", "40", "--top", "2", "--shake", "2", *argv]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("drakegrasp: warning: "), err
+    assert says in err[0] and ".py" not in err[0]
