@@ -1026,9 +1026,10 @@ them.
   with them and turned 17° with point contact.  The WSG-50 touches with tip
   spheres and holds either way: the model's own contact.
 - The Allegro hand's gains: each closing joint is aimed to press with its
-  effort limit, 0.7 N·m, at 10 N·m/rad and 0.1 N·m·s/rad; at the defaults
-  (4000, 50) Drake's SAP solver stopped on 2 of the top 10 sugar-box
-  candidates (``benchmarks/bench_allegro_squeeze.py``).  Seated on the soup
+  effort limit, 0.7 N·m, at 10 N·m/rad and 0.1 N·m·s/rad; at the fixed 4000
+  N·m/rad and 50 that were once every joint's default Drake's SAP solver
+  stopped on 2 of the top 10 sugar-box candidates
+  (``benchmarks/bench_allegro_squeeze.py``).  Seated on the soup
   can, the joints press with 0.33-0.38 N·m on average (those whose links
   touch nothing with none, the rest up to 0.7) and the five best grasps hold;
   at 100 N·m/rad the 0.007 rad aim is taken up as the fingers close on, they
@@ -1594,7 +1595,9 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         metavar="K",
         help="with --shake: the fingers' position gain, N/m or N·m/rad "
-        "(default 4000; 10 for --hand allegro: light fingers need light gains)",
+        "(default per joint: 4000 N/m for a prismatic one, and for a revolute "
+        "one what aims it 0.1 rad past its place, its squeeze / 0.1 rad; 10 for "
+        "--hand allegro)",
     )
     plan.add_argument(
         "--hydroelastic",
@@ -1614,7 +1617,8 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         metavar="D",
         help="with --shake: the fingers' damping, N·s/m or N·m·s/rad "
-        "(default 50; 0.1 for --hand allegro)",
+        "(default the stiffness times 0.0125 s: 50 at 4000 N/m; 0.1 for --hand "
+        "allegro)",
     )
     _add_scene_file_options(
         plan,

@@ -187,6 +187,9 @@ class ShakenCandidates(Sequence):
             for name in ("stiffness", "damping")
             if self.options.get(name) is not None
         )
+        if not gains and results and results[0].gains:  # the per-joint defaults
+            stiff, damp = (list(v) for v in zip(*results[0].gains, strict=True))
+            gains = f"stiffness {_span(stiff)}, damping {_span(damp)}"
         used = "".join(f"{x}; " for x in (squeeze, gains) if x)
         lines = [
             f"{n_held} of {len(self)} shaken candidates held (counted from the "
@@ -194,6 +197,12 @@ class ShakenCandidates(Sequence):
         ]
         lines += [f"  {s}" for s in self.shaken]
         return "\n".join(lines)
+
+
+def _span(values) -> str:
+    """``4000``, or ``7-20`` where the joints' values differ."""
+    low, high = min(values), max(values)
+    return f"{low:g}" if low == high else f"{low:g}-{high:g}"
 
 
 def _checked_top(top) -> int:

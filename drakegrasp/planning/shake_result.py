@@ -104,6 +104,11 @@ class ShakeResult:
         The shaken candidate's hand pose (where its base was welded), world
         frame; None in a record made before it existed.  :meth:`seated`
         accepts only the candidate with these joints and this pose.
+    gains : tuple of (float, float)
+        ``(stiffness, damping)`` of each closing joint's position control, in
+        actuator order (as ``efforts``): as given, or the per-joint defaults
+        of :func:`~drakegrasp.planning.shake.shake_test`.  Empty in a record
+        made before it existed.
     """
 
     held: bool
@@ -129,6 +134,7 @@ class ShakeResult:
     seated_X_WO: np.ndarray | None = None
     joint_names: tuple[str, ...] = ()
     X_WH: np.ndarray | None = None
+    gains: tuple[tuple[float, float], ...] = ()
 
     def seated(self, candidate):
         """``candidate`` with the hand's joints and the object where seating left them.

@@ -195,3 +195,25 @@ def test_a_follower_without_a_known_coupling_is_refused_with_its_remedy(
 
     with pytest.raises(dg.ModelError, match="no actuator to squeeze with.*mimic"):
         shake_test(bare, candidate, squeeze=0.5, stiffness=20.0, damping=1.0)
+
+
+def test_a_revolute_hands_default_gains_keep_its_squeeze(motors_on_leaders):
+    # A fixed 4000 N·m/rad, every joint's default once, aimed these 2 N·m
+    # fingers 0.5 mrad past their place: the fingers took most of it up as
+    # they closed on, and pressed with 0.7-0.9 N·m (on other candidates with
+    # next to nothing, or Drake's solver stopped).  By default a revolute
+    # finger is now aimed REVOLUTE_AIM = 0.1 rad past: 2 / 0.1 = 20 N·m/rad.
+    from drakegrasp.planning.shake import DAMPING_TIME, REVOLUTE_AIM
+
+    scene, result = motors_on_leaders
+    candidate = next(c for c in result if c.is_closure)
+    quick = dict(squeeze=2.0, directions=[[0.0, 0.0, -1.0]], settle=0.1, phase=0.2)
+    shaken = shake_test(scene.add_models, candidate, **quick)
+    k = 2.0 / REVOLUTE_AIM
+    assert shaken.gains == ((k, k * DAMPING_TIME),) * 3  # the three leaders
+    assert np.mean(shaken.efforts) > 0.9 * 2.0 and shaken.held_from_seat
+    stiff = shake_test(
+        scene.add_models, candidate, stiffness=4000.0, damping=50.0, **quick
+    )
+    assert stiff.gains == ((4000.0, 50.0),) * 3
+    assert np.mean(stiff.efforts) < 0.5 * 2.0

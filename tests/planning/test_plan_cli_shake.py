@@ -10,7 +10,12 @@ import json
 import pytest
 
 from drakegrasp.cli import PLAN_SHAKE_DEFAULTS, SHAKE_FLAGS, build_parser, main
-from drakegrasp.planning.shake import shake_test
+from drakegrasp.planning.shake import (
+    DAMPING_TIME,
+    PRISMATIC_STIFFNESS,
+    REVOLUTE_AIM,
+    shake_test,
+)
 
 
 def test_the_default_hand_holds_the_box_with_hydroelastic_pads(capsys):
@@ -77,8 +82,12 @@ def test_the_help_quotes_the_shake_tests_own_defaults():
     }
     _, sub = build_parser()
     text = " ".join(sub.choices["plan"].format_help().split())
-    for name in ("squeeze", "stiffness", "damping"):
-        assert f"default {defaults[name]:g}" in text, name
+    assert f"default {defaults['squeeze']:g}" in text
+    # the gains default per joint: the help quotes the library's constants
+    assert defaults["stiffness"] is None and defaults["damping"] is None
+    assert f"{PRISMATIC_STIFFNESS:g} N/m for a prismatic one" in text
+    assert f"squeeze / {REVOLUTE_AIM:g} rad" in text
+    assert f"stiffness times {DAMPING_TIME:g} s" in text
     assert defaults["hydroelastic_modulus"] is None
     assert set(SHAKE_FLAGS) <= set(defaults)
     for options in PLAN_SHAKE_DEFAULTS.values():
