@@ -297,16 +297,15 @@ def _motor_map(plant, candidate: GraspCandidate):
     each coordinate's generalized force ``(J C)ᵀ f`` may carry per N·m allowed
     at every actuator: ``|C|ᵀ a``, ``a_k`` 1 for a joint with an actuator and
     0 for one without (a follower's torque comes through its coupling; an
-    unactuated, uncoupled joint is passive).  A plant that gives none of the
-    candidate's joints an actuator says nothing of its motors: each joint
-    counts as one.  None when every joint is its own motor (``C = I``,
-    ``w = 1``).
+    unactuated, uncoupled joint is passive).  A plant without any actuator
+    says nothing of its motors: each joint counts as one.  None when every
+    joint is its own motor (``C = I``, ``w = 1``).
     """
     joints = [find_joint(plant, name) for name in candidate.joint_names]
     columns = np.array([j.velocity_start() for j in joints], dtype=int)
     C, _ = coupling_map(plant, columns, plant_couplings(plant))
     actuated = np.array([bool(_actuators(plant, j)) for j in joints])
-    a = actuated.astype(float) if actuated.any() else np.ones(len(joints))
+    a = actuated.astype(float) if plant.num_actuators() else np.ones(len(joints))
     if C.shape[0] == C.shape[1] and np.all(a == 1.0):
         return None
     return C, np.abs(C).T @ a

@@ -107,9 +107,9 @@ class SqueezeLostWarning(UserWarning):
 
 
 _LOST = 0.25
-""":class:`SqueezeLostWarning` when the closing joints' mean seated effort
+""":class:`SqueezeLostWarning` when the closing joints' seated efforts
 (``ShakeResult.efforts``; a joint whose link touches nothing presses with
-none) is under this share of the squeeze aimed for ..."""
+none) are on average under this share of the squeeze each was aimed at ..."""
 
 _PUSHED_OUT = 0.1
 """... and the object moves slower than this (m/s) at the seat: faster, the
@@ -501,7 +501,8 @@ def shake_test(
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
     by_name = {_scoped(plant, a.joint()): a for a in actuators}
     targets, gains = {}, {}
-    driven = _driven_followers(plant, set(by_name))
+    # a follower is driven by a leader among the candidate's own actuated joints
+    driven = _driven_followers(plant, set(candidate.joint_names) & set(by_name))
     for name, sign in zip(candidate.joint_names, candidate.closing_signs, strict=True):
         actuator = by_name.get(name)
         if actuator is None and name in driven:
@@ -525,6 +526,11 @@ def shake_test(
                 f"with nothing; give a stiffness below {push / _MIN_AIM:.3g}"
             )
         targets[int(actuator.joint().index())] = sign * push / k
+    if not targets:
+        raise ModelError(
+            f"none of the candidate's closing joints {list(candidate.joint_names)} "
+            "has an actuator to squeeze with"
+        )
     for actuator in actuators:  # every actuator position-controlled (Drake's PD)
         k, d = gains.get(int(actuator.index())) or _gains(
             actuator, squeeze, stiffness, damping
@@ -647,11 +653,13 @@ def shake_test(
     used = tuple(gains[int(a.index())] for a in squeezing)
     aims = [c / k for c, (k, _) in zip(capped, used, strict=True)]
     at_rest = seat > 0 and seated[2] < _PUSHED_OUT  # else pushed out: physics
-    if at_rest and efforts and np.mean(efforts) < _LOST * min(capped):
+    kept = [e / c for e, c in zip(efforts, capped, strict=True) if c > 0]
+    if at_rest and kept and np.mean(kept) < _LOST:  # a share: units apart
         warnings.warn(
-            f"at the seat the closing joints press with {np.mean(efforts):.3g} "
-            f"{squeeze_unit_of(effort_units)} on average of the {min(capped):g} "
-            f"aimed for, the object at rest: a position-controlled finger "
+            f"at the seat the closing joints press with {np.mean(kept):.0%} of "
+            f"the squeeze aimed for on average ({np.mean(efforts):.3g} "
+            f"{squeeze_unit_of(effort_units)} of {min(capped):g}), the object at "
+            f"rest: a position-controlled finger "
             f"presses with stiffness × what is left of its aim squeeze / "
             f"stiffness = {min(aims):.3g}, which the fingers took up as they "
             f"closed on (pads that give, a finger that touched nothing); lower "

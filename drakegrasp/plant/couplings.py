@@ -131,7 +131,7 @@ def couplings_in_model(
     if kind not in ("urdf", "sdf"):
         raise InvalidOptionError(f"kind must be 'urdf' or 'sdf', got {kind!r}")
     try:
-        root = ET.fromstring(_with_drake_namespace(text))
+        root = ET.fromstring(_with_prefixes_declared(text))
     except ET.ParseError as e:
         raise ModelError(f"cannot read the model's couplings: {e}") from None
     if kind == "urdf":
@@ -162,15 +162,33 @@ def couplings_in_model(
     return out
 
 
-def _with_drake_namespace(text: str) -> str:
-    """``text``, its root declaring ``xmlns:drake`` if it uses the prefix undeclared.
+_PROLOG = re.compile(
+    r"\ufeff?(?:\s|<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)*<([\w:.-]+)", re.S
+)
+"""What comes before the root element's name (an XML declaration, comments,
+a doctype), then that name."""
 
-    Drake's parser reads such a file; an XML parser does not.
+
+def _with_prefixes_declared(text: str) -> str:
+    """``text``, its root declaring every namespace prefix it uses undeclared.
+
+    Drake's parser reads ``<drake:mimic>`` in a file that declares no
+    ``xmlns:drake``, or a URDF's ``<gazebo><sensor:camera/>``; an XML parser
+    refuses them.  ``drake`` gets Drake's namespace (where ``<drake:mimic>``
+    is looked for), any other prefix a placeholder.
     """
-    if "drake:" not in text or "xmlns:drake" in text:
+    used = set(re.findall(r"</?([A-Za-z_][\w.-]*):[A-Za-z_]", text))
+    used |= set(re.findall(r"\s([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*\s*=", text))
+    used -= {"xmlns", "xml"}
+    missing = sorted(p for p in used if f"xmlns:{p}=" not in text)
+    root = _PROLOG.match(text)
+    if not missing or root is None:
         return text
-    declared = f'xmlns:drake="{_DRAKE_NS[1:-1]}"'
-    return re.sub(r"<(?![?!])([\w:.-]+)", rf"<\1 {declared}", text, count=1)
+    declared = " ".join(
+        f'xmlns:{p}="{_DRAKE_NS[1:-1] if p == "drake" else "urn:undeclared:" + p}"'
+        for p in missing
+    )
+    return f"{text[: root.end()]} {declared}{text[root.end() :]}"
 
 
 def _kind_of(name: str) -> str:
@@ -196,7 +214,14 @@ def _record_text(plant, text: str, kind: str, instances: Sequence) -> None:
     not simulate.  So they are recorded only when the plant holds a
     constraint for each (its constraints at least those recorded plus these).
     """
-    per_model = list(couplings_in_model(text, kind))[: len(instances)]
+    if "mimic" not in text:  # nothing to record: the file is not read as XML
+        return
+    try:
+        per_model = list(couplings_in_model(text, kind))[: len(instances)]
+    except ModelError:
+        if plant.num_constraints() <= len(_RECORDED.get(plant, ())):
+            return  # a file XML cannot read, but Drake made no coupler of it
+        raise
     declared = sum(len(found) for found in per_model)
     if plant.num_constraints() < len(_RECORDED.get(plant, ())) + declared:
         return  # Drake dropped them: the joints are free in this plant

@@ -13,6 +13,7 @@ import importlib.util
 import logging
 import math
 import os
+import re
 from pathlib import Path
 
 from pydrake.multibody.parsing import PackageMap, Parser
@@ -298,12 +299,13 @@ def check_obj_vertices(path) -> None:
                     count += 1
                     continue
                 for word in words[1:]:
-                    try:
-                        index = int(word.split("/")[0])
-                    except ValueError:
+                    # as Drake's reader (C's atoi): the leading integer counts
+                    digits = re.match(r"[+-]?\d+", word)
+                    if digits is None:
                         raise bad(
                             number, line, "a face's vertex must be an integer index"
-                        ) from None
+                        )
+                    index = int(digits.group())
                     if index == 0 or index < -count:
                         raise bad(number, line, f"a face names vertex {index}")
                     if index > highest[0]:

@@ -217,3 +217,25 @@ def test_a_revolute_hands_default_gains_keep_its_squeeze(motors_on_leaders):
     )
     assert stiff.gains == ((4000.0, 50.0),) * 3
     assert np.mean(stiff.efforts) < 0.5 * 2.0
+
+
+def test_followers_without_their_leaders_have_no_motor(motors_on_leaders):
+    # A candidate cut down to the distal joints (review, round 27): their
+    # leaders' motors are not among its joints.  The shake took an actuator
+    # anywhere in the plant as the followers' driver and squeezed nothing,
+    # silently; the torque capacity counted the followers as motors.
+    import dataclasses
+
+    scene, result = motors_on_leaders
+    c = next(c for c in result if c.is_closure)
+    keep = [k for k, name in enumerate(c.joint_names) if "dist" in name]
+    sub = dataclasses.replace(
+        c,
+        joint_names=tuple(c.joint_names[k] for k in keep),
+        q_hand=np.asarray(c.q_hand)[keep],
+        closing_signs=tuple(c.closing_signs[k] for k in keep),
+    )
+    with pytest.raises(dg.ModelError, match="no actuator to squeeze with"):
+        shake_test(scene.add_models, sub, squeeze=0.5)
+    beta = torque_capacity(scene.plant, scene.context, sub, scene.object_body)
+    assert np.all(beta == 0.0)  # passive joints hold no weight

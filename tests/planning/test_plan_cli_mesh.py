@@ -76,6 +76,7 @@ def test_a_hand_file_that_is_not_there_is_named(capsys, hand):
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", "line 4: a face names vertex -4"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "line 4: a face names vertex 0"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "line 4: a face's vertex must"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9.0\n", "line 4: a face names vertex 9"),
     ],
 )
 def test_a_hostile_mesh_is_refused_in_one_line(tmp_path, capsys, text, message):

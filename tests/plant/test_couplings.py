@@ -245,6 +245,59 @@ def test_a_mimic_drake_ignores_is_not_recorded(kind):
     )
 
 
+_MIMIC_BODY = (
+    "<model name='m'><link name='a'/><link name='b'/><link name='c'/>"
+    "<joint name='j1' type='revolute'><parent>a</parent><child>b</child>"
+    "<axis><xyz>0 0 1</xyz></axis></joint>"
+    "<joint name='j2' type='revolute'><parent>b</parent><child>c</child>"
+    "<axis><xyz>0 0 1</xyz></axis>"
+    "<drake:mimic joint='j1' multiplier='2' offset='0'/></joint></model>"
+)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        f"<sdf version='1.9'>{_MIMIC_BODY}</sdf>",
+        f"<?xml version='1.0'?>\n<sdf version='1.9'>{_MIMIC_BODY}</sdf>",
+        # a comment before the root that names an element, or the namespace
+        f"<!-- see <model> --><sdf version='1.9'>{_MIMIC_BODY}</sdf>",
+        f"<!-- no xmlns:drake here --><sdf version='1.9'>{_MIMIC_BODY}</sdf>",
+        f"<?xml version='1.0'?><!DOCTYPE sdf><sdf version='1.9'>{_MIMIC_BODY}</sdf>",
+        f"\ufeff<sdf version='1.9'>{_MIMIC_BODY}</sdf>",
+        # another prefix Drake ignores, beside the mimic
+        f"<sdf version='1.9'>{_MIMIC_BODY[:-8]}<gz:plugin/></model></sdf>",
+    ],
+)  # fmt: skip
+def test_a_prefix_the_file_does_not_declare_is_read_as_drake_reads_it(text):
+    # Drake's parser takes <drake:mimic> (or <gz:plugin>) in a file without
+    # the xmlns declaration; XML does not, and planning_scene, now loading
+    # through add_models, refused such models ("unbound prefix").
+    from drakegrasp.plant.couplings import couplings_in_model
+
+    assert couplings_in_model(text, "sdf") == [[("j2", "j1", 2.0, 0.0)]]
+
+
+def test_a_model_without_a_mimic_is_not_read_as_xml(tmp_path):
+    # A URDF's <gazebo><sensor:camera/> (an undeclared prefix): Drake loads it,
+    # and add_models, which has no coupling to read there, loads it too.
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    from drakegrasp.plant.couplings import add_models
+
+    path = tmp_path / "r.urdf"
+    path.write_text(
+        "<?xml version='1.0'?><robot name='r'><link name='a'/><link name='b'/>"
+        "<joint name='j' type='revolute'><parent link='a'/><child link='b'/>"
+        "<axis xyz='0 0 1'/><limit effort='1' lower='-1' upper='1' velocity='1'/>"
+        "</joint><gazebo><sensor:camera name='c'/></gazebo></robot>"
+    )
+    plant = MultibodyPlant(0.001)
+    assert len(add_models(Parser(plant), path)) == 1
+    assert plant_couplings(plant) == ()
+
+
 def test_a_drake_prefix_the_file_does_not_declare_is_read_as_drake_reads_it():
     # Drake's parser takes <drake:mimic> (or <drake:proximity_properties>) in a
     # file without xmlns:drake; XML does not, and planning_scene, now loading
