@@ -319,6 +319,24 @@ def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
     return float(k), float(d)
 
 
+def _on_couplings(plant, names, q: list) -> tuple[float, ...]:
+    """``q`` over joints ``names`` with each follower set exactly from its leader.
+
+    Drake's coupler constraint is compliant: a simulated follower drifts
+    micro-radians off ``ρ q_leader + Δq``, more than the coupling tolerance
+    that :func:`~drakegrasp.analyze_grasp` checks a pose against.
+    """
+    try:
+        couplings = plant_couplings(plant)
+    except InvalidOptionError:  # couplings drakegrasp was not told of
+        return tuple(float(x) for x in q)
+    at = {name: k for k, name in enumerate(names)}
+    for follower, leader, rho, offset in couplings:
+        if follower in at and leader in at:
+            q[at[follower]] = rho * q[at[leader]] + offset
+    return tuple(float(x) for x in q)
+
+
 def _driven_followers(plant, actuated: set) -> set:
     """Scoped names of the joints a recorded coupling ties to an actuated leader.
 
@@ -640,8 +658,11 @@ def shake_test(
         X_HO_seat = plant.CalcRelativeTransform(ctx, H, body.body_frame())
         max_ds = max_rs = 0.0
         q_now = plant.GetPositions(ctx)
-        seated_q = tuple(_within_limits(find_joint(plant, name), q_now)
-                         for name in candidate.joint_names)  # fmt: skip
+        seated_q = _on_couplings(
+            plant, candidate.joint_names,
+            [_within_limits(find_joint(plant, name), q_now)
+             for name in candidate.joint_names],
+        )  # fmt: skip
         seated_X_WO = plant.EvalBodyPoseInWorld(ctx, body).GetAsMatrix4()
     else:
         advance(settle)  # efforts are read once something has been simulated

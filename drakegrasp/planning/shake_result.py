@@ -143,10 +143,13 @@ class ShakeResult:
         the seated grasp in a context, for
         :func:`~drakegrasp.analyze_grasp` (the grasp a multi-finger hand
         really holds, millimetres from the planned one; its ``contacts``
-        and scores stay the plan's).  With hydroelastic fingers the seated
-        bodies overlap by millimetres (the pads are compliant: 1.1-4.3 mm for
-        the Allegro hand on the soup can at 1e6 Pa), which the analysis
-        refuses as penetration unless given ``allow_penetration=True``.
+        and scores stay the plan's).  The seated bodies overlap by
+        millimetres (compliant hydroelastic pads: 1.1-4.3 mm for the Allegro
+        hand on the soup can at 1e6 Pa; Drake's point contact too: about 2 mm
+        for a Barrett-like hand of 1.5 N·m), which the analysis refuses as
+        penetration unless given ``allow_penetration=True``.  A ``<mimic>``
+        follower is set exactly from its leader (Drake's coupler drifts
+        micro-radians off it).
 
         Raises
         ------

@@ -176,7 +176,16 @@ def test_a_hand_with_motors_on_its_leaders_only_is_shaken(motors_on_leaders):
     for k in range(3):
         prox = q[names.index(f"{MODEL}::f{k}_prox_joint")]
         dist = q[names.index(f"{MODEL}::f{k}_dist_joint")]
-        assert dist == pytest.approx(RATIO * prox, abs=1e-3)
+        # exactly on the coupling: Drake's compliant coupler drifts micro-
+        # radians, and analyze_grasp refused the seated grasp (CouplingError)
+        assert dist == RATIO * prox
+    ctx = scene.plant.GetMyContextFromRoot(scene.context.Clone())
+    shaken.seated(candidate).apply(scene.plant, ctx, object_body=scene.object_body)
+    report = dg.analyze_grasp(
+        scene.plant, ctx, scene.object_body, hand=scene.hand, mu=MU,
+        allow_penetration=True,
+    )  # fmt: skip
+    assert report.grasp.num_contacts >= 2
 
 
 def test_a_follower_without_a_known_coupling_is_refused_with_its_remedy(
