@@ -1212,6 +1212,9 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
         for j in (plant.get_joint(i) for i in plant.GetJointIndices())
         if j.child_body().index() in moved
     ]
+    from drakegrasp.plant.couplings import plant_couplings
+
+    followers = {c[0]: c[1] for c in plant_couplings(plant)}
     q = plant.GetPositions(ctx)
     for name, value in values.items():
         model, sep, joint_name = name.rpartition("::")
@@ -1233,6 +1236,12 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
             raise InvalidOptionError(
                 f"--preshape {name}: the joint has {joint.num_positions()} "
                 "positions; a pre-shape sets one-degree-of-freedom joints"
+            )
+        scoped = f"{plant.GetModelInstanceName(joint.model_instance())}::{joint.name()}"
+        if scoped in followers:  # set from its leader: the value would be lost
+            raise InvalidOptionError(
+                f"--preshape {name}: the joint follows {followers[scoped]} (a "
+                "<mimic>), which sets it: give the leader's value"
             )
         low = float(joint.position_lower_limits()[0])
         high = float(joint.position_upper_limits()[0])

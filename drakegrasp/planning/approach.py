@@ -160,6 +160,25 @@ def _check_preshape_limits(q: np.ndarray, structure) -> None:
         )
 
 
+def _check_preshape_couplings(given: np.ndarray, q: np.ndarray, structure) -> None:
+    """Refuse a pre-shape whose follower's value its coupling would overwrite.
+
+    ``q`` is ``given`` with every follower set from its leader; a value given
+    for a follower that differs from that (beyond
+    :data:`~drakegrasp.plant.pose.JOINT_LIMIT_TOL`) was silently replaced.
+    """
+    off = np.flatnonzero(np.abs(q - given) > JOINT_LIMIT_TOL)
+    if off.size:
+        k = int(off[0])
+        lead, rho, offset = structure.coupling.follows[k]
+        raise InvalidOptionError(
+            f"preshape[{k}] ({structure.names[k]}) = {given[k]:g} breaks its "
+            f"coupling {structure.names[k]} = {rho:g} * {structure.names[lead]} "
+            f"+ {offset:g}, which sets it to {q[k]:g}: give the leader's value "
+            "and the follower's that follows from it"
+        )
+
+
 def _vector(name, value, n) -> np.ndarray:
     try:
         v = np.asarray(value, dtype=float)
@@ -284,6 +303,7 @@ def multi_finger_hand(
         given = _vector("preshape", preshape, n)
         _check_preshape_limits(given, structure)  # the values given, as --preshape
         q0 = structure.coupling.apply(given)
+        _check_preshape_couplings(given, q0, structure)
     q0 = np.clip(q0, structure.lower, structure.upper)
     curl_synergy = isinstance(synergy, str)
     if curl_synergy and synergy != "curl":

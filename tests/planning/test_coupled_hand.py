@@ -248,3 +248,22 @@ def test_followers_without_their_leaders_have_no_motor(motors_on_leaders):
         shake_test(scene.add_models, sub, squeeze=0.5)
     beta = torque_capacity(scene.plant, scene.context, sub, scene.object_body)
     assert np.all(beta == 0.0)  # passive joints hold no weight
+
+
+def test_a_pre_shape_of_a_follower_is_refused_not_overwritten(tmp_path, capsys):
+    # The follower's value was replaced from its leader's without a word
+    # (a user's Barrett-like hand: --preshape f1_distal_joint=0.3 planned as
+    # if not given; round 27).
+    path = _hand_file(tmp_path, follower_effort=0)
+    args = ["plan", "cylinder", "--hand", str(path), "--num", "5"]
+    assert main([*args, "--preshape", "f0_dist_joint=-0.3"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "follows coupled_hand::f0_prox_joint" in err[0], err
+    scene = planning_scene(CYLINDER, hand_url=str(path))
+    bad = list(OPEN)
+    bad[1] = -0.2  # f0's distal joint, whose coupling makes it 0.6 * -0.5 = -0.3
+    with pytest.raises(dg.InvalidOptionError, match=r"preshape\[1\].*breaks its"):
+        plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=5, mu=MU, seed=0, preshape=bad,
+        )  # fmt: skip
