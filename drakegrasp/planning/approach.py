@@ -55,7 +55,12 @@ from drakegrasp.planning.gripper import free_base
 from drakegrasp.planning.placement import axis_frames
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import HandStructure, hand_structure, tip_bodies
+from drakegrasp.plant.fingers import (
+    HandStructure,
+    finger_chains,
+    hand_structure,
+    tip_bodies,
+)
 from drakegrasp.plant.pose import JOINT_LIMIT_TOL
 from drakegrasp.plant.validation import HandSpec, hand_bodies
 
@@ -81,6 +86,10 @@ class MultiFingerHand:
     structure : HandStructure
         Closing joints, limits, fingers and couplings
         (:func:`~drakegrasp.plant.fingers.hand_structure`).
+    chains : tuple of Finger
+        The fingers as kinematic chains
+        (:func:`~drakegrasp.plant.fingers.finger_chains`): two fingers that a
+        ``<mimic>`` closes as one are two here, each with its own contacts.
     preshape : (n_h,) float
         The base pre-shape ``q_0`` over the closing joints (radians or
         metres), within the limits and the couplings.
@@ -103,6 +112,7 @@ class MultiFingerHand:
 
     base: RigidBody
     structure: HandStructure
+    chains: tuple
     preshape: np.ndarray
     synergy: np.ndarray | None
     synergy_range: np.ndarray
@@ -113,8 +123,8 @@ class MultiFingerHand:
 
     @property
     def num_fingers(self) -> int:
-        """Number of fingers."""
-        return len(self.structure.fingers)
+        """Number of fingers: kinematic chains (``chains``), coupled or not."""
+        return len(self.chains)
 
     def preshapes(self, amounts: np.ndarray) -> np.ndarray:
         """(K, n_h) pre-shapes at synergy amounts ``amounts`` (K,)."""
@@ -130,7 +140,7 @@ class MultiFingerHand:
         return {
             "base": self.base.name(),
             "joints": list(self.structure.names),
-            "fingers": [f.name for f in self.structure.fingers],
+            "fingers": [f.name for f in self.chains],
             "preshape": self.preshape.tolist(),
             "synergy": None if self.synergy is None else self.synergy.tolist(),
             "synergy_range": self.synergy_range.tolist(),
@@ -295,6 +305,8 @@ def multi_finger_hand(
     )
     if not structure.fingers:
         raise ModelError("the hand has no fingers (no closing joint moves a body)")
+    # a finger is a kinematic chain, though a <mimic> closes two as one
+    chains = finger_chains(plant, structure)
     n = len(structure.names)
     if preshape is None:
         q0 = plant.GetPositions(plant_context)[structure.position_indices]
@@ -322,7 +334,7 @@ def multi_finger_hand(
     finger_tips = [
         list({id(b): b for _, _, b in f.tip_pairs}.values())
         or tip_bodies(plant, structure, f)  # no object geometry (a cloud)
-        for f in structure.fingers
+        for f in chains
     ]
     if not any(finger_tips):
         raise ModelError("the hand's fingers have no collision geometry to grasp with")
@@ -383,6 +395,7 @@ def multi_finger_hand(
     return MultiFingerHand(
         base=base,
         structure=structure,
+        chains=chains,
         preshape=q0,
         synergy=syn,
         synergy_range=_range("synergy_range", synergy_range),

@@ -36,7 +36,8 @@ from pydrake.multibody.tree import BodyIndex, Joint, RigidBody
 from drakegrasp.errors import ModelError
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.attachment import chain_to_world, free_carrier, how_held
-from drakegrasp.plant.fingers import hand_structure
+from drakegrasp.plant.couplings import plant_couplings
+from drakegrasp.plant.fingers import finger_chains, hand_structure
 from drakegrasp.plant.validation import HandSpec, hand_bodies, scoped_name
 
 __all__ = ["PAD_DEPTH", "ParallelJaw", "free_base", "parallel_jaw"]
@@ -300,8 +301,11 @@ def _two_prismatic_fingers(plant, plant_context, object_body, hand):
     bodies = hand_bodies(plant, object_body, hand)
     base = free_base(plant, bodies, hand=hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
-    structure = hand_structure(plant, object_body, bodies, inspector=inspector)
-    fingers = structure.fingers
+    structure = hand_structure(
+        plant, object_body, bodies, plant_couplings(plant), inspector=inspector
+    )
+    # a jaw whose fingers a <mimic> couples (one motor) has two chains
+    fingers = finger_chains(plant, structure)
     if len(fingers) != 2 or any(len(f.joints) != 1 for f in fingers):
         raise ModelError(
             "plan_grasps samples parallel-jaw grasps: the hand needs two fingers, "

@@ -533,7 +533,7 @@ def with_squeeze_limit(
     if squeeze_limit is not None:
         squeeze_limit = check_squeeze_limit(squeeze_limit)
     ranked = list(result.candidates)
-    limit = motor_limit(plant, ranked[0]) if ranked else math.inf
+    limit = motor_limit(plant, ranked[0], per_finger=True) if ranked else math.inf
     applied = squeeze_limit is not None and squeeze_limit < limit
     if applied:
         limit = squeeze_limit
@@ -603,14 +603,24 @@ def _positive_limit(name: str, value, unit: str) -> float:
     return number
 
 
-def motor_limit(plant, candidate: GraspCandidate) -> float:
+def motor_limit(plant, candidate: GraspCandidate, *, per_finger: bool = False) -> float:
     """The smallest effort limit (N·m, N) of a candidate's joints' actuators.
 
     ``inf`` when the plant gives none of them an actuator (or no finite
     limit): then nothing says which torques the hand can apply.
+    ``per_finger``: what each joint it drives gets of a motor that also
+    drives ``<mimic>`` followers without actuators of their own, its limit
+    over ``1 + Σ|ρ|`` (a parallel jaw whose one motor closes both fingers
+    presses each with half its effort limit).
     """
+    share = {name: 1.0 for name in candidate.joint_names}
+    if per_finger:
+        own = {n for n in share if _actuators(plant, find_joint(plant, n))}
+        for follower, leader, rho, _ in plant_couplings(plant):
+            if follower in share and follower not in own and leader in own:
+                share[leader] += abs(rho)
     limits = [
-        float(a.effort_limit())
+        float(a.effort_limit()) / share[name]
         for name in candidate.joint_names
         for a in _actuators(plant, find_joint(plant, name))
     ]

@@ -84,7 +84,8 @@ from drakegrasp.planning.ranking import (
 from drakegrasp.planning.weight import centre_of_mass, weight_capacity
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
-from drakegrasp.plant.fingers import hand_structure
+from drakegrasp.plant.couplings import plant_couplings
+from drakegrasp.plant.fingers import finger_chains, hand_structure
 from drakegrasp.plant.validation import hand_bodies, scoped_name
 
 __all__ = [
@@ -119,15 +120,23 @@ def hand_is_parallel_jaw(plant, plant_context, object_body, hand) -> bool:
     bodies = hand_bodies(plant, object_body, hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     try:
-        structure = hand_structure(plant, object_body, bodies, inspector=inspector)
+        structure = hand_structure(
+            plant, object_body, bodies, plant_couplings(plant), inspector=inspector
+        )
     except ModelError:  # no closing joint: the multi-finger route says why
         return False
-    return is_parallel_jaw(structure)
+    return is_parallel_jaw(structure, finger_chains(plant, structure))
 
 
-def is_parallel_jaw(structure) -> bool:
-    """Whether a hand's structure is two fingers of one prismatic joint each."""
-    fingers = structure.fingers
+def is_parallel_jaw(structure, chains=None) -> bool:
+    """Whether a hand is two fingers of one prismatic joint each.
+
+    ``chains``: its fingers as kinematic chains
+    (:func:`~drakegrasp.plant.fingers.finger_chains`: a jaw whose second
+    finger follows the first by a ``<mimic>``, one motor for both, is two);
+    default ``structure.fingers``.
+    """
+    fingers = structure.fingers if chains is None else chains
     return len(fingers) == 2 and all(
         len(f.joints) == 1 and structure.joints[f.joints[0]].type_name() == "prismatic"
         for f in fingers
@@ -154,7 +163,7 @@ class _Placer:
         }
         self.object_geoms = set(plant.GetCollisionGeometriesForBody(body))
         self.label = {}
-        for f, finger in enumerate(hand.structure.fingers):
+        for f, finger in enumerate(hand.chains):
             for b in finger.bodies:
                 self.label[scoped_name(plant, b)] = f
         self.min_fingers = int(min_fingers)
@@ -194,7 +203,9 @@ class _Placer:
         try:  # the pre-shape is clear, within the limits and the couplings
             closure = close_checked_hand(
                 plant, ctx, self.body, s, tol=self.tol,
-                min_fingers=self.min_fingers, t0=time.perf_counter(),
+                # the chains that close as one count once here; below, each
+                min_fingers=min(self.min_fingers, len(s.fingers)),
+                t0=time.perf_counter(),
             )  # fmt: skip
         except UnreachableError:
             return None, None, "fingers miss the object"
@@ -216,6 +227,8 @@ class _Placer:
         fingers = {self.label.get(c.finger_body, -1) for c in found} - {-1}
         if len(fingers) < 2:
             return None, None, "one finger touches"
+        if len(fingers) < self.min_fingers:  # chains that closed as one finger
+            return None, None, "fingers miss the object"
         return found, closure.q.copy(), None
 
 
@@ -499,7 +512,7 @@ def _checked_hand(
         synergy_range=synergy_range, approach=approach, standoff=standoff,
     )  # fmt: skip
     if min_fingers > hand_model.num_fingers:
-        fingers = [f.name for f in hand_model.structure.fingers]
+        fingers = [f.name for f in hand_model.chains]
         joints = len(hand_model.structure.names)
         arm = (
             f"; its one finger {fingers[0]} moves all {joints} closing joints "

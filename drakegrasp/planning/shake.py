@@ -319,6 +319,23 @@ def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
     return float(k), float(d)
 
 
+def _shares(plant, driven: set) -> dict:
+    """Per leader (scoped name): 1 + Σ|ρ| over the followers it drives.
+
+    A motor whose leader drives followers (``driven``, without actuators of
+    their own) applies ``squeeze`` to each of them as well: its generalized
+    force is ``τ_leader + Σ ρ τ_follower`` (a one-motor jaw's two fingers:
+    twice the squeeze).
+    """
+    out: dict = {}
+    if not driven:
+        return out
+    for follower, leader, rho, _ in plant_couplings(plant):
+        if follower in driven:
+            out[leader] = out.get(leader, 1.0) + abs(rho)
+    return out
+
+
 def _on_couplings(plant, names, q: list) -> tuple[float, ...]:
     """``q`` over joints ``names`` with each follower set exactly from its leader.
 
@@ -518,9 +535,10 @@ def shake_test(
     base = resolve_body(plant, candidate.hand_base)
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
     by_name = {_scoped(plant, a.joint()): a for a in actuators}
-    targets, gains = {}, {}
+    targets, gains, per_joint = {}, {}, {}
     # a follower is driven by a leader among the candidate's own actuated joints
     driven = _driven_followers(plant, set(candidate.joint_names) & set(by_name))
+    shares = _shares(plant, driven)
     for name, sign in zip(candidate.joint_names, candidate.closing_signs, strict=True):
         actuator = by_name.get(name)
         if actuator is None and name in driven:
@@ -532,9 +550,13 @@ def shake_test(
                 "couple it to an actuated joint with a <mimic> that drakegrasp "
                 "reads: drakegrasp.plant.add_models in add_models)"
             )
-        push = min(squeeze, actuator.effort_limit())
+        # a leader's motor also presses through the followers it drives: each
+        # of them and the leader press with squeeze (within the effort limit)
+        share = shares.get(name, 1.0)
+        push = min(squeeze * share, actuator.effort_limit())
+        per_joint[int(actuator.index())] = push / share
         k, _ = gains[int(actuator.index())] = _gains(
-            actuator, squeeze, stiffness, damping
+            actuator, squeeze * share, stiffness, damping
         )
         if 0 < push / k < _MIN_AIM:
             raise InvalidOptionError(
@@ -670,11 +692,15 @@ def shake_test(
     squeezing = [a for a in actuators if int(a.joint().index()) in targets]
     efforts = tuple(abs(float(u[a.input_start()])) for a in squeezing)
     effort_units = tuple(effort_unit(a.joint()) for a in squeezing)
-    capped = tuple(float(min(squeeze, a.effort_limit())) for a in squeezing)
+    capped = tuple(float(per_joint[int(a.index())]) for a in squeezing)
     used = tuple(gains[int(a.index())] for a in squeezing)
-    aims = [c / k for c, (k, _) in zip(capped, used, strict=True)]
+    pushes = [  # what each squeezing actuator was aimed to apply, followers' too
+        per_joint[int(a.index())] * shares.get(_scoped(plant, a.joint()), 1.0)
+        for a in squeezing
+    ]
+    aims = [c / k for c, (k, _) in zip(pushes, used, strict=True)]
     at_rest = seat > 0 and seated[2] < _PUSHED_OUT  # else pushed out: physics
-    kept = [e / c for e, c in zip(efforts, capped, strict=True) if c > 0]
+    kept = [e / c for e, c in zip(efforts, pushes, strict=True) if c > 0]
     if at_rest and kept and np.mean(kept) < _LOST:  # a share: units apart
         warnings.warn(
             f"at the seat the closing joints press with {np.mean(kept):.0%} of "

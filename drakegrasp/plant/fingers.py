@@ -52,6 +52,7 @@ __all__ = [
     "MAX_STEP",
     "effort_unit",
     "find_joint",
+    "finger_chains",
     "hand_structure",
     "tip_bodies",
 ]
@@ -435,6 +436,61 @@ def _deepest(bodies: list, moved: list[set[int]]) -> list:
     depth = [sum(int(b.index()) in m for m in moved) for b in bodies]
     top = max(depth, default=0)
     return [b for b, d in zip(bodies, depth, strict=True) if d == top]
+
+
+def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
+    """The hand's fingers as kinematic chains: coupled fingers split apart.
+
+    A ``<mimic>`` across fingers makes them one :class:`Finger` of ``structure``
+    (they close as one: a Robotiq-style gripper's two fingers on one motor); a
+    grasp is still held by each chain's own contacts.  Each chain is a
+    :class:`Finger` over its own joints (positions in ``structure.joints``),
+    bodies, pairs and tip; a finger of one chain is returned as it is.
+    """
+    position = {int(j.index()): k for k, j in enumerate(structure.joints)}
+    out = []
+    for finger in structure.fingers:
+        members = [structure.joints[k] for k in finger.joints]
+        hand = {int(b.index()) for b in finger.bodies}
+        moved = {
+            int(j.index()): {
+                int(i) for i in plant.GetBodiesKinematicallyAffectedBy([j.index()])
+            }
+            & hand
+            for j in members
+        }
+        groups = _group(members, {}, moved)
+        if len(groups) == 1:
+            out.append(finger)
+            continue
+        for group in groups:
+            ids = set().union(*(moved[int(j.index())] for j in group))
+            pairs = tuple(p for p in finger.pairs if int(p[2].index()) in ids)
+            paired = list({int(b.index()): b for _, _, b in pairs}.values())
+            tip = {
+                int(b.index())
+                for b in _deepest(paired, [moved[int(j.index())] for j in group])
+            }
+            roots = [
+                j
+                for j in group
+                if not any(
+                    int(j.parent_body().index()) in moved[int(k.index())]
+                    for k in group
+                    if k is not j
+                )
+            ]
+            out.append(
+                Finger(
+                    name=" + ".join(joint_name(plant, j) for j in roots),
+                    joints=tuple(sorted(position[int(j.index())] for j in group)),
+                    bodies=tuple(b for b in finger.bodies if int(b.index()) in ids),
+                    pairs=pairs,
+                    tip_pairs=tuple(p for p in pairs if int(p[2].index()) in tip),
+                    max_step=finger.max_step,
+                )
+            )
+    return tuple(out)
 
 
 def _couplings_key(plant, couplings) -> tuple:

@@ -60,3 +60,48 @@ def coupled_hand_sdf(*, follower_effort: float = 2.0, ratio: float = RATIO) -> s
         + "".join(joints)
         + "</model></sdf>"
     )
+
+
+def one_motor_jaw_urdf(*, effort: float = 40.0) -> str:
+    """A parallel jaw whose right finger follows the left (``<mimic>``, -1).
+
+    Two prismatic fingers 120 mm apart on a 200 mm palm, each closing 55 mm
+    towards the middle; one ``<transmission>``, on the left slide: one motor
+    closes both fingers, as many real two-finger grippers do.
+    """
+
+    def link(name, xyz, size, mass):
+        return (
+            f'<link name="{name}"><inertial><origin xyz="{xyz}"/><mass value='
+            f'"{mass}"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0"'
+            f' iyz="0"/></inertial><collision><origin xyz="{xyz}"/><geometry>'
+            f'<box size="{size}"/></geometry></collision></link>'
+        )
+
+    def slide(name, child, x, lower, upper, extra=""):
+        return (
+            f'<joint name="{name}" type="prismatic"><parent link="palm"/>'
+            f'<child link="{child}"/><origin xyz="{x} 0 0"/><axis xyz="1 0 0"/>'
+            f'<limit lower="{lower}" upper="{upper}" effort="{effort:g}" '
+            f'velocity="0.1"/>{extra}</joint>'
+        )
+
+    return (
+        '<?xml version="1.0"?><robot name="one_motor_jaw">'
+        + link("palm", "0 0 0.02", "0.2 0.05 0.04", 0.8)
+        + link("left", "0 0 0.07", "0.01 0.025 0.06", 0.05)
+        + link("right", "0 0 0.07", "0.01 0.025 0.06", 0.05)
+        + slide("left_slide", "left", -0.06, 0, 0.055)
+        + slide(
+            "right_slide",
+            "right",
+            0.06,
+            -0.055,
+            0,
+            '<mimic joint="left_slide" multiplier="-1" offset="0"/>',
+        )
+        + '<transmission name="t"><type>transmission_interface/SimpleTransmission'
+        '</type><joint name="left_slide"/><actuator name="motor">'
+        "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
+        "</robot>"
+    )

@@ -267,3 +267,34 @@ def test_a_pre_shape_of_a_follower_is_refused_not_overwritten(tmp_path, capsys):
             scene.plant, scene.context, scene.object_body, hand=scene.hand,
             num_candidates=5, mu=MU, seed=0, preshape=bad,
         )  # fmt: skip
+
+
+def test_a_jaw_on_one_motor_is_planned_as_a_jaw_and_squeezed_per_finger(tmp_path):
+    # Its <mimic> made the two fingers one, and the planner refused the hand
+    # ("min_fingers = 2 exceeds the hand's 1 fingers": a user's one-motor jaw
+    # and Robotiq-style gripper, round 27).  The motor closes both fingers:
+    # each gets half its 40 N.
+    from coupled_support import one_motor_jaw_urdf
+
+    from drakegrasp.planning.motors import motor_limit
+
+    path = tmp_path / "one_motor_jaw.urdf"
+    path.write_text(one_motor_jaw_urdf(effort=40.0))
+    scene = planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(path))
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=40, mu=0.5, seed=0, robustness_samples=4,
+    )  # fmt: skip
+    assert result.settings["gripper"]["joints"] == ["left_slide", "right_slide"]
+    best = result[0]
+    assert best.is_closure and np.isfinite(best.opening)
+    assert motor_limit(scene.plant, best) == 40.0
+    assert motor_limit(scene.plant, best, per_finger=True) == 20.0
+    assert result.settings["held_first"]["limit"] == 20.0
+    shaken = shake_test(
+        scene.add_models, best, squeeze=10.0, hydroelastic_modulus=1e6,
+        directions=[[0.0, 0.0, -1.0]], settle=0.1, phase=0.2,
+    )  # fmt: skip
+    assert shaken.squeeze_caps == (10.0,)  # each finger, through the one motor
+    assert shaken.efforts[0] == pytest.approx(20.0, rel=0.05)  # the motor: both
+    assert shaken.held_from_seat

@@ -128,6 +128,8 @@ class _Grasp:
         self.candidate = types.SimpleNamespace(grasp=_E)
         J = np.random.default_rng(5).standard_normal((_E.num_components, 6))
         monkeypatch.setattr(motors, "finger_jacobian", lambda *a, **k: J)
+        # six joints, each its own motor (no plant to read couplings from)
+        monkeypatch.setattr(motors, "_motor_map", lambda *a, **k: None)
 
     def __call__(self, directions):
         return motors.torque_capacity(
