@@ -311,8 +311,9 @@ def _group(joints, follows, moved) -> list[list[Joint]]:
     return list(groups.values())
 
 
-def _finger(plant, members, moved, bodies, position, object_geometries, inspector):
-    roots = [
+def _roots(members, moved) -> list:
+    """The joints of ``members`` whose parent body no other member moves."""
+    return [
         j
         for j in members
         if not any(
@@ -321,6 +322,10 @@ def _finger(plant, members, moved, bodies, position, object_geometries, inspecto
             if k is not j
         )
     ]
+
+
+def _finger(plant, members, moved, bodies, position, object_geometries, inspector):
+    roots = _roots(members, moved)
     ids = set().union(*(moved[int(j.index())] for j in members))
     finger_bodies = tuple(b for b in bodies if int(b.index()) in ids)
     pairs = tuple(
@@ -471,18 +476,9 @@ def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
                 int(b.index())
                 for b in _deepest(paired, [moved[int(j.index())] for j in group])
             }
-            roots = [
-                j
-                for j in group
-                if not any(
-                    int(j.parent_body().index()) in moved[int(k.index())]
-                    for k in group
-                    if k is not j
-                )
-            ]
             out.append(
                 Finger(
-                    name=" + ".join(joint_name(plant, j) for j in roots),
+                    name=" + ".join(joint_name(plant, j) for j in _roots(group, moved)),
                     joints=tuple(sorted(position[int(j.index())] for j in group)),
                     bodies=tuple(b for b in finger.bodies if int(b.index()) in ids),
                     pairs=pairs,

@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from coupled_support import MODEL, coupled_hand_sdf
+from grasp_builders import generator_matrix
 from scipy.optimize import linprog
 
 import drakegrasp as dg
 from drakegrasp.cli import main
-from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.motors import finger_jacobian, torque_capacity
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
@@ -89,12 +89,7 @@ def _explicit_beta(candidate, J, C, actuated, u) -> float:
     """
     grasp = candidate.grasp
     G = dg.grasp_matrix(grasp)
-    blocks = [friction_cone_generators(c, 8) for c in grasp.contacts]
-    S = np.zeros((G.shape[1], sum(b.shape[1] for b in blocks)))
-    r = c = 0
-    for b in blocks:
-        S[r : r + b.shape[0], c : c + b.shape[1]] = b
-        r, c = r + b.shape[0], c + b.shape[1]
+    S = generator_matrix(grasp)
     n, m = S.shape[1], J.shape[1]
     # variables: λ (n), τ (m), β
     A_eq = np.vstack([

@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from grasp_builders import generator_matrix
 from scipy.optimize import linprog
 
 import drakegrasp as dg
@@ -56,12 +57,7 @@ def _beta_by_generators(candidate, J, u) -> float:
     """max β: G S λ + β [u; 0] = 0, |Jᵀ S λ| <= 1, λ >= 0 (scipy HiGHS)."""
     grasp = candidate.grasp
     G = dg.grasp_matrix(grasp)
-    blocks = [friction_cone_generators(c, 8) for c in grasp.contacts]
-    S = np.zeros((G.shape[1], sum(b.shape[1] for b in blocks)))
-    r = c = 0
-    for b in blocks:
-        S[r : r + b.shape[0], c : c + b.shape[1]] = b
-        r, c = r + b.shape[0], c + b.shape[1]
+    S = generator_matrix(grasp)
     n = S.shape[1]
     A_eq = np.hstack([G @ S, np.concatenate([u, np.zeros(3)])[:, None]])
     T = J.T @ S

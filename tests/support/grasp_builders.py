@@ -105,3 +105,20 @@ def two_pads(rng, K, half):
     Nrm[..., 0] = -np.sign(x)
     F = np.repeat((np.arange(2 * half) >= half)[None].astype(int), K, axis=0)
     return P, Nrm, F
+
+
+def generator_matrix(grasp, num_generators=8):
+    """``S``: the contacts' cone generators block by block, ``f = S λ``, λ >= 0.
+
+    Rows the grasp's contact components, columns each contact's generators
+    (:func:`drakegrasp.core.friction_cone.friction_cone_generators`).
+    """
+    from drakegrasp.core.friction_cone import friction_cone_generators
+
+    blocks = [friction_cone_generators(c, num_generators) for c in grasp.contacts]
+    S = np.zeros((sum(b.shape[0] for b in blocks), sum(b.shape[1] for b in blocks)))
+    r = c = 0
+    for b in blocks:
+        S[r : r + b.shape[0], c : c + b.shape[1]] = b
+        r, c = r + b.shape[0], c + b.shape[1]
+    return S
