@@ -19,6 +19,7 @@ from scipy.optimize import linprog
 from drakegrasp import InvalidOptionError
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.planning.weight import (
     WEIGHT_DIRECTIONS,
     build_weight_capacity_program,
@@ -250,9 +251,18 @@ def test_never_raises_a_capacity_and_follows_order_and_rigid_motion(seed, mu):
     turned = weight_capacity(
         P @ R.T, N @ R.T, F, **kw, palm=2, directions=WEIGHT_DIRECTIONS @ R.T
     )
-    # a linearised cone turns with its normal only up to its generators' roll
+    # A linearised cone turns with its normal only up to its generators' roll:
+    # each inscribed 8-gon lies between the cones of mu cos(pi/8) and mu, so
+    # the turned grasp holds what the unturned one holds at mu cos(pi/8), and
+    # no more than at mu / cos(pi/8), direction by direction.  (A 10 % band
+    # on the least direction failed at seed 112, mu 0.3: 0.3295 against
+    # 0.3702, within these bounds.)
+    c = np.cos(np.pi / DEFAULT_NUM_GENERATORS)
+    inner = weight_capacity(P, N, F, **{**kw, "mu": mu * c}, palm=2)
+    outer = weight_capacity(P, N, F, **{**kw, "mu": mu / c}, palm=2)
     jaws = [0, 2]
-    assert turned[jaws].min(axis=1) == pytest.approx(new[jaws].min(axis=1), rel=0.1)
+    assert np.all(turned[jaws] >= inner[jaws] - 1e-7)
+    assert np.all(turned[jaws] <= outer[jaws] + 1e-7)
     # frictionless contacts have no generators to roll: exactly invariant
     # (twelve contacts round a ball, the palm's four below it)
     d = rng.normal(size=(1, 12, 3))
