@@ -1213,6 +1213,7 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
         if j.child_body().index() in moved
     ]
     from drakegrasp.plant.couplings import plant_couplings
+    from drakegrasp.plant.fingers import joint_name as scoped_joint
 
     followers = {c[0]: c[1] for c in plant_couplings(plant)}
     q = plant.GetPositions(ctx)
@@ -1237,7 +1238,7 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
                 f"--preshape {name}: the joint has {joint.num_positions()} "
                 "positions; a pre-shape sets one-degree-of-freedom joints"
             )
-        scoped = f"{plant.GetModelInstanceName(joint.model_instance())}::{joint.name()}"
+        scoped = scoped_joint(plant, joint)
         if scoped in followers:  # set from its leader: the value would be lost
             raise InvalidOptionError(
                 f"--preshape {name}: the joint follows {followers[scoped]} (a "

@@ -90,7 +90,7 @@ from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.checks import checked_directions
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
-from drakegrasp.plant.couplings import coupling_map, plant_couplings
+from drakegrasp.plant.couplings import coupling_map, motor_shares, plant_couplings
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.jacobians import contact_rows, hand_jacobian
 from drakegrasp.plant.validation import (
@@ -613,15 +613,14 @@ def motor_limit(plant, candidate: GraspCandidate, *, per_finger: bool = False) -
     over ``1 + Σ|ρ|`` (a parallel jaw whose one motor closes both fingers
     presses each with half its effort limit).
     """
-    share = {name: 1.0 for name in candidate.joint_names}
+    names = candidate.joint_names
+    shares = {}
     if per_finger:
-        own = {n for n in share if _actuators(plant, find_joint(plant, n))}
-        for follower, leader, rho, _ in plant_couplings(plant):
-            if follower in share and follower not in own and leader in own:
-                share[leader] += abs(rho)
+        own = [n for n in names if _actuators(plant, find_joint(plant, n))]
+        _, shares = motor_shares(plant_couplings(plant), names, own)
     limits = [
-        float(a.effort_limit()) / share[name]
-        for name in candidate.joint_names
+        float(a.effort_limit()) / shares.get(name, 1.0)
+        for name in names
         for a in _actuators(plant, find_joint(plant, name))
     ]
     finite = [v for v in limits if math.isfinite(v) and v > 0]

@@ -68,7 +68,7 @@ from drakegrasp.planning.turned_gravity import (
     _schedule,
     _TurnedGravity,
 )
-from drakegrasp.plant.couplings import plant_couplings
+from drakegrasp.plant.couplings import motor_shares, plant_couplings
 from drakegrasp.plant.fingers import effort_unit, find_joint
 from drakegrasp.plant.hydroelastic import (
     check_hydroelastic_modulus,
@@ -319,54 +319,30 @@ def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
     return float(k), float(d)
 
 
-def _shares(plant, driven: set) -> dict:
-    """Per leader (scoped name): 1 + Σ|ρ| over the followers it drives.
+def _known_couplings(plant) -> tuple:
+    """The plant's recorded couplings; none where some constraint is unknown.
 
-    A motor whose leader drives followers (``driven``, without actuators of
-    their own) applies ``squeeze`` to each of them as well: its generalized
-    force is ``τ_leader + Σ ρ τ_follower`` (a one-motor jaw's two fingers:
-    twice the squeeze).
+    (A bare ``Parser`` left a ``<mimic>`` unrecorded: then no follower is
+    taken as driven, and one without an actuator is refused.)
     """
-    out: dict = {}
-    if not driven:
-        return out
-    for follower, leader, rho, _ in plant_couplings(plant):
-        if follower in driven:
-            out[leader] = out.get(leader, 1.0) + abs(rho)
-    return out
+    try:
+        return plant_couplings(plant)
+    except InvalidOptionError:
+        return ()
 
 
-def _on_couplings(plant, names, q: list) -> tuple[float, ...]:
+def _on_couplings(couplings, names, q: list) -> tuple[float, ...]:
     """``q`` over joints ``names`` with each follower set exactly from its leader.
 
     Drake's coupler constraint is compliant: a simulated follower drifts
     micro-radians off ``ρ q_leader + Δq``, more than the coupling tolerance
     that :func:`~drakegrasp.analyze_grasp` checks a pose against.
     """
-    try:
-        couplings = plant_couplings(plant)
-    except InvalidOptionError:  # couplings drakegrasp was not told of
-        return tuple(float(x) for x in q)
     at = {name: k for k, name in enumerate(names)}
     for follower, leader, rho, offset in couplings:
         if follower in at and leader in at:
             q[at[follower]] = rho * q[at[leader]] + offset
     return tuple(float(x) for x in q)
-
-
-def _driven_followers(plant, actuated: set) -> set:
-    """Scoped names of the joints a recorded coupling ties to an actuated leader.
-
-    A ``<mimic>`` follower has no actuator of its own in a real hand's model
-    (the linkage moves it); its leader's motor drives it through Drake's
-    coupler constraint.  Couplings that were not recorded (a bare ``Parser``)
-    are not read.
-    """
-    try:
-        couplings = plant_couplings(plant)
-    except InvalidOptionError:
-        return set()
-    return {c[0] for c in couplings if c[1] in actuated}
 
 
 def shake_test(
@@ -535,10 +511,10 @@ def shake_test(
     base = resolve_body(plant, candidate.hand_base)
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
     by_name = {_scoped(plant, a.joint()): a for a in actuators}
-    targets, gains, per_joint = {}, {}, {}
+    targets, gains, pushed = {}, {}, {}
     # a follower is driven by a leader among the candidate's own actuated joints
-    driven = _driven_followers(plant, set(candidate.joint_names) & set(by_name))
-    shares = _shares(plant, driven)
+    couplings = _known_couplings(plant)
+    driven, shares = motor_shares(couplings, candidate.joint_names, by_name)
     for name, sign in zip(candidate.joint_names, candidate.closing_signs, strict=True):
         actuator = by_name.get(name)
         if actuator is None and name in driven:
@@ -554,7 +530,7 @@ def shake_test(
         # of them and the leader press with squeeze (within the effort limit)
         share = shares.get(name, 1.0)
         push = min(squeeze * share, actuator.effort_limit())
-        per_joint[int(actuator.index())] = push / share
+        pushed[int(actuator.index())] = (push, share)
         k, _ = gains[int(actuator.index())] = _gains(
             actuator, squeeze * share, stiffness, damping
         )
@@ -681,7 +657,7 @@ def shake_test(
         max_ds = max_rs = 0.0
         q_now = plant.GetPositions(ctx)
         seated_q = _on_couplings(
-            plant, candidate.joint_names,
+            couplings, candidate.joint_names,
             [_within_limits(find_joint(plant, name), q_now)
              for name in candidate.joint_names],
         )  # fmt: skip
@@ -692,12 +668,11 @@ def shake_test(
     squeezing = [a for a in actuators if int(a.joint().index()) in targets]
     efforts = tuple(abs(float(u[a.input_start()])) for a in squeezing)
     effort_units = tuple(effort_unit(a.joint()) for a in squeezing)
-    capped = tuple(float(per_joint[int(a.index())]) for a in squeezing)
+    # what each squeezing actuator was aimed to apply (its followers' too), and
+    # each joint it drives of that
+    pushes = [pushed[int(a.index())][0] for a in squeezing]
+    capped = tuple(float(p / s) for p, s in (pushed[int(a.index())] for a in squeezing))
     used = tuple(gains[int(a.index())] for a in squeezing)
-    pushes = [  # what each squeezing actuator was aimed to apply, followers' too
-        per_joint[int(a.index())] * shares.get(_scoped(plant, a.joint()), 1.0)
-        for a in squeezing
-    ]
     aims = [c / k for c, (k, _) in zip(pushes, used, strict=True)]
     at_rest = seat > 0 and seated[2] < _PUSHED_OUT  # else pushed out: physics
     kept = [e / c for e, c in zip(efforts, pushes, strict=True) if c > 0]

@@ -46,7 +46,9 @@ class ShakeResult:
         actuator order,
         read at the end of seating (with ``seat=0``, of settling).  A
         parallel jaw's fingers press with ``squeeze`` (within their effort
-        limits).  A multi-finger hand's joints share each finger's contact
+        limits); a motor that drives ``<mimic>`` followers without actuators
+        applies theirs too (a one-motor jaw's: twice the squeeze).  A
+        multi-finger hand's joints share each finger's contact
         force through its chain (``τ = Jᵀ f``), so theirs differ: a joint
         the contact pushes back presses harder, up to its effort limit, and
         one whose link moves freely presses with none.

@@ -66,6 +66,7 @@ __all__ = [
     "coupling_map",
     "coupling_violations",
     "couplings_in_model",
+    "motor_shares",
     "plant_couplings",
     "record_model_couplings",
     "recorded_couplings",
@@ -424,6 +425,41 @@ def coupling_map(
     for f, (lead, rho) in follows.items():
         C[row[f], col[lead]] = rho
     return C, np.array(independent, dtype=int)
+
+
+def motor_shares(couplings, joints, actuated) -> tuple[set, dict]:
+    """Which followers a leader's motor drives, and what it presses them with.
+
+    A ``<mimic>`` follower without an actuator of its own is driven by its
+    leader's motor through the coupler: the motor's generalized force is
+    ``τ_leader + Σ ρ τ_follower``, so for the leader and each follower to
+    press with ``τ`` it applies ``τ (1 + Σ|ρ|)`` (a one-motor jaw: twice
+    the squeeze, each finger half the motor's effort limit).
+
+    Parameters
+    ----------
+    couplings : sequence of (follower, leader, gear_ratio, offset)
+        Scoped joint names (:func:`plant_couplings`).
+    joints : iterable of str
+        The joints considered (a candidate's closing joints), scoped names.
+    actuated : iterable of str
+        Those of them with an actuator.
+
+    Returns
+    -------
+    driven : set of str
+        The followers among ``joints`` without an actuator whose leader is
+        among ``joints`` with one.
+    shares : dict of str to float
+        Per leader that drives any: ``1 + Σ|ρ|`` over its driven followers.
+    """
+    joints, actuated = set(joints), set(actuated)
+    driven, shares = set(), {}
+    for follower, leader, rho, _ in couplings:
+        if follower in joints - actuated and leader in joints & actuated:
+            driven.add(follower)
+            shares[leader] = shares.get(leader, 1.0) + abs(rho)
+    return driven, shares
 
 
 def coupled_torque_limits(C: np.ndarray, limits: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ import drakegrasp as dg
 from drakegrasp.cli import main
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.motors import finger_jacobian, torque_capacity
+from drakegrasp.planning.shake import DAMPING_TIME, REVOLUTE_AIM
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
 from drakegrasp.plant.couplings import recorded_couplings
 from drakegrasp.plant.models import register_models
@@ -149,12 +150,15 @@ def test_fewer_motors_hold_no_more(tmp_path):
     scene, result = _plan(_hand_file(tmp_path, follower_effort=0))
     (tmp_path / "every").mkdir()
     every = _plan(_hand_file(tmp_path / "every", follower_effort=2))[0]
+    fewer = False
     for candidate in [c for c in result if c.is_closure][:3]:
         leaders = torque_capacity(
             scene.plant, scene.context, candidate, scene.object_body
         )
         both = torque_capacity(every.plant, every.context, candidate, every.object_body)
         assert np.all(leaders <= both * (1 + 1e-7) + 1e-9)
+        fewer |= bool(np.any(leaders < both * (1 - 1e-6)))
+    assert fewer  # (equal numbers would pass the bound with the motors ignored)
 
 
 def test_a_hand_with_motors_on_its_leaders_only_is_shaken(motors_on_leaders):
@@ -207,8 +211,6 @@ def test_a_revolute_hands_default_gains_keep_its_squeeze(motors_on_leaders):
     # they closed on, and pressed with 0.7-0.9 N·m (on other candidates with
     # next to nothing, or Drake's solver stopped).  By default a revolute
     # finger is now aimed REVOLUTE_AIM = 0.1 rad past: 2 / 0.1 = 20 N·m/rad.
-    from drakegrasp.planning.shake import DAMPING_TIME, REVOLUTE_AIM
-
     scene, result = motors_on_leaders
     candidate = next(c for c in result if c.is_closure)
     quick = dict(squeeze=2.0, directions=[[0.0, 0.0, -1.0]], settle=0.1, phase=0.2)
@@ -293,3 +295,18 @@ def test_a_jaw_on_one_motor_is_planned_as_a_jaw_and_squeezed_per_finger(tmp_path
     assert shaken.squeeze_caps == (10.0,)  # each finger, through the one motor
     assert shaken.efforts[0] == pytest.approx(20.0, rel=0.05)  # the motor: both
     assert shaken.held_from_seat
+
+
+def test_a_follower_with_its_own_motor_is_not_pressed_through_its_leader(tmp_path):
+    # Review, round 27: the shake counted every follower of an actuated leader
+    # in the leader's share, its own motor or not, and aimed the leader at
+    # 0.5 x 1.6 N·m where each joint presses with 0.5 by its own motor.
+    scene, result = _plan(_hand_file(tmp_path, follower_effort=2.0))
+    candidate = next(c for c in result if c.is_closure)
+    shaken = shake_test(
+        scene.add_models, candidate, squeeze=0.5,
+        directions=[[0.0, 0.0, -1.0]], settle=0.1, phase=0.2,
+    )  # fmt: skip
+    k = 0.5 / REVOLUTE_AIM  # every joint its own motor: aimed at its own 0.5
+    assert shaken.gains == ((k, k * DAMPING_TIME),) * 6
+    assert shaken.squeeze_caps == (0.5,) * 6
