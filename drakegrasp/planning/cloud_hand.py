@@ -701,7 +701,8 @@ class CloudHand:
         return bool(np.max(np.abs(R.T @ n_O)) >= cos_tol)
 
     def run(self, X_WH, q_pre):
-        """(contacts, closed q, None) or (None, None, reason)."""
+        """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``."""
+        self.X_WH = X_WH
         plant, ctx, s = self.plant, self.ctx, self.hand.structure
         plant.SetFreeBodyPose(ctx, self.hand.base, X_WH)
         self._set(plant.GetPositions(ctx), q_pre)

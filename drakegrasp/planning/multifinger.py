@@ -13,7 +13,10 @@ rejection reason (:data:`REASONS`).
    hand geometry with signed distance below ``−distance_tolerance`` to the
    object or anything else rejects the pose.
 3. **Closing**: :func:`~drakegrasp.close_hand` (couplings read from the
-   plant) from the pre-shape; fewer than ``min_fingers`` fingers touching
+   plant) from the pre-shape.  Fingers that a ``<mimic>`` closes as one stop
+   when one touches: the hand is then moved so that their gaps to the object
+   are equal and closed again (:data:`CENTRING_STEPS`), the candidate keeping
+   the pose it closed at.  Fewer than ``min_fingers`` fingers touching
    rejects it, and so does a closed finger that penetrates the rest of the
    scene or another finger (``close_hand`` watches the object only).  The
    contacts are those of :func:`~drakegrasp.find_contacts`, which
@@ -82,6 +85,7 @@ from drakegrasp.planning.ranking import (
     tie_key,
 )
 from drakegrasp.planning.weight import centre_of_mass, weight_capacity
+from drakegrasp.plant._closing_steps import closest
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
 from drakegrasp.plant.couplings import plant_couplings
@@ -89,6 +93,7 @@ from drakegrasp.plant.fingers import finger_chains, hand_structure
 from drakegrasp.plant.validation import hand_bodies, scoped_name
 
 __all__ = [
+    "CENTRING_STEPS",
     "DEFAULT_TILT",
     "REASONS",
     "close_candidates",
@@ -102,6 +107,12 @@ __all__ = [
 
 DEFAULT_TILT = np.radians(20.0)
 """Default largest tilt of the approach from the surface's inward normal."""
+
+CENTRING_STEPS = 4
+"""Times at most a hand whose coupled fingers stopped short is moved and closed
+again (stage 3).  Each move equalises the fingers' gaps to first order: a
+pinch across parallel faces is centred by the first, one on curved or tilted
+faces by the next few."""
 
 REASONS = {
     "hand collides with the object": "the pre-shaped hand penetrates the object",
@@ -166,7 +177,17 @@ class _Placer:
         for f, finger in enumerate(hand.chains):
             for b in finger.bodies:
                 self.label[scoped_name(plant, b)] = f
+        # the closing group (a finger of the structure) of every chain
+        self.group = [
+            next(
+                k
+                for k, g in enumerate(hand.structure.fingers)
+                if set(chain.joints) <= set(g.joints)
+            )
+            for chain in hand.chains
+        ]
         self.min_fingers = int(min_fingers)
+        self.X_WH = None
 
     def _penetration(self):
         """None, or what a hand geometry penetrates.
@@ -189,7 +210,63 @@ class _Placer:
         return found
 
     def run(self, X_WH, q_pre):
-        """(contacts, closed q, None) or (None, None, reason)."""
+        """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``.
+
+        Where fingers that close as one (a ``<mimic>`` across them) stop
+        because one of them touched, the hand is moved towards the others and
+        closed again from ``q_pre`` (:data:`CENTRING_STEPS` times at most):
+        what the object does on a table when a one-motor gripper closes on
+        it, and what a parallel jaw's placement does at its midpoint.  The
+        pose the fingers closed at is left in ``self.X_WH``.
+        """
+        first = None
+        for step in range(CENTRING_STEPS + 1):
+            self.X_WH = X_WH
+            found, q, reason, touched = self._close(X_WH, q_pre)
+            first = first or reason
+            if reason is None:
+                return found, q, None
+            shift = None if step == CENTRING_STEPS else self._centring(touched)
+            if shift is None:
+                return None, None, first
+            X_WH = RigidTransform(X_WH.rotation(), X_WH.translation() + shift)
+        raise AssertionError("unreachable")  # pragma: no cover
+
+    def _centring(self, touched: set[int]) -> np.ndarray | None:
+        """The move (m, world) after which coupled fingers meet the object together.
+
+        ``touched``: the chains that touch.  For the chains that close as one
+        with a touching one, each at gap ψ_c along its unit line n̂_c from its
+        nearest point to the object's, a move ``t`` of the hand changes the
+        gaps to ``ψ_c − n̂_c·t``; the least ``t`` that makes them equal
+        (``(n̂_c − n̂_0)·t = ψ_c − ψ_0``, least squares) is returned.  For two
+        fingers on opposite faces it is half the difference towards the one
+        short of the object.  None when no chain is short, or when equal gaps
+        need a move larger than the gaps differ (fingers facing one way).
+        """
+        groups = {self.group[t] for t in touched}
+        chains = [c for c, g in enumerate(self.group) if g in groups]
+        if len(chains) == len(touched & set(chains)):
+            return None
+        query = self.port.Eval(self.ctx)
+        psi, lines = [], []
+        for c in chains:
+            d, n_W, *_ = closest(query, self.plant, self.ctx, self.hand.chains[c].pairs)
+            if n_W is None or not np.isfinite(d):
+                return None
+            psi.append(d)
+            lines.append(np.asarray(n_W, float))
+        psi, lines = np.array(psi), np.array(lines)
+        spread = float(psi.max() - psi.min())
+        if spread <= 1e-3 * self.tol:  # a gap the closing's own stop leaves
+            return None
+        t = np.linalg.lstsq(lines[1:] - lines[0], psi[1:] - psi[0], rcond=1e-6)[0]
+        if not np.all(np.isfinite(t)) or np.linalg.norm(t) > spread:
+            return None
+        return t
+
+    def _close(self, X_WH, q_pre):
+        """One closing at ``X_WH``: (contacts, q, reason, chains touching)."""
         plant, ctx, s = self.plant, self.ctx, self.hand.structure
         plant.SetFreeBodyPose(ctx, self.hand.base, X_WH)
         q_all = plant.GetPositions(ctx)
@@ -197,9 +274,9 @@ class _Placer:
         plant.SetPositions(ctx, q_all)
         hit = self._penetration()
         if hit == "hand":
-            return None, None, "fingers collide with each other"
+            return None, None, "fingers collide with each other", set()
         if hit is not None:
-            return None, None, f"hand collides with the {hit}"
+            return None, None, f"hand collides with the {hit}", set()
         try:  # the pre-shape is clear, within the limits and the couplings
             closure = close_checked_hand(
                 plant, ctx, self.body, s, tol=self.tol,
@@ -208,28 +285,28 @@ class _Placer:
                 t0=time.perf_counter(),
             )  # fmt: skip
         except UnreachableError:
-            return None, None, "fingers miss the object"
+            return None, None, "fingers miss the object", set()
         except PenetrationError:  # only an inaccurate distance gets here
-            return None, None, "hand collides with the object"
+            return None, None, "hand collides with the object", set()
         hit = self._penetration()
         if hit == "scene":
-            return None, None, "finger blocked by the scene"
+            return None, None, "finger blocked by the scene", set()
         if hit == "object":  # only an inaccurate distance gets here
-            return None, None, "hand collides with the object"
+            return None, None, "hand collides with the object", set()
         if hit == "hand":  # close_hand watches the object only
-            return None, None, "fingers collide with each other"
+            return None, None, "fingers collide with each other", set()
         try:
             found = find_contacts(
                 plant, ctx, self.body, hand=self.spec, distance_tolerance=self.tol
             )
         except (NoContactsError, PenetrationError):
-            return None, None, "one finger touches"
+            return None, None, "one finger touches", set()
         fingers = {self.label.get(c.finger_body, -1) for c in found} - {-1}
         if len(fingers) < 2:
-            return None, None, "one finger touches"
+            return None, None, "one finger touches", fingers
         if len(fingers) < self.min_fingers:  # chains that closed as one finger
-            return None, None, "fingers miss the object"
-        return found, closure.q.copy(), None
+            return None, None, "fingers miss the object", fingers
+        return found, closure.q.copy(), None, fingers
 
 
 def close_candidates(
@@ -247,8 +324,10 @@ def close_each(closer, poses, progress):
     """Close the hand at every sampled pose: (kept, rejection counts, labels).
 
     ``closer.run(X_WH, q_pre)`` gives ``(contacts, q, reason)`` (a body's
-    placer or a cloud's :class:`~drakegrasp.planning.cloud_hand.CloudHand`);
-    ``kept`` holds ``(sample, X_WH, q_pre, q, contacts)``.
+    placer or a cloud's :class:`~drakegrasp.planning.cloud_hand.CloudHand`)
+    and leaves the pose the hand closed at in ``closer.X_WH`` (the body's
+    placer may have centred it); ``kept`` holds ``(sample, X_WH, q_pre, q,
+    contacts)``.
     """
     rejections = Counter()
     kept = []
@@ -258,7 +337,7 @@ def close_each(closer, poses, progress):
         if reason is not None:
             rejections[reason] += 1
             continue
-        kept.append((k, X_WH, poses["q"][k], q, found))
+        kept.append((k, closer.X_WH, poses["q"][k], q, found))
     return kept, rejections, closer.label
 
 

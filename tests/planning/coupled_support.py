@@ -105,3 +105,55 @@ def one_motor_jaw_urdf(*, effort: float = 40.0) -> str:
         "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
         "</robot>"
     )
+
+
+def one_motor_pinch_urdf(*, effort: float = 5.0) -> str:
+    """A Robotiq-style pinch: two revolute knuckles on one motor, pads kept upright.
+
+    Knuckles 110 mm apart on the palm, about ``y``, 50 mm long; each carries a
+    pad (a 8 × 22 × 40 mm box) on a joint that undoes the knuckle's turn, so
+    the pads stay parallel as they close (a four-bar's effect, written as
+    ``<mimic>``).  The right knuckle and both pads follow the left knuckle,
+    whose slide is the only one with a ``<transmission>``: one motor.  Open
+    (0 rad) the pads are 71 mm apart.
+    """
+
+    def link(name, xyz, shape, mass):
+        return (
+            f'<link name="{name}"><inertial><origin xyz="{xyz}"/><mass value='
+            f'"{mass}"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0"'
+            f' iyz="0"/></inertial><collision><origin xyz="{xyz}"/><geometry>'
+            f"{shape}</geometry></collision></link>"
+        )
+
+    def hinge(name, parent, child, xyz, lower, upper, mimic=None):
+        extra = (
+            ""
+            if mimic is None
+            else f'<mimic joint="left_knuckle" multiplier="{mimic:g}" offset="0"/>'
+        )
+        return (
+            f'<joint name="{name}" type="revolute"><parent link="{parent}"/>'
+            f'<child link="{child}"/><origin xyz="{xyz}"/><axis xyz="0 1 0"/>'
+            f'<limit lower="{lower}" upper="{upper}" effort="{effort:g}" '
+            f'velocity="2"/>{extra}</joint>'
+        )
+
+    knuckle = '<capsule radius="0.006" length="0.038"/>'
+    pad = '<box size="0.008 0.022 0.04"/>'
+    return (
+        '<?xml version="1.0"?><robot name="one_motor_pinch">'
+        + link("palm", "0 0 0.025", '<box size="0.14 0.06 0.05"/>', 0.6)
+        + link("left_knuckle", "0 0 0.025", knuckle, 0.05)
+        + link("right_knuckle", "0 0 0.025", knuckle, 0.05)
+        + link("left_pad", "0.0085 0 0.02", pad, 0.03)
+        + link("right_pad", "-0.0085 0 0.02", pad, 0.03)
+        + hinge("left_knuckle", "palm", "left_knuckle", "-0.055 0 0.06", 0, 0.8)
+        + hinge("right_knuckle", "palm", "right_knuckle", "0.055 0 0.06", -0.8, 0, -1)
+        + hinge("left_pad_joint", "left_knuckle", "left_pad", "0 0 0.05", -0.8, 0, -1)
+        + hinge("right_pad_joint", "right_knuckle", "right_pad", "0 0 0.05", 0, 0.8, 1)
+        + '<transmission name="t"><type>transmission_interface/SimpleTransmission'
+        '</type><joint name="left_knuckle"/><actuator name="motor">'
+        "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
+        "</robot>"
+    )

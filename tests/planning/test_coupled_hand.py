@@ -10,14 +10,17 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from coupled_support import MODEL, coupled_hand_sdf
+from coupled_support import MODEL, coupled_hand_sdf, one_motor_pinch_urdf
 from grasp_builders import generator_matrix
+from pydrake.math import RotationMatrix
 from scipy.optimize import linprog
 
 import drakegrasp as dg
 from drakegrasp.cli import main
-from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning import multifinger, plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.approach import multi_finger_hand
 from drakegrasp.planning.motors import finger_jacobian, torque_capacity
+from drakegrasp.planning.multifinger import close_candidates
 from drakegrasp.planning.shake import DAMPING_TIME, REVOLUTE_AIM
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
 from drakegrasp.plant.couplings import recorded_couplings
@@ -310,3 +313,82 @@ def test_a_follower_with_its_own_motor_is_not_pressed_through_its_leader(tmp_pat
     k = 0.5 / REVOLUTE_AIM  # every joint its own motor: aimed at its own 0.5
     assert shaken.gains == ((k, k * DAMPING_TIME),) * 6
     assert shaken.squeeze_caps == (0.5,) * 6
+
+
+# A Robotiq-style pinch: two revolute knuckles and their pads on one motor.
+
+BOX = "package://drakegrasp/objects/box.sdf"  # 50 x 50 x 100 mm, at the origin
+
+
+@pytest.fixture(scope="module")
+def pinch(tmp_path_factory):
+    path = tmp_path_factory.mktemp("pinch") / "one_motor_pinch.urdf"
+    path.write_text(one_motor_pinch_urdf())
+    scene = planning_scene(BOX, hand_url=str(path))
+    hand = multi_finger_hand(
+        scene.plant, scene.plant.GetMyContextFromRoot(scene.context),
+        scene.object_body, scene.hand,
+    )  # fmt: skip
+    return scene, hand
+
+
+def _close_at(pinch, offsets):
+    """Close the pinch from above the box, its palm moved by ``offsets`` (m) along x."""
+    scene, hand = pinch
+    plant = scene.plant
+    ctx = plant.GetMyContextFromRoot(scene.context)
+    n = len(offsets)
+    down = RotationMatrix.MakeXRotation(np.pi).matrix()  # the palm's +z down
+    poses = {
+        "R_WH": np.repeat(down[None], n, axis=0),
+        "p_WH": np.array([[x, 0.0, 0.18] for x in offsets]),
+        "q": np.zeros((n, len(hand.structure.names))),
+    }
+    saved = plant.GetPositions(ctx).copy()
+    try:
+        return close_candidates(
+            plant, ctx, scene.object_body, scene.hand, hand, poses, 1e-4, False
+        )
+    finally:
+        plant.SetPositions(ctx, saved)
+
+
+def test_a_one_motor_pinch_is_centred_on_the_object(pinch):
+    # The two knuckles close as one: where the hand is off the box's centre,
+    # the near pad touches first and stops both.  The planner moves the hand
+    # towards the far pad and closes again, as the box slides on a table when
+    # such a gripper closes on it.  The pose it closes at does not depend on
+    # where along the jaw it started.
+    offsets = [-0.012, -0.004, 0.0, 0.007, 0.012]
+    kept, rejections, _ = _close_at(pinch, offsets)
+    assert not rejections and [k[0] for k in kept] == list(range(len(offsets)))
+    for sample, X_WH, _, _, contacts in kept:
+        np.testing.assert_allclose(X_WH.translation(), [0, 0, 0.18], atol=2e-4)
+        pads = {c.finger_body.split("::")[-1] for c in contacts}
+        assert pads == {"left_pad", "right_pad"}, (offsets[sample], pads)
+        x = sorted(c.p_OC[0] for c in contacts)  # the box is at the origin
+        np.testing.assert_allclose([x[0], x[-1]], [-0.025, 0.025], atol=2e-4)
+
+
+def test_without_centring_a_one_motor_pinch_off_centre_touches_with_one_pad(
+    pinch, monkeypatch
+):
+    monkeypatch.setattr(multifinger, "CENTRING_STEPS", 0)
+    kept, rejections, _ = _close_at(pinch, [-0.012, 0.0, 0.012])
+    assert [k[0] for k in kept] == [1]
+    assert rejections == {"one finger touches": 2}
+
+
+def test_a_one_motor_pinch_is_planned_on_both_pads(pinch):
+    # Before the centring every sample that reached the box was rejected:
+    # "one finger touches".
+    scene, _ = pinch
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=60, mu=0.5, seed=0, robustness_samples=8,
+    )  # fmt: skip
+    assert len(result) >= 5
+    assert result.rejections.get("one finger touches", 0) <= len(result) // 4
+    for candidate in result:
+        pads = {c.finger_body.split("::")[-1] for c in candidate.contacts}
+        assert pads == {"left_pad", "right_pad"}
