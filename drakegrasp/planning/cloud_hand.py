@@ -77,6 +77,7 @@ from pydrake.geometry import Box, Capsule, Cylinder, Sphere
 from pydrake.multibody.tree import JacobianWrtVariable
 from scipy.spatial import cKDTree
 
+from drakegrasp.planning.centring import chain_groups, close_centred
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
     SHADOW_PROBES,
@@ -328,10 +329,21 @@ class CloudHand:
         self.mask = [
             np.isin(np.arange(len(s.names)), list(f.joints)) for f in s.fingers
         ]
+        # a finger of the contacts is a kinematic chain (two that a <mimic>
+        # closes as one are two), as on a body
         self.label = {}
-        for f, finger in enumerate(s.fingers):
-            for b in finger.bodies:
-                self.label[scoped_name(plant, b)] = f
+        for c, chain in enumerate(hand.chains):
+            for b in chain.bodies:
+                self.label[scoped_name(plant, b)] = c
+        by_body = {}
+        for g in (g for geoms in self.fingers for g in geoms):
+            by_body.setdefault(int(g.body.index()), []).append(g)
+        self.chain_geoms = [
+            [g for b in chain.bodies for g in by_body.get(int(b.index()), [])]
+            for chain in hand.chains
+        ]
+        self.group = chain_groups(s, hand.chains)
+        self.X_WH = None
 
     # -- distances -------------------------------------------------------------
 
@@ -413,23 +425,50 @@ class CloudHand:
         s, plant, ctx = self.hand.structure, self.plant, self.ctx
         k = min(self.tips[f], key=lambda j: psi[j])
         g = self.fingers[f][k]
-        R, p = self._pose(g)
         x_W = self.points_W[witness[k]]
-        probe = np.vstack([np.zeros(3), _FD * np.eye(3), -_FD * np.eye(3)])
-        sd = self._signed(g, R, p, x_W + probe @ R.T)
-        grad = (sd[1:4] - sd[4:7]) / (2 * _FD)
-        norm = np.linalg.norm(grad)
-        if not norm > 0:
+        sd, n_W = self._line(g, x_W)
+        if n_W is None:
             return np.zeros_like(q)
-        n_G = grad / norm
-        y_W = x_W - sd[0] * (R @ n_G)
+        y_W = x_W - sd * n_W
         p_BY = plant.EvalBodyPoseInWorld(ctx, g.body).inverse().multiply(y_W)
         J = plant.CalcJacobianTranslationalVelocity(
             ctx, JacobianWrtVariable.kV, g.body.body_frame(), p_BY,
             plant.world_frame(), plant.world_frame(),
         )  # fmt: skip
-        d = s.coupling.pull_back((R @ n_G) @ J[:, s.velocity_indices])
+        d = s.coupling.pull_back(n_W @ J[:, s.velocity_indices])
         return unit_step(np.where(self.mask[f], d, 0.0), q, s.lower, s.upper)
+
+    def _line(self, g: _Geometry, x_W: np.ndarray):
+        """(ψ(x), n̂_W) of a cloud point ``x_W`` and a hand geometry ``g``.
+
+        ``ψ(x)`` its signed distance to ``g`` (m), ``n̂_W`` the gradient's unit
+        direction (world frame, from ``g`` towards the point; central
+        differences of the closed form), None where the gradient vanishes.
+        """
+        R, p = self._pose(g)
+        probe = np.vstack([np.zeros(3), _FD * np.eye(3), -_FD * np.eye(3)])
+        sd = self._signed(g, R, p, x_W + probe @ R.T)
+        grad = (sd[1:4] - sd[4:7]) / (2 * _FD)
+        norm = np.linalg.norm(grad)
+        if not norm > 0:
+            return float(sd[0]), None
+        return float(sd[0]), R @ (grad / norm)
+
+    def _gaps(self, chains):
+        """The chains' gaps to the cloud and lines towards it (world frame)."""
+        psi, lines = [], []
+        for c in chains:
+            geoms = self.chain_geoms[c]
+            if not geoms:
+                return None
+            d, witness, _ = self.distances(geoms, within=np.inf)
+            k = int(np.argmin(d))
+            _, n_W = self._line(geoms[k], self.points_W[witness[k]])
+            if n_W is None:
+                return None
+            psi.append(d[k])
+            lines.append(n_W)
+        return np.array(psi), np.array(lines)
 
     def _signed(self, g: _Geometry, R, p, points_W) -> np.ndarray:
         sd = signed_distances(g.shape, (points_W - p) @ R)
@@ -701,41 +740,52 @@ class CloudHand:
         return bool(np.max(np.abs(R.T @ n_O)) >= cos_tol)
 
     def run(self, X_WH, q_pre):
-        """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``."""
-        self.X_WH = X_WH
+        """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``.
+
+        Coupled fingers stopped short of the cloud are centred
+        (:func:`~drakegrasp.planning.centring.close_centred`); the pose the
+        hand closed at is left in ``self.X_WH``.
+        """
+        found, q, reason, self.X_WH = close_centred(
+            self._close, self._gaps, self.group, self.tol, X_WH, q_pre
+        )
+        return found, q, reason
+
+    def _close(self, X_WH, q_pre):
+        """One closing at ``X_WH``: (contacts, q, reason, chains touching)."""
         plant, ctx, s = self.plant, self.ctx, self.hand.structure
         plant.SetFreeBodyPose(ctx, self.hand.base, X_WH)
         self._set(plant.GetPositions(ctx), q_pre)
         hit = self.penetration()
         if hit is not None:
-            return (
-                None,
-                None,
-                (
-                    "fingers collide with each other"
-                    if hit == "hand"
-                    else "hand collides with the scene"
-                ),
+            reason = (
+                "fingers collide with each other"
+                if hit == "hand"
+                else "hand collides with the scene"
             )
+            return None, None, reason, set()
         if self.collides():
-            return None, None, "hand collides with the cloud"
+            return None, None, "hand collides with the cloud", set()
         if self.in_shadow():
-            return None, None, "hand enters the unseen side"
+            return None, None, "hand enters the unseen side", set()
         q, touching = self.close(q_pre)
-        if len(touching) < self.min_fingers:
-            return None, None, "fingers miss the object"
+        # the chains that close as one count once here; below, each
+        if len(touching) < min(self.min_fingers, len(s.fingers)):
+            return None, None, "fingers miss the object", set()
         hit = self.penetration()
         if hit == "scene":
-            return None, None, "finger blocked by the scene"
+            return None, None, "finger blocked by the scene", set()
         if hit == "hand":
-            return None, None, "fingers collide with each other"
+            return None, None, "fingers collide with each other", set()
         if self.in_shadow():
-            return None, None, "hand enters the unseen side"
+            return None, None, "hand enters the unseen side", set()
         found = self.contacts(touching)
         fingers = {self.label.get(c.finger_body, -1) for c in found} - {-1}
         if len(fingers) < 2:
-            return None, None, "one finger touches"
-        return found, s.coupling.apply(q), None
+            return None, None, "one finger touches", fingers
+        if len(fingers) < self.min_fingers:  # chains that closed as one finger
+            return None, None, "fingers miss the object", fingers
+        return found, s.coupling.apply(q), None, fingers
 
 
 def _fan(normals: np.ndarray, n_O: np.ndarray) -> np.ndarray | None:

@@ -15,8 +15,8 @@ rejection reason (:data:`REASONS`).
 3. **Closing**: :func:`~drakegrasp.close_hand` (couplings read from the
    plant) from the pre-shape.  Fingers that a ``<mimic>`` closes as one stop
    when one touches: the hand is then moved so that their gaps to the object
-   are equal and closed again (:data:`CENTRING_STEPS`), the candidate keeping
-   the pose it closed at.  Fewer than ``min_fingers`` fingers touching
+   are equal and closed again (:mod:`drakegrasp.planning.centring`), the
+   candidate keeping the pose it closed at.  Fewer than ``min_fingers`` fingers touching
    rejects it, and so does a closed finger that penetrates the rest of the
    scene or another finger (``close_hand`` watches the object only).  The
    contacts are those of :func:`~drakegrasp.find_contacts`, which
@@ -65,6 +65,7 @@ from drakegrasp.planning.candidates import (
     closing_order,
     planning_result,
 )
+from drakegrasp.planning.centring import chain_groups, close_centred
 from drakegrasp.planning.checks import (
     checked_contacts,
     checked_fingers,
@@ -93,7 +94,6 @@ from drakegrasp.plant.fingers import finger_chains, hand_structure
 from drakegrasp.plant.validation import hand_bodies, scoped_name
 
 __all__ = [
-    "CENTRING_STEPS",
     "DEFAULT_TILT",
     "REASONS",
     "close_candidates",
@@ -107,12 +107,6 @@ __all__ = [
 
 DEFAULT_TILT = np.radians(20.0)
 """Default largest tilt of the approach from the surface's inward normal."""
-
-CENTRING_STEPS = 4
-"""Times at most a hand whose coupled fingers stopped short is moved and closed
-again (stage 3).  Each move equalises the fingers' gaps to first order: a
-pinch across parallel faces is centred by the first, one on curved or tilted
-faces by the next few."""
 
 REASONS = {
     "hand collides with the object": "the pre-shaped hand penetrates the object",
@@ -177,15 +171,7 @@ class _Placer:
         for f, finger in enumerate(hand.chains):
             for b in finger.bodies:
                 self.label[scoped_name(plant, b)] = f
-        # the closing group (a finger of the structure) of every chain
-        self.group = [
-            next(
-                k
-                for k, g in enumerate(hand.structure.fingers)
-                if set(chain.joints) <= set(g.joints)
-            )
-            for chain in hand.chains
-        ]
+        self.group = chain_groups(hand.structure, hand.chains)
         self.min_fingers = int(min_fingers)
         self.X_WH = None
 
@@ -212,58 +198,26 @@ class _Placer:
     def run(self, X_WH, q_pre):
         """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``.
 
-        Where fingers that close as one (a ``<mimic>`` across them) stop
-        because one of them touched, the hand is moved towards the others and
-        closed again from ``q_pre`` (:data:`CENTRING_STEPS` times at most):
-        what the object does on a table when a one-motor gripper closes on
-        it, and what a parallel jaw's placement does at its midpoint.  The
-        pose the fingers closed at is left in ``self.X_WH``.
+        Coupled fingers stopped short of the object are centred
+        (:func:`~drakegrasp.planning.centring.close_centred`); the pose the
+        hand closed at is left in ``self.X_WH``.
         """
-        first = None
-        for step in range(CENTRING_STEPS + 1):
-            self.X_WH = X_WH
-            found, q, reason, touched = self._close(X_WH, q_pre)
-            first = first or reason
-            if reason is None:
-                return found, q, None
-            shift = None if step == CENTRING_STEPS else self._centring(touched)
-            if shift is None:
-                return None, None, first
-            X_WH = RigidTransform(X_WH.rotation(), X_WH.translation() + shift)
-        raise AssertionError("unreachable")  # pragma: no cover
+        found, q, reason, self.X_WH = close_centred(
+            self._close, self._gaps, self.group, self.tol, X_WH, q_pre
+        )
+        return found, q, reason
 
-    def _centring(self, touched: set[int]) -> np.ndarray | None:
-        """The move (m, world) after which coupled fingers meet the object together.
-
-        ``touched``: the chains that touch.  For the chains that close as one
-        with a touching one, each at gap ψ_c along its unit line n̂_c from its
-        nearest point to the object's, a move ``t`` of the hand changes the
-        gaps to ``ψ_c − n̂_c·t``; the least ``t`` that makes them equal
-        (``(n̂_c − n̂_0)·t = ψ_c − ψ_0``, least squares) is returned.  For two
-        fingers on opposite faces it is half the difference towards the one
-        short of the object.  None when no chain is short, or when equal gaps
-        need a move larger than the gaps differ (fingers facing one way).
-        """
-        groups = {self.group[t] for t in touched}
-        chains = [c for c, g in enumerate(self.group) if g in groups]
-        if len(chains) == len(touched & set(chains)):
-            return None
+    def _gaps(self, chains):
+        """The chains' gaps to the object and lines towards it (world frame)."""
         query = self.port.Eval(self.ctx)
         psi, lines = [], []
         for c in chains:
             d, n_W, *_ = closest(query, self.plant, self.ctx, self.hand.chains[c].pairs)
-            if n_W is None or not np.isfinite(d):
+            if n_W is None:
                 return None
             psi.append(d)
-            lines.append(np.asarray(n_W, float))
-        psi, lines = np.array(psi), np.array(lines)
-        spread = float(psi.max() - psi.min())
-        if spread <= 1e-3 * self.tol:  # a gap the closing's own stop leaves
-            return None
-        t = np.linalg.lstsq(lines[1:] - lines[0], psi[1:] - psi[0], rcond=1e-6)[0]
-        if not np.all(np.isfinite(t)) or np.linalg.norm(t) > spread:
-            return None
-        return t
+            lines.append(n_W)
+        return np.array(psi), np.array(lines)
 
     def _close(self, X_WH, q_pre):
         """One closing at ``X_WH``: (contacts, q, reason, chains touching)."""

@@ -17,7 +17,13 @@ from scipy.optimize import linprog
 
 import drakegrasp as dg
 from drakegrasp.cli import main
-from drakegrasp.planning import multifinger, plan_grasps, planning_scene, shake_test
+from drakegrasp.planning import (
+    centring,
+    object_surface,
+    plan_grasps,
+    planning_scene,
+    shake_test,
+)
 from drakegrasp.planning.approach import multi_finger_hand
 from drakegrasp.planning.motors import finger_jacobian, torque_capacity
 from drakegrasp.planning.multifinger import close_candidates
@@ -321,10 +327,15 @@ BOX = "package://drakegrasp/objects/box.sdf"  # 50 x 50 x 100 mm, at the origin
 
 
 @pytest.fixture(scope="module")
-def pinch(tmp_path_factory):
+def pinch_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("pinch") / "one_motor_pinch.urdf"
     path.write_text(one_motor_pinch_urdf())
-    scene = planning_scene(BOX, hand_url=str(path))
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def pinch(pinch_file):
+    scene = planning_scene(BOX, hand_url=pinch_file)
     hand = multi_finger_hand(
         scene.plant, scene.plant.GetMyContextFromRoot(scene.context),
         scene.object_body, scene.hand,
@@ -373,7 +384,7 @@ def test_a_one_motor_pinch_is_centred_on_the_object(pinch):
 def test_without_centring_a_one_motor_pinch_off_centre_touches_with_one_pad(
     pinch, monkeypatch
 ):
-    monkeypatch.setattr(multifinger, "CENTRING_STEPS", 0)
+    monkeypatch.setattr(centring, "CENTRING_STEPS", 0)
     kept, rejections, _ = _close_at(pinch, [-0.012, 0.0, 0.012])
     assert [k[0] for k in kept] == [1]
     assert rejections == {"one finger touches": 2}
@@ -389,6 +400,25 @@ def test_a_one_motor_pinch_is_planned_on_both_pads(pinch):
     )  # fmt: skip
     assert len(result) >= 5
     assert result.rejections.get("one finger touches", 0) <= len(result) // 4
+    for candidate in result:
+        pads = {c.finger_body.split("::")[-1] for c in candidate.contacts}
+        assert pads == {"left_pad", "right_pad"}
+
+
+def test_a_one_motor_pinch_is_planned_on_a_point_cloud(pinch, pinch_file):
+    # On a cloud the pinch's one closing group had to count as two fingers
+    # (min_fingers = 2 rejected every pose: "fingers miss the object"), and
+    # its chains are centred as on a body.
+    scene, _ = pinch
+    surface = object_surface(scene.plant, scene.context, scene.object_body)
+    points, normals, _ = surface.sample(3000, np.random.default_rng(0))
+    hand_only = planning_scene(None, hand_url=pinch_file)
+    result = plan_grasps(
+        hand_only.plant, hand_only.context, None, hand=hand_only.hand,
+        num_candidates=100, mu=0.5, seed=0, robustness_samples=8,
+        point_cloud=points, cloud_normals=normals, object_mass=0.2,
+    )  # fmt: skip
+    assert len(result) >= 5
     for candidate in result:
         pads = {c.finger_body.split("::")[-1] for c in candidate.contacts}
         assert pads == {"left_pad", "right_pad"}

@@ -1,0 +1,182 @@
+r"""Centring a hand whose coupled fingers stop short of the object.
+
+A ``<mimic>`` across fingers (a Robotiq-style gripper: two knuckles on one
+motor) makes them close as one: where the hand is off the object's centre,
+the finger nearest the object touches first and stops the others short of
+it.  On a table the object would slide until each of them touches.  Stage 3
+of the multi-finger routes (:mod:`drakegrasp.planning.multifinger` on a body,
+:mod:`drakegrasp.planning.cloud_hand` on a point cloud) does the same to the
+hand: it moves the hand so that their gaps are equal and closes again from
+the pre-shape, at most :data:`CENTRING_STEPS` times.  A candidate keeps the
+pose its fingers closed at.
+
+**The move.**  The chains of one closing group (kinematic chains that a
+coupling closes as one, :func:`~drakegrasp.plant.fingers.finger_chains`)
+have gaps ``ψ_c`` (m) to the object along unit lines ``n̂_c`` (world frame,
+from the chain's nearest point towards the object's).  Moving the hand by
+``t`` (m, world) with its joints held changes them to ``ψ_c − n̂_c·t`` to
+first order.  :func:`equalising_move` returns the least ``t`` that makes them
+equal, the least-squares solution of ``(n̂_c − n̄)·t = ψ_c − ψ̄`` (bars:
+means over the group): for two fingers across parallel faces, half the
+difference of their gaps towards the one short of the object.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+from pydrake.math import RigidTransform
+
+__all__ = [
+    "CENTRING_STEPS",
+    "chain_groups",
+    "chains_to_centre",
+    "close_centred",
+    "equalising_move",
+]
+
+CENTRING_STEPS = 4
+"""Times at most a hand whose coupled fingers stopped short is moved and closed
+again.  Each move equalises the gaps to first order: a pinch across parallel
+faces is centred by the first, one on curved or tilted faces by the next few."""
+
+_RCOND = 1e-6
+"""Singular value of the centred lines ``n̂_c − n̄`` (unit lines: an absolute
+figure) below which a direction is left unmoved: the lines do not tell it."""
+
+
+def chain_groups(structure, chains: Sequence) -> list[int]:
+    """The closing group of every chain: its finger's index in ``structure.fingers``.
+
+    Parameters
+    ----------
+    structure : HandStructure
+    chains : sequence of Finger
+        :func:`~drakegrasp.plant.fingers.finger_chains` of ``structure``.
+    """
+    return [
+        next(
+            k
+            for k, finger in enumerate(structure.fingers)
+            if set(chain.joints) <= set(finger.joints)
+        )
+        for chain in chains
+    ]
+
+
+def chains_to_centre(groups: Sequence[int], touched: set[int]) -> list[int]:
+    """The chains whose gaps are equalised, sorted; empty when none is short.
+
+    ``groups``: :func:`chain_groups`; ``touched``: the chains that touch.
+    The chains of every closing group in which one chain touches and another
+    does not.
+    """
+    short = {
+        groups[c]
+        for c in range(len(groups))
+        if c not in touched and any(groups[t] == groups[c] for t in touched)
+    }
+    return [c for c, g in enumerate(groups) if g in short]
+
+
+def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
+    """The least move of the hand (m, world) after which the gaps are equal.
+
+    Parameters
+    ----------
+    psi : (k,) float
+        The chains' gaps to the object, metres.
+    lines : (k, 3) float
+        Unit lines, world frame, from each chain's nearest point towards the
+        object's.
+    tol : float
+        The distance tolerance (m): gaps within ``1e-3 tol`` of each other are
+        equal already.
+    groups : (k,) int, optional
+        The chains' closing groups: the gaps are equalised within each
+        (default: one group).
+
+    Returns
+    -------
+    (3,) float or None
+        The least-squares solution of ``(n̂_c − n̄)·t = ψ_c − ψ̄`` (bars: means
+        over the chain's group), which neither the chains' order nor a
+        rotation of the scene changes.  None when the gaps are equal already,
+        a gap or line is not finite, the lines see no move (fingers facing
+        one way), or the move would be longer than the gaps differ.
+    """
+    psi = np.asarray(psi, float)
+    lines = np.asarray(lines, float)
+    groups = np.zeros(len(psi), int) if groups is None else np.asarray(groups)
+    if len(psi) < 2 or not (np.all(np.isfinite(psi)) and np.all(np.isfinite(lines))):
+        return None
+    A, b = lines.copy(), psi.copy()
+    spread = 0.0
+    for g in np.unique(groups):
+        mine = groups == g
+        A[mine] -= lines[mine].mean(axis=0)
+        b[mine] -= psi[mine].mean()
+        spread = max(spread, float(np.ptp(psi[mine])))
+    if spread <= 1e-3 * tol:
+        return None
+    # least squares, least norm; directions the unit lines tell apart by less
+    # than _RCOND are left unmoved (an absolute cut: the lines are unit)
+    U, sv, Vt = np.linalg.svd(A, full_matrices=False)
+    seen = sv > _RCOND
+    t = Vt[seen].T @ ((U[:, seen].T @ b) / sv[seen])
+    size = float(np.linalg.norm(t))
+    if not np.isfinite(size) or size <= 1e-3 * tol or size > spread:
+        return None
+    return t
+
+
+def close_centred(
+    close: Callable, gaps: Callable, groups: Sequence[int], tol: float, X_WH, q_pre
+):
+    """Close the hand at ``X_WH``, centring it while coupled chains stop short.
+
+    Parameters
+    ----------
+    close : callable
+        ``close(X_WH, q_pre) -> (contacts, q, reason, touched)``: one closing
+        from the pre-shape at a hand pose; ``reason`` None when kept,
+        ``touched`` the set of chains that touch.
+    gaps : callable
+        ``gaps(chains) -> (psi (k,), lines (k, 3))`` of the closed hand, or
+        None when a chain's gap cannot be measured.
+    groups : sequence of int
+        :func:`chain_groups`.
+    tol : float
+        Distance tolerance (m).
+    X_WH : RigidTransform
+        The sampled pose of the hand's base.
+    q_pre : (n_h,) float
+        The pre-shape.
+
+    Returns
+    -------
+    tuple
+        ``(contacts, q, reason, X_WH)``: the last closing's contacts and
+        joints, the first closing's rejection reason when none was kept, and
+        the pose the hand closed at.
+    """
+    first = None
+    for step in range(CENTRING_STEPS + 1):
+        found, q, reason, touched = close(X_WH, q_pre)
+        if reason is None:
+            return found, q, None, X_WH
+        first = first or reason
+        chains = chains_to_centre(groups, touched)
+        if step == CENTRING_STEPS or not chains:
+            break
+        measured = gaps(chains)
+        move = (
+            None
+            if measured is None
+            else equalising_move(*measured, tol, [groups[c] for c in chains])
+        )
+        if move is None:
+            break
+        X_WH = RigidTransform(X_WH.rotation(), X_WH.translation() + move)
+    return None, None, first, X_WH

@@ -1,0 +1,162 @@
+"""The move that centres coupled fingers (:mod:`drakegrasp.planning.centring`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from pydrake.math import RigidTransform
+from scipy.spatial.transform import Rotation
+
+from drakegrasp.planning.centring import (
+    chains_to_centre,
+    close_centred,
+    equalising_move,
+)
+
+TOL = 1e-4
+
+
+def _unit(v):
+    v = np.asarray(v, float)
+    return v / np.linalg.norm(v)
+
+
+def test_two_fingers_across_parallel_faces_move_half_the_difference():
+    # The far finger is 12 mm short, the near one touches: the hand moves
+    # 6 mm towards the far one, after which both are 6 mm off.
+    n = _unit([1.0, 0.0, 0.0])  # from the short finger towards the object
+    t = equalising_move([0.012, 0.0], [n, -n], TOL)
+    np.testing.assert_allclose(t, [0.006, 0.0, 0.0], atol=1e-15)
+
+
+def test_equal_gaps_need_no_move_and_fingers_facing_one_way_get_none():
+    n = _unit([0.0, 0.0, 1.0])
+    assert equalising_move([0.003, 0.003], [n, -n], TOL) is None
+    # both lines the same way: no move closes one gap without the other
+    assert equalising_move([0.003, 0.0], [n, n], TOL) is None
+    assert equalising_move([0.003, np.nan], [n, -n], TOL) is None
+    assert equalising_move([0.003], [n], TOL) is None
+
+
+def test_each_closing_group_is_equalised_apart():
+    # two pinches closing apart: each pair's gaps are evened, not all four
+    x, y = np.eye(3)[0], np.eye(3)[1]
+    t = equalising_move([0.004, 0.0, 0.002, 0.0], [x, -x, y, -y], TOL, [0, 0, 1, 1])
+    np.testing.assert_allclose(t, [0.002, 0.001, 0.0], atol=1e-15)
+
+
+lines3 = st.lists(
+    st.lists(st.floats(-1, 1), min_size=3, max_size=3).filter(
+        lambda v: np.linalg.norm(v) > 0.2
+    ),
+    min_size=2,
+    max_size=3,
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(lines=lines3, gaps=st.lists(st.floats(0, 0.05), min_size=3, max_size=3))
+def test_the_move_equalises_the_gaps_and_is_the_least(lines, gaps):
+    n = np.array([_unit(v) for v in lines])
+    psi = np.array(gaps[: len(n)])
+    t = equalising_move(psi, n, TOL)
+    # the gaps less their mean, against the lines less theirs (any chain order)
+    A, b = n - n.mean(axis=0), psi - psi.mean()
+    if t is None:
+        return
+    after = psi - n @ t
+    # equal where the lines tell the move apart, else the least-squares fit
+    # over the directions the lines tell apart by more than 1e-6 (an
+    # independent solver: scipy's truncated pseudo-inverse)
+    best = scipy.linalg.pinv(A, atol=1e-6, rtol=0.0) @ b
+    assert np.linalg.norm(A @ t - b) <= np.linalg.norm(A @ best - b) + 1e-12
+    if np.linalg.matrix_rank(A, tol=1e-6) == len(A) - 1:  # the most k chains allow
+        np.testing.assert_allclose(after, after[0], atol=1e-9)
+    # the least: no part along what the lines cannot see
+    _, s, Vt = np.linalg.svd(A)
+    unseen = Vt[np.sum(s > 1e-6 * s[0]) :]
+    np.testing.assert_allclose(unseen @ t, 0, atol=1e-12)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    lines=lines3,
+    gaps=st.lists(st.floats(0, 0.05), min_size=3, max_size=3),
+    quat=st.lists(st.floats(-1, 1), min_size=4, max_size=4).filter(
+        lambda q: np.linalg.norm(q) > 0.1
+    ),
+    order=st.permutations([0, 1, 2]),
+)
+def test_the_move_turns_with_the_scene_and_ignores_the_chains_order(
+    lines, gaps, quat, order
+):
+    n = np.array([_unit(v) for v in lines])
+    psi = np.array(gaps[: len(n)])
+    t = equalising_move(psi, n, TOL)
+    R = Rotation.from_quat(quat).as_matrix()
+    k = [i for i in order if i < len(n)]
+    u = equalising_move(psi[k], (n @ R.T)[k], TOL)
+    assert (t is None) == (u is None)
+    if t is not None:
+        np.testing.assert_allclose(u, R @ t, atol=1e-9)
+
+
+def test_only_chains_closing_with_a_touching_one_are_centred():
+    groups = [0, 0, 1, 2, 2]
+    assert chains_to_centre(groups, {0}) == [0, 1]
+    assert chains_to_centre(groups, {0, 1}) == []  # both touch
+    assert chains_to_centre(groups, {2}) == []  # a finger of its own
+    assert chains_to_centre(groups, {2, 4}) == [3, 4]
+    assert chains_to_centre(groups, set()) == []
+
+
+class _Pinch:
+    """A one-dimensional pinch: an object [e - w, e + w], pads closing to ±a/2."""
+
+    def __init__(self, e, w=0.025, tilt=0.0):
+        self.e, self.w, self.tilt, self.calls = e, w, tilt, 0
+
+    def _x(self, X_WH):
+        return X_WH.translation()[0]
+
+    def close(self, X_WH, q_pre):
+        self.calls += 1
+        e = self.e - self._x(X_WH)  # the object's offset from the hand
+        # both pads close together until the nearer one is 0.09 tol away
+        self.gap = (2 * abs(e) + 0.9 * TOL, 0.9 * TOL)  # (far, near)
+        self.short = 0 if e > 0 else 1  # the pad on -x is short when e > 0
+        if abs(2 * e) <= 0.1 * TOL:
+            return ["contacts"], np.zeros(2), None, {0, 1}
+        return None, None, "one finger touches", {1 - self.short}
+
+    def gaps(self, chains):
+        psi = np.zeros(2)
+        psi[self.short], psi[1 - self.short] = self.gap
+        lines = np.array([[1.0, 0, self.tilt], [-1.0, 0, self.tilt]])
+        return psi, lines / np.linalg.norm(lines, axis=1, keepdims=True)
+
+
+@pytest.mark.parametrize("e", [-0.012, -0.003, 0.0, 0.004, 0.012])
+def test_close_centred_centres_a_pinch_and_keeps_the_pose_it_closed_at(e):
+    pinch = _Pinch(e)
+    found, q, reason, X = close_centred(
+        pinch.close, pinch.gaps, [0, 0], TOL, RigidTransform([0.0, 0.0, 0.1]), None
+    )
+    assert reason is None and found == ["contacts"]
+    np.testing.assert_allclose(X.translation(), [e, 0.0, 0.1], atol=1e-12)
+    assert pinch.calls == (1 if e == 0 else 2)
+
+
+def test_close_centred_gives_the_first_reason_when_it_cannot_centre(monkeypatch):
+    from drakegrasp.planning import centring
+
+    pinch = _Pinch(0.01)
+    monkeypatch.setattr(centring, "CENTRING_STEPS", 0)
+    found, q, reason, X = close_centred(
+        pinch.close, pinch.gaps, [0, 0], TOL, RigidTransform(), None
+    )
+    assert (found, q, reason) == (None, None, "one finger touches")
+    assert pinch.calls == 1
