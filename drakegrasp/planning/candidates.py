@@ -144,6 +144,17 @@ class GraspCandidate:
         finger's torsion with (``GraspCandidates.torque_scale``), and so the
         characteristic length of ``grasp``; NaN for a candidate built without
         one (``grasp`` then takes the grasp's default).
+
+    Notes
+    -----
+    A candidate pickles, so that candidates can be sent to other processes
+    (``multiprocessing``, ``concurrent.futures``, Dask) and back: every
+    attribute comes back equal, its contacts' geometry ids too in the
+    process that planned it.  In any other process those two ids of each
+    contact are :class:`~drakegrasp.plant.handles.ForeignGeometryId`, which
+    name no geometry there (:mod:`drakegrasp.plant.handles`); nothing else
+    of the candidate depends on them.  ``grasp`` is not pickled: it is built
+    again on first access.
     """
 
     sample: int
@@ -169,6 +180,13 @@ class GraspCandidate:
     q_preshape: np.ndarray | None = None
     torque_needed: float = float("nan")
     torque_scale: float = float("nan")
+
+    def __getstate__(self) -> dict:
+        # ``grasp`` (a cached_property, in __dict__ once read) is rebuilt from
+        # the fields on first access: not pickled
+        state = dict(self.__dict__)
+        state.pop("grasp", None)
+        return state
 
     @cached_property
     def grasp(self) -> Grasp:

@@ -44,7 +44,7 @@ turns patch handling off.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from pydrake.geometry import GeometryId, QueryObject
@@ -66,6 +66,7 @@ from drakegrasp.plant.contact_pair import (
     resolve_pairs,
 )
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
+from drakegrasp.plant.handles import pickled_handle
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -116,7 +117,9 @@ class PlantContact:
         Scoped name ``model::body`` of the finger body.
     finger_body_index : BodyIndex
     object_geometry, finger_geometry : GeometryId
-        The geometry pair.
+        The geometry pair (a
+        :class:`~drakegrasp.plant.handles.ForeignGeometryId` in a process the
+        contact was pickled to: see the notes).
     object_geometry_name, finger_geometry_name : str
         Their names in the scene graph.
     normal_source : str
@@ -141,6 +144,16 @@ class PlantContact:
         Place of each geometry among its body's collision geometries (None
         when not known, e.g. contacts read from contact results); they make
         the labels ``finger_geometry_label``/``object_geometry_label`` unique.
+
+    Notes
+    -----
+    A contact pickles (and so crosses to another process) with its handles
+    as numbers: ``finger_body_index`` comes back as the same ``BodyIndex``;
+    ``object_geometry`` and ``finger_geometry`` as the same ``GeometryId`` in
+    the process that found the contact, and in any other as a
+    :class:`~drakegrasp.plant.handles.ForeignGeometryId`, since a
+    ``GeometryId`` names a geometry only in the process that made it (see
+    :mod:`drakegrasp.plant.handles`).
     """
 
     p_OC: np.ndarray
@@ -176,6 +189,10 @@ class PlantContact:
         """``geometry#k`` of the object's geometry (see ``finger_geometry_label``)."""
         return _label("", self.object_geometry_name, self.object_geometry_index)
 
+    def __reduce__(self):
+        values = {f.name: pickled_handle(getattr(self, f.name)) for f in fields(self)}
+        return (_unpickled_contact, (type(self), values))
+
     def to_dict(self) -> dict:
         """JSON-ready dictionary.
 
@@ -207,6 +224,11 @@ class PlantContact:
             f"PlantContact({self.finger_body}: p_OC={np.round(self.p_OC, 6).tolist()}, "
             f"nhat_O={np.round(self.nhat_O, 6).tolist()}, psi={self.psi:.3g}{patch})"
         )
+
+
+def _unpickled_contact(cls: type, values: dict) -> PlantContact:
+    """A pickled :class:`PlantContact` (its handles already unpickled)."""
+    return cls(**values)
 
 
 def _label(body: str, name: str, index: int | None) -> str:

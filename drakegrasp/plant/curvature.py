@@ -46,6 +46,7 @@ from drakegrasp.core.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import flat_faces, surface_pieces
 from drakegrasp.plant.contacts import PlantContact, resolve_object_body
+from drakegrasp.plant.handles import local_geometry_id
 from drakegrasp.plant.options import PLANES
 from drakegrasp.plant.validation import plant_context_of, query_object_of
 
@@ -272,6 +273,9 @@ def contact_curvatures(
     ------
     ModelError
         For a shape without a curvature model.
+    InvalidContactError
+        A contact unpickled in another process than the one that found it
+        (its geometries are :class:`~drakegrasp.plant.handles.ForeignGeometryId`).
     """
     plant_context = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
@@ -281,15 +285,17 @@ def contact_curvatures(
     inspector = query.inspector()
     X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
     out = []
-    for pc in contacts:
+    for k, pc in enumerate(contacts):
+        go = local_geometry_id(pc.object_geometry, f"contact {k}'s object_geometry")
+        gf = local_geometry_id(pc.finger_geometry, f"contact {k}'s finger_geometry")
         n_O = np.asarray(pc.nhat_O)
-        X_OGo = X_OW.multiply(query.GetPoseInWorld(pc.object_geometry))
-        X_OGf = X_OW.multiply(query.GetPoseInWorld(pc.finger_geometry))
+        X_OGo = X_OW.multiply(query.GetPoseInWorld(go))
+        X_OGf = X_OW.multiply(query.GetPoseInWorld(gf))
         R_OGo, R_OGf = X_OGo.rotation().matrix(), X_OGf.rotation().matrix()
         p_Go = np.asarray(X_OGo.inverse().multiply(pc.p_OC))
         p_Gf = np.asarray(X_OGf.inverse().multiply(pc.p_OC - pc.psi * n_O))
-        shape_o = inspector.GetShape(pc.object_geometry)
-        shape_f = inspector.GetShape(pc.finger_geometry)
+        shape_o = inspector.GetShape(go)
+        shape_f = inspector.GetShape(gf)
         if pc.normal_source == "patch":
             cc = _patch_curvatures(shape_o, p_Go, R_OGo, shape_f, p_Gf, R_OGf, n_O)
         else:

@@ -31,6 +31,7 @@ from pydrake.multibody.plant import (
 )
 
 from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.plant.handles import local_geometry_id
 from drakegrasp.plant.validation import (
     hand_contact_bodies,
     plant_context_of,
@@ -101,7 +102,12 @@ def pair_friction(
     ------
     ModelError
         If either geometry has no ``material/coulomb_friction`` property.
+    InvalidContactError
+        Either is a :class:`~drakegrasp.plant.handles.ForeignGeometryId`, a
+        geometry of another process (a contact unpickled here).
     """
+    id_a = local_geometry_id(id_a, "the first geometry (id_a)")
+    id_b = local_geometry_id(id_b, "the second geometry (id_b)")
     inspector = query_object.inspector()
     pair = CalcContactFrictionFromSurfaceProperties(
         _coulomb(inspector, id_a), _coulomb(inspector, id_b)
@@ -137,15 +143,28 @@ def plant_friction(
     -------
     (N,) float
         :func:`pair_friction` of each contact's object and finger geometries.
+
+    Raises
+    ------
+    ModelError
+        As :func:`pair_friction`.
+    InvalidContactError
+        A contact unpickled in another process than the one that found it
+        (its geometries are :class:`~drakegrasp.plant.handles.ForeignGeometryId`).
     """
+    contacts = list(contacts)
+    pairs = [
+        (
+            local_geometry_id(c.object_geometry, f"contact {k}'s object_geometry"),
+            local_geometry_id(c.finger_geometry, f"contact {k}'s finger_geometry"),
+        )
+        for k, c in enumerate(contacts)
+    ]
     if query_object is None:
         ctx = plant_context_of(plant, plant_context)
         query_object = query_object_of(plant, ctx)
     return np.array(
-        [
-            pair_friction(plant, query_object, c.object_geometry, c.finger_geometry)
-            for c in contacts
-        ],
+        [pair_friction(plant, query_object, go, gf) for go, gf in pairs],
         dtype=float,
     )
 

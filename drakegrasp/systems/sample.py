@@ -162,7 +162,7 @@ class GraspSample:
     def __deepcopy__(self, memo) -> GraspSample:
         # Drake copies abstract state values (by deepcopy for Python objects)
         # whenever it clones a context; a sample is never mutated, so sharing
-        # it is safe and avoids copying Drake ids that cannot be pickled.
+        # it is safe and avoids copying its report and contacts every clone.
         return self
 
     @property

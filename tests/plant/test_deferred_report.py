@@ -47,8 +47,7 @@ def _same_report(analyse) -> list[str]:
     assert _pending_parts(eager) == []
     lazy = analyse()
     deferred = _pending_parts(lazy)
-    # The report holds Drake ids (PlantContact), which never pickled; its
-    # results do, and pickling computes their pending parts.
+    # Each result pickles, and pickling computes its pending parts.
     fresh = analyse()
     pickled = {
         name: pickle.loads(pickle.dumps(getattr(fresh, name)))
