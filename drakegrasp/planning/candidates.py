@@ -28,6 +28,7 @@ from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidGraspError
+from drakegrasp.planning.needed import needed_text
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import (
@@ -111,10 +112,13 @@ class GraspCandidate:
         when not computed.
     squeeze_needed : float
         The squeeze per finger (N) that holds the object's weight in all those
-        directions, ``m g / weight_capacity`` (inf: none does; NaN: not
-        computed).  A lower bound for fingers that each press with a set
-        force: the LP shares each finger's force among its contacts at will,
-        while a rigid pad shares it as its geometry and compliance dictate (in
+        directions, ``m g / weight_capacity``
+        (:func:`~drakegrasp.planning.needed.needed_for`; inf: none does, or,
+        with a ``weight_capacity`` > 0, more than the largest float, about
+        1.8e308 N: an absurd ``object_mass``; NaN: not computed).  A lower
+        bound for fingers that each press with a set force: the LP shares
+        each finger's force among its contacts at will, while a rigid pad
+        shares it as its geometry and compliance dictate (in
         the shake test, grasps of cylinders with two tip spheres per finger
         needed up to twice this).  A position-controlled finger that the
         object pushes back presses harder, up to its effort limit, so such a
@@ -137,13 +141,21 @@ class GraspCandidate:
         ``max(certify, TORQUE_CHECK)``,
         :data:`~drakegrasp.planning.motors.TORQUE_CHECK`) when the weight is
         known: planned on a body, or on a point cloud with ``object_mass``;
-        inf: none does; NaN: not computed.  Compare it with the actuators'
-        effort limits, or use it as ``shake_test``'s squeeze.
+        ``m g / torque_capacity``; inf: none does, or, with a
+        ``torque_capacity`` > 0, more than the largest float; NaN: not
+        computed.  Compare it with the actuators' effort limits, or use it as
+        ``shake_test``'s squeeze.
     torque_scale : float
         The length (m) the planner divided moments by and bounded a soft
         finger's torsion with (``GraspCandidates.torque_scale``), and so the
         characteristic length of ``grasp``; NaN for a candidate built without
         one (``grasp`` then takes the grasp's default).
+    torque_capacity : float
+        Newtons of the object's weight held per N·m at every finger joint, in
+        the worst weight direction (``min_u β(u)`` of
+        :func:`~drakegrasp.planning.motors.torque_capacity`), for the
+        candidates that got a ``torque_needed``; 0: none holds it; NaN: not
+        computed.
 
     Notes
     -----
@@ -180,6 +192,7 @@ class GraspCandidate:
     q_preshape: np.ndarray | None = None
     torque_needed: float = float("nan")
     torque_scale: float = float("nan")
+    torque_capacity: float = float("nan")
 
     def __getstate__(self) -> dict:
         # ``grasp`` (a cached_property, in __dict__ once read) is rebuilt from
@@ -291,6 +304,7 @@ class GraspCandidate:
             else jsonable(self.q_preshape),
             "torque_needed": jsonable(self.torque_needed),
             "torque_scale": jsonable(self.torque_scale),
+            "torque_capacity": jsonable(self.torque_capacity),
         }
 
     def __str__(self) -> str:
@@ -301,13 +315,19 @@ class GraspCandidate:
             else f"{len(self.q_hand)} closing joints"
         )
         if not np.isnan(self.torque_needed):
-            shape += f", torque {self.torque_needed:.3g} N·m per joint"
+            torque = needed_text(
+                self.torque_needed, self.torque_capacity, "N·m per joint"
+            )
+            shape += f", torque {torque}"
         if np.isnan(self.weight_capacity):
             holds = "weight not checked"
         else:
             holds = f"holds {self.weight_capacity:.3f} N/N"
             if not np.isnan(self.squeeze_needed):  # NaN: the weight is unknown
-                holds += f" (squeeze {self.squeeze_needed:.1f} N per finger)"
+                squeeze = needed_text(
+                    self.squeeze_needed, self.weight_capacity, "N per finger", ".1f"
+                )
+                holds += f" (squeeze {squeeze})"
         return (
             f"sample {self.sample}: "
             f"{'force closure' if self.is_closure else 'no closure'}"
@@ -458,6 +478,7 @@ class GraspCandidates(Sequence):
             "weight_capacity": column(lambda c: c.weight_capacity),
             "squeeze_needed": column(lambda c: c.squeeze_needed),
             "torque_needed": column(lambda c: c.torque_needed),
+            "torque_capacity": column(lambda c: c.torque_capacity),
             "epsilon": column(lambda c: c.epsilon),
             "robustness": column(lambda c: c.robustness),
             "is_closure": column(lambda c: c.is_closure, bool),

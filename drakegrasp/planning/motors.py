@@ -89,6 +89,7 @@ from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.checks import checked_directions
+from drakegrasp.planning.needed import beyond_float_range, needed_for, needed_text
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
 from drakegrasp.plant.couplings import coupling_map, motor_shares, plant_couplings
 from drakegrasp.plant.fingers import find_joint
@@ -361,17 +362,27 @@ def torque_needed(
     Returns
     -------
     float
-        ``weight / min_u β(u)`` over the 14 weight directions: ``inf`` when
-        some direction cannot be held, NaN for a NaN weight (a point cloud
-        without ``object_mass``).
+        ``weight / min_u β(u)`` over the 14 weight directions
+        (:func:`~drakegrasp.planning.needed.needed_for`): ``inf`` when some
+        direction cannot be held, and where the quotient exceeds the largest
+        float (``min_u β(u) > 0``: the candidate's ``torque_capacity`` tells
+        the two apart); NaN for a NaN weight (a point cloud without
+        ``object_mass``).
     """
+    return _torque_figures(plant, plant_context, candidate, object_body, weight)[1]
+
+
+def _torque_figures(
+    plant, plant_context, candidate, object_body, weight
+) -> tuple[float, float]:
+    """``(min_u β(u), torque needed)`` of a candidate (see :func:`torque_needed`)."""
     weight = real_scalar("weight", weight)
     if math.isnan(weight):
-        return math.nan
+        return math.nan, math.nan
     if not math.isfinite(weight) or weight < 0:
         raise InvalidOptionError(f"weight must be finite and >= 0 (N), got {weight!r}")
     beta = float(np.min(torque_capacity(plant, plant_context, candidate, object_body)))
-    return math.inf if beta <= 0 else weight / beta
+    return beta, needed_for(weight, beta)
 
 
 def with_torques_needed(
@@ -432,17 +443,12 @@ def with_torques_needed(
     if math.isnan(weight):
         return result
     n = max(int(top), int(check))
-    head = [
-        dataclasses.replace(
-            c,
-            torque_needed=torque_needed(
-                plant, plant_context, c, object_body, weight=weight
-            ),
-        )
-        if c.is_closure
-        else c
-        for c in result.candidates[:n]
-    ]
+
+    def with_torque(c: GraspCandidate) -> GraspCandidate:
+        beta, needed = _torque_figures(plant, plant_context, c, object_body, weight)
+        return dataclasses.replace(c, torque_capacity=beta, torque_needed=needed)
+
+    head = [with_torque(c) if c.is_closure else c for c in result.candidates[:n]]
     ranked = [*head, *result.candidates[n:]]
     limit = motor_limit(plant, ranked[0]) if ranked else math.inf
     applied = torque_limit is not None and torque_limit < limit
@@ -632,13 +638,17 @@ def _too_weak(head, limit: float, applied: bool = False) -> str:
 
     ``applied``: the limit is the user's ``torque_limit``, not the effort limit.
     """
-    needed = [c.torque_needed for c in head if not np.isnan(c.torque_needed)]
+    needed = [
+        (c.torque_needed, c.torque_capacity)
+        for c in head
+        if not np.isnan(c.torque_needed)
+    ]
     who = (
         f"the hand at torque_limit {limit:.3g} N·m holds"
         if applied
         else f"the hand's actuators (effort limits from {limit:.3g} N·m) hold"
     )
-    return _none_held(needed, limit, who, "best ", "N·m per joint (torque_needed)")
+    return _none_held(needed, limit, who, "best ", "N·m per joint", "torque_needed")
 
 
 def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:
@@ -647,7 +657,7 @@ def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:
     ``applied``: the limit is the user's ``squeeze_limit``, not the effort limit.
     """
     needed = [
-        c.squeeze_needed
+        (c.squeeze_needed, c.weight_capacity)
         for c in candidates
         if c.is_closure and not np.isnan(c.squeeze_needed)
     ]
@@ -656,22 +666,32 @@ def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:
         if applied
         else f"the jaw's actuators (effort limits from {limit:.3g} N) hold"
     )
-    return _none_held(needed, limit, who, "", "N per finger (squeeze_needed)")
+    return _none_held(needed, limit, who, "", "N per finger", "squeeze_needed")
 
 
-def _none_held(needed: list, limit: float, who: str, best: str, unit: str) -> str:
-    """The sentence saying that none of ``needed`` is within ``limit``, or ""."""
-    if not needed or min(needed) <= limit:
+def _none_held(
+    needed: list, limit: float, who: str, best: str, unit: str, name: str
+) -> str:
+    """The sentence saying that none of ``needed`` is within ``limit``, or "".
+
+    ``needed`` holds ``(figure, capacity)`` pairs (the capacity tells a figure
+    beyond float range from none holding: :mod:`~drakegrasp.planning.needed`);
+    ``name`` is the candidates' attribute the figures are.
+    """
+    if not needed or min(n for n, _ in needed) <= limit:
         return ""
+    # the least figure; one beyond float range before inf where none holds
+    least, capacity = min(needed, key=lambda nc: (nc[0], -nc[1]))
+    text = f"{needed_text(least, capacity, unit)} ({name})"
     if len(needed) == 1:
         return (
             f"{who} not the one {best}force-closure candidate against the "
-            f"object's weight in every direction: it needs {needed[0]:.3g} {unit}"
+            f"object's weight in every direction: it needs {text}"
         )
+    at_least = "" if beyond_float_range(least, capacity) else "at least "
     return (
         f"{who} none of the {len(needed)} {best}force-closure candidates against "
-        f"the object's weight in every direction: they need at least "
-        f"{min(needed):.3g} {unit}"
+        f"the object's weight in every direction: they need {at_least}{text}"
     )
 
 

@@ -303,8 +303,11 @@ def plan_grasps(
     object_mass : float, optional
         The object's mass (kg) for ``squeeze_needed`` and (multi-finger hands)
         ``torque_needed`` and the ranking by it; default the body's mass (a
-        cloud has none: NaN, and neither is computed).  Finite and > 0, else
-        ``InvalidOptionError``.
+        cloud has none: NaN, and neither is computed).  Finite and > 0, with
+        a finite weight ``m g``, else ``InvalidOptionError``.  A figure it
+        makes that exceeds the largest float (``--mass 1.7e307``: 1.67e308 N
+        over a capacity below 1) is ``inf`` beside a capacity > 0, and said
+        "beyond float range" (:mod:`~drakegrasp.planning.needed`).
     torque_limit : float, optional
         Multi-finger hands with a known weight: the torque (N·m per finger
         joint; N for a prismatic one) you will apply when grasping.  The

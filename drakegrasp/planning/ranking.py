@@ -77,6 +77,7 @@ from drakegrasp.planning.checks import (
     checked_rng,
     checked_samples,
 )
+from drakegrasp.planning.needed import needed_for
 from drakegrasp.planning.reclose import perturbed_mu, reclosed_robustness
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.validation import scoped_name
@@ -475,12 +476,6 @@ def _axes_O(kept, rows, gripper, X_WO) -> np.ndarray:
     return np.array([R_OW @ kept[i][1].rotation().matrix() @ a_H for i in rows])
 
 
-def _squeeze(weight: float, alpha: float) -> float:
-    if not np.isfinite(alpha):
-        return float("nan")
-    return float(weight / alpha) if alpha > 0 else float("inf")
-
-
 @renamed_keyword("model", "contact_model")
 def ranked_candidates(
     order, scores: dict, pose, *, weight: float, certify: int, mu, contact_model, nu
@@ -516,7 +511,8 @@ def ranked_candidates(
     -------
     tuple of GraspCandidate
         In the order of ``order``; ``squeeze_needed`` is ``weight / α``
-        (newtons per finger; NaN without a capacity, inf at 0).
+        (newtons per finger, :func:`~drakegrasp.planning.needed.needed_for`:
+        NaN without a capacity, inf at 0 and beyond the largest float).
     """
     out = []
     for place, i in enumerate(order):
@@ -535,7 +531,7 @@ def ranked_candidates(
             robustness=float(scores["rho"][i]),
             score=float(scores["score"][i]),
             weight_capacity=float(alpha),
-            squeeze_needed=_squeeze(weight, alpha),
+            squeeze_needed=needed_for(weight, alpha),
         )
         if place < certify:
             candidate = replace(candidate, closure=force_closure(candidate.grasp))

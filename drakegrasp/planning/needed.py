@@ -1,0 +1,101 @@
+"""What a hand must apply to hold a weight: a load over a capacity, and its words.
+
+A candidate's ``squeeze_needed`` is the object's weight over its weight
+capacity (N of weight per N of squeeze), and ``torque_needed`` the weight
+over its torque capacity (N of weight per N·m at every finger joint).  Both
+come from :func:`needed_for`, and are said by :func:`needed_text`:
+
+- NaN where the capacity or the weight is unknown (not computed);
+- ``inf`` where the capacity is 0: no effort holds the weight;
+- 0 where the capacity is infinite: nothing is needed;
+- otherwise the quotient, which is ``inf`` too where it exceeds the largest
+  float (:data:`FLOAT_MAX`, about 1.8e308: an ``object_mass`` near 1e307
+  kg).  Such a figure exists but no float holds it; :func:`beyond_float_range`
+  tells it from "none holds" by its capacity, and :func:`needed_text` says
+  "more than 1.8e+308 N, beyond float range" rather than ``inf``.
+
+The quotient is taken in Python floats, without numpy's overflow warning:
+``inf`` is its honest value, not an accident to warn about.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+
+__all__ = ["FLOAT_MAX", "beyond_float_range", "needed_for", "needed_text"]
+
+FLOAT_MAX = sys.float_info.max
+"""The largest float, about 1.8e308: a needed effort above it reads ``inf``."""
+
+LONG_FIGURE = 1e6
+"""From this size on, a figure printed with fixed decimals (``.1f``) is printed
+with three significant digits instead: no 300-digit squeeze."""
+
+
+def needed_for(load: float, capacity: float) -> float:
+    """``load / capacity``: the effort that holds ``load`` at ``capacity`` per unit.
+
+    Parameters
+    ----------
+    load : float
+        The object's weight (N), >= 0; NaN when unknown.
+    capacity : float
+        Weight held per unit of effort (N per N of squeeze, or per N·m of
+        torque), >= 0 or ``inf``; NaN when not computed.
+
+    Returns
+    -------
+    float
+        NaN if either is NaN; ``inf`` for a capacity <= 0 (none holds); 0 for
+        an infinite capacity; else the quotient, ``inf`` where it exceeds
+        :data:`FLOAT_MAX` (:func:`beyond_float_range`).
+    """
+    load, capacity = float(load), float(capacity)
+    if math.isnan(load) or math.isnan(capacity):
+        return math.nan
+    if capacity <= 0.0:
+        return math.inf
+    if math.isinf(capacity):
+        return 0.0
+    return load / capacity  # Python floats: inf beyond FLOAT_MAX, no warning
+
+
+def beyond_float_range(needed: float, capacity: float) -> bool:
+    """Whether an ``inf`` of :func:`needed_for` is a figure above :data:`FLOAT_MAX`.
+
+    True for an infinite ``needed`` at a finite capacity > 0 (some effort
+    holds the weight, more than a float can say); False for one at a capacity
+    of 0 (none holds) and for any finite or NaN ``needed``.
+    """
+    return math.isinf(needed) and 0.0 < capacity < math.inf
+
+
+def needed_text(needed: float, capacity: float, unit: str, spec: str = ".3g") -> str:
+    """``needed`` in words with its ``unit``: "12.3 N per finger", honest at inf.
+
+    Parameters
+    ----------
+    needed : float
+        From :func:`needed_for`.
+    capacity : float
+        The capacity it came from, which tells "beyond float range" from "none
+        holds".
+    unit : str
+        Appended after the figure ("N per finger", "N·m per joint").
+    spec : str, optional
+        The figure's format (default ``".3g"``); a fixed-point one (``".1f"``)
+        gives way to ``".3g"`` from :data:`LONG_FIGURE` on.
+
+    Returns
+    -------
+    str
+        "12.3 N per finger"; "more than 1.8e+308 N per finger, beyond float
+        range" (:func:`beyond_float_range`); "inf N per finger" where none
+        holds; "nan N per finger" where not computed.
+    """
+    if beyond_float_range(needed, capacity):
+        return f"more than {FLOAT_MAX:.2g} {unit}, beyond float range"
+    if spec.endswith("f") and math.isfinite(needed) and abs(needed) >= LONG_FIGURE:
+        spec = ".3g"
+    return f"{needed:{spec}} {unit}"
