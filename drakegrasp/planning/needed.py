@@ -23,7 +23,13 @@ from __future__ import annotations
 import math
 import sys
 
-__all__ = ["FLOAT_MAX", "beyond_float_range", "needed_for", "needed_text"]
+__all__ = [
+    "FLOAT_MAX",
+    "LONG_FIGURE",
+    "beyond_float_range",
+    "needed_for",
+    "needed_text",
+]
 
 FLOAT_MAX = sys.float_info.max
 """The largest float, about 1.8e308: a needed effort above it reads ``inf``."""
