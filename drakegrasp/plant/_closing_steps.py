@@ -223,33 +223,51 @@ def _path_end(q, d, lower, upper) -> float:
 class Search:
     """The steps of every finger (see the module docstring)."""
 
-    def __init__(self, plant, context, hand: HandStructure, tol, user_d, max_it):
+    def __init__(
+        self, plant, context, hand: HandStructure, tol, user_d, max_it, split=None
+    ):
         self.plant, self.context, self.hand = plant, context, hand
         self.tol, self.target = tol, 0.5 * tol
         self.user_d, self.max_iterations = user_d, max_it
+        self.split = split  # touching state -> the state of its free part, or None
         self._tips: dict[int, np.ndarray | None] = {}  # id(finger) -> tip rows
         self._joints = {}  # id(finger) -> its joints' positions in q
         self._mine = {}  # id(finger) -> (n_h,) bool, its joints
         for f in hand.fingers:
-            self._joints[id(f)] = np.array(f.joints, dtype=int)
-            mine = np.zeros(len(hand.lower), dtype=bool)
-            mine[list(f.joints)] = True
-            self._mine[id(f)] = mine
+            self._know(f)
+
+    def _know(self, f: Finger) -> None:
+        self._joints[id(f)] = np.array(f.joints, dtype=int)
+        mine = np.zeros(len(self.hand.lower), dtype=bool)
+        mine[list(f.joints)] = True
+        self._mine[id(f)] = mine
 
     def run(self, states: list[FingerState], q_all: np.ndarray, q0: np.ndarray) -> int:
-        """Step until every finger has a status; the number of steps."""
+        """Step until every finger has a status; the number of steps.
+
+        With ``split``, the free part of a finger that comes to touch (joints
+        that move none of its touching bodies, coupled to none that does) is
+        appended to ``states`` and closes on from where the finger stopped.
+        """
         hand, steps = self.hand, 0
         while not all(st.status for st in states):
             q = q0.copy()
-            for st in states:
+            for st in states:  # a free part after its finger: its joints win
                 j = self._joints[id(st.finger)]
                 q[j] = st.q_trial[j]
             q_all[hand.position_indices] = hand.coupling.apply(q)
             self.plant.SetPositions(self.context, q_all)
             query = self.plant.get_geometry_query_input_port().Eval(self.context)
+            parts = []
             for st in states:
                 if not st.status:
                     self.advance(st, query)
+                    if st.status == "touching" and self.split is not None:
+                        part = self.split(st, q)
+                        if part is not None:
+                            self._know(part.finger)
+                            parts.append(part)
+            states.extend(parts)
             steps += 1
         # Where each finger stopped (a finger that ran out of steps goes back
         # to its last point clear of the object).

@@ -40,6 +40,14 @@ be neither the nearest nor bound the next step is not measured (the answers
 are those of measuring every pair).  The loop itself is in
 ``drakegrasp.plant._closing_steps``.
 
+**Coupled fingers.**  Fingers that a coupling closes as one (a
+``<mimic>`` across them) are one finger here and stop when one of them
+touches.  Its joints that move none of the touching bodies and are coupled
+to none that does (a Barrett-style hand's other flexion, where only the
+spread is shared) then close on from there as a finger of their own
+(:func:`~drakegrasp.plant.fingers.free_part`), listed after the others in
+``HandClosure.fingers``; with a ``direction`` they stay where they are.
+
 **Parallel grippers.**  A hand whose closing joints are two prismatic jaws
 facing each other (:mod:`drakegrasp.plant.jaws`) gets each jaw's distance in
 ``HandClosure.jaws``, and a warning when only one of them touches.
@@ -75,7 +83,7 @@ from drakegrasp.errors import (
 from drakegrasp.plant._closing_steps import FingerState, Search, closest
 from drakegrasp.plant.advancement import reach
 from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import HandStructure, hand_structure
+from drakegrasp.plant.fingers import HandStructure, free_part, hand_structure
 from drakegrasp.plant.jaws import JawContact, jaw_contacts, parallel_jaws
 from drakegrasp.plant.pose import find_penetrations, joint_limit_violations
 from drakegrasp.plant.settle import SettleResult, settle_object
@@ -154,6 +162,8 @@ class HandClosure:
     q_start, q : (n_h,) float
         Pre-shape and final positions (metres or radians).
     fingers : tuple of FingerClosure
+        One per finger, then one per free part of a coupled finger that
+        closed on after it stopped (see the module docstring).
     iterations : int
         Steps of the search (each one update of the kinematics).
     time : float
@@ -454,7 +464,23 @@ def _close(
     max_iterations, inspector, jaws, symmetric, settle, instance_bodies, t0,
 ):  # fmt: skip
     """The search, the settling and the result of :func:`close_hand`."""
-    search = Search(plant, plant_context, hand_, tol, user_d, max_iterations)
+
+    def split(st: FingerState, q: np.ndarray) -> FingerState | None:
+        # a finger's free part closes on where a coupling stopped it with the
+        # rest (not along a user's direction: it names the fingers it moves)
+        if user_d is not None or st.closest_body is None:
+            return None
+        part = free_part(plant, hand_, st.finger, [st.closest_body])
+        if part is None:
+            return None
+        return FingerState(
+            part,
+            q.copy(),
+            q.copy(),
+            reach(plant, plant_context, hand_, part, inspector),
+        )
+
+    search = Search(plant, plant_context, hand_, tol, user_d, max_iterations, split)
     states = [
         FingerState(
             f, q0.copy(), q0.copy(), reach(plant, plant_context, hand_, f, inspector)

@@ -53,6 +53,7 @@ __all__ = [
     "effort_unit",
     "find_joint",
     "finger_chains",
+    "free_part",
     "hand_structure",
     "tip_bodies",
 ]
@@ -487,6 +488,87 @@ def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
                 )
             )
     return tuple(out)
+
+
+def free_part(
+    plant: MultibodyPlant, structure: HandStructure, finger: Finger, touching
+) -> Finger | None:
+    """What of a finger can close on once some of its bodies touch.
+
+    A finger whose chains a coupling closes as one (a Barrett-style spread
+    joint coupling two fingers, each with its own flexion motor) stops where
+    one chain touches.  The joints of its other chains that are coupled to
+    none of a touching chain's can go on and close them.  A chain that
+    touches stops whole, as a finger of one chain does.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    structure : HandStructure
+    finger : Finger
+        One of ``structure.fingers``, or a part of one.
+    touching : iterable of RigidBody
+        The finger's bodies that touch.
+
+    Returns
+    -------
+    Finger or None
+        A :class:`Finger` over the free joints (positions in
+        ``structure.joints``), the bodies they move, and those bodies' pairs
+        and tip pairs; None when no joint is free or its bodies have no pair.
+    """
+    touched = {int(b.index()) for b in touching}
+    moved = {
+        k: {
+            int(i)
+            for i in plant.GetBodiesKinematicallyAffectedBy(
+                [structure.joints[k].index()]
+            )
+        }
+        for k in finger.joints
+    }
+    # a chain (the joints under one root, couplings aside) stops whole when a
+    # body of it touches: a finger of one chain has no free part
+    position = {int(structure.joints[k].index()): k for k in finger.joints}
+    chains = _group(
+        [structure.joints[k] for k in finger.joints],
+        {},
+        {int(structure.joints[k].index()): moved[k] for k in finger.joints},
+    )
+    frozen = set()
+    for chain in chains:
+        mine = [position[int(j.index())] for j in chain]
+        if any(moved[k] & touched for k in mine):
+            frozen.update(mine)
+    follows = structure.coupling.follows
+    grown = True
+    while grown:  # a follower moves with its leader: both go, or neither
+        grown = False
+        for f, (lead, _, _) in follows.items():
+            if f in moved and lead in moved and (f in frozen) != (lead in frozen):
+                frozen |= {f, lead}
+                grown = True
+    free = [k for k in finger.joints if k not in frozen]
+    if not free:
+        return None
+    ids = set().union(*(moved[k] for k in free))
+    pairs = tuple(p for p in finger.pairs if int(p[2].index()) in ids)
+    if not pairs:
+        return None
+    paired = list({int(b.index()): b for _, _, b in pairs}.values())
+    tip = {int(b.index()) for b in _deepest(paired, [moved[k] for k in free])}
+    roots = _roots(
+        [structure.joints[k] for k in free],
+        {int(structure.joints[k].index()): moved[k] for k in free},
+    )
+    return Finger(
+        name=" + ".join(joint_name(plant, j) for j in roots),
+        joints=tuple(free),
+        bodies=tuple(b for b in finger.bodies if int(b.index()) in ids),
+        pairs=pairs,
+        tip_pairs=tuple(p for p in pairs if int(p[2].index()) in tip),
+        max_step=finger.max_step,
+    )
 
 
 def _couplings_key(plant, couplings) -> tuple:

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from coupled_support import MODEL, coupled_hand_sdf, one_motor_pinch_urdf
+from coupled_hands import one_motor_pinch_urdf, spread_hand_urdf
+from coupled_support import MODEL, coupled_hand_sdf
 from grasp_builders import generator_matrix
 from pydrake.math import RotationMatrix
 from scipy.optimize import linprog
@@ -422,3 +423,22 @@ def test_a_one_motor_pinch_is_planned_on_a_point_cloud(pinch, pinch_file):
     for candidate in result:
         pads = {c.finger_body.split("::")[-1] for c in candidate.contacts}
         assert pads == {"left_pad", "right_pad"}
+
+
+def test_a_hand_with_a_coupled_spread_closes_all_its_fingers(tmp_path):
+    # f1 and f2 share a spread motor; each has its own flexion motor.  Before,
+    # the group stopped when one of them touched, and every candidate had
+    # two contacts (no force closure on the cylinder).
+    path = tmp_path / "spread_hand.urdf"
+    path.write_text(spread_hand_urdf())
+    scene = planning_scene(CYLINDER, hand_url=str(path))
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=60, mu=0.5, seed=0, robustness_samples=8,
+    )  # fmt: skip
+    three = [
+        c
+        for c in result
+        if {x.finger_body.split("::")[-1][:2] for x in c.contacts} == {"f1", "f2", "f3"}
+    ]
+    assert three and any(c.is_closure for c in three)

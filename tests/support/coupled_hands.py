@@ -1,0 +1,178 @@
+"""Hands of our own whose fingers a ``<mimic>`` closes as one group.
+
+- :func:`spread_hand_urdf`: a Barrett-style hand, two fingers on a coupled
+  spread, each with its own flexion motor, and a fixed third;
+- :func:`one_motor_pinch_urdf`: a Robotiq-style pinch, two knuckles and their
+  pads on one motor.
+
+Shared by the plant and planning tests.
+"""
+
+from __future__ import annotations
+
+MODEL = "spread_hand"
+
+
+def _link(name: str, xyz: str, shape: str, rpy: str = "0 0 0") -> str:
+    return (
+        f'<link name="{name}"><inertial><origin xyz="{xyz}"/><mass value="0.05"/>'
+        '<inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/>'
+        f'</inertial><collision><origin xyz="{xyz}" rpy="{rpy}"/><geometry>{shape}'
+        "</geometry></collision></link>"
+    )
+
+
+def _joint(name, kind, parent, child, xyz, rpy="0 0 0", axis="0 1 0", extra=""):
+    limit = (
+        ""
+        if kind == "fixed"
+        else f'<axis xyz="{axis}"/><limit lower="-0.5" upper="2.0" effort="1.5" '
+        'velocity="1"/>'
+    )
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/>'
+        f'<child link="{child}"/><origin xyz="{xyz}" rpy="{rpy}"/>{limit}{extra}'
+        "</joint>"
+    )
+
+
+def spread_hand_urdf() -> str:
+    """The hand as URDF text.
+
+    A palm (a 40 mm cylinder whose top is z = 0) with three fingers pointing
+    along +z: ``f3`` fixed at x = +50 mm, ``f1`` and ``f2`` at x = -50 mm,
+    y = ±20 mm on spread joints about z, ``f2``'s spread a ``<mimic>`` of
+    ``f1``'s (one motor turns both, as a Barrett hand's).  Each finger has a
+    proximal joint about its y axis (positive curls it towards the palm's
+    centre line; its own motor) and a distal joint following it at 0.5.
+    Open (0 rad) the fingers stand straight, 100 mm apart across x.
+    """
+    capsule = '<capsule radius="0.01" length="0.05"/>'
+    tip = '<capsule radius="0.009" length="0.035"/>'
+    parts = [_link("palm", "0 0 -0.015", '<cylinder radius="0.07" length="0.03"/>')]
+    joints = []
+    motors = []
+    for name, xyz, yaw, spread in (
+        ("f3", "0.05 0 0", "3.14159265", None),
+        ("f1", "-0.05 0.02 0", "0", "0 0 -1"),
+        ("f2", "-0.05 -0.02 0", "0", "0 0 1"),
+    ):
+        parts += [
+            _link(f"{name}_knuckle", "0 0 0.005", '<sphere radius="0.004"/>'),
+            _link(f"{name}_proximal", "0 0 0.035", capsule),
+            _link(f"{name}_distal", "0 0 0.0275", tip),
+        ]
+        if spread is None:
+            joints.append(
+                _joint(
+                    f"{name}_spread",
+                    "fixed",
+                    "palm",
+                    f"{name}_knuckle",
+                    xyz,
+                    f"0 0 {yaw}",
+                )  # fmt: skip
+            )
+        else:
+            mimic = (
+                '<mimic joint="f1_spread" multiplier="1" offset="0"/>'
+                if name == "f2"
+                else ""
+            )
+            joints.append(
+                _joint(
+                    f"{name}_spread",
+                    "revolute",
+                    "palm",
+                    f"{name}_knuckle",
+                    xyz,
+                    axis=spread,
+                    extra=mimic,
+                )  # fmt: skip
+            )
+            if name == "f1":
+                motors.append("f1_spread")
+        joints += [
+            _joint(
+                f"{name}_proximal_joint",
+                "revolute",
+                f"{name}_knuckle",
+                f"{name}_proximal",
+                "0 0 0.01",
+            ),  # fmt: skip
+            _joint(
+                f"{name}_distal_joint",
+                "revolute",
+                f"{name}_proximal",
+                f"{name}_distal",
+                "0 0 0.06",
+                extra=f'<mimic joint="{name}_proximal_joint" multiplier="0.5" '
+                'offset="0"/>',
+            ),  # fmt: skip
+        ]
+        motors.append(f"{name}_proximal_joint")
+    transmissions = "".join(
+        f'<transmission name="t_{j}"><type>transmission_interface/SimpleTransmission'
+        f'</type><joint name="{j}"/><actuator name="m_{j}"><mechanicalReduction>1'
+        "</mechanicalReduction></actuator></transmission>"
+        for j in motors
+    )
+    return (
+        f'<?xml version="1.0"?><robot name="{MODEL}">'
+        + "".join(parts)
+        + "".join(joints)
+        + transmissions
+        + "</robot>"
+    )
+
+
+def one_motor_pinch_urdf(*, effort: float = 5.0) -> str:
+    """A Robotiq-style pinch: two revolute knuckles on one motor, pads kept upright.
+
+    Knuckles 110 mm apart on the palm, about ``y``, 50 mm long; each carries a
+    pad (a 8 × 22 × 40 mm box) on a joint that undoes the knuckle's turn, so
+    the pads stay parallel as they close (a four-bar's effect, written as
+    ``<mimic>``).  The right knuckle and both pads follow the left knuckle,
+    whose slide is the only one with a ``<transmission>``: one motor.  Open
+    (0 rad) the pads are 71 mm apart.
+    """
+
+    def link(name, xyz, shape, mass):
+        return (
+            f'<link name="{name}"><inertial><origin xyz="{xyz}"/><mass value='
+            f'"{mass}"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0"'
+            f' iyz="0"/></inertial><collision><origin xyz="{xyz}"/><geometry>'
+            f"{shape}</geometry></collision></link>"
+        )
+
+    def hinge(name, parent, child, xyz, lower, upper, mimic=None):
+        extra = (
+            ""
+            if mimic is None
+            else f'<mimic joint="left_knuckle" multiplier="{mimic:g}" offset="0"/>'
+        )
+        return (
+            f'<joint name="{name}" type="revolute"><parent link="{parent}"/>'
+            f'<child link="{child}"/><origin xyz="{xyz}"/><axis xyz="0 1 0"/>'
+            f'<limit lower="{lower}" upper="{upper}" effort="{effort:g}" '
+            f'velocity="2"/>{extra}</joint>'
+        )
+
+    knuckle = '<capsule radius="0.006" length="0.038"/>'
+    pad = '<box size="0.008 0.022 0.04"/>'
+    return (
+        '<?xml version="1.0"?><robot name="one_motor_pinch">'
+        + link("palm", "0 0 0.025", '<box size="0.14 0.06 0.05"/>', 0.6)
+        + link("left_knuckle", "0 0 0.025", knuckle, 0.05)
+        + link("right_knuckle", "0 0 0.025", knuckle, 0.05)
+        + link("left_pad", "0.0085 0 0.02", pad, 0.03)
+        + link("right_pad", "-0.0085 0 0.02", pad, 0.03)
+        + hinge("left_knuckle", "palm", "left_knuckle", "-0.055 0 0.06", 0, 0.8)
+        + hinge("right_knuckle", "palm", "right_knuckle", "0.055 0 0.06", -0.8, 0, -1)
+        + hinge("left_pad_joint", "left_knuckle", "left_pad", "0 0 0.05", -0.8, 0, -1)
+        + hinge("right_pad_joint", "right_knuckle", "right_pad", "0 0 0.05", 0, 0.8, 1)
+        + '<transmission name="t"><type>transmission_interface/SimpleTransmission'
+        '</type><joint name="left_knuckle"/><actuator name="motor">'
+        "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
+        "</robot>"
+    )
