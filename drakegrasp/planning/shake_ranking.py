@@ -42,7 +42,7 @@ from drakegrasp.planning.candidates import (
     pose_dict,
 )
 from drakegrasp.planning.shake import check_shake_options, shake_test
-from drakegrasp.planning.shake_result import ShakeResult, motion_text
+from drakegrasp.planning.shake_result import ShakeResult, _limits, motion_text
 from drakegrasp.plant.validation import check_rigid_transform
 
 __all__ = [
@@ -178,10 +178,8 @@ class ShakenCandidates(Sequence):
         squeeze = self.options.get("squeeze")
         squeeze = "" if squeeze is None else f"squeeze {squeeze:g}{unit}"
         if capped:
-            squeeze += (
-                f" capped at the effort limit: "
-                f"{min(min(r.squeeze_caps) for r in capped):g}{unit}"
-            )
+            caps = [c for r in capped for c in r.squeeze_caps]
+            squeeze += f" capped at {_limits(caps, capped[0].squeeze)}{unit}"
         gains = ", ".join(
             f"{name} {self.options[name]:g}"
             for name in ("stiffness", "damping")

@@ -261,7 +261,7 @@ class ShakeResult:
             f"{verdict}: {motion}"
             f" over {self.duration:g} s, squeeze {self.squeeze:g} {self.squeeze_unit}"
             + (
-                f" (capped at the effort limit: {min(self.squeeze_caps):g} "
+                f" (capped at {_limits(self.squeeze_caps, self.squeeze)} "
                 f"{self.squeeze_unit})"
                 if self.squeeze_capped
                 else ""
@@ -333,3 +333,15 @@ def _pose(name: str, X) -> np.ndarray:
             f"{name} must be a finite (4, 4) rigid transform, got {X!r}"[:200]
         )
     return M
+
+
+def _limits(caps, squeeze: float) -> str:
+    """The cap of a capped squeeze, in words.
+
+    ``the effort limit: 140``, or ``the effort limits: 0.5-1.12`` where the
+    capped joints' limits differ (the other joints press with ``squeeze``).
+    """
+    below = sorted({c for c in caps if c < squeeze})
+    if len(below) <= 1:
+        return f"the effort limit: {min(caps):g}"
+    return f"the effort limits: {below[0]:g}-{below[-1]:g}"

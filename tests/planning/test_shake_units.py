@@ -197,3 +197,16 @@ def test_soft_fingers_in_point_contact_are_warned_of():
         )
         hard_scene, hard = _best(JAW)
         shake_test(hard_scene.add_models, hard, squeeze=5.0, **SHORT)
+
+
+def test_caps_that_differ_are_named_as_a_range():
+    # a Barrett-style hand: its spread motor drives two joints (0.5 N·m each of
+    # 1), each flexion motor a proximal and a distal joint (1.125 of 1.5); the
+    # summary named only the smallest, as if every joint pressed with 0.5
+    from drakegrasp.planning.shake_result import _limits
+
+    assert _limits((0.5, 0.5, 1.125, 1.125, 20.0), 20.0) == (
+        "the effort limits: 0.5-1.125"
+    )
+    assert _limits((140.0, 140.0), 300.0) == "the effort limit: 140"
+    assert _limits((140.0, 300.0), 300.0) == "the effort limit: 140"
