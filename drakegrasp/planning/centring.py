@@ -23,10 +23,14 @@ difference of their gaps towards the one short of the object.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
 from pydrake.math import RigidTransform
+
+from drakegrasp.core.validation import real_array
+from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
     "CENTRING_STEPS",
@@ -72,6 +76,11 @@ def chains_to_centre(groups: Sequence[int], touched: set[int]) -> list[int]:
     The chains of every closing group in which one chain touches and another
     does not.
     """
+    if not set(touched) <= set(range(len(groups))):
+        raise InvalidOptionError(
+            f"touched names chains {sorted(set(touched) - set(range(len(groups))))} "
+            f"of a hand with {len(groups)}"
+        )
     short = {
         groups[c]
         for c in range(len(groups))
@@ -97,6 +106,13 @@ def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
         The chains' closing groups: the gaps are equalised within each
         (default: one group).
 
+    Raises
+    ------
+    InvalidOptionError
+        ``psi`` not a vector of real numbers, ``lines`` not ``(k, 3)`` real
+        numbers beside it, ``groups`` not ``k`` integers, ``tol`` not a
+        finite number > 0.
+
     Returns
     -------
     (3,) float or None
@@ -106,9 +122,7 @@ def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
         a gap or line is not finite, the lines see no move (fingers facing
         one way), or the move would be longer than the gaps differ.
     """
-    psi = np.asarray(psi, float)
-    lines = np.asarray(lines, float)
-    groups = np.zeros(len(psi), int) if groups is None else np.asarray(groups)
+    psi, lines, groups = _checked(psi, lines, tol, groups)
     if len(psi) < 2 or not (np.all(np.isfinite(psi)) and np.all(np.isfinite(lines))):
         return None
     A, b = lines.copy(), psi.copy()
@@ -129,6 +143,32 @@ def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
     if not np.isfinite(size) or size <= 1e-3 * tol or size > spread:
         return None
     return t
+
+
+def _checked(psi, lines, tol, groups):
+    """The arguments of :func:`equalising_move` as arrays, or a clear refusal."""
+    psi = real_array("psi", psi, error=InvalidOptionError)
+    lines = real_array("lines", lines, error=InvalidOptionError)
+    if psi.ndim != 1 or lines.shape != (len(psi), 3):
+        raise InvalidOptionError(
+            f"psi must be k gaps and lines (k, 3) unit lines, got shapes "
+            f"{psi.shape} and {lines.shape}"
+        )
+    if (
+        isinstance(tol, bool)
+        or not isinstance(tol, int | float | np.integer | np.floating)
+        or not math.isfinite(tol)
+        or tol <= 0
+    ):
+        raise InvalidOptionError(f"tol must be a finite number > 0 (m), got {tol!r}")
+    if groups is None:
+        return psi, lines, np.zeros(len(psi), int)
+    g = np.asarray(groups)
+    if g.shape != psi.shape or (len(g) and g.dtype.kind not in "iu"):
+        raise InvalidOptionError(
+            f"groups must be {len(psi)} integers, one per gap, got {groups!r}"
+        )
+    return psi, lines, g
 
 
 def close_centred(

@@ -77,7 +77,7 @@ def test_the_move_equalises_the_gaps_and_is_the_least(lines, gaps):
         np.testing.assert_allclose(after, after[0], atol=1e-9)
     # the least: no part along what the lines cannot see
     _, s, Vt = np.linalg.svd(A)
-    unseen = Vt[np.sum(s > 1e-6 * s[0]) :]
+    unseen = Vt[np.sum(s > 1e-6) :]  # the cut of equalising_move: absolute
     np.testing.assert_allclose(unseen @ t, 0, atol=1e-12)
 
 
@@ -160,3 +160,32 @@ def test_close_centred_gives_the_first_reason_when_it_cannot_centre(monkeypatch)
     )
     assert (found, q, reason) == (None, None, "one finger touches")
     assert pinch.calls == 1
+
+
+@pytest.mark.parametrize(
+    "psi, lines, tol, groups",
+    [
+        ([0.01, 0.0], [[1, 0, 0]], TOL, None),  # a line short
+        ([0.01, 0.0], [[1, 0], [-1, 0]], TOL, None),  # planar lines
+        ([[0.01, 0.0]], [[1, 0, 0], [-1, 0, 0]], TOL, None),  # psi not a vector
+        ("0.01 0", [[1, 0, 0], [-1, 0, 0]], TOL, None),
+        ([0.01, 1j], [[1, 0, 0], [-1, 0, 0]], TOL, None),
+        ([0.01, 0.0], [[1, 0, 0], [-1, 0, 0]], 0.0, None),
+        ([0.01, 0.0], [[1, 0, 0], [-1, 0, 0]], float("nan"), None),
+        ([0.01, 0.0], [[1, 0, 0], [-1, 0, 0]], "1e-4", None),
+        ([0.01, 0.0], [[1, 0, 0], [-1, 0, 0]], TOL, [0]),
+        ([0.01, 0.0], [[1, 0, 0], [-1, 0, 0]], TOL, [0.5, 1.5]),
+    ],
+)
+def test_hostile_arguments_are_refused_by_name(psi, lines, tol, groups):
+    from drakegrasp.errors import InvalidOptionError
+
+    with pytest.raises(InvalidOptionError):
+        equalising_move(psi, lines, tol, groups)
+
+
+def test_a_touching_chain_the_hand_lacks_is_refused():
+    from drakegrasp.errors import InvalidOptionError
+
+    with pytest.raises(InvalidOptionError, match="touched names chains"):
+        chains_to_centre([0, 0], {2})
