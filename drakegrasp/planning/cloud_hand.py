@@ -70,6 +70,7 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
@@ -91,7 +92,7 @@ from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.advancement import geometry_reach
 from drakegrasp.plant.closing import DEFAULT_MAX_ITERATIONS
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
-from drakegrasp.plant.fingers import tip_bodies
+from drakegrasp.plant.fingers import Finger, free_part, tip_bodies
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
@@ -248,6 +249,21 @@ class _Geometry:
         self.probes_G = piece.sample(SHADOW_PROBES, rng)[0] if piece.area > 0 else None
 
 
+@dataclass(frozen=True)
+class _Closing:
+    """One finger as :meth:`CloudHand.close` moves it.
+
+    Its geometries, tips (indices into them), joints (a mask over the closing
+    joints) and reach (:func:`~drakegrasp.plant.advancement.geometry_reach`).
+    """
+
+    finger: Finger
+    geoms: list
+    tips: list
+    mask: np.ndarray
+    reach: np.ndarray
+
+
 class CloudHand:
     """Stages 2-4 on a cloud for one hand (scratch: the plant context).
 
@@ -344,6 +360,8 @@ class CloudHand:
         ]
         self.group = chain_groups(s, hand.chains)
         self.X_WH = None
+        self._by_body, self._inspector = by_body, inspector
+        self._parts = {}  # (finger, touching bodies) -> its free part's closing
 
     # -- distances -------------------------------------------------------------
 
@@ -413,7 +431,7 @@ class CloudHand:
         sd[near] = on_disc.min(axis=1)
         return sd
 
-    def _descent(self, f: int, psi, witness, q) -> np.ndarray:
+    def _descent(self, f: _Closing, psi, witness, q) -> np.ndarray:
         """Steepest descent of finger ``f``'s tip distance to the cloud.
 
         ``d = −∂ψ_tip/∂q = n̂ᵀ J`` at the tip geometry's closest point ``y`` to
@@ -423,8 +441,8 @@ class CloudHand:
         zero on joints blocked by a limit, scaled to a largest entry of 1.
         """
         s, plant, ctx = self.hand.structure, self.plant, self.ctx
-        k = min(self.tips[f], key=lambda j: psi[j])
-        g = self.fingers[f][k]
+        k = min(f.tips, key=lambda j: psi[j])
+        g = f.geoms[k]
         x_W = self.points_W[witness[k]]
         sd, n_W = self._line(g, x_W)
         if n_W is None:
@@ -436,7 +454,7 @@ class CloudHand:
             plant.world_frame(), plant.world_frame(),
         )  # fmt: skip
         d = s.coupling.pull_back(n_W @ J[:, s.velocity_indices])
-        return unit_step(np.where(self.mask[f], d, 0.0), q, s.lower, s.upper)
+        return unit_step(np.where(f.mask, d, 0.0), q, s.lower, s.upper)
 
     def _line(self, g: _Geometry, x_W: np.ndarray):
         """(ψ(x), n̂_W) of a cloud point ``x_W`` and a hand geometry ``g``.
@@ -572,31 +590,90 @@ class CloudHand:
         q_all[s.position_indices] = s.coupling.apply(q)
         self.plant.SetPositions(self.ctx, q_all)
 
+    def _part(self, f: int, closing: _Closing, bodies) -> _Closing | None:
+        """The closing of a coupled finger's free part (cached per touching bodies).
+
+        :func:`~drakegrasp.plant.fingers.free_part`: the chains of finger
+        ``f`` coupled to none that touches close on, as on a body.
+        """
+        key = (f, tuple(sorted(int(b.index()) for b in bodies)))
+        if key not in self._parts:
+            s, plant = self.hand.structure, self.plant
+            part = free_part(plant, s, closing.finger, bodies)
+            by_body = self._by_body
+            geoms = (
+                []
+                if part is None
+                else [g for b in part.bodies for g in by_body.get(int(b.index()), [])]
+            )
+            closing_part = None
+            if geoms:
+                tip = {int(b.index()) for b in tip_bodies(plant, s, part)}
+                closing_part = _Closing(
+                    finger=part,
+                    geoms=geoms,
+                    tips=[k for k, g in enumerate(geoms) if int(g.body.index()) in tip]
+                    or list(range(len(geoms))),
+                    mask=np.isin(np.arange(len(s.names)), list(part.joints)),
+                    reach=geometry_reach(
+                        plant,
+                        self.ctx,
+                        s,
+                        [(g.id, g.body) for g in geoms],
+                        self._inspector,
+                    ),  # fmt: skip
+                )
+            self._parts[key] = closing_part
+        return self._parts[key]
+
     def close(self, q_pre):
-        """Close every finger onto the cloud: (q, touching finger indices)."""
+        """Close every finger onto the cloud: (q, the touching fingers' geometries).
+
+        A coupled finger's free part (:func:`~drakegrasp.plant.fingers.free_part`)
+        closes on after the finger touches, as :func:`~drakegrasp.close_hand`
+        does on a body.
+        """
         s = self.hand.structure
         lower, upper = s.lower, s.upper
         touch, target = self.margin + self.tol, self.margin + 0.5 * self.tol
         q_all = self.plant.GetPositions(self.ctx)
         q = q_pre.copy()
-        F = len(s.fingers)
-        status = ["" if self.fingers[f] else "fixed" for f in range(F)]
-        watch = [SimpleNamespace(trail=[], best=np.inf, since_best=0) for _ in range(F)]
+        closings = [
+            _Closing(*entry)
+            for entry in zip(
+                s.fingers, self.fingers, self.tips, self.mask, self.reach, strict=True
+            )
+        ]
+        status = ["" if c.geoms else "fixed" for c in closings]
+        watch = [SimpleNamespace(trail=[], best=np.inf, since_best=0) for _ in closings]
         for _ in range(DEFAULT_MAX_ITERATIONS):
             if all(status):
                 break
             self._set(q_all, q)
-            for f, finger in enumerate(s.fingers):
+            for f, c in enumerate(list(closings)):
                 if status[f]:
                     continue
-                psi, witness, _ = self.distances(self.fingers[f])
+                psi, witness, _ = self.distances(c.geoms)
                 if psi.min() <= touch:
                     status[f] = "touching"
+                    if f < len(s.fingers):  # a coupled finger's free part goes on
+                        near = {
+                            int(g.body.index()): g.body
+                            for g, d in zip(c.geoms, psi, strict=True)
+                            if d <= touch
+                        }
+                        part = self._part(f, c, list(near.values()))
+                        if part is not None:
+                            closings.append(part)
+                            status.append("")
+                            watch.append(
+                                SimpleNamespace(trail=[], best=np.inf, since_best=0)
+                            )
                     continue
                 if stalled(watch[f], q.copy(), float(psi.min()), target, touch):
                     status[f] = "not converged"  # it circles, far from the cloud
                     continue
-                d = self._descent(f, psi, witness, q)
+                d = self._descent(c, psi, witness, q)
                 with np.errstate(divide="ignore", invalid="ignore"):
                     t = np.where(d > 0, (upper - q) / d, (lower - q) / d)
                 t = np.where(d != 0, np.where(np.isfinite(t), t, 1e3), 0.0)
@@ -604,29 +681,31 @@ class CloudHand:
                 if alpha_end <= 1e-12:
                     status[f] = "at limit"
                     continue
-                speed = self.reach[f] @ np.abs(s.coupling.tangent(d))
+                speed = c.reach @ np.abs(s.coupling.tangent(d))
                 moving = speed > 0
                 alpha = np.min(
                     np.maximum(psi[moving] - target, 0.0) / speed[moving],
                     initial=np.inf,
                 )
-                alpha = min(float(alpha), finger.max_step, alpha_end)
-                q = np.where(self.mask[f], np.clip(q + alpha * d, lower, upper), q)
-        touching = [f for f in range(F) if status[f] == "touching"]
-        for f in range(F):  # a finger that misses stays open
-            if f not in touching:
-                q = np.where(self.mask[f], q_pre, q)
+                alpha = min(float(alpha), c.finger.max_step, alpha_end)
+                q = np.where(c.mask, np.clip(q + alpha * d, lower, upper), q)
+        touching = [f for f, st in enumerate(status) if st == "touching"]
+        for f, c in enumerate(closings):  # a finger or free part that misses
+            if f not in touching:  # stays open
+                q = np.where(c.mask, q_pre, q)
         self._set(q_all, q)
-        return q, touching
+        return q, [closings[f].geoms for f in touching]
 
     def contacts(self, touching) -> list[CloudContact]:
         """One contact per touching geometry of the touching fingers and the palm.
+
+        ``touching``: the geometries of each touching finger (:meth:`close`).
 
         As :func:`~drakegrasp.find_contacts` reports one contact per pair of
         touching geometries on a body (stage 4 of the module's description).
         """
         out = []
-        for geoms in [self.fingers[f] for f in touching] + [self.palm]:
+        for geoms in [*touching, self.palm]:
             for g in geoms:
                 out += self._geometry_contacts(g)
         return out

@@ -514,8 +514,9 @@ def free_part(
     -------
     Finger or None
         A :class:`Finger` over the free joints (positions in
-        ``structure.joints``), the bodies they move, and those bodies' pairs
-        and tip pairs; None when no joint is free or its bodies have no pair.
+        ``structure.joints``), the finger's bodies they move, and those
+        bodies' pairs and tip pairs (none where the structure has no object,
+        a point cloud's); None when no joint is free or moves a body.
     """
     touched = {int(b.index()) for b in touching}
     moved = {
@@ -551,10 +552,12 @@ def free_part(
     free = [k for k in finger.joints if k not in frozen]
     if not free:
         return None
-    ids = set().union(*(moved[k] for k in free))
-    pairs = tuple(p for p in finger.pairs if int(p[2].index()) in ids)
-    if not pairs:
+    ids = set().union(*(moved[k] for k in free)) & {
+        int(b.index()) for b in finger.bodies
+    }
+    if not ids:
         return None
+    pairs = tuple(p for p in finger.pairs if int(p[2].index()) in ids)
     paired = list({int(b.index()): b for _, _, b in pairs}.values())
     tip = {int(b.index()) for b in _deepest(paired, [moved[k] for k in free])}
     roots = _roots(

@@ -442,3 +442,25 @@ def test_a_hand_with_a_coupled_spread_closes_all_its_fingers(tmp_path):
         if {x.finger_body.split("::")[-1][:2] for x in c.contacts} == {"f1", "f2", "f3"}
     ]
     assert three and any(c.is_closure for c in three)
+
+
+def test_a_hand_with_a_coupled_spread_closes_all_its_fingers_on_a_cloud(tmp_path):
+    # as on a body: a structure without an object has no geometry pairs, and
+    # the free part is read from the bodies its joints move
+    path = tmp_path / "spread_hand.urdf"
+    path.write_text(spread_hand_urdf())
+    full = planning_scene(CYLINDER, hand_url=str(path))
+    surface = object_surface(full.plant, full.context, full.object_body)
+    points, normals, _ = surface.sample(3000, np.random.default_rng(0))
+    hand_only = planning_scene(None, hand_url=str(path))
+    result = plan_grasps(
+        hand_only.plant, hand_only.context, None, hand=hand_only.hand,
+        num_candidates=60, mu=0.5, seed=0, robustness_samples=8,
+        point_cloud=points, cloud_normals=normals, object_mass=0.25,
+    )  # fmt: skip
+    three = [
+        c
+        for c in result
+        if {x.finger_body.split("::")[-1][:2] for x in c.contacts} == {"f1", "f2", "f3"}
+    ]
+    assert len(three) >= len(result) // 2 and any(c.is_closure for c in three)
