@@ -132,8 +132,11 @@ class MultiFingerHand:
         if self.synergy is None:
             return np.tile(self.preshape, (len(amounts), 1))
         q = self.preshape + np.asarray(amounts, float)[:, None] * self.synergy
-        q = np.array([s.coupling.apply(row) for row in q])
-        return np.clip(q, s.lower, s.upper)
+        # the leaders clipped to their ranges (cut to keep their followers in
+        # theirs), then the followers set from them: clipping after the
+        # couplings would break them where a follower's range is narrow
+        q = np.clip(q, s.lower, s.upper)
+        return np.array([s.coupling.apply(row) for row in q])
 
     def to_dict(self) -> dict:
         """JSON-ready summary."""
@@ -316,7 +319,7 @@ def multi_finger_hand(
         _check_preshape_limits(given, structure)  # the values given, as --preshape
         q0 = structure.coupling.apply(given)
         _check_preshape_couplings(given, q0, structure)
-    q0 = np.clip(q0, structure.lower, structure.upper)
+    q0 = structure.coupling.apply(np.clip(q0, structure.lower, structure.upper))
     curl_synergy = isinstance(synergy, str)
     if curl_synergy and synergy != "curl":
         raise InvalidOptionError(

@@ -120,7 +120,9 @@ def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
         over the chain's group), which neither the chains' order nor a
         rotation of the scene changes.  None when the gaps are equal already,
         a gap or line is not finite, the lines see no move (fingers facing
-        one way), or the move would be longer than the gaps differ.
+        one way), the move would be longer than the gaps differ, or it would
+        not narrow the widest spread of a group's gaps (more chains than a
+        move can even: the least-squares fit may widen one).
     """
     psi, lines, groups = _checked(psi, lines, tol, groups)
     if len(psi) < 2 or not (np.all(np.isfinite(psi)) and np.all(np.isfinite(lines))):
@@ -142,6 +144,10 @@ def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
     size = float(np.linalg.norm(t))
     if not np.isfinite(size) or size <= 1e-3 * tol or size > spread:
         return None
+    after = psi - lines @ t
+    widest = max(float(np.ptp(after[groups == g])) for g in np.unique(groups))
+    if widest > spread - 1e-3 * tol:  # more chains than a move can even: the
+        return None  # fit may leave the widest spread as it was, or widen it
     return t
 
 

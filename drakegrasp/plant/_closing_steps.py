@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydrake.multibody.tree import JacobianWrtVariable
 
+from drakegrasp.errors import PenetrationError
 from drakegrasp.plant.advancement import advancement_bound, finger_speed_bound
 from drakegrasp.plant.fingers import Finger, HandStructure
 
@@ -296,6 +297,11 @@ class Search:
             st.status = "fixed"
         elif 0.0 <= psi <= self.tol or (first and -self.tol <= psi <= self.tol):
             st.status = "touching"
+        elif first and psi < 0.0:  # a caller's unchecked pre-shape: no clear
+            raise PenetrationError(  # point to go back to
+                f"{st.finger.name} starts {-psi * 1e3:.4g} mm inside the object "
+                f"({body.name()}): open the hand before closing"
+            )
         elif st.iterations >= self.max_iterations:  # back to the last clear point
             st.status = "not converged"
             st.q_trial, st.psi = st.q_good.copy(), st.psi_good

@@ -685,12 +685,27 @@ def _build(plant, object_body, bodies, couplings, inspector) -> HandStructure:
             raise InvalidOptionError("a joint may not both lead and follow a coupling")
         mapped[f] = (lead, rho, off)
     coupling = Coupling(mapped)
+    limits = _limits(joints, coupling)
+    empty = np.flatnonzero(~(limits["lower"] <= limits["upper"]))
+    if len(empty):
+        k = int(empty[0])
+        followers = [
+            joint_name(plant, joints[f])
+            for f, (lead, _, _) in mapped.items()
+            if lead == k
+        ]
+        raise ModelError(
+            f"no position of {joint_name(plant, joints[k])} keeps it and its "
+            f"followers {followers} within their limits (the couplings leave "
+            f"[{limits['lower'][k]:g}, {limits['upper'][k]:g}]): the hand has "
+            "no configuration; widen the limits or mend the <mimic>"
+        )
     return HandStructure(
         joints=tuple(joints),
         names=tuple(joint_name(plant, j) for j in joints),
         position_indices=np.array([j.position_start() for j in joints]),
         velocity_indices=np.array([j.velocity_start() for j in joints]),
-        **_limits(joints, coupling),
+        **limits,
         fingers=fingers,
         coupling=coupling,
     )

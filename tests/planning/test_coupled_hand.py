@@ -464,3 +464,47 @@ def test_a_hand_with_a_coupled_spread_closes_all_its_fingers_on_a_cloud(tmp_path
         if {x.finger_body.split("::")[-1][:2] for x in c.contacts} == {"f1", "f2", "f3"}
     ]
     assert len(three) >= len(result) // 2 and any(c.is_closure for c in three)
+
+
+def _narrowed_pinch(tmp_path, right_upper: str, pad_lower: str):
+    """The pinch with the right knuckle's and the left pad's ranges narrowed."""
+    text = one_motor_pinch_urdf()
+    axis = '<axis xyz="0 1 0"/><limit lower="-0.8"'
+    knuckle = f'origin xyz="0.055 0 0.06"/>{axis} upper="0"'
+    pad = f'child link="left_pad"/><origin xyz="0 0 0.05"/>{axis}'
+    assert text.count(knuckle) == 1 and text.count(pad) == 1
+    text = text.replace(knuckle, knuckle.replace('upper="0"', f'upper="{right_upper}"'))
+    text = text.replace(pad, pad.replace('lower="-0.8"', f'lower="{pad_lower}"'))
+    path = tmp_path / "narrowed_pinch.urdf"
+    path.write_text(text)
+    return planning_scene(BOX, hand_url=str(path))
+
+
+def test_a_pre_shape_is_clipped_to_the_limits_before_its_couplings_are_applied(
+    tmp_path,
+):
+    # The leader's range is cut to [0.1, 0.3] by its followers'.  The open
+    # hand (every joint 0) was coupled, then clipped joint by joint: the
+    # leader went to 0.1 while its followers stayed at 0, a pre-shape that
+    # breaks its couplings; the search then coupled it again and could start
+    # inside the box (found by the fuzz suite: a raw ValueError).
+    scene = _narrowed_pinch(tmp_path, "-0.1", "-0.3")
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=30, mu=0.5, seed=0, robustness_samples=2,
+    )  # fmt: skip
+    for c in result:
+        q = dict(zip(c.joint_names, c.q_preshape, strict=True))
+        lead = q["one_motor_pinch::left_knuckle"]
+        assert 0.1 - 1e-12 <= lead <= 0.3 + 1e-12
+        assert q["one_motor_pinch::right_knuckle"] == pytest.approx(-lead)
+        assert q["one_motor_pinch::left_pad_joint"] == pytest.approx(-lead)
+
+
+def test_couplings_that_leave_a_hand_no_configuration_are_refused(tmp_path):
+    scene = _narrowed_pinch(tmp_path, "-0.5", "-0.3")  # leader [0.5, 0.3]
+    with pytest.raises(dg.ModelError, match="no position of .*left_knuckle"):
+        plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=5, mu=0.5, seed=0,
+        )  # fmt: skip
