@@ -40,10 +40,12 @@ __all__ = [
     "equalising_move",
 ]
 
-CENTRING_STEPS = 4
+CENTRING_STEPS = 8
 """Times at most a hand whose coupled fingers stopped short is moved and closed
-again.  Each move equalises the gaps to first order: a pinch across parallel
-faces is centred by the first, one on curved or tilted faces by the next few."""
+again.  Each move evens the gaps to first order only: fingers whose lines are
+not opposed, or whose closing paths are arcs, take a few (a Robotiq-style
+pinch on the shipped box: most within two to four), and a sample still short
+after these is rejected as it was."""
 
 _RCOND = 1e-6
 """Singular value of the centred lines ``n̂_c − n̄`` (unit lines: an absolute
@@ -58,6 +60,11 @@ def chain_groups(structure, chains: Sequence) -> list[int]:
     structure : HandStructure
     chains : sequence of Finger
         :func:`~drakegrasp.plant.fingers.finger_chains` of ``structure``.
+
+    Returns
+    -------
+    list of int
+        One per chain: the finger of ``structure`` whose joints hold its own.
     """
     return [
         next(
@@ -72,9 +79,23 @@ def chain_groups(structure, chains: Sequence) -> list[int]:
 def chains_to_centre(groups: Sequence[int], touched: set[int]) -> list[int]:
     """The chains whose gaps are equalised, sorted; empty when none is short.
 
-    ``groups``: :func:`chain_groups`; ``touched``: the chains that touch.
-    The chains of every closing group in which one chain touches and another
-    does not.
+    Parameters
+    ----------
+    groups : sequence of int
+        :func:`chain_groups`.
+    touched : set of int
+        The chains that touch.
+
+    Returns
+    -------
+    list of int
+        The chains of every closing group in which one chain touches and
+        another does not.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``touched`` names a chain the hand lacks.
     """
     if not set(touched) <= set(range(len(groups))):
         raise InvalidOptionError(
@@ -203,9 +224,9 @@ def close_centred(
     Returns
     -------
     tuple
-        ``(contacts, q, reason, X_WH)``: the last closing's contacts and
-        joints, the first closing's rejection reason when none was kept, and
-        the pose the hand closed at.
+        ``(contacts, q, reason, X_WH)``: the kept closing's contacts, joints
+        and pose, reason None; or None, None, the first closing's rejection
+        reason and the last pose tried.
     """
     first = None
     for step in range(CENTRING_STEPS + 1):

@@ -279,9 +279,9 @@ def close_each(closer, poses, progress):
 
     ``closer.run(X_WH, q_pre)`` gives ``(contacts, q, reason)`` (a body's
     placer or a cloud's :class:`~drakegrasp.planning.cloud_hand.CloudHand`)
-    and leaves the pose the hand closed at in ``closer.X_WH`` (the body's
-    placer may have centred it); ``kept`` holds ``(sample, X_WH, q_pre, q,
-    contacts)``.
+    and leaves the pose the hand closed at in ``closer.X_WH`` (centred, for
+    fingers a coupling closes as one); ``kept`` holds ``(sample, X_WH, q_pre,
+    q, contacts)``.
     """
     rejections = Counter()
     kept = []

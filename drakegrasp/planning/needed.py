@@ -23,6 +23,10 @@ from __future__ import annotations
 import math
 import sys
 
+import numpy as np
+
+from drakegrasp.errors import InvalidOptionError
+
 __all__ = [
     "FLOAT_MAX",
     "LONG_FIGURE",
@@ -53,18 +57,45 @@ def needed_for(load: float, capacity: float) -> float:
     Returns
     -------
     float
-        NaN if either is NaN; ``inf`` for a capacity <= 0 (none holds); 0 for
-        an infinite capacity; else the quotient, ``inf`` where it exceeds
-        :data:`FLOAT_MAX` (:func:`beyond_float_range`).
+        0 for no load; NaN for a capacity not computed; ``inf`` for a capacity
+        of 0 (none holds, whatever the weight: also when it is unknown); NaN
+        for an unknown weight; 0 for an infinite capacity; else the quotient,
+        ``inf`` where it exceeds :data:`FLOAT_MAX` (:func:`beyond_float_range`).
+
+    Raises
+    ------
+    InvalidOptionError
+        A load or capacity that is not a real number, or a negative load (a
+        negative capacity, an LP's rounding, holds none).
     """
-    load, capacity = float(load), float(capacity)
-    if math.isnan(load) or math.isnan(capacity):
+    load = _figure("load", load)
+    capacity = _figure("capacity", capacity, negative_is_none=True)
+    if load == 0.0:
+        return 0.0
+    if math.isnan(capacity):
         return math.nan
-    if capacity <= 0.0:
+    if capacity <= 0.0:  # an LP's -1e-17 is none too
         return math.inf
+    if math.isnan(load):
+        return math.nan
     if math.isinf(capacity):
         return 0.0
     return load / capacity  # Python floats: inf beyond FLOAT_MAX, no warning
+
+
+def _figure(name: str, value, *, negative_is_none: bool = False) -> float:
+    """A load or capacity: a real number >= 0, inf or NaN (unknown).
+
+    ``negative_is_none``: a capacity below 0 (an LP's rounding) reads as 0.
+    """
+    if isinstance(value, bool) or not isinstance(
+        value, int | float | np.integer | np.floating
+    ):
+        raise InvalidOptionError(f"{name} must be a real number, got {value!r}")
+    value = float(value)
+    if value < 0.0 and not negative_is_none:
+        raise InvalidOptionError(f"{name} must be >= 0, got {value:g}")
+    return value
 
 
 def beyond_float_range(needed: float, capacity: float) -> bool:
@@ -74,7 +105,7 @@ def beyond_float_range(needed: float, capacity: float) -> bool:
     holds the weight, more than a float can say); False for one at a capacity
     of 0 (none holds) and for any finite or NaN ``needed``.
     """
-    return math.isinf(needed) and 0.0 < capacity < math.inf
+    return math.isinf(needed) and needed > 0 and 0.0 < capacity < math.inf
 
 
 def needed_text(needed: float, capacity: float, unit: str, spec: str = ".3g") -> str:
@@ -100,8 +131,19 @@ def needed_text(needed: float, capacity: float, unit: str, spec: str = ".3g") ->
         range" (:func:`beyond_float_range`); "inf N per finger" where none
         holds; "nan N per finger" where not computed.
     """
+    capacity = _figure("capacity", capacity, negative_is_none=True)
+    if isinstance(needed, bool) or not isinstance(
+        needed, int | float | np.integer | np.floating
+    ):
+        raise InvalidOptionError(f"needed must be a real number, got {needed!r}")
+    needed = float(needed)
     if beyond_float_range(needed, capacity):
         return f"more than {FLOAT_MAX:.2g} {unit}, beyond float range"
-    if spec.endswith("f") and math.isfinite(needed) and abs(needed) >= LONG_FIGURE:
+    if spec.endswith("f") and math.isfinite(needed) and needed >= LONG_FIGURE:
         spec = ".3g"
-    return f"{needed:{spec}} {unit}"
+    try:
+        return f"{needed:{spec}} {unit}"
+    except (TypeError, ValueError):
+        raise InvalidOptionError(
+            f"spec must be a float format such as '.3g', got {spec!r}"
+        ) from None

@@ -83,7 +83,12 @@ from drakegrasp.errors import (
 from drakegrasp.plant._closing_steps import FingerState, Search, closest
 from drakegrasp.plant.advancement import reach
 from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import HandStructure, free_part, hand_structure
+from drakegrasp.plant.fingers import (
+    HandStructure,
+    free_part,
+    hand_structure,
+    most_fingers,
+)
 from drakegrasp.plant.jaws import JawContact, jaw_contacts, parallel_jaws
 from drakegrasp.plant.pose import find_penetrations, joint_limit_violations
 from drakegrasp.plant.settle import SettleResult, settle_object
@@ -414,7 +419,7 @@ def close_hand(
             "a free body (it is welded or jointed); settle=False closes onto it "
             "where it is"
         )
-    _check_min_fingers(min_fingers, hand_)
+    _check_min_fingers(plant, min_fingers, hand_)
     _check_coupled(hand_, q0)
     user_d = _user_direction(direction, len(q0), hand_)
     return _close(
@@ -425,10 +430,14 @@ def close_hand(
     )  # fmt: skip
 
 
-def _check_min_fingers(min_fingers: int, structure: HandStructure) -> None:
-    """Refuse, before any search, more touching fingers than the hand has."""
+def _check_min_fingers(plant, min_fingers: int, structure: HandStructure) -> None:
+    """Refuse, before any search, more touching fingers than the hand has.
+
+    A finger whose coupled chains can close on apart counts as many times
+    (:func:`~drakegrasp.plant.fingers.most_fingers`).
+    """
     n = len(structure.fingers)
-    if min_fingers > n:
+    if min_fingers > n and min_fingers > (n := most_fingers(plant, structure)):
         raise UnreachableError(
             f"min_fingers = {min_fingers} exceeds the hand's {n} fingers "
             f"({', '.join(f.name for f in structure.fingers)}); at most {n} can touch"
@@ -449,7 +458,7 @@ def close_checked_hand(
     """
     q_all = plant.GetPositions(plant_context)
     q0 = q_all[structure.position_indices].copy()
-    _check_min_fingers(min_fingers, structure)
+    _check_min_fingers(plant, min_fingers, structure)
     inspector = query_object_of(plant, plant_context).inspector()
     return _close(
         plant, plant_context, body, structure, q_all, q0, tol=tol,

@@ -44,7 +44,7 @@ turns patch handling off.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from pydrake.geometry import GeometryId, QueryObject
@@ -192,6 +192,11 @@ class PlantContact:
     def __reduce__(self):
         values = {f.name: pickled_handle(getattr(self, f.name)) for f in fields(self)}
         return (_unpickled_contact, (type(self), values))
+
+    def __copy__(self) -> PlantContact:
+        # copy.copy takes __reduce__ but, unlike pickle and deepcopy, does not
+        # rebuild its arguments: the handles' stand-ins would stay
+        return replace(self)
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary.

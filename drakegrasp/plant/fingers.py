@@ -55,6 +55,7 @@ __all__ = [
     "finger_chains",
     "free_part",
     "hand_structure",
+    "most_fingers",
     "tip_bodies",
 ]
 
@@ -510,6 +511,11 @@ def free_part(
     touching : iterable of RigidBody
         The finger's bodies that touch.
 
+    Raises
+    ------
+    InvalidOptionError
+        ``touching`` empty, or holding anything but bodies of ``finger``.
+
     Returns
     -------
     Finger or None
@@ -518,7 +524,7 @@ def free_part(
         bodies' pairs and tip pairs (none where the structure has no object,
         a point cloud's); None when no joint is free or moves a body.
     """
-    touched = {int(b.index()) for b in touching}
+    touched = _touching_bodies(plant, finger, touching)
     moved = {
         k: {
             int(i)
@@ -572,6 +578,61 @@ def free_part(
         tip_pairs=tuple(p for p in pairs if int(p[2].index()) in tip),
         max_step=finger.max_step,
     )
+
+
+def most_fingers(plant: MultibodyPlant, structure: HandStructure) -> int:
+    """The most fingers that can touch: each finger, and its free parts.
+
+    A finger of several chains that a coupling closes as one counts once,
+    and once more for each free part (:func:`free_part`) that can close on
+    after one of its chains touches, in the best order.
+    """
+    return sum(_most(plant, structure, f) for f in structure.fingers)
+
+
+def _most(plant, structure: HandStructure, finger: Finger) -> int:
+    joints = [structure.joints[k] for k in finger.joints]
+    moved = {
+        int(j.index()): {
+            int(i) for i in plant.GetBodiesKinematicallyAffectedBy([j.index()])
+        }
+        for j in joints
+    }
+    mine = {int(b.index()): b for b in finger.bodies}
+    best = 1
+    for chain in _group(joints, {}, moved):
+        ids = set().union(*(moved[int(j.index())] for j in chain)) & set(mine)
+        if not ids:
+            continue
+        part = free_part(plant, structure, finger, [mine[min(ids)]])
+        if part is not None:
+            best = max(best, 1 + _most(plant, structure, part))
+    return best
+
+
+def _touching_bodies(plant, finger: Finger, touching) -> set[int]:
+    """The indices of ``touching``, bodies of ``finger``, or a clear refusal."""
+    mine = {int(b.index()) for b in finger.bodies}
+    try:
+        bodies = list(touching)
+    except TypeError:
+        raise InvalidOptionError(
+            f"touching must be a list of the finger's bodies, got {touching!r}"
+        ) from None
+    if not bodies:
+        raise InvalidOptionError(
+            f"touching names no body: what of {finger.name} closes on depends on "
+            "which of its bodies touch"
+        )
+    out = set()
+    for b in bodies:
+        if not isinstance(b, RigidBody) or int(b.index()) not in mine:
+            what = scoped_name(plant, b) if isinstance(b, RigidBody) else repr(b)
+            raise InvalidOptionError(
+                f"touching holds {what}, which is not a body of {finger.name}"
+            )
+        out.add(int(b.index()))
+    return out
 
 
 def _couplings_key(plant, couplings) -> tuple:

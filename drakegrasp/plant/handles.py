@@ -32,8 +32,8 @@ a contact's geometry there, find the contacts again in that process:
 ``candidate.apply(plant, context)``, then
 :func:`~drakegrasp.plant.contacts.find_contacts`.
 
-A process started by ``fork`` is another process here too: the ids it
-inherited are not told apart from those it makes itself.
+A process started by ``fork`` is another process here too: it draws a name
+of its own, and the ids it inherited count as foreign there.
 """
 
 from __future__ import annotations
@@ -57,6 +57,21 @@ forked child keeps the salt and has another id)."""
 _MADE_HERE: dict[int, GeometryId] = {}
 """The ``GeometryId`` of each number this process has pickled, to give back the
 same object when one comes home (a few bytes per geometry)."""
+
+
+def _forked() -> None:
+    """In a forked child: a name of its own, and none of its parent's ids.
+
+    A child keeps the parent's salt, and a later sibling may get a dead
+    child's pid; an id the parent forwards from one must not come home as
+    another's.
+    """
+    global _SALT
+    _SALT = uuid.uuid4().hex
+    _MADE_HERE.clear()
+
+
+os.register_at_fork(after_in_child=_forked)
 
 
 def this_process() -> str:

@@ -160,6 +160,20 @@ def test_a_copied_candidate_is_equal_and_its_grasp_is_built_again(jaw):
     _same_candidate(c, copy.deepcopy(c))
 
 
+def test_a_copied_contact_keeps_its_handles(jaw):
+    # copy.copy takes __reduce__ without rebuilding its arguments: the copy
+    # held the handles' stand-ins (a foreign id in the planning process)
+    _, result = jaw
+    k = result[0].contacts[0]
+    for twin in (copy.copy(k), copy.deepcopy(k)):
+        assert type(twin.object_geometry) is GeometryId
+        assert type(twin.finger_geometry) is GeometryId
+        assert type(twin.finger_body_index) is BodyIndex
+        assert twin.object_geometry == k.object_geometry
+        assert twin.finger_body_index == k.finger_body_index
+        _same(k, twin, "copy")
+
+
 def test_an_unpickled_candidate_applies_and_shakes_as_the_planned_one(jaw):
     scene, result = jaw
     back = pickle.loads(pickle.dumps(result))
@@ -226,6 +240,10 @@ def test_in_another_process_a_geometry_id_is_foreign_and_refused(jaw, elsewhere)
         contact_curvatures(
             scene.plant, ctx, there.contacts, object_body=scene.object_body
         )
+    # either id alone foreign is refused (the object's, the finger's here)
+    half = [dataclasses.replace(m, finger_geometry=k.finger_geometry)]
+    with pytest.raises(InvalidContactError, match="object_geometry"):
+        contact_curvatures(scene.plant, ctx, half, object_body=scene.object_body)
     # back home, the very GeometryId again
     home = pickle.loads(pickle.dumps(there))
     _same_candidate(c, home)

@@ -208,3 +208,20 @@ def test_a_move_that_would_widen_the_spread_is_not_made():
         if t is not None:
             assert np.ptp(psi - n @ t) < np.ptp(psi)
     assert widened > 0  # the case exists among the draws
+
+
+def test_close_centred_keeps_the_first_reason_when_a_move_fails_later():
+    # the sample's own reason is counted, not that of a pose it was moved to
+    closes = iter(
+        [
+            (None, None, "one finger touches", {1}),
+            (None, None, "hand collides with the object", set()),
+        ]
+    )
+    gaps = (np.array([0.02, 1e-4]), np.array([[1.0, 0, 0], [-1.0, 0, 0]]))
+    found, q, reason, X = close_centred(
+        lambda X, q: next(closes), lambda chains: gaps, [0, 0], TOL,
+        RigidTransform(), None,
+    )  # fmt: skip
+    assert reason == "one finger touches"
+    assert X.translation()[0] > 0  # the pose tried last: moved

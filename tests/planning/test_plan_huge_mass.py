@@ -199,3 +199,36 @@ def test_needed_text(needed, capacity, spec, text):
     from drakegrasp.planning.needed import needed_text
 
     assert needed_text(needed, capacity, "N", spec) == text
+
+
+def test_needed_for_reads_none_holds_before_an_unknown_weight():
+    # a capacity of 0 holds no weight, known or not (a cloud planned without
+    # the object's mass); no weight needs no effort; a capacity not computed
+    # says nothing
+    from drakegrasp.planning.needed import needed_for
+
+    assert needed_for(float("nan"), 0.0) == math.inf
+    assert needed_for(float("nan"), -1e-17) == math.inf  # an LP's rounding
+    assert needed_for(0.0, 0.0) == 0.0
+    assert math.isnan(needed_for(9.81, float("nan")))
+    assert math.isnan(needed_for(float("nan"), 0.5))
+
+
+@pytest.mark.parametrize(
+    "load, capacity", [(-1.0, 1.0), ("2", 1.0), (True, 1.0), (None, 1.0), (1.0, "a")]
+)
+def test_needed_for_refuses_what_is_not_a_weight_or_capacity(load, capacity):
+    from drakegrasp.planning.needed import needed_for
+
+    with pytest.raises(dg.InvalidOptionError):
+        needed_for(load, capacity)
+
+
+def test_needed_text_says_beyond_float_range_only_of_a_positive_figure():
+    from drakegrasp.planning.needed import needed_text
+
+    assert "beyond float range" not in needed_text(-math.inf, 1.0, "N")
+    with pytest.raises(dg.InvalidOptionError, match="spec"):
+        needed_text(1.0, 1.0, "N", spec="q")
+    with pytest.raises(dg.InvalidOptionError, match="capacity"):
+        needed_text(1.0, None, "N")

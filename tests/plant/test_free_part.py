@@ -114,3 +114,37 @@ def test_fingers_one_motor_closes_have_no_free_part(tmp_path):
     (group,) = s.fingers
     pad = plant.GetBodyByName("left_pad", scene.hand)
     assert free_part(plant, s, group, [pad]) is None
+
+
+def test_min_fingers_counts_what_can_close_on(spread):
+    # the spread hand has two closing groups and can touch with three fingers:
+    # min_fingers = 3 was refused before any search ("exceeds the hand's 2")
+    scene, plant, ctx = spread
+    saved = plant.GetPositions(ctx).copy()
+    try:
+        closure = dg.close_hand(
+            plant, ctx, scene.object_body, hand=scene.hand, min_fingers=3
+        )
+        assert len(closure.touching_fingers) == 3
+        with pytest.raises(dg.UnreachableError, match="at most 3 can touch"):
+            dg.close_hand(plant, ctx, scene.object_body, hand=scene.hand, min_fingers=4)
+    finally:
+        plant.SetPositions(ctx, saved)
+
+
+def test_free_part_refuses_what_is_not_a_touching_body_of_the_finger(spread):
+    scene, plant, ctx = spread
+    s = _structure(scene, plant, ctx)
+    (group,) = [f for f in s.fingers if len(f.joints) > 2]
+    body = plant.GetBodyByName
+    for touching in (
+        [],
+        [None],
+        body("f1_distal", scene.hand),  # a body, not a list of them
+        ["spread_hand::f1_distal"],
+        [body("palm", scene.hand)],
+        [body("f3_distal", scene.hand)],  # another finger's
+        [scene.object_body],
+    ):
+        with pytest.raises(dg.InvalidOptionError):
+            free_part(plant, s, group, touching)
