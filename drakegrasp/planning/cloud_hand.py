@@ -517,11 +517,9 @@ class CloudHand:
         within one spacing of that ray, by more than two spacings plus the
         tolerance, lies where the unseen object may be.
         """
-        if self.completed:
-            return self.inside()
         view = self.surface.viewpoint
-        if view is None:
-            return False
+        if self.completed or view is None:  # a whole cloud: its interior
+            return self.inside()
         camera = view + self.surface.origin
         rho = self.surface.spacing
         for g in (*self.palm, *(g for f in self.fingers for g in f)):
