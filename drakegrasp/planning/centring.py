@@ -142,8 +142,8 @@ def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
         rotation of the scene changes.  None when the gaps are equal already,
         a gap or line is not finite, the lines see no move (fingers facing
         one way), the move would be longer than the gaps differ, or it would
-        not narrow the widest spread of a group's gaps (more chains than a
-        move can even: the least-squares fit may widen one).
+        not narrow the widest spread of a group's gaps or would widen any
+        (more chains than a move can even: the least-squares fit may).
     """
     psi, lines, groups = _checked(psi, lines, tol, groups)
     if len(psi) < 2 or not (np.all(np.isfinite(psi)) and np.all(np.isfinite(lines))):
@@ -166,10 +166,14 @@ def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
     if not np.isfinite(size) or size <= 1e-3 * tol or size > spread:
         return None
     after = psi - lines @ t
-    widest = max(float(np.ptp(after[groups == g])) for g in np.unique(groups))
-    if widest > spread - 1e-3 * tol:  # more chains than a move can even: the
-        return None  # fit may leave the widest spread as it was, or widen it
-    return t
+    before_after = [
+        (float(np.ptp(psi[groups == g])), float(np.ptp(after[groups == g])))
+        for g in np.unique(groups)
+    ]
+    widest = max(a for _, a in before_after)
+    if widest > spread - 1e-3 * tol or any(a > b for b, a in before_after):
+        return None  # more chains than a move can even: the fit may leave the
+    return t  # widest spread as it was, or widen a group's
 
 
 def _checked(psi, lines, tol, groups):

@@ -1024,8 +1024,8 @@ FINDINGS = {
     "wholly inside the object (over 2 cm into the hex prism): no cloud point "
     "lies inside the link, so the collision stage passes it",
 }
-"""Defects these families found, not fixed here: :func:`finding` names the
-cases that show each; the test counts them apart (and expects them to fail)."""
+"""Defects these families found in their first run, all fixed since:
+:func:`finding` names the cases that would show one again."""
 
 
 def finding(family: str, name: str, outcome: str, detail: str) -> str | None:

@@ -1,4 +1,4 @@
-"""Generated coupled hands (``fuzz_coupled``): good outcomes but the known findings.
+"""Generated coupled hands (``fuzz_coupled``): no raw error, hang or wrong answer.
 
 256 calls on 64 generated hands (32 pinches, 32 spread hands of random
 sizes, limits, mimic multipliers, offsets, efforts and transmissions: each
@@ -6,9 +6,9 @@ closed twice, planned on a body and on a cloud) and 600 ``equalising_move``
 inputs, seeded, in about 35 s; ``python tests/fuzz/fuzz_coupled.py`` prints
 the table.
 
-The defects the families found (``fuzz_coupled.FINDINGS``) are not fixed
-here: their cases are counted apart, and each has a test of its own marked
-``xfail`` that passes once it is fixed (then drop the mark).
+The four defects the families found in their first run
+(``fuzz_coupled.FINDINGS``) are fixed; each keeps a test of its own built on
+its reproducer, and a generated case that shows one again fails.
 """
 
 import fuzz_coupled
@@ -29,10 +29,14 @@ def _shown(bad, key):
     return [row for row in bad if fuzz_coupled.finding(*row) == key]
 
 
-def test_no_raw_error_hang_crash_or_wrong_answer_but_the_findings(outcomes):
+def test_no_raw_error_hang_crash_or_wrong_answer(outcomes):
+    # the four findings of the first run (fuzz_coupled.FINDINGS) are fixed:
+    # a case that shows one again fails here too
     _, bad, _ = outcomes
-    other = [row for row in bad if fuzz_coupled.finding(*row) is None]
-    assert not other, "\n".join(f"{o}: [{f}] {n}: {d}" for f, n, o, d in other)
+    assert not bad, "\n".join(
+        f"{o}: [{f}] {n}: {d} ({fuzz_coupled.finding(f, n, o, d)})"
+        for f, n, o, d in bad
+    )
 
 
 def test_every_route_refused_and_answered_and_the_oracles_saw_enough(outcomes):
@@ -59,7 +63,6 @@ def test_every_route_refused_and_answered_and_the_oracles_saw_enough(outcomes):
 # ---------------------------------------------------------------- findings
 
 
-@pytest.mark.xfail(strict=True, reason=fuzz_coupled.FINDINGS["F1"])
 def test_f1_equalising_move_refuses_hostile_arrays(outcomes):
     from drakegrasp.planning.centring import equalising_move
 
@@ -80,7 +83,6 @@ def test_f1_equalising_move_refuses_hostile_arrays(outcomes):
         assert t is None or np.shape(t) == (3,)
 
 
-@pytest.mark.xfail(strict=True, reason=fuzz_coupled.FINDINGS["F2"])
 def test_f2_a_hand_whose_limits_leave_its_motor_no_value_is_refused(outcomes, tmp_path):
     from coupled_hands import one_motor_pinch_urdf
 
@@ -110,7 +112,6 @@ def test_f2_a_hand_whose_limits_leave_its_motor_no_value_is_refused(outcomes, tm
             pass
 
 
-@pytest.mark.xfail(strict=True, reason=fuzz_coupled.FINDINGS["F3"])
 def test_f3_the_centring_move_does_not_spread_the_gaps(outcomes):
     from drakegrasp.planning.centring import equalising_move
 
@@ -185,7 +186,6 @@ F4_PRESHAPE = {
 }  # fmt: skip
 
 
-@pytest.mark.xfail(strict=True, reason=fuzz_coupled.FINDINGS["F4"])
 def test_f4_no_cloud_candidate_has_a_link_inside_the_object(outcomes):
     from sandbox import Sandbox
 
