@@ -170,10 +170,12 @@ def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
         (float(np.ptp(psi[groups == g])), float(np.ptp(after[groups == g])))
         for g in np.unique(groups)
     ]
+    # more chains than a move can even: the fit may leave the widest spread
+    # as it was, or widen a group's
     widest = max(a for _, a in before_after)
     if widest > spread - 1e-3 * tol or any(a > b for b, a in before_after):
-        return None  # more chains than a move can even: the fit may leave the
-    return t  # widest spread as it was, or widen a group's
+        return None
+    return t
 
 
 def _checked(psi, lines, tol, groups):
