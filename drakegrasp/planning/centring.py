@@ -34,6 +34,7 @@ from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
     "CENTRING_STEPS",
+    "CentredCloser",
     "chain_groups",
     "chains_to_centre",
     "close_centred",
@@ -253,3 +254,26 @@ def close_centred(
             break
         X_WH = RigidTransform(X_WH.rotation(), X_WH.translation() + move)
     return None, None, first, X_WH
+
+
+class CentredCloser:
+    """A closer whose :meth:`run` centres coupled fingers (stage 3 of both routes).
+
+    A subclass gives ``_close(X_WH, q_pre) -> (contacts, q, reason,
+    touched)`` and ``_gaps(chains)`` as :func:`close_centred` takes them, and
+    ``group`` (:func:`chain_groups`) and ``tol`` (m).
+    """
+
+    X_WH = None
+
+    def run(self, X_WH, q_pre):
+        """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``.
+
+        Coupled fingers stopped short of the object are centred
+        (:func:`close_centred`); the pose the hand closed at (or was last
+        tried at) is left in ``self.X_WH``.
+        """
+        found, q, reason, self.X_WH = close_centred(
+            self._close, self._gaps, self.group, self.tol, X_WH, q_pre
+        )
+        return found, q, reason

@@ -24,9 +24,11 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    sphere: only those can be nearest).  With the rest of the plant and
    between fingers: Drake's signed distances, as on a body.  With a
    completed cloud, a hand that reaches into its interior
-   (:meth:`CloudHand.inside`) is rejected; with a ``viewpoint`` and no
-   completion, one that reaches behind the seen surface (the unseen side
-   may hold the object), open and closed.
+   (:meth:`CloudHand.inside`) is rejected, and so with a cloud given without
+   a viewpoint, taken as whole (a finger link wholly inside the object holds
+   no cloud point); with a ``viewpoint`` and no completion, one that reaches
+   behind the seen surface (the unseen side may hold the object), open and
+   closed.
 3. **Closing**, as :func:`~drakegrasp.close_hand` closes on a body: each
    finger steps from the pre-shape along the steepest descent of its tip's
    distance to the cloud, ``d = −∂ψ_tip/∂q`` (re-aimed after every step,
@@ -78,7 +80,7 @@ from pydrake.geometry import Box, Capsule, Cylinder, Sphere
 from pydrake.multibody.tree import JacobianWrtVariable
 from scipy.spatial import cKDTree
 
-from drakegrasp.planning.centring import chain_groups, close_centred
+from drakegrasp.planning.centring import CentredCloser, chain_groups
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
     SHADOW_PROBES,
@@ -111,6 +113,8 @@ REASONS = {
     "hand collides with the cloud": "a cloud point lies inside the pre-shaped hand",
     "hand enters the unseen side": "the hand reaches behind a one-sided cloud "
     "(into a completed one)",
+    "hand reaches inside the cloud": "the hand reaches behind the surface of a "
+    "cloud given without a viewpoint (a whole one), into the object",
     "hand collides with the scene": "the pre-shaped hand penetrates another body",
     "fingers miss the object": "fewer than min_fingers fingers reach the cloud",
     "finger blocked by the scene": "a closed finger penetrates another body",
@@ -264,7 +268,7 @@ class _Closing:
     reach: np.ndarray
 
 
-class CloudHand:
+class CloudHand(CentredCloser):
     """Stages 2-4 on a cloud for one hand (scratch: the plant context).
 
     Parameters
@@ -289,6 +293,9 @@ class CloudHand:
     ):  # fmt: skip
         self.plant, self.ctx, self.hand, self.surface = plant, ctx, hand, surface
         self.completed = bool(completed)
+        # a cloud without a viewpoint is taken as whole: behind its surface
+        # is the object (a link wholly inside holds no cloud point)
+        self.whole = surface.viewpoint is None and not self.completed
         self.fan_reach = float(fan_reach)
         self.tol, self.min_fingers = tol, int(min_fingers)
         self.margin = GAP_SPACINGS * surface.spacing
@@ -517,9 +524,11 @@ class CloudHand:
         within one spacing of that ray, by more than two spacings plus the
         tolerance, lies where the unseen object may be.
         """
-        view = self.surface.viewpoint
-        if self.completed or view is None:  # a whole cloud: its interior
+        if self.completed:
             return self.inside()
+        view = self.surface.viewpoint
+        if view is None:
+            return False
         camera = view + self.surface.origin
         rho = self.surface.spacing
         for g in (*self.palm, *(g for f in self.fingers for g in f)):
@@ -816,18 +825,6 @@ class CloudHand:
         R, _ = self._pose(g)  # the box's face normals are ±R's columns
         return bool(np.max(np.abs(R.T @ n_O)) >= cos_tol)
 
-    def run(self, X_WH, q_pre):
-        """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``.
-
-        Coupled fingers stopped short of the cloud are centred
-        (:func:`~drakegrasp.planning.centring.close_centred`); the pose the
-        hand closed at is left in ``self.X_WH``.
-        """
-        found, q, reason, self.X_WH = close_centred(
-            self._close, self._gaps, self.group, self.tol, X_WH, q_pre
-        )
-        return found, q, reason
-
     def _close(self, X_WH, q_pre):
         """One closing at ``X_WH``: (contacts, q, reason, chains touching)."""
         plant, ctx, s = self.plant, self.ctx, self.hand.structure
@@ -845,6 +842,8 @@ class CloudHand:
             return None, None, "hand collides with the cloud", set()
         if self.in_shadow():
             return None, None, "hand enters the unseen side", set()
+        if self.whole and self.inside():
+            return None, None, "hand reaches inside the cloud", set()
         q, touching = self.close(q_pre)
         # the chains that close as one count once here; below, each
         if len(touching) < min(self.min_fingers, len(s.fingers)):
@@ -856,6 +855,8 @@ class CloudHand:
             return None, None, "fingers collide with each other", set()
         if self.in_shadow():
             return None, None, "hand enters the unseen side", set()
+        if self.whole and self.inside():
+            return None, None, "hand reaches inside the cloud", set()
         found = self.contacts(touching)
         fingers = {self.label.get(c.finger_body, -1) for c in found} - {-1}
         if len(fingers) < 2:

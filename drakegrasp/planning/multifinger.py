@@ -65,7 +65,7 @@ from drakegrasp.planning.candidates import (
     closing_order,
     planning_result,
 )
-from drakegrasp.planning.centring import chain_groups, close_centred
+from drakegrasp.planning.centring import CentredCloser, chain_groups
 from drakegrasp.planning.checks import (
     checked_contacts,
     checked_fingers,
@@ -148,7 +148,7 @@ def is_parallel_jaw(structure, chains=None) -> bool:
     )
 
 
-class _Placer:
+class _Placer(CentredCloser):
     """Stages 2-3 for one hand and object in a plant context (scratch)."""
 
     def __init__(
@@ -194,18 +194,6 @@ class _Placer:
             other = b if in_a else a
             return "object" if other in self.object_geoms else "scene"
         return found
-
-    def run(self, X_WH, q_pre):
-        """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``.
-
-        Coupled fingers stopped short of the object are centred
-        (:func:`~drakegrasp.planning.centring.close_centred`); the pose the
-        hand closed at is left in ``self.X_WH``.
-        """
-        found, q, reason, self.X_WH = close_centred(
-            self._close, self._gaps, self.group, self.tol, X_WH, q_pre
-        )
-        return found, q, reason
 
     def _gaps(self, chains):
         """The chains' gaps to the object and lines towards it (world frame)."""
