@@ -84,6 +84,7 @@ from drakegrasp.planning.ranking import (
     rank_candidates,
 )
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
+from drakegrasp.planning.turned_gravity import GRAVITY
 from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.attachment import free_carrier, how_held
 from drakegrasp.plant.validation import (
@@ -100,8 +101,6 @@ __all__ = ["MAX_CANDIDATES", "REASONS", "object_surface", "plan_grasps"]
 MAX_CANDIDATES = 1_000_000
 """Most poses one call samples (memory grows with it; call again for more)."""
 
-GRAVITY = 9.81
-"""m/s², for the squeeze that holds the object's weight."""
 
 REASONS = {
     "occluded": "another part of the object lies outside the sampled point on the axis",

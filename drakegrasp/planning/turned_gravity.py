@@ -20,7 +20,8 @@ from pydrake.systems.framework import LeafSystem
 __all__ = ["DEFAULT_DIRECTIONS", "GRAVITY"]
 
 GRAVITY = 9.81
-"""Magnitude of the turned gravity, m/s²."""
+"""Standard gravity, m/s²: the turned gravity's magnitude, and the planner's for
+the weight that ``squeeze_needed`` and ``torque_needed`` hold."""
 
 DEFAULT_DIRECTIONS = (
     (1.0, 0.0, 0.0),
