@@ -427,8 +427,8 @@ def test_a_one_motor_pinch_is_planned_on_a_point_cloud(pinch, pinch_file):
 
 def test_a_hand_with_a_coupled_spread_closes_all_its_fingers(tmp_path):
     # f1 and f2 share a spread motor; each has its own flexion motor.  Before,
-    # the group stopped when one of them touched, and every candidate had
-    # two contacts (no force closure on the cylinder).
+    # the group stopped when one of them touched: no candidate touched with
+    # all three fingers, and none was force closure on the cylinder.
     path = tmp_path / "spread_hand.urdf"
     path.write_text(spread_hand_urdf())
     scene = planning_scene(CYLINDER, hand_url=str(path))
