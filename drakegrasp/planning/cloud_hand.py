@@ -339,18 +339,10 @@ class CloudHand(CentredCloser):
             if int(b.index()) not in in_finger
             for g in plant.GetCollisionGeometriesForBody(b)
         ]
-        self.reach = [
-            geometry_reach(plant, ctx, s, [(g.id, g.body) for g in geoms], inspector)
-            for geoms in self.fingers
-        ]
-        tips = [{int(b.index()) for b in tip_bodies(plant, s, f)} for f in s.fingers]
-        self.tips = [
-            [k for k, g in enumerate(geoms) if int(g.body.index()) in tip]
-            or list(range(len(geoms)))
-            for geoms, tip in zip(self.fingers, tips, strict=True)
-        ]
-        self.mask = [
-            np.isin(np.arange(len(s.names)), list(f.joints)) for f in s.fingers
+        self._inspector = inspector
+        self._closings = [
+            self._closing(f, geoms)
+            for f, geoms in zip(s.fingers, self.fingers, strict=True)
         ]
         # a finger of the contacts is a kinematic chain (two that a <mimic>
         # closes as one are two), as on a body
@@ -367,7 +359,7 @@ class CloudHand(CentredCloser):
         ]
         self.group = chain_groups(s, hand.chains)
         self.X_WH = None
-        self._by_body, self._inspector = by_body, inspector
+        self._by_body = by_body
         self._parts = {}  # (finger, touching bodies) -> its free part's closing
 
     # -- distances -------------------------------------------------------------
@@ -605,33 +597,30 @@ class CloudHand(CentredCloser):
         """
         key = (f, tuple(sorted(int(b.index()) for b in bodies)))
         if key not in self._parts:
-            s, plant = self.hand.structure, self.plant
-            part = free_part(plant, s, closing.finger, bodies)
+            part = free_part(self.plant, self.hand.structure, closing.finger, bodies)
             by_body = self._by_body
             geoms = (
                 []
                 if part is None
                 else [g for b in part.bodies for g in by_body.get(int(b.index()), [])]
             )
-            closing_part = None
-            if geoms:
-                tip = {int(b.index()) for b in tip_bodies(plant, s, part)}
-                closing_part = _Closing(
-                    finger=part,
-                    geoms=geoms,
-                    tips=[k for k, g in enumerate(geoms) if int(g.body.index()) in tip]
-                    or list(range(len(geoms))),
-                    mask=np.isin(np.arange(len(s.names)), list(part.joints)),
-                    reach=geometry_reach(
-                        plant,
-                        self.ctx,
-                        s,
-                        [(g.id, g.body) for g in geoms],
-                        self._inspector,
-                    ),  # fmt: skip
-                )
-            self._parts[key] = closing_part
+            self._parts[key] = self._closing(part, geoms) if geoms else None
         return self._parts[key]
+
+    def _closing(self, finger: Finger, geoms: list) -> _Closing:
+        """A finger's closing: its tips among ``geoms``, its joints, its reach."""
+        s, plant = self.hand.structure, self.plant
+        tip = {int(b.index()) for b in tip_bodies(plant, s, finger)}
+        return _Closing(
+            finger=finger,
+            geoms=geoms,
+            tips=[k for k, g in enumerate(geoms) if int(g.body.index()) in tip]
+            or list(range(len(geoms))),
+            mask=np.isin(np.arange(len(s.names)), list(finger.joints)),
+            reach=geometry_reach(
+                plant, self.ctx, s, [(g.id, g.body) for g in geoms], self._inspector
+            ),
+        )
 
     def close(self, q_pre):
         """Close every finger onto the cloud: (q, the touching fingers' geometries).
@@ -645,12 +634,7 @@ class CloudHand(CentredCloser):
         touch, target = self.margin + self.tol, self.margin + 0.5 * self.tol
         q_all = self.plant.GetPositions(self.ctx)
         q = q_pre.copy()
-        closings = [
-            _Closing(*entry)
-            for entry in zip(
-                s.fingers, self.fingers, self.tips, self.mask, self.reach, strict=True
-            )
-        ]
+        closings = list(self._closings)
         status = ["" if c.geoms else "fixed" for c in closings]
         watch = [SimpleNamespace(trail=[], best=np.inf, since_best=0) for _ in closings]
         for _ in range(DEFAULT_MAX_ITERATIONS):

@@ -459,13 +459,7 @@ def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
     for finger in structure.fingers:
         members = [structure.joints[k] for k in finger.joints]
         hand = {int(b.index()) for b in finger.bodies}
-        moved = {
-            int(j.index()): {
-                int(i) for i in plant.GetBodiesKinematicallyAffectedBy([j.index()])
-            }
-            & hand
-            for j in members
-        }
+        moved = {i: ids & hand for i, ids in _affected(plant, members).items()}
         groups = _group(members, {}, moved)
         if len(groups) == 1:
             out.append(finger)
@@ -525,23 +519,13 @@ def free_part(
         a point cloud's); None when no joint is free or moves a body.
     """
     touched = _touching_bodies(plant, finger, touching)
-    moved = {
-        k: {
-            int(i)
-            for i in plant.GetBodiesKinematicallyAffectedBy(
-                [structure.joints[k].index()]
-            )
-        }
-        for k in finger.joints
-    }
+    joints = [structure.joints[k] for k in finger.joints]
+    by_joint = _affected(plant, joints)
+    position = {int(j.index()): k for j, k in zip(joints, finger.joints, strict=True)}
+    moved = {k: by_joint[i] for i, k in position.items()}  # by closing position
     # a chain (the joints under one root, couplings aside) stops whole when a
     # body of it touches: a finger of one chain has no free part
-    position = {int(structure.joints[k].index()): k for k in finger.joints}
-    chains = _group(
-        [structure.joints[k] for k in finger.joints],
-        {},
-        {int(structure.joints[k].index()): moved[k] for k in finger.joints},
-    )
+    chains = _group(joints, {}, by_joint)
     frozen = set()
     for chain in chains:
         mine = [position[int(j.index())] for j in chain]
@@ -566,10 +550,7 @@ def free_part(
     pairs = tuple(p for p in finger.pairs if int(p[2].index()) in ids)
     paired = list({int(b.index()): b for _, _, b in pairs}.values())
     tip = {int(b.index()) for b in _deepest(paired, [moved[k] for k in free])}
-    roots = _roots(
-        [structure.joints[k] for k in free],
-        {int(structure.joints[k].index()): moved[k] for k in free},
-    )
+    roots = _roots([structure.joints[k] for k in free], by_joint)
     return Finger(
         name=" + ".join(joint_name(plant, j) for j in roots),
         joints=tuple(free),
@@ -592,12 +573,7 @@ def most_fingers(plant: MultibodyPlant, structure: HandStructure) -> int:
 
 def _most(plant, structure: HandStructure, finger: Finger) -> int:
     joints = [structure.joints[k] for k in finger.joints]
-    moved = {
-        int(j.index()): {
-            int(i) for i in plant.GetBodiesKinematicallyAffectedBy([j.index()])
-        }
-        for j in joints
-    }
+    moved = _affected(plant, joints)
     mine = {int(b.index()): b for b in finger.bodies}
     best = 1
     for chain in _group(joints, {}, moved):
@@ -608,6 +584,16 @@ def _most(plant, structure: HandStructure, finger: Finger) -> int:
         if part is not None:
             best = max(best, 1 + _most(plant, structure, part))
     return best
+
+
+def _affected(plant: MultibodyPlant, joints) -> dict[int, set[int]]:
+    """Each joint's index to the indices of the bodies it moves."""
+    return {
+        int(j.index()): {
+            int(i) for i in plant.GetBodiesKinematicallyAffectedBy([j.index()])
+        }
+        for j in joints
+    }
 
 
 def _touching_bodies(plant, finger: Finger, touching) -> set[int]:
@@ -726,13 +712,7 @@ def _build(plant, object_body, bodies, couplings, inspector) -> HandStructure:
             f"{[scoped_name(plant, b) for b in bodies]}"
         )
     hand = {int(b.index()) for b in bodies}
-    moved = {
-        int(j.index()): {
-            int(i) for i in plant.GetBodiesKinematicallyAffectedBy([j.index()])
-        }
-        & hand
-        for j in joints
-    }
+    moved = {i: ids & hand for i, ids in _affected(plant, joints).items()}
     position = {int(j.index()): k for k, j in enumerate(joints)}
     object_geometries = plant.GetCollisionGeometriesForBody(object_body)
     fingers = tuple(
