@@ -424,6 +424,8 @@ def plan_grasps(
         "robustness_samples": robustness_samples,
         "noise": noise,
     }
+    if object_mass is not None:
+        settings["object_mass"] = object_mass  # the weight planned for, to shake
     if torque_limit is not None:
         settings["torque_limit"] = torque_limit
     if squeeze_limit is not None:

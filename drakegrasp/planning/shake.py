@@ -55,7 +55,7 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import (
     AddMultibodyPlantSceneGraph,
 )
-from pydrake.multibody.tree import PdControllerGains
+from pydrake.multibody.tree import PdControllerGains, SpatialInertia, UnitInertia
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
@@ -65,6 +65,7 @@ from drakegrasp.planning.candidates import GraspCandidate, check_candidate
 from drakegrasp.planning.shake_result import ShakeResult, squeeze_unit_of
 from drakegrasp.planning.turned_gravity import (
     DEFAULT_DIRECTIONS,
+    GRAVITY,
     _schedule,
     _TurnedGravity,
 )
@@ -205,6 +206,7 @@ def check_shake_options(
     max_displacement,
     max_rotation,
     hydroelastic_modulus=None,
+    object_mass=None,
 ) -> np.ndarray:
     """Check :func:`shake_test`'s options before anything is simulated.
 
@@ -214,6 +216,8 @@ def check_shake_options(
         As :func:`shake_test` takes them.
     time_step, max_displacement, max_rotation, hydroelastic_modulus
         As :func:`shake_test` takes them.
+    object_mass
+        As :func:`shake_test` takes it (None: the model's).
 
     Returns
     -------
@@ -225,8 +229,10 @@ def check_shake_options(
     InvalidOptionError
         The first option that is not a finite number in its range (naming it
         and its unit), a time step longer than a tenth of a phase, or
-        directions that are not finite non-zero 3-vectors, or a
-        ``hydroelastic_modulus`` that is neither None nor a finite number > 0.
+        directions that are not finite non-zero 3-vectors, a
+        ``hydroelastic_modulus`` that is neither None nor a finite number > 0,
+        or an ``object_mass`` that is neither None nor a finite number > 0
+        whose weight is a finite float.
     """
     check_hydroelastic_modulus(hydroelastic_modulus)
     gains = [
@@ -237,8 +243,10 @@ def check_shake_options(
         )
         if value is not None  # None: shake_test's per-joint default
     ]
+    mass = [] if object_mass is None else [("object_mass", object_mass, 0.0, "kg")]
     for name, value, low, unit in (
         *gains,
+        *mass,
         ("squeeze", squeeze, 0.0, "N, or N·m for revolute joints"),
         ("time_step", time_step, 0.0, "s"),
         ("phase", phase, 0.0, "s"),
@@ -259,6 +267,11 @@ def check_shake_options(
             raise InvalidOptionError(
                 f"{name} must be a finite number {relation} ({unit}), got {value!r}"
             )
+    if object_mass is not None and not math.isfinite(float(object_mass) * GRAVITY):
+        raise InvalidOptionError(
+            f"object_mass = {object_mass:g} kg weighs more than a float holds "
+            "(its weight m g is infinite)"
+        )
     if time_step > phase / 10:
         raise InvalidOptionError(
             f"time_step must be at most a tenth of a phase ({phase / 10:g} s) to "
@@ -301,6 +314,42 @@ its squeeze (within the effort limit) this far past its place."""
 
 DAMPING_TIME = 0.0125
 """Default damping over stiffness, s (50 N·s/m at 4000 N/m)."""
+
+
+def _object_inertia(body, object_mass, candidate):
+    """``(mass, p_BoBcm_B, M_BBo_B or None)``: what the shake's object weighs.
+
+    The model's mass and centre of mass (None: its inertia as it is); with
+    ``object_mass`` the model's shape of inertia (unit inertia and centre of
+    mass) scaled to that mass, or, for a massless model, which has no shape
+    of inertia, a uniform ball of radius ``candidate.torque_scale`` (it holds
+    the object) about ``candidate.reference_point`` (where the planner put
+    the weight: its collision surface's centroid).
+    """
+    model = body.default_mass()
+    if object_mass is None:
+        if not model > 0:  # NaN too
+            raise ModelError(
+                f"the object {body.name()} has mass {model:g} kg in the model: "
+                "gravity would pull on nothing and every grasp would hold; give "
+                "object_mass= (kg), the mass the grasp was planned for"
+            )
+        return model, body.default_com(), None
+    mass = float(object_mass)
+    if model > 0:
+        com = body.default_com()
+        unit = body.default_unit_inertia()
+    else:
+        radius = float(candidate.torque_scale)
+        com = np.asarray(candidate.reference_point, dtype=float)
+        if not (math.isfinite(radius) and radius > 0 and np.all(np.isfinite(com))):
+            raise ModelError(
+                f"the object {body.name()} has no mass in the model, and the "
+                "candidate no torque_scale to give it an inertia of (a candidate "
+                "from plan_grasps has one): give the model its mass and inertia"
+            )
+        unit = UnitInertia.SolidSphere(radius).ShiftFromCenterOfMass(-com)
+    return mass, com, SpatialInertia(mass, com, unit)
 
 
 def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
@@ -363,6 +412,7 @@ def shake_test(
     object_body=None,
     X_WO: RigidTransform | None = None,
     hydroelastic_modulus: float | None = None,
+    object_mass: float | None = None,
 ) -> ShakeResult:
     """Simulate a planned grasp in Drake and report whether the object stays put.
 
@@ -431,6 +481,16 @@ def shake_test(
         it and the object's rigid, so each pad presses over a patch, as it
         does on a real object (:mod:`drakegrasp.plant.hydroelastic`; 1e6 suits
         rubber pads).
+    object_mass : float or None, optional
+        The object's mass, kg (finite, > 0), that gravity pulls on and the
+        simulation moves; its inertia scales with it (the same shape and
+        centre of mass, a uniform density).  None (default): the model's
+        (``add_models``' object).  Give the mass the candidate was planned
+        for when that is not the model's (``plan_grasps``' ``object_mass``):
+        the shake then tests that plan.  A massless model (a URDF link
+        without ``<inertial>``) gets the inertia of a uniform ball that holds
+        it (radius ``candidate.torque_scale``) about the point the planner
+        took as its centre of mass (``candidate.reference_point``).
 
     Returns
     -------
@@ -447,8 +507,10 @@ def shake_test(
         message gives the time and what to lower.
     ModelError
         ``add_models`` did not add the candidate's hand base or closing joints,
-        or Drake refused to advance the model for another reason (its first
-        sentence is in the message).
+        its object has no mass and no ``object_mass`` is given (gravity would
+        pull on nothing and every grasp would hold), or Drake refused to
+        advance the model for another reason (its first sentence is in the
+        message).
     InvalidGraspError
         The candidate's joint values or poses are not finite or do not match
         its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`).
@@ -478,6 +540,7 @@ def shake_test(
         directions=directions, settle=settle, phase=phase, seat=seat,
         blend=blend, time_step=time_step, max_displacement=max_displacement,
         max_rotation=max_rotation, hydroelastic_modulus=hydroelastic_modulus,
+        object_mass=object_mass,
     )  # fmt: skip
     modulus = check_hydroelastic_modulus(hydroelastic_modulus)
     if modulus is None and candidate.contact_options.get("contact_model") == (
@@ -573,10 +636,9 @@ def shake_test(
             plant, scene_graph, hand_bodies, [body], modulus=modulus
         )
     plant.Finalize()
+    mass, com, inertia = _object_inertia(body, object_mass, candidate)
     schedule = _schedule(seat, settle, phase, blend, dirs)
-    gravity = builder.AddSystem(
-        _TurnedGravity(body.index(), body.default_mass(), body.default_com(), schedule)
-    )
+    gravity = builder.AddSystem(_TurnedGravity(body.index(), mass, com, schedule))
     builder.Connect(
         gravity.get_output_port(), plant.get_applied_spatial_force_input_port()
     )
@@ -584,6 +646,8 @@ def shake_test(
     simulator = Simulator(diagram)
     root = simulator.get_mutable_context()
     ctx = plant.GetMyContextFromRoot(root)
+    if inertia is not None:
+        body.SetSpatialInertiaInBodyFrame(ctx, inertia)
     candidate.apply(plant, ctx, object_body=body)
     q_held = plant.GetPositions(ctx)
 
@@ -723,4 +787,5 @@ def shake_test(
         joint_names=tuple(candidate.joint_names),
         X_WH=candidate.X_WH.GetAsMatrix4(),
         gains=used,
+        object_mass=mass,
     )

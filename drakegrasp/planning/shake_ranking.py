@@ -188,7 +188,9 @@ class ShakenCandidates(Sequence):
         if not gains and results and results[0].gains:  # the per-joint defaults
             stiff, damp = (list(v) for v in zip(*results[0].gains, strict=True))
             gains = f"stiffness {_span(stiff)}, damping {_span(damp)}"
-        used = "".join(f"{x}; " for x in (squeeze, gains) if x)
+        masses = {r.object_mass for r in results if np.isfinite(r.object_mass)}
+        mass = f"object {max(masses):.4g} kg" if len(masses) == 1 else ""
+        used = "".join(f"{x}; " for x in (mass, squeeze, gains) if x)
         lines = [
             f"{n_held} of {len(self)} shaken candidates held (counted from the "
             f"{self.held_from}; {used}{fingers}{self.wall_time:.1f} s)"
@@ -334,6 +336,10 @@ def shake_candidates(
         revolute fingers need light gains (the Allegro hand:
         ``squeeze=0.7, stiffness=10, damping=0.1``); flat pads need
         ``hydroelastic_modulus`` (see :mod:`drakegrasp.plant.hydroelastic`).
+        ``object_mass`` defaults to the mass the candidates were planned for
+        when ``plan_grasps`` was given one (its result's
+        ``settings["object_mass"]``), else the model's: the shake tests the
+        plan's weight.
 
     Returns
     -------
@@ -364,6 +370,13 @@ def shake_candidates(
             "add_models must be a function add_models(plant, parser) -> (hand, "
             f"object_body), got {type(add_models).__name__}"
         )
+    planned = (
+        candidates.settings.get("object_mass")
+        if isinstance(candidates, GraspCandidates)
+        else None
+    )
+    if planned is not None and "object_mass" not in options:
+        options = {**options, "object_mass": planned}  # the plan's weight
     settings = check_settings(top, held_from, options)
     chosen = _first_candidates(candidates, int(top))
     t0 = time.perf_counter()

@@ -111,6 +111,10 @@ class ShakeResult:
         actuator order (as ``efforts``): as given, or the per-joint defaults
         of :func:`~drakegrasp.planning.shake.shake_test`.  Empty in a record
         made before it existed.
+    object_mass : float
+        The object's mass (kg) that gravity pulled on and the simulation
+        moved: the model's, or ``shake_test``'s ``object_mass``.  NaN in a
+        record made before it existed.
     """
 
     held: bool
@@ -137,6 +141,7 @@ class ShakeResult:
     joint_names: tuple[str, ...] = ()
     X_WH: np.ndarray | None = None
     gains: tuple[tuple[float, float], ...] = ()
+    object_mass: float = float("nan")
 
     def seated(self, candidate):
         """``candidate`` with the hand's joints and the object where seating left them.

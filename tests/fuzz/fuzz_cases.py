@@ -1319,6 +1319,7 @@ SHAKE_POOLS = {
     "time_step": [0.0, -1e-3, NAN, 10.0],
     "max_displacement": [-1.0, NAN],
     "max_rotation": [-1.0, NAN],
+    "object_mass": [0.0, -1.0, NAN, INF, "1", True, 10**400, 1e308],
     "X_WO": [
         "x",
         np.eye(4),

@@ -26,8 +26,9 @@ def test_the_default_hand_holds_the_box_with_hydroelastic_pads(capsys):
     argv = ["plan", "--num", "200", "--top", "0", "--shake", "3"]
     assert main(argv) == 0
     out = capsys.readouterr().out
-    head = "3 of 3 shaken candidates held (counted from the seat; squeeze "
-    assert head in out and "; stiffness " in out and "; hydroelastic " in out
+    head = "3 of 3 shaken candidates held (counted from the seat; object "
+    assert head in out and " kg; squeeze " in out
+    assert "; stiffness " in out and "; hydroelastic " in out
     assert out.count("  plan #") == 3
 
 
