@@ -19,6 +19,15 @@ first order.  :func:`equalising_move` returns the least ``t`` that makes them
 equal, the least-squares solution of ``(n̂_c − n̄)·t = ψ_c − ψ̄`` (bars:
 means over the group): for two fingers across parallel faces, half the
 difference of their gaps towards the one short of the object.
+
+**Sides.**  Only the nearest of the chains that move alike is centred
+(:func:`chain_sides`, :func:`facing_chains`).  A parallelogram finger
+written with ``<mimic>`` joints (a Robotiq 2F-85's inner knuckle: a bar
+beside its pad's chain, turning with it, that no joint connects to it) is a
+chain of the pads' closing group whose root turns as the pad's does: behind
+the pad, it cannot touch first.  Centred with the pads, its gap kept every
+move from evening theirs, and no sample of such a gripper was planned.  A
+chain whose gap cannot be measured (no collision geometry) is left out.
 """
 
 from __future__ import annotations
@@ -36,9 +45,11 @@ __all__ = [
     "CENTRING_STEPS",
     "CentredCloser",
     "chain_groups",
+    "chain_sides",
     "chains_to_centre",
     "close_centred",
     "equalising_move",
+    "facing_chains",
 ]
 
 CENTRING_STEPS = 8
@@ -109,6 +120,111 @@ def chains_to_centre(groups: Sequence[int], touched: set[int]) -> list[int]:
         if c not in touched and any(groups[t] == groups[c] for t in touched)
     }
     return [c for c, g in enumerate(groups) if g in short]
+
+
+def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
+    """A side per chain: the chains of one closing group that move alike share one.
+
+    Parameters
+    ----------
+    plant_context : Context
+        The plant's context (its pose of the hand: the joints' axes are
+        compared in the world frame).
+    structure : HandStructure
+    chains : sequence of Finger
+        :func:`~drakegrasp.plant.fingers.finger_chains` of ``structure``.
+
+    Returns
+    -------
+    list of int
+        One label per chain, numbered from 0 in the chains' order.  Two chains
+        share one when they are of one closing group and their root joints
+        (the joints of the chain that no other joint of it carries) are of
+        one kind and move alike as the group closes: the same world axis
+        times the same rate (``<mimic>`` multiplier), to 1e-9 of the larger.
+        A bar of a four-bar finger shares its finger's; opposed fingers,
+        whose joints turn the other way, do not.
+    """
+    groups = chain_groups(structure, chains)
+    rate = structure.coupling.tangent(np.ones(len(structure.joints)))
+    motions = []
+    for chain in chains:
+        k = _root(structure, chain)
+        joint = structure.joints[k]
+        if joint.type_name() == "revolute":
+            axis = joint.revolute_axis()
+        elif joint.type_name() == "prismatic":
+            axis = joint.translation_axis()
+        else:  # another kind: a side of its own
+            motions.append(None)
+            continue
+        R_WF = joint.frame_on_parent().CalcRotationMatrixInWorld(plant_context)
+        motions.append((joint.type_name(), rate[k] * (R_WF.matrix() @ axis)))
+    sides: list[int] = []
+    for c, motion in enumerate(motions):
+        twin = next(
+            (
+                sides[d]
+                for d in range(c)
+                if groups[d] == groups[c]
+                and motion is not None
+                and motions[d] is not None
+                and motions[d][0] == motion[0]
+                and _alike(motions[d][1], motion[1])
+            ),
+            None,
+        )
+        sides.append(max(sides, default=-1) + 1 if twin is None else twin)
+    return sides
+
+
+def _root(structure, chain) -> int:
+    """The position (in ``structure.joints``) of the chain's root joint."""
+    bodies = {int(b.index()) for b in chain.bodies}
+    for k in chain.joints:
+        if int(structure.joints[k].parent_body().index()) not in bodies:
+            return k
+    return chain.joints[0]
+
+
+def _alike(a: np.ndarray, b: np.ndarray) -> bool:
+    scale = max(float(np.linalg.norm(a)), float(np.linalg.norm(b)))
+    return scale > 0 and float(np.linalg.norm(a - b)) <= 1e-9 * scale
+
+
+def facing_chains(psi, sides: Sequence[int]) -> list[int]:
+    """The nearest measured chain of each side (:func:`chain_sides`).
+
+    Parameters
+    ----------
+    psi : (k,) float
+        The chains' gaps to the object, metres; NaN where a gap cannot be
+        measured (that chain is left out).
+    sides : (k,) int
+        Each chain's side.
+
+    Returns
+    -------
+    list of int
+        Indices into ``psi``, ascending: of each side's measured chains the
+        one with the least gap (the first of equal ones).
+
+    Raises
+    ------
+    InvalidOptionError
+        ``psi`` not a vector of real numbers or ``sides`` not one integer
+        per gap.
+    """
+    psi = real_array("psi", psi, error=InvalidOptionError)
+    if psi.ndim != 1:
+        raise InvalidOptionError(f"psi must be a vector of gaps, got shape {psi.shape}")
+    sides = _integers("sides", sides, len(psi))
+    nearest: dict[int, int] = {}
+    for c in np.flatnonzero(np.isfinite(psi)):
+        s = int(sides[c])
+        if s not in nearest or psi[c] < psi[nearest[s]]:
+            nearest[s] = int(c)
+    return sorted(nearest.values())
 
 
 def equalising_move(psi, lines, tol: float, groups=None) -> np.ndarray | None:
@@ -197,16 +313,27 @@ def _checked(psi, lines, tol, groups):
         raise InvalidOptionError(f"tol must be a finite number > 0 (m), got {tol!r}")
     if groups is None:
         return psi, lines, np.zeros(len(psi), int)
-    g = np.asarray(groups)
-    if g.shape != psi.shape or (len(g) and g.dtype.kind not in "iu"):
+    return psi, lines, _integers("groups", groups, len(psi))
+
+
+def _integers(name: str, values, n: int) -> np.ndarray:
+    """``values`` as ``n`` integers, one per gap, else a refusal naming ``name``."""
+    g = np.asarray(values)
+    if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
         raise InvalidOptionError(
-            f"groups must be {len(psi)} integers, one per gap, got {groups!r}"
+            f"{name} must be {n} integers, one per gap, got {values!r}"
         )
-    return psi, lines, g
+    return g
 
 
 def close_centred(
-    close: Callable, gaps: Callable, groups: Sequence[int], tol: float, X_WH, q_pre
+    close: Callable,
+    gaps: Callable,
+    groups: Sequence[int],
+    tol: float,
+    X_WH,
+    q_pre,
+    sides: Sequence[int] | None = None,
 ):
     """Close the hand at ``X_WH``, centring it while coupled chains stop short.
 
@@ -217,8 +344,8 @@ def close_centred(
         from the pre-shape at a hand pose; ``reason`` None when kept,
         ``touched`` the set of chains that touch.
     gaps : callable
-        ``gaps(chains) -> (psi (k,), lines (k, 3))`` of the closed hand, or
-        None when a chain's gap cannot be measured.
+        ``gaps(chains) -> (psi (k,), lines (k, 3))`` of the closed hand (NaN
+        where a chain's gap cannot be measured), or None when none can.
     groups : sequence of int
         :func:`chain_groups`.
     tol : float
@@ -227,6 +354,9 @@ def close_centred(
         The sampled pose of the hand's base.
     q_pre : (n_h,) float
         The pre-shape.
+    sides : sequence of int, optional
+        :func:`chain_sides`: of the chains of one side only the nearest is
+        centred (default: every chain a side of its own).
 
     Returns
     -------
@@ -244,11 +374,9 @@ def close_centred(
         chains = chains_to_centre(groups, touched)
         if step == CENTRING_STEPS or not chains:
             break
-        measured = gaps(chains)
-        move = (
-            None
-            if measured is None
-            else equalising_move(*measured, tol, [groups[c] for c in chains])
+        side = list(range(len(groups))) if sides is None else sides
+        move = _move(
+            gaps(chains), [groups[c] for c in chains], [side[c] for c in chains], tol
         )
         if move is None:
             break
@@ -256,15 +384,28 @@ def close_centred(
     return None, None, first, X_WH
 
 
+def _move(measured, groups: list[int], sides: list[int], tol) -> np.ndarray | None:
+    """:func:`equalising_move` of the facing chains of ``measured``, or None."""
+    if measured is None:
+        return None
+    psi, lines = (np.asarray(a, dtype=float) for a in measured)
+    facing = facing_chains(psi, sides)
+    if len(facing) < 2:
+        return None
+    return equalising_move(psi[facing], lines[facing], tol, [groups[k] for k in facing])
+
+
 class CentredCloser:
     """A closer whose :meth:`run` centres coupled fingers (stage 3 of both routes).
 
     A subclass gives ``_close(X_WH, q_pre) -> (contacts, q, reason,
     touched)`` and ``_gaps(chains)`` as :func:`close_centred` takes them, and
-    ``group`` (:func:`chain_groups`) and ``tol`` (m).
+    ``group`` (:func:`chain_groups`), ``side`` (:func:`chain_sides`, or
+    None) and ``tol`` (m).
     """
 
     X_WH = None
+    side = None
 
     def run(self, X_WH, q_pre):
         """(contacts, closed q, None) or (None, None, reason); the pose in ``X_WH``.
@@ -274,6 +415,6 @@ class CentredCloser:
         tried at) is left in ``self.X_WH``.
         """
         found, q, reason, self.X_WH = close_centred(
-            self._close, self._gaps, self.group, self.tol, X_WH, q_pre
+            self._close, self._gaps, self.group, self.tol, X_WH, q_pre, self.side
         )
         return found, q, reason

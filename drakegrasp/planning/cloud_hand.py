@@ -80,7 +80,7 @@ from pydrake.geometry import Box, Capsule, Cylinder, Sphere
 from pydrake.multibody.tree import JacobianWrtVariable
 from scipy.spatial import cKDTree
 
-from drakegrasp.planning.centring import CentredCloser, chain_groups
+from drakegrasp.planning.centring import CentredCloser, chain_groups, chain_sides
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
     SHADOW_PROBES,
@@ -358,6 +358,7 @@ class CloudHand(CentredCloser):
             for chain in hand.chains
         ]
         self.group = chain_groups(s, hand.chains)
+        self.side = chain_sides(self.ctx, s, hand.chains)
         self.X_WH = None
         self._by_body = by_body
         self._parts = {}  # (finger, touching bodies) -> its free part's closing
@@ -472,20 +473,21 @@ class CloudHand(CentredCloser):
         return float(sd[0]), R @ (grad / norm)
 
     def _gaps(self, chains):
-        """The chains' gaps to the cloud and lines towards it (world frame)."""
-        psi, lines = [], []
-        for c in chains:
+        """The chains' gaps to the cloud and lines towards it (world frame).
+
+        NaN for a chain whose gap cannot be measured (no geometry, no line).
+        """
+        psi, lines = np.full(len(chains), np.nan), np.full((len(chains), 3), np.nan)
+        for i, c in enumerate(chains):
             geoms = self.chain_geoms[c]
             if not geoms:
-                return None
+                continue
             d, witness, _ = self.distances(geoms, within=np.inf)
             k = int(np.argmin(d))
             _, n_W = self._line(geoms[k], self.points_W[witness[k]])
-            if n_W is None:
-                return None
-            psi.append(d[k])
-            lines.append(n_W)
-        return np.array(psi), np.array(lines)
+            if n_W is not None:
+                psi[i], lines[i] = d[k], n_W
+        return psi, lines
 
     def _signed(self, g: _Geometry, R, p, points_W) -> np.ndarray:
         sd = signed_distances(g.shape, (points_W - p) @ R)

@@ -65,7 +65,7 @@ from drakegrasp.planning.candidates import (
     closing_order,
     planning_result,
 )
-from drakegrasp.planning.centring import CentredCloser, chain_groups
+from drakegrasp.planning.centring import CentredCloser, chain_groups, chain_sides
 from drakegrasp.planning.checks import (
     checked_contacts,
     checked_fingers,
@@ -172,6 +172,7 @@ class _Placer(CentredCloser):
             for b in finger.bodies:
                 self.label[scoped_name(plant, b)] = f
         self.group = chain_groups(hand.structure, hand.chains)
+        self.side = chain_sides(ctx, hand.structure, hand.chains)
         self.min_fingers = int(min_fingers)
         self.X_WH = None
 
@@ -198,14 +199,12 @@ class _Placer(CentredCloser):
     def _gaps(self, chains):
         """The chains' gaps to the object and lines towards it (world frame)."""
         query = self.port.Eval(self.ctx)
-        psi, lines = [], []
-        for c in chains:
+        psi, lines = np.full(len(chains), np.nan), np.full((len(chains), 3), np.nan)
+        for i, c in enumerate(chains):
             d, n_W, *_ = closest(query, self.plant, self.ctx, self.hand.chains[c].pairs)
-            if n_W is None:
-                return None
-            psi.append(d)
-            lines.append(n_W)
-        return np.array(psi), np.array(lines)
+            if n_W is not None:  # else no geometry to measure: NaN
+                psi[i], lines[i] = d, n_W
+        return psi, lines
 
     def _close(self, X_WH, q_pre):
         """One closing at ``X_WH``: (contacts, q, reason, chains touching)."""

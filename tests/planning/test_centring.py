@@ -14,6 +14,7 @@ from drakegrasp.planning.centring import (
     chains_to_centre,
     close_centred,
     equalising_move,
+    facing_chains,
 )
 
 TOL = 1e-4
@@ -160,6 +161,47 @@ def test_close_centred_gives_the_first_reason_when_it_cannot_centre(monkeypatch)
     )
     assert (found, q, reason) == (None, None, "one finger touches")
     assert pinch.calls == 1
+
+
+class _BarredPinch(_Pinch):
+    """The pinch with a bar behind each pad (chains 2, 3 behind 0, 1).
+
+    Each bar's nearest point lies 9 mm further from the object than its pad's,
+    below the pad's line (its line to the object tilted 37° down).
+    """
+
+    def gaps(self, chains):
+        psi, lines = super().gaps(chains)
+        bars = np.array([[0.8, 0.0, -0.6], [-0.8, 0.0, -0.6]])
+        return np.append(psi, psi + 0.009), np.vstack([lines, bars])
+
+
+@pytest.mark.parametrize("e", [-0.012, 0.004])
+def test_a_bar_behind_its_pad_is_not_centred_with_it(e):
+    # Four chains in one group: equalised with the pads, the bars' gaps pull
+    # the hand down towards them (the move evens four gaps in least squares,
+    # not the pads').  Of each side (a pad and its bar turn alike) only the
+    # nearest is centred: one move, exactly onto the object's centre.
+    pinch = _BarredPinch(e)
+    args = (pinch.close, pinch.gaps, [0] * 4, TOL, RigidTransform([0.0, 0.0, 0.1]))
+    found, _, reason, X = close_centred(*args, None, [0, 1, 0, 1])
+    assert reason is None and found == ["contacts"] and pinch.calls == 2
+    np.testing.assert_allclose(X.translation(), [e, 0.0, 0.1], atol=1e-12)
+    _, _, _, X = close_centred(*args, None)  # every chain its own side
+    assert abs(X.translation()[2] - 0.1) > 1e-3
+
+
+def test_facing_chains_keeps_the_nearest_measured_chain_of_each_side():
+    assert facing_chains([0.02, 0.0, 0.011, 0.03], [0, 1, 0, 1]) == [1, 2]
+    assert facing_chains([np.nan, 0.0, 0.011, np.nan], [0, 1, 0, 1]) == [1, 2]
+    assert facing_chains([0.01, 0.01], [0, 0]) == [0]  # the first of equal ones
+    assert facing_chains([np.nan, np.nan], [0, 1]) == []
+    assert facing_chains([], []) == []
+    from drakegrasp.errors import InvalidOptionError
+
+    for psi, sides in [([0.0, 0.1], [0]), ([0.0, 0.1], [0.0, 1.0]), ("ab", [0, 1])]:
+        with pytest.raises(InvalidOptionError):
+            facing_chains(psi, sides)
 
 
 @pytest.mark.parametrize(

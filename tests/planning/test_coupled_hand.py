@@ -13,7 +13,7 @@ import pytest
 from coupled_hands import one_motor_pinch_urdf, spread_hand_urdf
 from coupled_support import MODEL, coupled_hand_sdf
 from grasp_builders import generator_matrix
-from pydrake.math import RotationMatrix
+from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from scipy.optimize import linprog
 
 import drakegrasp as dg
@@ -26,6 +26,7 @@ from drakegrasp.planning import (
     shake_test,
 )
 from drakegrasp.planning.approach import multi_finger_hand
+from drakegrasp.planning.centring import chain_sides
 from drakegrasp.planning.motors import finger_jacobian, torque_capacity
 from drakegrasp.planning.multifinger import close_candidates
 from drakegrasp.planning.shake import DAMPING_TIME, REVOLUTE_AIM
@@ -406,23 +407,118 @@ def test_a_one_motor_pinch_is_planned_on_both_pads(pinch):
         assert pads == {"left_pad", "right_pad"}
 
 
-def test_a_one_motor_pinch_is_planned_on_a_point_cloud(pinch, pinch_file):
-    # On a cloud the pinch's one closing group had to count as two fingers
-    # (min_fingers = 2 rejected every pose: "fingers miss the object"), and
-    # its chains are centred as on a body.
-    scene, _ = pinch
+@pytest.fixture(scope="module")
+def barred(tmp_path_factory):
+    """The pinch with its four-bars' inner knuckles, as a Robotiq URDF has them."""
+    path = tmp_path_factory.mktemp("barred") / "barred_pinch.urdf"
+    path.write_text(one_motor_pinch_urdf(bars=True))
+    scene = planning_scene(BOX, hand_url=str(path))
+    hand = multi_finger_hand(
+        scene.plant, scene.plant.GetMyContextFromRoot(scene.context),
+        scene.object_body, scene.hand,
+    )  # fmt: skip
+    return scene, hand
+
+
+def test_a_pinch_with_four_bar_links_is_centred_on_its_pads(barred):
+    # The inner knuckles close with the pads but sit behind them: centred with
+    # them, their gaps kept every move from evening the pads' (no move, "one
+    # finger touches" at every offset).  Only the nearest chain on each side
+    # is centred now.
+    scene, hand = barred
+    assert len(hand.chains) == 4 and len(hand.structure.fingers) == 1
+    offsets = [-0.012, -0.004, 0.0, 0.007, 0.012]
+    kept, rejections, _ = _close_at(barred, offsets)
+    assert not rejections and [k[0] for k in kept] == list(range(len(offsets)))
+    for _, X_WH, _, _, contacts in kept:
+        np.testing.assert_allclose(X_WH.translation(), [0, 0, 0.18], atol=2e-4)
+        pads = {c.finger_body.split("::")[-1] for c in contacts}
+        assert pads == {"left_pad", "right_pad"}
+
+
+def _sides(scene, hand, X_WH=None):
+    plant = scene.plant
+    ctx = plant.GetMyContextFromRoot(scene.context.Clone())
+    if X_WH is not None:
+        plant.SetFreeBodyPose(ctx, hand.base, X_WH)
+    names = [c.name.split("::")[-1] for c in hand.chains]
+    return dict(zip(names, chain_sides(ctx, hand.structure, hand.chains), strict=True))
+
+
+def test_a_bar_shares_its_pads_side_and_opposed_fingers_do_not(barred, pinch, tmp_path):
+    # A side: the chains of one closing group whose root joints turn alike
+    # (the same world axis times the same mimic multiplier).
+    sides = _sides(*barred)
+    assert sides["left_bar_joint"] == sides["left_knuckle"]
+    assert sides["right_bar_joint"] == sides["right_knuckle"]
+    assert sides["left_knuckle"] != sides["right_knuckle"]
+    # wherever the hand is: axes are compared in one frame
+    X = RigidTransform(RollPitchYaw(0.4, -1.1, 2.0), [0.3, -1.0, 2.0])
+    assert _sides(*barred, X) == sides
+    assert sorted(_sides(*pinch).values()) == [0, 1]
+    # the spread hand: f1, f2 on one spread motor turning opposite ways; f3
+    path = tmp_path / "spread_hand.urdf"
+    path.write_text(spread_hand_urdf())
+    scene = planning_scene(CYLINDER, hand_url=str(path))
+    hand = multi_finger_hand(
+        scene.plant, scene.plant.GetMyContextFromRoot(scene.context),
+        scene.object_body, scene.hand,
+    )  # fmt: skip
+    spread = _sides(scene, hand)
+    assert len(set(spread.values())) == len(spread) == len(hand.chains)
+
+
+def test_a_pinch_with_four_bar_links_is_planned(barred, pinch):
+    # Before, every sample that reached the box was rejected, "one finger
+    # touches"; now the pinch with its bars is planned as the pinch without.
+    def plan(scene):
+        return plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=60, mu=0.5, seed=0, robustness_samples=8,
+        )  # fmt: skip
+
+    with_bars, without = plan(barred[0]), plan(pinch[0])
+    assert len(with_bars) >= max(5, len(without) // 2), (len(with_bars), len(without))
+    assert with_bars.rejections.get("one finger touches", 0) <= len(with_bars) // 4
+    for candidate in with_bars:  # a pad or its bar on each side (a power grasp)
+        sides = {
+            c.finger_body.split("::")[-1].split("_")[0] for c in candidate.contacts
+        }
+        assert sides == {"left", "right"}
+    pads = {"left_pad", "right_pad"}
+    assert sum({c.finger_body.split("::")[-1] for c in k.contacts} == pads
+               for k in with_bars) >= len(with_bars) // 2  # fmt: skip
+
+
+def _on_cloud(scene, hand_file):
     surface = object_surface(scene.plant, scene.context, scene.object_body)
     points, normals, _ = surface.sample(3000, np.random.default_rng(0))
-    hand_only = planning_scene(None, hand_url=pinch_file)
-    result = plan_grasps(
+    hand_only = planning_scene(None, hand_url=hand_file)
+    return plan_grasps(
         hand_only.plant, hand_only.context, None, hand=hand_only.hand,
         num_candidates=100, mu=0.5, seed=0, robustness_samples=8,
         point_cloud=points, cloud_normals=normals, object_mass=0.2,
     )  # fmt: skip
+
+
+def test_a_one_motor_pinch_is_planned_on_a_point_cloud(pinch, pinch_file):
+    # On a cloud the pinch's one closing group had to count as two fingers
+    # (min_fingers = 2 rejected every pose: "fingers miss the object"), and
+    # its chains are centred as on a body.
+    result = _on_cloud(pinch[0], pinch_file)
     assert len(result) >= 5
     for candidate in result:
         pads = {c.finger_body.split("::")[-1] for c in candidate.contacts}
         assert pads == {"left_pad", "right_pad"}
+
+
+def test_a_pinch_with_four_bar_links_is_planned_on_a_point_cloud(barred, tmp_path):
+    # 1 candidate of 100 samples before (18 "one finger touches"), 10 now
+    path = tmp_path / "barred.urdf"
+    path.write_text(one_motor_pinch_urdf(bars=True))
+    result = _on_cloud(barred[0], str(path))
+    assert len(result) >= 5
+    assert result.rejections.get("one finger touches", 0) <= len(result)
 
 
 def test_a_hand_with_a_coupled_spread_closes_all_its_fingers(tmp_path):

@@ -126,7 +126,7 @@ def spread_hand_urdf() -> str:
     )
 
 
-def one_motor_pinch_urdf(*, effort: float = 5.0) -> str:
+def one_motor_pinch_urdf(*, effort: float = 5.0, bars: bool = False) -> str:
     """A Robotiq-style pinch: two revolute knuckles on one motor, pads kept upright.
 
     Knuckles 110 mm apart on the palm, about ``y``, 50 mm long; each carries a
@@ -135,14 +135,24 @@ def one_motor_pinch_urdf(*, effort: float = 5.0) -> str:
     ``<mimic>``).  The right knuckle and both pads follow the left knuckle,
     whose slide is the only one with a ``<transmission>``: one motor.  Open
     (0 rad) the pads are 71 mm apart.
+
+    ``bars``: the four-bar's other links too, as a Robotiq 2F-85's URDF has
+    them: beside each knuckle an inner knuckle (two 4 mm capsules, 18 mm
+    either side of the pad, 5 mm behind its face) on its own hinge from the
+    palm, turning with the knuckle (``<mimic>`` 1 on the left, -1 on the
+    right) and joined to nothing: a chain of the closing group that never
+    reaches the object before its pad.
     """
 
-    def link(name, xyz, shape, mass):
+    def link(name, xyz, shape, mass, *more):
+        collisions = "".join(
+            f'<collision><origin xyz="{at}"/><geometry>{shape}</geometry></collision>'
+            for at in (xyz, *more)
+        )
         return (
             f'<link name="{name}"><inertial><origin xyz="{xyz}"/><mass value='
             f'"{mass}"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0"'
-            f' iyz="0"/></inertial><collision><origin xyz="{xyz}"/><geometry>'
-            f"{shape}</geometry></collision></link>"
+            f' iyz="0"/></inertial>{collisions}</link>'
         )
 
     def hinge(name, parent, child, xyz, lower, upper, mimic=None):
@@ -160,6 +170,15 @@ def one_motor_pinch_urdf(*, effort: float = 5.0) -> str:
 
     knuckle = '<capsule radius="0.006" length="0.038"/>'
     pad = '<box size="0.008 0.022 0.04"/>'
+    bar = '<capsule radius="0.004" length="0.042"/>'
+    four_bar = (
+        link("left_bar", "0 0.018 0.025", bar, 0.02, "0 -0.018 0.025")
+        + link("right_bar", "0 0.018 0.025", bar, 0.02, "0 -0.018 0.025")
+        + hinge("left_bar_joint", "palm", "left_bar", "-0.05 0 0.06", 0, 0.8, 1)
+        + hinge("right_bar_joint", "palm", "right_bar", "0.05 0 0.06", -0.8, 0, -1)
+        if bars
+        else ""
+    )
     return (
         '<?xml version="1.0"?><robot name="one_motor_pinch">'
         + link("palm", "0 0 0.025", '<box size="0.14 0.06 0.05"/>', 0.6)
@@ -171,6 +190,7 @@ def one_motor_pinch_urdf(*, effort: float = 5.0) -> str:
         + hinge("right_knuckle", "palm", "right_knuckle", "0.055 0 0.06", -0.8, 0, -1)
         + hinge("left_pad_joint", "left_knuckle", "left_pad", "0 0 0.05", -0.8, 0, -1)
         + hinge("right_pad_joint", "right_knuckle", "right_pad", "0 0 0.05", 0, 0.8, 1)
+        + four_bar
         + '<transmission name="t"><type>transmission_interface/SimpleTransmission'
         '</type><joint name="left_knuckle"/><actuator name="motor">'
         "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
