@@ -40,6 +40,21 @@ random axis across it; the palm's centre line is put through ``p`` along
 touching the surface to the grasp centre on it), and the hand is rolled about
 ``d`` by an angle uniform in ``[0, 2π)``.  Everything is drawn in the object
 frame O, so a rigid motion of the scene moves every pose with it.
+
+**A pinch** (a hand whose chains move on two sides,
+:func:`~drakegrasp.planning.centring.chain_sides`: a Robotiq-style gripper,
+two revolute fingers) closes along one axis, from one side's tip to the
+other's.  Rolled at random, its pads met a box's faces at an angle and
+touched with a corner each: two point contacts, never force closure.  Its
+roll is the best of :data:`PINCH_ROLLS` turns of the drawn one spread over a
+half turn: the one whose closing axis, through the pads' midpoint, leaves
+the object on both sides most nearly along the outward normals (the least of
+the two cosines, from :meth:`ObjectSurface.chord
+<drakegrasp.planning.surface.ObjectSurface.chord>`), across a width the open
+pads span; then turned to lay the axis along the difference of those two
+normals (exact on flat faces).  The drawn roll stays where no line meets the
+object.  The tilt turns the approach about that axis, so the pads still
+close square on the faces.
 """
 
 from __future__ import annotations
@@ -51,6 +66,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import RigidBody
 
 from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.planning.centring import chain_sides
 from drakegrasp.planning.gripper import free_base
 from drakegrasp.planning.placement import axis_frames
 from drakegrasp.planning.surface import piece_of_shape
@@ -64,7 +80,11 @@ from drakegrasp.plant.fingers import (
 from drakegrasp.plant.pose import JOINT_LIMIT_TOL
 from drakegrasp.plant.validation import HandSpec, hand_bodies
 
-__all__ = ["MultiFingerHand", "multi_finger_hand", "sample_approaches"]
+__all__ = ["PINCH_ROLLS", "MultiFingerHand", "multi_finger_hand", "sample_approaches"]
+
+PINCH_ROLLS = 8
+"""Rolls tried per pose of a pinch (evenly over half a turn from the drawn
+one: the two sides swap over the other half): one every 22.5°."""
 
 _MIN_REACH = 1e-3
 """The grasp centre must lie this far (m) in front of the palm."""
@@ -108,6 +128,16 @@ class MultiFingerHand:
     standoff : (2,) float
         ``(s_lo, s_hi)``, metres from the sampled surface point to the palm's
         front face.
+    closing_axis : (3,) float or None
+        A pinch's closing axis in K (unit, across the approach: from one
+        side's tip to the other's at the pre-shape, each side's tip that of
+        its chain reaching furthest along ``u``); None for another hand.
+    pinch_reach : float
+        Metres from K's origin along ``u`` to a pinch's tips' midpoint (NaN
+        for another hand).
+    pinch_width : float
+        Metres between a pinch's two tips along its closing axis at the
+        pre-shape (NaN for another hand): no object wider than this fits.
     """
 
     base: RigidBody
@@ -120,6 +150,9 @@ class MultiFingerHand:
     reach: float
     palm_depth: float
     standoff: np.ndarray
+    closing_axis: np.ndarray | None = None
+    pinch_reach: float = float("nan")
+    pinch_width: float = float("nan")
 
     @property
     def num_fingers(self) -> int:
@@ -152,7 +185,15 @@ class MultiFingerHand:
             "reach": self.reach,
             "palm_depth": self.palm_depth,
             "standoff": self.standoff.tolist(),
-        }
+        } | (
+            {}
+            if self.closing_axis is None
+            else {
+                "closing_axis_K": self.closing_axis.tolist(),
+                "pinch_reach": self.pinch_reach,
+                "pinch_width": self.pinch_width,
+            }
+        )
 
 
 def _check_preshape_limits(q: np.ndarray, structure) -> None:
@@ -395,6 +436,12 @@ def multi_finger_hand(
     span = np.array([0.0, reach]) if standoff is None else _range("standoff", standoff)
     if span[0] < 0:
         raise InvalidOptionError(f"standoff must be >= 0 metres, got {standoff!r}")
+    pinch = _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u)
+    closing_axis, pinch_reach, pinch_width = None, float("nan"), float("nan")
+    if pinch is not None:
+        c_H, mid, pinch_width = pinch
+        closing_axis = X_HK.rotation().inverse().multiply(c_H)
+        pinch_reach = float((mid - origin) @ u)
     return MultiFingerHand(
         base=base,
         structure=structure,
@@ -406,7 +453,120 @@ def multi_finger_hand(
         reach=reach,
         palm_depth=float(depth),
         standoff=span,
+        closing_axis=closing_axis,
+        pinch_reach=pinch_reach,
+        pinch_width=pinch_width,
     )
+
+
+def _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u):
+    """``(c_H, mid_H, width)`` of a hand whose chains move on two sides, else None.
+
+    Each side's tip is the tip centre (at the pre-shape ``q0``) of its chain
+    that reaches furthest along ``u`` (a pad, not the bar beside it);
+    ``c_H`` the unit line from the first side's tip to the second's with its
+    part along ``u`` removed, ``mid_H`` their midpoint, ``width`` their
+    distance along ``c_H`` (m).
+    """
+    q_all = plant.GetPositions(ctx)
+    q_all[structure.position_indices] = structure.coupling.apply(q0)
+    plant.SetPositions(ctx, q_all)
+    sides = chain_sides(ctx, structure, chains)
+    if len(set(sides)) != 2:
+        return None
+    tips = {}
+    for side, bodies in zip(sides, finger_tips, strict=True):
+        if not bodies:
+            continue
+        tip = np.mean(_centres(plant, ctx, inspector, H, bodies), axis=0)
+        if side not in tips or tip @ u > tips[side] @ u:
+            tips[side] = tip
+    if len(tips) != 2:
+        return None
+    a, b = tips[min(tips)], tips[max(tips)]
+    c = (b - a) - ((b - a) @ u) * u
+    if np.linalg.norm(c) < _MIN_REACH:  # the tips lie one behind the other
+        return None
+    width = float(np.linalg.norm(c))
+    return c / width, (a + b) / 2, width
+
+
+def _pinch_poses(surface, p_O, d0, across, angle, s, roll, hand: MultiFingerHand):
+    """``(d_O, roll)`` of a pinch's poses: rolled to meet the object, then tilted.
+
+    The roll is chosen about the inward normal ``d0`` (:func:`_aligned_rolls`),
+    with the tips' midpoint where the stand-off ``s`` puts it, kept within the
+    object along ``d0`` (a tenth of the reach inside its surfaces, or at its
+    middle if it is thinner: pads whose midpoint stops short of it or passes
+    it still reach into it).  The approach is then tilted by ``angle`` about
+    the closing axis, to the side ``across`` leans to, so that the axis stays
+    where the roll laid it; the roll is re-expressed about the tilted
+    approach.
+    """
+    depth = hand.pinch_reach - s - hand.palm_depth
+    _, through, _ = surface.chord(p_O, d0)
+    inset = np.fmin(0.1 * abs(hand.pinch_reach), through / 2)
+    depth = np.where(np.isnan(through), depth, np.clip(depth, inset, through - inset))
+    roll = _aligned_rolls(surface, p_O + depth[:, None] * d0, d0, roll, hand)
+    c = axis_frames(d0, roll) @ hand.closing_axis
+    side = np.cross(c, d0)  # unit: c is across d0
+    sign = np.where(np.sum(across * side, axis=1) < 0, -1.0, 1.0)
+    d_O = np.cos(angle)[:, None] * d0 + (sign * np.sin(angle))[:, None] * side
+    frame = axis_frames(d_O, np.zeros(len(d_O)))
+    alpha = np.arctan2(
+        np.sum(c * frame[:, :, 2], axis=1), np.sum(c * frame[:, :, 1], axis=1)
+    )
+    return d_O, alpha - np.arctan2(hand.closing_axis[2], hand.closing_axis[1])
+
+
+def _aligned_rolls(surface, mid_O, d_O, roll, hand: MultiFingerHand) -> np.ndarray:
+    """Per pose, the roll of :data:`PINCH_ROLLS` whose axis best meets the object.
+
+    ``mid_O`` (n, 3): where the pinch's tips' midpoint goes, frame O.  A roll
+    scores the least of ``n_+·c`` and ``n_-·(-c)``, the outward normals where
+    the line through ``mid_O`` along the closing axis ``±c`` leaves the
+    object; the drawn ``roll`` is kept where no roll's line meets it on both
+    sides.
+    """
+    n, m = len(roll), PINCH_ROLLS
+    rolls = roll[:, None] + np.arange(m)[None, :] * (np.pi / m)  # (n, m)
+    score, n_p, n_m = _roll_scores(surface, np.repeat(mid_O, m, axis=0),
+                                   np.repeat(d_O, m, axis=0), rolls.reshape(-1),
+                                   hand)  # fmt: skip
+    score = score.reshape(n, m)
+    best = np.argmax(score, axis=1)  # the first of equal ones: the drawn roll
+    rows = np.arange(n) * m + best
+    chosen = np.where(
+        np.isfinite(score[np.arange(n), best]), rolls[np.arange(n), best], roll
+    )
+    # Refined: the roll that lays the axis along n_+ - n_- across d (exact
+    # for flat faces; 22.5 deg apart, the coarse rolls left a pad's corner
+    # touching), kept where it scores no worse.
+    target = n_p[rows] - n_m[rows]
+    target -= np.sum(target * d_O, axis=1, keepdims=True) * d_O
+    frame = axis_frames(d_O, np.zeros(n))  # y: e1, z: e2 of roll 0
+    alpha = np.arctan2(
+        np.sum(target * frame[:, :, 2], axis=1), np.sum(target * frame[:, :, 1], axis=1)
+    )
+    refined = alpha - np.arctan2(hand.closing_axis[2], hand.closing_axis[1])
+    better, _, _ = _roll_scores(surface, mid_O, d_O, refined, hand)
+    ok = np.isfinite(score[np.arange(n), best]) & (better >= score[np.arange(n), best])
+    return np.where(ok, refined, chosen)
+
+
+def _roll_scores(surface, mid_O, d_O, rolls, hand: MultiFingerHand):
+    """``(score, n_+, n_-)`` of each roll: see :func:`_aligned_rolls`.
+
+    -inf where a line misses the object or the object is as wide as the
+    pinch's tips are apart along it.
+    """
+    c = axis_frames(d_O, rolls) @ hand.closing_axis  # frame O
+    _, out_p, n_p = surface.chord(mid_O, c)
+    _, out_m, n_m = surface.chord(mid_O, -c)
+    score = np.minimum(np.sum(n_p * c, axis=1), -np.sum(n_m * c, axis=1))
+    with np.errstate(invalid="ignore"):  # NaN: a miss
+        fits = out_p + out_m < hand.pinch_width
+    return np.where(fits, score, -np.inf), n_p, n_m
 
 
 def sample_approaches(surface, hand: MultiFingerHand, X_WO, n, rng, tilt):
@@ -439,6 +599,8 @@ def sample_approaches(surface, hand: MultiFingerHand, X_WO, n, rng, tilt):
     roll = rng.uniform(0.0, 2 * np.pi, n)
     s = rng.uniform(hand.standoff[0], hand.standoff[1], n)
     amounts = rng.uniform(hand.synergy_range[0], hand.synergy_range[1], n)
+    if hand.closing_axis is not None and n:
+        d_O, roll = _pinch_poses(surface, p_O, -nout_O, across, angle, s, roll, hand)
     R_OK = axis_frames(d_O, roll)  # x along d
     # K's origin: the palm's front face (palm_depth ahead of it) s before p
     p_OK = p_O - (s + hand.palm_depth)[:, None] * d_O
