@@ -136,8 +136,9 @@ class MultiFingerHand:
         Metres from K's origin along ``u`` to a pinch's tips' midpoint (NaN
         for another hand).
     pinch_width : float
-        Metres between a pinch's two tips along its closing axis at the
-        pre-shape (NaN for another hand): no object wider than this fits.
+        Metres between a pinch's two tips' collision geometries along its
+        closing axis at the pre-shape (NaN for another hand): no object
+        wider than this fits between them.
     """
 
     base: RigidBody
@@ -465,8 +466,9 @@ def _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u):
     Each side's tip is the tip centre (at the pre-shape ``q0``) of its chain
     that reaches furthest along ``u`` (a pad, not the bar beside it);
     ``c_H`` the unit line from the first side's tip to the second's with its
-    part along ``u`` removed, ``mid_H`` their midpoint, ``width`` their
-    distance along ``c_H`` (m).
+    part along ``u`` removed, ``mid_H`` their midpoint, ``width`` the gap
+    between the two tips' collision geometries along ``c_H`` (m: the
+    widest object the open pinch spans).
     """
     q_all = plant.GetPositions(ctx)
     q_all[structure.position_indices] = structure.coupling.apply(q0)
@@ -479,16 +481,31 @@ def _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u):
         if not bodies:
             continue
         tip = np.mean(_centres(plant, ctx, inspector, H, bodies), axis=0)
-        if side not in tips or tip @ u > tips[side] @ u:
-            tips[side] = tip
+        if side not in tips or tip @ u > tips[side][0] @ u:
+            tips[side] = (tip, bodies)
     if len(tips) != 2:
         return None
-    a, b = tips[min(tips)], tips[max(tips)]
+    (a, on_a), (b, on_b) = tips[min(tips)], tips[max(tips)]
     c = (b - a) - ((b - a) @ u) * u
     if np.linalg.norm(c) < _MIN_REACH:  # the tips lie one behind the other
         return None
-    width = float(np.linalg.norm(c))
-    return c / width, (a + b) / 2, width
+    c /= np.linalg.norm(c)
+    reach_a = _support(plant, ctx, inspector, H, on_a, c)
+    reach_b = _support(plant, ctx, inspector, H, on_b, -c)
+    return c, (a + b) / 2, float(-reach_b - reach_a)
+
+
+def _support(plant, ctx, inspector, H, bodies, v_H) -> float:
+    """``max x·v`` over the collision geometries of ``bodies`` (frame H, m)."""
+    out = -np.inf
+    for body in bodies:
+        X_HB = plant.CalcRelativeTransform(ctx, H, body.body_frame())
+        for g in plant.GetCollisionGeometriesForBody(body):
+            X_HG = X_HB @ inspector.GetPoseInFrame(g)
+            piece = piece_of_shape(inspector.GetShape(g), X_HG, inspector.GetName(g))
+            v_G = X_HG.rotation().inverse().multiply(v_H)
+            out = max(out, float(X_HG.translation() @ v_H + piece.support(v_G)))
+    return out
 
 
 def _pinch_poses(surface, p_O, d0, across, angle, s, roll, hand: MultiFingerHand):

@@ -97,11 +97,11 @@ def test_the_closing_axis_is_laid_along_a_face_normal_of_the_box(pinch):
 
 
 def test_the_pads_close_across_the_box_where_they_fit(pinch):
-    # The box is 50 x 50 x 100 mm, the open pads' centres 93 mm apart:
-    # approached through a long side, they close across its 50 mm, never
-    # along its 100 mm.
+    # The box is 50 x 50 x 100 mm, the open pads' faces 85 mm apart (their
+    # centres 93 mm): approached through a long side, they close across its
+    # 50 mm, never along its 100 mm.
     scene, hand = pinch
-    assert hand.pinch_width == pytest.approx(0.093, abs=1e-9)
+    assert hand.pinch_width == pytest.approx(0.085, abs=1e-9)
     c, u = _axes(scene, hand, RigidTransform())
     side = np.abs(u[:, 2]) < 1e-9
     assert side.sum() > 50
