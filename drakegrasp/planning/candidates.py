@@ -12,6 +12,7 @@ num_sampled``.
 from __future__ import annotations
 
 import json
+import math
 import reprlib
 import time
 from collections.abc import Sequence
@@ -29,6 +30,7 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidGraspError
 from drakegrasp.planning.needed import needed_text
+from drakegrasp.planning.turned_gravity import GRAVITY
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import (
@@ -156,6 +158,11 @@ class GraspCandidate:
         :func:`~drakegrasp.planning.motors.torque_capacity`), for the
         candidates that got a ``torque_needed``; 0: none holds it; NaN: not
         computed.
+    object_mass : float
+        The object's mass (kg) the candidate was planned for, whose weight
+        ``squeeze_needed`` and ``torque_needed`` hold: ``plan_grasps``'
+        ``object_mass``, or the body's (NaN on a point cloud without one).
+        :func:`~drakegrasp.planning.shake.shake_test` shakes this mass.
 
     Notes
     -----
@@ -193,6 +200,7 @@ class GraspCandidate:
     torque_needed: float = float("nan")
     torque_scale: float = float("nan")
     torque_capacity: float = float("nan")
+    object_mass: float = float("nan")
 
     def __getstate__(self) -> dict:
         # ``grasp`` (a cached_property, in __dict__ once read) is rebuilt from
@@ -305,6 +313,7 @@ class GraspCandidate:
             "torque_needed": jsonable(self.torque_needed),
             "torque_scale": jsonable(self.torque_scale),
             "torque_capacity": jsonable(self.torque_capacity),
+            "object_mass": jsonable(self.object_mass),
         }
 
     def __str__(self) -> str:
@@ -358,7 +367,9 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
         ``q_hand`` or ``closing_signs`` is not ``len(joint_names)`` finite real
         numbers, or ``X_WH`` / ``X_WO`` is not a pydrake ``RigidTransform``
         with a finite translation and a proper rotation
-        (:func:`~drakegrasp.plant.validation.check_rigid_transform`).
+        (:func:`~drakegrasp.plant.validation.check_rigid_transform`), or
+        ``object_mass`` is neither NaN (none recorded) nor a number > 0 whose
+        weight is a finite float.
     """
     names = list(candidate.joint_names)
     values = {}
@@ -376,6 +387,16 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
             f"the candidate's {field_name}",
             getattr(candidate, field_name),
             error=InvalidGraspError,
+        )
+    mass = getattr(candidate, "object_mass", math.nan)  # a record made before it
+    try:
+        ok = math.isnan(mass) or (mass > 0 and math.isfinite(mass * GRAVITY))
+    except (TypeError, OverflowError):
+        ok = False
+    if isinstance(mass, bool) or not ok:
+        raise InvalidGraspError(
+            "the candidate's object_mass must be NaN (none recorded) or a mass "
+            f"> 0 kg with a finite weight, got {reprlib.repr(mass)}"
         )
     return values["q_hand"]
 

@@ -316,6 +316,22 @@ DAMPING_TIME = 0.0125
 """Default damping over stiffness, s (50 N·s/m at 4000 N/m)."""
 
 
+def _planned_mass(candidate, body) -> float | None:
+    """The mass ``candidate`` was planned for, or None: the model's (kg).
+
+    None where it records none (NaN: a point cloud without ``object_mass``),
+    or where it is the model's (to a relative 1e-12: the planner recorded the
+    body's mass through its weight ``m g``).
+    """
+    planned = float(getattr(candidate, "object_mass", math.nan))
+    model = body.default_mass()
+    if not (math.isfinite(planned) and planned > 0):
+        return None
+    if model > 0 and abs(planned - model) <= 1e-12 * model:
+        return None
+    return planned
+
+
 def _object_inertia(body, object_mass, candidate):
     """``(mass, p_BoBcm_B, M_BBo_B or None)``: what the shake's object weighs.
 
@@ -484,10 +500,11 @@ def shake_test(
     object_mass : float or None, optional
         The object's mass, kg (finite, > 0), that gravity pulls on and the
         simulation moves; its inertia scales with it (the same shape and
-        centre of mass, a uniform density).  None (default): the model's
-        (``add_models``' object).  Give the mass the candidate was planned
-        for when that is not the model's (``plan_grasps``' ``object_mass``):
-        the shake then tests that plan.  A massless model (a URDF link
+        centre of mass, a uniform density).  None (default): the mass the
+        candidate was planned for (``candidate.object_mass``: ``plan_grasps``'
+        ``object_mass`` or the body's), so that the shake tests that plan;
+        the model's (``add_models``' object) for a candidate that records
+        none.  A massless model (a URDF link
         without ``<inertial>``) gets the inertia of a uniform ball that holds
         it (radius ``candidate.torque_scale``) about the point the planner
         took as its centre of mass (``candidate.reference_point``).
@@ -636,6 +653,8 @@ def shake_test(
             plant, scene_graph, hand_bodies, [body], modulus=modulus
         )
     plant.Finalize()
+    if object_mass is None:
+        object_mass = _planned_mass(candidate, body)
     mass, com, inertia = _object_inertia(body, object_mass, candidate)
     schedule = _schedule(seat, settle, phase, blend, dirs)
     gravity = builder.AddSystem(_TurnedGravity(body.index(), mass, com, schedule))

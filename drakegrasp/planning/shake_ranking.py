@@ -336,10 +336,8 @@ def shake_candidates(
         revolute fingers need light gains (the Allegro hand:
         ``squeeze=0.7, stiffness=10, damping=0.1``); flat pads need
         ``hydroelastic_modulus`` (see :mod:`drakegrasp.plant.hydroelastic`).
-        ``object_mass`` defaults to the mass the candidates were planned for
-        when ``plan_grasps`` was given one (its result's
-        ``settings["object_mass"]``), else the model's: the shake tests the
-        plan's weight.
+        ``object_mass`` defaults to each candidate's own (the mass it was
+        planned for: the shake tests the plan's weight).
 
     Returns
     -------
@@ -370,13 +368,6 @@ def shake_candidates(
             "add_models must be a function add_models(plant, parser) -> (hand, "
             f"object_body), got {type(add_models).__name__}"
         )
-    planned = (
-        candidates.settings.get("object_mass")
-        if isinstance(candidates, GraspCandidates)
-        else None
-    )
-    if planned is not None and "object_mass" not in options:
-        options = {**options, "object_mass": planned}  # the plan's weight
     settings = check_settings(top, held_from, options)
     chosen = _first_candidates(candidates, int(top))
     t0 = time.perf_counter()

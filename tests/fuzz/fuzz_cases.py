@@ -1334,6 +1334,7 @@ CANDIDATE_POOLS = {
     "closing_signs": [(1.0,), (NAN, 1.0)],
     "X_WH": [RigidTransform([NAN, 0.0, 0.0]), np.eye(4)],
     "X_WO": [RigidTransform(np.diag([2.0, 2.0, 2.0, 1.0]))],
+    "object_mass": [-1.0, 0.0, INF, 1e308, "x", None],
 }
 """Hostile fields of a planned candidate (flat jaw: two closing joints)."""
 

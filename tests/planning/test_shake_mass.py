@@ -4,12 +4,14 @@
 box full of something, a mesh of water).  Before, ``shake_test`` and
 ``plan --shake --mass`` always shook the model's mass: a 20 kg box planned to
 need 217 N per finger "held" at a 20 N squeeze.  Now the mass planned for is
-the mass shaken (``object_mass``), and a massless model is refused rather
-than shaken with no weight at all.
+the mass shaken: each candidate records it (``GraspCandidate.object_mass``),
+``shake_test`` takes it by default, and a massless model whose candidate
+records none is refused rather than shaken with no weight at all.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -17,7 +19,7 @@ import numpy as np
 import pytest
 
 from drakegrasp.cli import main
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.shake_ranking import check_settings, shake_candidates
 
@@ -59,8 +61,13 @@ def light_box(tmp_path_factory):
 def test_the_plan_records_the_mass_it_was_planned_for(light_box):
     scene, result = light_box
     assert result.settings["object_mass"] == 3.0
-    assert "object_mass" not in _plan(scene).settings  # the model's: not given
-    assert json.loads(json.dumps(result.to_dict()))["settings"]["object_mass"] == 3.0
+    assert all(c.object_mass == pytest.approx(3.0, rel=1e-15) for c in result)
+    model = _plan(scene)  # the body's own
+    assert "object_mass" not in model.settings
+    assert all(c.object_mass == pytest.approx(0.3, rel=1e-15) for c in model)
+    data = json.loads(json.dumps(result.to_dict()))
+    assert data["settings"]["object_mass"] == 3.0
+    assert data["candidates"][0]["object_mass"] == pytest.approx(3.0, rel=1e-15)
 
 
 def test_the_shake_agrees_with_squeeze_needed_at_the_planned_mass(light_box):
@@ -75,11 +82,29 @@ def test_the_shake_agrees_with_squeeze_needed_at_the_planned_mass(light_box):
         shake_candidates(scene.add_models, result, top=1, squeeze=f * needed, **SHAKE)
         for f in (0.5, 1.6)
     )
-    assert weak[0].result.object_mass == strong[0].result.object_mass == 3.0
+    assert weak[0].result.object_mass == pytest.approx(3.0, rel=1e-15)
+    assert strong[0].result.object_mass == pytest.approx(3.0, rel=1e-15)
     assert not weak[0].held and strong[0].held, (weak[0], strong[0])
     assert "object 3 kg; squeeze" in str(weak)
-    model = shake_test(scene.add_models, best, squeeze=0.5 * needed, **SHAKE)
-    assert model.object_mass == pytest.approx(0.3) and model.held_from_seat
+    one = shake_test(scene.add_models, best, squeeze=0.5 * needed, **SHAKE)
+    assert one.object_mass == pytest.approx(3.0, rel=1e-15) and not one.held_from_seat
+    model = shake_test(
+        scene.add_models, best, squeeze=0.5 * needed, object_mass=0.3, **SHAKE
+    )
+    assert model.object_mass == 0.3 and model.held_from_seat
+
+
+def test_candidates_sliced_or_filtered_keep_their_mass(light_box):
+    # each candidate records the mass it was planned for: a slice or a list
+    # of them is shaken at 3 kg, as the whole result is
+    scene, result = light_box
+    squeeze = 0.5 * result[0].squeeze_needed
+    for chosen in (result[:1], [c for c in result if c.is_closure][:1]):
+        shaken = shake_candidates(
+            scene.add_models, chosen, top=1, squeeze=squeeze, **SHAKE
+        )
+        assert shaken[0].result.object_mass == pytest.approx(3.0, rel=1e-15)
+        assert not shaken[0].held
 
 
 def test_an_explicit_mass_overrides_the_planned_one(light_box):
@@ -95,12 +120,27 @@ def test_an_explicit_mass_overrides_the_planned_one(light_box):
 def test_a_massless_model_is_shaken_only_with_a_mass(tmp_path):
     scene = planning_scene(_box(tmp_path / "massless.sdf", 0.0), hand_url=FLAT)
     result = _plan(scene, object_mass=0.3)
+    unknown = dataclasses.replace(result[0], object_mass=math.nan)  # none recorded
     with pytest.raises(ModelError, match=r"mass 0 kg in the model.*object_mass="):
-        shake_test(scene.add_models, result[0], **SHAKE)
-    shaken = shake_candidates(
-        scene.add_models, result, top=1, squeeze=2 * result[0].squeeze_needed, **SHAKE
-    )
-    assert shaken[0].result.object_mass == 0.3 and shaken[0].held, shaken[0]
+        shake_test(scene.add_models, unknown, **SHAKE)
+    squeeze = 2 * result[0].squeeze_needed
+    for shaken in (
+        shake_test(
+            scene.add_models, unknown, squeeze=squeeze, object_mass=0.3, **SHAKE
+        ),
+        shake_candidates(scene.add_models, result[:1], top=1, squeeze=squeeze, **SHAKE)[
+            0
+        ].result,
+    ):
+        assert shaken.object_mass == pytest.approx(0.3, rel=1e-15) and shaken.held
+
+
+@pytest.mark.parametrize("mass", [0.0, -1.0, math.inf, 1e308, "3", True, None])
+def test_a_candidate_with_a_bad_mass_is_refused(light_box, mass):
+    scene, result = light_box
+    bad = dataclasses.replace(result[0], object_mass=mass)
+    with pytest.raises(InvalidGraspError, match="object_mass"):
+        shake_test(scene.add_models, bad, **SHAKE)
 
 
 @pytest.mark.parametrize(
@@ -115,7 +155,34 @@ def test_plan_shake_shakes_the_mass_given_with_mass(capsys):
     argv = ["plan", "--num", "40", "--top", "1", "--shake", "1", "--json"]
     assert main([*argv, "--mass", "20"]) == 0
     shaken = json.loads(capsys.readouterr().out)["shaken"]
-    assert shaken["options"]["object_mass"] == 20.0
     result = shaken["shaken"][0]["result"]
     # the box planned for 20 kg needs about 217 N per finger; 20 N drops it
-    assert result["object_mass"] == 20.0 and not shaken["shaken"][0]["held"]
+    assert result["object_mass"] == pytest.approx(20.0, rel=1e-15)
+    assert not shaken["shaken"][0]["held"]
+
+
+def test_a_massless_models_ball_sits_at_the_planners_centre_of_mass(tmp_path):
+    # The ball's centre of mass is the candidate's reference point (frame O),
+    # not O's origin; its inertia about that point is 2/5 m r², r the
+    # candidate's torque scale.
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    from drakegrasp.planning.shake import _object_inertia
+
+    plant = MultibodyPlant(0.0)
+    Parser(plant).AddModels(_box(tmp_path / "massless.sdf", 0.0))
+    plant.Finalize()
+    body = plant.GetBodyByName("body")
+    scene = planning_scene(str(tmp_path / "massless.sdf"), hand_url=FLAT)
+    candidate = _plan(scene, object_mass=0.3)[0]
+    moved = dataclasses.replace(
+        candidate, reference_point=np.array([0.02, -0.01, 0.03])
+    )
+    mass, com, M = _object_inertia(body, 0.3, moved)
+    np.testing.assert_allclose(com, moved.reference_point)
+    np.testing.assert_allclose(M.get_com(), moved.reference_point)
+    r = moved.torque_scale
+    central = M.Shift(moved.reference_point).CopyToFullMatrix6()[:3, :3]
+    np.testing.assert_allclose(central, 0.4 * 0.3 * r**2 * np.eye(3), rtol=1e-12)
+    assert mass == M.get_mass() == 0.3
