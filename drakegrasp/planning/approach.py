@@ -463,8 +463,10 @@ def multi_finger_hand(
 def _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u):
     """``(c_H, mid_H, width)`` of a hand whose chains move on two sides, else None.
 
-    Each side's tip is the tip centre (at the pre-shape ``q0``) of its chain
-    that reaches furthest along ``u`` (a pad, not the bar beside it);
+    Each side's tip is the centre of the box about its chains' tip
+    geometries (at the pre-shape ``q0``, frame H: a mesh's frame may lie
+    anywhere), of those of its chains that reach furthest along ``u``, to a
+    millimetre (a pad, not the bar beside it);
     ``c_H`` the unit line from the first side's tip to the second's with its
     part along ``u`` removed, ``mid_H`` their midpoint, ``width`` the gap
     between the two tips' collision geometries along ``c_H`` (m: the
@@ -476,15 +478,23 @@ def _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u):
     sides = chain_sides(ctx, structure, chains)
     if len(set(sides)) != 2:
         return None
-    tips = {}
+    found: dict[int, list] = {}
     for side, bodies in zip(sides, finger_tips, strict=True):
-        if not bodies:
-            continue
-        tip = np.mean(_centres(plant, ctx, inspector, H, bodies), axis=0)
-        if side not in tips or tip @ u > tips[side][0] @ u:
-            tips[side] = (tip, bodies)
-    if len(tips) != 2:
+        if bodies:
+            reach = _support(plant, ctx, inspector, H, bodies, u)
+            found.setdefault(side, []).append((reach, bodies))
+    if len(found) != 2:
         return None
+    tips = {}
+    for side, entries in found.items():
+        furthest = max(r for r, _ in entries)
+        bodies = [b for r, on in entries if r >= furthest - _MIN_REACH for b in on]
+        centre = [
+            _support(plant, ctx, inspector, H, bodies, e)
+            - _support(plant, ctx, inspector, H, bodies, -e)
+            for e in np.eye(3)
+        ]
+        tips[side] = (np.array(centre) / 2, bodies)
     (a, on_a), (b, on_b) = tips[min(tips)], tips[max(tips)]
     c = (b - a) - ((b - a) @ u) * u
     if np.linalg.norm(c) < _MIN_REACH:  # the tips lie one behind the other

@@ -43,6 +43,7 @@ from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
     "CENTRING_STEPS",
+    "SIDE_TOLERANCE",
     "CentredCloser",
     "chain_groups",
     "chain_sides",
@@ -123,7 +124,7 @@ def chains_to_centre(groups: Sequence[int], touched: set[int]) -> list[int]:
 
 
 def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
-    """A side per chain: the chains of one closing group that move alike share one.
+    """A side per chain: a bar beside a finger, turning with it, shares its side.
 
     Parameters
     ----------
@@ -139,11 +140,15 @@ def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
     list of int
         One label per chain, numbered from 0 in the chains' order.  Two chains
         share one when they are of one closing group and their root joints
-        (the joints of the chain that no other joint of it carries) are of
-        one kind and move alike as the group closes: the same world axis
-        times the same rate (``<mimic>`` multiplier), to 1e-9 of the larger.
-        A bar of a four-bar finger shares its finger's; opposed fingers,
-        whose joints turn the other way, do not.
+        (the joints of the chain that no other joint of it carries) are
+        revolute, turn alike as the group closes (the same world axis times
+        the same ``<mimic>`` rate, to :data:`SIDE_TOLERANCE` of the larger:
+        exported URDFs round an axis or an angle differently from joint to
+        joint) and lie apart across their axis more than along it: a bar of
+        a four-bar finger, in the finger's plane of motion.  Two fingers side
+        by side on one hinge line, opposed fingers (their joints turn the
+        other way), prismatic ones and other kinds each have a side of their
+        own.
     """
     groups = chain_groups(structure, chains)
     rate = structure.coupling.tangent(np.ones(len(structure.joints)))
@@ -151,15 +156,12 @@ def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
     for chain in chains:
         k = _root(structure, chain)
         joint = structure.joints[k]
-        if joint.type_name() == "revolute":
-            axis = joint.revolute_axis()
-        elif joint.type_name() == "prismatic":
-            axis = joint.translation_axis()
-        else:  # another kind: a side of its own
+        if joint.type_name() != "revolute":  # a side of its own
             motions.append(None)
             continue
-        R_WF = joint.frame_on_parent().CalcRotationMatrixInWorld(plant_context)
-        motions.append((joint.type_name(), rate[k] * (R_WF.matrix() @ axis)))
+        X_WF = joint.frame_on_parent().CalcPoseInWorld(plant_context)
+        w = X_WF.rotation().matrix() @ joint.revolute_axis()
+        motions.append((rate[k] * w, X_WF.translation()))
     sides: list[int] = []
     for c, motion in enumerate(motions):
         twin = next(
@@ -169,13 +171,17 @@ def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
                 if groups[d] == groups[c]
                 and motion is not None
                 and motions[d] is not None
-                and motions[d][0] == motion[0]
-                and _alike(motions[d][1], motion[1])
+                and _beside(motions[d], motion)
             ),
             None,
         )
         sides.append(max(sides, default=-1) + 1 if twin is None else twin)
     return sides
+
+
+SIDE_TOLERANCE = 1e-4
+"""Relative difference below which two root joints turn alike
+(:func:`chain_sides`): 1e-4 rad between axes, a rate 1e-4 apart."""
 
 
 def _root(structure, chain) -> int:
@@ -187,9 +193,16 @@ def _root(structure, chain) -> int:
     return chain.joints[0]
 
 
-def _alike(a: np.ndarray, b: np.ndarray) -> bool:
-    scale = max(float(np.linalg.norm(a)), float(np.linalg.norm(b)))
-    return scale > 0 and float(np.linalg.norm(a - b)) <= 1e-9 * scale
+def _beside(a, b) -> bool:
+    """Whether two root joints ``(ω, origin)`` turn alike, apart in their plane."""
+    (w_a, o_a), (w_b, o_b) = a, b
+    scale = max(float(np.linalg.norm(w_a)), float(np.linalg.norm(w_b)))
+    if not scale > 0 or np.linalg.norm(w_a - w_b) > SIDE_TOLERANCE * scale:
+        return False
+    axis = w_a / np.linalg.norm(w_a)
+    v = o_b - o_a
+    along = abs(float(v @ axis))
+    return float(np.linalg.norm(v - (v @ axis) * axis)) > along
 
 
 def facing_chains(psi, sides: Sequence[int]) -> list[int]:

@@ -456,6 +456,17 @@ def test_a_bar_shares_its_pads_side_and_opposed_fingers_do_not(barred, pinch, tm
     X = RigidTransform(RollPitchYaw(0.4, -1.1, 2.0), [0.3, -1.0, 2.0])
     assert _sides(*barred, X) == sides
     assert sorted(_sides(*pinch).values()) == [0, 1]
+    # an exported URDF's hinge a few 1e-8 rad off its twin's: still a bar
+    text = one_motor_pinch_urdf(bars=True).replace(
+        '<origin xyz="0.05 0 0.06"/>', '<origin xyz="0.05 0 0.06" rpy="4e-8 0 0"/>'
+    )
+    rounded = tmp_path / "rounded.urdf"
+    rounded.write_text(text)
+    scene = planning_scene(BOX, hand_url=str(rounded))
+    assert _sides(scene, multi_finger_hand(
+        scene.plant, scene.plant.GetMyContextFromRoot(scene.context),
+        scene.object_body, scene.hand,
+    )) == sides  # fmt: skip
     # the spread hand: f1, f2 on one spread motor turning opposite ways; f3
     path = tmp_path / "spread_hand.urdf"
     path.write_text(spread_hand_urdf())

@@ -51,15 +51,59 @@ def test_a_pinch_knows_its_closing_axis(pinch):
     np.testing.assert_allclose(np.abs(c_H), [1.0, 0.0, 0.0], atol=1e-9)
     mid_H = hand.X_HK.translation() + hand.pinch_reach * hand.X_HK.rotation().col(0)
     np.testing.assert_allclose(mid_H, [0.0, 0.0, 0.13], atol=1e-9)
-    assert set(hand.to_dict()) >= {"closing_axis_K", "pinch_reach"}
+    assert set(hand.to_dict()) >= {"closing_axis_K", "pinch_reach", "pinch_width"}
+
+
+def _side_by_side_urdf() -> str:
+    """Two fingers side by side on one hinge line and one opposed, one motor.
+
+    f1 and f2 hinge about y at x = -50 mm, y = ±20 mm (coaxial: they turn
+    alike, but lie apart along their axis, not in its plane); f3 at x = +50
+    mm turns the other way (``<mimic>`` -1).  Only f1's hinge has a motor.
+    """
+    text = one_motor_pinch_urdf()
+    head, tail = text.split("<transmission", 1)
+    link = (
+        '<link name="{0}"><inertial><origin xyz="0 0 0.03"/><mass value="0.05"/>'
+        '<inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/>'
+        '</inertial><collision><origin xyz="0 0 0.03"/><geometry><box size='
+        '"0.012 0.012 0.06"/></geometry></collision></link>'
+    )
+    joint = (
+        '<joint name="{0}_joint" type="revolute"><parent link="palm"/><child '
+        'link="{0}"/><origin xyz="{1}"/><axis xyz="0 1 0"/><limit lower="{2}" '
+        'upper="{3}" effort="5" velocity="2"/>{4}</joint>'
+    )
+    mimic = '<mimic joint="f1_joint" multiplier="{0}" offset="0"/>'
+    body = "".join(
+        link.format(f) + joint.format(f, at, lo, hi, m)
+        for f, at, lo, hi, m in (
+            ("f1", "-0.05 0.02 0.06", 0, 0.8, ""),
+            ("f2", "-0.05 -0.02 0.06", 0, 0.8, mimic.format(1)),
+            ("f3", "0.05 0 0.06", -0.8, 0, mimic.format(-1)),
+        )
+    )
+    palm = head[: head.index('<link name="left_knuckle"')]
+    return (
+        palm + body + '<transmission name="t"><type>transmission_interface/'
+        'SimpleTransmission</type><joint name="f1_joint"/><actuator name="m">'
+        "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
+        "</robot>"
+    )
 
 
 def test_other_hands_have_no_closing_axis(tmp_path):
+    # not pinches: a three-finger hand, the spread hand, and two fingers side
+    # by side on one hinge line facing a third (they turn alike but lie apart
+    # along their axis: not a bar and its finger)
     path = tmp_path / "spread.urdf"
     path.write_text(spread_hand_urdf())
+    beside = tmp_path / "side_by_side.urdf"
+    beside.write_text(_side_by_side_urdf())
     for scene in (
         planning_scene(BOX, hand_url=THREE),
         planning_scene(BOX, hand_url=str(path)),
+        planning_scene(BOX, hand_url=str(beside)),
     ):
         hand = _hand(scene)
         assert hand.closing_axis is None and np.isnan(hand.pinch_reach)
@@ -121,15 +165,27 @@ def test_a_tilted_approach_turns_about_the_closing_axis(pinch):
     assert tilted.max() <= 20.0 + 1e-6 and tilted.max() > 10.0
 
 
-def test_the_roll_moves_with_the_object(pinch):
-    # drawn in the object's frame: a rigid motion of the scene moves every
-    # pose with it
-    scene, hand = pinch
+def test_a_pinch_plan_moves_with_the_object(tmp_path):
+    # the whole plan (the hand learnt, sampled, closed and centred in the
+    # world) in a scene moved rigidly: the same candidates in the object's
+    # frame
+    path = tmp_path / "barred.urdf"
+    path.write_text(one_motor_pinch_urdf(bars=True))
     X = RigidTransform(RollPitchYaw(0.3, -1.2, 2.5), [0.4, -0.2, 1.0])
-    c0, u0 = _axes(scene, hand, RigidTransform())
-    c1, u1 = _axes(scene, hand, X)
-    np.testing.assert_allclose(c1, c0, atol=1e-9)
-    np.testing.assert_allclose(u1, u0, atol=1e-9)
+    plans = []
+    for X_WO in (RigidTransform(), X):
+        scene = planning_scene(BOX, hand_url=str(path), X_WO=X_WO)
+        result = plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=40, mu=0.5, seed=0, robustness_samples=4,
+        )  # fmt: skip
+        plans.append(
+            [(c.sample, X_WO.inverse() @ c.X_WH, c.is_closure) for c in result]
+        )
+    assert len(plans[0]) >= 5 and [p[0] for p in plans[0]] == [p[0] for p in plans[1]]
+    for (_, X0, f0), (_, X1, f1) in zip(*plans, strict=True):
+        assert f0 == f1
+        np.testing.assert_allclose(X1.GetAsMatrix4(), X0.GetAsMatrix4(), atol=1e-7)
 
 
 def test_a_pinch_plans_force_closure_on_a_box_that_holds_in_drake(pinch):
