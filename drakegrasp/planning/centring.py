@@ -32,6 +32,7 @@ chain whose gap cannot be measured (no collision geometry) is left out.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 
@@ -138,10 +139,11 @@ def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
     Returns
     -------
     list of int
-        One label per chain, numbered from 0 in the chains' order.  Two chains
-        share one when they are of one closing group and their root joints
-        (the joints of the chain that no other joint of it carries) are
-        revolute, turn alike as the group closes (the same world axis times
+        One label per chain, numbered from 0 in the chains' order.  Two
+        chains share one when they are joined through chains each beside the
+        next: one is beside another when they are of one closing group and
+        their root joints (the joints of the chain that no other joint of it
+        carries) are revolute, turn alike as the group closes (the same world axis times
         the same ``<mimic>`` rate, to :data:`SIDE_TOLERANCE` of the larger:
         exported URDFs round an axis or an angle differently from joint to
         joint) and lie apart across their axis more than along it: a bar of
@@ -162,21 +164,25 @@ def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
         X_WF = joint.frame_on_parent().CalcPoseInWorld(plant_context)
         w = X_WF.rotation().matrix() @ joint.revolute_axis()
         motions.append((rate[k] * w, X_WF.translation()))
-    sides: list[int] = []
-    for c, motion in enumerate(motions):
-        twin = next(
-            (
-                sides[d]
-                for d in range(c)
-                if groups[d] == groups[c]
-                and motion is not None
-                and motions[d] is not None
-                and _beside(motions[d], motion)
-            ),
-            None,
-        )
-        sides.append(max(sides, default=-1) + 1 if twin is None else twin)
-    return sides
+    # the sides: the chains joined through pairs that lie beside each other
+    # (transitively, so that the partition does not depend on their order)
+    side = list(range(len(chains)))
+
+    def find(c: int) -> int:
+        while side[c] != c:
+            c = side[c]
+        return c
+
+    for c, d in itertools.combinations(range(len(chains)), 2):
+        if (
+            groups[c] == groups[d]
+            and motions[c] is not None
+            and motions[d] is not None
+            and _beside(motions[c], motions[d])
+        ):
+            side[find(d)] = find(c)
+    labels: dict[int, int] = {}
+    return [labels.setdefault(find(c), len(labels)) for c in range(len(chains))]
 
 
 SIDE_TOLERANCE = 1e-4
@@ -333,8 +339,9 @@ def _integers(name: str, values, n: int) -> np.ndarray:
     """``values`` as ``n`` integers, one per gap, else a refusal naming ``name``."""
     g = np.asarray(values)
     if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
-        raise InvalidOptionError(
-            f"{name} must be {n} integers, one per gap, got {values!r}"
+        raise InvalidOptionError(  # one line: no array's repr
+            f"{name} must be {n} integers, one per gap, got {g.dtype} values "
+            f"of shape {g.shape}"
         )
     return g
 

@@ -120,6 +120,19 @@ REASONS = {
 """Every rejection reason, with what it means."""
 
 
+def _mass_of(ctx, body, object_mass) -> float:
+    """The mass planned for (kg): ``object_mass``, else the body's; NaN for none.
+
+    A massless body (a URDF link without ``<inertial>``) has no weight to
+    hold: its ``squeeze_needed`` and ``torque_needed`` are not computed (NaN,
+    as on a point cloud without ``object_mass``), not 0.
+    """
+    if object_mass is not None:
+        return float(object_mass)
+    mass = body.get_mass(ctx)
+    return mass if mass > 0 else float("nan")
+
+
 def object_surface(plant, plant_context, object_body) -> ObjectSurface:
     """The object's collision geometry as convex pieces in its body frame O."""
     ctx = plant_context_of(plant, plant_context)
@@ -302,7 +315,8 @@ def plan_grasps(
     object_mass : float, optional
         The object's mass (kg) for ``squeeze_needed`` and (multi-finger hands)
         ``torque_needed`` and the ranking by it; default the body's mass (a
-        cloud has none: NaN, and neither is computed).  Finite and > 0, with
+        cloud has none, nor has a massless body: NaN, and neither is
+        computed).  Finite and > 0, with
         a finite weight ``m g``, else ``InvalidOptionError``.  A figure it
         makes that exceeds the largest float (``--mass 1.7e307``: 1.67e308 N
         over a capacity below 1) is ``inf`` beside a capacity > 0, and said
@@ -439,7 +453,7 @@ def plan_grasps(
         body = _graspable(plant, object_body, hand)
         if not hand_is_parallel_jaw(plant, ctx, body, hand):
             _jaw_only(squeeze_limit)
-            mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
+            mass = _mass_of(ctx, body, object_mass)
             return plan_multifinger(
                 plant, ctx, body, hand=hand, n=n, mu=mu,
                 rng=np.random.default_rng(seed),
@@ -453,7 +467,7 @@ def plan_grasps(
         X_WO = plant.EvalBodyPoseInWorld(ctx, body)
         reference = centre_of_mass(ctx, body, surface)
         name = scoped_name(plant, body)
-        mass = body.get_mass(ctx) if object_mass is None else float(object_mass)
+        mass = _mass_of(ctx, body, object_mass)
     else:
         body = None
         # a hand that cannot be placed is refused before the cloud is read

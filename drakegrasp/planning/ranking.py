@@ -533,7 +533,7 @@ def ranked_candidates(
             score=float(scores["score"][i]),
             weight_capacity=float(alpha),
             squeeze_needed=needed_for(weight, alpha),
-            object_mass=weight / GRAVITY,
+            object_mass=weight / GRAVITY if weight > 0 else float("nan"),
         )
         if place < certify:
             candidate = replace(candidate, closure=force_closure(candidate.grasp))

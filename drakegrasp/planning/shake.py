@@ -83,6 +83,7 @@ from drakegrasp.plant.validation import (
 
 __all__ = [
     "DAMPING_TIME",
+    "MIN_SHAKEN_MASS",
     "PRISMATIC_STIFFNESS",
     "REVOLUTE_AIM",
     "SoftFingerShakeWarning",
@@ -267,11 +268,8 @@ def check_shake_options(
             raise InvalidOptionError(
                 f"{name} must be a finite number {relation} ({unit}), got {value!r}"
             )
-    if object_mass is not None and not math.isfinite(float(object_mass) * GRAVITY):
-        raise InvalidOptionError(
-            f"object_mass = {object_mass:g} kg weighs more than a float holds "
-            "(its weight m g is infinite)"
-        )
+    if object_mass is not None:
+        _check_mass("object_mass", float(object_mass))
     if time_step > phase / 10:
         raise InvalidOptionError(
             f"time_step must be at most a tenth of a phase ({phase / 10:g} s) to "
@@ -297,6 +295,27 @@ def check_shake_options(
     # Only their directions count, whatever their length (no overflow).
     dirs = unit_vectors("directions", dirs, error=InvalidOptionError)
     return dirs
+
+
+MIN_SHAKEN_MASS = 1e-6
+"""The lightest object (kg) the shake test simulates: a milligram.  Drake's
+contact solver stopped on objects of 1e-12 kg against a gripper's gains (the
+fuzz suite); no hand grasps anything that light."""
+
+
+def _check_mass(name: str, mass: float) -> None:
+    """Refuse a mass (kg) the shake cannot simulate, naming ``name``."""
+    if not math.isfinite(mass * GRAVITY):
+        raise InvalidOptionError(
+            f"{name} = {mass:g} kg weighs more than a float holds (its weight "
+            "m g is infinite)"
+        )
+    if mass < MIN_SHAKEN_MASS:
+        raise InvalidOptionError(
+            f"{name} = {mass:g} kg is lighter than the shake test simulates "
+            f"({MIN_SHAKEN_MASS:g} kg, a milligram): Drake's contact solver "
+            "cannot hold so light an object against the fingers"
+        )
 
 
 _MIN_AIM = 1e-9
@@ -364,7 +383,17 @@ def _object_inertia(body, object_mass, candidate):
                 "candidate no torque_scale to give it an inertia of (a candidate "
                 "from plan_grasps has one): give the model its mass and inertia"
             )
-        unit = UnitInertia.SolidSphere(radius).ShiftFromCenterOfMass(-com)
+        try:
+            unit = UnitInertia.SolidSphere(radius).ShiftFromCenterOfMass(-com)
+            return mass, com, SpatialInertia(mass, com, unit)
+        except RuntimeError as e:  # not a physical inertia (it overflowed)
+            raise ModelError(
+                f"the object {body.name()} has no mass in the model, and the "
+                f"candidate's torque_scale {radius:g} m and reference_point "
+                f"{np.round(com, 6).tolist()} give no valid inertia (Drake: "
+                f"{str(e).splitlines()[0][:120]}): give the model its mass and "
+                "inertia"
+            ) from None
     return mass, com, SpatialInertia(mass, com, unit)
 
 
@@ -498,7 +527,8 @@ def shake_test(
         does on a real object (:mod:`drakegrasp.plant.hydroelastic`; 1e6 suits
         rubber pads).
     object_mass : float or None, optional
-        The object's mass, kg (finite, > 0), that gravity pulls on and the
+        The object's mass, kg (finite, at least :data:`MIN_SHAKEN_MASS`, with
+        a finite weight), that gravity pulls on and the
         simulation moves; its inertia scales with it (the same shape and
         centre of mass, a uniform density).  None (default): the mass the
         candidate was planned for (``candidate.object_mass``: ``plan_grasps``'
@@ -655,6 +685,8 @@ def shake_test(
     plant.Finalize()
     if object_mass is None:
         object_mass = _planned_mass(candidate, body)
+        if object_mass is not None:
+            _check_mass("the candidate's object_mass", object_mass)
     mass, com, inertia = _object_inertia(body, object_mass, candidate)
     schedule = _schedule(seat, settle, phase, blend, dirs)
     gravity = builder.AddSystem(_TurnedGravity(body.index(), mass, com, schedule))

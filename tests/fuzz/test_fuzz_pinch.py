@@ -101,7 +101,6 @@ def pinch_plans(tmp_path_factory):
     return out
 
 
-@pytest.mark.xfail(strict=True, reason="P1: a refusal of sides/groups spans lines")
 def test_p1_a_refusal_of_sides_or_groups_is_one_line(outcomes):
     from drakegrasp.planning.centring import equalising_move, facing_chains
 
@@ -119,7 +118,6 @@ def test_p1_a_refusal_of_sides_or_groups_is_one_line(outcomes):
         assert "\n" not in str(refused.value), repr(str(refused.value))
 
 
-@pytest.mark.xfail(strict=True, reason="P2: a slice of a plan shakes the model's mass")
 def test_p2_a_slice_or_list_of_a_plan_shakes_the_mass_planned_for(
     outcomes, pinch_plans
 ):
@@ -138,7 +136,6 @@ def test_p2_a_slice_or_list_of_a_plan_shakes_the_mass_planned_for(
         assert shaken[0].result.object_mass == 20.0, str(shaken).splitlines()[0]
 
 
-@pytest.mark.xfail(strict=True, reason="P3: a tiny object_mass fails inside Drake")
 def test_p3_a_tiny_object_mass_is_refused_up_front_or_shaken(outcomes, pinch_plans):
     from drakegrasp.planning import shake_test
 
@@ -164,7 +161,6 @@ def test_p3_a_tiny_object_mass_is_refused_up_front_or_shaken(outcomes, pinch_pla
             assert np.isfinite(shaken.max_displacement)
 
 
-@pytest.mark.xfail(strict=True, reason="P4: Drake's raw RuntimeError for the ball")
 def test_p4_a_massless_shake_whose_ball_overflows_is_refused(outcomes, pinch_plans):
     from drakegrasp.planning import shake_test
 
