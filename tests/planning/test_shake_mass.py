@@ -186,3 +186,15 @@ def test_a_massless_models_ball_sits_at_the_planners_centre_of_mass(tmp_path):
     central = M.Shift(moved.reference_point).CopyToFullMatrix6()[:3, :3]
     np.testing.assert_allclose(central, 0.4 * 0.3 * r**2 * np.eye(3), rtol=1e-12)
     assert mass == M.get_mass() == 0.3
+
+
+def test_a_massless_body_planned_without_a_mass_needs_no_squeeze_figure(tmp_path):
+    # Before: squeeze_needed 0 N (no weight), so any motor "held" every
+    # candidate; now not computed, as on a point cloud without object_mass.
+    scene = planning_scene(_box(tmp_path / "massless.sdf", 0.0), hand_url=FLAT)
+    result = _plan(scene)
+    assert len(result) and all(np.isnan(c.squeeze_needed) for c in result)
+    assert all(np.isnan(c.object_mass) for c in result)
+    assert result.settings.get("held_first", {}).get("held", 0) == 0  # none known
+    with pytest.raises(ModelError, match="give object_mass="):
+        shake_test(scene.add_models, result[0], **SHAKE)
