@@ -128,7 +128,12 @@ from pathlib import Path
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
-from drakegrasp.errors import GraspError, InvalidOptionError, InvalidPoseError
+from drakegrasp.errors import (
+    GraspError,
+    InvalidOptionError,
+    InvalidPoseError,
+    ModelError,
+)
 
 __all__ = ["Terminated", "build_parser", "main", "printable", "run"]
 
@@ -1382,7 +1387,11 @@ def _shaken(add_models, result, args: argparse.Namespace, options: dict):
     """``plan --shake``: the first ``args.shake`` candidates shaken in Drake."""
     from drakegrasp.planning.shake_ranking import shake_candidates
 
-    return shake_candidates(add_models, result, top=args.shake, **options)
+    try:
+        return shake_candidates(add_models, result, top=args.shake, **options)
+    except ModelError as e:  # a massless object: its object_mass= is --mass
+        text = re.sub(r"give object_mass= \(kg\)", "give --mass KG", str(e))
+        raise type(e)(text) from None
 
 
 def _shake_options(args: argparse.Namespace) -> dict | None:
@@ -1411,9 +1420,12 @@ def _shake_options(args: argparse.Namespace) -> dict | None:
     options = {**PLAN_SHAKE_DEFAULTS.get((args.hand or "flat").lower(), {}), **given}
     if options.get("hydroelastic_modulus") == "none":
         options["hydroelastic_modulus"] = None  # the models' own contact
-    flags = {"top": "--shake", **SHAKE_FLAGS}
+    flags = {"top": "--shake", "object_mass": "--mass", **SHAKE_FLAGS}
+    # --mass too: the mass planned for is the mass shaken (refused here if
+    # the shake cannot simulate it, before any planning)
+    mass = {} if args.mass is None else {"object_mass": args.mass}
     try:
-        check_settings(args.shake, "seat", options)
+        check_settings(args.shake, "seat", {**options, **mass})
     except GraspError as e:
         words = _in_flag_words(e, flags)
         # the flag's spelling of the library's None

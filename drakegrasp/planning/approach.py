@@ -130,8 +130,9 @@ class MultiFingerHand:
         front face.
     closing_axis : (3,) float or None
         A pinch's closing axis in K (unit, across the approach: from one
-        side's tip to the other's at the pre-shape, each side's tip that of
-        its chain reaching furthest along ``u``); None for another hand.
+        side's tip to the other's at the pre-shape, each side's tip the
+        centre of the box about the tip geometries of its chains that reach
+        furthest along ``u``, to a millimetre); None for another hand.
     pinch_reach : float
         Metres from K's origin along ``u`` to a pinch's tips' midpoint (NaN
         for another hand).

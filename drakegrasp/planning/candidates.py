@@ -12,7 +12,6 @@ num_sampled``.
 from __future__ import annotations
 
 import json
-import math
 import reprlib
 import time
 from collections.abc import Sequence
@@ -30,7 +29,6 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array
 from drakegrasp.errors import InvalidGraspError
 from drakegrasp.planning.needed import needed_text
-from drakegrasp.planning.turned_gravity import GRAVITY
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import (
@@ -161,7 +159,8 @@ class GraspCandidate:
     object_mass : float
         The object's mass (kg) the candidate was planned for, whose weight
         ``squeeze_needed`` and ``torque_needed`` hold: ``plan_grasps``'
-        ``object_mass``, or the body's (NaN on a point cloud without one).
+        ``object_mass``, or the body's (NaN on a point cloud without one,
+        and for a massless body).
         :func:`~drakegrasp.planning.shake.shake_test` shakes this mass.
 
     Notes
@@ -367,9 +366,7 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
         ``q_hand`` or ``closing_signs`` is not ``len(joint_names)`` finite real
         numbers, or ``X_WH`` / ``X_WO`` is not a pydrake ``RigidTransform``
         with a finite translation and a proper rotation
-        (:func:`~drakegrasp.plant.validation.check_rigid_transform`), or
-        ``object_mass`` is neither NaN (none recorded) nor a number > 0 whose
-        weight is a finite float.
+        (:func:`~drakegrasp.plant.validation.check_rigid_transform`).
     """
     names = list(candidate.joint_names)
     values = {}
@@ -387,16 +384,6 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
             f"the candidate's {field_name}",
             getattr(candidate, field_name),
             error=InvalidGraspError,
-        )
-    mass = getattr(candidate, "object_mass", math.nan)  # a record made before it
-    try:
-        ok = math.isnan(mass) or (mass > 0 and math.isfinite(mass * GRAVITY))
-    except (TypeError, OverflowError):
-        ok = False
-    if isinstance(mass, bool) or not ok:
-        raise InvalidGraspError(
-            "the candidate's object_mass must be NaN (none recorded) or a mass "
-            f"> 0 kg with a finite weight, got {reprlib.repr(mass)}"
         )
     return values["q_hand"]
 

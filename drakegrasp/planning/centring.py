@@ -44,6 +44,7 @@ from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
     "CENTRING_STEPS",
+    "PLANE_TOLERANCE",
     "SIDE_TOLERANCE",
     "CentredCloser",
     "chain_groups",
@@ -146,8 +147,9 @@ def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
         carries) are revolute, turn alike as the group closes (the same world axis times
         the same ``<mimic>`` rate, to :data:`SIDE_TOLERANCE` of the larger:
         exported URDFs round an axis or an angle differently from joint to
-        joint) and lie apart across their axis more than along it: a bar of
-        a four-bar finger, in the finger's plane of motion.  Two fingers side
+        joint) and lie in one plane of motion (their pins coincide, or lie
+        apart along the axis by at most :data:`PLANE_TOLERANCE` of their
+        distance across it): a bar of a four-bar finger.  Two fingers side
         by side on one hinge line, opposed fingers (their joints turn the
         other way), prismatic ones and other kinds each have a side of their
         own.
@@ -189,6 +191,13 @@ SIDE_TOLERANCE = 1e-4
 """Relative difference below which two root joints turn alike
 (:func:`chain_sides`): 1e-4 rad between axes, a rate 1e-4 apart."""
 
+PLANE_TOLERANCE = 0.1
+"""How far along their axis two pins turning alike may lie apart, over their
+distance across it, and still be in one plane of motion (:func:`chain_sides`:
+a bar and its finger).  Fingers side by side on one hinge line lie apart
+along it only; a bar 25 mm from its finger across the axis is not beside a
+finger 24 mm along it."""
+
 
 def _root(structure, chain) -> int:
     """The position (in ``structure.joints``) of the chain's root joint."""
@@ -200,7 +209,11 @@ def _root(structure, chain) -> int:
 
 
 def _beside(a, b) -> bool:
-    """Whether two root joints ``(ω, origin)`` turn alike, apart in their plane."""
+    """Whether two root joints ``(ω, origin)`` turn alike in one plane of motion.
+
+    Their pins may coincide; apart, they lie along the axis by at most
+    :data:`PLANE_TOLERANCE` of their distance across it.
+    """
     (w_a, o_a), (w_b, o_b) = a, b
     scale = max(float(np.linalg.norm(w_a)), float(np.linalg.norm(w_b)))
     if not scale > 0 or np.linalg.norm(w_a - w_b) > SIDE_TOLERANCE * scale:
@@ -208,7 +221,7 @@ def _beside(a, b) -> bool:
     axis = w_a / np.linalg.norm(w_a)
     v = o_b - o_a
     along = abs(float(v @ axis))
-    return float(np.linalg.norm(v - (v @ axis) * axis)) > along
+    return along <= PLANE_TOLERANCE * float(np.linalg.norm(v - (v @ axis) * axis))
 
 
 def facing_chains(psi, sides: Sequence[int]) -> list[int]:
@@ -337,7 +350,13 @@ def _checked(psi, lines, tol, groups):
 
 def _integers(name: str, values, n: int) -> np.ndarray:
     """``values`` as ``n`` integers, one per gap, else a refusal naming ``name``."""
-    g = np.asarray(values)
+    try:
+        g = np.asarray(values)
+    except (TypeError, ValueError):  # ragged
+        raise InvalidOptionError(
+            f"{name} must be {n} integers, one per gap, got a ragged "
+            f"{type(values).__name__}"
+        ) from None
     if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
         raise InvalidOptionError(  # one line: no array's repr
             f"{name} must be {n} integers, one per gap, got {g.dtype} values "

@@ -454,13 +454,13 @@ def plan_grasps(
         if not hand_is_parallel_jaw(plant, ctx, body, hand):
             _jaw_only(squeeze_limit)
             mass = _mass_of(ctx, body, object_mass)
-            return plan_multifinger(
+            return _with_mass(mass, plan_multifinger(
                 plant, ctx, body, hand=hand, n=n, mu=mu,
                 rng=np.random.default_rng(seed),
                 surface=object_surface(plant, ctx, body), settings=settings, t0=t0,
                 name=scoped_name(plant, body), certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY, **multi,
-            )  # fmt: skip
+            ))  # fmt: skip
         _multifinger_only(multi)
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
@@ -480,13 +480,13 @@ def plan_grasps(
             _jaw_only(squeeze_limit)
             mass = np.nan if object_mass is None else float(object_mass)
             settings.update(cloud_dropped=dropped)
-            return plan_multifinger_cloud(
+            return _with_mass(mass, plan_multifinger_cloud(
                 plant, ctx, hand=hand, points=points, normals=normals,
                 viewpoint=viewpoint, n=n, mu=mu, rng=np.random.default_rng(seed),
                 settings=settings, t0=t0, certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY, complete=complete_unseen,
                 **multi,
-            )  # fmt: skip
+            ))  # fmt: skip
         _multifinger_only(multi)
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface, completion = cloud_surface(points, normals, viewpoint, complete_unseen)
@@ -563,7 +563,16 @@ def plan_grasps(
         started=t0,
     )
     result = with_squeeze_limit(result, plant, top=certify, squeeze_limit=squeeze_limit)
-    return replace(result, time=time.perf_counter() - t0)
+    return replace(_with_mass(mass, result), time=time.perf_counter() - t0)
+
+
+def _with_mass(mass: float, result: GraspCandidates) -> GraspCandidates:
+    """``result`` whose candidates record the mass (kg) they were planned for."""
+    mass = float(mass)
+    return replace(
+        result,
+        candidates=tuple(replace(c, object_mass=mass) for c in result.candidates),
+    )
 
 
 def _graspable(plant, object_body, hand) -> RigidBody:

@@ -79,7 +79,6 @@ from drakegrasp.planning.checks import (
 )
 from drakegrasp.planning.needed import needed_for
 from drakegrasp.planning.reclose import perturbed_mu, reclosed_robustness
-from drakegrasp.planning.turned_gravity import GRAVITY
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.validation import scoped_name
 
@@ -533,7 +532,6 @@ def ranked_candidates(
             score=float(scores["score"][i]),
             weight_capacity=float(alpha),
             squeeze_needed=needed_for(weight, alpha),
-            object_mass=weight / GRAVITY if weight > 0 else float("nan"),
         )
         if place < certify:
             candidate = replace(candidate, closure=force_closure(candidate.grasp))

@@ -45,6 +45,7 @@ weld and actuators, and the grasp is what is tested.
 from __future__ import annotations
 
 import math
+import reprlib
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -60,7 +61,13 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.core.validation import unit_vectors
-from drakegrasp.errors import GraspError, InvalidOptionError, ModelError, SolverError
+from drakegrasp.errors import (
+    GraspError,
+    InvalidGraspError,
+    InvalidOptionError,
+    ModelError,
+    SolverError,
+)
 from drakegrasp.planning.candidates import GraspCandidate, check_candidate
 from drakegrasp.planning.shake_result import ShakeResult, squeeze_unit_of
 from drakegrasp.planning.turned_gravity import (
@@ -89,6 +96,7 @@ __all__ = [
     "SoftFingerShakeWarning",
     "SqueezeLostWarning",
     "check_shake_options",
+    "recorded_mass",
     "shake_test",
 ]
 
@@ -183,6 +191,14 @@ def _stopped(
         "as plan --shake uses); "
         "a smaller time_step also helps"
     )
+
+
+def _finite_or_nan(value) -> bool:
+    """Whether a real number is finite or NaN (an int too large for a float is not)."""
+    try:
+        return not math.isinf(float(value))
+    except OverflowError:
+        return False
 
 
 def _finite(value) -> bool:
@@ -335,18 +351,46 @@ DAMPING_TIME = 0.0125
 """Default damping over stiffness, s (50 N·s/m at 4000 N/m)."""
 
 
+def recorded_mass(candidate) -> float:
+    """The mass (kg) ``candidate`` records it was planned for, checked; NaN: none.
+
+    Raises
+    ------
+    InvalidGraspError
+        A recorded mass that is neither NaN nor a finite number of at least
+        :data:`MIN_SHAKEN_MASS` with a finite weight (a candidate edited by
+        hand).
+    """
+    raw = getattr(candidate, "object_mass", math.nan)  # a record made before it
+    if (
+        isinstance(raw, bool)
+        or not isinstance(raw, int | float | np.integer | np.floating)
+        or not _finite_or_nan(raw)
+        or raw <= 0
+    ):
+        raise InvalidGraspError(
+            "the candidate's object_mass must be NaN (none recorded) or a "
+            f"finite mass > 0 kg, got {reprlib.repr(raw)}"
+        )
+    planned = float(raw)
+    if not math.isnan(planned):
+        try:
+            _check_mass("the candidate's object_mass", planned)
+        except InvalidOptionError as e:
+            raise InvalidGraspError(str(e)) from None
+    return planned
+
+
 def _planned_mass(candidate, body) -> float | None:
     """The mass ``candidate`` was planned for, or None: the model's (kg).
 
-    None where it records none (NaN: a point cloud without ``object_mass``),
-    or where it is the model's (to a relative 1e-12: the planner recorded the
-    body's mass through its weight ``m g``).
+    None where it records none (NaN: a point cloud or a massless body planned
+    without ``object_mass``), or where it is the model's (to a relative
+    1e-12).
     """
-    planned = float(getattr(candidate, "object_mass", math.nan))
+    planned = recorded_mass(candidate)
     model = body.default_mass()
-    if not (math.isfinite(planned) and planned > 0):
-        return None
-    if model > 0 and abs(planned - model) <= 1e-12 * model:
+    if math.isnan(planned) or (model > 0 and abs(planned - model) <= 1e-12 * model):
         return None
     return planned
 
@@ -582,6 +626,7 @@ def shake_test(
     if X_WO is not None:
         candidate = replace(candidate, X_WO=check_rigid_transform("X_WO", X_WO))
     check_candidate(candidate)
+    recorded_mass(candidate)  # before anything is built
     dirs = check_shake_options(
         squeeze=squeeze, stiffness=stiffness, damping=damping,
         directions=directions, settle=settle, phase=phase, seat=seat,
@@ -685,8 +730,6 @@ def shake_test(
     plant.Finalize()
     if object_mass is None:
         object_mass = _planned_mass(candidate, body)
-        if object_mass is not None:
-            _check_mass("the candidate's object_mass", object_mass)
     mass, com, inertia = _object_inertia(body, object_mass, candidate)
     schedule = _schedule(seat, settle, phase, blend, dirs)
     gravity = builder.AddSystem(_TurnedGravity(body.index(), mass, com, schedule))

@@ -41,7 +41,7 @@ from drakegrasp.planning.candidates import (
     check_candidate,
     pose_dict,
 )
-from drakegrasp.planning.shake import check_shake_options, shake_test
+from drakegrasp.planning.shake import check_shake_options, recorded_mass, shake_test
 from drakegrasp.planning.shake_result import ShakeResult, _limits, motion_text
 from drakegrasp.plant.validation import check_rigid_transform
 
@@ -238,6 +238,7 @@ def _first_candidates(candidates, top: int) -> list[GraspCandidate]:
             )
         try:  # all of them before any is simulated: no run lost at the fifth
             check_candidate(c)
+            recorded_mass(c)
         except InvalidGraspError as e:
             raise InvalidGraspError(f"candidates[{k}]: {e}") from e
     return chosen

@@ -1438,12 +1438,13 @@ def _shake_cases(scene) -> Iterator[Case]:
     for field, values in CANDIDATE_POOLS.items():
         for i, value in enumerate(values):
             edited = replace(best, **{field: value})
-            yield Case(
-                "planning",
-                f"apply {field}={_short(value)}#{i}",
-                lambda c=edited: c.apply(scene.plant, scene.context.Clone()),
-                "refuse",
-            )
+            if field != "object_mass":  # apply puts no mass anywhere
+                yield Case(
+                    "planning",
+                    f"apply {field}={_short(value)}#{i}",
+                    lambda c=edited: c.apply(scene.plant, scene.context.Clone()),
+                    "refuse",
+                )
             yield Case(
                 "planning",
                 f"shake {field}={_short(value)}#{i}",

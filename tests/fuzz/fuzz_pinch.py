@@ -47,7 +47,8 @@ Per hand, each call in a sandboxed worker (a hang or crash is an outcome):
     pinch.  Judged against the hand's description: two chains share a side
     exactly when they are joined through root joints each beside the next
     (revolute, their written axis times their rate one vector, their origins
-    apart across the axis more than along it); the partition is the same
+    along the axis at most a tenth of their distance across it); the
+    partition is the same
     whatever the pose or order, and numbered from 0 in the chains' order.  A
     pinch is found when there are two sides with geometry and their pads are
     not one behind the other; its closing axis is across the approach, unit,
@@ -436,14 +437,15 @@ def origin(hand: dict, root: str) -> np.ndarray:
 
 
 def beside(hand: dict, a: str, b: str) -> bool:
-    """Whether two root joints share a side: revolute, turning alike, apart in
-    their plane of motion more than along their axis (a bar beside its pad)."""
+    """Whether two root joints share a side: revolute, turning alike, in one
+    plane of motion (along the axis at most a tenth of their distance across
+    it: a bar beside its pad)."""
     (kind_a, w_a), (kind_b, w_b) = motion(hand, a), motion(hand, b)
     if kind_a != "revolute" or kind_b != "revolute" or w_a != w_b:
         return False
     axis = np.asarray(w_a) / np.linalg.norm(w_a)
     v = origin(hand, b) - origin(hand, a)
-    return float(np.linalg.norm(v - (v @ axis) * axis)) > abs(float(v @ axis))
+    return abs(float(v @ axis)) <= 0.1 * float(np.linalg.norm(v - (v @ axis) * axis))
 
 
 def expected_partition(hand: dict, chain_roots: list[str]) -> list[int]:

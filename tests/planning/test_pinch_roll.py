@@ -54,12 +54,14 @@ def test_a_pinch_knows_its_closing_axis(pinch):
     assert set(hand.to_dict()) >= {"closing_axis_K", "pinch_reach", "pinch_width"}
 
 
-def _side_by_side_urdf() -> str:
+def _side_by_side_urdf(y: float = 0.02, bars: bool = False) -> str:
     """Two fingers side by side on one hinge line and one opposed, one motor.
 
-    f1 and f2 hinge about y at x = -50 mm, y = ±20 mm (coaxial: they turn
+    f1 and f2 hinge about y at x = -50 mm, y = ±``y`` (coaxial: they turn
     alike, but lie apart along their axis, not in its plane); f3 at x = +50
     mm turns the other way (``<mimic>`` -1).  Only f1's hinge has a motor.
+    ``bars``: beside f1 and f2 a bar each, 25 mm inwards in their plane,
+    turning with them.
     """
     text = one_motor_pinch_urdf()
     head, tail = text.split("<transmission", 1)
@@ -75,13 +77,18 @@ def _side_by_side_urdf() -> str:
         'upper="{3}" effort="5" velocity="2"/>{4}</joint>'
     )
     mimic = '<mimic joint="f1_joint" multiplier="{0}" offset="0"/>'
+    fingers = [
+        ("f1", f"-0.05 {y} 0.06", 0, 0.8, ""),
+        ("f2", f"-0.05 {-y} 0.06", 0, 0.8, mimic.format(1)),
+        ("f3", "0.05 0 0.06", -0.8, 0, mimic.format(-1)),
+    ]
+    if bars:
+        fingers += [
+            ("b1", f"-0.025 {y} 0.06", 0, 0.8, mimic.format(1)),
+            ("b2", f"-0.025 {-y} 0.06", 0, 0.8, mimic.format(1)),
+        ]
     body = "".join(
-        link.format(f) + joint.format(f, at, lo, hi, m)
-        for f, at, lo, hi, m in (
-            ("f1", "-0.05 0.02 0.06", 0, 0.8, ""),
-            ("f2", "-0.05 -0.02 0.06", 0, 0.8, mimic.format(1)),
-            ("f3", "0.05 0 0.06", -0.8, 0, mimic.format(-1)),
-        )
+        link.format(f) + joint.format(f, at, lo, hi, m) for f, at, lo, hi, m in fingers
     )
     palm = head[: head.index('<link name="left_knuckle"')]
     return (
@@ -100,14 +107,41 @@ def test_other_hands_have_no_closing_axis(tmp_path):
     path.write_text(spread_hand_urdf())
     beside = tmp_path / "side_by_side.urdf"
     beside.write_text(_side_by_side_urdf())
+    # with a bar beside each of them (a bar 25 mm across its finger's axis
+    # is not beside the other finger, 24 mm along it)
+    barred = tmp_path / "side_by_side_bars.urdf"
+    barred.write_text(_side_by_side_urdf(y=0.012, bars=True))
     for scene in (
         planning_scene(BOX, hand_url=THREE),
         planning_scene(BOX, hand_url=str(path)),
         planning_scene(BOX, hand_url=str(beside)),
+        planning_scene(BOX, hand_url=str(barred)),
     ):
         hand = _hand(scene)
         assert hand.closing_axis is None and np.isnan(hand.pinch_reach)
         assert "closing_axis_K" not in hand.to_dict()
+
+
+def test_bars_on_their_fingers_pins_share_their_sides(tmp_path):
+    # the inner knuckles hinged on the knuckles' own pins: they turn as the
+    # knuckles do about one line, a side each with them (before: every chain
+    # a side, not a pinch, and no candidate)
+    text = one_motor_pinch_urdf(bars=True)
+    for bar, pin in (
+        ("-0.05 0 0.06", "-0.055 0 0.06"),
+        ("0.05 0 0.06", "0.055 0 0.06"),
+    ):
+        assert text.count(f'<origin xyz="{bar}"/>') == 1
+        text = text.replace(f'<origin xyz="{bar}"/>', f'<origin xyz="{pin}"/>')
+    path = tmp_path / "pinned.urdf"
+    path.write_text(text)
+    scene = planning_scene(BOX, hand_url=str(path))
+    assert _hand(scene).closing_axis is not None
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=60, mu=0.5, seed=0, robustness_samples=4,
+    )  # fmt: skip
+    assert len(result) >= 5 and sum(c.is_closure for c in result) >= 5
 
 
 def _axes(scene, hand, X_WO, n=200, seed=0, tilt=0.0):
