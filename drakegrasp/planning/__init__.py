@@ -28,7 +28,11 @@ _SOURCES = {
     "drakegrasp.planning.gripper": ("ParallelJaw", "parallel_jaw"),
     "drakegrasp.planning.multifinger": ("hand_is_parallel_jaw",),
     "drakegrasp.planning.planner": ("REASONS", "object_surface", "plan_grasps"),
-    "drakegrasp.planning.scenes": ("PlanningScene", "planning_scene"),
+    "drakegrasp.planning.scenes": (
+        "PlanningScene",
+        "planning_scene",
+        "scene_from_models",
+    ),
     "drakegrasp.planning.shake": ("shake_test",),
     "drakegrasp.planning.shake_result": ("ShakeResult",),
     "drakegrasp.planning.shake_ranking": ("ShakenCandidates", "shake_candidates"),
@@ -75,6 +79,7 @@ __all__ = [
     "parallel_jaw",
     "plan_grasps",
     "planning_scene",
+    "scene_from_models",
     "shake_candidates",
     "shake_test",
 ]

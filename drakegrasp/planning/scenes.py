@@ -28,7 +28,7 @@ from drakegrasp.plant.models import (
 )
 from drakegrasp.plant.validation import check_rigid_transform
 
-__all__ = ["WSG_URL", "PlanningScene", "planning_scene"]
+__all__ = ["WSG_URL", "PlanningScene", "planning_scene", "scene_from_models"]
 
 WSG_URL = "package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.sdf"
 """Drake's Schunk WSG-50 with its four tip spheres per finger."""
@@ -124,6 +124,26 @@ def planning_scene(
         plant.SetDefaultFloatingBaseBodyPose(body, X_WO)
         return hand, f"{plant.GetModelInstanceName(obj)}::{body.name()}"
 
+    return scene_from_models(add_models)
+
+
+def scene_from_models(add_models) -> PlanningScene:
+    """A planning scene built by a recipe of one's own (time step 0).
+
+    Parameters
+    ----------
+    add_models : callable
+        ``add_models(plant, parser) -> (hand, object body)``: adds the hand
+        (its base left free) and the object to a fresh plant, and returns
+        the hand's model instance and the object body's scoped name
+        ``model::body`` (None: a hand alone, for a point cloud).  The shake
+        test builds its plants with it too.
+
+    Returns
+    -------
+    PlanningScene
+        The finalized plant in its diagram, a default context and the recipe.
+    """
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     hand, name = add_models(plant, Parser(plant))

@@ -23,6 +23,8 @@ seeds), so the counts are reproducible.
 
 from __future__ import annotations
 
+import collections
+import contextlib
 import hashlib
 import itertools
 import math
@@ -101,6 +103,68 @@ def print_bad(bad, *, details: bool = False) -> int:
         for family, name, outcome, detail in bad:
             print(f"{outcome}: [{family}] {name}: {detail}")
     return 1 if bad else 0
+
+
+def run_family(make_cases, sandboxed) -> tuple[dict, list, dict]:
+    """Run a generated family: ``(families' counters, bad cases, seconds per family)``.
+
+    ``make_cases(box)`` gives the cases, those that may crash or hang run in
+    the :class:`~sandbox.Sandbox` ``box`` (60 s a call); ``sandboxed(case)``
+    says which are (their limit 90 s, the others' 10 s).  Warnings are
+    silenced: they are not outcomes.
+    """
+    from sandbox import Sandbox
+
+    families = collections.defaultdict(collections.Counter)
+    bad, seconds = [], collections.Counter()
+    with contextlib.ExitStack() as stack:
+        stack.enter_context(warnings.catch_warnings())
+        warnings.simplefilter("ignore")
+        box = stack.enter_context(Sandbox(timeout=60.0))
+        for case in make_cases(box):
+            start = time.perf_counter()
+            limit = 90.0 if sandboxed(case) else 10.0
+            outcome, detail = run_case(case, limit=limit)
+            seconds[case.family] += time.perf_counter() - start
+            families[case.family][outcome] += 1
+            if outcome in BAD:
+                bad.append((case.family, case.name, outcome, detail))
+    return families, bad, seconds
+
+
+def report_family(run, finding, findings: dict, checked: dict, doc: str) -> int:
+    """The command line of a generated family: its outcome table and findings.
+
+    ``run() -> (families, bad, seconds)`` runs the family; ``finding(*row)``
+    names the known finding a bad row shows (or None), ``findings`` describes
+    them, ``checked`` counts what the oracles checked, ``doc`` is the
+    module's docstring.  Prints the table, each finding's first cases (all
+    with ``--details``) and any other bad case; returns the exit status.
+    """
+    import argparse
+
+    from report_surfaces import table
+
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--details", action="store_true", help="every bad case")
+    args = parser.parse_args()
+    start = time.perf_counter()
+    families, bad, seconds = run()
+    print(f"generated inputs run in {time.perf_counter() - start:.0f} s")
+    print(", ".join(f"{f}: {s:.1f} s" for f, s in seconds.items()))
+    print(", ".join(f"{what}: {n}" for what, n in checked.items()), "\n")
+    print(table(families))
+    known = collections.defaultdict(list)
+    for row in bad:
+        key = finding(*row)
+        if key is not None:
+            known[key].append(row)
+    for key, rows in sorted(known.items()):
+        print(f"\n{key} ({len(rows)} cases): {findings[key]}")
+        for family, name, outcome, detail in rows if args.details else rows[:3]:
+            print(f"  {outcome}: [{family}] {name}: {detail[:160]}")
+    others = [row for row in bad if finding(*row) is None]
+    return print_bad(others, details=args.details)
 
 
 def run_case(case: Case, limit: float = TIME_LIMIT) -> tuple[str, str]:

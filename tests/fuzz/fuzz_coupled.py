@@ -74,14 +74,11 @@ prints the outcome table and the findings' cases.
 from __future__ import annotations
 
 import collections
-import contextlib
 import json
 import math
 import re
 import sys
 import tempfile
-import time
-import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -89,7 +86,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from fuzz_cases import BAD, Case, print_bad, run_case  # noqa: E402
+from fuzz_cases import Case, report_family, run_family  # noqa: E402
 from hostile import array, pick  # noqa: E402
 from sandbox import Sandbox  # noqa: E402
 
@@ -707,6 +704,27 @@ def candidate_faults(
     ``spacing``: a cloud's (median distance of a point to its nearest), by
     which a finger closed on the cloud may lie inside the true object.
     """
+    faults = placed_faults(hand, tol, data, spacing)
+    if "apply" in data:
+        return faults
+    if data.get("cloud_depth", math.inf) < -tol:
+        faults.append(f"a cloud point {-data['cloud_depth']:.3g} m inside the hand")
+    chains = chain_bodies(hand)
+    strays = sorted(set(data["contacts"]) - chains - palm_bodies(hand))
+    if strays:
+        faults.append(f"contacts on {strays}, neither a chain's body nor the palm")
+    CHECKED["contacts on a chain"] += sum(b in chains for b in data["contacts"])
+    CHECKED["contacts on the palm"] += sum(b not in chains for b in data["contacts"])
+    return faults
+
+
+def placed_faults(hand: dict, tol: float, data: dict, spacing: float = 0.0):
+    """A candidate's pose, joints and depth in the object, as the worker applied it.
+
+    Its ``X_WH`` a rigid pose, ``apply`` not refused, its joints within
+    their limits and couplings and as the candidate says, and the hand no
+    deeper in the object than ``tol`` (plus a cloud's ``spacing``).
+    """
     faults = transform_faults(data["X_WH"])
     if "apply" in data:
         return [*faults, f"apply refused its candidate: {data['apply']}"]
@@ -716,14 +734,6 @@ def candidate_faults(
             faults.append(f"apply set {name} = {data['q'].get(name)!r}, not {value!r}")
     if data.get("min_distance", math.inf) < -(tol + spacing):
         faults.append(f"penetrates the object by {-data['min_distance']:.3g} m")
-    if data.get("cloud_depth", math.inf) < -tol:
-        faults.append(f"a cloud point {-data['cloud_depth']:.3g} m inside the hand")
-    chains = chain_bodies(hand)
-    strays = sorted(set(data["contacts"]) - chains - palm_bodies(hand))
-    if strays:
-        faults.append(f"contacts on {strays}, neither a chain's body nor the palm")
-    CHECKED["contacts on a chain"] += sum(b in chains for b in data["contacts"])
-    CHECKED["contacts on the palm"] += sum(b not in chains for b in data["contacts"])
     return faults
 
 
@@ -1065,53 +1075,19 @@ a cloud) and equalising_move inputs: the test's sizes, about 30 s."""
 def run(sizes: dict | None = None):
     """(families' counters, bad cases, seconds per family) over every case."""
     sizes = SIZES if sizes is None else sizes
-    families = collections.defaultdict(collections.Counter)
-    bad, seconds = [], collections.Counter()
-    with contextlib.ExitStack() as stack:
-        stack.enter_context(warnings.catch_warnings())
-        warnings.simplefilter("ignore")
-        box = stack.enter_context(Sandbox(timeout=60.0))
-        cases = [
+    return run_family(
+        lambda box: [
             *coupled_cases(box, "pinch", 2811, sizes["pinch"]),
             *coupled_cases(box, "spread", 2812, sizes["spread"]),
             *equalising_cases(count=sizes["equalising_move"]),
-        ]
-        for case in cases:
-            start = time.perf_counter()
-            sandboxed = case.family.startswith("coupled")
-            outcome, detail = run_case(case, limit=90.0 if sandboxed else 10.0)
-            seconds[case.family] += time.perf_counter() - start
-            families[case.family][outcome] += 1
-            if outcome in BAD:
-                bad.append((case.family, case.name, outcome, detail))
-    return families, bad, seconds
+        ],
+        lambda case: case.family.startswith("coupled"),
+    )
 
 
 def main() -> int:
     """Print the outcome table, the known findings' cases and any other bad one."""
-    import argparse
-
-    from report_surfaces import table
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--details", action="store_true", help="every bad case")
-    args = parser.parse_args()
-    start = time.perf_counter()
-    families, bad, seconds = run()
-    print(f"generated inputs run in {time.perf_counter() - start:.0f} s")
-    print(", ".join(f"{f}: {s:.1f} s" for f, s in seconds.items()))
-    print(", ".join(f"{what}: {n}" for what, n in CHECKED.items()), "\n")
-    print(table(families))
-    known = collections.defaultdict(list)
-    for row in bad:
-        key = finding(*row)
-        if key is not None:
-            known[key].append(row)
-    for key, rows in sorted(known.items()):
-        print(f"\n{key} ({len(rows)} cases): {FINDINGS[key]}")
-        for family, name, outcome, detail in rows if args.details else rows[:3]:
-            print(f"  {outcome}: [{family}] {name}: {detail[:160]}")
-    return print_bad([row for row in bad if finding(*row) is None])
+    return report_family(run, finding, FINDINGS, CHECKED, __doc__)
 
 
 if __name__ == "__main__":

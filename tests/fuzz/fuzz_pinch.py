@@ -101,13 +101,10 @@ prints the outcome table and the findings' cases.
 from __future__ import annotations
 
 import collections
-import contextlib
 import dataclasses
 import math
 import re
 import sys
-import time
-import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -115,10 +112,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from fuzz_cases import BAD, Case, print_bad, run_case  # noqa: E402
+from fuzz_cases import Case, report_family, run_family  # noqa: E402
 from fuzz_coupled import (  # noqa: E402
-    configuration_faults,
-    transform_faults,
+    placed_faults,
 )
 from hostile import pick  # noqa: E402
 from sandbox import Sandbox  # noqa: E402
@@ -566,11 +562,7 @@ def _add_models(hand_text: str, object_text: str | None, object_kind: str | None
 
 def _scene(hand: dict, obj: str | None):
     """The hand and object (a key of :data:`OBJECT_MODELS` or None), cached."""
-    from pydrake.multibody.parsing import Parser
-    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-    from pydrake.systems.framework import DiagramBuilder
-
-    from drakegrasp.planning.scenes import PlanningScene
+    from drakegrasp.planning.scenes import scene_from_models
 
     text = urdf(hand)
     key = (text, obj)
@@ -578,19 +570,8 @@ def _scene(hand: dict, obj: str | None):
         if len(_CACHE) > 8:
             _CACHE.clear()
         url, otext, okind = OBJECT_MODELS.get(obj, (None, None, None))
-        add_models = _add_models(text, otext, okind, url)
-        builder = DiagramBuilder()
-        plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-        hand_instance, name = add_models(plant, Parser(plant))
-        plant.Finalize()
-        diagram = builder.Build()
-        context = diagram.CreateDefaultContext()
-        body = None
-        if name is not None:
-            model, _, b = name.rpartition("::")
-            body = plant.GetBodyByName(b, plant.GetModelInstanceByName(model))
-        scene = PlanningScene(diagram, plant, context, hand_instance, body, add_models)
-        _CACHE[key] = (scene, context.Clone())
+        scene = scene_from_models(_add_models(text, otext, okind, url))
+        _CACHE[key] = (scene, scene.context.Clone())
     scene, root0 = _CACHE[key]
     scene.context.SetTimeStateAndParametersFrom(root0)
     return scene
@@ -994,15 +975,9 @@ def chain_bodies(hand: dict) -> set[str]:
 
 
 def candidate_faults(hand: dict, tol: float, data: dict, spacing: float = 0.0):
-    faults = transform_faults(data["X_WH"])
+    faults = placed_faults(hand, tol, data, spacing)
     if "apply" in data:
-        return [*faults, f"apply refused its candidate: {data['apply']}"]
-    faults += configuration_faults(hand, data["q"])
-    for name, value in data["q_hand"].items():
-        if data["q"].get(name) != value:
-            faults.append(f"apply set {name} = {data['q'].get(name)!r}, not {value!r}")
-    if data.get("min_distance", math.inf) < -(tol + spacing):
-        faults.append(f"penetrates the object by {-data['min_distance']:.3g} m")
+        return faults
     strays = sorted(set(data["contacts"]) - chain_bodies(hand) - set(PALM))
     if strays:
         faults.append(f"contacts on {strays}, neither a chain's body nor the palm")
@@ -1447,55 +1422,19 @@ facing_chains inputs: the test's sizes."""
 def run(sizes: dict | None = None):
     """(families' counters, bad cases, seconds per family) over every case."""
     sizes = SIZES if sizes is None else sizes
-    families = collections.defaultdict(collections.Counter)
-    bad, seconds = [], collections.Counter()
-    with contextlib.ExitStack() as stack:
-        stack.enter_context(warnings.catch_warnings())
-        warnings.simplefilter("ignore")
-        box = stack.enter_context(Sandbox(timeout=60.0))
-        cases = [
+    return run_family(
+        lambda box: [
             *hand_cases(box, 2901, sizes["hands"]),
             *shake_cases(box, 2902, sizes["shakes"]),
             *facing_cases(count=sizes["facing_chains"]),
-        ]
-        for case in cases:
-            start = time.perf_counter()
-            sandboxed = case.family != "facing_chains"
-            outcome, detail = run_case(case, limit=90.0 if sandboxed else 10.0)
-            seconds[case.family] += time.perf_counter() - start
-            families[case.family][outcome] += 1
-            if outcome in BAD:
-                bad.append((case.family, case.name, outcome, detail))
-    return families, bad, seconds
+        ],
+        lambda case: case.family != "facing_chains",
+    )
 
 
 def main() -> int:
     """Print the outcome table, the known findings' cases and any other bad one."""
-    import argparse
-
-    from report_surfaces import table
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--details", action="store_true", help="every bad case")
-    args = parser.parse_args()
-    start = time.perf_counter()
-    families, bad, seconds = run()
-    print(f"generated inputs run in {time.perf_counter() - start:.0f} s")
-    print(", ".join(f"{f}: {s:.1f} s" for f, s in seconds.items()))
-    print(", ".join(f"{what}: {n}" for what, n in CHECKED.items()), "\n")
-    print(table(families))
-    known = collections.defaultdict(list)
-    for row in bad:
-        key = finding(*row)
-        if key is not None:
-            known[key].append(row)
-    for key, rows in sorted(known.items()):
-        print(f"\n{key} ({len(rows)} cases): {FINDINGS[key]}")
-        for family, name, outcome, detail in rows if args.details else rows[:3]:
-            print(f"  {outcome}: [{family}] {name}: {detail[:160]}")
-    return print_bad(
-        [row for row in bad if finding(*row) is None], details=args.details
-    )
+    return report_family(run, finding, FINDINGS, CHECKED, __doc__)
 
 
 if __name__ == "__main__":
