@@ -128,6 +128,10 @@ class MultiFingerHand:
     standoff : (2,) float
         ``(s_lo, s_hi)``, metres from the sampled surface point to the palm's
         front face.
+    sides : tuple of int
+        :func:`~drakegrasp.planning.centring.chain_sides` of ``chains``: the
+        chains of a closing group whose root joints turn alike share one
+        (empty: each chain a side of its own).
     closing_axis : (3,) float or None
         A pinch's closing axis in K (unit, across the approach: from one
         side's tip to the other's at the pre-shape, each side's tip the
@@ -152,6 +156,7 @@ class MultiFingerHand:
     reach: float
     palm_depth: float
     standoff: np.ndarray
+    sides: tuple[int, ...] = ()
     closing_axis: np.ndarray | None = None
     pinch_reach: float = float("nan")
     pinch_width: float = float("nan")
@@ -438,7 +443,11 @@ def multi_finger_hand(
     span = np.array([0.0, reach]) if standoff is None else _range("standoff", standoff)
     if span[0] < 0:
         raise InvalidOptionError(f"standoff must be >= 0 metres, got {standoff!r}")
-    pinch = _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u)
+    q_all = plant.GetPositions(ctx)
+    q_all[structure.position_indices] = structure.coupling.apply(q0)
+    plant.SetPositions(ctx, q_all)  # the pre-shape, where the pinch is learnt
+    sides = tuple(chain_sides(ctx, structure, chains))
+    pinch = _pinch(plant, ctx, inspector, H, sides, finger_tips, u)
     closing_axis, pinch_reach, pinch_width = None, float("nan"), float("nan")
     if pinch is not None:
         c_H, mid, pinch_width = pinch
@@ -455,17 +464,18 @@ def multi_finger_hand(
         reach=reach,
         palm_depth=float(depth),
         standoff=span,
+        sides=sides,
         closing_axis=closing_axis,
         pinch_reach=pinch_reach,
         pinch_width=pinch_width,
     )
 
 
-def _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u):
+def _pinch(plant, ctx, inspector, H, sides, finger_tips, u):
     """``(c_H, mid_H, width)`` of a hand whose chains move on two sides, else None.
 
     Each side's tip is the centre of the box about its chains' tip
-    geometries (at the pre-shape ``q0``, frame H: a mesh's frame may lie
+    geometries (in ``ctx``, at the pre-shape; frame H: a mesh's frame may lie
     anywhere), of those of its chains that reach furthest along ``u``, to a
     millimetre (a pad, not the bar beside it);
     ``c_H`` the unit line from the first side's tip to the second's with its
@@ -473,10 +483,6 @@ def _pinch(plant, ctx, inspector, H, structure, chains, finger_tips, q0, u):
     between the two tips' collision geometries along ``c_H`` (m: the
     widest object the open pinch spans).
     """
-    q_all = plant.GetPositions(ctx)
-    q_all[structure.position_indices] = structure.coupling.apply(q0)
-    plant.SetPositions(ctx, q_all)
-    sides = chain_sides(ctx, structure, chains)
     if len(set(sides)) != 2:
         return None
     found: dict[int, list] = {}
@@ -540,11 +546,21 @@ def _pinch_poses(surface, p_O, d0, across, angle, s, roll, hand: MultiFingerHand
     side = np.cross(c, d0)  # unit: c is across d0
     sign = np.where(np.sum(across * side, axis=1) < 0, -1.0, 1.0)
     d_O = np.cos(angle)[:, None] * d0 + (sign * np.sin(angle))[:, None] * side
-    frame = axis_frames(d_O, np.zeros(len(d_O)))
+    return d_O, _roll_along(d_O, c, hand.closing_axis)
+
+
+def _roll_along(d_O, c_O, c_K) -> np.ndarray:
+    """The rolls about ``d_O`` (n, 3) that lay the closing axis ``c_K`` along ``c_O``.
+
+    ``c_O`` (n, 3) lies across ``d_O``.  A roll is the angle of
+    :func:`~drakegrasp.planning.placement.axis_frames`, at which ``c_K`` (in
+    K, across K's x axis) sits at ``atan2(c_z, c_y)``.
+    """
+    frame = axis_frames(d_O, np.zeros(len(d_O)))  # y: e1, z: e2 of roll 0
     alpha = np.arctan2(
-        np.sum(c * frame[:, :, 2], axis=1), np.sum(c * frame[:, :, 1], axis=1)
+        np.sum(c_O * frame[:, :, 2], axis=1), np.sum(c_O * frame[:, :, 1], axis=1)
     )
-    return d_O, alpha - np.arctan2(hand.closing_axis[2], hand.closing_axis[1])
+    return alpha - np.arctan2(c_K[2], c_K[1])
 
 
 def _aligned_rolls(surface, mid_O, d_O, roll, hand: MultiFingerHand) -> np.ndarray:
@@ -563,23 +579,17 @@ def _aligned_rolls(surface, mid_O, d_O, roll, hand: MultiFingerHand) -> np.ndarr
                                    hand)  # fmt: skip
     score = score.reshape(n, m)
     best = np.argmax(score, axis=1)  # the first of equal ones: the drawn roll
+    top = score[np.arange(n), best]
     rows = np.arange(n) * m + best
-    chosen = np.where(
-        np.isfinite(score[np.arange(n), best]), rolls[np.arange(n), best], roll
-    )
+    chosen = np.where(np.isfinite(top), rolls[np.arange(n), best], roll)
     # Refined: the roll that lays the axis along n_+ - n_- across d (exact
     # for flat faces; 22.5 deg apart, the coarse rolls left a pad's corner
     # touching), kept where it scores no worse.
     target = n_p[rows] - n_m[rows]
     target -= np.sum(target * d_O, axis=1, keepdims=True) * d_O
-    frame = axis_frames(d_O, np.zeros(n))  # y: e1, z: e2 of roll 0
-    alpha = np.arctan2(
-        np.sum(target * frame[:, :, 2], axis=1), np.sum(target * frame[:, :, 1], axis=1)
-    )
-    refined = alpha - np.arctan2(hand.closing_axis[2], hand.closing_axis[1])
+    refined = _roll_along(d_O, target, hand.closing_axis)
     better, _, _ = _roll_scores(surface, mid_O, d_O, refined, hand)
-    ok = np.isfinite(score[np.arange(n), best]) & (better >= score[np.arange(n), best])
-    return np.where(ok, refined, chosen)
+    return np.where(np.isfinite(top) & (better >= top), refined, chosen)
 
 
 def _roll_scores(surface, mid_O, d_O, rolls, hand: MultiFingerHand):

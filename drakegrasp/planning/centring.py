@@ -144,8 +144,9 @@ def chain_sides(plant_context, structure, chains: Sequence) -> list[int]:
         chains share one when they are joined through chains each beside the
         next: one is beside another when they are of one closing group and
         their root joints (the joints of the chain that no other joint of it
-        carries) are revolute, turn alike as the group closes (the same world axis times
-        the same ``<mimic>`` rate, to :data:`SIDE_TOLERANCE` of the larger:
+        carries) are revolute, turn alike as the group closes (the same world
+        axis times the same ``<mimic>`` rate, to :data:`SIDE_TOLERANCE` of the
+        larger:
         exported URDFs round an axis or an angle differently from joint to
         joint) and lie in one plane of motion (their pins coincide, or lie
         apart along the axis by at most :data:`PLANE_TOLERANCE` of their
@@ -405,6 +406,7 @@ def close_centred(
         reason and the last pose tried.
     """
     first = None
+    side = list(range(len(groups))) if sides is None else sides
     for step in range(CENTRING_STEPS + 1):
         found, q, reason, touched = close(X_WH, q_pre)
         if reason is None:
@@ -413,7 +415,6 @@ def close_centred(
         chains = chains_to_centre(groups, touched)
         if step == CENTRING_STEPS or not chains:
             break
-        side = list(range(len(groups))) if sides is None else sides
         move = _move(
             gaps(chains), [groups[c] for c in chains], [side[c] for c in chains], tol
         )

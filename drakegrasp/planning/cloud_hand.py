@@ -80,7 +80,7 @@ from pydrake.geometry import Box, Capsule, Cylinder, Sphere
 from pydrake.multibody.tree import JacobianWrtVariable
 from scipy.spatial import cKDTree
 
-from drakegrasp.planning.centring import CentredCloser, chain_groups, chain_sides
+from drakegrasp.planning.centring import CentredCloser, chain_groups
 from drakegrasp.planning.cloud import (
     CONTACT_BAND,
     SHADOW_PROBES,
@@ -358,7 +358,7 @@ class CloudHand(CentredCloser):
             for chain in hand.chains
         ]
         self.group = chain_groups(s, hand.chains)
-        self.side = chain_sides(self.ctx, s, hand.chains)
+        self.side = list(hand.sides) or None
         self.X_WH = None
         self._by_body = by_body
         self._parts = {}  # (finger, touching bodies) -> its free part's closing

@@ -65,7 +65,7 @@ from drakegrasp.planning.candidates import (
     closing_order,
     planning_result,
 )
-from drakegrasp.planning.centring import CentredCloser, chain_groups, chain_sides
+from drakegrasp.planning.centring import CentredCloser, chain_groups
 from drakegrasp.planning.checks import (
     checked_contacts,
     checked_fingers,
@@ -172,7 +172,7 @@ class _Placer(CentredCloser):
             for b in finger.bodies:
                 self.label[scoped_name(plant, b)] = f
         self.group = chain_groups(hand.structure, hand.chains)
-        self.side = chain_sides(ctx, hand.structure, hand.chains)
+        self.side = list(hand.sides) or None
         self.min_fingers = int(min_fingers)
         self.X_WH = None
 

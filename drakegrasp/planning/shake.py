@@ -381,14 +381,13 @@ def recorded_mass(candidate) -> float:
     return planned
 
 
-def _planned_mass(candidate, body) -> float | None:
-    """The mass ``candidate`` was planned for, or None: the model's (kg).
+def _planned_mass(planned: float, body) -> float | None:
+    """The mass a candidate was planned for, ``planned`` (kg), or None: the model's.
 
     None where it records none (NaN: a point cloud or a massless body planned
     without ``object_mass``), or where it is the model's (to a relative
     1e-12).
     """
-    planned = recorded_mass(candidate)
     model = body.default_mass()
     if math.isnan(planned) or (model > 0 and abs(planned - model) <= 1e-12 * model):
         return None
@@ -626,7 +625,7 @@ def shake_test(
     if X_WO is not None:
         candidate = replace(candidate, X_WO=check_rigid_transform("X_WO", X_WO))
     check_candidate(candidate)
-    recorded_mass(candidate)  # before anything is built
+    planned = recorded_mass(candidate)  # checked before anything is built
     dirs = check_shake_options(
         squeeze=squeeze, stiffness=stiffness, damping=damping,
         directions=directions, settle=settle, phase=phase, seat=seat,
@@ -729,7 +728,7 @@ def shake_test(
         )
     plant.Finalize()
     if object_mass is None:
-        object_mass = _planned_mass(candidate, body)
+        object_mass = _planned_mass(planned, body)
     mass, com, inertia = _object_inertia(body, object_mass, candidate)
     schedule = _schedule(seat, settle, phase, blend, dirs)
     gravity = builder.AddSystem(_TurnedGravity(body.index(), mass, com, schedule))

@@ -114,6 +114,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from fuzz_cases import Case, report_family, run_family  # noqa: E402
 from fuzz_coupled import (  # noqa: E402
+    _f,
+    _joint_values,
+    _min_distance,
+    _transform,
     placed_faults,
 )
 from hostile import pick  # noqa: E402
@@ -294,10 +298,6 @@ def _described(hand: dict) -> dict:
     hand["couplings"] = couplings
     hand["leader"] = first
     return hand
-
-
-def _f(*xs) -> str:
-    return " ".join(repr(float(x)) for x in xs)
 
 
 def _link(name, shapes, mass=0.05) -> str:
@@ -605,12 +605,6 @@ OBJECT_MODELS = {
 }
 
 
-def _transform(pose: dict):
-    from pydrake.math import RigidTransform, RollPitchYaw
-
-    return RigidTransform(RollPitchYaw(pose["rpy"]), pose["p"])
-
-
 def _place(scene, object_pose: dict, hand_pose: dict, q: dict | None = None):
     plant = scene.plant
     ctx = plant.GetMyContextFromRoot(scene.context)
@@ -625,16 +619,6 @@ def _place(scene, object_pose: dict, hand_pose: dict, q: dict | None = None):
             positions[j.position_start()] = value
         plant.SetPositions(ctx, positions)
     return plant, ctx
-
-
-def _joint_values(plant, ctx, instance) -> dict[str, float]:
-    q = plant.GetPositions(ctx)
-    out = {}
-    for i in plant.GetJointIndices(instance):
-        j = plant.get_joint(i)
-        if j.num_positions() == 1:
-            out[j.name()] = float(q[j.position_start()])
-    return out
 
 
 def sides_case(spec: dict) -> dict:
@@ -691,16 +675,6 @@ def _place_ctx(plant, ctx, scene, pose: dict, q: dict) -> None:
     for name, value in q.items():
         positions[plant.GetJointByName(name, scene.hand).position_start()] = value
     plant.SetPositions(ctx, positions)
-
-
-def _min_distance(scene) -> float:
-    from drake_distances import hand_object_distances  # tests/plant
-
-    plant = scene.plant
-    ctx = plant.GetMyContextFromRoot(scene.context)
-    query = plant.get_geometry_query_input_port().Eval(ctx)
-    found = hand_object_distances(plant, query, scene.hand, scene.object_body)
-    return min((d for *_, d in found), default=math.inf)
 
 
 def _candidate_data(c, plant, scene, obj_scene=None) -> dict:
