@@ -163,7 +163,7 @@ UNSEEN_DEPTH_ANGLE = np.radians(60.0)
 angle of the line of sight (a face seen head-on tells nothing of the depth)."""
 
 _CHUNK = 64
-"""Sampled lines processed at once (memory: chunk × points × 3 floats)."""
+"""Sampled lines processed at once (memory: a few chunk × points floats)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -835,27 +835,78 @@ class CloudSurface:
         return v - np.sum(v * d_O, axis=1, keepdims=True) * d_O
 
     def chord(self, p_O: np.ndarray, d_O: np.ndarray):
-        """Entry (0, or negative when occluded), exit and exit normal of lines."""
+        """Entry (0, or negative when occluded), exit and exit normal of lines.
+
+        A point is on a line when its distance from it is at most
+        ``line_radius``.  The few such points of each line are found by a
+        screen of every point (one matrix product per chunk of lines, with
+        a margin far above its rounding), then measured exactly.
+        """
         K = len(p_O)
         t_in = np.zeros(K)
         t_out = np.full(K, np.nan)
         n_out = np.zeros((K, 3))
         rho = self.line_radius
+        P = self.points
+        F = self._features(P)
+        scale = float(np.max(np.sum(P * P, axis=1), initial=0.0))
         for s in range(0, K, _CHUNK):
-            v = self.points[None, :, :] - p_O[s : s + _CHUNK, None, :]  # (k, M, 3)
-            t = np.einsum("kmi,ki->km", v, d_O[s : s + _CHUNK])
-            perp = np.linalg.norm(
-                v - t[..., None] * d_O[s : s + _CHUNK, None, :], axis=2
-            )
-            near = perp <= rho
-            before = np.where(near & (t < -rho), t, 0.0).min(axis=1)
-            after = np.where(near & (t > rho), t, -np.inf)
-            j = np.argmax(after, axis=1)
-            best = after[np.arange(len(j)), j]
+            p, d = p_O[s : s + _CHUNK], d_O[s : s + _CHUNK]
+            k, m = self._near_pairs(F, scale, p, d, rho)
+            v = P[m] - p[k]
+            t = np.einsum("ni,ni->n", v, d[k])
+            perp = np.linalg.norm(v - t[:, None] * d[k], axis=1)
+            on = perp <= rho
+            k, m, t = k[on], m[on], t[on]
+            before = np.zeros(len(p))
+            back = t < -rho
+            np.minimum.at(before, k[back], t[back])
+            ahead = t > rho
+            k, m, t = k[ahead], m[ahead], t[ahead]
+            # the farthest point of each line, the first of equal ones
+            order = np.lexsort((m, -t, k))
+            first = np.ones(len(order), bool)
+            first[1:] = k[order[1:]] != k[order[:-1]]
+            line, point, far = k[order[first]], m[order[first]], t[order[first]]
             t_in[s : s + _CHUNK] = before
-            t_out[s : s + _CHUNK] = np.where(np.isfinite(best), best, np.nan)
+            t_out[s + line] = far
+            j = np.zeros(len(p), np.intp)  # argmax of an all -inf row: point 0
+            j[line] = point
             n_out[s : s + _CHUNK] = self.normals[j]
         return t_in, t_out, n_out
+
+    @staticmethod
+    def _near_pairs(F, scale, p, d, rho):
+        """``(line, point)`` index pairs of points that may lie within ``rho``.
+
+        The squared distance ``vᵀ (I - d dᵀ) v`` (``v = P - p``) of every
+        point from every line is one matrix product of the points' quadratic
+        features ``F`` with each line's coefficients.  Its rounding (about
+        ``1e-15`` of the squared size ``scale`` of points and lines) is
+        covered by a margin of ``1e-9 scale``, so no point within ``rho`` is
+        missed; the pairs are measured exactly afterwards.
+        """
+        A = np.eye(3)[None] - d[:, :, None] * d[:, None, :]  # (k, 3, 3)
+        Ap = np.einsum("kij,kj->ki", A, p)
+        C = np.concatenate(
+            [
+                A[:, [0, 1, 2], [0, 1, 2]],
+                2.0 * A[:, [0, 0, 1], [1, 2, 2]],
+                -2.0 * Ap,
+                np.einsum("ki,ki->k", p, Ap)[:, None],
+            ],
+            axis=1,
+        )  # (k, 10): the features' coefficients
+        limit = rho * rho * (1.0 + 1e-6) + 1e-9 * (scale + np.max(np.sum(p * p, 1)))
+        m, k = np.nonzero(F @ C.T <= limit)
+        return k, m
+
+    @staticmethod
+    def _features(P):
+        """``(M, 10)`` features of points: x², y², z², xy, xz, yz, x, y, z, 1."""
+        x, y, z = P.T
+        return np.stack([x * x, y * y, z * z, x * y, x * z, y * z, x, y, z,
+                         np.ones(len(P))], axis=1)  # fmt: skip
 
     def radius_about(self, p_O) -> float:
         """Largest distance of a point from ``p_O``, metres."""
