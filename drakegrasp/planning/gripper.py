@@ -22,6 +22,11 @@ within :data:`PAD_DEPTH` of the innermost one (the WSG's four 1 mm tip
 spheres, a flat pad, a rounded dome).  The pad's coordinate along ``a`` is
 affine in its joint's value (a prismatic joint), which gives the opening
 ``w(q) = c_1(q_1) − c_0(q_0)`` and its inverse.
+
+**One motor.**  When a ``<mimic>`` (or another recorded coupling) ties one
+finger's joint to the other's, ``q_1 = m q_0 + b``, the jaw keeps it:
+:meth:`ParallelJaw.coupled` puts closed fingers back on the coupling and
+moves the hand along ``a`` so that each pad stays where it closed.
 """
 
 from __future__ import annotations
@@ -74,6 +79,9 @@ class ParallelJaw:
         Each finger's pad geometries.
     min_opening, max_opening : float
         The symmetric opening's range over the joint limits, metres.
+    coupling : (2,) float or None
+        ``(m, b)`` when one motor drives both fingers, ``q_1 = m q_0 + b``
+        (``b`` in metres); None when each finger has its own.
     """
 
     base: RigidBody
@@ -88,6 +96,7 @@ class ParallelJaw:
     pad_geometries: tuple
     min_opening: float
     max_opening: float
+    coupling: tuple[float, float] | None = None
 
     def q_for_opening(self, width) -> np.ndarray:
         """(…, 2) joint values that put the pads at ``x_K = ∓ width / 2``."""
@@ -100,6 +109,31 @@ class ParallelJaw:
         x = self.pad_at_zero + self.pad_rate * np.asarray(q, dtype=float)
         return x[..., 1] - x[..., 0]
 
+    def coupled(self, q) -> tuple[np.ndarray, float]:
+        """Joint values on the coupling that leave both pads where ``q`` puts them.
+
+        Parameters
+        ----------
+        q : (2,) float
+            Closed joint values, each finger stopped on its own, metres.
+
+        Returns
+        -------
+        q_coupled : (2,) float
+            ``q_1 = m q_0 + b``; ``q`` itself without a coupling.
+        shift : float
+            How far (m) the hand moves along the grasp axis ``a`` so that
+            each pad sits where ``q`` put it: ``x_f(q_coupled) + shift =
+            x_f(q)`` for both fingers; 0 without a coupling.
+        """
+        q = np.asarray(q, dtype=float)
+        if self.coupling is None:
+            return q, 0.0
+        m, b = self.coupling
+        r0, r1 = (float(r) for r in self.pad_rate)
+        q0 = (r0 * q[0] - r1 * (q[1] - b)) / (r0 - r1 * m)
+        return np.array([q0, m * q0 + b]), r0 * (float(q[0]) - q0)
+
     def to_dict(self) -> dict:
         """JSON-ready summary."""
         return {
@@ -110,6 +144,7 @@ class ParallelJaw:
             "p_HK": self.X_HK.translation().tolist(),
             "min_opening": self.min_opening,
             "max_opening": self.max_opening,
+            "coupling": None if self.coupling is None else list(self.coupling),
         }
 
 
@@ -239,7 +274,7 @@ def parallel_jaw(
         A hand without a free base, without two prismatic fingers with parallel
         axes and finite limits, or whose pads cannot be told from its palm.
     """
-    base, fingers, joints = _two_prismatic_fingers(
+    base, fingers, joints, coupling = _two_prismatic_fingers(
         plant, plant_context, object_body, hand
     )
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
@@ -271,6 +306,14 @@ def parallel_jaw(
         [[s0[1].max(), -s1[1].max()] for s0, s1 in map(supports, (lower, upper))]
     )
     rate = (pad[1] - pad[0]) / (upper - lower)
+    if coupling is not None and not abs(rate[0] - rate[1] * coupling[0]) > 1e-9 * (
+        abs(rate[0]) + abs(rate[1] * coupling[0])
+    ):
+        raise ModelError(
+            f"the coupling q({joints[1].name()}) = {coupling[0]:g} "
+            f"q({joints[0].name()}) + {coupling[1]:g} moves both pads the same "
+            "way: the jaw cannot close on anything"
+        )
     at_zero = pad[0] - rate * lower
     pad_ids, pad_lateral = _pads(supports(0.5 * (lower + upper)), a_H)
     approach = _approach(plant, inspector, base, pad_lateral, a_H)
@@ -293,11 +336,16 @@ def parallel_jaw(
         pad_geometries=pad_ids,
         min_opening=float(max(2 * max(centre - x_closed[0], x_closed[1] - centre), 0)),
         max_opening=float(2 * min(centre - x_open[0], x_open[1] - centre)),
+        coupling=coupling,
     )
 
 
 def _two_prismatic_fingers(plant, plant_context, object_body, hand):
-    """(free base, the two fingers, their prismatic joints), or a ModelError."""
+    """(free base, the two fingers, their prismatic joints, coupling), or a ModelError.
+
+    The coupling is ``(m, b)``, ``q_1 = m q_0 + b``, when one joint follows
+    the other (or both follow one leader), else None.
+    """
     bodies = hand_bodies(plant, object_body, hand)
     base = free_base(plant, bodies, hand=hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
@@ -320,7 +368,37 @@ def _two_prismatic_fingers(plant, plant_context, object_body, hand):
                 f"finger joint {j.name()} must be prismatic with finite limits to "
                 f"make a parallel jaw (it is {j.type_name()}, limits [{lo}, {hi}])"
             )
-    return base, fingers, joints
+        if not hi > lo:
+            raise ModelError(
+                f"finger joint {j.name()} has no stroke: its limits [{lo}, {hi}] "
+                "leave the finger no room to close"
+            )
+    coupling = _jaw_coupling(
+        structure.coupling.follows, *(f.joints[0] for f in fingers)
+    )
+    return base, fingers, joints, coupling
+
+
+def _jaw_coupling(follows, i0: int, i1: int) -> tuple[float, float] | None:
+    """``(m, b)`` with ``q_1 = m q_0 + b`` when joints ``i0``, ``i1`` share a leader.
+
+    ``follows``: :class:`~drakegrasp.plant.fingers.Coupling`'s follower ->
+    ``(leader, ρ, Δq)``.  Each joint is written as ``a q_root + c`` of the
+    joint at the end of its chain of leaders.
+    """
+
+    def root(i):
+        a, c, seen = 1.0, 0.0, set()
+        while i in follows and i not in seen:
+            seen.add(i)
+            i, rho, off = follows[i]
+            a, c = a * rho, a * off + c
+        return i, a, c
+
+    (r0, a0, c0), (r1, a1, c1) = root(i0), root(i1)
+    if r0 != r1:
+        return None
+    return float(a1 / a0), float(c1 - a1 / a0 * c0)
 
 
 def _grasp_axis(finger_origins, lower, upper) -> np.ndarray:

@@ -34,6 +34,7 @@ __all__ = [
     "SURE_PENETRATION",
     "BodyCloser",
     "axis_frames",
+    "onto_coupling",
     "sample_poses",
 ]
 
@@ -392,6 +393,12 @@ class BodyCloser:
         are exactly what :func:`~drakegrasp.analyze_grasp` reads on the
         applied candidate (once :meth:`finish` resolved them).
 
+        A jaw whose fingers one motor drives (``gripper.coupling``) closes
+        each finger on its own, then puts them back on the coupling and
+        moves the hand along the grasp axis so that each pad stays where it
+        stopped (:meth:`~drakegrasp.planning.gripper.ParallelJaw.coupled`),
+        and reads the contacts there.
+
         Returns
         -------
         contacts : StagedContacts or None
@@ -401,6 +408,9 @@ class BodyCloser:
             The closed joint values.
         reason : str or None
             The rejection reason, None when the hand closed on the object.
+        X_WH : RigidTransform
+            The hand's pose: ``X_WH``, moved along the grasp axis for a
+            coupled jaw.
         """
         g, tol, reach = self.g, self.tol, PAIR_REACH
         q0, q1 = (float(v) for v in g.q_for_opening(opening))
@@ -414,12 +424,14 @@ class BodyCloser:
         joint0, joint1 = g.joints
         ctx, port, role = self.ctx, self.port, self._role_of_value
         half = 0.5 * tol
-        for step_count in range(MAX_CLOSING_STEPS):
+        moved = True  # the hand moved (placed, or shifted onto the coupling)
+        for _ in range(MAX_CLOSING_STEPS):
             query = port.Eval(ctx)
             pairs = query.ComputeSignedDistancePairwiseClosestPoints(reach)
             psi0 = psi1 = reach
             hit0 = hit1 = False
-            colliding = -tol if step_count == 0 else -np.inf  # ψ below: rejected
+            colliding = -tol if moved else -np.inf  # ψ below: rejected
+            moved = False
             for pair in pairs:
                 distance = pair.distance
                 if distance >= colliding and distance >= psi0 and distance >= psi1:
@@ -431,8 +443,8 @@ class BodyCloser:
                 mine, other = (ra, rb) if ra >= _HAND else (rb, ra)
                 if distance < colliding:
                     if other == _OBJECT:
-                        return None, None, "hand collides with the object"
-                    return None, None, "hand collides with the scene"
+                        return None, None, "hand collides with the object", X_WH
+                    return None, None, "hand collides with the scene", X_WH
                 if mine == _FINGER:
                     if distance < psi0:
                         psi0, hit0 = distance, other == _OBJECT
@@ -440,9 +452,18 @@ class BodyCloser:
                     psi1, hit1 = distance, other == _OBJECT
             if psi0 <= tol and psi1 <= tol:
                 if not (hit0 and hit1):
-                    return None, None, "finger blocked by the scene"
+                    return None, None, "finger blocked by the scene", X_WH
+                m_b = g.coupling  # q1 = m q0 + b, kept within 1e-12 m
+                if m_b is not None and abs(q1 - (m_b[0] * q0 + m_b[1])) > 1e-12:
+                    X_WH, q = onto_coupling(g, X_WH, (q0, q1))
+                    if q is None:
+                        return None, None, "coupled fingers out of their stroke", X_WH
+                    q0, q1 = (float(v) for v in q)
+                    self._set(X_WH, (q0, q1))
+                    moved = True
+                    continue
                 found, reason = self._contacts(query, pairs)
-                return found, np.array([q0, q1]), reason
+                return found, np.array([q0, q1]), reason, X_WH
             # each finger advances by ψ - tol/2 (a translation by ψ cannot
             # penetrate), stopping at its closed limit; one already there
             # with ψ > tol misses the object
@@ -453,12 +474,12 @@ class BodyCloser:
             if (beyond0 and abs(q0 - limit0) <= 1e-12 and psi0 > tol) or (
                 beyond1 and abs(q1 - limit1) <= 1e-12 and psi1 > tol
             ):
-                return None, None, "finger misses the object"
+                return None, None, "finger misses the object", X_WH
             q0 = limit0 if beyond0 else new0
             q1 = limit1 if beyond1 else new1
             joint0.set_translation(ctx, q0)
             joint1.set_translation(ctx, q1)
-        return None, None, "closing did not converge"
+        return None, None, "closing did not converge", X_WH
 
     def _contacts(self, query, pairs):
         """The closed hand's contacts from the last step's pairs, staged.
@@ -523,3 +544,18 @@ class BodyCloser:
         if not all(touched):
             return None, "one finger touches"
         return found, None
+
+
+def onto_coupling(gripper: ParallelJaw, X_WH: RigidTransform, q):
+    """A coupled jaw's closed pose: ``(X_WH, q)`` on its coupling, pads kept.
+
+    ``q`` (2,): each finger stopped on its own.  Returns the hand moved along
+    the grasp axis and the joint values on the coupling
+    (:meth:`~drakegrasp.planning.gripper.ParallelJaw.coupled`), or
+    ``(X_WH, None)`` when those leave a joint's limits.
+    """
+    q, shift = gripper.coupled(q)
+    if not (np.all(q >= gripper.lower) and np.all(q <= gripper.upper)):
+        return X_WH, None
+    a_W = X_WH.rotation().multiply(gripper.X_HK.rotation().col(0))
+    return RigidTransform(X_WH.rotation(), X_WH.translation() + shift * a_W), q

@@ -77,7 +77,12 @@ from drakegrasp.planning.multifinger import (
     plan_multifinger,
     plan_multifinger_cloud,
 )
-from drakegrasp.planning.placement import MAX_CLOSING_STEPS, BodyCloser, sample_poses
+from drakegrasp.planning.placement import (
+    MAX_CLOSING_STEPS,
+    BodyCloser,
+    onto_coupling,
+    sample_poses,
+)
 from drakegrasp.planning.ranking import (
     DEFAULT_NOISE,
     checked_noise,
@@ -534,9 +539,9 @@ def plan_grasps(
             X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
             opening = float(poses["opening"][k])
             if cloud is None:
-                found, q, reason = _close_on_body(closer, X_WH, opening)
+                found, q, reason, X_WH = _close_on_body(closer, X_WH, opening)
             else:
-                found, q, reason = _close_on_cloud(closer, cloud, X_WH, opening)
+                found, q, reason, X_WH = _close_on_cloud(closer, cloud, X_WH, opening)
             if reason is not None:
                 rejections[reason] += 1
                 continue
@@ -669,28 +674,39 @@ def _is_default(value, default) -> bool:
 
 
 def _close_on_body(closer: BodyCloser, X_WH, opening):
-    """Stages 2-3 on the object body: (contacts, q, reason)."""
+    """Stages 2-3 on the object body: (contacts, q, reason, X_WH)."""
     return closer.close_on_body(X_WH, opening)
 
 
 def _close_on_cloud(closer: BodyCloser, cloud: CloudFingers, X_WH, opening):
-    """Stages 2-3 on a cloud: (contacts, q, reason)."""
+    """Stages 2-3 on a cloud: (contacts, q, reason, X_WH).
+
+    A coupled jaw's fingers are put back on their coupling as on a body
+    (:func:`~drakegrasp.planning.placement.onto_coupling`): the pads, and so
+    the cloud points they touch, stay where they stopped.
+    """
     q_open = closer.g.q_for_opening(opening)
     reason = closer.clear_at(X_WH, q_open)
     if reason is not None:
-        return None, None, reason
+        return None, None, reason, X_WH
     if cloud.collides():
-        return None, None, "hand collides with the cloud"
+        return None, None, "hand collides with the cloud", X_WH
     if cloud.in_shadow():
-        return None, None, "hand enters the unseen side"
+        return None, None, "hand enters the unseen side", X_WH
     q, travel_hits, reason = cloud.close(X_WH, q_open)
     if reason is not None:
-        return None, None, reason
+        return None, None, reason, X_WH
+    if closer.g.coupling is not None:
+        X_WH, q = onto_coupling(closer.g, X_WH, q)
+        if q is None:
+            return None, None, "coupled fingers out of their stroke", X_WH
+        if cloud.collides():
+            return None, None, "hand collides with the cloud", X_WH
     if closer.clear_at(X_WH, q) is not None:
-        return None, None, "finger blocked by the scene"
+        return None, None, "finger blocked by the scene", X_WH
     if cloud.in_shadow():
-        return None, None, "hand enters the unseen side"
+        return None, None, "hand enters the unseen side", X_WH
     found = cloud.contacts(travel_hits)
     if found is None:
-        return None, None, "one finger touches"
-    return found, q, None
+        return None, None, "one finger touches", X_WH
+    return found, q, None, X_WH

@@ -3,7 +3,9 @@
 - :func:`spread_hand_urdf`: a Barrett-style hand, two fingers on a coupled
   spread, each with its own flexion motor, and a fixed third;
 - :func:`one_motor_pinch_urdf`: a Robotiq-style pinch, two knuckles and their
-  pads on one motor.
+  pads on one motor;
+- :func:`coupled_jaw_urdf`: a parallel jaw whose prismatic fingers one motor
+  drives.
 
 Shared by the plant and planning tests.
 """
@@ -195,4 +197,71 @@ def one_motor_pinch_urdf(*, effort: float = 5.0, bars: bool = False) -> str:
         '</type><joint name="left_knuckle"/><actuator name="motor">'
         "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
         "</robot>"
+    )
+
+
+def coupled_jaw_urdf(
+    *,
+    pad: str = "capsule",
+    ratio: float = -1.0,
+    offset: float = 0.0,
+    follower: str = "right",
+    stroke: float = 0.045,
+) -> str:
+    """A parallel jaw whose two prismatic fingers one motor drives (``<mimic>``).
+
+    The palm (a 40 × 140 × 40 mm box) carries two fingers sliding along ``y``,
+    both at the middle when closed; the left one opens towards +y over
+    ``[0, stroke]``, the right one towards -y over ``[-stroke, 0]``.
+    The ``follower`` finger's joint mimics the other's with ``ratio`` and
+    ``offset`` (the right one with ``ratio = -1`` is the symmetric jaw); only
+    the leader has a ``<transmission>``.  Each finger ends in a ``pad`` 48 mm
+    past the palm: a ``"capsule"`` (7 mm radius, 25 mm long, across the axis),
+    a ``"sphere"`` (7 mm) or a ``"box"`` (a 20 × 8 × 20 mm plate).
+    """
+    shapes = {
+        "capsule": ('rpy="0 1.5707963 0"', '<capsule radius="0.007" length="0.025"/>'),
+        "sphere": ('rpy="0 0 0"', '<sphere radius="0.007"/>'),
+        "box": ('rpy="0 0 0"', '<box size="0.02 0.008 0.02"/>'),
+    }
+    rpy, shape = shapes[pad]
+
+    def finger(name, side):
+        y = 0.012 * side
+        return (
+            f'<link name="{name}"><inertial><origin xyz="0 {0.008 * side} 0.03"/>'
+            '<mass value="0.05"/><inertia ixx="1.6e-5" iyy="1.7e-5" izz="2.7e-6" '
+            'ixy="0" ixz="0" iyz="0"/></inertial>'
+            f'<collision><origin xyz="0 {y} 0.03"/><geometry><box size="0.02 0.008 '
+            '0.06"/></geometry></collision>'
+            f'<collision><origin xyz="0 0 0.048" {rpy}/><geometry>{shape}</geometry>'
+            "</collision></link>"
+        )
+
+    def slide(name, child, lower, upper, mimic=""):
+        return (
+            f'<joint name="{name}" type="prismatic"><parent link="palm"/>'
+            f'<child link="{child}"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/>'
+            f'<limit lower="{lower}" upper="{upper}" effort="40" velocity="0.1"/>'
+            f"{mimic}</joint>"
+        )
+
+    lead, follow = ("left", "right") if follower == "right" else ("right", "left")
+    mimic = f'<mimic joint="{lead}_slide" multiplier="{ratio}" offset="{offset}"/>'
+    limits = {"left": (0.0, stroke), "right": (-stroke, 0.0)}
+    joints = "".join(
+        slide(f"{s}_slide", f"{s}_finger", *limits[s], mimic if s == follow else "")
+        for s in ("left", "right")
+    )
+    return (
+        '<?xml version="1.0"?><robot name="coupled_jaw">'
+        '<link name="palm"><inertial><origin xyz="0 0 -0.02"/><mass value="0.6"/>'
+        '<inertia ixx="1e-3" iyy="1.6e-4" izz="1e-3" ixy="0" ixz="0" iyz="0"/>'
+        '</inertial><collision><origin xyz="0 0 -0.02"/><geometry><box size="0.04 '
+        '0.14 0.04"/></geometry></collision></link>'
+        f"{finger('left_finger', 1)}{finger('right_finger', -1)}{joints}"
+        f'<transmission name="t"><type>transmission_interface/SimpleTransmission'
+        f'</type><joint name="{lead}_slide"><hardwareInterface>EffortJointInterface'
+        f'</hardwareInterface></joint><actuator name="m"><mechanicalReduction>1'
+        "</mechanicalReduction></actuator></transmission></robot>"
     )
