@@ -62,6 +62,7 @@ __all__ = [
     "JointCoupling",
     "add_coupler_constraint",
     "add_models",
+    "refuse_reversed_limits",
     "coupled_torque_limits",
     "coupling_map",
     "coupling_violations",
@@ -295,19 +296,66 @@ def add_models(
     if text is not None:
         if kind not in ("urdf", "sdf"):
             raise InvalidOptionError(f"text needs kind='urdf' or 'sdf', got {kind!r}")
+        refuse_reversed_limits(text, kind, "the model text")
         instances = parser.AddModelsFromString(text, kind)
         _record_text(plant, text, kind, instances)
         return instances
+    path = parser.package_map().ResolveUrl(url) if url is not None else str(file_name)
+    kind = _kind_of(path)
+    document = Path(path).read_text() if kind and Path(path).is_file() else None
+    if document is not None:
+        refuse_reversed_limits(document, kind, path)
     if url is not None:
         instances = parser.AddModels(url=url)
-        path = parser.package_map().ResolveUrl(url)
     else:
         instances = parser.AddModels(str(file_name))
-        path = str(file_name)
-    kind = _kind_of(path)
-    if kind:
-        _record_text(plant, Path(path).read_text(), kind, instances)
+    if document is not None:
+        _record_text(plant, document, kind, instances)
     return instances
+
+
+def refuse_reversed_limits(text: str, kind: str, where: str) -> None:
+    """Refuse a joint whose lower position limit lies above its upper one.
+
+    Drake stops the process on such a joint (a failed internal condition,
+    not an exception), so the document is read first.  A document that is
+    not XML, or a limit that is not a number, is left to Drake's parser.
+
+    Raises
+    ------
+    ModelError
+        Naming the joint, its limits and ``where`` the document came from.
+    """
+    if "limit" not in text:
+        return
+    try:
+        root = ET.fromstring(_with_prefixes_declared(text))
+    except ET.ParseError:
+        return
+    # the formats' defaults: URDF 0 and 0, SDFormat -1e16 and 1e16
+    default = (0.0, 0.0) if kind == "urdf" else (-1e16, 1e16)
+    for joint in root.iter("joint"):
+        if kind == "urdf":
+            limit = joint.find("limit")
+            bounds = [] if limit is None else [(limit.get("lower"), limit.get("upper"))]
+        else:
+            bounds = [
+                (limit.findtext("lower"), limit.findtext("upper"))
+                for axis in ("axis", "axis2")
+                for limit in joint.findall(f"{axis}/limit")
+            ]
+        for lower, upper in bounds:
+            try:
+                lo = float(lower if lower is not None else default[0])
+                hi = float(upper if upper is not None else default[1])
+            except ValueError:
+                continue
+            if lo > hi:
+                raise ModelError(
+                    f"joint {joint.get('name')!r} in {where} has its lower limit "
+                    f"{lo:g} above its upper limit {hi:g}: swap them (Drake cannot "
+                    "load such a joint)"
+                )
 
 
 def add_coupler_constraint(

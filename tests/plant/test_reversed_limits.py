@@ -1,0 +1,87 @@
+"""A joint whose limits are reversed is refused before Drake sees it.
+
+Drake stops the whole process on such a joint (a failed internal condition,
+not an exception): ``drakegrasp plan --hand`` printed Drake's failure text
+instead of one line.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+
+from drakegrasp.errors import ModelError
+from drakegrasp.plant.couplings import add_models
+
+LINK = '<link name="{0}"><inertial><mass value="0.1"/><inertia ixx="1e-5" ' \
+    'iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>'  # fmt: skip
+
+
+def _urdf(kind="prismatic", lower="0.04", upper="0.0"):
+    limit = f'<limit lower="{lower}" upper="{upper}" effort="1" velocity="1"/>'
+    return (
+        f'<robot name="r">{LINK.format("a")}{LINK.format("b")}'
+        f'<joint name="slide" type="{kind}"><parent link="a"/><child link="b"/>'
+        f'<axis xyz="0 1 0"/>{limit}</joint></robot>'
+    )
+
+
+def _sdf(lower="<lower>0.5</lower>", upper="<upper>-0.5</upper>"):
+    return (
+        '<sdf version="1.9"><model name="m"><link name="a"/><link name="b"/>'
+        '<joint name="hinge" type="revolute"><parent>a</parent><child>b</child>'
+        f"<axis><xyz>0 0 1</xyz><limit>{lower}{upper}</limit></axis></joint>"
+        "</model></sdf>"
+    )
+
+
+_PLANTS: list = []  # a Parser does not keep its plant alive
+
+
+def _parser():
+    _PLANTS.append(MultibodyPlant(0.001))
+    return Parser(_PLANTS[-1])
+
+
+@pytest.mark.parametrize(
+    "text, kind",
+    [(_urdf(), "urdf"), (_urdf(kind="continuous"), "urdf"), (_sdf(), "sdf")],
+)
+def test_reversed_limits_are_refused_by_name(text, kind):
+    with pytest.raises(ModelError, match="joint '(slide|hinge)'.*above its upper"):
+        add_models(_parser(), text=text, kind=kind)
+
+
+def test_reversed_limits_in_a_file_name_the_file(tmp_path):
+    path = tmp_path / "hand.urdf"
+    path.write_text(_urdf())
+    with pytest.raises(ModelError, match="hand.urdf"):
+        add_models(_parser(), path)
+
+
+@pytest.mark.parametrize(
+    "text, kind",
+    [
+        (_urdf(lower="0.0", upper="0.04"), "urdf"),
+        (_sdf(lower=""), "sdf"),  # the default lower limit is -1e16
+        (_sdf(lower="", upper=""), "sdf"),
+    ],
+)
+def test_valid_limits_load(text, kind):
+    assert add_models(_parser(), text=text, kind=kind)
+
+
+def test_the_command_line_says_one_line(tmp_path):
+    path = tmp_path / "jaw.urdf"
+    path.write_text(_urdf())
+    run = subprocess.run(
+        [sys.executable, "-m", "drakegrasp", "plan", "--hand", str(path), "--num", "5"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert run.returncode != 0
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("drakegrasp: error: joint 'slide'")
