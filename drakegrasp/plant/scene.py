@@ -148,7 +148,7 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.validation import check_coefficient, check_flag
 from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
-from drakegrasp.plant.couplings import record_model_couplings
+from drakegrasp.plant.couplings import record_model_couplings, refuse_reversed_limits
 from drakegrasp.plant.models import drake_reading, explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import (
@@ -405,6 +405,7 @@ def _new_plant(path: Path, package_map: PackagesSpec, ros_package_path: bool):
 
 def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
     """Process the (checked) directives into ``plant`` and finalize it."""
+    _refuse_reversed_limits(path, directives, parser)
     try:
         added = drake_reading(ProcessModelDirectives, directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError
@@ -414,6 +415,29 @@ def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
         ) from None
     record_model_couplings(plant, added)
     plant.Finalize()
+
+
+def _refuse_reversed_limits(path: Path, directives, parser) -> None:
+    """Refuse a model of the scene whose joint limits are reversed (Drake aborts).
+
+    Each ``add_model``'s file is read first
+    (:func:`~drakegrasp.plant.couplings.refuse_reversed_limits`); one that
+    cannot be resolved or read is left to Drake, which reports it.
+    """
+    for d in directives.directives:
+        if d.add_model is None:
+            continue
+        try:
+            model = Path(parser.package_map().ResolveUrl(d.add_model.file))
+            kind = {".urdf": "urdf", ".sdf": "sdf"}.get(model.suffix.lower())
+            text = model.read_text() if kind else None
+        except (RuntimeError, OSError, ValueError):
+            continue
+        if text is not None:
+            try:
+                refuse_reversed_limits(text, kind, model.name)
+            except ModelError as e:
+                raise ModelError(f"scene {str(path)!r}: {e}") from None
 
 
 def _scene_body(path: Path, plant: MultibodyPlant, name: str) -> RigidBody:

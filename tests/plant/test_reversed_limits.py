@@ -16,6 +16,7 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from drakegrasp.errors import ModelError
 from drakegrasp.plant.couplings import add_models
+from drakegrasp.plant.scene import load_scene
 
 LINK = '<link name="{0}"><inertial><mass value="0.1"/><inertia ixx="1e-5" ' \
     'iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>'  # fmt: skip
@@ -85,3 +86,21 @@ def test_the_command_line_says_one_line(tmp_path):
     assert run.returncode != 0
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("drakegrasp: error: joint 'slide'")
+
+
+def test_a_scene_with_reversed_limits_is_refused_naming_scene_and_file(tmp_path):
+    (tmp_path / "jaw.urdf").write_text(_urdf())
+    (tmp_path / "ball.sdf").write_text(
+        '<sdf version="1.9"><model name="ball"><link name="body"><collision '
+        'name="c"><geometry><sphere><radius>0.02</radius></sphere></geometry>'
+        "</collision></link></model></sdf>"
+    )
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(
+        "directives:\n- add_model:\n    name: jaw\n    file: jaw.urdf\n"
+        "- add_weld:\n    parent: world\n    child: jaw::a\n"
+        "- add_model:\n    name: ball\n    file: ball.sdf\n"
+        "drakegrasp:\n  object_body: ball::body\n  hand: jaw\n  mu: 0.5\n"
+    )
+    with pytest.raises(ModelError, match=r"scene.yaml.*'slide' in jaw.urdf"):
+        load_scene(scene)
