@@ -78,6 +78,11 @@ from drakegrasp.planning.turned_gravity import (
 )
 from drakegrasp.plant.couplings import motor_shares, plant_couplings
 from drakegrasp.plant.fingers import effort_unit, find_joint
+from drakegrasp.plant.friction import (
+    MU_RELATIVE_TOL,
+    FrictionMismatchWarning,
+    hand_object_friction,
+)
 from drakegrasp.plant.hydroelastic import (
     check_hydroelastic_modulus,
     use_hydroelastic_contact,
@@ -136,6 +141,29 @@ class SoftFingerShakeWarning(UserWarning):
     drop a grasp that the plan's model holds.  Hydroelastic fingers
     (``hydroelastic_modulus=``) press over patches, which do resist it.
     """
+
+
+def _warn_friction(plant, ctx, body, hand, candidate: GraspCandidate) -> None:
+    """Warn when the plan's ``μ`` is not the friction Drake simulates here."""
+    try:
+        mu = float(candidate.contact_options.get("mu"))
+        simulated = hand_object_friction(plant, ctx, body, hand)
+    except (TypeError, ValueError, GraspError):
+        return  # no planned μ, or friction the plant cannot tell: nothing to say
+    if not (math.isfinite(mu) and len(simulated)):
+        return
+    lo, hi = float(np.min(simulated)), float(np.max(simulated))
+    if max(abs(lo - mu), abs(hi - mu)) <= MU_RELATIVE_TOL * mu:
+        return
+    warnings.warn(
+        f"the candidate was planned with mu = {mu:g}, but Drake simulates the "
+        "models' friction between hand and object, mu = "
+        f"{lo:g}{'' if lo == hi else f' to {hi:g}'}: the shake tests the grasp "
+        "at that friction (plan with the models' friction, `drakegrasp plan --mu "
+        "plant`, or set their coulomb_friction, to plan and shake alike)",
+        FrictionMismatchWarning,
+        stacklevel=3,
+    )
 
 
 def _scoped(plant, joint) -> str:
@@ -611,6 +639,9 @@ def shake_test(
         The candidate was planned with soft fingers and the shake runs in
         point contact (no ``hydroelastic_modulus``), which resists no torque
         about a contact normal.
+    FrictionMismatchWarning
+        The candidate was planned with a ``μ`` other than the friction Drake
+        simulates between the hand and the object (the models' own).
     """
     if not callable(add_models):
         raise InvalidOptionError(
@@ -678,7 +709,9 @@ def shake_test(
                 f"closing joint {name} has no actuator to squeeze with (give it "
                 "one, a URDF <transmission> or an SDFormat <drake:actuator>, or "
                 "couple it to an actuated joint with a <mimic> that drakegrasp "
-                "reads: drakegrasp.plant.add_models in add_models)"
+                "reads: drakegrasp.plant.add_models in add_models; Drake's "
+                "parser gives no actuator to a URDF joint whose effort limit "
+                "is 0)"
             )
         # a leader's motor also presses through the followers it drives: each
         # of them and the leader press with squeeze (within the effort limit)
@@ -742,6 +775,7 @@ def shake_test(
     if inertia is not None:
         body.SetSpatialInertiaInBodyFrame(ctx, inertia)
     candidate.apply(plant, ctx, object_body=body)
+    _warn_friction(plant, ctx, body, hand, candidate)
     q_held = plant.GetPositions(ctx)
 
     def aim() -> None:

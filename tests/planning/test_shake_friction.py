@@ -1,0 +1,52 @@
+"""A shake says so when the plan's μ is not the friction Drake simulates.
+
+``plan --mu 10 --shake`` planned "0.2 N per finger" and shook at the
+models' μ = 1 without a word.  The shake keeps simulating the models'
+friction (what a real hand meets) and warns when the plan assumed another.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.plant.friction import FrictionMismatchWarning, hand_object_friction
+
+BOX = "package://drakegrasp/objects/box.sdf"
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return planning_scene(BOX)
+
+
+def _best(scene, mu):
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=30, mu=mu, seed=0,
+    )  # fmt: skip
+    return result[0]
+
+
+def _models_mu(scene) -> float:
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    mus = hand_object_friction(
+        scene.plant, ctx, scene.object_body, scene.hand, rule="dynamic"
+    )
+    assert np.ptp(mus) == 0  # one friction for every hand-object pair
+    return float(mus[0])
+
+
+def test_a_plan_at_another_mu_warns_with_both_figures(scene):
+    mu = _models_mu(scene)
+    with pytest.warns(FrictionMismatchWarning, match=f"mu = {3 * mu:g}.*mu = {mu:g}"):
+        shake_test(scene.add_models, _best(scene, 3 * mu))
+
+
+def test_a_plan_at_the_models_mu_does_not(scene):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FrictionMismatchWarning)
+        shake_test(scene.add_models, _best(scene, _models_mu(scene)))
