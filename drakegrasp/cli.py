@@ -484,6 +484,9 @@ def _cli_words(message: str, command: str | None) -> str:
         "give hydroelastic_modulus= (1e6 Pa, rubber)",
         "give --hydroelastic 1e6 (Pa, rubber)",
     )
+    message = message.replace(  # the shake's friction advice
+        "plan with the models' friction,", "plan with --mu plant,"
+    )
     if command == "batch":  # batch --kind form: the friction program's flag
         message = re.sub(
             r"(needs friction); use batch_force_closure\b", r"\1; use --kind force",

@@ -41,6 +41,7 @@ over the edge's normal fan (:func:`fan_capacity`); the torque needed (with
 from __future__ import annotations
 
 import time
+import warnings
 from collections import Counter
 
 import numpy as np
@@ -90,12 +91,13 @@ from drakegrasp.plant._closing_steps import closest
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
 from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import finger_chains, hand_structure
+from drakegrasp.plant.fingers import finger_chains, hand_structure, passive_joints
 from drakegrasp.plant.validation import hand_bodies, scoped_name
 
 __all__ = [
     "DEFAULT_TILT",
     "REASONS",
+    "PassiveJointWarning",
     "close_candidates",
     "fan_capacity",
     "hand_is_parallel_jaw",
@@ -104,6 +106,22 @@ __all__ = [
     "plan_multifinger_cloud",
     "rank_multifinger",
 ]
+
+
+class PassiveJointWarning(UserWarning):
+    """A hand has joints no motor moves, which the planner holds locked.
+
+    A one-dof joint without an actuator that follows no other (no
+    ``<mimic>``) is passive: in Drake it turns freely between its limits.
+    The planner closes the motors' joints only and keeps a passive one where
+    the context puts it, as if welded, and its torque figures leave it out;
+    :func:`~drakegrasp.analyze_grasp`'s load check gives it no torque, and
+    :func:`~drakegrasp.planning.shake_test` lets it turn.  A grasp that
+    loads it may fold: on a three-finger hand with passive distal joints
+    (damped, at 0.2 rad of [0, 1.2]) 2 of the 4 best planned box grasps
+    dropped in Drake, and all 4 held with those joints welded.
+    """
+
 
 DEFAULT_TILT = np.radians(20.0)
 """Default largest tilt of the approach from the surface's inward normal."""
@@ -517,6 +535,24 @@ def _ranked_result(
     )
 
 
+def _warn_passive(plant, body, hand, structure) -> None:
+    """:class:`PassiveJointWarning` naming the hand's passive joints, if any."""
+    passive = passive_joints(plant, hand_bodies(plant, body, hand), structure)
+    if not passive:
+        return
+    names = ", ".join(scoped_name(plant, j) for j in passive)
+    warnings.warn(
+        f"joint(s) {names} have no actuator and follow no other joint: the "
+        "planner holds them where the context puts them, as if welded, and "
+        "ranks torque without them, but in Drake they turn freely between "
+        "their limits, so a planned grasp that loads them may fold (shake_test "
+        "simulates them as they are); give them a <transmission>, couple them "
+        "with a <mimic>, or weld them, to plan the hand Drake simulates",
+        PassiveJointWarning,
+        stacklevel=4,
+    )
+
+
 def _checked_hand(
     plant, ctx, body, hand, *, tilt, min_fingers, preshape, synergy,
     synergy_range, approach, standoff,
@@ -531,6 +567,7 @@ def _checked_hand(
         plant, ctx, body, hand, preshape=preshape, synergy=synergy,
         synergy_range=synergy_range, approach=approach, standoff=standoff,
     )  # fmt: skip
+    _warn_passive(plant, body, hand, hand_model.structure)
     if min_fingers > hand_model.num_fingers:
         fingers = [f.name for f in hand_model.chains]
         joints = len(hand_model.structure.names)

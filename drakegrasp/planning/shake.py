@@ -159,8 +159,8 @@ def _warn_friction(plant, ctx, body, hand, candidate: GraspCandidate) -> None:
         f"the candidate was planned with mu = {mu:g}, but Drake simulates the "
         "models' friction between hand and object, mu = "
         f"{lo:g}{'' if lo == hi else f' to {hi:g}'}: the shake tests the grasp "
-        "at that friction (plan with the models' friction, `drakegrasp plan --mu "
-        "plant`, or set their coulomb_friction, to plan and shake alike)",
+        "at that friction (plan with the models' friction, or set their "
+        "coulomb_friction to the plan's, to plan and shake alike)",
         FrictionMismatchWarning,
         stacklevel=3,
     )

@@ -56,6 +56,7 @@ __all__ = [
     "free_part",
     "hand_structure",
     "most_fingers",
+    "passive_joints",
     "tip_bodies",
 ]
 
@@ -353,6 +354,39 @@ def _finger(plant, members, moved, bodies, position, object_geometries, inspecto
             for j in members
         ),
     )
+
+
+def passive_joints(
+    plant: MultibodyPlant, bodies: Sequence[RigidBody], structure: HandStructure
+) -> tuple[Joint, ...]:
+    """The hand's one-dof joints that no motor moves: not closing joints.
+
+    A joint of a hand with actuators that has none and follows no other
+    (no ``<mimic>``): in Drake it turns freely between its limits.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    bodies : sequence of RigidBody
+        The hand's movable bodies, as for :func:`hand_structure`.
+    structure : HandStructure
+        What :func:`hand_structure` learnt of them.
+
+    Returns
+    -------
+    tuple of Joint
+        In the order of the plant's positions.
+    """
+    wanted = {int(b.index()) for b in bodies}
+    closing = {int(j.index()) for j in structure.joints}
+    found = [
+        plant.get_joint(JointIndex(i))
+        for i in range(plant.num_joints())
+        if plant.get_joint(JointIndex(i)).num_positions() == 1
+        and int(plant.get_joint(JointIndex(i)).child_body().index()) in wanted
+        and i not in closing
+    ]
+    return tuple(sorted(found, key=lambda j: j.position_start()))
 
 
 def hand_structure(

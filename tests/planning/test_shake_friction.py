@@ -50,3 +50,11 @@ def test_a_plan_at_the_models_mu_does_not(scene):
     with warnings.catch_warnings():
         warnings.simplefilter("error", FrictionMismatchWarning)
         shake_test(scene.add_models, _best(scene, _models_mu(scene)))
+
+
+def test_the_command_line_gives_the_advice_as_a_flag(capsys):
+    from drakegrasp.cli import main
+
+    assert main(["plan", "--num", "30", "--top", "1", "--shake", "1", "--mu", "3"]) == 0
+    warned = [w for w in capsys.readouterr().err.splitlines() if "mu = 3" in w]
+    assert len(warned) == 1 and "plan with --mu plant," in warned[0]
