@@ -353,8 +353,12 @@ class SecondOrderResult:
             self.order, "no"
         )
         lam = np.round(self.multipliers, 4).tolist()
+        # no equilibrium to test: the program of t* was not solved
+        t_star = (
+            f"t* = {self.t_star:.6g}" if math.isfinite(self.t_star) else "t* not solved"
+        )
         line = (
-            f"second-order form closure: {verdict}, t* = {self.t_star:.6g}, "
+            f"second-order form closure: {verdict}, {t_star}, "
             f"dim W = {self.dim_w}, λ* = {lam}, solver {self.solver} "
             f"({self.status})"
         )

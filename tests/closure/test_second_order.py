@@ -554,6 +554,7 @@ def test_no_equilibrium_gives_a_first_order_escape():
     assert not r.is_closure and r.escape_verified and math.isnan(r.t_star)
     assert np.all(normal_grasp_matrix(g).T @ r.escape_twist > 0)
     assert "no equilibrium" in str(r)
+    assert "t* not solved" in str(r) and "nan" not in str(r)  # not "t* = nan"
     assert r.to_dict()["support"] == []
 
 
