@@ -1455,6 +1455,9 @@ _PLAN_REASON_WORDS = {
         "--torsional-friction NU)"
     ),
     "num_candidates is 0": "--num is 0",
+    "open it wider (preshape=) or move the palm back (standoff=)": (
+        "open it wider (--preshape JOINT=VALUE)"
+    ),
     "the jaw at squeeze_limit ": "the jaw at --squeeze-limit ",
     "the hand at torque_limit ": "the hand at --torque-limit ",
 }

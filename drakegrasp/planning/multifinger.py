@@ -40,6 +40,7 @@ over the edge's normal fan (:func:`fan_capacity`); the torque needed (with
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from collections import Counter
@@ -96,6 +97,7 @@ from drakegrasp.plant.validation import hand_bodies, scoped_name
 
 __all__ = [
     "DEFAULT_TILT",
+    "OPEN_HAND_HINT",
     "REASONS",
     "PassiveJointWarning",
     "close_candidates",
@@ -523,7 +525,7 @@ def _ranked_result(
         noise=settings["noise"], rng=rng, certify=certify, workers=workers,
         X_WO=X_WO, weight=weight, reference=reference,
     )  # fmt: skip
-    return planning_result(
+    result = planning_result(
         candidates,
         rejections=rejections,
         num_sampled=num_sampled,
@@ -533,6 +535,19 @@ def _ranked_result(
         settings=settings,
         started=started,
     )
+    collided = sum(n for why, n in rejections.items() if why in _OPEN_HAND_COLLIDES)
+    if not candidates and num_sampled and collided == num_sampled:
+        result = dataclasses.replace(result, reason=result.reason + OPEN_HAND_HINT)
+    return result
+
+
+_OPEN_HAND_COLLIDES = ("hand collides with the object", "hand collides with the cloud")
+
+OPEN_HAND_HINT = (
+    "; the open hand collides wherever it is placed: open it wider "
+    "(preshape=) or move the palm back (standoff=)"
+)
+"""Added to an empty result's reason when every pose collided as placed."""
 
 
 def _warn_passive(plant, body, hand, structure) -> None:

@@ -58,3 +58,24 @@ def test_a_hand_whose_joints_all_move_with_motors_plans_without_it(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error", PassiveJointWarning)
         _plan(_scene(tmp_path, passive=False))
+
+
+def test_an_open_hand_that_collides_everywhere_is_told_to_open(tmp_path, capsys):
+    # the spread hand curled shut (its flexion joints at their upper limits)
+    # penetrates the cylinder at every sampled pose
+    from drakegrasp.cli import main
+    from drakegrasp.planning.multifinger import OPEN_HAND_HINT
+
+    shut = [f"f{k}_proximal_joint" for k in (1, 2, 3)]
+    scene = _scene(tmp_path, passive=False)
+    ctx = scene.plant.GetMyMutableContextFromRoot(scene.context)
+    for name in shut:
+        scene.plant.GetJointByName(name).set_angle(ctx, 2.0)
+    result = _plan(scene)
+    assert len(result) == 0
+    assert set(result.rejections) == {"hand collides with the object"}
+    assert result.reason.endswith(OPEN_HAND_HINT)
+    argv = ["plan", "cylinder", "--hand", str(tmp_path / "hand_False.urdf")]
+    argv += ["--num", "10", *(f"--preshape={name}=2.0" for name in shut)]
+    assert main(argv) == 0
+    assert "open it wider (--preshape JOINT=VALUE)" in capsys.readouterr().out
