@@ -26,7 +26,8 @@ Usage::
                     [--shake K [--squeeze X] [--stiffness K] [--damping D]
                      [--hydroelastic PA|none]]
                     [--package NAME=DIR ...] [--allow-any-file] [--progress]
-                    [--json | --out FILE.parquet [--overwrite]]
+                    [--json | --out FILE.parquet] [--scene-out FILE.yaml]
+                    [--overwrite]
 
 Every option's default and meaning: ``drakegrasp COMMAND --help`` (read from
 the library's own defaults), or the generated reference in the CLI guide.
@@ -100,7 +101,8 @@ traceback), 2 for a bad command line (argparse), 130 on Ctrl-C (SIGINT) with
 one line ``drakegrasp: interrupted``, 143 on SIGTERM and 129 on SIGHUP with one
 line ``drakegrasp: terminated by SIGTERM`` (the run unwinds as on Ctrl-C: no
 partial file, scratch folder or worker process is left).  ``batch`` and
-``plan --out`` refuse an output that exists unless ``--overwrite`` (``batch``
+``plan --out`` / ``--scene-out`` refuse an output that exists unless
+``--overwrite`` (``batch``
 also one that is its input), checked before any work; both write atomically
 (a temporary file renamed into place), so an interrupted run loses nothing.
 Set ``DRAKEGRASP_DEBUG=1`` to see the traceback of an unexpected error.
@@ -1339,8 +1341,12 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         check_output(
             Path(args.out), (), overwrite=args.overwrite, remedy="pass --overwrite"
         )
-    elif args.overwrite:
-        raise InvalidOptionError("--overwrite is for --out FILE.parquet")
+    if args.scene_out is not None:
+        _check_scene_out(args)
+    elif args.overwrite and args.out is None:
+        raise InvalidOptionError(
+            "--overwrite is for --out FILE.parquet or --scene-out FILE.yaml"
+        )
     if args.progress:
         _check_progress()
     shake = _shake_options(args)
@@ -1369,20 +1375,83 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if args.json:
         data = result.to_dict()
         data["candidates"] = data["candidates"][: args.top]
+        shaken = None
         if shake is not None:
-            data["shaken"] = _shaken(add_models, result, args, shake).to_dict()
+            shaken = _shaken(add_models, result, args, shake)
+            data["shaken"] = shaken.to_dict()
         json.dump(data, sys.stdout, indent=2)
         sys.stdout.write("\n")
-        return 0
+        return _write_scene_out(args, result, shaken, plant, context, object_body)
     if args.out is None:
         print(result.__str__().split("\n  #")[0])
         for k, c in enumerate(result[: args.top]):
             print(f"  #{k:<3} {c}")
     else:
         print(f"wrote {len(result)} candidates to {args.out}")
+    shaken = None
     if shake is not None:
         sys.stdout.flush()
-        print(_shaken(add_models, result, args, shake))
+        shaken = _shaken(add_models, result, args, shake)
+        print(shaken)
+    return _write_scene_out(args, result, shaken, plant, context, object_body)
+
+
+def _check_scene_out(args: argparse.Namespace) -> None:
+    """``plan --scene-out``: refused up front where it cannot be written."""
+    if not args.scene_out.endswith((".yaml", ".yml")):
+        raise InvalidOptionError(
+            f"--scene-out must name a .yaml file, got {args.scene_out!r}"
+        )
+    if _is_scene(args.object):
+        raise InvalidOptionError(
+            "--scene-out writes the grasp of an object and --hand; a scene's "
+            "own file places its hand: apply a candidate to it in Python "
+            "(candidate.apply, then analyze_grasp)"
+        )
+    path = Path(args.scene_out)
+    if path.is_dir():
+        raise InvalidOptionError(f"--scene-out {str(path)!r} is a directory")
+    if path.exists() and not args.overwrite:
+        raise InvalidOptionError(
+            f"--scene-out {str(path)!r} exists; pass --overwrite to replace it"
+        )
+    if not path.resolve().parent.is_dir():
+        raise InvalidOptionError(
+            f"--scene-out {str(path)!r}: its folder does not exist"
+        )
+
+
+def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:
+    """``plan --scene-out``: the best candidate as a scene ``analyze`` loads.
+
+    The planner's best, or with ``--shake`` the best of those that held.
+    """
+    if args.scene_out is None:
+        return 0
+    from drakegrasp.batch.files.writer import placed
+    from drakegrasp.planning.grasp_scene import grasp_scene_text
+
+    if not len(result):
+        raise InvalidOptionError("--scene-out: the plan has no candidate to write")
+    best = result[0] if shaken is None or shaken.best is None else shaken.best
+    rank = next(k for k, c in enumerate(result) if c is best)
+    held = "" if shaken is None else (" (held)" if shaken.best is not None else "")
+    path = Path(args.scene_out)
+    text = grasp_scene_text(
+        plant, context, best, object_body=object_body,
+        hand_file=_plan_hand(args.hand), object_file=_plan_url(args.object),
+        mu=result.mu, folder=path.resolve().parent,
+        description=f"Candidate #{rank}{held} of drakegrasp plan "
+        f"{args.object} --hand {args.hand or 'flat'} (sample {best.sample}).",
+    )  # fmt: skip
+    with placed(path, overwrite=args.overwrite) as tmp:
+        Path(tmp).write_text(text)
+    note = "" if shaken is None or shaken.best is not None else ", none held"
+    line = f"wrote candidate #{rank}{note} to {path} (drakegrasp analyze {path})"
+    if args.json:  # stdout holds the JSON document alone
+        _say(f"drakegrasp: {line}")
+    else:
+        print(line)
     return 0
 
 
@@ -1666,10 +1735,20 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         "an existing file is refused unless --overwrite",
     )
     plan.add_argument(
+        "--scene-out",
+        default=None,
+        metavar="FILE.yaml",
+        help="write the best candidate (with --shake: the best that held) as a "
+        "scene file that `drakegrasp analyze FILE.yaml` loads: the hand welded "
+        "where the plan put it, every joint set, the object at its pose; model "
+        "files are referred to relative to FILE's folder (one outside it needs "
+        "analyze --allow-any-file); for an object and --hand, not a scene",
+    )
+    plan.add_argument(
         "--overwrite",
         action="store_true",
-        help="with --out: replace an existing file (default: refuse); it is "
-        "written to a temporary file and renamed into place",
+        help="with --out or --scene-out: replace an existing file (default: "
+        "refuse); it is written to a temporary file and renamed into place",
     )
     plan.set_defaults(func=_cmd_plan)
 

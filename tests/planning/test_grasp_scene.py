@@ -1,0 +1,125 @@
+"""A planned grasp written as a scene file analyses as planned.
+
+``grasp_scene_text`` (and ``drakegrasp plan --scene-out``) write a
+candidate as the scene ``drakegrasp analyze`` loads: the hand welded at
+``X_WH`` with every joint set, the object at ``X_WO``.  The second route is
+the scene loader and ``analyze_grasp`` on what it builds, against the plan's
+own contacts and verdict.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from coupled_hands import coupled_jaw_urdf
+
+import drakegrasp as dg
+from drakegrasp.cli import main
+from drakegrasp.planning import plan_grasps, planning_scene
+from drakegrasp.planning.grasp_scene import grasp_scene_text
+from drakegrasp.plant.scene import load_scene
+
+BOX = "package://drakegrasp/objects/box.sdf"
+FLAT = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+ALLEGRO = (
+    "package://drake_models/allegro_hand_description/sdf/"
+    "allegro_hand_description_right.sdf"
+)
+SOUP = "package://drake_models/ycb/005_tomato_soup_can.sdf"
+
+
+def _plan(scene, n=40, mu=0.5):
+    return plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=n, mu=mu, seed=0, robustness_samples=4,
+    )  # fmt: skip
+
+
+def _as_planned(tmp_path, scene, result, hand_file, object_file, top=3):
+    """Each of the ``top`` best written, loaded and analysed as planned."""
+    assert len(result) >= top
+    for k, c in enumerate(result[:top]):
+        path = tmp_path / f"grasp_{k}.yaml"
+        path.write_text(
+            grasp_scene_text(
+                scene.plant,
+                scene.context,
+                c,
+                object_body=scene.object_body,
+                hand_file=hand_file,
+                object_file=object_file,
+                mu=result.mu,
+                folder=tmp_path,
+            )  # fmt: skip
+        )
+        loaded = load_scene(path)
+        report = dg.analyze_grasp(
+            loaded.plant, loaded.plant_context, loaded.object_body,
+            hand=loaded.hand, mu=result.mu,
+        )  # fmt: skip
+        assert report.force_closure.is_closure == c.is_closure
+        assert len(report.contacts) == len(c.contacts)
+        got = np.array([p.p_OC for p in report.contacts])
+        want = np.array([p.p_OC for p in c.contacts])
+        np.testing.assert_allclose(got, want, atol=1e-9)
+        np.testing.assert_allclose(
+            loaded.plant.EvalBodyPoseInWorld(
+                loaded.plant_context, loaded.object_body
+            ).GetAsMatrix4(),
+            c.X_WO.GetAsMatrix4(),
+            atol=1e-12,
+        )
+
+
+def test_the_flat_jaw_on_the_box(tmp_path):
+    scene = planning_scene(BOX, hand_url=FLAT)
+    _as_planned(tmp_path, scene, _plan(scene), FLAT, BOX)
+
+
+def test_files_by_path_are_written_relative_to_the_scene(tmp_path):
+    # a one-motor jaw of one's own, in the scene's folder: found from there
+    hand = tmp_path / "jaw.urdf"
+    hand.write_text(coupled_jaw_urdf(offset=-0.002))
+    moved = dg.planning_scene(BOX, hand_url=str(hand))
+    result = _plan(moved)
+    text = grasp_scene_text(
+        moved.plant, moved.context, result[0], object_body=moved.object_body,
+        hand_file=hand, object_file=BOX, mu=result.mu, folder=tmp_path,
+    )  # fmt: skip
+    assert "file: jaw.urdf" in text
+    _as_planned(tmp_path, moved, result, hand, BOX)
+
+
+def test_the_allegro_hand_on_the_soup_can(tmp_path, drake_models_dir):
+    scene = planning_scene(SOUP, hand_url=ALLEGRO, models_dir=drake_models_dir)
+    ctx = scene.plant.GetMyMutableContextFromRoot(scene.context)
+    scene.plant.GetJointByName("joint_12").set_angle(ctx, 1.0)  # thumb opposed
+    _as_planned(tmp_path, scene, _plan(scene, n=60, mu=1.0), ALLEGRO, SOUP, top=2)
+
+
+def test_the_command_line_writes_and_analyze_reads_it(tmp_path, capsys):
+    out = tmp_path / "best.yaml"
+    argv = ["plan", "--num", "40", "--top", "1", "--scene-out", str(out)]
+    assert main(argv) == 0
+    assert f"wrote candidate #0 to {out}" in capsys.readouterr().out
+    assert main(["analyze", str(out)]) == 0
+    assert "force closure: YES" in capsys.readouterr().out
+    # an existing file is kept unless --overwrite
+    assert main(argv) != 0
+    assert "pass --overwrite" in capsys.readouterr().err
+    assert main([*argv, "--overwrite"]) == 0
+
+
+@pytest.mark.parametrize(
+    "argv, says",
+    [
+        (["parallel_jaw_box"], "a scene's own file places its hand"),
+        (["box", "--scene-out", "x.txt"], "must name a .yaml file"),
+    ],
+)
+def test_the_command_line_refuses_what_it_cannot_write(tmp_path, capsys, argv, says):
+    if "--scene-out" not in argv:
+        argv = [*argv, "--scene-out", str(tmp_path / "x.yaml")]
+    assert main(["plan", "--num", "5", *argv]) != 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and says in err[0]
