@@ -111,15 +111,16 @@ __all__ = [
 
 
 class PassiveJointWarning(UserWarning):
-    """A hand has joints no motor moves, which the planner holds locked.
+    """A hand has joints no motor moves, which the planner treats as driven.
 
-    A one-dof joint without an actuator that follows no other (no
-    ``<mimic>``) is passive: in Drake it turns freely between its limits.
-    The planner closes the motors' joints only and keeps a passive one where
-    the context puts it, as if welded, and its torque figures leave it out;
-    :func:`~drakegrasp.analyze_grasp`'s load check gives it no torque, and
-    :func:`~drakegrasp.planning.shake_test` lets it turn.  A grasp that
-    loads it may fold: on a three-finger hand with passive distal joints
+    A one-dof joint without an actuator that follows no driven joint (no
+    ``<mimic>`` of a joint with a motor) is passive: in Drake it turns freely
+    between its limits.  The planner closes the motors' joints (and those
+    coupled to them) and holds the others where the context puts them, as if
+    welded; its torque figures leave them out.
+    :func:`~drakegrasp.analyze_grasp`'s load check gives a passive joint no
+    torque, and :func:`~drakegrasp.planning.shake_test` lets it turn.  A grasp
+    that loads it may fold: on a three-finger hand with passive distal joints
     (damped, at 0.2 rad of [0, 1.2]) 2 of the 4 best planned box grasps
     dropped in Drake, and all 4 held with those joints welded.
     """
@@ -557,12 +558,13 @@ def _warn_passive(plant, body, hand, structure) -> None:
         return
     names = ", ".join(scoped_name(plant, j) for j in passive)
     warnings.warn(
-        f"joint(s) {names} have no actuator and follow no other joint: the "
-        "planner holds them where the context puts them, as if welded, and "
-        "ranks torque without them, but in Drake they turn freely between "
-        "their limits, so a planned grasp that loads them may fold (shake_test "
-        "simulates them as they are); give them a <transmission>, couple them "
-        "with a <mimic>, or weld them, to plan the hand Drake simulates",
+        f"no motor moves joint(s) {names} (no actuator, and no <mimic> of a "
+        "joint with one): in Drake they turn freely between their limits, but "
+        "the planner closes or holds them as if driven or welded and ranks "
+        "torque without them, so a planned grasp that loads them may fold "
+        "(shake_test simulates them as they are); give them a <transmission>, "
+        "couple them with a <mimic> to a driven joint, or weld them, to plan "
+        "the hand Drake simulates",
         PassiveJointWarning,
         stacklevel=4,
     )

@@ -62,7 +62,7 @@ __all__ = [
     "JointCoupling",
     "add_coupler_constraint",
     "add_models",
-    "refuse_reversed_limits",
+    "check_joint_limits",
     "coupled_torque_limits",
     "coupling_map",
     "coupling_violations",
@@ -296,7 +296,7 @@ def add_models(
     if text is not None:
         if kind not in ("urdf", "sdf"):
             raise InvalidOptionError(f"text needs kind='urdf' or 'sdf', got {kind!r}")
-        refuse_reversed_limits(text, kind, "the model text")
+        check_joint_limits(text, kind, "the model text")
         instances = parser.AddModelsFromString(text, kind)
         _record_text(plant, text, kind, instances)
         return instances
@@ -304,7 +304,7 @@ def add_models(
     kind = _kind_of(path)
     document = Path(path).read_text() if kind and Path(path).is_file() else None
     if document is not None:
-        refuse_reversed_limits(document, kind, path)
+        check_joint_limits(document, kind, path)
     if url is not None:
         instances = parser.AddModels(url=url)
     else:
@@ -314,12 +314,22 @@ def add_models(
     return instances
 
 
-def refuse_reversed_limits(text: str, kind: str, where: str) -> None:
-    """Refuse a joint whose lower position limit lies above its upper one.
+def check_joint_limits(text: str, kind: str, where: str) -> None:
+    """Refuse joint limits that would stop the process inside Drake.
 
-    Drake stops the process on such a joint (a failed internal condition,
-    not an exception), so the document is read first.  A document that is
-    not XML, or a limit that is not a number, is left to Drake's parser.
+    Drake stops the whole process (a failed internal condition, not an
+    exception) on a joint whose lower position limit lies above its upper one,
+    or is NaN.  Its SDFormat parser refuses a reversed pair itself, but not a
+    NaN; its URDF parser refuses neither.  So the document is read first, as
+    Drake reads it: the limits of revolute and prismatic joints, and of a
+    URDF's continuous ones (Drake ignores the others'), a missing bound as no
+    bound (∓inf).  A URDF
+    value is read by its leading decimal number, as Drake's URDF parser reads
+    it (``0.5abc`` is 0.5, ``1_0`` is 1, ``0x1p-1`` is 0); an SDFormat pair is
+    compared only where both are plain numbers (SDFormat reads other forms
+    its own way, and Drake refuses a reversed pair there itself).  A document
+    that is not XML, or a value without a leading number, is left to Drake's
+    parser, which reports it.
 
     Raises
     ------
@@ -332,30 +342,64 @@ def refuse_reversed_limits(text: str, kind: str, where: str) -> None:
         root = ET.fromstring(_with_prefixes_declared(text))
     except ET.ParseError:
         return
-    # the formats' defaults: URDF 0 and 0, SDFormat -1e16 and 1e16
-    default = (0.0, 0.0) if kind == "urdf" else (-1e16, 1e16)
     for joint in root.iter("joint"):
+        if (joint.get("type") or "").lower() not in _LIMITED_JOINTS[kind]:
+            continue
         if kind == "urdf":
             limit = joint.find("limit")
             bounds = [] if limit is None else [(limit.get("lower"), limit.get("upper"))]
         else:
             bounds = [
                 (limit.findtext("lower"), limit.findtext("upper"))
-                for axis in ("axis", "axis2")
-                for limit in joint.findall(f"{axis}/limit")
+                for limit in joint.findall("axis/limit")
             ]
+        name = joint.get("name")
         for lower, upper in bounds:
-            try:
-                lo = float(lower if lower is not None else default[0])
-                hi = float(upper if upper is not None else default[1])
-            except ValueError:
-                continue
+            lo = _limit_value(lower, -math.inf, kind)
+            hi = _limit_value(upper, math.inf, kind)
+            if any(v is not None and math.isnan(v) for v in (lo, hi)):
+                raise ModelError(
+                    f"joint {name!r} in {where} has a limit that is not a number "
+                    f"(lower {lower!r}, upper {upper!r}): give a number or leave the "
+                    "bound out (Drake cannot load such a joint)"
+                )
+            if lo is None or hi is None:
+                continue  # no number Drake reads alike: its parser says
             if lo > hi:
                 raise ModelError(
-                    f"joint {joint.get('name')!r} in {where} has its lower limit "
-                    f"{lo:g} above its upper limit {hi:g}: swap them (Drake cannot "
-                    "load such a joint)"
+                    f"joint {name!r} in {where} has its lower limit {lo:g} above "
+                    f"its upper limit {hi:g}: swap them (Drake cannot load such a "
+                    "joint)"
                 )
+
+
+_LIMITED_JOINTS = {
+    "urdf": ("revolute", "prismatic", "continuous"),
+    "sdf": ("revolute", "prismatic"),
+}
+"""Joint types whose position limits Drake reads (an SDFormat continuous joint
+has none in Drake; SDFormat itself refuses its reversed pair)."""
+
+_LEADING_NUMBER = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)")
+_NAN = re.compile(r"\s*[+-]?nan", re.IGNORECASE)
+
+
+def _limit_value(text: str | None, missing: float, kind: str) -> float | None:
+    """A limit's text as Drake reads it: a number, NaN, or None (Drake's to say).
+
+    A URDF value's leading decimal number; an SDFormat value only when it is
+    a plain number as a whole.
+    """
+    if text is None:
+        return missing
+    if _NAN.match(text):
+        return math.nan
+    number = (
+        _LEADING_NUMBER.match(text)
+        if kind == "urdf"
+        else _LEADING_NUMBER.fullmatch(text.strip())
+    )
+    return float(number.group(1)) if number else None
 
 
 def add_coupler_constraint(

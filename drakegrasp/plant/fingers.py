@@ -359,10 +359,12 @@ def _finger(plant, members, moved, bodies, position, object_geometries, inspecto
 def passive_joints(
     plant: MultibodyPlant, bodies: Sequence[RigidBody], structure: HandStructure
 ) -> tuple[Joint, ...]:
-    """The hand's one-dof joints that no motor moves: not closing joints.
+    """The hand's one-dof joints that no motor moves.
 
-    A joint of a hand with actuators that has none and follows no other
-    (no ``<mimic>``): in Drake it turns freely between its limits.
+    A joint is driven when it has an actuator, or follows (through its
+    couplings, a ``<mimic>``) a driven joint; the others turn freely in Drake
+    between their limits.  A hand none of whose joints has an actuator (a
+    model that describes no motors) has none.
 
     Parameters
     ----------
@@ -370,7 +372,7 @@ def passive_joints(
     bodies : sequence of RigidBody
         The hand's movable bodies, as for :func:`hand_structure`.
     structure : HandStructure
-        What :func:`hand_structure` learnt of them.
+        What :func:`hand_structure` learnt of them (its couplings).
 
     Returns
     -------
@@ -378,15 +380,34 @@ def passive_joints(
         In the order of the plant's positions.
     """
     wanted = {int(b.index()) for b in bodies}
-    closing = {int(j.index()) for j in structure.joints}
-    found = [
+    joints = [
         plant.get_joint(JointIndex(i))
         for i in range(plant.num_joints())
         if plant.get_joint(JointIndex(i)).num_positions() == 1
         and int(plant.get_joint(JointIndex(i)).child_body().index()) in wanted
-        and i not in closing
     ]
-    return tuple(sorted(found, key=lambda j: j.position_start()))
+    actuated = {
+        int(plant.get_joint_actuator(a).joint().index())
+        for a in plant.GetJointActuatorIndices()
+    }
+    if not any(int(j.index()) in actuated for j in joints):
+        return ()
+    leader = {
+        int(structure.joints[f].index()): int(structure.joints[lead].index())
+        for f, (lead, _, _) in structure.coupling.follows.items()
+    }
+
+    def driven(i: int) -> bool:
+        seen = set()
+        while i not in actuated:
+            if i not in leader or i in seen:
+                return False
+            seen.add(i)
+            i = leader[i]
+        return True
+
+    passive = [j for j in joints if not driven(int(j.index()))]
+    return tuple(sorted(passive, key=lambda j: j.position_start()))
 
 
 def hand_structure(

@@ -148,7 +148,7 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.validation import check_coefficient, check_flag
 from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
-from drakegrasp.plant.couplings import record_model_couplings, refuse_reversed_limits
+from drakegrasp.plant.couplings import check_joint_limits, record_model_couplings
 from drakegrasp.plant.models import drake_reading, explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import (
@@ -405,7 +405,7 @@ def _new_plant(path: Path, package_map: PackagesSpec, ros_package_path: bool):
 
 def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
     """Process the (checked) directives into ``plant`` and finalize it."""
-    _refuse_reversed_limits(path, directives, parser)
+    _check_joint_limits(path, directives, parser)
     try:
         added = drake_reading(ProcessModelDirectives, directives, plant, parser)
     except Exception as e:  # Drake reports parse errors as RuntimeError
@@ -417,11 +417,11 @@ def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
     plant.Finalize()
 
 
-def _refuse_reversed_limits(path: Path, directives, parser) -> None:
+def _check_joint_limits(path: Path, directives, parser) -> None:
     """Refuse a model of the scene whose joint limits are reversed (Drake aborts).
 
     Each ``add_model``'s file is read first
-    (:func:`~drakegrasp.plant.couplings.refuse_reversed_limits`); one that
+    (:func:`~drakegrasp.plant.couplings.check_joint_limits`); one that
     cannot be resolved or read is left to Drake, which reports it.
     """
     for d in directives.directives:
@@ -435,7 +435,7 @@ def _refuse_reversed_limits(path: Path, directives, parser) -> None:
             continue
         if text is not None:
             try:
-                refuse_reversed_limits(text, kind, model.name)
+                check_joint_limits(text, kind, model.name)
             except ModelError as e:
                 raise ModelError(f"scene {str(path)!r}: {e}") from None
 

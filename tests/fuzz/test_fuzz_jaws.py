@@ -92,7 +92,6 @@ except ModelError as e:
 """
 
 
-@pytest.mark.xfail(strict=True, reason="J1: Drake aborts on NaN or prefix-read limits")
 @pytest.mark.parametrize(
     "lower, upper, kind",
     [("nan", "1", "sdf"), ("0", "nan", "sdf"), ("0.5abc", "0.25", "urdf")],
@@ -100,8 +99,6 @@ except ModelError as e:
 def test_j1_a_limit_drake_cannot_load_is_refused_not_aborted(
     outcomes, lower, upper, kind
 ):
-    _, bad, _ = outcomes
-    assert _shown(bad, "J1")  # the generated cases show it too
     text = fuzz_jaws.limits_doc(
         {"format": kind, "joint": "revolute", "lower": lower, "upper": upper}
     )
@@ -111,7 +108,6 @@ def test_j1_a_limit_drake_cannot_load_is_refused_not_aborted(
     assert run.stdout.startswith("refused: joint 'j'")
 
 
-@pytest.mark.xfail(strict=True, reason="J2: limits Drake ignores or reads as inf")
 @pytest.mark.parametrize(
     "kind, joint, lower, upper",
     [
@@ -129,7 +125,6 @@ def test_j2_a_document_drake_loads_is_loaded(outcomes, kind, joint, lower, upper
     from drakegrasp.plant.couplings import add_models
 
     _, bad, _ = outcomes
-    assert _shown(bad, "J2")
     spec = {"format": kind, "joint": joint, "lower": lower, "upper": upper}
     if joint == "universal":
         spec["lower2"], spec["upper2"] = "0", "1"
@@ -138,7 +133,6 @@ def test_j2_a_document_drake_loads_is_loaded(outcomes, kind, joint, lower, upper
     assert add_models(Parser(plant), text=text, kind=kind)
 
 
-@pytest.mark.xfail(strict=True, reason="J3: a passive joint a mimic follows")
 def test_j3_a_passive_leader_is_named(outcomes, tmp_path):
     from drakegrasp.planning import planning_scene
     from drakegrasp.planning.approach import multi_finger_hand
@@ -146,7 +140,6 @@ def test_j3_a_passive_leader_is_named(outcomes, tmp_path):
     from drakegrasp.plant.validation import hand_bodies
 
     _, bad, _ = outcomes
-    assert _shown(bad, "J3")
     # the f1 proximal joint's motor taken away: it has no actuator and follows
     # no joint (its distal joint follows it)
     text = spread_hand_urdf()

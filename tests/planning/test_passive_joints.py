@@ -79,3 +79,22 @@ def test_an_open_hand_that_collides_everywhere_is_told_to_open(tmp_path, capsys)
     argv += ["--num", "10", *(f"--preshape={name}=2.0" for name in shut)]
     assert main(argv) == 0
     assert "open it wider (--preshape JOINT=VALUE)" in capsys.readouterr().out
+
+
+def test_a_joint_without_a_motor_that_others_follow_is_passive_with_them(tmp_path):
+    # f1's flexion loses its transmission: it and the distal joint that
+    # follows it (<mimic> 0.5) are moved by no motor
+    text = spread_hand_urdf()
+    motor = '<transmission name="t_f1_proximal_joint">'
+    start = text.index(motor)
+    end = text.index("</transmission>", start) + len("</transmission>")
+    path = tmp_path / "hand.urdf"
+    path.write_text(text[:start] + text[end:])
+    scene = planning_scene(CYLINDER, hand_url=str(path))
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    hand = multi_finger_hand(scene.plant, ctx, scene.object_body, scene.hand)
+    bodies = hand_bodies(scene.plant, scene.object_body, scene.hand)
+    found = passive_joints(scene.plant, bodies, hand.structure)
+    assert [j.name() for j in found] == ["f1_proximal_joint", "f1_distal_joint"]
+    with pytest.warns(PassiveJointWarning, match="f1_proximal_joint"):
+        _plan(scene)

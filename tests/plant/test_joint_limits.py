@@ -1,4 +1,4 @@
-"""A joint whose limits are reversed is refused before Drake sees it.
+"""Joint limits that would stop Drake are refused before Drake sees them.
 
 Drake stops the whole process on such a joint (a failed internal condition,
 not an exception): ``drakegrasp plan --hand`` printed Drake's failure text
@@ -23,7 +23,10 @@ LINK = '<link name="{0}"><inertial><mass value="0.1"/><inertia ixx="1e-5" ' \
 
 
 def _urdf(kind="prismatic", lower="0.04", upper="0.0"):
-    limit = f'<limit lower="{lower}" upper="{upper}" effort="1" velocity="1"/>'
+    bounds = "".join(
+        f' {k}="{v}"' for k, v in (("lower", lower), ("upper", upper)) if v is not None
+    )
+    limit = f'<limit{bounds} effort="1" velocity="1"/>'
     return (
         f'<robot name="r">{LINK.format("a")}{LINK.format("b")}'
         f'<joint name="slide" type="{kind}"><parent link="a"/><child link="b"/>'
@@ -50,11 +53,30 @@ def _parser():
 
 @pytest.mark.parametrize(
     "text, kind",
-    [(_urdf(), "urdf"), (_urdf(kind="continuous"), "urdf"), (_sdf(), "sdf")],
+    [
+        (_urdf(), "urdf"),
+        (_urdf(kind="continuous"), "urdf"),
+        (_urdf(lower="0.5abc", upper="0.25"), "urdf"),  # Drake reads 0.5
+        (_sdf(), "sdf"),
+    ],
 )
 def test_reversed_limits_are_refused_by_name(text, kind):
     with pytest.raises(ModelError, match="joint '(slide|hinge)'.*above its upper"):
         add_models(_parser(), text=text, kind=kind)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        _sdf(lower="<lower>nan</lower>", upper="<upper>1</upper>"),
+        _sdf(lower="<lower>-1</lower>", upper="<upper> NaN</upper>"),
+        _sdf(lower="<lower>0.5 0.6</lower>", upper="<upper>nan</upper>"),
+    ],
+)
+def test_a_limit_that_is_not_a_number_is_refused(text):
+    # Drake's SDFormat parser passes NaN on, and its Joint() stops the process
+    with pytest.raises(ModelError, match="joint 'hinge'.*not a number"):
+        add_models(_parser(), text=text, kind="sdf")
 
 
 def test_reversed_limits_in_a_file_name_the_file(tmp_path):
@@ -70,6 +92,12 @@ def test_reversed_limits_in_a_file_name_the_file(tmp_path):
         (_urdf(lower="0.0", upper="0.04"), "urdf"),
         (_sdf(lower=""), "sdf"),  # the default lower limit is -1e16
         (_sdf(lower="", upper=""), "sdf"),
+        # as Drake reads them: a missing bound is none, a value its leading
+        # number, the limits of a fixed joint are not read
+        (_urdf(lower=None, upper="-0.5"), "urdf"),
+        (_urdf(lower="1_0", upper="5"), "urdf"),
+        (_urdf(kind="fixed"), "urdf"),
+        (_sdf(lower="", upper="<upper>-1e17</upper>"), "sdf"),
     ],
 )
 def test_valid_limits_load(text, kind):
