@@ -106,7 +106,7 @@ def _record(plant: MultibodyPlant, couplings: Iterable[JointCoupling]) -> None:
 
 
 def couplings_in_model(
-    text: str, kind: str
+    text: str, kind: str, *, resolve=None
 ) -> list[list[tuple[str, str, float, float]]]:
     """The mimic elements of a URDF or SDFormat document, per model.
 
@@ -116,14 +116,19 @@ def couplings_in_model(
         The document.
     kind : {"urdf", "sdf"}
         Its format.
+    resolve : callable, optional
+        ``resolve(uri) -> (text, kind, resolve) or None``: an SDFormat
+        ``<include>``'s document (and how to resolve the includes in it);
+        without it, includes are not read.
 
     Returns
     -------
     list of list of (follower, leader, gear_ratio, offset)
         One list per model, in the document's order (a URDF has one model; an
         SDFormat file one per top-level ``<model>``), with joint names local
-        to the model.  ``multiplier`` defaults to 1 and ``offset`` to 0, as in
-        Drake's parsers.
+        to the model: a nested (or included) model's joints as
+        ``nested::joint``, as Drake scopes them.  ``multiplier`` defaults to 1
+        and ``offset`` to 0, as in Drake's parsers.
 
     Raises
     ------
@@ -132,36 +137,87 @@ def couplings_in_model(
     """
     if kind not in ("urdf", "sdf"):
         raise InvalidOptionError(f"kind must be 'urdf' or 'sdf', got {kind!r}")
-    try:
-        root = ET.fromstring(_with_prefixes_declared(text))
-    except ET.ParseError as e:
-        raise ModelError(f"cannot read the model's couplings: {e}") from None
+    root = _xml_root(text, "cannot read the model's couplings")
     if kind == "urdf":
-        models, tag = [root], "mimic"
-    else:
-        models = [root] if root.tag == "model" else root.findall("model")
-        tag = _DRAKE_NS + "mimic"
-    out = []
-    for model in models:
-        found = []
-        for joint in model.iter("joint"):
-            for mimic in joint.findall(tag):
-                leader = mimic.get("joint")
-                if not leader:
-                    raise ModelError(
-                        f"the mimic element of joint {joint.get('name')!r} names no "
-                        "joint to follow"
-                    )
-                found.append(
-                    (
-                        joint.get("name"),
-                        leader,
-                        float(mimic.get("multiplier", 1.0)),
-                        float(mimic.get("offset", 0.0)),
-                    )
+        return [_mimics(root, "mimic", "", recurse=False)]
+    models = [root] if root.tag == "model" else root.findall("model")
+    return [_sdf_mimics(m, "", resolve, 0) for m in models]
+
+
+_MAX_INCLUDE_DEPTH = 16
+"""Includes followed at most this deep (a loop of includes stops there)."""
+
+
+def _xml_root(text: str, what: str):
+    try:
+        return ET.fromstring(_with_prefixes_declared(text))
+    except ET.ParseError as e:
+        raise ModelError(f"{what}: {e}") from None
+
+
+def _mimics(element, tag: str, prefix: str, *, recurse: bool) -> list[tuple]:
+    """``(follower, leader, ratio, offset)`` of the joints of ``element``."""
+    found = []
+    joints = element.iter("joint") if recurse else element.findall("joint")
+    for joint in joints:
+        for mimic in joint.findall(tag):
+            leader = mimic.get("joint")
+            if not leader:
+                raise ModelError(
+                    f"the mimic element of joint {joint.get('name')!r} names no "
+                    "joint to follow"
                 )
-        out.append(found)
-    return out
+            found.append(
+                (
+                    prefix + str(joint.get("name")),
+                    prefix + leader,
+                    float(mimic.get("multiplier", 1.0)),
+                    float(mimic.get("offset", 0.0)),
+                )
+            )
+    return found
+
+
+def _sdf_mimics(model, prefix: str, resolve, depth: int) -> list[tuple]:
+    """A model's mimics, its nested and included models' scoped under it."""
+    found = _mimics(model, _DRAKE_NS + "mimic", prefix, recurse=False)
+    for nested in model.findall("model"):
+        found += _sdf_mimics(nested, f"{prefix}{nested.get('name')}::", resolve, depth)
+    if resolve is None or depth >= _MAX_INCLUDE_DEPTH:
+        return found
+    for include in model.findall("include"):
+        got = resolve((include.findtext("uri") or "").strip())
+        if got is None:
+            continue
+        text, kind, inner = got
+        root = _xml_root(text, "cannot read an included model's couplings")
+        if kind == "urdf":
+            name = include.findtext("name") or root.get("name")
+            found += _mimics(root, "mimic", f"{prefix}{name}::", recurse=False)
+            continue
+        for included in [root] if root.tag == "model" else root.findall("model")[:1]:
+            name = include.findtext("name") or included.get("name")
+            found += _sdf_mimics(included, f"{prefix}{name}::", inner, depth + 1)
+    return found
+
+
+def _resolver(package_map, folder: Path):
+    """``resolve(uri)`` for :func:`couplings_in_model`: files beside ``folder``."""
+
+    def resolve(uri: str):
+        try:
+            if "://" in uri:
+                path = Path(package_map.ResolveUrl(uri))
+            else:
+                path = folder / uri
+            kind = _kind_of(str(path))
+            if not kind or not path.is_file():
+                return None  # a model folder (model.config), or nothing there
+            return path.read_text(), kind, _resolver(package_map, path.parent)
+        except (RuntimeError, OSError, ValueError):
+            return None  # Drake's parser reports what it cannot find
+
+    return resolve
 
 
 _PROLOG = re.compile(
@@ -206,7 +262,9 @@ def _scoped(plant: MultibodyPlant, instance, local: str) -> str:
     return f"{plant.GetModelInstanceName(instance)}::{local}"
 
 
-def _record_text(plant, text: str, kind: str, instances: Sequence) -> None:
+def _record_text(
+    plant, text: str, kind: str, instances: Sequence, resolve=None
+) -> None:
     """Record the mimic couplings of models just parsed, if Drake kept them.
 
     Drake's parser ignores a ``<mimic>`` (with a warning) unless the plant can
@@ -216,10 +274,18 @@ def _record_text(plant, text: str, kind: str, instances: Sequence) -> None:
     not simulate.  So they are recorded only when the plant holds a
     constraint for each (its constraints at least those recorded plus these).
     """
-    if "mimic" not in text:  # nothing to record: the file is not read as XML
-        return
+    if "mimic" not in text and "<include" not in text:
+        return  # nothing to record: the file is not read as XML
+    # the top-level models' instances (Drake lists nested ones after each)
+    names = [plant.GetModelInstanceName(i) for i in instances]
+    instances = [
+        i
+        for i, name in zip(instances, names, strict=True)
+        if not any(name.startswith(f"{other}::") for other in names)
+    ]
     try:
-        per_model = list(couplings_in_model(text, kind))[: len(instances)]
+        per_model = list(couplings_in_model(text, kind, resolve=resolve))
+        per_model = per_model[: len(instances)]
     except ModelError:
         if plant.num_constraints() <= len(_RECORDED.get(plant, ())):
             return  # a file XML cannot read, but Drake made no coupler of it
@@ -239,7 +305,9 @@ def _record_text(plant, text: str, kind: str, instances: Sequence) -> None:
         )
 
 
-def record_model_couplings(plant: MultibodyPlant, infos: Iterable) -> None:
+def record_model_couplings(
+    plant: MultibodyPlant, infos: Iterable, package_map=None
+) -> None:
     """Record the couplings of models added by ``ProcessModelDirectives``.
 
     Parameters
@@ -249,12 +317,20 @@ def record_model_couplings(plant: MultibodyPlant, infos: Iterable) -> None:
     infos : iterable of ModelInstanceInfo
         What ``ProcessModelDirectives`` returned (each with its resolved
         ``model_path`` and ``model_instance``).
+    package_map : PackageMap, optional
+        The parser's, to read the mimics of the models' ``<include>`` s.
     """
     for info in infos:
         kind = _kind_of(info.model_path)
         if kind:
-            text = Path(info.model_path).read_text()
-            _record_text(plant, text, kind, [info.model_instance])
+            path = Path(info.model_path)
+            _record_text(
+                plant,
+                path.read_text(),
+                kind,
+                [info.model_instance],
+                _resolver(package_map, path.parent) if package_map else None,
+            )
 
 
 def add_models(
@@ -298,7 +374,9 @@ def add_models(
             raise InvalidOptionError(f"text needs kind='urdf' or 'sdf', got {kind!r}")
         check_joint_limits(text, kind, "the model text")
         instances = parser.AddModelsFromString(text, kind)
-        _record_text(plant, text, kind, instances)
+        _record_text(
+            plant, text, kind, instances, _resolver(parser.package_map(), Path.cwd())
+        )
         return instances
     path = parser.package_map().ResolveUrl(url) if url is not None else str(file_name)
     kind = _kind_of(path)
@@ -310,7 +388,8 @@ def add_models(
     else:
         instances = parser.AddModels(str(file_name))
     if document is not None:
-        _record_text(plant, document, kind, instances)
+        resolve = _resolver(parser.package_map(), Path(path).parent)
+        _record_text(plant, document, kind, instances, resolve)
     return instances
 
 

@@ -413,7 +413,7 @@ def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
         raise ModelError(
             f"scene {str(path)!r}: cannot load the models: {msg}"
         ) from None
-    record_model_couplings(plant, added)
+    record_model_couplings(plant, added, parser.package_map())
     plant.Finalize()
 
 

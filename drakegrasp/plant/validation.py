@@ -478,7 +478,8 @@ def hand_bodies(
     object_body : RigidBody
     hand : ModelInstanceIndex, str, iterable of RigidBody (or scoped names), or None
         A model instance, given by index or name (all its bodies that are not
-        welded to the world), an explicit list of bodies, or None: every body
+        welded to the world, with those of the models nested in it, named
+        ``name::...``), an explicit list of bodies, or None: every body
         that is not the object, not welded to the world and not in the object's
         model instance.
 
@@ -564,7 +565,11 @@ def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
     welded = _welded_to_world(plant)
     if isinstance(hand, str | ModelInstanceIndex):
         instance = model_instance(plant, hand)
-        bodies = [plant.get_body(i) for i in plant.GetBodyIndices(instance)]
+        bodies = [
+            plant.get_body(i)
+            for nested in _with_nested(plant, instance)
+            for i in plant.GetBodyIndices(nested)
+        ]
         _check_apart(plant, object_body, hand, bodies)
         bodies = [b for b in bodies if int(b.index()) not in welded]
     elif hand is None:
@@ -590,6 +595,22 @@ def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
     if not bodies:
         raise _no_bodies(plant, object_body, hand, " that can move")
     return sorted(bodies, key=lambda b: int(b.index()))
+
+
+def _with_nested(plant, instance) -> list:
+    """``instance`` and the model instances nested in it (``name::...``).
+
+    An SDFormat model's nested ``<model>`` s (and ``<include>`` s) become model
+    instances of their own, named under it: a hand whose fingers are nested
+    models is all of them.
+    """
+    name = plant.GetModelInstanceName(instance) + "::"
+    nested = [
+        ModelInstanceIndex(k)
+        for k in range(plant.num_model_instances())
+        if plant.GetModelInstanceName(ModelInstanceIndex(k)).startswith(name)
+    ]
+    return [instance, *nested]
 
 
 def _no_bodies(plant, object_body, hand, which: str) -> ModelError:
@@ -645,7 +666,11 @@ def hand_contact_bodies(
         return hand_model_instances(plant, movable, object_body)
     if isinstance(hand, str | ModelInstanceIndex):
         instance = model_instance(plant, hand)
-        bodies = [plant.get_body(i) for i in plant.GetBodyIndices(instance)]
+        bodies = [
+            plant.get_body(i)
+            for nested in _with_nested(plant, instance)
+            for i in plant.GetBodyIndices(nested)
+        ]
     else:
         bodies = [resolve_object_body(plant, b) for b in _listed(hand)]
     _check_apart(plant, object_body, hand, bodies)
