@@ -176,9 +176,16 @@ class GraspMonitor(LeafSystem):
         As in :func:`drakegrasp.analyze_grasp`: a pose that the check refuses
         (penetration deeper than ``distance_tolerance`` by any hand body, a
         joint off its limits) gives an ``"invalid"`` sample, not an exception.
-        With ``contacts="contact_results"`` penetration is allowed
-        (``allow_penetration`` is True): the simulator's contacts penetrate to
-        make their force.
+    allow_penetration : bool, optional
+        As in :func:`drakegrasp.analyze_grasp`; default (None) True: the
+        simulator's contacts penetrate to make their force (the WSG-50
+        squeezing a box with 20 N sinks 0.145 mm into it in point contact:
+        with penetration refused, every sample of that grip was
+        ``"invalid"``).  False makes such a sample ``"invalid"``; with
+        ``contacts="contact_results"`` penetration is always allowed.  Given
+        ``options=``, its ``allow_penetration`` is used (an
+        :class:`~drakegrasp.AnalysisOptions` defaults to an analysis's False:
+        give it True for a simulation).
     contacts : {"geometry", "contact_results"}, optional
         Signed distances (default), or the plant's contact results (then the
         ``contact_results`` input port exists and must be connected).  See
@@ -245,7 +252,7 @@ class GraspMonitor(LeafSystem):
         characteristic_length: float | None = None,
         num_generators: int = DEFAULT_NUM_GENERATORS,
         tol: float = DEFAULT_TOL,
-        allow_penetration: bool = False,
+        allow_penetration: bool | None = None,
         patches: str = "vertices",
         check_pose: bool = True,
         load: str | Sequence[float] | None = None,

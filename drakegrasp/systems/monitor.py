@@ -46,8 +46,10 @@ same instant, so geometry and kinematics agree).
   does outside a simulation: a contact is a pair within ``distance_tolerance``
   (``|ψ| <= tol``) whose points are not moving apart faster than
   ``separation_speed``.  A simulated contact penetrates a little (point
-  contact: ~0.1 mm for newtons of squeeze), so choose ``distance_tolerance``
-  above that (1e-3 m is a good start) or pass ``allow_penetration=True``.
+  contact: ~0.1 mm for newtons of squeeze; the WSG-50 at 20 N: 0.145 mm), so
+  the monitor allows penetration by default (``allow_penetration=None``:
+  True); ``allow_penetration=False`` makes a sample that penetrates deeper
+  than ``distance_tolerance`` ``"invalid"``.
   *It sees* positions, normals and velocities, hence slip, and whether a
   finger's geometry touches the object's (``ψ <= 0``: the plant pushes only
   there); *it cannot see* forces.  So the analysis counts a finger within the

@@ -148,7 +148,14 @@ def monitor_settings(
         raise InvalidOptionError(
             f"holding must be a HoldingThresholds, got {type(holding).__name__}"
         )
+    # a monitor allows penetration unless told not to: a simulation's
+    # contacts penetrate to make their force
+    penetrate = options is None and analysis_keywords.get("allow_penetration") is None
+    if analysis_keywords.get("allow_penetration") is None:
+        analysis_keywords["allow_penetration"] = False  # AnalysisOptions' default
     analysis = resolve_options(options, **analysis_keywords)
+    if penetrate:
+        analysis = analysis.replace(allow_penetration=True)
     if contacts == "contact_results" and analysis.mu is None:
         # The simulator's own contacts, with the forces its friction made:
         # their coefficients are the plant's (a number would only be checked

@@ -291,23 +291,38 @@ def test_hydroelastic_patches_match_the_geometry(hydro_pick):
     )
 
 
-def test_deep_penetration_is_an_invalid_sample(point_pick):
-    context = point_pick.diagram.CreateDefaultContext()
-    plant = point_pick.plant
+def _squeezed(pick, depth: float):
+    """A sample of ``pick``'s monitor with the pads ``depth`` (m) into the box."""
+    context = pick.diagram.CreateDefaultContext()
+    plant = pick.plant
     plant_context = plant.GetMyMutableContextFromRoot(context)
     for name in ("left_finger_joint", "right_finger_joint"):
-        plant.GetJointByName(name, point_pick.gripper).set_translation(
+        plant.GetJointByName(name, pick.gripper).set_translation(
             plant_context,
-            0.022,  # 3 mm into the 50 mm box
+            0.025 - depth,  # the 50 mm box between pads at ±25 mm
         )
-    box = plant.GetBodyByName("box", point_pick.box)
+    box = plant.GetBodyByName("box", pick.box)
     plant.SetFreeBodyPose(plant_context, box, RigidTransform([0.0, 0.0, 0.05]))
-    sample = point_pick.monitor.evaluate(
-        point_pick.monitor.GetMyContextFromRoot(context)
-    )
+    return pick.monitor.evaluate(pick.monitor.GetMyContextFromRoot(context))
+
+
+def test_deep_penetration_is_an_invalid_sample_when_refused():
+    pick = build_pick(plant_contact="point", allow_penetration=False, **OPTIONS)
+    sample = _squeezed(pick, 3e-3)
     assert sample.status == "invalid"
     assert "penetrat" in sample.message
     assert sample.verdicts[GraspMonitor.STATUS] == -1.0
+
+
+def test_a_firm_grip_that_penetrates_is_analysed_by_default():
+    # The WSG-50 squeezing with 20 N sinks 0.145 mm into a box in point
+    # contact; at the default 0.1 mm tolerance every such sample was
+    # "invalid" (force closure 0, no contacts) while the object was held.
+    pick = build_pick(plant_contact="point", mu=0.5, **SOFT)  # rounded pads
+    sample = _squeezed(pick, 0.15e-3)
+    assert sample.status != "invalid", sample.message
+    assert sample.verdicts[GraspMonitor.FORCE_CLOSURE] == 1.0
+    assert sample.verdicts[GraspMonitor.NUM_CONTACTS] > 0
 
 
 def test_bad_options_fail_at_construction(point_pick):

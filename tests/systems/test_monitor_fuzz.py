@@ -52,6 +52,10 @@ def test_bad_characteristic_length_is_refused_at_construction(pick, b):
 @pytest.mark.parametrize("flag", ["compute_epsilon", "check_pose", "allow_penetration"])
 @pytest.mark.parametrize("value", [1, 0, "yes", None, [True], np.float64(1.0)])
 def test_flags_must_be_bools(pick, flag, value):
+    if flag == "allow_penetration" and value is None:  # its default: allowed
+        monitor = GraspMonitor(pick.plant, object_body=BOX, mu=0.5, **{flag: value})
+        assert monitor.settings.analysis.allow_penetration is True
+        return
     with pytest.raises(InvalidOptionError, match=flag):
         GraspMonitor(pick.plant, object_body=BOX, mu=0.5, **{flag: value})
 
