@@ -77,6 +77,7 @@ from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
     InvalidOptionError,
     JointLimitError,
+    ModelError,
     PenetrationError,
     UnreachableError,
 )
@@ -391,6 +392,7 @@ def close_hand(
     query = query_object_of(plant, plant_context)
     inspector = query.inspector()
     hand_ = hand_structure(plant, body, bodies, couplings, inspector=inspector)
+    _refuse_branching_fingers(plant, hand_)
     instance_bodies = hand_model_instances(plant, bodies, body)
     found = find_penetrations(plant, plant_context, body, instance_bodies, tol)
     if found:
@@ -552,6 +554,43 @@ def _close(
 def _check_flag(name: str, value) -> None:
     if not isinstance(value, bool | np.bool_):
         raise InvalidOptionError(f"{name} must be True or False, got {value!r}")
+
+
+def _refuse_branching_fingers(plant, hand: HandStructure) -> None:
+    """Refuse a finger whose joints lie on separate branches: an arm, not a finger.
+
+    A finger is one chain from its root joint out (fingers that a coupling
+    closes as one are several chains, joined by ``+`` in their name).  A hand
+    given with the arm or wrist that carries it (Drake's
+    ``panda_arm_hand.urdf`` as one model instance) has one "finger" rooted at
+    the arm's first joint, whose two finger joints branch off the same body:
+    closing it moved the arm and left a finger open.
+    """
+    for finger in hand.fingers:
+        if "+" in finger.name:
+            continue
+        joints = [hand.joints[i] for i in finger.joints]
+        moved = {
+            int(j.index()): {
+                int(b)
+                for b in plant.GetBodiesKinematicallyAffectedBy([j.index()])
+            }
+            for j in joints
+        }
+        for k, a in enumerate(joints):
+            for b in joints[k + 1 :]:
+                if int(b.child_body().index()) in moved[int(a.index())]:
+                    continue
+                if int(a.child_body().index()) in moved[int(b.index())]:
+                    continue
+                raise ModelError(
+                    f"finger {finger.name} is not one chain: its joints "
+                    f"{scoped_name(plant, a)} and {scoped_name(plant, b)} move "
+                    "separate branches, so the hand given includes the arm or "
+                    "wrist that carries the fingers, which closing would move; "
+                    "give hand= the hand's own bodies (its palm and fingers), "
+                    "or weld the arm's joints"
+                )
 
 
 def _couple_jaws(plant, body, bodies, couplings, hand, jaws, q0, inspector):
