@@ -44,7 +44,7 @@ from drakegrasp.plant.friction import (
 )
 from drakegrasp.plant.jacobians import hand_velocity_indices
 from drakegrasp.plant.options import AnalysisOptions
-from drakegrasp.plant.validation import hand_contact_bodies
+from drakegrasp.plant.validation import hand_contact_bodies, plant_context_of
 from drakegrasp.quality import ferrari_canny
 from drakegrasp.quality.epsilon import L1_MAX_POINTS, primitive_wrenches
 from drakegrasp.systems.holding import (
@@ -341,6 +341,24 @@ class GraspMonitor(LeafSystem):
         )
 
     # Ports ---------------------------------------------------------------
+    def use_parameters_of(self, plant_context: Context) -> None:
+        """Analyse with the parameters (masses, inertias, ...) of a plant context.
+
+        Each sample is analysed in a plant context of the monitor's own, made
+        with the model's default parameters: a mass set in the simulation's
+        context (``body.SetMass(plant_context, m)``, as mass randomisation
+        does) reaches no input port.  Call this with the simulation's plant
+        context (or its root context) after changing them, before the next
+        sample; only the parameters are copied.
+
+        Raises
+        ------
+        InvalidContextError
+            A context that is not of the monitored plant.
+        """
+        source = plant_context_of(self._plant, plant_context)
+        self._plant_context.get_mutable_parameters().SetFrom(source.get_parameters())
+
     def get_plant_state_input_port(self):
         """Input: the plant's state ``[q; v]`` (``plant.get_state_output_port()``)."""
         return self._state_port

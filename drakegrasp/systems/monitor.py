@@ -38,7 +38,11 @@ that disagrees with them is warned about once
 plant context; the monitor keeps a private one, sets its positions and
 velocities from the ``plant_state`` input at each sample, and passes the scene
 graph's query object from its ``query_object`` input (the query object of the
-same instant, so geometry and kinematics agree).
+same instant, so geometry and kinematics agree).  Its parameters are the
+model's defaults: a mass set in the simulation's context (mass
+randomisation) reaches no port, so call
+:meth:`~drakegrasp.GraspMonitor.use_parameters_of` with that context after
+setting it (the gravity load otherwise weighs the model's mass).
 
 **Where the contacts come from** (``contacts=``), and what each mode sees:
 

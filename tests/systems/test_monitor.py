@@ -293,7 +293,11 @@ def test_hydroelastic_patches_match_the_geometry(hydro_pick):
 
 def _squeezed(pick, depth: float):
     """A sample of ``pick``'s monitor with the pads ``depth`` (m) into the box."""
-    context = pick.diagram.CreateDefaultContext()
+    return _squeezed_in(pick, pick.diagram.CreateDefaultContext(), depth)
+
+
+def _squeezed_in(pick, context, depth: float):
+    """:func:`_squeezed` in a root ``context`` of ``pick``'s diagram."""
     plant = pick.plant
     plant_context = plant.GetMyMutableContextFromRoot(context)
     for name in ("left_finger_joint", "right_finger_joint"):
@@ -397,3 +401,23 @@ def test_epsilon_at_a_length_out_of_scale_is_nan_and_said_not_a_crash():
     log = pick.verdict_log.FindLog(pick.simulator.get_context()).data()
     closed = log[GraspMonitor.FORCE_CLOSURE] == 1
     assert closed.any() and np.isnan(log[GraspMonitor.EPSILON][closed]).all()
+
+
+def test_a_mass_set_in_the_simulation_is_used_once_copied():
+    # The monitor analyses in a plant context of its own: a mass set in the
+    # simulation's context (mass randomisation) reached no port, and the
+    # gravity load kept the model's 0.2 kg
+    pick = build_pick(plant_contact="point", mu=1.0, load="gravity", **SOFT)
+    box = pick.plant.GetBodyByName("box", pick.box)
+
+    def weight(mass: float | None) -> float:
+        context = pick.diagram.CreateDefaultContext()
+        plant_context = pick.plant.GetMyMutableContextFromRoot(context)
+        box.SetMass(plant_context, 3.0)
+        if mass is not None:
+            pick.monitor.use_parameters_of(context)
+        sample = _squeezed_in(pick, context, 1e-4)
+        return float(np.linalg.norm(sample.report.load.wrench[:3]))
+
+    assert weight(None) == pytest.approx(0.2 * 9.81, rel=1e-9)
+    assert weight(3.0) == pytest.approx(3.0 * 9.81, rel=1e-9)
