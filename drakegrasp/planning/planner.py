@@ -88,7 +88,11 @@ from drakegrasp.planning.ranking import (
     checked_noise,
     rank_candidates,
 )
-from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
+from drakegrasp.planning.surface import (
+    ObjectSurface,
+    piece_of_shape,
+    warn_if_not_convex,
+)
 from drakegrasp.planning.turned_gravity import GRAVITY
 from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.attachment import free_carrier, how_held
@@ -143,12 +147,12 @@ def object_surface(plant, plant_context, object_body) -> ObjectSurface:
     ctx = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
     inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
-    return ObjectSurface.from_pieces(
-        piece_of_shape(
-            inspector.GetShape(g), inspector.GetPoseInFrame(g), inspector.GetName(g)
-        )
-        for g in plant.GetCollisionGeometriesForBody(body)
-    )
+    pieces = []
+    for g in plant.GetCollisionGeometriesForBody(body):
+        shape, name = inspector.GetShape(g), inspector.GetName(g)
+        pieces.append(piece_of_shape(shape, inspector.GetPoseInFrame(g), name))
+        warn_if_not_convex(shape, pieces[-1], name)
+    return ObjectSurface.from_pieces(pieces)
 
 
 def _check_count(value) -> int:
