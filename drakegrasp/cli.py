@@ -1703,7 +1703,8 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         metavar="PA|none",
         dest="hydroelastic_modulus",
         help="with --shake: make the hand's geometries compliant hydroelastic "
-        "with this modulus in Pa (the object's rigid), so that a flat pad presses "
+        "with this modulus in Pa (the object's rigid, unless its model makes it "
+        "compliant), so that a flat pad presses "
         "over a patch, not at Drake's one contact point; none: the models' own "
         "contact (default 1e6 for --hand flat, rounded and allegro, none "
         "otherwise)",

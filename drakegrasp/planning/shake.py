@@ -33,7 +33,8 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
 - contact, friction and stiffness are the plant's (the models' proximity
   properties: point contact where they declare no hydroelastic ones), or with
   ``hydroelastic_modulus`` the hand's geometries are made compliant
-  hydroelastic and the object's rigid (:mod:`drakegrasp.plant.hydroelastic`),
+  hydroelastic and the object's rigid, unless its model makes it compliant
+  (:mod:`drakegrasp.plant.hydroelastic`),
   so that a flat pad presses over a patch instead of at one point.
 
 The object *holds* when its pose in the hand frame never moves more than
@@ -594,7 +595,8 @@ def shake_test(
         geometries, so a flat pad on a flat face touches at one point and the
         object pivots between two such pads).  A modulus (Pa, finite > 0):
         the hand's collision geometries are made compliant hydroelastic with
-        it and the object's rigid, so each pad presses over a patch, as it
+        it and the object's rigid (unless its model makes it compliant: it
+        keeps its own), so each pad presses over a patch, as it
         does on a real object (:mod:`drakegrasp.plant.hydroelastic`; 1e6 suits
         rubber pads).
     object_mass : float or None, optional

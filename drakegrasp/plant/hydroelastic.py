@@ -126,13 +126,17 @@ def _resolution_hint(shape) -> float:
     return max(width / 4.0, 1e-6)
 
 
-def _assign(plant, scene_graph, geometry, add) -> bool:
+def _assign(plant, scene_graph, geometry, add, *, keep_own: bool = False) -> bool:
     """Replace ``geometry``'s proximity properties by a copy that ``add`` extends.
 
-    Returns False when Drake refuses them (the geometry keeps its own).
+    With ``keep_own``, a geometry the model makes hydroelastic itself keeps
+    its values.  Returns False when Drake refuses them (the geometry keeps
+    its own).
     """
     inspector = scene_graph.model_inspector()
     props = ProximityProperties(inspector.GetProximityProperties(geometry))
+    if keep_own and props.HasProperty(_GROUP, "compliance_type"):
+        return True
     if props.HasGroup(_GROUP):  # the model's own hydroelastic values: replaced
         for name in list(props.GetPropertiesInGroup(_GROUP)):
             props.RemoveProperty(_GROUP, name)
@@ -155,6 +159,11 @@ def use_hydroelastic_contact(
     modulus: float,
 ) -> int:
     """Make the hand's geometries compliant and the object's rigid hydroelastic.
+
+    An object geometry the model makes hydroelastic itself (a soft object's
+    ``<drake:compliant_hydroelastic>``) keeps its own properties: the shake
+    then presses on the object as modelled (before, it was made rigid
+    without a word).
 
     Parameters
     ----------
@@ -208,5 +217,7 @@ def use_hydroelastic_contact(
     for bodies, add in ((hand_bodies, compliant), (object_bodies, rigid)):
         for body in bodies:
             for geometry in plant.GetCollisionGeometriesForBody(body):
-                refused += not _assign(plant, scene_graph, geometry, add)
+                refused += not _assign(
+                    plant, scene_graph, geometry, add, keep_own=add is rigid
+                )
     return refused

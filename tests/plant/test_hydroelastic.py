@@ -152,3 +152,34 @@ def test_flat_pads_pivot_in_point_contact_and_hold_as_patches(jaw_on_box):
     assert all(s.result.hydroelastic_modulus == 1e6 for s in patch)
     assert all(s.result.hydroelastic_modulus is None for s in point)
     assert "hydroelastic fingers (1e+06 Pa)" in str(patch[0].result)
+
+
+SOFT_BOX = """<?xml version="1.0"?>
+<sdf version="1.9" xmlns:drake="http://drake.mit.edu"><model name="soft">
+<link name="soft"><inertial><mass>0.2</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy>
+<izz>1e-4</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
+<collision name="c"><geometry><box><size>0.05 0.05 0.1</size></box></geometry>
+<drake:proximity_properties><drake:compliant_hydroelastic/>
+<drake:hydroelastic_modulus>5e5</drake:hydroelastic_modulus>
+<drake:mu_dynamic>0.8</drake:mu_dynamic></drake:proximity_properties></collision>
+</link></model></sdf>"""
+
+
+def test_an_object_the_model_makes_compliant_keeps_its_compliance(tmp_path):
+    # A soft object's own <drake:compliant_hydroelastic> was replaced by rigid
+    # properties, and the shake pressed on another object than the modelled
+    path = tmp_path / "soft.sdf"
+    path.write_text(SOFT_BOX)
+    scene = dg.planning_scene(str(path), hand_url=JAW)
+    plant, sg, hand_bodies, body, friction, refused = _built(scene, 2.5e6)
+    assert refused == 0
+    inspector = sg.model_inspector()
+    (g,) = plant.GetCollisionGeometriesForBody(body)
+    props = inspector.GetProximityProperties(g)
+    assert props.GetProperty("hydroelastic", "hydroelastic_modulus") == 5e5
+    for b in hand_bodies:  # the hand is made compliant as before
+        for h in plant.GetCollisionGeometriesForBody(b):
+            modulus = inspector.GetProximityProperties(h).GetProperty(
+                "hydroelastic", "hydroelastic_modulus"
+            )
+            assert modulus == 2.5e6
