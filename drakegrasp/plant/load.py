@@ -281,7 +281,7 @@ class LoadReport:
             )
         f = self.forces
         if f.feasible:
-            lines.append(f"  least squeeze {f.squeeze:.4g} N")
+            lines.append(f"  least squeeze {f.squeeze:.4g} N in all (Σ f_n)")
             if f.joint_torques is not None:
                 tau = _named(self.joint_names, f.joint_torques, self.torque_units)
                 lines.append(f"  joint torques: {tau}")
