@@ -1188,13 +1188,9 @@ def _plan_setup(args: argparse.Namespace):
         options["contact_model"] = args.contact_model
     if args.torsional_friction is not None:
         options["torsional_friction"] = args.torsional_friction
-    options["mu"] = (
-        default_mu
-        if args.mu is None
-        else _plant_mu(plant, context, body, hand)
-        if args.mu == "plant"
-        else args.mu
-    )
+    mu = default_mu if args.mu is None else args.mu
+    # a scene's `mu: plant` is read from the plant, as --mu plant is
+    options["mu"] = _plant_mu(plant, context, body, hand) if mu == "plant" else mu
     return plant, context, body, hand, options, add_models
 
 

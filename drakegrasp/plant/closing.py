@@ -572,8 +572,7 @@ def _refuse_branching_fingers(plant, hand: HandStructure) -> None:
         joints = [hand.joints[i] for i in finger.joints]
         moved = {
             int(j.index()): {
-                int(b)
-                for b in plant.GetBodiesKinematicallyAffectedBy([j.index()])
+                int(b) for b in plant.GetBodiesKinematicallyAffectedBy([j.index()])
             }
             for j in joints
         }

@@ -29,7 +29,7 @@ The format
       description: one line shown by `drakegrasp scenes`
       object_body: box::box          # required: scoped body name (model::body)
       hand: gripper                  # model instance name, or a list of bodies
-      mu: 0.5                        # required: friction coefficient, >= 0
+      mu: 0.5                        # required: friction coefficient, >= 0, or plant
       contact_model: hard_finger     # frictionless | hard_finger | soft_finger
       torsional_friction: 0.1        # soft fingers: nu >= 0
       plane: yz                      # optional: planar analysis (xy | yz | zx)
@@ -230,7 +230,7 @@ class SceneInfo:
     description: str
     object_body: str
     hand: str | tuple[str, ...] | None
-    mu: float
+    mu: float | str
     contact_model: ContactModel
     torsional_friction: float | None
     plane: str | None

@@ -61,7 +61,7 @@ KEYS = {
     "description": "a string",
     "object_body": "a 'model::body' name",
     "hand": "a model-instance name or a list of 'model::body' names",
-    "mu": f"0 or a number in [{COEFFICIENT_MIN:g}, {COEFFICIENT_MAX:g}]",
+    "mu": f"0 or a number in [{COEFFICIENT_MIN:g}, {COEFFICIENT_MAX:g}], or plant",
     "contact_model": f"one of {[m.value for m in ContactModel]}",
     "torsional_friction": f"0 or a number in [{COEFFICIENT_MIN:g}, "
     f"{COEFFICIENT_MAX:g}]",
@@ -411,7 +411,11 @@ def check_section(
         else _string(path, "description", description),
         "object_body": _string(path, "object_body", section["object_body"]),
         "hand": hand,
-        "mu": _coefficient(path, "mu", section["mu"]),
+        "mu": (
+            "plant"
+            if section["mu"] == "plant"
+            else _coefficient(path, "mu", section["mu"])
+        ),
         "contact_model": model,
         # Absent is not 0: a soft finger without a given nu is refused above
         # (and by the analysis, when --contact-model soft_finger asks for one),

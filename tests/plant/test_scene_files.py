@@ -289,3 +289,27 @@ def test_a_files_absent_nu_is_not_given_and_its_zero_is_a_valid_nu(
         **{**scene.analysis_options(), "contact_model": "hard_finger"},
     )
     assert report.force_closure.is_closure == hard.force_closure.is_closure
+
+
+def test_mu_plant_in_a_scene_is_the_plants_friction(tmp_path, capsys):
+    # `mu: plant` was refused ("mu must be a number") where --mu plant and
+    # analyze_grasp(mu="plant") take it
+    from drakegrasp import analyze_grasp
+    from drakegrasp.cli import main
+
+    path = _write(tmp_path, DEFAULT.replace("  mu: 0.5", "  mu: plant"))
+    scene = load_scene(path)
+    assert scene.info.mu == "plant"
+    report = analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
+    by_name = analyze_grasp(
+        scene.plant, scene.plant_context, scene.object_body, hand=scene.hand,
+        mu="plant", contact_model=scene.info.contact_model,
+        torsional_friction=scene.info.torsional_friction,
+    )  # fmt: skip
+    assert report.force_closure.is_closure == by_name.force_closure.is_closure
+    assert report.force_closure.d_star == by_name.force_closure.d_star
+    assert main(["analyze", str(path)]) == 0
+    assert main(["plan", str(path), "--num", "10", "--top", "1"]) == 0
+    assert "mu = " in capsys.readouterr().out
+    with pytest.raises(SceneError, match="mu must be a number"):
+        load_scene(_write(tmp_path, DEFAULT.replace("  mu: 0.5", "  mu: plants")))
