@@ -131,6 +131,7 @@ tips touch.)
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -417,6 +418,38 @@ def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
     plant.Finalize()
 
 
+_UNKNOWN_KEY = re.compile(
+    r"^\S*?:(?P<line>\d+):(?P<column>\d+): .*?key '(?P<key>[^']*)' did not "
+    r"match any visited value entry.*?while visiting (?P<type>[\w:]+)"
+)
+
+_ROTATION_KEYS = {
+    "Rpy": "!Rpy {deg: [roll, pitch, yaw]}",
+    "AngleAxis": "!AngleAxis {angle_deg: a, axis: [x, y, z]}",
+}
+"""Drake's rotation schemas, written as a scene file gives them (in degrees)."""
+
+
+def _schema_words(message: str) -> str:
+    """Drake's 'key did not match any visited value entry' as one short clause.
+
+    Drake names the key, then every enclosing schema; the first is the one
+    that lacks the key.  A rotation's key (``rad``, ``angle``) gets the
+    spelling Drake reads: rotations are in degrees.
+    """
+    found = _UNKNOWN_KEY.match(message)
+    if found is None:
+        return message
+    kind = found["type"].rpartition("::")[2]
+    where = f"line {found['line']}, column {found['column']}"
+    if kind in _ROTATION_KEYS:
+        return (
+            f"{where}: unknown key {found['key']!r} in an !{kind} rotation; "
+            f"Drake's rotations are in degrees: {_ROTATION_KEYS[kind]}"
+        )
+    return f"{where}: unknown key {found['key']!r} in {found['type']}"
+
+
 def _check_joint_limits(path: Path, directives, parser) -> None:
     """Refuse a model of the scene whose joint limits are reversed (Drake aborts).
 
@@ -700,7 +733,7 @@ def load_scene(
     except SceneError:
         raise
     except Exception as e:  # Drake raises RuntimeError/ValueError on bad schema
-        msg = " ".join(str(e).split())
+        msg = _schema_words(" ".join(str(e).split()))
         raise SceneError(f"scene {str(path)!r}: bad model directives: {msg}") from None
     # What Drake will load, from Drake's reading (and includes followed first:
     # a loop would crash Drake), with the reference policy unless trusted.

@@ -119,3 +119,23 @@ def test_a_refusal_keeps_its_reason():
     assert logger.propagate and not any(
         type(h).__name__ == "_Collected" for h in logger.handlers
     )
+
+
+@pytest.mark.parametrize(
+    "rotation, says",
+    [
+        ("!Rpy { rad: [0.0, 0.0, 1.0] }", "unknown key 'rad' in an !Rpy rotation"),
+        ("!AngleAxis { angle: 1.0, axis: [0, 0, 1] }", "angle_deg: a, axis"),
+    ],
+)
+def test_a_rotation_in_radians_is_told_degrees(tmp_path, rotation, says):
+    # Drake's own text named the key, then nine enclosing schemas
+    path = tmp_path / "scene.yaml"
+    assert "rotation: !Rpy {deg: [0.0, 0.0, 0.0]}" in DEFAULT
+    path.write_text(DEFAULT.replace("!Rpy {deg: [0.0, 0.0, 0.0]}", rotation, 1))
+    with pytest.raises(SceneError, match="bad model directives") as info:
+        dg.load_scene(path)
+    message = str(info.value)
+    assert says in message and "degrees" in message and "while visiting" not in message
+    line = next(k for k, t in enumerate(DEFAULT.splitlines(), 1) if "!Rpy" in t)
+    assert f"line {line}, column" in message
