@@ -497,21 +497,29 @@ def _transform(pose: dict):
 
 def _scene(hand: dict, obj: str | None):
     """The hand (and object) in a planning scene, its context as it was built."""
+    return cached_scene(_CACHE, urdf(hand), obj, f"{hand['kind']}.urdf")
+
+
+def cached_scene(cache: dict, text: str, obj: str | None, filename: str):
+    """A planning scene of a hand's URDF ``text`` (and a shipped object), cached.
+
+    Its context is reset to how it was built on every call; ``cache`` holds
+    at most nine scenes, to keep a worker's memory flat.
+    """
     from drakegrasp.planning import planning_scene
 
-    text = urdf(hand)
     key = (text, obj)
-    if key not in _CACHE:
+    if key not in cache:
         url = None if obj is None else f"package://drakegrasp/objects/{obj}.sdf"
-        if len(_CACHE) > 8:  # keep the worker's memory flat
-            _CACHE.clear()
+        if len(cache) > 8:
+            cache.clear()
         # the file only while Drake parses it: a killed worker leaves nothing
         with tempfile.TemporaryDirectory(prefix="drakegrasp-fuzz-") as folder:
-            path = Path(folder) / f"{hand['kind']}.urdf"
+            path = Path(folder) / filename
             path.write_text(text)
             scene = planning_scene(url, hand_url=str(path))
-        _CACHE[key] = (scene, scene.context.Clone())
-    scene, root0 = _CACHE[key]
+        cache[key] = (scene, scene.context.Clone())
+    scene, root0 = cache[key]
     scene.context.SetTimeStateAndParametersFrom(root0)
     return scene
 

@@ -285,22 +285,9 @@ _CACHE: dict = {}
 
 
 def _jaw_scene(jaw: dict, obj: str | None):
-    from drakegrasp.planning import planning_scene
+    from fuzz_coupled import cached_scene
 
-    text = jaw_urdf(jaw)
-    key = (text, obj)
-    if key not in _CACHE:
-        if len(_CACHE) > 8:
-            _CACHE.clear()
-        url = None if obj is None else f"package://drakegrasp/objects/{obj}.sdf"
-        with tempfile.TemporaryDirectory(prefix="drakegrasp-fuzz-") as folder:
-            path = Path(folder) / "jaw.urdf"
-            path.write_text(text)
-            scene = planning_scene(url, hand_url=str(path))
-        _CACHE[key] = (scene, scene.context.Clone())
-    scene, root0 = _CACHE[key]
-    scene.context.SetTimeStateAndParametersFrom(root0)
-    return scene
+    return cached_scene(_CACHE, jaw_urdf(jaw), obj, "jaw.urdf")
 
 
 def _pose(pose):
@@ -863,16 +850,12 @@ def hand_urdf(hand: dict) -> str:
                 if d == "motor":
                     motors.append(name)
             chain.append(body)
-    transmissions = "".join(
-        f'<transmission name="t_{j}"><type>transmission_interface/SimpleTransmission'
-        f'</type><joint name="{j}"/><actuator name="m_{j}"><mechanicalReduction>1'
-        "</mechanicalReduction></actuator></transmission>"
-        for j in motors
-    )
+    from coupled_hands import transmissions
+
     return (
         '<?xml version="1.0"?><robot name="fuzz_hand">'
         + "".join(parts)
-        + transmissions
+        + transmissions(motors)
         + "</robot>"
     )
 

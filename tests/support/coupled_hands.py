@@ -38,6 +38,16 @@ def _joint(name, kind, parent, child, xyz, rpy="0 0 0", axis="0 1 0", extra=""):
     )
 
 
+def transmissions(joints) -> str:
+    """URDF ``<transmission>`` s giving each of ``joints`` its own motor."""
+    return "".join(
+        f'<transmission name="t_{j}"><type>transmission_interface/SimpleTransmission'
+        f'</type><joint name="{j}"/><actuator name="m_{j}"><mechanicalReduction>1'
+        "</mechanicalReduction></actuator></transmission>"
+        for j in joints
+    )
+
+
 def spread_hand_urdf() -> str:
     """The hand as URDF text.
 
@@ -113,17 +123,11 @@ def spread_hand_urdf() -> str:
             ),  # fmt: skip
         ]
         motors.append(f"{name}_proximal_joint")
-    transmissions = "".join(
-        f'<transmission name="t_{j}"><type>transmission_interface/SimpleTransmission'
-        f'</type><joint name="{j}"/><actuator name="m_{j}"><mechanicalReduction>1'
-        "</mechanicalReduction></actuator></transmission>"
-        for j in motors
-    )
     return (
         f'<?xml version="1.0"?><robot name="{MODEL}">'
         + "".join(parts)
         + "".join(joints)
-        + transmissions
+        + transmissions(motors)
         + "</robot>"
     )
 
