@@ -1436,7 +1436,8 @@ def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:
     text = grasp_scene_text(
         plant, context, best, object_body=object_body,
         hand_file=_plan_hand(args.hand), object_file=_plan_url(args.object),
-        mu=result.mu, folder=path.resolve().parent,
+        mu="plant" if args.mu == "plant" else result.mu,  # as planned
+        folder=path.resolve().parent,
         description=f"Candidate #{rank}{held} of drakegrasp plan "
         f"{args.object} --hand {args.hand or 'flat'} (sample {best.sample}).",
     )  # fmt: skip

@@ -897,8 +897,8 @@ class CloudSurface:
             ],
             axis=1,
         )  # (k, 10): the features' coefficients
-        limit = rho * rho * (1.0 + 1e-6) + 1e-9 * (scale + np.max(np.sum(p * p, 1)))
-        m, k = np.nonzero(F @ C.T <= limit)
+        limit = rho * rho * (1.0 + 1e-6) + 1e-9 * (scale + np.sum(p * p, axis=1))
+        m, k = np.nonzero(F @ C.T <= limit)  # per line: a NaN line blinds only itself
         return k, m
 
     @staticmethod

@@ -50,7 +50,7 @@ def grasp_scene_text(
     object_body,
     hand_file: str | os.PathLike,
     object_file: str | os.PathLike,
-    mu: float,
+    mu: float | str,
     contact_model: str | None = None,
     torsional_friction: float | None = None,
     folder: str | os.PathLike = ".",
@@ -72,8 +72,9 @@ def grasp_scene_text(
     hand_file, object_file : str or path
         The model files (or ``package://`` / ``file://`` URLs) the hand's and
         the object's model instances were loaded from.
-    mu : float
-        The friction coefficient the grasp was planned with.
+    mu : float or "plant"
+        The friction coefficient the grasp was planned with, or ``"plant"``
+        (each pair's from the models, as the scene file's ``mu: plant``).
     contact_model, torsional_friction : optional
         As planned (default: the candidate's ``contact_options``).
     folder : str or path, optional
@@ -166,7 +167,7 @@ def grasp_scene_text(
         or f"The grasp of plan sample {candidate.sample} (drakegrasp plan).",
         "object_body": f"{object_name}::{body.name()}",
         "hand": hand_name,
-        "mu": float(mu),
+        "mu": mu if mu == "plant" else float(mu),
         "contact_model": str(contact_model),
     }
     if torsional_friction is not None:

@@ -555,7 +555,9 @@ def onto_coupling(gripper: ParallelJaw, X_WH: RigidTransform, q):
     ``(X_WH, None)`` when those leave a joint's limits.
     """
     q, shift = gripper.coupled(q)
-    if not (np.all(q >= gripper.lower) and np.all(q <= gripper.upper)):
+    slack = 1e-12  # the coupling's rounding at a limit
+    if not (np.all(q >= gripper.lower - slack) and np.all(q <= gripper.upper + slack)):
         return X_WH, None
+    q = np.clip(q, gripper.lower, gripper.upper)
     a_W = X_WH.rotation().multiply(gripper.X_HK.rotation().col(0))
     return RigidTransform(X_WH.rotation(), X_WH.translation() + shift * a_W), q

@@ -125,6 +125,8 @@ REASONS = {
     "one finger touches": "only one finger's geometry touches the object",
     "hand collides with the cloud": "a cloud point lies inside the open hand",
     "hand enters the unseen side": "the hand reaches behind a one-sided cloud",
+    "coupled fingers out of their stroke": "a one-motor jaw's fingers, put back "
+    "on their coupling, leave a joint's limits",
 }
 """Every rejection reason, with what it means."""
 
@@ -700,14 +702,15 @@ def _close_on_cloud(closer: BodyCloser, cloud: CloudFingers, X_WH, opening):
     q, travel_hits, reason = cloud.close(X_WH, q_open)
     if reason is not None:
         return None, None, reason, X_WH
-    if closer.g.coupling is not None:
+    coupled = closer.g.coupling is not None
+    if coupled:
         X_WH, q = onto_coupling(closer.g, X_WH, q)
         if q is None:
             return None, None, "coupled fingers out of their stroke", X_WH
-        if cloud.collides():
-            return None, None, "hand collides with the cloud", X_WH
-    if closer.clear_at(X_WH, q) is not None:
+    if closer.clear_at(X_WH, q) is not None:  # puts the hand at X_WH, q
         return None, None, "finger blocked by the scene", X_WH
+    if coupled and cloud.collides():  # the palm moved along the axis
+        return None, None, "hand collides with the cloud", X_WH
     if cloud.in_shadow():
         return None, None, "hand enters the unseen side", X_WH
     found = cloud.contacts(travel_hits)

@@ -67,6 +67,7 @@ __all__ = [
     "coupling_map",
     "coupling_violations",
     "couplings_in_model",
+    "model_resolver",
     "motor_shares",
     "plant_couplings",
     "record_model_couplings",
@@ -193,16 +194,24 @@ def _sdf_mimics(model, prefix: str, resolve, depth: int) -> list[tuple]:
         root = _xml_root(text, "cannot read an included model's couplings")
         if kind == "urdf":
             name = include.findtext("name") or root.get("name")
-            found += _mimics(root, "mimic", f"{prefix}{name}::", recurse=False)
+            merged = (include.get("merge") or "").strip().lower() == "true"
+            scope = prefix if merged else f"{prefix}{name}::"
+            found += _mimics(root, "mimic", scope, recurse=False)
             continue
+        merged = (include.get("merge") or "").strip().lower() == "true"
         for included in [root] if root.tag == "model" else root.findall("model")[:1]:
             name = include.findtext("name") or included.get("name")
-            found += _sdf_mimics(included, f"{prefix}{name}::", inner, depth + 1)
+            scope = prefix if merged else f"{prefix}{name}::"  # merge: the parent's
+            found += _sdf_mimics(included, scope, inner, depth + 1)
     return found
 
 
-def _resolver(package_map, folder: Path):
-    """``resolve(uri)`` for :func:`couplings_in_model`: files beside ``folder``."""
+def model_resolver(package_map, folder: Path):
+    """``resolve(uri)`` for :func:`couplings_in_model` and :func:`check_joint_limits`.
+
+    ``package://`` and ``file://`` URIs through ``package_map``, other paths
+    beside ``folder``; None for what is not a URDF or SDFormat file there.
+    """
 
     def resolve(uri: str):
         try:
@@ -213,7 +222,7 @@ def _resolver(package_map, folder: Path):
             kind = _kind_of(str(path))
             if not kind or not path.is_file():
                 return None  # a model folder (model.config), or nothing there
-            return path.read_text(), kind, _resolver(package_map, path.parent)
+            return path.read_text(), kind, model_resolver(package_map, path.parent)
         except (RuntimeError, OSError, ValueError):
             return None  # Drake's parser reports what it cannot find
 
@@ -329,7 +338,7 @@ def record_model_couplings(
                 path.read_text(),
                 kind,
                 [info.model_instance],
-                _resolver(package_map, path.parent) if package_map else None,
+                model_resolver(package_map, path.parent) if package_map else None,
             )
 
 
@@ -372,34 +381,37 @@ def add_models(
     if text is not None:
         if kind not in ("urdf", "sdf"):
             raise InvalidOptionError(f"text needs kind='urdf' or 'sdf', got {kind!r}")
-        check_joint_limits(text, kind, "the model text")
+        resolve = model_resolver(parser.package_map(), Path.cwd())
+        check_joint_limits(text, kind, "the model text", resolve=resolve)
         instances = parser.AddModelsFromString(text, kind)
-        _record_text(
-            plant, text, kind, instances, _resolver(parser.package_map(), Path.cwd())
-        )
+        _record_text(plant, text, kind, instances, resolve)
         return instances
     path = parser.package_map().ResolveUrl(url) if url is not None else str(file_name)
     kind = _kind_of(path)
     document = Path(path).read_text() if kind and Path(path).is_file() else None
+    resolve = model_resolver(parser.package_map(), Path(path).parent)
     if document is not None:
-        check_joint_limits(document, kind, path)
+        check_joint_limits(document, kind, path, resolve=resolve)
     if url is not None:
         instances = parser.AddModels(url=url)
     else:
         instances = parser.AddModels(str(file_name))
     if document is not None:
-        resolve = _resolver(parser.package_map(), Path(path).parent)
         _record_text(plant, document, kind, instances, resolve)
     return instances
 
 
-def check_joint_limits(text: str, kind: str, where: str) -> None:
+def check_joint_limits(
+    text: str, kind: str, where: str, *, resolve=None, depth: int = 0
+) -> None:
     """Refuse joint limits that would stop the process inside Drake.
 
     Drake stops the whole process (a failed internal condition, not an
     exception) on a joint whose lower position limit lies above its upper one,
     or is NaN.  Its SDFormat parser refuses a reversed pair itself, but not a
-    NaN; its URDF parser refuses neither.  So the document is read first, as
+    NaN; its URDF parser refuses a NaN, not a reversed pair.  So the document
+    (and with ``resolve``, as for :func:`couplings_in_model`, the SDFormat
+    files it includes) is read first, as
     Drake reads it: the limits of revolute and prismatic joints, and of a
     URDF's continuous ones (Drake ignores the others'), a missing bound as no
     bound (∓inf).  A URDF
@@ -415,12 +427,22 @@ def check_joint_limits(text: str, kind: str, where: str) -> None:
     ModelError
         Naming the joint, its limits and ``where`` the document came from.
     """
-    if "limit" not in text:
+    if "limit" not in text and "<include" not in text:
         return
     try:
         root = ET.fromstring(_with_prefixes_declared(text))
     except ET.ParseError:
         return
+    if kind == "sdf" and resolve is not None and depth < _MAX_INCLUDE_DEPTH:
+        for include in root.iter("include"):
+            uri = (include.findtext("uri") or "").strip()
+            got = resolve(uri)
+            if got is not None:
+                inner_text, inner_kind, inner = got
+                check_joint_limits(
+                    inner_text, inner_kind, f"{uri} (included by {where})",
+                    resolve=inner, depth=depth + 1,
+                )  # fmt: skip
     for joint in root.iter("joint"):
         if (joint.get("type") or "").lower() not in _LIMITED_JOINTS[kind]:
             continue

@@ -149,7 +149,11 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.validation import check_coefficient, check_flag
 from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
-from drakegrasp.plant.couplings import check_joint_limits, record_model_couplings
+from drakegrasp.plant.couplings import (
+    check_joint_limits,
+    model_resolver,
+    record_model_couplings,
+)
 from drakegrasp.plant.models import drake_reading, explain_drake_models, models_dir
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import (
@@ -457,7 +461,7 @@ def _check_joint_limits(path: Path, directives, parser) -> None:
     (:func:`~drakegrasp.plant.couplings.check_joint_limits`); one that
     cannot be resolved or read is left to Drake, which reports it.
     """
-    for d in directives.directives:
+    for d in _flattened(path, directives, parser).directives:
         if d.add_model is None:
             continue
         try:
@@ -468,7 +472,10 @@ def _check_joint_limits(path: Path, directives, parser) -> None:
             continue
         if text is not None:
             try:
-                check_joint_limits(text, kind, model.name)
+                check_joint_limits(
+                    text, kind, model.name,
+                    resolve=model_resolver(parser.package_map(), model.parent),
+                )  # fmt: skip
             except ModelError as e:
                 raise ModelError(f"scene {str(path)!r}: {e}") from None
 

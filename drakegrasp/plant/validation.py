@@ -24,7 +24,7 @@ from contextvars import ContextVar
 import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
+from pydrake.multibody.tree import BodyIndex, JointIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.deferred import WeakMemo
@@ -602,7 +602,9 @@ def _with_nested(plant, instance) -> list:
 
     An SDFormat model's nested ``<model>`` s (and ``<include>`` s) become model
     instances of their own, named under it: a hand whose fingers are nested
-    models is all of them.
+    models is all of them.  Only those joined to it count: a scene's
+    ``model_namespace`` names other models ``name::...`` too (a free object,
+    a fixture), which are no part of it.
     """
     name = plant.GetModelInstanceName(instance) + "::"
     nested = [
@@ -610,7 +612,25 @@ def _with_nested(plant, instance) -> list:
         for k in range(plant.num_model_instances())
         if plant.GetModelInstanceName(ModelInstanceIndex(k)).startswith(name)
     ]
-    return [instance, *nested]
+    if not nested:
+        return [instance]
+    parent = {}  # body -> the body its joint hangs from
+    for k in range(plant.num_joints()):
+        joint = plant.get_joint(JointIndex(k))
+        parent[int(joint.child_body().index())] = int(joint.parent_body().index())
+    own = {int(b) for b in plant.GetBodyIndices(instance)}
+
+    def joined(other) -> bool:
+        for b in plant.GetBodyIndices(other):
+            seen, i = set(), int(b)
+            while i in parent and i not in seen:  # up the tree to the world
+                seen.add(i)
+                i = parent[i]
+                if i in own:
+                    return True
+        return False
+
+    return [instance, *(n for n in nested if joined(n))]
 
 
 def _no_bodies(plant, object_body, hand, which: str) -> ModelError:

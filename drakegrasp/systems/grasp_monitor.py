@@ -174,8 +174,9 @@ class GraspMonitor(LeafSystem):
         the YCB soup can), which hold.
     check_pose : bool, optional
         As in :func:`drakegrasp.analyze_grasp`: a pose that the check refuses
-        (penetration deeper than ``distance_tolerance`` by any hand body, a
-        joint off its limits) gives an ``"invalid"`` sample, not an exception.
+        (a joint off its limits; penetration deeper than
+        ``distance_tolerance`` by any hand body where ``allow_penetration`` is
+        False) gives an ``"invalid"`` sample, not an exception.
     allow_penetration : bool, optional
         As in :func:`drakegrasp.analyze_grasp`; default (None) True: the
         simulator's contacts penetrate to make their force (the WSG-50
@@ -349,7 +350,8 @@ class GraspMonitor(LeafSystem):
         context (``body.SetMass(plant_context, m)``, as mass randomisation
         does) reaches no input port.  Call this with the simulation's plant
         context (or its root context) after changing them, before the next
-        sample; only the parameters are copied.
+        sample; only the parameters are copied.  They are the monitor's, not
+        a context's: simulators that share one diagram share them too.
 
         Raises
         ------

@@ -66,7 +66,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+# the test hands' helpers, in a sandbox's worker too
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "support"))
 
+from coupled_hands import transmissions  # noqa: E402
 from fuzz_cases import Case, report_family, run_family  # noqa: E402
 from hostile import pick  # noqa: E402
 from sandbox import Sandbox  # noqa: E402
@@ -850,8 +853,6 @@ def hand_urdf(hand: dict) -> str:
                 if d == "motor":
                     motors.append(name)
             chain.append(body)
-    from coupled_hands import transmissions
-
     return (
         '<?xml version="1.0"?><robot name="fuzz_hand">'
         + "".join(parts)

@@ -19,6 +19,7 @@ import drakegrasp as dg
 from drakegrasp.errors import ModelError
 from drakegrasp.planning import object_surface, plan_grasps, planning_scene
 from drakegrasp.planning.gripper import parallel_jaw
+from drakegrasp.planning.placement import onto_coupling
 
 BOX = "package://drakegrasp/objects/box.sdf"
 CYLINDER = "package://drakegrasp/objects/cylinder.sdf"
@@ -66,20 +67,39 @@ def test_an_uncoupled_jaw_has_no_coupling(wsg_scene):
     assert _jaw(wsg_scene()).coupling is None
 
 
-@settings(max_examples=60, deadline=None)
+JAWS = [(-1.0, 0.0), (-1.0, -0.004), (-1.0, 0.003), (-2.0, 0.0), (-0.5, -0.005)]
+
+
+@settings(max_examples=80, deadline=None)
 @given(
     q=st.tuples(st.floats(0.0, 0.045), st.floats(-0.045, 0.0)),
-    offset=st.sampled_from([0.0, -0.004, 0.003]),
+    jaw=st.sampled_from(JAWS),
 )
-def test_coupled_keeps_each_pad_where_it_stopped(tmp_path_factory, q, offset):
-    # second route: the pads' coordinates along the axis, x_f = z_f + r_f q_f
-    g = _jaws(tmp_path_factory)[offset]
+def test_coupled_keeps_each_pad_where_it_stopped(tmp_path_factory, q, jaw):
+    # second route: the pads' coordinates along the axis, x_f = z_f + r_f q_f,
+    # and the pads' world positions, the hand moved by the shift
+    g = _jaws(tmp_path_factory)[jaw]
     q = np.array(q) if g.joints[0].name() == "left_slide" else np.array(q[::-1])
     qc, shift = g.coupled(q)
     assert _on_coupling(g, qc) <= 1e-15
     before = g.pad_at_zero + g.pad_rate * q
     after = g.pad_at_zero + g.pad_rate * qc + shift
     np.testing.assert_allclose(after, before, atol=1e-15)
+    # in the world: the hand at X_WH, then moved along its grasp axis
+    from pydrake.math import RigidTransform, RollPitchYaw
+
+    X_WH = RigidTransform(RollPitchYaw(0.3, -0.7, 1.1), [0.1, -0.2, 0.3])
+    moved, qm = onto_coupling(g, X_WH, q)
+    if qm is None:  # off the limits: refused, not kept
+        return
+    a_W = X_WH.rotation().multiply(g.X_HK.rotation().col(0))
+    for f in range(2):
+        p_W = X_WH.multiply(g.X_HK.multiply(before[f] * np.eye(3)[0]))
+        p_moved = moved.multiply(g.X_HK.multiply((after[f] - shift) * np.eye(3)[0]))
+        np.testing.assert_allclose(p_moved, p_W, atol=1e-15)
+    np.testing.assert_allclose(
+        moved.translation() - X_WH.translation(), shift * a_W, atol=1e-15
+    )
 
 
 _JAWS: dict = {}
@@ -87,9 +107,9 @@ _JAWS: dict = {}
 
 def _jaws(tmp_path_factory):
     if not _JAWS:
-        for offset in (0.0, -0.004, 0.003):
+        for ratio, offset in JAWS:
             d = tmp_path_factory.mktemp("jaw")
-            _JAWS[offset] = _jaw(_scene(d, offset=offset))
+            _JAWS[ratio, offset] = _jaw(_scene(d, ratio=ratio, offset=offset))
     return _JAWS
 
 
@@ -162,3 +182,34 @@ def test_a_finger_without_stroke_is_refused(tmp_path):
     scene = _scene(tmp_path, stroke=0.0)
     with pytest.raises(ModelError, match="has no stroke"):
         _jaw(scene)
+
+
+def test_on_a_cloud_the_shifted_hand_is_checked_against_the_cloud(
+    tmp_path, monkeypatch
+):
+    # The cloud check after the shift onto the coupling looked at the hand's
+    # pose before the shift (the context was moved only later)
+    from drakegrasp.planning.cloud import CloudFingers
+
+    seen = []
+    check = CloudFingers.collides
+
+    def collides(self):
+        base = self.g.base
+        seen.append(self.plant.EvalBodyPoseInWorld(self.ctx, base).translation())
+        return check(self)
+
+    monkeypatch.setattr(CloudFingers, "collides", collides)
+    jaw = {"ratio": -0.5, "offset": -0.005, "stroke": 0.06}
+    scene = _scene(tmp_path, url=CYLINDER, **jaw)
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    surface = object_surface(scene.plant, ctx, scene.object_body)
+    p, n, _ = surface.sample(3000, np.random.default_rng(0))
+    hand_only = _scene(tmp_path, url=None, **jaw)
+    result = plan_grasps(
+        hand_only.plant, hand_only.context, None, hand=hand_only.hand,
+        num_candidates=60, mu=1.0, seed=0, point_cloud=p, cloud_normals=n,
+    )  # fmt: skip
+    assert len(result) >= 3
+    for c in result:
+        assert min(np.linalg.norm(s - c.X_WH.translation()) for s in seen) < 1e-12

@@ -58,3 +58,25 @@ def test_the_command_line_gives_the_advice_as_a_flag(capsys):
     assert main(["plan", "--num", "30", "--top", "1", "--shake", "1", "--mu", "3"]) == 0
     warned = [w for w in capsys.readouterr().err.splitlines() if "mu = 3" in w]
     assert len(warned) == 1 and "plan with --mu plant," in warned[0]
+
+
+@pytest.mark.parametrize(
+    "pairs, warned",
+    [((1.0, 1.0), False), ((1.0, 2.0), False), ((0.5, 1.0), True), ((2.0, 3.0), True)],
+)
+def test_the_smallest_pair_friction_is_what_a_plan_may_take(monkeypatch, pairs, warned):
+    # `--mu plant` plans with the smallest pair friction: where the pairs
+    # differ, its shake warned and advised `--mu plant`, which it was
+    import drakegrasp.planning.shake as shake
+
+    monkeypatch.setattr(shake, "hand_object_friction", lambda *a: np.array(pairs))
+
+    class Candidate:
+        contact_options = {"mu": 1.0}
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        shake._warn_friction(None, None, None, None, Candidate())
+    assert (
+        any(issubclass(w.category, FrictionMismatchWarning) for w in caught) is warned
+    )

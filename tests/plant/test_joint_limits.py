@@ -132,3 +132,55 @@ def test_a_scene_with_reversed_limits_is_refused_naming_scene_and_file(tmp_path)
     )
     with pytest.raises(ModelError, match=r"scene.yaml.*'slide' in jaw.urdf"):
         load_scene(scene)
+
+
+_INCLUDE_CHILD = """
+import sys
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+from drakegrasp.errors import ModelError
+from drakegrasp.plant.couplings import add_models
+plant = MultibodyPlant(0.001)  # a Parser does not keep its plant alive
+try:
+    add_models(Parser(plant), sys.argv[1])
+except ModelError as e:
+    print("refused:", e)
+"""
+
+
+def test_a_file_an_sdformat_model_includes_is_read_too(tmp_path):
+    # only the top document was read: the included one stopped the process
+    (tmp_path / "bad.urdf").write_text(_urdf())
+    holder = tmp_path / "holder.sdf"
+    holder.write_text(
+        "<sdf version='1.9'><model name='holder'><link name='mount'/><include>"
+        f"<uri>file://{tmp_path}/bad.urdf</uri></include></model></sdf>"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", _INCLUDE_CHILD, str(holder)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr[-300:]  # now: Drake's Failure, exit 1
+    assert run.stdout.startswith("refused: joint 'slide' in file://")
+    assert "bad.urdf (included by" in run.stdout
+
+
+def test_a_scene_file_its_directives_include_is_read_too(tmp_path):
+    # add_directives were not followed: Drake's own failure text came out
+    (tmp_path / "jaw.urdf").write_text(_urdf())
+    (tmp_path / "more.yaml").write_text(
+        "directives:\n- add_model:\n    name: jaw\n    file: package://here/jaw.urdf\n"
+    )
+    (tmp_path / "ball.sdf").write_text(
+        '<sdf version="1.9"><model name="ball"><link name="body"><collision '
+        'name="c"><geometry><sphere><radius>0.02</radius></sphere></geometry>'
+        "</collision></link></model></sdf>"
+    )
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(
+        "directives:\n- add_directives:\n    file: package://here/more.yaml\n"
+        "- add_model:\n    name: ball\n    file: ball.sdf\n"
+        "drakegrasp:\n  object_body: ball::body\n  hand: jaw\n  mu: 0.5\n"
+    )
+    with pytest.raises(ModelError, match=r"scene.yaml.*'slide' in jaw.urdf.*swap"):
+        load_scene(scene, package_map={"here": str(tmp_path)})

@@ -38,7 +38,10 @@ def _nested() -> str:
     return (
         f"<sdf version='1.9' {DRAKE}><model name='hand'><link name='palm'>"
         "<inertial><mass>0.2</mass></inertial></link>"
-        f"{_finger('f0', 0.5)}{_finger('f1', 0.8)}</model></sdf>"
+        f"{_finger('f0', 0.5)}{_finger('f1', 0.8)}"
+        "<joint name='w0' type='fixed'><parent>palm</parent><child>f0::base</child>"
+        "</joint><joint name='w1' type='fixed'><parent>palm</parent><child>f1::base"
+        "</child></joint></model></sdf>"
     )
 
 
@@ -98,3 +101,40 @@ def test_an_included_models_couplings_are_recorded(tmp_path, uri):
         2.0,
     )
     assert find_joint(plant, c.leader).name() == "j1"
+
+
+def test_a_merged_include_keeps_its_parents_scope(tmp_path):
+    from drakegrasp.plant.couplings import model_resolver, plant_couplings
+
+    (tmp_path / "finger.sdf").write_text(
+        f"<sdf version='1.9' {DRAKE}>{_finger('finger', 2.0)}</sdf>"
+    )
+    text = (
+        "<sdf version='1.9'><model name='hand'><link name='palm'><inertial><mass>"
+        f"0.1</mass></inertial></link><include merge='true'><uri>file://{tmp_path}"
+        "/finger.sdf</uri></include></model></sdf>"
+    )
+    plant, parser = _plant()
+    resolve = model_resolver(parser.package_map(), tmp_path)
+    assert couplings_in_model(text, "sdf", resolve=resolve) == [
+        [("j2", "j1", 2.0, 0.0)]
+    ]
+    add_models(parser, text=text, kind="sdf")
+    plant.Finalize()
+    (c,) = plant_couplings(plant)
+    assert find_joint(plant, c.follower).name() == "j2"  # hand::j2: Drake's name
+
+
+def test_a_namespaced_model_not_joined_to_the_hand_is_no_part_of_it():
+    # a scene's model_namespace names other models `hand::...` too
+    plant, parser = _plant()
+    add_models(parser, text=_nested(), kind="sdf")
+    from pydrake.multibody.tree import SpatialInertia
+
+    cup = plant.AddModelInstance("hand::cup")  # as model_namespace: hand makes
+    plant.AddRigidBody("cup", cup, SpatialInertia.SolidSphereWithMass(0.1, 0.03))
+    plant.Finalize()
+    palm = plant.GetBodyByName("palm")
+    names = {b.name() for b in hand_bodies(plant, plant.GetBodyByName("cup"), "hand")}
+    assert "cup" not in names and {"palm", "prox", "dist"} <= names
+    assert palm.name() in names
