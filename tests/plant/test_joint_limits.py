@@ -116,13 +116,18 @@ def test_the_command_line_says_one_line(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("drakegrasp: error: joint 'slide'")
 
 
-def test_a_scene_with_reversed_limits_is_refused_naming_scene_and_file(tmp_path):
-    (tmp_path / "jaw.urdf").write_text(_urdf())
-    (tmp_path / "ball.sdf").write_text(
+def _write_ball(folder) -> None:
+    """The scenes' object: a 20 mm sphere, ``ball.sdf`` in ``folder``."""
+    (folder / "ball.sdf").write_text(
         '<sdf version="1.9"><model name="ball"><link name="body"><collision '
         'name="c"><geometry><sphere><radius>0.02</radius></sphere></geometry>'
         "</collision></link></model></sdf>"
     )
+
+
+def test_a_scene_with_reversed_limits_is_refused_naming_scene_and_file(tmp_path):
+    (tmp_path / "jaw.urdf").write_text(_urdf())
+    _write_ball(tmp_path)
     scene = tmp_path / "scene.yaml"
     scene.write_text(
         "directives:\n- add_model:\n    name: jaw\n    file: jaw.urdf\n"
@@ -171,11 +176,7 @@ def test_a_scene_file_its_directives_include_is_read_too(tmp_path):
     (tmp_path / "more.yaml").write_text(
         "directives:\n- add_model:\n    name: jaw\n    file: package://here/jaw.urdf\n"
     )
-    (tmp_path / "ball.sdf").write_text(
-        '<sdf version="1.9"><model name="ball"><link name="body"><collision '
-        'name="c"><geometry><sphere><radius>0.02</radius></sphere></geometry>'
-        "</collision></link></model></sdf>"
-    )
+    _write_ball(tmp_path)
     scene = tmp_path / "scene.yaml"
     scene.write_text(
         "directives:\n- add_directives:\n    file: package://here/more.yaml\n"
