@@ -259,29 +259,37 @@ def coupling_entry(plant: MultibodyPlant, entry) -> tuple[Joint, Joint, float, f
     return j0, j1, rho, off
 
 
-def _closing_joints(plant, bodies, couplings):
-    """The closing joints and the couplings as joint index -> (leader, ρ, Δq)."""
+def _one_dof_and_actuated(plant, bodies) -> tuple[list[Joint], set[int]]:
+    """The one-dof joints that move one of ``bodies``, and the plant's actuated joints.
+
+    Returns the joints in the plant's joint order, and the set of joint
+    indices that carry an actuator (anywhere in the plant).
+    """
     wanted = {int(b.index()) for b in bodies}
-
-    def of_hand(j: Joint) -> bool:
-        return j.num_positions() == 1 and int(j.child_body().index()) in wanted
-
+    joints = [plant.get_joint(JointIndex(i)) for i in range(plant.num_joints())]
     one_dof = [
-        plant.get_joint(JointIndex(i))
-        for i in range(plant.num_joints())
-        if of_hand(plant.get_joint(JointIndex(i)))
+        j
+        for j in joints
+        if j.num_positions() == 1 and int(j.child_body().index()) in wanted
     ]
     actuated = {
         int(plant.get_joint_actuator(a).joint().index())
         for a in plant.GetJointActuatorIndices()
     }
+    return one_dof, actuated
+
+
+def _closing_joints(plant, bodies, couplings):
+    """The closing joints and the couplings as joint index -> (leader, ρ, Δq)."""
+    one_dof, actuated = _one_dof_and_actuated(plant, bodies)
+    of_hand = {int(j.index()) for j in one_dof}
     joints = [j for j in one_dof if int(j.index()) in actuated] or one_dof
     follows = {}
     for entry in coupling_entries(couplings):
         j0, j1, rho, off = coupling_entry(plant, entry)
         follows[int(j0.index())] = (int(j1.index()), rho, off)
         for j in (j0, j1):
-            if not of_hand(j):
+            if int(j.index()) not in of_hand:
                 raise InvalidOptionError(
                     f"coupled joint {joint_name(plant, j)} is not a one-dof joint "
                     "of the hand"
@@ -379,17 +387,7 @@ def passive_joints(
     tuple of Joint
         In the order of the plant's positions.
     """
-    wanted = {int(b.index()) for b in bodies}
-    joints = [
-        plant.get_joint(JointIndex(i))
-        for i in range(plant.num_joints())
-        if plant.get_joint(JointIndex(i)).num_positions() == 1
-        and int(plant.get_joint(JointIndex(i)).child_body().index()) in wanted
-    ]
-    actuated = {
-        int(plant.get_joint_actuator(a).joint().index())
-        for a in plant.GetJointActuatorIndices()
-    }
+    joints, actuated = _one_dof_and_actuated(plant, bodies)
     if not any(int(j.index()) in actuated for j in joints):
         return ()
     leader = {
