@@ -88,14 +88,11 @@ from drakegrasp.planning.ranking import (
     checked_noise,
     rank_candidates,
 )
-from drakegrasp.planning.surface import (
-    ObjectSurface,
-    piece_of_shape,
-    warn_if_not_convex,
-)
+from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
 from drakegrasp.planning.turned_gravity import GRAVITY
 from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.attachment import free_carrier, how_held
+from drakegrasp.plant.mesh_convexity import warn_if_not_convex
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -153,7 +150,7 @@ def object_surface(plant, plant_context, object_body) -> ObjectSurface:
     for g in plant.GetCollisionGeometriesForBody(body):
         shape, name = inspector.GetShape(g), inspector.GetName(g)
         pieces.append(piece_of_shape(shape, inspector.GetPoseInFrame(g), name))
-        warn_if_not_convex(shape, pieces[-1], name)
+        warn_if_not_convex(shape, name)
     return ObjectSurface.from_pieces(pieces)
 
 

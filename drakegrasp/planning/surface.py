@@ -31,14 +31,12 @@ geometry's frame.  numpy only, plus Drake's shape classes.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 from pydrake.geometry import (
     Box,
-    CalcVolume,
     Capsule,
     Convex,
     Cylinder,
@@ -50,30 +48,16 @@ from pydrake.geometry import (
 from pydrake.math import RigidTransform
 
 from drakegrasp.errors import ModelError
+from drakegrasp.plant.mesh_convexity import NON_CONVEX_SHARE as NON_CONVEX_SHARE
+from drakegrasp.plant.mesh_convexity import NonConvexMeshWarning as NonConvexMeshWarning
+from drakegrasp.plant.mesh_convexity import warn_if_not_convex as warn_if_not_convex
 
 __all__ = [
-    "NON_CONVEX_SHARE",
-    "NonConvexMeshWarning",
     "ObjectSurface",
     "Piece",
     "piece_of_shape",
-    "warn_if_not_convex",
 ]
 
-
-class NonConvexMeshWarning(UserWarning):
-    """An object's collision ``Mesh`` is not convex: it is planned as its hull.
-
-    The planner, like Drake's point-contact queries, treats a ``Mesh`` as its
-    convex hull, so a grasp may touch where the object has no surface (across
-    a torus's hole: all six best WSG-50 grasps of one put their contacts
-    there, reported as force closure).
-    """
-
-
-NON_CONVEX_SHARE = 0.95
-"""A collision ``Mesh`` whose volume is below this share of its hull's is
-warned of (:class:`NonConvexMeshWarning`): a torus is 61 % of its hull."""
 
 _PARALLEL = 1e-12
 """``|n_j^T d|`` (or ``|d_xy|``, ``|d_z|``) below this: the line is parallel."""
@@ -385,34 +369,6 @@ def _hull_piece(X_OG, name, vertices, polygons) -> Piece:
         offsets=np.array(offsets),
         triangles=np.array(tris),
     )
-
-
-def warn_if_not_convex(shape: Shape, piece: Piece, name: str = "") -> None:
-    """:class:`NonConvexMeshWarning` for a ``Mesh`` well inside its hull ``piece``.
-
-    Its own volume is Drake's ``CalcVolume`` (a mesh Drake cannot measure,
-    not closed or of another format, is let be); the hull's is that of the
-    piece's outward triangles.
-    """
-    if not isinstance(shape, Mesh) or piece.kind != "hull" or not len(piece.triangles):
-        return
-    try:
-        own = float(CalcVolume(shape))
-    except Exception:  # noqa: BLE001 - Drake's refusal: nothing to compare
-        return
-    t = piece.triangles
-    hull = float(np.sum(np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2]))))
-    hull /= 6.0
-    if hull > 0 and 0 < own < NON_CONVEX_SHARE * hull:
-        warnings.warn(
-            f"the object's collision mesh {name!r} is not convex (its volume is "
-            f"{100 * own / hull:.0f}% of its hull's): the planner, like Drake's "
-            "point contact, treats it as its hull, so a grasp may touch where the "
-            "object has no surface (across a hole or a hollow); split it into "
-            "convex pieces, one <collision> each, to plan on its true shape",
-            NonConvexMeshWarning,
-            stacklevel=3,
-        )
 
 
 def piece_of_shape(shape: Shape, X_OG: RigidTransform, name: str = "") -> Piece:

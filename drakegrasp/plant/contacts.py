@@ -67,6 +67,7 @@ from drakegrasp.plant.contact_pair import (
 )
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
 from drakegrasp.plant.handles import pickled_handle
+from drakegrasp.plant.mesh_convexity import warn_if_not_convex
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -460,6 +461,7 @@ def stage_contacts(
     allow_penetration: bool = False,
     patches: str = "vertices",
     cache: dict | None = None,
+    warn_hull: bool = True,
 ) -> StagedContacts:
     """Read the touching pairs of :func:`contacts_of_distances` from Drake now.
 
@@ -467,7 +469,11 @@ def stage_contacts(
     the context may change once this returns: :func:`resolve_staged` and
     :func:`staged_contacts` finish the work.  ``cache`` is a dict the caller
     keeps across calls on one plant and scene graph (names and shapes are
-    then read once).
+    then read once).  A touching object geometry that is a non-convex
+    ``Mesh`` is warned of once per ``cache``
+    (:class:`~drakegrasp.plant.mesh_convexity.NonConvexMeshWarning`: Drake's
+    distances are to its hull) unless ``warn_hull`` is False (a planner that
+    has warned already).
     """
     tol = distance_tolerance
     cache = {} if cache is None else cache
@@ -514,6 +520,9 @@ def stage_contacts(
             continue
         if abs(psi) > tol and not (allow_penetration and psi < 0):
             continue
+        if warn_hull and ("hull", go) not in cache:  # once per geometry and cache
+            cache["hull", go] = True
+            warn_if_not_convex(inspector.GetShape(go), name(go), user="this analysis")
         if index not in fingers:
             X_WF = plant.EvalBodyPoseInWorld(plant_context, finger)
             fingers[index] = X_WF.inverse().multiply(X_WO)

@@ -1,0 +1,142 @@
+"""Whether a collision ``Mesh`` is its convex hull, as Drake's queries take it.
+
+Drake's point contact and signed distances treat a ``Mesh`` as its convex
+hull.  For a non-convex mesh (a torus, an L, a mug) the contacts that
+:func:`~drakegrasp.analyze_grasp` reads from Drake, and the grasps the planner
+finds, may then touch where the object has no surface: across a hole or a
+hollow.  :func:`hull_share` measures how far a mesh is from its hull (its
+volume over its hull's) and :func:`warn_if_not_convex` says so with a
+:class:`NonConvexMeshWarning` when the share is below
+:data:`NON_CONVEX_SHARE`.  Volumes are in cubic metres, in the mesh's own
+frame with its scale.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+from pydrake.geometry import CalcVolume, Mesh, Shape
+
+__all__ = [
+    "NON_CONVEX_SHARE",
+    "NonConvexMeshWarning",
+    "hull_share",
+    "hull_volume",
+    "warn_if_not_convex",
+]
+
+
+class NonConvexMeshWarning(UserWarning):
+    """A collision ``Mesh`` is not convex: Drake, and drakegrasp, use its hull.
+
+    The planner, like Drake's point-contact queries, treats a ``Mesh`` as its
+    convex hull, so a grasp may touch where the object has no surface (across
+    a torus's hole: all six best WSG-50 grasps of one put their contacts
+    there, reported as force closure).
+    """
+
+
+NON_CONVEX_SHARE = 0.95
+"""A collision ``Mesh`` whose volume is below this share of its hull's is
+warned of (:class:`NonConvexMeshWarning`): a torus is 61 % of its hull."""
+
+_SHARES: dict[tuple, float | None] = {}
+""":func:`hull_share` per mesh file and scale: a file is read once."""
+
+
+def hull_volume(hull) -> float:
+    """The volume enclosed by a closed polygon mesh, m³.
+
+    Parameters
+    ----------
+    hull : PolygonSurfaceMesh
+        Drake's ``Shape.GetConvexHull()``: polygons over ``num_vertices()``
+        vertices, wound either way (the sign is taken off).
+
+    Returns
+    -------
+    float
+        The divergence theorem over the polygons' triangle fans, about the
+        vertices' centroid (so far-off meshes lose no digits).
+    """
+    vertices = np.array([hull.vertex(i) for i in range(hull.num_vertices())])
+    if not len(vertices):
+        return 0.0
+    vertices = vertices - vertices.mean(axis=0)
+    total = 0.0
+    for e in range(hull.num_elements()):
+        poly = hull.element(e)
+        ring = vertices[[poly.vertex(k) for k in range(poly.num_vertices())]]
+        for k in range(1, len(ring) - 1):
+            total += float(np.dot(ring[0], np.cross(ring[k], ring[k + 1])))
+    return abs(total) / 6.0
+
+
+def _key(shape: Mesh) -> tuple | None:
+    source = shape.source()
+    if not source.is_path():
+        return None  # an in-memory mesh: measured each time
+    return (str(source.path()), tuple(float(s) for s in shape.scale3()))
+
+
+def hull_share(shape: Shape) -> float | None:
+    """A ``Mesh``'s volume over its convex hull's, or None.
+
+    Parameters
+    ----------
+    shape : pydrake.geometry.Shape
+
+    Returns
+    -------
+    float or None
+        In (0, 1] for a closed mesh (1 when convex, to round-off); None for
+        another shape, or a mesh whose volume Drake does not measure (not
+        closed, or of a format ``CalcVolume`` does not read).
+    """
+    if not isinstance(shape, Mesh):
+        return None
+    key = _key(shape)
+    if key is not None and key in _SHARES:
+        return _SHARES[key]
+    try:
+        own = float(CalcVolume(shape))
+        hull = hull_volume(shape.GetConvexHull())
+    except Exception:  # noqa: BLE001 - Drake's refusal: nothing to compare
+        share = None
+    else:
+        share = own / hull if hull > 0 and own > 0 else None
+    if key is not None:
+        _SHARES[key] = share
+    return share
+
+
+def warn_if_not_convex(
+    shape: Shape, name: str = "", *, user: str = "the planner", stacklevel: int = 2
+) -> None:
+    """:class:`NonConvexMeshWarning` for a ``Mesh`` well inside its hull.
+
+    Parameters
+    ----------
+    shape : pydrake.geometry.Shape
+        Any shape; only a ``Mesh`` whose :func:`hull_share` is below
+        :data:`NON_CONVEX_SHARE` is warned of.
+    name : str
+        The geometry's name, for the message.
+    user : str
+        Who treats the mesh as its hull, for the message ("the planner",
+        "this analysis").
+    stacklevel : int
+        As for ``warnings.warn``, counted from the caller.
+    """
+    share = hull_share(shape)
+    if share is not None and share < NON_CONVEX_SHARE:
+        warnings.warn(
+            f"the object's collision mesh {name!r} is not convex (its volume is "
+            f"{100 * share:.0f}% of its hull's): {user}, like Drake's point "
+            "contact, treats it as its hull, so a grasp may touch where the "
+            "object has no surface (across a hole or a hollow); split it into "
+            "convex pieces, one <collision> each, to use its true shape",
+            NonConvexMeshWarning,
+            stacklevel=stacklevel + 1,
+        )
