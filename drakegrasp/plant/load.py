@@ -77,6 +77,7 @@ __all__ = [
     "gravity_wrench",
     "passive_preload",
     "plant_torque_limits",
+    "unbounded_actuators",
 ]
 
 
@@ -155,6 +156,51 @@ def plant_torque_limits(
         for j in range(joint.num_velocities()):
             limit_of[joint.velocity_start() + j] = float(actuator.effort_limit())
     return np.array([limit_of.get(int(v), 0.0) for v in velocity_indices], dtype=float)
+
+
+def unbounded_actuators(
+    plant: MultibodyPlant, velocity_indices: np.ndarray
+) -> tuple[str, ...]:
+    """The joints among ``velocity_indices`` whose actuator has no effort limit.
+
+    Drake gives an actuator an infinite ``effort_limit()`` where the model
+    states none (an SDFormat joint without ``<effort>``, a URDF ``<limit>``
+    without ``effort``): :func:`plant_torque_limits` then bounds nothing
+    there, and "holds" means with any torque.  A floating base's ``inf`` is
+    not counted (it is held where placed, not driven).
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    velocity_indices : (n,) int
+        Plant velocities, as for :func:`plant_torque_limits`.
+
+    Returns
+    -------
+    tuple of str
+        Joint names, in the order of ``velocity_indices``, each once.
+    """
+    wanted = {int(v) for v in velocity_indices}
+    found = {}
+    for k in range(plant.num_actuators()):
+        actuator = plant.get_joint_actuator(JointActuatorIndex(k))
+        joint = actuator.joint()
+        starts = range(
+            joint.velocity_start(), joint.velocity_start() + joint.num_velocities()
+        )
+        if math.isinf(actuator.effort_limit()) and wanted.intersection(starts):
+            found[min(wanted.intersection(starts))] = joint.name()
+    return tuple(found[v] for v in sorted(found))
+
+
+def _unbounded_warning(names: tuple[str, ...]) -> str:
+    listed = ", ".join(repr(n) for n in names)
+    return (
+        f"the actuators of {listed} have no effort limit in the model (Drake "
+        "takes a missing <effort> as unbounded), so torque_limits='plant' "
+        "bounds nothing there and 'holds' allows any torque; give the joints "
+        "an <effort> (SDFormat) or effort= (URDF), or pass torque_limits"
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -496,6 +542,11 @@ def analyze_load(
     disagreement = friction_disagreement(plant, mu_given, mu_plant)
     warnings = [] if disagreement is None else [disagreement]
     coupling = _coupling(data)
+    if source == "plant":
+        driven = data.hand_velocity_indices if coupling is None else coupling[1]
+        unbounded = unbounded_actuators(plant, driven)
+        if unbounded:
+            warnings.append(_unbounded_warning(unbounded))
     actuator_names, actuator_units, actuator_torques = (), (), None
     if coupling is not None and per_actuator is not None:
         C, every = coupling

@@ -125,3 +125,47 @@ def test_a_zero_load_is_held_and_has_no_payload_factor():
     assert r.load.forces.squeeze == pytest.approx(0.0, abs=1e-8)
     assert "payload factor: none" in str(r.load)
     assert json.loads(json.dumps(r.to_dict()))["load"]["payload"] is None
+
+
+def _jaw_box_scene(tmp_path, effort: str):
+    """The default scene with its jaw's ``<effort>`` replaced by ``effort``."""
+    from drakegrasp.plant.models import models_dir
+
+    root = models_dir()
+    hand = (root / "hands" / "parallel_jaw.sdf").read_text()
+    assert hand.count("<effort>140.0</effort>") == 2
+    (tmp_path / "jaw.sdf").write_text(hand.replace("<effort>140.0</effort>", effort))
+    scene = (root / "scenes" / "parallel_jaw_box.yaml").read_text()
+    scene = scene.replace("package://drakegrasp/hands/parallel_jaw.sdf", "jaw.sdf")
+    (tmp_path / "scene.yaml").write_text(scene)
+    return dg.load_scene(tmp_path / "scene.yaml")
+
+
+@pytest.mark.parametrize("effort", ["", "<effort>-1</effort>"])
+def test_actuators_without_an_effort_limit_are_named(tmp_path, effort):
+    # Drake gives an SDFormat joint without <effort> (or with -1) an actuator
+    # of infinite effort: the plant's limits bound nothing, and the report
+    # said "payload factor unbounded" as if the motors were that strong.
+    s = _jaw_box_scene(tmp_path, effort)
+    report = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5,
+        load="gravity", torque_limits="plant",
+    )  # fmt: skip
+    assert np.all(np.isinf(report.load.torque_limits))
+    said = [w for w in report.load.warnings if "no effort limit" in w]
+    assert len(said) == 1
+    assert "'left_finger_joint', 'right_finger_joint'" in said[0]
+    assert "no effort limit" in str(report)
+    # given limits, or the model's own, are not warned of
+    given = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5,
+        load="gravity", torque_limits=[50.0, 50.0],
+    )  # fmt: skip
+    assert not any("no effort limit" in w for w in given.load.warnings)
+    own = _jaw_box_scene(tmp_path, "<effort>140.0</effort>")
+    report = dg.analyze_grasp(
+        own.plant, own.plant_context, own.object_body, hand=own.hand, mu=0.5,
+        load="gravity", torque_limits="plant",
+    )  # fmt: skip
+    np.testing.assert_array_equal(report.load.torque_limits, [140.0, 140.0])
+    assert not any("no effort limit" in w for w in report.load.warnings)
