@@ -1526,6 +1526,8 @@ _PLAN_REASON_WORDS = {
     ),
     "the jaw at squeeze_limit ": "the jaw at --squeeze-limit ",
     "the hand at torque_limit ": "the hand at --torque-limit ",
+    "or pass squeeze_limit": "or pass --squeeze-limit N",
+    "or pass torque_limit": "or pass --torque-limit N·m",
 }
 """Phrases of a plan result's ``reason`` that name what ``plan`` cannot set."""
 

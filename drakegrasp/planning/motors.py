@@ -454,7 +454,11 @@ def with_torques_needed(
     applied = torque_limit is not None and torque_limit < limit
     if applied:
         limit = torque_limit
-    reason = result.reason or _too_weak(head, limit, applied)
+    reason = (
+        result.reason
+        or _too_weak(head, limit, applied)
+        or _no_limit(plant, ranked, limit, "torque_limit")
+    )
     settings = result.settings
     if motors_first:
         ranked = _held_first(ranked, "torque_needed", limit, top)
@@ -543,7 +547,11 @@ def with_squeeze_limit(
     applied = squeeze_limit is not None and squeeze_limit < limit
     if applied:
         limit = squeeze_limit
-    reason = result.reason or _too_weak_jaw(ranked, limit, applied)
+    reason = (
+        result.reason
+        or _too_weak_jaw(ranked, limit, applied)
+        or _no_limit(plant, ranked, limit, "squeeze_limit")
+    )
     ranked = _held_first(ranked, "squeeze_needed", limit, top)
     return dataclasses.replace(
         result,
@@ -692,6 +700,35 @@ def _none_held(
     return (
         f"{who} none of the {len(needed)} {best}force-closure candidates against "
         f"the object's weight in every direction: they need {at_least}{text}"
+    )
+
+
+def _no_limit(plant, ranked: list, limit: float, option: str) -> str:
+    """Why the motors ranked nothing: no effort limit in the model; or "".
+
+    Said only when no finite limit is known and some of the candidates'
+    joints have an actuator of infinite effort (Drake makes a missing
+    ``<effort>`` so); a hand modelled without actuators describes no motors
+    to weigh.
+    """
+    if not ranked or math.isfinite(limit):
+        return ""
+    names = ranked[0].joint_names
+    unbounded = [
+        n
+        for n in names
+        if any(
+            math.isinf(a.effort_limit())
+            for a in _actuators(plant, find_joint(plant, n))
+        )
+    ]
+    if not unbounded:
+        return ""
+    listed = ", ".join(repr(n) for n in unbounded)
+    return (
+        f"ranked by score alone: the actuators of {listed} have no effort "
+        "limit in the model (Drake takes a missing <effort> as unbounded), so "
+        f"nothing says which grasps the motors hold; give them one, or pass {option}"
     )
 
 

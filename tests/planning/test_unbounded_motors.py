@@ -1,0 +1,73 @@
+"""A plan says when the hand's motors have no effort limit to rank by.
+
+Drake gives an SDFormat joint without ``<effort>`` an actuator of infinite
+effort.  The motor re-ranking (``squeeze_needed``/``torque_needed`` within
+the effort limit first) then had nothing to compare with and the plan read
+as if any candidate were held; it now says why it ranks by score alone.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from drakegrasp.planning import plan_grasps, planning_scene
+from drakegrasp.plant.models import models_dir
+
+BOX = "package://drakegrasp/objects/box.sdf"
+SPHERE = "package://drakegrasp/objects/sphere.sdf"
+
+
+def _hand(tmp_path, name: str, effort: str, replacement: str):
+    text = (models_dir() / "hands" / name).read_text()
+    assert effort in text
+    path = tmp_path / name
+    path.write_text(text.replace(effort, replacement))
+    return str(path)
+
+
+def _plan(tmp_path, name, effort, replacement, obj, **options):
+    hand = _hand(tmp_path, name, effort, replacement)
+    scene = planning_scene(obj, hand_url=hand)
+    return plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=40, mu=0.5, seed=0, robustness_samples=4, **options,
+    )  # fmt: skip
+
+
+JAW = ("parallel_jaw_flat.sdf", "<effort>140.0</effort>", BOX)
+THREE = ("three_finger_hand.sdf", "<effort>2.0</effort>", SPHERE)
+
+
+@pytest.mark.parametrize("name, effort, obj", [JAW, THREE])
+def test_actuators_without_effort_are_said(tmp_path, name, effort, obj):
+    result = _plan(tmp_path, name, effort, "", obj)
+    assert len(result) > 0
+    assert result.reason.startswith("ranked by score alone")
+    assert "no effort limit in the model" in result.reason
+    assert "held_first" not in result.settings
+    assert "ranked by score alone" in str(result)
+
+
+@pytest.mark.parametrize("name, effort, obj", [JAW, THREE])
+def test_a_model_with_limits_says_nothing_of_it(tmp_path, name, effort, obj):
+    result = _plan(tmp_path, name, effort, effort, obj)
+    assert "ranked by score alone" not in result.reason
+    assert result.settings["held_first"]["source"] == "effort limit"
+
+
+def test_a_given_squeeze_limit_ranks_instead(tmp_path):
+    name, effort, obj = JAW
+    result = _plan(tmp_path, name, effort, "", obj, squeeze_limit=5.0)
+    assert "ranked by score alone" not in result.reason
+    assert result.settings["held_first"]["source"] == "squeeze_limit given"
+
+
+def test_the_command_line_names_its_option(tmp_path, capsys):
+    from drakegrasp.cli import main
+
+    name, effort, _ = JAW
+    hand = _hand(tmp_path, name, effort, "")
+    assert main(["plan", "box", "--hand", hand, "--num", "30", "--top", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "no effort limit in the model" in out
+    assert "or pass --squeeze-limit N" in out
