@@ -99,6 +99,7 @@ __all__ = [
     "MIN_SHAKEN_MASS",
     "PRISMATIC_STIFFNESS",
     "REVOLUTE_AIM",
+    "SEAT_TOLERANCE",
     "SoftFingerShakeWarning",
     "SqueezeLostWarning",
     "check_shake_options",
@@ -363,6 +364,12 @@ def _check_mass(name: str, mass: float) -> None:
         )
 
 
+SEAT_TOLERANCE = 1e-3
+"""How far (m) beyond its planned ``ψ`` a finger of a candidate planned on a
+body may be from the shaken object, at the candidate's poses, before the
+shake refuses it as another object than the one planned on (a box's grasp
+shaken on a cylinder read "held")."""
+
 _MIN_AIM = 1e-9
 """The least aim ``squeeze / stiffness`` (m or rad) past the touching place: a
 joint position of order 1 carries about 16 digits, so a smaller offset is lost
@@ -511,6 +518,67 @@ def _on_couplings(couplings, names, q: list) -> tuple[float, ...]:
     return tuple(float(x) for x in q)
 
 
+def _check_planned_object(
+    plant, ctx, body, candidate: GraspCandidate, X_WO: RigidTransform
+) -> None:
+    """Refuse an object whose surface is not where the candidate touched it.
+
+    Each finger that touched the object in the plan (a candidate planned on
+    a body: its contacts name their geometry) must be within its planned
+    ``|ψ|`` plus :data:`SEAT_TOLERANCE` of the shaken object, the hand at
+    the candidate's pose and a free object at the planned ``X_WO`` (put
+    back where ``ctx`` had it after).  A candidate planned on a point cloud
+    is let be (its surface is the cloud's, not the model's).
+    """
+    planned = [
+        c for c in candidate.contacts if getattr(c, "object_geometry_name", None)
+    ]
+    if not planned:
+        return
+    placed = None
+    if body.is_floating_base_body():
+        placed = plant.GetFreeBodyPose(ctx, body)
+        plant.SetFreeBodyPose(ctx, body, X_WO)
+    try:
+        _check_finger_gaps(plant, ctx, body, planned)
+    finally:
+        if placed is not None:
+            plant.SetFreeBodyPose(ctx, body, placed)
+
+
+def _check_finger_gaps(plant, ctx, body, planned: list) -> None:
+    """:func:`_check_planned_object` at the poses ``ctx`` holds."""
+    query = plant.get_geometry_query_input_port().Eval(ctx)
+    inspector = query.inspector()
+    objects = plant.GetCollisionGeometriesForBody(body)
+    for name in sorted({c.finger_body for c in planned}):
+        finger = resolve_body(plant, name)
+        bound = SEAT_TOLERANCE + max(
+            abs(c.psi) for c in planned if c.finger_body == name
+        )
+        gaps = []
+        for gf in plant.GetCollisionGeometriesForBody(finger):
+            for go in objects:
+                if inspector.CollisionFiltered(go, gf):
+                    continue
+                try:
+                    pair = query.ComputeSignedDistancePairClosestPoints(go, gf)
+                except RuntimeError:  # a pair Drake does not measure: let be
+                    continue
+                gaps.append(float(pair.distance))
+        if gaps and abs(min(gaps)) > bound:
+            gap = min(gaps)
+            where = (
+                f"{gap * 1e3:.3g} mm from" if gap > 0 else f"{-gap * 1e3:.3g} mm inside"
+            )
+            raise ModelError(
+                f"the candidate's finger {name} touched the object it was planned "
+                f"on, but at the candidate's poses it is {where} "
+                f"{_scoped(plant, body)}: this is not the object it was planned on "
+                f"(beyond {bound * 1e3:.3g} mm); shake it with that object"
+            )
+
+
 def shake_test(
     add_models: Callable,
     candidate: GraspCandidate,
@@ -655,6 +723,7 @@ def shake_test(
             "candidate must be a GraspCandidate from plan_grasps, got "
             f"{type(candidate).__name__}"
         )
+    planned_X_WO = candidate.X_WO
     if X_WO is not None:
         candidate = replace(candidate, X_WO=check_rigid_transform("X_WO", X_WO))
     check_candidate(candidate)
@@ -777,6 +846,7 @@ def shake_test(
     if inertia is not None:
         body.SetSpatialInertiaInBodyFrame(ctx, inertia)
     candidate.apply(plant, ctx, object_body=body)
+    _check_planned_object(plant, ctx, body, candidate, planned_X_WO)
     _warn_friction(plant, ctx, body, hand, candidate)
     q_held = plant.GetPositions(ctx)
 
