@@ -706,10 +706,9 @@ def _none_held(
 def _no_limit(plant, ranked: list, limit: float, option: str) -> str:
     """Why the motors ranked nothing: no effort limit in the model; or "".
 
-    Said only when no finite limit is known and some of the candidates'
-    joints have an actuator of infinite effort (Drake makes a missing
-    ``<effort>`` so); a hand modelled without actuators describes no motors
-    to weigh.
+    Said when no finite limit is known and some of the candidates' joints
+    have an actuator of infinite effort (Drake makes a missing ``<effort>``
+    so), or none of them has an actuator at all.
     """
     if not ranked or math.isfinite(limit):
         return ""
@@ -723,7 +722,15 @@ def _no_limit(plant, ranked: list, limit: float, option: str) -> str:
         )
     ]
     if not unbounded:
-        return ""
+        if any(_actuators(plant, find_joint(plant, n)) for n in names):
+            return ""  # zero effort limits: nothing a motor could weigh
+        listed = ", ".join(repr(n) for n in names)
+        return (
+            f"ranked by score alone: the model gives {listed} no actuator (a URDF "
+            "joint gets one from a <transmission>), so nothing says which grasps "
+            f"the motors hold, and a shake cannot squeeze; give them one, or pass "
+            f"{option}"
+        )
     listed = ", ".join(repr(n) for n in unbounded)
     return (
         f"ranked by score alone: the actuators of {listed} have no effort "

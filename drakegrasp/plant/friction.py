@@ -127,7 +127,12 @@ def _check_rule(rule) -> str:
 
 
 def plant_friction(
-    plant: MultibodyPlant, plant_context, contacts, *, query_object=None
+    plant: MultibodyPlant,
+    plant_context,
+    contacts,
+    *,
+    query_object=None,
+    rule: str | None = None,
 ) -> np.ndarray:
     """Per contact, the plant's combined friction coefficient (see the module).
 
@@ -138,6 +143,8 @@ def plant_friction(
     contacts : sequence of PlantContact
     query_object : QueryObject, optional
         Read the geometry from it instead of the plant's query port.
+    rule : {"static", "dynamic"}, optional
+        As in :func:`pair_friction` (default: the plant's rule).
 
     Returns
     -------
@@ -164,9 +171,14 @@ def plant_friction(
         ctx = plant_context_of(plant, plant_context)
         query_object = query_object_of(plant, ctx)
     return np.array(
-        [pair_friction(plant, query_object, go, gf) for go, gf in pairs],
+        [pair_friction(plant, query_object, go, gf, rule=rule) for go, gf in pairs],
         dtype=float,
     )
+
+
+def _differs(mu: np.ndarray, given: float) -> np.ndarray:
+    """Where ``mu`` is not ``given`` (beyond :data:`MU_RELATIVE_TOL`, relative)."""
+    return np.abs(mu - given) > MU_RELATIVE_TOL * np.maximum(mu, 1.0)
 
 
 def hand_object_friction(
@@ -230,7 +242,7 @@ def hand_object_friction(
 
 
 def friction_disagreement(
-    plant: MultibodyPlant, mu_given: float | None, mu_plant
+    plant: MultibodyPlant, mu_given: float | None, mu_plant, *, mu_dynamic=None
 ) -> str | None:
     """Why a given ``μ`` is not the plant's, or None when they agree.
 
@@ -242,6 +254,12 @@ def friction_disagreement(
         The coefficient the caller typed (None: nothing to compare).
     mu_plant : (N,) float or None
         The plant's coefficient per contact (:func:`plant_friction`).
+    mu_dynamic : (N,) float or None, optional
+        For a continuous plant, the dynamic coefficient per contact
+        (``plant_friction(..., rule="dynamic")``): where ``mu_given`` is that
+        at every contact that differs (``drakegrasp plan --mu plant``'s, what
+        a discrete simulation uses), the sentence says so instead of
+        advising ``mu='plant'``.
 
     Returns
     -------
@@ -252,9 +270,21 @@ def friction_disagreement(
     if mu_given is None or mu_plant is None:
         return None
     mu_plant = np.asarray(mu_plant, dtype=float)
-    off = np.abs(mu_plant - mu_given) > MU_RELATIVE_TOL * np.maximum(mu_plant, 1.0)
+    off = _differs(mu_plant, mu_given)
     if not np.any(off):
         return None
+    if mu_dynamic is not None and friction_rule(plant) == "static":
+        dynamic = np.asarray(mu_dynamic, dtype=float)
+        if dynamic.shape == mu_plant.shape and not np.any(
+            _differs(dynamic[off], mu_given)
+        ):
+            return (
+                f"mu = {mu_given:g} is the models' dynamic friction at contacts "
+                f"{np.flatnonzero(off).tolist()}, what a discrete simulation uses "
+                "(and drakegrasp plan --mu plant); this continuous plant's rule "
+                f"takes the static {np.round(np.unique(mu_plant[off]), 6).tolist()} "
+                "(mu='plant'), which holds more"
+            )
     return (
         f"mu = {mu_given:g} was given but the plant simulates "
         f"{np.round(np.unique(mu_plant[off]), 6).tolist()} "

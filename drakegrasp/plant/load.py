@@ -70,6 +70,7 @@ from drakegrasp.plant.validation import (
 
 __all__ = [
     "MAX_BODY_SETS",
+    "MAX_LOAD",
     "PRELOAD_TOL",
     "LoadReport",
     "analyze_load",
@@ -80,6 +81,12 @@ __all__ = [
     "unbounded_actuators",
 ]
 
+
+MAX_LOAD = 1e150
+"""Largest magnitude (N, N·m) of a given load's components: the load programs
+square and multiply them (``analyze --load 0,0,-1e308,...`` printed ``-inf``
+beside numpy's overflow warnings); every load up to this resolves (a payload
+factor of 1.4e-148 for the default scene)."""
 
 FLOATING_JOINTS = ("quaternion_floating", "rpy_floating")
 """Drake joint types of a free body: six velocities that no actuator drives."""
@@ -191,6 +198,17 @@ def unbounded_actuators(
         if math.isinf(actuator.effort_limit()) and wanted.intersection(starts):
             found[min(wanted.intersection(starts))] = joint.name()
     return tuple(found[v] for v in sorted(found))
+
+
+def _unactuated_warning(names: tuple[str, ...]) -> str:
+    listed = ", ".join(repr(n) for n in names)
+    return (
+        f"{listed} {'has' if len(names) == 1 else 'have'} no actuator in the "
+        "model (or an effort limit of 0), so torque_limits='plant' gives "
+        f"{'it' if len(names) == 1 else 'them'} 0 (no torque: a passive joint); "
+        "give the model its motors (a URDF <transmission>, an SDFormat "
+        "<effort>), or pass torque_limits"
+    )
 
 
 def _unbounded_warning(names: tuple[str, ...]) -> str:
@@ -434,6 +452,12 @@ def _load_wrench(plant, plant_context, data, load):
             f"load must be 'gravity' or a finite {data.grasp.wrench_dim}-vector "
             f"[f; m] in frame O about its origin, got {np.asarray(load).tolist()}"
         )
+    if np.max(np.abs(w)) > MAX_LOAD:
+        raise InvalidOptionError(
+            f"load components must be at most {MAX_LOAD:g} (N, N·m) in magnitude, "
+            f"got {np.asarray(load).tolist()}: the programs' products of "
+            "such numbers overflow"
+        )
     return w
 
 
@@ -499,6 +523,7 @@ def analyze_load(
     torque_limits=None,
     mu_given: float | None,
     mu_plant: np.ndarray | None,
+    mu_dynamic: np.ndarray | None = None,
 ) -> LoadReport:
     """The load section of a grasp report (see :class:`LoadReport`).
 
@@ -514,6 +539,9 @@ def analyze_load(
         The ``μ`` the caller typed (None with ``mu="plant"``).
     mu_plant : (N,) float or None
         The plant's friction per contact (None when it cannot be read).
+    mu_dynamic : (N,) float or None, optional
+        A continuous plant's dynamic friction per contact, for the wording of
+        a disagreement (:func:`~drakegrasp.plant.friction.friction_disagreement`).
     """
     w = _load_wrench(plant, plant_context, data, load)
     limits, source, per_actuator = _torque_limits(plant, data, torque_limits)
@@ -539,7 +567,9 @@ def analyze_load(
         if payload is not None and payload.saturating_joints
         else None
     )
-    disagreement = friction_disagreement(plant, mu_given, mu_plant)
+    disagreement = friction_disagreement(
+        plant, mu_given, mu_plant, mu_dynamic=mu_dynamic
+    )
     warnings = [] if disagreement is None else [disagreement]
     coupling = _coupling(data)
     if source == "plant":
@@ -547,6 +577,9 @@ def analyze_load(
         unbounded = unbounded_actuators(plant, driven)
         if unbounded:
             warnings.append(_unbounded_warning(unbounded))
+        if np.any(limits == 0.0):  # per coordinate: a follower moves with its leader
+            passive = tuple(n for n, t in zip(names, limits, strict=True) if t == 0.0)
+            warnings.append(_unactuated_warning(passive))
     actuator_names, actuator_units, actuator_torques = (), (), None
     if coupling is not None and per_actuator is not None:
         C, every = coupling
@@ -726,6 +759,12 @@ def load_section(
     except ModelError:
         if isinstance(mu, str):
             raise
+    mu_dynamic = None  # what plan --mu plant and a discrete simulation use
+    if mu_plant is not None and not isinstance(mu, str) and plant.time_step() == 0:
+        mu_dynamic = plant_friction(
+            plant, plant_context, data.contacts, query_object=query_object,
+            rule="dynamic",
+        )  # fmt: skip
     if isinstance(mu, str):
         grasp = data.grasp.with_contacts(
             [c.with_(mu=m) for c, m in zip(data.grasp.contacts, mu_plant, strict=True)]
@@ -746,5 +785,6 @@ def load_section(
         torque_limits=torque_limits,
         mu_given=None if isinstance(mu, str) else float(mu),
         mu_plant=mu_plant,
+        mu_dynamic=mu_dynamic,
     )
     return data, report

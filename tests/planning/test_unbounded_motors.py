@@ -71,3 +71,10 @@ def test_the_command_line_names_its_option(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "no effort limit in the model" in out
     assert "or pass --squeeze-limit N" in out
+
+
+def test_a_hand_without_actuators_is_said(tmp_path):
+    name, effort, obj = JAW
+    result = _plan(tmp_path, name, effort, "<effort>0</effort>", obj)
+    assert result.reason.startswith("ranked by score alone")
+    assert "no actuator" in result.reason

@@ -1,6 +1,7 @@
 """Grasps under load from a plant: gravity, actuator limits, the plant's friction."""
 
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -169,3 +170,37 @@ def test_actuators_without_an_effort_limit_are_named(tmp_path, effort):
     )  # fmt: skip
     np.testing.assert_array_equal(report.load.torque_limits, [140.0, 140.0])
     assert not any("no effort limit" in w for w in report.load.warnings)
+
+
+@pytest.mark.parametrize("size, held", [(1e150, True), (1e151, None), (1e308, None)])
+def test_a_load_too_large_to_compute_with_is_refused(size, held):
+    # 1e308 printed "-inf" beside numpy's overflow warnings and a verdict
+    s = dg.load_scene("parallel_jaw_box")
+    load = [0.0, 0.0, -size, 0.0, 0.0, 0.0]
+    if held is None:
+        with pytest.raises(dg.InvalidOptionError, match="at most 1e\\+150"):
+            dg.analyze_grasp(
+                s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load=load
+            )
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # no overflow on the way
+        report = dg.analyze_grasp(
+            s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load=load
+        )
+    assert report.load.holds is held
+    assert np.all(np.isfinite(report.load.wrench))
+
+
+def test_joints_without_an_actuator_are_named(tmp_path):
+    # "holds: NO ... (bound 0)" never said that the model had no motors
+    s = _jaw_box_scene(tmp_path, "<effort>0</effort>")
+    assert s.plant.num_actuators() == 0  # Drake adds none for a zero effort
+    report = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5,
+        load="gravity", torque_limits="plant",
+    )  # fmt: skip
+    np.testing.assert_array_equal(report.load.torque_limits, [0.0, 0.0])
+    said = [w for w in report.load.warnings if "no actuator" in w]
+    assert len(said) == 1
+    assert "'left_finger_joint', 'right_finger_joint' have no actuator" in said[0]
