@@ -269,6 +269,12 @@ class GraspMonitor(LeafSystem):
             raise InvalidOptionError(
                 f"GraspMonitor needs a finalized pydrake MultibodyPlant, got {plant!r}"
             )
+        if not plant.geometry_source_is_registered():
+            raise ModelError(
+                "the plant is not registered with a SceneGraph, so it has no "
+                "geometry to find contacts in: build it with "
+                "AddMultibodyPlantSceneGraph"
+            )
         self.settings = monitor_settings(
             options,
             contacts=contacts,
@@ -561,6 +567,9 @@ class GraspMonitor(LeafSystem):
                 contacts=sensed.contacts,
                 couplings=self.couplings,
             )
+            deep = self._too_deep(report)
+            if deep:
+                return "invalid", deep, None, sensed.loads
             return "ok", "", report, sensed.loads
         except NoContactsError as e:
             status, message = "no contact", str(e)
@@ -577,6 +586,25 @@ class GraspMonitor(LeafSystem):
         # tolerance, a Drake error), which says nothing about the grip.
         loads = None if sensed is None else sensed.loads
         return status, message, None, loads
+
+    def _too_deep(self, report) -> str:
+        """Why ``report``'s hand sinks too deep to judge, or "".
+
+        Deeper than ``HoldingThresholds.max_penetration`` (where penetration
+        is allowed; else the analysis refused it already).
+        """
+        pose = report.pose
+        if pose is None or not pose.penetrations:
+            return ""
+        deepest = max(pose.penetrations, key=lambda p: p.depth)
+        bound = self.settings.thresholds.max_penetration
+        if deepest.depth <= bound:
+            return ""
+        return (
+            f"{deepest}: deeper than max_penetration ({bound * 1e3:g} mm), no "
+            "grip to judge (raise HoldingThresholds.max_penetration for a "
+            "softer contact)"
+        )
 
     def evaluate(self, context: Context) -> GraspSample:
         """Analyse the grasp at the inputs of ``context`` (one sample).

@@ -135,6 +135,12 @@ class HoldingThresholds:
         which a contact still counts (the monitor refuses it at or below its
         ``distance_tolerance``) and the chatter of a sliding finger (~0.3 mm
         on the WSG-50's pads).
+    max_penetration : float
+        Metres (default 5 mm): a sample whose hand sinks deeper into the
+        object than this is ``"invalid"`` even where penetration is allowed
+        (a simulation's contacts penetrate to make their force: the WSG-50
+        squeezing with 20 N sinks 0.145 mm; fingers 15 mm inside a box are
+        no grip to judge).
     """
 
     risk: float = 0.8
@@ -142,9 +148,16 @@ class HoldingThresholds:
     separation_speed: float = 5e-3
     hold_samples: int = 1
     release_distance: float = 2e-3
+    max_penetration: float = 5e-3
 
     def __post_init__(self):
-        for name in ("risk", "slip_speed", "separation_speed", "release_distance"):
+        for name in (
+            "risk",
+            "slip_speed",
+            "separation_speed",
+            "release_distance",
+            "max_penetration",
+        ):
             value = real_scalar(name, getattr(self, name))  # numpy reals too
             object.__setattr__(self, name, value)  # a float, whatever was given
             if not (np.isfinite(value) and value > 0):

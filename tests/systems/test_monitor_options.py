@@ -212,3 +212,61 @@ def test_no_warning_before_contact():
         pick = build_pick(mu=0.5, distance_tolerance=1e-3)
         pick.run(0.3)  # the fingers are still open
     assert pick.monitor.friction_warning is None
+
+
+def test_a_plant_without_a_scene_graph_is_named():
+    # it said the box "has no collision geometry", which its file gives it
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    plant = MultibodyPlant(0.0)
+    parser = Parser(plant)
+    dg.register_models(parser)
+    parser.AddModels(url="package://drakegrasp/objects/box.sdf")
+    plant.Finalize()
+    with pytest.raises(dg.ModelError, match="not registered with a SceneGraph"):
+        dg.GraspMonitor(plant, object_body=plant.GetBodyByName("box"), mu=0.5)
+
+
+def _jaw_box_monitor(**keywords):
+    from pydrake.math import RigidTransform
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.framework import DiagramBuilder
+
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=1e-3)
+    parser = Parser(plant)
+    dg.register_models(parser)
+    hand = parser.AddModels(url="package://drakegrasp/hands/parallel_jaw.sdf")[0]
+    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("palm", hand))
+    parser.AddModels(url="package://drakegrasp/objects/box.sdf")
+    plant.Finalize()
+    monitor = dg.add_grasp_monitor(
+        builder, plant, scene_graph, object_body=plant.GetBodyByName("box"),
+        mu=0.5, **keywords,
+    )  # fmt: skip
+    diagram = builder.Build()
+    root = diagram.CreateDefaultContext()
+    ctx = plant.GetMyContextFromRoot(root)
+    box = plant.GetBodyByName("box")
+    plant.SetFreeBodyPose(ctx, box, RigidTransform([0, 0, 0.065]))
+
+    def sample(q):
+        plant.SetPositions(ctx, hand, q)
+        return monitor.evaluate(monitor.GetMyContextFromRoot(root))
+
+    return sample
+
+
+@pytest.mark.parametrize("q, status", [(0.0249, "ok"), (0.01, "invalid")])
+def test_fingers_deep_in_the_object_are_no_grip(q, status):
+    # 15 mm inside the box read "holding, force closure 1" (penetration is
+    # allowed in a monitor by default: a simulation's contacts sink a little)
+    sample = _jaw_box_monitor()([q, q])
+    assert sample.status == status
+    if status == "invalid":
+        assert "15 mm: deeper than max_penetration (5 mm)" in sample.message
+        assert sample.holding == "no contact"  # the grip before it is kept
+    deeper = _jaw_box_monitor(holding=dg.HoldingThresholds(max_penetration=0.02))
+    assert deeper([q, q]).status == "ok"
