@@ -1433,16 +1433,21 @@ def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:
     rank = next(k for k, c in enumerate(result) if c is best)
     held = "" if shaken is None else (" (held)" if shaken.best is not None else "")
     path = Path(args.scene_out)
+    # mu as planned: --mu plant planned with the smallest dynamic coefficient,
+    # where the scene's mu: plant would read the static one (a continuous plant)
+    source = "; mu: --mu plant's, the models' dynamic" if args.mu == "plant" else ""
     text = grasp_scene_text(
         plant, context, best, object_body=object_body,
         hand_file=_plan_hand(args.hand), object_file=_plan_url(args.object),
-        mu="plant" if args.mu == "plant" else result.mu,  # as planned
-        folder=path.resolve().parent,
+        mu=result.mu, folder=path.resolve().parent,
         description=f"Candidate #{rank}{held} of drakegrasp plan "
-        f"{args.object} --hand {args.hand or 'flat'} (sample {best.sample}).",
+        f"{args.object} --hand {args.hand or 'flat'} (sample {best.sample}"
+        f"{source}).",
     )  # fmt: skip
     with placed(path, overwrite=args.overwrite) as tmp:
         Path(tmp).write_text(text)
+    for kept in _scene_out_notes(args, best):
+        _say(f"drakegrasp: note: {kept}")
     note = "" if shaken is None or shaken.best is not None else ", none held"
     line = f"wrote candidate #{rank}{note} to {path} (drakegrasp analyze {path})"
     if args.json:  # stdout holds the JSON document alone
@@ -1450,6 +1455,24 @@ def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:
     else:
         print(line)
     return 0
+
+
+def _scene_out_notes(args: argparse.Namespace, best) -> list[str]:
+    """What the plan assumed that a scene file does not keep, and how to give it."""
+    notes = []
+    if best.contact_options.get("contact_model") == "soft_finger":
+        notes.append(
+            "a scene file keeps no torsion length: analyze it with "
+            f"--characteristic-length {best.torque_scale:.6g} for the plan's "
+            "soft-finger moments (and its epsilon)"
+        )
+    if args.mass is not None:
+        notes.append(
+            f"the scene keeps the model's mass, not --mass {args.mass:g}: "
+            "analyze --load gravity weighs the model's; give the load as a "
+            "wrench (--load FX,FY,FZ,MX,MY,MZ) for the planned mass"
+        )
+    return notes
 
 
 def _shaken(add_models, result, args: argparse.Namespace, options: dict):

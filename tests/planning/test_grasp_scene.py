@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import yaml
 from coupled_hands import coupled_jaw_urdf
 
 import drakegrasp as dg
 from drakegrasp.cli import main
 from drakegrasp.planning import plan_grasps, planning_scene
 from drakegrasp.planning.grasp_scene import grasp_scene_text
+from drakegrasp.plant.models import models_dir
 from drakegrasp.plant.scene import load_scene
 
 BOX = "package://drakegrasp/objects/box.sdf"
@@ -123,3 +125,46 @@ def test_the_command_line_refuses_what_it_cannot_write(tmp_path, capsys, argv, s
     assert main(["plan", "--num", "5", *argv]) != 0
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and says in err[0]
+
+
+def test_plan_mu_plant_is_written_as_the_number_planned(tmp_path, capsys):
+    # --mu plant plans with the dynamic coefficient; a scene's mu: plant reads
+    # the static one (a continuous plant): the scene held 25 % more load than
+    # the plan, and than a discrete simulation, without a word
+    box = tmp_path / "box.sdf"
+    text = (models_dir() / "objects" / "box.sdf").read_text()
+    geometry = "<geometry><box><size>0.05 0.05 0.1</size></box></geometry>\n"
+    assert text.count(geometry) == 2  # collision, then visual
+    box.write_text(
+        text.replace(
+            geometry,
+            geometry + "        <drake:proximity_properties><drake:mu_dynamic>0.4"
+            "</drake:mu_dynamic><drake:mu_static>1.0</drake:mu_static>"
+            "</drake:proximity_properties>\n",
+            1,
+        )
+    )
+    dynamic = 2 * 0.4 * 1.0 / (0.4 + 1.0)  # Drake's combination with the pads' 1
+    out = tmp_path / "best.yaml"
+    argv = ["plan", str(box), "--num", "40", "--top", "1", "--mu", "plant"]
+    assert main([*argv, "--scene-out", str(out)]) == 0
+    capsys.readouterr()
+    written = out.read_text()  # the drakegrasp: section (the rest has Drake's tags)
+    section = yaml.safe_load(written[written.index("\ndrakegrasp:") :])["drakegrasp"]
+    assert section["mu"] == pytest.approx(dynamic, rel=1e-12)
+    assert "--mu plant's, the models' dynamic" in section["description"]
+    assert main(["analyze", str(out), "--load", "gravity"]) == 0
+    said = capsys.readouterr().out
+    assert f"mu = {dynamic:g} is the models' dynamic friction" in said
+    assert "pass mu='plant'" not in said
+
+
+def test_what_a_scene_file_cannot_keep_is_said(tmp_path, capsys):
+    out = tmp_path / "soft.yaml"
+    argv = ["plan", "cylinder", "--hand", "rounded", "--num", "60", "--top", "1",
+            "--contact-model", "soft_finger", "--torsional-friction", "0.1",
+            "--mass", "0.5", "--scene-out", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "--characteristic-length 0.0670" in err
+    assert "not --mass 0.5" in err
