@@ -123,7 +123,8 @@ class AnalysisOptions:
         its origin, or the object's weight: the report then has a load section.
     torque_limits : None, "plant" or tuple of float
         Motor limits of the load section (N·m or N per hand velocity; ``inf``
-        for none).  ``"plant"`` reads the actuators' effort limits, a free hand
+        for none); one number (``100`` or ``[100]``, kept as ``(100.0,)``) is
+        every actuator's.  ``"plant"`` reads the actuators' effort limits, a free hand
         base's velocities unbounded
         (:func:`~drakegrasp.plant.load.plant_torque_limits`).
     """
@@ -243,7 +244,9 @@ class AnalysisOptions:
 def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
     """None, ``word``, or a finite 1-D sequence of numbers as a tuple.
 
-    With ``limits``, ``+inf`` is allowed too (a joint with no limit).
+    With ``limits``, ``+inf`` is allowed too (a joint with no limit), and one
+    real number is one limit for every actuator: ``x`` gives ``(x,)``, as
+    ``[x]`` does.
     """
     if value is None or (isinstance(value, str) and value == word):
         return None if value is None else word  # a plain str
@@ -258,14 +261,21 @@ def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
             f"{name} must be {word!r}, numbers or None, got {value!r}"
         ) from None
     if limits:  # a motor's limit is a magnitude: >= 0, inf for none
+        if values.ndim == 0:  # one number: every actuator's limit, as [x] is
+            values = values.reshape(1)
         ok = (values >= 0.0) & ~np.isnan(values)
     else:
         ok = np.isfinite(values)
     if values.ndim != 1 or values.size == 0 or not np.all(ok):
-        what = "numbers >= 0 (inf: no limit)" if limits else "finite numbers"
-        what = f"one or more {what}"
+        if limits:
+            raise InvalidOptionError(
+                f"{name} must be {word!r}, one number >= 0 for every actuator or "
+                "a 1-D sequence of one or more numbers >= 0 (inf: no limit), got "
+                f"{value!r}"
+            )
         raise InvalidOptionError(
-            f"{name} must be a 1-D sequence of {what}, got {value!r}"
+            f"{name} must be a 1-D sequence of one or more finite numbers, got "
+            f"{value!r}"
         )
     return tuple(float(x) for x in values)
 

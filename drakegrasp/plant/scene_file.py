@@ -74,8 +74,8 @@ KEYS = {
     "origin: analyse the grasp under that load",
     "torque_limits": "'plant' (the actuators' effort limits) or a list of "
     "numbers >= 0 (.inf: no limit), one per hand velocity (a coupled hand: per "
-    "actuated joint or per independent coordinate) or one for all: the motors "
-    "of the load analysis",
+    "actuated joint or per independent coordinate), or one number >= 0 for all: "
+    "the motors of the load analysis",
 }
 """The keys of the ``drakegrasp:`` section and what each must be."""
 

@@ -45,3 +45,20 @@ def test_valid_loads_and_limits_are_kept_as_tuples_of_floats():
     planar = dg.AnalysisOptions(load=[0, -9.81, 0], plane="xy")
     assert planar.load == (0.0, -9.81, 0.0)
     assert dg.AnalysisOptions(load="gravity", torque_limits="plant").load == "gravity"
+
+
+@pytest.mark.parametrize(
+    "limit", [100, 100.0, 0, 1e-3, np.inf, np.float64(2.5), np.int64(7), np.array(3.0)]
+)
+def test_one_number_is_every_actuators_torque_limit_as_a_list_of_one_is(limit):
+    # docs/scene_format.md says "or one for all"; a scalar was refused ("must
+    # be a 1-D sequence ..., got 100") where [100] was taken.
+    one = dg.AnalysisOptions(load="gravity", torque_limits=limit)
+    assert one.torque_limits == dg.AnalysisOptions(torque_limits=[limit]).torque_limits
+    assert one.torque_limits == (float(limit),)
+
+
+@pytest.mark.parametrize("limit", [-1.0, -np.inf, np.nan, True, "100", 1j])
+def test_a_scalar_torque_limit_that_cannot_be_is_refused_naming_it(limit):
+    with pytest.raises(dg.InvalidOptionError, match=r"^torque_limits must be 'plant'"):
+        dg.AnalysisOptions(torque_limits=limit)

@@ -110,3 +110,24 @@ def test_a_planar_scene_takes_a_planar_load(tmp_path):
     bad = planar.replace("  plane: yz", "  plane: yz\n  load: [0, 0, -1, 0, 0, 0]")
     with pytest.raises(SceneError, match="a planar wrench"):
         load_scene(_write(tmp_path, bad))
+
+
+def test_one_torque_limit_for_all_in_a_scene_and_in_python(tmp_path):
+    # "one for all" (docs/scene_format.md): `torque_limits: 100` and
+    # torque_limits=100.0 were refused, where [100] was taken.
+    scalar = DEFAULT.replace(
+        "  mu: 0.5", "  mu: 0.5\n  load: gravity\n  torque_limits: 100"
+    )
+    scene = load_scene(_write(tmp_path, scalar))
+    assert scene.info.torque_limits == (100.0,)
+    report = analyze_grasp(scene.plant, scene.plant_context, **scene.analysis_options())
+    plain = load_scene(DEFAULT_SCENE)
+    args = (plain.plant, plain.plant_context)
+    listed = analyze_grasp(
+        *args, **plain.analysis_options(), load="gravity", torque_limits=[100.0]
+    )
+    direct = analyze_grasp(
+        *args, **plain.analysis_options(), load="gravity", torque_limits=100.0
+    )
+    assert report.load.to_dict() == listed.load.to_dict() == direct.load.to_dict()
+    assert list(report.load.torque_limits) == [100.0] * len(report.load.torque_limits)
