@@ -16,6 +16,7 @@ __all__ = [
     "DEFAULT_NUM_GENERATORS",
     "DEFAULT_RANK_TOL",
     "DEFAULT_TOL",
+    "MAX_DISTANCE_TOLERANCE",
     "ZERO_FRACTION",
     "near_threshold",
     "relative_margin",
@@ -34,6 +35,17 @@ DEFAULT_RANK_TOL = 1e-9
 
 DEFAULT_DISTANCE_TOLERANCE = 1e-4
 """Default ``|ψ|`` (metres) below which a geometry pair counts as a contact."""
+
+MAX_DISTANCE_TOLERANCE = 0.01
+"""Largest ``distance_tolerance`` accepted: 0.01 m (10 mm).
+
+Bodies that far apart count as touching: above it a palm 15 mm below a box
+became four contacts and turned the verdict to force closure, "pose: valid"
+(``distance_tolerance: 0.02``, a user thinking in millimetres).  The unit is
+metres; the widest tolerance drakegrasp uses itself, in its tests, tutorials
+and benchmarks, is 2 mm (a point cloud's spacing), most 1 mm or the default
+0.1 mm.
+"""
 
 DEFAULT_NUM_GENERATORS = 8
 """Default generators ``n_g`` of each polyhedral (inscribed) spatial Coulomb cone."""

@@ -55,7 +55,7 @@ import sys
 
 import numpy as np
 
-from drakegrasp.core.tolerances import MOMENT_ARMS
+from drakegrasp.core.tolerances import MAX_DISTANCE_TOLERANCE, MOMENT_ARMS
 from drakegrasp.errors import (
     InvalidContactError,
     InvalidGraspError,
@@ -490,20 +490,37 @@ def check_flag(name: str, value) -> bool:
 
 
 def check_distance_tolerance(value) -> float:
-    """``distance_tolerance`` as a float, once it is finite and > 0 (metres).
+    """``distance_tolerance`` as a float, once it is in ``(0, 0.01]`` (metres).
+
+    The bound is
+    :data:`~drakegrasp.core.tolerances.MAX_DISTANCE_TOLERANCE` (10 mm): pairs
+    farther apart than it would count as touching.
 
     Raises
     ------
     InvalidOptionError
-        For anything else (also a string or None), naming the value.
+        For anything else (also a string or None), naming the value; above
+        the bound, giving it in metres and in millimetres.
     """
-    message = f"distance_tolerance must be finite and > 0 (metres), got {value!r}"
+    message = (
+        f"distance_tolerance must be finite and > 0, at most "
+        f"{MAX_DISTANCE_TOLERANCE:g} m (metres), got {value!r}"
+    )
     try:  # a real number only: float() would also read "1e-4" and True
         tol = real_scalar("distance_tolerance", value)
     except InvalidOptionError:
         raise InvalidOptionError(message) from None
     if not tol > 0 or tol == float("inf"):
         raise InvalidOptionError(message)
+    if tol > MAX_DISTANCE_TOLERANCE:
+        mm = tol * 1e3
+        mm = f"{mm:g} mm" if mm != float("inf") else "over 1e308 mm"
+        raise InvalidOptionError(
+            f"distance_tolerance {tol:g} m ({mm}) is above the "
+            f"largest accepted, {MAX_DISTANCE_TOLERANCE:g} m "
+            f"({MAX_DISTANCE_TOLERANCE * 1e3:g} mm): bodies that far apart would "
+            "count as touching; the unit is metres (the default 0.1 mm is 1e-4)"
+        )
     return tol
 
 

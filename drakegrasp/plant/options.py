@@ -63,7 +63,8 @@ OPTION_HELP = {
     "contact_model": "contact model: frictionless, hard_finger or soft_finger",
     "torsional_friction": "soft-finger torsional friction nu (>= 0; soft_finger "
     "needs it)",
-    "distance_tolerance": "signed distance below which a pair touches (metres)",
+    "distance_tolerance": "signed distance below which a pair touches (metres, "
+    "> 0 and at most 0.01, i.e. 10 mm)",
     "plane": "planar analysis in this plane of the object frame (xy, yz or zx)",
     "characteristic_length": "length b that makes moments comparable with "
     "forces and sets a soft finger's torsion limit b nu f_n (metres)",
@@ -101,7 +102,9 @@ class AnalysisOptions:
         bounded by ``b ν f_n``); a soft-finger analysis needs it, 0 otherwise.
     distance_tolerance : float
         A pair closer than this (metres) touches (default
-        :data:`~drakegrasp.core.tolerances.DEFAULT_DISTANCE_TOLERANCE`).
+        :data:`~drakegrasp.core.tolerances.DEFAULT_DISTANCE_TOLERANCE`);
+        ``> 0`` and at most
+        :data:`~drakegrasp.core.tolerances.MAX_DISTANCE_TOLERANCE` (0.01 m).
     plane : {"xy", "yz", "zx"} or None
         Planar analysis in this plane of the object frame O.
     characteristic_length : float or None

@@ -33,7 +33,7 @@ The format
       contact_model: hard_finger     # frictionless | hard_finger | soft_finger
       torsional_friction: 0.1        # soft fingers: nu >= 0
       plane: yz                      # optional: planar analysis (xy | yz | zx)
-      distance_tolerance: 1.0e-4     # optional, metres, > 0
+      distance_tolerance: 1.0e-4     # optional, metres, > 0, <= 0.01
       close: true                    # optional: close the hand when loading
       load: gravity                  # optional: analyse under the weight
       torque_limits: plant           # optional: the actuators' effort limits
@@ -52,7 +52,8 @@ unknown keys.  ``drakegrasp:`` keys (see :data:`drakegrasp.plant.scene_file.KEYS
 - ``contact_model`` (default ``hard_finger``), ``torsional_friction``
   (``ν >= 0``; absent is not 0, and a ``soft_finger`` file without it is
   refused when read), ``plane`` (absent: spatial),
-  ``distance_tolerance`` (default 1e-4 m), ``description`` (default empty);
+  ``distance_tolerance`` (default 1e-4 m, at most 0.01 m), ``description``
+  (default empty);
 - ``close`` (default false): ``true`` closes the hand onto the object when
   the scene is loaded (:func:`~drakegrasp.plant.closing.close_hand` from the
   joint values of the directives, the pre-shape, with the scene's distance

@@ -31,10 +31,15 @@ from pathlib import Path
 import yaml
 
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.tolerances import (
+    DEFAULT_DISTANCE_TOLERANCE,
+    MAX_DISTANCE_TOLERANCE,
+)
 from drakegrasp.core.validation import (
     COEFFICIENT_MAX,
     COEFFICIENT_MIN,
     check_coefficient,
+    check_distance_tolerance,
 )
 from drakegrasp.errors import GraspError, SceneError
 from drakegrasp.plant.options import PLANES, AnalysisOptions
@@ -66,7 +71,8 @@ KEYS = {
     "torsional_friction": f"0 or a number in [{COEFFICIENT_MIN:g}, "
     f"{COEFFICIENT_MAX:g}]",
     "plane": f"one of {sorted(PLANES)}",
-    "distance_tolerance": "a number > 0 (metres)",
+    "distance_tolerance": f"a number > 0 and at most {MAX_DISTANCE_TOLERANCE:g} "
+    "(metres)",
     "close": "true, false, or a mapping {direction: [one number per closing "
     "joint]}: close the hand onto the object when the scene is loaded",
     "load": "'gravity' (the object's weight) or a list of 6 numbers (3 with "
@@ -236,6 +242,15 @@ def _coefficient(path: Path, key: str, value) -> float:
     try:
         return check_coefficient(key, x, error=SceneError)
     except SceneError as e:
+        raise SceneError(f"scene {str(path)!r}: drakegrasp.{e}") from None
+
+
+def _distance_tolerance(path: Path, value) -> float:
+    """``distance_tolerance``: in the range every analysis takes (at most 10 mm)."""
+    x = _number(path, "distance_tolerance", value, positive=True)
+    try:
+        return check_distance_tolerance(x)
+    except GraspError as e:
         raise SceneError(f"scene {str(path)!r}: drakegrasp.{e}") from None
 
 
@@ -424,11 +439,8 @@ def check_section(
         if "torsional_friction" not in section
         else _coefficient(path, "torsional_friction", section["torsional_friction"]),
         "plane": plane,
-        "distance_tolerance": _number(
-            path,
-            "distance_tolerance",
-            section.get("distance_tolerance", 1e-4),
-            positive=True,
+        "distance_tolerance": _distance_tolerance(
+            path, section.get("distance_tolerance", DEFAULT_DISTANCE_TOLERANCE)
         ),
         "close": close,
         "close_direction": close_direction,

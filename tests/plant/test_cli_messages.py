@@ -53,6 +53,14 @@ def test_an_analyze_value_out_of_range_names_its_flag(capsys, argv, flag):
     assert err.startswith(f"drakegrasp: error: {flag} must be"), err
 
 
+@pytest.mark.parametrize("value", ["0.02", "1e9"])
+def test_a_distance_tolerance_in_millimetres_is_refused_naming_the_unit(capsys, value):
+    # --distance-tolerance 1e9 counted a palm 15 mm away as 4 contacts
+    err = _one_line(capsys, "analyze", "--distance-tolerance", value)
+    assert err.startswith(f"drakegrasp: error: --distance-tolerance {float(value):g} m")
+    assert "0.01 m (10 mm)" in err and "the unit is metres" in err
+
+
 @pytest.mark.parametrize(
     ("extra", "flag"),
     [

@@ -111,18 +111,23 @@ def test_min_fingers_above_the_number_of_fingers_says_so():
     assert e.value.closure is None  # refused before any search
 
 
-def test_a_huge_distance_tolerance_or_load_warns_of_nothing():
+def test_the_widest_distance_tolerance_or_a_huge_load_warns_of_nothing():
     # Each printed numpy's overflow warning (and its source line) on a run
     # that succeeds: the patch clipper's sign test fp * fq < 0 overflowed at a
-    # 1e300 m tolerance, the payload's proof of "unbounded" at a 1e300 N load.
+    # 1e300 m tolerance (now refused: at most MAX_DISTANCE_TOLERANCE), the
+    # payload's proof of "unbounded" at a 1e300 N load.
     import warnings
+
+    from drakegrasp.core.tolerances import MAX_DISTANCE_TOLERANCE
 
     scene = dg.load_scene()
     args = (scene.plant, scene.plant_context, scene.object_body)
+    with pytest.raises(dg.InvalidOptionError, match="above the largest accepted"):
+        dg.analyze_grasp(*args, hand=scene.hand, mu=0.5, distance_tolerance=1e300)
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         wide = dg.analyze_grasp(
-            *args, hand=scene.hand, mu=0.5, distance_tolerance=1e300
+            *args, hand=scene.hand, mu=0.5, distance_tolerance=MAX_DISTANCE_TOLERANCE
         )
         heavy = dg.analyze_grasp(
             *args, hand=scene.hand, mu=0.5, load=[0, 0, -1e300, 0, 0, 0]

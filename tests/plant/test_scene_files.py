@@ -313,3 +313,24 @@ def test_mu_plant_in_a_scene_is_the_plants_friction(tmp_path, capsys):
     assert "mu = " in capsys.readouterr().out
     with pytest.raises(SceneError, match="mu must be a number"):
         load_scene(_write(tmp_path, DEFAULT.replace("  mu: 0.5", "  mu: plants")))
+
+
+@pytest.mark.parametrize(
+    "tol, mm", [("0.02", "20 mm"), ("1", "1000 mm"), ("10", "10000 mm")]
+)
+def test_a_scene_distance_tolerance_above_ten_mm_is_refused(tmp_path, tol, mm):
+    # distance_tolerance: 0.02 made the palm 15 mm below the box 4 contacts
+    # and the verdict force closure, "pose: valid"
+    path = _write(
+        tmp_path,
+        DEFAULT.replace("  mu: 0.5", f"  mu: 0.5\n  distance_tolerance: {tol}"),
+    )
+    for read in (load_scene, read_scene_info):
+        with pytest.raises(SceneError) as info:
+            read(path)
+        message = str(info.value)
+        assert str(path) in message and "drakegrasp.distance_tolerance" in message
+        assert f"({mm}) is above the largest accepted, 0.01 m (10 mm)" in message
+        assert "the unit is metres" in message
+    ok = DEFAULT.replace("  mu: 0.5", "  mu: 0.5\n  distance_tolerance: 0.01")
+    assert read_scene_info(_write(tmp_path, ok)).distance_tolerance == 0.01

@@ -232,3 +232,34 @@ def test_resolve_body_refuses_a_name_that_is_no_string(name):
     assert resolve_body(plant, "box").name() == "box"
     with pytest.raises(dg.InvalidOptionError, match="a body name must be a string"):
         resolve_body(plant, name)
+
+
+@pytest.mark.parametrize("tol", [0.0100001, 0.02, 1.0, 1e9, 1e300])
+def test_a_distance_tolerance_above_ten_mm_is_refused_in_metres_and_mm(tol):
+    # A user thinking in millimetres: at 0.02 the default scene's palm, 15 mm
+    # below the box, became 4 contacts and the verdict force closure, "pose:
+    # valid", without a word.
+    scene = dg.load_scene()
+    plant, ctx, box, hand = (
+        scene.plant, scene.plant_context, scene.object_body, scene.hand
+    )  # fmt: skip
+    for call in (
+        lambda t: dg.AnalysisOptions(distance_tolerance=t),
+        lambda t: find_contacts(plant, ctx, box, hand=hand, distance_tolerance=t),
+        lambda t: analyze_grasp(plant, ctx, box, mu=0.5, distance_tolerance=t),
+        lambda t: close_hand(plant, ctx, box, hand=hand, distance_tolerance=t),
+    ):
+        with pytest.raises(dg.InvalidOptionError) as info:
+            call(tol)
+        message = str(info.value)
+        assert message.startswith(f"distance_tolerance {tol:g} m (")
+        assert "mm) is above the largest accepted, 0.01 m (10 mm)" in message
+        assert "would count as touching" in message and "metres" in message
+
+
+def test_the_largest_distance_tolerance_is_taken():
+    from drakegrasp.core.tolerances import MAX_DISTANCE_TOLERANCE
+
+    assert MAX_DISTANCE_TOLERANCE == 0.01
+    options = dg.AnalysisOptions(distance_tolerance=MAX_DISTANCE_TOLERANCE)
+    assert options.distance_tolerance == 0.01
