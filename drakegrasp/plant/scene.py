@@ -92,7 +92,10 @@ Safety
 A scene file is read with a safe YAML loader, at most 1 MiB, without YAML
 anchors or aliases (which can expand without bound) and at most 64 levels
 deep, with no key given twice and numbers read as YAML 1.2 (as Drake reads
-them); every key and value of ``drakegrasp:`` is type-checked.  References are
+them); every key and value of ``drakegrasp:`` is type-checked, and the
+directives' poses are refused by line and key where Drake would drop them (an
+``!AngleAxis`` axis of zero) or stop on them unnamed (a NaN or infinite angle
+or translation: :func:`~drakegrasp.plant.scene_file.check_poses`).  References are
 checked on Drake's own reading of the directives, include loops are refused
 before Drake would follow them, and the include limit counts loads.  Every problem is
 a :class:`~drakegrasp.errors.SceneError` (a :class:`~drakegrasp.ModelError`)
@@ -159,6 +162,7 @@ from drakegrasp.plant.models import drake_reading, explain_drake_models, models_
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import (
     check_directives,
+    check_poses,
     check_section,
     directives_text,
     read_yaml,
@@ -743,6 +747,7 @@ def load_scene(
     except Exception as e:  # Drake raises RuntimeError/ValueError on bad schema
         msg = _schema_words(" ".join(str(e).split()))
         raise SceneError(f"scene {str(path)!r}: bad model directives: {msg}") from None
+    check_poses(path, text)  # what Drake read without a word, by line and key
     # What Drake will load, from Drake's reading (and includes followed first:
     # a loop would crash Drake), with the reference policy unless trusted.
     check_references(

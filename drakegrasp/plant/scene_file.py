@@ -51,6 +51,7 @@ __all__ = [
     "MAX_SCENE_BYTES",
     "TOP_LEVEL_KEYS",
     "check_directives",
+    "check_poses",
     "check_section",
     "directives_text",
     "read_yaml",
@@ -329,6 +330,143 @@ def check_directives(path: Path, data: dict) -> None:
             "directives (- add_model: ..., - add_weld: ...), got "
             f"{type(data['directives']).__name__}"
         )
+
+
+_TRANSFORMS = {
+    "add_model": "default_free_body_pose",
+    "add_frame": "X_PF",
+    "add_weld": "X_PC",
+}
+"""Where a directive holds poses (Drake's ``schema::Transform``): a mapping of
+body names to poses for ``add_model``, one pose for the others."""
+
+
+def check_poses(path: Path, text: str) -> None:
+    """Refuse a pose of the directives that Drake would drop or fail on unnamed.
+
+    Drake reads ``!AngleAxis {angle_deg: a, axis: [0, 0, 0]}`` without a
+    word and normalises nothing: the rotation is lost (the object stood
+    unrotated).  A NaN or infinite angle stops it later with "NaN is
+    detected during Symbolic computation.", and a non-finite translation is
+    refused later still, as a body's position: neither names the key.  Each
+    pose of ``add_model``'s ``default_free_body_pose``, ``add_frame``'s
+    ``X_PF`` and ``add_weld``'s ``X_PC`` is checked here, on the text Drake
+    has just read without complaint (its schema holds), so the message can
+    give the line and the key.  Poses given by a random distribution
+    (``!Uniform``...) are left to Drake.
+
+    Raises
+    ------
+    SceneError
+        Naming the file, the line and column, the key and what is valid: an
+        ``!AngleAxis`` axis whose length cannot be normalised (zero, or too
+        short or too long in double precision), or a non-finite angle or
+        translation.
+    """
+    loader = _SceneLoader(text)  # text that read_yaml has read: it parses
+    try:
+        directives = _entries(loader.get_single_node()).get("directives")
+        if not isinstance(directives, yaml.SequenceNode):
+            return
+        for index, directive in enumerate(directives.value):
+            for name, pose in _poses(directive):
+                _check_pose(path, loader, f"directives[{index}].{name}", pose)
+    finally:
+        loader.dispose()
+
+
+def _entries(node) -> dict:
+    """A mapping node's entries by their (scalar) key; {} for another node."""
+    if not isinstance(node, yaml.MappingNode):
+        return {}
+    return {k.value: v for k, v in node.value if isinstance(k, yaml.ScalarNode)}
+
+
+def _poses(directive):
+    """``(key path, pose node)`` of each pose a directive node holds."""
+    for kind, holder in _entries(directive).items():
+        key = _TRANSFORMS.get(kind)
+        pose = _entries(holder).get(key) if key else None
+        if pose is None:
+            continue
+        if kind == "add_model":
+            for body, body_pose in _entries(pose).items():
+                yield f"{kind}.{key}.{body}", body_pose
+        else:
+            yield f"{kind}.{key}", pose
+
+
+def _numbers(loader, node) -> list[float] | None:
+    """The numbers of a scalar or a sequence of scalars; None for anything else."""
+    nodes = node.value if isinstance(node, yaml.SequenceNode) else [node]
+    if not all(isinstance(n, yaml.ScalarNode) for n in nodes):
+        return None
+    values = [loader.construct_object(n) for n in nodes]
+    if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in values):
+        return None
+    try:
+        return [float(v) for v in values]
+    except OverflowError:  # an integer beyond a double: Drake's schema refuses it
+        return None
+
+
+def _check_pose(path: Path, loader, where: str, pose) -> None:
+    """Refuse one pose node's non-finite numbers and degenerate rotation axis."""
+    fields = _entries(pose)
+
+    def refuse(node, key: str, what: str) -> None:
+        mark = node.start_mark
+        raise SceneError(
+            f"scene {str(path)!r}: line {mark.line + 1}, column {mark.column + 1}: "
+            f"{where}.{key} {what}"
+        )
+
+    translation = fields.get("translation")
+    shown = _numbers(loader, translation) if translation is not None else None
+    if shown is not None and not all(math.isfinite(x) for x in shown):
+        refuse(translation, "translation", f"{shown} must be finite (metres)")
+    rotation = fields.get("rotation")
+    if rotation is None:
+        return
+    tag = rotation.tag
+    parts = _entries(rotation)
+    if tag == "!Rpy" and "deg" in parts:
+        deg = _numbers(loader, parts["deg"])
+        if deg is not None and not all(math.isfinite(x) for x in deg):
+            refuse(
+                parts["deg"], "rotation",
+                f"!Rpy deg {deg} must be finite (degrees): "
+                "!Rpy {deg: [roll, pitch, yaw]}",
+            )  # fmt: skip
+    if tag == "!AngleAxis":
+        angle = parts.get("angle_deg")
+        value = _numbers(loader, angle) if angle is not None else None
+        if value is not None and not math.isfinite(value[0]):
+            refuse(
+                angle, "rotation",
+                f"!AngleAxis angle_deg {value[0]} must be finite (degrees)",
+            )  # fmt: skip
+        axis = parts.get("axis")
+        value = _numbers(loader, axis) if axis is not None else None
+        if value is None:
+            return
+        if not all(math.isfinite(x) for x in value):
+            refuse(axis, "rotation", f"!AngleAxis axis {value} must be finite")
+        squared = sum(x * x for x in value)  # as Eigen's normalized() does
+        if not 0.0 < squared < math.inf:
+            why = (
+                "is zero"
+                if not any(value)
+                else "is too short to normalise in double precision"
+                if squared == 0.0
+                else "is too long to normalise in double precision"
+            )
+            refuse(
+                axis, "rotation",
+                f"!AngleAxis axis {value} {why}: the axis must be a non-zero "
+                "direction, such as [0, 0, 1] (Drake normalises it, and drops "
+                "this one without a word)",
+            )  # fmt: skip
 
 
 LOADER_NU_REMEDY = "give it to the loader (load_scene(..., torsional_friction=NU))"

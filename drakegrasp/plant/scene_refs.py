@@ -54,6 +54,7 @@ from drakegrasp.plant.models import (
     register_models,
     use_local_drake_models,
 )
+from drakegrasp.plant.scene_file import check_poses
 
 __all__ = [
     "MAX_INCLUDED_FILES",
@@ -401,7 +402,7 @@ def check_references(
                     f"scene {str(path)!r} loads more than {MAX_INCLUDED_FILES} "
                     "directive files (counting each time a file is included)"
                 )
-            _, included_data = read_yaml(Path(local))
+            included_text, included_data = read_yaml(Path(local))
             try:
                 included = drake_reading(LoadModelDirectives, local)
             except Exception as e:  # Drake's schema errors: RuntimeError et al.
@@ -409,6 +410,7 @@ def check_references(
                 raise SceneError(
                     f"scene {str(current)!r}: bad model directives in {local!r}: {msg}"
                 ) from None
+            check_poses(Path(local), included_text)
             visit(Path(local), included_data, included, (*chain, local))
 
     visit(path, data, directives, (os.path.realpath(path),))

@@ -139,3 +139,89 @@ def test_a_rotation_in_radians_is_told_degrees(tmp_path, rotation, says):
     assert says in message and "degrees" in message and "while visiting" not in message
     line = next(k for k, t in enumerate(DEFAULT.splitlines(), 1) if "!Rpy" in t)
     assert f"line {line}, column" in message
+
+
+ROTATION = "rotation: !Rpy {deg: [0.0, 0.0, 0.0]}"
+TRANSLATION = "translation: [0.0, 0.0, 0.065]"
+BOX_POSE = "directives[2].add_model.default_free_body_pose.box"
+
+
+@pytest.mark.parametrize(
+    "old, new, says",
+    [
+        # Drake read these without a word and dropped the rotation
+        (ROTATION, "rotation: !AngleAxis {angle_deg: 90, axis: [0, 0, 0]}",
+         "!AngleAxis axis [0.0, 0.0, 0.0] is zero: the axis must be a non-zero"),
+        (ROTATION, "rotation: !AngleAxis {angle_deg: 90, axis: [1e-300, 0, 0]}",
+         "is too short to normalise in double precision"),
+        (ROTATION, "rotation: !AngleAxis {angle_deg: 90, axis: [1e200, 0, 0]}",
+         "is too long to normalise in double precision"),
+        # Drake: "NaN is detected during Symbolic computation.", no key named
+        (ROTATION, "rotation: !Rpy {deg: [.nan, 0.0, 0.0]}",
+         "rotation !Rpy deg [nan, 0.0, 0.0] must be finite (degrees)"),
+        (ROTATION, "rotation: !Rpy {deg: [0.0, -.inf, 0.0]}",
+         "rotation !Rpy deg [0.0, -inf, 0.0] must be finite (degrees)"),
+        (ROTATION, "rotation: !AngleAxis {angle_deg: .nan, axis: [0, 0, 1]}",
+         "rotation !AngleAxis angle_deg nan must be finite (degrees)"),
+        # refused later, as a body's position, without the key
+        (TRANSLATION, "translation: [.nan, 0.0, 0.065]",
+         "translation [nan, 0.0, 0.065] must be finite (metres)"),
+        (TRANSLATION, "translation: [0.0, .inf, 0.065]",
+         "translation [0.0, inf, 0.065] must be finite (metres)"),
+    ],
+)  # fmt: skip
+def test_a_pose_drake_would_drop_or_fail_on_is_refused_by_line_and_key(
+    tmp_path, old, new, says
+):
+    assert old in DEFAULT
+    path = tmp_path / "scene.yaml"
+    path.write_text(DEFAULT.replace(old, new, 1))
+    with pytest.raises(SceneError) as info:
+        dg.load_scene(path)
+    message = str(info.value)
+    line = next(k for k, t in enumerate(DEFAULT.splitlines(), 1) if old in t)
+    assert message.startswith(f"scene {str(path)!r}: line {line}, column "), message
+    key = old.split(":")[0]  # rotation or translation
+    assert f"{BOX_POSE}.{key} " in message and says in message, message
+
+
+def test_the_poses_of_frames_welds_and_included_files_are_checked(tmp_path):
+    zero = "!AngleAxis {angle_deg: 90, axis: [0, 0, 0]}"
+    frame = (
+        "- add_frame:\n    name: tilted\n    X_PF:\n      base_frame: world\n"
+        f"      rotation: {zero}\n"
+    )
+    path = tmp_path / "frame.yaml"
+    path.write_text(DEFAULT.replace(WELD, WELD + frame))
+    with pytest.raises(SceneError, match=r"directives\[2\]\.add_frame\.X_PF\.rotation"):
+        dg.load_scene(path)
+    weld = WELD + f"    X_PC:\n      rotation: {zero}\n"
+    path.write_text(DEFAULT.replace(WELD, weld))
+    with pytest.raises(SceneError, match=r"directives\[1\]\.add_weld\.X_PC\.rotation"):
+        dg.load_scene(path)
+    inner = tmp_path / "inner.yaml"
+    inner.write_text("directives:\n" + frame)
+    path.write_text(
+        DEFAULT.replace(
+            "directives:\n",
+            f"directives:\n- add_directives:\n    file: file://{inner}\n",
+        )
+    )
+    with pytest.raises(SceneError) as info:
+        dg.load_scene(path)
+    assert str(info.value).startswith(f"scene {str(inner)!r}: line 6, column ")
+    assert "add_frame.X_PF.rotation !AngleAxis axis [0.0, 0.0, 0.0] is zero" in str(
+        info.value
+    )
+
+
+def test_an_axis_of_any_normalisable_length_still_rotates(tmp_path):
+    path = tmp_path / "scene.yaml"
+    path.write_text(
+        DEFAULT.replace(
+            ROTATION, "rotation: !AngleAxis {angle_deg: 90, axis: [0, 0, 5]}"
+        )
+    )
+    scene = dg.load_scene(path)
+    R = scene.object_body.EvalPoseInWorld(scene.plant_context).rotation().matrix()
+    assert abs(R[1, 0] - 1.0) < 1e-12 and abs(R[0, 1] + 1.0) < 1e-12
