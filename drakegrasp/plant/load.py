@@ -82,11 +82,11 @@ __all__ = [
 ]
 
 
-MAX_LOAD = 1e150
+MAX_LOAD = 1e300
 """Largest magnitude (N, N·m) of a given load's components: the load programs
-square and multiply them (``analyze --load 0,0,-1e308,...`` printed ``-inf``
-beside numpy's overflow warnings); every load up to this resolves (a payload
-factor of 1.4e-148 for the default scene)."""
+multiply them (``analyze --load 0,0,-1e308,...`` printed ``-inf`` beside
+numpy's overflow warnings); every load up to this resolves, with and without
+torque limits, on the default scene."""
 
 FLOATING_JOINTS = ("quaternion_floating", "rpy_floating")
 """Drake joint types of a free body: six velocities that no actuator drives."""

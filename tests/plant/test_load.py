@@ -172,13 +172,13 @@ def test_actuators_without_an_effort_limit_are_named(tmp_path, effort):
     assert not any("no effort limit" in w for w in report.load.warnings)
 
 
-@pytest.mark.parametrize("size, held", [(1e150, True), (1e151, None), (1e308, None)])
+@pytest.mark.parametrize("size, held", [(1e300, True), (1e301, None), (1e308, None)])
 def test_a_load_too_large_to_compute_with_is_refused(size, held):
     # 1e308 printed "-inf" beside numpy's overflow warnings and a verdict
     s = dg.load_scene("parallel_jaw_box")
     load = [0.0, 0.0, -size, 0.0, 0.0, 0.0]
     if held is None:
-        with pytest.raises(dg.InvalidOptionError, match="at most 1e\\+150"):
+        with pytest.raises(dg.InvalidOptionError, match="at most 1e\\+300"):
             dg.analyze_grasp(
                 s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load=load
             )
