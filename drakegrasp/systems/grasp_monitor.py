@@ -655,7 +655,8 @@ class GraspMonitor(LeafSystem):
         epsilon = 0.0
         if grip[0].bridged(self.settings.thresholds) and previous.report is not None:
             status, report, epsilon = previous.status, previous.report, previous.epsilon
-            message = f"no contact in this sample ({message}); the last grip is held"
+            why = f" ({message})" if message else ""
+            message = f"no contact in this sample{why}; the last grip is held"
         elif (
             report is not None
             and self.settings.compute_epsilon

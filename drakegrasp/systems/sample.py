@@ -197,6 +197,8 @@ class GraspSample:
         if not np.isnan(v["friction_use"]):
             grip += f", friction in use {v['friction_use']:.2f}"
         grip += f", slip {1e3 * v['slip_speed']:.3g} mm/s"
+        if self.sliding_speed > v["slip_speed"]:  # the object along the fingers
+            grip += f", sliding {1e3 * self.sliding_speed:.3g} mm/s along the fingers"
         if self.contact_gap:
             grip += f", contact missing for {self.contact_gap} sample(s), held"
         if self.report is None:

@@ -270,3 +270,41 @@ def test_fingers_deep_in_the_object_are_no_grip(q, status):
         assert sample.holding == "no contact"  # the grip before it is kept
     deeper = _jaw_box_monitor(holding=dg.HoldingThresholds(max_penetration=0.02))
     assert deeper([q, q]).status == "ok"
+
+
+def test_a_falling_box_reads_as_sliding():
+    # the box falls between jaws that press with nothing: the sample said
+    # "slip 0 mm/s" beside its own sliding speed of 0.49 m/s, and "no contact
+    # in this sample ()" with empty parentheses
+    from pydrake.math import RigidTransform
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=1e-3)
+    parser = Parser(plant)
+    dg.register_models(parser)
+    hand = parser.AddModels(url="package://drakegrasp/hands/parallel_jaw.sdf")[0]
+    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("palm", hand))
+    parser.AddModels(url="package://drakegrasp/objects/box.sdf")
+    plant.Finalize()
+    monitor = dg.add_grasp_monitor(
+        builder, plant, scene_graph, object_body=plant.GetBodyByName("box"),
+        mu="plant", load="gravity", torque_limits="plant",
+    )  # fmt: skip
+    diagram = builder.Build()
+    root = diagram.CreateDefaultContext()
+    ctx = plant.GetMyContextFromRoot(root)
+    plant.SetPositions(ctx, hand, [0.025, 0.025])
+    plant.SetFreeBodyPose(
+        ctx, plant.GetBodyByName("box"), RigidTransform([0, 0, 0.065])
+    )
+    simulator = Simulator(diagram, root)
+    simulator.AdvanceTo(0.051)
+    sample = monitor.get_output_port(1).Eval(monitor.GetMyContextFromRoot(root))
+    assert sample.sliding_speed > 0.1
+    line = str(sample).splitlines()[0]
+    assert f"sliding {1e3 * sample.sliding_speed:.3g} mm/s along the fingers" in line
+    assert "()" not in line
