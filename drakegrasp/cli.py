@@ -1347,6 +1347,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         _check_progress()
     shake = _shake_options(args)
     plant, context, object_body, hand, options, add_models = _plan_setup(args)
+    if shake is not None:
+        _check_shake_motors(plant, object_body, hand)
     try:
         result = plan_grasps(
             plant,
@@ -1392,6 +1394,23 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     return _write_scene_out(args, result, shaken, plant, context, object_body)
 
 
+def _check_shake_motors(plant, object_body, hand) -> None:
+    """``plan --shake``: refused before planning when the hand has no motor."""
+    from drakegrasp.plant.validation import hand_bodies
+
+    bodies = {int(b.index()) for b in hand_bodies(plant, object_body, hand)}
+    if not any(
+        int(plant.get_joint_actuator(a).joint().child_body().index()) in bodies
+        for a in plant.GetJointActuatorIndices()
+    ):
+        raise InvalidOptionError(
+            "--shake squeezes with the hand's motors, and the model gives the "
+            "hand's joints no actuator (a URDF joint gets one from a "
+            "<transmission>; Drake adds none for an effort limit of 0): plan "
+            "without --shake, or give the model its motors"
+        )
+
+
 def _check_scene_out(args: argparse.Namespace) -> None:
     """``plan --scene-out``: refused up front where it cannot be written."""
     if not args.scene_out.endswith((".yaml", ".yml")):
@@ -1415,6 +1434,11 @@ def _check_scene_out(args: argparse.Namespace) -> None:
         raise InvalidOptionError(
             f"--scene-out {str(path)!r}: its folder does not exist"
         )
+    from drakegrasp.batch.files.writer import unwritable
+
+    why = unwritable(path.resolve().parent)
+    if why:
+        raise InvalidOptionError(f"--scene-out {str(path)!r}: {why}")
 
 
 def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:

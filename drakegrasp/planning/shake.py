@@ -613,7 +613,12 @@ def shake_test(
     squeeze : float, optional
         Force with which each finger presses, newtons (default 20 N; at most
         the actuator's effort limit); for a revolute joint (a multi-finger
-        hand) the torque on each closing joint that closing moved, N·m.
+        hand) the torque on each closing joint that closing moved, N·m.  It
+        is the press at rest, the position control's aim, not a cap: a
+        finger that the object pushes back presses harder, up to the
+        actuator's effort limit, where Drake clamps it (the Allegro hand's
+        0.7 N·m under a 0.5 N·m squeeze); to test motors of a given strength,
+        give the model that effort limit.
     stiffness, damping : float or None, optional
         Gains of the fingers' position control (N/m, N·s/m; per radian for
         revolute joints): each finger is aimed ``squeeze / stiffness`` past

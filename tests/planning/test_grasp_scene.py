@@ -9,6 +9,8 @@ own contacts and verdict.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import yaml
@@ -168,3 +170,14 @@ def test_what_a_scene_file_cannot_keep_is_said(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--characteristic-length 0.0670" in err
     assert "not --mass 0.5" in err
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
+@pytest.mark.parametrize(
+    "flag, name", [("--scene-out", "x.yaml"), ("--out", "x.parquet")]
+)
+def test_an_unwritable_folder_is_refused_before_planning(capsys, flag, name):
+    # /proc takes no new file: the plan ran first, then failed to write
+    assert main(["plan", "--num", "5", flag, f"/proc/{name}"]) != 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no file can be written there" in err[0]

@@ -78,3 +78,16 @@ def test_a_hand_without_actuators_is_said(tmp_path):
     result = _plan(tmp_path, name, effort, "<effort>0</effort>", obj)
     assert result.reason.startswith("ranked by score alone")
     assert "no actuator" in result.reason
+
+
+def test_plan_shake_of_a_hand_without_motors_is_refused_up_front(tmp_path, capsys):
+    # it planned, printed, then failed in the shake
+    from drakegrasp.cli import main
+
+    name, effort, _ = JAW
+    hand = _hand(tmp_path, name, effort, "<effort>0</effort>")
+    assert main(["plan", "box", "--hand", hand, "--num", "30", "--shake", "2"]) != 0
+    captured = capsys.readouterr()
+    assert captured.out == ""  # nothing planned
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and "--shake squeezes with the hand's motors" in err[0]

@@ -30,6 +30,7 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
+import tempfile
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,6 +48,7 @@ __all__ = [
     "check_output",
     "format_of",
     "placed",
+    "unwritable",
     "write_chunks",
 ]
 
@@ -170,7 +172,26 @@ def check_output(
     if not output.parent.is_dir():
         what = "is not a directory" if output.parent.exists() else "does not exist"
         raise BatchFileError(f"output directory {str(output.parent)!r} {what}")
+    why = unwritable(output.parent)
+    if why:
+        raise BatchFileError(f"output directory {str(output.parent)!r}: {why}")
     return output, suffix
+
+
+def unwritable(folder: Path) -> str:
+    """Why no file can be written in ``folder``, or "" (a file made and removed).
+
+    Checked before a long run, so that it is refused up front rather than
+    after the work (``/proc``, a read-only mount, no permission).
+    """
+    try:
+        handle, probe = tempfile.mkstemp(dir=folder, prefix=".drakegrasp-probe-")
+    except OSError as e:
+        return f"no file can be written there ({e.strerror or e})"
+    os.close(handle)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
+    return ""
 
 
 def _link_or_rename(tmp: str, path: Path) -> None:
