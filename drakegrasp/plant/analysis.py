@@ -258,7 +258,8 @@ def grasp_from_plant(
         ``ν`` of soft fingers; required (>= 0) with ``"soft_finger"``, where
         0 makes a soft finger act as a hard one.
     distance_tolerance : float, optional
-        Contact when ``|ψ| <=`` this (metres, default 1e-4).
+        Contact when ``|ψ| <=`` this (metres, default 1e-4, at most
+        :data:`~drakegrasp.core.tolerances.MAX_DISTANCE_TOLERANCE`, 0.01).
     plane : {"xy", "yz", "zx"}, optional
         Analyse a planar grasp in this plane of frame O (wrenches
         ``[f_a, f_b, m]``); every contact normal must lie in the plane.

@@ -327,7 +327,7 @@ def close_hand(
         from a scene file); an explicit list overrides them (``()``: none).
     distance_tolerance : float, optional
         A finger touches when ``0 <= ψ <= distance_tolerance`` (metres,
-        default 1e-4, the contact tolerance of
+        default 1e-4, at most 0.01, the contact tolerance of
         :func:`~drakegrasp.plant.contacts.find_contacts`).
     min_fingers : int, optional
         Fewest fingers that must touch (default 1).

@@ -271,7 +271,8 @@ def find_contacts(
         body of the hand touches, a palm welded to the world included.
     distance_tolerance : float, optional
         A pair is a contact when ``|ψ| <= distance_tolerance`` (metres, default
-        1e-4).
+        1e-4, at most
+        :data:`~drakegrasp.core.tolerances.MAX_DISTANCE_TOLERANCE`, 0.01).
     allow_penetration : bool, optional
         If False (default), a pair with ``ψ < -distance_tolerance`` raises
         :class:`~drakegrasp.PenetrationError`; if True it is reported as a contact.
