@@ -1172,7 +1172,11 @@ def _plan_setup(args: argparse.Namespace):
         default_mu = info.mu
         add_models = None
     else:
-        scene = planning_scene(_plan_url(args.object), hand_url=_plan_hand(args.hand))
+        scene = planning_scene(
+            _plan_url(args.object),
+            hand_url=_plan_hand(args.hand),
+            package_map=dict(args.package) or None,
+        )
         plant, context, body, hand = (
             scene.plant, scene.context, scene.object_body, scene.hand
         )  # fmt: skip
@@ -1766,7 +1770,8 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
     )
     _add_scene_file_options(
         plan,
-        package_help="for a scene: resolve package://NAME/... to DIR (repeatable)",
+        package_help="resolve package://NAME/... to DIR, in a scene's files or "
+        "the object's and --hand's URLs (repeatable)",
     )
     plan.add_argument(
         "--progress",

@@ -64,6 +64,7 @@ def planning_scene(
     hand_url: str = WSG_URL,
     X_WO: RigidTransform | None = None,
     models_dir=None,
+    package_map: dict | None = None,
 ) -> PlanningScene:
     """A free gripper and a free object in a new plant (time step 0).
 
@@ -82,6 +83,9 @@ def planning_scene(
     models_dir : path, optional
         Local ``drake_models`` folder
         (:func:`~drakegrasp.plant.models.use_local_drake_models`).
+    package_map : dict of str to path, optional
+        More packages for ``package://NAME/...`` URLs of the object and the
+        hand: ``{NAME: folder}`` (``drakegrasp plan --package NAME=DIR``).
 
     Raises
     ------
@@ -109,10 +113,18 @@ def planning_scene(
                 ".obj, ...) or a package:// URL"
             )
     X_WO = RigidTransform() if X_WO is None else check_rigid_transform("X_WO", X_WO)
+    packages = _checked_packages(package_map)
 
     def add_models(plant, parser):
         use_local_drake_models(parser, models_dir)
         register_models(parser)
+        for name, folder in packages:
+            try:
+                parser.package_map().Add(name, folder)
+            except RuntimeError as exc:  # a name known at another folder
+                raise InvalidOptionError(
+                    f"package {name!r} at {folder!r}: {_one_line(exc)}"
+                ) from None
         try:
             hand = _add(parser, hand_url)
             obj = None if object_url is None else _add(parser, object_url)
@@ -125,6 +137,29 @@ def planning_scene(
         return hand, f"{plant.GetModelInstanceName(obj)}::{body.name()}"
 
     return scene_from_models(add_models)
+
+
+def _checked_packages(package_map) -> list[tuple[str, str]]:
+    """``package_map``'s ``(name, folder)`` pairs, each folder an existing one."""
+    if package_map is None:
+        return []
+    if not isinstance(package_map, dict):
+        raise InvalidOptionError(
+            f"package_map must be a dict of package name to folder, got "
+            f"{type(package_map).__name__}"
+        )
+    pairs = []
+    for name, folder in package_map.items():
+        if not isinstance(name, str) or not name or "/" in name:
+            raise InvalidOptionError(f"package name must be a word, got {name!r}")
+        if not isinstance(folder, (str, os.PathLike)) or not Path(folder).is_dir():
+            raise InvalidOptionError(f"package {name!r}: {folder!r} is not a folder")
+        pairs.append((name, str(Path(folder).resolve())))
+    return pairs
+
+
+def _one_line(exc: Exception) -> str:
+    return " ".join(str(exc).split())
 
 
 def scene_from_models(add_models) -> PlanningScene:

@@ -181,3 +181,22 @@ def test_an_unwritable_folder_is_refused_before_planning(capsys, flag, name):
     assert main(["plan", "--num", "5", flag, f"/proc/{name}"]) != 0
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no file can be written there" in err[0]
+
+
+def test_plan_reads_its_own_packages(tmp_path, capsys):
+    # --package was for scenes only: a hand's package:// URL was "unknown"
+    folder = tmp_path / "mypkg"
+    folder.mkdir()
+    root = models_dir()
+    (folder / "hand.sdf").write_text((root / "hands/parallel_jaw_flat.sdf").read_text())
+    (folder / "box.sdf").write_text((root / "objects/box.sdf").read_text())
+    out = tmp_path / "pk.yaml"
+    argv = ["plan", "package://mypkg/box.sdf", "--hand", "package://mypkg/hand.sdf",
+            "--package", f"mypkg={folder}", "--num", "30", "--top", "1",
+            "--scene-out", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    capsys.readouterr()
+    assert main(["analyze", str(out), "--package", f"mypkg={folder}"]) == 0
+    assert "force closure: YES" in capsys.readouterr().out
+    with pytest.raises(dg.InvalidOptionError, match="is not a folder"):
+        planning_scene(BOX, package_map={"mypkg": tmp_path / "none"})
