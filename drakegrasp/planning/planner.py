@@ -102,10 +102,15 @@ from drakegrasp.plant.validation import (
     scoped_name,
 )
 
-__all__ = ["MAX_CANDIDATES", "REASONS", "object_surface", "plan_grasps"]
+__all__ = ["MAX_CANDIDATES", "MAX_PLAN_MU", "REASONS", "object_surface", "plan_grasps"]
 
 MAX_CANDIDATES = 1_000_000
 """Most poses one call samples (memory grows with it; call again for more)."""
+
+MAX_PLAN_MU = 1e6
+"""Largest friction coefficient a plan takes: its weight-capacity program
+failed in the solver at 1e12 (a WSG-50 plan of the box), and plans at 100,
+1e3, 1e4 and 1e6 gave the same best candidate."""
 
 
 REASONS = {
@@ -252,7 +257,7 @@ def plan_grasps(
         becomes a candidate or a counted rejection.
     mu : float
         Coulomb friction coefficient of the verdicts (and of the sampler's
-        cone test).
+        cone test); at most :data:`MAX_PLAN_MU`.
     seed : int, optional
         Seed of every random draw (sampling and robustness noise).  The same
         seed gives the same candidates.
@@ -384,6 +389,12 @@ def plan_grasps(
     t0 = time.perf_counter()
     n = _check_count(num_candidates)
     mu = check_coefficient("mu", mu, error=InvalidOptionError)
+    if mu > MAX_PLAN_MU:
+        raise InvalidOptionError(
+            f"mu = {mu:g} is above {MAX_PLAN_MU:g}, the largest friction the "
+            "planner's programs resolve (at 1e12 its weight-capacity program "
+            f"fails in the solver): plan with mu at most {MAX_PLAN_MU:g}"
+        )
     tol = check_distance_tolerance(distance_tolerance)
     clearance = checked_nonnegative("clearance", clearance, "metres")
     complete_unseen = check_flag("complete_unseen", complete_unseen)

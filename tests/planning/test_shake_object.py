@@ -12,10 +12,12 @@ import pytest
 
 import drakegrasp as dg
 
+FLAT = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+
 
 @pytest.fixture(scope="module")
 def box_candidate():
-    box = dg.planning_scene("package://drakegrasp/objects/box.sdf")
+    box = dg.planning_scene("package://drakegrasp/objects/box.sdf", hand_url=FLAT)
     result = dg.plan_grasps(
         box.plant, box.context, box.object_body, hand=box.hand,
         num_candidates=20, mu=0.5, seed=0,
@@ -25,7 +27,9 @@ def box_candidate():
 
 def test_another_object_is_refused(box_candidate):
     _, candidate = box_candidate
-    cylinder = dg.planning_scene("package://drakegrasp/objects/cylinder.sdf")
+    cylinder = dg.planning_scene(
+        "package://drakegrasp/objects/cylinder.sdf", hand_url=FLAT
+    )
     with pytest.raises(dg.ModelError, match="not the object it was planned on"):
         dg.shake_test(
             cylinder.add_models, candidate, squeeze=10.0, directions=[(0.0, 0.0, -1.0)]

@@ -15,6 +15,7 @@ from drakegrasp.plant.models import models_dir
 
 BOX = "package://drakegrasp/objects/box.sdf"
 SPHERE = "package://drakegrasp/objects/sphere.sdf"
+FLAT = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
 
 
 def _hand(tmp_path, name: str, effort: str, replacement: str):
@@ -91,3 +92,21 @@ def test_plan_shake_of_a_hand_without_motors_is_refused_up_front(tmp_path, capsy
     assert captured.out == ""  # nothing planned
     err = captured.err.strip().splitlines()
     assert len(err) == 1 and "--shake squeezes with the hand's motors" in err[0]
+
+
+def test_friction_beyond_what_the_programs_resolve_is_refused():
+    # --mu 1e12, inside the coefficients' range, failed the whole plan in Clp
+    from drakegrasp.errors import InvalidOptionError
+    from drakegrasp.planning.planner import MAX_PLAN_MU
+
+    scene = planning_scene(BOX, hand_url=FLAT)
+    for mu, ok in ((MAX_PLAN_MU, True), (1e12, False)):
+        run = lambda mu=mu: plan_grasps(  # noqa: E731
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=10, mu=mu, seed=0, robustness_samples=2,
+        )  # fmt: skip
+        if ok:
+            assert len(run()) > 0
+        else:
+            with pytest.raises(InvalidOptionError, match="at most 1e\\+06"):
+                run()
