@@ -228,7 +228,12 @@ def test_a_plant_without_a_scene_graph_is_named():
         dg.GraspMonitor(plant, object_body=plant.GetBodyByName("box"), mu=0.5)
 
 
-def _jaw_box_monitor(**keywords):
+def _jaw_box(**keywords):
+    """The default jaw welded at its palm, the box free at 65 mm, a monitor.
+
+    Returns the diagram, its root context, the plant, the hand's instance
+    and the monitor; ``keywords`` go to ``add_grasp_monitor``.
+    """
     from pydrake.math import RigidTransform
     from pydrake.multibody.parsing import Parser
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
@@ -244,16 +249,22 @@ def _jaw_box_monitor(**keywords):
     plant.Finalize()
     monitor = dg.add_grasp_monitor(
         builder, plant, scene_graph, object_body=plant.GetBodyByName("box"),
-        mu=0.5, **keywords,
+        **keywords,
     )  # fmt: skip
     diagram = builder.Build()
     root = diagram.CreateDefaultContext()
     ctx = plant.GetMyContextFromRoot(root)
-    box = plant.GetBodyByName("box")
-    plant.SetFreeBodyPose(ctx, box, RigidTransform([0, 0, 0.065]))
+    plant.SetFreeBodyPose(
+        ctx, plant.GetBodyByName("box"), RigidTransform([0, 0, 0.065])
+    )
+    return diagram, root, plant, hand, monitor
+
+
+def _jaw_box_monitor(**keywords):
+    _, root, plant, hand, monitor = _jaw_box(mu=0.5, **keywords)
 
     def sample(q):
-        plant.SetPositions(ctx, hand, q)
+        plant.SetPositions(plant.GetMyContextFromRoot(root), hand, q)
         return monitor.evaluate(monitor.GetMyContextFromRoot(root))
 
     return sample
@@ -276,31 +287,12 @@ def test_a_falling_box_reads_as_sliding():
     # the box falls between jaws that press with nothing: the sample said
     # "slip 0 mm/s" beside its own sliding speed of 0.49 m/s, and "no contact
     # in this sample ()" with empty parentheses
-    from pydrake.math import RigidTransform
-    from pydrake.multibody.parsing import Parser
-    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
     from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
 
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=1e-3)
-    parser = Parser(plant)
-    dg.register_models(parser)
-    hand = parser.AddModels(url="package://drakegrasp/hands/parallel_jaw.sdf")[0]
-    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("palm", hand))
-    parser.AddModels(url="package://drakegrasp/objects/box.sdf")
-    plant.Finalize()
-    monitor = dg.add_grasp_monitor(
-        builder, plant, scene_graph, object_body=plant.GetBodyByName("box"),
-        mu="plant", load="gravity", torque_limits="plant",
-    )  # fmt: skip
-    diagram = builder.Build()
-    root = diagram.CreateDefaultContext()
-    ctx = plant.GetMyContextFromRoot(root)
-    plant.SetPositions(ctx, hand, [0.025, 0.025])
-    plant.SetFreeBodyPose(
-        ctx, plant.GetBodyByName("box"), RigidTransform([0, 0, 0.065])
+    diagram, root, plant, hand, monitor = _jaw_box(
+        mu="plant", load="gravity", torque_limits="plant"
     )
+    plant.SetPositions(plant.GetMyContextFromRoot(root), hand, [0.025, 0.025])
     simulator = Simulator(diagram, root)
     simulator.AdvanceTo(0.051)
     sample = monitor.get_output_port(1).Eval(monitor.GetMyContextFromRoot(root))
