@@ -135,6 +135,22 @@ def _wrench_text(cert: Witness) -> str:
     return f"cannot resist {what}{_more(cert, 'wrenches')}"
 
 
+def _friction_needed(forces) -> float:
+    """The largest ``‖f_t‖ / f_n`` over contacts pressed (0 if none).
+
+    A contact's force is normal first, then its tangential components (one
+    planar, two spatial), then a soft finger's moment, which is not counted.
+    """
+    worst = 0.0
+    for f in forces:
+        f = np.asarray(f, dtype=float)
+        if f.size < 2 or not f[0] > 0:
+            continue
+        tangential = f[1:3] if f.size >= 3 else f[1:2]
+        worst = max(worst, float(np.linalg.norm(tangential)) / float(f[0]))
+    return worst
+
+
 def describe_certificate(cert: Witness) -> str:
     """See :meth:`drakegrasp.certificates.certificate.Certificate.describe`."""
     if cert.kind == ESCAPE_TWIST:
@@ -145,10 +161,17 @@ def describe_certificate(cert: Witness) -> str:
     f_n = np.array([f[0] for f in forces])
     shown = ", ".join(f"{x:.3g}" for x in f_n)
     if cert.kind == UNCONTROLLABLE:
-        return (
+        text = (
             f"the hand cannot change a squeeze with normal forces ({shown}) N "
             "(per Σ f_n = N): no joint torque acts on it"
         )
+        ratio = _friction_needed(forces)
+        if ratio > 1.0:  # LP3 leaves the tangential components free
+            text += (
+                f"; it presses {ratio:.3g} times harder along the surfaces than "
+                "into them (LP3 bounds no friction)"
+            )
+        return text
     assert cert.kind == BALANCE
     k = 0 if cert.internal_basis is None else cert.internal_basis.shape[1]
     return (
