@@ -32,6 +32,8 @@ from fuzz_cases import Case
 from hostile import opaque, pick
 from sandbox import Sandbox
 
+from drakegrasp import HoldingThresholds
+
 BOX = "box::box"
 TOL = 1e-3  # the pick's monitor's distance tolerance, m
 _PICK = []
@@ -121,6 +123,8 @@ def _sample_right(out: dict, bad) -> bool:
     deepest, status = out["deepest"], out["status"]
     if deepest > TOL:
         return status == "no contact"
+    if -deepest > HoldingThresholds().max_penetration:  # no grip to judge
+        return status == "invalid" and "penetrate" in out["message"]
     if status != "ok":
         # a graze; or, as a monitor allows penetration by default (a
         # simulation's contacts penetrate to make their force), contacts
