@@ -93,7 +93,6 @@ from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
 from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import finger_chains, hand_structure, passive_joints
-from drakegrasp.plant.mesh_convexity import NonConvexMeshWarning
 from drakegrasp.plant.validation import hand_bodies, scoped_name
 
 __all__ = [
@@ -294,16 +293,13 @@ def close_each(closer, poses, progress):
     """
     rejections = Counter()
     kept = []
-    with warnings.catch_warnings():  # object_surface warned of the hull already
-        warnings.simplefilter("ignore", NonConvexMeshWarning)
-        for k in closing_order(len(poses["q"]), progress):
-            R_WH = RotationMatrix(poses["R_WH"][k])
-            X_WH = RigidTransform(R_WH, poses["p_WH"][k])
-            found, q, reason = closer.run(X_WH, poses["q"][k])
-            if reason is not None:
-                rejections[reason] += 1
-                continue
-            kept.append((k, closer.X_WH, poses["q"][k], q, found))
+    for k in closing_order(len(poses["q"]), progress):
+        X_WH = RigidTransform(RotationMatrix(poses["R_WH"][k]), poses["p_WH"][k])
+        found, q, reason = closer.run(X_WH, poses["q"][k])
+        if reason is not None:
+            rejections[reason] += 1
+            continue
+        kept.append((k, closer.X_WH, poses["q"][k], q, found))
     return kept, rejections, closer.label
 
 

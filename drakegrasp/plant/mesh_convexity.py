@@ -13,10 +13,11 @@ frame with its scale.
 
 from __future__ import annotations
 
+import os
 import warnings
 
 import numpy as np
-from pydrake.geometry import CalcVolume, Mesh, Shape
+from pydrake.geometry import CalcVolume, Mesh, ReadObjToTriangleSurfaceMesh, Shape
 
 __all__ = [
     "NON_CONVEX_SHARE",
@@ -42,7 +43,10 @@ NON_CONVEX_SHARE = 0.95
 warned of (:class:`NonConvexMeshWarning`): a torus is 61 % of its hull."""
 
 _SHARES: dict[tuple, float | None] = {}
-""":func:`hull_share` per mesh file and scale: a file is read once."""
+""":func:`hull_share` per mesh file (path, size, modification time) and scale."""
+
+_WARNED: set[tuple] = set()
+"""Mesh files already warned of: each once per process."""
 
 
 def hull_volume(hull) -> float:
@@ -77,7 +81,48 @@ def _key(shape: Mesh) -> tuple | None:
     source = shape.source()
     if not source.is_path():
         return None  # an in-memory mesh: measured each time
-    return (str(source.path()), tuple(float(s) for s in shape.scale3()))
+    path = str(source.path())
+    try:
+        stat = os.stat(path)
+    except OSError:
+        return None
+    scale = tuple(float(s) for s in shape.scale3())
+    return (path, stat.st_size, stat.st_mtime_ns, scale)
+
+
+def _own_volume(shape: Mesh) -> float | None:
+    """The mesh's volume, m³, or None where it encloses none (open, not manifold).
+
+    A Wavefront ``.obj`` is read with Drake's ``ReadObjToTriangleSurfaceMesh``
+    and measured only when every edge bounds exactly two triangles: Drake's
+    ``CalcVolume`` measures an open mesh too, by an amount that depends on
+    where its origin is.  Another format is Drake's ``CalcVolume``.
+    """
+    source = shape.source()
+    if source.is_path() and str(source.path()).lower().endswith(".obj"):
+        try:
+            mesh = ReadObjToTriangleSurfaceMesh(source.path(), shape.scale3())
+        except Exception:  # noqa: BLE001 - Drake's refusal: nothing to measure
+            return None
+        tris = np.array([[t.vertex(k) for k in range(3)] for t in mesh.triangles()])
+        if not len(tris):
+            return None
+        edges = np.sort(
+            np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1
+        )
+        _, uses = np.unique(edges, axis=0, return_counts=True)
+        if not np.all(uses == 2):
+            return None
+        v = np.array(mesh.vertices(), dtype=float)
+        v = v - v.mean(axis=0)
+        signed = np.einsum(
+            "ij,ij->i", v[tris[:, 0]], np.cross(v[tris[:, 1]], v[tris[:, 2]])
+        )
+        return abs(float(np.sum(signed))) / 6.0
+    try:
+        return float(CalcVolume(shape))
+    except Exception:  # noqa: BLE001 - Drake's refusal: nothing to compare
+        return None
 
 
 def hull_share(shape: Shape) -> float | None:
@@ -91,21 +136,22 @@ def hull_share(shape: Shape) -> float | None:
     -------
     float or None
         In (0, 1] for a closed mesh (1 when convex, to round-off); None for
-        another shape, or a mesh whose volume Drake does not measure (not
-        closed, or of a format ``CalcVolume`` does not read).
+        another shape, or a mesh that encloses no volume to compare (an open
+        ``.obj``, or a share above 1) or that Drake cannot read.
     """
     if not isinstance(shape, Mesh):
         return None
     key = _key(shape)
     if key is not None and key in _SHARES:
         return _SHARES[key]
+    own = _own_volume(shape)
     try:
-        own = float(CalcVolume(shape))
         hull = hull_volume(shape.GetConvexHull())
     except Exception:  # noqa: BLE001 - Drake's refusal: nothing to compare
+        hull = 0.0
+    share = own / hull if own and hull > 0 else None
+    if share is not None and share > 1.0 + 1e-9:  # no closed mesh exceeds its hull
         share = None
-    else:
-        share = own / hull if hull > 0 and own > 0 else None
     if key is not None:
         _SHARES[key] = share
     return share
@@ -115,6 +161,10 @@ def warn_if_not_convex(
     shape: Shape, name: str = "", *, user: str = "the planner", stacklevel: int = 2
 ) -> None:
     """:class:`NonConvexMeshWarning` for a ``Mesh`` well inside its hull.
+
+    Once per mesh file (and scale) in a process, whoever asks: a monitor
+    that samples a grasp on it, an analysis run again, or the analysis of a
+    grasp planned on it warns no more (an in-memory mesh each time).
 
     Parameters
     ----------
@@ -130,13 +180,19 @@ def warn_if_not_convex(
         As for ``warnings.warn``, counted from the caller.
     """
     share = hull_share(shape)
-    if share is not None and share < NON_CONVEX_SHARE:
-        warnings.warn(
-            f"the object's collision mesh {name!r} is not convex (its volume is "
-            f"{100 * share:.0f}% of its hull's): {user}, like Drake's point "
-            "contact, treats it as its hull, so a grasp may touch where the "
-            "object has no surface (across a hole or a hollow); split it into "
-            "convex pieces, one <collision> each, to use its true shape",
-            NonConvexMeshWarning,
-            stacklevel=stacklevel + 1,
-        )
+    if share is None or share >= NON_CONVEX_SHARE:
+        return
+    key = _key(shape)
+    if key is not None:
+        if key in _WARNED:
+            return
+        _WARNED.add(key)
+    warnings.warn(
+        f"the object's collision mesh {name!r} is not convex (its volume is "
+        f"{100 * share:.0f}% of its hull's): {user}, like Drake's point "
+        "contact, treats it as its hull, so a grasp may touch where the "
+        "object has no surface (across a hole or a hollow); split it into "
+        "convex pieces, one <collision> each, to use its true shape",
+        NonConvexMeshWarning,
+        stacklevel=stacklevel + 1,
+    )
