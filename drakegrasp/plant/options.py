@@ -127,7 +127,10 @@ class AnalysisOptions:
     torque_limits : None, "plant" or tuple of float
         Motor limits of the load section (N·m or N per hand velocity; ``inf``
         for none); one number (``100`` or ``[100]``, kept as ``(100.0,)``) is
-        every actuator's.  ``"plant"`` reads the actuators' effort limits, a free hand
+        every actuator's, except on a hand with one independent coordinate
+        (a one-motor jaw), where it is that coordinate's (a ``<mimic>``
+        follower without a motor of its own must not count one).
+        ``"plant"`` reads the actuators' effort limits, a free hand
         base's velocities unbounded
         (:func:`~drakegrasp.plant.load.plant_torque_limits`).
     """
