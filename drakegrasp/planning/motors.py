@@ -457,7 +457,7 @@ def with_torques_needed(
     reason = (
         result.reason
         or _too_weak(head, limit, applied)
-        or _no_limit(plant, ranked, limit, "torque_limit")
+        or _no_limit(plant, ranked, limit, "torque_needed", "torque_limit")
     )
     settings = result.settings
     if motors_first:
@@ -550,7 +550,7 @@ def with_squeeze_limit(
     reason = (
         result.reason
         or _too_weak_jaw(ranked, limit, applied)
-        or _no_limit(plant, ranked, limit, "squeeze_limit")
+        or _no_limit(plant, ranked, limit, "squeeze_needed", "squeeze_limit")
     )
     ranked = _held_first(ranked, "squeeze_needed", limit, top)
     return dataclasses.replace(
@@ -703,15 +703,19 @@ def _none_held(
     )
 
 
-def _no_limit(plant, ranked: list, limit: float, option: str) -> str:
+def _no_limit(plant, ranked: list, limit: float, needed: str, option: str) -> str:
     """Why the motors ranked nothing: no effort limit in the model; or "".
 
     Said when no finite limit is known and some of the candidates' joints
     have an actuator of infinite effort (Drake makes a missing ``<effort>``
-    so), or none of them has an actuator at all.
+    so), or none of them has an actuator at all; not when no candidate has
+    a finite ``needed`` figure (a cloud planned without ``object_mass``),
+    which no limit would rank.
     """
     if not ranked or math.isfinite(limit):
         return ""
+    if not any(math.isfinite(getattr(c, needed)) for c in ranked):
+        return ""  # nothing to rank by whatever the limit (no mass known)
     names = ranked[0].joint_names
     unbounded = [
         n

@@ -572,10 +572,12 @@ def _check_finger_gaps(plant, ctx, body, planned: list) -> None:
                 f"{gap * 1e3:.3g} mm from" if gap > 0 else f"{-gap * 1e3:.3g} mm inside"
             )
             raise ModelError(
-                f"the candidate's finger {name} touched the object it was planned "
-                f"on, but at the candidate's poses it is {where} "
-                f"{_scoped(plant, body)}: this is not the object it was planned on "
-                f"(beyond {bound * 1e3:.3g} mm); shake it with that object"
+                f"the candidate's finger {name} touched the object in the plan, "
+                f"but the shake's models put it {where} {_scoped(plant, body)} "
+                f"at the candidate's poses (beyond {bound * 1e3:.3g} mm): shake "
+                "it with the object it was planned on, and a hand whose joints "
+                "the candidate sets (a joint without a motor keeps its model's "
+                "default in the shake, not the value the plan held it at)"
             )
 
 

@@ -30,7 +30,9 @@ def test_another_object_is_refused(box_candidate):
     cylinder = dg.planning_scene(
         "package://drakegrasp/objects/cylinder.sdf", hand_url=FLAT
     )
-    with pytest.raises(dg.ModelError, match="not the object it was planned on"):
+    with pytest.raises(
+        dg.ModelError, match="shake it with the object it was planned on"
+    ):
         dg.shake_test(
             cylinder.add_models, candidate, squeeze=10.0, directions=[(0.0, 0.0, -1.0)]
         )

@@ -8,6 +8,7 @@ as if any candidate were held; it now says why it ranks by score alone.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from drakegrasp.planning import plan_grasps, planning_scene
@@ -110,3 +111,24 @@ def test_friction_beyond_what_the_programs_resolve_is_refused():
         else:
             with pytest.raises(InvalidOptionError, match="at most 1e\\+06"):
                 run()
+
+
+def test_a_cloud_without_a_mass_gets_no_advice_it_cannot_follow(tmp_path):
+    # no object_mass: every squeeze_needed is NaN, and squeeze_limit is
+    # refused on a cloud without one: advising it was a dead end
+    from drakegrasp.planning.planner import object_surface
+
+    name, effort, _ = JAW
+    hand = _hand(tmp_path, name, effort, "")
+    scene = planning_scene(BOX, hand_url=hand)
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    surface = object_surface(scene.plant, ctx, scene.object_body)
+    p, n, _ = surface.sample(3000, np.random.default_rng(0))
+    alone = planning_scene(None, hand_url=hand)
+    result = plan_grasps(
+        alone.plant, alone.context, None, hand=alone.hand, num_candidates=60,
+        mu=0.5, seed=0, point_cloud=p, cloud_normals=n, robustness_samples=2,
+    )  # fmt: skip
+    assert len(result) > 0
+    assert all(np.isnan(c.squeeze_needed) for c in result)
+    assert "ranked by score alone" not in result.reason
