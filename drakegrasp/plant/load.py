@@ -206,8 +206,8 @@ def _unactuated_warning(names: tuple[str, ...]) -> str:
         f"{listed} {'has' if len(names) == 1 else 'have'} no actuator in the "
         "model (or an effort limit of 0), so torque_limits='plant' gives "
         f"{'it' if len(names) == 1 else 'them'} 0 (no torque: a passive joint); "
-        "give the model its motors (a URDF <transmission>, an SDFormat "
-        "<effort>), or pass torque_limits"
+        "where a motor drives them, give the model its actuators (a URDF "
+        "<transmission>, an SDFormat <effort>), or pass torque_limits"
     )
 
 

@@ -622,7 +622,10 @@ class GraspMonitor(LeafSystem):
         limits): the holding state judges a grip by its analysis, and without
         one it would call every grip "touching" (not in force closure).  So
         the holding state, its loads and its speeds are those of the last
-        valid sample, and "no contact" (the initial state) before any.
+        valid sample, and "no contact" (the initial state) before any.  A
+        hand sunk deeper into the object than
+        ``HoldingThresholds.max_penetration`` gives an ``"invalid"`` sample
+        too, where penetration is allowed.
 
         Raises
         ------

@@ -52,8 +52,10 @@ setting it (the gravity load otherwise weighs the model's mass).
   ``separation_speed``.  A simulated contact penetrates a little (point
   contact: ~0.1 mm for newtons of squeeze; the WSG-50 at 20 N: 0.145 mm), so
   the monitor allows penetration by default (``allow_penetration=None``:
-  True); ``allow_penetration=False`` makes a sample that penetrates deeper
-  than ``distance_tolerance`` ``"invalid"``.
+  True), up to ``HoldingThresholds.max_penetration`` (5 mm: deeper, the
+  sample is ``"invalid"``, no grip to judge); ``allow_penetration=False``
+  makes a sample that penetrates deeper than ``distance_tolerance``
+  ``"invalid"``.
   *It sees* positions, normals and velocities, hence slip, and whether a
   finger's geometry touches the object's (``ψ <= 0``: the plant pushes only
   there); *it cannot see* forces.  So the analysis counts a finger within the
@@ -73,7 +75,8 @@ setting it (the gravity load otherwise weighs the model's mass).
   "at risk" before it slips.  These contacts penetrate to make their force
   (point contact: 0.2 mm at 20 N between the WSG-50's tips and a box), so
   the analysis allows penetration whatever ``distance_tolerance`` is (a pose
-  is invalid only for a joint off its limits): at the default 0.1 mm a firm
+  is invalid only for a joint off its limits, or a hand sunk deeper than
+  ``HoldingThresholds.max_penetration``): at the default 0.1 mm a firm
   grip was "invalid", shown as "touching", until it slipped.  *It cannot see*
   contacts the step did not
   compute (a hydroelastic surface has one net force, not a distribution), nor

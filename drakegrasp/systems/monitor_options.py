@@ -137,7 +137,8 @@ def monitor_settings(
         option, an unknown contact source, a period or offset that is not
         finite seconds in range, a flag that is not a bool, ``holding``
         that is not a :class:`~drakegrasp.HoldingThresholds`, or its
-        ``release_distance`` at or below ``distance_tolerance``.
+        ``release_distance`` or ``max_penetration`` at or below
+        ``distance_tolerance``.
     """
     if not isinstance(contacts, str) or contacts not in CONTACT_SOURCES:
         raise InvalidOptionError(
@@ -173,6 +174,12 @@ def monitor_settings(
             f"holding.release_distance = {holding.release_distance:g} m must exceed "
             f"distance_tolerance = {analysis.distance_tolerance:g} m: a gap at which "
             "a contact still counts cannot mean the object has left the hand"
+        )
+    if holding.max_penetration <= analysis.distance_tolerance:
+        raise InvalidOptionError(
+            f"holding.max_penetration = {holding.max_penetration:g} m must exceed "
+            f"distance_tolerance = {analysis.distance_tolerance:g} m: a depth "
+            "within the tolerance is a contact, never seen as a penetration"
         )
     return MonitorSettings(
         analysis=analysis,

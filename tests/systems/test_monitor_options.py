@@ -300,3 +300,16 @@ def test_a_falling_box_reads_as_sliding():
     line = str(sample).splitlines()[0]
     assert f"sliding {1e3 * sample.sliding_speed:.3g} mm/s along the fingers" in line
     assert "()" not in line
+
+
+def test_max_penetration_must_exceed_the_distance_tolerance():
+    # depths within the tolerance are contacts: 5-8 mm went unjudged at 8 mm
+    with pytest.raises(InvalidOptionError, match="max_penetration = 0.005 m must"):
+        _jaw_box_monitor(
+            distance_tolerance=0.008,
+            holding=dg.HoldingThresholds(release_distance=0.01),
+        )
+    _jaw_box_monitor(
+        distance_tolerance=0.008,
+        holding=dg.HoldingThresholds(max_penetration=0.01, release_distance=0.01),
+    )
