@@ -116,14 +116,11 @@ def test_friction_beyond_what_the_programs_resolve_is_refused():
 def test_a_cloud_without_a_mass_gets_no_advice_it_cannot_follow(tmp_path):
     # no object_mass: every squeeze_needed is NaN, and squeeze_limit is
     # refused on a cloud without one: advising it was a dead end
-    from drakegrasp.planning.planner import object_surface
+    from cloud_support import sample_cloud
 
     name, effort, _ = JAW
     hand = _hand(tmp_path, name, effort, "")
-    scene = planning_scene(BOX, hand_url=hand)
-    ctx = scene.plant.GetMyContextFromRoot(scene.context)
-    surface = object_surface(scene.plant, ctx, scene.object_body)
-    p, n, _ = surface.sample(3000, np.random.default_rng(0))
+    p, n = sample_cloud(planning_scene(BOX, hand_url=hand), 3000)
     alone = planning_scene(None, hand_url=hand)
     result = plan_grasps(
         alone.plant, alone.context, None, hand=alone.hand, num_candidates=60,
