@@ -39,7 +39,9 @@ SQUARE = [(0, 0), (0.06, 0), (0.06, 0.06), (0, 0.06)]
 
 
 def _surface(path):
-    scene = planning_scene(str(path))
+    # the shipped jaw: the default hand (the WSG-50) needs drake_models
+    hand = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+    scene = planning_scene(str(path), hand_url=hand)
     return object_surface(scene.plant, scene.context, scene.object_body)
 
 

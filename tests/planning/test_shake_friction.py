@@ -16,11 +16,13 @@ from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.plant.friction import FrictionMismatchWarning, hand_object_friction
 
 BOX = "package://drakegrasp/objects/box.sdf"
+FLAT = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
 
 
 @pytest.fixture(scope="module")
 def scene():
-    return planning_scene(BOX)
+    # the shipped jaw: the default hand (the WSG-50) needs drake_models
+    return planning_scene(BOX, hand_url=FLAT)
 
 
 def _best(scene, mu):
