@@ -507,7 +507,6 @@ class BodyCloser:
             [(r[3], r[1], r[2], r[4]) for r in results],
             distance_tolerance=self.tol,
             cache=self._cache,
-            warn_hull=False,  # object_surface warned already
         )
         return staged, None
 

@@ -462,7 +462,6 @@ def stage_contacts(
     allow_penetration: bool = False,
     patches: str = "vertices",
     cache: dict | None = None,
-    warn_hull: bool = True,
 ) -> StagedContacts:
     """Read the touching pairs of :func:`contacts_of_distances` from Drake now.
 
@@ -471,10 +470,9 @@ def stage_contacts(
     :func:`staged_contacts` finish the work.  ``cache`` is a dict the caller
     keeps across calls on one plant and scene graph (names and shapes are
     then read once).  A touching object geometry that is a non-convex
-    ``Mesh`` is warned of once per ``cache``
+    ``Mesh`` is warned of
     (:class:`~drakegrasp.plant.mesh_convexity.NonConvexMeshWarning`: Drake's
-    distances are to its hull) unless ``warn_hull`` is False (a planner that
-    has warned already).
+    distances are to its hull), once per mesh file in a process.
     """
     tol = distance_tolerance
     cache = {} if cache is None else cache
@@ -521,7 +519,7 @@ def stage_contacts(
             continue
         if abs(psi) > tol and not (allow_penetration and psi < 0):
             continue
-        if warn_hull and ("hull", go) not in cache:  # once per geometry and cache
+        if ("hull", go) not in cache:  # measured once per geometry and cache
             cache["hull", go] = True
             warn_if_not_convex(inspector.GetShape(go), name(go), user="this analysis")
         if index not in fingers:
