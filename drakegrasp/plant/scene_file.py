@@ -47,6 +47,7 @@ from drakegrasp.plant.options import PLANES, AnalysisOptions
 __all__ = [
     "KEYS",
     "LOADER_NU_REMEDY",
+    "MAX_ANGLE_DEG",
     "MAX_DEPTH",
     "MAX_SCENE_BYTES",
     "TOP_LEVEL_KEYS",
@@ -62,6 +63,16 @@ MAX_SCENE_BYTES = 1 << 20
 
 MAX_DEPTH = 64
 """Deepest nesting of YAML collections accepted."""
+
+MAX_ANGLE_DEG = 1e8
+"""Largest magnitude of a pose's angle, degrees.
+
+Drake turns degrees into radians by one multiplication, whose rounding is
+about ``|angle| · 1e-18`` rad: 2e-10 rad here, and a whole turn at 1e19
+degrees, where the rotation is no longer the one written.  No pose means more
+than a few turns; a larger angle is refused with the advice to take it
+modulo 360.
+"""
 
 KEYS = {
     "description": "a string",
@@ -360,8 +371,8 @@ def check_poses(path: Path, text: str) -> None:
     SceneError
         Naming the file, the line and column, the key and what is valid: an
         ``!AngleAxis`` axis whose length cannot be normalised (zero, or too
-        short or too long in double precision), or a non-finite angle or
-        translation.
+        short or too long in double precision), a non-finite angle or
+        translation, or an angle beyond :data:`MAX_ANGLE_DEG`.
     """
     loader = _SceneLoader(text)  # text that read_yaml has read: it parses
     try:
@@ -410,6 +421,12 @@ def _numbers(loader, node) -> list[float] | None:
         return None
 
 
+_TOO_LARGE = (
+    f"is beyond ±{MAX_ANGLE_DEG:.0e} degrees, where double precision no longer "
+    "holds the angle's part of a turn; give it modulo 360"
+)
+
+
 def _check_pose(path: Path, loader, where: str, pose) -> None:
     """Refuse one pose node's non-finite numbers and degenerate rotation axis."""
     fields = _entries(pose)
@@ -438,6 +455,8 @@ def _check_pose(path: Path, loader, where: str, pose) -> None:
                 f"!Rpy deg {deg} must be finite (degrees): "
                 "!Rpy {deg: [roll, pitch, yaw]}",
             )  # fmt: skip
+        if deg is not None and any(abs(x) > MAX_ANGLE_DEG for x in deg):
+            refuse(parts["deg"], "rotation", f"!Rpy deg {deg} {_TOO_LARGE}")
     if tag == "!AngleAxis":
         angle = parts.get("angle_deg")
         value = _numbers(loader, angle) if angle is not None else None
@@ -446,6 +465,10 @@ def _check_pose(path: Path, loader, where: str, pose) -> None:
                 angle, "rotation",
                 f"!AngleAxis angle_deg {value[0]} must be finite (degrees)",
             )  # fmt: skip
+        if value is not None and abs(value[0]) > MAX_ANGLE_DEG:
+            refuse(
+                angle, "rotation", f"!AngleAxis angle_deg {value[0]} {_TOO_LARGE}"
+            )
         axis = parts.get("axis")
         value = _numbers(loader, axis) if axis is not None else None
         if value is None:

@@ -163,6 +163,11 @@ BOX_POSE = "directives[2].add_model.default_free_body_pose.box"
          "rotation !Rpy deg [0.0, -inf, 0.0] must be finite (degrees)"),
         (ROTATION, "rotation: !AngleAxis {angle_deg: .nan, axis: [0, 0, 1]}",
          "rotation !AngleAxis angle_deg nan must be finite (degrees)"),
+        # Drake took these, and turned the box by whatever the rounding left
+        (ROTATION, "rotation: !Rpy {deg: [1e300, 0.0, 0.0]}",
+         "!Rpy deg [1e+300, 0.0, 0.0] is beyond ±1e+08 degrees"),
+        (ROTATION, "rotation: !AngleAxis {angle_deg: -2e8, axis: [0, 0, 1]}",
+         "!AngleAxis angle_deg -200000000.0 is beyond ±1e+08 degrees"),
         # refused later, as a body's position, without the key
         (TRANSLATION, "translation: [.nan, 0.0, 0.065]",
          "translation [nan, 0.0, 0.065] must be finite (metres)"),
@@ -183,6 +188,17 @@ def test_a_pose_drake_would_drop_or_fail_on_is_refused_by_line_and_key(
     assert message.startswith(f"scene {str(path)!r}: line {line}, column "), message
     key = old.split(":")[0]  # rotation or translation
     assert f"{BOX_POSE}.{key} " in message and says in message, message
+
+
+def test_angles_of_a_few_turns_either_way_are_taken(tmp_path):
+    path = tmp_path / "scene.yaml"
+    for rotation in (
+        "rotation: !Rpy {deg: [720.0, -1e8, 0.0]}",
+        "rotation: !AngleAxis {angle_deg: -1e8, axis: [0, 0, 1]}",
+    ):
+        path.write_text(DEFAULT.replace(ROTATION, rotation, 1))
+        scene = dg.load_scene(path)  # the check refuses nothing here
+        assert scene.object_body.name() == "box"
 
 
 def test_the_poses_of_frames_welds_and_included_files_are_checked(tmp_path):
