@@ -1577,8 +1577,8 @@ _PLAN_REASON_WORDS = {
     ),
     "the jaw at squeeze_limit ": "the jaw at --squeeze-limit ",
     "the hand at torque_limit ": "the hand at --torque-limit ",
-    "or pass squeeze_limit": "or pass --squeeze-limit N",
-    "or pass torque_limit": "or pass --torque-limit N·m",
+    "or pass squeeze_limit (": "or pass --squeeze-limit LIMIT (",
+    "or pass torque_limit (": "or pass --torque-limit LIMIT (",
 }
 """Phrases of a plan result's ``reason`` that name what ``plan`` cannot set."""
 

@@ -76,7 +76,7 @@ import math
 import time
 
 import numpy as np
-from pydrake.multibody.tree import JacobianWrtVariable
+from pydrake.multibody.tree import JacobianWrtVariable, PrismaticJoint
 from pydrake.solvers import MathematicalProgram
 from scipy.linalg import block_diag
 
@@ -115,6 +115,7 @@ __all__ = [
     "TORQUE_CHECK",
     "check_squeeze_limit",
     "check_torque_limit",
+    "effort_unit",
     "finger_jacobian",
     "motor_limit",
     "torque_capacity",
@@ -454,16 +455,17 @@ def with_torques_needed(
     applied = torque_limit is not None and torque_limit < limit
     if applied:
         limit = torque_limit
+    unit = effort_unit(plant, ranked[0].joint_names) if ranked else "N·m"
     reason = (
         result.reason
-        or _too_weak(head, limit, applied)
-        or _no_limit(plant, ranked, limit, "torque_needed", "torque_limit")
+        or _too_weak(head, limit, applied, unit)
+        or _no_limit(plant, ranked, limit, "torque_needed", "torque_limit", unit)
     )
     settings = result.settings
     if motors_first:
         ranked = _held_first(ranked, "torque_needed", limit, top)
         settings = _with_held_first(
-            settings, ranked, "torque_needed", limit, "N·m", applied, torque_limit
+            settings, ranked, "torque_needed", limit, unit, applied, torque_limit
         )
     return dataclasses.replace(
         result,
@@ -550,7 +552,9 @@ def with_squeeze_limit(
     reason = (
         result.reason
         or _too_weak_jaw(ranked, limit, applied)
-        or _no_limit(plant, ranked, limit, "squeeze_needed", "squeeze_limit")
+        or _no_limit(
+            plant, ranked, limit, "squeeze_needed", "squeeze_limit", "N per finger"
+        )
     )
     ranked = _held_first(ranked, "squeeze_needed", limit, top)
     return dataclasses.replace(
@@ -592,7 +596,9 @@ def check_torque_limit(torque_limit) -> float:
         Not a real number, or not finite and > 0; the message names
         ``torque_limit``.
     """
-    return _positive_limit("torque_limit", torque_limit, "N·m per finger joint")
+    return _positive_limit(
+        "torque_limit", torque_limit, "N·m per finger joint, N at a prismatic one"
+    )
 
 
 def check_squeeze_limit(squeeze_limit) -> float:
@@ -641,22 +647,42 @@ def motor_limit(plant, candidate: GraspCandidate, *, per_finger: bool = False) -
     return min(finite, default=math.inf)
 
 
-def _too_weak(head, limit: float, applied: bool = False) -> str:
+def effort_unit(plant, joint_names) -> str:
+    """The unit of the efforts of ``joint_names``' motors, for the messages.
+
+    ``"N·m"`` when every joint turns (revolute), ``"N"`` when every one
+    slides (prismatic), and ``"N·m (N at prismatic joints)"`` for a hand with
+    both: ``torque_limit`` and ``torque_needed`` are per joint, in its own
+    unit.
+    """
+    kinds = {
+        "N" if isinstance(find_joint(plant, n), PrismaticJoint) else "N·m"
+        for n in joint_names
+    }
+    if kinds == {"N"}:
+        return "N"
+    return "N·m (N at prismatic joints)" if kinds == {"N", "N·m"} else "N·m"
+
+
+def _too_weak(head, limit: float, applied: bool = False, unit: str = "N·m") -> str:
     """Why no candidate of ``head`` holds with actuators limited to ``limit``, or "".
 
-    ``applied``: the limit is the user's ``torque_limit``, not the effort limit.
+    ``applied``: the limit is the user's ``torque_limit``, not the effort
+    limit; ``unit``: :func:`effort_unit` of the hand's joints.
     """
     needed = [
         (c.torque_needed, c.torque_capacity)
         for c in head
         if not np.isnan(c.torque_needed)
     ]
+    one, _, other = unit.partition(" ")
     who = (
-        f"the hand at torque_limit {limit:.3g} N·m holds"
+        f"the hand at torque_limit {limit:.3g} {unit} holds"
         if applied
-        else f"the hand's actuators (effort limits from {limit:.3g} N·m) hold"
+        else f"the hand's actuators (effort limits from {limit:.3g} {unit}) hold"
     )
-    return _none_held(needed, limit, who, "best ", "N·m per joint", "torque_needed")
+    per_joint = f"{one} per joint {other}".rstrip()
+    return _none_held(needed, limit, who, "best ", per_joint, "torque_needed")
 
 
 def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:
@@ -703,14 +729,17 @@ def _none_held(
     )
 
 
-def _no_limit(plant, ranked: list, limit: float, needed: str, option: str) -> str:
+def _no_limit(
+    plant, ranked: list, limit: float, needed: str, option: str, unit: str
+) -> str:
     """Why the motors ranked nothing: no effort limit in the model; or "".
 
     Said when no finite limit is known and some of the candidates' joints
     have an actuator of infinite effort (Drake makes a missing ``<effort>``
     so), or none of them has an actuator at all; not when no candidate has
     a finite ``needed`` figure (a cloud planned without ``object_mass``),
-    which no limit would rank.
+    which no limit would rank.  ``unit``: the option's, as the advice
+    gives it.
     """
     if not ranked or math.isfinite(limit):
         return ""
@@ -733,13 +762,14 @@ def _no_limit(plant, ranked: list, limit: float, needed: str, option: str) -> st
             f"ranked by score alone: the model gives {listed} no actuator (a URDF "
             "joint gets one from a <transmission>), so nothing says which grasps "
             f"the motors hold, and a shake cannot squeeze; give them one, or pass "
-            f"{option}"
+            f"{option} ({unit})"
         )
     listed = ", ".join(repr(n) for n in unbounded)
     return (
         f"ranked by score alone: the actuators of {listed} have no effort "
         "limit in the model (Drake takes a missing <effort> as unbounded), so "
-        f"nothing says which grasps the motors hold; give them one, or pass {option}"
+        "nothing says which grasps the motors hold; give them one, or pass "
+        f"{option} ({unit})"
     )
 
 

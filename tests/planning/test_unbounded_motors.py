@@ -72,7 +72,7 @@ def test_the_command_line_names_its_option(tmp_path, capsys):
     assert main(["plan", "box", "--hand", hand, "--num", "30", "--top", "1"]) == 0
     out = capsys.readouterr().out
     assert "no effort limit in the model" in out
-    assert "or pass --squeeze-limit N" in out
+    assert "or pass --squeeze-limit LIMIT (N per finger)" in out
 
 
 def test_a_hand_without_actuators_is_said(tmp_path):
@@ -129,3 +129,66 @@ def test_a_cloud_without_a_mass_gets_no_advice_it_cannot_follow(tmp_path):
     assert len(result) > 0
     assert all(np.isnan(c.squeeze_needed) for c in result)
     assert "ranked by score alone" not in result.reason
+
+
+def test_the_advice_gives_the_unit_of_the_hands_joints(tmp_path, capsys):
+    from drakegrasp.cli import main
+
+    name, effort, obj = THREE
+    result = _plan(tmp_path, name, effort, "", obj)
+    assert result.reason.endswith("or pass torque_limit (N·m)"), result.reason
+    hand = _hand(tmp_path, name, effort, "")
+    argv = ["plan", "sphere", "--hand", hand, "--num", "40", "--top", "1"]
+    assert main(argv) == 0
+    assert "or pass --torque-limit LIMIT (N·m)" in capsys.readouterr().out
+
+
+def _three_finger_plant(tmp_path, prismatic: tuple[str, ...]):
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    text = (models_dir() / "hands" / "three_finger_hand.sdf").read_text()
+    for joint in prismatic:
+        old = f'<joint name="{joint}" type="revolute">'
+        assert old in text
+        text = text.replace(old, f'<joint name="{joint}" type="prismatic">')
+    plant = MultibodyPlant(0.0)
+    Parser(plant).AddModelsFromString(text, "sdf")
+    plant.Finalize()
+    return plant
+
+
+@pytest.mark.parametrize(
+    "prismatic, unit",
+    [
+        ((), "N·m"),
+        (("finger1_proximal_joint", "finger2_proximal_joint"), "N"),
+        (("finger1_proximal_joint",), "N·m (N at prismatic joints)"),
+    ],
+)
+def test_effort_unit_follows_the_joint_types(tmp_path, prismatic, unit):
+    from drakegrasp.planning.motors import effort_unit
+
+    plant = _three_finger_plant(tmp_path, prismatic)
+    joints = [
+        plant.get_joint(i).name()
+        for i in plant.GetJointIndices()
+        if plant.get_joint(i).name() in prismatic or not prismatic
+    ]
+    scoped = [f"three_finger_hand::{j}" for j in joints]
+    if prismatic and unit.startswith("N·m"):
+        scoped.append("three_finger_hand::finger2_proximal_joint")
+    assert effort_unit(plant, scoped) == unit
+
+
+def test_a_prismatic_hand_too_weak_is_told_in_newtons():
+    from types import SimpleNamespace
+
+    from drakegrasp.planning.motors import _too_weak
+
+    head = [SimpleNamespace(torque_needed=3.0, torque_capacity=1.0)]
+    text = _too_weak(head, 1.0, True, "N")
+    assert "torque_limit 1 N holds" in text and "3 N per joint" in text, text
+    assert "N·m" not in text
+    mixed = _too_weak(head, 1.0, False, "N·m (N at prismatic joints)")
+    assert "3 N·m per joint (N at prismatic joints)" in mixed, mixed
