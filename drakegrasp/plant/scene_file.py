@@ -466,9 +466,7 @@ def _check_pose(path: Path, loader, where: str, pose) -> None:
                 f"!AngleAxis angle_deg {value[0]} must be finite (degrees)",
             )  # fmt: skip
         if value is not None and abs(value[0]) > MAX_ANGLE_DEG:
-            refuse(
-                angle, "rotation", f"!AngleAxis angle_deg {value[0]} {_TOO_LARGE}"
-            )
+            refuse(angle, "rotation", f"!AngleAxis angle_deg {value[0]} {_TOO_LARGE}")
         axis = parts.get("axis")
         value = _numbers(loader, axis) if axis is not None else None
         if value is None:
