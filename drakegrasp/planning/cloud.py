@@ -1342,10 +1342,11 @@ class FittedCloud:
         t_out : (L,) float
             Minus the travel along ``−d_O`` (metres) at which each probe meets
             the surface; NaN where no facing point lies within
-            :data:`FACING_NEIGHBOURS` of it or its first meeting (with the
-            nearest facing point's quadric) is more than :data:`EDGE_LINES`
-            line radii from every point (the probe slid past the cloud's
-            edge).
+            :data:`FACING_NEIGHBOURS` of it, or where its first meeting
+            (with the nearest facing point's quadric) or its meeting with the
+            quadric of the point nearest that is more than
+            :data:`EDGE_LINES` line radii from every point (the probe slid
+            past the cloud's edge, or grazed a quadric far from its points).
         n_out : (L, 3) float
             Outward unit normal there, frame O.
         """
@@ -1371,6 +1372,11 @@ class FittedCloud:
         j = np.where(facing2, j2, j)
         t, normal = self._meet(p, d, j)
         found &= np.isfinite(t) & (gap <= EDGE_LINES * surf.line_radius)
+        # that quadric's meeting must be near the cloud too: a line grazing it
+        # (a box's edge) met it 4.7e26 m away
+        hit = p + np.where(found, t, 0.0)[:, None] * d
+        gap, _ = self.tree.query(np.where(np.isfinite(hit), hit, p))
+        found &= np.isfinite(hit).all(axis=1) & (gap <= EDGE_LINES * surf.line_radius)
         t_out[found] = -t[found]
         n_out[found] = normal[found]
         return np.full(L, np.nan), t_out, n_out

@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from drakegrasp.planning.cloud import (
+    EDGE_LINES,
     FIT_MIN_POINTS,
     CloudSurface,
     FittedCloud,
@@ -236,3 +238,35 @@ def test_repeated_points_do_not_shrink_the_spacing():
         origin=np.zeros(3),
     )
     assert half.spacing == surface.spacing
+
+
+def _box_surface(rng, n=6000, half=(0.025, 0.03, 0.05)):
+    """A box's faces sampled at random, as a CloudSurface (exact normals)."""
+    half = np.asarray(half)
+    axis = rng.integers(0, 3, n)
+    side = rng.choice([-1.0, 1.0], size=n)
+    p = rng.uniform(-1.0, 1.0, (n, 3))
+    p[np.arange(n), axis] = side
+    normals = np.zeros((n, 3))
+    normals[np.arange(n), axis] = side
+    return CloudSurface(p * half, normals, origin=np.zeros(3))
+
+
+def test_a_probe_grazing_a_quadric_at_an_edge_meets_only_near_the_cloud():
+    # A probe that ran along a box's face to its edge met the quadric of the
+    # point nearest its first meeting at -4.7e26 m: robustness then sent that
+    # contact to the engine, which refused the whole plan (the flat jaw on a
+    # box's cloud).  Every meeting must lie near the cloud's points.
+    rng = np.random.default_rng(1)
+    surface = _box_surface(rng)
+    fitted = FittedCloud(surface)
+    count = 20000
+    p = rng.uniform(-1.0, 1.0, (count, 3)) * np.array([0.035, 0.04, 0.06])
+    d = rng.normal(size=(count, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    _, t_out, _ = fitted.chord(p, -d)
+    met = np.isfinite(t_out)
+    assert met.sum() > count // 4
+    hit = p[met] + (-t_out[met])[:, None] * d[met]
+    gap, _ = cKDTree(surface.points).query(hit)
+    assert np.max(gap) <= EDGE_LINES * surface.line_radius * (1 + 1e-9)
