@@ -12,6 +12,7 @@ num_sampled``.
 from __future__ import annotations
 
 import json
+import math
 import reprlib
 import time
 from collections.abc import Sequence
@@ -27,7 +28,7 @@ from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array
-from drakegrasp.errors import InvalidGraspError
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.planning.needed import needed_text
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
@@ -162,6 +163,14 @@ class GraspCandidate:
         ``object_mass``, or the body's (NaN on a point cloud without one,
         and for a massless body).
         :func:`~drakegrasp.planning.shake.shake_test` shakes this mass.
+    held_joints : tuple of (str, float)
+        The hand's other one-dof joints, ``("model::joint", value)`` (metres
+        or radians), where the plan held them: the joints of the hand's
+        model instances that are not in ``joint_names`` (joints no motor
+        moves, which the planner keeps where the context puts them, and any
+        other it did not close).  :meth:`apply` sets them too, so that a
+        shake or an analysis starts from the hand that was planned; () for
+        a candidate built without them.
 
     Notes
     -----
@@ -200,6 +209,7 @@ class GraspCandidate:
     torque_scale: float = float("nan")
     torque_capacity: float = float("nan")
     object_mass: float = float("nan")
+    held_joints: tuple[tuple[str, float], ...] = ()
 
     def __getstate__(self) -> dict:
         # ``grasp`` (a cached_property, in __dict__ once read) is rebuilt from
@@ -253,18 +263,20 @@ class GraspCandidate:
             ``X_WH`` or ``X_WO`` is not what Drake can be given
             (:func:`check_candidate`); the context is unchanged.
         ModelError, InvalidOptionError
-            ``object_body`` is not a body of the plant.
+            ``object_body`` is not a body of the plant, or a joint of
+            ``joint_names`` or ``held_joints`` not a one-dof joint of it.
         """
         q_hand = check_candidate(self)
         ctx = plant_context_of(plant, context)
         if object_body is not None:
             object_body = resolve_object_body(plant, object_body)
         joints = [find_joint(plant, n) for n in self.joint_names]
+        held = _held_joints(plant, self.held_joints)
         base = resolve_body(plant, self.hand_base)
         if base.is_floating_base_body():  # else welded (at X_WH, the caller's word)
             plant.SetFreeBodyPose(ctx, base, self.X_WH)
         q_all = plant.GetPositions(ctx)
-        for j, q in zip(joints, q_hand, strict=True):  # one-dof joints
+        for j, q in [*zip(joints, q_hand, strict=True), *held]:  # one-dof joints
             q_all[j.position_start()] = q
         plant.SetPositions(ctx, q_all)
         if object_body is not None and object_body.is_floating_base_body():
@@ -313,6 +325,7 @@ class GraspCandidate:
             "torque_scale": jsonable(self.torque_scale),
             "torque_capacity": jsonable(self.torque_capacity),
             "object_mass": jsonable(self.object_mass),
+            "held_joints": {name: float(q) for name, q in self.held_joints},
         }
 
     def __str__(self) -> str:
@@ -345,6 +358,30 @@ class GraspCandidate:
         )
 
 
+def _held_joints(plant, held_joints) -> list:
+    """``(Joint, value)`` of a candidate's ``held_joints`` in ``plant``.
+
+    Raises
+    ------
+    ModelError
+        A name that is not a one-dof joint of ``plant``.
+    """
+    out = []
+    for name, q in held_joints:
+        try:
+            joint = find_joint(plant, name)
+        except InvalidOptionError:
+            joint = None
+        if joint is None or joint.num_positions() != 1:
+            raise ModelError(
+                f"the candidate's held joint {name!r} is not a one-dof joint of "
+                "this plant (held_joints records the hand's other joints as "
+                "planned): apply the candidate to the hand it was planned with"
+            )
+        out.append((joint, float(q)))
+    return out
+
+
 def check_candidate(candidate: GraspCandidate) -> np.ndarray:
     """Check what :meth:`GraspCandidate.apply` gives Drake; return ``q_hand``.
 
@@ -364,8 +401,9 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
     ------
     InvalidGraspError
         ``q_hand`` or ``closing_signs`` is not ``len(joint_names)`` finite real
-        numbers, or ``X_WH`` / ``X_WO`` is not a pydrake ``RigidTransform``
-        with a finite translation and a proper rotation
+        numbers, ``held_joints`` not (name, finite number) pairs, or
+        ``X_WH`` / ``X_WO`` is not a pydrake ``RigidTransform`` with a finite
+        translation and a proper rotation
         (:func:`~drakegrasp.plant.validation.check_rigid_transform`).
     """
     names = list(candidate.joint_names)
@@ -379,6 +417,23 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
                 f"numbers, one per closing joint {names}, got {reprlib.repr(value)}"
             )
         values[field_name] = a
+    held = candidate.held_joints
+    if not (
+        isinstance(held, tuple | list)
+        and all(
+            isinstance(pair, tuple | list)
+            and len(pair) == 2
+            and isinstance(pair[0], str)
+            and isinstance(pair[1], int | float | np.floating | np.integer)
+            and not isinstance(pair[1], bool)
+            and math.isfinite(pair[1])
+            for pair in held
+        )
+    ):
+        raise InvalidGraspError(
+            "the candidate's held_joints must be (joint name, finite number) "
+            f"pairs, got {reprlib.repr(held)}"
+        )
     for field_name in ("X_WH", "X_WO"):
         check_rigid_transform(
             f"the candidate's {field_name}",

@@ -49,6 +49,7 @@ from drakegrasp.core.validation import (
 )
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.candidates import (
+    GraspCandidate,
     GraspCandidates,
     closing_order,
     planning_result,
@@ -447,6 +448,7 @@ def plan_grasps(
     if contact_model == ContactModel.SOFT_FINGER.value and torsional_friction is None:
         raise missing_torsional_friction(InvalidOptionError)
     ctx = plant_context_of(plant, plant_context)
+    q_planned = plant.GetPositions(ctx).copy()  # the joints not closed stay here
     if (object_body is None) == (point_cloud is None):
         raise InvalidOptionError(
             "give the object either as object_body or as point_cloud= with "
@@ -479,13 +481,13 @@ def plan_grasps(
         if not hand_is_parallel_jaw(plant, ctx, body, hand):
             _jaw_only(squeeze_limit)
             mass = _mass_of(ctx, body, object_mass)
-            return _with_mass(mass, plan_multifinger(
+            return _finished(mass, plan_multifinger(
                 plant, ctx, body, hand=hand, n=n, mu=mu,
                 rng=np.random.default_rng(seed),
                 surface=object_surface(plant, ctx, body), settings=settings, t0=t0,
                 name=scoped_name(plant, body), certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY, **multi,
-            ))  # fmt: skip
+            ), plant, q_planned, body, hand)  # fmt: skip
         _multifinger_only(multi)
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
@@ -505,13 +507,13 @@ def plan_grasps(
             _jaw_only(squeeze_limit)
             mass = np.nan if object_mass is None else float(object_mass)
             settings.update(cloud_dropped=dropped)
-            return _with_mass(mass, plan_multifinger_cloud(
+            return _finished(mass, plan_multifinger_cloud(
                 plant, ctx, hand=hand, points=points, normals=normals,
                 viewpoint=viewpoint, n=n, mu=mu, rng=np.random.default_rng(seed),
                 settings=settings, t0=t0, certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY, complete=complete_unseen,
                 **multi,
-            ))  # fmt: skip
+            ), plant, q_planned, plant.world_body(), hand)  # fmt: skip
         _multifinger_only(multi)
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface, completion = cloud_surface(points, normals, viewpoint, complete_unseen)
@@ -588,15 +590,40 @@ def plan_grasps(
         started=t0,
     )
     result = with_squeeze_limit(result, plant, top=certify, squeeze_limit=squeeze_limit)
-    return replace(_with_mass(mass, result), time=time.perf_counter() - t0)
+    anchor = plant.world_body() if body is None else body
+    result = _finished(mass, result, plant, q_planned, anchor, hand)
+    return replace(result, time=time.perf_counter() - t0)
 
 
-def _with_mass(mass: float, result: GraspCandidates) -> GraspCandidates:
-    """``result`` whose candidates record the mass (kg) they were planned for."""
+def _finished(
+    mass: float, result: GraspCandidates, plant, q_planned, anchor, hand
+) -> GraspCandidates:
+    """``result`` whose candidates record their mass and the hand's held joints.
+
+    ``mass``: the kg planned for; ``q_planned``: the plant's positions when
+    the plan began (the planner keeps the joints it does not close there);
+    ``anchor``: the object body, or the world body on a cloud.
+    """
+    instances = {b.model_instance() for b in hand_bodies(plant, anchor, hand)}
+    joints = [
+        plant.get_joint(j) for i in sorted(instances) for j in plant.GetJointIndices(i)
+    ]
+    values = [
+        (scoped_name(plant, j), float(q_planned[j.position_start()]))
+        for j in joints
+        if j.num_positions() == 1
+    ]
+
+    def held(c: GraspCandidate) -> tuple[tuple[str, float], ...]:
+        closing = set(c.joint_names)
+        return tuple(pair for pair in values if pair[0] not in closing)
+
     mass = float(mass)
     return replace(
         result,
-        candidates=tuple(replace(c, object_mass=mass) for c in result.candidates),
+        candidates=tuple(
+            replace(c, object_mass=mass, held_joints=held(c)) for c in result.candidates
+        ),
     )
 
 

@@ -575,9 +575,7 @@ def _check_finger_gaps(plant, ctx, body, planned: list) -> None:
                 f"the candidate's finger {name} touched the object in the plan, "
                 f"but the shake's models put it {where} {_scoped(plant, body)} "
                 f"at the candidate's poses (beyond {bound * 1e3:.3g} mm): shake "
-                "it with the object it was planned on, and a hand whose joints "
-                "the candidate sets (a joint without a motor keeps its model's "
-                "default in the shake, not the value the plan held it at)"
+                "it with the object and the hand it was planned with"
             )
 
 

@@ -98,3 +98,70 @@ def test_a_joint_without_a_motor_that_others_follow_is_passive_with_them(tmp_pat
     assert [j.name() for j in found] == ["f1_proximal_joint", "f1_distal_joint"]
     with pytest.warns(PassiveJointWarning, match="f1_proximal_joint"):
         _plan(scene)
+
+
+@pytest.fixture(scope="module")
+def bent(tmp_path_factory):
+    """A plan of the hand whose f1 distal joint is passive, bent to 0.3 rad."""
+    scene = _scene(tmp_path_factory.mktemp("bent"), passive=True)
+    ctx = scene.plant.GetMyMutableContextFromRoot(scene.context)
+    scene.plant.GetJointByName("f1_distal_joint").set_angle(ctx, 0.3)
+    with pytest.warns(PassiveJointWarning):
+        result = plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=60, mu=0.5, seed=0, robustness_samples=4,
+        )  # fmt: skip
+    closure = [c for c in result if c.is_closure]
+    assert closure
+    return scene, closure[0]
+
+
+def test_a_candidate_records_the_joints_the_plan_held(bent):
+    scene, candidate = bent
+    held = dict(candidate.held_joints)
+    assert held == {"spread_hand::f1_distal_joint": 0.3}
+    assert not set(held) & set(candidate.joint_names)
+    assert candidate.to_dict()["held_joints"] == held
+    # a fresh context of the same models starts the joint at its default, 0
+    ctx = scene.plant.CreateDefaultContext()
+    candidate.apply(scene.plant, ctx)
+    assert scene.plant.GetJointByName("f1_distal_joint").get_angle(ctx) == 0.3
+
+
+def test_a_shake_starts_from_the_hand_that_was_planned(bent):
+    # the shake's own plant put the joint at its default (0): the finger that
+    # touched stood 4.07 mm off the cylinder and the shake was refused
+    from drakegrasp.planning import shake_test
+    from drakegrasp.planning.shake import FrictionMismatchWarning
+
+    scene, candidate = bent
+    fingers = {c.finger_body for c in candidate.contacts}
+    assert "spread_hand::f1_distal" in fingers
+    with pytest.warns(FrictionMismatchWarning):  # the plan's mu 0.5, Drake's 1
+        result = shake_test(
+            scene.add_models, candidate, squeeze=2.0, directions=[(0.0, 0.0, -1.0)]
+        )
+    assert len(result.seated_q_hand) == len(candidate.joint_names)  # it ran
+
+
+def test_held_joints_are_checked_before_drake_sees_them(bent):
+    import dataclasses
+    import pickle
+
+    from drakegrasp.errors import InvalidGraspError, ModelError
+
+    scene, candidate = bent
+    ctx = scene.plant.CreateDefaultContext()
+    for bad in ((("spread_hand::f1_distal_joint", float("nan")),), (("x", "1"),), 5):
+        edited = dataclasses.replace(candidate, held_joints=bad)
+        with pytest.raises(InvalidGraspError, match="held_joints"):
+            edited.apply(scene.plant, ctx)
+    other = dataclasses.replace(candidate, held_joints=(("spread_hand::nope", 0.1),))
+    with pytest.raises(ModelError, match="'spread_hand::nope' is not a one-dof"):
+        other.apply(scene.plant, ctx)
+    # a candidate pickled before the field existed reads as holding none
+    state = pickle.loads(pickle.dumps(candidate)).__dict__
+    state.pop("held_joints")
+    old = object.__new__(type(candidate))
+    old.__dict__.update(state)
+    assert old.held_joints == ()

@@ -31,7 +31,7 @@ def test_another_object_is_refused(box_candidate):
         "package://drakegrasp/objects/cylinder.sdf", hand_url=FLAT
     )
     with pytest.raises(
-        dg.ModelError, match="shake it with the object it was planned on"
+        dg.ModelError, match="shake it with the object and the hand it was planned with"
     ):
         dg.shake_test(
             cylinder.add_models, candidate, squeeze=10.0, directions=[(0.0, 0.0, -1.0)]
