@@ -93,6 +93,8 @@ from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
 from drakegrasp.planning.turned_gravity import GRAVITY
 from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.attachment import free_carrier, how_held
+from drakegrasp.plant.couplings import plant_couplings
+from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.mesh_convexity import warn_if_not_convex
 from drakegrasp.plant.validation import (
     HandSpec,
@@ -602,7 +604,8 @@ def _finished(
 
     ``mass``: the kg planned for; ``q_planned``: the plant's positions when
     the plan began (the planner keeps the joints it does not close there);
-    ``anchor``: the object body, or the world body on a cloud.
+    ``anchor``: the object body, or the world body on a cloud.  A joint that
+    a coupling ties to a closing joint moved with it: it is not held.
     """
     instances = {b.model_instance() for b in hand_bodies(plant, anchor, hand)}
     joints = [
@@ -614,9 +617,13 @@ def _finished(
         if j.num_positions() == 1
     ]
 
+    links = _coupling_links(plant)
+    moved: dict[tuple[str, ...], set[str]] = {}
+
     def held(c: GraspCandidate) -> tuple[tuple[str, float], ...]:
-        closing = set(c.joint_names)
-        return tuple(pair for pair in values if pair[0] not in closing)
+        if c.joint_names not in moved:  # the closing joints and their couplings'
+            moved[c.joint_names] = _linked(set(c.joint_names), links)
+        return tuple(pair for pair in values if pair[0] not in moved[c.joint_names])
 
     mass = float(mass)
     return replace(
@@ -625,6 +632,31 @@ def _finished(
             replace(c, object_mass=mass, held_joints=held(c)) for c in result.candidates
         ),
     )
+
+
+def _coupling_links(plant) -> dict[str, set[str]]:
+    """Each coupled joint's scoped name → the joints a coupling ties it to."""
+    try:
+        couplings = plant_couplings(plant)
+    except InvalidOptionError:  # couplings drakegrasp was not told of: none
+        return {}
+    links: dict[str, set[str]] = {}
+    for entry in couplings:
+        a, b = (scoped_name(plant, find_joint(plant, j)) for j in entry[:2])
+        links.setdefault(a, set()).add(b)
+        links.setdefault(b, set()).add(a)
+    return links
+
+
+def _linked(names: set[str], links: dict[str, set[str]]) -> set[str]:
+    """``names`` and every joint their couplings tie them to, however far."""
+    found, todo = set(names), list(names)
+    while todo:
+        for other in links.get(todo.pop(), ()):
+            if other not in found:
+                found.add(other)
+                todo.append(other)
+    return found
 
 
 def _graspable(plant, object_body, hand) -> RigidBody:

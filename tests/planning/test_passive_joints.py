@@ -165,3 +165,57 @@ def test_held_joints_are_checked_before_drake_sees_them(bent):
     old = object.__new__(type(candidate))
     old.__dict__.update(state)
     assert old.held_joints == ()
+
+
+DIAL = (
+    '<link name="dial"><inertial><mass value="0.01"/><inertia ixx="1e-6" '
+    'iyy="1e-6" izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    '<joint name="dial_joint" type="revolute"><parent link="palm"/><child '
+    'link="dial"/><origin xyz="0 0 -0.05"/><axis xyz="0 0 1"/><limit lower="-3" '
+    'upper="3" effort="1" velocity="1"/>{mimic}</joint>'
+)
+
+
+def _dial_jaw(tmp_path, mimic: str):
+    from coupled_hands import coupled_jaw_urdf
+
+    path = tmp_path / "jaw.urdf"
+    path.write_text(
+        coupled_jaw_urdf().replace("</robot>", DIAL.format(mimic=mimic) + "</robot>")
+    )
+    return planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(path))
+
+
+def test_a_free_joint_beside_a_jaw_is_held(tmp_path):
+    # a dial without collision geometry, no motor and no mimic: the jaw's
+    # planner leaves it where it was, and the candidates say so
+    scene = _dial_jaw(tmp_path, "")
+    ctx = scene.plant.GetMyMutableContextFromRoot(scene.context)
+    scene.plant.GetJointByName("dial_joint").set_angle(ctx, 1.25)
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=20, mu=0.5, seed=0, robustness_samples=4,
+    )  # fmt: skip
+    assert len(result) > 0
+    for candidate in result:
+        assert candidate.joint_names == (
+            "coupled_jaw::left_slide", "coupled_jaw::right_slide"
+        )  # fmt: skip
+        assert candidate.held_joints == (("coupled_jaw::dial_joint", 1.25),)
+
+
+def test_joints_a_coupling_ties_to_the_closing_ones_move_with_them(tmp_path):
+    # a dial turned by the leader's slide moves as the hand closes: its value
+    # at the plan's start is not the closed hand's, so it is never held
+    from drakegrasp.planning.planner import _coupling_links, _linked
+
+    mimic = '<mimic joint="left_slide" multiplier="10" offset="0"/>'
+    plant = _dial_jaw(tmp_path, mimic).plant
+    links = _coupling_links(plant)
+    tied = {"coupled_jaw::left_slide", "coupled_jaw::right_slide"}
+    assert _linked({"coupled_jaw::right_slide"}, links) == tied | {
+        "coupled_jaw::dial_joint"
+    }
+    assert _linked({"coupled_jaw::other"}, links) == {"coupled_jaw::other"}
+    free = _dial_jaw(tmp_path, "").plant
+    assert _linked({"coupled_jaw::left_slide"}, _coupling_links(free)) == tied
