@@ -936,8 +936,10 @@ def _maybe_inside(piece, q_G: np.ndarray) -> np.ndarray:
     relative 1e-9 of the coordinates and 1e-12 m) has no depth, so
     :func:`_depth_inside` (three chords per point) need not measure it.  The
     box test, then one matrix product against the faces, drop most of the
-    points of a piece's bounding ball; every depth kept is bitwise the same
-    (each is per point).  Other pieces' chords are closed-form: all rows.
+    points of a piece's bounding ball; the depths kept are those of the
+    whole ball (each is per point, up to the last bit BLAS may round a
+    product to in a batch of another size).  Other pieces' chords are
+    closed-form: all rows.
     """
     if piece.kind != "hull" or not len(q_G):
         return q_G
@@ -1100,7 +1102,8 @@ class CloudFingers:
         the capsule the piece can meet; the rest cannot change
         :meth:`_entry`'s answer, which is per point (a sphere's fit reads
         only points within ``lateral``), so leaving them out keeps every
-        figure bitwise and spares the chords of most of a dense cloud.  The
+        figure (up to the last bit BLAS may round a product to in a batch of
+        another size) and spares the chords of most of a dense cloud.  The
         test is loose by a relative 1e-9 and 1e-12 m, beyond round-off.
         """
         if not len(idx):

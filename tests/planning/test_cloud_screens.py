@@ -1,4 +1,4 @@
-"""The screens that spare a dense cloud's chords leave every answer bitwise.
+"""The screens that spare a dense cloud's chords leave every answer as it was.
 
 A jaw's closing measures, per finger piece, the cloud points of a ball that
 holds the piece's whole sweep, and the collision test every point of a hand
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from pydrake.geometry import Box, Convex
 from pydrake.math import RigidTransform, RollPitchYaw
@@ -90,6 +90,7 @@ def _pieces():
     rpy=st.tuples(*[st.floats(-3.2, 3.2)] * 3),
     spread=st.sampled_from([0.005, 0.03, 0.1]),
 )
+@example(seed=2423, rpy=(2.5, 2.25, -0.25), spread=0.1)  # an ulp apart alone
 def test_points_dropped_as_outside_have_no_depth(seed, rpy, spread):
     rng = np.random.default_rng(seed)
     R = RollPitchYaw(np.array(rpy)).ToRotationMatrix().matrix()
@@ -101,4 +102,8 @@ def test_points_dropped_as_outside_have_no_depth(seed, rpy, spread):
         kept_rows = {r.tobytes() for r in kept}
         dropped = np.array([r.tobytes() not in kept_rows for r in q])
         assert np.all(depth[dropped] < 0.0)
-        assert np.array_equal(cloud._depth_inside(piece, kept), depth[~dropped])
+        # the same depths: BLAS may round a product in a batch of another
+        # size by an ulp (one point alone, 0.00641811 either way, differed)
+        np.testing.assert_allclose(
+            cloud._depth_inside(piece, kept), depth[~dropped], rtol=1e-12, atol=1e-15
+        )
