@@ -944,7 +944,8 @@ def _maybe_inside(piece, q_G: np.ndarray) -> np.ndarray:
     if piece.kind != "hull" or not len(q_G):
         return q_G
     corners = piece.triangles.reshape(-1, 3)
-    slack = 1e-9 * (np.max(np.abs(corners)) + np.max(np.abs(q_G))) + 1e-12
+    size = np.max(np.abs(q_G), initial=0.0, where=np.isfinite(q_G))  # NaN: out
+    slack = 1e-9 * (np.max(np.abs(corners)) + size) + 1e-12
     lo, hi = corners.min(axis=0) - slack, corners.max(axis=0) + slack
     q_G = q_G[np.all((q_G >= lo) & (q_G <= hi), axis=1)]  # the hull's box first
     gap = piece.offsets[None, :] - q_G @ piece.normals.T  # (K, F), >= 0 inside
@@ -1396,11 +1397,13 @@ class FittedCloud:
         t_out : (L,) float
             Minus the travel along ``−d_O`` (metres) at which each probe meets
             the surface; NaN where no facing point lies within
-            :data:`FACING_NEIGHBOURS` of it, or where its first meeting
-            (with the nearest facing point's quadric) or its meeting with the
-            quadric of the point nearest that is more than
+            :data:`FACING_NEIGHBOURS` of it, where its first meeting (with
+            the nearest facing point's quadric) is more than
             :data:`EDGE_LINES` line radii from every point (the probe slid
-            past the cloud's edge, or grazed a quadric far from its points).
+            past the cloud's edge), or where its meeting with the quadric of
+            the facing point nearest that is farther from that point than
+            the radius the quadric was fitted in (:data:`FIT_RADIUS_LINES`
+            line radii: the line grazed it).
         n_out : (L, 3) float
             Outward unit normal there, frame O.
         """
@@ -1426,11 +1429,12 @@ class FittedCloud:
         j = np.where(facing2, j2, j)
         t, normal = self._meet(p, d, j)
         found &= np.isfinite(t) & (gap <= EDGE_LINES * surf.line_radius)
-        # that quadric's meeting must be near the cloud too: a line grazing it
-        # (a box's edge) met it 4.7e26 m away
+        # that quadric holds only within the radius it was fitted in, about
+        # its point: a line grazing it there (a box's edge) met it 4.7e26 m
+        # away, or 20 mm off the box where it ran on into the next face
         hit = p + np.where(found, t, 0.0)[:, None] * d
-        gap, _ = self.tree.query(np.where(np.isfinite(hit), hit, p))
-        found &= np.isfinite(hit).all(axis=1) & (gap <= EDGE_LINES * surf.line_radius)
+        off = np.linalg.norm(hit - surf.points[j], axis=1)
+        found &= np.isfinite(hit).all(axis=1) & (off <= self.fit)
         t_out[found] = -t[found]
         n_out[found] = normal[found]
         return np.full(L, np.nan), t_out, n_out

@@ -12,8 +12,8 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from drakegrasp.planning.cloud import (
-    EDGE_LINES,
     FIT_MIN_POINTS,
+    FIT_RADIUS_LINES,
     CloudSurface,
     FittedCloud,
     sphere_entry,
@@ -252,11 +252,20 @@ def _box_surface(rng, n=6000, half=(0.025, 0.03, 0.05)):
     return CloudSurface(p * half, normals, origin=np.zeros(3))
 
 
-def test_a_probe_grazing_a_quadric_at_an_edge_meets_only_near_the_cloud():
+def test_a_probe_grazing_a_quadric_at_an_edge_meets_only_near_the_cloud(monkeypatch):
     # A probe that ran along a box's face to its edge met the quadric of the
     # point nearest its first meeting at -4.7e26 m: robustness then sent that
     # contact to the engine, which refused the whole plan (the flat jaw on a
-    # box's cloud).  Every meeting must lie near the cloud's points.
+    # box's cloud).  Every meeting must lie on the patch its quadric was
+    # fitted to: within FIT_RADIUS_LINES line radii of that quadric's point.
+    met_with = {}
+    meet = FittedCloud._meet
+
+    def recorded(self, p, d, j):
+        met_with["j"] = j.copy()  # the last call is the meeting reported
+        return meet(self, p, d, j)
+
+    monkeypatch.setattr(FittedCloud, "_meet", recorded)
     rng = np.random.default_rng(1)
     surface = _box_surface(rng)
     fitted = FittedCloud(surface)
@@ -268,5 +277,9 @@ def test_a_probe_grazing_a_quadric_at_an_edge_meets_only_near_the_cloud():
     met = np.isfinite(t_out)
     assert met.sum() > count // 4
     hit = p[met] + (-t_out[met])[:, None] * d[met]
+    own = np.linalg.norm(hit - surface.points[met_with["j"][met]], axis=1)
+    # 0.81 m before; up to 68 mm with a first fix that asked
+    # only for some point within EDGE_LINES line radii of the meeting
+    assert np.max(own) <= FIT_RADIUS_LINES * surface.line_radius * (1 + 1e-9)
     gap, _ = cKDTree(surface.points).query(hit)
-    assert np.max(gap) <= EDGE_LINES * surface.line_radius * (1 + 1e-9)
+    assert np.max(gap) <= FIT_RADIUS_LINES * surface.line_radius * (1 + 1e-9)
