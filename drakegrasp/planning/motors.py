@@ -76,7 +76,7 @@ import math
 import time
 
 import numpy as np
-from pydrake.multibody.tree import JacobianWrtVariable, PrismaticJoint
+from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.solvers import MathematicalProgram
 from scipy.linalg import block_diag
 
@@ -92,7 +92,7 @@ from drakegrasp.planning.checks import checked_directions
 from drakegrasp.planning.needed import beyond_float_range, needed_for, needed_text
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
 from drakegrasp.plant.couplings import coupling_map, motor_shares, plant_couplings
-from drakegrasp.plant.fingers import find_joint
+from drakegrasp.plant.fingers import effort_unit, find_joint
 from drakegrasp.plant.jacobians import contact_rows, hand_jacobian
 from drakegrasp.plant.validation import (
     plant_context_of,
@@ -115,7 +115,6 @@ __all__ = [
     "TORQUE_CHECK",
     "check_squeeze_limit",
     "check_torque_limit",
-    "effort_unit",
     "finger_jacobian",
     "motor_limit",
     "torque_capacity",
@@ -455,7 +454,7 @@ def with_torques_needed(
     applied = torque_limit is not None and torque_limit < limit
     if applied:
         limit = torque_limit
-    unit = effort_unit(plant, ranked[0].joint_names) if ranked else "N·m"
+    unit = _unit_of_joints(plant, ranked[0].joint_names) if ranked else "N·m"
     reason = (
         result.reason
         or _too_weak(head, limit, applied, unit)
@@ -647,41 +646,38 @@ def motor_limit(plant, candidate: GraspCandidate, *, per_finger: bool = False) -
     return min(finite, default=math.inf)
 
 
-def effort_unit(plant, joint_names) -> str:
+def _unit_of_joints(plant, joint_names) -> str:
     """The unit of the efforts of ``joint_names``' motors, for the messages.
 
-    ``"N·m"`` when every joint turns (revolute), ``"N"`` when every one
-    slides (prismatic), and ``"N·m (N at prismatic joints)"`` for a hand with
-    both: ``torque_limit`` and ``torque_needed`` are per joint, in its own
-    unit.
+    ``"N·m"`` when every joint turns, ``"N"`` when every one slides, and
+    ``"N·m, N at prismatic joints"`` for a hand with both
+    (:func:`~drakegrasp.plant.fingers.effort_unit` of each):
+    ``torque_limit`` and ``torque_needed`` are per joint, in its own unit.
     """
-    kinds = {
-        "N" if isinstance(find_joint(plant, n), PrismaticJoint) else "N·m"
-        for n in joint_names
-    }
+    kinds = {effort_unit(find_joint(plant, n)) or "N·m" for n in joint_names}
     if kinds == {"N"}:
         return "N"
-    return "N·m (N at prismatic joints)" if kinds == {"N", "N·m"} else "N·m"
+    return "N·m, N at prismatic joints" if kinds == {"N", "N·m"} else "N·m"
 
 
 def _too_weak(head, limit: float, applied: bool = False, unit: str = "N·m") -> str:
     """Why no candidate of ``head`` holds with actuators limited to ``limit``, or "".
 
     ``applied``: the limit is the user's ``torque_limit``, not the effort
-    limit; ``unit``: :func:`effort_unit` of the hand's joints.
+    limit; ``unit``: :func:`_unit_of_joints` of the hand's joints.
     """
     needed = [
         (c.torque_needed, c.torque_capacity)
         for c in head
         if not np.isnan(c.torque_needed)
     ]
-    one, _, other = unit.partition(" ")
+    one, _, other = unit.partition(", ")
     who = (
         f"the hand at torque_limit {limit:.3g} {unit} holds"
         if applied
         else f"the hand's actuators (effort limits from {limit:.3g} {unit}) hold"
     )
-    per_joint = f"{one} per joint {other}".rstrip()
+    per_joint = f"{one} per joint, {other}" if other else f"{one} per joint"
     return _none_held(needed, limit, who, "best ", per_joint, "torque_needed")
 
 

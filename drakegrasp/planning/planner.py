@@ -737,8 +737,9 @@ def _jaw_only(squeeze_limit) -> None:
     if squeeze_limit is not None:
         raise InvalidOptionError(
             "squeeze_limit applies to parallel jaws (N per finger); a "
-            "multi-finger hand's fingers apply joint torques: give "
-            f"torque_limit (N·m per finger joint) instead (got {squeeze_limit!r})"
+            "multi-finger hand's fingers apply joint torques: give torque_limit "
+            "(N·m per finger joint, N at a prismatic one) instead (got "
+            f"{squeeze_limit!r})"
         )
 
 

@@ -76,7 +76,10 @@ def test_a_multi_finger_hand_refuses_the_squeeze_limit(capsys):
     ]
     assert main([*argv, "--num", "2", "--squeeze-limit", "5"]) == 1
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "give --torque-limit (N·m per finger joint)" in err[0]
+    assert (
+        len(err) == 1
+        and "give --torque-limit (N·m per finger joint, N at a prismatic one)" in err[0]
+    )
 
 
 def test_the_franka_alias_plans_with_its_pads(capsys, drake_models_dir, monkeypatch):

@@ -163,11 +163,11 @@ def _three_finger_plant(tmp_path, prismatic: tuple[str, ...]):
     [
         ((), "N·m"),
         (("finger1_proximal_joint", "finger2_proximal_joint"), "N"),
-        (("finger1_proximal_joint",), "N·m (N at prismatic joints)"),
+        (("finger1_proximal_joint",), "N·m, N at prismatic joints"),
     ],
 )
-def test_effort_unit_follows_the_joint_types(tmp_path, prismatic, unit):
-    from drakegrasp.planning.motors import effort_unit
+def test_the_unit_follows_the_joint_types(tmp_path, prismatic, unit):
+    from drakegrasp.planning.motors import _unit_of_joints
 
     plant = _three_finger_plant(tmp_path, prismatic)
     joints = [
@@ -178,7 +178,7 @@ def test_effort_unit_follows_the_joint_types(tmp_path, prismatic, unit):
     scoped = [f"three_finger_hand::{j}" for j in joints]
     if prismatic and unit.startswith("N·m"):
         scoped.append("three_finger_hand::finger2_proximal_joint")
-    assert effort_unit(plant, scoped) == unit
+    assert _unit_of_joints(plant, scoped) == unit
 
 
 def test_a_prismatic_hand_too_weak_is_told_in_newtons():
@@ -190,5 +190,6 @@ def test_a_prismatic_hand_too_weak_is_told_in_newtons():
     text = _too_weak(head, 1.0, True, "N")
     assert "torque_limit 1 N holds" in text and "3 N per joint" in text, text
     assert "N·m" not in text
-    mixed = _too_weak(head, 1.0, False, "N·m (N at prismatic joints)")
-    assert "3 N·m per joint (N at prismatic joints)" in mixed, mixed
+    mixed = _too_weak(head, 1.0, False, "N·m, N at prismatic joints")
+    assert "(effort limits from 1 N·m, N at prismatic joints) hold" in mixed
+    assert "3 N·m per joint, N at prismatic joints" in mixed, mixed
