@@ -376,10 +376,24 @@ def _held_joints(plant, held_joints) -> list:
             raise ModelError(
                 f"the candidate's held joint {name!r} is not a one-dof joint of "
                 "this plant (held_joints records the hand's other joints as "
-                "planned): apply the candidate to the hand it was planned with"
+                "planned): apply the candidate to the hand it was planned with, "
+                "or leave them as this plant has them: "
+                "dataclasses.replace(candidate, held_joints=())"
             )
         out.append((joint, float(q)))
     return out
+
+
+def _finite_number(value) -> bool:
+    """Whether ``value`` is a real, finite number (not a bool) a float holds."""
+    if isinstance(value, bool) or not isinstance(
+        value, int | float | np.floating | np.integer
+    ):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an int beyond a double
+        return False
 
 
 def check_candidate(candidate: GraspCandidate) -> np.ndarray:
@@ -401,7 +415,8 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
     ------
     InvalidGraspError
         ``q_hand`` or ``closing_signs`` is not ``len(joint_names)`` finite real
-        numbers, ``held_joints`` not (name, finite number) pairs, or
+        numbers, ``held_joints`` not (name, finite number) pairs or naming
+        a closing joint, or
         ``X_WH`` / ``X_WO`` is not a pydrake ``RigidTransform`` with a finite
         translation and a proper rotation
         (:func:`~drakegrasp.plant.validation.check_rigid_transform`).
@@ -424,15 +439,19 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
             isinstance(pair, tuple | list)
             and len(pair) == 2
             and isinstance(pair[0], str)
-            and isinstance(pair[1], int | float | np.floating | np.integer)
-            and not isinstance(pair[1], bool)
-            and math.isfinite(pair[1])
+            and _finite_number(pair[1])
             for pair in held
         )
     ):
         raise InvalidGraspError(
             "the candidate's held_joints must be (joint name, finite number) "
             f"pairs, got {reprlib.repr(held)}"
+        )
+    twice = sorted({name for name, _ in held} & set(names))
+    if twice:
+        raise InvalidGraspError(
+            f"the candidate's held_joints name closing joint(s) {twice}, whose "
+            "values are q_hand's: a joint is either closed or held"
         )
     for field_name in ("X_WH", "X_WO"):
         check_rigid_transform(

@@ -602,19 +602,20 @@ def _finished(
 ) -> GraspCandidates:
     """``result`` whose candidates record their mass and the hand's held joints.
 
+    The held joints are the one-dof joints that move a body of the hand
+    (:func:`~drakegrasp.plant.validation.hand_bodies`) and are not closed.
+
     ``mass``: the kg planned for; ``q_planned``: the plant's positions when
     the plan began (the planner keeps the joints it does not close there);
     ``anchor``: the object body, or the world body on a cloud.  A joint that
     a coupling ties to a closing joint moved with it: it is not held.
     """
-    instances = {b.model_instance() for b in hand_bodies(plant, anchor, hand)}
-    joints = [
-        plant.get_joint(j) for i in sorted(instances) for j in plant.GetJointIndices(i)
-    ]
+    bodies = {int(b.index()) for b in hand_bodies(plant, anchor, hand)}
+    joints = [plant.get_joint(j) for j in plant.GetJointIndices()]
     values = [
         (scoped_name(plant, j), float(q_planned[j.position_start()]))
         for j in joints
-        if j.num_positions() == 1
+        if j.num_positions() == 1 and int(j.child_body().index()) in bodies
     ]
 
     links = _coupling_links(plant)

@@ -107,3 +107,13 @@ def test_points_dropped_as_outside_have_no_depth(seed, rpy, spread):
         np.testing.assert_allclose(
             cloud._depth_inside(piece, kept), depth[~dropped], rtol=1e-12, atol=1e-15
         )
+
+
+def test_a_nan_point_does_not_blind_the_screen_to_the_deep_ones():
+    # the slack is sized from finite coordinates: a NaN one made it NaN,
+    # and every point was dropped, the deep ones too
+    box = _pieces()[0]  # points in its frame G, whose origin is its centre
+    q = np.array([[0.0, 0.0, 0.0], [0.001, 0.0, 0.0], [np.nan, 0.0, 0.0]])
+    kept = cloud._maybe_inside(box, q)
+    np.testing.assert_array_equal(kept, q[:2])
+    assert np.all(cloud._depth_inside(box, kept) > 0.0)

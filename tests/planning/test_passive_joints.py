@@ -152,13 +152,21 @@ def test_held_joints_are_checked_before_drake_sees_them(bent):
 
     scene, candidate = bent
     ctx = scene.plant.CreateDefaultContext()
-    for bad in ((("spread_hand::f1_distal_joint", float("nan")),), (("x", "1"),), 5):
+    for bad in (
+        (("spread_hand::f1_distal_joint", float("nan")),),
+        (("spread_hand::f1_distal_joint", 10**400),),  # an int beyond a double
+        (("x", "1"),),
+        (("x", True),),
+        5,
+        ((candidate.joint_names[0], 0.0),),  # q_hand's joint: closed or held
+    ):
         edited = dataclasses.replace(candidate, held_joints=bad)
         with pytest.raises(InvalidGraspError, match="held_joints"):
             edited.apply(scene.plant, ctx)
     other = dataclasses.replace(candidate, held_joints=(("spread_hand::nope", 0.1),))
     with pytest.raises(ModelError, match="'spread_hand::nope' is not a one-dof"):
         other.apply(scene.plant, ctx)
+    dataclasses.replace(other, held_joints=()).apply(scene.plant, ctx)  # the remedy
     # a candidate pickled before the field existed reads as holding none
     state = pickle.loads(pickle.dumps(candidate)).__dict__
     state.pop("held_joints")
