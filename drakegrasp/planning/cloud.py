@@ -58,6 +58,7 @@ from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
+    "CLOUD_SMALL_EXTENT",
     "CLOUD_UNITS_EXTENT",
     "MAX_COORDINATE",
     "CONTACT_BAND",
@@ -219,12 +220,22 @@ few metres long; in millimetres, anything more than 5 mm across exceeds 5
 every chord "wider than the stroke".  Only a warning: a long thin object is
 graspable across its thickness."""
 
+CLOUD_SMALL_EXTENT = 1e-3
+"""A cloud whose bounding box is less than this many metres long on its longest
+side gets a :class:`PointCloudWarning` that it may have been scaled twice.
+
+A robot hand's smallest objects (a bead, a screw's head) are a few millimetres
+across; a cloud in metres divided by 1000 once more reads the YCB sugar box
+as 0.19 mm, and the planner then rejects every pose ("no opposite surface":
+the cloud is a few distance tolerances across)."""
+
 
 class PointCloudWarning(UserWarning):
     """Planning went on with a point cloud that may not be what was meant.
 
     Points left out (not finite: a depth camera's missing depth), or an
-    extent too large for metres (:data:`CLOUD_UNITS_EXTENT`).  Silence it
+    extent too large for metres (:data:`CLOUD_UNITS_EXTENT`) or too small
+    for an object a hand grasps (:data:`CLOUD_SMALL_EXTENT`).  Silence it
     with ``warnings.simplefilter("ignore", PointCloudWarning)``.
     """
 
@@ -258,7 +269,8 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     -----
     PointCloudWarning
         When points that are not finite were left out (how many), or the
-        cloud is more than :data:`CLOUD_UNITS_EXTENT` across (millimetres?).
+        cloud is more than :data:`CLOUD_UNITS_EXTENT` across (millimetres?)
+        or less than :data:`CLOUD_SMALL_EXTENT` (scaled twice?).
     """
     return read_cloud_fit(point_cloud, normals, viewpoint=viewpoint)[:3]
 
@@ -365,7 +377,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
 
 
 def _warn_of(points: np.ndarray, total: int) -> None:
-    """Warn of the non-finite points left out and of an extent beyond metres."""
+    """Warn of the non-finite points left out and of an extent unlike metres."""
     left_out = total - len(points)
     if left_out:
         warnings.warn(
@@ -381,6 +393,15 @@ def _warn_of(points: np.ndarray, total: int) -> None:
             f"point_cloud is {extent:.4g} m across (its bounding box's longest side), "
             f"more than {CLOUD_UNITS_EXTENT:g} m: a cloud is in metres; if this "
             f"one is in millimetres, divide it by 1000 ({extent / 1000:.4g} m)",
+            PointCloudWarning,
+            stacklevel=4,
+        )
+    if extent < CLOUD_SMALL_EXTENT:
+        warnings.warn(
+            f"point_cloud is {extent * 1e3:.4g} mm across (its bounding box's "
+            f"longest side), less than {CLOUD_SMALL_EXTENT * 1e3:g} mm, smaller "
+            "than what a hand grasps: a cloud is in metres; if this one was "
+            f"divided by 1000 twice, multiply it by 1000 ({extent * 1e3:.4g} m)",
             PointCloudWarning,
             stacklevel=4,
         )

@@ -14,6 +14,7 @@ import pytest
 
 from drakegrasp.planning import plan_grasps, planning_scene
 from drakegrasp.planning.cloud import (
+    CLOUD_SMALL_EXTENT,
     CLOUD_UNITS_EXTENT,
     PointCloudWarning,
     read_cloud,
@@ -77,3 +78,23 @@ def test_planning_on_a_millimetre_cloud_says_why_it_is_empty():
     (units,) = [str(x.message) for x in w if "millimetres" in str(x.message)]
     assert units.startswith("point_cloud is 79.9")  # an 80 mm ball, sampled
     assert w[0].filename == __file__  # points at the caller's line
+
+
+def test_a_cloud_scaled_twice_gets_a_units_hint():
+    # a 10 um ball: every pose was rejected as "no opposite surface", unsaid why
+    scene = planning_scene(None, hand_url=OWN_HAND)
+    p, n = _ball(radius=5e-6)
+    with pytest.warns(PointCloudWarning, match="multiply it by 1000") as w:
+        result = plan_grasps(
+            scene.plant, scene.context, None, hand=scene.hand, num_candidates=10,
+            mu=0.5, seed=0, robustness_samples=2, point_cloud=p, cloud_normals=n,
+        )  # fmt: skip
+    assert len(result) == 0
+    (units,) = [str(x.message) for x in w if "multiply" in str(x.message)]
+    assert units.startswith("point_cloud is 0.00999")  # a 10 um ball, sampled
+    assert w[0].filename == __file__
+    # at the threshold's scale: 1 mm across is an object a hand may grasp
+    edge = CLOUD_SMALL_EXTENT / 2
+    box = np.array([[x, y, z] for x in (-edge, edge) for y in (-edge, edge)
+                    for z in (-edge, edge)])  # fmt: skip
+    _quietly(box * 1.001, box)
