@@ -699,3 +699,25 @@ def test_completion_can_be_turned_off(can, partial_result):
     assert partial_result.settings["unseen_completion"]["added"] > 0
     assert off.rejections["hand enters the unseen side"] > 0
     assert {c.sample for c in off} != {c.sample for c in partial_result}
+
+
+def test_a_contact_measured_on_surfels_finds_its_fan_on_a_sparse_cloud():
+    # A 200-point sphere: a contact's ψ, measured on the points' tangent discs
+    # (0.09 mm), was below the bound the screen took from the points alone
+    # (0.56 mm), so the fan's query measured nothing and the plan raised
+    # TypeError ('>=' between float and None); the screen now allows for the
+    # discs' radius.  Every seed of 12 failed with this noise.
+    scene = planning_scene(
+        None, hand_url="package://drakegrasp/hands/three_finger_hand.sdf"
+    )
+    rng = np.random.default_rng(0)
+    v = rng.normal(size=(200, 3))
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    result = plan_grasps(
+        scene.plant, scene.context, None, hand=scene.hand, num_candidates=60,
+        mu=0.5, seed=0, robustness_samples=8, point_cloud=0.03 * v,
+        cloud_normals=v, noise={"position": 1e-4},
+    )  # fmt: skip
+    assert len(result) > 0
+    for c in result:
+        assert np.isfinite([c.d_star, c.epsilon, c.robustness, c.score]).all()
