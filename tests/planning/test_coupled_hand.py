@@ -519,8 +519,13 @@ def test_a_one_motor_pinch_is_planned_on_a_point_cloud(pinch, pinch_file):
     result = _on_cloud(pinch[0], pinch_file)
     assert len(result) >= 5
     for candidate in result:
-        pads = {c.finger_body.split("::")[-1] for c in candidate.contacts}
-        assert pads == {"left_pad", "right_pad"}
+        bodies = {c.finger_body.split("::")[-1] for c in candidate.contacts}
+        # both pads; a knuckle too where it touches (sample 15's left one,
+        # 0.02 mm from the true box: missed while the cloud hand's screen
+        # left out the surfels' radius)
+        assert {"left_pad", "right_pad"} <= bodies <= {
+            "left_pad", "right_pad", "left_knuckle", "right_knuckle"
+        }  # fmt: skip
 
 
 def test_a_pinch_with_four_bar_links_is_planned_on_a_point_cloud(barred, tmp_path):
