@@ -291,10 +291,21 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
     """
     from pydrake.perception import PointCloud
 
+    source = "cloud_normals"  # where the normals came from, for the messages
     if isinstance(point_cloud, PointCloud):
         points = np.asarray(point_cloud.xyzs(), float).T.copy()
         if normals is None and point_cloud.has_normals():
             normals = np.asarray(point_cloud.normals(), float).T.copy()
+            source = "point_cloud's normals field"
+            if not np.isfinite(normals).all(axis=1).any():
+                warnings.warn(
+                    "point_cloud has a normals field with no finite normal "
+                    "(Drake fills a new field with NaN: never set?); estimating "
+                    "the normals from the points, as for a cloud without one",
+                    PointCloudWarning,
+                    stacklevel=3,
+                )
+                normals = None
     else:
         points = real_array("point_cloud", point_cloud, error=InvalidOptionError)
     if points.ndim != 2 or points.shape[1] != 3:
@@ -340,7 +351,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
             raise InvalidOptionError(
                 f"point_cloud has {len(points)} points of {total} with a finite "
                 f"normal: {bad_normals} of its {int(finite_points.sum())} finite "
-                "points have a cloud_normals row that is not finite; too few "
+                f"points have a {source} row that is not finite; too few "
                 "to grasp"
             )
         raise InvalidOptionError(

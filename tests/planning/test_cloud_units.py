@@ -12,6 +12,7 @@ import warnings
 import numpy as np
 import pytest
 
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning import plan_grasps, planning_scene
 from drakegrasp.planning.cloud import (
     CLOUD_SMALL_EXTENT,
@@ -98,3 +99,31 @@ def test_a_cloud_scaled_twice_gets_a_units_hint():
     box = np.array([[x, y, z] for x in (-edge, edge) for y in (-edge, edge)
                     for z in (-edge, edge)])  # fmt: skip
     _quietly(box * 1.001, box)
+
+
+def _drake_cloud(points, normals=None):
+    from pydrake.perception import BaseField, Fields, PointCloud
+
+    cloud = PointCloud(len(points), Fields(BaseField.kXYZs | BaseField.kNormals))
+    cloud.mutable_xyzs()[:] = points.T
+    if normals is not None:
+        cloud.mutable_normals()[:] = normals.T
+    return cloud
+
+
+def test_a_drake_cloud_whose_normals_were_never_filled_plans_on_estimated_ones():
+    # Drake fills a new normals field with NaN: every point was dropped and
+    # the message blamed "a cloud_normals row", an argument never given
+    p, n = _ball()
+    cloud = _drake_cloud(p)
+    with pytest.warns(PointCloudWarning, match="no finite normal"):
+        points, normals, dropped = read_cloud(cloud)
+    assert dropped == 0 and len(points) == len(p)
+    stored = _quietly(p.astype(np.float32).astype(float))  # Drake keeps float32
+    np.testing.assert_array_equal(points, stored[0])
+    np.testing.assert_array_equal(normals, stored[1])  # estimated alike
+    # some normals filled, the others NaN: the field is named, not the argument
+    some = n.copy()
+    some[2:] = np.nan
+    with pytest.raises(InvalidOptionError, match="a point_cloud's normals field row"):
+        read_cloud(_drake_cloud(p, some))
