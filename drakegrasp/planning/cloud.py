@@ -59,6 +59,7 @@ from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
     "CLOUD_SMALL_EXTENT",
+    "CLOUD_STRAY_RATIO",
     "CLOUD_UNITS_EXTENT",
     "MAX_COORDINATE",
     "CONTACT_BAND",
@@ -230,6 +231,19 @@ as 0.19 mm, and the planner then rejects every pose ("no opposite surface":
 the cloud is a few distance tolerances across)."""
 
 
+CLOUD_STRAY_RATIO = 1e3
+"""Most times its median point's distance from the cloud's centre (the median
+point) that its farthest point may lie.
+
+The cloud is the object: a stray point (a depth camera's spurious return)
+makes it as large as that point is far, and the planner's torque scale (the
+radius about the centre holding every point) with it.  A 2 mm cube's cloud
+with one point 30 m away had that scale at 30 m, 3e4 times its grasps' size,
+and the ranking was refused for a "characteristic length out of scale",
+which named an argument of the batch engine.  A rod, a plate or a one-sided
+view stays within a few times its median."""
+
+
 class PointCloudWarning(UserWarning):
     """Planning went on with a point cloud that may not be what was meant.
 
@@ -263,7 +277,9 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     Raises
     ------
     InvalidOptionError
-        An empty cloud, one with no finite point, or malformed arrays.
+        An empty cloud, one with no finite point, malformed arrays, or a
+        point more than :data:`CLOUD_STRAY_RATIO` times as far from the
+        cloud's centre as its median point (a stray point).
 
     Warns
     -----
@@ -364,6 +380,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
             f"({points[0].tolist()}): there is no surface to grasp"
         )
     _warn_of(points, total)
+    _refuse_strays(points)
     fit = None
     if normals is None:
         normals, fit = _estimate_normals(points)
@@ -385,6 +402,35 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
     flip = np.sum(normals * towards, axis=1) < 0
     normals[flip] *= -1
     return points, normals, total - len(points), fit
+
+
+def _refuse_strays(points: np.ndarray) -> None:
+    """Refuse a cloud whose farthest point makes it another object's size.
+
+    Raises
+    ------
+    InvalidOptionError
+        The farthest point from the median point is more than
+        :data:`CLOUD_STRAY_RATIO` times the median point's distance (of the
+        distinct points, :data:`DISTINCT` apart: a spot repeated many times
+        counts once).
+    """
+    # a spot seen many times counts once (within DISTINCT, as for the spacing)
+    _, keep = np.unique(np.round(points / DISTINCT), axis=0, return_index=True)
+    distinct = points[np.sort(keep)]
+    centre = np.median(distinct, axis=0)
+    r = np.linalg.norm(points - centre, axis=1)
+    typical = float(np.median(np.linalg.norm(distinct - centre, axis=1)))
+    far = int(np.argmax(r))
+    if typical > 0.0 and r[far] > CLOUD_STRAY_RATIO * typical:
+        stray = int(np.count_nonzero(r > CLOUD_STRAY_RATIO * typical))
+        raise InvalidOptionError(
+            f"point_cloud has {stray} point(s) more than {CLOUD_STRAY_RATIO:g} "
+            f"times as far from its centre as its median point ({typical:.3g} m): "
+            f"the farthest, {points[far].tolist()}, is {r[far]:.4g} m away; the "
+            "cloud is the object, so crop it to the object (a stray point, a "
+            "depth camera's spurious return, makes the object that large)"
+        )
 
 
 def _warn_of(points: np.ndarray, total: int) -> None:

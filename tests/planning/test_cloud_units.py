@@ -127,3 +127,26 @@ def test_a_drake_cloud_whose_normals_were_never_filled_plans_on_estimated_ones()
     some[2:] = np.nan
     with pytest.raises(InvalidOptionError, match="a point_cloud's normals field row"):
         read_cloud(_drake_cloud(p, some))
+
+
+def test_a_stray_point_far_away_is_refused_naming_it():
+    # a 2 mm cube's cloud and one point 30 m off: the torque scale became
+    # 30 m and the ranking was refused for "characteristic_lengths", an
+    # argument plan_grasps does not have
+    scene = planning_scene(None, hand_url=OWN_HAND)
+    p, n = _ball(radius=1e-3)
+    cloud = np.r_[p, [[30.0, 0.0, 0.0]]]
+    normals = np.r_[n, [[1.0, 0.0, 0.0]]]
+    with pytest.raises(InvalidOptionError, match=r"the farthest, \[30.0, 0.0, 0.0\]"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PointCloudWarning)  # 30 m across
+            plan_grasps(
+                scene.plant, scene.context, None, hand=scene.hand,
+                num_candidates=10, mu=0.5, seed=0, point_cloud=cloud,
+                cloud_normals=normals,
+            )  # fmt: skip
+    # a long rod (1 m by 2 mm) and a one-sided view are far from the bound
+    rod = np.c_[np.linspace(-0.5, 0.5, 2000), 1e-3 * _ball(2000)[0][:, :2]]
+    _quietly(rod)
+    half = p[p[:, 2] > 0]
+    _quietly(half, n[p[:, 2] > 0])
