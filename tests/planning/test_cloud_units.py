@@ -61,43 +61,42 @@ def test_a_cloud_in_millimetres_gets_a_units_hint():
         points, normals, _ = read_cloud(p, n)
     np.testing.assert_array_equal(points, p)  # read as given, only warned of
     # at the threshold's scale: 5 m across is still metres
-    edge = CLOUD_UNITS_EXTENT / 2
-    box = np.array([[x, y, z] for x in (-edge, edge) for y in (-edge, edge)
-                    for z in (-edge, edge)])  # fmt: skip
+    box = _cube(CLOUD_UNITS_EXTENT)
     _quietly(box * 0.999, box)
 
 
-def test_planning_on_a_millimetre_cloud_says_why_it_is_empty():
+def _cube(edge: float) -> np.ndarray:
+    """The 8 corners of a cube ``edge`` metres on a side, centred at 0."""
+    h = edge / 2
+    return np.array([[x, y, z] for x in (-h, h) for y in (-h, h) for z in (-h, h)])
+
+
+@pytest.mark.parametrize(
+    "radius, hint, starts",
+    [
+        (40.0, "millimetres, divide it by 1000", "point_cloud is 79.9"),
+        # a 10 um ball: every pose was "no opposite surface", unsaid why
+        (5e-6, "multiply it by 1000", "point_cloud is 0.00999"),
+    ],
+)
+def test_planning_on_a_cloud_of_the_wrong_units_says_why_it_is_empty(
+    radius, hint, starts
+):
     scene = planning_scene(None, hand_url=OWN_HAND)
-    p, n = _ball(radius=40.0)
-    with pytest.warns(PointCloudWarning, match="millimetres") as w:
+    p, n = _ball(radius=radius)
+    with pytest.warns(PointCloudWarning, match=hint) as w:
         result = plan_grasps(
             scene.plant, scene.context, None, hand=scene.hand, num_candidates=10,
             mu=0.5, seed=0, robustness_samples=2, point_cloud=p, cloud_normals=n,
         )  # fmt: skip
     assert len(result) == 0
-    (units,) = [str(x.message) for x in w if "millimetres" in str(x.message)]
-    assert units.startswith("point_cloud is 79.9")  # an 80 mm ball, sampled
+    (units,) = [str(x.message) for x in w if hint in str(x.message)]
+    assert units.startswith(starts)  # the ball's sampled extent
     assert w[0].filename == __file__  # points at the caller's line
 
 
-def test_a_cloud_scaled_twice_gets_a_units_hint():
-    # a 10 um ball: every pose was rejected as "no opposite surface", unsaid why
-    scene = planning_scene(None, hand_url=OWN_HAND)
-    p, n = _ball(radius=5e-6)
-    with pytest.warns(PointCloudWarning, match="multiply it by 1000") as w:
-        result = plan_grasps(
-            scene.plant, scene.context, None, hand=scene.hand, num_candidates=10,
-            mu=0.5, seed=0, robustness_samples=2, point_cloud=p, cloud_normals=n,
-        )  # fmt: skip
-    assert len(result) == 0
-    (units,) = [str(x.message) for x in w if "multiply" in str(x.message)]
-    assert units.startswith("point_cloud is 0.00999")  # a 10 um ball, sampled
-    assert w[0].filename == __file__
-    # at the threshold's scale: 1 mm across is an object a hand may grasp
-    edge = CLOUD_SMALL_EXTENT / 2
-    box = np.array([[x, y, z] for x in (-edge, edge) for y in (-edge, edge)
-                    for z in (-edge, edge)])  # fmt: skip
+def test_a_cloud_of_a_millimetre_is_an_object_a_hand_may_grasp():
+    box = _cube(CLOUD_SMALL_EXTENT)
     _quietly(box * 1.001, box)
 
 
