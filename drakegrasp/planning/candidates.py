@@ -27,7 +27,7 @@ from drakegrasp.closure.results import ClosureResult
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import real_array
+from drakegrasp.core.validation import real_array, real_scalar
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.planning.needed import needed_text
 from drakegrasp.plant.contacts import PlantContact
@@ -165,12 +165,13 @@ class GraspCandidate:
         :func:`~drakegrasp.planning.shake.shake_test` shakes this mass.
     held_joints : tuple of (str, float)
         The hand's other one-dof joints, ``("model::joint", value)`` (metres
-        or radians), where the plan held them: the joints of the hand's
-        model instances that are not in ``joint_names`` (joints no motor
-        moves, which the planner keeps where the context puts them, and any
-        other it did not close).  :meth:`apply` sets them too, so that a
-        shake or an analysis starts from the hand that was planned; () for
-        a candidate built without them.
+        or radians), where the plan held them: the joints that move a body
+        of the hand and are neither in ``joint_names`` nor tied to one of
+        those by a coupling (joints no motor moves, which the planner keeps
+        where the context puts them, and any other it did not close).
+        :meth:`apply` sets them too, so that a shake or an analysis starts
+        from the hand that was planned; () for a candidate built without
+        them.
 
     Notes
     -----
@@ -386,13 +387,9 @@ def _held_joints(plant, held_joints) -> list:
 
 def _finite_number(value) -> bool:
     """Whether ``value`` is a real, finite number (not a bool) a float holds."""
-    if isinstance(value, bool) or not isinstance(
-        value, int | float | np.floating | np.integer
-    ):
-        return False
     try:
-        return math.isfinite(value)
-    except OverflowError:  # an int beyond a double
+        return math.isfinite(real_scalar("value", value, error=InvalidGraspError))
+    except InvalidGraspError:  # not a real number, or an int beyond a double
         return False
 
 

@@ -415,9 +415,7 @@ def _refuse_strays(points: np.ndarray) -> None:
         distinct points, :data:`DISTINCT` apart: a spot repeated many times
         counts once).
     """
-    # a spot seen many times counts once (within DISTINCT, as for the spacing)
-    _, keep = np.unique(np.round(points / DISTINCT), axis=0, return_index=True)
-    distinct = points[np.sort(keep)]
+    distinct = _distinct(points)  # a spot seen many times counts once
     centre = np.median(distinct, axis=0)
     r = np.linalg.norm(points - centre, axis=1)
     typical = float(np.median(np.linalg.norm(distinct - centre, axis=1)))
@@ -821,6 +819,12 @@ DISTINCT = 1e-9
 """Points closer than this (m) are one point repeated, for the spacing."""
 
 
+def _distinct(points: np.ndarray) -> np.ndarray:
+    """``points`` taken once each, on a grid of :data:`DISTINCT`, in their order."""
+    _, keep = np.unique(np.round(points / DISTINCT), axis=0, return_index=True)
+    return points[np.sort(keep)]
+
+
 def _spacing(points: np.ndarray) -> float:
     """Median distance (m) from a point to its nearest distinct neighbour.
 
@@ -828,8 +832,7 @@ def _spacing(points: np.ndarray) -> float:
     one point: the points are taken once each (on a grid of
     :data:`DISTINCT`), then each one's nearest neighbour.
     """
-    _, keep = np.unique(np.round(points / DISTINCT), axis=0, return_index=True)
-    distinct = points[np.sort(keep)]
+    distinct = _distinct(points)
     if len(distinct) < 2:
         return 0.0
     return float(np.median(cKDTree(distinct).query(distinct, k=2)[0][:, 1]))

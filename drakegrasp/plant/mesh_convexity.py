@@ -141,7 +141,11 @@ def hull_share(shape: Shape) -> float | None:
     """
     if not isinstance(shape, Mesh):
         return None
-    key = _key(shape)
+    return _share(shape, _key(shape))
+
+
+def _share(shape: Mesh, key: tuple | None) -> float | None:
+    """:func:`hull_share` of a mesh whose cache key (:func:`_key`) is known."""
     if key is not None and key in _SHARES:
         return _SHARES[key]
     own = _own_volume(shape)
@@ -179,10 +183,12 @@ def warn_if_not_convex(
     stacklevel : int
         As for ``warnings.warn``, counted from the caller.
     """
-    share = hull_share(shape)
+    if not isinstance(shape, Mesh):
+        return
+    key = _key(shape)  # one stat of the file for the share and the once-only
+    share = _share(shape, key)
     if share is None or share >= NON_CONVEX_SHARE:
         return
-    key = _key(shape)
     if key is not None:
         if key in _WARNED:
             return
