@@ -77,6 +77,9 @@ __all__ = [
     "NORMAL_NEIGHBOURS",
     "NORMAL_OWN_FACTOR",
     "PAD_CONTACT_BAND",
+    "SPACING_DENSITY_FLOOR",
+    "SPACING_NEIGHBOURS",
+    "TWIN_RADIUS",
     "UNSEEN_DEPTH_ANGLE",
     "UNSEEN_WEAK",
     "CloudContact",
@@ -249,7 +252,9 @@ class PointCloudWarning(UserWarning):
 
     Points left out (not finite: a depth camera's missing depth), or an
     extent too large for metres (:data:`CLOUD_UNITS_EXTENT`) or too small
-    for an object a hand grasps (:data:`CLOUD_SMALL_EXTENT`).  Silence it
+    for an object a hand grasps (:data:`CLOUD_SMALL_EXTENT`), or points in
+    near twins (scans merged without downsampling: see
+    :data:`SPACING_DENSITY_FLOOR`).  Silence it
     with ``warnings.simplefilter("ignore", PointCloudWarning)``.
     """
 
@@ -818,6 +823,34 @@ def cloud_surface(points, normals, viewpoint=None, complete: bool = True):
 DISTINCT = 1e-9
 """Points closer than this (m) are one point repeated, for the spacing."""
 
+SPACING_NEIGHBOURS = 64
+"""Neighbours whose farthest sets a point's density spacing (see
+:data:`SPACING_DENSITY_FLOOR`)."""
+
+SPACING_DENSITY_FLOOR = 0.4
+"""The spacing is at least this many density spacings of the cloud's spots.
+
+A point's density spacing, ``sqrt(pi / k) r_k`` with ``r_k`` the distance to
+its ``k``-th neighbour (``k`` = :data:`SPACING_NEIGHBOURS`), is the side of
+the square it has on the surface; the cloud's is the median.  On a randomly
+sampled surface the median nearest-neighbour distance is 0.46-0.52 of it (on
+a grid, 1), so the floor leaves such clouds alone.
+
+Scans merged with a registration error of up to a fraction of their spacing
+see each spot several times: every point has near twins, and the nearest-
+neighbour median is the registration error.  The points within
+:data:`TWIN_RADIUS` density spacings of a point are one spot; with ``m`` the
+median count, a spot has ``m`` times a point's square, ``sqrt(m)`` times its
+side, and the floor is taken on that."""
+
+TWIN_RADIUS = 0.25
+"""Points this many density spacings apart are one spot seen twice (a
+randomly sampled surface has another point that near one point in five)."""
+
+_SPACING_QUERIES = 4096
+"""Points, evenly strided, whose density spacing and spot are measured (the
+median of 4,096 is within a few per cent of all of them)."""
+
 
 def _distinct(points: np.ndarray) -> np.ndarray:
     """``points`` taken once each, on a grid of :data:`DISTINCT`, in their order."""
@@ -825,17 +858,53 @@ def _distinct(points: np.ndarray) -> np.ndarray:
     return points[np.sort(keep)]
 
 
-def _spacing(points: np.ndarray) -> float:
-    """Median distance (m) from a point to its nearest distinct neighbour.
+def _spacings(points: np.ndarray) -> tuple[float, float, int]:
+    """A cloud's nearest-neighbour and spot spacings (m).
 
-    A point repeated (merged camera frames repeat the points they share) is
-    one point: the points are taken once each (on a grid of
-    :data:`DISTINCT`), then each one's nearest neighbour.
+    Returns
+    -------
+    nearest : float
+        The median distance from a point to its nearest distinct neighbour.
+        A point repeated (merged camera frames repeat the points they share)
+        is one point: the points are taken once each (on a grid of
+        :data:`DISTINCT`).  0 for a single point.
+    spots : float
+        The side of the square each spot has on the surface: the density
+        spacing times ``sqrt(seen)`` (see :data:`SPACING_DENSITY_FLOOR`).
+    seen : int
+        The median number of distinct points within :data:`TWIN_RADIUS`
+        density spacings of a point, itself included: 1 unless scans were
+        merged as they were.
     """
     distinct = _distinct(points)
     if len(distinct) < 2:
-        return 0.0
-    return float(np.median(cKDTree(distinct).query(distinct, k=2)[0][:, 1]))
+        return 0.0, 0.0, 1
+    tree = cKDTree(distinct)
+    nearest = float(np.median(tree.query(distinct, k=2)[0][:, 1]))
+    k = min(SPACING_NEIGHBOURS, len(distinct) - 1)
+    queries = distinct[:: max(1, len(distinct) // _SPACING_QUERIES)]
+    density = float(
+        np.sqrt(np.pi / k) * np.median(tree.query(queries, k=k + 1)[0][:, k])
+    )
+    near = tree.query_ball_point(queries, TWIN_RADIUS * density, return_length=True)
+    seen = max(1, int(np.median(near)))
+    return nearest, density * np.sqrt(seen), seen
+
+
+def _warn_of_twins(nearest: float, spots: float, seen: int) -> None:
+    """Warn that a cloud's points come in near twins (scans merged as they were)."""
+    warnings.warn(
+        f"point_cloud's points come in near twins (scans merged without "
+        f"downsampling?): a point has {seen} within "
+        f"{TWIN_RADIUS * spots / np.sqrt(seen) * 1e3:.3g} mm (median, itself "
+        f"included) and its nearest {nearest * 1e3:.3g} mm away; planning with "
+        f"a spacing of {SPACING_DENSITY_FLOOR * spots * 1e3:.3g} mm, from the "
+        f"density of these spots; downsample the merged cloud to plan faster, "
+        f"for instance with PointCloud.VoxelizedDownSample(voxel_size="
+        f"{spots / 2:.2g})",
+        PointCloudWarning,
+        stacklevel=5,
+    )
 
 
 class CloudSurface:
@@ -850,9 +919,11 @@ class CloudSurface:
         World frame, outward unit normals.
     line_radius : float, optional
         Points this close (m) to a grasp line are on it; default
-        :data:`LINE_RADIUS_SPACINGS` times the median distance from a point to
-        its nearest distinct neighbour (repeated points, as merged frames
-        give, do not count), at least 1 mm.
+        :data:`LINE_RADIUS_SPACINGS` times the cloud's spacing (the median
+        distance from a point to its nearest distinct neighbour, at least
+        :data:`SPACING_DENSITY_FLOOR` of the spacing its density gives, so
+        that repeated or nearly repeated points, as merged frames and scans
+        give, do not shrink it), at least 1 mm.
     viewpoint : (3,) float, optional
         The camera, world frame (a one-sided cloud).
     origin : (3,) float, optional
@@ -879,7 +950,10 @@ class CloudSurface:
         self.viewpoint = (
             None if viewpoint is None else np.asarray(viewpoint, float) - self.origin
         )
-        self.spacing = _spacing(self.points)
+        nearest, spots, seen = _spacings(self.points)
+        self.spacing = max(nearest, SPACING_DENSITY_FLOOR * spots)
+        if nearest < SPACING_DENSITY_FLOOR * spots:
+            _warn_of_twins(nearest, spots, seen)
         if line_radius is None:
             line_radius = max(LINE_RADIUS_SPACINGS * self.spacing, 1e-3)
         self.line_radius = float(line_radius)

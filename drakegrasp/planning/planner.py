@@ -310,7 +310,10 @@ def plan_grasps(
         normals; ``benchmarks/bench_cloud_size.py``).  A camera's cloud of
         several 100,000 points can be voxel-downsampled first
         (``PointCloud.VoxelizedDownSample``): the tests plan YCB objects from
-        3,000-20,000 points.
+        3,000-20,000 points.  So can scans merged as they are: each spot is
+        then seen several times, and the cloud is planned on the density of
+        its spots, with a ``PointCloudWarning``
+        (:data:`~drakegrasp.planning.cloud.SPACING_DENSITY_FLOOR`).
     cloud_normals : (M, 3) float, optional
         Outward normals of the cloud's points; default the cloud's own, else
         estimated from the flattest nearby patch, plane or quadric, grown with
