@@ -40,6 +40,7 @@ from drakegrasp.plant.validation import (
 )
 
 __all__ = [
+    "HELD_JOINT_COLUMN",
     "GraspCandidate",
     "GraspCandidates",
     "check_candidate",
@@ -47,6 +48,14 @@ __all__ = [
     "planning_result",
     "pose_dict",
 ]
+
+
+HELD_JOINT_COLUMN = "held_joints:"
+"""Prefix of :meth:`GraspCandidates.table`'s held-joint columns.
+
+One column per joint the candidates held, named this prefix and the joint's
+scoped name, ``"held_joints:model::joint"``: a name of ``held_joints``.
+"""
 
 
 def pose_dict(X: RigidTransform) -> dict:
@@ -171,7 +180,8 @@ class GraspCandidate:
         where the context puts them, and any other it did not close).
         :meth:`apply` sets them too, so that a shake or an analysis starts
         from the hand that was planned; () for a candidate built without
-        them.
+        them.  ``to_dict()`` has them, and :meth:`GraspCandidates.table` a
+        column for each (:data:`HELD_JOINT_COLUMN`).
 
     Notes
     -----
@@ -543,6 +553,17 @@ class GraspCandidates(Sequence):
         rows: ``p_WH`` is (0, 3), ``R_WH`` (0, 9) and ``q_hand`` (0, n_h), with
         n_h the closing joints of the hand in ``settings`` (0 if it names
         none).
+
+        The candidates' ``held_joints`` follow, one (n,) float column per
+        joint some candidate held, named :data:`HELD_JOINT_COLUMN` and the
+        joint's scoped name (``"held_joints:model::joint"``), in the order the
+        candidates list them: the joint's value as planned (metres or
+        radians), NaN in the row of a candidate that did not hold it.  Being
+        one-dimensional and named, they reach a file as they are (``plan
+        --out``, where ``p_WH`` becomes ``p_WH_0`` ... and ``q_hand``
+        ``q_hand_0`` ...).  A result whose candidates held no joint (each
+        joint of the hand closed, or tied to one by a coupling) has no such
+        column, nor has an empty result: no candidate names one.
         """
         rows = self.candidates
         n = len(rows)
@@ -568,6 +589,18 @@ class GraspCandidates(Sequence):
             "p_WH": column(lambda c: c.X_WH.translation()).reshape(n, 3),
             "R_WH": column(lambda c: c.X_WH.rotation().matrix()).reshape(n, 9),
             "q_hand": column(lambda c: c.q_hand).reshape(n, self._q_hand_width()),
+            **self._held_joint_columns(),
+        }
+
+    def _held_joint_columns(self) -> dict[str, np.ndarray]:
+        """``table``'s held-joint columns: each value, NaN where not held."""
+        held = [dict(c.held_joints) for c in self.candidates]
+        names = dict.fromkeys(name for row in held for name in row)  # first met
+        return {
+            HELD_JOINT_COLUMN + name: np.array(
+                [float(row.get(name, np.nan)) for row in held], dtype=float
+            )
+            for name in names
         }
 
     def _q_hand_width(self) -> int:

@@ -21,6 +21,7 @@ from drakegrasp.plant.validation import hand_bodies
 
 CYLINDER = "package://drakegrasp/objects/cylinder.sdf"
 MIMIC = '<mimic joint="f1_proximal_joint" multiplier="0.5" offset="0"/>'
+DISTAL = "spread_hand::f1_distal_joint"  # passive without the <mimic>
 
 
 def _scene(tmp_path, passive: bool):
@@ -101,7 +102,7 @@ def test_a_joint_without_a_motor_that_others_follow_is_passive_with_them(tmp_pat
 
 
 @pytest.fixture(scope="module")
-def bent(tmp_path_factory):
+def bent_plan(tmp_path_factory):
     """A plan of the hand whose f1 distal joint is passive, bent to 0.3 rad."""
     scene = _scene(tmp_path_factory.mktemp("bent"), passive=True)
     ctx = scene.plant.GetMyMutableContextFromRoot(scene.context)
@@ -111,6 +112,13 @@ def bent(tmp_path_factory):
             scene.plant, scene.context, scene.object_body, hand=scene.hand,
             num_candidates=60, mu=0.5, seed=0, robustness_samples=4,
         )  # fmt: skip
+    return scene, result
+
+
+@pytest.fixture(scope="module")
+def bent(bent_plan):
+    """The best force-closure candidate of that plan."""
+    scene, result = bent_plan
     closure = [c for c in result if c.is_closure]
     assert closure
     return scene, closure[0]
@@ -126,6 +134,84 @@ def test_a_candidate_records_the_joints_the_plan_held(bent):
     ctx = scene.plant.CreateDefaultContext()
     candidate.apply(scene.plant, ctx)
     assert scene.plant.GetJointByName("f1_distal_joint").get_angle(ctx) == 0.3
+
+
+COLUMNS = [
+    "rank_in_result", "sample", "score", "weight_capacity", "squeeze_needed",
+    "torque_needed", "torque_capacity", "epsilon", "robustness", "is_closure",
+    "d_star", "num_contacts", "opening", "p_WH", "R_WH", "q_hand",
+]  # fmt: skip
+"""``GraspCandidates.table()``'s columns for candidates that held no joint."""
+
+
+HELD = "held_joints:"  # a held joint's column: HELD + "model::joint"
+
+
+def _held_columns(table) -> dict:
+    """The held-joint columns of a table, by joint name."""
+    return {
+        name.removeprefix(HELD): values
+        for name, values in table.items()
+        if name.startswith(HELD)
+    }
+
+
+def test_the_table_has_a_column_for_each_held_joint(bent_plan):
+    # to_dict() had held_joints, table() (plan --out) did not: a file of the
+    # plan lost where the passive joint was held
+    import dataclasses
+
+    import numpy as np
+
+    _, result = bent_plan
+    table = result.table()
+    held = _held_columns(table)
+    assert list(table) == [*COLUMNS, HELD + DISTAL]
+    for k, candidate in enumerate(result):
+        row = {name: values[k] for name, values in held.items()}
+        assert row == dict(candidate.held_joints) == {DISTAL: 0.3}
+    from drakegrasp.planning.candidates import HELD_JOINT_COLUMN
+
+    assert HELD_JOINT_COLUMN == HELD
+    # a joint one candidate held and another did not: NaN in the other's row
+    first, second = result[0], result[1]
+    mixed = dataclasses.replace(
+        result,
+        candidates=(
+            dataclasses.replace(first, held_joints=(("spread_hand::a", 0.5),)),
+            dataclasses.replace(second, held_joints=(("spread_hand::b", -0.25),)),
+        ),
+    )
+    held = _held_columns(mixed.table())
+    assert list(held) == ["spread_hand::a", "spread_hand::b"]
+    assert held["spread_hand::a"].tolist()[0] == 0.5
+    assert held["spread_hand::b"].tolist()[1] == -0.25
+    assert np.isnan(held["spread_hand::a"][1]) and np.isnan(held["spread_hand::b"][0])
+    # none held: the table of before, no held-joint column
+    none = dataclasses.replace(
+        result,
+        candidates=tuple(dataclasses.replace(c, held_joints=()) for c in result),
+    )
+    assert list(none.table()) == COLUMNS
+
+
+def test_plan_out_writes_the_held_joints(tmp_path, capsys):
+    # the file has a column per held joint, named with the joint: a reader
+    # gets back each candidate's held_joints
+    pq = pytest.importorskip("pyarrow.parquet")
+    from drakegrasp.cli import main
+
+    _scene(tmp_path, passive=True)  # writes the hand's file
+    out = tmp_path / "plan.parquet"
+    argv = ["plan", "cylinder", "--hand", str(tmp_path / "hand_True.urdf")]
+    argv += ["--num", "20", "--preshape", "f1_distal_joint=0.3", "--out", str(out)]
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    assert DISTAL in captured.err  # the passive joint's warning
+    n = int(captured.out.split()[1])
+    assert n > 0
+    held = _held_columns(pq.read_table(out).to_pydict())
+    assert held == {DISTAL: [0.3] * n}
 
 
 def test_a_shake_starts_from_the_hand_that_was_planned(bent):
