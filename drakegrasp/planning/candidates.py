@@ -29,7 +29,7 @@ from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array, real_scalar
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
-from drakegrasp.planning.needed import needed_text
+from drakegrasp.planning.needed import needed_text, per_joint
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import (
@@ -142,8 +142,9 @@ class GraspCandidate:
         A multi-finger hand's pre-shape, from which ``close_hand`` closed it
         (None for a parallel jaw, whose pre-grasp is ``opening``).
     torque_needed : float
-        A multi-finger hand's torque (N·m) at every finger joint that holds
-        the object's weight in all the weight directions
+        A multi-finger hand's torque at every finger joint (in
+        ``torque_unit``: N·m, N at a prismatic joint) that holds the object's
+        weight in all the weight directions
         (:func:`~drakegrasp.planning.motors.torque_needed`; a lower bound for
         the planned contacts held still, an estimate of what a simulation
         needs: see there),
@@ -161,8 +162,9 @@ class GraspCandidate:
         characteristic length of ``grasp``; NaN for a candidate built without
         one (``grasp`` then takes the grasp's default).
     torque_capacity : float
-        Newtons of the object's weight held per N·m at every finger joint, in
-        the worst weight direction (``min_u β(u)`` of
+        Newtons of the object's weight held per N·m (per N at a prismatic
+        joint: ``torque_unit``) at every finger joint, in the worst weight
+        direction (``min_u β(u)`` of
         :func:`~drakegrasp.planning.motors.torque_capacity`), for the
         candidates that got a ``torque_needed``; 0: none holds it; NaN: not
         computed.
@@ -182,6 +184,12 @@ class GraspCandidate:
         from the hand that was planned; () for a candidate built without
         them.  ``to_dict()`` has them, and :meth:`GraspCandidates.table` a
         column for each (:data:`HELD_JOINT_COLUMN`).
+    torque_unit : str
+        The unit of ``torque_needed`` at the closing joints, from their kinds:
+        ``"N·m"`` when every one turns, ``"N"`` when every one slides
+        (prismatic), ``"N·m, N at prismatic joints"`` for a hand with both;
+        recorded with ``torque_needed`` (``"N·m"`` where none was, and for a
+        candidate built or pickled without it).
 
     Notes
     -----
@@ -221,6 +229,7 @@ class GraspCandidate:
     torque_capacity: float = float("nan")
     object_mass: float = float("nan")
     held_joints: tuple[tuple[str, float], ...] = ()
+    torque_unit: str = "N·m"
 
     def __getstate__(self) -> dict:
         # ``grasp`` (a cached_property, in __dict__ once read) is rebuilt from
@@ -337,6 +346,7 @@ class GraspCandidate:
             "torque_capacity": jsonable(self.torque_capacity),
             "object_mass": jsonable(self.object_mass),
             "held_joints": {name: float(q) for name, q in self.held_joints},
+            "torque_unit": self.torque_unit,
         }
 
     def __str__(self) -> str:
@@ -348,7 +358,7 @@ class GraspCandidate:
         )
         if not np.isnan(self.torque_needed):
             torque = needed_text(
-                self.torque_needed, self.torque_capacity, "N·m per joint"
+                self.torque_needed, self.torque_capacity, per_joint(self.torque_unit)
             )
             shape += f", torque {torque}"
         if np.isnan(self.weight_capacity):

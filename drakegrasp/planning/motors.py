@@ -89,7 +89,12 @@ from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.checks import checked_directions
-from drakegrasp.planning.needed import beyond_float_range, needed_for, needed_text
+from drakegrasp.planning.needed import (
+    beyond_float_range,
+    needed_for,
+    needed_text,
+    per_joint,
+)
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
 from drakegrasp.plant.couplings import coupling_map, motor_shares, plant_couplings
 from drakegrasp.plant.fingers import effort_unit, find_joint
@@ -400,6 +405,9 @@ def with_torques_needed(
 ) -> GraspCandidates:
     """``result`` with :func:`torque_needed` on its best candidates, re-ranked.
 
+    Each checked candidate records the unit of its figures too
+    (``torque_unit``: N·m, N where its closing joints slide).
+
     Parameters
     ----------
     result : GraspCandidates
@@ -446,7 +454,10 @@ def with_torques_needed(
 
     def with_torque(c: GraspCandidate) -> GraspCandidate:
         beta, needed = _torque_figures(plant, plant_context, c, object_body, weight)
-        return dataclasses.replace(c, torque_capacity=beta, torque_needed=needed)
+        unit = _unit_of_joints(plant, c.joint_names)  # what __str__ says it in
+        return dataclasses.replace(
+            c, torque_capacity=beta, torque_needed=needed, torque_unit=unit
+        )
 
     head = [with_torque(c) if c.is_closure else c for c in result.candidates[:n]]
     ranked = [*head, *result.candidates[n:]]
@@ -671,14 +682,12 @@ def _too_weak(head, limit: float, applied: bool = False, unit: str = "N·m") -> 
         for c in head
         if not np.isnan(c.torque_needed)
     ]
-    one, _, other = unit.partition(", ")
     who = (
         f"the hand at torque_limit {limit:.3g} {unit} holds"
         if applied
         else f"the hand's actuators (effort limits from {limit:.3g} {unit}) hold"
     )
-    per_joint = f"{one} per joint, {other}" if other else f"{one} per joint"
-    return _none_held(needed, limit, who, "best ", per_joint, "torque_needed")
+    return _none_held(needed, limit, who, "best ", per_joint(unit), "torque_needed")
 
 
 def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:

@@ -33,6 +33,7 @@ __all__ = [
     "beyond_float_range",
     "needed_for",
     "needed_text",
+    "per_joint",
 ]
 
 FLOAT_MAX = sys.float_info.max
@@ -147,3 +148,15 @@ def needed_text(needed: float, capacity: float, unit: str, spec: str = ".3g") ->
         raise InvalidOptionError(
             f"spec must be a float format such as '.3g', got {spec!r}"
         ) from None
+
+
+def per_joint(unit: str) -> str:
+    """A joint effort's ``unit`` as ``torque_needed``'s words: "N·m per joint".
+
+    ``unit`` is the unit of the efforts of a hand's closing joints: ``"N·m"``
+    (every joint turns), ``"N"`` (every one slides) or ``"N·m, N at prismatic
+    joints"`` (both; ``GraspCandidate.torque_unit``), which reads "N·m per
+    joint, N at prismatic joints".
+    """
+    one, _, other = unit.partition(", ")
+    return f"{one} per joint, {other}" if other else f"{one} per joint"

@@ -17,6 +17,7 @@ from drakegrasp.plant.models import models_dir
 BOX = "package://drakegrasp/objects/box.sdf"
 SPHERE = "package://drakegrasp/objects/sphere.sdf"
 FLAT = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
+THREE_FINGER = "package://drakegrasp/hands/three_finger_hand.sdf"
 
 
 def _hand(tmp_path, name: str, effort: str, replacement: str):
@@ -193,3 +194,77 @@ def test_a_prismatic_hand_too_weak_is_told_in_newtons():
     mixed = _too_weak(head, 1.0, False, "N·m, N at prismatic joints")
     assert "(effort limits from 1 N·m, N at prismatic joints) hold" in mixed
     assert "3 N·m per joint, N at prismatic joints" in mixed, mixed
+
+
+def _chuck_sdf() -> str:
+    """A three-jaw chuck: three capsule fingers 120° apart, each sliding 55 mm
+    towards the palm's axis on a prismatic joint with a 20 N motor."""
+    inertia = (
+        "<inertial><mass>0.05</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy>"
+        "<izz>1e-6</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>"
+    )
+    parts = []
+    for k in range(3):
+        a = 2 * np.pi * k / 3
+        parts.append(
+            f"<link name='f{k}'><pose>{0.065 * np.cos(a)} {0.065 * np.sin(a)} 0 0 "
+            f"0 {a}</pose>{inertia}<collision name='c'><pose>0 0 0.045 0 0 0</pose>"
+            "<geometry><capsule><radius>0.008</radius><length>0.06</length>"
+            "</capsule></geometry></collision></link>"
+            f"<joint name='f{k}_slide' type='prismatic'><parent>palm</parent>"
+            f"<child>f{k}</child><axis><xyz>-1 0 0</xyz><limit><lower>0</lower>"
+            "<upper>0.055</upper><effort>20</effort></limit></axis></joint>"
+        )
+    return (
+        '<?xml version="1.0"?><sdf version="1.9"><model name="chuck">'
+        f"<link name='palm'>{inertia}<collision name='c'><pose>0 0 -0.01 0 0 0"
+        "</pose><geometry><cylinder><radius>0.08</radius><length>0.02</length>"
+        "</cylinder></geometry></collision></link>" + "".join(parts) + "</model></sdf>"
+    )
+
+
+def test_a_sliding_hands_torque_needed_is_printed_in_newtons(tmp_path):
+    # the plan's head said "torque_needed <= 20 N (effort limit)" and each
+    # candidate below it "torque 1.18 N·m per joint"
+    import dataclasses
+    import pickle
+
+    path = tmp_path / "chuck.sdf"
+    path.write_text(_chuck_sdf())
+    scene = planning_scene(SPHERE, hand_url=str(path))
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=20, mu=0.5, seed=0, robustness_samples=2,
+    )  # fmt: skip
+    assert "<= 20 N (effort limit)" in str(result)
+    checked = [c for c in result if np.isfinite(c.torque_needed)]
+    assert checked
+    for c in checked:
+        assert f", torque {c.torque_needed:.3g} N per joint, p_WH" in str(c), str(c)
+        assert "N·m" not in str(c)
+        assert c.torque_unit == "N" and c.to_dict()["torque_unit"] == "N"
+    c = checked[0]
+    mixed = dataclasses.replace(c, torque_unit="N·m, N at prismatic joints")
+    words = f"torque {c.torque_needed:.3g} N·m per joint, N at prismatic joints, "
+    assert words in str(mixed)
+    # a turning hand's words as before; a candidate pickled before the unit
+    # was recorded reads as one
+    turning = dataclasses.replace(c, torque_unit="N·m")
+    assert f", torque {c.torque_needed:.3g} N·m per joint, p_WH" in str(turning)
+    state = pickle.loads(pickle.dumps(turning)).__dict__
+    state.pop("torque_unit")
+    old = object.__new__(type(c))
+    old.__dict__.update(state)
+    assert old.torque_unit == "N·m" and str(old) == str(turning)
+
+
+def test_a_turning_hand_records_newton_metres():
+    scene = planning_scene(SPHERE, hand_url=THREE_FINGER)
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=20, mu=0.5, seed=0, robustness_samples=2,
+    )  # fmt: skip
+    checked = [c for c in result if np.isfinite(c.torque_needed)]
+    assert checked
+    assert {c.torque_unit for c in checked} == {"N·m"}
+    assert all(" N·m per joint, p_WH" in str(c) for c in checked)
