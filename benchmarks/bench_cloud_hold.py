@@ -112,6 +112,21 @@ def noisy(points, view, sigma):
     return points + rng.normal(0.0, sigma, len(points))[:, None] * ray
 
 
+def camera_density(points, normals, view, seed=0):
+    """The points a depth camera at ``view`` would keep: as many per area as it sees.
+
+    A camera's pixels sample a face seen near or head-on more densely than
+    one seen far or obliquely: ``cos θ / r²`` points per area (θ between the
+    normal and the line of sight, ``r`` the distance).  Each point is kept
+    with that density over the largest (seeded), from an area-uniform sample.
+    """
+    eye = np.asarray(view, float) - points
+    r = np.linalg.norm(eye, axis=1)
+    density = np.maximum(np.sum(normals * eye, axis=1), 0.0) / r**3
+    keep = np.random.default_rng(seed).random(len(points)) < density / density.max()
+    return points[keep], normals[keep]
+
+
 def _describe(c, s) -> str:
     fingers = Counter(k.finger_body.split("::")[-1] for k in c.contacts)
     fans = sum(getattr(k, "fan", None) is not None for k in c.contacts)

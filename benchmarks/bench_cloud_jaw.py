@@ -5,7 +5,7 @@ Usage::
     python benchmarks/bench_cloud_jaw.py [--objects NAME ...]
         [--views full side oblique] [--num 600] [--points 3000] [--top 10]
         [--random 10] [--seed 0] [--margin 1.2] [--firm 5] [--noise MM]
-        [--verbose]
+        [--camera] [--verbose]
 
 The parallel-jaw cloud route of :func:`drakegrasp.plan_grasps` (Drake's WSG-50,
 free base, μ = 1, the models' friction) on clouds sampled from each object's
@@ -18,6 +18,11 @@ object's mass:
   head-on: its depth is unknown, and nothing is planned, with the reason);
 * **oblique**: the points a camera at ``(0.4, 0.25, 0.3)`` m sees (three faces
   of a box).
+
+``--camera`` thins a one-sided cloud to the density a depth camera samples it
+with (``cos θ / r²`` points per area: faces seen near or head-on crowd;
+``bench_cloud_hold.camera_density``); ``--points`` is then the area-uniform
+sample it thins (12,000 leave about 3,000 of a box seen obliquely).
 
 One-sided clouds are planned with ``viewpoint=`` the camera: the unseen side is
 completed by point symmetry and O sits at the centre of symmetry.  For each
@@ -45,9 +50,15 @@ import numpy as np
 from drakegrasp.planning import planning_scene, shake_test
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_cloud_hold import noisy, plan_cloud, sample_cloud  # noqa: E402  (the same clouds)
+from bench_cloud_hold import (  # noqa: E402  (the same clouds)
+    camera_density,
+    noisy,
+    plan_cloud,
+    sample_cloud,
+)
 from bench_plan import YCB, drake_models  # noqa: E402  (the same local copy)
 
+CAMERA_NOTE = ", thinned to a depth camera's density"
 VIEWS = {"full": None, "side": (0.5, 0.0, 0.0), "oblique": (0.4, 0.25, 0.3)}
 
 
@@ -75,6 +86,11 @@ def main(argv=None) -> int:
         help="depth noise, mm (σ along each point's line of sight; normals "
         "then estimated from the points, as read_cloud does)",
     )
+    parser.add_argument(
+        "--camera",
+        action="store_true",
+        help="thin one-sided clouds to a depth camera's density (cos θ / r²)",
+    )
     parser.add_argument("--verbose", action="store_true")
     args = parser.parse_args(argv)
     models = drake_models()
@@ -84,7 +100,8 @@ def main(argv=None) -> int:
     hand = planning_scene(None, models_dir=models)
     print(
         f"load {os.getloadavg()[0]:.2f}; WSG-50 on point clouds, {args.points} "
-        f"points, {args.num} samples, seed {args.seed}"
+        f"points{CAMERA_NOTE if args.camera else ''}, "
+        f"{args.num} samples, seed {args.seed}"
     )
     print(
         f"{'object':<20} {'view':<8} {'points':>6} {'cands':>6} {'FC':>4}"
@@ -101,6 +118,8 @@ def main(argv=None) -> int:
         for view_name in args.views:
             view = VIEWS[view_name]
             p, nrm = sample_cloud(full, args.points, 0, view)
+            if args.camera and view is not None:
+                p, nrm = camera_density(p, nrm, view)
             if args.noise > 0:
                 p, nrm = noisy(p, view, args.noise * 1e-3), None
             result, plan_s = plan_cloud(
