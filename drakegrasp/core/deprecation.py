@@ -19,7 +19,7 @@ from typing import TypeVar
 
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["keyword_only", "renamed_keyword", "warn_deprecated"]
+__all__ = ["keyword_only", "outside_stacklevel", "renamed_keyword", "warn_deprecated"]
 
 F = TypeVar("F", bound=Callable)
 
@@ -35,12 +35,24 @@ def warn_deprecated(message: str, *, stacklevel: int | None = 3) -> None:
     on is not where the old spelling was written).
     """
     if stacklevel is None:
-        stacklevel = 2
-        frame = sys._getframe(1)
-        while frame is not None and _inside(frame.f_globals.get("__name__", "")):
-            frame = frame.f_back
-            stacklevel += 1
+        stacklevel = outside_stacklevel()
     warnings.warn(message, DeprecationWarning, stacklevel=stacklevel)
+
+
+def outside_stacklevel() -> int:
+    """``warnings.warn``'s ``stacklevel`` for the user's line, from the caller.
+
+    Called by the function that calls ``warnings.warn``: the level of the
+    first frame outside drakegrasp and ``dataclasses``, however deep in the
+    library the warning was raised (a ``plan_grasps`` call and a direct
+    call of the class that warns point at the user's own line alike).
+    """
+    stacklevel = 1
+    frame = sys._getframe(1)
+    while frame is not None and _inside(frame.f_globals.get("__name__", "")):
+        frame = frame.f_back
+        stacklevel += 1
+    return stacklevel
 
 
 def _inside(module: str) -> bool:

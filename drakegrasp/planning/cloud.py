@@ -50,6 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
+from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import real_array, unit_vectors
 from drakegrasp.errors import InvalidOptionError
@@ -83,7 +84,9 @@ __all__ = [
     "PAD_CONTACT_BAND",
     "SPACING_DENSITY_FLOOR",
     "SPACING_NEIGHBOURS",
+    "TWIN_MIN_POINTS",
     "TWIN_RADIUS",
+    "TWIN_TIGHT",
     "UNSEEN_DEPTH_ANGLE",
     "UNSEEN_WEAK",
     "CloudContact",
@@ -905,24 +908,36 @@ SPACING_NEIGHBOURS = 64
 :data:`SPACING_DENSITY_FLOOR`)."""
 
 SPACING_DENSITY_FLOOR = 0.4
-"""The spacing is at least this many density spacings of the cloud's spots.
+"""The spacing of scans merged as they were, in spot spacings.
 
 A point's density spacing, ``sqrt(pi / k) r_k`` with ``r_k`` the distance to
 its ``k``-th neighbour (``k`` = :data:`SPACING_NEIGHBOURS`), is the side of
 the square it has on the surface; the cloud's is the median.  On a randomly
 sampled surface the median nearest-neighbour distance is 0.46-0.52 of it (on
-a grid, 1), so the floor leaves such clouds alone.
+a grid, 1).
 
 Scans merged with a registration error of up to a fraction of their spacing
 see each spot several times: every point has near twins, and the nearest-
 neighbour median is the registration error.  The points within
 :data:`TWIN_RADIUS` density spacings of a point are one spot; with ``m`` the
 median count, a spot has ``m`` times a point's square, ``sqrt(m)`` times its
-side, and the floor is taken on that."""
+side, and such a cloud's spacing is this fraction of a spot's side (about 0.8
+of one scan's nearest-neighbour median).  Other clouds keep that median."""
 
 TWIN_RADIUS = 0.25
 """Points this many density spacings apart are one spot seen twice (a
 randomly sampled surface has another point that near one point in five)."""
+
+TWIN_TIGHT = 0.75
+"""Near twins lie this close: a point's nearest (the median) within this
+fraction of :data:`TWIN_RADIUS`.  Scans merged 0.01-0.1 mm apart put it at
+0.05-0.5 of it; a single scan with a dense patch that happens to put a second
+point in the radius, at 0.8-1."""
+
+TWIN_MIN_POINTS = 4 * SPACING_NEIGHBOURS
+"""Fewest distinct points for near twins to be told: in a smaller cloud the
+:data:`SPACING_NEIGHBOURS`-th neighbour lies across the object, and its
+spots are no spots (a 58-point face read as twins of three)."""
 
 _SPACING_QUERIES = 4096
 """Points, evenly strided, whose density spacing and spot are measured (the
@@ -965,13 +980,39 @@ def _spacings(points: np.ndarray) -> tuple[float, float, int]:
     )
     near = tree.query_ball_point(queries, TWIN_RADIUS * density, return_length=True)
     seen = max(1, int(np.median(near)))
+    if len(distinct) < TWIN_MIN_POINTS:  # k reaches across the object: no spots
+        seen = 1
     return nearest, density * np.sqrt(seen), seen
 
 
-def _spacing(points: np.ndarray) -> float:
-    """A cloud's spacing (m) as :class:`CloudSurface` takes it (:func:`_spacings`)."""
-    nearest, spots, _ = _spacings(points)
-    return max(nearest, SPACING_DENSITY_FLOOR * spots)
+def _twinned(nearest: float, spots: float, seen: int) -> bool:
+    """Whether a cloud's points come in near twins: scans merged as they were.
+
+    Each spot holds two or more points (``seen``, the median), a point's
+    nearest lies well inside its spot (:data:`TWIN_TIGHT`), and the
+    nearest-neighbour median is below the floor the spots give.  A single
+    scan, however sparse or uneven (whose spots hold one point each), is
+    not: its spacing is its nearest-neighbour median.
+    """
+    twin_radius = TWIN_RADIUS * spots / np.sqrt(seen)
+    return (
+        seen >= 2
+        and nearest <= TWIN_TIGHT * twin_radius
+        and nearest < SPACING_DENSITY_FLOOR * spots
+    )
+
+
+def _spacing(points: np.ndarray, parts=None) -> float:
+    """A cloud's spacing (m) as :class:`CloudSurface` takes it.
+
+    The median distance from a point to its nearest distinct neighbour, or
+    for near twins (:func:`_twinned`) :data:`SPACING_DENSITY_FLOOR` spot
+    spacings; ``parts``: :func:`_spacings`' answer, if already at hand.
+    """
+    nearest, spots, seen = _spacings(points) if parts is None else parts
+    if _twinned(nearest, spots, seen):
+        return SPACING_DENSITY_FLOOR * spots
+    return nearest
 
 
 def _warn_of_twins(nearest: float, spots: float, seen: int) -> None:
@@ -984,9 +1025,9 @@ def _warn_of_twins(nearest: float, spots: float, seen: int) -> None:
         f"a spacing of {SPACING_DENSITY_FLOOR * spots * 1e3:.3g} mm, from the "
         f"density of these spots; downsample the merged cloud to plan faster, "
         f"for instance with PointCloud.VoxelizedDownSample(voxel_size="
-        f"{spots / 2:.2g})",
+        f"{spots:.2g}), a spot's side",
         PointCloudWarning,
-        stacklevel=5,
+        stacklevel=outside_stacklevel(),
     )
 
 
@@ -1003,10 +1044,9 @@ class CloudSurface:
     line_radius : float, optional
         Points this close (m) to a grasp line are on it; default
         :data:`LINE_RADIUS_SPACINGS` times the cloud's spacing (the median
-        distance from a point to its nearest distinct neighbour, at least
-        :data:`SPACING_DENSITY_FLOOR` of the spacing its density gives, so
-        that repeated or nearly repeated points, as merged frames and scans
-        give, do not shrink it), at least 1 mm.
+        distance from a point to its nearest distinct neighbour; for near
+        twins, as scans merged as they were give,
+        :data:`SPACING_DENSITY_FLOOR` of a spot's side), at least 1 mm.
     viewpoint : (3,) float, optional
         The camera, world frame (a one-sided cloud).
     origin : (3,) float, optional
@@ -1017,6 +1057,14 @@ class CloudSurface:
 
     Attributes
     ----------
+    spacing : float
+        The gap between neighbouring points on the surface, metres: the
+        median distance from a point to its nearest distinct one, or for
+        scans merged as they were :data:`SPACING_DENSITY_FLOOR` spot spacings.
+    seen : int
+        Points per spot: 1, or for scans merged as they were the median
+        count of a spot's near twins; point-count thresholds
+        (:data:`FIT_MIN_POINTS`, :data:`FIT_NEIGHBOURS`) are multiplied by it.
     centroid : (3,) float
         The points' mean, world frame.
     origin : (3,) float
@@ -1034,8 +1082,9 @@ class CloudSurface:
             None if viewpoint is None else np.asarray(viewpoint, float) - self.origin
         )
         nearest, spots, seen = _spacings(self.points)
-        self.spacing = max(nearest, SPACING_DENSITY_FLOOR * spots)
-        if nearest < SPACING_DENSITY_FLOOR * spots:
+        self.seen = seen if _twinned(nearest, spots, seen) else 1
+        self.spacing = _spacing(self.points, (nearest, spots, seen))
+        if self.seen > 1:
             _warn_of_twins(nearest, spots, seen)
         if line_radius is None:
             line_radius = max(LINE_RADIUS_SPACINGS * self.spacing, 1e-3)
@@ -1363,8 +1412,9 @@ class CloudFingers:
         if piece.kind == "ellipsoid" and np.ptp(piece.semi_axes) == 0:
             n_G = self.surface.normals[idx] @ R  # the points' normals, frame G
             return sphere_entry(
-                piece.semi_axes[0], q_G, u_G, n_G, self.surface.line_radius
-            )
+                piece.semi_axes[0], q_G, u_G, n_G, self.surface.line_radius,
+                FIT_MIN_POINTS * self.surface.seen,
+            )  # fmt: skip
         return piece.chord(q_G, np.tile(u_G, (len(q_G), 1)))[0]
 
     def contacts(self, travel_hits) -> list[CloudContact] | None:
@@ -1437,7 +1487,12 @@ touch of a fitted surface is sought."""
 
 
 def sphere_entry(
-    r: float, q_G: np.ndarray, u_G: np.ndarray, n_G: np.ndarray, line_radius: float
+    r: float,
+    q_G: np.ndarray,
+    u_G: np.ndarray,
+    n_G: np.ndarray,
+    line_radius: float,
+    min_points: int = FIT_MIN_POINTS,
 ) -> np.ndarray:
     """Travel at which a sphere first meets the surface that points sample.
 
@@ -1451,6 +1506,11 @@ def sphere_entry(
         Their outward unit normals, frame G.
     line_radius : float
         Points within ``r + line_radius`` of the centre's line count.
+    min_points : int, optional
+        Fewest points of the face for the fit: :data:`FIT_MIN_POINTS`, times
+        the points a spot holds in scans merged as they were
+        (``CloudSurface.seen``), whose twins would let two spots pass for
+        eight points.
 
     Returns
     -------
@@ -1469,7 +1529,7 @@ def sphere_entry(
         already behind the centre by more than ``r``.  Points of another face
         (an edge's, the far side's, one passed) keep their own travel
         ``s − sqrt(max(r² − δ², 0))`` (``δ`` their distance from the line), as
-        do faces with fewer than :data:`FIT_MIN_POINTS` points.
+        do faces with fewer than ``min_points`` points.
     """
     s = -(q_G @ u_G)  # travel to the centre's closest approach
     lateral = q_G + s[:, None] * u_G
@@ -1486,7 +1546,7 @@ def sphere_entry(
         & (n_G @ n_G[first] >= FIT_FACE_COS)
         & (np.abs(s - s[first]) <= fit)  # the same sheet: slopes up to 45°
     )
-    if np.count_nonzero(face) < FIT_MIN_POINTS:
+    if np.count_nonzero(face) < min_points:
         return t
     e1, e2 = _basis_across(u_G[None, :])
     x, y = lateral[face] @ e1[0], lateral[face] @ e2[0]
@@ -1557,7 +1617,8 @@ class FittedCloud:
     def _fit(self, rows: np.ndarray) -> np.ndarray:
         points, normals = self.surface.points, self.surface.normals
         fit, L = self.fit, len(rows)
-        k = min(FIT_NEIGHBOURS, len(points))  # bounded memory however dense
+        seen = self.surface.seen  # points per spot: merged scans' twins
+        k = min(FIT_NEIGHBOURS * seen, len(points))  # bounded however dense
         dist, idx = self.tree.query(points[rows], k=k, distance_upper_bound=fit)
         dist, idx = dist.reshape(L, k), idx.reshape(L, k)
         valid = np.isfinite(dist)
@@ -1574,7 +1635,7 @@ class FittedCloud:
         AtA = np.einsum("lw,lwi,lwj->lij", weight, A, A)
         Atb = np.einsum("lw,lwi,lw->li", weight, A, z)
         eig = np.linalg.eigvalsh(AtA)
-        ok = (face.sum(axis=1) >= FIT_MIN_POINTS) & (
+        ok = (face.sum(axis=1) >= FIT_MIN_POINTS * seen) & (
             eig[:, 0] > 1e-9 * np.maximum(eig[:, -1], 1e-300)
         )
         coef = np.zeros((L, 6))

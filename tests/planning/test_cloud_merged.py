@@ -160,3 +160,88 @@ def test_two_scans_of_the_sugar_box_plan_like_one(drake_models_dir):
     assert len(merged) >= 0.8 * len(single)
     assert sum(c.is_closure for c in merged) >= 0.8 * sum(c.is_closure for c in single)
     assert merged.rejections.get("no opposite surface", 0) <= 5
+
+
+def _dense_spot() -> np.ndarray:
+    """A box's cloud with 2,200 more points in a 2 mm spot on its +x face."""
+    spot = np.random.default_rng(7).normal(0.0, 2e-3, (2200, 3))
+    spot[:, 0] = 0.025
+    return np.vstack([_box(3000, 6), spot])
+
+
+def _off_the_object(full, candidate) -> float:
+    """How far (m) the farther finger of ``candidate`` stands off the true object."""
+    plant, ctx = full.plant, full.context.Clone()
+    candidate.apply(plant, ctx)
+    query = plant.get_geometry_query_input_port().Eval(plant.GetMyContextFromRoot(ctx))
+    mine = set(plant.GetCollisionGeometriesForBody(full.object_body))
+    gaps = {}
+    for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.05):
+        for a, b in ((pair.id_A, pair.id_B), (pair.id_B, pair.id_A)):
+            if a in mine and b not in mine:
+                body = plant.GetBodyFromFrameId(query.inspector().GetFrameId(b))
+                gaps[body.name()] = min(gaps.get(body.name(), np.inf), pair.distance)
+    return max(gaps.get("left_finger", np.inf), gaps.get("right_finger", np.inf))
+
+
+@pytest.mark.parametrize("name", ["005_tomato_soup_can", "004_sugar_box"])
+def test_merged_scans_put_the_fingertips_on_the_object(drake_models_dir, name):
+    # the WSG-50's 1 mm tips meet a quadric fitted to the face's points; twins
+    # let 2-4 spots pass for the 8 points of a fit, which then bulged, and
+    # force-closure candidates stood 2-4.5 mm off the true object (4 scans
+    # 0.1 mm apart: up to 4.9 mm); a fit now needs 8 spots' worth of points
+    full = planning_scene(
+        f"package://drake_models/ycb/{name}.sdf", models_dir=drake_models_dir
+    )
+    hand = planning_scene(None, models_dir=drake_models_dir)
+    p, n = sample_cloud(full, 3000, 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PointCloudWarning)
+        result = plan_grasps(
+            hand.plant, hand.context, None, hand=hand.hand, num_candidates=100,
+            mu=0.5, seed=0, robustness_samples=4,
+            point_cloud=_merged(p, 4, 1e-4), cloud_normals=np.tile(n, (4, 1)),
+        )  # fmt: skip
+    closure = [c for c in result if c.is_closure]
+    assert len(closure) >= 20
+    off = [_off_the_object(full, c) for c in closure]
+    assert max(off) < 1.5e-3, sorted(off)[-3:]
+
+
+@pytest.mark.parametrize(
+    "points",
+    [
+        pytest.param(_box(58, 4), id="58 points"),
+        pytest.param(_box(150, 5), id="150 points"),
+        pytest.param(np.c_[np.arange(100) * 1e-3, np.zeros((100, 2))], id="a line"),
+        pytest.param(_dense_spot(), id="a dense spot"),
+    ],
+)
+def test_a_sparse_or_uneven_single_scan_is_not_taken_for_twins(points):
+    # a small cloud's 64th neighbour lies across the object (a 58-point face
+    # read as "twins of three", its line radius 53 mm against 10 mm); a
+    # dense spot puts a second point in the twin radius now and then
+    normals = np.tile([1.0, 0.0, 0.0], (len(points), 1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PointCloudWarning)
+        surface = CloudSurface(points, normals, origin=np.zeros(3))
+    distinct = np.unique(points, axis=0)
+    nearest = np.median(cKDTree(distinct).query(distinct, k=2)[0][:, 1])
+    assert surface.spacing == nearest
+    assert surface.seen == 1
+
+
+def test_the_twin_warning_names_the_callers_line():
+    # the warning is raised deep in the planner; it names the user's call,
+    # whichever route (jaw, multi-finger, the class itself) raised it
+    points = _merged(_box(3000, 0), 3, 1e-5)
+    with pytest.warns(PointCloudWarning, match="near twins") as caught:
+        _surface(points)
+    assert caught[0].filename == __file__
+    scene = planning_scene(None, hand_url=JAW)
+    with pytest.warns(PointCloudWarning, match="near twins") as caught:
+        plan_grasps(
+            scene.plant, scene.context, None, hand=scene.hand, num_candidates=5,
+            mu=0.5, seed=0, robustness_samples=0, point_cloud=points,
+        )  # fmt: skip
+    assert {w.filename for w in caught if "near twins" in str(w.message)} == {__file__}
