@@ -56,3 +56,19 @@ def fingerless_scene(tmp_path):
         "</geometry></collision></link></model></sdf>"
     )
     return planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(paddle))
+
+
+@pytest.fixture
+def hand_file_scene(tmp_path):
+    """A planning scene of an object and a hand written to a file from its text.
+
+    ``make(object_url, text, name="hand.sdf")``: the hand's model file (SDF or
+    URDF, by ``name``'s suffix) holds ``text``.
+    """
+
+    def make(object_url, text: str, name: str = "hand.sdf"):
+        path = tmp_path / name
+        path.write_text(text)
+        return planning_scene(object_url, hand_url=str(path))
+
+    return make

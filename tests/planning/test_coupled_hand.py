@@ -537,13 +537,11 @@ def test_a_pinch_with_four_bar_links_is_planned_on_a_point_cloud(barred, tmp_pat
     assert result.rejections.get("one finger touches", 0) <= len(result)
 
 
-def test_a_hand_with_a_coupled_spread_closes_all_its_fingers(tmp_path):
+def test_a_hand_with_a_coupled_spread_closes_all_its_fingers(hand_file_scene):
     # f1 and f2 share a spread motor; each has its own flexion motor.  Before,
     # the group stopped when one of them touched: no candidate touched with
     # all three fingers, and none was force closure on the cylinder.
-    path = tmp_path / "spread_hand.urdf"
-    path.write_text(spread_hand_urdf())
-    scene = planning_scene(CYLINDER, hand_url=str(path))
+    scene = hand_file_scene(CYLINDER, spread_hand_urdf(), "spread_hand.urdf")
     result = plan_grasps(
         scene.plant, scene.context, scene.object_body, hand=scene.hand,
         num_candidates=60, mu=0.5, seed=0, robustness_samples=8,

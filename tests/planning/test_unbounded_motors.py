@@ -223,19 +223,22 @@ def _chuck_sdf() -> str:
     )
 
 
-def test_a_sliding_hands_torque_needed_is_printed_in_newtons(tmp_path):
+def _chuck_plan(hand_file_scene):
+    """The three-jaw chuck's plan on the sphere (20 samples, seed 0)."""
+    scene = hand_file_scene(SPHERE, _chuck_sdf(), "chuck.sdf")
+    return plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=20, mu=0.5, seed=0, robustness_samples=2,
+    )  # fmt: skip
+
+
+def test_a_sliding_hands_torque_needed_is_printed_in_newtons(hand_file_scene):
     # the plan's head said "torque_needed <= 20 N (effort limit)" and each
     # candidate below it "torque 1.18 N·m per joint"
     import dataclasses
     import pickle
 
-    path = tmp_path / "chuck.sdf"
-    path.write_text(_chuck_sdf())
-    scene = planning_scene(SPHERE, hand_url=str(path))
-    result = plan_grasps(
-        scene.plant, scene.context, scene.object_body, hand=scene.hand,
-        num_candidates=20, mu=0.5, seed=0, robustness_samples=2,
-    )  # fmt: skip
+    result = _chuck_plan(hand_file_scene)
     assert "<= 20 N (effort limit)" in str(result)
     checked = [c for c in result if np.isfinite(c.torque_needed)]
     assert checked
