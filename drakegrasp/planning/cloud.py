@@ -739,7 +739,7 @@ def complete_unseen(points, normals, viewpoint):
     box, a bottle's body, a ball), so its unseen surface is the seen one
     reflected through ``c``: points ``2c − p`` with normals ``−n``.  ``c`` is
     the point nearest, in least squares, to every normal line ``p + t n``,
-    each point weighted by its share ``a_i`` of the surface (:func:`_areas`):
+    each point weighted by its share ``a_i`` of the surface (:data:`AREA_NEIGHBOURS`):
 
     .. math::
 
@@ -794,8 +794,8 @@ def complete_unseen(points, normals, viewpoint):
 
 AREA_NEIGHBOURS = 8
 """A point's raw share of the surface is the square of the distance to this
-neighbour on its own face (:func:`_areas`; :func:`complete_unseen` weighs each
-point by its share)."""
+neighbour on its own face (:func:`complete_unseen` weighs each point by its
+share)."""
 
 AREA_SMOOTHING = 16
 """A point's share of the surface is the median of the raw shares of the
