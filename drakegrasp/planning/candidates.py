@@ -358,7 +358,9 @@ class GraspCandidate:
         )
         if not np.isnan(self.torque_needed):
             torque = needed_text(
-                self.torque_needed, self.torque_capacity, per_joint(self.torque_unit)
+                self.torque_needed,
+                self.torque_capacity,
+                per_joint(str(self.torque_unit)),
             )
             shape += f", torque {torque}"
         if np.isnan(self.weight_capacity):

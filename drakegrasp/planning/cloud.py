@@ -769,8 +769,25 @@ def complete_unseen(points, normals, viewpoint):
     info : dict
         ``centre`` (3,) world frame or None, ``added`` K, and ``skipped``: the
         reason it was skipped, or None.
+
+    Raises
+    ------
+    InvalidOptionError
+        Points and normals not both (M, 3), finite, with M >= 3.
     """
-    points, normals = np.asarray(points, float), np.asarray(normals, float)
+    points = real_array("points", points, error=InvalidOptionError)
+    normals = real_array("normals", normals, error=InvalidOptionError)
+    if (
+        points.ndim != 2
+        or points.shape[1:] != (3,)
+        or normals.shape != points.shape
+        or len(points) < 3
+        or not (np.all(np.isfinite(points)) and np.all(np.isfinite(normals)))
+    ):
+        raise InvalidOptionError(
+            f"complete_unseen needs (M, 3) finite points and normals, M >= 3, got "
+            f"shapes {points.shape} and {normals.shape}"
+        )
     w = _areas(points, normals)
     w = w / w.sum()
     mean = w @ points
@@ -816,46 +833,85 @@ missing, so its raw share is about double: it is left out of the medians."""
 _AREA_CANDIDATES = 48
 """Nearest points searched for a point's neighbours on its own face."""
 
+_AREA_CHUNK = 20_000
+"""Points whose neighbourhoods are measured at once (memory: chunk × 48 × 3)."""
+
 
 def _areas(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """(M,) each point's share of the surface, up to a common factor (m²).
+    """(M,) each point's share of the surface, up to a common factor.
 
     Where a camera's points crowd (a face seen near or head-on) each stands
-    for less of the surface.  Only neighbours on the point's own face count
-    (normals within :data:`AREA_FACE_ANGLE`).  The raw share is ``r_k²``,
-    with ``r_k`` the distance to the :data:`AREA_NEIGHBOURS`-th of them; a
-    point's share is the median of the raw shares of its
-    :data:`AREA_SMOOTHING` nearest (itself included) that are not on the
-    edge of the view (:data:`AREA_EDGE_OFFSET`), or of all of them where
-    every one is.  A point repeated shares its area.
+    for less of the surface.  The points are first gathered into spots:
+    repeats (:data:`DISTINCT`) and, for scans merged as they were, near twins
+    (cells of the twin radius, :data:`TWIN_RADIUS`); each spot's share is
+    split among its points.  A spot's raw share is ``r_k²``, with ``r_k`` the
+    distance to the :data:`AREA_NEIGHBOURS`-th spot of its own face (normals
+    within :data:`AREA_FACE_ANGLE`), and its share the median of the raw
+    shares of its :data:`AREA_SMOOTHING` nearest spots of the face (itself
+    included) that are not on the edge of the view
+    (:data:`AREA_EDGE_OFFSET`), or of all of them where every one is.
+    Fewer than ``AREA_NEIGHBOURS + 1`` spots: equal shares.
 
     Parameters
     ----------
     points, normals : (M, 3) float
-        Any frame, metres; unit normals.
+        Any frame and unit of length; unit normals.
     """
     M = len(points)
+    nearest, spots, seen = _spacings(points)
+    cell = (
+        TWIN_RADIUS * spots / np.sqrt(seen)
+        if _twinned(nearest, spots, seen)
+        else DISTINCT
+    )
+    _, first, spot = np.unique(
+        np.floor(points / cell), axis=0, return_index=True, return_inverse=True
+    )
+    spot = spot.reshape(-1)
+    if len(first) <= AREA_NEIGHBOURS:
+        return np.ones(M)
+    share = _spot_areas(points[first], normals[first])
+    return share[spot] / np.bincount(spot)[spot]
+
+
+def _spot_areas(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """:func:`_areas` of distinct spots, in chunks of rows (memory ~ 50 per row)."""
+    M = len(points)
     K = min(_AREA_CANDIDATES, M - 1)
-    d, near = cKDTree(points).query(points, k=K + 1)
-    same = np.einsum("ij,ikj->ik", normals, normals[near]) >= np.cos(AREA_FACE_ANGLE)
-    same[:, 0] = True  # the point itself (d = 0, first)
-    rank = np.cumsum(same, axis=1) - 1  # each neighbour's place on the face
+    tree = cKDTree(points)
+    raw, reach, face_near = np.empty(M), np.empty(M), []
+    inner = np.empty(M, dtype=bool)
+    for lo in range(0, M, _AREA_CHUNK):
+        rows = slice(lo, min(lo + _AREA_CHUNK, M))
+        d, near = tree.query(points[rows], k=K + 1)
+        cos = np.einsum("ij,ikj->ik", normals[rows], normals[near])
+        same = cos >= np.cos(AREA_FACE_ANGLE)
+        same[:, 0] = True  # the point itself (d = 0, first)
+        rank = np.cumsum(same, axis=1) - 1  # each neighbour's place on the face
 
-    def distance_to(k: int) -> np.ndarray:
-        at = same & (rank == k)
-        return np.where(at.any(axis=1), d[np.arange(M), np.argmax(at, axis=1)], np.nan)
+        def distance_to(k, same=same, rank=rank, d=d):
+            at = same & (rank == k)
+            where = np.argmax(at, axis=1)
+            return np.where(at.any(axis=1), d[np.arange(len(d)), where], np.nan)
 
-    raw = distance_to(AREA_NEIGHBOURS) ** 2
-    reach = distance_to(AREA_SMOOTHING - 1)
-    face = same & (rank < AREA_SMOOTHING)
-    count = face.sum(axis=1)
-    centroid = np.einsum("ik,ikj->ij", face, points[near]) / count[:, None]
-    offset = np.linalg.norm(centroid - points, axis=1)
-    inner = offset <= AREA_EDGE_OFFSET * reach  # False where reach is NaN
+        raw[rows] = distance_to(AREA_NEIGHBOURS)
+        reach[rows] = distance_to(AREA_SMOOTHING - 1)
+        face = same & (rank < AREA_SMOOTHING)
+        centroid = (
+            np.einsum("ik,ikj->ij", face, points[near]) / face.sum(axis=1)[:, None]
+        )
+        offset = np.linalg.norm(centroid - points[rows], axis=1)
+        inner[rows] = offset <= AREA_EDGE_OFFSET * reach[rows]  # False if NaN
+        face_near.append(np.where(face, near, -1))
+    face_near = np.concatenate(face_near)
+    scale = np.nanmedian(raw) if np.any(np.isfinite(raw)) else 1.0
+    raw = (raw / (scale or 1.0)) ** 2  # in units of the cloud: no underflow
+    member = face_near >= 0
+    at = np.where(member, face_near, 0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
-        share = np.nanmedian(np.where(face & inner[near], raw[near], np.nan), axis=1)
-        every = np.nanmedian(np.where(face, raw[near], np.nan), axis=1)
+        share = np.nanmedian(np.where(member & inner[at], raw[at], np.nan), axis=1)
+        every = np.nanmedian(np.where(member, raw[at], np.nan), axis=1)
         share = np.where(np.isnan(share), every, share)
         if np.all(np.isnan(share)):  # too few points on any face
             return np.ones(M)
@@ -1588,10 +1644,11 @@ class FittedCloud:
     points of its face (normals within 45°) within ``ρ =``
     :data:`FIT_RADIUS_LINES` line radii, and a probe meets the quadric of the
     facing point nearest it, then of the point nearest that meeting (where a
-    face has fewer than :data:`FIT_MIN_POINTS` points, its tangent plane).
+    face has fewer than :data:`FIT_MIN_POINTS` points, times the points a
+    spot holds, ``CloudSurface.seen``, its tangent plane).
     A point's quadric is fitted when a probe first meets it (a cloud of
     200,000 points fits only those near the grasps), on at most
-    :data:`FIT_NEIGHBOURS` neighbours.
+    :data:`FIT_NEIGHBOURS` neighbours (times ``seen``).
 
     Parameters
     ----------

@@ -16,6 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
+from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.cloud import _areas, complete_unseen
 
 HALF = np.array([0.08, 0.105, 0.033])  # the cracker box's half sides (m)
@@ -75,14 +76,14 @@ def test_a_cameras_crowding_does_not_move_the_centre(shape, view):
     # a cracker box and a soup can at 0.5 m, as a depth camera samples them;
     # with the points counted equally the centre slid 12-19 mm towards where
     # they crowd (the box), 1.8-2.2 mm (the can); weighted, 0.5-1.0 and
-    # 0.15-0.3 mm
+    # 0.15-0.3 mm (seed 0; over seeds 0-3, up to 1.6 and 0.6 mm)
     rng = np.random.default_rng(0)
     make = _box if shape == "box" else _can
     camera = np.asarray(view)
     points, normals = _seen(*make(30000, rng), camera, rng, perspective=True)
     _, _, info = complete_unseen(points, normals, camera)
     assert info["skipped"] is None
-    assert np.linalg.norm(info["centre"]) < (2e-3 if shape == "box" else 6e-4)
+    assert np.linalg.norm(info["centre"]) < (2e-3 if shape == "box" else 1e-3)
 
 
 def test_a_density_ramp_across_the_view_does_not_move_the_centre():
@@ -122,8 +123,8 @@ def test_an_even_cloud_keeps_its_centre():
     offset=st.tuples(*[st.floats(-2.0, 2.0)] * 3),
 )
 def test_the_centre_moves_with_the_cloud(seed, scale, angles, offset):
-    # rigid motion and units: the centre is the cloud's own, and the areas
-    # scale with the square of the length
+    # rigid motion and units: the centre is the cloud's own, and the shares
+    # are relative (a cloud 1e-160 m across squared its distances to zero)
     rng = np.random.default_rng(seed)
     camera = np.array([0.4, 0.25, 0.3])
     points, normals = _seen(*_can(3000, rng), camera, rng, perspective=True)
@@ -134,8 +135,8 @@ def test_the_centre_moves_with_the_cloud(seed, scale, angles, offset):
     _, _, there = complete_unseen(moved, normals @ R.T, scale * R @ camera + t)
     expected = scale * R @ here["centre"] + t
     assert np.allclose(there["centre"], expected, atol=1e-9 * max(scale, 1.0))
-    a = _areas(points, normals)
-    assert np.allclose(_areas(moved, normals @ R.T), scale**2 * a, rtol=1e-6)
+    a = _areas(points, normals)  # in the cloud's own units: no unit at all
+    assert np.allclose(_areas(moved, normals @ R.T), a, rtol=1e-6)
 
 
 def test_a_second_scan_of_part_of_the_view_does_not_move_the_centre():
@@ -150,3 +151,65 @@ def test_a_second_scan_of_part_of_the_view_does_not_move_the_centre():
     twice = np.vstack([points, points[again] + rng.normal(0, 5e-5, (again.sum(), 3))])
     _, _, merged = complete_unseen(twice, np.vstack([normals, normals[again]]), camera)
     assert np.linalg.norm(merged["centre"] - once["centre"]) < 3e-3
+
+
+@pytest.mark.parametrize(
+    "times, error, part",
+    [
+        (5, 0.0, 0.0),  # half the view repeated five times
+        (10, 0.0, 0.0),
+        (4, 1e-5, -1.0),  # the whole view in 4 scans 0.01 mm apart
+        (10, 1e-4, -1.0),
+        (10, 1e-5, 0.0),  # half the view in 10 scans
+    ],
+)
+def test_repeats_and_merged_scans_share_their_spots_area(times, error, part):
+    # a spot seen many times has one share, split among its points: counted
+    # per point (its 8th neighbour a copy), 5 repeats of half the view put the
+    # centre 14 mm off, 10 scans of half of it 40 mm, 10 of all of it 12 mm;
+    # now 0.6 mm (one scan's), 0.6, 0.7, 2.1 and 2.6 mm (a spot split between
+    # two cells of the twin radius counts twice)
+    rng = np.random.default_rng(4)
+    camera = np.array([0.4, 0.25, 0.3])
+    points, normals = _seen(*_box(30000, rng), camera, rng, perspective=True)
+    again = points[:, 0] > part * HALF[0]
+    extra = np.vstack(
+        [
+            points[again] + rng.normal(0.0, error, (again.sum(), 3))
+            for _ in range(times - 1)
+        ]
+    )
+    merged = np.vstack([points, extra])
+    merged_normals = np.vstack([normals] + [normals[again]] * (times - 1))
+    _, _, once = complete_unseen(points, normals, camera)
+    _, _, info = complete_unseen(merged, merged_normals, camera)
+    assert np.linalg.norm(info["centre"]) < 3e-3
+    assert np.linalg.norm(info["centre"] - once["centre"]) < 3e-3
+
+
+@pytest.mark.parametrize(
+    "points, normals",
+    [
+        (np.zeros((1, 3)), [[0.0, 0.0, 1.0]]),
+        (np.zeros((0, 3)), np.zeros((0, 3))),
+        (np.zeros((5, 2)), np.zeros((5, 2))),
+        ([[0.0, 0.0, np.nan]] * 5, [[0.0, 0.0, 1.0]] * 5),
+        (np.zeros((5, 3)), np.zeros((4, 3))),
+    ],
+)
+def test_complete_unseen_refuses_what_is_no_cloud(points, normals):
+    with pytest.raises(InvalidOptionError, match="complete_unseen needs"):
+        complete_unseen(points, normals, [1.0, 0.0, 0.0])
+
+
+def test_a_cloud_of_few_points_or_tiny_units_gets_its_shares():
+    rng = np.random.default_rng(5)
+    points, normals = _box(400, rng)
+    assert np.all(_areas(points[:6], normals[:6]) == 1.0)  # too few: equal
+    shares = _areas(points, normals)
+    assert np.all(np.isfinite(shares)) and np.all(shares > 0)
+    # relative shares: a cloud 0.2 mm across has the same; one 1e-160 m across
+    # (its squared distances underflow) falls within DISTINCT: equal shares
+    assert np.allclose(_areas(1e-3 * points, normals), shares, rtol=1e-6)
+    tiny = _areas(1e-160 * points, normals)
+    assert np.all(np.isfinite(tiny)) and np.all(tiny > 0)
