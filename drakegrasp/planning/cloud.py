@@ -804,7 +804,9 @@ def complete_unseen(points, normals, viewpoint):
         info = {"centre": None, "added": 0, "skipped": "depth undetermined"}
         return empty, empty, info
     mirrored = 2 * centre - points
-    keep = cKDTree(points).query(mirrored)[0] > _spacing(points)
+    spacing = _spacing(points)  # only whether a seen point is that near counts:
+    gap = cKDTree(points).query(mirrored, distance_upper_bound=spacing)[0]
+    keep = gap > spacing  # (inf beyond the bound: a far query stops early)
     info = {"centre": centre, "added": int(keep.sum()), "skipped": None}
     return mirrored[keep], -normals[keep], info
 
@@ -902,17 +904,19 @@ def _spot_areas(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
         )
         offset = np.linalg.norm(centroid - points[rows], axis=1)
         inner[rows] = offset <= AREA_EDGE_OFFSET * reach[rows]  # False if NaN
-        face_near.append(np.where(face, near, -1))
+        face_near.append(np.where(face, near, -1).astype(np.int32))
     face_near = np.concatenate(face_near)
     scale = np.nanmedian(raw) if np.any(np.isfinite(raw)) else 1.0
     raw = (raw / (scale or 1.0)) ** 2  # in units of the cloud: no underflow
-    member = face_near >= 0
-    at = np.where(member, face_near, 0)
+    share = np.empty(M)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
-        share = np.nanmedian(np.where(member & inner[at], raw[at], np.nan), axis=1)
-        every = np.nanmedian(np.where(member, raw[at], np.nan), axis=1)
-        share = np.where(np.isnan(share), every, share)
+        for lo in range(0, M, _AREA_CHUNK):
+            member = face_near[lo : lo + _AREA_CHUNK] >= 0
+            at = np.where(member, face_near[lo : lo + _AREA_CHUNK], 0)
+            mine = np.nanmedian(np.where(member & inner[at], raw[at], np.nan), 1)
+            every = np.nanmedian(np.where(member, raw[at], np.nan), axis=1)
+            share[lo : lo + _AREA_CHUNK] = np.where(np.isnan(mine), every, mine)
         if np.all(np.isnan(share)):  # too few points on any face
             return np.ones(M)
         share = np.where(np.isnan(share), np.nanmedian(share), share)
