@@ -1026,7 +1026,8 @@ def _spacings(points: np.ndarray) -> tuple[float, float, int]:
     seen : int
         The median number of distinct points within :data:`TWIN_RADIUS`
         density spacings of a point, itself included: 1 unless scans were
-        merged as they were.
+        merged as they were, and 1 for fewer than :data:`TWIN_MIN_POINTS`
+        distinct points.
     """
     distinct = _distinct(points)
     if len(distinct) < 2:
@@ -1051,8 +1052,9 @@ def _twinned(nearest: float, spots: float, seen: int) -> bool:
     Each spot holds two or more points (``seen``, the median), a point's
     nearest lies well inside its spot (:data:`TWIN_TIGHT`), and the
     nearest-neighbour median is below the floor the spots give.  A single
-    scan, however sparse or uneven (whose spots hold one point each), is
-    not: its spacing is its nearest-neighbour median.
+    scan, sparse or uneven (whose spots hold one point each), is not: its
+    spacing is its nearest-neighbour median.  (A line scanner's pass, dense
+    along its lines and sparse across them, can be.)
     """
     twin_radius = TWIN_RADIUS * spots / np.sqrt(seen)
     return (
