@@ -788,7 +788,8 @@ def complete_unseen(points, normals, viewpoint):
             f"complete_unseen needs (M, 3) finite points and normals, M >= 3, got "
             f"shapes {points.shape} and {normals.shape}"
         )
-    w = _areas(points, normals)
+    parts = _spacings(points)  # for the shares and the seam alike
+    w = _areas(points, normals, parts)
     w = w / w.sum()
     mean = w @ points
     A = np.eye(3) - (normals * w[:, None]).T @ normals
@@ -804,7 +805,7 @@ def complete_unseen(points, normals, viewpoint):
         info = {"centre": None, "added": 0, "skipped": "depth undetermined"}
         return empty, empty, info
     mirrored = 2 * centre - points
-    spacing = _spacing(points)  # only whether a seen point is that near counts:
+    spacing = _spacing(points, parts)  # only whether a seen point is that near counts:
     gap = cKDTree(points).query(mirrored, distance_upper_bound=spacing)[0]
     keep = gap > spacing  # (inf beyond the bound: a far query stops early)
     info = {"centre": centre, "added": int(keep.sum()), "skipped": None}
@@ -839,7 +840,7 @@ _AREA_CHUNK = 20_000
 """Points whose neighbourhoods are measured at once (memory: chunk × 48 × 3)."""
 
 
-def _areas(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
+def _areas(points: np.ndarray, normals: np.ndarray, parts=None) -> np.ndarray:
     """(M,) each point's share of the surface, up to a common factor.
 
     Where a camera's points crowd (a face seen near or head-on) each stands
@@ -858,18 +859,13 @@ def _areas(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
     ----------
     points, normals : (M, 3) float
         Any frame and unit of length; unit normals.
+    parts : tuple, optional
+        :func:`_spacings` of ``points``, if already at hand.
     """
     M = len(points)
-    nearest, spots, seen = _spacings(points)
-    cell = (
-        TWIN_RADIUS * spots / np.sqrt(seen)
-        if _twinned(nearest, spots, seen)
-        else DISTINCT
-    )
-    _, first, spot = np.unique(
-        np.floor(points / cell), axis=0, return_index=True, return_inverse=True
-    )
-    spot = spot.reshape(-1)
+    nearest, spots, seen = _spacings(points) if parts is None else parts
+    twinned = _twinned(nearest, spots, seen)
+    first, spot = _cells(points, _twin_radius(spots, seen) if twinned else DISTINCT)
     if len(first) <= AREA_NEIGHBOURS:
         return np.ones(M)
     share = _spot_areas(points[first], normals[first])
@@ -1004,10 +1000,20 @@ _SPACING_QUERIES = 4096
 median of 4,096 is within a few per cent of all of them)."""
 
 
+def _cells(points: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarray]:
+    """The cells of a grid of ``size`` (m) that hold ``points``.
+
+    Returns each cell's first point (index) and each point's cell, (M,).
+    """
+    _, first, cell = np.unique(
+        np.round(points / size), axis=0, return_index=True, return_inverse=True
+    )
+    return first, cell.reshape(-1)
+
+
 def _distinct(points: np.ndarray) -> np.ndarray:
     """``points`` taken once each, on a grid of :data:`DISTINCT`, in their order."""
-    _, keep = np.unique(np.round(points / DISTINCT), axis=0, return_index=True)
-    return points[np.sort(keep)]
+    return points[np.sort(_cells(points, DISTINCT)[0])]
 
 
 def _spacings(points: np.ndarray) -> tuple[float, float, int]:
@@ -1046,6 +1052,11 @@ def _spacings(points: np.ndarray) -> tuple[float, float, int]:
     return nearest, density * np.sqrt(seen), seen
 
 
+def _twin_radius(spots: float, seen: int) -> float:
+    """Radius (m) within which points are one spot (:data:`TWIN_RADIUS`)."""
+    return TWIN_RADIUS * spots / np.sqrt(seen)
+
+
 def _twinned(nearest: float, spots: float, seen: int) -> bool:
     """Whether a cloud's points come in near twins: scans merged as they were.
 
@@ -1056,10 +1067,9 @@ def _twinned(nearest: float, spots: float, seen: int) -> bool:
     spacing is its nearest-neighbour median.  (A line scanner's pass, dense
     along its lines and sparse across them, can be.)
     """
-    twin_radius = TWIN_RADIUS * spots / np.sqrt(seen)
     return (
         seen >= 2
-        and nearest <= TWIN_TIGHT * twin_radius
+        and nearest <= TWIN_TIGHT * _twin_radius(spots, seen)
         and nearest < SPACING_DENSITY_FLOOR * spots
     )
 
@@ -1082,7 +1092,7 @@ def _warn_of_twins(nearest: float, spots: float, seen: int) -> None:
     warnings.warn(
         f"point_cloud's points come in near twins (scans merged without "
         f"downsampling?): a point has {seen} within "
-        f"{TWIN_RADIUS * spots / np.sqrt(seen) * 1e3:.3g} mm (median, itself "
+        f"{_twin_radius(spots, seen) * 1e3:.3g} mm (median, itself "
         f"included) and its nearest {nearest * 1e3:.3g} mm away; planning with "
         f"a spacing of {SPACING_DENSITY_FLOOR * spots * 1e3:.3g} mm, from the "
         f"density of these spots; downsample the merged cloud to plan faster, "
