@@ -46,8 +46,11 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, cKDTree
 
 from drakegrasp.core.deprecation import outside_stacklevel
@@ -82,13 +85,13 @@ __all__ = [
     "NORMAL_NEIGHBOURS",
     "NORMAL_OWN_FACTOR",
     "PAD_CONTACT_BAND",
-    "SPACING_DENSITY_FLOOR",
-    "SPACING_NEIGHBOURS",
-    "TWIN_MIN_POINTS",
-    "TWIN_RADIUS",
-    "TWIN_TIGHT",
+    "SPOT_LINKS",
+    "SPOT_NEIGHBOURS",
+    "TWIN_JUMP",
+    "TWIN_MIN_SPOTS",
     "UNSEEN_DEPTH_ANGLE",
     "UNSEEN_WEAK",
+    "VOXEL_SPACINGS",
     "CloudContact",
     "CloudFingers",
     "CloudSurface",
@@ -261,8 +264,8 @@ class PointCloudWarning(UserWarning):
     Points left out (not finite: a depth camera's missing depth), or an
     extent too large for metres (:data:`CLOUD_UNITS_EXTENT`) or too small
     for an object a hand grasps (:data:`CLOUD_SMALL_EXTENT`), or points in
-    near twins (scans merged without downsampling: see
-    :data:`SPACING_DENSITY_FLOOR`).  Silence it
+    near twins (scans merged without downsampling: see :data:`TWIN_JUMP`).
+    Silence it
     with ``warnings.simplefilter("ignore", PointCloudWarning)``.
     """
 
@@ -788,8 +791,8 @@ def complete_unseen(points, normals, viewpoint):
             f"complete_unseen needs (M, 3) finite points and normals, M >= 3, got "
             f"shapes {points.shape} and {normals.shape}"
         )
-    parts = _spacings(points)  # for the shares and the seam alike
-    w = _areas(points, normals, parts)
+    spots = _spots(points)  # for the shares and the seam alike
+    w = _areas(points, normals, spots)
     w = w / w.sum()
     mean = w @ points
     A = np.eye(3) - (normals * w[:, None]).T @ normals
@@ -805,7 +808,7 @@ def complete_unseen(points, normals, viewpoint):
         info = {"centre": None, "added": 0, "skipped": "depth undetermined"}
         return empty, empty, info
     mirrored = 2 * centre - points
-    spacing = _spacing(points, parts)  # only whether a seen point is that near counts:
+    spacing = spots.spacing  # only whether a seen point is that near counts:
     gap = cKDTree(points).query(mirrored, distance_upper_bound=spacing)[0]
     keep = gap > spacing  # (inf beyond the bound: a far query stops early)
     info = {"centre": centre, "added": int(keep.sum()), "skipped": None}
@@ -840,13 +843,13 @@ _AREA_CHUNK = 20_000
 """Points whose neighbourhoods are measured at once (memory: chunk × 48 × 3)."""
 
 
-def _areas(points: np.ndarray, normals: np.ndarray, parts=None) -> np.ndarray:
+def _areas(points: np.ndarray, normals: np.ndarray, spots=None) -> np.ndarray:
     """(M,) each point's share of the surface, up to a common factor.
 
     Where a camera's points crowd (a face seen near or head-on) each stands
     for less of the surface.  The points are first gathered into spots:
     repeats (:data:`DISTINCT`) and, for scans merged as they were, near twins
-    (cells of the twin radius, :data:`TWIN_RADIUS`); each spot's share is
+    (:data:`TWIN_JUMP`, :data:`SPOT_LINKS`); each spot's share is
     split among its points.  A spot's raw share is ``r_k²``, with ``r_k`` the
     distance to the :data:`AREA_NEIGHBOURS`-th spot of its own face (normals
     within :data:`AREA_FACE_ANGLE`), and its share the median of the raw
@@ -859,13 +862,11 @@ def _areas(points: np.ndarray, normals: np.ndarray, parts=None) -> np.ndarray:
     ----------
     points, normals : (M, 3) float
         Any frame and unit of length; unit normals.
-    parts : tuple, optional
-        :func:`_spacings` of ``points``, if already at hand.
+    spots : optional
+        The spots of ``points`` (see :data:`TWIN_JUMP`), if already at hand.
     """
     M = len(points)
-    nearest, spots, seen = _spacings(points) if parts is None else parts
-    twinned = _twinned(nearest, spots, seen)
-    first, spot = _cells(points, _twin_radius(spots, seen) if twinned else DISTINCT)
+    first, spot = _gathered(points, _spots(points) if spots is None else spots)
     if len(first) <= AREA_NEIGHBOURS:
         return np.ones(M)
     share = _spot_areas(points[first], normals[first])
@@ -959,45 +960,51 @@ def cloud_surface(points, normals, viewpoint=None, complete: bool = True):
 DISTINCT = 1e-9
 """Points closer than this (m) are one point repeated, for the spacing."""
 
-SPACING_NEIGHBOURS = 64
-"""Neighbours whose farthest sets a point's density spacing (see
-:data:`SPACING_DENSITY_FLOOR`)."""
+TWIN_JUMP = 3.0
+"""How many times farther the next spot lies than a spot's own points.
 
-SPACING_DENSITY_FLOOR = 0.4
-"""The spacing of scans merged as they were, in spot spacings.
+Scans merged without downsampling see each spot of the surface several
+times, a registration error apart.  The median distance from a point to its
+``k``-th nearest then jumps, from ``k = seen - 1`` (its farthest twin) to
+``k = seen`` (the nearest point of another spot), by the ratio of the spots'
+spacing to the error: 4-125 for 2-100 scans 0.01-0.1 mm apart on a 2 mm
+cloud.  The largest such step of a single scan is 1.4-1.6 (points at random
+or on a grid), and 2 for a line scanner's pass (its points evenly along
+lines); scans blurred by an error near a third of their spacing show none
+and read as one noisy scan."""
 
-A point's density spacing, ``sqrt(pi / k) r_k`` with ``r_k`` the distance to
-its ``k``-th neighbour (``k`` = :data:`SPACING_NEIGHBOURS`), is the side of
-the square it has on the surface; the cloud's is the median.  On a randomly
-sampled surface the median nearest-neighbour distance is 0.46-0.52 of it (on
-a grid, 1).
+TWIN_MIN_SPOTS = 64
+"""Fewest spots for near twins to be told (a cloud of two patches far apart
+has one jump, at the size of a patch, and two "spots")."""
 
-Scans merged with a registration error of up to a fraction of their spacing
-see each spot several times: every point has near twins, and the nearest-
-neighbour median is the registration error.  The points within
-:data:`TWIN_RADIUS` density spacings of a point are one spot; with ``m`` the
-median count, a spot has ``m`` times a point's square, ``sqrt(m)`` times its
-side, and such a cloud's spacing is this fraction of a spot's side (about 0.8
-of one scan's nearest-neighbour median).  Other clouds keep that median."""
+SPOT_NEIGHBOURS = 1024
+"""Neighbours looked through for the jump: the most scans merged whose
+twins are told (more read as one noisy scan)."""
 
-TWIN_RADIUS = 0.25
-"""Points this many density spacings apart are one spot seen twice (a
-randomly sampled surface has another point that near one point in five)."""
+VOXEL_SPACINGS = 2.0
+"""The voxel a twin warning suggests, in spot spacings: one voxel holds one
+spot, its twins not split across voxels' sides (at 1.5 spacings, 50 scans
+0.1 mm apart still come in twins)."""
 
-TWIN_TIGHT = 0.75
-"""Near twins lie this close: a point's nearest (the median) within this
-fraction of :data:`TWIN_RADIUS`.  Scans merged 0.01-0.1 mm apart put it at
-0.05-0.5 of it; a single scan with a dense patch that happens to put a second
-point in the radius, at 0.8-1."""
+_SPOT_QUERIES = 512
+"""Points, evenly strided, whose neighbour distances tell the jump."""
 
-TWIN_MIN_POINTS = 4 * SPACING_NEIGHBOURS
-"""Fewest distinct points for near twins to be told: in a smaller cloud the
-:data:`SPACING_NEIGHBOURS`-th neighbour lies across the object, and its
-spots are no spots (a 58-point face read as twins of three)."""
+_SPOT_SPACING_QUERIES = 16384
+"""Points, evenly strided, whose distance past their twins is the spacing
+(the median of 512 can be 10 % off all of them; of 16,384, 1 %)."""
 
-_SPACING_QUERIES = 4096
-"""Points, evenly strided, whose density spacing and spot are measured (the
-median of 4,096 is within a few per cent of all of them)."""
+
+class _Spots(NamedTuple):
+    """A cloud's spacing and the spots its points gather in (:func:`_spots`)."""
+
+    nearest: float
+    """The median distance (m) from a point to its nearest distinct one."""
+    spacing: float
+    """The gap (m) between neighbouring spots: ``nearest`` unless ``seen > 1``."""
+    seen: int
+    """Points per spot (the median): 1 unless scans were merged as they were."""
+    radius: float
+    """Points this close (m) are one spot: :data:`DISTINCT` unless ``seen > 1``."""
 
 
 def _cells(points: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarray]:
@@ -1016,88 +1023,82 @@ def _distinct(points: np.ndarray) -> np.ndarray:
     return points[np.sort(_cells(points, DISTINCT)[0])]
 
 
-def _spacings(points: np.ndarray) -> tuple[float, float, int]:
-    """A cloud's nearest-neighbour and spot spacings (m).
+SPOT_LINKS = 16
+"""Twins a point is linked to when scans merged as they were are gathered
+into spots (each spot one share of the surface in the completion's centre):
+a spot of up to a hundred points is one connected piece."""
 
-    Returns
-    -------
-    nearest : float
-        The median distance from a point to its nearest distinct neighbour.
-        A point repeated (merged camera frames repeat the points they share)
-        is one point: the points are taken once each (on a grid of
-        :data:`DISTINCT`).  0 for a single point.
-    spots : float
-        The side of the square each spot has on the surface: the density
-        spacing times ``sqrt(seen)`` (see :data:`SPACING_DENSITY_FLOOR`).
-    seen : int
-        The median number of distinct points within :data:`TWIN_RADIUS`
-        density spacings of a point, itself included: 1 unless scans were
-        merged as they were, and 1 for fewer than :data:`TWIN_MIN_POINTS`
-        distinct points.
+
+def _gathered(points: np.ndarray, spots: _Spots) -> tuple[np.ndarray, np.ndarray]:
+    """The spots ``points`` gather in, as :func:`_cells` gives cells.
+
+    Repeats (:data:`DISTINCT`) are one spot.  For near twins (``seen > 1``) a
+    spot is a connected piece of the graph linking each point to its
+    :data:`SPOT_LINKS` nearest within ``spots.radius``, wherever it lies (a
+    grid of cells would split a spot across a cell's side and count it
+    twice).
+    """
+    if spots.seen == 1:
+        return _cells(points, DISTINCT)
+    M = len(points)
+    k = min(SPOT_LINKS, spots.seen - 1, M - 1) + 1
+    d, j = cKDTree(points).query(points, k=k, distance_upper_bound=spots.radius)
+    linked = np.isfinite(d)
+    rows = np.broadcast_to(np.arange(M)[:, None], d.shape)[linked]
+    graph = coo_matrix((np.ones(len(rows)), (rows, j[linked])), shape=(M, M))
+    _, spot = connected_components(graph, directed=False)
+    _, first = np.unique(spot, return_index=True)
+    return first, spot
+
+
+def _spots(points: np.ndarray) -> _Spots:
+    """A cloud's spacing, telling scans merged as they were (near twins).
+
+    The points are taken once each (on a grid of :data:`DISTINCT`: merged
+    camera frames repeat the points they share).  The spacing is the median
+    distance from a point to its nearest, unless the median distance to the
+    ``k``-th nearest jumps by :data:`TWIN_JUMP` or more at some ``k``
+    (looking through :data:`SPOT_NEIGHBOURS`), in a cloud of at least
+    :data:`TWIN_MIN_SPOTS` spots of ``k`` points.  Then the points come in
+    spots of ``seen = k`` near twins, the spacing is the median distance to
+    the nearest point of another spot (what one of the scans would give),
+    and the spot radius is halfway (geometrically) between a spot's
+    farthest twin and that.
     """
     distinct = _distinct(points)
     if len(distinct) < 2:
-        return 0.0, 0.0, 1
+        return _Spots(0.0, 0.0, 1, DISTINCT)
     tree = cKDTree(distinct)
     nearest = float(np.median(tree.query(distinct, k=2)[0][:, 1]))
-    k = min(SPACING_NEIGHBOURS, len(distinct) - 1)
-    queries = distinct[:: max(1, len(distinct) // _SPACING_QUERIES)]
-    density = float(
-        np.sqrt(np.pi / k) * np.median(tree.query(queries, k=k + 1)[0][:, k])
-    )
-    near = tree.query_ball_point(queries, TWIN_RADIUS * density, return_length=True)
-    seen = max(1, int(np.median(near)))
-    if len(distinct) < TWIN_MIN_POINTS:  # k reaches across the object: no spots
-        seen = 1
-    return nearest, density * np.sqrt(seen), seen
+    alone = _Spots(nearest, nearest, 1, DISTINCT)
+    K = min(SPOT_NEIGHBOURS, len(distinct) - 1)
+    if len(distinct) < 2 * TWIN_MIN_SPOTS or K < 2:
+        return alone
+    queries = distinct[:: max(1, len(distinct) // _SPOT_QUERIES)]
+    reach = np.median(tree.query(queries, k=K + 1)[0][:, 1:], axis=0)  # (K,)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        step = reach[1:] / reach[:-1]
+    step[~np.isfinite(step)] = 0.0  # a zero reach: below DISTINCT, no spot
+    k = int(np.argmax(step))  # reach[k] the farthest twin, reach[k + 1] beyond
+    seen = k + 2
+    if step[k] < TWIN_JUMP or len(distinct) < TWIN_MIN_SPOTS * seen:
+        return alone
+    many = distinct[:: max(1, len(distinct) // _SPOT_SPACING_QUERIES)]
+    beyond = np.median(tree.query(many, k=seen + 1)[0][:, seen - 1 :], axis=0)
+    spacing = float(beyond[1])  # the nearest point past the farthest twin
+    return _Spots(nearest, spacing, seen, float(np.sqrt(beyond[0] * spacing)))
 
 
-def _twin_radius(spots: float, seen: int) -> float:
-    """Radius (m) within which points are one spot (:data:`TWIN_RADIUS`)."""
-    return TWIN_RADIUS * spots / np.sqrt(seen)
-
-
-def _twinned(nearest: float, spots: float, seen: int) -> bool:
-    """Whether a cloud's points come in near twins: scans merged as they were.
-
-    Each spot holds two or more points (``seen``, the median), a point's
-    nearest lies well inside its spot (:data:`TWIN_TIGHT`), and the
-    nearest-neighbour median is below the floor the spots give.  A single
-    scan, sparse or uneven (whose spots hold one point each), is not: its
-    spacing is its nearest-neighbour median.  (A line scanner's pass, dense
-    along its lines and sparse across them, can be.)
-    """
-    return (
-        seen >= 2
-        and nearest <= TWIN_TIGHT * _twin_radius(spots, seen)
-        and nearest < SPACING_DENSITY_FLOOR * spots
-    )
-
-
-def _spacing(points: np.ndarray, parts=None) -> float:
-    """A cloud's spacing (m) as :class:`CloudSurface` takes it.
-
-    The median distance from a point to its nearest distinct neighbour, or
-    for near twins (:func:`_twinned`) :data:`SPACING_DENSITY_FLOOR` spot
-    spacings; ``parts``: :func:`_spacings`' answer, if already at hand.
-    """
-    nearest, spots, seen = _spacings(points) if parts is None else parts
-    if _twinned(nearest, spots, seen):
-        return SPACING_DENSITY_FLOOR * spots
-    return nearest
-
-
-def _warn_of_twins(nearest: float, spots: float, seen: int) -> None:
+def _warn_of_twins(spots: _Spots) -> None:
     """Warn that a cloud's points come in near twins (scans merged as they were)."""
     warnings.warn(
         f"point_cloud's points come in near twins (scans merged without "
-        f"downsampling?): a point has {seen} within "
-        f"{_twin_radius(spots, seen) * 1e3:.3g} mm (median, itself "
-        f"included) and its nearest {nearest * 1e3:.3g} mm away; planning with "
-        f"a spacing of {SPACING_DENSITY_FLOOR * spots * 1e3:.3g} mm, from the "
-        f"density of these spots; downsample the merged cloud to plan faster, "
-        f"for instance with PointCloud.VoxelizedDownSample(voxel_size="
-        f"{spots:.2g}), a spot's side",
+        f"downsampling?): a point has {spots.seen} within "
+        f"{spots.radius * 1e3:.3g} mm (median, itself included) and its "
+        f"nearest {spots.nearest * 1e3:.3g} mm away; planning with a spacing of "
+        f"{spots.spacing * 1e3:.3g} mm, the spots'; downsample the merged cloud "
+        f"to plan faster, for instance with PointCloud.VoxelizedDownSample("
+        f"voxel_size={VOXEL_SPACINGS * spots.spacing:.2g})",
         PointCloudWarning,
         stacklevel=outside_stacklevel(),
     )
@@ -1117,8 +1118,8 @@ class CloudSurface:
         Points this close (m) to a grasp line are on it; default
         :data:`LINE_RADIUS_SPACINGS` times the cloud's spacing (the median
         distance from a point to its nearest distinct neighbour; for near
-        twins, as scans merged as they were give,
-        :data:`SPACING_DENSITY_FLOOR` of a spot's side), at least 1 mm.
+        twins, as scans merged as they were give, to the nearest point of
+        another spot, :data:`TWIN_JUMP`), at least 1 mm.
     viewpoint : (3,) float, optional
         The camera, world frame (a one-sided cloud).
     origin : (3,) float, optional
@@ -1132,7 +1133,8 @@ class CloudSurface:
     spacing : float
         The gap between neighbouring points on the surface, metres: the
         median distance from a point to its nearest distinct one, or for
-        scans merged as they were :data:`SPACING_DENSITY_FLOOR` spot spacings.
+        scans merged as they were to the nearest point of another spot
+        (:data:`TWIN_JUMP`).
     seen : int
         Points per spot: 1, or for scans merged as they were the median
         count of a spot's near twins; point-count thresholds
@@ -1153,11 +1155,10 @@ class CloudSurface:
         self.viewpoint = (
             None if viewpoint is None else np.asarray(viewpoint, float) - self.origin
         )
-        nearest, spots, seen = _spacings(self.points)
-        self.seen = seen if _twinned(nearest, spots, seen) else 1
-        self.spacing = _spacing(self.points, (nearest, spots, seen))
+        spots = _spots(self.points)
+        self.seen, self.spacing = spots.seen, spots.spacing
         if self.seen > 1:
-            _warn_of_twins(nearest, spots, seen)
+            _warn_of_twins(spots)
         if line_radius is None:
             line_radius = max(LINE_RADIUS_SPACINGS * self.spacing, 1e-3)
         self.line_radius = float(line_radius)
