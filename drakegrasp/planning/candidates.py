@@ -575,7 +575,10 @@ class GraspCandidates(Sequence):
         --out``, where ``p_WH`` becomes ``p_WH_0`` ... and ``q_hand``
         ``q_hand_0`` ...).  A result whose candidates held no joint (each
         joint of the hand closed, or tied to one by a coupling) has no such
-        column, nor has an empty result: no candidate names one.
+        column.  An empty result has the columns of the joints the planner
+        held for its hand (``settings["held_joints"]``, recorded by
+        :func:`~drakegrasp.planning.planner.plan_grasps`), so that its
+        table has a full one's schema; none if ``settings`` names none.
         """
         rows = self.candidates
         n = len(rows)
@@ -605,9 +608,14 @@ class GraspCandidates(Sequence):
         }
 
     def _held_joint_columns(self) -> dict[str, np.ndarray]:
-        """``table``'s held-joint columns: each value, NaN where not held."""
+        """``table``'s held-joint columns: each value, NaN where not held.
+
+        Without candidates, the joints ``settings`` says the plan held.
+        """
         held = [dict(c.held_joints) for c in self.candidates]
         names = dict.fromkeys(name for row in held for name in row)  # first met
+        if not self.candidates:
+            names = dict.fromkeys(self.settings.get("held_joints", ()))
         return {
             HELD_JOINT_COLUMN + name: np.array(
                 [float(row.get(name, np.nan)) for row in held], dtype=float

@@ -49,7 +49,6 @@ from drakegrasp.core.validation import (
 )
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.candidates import (
-    GraspCandidate,
     GraspCandidates,
     closing_order,
     planning_result,
@@ -94,7 +93,7 @@ from drakegrasp.planning.turned_gravity import GRAVITY
 from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.attachment import free_carrier, how_held
 from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import find_joint
+from drakegrasp.plant.fingers import find_joint, joint_name
 from drakegrasp.plant.mesh_convexity import warn_if_not_convex
 from drakegrasp.plant.validation import (
     HandSpec,
@@ -486,13 +485,15 @@ def plan_grasps(
         if not hand_is_parallel_jaw(plant, ctx, body, hand):
             _jaw_only(squeeze_limit)
             mass = _mass_of(ctx, body, object_mass)
-            return _finished(mass, plan_multifinger(
+            result = plan_multifinger(
                 plant, ctx, body, hand=hand, n=n, mu=mu,
                 rng=np.random.default_rng(seed),
                 surface=object_surface(plant, ctx, body), settings=settings, t0=t0,
                 name=scoped_name(plant, body), certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY, **multi,
-            ), plant, q_planned, body, hand)  # fmt: skip
+            )  # fmt: skip
+            closing = result.settings["hand"]["joints"]
+            return _finished(mass, result, plant, q_planned, body, hand, closing)
         _multifinger_only(multi)
         gripper = parallel_jaw(plant, ctx, body, hand)
         surface = object_surface(plant, ctx, body)
@@ -512,13 +513,16 @@ def plan_grasps(
             _jaw_only(squeeze_limit)
             mass = np.nan if object_mass is None else float(object_mass)
             settings.update(cloud_dropped=dropped)
-            return _finished(mass, plan_multifinger_cloud(
+            result = plan_multifinger_cloud(
                 plant, ctx, hand=hand, points=points, normals=normals,
                 viewpoint=viewpoint, n=n, mu=mu, rng=np.random.default_rng(seed),
                 settings=settings, t0=t0, certify=certify, workers=workers,
                 progress=progress, weight=mass * GRAVITY, complete=complete_unseen,
                 **multi,
-            ), plant, q_planned, plant.world_body(), hand)  # fmt: skip
+            )  # fmt: skip
+            closing = result.settings["hand"]["joints"]
+            world = plant.world_body()
+            return _finished(mass, result, plant, q_planned, world, hand, closing)
         _multifinger_only(multi)
         gripper = parallel_jaw(plant, ctx, plant.world_body(), hand)
         surface, completion = cloud_surface(points, normals, viewpoint, complete_unseen)
@@ -596,12 +600,13 @@ def plan_grasps(
     )
     result = with_squeeze_limit(result, plant, top=certify, squeeze_limit=squeeze_limit)
     anchor = plant.world_body() if body is None else body
-    result = _finished(mass, result, plant, q_planned, anchor, hand)
+    closing = [joint_name(plant, j) for j in gripper.joints]
+    result = _finished(mass, result, plant, q_planned, anchor, hand, closing)
     return replace(result, time=time.perf_counter() - t0)
 
 
 def _finished(
-    mass: float, result: GraspCandidates, plant, q_planned, anchor, hand
+    mass: float, result: GraspCandidates, plant, q_planned, anchor, hand, closing
 ) -> GraspCandidates:
     """``result`` whose candidates record their mass and the hand's held joints.
 
@@ -610,8 +615,12 @@ def _finished(
 
     ``mass``: the kg planned for; ``q_planned``: the plant's positions when
     the plan began (the planner keeps the joints it does not close there);
-    ``anchor``: the object body, or the world body on a cloud.  A joint that
-    a coupling ties to a closing joint moved with it: it is not held.
+    ``anchor``: the object body, or the world body on a cloud; ``closing``:
+    the scoped names of the hand's closing joints (each candidate's
+    ``joint_names``).  A joint that a coupling ties to a closing joint moved
+    with it: it is not held.  The names of the joints held with ``closing``
+    go to ``settings["held_joints"]``, so that a result without candidates
+    still knows its table's held-joint columns.
     """
     bodies = {int(b.index()) for b in hand_bodies(plant, anchor, hand)}
     joints = [plant.get_joint(j) for j in plant.GetJointIndices()]
@@ -624,17 +633,22 @@ def _finished(
     links = _coupling_links(plant)
     moved: dict[tuple[str, ...], set[str]] = {}
 
-    def held(c: GraspCandidate) -> tuple[tuple[str, float], ...]:
-        if c.joint_names not in moved:  # the closing joints and their couplings'
-            moved[c.joint_names] = _linked(set(c.joint_names), links)
-        return tuple(pair for pair in values if pair[0] not in moved[c.joint_names])
+    def held(names: tuple[str, ...]) -> tuple[tuple[str, float], ...]:
+        if names not in moved:  # the closing joints and their couplings'
+            moved[names] = _linked(set(names), links)
+        return tuple(pair for pair in values if pair[0] not in moved[names])
 
     mass = float(mass)
     return replace(
         result,
         candidates=tuple(
-            replace(c, object_mass=mass, held_joints=held(c)) for c in result.candidates
+            replace(c, object_mass=mass, held_joints=held(c.joint_names))
+            for c in result.candidates
         ),
+        settings={
+            **result.settings,
+            "held_joints": [name for name, _ in held(tuple(closing))],
+        },
     )
 
 

@@ -195,6 +195,40 @@ def test_the_table_has_a_column_for_each_held_joint(bent_plan):
     assert list(none.table()) == COLUMNS
 
 
+def _same_schema(empty: dict, full: dict) -> None:
+    """``empty`` has ``full``'s columns, in its order, dtypes and widths, no rows."""
+    assert list(empty) == list(full)
+    for name, column in full.items():
+        assert empty[name].dtype == column.dtype, name
+        assert empty[name].shape == (0, *column.shape[1:]), name
+
+
+def test_an_empty_result_has_the_held_joint_columns_of_a_full_one(bent_plan, tmp_path):
+    # an empty result had no held-joint column, a full one of the same hand
+    # one per held joint: a file of each did not share a schema
+    scene, result = bent_plan
+    with pytest.warns(PassiveJointWarning):
+        empty = plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=0, mu=0.5, seed=0, robustness_samples=4,
+        )  # fmt: skip
+    assert len(empty) == 0
+    _same_schema(empty.table(), result.table())
+    assert HELD + DISTAL in empty.table()
+    # the jaw's route too: the dial beside it is held
+    jaw = _dial_jaw(tmp_path, "")
+
+    def plan(n):
+        return plan_grasps(
+            jaw.plant, jaw.context, jaw.object_body, hand=jaw.hand,
+            num_candidates=n, mu=0.5, seed=0, robustness_samples=4,
+        )  # fmt: skip
+
+    full = plan(20).table()
+    assert HELD + "coupled_jaw::dial_joint" in full
+    _same_schema(plan(0).table(), full)
+
+
 def test_plan_out_writes_the_held_joints(tmp_path, capsys):
     # the file has a column per held joint, named with the joint: a reader
     # gets back each candidate's held_joints
