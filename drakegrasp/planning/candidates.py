@@ -407,6 +407,41 @@ def _held_joints(plant, held_joints) -> list:
     return out
 
 
+def _held_values(k: int, candidate: GraspCandidate) -> dict[str, float]:
+    """Candidate ``k``'s ``held_joints`` as ``{name: value}``, for the table.
+
+    Raises
+    ------
+    InvalidGraspError
+        ``held_joints`` is not (joint name, value) pairs, or a value is not a
+        real number (NaN passes: the table records what the candidate says).
+    """
+    held = candidate.held_joints
+    if not (
+        isinstance(held, tuple | list)
+        and all(
+            isinstance(pair, tuple | list)
+            and len(pair) == 2
+            and isinstance(pair[0], str)
+            for pair in held
+        )
+    ):
+        raise InvalidGraspError(
+            f"candidate {k}'s held_joints must be (joint name, value) pairs, "
+            f"got {reprlib.repr(held)}"
+        )
+    values = {}
+    for name, value in held:
+        try:
+            values[name] = real_scalar(name, value, error=InvalidGraspError)
+        except InvalidGraspError:
+            raise InvalidGraspError(
+                f"candidate {k}'s held joint {name!r} has the value "
+                f"{reprlib.repr(value)}, not a real number (metres or radians)"
+            ) from None
+    return values
+
+
 def _finite_number(value) -> bool:
     """Whether ``value`` is a real, finite number (not a bool) a float holds."""
     try:
@@ -579,6 +614,13 @@ class GraspCandidates(Sequence):
         held for its hand (``settings["held_joints"]``, recorded by
         :func:`~drakegrasp.planning.planner.plan_grasps`), so that its
         table has a full one's schema; none if ``settings`` names none.
+
+        Raises
+        ------
+        InvalidGraspError
+            A candidate's ``held_joints`` is not (joint name, real number)
+            pairs (one edited by hand); the message names the candidate's
+            index in the result, the joint and the value.
         """
         rows = self.candidates
         n = len(rows)
@@ -612,13 +654,13 @@ class GraspCandidates(Sequence):
 
         Without candidates, the joints ``settings`` says the plan held.
         """
-        held = [dict(c.held_joints) for c in self.candidates]
+        held = [_held_values(k, c) for k, c in enumerate(self.candidates)]
         names = dict.fromkeys(name for row in held for name in row)  # first met
         if not self.candidates:
             names = dict.fromkeys(self.settings.get("held_joints", ()))
         return {
             HELD_JOINT_COLUMN + name: np.array(
-                [float(row.get(name, np.nan)) for row in held], dtype=float
+                [row.get(name, np.nan) for row in held], dtype=float
             )
             for name in names
         }

@@ -229,6 +229,34 @@ def test_an_empty_result_has_the_held_joint_columns_of_a_full_one(bent_plan, tmp
     _same_schema(plan(0).table(), full)
 
 
+def test_a_held_joint_value_that_is_no_number_is_named(bent_plan):
+    # an edited candidate's held value reached numpy: a raw ValueError, "could
+    # not convert string to float", naming neither candidate nor joint
+    import dataclasses
+
+    from drakegrasp.errors import InvalidGraspError
+
+    _, result = bent_plan
+    for bad in ("0.3x", None, True, [0.3]):
+        edited = dataclasses.replace(
+            result,
+            candidates=(
+                result[0],
+                dataclasses.replace(result[1], held_joints=((DISTAL, bad),)),
+            ),
+        )
+        with pytest.raises(InvalidGraspError) as info:
+            edited.table()
+        assert f"candidate 1's held joint {DISTAL!r}" in str(info.value)
+        assert repr(bad) in str(info.value)
+    for bad in (5, ((DISTAL,),), (("x", 1.0, 2.0),), ((3, 1.0),)):  # not pairs
+        edited = dataclasses.replace(
+            result, candidates=(dataclasses.replace(result[0], held_joints=bad),)
+        )
+        with pytest.raises(InvalidGraspError, match="candidate 0's held_joints"):
+            edited.table()
+
+
 def test_plan_out_writes_the_held_joints(tmp_path, capsys):
     # the file has a column per held joint, named with the joint: a reader
     # gets back each candidate's held_joints
