@@ -1611,7 +1611,9 @@ def _write_plan_parquet(result, path: str, *, overwrite: bool) -> None:
         ) from exc
     columns = {}
     for name, values in result.table().items():
-        if values.ndim == 1:
+        if values.dtype == object:  # str (torque_unit): a string column, rows or not
+            columns[name] = pa.array(values.tolist(), type=pa.string())
+        elif values.ndim == 1:
             columns[name] = values
         else:
             for j in range(values.shape[1]):

@@ -596,6 +596,14 @@ class GraspCandidates(Sequence):
     def table(self) -> dict[str, np.ndarray]:
         """One row per candidate (columns of equal length), for Parquet or pandas.
 
+        Each column is an (n,) array of the candidates' attribute of that
+        name (``rank_in_result``: the row's rank), but ``p_WH`` (n, 3) and
+        ``R_WH`` (n, 9, row-major) of ``X_WH``, and ``q_hand`` (n, n_h).
+        ``torque_unit``, after ``torque_capacity``, holds str (dtype object):
+        the unit of the row's ``torque_needed`` (``"N·m"``, ``"N"``, or both
+        named for a hand whose closing joints turn and slide), and of the
+        joint effort that ``torque_capacity`` is newtons per.
+
         An empty result has the same columns, dtypes and widths with zero
         rows: ``p_WH`` is (0, 3), ``R_WH`` (0, 9) and ``q_hand`` (0, n_h), with
         n_h the closing joints of the hand in ``settings`` (0 if it names
@@ -636,6 +644,7 @@ class GraspCandidates(Sequence):
             "squeeze_needed": column(lambda c: c.squeeze_needed),
             "torque_needed": column(lambda c: c.torque_needed),
             "torque_capacity": column(lambda c: c.torque_capacity),
+            "torque_unit": column(lambda c: c.torque_unit, object),
             "epsilon": column(lambda c: c.epsilon),
             "robustness": column(lambda c: c.robustness),
             "is_closure": column(lambda c: c.is_closure, bool),

@@ -138,8 +138,8 @@ def test_a_candidate_records_the_joints_the_plan_held(bent):
 
 COLUMNS = [
     "rank_in_result", "sample", "score", "weight_capacity", "squeeze_needed",
-    "torque_needed", "torque_capacity", "epsilon", "robustness", "is_closure",
-    "d_star", "num_contacts", "opening", "p_WH", "R_WH", "q_hand",
+    "torque_needed", "torque_capacity", "torque_unit", "epsilon", "robustness",
+    "is_closure", "d_star", "num_contacts", "opening", "p_WH", "R_WH", "q_hand",
 ]  # fmt: skip
 """``GraspCandidates.table()``'s columns for candidates that held no joint."""
 
@@ -255,6 +255,23 @@ def test_a_held_joint_value_that_is_no_number_is_named(bent_plan):
         )
         with pytest.raises(InvalidGraspError, match="candidate 0's held_joints"):
             edited.table()
+
+
+def test_the_table_has_each_candidates_torque_unit(bent_plan):
+    # GraspCandidate.torque_unit had no column: a file of a sliding hand's
+    # plan gave torque_needed without saying it was in newtons
+    import dataclasses
+
+    _, result = bent_plan
+    sliding = dataclasses.replace(result[1], torque_unit="N")
+    edited = dataclasses.replace(result, candidates=(result[0], sliding, *result[2:]))
+    table = edited.table()
+    names = list(table)
+    assert names.index("torque_unit") == names.index("torque_capacity") + 1
+    assert table["torque_unit"].dtype == object
+    expected = [c.torque_unit for c in edited]
+    assert table["torque_unit"].tolist() == expected
+    assert expected[:2] == ["N·m", "N"]
 
 
 def test_plan_out_writes_the_held_joints(tmp_path, capsys):
