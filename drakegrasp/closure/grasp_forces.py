@@ -45,6 +45,7 @@ from drakegrasp.closure.load_problem import (
     add_balance,
     add_force_constraints,
     check_wrench,
+    effort_unit_of,
     load_problem,
     saturating_joints,
 )
@@ -196,7 +197,8 @@ class GraspForceResult:
         ]
         if self.joint_torques is not None:
             tau = ", ".join(f"{t:.4g}" for t in self.joint_torques)
-            lines.append(f"  joint torques [{tau}] (N·m revolute, N prismatic)")
+            unit = effort_unit_of(("N·m", "N"))  # a joint turns or slides
+            lines.append(f"  joint torques [{tau}] ({unit})")
         if not math.isnan(self.torque_usage):
             sat = list(self.saturating_joints) or "none"
             lines.append(

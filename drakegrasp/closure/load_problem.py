@@ -41,6 +41,7 @@ has ``f_n`` alone).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -67,6 +68,7 @@ __all__ = [
     "LoadProblem",
     "check_direction",
     "check_wrench",
+    "effort_unit_of",
     "load_problem",
     "saturating_joints",
 ]
@@ -704,3 +706,34 @@ def saturating_joints(
     at = np.flatnonzero(use & (ratio >= 1.0 - SATURATION_TOL))
     order = at[np.argsort(-ratio[at], kind="stable")]
     return tuple(int(j) for j in order), float(np.max(ratio[use]))
+
+
+_MIXED_UNIT = "N·m, N at prismatic joints"
+
+
+def effort_unit_of(units: Iterable[str], default: str = "N·m") -> str:
+    """The unit of joints' efforts, as drakegrasp writes it in its words.
+
+    Each joint's effort has its own unit: ``"N·m"`` at a revolute joint (a
+    torque), ``"N"`` at a prismatic one (a force).  Joints that share one are
+    given in it; joints of both kinds in ``"N·m, N at prismatic joints"``,
+    the one spelling of a mixed hand's unit (a planned candidate's
+    ``torque_unit``, the shake test's summary, the joint torques of a
+    :class:`~drakegrasp.closure.grasp_forces.GraspForceResult`); no joint in
+    ``default``.
+
+    Parameters
+    ----------
+    units : iterable of str
+        One unit per joint.
+    default : str, optional
+        The unit of no joint (a record made before units were kept).
+
+    Returns
+    -------
+    str
+    """
+    kinds = set(units)
+    if not kinds:
+        return default
+    return kinds.pop() if len(kinds) == 1 else _MIXED_UNIT

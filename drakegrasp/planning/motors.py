@@ -81,6 +81,7 @@ from pydrake.solvers import MathematicalProgram
 from scipy.linalg import block_diag
 
 from drakegrasp._solvers import require_solution, solve
+from drakegrasp.closure.load_problem import effort_unit_of
 from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import grasp_matrix
@@ -662,13 +663,13 @@ def _unit_of_joints(plant, joint_names) -> str:
 
     ``"N·m"`` when every joint turns, ``"N"`` when every one slides, and
     ``"N·m, N at prismatic joints"`` for a hand with both
-    (:func:`~drakegrasp.plant.fingers.effort_unit` of each):
+    (:func:`~drakegrasp.closure.load_problem.effort_unit_of` of each one's
+    :func:`~drakegrasp.plant.fingers.effort_unit`):
     ``torque_limit`` and ``torque_needed`` are per joint, in its own unit.
     """
-    kinds = {effort_unit(find_joint(plant, n)) or "N·m" for n in joint_names}
-    if kinds == {"N"}:
-        return "N"
-    return "N·m, N at prismatic joints" if kinds == {"N", "N·m"} else "N·m"
+    return effort_unit_of(
+        effort_unit(find_joint(plant, n)) or "N·m" for n in joint_names
+    )
 
 
 def _too_weak(head, limit: float, applied: bool = False, unit: str = "N·m") -> str:

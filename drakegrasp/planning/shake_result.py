@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from pydrake.math import RigidTransform
 
+from drakegrasp.closure.load_problem import effort_unit_of
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
@@ -312,11 +313,13 @@ def motion_text(displacement: float, rotation: float, digits: int = 2) -> str:
 
 
 def squeeze_unit_of(units: tuple[str, ...]) -> str:
-    """The squeeze's unit for a summary line: one unit, or both when mixed."""
-    kinds = set(units) or {"N"}
-    if len(kinds) == 1:
-        return kinds.pop()
-    return "(N on prismatic, N·m on revolute joints)"
+    """The squeeze's unit for a summary line: one unit, or both when mixed.
+
+    :func:`~drakegrasp.closure.load_problem.effort_unit_of` of the joints'
+    ``units``: ``"N·m, N at prismatic joints"`` when mixed, and ``"N"`` for
+    none (a result recorded before ``effort_units``, of a parallel jaw).
+    """
+    return effort_unit_of(units, default="N")
 
 
 def _pose(name: str, X) -> np.ndarray:

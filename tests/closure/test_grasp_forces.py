@@ -111,6 +111,24 @@ def test_torques_are_J_transpose_f_and_limits_hold():
     assert r.saturating_joints == ()
 
 
+def test_a_hands_effort_unit_has_one_spelling():
+    # three spellings of a mixed hand's unit: "(N·m revolute, N prismatic)"
+    # here, "N·m, N at prismatic joints" in the plan's words and
+    # "(N on prismatic, N·m on revolute joints)" in the shake's summary
+    from drakegrasp.closure.load_problem import effort_unit_of
+
+    mixed = "N·m, N at prismatic joints"
+    assert effort_unit_of(["N·m", "N·m"]) == "N·m"
+    assert effort_unit_of(["N"]) == "N"
+    assert effort_unit_of(["N", "N·m", "N"]) == mixed
+    assert effort_unit_of([]) == "N·m" and effort_unit_of([], default="N") == "N"
+    g = pinch(0.5)
+    r = dg.grasp_forces(
+        g, weight(1.0), hand_jacobian=pinch_jacobian(g), torque_limits=[30, 30]
+    )
+    assert f"] ({mixed})\n" in str(r), str(r)
+
+
 @pytest.mark.parametrize("objective", ["min_squeeze", "min_torque"])
 @pytest.mark.parametrize("cones", ["exact", "polyhedral"])
 def test_a_zero_load_is_held_by_zero_forces(objective, cones):
