@@ -14,7 +14,7 @@ import warnings
 
 import numpy as np
 import pytest
-from cloud_support import sample_cloud
+from cloud_support import box_points, sample_cloud
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import cKDTree
@@ -23,15 +23,6 @@ from drakegrasp.planning import plan_grasps, planning_scene
 from drakegrasp.planning.cloud import CloudSurface, PointCloudWarning
 
 JAW = "package://drakegrasp/hands/parallel_jaw.sdf"
-
-
-def _box(n: int, seed: int, half=(0.025, 0.03, 0.05)) -> np.ndarray:
-    """A box's faces sampled at random (m, world frame)."""
-    rng = np.random.default_rng(seed)
-    axis = rng.integers(0, 3, n)
-    p = rng.uniform(-1.0, 1.0, (n, 3))
-    p[np.arange(n), axis] = rng.choice([-1.0, 1.0], size=n)
-    return p * np.asarray(half)
 
 
 def _normals(points: np.ndarray, half=(0.025, 0.03, 0.05)) -> np.ndarray:
@@ -62,7 +53,12 @@ def test_a_single_scan_keeps_its_nearest_neighbour_spacing():
     grid = np.arange(-0.024, 0.0241, 0.002)
     y, z = np.meshgrid(grid, grid)
     square = np.c_[np.full(y.size, 0.025), y.ravel(), z.ravel()]
-    for points in (_box(300, 0), _box(3000, 1), _box(20000, 2), square):
+    for points in (
+        box_points(300, 0),
+        box_points(3000, 1),
+        box_points(20000, 2),
+        square,
+    ):
         with warnings.catch_warnings():
             warnings.simplefilter("error", PointCloudWarning)
             surface = _surface(points)
@@ -73,9 +69,9 @@ def test_a_single_scan_keeps_its_nearest_neighbour_spacing():
 @pytest.mark.parametrize("scans", [2, 4, 10])
 @pytest.mark.parametrize("error", [1e-6, 1e-5, 1e-4])
 def test_merged_scans_keep_the_surface_spacing(scans, error):
-    single = _surface(_box(3000, 0))
+    single = _surface(box_points(3000, 0))
     with pytest.warns(PointCloudWarning, match="near twins") as caught:
-        merged = _surface(_merged(_box(3000, 0), scans, error))
+        merged = _surface(_merged(box_points(3000, 0), scans, error))
     # the floor: 0.4 density spacings of the spots, about 0.8 of the single
     # scan's nearest-neighbour median (0.47-0.52 density spacings) while the
     # twins lie within a quarter of a density spacing; less as they spread to
@@ -90,7 +86,7 @@ def test_merged_scans_keep_the_surface_spacing(scans, error):
 
 def test_exact_repeats_are_one_point_without_a_warning():
     # repeated points (merged frames share them) were always one point
-    points = _box(3000, 0)
+    points = box_points(3000, 0)
     with warnings.catch_warnings():
         warnings.simplefilter("error", PointCloudWarning)
         repeated = _surface(np.repeat(points, 5, axis=0))
@@ -106,7 +102,7 @@ def test_exact_repeats_are_one_point_without_a_warning():
     seed=st.integers(0, 2**16),
 )
 def test_the_merged_spacing_follows_the_surface(n, scans, error, scale, seed):
-    points = _box(n, seed)
+    points = box_points(n, seed)
     single = _surface(points)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PointCloudWarning)
@@ -131,8 +127,8 @@ def test_a_jaw_finds_the_far_side_of_merged_scans(scans):
                 point_cloud=points,
             )  # fmt: skip
 
-    single = plan(_box(1500, 0))
-    merged = plan(_merged(_box(1500, 0), scans, 1e-4))
+    single = plan(box_points(1500, 0))
+    merged = plan(_merged(box_points(1500, 0), scans, 1e-4))
     missed = merged.rejections.get("no opposite surface", 0)
     assert missed <= single.rejections.get("no opposite surface", 0) + 4
     assert len(merged) >= len(single) // 2
@@ -166,7 +162,7 @@ def _dense_spot() -> np.ndarray:
     """A box's cloud with 2,200 more points in a 2 mm spot on its +x face."""
     spot = np.random.default_rng(7).normal(0.0, 2e-3, (2200, 3))
     spot[:, 0] = 0.025
-    return np.vstack([_box(3000, 6), spot])
+    return np.vstack([box_points(3000, 6), spot])
 
 
 def _off_the_object(full, candidate) -> float:
@@ -211,8 +207,8 @@ def test_merged_scans_put_the_fingertips_on_the_object(drake_models_dir, name):
 @pytest.mark.parametrize(
     "points",
     [
-        pytest.param(_box(58, 4), id="58 points"),
-        pytest.param(_box(150, 5), id="150 points"),
+        pytest.param(box_points(58, 4), id="58 points"),
+        pytest.param(box_points(150, 5), id="150 points"),
         pytest.param(np.c_[np.arange(100) * 1e-3, np.zeros((100, 2))], id="a line"),
         pytest.param(_dense_spot(), id="a dense spot"),
     ],
@@ -234,7 +230,7 @@ def test_a_sparse_or_uneven_single_scan_is_not_taken_for_twins(points):
 def test_the_twin_warning_names_the_callers_line():
     # the warning is raised deep in the planner; it names the user's call,
     # whichever route (jaw, multi-finger, the class itself) raised it
-    points = _merged(_box(3000, 0), 3, 1e-5)
+    points = _merged(box_points(3000, 0), 3, 1e-5)
     with pytest.warns(PointCloudWarning, match="near twins") as caught:
         _surface(points)
     assert caught[0].filename == __file__

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from cloud_support import box_points
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from pydrake.geometry import Box, Convex
@@ -21,15 +22,6 @@ from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.models import models_dir
 
 JAW = "package://drakegrasp/hands/parallel_jaw.sdf"
-
-
-def _box_cloud(n: int, seed: int) -> np.ndarray:
-    half = np.array([0.025, 0.03, 0.05])
-    rng = np.random.default_rng(seed)
-    axis = rng.integers(0, 3, n)
-    p = rng.uniform(-1.0, 1.0, (n, 3))
-    p[np.arange(n), axis] = rng.choice([-1.0, 1.0], size=n)
-    return p * half
 
 
 def _fingerprint(result) -> list:
@@ -54,7 +46,7 @@ def _compare(scene, monkeypatch):
     def plan():
         return plan_grasps(
             scene.plant, scene.context, None, hand=scene.hand, num_candidates=40,
-            mu=0.5, seed=3, robustness_samples=4, point_cloud=_box_cloud(6000, 1),
+            mu=0.5, seed=3, robustness_samples=4, point_cloud=box_points(6000, 1),
         )  # fmt: skip
 
     screened = plan()
