@@ -32,6 +32,7 @@ from drakegrasp.errors import (
     GraspError,
     InvalidContextError,
     InvalidOptionError,
+    InvalidPoseError,
     ModelError,
 )
 from drakegrasp.plant.attachment import joined
@@ -171,6 +172,9 @@ def plant_context_of(plant, context) -> Context:
         If the plant is not a finalized ``MultibodyPlant``.
     InvalidContextError
         If ``context`` is not a Context, or belongs to another system.
+    InvalidPoseError
+        If the plant's positions in it are not all finite (the message names
+        the joints: a free body's is its floating joint).
     """
     checked = _CHECKED.get()
     if checked is not None and checked[0] is plant and checked[1] is context:
@@ -183,13 +187,12 @@ def plant_context_of(plant, context) -> Context:
         )
     try:
         plant.ValidateContext(context)
-        return context
+        return _finite_positions(plant, context)
     except RuntimeError:
         pass
     try:
         sub = plant.GetMyContextFromRoot(context)
         plant.ValidateContext(sub)
-        return sub
     except RuntimeError as e:
         msg = " ".join(str(e).split())
         raise InvalidContextError(
@@ -197,6 +200,30 @@ def plant_context_of(plant, context) -> Context:
             f"holds it (pass plant.GetMyContextFromRoot(root) or the root); "
             f"Drake says: {msg}"
         ) from None
+    return _finite_positions(plant, sub)
+
+
+def _finite_positions(plant: MultibodyPlant, context: Context) -> Context:
+    """``context``, once its positions are all finite.
+
+    Drake aborts the process (no exception) when positions that are not are
+    written back, as every planner and pose check does when it is done.
+    """
+    q = plant.GetPositions(context)
+    if np.all(np.isfinite(q)):
+        return context
+    bad = []
+    for j in plant.GetJointIndices():
+        joint = plant.get_joint(j)
+        start = joint.position_start()
+        at = slice(start, start + joint.num_positions())
+        if not np.all(np.isfinite(q[at])):
+            bad.append(f"{scoped_name(plant, joint)!r} at {q[at].tolist()}")
+    raise InvalidPoseError(
+        "plant_context holds positions that are not finite: joint "
+        + ", joint ".join(bad)
+        + " (set the plant's positions to finite values)"
+    )
 
 
 @contextlib.contextmanager
