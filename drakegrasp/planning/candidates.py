@@ -188,8 +188,9 @@ class GraspCandidate:
         The unit of ``torque_needed`` at the closing joints, from their kinds:
         ``"N·m"`` when every one turns, ``"N"`` when every one slides
         (prismatic), ``"N·m, N at prismatic joints"`` for a hand with both;
-        recorded with ``torque_needed`` (``"N·m"`` where none was, and for a
-        candidate built or pickled without it).
+        set by the planner for every candidate, a jaw's too (whose
+        ``torque_needed`` is NaN), and ``"N·m"`` for a candidate built or
+        pickled without it.
 
     Notes
     -----

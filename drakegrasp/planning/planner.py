@@ -67,6 +67,7 @@ from drakegrasp.planning.cloud import (
 )
 from drakegrasp.planning.gripper import free_base, parallel_jaw
 from drakegrasp.planning.motors import (
+    _unit_of_joints,
     check_squeeze_limit,
     check_torque_limit,
     with_squeeze_limit,
@@ -617,8 +618,9 @@ def _finished(
     the plan began (the planner keeps the joints it does not close there);
     ``anchor``: the object body, or the world body on a cloud; ``closing``:
     the scoped names of the hand's closing joints (each candidate's
-    ``joint_names``).  A joint that a coupling ties to a closing joint moved
-    with it: it is not held.  The names of the joints held with ``closing``
+    ``joint_names``, whose kinds set each one's ``torque_unit``, a jaw's
+    too).  A joint that a coupling ties to a closing joint moved with it: it
+    is not held.  The names of the joints held with ``closing``
     go to ``settings["held_joints"]``, so that a result without candidates
     still knows its table's held-joint columns.
     """
@@ -642,7 +644,12 @@ def _finished(
     return replace(
         result,
         candidates=tuple(
-            replace(c, object_mass=mass, held_joints=held(c.joint_names))
+            replace(
+                c,
+                object_mass=mass,
+                held_joints=held(c.joint_names),
+                torque_unit=_unit_of_joints(plant, c.joint_names),
+            )
             for c in result.candidates
         ),
         settings={

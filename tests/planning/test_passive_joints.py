@@ -392,3 +392,18 @@ def test_joints_a_coupling_ties_to_the_closing_ones_move_with_them(tmp_path):
     assert _linked({"coupled_jaw::other"}, links) == {"coupled_jaw::other"}
     free = _dial_jaw(tmp_path, "").plant
     assert _linked({"coupled_jaw::left_slide"}, _coupling_links(free)) == tied
+
+
+def test_a_jaws_rows_carry_the_unit_of_its_sliding_joints():
+    # a jaw's candidates kept the default "N·m" though its joints slide: the
+    # table's torque_unit column said N·m on every jaw row
+    scene = planning_scene(
+        "package://drakegrasp/objects/box.sdf",
+        hand_url="package://drakegrasp/hands/parallel_jaw.sdf",
+    )
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=10, mu=0.5, seed=0,
+    )  # fmt: skip
+    assert len(result) > 0
+    assert set(result.table()["torque_unit"].tolist()) == {"N"}
