@@ -1474,7 +1474,7 @@ def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:
     )  # fmt: skip
     with placed(path, overwrite=args.overwrite) as tmp:
         Path(tmp).write_text(text)
-    for kept in _scene_out_notes(args, best):
+    for kept in _scene_out_notes(args):
         _say(f"drakegrasp: note: {kept}")
     note = "" if shaken is None or shaken.best is not None else ", none held"
     line = f"wrote candidate #{rank}{note} to {path} (drakegrasp analyze {path})"
@@ -1485,15 +1485,9 @@ def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:
     return 0
 
 
-def _scene_out_notes(args: argparse.Namespace, best) -> list[str]:
+def _scene_out_notes(args: argparse.Namespace) -> list[str]:
     """What the plan assumed that a scene file does not keep, and how to give it."""
     notes = []
-    if best.contact_options.get("contact_model") == "soft_finger":
-        notes.append(
-            "a scene file keeps no torsion length: analyze it with "
-            f"--characteristic-length {best.torque_scale:.6g} for the plan's "
-            "soft-finger moments (and its epsilon)"
-        )
     if args.mass is not None:
         notes.append(
             f"the scene keeps the model's mass, not --mass {args.mass:g}: "

@@ -17,6 +17,7 @@ the scene loader accepts where it lies inside that folder; elsewhere
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -31,6 +32,7 @@ from pydrake.multibody.parsing import (
 )
 from pydrake.multibody.tree import JointIndex
 
+from drakegrasp.core.validation import check_length
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.candidates import GraspCandidate
 from drakegrasp.plant.validation import (
@@ -53,6 +55,7 @@ def grasp_scene_text(
     mu: float | str,
     contact_model: str | None = None,
     torsional_friction: float | None = None,
+    characteristic_length: float | None = None,
     folder: str | os.PathLike = ".",
     description: str | None = None,
 ) -> str:
@@ -77,6 +80,12 @@ def grasp_scene_text(
         (each pair's from the models, as the scene file's ``mu: plant``).
     contact_model, torsional_friction : optional
         As planned (default: the candidate's ``contact_options``).
+    characteristic_length : float, optional
+        The length (metres) moments are compared with forces by, and a soft
+        finger's torsion limited with (the scene's ``characteristic_length``).
+        Default: for soft fingers the candidate's ``torque_scale``, so that
+        ``analyze`` of the file finds the planned torsion and ε; for other
+        models none (the grasp's own).
     folder : str or path, optional
         The folder the scene file will be written to: paths are written
         relative to it.
@@ -172,6 +181,12 @@ def grasp_scene_text(
     }
     if torsional_friction is not None:
         section["torsional_friction"] = float(torsional_friction)
+    if characteristic_length is not None:
+        section["characteristic_length"] = check_length(
+            "characteristic_length", characteristic_length, error=InvalidOptionError
+        )
+    elif str(contact_model) == "soft_finger" and math.isfinite(candidate.torque_scale):
+        section["characteristic_length"] = float(candidate.torque_scale)
     tolerance = options.get("distance_tolerance")
     if tolerance is not None:
         section["distance_tolerance"] = float(tolerance)

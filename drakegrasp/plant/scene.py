@@ -66,7 +66,12 @@ unknown keys.  ``drakegrasp:`` keys (see :data:`drakegrasp.plant.scene_file.KEYS
   with ``plane``; N and N·m, frame O about its origin) the grasp is analysed
   under, and ``torque_limits`` (needs ``load``): ``plant`` or one limit per
   hand velocity; ``drakegrasp analyze --load`` / ``--torque-limits``
-  override them.
+  override them;
+- ``characteristic_length`` (absent: the grasp's own): the length ``b``
+  (metres) that makes moments comparable with forces and bounds a soft
+  finger's torsion by ``b ν f_n`` (``plan --scene-out`` of soft fingers
+  writes the plan's); ``drakegrasp analyze --characteristic-length``
+  overrides it.
 
 Packages and files
 ------------------
@@ -233,6 +238,10 @@ class SceneInfo:
     torque_limits : None, "plant" or tuple of float
         The motor limits of that load analysis
         (``AnalysisOptions.torque_limits``).
+    characteristic_length : float or None
+        The length ``b`` (metres) that makes moments comparable with forces
+        and sets a soft finger's torsion limit ``b ν f_n``
+        (``AnalysisOptions.characteristic_length``); None: the grasp's own.
     """
 
     name: str
@@ -249,6 +258,7 @@ class SceneInfo:
     close_direction: tuple[float, ...] | None = None
     load: str | tuple[float, ...] | None = None
     torque_limits: str | tuple[float, ...] | None = None
+    characteristic_length: float | None = None
 
 
 @dataclass(frozen=True)
@@ -303,6 +313,7 @@ class Scene:
             distance_tolerance=info.distance_tolerance,
             load=info.load,
             torque_limits=info.torque_limits,
+            characteristic_length=info.characteristic_length,
         )
 
     def analysis_options(self) -> dict:
@@ -321,6 +332,7 @@ class Scene:
                 for key, value in (
                     ("load", self.info.load),
                     ("torque_limits", self.info.torque_limits),
+                    ("characteristic_length", self.info.characteristic_length),
                 )
                 if value is not None
             },

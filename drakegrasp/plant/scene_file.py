@@ -94,6 +94,10 @@ KEYS = {
     "numbers >= 0 (.inf: no limit), one per hand velocity (a coupled hand: per "
     "actuated joint or per independent coordinate), or one number >= 0 for all: "
     "the motors of the load analysis",
+    "characteristic_length": "a number > 0 (metres): the length b that makes "
+    "moments comparable with forces and sets a soft finger's torsion limit "
+    "b nu f_n (as planned: plan --scene-out writes the plan's); absent: the "
+    "grasp's own",
 }
 """The keys of the ``drakegrasp:`` section and what each must be."""
 
@@ -508,7 +512,8 @@ def check_section(
     dict
         Keys ``description, object_body, hand, mu, contact_model,
         torsional_friction, plane, distance_tolerance, close,
-        close_direction, load, torque_limits``; ``hand`` is None, a string or
+        close_direction, load, torque_limits, characteristic_length``;
+        ``characteristic_length`` is None or a float; ``hand`` is None, a string or
         a tuple of strings, ``contact_model`` a ContactModel, ``close`` a bool,
         ``close_direction`` None or a tuple of floats, ``load`` None,
         ``"gravity"`` or a tuple of floats, ``torque_limits`` None,
@@ -572,7 +577,7 @@ def check_section(
         )
     description = section.get("description", "")
     close, close_direction = _close(path, section.get("close", False))
-    load, limits = _load_options(path, section, plane)
+    load, limits, length = _checked_options(path, section, plane)
     if limits is not None and load is None:
         raise SceneError(
             f"scene {str(path)!r}: drakegrasp.torque_limits without "
@@ -605,11 +610,12 @@ def check_section(
         "close_direction": close_direction,
         "load": load,
         "torque_limits": limits,
+        "characteristic_length": length,
     }
 
 
-def _load_options(path: Path, section: dict, plane):
-    """``(load, torque_limits)``, checked with the key named.
+def _checked_options(path: Path, section: dict, plane):
+    """``(load, torque_limits, characteristic_length)``, checked with the key named.
 
     :class:`~drakegrasp.AnalysisOptions` checks them: one rule for the file,
     the command line and Python.
@@ -619,10 +625,11 @@ def _load_options(path: Path, section: dict, plane):
             plane=plane,
             load=section.get("load"),
             torque_limits=section.get("torque_limits"),
+            characteristic_length=section.get("characteristic_length"),
         )
     except GraspError as e:
         raise SceneError(f"scene {str(path)!r}: drakegrasp.{e}") from None
-    return options.load, options.torque_limits
+    return options.load, options.torque_limits, options.characteristic_length
 
 
 def directives_text(path: Path, text: str) -> str:

@@ -9,6 +9,7 @@ own contacts and verdict.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +22,7 @@ from drakegrasp.cli import main
 from drakegrasp.planning import plan_grasps, planning_scene
 from drakegrasp.planning.grasp_scene import grasp_scene_text
 from drakegrasp.plant.models import models_dir
-from drakegrasp.plant.scene import load_scene
+from drakegrasp.plant.scene import load_scene, read_scene_info
 
 BOX = "package://drakegrasp/objects/box.sdf"
 FLAT = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
@@ -168,8 +169,31 @@ def test_what_a_scene_file_cannot_keep_is_said(tmp_path, capsys):
             "--mass", "0.5", "--scene-out", str(out)]  # fmt: skip
     assert main(argv) == 0
     err = capsys.readouterr().err
-    assert "--characteristic-length 0.0670" in err
     assert "not --mass 0.5" in err
+    assert "characteristic-length" not in err  # the file keeps it now
+
+
+def test_a_soft_finger_scene_keeps_the_planned_torsion_length(tmp_path, capsys):
+    # the scene kept no torsion length: analyze of a soft-finger plan's scene
+    # took the grasp's own and gave epsilon 0.04375 where the plan said 0.0900
+    out = tmp_path / "soft.yaml"
+    argv = ["plan", "cylinder", "--hand", "rounded", "--num", "60", "--top", "1",
+            "--contact-model", "soft_finger", "--torsional-friction", "0.1",
+            "--json", "--scene-out", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    planned = json.loads(capsys.readouterr().out)["candidates"][0]
+    written = out.read_text()
+    section = yaml.safe_load(written[written.index("\ndrakegrasp:") :])["drakegrasp"]
+    assert section["characteristic_length"] == planned["torque_scale"]
+    assert main(["analyze", str(out), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["epsilon"]["epsilon"] == pytest.approx(planned["epsilon"], rel=1e-9)
+    info = read_scene_info(out)
+    assert info.characteristic_length == planned["torque_scale"]
+    assert (
+        load_scene(out).analysis_options()["characteristic_length"]
+        == (planned["torque_scale"])
+    )
 
 
 @pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
