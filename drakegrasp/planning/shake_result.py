@@ -263,12 +263,15 @@ class ShakeResult:
         verdict = "held" if self.held_from_seat else "dropped"
         if not np.isnan(self.max_displacement_from_seat):
             verdict += " from the seat"  # not `held`, which counts from the plan
+        unit = self.squeeze_unit
+        if "," in unit:  # a mixed hand's: kept apart from the line's commas
+            unit = f"({unit})"
         return (
             f"{verdict}: {motion}"
-            f" over {self.duration:g} s, squeeze {self.squeeze:g} {self.squeeze_unit}"
+            f" over {self.duration:g} s, squeeze {self.squeeze:g} {unit}"
             + (
                 f" (capped at {_limits(self.squeeze_caps, self.squeeze)} "
-                f"{self.squeeze_unit})"
+                f"{unit})"
                 if self.squeeze_capped
                 else ""
             )

@@ -51,7 +51,7 @@ def test_a_parallel_jaw_squeezes_in_newtons():
     ("units", "text"),
     [
         ((), "squeeze 2 N,"),
-        (("N", "N·m"), "squeeze 2 N·m, N at prismatic joints,"),  # the plan's
+        (("N", "N·m"), "squeeze 2 (N·m, N at prismatic joints),"),  # the plan's
     ],
 )
 def test_the_summary_unit_of_an_older_or_mixed_result(units, text):
