@@ -287,8 +287,11 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     Returns
     -------
     points, normals : (M', 3) float
+        For scans merged as they were (near twins, :data:`TWIN_JUMP`), each
+        spot's mean point, and its points' normals summed.
     dropped : int
-        Points left out (not finite, or no normal could be estimated).
+        Points left out (not finite, or no normal could be estimated); a
+        spot's twins gathered into its mean are not.
 
     Raises
     ------
@@ -300,9 +303,10 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     Warns
     -----
     PointCloudWarning
-        When points that are not finite were left out (how many), or the
+        When points that are not finite were left out (how many), the
         cloud is more than :data:`CLOUD_UNITS_EXTENT` across (millimetres?)
-        or less than :data:`CLOUD_SMALL_EXTENT` (scaled twice?).
+        or less than :data:`CLOUD_SMALL_EXTENT` (scaled twice?), or its
+        points come in near twins (gathered into their spots' means).
     """
     return read_cloud_fit(point_cloud, normals, viewpoint=viewpoint)[:3]
 
@@ -397,6 +401,13 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
         )
     _warn_of(points, total)
     _refuse_strays(points)
+    spots = _spots(points)
+    merged = 0  # points gathered into their spots' means: not dropped
+    if spots.seen > 1:  # scans merged as they were: one point per spot
+        read = len(points)
+        points, normals = _gather(points, normals, spots)
+        merged = read - len(points)
+        _warn_of_twins(spots, (read, len(points)))
     fit = None
     if normals is None:
         normals, fit = _estimate_normals(points)
@@ -417,7 +428,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
     towards = points - points.mean(axis=0) if viewpoint is None else viewpoint - points
     flip = np.sum(normals * towards, axis=1) < 0
     normals[flip] *= -1
-    return points, normals, total - len(points), fit
+    return points, normals, total - merged - len(points), fit
 
 
 def _refuse_strays(points: np.ndarray) -> None:
@@ -1089,19 +1100,51 @@ def _spots(points: np.ndarray) -> _Spots:
     return _Spots(nearest, spacing, seen, float(np.sqrt(beyond[0] * spacing)))
 
 
-def _warn_of_twins(spots: _Spots) -> None:
-    """Warn that a cloud's points come in near twins (scans merged as they were)."""
+def _warn_of_twins(spots: _Spots, gathered: tuple[int, int] | None = None) -> None:
+    """Warn that a cloud's points come in near twins (scans merged as they were).
+
+    ``gathered``: (points, spots) when each spot was gathered into its mean.
+    """
+    if gathered is None:
+        doing = f"planning with a spacing of {spots.spacing * 1e3:.3g} mm, the spots'"
+    else:
+        doing = (
+            f"planning on each spot's mean ({gathered[1]} of {gathered[0]} points), "
+            f"{spots.spacing * 1e3:.3g} mm apart"
+        )
     warnings.warn(
         f"point_cloud's points come in near twins (scans merged without "
         f"downsampling?): a point has {spots.seen} within "
         f"{spots.radius * 1e3:.3g} mm (median, itself included) and its "
-        f"nearest {spots.nearest * 1e3:.3g} mm away; planning with a spacing of "
-        f"{spots.spacing * 1e3:.3g} mm, the spots'; downsample the merged cloud "
-        f"to plan faster, for instance with PointCloud.VoxelizedDownSample("
-        f"voxel_size={VOXEL_SPACINGS * spots.spacing:.2g})",
+        f"nearest {spots.nearest * 1e3:.3g} mm away; {doing}; downsample the "
+        f"merged cloud to read it faster, for instance with "
+        f"PointCloud.VoxelizedDownSample(voxel_size="
+        f"{VOXEL_SPACINGS * spots.spacing:.2g})",
         PointCloudWarning,
         stacklevel=outside_stacklevel(),
     )
+
+
+def _gather(points: np.ndarray, normals, spots: _Spots):
+    """Each spot of ``points`` (:func:`_gathered`) as its mean point, in order.
+
+    ``normals`` (or None): each spot's the sum of its points' (their
+    direction is all that counts).
+    """
+    first, spot = _gathered(points, spots)
+    order = np.argsort(first, kind="stable")  # spots in their first point's order
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    spot = rank[spot]
+    count = np.bincount(spot).astype(float)
+
+    def summed(values: np.ndarray) -> np.ndarray:
+        return np.stack(
+            [np.bincount(spot, weights=values[:, i]) for i in range(3)], axis=1
+        )
+
+    means = summed(points) / count[:, None]
+    return means, None if normals is None else summed(normals)
 
 
 class CloudSurface:

@@ -311,8 +311,8 @@ def plan_grasps(
         several 100,000 points can be voxel-downsampled first
         (``PointCloud.VoxelizedDownSample``): the tests plan YCB objects from
         3,000-20,000 points.  So can scans merged as they are: each spot is
-        then seen several times, and the cloud is planned on the spacing of
-        its spots, with a ``PointCloudWarning``
+        then seen several times, and the cloud is planned on each spot's
+        mean point, with a ``PointCloudWarning``
         (:data:`~drakegrasp.planning.cloud.TWIN_JUMP`).
     cloud_normals : (M, 3) float, optional
         Outward normals of the cloud's points; default the cloud's own, else
