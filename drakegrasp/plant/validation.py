@@ -178,7 +178,7 @@ def plant_context_of(plant, context) -> Context:
     """
     checked = _CHECKED.get()
     if checked is not None and checked[0] is plant and checked[1] is context:
-        return context
+        return _finite_positions(plant, context)  # set since: written back later
     check_plant(plant)
     if not isinstance(context, Context):
         raise InvalidContextError(
@@ -233,7 +233,9 @@ def checked_context(plant: MultibodyPlant, context: Context) -> Iterator[Context
     Inside the ``with`` block, :func:`plant_context_of` returns the checked
     plant context at once when given it again with the same plant (the
     contacts, Jacobians, friction and curvatures of one
-    :func:`~drakegrasp.analyze_grasp` call each ask for it).  Any other plant
+    :func:`~drakegrasp.analyze_grasp` call each ask for it), its positions
+    checked finite again (positions set in the block are written back by
+    planners).  Any other plant
     or context is checked as usual.  The pair is held in a ``ContextVar``: other
     threads and tasks do not see it.
 

@@ -127,3 +127,27 @@ def test_the_message_names_every_joint_that_is_not_finite():
     assert str(caught.value).count("at [inf]") == 2
     plant.SetPositions(ctx, q)
     assert plant_context_of(plant, scene.context) is ctx
+
+
+def test_a_checked_context_set_to_nan_inside_its_block_is_refused():
+    # the cache of checked_context returned the context before the check: a
+    # NaN set inside the block reached plan_grasps' write-back (Drake's abort)
+    from drakegrasp.plant.validation import checked_context
+
+    scene = planning_scene(
+        "package://drakegrasp/objects/box.sdf",
+        hand_url="package://drakegrasp/hands/parallel_jaw.sdf",
+    )
+    plant = scene.plant
+    ctx = plant.GetMyContextFromRoot(scene.context)
+    q = plant.GetPositions(ctx).copy()
+    joint = next(
+        plant.get_joint(j)
+        for j in plant.GetJointIndices()
+        if plant.get_joint(j).num_positions() == 1
+    )
+    with checked_context(plant, ctx) as checked:
+        joint.set_translation(checked, np.nan)
+        with pytest.raises(dg.InvalidPoseError, match="not finite"):
+            plant_context_of(plant, checked)
+    plant.SetPositions(ctx, q)

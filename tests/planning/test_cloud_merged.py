@@ -293,3 +293,19 @@ def test_the_twin_warning_names_the_callers_line():
             mu=0.5, seed=0, robustness_samples=0, point_cloud=points,
         )  # fmt: skip
     assert {w.filename for w in caught if "near twins" in str(w.message)} == {__file__}
+
+
+def test_twins_of_two_patches_far_apart_are_told():
+    # a small cloud's profile reaches across to the other patch: that jump
+    # (at a patch's size) was larger than the twins' and hid it, the spacing
+    # the registration error; twins are looked for up to a spot in 64 only
+    rng = np.random.default_rng(0)
+    patch = np.c_[np.zeros(300), rng.uniform(0.0, 0.03, (300, 2))]
+    two = np.r_[patch, patch + [0.5, 0.0, 0.0]]
+    merged = np.r_[two, two + rng.normal(0.0, 1e-4, two.shape)]
+    normals = np.tile([1.0, 0.0, 0.0], (len(merged), 1))
+    with pytest.warns(PointCloudWarning, match="near twins"):
+        surface = CloudSurface(merged, normals, origin=np.zeros(3))
+    single = CloudSurface(two, normals[: len(two)], origin=np.zeros(3))
+    assert surface.seen == 2
+    assert 0.7 * single.spacing < surface.spacing < 1.05 * single.spacing
