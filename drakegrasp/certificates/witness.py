@@ -122,9 +122,13 @@ def _readable(N: np.ndarray) -> np.ndarray:
         e = np.zeros(N.shape[0])
         e[j] = 1.0
         if rest.shape[1] and np.linalg.norm(rest.T @ e) > 1.0 - 1e-9:
+            # the axis itself (within 1e-9 of the span), and the span less
+            # it: one column fewer (thresholded, an axis only nearly in the
+            # span left its small part behind as a column more, a direction
+            # out of the span: a witness failing its own check)
             picked.append(e)
-            U, sv, _ = np.linalg.svd(rest - np.outer(e, e @ rest), full_matrices=False)
-            rest = U[:, sv > 1e-9]
+            U, _, _ = np.linalg.svd(rest - np.outer(e, e @ rest), full_matrices=False)
+            rest = U[:, : rest.shape[1] - 1]
     return np.column_stack(picked + [rest]) if picked else N
 
 
