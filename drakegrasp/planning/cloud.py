@@ -85,10 +85,17 @@ __all__ = [
     "NORMAL_NEIGHBOURS",
     "NORMAL_OWN_FACTOR",
     "PAD_CONTACT_BAND",
+    "SPACING_DENSITY_FLOOR",
+    "SPACING_NEIGHBOURS",
+    "SPACING_REACH",
     "SPOT_LINKS",
     "SPOT_NEIGHBOURS",
     "TWIN_JUMP",
+    "TWIN_MIN_POINTS",
     "TWIN_MIN_SPOTS",
+    "TWIN_RADIUS",
+    "TWIN_SHARE",
+    "TWIN_TIGHT",
     "UNSEEN_DEPTH_ANGLE",
     "UNSEEN_WEAK",
     "VOXEL_SPACINGS",
@@ -403,7 +410,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
     _refuse_strays(points)
     spots = _spots(points)
     merged = 0  # points gathered into their spots' means: not dropped
-    if spots.seen > 1:  # scans merged as they were: one point per spot
+    if spots.sharp:  # scans merged as they were: one point per spot
         read = len(points)
         points, normals = _gather(points, normals, spots)
         merged = read - len(points)
@@ -975,23 +982,71 @@ TWIN_JUMP = 3.0
 """How many times farther the next spot lies than a spot's own points.
 
 Scans merged without downsampling see each spot of the surface several
-times, a registration error apart.  The median distance from a point to its
-``k``-th nearest then jumps, from ``k = seen - 1`` (its farthest twin) to
-``k = seen`` (the nearest point of another spot), by the ratio of the spots'
-spacing to the error: 4-125 for 2-100 scans 0.01-0.1 mm apart on a 2 mm
-cloud.  The largest such step of a single scan is 1.4-1.6 (points at random
-or on a grid), and 2 for a line scanner's pass (its points evenly along
-lines).  Scans blurred by a larger error show none and read as one noisy
-scan: measured on a box, from an error (standard deviation) of 0.2 of the
-single scan's spacing for 2 scans, 0.1 for 4 to 50."""
+times, a registration error apart.  The distances from a point to its
+nearest ones then jump, past its own spot's twins, by the ratio of the
+spots' spacing to the error: 4-125 for 2-100 scans 0.01-0.1 mm apart on a
+2 mm cloud.  Each point's jump is its own, so spots of different counts
+(scans that overlap in part, or of different densities) are told alike.  A
+single scan's points show such a jump now and then (a point whose nearest
+happens to be near): the cloud has *sharp twins* when most of its points
+do (:data:`TWIN_SHARE`).  Scans blurred by a larger error (a standard
+deviation near a tenth of their spacing) show none, and are told by their
+density instead (:data:`SPACING_DENSITY_FLOOR`)."""
 
-TWIN_MIN_SPOTS = 64
-"""Fewest spots for near twins to be told (a cloud of two patches far apart
-has one jump, at the size of a patch, and two "spots")."""
+TWIN_SHARE = 0.5
+"""Share of the points whose neighbour distances jump by :data:`TWIN_JUMP`
+for a cloud to have sharp twins (a single scan at random: about 0.1)."""
+
+TWIN_MIN_SPOTS = 256
+"""Fewest spots a cloud of sharp twins has (clusters of points far apart,
+200 cubes of 20 points each, are not twins of one surface)."""
 
 SPOT_NEIGHBOURS = 1024
-"""Neighbours looked through for the jump: the most scans merged whose
-twins are told (more read as one noisy scan)."""
+"""Neighbours looked through for a point's jump: the most scans merged whose
+sharp twins are told."""
+
+SPACING_NEIGHBOURS = 64
+"""Neighbours whose farthest sets a point's density spacing (see
+:data:`SPACING_DENSITY_FLOOR`)."""
+
+SPACING_DENSITY_FLOOR = 0.4
+"""The spacing of scans merged as they were, blurred, in spot spacings.
+
+A point's density spacing, ``sqrt(pi / k) r_k`` with ``r_k`` the distance to
+its ``k``-th neighbour (``k`` = :data:`SPACING_NEIGHBOURS`), is the side of
+the square it has on the surface; the cloud's is the median.  On a randomly
+sampled surface the median nearest-neighbour distance is 0.46-0.52 of it (on
+a grid, 1).
+
+Scans merged with a registration error too large for a jump
+(:data:`TWIN_JUMP`) but below their spacing still see each spot several
+times: the nearest-neighbour median is the error.  The points within
+:data:`TWIN_RADIUS` density spacings of a point are one spot; with ``m`` the
+median count, a spot has ``m`` times a point's square, ``sqrt(m)`` times its
+side, and such a cloud's spacing is this fraction of a spot's side (about 0.8
+of one scan's nearest-neighbour median).  Other clouds keep that median."""
+
+SPACING_REACH = 20.0
+"""The density spacing is a surface's when a point's
+:data:`SPACING_NEIGHBOURS`-th neighbour lies at most this many times farther
+than its quarter of them (on a surface about 2; up to 10 for blurred twins): not
+in another piece of the cloud (70 cubes of 30 points 0.5 m apart read as
+twins of 30, a line radius of 0.6 m)."""
+
+TWIN_RADIUS = 0.25
+"""Points this many density spacings apart are one spot seen twice (a
+randomly sampled surface has another point that near one point in five)."""
+
+TWIN_TIGHT = 0.75
+"""Blurred twins lie this close: a point's nearest (the median) within this
+fraction of :data:`TWIN_RADIUS`.  Scans merged 0.01-0.1 mm apart put it at
+0.05-0.5 of it; a single scan with a dense patch that happens to put a second
+point in the radius, at 0.8-1."""
+
+TWIN_MIN_POINTS = 4 * SPACING_NEIGHBOURS
+"""Fewest distinct points for blurred twins to be told: in a smaller cloud
+the :data:`SPACING_NEIGHBOURS`-th neighbour lies across the object, and its
+spots are no spots (a 58-point face read as twins of three)."""
 
 VOXEL_SPACINGS = 2.0
 """The voxel a twin warning suggests, in spot spacings: few spots are split
@@ -999,14 +1054,17 @@ across voxels' sides (at 1.5 spacings, 50 scans 0.1 mm apart still came in
 twins), at the price of a coarser cloud (on the sugar box, 2,000-2,750
 points of 3,000 spots, their spacing 1.0-1.5 times theirs)."""
 
-_SPOT_QUERIES = 128
-"""Points, evenly spread over the cloud, whose neighbour distances tell the
-jump (their medians; a jump is 3 or more where a single scan's steps are 2
-at most)."""
+_SPOT_QUERIES = 512
+"""Points, evenly spread over the cloud, whose own jumps are measured."""
 
 _SPOT_SPACING_QUERIES = 16384
 """Points, evenly strided, whose distance past their twins is the spacing
-(the median of 512 can be 10 % off all of them; of 16,384, 1 %)."""
+(the median of 512 can be 10 % off all of them; of 16,384, 1 %); fewer where
+a spot holds hundreds (4 million distances at most)."""
+
+_SPACING_QUERIES = 4096
+"""Points, evenly strided, whose density spacing and blurred spot are
+measured (the median of 4,096 is within a few per cent of all of them)."""
 
 
 class _Spots(NamedTuple):
@@ -1020,6 +1078,9 @@ class _Spots(NamedTuple):
     """Points per spot (the median): 1 unless scans were merged as they were."""
     radius: float
     """Points this close (m) are one spot: :data:`DISTINCT` unless ``seen > 1``."""
+    sharp: bool = False
+    """Twins told by their jump (:data:`TWIN_JUMP`): each spot can be
+    gathered into its mean.  Blurred twins (told by their density) are not."""
 
 
 def _cells(points: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarray]:
@@ -1082,40 +1143,87 @@ def _spots(points: np.ndarray) -> _Spots:
 
     The points are taken once each (on a grid of :data:`DISTINCT`: merged
     camera frames repeat the points they share).  The spacing is the median
-    distance from a point to its nearest, unless the median distance to the
-    ``k``-th nearest jumps by :data:`TWIN_JUMP` or more at some ``k``
-    (looking through :data:`SPOT_NEIGHBOURS`), in a cloud of at least
-    :data:`TWIN_MIN_SPOTS` spots of ``k`` points.  Then the points come in
-    spots of ``seen = k`` near twins, the spacing is the median distance to
-    the nearest point of another spot (what one of the scans would give),
-    and the spot radius is halfway (geometrically) between a spot's
-    farthest twin and that.
+    distance from a point to its nearest, unless
+
+    - most points' distances to their nearest ones jump by :data:`TWIN_JUMP`
+      (:data:`TWIN_SHARE`), in a cloud of at least :data:`TWIN_MIN_SPOTS`
+      spots: *sharp twins*.  ``seen`` is the median count of a point's spot
+      (itself and the neighbours before its jump), the spacing the median
+      distance past each point's own jump (its nearest point of another
+      spot; a point without a jump counts its nearest), and the spot radius
+      halfway (geometrically) between a spot's farthest twin and that;
+    - else, the points come in blurred twins (:func:`_blurred`): the spacing
+      is :data:`SPACING_DENSITY_FLOOR` of a spot's side.
     """
     distinct = _distinct(points)
     if len(distinct) < 2:
         return _Spots(0.0, 0.0, 1, DISTINCT)
     tree = cKDTree(distinct)
     nearest = float(np.median(tree.query(distinct, k=2)[0][:, 1]))
-    alone = _Spots(nearest, nearest, 1, DISTINCT)
-    if len(distinct) < 2 * TWIN_MIN_SPOTS:
-        return alone
-    # seen = k + 2 points per spot, at most len / TWIN_MIN_SPOTS: a larger
-    # jump farther out (a patch's size) must not hide a twin's
-    most = len(distinct) // TWIN_MIN_SPOTS - 1
-    K = min(SPOT_NEIGHBOURS, len(distinct) - 1, most + 1)
-    queries = distinct[np.linspace(0, len(distinct) - 1, _SPOT_QUERIES).astype(int)]
-    reach = np.median(tree.query(queries, k=K + 1)[0][:, 1:], axis=0)  # (K,)
+    if len(distinct) >= 2 * TWIN_MIN_SPOTS:
+        K = min(SPOT_NEIGHBOURS, len(distinct) // TWIN_MIN_SPOTS)
+        at = np.linspace(0, len(distinct) - 1, _SPOT_QUERIES).astype(int)
+        own = _own_spots(tree.query(distinct[at], k=K + 1)[0][:, 1:])
+        if np.mean(own > 1) >= TWIN_SHARE:
+            seen = int(np.median(own))
+            # the distances past each point's jump, of every point strided
+            K = min(K, 2 * int(np.max(own)) + 2)
+            count = max(1024, min(_SPOT_SPACING_QUERIES, 4_000_000 // K))
+            many = distinct[:: max(1, len(distinct) // count)]
+            d = tree.query(many, k=K + 1)[0][:, 1:]
+            mine = _own_spots(d)
+            rows = np.arange(len(d))
+            past = d[rows, np.minimum(mine - 1, K - 1)]
+            farthest = d[rows, np.maximum(mine - 2, 0)]
+            twinned = mine > 1
+            spacing = float(np.median(past))
+            radius = float(np.sqrt(np.median(farthest[twinned]) * spacing))
+            return _Spots(nearest, spacing, seen, radius, sharp=True)
+    blurred = _blurred(tree, distinct, nearest)
+    return blurred or _Spots(nearest, nearest, 1, DISTINCT)
+
+
+def _own_spots(d: np.ndarray) -> np.ndarray:
+    """Each point's spot count: 1 + the neighbours before its jump.
+
+    ``d`` (n, K) are the sorted distances to its ``K`` nearest others; the
+    jump is the first step of :data:`TWIN_JUMP` or more (none: 1).
+    """
     with np.errstate(divide="ignore", invalid="ignore"):
-        step = reach[1:] / reach[:-1]
-    step[~np.isfinite(step)] = 0.0  # a zero reach: below DISTINCT, no spot
-    k = int(np.argmax(step))  # reach[k] the farthest twin, reach[k + 1] beyond
-    seen = k + 2
-    if step[k] < TWIN_JUMP:
-        return alone
-    many = distinct[:: max(1, len(distinct) // _SPOT_SPACING_QUERIES)]
-    beyond = np.median(tree.query(many, k=seen + 1)[0][:, seen - 1 :], axis=0)
-    spacing = float(beyond[1])  # the nearest point past the farthest twin
-    return _Spots(nearest, spacing, seen, float(np.sqrt(beyond[0] * spacing)))
+        step = d[:, 1:] / d[:, :-1]
+    jump = np.isfinite(step) & (step >= TWIN_JUMP)
+    has = jump.any(axis=1)
+    return np.where(has, np.argmax(jump, axis=1) + 2, 1)
+
+
+def _blurred(tree, distinct: np.ndarray, nearest: float) -> _Spots | None:
+    """Scans merged as they were whose twins show no jump, told by density.
+
+    The median number ``m`` of distinct points within :data:`TWIN_RADIUS`
+    density spacings of a point (its spot) is 2 or more (the density a
+    surface's, :data:`SPACING_REACH`), a point's nearest
+    lies well inside that (:data:`TWIN_TIGHT`), and the nearest-neighbour
+    median is below :data:`SPACING_DENSITY_FLOOR` of a spot's side (the
+    density spacing times ``sqrt(m)``); at least :data:`TWIN_MIN_POINTS`
+    distinct points.  None otherwise.
+    """
+    if len(distinct) < TWIN_MIN_POINTS:  # k reaches across the object: no spots
+        return None
+    k = min(SPACING_NEIGHBOURS, len(distinct) - 1)
+    queries = distinct[:: max(1, len(distinct) // _SPACING_QUERIES)]
+    reach = np.median(tree.query(queries, k=k + 1)[0], axis=0)
+    if reach[k] > SPACING_REACH * reach[k // 4]:  # across to other pieces
+        return None
+    density = float(np.sqrt(np.pi / k) * reach[k])
+    near = tree.query_ball_point(queries, TWIN_RADIUS * density, return_length=True)
+    seen = max(1, int(np.median(near)))
+    side = density * np.sqrt(seen)
+    radius = TWIN_RADIUS * density
+    if seen < 2 or nearest > TWIN_TIGHT * radius:
+        return None
+    if not nearest < SPACING_DENSITY_FLOOR * side:
+        return None
+    return _Spots(nearest, SPACING_DENSITY_FLOOR * side, seen, radius)
 
 
 def _warn_of_twins(spots: _Spots, gathered: tuple[int, int] | None = None) -> None:
