@@ -1837,6 +1837,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (OSError, ValueError, RuntimeError, MemoryError) as e:
         # File or Drake errors that were not already wrapped.
         return _error(f"{type(e).__name__}: {e}" if not str(e) else str(e))
+    except SystemExit as e:
+        # pydrake raises a failed DRAKE_DEMAND ("Failure at ...") as
+        # SystemExit with its text: one line, like any other refusal
+        if not isinstance(e.code, str):
+            raise
+        return _error(e.code)
     except Exception as e:  # noqa: BLE001 - the CLI never shows a traceback
         if os.environ.get("DRAKEGRASP_DEBUG"):
             raise

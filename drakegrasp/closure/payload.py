@@ -176,7 +176,7 @@ def _build(P: LoadProblem, d: np.ndarray, alpha_unit: float | None = None):
         # of a friction-scaled problem, see LoadProblem.friction_scaled).
         unit = alpha_unit
         F0 = unit * size / P.tangent_scale
-        column = target * (P.tangent_scale / size)
+        column = (target / size) * P.tangent_scale  # a subnormal size: no inf
     prog = MathematicalProgram()
     x = prog.NewContinuousVariables(P.num_forces, "f")
     alpha = prog.NewContinuousVariables(1, "alpha")[0]

@@ -55,6 +55,7 @@ from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import coupling_entries, coupling_entry
+from drakegrasp.plant.models import drake_reading
 
 __all__ = [
     "COUPLING_TOL",
@@ -383,7 +384,7 @@ def add_models(
             raise InvalidOptionError(f"text needs kind='urdf' or 'sdf', got {kind!r}")
         resolve = model_resolver(parser.package_map(), Path.cwd())
         check_joint_limits(text, kind, "the model text", resolve=resolve)
-        instances = parser.AddModelsFromString(text, kind)
+        instances = drake_reading(parser.AddModelsFromString, text, kind)
         _record_text(plant, text, kind, instances, resolve)
         return instances
     path = parser.package_map().ResolveUrl(url) if url is not None else str(file_name)
@@ -392,10 +393,12 @@ def add_models(
     resolve = model_resolver(parser.package_map(), Path(path).parent)
     if document is not None:
         check_joint_limits(document, kind, path, resolve=resolve)
+    # through drake_reading: a shape Drake refuses (a sphere of radius NaN)
+    # is a RuntimeError, not pydrake's SystemExit that ends the program
     if url is not None:
-        instances = parser.AddModels(url=url)
+        instances = drake_reading(parser.AddModels, url=url)
     else:
-        instances = parser.AddModels(str(file_name))
+        instances = drake_reading(parser.AddModels, str(file_name))
     if document is not None:
         _record_text(plant, document, kind, instances, resolve)
     return instances
