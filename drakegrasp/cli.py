@@ -1372,6 +1372,9 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     result = _in_plan_words(result)
     # The plan is written and printed before the shake, so that a shake that
     # fails or is interrupted leaves it (JSON is one document: shaken first).
+    if args.scene_out is not None and not len(result):
+        # before --out is written: a failed command leaves no file behind
+        raise InvalidOptionError("--scene-out: the plan has no candidate to write")
     if args.out is not None:
         _write_plan_parquet(result, args.out, overwrite=args.overwrite)
     if args.json:

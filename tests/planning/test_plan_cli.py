@@ -259,3 +259,14 @@ def test_a_mass_whose_weight_overflows_is_refused_in_one_line(capsys):
     assert main(["plan", "--num", "5", "--mass", "1e308"]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--mass = 1e+308 kg weighs more" in err[0], err
+
+
+@pytest.mark.parametrize("argv", [["--num", "0"], ["--num", "1", "--seed", "3"]])
+def test_an_empty_plan_with_scene_out_writes_no_file(tmp_path, capsys, argv):
+    # --out was written, then --scene-out refused: the failed command left
+    # its parquet file behind
+    out, scene = tmp_path / "e.parquet", tmp_path / "e.yaml"
+    assert main(["plan", *argv, "--out", str(out), "--scene-out", str(scene)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no candidate to write" in err[0]
+    assert not out.exists() and not scene.exists()
