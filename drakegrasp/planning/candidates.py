@@ -408,6 +408,14 @@ def _held_joints(plant, held_joints) -> list:
     return out
 
 
+def _named_pairs(held) -> bool:
+    """Whether ``held`` is a tuple or list of (str, value) pairs."""
+    return isinstance(held, tuple | list) and all(
+        isinstance(pair, tuple | list) and len(pair) == 2 and isinstance(pair[0], str)
+        for pair in held
+    )
+
+
 def _held_values(k: int, candidate: GraspCandidate) -> dict[str, float]:
     """Candidate ``k``'s ``held_joints`` as ``{name: value}``, for the table.
 
@@ -418,15 +426,7 @@ def _held_values(k: int, candidate: GraspCandidate) -> dict[str, float]:
         real number (NaN passes: the table records what the candidate says).
     """
     held = candidate.held_joints
-    if not (
-        isinstance(held, tuple | list)
-        and all(
-            isinstance(pair, tuple | list)
-            and len(pair) == 2
-            and isinstance(pair[0], str)
-            for pair in held
-        )
-    ):
+    if not _named_pairs(held):
         raise InvalidGraspError(
             f"candidate {k}'s held_joints must be (joint name, value) pairs, "
             f"got {reprlib.repr(held)}"
@@ -488,16 +488,7 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
             )
         values[field_name] = a
     held = candidate.held_joints
-    if not (
-        isinstance(held, tuple | list)
-        and all(
-            isinstance(pair, tuple | list)
-            and len(pair) == 2
-            and isinstance(pair[0], str)
-            and _finite_number(pair[1])
-            for pair in held
-        )
-    ):
+    if not (_named_pairs(held) and all(_finite_number(v) for _, v in held)):
         raise InvalidGraspError(
             "the candidate's held_joints must be (joint name, finite number) "
             f"pairs, got {reprlib.repr(held)}"

@@ -108,14 +108,18 @@ def test_positions_not_finite_are_refused_by_name():
         assert f"::{joint}' at [" in line, line
 
 
-def test_the_message_names_every_joint_that_is_not_finite():
+def _jaw_scene():
+    """The shipped jaw and box: the scene, its plant, context and positions."""
     scene = planning_scene(
         "package://drakegrasp/objects/box.sdf",
         hand_url="package://drakegrasp/hands/parallel_jaw.sdf",
     )
-    plant = scene.plant
-    ctx = plant.GetMyContextFromRoot(scene.context)
-    q = plant.GetPositions(ctx).copy()
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    return scene, scene.plant, ctx, scene.plant.GetPositions(ctx).copy()
+
+
+def test_the_message_names_every_joint_that_is_not_finite():
+    scene, plant, ctx, q = _jaw_scene()
     finite = plant_context_of(plant, scene.context)
     assert finite is ctx
     for j in plant.GetJointIndices():
@@ -134,13 +138,7 @@ def test_a_checked_context_set_to_nan_inside_its_block_is_refused():
     # NaN set inside the block reached plan_grasps' write-back (Drake's abort)
     from drakegrasp.plant.validation import checked_context
 
-    scene = planning_scene(
-        "package://drakegrasp/objects/box.sdf",
-        hand_url="package://drakegrasp/hands/parallel_jaw.sdf",
-    )
-    plant = scene.plant
-    ctx = plant.GetMyContextFromRoot(scene.context)
-    q = plant.GetPositions(ctx).copy()
+    scene, plant, ctx, q = _jaw_scene()
     joint = next(
         plant.get_joint(j)
         for j in plant.GetJointIndices()
