@@ -121,13 +121,20 @@ def _readable(N: np.ndarray) -> np.ndarray:
     for j in range(N.shape[0]):
         e = np.zeros(N.shape[0])
         e[j] = 1.0
-        if rest.shape[1] and np.linalg.norm(rest.T @ e) > 1.0 - 1e-9:
-            # the axis itself (within 1e-9 of the span), and the span less
-            # it: one column fewer (thresholded, an axis only nearly in the
-            # span left its small part behind as a column more, a direction
-            # out of the span: a witness failing its own check)
-            picked.append(e)
-            U, _, _ = np.linalg.svd(rest - np.outer(e, e @ rest), full_matrices=False)
+        along = rest.T @ e
+        if rest.shape[1] and np.linalg.norm(along) > 1.0 - 1e-9:
+            # the axis as the span holds it (within 1e-9 of it; the axis
+            # itself when it lies in the span to round-off, which keeps the
+            # wording's axes exact), and the span less it: one column fewer.
+            # Thresholded, an axis only nearly in the span left its small part
+            # behind as a column more; taken as it was, it tilted the span by
+            # up to 4.5e-5 rad: witnesses failing their own check
+            v = rest @ along
+            v /= np.linalg.norm(v)
+            if np.linalg.norm(v - e) <= 1e-12:
+                v = e
+            picked.append(v)
+            U, _, _ = np.linalg.svd(rest - np.outer(v, v @ rest), full_matrices=False)
             rest = U[:, : rest.shape[1] - 1]
     return np.column_stack(picked + [rest]) if picked else N
 

@@ -364,13 +364,12 @@ class LoadProblem:
             hand = float(np.max(size, initial=0.0))
             for j in self.limited_joints():
                 lim = self.torque_limits[j]
-                scale = max(lim, size[j])
-                if lim <= FEASIBILITY_TOL * hand:
-                    # a joint without a motor (a limit of 0, or one below what
-                    # the check resolves): against the hand's torques.  A
-                    # finger pressing 1e-12 of the load left 2e-14 N·m there,
-                    # measured against its own terms a violation "by 3 %"
-                    scale = max(scale, hand)
+                # at least the hand's largest torque terms times the tolerance:
+                # a joint without a motor (limit 0) under a finger pressing
+                # 1e-12 of the load got 2e-14 N·m, which its own terms (of
+                # that size) called a violation "by 3 %"; a torque 1.8 times
+                # a small but real limit is still one
+                scale = max(lim, size[j], FEASIBILITY_TOL * hand)
                 note(abs(tau[j]) - lim, scale, f"joint {j}")
         fn = full[self.grasp.normal_indices()]
         for i in self.bounded_contacts():

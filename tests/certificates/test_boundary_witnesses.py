@@ -78,3 +78,27 @@ def test_an_axis_nearly_in_the_null_space_adds_no_column(tilt):
     assert not result.is_closure and result.rank == 4
     assert result.certificate.null_basis.shape[1] == 6 - result.rank
     assert result.certificate.check(grasp).holds
+
+
+@pytest.mark.parametrize("tilt", [1e-8, 1e-6, 1e-5, 4e-5, 1e-4])
+def test_an_axis_nearly_in_the_null_space_is_taken_as_the_span_holds_it(tilt):
+    # the normals tilted out of the plane instead: the bare axis, taken for
+    # the span's direction, tilted the span by up to 4.5e-5 rad, and the
+    # escape twist failed its own check (violation about the tilt)
+    R = 0.03
+    contacts = [
+        dg.Contact(
+            [R * np.cos(a), R * np.sin(a), z],
+            [-np.cos(a), -np.sin(a), tilt * sign],
+            mu=0.5,
+        )
+        for a, z, sign in [
+            (0.29, 0.019, 1), (0.25, -0.0007, -1), (np.pi + 0.29, -0.0007, 1),
+            (np.pi + 0.25, 0.019, -1),
+        ]
+    ]  # fmt: skip
+    grasp = dg.Grasp(contacts)
+    result = dg.form_closure(grasp)
+    assert not result.is_closure
+    assert result.certificate.null_basis.shape[1] == 6 - result.rank
+    assert result.certificate.check(grasp).holds
