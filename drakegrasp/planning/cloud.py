@@ -411,10 +411,13 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
     spots = _spots(points)
     merged = 0  # points gathered into their spots' means: not dropped
     if spots.sharp:  # scans merged as they were: one point per spot
+        if normals is not None:  # unit and oriented, for twins to agree
+            points, normals = _oriented(points, normals, viewpoint)
         read = len(points)
         points, normals = _gather(points, normals, spots)
         merged = read - len(points)
-        _warn_of_twins(spots, (read, len(points)))
+        if merged:  # none: twins whose normals disagree (a plate's two faces)
+            _warn_of_twins(spots, (read, len(points)))
     fit = None
     if normals is None:
         normals, fit = _estimate_normals(points)
@@ -432,10 +435,24 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
             f"point_cloud has {len(points)} points of {total} with a finite, "
             "non-zero normal: too few to grasp"
         )
+    points, normals = _oriented(points, normals, viewpoint, checked=True)
+    return points, normals, total - merged - len(points), fit
+
+
+def _oriented(points, normals, viewpoint, checked: bool = False):
+    """Points with a normal, and their unit normals turned to the viewpoint.
+
+    ``checked``: the normals are already unit and non-zero.  Without a
+    viewpoint, away from the points' centroid.
+    """
+    if not checked:
+        ok = np.any(normals != 0.0, axis=1)
+        points = points[ok]
+        normals = unit_vectors("cloud_normals", normals[ok], error=InvalidOptionError)
     towards = points - points.mean(axis=0) if viewpoint is None else viewpoint - points
     flip = np.sum(normals * towards, axis=1) < 0
     normals[flip] *= -1
-    return points, normals, total - merged - len(points), fit
+    return points, normals
 
 
 def _refuse_strays(points: np.ndarray) -> None:
@@ -884,7 +901,7 @@ def _areas(points: np.ndarray, normals: np.ndarray, spots=None) -> np.ndarray:
         The spots of ``points`` (see :data:`TWIN_JUMP`), if already at hand.
     """
     M = len(points)
-    first, spot = _gathered(points, _spots(points) if spots is None else spots)
+    first, spot = _gathered(points, _spots(points) if spots is None else spots, normals)
     if len(first) <= AREA_NEIGHBOURS:
         return np.ones(M)
     share = _spot_areas(points[first], normals[first])
@@ -998,8 +1015,9 @@ TWIN_SHARE = 0.5
 for a cloud to have sharp twins (a single scan at random: about 0.1)."""
 
 TWIN_MIN_SPOTS = 256
-"""Fewest spots a cloud of sharp twins has (clusters of points far apart,
-200 cubes of 20 points each, are not twins of one surface)."""
+"""Fewest spots a cloud of sharp twins has: a spot holds at most this
+fraction of its points (clusters of points far apart are not twins of one
+surface: 200 cubes of 20 points each are not; 300 are)."""
 
 SPOT_NEIGHBOURS = 1024
 """Neighbours looked through for a point's jump: the most scans merged whose
@@ -1105,22 +1123,26 @@ into spots (each spot one share of the surface in the completion's centre):
 a spot of up to a hundred points is one connected piece."""
 
 
-def _gathered(points: np.ndarray, spots: _Spots) -> tuple[np.ndarray, np.ndarray]:
+def _gathered(
+    points: np.ndarray, spots: _Spots, normals: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """The spots ``points`` gather in, as :func:`_cells` gives cells.
 
     Repeats (:data:`DISTINCT`) are one spot.  For near twins (``seen > 1``) a
     spot is a connected piece of the graph linking each distinct point to its
     :data:`SPOT_LINKS` nearest within ``spots.radius``, wherever it lies (a
     grid of cells would split a spot across a cell's side and count it
-    twice).  Repeats are taken once first: a point's nearest would otherwise
-    be its own copies, and its twins left unlinked.
+    twice), and, given oriented unit ``normals``, only where they agree
+    (:data:`FIT_FACE_COS`: the two faces of a plate thinner than the radius
+    stay apart).  Repeats are taken once first: a point's nearest would
+    otherwise be its own copies, and its twins left unlinked.
     """
     first, cell = _cells(points, DISTINCT)
     if spots.seen == 1:
         return first, cell
     distinct = points[first]
     M = len(distinct)
-    k = min(SPOT_LINKS, spots.seen - 1, M - 1) + 1
+    k = min(SPOT_LINKS, M - 1) + 1  # within the radius: a spot of more links too
     tree = cKDTree(distinct)
     rows, cols = [], []
     for lo in range(0, M, _AREA_CHUNK):  # memory ~ 16 k bytes per point
@@ -1128,8 +1150,13 @@ def _gathered(points: np.ndarray, spots: _Spots) -> tuple[np.ndarray, np.ndarray
             distinct[lo : lo + _AREA_CHUNK], k=k, distance_upper_bound=spots.radius
         )
         linked = np.isfinite(d)
-        rows.append((np.nonzero(linked)[0] + lo).astype(np.int32))
-        cols.append(j[linked].astype(np.int32))
+        r, c = np.nonzero(linked)[0] + lo, j[linked]
+        if normals is not None:
+            n = normals[first]
+            agree = np.einsum("ij,ij->i", n[r], n[c]) >= FIT_FACE_COS
+            r, c = r[agree], c[agree]
+        rows.append(r.astype(np.int32))
+        cols.append(c.astype(np.int32))
     rows, cols = np.concatenate(rows), np.concatenate(cols)
     graph = coo_matrix((np.ones(len(rows), bool), (rows, cols)), shape=(M, M))
     _, piece = connected_components(graph, directed=False)
@@ -1164,8 +1191,8 @@ def _spots(points: np.ndarray) -> _Spots:
         K = min(SPOT_NEIGHBOURS, len(distinct) // TWIN_MIN_SPOTS)
         at = np.linspace(0, len(distinct) - 1, _SPOT_QUERIES).astype(int)
         own = _own_spots(tree.query(distinct[at], k=K + 1)[0][:, 1:])
-        if np.mean(own > 1) >= TWIN_SHARE:
-            seen = int(np.median(own))
+        seen = int(np.ceil(np.median(own)))
+        if np.mean(own > 1) >= TWIN_SHARE and seen >= 2:
             # the distances past each point's jump, of every point strided
             K = min(K, 2 * int(np.max(own)) + 2)
             count = max(1024, min(_SPOT_SPACING_QUERIES, 4_000_000 // K))
@@ -1254,10 +1281,10 @@ def _warn_of_twins(spots: _Spots, gathered: tuple[int, int] | None = None) -> No
 def _gather(points: np.ndarray, normals, spots: _Spots):
     """Each spot of ``points`` (:func:`_gathered`) as its mean point, in order.
 
-    ``normals`` (or None): each spot's the sum of its points' (their
-    direction is all that counts).
+    ``normals`` (or None): oriented unit normals, which link only twins that
+    agree; each spot's is the sum of its points'.
     """
-    first, spot = _gathered(points, spots)
+    first, spot = _gathered(points, spots, normals)
     order = np.argsort(first, kind="stable")  # spots in their first point's order
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))

@@ -301,3 +301,32 @@ def test_twins_of_two_patches_far_apart_are_told():
     single = CloudSurface(two, normals[: len(two)], origin=np.zeros(3))
     assert surface.seen == 2
     assert 0.7 * single.spacing < surface.spacing < 1.05 * single.spacing
+
+
+def test_gathering_keeps_a_plates_two_faces_and_unoriented_normals():
+    # a plate 0.5 mm thick sampled on both faces reads as sharp twins; its
+    # faces' normals summed to 0 (read_cloud refused every point) and without
+    # them its thickness was gone; normals of random sign cancelled (1,102 of
+    # 2,997 spots of 4 scans of a sphere dropped)
+    from drakegrasp.planning.cloud import read_cloud
+
+    g = np.arange(0.0, 0.102, 0.002)
+    x, y = (a.ravel() for a in np.meshgrid(g, g))
+    top = np.c_[x, y, np.full(x.size, 0.0005)]
+    bottom = np.c_[x, y, np.zeros(x.size)]
+    plate = np.r_[top, bottom]
+    up = np.tile([0.0, 0.0, 1.0], (len(top), 1))
+    points, normals, dropped = read_cloud(plate, np.r_[up, -up])
+    assert len(points) == len(plate) and dropped == 0
+    assert np.ptp(points[:, 2]) == pytest.approx(0.0005)
+
+    rng = np.random.default_rng(3)
+    sphere = rng.normal(size=(3000, 3))
+    sphere /= np.linalg.norm(sphere, axis=1, keepdims=True)
+    scans = _merged(0.05 * sphere, 4, 1e-5)
+    signs = rng.choice([-1.0, 1.0], size=(len(scans), 1))
+    with pytest.warns(PointCloudWarning, match="near twins"):
+        points, normals, dropped = read_cloud(scans, signs * np.tile(sphere, (4, 1)))
+    assert dropped == 0 and len(points) >= 2900
+    truth = points / np.linalg.norm(points, axis=1, keepdims=True)
+    assert np.min(np.sum(normals * truth, axis=1)) > np.cos(np.radians(0.5))
