@@ -1374,7 +1374,13 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     # fails or is interrupted leaves it (JSON is one document: shaken first).
     if args.scene_out is not None and not len(result):
         # before --out is written: a failed command leaves no file behind
-        raise InvalidOptionError("--scene-out: the plan has no candidate to write")
+        why = "; ".join(
+            f"{count} {reason}" for reason, count in result.rejections.items()
+        )
+        raise InvalidOptionError(
+            f"--scene-out: the plan has no candidate to write ({result.num_sampled}"
+            f" sampled poses, rejected: {why or 'none'})"
+        )
     if args.out is not None:
         _write_plan_parquet(result, args.out, overwrite=args.overwrite)
     if args.json:
