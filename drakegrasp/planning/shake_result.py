@@ -270,8 +270,7 @@ class ShakeResult:
             f"{verdict}: {motion}"
             f" over {self.duration:g} s, squeeze {self.squeeze:g} {unit}"
             + (
-                f" (capped at {_limits(self.squeeze_caps, self.squeeze)} "
-                f"{unit})"
+                f" (capped at {_limits(self.squeeze_caps, self.squeeze)} {unit})"
                 if self.squeeze_capped
                 else ""
             )
