@@ -1204,7 +1204,8 @@ def _spots(points: np.ndarray) -> _Spots:
             farthest = d[rows, np.maximum(mine - 2, 0)]
             twinned = mine > 1
             spacing = float(np.median(past))
-            radius = float(np.sqrt(np.median(farthest[twinned]) * spacing))
+            spread = np.median(farthest[twinned]) if twinned.any() else 0.0
+            radius = float(np.sqrt(spread * spacing)) or spacing / TWIN_JUMP
             return _Spots(nearest, spacing, seen, radius, sharp=True)
     blurred = _blurred(tree, distinct, nearest)
     return blurred or _Spots(nearest, nearest, 1, DISTINCT)
