@@ -1316,7 +1316,8 @@ class CloudSurface:
         :data:`LINE_RADIUS_SPACINGS` times the cloud's spacing (the median
         distance from a point to its nearest distinct neighbour; for near
         twins, as scans merged as they were give, to the nearest point of
-        another spot, :data:`TWIN_JUMP`), at least 1 mm.
+        another spot, :data:`TWIN_JUMP`, or for blurred ones
+        :data:`SPACING_DENSITY_FLOOR` of a spot's side), at least 1 mm.
     viewpoint : (3,) float, optional
         The camera, world frame (a one-sided cloud).
     origin : (3,) float, optional
@@ -1331,7 +1332,8 @@ class CloudSurface:
         The gap between neighbouring points on the surface, metres: the
         median distance from a point to its nearest distinct one, or for
         scans merged as they were to the nearest point of another spot
-        (:data:`TWIN_JUMP`).
+        (:data:`TWIN_JUMP`; blurred: :data:`SPACING_DENSITY_FLOOR` of a
+        spot's side).
     seen : int
         Points per spot: 1, or for scans merged as they were the median
         count of a spot's near twins; point-count thresholds

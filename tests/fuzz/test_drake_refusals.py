@@ -36,7 +36,9 @@ def test_a_shape_drake_refuses_is_one_line(tmp_path, capsys):
     assert len(err) == 1
     assert err[0].startswith("drakegrasp: error: ") and "radius" in err[0]
     with pytest.raises(dg.ModelError, match="radius"):  # not SystemExit
-        dg.planning_scene(str(model))
+        dg.planning_scene(
+            str(model), hand_url="package://drakegrasp/hands/parallel_jaw.sdf"
+        )
 
 
 def test_a_subnormal_load_is_analysed(capsys):
