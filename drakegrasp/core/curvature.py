@@ -345,10 +345,22 @@ def _relative_quadratic(
     R = np.zeros((3 * k, N.shape[1]))
     R[:k] = N
     RBR = R.T @ B @ R
-    if np.min(np.linalg.eigvalsh(RBR)) * length <= ISOLATION_TOL:
+    kappa = np.linalg.eigvalsh(RBR)
+    if kappa[0] * length <= ISOLATION_TOL:
+        shown = np.round(kappa, 9).tolist()
+        if kappa[0] > 0.0:  # positive, yet flat on the scale of the grasp's b
+            raise InvalidContactError(
+                f"the relative curvature κ_object + κ_finger, {shown} 1/m in the "
+                f"smooth directions, times the grasp's length b = {length:g} m "
+                f"is {kappa[0] * length:.3g} <= {ISOLATION_TOL:g} "
+                "(ISOLATION_TOL): on that scale the surfaces conform, as flat on "
+                "flat.  Give the grasp a characteristic_length of its own size "
+                "(by default the largest distance from its reference point to a "
+                "contact)"
+            )
         raise InvalidContactError(
             "the relative curvature κ_object + κ_finger is not positive: "
-            f"{np.round(np.linalg.eigvalsh(RBR), 9).tolist()} 1/m in the smooth "
+            f"{shown} 1/m in the smooth "
             "directions.  Zero means the surfaces conform along a line or an "
             "area (flat on flat: describe the patch by its vertices, as "
             "drakegrasp.find_contacts does); negative means the finger's cavity "

@@ -617,3 +617,31 @@ def test_second_order_tol_is_bounded_as_the_first_orders(tol):
     grasp, curv = _ellipse_grasp(2.0, 1.0)
     with pytest.raises(dg.InvalidOptionError, match=r"tol must be .* \[1e-10, 0.5\]"):
         second_order_form_closure(grasp, curv, tol=tol)
+
+
+def test_a_curvature_flat_only_on_a_tiny_length_says_so():
+    """Positive curvatures judged flat on a user's tiny ``b`` are not "not positive".
+
+    At ``b = 1e-12`` m the jaw's 6 mm pads (166.7 1/m) times ``b`` fall under
+    ``ISOLATION_TOL``: the message said "not positive: [166.67, 166.67]".
+    """
+    from drakegrasp.core.curvature import (
+        ContactCurvature,
+        SurfaceCurvature,
+        contact_hessian,
+    )
+
+    contacts = [
+        dg.Contact([0.0, 0.0, 0.025], [0.0, 0.0, -1.0], mu=0.5),
+        dg.Contact([0.0, 0.0, -0.025], [0.0, 0.0, 1.0], mu=0.5),
+    ]
+    pad = ContactCurvature(SurfaceCurvature.flat(), SurfaceCurvature.convex(0.006))
+    for b, words in ((1e-12, "times the grasp's length b = 1e-12 m"), (0.05, None)):
+        grasp = dg.Grasp(contacts, characteristic_length=b)
+        if words is None:
+            contact_hessian(grasp, 0, pad)
+            continue
+        with pytest.raises(dg.InvalidContactError) as info:
+            contact_hessian(grasp, 0, pad)
+        assert words in str(info.value)
+        assert "not positive" not in str(info.value)
