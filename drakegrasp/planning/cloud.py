@@ -44,6 +44,8 @@ body, meeting a quadric fitted at each point (:class:`FittedCloud`).
 
 from __future__ import annotations
 
+import hashlib
+import threading
 import warnings
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -1165,7 +1167,41 @@ def _gathered(
     return first, spot
 
 
+_SPOTS_KEPT = 2
+"""Clouds whose spots are kept: a plan reads its cloud, then completes it."""
+
+_spots_lock = threading.Lock()
+_spots_kept: dict[tuple, _Spots] = {}
+
+
 def _spots(points: np.ndarray) -> _Spots:
+    """:func:`_measured_spots`, kept for the last clouds by their contents.
+
+    A one-sided cloud's plan measures its spots when it reads the cloud
+    (:func:`read_cloud_fit`) and again when it completes it
+    (:func:`complete_unseen`, public and callable alone), on the same
+    points: 2.1 s at 10⁶ points.  The key is the points' bytes (a 16-byte
+    BLAKE2 digest with the shape and dtype), so a cloud changed in place or
+    equal to another one is never confused.
+    """
+    points = np.ascontiguousarray(points)
+    key = (
+        points.shape,
+        points.dtype.str,
+        hashlib.blake2b(points.tobytes(), digest_size=16).digest(),
+    )
+    with _spots_lock:
+        spots = _spots_kept.get(key)
+    if spots is None:
+        spots = _measured_spots(points)
+        with _spots_lock:
+            _spots_kept[key] = spots
+            while len(_spots_kept) > _SPOTS_KEPT:
+                del _spots_kept[next(iter(_spots_kept))]
+    return spots
+
+
+def _measured_spots(points: np.ndarray) -> _Spots:
     """A cloud's spacing, telling scans merged as they were (near twins).
 
     The points are taken once each (on a grid of :data:`DISTINCT`: merged

@@ -235,3 +235,38 @@ def test_twins_that_are_also_repeated_are_one_spot(scans, error):
     _, _, once = complete_unseen(points, normals, camera)
     _, _, info = complete_unseen(repeated, repeated_normals, camera)
     assert np.linalg.norm(info["centre"] - once["centre"]) < 1e-3
+
+
+def test_a_one_sided_plan_measures_its_clouds_spots_once(monkeypatch):
+    """Reading a cloud and completing it measure its spots once, not twice.
+
+    The second measure cost 2.1 s at 10⁶ points; the completed cloud (other
+    points) is measured on its own.  A cloud changed in place is measured
+    again: the kept spots are keyed by the points' contents.
+    """
+    from drakegrasp.planning import cloud
+
+    measured = []
+    real = cloud._measured_spots
+
+    def counted(points):
+        measured.append(len(points))
+        return real(points)
+
+    monkeypatch.setattr(cloud, "_measured_spots", counted)
+    monkeypatch.setattr(cloud, "_spots_kept", {})
+    rng = np.random.default_rng(3)
+    u = rng.normal(size=(4000, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    u = u[u[:, 0] > 0.0][:1500]
+    viewpoint = [1.5, 0.0, 0.1]
+    points = 0.03 * u + [0.5, 0.0, 0.1]
+    p, n, _, _ = cloud.read_cloud_fit(points, u, viewpoint=viewpoint)
+    surface, completion = cloud.cloud_surface(p, n, viewpoint, True)
+    assert completion["skipped"] is None
+    assert measured == [len(p), len(surface.points)]
+    kept = cloud._spots(p.copy())  # another array, the same points: kept
+    assert len(measured) == 2
+    p[0] += 0.01  # the same array, moved in place: its spots are measured again
+    assert cloud._spots(p) is not kept
+    assert len(measured) == 3
