@@ -9,7 +9,7 @@ Usage::
                        [--num-generators NG] [--tol TOL] [--patches MODE]
                        [--close | --no-close] [--allow-penetration]
                        [--check-pose | --no-check-pose]
-                       [--load gravity|FX,FY,FZ,MX,MY,MZ]
+                       [--load gravity|FX,FY,FZ,MX,MY,MZ] [--object-mass KG]
                        [--torque-limits plant|T1,T2,...]
                        [--package NAME=DIR ...] [--allow-any-file] [--json]
     drakegrasp scenes
@@ -181,6 +181,8 @@ def _analyze(args: argparse.Namespace) -> int:
         for name in _ANALYSIS_FLAGS
         if getattr(args, name, None) is not None
     }
+    if changes.get("load", "gravity") != "gravity" and "object_mass" not in changes:
+        changes["object_mass"] = None  # a wrench given: the scene's mass weighs nothing
     try:
         options = scene.options.replace(**changes)
     except GraspError as e:  # a flag's value the options refuse, in flag words
@@ -748,6 +750,7 @@ _ANALYSIS_FLAGS = (
     "patches",
     "check_pose",
     "load",
+    "object_mass",
     "torque_limits",
 )
 
@@ -775,6 +778,7 @@ def _add_analysis_options(parser: argparse.ArgumentParser) -> None:
             "type": _named_or_numbers("plant"),
             "metavar": "plant|T1,T2,...",
         },
+        "object_mass": {"type": _positive_float, "metavar": "KG"},
     }
     for name in _ANALYSIS_FLAGS:
         flag = "--" + name.replace("_", "-")
@@ -806,6 +810,7 @@ _SCENE_OPTIONS = (
     "plane",
     "distance_tolerance",
     "load",
+    "object_mass",
     "torque_limits",
 )
 
@@ -1483,8 +1488,6 @@ def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:
     )  # fmt: skip
     with placed(path, overwrite=args.overwrite) as tmp:
         Path(tmp).write_text(text)
-    for kept in _scene_out_notes(args):
-        _say(f"drakegrasp: note: {kept}")
     note = "" if shaken is None or shaken.best is not None else ", none held"
     line = f"wrote candidate #{rank}{note} to {path} (drakegrasp analyze {path})"
     if args.json:  # stdout holds the JSON document alone
@@ -1492,18 +1495,6 @@ def _write_scene_out(args, result, shaken, plant, context, object_body) -> int:
     else:
         print(line)
     return 0
-
-
-def _scene_out_notes(args: argparse.Namespace) -> list[str]:
-    """What the plan assumed that a scene file does not keep, and how to give it."""
-    notes = []
-    if args.mass is not None:
-        notes.append(
-            f"the scene keeps the model's mass, not --mass {args.mass:g}: "
-            "analyze --load gravity weighs the model's; give the load as a "
-            "wrench (--load FX,FY,FZ,MX,MY,MZ) for the planned mass"
-        )
-    return notes
 
 
 def _shaken(add_models, result, args: argparse.Namespace, options: dict):

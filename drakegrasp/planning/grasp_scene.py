@@ -86,6 +86,11 @@ def grasp_scene_text(
         Default: for soft fingers the candidate's ``torque_scale``, so that
         ``analyze`` of the file finds the planned torsion and ε; for other
         models none (the grasp's own).
+
+        When the candidate was planned for a mass other than the model's
+        (``candidate.object_mass``, ``plan --mass``), the scene gets
+        ``load: gravity`` and that ``object_mass``: ``analyze`` of the file
+        weighs what was planned for.
     folder : str or path, optional
         The folder the scene file will be written to: paths are written
         relative to it.
@@ -190,6 +195,10 @@ def grasp_scene_text(
     tolerance = options.get("distance_tolerance")
     if tolerance is not None:
         section["distance_tolerance"] = float(tolerance)
+    planned = float(candidate.object_mass)
+    if math.isfinite(planned) and planned > 0.0 and planned != body.get_mass(ctx):
+        section["load"] = "gravity"  # the weight planned for, not the model's
+        section["object_mass"] = planned
     drakegrasp = yaml.safe_dump(
         {"drakegrasp": section}, sort_keys=False, allow_unicode=True
     )

@@ -634,6 +634,7 @@ def analyze_grasp(
     query_object: QueryObject | None = None,
     contacts: list[PlantContact] | None = None,
     load=None,
+    object_mass: float | None = None,
     torque_limits=None,
     couplings: Sequence[tuple] | None = None,
 ) -> GraspReport:
@@ -668,6 +669,10 @@ def analyze_grasp(
         weight: the report then has a ``load`` section
         (:class:`~drakegrasp.plant.load.LoadReport`), with a warning where a
         given ``mu`` disagrees with the plant's friction.
+    object_mass : float, optional
+        The mass (kg, finite and > 0) that ``load="gravity"`` weighs, at the
+        object's centre of mass, instead of the model's (a plan's
+        ``object_mass``); needs ``load="gravity"``.
     torque_limits : None, "plant" or (n_h,) float, optional
         Motor limits for the load section: the actuators' effort limits, or
         one per hand velocity.
@@ -690,6 +695,7 @@ def analyze_grasp(
         patches=patches,
         check_pose=check_pose,
         load=load,
+        object_mass=object_mass,
         torque_limits=torque_limits,
     ).require_friction()
     with checked_context(plant, plant_context) as plant_context:
@@ -713,6 +719,7 @@ def analyze_grasp(
             if opts.torque_limits is None
             else _as_load(opts.torque_limits),
             query_object=query_object,
+            object_mass=opts.object_mass,
         )
         tol, num_generators = opts.tol, opts.num_generators
         grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)

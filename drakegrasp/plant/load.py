@@ -62,7 +62,7 @@ from drakegrasp.plant.friction import (
     friction_rule,
     plant_friction,
 )
-from drakegrasp.plant.options import PLANES
+from drakegrasp.plant.options import PLANES, check_object_mass
 from drakegrasp.plant.validation import (
     plant_context_of,
     resolve_object_body,
@@ -92,7 +92,9 @@ FLOATING_JOINTS = ("quaternion_floating", "rpy_floating")
 """Drake joint types of a free body: six velocities that no actuator drives."""
 
 
-def gravity_wrench(plant: MultibodyPlant, plant_context, object_body, *, plane=None):
+def gravity_wrench(
+    plant: MultibodyPlant, plant_context, object_body, *, plane=None, mass=None
+):
     """The object's weight as a wrench in its body frame O, about O's origin.
 
     Parameters
@@ -103,6 +105,9 @@ def gravity_wrench(plant: MultibodyPlant, plant_context, object_body, *, plane=N
     object_body : RigidBody, BodyIndex or str
     plane : {"xy", "yz", "zx"}, optional
         Planar analysis: ``[f_a, f_b, m_c]`` in that plane of O.
+    mass : float, optional
+        The mass ``m`` to weigh (kg, finite and > 0), at the body's centre of
+        mass; default: the body's own (``AnalysisOptions.object_mass``).
 
     Returns
     -------
@@ -114,7 +119,7 @@ def gravity_wrench(plant: MultibodyPlant, plant_context, object_body, *, plane=N
     body = resolve_object_body(plant, object_body)
     R_WO = plant.EvalBodyPoseInWorld(ctx, body).rotation().matrix()
     g_W = np.asarray(plant.gravity_field().gravity_vector(), dtype=float)
-    mass = float(body.get_mass(ctx))
+    mass = float(body.get_mass(ctx)) if mass is None else check_object_mass(mass)
     p_OBcm = np.asarray(body.CalcCenterOfMassInBodyFrame(ctx), dtype=float)
     f_O = R_WO.T @ (mass * g_W)
     m_O = np.cross(p_OBcm, f_O)
@@ -231,6 +236,9 @@ class LoadReport:
         The external wrench on the object, frame O about its origin (N, N·m).
     source : str
         ``"gravity"`` or ``"given"``.
+    object_mass : float or None
+        With ``source == "gravity"``, the mass weighed (kg) when it is not
+        the model's (``AnalysisOptions.object_mass``); None: the model's.
     holds : bool
         Forces in the (exact) cones and within the torque limits hold it.
     forces : GraspForceResult
@@ -316,6 +324,7 @@ class LoadReport:
     defective: bool = False
     needs_preload: bool = False
     motor_bodies: tuple[str, ...] | None = None
+    object_mass: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
@@ -324,8 +333,11 @@ class LoadReport:
     def report_lines(self) -> list[str]:
         """The report's ``load`` section, one line per fact."""
         w = np.round(self.wrench, 4).tolist()
+        weighed = (
+            "" if self.object_mass is None else f" of {self.object_mass:g} kg given"
+        )
         lines = [
-            f"Load ({self.source}, frame O about its origin): {w}",
+            f"Load ({self.source}{weighed}, frame O about its origin): {w}",
             f"  holds: {'yes' if self.holds else 'NO'}",
         ]
         if self.needs_preload:
@@ -438,14 +450,33 @@ def _named(names, values, units, *, signed: bool = True) -> str:
     )
 
 
-def _load_wrench(plant, plant_context, data, load):
+def _load_wrench(plant, plant_context, data, load, object_mass=None):
     if isinstance(load, str):
         if load != "gravity":
             raise InvalidOptionError(
                 f"load must be None, 'gravity' or a wrench [f; m] in frame O, got "
                 f"{load!r}"
             )
-        return gravity_wrench(plant, plant_context, data.object_body, plane=data.plane)
+        with np.errstate(over="ignore", invalid="ignore"):
+            w = gravity_wrench(
+                plant,
+                plant_context,
+                data.object_body,
+                plane=data.plane,
+                mass=object_mass,
+            )
+        if not np.max(np.abs(w)) <= MAX_LOAD:  # NaN too: inf m g times a lever 0
+            of = "the model's mass" if object_mass is None else f"{object_mass:g} kg"
+            raise InvalidOptionError(
+                f"load 'gravity' of {of} weighs more than {MAX_LOAD:g} (N, N·m): "
+                "the programs' products of such numbers overflow"
+            )
+        return w
+    if object_mass is not None:
+        raise InvalidOptionError(
+            f"object_mass ({object_mass:g} kg) is weighed by load='gravity'; "
+            "a given wrench carries its own weight"
+        )
     w = real_array("load", load, error=InvalidOptionError).reshape(-1)
     if w.shape != (data.grasp.wrench_dim,) or not np.all(np.isfinite(w)):
         raise InvalidOptionError(
@@ -524,6 +555,7 @@ def analyze_load(
     mu_given: float | None,
     mu_plant: np.ndarray | None,
     mu_dynamic: np.ndarray | None = None,
+    object_mass: float | None = None,
 ) -> LoadReport:
     """The load section of a grasp report (see :class:`LoadReport`).
 
@@ -542,8 +574,10 @@ def analyze_load(
     mu_dynamic : (N,) float or None, optional
         A continuous plant's dynamic friction per contact, for the wording of
         a disagreement (:func:`~drakegrasp.plant.friction.friction_disagreement`).
+    object_mass : float or None, optional
+        The mass (kg) ``load="gravity"`` weighs; None: the model's.
     """
-    w = _load_wrench(plant, plant_context, data, load)
+    w = _load_wrench(plant, plant_context, data, load, object_mass)
     limits, source, per_actuator = _torque_limits(plant, data, torque_limits)
     J = data.hand_jacobian
     forces = grasp_forces(data.grasp, w, hand_jacobian=J, torque_limits=limits)
@@ -608,6 +642,7 @@ def analyze_load(
         actuator_torques=actuator_torques,
         actuator_units=actuator_units,
         defective=defective,
+        object_mass=None if object_mass is None else float(object_mass),
         needs_preload=needs_preload,
         motor_bodies=motor_bodies,
     )
@@ -731,8 +766,11 @@ def load_section(
     load,
     torque_limits,
     query_object=None,
+    object_mass=None,
 ):
     """What :func:`~drakegrasp.analyze_grasp` adds for ``mu="plant"`` and a load.
+
+    ``object_mass`` (kg; None: the model's) is what ``load="gravity"`` weighs.
 
     Returns
     -------
@@ -786,5 +824,6 @@ def load_section(
         mu_given=None if isinstance(mu, str) else float(mu),
         mu_plant=mu_plant,
         mu_dynamic=mu_dynamic,
+        object_mass=object_mass,
     )
     return data, report

@@ -35,6 +35,7 @@ from drakegrasp.core.validation import (
     check_tol,
     checked_fields,
     real_array,
+    real_scalar,
 )
 from drakegrasp.errors import InvalidOptionError
 
@@ -43,6 +44,7 @@ __all__ = [
     "PATCH_MODES",
     "PLANES",
     "AnalysisOptions",
+    "check_object_mass",
     "checked_options",
     "resolve_options",
 ]
@@ -76,6 +78,8 @@ OPTION_HELP = {
     "check_pose": "refuse an impossible pose (penetration, joints beyond limits)",
     "load": "an external wrench on the object (frame O about its origin), or "
     "'gravity' (its weight): adds the load section",
+    "object_mass": "the object's mass (kg, > 0) that load 'gravity' weighs, "
+    "instead of the model's (needs load 'gravity')",
     "torque_limits": "motor limits of the load section: 'plant' (the actuators' "
     "effort limits), one per hand velocity (a coupled hand: per actuated joint "
     "or per independent coordinate), or one for all",
@@ -124,6 +128,10 @@ class AnalysisOptions:
     load : None, "gravity" or tuple of float
         An external wrench on the object, (6,) or planar (3,), in frame O about
         its origin, or the object's weight: the report then has a load section.
+    object_mass : float or None
+        The mass (kg, finite and > 0) that ``load="gravity"`` weighs, at the
+        model's centre of mass; None: the model's own.  It needs
+        ``load="gravity"`` (a wrench has no mass to replace).
     torque_limits : None, "plant" or tuple of float
         Motor limits of the load section (N·m or N per hand velocity; ``inf``
         for none); one number (``100`` or ``[100]``, kept as ``(100.0,)``) is
@@ -147,6 +155,7 @@ class AnalysisOptions:
     patches: str = "vertices"
     check_pose: bool = True
     load: str | tuple[float, ...] | None = None
+    object_mass: float | None = None
     torque_limits: str | tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
@@ -214,6 +223,13 @@ class AnalysisOptions:
             "torque_limits",
             _named_or_values("torque_limits", self.torque_limits, "plant", limits=True),
         )
+        if self.object_mass is not None:
+            put("object_mass", check_object_mass(self.object_mass))
+            if self.load != "gravity":
+                raise InvalidOptionError(
+                    f"object_mass ({self.object_mass:g} kg) is the mass that load "
+                    f"'gravity' weighs: it needs load 'gravity', got {self.load!r}"
+                )
 
     def replace(self, **changes: Any) -> AnalysisOptions:
         """A copy with ``changes`` (validated again); unknown names are refused."""
@@ -245,6 +261,16 @@ class AnalysisOptions:
         out = {f.name: getattr(self, f.name) for f in fields(self)}
         out["contact_model"] = self.contact_model.value
         return jsonable(out)
+
+
+def check_object_mass(value: Any) -> float:
+    """``object_mass`` (kg) as a float, once it is finite and > 0."""
+    m = real_scalar("object_mass", value, error=InvalidOptionError)
+    if not (0.0 < m < np.inf):
+        raise InvalidOptionError(
+            f"object_mass must be a finite mass > 0 (kg), got {value!r}"
+        )
+    return m
 
 
 def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):

@@ -71,7 +71,10 @@ unknown keys.  ``drakegrasp:`` keys (see :data:`drakegrasp.plant.scene_file.KEYS
   (metres) that makes moments comparable with forces and bounds a soft
   finger's torsion by ``b ν f_n`` (``plan --scene-out`` of soft fingers
   writes the plan's); ``drakegrasp analyze --characteristic-length``
-  overrides it.
+  overrides it;
+- ``object_mass`` (absent: the model's; needs ``load: gravity``): the mass
+  (kg) the weight is taken of (``plan --mass`` with ``--scene-out`` writes
+  it); ``drakegrasp analyze --object-mass`` overrides it.
 
 Packages and files
 ------------------
@@ -242,6 +245,9 @@ class SceneInfo:
         The length ``b`` (metres) that makes moments comparable with forces
         and sets a soft finger's torsion limit ``b ν f_n``
         (``AnalysisOptions.characteristic_length``); None: the grasp's own.
+    object_mass : float or None
+        The mass (kg) that ``load: gravity`` weighs
+        (``AnalysisOptions.object_mass``); None: the model's.
     """
 
     name: str
@@ -259,6 +265,7 @@ class SceneInfo:
     load: str | tuple[float, ...] | None = None
     torque_limits: str | tuple[float, ...] | None = None
     characteristic_length: float | None = None
+    object_mass: float | None = None
 
 
 @dataclass(frozen=True)
@@ -314,6 +321,7 @@ class Scene:
             load=info.load,
             torque_limits=info.torque_limits,
             characteristic_length=info.characteristic_length,
+            object_mass=info.object_mass,
         )
 
     def analysis_options(self) -> dict:
@@ -333,6 +341,7 @@ class Scene:
                     ("load", self.info.load),
                     ("torque_limits", self.info.torque_limits),
                     ("characteristic_length", self.info.characteristic_length),
+                    ("object_mass", self.info.object_mass),
                 )
                 if value is not None
             },

@@ -98,6 +98,9 @@ KEYS = {
     "moments comparable with forces and sets a soft finger's torsion limit "
     "b nu f_n (as planned: plan --scene-out writes the plan's); absent: the "
     "grasp's own",
+    "object_mass": "a number > 0 (kg): the mass that load: gravity weighs, at the "
+    "model's centre of mass (plan --mass with --scene-out writes it); needs "
+    "load: gravity; absent: the model's",
 }
 """The keys of the ``drakegrasp:`` section and what each must be."""
 
@@ -512,8 +515,8 @@ def check_section(
     dict
         Keys ``description, object_body, hand, mu, contact_model,
         torsional_friction, plane, distance_tolerance, close,
-        close_direction, load, torque_limits, characteristic_length``;
-        ``characteristic_length`` is None or a float; ``hand`` is None, a string or
+        close_direction, load, torque_limits, characteristic_length,
+        object_mass``; the last two are None or a float; ``hand`` is None, a string or
         a tuple of strings, ``contact_model`` a ContactModel, ``close`` a bool,
         ``close_direction`` None or a tuple of floats, ``load`` None,
         ``"gravity"`` or a tuple of floats, ``torque_limits`` None,
@@ -577,7 +580,8 @@ def check_section(
         )
     description = section.get("description", "")
     close, close_direction = _close(path, section.get("close", False))
-    load, limits, length = _checked_options(path, section, plane)
+    checked = _checked_options(path, section, plane)
+    load, limits = checked["load"], checked["torque_limits"]
     if limits is not None and load is None:
         raise SceneError(
             f"scene {str(path)!r}: drakegrasp.torque_limits without "
@@ -608,28 +612,26 @@ def check_section(
         ),
         "close": close,
         "close_direction": close_direction,
-        "load": load,
-        "torque_limits": limits,
-        "characteristic_length": length,
+        **checked,
     }
 
 
-def _checked_options(path: Path, section: dict, plane):
-    """``(load, torque_limits, characteristic_length)``, checked with the key named.
+_CHECKED_OPTIONS = ("load", "torque_limits", "characteristic_length", "object_mass")
+"""The section's keys that :class:`~drakegrasp.AnalysisOptions` checks."""
+
+
+def _checked_options(path: Path, section: dict, plane) -> dict:
+    """:data:`_CHECKED_OPTIONS` of ``section``, checked with the key named.
 
     :class:`~drakegrasp.AnalysisOptions` checks them: one rule for the file,
     the command line and Python.
     """
+    given = {key: section.get(key) for key in _CHECKED_OPTIONS}
     try:
-        options = AnalysisOptions(
-            plane=plane,
-            load=section.get("load"),
-            torque_limits=section.get("torque_limits"),
-            characteristic_length=section.get("characteristic_length"),
-        )
+        options = AnalysisOptions(plane=plane, **given)
     except GraspError as e:
         raise SceneError(f"scene {str(path)!r}: drakegrasp.{e}") from None
-    return options.load, options.torque_limits, options.characteristic_length
+    return {key: getattr(options, key) for key in _CHECKED_OPTIONS}
 
 
 def directives_text(path: Path, text: str) -> str:

@@ -1948,6 +1948,8 @@ def value_cases() -> Iterator[Case]:
         "check_pose": bad_flags,
         "load": ["weight", [1, 2], np.zeros(7), [NAN] * 6, [INF] * 6, ["1"] * 6, 1j],
         "torque_limits": ["motors", [-1.0], [NAN], [-INF], [[1.0]], [True], 1j, []],
+        # 1.0: a valid mass, but no load 'gravity' to weigh it
+        "object_mass": [NAN, INF, 0.0, -1.0, 1e-330, "1", True, [1.0], 1j, 1.0],
     }
     batch = {
         "contact_model": BAD_MODELS,

@@ -162,15 +162,52 @@ def test_plan_mu_plant_is_written_as_the_number_planned(tmp_path, capsys):
     assert "pass mu='plant'" not in said
 
 
-def test_what_a_scene_file_cannot_keep_is_said(tmp_path, capsys):
+def test_a_scene_keeps_the_mass_planned_for(tmp_path, capsys):
+    # the scene kept the model's mass: analyze --load gravity of a plan for
+    # --mass 0.5 weighed the model's, and stderr said to give a wrench
     out = tmp_path / "soft.yaml"
     argv = ["plan", "cylinder", "--hand", "rounded", "--num", "60", "--top", "1",
             "--contact-model", "soft_finger", "--torsional-friction", "0.1",
             "--mass", "0.5", "--scene-out", str(out)]  # fmt: skip
     assert main(argv) == 0
     err = capsys.readouterr().err
-    assert "not --mass 0.5" in err
-    assert "characteristic-length" not in err  # the file keeps it now
+    assert "--mass" not in err and "characteristic-length" not in err
+    info = read_scene_info(out)
+    assert info.load == "gravity" and info.object_mass == 0.5
+    assert main(["analyze", str(out), "--json"]) == 0
+    load = json.loads(capsys.readouterr().out)["load"]
+    assert load["object_mass"] == 0.5 and load["source"] == "gravity"
+    assert np.linalg.norm(load["wrench"][:3]) == pytest.approx(0.5 * 9.81, rel=1e-12)
+    # a wrench given on the command line replaces the weight and its mass
+    assert main(["analyze", str(out), "--json", "--load", "0,0,-1,0,0,0"]) == 0
+    load = json.loads(capsys.readouterr().out)["load"]
+    assert load["object_mass"] is None and load["wrench"] == [0, 0, -1, 0, 0, 0]
+    # the model's own mass planned for: no load written, as before
+    plain = tmp_path / "plain.yaml"
+    assert main([*argv[:-4], "--scene-out", str(plain)]) == 0
+    capsys.readouterr()
+    assert read_scene_info(plain).object_mass is None
+    assert read_scene_info(plain).load is None
+
+
+@pytest.mark.parametrize(
+    "extra, says",
+    [
+        ("  object_mass: 2.0\n", "drakegrasp.object_mass (2 kg) is the mass that"),
+        ("  load: gravity\n  object_mass: -2\n", "object_mass must be a finite"),
+        ("  load: gravity\n  object_mass: .nan\n", "object_mass must be a finite"),
+        ("  load: gravity\n  object_mass: heavy\n", "object_mass"),
+        ("  load: [0, 0, -1, 0, 0, 0]\n  object_mass: 2\n", "needs load 'gravity'"),
+    ],
+)
+def test_a_scenes_object_mass_is_checked_naming_the_key(tmp_path, extra, says):
+    text = (models_dir() / "scenes" / "parallel_jaw_box.yaml").read_text()
+    assert text.rstrip().splitlines()[-1].startswith("  ")  # in drakegrasp:
+    path = tmp_path / "scene.yaml"
+    path.write_text(text.rstrip("\n") + "\n" + extra)
+    with pytest.raises(dg.SceneError) as info:
+        read_scene_info(path)
+    assert says in str(info.value)
 
 
 def test_a_soft_finger_scene_keeps_the_planned_torsion_length(tmp_path, capsys):

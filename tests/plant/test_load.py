@@ -204,3 +204,63 @@ def test_joints_without_an_actuator_are_named(tmp_path):
     said = [w for w in report.load.warnings if "no actuator" in w]
     assert len(said) == 1
     assert "'left_finger_joint', 'right_finger_joint' have no actuator" in said[0]
+
+
+def test_object_mass_weighs_that_mass_at_the_models_centre_of_mass(tmp_path):
+    """``object_mass`` scales the model's weight; the report equals a given wrench.
+
+    Independent routes: the gravity wrench is linear in the mass (the
+    model's weight times m / m_model), and the load section of
+    ``load="gravity", object_mass=m`` is that of the same wrench given.
+    """
+    s = dg.load_scene("parallel_jaw_box")
+    own = gravity_wrench(s.plant, s.plant_context, s.object_body)
+    m_model = s.object_body.get_mass(s.plant_context)
+    for m in (1e-6, 0.3, 2.0, 1e4):
+        w = gravity_wrench(s.plant, s.plant_context, s.object_body, mass=m)
+        np.testing.assert_allclose(w, own * (m / m_model), rtol=1e-14, atol=0)
+    common = dict(hand=s.hand, mu=0.5, torque_limits=[3.0, 3.0])
+    heavy = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, load="gravity", object_mass=2.0,
+        **common,
+    )  # fmt: skip
+    given = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, load=own * (2.0 / m_model),
+        **common,
+    )  # fmt: skip
+    np.testing.assert_allclose(heavy.load.wrench, given.load.wrench, rtol=1e-14)
+    assert heavy.load.holds is given.load.holds
+    assert heavy.load.payload.alpha == pytest.approx(given.load.payload.alpha, rel=1e-9)
+    # the payload factor scales as 1 / m: a load twice as heavy, half the factor
+    light = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, load="gravity", object_mass=1.0,
+        **common,
+    )  # fmt: skip
+    assert light.load.payload.alpha == pytest.approx(
+        2.0 * heavy.load.payload.alpha, rel=1e-6
+    )
+    assert heavy.load.object_mass == 2.0 and given.load.object_mass is None
+    assert "Load (gravity of 2 kg given" in str(heavy)
+    assert json.loads(json.dumps(heavy.to_dict()))["load"]["object_mass"] == 2.0
+    assert heavy.options.object_mass == 2.0
+
+
+@pytest.mark.parametrize(
+    "options, words",
+    [
+        ({"object_mass": 2.0}, "needs load 'gravity', got None"),
+        ({"object_mass": 2.0, "load": [0.0] * 6}, "needs load 'gravity'"),
+        ({"object_mass": 0.0, "load": "gravity"}, "finite mass > 0"),
+        ({"object_mass": float("nan"), "load": "gravity"}, "finite mass > 0"),
+        ({"object_mass": 1e308, "load": "gravity"}, "weighs more than 1e+300"),
+    ],
+)
+def test_an_object_mass_without_gravity_or_out_of_range_is_refused(options, words):
+    s = dg.load_scene("parallel_jaw_box")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # no overflow on the way
+        with pytest.raises(dg.InvalidOptionError, match=words.replace("+", "\\+")):
+            dg.analyze_grasp(
+                s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5,
+                **options,
+            )  # fmt: skip
