@@ -356,6 +356,17 @@ def multi_finger_hand(
     )
     if not structure.fingers:
         raise ModelError("the hand has no fingers (no closing joint moves a body)")
+    if not np.any(structure.upper > structure.lower):
+        limits = ", ".join(
+            f"{name} [{lo:g}, {hi:g}]"
+            for name, lo, hi in zip(
+                structure.names, structure.lower, structure.upper, strict=True
+            )
+        )
+        raise ModelError(
+            f"no closing joint of the hand has any range: {limits}; the "
+            "fingers cannot open or close (give the joints limits lower < upper)"
+        )
     # a finger is a kinematic chain, though a <mimic> closes two as one
     chains = finger_chains(plant, structure)
     n = len(structure.names)

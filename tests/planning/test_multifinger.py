@@ -20,6 +20,7 @@ from drakegrasp.planning.multifinger import REASONS
 from drakegrasp.planning.ranking import perturbed_copies
 from drakegrasp.planning.weight import weight_capacity
 from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE
+from drakegrasp.plant.models import models_dir
 
 THREE = "package://drakegrasp/hands/three_finger_hand.sdf"
 THREE_OPEN = [-0.4, 0.0, 0.0] * 3  # proximal joints splayed out, the rest straight
@@ -267,6 +268,28 @@ def test_unreachable_object_gives_an_empty_result_that_says_why(tmp_path):
 def test_a_hand_without_fingers_is_refused(fingerless_scene):
     with pytest.raises(ModelError, match="one-dof joint"):
         plan(fingerless_scene, n=5)
+
+
+def test_a_hand_whose_joints_have_no_range_is_refused(tmp_path):
+    # planned 20 poses, returned none and advised --preshape, which the
+    # joints' limits [0.3, 0.3] then refused: the hand cannot move at all
+    text = (models_dir() / "hands" / "three_finger_hand.sdf").read_text()
+    frozen = "<lower>0.3</lower><upper>0.3</upper>"
+    assert text.count("<lower>-0.5</lower><upper>1.6</upper>") == 9
+    hand = tmp_path / "frozen.sdf"
+    hand.write_text(text.replace("<lower>-0.5</lower><upper>1.6</upper>", frozen))
+    scene = planning_scene(
+        "package://drakegrasp/objects/sphere.sdf", hand_url=str(hand)
+    )
+    with pytest.raises(ModelError, match="no closing joint of the hand has any range"):
+        plan(scene, n=5)
+    # one joint that moves is enough to close
+    one = text.replace("<lower>-0.5</lower><upper>1.6</upper>", frozen, 8)
+    hand.write_text(one)
+    scene = planning_scene(
+        "package://drakegrasp/objects/sphere.sdf", hand_url=str(hand)
+    )
+    plan(scene, n=5, preshape=None)
 
 
 @pytest.mark.parametrize(
