@@ -109,6 +109,19 @@ class ParallelJaw:
         x = self.pad_at_zero + self.pad_rate * np.asarray(q, dtype=float)
         return x[..., 1] - x[..., 0]
 
+    def travel_left(self, q) -> np.ndarray:
+        """(2,) how far (m) each pad can still close past joint values ``q``.
+
+        Finger 0 closes along ``+a`` and finger 1 along ``-a`` (the grasp
+        axis of K); each stops at its joint's closed limit.  A pad with no
+        travel left presses on its limit, not on the object.
+        """
+        q = np.asarray(q, dtype=float)
+        r = self.pad_rate
+        rises = np.array([r[0] > 0, r[1] < 0])  # q grows while closing
+        closed = np.where(rises, self.upper, self.lower)
+        return np.abs(closed - q) * np.abs(r)
+
     def coupled(self, q) -> tuple[np.ndarray, float]:
         """Joint values on the coupling that leave both pads where ``q`` puts them.
 

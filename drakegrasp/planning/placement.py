@@ -462,6 +462,8 @@ class BodyCloser:
                     self._set(X_WH, (q0, q1))
                     moved = True
                     continue
+                if np.min(g.travel_left((q0, q1))) <= tol:
+                    return None, None, "finger at its closed limit", X_WH
                 found, reason = self._contacts(query, pairs)
                 return found, np.array([q0, q1]), reason, X_WH
             # each finger advances by ψ - tol/2 (a translation by ψ cannot

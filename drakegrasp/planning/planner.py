@@ -126,6 +126,9 @@ REASONS = {
     "hand collides with the scene": "the open hand penetrates another body",
     "finger misses the object": "a finger reached its joint limit without touching",
     "finger blocked by the scene": "a finger touched another body first",
+    "finger at its closed limit": "a finger touches within the contact "
+    "tolerance of its joint's closed limit: it would press on the limit, not "
+    "squeeze the object",
     "closing did not converge": f"more than {MAX_CLOSING_STEPS} closing steps",
     "one finger touches": "only one finger's geometry touches the object",
     "hand collides with the cloud": "a cloud point lies inside the open hand",
@@ -806,6 +809,8 @@ def _close_on_cloud(closer: BodyCloser, cloud: CloudFingers, X_WH, opening):
         X_WH, q = onto_coupling(closer.g, X_WH, q)
         if q is None:
             return None, None, "coupled fingers out of their stroke", X_WH
+    if np.min(closer.g.travel_left(q)) <= closer.tol:
+        return None, None, "finger at its closed limit", X_WH
     if closer.clear_at(X_WH, q) is not None:  # puts the hand at X_WH, q
         return None, None, "finger blocked by the scene", X_WH
     if coupled and cloud.collides():  # the palm moved along the axis

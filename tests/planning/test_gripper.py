@@ -56,3 +56,44 @@ def test_own_jaw_geometry(own_scene):
     # the approach runs from the palm to the pads, across the axis
     R = g.X_HK.rotation().matrix()
     assert abs(R[:, 0] @ R[:, 1]) < 1e-12
+
+
+def _jaw_closing_at(tmp_path, closed: float):
+    """The flat jaw with its fingers' closed limit at ``closed`` (m) each."""
+    import drakegrasp as dg
+    from drakegrasp.plant.models import models_dir
+
+    text = (models_dir() / "hands" / "parallel_jaw_flat.sdf").read_text()
+    old = "<lower>0.0</lower><upper>0.0425</upper>"
+    assert text.count(old) == 2
+    hand = tmp_path / f"jaw_{closed}.sdf"
+    hand.write_text(text.replace(old, f"<lower>{closed}</lower><upper>0.0425</upper>"))
+    return dg.planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(hand))
+
+
+@pytest.mark.parametrize("closed, at_limit", [(0.02495, True), (0.0245, False)])
+def test_a_finger_closed_on_its_limit_is_rejected(tmp_path, closed, at_limit):
+    # A jaw whose pads meet the 50 mm box 0.05 mm before their closed limit
+    # was planned as holding (the fuzzer's rod: "squeeze 1.6 N per finger"),
+    # yet its motors press on the limits: Drake drops the object at any squeeze.
+    from drakegrasp.planning import plan_grasps
+    from drakegrasp.plant.contacts import DEFAULT_DISTANCE_TOLERANCE as tol
+
+    scene = _jaw_closing_at(tmp_path, closed)
+    plant = scene.plant
+    g = parallel_jaw(
+        plant, plant.GetMyContextFromRoot(scene.context), scene.object_body, scene.hand
+    )
+    # independent route: the two pads' travel is the opening above the closed one
+    q = g.q_for_opening(0.06)
+    assert np.sum(g.travel_left(q)) == pytest.approx(
+        g.opening(q) - g.opening([closed, closed]), abs=1e-15
+    )
+    result = plan_grasps(
+        plant, scene.context, scene.object_body, hand=scene.hand, mu=0.5,
+        num_candidates=60, seed=0, robustness_samples=4,
+    )  # fmt: skip
+    assert len(result) > 0  # wider chords, across the box's corners
+    assert (result.rejections.get("finger at its closed limit", 0) > 0) is at_limit
+    for c in result:
+        assert np.min(g.travel_left(c.q_hand)) > tol
