@@ -5,6 +5,7 @@ Everything here is numpy (no solver, no plant): contacts and their frames
 (:mod:`~drakegrasp.core.grasp`), friction cones and their support functions
 (:mod:`~drakegrasp.core.friction_cone`), the antipodal test, surface curvature,
 the textbook example grasps, input validation, the tolerance table, rank and
-null spaces (:mod:`~drakegrasp.core.linalg`) and the JSON helper.  Every other
-layer imports from here; nothing here imports another layer.
+null spaces (:mod:`~drakegrasp.core.linalg`), the JSON helper and the test of a
+regular file (:mod:`~drakegrasp.core.files`).  Every other layer imports from
+here; nothing here imports another layer.
 """

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from drakegrasp.core.files import not_a_file
 from drakegrasp.errors import BatchFileError, GraspError, InvalidOptionError
 
 __all__ = ["as_path", "engine_options", "input_files", "read_grasps"]
@@ -54,6 +55,7 @@ def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
             "normals and optionally mu, torsional_friction, reference_points, "
             "characteristic_lengths)"
         )
+    _check_regular("input file", path)
     _check_magic(path)
     try:
         with np.load(path, allow_pickle=False) as data:
@@ -85,6 +87,17 @@ def as_path(what: str, path) -> Path:
     if not isinstance(path, (str, os.PathLike)) or not str(path):
         raise BatchFileError(f"{what} must be a file path, got {path!r}")
     return Path(path)
+
+
+def _check_regular(what: str, path: Path) -> None:
+    """Refuse anything but a regular file by ``stat``, before it is opened.
+
+    Opening a named pipe would block until a writer comes, and a device would
+    be read forever or as nothing.
+    """
+    why = not_a_file(path)
+    if why:
+        raise BatchFileError(f"{what} {str(path)!r} {why}")
 
 
 def _check_magic(path: Path) -> None:
@@ -135,6 +148,8 @@ def _check_names(path: Path, what: str, names: list[str]) -> None:
 def _read_npy_directory(path: Path) -> dict[str, np.ndarray]:
     names = {f.stem: f for f in sorted(path.glob("*.npy"))}
     _check_names(path, "input directory", list(names))
+    for f in names.values():
+        _check_regular("input file", f)
     try:
         return {
             k: np.load(f, mmap_mode="r", allow_pickle=False) for k, f in names.items()
