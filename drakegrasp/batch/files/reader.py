@@ -17,6 +17,7 @@ grasps at a time and a file of millions of grasps is analysed in bounded memory
 
 from __future__ import annotations
 
+import math
 import os
 import zipfile
 import zlib
@@ -62,9 +63,16 @@ def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
             if not hasattr(data, "files"):  # pragma: no cover - magic says zip
                 raise BatchFileError(f"input file {str(path)!r} is not an archive")
             _check_names(path, "input file", list(data.files))
+            _check_members(path, data.zip)
             return {k: data[k] for k in data.files}
     except GraspError:
         raise
+    except MemoryError:
+        raise BatchFileError(
+            f"input file {str(path)!r} holds more than the free memory (a .npz "
+            "archive is read whole); store its arrays as a directory of .npy "
+            "files, which is memory-mapped"
+        ) from None
     except ValueError as err:
         if "pickle" in str(err):
             raise BatchFileError(
@@ -98,6 +106,45 @@ def _check_regular(what: str, path: Path) -> None:
     why = not_a_file(path)
     if why:
         raise BatchFileError(f"{what} {str(path)!r} {why}")
+
+
+def _check_header(where: str, name: str, f, size: int) -> None:
+    """Refuse an array whose header claims more bytes than its ``.npy`` holds.
+
+    ``f`` is open at the start of the array's ``.npy`` bytes, ``size`` bytes
+    long; numpy would allocate what the header claims before reading a byte.
+    """
+    version = np.lib.format.read_magic(f)
+    read = (
+        np.lib.format.read_array_header_1_0
+        if version == (1, 0)
+        else np.lib.format.read_array_header_2_0  # 3.0 differs in encoding only
+    )
+    shape, _, dtype = read(f)
+    if dtype.hasobject:  # refused as pickled objects when loaded
+        return
+    claimed, held = math.prod(shape) * dtype.itemsize, size - f.tell()
+    if claimed > held:
+        raise BatchFileError(
+            f"{where} is damaged: {name} claims shape {shape} of {dtype} "
+            f"({claimed} bytes) in {held} bytes; write it again"
+        )
+
+
+def _check_members(path: Path, archive: zipfile.ZipFile) -> None:
+    """Check every member's array header against the bytes the member holds.
+
+    A legitimate array occupies its member's uncompressed size (``file_size``;
+    a stored member also its ``compress_size``, within the archive).
+    """
+    total = path.stat().st_size
+    for info in archive.infolist():
+        size = info.file_size
+        if info.compress_type == zipfile.ZIP_STORED:
+            size = min(size, info.compress_size, total)
+        with archive.open(info) as f:
+            name = info.filename.removesuffix(".npy")
+            _check_header(f"input file {str(path)!r}", name, f, size)
 
 
 def _check_magic(path: Path) -> None:
@@ -151,6 +198,10 @@ def _read_npy_directory(path: Path) -> dict[str, np.ndarray]:
     for f in names.values():
         _check_regular("input file", f)
     try:
+        for k, f in names.items():
+            with open(f, "rb") as fp:
+                size = os.fstat(fp.fileno()).st_size
+                _check_header(f"input directory {str(path)!r}", k, fp, size)
         return {
             k: np.load(f, mmap_mode="r", allow_pickle=False) for k, f in names.items()
         }
