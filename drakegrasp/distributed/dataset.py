@@ -26,10 +26,12 @@ import hashlib
 import json
 import os
 import re
+import reprlib
 from pathlib import Path
 
 import numpy as np
 
+from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import BatchFileError, InvalidOptionError
 
@@ -124,14 +126,40 @@ def _plain(value):
 
 
 def _read_manifest(output_dir: Path) -> dict | None:
+    """The manifest of ``output_dir``: None if there is none, {} if damaged."""
+    return _manifest(output_dir)[0]
+
+
+def _manifest(output_dir: Path) -> tuple[dict | None, str]:
+    """The manifest (None: none; {}: damaged) and why it is damaged ("" if not).
+
+    Damaged: not a regular file (never opened: a pipe would block), not
+    readable, not a JSON object, or a key the readers use (``job``, a string;
+    ``rows``, a list of row counts) missing or of the wrong type.
+    """
     path = output_dir / MANIFEST
-    if not path.exists():
-        return None
+    why = not_a_file(path)
+    if why == MISSING:
+        return None, ""
+    if why:
+        return {}, why
     try:
         data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return {}  # damaged: not this job's
-    return data if isinstance(data, dict) else {}
+    except OSError as err:
+        return {}, f"cannot be read ({err.strerror or err})"
+    except ValueError as err:  # UnicodeDecodeError too
+        return {}, f"is not valid JSON ({err})"
+    if not isinstance(data, dict):
+        return {}, f"holds a JSON {type(data).__name__}, not a JSON object"
+    job, rows = data.get("job"), data.get("rows")
+    if not isinstance(job, str):
+        return {}, f"has 'job' {reprlib.repr(job)}, not a string"
+    if not isinstance(rows, list):
+        return {}, f"has 'rows' {reprlib.repr(rows)}, not a list of row counts"
+    for j, r in enumerate(rows):
+        if type(r) is not int or r < 0:
+            return {}, f"has 'rows'[{j}] {reprlib.repr(r)}, not a row count"
+    return data, ""
 
 
 def _differences(old: dict, new: dict) -> str:
@@ -280,6 +308,9 @@ def _shard_problem(shard: Path, job: str | None, rows: int | None) -> str | None
     """Why ``shard`` is not a complete shard of ``job`` with ``rows`` rows."""
     import pyarrow.parquet as pq
 
+    why = not_a_file(shard)
+    if why:
+        return why
     try:
         meta = pq.read_metadata(shard)
     except (OSError, ValueError) as err:  # pyarrow's errors derive from these
@@ -325,15 +356,15 @@ def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
     if not output_dir.is_dir():
         raise BatchFileError(f"dataset directory {str(output_dir)!r} does not exist")
     shards = _shards(output_dir)
-    manifest = _read_manifest(output_dir)
-    if manifest == {}:
+    manifest, damage = _manifest(output_dir)
+    if damage:
         raise BatchFileError(
-            f"dataset {str(output_dir)!r} has a damaged {MANIFEST}; run the job "
-            "again with overwrite"
+            f"dataset {str(output_dir)!r} has a damaged {MANIFEST} (it {damage}); "
+            "run the job again with overwrite"
         )
     job, expected = None, None
     if manifest is not None:
-        job, expected = manifest.get("job"), list(manifest.get("rows", []))
+        job, expected = manifest["job"], manifest["rows"]
         missing = [j for j in range(len(expected)) if j not in shards]
         extra = sorted(set(shards) - set(range(len(expected))))
         if missing or extra:
