@@ -159,6 +159,7 @@ from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.validation import check_coefficient, check_flag
 from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
 from drakegrasp.plant.couplings import (
@@ -377,20 +378,20 @@ def scene_path(path_or_name: str | Path) -> Path:
         If it is not a ``str`` or an ``os.PathLike`` of one.
     ModelError
         If it is neither an existing file nor a shipped scene's name (a
-        directory is named as one).
+        directory, a named pipe or a device is named as one, by ``stat``: a
+        pipe is never opened).
     """
     candidate = _path_argument(path_or_name)
-    if candidate.is_file():
+    why = not_a_file(candidate, "a scene file")
+    if not why:
         return candidate
     name = str(path_or_name)
     shipped = scenes_dir() / f"{name.removesuffix('.yaml')}.yaml"
     if "/" not in name and shipped.is_file():
         return shipped
     names = ", ".join(p.stem for p in sorted(scenes_dir().glob("*.yaml")))
-    if candidate.is_dir():
-        raise ModelError(
-            f"scene {name!r} is a directory, not a scene file (shipped scenes: {names})"
-        )
+    if why != MISSING:
+        raise ModelError(f"scene {name!r} {why} (shipped scenes: {names})")
     raise ModelError(
         f"scene {name!r} not found: no such file and no shipped scene of that "
         f"name (shipped scenes: {names})"

@@ -31,6 +31,7 @@ from pathlib import Path
 import yaml
 
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.files import not_a_file
 from drakegrasp.core.tolerances import (
     DEFAULT_DISTANCE_TOLERANCE,
     MAX_DISTANCE_TOLERANCE,
@@ -201,9 +202,12 @@ def read_yaml(path: Path) -> tuple[str, dict]:
     Raises
     ------
     SceneError
-        Unreadable, too large, not valid YAML, anchors or aliases, too deep,
-        or not a mapping.
+        Not a regular file (a pipe is never opened), unreadable, too large,
+        not valid YAML, anchors or aliases, too deep, or not a mapping.
     """
+    why = not_a_file(path, "a scene file")
+    if why:
+        raise SceneError(f"cannot read scene file {str(path)!r}: it {why}")
     try:
         size = path.stat().st_size
         if size > MAX_SCENE_BYTES:
