@@ -354,7 +354,8 @@ def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
 
     output_dir = Path(output_dir)
     if not output_dir.is_dir():
-        raise BatchFileError(f"dataset directory {str(output_dir)!r} does not exist")
+        what = "is not a directory" if output_dir.exists() else "does not exist"
+        raise BatchFileError(f"dataset directory {str(output_dir)!r} {what}")
     shards = _shards(output_dir)
     manifest, damage = _manifest(output_dir)
     if damage:

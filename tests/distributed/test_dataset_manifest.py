@@ -98,3 +98,9 @@ def test_a_shard_that_is_a_pipe_is_refused_unopened(tmp_path):
             read_dataset(out)
         assert not shard_is_done(pipe.path, "x", 3)
     assert pipe.opened == 0
+
+
+def test_a_dataset_that_is_a_file_is_not_called_missing(tmp_path):
+    (tmp_path / "d").write_text("")
+    with pytest.raises(BatchFileError, match="is not a directory"):
+        read_dataset(tmp_path / "d")
