@@ -55,7 +55,7 @@ from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import coupling_entries, coupling_entry
-from drakegrasp.plant.models import drake_reading
+from drakegrasp.plant.models import load_models
 
 __all__ = [
     "COUPLING_TOL",
@@ -374,6 +374,9 @@ def add_models(
     ------
     InvalidOptionError
         Unless exactly one of ``file_name``, ``url`` and ``text`` is given.
+    ModelError
+        Drake cannot load the models (a missing or unreadable file, an unknown
+        package, text that is not a model), as :func:`drakegrasp.load_scene`.
     """
     given = [x is not None for x in (file_name, url, text)]
     if sum(given) != 1:
@@ -384,21 +387,33 @@ def add_models(
             raise InvalidOptionError(f"text needs kind='urdf' or 'sdf', got {kind!r}")
         resolve = model_resolver(parser.package_map(), Path.cwd())
         check_joint_limits(text, kind, "the model text", resolve=resolve)
-        instances = drake_reading(parser.AddModelsFromString, text, kind)
+        instances = load_models(
+            "the model text", parser.AddModelsFromString, text, kind
+        )
         _record_text(plant, text, kind, instances, resolve)
         return instances
-    path = parser.package_map().ResolveUrl(url) if url is not None else str(file_name)
+    if url is not None:
+        where = f"model URL {url!r}"
+        path = load_models(where, parser.package_map().ResolveUrl, url)
+    else:
+        where = f"model file {str(file_name)!r}"
+        path = str(file_name)
     kind = _kind_of(path)
-    document = Path(path).read_text() if kind and Path(path).is_file() else None
+    document = None
+    if kind and Path(path).is_file():
+        try:
+            document = Path(path).read_text()
+        except (OSError, UnicodeDecodeError) as e:
+            raise ModelError(f"{where}: cannot read it: {e}") from None
     resolve = model_resolver(parser.package_map(), Path(path).parent)
     if document is not None:
         check_joint_limits(document, kind, path, resolve=resolve)
-    # through drake_reading: a shape Drake refuses (a sphere of radius NaN)
-    # is a RuntimeError, not pydrake's SystemExit that ends the program
+    # through load_models: a shape Drake refuses (a sphere of radius NaN)
+    # is a ModelError, not pydrake's SystemExit that ends the program
     if url is not None:
-        instances = drake_reading(parser.AddModels, url=url)
+        instances = load_models(where, parser.AddModels, url=url)
     else:
-        instances = drake_reading(parser.AddModels, str(file_name))
+        instances = load_models(where, parser.AddModels, str(file_name))
     if document is not None:
         _record_text(plant, document, kind, instances, resolve)
     return instances

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from pydrake.multibody.parsing import PackageMap, Parser
 
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import GraspError, InvalidOptionError, ModelError
 
 __all__ = [
     "DRAKE_MODELS_ENV",
@@ -27,6 +27,7 @@ __all__ = [
     "check_obj_vertices",
     "drake_reading",
     "explain_drake_models",
+    "load_models",
     "models_dir",
     "register_models",
     "use_local_drake_models",
@@ -124,6 +125,34 @@ def drake_reading(read, *args, **kwargs):
 
 
 @functools.cache
+def load_models(where: str, read, *args, **kwargs):
+    """:func:`drake_reading` of models, its refusal a :class:`~drakegrasp.ModelError`.
+
+    Parameters
+    ----------
+    where : str
+        What is read, as the message names it (``"scene 'a.yaml'"``, ``"model
+        file 'hand.urdf'"``); the message is ``"{where}: cannot load the
+        models: {Drake's reason}"``, with :data:`DRAKE_MODELS_HINT` when
+        drake_models could not be fetched.
+    read : callable
+        The Drake reader, called as ``read(*args, **kwargs)``.
+
+    Raises
+    ------
+    ModelError
+        Drake refused (a missing file, an unknown package, text that is not
+        a model).  A :class:`~drakegrasp.GraspError` passes unchanged.
+    """
+    try:
+        return drake_reading(read, *args, **kwargs)
+    except GraspError:
+        raise
+    except Exception as e:  # Drake reports what it cannot read as RuntimeError
+        msg = explain_drake_models(str(e))
+        raise ModelError(f"{where}: cannot load the models: {msg}") from None
+
+
 def models_dir() -> Path:
     """Absolute path of the directory that holds ``package.xml`` and the models.
 

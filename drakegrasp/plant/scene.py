@@ -167,7 +167,12 @@ from drakegrasp.plant.couplings import (
     model_resolver,
     record_model_couplings,
 )
-from drakegrasp.plant.models import drake_reading, explain_drake_models, models_dir
+from drakegrasp.plant.models import (
+    drake_reading,
+    explain_drake_models,
+    load_models,
+    models_dir,
+)
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import (
     check_directives,
@@ -438,13 +443,9 @@ def _new_plant(path: Path, package_map: PackagesSpec, ros_package_path: bool):
 def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
     """Process the (checked) directives into ``plant`` and finalize it."""
     _check_joint_limits(path, directives, parser)
-    try:
-        added = drake_reading(ProcessModelDirectives, directives, plant, parser)
-    except Exception as e:  # Drake reports parse errors as RuntimeError
-        msg = explain_drake_models(str(e))
-        raise ModelError(
-            f"scene {str(path)!r}: cannot load the models: {msg}"
-        ) from None
+    added = load_models(
+        f"scene {str(path)!r}", ProcessModelDirectives, directives, plant, parser
+    )
     record_model_couplings(plant, added, parser.package_map())
     plant.Finalize()
 

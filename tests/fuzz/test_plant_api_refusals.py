@@ -1,0 +1,41 @@
+"""Bad input to the plant layer's public functions is a GraspError.
+
+A fuzzer of the plant-side API found Drake's and Python's own errors escaping
+(and one ``SystemExit`` from a Drake assertion), and answers computed
+silently from contacts or bodies of another plant.
+"""
+
+from __future__ import annotations
+
+import pytest
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+
+import drakegrasp as dg
+
+# -- add_models ------------------------------------------------------------
+
+
+@pytest.fixture
+def parser():
+    # pydrake's Parser does not keep its plant alive: a Parser of a temporary
+    # MultibodyPlant reads freed memory (a crash, or Drake asserting)
+    plant = MultibodyPlant(0.0)
+    parser = Parser(plant)
+    dg.register_models(parser)
+    yield parser
+    del parser, plant
+
+
+@pytest.mark.parametrize(
+    ("given", "words"),
+    [
+        ({"file_name": "/nonexistent/hand.urdf"}, "/nonexistent/hand.urdf"),
+        ({"url": "package://nopkg/hand.sdf"}, "nopkg"),
+        ({"text": "garbage", "kind": "urdf"}, "the model text"),
+    ],
+)
+def test_add_models_refusals_are_model_errors(parser, given, words):
+    with pytest.raises(dg.ModelError, match="cannot load") as e:
+        dg.plant.add_models(parser, **given)
+    assert words in str(e.value)
