@@ -62,7 +62,7 @@ from drakegrasp.plant.friction import (
     friction_rule,
     plant_friction,
 )
-from drakegrasp.plant.options import PLANES, check_object_mass
+from drakegrasp.plant.options import PLANES, check_object_mass, check_plane
 from drakegrasp.plant.validation import (
     plant_context_of,
     resolve_object_body,
@@ -117,6 +117,7 @@ def gravity_wrench(
     """
     ctx = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
+    plane = check_plane(plane)
     R_WO = plant.EvalBodyPoseInWorld(ctx, body).rotation().matrix()
     g_W = np.asarray(plant.gravity_field().gravity_vector(), dtype=float)
     mass = float(body.get_mass(ctx)) if mass is None else check_object_mass(mass)

@@ -34,6 +34,7 @@ from drakegrasp.core.validation import (
     check_num_generators,
     check_tol,
     checked_fields,
+    describe,
     real_array,
     real_scalar,
 )
@@ -45,6 +46,7 @@ __all__ = [
     "PLANES",
     "AnalysisOptions",
     "check_object_mass",
+    "check_plane",
     "checked_options",
     "resolve_options",
 ]
@@ -55,6 +57,25 @@ PLANES = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
 Each pair is ordered so that the plane's normal (the moment axis) is the third
 axis of a right-handed frame: ``"yz"`` gives wrenches ``[f_y, f_z, m_x]``.
 """
+
+
+def check_plane(plane: Any) -> str | None:
+    """``plane`` as a plain ``str``, once it is a key of :data:`PLANES`, or None.
+
+    Raises
+    ------
+    InvalidOptionError
+        For any other value (the message lists the planes).
+    """
+    if plane is None:
+        return None
+    if not isinstance(plane, str) or plane not in PLANES:
+        raise InvalidOptionError(
+            f"plane must be one of {sorted(PLANES)} (object-frame axes) or "
+            f"None, got {describe(plane)}"
+        )
+    return str(plane)  # numpy.str_ and other subclasses
+
 
 PATCH_MODES = ("vertices", "witness")
 """How a flat contact patch is reported: its corners, or Drake's witness point."""
@@ -172,15 +193,7 @@ class AnalysisOptions:
             put("mu", check_coefficient("mu", self.mu))
         model = ContactModel.parse(self.contact_model)
         put("contact_model", model)
-        if self.plane is not None and (
-            not isinstance(self.plane, str) or self.plane not in PLANES
-        ):
-            raise InvalidOptionError(
-                f"plane must be one of {sorted(PLANES)} (object-frame axes) or "
-                f"None, got {self.plane!r}"
-            )
-        if self.plane is not None:
-            put("plane", str(self.plane))  # numpy.str_ and other subclasses
+        put("plane", check_plane(self.plane))
         if self.plane is not None and model is ContactModel.SOFT_FINGER:
             raise InvalidOptionError(
                 "a planar analysis has no soft fingers (no moment about an in-plane "

@@ -28,6 +28,7 @@ from pydrake.multibody.tree import BodyIndex, JointIndex, ModelInstanceIndex, Ri
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.deferred import WeakMemo
+from drakegrasp.core.validation import describe, integer_or_none
 from drakegrasp.errors import (
     GraspError,
     InvalidContextError,
@@ -40,9 +41,11 @@ from drakegrasp.plant.attachment import joined
 __all__ = [
     "ROTATION_TOL",
     "HandSpec",
+    "check_bodies",
     "check_plant",
     "checked_context",
     "check_rigid_transform",
+    "check_velocity_indices",
     "hand_bodies",
     "hand_contact_bodies",
     "hand_model_instances",
@@ -437,11 +440,7 @@ def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
         For any other type.
     """
     if isinstance(object_body, RigidBody):
-        if object_body.GetParentPlant() is not plant:
-            raise ModelError(
-                f"body {object_body.name()!r} does not belong to this plant"
-            )
-        return object_body
+        return _own_body(plant, object_body, "body")
     if isinstance(object_body, BodyIndex):
         n = plant.num_bodies()
         if not object_body.is_valid() or not 0 <= int(object_body) < n:
@@ -456,6 +455,110 @@ def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
         "object_body must be a RigidBody, a BodyIndex or a 'model::body' name, "
         f"got {type(object_body).__name__}"
     )
+
+
+def _own_body(plant: MultibodyPlant, body: RigidBody, what: str) -> RigidBody:
+    """``body``, once it is a body of ``plant`` (``what`` names it in the message)."""
+    if body.GetParentPlant() is not plant:
+        raise ModelError(f"{what} {body.name()!r} does not belong to this plant")
+    return body
+
+
+def check_bodies(
+    plant: MultibodyPlant, bodies, *, argument: str = "bodies"
+) -> list[RigidBody]:
+    """``bodies`` as a list, once each is a ``RigidBody`` of ``plant``.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    bodies : iterable of RigidBody
+    argument : str, optional
+        The caller's parameter, for the message.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``bodies`` is not an iterable (a string is none), or holds something
+        that is not a ``RigidBody`` (the message names its place).
+    ModelError
+        A body of another plant (the message names it).
+    """
+    if isinstance(bodies, str | bytes | dict) or not isinstance(bodies, Iterable):
+        raise InvalidOptionError(
+            f"{argument} must be an iterable of the plant's RigidBody objects, "
+            f"got {describe(bodies)}"
+        )
+    out = []
+    for k, body in enumerate(bodies):
+        if not isinstance(body, RigidBody):
+            raise InvalidOptionError(
+                f"{argument}[{k}] must be a RigidBody of the plant, got "
+                f"{type(body).__name__} {describe(body)}"
+            )
+        out.append(_own_body(plant, body, f"{argument}[{k}], body"))
+    return out
+
+
+def check_velocity_indices(
+    plant: MultibodyPlant, indices, *, argument: str = "velocity_indices"
+) -> np.ndarray:
+    """Indices into the plant's velocities ``v``, each once, checked.
+
+    numpy would wrap a negative index, truncate ``0.5`` to 0 and raise a bare
+    ``IndexError`` past the end; a velocity named twice would be two columns
+    (two motors) for one velocity.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+    indices : sequence of int
+        One-dimensional; empty is a hand without velocities.
+    argument : str, optional
+        The caller's parameter, for the message.
+
+    Returns
+    -------
+    (n,) int
+        The indices, in the order given.
+
+    Raises
+    ------
+    InvalidOptionError
+        For what is not a one-dimensional sequence, an entry that is not an
+        integer (bools are not) or lies outside ``[0, nv)``, and an index
+        given more than once; the message names the entries and their places.
+    """
+    nv = plant.num_velocities()
+    try:
+        items = np.asarray(indices, dtype=object)
+    except (TypeError, ValueError):  # a ragged nest
+        items = None
+    if isinstance(indices, str | bytes | dict) or items is None or items.ndim != 1:
+        raise InvalidOptionError(
+            f"{argument} must be a one-dimensional sequence of plant velocity "
+            f"indices (integers in 0..{nv - 1}), got {describe(indices)}"
+        )
+    values = [integer_or_none(x) for x in items]
+    bad = [
+        f"{describe(x)} at [{k}]"
+        for k, (x, i) in enumerate(zip(items, values, strict=True))
+        if i is None or not 0 <= i < nv
+    ]
+    if bad:
+        raise InvalidOptionError(
+            f"{argument} must be integers in 0..{nv - 1} (the plant has {nv} "
+            f"velocities), got {', '.join(bad)}"
+        )
+    first: dict[int, int] = {}
+    for k, i in enumerate(values):
+        if i in first:
+            raise InvalidOptionError(
+                f"{argument} names velocity {i} more than once (at [{first[i]}] "
+                f"and [{k}]); each velocity is one column"
+            )
+        first[i] = k
+    return np.array(values, dtype=int)
 
 
 def resolve_grasped_body(plant: MultibodyPlant, object_body) -> RigidBody:

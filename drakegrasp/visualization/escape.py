@@ -39,7 +39,7 @@ from drakegrasp.core.validation import (
     real_scalar,
 )
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.plant.options import PLANES
+from drakegrasp.plant.options import PLANES, check_plane
 from drakegrasp.plant.validation import (
     check_plant,
     plant_context_of,
@@ -318,10 +318,7 @@ def _unpack(scene_or_plant, result, plant_context, object_body, plane):
     body = object_body
     if body is None:
         body = getattr(scene_or_plant, "object_body", None)
-    if plane is not None and (not isinstance(plane, str) or plane not in PLANES):
-        raise InvalidOptionError(
-            f"plane must be one of {sorted(PLANES)} or None, got {describe(plane)}"
-        )
+    plane = check_plane(plane)
     data = getattr(result, "data", None)  # a GraspReport
     if data is not None and hasattr(result, "form_closure"):
         analysed = getattr(data, "object_body", None)

@@ -12,6 +12,13 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 import drakegrasp as dg
+from drakegrasp.plant.load import gravity_wrench
+
+
+@pytest.fixture(scope="module")
+def jaw():
+    return dg.load_scene("parallel_jaw_box")
+
 
 # -- add_models ------------------------------------------------------------
 
@@ -39,3 +46,11 @@ def test_add_models_refusals_are_model_errors(parser, given, words):
     with pytest.raises(dg.ModelError, match="cannot load") as e:
         dg.plant.add_models(parser, **given)
     assert words in str(e.value)
+
+
+# -- the plane of a planar analysis ------------------------------------------
+
+
+def test_gravity_wrench_refuses_a_bad_plane(jaw):
+    with pytest.raises(dg.InvalidOptionError, match="plane must be one of"):
+        gravity_wrench(jaw.plant, jaw.plant_context, jaw.object_body, plane="ab")
