@@ -43,6 +43,7 @@ from drakegrasp.plant.contacts import (
     HandSpec,
     PlantContact,
     _scoped_name,
+    check_plant_contacts,
     find_contacts,
     resolve_object_body,
 )
@@ -280,6 +281,9 @@ def grasp_from_plant(
         Analyse these contacts (frame O of ``object_body``) instead of finding
         them from signed distances: e.g. the patches of hydroelastic contact
         surfaces read by :func:`drakegrasp.plant.contacts_from_results`.
+        They must be contacts of this plant and object: contacts found in
+        another plant (even one built from the same files) are refused
+        (:func:`~drakegrasp.plant.contacts.check_plant_contacts`).
     couplings : sequence of (joint_0, joint_1, gear_ratio, offset), optional
         Joint couplings ``q_0 = gear_ratio * q_1 + offset``; ``J`` becomes
         ``J C`` with one column per independent motion.  Default: those
@@ -297,6 +301,8 @@ def grasp_from_plant(
         Both :class:`~drakegrasp.InvalidPoseError`: the pose is impossible
         (names the bodies and the depth, or the joint, its value and limits).
     NoContactsError, ModelError, InvalidOptionError, InvalidContextError
+    InvalidContactError
+        For ``contacts`` that are not PlantContacts.
     """
     opts = resolve_options(
         options,
@@ -319,6 +325,8 @@ def grasp_from_plant(
         check_pose = opts.check_pose
         torsional_friction = opts.torsional_friction or 0.0
         body = resolve_object_body(plant, object_body)
+        if contacts is not None:
+            contacts = check_plant_contacts(plant, contacts, body)
         bodies = hand_contact_bodies(plant, body, hand)
         couplings = plant_couplings(plant, couplings)
         pose = _pose_of(

@@ -44,18 +44,24 @@ turns patch handling off.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from pydrake.geometry import GeometryId, QueryObject
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import BodyIndex
+from pydrake.multibody.tree import BodyIndex, RigidBody
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
-from drakegrasp.core.validation import check_distance_tolerance
+from drakegrasp.core.validation import (
+    check_distance_tolerance,
+    describe,
+    integer_or_none,
+)
 from drakegrasp.errors import (
+    InvalidContactError,
     InvalidOptionError,
     ModelError,
 )
@@ -66,10 +72,11 @@ from drakegrasp.plant.contact_pair import (
     resolve_pairs,
 )
 from drakegrasp.plant.contact_patches import PATCH_ANGLE_TOL
-from drakegrasp.plant.handles import pickled_handle
+from drakegrasp.plant.handles import ForeignGeometryId, pickled_handle
 from drakegrasp.plant.mesh_convexity import warn_if_not_convex
 from drakegrasp.plant.validation import (
     HandSpec,
+    _per_plant,
     hand_bodies,
     hand_contact_bodies,
     plant_context_of,
@@ -83,6 +90,7 @@ __all__ = [
     "PATCH_ANGLE_TOL",
     "PlantContact",
     "StagedContacts",
+    "check_plant_contacts",
     "contacts_of_distances",
     "find_contacts",
     "hand_bodies",
@@ -235,6 +243,117 @@ class PlantContact:
 def _unpickled_contact(cls: type, values: dict) -> PlantContact:
     """A pickled :class:`PlantContact` (its handles already unpickled)."""
     return cls(**values)
+
+
+def check_plant_contacts(
+    plant: MultibodyPlant, contacts, object_body: RigidBody
+) -> list[PlantContact]:
+    """``contacts`` as a list, once each is a :class:`PlantContact` of this plant.
+
+    A contact belongs to ``plant`` and ``object_body`` when
+
+    - its ``finger_body_index`` is a body of the plant whose scoped name is its
+      ``finger_body`` (an index alone names some body in many plants);
+    - each of its two geometry ids is a collision geometry of the plant,
+      the finger's on that finger body and the object's on ``object_body``.
+      Drake draws every ``GeometryId`` of a process from one counter, so an id
+      registered with this plant was found in it, and one that is not was
+      found in another plant (the same scene loaded twice has other ids).
+      An id pickled in another process
+      (:class:`~drakegrasp.plant.handles.ForeignGeometryId`) says nothing
+      here: the body's name and index are checked, and the functions that
+      read the geometry refuse it (:func:`~drakegrasp.plant.handles.local_geometry_id`).
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized.
+    contacts : sequence of PlantContact
+    object_body : RigidBody
+        The object, a body of ``plant`` (resolved by the caller).
+
+    Returns
+    -------
+    list of PlantContact
+
+    Raises
+    ------
+    InvalidContactError
+        ``contacts`` is not a sequence, or holds what is not a
+        ``PlantContact`` (the message names its place).
+    ModelError
+        A contact of another plant or of another object (the message names
+        the contact, and its body or geometry).
+    """
+    if isinstance(contacts, str | bytes | dict) or not isinstance(contacts, Iterable):
+        raise InvalidContactError(
+            "contacts must be a sequence of PlantContact (from find_contacts), "
+            f"got {describe(contacts)}"
+        )
+    contacts = list(contacts)
+    owners = _collision_owners(plant)
+    for k, c in enumerate(contacts):
+        if not isinstance(c, PlantContact):
+            raise InvalidContactError(
+                f"contacts[{k}] must be a PlantContact (from find_contacts), got "
+                f"{type(c).__name__} {describe(c)}"
+            )
+        finger = _finger_of(plant, c, k)
+        for what, body in (("finger", finger), ("object", object_body)):
+            gid = getattr(c, f"{what}_geometry")
+            if isinstance(gid, ForeignGeometryId):
+                continue
+            name = getattr(c, f"{what}_geometry_name")
+            value = gid.get_value() if isinstance(gid, GeometryId) else None
+            owner = owners.get(value)
+            if owner is None:
+                raise ModelError(
+                    f"contacts[{k}]'s {what} geometry {name!r} ({describe(gid)}) "
+                    "is not a collision geometry of this plant: the contact was "
+                    "found in another plant; find the contacts in this one"
+                )
+            if owner != int(body.index()):
+                raise ModelError(
+                    f"contacts[{k}]'s {what} geometry {name!r} belongs to "
+                    f"{scoped_name(plant, plant.get_body(BodyIndex(owner)))}, not "
+                    f"to the {what} {scoped_name(plant, body)}: the contact is "
+                    f"not one of this {what}"
+                )
+    return contacts
+
+
+def _finger_of(plant: MultibodyPlant, c: PlantContact, k: int) -> RigidBody:
+    """The finger body contact ``k`` names, once its index and name agree."""
+    n = plant.num_bodies()
+    i = integer_or_none(c.finger_body_index)
+    if i is None or not 0 <= i < n:
+        raise ModelError(
+            f"contacts[{k}] names finger body {c.finger_body!r} at "
+            f"{describe(c.finger_body_index)}, which is no body of this plant "
+            f"(its bodies are 0..{n - 1}): the contact was found in another "
+            "plant; find the contacts in this one"
+        )
+    body = plant.get_body(BodyIndex(i))
+    if scoped_name(plant, body) != c.finger_body:
+        raise ModelError(
+            f"contacts[{k}] names finger body {c.finger_body!r} at BodyIndex({i}),"
+            f" which is {scoped_name(plant, body)!r} in this plant: the contact "
+            "was found in another plant; find the contacts in this one"
+        )
+    return body
+
+
+def _collision_owners(plant: MultibodyPlant) -> dict[int, int]:
+    """Per collision geometry of the plant (its id's number): its body's index."""
+
+    def compute():
+        return {
+            g.get_value(): b
+            for b in range(plant.num_bodies())
+            for g in plant.GetCollisionGeometriesForBody(plant.get_body(BodyIndex(b)))
+        }
+
+    return _per_plant(plant, ("collision owners",), compute)
 
 
 def _label(body: str, name: str, index: int | None) -> str:

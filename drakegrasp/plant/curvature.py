@@ -45,9 +45,13 @@ from pydrake.systems.framework import Context
 from drakegrasp.core.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import flat_faces, surface_pieces
-from drakegrasp.plant.contacts import PlantContact, resolve_object_body
+from drakegrasp.plant.contacts import (
+    PlantContact,
+    check_plant_contacts,
+    resolve_object_body,
+)
 from drakegrasp.plant.handles import local_geometry_id
-from drakegrasp.plant.options import PLANES
+from drakegrasp.plant.options import PLANES, check_plane
 from drakegrasp.plant.validation import plant_context_of, query_object_of
 
 __all__ = [
@@ -272,13 +276,19 @@ def contact_curvatures(
     Raises
     ------
     ModelError
-        For a shape without a curvature model.
+        For a shape without a curvature model, or a contact of another plant
+        or object (:func:`~drakegrasp.plant.contacts.check_plant_contacts`).
     InvalidContactError
         A contact unpickled in another process than the one that found it
-        (its geometries are :class:`~drakegrasp.plant.handles.ForeignGeometryId`).
+        (its geometries are :class:`~drakegrasp.plant.handles.ForeignGeometryId`),
+        or an item of ``contacts`` that is not a ``PlantContact``.
+    InvalidOptionError
+        An unknown ``plane``.
     """
     plant_context = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
+    contacts = check_plant_contacts(plant, contacts, body)
+    plane = check_plane(plane)
     query = query_object
     if query is None:
         query = query_object_of(plant, plant_context)

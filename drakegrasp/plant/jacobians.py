@@ -30,10 +30,15 @@ from pydrake.systems.framework import Context
 
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.plant.contacts import PlantContact
-from drakegrasp.plant.options import PLANES
+from drakegrasp.core.validation import check_grasp
+from drakegrasp.errors import InvalidGraspError
+from drakegrasp.plant.contacts import PlantContact, check_plant_contacts
+from drakegrasp.plant.options import PLANES, check_plane
 from drakegrasp.plant.validation import (
     _per_plant,
+    check_bodies,
+    check_plant,
+    check_velocity_indices,
     plant_context_of,
     resolve_object_body,
 )
@@ -62,8 +67,16 @@ def hand_velocity_indices(
     -------
     (n_h,) int
         Sorted indices into ``v`` of every joint whose child is one of the bodies.
+
+    Raises
+    ------
+    ModelError
+        A body of another plant.
+    InvalidOptionError
+        ``bodies`` is not an iterable of ``RigidBody``.
     """
-    wanted = frozenset(int(b.index()) for b in bodies)
+    check_plant(plant)
+    wanted = frozenset(int(b.index()) for b in check_bodies(plant, bodies))
 
     def compute():
         out: list[int] = []
@@ -128,10 +141,22 @@ def signed_distance_jacobian(
     Returns
     -------
     (N, nv) float
-        ``ψ̇ = (∂ψ/∂v) v`` (metres per unit velocity; ``JacobianWrtVariable.kV``).
+        ``ψ̇ = (∂ψ/∂v) v`` (metres per unit velocity; ``JacobianWrtVariable.kV``);
+        ``(0, nv)`` for no contacts.
+
+    Raises
+    ------
+    InvalidContactError
+        ``contacts`` holds what is not a ``PlantContact``.
+    ModelError
+        A contact of another plant or another object
+        (:func:`~drakegrasp.plant.contacts.check_plant_contacts`).
     """
     plant_context = plant_context_of(plant, plant_context)
     object_body = resolve_object_body(plant, object_body)
+    contacts = check_plant_contacts(plant, contacts, object_body)
+    if not contacts:  # Drake asserts that it is given a point
+        return np.zeros((0, plant.num_velocities()))
     frame_O = object_body.body_frame()
     points_O = np.array([c.p_OC for c in contacts])
     J_obj = _translational(plant, plant_context, object_body, points_O, frame_O)
@@ -165,9 +190,11 @@ def hand_jacobian(
     object_body : RigidBody, BodyIndex or str
         Frame O in which everything is expressed; positional or keyword.
     velocity_indices : (n_h,) int
-        Plant velocities that are the hand's (the columns of ``J``).
+        Plant velocities that are the hand's (the columns of ``J``), each
+        once, in ``0..nv-1``.
     plane : {"xy", "yz", "zx"} or None, optional
-        For a planar grasp: the object-frame plane the contacts live in.
+        For a planar grasp: the object-frame plane the contacts live in
+        (given exactly when the grasp is planar).
 
     Returns
     -------
@@ -176,11 +203,38 @@ def hand_jacobian(
         order, each in the contact's components ``[n, t1, t2(, m_n)]`` (planar
         ``[n, t]``; frictionless ``[n]``).  Velocities in m/s (rad/s for the
         soft-finger row) per unit hand velocity.
+
+    Raises
+    ------
+    InvalidOptionError
+        Bad ``velocity_indices`` (negative, not integers, past the plant's
+        velocities, repeated) or ``plane``.
+    InvalidGraspError
+        ``contacts`` are not as many as ``grasp.contacts``, or ``plane`` is
+        given for a spatial grasp or missing for a planar one.
+    InvalidContactError, ModelError
+        As :func:`signed_distance_jacobian`, for ``contacts``.
     """
     plant_context = plant_context_of(plant, plant_context)
     object_body = resolve_object_body(plant, object_body)
+    contacts = check_plant_contacts(plant, contacts, object_body)
+    grasp = check_grasp(grasp)
+    plane = check_plane(plane)
+    cols = check_velocity_indices(plant, velocity_indices)
+    if len(contacts) != grasp.num_contacts:
+        raise InvalidGraspError(
+            f"{len(contacts)} contact(s) given for a grasp of "
+            f"{grasp.num_contacts} contacts: contacts must be the plant contacts "
+            "the grasp was built from, in its order"
+        )
+    if grasp.planar != (plane is not None):
+        raise InvalidGraspError(
+            f"plane={plane!r} for a spatial grasp: give no plane"
+            if plane is not None
+            else "a planar grasp needs plane= (the object-frame plane of its "
+            f"contacts, one of {sorted(PLANES)})"
+        )
     frame_O = object_body.body_frame()
-    cols = np.asarray(velocity_indices, dtype=int)
     J_fin = _finger_jacobians(plant, plant_context, contacts, frame_O)
     blocks = []
     for i, (pc, c) in enumerate(zip(contacts, grasp.contacts, strict=True)):

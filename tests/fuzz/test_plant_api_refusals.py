@@ -7,17 +7,225 @@ silently from contacts or bodies of another plant.
 
 from __future__ import annotations
 
+import dataclasses
+
+import numpy as np
 import pytest
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 import drakegrasp as dg
+from drakegrasp.plant.jacobians import hand_velocity_indices
 from drakegrasp.plant.load import gravity_wrench
 
 
 @pytest.fixture(scope="module")
 def jaw():
     return dg.load_scene("parallel_jaw_box")
+
+
+@pytest.fixture(scope="module")
+def three():
+    return dg.load_scene("three_finger_sphere")
+
+
+@pytest.fixture(scope="module")
+def jaw_found(jaw):
+    g = dg.grasp_from_plant(jaw.plant, jaw.plant_context, jaw.object_body, mu=0.5)
+    return g, list(g.contacts)
+
+
+def _contacts(scene):
+    return dg.find_contacts(scene.plant, scene.plant_context, scene.object_body)
+
+
+def _hand(scene, instance):
+    plant = scene.plant
+    found = plant.GetBodyIndices(plant.GetModelInstanceByName(instance))
+    return [plant.get_body(i) for i in found]
+
+
+# -- signed_distance_jacobian ----------------------------------------------
+
+
+def test_no_contacts_give_an_empty_signed_distance_jacobian(jaw):
+    J = dg.signed_distance_jacobian(jaw.plant, jaw.plant_context, [], jaw.object_body)
+    assert J.shape == (0, jaw.plant.num_velocities())
+
+
+@pytest.mark.parametrize("item", [1, "contact", None])
+def test_a_signed_distance_jacobian_refuses_what_is_no_contact(jaw, jaw_found, item):
+    contacts = [jaw_found[1][0], item]
+    with pytest.raises(dg.InvalidContactError, match=r"contacts\[1\]"):
+        dg.signed_distance_jacobian(
+            jaw.plant, jaw.plant_context, contacts, jaw.object_body
+        )
+
+
+# -- hand_jacobian ---------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("indices", "words"),
+    [
+        ([-1], "-1"),
+        ([0.5], "0.5"),
+        ([100], "100"),
+        ([0, 0], "more than once"),
+        ([True], "True"),
+        ("ab", "'ab'"),
+        ([[0, 1]], "one-dimensional"),
+    ],
+)
+def test_hand_jacobian_refuses_bad_velocity_indices(jaw, jaw_found, indices, words):
+    g, contacts = jaw_found
+    with pytest.raises(dg.InvalidOptionError, match="velocity_indices") as e:
+        dg.hand_jacobian(
+            jaw.plant, jaw.plant_context, contacts, g.grasp, jaw.object_body,
+            velocity_indices=indices,
+        )  # fmt: skip
+    assert words in str(e.value)
+
+
+def test_hand_jacobian_takes_integral_indices_of_any_integer_type(jaw, jaw_found):
+    g, contacts = jaw_found
+    for indices in ([], np.array([1, 0], dtype=np.int32), (g.hand_velocity_indices)):
+        J = dg.hand_jacobian(
+            jaw.plant, jaw.plant_context, contacts, g.grasp, jaw.object_body,
+            velocity_indices=indices,
+        )  # fmt: skip
+        assert J.shape == (g.grasp.num_components, len(indices))
+
+
+def test_hand_jacobian_refuses_a_bad_plane(jaw, jaw_found):
+    g, contacts = jaw_found
+    call = dict(velocity_indices=[0])
+    with pytest.raises(dg.InvalidOptionError, match="plane must be one of"):
+        dg.hand_jacobian(
+            jaw.plant, jaw.plant_context, contacts, g.grasp, jaw.object_body,
+            plane="ab", **call,
+        )  # fmt: skip
+    with pytest.raises(dg.InvalidGraspError, match="spatial"):
+        dg.hand_jacobian(
+            jaw.plant, jaw.plant_context, contacts, g.grasp, jaw.object_body,
+            plane="xy", **call,
+        )  # fmt: skip
+
+
+def test_hand_jacobian_refuses_contacts_not_of_the_grasp(jaw, jaw_found):
+    g, contacts = jaw_found
+    with pytest.raises(dg.InvalidGraspError, match=r"1 contact.*2 contacts"):
+        dg.hand_jacobian(
+            jaw.plant, jaw.plant_context, contacts[:1], g.grasp, jaw.object_body,
+            velocity_indices=[0],
+        )  # fmt: skip
+
+
+# -- contacts of another plant ---------------------------------------------
+
+
+def test_analyze_grasp_refuses_contacts_of_another_plant(jaw, three):
+    for scene, other in ((jaw, three), (three, jaw)):
+        with pytest.raises(dg.ModelError, match="another plant") as e:
+            dg.analyze_grasp(
+                scene.plant, scene.plant_context, scene.object_body, mu=0.5,
+                contacts=_contacts(other),
+            )  # fmt: skip
+        assert "contacts[0]" in str(e.value)
+
+
+def test_analyze_grasp_refuses_contacts_of_a_copy_of_the_plant(jaw):
+    # the same scene loaded again: same body names and indices, other geometry
+    copy = dg.load_scene("parallel_jaw_box")
+    with pytest.raises(dg.ModelError, match="geometry"):
+        dg.analyze_grasp(
+            jaw.plant, jaw.plant_context, jaw.object_body, mu=0.5,
+            contacts=_contacts(copy),
+        )  # fmt: skip
+
+
+def test_analyze_grasp_refuses_contacts_of_another_object(jaw, jaw_found):
+    _, contacts = jaw_found
+    finger = contacts[0].finger_body
+    with pytest.raises(dg.ModelError, match="object"):
+        dg.analyze_grasp(
+            jaw.plant, jaw.plant_context, finger, mu=0.5, contacts=contacts,
+            check_pose=False,
+        )  # fmt: skip
+
+
+def test_analyze_grasp_refuses_a_renamed_finger(jaw, jaw_found):
+    _, contacts = jaw_found
+    renamed = [dataclasses.replace(contacts[0], finger_body="gripper::palm")]
+    with pytest.raises(dg.ModelError, match="gripper::palm"):
+        dg.analyze_grasp(
+            jaw.plant, jaw.plant_context, jaw.object_body, mu=0.5, contacts=renamed
+        )
+
+
+def test_analyze_grasp_refuses_what_is_no_contact(jaw):
+    with pytest.raises(dg.InvalidContactError, match=r"contacts\[0\].*int"):
+        dg.analyze_grasp(
+            jaw.plant, jaw.plant_context, jaw.object_body, mu=0.5, contacts=[1, 2]
+        )
+
+
+def test_analyze_grasp_takes_its_own_contacts(jaw, jaw_found):
+    _, contacts = jaw_found
+    report = dg.analyze_grasp(
+        jaw.plant, jaw.plant_context, jaw.object_body, mu=0.5, contacts=contacts
+    )
+    assert report.grasp.num_contacts == len(contacts)
+
+
+def test_jacobians_refuse_contacts_of_another_plant(jaw, three, jaw_found):
+    g, _ = jaw_found
+    foreign = _contacts(three)
+    with pytest.raises(dg.ModelError, match="another plant"):
+        dg.signed_distance_jacobian(
+            jaw.plant, jaw.plant_context, foreign, jaw.object_body
+        )
+    with pytest.raises(dg.ModelError, match="another plant"):
+        dg.hand_jacobian(
+            jaw.plant, jaw.plant_context, foreign[:2], g.grasp, jaw.object_body,
+            velocity_indices=[0],
+        )  # fmt: skip
+
+
+# -- hand_velocity_indices -------------------------------------------------
+
+
+def test_hand_velocity_indices_refuse_bodies_of_another_plant(jaw, three):
+    with pytest.raises(dg.ModelError, match="palm.*does not belong to this plant"):
+        hand_velocity_indices(jaw.plant, _hand(three, "hand"))
+
+
+@pytest.mark.parametrize("bodies", [[1, 2], "abc", 3, None])
+def test_hand_velocity_indices_refuse_what_is_no_body(jaw, bodies):
+    with pytest.raises(dg.InvalidOptionError, match="bodies"):
+        hand_velocity_indices(jaw.plant, bodies)
+
+
+def test_hand_velocity_indices_of_own_bodies(jaw):
+    assert hand_velocity_indices(jaw.plant, _hand(jaw, "gripper")).tolist() == [0, 1]
+
+
+# -- contact_curvatures ----------------------------------------------------
+
+
+def test_contact_curvatures_refuse_contacts_of_another_plant(jaw, three):
+    with pytest.raises(dg.ModelError, match="another plant"):
+        dg.plant.contact_curvatures(
+            jaw.plant, jaw.plant_context, _contacts(three), object_body=jaw.object_body
+        )
+
+
+def test_contact_curvatures_refuse_a_bad_plane(jaw, jaw_found):
+    with pytest.raises(dg.InvalidOptionError, match="plane must be one of"):
+        dg.plant.contact_curvatures(
+            jaw.plant, jaw.plant_context, jaw_found[1],
+            object_body=jaw.object_body, plane="ab",
+        )  # fmt: skip
 
 
 # -- add_models ------------------------------------------------------------

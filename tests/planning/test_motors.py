@@ -178,13 +178,17 @@ def _with_palm_contact(scene, candidate):
         p_OC = centre - 0.03 * n_O  # on the can's side, facing the palm
         X_WF = plant.EvalBodyPoseInWorld(ctx, palm)
         p_FC = X_WF.inverse().multiply(X_WO.multiply(p_OC))
+        inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
     finally:
         plant.SetPositions(ctx, saved)
     first = candidate.contacts[0]
+    palm_geometry = plant.GetCollisionGeometriesForBody(palm)[0]  # on its body
     contact = dataclasses.replace(
         first, p_OC=p_OC, nhat_O=n_O, p_FC=p_FC,
         finger_body=plant.GetModelInstanceName(palm.model_instance()) + "::hand_root",
         finger_body_index=palm.index(),
+        finger_geometry=palm_geometry,
+        finger_geometry_name=inspector.GetName(palm_geometry),
     )  # fmt: skip
     return dataclasses.replace(candidate, contacts=(*candidate.contacts, contact))
 
