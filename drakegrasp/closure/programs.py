@@ -72,6 +72,7 @@ __all__ = [
     "build_force_closure_program",
     "build_form_closure_program",
     "build_internal_force_program",
+    "lp3_is_conic",
 ]
 
 OBJECTIVE_SCALE = 1e4
@@ -477,17 +478,44 @@ def build_exact_force_closure_program(
     rows = _shared_balance_rows(grasp, layout, rank_tol)
     add_balance(prog, None, f, rank_tol, rows=rows)
     _add_normal_budget(prog, f[layout.normal_positions], N)
+    _add_exact_cones(prog, grasp, layout, f, d)
+    return prog, _scaled_variables(d, f, layout)
+
+
+def _add_exact_cones(prog, grasp: Grasp, layout: ConeLayout, x, d=None) -> None:
+    """Each contact's scaled force ``x_i`` in its exact Coulomb cone.
+
+    With ``d``, at distance ``d`` inside it (the exact-cone program's
+    margin); without, in the closed cone.  A spatial contact with friction
+    gets Lorentz cones (:func:`~drakegrasp.closure.constraints.exact_cone_rows`);
+    a planar or frictionless cone, exact as a polyhedron, its facets.
+    """
     b = grasp.characteristic_length
     starts = list(layout.normal_positions) + [len(layout.columns)]
     for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
-        fi = f[starts[i] : starts[i + 1]]
+        xi = x[starts[i] : starts[i + 1]]
         scale = layout.scales[starts[i] : starts[i + 1]]
         if cone.components not in EXACT_CONE_COMPONENTS:
-            _add_margin_rows(prog, cone.facets * scale, fi, d)  # exact already
+            if d is None:
+                rows = cone.facets * scale
+                lower = np.zeros(rows.shape[0])
+                add_linear_constraint(
+                    prog, rows, lower, np.full_like(lower, np.inf), xi
+                )
+            else:
+                _add_margin_rows(prog, cone.facets * scale, xi, d)
             continue
         for A in exact_cone_rows(contact, scale, b):
-            prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(fi, d))
-    return prog, _scaled_variables(d, f, layout)
+            if d is None:
+                prog.AddLorentzConeConstraint(A[:, :-1], np.zeros(3), xi)
+            else:
+                prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(xi, d))
+
+
+def lp3_is_conic(grasp: Grasp) -> bool:
+    """Whether LP3 within friction has a Lorentz cone (spatial, with friction)."""
+    layout = cone_layout(grasp, DEFAULT_NUM_GENERATORS)
+    return any(c.components in EXACT_CONE_COMPONENTS for c in layout.cones)
 
 
 def build_internal_force_program(
@@ -495,6 +523,7 @@ def build_internal_force_program(
     hand_jacobian: np.ndarray,
     *,
     rank_tol: float = DEFAULT_RANK_TOL,
+    within_friction: bool = False,
 ) -> tuple[MathematicalProgram, ProgramVariables]:
     """Build LP3: an internal force with positive normals that the hand cannot feel.
 
@@ -507,12 +536,19 @@ def build_internal_force_program(
         hand's generalized velocities.
     rank_tol : float, optional
         Relative singular-value threshold that defines the numerical null space.
+    within_friction : bool, optional
+        Also keep every contact force in its closed, exact Coulomb cone (a
+        second-order cone program when a contact is spatial with friction):
+        a squeeze the contacts can carry.  Not LP3 (which bounds the normals
+        only, as the conventions fix it) but a fact reported beside it when
+        it fails (:attr:`~drakegrasp.InternalForceResult.passes_within_friction`).
 
     Returns
     -------
     prog : MathematicalProgram
         ``max d`` s.t. ``G f = 0``, ``Jᵀ f = 0``, ``E f - 1 d >= 0``, ``d >= 0``,
-        ``Σ f_n <= N``.  ``d* = 0`` passes.
+        ``Σ f_n <= N`` (and ``f ∈ FC`` with ``within_friction``).  ``d* = 0``
+        passes.
     variables : ProgramVariables
 
     Notes
@@ -532,10 +568,17 @@ def build_internal_force_program(
     A = np.vstack(
         [balance_matrix(grasp, layout.columns), unit_columns(J[layout.columns]).T]
     )
-    add_balance(prog, A, f, rank_tol)
+    if not within_friction:
+        add_balance(prog, A, f, rank_tol)
+        _add_margin_rows(prog, _selection(layout.normal_positions, len(f)), f, d)
+        _add_normal_budget(prog, f[layout.normal_positions], N)
+        return prog, ProgramVariables(d, f, layout.columns)
+    # f holds scaled components (a soft finger's m_n / (b ν)): ConeLayout.scales
+    add_balance(prog, A, f, rank_tol, scales=layout.scales)
     _add_margin_rows(prog, _selection(layout.normal_positions, len(f)), f, d)
     _add_normal_budget(prog, f[layout.normal_positions], N)
-    return prog, ProgramVariables(d, f, layout.columns)
+    _add_exact_cones(prog, grasp, layout, f)
+    return prog, _scaled_variables(d, f, layout)
 
 
 def balance_matrix(grasp: Grasp, columns: np.ndarray) -> np.ndarray:

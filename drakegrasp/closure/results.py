@@ -57,6 +57,18 @@ class InternalForceResult:
         resolution (``rank_tol``).  Such a ``d*`` says nothing, and whether it
         fell above or below ``tol`` depended on the machine; a squeeze must
         have normals above both ``tol`` and this to fail LP3.
+    passes_within_friction : bool or None
+        When LP3 fails: whether it would pass over the squeezes the contacts
+        can carry, every contact force in its closed, exact Coulomb cone
+        (``build_internal_force_program(within_friction=True)``).  True means
+        every uncontrollable squeeze LP3 found would make a contact slide: the
+        joints feel every squeeze the contacts can hold (a WSG-50's two tip
+        spheres per pad whose normals lean 0.39° from the joint axis: LP3's
+        squeeze presses 21,500 times harder along the surfaces than into
+        them, and the planned grasp held in Drake).  None when LP3 passes.
+        Reported beside the verdict, never in its place.
+    d_star_within_friction : float or None
+        That program's optimal ``d`` (None when LP3 passes).
 
     Notes
     -----
@@ -84,6 +96,8 @@ class InternalForceResult:
     tol: float
     certificate: Certificate | None = None
     resolution: float = 0.0
+    d_star_within_friction: float | None = None
+    passes_within_friction: bool | None = None
 
     @property
     def threshold(self) -> float:
@@ -134,6 +148,16 @@ class InternalForceResult:
             )
         if self.near_boundary:
             lp3 += "  [within tol of the boundary]"
+        if self.passes_within_friction is not None:
+            lp3 += (
+                "; within the friction cones none exists (d* = "
+                f"{_zero_text(self.d_star_within_friction, self.tol)}): every "
+                "such squeeze would make a contact slide, and the joints feel "
+                "every squeeze the contacts can carry"
+                if self.passes_within_friction
+                else "; one exists within the friction cones too (d* = "
+                f"{self.d_star_within_friction:.3g})"
+            )
         dim = self.null_space_dim
         null = (
             f"dim N(G) ∩ N(Jᵀ) = {dim} (null-space condition: "

@@ -28,6 +28,7 @@ from drakegrasp.closure.programs import (
     check_formulation,
     check_program_options,
     cone_layout,
+    lp3_is_conic,
     normal_balance_matrix,
     per_grasp,
 )
@@ -204,11 +205,22 @@ def internal_forces(
     null_dim = len(variables.columns) - rank
     # Normals below rank_tol of the force's size are round-off, not a squeeze
     # (InternalForceResult.resolution).
-    size = 0.0 if forces is None else float(np.max(np.abs(forces), initial=0.0))
-    resolution = rank_tol * size
+    resolution = rank_tol * _largest(forces)
     threshold = max(tol, resolution)
     passes = not (d_star > threshold)  # NaN (infeasible) passes: no such force
     contact_forces = _split_forces(grasp, variables.columns, forces)
+    within = None
+    if not passes:  # is there one the contacts can carry, within friction?
+        prog, friction_variables = build_internal_force_program(
+            grasp, hand_jacobian, rank_tol=rank_tol, within_friction=True
+        )
+        d_within, carried, _, _ = _solve_margin(
+            prog, friction_variables, conic=lp3_is_conic(grasp)
+        )
+        within = (
+            float(d_within) if np.isfinite(d_within) else 0.0,
+            not (d_within > max(tol, rank_tol * _largest(carried))),
+        )
     return InternalForceResult(
         passes=bool(passes),
         d_star=d_star,
@@ -220,7 +232,14 @@ def internal_forces(
         tol=tol,
         certificate=None if passes else uncontrollable_force(grasp, contact_forces),
         resolution=resolution,
+        d_star_within_friction=None if within is None else within[0],
+        passes_within_friction=None if within is None else bool(within[1]),
     )
+
+
+def _largest(forces) -> float:
+    """The largest |component| of an optimal force (0 for none)."""
+    return 0.0 if forces is None else float(np.max(np.abs(forces), initial=0.0))
 
 
 def _margin_solution(grasp: Grasp, build, tol: float) -> tuple:
