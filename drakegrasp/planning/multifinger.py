@@ -596,6 +596,14 @@ def _checked_hand(
             if hand_model.num_fingers == 1 and joints > 2
             else ""
         )
+        if hand_model.num_fingers == 1 and not arm:
+            raise ModelError(
+                f"the hand has one moving finger {fingers}: the planner closes "
+                "two or more fingers onto the object, and a single-acting jaw "
+                "(one finger pressing the object against a jaw fixed to the "
+                "palm) is not planned; place such a grasp yourself and judge it "
+                "with analyze_grasp"
+            )
         raise InvalidOptionError(
             f"min_fingers = {min_fingers} exceeds the hand's "
             f"{hand_model.num_fingers} fingers {fingers}{arm}"

@@ -246,7 +246,7 @@ def _unpickled_contact(cls: type, values: dict) -> PlantContact:
 
 
 def check_plant_contacts(
-    plant: MultibodyPlant, contacts, object_body: RigidBody
+    plant: MultibodyPlant, contacts, object_body: RigidBody, *, reads_geometry=True
 ) -> list[PlantContact]:
     """``contacts`` as a list, once each is a :class:`PlantContact` of this plant.
 
@@ -264,6 +264,13 @@ def check_plant_contacts(
       here: the body's name and index are checked, and the functions that
       read the geometry refuse it (:func:`~drakegrasp.plant.handles.local_geometry_id`).
 
+    A caller that reads only the bodies and points (the Jacobians:
+    ``reads_geometry=False``) takes a contact whose geometry ids this plant
+    does not hold once its finger body checks out: a candidate's contacts
+    applied to the same scene loaded again (the ids differ, the bodies and
+    points do not).  A geometry id this plant holds on another body is
+    refused either way.
+
     Parameters
     ----------
     plant : MultibodyPlant
@@ -271,6 +278,8 @@ def check_plant_contacts(
     contacts : sequence of PlantContact
     object_body : RigidBody
         The object, a body of ``plant`` (resolved by the caller).
+    reads_geometry : bool, optional
+        Whether the caller reads the contacts' geometries (default True).
 
     Returns
     -------
@@ -306,6 +315,8 @@ def check_plant_contacts(
             name = getattr(c, f"{what}_geometry_name")
             value = gid.get_value() if isinstance(gid, GeometryId) else None
             owner = owners.get(value)
+            if owner is None and not reads_geometry:
+                continue  # the same scene loaded again: its bodies are checked
             if owner is None:
                 raise ModelError(
                     f"contacts[{k}]'s {what} geometry {name!r} ({describe(gid)}) "

@@ -154,7 +154,7 @@ def signed_distance_jacobian(
     """
     plant_context = plant_context_of(plant, plant_context)
     object_body = resolve_object_body(plant, object_body)
-    contacts = check_plant_contacts(plant, contacts, object_body)
+    contacts = check_plant_contacts(plant, contacts, object_body, reads_geometry=False)
     if not contacts:  # Drake asserts that it is given a point
         return np.zeros((0, plant.num_velocities()))
     frame_O = object_body.body_frame()
@@ -217,7 +217,7 @@ def hand_jacobian(
     """
     plant_context = plant_context_of(plant, plant_context)
     object_body = resolve_object_body(plant, object_body)
-    contacts = check_plant_contacts(plant, contacts, object_body)
+    contacts = check_plant_contacts(plant, contacts, object_body, reads_geometry=False)
     grasp = check_grasp(grasp)
     plane = check_plane(plane)
     cols = check_velocity_indices(plant, velocity_indices)

@@ -192,6 +192,22 @@ def test_jacobians_refuse_contacts_of_another_plant(jaw, three, jaw_found):
         )  # fmt: skip
 
 
+def test_jacobians_take_contacts_of_the_same_scene_loaded_again(jaw):
+    # a candidate's contacts applied to another load of its scene (a second
+    # plant of the same models: torque_capacity across plants) read only the
+    # bodies and points, which agree; the geometry ids differ
+    copy = dg.load_scene("parallel_jaw_box")
+    theirs = _contacts(copy)
+    np.testing.assert_array_equal(
+        dg.signed_distance_jacobian(
+            jaw.plant, jaw.plant_context, theirs, jaw.object_body
+        ),
+        dg.signed_distance_jacobian(
+            jaw.plant, jaw.plant_context, _contacts(jaw), jaw.object_body
+        ),
+    )
+
+
 # -- hand_velocity_indices -------------------------------------------------
 
 

@@ -292,6 +292,31 @@ def test_a_hand_whose_joints_have_no_range_is_refused(tmp_path):
     plan(scene, n=5, preshape=None)
 
 
+SINGLE_ACTING = """<?xml version="1.0"?><sdf version="1.9"><model name="single">
+<link name="palm"><inertial><mass>0.5</mass></inertial>
+<collision name="palm"><pose>0 0.02 -0.015 0 0 0</pose><geometry><box>
+<size>0.06 0.12 0.03</size></box></geometry></collision>
+<collision name="jaw"><pose>0 -0.034 0.04 0 0 0</pose><geometry><box>
+<size>0.02 0.008 0.08</size></box></geometry></collision></link>
+<link name="finger"><inertial><mass>0.05</mass></inertial>
+<collision name="bar"><pose>0 0.074 0.04 0 0 0</pose><geometry><box>
+<size>0.02 0.008 0.08</size></box></geometry></collision></link>
+<joint name="slide" type="prismatic"><parent>palm</parent><child>finger</child>
+<axis><xyz>0 -1 0</xyz><limit><lower>0</lower><upper>0.06</upper>
+<effort>20</effort></limit></axis></joint></model></sdf>"""
+
+
+def test_a_single_acting_jaw_is_said_to_be_one_the_planner_does_not_plan(tmp_path):
+    # "min_fingers = 2 exceeds the hand's 1 fingers" pointed at min_fingers,
+    # which refuses 1: the hand (one finger, a jaw fixed to the palm) was the cause
+    hand = tmp_path / "single.sdf"
+    hand.write_text(SINGLE_ACTING)
+    scene = planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(hand))
+    with pytest.raises(ModelError, match="one moving finger .'single::slide'.") as e:
+        plan(scene, n=5)
+    assert "single-acting jaw" in str(e.value) and "min_fingers" not in str(e.value)
+
+
 @pytest.mark.parametrize(
     "bad, match",
     [
