@@ -728,6 +728,7 @@ def analyze_grasp(
             else _as_load(opts.torque_limits),
             query_object=query_object,
             object_mass=opts.object_mass,
+            distance_tolerance=opts.distance_tolerance,
         )
         tol, num_generators = opts.tol, opts.num_generators
         grasp, J = data.grasp, lp3_jacobian(data.hand_jacobian)

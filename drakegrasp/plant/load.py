@@ -75,6 +75,7 @@ __all__ = [
     "LoadReport",
     "analyze_load",
     "load_section",
+    "pressing_on_limits",
     "gravity_wrench",
     "passive_preload",
     "plant_torque_limits",
@@ -214,6 +215,71 @@ def _unactuated_warning(names: tuple[str, ...]) -> str:
         f"{'it' if len(names) == 1 else 'them'} 0 (no torque: a passive joint); "
         "where a motor drives them, give the model its actuators (a URDF "
         "<transmission>, an SDFormat <effort>), or pass torque_limits"
+    )
+
+
+def pressing_on_limits(
+    plant: MultibodyPlant, plant_context, data, joint_torques, distance_tolerance
+) -> tuple[str, ...]:
+    """The hand joints that would press the squeeze on their own limits.
+
+    A one-dof joint ``j`` whose torque ``τ_j`` drives it towards a finite
+    limit that its contacts reach within the contact tolerance: ``|q_limit -
+    q_j| · max_i |∂ψ_i/∂q_j| <= distance_tolerance`` (the contacts' travel
+    left).  Its motor then presses on the limit, not on the object: Drake
+    dropped a rod held by a jaw 0.05 mm from its closed limit at any squeeze
+    up to its motors' 8 N.
+
+    Parameters
+    ----------
+    plant, plant_context
+    data : GraspFromPlant
+        ``hand_velocity_indices`` and ``dpsi_dv`` (``(N, nv)``).
+    joint_torques : (n_h,) float
+        The efforts the load needs, per hand velocity (N·m or N).
+    distance_tolerance : float
+        Metres.
+
+    Returns
+    -------
+    tuple of str
+        The joints' names, in the order of the hand's velocities.
+    """
+    q_all = plant.GetPositions(plant_context_of(plant, plant_context))
+    by_velocity = {}
+    for index in plant.GetJointIndices():
+        joint = plant.get_joint(index)
+        if joint.num_velocities() == 1 and joint.num_positions() == 1:
+            by_velocity[joint.velocity_start()] = joint
+    dpsi = np.asarray(data.dpsi_dv, dtype=float)
+    tau = np.asarray(joint_torques, dtype=float)
+    scale = float(np.max(np.abs(tau), initial=0.0))
+    found = []
+    for v, t in zip(data.hand_velocity_indices, tau, strict=True):
+        joint = by_velocity.get(int(v))
+        if joint is None or not abs(t) > 1e-9 * scale:
+            continue  # a free base's velocity, or no torque to press with
+        q = float(q_all[joint.position_start()])
+        limit = (
+            joint.position_upper_limits()[0]
+            if t > 0
+            else joint.position_lower_limits()[0]
+        )
+        reach = float(np.max(np.abs(dpsi[:, int(v)]), initial=0.0))
+        if np.isfinite(limit) and abs(limit - q) * reach <= distance_tolerance:
+            found.append(joint.name())
+    return tuple(found)
+
+
+def _on_limits_warning(names: tuple[str, ...], tolerance: float) -> str:
+    listed = ", ".join(repr(n) for n in names)
+    return (
+        f"{listed} {'presses' if len(names) == 1 else 'press'} towards "
+        f"{'its limit' if len(names) == 1 else 'their limits'}, which the "
+        f"contacts reach within the contact tolerance ({tolerance:g} m): the "
+        "motor would press on the limit, not squeeze the object, so the hold "
+        "rests on how the limit gives (open the hand a little, or grasp where "
+        "the fingers have travel left)"
     )
 
 
@@ -557,6 +623,7 @@ def analyze_load(
     mu_plant: np.ndarray | None,
     mu_dynamic: np.ndarray | None = None,
     object_mass: float | None = None,
+    distance_tolerance: float | None = None,
 ) -> LoadReport:
     """The load section of a grasp report (see :class:`LoadReport`).
 
@@ -577,6 +644,10 @@ def analyze_load(
         a disagreement (:func:`~drakegrasp.plant.friction.friction_disagreement`).
     object_mass : float or None, optional
         The mass (kg) ``load="gravity"`` weighs; None: the model's.
+    distance_tolerance : float or None, optional
+        The contact tolerance (m) the grasp was read with: a joint whose
+        limit lies within it of the contacts, in the direction its torque
+        drives, is warned of (:func:`pressing_on_limits`).
     """
     w = _load_wrench(plant, plant_context, data, load, object_mass)
     limits, source, per_actuator = _torque_limits(plant, data, torque_limits)
@@ -615,6 +686,12 @@ def analyze_load(
         if np.any(limits == 0.0):  # per coordinate: a follower moves with its leader
             passive = tuple(n for n, t in zip(names, limits, strict=True) if t == 0.0)
             warnings.append(_unactuated_warning(passive))
+    if forces.joint_torques is not None and distance_tolerance is not None:
+        on_limits = pressing_on_limits(
+            plant, plant_context, data, forces.joint_torques, distance_tolerance
+        )
+        if on_limits:
+            warnings.append(_on_limits_warning(on_limits, distance_tolerance))
     actuator_names, actuator_units, actuator_torques = (), (), None
     if coupling is not None and per_actuator is not None:
         C, every = coupling
@@ -768,10 +845,13 @@ def load_section(
     torque_limits,
     query_object=None,
     object_mass=None,
+    distance_tolerance=None,
 ):
     """What :func:`~drakegrasp.analyze_grasp` adds for ``mu="plant"`` and a load.
 
-    ``object_mass`` (kg; None: the model's) is what ``load="gravity"`` weighs.
+    ``object_mass`` (kg; None: the model's) is what ``load="gravity"`` weighs;
+    ``distance_tolerance`` (m), the contact tolerance, finds joints that would
+    press on their limits (:func:`pressing_on_limits`).
 
     Returns
     -------
@@ -826,5 +906,6 @@ def load_section(
         mu_plant=mu_plant,
         mu_dynamic=mu_dynamic,
         object_mass=object_mass,
+        distance_tolerance=distance_tolerance,
     )
     return data, report

@@ -264,3 +264,39 @@ def test_an_object_mass_without_gravity_or_out_of_range_is_refused(options, word
                 s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5,
                 **options,
             )  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "lower, warned", [(0.0, False), (0.02496, True), (0.025, True)]
+)
+def test_joints_that_would_press_on_their_limits_are_warned_of(tmp_path, lower, warned):
+    # A jaw 0.05 mm from its closed limit read "holds: yes, payload 10.9",
+    # and Drake dropped the rod at any squeeze up to the motors' 8 N.  The
+    # default scene's fingers sit at 25 mm, closing towards 0: a closed limit
+    # within the contact tolerance (0.1 mm) of that is warned of.
+    from drakegrasp.plant.models import models_dir
+
+    root = models_dir()
+    hand = (root / "hands" / "parallel_jaw.sdf").read_text()
+    old = "<lower>0.0</lower><upper>0.0425</upper>"
+    assert hand.count(old) == 2
+    (tmp_path / "jaw.sdf").write_text(
+        hand.replace(old, f"<lower>{lower}</lower><upper>0.0425</upper>")
+    )
+    scene = (root / "scenes" / "parallel_jaw_box.yaml").read_text()
+    scene = scene.replace("package://drakegrasp/hands/parallel_jaw.sdf", "jaw.sdf")
+    (tmp_path / "scene.yaml").write_text(scene)
+    s = dg.load_scene(tmp_path / "scene.yaml")
+    report = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load="gravity"
+    )
+    said = [w for w in report.load.warnings if "press on the limit" in w]
+    assert bool(said) is warned
+    if warned:
+        assert "'left_finger_joint', 'right_finger_joint'" in said[0]
+        assert "press on the limit" in str(report)
+    # no torque towards a limit, no warning: a load the contacts carry alone
+    free = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load=[0.0] * 6
+    )
+    assert not any("press on the limit" in w for w in free.load.warnings)
