@@ -124,7 +124,6 @@ def drake_reading(read, *args, **kwargs):
             logger.handle(record)
 
 
-@functools.cache
 def load_models(where: str, read, *args, **kwargs):
     """:func:`drake_reading` of models, its refusal a :class:`~drakegrasp.ModelError`.
 
@@ -153,6 +152,7 @@ def load_models(where: str, read, *args, **kwargs):
         raise ModelError(f"{where}: cannot load the models: {msg}") from None
 
 
+@functools.cache
 def models_dir() -> Path:
     """Absolute path of the directory that holds ``package.xml`` and the models.
 

@@ -278,3 +278,30 @@ def test_add_models_refusals_are_model_errors(parser, given, words):
 def test_gravity_wrench_refuses_a_bad_plane(jaw):
     with pytest.raises(dg.InvalidOptionError, match="plane must be one of"):
         gravity_wrench(jaw.plant, jaw.plant_context, jaw.object_body, plane="ab")
+
+
+def test_every_add_models_call_reaches_drake():
+    # load_models once carried models_dir's functools.cache: a second add of
+    # the same file on the same parser returned the first's instances without
+    # calling Drake (no auto-renamed copy), and every plant stayed referenced
+    import gc
+    import weakref
+
+    from drakegrasp.plant.models import models_dir
+
+    box = str(models_dir() / "objects" / "box.sdf")
+    plant = MultibodyPlant(0.0)
+    parser = Parser(plant)
+    parser.SetAutoRenaming(True)
+    dg.register_models(parser)
+    first = dg.plant.add_models(parser, file_name=box)
+    second = dg.plant.add_models(parser, file_name=box)
+    assert list(map(int, first)) != list(map(int, second))
+    assert plant.HasModelInstanceNamed("box_1")
+    refs = []
+    for _ in range(2):
+        scene = dg.load_scene("parallel_jaw_box")
+        refs.append(weakref.ref(scene.plant))
+        del scene
+    gc.collect()
+    assert not any(r() is not None for r in refs)
