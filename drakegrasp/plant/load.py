@@ -226,7 +226,8 @@ def pressing_on_limits(
     A one-dof joint ``j`` whose torque ``τ_j`` drives it towards a finite
     limit that its contacts reach within the contact tolerance: ``|q_limit -
     q_j| · max_i |∂ψ_i/∂q_j| <= distance_tolerance`` (the contacts' travel
-    left).  Its motor then presses on the limit, not on the object: Drake
+    left).  On a coupled hand every joint, followers included, is driven
+    the way ``C τ`` says (``τ`` per independent coordinate).  Its motor then presses on the limit, not on the object: Drake
     dropped a rod held by a jaw 0.05 mm from its closed limit at any squeeze
     up to its motors' 8 N.
 
@@ -236,7 +237,8 @@ def pressing_on_limits(
     data : GraspFromPlant
         ``hand_velocity_indices`` and ``dpsi_dv`` (``(N, nv)``).
     joint_torques : (n_h,) float
-        The efforts the load needs, per hand velocity (N·m or N).
+        The efforts the load needs, per hand velocity (N·m or N; a coupled
+        hand's per independent coordinate).
     distance_tolerance : float
         Metres.
 
@@ -253,9 +255,14 @@ def pressing_on_limits(
             by_velocity[joint.velocity_start()] = joint
     dpsi = np.asarray(data.dpsi_dv, dtype=float)
     tau = np.asarray(joint_torques, dtype=float)
+    velocities = data.hand_velocity_indices
+    coupling = _coupling(data)
+    if coupling is not None:  # every joint, followers too: each moves as C τ says
+        C, velocities = coupling
+        tau = np.asarray(C, dtype=float) @ tau
     scale = float(np.max(np.abs(tau), initial=0.0))
     found = []
-    for v, t in zip(data.hand_velocity_indices, tau, strict=True):
+    for v, t in zip(velocities, tau, strict=True):
         joint = by_velocity.get(int(v))
         if joint is None or not abs(t) > 1e-9 * scale:
             continue  # a free base's velocity, or no torque to press with

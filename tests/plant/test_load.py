@@ -266,27 +266,54 @@ def test_an_object_mass_without_gravity_or_out_of_range_is_refused(options, word
             )  # fmt: skip
 
 
-@pytest.mark.parametrize(
-    "lower, warned", [(0.0, False), (0.02496, True), (0.025, True)]
-)
-def test_joints_that_would_press_on_their_limits_are_warned_of(tmp_path, lower, warned):
-    # A jaw 0.05 mm from its closed limit read "holds: yes, payload 10.9",
-    # and Drake dropped the rod at any squeeze up to the motors' 8 N.  The
-    # default scene's fingers sit at 25 mm, closing towards 0: a closed limit
-    # within the contact tolerance (0.1 mm) of that is warned of.
+def _jaw_limits_scene(tmp_path, lower, *, flipped=False, mimic=False):
+    """The default scene, its jaw's closed limits at ``lower`` (m).
+
+    ``flipped``: the joints' axes and values negated, so that the fingers
+    close towards their *upper* limits (``-lower``).  ``mimic``: the right
+    finger follows the left (one independent coordinate).
+    """
     from drakegrasp.plant.models import models_dir
 
     root = models_dir()
     hand = (root / "hands" / "parallel_jaw.sdf").read_text()
     old = "<lower>0.0</lower><upper>0.0425</upper>"
     assert hand.count(old) == 2
-    (tmp_path / "jaw.sdf").write_text(
-        hand.replace(old, f"<lower>{lower}</lower><upper>0.0425</upper>")
-    )
+    new = f"<lower>{lower}</lower><upper>0.0425</upper>"
+    if flipped:
+        new = f"<lower>-0.0425</lower><upper>{-lower}</upper>"
+        hand = hand.replace("<xyz>0.0 1.0 0.0</xyz>", "<xyz>@0.0 -1.0 0.0</xyz>")
+        hand = hand.replace("<xyz>0.0 -1.0 0.0</xyz>", "<xyz>0.0 1.0 0.0</xyz>")
+        hand = hand.replace("<xyz>@", "<xyz>")
+    hand = hand.replace(old, new)
+    if mimic:
+        j = hand.index("</joint>", hand.index('name="right_finger_joint"'))
+        follow = "<drake:mimic joint='left_finger_joint' multiplier='1' offset='0'/>"
+        hand = hand[:j] + follow + hand[j:]
+    (tmp_path / "jaw.sdf").write_text(hand)
     scene = (root / "scenes" / "parallel_jaw_box.yaml").read_text()
     scene = scene.replace("package://drakegrasp/hands/parallel_jaw.sdf", "jaw.sdf")
+    if flipped:
+        scene = scene.replace("_finger_joint: [0.025]", "_finger_joint: [-0.025]")
     (tmp_path / "scene.yaml").write_text(scene)
-    s = dg.load_scene(tmp_path / "scene.yaml")
+    return dg.load_scene(tmp_path / "scene.yaml")
+
+
+@pytest.mark.parametrize("flipped", [False, True])
+@pytest.mark.parametrize("mimic", [False, True])
+@pytest.mark.parametrize(
+    "lower, warned", [(0.0, False), (0.02496, True), (0.025, True)]
+)
+def test_joints_that_would_press_on_their_limits_are_warned_of(
+    tmp_path, lower, warned, mimic, flipped
+):
+    # A jaw 0.05 mm from its closed limit read "holds: yes, payload 10.9",
+    # and Drake dropped the rod at any squeeze up to the motors' 8 N.  The
+    # default scene's fingers sit 25 mm from their closed limits: a limit
+    # within the contact tolerance (0.1 mm) of that is warned of, whether
+    # the fingers close towards their lower or (axes flipped) upper limits,
+    # and for a follower of a coupling (review: the leaders alone were read).
+    s = _jaw_limits_scene(tmp_path, lower, flipped=flipped, mimic=mimic)
     report = dg.analyze_grasp(
         s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load="gravity"
     )
@@ -295,7 +322,7 @@ def test_joints_that_would_press_on_their_limits_are_warned_of(tmp_path, lower, 
     if warned:
         assert "'left_finger_joint', 'right_finger_joint'" in said[0]
         assert "press on the limit" in str(report)
-    # no torque towards a limit, no warning: a load the contacts carry alone
+    # no torque towards a limit, no warning: a zero load needs none
     free = dg.analyze_grasp(
         s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load=[0.0] * 6
     )
