@@ -325,8 +325,10 @@ def grasp_from_plant(
         check_pose = opts.check_pose
         torsional_friction = opts.torsional_friction or 0.0
         body = resolve_object_body(plant, object_body)
-        if contacts is not None:
-            contacts = check_plant_contacts(plant, contacts, body)
+        if contacts is not None:  # only mu="plant" reads their geometries
+            contacts = check_plant_contacts(
+                plant, contacts, body, reads_geometry=opts.mu == "plant"
+            )
         bodies = hand_contact_bodies(plant, body, hand)
         couplings = plant_couplings(plant, couplings)
         pose = _pose_of(
@@ -707,6 +709,10 @@ def analyze_grasp(
         torque_limits=torque_limits,
     ).require_friction()
     with checked_context(plant, plant_context) as plant_context:
+        if contacts is not None:  # the friction and curvatures read geometries
+            contacts = check_plant_contacts(
+                plant, contacts, resolve_object_body(plant, object_body)
+            )
         data = grasp_from_plant(
             plant,
             plant_context,

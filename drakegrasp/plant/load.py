@@ -227,9 +227,10 @@ def pressing_on_limits(
     limit that its contacts reach within the contact tolerance: ``|q_limit -
     q_j| · max_i |∂ψ_i/∂q_j| <= distance_tolerance`` (the contacts' travel
     left).  On a coupled hand every joint, followers included, is driven
-    the way ``C τ`` says (``τ`` per independent coordinate).  Its motor then presses on the limit, not on the object: Drake
-    dropped a rod held by a jaw 0.05 mm from its closed limit at any squeeze
-    up to its motors' 8 N.
+    the way ``C τ`` says (``τ`` per independent coordinate).  Its motor
+    then presses on the limit, not on the object: Drake dropped a rod held
+    by a jaw 0.05 mm from its closed limit at any squeeze up to its motors'
+    8 N.
 
     Parameters
     ----------

@@ -192,6 +192,23 @@ def test_jacobians_refuse_contacts_of_another_plant(jaw, three, jaw_found):
         )  # fmt: skip
 
 
+def test_grasp_from_plant_takes_contacts_of_the_same_scene_loaded_again(jaw):
+    # with a number for mu it reads bodies and points only (review: refused
+    # since the contact check came in, though it worked before); mu="plant"
+    # reads the geometries' friction, which this plant does not hold
+    theirs = _contacts(dg.load_scene("parallel_jaw_box"))
+    given = dg.grasp_from_plant(
+        jaw.plant, jaw.plant_context, jaw.object_body, mu=0.5, contacts=theirs
+    )
+    own = dg.grasp_from_plant(jaw.plant, jaw.plant_context, jaw.object_body, mu=0.5)
+    np.testing.assert_array_equal(given.hand_jacobian, own.hand_jacobian)
+    with pytest.raises(dg.ModelError, match="geometry"):
+        dg.grasp_from_plant(
+            jaw.plant, jaw.plant_context, jaw.object_body, mu="plant",
+            contacts=theirs,
+        )  # fmt: skip
+
+
 def test_jacobians_take_contacts_of_the_same_scene_loaded_again(jaw):
     # a candidate's contacts applied to another load of its scene (a second
     # plant of the same models: torque_capacity across plants) read only the
