@@ -21,6 +21,7 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
 import yaml
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_dump_typed
@@ -90,7 +91,10 @@ def grasp_scene_text(
         When the candidate was planned for a mass other than the model's
         (``candidate.object_mass``, ``plan --mass``), the scene gets
         ``load: gravity`` and that ``object_mass``: ``analyze`` of the file
-        weighs what was planned for.
+        weighs what was planned for.  A massless model has no centre of mass
+        to weigh it at: the scene's ``load`` is then the weight as a wrench
+        about O's origin, acting at the candidate's ``reference_point``, as
+        planned.
     folder : str or path, optional
         The folder the scene file will be written to: paths are written
         relative to it.
@@ -195,10 +199,16 @@ def grasp_scene_text(
     tolerance = options.get("distance_tolerance")
     if tolerance is not None:
         section["distance_tolerance"] = float(tolerance)
-    planned = float(candidate.object_mass)
-    if math.isfinite(planned) and planned > 0.0 and planned != body.get_mass(ctx):
-        section["load"] = "gravity"  # the weight planned for, not the model's
-        section["object_mass"] = planned
+    planned, model = float(candidate.object_mass), float(body.get_mass(ctx))
+    if math.isfinite(planned) and planned > 0.0 and planned != model:
+        if model > 0.0:  # the weight planned for, at the model's centre of mass
+            section["load"] = "gravity"
+            section["object_mass"] = planned
+        else:  # no centre of mass in the model: the weight where the plan put it
+            g_W = np.asarray(plant.gravity_field().gravity_vector(), dtype=float)
+            f_O = X_WO.rotation().matrix().T @ (planned * g_W)
+            m_O = np.cross(np.asarray(candidate.reference_point, dtype=float), f_O)
+            section["load"] = [float(v) for v in np.concatenate([f_O, m_O])]
     drakegrasp = yaml.safe_dump(
         {"drakegrasp": section}, sort_keys=False, allow_unicode=True
     )

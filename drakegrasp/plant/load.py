@@ -121,7 +121,14 @@ def gravity_wrench(
     plane = check_plane(plane)
     R_WO = plant.EvalBodyPoseInWorld(ctx, body).rotation().matrix()
     g_W = np.asarray(plant.gravity_field().gravity_vector(), dtype=float)
-    mass = float(body.get_mass(ctx)) if mass is None else check_object_mass(mass)
+    own = float(body.get_mass(ctx))
+    if mass is not None and not own > 0.0:
+        raise InvalidOptionError(
+            f"object_mass = {mass!r} kg: the model gives {body.name()!r} no mass, "
+            "so no centre of mass to weigh it at; give the load as a wrench "
+            "[f; m] in frame O about its origin"
+        )
+    mass = own if mass is None else check_object_mass(mass)
     p_OBcm = np.asarray(body.CalcCenterOfMassInBodyFrame(ctx), dtype=float)
     f_O = R_WO.T @ (mass * g_W)
     m_O = np.cross(p_OBcm, f_O)

@@ -190,6 +190,37 @@ def test_a_scene_keeps_the_mass_planned_for(tmp_path, capsys):
     assert read_scene_info(plain).load is None
 
 
+def test_a_massless_models_scene_keeps_the_weight_where_it_was_planned(
+    tmp_path, capsys
+):
+    # a massless model has no centre of mass to weigh object_mass at: the
+    # plan weighed it at its collision centroid (here 10 mm off the origin),
+    # while load: gravity would weigh it at the origin (review)
+    obj = tmp_path / "obj.urdf"
+    obj.write_text(
+        '<?xml version="1.0"?><robot name="box"><link name="box"><collision>'
+        '<origin xyz="0.01 0 0"/><geometry><box size="0.05 0.05 0.1"/>'
+        "</geometry></collision></link></robot>"
+    )
+    out = tmp_path / "m.yaml"
+    argv = ["plan", str(obj), "--num", "40", "--top", "1", "--mass", "0.3",
+            "--json", "--scene-out", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    planned = json.loads(capsys.readouterr().out)["candidates"][0]
+    info = read_scene_info(out)
+    assert info.object_mass is None
+    weight = np.array([0.0, 0.0, -0.3 * 9.81])  # the object as planned: O = W
+    expected = np.concatenate([weight, np.cross(planned["reference_point"], weight)])
+    assert planned["reference_point"][0] == pytest.approx(0.01, abs=1e-12)
+    np.testing.assert_allclose(info.load, expected, rtol=1e-12, atol=1e-15)
+    scene = load_scene(out)
+    with pytest.raises(dg.InvalidOptionError, match="no mass, so no centre of mass"):
+        dg.analyze_grasp(
+            scene.plant, scene.plant_context, scene.object_body, hand=scene.hand,
+            mu=0.5, load="gravity", object_mass=0.3,
+        )  # fmt: skip
+
+
 @pytest.mark.parametrize(
     "extra, says",
     [
