@@ -214,13 +214,17 @@ def internal_forces(
         prog, friction_variables = build_internal_force_program(
             grasp, hand_jacobian, rank_tol=rank_tol, within_friction=True
         )
-        d_within, carried, _, _ = _solve_margin(
-            prog, friction_variables, conic=lp3_is_conic(grasp)
-        )
-        within = (
-            float(d_within) if np.isfinite(d_within) else 0.0,
-            not (d_within > max(tol, rank_tol * _largest(carried))),
-        )
+        try:
+            d_within, carried, _, _ = _solve_margin(
+                prog, friction_variables, conic=lp3_is_conic(grasp)
+            )
+        except SolverError:  # a fact beside the verdict: unknown, not fatal
+            pass
+        else:
+            within = (
+                float(d_within) if np.isfinite(d_within) else 0.0,
+                not (d_within > max(tol, rank_tol * _largest(carried))),
+            )
     return InternalForceResult(
         passes=bool(passes),
         d_star=d_star,

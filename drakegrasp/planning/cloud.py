@@ -1191,7 +1191,9 @@ def _spots(points: np.ndarray) -> _Spots:
         hashlib.blake2b(points.tobytes(), digest_size=16).digest(),
     )
     with _spots_lock:
-        spots = _spots_kept.get(key)
+        spots = _spots_kept.pop(key, None)
+        if spots is not None:  # the last used is the last evicted
+            _spots_kept[key] = spots
     if spots is None:
         spots = _measured_spots(points)
         with _spots_lock:

@@ -97,3 +97,26 @@ def test_lp3s_squeeze_at_a_tilt_lies_outside_the_cones():
     lp3 = dg.internal_forces(grasp, J)
     for x in lp3.contact_forces:  # LP3's own optimum leans as far
         assert np.linalg.norm(x[1:3]) > 0.5 * x[0]
+
+
+def test_a_solver_failure_on_the_second_program_leaves_the_verdict(monkeypatch):
+    # the within-friction program is a fact beside LP3: its solver failing
+    # must not turn LP3's answer into an exception (review)
+    from drakegrasp.closure import verdicts
+
+    real = verdicts._solve_margin
+    calls = []
+
+    def failing_second(prog, variables, *, conic):
+        calls.append(conic)
+        if len(calls) == 2:
+            raise dg.SolverError("Clarabel failed with status kSolverSpecificError")
+        return real(prog, variables, conic=conic)
+
+    monkeypatch.setattr(verdicts, "_solve_margin", failing_second)
+    grasp, J = _tilted_jaw(np.radians(0.39))
+    lp3 = dg.internal_forces(grasp, J)
+    assert calls == [False, True]
+    assert not lp3.passes and lp3.certificate is not None
+    assert lp3.passes_within_friction is None and lp3.d_star_within_friction is None
+    assert "friction cones" not in str(lp3)
