@@ -541,7 +541,8 @@ def build_internal_force_program(
         second-order cone program when a contact is spatial with friction):
         a squeeze the contacts can carry.  Not LP3 (which bounds the normals
         only, as the conventions fix it) but a fact reported beside it when
-        it fails (:attr:`~drakegrasp.InternalForceResult.passes_within_friction`).
+        it fails (``passes_within_friction`` of
+        :class:`~drakegrasp.InternalForceResult`).
 
     Returns
     -------
