@@ -64,6 +64,7 @@ from drakegrasp.plant.friction import (
 )
 from drakegrasp.plant.options import PLANES, check_object_mass, check_plane
 from drakegrasp.plant.validation import (
+    check_velocity_indices,
     plant_context_of,
     resolve_object_body,
 )
@@ -164,7 +165,14 @@ def plant_torque_limits(
     simulation) supplies the base's wrench, so no limit bounds it.  Counting
     the floating joint as passive would make every grasp of such a hand fail
     to hold any load.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``velocity_indices`` that are not each a velocity of the plant, once
+        (:func:`~drakegrasp.plant.validation.check_velocity_indices`).
     """
+    velocity_indices = check_velocity_indices(plant, velocity_indices)
     limit_of = {}
     for index in plant.GetJointIndices():
         joint = plant.get_joint(index)
@@ -200,7 +208,13 @@ def unbounded_actuators(
     -------
     tuple of str
         Joint names, in the order of ``velocity_indices``, each once.
+
+    Raises
+    ------
+    InvalidOptionError
+        As :func:`plant_torque_limits`.
     """
+    velocity_indices = check_velocity_indices(plant, velocity_indices)
     wanted = {int(v) for v in velocity_indices}
     found = {}
     for k in range(plant.num_actuators()):

@@ -77,6 +77,30 @@ def test_a_signed_distance_jacobian_refuses_what_is_no_contact(jaw, jaw_found, i
         ([[0, 1]], "one-dimensional"),
     ],
 )
+def test_torque_limit_readers_refuse_bad_velocity_indices(jaw, indices, words):
+    # plant_torque_limits read -1 as the last velocity, 0.5 as 0, and 100 as
+    # a velocity no actuator drives (limit 0): a silent answer
+    from drakegrasp.plant.load import plant_torque_limits, unbounded_actuators
+
+    for read in (plant_torque_limits, unbounded_actuators):
+        with pytest.raises(dg.InvalidOptionError) as e:
+            read(jaw.plant, indices)
+        assert words in str(e.value)
+    np.testing.assert_array_equal(plant_torque_limits(jaw.plant, [0, 1]), [140, 140])
+
+
+@pytest.mark.parametrize(
+    ("indices", "words"),
+    [
+        ([-1], "-1"),
+        ([0.5], "0.5"),
+        ([100], "100"),
+        ([0, 0], "more than once"),
+        ([True], "True"),
+        ("ab", "'ab'"),
+        ([[0, 1]], "one-dimensional"),
+    ],
+)
 def test_hand_jacobian_refuses_bad_velocity_indices(jaw, jaw_found, indices, words):
     g, contacts = jaw_found
     with pytest.raises(dg.InvalidOptionError, match="velocity_indices") as e:
