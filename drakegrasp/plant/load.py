@@ -53,7 +53,7 @@ from drakegrasp.closure.payload import MaxLoadResult, max_load
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import grasp_matrix
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import real_array
+from drakegrasp.core.validation import check_distance_tolerance, real_array
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import coupled_torque_limits, split_coupled_torque
 from drakegrasp.plant.fingers import effort_unit
@@ -72,6 +72,7 @@ from drakegrasp.plant.validation import (
 __all__ = [
     "MAX_BODY_SETS",
     "MAX_LOAD",
+    "TORQUE_RESOLUTION",
     "PRELOAD_TOL",
     "LoadReport",
     "analyze_load",
@@ -131,10 +132,18 @@ def gravity_wrench(
         )
     mass = own if mass is None else check_object_mass(mass)
     p_OBcm = np.asarray(body.CalcCenterOfMassInBodyFrame(ctx), dtype=float)
-    f_O = R_WO.T @ (mass * g_W)
-    m_O = np.cross(p_OBcm, f_O)
+    with np.errstate(over="ignore", invalid="ignore"):
+        f_O = R_WO.T @ (mass * g_W)
+        m_O = np.cross(p_OBcm, f_O)
+    w = np.concatenate([f_O, m_O])
+    if not np.max(np.abs(w)) <= MAX_LOAD:  # NaN too: inf m g times a lever 0
+        raise InvalidOptionError(
+            f"the weight of {mass:g} kg ({body.name()!r}) is more than "
+            f"{MAX_LOAD:g} (N, N·m): the programs' products of such numbers "
+            "overflow"
+        )
     if plane is None:
-        return np.concatenate([f_O, m_O])
+        return w
     a, b = PLANES[plane]
     c = ({0, 1, 2} - {a, b}).pop()
     return np.array([f_O[a], f_O[b], m_O[c]])
@@ -239,13 +248,21 @@ def _unactuated_warning(names: tuple[str, ...]) -> str:
     )
 
 
+TORQUE_RESOLUTION = 1e-6
+"""Joint torques below this fraction of the largest are the solver's noise
+(:func:`pressing_on_limits`): an Allegro finger without contacts carried
+5e-10-9e-10 N·m beside a 0.2 N·m peak."""
+
+
 def pressing_on_limits(
     plant: MultibodyPlant, plant_context, data, joint_torques, distance_tolerance
 ) -> tuple[str, ...]:
     """The hand joints that would press the squeeze on their own limits.
 
-    A one-dof joint ``j`` whose torque ``τ_j`` drives it towards a finite
-    limit that its contacts reach within the contact tolerance: ``|q_limit -
+    A one-dof joint ``j`` that moves a contact (``∂ψ_i/∂q_j ≠ 0``), whose
+    torque ``τ_j`` (above :data:`TORQUE_RESOLUTION` of the largest) drives it
+    towards a finite limit that its contacts reach within the contact
+    tolerance: ``|q_limit -
     q_j| · max_i |∂ψ_i/∂q_j| <= distance_tolerance`` (the contacts' travel
     left).  On a coupled hand every joint, followers included, is driven
     the way ``C τ`` says (``τ`` per independent coordinate).  Its motor
@@ -275,9 +292,16 @@ def pressing_on_limits(
         joint = plant.get_joint(index)
         if joint.num_velocities() == 1 and joint.num_positions() == 1:
             by_velocity[joint.velocity_start()] = joint
+    distance_tolerance = check_distance_tolerance(distance_tolerance)
     dpsi = np.asarray(data.dpsi_dv, dtype=float)
-    tau = np.asarray(joint_torques, dtype=float)
+    tau = real_array("joint_torques", joint_torques, error=InvalidOptionError)
     velocities = data.hand_velocity_indices
+    if tau.shape != (len(velocities),) or not np.all(np.isfinite(tau)):
+        raise InvalidOptionError(
+            f"joint_torques must be {len(velocities)} finite numbers, one per hand "
+            f"velocity, got shape {tau.shape}"
+            + ("" if tau.shape != (len(velocities),) else " with a value not finite")
+        )
     coupling = _coupling(data)
     if coupling is not None:  # every joint, followers too: each moves as C τ says
         C, velocities = coupling
@@ -286,15 +310,15 @@ def pressing_on_limits(
     found = []
     for v, t in zip(velocities, tau, strict=True):
         joint = by_velocity.get(int(v))
-        if joint is None or not abs(t) > 1e-9 * scale:
-            continue  # a free base's velocity, or no torque to press with
+        reach = float(np.max(np.abs(dpsi[:, int(v)]), initial=0.0))
+        if joint is None or not abs(t) > TORQUE_RESOLUTION * scale or reach == 0.0:
+            continue  # a free base's velocity, no torque, or no contact it moves
         q = float(q_all[joint.position_start()])
         limit = (
             joint.position_upper_limits()[0]
             if t > 0
             else joint.position_lower_limits()[0]
         )
-        reach = float(np.max(np.abs(dpsi[:, int(v)]), initial=0.0))
         if np.isfinite(limit) and abs(limit - q) * reach <= distance_tolerance:
             found.append(joint.name())
     return tuple(found)
@@ -553,21 +577,13 @@ def _load_wrench(plant, plant_context, data, load, object_mass=None):
                 f"load must be None, 'gravity' or a wrench [f; m] in frame O, got "
                 f"{load!r}"
             )
-        with np.errstate(over="ignore", invalid="ignore"):
-            w = gravity_wrench(
-                plant,
-                plant_context,
-                data.object_body,
-                plane=data.plane,
-                mass=object_mass,
-            )
-        if not np.max(np.abs(w)) <= MAX_LOAD:  # NaN too: inf m g times a lever 0
-            of = "the model's mass" if object_mass is None else f"{object_mass:g} kg"
-            raise InvalidOptionError(
-                f"load 'gravity' of {of} weighs more than {MAX_LOAD:g} (N, N·m): "
-                "the programs' products of such numbers overflow"
-            )
-        return w
+        return gravity_wrench(
+            plant,
+            plant_context,
+            data.object_body,
+            plane=data.plane,
+            mass=object_mass,
+        )
     if object_mass is not None:
         raise InvalidOptionError(
             f"object_mass ({object_mass:g} kg) is weighed by load='gravity'; "
@@ -678,6 +694,8 @@ def analyze_load(
         limit lies within it of the contacts, in the direction its torque
         drives, is warned of (:func:`pressing_on_limits`).
     """
+    if distance_tolerance is not None:
+        distance_tolerance = check_distance_tolerance(distance_tolerance)
     w = _load_wrench(plant, plant_context, data, load, object_mass)
     limits, source, per_actuator = _torque_limits(plant, data, torque_limits)
     J = data.hand_jacobian

@@ -252,7 +252,7 @@ def test_object_mass_weighs_that_mass_at_the_models_centre_of_mass(tmp_path):
         ({"object_mass": 2.0, "load": [0.0] * 6}, "needs load 'gravity'"),
         ({"object_mass": 0.0, "load": "gravity"}, "finite mass > 0"),
         ({"object_mass": float("nan"), "load": "gravity"}, "finite mass > 0"),
-        ({"object_mass": 1e308, "load": "gravity"}, "weighs more than 1e+300"),
+        ({"object_mass": 1e308, "load": "gravity"}, "is more than 1e+300"),
     ],
 )
 def test_an_object_mass_without_gravity_or_out_of_range_is_refused(options, words):
@@ -327,3 +327,71 @@ def test_joints_that_would_press_on_their_limits_are_warned_of(
         s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load=[0.0] * 6
     )
     assert not any("press on the limit" in w for w in free.load.warnings)
+
+
+def test_a_joint_that_moves_no_contact_is_not_warned_of(tmp_path):
+    # a lift joint 0.1 m from its limits, carrying the weight by friction,
+    # read "presses towards its limit": moving no contact (dψ/dq = 0), its
+    # reach was 0 and any distance passed the test (fuzzer)
+    from drakegrasp.plant.models import models_dir
+
+    root = models_dir()
+    hand = (root / "hands" / "parallel_jaw.sdf").read_text()
+    i = hand.index('<link name="palm">')
+    lift = (
+        '<link name="base"><inertial><mass>0.1</mass><inertia><ixx>1e-4</ixx>'
+        "<ixy>0</ixy><ixz>0</ixz><iyy>1e-4</iyy><iyz>0</iyz><izz>1e-4</izz>"
+        '</inertia></inertial></link><joint name="lift_joint" type="prismatic">'
+        "<parent>base</parent><child>palm</child><axis><xyz>0 0 1</xyz><limit>"
+        "<lower>-0.1</lower><upper>0.1</upper><effort>100</effort></limit></axis>"
+        "</joint>"
+    )
+    (tmp_path / "jaw.sdf").write_text(hand[:i] + lift + hand[i:])
+    scene = (root / "scenes" / "parallel_jaw_box.yaml").read_text()
+    scene = scene.replace("package://drakegrasp/hands/parallel_jaw.sdf", "jaw.sdf")
+    scene = scene.replace("child: gripper::palm", "child: gripper::base")
+    (tmp_path / "scene.yaml").write_text(scene)
+    s = dg.load_scene(tmp_path / "scene.yaml")
+    report = dg.analyze_grasp(
+        s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5, load="gravity"
+    )
+    names = report.load.joint_names
+    tau = dict(zip(names, report.load.forces.joint_torques, strict=True))
+    assert abs(tau["lift_joint"]) > 1.0  # it carries the weight
+    assert not any("press on the limit" in w for w in report.load.warnings)
+
+
+@pytest.mark.parametrize(
+    "torques, tolerance, words",
+    [
+        ([1.0], 1e-4, "2 finite numbers"),
+        ([1.0, float("nan")], 1e-4, "not finite"),
+        (None, 1e-4, "joint_torques"),
+        ([1.0, 1.0], "x", "distance_tolerance"),
+        ([1.0, 1.0], -1.0, "distance_tolerance"),
+        ([1.0, 1.0], float("nan"), "distance_tolerance"),
+    ],
+)
+def test_pressing_on_limits_checks_its_inputs(torques, tolerance, words):
+    from drakegrasp.plant.load import pressing_on_limits
+
+    s = dg.load_scene("parallel_jaw_box")
+    data = dg.grasp_from_plant(
+        s.plant, s.plant_context, s.object_body, hand=s.hand, mu=0.5
+    )
+    with pytest.raises(dg.InvalidOptionError, match=words):
+        pressing_on_limits(s.plant, s.plant_context, data, torques, tolerance)
+
+
+@pytest.mark.parametrize("plane", [None, "yz"])
+def test_gravity_wrench_refuses_a_weight_beyond_the_programs(plane):
+    # mass=1e308 returned [nan, nan, -inf, ...] with a numpy warning (fuzzer)
+    s = dg.load_scene("parallel_jaw_box")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(dg.InvalidOptionError, match="is more than 1e\\+300"):
+            gravity_wrench(
+                s.plant, s.plant_context, s.object_body, mass=1e308, plane=plane
+            )
+        w = gravity_wrench(s.plant, s.plant_context, s.object_body, mass=1e29)
+    assert np.all(np.isfinite(w))
