@@ -264,9 +264,11 @@ def check_plant_contacts(
       here: the body's name and index are checked, and the functions that
       read the geometry refuse it (:func:`~drakegrasp.plant.handles.local_geometry_id`).
 
-    A caller that reads only the bodies and points (the Jacobians:
-    ``reads_geometry=False``) takes a contact whose geometry ids this plant
-    does not hold once its finger body checks out: a candidate's contacts
+    Each geometry's name must be scoped by its body's model instance
+    (Drake names a plant's geometries ``model::name``).  A caller that reads
+    only the bodies and points (the Jacobians: ``reads_geometry=False``)
+    takes a contact whose geometry ids this plant does not hold once its
+    finger body and those names check out: a candidate's contacts
     applied to the same scene loaded again (the ids differ, the bodies and
     points do not).  A geometry id this plant holds on another body is
     refused either way.
@@ -310,9 +312,16 @@ def check_plant_contacts(
         finger = _finger_of(plant, c, k)
         for what, body in (("finger", finger), ("object", object_body)):
             gid = getattr(c, f"{what}_geometry")
+            name = getattr(c, f"{what}_geometry_name")
+            model = plant.GetModelInstanceName(body.model_instance())
+            if not str(name).startswith(f"{model}::"):  # Drake scopes the names
+                raise ModelError(
+                    f"contacts[{k}]'s {what} geometry {name!r} is not of model "
+                    f"{model!r}, the {what} {scoped_name(plant, body)}'s: the "
+                    f"contact is not one of this {what}"
+                )
             if isinstance(gid, ForeignGeometryId):
                 continue
-            name = getattr(c, f"{what}_geometry_name")
             value = gid.get_value() if isinstance(gid, GeometryId) else None
             owner = owners.get(value)
             if owner is None and not reads_geometry:

@@ -233,6 +233,23 @@ def test_grasp_from_plant_takes_contacts_of_the_same_scene_loaded_again(jaw):
         )  # fmt: skip
 
 
+def test_contacts_of_another_object_are_refused_where_ids_are_not_read(jaw):
+    # the box scene's contacts on the cylinder scene (same hand, same body
+    # names and indices) were taken by grasp_from_plant with a number for mu
+    # and by the Jacobians: points 5 mm inside the cylinder's surface (fuzzer)
+    cylinder = dg.load_scene("parallel_jaw_cylinder")
+    theirs = _contacts(jaw)
+    with pytest.raises(dg.ModelError, match="not of model 'cylinder'"):
+        dg.grasp_from_plant(
+            cylinder.plant, cylinder.plant_context, cylinder.object_body, mu=0.5,
+            contacts=theirs,
+        )  # fmt: skip
+    with pytest.raises(dg.ModelError, match="not of model 'cylinder'"):
+        dg.signed_distance_jacobian(
+            cylinder.plant, cylinder.plant_context, theirs, cylinder.object_body
+        )
+
+
 def test_jacobians_take_contacts_of_the_same_scene_loaded_again(jaw):
     # a candidate's contacts applied to another load of its scene (a second
     # plant of the same models: torque_capacity across plants) read only the
