@@ -53,6 +53,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
+from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import coupling_entries, coupling_entry
 from drakegrasp.plant.models import load_models
@@ -398,6 +399,9 @@ def add_models(
     else:
         where = f"model file {str(file_name)!r}"
         path = str(file_name)
+    why = not_a_file(path, "a model file")
+    if why and why != MISSING:  # a pipe would block Drake's parser for good
+        raise ModelError(f"{where} {why}")
     kind = _kind_of(path)
     document = None
     if kind and Path(path).is_file():

@@ -494,6 +494,12 @@ def _check_joint_limits(path: Path, directives, parser) -> None:
             continue
         try:
             model = Path(parser.package_map().ResolveUrl(d.add_model.file))
+        except (RuntimeError, OSError, ValueError):
+            continue
+        why = not_a_file(model, "a model file")
+        if why and why != MISSING:  # a pipe would block the read and Drake
+            raise SceneError(f"scene {str(path)!r}: model file {str(model)!r} {why}")
+        try:
             kind = {".urdf": "urdf", ".sdf": "sdf"}.get(model.suffix.lower())
             text = model.read_text() if kind else None
         except (RuntimeError, OSError, ValueError):

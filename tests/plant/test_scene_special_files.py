@@ -59,3 +59,26 @@ def test_the_command_names_a_pipe_in_one_line(tmp_path):
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1, run.stderr
     assert "named pipe" in lines[0] and "not found" not in lines[0]
+
+
+@needs_mkfifo
+def test_a_model_file_that_is_a_pipe_is_refused_unopened(tmp_path):
+    # a scene's add_model file, or add_models' file_name, that is a named
+    # pipe blocked the joint-limit read and Drake's parser for good (fuzzer)
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    from drakegrasp.plant.models import models_dir
+
+    scene = (models_dir() / "scenes" / "parallel_jaw_box.yaml").read_text()
+    scene = scene.replace("package://drakegrasp/objects/box.sdf", "model.sdf")
+    (tmp_path / "scene.yaml").write_text(scene)
+    with watched_fifo(tmp_path / "model.sdf") as pipe:
+        with pytest.raises(SceneError, match=r"model\.sdf' is a named pipe"):
+            dg.load_scene(tmp_path / "scene.yaml")
+        plant = MultibodyPlant(0.0)
+        parser = Parser(plant)
+        with pytest.raises(ModelError, match=r"model\.sdf' is a named pipe"):
+            dg.plant.add_models(parser, file_name=pipe.path)
+        del parser, plant
+    assert pipe.opened == 0
