@@ -352,6 +352,10 @@ def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
     """
     import pyarrow.parquet as pq
 
+    if not isinstance(output_dir, str | os.PathLike) or not str(output_dir):
+        raise BatchFileError(
+            f"the dataset directory must be a path, got {output_dir!r}"
+        )
     output_dir = Path(output_dir)
     if not output_dir.is_dir():
         what = "is not a directory" if output_dir.exists() else "does not exist"

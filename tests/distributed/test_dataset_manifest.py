@@ -104,3 +104,10 @@ def test_a_dataset_that_is_a_file_is_not_called_missing(tmp_path):
     (tmp_path / "d").write_text("")
     with pytest.raises(BatchFileError, match="is not a directory"):
         read_dataset(tmp_path / "d")
+
+
+@pytest.mark.parametrize("given", [None, 5, b"out", ""])
+def test_a_dataset_directory_that_is_no_path_is_refused(given):
+    # read_dataset(None) raised Python's TypeError (fuzzer)
+    with pytest.raises(BatchFileError, match="the dataset directory must be a path"):
+        read_dataset(given)
