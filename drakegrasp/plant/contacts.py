@@ -51,7 +51,12 @@ import numpy as np
 from pydrake.geometry import GeometryId, QueryObject
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import BodyIndex, RigidBody
+from pydrake.multibody.tree import (
+    BodyIndex,
+    RigidBody,
+    default_model_instance,
+    world_model_instance,
+)
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
@@ -265,7 +270,8 @@ def check_plant_contacts(
       read the geometry refuse it (:func:`~drakegrasp.plant.handles.local_geometry_id`).
 
     Each geometry's name must be scoped by its body's model instance
-    (Drake names a plant's geometries ``model::name``).  A caller that reads
+    (Drake names a plant's geometries ``model::name``, but for the default
+    and world instances, whose names it leaves bare).  A caller that reads
     only the bodies and points (the Jacobians: ``reads_geometry=False``)
     takes a contact whose geometry ids this plant does not hold once its
     finger body and those names check out: a candidate's contacts
@@ -313,8 +319,10 @@ def check_plant_contacts(
         for what, body in (("finger", finger), ("object", object_body)):
             gid = getattr(c, f"{what}_geometry")
             name = getattr(c, f"{what}_geometry_name")
-            model = plant.GetModelInstanceName(body.model_instance())
-            if not str(name).startswith(f"{model}::"):  # Drake scopes the names
+            instance = body.model_instance()
+            model = plant.GetModelInstanceName(instance)
+            scoped = instance not in (default_model_instance(), world_model_instance())
+            if scoped and not str(name).startswith(f"{model}::"):  # Drake's names
                 raise ModelError(
                     f"contacts[{k}]'s {what} geometry {name!r} is not of model "
                     f"{model!r}, the {what} {scoped_name(plant, body)}'s: the "
