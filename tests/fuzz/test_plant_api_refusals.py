@@ -65,18 +65,19 @@ def test_a_signed_distance_jacobian_refuses_what_is_no_contact(jaw, jaw_found, i
 # -- hand_jacobian ---------------------------------------------------------
 
 
-@pytest.mark.parametrize(
-    ("indices", "words"),
-    [
-        ([-1], "-1"),
-        ([0.5], "0.5"),
-        ([100], "100"),
-        ([0, 0], "more than once"),
-        ([True], "True"),
-        ("ab", "'ab'"),
-        ([[0, 1]], "one-dimensional"),
-    ],
-)
+BAD_INDICES = [
+    ([-1], "-1"),
+    ([0.5], "0.5"),
+    ([100], "100"),
+    ([0, 0], "more than once"),
+    ([True], "True"),
+    ("ab", "'ab'"),
+    ([[0, 1]], "one-dimensional"),
+]
+"""Velocity indices every taker refuses, and a word of each message."""
+
+
+@pytest.mark.parametrize(("indices", "words"), BAD_INDICES)
 def test_torque_limit_readers_refuse_bad_velocity_indices(jaw, indices, words):
     # plant_torque_limits read -1 as the last velocity, 0.5 as 0, and 100 as
     # a velocity no actuator drives (limit 0): a silent answer
@@ -89,18 +90,7 @@ def test_torque_limit_readers_refuse_bad_velocity_indices(jaw, indices, words):
     np.testing.assert_array_equal(plant_torque_limits(jaw.plant, [0, 1]), [140, 140])
 
 
-@pytest.mark.parametrize(
-    ("indices", "words"),
-    [
-        ([-1], "-1"),
-        ([0.5], "0.5"),
-        ([100], "100"),
-        ([0, 0], "more than once"),
-        ([True], "True"),
-        ("ab", "'ab'"),
-        ([[0, 1]], "one-dimensional"),
-    ],
-)
+@pytest.mark.parametrize(("indices", "words"), BAD_INDICES)
 def test_hand_jacobian_refuses_bad_velocity_indices(jaw, jaw_found, indices, words):
     g, contacts = jaw_found
     with pytest.raises(dg.InvalidOptionError, match="velocity_indices") as e:
