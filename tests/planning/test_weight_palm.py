@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
@@ -229,6 +229,9 @@ def test_a_finger_pressing_towards_the_palm_lets_it_push_back():
 
 @settings(max_examples=25, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), mu=st.sampled_from([0.3, 0.7, 1.0, 2.0]))
+# two palm normals 1 mrad apart, one face whose row was whichever came first:
+# a permutation moved a capacity by 4e-4 (found by hypothesis in CI)
+@example(seed=41550, mu=0.3)
 def test_never_raises_a_capacity_and_follows_order_and_rigid_motion(seed, mu):
     rng = np.random.default_rng(seed)
     P, N, F = _jaw_over_palm(rng, 3)
