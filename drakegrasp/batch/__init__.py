@@ -28,22 +28,46 @@ The folder reads as the pipeline, one stage per room:
   driver.
 """
 
-from drakegrasp.batch.api import (
-    DEFAULT_CHUNK_SIZE,
-    METRICS,
-    BatchClosureResult,
-    batch_force_closure,
-    batch_form_closure,
-    iter_batch_closure,
-    stream_force_closure,
-    stream_form_closure,
+from drakegrasp._lazy import lazy_exports
+
+_SOURCES = {
+    "drakegrasp.batch.api": (
+        "DEFAULT_CHUNK_SIZE",
+        "METRICS",
+        "BatchClosureResult",
+        "batch_force_closure",
+        "batch_form_closure",
+        "iter_batch_closure",
+        "stream_force_closure",
+        "stream_form_closure",
+    ),
+    "drakegrasp.batch.epsilon.driver": ("batch_epsilon_l1",),
+    "drakegrasp.batch.files.driver": ("evaluate_file", "stream_file", "write_result"),
+    "drakegrasp.batch.files.reader": ("read_grasps",),
+    "drakegrasp.batch.files.writer": ("BatchSummary", "write_chunks"),
+    "drakegrasp.batch.loads": ("batch_grasp_forces",),
+    "drakegrasp.batch.options": ("BatchOptions",),
+}
+
+_SUBMODULES = (
+    "aot",
+    "aot_build",
+    "api",
+    "build",
+    "columns",
+    "compiled",
+    "epsilon",
+    "files",
+    "inputs",
+    "loads",
+    "lp",
+    "metrics",
+    "options",
+    "ragged",
+    "run",
+    "warmup",
+    "witnesses",
 )
-from drakegrasp.batch.epsilon.driver import batch_epsilon_l1
-from drakegrasp.batch.files.driver import evaluate_file, stream_file, write_result
-from drakegrasp.batch.files.reader import read_grasps
-from drakegrasp.batch.files.writer import BatchSummary, write_chunks
-from drakegrasp.batch.loads import batch_grasp_forces
-from drakegrasp.batch.options import BatchOptions
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -64,3 +88,7 @@ __all__ = [
     "write_chunks",
     "write_result",
 ]
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
+)

@@ -51,43 +51,58 @@ The ε module imports ``scipy`` (Qhull, NNLS); the LPs import
 ``pydrake.solvers``.  Nothing here touches a plant.
 """
 
-from drakegrasp.closure.grasp_forces import (
-    GraspForceResult,
-    GraspForceVariables,
-    build_grasp_forces_program,
-    grasp_forces,
-)
-from drakegrasp.closure.payload import MaxLoadResult, build_max_load_program, max_load
-from drakegrasp.quality._common import RANK_TOL
-from drakegrasp.quality.epsilon import (
-    HULL_TOL,
-    L1_MAX_POINTS,
-    LINF_MAX_CANDIDATES,
-    ferrari_canny,
-    primitive_wrenches,
-)
-from drakegrasp.quality.indices import (
-    distance_to_singularity,
-    grasp_singular_values,
-    hand_object_matrix,
-    hand_object_singular_values,
-    isotropy,
-    manipulability_volume,
-    min_singular_value,
-    uniformity_of_transformation,
-    wrench_ellipsoid_volume,
-)
-from drakegrasp.quality.resistible import (
-    MaxWrenchResult,
-    MaxWrenchVariables,
-    build_max_resistible_wrench_program,
-    max_resistible_wrench,
-)
-from drakegrasp.quality.summary import (
-    GraspQuality,
-    grasp_quality,
-    lp2_d_star,
-    lp2_margin,
+from drakegrasp._lazy import lazy_exports
+
+_SOURCES = {
+    "drakegrasp.closure.grasp_forces": (
+        "GraspForceResult",
+        "GraspForceVariables",
+        "build_grasp_forces_program",
+        "grasp_forces",
+    ),
+    "drakegrasp.closure.payload": (
+        "MaxLoadResult",
+        "build_max_load_program",
+        "max_load",
+    ),
+    "drakegrasp.quality._common": ("RANK_TOL",),
+    "drakegrasp.quality.epsilon": (
+        "HULL_TOL",
+        "L1_MAX_POINTS",
+        "LINF_MAX_CANDIDATES",
+        "ferrari_canny",
+        "primitive_wrenches",
+    ),
+    "drakegrasp.quality.indices": (
+        "distance_to_singularity",
+        "grasp_singular_values",
+        "hand_object_matrix",
+        "hand_object_singular_values",
+        "isotropy",
+        "manipulability_volume",
+        "min_singular_value",
+        "uniformity_of_transformation",
+        "wrench_ellipsoid_volume",
+    ),
+    "drakegrasp.quality.resistible": (
+        "MaxWrenchResult",
+        "MaxWrenchVariables",
+        "build_max_resistible_wrench_program",
+        "max_resistible_wrench",
+    ),
+    "drakegrasp.quality.summary": (
+        "GraspQuality",
+        "grasp_quality",
+        "lp2_d_star",
+        "lp2_margin",
+    ),
+}
+
+_SUBMODULES = (
+    "epsilon",
+    "indices",
+    "resistible",
+    "summary",
 )
 
 __all__ = [
@@ -122,3 +137,7 @@ __all__ = [
     "uniformity_of_transformation",
     "wrench_ellipsoid_volume",
 ]
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
+)

@@ -16,41 +16,60 @@ matplotlib and scipy are imported only when a plot is made, so importing this
 package needs neither.
 """
 
-from drakegrasp.visualization.candidates import (
-    CandidateDrawing,
-    draw_candidates,
-    plot_score_distribution,
-    score_colors,
-)
-from drakegrasp.visualization.geometry import (
-    cone_edge_directions,
-    contact_forces_in_grasp_frame,
-    contact_pose_3d,
-    exact_cone_mesh,
-    normalize_contact_forces,
-    pyramid_mesh,
-)
-from drakegrasp.visualization.meshcat import (
-    DEFAULT_PREFIX,
-    MESHCAT_COLORS,
-    GraspDrawing,
-    clear_grasp,
-    draw_grasp,
-)
-from drakegrasp.visualization.plots import (
-    PLOT_COLORS,
-    PlanarGraspPlot,
-    plot_planar_grasp,
-)
-from drakegrasp.visualization.robot import set_translucent, visualizer_paths
-from drakegrasp.visualization.snapshot import draw_scene_geometry
-from drakegrasp.visualization.view import CameraView, frame_points, grasp_pose
-from drakegrasp.visualization.wrench_space import (
-    WrenchHull,
-    WrenchSpacePlot,
-    plot_wrench_space,
-    wrench_hull,
-    wrench_space_points,
+from drakegrasp._lazy import lazy_exports
+
+_SOURCES = {
+    "drakegrasp.visualization.candidates": (
+        "CandidateDrawing",
+        "draw_candidates",
+        "plot_score_distribution",
+        "score_colors",
+    ),
+    "drakegrasp.visualization.geometry": (
+        "cone_edge_directions",
+        "contact_forces_in_grasp_frame",
+        "contact_pose_3d",
+        "exact_cone_mesh",
+        "normalize_contact_forces",
+        "pyramid_mesh",
+    ),
+    "drakegrasp.visualization.meshcat": (
+        "DEFAULT_PREFIX",
+        "MESHCAT_COLORS",
+        "GraspDrawing",
+        "clear_grasp",
+        "draw_grasp",
+    ),
+    "drakegrasp.visualization.plots": (
+        "PLOT_COLORS",
+        "PlanarGraspPlot",
+        "plot_planar_grasp",
+    ),
+    "drakegrasp.visualization.robot": ("set_translucent", "visualizer_paths"),
+    "drakegrasp.visualization.snapshot": ("draw_scene_geometry",),
+    "drakegrasp.visualization.view": ("CameraView", "frame_points", "grasp_pose"),
+    "drakegrasp.visualization.wrench_space": (
+        "WrenchHull",
+        "WrenchSpacePlot",
+        "plot_wrench_space",
+        "wrench_hull",
+        "wrench_space_points",
+    ),
+}
+
+_SUBMODULES = (
+    "candidates",
+    "certificate_plots",
+    "escape",
+    "geometry",
+    "meshcat",
+    "meshcat_certificates",
+    "plots",
+    "primitives",
+    "robot",
+    "snapshot",
+    "view",
+    "wrench_space",
 )
 
 __all__ = [
@@ -84,3 +103,7 @@ __all__ = [
     "wrench_hull",
     "wrench_space_points",
 ]
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
+)
