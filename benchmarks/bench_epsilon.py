@@ -16,7 +16,7 @@ force closure; ``--spread 0.2`` closes most three-finger grasps) go through
 * ``kernel``: the compiled kernel alone on prebuilt wrenches;
 * ``qhull loop``: what ``metrics=["epsilon_l1"]`` did before, one
   :func:`drakegrasp.quality.ferrari_canny` per grasp with its ``Grasp`` built
-  inside the loop (:func:`drakegrasp.batch.metrics.epsilon_l1_per_grasp`);
+  inside the loop (:func:`drakegrasp.batch.epsilon.routes.epsilon_l1_per_grasp`);
 * ``ferrari_canny``: the same calls on ``Grasp`` objects built outside the
   clock.
 
@@ -54,7 +54,7 @@ from drakegrasp.batch import batch_epsilon_l1  # noqa: E402
 from drakegrasp.batch.build.construction import batched_characteristic_lengths  # noqa: E402
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches  # noqa: E402
 from drakegrasp.batch.epsilon import kernel as epsilon_kernel  # noqa: E402
-from drakegrasp.batch.metrics import epsilon_l1_per_grasp, epsilon_l1_routes  # noqa: E402
+from drakegrasp.batch.epsilon.routes import epsilon_l1_per_grasp, epsilon_l1_routes  # noqa: E402
 from drakegrasp.quality import ferrari_canny  # noqa: E402
 
 CASES = {

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drakegrasp.batch.columns import result_arrays
+from drakegrasp.batch.epsilon.routes import EPSILON_METRIC, with_epsilon
 from drakegrasp.batch.inputs import METRICS, shape_of
 from drakegrasp.batch.metrics import metric_moment_arms
 from drakegrasp.batch.options import takes_batch_options
@@ -212,6 +213,8 @@ def force_chunks(
         positions, mu, contact_model, num_generators, torsional_friction,
         reference_points, characteristic_lengths, tol, rank_tol, metrics, kernel,
     )  # fmt: skip
+    if EPSILON_METRIC in options["metrics"]:
+        task = with_epsilon(task)
     chunks = stream(
         positions, normals, kind="force", task=task, chunk_size=chunk_size,
         progress=progress, workers=workers, n_g=options["num_generators"],

@@ -18,7 +18,7 @@ from drakegrasp.batch import batch_epsilon_l1
 from drakegrasp.batch.build.construction import batched_characteristic_lengths
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
 from drakegrasp.batch.epsilon import kernel as epsilon_kernel
-from drakegrasp.batch.metrics import epsilon_l1_per_grasp, epsilon_l1_routes
+from drakegrasp.batch.epsilon.routes import epsilon_l1_per_grasp, epsilon_l1_routes
 
 pytestmark = pytest.mark.skipif(
     not epsilon_kernel.AVAILABLE, reason="the compiled ε kernel needs numba"

@@ -14,7 +14,7 @@ from drakegrasp.batch.build.construction import batched_characteristic_lengths
 from drakegrasp.batch.build.wrenches import batched_primitive_wrenches
 from drakegrasp.batch.epsilon import kernel as epsilon_kernel
 from drakegrasp.batch.epsilon import polytope
-from drakegrasp.batch.metrics import epsilon_l1_routes
+from drakegrasp.batch.epsilon.routes import epsilon_l1_routes
 from drakegrasp.quality import ferrari_canny
 
 pytestmark = pytest.mark.skipif(

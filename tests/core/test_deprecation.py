@@ -177,7 +177,7 @@ def test_planning_stages_take_mu_by_keyword_after_their_arrays(module, name, aft
 
 def test_planning_and_batch_stages_accept_the_old_spellings_with_a_warning():
     from drakegrasp.batch.build.construction import batched_characteristic_lengths
-    from drakegrasp.batch.metrics import epsilon_l1_batch
+    from drakegrasp.batch.epsilon.routes import epsilon_l1_batch
     from drakegrasp.planning.weight import weight_capacity
 
     P, N, _ = _arrays(2)

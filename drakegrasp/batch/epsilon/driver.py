@@ -38,11 +38,8 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.batch.build.construction import batched_characteristic_lengths
-from drakegrasp.batch.metrics import (
-    check_moment_arms,
-    epsilon_l1_batch,
-    moment_arms_in_input_order,
-)
+from drakegrasp.batch.epsilon.routes import epsilon_l1_batch
+from drakegrasp.batch.metrics import check_moment_arms, moment_arms_in_input_order
 from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_task

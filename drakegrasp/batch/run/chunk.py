@@ -51,11 +51,7 @@ from drakegrasp.batch.inputs import (
     shape_of,
 )
 from drakegrasp.batch.lp.dstar import solve_dstar_blocks
-from drakegrasp.batch.metrics import (
-    check_moment_arms,
-    epsilon_l1_batch,
-    singular_value_metrics,
-)
+from drakegrasp.batch.metrics import check_moment_arms, singular_value_metrics
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.validation import check_num_generators
@@ -281,7 +277,9 @@ def force_chunk(
     b : (k,) float or None
         Characteristic lengths (None: the default of :class:`~drakegrasp.Grasp`).
     contact_model, num_generators, tol, rank_tol, metrics, kernel
-        As in :func:`drakegrasp.batch.batch_force_closure`.
+        As in :func:`drakegrasp.batch.batch_force_closure`, ``metrics`` less
+        ``"epsilon_l1"``: ε is a stage of its own
+        (:func:`drakegrasp.batch.epsilon.routes.force_chunk_with_epsilon`).
     verdict_only : bool, optional
         Internal (:func:`~drakegrasp.batch.run.verdicts.force_verdicts`): each
         LP stops once its verdict is proved, so ``is_closure`` is exact but
@@ -293,6 +291,11 @@ def force_chunk(
         ``is_closure``, ``d_star``, ``rank``, ``margin``, ``converged``,
         ``normal_certificate`` and the metrics.
     """
+    if "epsilon_l1" in metrics:
+        raise InvalidOptionError(
+            "force_chunk gives the singular-value metrics; ε L1 (metric "
+            "'epsilon_l1') is the ε stage's: batch.epsilon.routes.with_epsilon"
+        )
     k, N, d = P.shape
     compiled = _compiled(kernel)
     if b is None and (contact_model == "soft_finger" or metrics):  # else b is unused
@@ -329,11 +332,6 @@ def force_chunk(
         }[contact_model]
         Gfull, _ = _grasp_matrices(P, Nrm, p, (full,) * N, None, compiled)
         out.update(singular_value_metrics(Gfull, b, metrics))
-        if "epsilon_l1" in metrics:
-            out["epsilon_l1"] = epsilon_l1_batch(
-                P, Nrm, mu_c, nu_c, p, b, contact_model=contact_model,
-                num_generators=num_generators, kernel=kernel,
-            )  # fmt: skip
     return out
 
 
