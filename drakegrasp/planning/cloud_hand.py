@@ -6,7 +6,7 @@ parallel jaw (the Allegro hand, a three-finger hand).  The
 plant holds the hand and the surroundings; the object is a cloud with outward
 normals (:func:`~drakegrasp.planning.cloud.read_cloud`), in its centroid frame
 O (:class:`~drakegrasp.planning.cloud.CloudSurface`); the driver is
-:func:`~drakegrasp.planning.multifinger.plan_multifinger_cloud`.  Every
+:func:`~drakegrasp.planning.planner.plan_multifinger_cloud`.  Every
 sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
 
 1. **Approach and pre-shape** as on a body
@@ -57,7 +57,7 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    also carries its *fan* (:data:`FAN_SIGMAS`): where the cloud within reach
    of the finger folds, the arc of normals between the faces it may meet,
    over which the ranking averages the weight capacity
-   (:func:`~drakegrasp.planning.multifinger.fan_capacity`).  Only a box's face lying
+   (:func:`~drakegrasp.planning.weight.fan_capacity`).  Only a box's face lying
    flat on a flat patch touches along an area and reports the patch's
    corners, as a pad on a body's flat face does (on a body, a face along a
    cylinder's side also reports the two ends of its line; a cloud has no
@@ -67,7 +67,7 @@ sampled pose becomes a candidate or is counted under one of :data:`REASONS`.
    the can's side became a patch 16 mm wide, resisting torsion and tilt it
    cannot resist, and inflated the verdicts, ε, weight capacity and score.)
 5. **Ranking** as on a body
-   (:func:`~drakegrasp.planning.multifinger.rank_multifinger`).
+   (:func:`~drakegrasp.planning.ranking.rank_multifinger`).
 """
 
 from __future__ import annotations
@@ -169,7 +169,7 @@ FAN_SIGMAS = 2.0
 """A contact's normal fan holds the normals of the cloud points within this
 many robustness position noises ``σ_p`` of the finger (the noise's
 ``"position"``; 4 mm by default): the surface a finger misplaced by up to
-``2 σ_p`` may meet.  See :func:`~drakegrasp.planning.multifinger.fan_capacity`."""
+``2 σ_p`` may meet.  See :func:`~drakegrasp.planning.weight.fan_capacity`."""
 
 OPEN_END_SPACINGS = 6.0
 """Radius, in cloud spacings, of the neighbourhood that tells whether a

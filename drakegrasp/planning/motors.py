@@ -412,7 +412,7 @@ def with_torques_needed(
     Parameters
     ----------
     result : GraspCandidates
-        Ranked by score (:func:`~drakegrasp.planning.multifinger.rank_multifinger`).
+        Ranked by score (:func:`~drakegrasp.planning.ranking.rank_multifinger`).
     plant, plant_context, object_body
         As for :func:`finger_jacobian` (``object_body`` None on a point cloud).
     weight : float

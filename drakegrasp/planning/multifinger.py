@@ -1,9 +1,12 @@
-r"""Plan multi-finger grasps: approach, pre-shape, ``close_hand``, rank.
+r"""The multi-finger route's hand and closings: approach, pre-shape, ``close_hand``.
 
 The route :func:`~drakegrasp.planning.planner.plan_grasps` takes for a hand
 that is not a parallel jaw (the Allegro hand, drakegrasp's three-finger hand,
-a user's).  Every sampled pose becomes a candidate or is counted under one
-rejection reason (:data:`REASONS`).
+a user's): :func:`~drakegrasp.planning.planner.plan_multifinger` runs the
+stages below, this module holds the hand's checks and stages 2 and 3, and
+stage 4 is :func:`~drakegrasp.planning.ranking.rank_multifinger`, beside the
+parallel jaw's ranking.  Every sampled pose becomes a candidate or is counted
+under one rejection reason (:data:`REASONS`).
 
 1. **Approach and pre-shape** (numpy, all samples at once,
    :mod:`drakegrasp.planning.approach`): a surface point, the approach along
@@ -30,17 +33,17 @@ rejection reason (:data:`REASONS`).
    joint torque that holds it (:mod:`drakegrasp.planning.motors`), and those
    the actuators' effort limits allow are ranked first.
 
-On a point cloud (:func:`plan_multifinger_cloud`), stages 2 and 3 are those
-of :mod:`drakegrasp.planning.cloud_hand` (the hand against the cloud's points,
-the fingers closed onto them); stage 1 is the same, and in stage 4 the weight
-capacity of a candidate with a contact at an edge of the cloud is averaged
-over the edge's normal fan (:func:`fan_capacity`); the torque needed (with
+On a point cloud (:func:`~drakegrasp.planning.planner.plan_multifinger_cloud`),
+stages 2 and 3 are those of :mod:`drakegrasp.planning.cloud_hand` (the hand
+against the cloud's points, the fingers closed onto them); stage 1 is the
+same, and in stage 4 the weight capacity of a candidate with a contact at an
+edge of the cloud is averaged over the edge's normal fan
+(:func:`~drakegrasp.planning.weight.fan_capacity`); the torque needed (with
 ``object_mass``) takes each contact's finger point at its cloud point.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import time
 import warnings
 from collections import Counter
@@ -48,10 +51,7 @@ from collections import Counter
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
-from drakegrasp.core.deprecation import keyword_only, renamed_keyword
-from drakegrasp.core.validation import real_array, unit_vectors
 from drakegrasp.errors import (
-    InvalidContactError,
     InvalidOptionError,
     ModelError,
     NoContactsError,
@@ -61,33 +61,11 @@ from drakegrasp.errors import (
 from drakegrasp.planning.approach import (
     MultiFingerHand,
     multi_finger_hand,
-    sample_approaches,
 )
 from drakegrasp.planning.candidates import (
     closing_order,
-    planning_result,
 )
 from drakegrasp.planning.centring import CentredCloser, chain_groups
-from drakegrasp.planning.checks import (
-    checked_contacts,
-    checked_fingers,
-    checked_friction,
-    checked_palm,
-    checked_rng,
-    checked_samples,
-    checked_torque_scale,
-)
-from drakegrasp.planning.cloud import CONTACT_BAND, cloud_surface
-from drakegrasp.planning.cloud_hand import FAN_SIGMAS, CloudHand
-from drakegrasp.planning.motors import with_torques_needed
-from drakegrasp.planning.ranking import (
-    group_by_count,
-    grouped_verdicts,
-    ranked_candidates,
-    robustness,
-    tie_key,
-)
-from drakegrasp.planning.weight import centre_of_mass, weight_capacity
 from drakegrasp.plant._closing_steps import closest
 from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
@@ -97,16 +75,12 @@ from drakegrasp.plant.validation import hand_bodies, scoped_name
 
 __all__ = [
     "DEFAULT_TILT",
-    "OPEN_HAND_HINT",
     "REASONS",
     "PassiveJointWarning",
+    "checked_hand",
     "close_candidates",
-    "fan_capacity",
     "hand_is_parallel_jaw",
     "is_parallel_jaw",
-    "plan_multifinger",
-    "plan_multifinger_cloud",
-    "rank_multifinger",
 ]
 
 
@@ -303,254 +277,6 @@ def close_each(closer, poses, progress):
     return kept, rejections, closer.label
 
 
-def _labels(found, label, palm) -> list[int]:
-    return [label.get(c.finger_body, palm) for c in found]
-
-
-def _has_fan(found) -> bool:
-    return any(getattr(c, "fan", None) is not None for c in found)
-
-
-def _fans(found) -> np.ndarray:
-    """(N, 2, 3) fan ends per contact, NaN where a contact has none."""
-    out = np.full((len(found), 2, 3), np.nan)
-    for j, c in enumerate(found):
-        if getattr(c, "fan", None) is not None:
-            out[j] = c.fan
-    return out
-
-
-def _slerp(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Unit vectors a fraction ``t`` along the great-circle arcs from ``a`` to ``b``.
-
-    ``a``, ``b`` : (..., 3) unit; ``t`` : (...) in [0, 1].  Where ``a = b`` (or
-    opposite: no unique arc) the result is ``a``.
-    """
-    cos = np.clip(np.sum(a * b, axis=-1), -1.0, 1.0)
-    omega = np.arccos(cos)
-    sin = np.sin(omega)
-    ok = sin > 1e-9
-    safe = np.where(ok, sin, 1.0)
-    wa = np.where(ok, np.sin((1.0 - t) * omega) / safe, 1.0)
-    wb = np.where(ok, np.sin(t * omega) / safe, 0.0)
-    return wa[..., None] * a + wb[..., None] * b
-
-
-@keyword_only("mu", after=4)
-@renamed_keyword("model", "contact_model")
-def fan_capacity(
-    positions, normals, fans, fingers, *, mu, samples, rng, torque_scale, contact_model,
-    torsional_friction, palm=None,
-):  # fmt: skip
-    r"""(K,) weight capacity of grasps whose edge contacts' normals are unknown.
-
-    On a point cloud a contact at an edge (a fold of the sampled surface,
-    where the finger meets two faces) has no one normal the cloud can tell:
-    the true contact normal lies between the faces' normals, set by where
-    the finger sits on the edge to a fraction of a millimetre (on 3,000
-    points of the YCB soup can, the true can's normal differed from the
-    cloud's by more than 30° at 20 of 113 contacts, all within 3 mm of a
-    rim).  Each such contact carries its *fan*, the arc of normals from
-    ``a`` to ``b``
-    (:class:`~drakegrasp.planning.cloud.CloudContact`); the capacity is the
-    mean, over ``samples`` copies, of the worst-direction weight capacity
-    (:func:`~drakegrasp.planning.weight.weight_capacity`) with each edge
-    contact's normal drawn uniformly along its arc,
-    :math:`\hat n = \mathrm{slerp}(a, b, t)`, :math:`t \sim U(0, 1)`, one
-    draw per contact and copy (a copy that is not force closure holds 0).
-
-    Parameters
-    ----------
-    positions, normals : (K, N, 3) float
-        Contacts (m, finite) and inward normals (finite, non-zero; normalised
-        here), frame O.
-    fans : (K, N, 2, 3) float
-        Each contact's fan ends (inward normals, finite and non-zero;
-        normalised here), all NaN for a contact without one (its normal
-        stays).
-    fingers : (K, N) int
-        Finger labels (the palm ``F``), as for ``weight_capacity``.
-    mu : float
-        0 or in ``[1e-12, 1e12]``, as for ``weight_capacity``.
-    samples : int
-        Copies per grasp (the robustness samples), an integer ``>= 0``; 0
-        gives the nominal capacity.  The copies' points (``K * samples * N *
-        3`` floats) at most :data:`~drakegrasp.planning.checks.MAX_COPY_BYTES`.
-    rng : numpy.random.Generator
-        Draws the fans' normals (only with ``samples > 0``).
-    torque_scale, contact_model, torsional_friction, palm
-        As for :func:`~drakegrasp.planning.weight.weight_capacity`.
-
-    Returns
-    -------
-    (K,) float
-        Newtons of weight held per newton of squeeze on each finger.
-
-    Raises
-    ------
-    GraspError
-        An argument out of its range, naming it (checked before any draw).
-    """
-    positions, normals = checked_contacts(positions, normals)
-    K, N, _ = positions.shape
-    fans = _checked_fans(fans, (K, N, 2, 3))
-    fingers = checked_fingers(fingers, (K, N))
-    mu, contact_model, torsional_friction = checked_friction(
-        mu, contact_model, torsional_friction
-    )
-    samples = checked_samples(samples, K, N)
-    rng = checked_rng(rng)
-    torque_scale = checked_torque_scale(torque_scale, positions)  # before any draw
-    palm = checked_palm(palm)
-    S = max(samples, 1)
-    has = np.all(np.isfinite(fans), axis=(2, 3))  # (K, N)
-    t = rng.uniform(size=(K, S, N)) if samples else np.zeros((K, S, N))
-    drawn = _slerp(fans[:, None, :, 0], fans[:, None, :, 1], t)  # (K, S, N, 3)
-    Nrm = np.where(has[:, None, :, None], drawn, normals[:, None])
-    if not samples:
-        Nrm = np.broadcast_to(normals[:, None], Nrm.shape)
-    alpha = weight_capacity(
-        np.repeat(positions, S, axis=0), Nrm.reshape(K * S, N, 3),
-        np.repeat(fingers, S, axis=0), mu=mu, torque_scale=torque_scale,
-        contact_model=contact_model, torsional_friction=torsional_friction,
-        palm=palm,
-    ).min(axis=1)  # fmt: skip
-    return np.where(np.isfinite(alpha), alpha, 0.0).reshape(K, S).mean(axis=1)
-
-
-def _checked_fans(fans, shape: tuple) -> np.ndarray:
-    """``fans`` of :func:`fan_capacity`: unit ends, or all NaN (no fan)."""
-    a = real_array("fans", fans)
-    if a.shape != shape:
-        raise InvalidContactError(
-            f"fans must have shape (K, N, 2, 3) = {shape}, two ends per contact, "
-            f"got shape {a.shape}"
-        )
-    none = np.all(np.isnan(a), axis=(2, 3))[..., None, None]  # (K, N, 1, 1)
-    try:  # each end a contact normal: the message names grasp, contact, end
-        ends = unit_vectors("fans", np.where(none, 1.0, a))
-    except InvalidContactError as err:
-        raise InvalidContactError(
-            f"{err}; a contact without a fan has both ends all NaN"
-        ) from None
-    return np.where(none, np.nan, ends)
-
-
-@renamed_keyword("model", "contact_model")
-def rank_multifinger(
-    kept, *, label, hand: MultiFingerHand, plant, mu, contact_model, nu, torque_scale,
-    samples, noise, rng, certify, workers, X_WO, weight, reference,
-):  # fmt: skip
-    """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
-
-    ``label`` maps a finger body's scoped name to its finger; other hand
-    bodies (the palm) are labelled ``F``, the number of fingers.  Moments are
-    about ``reference`` ((3,) in O, metres), where the weight acts.
-    """
-    if not kept:
-        return ()
-    F = hand.num_fingers
-    counts = np.array([len(k[4]) for k in kept])
-    K = len(kept)
-    rho = np.zeros(K)
-    alpha = np.full(K, np.nan)
-    verdict, groups = grouped_verdicts(
-        kept, lambda found: _labels(found, label, F), mu=mu,
-        torque_scale=torque_scale, contact_model=contact_model, nu=nu,
-        workers=workers, reference=reference,
-    )  # fmt: skip
-    is_closure, d_star, rank, eps = verdict.values()
-    for idx, P, Nrm, L, fc in groups:
-        closed = idx[fc]
-        if len(closed):
-            rho[closed] = robustness(
-                P[fc] - reference, Nrm[fc], L[fc], mu=mu, samples=samples,
-                rng=rng, noise=noise, contact_model=contact_model,
-                torsional_friction=nu, workers=workers, groups=tuple(range(F)),
-            )  # fmt: skip
-            alpha[closed] = weight_capacity(
-                P[fc] - reference, Nrm[fc], L[fc], mu=mu,
-                torque_scale=torque_scale, contact_model=contact_model,
-                torsional_friction=nu, palm=F,
-            ).min(axis=1)  # fmt: skip
-    fanned = np.flatnonzero(
-        np.isfinite(alpha) & (rho > 0) & [_has_fan(k[4]) for k in kept]
-    )
-    for idx in group_by_count(counts[fanned]).values():
-        rows = fanned[idx]
-        alpha[rows] = fan_capacity(
-            np.array([[c.p_OC for c in kept[i][4]] for i in rows]) - reference,
-            np.array([[c.nhat_O for c in kept[i][4]] for i in rows]),
-            np.array([_fans(kept[i][4]) for i in rows]),
-            np.array([_labels(kept[i][4], label, F) for i in rows]),
-            mu=mu, samples=samples, rng=rng, torque_scale=torque_scale,
-            contact_model=contact_model, torsional_friction=nu, palm=F,
-        )  # fmt: skip
-    score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
-    sample = np.array([k[0] for k in kept])
-    order = np.lexsort((sample, -tie_key(d_star), -tie_key(eps * rho), -tie_key(score)))
-    s = hand.structure
-    base = scoped_name(plant, hand.base)
-    scores = {
-        "is_closure": is_closure, "d_star": d_star, "rank": rank, "eps": eps,
-        "rho": rho, "score": score, "alpha": alpha,
-    }  # fmt: skip
-
-    def pose(i: int) -> dict:
-        k, X_WH, q_pre, q, found = kept[i]
-        return dict(
-            sample=int(k), hand_base=base, X_WH=X_WH, X_WO=X_WO,
-            q_hand=np.asarray(q, float), joint_names=s.names,
-            closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
-            opening=float("nan"), contacts=tuple(found),
-            q_preshape=np.asarray(q_pre, float), reference_point=reference.copy(),
-            torque_scale=float(torque_scale),
-        )  # fmt: skip
-
-    return ranked_candidates(
-        order, scores, pose, weight=weight, certify=certify, mu=mu,
-        contact_model=contact_model, nu=nu,
-    )  # fmt: skip
-
-
-def _ranked_result(
-    kept, *, label, hand_model, plant, mu, settings, torque_scale, rng, certify,
-    workers, X_WO, weight, rejections, num_sampled, object_body, started,
-    reference,
-):  # fmt: skip
-    """Both routes' last stage: the kept closings ranked, as GraspCandidates."""
-    candidates = rank_multifinger(
-        kept, label=label, hand=hand_model, plant=plant, mu=mu,
-        contact_model=settings["contact_model"], nu=settings["torsional_friction"],
-        torque_scale=torque_scale, samples=settings["robustness_samples"],
-        noise=settings["noise"], rng=rng, certify=certify, workers=workers,
-        X_WO=X_WO, weight=weight, reference=reference,
-    )  # fmt: skip
-    result = planning_result(
-        candidates,
-        rejections=rejections,
-        num_sampled=num_sampled,
-        object_body=object_body,
-        mu=mu,
-        torque_scale=torque_scale,
-        settings=settings,
-        started=started,
-    )
-    collided = sum(n for why, n in rejections.items() if why in _OPEN_HAND_COLLIDES)
-    if not candidates and num_sampled and collided == num_sampled:
-        result = dataclasses.replace(result, reason=result.reason + OPEN_HAND_HINT)
-    return result
-
-
-_OPEN_HAND_COLLIDES = ("hand collides with the object", "hand collides with the cloud")
-
-OPEN_HAND_HINT = (
-    "; the open hand collides wherever it is placed: open it wider "
-    "(preshape=) or move the palm back (standoff=)"
-)
-"""Added to an empty result's reason when every pose collided as placed."""
-
-
 def _warn_passive(plant, body, hand, structure) -> None:
     """:class:`PassiveJointWarning` naming the hand's passive joints, if any."""
     passive = passive_joints(plant, hand_bodies(plant, body, hand), structure)
@@ -570,7 +296,7 @@ def _warn_passive(plant, body, hand, structure) -> None:
     )
 
 
-def _checked_hand(
+def checked_hand(
     plant, ctx, body, hand, *, tilt, min_fingers, preshape, synergy,
     synergy_range, approach, standoff,
 ):  # fmt: skip
@@ -609,108 +335,3 @@ def _checked_hand(
             f"{hand_model.num_fingers} fingers {fingers}{arm}"
         )
     return tilt, hand_model
-
-
-def plan_multifinger(
-    plant, ctx, body, *, hand, n, mu, rng, surface, settings, t0, name,
-    preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
-    standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
-    progress=False, weight=None, torque_limit=None,
-):  # fmt: skip
-    """The multi-finger route of :func:`~drakegrasp.planning.planner.plan_grasps`.
-
-    Called by ``plan_grasps`` once the options are checked (``settings`` holds
-    them); ``weight`` is the object's weight (N), ``torque_limit`` the
-    torque applied (N·m, None: the effort limits).  Returns its
-    :class:`~drakegrasp.planning.candidates.GraspCandidates`.
-    """
-    tilt, hand_model = _checked_hand(
-        plant, ctx, body, hand, tilt=tilt, min_fingers=min_fingers,
-        preshape=preshape, synergy=synergy, synergy_range=synergy_range,
-        approach=approach, standoff=standoff,
-    )  # fmt: skip
-    settings = {**settings, "hand": hand_model.to_dict(), "tilt": tilt,
-                "min_fingers": int(min_fingers)}  # fmt: skip
-    X_WO = plant.EvalBodyPoseInWorld(ctx, body)
-    reference = centre_of_mass(ctx, body, surface)
-    torque_scale = surface.radius_about(reference)
-    poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
-    saved = plant.GetPositions(ctx).copy()
-    try:
-        kept, rejections, label = close_candidates(
-            plant, ctx, body, hand, hand_model, poses, settings["distance_tolerance"],
-            progress, min_fingers,
-        )  # fmt: skip
-    finally:
-        plant.SetPositions(ctx, saved)
-    result = _ranked_result(
-        kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
-        settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
-        workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
-        num_sampled=n, object_body=name, started=t0, reference=reference,
-    )  # fmt: skip
-    return with_torques_needed(
-        result, plant, ctx, body, weight=weight, top=certify, started=t0,
-        torque_limit=torque_limit,
-    )  # fmt: skip
-
-
-def plan_multifinger_cloud(
-    plant, ctx, *, hand, points, normals, viewpoint, n, mu, rng, settings, t0,
-    preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
-    standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
-    progress=False, weight=float("nan"), complete=True, torque_limit=None,
-):  # fmt: skip
-    """The multi-finger cloud route of :func:`~drakegrasp.planning.planner.plan_grasps`.
-
-    Called by ``plan_grasps`` with the cloud read
-    (:func:`~drakegrasp.planning.cloud.read_cloud`: world frame, outward unit
-    normals) and the options checked (``settings``); ``weight`` is the
-    object's weight (N, NaN when unknown), ``torque_limit`` the torque
-    applied (N·m, None: the effort limits).  With a ``viewpoint`` and
-    ``complete`` the unseen side is the seen one reflected through the
-    object's estimated centre (:func:`~drakegrasp.planning.cloud.complete_unseen`,
-    an assumption: a centrally symmetric object), and the hand may reach
-    around the object but not into it.  Returns its
-    :class:`~drakegrasp.planning.candidates.GraspCandidates`.
-    """
-    tilt, hand_model = _checked_hand(
-        plant, ctx, plant.world_body(), hand, tilt=tilt, min_fingers=min_fingers,
-        preshape=preshape, synergy=synergy, synergy_range=synergy_range,
-        approach=approach, standoff=standoff,
-    )  # fmt: skip
-    surface, completion = cloud_surface(points, normals, viewpoint, complete)
-    X_WO = RigidTransform(surface.origin)
-    settings = {
-        **settings,
-        "hand": hand_model.to_dict(),
-        "tilt": tilt,
-        "min_fingers": int(min_fingers),
-        "cloud_points": len(points),
-        "contact_band": CONTACT_BAND,
-        "unseen_completion": completion,
-    }
-    torque_scale = surface.radius_about(np.zeros(3))
-    poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
-    saved = plant.GetPositions(ctx).copy()
-    closer = CloudHand(
-        plant, ctx, hand_model, surface, settings["distance_tolerance"], min_fingers,
-        completed=surface.viewpoint is None and completion is not None,
-        fan_reach=FAN_SIGMAS * settings["noise"]["position"],
-    )  # fmt: skip
-    try:
-        kept, rejections, label = close_each(closer, poses, progress)
-    finally:
-        plant.SetPositions(ctx, saved)
-    result = _ranked_result(
-        kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
-        settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
-        workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
-        num_sampled=n, object_body="point cloud", started=t0,
-        reference=np.zeros(3),
-    )  # fmt: skip
-    # no object body: each contact's finger point is its cloud point
-    return with_torques_needed(
-        result, plant, ctx, None, weight=weight, top=certify, started=t0,
-        torque_limit=torque_limit,
-    )  # fmt: skip

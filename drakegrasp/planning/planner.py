@@ -31,6 +31,7 @@ candidate or is counted under one rejection reason.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import replace
 
@@ -48,6 +49,7 @@ from drakegrasp.core.validation import (
     real_scalar,
 )
 from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.planning.approach import sample_approaches
 from drakegrasp.planning.candidates import (
     GraspCandidates,
     closing_order,
@@ -59,24 +61,28 @@ from drakegrasp.planning.checks import (
     checked_samples,
 )
 from drakegrasp.planning.cloud import (
+    CONTACT_BAND,
     PAD_CONTACT_BAND,
     CloudFingers,
     FittedCloud,
     cloud_surface,
     read_cloud_fit,
 )
+from drakegrasp.planning.cloud_hand import FAN_SIGMAS, CloudHand
 from drakegrasp.planning.gripper import free_base, parallel_jaw
 from drakegrasp.planning.motors import (
     _unit_of_joints,
     check_squeeze_limit,
     check_torque_limit,
     with_squeeze_limit,
+    with_torques_needed,
 )
 from drakegrasp.planning.multifinger import (
     DEFAULT_TILT,
+    checked_hand,
+    close_candidates,
+    close_each,
     hand_is_parallel_jaw,
-    plan_multifinger,
-    plan_multifinger_cloud,
 )
 from drakegrasp.planning.placement import (
     MAX_CLOSING_STEPS,
@@ -88,6 +94,7 @@ from drakegrasp.planning.ranking import (
     DEFAULT_NOISE,
     checked_noise,
     rank_candidates,
+    rank_multifinger,
 )
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
 from drakegrasp.planning.turned_gravity import GRAVITY
@@ -105,7 +112,16 @@ from drakegrasp.plant.validation import (
     scoped_name,
 )
 
-__all__ = ["MAX_CANDIDATES", "MAX_PLAN_MU", "REASONS", "object_surface", "plan_grasps"]
+__all__ = [
+    "MAX_CANDIDATES",
+    "MAX_PLAN_MU",
+    "OPEN_HAND_HINT",
+    "REASONS",
+    "object_surface",
+    "plan_grasps",
+    "plan_multifinger",
+    "plan_multifinger_cloud",
+]
 
 MAX_CANDIDATES = 1_000_000
 """Most poses one call samples (memory grows with it; call again for more)."""
@@ -821,3 +837,147 @@ def _close_on_cloud(closer: BodyCloser, cloud: CloudFingers, X_WH, opening):
     if found is None:
         return None, None, "one finger touches", X_WH
     return found, q, None, X_WH
+
+
+def _ranked_result(
+    kept, *, label, hand_model, plant, mu, settings, torque_scale, rng, certify,
+    workers, X_WO, weight, rejections, num_sampled, object_body, started,
+    reference,
+):  # fmt: skip
+    """Both routes' last stage: the kept closings ranked, as GraspCandidates."""
+    candidates = rank_multifinger(
+        kept, label=label, hand=hand_model, plant=plant, mu=mu,
+        contact_model=settings["contact_model"], nu=settings["torsional_friction"],
+        torque_scale=torque_scale, samples=settings["robustness_samples"],
+        noise=settings["noise"], rng=rng, certify=certify, workers=workers,
+        X_WO=X_WO, weight=weight, reference=reference,
+    )  # fmt: skip
+    result = planning_result(
+        candidates,
+        rejections=rejections,
+        num_sampled=num_sampled,
+        object_body=object_body,
+        mu=mu,
+        torque_scale=torque_scale,
+        settings=settings,
+        started=started,
+    )
+    collided = sum(n for why, n in rejections.items() if why in _OPEN_HAND_COLLIDES)
+    if not candidates and num_sampled and collided == num_sampled:
+        result = dataclasses.replace(result, reason=result.reason + OPEN_HAND_HINT)
+    return result
+
+
+_OPEN_HAND_COLLIDES = ("hand collides with the object", "hand collides with the cloud")
+
+
+OPEN_HAND_HINT = (
+    "; the open hand collides wherever it is placed: open it wider "
+    "(preshape=) or move the palm back (standoff=)"
+)
+"""Added to an empty result's reason when every pose collided as placed."""
+
+
+def plan_multifinger(
+    plant, ctx, body, *, hand, n, mu, rng, surface, settings, t0, name,
+    preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
+    standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
+    progress=False, weight=None, torque_limit=None,
+):  # fmt: skip
+    """The multi-finger route of :func:`~drakegrasp.planning.planner.plan_grasps`.
+
+    Called by ``plan_grasps`` once the options are checked (``settings`` holds
+    them); ``weight`` is the object's weight (N), ``torque_limit`` the
+    torque applied (N·m, None: the effort limits).  Returns its
+    :class:`~drakegrasp.planning.candidates.GraspCandidates`.
+    """
+    tilt, hand_model = checked_hand(
+        plant, ctx, body, hand, tilt=tilt, min_fingers=min_fingers,
+        preshape=preshape, synergy=synergy, synergy_range=synergy_range,
+        approach=approach, standoff=standoff,
+    )  # fmt: skip
+    settings = {**settings, "hand": hand_model.to_dict(), "tilt": tilt,
+                "min_fingers": int(min_fingers)}  # fmt: skip
+    X_WO = plant.EvalBodyPoseInWorld(ctx, body)
+    reference = centre_of_mass(ctx, body, surface)
+    torque_scale = surface.radius_about(reference)
+    poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
+    saved = plant.GetPositions(ctx).copy()
+    try:
+        kept, rejections, label = close_candidates(
+            plant, ctx, body, hand, hand_model, poses, settings["distance_tolerance"],
+            progress, min_fingers,
+        )  # fmt: skip
+    finally:
+        plant.SetPositions(ctx, saved)
+    result = _ranked_result(
+        kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
+        settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
+        workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
+        num_sampled=n, object_body=name, started=t0, reference=reference,
+    )  # fmt: skip
+    return with_torques_needed(
+        result, plant, ctx, body, weight=weight, top=certify, started=t0,
+        torque_limit=torque_limit,
+    )  # fmt: skip
+
+
+def plan_multifinger_cloud(
+    plant, ctx, *, hand, points, normals, viewpoint, n, mu, rng, settings, t0,
+    preshape=None, synergy=None, synergy_range=(0.0, 1.0), approach=None,
+    standoff=None, tilt=DEFAULT_TILT, min_fingers=2, certify=10, workers=1,
+    progress=False, weight=float("nan"), complete=True, torque_limit=None,
+):  # fmt: skip
+    """The multi-finger cloud route of :func:`~drakegrasp.planning.planner.plan_grasps`.
+
+    Called by ``plan_grasps`` with the cloud read
+    (:func:`~drakegrasp.planning.cloud.read_cloud`: world frame, outward unit
+    normals) and the options checked (``settings``); ``weight`` is the
+    object's weight (N, NaN when unknown), ``torque_limit`` the torque
+    applied (N·m, None: the effort limits).  With a ``viewpoint`` and
+    ``complete`` the unseen side is the seen one reflected through the
+    object's estimated centre (:func:`~drakegrasp.planning.cloud.complete_unseen`,
+    an assumption: a centrally symmetric object), and the hand may reach
+    around the object but not into it.  Returns its
+    :class:`~drakegrasp.planning.candidates.GraspCandidates`.
+    """
+    tilt, hand_model = checked_hand(
+        plant, ctx, plant.world_body(), hand, tilt=tilt, min_fingers=min_fingers,
+        preshape=preshape, synergy=synergy, synergy_range=synergy_range,
+        approach=approach, standoff=standoff,
+    )  # fmt: skip
+    surface, completion = cloud_surface(points, normals, viewpoint, complete)
+    X_WO = RigidTransform(surface.origin)
+    settings = {
+        **settings,
+        "hand": hand_model.to_dict(),
+        "tilt": tilt,
+        "min_fingers": int(min_fingers),
+        "cloud_points": len(points),
+        "contact_band": CONTACT_BAND,
+        "unseen_completion": completion,
+    }
+    torque_scale = surface.radius_about(np.zeros(3))
+    poses = sample_approaches(surface, hand_model, X_WO, n, rng, tilt)
+    saved = plant.GetPositions(ctx).copy()
+    closer = CloudHand(
+        plant, ctx, hand_model, surface, settings["distance_tolerance"], min_fingers,
+        completed=surface.viewpoint is None and completion is not None,
+        fan_reach=FAN_SIGMAS * settings["noise"]["position"],
+    )  # fmt: skip
+    try:
+        kept, rejections, label = close_each(closer, poses, progress)
+    finally:
+        plant.SetPositions(ctx, saved)
+    result = _ranked_result(
+        kept, label=label, hand_model=hand_model, plant=plant, mu=mu,
+        settings=settings, torque_scale=torque_scale, rng=rng, certify=certify,
+        workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
+        num_sampled=n, object_body="point cloud", started=t0,
+        reference=np.zeros(3),
+    )  # fmt: skip
+    # no object body: each contact's finger point is its cloud point
+    return with_torques_needed(
+        result, plant, ctx, None, weight=weight, top=certify, started=t0,
+        torque_limit=torque_limit,
+    )  # fmt: skip

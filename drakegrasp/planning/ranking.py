@@ -3,7 +3,10 @@ r"""Ranking planned grasps: verdicts, ε on one scale, robustness and the score.
 Every measure runs in the batch engine (:mod:`drakegrasp.batch`), on the
 candidates grouped by their number of contacts (the engine takes ``K`` grasps
 of ``N`` contacts each; a WSG finger seats one to four tip spheres, so the
-counts are ragged).
+counts are ragged).  Both routes of the planner rank here:
+:func:`rank_candidates` the parallel jaw's candidates, :func:`rank_multifinger`
+a multi-finger hand's (its capacity averaged over a cloud contact's fan,
+:func:`~drakegrasp.planning.weight.fan_capacity`).
 
 **ε on one scale.**  The Ferrari–Canny L1 ε divides moments by a length; by
 default each grasp uses its own (its largest contact distance), which makes a
@@ -67,6 +70,7 @@ from drakegrasp.core.validation import (
     integer_or_none,
 )
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.planning.approach import MultiFingerHand
 from drakegrasp.planning.candidates import GraspCandidate
 from drakegrasp.planning.checks import (
     MAX_FINGER_LABEL,
@@ -79,7 +83,7 @@ from drakegrasp.planning.checks import (
 )
 from drakegrasp.planning.needed import needed_for
 from drakegrasp.planning.reclose import perturbed_mu, reclosed_robustness
-from drakegrasp.planning.weight import weight_capacity
+from drakegrasp.planning.weight import fan_capacity, weight_capacity
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
@@ -89,6 +93,7 @@ __all__ = [
     "grouped_verdicts",
     "perturbed_copies",
     "rank_candidates",
+    "rank_multifinger",
     "rank_order",
     "ranked_candidates",
     "robustness",
@@ -722,6 +727,100 @@ def rank_candidates(
             q_hand=np.asarray(q, float), joint_names=joint_names,
             closing_signs=signs, opening=opening, contacts=tuple(found),
             reference_point=reference.copy(), torque_scale=float(torque_scale),
+        )  # fmt: skip
+
+    return ranked_candidates(
+        order, scores, pose, weight=weight, certify=certify, mu=mu,
+        contact_model=contact_model, nu=nu,
+    )  # fmt: skip
+
+
+def _labels(found, label, palm) -> list[int]:
+    return [label.get(c.finger_body, palm) for c in found]
+
+
+def _has_fan(found) -> bool:
+    return any(getattr(c, "fan", None) is not None for c in found)
+
+
+def _fans(found) -> np.ndarray:
+    """(N, 2, 3) fan ends per contact, NaN where a contact has none."""
+    out = np.full((len(found), 2, 3), np.nan)
+    for j, c in enumerate(found):
+        if getattr(c, "fan", None) is not None:
+            out[j] = c.fan
+    return out
+
+
+@renamed_keyword("model", "contact_model")
+def rank_multifinger(
+    kept, *, label, hand: MultiFingerHand, plant, mu, contact_model, nu, torque_scale,
+    samples, noise, rng, certify, workers, X_WO, weight, reference,
+):  # fmt: skip
+    """Stage 4: verdicts, ε, robustness, weight capacity, score; ranked candidates.
+
+    ``label`` maps a finger body's scoped name to its finger; other hand
+    bodies (the palm) are labelled ``F``, the number of fingers.  Moments are
+    about ``reference`` ((3,) in O, metres), where the weight acts.
+    """
+    if not kept:
+        return ()
+    F = hand.num_fingers
+    counts = np.array([len(k[4]) for k in kept])
+    K = len(kept)
+    rho = np.zeros(K)
+    alpha = np.full(K, np.nan)
+    verdict, groups = grouped_verdicts(
+        kept, lambda found: _labels(found, label, F), mu=mu,
+        torque_scale=torque_scale, contact_model=contact_model, nu=nu,
+        workers=workers, reference=reference,
+    )  # fmt: skip
+    is_closure, d_star, rank, eps = verdict.values()
+    for idx, P, Nrm, L, fc in groups:
+        closed = idx[fc]
+        if len(closed):
+            rho[closed] = robustness(
+                P[fc] - reference, Nrm[fc], L[fc], mu=mu, samples=samples,
+                rng=rng, noise=noise, contact_model=contact_model,
+                torsional_friction=nu, workers=workers, groups=tuple(range(F)),
+            )  # fmt: skip
+            alpha[closed] = weight_capacity(
+                P[fc] - reference, Nrm[fc], L[fc], mu=mu,
+                torque_scale=torque_scale, contact_model=contact_model,
+                torsional_friction=nu, palm=F,
+            ).min(axis=1)  # fmt: skip
+    fanned = np.flatnonzero(
+        np.isfinite(alpha) & (rho > 0) & [_has_fan(k[4]) for k in kept]
+    )
+    for idx in group_by_count(counts[fanned]).values():
+        rows = fanned[idx]
+        alpha[rows] = fan_capacity(
+            np.array([[c.p_OC for c in kept[i][4]] for i in rows]) - reference,
+            np.array([[c.nhat_O for c in kept[i][4]] for i in rows]),
+            np.array([_fans(kept[i][4]) for i in rows]),
+            np.array([_labels(kept[i][4], label, F) for i in rows]),
+            mu=mu, samples=samples, rng=rng, torque_scale=torque_scale,
+            contact_model=contact_model, torsional_friction=nu, palm=F,
+        )  # fmt: skip
+    score = np.where(np.isfinite(alpha), alpha * rho, 0.0)
+    sample = np.array([k[0] for k in kept])
+    order = np.lexsort((sample, -tie_key(d_star), -tie_key(eps * rho), -tie_key(score)))
+    s = hand.structure
+    base = scoped_name(plant, hand.base)
+    scores = {
+        "is_closure": is_closure, "d_star": d_star, "rank": rank, "eps": eps,
+        "rho": rho, "score": score, "alpha": alpha,
+    }  # fmt: skip
+
+    def pose(i: int) -> dict:
+        k, X_WH, q_pre, q, found = kept[i]
+        return dict(
+            sample=int(k), hand_base=base, X_WH=X_WH, X_WO=X_WO,
+            q_hand=np.asarray(q, float), joint_names=s.names,
+            closing_signs=tuple(float(v) for v in np.sign(q - q_pre)),
+            opening=float("nan"), contacts=tuple(found),
+            q_preshape=np.asarray(q_pre, float), reference_point=reference.copy(),
+            torque_scale=float(torque_scale),
         )  # fmt: skip
 
     return ranked_candidates(

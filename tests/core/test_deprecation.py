@@ -161,7 +161,7 @@ def test_no_public_function_takes_a_scalar_mu_by_position_after_other_arguments(
         ("drakegrasp.planning.ranking", "perturbed_copies", 3),
         ("drakegrasp.planning.ranking", "grouped_verdicts", 2),
         ("drakegrasp.planning.reclose", "reclosed_robustness", 4),
-        ("drakegrasp.planning.multifinger", "fan_capacity", 4),
+        ("drakegrasp.planning.weight", "fan_capacity", 4),
     ],
 )
 def test_planning_stages_take_mu_by_keyword_after_their_arrays(module, name, after):

@@ -25,15 +25,14 @@ from pydrake.geometry import Box
 from pydrake.math import RigidTransform
 
 import drakegrasp as dg
-from drakegrasp.planning import checks, multifinger, planner, ranking, reclose, weight
+from drakegrasp.planning import checks, planner, ranking, reclose, weight
 from drakegrasp.planning.gripper import ParallelJaw
-from drakegrasp.planning.multifinger import fan_capacity
 from drakegrasp.planning.placement import sample_poses
 from drakegrasp.planning.planner import plan_grasps
 from drakegrasp.planning.ranking import perturbed_copies, robustness, verdicts
 from drakegrasp.planning.reclose import reclosed_robustness
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
-from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, weight_capacity
+from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, fan_capacity, weight_capacity
 
 NOISE = {"position": 4e-3, "angle_deg": 8.0, "friction": 0.3}
 
@@ -304,7 +303,7 @@ def _fan_args(**change):
 def test_fan_capacity_names_a_bad_argument(name, value, monkeypatch):
     _stage_refuses(
         fan_capacity, _fan_args, name, value, monkeypatch,
-        (multifinger, "weight_capacity"),
+        (weight, "weight_capacity"),
     )  # fmt: skip
 
 

@@ -1,5 +1,5 @@
 """The normal fans of cloud contacts at edges and the capacity averaged over
-them (drakegrasp.planning.multifinger.fan_capacity): the arc's draws against a
+them (drakegrasp.planning.weight.fan_capacity): the arc's draws against a
 rotation about the arc's axis, the capacity against weight_capacity on the
 same drawn normals, and fans that change nothing (none, or of one normal)."""
 
@@ -10,8 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from drakegrasp.core.linalg import rotations_about
-from drakegrasp.planning.multifinger import _slerp, fan_capacity
-from drakegrasp.planning.weight import weight_capacity
+from drakegrasp.planning.weight import _slerp, fan_capacity, weight_capacity
 
 MU = 0.8
 SCALE = 0.05

@@ -65,7 +65,7 @@ def test_an_open_hand_that_collides_everywhere_is_told_to_open(tmp_path, capsys)
     # the spread hand curled shut (its flexion joints at their upper limits)
     # penetrates the cylinder at every sampled pose
     from drakegrasp.cli import main
-    from drakegrasp.planning.multifinger import OPEN_HAND_HINT
+    from drakegrasp.planning.planner import OPEN_HAND_HINT
 
     shut = [f"f{k}_proximal_joint" for k in (1, 2, 3)]
     scene = _scene(tmp_path, passive=False)
