@@ -169,13 +169,16 @@ _SOURCES = {
     ),
 }
 
-# Subpackages reachable as attributes after a bare ``import drakegrasp``, and
-# ``drakegrasp.examples``, the textbook grasps the README uses.
+# Subpackages and modules reachable as attributes after a bare ``import
+# drakegrasp``, and ``drakegrasp.examples``, the textbook grasps the README uses.
 _SUBMODULES = {
     name: f"drakegrasp.{name}"
     for name in (
+        "_lazy",
+        "_solvers",
         "batch",
         "certificates",
+        "cli",
         "closure",
         "core",
         "distributed",

@@ -18,6 +18,17 @@ _SOURCES = {
     "drakegrasp.certificates.load": ("LoadCertificate",),
 }
 
-__getattr__, __dir__ = lazy_exports(__name__, globals(), _SOURCES)
+_SUBMODULES = (
+    "_matching",
+    "certificate",
+    "kinds",
+    "load",
+    "text",
+    "witness",
+)
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
+)
 
 __all__ = ["Certificate", "CertificateCheck", "LoadCertificate"]

@@ -38,7 +38,21 @@ _SOURCES = {
     ),
 }
 
-__getattr__, __dir__ = lazy_exports(__name__, globals(), _SOURCES)
+_SUBMODULES = (
+    "constraints",
+    "force_dual",
+    "grasp_forces",
+    "load_problem",
+    "payload",
+    "programs",
+    "results",
+    "second_order",
+    "verdicts",
+)
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
+)
 
 __all__ = [
     "ClosureResult",

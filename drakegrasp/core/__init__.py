@@ -9,3 +9,23 @@ null spaces (:mod:`~drakegrasp.core.linalg`), the JSON helper and the test of a
 regular file (:mod:`~drakegrasp.core.files`).  Every other layer imports from
 here; nothing here imports another layer.
 """
+
+from drakegrasp._lazy import lazy_exports
+
+_SUBMODULES = (
+    "antipodal",
+    "contact",
+    "curvature",
+    "deferred",
+    "deprecation",
+    "examples",
+    "files",
+    "friction_cone",
+    "grasp",
+    "linalg",
+    "serialize",
+    "tolerances",
+    "validation",
+)
+
+__getattr__, __dir__ = lazy_exports(__name__, globals(), {}, submodules=_SUBMODULES)

@@ -17,7 +17,16 @@ _SOURCES = {
     "drakegrasp.distributed.plant_side": ("analyze_poses", "cached_scenes"),
 }
 
-__getattr__, __dir__ = lazy_exports(__name__, globals(), _SOURCES)
+_SUBMODULES = (
+    "batch_side",
+    "client",
+    "dataset",
+    "plant_side",
+)
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
+)
 
 __all__ = [
     "analyze_poses",

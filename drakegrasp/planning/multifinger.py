@@ -51,6 +51,7 @@ from collections import Counter
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
+from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.errors import (
     InvalidOptionError,
     ModelError,
@@ -292,7 +293,7 @@ def _warn_passive(plant, body, hand, structure) -> None:
         "couple them with a <mimic> to a driven joint, or weld them, to plan "
         "the hand Drake simulates",
         PassiveJointWarning,
-        stacklevel=4,
+        stacklevel=outside_stacklevel(),
     )
 
 

@@ -74,6 +74,7 @@ _SOURCES = {
 
 # Submodules an eager package imported, reachable after ``import drakegrasp.plant``.
 _SUBMODULES = (
+    "_closing_steps",
     "_shapes",
     "advancement",
     "analysis",
@@ -89,17 +90,23 @@ _SUBMODULES = (
     "exact_contact",
     "finger_antipodal",
     "fingers",
+    "friction",
+    "handles",
+    "hydroelastic",
     "jacobians",
     "jaws",
     "load",
+    "mesh_convexity",
     "models",
     "options",
     "pose",
+    "scale",
     "scene",
     "scene_file",
     "scene_refs",
     "settle",
     "shape_queries",
+    "sphere_tips",
     "validation",
 )
 

@@ -99,6 +99,7 @@ _SOURCES = {
 }
 
 _SUBMODULES = (
+    "_common",
     "epsilon",
     "indices",
     "resistible",

@@ -13,7 +13,19 @@ _SOURCES = {
     "drakegrasp.systems.holding": ("HOLDING_STATES", "HoldingThresholds"),
 }
 
-__getattr__, __dir__ = lazy_exports(__name__, globals(), _SOURCES)
+_SUBMODULES = (
+    "finger_loads",
+    "grasp_monitor",
+    "holding",
+    "monitor",
+    "monitor_options",
+    "sample",
+    "sensing",
+)
+
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(), _SOURCES, submodules=_SUBMODULES
+)
 
 __all__ = [
     "HOLDING_STATES",

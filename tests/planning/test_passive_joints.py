@@ -51,8 +51,10 @@ def test_passive_joints_are_the_hands_joints_no_motor_moves(tmp_path, passive):
 
 
 def test_planning_a_hand_with_a_passive_joint_names_it(tmp_path):
-    with pytest.warns(PassiveJointWarning, match=r"spread_hand::f1_distal_joint"):
+    with pytest.warns(PassiveJointWarning, match=r"spread_hand::f1_distal_joint") as w:
         _plan(_scene(tmp_path, passive=True))
+    # attributed to the user's line (here, _plan's call of plan_grasps)
+    assert [r.filename for r in w if r.category is PassiveJointWarning] == [__file__]
 
 
 def test_a_hand_whose_joints_all_move_with_motors_plans_without_it(tmp_path):

@@ -2,3 +2,14 @@
 
 The driver, the compiled expanding-polytope kernel and its polytope updates.
 """
+
+from drakegrasp._lazy import lazy_exports
+
+_SUBMODULES = (
+    "driver",
+    "kernel",
+    "polytope",
+    "routes",
+)
+
+__getattr__, __dir__ = lazy_exports(__name__, globals(), {}, submodules=_SUBMODULES)

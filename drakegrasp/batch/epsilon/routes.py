@@ -7,8 +7,8 @@ flags and, without numba, for all.
 
 ε is a stage after the LP: :func:`force_chunk_with_epsilon` runs a chunk's LP2
 (:func:`drakegrasp.batch.run.chunk.force_chunk`) and adds ``epsilon_l1``, and
-:func:`with_epsilon` makes an LP2 task give it, so the chunk of the LP imports
-nothing of ε and the verdict-only runs of the planner do not load it.
+:func:`with_epsilon` makes an LP2 task give it, so the chunk of the LP and the
+verdict-only runs (:mod:`drakegrasp.batch.run.verdicts`) import nothing of ε.
 """
 
 from __future__ import annotations
