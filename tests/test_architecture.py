@@ -279,15 +279,19 @@ def test_no_import_cycle_type_only_and_function_level_imports_included():
     assert cycle is None, f"import cycle: {' -> '.join(cycle)}"
 
 
+def _as_a_module(source: str, monkeypatch) -> Path:
+    """A library module's path whose text reads as ``source`` in this test."""
+    monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: source)
+    return PACKAGE / "core" / "contact.py"
+
+
 def test_type_only_and_lazy_imports_are_edges(tmp_path, monkeypatch):
     source = (
         "from typing import TYPE_CHECKING\n"
         "if TYPE_CHECKING:\n    from drakegrasp.core.grasp import Grasp\n"
         "def f():\n    from drakegrasp.plant.scene import load_scene\n"
     )
-    path = PACKAGE / "core" / "contact.py"
-    monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: source)
-    found = imports_of(path)
+    found = imports_of(_as_a_module(source, monkeypatch))
     assert {"drakegrasp.core.grasp", "drakegrasp.plant.scene"} <= found
 
 
@@ -399,8 +403,7 @@ def test_a_package_import_the_graph_cannot_follow_is_seen(tmp_path, monkeypatch)
         "from drakegrasp.planning import no_such_name\n"
         "from drakegrasp import plan_grasps, examples\n"
     )
-    path = PACKAGE / "core" / "contact.py"
-    monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: source)
+    path = _as_a_module(source, monkeypatch)
     assert opaque_imports(path) == [
         "drakegrasp.batch",
         "drakegrasp.planning.no_such_name",
