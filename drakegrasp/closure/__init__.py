@@ -38,10 +38,11 @@ _SOURCES = {
     ),
 }
 
+# ``grasp_forces`` is also the public function of that module, which the name
+# keeps (import the module as ``drakegrasp.closure.grasp_forces`` by path).
 _SUBMODULES = (
     "constraints",
     "force_dual",
-    "grasp_forces",
     "load_problem",
     "payload",
     "programs",

@@ -72,7 +72,7 @@ _SOURCES = {
     ),
 }
 
-# Submodules an eager package imported, reachable after ``import drakegrasp.plant``.
+# Every module of the folder, an attribute after ``import drakegrasp.plant``.
 _SUBMODULES = (
     "_closing_steps",
     "_shapes",

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import importlib.util
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -71,7 +73,32 @@ def test_with_epsilon_keeps_the_task_arguments():
     assert set(fn(*args, **opts)) >= {"is_closure", "d_star", "epsilon_l1"}
 
 
-def test_the_verdict_only_runs_do_not_load_epsilon():
+def _reached(graph, start):
+    seen, todo = set(), [start]
+    while todo:
+        for module in graph.get(todo.pop(), ()):
+            if module not in seen:
+                seen.add(module)
+                todo.append(module)
+    return seen
+
+
+def test_the_lp_chunk_and_the_verdict_only_runs_import_nothing_of_epsilon():
+    # Every import counts, function-level ones too: the chunk once reached the
+    # Qhull route of quality.epsilon through batch.metrics.
+    spec = importlib.util.spec_from_file_location(
+        "_architecture", Path(__file__).resolve().parents[1] / "test_architecture.py"
+    )
+    architecture = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(architecture)
+    edges = architecture.graph()
+    for start in ("drakegrasp.batch.run.chunk", "drakegrasp.batch.run.verdicts"):
+        reached = _reached(edges, start)
+        assert "drakegrasp.batch.run.chunk" in reached | {start}
+        assert not {m for m in reached if ".epsilon" in m or ".quality" in m}, start
+
+
+def test_the_verdict_only_runs_load_nothing_of_epsilon():
     code = (
         "import sys, drakegrasp.batch.run.verdicts; "
         "print(sorted(m for m in sys.modules if 'epsilon' in m or 'quality' in m))"
