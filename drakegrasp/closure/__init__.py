@@ -39,7 +39,8 @@ _SOURCES = {
 }
 
 # ``grasp_forces`` is also the public function of that module, which the name
-# keeps (import the module as ``drakegrasp.closure.grasp_forces`` by path).
+# keeps: reach the module with ``from drakegrasp.closure.grasp_forces import``
+# or ``importlib.import_module``.
 _SUBMODULES = (
     "constraints",
     "force_dual",
