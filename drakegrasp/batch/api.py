@@ -16,18 +16,19 @@ matrices exist at any moment, and inputs may be memory-mapped arrays.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from drakegrasp.batch.build.construction import batched_characteristic_lengths
 from drakegrasp.batch.columns import result_arrays
-from drakegrasp.batch.epsilon.routes import EPSILON_METRIC, with_epsilon
+from drakegrasp.batch.epsilon.routes import EPSILON_METRIC, epsilon_l1_batch
 from drakegrasp.batch.inputs import METRICS, shape_of
 from drakegrasp.batch.metrics import metric_moment_arms
 from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
-from drakegrasp.batch.run.chunk import force_task, form_task
+from drakegrasp.batch.run.chunk import force_chunk, force_task, form_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
@@ -197,6 +198,66 @@ def merge_results(
     chunks = ((idx, result.to_arrays()) for idx, result in parts)
     first = parts[0][1]
     return collect(K, d, first.kind, first.tol, names, chunks)
+
+
+def force_chunk_with_epsilon(
+    P: np.ndarray,
+    Nrm: np.ndarray,
+    mu_c: np.ndarray,
+    nu_c: np.ndarray,
+    p: np.ndarray,
+    b: np.ndarray | None,
+    *,
+    metrics: Sequence[str],
+    **options,
+) -> dict[str, np.ndarray]:
+    """LP2 of one chunk, then its ε L1: the two stages of a chunk that asks for ε.
+
+    The LP stage (:func:`drakegrasp.batch.run.chunk.force_chunk`) and the ε
+    stage (:func:`drakegrasp.batch.epsilon.routes.epsilon_l1_batch`) know
+    nothing of each other; this is where they meet.  A top-level function, so
+    a worker process runs it as it runs ``force_chunk``.
+
+    Parameters
+    ----------
+    P, Nrm, mu_c, nu_c, p, b
+        As :func:`drakegrasp.batch.run.chunk.force_chunk`.
+    metrics : sequence of str
+        Checked metric names, ``"epsilon_l1"`` among them; the others are
+        ``force_chunk``'s.
+    **options
+        ``force_chunk``'s other keywords (``contact_model``, ``num_generators``,
+        ``tol``, ``rank_tol``, ``kernel``).
+
+    Returns
+    -------
+    dict of str to (k,) array
+        ``force_chunk``'s arrays, then ``epsilon_l1``.
+    """
+    if b is None:  # the same default force_chunk gives a metric
+        b = batched_characteristic_lengths(P, p)
+    others = tuple(name for name in metrics if name != EPSILON_METRIC)
+    out = force_chunk(P, Nrm, mu_c, nu_c, p, b, metrics=others, **options)
+    out[EPSILON_METRIC] = epsilon_l1_batch(
+        P, Nrm, mu_c, nu_c, p, b, contact_model=options["contact_model"],
+        num_generators=options["num_generators"], kernel=options.get("kernel", "auto"),
+    )  # fmt: skip
+    return out
+
+
+def with_epsilon(task: Callable) -> Callable:
+    """An LP2 chunk-task builder whose chunks also give ε L1.
+
+    ``task`` is the builder of :func:`drakegrasp.batch.run.chunk.force_task`
+    (``(P, Nrm, slice) -> (function, args, options)``); the returned builder
+    runs :func:`force_chunk_with_epsilon` on the same arguments instead.
+    """
+
+    def measured(P, Nrm, sl):
+        _, args, options = task(P, Nrm, sl)
+        return force_chunk_with_epsilon, args, options
+
+    return measured
 
 
 def force_chunks(

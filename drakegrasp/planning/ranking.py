@@ -28,7 +28,7 @@ draw per copy.  A rigid motion of the whole grasp changes no verdict, so the
 noise is per finger: it models the object's pose error and the fingers'
 placement error relative to each other.  Only each copy's verdict counts, so
 both routes solve their copies' LPs in verdict-only mode
-(:func:`drakegrasp.batch.run.verdicts.force_verdicts`): each LP stops once its
+(:func:`drakegrasp.batch.run.chunk.force_verdicts`): each LP stops once its
 verdict is proved, and the verdicts are those of
 :func:`~drakegrasp.batch.batch_force_closure`.
 
@@ -58,7 +58,7 @@ from dataclasses import replace
 import numpy as np
 
 from drakegrasp.batch import batch_epsilon_l1, batch_force_closure
-from drakegrasp.batch.run.verdicts import force_verdicts
+from drakegrasp.batch.run.chunk import force_verdicts
 from drakegrasp.batch.run.workers import check_workers
 from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword

@@ -40,7 +40,7 @@ estimate errs towards fewer contacts.
 
 Everything is vectorised over all copies and probes (one chord query); the
 copies' verdicts are then the batch engine's LP2 (verdicts only:
-:func:`drakegrasp.batch.run.verdicts.force_verdicts`), grouped by their (ragged)
+:func:`drakegrasp.batch.run.chunk.force_verdicts`), grouped by their (ragged)
 contact counts, except for copies with too few contacts to be force closure
 at all (:data:`NEVER_CLOSURE`).
 """
@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.batch.run.verdicts import force_verdicts
+from drakegrasp.batch.run.chunk import force_verdicts
 from drakegrasp.batch.run.workers import check_workers
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.linalg import rotations_about

@@ -1,4 +1,4 @@
-"""ε L1 as a stage after the LP: the chunk of LP2 gives it only through the stage."""
+"""ε L1 as a stage after the LP: neither stage imports the other; the API joins them."""
 
 from __future__ import annotations
 
@@ -10,11 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drakegrasp.batch.epsilon.routes import (
-    epsilon_l1_batch,
-    force_chunk_with_epsilon,
-    with_epsilon,
-)
+from drakegrasp.batch.api import force_chunk_with_epsilon, with_epsilon
+from drakegrasp.batch.epsilon.routes import epsilon_l1_batch
 from drakegrasp.batch.run.chunk import force_chunk, force_task
 from drakegrasp.errors import InvalidOptionError
 
@@ -83,24 +80,37 @@ def _reached(graph, start):
     return seen
 
 
-def test_the_lp_chunk_and_the_verdict_only_runs_import_nothing_of_epsilon():
-    # Every import counts, function-level ones too: the chunk once reached the
-    # Qhull route of quality.epsilon through batch.metrics.
+def _import_graph():
     spec = importlib.util.spec_from_file_location(
         "_architecture", Path(__file__).resolve().parents[1] / "test_architecture.py"
     )
     architecture = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(architecture)
-    edges = architecture.graph()
-    for start in ("drakegrasp.batch.run.chunk", "drakegrasp.batch.run.verdicts"):
-        reached = _reached(edges, start)
-        assert "drakegrasp.batch.run.chunk" in reached | {start}
-        assert not {m for m in reached if ".epsilon" in m or ".quality" in m}, start
+    return architecture.graph()
 
 
-def test_the_verdict_only_runs_load_nothing_of_epsilon():
+def test_the_lp_chunk_and_its_verdict_only_run_import_nothing_of_epsilon():
+    # Every import counts, function-level ones too: the chunk once reached the
+    # Qhull route of quality.epsilon through batch.metrics.
+    reached = _reached(_import_graph(), "drakegrasp.batch.run.chunk")
+    assert "drakegrasp.batch.run.stream" in reached  # force_verdicts' stream
+    assert not {m for m in reached if ".epsilon" in m or ".quality" in m}
+
+
+def test_the_epsilon_stage_imports_nothing_of_the_lp():
+    graph = _import_graph()
+    reached = _reached(graph, "drakegrasp.batch.epsilon.routes")
+    assert "drakegrasp.batch.epsilon.kernel" in reached  # the walk sees its imports
+    assert not {m for m in reached if ".batch.run" in m or ".batch.lp" in m}
+    # The API is where they meet.
+    assert {"drakegrasp.batch.run.chunk", "drakegrasp.batch.epsilon.routes"} <= graph[
+        "drakegrasp.batch.api"
+    ]
+
+
+def test_the_verdict_only_run_loads_nothing_of_epsilon():
     code = (
-        "import sys, drakegrasp.batch.run.verdicts; "
+        "import sys; from drakegrasp.batch.run.chunk import force_verdicts; "
         "print(sorted(m for m in sys.modules if 'epsilon' in m or 'quality' in m))"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

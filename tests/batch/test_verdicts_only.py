@@ -1,6 +1,6 @@
 """LP2 in verdict-only mode (``force_verdicts``) against the full solve's verdicts.
 
-Robustness counts verdicts, so :func:`drakegrasp.batch.run.verdicts.force_verdicts`
+Robustness counts verdicts, so :func:`drakegrasp.batch.run.chunk.force_verdicts`
 stops each LP once its verdict is proved (``solve_dstar_blocks``'s
 ``verdict_tol``).  Its verdicts must equal ``batch_force_closure``'s exactly, on
 random grasps of every contact model, on degenerate ones (rank deficient, one
@@ -22,8 +22,7 @@ from drakegrasp.batch.build.construction import SPATIAL_HARD, kind_facets
 from drakegrasp.batch.build.rowspace import normalised_positions, row_spaces
 from drakegrasp.batch.inputs import numba_available
 from drakegrasp.batch.lp.dstar import _verdict_band
-from drakegrasp.batch.run.chunk import _grasp_matrices, force_chunk
-from drakegrasp.batch.run.verdicts import force_verdicts
+from drakegrasp.batch.run.chunk import _grasp_matrices, force_chunk, force_verdicts
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
 
 KERNELS = [

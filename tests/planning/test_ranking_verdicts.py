@@ -2,7 +2,7 @@
 
 Both robustness routes (contacts moved per finger, :func:`robustness`; the
 jaws re-closed on the moved object, :func:`reclosed_robustness`) take their
-copies' verdicts from :func:`drakegrasp.batch.run.verdicts.force_verdicts`, which
+copies' verdicts from :func:`drakegrasp.batch.run.chunk.force_verdicts`, which
 stops each LP once its verdict is proved.  With the same seed, the values must
 equal those computed from ``batch_force_closure``'s full verdicts.
 """

@@ -1,24 +1,20 @@
-"""ε L1 of a chunk of grasps, by its two routes, and the LP2 chunk that reports it.
+"""ε L1 of a chunk of grasps, by its two routes.
 
 The compiled expanding-polytope kernel (:mod:`drakegrasp.batch.epsilon.kernel`)
 on the chunk's primitive wrenches (:mod:`drakegrasp.batch.build.wrenches`), and
 :func:`drakegrasp.quality.ferrari_canny` (Qhull) for the grasps that the kernel
 flags and, without numba, for all.
 
-ε is a stage after the LP: :func:`force_chunk_with_epsilon` runs a chunk's LP2
-(:func:`drakegrasp.batch.run.chunk.force_chunk`) and adds ``epsilon_l1``, and
-:func:`with_epsilon` makes an LP2 task give it, so the chunk of the LP and the
-verdict-only runs (:mod:`drakegrasp.batch.run.verdicts`) import nothing of ε.
+ε is a stage of its own, after the LP: this module takes a chunk's validated
+arrays and never runs its LP, and the LP's chunk
+(:mod:`drakegrasp.batch.run.chunk`) imports nothing of ε.  The public API
+joins the two stages (:func:`drakegrasp.batch.api.force_chunk_with_epsilon`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-
 import numpy as np
 
-from drakegrasp.batch.build.construction import batched_characteristic_lengths
-from drakegrasp.batch.run.chunk import force_chunk
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import L1_MAX_POINTS
 from drakegrasp.errors import InvalidOptionError
@@ -28,8 +24,6 @@ __all__ = [
     "epsilon_l1_batch",
     "epsilon_l1_per_grasp",
     "epsilon_l1_routes",
-    "force_chunk_with_epsilon",
-    "with_epsilon",
 ]
 
 EPSILON_METRIC = "epsilon_l1"
@@ -170,58 +164,3 @@ def epsilon_l1_batch(
         P, Nrm, mu, nu, p, b, contact_model=contact_model,
         num_generators=num_generators, kernel=kernel,
     )[0]  # fmt: skip
-
-
-def force_chunk_with_epsilon(
-    P: np.ndarray,
-    Nrm: np.ndarray,
-    mu_c: np.ndarray,
-    nu_c: np.ndarray,
-    p: np.ndarray,
-    b: np.ndarray | None,
-    *,
-    metrics: Sequence[str],
-    **options,
-) -> dict[str, np.ndarray]:
-    """LP2 of one chunk and its ε L1: ``force_chunk``'s arrays and ``epsilon_l1``.
-
-    Parameters
-    ----------
-    P, Nrm, mu_c, nu_c, p, b
-        As :func:`drakegrasp.batch.run.chunk.force_chunk`.
-    metrics : sequence of str
-        Checked metric names, ``"epsilon_l1"`` among them; the others are
-        ``force_chunk``'s.
-    **options
-        ``force_chunk``'s other keywords (``contact_model``, ``num_generators``,
-        ``tol``, ``rank_tol``, ``kernel``).
-
-    Returns
-    -------
-    dict of str to (k,) array
-        ``force_chunk``'s arrays, then ``epsilon_l1``.
-    """
-    if b is None:  # the same default force_chunk gives a metric
-        b = batched_characteristic_lengths(P, p)
-    others = tuple(name for name in metrics if name != EPSILON_METRIC)
-    out = force_chunk(P, Nrm, mu_c, nu_c, p, b, metrics=others, **options)
-    out[EPSILON_METRIC] = epsilon_l1_batch(
-        P, Nrm, mu_c, nu_c, p, b, contact_model=options["contact_model"],
-        num_generators=options["num_generators"], kernel=options.get("kernel", "auto"),
-    )  # fmt: skip
-    return out
-
-
-def with_epsilon(task: Callable) -> Callable:
-    """An LP2 chunk-task builder whose chunks also give ε L1.
-
-    ``task`` is the builder of :func:`drakegrasp.batch.run.chunk.force_task`
-    (``(P, Nrm, slice) -> (function, args, options)``); the returned builder
-    runs :func:`force_chunk_with_epsilon` on the same arguments instead.
-    """
-
-    def measured(P, Nrm, sl):
-        _, args, options = task(P, Nrm, sl)
-        return force_chunk_with_epsilon, args, options
-
-    return measured

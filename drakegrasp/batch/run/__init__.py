@@ -1,8 +1,9 @@
 """The run: chunks, their stream, worker processes and shared memory.
 
-One chunk of grasps start to finish (:mod:`~drakegrasp.batch.run.chunk`), the
-chunk stream (:mod:`~drakegrasp.batch.run.stream`), worker processes and the
-shared memory that feeds them.
+One chunk of grasps start to finish and the verdict-only run of chunks
+(:mod:`~drakegrasp.batch.run.chunk`), the chunk stream
+(:mod:`~drakegrasp.batch.run.stream`), worker processes and the shared memory
+that feeds them.
 """
 
 from drakegrasp._lazy import lazy_exports
@@ -11,7 +12,6 @@ _SUBMODULES = (
     "chunk",
     "shared_arrays",
     "stream",
-    "verdicts",
     "workers",
 )
 

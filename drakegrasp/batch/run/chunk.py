@@ -12,6 +12,12 @@ divided by their spread), so verdicts do not depend on units or on the
 reference point; ``d*`` does not either, since ``N(G)`` is the same.  A soft
 finger's torsion variable is measured in units of that spread, and its facet
 column is scaled to match.
+
+A planner that asks what fraction of perturbed copies of a grasp stay force
+closure needs each copy's verdict, never its ``d*``: :func:`force_verdicts`
+streams the LP2 chunks in their verdict-only mode, each LP stopping once its
+verdict is proved.  It lives with the mode it runs, and the chunk's LP imports
+nothing of the ε stage (:mod:`drakegrasp.batch.epsilon.routes`).
 """
 
 from __future__ import annotations
@@ -52,8 +58,14 @@ from drakegrasp.batch.inputs import (
 )
 from drakegrasp.batch.lp.dstar import solve_dstar_blocks
 from drakegrasp.batch.metrics import check_moment_arms, singular_value_metrics
+from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.deprecation import renamed_keyword
+from drakegrasp.core.tolerances import (
+    DEFAULT_NUM_GENERATORS,
+    DEFAULT_RANK_TOL,
+    DEFAULT_TOL,
+)
 from drakegrasp.core.validation import check_num_generators
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
@@ -64,6 +76,7 @@ __all__ = [
     "force_task",
     "form_chunk",
     "form_task",
+    "force_verdicts",
 ]
 
 _TORSION_COLUMN = {SOFT_FULL: 3, SOFT_TORSION: 1}
@@ -279,9 +292,9 @@ def force_chunk(
     contact_model, num_generators, tol, rank_tol, metrics, kernel
         As in :func:`drakegrasp.batch.batch_force_closure`, ``metrics`` less
         ``"epsilon_l1"``: ε is a stage of its own
-        (:func:`drakegrasp.batch.epsilon.routes.force_chunk_with_epsilon`).
+        (:func:`drakegrasp.batch.api.force_chunk_with_epsilon`).
     verdict_only : bool, optional
-        Internal (:func:`~drakegrasp.batch.run.verdicts.force_verdicts`): each
+        Internal (:func:`force_verdicts`): each
         LP stops once its verdict is proved, so ``is_closure`` is exact but
         ``d_star`` and ``margin`` are only bounds on the right side of ``tol``.
 
@@ -294,7 +307,7 @@ def force_chunk(
     if "epsilon_l1" in metrics:
         raise InvalidOptionError(
             "force_chunk gives the singular-value metrics; ε L1 (metric "
-            "'epsilon_l1') is the ε stage's: batch.epsilon.routes.with_epsilon"
+            "'epsilon_l1') is the ε stage's: batch.api.with_epsilon"
         )
     k, N, d = P.shape
     compiled = _compiled(kernel)
@@ -467,3 +480,60 @@ def form_task(positions, reference_points, characteristic_lengths, tol, rank_tol
         return form_chunk, (P, Nrm, p, b), options
 
     return task, options
+
+
+def force_verdicts(
+    positions,
+    normals,
+    *,
+    mu,
+    contact_model="hard_finger",
+    torsional_friction=None,
+    num_generators: int = DEFAULT_NUM_GENERATORS,
+    workers=None,
+    tol: float = DEFAULT_TOL,
+    rank_tol: float = DEFAULT_RANK_TOL,
+    kernel: str = "auto",
+) -> np.ndarray:
+    """``is_closure`` of LP2 for ``K`` grasps of ``N`` contacts, verdicts only.
+
+    Internal, for counts of verdicts (:func:`drakegrasp.planning.ranking.robustness`
+    and :func:`drakegrasp.planning.reclose.reclosed_robustness`): the same
+    validation, chunks, workers and rules as
+    :func:`drakegrasp.batch.batch_force_closure` (rank, normal-force
+    certificate), whose ``is_closure`` it returns, but each LP stops as soon
+    as its verdict is proved either way (a feasible point above the
+    threshold, a dual bound below it, a rank-deficient ``G``: see
+    :func:`drakegrasp.batch.lp.dstar.solve_dstar_blocks`'s ``verdict_tol``).
+
+    Parameters
+    ----------
+    positions, normals : (K, N, d) float
+        Contact points (metres) and unit inward normals, one frame per grasp.
+    mu, contact_model, torsional_friction, num_generators
+        As :func:`drakegrasp.batch.batch_force_closure`.
+    workers, tol, rank_tol, kernel
+        As :func:`drakegrasp.batch.batch_force_closure`.
+
+    Returns
+    -------
+    (K,) bool
+    """
+    K = shape_of("positions", positions)[0]
+    task, options = force_task(
+        positions, mu, contact_model, num_generators, torsional_friction, None,
+        None, tol, rank_tol, (), kernel,
+    )  # fmt: skip
+
+    def verdict_task(P, Nrm, sl):
+        fn, args, opts = task(P, Nrm, sl)
+        return fn, args, {**opts, "verdict_only": True}
+
+    out = np.zeros(K, dtype=bool)
+    for sl, arrays in stream(
+        positions, normals, kind="force", task=verdict_task,
+        chunk_size=DEFAULT_CHUNK_SIZE,
+        progress=False, workers=workers, n_g=options["num_generators"],
+    ):  # fmt: skip
+        out[sl] = arrays["is_closure"]
+    return out
