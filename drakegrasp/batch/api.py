@@ -46,9 +46,11 @@ __all__ = [
     "BatchClosureResult",
     "batch_force_closure",
     "batch_form_closure",
+    "force_chunk_with_epsilon",
     "iter_batch_closure",
     "stream_force_closure",
     "stream_form_closure",
+    "with_epsilon",
 ]
 
 

@@ -34,7 +34,7 @@ def test_the_lp_chunk_refuses_epsilon_instead_of_dropping_it():
         force_chunk(P, Nrm, mu, nu, p, None, metrics=("epsilon_l1",), **OPTIONS)
 
 
-def test_the_stage_adds_epsilon_to_the_lp_chunk_unchanged():
+def test_the_api_adds_the_epsilon_stage_to_the_lp_chunk_unchanged():
     P, Nrm, mu, nu, p = _chunk()
     metrics = ("sigma_min", "epsilon_l1", "isotropy")
     both = force_chunk_with_epsilon(P, Nrm, mu, nu, p, None, metrics=metrics, **OPTIONS)

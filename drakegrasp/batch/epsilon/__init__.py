@@ -1,6 +1,7 @@
 """Ferrari–Canny L1 ε of many grasps.
 
-The driver, the compiled expanding-polytope kernel and its polytope updates.
+The driver, the compiled expanding-polytope kernel and its polytope updates,
+and the two routes of a chunk's ε (kernel, Qhull).
 """
 
 from drakegrasp._lazy import lazy_exports

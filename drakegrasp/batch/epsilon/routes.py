@@ -7,8 +7,9 @@ flags and, without numba, for all.
 
 ε is a stage of its own, after the LP: this module takes a chunk's validated
 arrays and never runs its LP, and the LP's chunk
-(:mod:`drakegrasp.batch.run.chunk`) imports nothing of ε.  The public API
-joins the two stages (:func:`drakegrasp.batch.api.force_chunk_with_epsilon`).
+(:mod:`drakegrasp.batch.run.chunk`) imports nothing of ε.  The module of the
+public API, which chooses the stages, joins them
+(:func:`drakegrasp.batch.api.force_chunk_with_epsilon`).
 """
 
 from __future__ import annotations

@@ -1,7 +1,8 @@
 r"""One chunk of grasps, start to finish: validated arrays in, result arrays out.
 
-These functions are the unit of work of the batch engine.  They are top-level
-and take only arrays and plain options, so a chunk can run in this process or
+The chunk functions (:func:`force_chunk`, :func:`form_chunk`) are the unit of
+work of the batch engine.  They are top-level and take only arrays and plain
+options, so a chunk can run in this process or
 in a worker process (:mod:`drakegrasp.batch.run.workers`) with bitwise the same
 result: nothing in a chunk's computation depends on where it runs or on the
 other chunks.
@@ -74,9 +75,9 @@ __all__ = [
     "finish",
     "force_chunk",
     "force_task",
+    "force_verdicts",
     "form_chunk",
     "form_task",
-    "force_verdicts",
 ]
 
 _TORSION_COLUMN = {SOFT_FULL: 3, SOFT_TORSION: 1}
@@ -294,9 +295,9 @@ def force_chunk(
         ``"epsilon_l1"``: ε is a stage of its own
         (:func:`drakegrasp.batch.api.force_chunk_with_epsilon`).
     verdict_only : bool, optional
-        Internal (:func:`force_verdicts`): each
-        LP stops once its verdict is proved, so ``is_closure`` is exact but
-        ``d_star`` and ``margin`` are only bounds on the right side of ``tol``.
+        Internal (:func:`force_verdicts`): each LP stops once its verdict is
+        proved, so ``is_closure`` is exact but ``d_star`` and ``margin`` are
+        only bounds on the right side of ``tol``.
 
     Returns
     -------
