@@ -351,10 +351,19 @@ def _children(package: str) -> set[str]:
     }
 
 
-def _shadowed(package: str) -> set[str]:
-    """Modules named like one of their package's public names, which wins."""
+def _public_names(package: str) -> set[str]:
     tables = vars(importlib.import_module(package)).get("_SOURCES", {}).values()
-    return _children(package) & {name for names in tables for name in names}
+    return {name for names in tables for name in names}
+
+
+@pytest.mark.parametrize("package", sorted(PACKAGES))
+def test_no_module_is_named_like_a_public_name_of_its_package(package):
+    # Importing a module sets it as its package's attribute, over the public
+    # name: ``from drakegrasp.closure import grasp_forces`` gave the module,
+    # not the function, once anything (``dg.grasp_forces`` itself) had
+    # imported ``drakegrasp.closure.grasp_forces``.  That module is now
+    # ``closure.load_forces``.
+    assert not _children(package) & _public_names(package)
 
 
 @pytest.mark.parametrize("package", sorted(PACKAGES))
@@ -362,7 +371,7 @@ def test_a_package_lists_every_module_in_it_as_an_attribute(package):
     # drakegrasp.batch.run.stream, drakegrasp.quality._common: each step of a
     # dotted path is an attribute, imported on first read.
     children = vars(importlib.import_module(package)).get("_SUBMODULES", ())
-    missing = _children(package) - _shadowed(package) - set(children)
+    missing = _children(package) - set(children)
     assert not missing, missing
 
 
@@ -371,7 +380,7 @@ def test_every_listed_module_is_its_packages_attribute_in_a_fresh_interpreter():
     pairs = [
         (package, child)
         for package in sorted(PACKAGES)
-        for child in sorted(_children(package) - _shadowed(package))
+        for child in sorted(_children(package))
     ]
     code = (
         "import importlib\n"
@@ -381,7 +390,26 @@ def test_every_listed_module_is_its_packages_attribute_in_a_fresh_interpreter():
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr[-2000:]
-    assert _shadowed("drakegrasp.closure") == {"grasp_forces"}
+
+
+def test_public_names_stay_themselves_after_every_module_is_imported():
+    # Whatever the user imported first, a package's public name is what its
+    # table says, never a module that import history put in its place.
+    modules = sorted(m for m in MODULES if m != "drakegrasp.__main__")
+    names = {package: sorted(_public_names(package)) for package in sorted(PACKAGES)}
+    code = (
+        "import importlib, types\n"
+        f"for module in {modules!r}:\n"
+        "    importlib.import_module(module)\n"
+        f"for package, names in {names!r}.items():\n"
+        "    found = importlib.import_module(package)\n"
+        "    for name in names:\n"
+        "        if isinstance(getattr(found, name), types.ModuleType):\n"
+        "            print(package, name)\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout == ""
 
 
 def test_dotted_paths_resolve_in_a_fresh_interpreter():

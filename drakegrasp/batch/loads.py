@@ -17,7 +17,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from drakegrasp.closure.grasp_forces import GraspForceResult, grasp_forces
+from drakegrasp.closure.load_forces import GraspForceResult, grasp_forces
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS

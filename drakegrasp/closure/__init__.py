@@ -5,7 +5,7 @@
 solver gateway (``drakegrasp._solvers``) and assembles the frozen results
 of :mod:`~drakegrasp.closure.results`, and
 :mod:`~drakegrasp.closure.second_order` decides Rimon–Burdick second-order
-form closure.  Under load: :mod:`~drakegrasp.closure.grasp_forces` (forces and
+form closure.  Under load: :mod:`~drakegrasp.closure.load_forces` (forces and
 joint torques that hold a wrench within cones and motor limits, or a
 certificate that none do), :mod:`~drakegrasp.closure.payload` (the largest
 multiple of a load), with :mod:`~drakegrasp.closure.load_problem` (what they
@@ -22,7 +22,7 @@ _SOURCES = {
         "internal_forces",
     ),
     "drakegrasp.closure.results": ("ClosureResult", "InternalForceResult"),
-    "drakegrasp.closure.grasp_forces": (
+    "drakegrasp.closure.load_forces": (
         "GraspForceResult",
         "build_grasp_forces_program",
         "grasp_forces",
@@ -38,12 +38,10 @@ _SOURCES = {
     ),
 }
 
-# ``grasp_forces`` is also the public function of that module, which the name
-# keeps: reach the module with ``from drakegrasp.closure.grasp_forces import``
-# or ``importlib.import_module``.
 _SUBMODULES = (
     "constraints",
     "force_dual",
+    "load_forces",
     "load_problem",
     "payload",
     "programs",

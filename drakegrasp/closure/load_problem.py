@@ -726,7 +726,7 @@ def effort_unit_of(units: Iterable[str], default: str = "N·m") -> str:
     given in it; joints of both kinds in ``"N·m, N at prismatic joints"``,
     the one spelling of a mixed hand's unit (a planned candidate's
     ``torque_unit``, the shake test's summary, the joint torques of a
-    :class:`~drakegrasp.closure.grasp_forces.GraspForceResult`); no joint in
+    :class:`~drakegrasp.closure.load_forces.GraspForceResult`); no joint in
     ``default``.
 
     Parameters

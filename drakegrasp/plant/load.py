@@ -48,7 +48,7 @@ from pydrake.multibody.tree import JointActuatorIndex
 from pydrake.solvers import MathematicalProgram
 
 from drakegrasp._solvers import require_solution, solve
-from drakegrasp.closure.grasp_forces import GraspForceResult, grasp_forces
+from drakegrasp.closure.load_forces import GraspForceResult, grasp_forces
 from drakegrasp.closure.payload import MaxLoadResult, max_load
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import grasp_matrix

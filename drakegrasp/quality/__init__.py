@@ -45,7 +45,7 @@ Submodules: :mod:`~drakegrasp.quality.epsilon` (primitive wrenches and ε),
 :mod:`~drakegrasp.quality.resistible` (the LP) and
 :mod:`~drakegrasp.quality.summary` (LP2 margin and :class:`GraspQuality`).
 The grasp-force programs live beside the closure programs
-(:mod:`~drakegrasp.closure.grasp_forces`, :mod:`~drakegrasp.closure.payload`),
+(:mod:`~drakegrasp.closure.load_forces`, :mod:`~drakegrasp.closure.payload`),
 so that the plant layer can use them; they are re-exported here.
 The ε module imports ``scipy`` (Qhull, NNLS); the LPs import
 ``pydrake.solvers``.  Nothing here touches a plant.
@@ -54,7 +54,7 @@ The ε module imports ``scipy`` (Qhull, NNLS); the LPs import
 from drakegrasp._lazy import lazy_exports
 
 _SOURCES = {
-    "drakegrasp.closure.grasp_forces": (
+    "drakegrasp.closure.load_forces": (
         "GraspForceResult",
         "GraspForceVariables",
         "build_grasp_forces_program",
