@@ -10,8 +10,9 @@ constraint (same rows, same bounds, same solver attribute) and never touches
 the sparse caster.  Core layer: ``pydrake.solvers`` and numpy only.
 
 The Lorentz-cone rows of an exact spatial friction cone with a margin
-(:func:`exact_cone_rows`) live here too, so that the exact force-closure
-program and the grasp-force and payload programs write them once.
+(:func:`exact_cone_rows`), and the loop that puts every contact's force in its
+cone (:func:`add_contact_cones`), live here too, so that the exact
+force-closure program and the grasp-force and payload programs write them once.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from pydrake.solvers import LinearConstraint, LinearEqualityConstraint
 
 __all__ = [
     "EXACT_CONE_COMPONENTS",
+    "add_contact_cones",
     "add_linear_constraint",
     "add_linear_equality_constraint",
     "exact_cone_rows",
@@ -96,3 +98,60 @@ def exact_cone_rows(contact, scales: np.ndarray, b: float) -> list[np.ndarray]:
             A /= size
         rows.append(A)
     return rows
+
+
+def add_contact_cones(
+    prog, contacts, layout, x, b: float, *, d=None, exact: bool = True
+) -> None:
+    """Each contact's scaled force ``x_i`` in its friction cone.
+
+    With ``d``, at distance ``d`` inside it (``facets x_i >= d``, or the Lorentz
+    rows of :func:`exact_cone_rows` with their margin column); without, in the
+    closed cone.  With ``exact``, a spatial contact with friction (components
+    in :data:`EXACT_CONE_COMPONENTS`) gets Lorentz cones; every other cone,
+    and every cone when ``exact`` is False, its polyhedral facets (exact for a
+    planar or frictionless contact).
+
+    Parameters
+    ----------
+    prog : MathematicalProgram
+    contacts : sequence of Contact
+        The grasp's contacts, in the order of ``layout.cones``.
+    layout : ConeLayout
+        Its ``cones`` (facets and components), ``scales`` and
+        ``normal_positions``: contact ``i``'s variables are
+        ``x[normal_positions[i] : normal_positions[i + 1]]``, the force
+        components ``scales * x``.
+    x : (m,) Variable
+        The force variables, ``m = len(layout.columns)``.
+    b : float
+        Characteristic length, metres.
+    d : Variable, optional
+        The margin.
+    exact : bool
+        Lorentz cones where the cone is spatial with friction.
+    """
+    starts = list(layout.normal_positions) + [len(layout.columns)]
+    for i, (contact, cone) in enumerate(zip(contacts, layout.cones, strict=True)):
+        xi = x[starts[i] : starts[i + 1]]
+        scale = layout.scales[starts[i] : starts[i + 1]]
+        if not (exact and cone.components in EXACT_CONE_COMPONENTS):
+            F = cone.facets * scale
+            if d is None:
+                add_linear_constraint(
+                    prog, F, np.zeros(len(F)), np.full(len(F), np.inf), xi
+                )
+            else:
+                add_linear_constraint(
+                    prog,
+                    np.hstack([F, -np.ones((len(F), 1))]),
+                    np.zeros(len(F)),
+                    np.full(len(F), np.inf),
+                    np.append(xi, d),
+                )
+            continue
+        for A in exact_cone_rows(contact, scale, b):
+            if d is None:
+                prog.AddLorentzConeConstraint(A[:, :-1], np.zeros(3), xi)
+            else:
+                prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(xi, d))

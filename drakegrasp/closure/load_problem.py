@@ -48,9 +48,9 @@ import numpy as np
 
 from drakegrasp.closure.constraints import (
     EXACT_CONE_COMPONENTS,
+    add_contact_cones,
     add_linear_constraint,
     add_linear_equality_constraint,
-    exact_cone_rows,
 )
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
@@ -623,7 +623,10 @@ def add_force_constraints(prog, P: LoadProblem, x, force_scale: float, d=None):
     ``P.layout.columns`` are ``force_scale * P.layout.scales * x``.  Returns
     the scaled torque expressions' matrix ``A_τ`` (``τ_j = c_j F0 (A_τ x)_j``).
     """
-    _add_cones(prog, P, x, d)
+    add_contact_cones(
+        prog, P.grasp.contacts, P.layout, x, P.grasp.characteristic_length,
+        d=d, exact=P.cones == "exact",
+    )  # fmt: skip
     scales = P.layout.scales
     A_tau = P.Jt * scales
     lim = P.limited_joints()
@@ -665,36 +668,6 @@ def add_balance(prog, P: LoadProblem, x, rhs: np.ndarray, alpha=None) -> None:
             np.zeros(A.shape[0]),
             np.append(x, alpha),
         )
-
-
-def _add_cones(prog, P: LoadProblem, x, d) -> None:
-    grasp, layout = P.grasp, P.layout
-    b = grasp.characteristic_length
-    starts = list(layout.normal_positions) + [P.num_forces]
-    for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
-        xi = x[starts[i] : starts[i + 1]]
-        scale = layout.scales[starts[i] : starts[i + 1]]
-        exact = P.cones == "exact" and cone.components in EXACT_CONE_COMPONENTS
-        if not exact:
-            F = cone.facets * scale
-            if d is None:
-                add_linear_constraint(
-                    prog, F, np.zeros(len(F)), np.full(len(F), np.inf), xi
-                )
-            else:
-                add_linear_constraint(
-                    prog,
-                    np.hstack([F, -np.ones((len(F), 1))]),
-                    np.zeros(len(F)),
-                    np.full(len(F), np.inf),
-                    np.append(xi, d),
-                )
-            continue
-        for A in exact_cone_rows(contact, scale, b):
-            if d is None:
-                prog.AddLorentzConeConstraint(A[:, :-1], np.zeros(3), xi)
-            else:
-                prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(xi, d))
 
 
 def saturating_joints(

@@ -37,9 +37,9 @@ from pydrake.solvers import MathematicalProgram
 
 from drakegrasp.closure.constraints import (
     EXACT_CONE_COMPONENTS,
+    add_contact_cones,
     add_linear_constraint,
     add_linear_equality_constraint,
-    exact_cone_rows,
 )
 from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.core.friction_cone import ConeLayout
@@ -478,38 +478,8 @@ def build_exact_force_closure_program(
     rows = _shared_balance_rows(grasp, layout, rank_tol)
     add_balance(prog, None, f, rank_tol, rows=rows)
     _add_normal_budget(prog, f[layout.normal_positions], N)
-    _add_exact_cones(prog, grasp, layout, f, d)
+    add_contact_cones(prog, grasp.contacts, layout, f, grasp.characteristic_length, d=d)
     return prog, _scaled_variables(d, f, layout)
-
-
-def _add_exact_cones(prog, grasp: Grasp, layout: ConeLayout, x, d=None) -> None:
-    """Each contact's scaled force ``x_i`` in its exact Coulomb cone.
-
-    With ``d``, at distance ``d`` inside it (the exact-cone program's
-    margin); without, in the closed cone.  A spatial contact with friction
-    gets Lorentz cones (:func:`~drakegrasp.closure.constraints.exact_cone_rows`);
-    a planar or frictionless cone, exact as a polyhedron, its facets.
-    """
-    b = grasp.characteristic_length
-    starts = list(layout.normal_positions) + [len(layout.columns)]
-    for i, (contact, cone) in enumerate(zip(grasp.contacts, layout.cones, strict=True)):
-        xi = x[starts[i] : starts[i + 1]]
-        scale = layout.scales[starts[i] : starts[i + 1]]
-        if cone.components not in EXACT_CONE_COMPONENTS:
-            if d is None:
-                rows = cone.facets * scale
-                lower = np.zeros(rows.shape[0])
-                add_linear_constraint(
-                    prog, rows, lower, np.full_like(lower, np.inf), xi
-                )
-            else:
-                _add_margin_rows(prog, cone.facets * scale, xi, d)
-            continue
-        for A in exact_cone_rows(contact, scale, b):
-            if d is None:
-                prog.AddLorentzConeConstraint(A[:, :-1], np.zeros(3), xi)
-            else:
-                prog.AddLorentzConeConstraint(A, np.zeros(3), np.append(xi, d))
 
 
 def lp3_is_conic(grasp: Grasp) -> bool:
@@ -578,7 +548,7 @@ def build_internal_force_program(
     add_balance(prog, A, f, rank_tol, scales=layout.scales)
     _add_margin_rows(prog, _selection(layout.normal_positions, len(f)), f, d)
     _add_normal_budget(prog, f[layout.normal_positions], N)
-    _add_exact_cones(prog, grasp, layout, f)
+    add_contact_cones(prog, grasp.contacts, layout, f, grasp.characteristic_length)
     return prog, _scaled_variables(d, f, layout)
 
 
