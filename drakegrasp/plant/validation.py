@@ -696,12 +696,7 @@ def _check_apart(
 def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
     welded = _welded_to_world(plant)
     if isinstance(hand, str | ModelInstanceIndex):
-        instance = model_instance(plant, hand)
-        bodies = [
-            plant.get_body(i)
-            for nested in _with_nested(plant, instance)
-            for i in plant.GetBodyIndices(nested)
-        ]
+        bodies = _instance_bodies(plant, hand)
         _check_apart(plant, object_body, hand, bodies)
         bodies = [b for b in bodies if int(b.index()) not in welded]
     elif hand is None:
@@ -727,6 +722,16 @@ def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
     if not bodies:
         raise _no_bodies(plant, object_body, hand, " that can move")
     return sorted(bodies, key=lambda b: int(b.index()))
+
+
+def _instance_bodies(plant, hand) -> list[RigidBody]:
+    """Every body of the model instance ``hand`` names and of those nested in it."""
+    instance = model_instance(plant, hand)
+    return [
+        plant.get_body(i)
+        for nested in _with_nested(plant, instance)
+        for i in plant.GetBodyIndices(nested)
+    ]
 
 
 def _with_nested(plant, instance) -> list:
@@ -817,12 +822,7 @@ def hand_contact_bodies(
         movable = hand_bodies(plant, object_body, None)
         return hand_model_instances(plant, movable, object_body)
     if isinstance(hand, str | ModelInstanceIndex):
-        instance = model_instance(plant, hand)
-        bodies = [
-            plant.get_body(i)
-            for nested in _with_nested(plant, instance)
-            for i in plant.GetBodyIndices(nested)
-        ]
+        bodies = _instance_bodies(plant, hand)
     else:
         bodies = [resolve_object_body(plant, b) for b in _listed(hand)]
     _check_apart(plant, object_body, hand, bodies)
