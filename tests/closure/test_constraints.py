@@ -22,7 +22,9 @@ TOL = 1e-9
 
 def _one_contact(model: str, mu: float, nu: float = 0.3):
     extra = {"torsional_friction": nu} if model == "soft_finger" else {}
-    contact = dg.Contact([0.0, 0.0, 0.1], [0.0, 0.0, -1.0], mu=mu, contact_model=model, **extra)
+    contact = dg.Contact(
+        [0.0, 0.0, 0.1], [0.0, 0.0, -1.0], mu=mu, contact_model=model, **extra
+    )
     grasp = dg.Grasp(
         [contact, dg.Contact([0.0, 0.0, -0.1], [0.0, 0.0, 1.0], mu=mu)],
         characteristic_length=0.1,
