@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drakegrasp.core.deprecation import renamed_keyword, warn_deprecated
+from drakegrasp.core.tolerances import UNIT_NORMAL_TOL
 from drakegrasp.core.validation import (
     check_coefficient,
     check_positions,
@@ -84,7 +85,9 @@ def contact_frames(normals: np.ndarray) -> np.ndarray:
     ----------
     normals : (..., 3) or (..., 2) float
         Unit contact normals, pointing into the object.  They are not
-        re-normalised here.
+        re-normalised here: a length off 1 by more than
+        :data:`~drakegrasp.core.tolerances.UNIT_NORMAL_TOL` (1e-9) is refused
+        (:func:`contact_frame` normalises one normal).
 
     Returns
     -------
@@ -109,6 +112,17 @@ def contact_frames(normals: np.ndarray) -> np.ndarray:
             "normals must be finite, non-zero unit vectors (see contact_frame, "
             "which normalises one)"
         )
+    if n.shape[-1] in (2, 3):
+        off = np.abs(np.sqrt(np.sum(n * n, axis=-1)) - 1.0)
+        if not np.all(off <= UNIT_NORMAL_TOL):
+            idx = tuple(int(i) for i in np.argwhere(~(off <= UNIT_NORMAL_TOL))[0])
+            where = f" at index {idx}" if idx else ""
+            raise InvalidContactError(
+                f"normals must be unit vectors: the normal{where} "
+                f"{np.asarray(n[idx]).tolist()} has length "
+                f"{float(np.linalg.norm(n[idx])):.6g} (normalise them, or build "
+                "each frame with contact_frame, which does)"
+            )
     if n.shape[-1] == 2:
         t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
         return np.stack([n, t], axis=-1)
@@ -322,7 +336,11 @@ class Contact:
         return ContactModel.HARD_FINGER
 
     def with_(self, **changes) -> Contact:
-        """Return a copy with some fields replaced (``mu``, ``contact_model``, ...)."""
+        """Return a copy with some fields replaced (``mu``, ``contact_model``, ...).
+
+        A contact made a soft finger needs ``torsional_friction`` with it (the
+        other models carry none to inherit), as :class:`Contact` does.
+        """
         kwargs = {
             "position": self.position,
             "normal": self.normal,
@@ -345,6 +363,14 @@ class Contact:
             warn_deprecated("Contact.with_(): model= is deprecated; use contact_model=")
             changes["contact_model"] = changes.pop("model")
         kwargs.update(changes)
+        if (
+            "torsional_friction" not in changes
+            and self.contact_model is not ContactModel.SOFT_FINGER
+            and ContactModel.parse(kwargs["contact_model"]) is ContactModel.SOFT_FINGER
+        ):
+            # a hard finger's 0 is no torsion coefficient: ask for one, as
+            # Contact(contact_model="soft_finger") does
+            kwargs["torsional_friction"] = None
         position = kwargs.pop("position")
         normal = kwargs.pop("normal")
         return Contact(position, normal, **kwargs)

@@ -199,7 +199,8 @@ class Grasp:
     ) -> Grasp:
         """Copy with every contact's friction and contact model set (those given).
 
-        ``model=`` is a deprecated alias of ``contact_model=``.
+        ``model=`` is a deprecated alias of ``contact_model=``.  Contacts made
+        soft fingers need ``torsional_friction`` (:meth:`Contact.with_`).
         """
         changes = {}
         if mu is not None:

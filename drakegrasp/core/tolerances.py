@@ -17,6 +17,7 @@ __all__ = [
     "DEFAULT_RANK_TOL",
     "DEFAULT_TOL",
     "MAX_DISTANCE_TOLERANCE",
+    "UNIT_NORMAL_TOL",
     "ZERO_FRACTION",
     "near_threshold",
     "relative_margin",
@@ -45,6 +46,13 @@ became four contacts and turned the verdict to force closure, "pose: valid"
 metres; the widest tolerance drakegrasp uses itself, in its tests, tutorials
 and benchmarks, is 2 mm (a point cloud's spacing), most 1 mm or the default
 0.1 mm.
+"""
+
+UNIT_NORMAL_TOL = 1e-9
+"""How far from 1 the length of a normal given to ``contact_frames`` may be.
+
+The function builds frames from the normals as they are; every other entry
+point normalises them first (to within a few units in the last place).
 """
 
 DEFAULT_NUM_GENERATORS = 8

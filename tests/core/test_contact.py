@@ -81,3 +81,42 @@ def test_model_enum_and_strings_are_interchangeable():
     b = dg.Contact([0, 0], [1, 0], contact_model="Frictionless")
     assert a.contact_model is b.contact_model is dg.ContactModel.FRICTIONLESS
     assert a.to_dict()["contact_model"] == "frictionless"
+
+
+def test_a_contact_made_a_soft_finger_needs_its_torsion_coefficient():
+    # Contact.with_ and Grasp.with_friction took the hard finger's 0 as the
+    # soft finger's ν: a soft finger that resists no torsion, silently (a
+    # grasp whose verdict then read "no").  Now as Contact(...) does.
+    grasp = dg.examples.spatial_two_fingers(0.5)
+    with pytest.raises(dg.InvalidContactError, match="torsional_friction"):
+        grasp.with_friction(contact_model="soft_finger")
+    with pytest.raises(dg.InvalidContactError, match="torsional_friction"):
+        grasp.contacts[0].with_(contact_model="soft_finger")
+    soft = grasp.with_friction(contact_model="soft_finger", torsional_friction=0.1)
+    assert all(c.torsional_friction == 0.1 for c in soft.contacts)
+    assert dg.force_closure(soft).is_closure
+    # a soft finger keeps its own ν through other changes, and ν = 0 stays
+    # possible when asked for
+    assert soft.with_friction(mu=0.8).contacts[0].torsional_friction == 0.1
+    explicit = grasp.with_friction(contact_model="soft_finger", torsional_friction=0)
+    assert explicit.contacts[0].torsional_friction == 0.0
+
+
+def test_contact_frames_refuses_normals_that_are_not_unit():
+    # it returned [[2, 0, 0], [0, 1, 0], [0, 0, 2]] for the normal [2, 0, 0]:
+    # no rotation, silently
+    with pytest.raises(dg.InvalidContactError, match=r"index \(1,\).*length 2"):
+        dg.contact_frames([[0.0, 0.0, 1.0], [2.0, 0.0, 0.0]])
+    with pytest.raises(dg.InvalidContactError, match="length 0.5"):
+        dg.contact_frames([0.0, 0.5])
+    n = np.array([[1.0, 2.0, 3.0], [0.0, -1.0, 0.0]])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    R = dg.contact_frames(n)
+    np.testing.assert_allclose(
+        R @ np.swapaxes(R, -1, -2), np.broadcast_to(np.eye(3), R.shape), atol=1e-15
+    )
+    np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-15)
+    # the one-normal route normalises
+    np.testing.assert_allclose(
+        dg.contact_frame([2.0, 0.0, 0.0]), dg.contact_frames([1.0, 0.0, 0.0])
+    )
