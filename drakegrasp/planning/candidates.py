@@ -31,12 +31,14 @@ from drakegrasp.core.validation import real_array, real_scalar
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.planning.needed import needed_text, per_joint
 from drakegrasp.plant.contacts import PlantContact
+from drakegrasp.plant.couplings import coupled_positions, recorded_couplings
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.validation import (
     check_rigid_transform,
     plant_context_of,
     resolve_body,
     resolve_object_body,
+    scoped_name,
 )
 
 __all__ = [
@@ -266,6 +268,13 @@ class GraspCandidate:
     def apply(self, plant, context, *, object_body=None) -> None:
         """Put the candidate's hand pose (and the planned object pose) in a context.
 
+        The closing joints take ``q_hand``, the held joints their values, and a
+        joint that the plant's couplings tie to them but that neither names
+        (a hidden drive that the fingers follow through their ``<mimic>``)
+        the value the couplings give it
+        (:func:`~drakegrasp.plant.couplings.coupled_positions`), so that the
+        pose holds Drake's coupler constraints.
+
         Parameters
         ----------
         plant : MultibodyPlant
@@ -296,8 +305,13 @@ class GraspCandidate:
         base = resolve_body(plant, self.hand_base)
         if base.is_floating_base_body():  # else welded (at X_WH, the caller's word)
             plant.SetFreeBodyPose(ctx, base, self.X_WH)
+        set_ = [*zip(joints, q_hand, strict=True), *held]  # one-dof joints
+        tied = coupled_positions(
+            recorded_couplings(plant), {scoped_name(plant, j): q for j, q in set_}
+        )
+        set_ += [(find_joint(plant, name), q) for name, q in tied.items()]
         q_all = plant.GetPositions(ctx)
-        for j, q in [*zip(joints, q_hand, strict=True), *held]:  # one-dof joints
+        for j, q in set_:
             q_all[j.position_start()] = q
         plant.SetPositions(ctx, q_all)
         if object_body is not None and object_body.is_floating_base_body():

@@ -98,7 +98,7 @@ from drakegrasp.planning.needed import (
 )
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
 from drakegrasp.plant.couplings import coupling_map, motor_shares, plant_couplings
-from drakegrasp.plant.fingers import effort_unit, find_joint
+from drakegrasp.plant.fingers import effort_unit, find_joint, is_hidden_drive
 from drakegrasp.plant.jacobians import contact_rows, hand_jacobian
 from drakegrasp.plant.validation import (
     plant_context_of,
@@ -642,20 +642,47 @@ def motor_limit(plant, candidate: GraspCandidate, *, per_finger: bool = False) -
     ``per_finger``: what each joint it drives gets of a motor that also
     drives ``<mimic>`` followers without actuators of their own, its limit
     over ``1 + Σ|ρ|`` (a parallel jaw whose one motor closes both fingers
-    presses each with half its effort limit).
+    presses each with half its effort limit); a motor on a hidden drive that
+    the fingers follow counts too, over ``Σ|ρ|``
+    (:func:`~drakegrasp.plant.couplings.motor_shares`).
     """
-    names = candidate.joint_names
-    shares = {}
-    if per_finger:
-        own = [n for n in names if _actuators(plant, find_joint(plant, n))]
-        _, shares = motor_shares(plant_couplings(plant), names, own)
     limits = [
-        float(a.effort_limit()) / shares.get(name, 1.0)
-        for name in names
-        for a in _actuators(plant, find_joint(plant, name))
+        float(a.effort_limit()) / share
+        for motors in _joint_motors(plant, candidate.joint_names, per_finger).values()
+        for a, share in motors
     ]
     finite = [v for v in limits if math.isfinite(v) and v > 0]
     return min(finite, default=math.inf)
+
+
+def _joint_motors(plant, names, per_finger: bool = True) -> dict:
+    """Per closing joint, the actuators that press it and the share each gives.
+
+    A joint's own actuators; with ``per_finger``, shares over the followers a
+    motor drives, and for a follower of a hidden drive (a leader that is not
+    a closing joint and touches nothing:
+    :func:`~drakegrasp.plant.fingers.is_hidden_drive`) the drive's actuators.
+    A leader with geometry that the candidate leaves out drives nothing of it.
+    """
+    own = {n: _actuators(plant, find_joint(plant, n)) for n in names}
+    if not per_finger:
+        return {n: [(a, 1.0) for a in own[n]] for n in names}
+    couplings = plant_couplings(plant)
+    hidden = {
+        leader: _actuators(plant, find_joint(plant, leader))
+        for _, leader, _, _ in couplings
+        if leader not in own and is_hidden_drive(plant, find_joint(plant, leader))
+    }
+    motors = {**own, **hidden}
+    driven, shares = motor_shares(couplings, names, [n for n in motors if motors[n]])
+    return {
+        n: [
+            (a, shares.get(m, 1.0))
+            for m in [driven[n] if driven.get(n) in hidden else n]
+            for a in motors[m]
+        ]
+        for n in names
+    }
 
 
 def _unit_of_joints(plant, joint_names) -> str:
@@ -752,16 +779,12 @@ def _no_limit(
     if not any(math.isfinite(getattr(c, needed)) for c in ranked):
         return ""  # nothing to rank by whatever the limit (no mass known)
     names = ranked[0].joint_names
+    motors = _joint_motors(plant, names, per_finger=needed == "squeeze_needed")
     unbounded = [
-        n
-        for n in names
-        if any(
-            math.isinf(a.effort_limit())
-            for a in _actuators(plant, find_joint(plant, n))
-        )
+        n for n in names if any(math.isinf(a.effort_limit()) for a, _ in motors[n])
     ]
     if not unbounded:
-        if any(_actuators(plant, find_joint(plant, n)) for n in names):
+        if any(motors.values()):
             return ""  # zero effort limits: nothing a motor could weigh
         listed = ", ".join(repr(n) for n in names)
         return (

@@ -78,7 +78,7 @@ from drakegrasp.planning.turned_gravity import (
     _TurnedGravity,
 )
 from drakegrasp.plant.couplings import motor_shares, plant_couplings
-from drakegrasp.plant.fingers import effort_unit, find_joint
+from drakegrasp.plant.fingers import effort_unit, find_joint, is_hidden_drive
 from drakegrasp.plant.friction import (
     MU_RELATIVE_TOL,
     FrictionMismatchWarning,
@@ -492,6 +492,42 @@ def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
     return float(k), float(d)
 
 
+def _squeezers(candidate, couplings, driven: dict, by_name: dict) -> dict:
+    """The actuated joints that squeeze, each with the sign that closes it.
+
+    A closing joint with an actuator squeezes; a ``<mimic>`` follower of
+    another closing joint moves with it; a follower of a hidden drive (a
+    leader that is no closing joint) is closed by the drive, moving the way
+    that closes the follower times the sign of ``ρ``.
+    """
+    rho = {follower: r for follower, _, r, _ in couplings}
+    out = {}
+    for name, sign in zip(candidate.joint_names, candidate.closing_signs, strict=True):
+        leader = driven.get(name)
+        if name not in by_name and leader in candidate.joint_names:
+            continue  # its coupler moves it with its leader
+        if name not in by_name and leader is not None:
+            drive_sign = sign * math.copysign(1.0, rho[name])
+            if out.setdefault(leader, drive_sign) != drive_sign:
+                raise ModelError(
+                    f"the drive {leader} cannot close the candidate's fingers: "
+                    "moving it closes one of the joints that follow it and "
+                    "opens another"
+                )
+            continue
+        if name not in by_name:
+            raise ModelError(
+                f"closing joint {name} has no actuator to squeeze with (give it "
+                "one, a URDF <transmission> or an SDFormat <drake:actuator>, or "
+                "couple it to an actuated joint with a <mimic> that drakegrasp "
+                "reads: drakegrasp.plant.add_models in add_models; Drake's "
+                "parser gives no actuator to a URDF joint whose effort limit "
+                "is 0)"
+            )
+        out[name] = sign
+    return out
+
+
 def _known_couplings(plant) -> tuple:
     """The plant's recorded couplings; none where some constraint is unknown.
 
@@ -773,22 +809,18 @@ def shake_test(
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
     by_name = {_scoped(plant, a.joint()): a for a in actuators}
     targets, gains, pushed = {}, {}, {}
-    # a follower is driven by a leader among the candidate's own actuated joints
+    # a follower is driven by its leader's motor: a closing joint's, or a
+    # hidden drive's (a leader that closes nothing itself)
     couplings = _known_couplings(plant)
-    driven, shares = motor_shares(couplings, candidate.joint_names, by_name)
-    for name, sign in zip(candidate.joint_names, candidate.closing_signs, strict=True):
-        actuator = by_name.get(name)
-        if actuator is None and name in driven:
-            continue  # a <mimic> follower: its coupler moves it with its leader
-        if actuator is None:
-            raise ModelError(
-                f"closing joint {name} has no actuator to squeeze with (give it "
-                "one, a URDF <transmission> or an SDFormat <drake:actuator>, or "
-                "couple it to an actuated joint with a <mimic> that drakegrasp "
-                "reads: drakegrasp.plant.add_models in add_models; Drake's "
-                "parser gives no actuator to a URDF joint whose effort limit "
-                "is 0)"
-            )
+    actuated = [
+        name
+        for name, actuator in by_name.items()
+        if name in candidate.joint_names or is_hidden_drive(plant, actuator.joint())
+    ]
+    driven, shares = motor_shares(couplings, candidate.joint_names, actuated)
+    squeezers = _squeezers(candidate, couplings, driven, by_name)
+    for name, sign in squeezers.items():
+        actuator = by_name[name]
         # a leader's motor also presses through the followers it drives: each
         # of them and the leader press with squeeze (within the effort limit)
         share = shares.get(name, 1.0)

@@ -65,6 +65,7 @@ __all__ = [
     "add_coupler_constraint",
     "add_models",
     "check_joint_limits",
+    "coupled_positions",
     "coupled_torque_limits",
     "coupling_map",
     "coupling_violations",
@@ -642,14 +643,17 @@ def coupling_map(
     return C, np.array(independent, dtype=int)
 
 
-def motor_shares(couplings, joints, actuated) -> tuple[set, dict]:
+def motor_shares(couplings, joints, actuated) -> tuple[dict, dict]:
     """Which followers a leader's motor drives, and what it presses them with.
 
     A ``<mimic>`` follower without an actuator of its own is driven by its
     leader's motor through the coupler: the motor's generalized force is
     ``τ_leader + Σ ρ τ_follower``, so for the leader and each follower to
     press with ``τ`` it applies ``τ (1 + Σ|ρ|)`` (a one-motor jaw: twice
-    the squeeze, each finger half the motor's effort limit).
+    the squeeze, each finger half the motor's effort limit).  A leader that
+    is not among ``joints`` (a hidden drive: a slide or linkage with no
+    geometry, which the fingers follow) presses nothing itself: it applies
+    ``τ Σ|ρ|``.
 
     Parameters
     ----------
@@ -658,23 +662,61 @@ def motor_shares(couplings, joints, actuated) -> tuple[set, dict]:
     joints : iterable of str
         The joints considered (a candidate's closing joints), scoped names.
     actuated : iterable of str
-        Those of them with an actuator.
+        The joints with an actuator: those of ``joints``, and any leader
+        outside them whose motor is to count.
 
     Returns
     -------
-    driven : set of str
-        The followers among ``joints`` without an actuator whose leader is
-        among ``joints`` with one.
+    driven : dict of str to str
+        Each follower among ``joints`` without an actuator whose leader has
+        one, and that leader.
     shares : dict of str to float
-        Per leader that drives any: ``1 + Σ|ρ|`` over its driven followers.
+        Per leader that drives any: ``1 + Σ|ρ|`` over its driven followers
+        (``Σ|ρ|`` for a leader outside ``joints``).
     """
     joints, actuated = set(joints), set(actuated)
-    driven, shares = set(), {}
+    driven, shares = {}, {}
     for follower, leader, rho, _ in couplings:
-        if follower in joints - actuated and leader in joints & actuated:
-            driven.add(follower)
-            shares[leader] = shares.get(leader, 1.0) + abs(rho)
+        if follower in joints - actuated and leader in actuated:
+            driven[follower] = leader
+            own = 1.0 if leader in joints else 0.0
+            shares[leader] = shares.get(leader, own) + abs(rho)
     return driven, shares
+
+
+def coupled_positions(couplings, known: dict) -> dict:
+    """Positions of the joints that couplings tie to ``known`` ones.
+
+    ``q_follower = ρ q_leader + Δq`` read both ways, along chains of
+    couplings: a leader outside ``known`` (a hidden drive the fingers
+    follow) gets ``(q_follower - Δq) / ρ``, a follower ``ρ q_leader + Δq``.
+    Setting them makes a pose that the coupler constraints hold.
+
+    Parameters
+    ----------
+    couplings : sequence of (follower, leader, gear_ratio, offset)
+        Scoped joint names (:func:`plant_couplings`).
+    known : dict of str to float
+        Joint positions (metres or radians) by scoped name.
+
+    Returns
+    -------
+    dict of str to float
+        The positions of the tied joints that are not in ``known`` (the
+        first value found where two couplings would give one).
+    """
+    found = dict(known)
+    changed = True
+    while changed:
+        changed = False
+        for follower, leader, rho, offset in couplings:
+            if leader in found and follower not in found:
+                found[follower] = rho * found[leader] + offset
+                changed = True
+            elif follower in found and leader not in found and rho != 0:
+                found[leader] = (found[follower] - offset) / rho
+                changed = True
+    return {name: float(q) for name, q in found.items() if name not in known}
 
 
 def coupled_torque_limits(C: np.ndarray, limits: np.ndarray) -> np.ndarray:

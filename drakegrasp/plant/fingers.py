@@ -55,6 +55,7 @@ __all__ = [
     "finger_chains",
     "free_part",
     "hand_structure",
+    "is_hidden_drive",
     "most_fingers",
     "passive_joints",
     "tip_bodies",
@@ -498,6 +499,23 @@ def _deepest(bodies: list, moved: list[set[int]]) -> list:
     return [b for b, d in zip(bodies, depth, strict=True) if d == top]
 
 
+def is_hidden_drive(plant: MultibodyPlant, joint: Joint) -> bool:
+    """True when ``joint`` moves one body that touches nothing.
+
+    A hidden drive: a slide or a linkage's link with no collision geometry,
+    from which no other joint hangs, that the fingers follow through their
+    ``<mimic>`` (its motor closes them).  Read from the model alone, so a
+    plant that is not finalized yet (a shake's) answers too.
+    """
+    child = joint.child_body()
+    if plant.GetCollisionGeometriesForBody(child):
+        return False
+    return not any(
+        plant.get_joint(JointIndex(k)).parent_body().index() == child.index()
+        for k in range(plant.num_joints())
+    )
+
+
 def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
     """The hand's fingers as kinematic chains: coupled fingers split apart.
 
@@ -505,7 +523,10 @@ def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
     (they close as one: a Robotiq-style gripper's two fingers on one motor); a
     grasp is still held by each chain's own contacts.  Each chain is a
     :class:`Finger` over its own joints (positions in ``structure.joints``),
-    bodies, pairs and tip; a finger of one chain is returned as it is.
+    bodies, pairs and tip; a finger of one chain is returned as it is.  A
+    chain with no collision geometry (a drive slide or a linkage's hidden
+    link, which the fingers follow through their ``<mimic>``) touches nothing
+    and is no finger: it is left out.
     """
     position = {int(j.index()): k for k, j in enumerate(structure.joints)}
     out = []
@@ -519,6 +540,12 @@ def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
             continue
         for group in groups:
             ids = set().union(*(moved[int(j.index())] for j in group))
+            if not any(
+                plant.GetCollisionGeometriesForBody(b)
+                for b in finger.bodies
+                if int(b.index()) in ids
+            ):
+                continue
             pairs = tuple(p for p in finger.pairs if int(p[2].index()) in ids)
             paired = list({int(b.index()): b for _, _, b in pairs}.values())
             tip = {

@@ -211,6 +211,7 @@ def coupled_jaw_urdf(
     offset: float = 0.0,
     follower: str = "right",
     stroke: float = 0.045,
+    hidden_drive: bool = False,
 ) -> str:
     """A parallel jaw whose two prismatic fingers one motor drives (``<mimic>``).
 
@@ -222,6 +223,11 @@ def coupled_jaw_urdf(
     the leader has a ``<transmission>``.  Each finger ends in a ``pad`` 48 mm
     past the palm: a ``"capsule"`` (7 mm radius, 25 mm long, across the axis),
     a ``"sphere"`` (7 mm) or a ``"box"`` (a 20 × 8 × 20 mm plate).
+
+    With ``hidden_drive`` the motor is on a third slide, ``drive``, whose link
+    has no geometry (10 g), and both fingers follow it: the leader finger
+    with ratio 1, the follower with ``ratio`` and ``offset``.  The jaw moves
+    as the one without it, whose leader finger is where the drive is.
     """
     shapes = {
         "capsule": ('rpy="0 1.5707963 0"', '<capsule radius="0.007" length="0.025"/>'),
@@ -251,12 +257,22 @@ def coupled_jaw_urdf(
         )
 
     lead, follow = ("left", "right") if follower == "right" else ("right", "left")
-    mimic = f'<mimic joint="{lead}_slide" multiplier="{ratio}" offset="{offset}"/>'
+    leader = "drive" if hidden_drive else f"{lead}_slide"
+    mimic = f'<mimic joint="{leader}" multiplier="{ratio}" offset="{offset}"/>'
+    mimics = {follow: mimic}
+    if hidden_drive:
+        mimics[lead] = '<mimic joint="drive" multiplier="1" offset="0"/>'
     limits = {"left": (0.0, stroke), "right": (-stroke, 0.0)}
     joints = "".join(
-        slide(f"{s}_slide", f"{s}_finger", *limits[s], mimic if s == follow else "")
+        slide(f"{s}_slide", f"{s}_finger", *limits[s], mimics.get(s, ""))
         for s in ("left", "right")
     )
+    if hidden_drive:
+        joints += (
+            '<link name="drive_link"><inertial><mass value="0.01"/><inertia '
+            'ixx="1e-6" iyy="1e-6" izz="1e-6" ixy="0" ixz="0" iyz="0"/>'
+            "</inertial></link>" + slide("drive", "drive_link", *limits[lead])
+        )
     return (
         '<?xml version="1.0"?><robot name="coupled_jaw">'
         '<link name="palm"><inertial><origin xyz="0 0 -0.02"/><mass value="0.6"/>'
@@ -265,7 +281,7 @@ def coupled_jaw_urdf(
         '0.14 0.04"/></geometry></collision></link>'
         f"{finger('left_finger', 1)}{finger('right_finger', -1)}{joints}"
         f'<transmission name="t"><type>transmission_interface/SimpleTransmission'
-        f'</type><joint name="{lead}_slide"><hardwareInterface>EffortJointInterface'
+        f'</type><joint name="{leader}"><hardwareInterface>EffortJointInterface'
         f'</hardwareInterface></joint><actuator name="m"><mechanicalReduction>1'
         "</mechanicalReduction></actuator></transmission></robot>"
     )

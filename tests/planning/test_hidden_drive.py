@@ -1,0 +1,177 @@
+"""A parallel jaw whose motor sits on a hidden drive that both fingers follow.
+
+Some grippers are modelled with the motor on a third slide (or a linkage's
+hidden link) that carries no geometry, both fingers following it through a
+``<mimic>``.  Such a jaw is the one-motor jaw whose leader finger stands where
+the drive is (``coupled_jaw_urdf(hidden_drive=True)`` against its twin without
+the drive), so everything the planner says of one it must say of the other:
+the fingers, the coupling, the candidates, the squeeze the motor gives each
+finger (its effort limit over ``Σ|ρ|`` = 2), the pose a candidate puts in a
+context, and what Drake's simulation of a shake finds.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from coupled_hands import coupled_jaw_urdf
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import drakegrasp as dg
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.gripper import parallel_jaw
+from drakegrasp.plant.couplings import coupled_positions, motor_shares
+
+BOX = "package://drakegrasp/objects/box.sdf"
+QUICK = dict(settle=0.2, phase=0.3)
+
+
+def _scene(tmp_path, name, **jaw):
+    path = tmp_path / f"{name}.urdf"
+    path.write_text(coupled_jaw_urdf(**jaw))
+    return planning_scene(BOX, hand_url=str(path))
+
+
+@pytest.fixture(scope="module")
+def twins(tmp_path_factory):
+    """The hidden-drive jaw and its twin, each planned on the box (same seed)."""
+    tmp = tmp_path_factory.mktemp("hidden_drive")
+    out = {}
+    for name, hidden in (("twin", False), ("hidden", True)):
+        scene = _scene(tmp, name, ratio=-1.0, offset=-0.002, hidden_drive=hidden)
+        ctx = scene.plant.GetMyContextFromRoot(scene.context)
+        result = plan_grasps(
+            scene.plant, ctx, scene.object_body, hand=scene.hand,
+            num_candidates=200, mu=0.5, seed=4, object_mass=0.3,
+        )  # fmt: skip
+        out[name] = (scene, ctx, result)
+    return out
+
+
+def test_the_drive_is_no_finger(twins):
+    jaws = {}
+    for name, (scene, ctx, _) in twins.items():
+        jaws[name] = parallel_jaw(scene.plant, ctx, scene.object_body, scene.hand)
+    hidden, twin = jaws["hidden"], jaws["twin"]
+    assert [j.name() for j in hidden.joints] == [j.name() for j in twin.joints]
+    np.testing.assert_allclose(hidden.coupling, twin.coupling, atol=1e-15)
+    assert hidden.min_opening == twin.min_opening
+    assert hidden.max_opening == twin.max_opening
+
+
+def test_the_plans_are_the_same(twins):
+    hidden, twin = twins["hidden"][2], twins["twin"][2]
+    assert len(hidden.candidates) == len(twin.candidates) > 10
+    for a, b in zip(hidden.candidates, twin.candidates, strict=True):
+        assert a.sample == b.sample
+        np.testing.assert_array_equal(a.q_hand, b.q_hand)
+        assert a.score == b.score
+        assert a.squeeze_needed == b.squeeze_needed
+        assert a.held_joints == b.held_joints  # the drive is tied, not held
+
+
+def test_the_drives_motor_squeezes_each_finger_with_half_its_limit(twins):
+    hidden, twin = twins["hidden"][2], twins["twin"][2]
+    assert not hidden.reason, hidden.reason  # was: "the model gives ... no actuator"
+    assert hidden.settings["held_first"] == twin.settings["held_first"]
+    assert hidden.settings["held_first"]["limit"] == pytest.approx(40.0 / 2)
+
+
+def test_a_candidate_puts_the_drive_where_the_couplings_do(twins):
+    scene, ctx, result = twins["hidden"]
+    plant = scene.plant
+    best = result.candidates[0]
+    best.apply(plant, ctx, object_body=scene.object_body)
+    lead = plant.GetJointByName("left_slide").get_translation(ctx)
+    follow = plant.GetJointByName("right_slide").get_translation(ctx)
+    drive = plant.GetJointByName("drive").get_translation(ctx)
+    assert drive == lead  # the leader finger follows the drive with ratio 1
+    assert follow == pytest.approx(-1.0 * drive - 0.002, abs=1e-15)
+    # the pose holds the coupler constraints: the analysis takes it as it is
+    report = dg.analyze_grasp(plant, ctx, scene.object_body, hand=scene.hand, mu=0.5)
+    twin_scene, twin_ctx, twin_result = twins["twin"]
+    twin_result.candidates[0].apply(
+        twin_scene.plant, twin_ctx, object_body=twin_scene.object_body
+    )
+    twin_report = dg.analyze_grasp(
+        twin_scene.plant, twin_ctx, twin_scene.object_body, hand=twin_scene.hand,
+        mu=0.5,
+    )  # fmt: skip
+    assert report.force_closure.is_closure == twin_report.force_closure.is_closure
+    assert report.force_closure.d_star == pytest.approx(
+        twin_report.force_closure.d_star, rel=1e-9
+    )
+
+
+@pytest.mark.filterwarnings(
+    "ignore::drakegrasp.plant.friction.FrictionMismatchWarning"  # plan 0.5, Drake 1
+)
+def test_a_shake_squeezes_through_the_drive(twins):
+    """Drake's simulation: the drive's motor holds what the twin's motor holds.
+
+    At the motor's limit (20 N per finger) the first candidate the twin holds
+    is held by the hidden drive too, moved as far within 25 %; at 1 N per
+    finger both drop it (the drive does squeeze: without it nothing would
+    tell the two apart).
+    """
+    (hidden_scene, _, hidden), (twin_scene, _, twin) = twins["hidden"], twins["twin"]
+    for k in range(4):
+        held = shake_test(
+            twin_scene.add_models, twin.candidates[k], squeeze=20.0, **QUICK
+        )
+        if held.held:
+            break
+    else:
+        pytest.fail("the twin holds none of its first 4 candidates")
+    same = shake_test(
+        hidden_scene.add_models, hidden.candidates[k], squeeze=20.0, **QUICK
+    )
+    assert same.held
+    assert same.efforts == pytest.approx(held.efforts, rel=1e-3)  # 40 N: 2 x 20
+    assert same.max_displacement == pytest.approx(held.max_displacement, rel=0.25)
+    for scene, result in ((twin_scene, twin), (hidden_scene, hidden)):
+        weak = shake_test(scene.add_models, result.candidates[k], squeeze=1.0, **QUICK)
+        assert not weak.held
+
+
+def test_a_drive_that_opens_one_finger_as_it_closes_the_other_is_refused(tmp_path):
+    # both fingers follow the drive with ratio +1: the pads move the same way
+    scene = _scene(tmp_path, "same_way", ratio=1.0, hidden_drive=True)
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    with pytest.raises(dg.ModelError, match="the same way"):
+        parallel_jaw(scene.plant, ctx, scene.object_body, scene.hand)
+
+
+def test_motor_shares_of_a_hidden_leader():
+    couplings = [("a", "d", 1.0, 0.0), ("b", "d", -0.5, 0.01), ("c", "a", 2.0, 0.0)]
+    driven, shares = motor_shares(couplings, ["a", "b"], ["d"])
+    assert driven == {"a": "d", "b": "d"}
+    assert shares == {"d": 1.5}  # Σ|ρ|: the drive presses nothing itself
+    driven, shares = motor_shares(couplings, ["a", "c"], ["a"])
+    assert driven == {"c": "a"}
+    assert shares == {"a": 3.0}  # 1 + |ρ|: the leader presses too
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    q=st.floats(-1.0, 1.0),
+    rho=st.lists(
+        st.floats(0.1, 3.0).flatmap(lambda r: st.sampled_from([r, -r])),
+        min_size=3,
+        max_size=3,
+    ),
+    offsets=st.lists(st.floats(-0.1, 0.1), min_size=3, max_size=3),
+)
+def test_coupled_positions_hold_every_coupling(q, rho, offsets):
+    # a chain d <- a <- c and a second follower b of d; only a is known
+    couplings = [
+        ("a", "d", rho[0], offsets[0]),
+        ("b", "d", rho[1], offsets[1]),
+        ("c", "a", rho[2], offsets[2]),
+    ]
+    found = coupled_positions(couplings, {"a": q})
+    assert set(found) == {"b", "c", "d"}
+    values = {"a": q, **found}
+    for follower, leader, r, off in couplings:
+        assert values[follower] == pytest.approx(r * values[leader] + off, abs=1e-12)
