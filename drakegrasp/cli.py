@@ -130,6 +130,7 @@ from pathlib import Path
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import (
     GraspError,
     InvalidOptionError,
@@ -171,7 +172,7 @@ def _analyze(args: argparse.Namespace) -> int:
 
     scene = load_scene(
         args.scene,
-        package_map=dict(args.package) or None,
+        package_map=_package_map(args.package),
         allow_any_file=args.allow_any_file,
         close=args.close,
         torsional_friction=args.torsional_friction,
@@ -573,6 +574,21 @@ def _package(text: str) -> tuple[str, str]:
             f"expected NAME=DIR (a package name, '=', its directory), got {text!r}"
         )
     return name, folder
+
+
+def _package_map(packages: list[tuple[str, str]]) -> dict[str, str] | None:
+    """``--package`` flags as a map; one name given two directories is refused.
+
+    (The last one won, silently: a scene then read another package's files.)
+    """
+    found: dict[str, str] = {}
+    for name, folder in packages:
+        if found.setdefault(name, folder) != folder:
+            raise InvalidOptionError(
+                f"--package {name} is given twice, as {found[name]!r} and "
+                f"{folder!r}: give each package one directory"
+            )
+    return found or None
 
 
 def _add_scene_file_options(
@@ -1156,7 +1172,7 @@ def _plan_setup(args: argparse.Namespace):
         # places it for analyze, is left out
         scene = load_scene(
             args.object,
-            package_map=dict(args.package) or None,
+            package_map=_package_map(args.package),
             allow_any_file=args.allow_any_file,
             close=False,
             free_hand=True,
@@ -1180,7 +1196,7 @@ def _plan_setup(args: argparse.Namespace):
         scene = planning_scene(
             _plan_url(args.object),
             hand_url=_plan_hand(args.hand),
-            package_map=dict(args.package) or None,
+            package_map=_package_map(args.package),
         )
         plant, context, body, hand = (
             scene.plant, scene.context, scene.object_body, scene.hand
@@ -1332,6 +1348,17 @@ def _check_progress() -> None:
         ) from None
 
 
+def _check_pyarrow() -> None:
+    """``--out FILE.parquet`` needs pyarrow: refuse it up front, before planning."""
+    try:
+        import pyarrow.parquet  # noqa: F401
+    except ImportError:
+        raise InvalidOptionError(
+            "--out FILE.parquet needs the optional package pyarrow, which is not "
+            'installed: pip install "drakegrasp[parquet]", or leave out --out'
+        ) from None
+
+
 def _cmd_plan(args: argparse.Namespace) -> int:
     from drakegrasp.planning import plan_grasps
 
@@ -1342,6 +1369,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
             raise InvalidOptionError(
                 f"--out must name a .parquet file, got {args.out!r}"
             )
+        _check_pyarrow()  # (it was found missing after the whole plan)
         # before planning: refuse an existing file unless --overwrite, as batch
         check_output(
             Path(args.out), (), overwrite=args.overwrite, remedy="pass --overwrite"
@@ -1596,13 +1624,10 @@ def _write_plan_parquet(result, path: str, *, overwrite: bool) -> None:
     """
     from drakegrasp.batch.files.writer import placed
 
-    try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-    except ImportError as exc:
-        raise InvalidOptionError(
-            "--out FILE.parquet needs pyarrow (pip install pyarrow)"
-        ) from exc
+    _check_pyarrow()
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
     columns = {}
     for name, values in result.table().items():
         if values.dtype == object:  # str (torque_unit): a string column, rows or not
@@ -1834,7 +1859,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     except GraspError as e:
         return _error(_cli_words(str(e), getattr(args, "command", None)))
-    except (OSError, ValueError, RuntimeError, MemoryError) as e:
+    except OSError as e:  # a file error not already wrapped: its name cut short
+        if e.strerror and e.filename is not None:
+            return _error(f"{e.strerror}: {describe(os.fsdecode(e.filename))}")
+        return _error(f"{type(e).__name__}: {e}" if not str(e) else str(e))
+    except (ValueError, RuntimeError, MemoryError) as e:
         # File or Drake errors that were not already wrapped.
         return _error(f"{type(e).__name__}: {e}" if not str(e) else str(e))
     except SystemExit as e:

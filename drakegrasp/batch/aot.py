@@ -35,6 +35,7 @@ import importlib.util
 import json
 import os
 import threading
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -200,7 +201,11 @@ def _load() -> tuple[object | None, str]:
     """The extension module if usable, and a sentence saying which route runs."""
     choice = os.environ.get(ENV, "auto").strip().lower() or "auto"
     if choice not in ("auto", "jit"):
-        return None, f"{ENV}={choice!r} is not 'auto' or 'jit'; numba's JIT runs"
+        status = f"{ENV}={choice!r} is not 'auto' or 'jit'; numba's JIT runs"
+        # said once per process: a misspelt value would otherwise cost the
+        # compile (tens of seconds) without a word
+        warnings.warn(status, RuntimeWarning, stacklevel=4)
+        return None, status
     if choice == "jit":
         return None, f"{ENV}=jit: numba's JIT runs"
     try:

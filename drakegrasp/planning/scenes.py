@@ -26,6 +26,7 @@ from drakegrasp.plant.models import (
     register_models,
     use_local_drake_models,
 )
+from drakegrasp.plant.scene_refs import add_named_package
 from drakegrasp.plant.validation import check_rigid_transform
 
 __all__ = ["WSG_URL", "PlanningScene", "planning_scene", "scene_from_models"]
@@ -118,13 +119,8 @@ def planning_scene(
     def add_models(plant, parser):
         use_local_drake_models(parser, models_dir)
         register_models(parser)
-        for name, folder in packages:
-            try:
-                parser.package_map().Add(name, folder)
-            except RuntimeError as exc:  # a name known at another folder
-                raise InvalidOptionError(
-                    f"package {name!r} at {folder!r}: {_one_line(exc)}"
-                ) from None
+        for name, folder in packages:  # drake_models too: the user's folder wins
+            add_named_package(parser.package_map(), name, folder)
         try:
             hand = _add(parser, hand_url)
             obj = None if object_url is None else _add(parser, object_url)
@@ -156,10 +152,6 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
             raise InvalidOptionError(f"package {name!r}: {folder!r} is not a folder")
         pairs.append((name, str(Path(folder).resolve())))
     return pairs
-
-
-def _one_line(exc: Exception) -> str:
-    return " ".join(str(exc).split())
 
 
 def scene_from_models(add_models) -> PlanningScene:

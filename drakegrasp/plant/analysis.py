@@ -67,6 +67,7 @@ from drakegrasp.plant.pose import PoseCheck
 from drakegrasp.plant.pose import check_pose as _check_pose
 from drakegrasp.plant.validation import (
     checked_context,
+    checked_query_object,
     hand_contact_bodies,
     hand_model_instances,
 )
@@ -325,6 +326,8 @@ def grasp_from_plant(
         check_pose = opts.check_pose
         torsional_friction = opts.torsional_friction or 0.0
         body = resolve_object_body(plant, object_body)
+        if query_object is not None:
+            checked_query_object(plant, query_object)
         if contacts is not None:  # only mu="plant" reads their geometries
             contacts = check_plant_contacts(
                 plant, contacts, body, reads_geometry=opts.mu == "plant"

@@ -24,7 +24,7 @@ Pairs between the object and bodies outside the hand (a table) are ignored.
 from __future__ import annotations
 
 import numpy as np
-from pydrake.geometry import ContactSurface, GeometryId, QueryObject, SceneGraph
+from pydrake.geometry import ContactSurface, GeometryId, QueryObject
 from pydrake.multibody.plant import ContactResults, MultibodyPlant
 from pydrake.systems.framework import Context
 
@@ -33,7 +33,6 @@ from drakegrasp.errors import (
     InvalidContactError,
     InvalidOptionError,
     InvalidPoseError,
-    ModelError,
     NoContactsError,
 )
 from drakegrasp.plant._shapes import plane_basis
@@ -44,7 +43,7 @@ from drakegrasp.plant.contacts import (
     _scoped_name,
     resolve_object_body,
 )
-from drakegrasp.plant.validation import hand_contact_bodies
+from drakegrasp.plant.validation import checked_query_object, hand_contact_bodies
 
 __all__ = ["contacts_from_results", "patch_polygon"]
 
@@ -126,33 +125,6 @@ def _surface_points_and_normal(
     return vertices, np.asarray(normal, dtype=float)
 
 
-def _checked_inspector(plant: MultibodyPlant, query_object: QueryObject):
-    """The query object's inspector, once it is known to serve ``plant``."""
-    source = plant.get_source_id()
-    if source is None:
-        raise ModelError("the plant is not registered with a SceneGraph; no geometry")
-    try:  # a default-constructed QueryObject answers no query
-        query_object.GetPoseInWorld(SceneGraph.world_frame_id())
-    except RuntimeError as e:
-        text = " ".join(str(e).split())
-        if "invalid QueryObject" in text:
-            raise InvalidOptionError(
-                f"query_object holds no scene graph's query ({text}); pass the "
-                "value of scene_graph.get_query_output_port()"
-            ) from None
-        raise InvalidPoseError(  # its poses: a bad state of the plant it reads
-            f"Drake cannot compute the geometry poses of query_object: {text}"
-        ) from None
-    inspector = query_object.inspector()
-    if not inspector.SourceIsRegistered(source):
-        raise InvalidOptionError(
-            "query_object comes from a scene graph that the plant "
-            f"{plant.get_name()!r} is not registered with; pass the query of the "
-            "plant's own scene graph"
-        )
-    return inspector
-
-
 def contacts_from_results(
     plant: MultibodyPlant,
     plant_context: Context,
@@ -220,7 +192,7 @@ def contacts_from_results(
             f"body's quaternion of zeros?): {' '.join(str(e).split())}"
         ) from None
     R_OW = X_OW.rotation().matrix()
-    inspector = _checked_inspector(plant, query_object)
+    inspector = checked_query_object(plant, query_object)
 
     def body_of(gid: GeometryId):
         return plant.GetBodyFromFrameId(inspector.GetFrameId(gid))

@@ -82,6 +82,7 @@ from drakegrasp.plant.mesh_convexity import warn_if_not_convex
 from drakegrasp.plant.validation import (
     HandSpec,
     _per_plant,
+    checked_query_object,
     hand_bodies,
     hand_contact_bodies,
     plant_context_of,
@@ -463,14 +464,9 @@ def find_contacts(
         raise ModelError("the plant is not registered with a SceneGraph; no geometry")
     if query_object is None:
         query = query_object_of(plant, plant_context)
-    elif isinstance(query_object, QueryObject):
-        query = query_object
+        inspector = query.inspector()
     else:
-        raise InvalidOptionError(
-            "query_object must be a pydrake.geometry.QueryObject or None, got "
-            f"{type(query_object).__name__}"
-        )
-    inspector = query.inspector()
+        query, inspector = query_object, checked_query_object(plant, query_object)
     object_geometries = plant.GetCollisionGeometriesForBody(body)
     object_name = _scoped_name(plant, body)
     if not object_geometries:

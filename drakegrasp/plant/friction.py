@@ -33,6 +33,7 @@ from pydrake.multibody.plant import (
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.handles import local_geometry_id
 from drakegrasp.plant.validation import (
+    checked_query_object,
     hand_contact_bodies,
     plant_context_of,
     query_object_of,
@@ -170,6 +171,8 @@ def plant_friction(
     if query_object is None:
         ctx = plant_context_of(plant, plant_context)
         query_object = query_object_of(plant, ctx)
+    else:
+        checked_query_object(plant, query_object)
     return np.array(
         [pair_friction(plant, query_object, go, gf, rule=rule) for go, gf in pairs],
         dtype=float,

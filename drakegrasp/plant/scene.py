@@ -160,7 +160,7 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.files import MISSING, not_a_file
-from drakegrasp.core.validation import check_coefficient, check_flag
+from drakegrasp.core.validation import check_coefficient, check_flag, describe
 from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
 from drakegrasp.plant.couplings import (
     check_joint_limits,
@@ -391,14 +391,17 @@ def scene_path(path_or_name: str | Path) -> Path:
     if not why:
         return candidate
     name = str(path_or_name)
-    shipped = scenes_dir() / f"{name.removesuffix('.yaml')}.yaml"
-    if "/" not in name and shipped.is_file():
-        return shipped
     names = ", ".join(p.stem for p in sorted(scenes_dir().glob("*.yaml")))
+    if not name.strip():
+        raise ModelError(f"the scene's name is empty (shipped scenes: {names})")
+    shipped = scenes_dir() / f"{name.removesuffix('.yaml')}.yaml"
+    if "/" not in name and not not_a_file(shipped):  # (a name too long: no file)
+        return shipped
+    shown = describe(name)  # a name of thousands of characters, cut
     if why != MISSING:
-        raise ModelError(f"scene {name!r} {why} (shipped scenes: {names})")
+        raise ModelError(f"scene {shown} {why} (shipped scenes: {names})")
     raise ModelError(
-        f"scene {name!r} not found: no such file and no shipped scene of that "
+        f"scene {shown} not found: no such file and no shipped scene of that "
         f"name (shipped scenes: {names})"
     )
 

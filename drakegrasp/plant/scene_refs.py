@@ -59,6 +59,7 @@ from drakegrasp.plant.scene_file import check_poses
 __all__ = [
     "MAX_INCLUDED_FILES",
     "PackagesSpec",
+    "add_named_package",
     "add_packages",
     "anchor_relative_files",
     "check_references",
@@ -113,7 +114,7 @@ def add_packages(
             raise SceneError(f"cannot merge the given PackageMap: {e}") from None
     elif isinstance(packages, Mapping):
         for name, folder in packages.items():
-            _add_named(package_map, name, folder)
+            add_named_package(package_map, name, folder)
     elif packages is not None:
         if isinstance(packages, str | os.PathLike):
             packages = [packages]
@@ -129,7 +130,19 @@ def add_packages(
     return package_map
 
 
-def _add_named(package_map: PackageMap, name, folder) -> None:
+def add_named_package(package_map: PackageMap, name, folder) -> None:
+    """Add package ``name`` at ``folder``; it replaces one of that name.
+
+    A name Drake or drakegrasp registers (``drake_models``, a download) is
+    replaced by the user's folder, but ``drake`` and ``drakegrasp`` are
+    built in and refused.
+
+    Raises
+    ------
+    SceneError
+        A name that is not a word, a folder that is not a directory, or a
+        built-in package.
+    """
     if not isinstance(name, str) or not name or "/" in name:
         raise SceneError(
             f"package name must be a non-empty string without '/', got {name!r}"
@@ -285,8 +298,8 @@ def _check_url(
             raise SceneError(
                 f"{url!r} leaves the package {name!r} (its path {rel!r} climbs "
                 "out with '..' or is empty); a scene may only reference files "
-                "inside its packages and its own directory (allow_any_file=True "
-                "trusts the scene)"
+                "inside its packages and its own directory (allow_any_file=True, "
+                "or --allow-any-file, trusts the scene)"
             )
         return "package", None
     if not url.startswith("file://"):
@@ -312,7 +325,8 @@ def _check_url(
         raise SceneError(
             f"{url!r} is {path!r} to Drake, outside the scene's directory "
             f"{str(scene_dir)!r}; a scene may only reference files inside its "
-            "packages and its own directory (allow_any_file=True trusts the scene)"
+            "packages and its own directory (allow_any_file=True, or "
+            "--allow-any-file, trusts the scene)"
         )
     return "file", path
 

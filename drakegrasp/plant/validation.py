@@ -44,6 +44,7 @@ __all__ = [
     "check_bodies",
     "check_plant",
     "checked_context",
+    "checked_query_object",
     "check_rigid_transform",
     "check_velocity_indices",
     "hand_bodies",
@@ -259,6 +260,63 @@ def checked_context(plant: MultibodyPlant, context: Context) -> Iterator[Context
         yield plant_context
     finally:
         _CHECKED.reset(token)
+
+
+def checked_query_object(plant: MultibodyPlant, query_object):
+    """``query_object``'s inspector, once it is known to serve ``plant``.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Registered with a ``SceneGraph``.
+    query_object : pydrake.geometry.QueryObject
+        A value of that scene graph's query output port.
+
+    Returns
+    -------
+    pydrake.geometry.SceneGraphInspector
+
+    Raises
+    ------
+    InvalidOptionError
+        Not a ``QueryObject``, one that holds no scene graph's query
+        (default-constructed), or one of a scene graph the plant is not
+        registered with (another diagram's).
+    InvalidPoseError
+        Drake cannot compute its geometries' poses (a bad state of the plant).
+    ModelError
+        The plant has no scene graph.
+    """
+    from pydrake.geometry import QueryObject, SceneGraph
+
+    if not isinstance(query_object, QueryObject):
+        raise InvalidOptionError(
+            "query_object must be a pydrake.geometry.QueryObject or None, got "
+            f"{type(query_object).__name__}"
+        )
+    source = plant.get_source_id()
+    if source is None:
+        raise ModelError("the plant is not registered with a SceneGraph; no geometry")
+    try:  # a default-constructed QueryObject answers no query
+        query_object.GetPoseInWorld(SceneGraph.world_frame_id())
+    except RuntimeError as e:
+        text = " ".join(str(e).split())
+        if "invalid QueryObject" in text:
+            raise InvalidOptionError(
+                f"query_object holds no scene graph's query ({text}); pass the "
+                "value of scene_graph.get_query_output_port()"
+            ) from None
+        raise InvalidPoseError(  # its poses: a bad state of the plant it reads
+            f"Drake cannot compute the geometry poses of query_object: {text}"
+        ) from None
+    inspector = query_object.inspector()
+    if not inspector.SourceIsRegistered(source):
+        raise InvalidOptionError(
+            "query_object comes from a scene graph that the plant "
+            f"{plant.get_name()!r} is not registered with; pass the query of the "
+            "plant's own scene graph"
+        )
+    return inspector
 
 
 def query_object_of(plant: MultibodyPlant, plant_context: Context):

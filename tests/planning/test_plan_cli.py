@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import pytest
 
@@ -270,3 +271,53 @@ def test_an_empty_plan_with_scene_out_writes_no_file(tmp_path, capsys, argv):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no candidate to write" in err[0]
     assert not out.exists() and not scene.exists()
+
+
+def test_plan_reads_drake_models_from_package_offline(
+    drake_models_dir, monkeypatch, capsys
+):
+    # The offline hint says "--package drake_models=DIR"; plan refused it
+    # ("PackageMap::Add() cannot add 'drake_models' because the existing path
+    # is remote") while analyze took it.  Now the user's folder wins.
+    # (DRAKE_ALLOW_NETWORK=none would stop Drake's Parser itself: its default
+    # package map registers drake_models as a download when it is made)
+    monkeypatch.delenv("DRAKEGRASP_DRAKE_MODELS", raising=False)
+    args = ["plan", "--hand", "wsg", "--num", "30", "--json"]
+    package = f"drake_models={drake_models_dir}"
+    assert main([*args, "--package", package]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["candidates"]
+
+
+def test_a_package_given_two_folders_is_refused(tmp_path, capsys):
+    # the last one won, silently: a scene read the other folder's files
+    one, two = tmp_path / "one", tmp_path / "two"
+    one.mkdir()
+    two.mkdir()
+    for command in (["analyze", "three_finger_sphere"], ["plan", "box"]):
+        code = main([*command, "--package", f"p={one}", "--package", f"p={two}"])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert code == 1 and len(err) == 1, err
+        assert "--package p is given twice" in err[0]
+    # the same folder twice is one package
+    assert main(["analyze", "three_finger_sphere", "--package", f"p={one}",
+                 "--package", f"p={one}"]) == 0  # fmt: skip
+
+
+def test_out_parquet_without_pyarrow_is_refused_before_planning(
+    tmp_path, monkeypatch, capsys
+):
+    # it planned everything (7.9 s for --num 3000) and then refused
+    import drakegrasp.cli as cli
+
+    monkeypatch.setitem(sys.modules, "pyarrow", None)
+    monkeypatch.setitem(sys.modules, "pyarrow.parquet", None)
+
+    def planned(*_):
+        raise AssertionError("planned before refusing --out")
+
+    monkeypatch.setattr(cli, "_plan_setup", planned)
+    assert main(["plan", "box", "--out", str(tmp_path / "c.parquet")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "drakegrasp[parquet]" in err[0], err
+    assert not (tmp_path / "c.parquet").exists()

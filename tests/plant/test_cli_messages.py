@@ -197,3 +197,20 @@ def test_a_misspelt_model_file_does_not_blame_the_folder(
     url = "package://drake_models/wsg_50_description/sdf/nonexistent.sdf"
     err = _one_line(capsys, "plan", "box", "--hand", url, "--num", "1")
     assert "nonexistent.sdf" in err and "DRAKEGRASP_DRAKE_MODELS is set" not in err
+
+
+def test_an_empty_or_endless_name_gets_a_short_line(tmp_path, capsys):
+    # "" read as "a directory, not a scene file"; a 5,000-character name gave
+    # "[Errno 36] File name too long: '…'" with the whole name in it
+    assert main(["analyze", ""]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "the scene's name is empty" in err[0], err
+    endless = "a" * 5000
+    assert main(["analyze", endless]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and len(err[0]) < 400 and "..." in err[0], err
+    src = tmp_path / "in.npz"
+    np.savez(src, positions=np.zeros((2, 2, 3)), normals=np.ones((2, 2, 3)), mu=0.5)
+    assert main(["batch", str(src), str(tmp_path / f"{endless}.npz")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and len(err[0]) < 400 and "too long" in err[0], err

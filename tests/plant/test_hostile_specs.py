@@ -105,3 +105,36 @@ def test_a_positive_multiple_of_a_direction_closes_alike(scale):
     np.testing.assert_array_equal(got.q, want.q)
     assert [f.status for f in got.fingers] == [f.status for f in want.fingers]
     assert "touching" in [f.status for f in got.fingers]
+
+
+def test_a_query_object_of_another_scene_graph_is_refused():
+    # analyze_grasp, grasp_from_plant, find_contacts and plant_friction let
+    # pydrake's RuntimeError ("Can't report collision filter status ...") or
+    # an AttributeError (an int) through; now the check contacts_from_results
+    # made, for every entry point that takes a query_object.
+    from drakegrasp.plant.friction import plant_friction
+
+    scene, other = (
+        dg.load_scene("three_finger_sphere"),
+        dg.load_scene("three_finger_sphere"),
+    )
+    plant, ctx, body = scene.plant, scene.plant_context, scene.object_body
+    foreign = other.plant.get_geometry_query_input_port().Eval(other.plant_context)
+    contacts = dg.find_contacts(plant, ctx, object_body=body)
+    calls = [
+        lambda q: dg.analyze_grasp(plant, ctx, body, mu=0.5, query_object=q),
+        lambda q: dg.grasp_from_plant(plant, ctx, body, mu=0.5, query_object=q),
+        lambda q: dg.find_contacts(plant, ctx, object_body=body, query_object=q),
+        lambda q: plant_friction(plant, ctx, contacts, query_object=q),
+    ]
+    for call in calls:
+        with pytest.raises(dg.InvalidOptionError, match="not registered with"):
+            call(foreign)
+        with pytest.raises(dg.InvalidOptionError, match="QueryObject or None, got int"):
+            call(5)
+    own = plant.get_geometry_query_input_port().Eval(ctx)
+    report = dg.analyze_grasp(plant, ctx, body, mu=0.5, query_object=own)
+    assert (
+        report.force_closure.is_closure
+        == dg.analyze_grasp(plant, ctx, body, mu=0.5).force_closure.is_closure
+    )
