@@ -287,12 +287,10 @@ def parallel_jaw(
         A hand without a free base, without two prismatic fingers with parallel
         axes and finite limits, or whose pads cannot be told from its palm.
     """
-    base, fingers, joints, coupling = _two_prismatic_fingers(
+    base, fingers, joints, coupling, (lower, upper) = _two_prismatic_fingers(
         plant, plant_context, object_body, hand
     )
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
-    lower = np.array([j.position_lower_limits()[0] for j in joints])
-    upper = np.array([j.position_upper_limits()[0] for j in joints])
     ctx = plant.CreateDefaultContext()
 
     def finger_origins(q):  # finger body origins in H at joint values q
@@ -354,10 +352,12 @@ def parallel_jaw(
 
 
 def _two_prismatic_fingers(plant, plant_context, object_body, hand):
-    """(free base, the two fingers, their prismatic joints, coupling), or a ModelError.
+    """(free base, fingers, their prismatic joints, coupling, limits), or a ModelError.
 
     The coupling is ``(m, b)``, ``q_1 = m q_0 + b``, when one joint follows
-    the other (or both follow one leader), else None.
+    the other (or both follow one leader), else None.  The limits are
+    ``(lower, upper)``, (2,) each: the joints' own, within what a hidden
+    drive they follow allows (:func:`_within_drive`).
     """
     bodies = hand_bodies(plant, object_body, hand)
     base = free_base(plant, bodies, hand=hand)
@@ -374,8 +374,11 @@ def _two_prismatic_fingers(plant, plant_context, object_body, hand):
             f"({[f.name for f in fingers]})"
         )
     joints = tuple(structure.joints[f.joints[0]] for f in fingers)
-    for j in joints:
-        lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
+    follows = structure.coupling.follows
+    own_order = [f.joints[0] for f in fingers]
+    own = set(own_order)
+    limits = [_within_drive(structure.joints, follows, i, own) for i in own_order]
+    for j, (lo, hi) in zip(joints, limits, strict=True):
         if j.type_name() != "prismatic" or not (np.isfinite(lo) and np.isfinite(hi)):
             raise ModelError(
                 f"finger joint {j.name()} must be prismatic with finite limits to "
@@ -384,12 +387,37 @@ def _two_prismatic_fingers(plant, plant_context, object_body, hand):
         if not hi > lo:
             raise ModelError(
                 f"finger joint {j.name()} has no stroke: its limits [{lo}, {hi}] "
-                "leave the finger no room to close"
+                "(within those of the drive it follows, if any) leave the finger "
+                "no room to close"
             )
-    coupling = _jaw_coupling(
-        structure.coupling.follows, *(f.joints[0] for f in fingers)
+    coupling = _jaw_coupling(follows, *(f.joints[0] for f in fingers))
+    lower, upper = (np.array(v, dtype=float) for v in zip(*limits, strict=True))
+    return base, fingers, joints, coupling, (lower, upper)
+
+
+def _within_drive(joints, follows, i: int, fingers: set) -> tuple[float, float]:
+    """Joint ``i``'s limits, within those its chain's root allows through it.
+
+    ``q_i = a q_root + c`` along its chain of leaders (``follows``: index ->
+    ``(leader, ρ, Δq)``); a root that is no finger joint (a hidden drive)
+    reaches only ``a [lo, hi] + c`` of the finger, so a pose outside it
+    breaks the drive's limits (the planner read the finger's alone).
+    """
+    j = joints[i]
+    lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
+    k, a, c, seen = i, 1.0, 0.0, set()
+    while k in follows and k not in seen:
+        seen.add(k)
+        k, rho, off = follows[k]
+        a, c = a * rho, a * off + c
+    if k == i or k in fingers or a == 0.0:
+        return float(lo), float(hi)
+    root = joints[k]
+    ends = sorted(
+        a * q + c
+        for q in (root.position_lower_limits()[0], root.position_upper_limits()[0])
     )
-    return base, fingers, joints, coupling
+    return float(max(lo, ends[0])), float(min(hi, ends[1]))
 
 
 def _jaw_coupling(follows, i0: int, i1: int) -> tuple[float, float] | None:

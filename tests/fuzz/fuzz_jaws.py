@@ -385,14 +385,21 @@ def _jaw_faults(jaw: dict, out: dict) -> list[str]:
         )
     limits = limits_of(jaw)
     for k, c in enumerate(out["candidates"]):
-        q = c["q"]
+        q = dict(c["q"])
+        drive = {}  # a hidden drive (no finger joint): where its followers put it
         for f, lead, m, o in mimics(jaw):
             if f in q and lead in q:
                 err = abs(q[f] - (m * q[lead] + o))
                 if not err <= COUPLING_TOL:
                     faults.append(f"#{k}: {f} off its mimic of {lead} by {err:.3g} m")
+            elif f in q and m != 0.0:
+                drive.setdefault(lead, []).append((q[f] - o) / m)
             else:
                 faults.append(f"#{k}: q_hand lacks {f} or {lead}: {sorted(q)}")
+        for lead, values in drive.items():
+            if max(values) - min(values) > COUPLING_TOL * 1e3:
+                faults.append(f"#{k}: the followers of {lead} disagree: {values}")
+            q[lead] = values[0]
         for name, (lo, hi) in limits.items():
             if name in q and not lo - LIMIT_TOL <= q[name] <= hi + LIMIT_TOL:
                 faults.append(f"#{k}: {name} = {q[name]!r} outside [{lo}, {hi}]")

@@ -136,11 +136,38 @@ def test_a_shake_squeezes_through_the_drive(twins):
 
 
 def test_a_drive_that_opens_one_finger_as_it_closes_the_other_is_refused(tmp_path):
-    # both fingers follow the drive with ratio +1: the pads move the same way
+    # both fingers follow the drive with ratio +1: the pads move the same way,
+    # and the right finger's [-45, 0] mm meets the drive's [0, 45] mm at 0
     scene = _scene(tmp_path, "same_way", ratio=1.0, hidden_drive=True)
     ctx = scene.plant.GetMyContextFromRoot(scene.context)
-    with pytest.raises(dg.ModelError, match="the same way"):
+    with pytest.raises(dg.ModelError, match="right_slide has no stroke"):
         parallel_jaw(scene.plant, ctx, scene.object_body, scene.hand)
+
+
+def test_the_drives_limits_bound_the_fingers(tmp_path):
+    # A drive whose stroke is cut to [0, 10] mm: the leader finger (ratio 1)
+    # reaches [0, 10] mm of its own [0, 45], the follower (ratio -2) [-20, 0]
+    # of its [-45, 0].  The planner read the fingers' limits alone, so a pose
+    # beyond broke the drive's, and analyze_grasp refused it (the fuzz suite).
+    text = coupled_jaw_urdf(ratio=-2.0, hidden_drive=True).replace(
+        '<joint name="drive" type="prismatic"><parent link="palm"/><child '
+        'link="drive_link"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit '
+        'lower="0.0" upper="0.045"',
+        '<joint name="drive" type="prismatic"><parent link="palm"/><child '
+        'link="drive_link"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit '
+        'lower="0.0" upper="0.01"',
+    )
+    assert 'upper="0.01"' in text
+    path = tmp_path / "short.urdf"
+    path.write_text(text)
+    scene = planning_scene(BOX, hand_url=str(path))
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    jaw = parallel_jaw(scene.plant, ctx, scene.object_body, scene.hand)
+    limits = {
+        j.name(): (lo, hi)
+        for j, lo, hi in zip(jaw.joints, jaw.lower, jaw.upper, strict=True)
+    }
+    assert limits == {"left_slide": (0.0, 0.01), "right_slide": (-0.02, 0.0)}
 
 
 def test_motor_shares_of_a_hidden_leader():
