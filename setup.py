@@ -21,6 +21,7 @@ from setuptools.command.build_ext import build_ext
 
 HERE = Path(__file__).resolve().parent
 KERNELS = "drakegrasp.batch._aot_kernels"
+MANIFEST = "_aot_kernels.json"  # drakegrasp.batch.aot.MANIFEST
 
 
 def _kernel_package_only() -> None:
@@ -71,6 +72,23 @@ class BuildKernels(build_ext):
             finally:
                 sys.path.remove(str(HERE))
         return None
+
+    def copy_extensions_to_source(self):
+        """Also put the kernels' manifest beside them (an editable install).
+
+        ``pip install -e`` copies each extension into the source tree; the
+        manifest that :mod:`drakegrasp.batch.aot` checks the kernels against
+        stayed in ``build/``, so the kernels built were never used.
+        """
+        super().copy_extensions_to_source()
+        build_py = self.get_finalized_command("build_py")
+        for ext in self.extensions:
+            if ext.name != KERNELS or not hasattr(self, "_get_inplace_equivalent"):
+                continue
+            inplace_file, regular_file = self._get_inplace_equivalent(build_py, ext)
+            manifest = Path(regular_file).parent / MANIFEST
+            if os.path.exists(regular_file) and manifest.exists():
+                self.copy_file(str(manifest), str(Path(inplace_file).parent / MANIFEST))
 
     def get_outputs(self):
         """The extension when it was built (a failed or skipped build has none)."""
