@@ -515,8 +515,10 @@ def batch_force_closure(
     metrics : sequence of str, optional
         Any of ``"sigma_min"``, ``"isotropy"``, ``"ellipsoid_volume"`` —
         singular-value indices of ``G`` (full rows; moment rows divided by
-        ``b``): ``σ_min``, ``σ_min/σ_max`` and ``∏ σ_i`` (the wrench
-        ellipsoid's volume over the unit ball's) — and ``"epsilon_l1"``, the
+        ``b``, a soft finger's torsion column kept ``[0; n]``, as
+        :func:`~drakegrasp.grasp_singular_values`): ``σ_min``,
+        ``σ_min/σ_max`` and ``∏ σ_i`` (the wrench ellipsoid's volume over
+        the unit ball's) — and ``"epsilon_l1"``, the
         Ferrari–Canny L1 ε of :func:`drakegrasp.quality.ferrari_canny`,
         computed as :func:`~drakegrasp.batch.batch_epsilon_l1` does (a compiled
         kernel; Qhull per grasp with ``kernel="numpy"`` or without numba).

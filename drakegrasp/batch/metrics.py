@@ -20,6 +20,7 @@ from drakegrasp.batch.inputs import (
     positive_int,
     shape_of,
 )
+from drakegrasp.core.grasp import scaled_for_metrics
 from drakegrasp.core.tolerances import MOMENT_ARMS
 from drakegrasp.core.validation import outside_moment_arms, real_array, safe_norm
 from drakegrasp.errors import GraspError, InvalidGraspError
@@ -210,9 +211,18 @@ def metric_moment_arms(calls) -> None:
 
 
 def singular_value_metrics(
-    G: np.ndarray, b: np.ndarray, names: Sequence[str]
+    G: np.ndarray,
+    b: np.ndarray,
+    names: Sequence[str],
+    torsion_columns: Sequence[int] = (),
 ) -> dict[str, np.ndarray]:
-    """σ_min, σ_min/σ_max and ∏σ of ``G`` with moment rows divided by ``b``.
+    """σ_min, σ_min/σ_max and ∏σ of ``Ĝ = T G S``, as the single-grasp indices.
+
+    ``T`` divides the moment rows by ``b``; ``S`` keeps each soft finger's
+    torsion column ``[0; n]`` (its ``m_n`` measured in ``b`` newtons), so the
+    metrics do not depend on the unit of length
+    (:func:`~drakegrasp.core.grasp.scaled_for_metrics`, which
+    :func:`~drakegrasp.grasp_singular_values` reads too).
 
     Parameters
     ----------
@@ -222,6 +232,9 @@ def singular_value_metrics(
         Characteristic lengths, metres.
     names : sequence of str
         The metrics wanted (others are ignored).
+    torsion_columns : sequence of int, optional
+        The columns of ``G`` that are soft fingers' torsional moments (none
+        by default).
 
     Returns
     -------
@@ -231,9 +244,7 @@ def singular_value_metrics(
     if not wanted:
         return {}
     w = G.shape[1]
-    f = 2 if w == 3 else 3
-    Gs = G.copy()
-    Gs[:, f:, :] /= b[:, None, None]
+    Gs = scaled_for_metrics(G, b, np.asarray(torsion_columns, dtype=int))
     sv = np.linalg.svd(Gs, compute_uv=False)
     if sv.shape[1] < w:  # fewer columns than wrench rows: the rest are zero
         sv = np.concatenate([sv, np.zeros((sv.shape[0], w - sv.shape[1]))], axis=1)

@@ -37,6 +37,7 @@ __all__ = [
     "normal_grasp_matrix",
     "invariant_grasp_matrix",
     "normalised_grasp_matrix",
+    "scaled_for_metrics",
     "wrench_columns",
 ]
 
@@ -393,6 +394,49 @@ def normalised_grasp_matrix(grasp: Grasp) -> np.ndarray:
         "(normal_grasp_matrix is G_n, another matrix)"
     )
     return invariant_grasp_matrix(grasp)
+
+
+def scaled_for_metrics(
+    G: np.ndarray, b: float | np.ndarray, torsion_columns: np.ndarray
+) -> np.ndarray:
+    r"""``Ĝ = T G S``: the grasp matrix whose singular values the metrics read.
+
+    Parameters
+    ----------
+    G : (..., 6, M) or (..., 3, M) float
+        Grasp matrices (:func:`grasp_matrix`, or a stack of them), about the
+        grasps' reference points.
+    b : float or (...,) float
+        The length ``b_s`` (metres) of each matrix.
+    torsion_columns : (n,) int
+        The columns of ``G`` that are a soft finger's torsional moment
+        ``m_n`` (``[0; n]``), the same in every matrix of the stack.
+
+    Returns
+    -------
+    (..., 6, M) or (..., 3, M) float
+        A new array: ``T = diag(I, I / b_s)`` divides the moment rows by
+        ``b_s``, and ``S`` multiplies each torsion column by ``b_s``, so that
+        that column stays ``[0; n]``.
+
+    Notes
+    -----
+    A soft finger's ``m_n`` is an input in N·m; written as ``m_n = b_s μ̃``
+    with ``μ̃`` in N (as every other input), its column is ``[0; b_s n]`` and
+    ``T`` brings it back to ``[0; n]``.  Every entry of ``Ĝ`` is then
+    dimensionless and unchanged when lengths and ``b_s`` are scaled together;
+    without ``S`` that column was ``[0; n / b_s]``, in 1/m.  Hard-finger,
+    frictionless and planar grasps have no torsion column: ``Ĝ = T G``, to
+    the bit.  The column is copied, not multiplied, so ``b_s = 1`` changes
+    nothing either.
+    """
+    rows = slice(3, 6) if G.shape[-2] == 6 else slice(2, 3)
+    out = np.array(G, dtype=float)
+    b = np.asarray(b, dtype=float)[..., None, None]
+    out[..., rows, :] /= b
+    if len(torsion_columns):
+        out[..., rows, torsion_columns] = G[..., rows, torsion_columns]
+    return out
 
 
 def _require_grasp(grasp) -> Grasp:

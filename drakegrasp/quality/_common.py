@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from drakegrasp.core.grasp import Grasp, grasp_matrix
+from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.grasp import Grasp, grasp_matrix, scaled_for_metrics
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, MOMENT_ARMS
 from drakegrasp.core.validation import (
     check_grasp,
@@ -79,9 +80,36 @@ def _moment_rows(wrench_dim: int) -> slice:
 
 
 def _scaled_grasp_matrix(grasp: Grasp, b: float) -> np.ndarray:
+    """``T G``: moment rows over ``b``, for wrenches of generators (ε).
+
+    A generator's torsion component is already ``b ν`` N·m per newton of
+    ``f_n``, so ε's wrenches are dimensionless without ``S`` (contrast
+    :func:`_metric_grasp_matrix`).
+    """
     G = grasp_matrix(grasp)
     G[_moment_rows(G.shape[0]), :] /= b
     return G
+
+
+def _torsion_columns(grasp: Grasp) -> np.ndarray:
+    """The columns of ``G`` that are a soft finger's torsional moment ``m_n``."""
+    return np.array(
+        [
+            sl.start + 3
+            for c, sl in zip(grasp.contacts, grasp.component_slices(), strict=True)
+            if c.contact_model is ContactModel.SOFT_FINGER
+        ],
+        dtype=int,
+    )
+
+
+def _metric_grasp_matrix(grasp: Grasp, b: float) -> np.ndarray:
+    """``T G S`` of :func:`~drakegrasp.core.grasp.scaled_for_metrics`.
+
+    The singular-value indices' matrix: moment rows over ``b``, each soft
+    finger's torsion column kept ``[0; n]`` (``m_n`` measured in ``b`` N).
+    """
+    return scaled_for_metrics(grasp_matrix(grasp), b, _torsion_columns(grasp))
 
 
 def _padded_singular_values(A: np.ndarray) -> np.ndarray:

@@ -10,9 +10,10 @@ from drakegrasp.core.grasp import Grasp, check_hand_jacobian
 from drakegrasp.quality._common import (
     RANK_TOL,
     _check_grasp,
+    _metric_grasp_matrix,
     _padded_singular_values,
-    _scaled_grasp_matrix,
     _torque_scale,
+    _torsion_columns,
 )
 
 __all__ = [
@@ -31,13 +32,14 @@ __all__ = [
 def grasp_singular_values(
     grasp: Grasp, *, torque_scale: float | None = None
 ) -> np.ndarray:
-    r"""Singular values of the torque-scaled grasp matrix ``S G``.
+    r"""Singular values of the torque-scaled grasp matrix ``Ĝ = T G S``.
 
     Parameters
     ----------
     grasp : Grasp
     torque_scale : float, optional
-        Length ``b_s`` (metres) dividing the moment rows; default the grasp's
+        Length ``b_s`` (metres) dividing the moment rows (and measuring a
+        soft finger's torsional moment, see Notes); default the grasp's
         characteristic length, ``1.0`` for the unscaled ``G``.
         An explicit length must be in ``[2.2e-308, 1e30]`` m with the grasp's
         extent (the largest distance from ``p`` to a contact) over it in
@@ -47,39 +49,46 @@ def grasp_singular_values(
     Returns
     -------
     sigma : (6,) or (3,) float
-        ``σ_1 >= … >= σ_D`` of ``S G`` (``D`` = wrench dimension), zero-padded
+        ``σ_1 >= … >= σ_D`` of ``Ĝ`` (``D`` = wrench dimension), zero-padded
         when ``G`` has fewer than ``D`` columns.  Dimensionless (newtons of
-        scaled wrench per newton of contact force).
+        scaled wrench per newton of contact force), so unchanged when the
+        positions and ``b_s`` are given in another unit of length.
 
     Notes
     -----
     ``G`` is :func:`~drakegrasp.grasp_matrix` with every component of each
     contact model (a hard finger with ``mu = 0`` keeps its tangential columns:
-    these indices describe the contact geometry, not friction).  The columns of
-    ``G`` map orthonormal contact-frame components, so ``σ_i`` are the semi-axes
-    of the wrench ellipsoid ``{S G f : ‖f‖ <= 1}``.
+    these indices describe the contact geometry, not friction).
+    ``T = diag(I, I / b_s)`` divides the moment rows by ``b_s``; ``S`` is the
+    identity but for each soft finger's torsional moment ``m_n``, an input in
+    N·m, which it measures in units of ``b_s`` newtons (``m_n = b_s μ̃``): its
+    column of ``Ĝ`` stays ``[0; n]``, where ``T G`` alone made it
+    ``[0; n / b_s]``, in 1/m (:func:`~drakegrasp.core.grasp.scaled_for_metrics`;
+    without soft fingers ``Ĝ = T G``).  The columns of ``Ĝ`` map orthonormal
+    contact-frame components, so ``σ_i`` are the semi-axes of the wrench
+    ellipsoid ``{Ĝ f̃ : ‖f̃‖ <= 1}`` (``f̃ = S^{-1} f``).
     """
     _check_grasp(grasp)
     b = _torque_scale(grasp, torque_scale)
-    return _padded_singular_values(_scaled_grasp_matrix(grasp, b))
+    return _padded_singular_values(_metric_grasp_matrix(grasp, b))
 
 
 def min_singular_value(grasp: Grasp, *, torque_scale: float | None = None) -> float:
-    """Smallest singular value ``σ_min(S G)``: the worst-direction wrench gain.
+    """Smallest singular value ``σ_min(Ĝ)``: the worst-direction wrench gain.
 
     The smallest wrench norm that a unit contact-force vector can produce in
     the least favourable direction; 0 when ``G`` is rank-deficient.  See
-    :func:`grasp_singular_values` for ``S``, units and conventions.
+    :func:`grasp_singular_values` for ``Ĝ = T G S``, units and conventions.
     """
     return float(grasp_singular_values(grasp, torque_scale=torque_scale)[-1])
 
 
 def isotropy(grasp: Grasp, *, torque_scale: float | None = None) -> float:
-    """Grasp isotropy index ``σ_min(S G) / σ_max(S G)`` in ``[0, 1]``.
+    """Grasp isotropy index ``σ_min(Ĝ) / σ_max(Ĝ)`` in ``[0, 1]``.
 
     1 when every wrench direction is produced equally well; 0 when ``G`` is
-    rank-deficient.  Depends on the torque scale; see
-    :func:`grasp_singular_values`.
+    rank-deficient.  Depends on the torque scale but not on the unit of
+    length (soft fingers included); see :func:`grasp_singular_values`.
     """
     s = grasp_singular_values(grasp, torque_scale=torque_scale)
     return float(s[-1] / s[0]) if s[0] > 0 else 0.0
@@ -88,14 +97,15 @@ def isotropy(grasp: Grasp, *, torque_scale: float | None = None) -> float:
 def wrench_ellipsoid_volume(
     grasp: Grasp, *, torque_scale: float | None = None
 ) -> float:
-    r"""Volume index of the wrench ellipsoid: ``σ_1 σ_2 … σ_D = sqrt(det(S G Gᵀ S))``.
+    r"""Volume index of the wrench ellipsoid: ``σ_1 σ_2 … σ_D = sqrt(det(Ĝ Ĝᵀ))``.
 
-    The ellipsoid ``{S G f : ‖f‖ <= 1}`` has semi-axes ``σ_i``, so its volume is
-    ``V_D σ_1 … σ_D`` with ``V_D`` the volume of the unit ball (``π³/6`` in 6-D,
-    ``4π/3`` in 3-D).  As in the grasp-quality literature the constant ``V_D``
-    is left out: the index is the product of the singular values
-    (dimensionless; 0 when ``G`` is rank-deficient).  See
-    :func:`grasp_singular_values` for the scaling.
+    The ellipsoid ``{Ĝ f̃ : ‖f̃‖ <= 1}`` (``Ĝ = T G S``) has semi-axes
+    ``σ_i``, so its volume is ``V_D σ_1 … σ_D`` with ``V_D`` the volume of the
+    unit ball (``π³/6`` in 6-D, ``4π/3`` in 3-D).  As in the grasp-quality
+    literature the constant ``V_D`` is left out: the index is the product of
+    the singular values (dimensionless; 0 when ``G`` is rank-deficient).  See
+    :func:`grasp_singular_values` for the scaling (a soft finger's torsion
+    column included).
     """
     return float(np.prod(grasp_singular_values(grasp, torque_scale=torque_scale)))
 
@@ -106,7 +116,7 @@ def hand_object_matrix(
     *,
     torque_scale: float | None = None,
 ) -> np.ndarray:
-    r"""Hand-object matrix ``H = ((S G)^+)^T J``: hand velocities to object twist.
+    r"""Hand-object matrix ``H = (Ĝ^+)^T S J``: hand velocities to object twist.
 
     Parameters
     ----------
@@ -138,14 +148,21 @@ def hand_object_matrix(
     is ``ν = (Gᵀ)^+ J v = (G^+)ᵀ J v``, and ``H = (G^+)ᵀ J`` is the matrix whose
     singular values give the hand-configuration indices of Roa & Suárez,
     *Grasp quality measures: review and performance* (Auton. Robots, 2015).
-    With scaling, ``Gᵀ ν = (S G)ᵀ (S^{-1} ν)``, so the twist becomes
-    ``S^{-1} ν = [v; b_s ω]``.  The pseudo-inverse drops singular values below
-    ``RANK_TOL σ_max``.
+    With scaling (``Ĝ = T G S`` of :func:`grasp_singular_values`),
+    ``S J v = S Gᵀ ν = Ĝᵀ (T^{-1} ν)``, so the twist becomes
+    ``T^{-1} ν = [v; b_s ω]`` and a soft finger's row of ``J`` (its spin
+    about the normal, rad/s) is multiplied by ``b_s``, into m/s as the other
+    rows; without soft fingers ``S = I``.  The pseudo-inverse drops singular
+    values below ``RANK_TOL σ_max``.
     """
     _check_grasp(grasp)
     J = check_hand_jacobian(grasp, hand_jacobian)
     b = _torque_scale(grasp, torque_scale)
-    G = _scaled_grasp_matrix(grasp, b)
+    G = _metric_grasp_matrix(grasp, b)
+    torsion = _torsion_columns(grasp)
+    if torsion.size:  # S J: each soft finger's spin in m/s, as G's column
+        J = J.copy()
+        J[torsion] *= b
     G_pinv = np.linalg.pinv(G, rcond=RANK_TOL)
     return G_pinv.T @ J
 

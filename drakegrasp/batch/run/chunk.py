@@ -345,7 +345,8 @@ def force_chunk(
             "soft_finger": SOFT_FULL,
         }[contact_model]
         Gfull, _ = _grasp_matrices(P, Nrm, p, (full,) * N, None, compiled)
-        out.update(singular_value_metrics(Gfull, b, metrics))
+        torsion = 4 * np.arange(N) + _TORSION_COLUMN[full] if full == SOFT_FULL else ()
+        out.update(singular_value_metrics(Gfull, b, metrics, torsion))
     return out
 
 
