@@ -112,6 +112,75 @@ def test_singular_value_metrics_match_the_quality_module():
             np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-14)
 
 
+@pytest.mark.parametrize("exponent", [-4, -1, 0, 2, 5])
+def test_soft_finger_metrics_batch_equal_single_at_any_unit(exponent):
+    # b far from 1 (the test above sits at b = 1, where a soft finger's
+    # torsion column is the same kept or divided by b), p off the origin.
+    quality = pytest.importorskip("drakegrasp.quality")
+    rng = np.random.default_rng(29)
+    K, N, s = 20, 4, 10.0**exponent
+    P, Nrm = random_grasps(rng, K, N, 3)
+    p = 0.3 * rng.normal(size=(K, 3))
+    b = rng.uniform(0.4, 2.5, K)
+    names = ["sigma_min", "isotropy", "ellipsoid_volume"]
+    res = batch_force_closure(
+        s * P,
+        Nrm,
+        mu=0.5,
+        contact_model="soft_finger",
+        torsional_friction=0.2,
+        reference_points=s * p,
+        characteristic_lengths=s * b,
+        metrics=names,
+    )
+    unit = batch_force_closure(
+        P,
+        Nrm,
+        mu=0.5,
+        contact_model="soft_finger",
+        torsional_friction=0.2,
+        reference_points=p,
+        characteristic_lengths=b,
+        metrics=names,
+    )
+    np.testing.assert_array_equal(res.is_closure, unit.is_closure)
+    for k in range(K):
+        g = make_grasp(
+            s * P[k], Nrm[k], 0.5, model="soft_finger", nu=0.2, p=s * p[k], b=s * b[k]
+        )
+        want = (
+            quality.min_singular_value(g),
+            quality.isotropy(g),
+            quality.wrench_ellipsoid_volume(g),
+        )
+        got = [res.metrics[n][k] for n in names]
+        np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-14)
+        # and the unit of length changes none of them
+        got1 = [unit.metrics[n][k] for n in names]
+        np.testing.assert_allclose(got, got1, rtol=1e-9, atol=1e-12)
+
+
+def test_soft_finger_metrics_of_the_equator_grasp():
+    # Three soft fingers on a sphere's equator: G Gᵀ = 3 I once the torsion
+    # columns stay [0; n] (tests/quality/test_quality_singular_values.py), in
+    # any unit: σ = √3, isotropy 1, volume 27 (1224.7, 0.0014 and 1.35e7 in
+    # millimetres while those columns were divided by b).
+    t = np.deg2rad([0.0, 120.0, 240.0])
+    c = np.stack([np.cos(t), np.sin(t), np.zeros(3)], axis=-1)
+    for s in (1e-3, 1.0, 1e3):
+        res = batch_force_closure(
+            s * c[None],
+            -c[None],
+            mu=0.5,
+            contact_model="soft_finger",
+            torsional_friction=0.1,
+            metrics=["sigma_min", "isotropy", "ellipsoid_volume"],
+        )
+        assert res.metrics["sigma_min"][0] == pytest.approx(np.sqrt(3.0), rel=1e-12)
+        assert res.metrics["isotropy"][0] == pytest.approx(1.0, abs=1e-12)
+        assert res.metrics["ellipsoid_volume"][0] == pytest.approx(27.0, rel=1e-12)
+
+
 def test_epsilon_metric_calls_ferrari_canny():
     quality = pytest.importorskip("drakegrasp.quality")
     rng = np.random.default_rng(24)
