@@ -1,8 +1,9 @@
 """The linear-in-N batch engine: agreement across N, invariance, kernels, workers.
 
 Agreement: on 10,000+ seeded grasps across N = 2…32 (hard, planar, soft,
-frictionless) the batch d* agrees with the single MathematicalProgram path to
-1e-8 and the verdicts agree exactly.  Invariance: verdicts and d* do not change
+frictionless) the batch d* agrees with the single MathematicalProgram path
+within ``agreement_bound`` (10 · 1e-10 · N · κ · (1 + d*)) and the verdicts
+agree exactly.  Invariance: verdicts and d* do not change
 when a grasp is scaled from 1e-9 m to 1e9 m or its reference point moves 1e6 b
 away (issue 9, finding 1).  Second formulations: the numba kernel against the
 numpy block IPM, and both against the old null-space reduction.  Workers: the
