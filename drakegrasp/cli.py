@@ -886,7 +886,7 @@ class _BatchMetrics:
 def _add_batch_parser(sub: argparse._SubParsersAction) -> None:
     batch = sub.add_parser(
         "batch",
-        help="decide closure for every grasp of an .npz file",
+        help="decide closure for every grasp of an .npz file or a folder of .npy files",
         description="Decide form or force closure for K grasps of N contacts "
         "stored as arrays positions (K, N, d) and normals (K, N, d) [, mu, "
         "torsional_friction, reference_points, characteristic_lengths] in an "
