@@ -611,11 +611,14 @@ def _add_scene_file_options(
     )
 
 
-_JIT_TIME = "under a minute, about 40 s of one CPU core"
+_JIT_TIME = "40 s to two minutes, depending on the machine and its load"
 """How long numba's JIT takes to compile every kernel (``warmup``).
 
-Measured with an empty ``NUMBA_CACHE_DIR``: 86 functions in 42 s on a shared
-two-core machine under load (one core busy).
+Measured with an empty ``NUMBA_CACHE_DIR`` on a shared two-core machine: 86
+functions in 42 s (one core busy) and in 59 s of CPU (74 s wall, load 1.5);
+the first closure and ε calls of a process, 56-68 s at load 3 and up to two
+minutes at load 8-10 (``benchmarks/README.md``, ``bench_first_call.py``).
+The same words are in :mod:`drakegrasp.batch.compiled`'s stderr line.
 """
 
 

@@ -141,8 +141,8 @@ class _CompileNotice:
             self.announced = True
             self._write(
                 "compiling the batch kernels with numba (once per install, "
-                "under a minute; cached for later runs; `drakegrasp warmup` "
-                "does it up front) ..."
+                "40 s to two minutes, depending on the machine and its load; "
+                "cached for later runs; `drakegrasp warmup` does it up front) ..."
             )
 
     def on_end(self, ev) -> None:
