@@ -60,3 +60,14 @@ def test_readme_python_examples_run(capsys, request):
         exec(compile(block, "README.md", "exec"), namespace)
     out = capsys.readouterr().out
     assert "force closure: YES" in out and "form closure: no" in out
+
+
+def test_setup_places_the_kernels_manifest_the_engine_reads():
+    # setup.py cannot import drakegrasp.batch.aot (the build environment has
+    # no Drake); the manifest's name it copies beside the kernels on an
+    # editable install must be the one aot checks them against
+    from drakegrasp.batch import aot
+
+    text = (ROOT / "setup.py").read_text()
+    assert re.search(r'^MANIFEST = "([^"]+)"', text, re.M).group(1) == aot.MANIFEST
+    assert re.search(r'^KERNELS = "([^"]+)"', text, re.M).group(1) == aot.MODULE
