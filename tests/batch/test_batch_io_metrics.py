@@ -103,13 +103,18 @@ def test_singular_value_metrics_match_the_quality_module():
         )
         for k in range(K):
             g = make_grasp(P[k], Nrm[k], mu[k], model=model, nu=nu)
-            want = (
-                quality.min_singular_value(g),
-                quality.isotropy(g),
-                quality.wrench_ellipsoid_volume(g),
-            )
+            want = _single_metrics(quality, g)
             got = [res.metrics[n][k] for n in names]
             np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-14)
+
+
+def _single_metrics(quality, g) -> tuple[float, float, float]:
+    """The single-grasp route of the batch's sigma_min, isotropy, ellipsoid_volume."""
+    return (
+        quality.min_singular_value(g),
+        quality.isotropy(g),
+        quality.wrench_ellipsoid_volume(g),
+    )
 
 
 @pytest.mark.parametrize("exponent", [-4, -1, 0, 2, 5])
@@ -148,11 +153,7 @@ def test_soft_finger_metrics_batch_equal_single_at_any_unit(exponent):
         g = make_grasp(
             s * P[k], Nrm[k], 0.5, model="soft_finger", nu=0.2, p=s * p[k], b=s * b[k]
         )
-        want = (
-            quality.min_singular_value(g),
-            quality.isotropy(g),
-            quality.wrench_ellipsoid_volume(g),
-        )
+        want = _single_metrics(quality, g)
         got = [res.metrics[n][k] for n in names]
         np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-14)
         # and the unit of length changes none of them
