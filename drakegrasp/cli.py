@@ -1862,9 +1862,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     except GraspError as e:
         return _error(_cli_words(str(e), getattr(args, "command", None)))
-    except OSError as e:  # a file error not already wrapped: its name cut short
-        if e.strerror and e.filename is not None:
-            return _error(f"{e.strerror}: {describe(os.fsdecode(e.filename))}")
+    except OSError as e:  # a file error not already wrapped: its names cut short
+        names = [
+            describe(os.fsdecode(f))
+            for f in (e.filename, e.filename2)
+            if isinstance(f, str | bytes | os.PathLike)
+        ]
+        if e.strerror and names:
+            return _error(f"{e.strerror}: {' -> '.join(names)}")
         return _error(f"{type(e).__name__}: {e}" if not str(e) else str(e))
     except (ValueError, RuntimeError, MemoryError) as e:
         # File or Drake errors that were not already wrapped.

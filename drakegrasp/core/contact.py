@@ -86,7 +86,7 @@ def contact_frames(normals: np.ndarray) -> np.ndarray:
     normals : (..., 3) or (..., 2) float
         Unit contact normals, pointing into the object.  They are not
         re-normalised here: a length off 1 by more than
-        :data:`~drakegrasp.core.tolerances.UNIT_NORMAL_TOL` (1e-9) is refused
+        :data:`~drakegrasp.core.tolerances.UNIT_NORMAL_TOL` (1e-6) is refused
         (:func:`contact_frame` normalises one normal).
 
     Returns
@@ -113,15 +113,15 @@ def contact_frames(normals: np.ndarray) -> np.ndarray:
             "which normalises one)"
         )
     if n.shape[-1] in (2, 3):
-        off = np.abs(np.sqrt(np.sum(n * n, axis=-1)) - 1.0)
+        off = np.abs(np.sqrt(np.sum(n * n, axis=-1)) - 1.0)  # n is float64
         if not np.all(off <= UNIT_NORMAL_TOL):
             idx = tuple(int(i) for i in np.argwhere(~(off <= UNIT_NORMAL_TOL))[0])
             where = f" at index {idx}" if idx else ""
             raise InvalidContactError(
                 f"normals must be unit vectors: the normal{where} "
-                f"{np.asarray(n[idx]).tolist()} has length "
-                f"{float(np.linalg.norm(n[idx])):.6g} (normalise them, or build "
-                "each frame with contact_frame, which does)"
+                f"{np.asarray(n[idx]).tolist()} has a length off 1 by "
+                f"{float(off[idx]):.3g} (more than {UNIT_NORMAL_TOL:g}; normalise "
+                "them, or build each frame with contact_frame, which does)"
             )
     if n.shape[-1] == 2:
         t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
@@ -338,8 +338,9 @@ class Contact:
     def with_(self, **changes) -> Contact:
         """Return a copy with some fields replaced (``mu``, ``contact_model``, ...).
 
-        A contact made a soft finger needs ``torsional_friction`` with it (the
-        other models carry none to inherit), as :class:`Contact` does.
+        A contact made a soft finger keeps the ``torsional_friction`` it
+        carries; one that carries none (0, the other models' default) needs it
+        given, as :class:`Contact` does.
         """
         kwargs = {
             "position": self.position,
@@ -365,11 +366,12 @@ class Contact:
         kwargs.update(changes)
         if (
             "torsional_friction" not in changes
+            and self.torsional_friction == 0.0
             and self.contact_model is not ContactModel.SOFT_FINGER
             and ContactModel.parse(kwargs["contact_model"]) is ContactModel.SOFT_FINGER
         ):
-            # a hard finger's 0 is no torsion coefficient: ask for one, as
-            # Contact(contact_model="soft_finger") does
+            # the default 0 of another model is no torsion coefficient: ask
+            # for one, as Contact(contact_model="soft_finger") does
             kwargs["torsional_friction"] = None
         position = kwargs.pop("position")
         normal = kwargs.pop("normal")

@@ -48,11 +48,13 @@ and benchmarks, is 2 mm (a point cloud's spacing), most 1 mm or the default
 0.1 mm.
 """
 
-UNIT_NORMAL_TOL = 1e-9
+UNIT_NORMAL_TOL = 1e-6
 """How far from 1 the length of a normal given to ``contact_frames`` may be.
 
 The function builds frames from the normals as they are; every other entry
-point normalises them first (to within a few units in the last place).
+point normalises them first (to within a few units in the last place).  1e-6
+admits normals normalised in float32 (about 1e-7 off) or read from six-digit
+text, and refuses a normal that was never normalised.
 """
 
 DEFAULT_NUM_GENERATORS = 8

@@ -86,7 +86,9 @@ def planning_scene(
         (:func:`~drakegrasp.plant.models.use_local_drake_models`).
     package_map : dict of str to path, optional
         More packages for ``package://NAME/...`` URLs of the object and the
-        hand: ``{NAME: folder}`` (``drakegrasp plan --package NAME=DIR``).
+        hand: ``{NAME: folder}`` (``drakegrasp plan --package NAME=DIR``).  A
+        folder given for ``drake_models`` replaces Drake's download of it;
+        ``drake`` and ``drakegrasp`` are built in and refused.
 
     Raises
     ------
@@ -148,6 +150,10 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
     for name, folder in package_map.items():
         if not isinstance(name, str) or not name or "/" in name:
             raise InvalidOptionError(f"package name must be a word, got {name!r}")
+        if name in ("drake", "drakegrasp"):  # (refused again where it is added)
+            raise InvalidOptionError(
+                f"package {name!r} is built in and cannot be replaced"
+            )
         if not isinstance(folder, (str, os.PathLike)) or not Path(folder).is_dir():
             raise InvalidOptionError(f"package {name!r}: {folder!r} is not a folder")
         pairs.append((name, str(Path(folder).resolve())))

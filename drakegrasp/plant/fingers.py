@@ -500,20 +500,33 @@ def _deepest(bodies: list, moved: list[set[int]]) -> list:
 
 
 def is_hidden_drive(plant: MultibodyPlant, joint: Joint) -> bool:
-    """True when ``joint`` moves one body that touches nothing.
+    """True when nothing ``joint`` moves can touch: no collision geometry.
 
-    A hidden drive: a slide or a linkage's link with no collision geometry,
-    from which no other joint hangs, that the fingers follow through their
-    ``<mimic>`` (its motor closes them).  Read from the model alone, so a
-    plant that is not finalized yet (a shake's) answers too.
+    A hidden drive: a slide or a linkage (the bodies below ``joint``, welded
+    or jointed) with no collision geometry, that the fingers follow through
+    their ``<mimic>`` (its motor closes them).  The same test leaves such a
+    chain out of :func:`finger_chains`.  Read from the model's joints alone,
+    so a plant that is not finalized yet (a shake's) answers too.
     """
-    child = joint.child_body()
-    if plant.GetCollisionGeometriesForBody(child):
-        return False
     return not any(
-        plant.get_joint(JointIndex(k)).parent_body().index() == child.index()
-        for k in range(plant.num_joints())
+        plant.GetCollisionGeometriesForBody(plant.get_body(b))
+        for b in _below(plant, joint.child_body().index())
     )
+
+
+def _below(plant: MultibodyPlant, body) -> set:
+    """``body`` and every body a joint hangs below it (welds too), by index."""
+    children: dict = {}
+    for k in plant.GetJointIndices():
+        j = plant.get_joint(k)
+        children.setdefault(j.parent_body().index(), []).append(j.child_body().index())
+    found, todo = set(), [body]
+    while todo:
+        b = todo.pop()
+        if b not in found:
+            found.add(b)
+            todo.extend(children.get(b, ()))
+    return found
 
 
 def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
@@ -540,12 +553,8 @@ def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
             continue
         for group in groups:
             ids = set().union(*(moved[int(j.index())] for j in group))
-            if not any(
-                plant.GetCollisionGeometriesForBody(b)
-                for b in finger.bodies
-                if int(b.index()) in ids
-            ):
-                continue
+            if all(is_hidden_drive(plant, j) for j in _roots(group, moved)):
+                continue  # it touches nothing: a hidden drive, no finger
             pairs = tuple(p for p in finger.pairs if int(p[2].index()) in ids)
             paired = list({int(b.index()): b for _, _, b in pairs}.values())
             tip = {

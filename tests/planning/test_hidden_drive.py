@@ -202,3 +202,28 @@ def test_coupled_positions_hold_every_coupling(q, rho, offsets):
     values = {"a": q, **found}
     for follower, leader, r, off in couplings:
         assert values[follower] == pytest.approx(r * values[leader] + off, abs=1e-12)
+
+
+def test_a_drive_with_a_link_welded_to_it_is_still_a_drive(tmp_path):
+    # a marker (or a linkage's second link) welded below the drive, no
+    # collision geometry either: the chain was left out of the fingers, but
+    # the drive's motor was not found (no squeeze limit, a shake refused)
+    from drakegrasp.planning.motors import motor_limit
+
+    text = coupled_jaw_urdf(ratio=-1.0, hidden_drive=True).replace(
+        "</robot>",
+        '<link name="drive_marker"><inertial><mass value="0.001"/><inertia '
+        'ixx="1e-8" iyy="1e-8" izz="1e-8" ixy="0" ixz="0" iyz="0"/></inertial>'
+        '</link><joint name="marker_weld" type="fixed"><parent link="drive_link"/>'
+        '<child link="drive_marker"/></joint></robot>',
+    )
+    path = tmp_path / "marked.urdf"
+    path.write_text(text)
+    scene = planning_scene(BOX, hand_url=str(path))
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    result = plan_grasps(
+        scene.plant, ctx, scene.object_body, hand=scene.hand,
+        num_candidates=60, mu=0.5, seed=4, object_mass=0.3,
+    )  # fmt: skip
+    assert result.candidates and not result.reason, result.reason
+    assert motor_limit(scene.plant, result.candidates[0], per_finger=True) == 20.0

@@ -216,3 +216,27 @@ def test_an_empty_or_endless_name_gets_a_short_line(tmp_path, capsys):
     assert main(["batch", str(src), str(tmp_path / f"{endless}.npz")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and len(err[0]) < 400 and "too long" in err[0], err
+
+
+@pytest.mark.parametrize(
+    "error, want",
+    [
+        (OSError(18, "Invalid cross-device link", "/a/o.partial", None, "/b/o.npz"),
+         "Invalid cross-device link: '/a/o.partial' -> '/b/o.npz'"),
+        (OSError(9, "Bad file descriptor", 3), "[Errno 9] Bad file descriptor: 3"),
+    ],
+)  # fmt: skip
+def test_a_file_error_names_both_files_and_never_fails_itself(
+    monkeypatch, capsys, error, want
+):
+    # os.replace's failure named only the temporary file; an int file name
+    # (a descriptor) would have raised TypeError in the message itself
+    import drakegrasp.cli as cli
+
+    def fails(_args):
+        raise error
+
+    monkeypatch.setattr(cli, "_analyze", fails)
+    assert main(["analyze"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith(want), err
