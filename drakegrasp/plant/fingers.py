@@ -514,6 +514,23 @@ def is_hidden_drive(plant: MultibodyPlant, joint: Joint) -> bool:
     )
 
 
+def _drives_only(plant, structure: HandStructure, group, moved, position) -> bool:
+    """True when a chain is a hidden drive: it touches nothing, others follow it.
+
+    A chain without geometry that follows another (a parallelogram's bare bar)
+    stays a chain, as before: only a leader is a drive.
+    """
+    own = {position[int(j.index())] for j in group}
+    leads = {
+        lead
+        for follower, (lead, _, _) in structure.coupling.follows.items()
+        if follower not in own
+    }
+    return bool(own & leads) and all(
+        is_hidden_drive(plant, j) for j in _roots(group, moved)
+    )
+
+
 def _below(plant: MultibodyPlant, body) -> set:
     """``body`` and every body a joint hangs below it (welds too), by index."""
     children: dict = {}
@@ -537,9 +554,10 @@ def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
     grasp is still held by each chain's own contacts.  Each chain is a
     :class:`Finger` over its own joints (positions in ``structure.joints``),
     bodies, pairs and tip; a finger of one chain is returned as it is.  A
-    chain with no collision geometry (a drive slide or a linkage's hidden
-    link, which the fingers follow through their ``<mimic>``) touches nothing
-    and is no finger: it is left out.
+    chain with no collision geometry that other chains follow through their
+    ``<mimic>`` (a drive slide or a linkage's hidden link) touches nothing and
+    is no finger: it is left out (a bare chain that follows, such as a
+    parallelogram's bar, is kept).
     """
     position = {int(j.index()): k for k, j in enumerate(structure.joints)}
     out = []
@@ -553,8 +571,8 @@ def finger_chains(plant: MultibodyPlant, structure: HandStructure) -> tuple:
             continue
         for group in groups:
             ids = set().union(*(moved[int(j.index())] for j in group))
-            if all(is_hidden_drive(plant, j) for j in _roots(group, moved)):
-                continue  # it touches nothing: a hidden drive, no finger
+            if _drives_only(plant, structure, group, moved, position):
+                continue  # it touches nothing and others follow it: no finger
             pairs = tuple(p for p in finger.pairs if int(p[2].index()) in ids)
             paired = list({int(b.index()): b for _, _, b in pairs}.values())
             tip = {
