@@ -185,6 +185,8 @@ def test_gram_certificate_on_prescribed_singular_values(w):
 
 
 def _chunk(P, Nrm, mu, nu, model, kernel, metrics=()):
+    # force_chunk takes unit normals (the API normalises them before it)
+    Nrm = unit_vectors("normals", Nrm)
     K = P.shape[0]
     return chunks.force_chunk(
         P, Nrm, mu, nu, np.zeros((K, P.shape[2])), None, contact_model=model,

@@ -24,6 +24,7 @@ from drakegrasp.batch.inputs import numba_available
 from drakegrasp.batch.lp.dstar import _verdict_band
 from drakegrasp.batch.run.chunk import _grasp_matrices, force_chunk, force_verdicts
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL, DEFAULT_TOL
+from drakegrasp.core.validation import unit_vectors
 
 KERNELS = [
     pytest.param(
@@ -129,6 +130,7 @@ def test_verdicts_next_to_the_threshold(N, kernel):
 
 def _single(P, Nrm, mu, tol, kernel, verdict_only):
     K, N, _ = P.shape
+    Nrm = unit_vectors("normals", Nrm)  # force_chunk takes unit normals
     return force_chunk(
         P, Nrm, np.broadcast_to(mu, (K, N)).copy(), np.zeros((K, N)),
         np.zeros((K, 3)), None, contact_model="hard_finger", num_generators=8, tol=tol,
@@ -174,6 +176,7 @@ def _block_inputs(P, Nrm, mu):
     """The block IPM's inputs of hard-finger grasps (as dstar prepares them)."""
     K, N, _ = P.shape
     Pn, _ = normalised_positions(P)
+    Nrm = unit_vectors("normals", Nrm)  # as the API gives them
     G, normal = _grasp_matrices(Pn, Nrm, None, (SPATIAL_HARD,) * N, None, False)
     rank, spaces = row_spaces(G, rank_tol=DEFAULT_RANK_TOL)
     assert (rank == 6).all()
