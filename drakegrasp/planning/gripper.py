@@ -405,11 +405,7 @@ def _within_drive(joints, follows, i: int, fingers: set) -> tuple[float, float]:
     """
     j = joints[i]
     lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
-    k, a, c, seen = i, 1.0, 0.0, set()
-    while k in follows and k not in seen:
-        seen.add(k)
-        k, rho, off = follows[k]
-        a, c = a * rho, a * off + c
+    k, a, c = _chain_root(follows, i)
     if k == i or k in fingers or a == 0.0:
         return float(lo), float(hi)
     root = joints[k]
@@ -425,21 +421,26 @@ def _jaw_coupling(follows, i0: int, i1: int) -> tuple[float, float] | None:
 
     ``follows``: :class:`~drakegrasp.plant.fingers.Coupling`'s follower ->
     ``(leader, ρ, Δq)``.  Each joint is written as ``a q_root + c`` of the
-    joint at the end of its chain of leaders.
+    joint at the end of its chain of leaders (:func:`_chain_root`).
     """
-
-    def root(i):
-        a, c, seen = 1.0, 0.0, set()
-        while i in follows and i not in seen:
-            seen.add(i)
-            i, rho, off = follows[i]
-            a, c = a * rho, a * off + c
-        return i, a, c
-
-    (r0, a0, c0), (r1, a1, c1) = root(i0), root(i1)
+    (r0, a0, c0), (r1, a1, c1) = _chain_root(follows, i0), _chain_root(follows, i1)
     if r0 != r1:
         return None
     return float(a1 / a0), float(c1 - a1 / a0 * c0)
+
+
+def _chain_root(follows, i: int) -> tuple[int, float, float]:
+    """``(root, a, c)`` with ``q_i = a q_root + c``, up ``i``'s chain of leaders.
+
+    ``follows``: follower -> ``(leader, ρ, Δq)``, ``q_f = ρ q_l + Δq``; a
+    joint that follows none is its own root (``a = 1``, ``c = 0``).
+    """
+    a, c, seen = 1.0, 0.0, set()
+    while i in follows and i not in seen:
+        seen.add(i)
+        i, rho, off = follows[i]
+        a, c = a * rho, a * off + c
+    return i, a, c
 
 
 def _grasp_axis(finger_origins, lower, upper) -> np.ndarray:

@@ -668,10 +668,11 @@ def _joint_motors(plant, names, per_finger: bool = True) -> dict:
     if not per_finger:
         return {n: [(a, 1.0) for a in own[n]] for n in names}
     couplings = plant_couplings(plant)
+    leaders = {leader for _, leader, _, _ in couplings} - own.keys()
     hidden = {
-        leader: _actuators(plant, find_joint(plant, leader))
-        for _, leader, _, _ in couplings
-        if leader not in own and is_hidden_drive(plant, find_joint(plant, leader))
+        leader: _actuators(plant, joint)
+        for leader in leaders
+        if is_hidden_drive(plant, joint := find_joint(plant, leader))
     }
     motors = {**own, **hidden}
     driven, shares = motor_shares(couplings, names, [n for n in motors if motors[n]])
