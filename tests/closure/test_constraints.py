@@ -99,12 +99,18 @@ def test_a_margin_shrinks_the_cone(exact):
     """``d > 0`` asks for more than the closed cone; ``d < 0`` for less."""
     rng = np.random.default_rng(13)
     grasp, layout = _one_contact("soft_finger", 0.5)
+    bitten = widened = 0  # the margin must change the answer somewhere
     for _ in range(200):
         x = np.zeros(len(layout.columns))
         x[:4] = rng.normal(size=4) + [1.0, 0.0, 0.0, 0.0]
         x[4:] = [1.0, 0.0, 0.0]
         closed = _satisfied(grasp, layout, x, exact=exact)
-        if _satisfied(grasp, layout, x, exact=exact, d_value=0.05):
+        inside = _satisfied(grasp, layout, x, exact=exact, d_value=0.05)
+        outside = _satisfied(grasp, layout, x, exact=exact, d_value=-0.05)
+        if inside:
             assert closed
         if closed:
-            assert _satisfied(grasp, layout, x, exact=exact, d_value=-0.05)
+            assert outside
+        bitten += closed and not inside
+        widened += outside and not closed
+    assert bitten > 0 and widened > 0  # (a d left out would pass the above)
