@@ -659,27 +659,29 @@ def _joint_motors(plant, names, per_finger: bool = True) -> dict:
     """Per closing joint, the actuators that press it and the share each gives.
 
     A joint's own actuators; with ``per_finger``, shares over the followers a
-    motor drives, and for a follower of a hidden drive (a leader that is not
-    a closing joint and touches nothing:
-    :func:`~drakegrasp.plant.fingers.is_hidden_drive`) the drive's actuators.
+    motor drives, and for a follower of a hidden drive (a leader that touches
+    nothing: :func:`~drakegrasp.plant.fingers.is_hidden_drive`; a
+    multi-finger candidate holds it among its closing joints, a jaw's does
+    not) the drive's actuators, which press only through its followers.
     A leader with geometry that the candidate leaves out drives nothing of it.
     """
     own = {n: _actuators(plant, find_joint(plant, n)) for n in names}
     if not per_finger:
         return {n: [(a, 1.0) for a in own[n]] for n in names}
     couplings = plant_couplings(plant)
-    leaders = {leader for _, leader, _, _ in couplings} - own.keys()
-    hidden = {
-        leader: _actuators(plant, joint)
-        for leader in leaders
-        if is_hidden_drive(plant, joint := find_joint(plant, leader))
+    drives = {
+        leader
+        for _, leader, _, _ in couplings
+        if is_hidden_drive(plant, find_joint(plant, leader))
     }
+    hidden = {d: _actuators(plant, find_joint(plant, d)) for d in drives - own.keys()}
     motors = {**own, **hidden}
-    driven, shares = motor_shares(couplings, names, [n for n in motors if motors[n]])
+    actuated = [n for n in motors if motors[n]]
+    driven, shares = motor_shares(couplings, names, actuated, drives=drives)
     return {
         n: [
             (a, shares.get(m, 1.0))
-            for m in [driven[n] if driven.get(n) in hidden else n]
+            for m in [driven[n] if driven.get(n) in drives else n]
             for a in motors[m]
         ]
         for n in names

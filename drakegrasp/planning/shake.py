@@ -812,12 +812,17 @@ def shake_test(
     # a follower is driven by its leader's motor: a closing joint's, or a
     # hidden drive's (a leader that closes nothing itself)
     couplings = _known_couplings(plant)
-    actuated = [
+    drives = {
         name
         for name, actuator in by_name.items()
-        if name in candidate.joint_names or is_hidden_drive(plant, actuator.joint())
+        if is_hidden_drive(plant, actuator.joint())
+    }
+    actuated = [
+        name for name in by_name if name in candidate.joint_names or name in drives
     ]
-    driven, shares = motor_shares(couplings, candidate.joint_names, actuated)
+    driven, shares = motor_shares(
+        couplings, candidate.joint_names, actuated, drives=drives
+    )
     squeezers = _squeezers(candidate, couplings, driven, by_name)
     for name, sign in squeezers.items():
         actuator = by_name[name]

@@ -643,7 +643,7 @@ def coupling_map(
     return C, np.array(independent, dtype=int)
 
 
-def motor_shares(couplings, joints, actuated) -> tuple[dict, dict]:
+def motor_shares(couplings, joints, actuated, *, drives=()) -> tuple[dict, dict]:
     """Which followers a leader's motor drives, and what it presses them with.
 
     A ``<mimic>`` follower without an actuator of its own is driven by its
@@ -651,9 +651,9 @@ def motor_shares(couplings, joints, actuated) -> tuple[dict, dict]:
     ``τ_leader + Σ ρ τ_follower``, so for the leader and each follower to
     press with ``τ`` it applies ``τ (1 + Σ|ρ|)`` (a one-motor jaw: twice
     the squeeze, each finger half the motor's effort limit).  A leader that
-    is not among ``joints`` (a hidden drive: a slide or linkage with no
-    geometry, which the fingers follow) presses nothing itself: it applies
-    ``τ Σ|ρ|``.
+    is not among ``joints``, or is one of ``drives`` (a hidden drive: a slide
+    or linkage with no geometry, which the fingers follow), presses nothing
+    itself: it applies ``τ Σ|ρ|``.
 
     Parameters
     ----------
@@ -664,6 +664,10 @@ def motor_shares(couplings, joints, actuated) -> tuple[dict, dict]:
     actuated : iterable of str
         The joints with an actuator: those of ``joints``, and any leader
         outside them whose motor is to count.
+    drives : iterable of str, optional
+        Hidden drives among ``joints`` (a multi-finger hand's closing joints
+        hold every joint of the hand, its drive too): they touch nothing, so
+        their motors press only through their followers.
 
     Returns
     -------
@@ -672,9 +676,9 @@ def motor_shares(couplings, joints, actuated) -> tuple[dict, dict]:
         one, and that leader.
     shares : dict of str to float
         Per leader that drives any: ``1 + Σ|ρ|`` over its driven followers
-        (``Σ|ρ|`` for a leader outside ``joints``).
+        (``Σ|ρ|`` for a leader outside ``joints`` or among ``drives``).
     """
-    joints, actuated = set(joints), set(actuated)
+    joints, actuated = set(joints) - set(drives), set(actuated)
     driven, shares = {}, {}
     for follower, leader, rho, _ in couplings:
         if follower in joints - actuated and leader in actuated:

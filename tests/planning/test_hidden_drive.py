@@ -8,19 +8,25 @@ the drive), so everything the planner says of one it must say of the other:
 the fingers, the coupling, the candidates, the squeeze the motor gives each
 finger (its effort limit over ``Σ|ρ|`` = 2), the pose a candidate puts in a
 context, and what Drake's simulation of a shake finds.
+
+A multi-finger hand on a hidden drive (``one_motor_pinch_urdf(hidden_drive=
+True)``: the knuckles and pads of a pinch follow a bare hinge) keeps the drive
+among its closing joints; its motor presses only through the fingers, so it
+too squeezes as its twin's does (the effort limit over ``Σ|ρ|`` = 4).
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from coupled_hands import coupled_jaw_urdf
+from coupled_hands import coupled_jaw_urdf, one_motor_pinch_urdf
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import drakegrasp as dg
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.gripper import parallel_jaw
+from drakegrasp.planning.motors import motor_limit
 from drakegrasp.plant.couplings import coupled_positions, motor_shares
 
 BOX = "package://drakegrasp/objects/box.sdf"
@@ -178,6 +184,11 @@ def test_motor_shares_of_a_hidden_leader():
     driven, shares = motor_shares(couplings, ["a", "c"], ["a"])
     assert driven == {"c": "a"}
     assert shares == {"a": 3.0}  # 1 + |ρ|: the leader presses too
+    # a drive among the joints (a multi-finger hand's) still presses nothing
+    driven, shares = motor_shares(couplings, ["d", "a", "b"], ["d"], drives=["d"])
+    assert driven == {"a": "d", "b": "d"}
+    assert shares == {"d": 1.5}
+    assert motor_shares(couplings, ["d", "a", "b"], ["d"])[1] == {"d": 2.5}
 
 
 @settings(max_examples=60, deadline=None)
@@ -227,3 +238,55 @@ def test_a_drive_with_a_link_welded_to_it_is_still_a_drive(tmp_path):
     )  # fmt: skip
     assert result.candidates and not result.reason, result.reason
     assert motor_limit(scene.plant, result.candidates[0], per_finger=True) == 20.0
+
+
+@pytest.fixture(scope="module")
+def pinch_twins(tmp_path_factory):
+    """The pinch on a hidden drive and its twin, each planned on the box."""
+    tmp = tmp_path_factory.mktemp("hidden_pinch")
+    out = {}
+    for name, hidden in (("twin", False), ("hidden", True)):
+        path = tmp / f"{name}.urdf"
+        path.write_text(one_motor_pinch_urdf(hidden_drive=hidden))
+        scene = planning_scene(BOX, hand_url=str(path))
+        result = plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=60, mu=0.5, seed=0, robustness_samples=8,
+            object_mass=0.2,
+        )  # fmt: skip
+        out[name] = (scene, result)
+    return out
+
+
+def test_a_pinch_on_a_hidden_drive_plans_as_its_twin(pinch_twins):
+    (scene, hidden), (twin_scene, twin) = pinch_twins["hidden"], pinch_twins["twin"]
+    assert len(hidden) == len(twin) > 10
+    drive = "one_motor_pinch::drive"
+    for a, b in zip(hidden, twin, strict=True):
+        assert a.joint_names == (drive, *b.joint_names)
+        assert a.sample == b.sample and a.score == b.score
+        np.testing.assert_array_equal(a.q_hand[1:], b.q_hand)
+        assert a.q_hand[0] == a.q_hand[1]  # the left knuckle follows at 1
+        assert a.torque_needed == pytest.approx(b.torque_needed, rel=1e-6)
+        assert a.torque_capacity == pytest.approx(b.torque_capacity, rel=1e-6)
+    assert hidden.settings["held_first"] == twin.settings["held_first"]
+    for per_finger in (False, True):  # 5 N·m; 5 / 4 through the four followers
+        limit = motor_limit(scene.plant, hidden[0], per_finger=per_finger)
+        assert limit == motor_limit(twin_scene.plant, twin[0], per_finger=per_finger)
+    assert limit == pytest.approx(5.0 / 4)
+
+
+@pytest.mark.filterwarnings(
+    "ignore::drakegrasp.plant.friction.FrictionMismatchWarning"  # plan 0.5, Drake 1
+)
+def test_a_pinchs_hidden_drive_squeezes_through_its_followers(pinch_twins):
+    # The drive touches nothing: its motor's squeeze is shared by the four
+    # joints it drives, as the twin's knuckle motor's is (it counted itself
+    # as a fifth, and squeezed each with 1 N·m where the twin gives 1.25).
+    shaken = {
+        name: shake_test(scene.add_models, result[0], object_mass=0.2, **QUICK)
+        for name, (scene, result) in pinch_twins.items()
+    }
+    hidden, twin = shaken["hidden"], shaken["twin"]
+    assert hidden.squeeze_caps == twin.squeeze_caps == (pytest.approx(5.0 / 4),)
+    assert hidden.efforts == pytest.approx(twin.efforts, rel=1e-2)  # at 5 N·m

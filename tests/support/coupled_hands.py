@@ -132,7 +132,9 @@ def spread_hand_urdf() -> str:
     )
 
 
-def one_motor_pinch_urdf(*, effort: float = 5.0, bars: bool = False) -> str:
+def one_motor_pinch_urdf(
+    *, effort: float = 5.0, bars: bool = False, hidden_drive: bool = False
+) -> str:
     """A Robotiq-style pinch: two revolute knuckles on one motor, pads kept upright.
 
     Knuckles 110 mm apart on the palm, about ``y``, 50 mm long; each carries a
@@ -148,7 +150,13 @@ def one_motor_pinch_urdf(*, effort: float = 5.0, bars: bool = False) -> str:
     palm, turning with the knuckle (``<mimic>`` 1 on the left, -1 on the
     right) and joined to nothing: a chain of the closing group that never
     reaches the object before its pad.
+
+    ``hidden_drive``: the motor on a fifth hinge, ``drive``, whose link has no
+    geometry, and the knuckles and pads follow it (``<mimic>`` of the drive,
+    with the ratios they have to the left knuckle above): the same pinch, its
+    motor moved off the fingers, as a linkage's input crank.
     """
+    lead = "drive" if hidden_drive else "left_knuckle"
 
     def link(name, xyz, shape, mass, *more):
         collisions = "".join(
@@ -165,7 +173,7 @@ def one_motor_pinch_urdf(*, effort: float = 5.0, bars: bool = False) -> str:
         extra = (
             ""
             if mimic is None
-            else f'<mimic joint="left_knuckle" multiplier="{mimic:g}" offset="0"/>'
+            else f'<mimic joint="{lead}" multiplier="{mimic:g}" offset="0"/>'
         )
         return (
             f'<joint name="{name}" type="revolute"><parent link="{parent}"/>'
@@ -185,6 +193,14 @@ def one_motor_pinch_urdf(*, effort: float = 5.0, bars: bool = False) -> str:
         if bars
         else ""
     )
+    drive = (
+        '<link name="drive"><inertial><mass value="0.01"/><inertia ixx="1e-6" '
+        'iyy="1e-6" izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        + hinge("drive", "palm", "drive", "0 0 0.03", 0, 0.8)
+        if hidden_drive
+        else ""
+    )
+    knuckle_mimic = 1 if hidden_drive else None
     return (
         '<?xml version="1.0"?><robot name="one_motor_pinch">'
         + link("palm", "0 0 0.025", '<box size="0.14 0.06 0.05"/>', 0.6)
@@ -192,13 +208,22 @@ def one_motor_pinch_urdf(*, effort: float = 5.0, bars: bool = False) -> str:
         + link("right_knuckle", "0 0 0.025", knuckle, 0.05)
         + link("left_pad", "0.0085 0 0.02", pad, 0.03)
         + link("right_pad", "-0.0085 0 0.02", pad, 0.03)
-        + hinge("left_knuckle", "palm", "left_knuckle", "-0.055 0 0.06", 0, 0.8)
+        + drive
+        + hinge(
+            "left_knuckle",
+            "palm",
+            "left_knuckle",
+            "-0.055 0 0.06",
+            0,
+            0.8,
+            knuckle_mimic,
+        )
         + hinge("right_knuckle", "palm", "right_knuckle", "0.055 0 0.06", -0.8, 0, -1)
         + hinge("left_pad_joint", "left_knuckle", "left_pad", "0 0 0.05", -0.8, 0, -1)
         + hinge("right_pad_joint", "right_knuckle", "right_pad", "0 0 0.05", 0, 0.8, 1)
         + four_bar
         + '<transmission name="t"><type>transmission_interface/SimpleTransmission'
-        '</type><joint name="left_knuckle"/><actuator name="motor">'
+        f'</type><joint name="{lead}"/><actuator name="motor">'
         "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
         "</robot>"
     )
