@@ -18,6 +18,7 @@ __all__ = [
     "DEFAULT_TOL",
     "MAX_DISTANCE_TOLERANCE",
     "UNIT_NORMAL_TOL",
+    "QUERY_POSE_TOL",
     "ZERO_FRACTION",
     "near_threshold",
     "relative_margin",
@@ -56,6 +57,13 @@ point normalises them first (to within a few units in the last place).  1e-6
 admits normals normalised in float32 (about 1e-7 off) or read from six-digit
 text, and refuses a normal that was never normalised.
 """
+
+QUERY_POSE_TOL = 1e-9
+"""How far a body may stand in a ``QueryObject`` from where the plant's context
+puts it: each entry of its pose's ``[R | p]`` (p in metres), times the body's
+distance from the world origin where that is past 1 m.  Both compute the same
+kinematics from the same state, so they agree to rounding
+(:func:`drakegrasp.plant.validation.checked_query_object`)."""
 
 DEFAULT_NUM_GENERATORS = 8
 """Default generators ``n_g`` of each polyhedral (inscribed) spatial Coulomb cone."""

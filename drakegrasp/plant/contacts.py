@@ -466,7 +466,8 @@ def find_contacts(
         query = query_object_of(plant, plant_context)
         inspector = query.inspector()
     else:
-        query, inspector = query_object, checked_query_object(plant, query_object)
+        query = query_object
+        inspector = checked_query_object(plant, query, plant_context, [body, *fingers])
     object_geometries = plant.GetCollisionGeometriesForBody(body)
     object_name = _scoped_name(plant, body)
     if not object_geometries:

@@ -28,6 +28,7 @@ from pydrake.multibody.tree import BodyIndex, JointIndex, ModelInstanceIndex, Ri
 from pydrake.systems.framework import Context
 
 from drakegrasp.core.deferred import WeakMemo
+from drakegrasp.core.tolerances import QUERY_POSE_TOL
 from drakegrasp.core.validation import describe, integer_or_none
 from drakegrasp.errors import (
     GraspError,
@@ -262,7 +263,12 @@ def checked_context(plant: MultibodyPlant, context: Context) -> Iterator[Context
         _CHECKED.reset(token)
 
 
-def checked_query_object(plant: MultibodyPlant, query_object):
+def checked_query_object(
+    plant: MultibodyPlant,
+    query_object,
+    plant_context: Context | None = None,
+    bodies: Iterable[RigidBody] = (),
+):
     """``query_object``'s inspector, once it is known to serve ``plant``.
 
     Parameters
@@ -271,6 +277,13 @@ def checked_query_object(plant: MultibodyPlant, query_object):
         Registered with a ``SceneGraph``.
     query_object : pydrake.geometry.QueryObject
         A value of that scene graph's query output port.
+    plant_context : Context, optional
+        The plant's context that the query's distances are read with (already
+        resolved by :func:`plant_context_of`): then each of ``bodies`` must
+        stand in the query where the context puts it.
+    bodies : iterable of RigidBody, optional
+        The bodies whose geometry the query is asked about (a hand's and the
+        object), checked against ``plant_context``.
 
     Returns
     -------
@@ -280,8 +293,10 @@ def checked_query_object(plant: MultibodyPlant, query_object):
     ------
     InvalidOptionError
         Not a ``QueryObject``, one that holds no scene graph's query
-        (default-constructed), or one of a scene graph the plant is not
-        registered with (another diagram's).
+        (default-constructed), one of a scene graph the plant is not
+        registered with (another diagram's), or one evaluated at another
+        state than ``plant_context`` (another context of the same diagram: its
+        distances and the context's Jacobians would describe two poses).
     InvalidPoseError
         Drake cannot compute its geometries' poses (a bad state of the plant).
     ModelError
@@ -316,7 +331,31 @@ def checked_query_object(plant: MultibodyPlant, query_object):
             f"{plant.get_name()!r} is not registered with; pass the query of the "
             "plant's own scene graph"
         )
+    if plant_context is not None:
+        _check_same_state(plant, query_object, plant_context, bodies)
     return inspector
+
+
+def _check_same_state(plant, query_object, plant_context, bodies) -> None:
+    """Refuse a query whose bodies stand elsewhere than ``plant_context`` puts them."""
+    for body in bodies:
+        frame = plant.GetBodyFrameIdIfExists(body.index())
+        if frame is None:
+            continue
+        X_context = plant.EvalBodyPoseInWorld(plant_context, body)
+        X_query = query_object.GetPoseInWorld(frame)
+        scale = max(1.0, float(np.linalg.norm(X_context.translation())))
+        gap = X_context.GetAsMatrix34() - X_query.GetAsMatrix34()
+        if not np.max(np.abs(gap)) <= QUERY_POSE_TOL * scale:
+            moved = np.linalg.norm(X_context.translation() - X_query.translation())
+            turned = X_context.rotation().inverse().multiply(X_query.rotation())
+            angle = np.degrees(turned.ToAngleAxis().angle())
+            raise InvalidOptionError(
+                f"query_object was evaluated at another state than plant_context: "
+                f"body {scoped_name(plant, body)!r} stands {moved * 1e3:.3g} mm and "
+                f"{angle:.3g} deg from where the context puts it; pass the query "
+                "of the same context (or none: it is read from plant_context)"
+            )
 
 
 def query_object_of(plant: MultibodyPlant, plant_context: Context):

@@ -60,3 +60,33 @@ def test_query_object_of_the_wrong_type(scene):
             object_body=scene.object_body,
             query_object="scene_graph",
         )
+
+
+def test_query_object_at_another_state_is_refused(scene):
+    # The same scene graph's query, evaluated where a finger stands 5 mm off:
+    # its distances and the context's Jacobians would describe two grasps.
+    plant = scene.plant
+    context = _private_context(scene)
+    moved = plant.GetPositions(scene.plant_context).copy()
+    joint = next(
+        plant.get_joint(j)
+        for j in plant.GetJointIndices()
+        if plant.get_joint(j).type_name() == "prismatic"
+    )
+    moved[joint.position_start()] += 0.005
+    saved = plant.GetPositions(scene.plant_context).copy()
+    plant.SetPositions(scene.plant_context, moved)
+    try:
+        query = _query(scene)
+        with pytest.raises(InvalidOptionError, match="another state") as info:
+            dg.analyze_grasp(
+                plant, context, query_object=query, **scene.analysis_options()
+            )
+        assert "5 mm" in str(info.value)
+        plant.SetPositions(context, moved)  # the same state: accepted
+        report = dg.find_contacts(
+            plant, context, object_body=scene.object_body, query_object=query
+        )
+        assert len(report) == 4  # the moved finger is off the box
+    finally:
+        plant.SetPositions(scene.plant_context, saved)
