@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 from pydrake.math import RigidTransform
-from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
@@ -23,6 +22,7 @@ from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import add_models as add_coupled_models
 from drakegrasp.plant.models import (
     check_obj_vertices,
+    new_parser,
     register_models,
     use_local_drake_models,
 )
@@ -179,7 +179,7 @@ def scene_from_models(add_models) -> PlanningScene:
     """
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    hand, name = add_models(plant, Parser(plant))
+    hand, name = add_models(plant, new_parser(plant, "the planning scene"))
     plant.Finalize()
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()

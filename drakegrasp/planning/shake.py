@@ -88,6 +88,7 @@ from drakegrasp.plant.hydroelastic import (
     check_hydroelastic_modulus,
     use_hydroelastic_contact,
 )
+from drakegrasp.plant.models import new_parser
 from drakegrasp.plant.validation import (
     check_rigid_transform,
     resolve_body,
@@ -791,13 +792,11 @@ def shake_test(
             stacklevel=2,
         )
     t0 = time.perf_counter()
-    from pydrake.multibody.parsing import Parser
-
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(
         builder, time_step=float(time_step)
     )
-    made = add_models(plant, Parser(plant))
+    made = add_models(plant, new_parser(plant, "the shake test's plant"))
     if not (isinstance(made, tuple | list) and len(made) == 2):
         raise ModelError(
             f"add_models must return (hand, object_body), got {type(made).__name__}"

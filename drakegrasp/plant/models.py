@@ -29,6 +29,7 @@ __all__ = [
     "explain_drake_models",
     "load_models",
     "models_dir",
+    "new_parser",
     "register_models",
     "use_local_drake_models",
 ]
@@ -74,6 +75,21 @@ def explain_drake_models(message: str) -> str:
     if "download" in text:
         return f"{text}. {DRAKE_MODELS_HINT}"
     return text
+
+
+def new_parser(plant, what: str) -> Parser:
+    """``Parser(plant)``, or a ``ModelError`` naming ``what`` and the way out.
+
+    Drake's parser registers ``drake_models`` as a download when it is made,
+    and refuses to be made while ``DRAKE_ALLOW_NETWORK`` forbids downloads
+    and the cache lacks the package (:func:`explain_drake_models`).
+    """
+    try:
+        return Parser(plant)
+    except RuntimeError as e:  # its default PackageMap could not add drake_models
+        raise ModelError(
+            f"{what}: cannot make Drake's parser: " + explain_drake_models(str(e))
+        ) from None
 
 
 class _Collected(logging.Handler):

@@ -151,7 +151,6 @@ from typing import TYPE_CHECKING
 from pydrake.multibody.parsing import (
     FlattenModelDirectives,
     LoadModelDirectivesFromString,
-    Parser,
     ProcessModelDirectives,
 )
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
@@ -172,6 +171,7 @@ from drakegrasp.plant.models import (
     explain_drake_models,
     load_models,
     models_dir,
+    new_parser,
 )
 from drakegrasp.plant.options import AnalysisOptions
 from drakegrasp.plant.scene_file import (
@@ -432,13 +432,7 @@ def _new_plant(path: Path, package_map: PackagesSpec, ros_package_path: bool):
     """(builder, plant, parser, packages) of an empty scene, packages registered."""
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    try:
-        parser = Parser(plant)
-    except RuntimeError as e:  # its default PackageMap could not add drake_models
-        raise ModelError(
-            f"scene {str(path)!r}: cannot make Drake's parser: "
-            + explain_drake_models(str(e))
-        ) from None
+    parser = new_parser(plant, f"scene {str(path)!r}")
     packages = add_packages(parser, package_map, ros_package_path=ros_package_path)
     return builder, plant, parser, packages
 

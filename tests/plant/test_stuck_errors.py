@@ -56,9 +56,10 @@ drakegrasp:
 REPO = Path(drakegrasp.__file__).resolve().parents[1]
 
 
-def _analyze_offline(tmp_path: Path, prefix: list[str], **env: str):
+def _analyze_offline(tmp_path: Path, prefix: list[str], command=None, **env: str):
     scene = tmp_path / "wsg.yaml"
     scene.write_text(SCENE)
+    command = command or ["analyze", str(scene)]
     cache = tmp_path / "cache"  # an empty download cache
     cache.mkdir()
     child = {
@@ -68,7 +69,7 @@ def _analyze_offline(tmp_path: Path, prefix: list[str], **env: str):
     }
     child.update(XDG_CACHE_HOME=str(cache), PYTHONPATH=str(REPO), **env)
     return subprocess.run(
-        [*prefix, sys.executable, "-m", "drakegrasp", "analyze", str(scene)],
+        [*prefix, sys.executable, "-m", "drakegrasp", *command],
         capture_output=True,
         text=True,
         env=child,
@@ -99,6 +100,17 @@ def test_failed_download_names_the_variable_and_the_flag(tmp_path):
 def test_network_forbidden_names_the_variable_and_the_flag(tmp_path):
     done = _analyze_offline(tmp_path, [], DRAKE_ALLOW_NETWORK="none")
     assert done.returncode == 1 and done.stdout == ""
+    assert "unset DRAKE_ALLOW_NETWORK" in done.stderr
+    _names_the_way_out(done.stderr)
+
+
+def test_network_forbidden_stops_plan_with_the_same_words(tmp_path):
+    # plan made its parser unguarded: Drake's words alone, no way out named
+    done = _analyze_offline(
+        tmp_path, [], ["plan", "box", "--num", "5"], DRAKE_ALLOW_NETWORK="none"
+    )
+    assert done.returncode == 1 and done.stdout == ""
+    assert "the planning scene: cannot make Drake's parser" in done.stderr
     assert "unset DRAKE_ALLOW_NETWORK" in done.stderr
     _names_the_way_out(done.stderr)
 
