@@ -356,8 +356,8 @@ def _two_prismatic_fingers(plant, plant_context, object_body, hand):
 
     The coupling is ``(m, b)``, ``q_1 = m q_0 + b``, when one joint follows
     the other (or both follow one leader), else None.  The limits are
-    ``(lower, upper)``, (2,) each: the joints' own, within what a hidden
-    drive they follow allows (:func:`_within_drive`).
+    ``(lower, upper)``, (2,) each: the joints' own, within what their
+    couplings let them reach (:func:`_coupled_limits`).
     """
     bodies = hand_bodies(plant, object_body, hand)
     base = free_base(plant, bodies, hand=hand)
@@ -375,9 +375,7 @@ def _two_prismatic_fingers(plant, plant_context, object_body, hand):
         )
     joints = tuple(structure.joints[f.joints[0]] for f in fingers)
     follows = structure.coupling.follows
-    own_order = [f.joints[0] for f in fingers]
-    own = set(own_order)
-    limits = [_within_drive(structure.joints, follows, i, own) for i in own_order]
+    limits = _coupled_limits(structure.joints, follows, [f.joints[0] for f in fingers])
     for j, (lo, hi) in zip(joints, limits, strict=True):
         if j.type_name() != "prismatic" or not (np.isfinite(lo) and np.isfinite(hi)):
             raise ModelError(
@@ -387,33 +385,61 @@ def _two_prismatic_fingers(plant, plant_context, object_body, hand):
         if not hi > lo:
             raise ModelError(
                 f"finger joint {j.name()} has no stroke: its limits [{lo}, {hi}] "
-                "(within those of the drive it follows, if any) leave the finger "
-                "no room to close"
+                "(within what its coupling to the other finger or to a drive "
+                "lets it reach, if any) leave the finger no room to close"
             )
     coupling = _jaw_coupling(follows, *(f.joints[0] for f in fingers))
     lower, upper = (np.array(v, dtype=float) for v in zip(*limits, strict=True))
     return base, fingers, joints, coupling, (lower, upper)
 
 
-def _within_drive(joints, follows, i: int, fingers: set) -> tuple[float, float]:
-    """Joint ``i``'s limits, within those its chain's root allows through it.
+def _coupled_limits(joints, follows, fingers: list) -> list[tuple[float, float]]:
+    """The finger joints' limits, within what their couplings let them reach.
 
-    ``q_i = a q_root + c`` along its chain of leaders (``follows``: index ->
-    ``(leader, ρ, Δq)``); a root that is no finger joint (a hidden drive)
-    reaches only ``a [lo, hi] + c`` of the finger, so a pose outside it
-    breaks the drive's limits (the planner read the finger's alone).
+    ``q_i = a_i q_root + c_i`` along each finger's chain of leaders
+    (``follows``: index -> ``(leader, ρ, Δq)``).  The fingers tied to one root
+    (a hidden drive, or one finger the other follows) move as one: the
+    root's positions that keep the root and every one of them within its
+    limits are those of the jaw, and each finger reaches only their image.
+    (The planner read each joint's own limits, and a hidden drive's, so a
+    follower at ratio -2 opened past where its leader can go.)
+
+    Parameters
+    ----------
+    joints : sequence of Joint
+        The hand's joints, indexed as ``follows`` and ``fingers`` are.
+    follows : dict
+        :class:`~drakegrasp.plant.fingers.Coupling`'s follower -> ``(leader,
+        ρ, Δq)``.
+    fingers : list of int
+        The finger joints, in the jaw's order.
+
+    Returns
+    -------
+    list of (float, float)
+        Per finger, ``(lower, upper)`` in its own unit (m); ``upper < lower``
+        when the couplings leave it no position.
     """
-    j = joints[i]
-    lo, hi = j.position_lower_limits()[0], j.position_upper_limits()[0]
-    k, a, c = _chain_root(follows, i)
-    if k == i or k in fingers or a == 0.0:
-        return float(lo), float(hi)
-    root = joints[k]
-    ends = sorted(
-        a * q + c
-        for q in (root.position_lower_limits()[0], root.position_upper_limits()[0])
-    )
-    return float(max(lo, ends[0])), float(min(hi, ends[1]))
+
+    def own(i: int) -> tuple[float, float]:
+        j = joints[i]
+        return float(j.position_lower_limits()[0]), float(j.position_upper_limits()[0])
+
+    roots: dict[int, list] = {}
+    for i in fingers:
+        k, a, c = _chain_root(follows, i)
+        roots.setdefault(k, []).append((i, a, c))
+    out = {}
+    for k, members in roots.items():
+        lo, hi = own(k)
+        for i, a, c in members:
+            if a != 0.0:
+                ends = sorted(((own(i)[0] - c) / a, (own(i)[1] - c) / a))
+                lo, hi = max(lo, ends[0]), min(hi, ends[1])
+        for i, a, c in members:
+            mapped = sorted((a * lo + c, a * hi + c)) if a != 0.0 else own(i)
+            out[i] = (float(mapped[0]), float(mapped[1]))
+    return [out[i] for i in fingers]
 
 
 def _jaw_coupling(follows, i0: int, i1: int) -> tuple[float, float] | None:

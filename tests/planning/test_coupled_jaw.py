@@ -213,3 +213,34 @@ def test_on_a_cloud_the_shifted_hand_is_checked_against_the_cloud(
     assert len(result) >= 3
     for c in result:
         assert min(np.linalg.norm(s - c.X_WH.translation()) for s in seen) < 1e-12
+
+
+@pytest.mark.parametrize(
+    ("ratio", "offset", "left", "right"),
+    [
+        (-2.0, 0.0, (0.0, 0.0225), (-0.045, 0.0)),  # the follower stops the leader
+        (-0.5, 0.0, (0.0, 0.045), (-0.0225, 0.0)),  # the leader stops the follower
+        (-2.0, 0.01, (0.005, 0.0275), (-0.045, 0.0)),
+        (-1.0, -0.002, (0.0, 0.043), (-0.045, -0.002)),
+    ],
+)
+def test_each_finger_reaches_only_what_its_coupling_allows(
+    tmp_path, ratio, offset, left, right
+):
+    # q_right = ratio q_left + offset, both within their own limits: the
+    # fingers reach the image of the leader's positions that keep both within
+    # theirs.  Read without the coupling, a follower at ratio -2 opened the
+    # jaw to 76 mm where it reaches 53.5 mm, and a jaw on a hidden drive (the
+    # same jaw) reached less than its twin.
+    jaws = {
+        hidden: _jaw(_scene(tmp_path, ratio=ratio, offset=offset, hidden_drive=hidden))
+        for hidden in (False, True)
+    }
+    for jaw in jaws.values():
+        np.testing.assert_allclose(jaw.lower, [left[0], right[0]], atol=1e-15)
+        np.testing.assert_allclose(jaw.upper, [left[1], right[1]], atol=1e-15)
+    twin, hidden = jaws[False], jaws[True]
+    assert hidden.min_opening == twin.min_opening
+    assert hidden.max_opening == twin.max_opening
+    # open, the capsules' inner sides (7 mm radius) are the fingers' less 14 mm
+    assert twin.max_opening == pytest.approx(left[1] - right[0] - 0.014, abs=1e-12)

@@ -143,10 +143,11 @@ def test_a_shake_squeezes_through_the_drive(twins):
 
 def test_a_drive_that_opens_one_finger_as_it_closes_the_other_is_refused(tmp_path):
     # both fingers follow the drive with ratio +1: the pads move the same way,
-    # and the right finger's [-45, 0] mm meets the drive's [0, 45] mm at 0
+    # and the right finger's [-45, 0] mm meets the drive's [0, 45] mm at 0:
+    # the drive reaches only 0, and neither finger has a stroke
     scene = _scene(tmp_path, "same_way", ratio=1.0, hidden_drive=True)
     ctx = scene.plant.GetMyContextFromRoot(scene.context)
-    with pytest.raises(dg.ModelError, match="right_slide has no stroke"):
+    with pytest.raises(dg.ModelError, match="left_slide has no stroke"):
         parallel_jaw(scene.plant, ctx, scene.object_body, scene.hand)
 
 
