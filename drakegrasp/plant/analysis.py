@@ -326,13 +326,13 @@ def grasp_from_plant(
         check_pose = opts.check_pose
         torsional_friction = opts.torsional_friction or 0.0
         body = resolve_object_body(plant, object_body)
-        if query_object is not None:
-            checked_query_object(plant, query_object)
+        bodies = hand_contact_bodies(plant, body, hand)
+        if query_object is not None:  # before the pose check reads it
+            checked_query_object(plant, query_object, plant_context, [body, *bodies])
         if contacts is not None:  # only mu="plant" reads their geometries
             contacts = check_plant_contacts(
                 plant, contacts, body, reads_geometry=opts.mu == "plant"
             )
-        bodies = hand_contact_bodies(plant, body, hand)
         couplings = plant_couplings(plant, couplings)
         pose = _pose_of(
             plant,

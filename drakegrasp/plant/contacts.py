@@ -432,8 +432,9 @@ def find_contacts(
         from.  Default: evaluate the plant's geometry query input port in
         ``plant_context``.  Pass one when ``plant_context`` is not connected to
         a scene graph (e.g. a private context inside a Drake ``System`` such as
-        :class:`drakegrasp.GraspMonitor`, fed by a query-object input port); it
-        must describe the same configuration as ``plant_context``.
+        :class:`drakegrasp.GraspMonitor`, fed by a query-object input port); a
+        query whose bodies stand elsewhere than ``plant_context`` puts them is
+        refused.
 
     Returns
     -------
@@ -451,6 +452,10 @@ def find_contacts(
         the pair and its depth.
     ModelError
         If the plant has no scene graph, or a geometry's shape is unsupported.
+    InvalidOptionError
+        An option out of range, or a ``query_object`` that is not a query of
+        the plant's scene graph at ``plant_context``'s state
+        (:func:`~drakegrasp.plant.validation.checked_query_object`).
     """
     plant_context = plant_context_of(plant, plant_context)
     tol = check_distance_tolerance(distance_tolerance)

@@ -17,6 +17,7 @@ import re
 from pathlib import Path
 
 from pydrake.multibody.parsing import PackageMap, Parser
+from pydrake.multibody.plant import MultibodyPlant
 
 from drakegrasp.errors import GraspError, InvalidOptionError, ModelError
 
@@ -77,12 +78,19 @@ def explain_drake_models(message: str) -> str:
     return text
 
 
-def new_parser(plant, what: str) -> Parser:
+def new_parser(plant: MultibodyPlant, what: str) -> Parser:
     """``Parser(plant)``, or a ``ModelError`` naming ``what`` and the way out.
 
     Drake's parser registers ``drake_models`` as a download when it is made,
     and refuses to be made while ``DRAKE_ALLOW_NETWORK`` forbids downloads
     and the cache lacks the package (:func:`explain_drake_models`).
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Not finalized: the parser adds models to it.
+    what : str
+        What the parser is for, to begin the error ("scene 'x.yaml'").
     """
     try:
         return Parser(plant)

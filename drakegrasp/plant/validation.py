@@ -267,7 +267,7 @@ def checked_query_object(
     plant: MultibodyPlant,
     query_object,
     plant_context: Context | None = None,
-    bodies: Iterable[RigidBody] = (),
+    bodies: Iterable[RigidBody] | None = None,
 ):
     """``query_object``'s inspector, once it is known to serve ``plant``.
 
@@ -278,12 +278,13 @@ def checked_query_object(
     query_object : pydrake.geometry.QueryObject
         A value of that scene graph's query output port.
     plant_context : Context, optional
-        The plant's context that the query's distances are read with (already
-        resolved by :func:`plant_context_of`): then each of ``bodies`` must
-        stand in the query where the context puts it.
+        The context (the plant's or its diagram's: :func:`plant_context_of`)
+        that the query's distances are read with: then each of ``bodies``
+        must stand in the query where the context puts it.
     bodies : iterable of RigidBody, optional
         The bodies whose geometry the query is asked about (a hand's and the
-        object), checked against ``plant_context``.
+        object), checked against ``plant_context``; None (default): every
+        body of the plant with geometry.
 
     Returns
     -------
@@ -295,8 +296,9 @@ def checked_query_object(
         Not a ``QueryObject``, one that holds no scene graph's query
         (default-constructed), one of a scene graph the plant is not
         registered with (another diagram's), or one evaluated at another
-        state than ``plant_context`` (another context of the same diagram: its
-        distances and the context's Jacobians would describe two poses).
+        state, or with other kinematic parameters, than ``plant_context``
+        (another context of the same diagram: its distances and the context's
+        Jacobians would describe two poses).
     InvalidPoseError
         Drake cannot compute its geometries' poses (a bad state of the plant).
     ModelError
@@ -332,12 +334,26 @@ def checked_query_object(
             "plant's own scene graph"
         )
     if plant_context is not None:
+        if bodies is None:
+            bodies = [plant.get_body(b) for b in range(plant.num_bodies())]
+        plant_context = plant_context_of(plant, plant_context)
         _check_same_state(plant, query_object, plant_context, bodies)
     return inspector
 
 
-def _check_same_state(plant, query_object, plant_context, bodies) -> None:
-    """Refuse a query whose bodies stand elsewhere than ``plant_context`` puts them."""
+def _check_same_state(
+    plant: MultibodyPlant,
+    query_object,
+    plant_context: Context,
+    bodies: Iterable[RigidBody],
+) -> None:
+    """Refuse a query whose bodies stand elsewhere than ``plant_context`` puts them.
+
+    Each body's pose in the world, ``[R | p]`` (p in metres), from the query
+    and from the context, entry by entry within
+    :data:`~drakegrasp.core.tolerances.QUERY_POSE_TOL` (times the body's
+    distance from the origin past 1 m); a body without geometry is let be.
+    """
     for body in bodies:
         frame = plant.GetBodyFrameIdIfExists(body.index())
         if frame is None:
@@ -351,10 +367,12 @@ def _check_same_state(plant, query_object, plant_context, bodies) -> None:
             turned = X_context.rotation().inverse().multiply(X_query.rotation())
             angle = np.degrees(turned.ToAngleAxis().angle())
             raise InvalidOptionError(
-                f"query_object was evaluated at another state than plant_context: "
-                f"body {scoped_name(plant, body)!r} stands {moved * 1e3:.3g} mm and "
-                f"{angle:.3g} deg from where the context puts it; pass the query "
-                "of the same context (or none: it is read from plant_context)"
+                "query_object was evaluated at another state (or with other "
+                f"parameters) than plant_context: body {scoped_name(plant, body)!r} "
+                f"stands {moved * 1e3:.3g} mm and {angle:.3g} deg from where the "
+                "context puts it; pass the query of the same context (or none: "
+                "it is read from plant_context; a GraspMonitor takes its "
+                "diagram's parameters with use_parameters_of)"
             )
 
 

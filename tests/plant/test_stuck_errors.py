@@ -56,7 +56,7 @@ drakegrasp:
 REPO = Path(drakegrasp.__file__).resolve().parents[1]
 
 
-def _analyze_offline(tmp_path: Path, prefix: list[str], command=None, **env: str):
+def _run_offline(tmp_path: Path, prefix: list[str], command=None, **env: str):
     scene = tmp_path / "wsg.yaml"
     scene.write_text(SCENE)
     command = command or ["analyze", str(scene)]
@@ -91,14 +91,14 @@ def test_failed_download_names_the_variable_and_the_flag(tmp_path):
     probe = subprocess.run(["unshare", "-rn", "true"], capture_output=True)
     if probe.returncode != 0:
         pytest.skip(f"unshare -rn is not permitted here: {probe.stderr.strip()}")
-    done = _analyze_offline(tmp_path, ["unshare", "-rn"])
+    done = _run_offline(tmp_path, ["unshare", "-rn"])
     assert done.returncode == 1 and done.stdout == ""
     assert "when downloading 'drake_models'" in done.stderr
     _names_the_way_out(done.stderr)
 
 
 def test_network_forbidden_names_the_variable_and_the_flag(tmp_path):
-    done = _analyze_offline(tmp_path, [], DRAKE_ALLOW_NETWORK="none")
+    done = _run_offline(tmp_path, [], DRAKE_ALLOW_NETWORK="none")
     assert done.returncode == 1 and done.stdout == ""
     assert "unset DRAKE_ALLOW_NETWORK" in done.stderr
     _names_the_way_out(done.stderr)
@@ -106,7 +106,7 @@ def test_network_forbidden_names_the_variable_and_the_flag(tmp_path):
 
 def test_network_forbidden_stops_plan_with_the_same_words(tmp_path):
     # plan made its parser unguarded: Drake's words alone, no way out named
-    done = _analyze_offline(
+    done = _run_offline(
         tmp_path, [], ["plan", "box", "--num", "5"], DRAKE_ALLOW_NETWORK="none"
     )
     assert done.returncode == 1 and done.stdout == ""

@@ -83,6 +83,15 @@ def test_query_object_at_another_state_is_refused(scene):
                 plant, context, query_object=query, **scene.analysis_options()
             )
         assert "5 mm" in str(info.value)
+        found = dg.find_contacts(
+            plant, scene.plant_context, object_body=scene.object_body, hand=scene.hand
+        )
+        with pytest.raises(InvalidOptionError, match="another state"):
+            # given contacts, the query is still read (the pose, mu="plant")
+            dg.analyze_grasp(
+                plant, context, query_object=query, contacts=found,
+                **scene.analysis_options(),
+            )  # fmt: skip
         plant.SetPositions(context, moved)  # the same state: accepted
         report = dg.find_contacts(
             plant, context, object_body=scene.object_body, query_object=query
