@@ -98,7 +98,7 @@ from drakegrasp.planning.needed import (
 )
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
 from drakegrasp.plant.couplings import coupling_map, motor_shares, plant_couplings
-from drakegrasp.plant.fingers import effort_unit, find_joint, is_hidden_drive
+from drakegrasp.plant.fingers import effort_unit, find_joint, hidden_drives
 from drakegrasp.plant.jacobians import contact_rows, hand_jacobian
 from drakegrasp.plant.validation import (
     plant_context_of,
@@ -305,14 +305,19 @@ def _motor_map(plant, candidate: GraspCandidate):
     at every actuator: ``|C|ᵀ a``, ``a_k`` 1 for a joint with an actuator and
     0 for one without (a follower's torque comes through its coupling; an
     unactuated, uncoupled joint is passive).  A plant without any actuator
-    says nothing of its motors: each joint counts as one.  None when every
-    joint is its own motor (``C = I``, ``w = 1``).
+    says nothing of its motors: each joint counts as one, but a hidden drive
+    (its followers count in its stead, as in its twin whose motor sits on a
+    finger).  None when every joint is its own motor (``C = I``, ``w = 1``).
     """
     joints = [find_joint(plant, name) for name in candidate.joint_names]
     columns = np.array([j.velocity_start() for j in joints], dtype=int)
-    C, _ = coupling_map(plant, columns, plant_couplings(plant))
-    actuated = np.array([bool(_actuators(plant, j)) for j in joints])
-    a = actuated.astype(float) if plant.num_actuators() else np.ones(len(joints))
+    couplings = plant_couplings(plant)
+    C, _ = coupling_map(plant, columns, couplings)
+    if plant.num_actuators():
+        a = np.array([bool(_actuators(plant, j)) for j in joints], dtype=float)
+    else:  # every joint a motor, but a hidden drive, which touches nothing
+        drives = hidden_drives(plant, couplings)
+        a = np.array([n not in drives for n in candidate.joint_names], dtype=float)
     if C.shape[0] == C.shape[1] and np.all(a == 1.0):
         return None
     return C, np.abs(C).T @ a
@@ -658,30 +663,25 @@ def motor_limit(plant, candidate: GraspCandidate, *, per_finger: bool = False) -
 def _joint_motors(plant, names, per_finger: bool = True) -> dict:
     """Per closing joint, the actuators that press it and the share each gives.
 
-    A joint's own actuators; with ``per_finger``, shares over the followers a
-    motor drives, and for a follower of a hidden drive (a leader that touches
-    nothing: :func:`~drakegrasp.plant.fingers.is_hidden_drive`; a
-    multi-finger candidate holds it among its closing joints, a jaw's does
-    not) the drive's actuators, which press only through its followers.
-    A leader with geometry that the candidate leaves out drives nothing of it.
+    A joint's own actuators, and for a follower of a hidden drive that is no
+    closing joint (a jaw's: :func:`~drakegrasp.plant.fingers.hidden_drives`)
+    the drive's.  With ``per_finger`` each comes with its share over the
+    joints it drives (:func:`~drakegrasp.plant.couplings.motor_shares`: a
+    drive presses only through its followers, also where it is a closing
+    joint, as a multi-finger candidate's is); without, with 1.  A leader with
+    geometry that the candidate leaves out drives nothing of it.
     """
     own = {n: _actuators(plant, find_joint(plant, n)) for n in names}
-    if not per_finger:
-        return {n: [(a, 1.0) for a in own[n]] for n in names}
     couplings = plant_couplings(plant)
-    drives = {
-        leader
-        for _, leader, _, _ in couplings
-        if is_hidden_drive(plant, find_joint(plant, leader))
-    }
+    drives = hidden_drives(plant, couplings)
     hidden = {d: _actuators(plant, find_joint(plant, d)) for d in drives - own.keys()}
     motors = {**own, **hidden}
     actuated = [n for n in motors if motors[n]]
     driven, shares = motor_shares(couplings, names, actuated, drives=drives)
     return {
         n: [
-            (a, shares.get(m, 1.0))
-            for m in [driven[n] if driven.get(n) in drives else n]
+            (a, shares.get(m, 1.0) if per_finger else 1.0)
+            for m in [driven[n] if driven.get(n) in hidden else n]
             for a in motors[m]
         ]
         for n in names

@@ -78,7 +78,7 @@ from drakegrasp.planning.turned_gravity import (
     _TurnedGravity,
 )
 from drakegrasp.plant.couplings import motor_shares, plant_couplings
-from drakegrasp.plant.fingers import effort_unit, find_joint, is_hidden_drive
+from drakegrasp.plant.fingers import effort_unit, find_joint, hidden_drives
 from drakegrasp.plant.friction import (
     MU_RELATIVE_TOL,
     FrictionMismatchWarning,
@@ -811,11 +811,7 @@ def shake_test(
     # a follower is driven by its leader's motor: a closing joint's, or a
     # hidden drive's (a leader that closes nothing itself)
     couplings = _known_couplings(plant)
-    drives = {
-        name
-        for name, actuator in by_name.items()
-        if is_hidden_drive(plant, actuator.joint())
-    }
+    drives = hidden_drives(plant, couplings)
     actuated = [
         name for name in by_name if name in candidate.joint_names or name in drives
     ]

@@ -665,9 +665,11 @@ def motor_shares(couplings, joints, actuated, *, drives=()) -> tuple[dict, dict]
         The joints with an actuator: those of ``joints``, and any leader
         outside them whose motor is to count.
     drives : iterable of str, optional
-        Hidden drives among ``joints`` (a multi-finger hand's closing joints
-        hold every joint of the hand, its drive too): they touch nothing, so
-        their motors press only through their followers.
+        Leaders that are hidden drives
+        (:func:`~drakegrasp.plant.fingers.hidden_drives`): they touch nothing,
+        so their motors press only through their followers, also when they are
+        among ``joints`` (a multi-finger hand's closing joints hold every joint
+        of the hand, its drive too).
 
     Returns
     -------

@@ -55,6 +55,7 @@ __all__ = [
     "finger_chains",
     "free_part",
     "hand_structure",
+    "hidden_drives",
     "is_hidden_drive",
     "most_fingers",
     "passive_joints",
@@ -512,6 +513,26 @@ def is_hidden_drive(plant: MultibodyPlant, joint: Joint) -> bool:
         plant.GetCollisionGeometriesForBody(plant.get_body(b))
         for b in _below(plant, joint.child_body().index())
     )
+
+
+def hidden_drives(plant: MultibodyPlant, couplings) -> set[str]:
+    """The leaders of ``couplings`` that are hidden drives (:func:`is_hidden_drive`).
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized or not (a shake's plant is read before it is).
+    couplings : sequence of (follower, leader, gear_ratio, offset)
+        Scoped joint names (:func:`~drakegrasp.plant.couplings.plant_couplings`).
+
+    Returns
+    -------
+    set of str
+        Scoped names of the leaders that touch nothing: their motors press
+        only through the joints that follow them.
+    """
+    leaders = {leader for _, leader, _, _ in couplings}
+    return {n for n in leaders if is_hidden_drive(plant, find_joint(plant, n))}
 
 
 def _drives_only(plant, structure: HandStructure, group, moved, position) -> bool:

@@ -82,6 +82,10 @@ def test_the_drives_motor_squeezes_each_finger_with_half_its_limit(twins):
     assert not hidden.reason, hidden.reason  # was: "the model gives ... no actuator"
     assert hidden.settings["held_first"] == twin.settings["held_first"]
     assert hidden.settings["held_first"]["limit"] == pytest.approx(40.0 / 2)
+    # the motor's own limit: the drive's (it said inf, reading the fingers')
+    (scene, _, result), (twin_scene, _, twin_result) = twins["hidden"], twins["twin"]
+    limit = motor_limit(scene.plant, result.candidates[0])
+    assert limit == motor_limit(twin_scene.plant, twin_result.candidates[0]) == 40.0
 
 
 def test_a_candidate_puts_the_drive_where_the_couplings_do(twins):
@@ -277,6 +281,28 @@ def test_a_pinch_on_a_hidden_drive_plans_as_its_twin(pinch_twins):
     assert limit == pytest.approx(5.0 / 4)
 
 
+def test_a_pinch_without_actuators_counts_its_drive_as_no_motor(tmp_path):
+    # With effort 0 Drake gives no joint an actuator, and each joint counts as
+    # a motor: the drive, touching nothing, counted too (its column bound
+    # 1 + Σ|ρ| = 5 where the twin's knuckle has 1 + 3 = 4), so the hidden
+    # drive's torque_needed came out 4/5 of the twin's.
+    needed = {}
+    for name, hidden in (("twin", False), ("hidden", True)):
+        path = tmp_path / f"{name}.urdf"
+        path.write_text(one_motor_pinch_urdf(effort=0.0, hidden_drive=hidden))
+        scene = planning_scene(BOX, hand_url=str(path))
+        assert scene.plant.num_actuators() == 0
+        result = plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=30, mu=0.5, seed=0, robustness_samples=4,
+            object_mass=0.2,
+        )  # fmt: skip
+        needed[name] = [(c.sample, c.torque_needed) for c in result]
+    assert len(needed["twin"]) > 5
+    for (s_h, t_h), (s_t, t_t) in zip(needed["hidden"], needed["twin"], strict=True):
+        assert s_h == s_t and t_h == pytest.approx(t_t, rel=1e-6)
+
+
 @pytest.mark.filterwarnings(
     "ignore::drakegrasp.plant.friction.FrictionMismatchWarning"  # plan 0.5, Drake 1
 )
@@ -284,14 +310,16 @@ def test_a_pinchs_hidden_drive_squeezes_through_its_followers(pinch_twins):
     """Drake's simulation: the drive's motor holds what the twin's holds.
 
     The drive touches nothing: its motor's squeeze is shared by the four
-    joints it drives, as the twin's knuckle motor's is (it counted itself as
-    a fifth, and squeezed each with 1 N·m where the twin gives 1.25).  The
-    pads press over patches (hydroelastic): with Drake's point contact a flat
-    pad on the box's face touches at one point, and whether the box pivots
-    out turns on how square the pads stand (seated, Drake's compliant couplers
-    leave the knuckles 1.3 mrad off the light drive, the twin's pads 0.013
-    mrad off its knuckles: the twin held its first candidate there and the
-    drive dropped it).  Both drop it at 0.01 N·m.
+    joints it drives, as the twin's knuckle motor's is.  It counted itself as
+    a fifth: its cap said 1 N·m per joint where the twin's says 1.25, and
+    below the effort limit it pressed with 5 × the squeeze where the twin
+    presses with 4 × (at 1 N·m: 4.96 N·m against 3.99).  The pads press over
+    patches (hydroelastic): with Drake's point contact a flat pad on the box's
+    face touches at one point, and whether the box pivots out turns on how
+    square the pads stand (seated, Drake's compliant couplers leave the
+    knuckles 1.3 mrad off the light drive, the twin's right knuckle 0.012
+    mrad off its left: the twin held its first candidate there and the drive
+    dropped it).  Both drop it at 0.01 N·m.
     """
     shaken = {
         (name, squeeze): shake_test(
@@ -303,11 +331,15 @@ def test_a_pinchs_hidden_drive_squeezes_through_its_followers(pinch_twins):
             **QUICK,
         )  # fmt: skip
         for name, (scene, result) in pinch_twins.items()
-        for squeeze in (20.0, 0.01)
+        for squeeze in (20.0, 1.0, 0.01)
     }
     hidden, twin = shaken["hidden", 20.0], shaken["twin", 20.0]
     assert hidden.squeeze_caps == twin.squeeze_caps == (pytest.approx(5.0 / 4),)
     assert hidden.efforts == pytest.approx(twin.efforts, rel=1e-2)  # at 5 N·m
     assert hidden.held and twin.held
     assert hidden.max_displacement == pytest.approx(twin.max_displacement, abs=2e-5)
+    hidden, twin = shaken["hidden", 1.0], shaken["twin", 1.0]
+    assert twin.efforts == (pytest.approx(4.0, rel=1e-2),)  # 1 N·m per joint
+    assert hidden.efforts == pytest.approx(twin.efforts, rel=1e-2)
+    assert hidden.held and twin.held
     assert not shaken["hidden", 0.01].held and not shaken["twin", 0.01].held
