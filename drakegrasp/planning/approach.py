@@ -75,6 +75,7 @@ from drakegrasp.plant.fingers import (
     HandStructure,
     finger_chains,
     hand_structure,
+    is_hidden_drive,
     tip_bodies,
 )
 from drakegrasp.plant.pose import JOINT_LIMIT_TOL
@@ -271,15 +272,20 @@ def _centres(plant, ctx, inspector, H, bodies) -> list[np.ndarray]:
     return out
 
 
-def _curl(tips, q0, structure, steps=_CURL_STEPS) -> np.ndarray:
+def _curl(tips, q0, structure, moves, steps=_CURL_STEPS) -> np.ndarray:
     """The closed hand: ``q0`` moved to draw the fingertips together.
 
     Projected gradient descent of the fingertips' spread
-    ``Σ_f |t_f(q) − t̄|²`` (central differences, each joint's step capped at
-    :data:`_CURL_STEP`), within the joint limits and couplings.
+    ``Σ_f |t_f(q) − t̄|²`` (central differences), within the joint limits and
+    couplings.  Each joint moves at most :data:`_CURL_STEP` a step: a leader
+    steps within its followers' caps over their ratios, a hidden drive
+    (``moves`` False) within those alone (:meth:`Coupling.leader_steps
+    <drakegrasp.plant.fingers.Coupling.leader_steps>`), so that a hand on a
+    drive curls as its twin with the motor on a finger does.
     """
     lower, upper = structure.lower, structure.upper
-    cap = np.array([_CURL_STEP[j.type_name() == "prismatic"] for j in structure.joints])
+    own = np.array([_CURL_STEP[j.type_name() == "prismatic"] for j in structure.joints])
+    cap = structure.coupling.leader_steps(own, moves)
     q = q0.copy()
     h = 1e-4
     for _ in range(steps):
@@ -413,7 +419,8 @@ def multi_finger_hand(
             ]
         )
 
-    q_curled = _curl(tips, q0, structure)
+    moves = np.array([not is_hidden_drive(plant, j) for j in structure.joints])
+    q_curled = _curl(tips, q0, structure, moves)
     centre = tips(q_curled).mean(axis=0)
     if curl_synergy:
         syn = q_curled - q0

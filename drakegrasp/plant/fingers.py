@@ -147,6 +147,30 @@ class Coupling:
             g[f] = 0.0
         return g
 
+    def leader_steps(self, cap: np.ndarray, moves: np.ndarray) -> np.ndarray:
+        """Each joint's largest step that moves no joint past its own ``cap``.
+
+        Parameters
+        ----------
+        cap : (n_h,) float
+            Largest change of each closing joint per step (its own unit).
+        moves : (n_h,) bool
+            False for a hidden drive (:func:`is_hidden_drive`): its motion
+            moves nothing, so only its followers bound its step.
+
+        Returns
+        -------
+        (n_h,) float
+            A leader's step within ``cap_f / |ρ|`` of each follower ``f`` (and
+            its own cap where it ``moves``); a follower's own cap.
+        """
+        step = np.where(moves, cap, np.inf)
+        for f, (lead, rho, _) in self.follows.items():
+            step[f] = cap[f]
+            if rho != 0.0:
+                step[lead] = min(step[lead], cap[f] / abs(rho))
+        return np.where(np.isfinite(step), step, cap)
+
     def leader_limits(self, lower: np.ndarray, upper: np.ndarray):
         """Limits with each leader's range cut to keep its follower in range."""
         lower, upper = lower.copy(), upper.copy()

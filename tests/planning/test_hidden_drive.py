@@ -25,11 +25,13 @@ from hypothesis import strategies as st
 
 import drakegrasp as dg
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.approach import multi_finger_hand
 from drakegrasp.planning.gripper import parallel_jaw
 from drakegrasp.planning.motors import motor_limit
 from drakegrasp.plant.couplings import coupled_positions, motor_shares
 
 BOX = "package://drakegrasp/objects/box.sdf"
+CYLINDER = "package://drakegrasp/objects/cylinder.sdf"
 QUICK = dict(settle=0.2, phase=0.3)
 
 
@@ -343,3 +345,30 @@ def test_a_pinchs_hidden_drive_squeezes_through_its_followers(pinch_twins):
     assert hidden.efforts == pytest.approx(twin.efforts, rel=1e-2)
     assert hidden.held and twin.held
     assert not shaken["hidden", 0.01].held and not shaken["twin", 0.01].held
+
+
+def test_a_drive_at_any_ratio_curls_the_hand_as_its_twin(tmp_path):
+    # The curl that sizes the hand capped each step of the drive at 0.1 rad,
+    # its own joint's cap: at ratio 0.5 its fingers moved 0.05 rad a step,
+    # the curl stopped short, and the hand's reach came out 91.6 mm against
+    # the twin's 89.8 (44 candidates on the cylinder against 46).
+    plans = {}
+    for ratio in (None, 0.5, 2.0):
+        path = tmp_path / f"pinch_{ratio}.urdf"
+        path.write_text(
+            one_motor_pinch_urdf(hidden_drive=ratio is not None, drive_ratio=ratio or 1)
+        )
+        scene = planning_scene(CYLINDER, hand_url=str(path))
+        ctx = scene.plant.GetMyContextFromRoot(scene.context)
+        hand = multi_finger_hand(scene.plant, ctx, scene.object_body, scene.hand)
+        result = plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=60, mu=0.5, seed=0, robustness_samples=8,
+        )  # fmt: skip
+        plans[ratio] = (hand.reach, [(c.sample, c.score) for c in result])
+    twin_reach, twin = plans.pop(None)
+    assert len(twin) > 30
+    for reach, candidates in plans.values():
+        assert reach == pytest.approx(twin_reach, rel=1e-9)
+        assert [s for s, _ in candidates] == [s for s, _ in twin]
+        np.testing.assert_allclose([v for _, v in candidates], [v for _, v in twin])

@@ -133,7 +133,11 @@ def spread_hand_urdf() -> str:
 
 
 def one_motor_pinch_urdf(
-    *, effort: float = 5.0, bars: bool = False, hidden_drive: bool = False
+    *,
+    effort: float = 5.0,
+    bars: bool = False,
+    hidden_drive: bool = False,
+    drive_ratio: float = 1.0,
 ) -> str:
     """A Robotiq-style pinch: two revolute knuckles on one motor, pads kept upright.
 
@@ -154,9 +158,12 @@ def one_motor_pinch_urdf(
     ``hidden_drive``: the motor on a fifth hinge, ``drive``, whose link has no
     geometry, and the knuckles and pads follow it (``<mimic>`` of the drive,
     with the ratios they have to the left knuckle above): the same pinch, its
-    motor moved off the fingers, as a linkage's input crank.
+    motor moved off the fingers, as a linkage's input crank.  ``drive_ratio``
+    scales every ratio to the drive, and the drive's range by its inverse:
+    the fingers reach what they reach at 1.
     """
     lead = "drive" if hidden_drive else "left_knuckle"
+    scale = drive_ratio if hidden_drive else 1.0
 
     def link(name, xyz, shape, mass, *more):
         collisions = "".join(
@@ -173,7 +180,7 @@ def one_motor_pinch_urdf(
         extra = (
             ""
             if mimic is None
-            else f'<mimic joint="{lead}" multiplier="{mimic:g}" offset="0"/>'
+            else f'<mimic joint="{lead}" multiplier="{mimic * scale:g}" offset="0"/>'
         )
         return (
             f'<joint name="{name}" type="revolute"><parent link="{parent}"/>'
@@ -196,7 +203,7 @@ def one_motor_pinch_urdf(
     drive = (
         '<link name="drive"><inertial><mass value="0.01"/><inertia ixx="1e-6" '
         'iyy="1e-6" izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial></link>'
-        + hinge("drive", "palm", "drive", "0 0 0.03", 0, 0.8)
+        + hinge("drive", "palm", "drive", "0 0 0.03", 0, 0.8 / drive_ratio)
         if hidden_drive
         else ""
     )
