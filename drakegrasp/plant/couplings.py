@@ -55,7 +55,7 @@ from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.plant.fingers import coupling_entries, coupling_entry
+from drakegrasp.plant.fingers import coupling_entries, coupling_entry, joint_name
 from drakegrasp.plant.models import load_models
 
 __all__ = [
@@ -631,8 +631,18 @@ def coupling_map(
         f, lead = j0.velocity_start(), j1.velocity_start()
         if f in row and lead in row:
             follows[f] = (lead, rho)
-    if set(follows) & {lead for lead, _ in follows.values()}:
-        raise InvalidOptionError("a joint may not both lead and follow a coupling")
+    both = set(follows) & {lead for lead, _ in follows.values()}
+    if both:
+        joint = next(
+            j for j in plant.GetJointIndices()
+            if plant.get_joint(j).num_velocities() == 1
+            and plant.get_joint(j).velocity_start() == min(both)
+        )  # fmt: skip
+        raise InvalidOptionError(
+            f"joint {joint_name(plant, plant.get_joint(joint))} both leads and "
+            "follows a coupling; a coupling map takes one level (each joint "
+            "following a joint that follows none)"
+        )
     independent = [vi for vi in v if vi not in follows]
     col = {vi: k for k, vi in enumerate(independent)}
     C = np.zeros((len(v), len(independent)))

@@ -279,8 +279,9 @@ def coupling_entry(plant: MultibodyPlant, entry) -> tuple[Joint, Joint, float, f
     rho, off = values
     if rho == 0 or not np.isfinite(rho) or not np.isfinite(off):
         raise InvalidOptionError(
-            "coupling gear_ratio must be a finite non-zero real number and offset "
-            f"a finite real number, got {entry[2]!r}, {entry[3]!r}"
+            f"coupling of {joint_name(plant, j0)} to {joint_name(plant, j1)}: "
+            "gear_ratio must be a finite non-zero real number and offset a finite "
+            f"real number, got {entry[2]!r}, {entry[3]!r}"
         )
     return j0, j1, rho, off
 
@@ -875,7 +876,13 @@ def _build(plant, object_body, bodies, couplings, inspector) -> HandStructure:
     for follower, (leader, rho, off) in follows.items():
         f, lead = position[follower], position[leader]
         if lead in mapped or f in {v[0] for v in mapped.values()}:
-            raise InvalidOptionError("a joint may not both lead and follow a coupling")
+            names = [joint_name(plant, j) for j in joints]
+            both = names[lead] if lead in mapped else names[f]
+            raise InvalidOptionError(
+                f"joint {both} both leads and follows a coupling; the planner "
+                "takes one level of couplings (each joint following a joint that "
+                "follows none)"
+            )
         mapped[f] = (lead, rho, off)
     coupling = Coupling(mapped)
     limits = _limits(joints, coupling)

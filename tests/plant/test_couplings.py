@@ -311,3 +311,52 @@ def test_a_drake_prefix_the_file_does_not_declare_is_read_as_drake_reads_it():
     assert "xmlns:drake" not in bare and "drake:mimic" in bare
     assert couplings_in_model(bare, "sdf") == couplings_in_model(text, "sdf")
     assert couplings_in_model(bare, "sdf")[0][0][2:] == (2.0, -0.01)
+
+
+def _chain_plant(ratios=(1.0, 0.5)):
+    """Three hinges on a palm, ``b`` following ``a`` and ``c`` following ``b``."""
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    from drakegrasp.plant.couplings import add_models
+
+    link = (
+        '<link name="{0}"><inertial><mass value="0.05"/><inertia ixx="1e-5" '
+        'iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    )
+    hinge = (
+        '<joint name="{0}" type="revolute"><parent link="palm"/><child link="l{0}"/>'
+        '<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+        "{1}</joint>"
+    )
+    mimic = '<mimic joint="{0}" multiplier="{1}" offset="0"/>'
+    urdf = (
+        '<?xml version="1.0"?><robot name="chain">'
+        + "".join(link.format(n) for n in ("palm", "la", "lb", "lc"))
+        + hinge.format("a", "")
+        + hinge.format("b", mimic.format("a", ratios[0]))
+        + hinge.format("c", mimic.format("b", ratios[1]))
+        + "</robot>"
+    )
+    plant = MultibodyPlant(0.0)
+    add_models(Parser(plant), text=urdf, kind="urdf")
+    plant.Finalize()
+    return plant
+
+
+def test_a_chain_of_couplings_is_refused_naming_the_joint_in_the_middle():
+    # "a joint may not both lead and follow a coupling": which one, it did not say
+    from drakegrasp.plant.couplings import coupling_map
+
+    plant = _chain_plant()
+    columns = [plant.GetJointByName(n).velocity_start() for n in "abc"]
+    with pytest.raises(InvalidOptionError, match="joint chain::b both leads and"):
+        coupling_map(plant, columns, plant_couplings(plant))
+
+
+def test_a_zero_ratio_names_the_joints_it_couples():
+    from drakegrasp.plant.fingers import coupling_entry
+
+    plant = _chain_plant()
+    with pytest.raises(InvalidOptionError, match="coupling of chain::b to chain::a"):
+        coupling_entry(plant, ("chain::b", "chain::a", 0.0, 0.0))
