@@ -979,8 +979,9 @@ def shake_test(
     if at_rest and kept and np.mean(kept) < _LOST:  # a share: units apart
         warnings.warn(
             f"at the seat the closing joints press with {np.mean(kept):.0%} of "
-            f"the squeeze aimed for on average ({np.mean(efforts):.3g} "
-            f"{squeeze_unit_of(effort_units)} of {min(capped):g}), the object at "
+            f"the squeeze aimed for on average (their motors {np.mean(efforts):.3g} "
+            f"{squeeze_unit_of(effort_units)} of {np.mean(pushes):.3g}, a motor's "
+            "aim the squeeze times the joints it drives), the object at "
             f"rest: a position-controlled finger "
             f"presses with stiffness × what is left of its aim squeeze / "
             f"stiffness = {min(aims):.3g}, which the fingers took up as they "

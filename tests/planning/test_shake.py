@@ -311,7 +311,10 @@ def test_a_squeeze_the_seated_fingers_lost_is_said(own_scene):
         num_candidates=20, mu=0.5, seed=0, robustness_samples=4,
     )[0]  # fmt: skip
     quick = dict(hydroelastic_modulus=1e6, settle=0.1, phase=0.1)
-    said = r"press with \d+% of the squeeze aimed for on average \([0-9.e+-]+ N of 20\)"
+    said = (
+        r"press with \d+% of the squeeze aimed for on average \(their motors "
+        r"[0-9.e+-]+ N of 20, "
+    )
     with pytest.warns(SqueezeLostWarning, match=said):
         lost = shake_test(scene.add_models, best, stiffness=1e6, **quick)
     assert np.mean(lost.efforts) < 0.25 * 20.0
@@ -319,3 +322,25 @@ def test_a_squeeze_the_seated_fingers_lost_is_said(own_scene):
         warnings.simplefilter("error", SqueezeLostWarning)
         kept = shake_test(scene.add_models, best, **quick)  # 4000 N/m: 5 mm aim
     assert np.mean(kept.efforts) == pytest.approx(20.0, rel=0.01)
+
+
+def test_a_lost_squeeze_is_said_against_what_the_motor_aimed_for(tmp_path):
+    # One motor closes both fingers of a coupled jaw and aims at twice the
+    # squeeze; the warning compared its effort with that aim (the percentage)
+    # but printed the squeeze per finger: "16% ... (19.8 N·m of 20)" on a
+    # one-motor linkage whose motor aimed at 120.
+    from coupled_hands import coupled_jaw_urdf
+
+    from drakegrasp.planning.shake import SqueezeLostWarning
+
+    path = tmp_path / "jaw.urdf"
+    path.write_text(coupled_jaw_urdf())
+    scene = planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(path))
+    best = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=40, mu=0.5, seed=0, robustness_samples=4,
+    )[0]  # fmt: skip
+    quick = dict(hydroelastic_modulus=1e6, settle=0.1, phase=0.1)
+    with pytest.warns(SqueezeLostWarning, match=r"their motors [0-9.e+-]+ N of 40, "):
+        lost = shake_test(scene.add_models, best, stiffness=2e5, **quick)
+    assert lost.squeeze_caps == (20.0,)
