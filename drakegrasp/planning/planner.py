@@ -116,6 +116,7 @@ __all__ = [
     "MAX_CANDIDATES",
     "MAX_PLAN_MU",
     "OPEN_HAND_HINT",
+    "OPEN_HAND_SHARE",
     "REASONS",
     "object_surface",
     "plan_grasps",
@@ -862,20 +863,29 @@ def _ranked_result(
         settings=settings,
         started=started,
     )
-    collided = sum(n for why, n in rejections.items() if why in _OPEN_HAND_COLLIDES)
-    if not candidates and num_sampled and collided == num_sampled:
+    if not candidates and _opens_too_little(rejections, num_sampled):
         result = dataclasses.replace(result, reason=result.reason + OPEN_HAND_HINT)
     return result
 
 
 _OPEN_HAND_COLLIDES = ("hand collides with the object", "hand collides with the cloud")
 
+OPEN_HAND_SHARE = 0.9
+"""Share of the sampled poses that must collide as placed for
+:data:`OPEN_HAND_HINT` (a hand shut at its pre-shape also misses the object
+from a few poses: 94 collided and 6 missed of an SDH-like hand's 100)."""
 
 OPEN_HAND_HINT = (
-    "; the open hand collides wherever it is placed: open it wider "
+    "; the open hand collides nearly wherever it is placed: open it wider "
     "(preshape=) or move the palm back (standoff=)"
 )
-"""Added to an empty result's reason when every pose collided as placed."""
+"""Added to an empty result's reason when nearly every pose collided as placed."""
+
+
+def _opens_too_little(rejections: dict, num_sampled: int) -> bool:
+    """True when at least :data:`OPEN_HAND_SHARE` of the poses collided as placed."""
+    collided = sum(n for why, n in rejections.items() if why in _OPEN_HAND_COLLIDES)
+    return num_sampled > 0 and collided >= OPEN_HAND_SHARE * num_sampled
 
 
 def plan_multifinger(

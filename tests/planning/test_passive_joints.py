@@ -409,3 +409,17 @@ def test_a_jaws_rows_carry_the_unit_of_its_sliding_joints():
     )  # fmt: skip
     assert len(result) > 0
     assert set(result.table()["torque_unit"].tolist()) == {"N"}
+
+
+def test_a_hand_that_collides_nearly_everywhere_is_told_to_open_too():
+    # A hand shut at its pre-shape also misses the object from a few poses
+    # (an SDH-like hand: 94 collided, 6 missed of 100): the hint needed all
+    # 100 to collide, and said nothing.
+    from drakegrasp.planning.planner import _opens_too_little
+
+    collides = "hand collides with the object"
+    misses = "fingers miss the object"
+    assert _opens_too_little({collides: 94, misses: 6}, 100)
+    assert _opens_too_little({"hand collides with the cloud": 90}, 100)
+    assert not _opens_too_little({collides: 89, misses: 11}, 100)
+    assert not _opens_too_little({}, 0)
