@@ -639,8 +639,8 @@ def coupling_map(
             and plant.get_joint(j).velocity_start() == min(both)
         )  # fmt: skip
         raise InvalidOptionError(
-            f"joint {joint_name(plant, plant.get_joint(joint))} both leads and "
-            "follows a coupling; a coupling map takes one level (each joint "
+            f"joint {joint_name(plant, plant.get_joint(joint))} may not both "
+            "lead and follow a coupling; a coupling map takes one level (each joint "
             "following a joint that follows none)"
         )
     independent = [vi for vi in v if vi not in follows]

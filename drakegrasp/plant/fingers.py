@@ -879,7 +879,7 @@ def _build(plant, object_body, bodies, couplings, inspector) -> HandStructure:
             names = [joint_name(plant, j) for j in joints]
             both = names[lead] if lead in mapped else names[f]
             raise InvalidOptionError(
-                f"joint {both} both leads and follows a coupling; the planner "
+                f"joint {both} may not both lead and follow a coupling; the planner "
                 "takes one level of couplings (each joint following a joint that "
                 "follows none)"
             )
