@@ -620,6 +620,7 @@ def coupling_map(
     v = [int(i) for i in velocity_indices]
     row = {vi: k for k, vi in enumerate(v)}
     follows: dict[int, tuple[int, float]] = {}
+    by_velocity: dict[int, Joint] = {}
     for entry in coupling_entries(couplings):
         j0, j1, rho, _ = coupling_entry(plant, entry)
         for j in (j0, j1):
@@ -631,15 +632,11 @@ def coupling_map(
         f, lead = j0.velocity_start(), j1.velocity_start()
         if f in row and lead in row:
             follows[f] = (lead, rho)
+            by_velocity[f] = j0
     both = set(follows) & {lead for lead, _ in follows.values()}
     if both:
-        joint = next(
-            j for j in plant.GetJointIndices()
-            if plant.get_joint(j).num_velocities() == 1
-            and plant.get_joint(j).velocity_start() == min(both)
-        )  # fmt: skip
         raise InvalidOptionError(
-            f"joint {joint_name(plant, plant.get_joint(joint))} may not both "
+            f"joint {joint_name(plant, by_velocity[min(both)])} may not both "
             "lead and follow a coupling; a coupling map takes one level (each joint "
             "following a joint that follows none)"
         )

@@ -335,7 +335,7 @@ def checked_query_object(
         )
     if plant_context is not None:
         if bodies is None:
-            bodies = [plant.get_body(b) for b in range(plant.num_bodies())]
+            bodies = [plant.get_body(BodyIndex(b)) for b in range(plant.num_bodies())]
         plant_context = plant_context_of(plant, plant_context)
         _check_same_state(plant, query_object, plant_context, bodies)
     return inspector

@@ -99,3 +99,23 @@ def test_query_object_at_another_state_is_refused(scene):
         assert len(report) == 4  # the moved finger is off the box
     finally:
         plant.SetPositions(scene.plant_context, saved)
+
+
+def test_query_object_checks_every_body_when_none_are_named(scene):
+    # bodies=None is the default: every body of the plant with geometry (it
+    # raised pydrake's TypeError, reading bodies by a bare int)
+    from drakegrasp.plant.validation import checked_query_object
+
+    plant = scene.plant
+    saved = plant.GetPositions(scene.plant_context).copy()
+    context = _private_context(scene)
+    inspector = checked_query_object(plant, _query(scene), context)
+    assert inspector.SourceIsRegistered(plant.get_source_id())
+    moved = saved.copy()
+    moved[-1] += 0.003  # the last coordinate: the object's z (a free body)
+    plant.SetPositions(scene.plant_context, moved)
+    try:
+        with pytest.raises(InvalidOptionError, match="another state"):
+            checked_query_object(plant, _query(scene), context)
+    finally:
+        plant.SetPositions(scene.plant_context, saved)
