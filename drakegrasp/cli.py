@@ -1757,8 +1757,10 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         metavar="X",
         help="with --shake: what each closing joint presses with, N for a "
-        "prismatic joint, N·m for a revolute one (default 20, within the "
-        "actuators' effort limits; 0.7 for --hand allegro)",
+        "prismatic joint, N·m for a revolute one (default 20 N, for a "
+        "revolute joint at the contacts: the torque that presses each finger "
+        "it closes with 20 N there; within the actuators' effort limits; 0.7 "
+        "for --hand allegro)",
     )
     plan.add_argument(
         "--stiffness",

@@ -59,6 +59,7 @@ _SUBMODULES = (
     "shake",
     "shake_ranking",
     "shake_result",
+    "squeeze",
     "surface",
     "turned_gravity",
     "weight",

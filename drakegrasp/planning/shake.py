@@ -9,7 +9,9 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
   (``JointActuator.set_controller_gains``, stiffness ``k``) aimed
   ``squeeze / k`` past the place where they touch, so each presses with
   ``squeeze`` newtons, or N·m for a revolute joint (within its effort
-  limit), less ``k`` times however far it closes on after that (pads that
+  limit; by default 20 N at a revolute finger's contacts, its torque from
+  its lever arms: :mod:`drakegrasp.planning.squeeze`),
+  less ``k`` times however far it closes on after that (pads that
   give, an object pushed along: ``ShakeResult.efforts`` are what the joints
   apply once seated, and :class:`SqueezeLostWarning` says when little is
   left), and resists being pushed open with stiffness ``k``, as a
@@ -71,6 +73,7 @@ from drakegrasp.errors import (
 )
 from drakegrasp.planning.candidates import GraspCandidate, check_candidate
 from drakegrasp.planning.shake_result import ShakeResult, squeeze_unit_of
+from drakegrasp.planning.squeeze import DEFAULT_SQUEEZE, HOLD_LEVER, contact_levers
 from drakegrasp.planning.turned_gravity import (
     DEFAULT_DIRECTIONS,
     GRAVITY,
@@ -292,10 +295,13 @@ def check_shake_options(
         if value is not None  # None: shake_test's per-joint default
     ]
     mass = [] if object_mass is None else [("object_mass", object_mass, 0.0, "kg")]
+    squeezes = []  # None: newtons at the contacts (shake_test)
+    if squeeze is not None:
+        squeezes = [("squeeze", squeeze, 0.0, "N, or N·m for revolute joints")]
     for name, value, low, unit in (
         *gains,
         *mass,
-        ("squeeze", squeeze, 0.0, "N, or N·m for revolute joints"),
+        *squeezes,
         ("time_step", time_step, 0.0, "s"),
         ("phase", phase, 0.0, "s"),
         ("settle", settle, None, "s"),
@@ -493,6 +499,29 @@ def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
     return float(k), float(d)
 
 
+def _levers(add_models, candidate, squeezers, couplings, by_name, X_WO) -> tuple:
+    """``(levers, hold)`` of the default squeeze.
+
+    ``levers``: per revolute squeezer, its torque per newton at the contacts
+    (m; :func:`~drakegrasp.planning.squeeze.contact_levers`); a prismatic one
+    is left out (its force is the squeeze); the contacts in frame ``X_WO``
+    (the planned one).  ``hold``: the aim whose stiffness
+    a joint that presses nothing holds with, N·m: the squeeze at the largest
+    lever, else at :data:`~drakegrasp.planning.squeeze.HOLD_LEVER`; with no
+    revolute squeezer, the squeeze (N, or N·m), as an explicit one.
+    """
+    turning = {
+        name: sign
+        for name, sign in squeezers.items()
+        if by_name[name].joint().type_name() != "prismatic"
+    }
+    if not turning:  # a jaw's sliding fingers: the squeeze is their force
+        return {}, DEFAULT_SQUEEZE
+    levers = contact_levers(add_models, candidate, turning, couplings, X_WO=X_WO)
+    lever = max(levers.values(), default=0.0)
+    return levers, DEFAULT_SQUEEZE * (lever if lever > 0 else HOLD_LEVER)
+
+
 def _squeezers(candidate, couplings, driven: dict, by_name: dict) -> dict:
     """The actuated joints that squeeze, each with the sign that closes it.
 
@@ -620,7 +649,7 @@ def shake_test(
     add_models: Callable,
     candidate: GraspCandidate,
     *,
-    squeeze: float = 20.0,
+    squeeze: float | None = None,
     stiffness: float | None = None,
     damping: float | None = None,
     directions: Sequence[Sequence[float]] = DEFAULT_DIRECTIONS,
@@ -647,10 +676,20 @@ def shake_test(
         Leave out supports such as a table: the test turns gravity around.
     candidate : GraspCandidate
         From :func:`~drakegrasp.planning.planner.plan_grasps`.
-    squeeze : float, optional
-        Force with which each finger presses, newtons (default 20 N; at most
-        the actuator's effort limit); for a revolute joint (a multi-finger
-        hand) the torque on each closing joint that closing moved, N·m.  It
+    squeeze : float or None, optional
+        Force with which each finger presses, newtons (at most the actuator's
+        effort limit); for a revolute joint (a multi-finger hand) the torque
+        on each closing joint that closing moved, N·m.  None (default):
+        :data:`~drakegrasp.planning.squeeze.DEFAULT_SQUEEZE` (20 N), a
+        prismatic finger's force and, for a revolute joint, at the contacts:
+        its motor is aimed at the torque that presses each finger body it
+        closes on the object with 20 N there, ``20 N × Σ lever arms`` from the
+        hand's Jacobian at the candidate's pose
+        (:func:`~drakegrasp.planning.squeeze.contact_levers`: 2.15 N·m, 20
+        N at each pad 54 mm from the axes, for the one motor of a
+        Robotiq-2F-85-like hand that a squeeze of 20 N·m on each of its six
+        joints aimed at 120 N·m, throwing the box out of the hand); a
+        revolute joint that moves no contact holds where it stands.  It
         is the press at rest, the position control's aim, not a cap: a
         finger that the object pushes back presses harder, up to the
         actuator's effort limit, where Drake clamps it (the Allegro hand's
@@ -819,15 +858,33 @@ def shake_test(
         couplings, candidate.joint_names, actuated, drives=drives
     )
     squeezers = _squeezers(candidate, couplings, driven, by_name)
+    default = squeeze is None
+    levers, hold = (
+        _levers(add_models, candidate, squeezers, couplings, by_name, planned_X_WO)
+        if default
+        else ({}, squeeze)
+    )
+    if default:
+        squeeze = DEFAULT_SQUEEZE
+    at_contacts = bool(levers)  # a revolute motor aims at newtons at contacts
     for name, sign in squeezers.items():
         actuator = by_name[name]
         # a leader's motor also presses through the followers it drives: each
-        # of them and the leader press with squeeze (within the effort limit)
+        # of them and the leader press with squeeze (within the effort limit);
+        # by default a revolute motor with the torque that presses its
+        # fingers' contacts with squeeze newtons (planning.squeeze)
         share = shares.get(name, 1.0)
-        push = min(squeeze * share, actuator.effort_limit())
-        pushed[int(actuator.index())] = (push, share)
+        lever = levers.get(name)
+        aim = squeeze * share if lever is None else squeeze * lever
+        push = min(aim, actuator.effort_limit())
+        # the squeeze each presses with, capped: squeeze's unit
+        if lever is None:
+            cap = push / share
+        else:  # newtons at the contacts
+            cap = push / lever if push < aim else squeeze
+        pushed[int(actuator.index())] = (push, cap)
         k, _ = gains[int(actuator.index())] = _gains(
-            actuator, squeeze * share, stiffness, damping
+            actuator, aim if aim > 0 else hold, stiffness, damping
         )
         if 0 < push / k < _MIN_AIM:
             raise InvalidOptionError(
@@ -844,7 +901,7 @@ def shake_test(
         )
     for actuator in actuators:  # every actuator position-controlled (Drake's PD)
         k, d = gains.get(int(actuator.index())) or _gains(
-            actuator, squeeze, stiffness, damping
+            actuator, hold, stiffness, damping
         )
         actuator.set_controller_gains(PdControllerGains(p=k, d=d))
     plant.WeldFrames(plant.world_frame(), base.body_frame(), candidate.X_WH)
@@ -969,11 +1026,11 @@ def shake_test(
     efforts = tuple(abs(float(u[a.input_start()])) for a in squeezing)
     effort_units = tuple(effort_unit(a.joint()) for a in squeezing)
     # what each squeezing actuator was aimed to apply (its followers' too), and
-    # each joint it drives of that
+    # the squeeze that is (a joint's share, or the newtons at its contacts)
     pushes = [pushed[int(a.index())][0] for a in squeezing]
-    capped = tuple(float(p / s) for p, s in (pushed[int(a.index())] for a in squeezing))
+    capped = tuple(float(pushed[int(a.index())][1]) for a in squeezing)
     used = tuple(gains[int(a.index())] for a in squeezing)
-    aims = [c / k for c, (k, _) in zip(pushes, used, strict=True)]
+    aims = [c / k for c, (k, _) in zip(pushes, used, strict=True) if c > 0]
     at_rest = seat > 0 and seated[2] < _PUSHED_OUT  # else pushed out: physics
     kept = [e / c for e, c in zip(efforts, pushes, strict=True) if c > 0]
     if at_rest and kept and np.mean(kept) < _LOST:  # a share: units apart
@@ -981,7 +1038,13 @@ def shake_test(
             f"at the seat the closing joints press with {np.mean(kept):.0%} of "
             f"the squeeze aimed for on average (their motors {np.mean(efforts):.3g} "
             f"{squeeze_unit_of(effort_units)} of {np.mean(pushes):.3g}, a motor's "
-            "aim the squeeze times the joints it drives), the object at "
+            + (
+                "aim the torque that presses its fingers' contacts with the "
+                f"squeeze, {squeeze:g} N"
+                if at_contacts
+                else "aim the squeeze times the joints it drives"
+            )
+            + "), the object at "
             f"rest: a position-controlled finger "
             f"presses with stiffness × what is left of its aim squeeze / "
             f"stiffness = {min(aims):.3g}, which the fingers took up as they "
@@ -1019,6 +1082,7 @@ def shake_test(
         hydroelastic_modulus=modulus,
         hydroelastic_refused=refused,
         squeeze_caps=capped,
+        squeeze_at_contacts=at_contacts,
         seated_q_hand=seated_q,
         seated_X_WO=seated_X_WO,
         joint_names=tuple(candidate.joint_names),

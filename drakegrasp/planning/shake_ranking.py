@@ -176,7 +176,10 @@ class ShakenCandidates(Sequence):
         capped = [r for r in results if r.squeeze_capped]
         unit = f" {results[0].squeeze_unit}" if results else ""
         squeeze = self.options.get("squeeze")
-        squeeze = "" if squeeze is None else f"squeeze {squeeze:g}{unit}"
+        if squeeze is None and results:  # the default: newtons at the contacts
+            squeeze = results[0].squeeze
+        where = " at the contacts" if results and results[0].squeeze_at_contacts else ""
+        squeeze = "" if squeeze is None else f"squeeze {squeeze:g}{unit}{where}"
         if capped:
             caps = [c for r in capped for c in r.squeeze_caps]
             squeeze += f" capped at {_limits(caps, capped[0].squeeze)}{unit}"

@@ -40,7 +40,9 @@ class ShakeResult:
     squeeze : float
         What each closing joint's actuator presses with: a force in newtons
         for a prismatic joint (a parallel jaw), a torque in N·m for a revolute
-        one (a multi-finger hand); see ``effort_units``.
+        one (a multi-finger hand); see ``effort_units``.  With
+        ``squeeze_at_contacts``, newtons with which each finger body that
+        touches presses at its contacts, every joint's kind alike.
     efforts : tuple of float
         The magnitude of what each closing joint's actuator applied once the
         fingers had seated (newtons, or N·m for a revolute joint), in
@@ -91,7 +93,16 @@ class ShakeResult:
         What each closing joint was set to press with, in actuator order:
         ``squeeze``, or its actuator's effort limit where that is smaller (an
         actuator applies no more; ``squeeze_capped`` says so, and the summary
-        line names the cap).  Empty in a record made before it existed.
+        line names the cap).  With ``squeeze_at_contacts``, newtons at the
+        contacts: what the effort limit presses them with where it caps the
+        motor (a joint that presses no contact: ``squeeze``).  Empty in a
+        record made before it existed.
+    squeeze_at_contacts : bool
+        Whether ``squeeze`` was newtons at the fingers' contacts
+        (:func:`~drakegrasp.planning.shake.shake_test`'s default: a revolute
+        motor aimed at the torque that presses them with it,
+        :mod:`drakegrasp.planning.squeeze`) rather than each joint's own
+        effort.  False in a record made before it existed.
     seated_q_hand : (n_h,) float
         The candidate's joints (``joint_names``, its order) where seating
         left them, rad or m, clipped to their limits (Drake overshoots a limit
@@ -143,6 +154,7 @@ class ShakeResult:
     X_WH: np.ndarray | None = None
     gains: tuple[tuple[float, float], ...] = ()
     object_mass: float = float("nan")
+    squeeze_at_contacts: bool = False
 
     def seated(self, candidate):
         """``candidate`` with the hand's joints and the object where seating left them.
@@ -194,7 +206,12 @@ class ShakeResult:
 
     @property
     def squeeze_unit(self) -> str:
-        """The unit of ``squeeze``: "N", "N·m", or both named when mixed."""
+        """The unit of ``squeeze``: "N", "N·m", or both named when mixed.
+
+        "N" with ``squeeze_at_contacts``: newtons at the contacts.
+        """
+        if self.squeeze_at_contacts:
+            return "N"
         return squeeze_unit_of(self.effort_units)
 
     @property
@@ -266,11 +283,13 @@ class ShakeResult:
         unit = self.squeeze_unit
         if "," in unit:  # a mixed hand's: kept apart from the line's commas
             unit = f"({unit})"
+        where = " at the contacts" if self.squeeze_at_contacts else ""
         return (
             f"{verdict}: {motion}"
-            f" over {self.duration:g} s, squeeze {self.squeeze:g} {unit}"
+            f" over {self.duration:g} s, squeeze {self.squeeze:g} {unit}{where}"
             + (
-                f" (capped at {_limits(self.squeeze_caps, self.squeeze)} {unit})"
+                f" (capped at {_limits(self.squeeze_caps, self.squeeze)} {unit}"
+                + (" at the contacts)" if self.squeeze_at_contacts else ")")
                 if self.squeeze_capped
                 else ""
             )

@@ -1373,7 +1373,7 @@ PLAN_POOLS = {
 
 
 SHAKE_POOLS = {
-    "squeeze": [-1.0, 0.0, NAN, INF, "abc", None, True],
+    "squeeze": [-1.0, 0.0, NAN, INF, "abc", True],  # None: the default
     "stiffness": [-1.0, NAN, INF, "x"],
     "damping": [-1.0, NAN, "x"],
     "directions": [[], [[0, 0, 0]], [[NAN, 0, 1]], "down", [[1, 2]], None],

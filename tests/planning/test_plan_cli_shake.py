@@ -16,6 +16,7 @@ from drakegrasp.planning.shake import (
     REVOLUTE_AIM,
     shake_test,
 )
+from drakegrasp.planning.squeeze import DEFAULT_SQUEEZE
 
 
 def test_the_default_hand_holds_the_box_with_hydroelastic_pads(capsys):
@@ -83,7 +84,11 @@ def test_the_help_quotes_the_shake_tests_own_defaults():
     }
     _, sub = build_parser()
     text = " ".join(sub.choices["plan"].format_help().split())
-    assert f"default {defaults['squeeze']:g}" in text
+    # the squeeze defaults to newtons at the contacts (a revolute motor's
+    # torque from its lever arms): the help quotes the library's figure
+    assert defaults["squeeze"] is None
+    at_contacts = "for a revolute joint at the contacts"
+    assert f"default {DEFAULT_SQUEEZE:g} N, {at_contacts}" in text
     # the gains default per joint: the help quotes the library's constants
     assert defaults["stiffness"] is None and defaults["damping"] is None
     assert f"{PRISMATIC_STIFFNESS:g} N/m for a prismatic one" in text
