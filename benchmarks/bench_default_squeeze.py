@@ -15,7 +15,7 @@ the object's mass) and its ``--top`` best are shaken in Drake
 (``shake_test``, hydroelastic pads of 1e6 Pa) twice: at the default squeeze
 (None: 20 N with which each pad presses, the motor aimed at the torque its
 lever arms give, :mod:`drakegrasp.planning.squeeze`) and at ``squeeze=20``
-(the old default: 20 N·m per joint, 80 N·m at the motor of four joints,
+(the old default: 20 N·m per joint, 120 N·m at the motor of six joints,
 within its effort limit).  It prints, per run, how many held (from the
 seat), the largest displacement, and the motor's aim.  The YCB objects need
 Drake's ``drake_models`` (``DRAKEGRASP_DRAKE_MODELS`` or

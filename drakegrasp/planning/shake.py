@@ -499,27 +499,46 @@ def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
     return float(k), float(d)
 
 
-def _levers(add_models, candidate, squeezers, couplings, by_name, X_WO) -> tuple:
+def _levers(plant, add_models, candidate, squeezers, couplings, by_name, X_WO):
     """``(levers, hold)`` of the default squeeze.
 
-    ``levers``: per revolute squeezer, its torque per newton at the contacts
-    (m; :func:`~drakegrasp.planning.squeeze.contact_levers`); a prismatic one
-    is left out (its force is the squeeze); the contacts in frame ``X_WO``
-    (the planned one).  ``hold``: the aim whose stiffness
-    a joint that presses nothing holds with, N·m: the squeeze at the largest
-    lever, else at :data:`~drakegrasp.planning.squeeze.HOLD_LEVER`; with no
-    revolute squeezer, the squeeze (N, or N·m), as an explicit one.
+    ``levers``: per squeezer that turns a finger (its own joint, or one of the
+    followers it drives, revolute: a slide may drive a linkage), its torque,
+    or force, per newton at the contacts (m, or 1;
+    :func:`~drakegrasp.planning.squeeze.contact_levers`, the contacts in
+    frame ``X_WO``, the planned one; a follower with a motor of its own
+    presses with that motor, not its leader's).  A squeezer that only
+    slides fingers is left out: its force is the squeeze.  ``hold``: the aim
+    whose stiffness a joint holds with at the least, N·m: the squeeze at
+    :data:`~drakegrasp.planning.squeeze.HOLD_LEVER`; with no finger that
+    turns, the squeeze (N, or N·m), as an explicit one.
+
+    Raises
+    ------
+    ModelError
+        No squeezer presses the candidate's contacts when it closes (each
+        closes no contact onto the object: contacts on the palm, say).
     """
+    moved = [c for c in couplings if c[0] not in by_name]  # no motor of its own
     turning = {
         name: sign
         for name, sign in squeezers.items()
-        if by_name[name].joint().type_name() != "prismatic"
+        if any(
+            find_joint(plant, joint).type_name() != "prismatic"
+            for joint in [name, *(f for f, leader, _, _ in moved if leader == name)]
+        )
     }
     if not turning:  # a jaw's sliding fingers: the squeeze is their force
         return {}, DEFAULT_SQUEEZE
-    levers = contact_levers(add_models, candidate, turning, couplings, X_WO=X_WO)
-    lever = max(levers.values(), default=0.0)
-    return levers, DEFAULT_SQUEEZE * (lever if lever > 0 else HOLD_LEVER)
+    levers = contact_levers(add_models, candidate, turning, moved, X_WO=X_WO)
+    if len(turning) == len(squeezers) and not any(levers.values()):
+        raise ModelError(
+            f"none of the candidate's motors ({', '.join(turning)}) closes a "
+            "finger onto the object at its contacts, so the default squeeze (20 N "
+            "at the contacts) presses nothing: give squeeze= (N, or N·m per "
+            "revolute joint)"
+        )
+    return levers, DEFAULT_SQUEEZE * HOLD_LEVER
 
 
 def _squeezers(candidate, couplings, driven: dict, by_name: dict) -> dict:
@@ -688,8 +707,13 @@ def shake_test(
         (:func:`~drakegrasp.planning.squeeze.contact_levers`: 2.15 N·m, 20
         N at each pad 54 mm from the axes, for the one motor of a
         Robotiq-2F-85-like hand that a squeeze of 20 N·m on each of its six
-        joints aimed at 120 N·m, throwing the box out of the hand); a
-        revolute joint that moves no contact holds where it stands.  It
+        joints aimed at 120 N·m, throwing the box out of the hand; a slide
+        that drives turning fingers through its ``<mimic>`` followers alike).
+        A joint whose closing moves no contact holds where it stands, and
+        every turning finger holds at least as stiffly as one pressing 20 N
+        at :data:`~drakegrasp.planning.squeeze.HOLD_LEVER` (10 N·m/rad,
+        within its effort limit).  A candidate whose closing presses none of
+        its contacts is refused (``ModelError``): give a number.  It
         is the press at rest, the position control's aim, not a cap: a
         finger that the object pushes back presses harder, up to the
         actuator's effort limit, where Drake clamps it (the Allegro hand's
@@ -775,14 +799,18 @@ def shake_test(
         too stiff for the fingers' inertia, or too long a ``time_step``); the
         message gives the time and what to lower.
     ModelError
-        ``add_models`` did not add the candidate's hand base or closing joints,
-        its object has no mass and no ``object_mass`` is given (gravity would
-        pull on nothing and every grasp would hold), or Drake refused to
+        ``add_models`` did not add the candidate's hand base or closing joints
+        or welded the base itself, its object has no mass and no
+        ``object_mass`` is given (gravity would pull on nothing and every grasp
+        would hold), the default squeeze would press none of the candidate's
+        contacts (above), or Drake refused to
         advance the model for another reason (its first sentence is in the
         message).
     InvalidGraspError
         The candidate's joint values or poses are not finite or do not match
-        its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`).
+        its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`),
+        or, at the default squeeze, a contact is not a finite point and unit
+        normal.
 
     Warns
     -----
@@ -860,7 +888,9 @@ def shake_test(
     squeezers = _squeezers(candidate, couplings, driven, by_name)
     default = squeeze is None
     levers, hold = (
-        _levers(add_models, candidate, squeezers, couplings, by_name, planned_X_WO)
+        _levers(
+            plant, add_models, candidate, squeezers, couplings, by_name, planned_X_WO
+        )
         if default
         else ({}, squeeze)
     )
@@ -877,14 +907,14 @@ def shake_test(
         lever = levers.get(name)
         aim = squeeze * share if lever is None else squeeze * lever
         push = min(aim, actuator.effort_limit())
-        # the squeeze each presses with, capped: squeeze's unit
-        if lever is None:
-            cap = push / share
-        else:  # newtons at the contacts
-            cap = push / lever if push < aim else squeeze
+        # the squeeze each presses with, capped, in squeeze's unit: a joint's
+        # share of its motor, or newtons at the contacts
+        cap = squeeze if push >= aim else push / (share if lever is None else lever)
         pushed[int(actuator.index())] = (push, cap)
+        # a turning finger holds at least as stiffly as `hold` aims it: one
+        # whose closing barely moves its contacts (a spread) is not left limp
         k, _ = gains[int(actuator.index())] = _gains(
-            actuator, aim if aim > 0 else hold, stiffness, damping
+            actuator, aim if lever is None else max(aim, hold), stiffness, damping
         )
         if 0 < push / k < _MIN_AIM:
             raise InvalidOptionError(
@@ -904,7 +934,13 @@ def shake_test(
             actuator, hold, stiffness, damping
         )
         actuator.set_controller_gains(PdControllerGains(p=k, d=d))
-    plant.WeldFrames(plant.world_frame(), base.body_frame(), candidate.X_WH)
+    try:
+        plant.WeldFrames(plant.world_frame(), base.body_frame(), candidate.X_WH)
+    except RuntimeError as e:  # add_models welded it already
+        raise ModelError(
+            f"add_models must leave the hand's base {candidate.hand_base} free (the "
+            f"shake welds it at the candidate's X_WH); Drake: {str(e)[:160]}"
+        ) from None
     plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
     body = resolve_object_body(plant, obj)
     refused = 0
@@ -1046,8 +1082,9 @@ def shake_test(
             )
             + "), the object at "
             f"rest: a position-controlled finger "
-            f"presses with stiffness × what is left of its aim squeeze / "
-            f"stiffness = {min(aims):.3g}, which the fingers took up as they "
+            f"presses with stiffness × what is left of its aim (what it is to "
+            f"press with / stiffness, {min(aims):.3g} at the least), which the "
+            f"fingers took up as they "
             f"closed on (pads that give, a finger that touched nothing); lower "
             f"the stiffness (or raise the squeeze) for the squeeze to hold",
             SqueezeLostWarning,

@@ -182,7 +182,7 @@ class ShakenCandidates(Sequence):
         squeeze = "" if squeeze is None else f"squeeze {squeeze:g}{unit}{where}"
         if capped:
             caps = [c for r in capped for c in r.squeeze_caps]
-            squeeze += f" capped at {_limits(caps, capped[0].squeeze)}{unit}"
+            squeeze += f" capped at {_limits(caps, capped[0].squeeze)}{unit}{where}"
         gains = ", ".join(
             f"{name} {self.options[name]:g}"
             for name in ("stiffness", "damping")

@@ -13,14 +13,18 @@ asks for newtons at the contacts and works out each motor's torque here.
 By virtual work, a motor ``m`` turning at ``q̇_m`` moves the finger point
 ``C`` of a contact at ``v_C = J_C ∂q/∂q_m q̇_m`` (``J_C`` (3, n_v) its
 translational Jacobian, ``∂q/∂q_m`` 1 at ``m`` and ``ρ`` at each ``<mimic>``
-follower it drives), so the torque that presses ``C`` along the contact normal
-``n`` (into the object) with ``f`` newtons is ``τ = f nᵀ J_C ∂q/∂q_m``.  Each
-finger body that touches the object presses with the squeeze at the mean of
-its contacts' lever arms ``ℓ_b = mean_C  s nᵀ J_C ∂q/∂q_m`` (``s`` the
-sign that closes ``m``; a body the closing motion pulls away counts 0), and
-the motor's aim is the squeeze times ``Σ_b ℓ_b`` (metres: N·m per N).  For a
-one-link finger touching at ``r`` from its axis, square to it, that is
-``r``: the torque is ``f r``.
+follower without a motor of its own that it drives), so the torque that
+presses ``C`` along the contact normal ``n`` (into the object) with ``f``
+newtons is ``τ = f nᵀ J_C ∂q/∂q_m`` (``τ = Jᵀ f``).  Each finger body that
+touches the object presses with the squeeze at the mean of its contacts' lever
+arms, ``ℓ_b = mean_C  s nᵀ J_C ∂q/∂q_m`` (``s`` the sign that closes ``m``),
+and the motor's aim is the squeeze times ``Σ_b ℓ_b`` (metres: N·m per N),
+or nothing where that sum is not positive: a motor is only aimed to close.  A
+body that closing pulls away counts against the others (a spread joint that
+turns one finger towards the object and another away from it); motors that
+share a body's motion share its press, as ``Jᵀ f`` splits it.  For a one-link
+finger touching at ``r`` from its axis, square to it, the arm is ``r``: the
+torque is ``f r``.
 """
 
 from __future__ import annotations
@@ -35,12 +39,12 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import DiagramBuilder
 
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.models import new_parser
 from drakegrasp.plant.validation import check_rigid_transform, resolve_body
 
-__all__ = ["DEFAULT_SQUEEZE", "HOLD_LEVER", "contact_levers"]
+__all__ = ["DEFAULT_SQUEEZE", "HOLD_LEVER", "LEVER_TOL", "contact_levers"]
 
 DEFAULT_SQUEEZE = 20.0
 """The shake test's default squeeze, N: what each finger body that touches
@@ -49,10 +53,15 @@ it, times the fingers it drives; a revolute one's the torque that presses
 them with it: :func:`contact_levers`)."""
 
 HOLD_LEVER = 0.05
-"""Lever arm (m) of a revolute joint's hold where none of the candidate's
-revolute motors presses a contact: a joint that holds still (a spread joint,
-a finger that touches nothing) is as stiff as one that presses the default
-squeeze at 5 cm."""
+"""Lever arm (m) of the least stiffness of a turning finger at the default
+squeeze: a joint whose closing moves its contacts little or not at all (a
+spread joint, a finger that touches nothing) and a joint that does not
+squeeze hold their place as stiffly as one that presses the squeeze at 5 cm
+(10 N·m/rad at 20 N, within the effort limit)."""
+
+LEVER_TOL = 1e-9
+"""Lever arms (m) below this are zero: a joint they would aim a nanometre
+past its place presses with nothing that round-off leaves."""
 
 
 _CANDIDATE = ("apply", "contacts", "hand_base", "X_WH", "X_WO")
@@ -81,10 +90,12 @@ def contact_levers(
         ``X_WO``, each naming its finger body) are where the fingers press.
     squeezers : mapping of str to float
         Scoped name of each joint whose actuator squeezes, to the sign
-        (±1) that closes it.
+        (±1) that closes it, or 0 for one that closing leaves still (a
+        candidate's ``closing_signs``: a spread joint); its arm is 0.
     couplings : sequence of (follower, leader, gear_ratio, offset)
-        The plant's couplings (scoped names): a follower moves ``ρ`` per unit
-        of its leader.
+        The couplings through which the squeezers drive followers (scoped
+        names): a follower moves ``ρ`` per unit of its leader.  Leave out a
+        follower with a motor of its own: it presses with that one.
     X_WO : RigidTransform, optional
         The frame the contacts are in (default ``candidate.X_WO``): the one
         planned on, where a shake puts the object elsewhere (a candidate of a
@@ -94,15 +105,16 @@ def contact_levers(
     -------
     dict of str to float
         Per squeezer, ``Σ_b ℓ_b`` (module docstring) over the finger bodies
-        that touch: m (N·m per N) for a revolute joint, 1 per touching body
-        for a prismatic one along the normals; >= 0, 0 for a joint that
-        presses no contact when it closes.
+        that touch: m (N·m per N) for a revolute joint, N per N for a
+        prismatic one; 0 where that is not above :data:`LEVER_TOL` (closing
+        it presses no contact).
 
     Raises
     ------
     InvalidOptionError
         ``add_models`` not callable, ``candidate`` not a candidate of
-        ``plan_grasps``, ``squeezers`` not a mapping or a sign other than ±1,
+        ``plan_grasps``, ``squeezers`` not a mapping or a sign other than ±1
+        or 0,
         ``couplings`` not 4-tuples, ``X_WO`` not a rigid transform.
     ModelError
         ``add_models`` did not build the hand again (a body or joint of the
@@ -124,29 +136,43 @@ def contact_levers(
             f"{type(squeezers).__name__}"
         )
     try:
-        couplings = [
-            (str(f), str(leader), float(rho)) for f, leader, rho, _ in couplings
-        ]
+        read = [(str(f), str(leader), float(rho)) for f, leader, rho, _ in couplings]
     except (TypeError, ValueError):
+        read = None
+    if read is None or not all(math.isfinite(c[2]) for c in read):
         raise InvalidOptionError(
-            "couplings must be (follower, leader, gear_ratio, offset) tuples, "
-            f"as plant_couplings gives them, got {reprlib.repr(couplings)}"
-        ) from None
+            "couplings must be (follower, leader, gear_ratio, offset) tuples with "
+            "a finite ratio, as plant_couplings gives them, got "
+            f"{reprlib.repr(couplings)}"
+        )
     for name, sign in squeezers.items():
-        if isinstance(sign, bool) or sign not in (1, -1):
+        if not (
+            isinstance(sign, int | float | np.integer | np.floating)
+            and not isinstance(sign, bool)
+            and sign in (1, 0, -1)
+        ):
             raise InvalidOptionError(
-                f"the sign that closes joint {name!r} must be 1 or -1, got {sign!r}"
+                f"the sign that closes joint {name!r} must be 1, -1 or 0 (closing "
+                f"leaves it still), got {sign!r}"
             )
+    contacts = _contact_frames(candidate)
+    X_WO = candidate.X_WO if X_WO is None else check_rigid_transform("X_WO", X_WO)
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     add_models(plant, new_parser(plant, "the shake test's lever-arm plant"))
     base = resolve_body(plant, candidate.hand_base)
-    plant.WeldFrames(plant.world_frame(), base.body_frame(), candidate.X_WH)
+    try:
+        plant.WeldFrames(plant.world_frame(), base.body_frame(), candidate.X_WH)
+    except RuntimeError as e:  # add_models welded it: the shake welds it at X_WH
+        raise ModelError(
+            f"add_models must leave the hand's base {candidate.hand_base} free (the "
+            f"shake welds it at the candidate's X_WH); Drake: {str(e)[:160]}"
+        ) from None
     plant.Finalize()
     ctx = plant.CreateDefaultContext()
     candidate.apply(plant, ctx)
     followers: dict[str, list[tuple[str, float]]] = {}
-    for follower, leader, rho in couplings:
+    for follower, leader, rho in read:
         followers.setdefault(leader, []).append((follower, rho))
     columns = {
         name: [
@@ -155,19 +181,17 @@ def contact_levers(
         ]
         for name in squeezers
     }
-    X_WO = candidate.X_WO if X_WO is None else check_rigid_transform("X_WO", X_WO)
     R_WO = X_WO.rotation().matrix()
     rows: dict[str, list[np.ndarray]] = {}  # per finger body: n_Wᵀ J_C per contact
-    for pc in candidate.contacts:
-        finger = resolve_body(plant, pc.finger_body)
-        p_WC = X_WO.multiply(np.asarray(pc.p_OC, dtype=float))
+    for name, p_OC, nhat_O in contacts:
+        finger = resolve_body(plant, name)
+        p_WC = X_WO.multiply(p_OC)
         p_FC = plant.EvalBodyPoseInWorld(ctx, finger).inverse().multiply(p_WC)
         J = plant.CalcJacobianTranslationalVelocity(
             ctx, JacobianWrtVariable.kV, finger.body_frame(), p_FC,
             plant.world_frame(), plant.world_frame(),
         )  # fmt: skip
-        n_W = R_WO @ np.asarray(pc.nhat_O, dtype=float)
-        rows.setdefault(pc.finger_body, []).append(n_W @ J)
+        rows.setdefault(name, []).append((R_WO @ nhat_O) @ J)
     levers = {}
     for name, sign in squeezers.items():
         total = 0.0
@@ -176,6 +200,47 @@ def contact_levers(
                 sign * sum(rho * float(row[v]) for v, rho in columns[name])
                 for row in body_rows
             ]
-            total += max(0.0, float(np.mean(arms)))
-        levers[name] = total if math.isfinite(total) else 0.0
+            total += float(np.mean(arms))
+        levers[name] = total if total > LEVER_TOL else 0.0  # it only closes
     return levers
+
+
+def _contact_frames(candidate) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """``(finger body, p_OC, nhat_O)`` of each of ``candidate``'s contacts, checked.
+
+    Raises
+    ------
+    InvalidGraspError
+        No contacts, or one whose point or normal is not a finite 3-vector
+        (the normal of unit length), or that names no finger body.
+    """
+    try:
+        contacts = list(candidate.contacts)
+    except TypeError:
+        contacts = []
+    if not contacts:
+        raise InvalidGraspError(
+            "the candidate has no contacts: the default squeeze presses the "
+            "fingers at theirs (give squeeze= to press without them)"
+        )
+    out = []
+    for k, pc in enumerate(contacts):
+        try:
+            name = pc.finger_body
+            p = np.asarray(pc.p_OC, dtype=float)
+            n = np.asarray(pc.nhat_O, dtype=float)
+        except (AttributeError, TypeError, ValueError):
+            name, p, n = None, np.zeros(0), np.zeros(0)
+        if not (
+            isinstance(name, str)
+            and p.shape == n.shape == (3,)
+            and np.all(np.isfinite(p))
+            and np.all(np.isfinite(n))
+            and abs(float(np.linalg.norm(n)) - 1.0) < 1e-6
+        ):
+            raise InvalidGraspError(
+                f"the candidate's contact {k} must name its finger body and have "
+                "a finite point p_OC and unit normal nhat_O, 3-vectors in frame O"
+            )
+        out.append((name, p, n))
+    return out

@@ -14,13 +14,13 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from coupled_hands import one_motor_pinch_urdf
+from coupled_hands import one_motor_pinch_urdf, spread_hand_urdf
 from pydrake.math import RigidTransform, RollPitchYaw
 
-from drakegrasp import GraspError
+from drakegrasp import GraspError, InvalidGraspError, ModelError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.shake import REVOLUTE_AIM
-from drakegrasp.planning.squeeze import DEFAULT_SQUEEZE, contact_levers
+from drakegrasp.planning.squeeze import DEFAULT_SQUEEZE, HOLD_LEVER, contact_levers
 from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import find_joint
 
@@ -208,9 +208,9 @@ def test_the_lever_arms_move_with_the_grasp_and_stay_in_the_planned_frame(strong
     [
         (("not callable", "candidate", {}), "add_models must be a function"),
         ((None, object(), {}), "candidate must be a GraspCandidate"),
-        ((None, "candidate", {"one_motor_pinch::left_knuckle": 0.0}), "1 or -1"),
-        ((None, "candidate", {"one_motor_pinch::left_knuckle": True}), "1 or -1"),
-        ((None, "candidate", {"one_motor_pinch::left_knuckle": np.nan}), "1 or -1"),
+        ((None, "candidate", {"one_motor_pinch::left_knuckle": 0.5}), "1, -1 or 0"),
+        ((None, "candidate", {"one_motor_pinch::left_knuckle": True}), "1, -1 or 0"),
+        ((None, "candidate", {"one_motor_pinch::left_knuckle": np.nan}), "1, -1 or 0"),
         ((None, "candidate", {"no_such_joint": 1.0}), "no_such_joint"),
     ],
 )
@@ -239,3 +239,161 @@ def test_hostile_couplings_and_frames_are_refused(strong, couplings, X_WO, words
             scene.add_models, result.candidates[0],
             {"one_motor_pinch::left_knuckle": 1.0}, couplings, X_WO=X_WO,
         )  # fmt: skip
+
+
+# ------------------------------------------------------------- a review's finds
+
+
+def test_a_slide_that_turns_the_fingers_presses_them_with_20_n(tmp_path):
+    """A hidden drive that slides (a linkage's input slider, 20 rad/m to the
+    knuckles) turns the fingers: it is aimed at 20 N × its arms (N per N),
+    not at its own 20 N times the four joints it drives (it applied 1000 N,
+    its effort limit: some 530 N at each pad)."""
+    text = one_motor_pinch_urdf(effort=1000.0, hidden_drive=True, drive_ratio=20.0)
+    text = text.replace(
+        '<joint name="drive" type="revolute">', '<joint name="drive" type="prismatic">'
+    )
+    path = tmp_path / "slide.urdf"
+    path.write_text(text)
+    scene = planning_scene(BOX, hand_url=str(path))
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=60, mu=0.5, seed=0, object_mass=0.2,
+    )  # fmt: skip
+    candidate = result.candidates[0]
+    drive = "one_motor_pinch::drive"
+    sign = candidate.closing_signs[candidate.joint_names.index(drive)]
+    arms = _cross_product_levers(scene, candidate, drive, sign)
+    assert 1.5 < arms < 2.2  # 20 × the knuckles' arms, N per N
+    shaken = shake_test(scene.add_models, candidate, hydroelastic_modulus=1e6, **QUICK)
+    assert shaken.squeeze_at_contacts and shaken.held
+    assert shaken.efforts == (pytest.approx(DEFAULT_SQUEEZE * arms, rel=1e-2),)
+
+
+def test_a_follower_with_its_own_motor_presses_with_that_motor(tmp_path, strong):
+    """The right knuckle given a motor of its own: the two motors share the
+    pads' press (τ = Jᵀ f), their torques along the coupled motion summing
+    to the one motor's.  Counted in both, it came to 3.21 N·m for 1.87."""
+    scene, result = strong
+    text = one_motor_pinch_urdf(effort=1000.0).replace(
+        "</robot>",
+        '<transmission name="t2"><type>transmission_interface/SimpleTransmission'
+        '</type><joint name="right_knuckle"/><actuator name="motor2">'
+        "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
+        "</robot>",
+    )
+    path = tmp_path / "two_motors.urdf"
+    path.write_text(text)
+    two = planning_scene(BOX, hand_url=str(path))
+    candidate = result.candidates[0]
+    one = shake_test(scene.add_models, candidate, hydroelastic_modulus=1e6, **QUICK)
+    both = shake_test(two.add_models, candidate, hydroelastic_modulus=1e6, **QUICK)
+    assert len(both.efforts) == 2 and both.held
+    # q_right = -q_left, each closing its own way: both torques add
+    assert sum(both.efforts) == pytest.approx(one.efforts[0], rel=2e-2)
+
+
+def _with_contacts(candidate, **fields):
+    return replace(
+        candidate,
+        contacts=tuple(replace(pc, **fields) for pc in candidate.contacts),
+    )
+
+
+def test_contacts_the_default_cannot_press_are_refused(strong):
+    """No contacts, a NaN or misshapen contact, or normals that closing moves
+    away from: the default squeeze would press nothing (each shook with no
+    force at all and the box fell 3.64 m, the result reading "20 N")."""
+    scene, result = strong
+    c = result.candidates[0]
+    for bad, words in (
+        (replace(c, contacts=()), "no contacts"),
+        (_with_contacts(c, nhat_O=np.full(3, np.nan)), "unit normal nhat_O"),
+        (_with_contacts(c, p_OC=np.zeros(2)), "finite point p_OC"),
+    ):
+        with pytest.raises(InvalidGraspError, match=words):
+            shake_test(scene.add_models, bad, **QUICK)
+    outward = replace(
+        c, contacts=tuple(replace(pc, nhat_O=-pc.nhat_O) for pc in c.contacts)
+    )
+    with pytest.raises(ModelError, match="presses nothing: give squeeze="):
+        shake_test(scene.add_models, outward, **QUICK)
+
+
+def test_a_hand_welded_by_add_models_is_refused_by_name(strong):
+    scene, result = strong
+    candidate = result.candidates[0]
+
+    def welded(plant, parser):
+        hand, body = scene.add_models(plant, parser)
+        base = plant.GetBodyByName("palm")
+        plant.WeldFrames(plant.world_frame(), base.body_frame())
+        return hand, body
+
+    for squeeze in (None, 20.0):
+        with pytest.raises(ModelError, match="must leave the hand's base"):
+            shake_test(welded, candidate, squeeze=squeeze, **QUICK)
+
+
+@pytest.fixture(scope="module")
+def spread(tmp_path_factory):
+    path = tmp_path_factory.mktemp("spread") / "spread.urdf"
+    path.write_text(spread_hand_urdf())
+    scene = planning_scene(BOX, hand_url=str(path))
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=80, mu=0.5, seed=0, object_mass=0.2,
+    )  # fmt: skip
+    return scene, result
+
+
+def test_a_joint_that_barely_presses_still_holds_stiffly(spread):
+    """Each turning finger holds at least as stiffly as one pressing 20 N at
+    HOLD_LEVER (within its effort limit): a spread whose arms sum to 1.3 mm
+    was aimed at 0.027 N·m with 0.27 N·m/rad, near limp."""
+    scene, result = spread
+    for candidate in result.candidates[:2]:
+        shaken = shake_test(scene.add_models, candidate, **QUICK)
+        floor = min(DEFAULT_SQUEEZE * HOLD_LEVER, 1.5)  # the joints' limit 1.5
+        assert all(k * REVOLUTE_AIM >= floor * (1 - 1e-12) for k, _ in shaken.gains)
+
+
+def test_an_uncapped_squeeze_reads_exactly_the_squeeze(spread):
+    """0.7 N·m on a motor of share 1.5: its cap came out 0.6999999999999998,
+    and the summary said "capped" where no effort limit capped anything."""
+    scene, result = spread
+    shaken = shake_test(scene.add_models, result.candidates[0], squeeze=0.7, **QUICK)
+    assert not shaken.squeeze_capped
+    assert 0.7 in shaken.squeeze_caps and "capped" not in str(shaken)
+
+
+def test_the_allegro_hands_joints_that_closing_leaves_still_hold(drake_models_dir):
+    """A multi-finger candidate's closing sign is 0 for a joint closing leaves
+    still (the Allegro hand's spreads): its arm is 0 and it holds where it
+    stands, at the hold's stiffness within its 0.7 N·m; the default shake of
+    such a candidate was refused, the sign read as a hostile one."""
+    scene = planning_scene(
+        "package://drake_models/ycb/005_tomato_soup_can.sdf",
+        hand_url="package://drake_models/allegro_hand_description/sdf/"
+        "allegro_hand_description_right.sdf",
+        models_dir=drake_models_dir,
+    )
+    ctx = scene.plant.GetMyContextFromRoot(scene.context)
+    scene.plant.GetJointByName("joint_12").set_angle(ctx, 1.0)  # thumb opposed
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=100, mu=0.5, seed=0,
+    )  # fmt: skip
+    still = [c for c in result.candidates[:10] if 0.0 in c.closing_signs]
+    assert still, [c.closing_signs for c in result.candidates[:10]]
+    candidate = still[0]
+    shaken = shake_test(scene.add_models, candidate, hydroelastic_modulus=1e6, **QUICK)
+    assert shaken.squeeze_at_contacts
+    hold = min(DEFAULT_SQUEEZE * HOLD_LEVER, 0.7) / REVOLUTE_AIM
+    assert min(k for k, _ in shaken.gains) == pytest.approx(hold, rel=1e-12)
+    joints = dict(zip(candidate.joint_names, shaken.seated_q_hand, strict=True))
+    for name, sign, q in zip(
+        candidate.joint_names, candidate.closing_signs, candidate.q_hand, strict=True
+    ):
+        if sign == 0.0:  # held where it stood, within what the contacts push
+            assert joints[name] == pytest.approx(q, abs=0.05), name
