@@ -37,17 +37,12 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests" / "support"))
+from bench_pinch import OBJECTS  # noqa: E402  (the pinch's objects, by name)
 from bench_plan import drake_models  # noqa: E402
 from coupled_hands import one_motor_pinch_urdf  # noqa: E402
 
 import drakegrasp as dg  # noqa: E402
 from drakegrasp.planning.shake import REVOLUTE_AIM  # noqa: E402
-
-OBJECTS = {
-    "box": "package://drakegrasp/objects/box.sdf",
-    "sugar_box": "package://drake_models/ycb/004_sugar_box.sdf",
-    "soup_can": "package://drake_models/ycb/005_tomato_soup_can.sdf",
-}
 
 
 def _distance(metres: float) -> str:
@@ -57,7 +52,8 @@ def _distance(metres: float) -> str:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--objects", nargs="+", default=list(OBJECTS))
+    objects = ["box", "sugar_box", "soup_can"]
+    parser.add_argument("--objects", nargs="+", default=objects, choices=OBJECTS)
     parser.add_argument("--efforts", nargs="+", type=float, default=[1000.0, 5.0])
     parser.add_argument("--top", type=int, default=6)
     parser.add_argument("--num", type=int, default=60)

@@ -14,7 +14,12 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from coupled_hands import one_motor_pinch_urdf, spread_hand_urdf
+from coupled_hands import (
+    one_motor_pinch_urdf,
+    plan_pinch_on_box,
+    spread_hand_urdf,
+    transmissions,
+)
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from drakegrasp import GraspError, InvalidGraspError, ModelError
@@ -33,13 +38,7 @@ pytestmark = pytest.mark.filterwarnings(
 
 def _planned(tmp_path, name, **pinch):
     path = tmp_path / f"{name}.urdf"
-    path.write_text(one_motor_pinch_urdf(**pinch))
-    scene = planning_scene(BOX, hand_url=str(path))
-    result = plan_grasps(
-        scene.plant, scene.context, scene.object_body, hand=scene.hand,
-        num_candidates=60, mu=0.5, seed=0, robustness_samples=8,
-        object_mass=0.2,
-    )  # fmt: skip
+    scene, result = plan_pinch_on_box(path, one_motor_pinch_urdf(**pinch))
     assert len(result) > 5, result.reason
     return scene, result
 
@@ -276,11 +275,7 @@ def test_a_follower_with_its_own_motor_presses_with_that_motor(tmp_path, strong)
     to the one motor's.  Counted in both, it came to 3.21 N·m for 1.87."""
     scene, result = strong
     text = one_motor_pinch_urdf(effort=1000.0).replace(
-        "</robot>",
-        '<transmission name="t2"><type>transmission_interface/SimpleTransmission'
-        '</type><joint name="right_knuckle"/><actuator name="motor2">'
-        "<mechanicalReduction>1</mechanicalReduction></actuator></transmission>"
-        "</robot>",
+        "</robot>", transmissions(["right_knuckle"]) + "</robot>"
     )
     path = tmp_path / "two_motors.urdf"
     path.write_text(text)

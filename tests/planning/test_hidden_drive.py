@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from coupled_hands import coupled_jaw_urdf, one_motor_pinch_urdf
+from coupled_hands import coupled_jaw_urdf, one_motor_pinch_urdf, plan_pinch_on_box
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -253,15 +253,9 @@ def pinch_twins(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("hidden_pinch")
     out = {}
     for name, hidden in (("twin", False), ("hidden", True)):
-        path = tmp / f"{name}.urdf"
-        path.write_text(one_motor_pinch_urdf(hidden_drive=hidden))
-        scene = planning_scene(BOX, hand_url=str(path))
-        result = plan_grasps(
-            scene.plant, scene.context, scene.object_body, hand=scene.hand,
-            num_candidates=60, mu=0.5, seed=0, robustness_samples=8,
-            object_mass=0.2,
-        )  # fmt: skip
-        out[name] = (scene, result)
+        out[name] = plan_pinch_on_box(
+            tmp / f"{name}.urdf", one_motor_pinch_urdf(hidden_drive=hidden)
+        )
     return out
 
 

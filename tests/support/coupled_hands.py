@@ -317,3 +317,23 @@ def coupled_jaw_urdf(
         f'</hardwareInterface></joint><actuator name="m"><mechanicalReduction>1'
         "</mechanicalReduction></actuator></transmission></robot>"
     )
+
+
+def plan_pinch_on_box(path, urdf: str, **plan):
+    """``(scene, result)``: ``urdf`` written to ``path`` and planned on the box.
+
+    The pinch tests' plan: 60 samples, ``mu`` 0.5, seed 0, 8 robustness
+    samples, an object of 0.2 kg; ``plan`` overrides any of them.
+    """
+    from drakegrasp.planning import plan_grasps, planning_scene
+
+    path.write_text(urdf)
+    scene = planning_scene("package://drakegrasp/objects/box.sdf", hand_url=str(path))
+    options = dict(
+        num_candidates=60, mu=0.5, seed=0, robustness_samples=8, object_mass=0.2
+    )
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        **{**options, **plan},
+    )  # fmt: skip
+    return scene, result
