@@ -17,7 +17,8 @@ the object's mass) and its ``--top`` best are shaken in Drake
 lever arms give, :mod:`drakegrasp.planning.squeeze`) and at ``squeeze=20``
 (the old default: 20 N·m per joint, 120 N·m at the motor of six joints,
 within its effort limit).  It prints, per run, how many held (from the
-seat), the largest displacement, and the motor's aim.  The YCB objects need
+seat), the largest displacement, and what the motor pressed with once the
+fingers had seated (``ShakeResult.efforts``).  The YCB objects need
 Drake's ``drake_models`` (``DRAKEGRASP_DRAKE_MODELS`` or
 ``../shared/drake_models``; left out without it).
 
@@ -42,7 +43,6 @@ from bench_plan import drake_models  # noqa: E402
 from coupled_hands import one_motor_pinch_urdf  # noqa: E402
 
 import drakegrasp as dg  # noqa: E402
-from drakegrasp.planning.shake import REVOLUTE_AIM  # noqa: E402
 
 
 def _distance(metres: float) -> str:
@@ -94,12 +94,13 @@ def main(argv=None) -> int:
                     ]
                     held = sum(s.held_from_seat for s in shaken)
                     worst = max((s.max_displacement for s in shaken), default=0.0)
-                    aims = [k * REVOLUTE_AIM for s in shaken for k, _ in s.gains]
-                    aim = f"{min(aims):.3g}-{max(aims):.3g}" if aims else "-"
+                    pressed = [e for s in shaken for e in s.efforts]
+                    aim = f"{min(pressed):.3g}-{max(pressed):.3g}" if pressed else "-"
                     print(
                         f"  {name:10s} {label:17s} held {held}/{len(shaken)}, "
                         f"largest displacement {_distance(worst)}, "
-                        f"motor aimed at {aim} N·m ({time.perf_counter() - t0:.1f} s)",
+                        f"motor pressed with {aim} N·m once seated "
+                        f"({time.perf_counter() - t0:.1f} s)",
                         flush=True,
                     )
     return 0

@@ -1769,8 +1769,9 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         metavar="K",
         help="with --shake: the fingers' position gain, N/m or N·m/rad "
         "(default per joint: 4000 N/m for a prismatic one, and for a revolute "
-        "one what aims it 0.1 rad past its place, its squeeze / 0.1 rad; 10 for "
-        "--hand allegro)",
+        "one what aims it 0.1 rad past its place, its squeeze / 0.1 rad, at the "
+        "default squeeze what deflects it 0.1 rad under 20 N at its contacts; "
+        "10 for --hand allegro)",
     )
     plan.add_argument(
         "--hydroelastic",

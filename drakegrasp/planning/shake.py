@@ -500,24 +500,24 @@ def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
 
 
 def _levers(plant, add_models, candidate, squeezers, couplings, by_name, X_WO):
-    """``(levers, hold)`` of the default squeeze.
+    """``(arms, hold)`` of the default squeeze.
 
-    ``levers``: per squeezer that turns a finger (its own joint, or one of the
-    followers it drives, revolute: a slide may drive a linkage), its torque,
-    or force, per newton at the contacts (m, or 1;
-    :func:`~drakegrasp.planning.squeeze.contact_levers`, the contacts in
-    frame ``X_WO``, the planned one; a follower with a motor of its own
-    presses with that motor, not its leader's).  A squeezer that only
+    ``arms``: per squeezer that turns a finger (its own joint, or one of the
+    followers it drives, revolute: a slide may drive a linkage), its
+    :class:`~drakegrasp.planning.squeeze.Arms` at the contacts in frame
+    ``X_WO`` (the planned one), through the followers without a motor of
+    their own (a follower with one presses with it).  A squeezer that only
     slides fingers is left out: its force is the squeeze.  ``hold``: the aim
-    whose stiffness a joint holds with at the least, N·m: the squeeze at
-    :data:`~drakegrasp.planning.squeeze.HOLD_LEVER`; with no finger that
-    turns, the squeeze (N, or N·m), as an explicit one.
+    whose stiffness a revolute joint that moves no contact holds with, N·m:
+    the squeeze at :data:`~drakegrasp.planning.squeeze.HOLD_LEVER`; with no
+    finger that turns, the squeeze (N, or N·m), as an explicit one.
 
     Raises
     ------
-    ModelError
+    InvalidGraspError
         No squeezer presses the candidate's contacts when it closes (each
-        closes no contact onto the object: contacts on the palm, say).
+        closes no contact onto the object: contacts on the palm, say), or a
+        contact is not a finite point and unit normal.
     """
     moved = [c for c in couplings if c[0] not in by_name]  # no motor of its own
     turning = {
@@ -530,15 +530,15 @@ def _levers(plant, add_models, candidate, squeezers, couplings, by_name, X_WO):
     }
     if not turning:  # a jaw's sliding fingers: the squeeze is their force
         return {}, DEFAULT_SQUEEZE
-    levers = contact_levers(add_models, candidate, turning, moved, X_WO=X_WO)
-    if len(turning) == len(squeezers) and not any(levers.values()):
-        raise ModelError(
+    arms = contact_levers(add_models, candidate, turning, moved, X_WO=X_WO)
+    if len(turning) == len(squeezers) and not any(a.press for a in arms.values()):
+        raise InvalidGraspError(
             f"none of the candidate's motors ({', '.join(turning)}) closes a "
             "finger onto the object at its contacts, so the default squeeze (20 N "
             "at the contacts) presses nothing: give squeeze= (N, or N·m per "
             "revolute joint)"
         )
-    return levers, DEFAULT_SQUEEZE * HOLD_LEVER
+    return arms, DEFAULT_SQUEEZE * HOLD_LEVER
 
 
 def _squeezers(candidate, couplings, driven: dict, by_name: dict) -> dict:
@@ -709,11 +709,9 @@ def shake_test(
         Robotiq-2F-85-like hand that a squeeze of 20 N·m on each of its six
         joints aimed at 120 N·m, throwing the box out of the hand; a slide
         that drives turning fingers through its ``<mimic>`` followers alike).
-        A joint whose closing moves no contact holds where it stands, and
-        every turning finger holds at least as stiffly as one pressing 20 N
-        at :data:`~drakegrasp.planning.squeeze.HOLD_LEVER` (10 N·m/rad,
-        within its effort limit).  A candidate whose closing presses none of
-        its contacts is refused (``ModelError``): give a number.  It
+        A joint whose closing presses no contact holds where it stands.  A
+        candidate whose closing presses none of its contacts is refused
+        (``InvalidGraspError``): give a number.  It
         is the press at rest, the position control's aim, not a cap: a
         finger that the object pushes back presses harder, up to the
         actuator's effort limit, where Drake clamps it (the Allegro hand's
@@ -732,9 +730,17 @@ def shake_test(
         :data:`REVOLUTE_AIM` (0.1 rad) past its place (its pressing torque
         over 0.1 rad: 7 N·m/rad for the Allegro hand's 0.7 N·m; a fixed 4000
         N·m/rad aimed its light fingers 0.2 mrad past, lost at once as they
-        closed on); damping ``stiffness`` × :data:`DAMPING_TIME` (50 N·s/m at
-        4000 N/m).  Given, one value for every joint (``plan --shake`` gives
-        the Allegro hand 0.7 N·m, stiffness 10, damping 0.1).
+        closed on); at the default squeeze, what deflects it 0.1 rad under
+        the squeeze at its contacts in any direction, its reach's torque over
+        0.1 rad (:class:`~drakegrasp.planning.squeeze.Arms`; a finger that
+        presses square on is aimed 0.1 rad past, a spread presses little and
+        holds as stiffly as its reach asks), and for one that moves no
+        contact the squeeze at
+        :data:`~drakegrasp.planning.squeeze.HOLD_LEVER` over 0.1 rad, each
+        within its effort limit; damping ``stiffness`` ×
+        :data:`DAMPING_TIME` (50 N·s/m at 4000 N/m).  Given, one value for
+        every joint (``plan --shake`` gives the Allegro hand 0.7 N·m,
+        stiffness 10, damping 0.1).
     directions : sequence of (3,) float, optional
         World gravity directions after the settling phase along −z (any
         finite, non-zero length: only the direction counts; consecutive ones
@@ -802,15 +808,14 @@ def shake_test(
         ``add_models`` did not add the candidate's hand base or closing joints
         or welded the base itself, its object has no mass and no
         ``object_mass`` is given (gravity would pull on nothing and every grasp
-        would hold), the default squeeze would press none of the candidate's
-        contacts (above), or Drake refused to
+        would hold), or Drake refused to
         advance the model for another reason (its first sentence is in the
         message).
     InvalidGraspError
         The candidate's joint values or poses are not finite or do not match
         its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`),
         or, at the default squeeze, a contact is not a finite point and unit
-        normal.
+        normal, or its closing presses none of its contacts.
 
     Warns
     -----
@@ -896,7 +901,7 @@ def shake_test(
     )
     if default:
         squeeze = DEFAULT_SQUEEZE
-    at_contacts = bool(levers)  # a revolute motor aims at newtons at contacts
+    at_contacts = bool(levers)  # a turning motor aims at newtons at contacts
     for name, sign in squeezers.items():
         actuator = by_name[name]
         # a leader's motor also presses through the followers it drives: each
@@ -904,18 +909,22 @@ def shake_test(
         # by default a revolute motor with the torque that presses its
         # fingers' contacts with squeeze newtons (planning.squeeze)
         share = shares.get(name, 1.0)
-        lever = levers.get(name)
-        aim = squeeze * share if lever is None else squeeze * lever
+        arm = levers.get(name)
+        aim = squeeze * share if arm is None else squeeze * arm.press
         push = min(aim, actuator.effort_limit())
         # the squeeze each presses with, capped, in squeeze's unit: a joint's
         # share of its motor, or newtons at the contacts
-        cap = squeeze if push >= aim else push / (share if lever is None else lever)
-        pushed[int(actuator.index())] = (push, cap)
-        # a turning finger holds at least as stiffly as `hold` aims it: one
-        # whose closing barely moves its contacts (a spread) is not left limp
+        cap = squeeze if push >= aim else push / (share if arm is None else arm.press)
+        # a turning finger holds as stiffly as the squeeze at its reach asks
+        # (a spread presses little, a geared drive reaches little); one that
+        # moves no contact as `hold` does
+        held = hold if arm is None or not arm.reach else squeeze * arm.reach
         k, _ = gains[int(actuator.index())] = _gains(
-            actuator, aim if lever is None else max(aim, hold), stiffness, damping
+            actuator, aim if arm is None else max(aim, held), stiffness, damping
         )
+        if arm is not None and push / k < _MIN_AIM:  # round-off: it holds still
+            push = 0.0
+        pushed[int(actuator.index())] = (push, cap)
         if 0 < push / k < _MIN_AIM:
             raise InvalidOptionError(
                 f"stiffness = {k:g} aims joint {name} {push / k:.3g} "

@@ -43,6 +43,7 @@ from drakegrasp.planning.candidates import (
 )
 from drakegrasp.planning.shake import check_shake_options, recorded_mass, shake_test
 from drakegrasp.planning.shake_result import ShakeResult, _limits, motion_text
+from drakegrasp.planning.squeeze import checked_contacts
 from drakegrasp.plant.validation import check_rigid_transform
 
 __all__ = [
@@ -220,8 +221,13 @@ def _checked_top(top) -> int:
     return int(top)
 
 
-def _first_candidates(candidates, top: int) -> list[GraspCandidate]:
-    """The first ``top`` candidates (an endless iterator is read ``top`` deep)."""
+def _first_candidates(
+    candidates, top: int, at_contacts: bool = False
+) -> list[GraspCandidate]:
+    """The first ``top`` candidates (an endless iterator is read ``top`` deep).
+
+    Each checked; with ``at_contacts`` (the default squeeze) its contacts too.
+    """
     if isinstance(candidates, GraspCandidate):
         raise InvalidOptionError(
             "candidates must be several candidates (plan_grasps' result or a "
@@ -242,6 +248,8 @@ def _first_candidates(candidates, top: int) -> list[GraspCandidate]:
         try:  # all of them before any is simulated: no run lost at the fifth
             check_candidate(c)
             recorded_mass(c)
+            if at_contacts:
+                checked_contacts(c)
         except InvalidGraspError as e:
             raise InvalidGraspError(f"candidates[{k}]: {e}") from e
     return chosen
@@ -347,9 +355,11 @@ def shake_candidates(
     -------
     ShakenCandidates
         The shaken candidates: held, then dropped, then those Drake could not
-        simulate (its ``SolverError``, or a ``ModelError`` past the first
-        candidate, is recorded in one line, and the others are still
-        shaken); each group in the planner's order.
+        simulate (its ``SolverError``, a ``ModelError`` past the first
+        candidate, or the ``InvalidGraspError`` of one whose closing the
+        default squeeze finds pressing none of its contacts, is recorded in
+        one line, and the others are still shaken); each group in the
+        planner's order.
 
     Raises
     ------
@@ -360,8 +370,9 @@ def shake_candidates(
         candidates.
     InvalidGraspError
         A candidate whose joint values or poses are not finite or do not
-        match its joints, named by its place (all are checked before any is
-        simulated).
+        match its joints, or, at the default squeeze, whose contacts are not
+        finite points and unit normals, named by its place (all are checked
+        before any is simulated).
     ModelError
         As :func:`~drakegrasp.planning.shake.shake_test` raises it for the
         first candidate: a model that does not match the candidates (the
@@ -373,16 +384,19 @@ def shake_candidates(
             f"object_body), got {type(add_models).__name__}"
         )
     settings = check_settings(top, held_from, options)
-    chosen = _first_candidates(candidates, int(top))
+    chosen = _first_candidates(
+        candidates, int(top), at_contacts=settings["squeeze"] is None
+    )
     t0 = time.perf_counter()
     shaken = []
     for k, c in enumerate(chosen):
         try:
             result = shake_test(add_models, c, **options)
-        except (SolverError, ModelError) as e:
+        except (SolverError, ModelError, InvalidGraspError) as e:
             if k == 0 and isinstance(e, ModelError):
                 raise  # the models and the candidates do not match: every one
-            # Drake could not simulate this one: recorded, the rest still run
+            # Drake could not simulate this one, or the default squeeze presses
+            # none of its contacts: recorded, the rest still run
             shaken.append(ShakenCandidate(c, k, None, False, str(e)))
             continue
         held = result.held_from_seat if held_from == "seat" else result.held

@@ -62,7 +62,8 @@ class ShakeResult:
     bounds : tuple of float
         ``(max_displacement, max_rotation)`` allowed.
     effort_units : tuple of str
-        The unit of ``squeeze`` and of each entry of ``efforts``, per closing
+        The unit of each entry of ``efforts``, and of ``squeeze`` unless
+        ``squeeze_at_contacts`` (newtons then), per closing
         joint in actuator order: ``"N"`` for a prismatic joint, ``"N·m"`` for
         a revolute one (empty: newtons assumed).
     seat_displacement, seat_rotation : float

@@ -25,6 +25,14 @@ turns one finger towards the object and another away from it); motors that
 share a body's motion share its press, as ``Jᵀ f`` splits it.  For a one-link
 finger touching at ``r`` from its axis, square to it, the arm is ``r``: the
 torque is ``f r``.
+
+The motor's reach ``Σ_b mean_C ‖J_C ∂q/∂q_m‖`` sets how stiffly it holds
+(with the shake's default stiffness): as stiffly as deflects it
+:data:`~drakegrasp.planning.shake.REVOLUTE_AIM` under the squeeze at its
+contacts, in whatever direction they push.  A finger that presses square on
+(press = reach) is then aimed 0.1 rad past its place; a spread joint, whose
+closing moves its contacts sideways, presses little but holds as stiffly as
+its reach asks; a geared drive's stiffness scales with its gearing.
 """
 
 from __future__ import annotations
@@ -32,6 +40,7 @@ from __future__ import annotations
 import math
 import reprlib
 from collections.abc import Callable, Mapping, Sequence
+from typing import NamedTuple
 
 import numpy as np
 from pydrake.math import RigidTransform
@@ -44,7 +53,14 @@ from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.models import new_parser
 from drakegrasp.plant.validation import check_rigid_transform, resolve_body
 
-__all__ = ["DEFAULT_SQUEEZE", "HOLD_LEVER", "LEVER_TOL", "contact_levers"]
+__all__ = [
+    "DEFAULT_SQUEEZE",
+    "HOLD_LEVER",
+    "LEVER_TOL",
+    "Arms",
+    "checked_contacts",
+    "contact_levers",
+]
 
 DEFAULT_SQUEEZE = 20.0
 """The shake test's default squeeze, N: what each finger body that touches
@@ -53,15 +69,36 @@ it, times the fingers it drives; a revolute one's the torque that presses
 them with it: :func:`contact_levers`)."""
 
 HOLD_LEVER = 0.05
-"""Lever arm (m) of the least stiffness of a turning finger at the default
-squeeze: a joint whose closing moves its contacts little or not at all (a
-spread joint, a finger that touches nothing) and a joint that does not
-squeeze hold their place as stiffly as one that presses the squeeze at 5 cm
-(10 N·m/rad at 20 N, within the effort limit)."""
+"""Lever arm (m) of a revolute joint's hold at the default squeeze where it
+moves no contact (a finger that touches nothing, an actuator that does not
+squeeze): with the default stiffness it holds its place as stiffly as one
+that presses the squeeze at 5 cm (10 N·m/rad at 20 N, within the effort
+limit)."""
 
 LEVER_TOL = 1e-9
 """Lever arms (m) below this are zero: a joint they would aim a nanometre
 past its place presses with nothing that round-off leaves."""
+
+
+class Arms(NamedTuple):
+    """A squeezer's arms at the candidate's contacts (m, or N per N for a slide).
+
+    Attributes
+    ----------
+    press : float
+        ``Σ_b mean_C s nᵀ J_C ∂q/∂q_m`` (the module docstring): the torque per
+        newton with which closing presses the touching bodies along their
+        normals; 0 where that is not above :data:`LEVER_TOL`.
+    reach : float
+        ``Σ_b mean_C ‖J_C ∂q/∂q_m‖``: how fast the contacts' finger points
+        move per unit of the motor, whatever the direction; the torque per
+        newton that a force on them in any direction exerts at the most (a
+        spread joint reaches far and presses little).  0 for a joint that
+        moves no contact.
+    """
+
+    press: float
+    reach: float
 
 
 _CANDIDATE = ("apply", "contacts", "hand_base", "X_WH", "X_WO")
@@ -75,8 +112,8 @@ def contact_levers(
     couplings: Sequence,
     *,
     X_WO: RigidTransform | None = None,
-) -> dict[str, float]:
-    """Per squeezing joint, ``Σ_b ℓ_b``: its torque per newton at the contacts.
+) -> dict[str, Arms]:
+    """Per squeezing joint, its :class:`Arms`: torque per newton at the contacts.
 
     Parameters
     ----------
@@ -103,14 +140,17 @@ def contact_levers(
 
     Returns
     -------
-    dict of str to float
-        Per squeezer, ``Σ_b ℓ_b`` (module docstring) over the finger bodies
-        that touch: m (N·m per N) for a revolute joint, N per N for a
-        prismatic one; 0 where that is not above :data:`LEVER_TOL` (closing
-        it presses no contact).
+    dict of str to Arms
+        Per squeezer, ``press`` = ``Σ_b ℓ_b`` (module docstring) over the
+        finger bodies that touch, and ``reach``: m (N·m per N) for a revolute
+        joint, N per N for a prismatic one; each 0 where not above
+        :data:`LEVER_TOL` (closing presses no contact; the joint moves none).
 
     Raises
     ------
+    InvalidGraspError
+        A contact of the candidate that is not a finite point and unit normal
+        naming its finger body, or no contacts.
     InvalidOptionError
         ``add_models`` not callable, ``candidate`` not a candidate of
         ``plan_grasps``, ``squeezers`` not a mapping or a sign other than ±1
@@ -118,7 +158,8 @@ def contact_levers(
         ``couplings`` not 4-tuples, ``X_WO`` not a rigid transform.
     ModelError
         ``add_models`` did not build the hand again (a body or joint of the
-        candidate is missing on its second call).
+        candidate is missing on its second call), or welded its base (the
+        shake welds it at ``X_WH``).
     """
     if not callable(add_models):
         raise InvalidOptionError(
@@ -155,7 +196,7 @@ def contact_levers(
                 f"the sign that closes joint {name!r} must be 1, -1 or 0 (closing "
                 f"leaves it still), got {sign!r}"
             )
-    contacts = _contact_frames(candidate)
+    contacts = checked_contacts(candidate)
     X_WO = candidate.X_WO if X_WO is None else check_rigid_transform("X_WO", X_WO)
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
@@ -182,7 +223,8 @@ def contact_levers(
         for name in squeezers
     }
     R_WO = X_WO.rotation().matrix()
-    rows: dict[str, list[np.ndarray]] = {}  # per finger body: n_Wᵀ J_C per contact
+    # per finger body, per contact: (n_W, J_C (3, n_v))
+    jacobians: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     for name, p_OC, nhat_O in contacts:
         finger = resolve_body(plant, name)
         p_WC = X_WO.multiply(p_OC)
@@ -191,21 +233,25 @@ def contact_levers(
             ctx, JacobianWrtVariable.kV, finger.body_frame(), p_FC,
             plant.world_frame(), plant.world_frame(),
         )  # fmt: skip
-        rows.setdefault(name, []).append((R_WO @ nhat_O) @ J)
-    levers = {}
+        jacobians.setdefault(name, []).append((R_WO @ nhat_O, J))
+    arms = {}
     for name, sign in squeezers.items():
-        total = 0.0
-        for body_rows in rows.values():
-            arms = [
-                sign * sum(rho * float(row[v]) for v, rho in columns[name])
-                for row in body_rows
+        press = reach = 0.0
+        for body in jacobians.values():
+            # each contact's finger point's velocity per unit of the motor
+            moves = [
+                (n, sum(rho * J[:, v] for v, rho in columns[name])) for n, J in body
             ]
-            total += float(np.mean(arms))
-        levers[name] = total if total > LEVER_TOL else 0.0  # it only closes
-    return levers
+            press += float(np.mean([sign * (n @ v) for n, v in moves]))
+            reach += float(np.mean([np.linalg.norm(v) for _, v in moves]))
+        arms[name] = Arms(
+            press if press > LEVER_TOL else 0.0,  # a motor is aimed only to close
+            reach if reach > LEVER_TOL else 0.0,
+        )
+    return arms
 
 
-def _contact_frames(candidate) -> list[tuple[str, np.ndarray, np.ndarray]]:
+def checked_contacts(candidate) -> list[tuple[str, np.ndarray, np.ndarray]]:
     """``(finger body, p_OC, nhat_O)`` of each of ``candidate``'s contacts, checked.
 
     Raises

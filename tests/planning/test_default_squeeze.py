@@ -15,15 +15,22 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from coupled_hands import (
+    coupled_jaw_urdf,
     one_motor_pinch_urdf,
     plan_pinch_on_box,
     spread_hand_urdf,
     transmissions,
 )
+from numpy.linalg import norm
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from drakegrasp import GraspError, InvalidGraspError, ModelError
-from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning import (
+    plan_grasps,
+    planning_scene,
+    shake_candidates,
+    shake_test,
+)
 from drakegrasp.planning.shake import REVOLUTE_AIM
 from drakegrasp.planning.squeeze import DEFAULT_SQUEEZE, HOLD_LEVER, contact_levers
 from drakegrasp.plant.couplings import plant_couplings
@@ -49,10 +56,11 @@ def strong(tmp_path_factory):
     return _planned(tmp_path_factory.mktemp("strong"), "strong", effort=1000.0)
 
 
-def _cross_product_levers(scene, candidate, motor, sign):
-    """``Σ_b max(0, mean_C s n·Σ_j ρ_j a_j × (p_C − o_j))``: each joint's axis
-    ``a_j`` through ``o_j`` at the candidate's pose, for the joints that move
-    the contact's body (an independent route to Drake's Jacobian)."""
+def _cross_product_arms(scene, candidate, motor, sign):
+    """``(press, reach)``: ``max(0, Σ_b mean_C s n·v_C)`` and ``Σ_b mean_C ‖v_C‖``
+    with ``v_C = Σ_j ρ_j a_j × (p_C − o_j)``, each joint's axis ``a_j``
+    through ``o_j`` at the candidate's pose, for the joints that move the
+    contact's body (an independent route to Drake's Jacobian)."""
     plant = scene.plant
     ctx = plant.CreateDefaultContext()
     candidate.apply(plant, ctx, object_body=scene.object_body)
@@ -74,8 +82,15 @@ def _cross_product_levers(scene, candidate, motor, sign):
             X_WJ = joint.frame_on_child().CalcPoseInWorld(ctx)
             a = X_WJ.rotation().matrix() @ joint.revolute_axis()
             v += rho * np.cross(a, p - X_WJ.translation())
-        per_body.setdefault(pc.finger_body, []).append(sign * n @ v)
-    return sum(max(0.0, float(np.mean(arms))) for arms in per_body.values())
+        per_body.setdefault(pc.finger_body, []).append((sign * n @ v, norm(v)))
+    press = sum(np.mean([a for a, _ in arms]) for arms in per_body.values())
+    reach = sum(np.mean([r for _, r in arms]) for arms in per_body.values())
+    return max(0.0, float(press)), float(reach)
+
+
+def _cross_product_levers(scene, candidate, motor, sign):
+    """The press of :func:`_cross_product_arms`."""
+    return _cross_product_arms(scene, candidate, motor, sign)[0]
 
 
 def test_the_lever_arms_are_the_cross_products_of_the_axes(strong):
@@ -86,15 +101,18 @@ def test_the_lever_arms_are_the_cross_products_of_the_axes(strong):
         levers = contact_levers(
             scene.add_models, candidate, {motor: sign}, plant_couplings(scene.plant)
         )
-        expected = _cross_product_levers(scene, candidate, motor, sign)
-        # two pads, each some 47 mm from the knuckle axes it turns about
-        assert 0.08 < expected < 0.11
-        assert levers[motor] == pytest.approx(expected, rel=1e-9)
-        # opening presses nothing: each pad's arm counts 0
+        press, reach = _cross_product_arms(scene, candidate, motor, sign)
+        # two pads, each some 47 mm from the knuckle axes it turns about,
+        # pressed as they swing (moving a little along the face too)
+        assert 0.08 < press < 0.11 and press <= reach < 1.1 * press
+        assert levers[motor].press == pytest.approx(press, rel=1e-9)
+        assert levers[motor].reach == pytest.approx(reach, rel=1e-9)
+        # opening presses nothing, and reaches as far
         opened = contact_levers(
             scene.add_models, candidate, {motor: -sign}, plant_couplings(scene.plant)
         )
-        assert opened == {motor: 0.0}
+        assert opened[motor].press == 0.0
+        assert opened[motor].reach == pytest.approx(reach, rel=1e-12)
 
 
 def test_a_hidden_drive_presses_as_its_twin_does(tmp_path, strong):
@@ -112,8 +130,8 @@ def test_a_hidden_drive_presses_as_its_twin_does(tmp_path, strong):
             scene.add_models, b, {"one_motor_pinch::left_knuckle": 1.0},
             plant_couplings(scene.plant),
         )  # fmt: skip
-        assert drive["one_motor_pinch::drive"] == pytest.approx(
-            knuckle["one_motor_pinch::left_knuckle"], rel=1e-9
+        assert list(drive["one_motor_pinch::drive"]) == pytest.approx(
+            list(knuckle["one_motor_pinch::left_knuckle"]), rel=1e-9
         )
 
 
@@ -138,10 +156,10 @@ def test_strong_motors_hold_at_the_default_where_20_nm_per_joint_threw_the_box(
         assert not per_joint.held and per_joint.max_displacement > 1.0
         assert not per_joint.squeeze_at_contacts
         sign = candidate.closing_signs[candidate.joint_names.index(motor)]
-        lever = _cross_product_levers(scene, candidate, motor, sign)
-        # the motor aimed at, and seated with, 20 N times its arms
+        lever, reach = _cross_product_arms(scene, candidate, motor, sign)
+        # the motor seated with 20 N times its arms, as stiff as its reach asks
         ((k, _),) = at_contacts.gains
-        assert k * REVOLUTE_AIM == pytest.approx(DEFAULT_SQUEEZE * lever, rel=1e-9)
+        assert k * REVOLUTE_AIM == pytest.approx(DEFAULT_SQUEEZE * reach, rel=1e-9)
         assert at_contacts.efforts == (
             pytest.approx(DEFAULT_SQUEEZE * lever, rel=1e-2),
         )
@@ -189,17 +207,18 @@ def test_the_lever_arms_move_with_the_grasp_and_stay_in_the_planned_frame(strong
     candidate = result.candidates[0]
     motor = {"one_motor_pinch::left_knuckle": 1.0}
     couplings = plant_couplings(scene.plant)
-    planned = contact_levers(scene.add_models, candidate, motor, couplings)
+    (planned,) = contact_levers(scene.add_models, candidate, motor, couplings).values()
     T = RigidTransform(RollPitchYaw(0.3, -1.1, 2.0), [0.4, -0.2, 1.5])
     moved = replace(
         candidate, X_WH=T.multiply(candidate.X_WH), X_WO=T.multiply(candidate.X_WO)
     )
-    assert contact_levers(scene.add_models, moved, motor, couplings) == pytest.approx(
-        planned, rel=1e-9
-    )
+    (turned,) = contact_levers(scene.add_models, moved, motor, couplings).values()
+    assert list(turned) == pytest.approx(list(planned), rel=1e-9)
     away = replace(candidate, X_WO=T.multiply(candidate.X_WO))
-    kept = contact_levers(scene.add_models, away, motor, couplings, X_WO=candidate.X_WO)
-    assert kept == pytest.approx(planned, rel=1e-12)
+    (kept,) = contact_levers(
+        scene.add_models, away, motor, couplings, X_WO=candidate.X_WO
+    ).values()
+    assert list(kept) == pytest.approx(list(planned), rel=1e-12)
 
 
 @pytest.mark.parametrize(
@@ -311,8 +330,16 @@ def test_contacts_the_default_cannot_press_are_refused(strong):
     outward = replace(
         c, contacts=tuple(replace(pc, nhat_O=-pc.nhat_O) for pc in c.contacts)
     )
-    with pytest.raises(ModelError, match="presses nothing: give squeeze="):
+    with pytest.raises(InvalidGraspError, match="presses nothing: give squeeze="):
         shake_test(scene.add_models, outward, **QUICK)
+    # shaking several, a candidate the default cannot press is recorded and
+    # the rest are shaken; a bad contact is refused before any simulation
+    ranked = shake_candidates(scene.add_models, [outward, c], top=2, **QUICK)
+    assert [s.planned_rank for s in ranked] == [1, 0]
+    assert ranked[1].result is None and "presses nothing" in ranked[1].error
+    nan = _with_contacts(c, nhat_O=np.full(3, np.nan))
+    with pytest.raises(InvalidGraspError, match=r"candidates\[1\]: .*unit normal"):
+        shake_candidates(scene.add_models, [c, nan], top=2, **QUICK)
 
 
 def test_a_hand_welded_by_add_models_is_refused_by_name(strong):
@@ -342,15 +369,56 @@ def spread(tmp_path_factory):
     return scene, result
 
 
-def test_a_joint_that_barely_presses_still_holds_stiffly(spread):
-    """Each turning finger holds at least as stiffly as one pressing 20 N at
-    HOLD_LEVER (within its effort limit): a spread whose arms sum to 1.3 mm
-    was aimed at 0.027 N·m with 0.27 N·m/rad, near limp."""
+def test_each_motor_holds_as_stiffly_as_its_reach_asks(spread):
+    """With the default stiffness a turning motor is as stiff as deflects it
+    0.1 rad under 20 N at its contacts in any direction (its reach), within
+    its 1.5 N·m: a spread whose closing barely presses (arms of 1.3 mm) but
+    moves its contacts sideways is not left limp (it had 0.27 N·m/rad)."""
     scene, result = spread
+    plant = scene.plant
+    motors = {
+        f"spread_hand::{plant.get_joint_actuator(a).joint().name()}"
+        for a in plant.GetJointActuatorIndices()
+    }
+    moved = [c for c in plant_couplings(plant) if c[0] not in motors]
     for candidate in result.candidates[:2]:
+        signs = dict(zip(candidate.joint_names, candidate.closing_signs, strict=True))
+        squeezers = {n: signs[n] for n in sorted(motors) if n in signs}
+        arms = contact_levers(scene.add_models, candidate, squeezers, moved)
         shaken = shake_test(scene.add_models, candidate, **QUICK)
-        floor = min(DEFAULT_SQUEEZE * HOLD_LEVER, 1.5)  # the joints' limit 1.5
-        assert all(k * REVOLUTE_AIM >= floor * (1 - 1e-12) for k, _ in shaken.gains)
+        # gains in actuator order, as the motors are declared
+        names = [
+            f"spread_hand::{plant.get_joint_actuator(a).joint().name()}"
+            for a in plant.GetJointActuatorIndices()
+        ]
+        turning = [n for n in names if n in squeezers]
+        stiffness = dict(zip(turning, shaken.gains, strict=True))
+        for name, arm in arms.items():
+            aim = DEFAULT_SQUEEZE * max(arm.press, arm.reach)
+            expected = min(aim if arm.reach else DEFAULT_SQUEEZE * HOLD_LEVER, 1.5)
+            k, _ = stiffness[name]
+            assert k * REVOLUTE_AIM == pytest.approx(expected, rel=1e-9), name
+
+
+def test_a_geared_drive_holds_as_stiffly_as_its_gearing_asks(tmp_path):
+    """A hidden drive geared 20:1 (the knuckles turn 0.05 rad a radian): a
+    fixed floor of 10 N·m/rad aimed it 0.47 mrad at the knuckles, which the
+    pads took up, and the box fell 3.64 m; its reach asks 0.94 N·m/rad."""
+    scene, result = _planned(
+        tmp_path, "geared", effort=1000.0, hidden_drive=True, drive_ratio=0.05
+    )
+    candidate = result.candidates[0]
+    shaken = shake_test(scene.add_models, candidate, hydroelastic_modulus=1e6, **QUICK)
+    assert shaken.held
+    drive = "one_motor_pinch::drive"
+    sign = candidate.closing_signs[candidate.joint_names.index(drive)]
+    (arm,) = contact_levers(
+        scene.add_models, candidate, {drive: sign}, plant_couplings(scene.plant)
+    ).values()
+    assert 0.004 < arm.press < 0.006  # the knuckles' 94 mm, geared 20:1
+    ((k, _),) = shaken.gains
+    assert k * REVOLUTE_AIM == pytest.approx(DEFAULT_SQUEEZE * arm.reach, rel=1e-9)
+    assert shaken.efforts[0] == pytest.approx(DEFAULT_SQUEEZE * arm.press, rel=0.2)
 
 
 def test_an_uncapped_squeeze_reads_exactly_the_squeeze(spread):
@@ -364,9 +432,9 @@ def test_an_uncapped_squeeze_reads_exactly_the_squeeze(spread):
 
 def test_the_allegro_hands_joints_that_closing_leaves_still_hold(drake_models_dir):
     """A multi-finger candidate's closing sign is 0 for a joint closing leaves
-    still (the Allegro hand's spreads): its arm is 0 and it holds where it
-    stands, at the hold's stiffness within its 0.7 N·m; the default shake of
-    such a candidate was refused, the sign read as a hostile one."""
+    still (the Allegro hand's spreads): it presses nothing and holds where it
+    stands, as stiffly as its reach asks within its 0.7 N·m; the default
+    shake of such a candidate was refused, the sign read as a hostile one."""
     scene = planning_scene(
         "package://drake_models/ycb/005_tomato_soup_can.sdf",
         hand_url="package://drake_models/allegro_hand_description/sdf/"
@@ -384,11 +452,60 @@ def test_the_allegro_hands_joints_that_closing_leaves_still_hold(drake_models_di
     candidate = still[0]
     shaken = shake_test(scene.add_models, candidate, hydroelastic_modulus=1e6, **QUICK)
     assert shaken.squeeze_at_contacts
-    hold = min(DEFAULT_SQUEEZE * HOLD_LEVER, 0.7) / REVOLUTE_AIM
-    assert min(k for k, _ in shaken.gains) == pytest.approx(hold, rel=1e-12)
+    # every joint as stiff as its reach asks, within its 0.7 N·m
+    assert all(0 < k * REVOLUTE_AIM <= 0.7 for k, _ in shaken.gains)
     joints = dict(zip(candidate.joint_names, shaken.seated_q_hand, strict=True))
     for name, sign, q in zip(
         candidate.joint_names, candidate.closing_signs, candidate.q_hand, strict=True
     ):
         if sign == 0.0:  # held where it stood, within what the contacts push
             assert joints[name] == pytest.approx(q, abs=0.05), name
+
+
+def test_a_cranks_arms_are_its_ratios(tmp_path):
+    """A jaw whose sliding fingers follow a revolute crank at ±5 mm/rad: on
+    the box's faces, square to the slides, each pad's arm is the crank's
+    ratio, and the shake at the default aims the crank at 20 N × 10 mm, as
+    20 per joint over its followers' Σ|ρ| did."""
+    rho = 0.005
+    text = coupled_jaw_urdf(ratio=-1.0, hidden_drive=True)
+    text = text.replace(
+        '<mimic joint="drive" multiplier="-1.0" offset="0.0"/>',
+        f'<mimic joint="drive" multiplier="{-rho}" offset="0.0"/>',
+    ).replace(
+        '<mimic joint="drive" multiplier="1" offset="0"/>',
+        f'<mimic joint="drive" multiplier="{rho}" offset="0"/>',
+    )
+    slide = (
+        '<joint name="drive" type="prismatic"><parent link="palm"/><child '
+        'link="drive_link"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit '
+        'lower="0.0" upper="0.045"'
+    )
+    assert slide in text
+    text = text.replace(
+        slide,
+        slide.replace("prismatic", "revolute").replace("0.045", f"{0.045 / rho:g}"),
+    )
+    path = tmp_path / "crank.urdf"
+    path.write_text(text)
+    scene = planning_scene(BOX, hand_url=str(path))
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=200, mu=0.5, seed=4, object_mass=0.3,
+    )  # fmt: skip
+    candidate = result.candidates[0]
+    couplings = plant_couplings(scene.plant)
+    # the crank closes a finger turning the way its ratio's sign and the
+    # finger's closing sign give
+    follower, _, ratio, _ = couplings[0]
+    sign = candidate.closing_signs[candidate.joint_names.index(follower)]
+    (arm,) = contact_levers(
+        scene.add_models, candidate, {"coupled_jaw::drive": sign * np.sign(ratio)},
+        couplings,
+    ).values()  # fmt: skip
+    assert arm.press == pytest.approx(2 * rho, rel=1e-6)
+    assert arm.reach == pytest.approx(2 * rho, rel=1e-6)
+    shaken = shake_test(scene.add_models, candidate, hydroelastic_modulus=1e6, **QUICK)
+    assert shaken.squeeze_at_contacts and shaken.held
+    ((k, _),) = shaken.gains
+    assert k * REVOLUTE_AIM == pytest.approx(DEFAULT_SQUEEZE * 2 * rho, rel=1e-6)
