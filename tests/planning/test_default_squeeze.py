@@ -17,7 +17,7 @@ import pytest
 from coupled_hands import (
     coupled_jaw_urdf,
     one_motor_pinch_urdf,
-    plan_pinch_on_box,
+    plan_on_box,
     spread_hand_urdf,
     transmissions,
 )
@@ -45,7 +45,7 @@ pytestmark = pytest.mark.filterwarnings(
 
 def _planned(tmp_path, name, **pinch):
     path = tmp_path / f"{name}.urdf"
-    scene, result = plan_pinch_on_box(path, one_motor_pinch_urdf(**pinch))
+    scene, result = plan_on_box(path, one_motor_pinch_urdf(**pinch))
     assert len(result) > 5, result.reason
     return scene, result
 
@@ -271,13 +271,7 @@ def test_a_slide_that_turns_the_fingers_presses_them_with_20_n(tmp_path):
     text = text.replace(
         '<joint name="drive" type="revolute">', '<joint name="drive" type="prismatic">'
     )
-    path = tmp_path / "slide.urdf"
-    path.write_text(text)
-    scene = planning_scene(BOX, hand_url=str(path))
-    result = plan_grasps(
-        scene.plant, scene.context, scene.object_body, hand=scene.hand,
-        num_candidates=60, mu=0.5, seed=0, object_mass=0.2,
-    )  # fmt: skip
+    scene, result = plan_on_box(tmp_path / "slide.urdf", text)
     candidate = result.candidates[0]
     drive = "one_motor_pinch::drive"
     sign = candidate.closing_signs[candidate.joint_names.index(drive)]
@@ -486,13 +480,9 @@ def test_a_cranks_arms_are_its_ratios(tmp_path):
         slide,
         slide.replace("prismatic", "revolute").replace("0.045", f"{0.045 / rho:g}"),
     )
-    path = tmp_path / "crank.urdf"
-    path.write_text(text)
-    scene = planning_scene(BOX, hand_url=str(path))
-    result = plan_grasps(
-        scene.plant, scene.context, scene.object_body, hand=scene.hand,
-        num_candidates=200, mu=0.5, seed=4, object_mass=0.3,
-    )  # fmt: skip
+    scene, result = plan_on_box(
+        tmp_path / "crank.urdf", text, num_candidates=200, seed=4, object_mass=0.3
+    )
     candidate = result.candidates[0]
     couplings = plant_couplings(scene.plant)
     # the crank closes a finger turning the way its ratio's sign and the

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from coupled_hands import coupled_jaw_urdf, one_motor_pinch_urdf, plan_pinch_on_box
+from coupled_hands import coupled_jaw_urdf, one_motor_pinch_urdf, plan_on_box
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -253,7 +253,7 @@ def pinch_twins(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("hidden_pinch")
     out = {}
     for name, hidden in (("twin", False), ("hidden", True)):
-        out[name] = plan_pinch_on_box(
+        out[name] = plan_on_box(
             tmp / f"{name}.urdf", one_motor_pinch_urdf(hidden_drive=hidden)
         )
     return out

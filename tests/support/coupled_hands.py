@@ -319,11 +319,11 @@ def coupled_jaw_urdf(
     )
 
 
-def plan_pinch_on_box(path, urdf: str, **plan):
+def plan_on_box(path, urdf: str, **plan):
     """``(scene, result)``: ``urdf`` written to ``path`` and planned on the box.
 
-    The pinch tests' plan: 60 samples, ``mu`` 0.5, seed 0, 8 robustness
-    samples, an object of 0.2 kg; ``plan`` overrides any of them.
+    The coupled hands' tests' plan: 60 samples, ``mu`` 0.5, seed 0, 8
+    robustness samples, an object of 0.2 kg; ``plan`` overrides any of them.
     """
     from drakegrasp.planning import plan_grasps, planning_scene
 
