@@ -37,6 +37,7 @@ from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import find_joint
 
 BOX = "package://drakegrasp/objects/box.sdf"
+FLAT_JAW = "package://drakegrasp/hands/parallel_jaw_flat.sdf"
 QUICK = dict(settle=0.2, phase=0.3, object_mass=0.2)
 pytestmark = pytest.mark.filterwarnings(
     "ignore::drakegrasp.plant.friction.FrictionMismatchWarning"  # plan 0.5, Drake 1
@@ -186,7 +187,7 @@ def test_a_weak_motor_caps_the_newtons_at_the_contacts(tmp_path):
 
 def test_a_parallel_jaws_default_is_its_20_n(tmp_path):
     """Sliding fingers: the default is the explicit 20 N, to the bit."""
-    scene = planning_scene(BOX)
+    scene = planning_scene(BOX, hand_url=FLAT_JAW)  # shipped: offline too
     result = plan_grasps(
         scene.plant, scene.context, scene.object_body, hand=scene.hand,
         num_candidates=40, mu=0.5, seed=0,
