@@ -49,6 +49,7 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
+from drakegrasp.plant.couplings import coupling_map
 from drakegrasp.plant.fingers import find_joint
 from drakegrasp.plant.models import new_parser
 from drakegrasp.plant.validation import check_rigid_transform, resolve_body
@@ -212,16 +213,24 @@ def contact_levers(
     plant.Finalize()
     ctx = plant.CreateDefaultContext()
     candidate.apply(plant, ctx)
-    followers: dict[str, list[tuple[str, float]]] = {}
-    for follower, leader, rho in read:
-        followers.setdefault(leader, []).append((follower, rho))
-    columns = {
-        name: [
-            (find_joint(plant, joint).velocity_start(), rho)
-            for joint, rho in [(name, 1.0), *followers.get(name, [])]
-        ]
-        for name in squeezers
-    }
+    # C (v_h = C u): each squeezer's motion and its followers' rho per unit
+    # of it, as the hand Jacobian's coupled columns J C (docs/conventions.md)
+    own = {name: find_joint(plant, name).velocity_start() for name in squeezers}
+    joints = dict.fromkeys(
+        [*squeezers, *(f for f, leader, _ in read if leader in squeezers)]
+    )
+    velocities = np.array([find_joint(plant, j).velocity_start() for j in joints])
+    C, independent = coupling_map(plant, velocities, couplings)
+    column = {int(u): k for k, u in enumerate(independent)}
+    motion = {}  # (n_v,) per squeezer: dq/dq_m
+    for name, v in own.items():
+        if v not in column:
+            raise InvalidOptionError(
+                f"squeezer {name} follows another through couplings: leave that "
+                "coupling out (a follower with a motor of its own presses with it)"
+            )
+        motion[name] = np.zeros(plant.num_velocities())
+        motion[name][velocities] = C[:, column[v]]
     R_WO = X_WO.rotation().matrix()
     # per finger body, per contact: (n_W, J_C (3, n_v))
     jacobians: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
@@ -239,9 +248,7 @@ def contact_levers(
         press = reach = 0.0
         for body in jacobians.values():
             # each contact's finger point's velocity per unit of the motor
-            moves = [
-                (n, sum(rho * J[:, v] for v, rho in columns[name])) for n, J in body
-            ]
+            moves = [(n, J @ motion[name]) for n, J in body]
             press += float(np.mean([sign * (n @ v) for n, v in moves]))
             reach += float(np.mean([np.linalg.norm(v) for _, v in moves]))
         arms[name] = Arms(
