@@ -101,6 +101,40 @@ def local_drake_models_or_none() -> Path | None:
     return local_drake_models()
 
 
+# -- the suite on several cores (pytest-xdist) ---------------------------------------
+
+
+@pytest.hookimpl(optionalhook=True)  # a hook of pytest-xdist's, absent without it
+def pytest_xdist_make_scheduler(config, log):
+    """With ``pytest -n N``, send each test file whole to one worker.
+
+    A file's module-scoped fixtures (the fuzz families' scenes, a planned
+    candidate set) are then built once, as in a serial run.  The files that
+    read :func:`tutorial_runs` go to one worker together, so that each tutorial
+    still executes once per run.  An explicit ``--dist`` other than ``load``
+    (what ``-n`` implies) or ``loadfile`` is left to pytest-xdist.
+    """
+    if config.getoption("dist") not in ("load", "loadfile"):
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    tests = Path(__file__).resolve().parent
+
+    class _FileScheduling(LoadFileScheduling):
+        _tutorial_files: dict[str, bool] = {}
+
+        def _split_scope(self, nodeid: str) -> str:
+            scope = super()._split_scope(nodeid)
+            if scope not in self._tutorial_files:
+                path = tests.parent / scope
+                self._tutorial_files[scope] = path.is_file() and (
+                    "tutorial_runs" in path.read_text(encoding="utf-8")
+                )
+            return "tutorial runs" if self._tutorial_files[scope] else scope
+
+    return _FileScheduling(config, log)
+
+
 # -- seeded random grasps (core, closure and certificate tests) ---------------------
 
 

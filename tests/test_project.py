@@ -22,7 +22,42 @@ def test_readme_quick_start_has_exactly_two_commands():
     commands = _quick_start_commands()
     assert len(commands) == 2
     assert commands[0].endswith("drakegrasp analyze")
-    assert commands[1].endswith("pytest")
+    assert '".[test]"' in commands[1]
+    assert re.search(r"&& pytest( -n auto)?$", commands[1])
+
+
+class _ParallelRun:
+    """The options ``pytest -n 2`` gives a scheduler (what the hook reads)."""
+
+    def __init__(self, dist: str):
+        self._values = {"dist": dist, "tx": ["2*popen"]}
+
+    def getoption(self, name):
+        return self._values[name]
+
+    getvalue = getoption
+
+
+def _scheduler(request, dist: str):
+    (conftest,) = [
+        p
+        for p in request.config.pluginmanager.get_plugins()
+        if str(getattr(p, "__file__", "")) == str(ROOT / "tests" / "conftest.py")
+    ]
+    return conftest.pytest_xdist_make_scheduler(_ParallelRun(dist), None)
+
+
+def test_a_parallel_run_sends_files_whole_and_the_tutorial_runs_together(request):
+    pytest.importorskip("xdist")
+    scheduler = _scheduler(request, "load")
+    scope = scheduler._split_scope
+    docs = scope("tests/docs/test_docs_build.py::test_site_builds_without_warnings")
+    tutorials = scope("tests/tutorials/test_notebooks.py::test_notebook_runs[x]")
+    assert docs == tutorials  # each tutorial executes once per run
+    one = scope("tests/test_solvers.py::test_a")
+    assert one == scope("tests/test_solvers.py::test_b") != docs
+    assert one != scope("tests/test_architecture.py::test_a")
+    assert _scheduler(request, "loadgroup") is None  # asked for: pytest-xdist's
 
 
 def test_ci_runs_the_readme_test_command_verbatim():

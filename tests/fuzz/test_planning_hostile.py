@@ -55,7 +55,17 @@ BAD_MU = [
 BAD_COUNT = [-1, 2.5, 4.0, True, "4", None, [4]]
 # copies whose points exceed checks.MAX_COPY_BYTES: a MemoryError before the cap
 BAD_SAMPLES = [*BAD_COUNT, 10**12, 2**40]
-BAD_RNG = [None, 0, "seed", object()]
+
+
+class _Opaque:
+    """An object of no type the API takes, with a repr that names no address
+    (so every pytest-xdist worker collects the same test ids)."""
+
+    def __repr__(self) -> str:
+        return "<an object>"
+
+
+BAD_RNG = [None, 0, "seed", _Opaque()]
 BAD_SIGMA = [-1e-3, np.nan, np.inf, "0.1", None, True]
 BAD_LENGTH = [0.0, -1e-4, np.nan, np.inf, "1e-4", None, True]
 

@@ -257,7 +257,9 @@ def test_animate_escape_refuses_bad_amounts(meshcat, box, bad):
         animate_escape(meshcat, scene, report, amount=bad)
 
 
-@pytest.mark.parametrize("bad", [None, "parallel_jaw_box", 3, object()], ids=repr)
+@pytest.mark.parametrize(
+    "bad", [None, "parallel_jaw_box", 3, object()], ids=["None", "name", "3", "object"]
+)
 def test_animate_escape_refuses_what_is_no_scene(meshcat, box, bad):
     _, report = box
     with pytest.raises(InvalidOptionError, match="scene_or_plant"):
