@@ -1699,7 +1699,7 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         type=_strictly_positive,
         default=None,
         metavar="NM",
-        help="multi-finger hands: the torque per finger joint (N·m) the hand "
+        help="multi-finger hands: the torque per motor (N·m) the hand "
         "will apply; candidates held within it rank first (default: the "
         "actuators' effort limits)",
     )

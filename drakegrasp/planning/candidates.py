@@ -29,7 +29,7 @@ from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array, real_scalar
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
-from drakegrasp.planning.needed import needed_text, per_joint
+from drakegrasp.planning.needed import needed_text, per_motor
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.couplings import coupled_positions, recorded_couplings
 from drakegrasp.plant.fingers import find_joint
@@ -144,8 +144,9 @@ class GraspCandidate:
         A multi-finger hand's pre-shape, from which ``close_hand`` closed it
         (None for a parallel jaw, whose pre-grasp is ``opening``).
     torque_needed : float
-        A multi-finger hand's torque at every finger joint (in
-        ``torque_unit``: N·m, N at a prismatic joint) that holds the object's
+        A multi-finger hand's torque at every motor (in ``torque_unit``: N·m,
+        N at a prismatic joint; a motor is an actuated closing joint, and a
+        ``<mimic>`` follower turns with its leader's) that holds the object's
         weight in all the weight directions
         (:func:`~drakegrasp.planning.motors.torque_needed`; a lower bound for
         the planned contacts held still, an estimate of what a simulation
@@ -165,7 +166,7 @@ class GraspCandidate:
         one (``grasp`` then takes the grasp's default).
     torque_capacity : float
         Newtons of the object's weight held per N·m (per N at a prismatic
-        joint: ``torque_unit``) at every finger joint, in the worst weight
+        joint: ``torque_unit``) at every motor, in the worst weight
         direction (``min_u β(u)`` of
         :func:`~drakegrasp.planning.motors.torque_capacity`), for the
         candidates that got a ``torque_needed``; 0: none holds it; NaN: not
@@ -375,7 +376,7 @@ class GraspCandidate:
             torque = needed_text(
                 self.torque_needed,
                 self.torque_capacity,
-                per_joint(str(self.torque_unit)),
+                per_motor(str(self.torque_unit)),
             )
             shape += f", torque {torque}"
         if np.isnan(self.weight_capacity):

@@ -23,10 +23,13 @@ motors it has: with a ``<mimic>`` follower moving as ``v_h = C u``
 ``(J C)ᵀ f``, each within ``Σ_k |C_ki| a_k`` for ``a_k`` 1 at an actuated
 joint and 0 at one without an actuator (a follower's torque then comes
 through the coupling from its leader's motor, as Drake's coupler constraint
-carries it); ``β`` is then per N·m at every actuator.  By linearity
-the hand holds a weight ``m g`` in every one of the directions
-:data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS` when each joint may
-apply :math:`m g / \min_u \beta(u)`: the **torque needed**.  Like the squeeze
+carries it); ``β`` is then per N·m at every actuator.  The **motors** are
+these: the actuated closing joints, each driving its followers (the 2F-85's
+one motor closes six joints), or, in a model that declares no actuators,
+every closing joint but a hidden drive (whose followers count in its
+stead).  By linearity the hand holds a weight ``m g`` in every one of the
+directions :data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS` when each
+motor may apply :math:`m g / \min_u \beta(u)`: the **torque needed**.  Like the squeeze
 needed, it is a lower bound for the planned contacts held still (rigid,
 quasi-static): the program shares the torques among the contacts at will, and a
 real finger presses as its controller dictates.  It is an estimate of what a
@@ -94,7 +97,7 @@ from drakegrasp.planning.needed import (
     beyond_float_range,
     needed_for,
     needed_text,
-    per_joint,
+    per_motor,
 )
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
 from drakegrasp.plant.couplings import coupling_map, motor_shares, plant_couplings
@@ -218,7 +221,7 @@ def torque_capacity(
     *,
     directions: np.ndarray = WEIGHT_DIRECTIONS,
 ) -> np.ndarray:
-    """``β(u)`` per direction: weight held per N·m at every finger joint.
+    """``β(u)`` per direction: weight held per N·m at every motor.
 
     Parameters
     ----------
@@ -361,7 +364,7 @@ def _torque_lp(GS, TS, u, *, idle=None, row=None, bound=None) -> np.ndarray:
 def torque_needed(
     plant, plant_context, candidate: GraspCandidate, object_body, *, weight: float
 ) -> float:
-    """The torque (N·m per finger joint) that holds ``weight`` in every direction.
+    """The torque (N·m per motor) that holds ``weight`` in every direction.
 
     Parameters
     ----------
@@ -440,7 +443,7 @@ def with_torques_needed(
         joints, :func:`motor_limit`) ahead of all others, each group in its
         score order.  Nothing moves when the plant gives no finite limit.
     torque_limit : float or None, optional
-        The torque (N·m per finger joint; N for a prismatic one) the user will
+        The torque (N·m per motor; N for a prismatic one) the user will
         apply, used instead of :func:`motor_limit` for ``motors_first`` and
         the ``reason``; capped by the effort limit (an actuator applies no
         more).  None (default): the effort limit.  Finite and > 0, else
@@ -613,7 +616,7 @@ def check_torque_limit(torque_limit) -> float:
         ``torque_limit``.
     """
     return _positive_limit(
-        "torque_limit", torque_limit, "N·m per finger joint, N at a prismatic one"
+        "torque_limit", torque_limit, "N·m per motor, N at a prismatic one"
     )
 
 
@@ -695,7 +698,7 @@ def _unit_of_joints(plant, joint_names) -> str:
     ``"N·m, N at prismatic joints"`` for a hand with both
     (:func:`~drakegrasp.closure.load_problem.effort_unit_of` of each one's
     :func:`~drakegrasp.plant.fingers.effort_unit`):
-    ``torque_limit`` and ``torque_needed`` are per joint, in its own unit.
+    ``torque_limit`` and ``torque_needed`` are per motor, in its own unit.
     """
     return effort_unit_of(
         effort_unit(find_joint(plant, n)) or "N·m" for n in joint_names
@@ -718,7 +721,7 @@ def _too_weak(head, limit: float, applied: bool = False, unit: str = "N·m") -> 
         if applied
         else f"the hand's actuators (effort limits from {limit:.3g} {unit}) hold"
     )
-    return _none_held(needed, limit, who, "best ", per_joint(unit), "torque_needed")
+    return _none_held(needed, limit, who, "best ", per_motor(unit), "torque_needed")
 
 
 def _too_weak_jaw(candidates, limit: float, applied: bool) -> str:

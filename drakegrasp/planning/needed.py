@@ -2,7 +2,9 @@
 
 A candidate's ``squeeze_needed`` is the object's weight over its weight
 capacity (N of weight per N of squeeze), and ``torque_needed`` the weight
-over its torque capacity (N of weight per N·m at every finger joint).  Both
+over its torque capacity (N of weight per N·m at every motor: an actuated
+closing joint, whose ``<mimic>`` followers it drives;
+:mod:`~drakegrasp.planning.motors`).  Both
 come from :func:`needed_for`, and are said by :func:`needed_text`:
 
 - NaN where the capacity or the weight is unknown (not computed);
@@ -25,6 +27,7 @@ import sys
 
 import numpy as np
 
+from drakegrasp.core.deprecation import warn_deprecated
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -34,6 +37,7 @@ __all__ = [
     "needed_for",
     "needed_text",
     "per_joint",
+    "per_motor",
 ]
 
 FLOAT_MAX = sys.float_info.max
@@ -120,7 +124,7 @@ def needed_text(needed: float, capacity: float, unit: str, spec: str = ".3g") ->
         The capacity it came from, which tells "beyond float range" from "none
         holds".
     unit : str
-        Appended after the figure ("N per finger", "N·m per joint").
+        Appended after the figure ("N per finger", "N·m per motor").
     spec : str, optional
         The figure's format (default ``".3g"``); a fixed-point one (``".1f"``)
         gives way to ``".3g"`` from :data:`LONG_FIGURE` on.
@@ -150,13 +154,27 @@ def needed_text(needed: float, capacity: float, unit: str, spec: str = ".3g") ->
         ) from None
 
 
-def per_joint(unit: str) -> str:
-    """A joint effort's ``unit`` as ``torque_needed``'s words: "N·m per joint".
+def per_motor(unit: str) -> str:
+    """A motor effort's ``unit`` as ``torque_needed``'s words: "N·m per motor".
 
     ``unit`` is the unit of the efforts of a hand's closing joints: ``"N·m"``
     (every joint turns), ``"N"`` (every one slides) or ``"N·m, N at prismatic
     joints"`` (both; ``GraspCandidate.torque_unit``), which reads "N·m per
-    joint, N at prismatic joints".
+    motor, N at prismatic joints".  ``torque_needed`` is what every motor
+    applies: a hand's motors are its actuated closing joints, a ``<mimic>``
+    follower turning with its leader's (the 2F-85's one motor closes six
+    joints), and a model without actuators has one at each joint
+    (:mod:`~drakegrasp.planning.motors`).
     """
     one, _, other = unit.partition(", ")
-    return f"{one} per joint, {other}" if other else f"{one} per joint"
+    return f"{one} per motor, {other}" if other else f"{one} per motor"
+
+
+def per_joint(unit: str) -> str:
+    """Deprecated name of :func:`per_motor`.
+
+    Its words ("N·m per joint") misnamed ``torque_needed`` for a hand whose
+    motors drive several joints.
+    """
+    warn_deprecated("per_joint is deprecated; use per_motor (torque is per motor)")
+    return per_motor(unit)

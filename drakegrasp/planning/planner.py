@@ -783,7 +783,7 @@ def _jaw_only(squeeze_limit) -> None:
         raise InvalidOptionError(
             "squeeze_limit applies to parallel jaws (N per finger); a "
             "multi-finger hand's fingers apply joint torques: give torque_limit "
-            "(N·m per finger joint, N at a prismatic one) instead (got "
+            "(N·m per motor, N at a prismatic one) instead (got "
             f"{squeeze_limit!r})"
         )
 

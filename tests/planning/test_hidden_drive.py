@@ -270,6 +270,10 @@ def test_a_pinch_on_a_hidden_drive_plans_as_its_twin(pinch_twins):
         assert a.q_hand[0] == a.q_hand[1]  # the left knuckle follows at 1
         assert a.torque_needed == pytest.approx(b.torque_needed, rel=1e-6)
         assert a.torque_capacity == pytest.approx(b.torque_capacity, rel=1e-6)
+        if not np.isnan(a.torque_needed):  # one motor closes all five joints
+            words = f"5 closing joints, torque {a.torque_needed:.3g} N·m per motor"
+            assert words in str(a), str(a)
+    assert any(not np.isnan(a.torque_needed) for a in hidden)
     assert hidden.settings["held_first"] == twin.settings["held_first"]
     for per_finger in (False, True):  # 5 N·m; 5 / 4 through the four followers
         limit = motor_limit(scene.plant, hidden[0], per_finger=per_finger)

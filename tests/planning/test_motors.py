@@ -136,7 +136,7 @@ def test_plan_grasps_sets_it_on_the_best(allegro_on_soup):
             ),  # fmt: skip
             rel=1e-9,
         )
-        assert "N·m per joint" in str(c)
+        assert "N·m per motor" in str(c)
         assert c.to_dict()["torque_needed"] == pytest.approx(c.torque_needed)
         # The JSON names the geometries of each contact and whose surface its
         # normal is (review r22: a contact on a model's marker sphere could

@@ -78,7 +78,7 @@ def test_a_multi_finger_hand_refuses_the_squeeze_limit(capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert (
         len(err) == 1
-        and "give --torque-limit (N·m per finger joint, N at a prismatic one)" in err[0]
+        and "give --torque-limit (N·m per motor, N at a prismatic one)" in err[0]
     )
 
 

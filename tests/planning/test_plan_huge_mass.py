@@ -126,7 +126,7 @@ def test_a_torque_beyond_float_range_is_said_so_not_inf(capsys, models):
     # the sugar box's one force-closure candidate needs 0.95 N·m per N: its
     # torque for 1.75e307 kg (1.72e308 N) is past the float range
     out, _ = _plan(capsys, SUGAR, *ALLEGRO, "--mass", "1.75e307", "--top", "1")
-    words = "more than 1.8e+308 N·m per joint, beyond float range"
+    words = "more than 1.8e+308 N·m per motor, beyond float range"
     assert f"torque {words}" in _lines(out)[0], out
     assert f"it needs {words} (torque_needed)" in out
     assert "inf N" not in out
@@ -232,3 +232,14 @@ def test_needed_text_says_beyond_float_range_only_of_a_positive_figure():
         needed_text(1.0, 1.0, "N", spec="q")
     with pytest.raises(dg.InvalidOptionError, match="capacity"):
         needed_text(1.0, None, "N")
+
+
+def test_torque_is_said_per_motor_and_the_old_name_warns():
+    from drakegrasp.planning.needed import per_joint, per_motor
+
+    assert per_motor("N·m") == "N·m per motor"
+    assert per_motor("N") == "N per motor"
+    mixed = "N·m, N at prismatic joints"
+    assert per_motor(mixed) == "N·m per motor, N at prismatic joints"
+    with pytest.warns(DeprecationWarning, match="use per_motor"):
+        assert per_joint(mixed) == per_motor(mixed)

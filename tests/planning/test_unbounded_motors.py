@@ -189,11 +189,11 @@ def test_a_prismatic_hand_too_weak_is_told_in_newtons():
 
     head = [SimpleNamespace(torque_needed=3.0, torque_capacity=1.0)]
     text = _too_weak(head, 1.0, True, "N")
-    assert "torque_limit 1 N holds" in text and "3 N per joint" in text, text
+    assert "torque_limit 1 N holds" in text and "3 N per motor" in text, text
     assert "N·m" not in text
     mixed = _too_weak(head, 1.0, False, "N·m, N at prismatic joints")
     assert "(effort limits from 1 N·m, N at prismatic joints) hold" in mixed
-    assert "3 N·m per joint, N at prismatic joints" in mixed, mixed
+    assert "3 N·m per motor, N at prismatic joints" in mixed, mixed
 
 
 def _chuck_sdf() -> str:
@@ -234,7 +234,7 @@ def _chuck_plan(hand_file_scene):
 
 def test_a_sliding_hands_torque_needed_is_printed_in_newtons(hand_file_scene):
     # the plan's head said "torque_needed <= 20 N (effort limit)" and each
-    # candidate below it "torque 1.18 N·m per joint"
+    # candidate below it "torque 1.18 N·m per motor"
     import dataclasses
     import pickle
 
@@ -243,17 +243,17 @@ def test_a_sliding_hands_torque_needed_is_printed_in_newtons(hand_file_scene):
     checked = [c for c in result if np.isfinite(c.torque_needed)]
     assert checked
     for c in checked:
-        assert f", torque {c.torque_needed:.3g} N per joint, p_WH" in str(c), str(c)
+        assert f", torque {c.torque_needed:.3g} N per motor, p_WH" in str(c), str(c)
         assert "N·m" not in str(c)
         assert c.torque_unit == "N" and c.to_dict()["torque_unit"] == "N"
     c = checked[0]
     mixed = dataclasses.replace(c, torque_unit="N·m, N at prismatic joints")
-    words = f"torque {c.torque_needed:.3g} N·m per joint, N at prismatic joints, "
+    words = f"torque {c.torque_needed:.3g} N·m per motor, N at prismatic joints, "
     assert words in str(mixed)
     # a turning hand's words as before; a candidate pickled before the unit
     # was recorded reads as one
     turning = dataclasses.replace(c, torque_unit="N·m")
-    assert f", torque {c.torque_needed:.3g} N·m per joint, p_WH" in str(turning)
+    assert f", torque {c.torque_needed:.3g} N·m per motor, p_WH" in str(turning)
     state = pickle.loads(pickle.dumps(turning)).__dict__
     state.pop("torque_unit")
     old = object.__new__(type(c))
@@ -270,4 +270,4 @@ def test_a_turning_hand_records_newton_metres():
     checked = [c for c in result if np.isfinite(c.torque_needed)]
     assert checked
     assert {c.torque_unit for c in checked} == {"N·m"}
-    assert all(" N·m per joint, p_WH" in str(c) for c in checked)
+    assert all(" N·m per motor, p_WH" in str(c) for c in checked)
