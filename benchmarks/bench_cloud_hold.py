@@ -16,9 +16,10 @@ can's collision geometry (``--points`` area-uniform points, seed 0, as
   facing it), planned with ``viewpoint=`` the camera.
 
 Both are planned with ``object_mass=`` the can's mass (from its model), as a
-user who knows it would, and ``torque_limit=`` the shake's 0.5 N·m per joint,
-the torque the hand will apply: the candidates then carry ``torque_needed``
-and those held at that torque are ranked first
+user who knows it would, and ``torque_limit=`` the shake's 0.5 N·m per joint
+(per motor: each of the Allegro's joints is one), the torque the hand will
+apply: the candidates then carry ``torque_needed`` and those held at that
+torque are ranked first
 (:func:`~drakegrasp.planning.motors.with_torques_needed`).
 ``--effort-limit`` ranks by the Allegro's effort limit (0.7 N·m) instead, as
 before ``torque_limit`` existed; ``--no-mass`` plans without the mass (no

@@ -3,8 +3,10 @@ tutorial notebooks executed once per session."""
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -69,7 +71,35 @@ def drake_models_dir() -> Path:
 
 
 @pytest.fixture(scope="session")
-def checkout_env() -> dict:
+def numba_cache_lock(tmp_path_factory):
+    """A lock on the checkout's numba cache, shared by pytest-xdist's workers.
+
+    Each worker runs :func:`checkout_env`'s warmup once; two writing the
+    cache at once can lose an entry of numba's index (read, changed and
+    written back by each), so that a later process compiles what a test says
+    it loads.  Hold ``numba_cache_lock()`` while a process may write the cache.
+    A serial run needs no lock.
+    """
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return contextlib.nullcontext
+    path = tmp_path_factory.getbasetemp().parent / "numba-cache.lock"  # the run's
+
+    @contextlib.contextmanager
+    def held():
+        import fcntl
+
+        with open(path, "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                yield
+            finally:
+                fcntl.flock(lock, fcntl.LOCK_UN)
+
+    return held
+
+
+@pytest.fixture(scope="session")
+def checkout_env(numba_cache_lock) -> dict:
     """The environment for a subprocess that runs this checkout's drakegrasp,
     with its batch kernels compiled (or loaded from numba's cache) first.
 
@@ -83,14 +113,15 @@ def checkout_env() -> dict:
     env = dict(os.environ)
     paths = [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *paths])
-    done = subprocess.run(
-        [sys.executable, "-m", "drakegrasp", "warmup"],
-        capture_output=True,
-        text=True,
-        env=env,
-        cwd=ROOT,
-        timeout=900,
-    )
+    with numba_cache_lock():  # another worker's warmup may write it too
+        done = subprocess.run(
+            [sys.executable, "-m", "drakegrasp", "warmup"],
+            capture_output=True,
+            text=True,
+            env=env,
+            cwd=ROOT,
+            timeout=900,
+        )
     assert done.returncode == 0, done.stderr
     return env
 
@@ -127,8 +158,8 @@ def pytest_xdist_make_scheduler(config, log):
             scope = super()._split_scope(nodeid)
             if scope not in self._tutorial_files:
                 path = tests.parent / scope
-                self._tutorial_files[scope] = path.is_file() and (
-                    "tutorial_runs" in path.read_text(encoding="utf-8")
+                self._tutorial_files[scope] = path.is_file() and bool(
+                    re.search(r"\btutorial_runs\b", path.read_text(encoding="utf-8"))
                 )
             return "tutorial runs" if self._tutorial_files[scope] else scope
 

@@ -54,6 +54,7 @@ def test_a_parallel_run_sends_files_whole_and_the_tutorial_runs_together(request
     docs = scope("tests/docs/test_docs_build.py::test_site_builds_without_warnings")
     tutorials = scope("tests/tutorials/test_notebooks.py::test_notebook_runs[x]")
     assert docs == tutorials  # each tutorial executes once per run
+    assert scope("tests/test_project.py::test_a") != docs  # names it in a test name
     one = scope("tests/test_solvers.py::test_a")
     assert one == scope("tests/test_solvers.py::test_b") != docs
     assert one != scope("tests/test_architecture.py::test_a")

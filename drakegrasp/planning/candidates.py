@@ -609,7 +609,7 @@ class GraspCandidates(Sequence):
         ``torque_unit``, after ``torque_capacity``, holds str (dtype object):
         the unit of the row's ``torque_needed`` (``"N·m"``, ``"N"``, or both
         named for a hand whose closing joints turn and slide), and of the
-        joint effort that ``torque_capacity`` is newtons per.
+        motor effort that ``torque_capacity`` is newtons per.
 
         An empty result has the same columns, dtypes and widths with zero
         rows: ``p_WH`` is (0, 3), ``R_WH`` (0, 9) and ``q_hand`` (0, n_h), with

@@ -478,7 +478,9 @@ def with_torques_needed(
     reason = (
         result.reason
         or _too_weak(head, limit, applied, unit)
-        or _no_limit(plant, ranked, limit, "torque_needed", "torque_limit", unit)
+        or _no_limit(
+            plant, ranked, limit, "torque_needed", "torque_limit", per_motor(unit)
+        )
     )
     settings = result.settings
     if motors_first:

@@ -177,4 +177,5 @@ def per_joint(unit: str) -> str:
     motors drive several joints.
     """
     warn_deprecated("per_joint is deprecated; use per_motor (torque is per motor)")
-    return per_motor(unit)
+    one, _, other = unit.partition(", ")
+    return f"{one} per joint, {other}" if other else f"{one} per joint"

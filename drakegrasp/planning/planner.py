@@ -367,13 +367,14 @@ def plan_grasps(
         over a capacity below 1) is ``inf`` beside a capacity > 0, and said
         "beyond float range" (:mod:`~drakegrasp.planning.needed`).
     torque_limit : float, optional
-        Multi-finger hands with a known weight: the torque (N·m per finger
-        joint; N for a prismatic one) you will apply when grasping.  The
+        Multi-finger hands with a known weight: the torque (N·m per motor; N
+        for a prismatic one) you will apply when grasping.  The
         candidates whose ``torque_needed`` is at most this are ranked first
         (:func:`~drakegrasp.planning.motors.with_torques_needed`); capped by the
         actuators' effort limits, the default (an actuator applies no more).
         Give it when the hand will squeeze with less than its motors allow (a
-        gentler controller, the shake test's ``squeeze``), so the ranking
+        gentler controller, or the shake test's ``squeeze`` on a hand whose
+        every joint is a motor), so the ranking
         assumes the torque actually applied.  Finite and > 0, else
         ``InvalidOptionError``, which a parallel jaw (no ``torque_needed``:
         its ``squeeze_needed`` is in N) and a point cloud without

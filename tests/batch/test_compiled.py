@@ -201,8 +201,9 @@ def jit_only(monkeypatch):
     aot._reset()
 
 
+@pytest.mark.usefixtures("checkout_env")  # the cache other workers write, warm
 def test_warmup_compiles_every_route_then_a_new_process_compiles_nothing(
-    capsys, jit_only
+    capsys, jit_only, numba_cache_lock
 ):
     from drakegrasp.cli import main
 
@@ -227,9 +228,10 @@ def test_warmup_compiles_every_route_then_a_new_process_compiles_nothing(
         [str(ROOT)] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
     )
     code = "from drakegrasp.cli import main; main()"
-    writer = _run(code, env, "warmup", "--json")
-    assert json.loads(writer.stdout)["available"] is True, writer.stderr
-    fresh = _run(code, env, "warmup", "--json")
+    with numba_cache_lock():  # no other worker writes the cache meanwhile
+        writer = _run(code, env, "warmup", "--json")
+        assert json.loads(writer.stdout)["available"] is True, writer.stderr
+        fresh = _run(code, env, "warmup", "--json")
     again = json.loads(fresh.stdout)
     assert [s["name"] for s in again["steps"]] == names
     assert again["compiled"] == 0, again

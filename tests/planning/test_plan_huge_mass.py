@@ -242,4 +242,4 @@ def test_torque_is_said_per_motor_and_the_old_name_warns():
     mixed = "N·m, N at prismatic joints"
     assert per_motor(mixed) == "N·m per motor, N at prismatic joints"
     with pytest.warns(DeprecationWarning, match="use per_motor"):
-        assert per_joint(mixed) == per_motor(mixed)
+        assert per_joint(mixed) == "N·m per joint, N at prismatic joints"

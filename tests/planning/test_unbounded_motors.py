@@ -137,11 +137,11 @@ def test_the_advice_gives_the_unit_of_the_hands_joints(tmp_path, capsys):
 
     name, effort, obj = THREE
     result = _plan(tmp_path, name, effort, "", obj)
-    assert result.reason.endswith("or pass torque_limit (N·m)"), result.reason
+    assert result.reason.endswith("or pass torque_limit (N·m per motor)"), result.reason
     hand = _hand(tmp_path, name, effort, "")
     argv = ["plan", "sphere", "--hand", hand, "--num", "40", "--top", "1"]
     assert main(argv) == 0
-    assert "or pass --torque-limit LIMIT (N·m)" in capsys.readouterr().out
+    assert "or pass --torque-limit LIMIT (N·m per motor)" in capsys.readouterr().out
 
 
 def _three_finger_plant(tmp_path, prismatic: tuple[str, ...]):
