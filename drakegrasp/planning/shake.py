@@ -124,6 +124,10 @@ class SqueezeLostWarning(UserWarning):
     0.7 N·m: its joints' mean seated effort 0.33-0.38 N·m at stiffness 10
     N·m/rad (its five best grasps held), 0.03-0.07 N·m at 100 (all five
     dropped).
+
+    Also when the object was not held and a squeezing joint stood at its
+    position limit at the seat, aimed past it (:data:`_AT_STOP`): its motor's
+    effort then pressed the joint's stop, not the object.
     """
 
 
@@ -131,6 +135,14 @@ _LOST = 0.25
 """:class:`SqueezeLostWarning` when the closing joints' seated efforts
 (``ShakeResult.efforts``; a joint whose link touches nothing presses with
 none) are on average under this share of the squeeze each was aimed at ..."""
+
+_AT_STOP = 0.05
+""":class:`SqueezeLostWarning` when the object was not held and a squeezing
+joint had less than this share of its aim (``squeeze / stiffness``) left
+before its position limit at the seat: its motor pressed the joint's stop, not
+the object (a Robotiq-3-finger-like hand's scissor joint, planned 0.0225 rad
+from its limit and aimed 0.067 rad past, reached the stop in 20 ms and its
+sphere fell)."""
 
 _PUSHED_OUT = 0.1
 """... and the object moves slower than this (m/s) at the seat: faster, the
@@ -664,6 +676,49 @@ def _check_finger_gaps(plant, ctx, body, planned: list) -> None:
             )
 
 
+def _at_stops(plant, ctx, squeezing, targets, efforts, units) -> list[str]:
+    """The squeezing joints that stand at their limit, aimed past it, in words.
+
+    A joint aimed past its position limit stops there: its motor's effort then
+    goes into the stop, and the object keeps none of it (:data:`_AT_STOP`).
+    """
+    q = plant.GetPositions(ctx)
+    stopped = []
+    for actuator, effort, unit in zip(squeezing, efforts, units, strict=True):
+        joint = actuator.joint()
+        aim = targets[int(joint.index())]
+        if joint.num_positions() != 1 or aim == 0.0:
+            continue
+        limits = (
+            joint.position_upper_limits() if aim > 0 else joint.position_lower_limits()
+        )
+        limit = float(limits[0])
+        room = math.copysign(1.0, aim) * (limit - q[joint.position_start()])
+        if math.isfinite(limit) and room < _AT_STOP * abs(aim):
+            stopped.append(
+                f"{joint.name()!r} at its limit {limit:.4g} ({effort:.3g} {unit})"
+            )
+    return stopped
+
+
+def _warn_at_stops(stopped: list[str]) -> None:
+    """Say that a dropped object's squeeze went into joint stops, if it did."""
+    if stopped:
+        one = len(stopped) == 1
+        warnings.warn(
+            f"the object was not held, and at the seat the closing joint"
+            f"{'' if one else 's'} "
+            + "; ".join(stopped)
+            + " stood aimed past the limit: "
+            + ("that effort" if one else "those efforts")
+            + " pressed the stop, not the object.  A grasp that leans on such a "
+            "joint needs it to close further than the model allows: choose a "
+            "candidate that leaves it room (or give the model its true range)",
+            SqueezeLostWarning,
+            stacklevel=3,
+        )
+
+
 def shake_test(
     add_models: Callable,
     candidate: GraspCandidate,
@@ -826,6 +881,11 @@ def shake_test(
     FrictionMismatchWarning
         The candidate was planned with a ``μ`` other than the friction Drake
         simulates between the hand and the object (the models' own).
+    SqueezeLostWarning
+        At the seat, the closing joints press with under a quarter of their
+        aim on average, the object at rest; or the object was not held and
+        a squeezing joint stood at its position limit at the seat, aimed past
+        it (its effort pressed the stop).
     """
     if not callable(add_models):
         raise InvalidOptionError(
@@ -1099,6 +1159,11 @@ def shake_test(
             SqueezeLostWarning,
             stacklevel=2,
         )
+    stopped = (
+        _at_stops(plant, ctx, squeezing, targets, efforts, effort_units)
+        if seat > 0
+        else []
+    )
     for end in ends:
         d, r = advance(end)
         phases.append(
@@ -1108,8 +1173,11 @@ def shake_test(
                 "rotation": r,
             }
         )
+    held = bool(max_d <= max_displacement and max_r <= max_rotation)
+    if not held:
+        _warn_at_stops(stopped)
     return ShakeResult(
-        held=bool(max_d <= max_displacement and max_r <= max_rotation),
+        held=held,
         max_displacement=max_d,
         max_rotation=max_r,
         phases=tuple(phases),
