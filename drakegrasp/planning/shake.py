@@ -126,8 +126,8 @@ class SqueezeLostWarning(UserWarning):
     dropped).
 
     Also when the object was not held and a squeezing joint stood at its
-    position limit at the seat, aimed past it (:data:`_AT_STOP`): its motor's
-    effort then pressed the joint's stop, not the object.
+    position limit at the seat, aimed past it (within 5 % of its aim): its
+    motor's effort then pressed the joint's stop, not the object.
     """
 
 
