@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import functools
 import os
 import re
 import signal
@@ -151,17 +152,17 @@ def pytest_xdist_make_scheduler(config, log):
 
     tests = Path(__file__).resolve().parent
 
-    class _FileScheduling(LoadFileScheduling):
-        _tutorial_files: dict[str, bool] = {}
+    @functools.cache
+    def reads_tutorial_runs(scope: str) -> bool:
+        path = tests.parent / scope
+        return path.is_file() and bool(
+            re.search(r"\btutorial_runs\b", path.read_text(encoding="utf-8"))
+        )
 
+    class _FileScheduling(LoadFileScheduling):
         def _split_scope(self, nodeid: str) -> str:
             scope = super()._split_scope(nodeid)
-            if scope not in self._tutorial_files:
-                path = tests.parent / scope
-                self._tutorial_files[scope] = path.is_file() and bool(
-                    re.search(r"\btutorial_runs\b", path.read_text(encoding="utf-8"))
-                )
-            return "tutorial runs" if self._tutorial_files[scope] else scope
+            return "tutorial runs" if reads_tutorial_runs(scope) else scope
 
     return _FileScheduling(config, log)
 

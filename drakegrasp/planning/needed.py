@@ -166,8 +166,7 @@ def per_motor(unit: str) -> str:
     joints), and a model without actuators has one at each joint
     (:mod:`~drakegrasp.planning.motors`).
     """
-    one, _, other = unit.partition(", ")
-    return f"{one} per motor, {other}" if other else f"{one} per motor"
+    return _per(unit, "motor")
 
 
 def per_joint(unit: str) -> str:
@@ -177,5 +176,10 @@ def per_joint(unit: str) -> str:
     motors drive several joints.
     """
     warn_deprecated("per_joint is deprecated; use per_motor (torque is per motor)")
+    return _per(unit, "joint")
+
+
+def _per(unit: str, each: str) -> str:
+    """``unit`` per ``each``: "N·m per motor" (mixed: "..., N at prismatic joints")."""
     one, _, other = unit.partition(", ")
-    return f"{one} per joint, {other}" if other else f"{one} per joint"
+    return f"{one} per {each}, {other}" if other else f"{one} per {each}"

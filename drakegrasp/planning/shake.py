@@ -81,7 +81,12 @@ from drakegrasp.planning.turned_gravity import (
     _TurnedGravity,
 )
 from drakegrasp.plant.couplings import motor_shares, plant_couplings
-from drakegrasp.plant.fingers import effort_unit, find_joint, hidden_drives
+from drakegrasp.plant.fingers import (
+    effort_unit,
+    find_joint,
+    hidden_drives,
+    limit_towards,
+)
 from drakegrasp.plant.friction import (
     MU_RELATIVE_TOL,
     FrictionMismatchWarning,
@@ -511,7 +516,7 @@ def _gains(actuator, squeeze: float, stiffness, damping) -> tuple[float, float]:
     return float(k), float(d)
 
 
-def _levers(plant, add_models, candidate, squeezers, couplings, by_name, X_WO):
+def _arms(plant, add_models, candidate, squeezers, couplings, by_name, X_WO):
     """``(arms, hold)`` of the default squeeze.
 
     ``arms``: per squeezer that turns a finger (its own joint, or one of the
@@ -689,10 +694,7 @@ def _at_stops(plant, ctx, squeezing, targets, efforts, units) -> list[str]:
         aim = targets[int(joint.index())]
         if joint.num_positions() != 1 or aim == 0.0:
             continue
-        limits = (
-            joint.position_upper_limits() if aim > 0 else joint.position_lower_limits()
-        )
-        limit = float(limits[0])
+        limit = limit_towards(joint, aim)
         room = math.copysign(1.0, aim) * (limit - q[joint.position_start()])
         if math.isfinite(limit) and room < _AT_STOP * abs(aim):
             stopped.append(
@@ -952,16 +954,14 @@ def shake_test(
     )
     squeezers = _squeezers(candidate, couplings, driven, by_name)
     default = squeeze is None
-    levers, hold = (
-        _levers(
-            plant, add_models, candidate, squeezers, couplings, by_name, planned_X_WO
-        )
+    arms, hold = (
+        _arms(plant, add_models, candidate, squeezers, couplings, by_name, planned_X_WO)
         if default
         else ({}, squeeze)
     )
     if default:
         squeeze = DEFAULT_SQUEEZE
-    at_contacts = bool(levers)  # a turning motor aims at newtons at contacts
+    at_contacts = bool(arms)  # a turning motor aims at newtons at contacts
     for name, sign in squeezers.items():
         actuator = by_name[name]
         # a leader's motor also presses through the followers it drives: each
@@ -969,7 +969,7 @@ def shake_test(
         # by default a revolute motor with the torque that presses its
         # fingers' contacts with squeeze newtons (planning.squeeze)
         share = shares.get(name, 1.0)
-        arm = levers.get(name)
+        arm = arms.get(name)
         aim = squeeze * share if arm is None else squeeze * arm.press
         push = min(aim, actuator.effort_limit())
         # the squeeze each presses with, capped, in squeeze's unit: a joint's

@@ -57,6 +57,7 @@ __all__ = [
     "hand_structure",
     "hidden_drives",
     "is_hidden_drive",
+    "limit_towards",
     "most_fingers",
     "passive_joints",
     "tip_bodies",
@@ -64,6 +65,27 @@ __all__ = [
 
 MAX_STEP = {"revolute": 0.2, "prismatic": 0.01}
 """Largest change of any joint of a finger in one closing step: radians, metres."""
+
+
+def limit_towards(joint, direction: float) -> float:
+    """A one-dof joint's position limit on the side ``direction`` moves it to.
+
+    Parameters
+    ----------
+    joint : Joint
+        A one-dof joint (revolute or prismatic).
+    direction : float
+        A velocity, torque or aim along the joint; only its sign counts.
+
+    Returns
+    -------
+    float
+        The upper limit for ``direction > 0``, else the lower one (rad or m;
+        ``±inf`` where the model gives none).
+    """
+    if direction > 0:
+        return float(joint.position_upper_limits()[0])
+    return float(joint.position_lower_limits()[0])
 
 
 def effort_unit(joint, k: int = 0) -> str:

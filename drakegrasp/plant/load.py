@@ -56,7 +56,7 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import check_distance_tolerance, real_array
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import coupled_torque_limits, split_coupled_torque
-from drakegrasp.plant.fingers import effort_unit
+from drakegrasp.plant.fingers import effort_unit, limit_towards
 from drakegrasp.plant.friction import (
     friction_disagreement,
     friction_rule,
@@ -314,11 +314,7 @@ def pressing_on_limits(
         if joint is None or not abs(t) > TORQUE_RESOLUTION * scale or reach == 0.0:
             continue  # a free base's velocity, no torque, or no contact it moves
         q = float(q_all[joint.position_start()])
-        limit = (
-            joint.position_upper_limits()[0]
-            if t > 0
-            else joint.position_lower_limits()[0]
-        )
+        limit = limit_towards(joint, t)
         if np.isfinite(limit) and abs(limit - q) * reach <= distance_tolerance:
             found.append(joint.name())
     return tuple(found)

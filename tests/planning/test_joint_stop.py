@@ -24,6 +24,7 @@ from drakegrasp.planning.shake import SqueezeLostWarning
 BOX = "package://drakegrasp/objects/box.sdf"
 QUICK = dict(settle=0.2, phase=0.3, object_mass=0.2)
 AT_STOP = "pressed the stop, not the object"
+KNUCKLE = "one_motor_pinch::left_knuckle"
 pytestmark = pytest.mark.filterwarnings(
     "ignore::drakegrasp.plant.friction.FrictionMismatchWarning"  # plan 0.5, Drake 1
 )
@@ -50,7 +51,7 @@ def _shake(add_models, candidate):
 
 def _with_knuckle_limit(urdf: str, candidate, room: float) -> str:
     """``urdf`` whose left knuckle may close only ``room`` rad past the plan's."""
-    i = candidate.joint_names.index("one_motor_pinch::left_knuckle")
+    i = candidate.joint_names.index(KNUCKLE)
     q, sign = float(candidate.q_hand[i]), float(candidate.closing_signs[i])
     joint = re.search(r'<joint name="left_knuckle".*?</joint>', urdf, re.S).group(0)
     lower, upper = (float(v) for v in re.search(
@@ -62,15 +63,28 @@ def _with_knuckle_limit(urdf: str, candidate, room: float) -> str:
     return urdf.replace(joint, tight)
 
 
+def _tight(tmp, urdf, best, room):
+    path = tmp / f"tight_{room:g}.urdf"
+    path.write_text(_with_knuckle_limit(urdf, best, room=room))
+    return planning_scene(BOX, hand_url=str(path))
+
+
+def _seated_knuckle(result, best) -> float:
+    return result.seated_q_hand[best.joint_names.index(KNUCKLE)]
+
+
+def _limit(best, room: float) -> float:
+    """The knuckle's limit that :func:`_with_knuckle_limit` gives ``room`` for."""
+    i = best.joint_names.index(KNUCKLE)
+    return float(best.q_hand[i]) + float(best.closing_signs[i]) * room
+
+
 def test_a_knuckle_at_its_limit_is_said_and_one_with_room_is_not(pinch):
     tmp, urdf, scene, best = pinch
     roomy, said = _shake(scene.add_models, best)
     assert roomy.held and not any(AT_STOP in m for m in said), said
 
-    path = tmp / "tight.urdf"
-    path.write_text(_with_knuckle_limit(urdf, best, room=0.0005))
-    tight = planning_scene(BOX, hand_url=str(path))
-    stopped, said = _shake(tight.add_models, best)
+    stopped, said = _shake(_tight(tmp, urdf, best, 0.0005).add_models, best)
     at_stop = [m for m in said if AT_STOP in m]
     assert len(at_stop) == 1, said
     assert not stopped.held
@@ -78,3 +92,18 @@ def test_a_knuckle_at_its_limit_is_said_and_one_with_room_is_not(pinch):
     assert at_stop[0].startswith(head), at_stop
     # the effort it names is the motor's, which the result reports too
     assert f"({stopped.efforts[0]:.3g} N·m)" in at_stop[0], (at_stop, stopped.efforts)
+    # where the result seats the knuckle, read apart from the warning: its limit
+    limit = _limit(best, 0.0005)
+    assert f"at its limit {limit:.4g} " in at_stop[0]
+    assert _seated_knuckle(stopped, best) == pytest.approx(limit, abs=1e-9)
+
+
+def test_a_grasp_held_against_a_stop_is_not_warned_of(pinch):
+    """2 mrad of room: the knuckle seats at its limit too, the pads squeezed
+    through their compliance against the stop, and the box holds; the stop
+    explains only a drop."""
+    tmp, urdf, _, best = pinch
+    limit = _limit(best, 0.002)
+    held, said = _shake(_tight(tmp, urdf, best, 0.002).add_models, best)
+    assert _seated_knuckle(held, best) == pytest.approx(limit, abs=1e-9)
+    assert held.held and not any(AT_STOP in m for m in said), said
