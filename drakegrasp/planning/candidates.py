@@ -194,6 +194,14 @@ class GraspCandidate:
         set by the planner for every candidate, a jaw's too (whose
         ``torque_needed`` is NaN), and ``"N·m"`` for a candidate built or
         pickled without it.
+    motors : tuple of str
+        The joints of ``joint_names`` that carry a motor, which
+        ``torque_needed`` is per (:func:`~drakegrasp.planning.motors.motor_names`:
+        a ``<mimic>`` follower turns with its leader's, so a
+        Robotiq-2F-85-like hand's six closing joints have one); set by the
+        planner for every candidate on a plant, () for one built or pickled
+        without them (and when the plant's constraints are unknown to
+        drakegrasp).  ``num_motors`` counts them.
 
     Notes
     -----
@@ -234,6 +242,7 @@ class GraspCandidate:
     object_mass: float = float("nan")
     held_joints: tuple[tuple[str, float], ...] = ()
     torque_unit: str = "N·m"
+    motors: tuple[str, ...] = ()
 
     def __getstate__(self) -> dict:
         # ``grasp`` (a cached_property, in __dict__ once read) is rebuilt from
@@ -265,6 +274,11 @@ class GraspCandidate:
     def num_contacts(self) -> int:
         """Number of contacts."""
         return len(self.contacts)
+
+    @property
+    def num_motors(self) -> int:
+        """Number of ``motors`` (0: not recorded)."""
+        return len(self.motors)
 
     def apply(self, plant, context, *, object_body=None) -> None:
         """Put the candidate's hand pose (and the planned object pose) in a context.
@@ -363,15 +377,17 @@ class GraspCandidate:
             "object_mass": jsonable(self.object_mass),
             "held_joints": {name: float(q) for name, q in self.held_joints},
             "torque_unit": self.torque_unit,
+            "motors": list(self.motors),
         }
 
     def __str__(self) -> str:
         p = self.X_WH.translation() * 1e3
-        shape = (
-            f"opening {self.opening * 1e3:.1f} mm"
-            if np.isfinite(self.opening)
-            else f"{len(self.q_hand)} closing joints"
-        )
+        if np.isfinite(self.opening):
+            shape = f"opening {self.opening * 1e3:.1f} mm"
+        else:
+            shape = f"{len(self.q_hand)} closing joints"
+            if self.motors:
+                shape += f", {_counted(self.num_motors, 'motor')}"
         if not np.isnan(self.torque_needed):
             torque = needed_text(
                 self.torque_needed,
@@ -395,6 +411,11 @@ class GraspCandidate:
             f"{self.robustness:.2f}, {holds}, score {self.score:.4f}; {shape}, "
             f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
         )
+
+
+def _counted(n: int, noun: str) -> str:
+    """``"1 motor"``, ``"16 motors"``."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 def _held_joints(plant, held_joints) -> list:
@@ -456,6 +477,26 @@ def _held_values(k: int, candidate: GraspCandidate) -> dict[str, float]:
                 f"{reprlib.repr(value)}, not a real number (metres or radians)"
             ) from None
     return values
+
+
+def _motor_count(k: int, candidate: GraspCandidate) -> int:
+    """Candidate ``k``'s ``num_motors``, for the table.
+
+    Raises
+    ------
+    InvalidGraspError
+        ``motors`` is not a tuple or list of joint names (one edited by hand:
+        a string would count its letters).
+    """
+    motors = candidate.motors
+    if not isinstance(motors, tuple | list) or not all(
+        isinstance(name, str) for name in motors
+    ):
+        raise InvalidGraspError(
+            f"candidate {k}'s motors must be a tuple of joint names, got "
+            f"{reprlib.repr(motors)}"
+        )
+    return len(motors)
 
 
 def _finite_number(value) -> bool:
@@ -630,12 +671,16 @@ class GraspCandidates(Sequence):
         :func:`~drakegrasp.planning.planner.plan_grasps`), so that its
         table has a full one's schema; none if ``settings`` names none.
 
+        ``num_motors`` (int64), after ``torque_unit``, counts each row's
+        ``motors``, the motors its ``torque_needed`` is per (0: not recorded).
+
         Raises
         ------
         InvalidGraspError
             A candidate's ``held_joints`` is not (joint name, real number)
-            pairs (one edited by hand); the message names the candidate's
-            index in the result, the joint and the value.
+            pairs, or its ``motors`` not joint names (one edited by hand); the
+            message names the candidate's index in the result, the joint and
+            the value.
         """
         rows = self.candidates
         n = len(rows)
@@ -652,6 +697,9 @@ class GraspCandidates(Sequence):
             "torque_needed": column(lambda c: c.torque_needed),
             "torque_capacity": column(lambda c: c.torque_capacity),
             "torque_unit": column(lambda c: c.torque_unit, object),
+            "num_motors": np.array(
+                [_motor_count(k, c) for k, c in enumerate(rows)], dtype=np.int64
+            ),
             "epsilon": column(lambda c: c.epsilon),
             "robustness": column(lambda c: c.robustness),
             "is_closure": column(lambda c: c.is_closure, bool),

@@ -126,6 +126,7 @@ __all__ = [
     "check_torque_limit",
     "finger_jacobian",
     "motor_limit",
+    "motor_names",
     "torque_capacity",
     "torque_needed",
     "with_squeeze_limit",
@@ -316,14 +317,63 @@ def _motor_map(plant, candidate: GraspCandidate):
     columns = np.array([j.velocity_start() for j in joints], dtype=int)
     couplings = plant_couplings(plant)
     C, _ = coupling_map(plant, columns, couplings)
-    if plant.num_actuators():
-        a = np.array([bool(_actuators(plant, j)) for j in joints], dtype=float)
-    else:  # every joint a motor, but a hidden drive, which touches nothing
-        drives = hidden_drives(plant, couplings)
-        a = np.array([n not in drives for n in candidate.joint_names], dtype=float)
+    a = _motor_flags(plant, candidate.joint_names, couplings).astype(float)
     if C.shape[0] == C.shape[1] and np.all(a == 1.0):
         return None
     return C, np.abs(C).T @ a
+
+
+def _motor_flags(plant, joint_names, couplings=None) -> np.ndarray:
+    """(n,) bool: which of ``joint_names`` is a motor (see :func:`motor_names`).
+
+    ``couplings``: the plant's (:func:`~drakegrasp.plant.couplings.plant_couplings`),
+    read here when None and needed (a plant without actuators).
+    """
+    if plant.num_actuators():
+        return np.array(
+            [bool(_actuators(plant, find_joint(plant, n))) for n in joint_names],
+            dtype=bool,
+        )
+    if couplings is None:
+        couplings = plant_couplings(plant)
+    drives = hidden_drives(plant, couplings)  # a hidden drive touches nothing
+    return np.array([n not in drives for n in joint_names], dtype=bool)
+
+
+def motor_names(plant, joint_names) -> tuple[str, ...]:
+    """The joints of ``joint_names`` that carry a motor, in their order.
+
+    ``torque_needed`` and ``torque_limit`` are per motor: a joint with an
+    actuator of ``plant``.  A ``<mimic>`` follower without an actuator of its
+    own turns with its leader's motor and is not one (the Robotiq-2F-85's
+    six closing joints have one motor).  A plant without any actuator says
+    nothing of its motors: each joint counts as one, but a hidden drive,
+    whose followers count in its stead (as :func:`torque_capacity` takes
+    them).
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        The plant of the hand (finalized).
+    joint_names : sequence of str
+        Scoped names (``"model::joint"``) of one-dof joints of ``plant``: a
+        candidate's ``joint_names``.
+
+    Returns
+    -------
+    tuple of str
+        The motors' scoped names, a subsequence of ``joint_names``.
+
+    Raises
+    ------
+    InvalidOptionError
+        A name that is not a joint of ``plant``; for a plant without
+        actuators, constraints drakegrasp was not told of
+        (:func:`~drakegrasp.plant.couplings.plant_couplings`).
+    """
+    names = tuple(joint_names)
+    flags = _motor_flags(plant, names)
+    return tuple(n for n, motor in zip(names, flags, strict=True) if motor)
 
 
 def _torque_lp(GS, TS, u, *, idle=None, row=None, bound=None) -> np.ndarray:

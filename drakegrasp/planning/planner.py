@@ -74,6 +74,7 @@ from drakegrasp.planning.motors import (
     _unit_of_joints,
     check_squeeze_limit,
     check_torque_limit,
+    motor_names,
     with_squeeze_limit,
     with_torques_needed,
 )
@@ -640,8 +641,8 @@ def _finished(
     ``anchor``: the object body, or the world body on a cloud; ``closing``:
     the scoped names of the hand's closing joints (each candidate's
     ``joint_names``, whose kinds set each one's ``torque_unit``, a jaw's
-    too).  A joint that a coupling ties to a closing joint moved with it: it
-    is not held.  The names of the joints held with ``closing``
+    too, and its ``motors``).  A joint that a coupling ties to a closing
+    joint moved with it: it is not held.  The names of the joints held with ``closing``
     go to ``settings["held_joints"]``, so that a result without candidates
     still knows its table's held-joint columns.
     """
@@ -661,6 +662,16 @@ def _finished(
             moved[names] = _linked(set(names), links)
         return tuple(pair for pair in values if pair[0] not in moved[names])
 
+    found: dict[tuple[str, ...], tuple[str, ...]] = {}
+
+    def motors(names: tuple[str, ...]) -> tuple[str, ...]:
+        if names not in found:
+            try:
+                found[names] = motor_names(plant, names)
+            except InvalidOptionError:  # constraints drakegrasp was not told of
+                found[names] = ()
+        return found[names]
+
     mass = float(mass)
     return replace(
         result,
@@ -670,6 +681,7 @@ def _finished(
                 object_mass=mass,
                 held_joints=held(c.joint_names),
                 torque_unit=_unit_of_joints(plant, c.joint_names),
+                motors=motors(c.joint_names),
             )
             for c in result.candidates
         ),

@@ -270,9 +270,15 @@ def test_a_pinch_on_a_hidden_drive_plans_as_its_twin(pinch_twins):
         assert a.q_hand[0] == a.q_hand[1]  # the left knuckle follows at 1
         assert a.torque_needed == pytest.approx(b.torque_needed, rel=1e-6)
         assert a.torque_capacity == pytest.approx(b.torque_capacity, rel=1e-6)
-        if not np.isnan(a.torque_needed):  # one motor closes all five joints
-            words = f"5 closing joints, torque {a.torque_needed:.3g} N·m per motor"
+        # one motor closes all five joints: the drive's, the twin's knuckle's
+        assert a.motors == (drive,)
+        assert b.motors == ("one_motor_pinch::left_knuckle",)
+        if not np.isnan(a.torque_needed):
+            words = (
+                f"5 closing joints, 1 motor, torque {a.torque_needed:.3g} N·m per motor"
+            )
             assert words in str(a), str(a)
+            assert f"4 closing joints, 1 motor, torque {b.torque_needed:.3g}" in str(b)
     assert any(not np.isnan(a.torque_needed) for a in hidden)
     assert hidden.settings["held_first"] == twin.settings["held_first"]
     for per_finger in (False, True):  # 5 N·m; 5 / 4 through the four followers
@@ -298,6 +304,12 @@ def test_a_pinch_without_actuators_counts_its_drive_as_no_motor(tmp_path):
             object_mass=0.2,
         )  # fmt: skip
         needed[name] = [(c.sample, c.torque_needed) for c in result]
+        # the motors counted are those the torque is per: every joint but
+        # the drive (the twin's four, the drive's four followers)
+        assert {c.motors for c in result} == {
+            tuple(n for n in result[0].joint_names if n != "one_motor_pinch::drive")
+        }
+        assert result[0].num_motors == 4
     assert len(needed["twin"]) > 5
     for (s_h, t_h), (s_t, t_t) in zip(needed["hidden"], needed["twin"], strict=True):
         assert s_h == s_t and t_h == pytest.approx(t_t, rel=1e-6)
