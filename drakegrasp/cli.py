@@ -22,7 +22,7 @@ Usage::
     drakegrasp plan [SCENE | OBJECT] [--hand HAND] [--num N] [--top K]
                     [--seed S] [--mu M|plant] [--mass KG] [--torque-limit NM]
                     [--squeeze-limit N] [--contact-model MODEL]
-                    [--torsional-friction NU] [--preshape JOINT=VALUE ...]
+                    [--torsional-friction NU] [--preshape JOINT=VALUE|open ...]
                     [--shake K [--squeeze X] [--stiffness K] [--damping D]
                      [--hydroelastic PA|none]]
                     [--package NAME=DIR ...] [--allow-any-file] [--progress]
@@ -77,7 +77,8 @@ a scene's), ``--mass`` gives the object's mass, ``--squeeze-limit`` the squeeze
 a parallel jaw will apply (default its actuators' effort limits: candidates
 held within it rank first, and the output says when none is),
 ``--torque-limit`` the torque a multi-finger hand will apply and
-``--preshape JOINT=VALUE`` its open shape, and ``--shake K`` shakes the
+``--preshape JOINT=VALUE`` its open shape (``--preshape open`` opens it
+from there), and ``--shake K`` shakes the
 first K candidates in a Drake simulation and lists them again, those that
 held first (:func:`~drakegrasp.planning.shake_ranking.shake_candidates`; the
 gains ``--squeeze``, ``--stiffness`` and ``--damping``, light ones by default
@@ -1207,10 +1208,15 @@ def _plan_setup(args: argparse.Namespace):
         options = {}
         default_mu = PLAN_DEFAULT_MU
         add_models = scene.add_models
+    from drakegrasp.planning.approach import OPEN
+
     alias = (args.hand or "").lower()
-    preshape = {**PLAN_PRESHAPES.get(alias, {}), **dict(args.preshape)}
+    given = dict(v for v in args.preshape if v != OPEN)
+    preshape = {**PLAN_PRESHAPES.get(alias, {}), **given}
     if preshape:
-        _apply_preshape(plant, context, body, hand, preshape, given=dict(args.preshape))
+        _apply_preshape(plant, context, body, hand, preshape, given=given)
+    if OPEN in args.preshape:  # opened from the shape set above
+        options["preshape"] = OPEN
     # the flags over the scene's values, as for analyze
     if args.contact_model is not None:
         options["contact_model"] = args.contact_model
@@ -1289,8 +1295,12 @@ def _apply_preshape(plant, context, body, hand, values: dict, *, given: dict):
     plant.SetPositions(ctx, q)
 
 
-def _joint_value(text: str) -> tuple[str, float]:
-    """``--preshape NAME=VALUE``: a joint's name and a finite position."""
+def _joint_value(text: str) -> tuple[str, float] | str:
+    """``--preshape NAME=VALUE``: a joint's name and a finite position; or ``open``."""
+    from drakegrasp.planning.approach import OPEN
+
+    if text == OPEN:
+        return OPEN
     name, sep, value = text.partition("=")
     try:
         number = float(value)
@@ -1299,7 +1309,7 @@ def _joint_value(text: str) -> tuple[str, float]:
     if not sep or not name or not math.isfinite(number):
         raise argparse.ArgumentTypeError(
             f"expected JOINT=VALUE (a joint's name, '=', a finite position in "
-            f"rad or m), got {text!r}"
+            f"rad or m) or {OPEN!r}, got {text!r}"
         )
     return name, number
 
@@ -1588,6 +1598,7 @@ _PLAN_FLAGS = {
     "squeeze_limit": "--squeeze-limit",
     "contact_model": "--contact-model",
     "torsional_friction": "--torsional-friction",
+    "preshape": "--preshape",
 }
 """``plan_grasps`` keywords that ``plan`` sets from a flag, and that flag."""
 
@@ -1597,8 +1608,8 @@ _PLAN_REASON_WORDS = {
         "--torsional-friction NU)"
     ),
     "num_candidates is 0": "--num is 0",
-    "open it wider (preshape=) or move the palm back (standoff=)": (
-        "open it wider (--preshape JOINT=VALUE)"
+    "open it (preshape='open', or joint values) or move the palm back (standoff=)": (
+        "open it (--preshape open, or --preshape JOINT=VALUE)"
     ),
     "the jaw at squeeze_limit ": "the jaw at --squeeze-limit ",
     "the hand at torque_limit ": "the hand at --torque-limit ",
@@ -1734,11 +1745,12 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         type=_joint_value,
         action="append",
         default=[],
-        metavar="JOINT=VALUE",
+        metavar="JOINT=VALUE|open",
         help="multi-finger hands: the open hand's position of a joint (rad or "
         "m, within its limits; repeatable; 'model::joint' where names repeat); "
         "default the model's, and for --hand allegro the thumb opposed "
-        "(joint_12=1.0)",
+        "(joint_12=1.0); 'open': from there, each joint turned the way that "
+        "parts the fingertips, to its limit (an angular gripper shut at zero)",
     )
     plan.add_argument(
         "--shake",

@@ -81,7 +81,13 @@ from drakegrasp.plant.fingers import (
 from drakegrasp.plant.pose import JOINT_LIMIT_TOL
 from drakegrasp.plant.validation import HandSpec, hand_bodies
 
-__all__ = ["PINCH_ROLLS", "MultiFingerHand", "multi_finger_hand", "sample_approaches"]
+__all__ = [
+    "OPEN",
+    "PINCH_ROLLS",
+    "MultiFingerHand",
+    "multi_finger_hand",
+    "sample_approaches",
+]
 
 PINCH_ROLLS = 8
 """Rolls tried per pose of a pinch (evenly over half a turn from the drawn
@@ -94,6 +100,13 @@ _CURL_STEPS = 15
 _CURL_STEP = (0.1, 0.005)
 """Steps, and largest change of a revolute (rad) and a prismatic (m) joint per
 step, of the curl (:func:`_curl`)."""
+
+OPEN = "open"
+"""``preshape=OPEN``: the context's hand, its fingertips drawn apart
+(:func:`multi_finger_hand`)."""
+
+_OPEN_MAX_STEPS = 400
+"""Most steps of the opening (:func:`_opened`): 40 rad of a revolute joint."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -309,6 +322,63 @@ def _curl(tips, q0, structure, moves, steps=_CURL_STEPS) -> np.ndarray:
     return q
 
 
+def _opened(tips, q0, structure, moves) -> np.ndarray:
+    """The open hand (``preshape="open"``): the fingertips drawn apart from ``q0``.
+
+    Projected gradient *ascent* of the fingertips' spread ``Σ_f |t_f(q) − t̄|²``
+    (the curl's measure, :func:`_curl`) from the context's hand ``q0``, by
+    the curl's steps, until the spread stops growing: each joint turns the
+    way that parts the fingertips until it reaches its limit, so an angular
+    gripper's jaws open fully and a joint that does not part them stays
+    where it is.  A joint at the limit it is pushed against drops out of the
+    step (else it would hold the others to a crawl), and the steps are
+    enough to cross every joint's range twice (at most
+    :data:`_OPEN_MAX_STEPS`).  The ascent is local: a finger curled shut
+    past the others' tips spreads them further by curling on, and stays.
+    """
+    own = np.array([_CURL_STEP[j.type_name() == "prismatic"] for j in structure.joints])
+    cap = structure.coupling.leader_steps(own, moves)
+    span = structure.upper - structure.lower
+    span = np.where(np.isfinite(span), span, 0.0)
+    moving = cap > 0
+    steps = int(np.ceil(np.max(span[moving] / cap[moving], initial=0.0))) + 1
+
+    def spread(q):
+        t = tips(q)
+        return float(np.sum((t - t.mean(axis=0)) ** 2))
+
+    return _ascend(spread, structure, cap, min(2 * steps, _OPEN_MAX_STEPS), q0)
+
+
+def _ascend(spread, structure, cap, steps: int, q0) -> np.ndarray:
+    """:func:`_opened`'s ascent of ``spread`` from ``q0``, at most ``steps`` steps."""
+    lower, upper = structure.lower, structure.upper
+    q = structure.coupling.apply(np.clip(q0, lower, upper))
+    h = 1e-4
+    current = spread(q)
+    for _ in range(steps):
+        grad = np.zeros_like(q)
+        for j in range(len(q)):
+            e = np.zeros_like(q)
+            e[j] = h
+            grad[j] = (
+                spread(np.clip(q + e, lower, upper))
+                - spread(np.clip(q - e, lower, upper))
+            ) / (2 * h)
+        grad = structure.coupling.pull_back(grad)
+        pinned = ((grad > 0) & (q >= upper)) | ((grad < 0) & (q <= lower))
+        grad = np.where(pinned, 0.0, grad)
+        scale = np.max(np.abs(grad), initial=0.0)
+        if scale <= 1e-12:
+            break
+        trial = structure.coupling.apply(np.clip(q + cap * grad / scale, lower, upper))
+        grown = spread(trial)
+        if grown <= current:
+            break
+        q, current = trial, grown
+    return q
+
+
 def multi_finger_hand(
     plant,
     plant_context,
@@ -333,9 +403,16 @@ def multi_finger_hand(
     object_body : RigidBody
         The object (the fingers' geometry pairs are read against it).
     hand : HandSpec
-    preshape : (n_h,) float, optional
+    preshape : (n_h,) float or "open", optional
         The pre-shape over the closing joints (order of
-        ``structure.names``); default the context's.
+        ``structure.names``); default the context's.  :data:`OPEN`: the
+        context's hand with its fingertips drawn apart, each joint turned the
+        way that parts them, to its limit or as far as that parts them (an
+        angular gripper whose model's zero is nearly shut opened fully, as
+        the parallel-jaw route opens a jaw's stroke); a joint that does not
+        part them keeps the context's value.  The opening is a local ascent
+        of the fingertips' spread: a finger curled shut past the others'
+        tips stays shut (give joint values then).
     synergy : (n_h,) float or "curl", optional
         A direction the pre-shape moves along by an amount drawn in
         ``synergy_range`` per pose (``"curl"``: towards the curl).
@@ -376,7 +453,12 @@ def multi_finger_hand(
     # a finger is a kinematic chain, though a <mimic> closes two as one
     chains = finger_chains(plant, structure)
     n = len(structure.names)
-    if preshape is None:
+    opened = isinstance(preshape, str)
+    if opened and preshape != OPEN:
+        raise InvalidOptionError(
+            f"preshape must be n_h = {n} numbers or {OPEN!r}, got {preshape!r}"
+        )
+    if preshape is None or opened:
         q0 = plant.GetPositions(plant_context)[structure.position_indices]
         q0 = structure.coupling.apply(q0)
     else:
@@ -420,6 +502,8 @@ def multi_finger_hand(
         )
 
     moves = np.array([not is_hidden_drive(plant, j) for j in structure.joints])
+    if opened:
+        q0 = _opened(tips, q0, structure, moves)
     q_curled = _curl(tips, q0, structure, moves)
     centre = tips(q_curled).mean(axis=0)
     if curl_synergy:

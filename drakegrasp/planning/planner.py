@@ -392,9 +392,12 @@ def plan_grasps(
     preshape, synergy, synergy_range, approach, standoff : optional
         Multi-finger hands only
         (:func:`~drakegrasp.planning.approach.multi_finger_hand`): the
-        pre-shape over the closing joints (default the context's open hand), a
-        synergy direction and the range of its amount drawn per
-        pose, the approach in the base frame H, the palm stand-off range (m).
+        pre-shape over the closing joints (default the context's open hand;
+        ``"open"``: the hand opened from there, each joint turned the way
+        that parts the fingertips, to its limit: an angular gripper whose
+        model's zero is nearly shut), a synergy direction and the range of
+        its amount drawn per pose, the approach in the base frame H, the
+        palm stand-off range (m).
     tilt : float, optional
         Multi-finger hands: largest tilt (rad) of the approach from the
         surface's inward normal.
@@ -889,8 +892,8 @@ OPEN_HAND_SHARE = 0.9
 from a few poses: 94 collided and 6 missed of an SDH-like hand's 100)."""
 
 OPEN_HAND_HINT = (
-    "; the open hand collides nearly wherever it is placed: open it wider "
-    "(preshape=) or move the palm back (standoff=)"
+    "; the open hand collides nearly wherever it is placed: open it "
+    "(preshape='open', or joint values) or move the palm back (standoff=)"
 )
 """Added to an empty result's reason when nearly every pose collided as placed."""
 

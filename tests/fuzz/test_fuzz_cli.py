@@ -76,6 +76,7 @@ def _one_line_error(proc, code=1):
         (("plan", "--preshape", "joint_12=nan"), "argument --preshape: expected"),
         (("plan", "--preshape", "=1"), "argument --preshape: expected"),
         (("plan", "--preshape", "j=1e400"), "argument --preshape: expected"),
+        (("plan", "--preshape", "opened"), "or 'open', got 'opened'"),
         (("analyze", "--tol", "abc"), "argument --tol"),
         (("analyze", "--load", "heavy"), "argument --load: expected 'gravity'"),
         (("analyze", "--load", "1,,2"), "argument --load: expected 'gravity'"),

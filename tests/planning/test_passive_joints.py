@@ -81,7 +81,10 @@ def test_an_open_hand_that_collides_everywhere_is_told_to_open(tmp_path, capsys)
     argv = ["plan", "cylinder", "--hand", str(tmp_path / "hand_False.urdf")]
     argv += ["--num", "10", *(f"--preshape={name}=2.0" for name in shut)]
     assert main(argv) == 0
-    assert "open it wider (--preshape JOINT=VALUE)" in capsys.readouterr().out
+    said = capsys.readouterr().out
+    assert "open it (--preshape open, or --preshape JOINT=VALUE)" in said
+    # the flag the words name is taken (what it opens: test_open_preshape.py)
+    assert main([*argv, "--preshape", "open"]) == 0
 
 
 def test_a_joint_without_a_motor_that_others_follow_is_passive_with_them(tmp_path):

@@ -5,7 +5,9 @@
 - :func:`one_motor_pinch_urdf`: a Robotiq-style pinch, two knuckles and their
   pads on one motor;
 - :func:`coupled_jaw_urdf`: a parallel jaw whose prismatic fingers one motor
-  drives.
+  drives;
+- :func:`angular_gripper_urdf`: two jaws that turn apart on one motor, shut
+  (parallel) at the model's zero.
 
 Shared by the plant and planning tests.
 """
@@ -316,6 +318,63 @@ def coupled_jaw_urdf(
         f'</type><joint name="{leader}"><hardwareInterface>EffortJointInterface'
         f'</hardwareInterface></joint><actuator name="m"><mechanicalReduction>1'
         "</mechanicalReduction></actuator></transmission></robot>"
+    )
+
+
+def angular_gripper_urdf() -> str:
+    """An angular gripper: two jaws on hinges, one motor, parallel at zero.
+
+    A palm (30 x 60 x 70 mm, its top at z = 70 mm) with two 90 mm jaws
+    (16 x 10 mm section, a 30 mm pad on each inner face near the tip) hinged
+    about x at y = -/+24 mm, z = 75 mm.  At 0 rad the jaws stand parallel, the
+    pads 32 mm apart: too narrow for drakegrasp's cylinder, sphere or box.
+    Positive turns them apart, up to 30 degrees (the pads then some 120 mm
+    apart at the tips); the right jaw's hinge is a ``<mimic>`` of the left's,
+    which alone has a ``<transmission>`` (0.8 N·m).
+    """
+    inertia = '<inertia ixx="4e-5" iyy="4e-5" izz="4e-5" ixy="0" ixz="0" iyz="0"/>'
+
+    def jaw(name: str, side: float) -> str:
+        boxes = (
+            ("0 {y:g} 0.045", "0.016 0.01 0.09"),
+            ("0 {p:g} 0.075", "0.016 0.008 0.03"),
+        )
+        shapes = "".join(
+            f'<collision><origin xyz="{xyz.format(y=-0.004 * side, p=0.005 * side)}"/>'
+            f'<geometry><box size="{size}"/></geometry></collision>'
+            for xyz, size in boxes
+        )
+        return (
+            f'<link name="{name}"><inertial><mass value="0.04"/>{inertia}'
+            f"</inertial>{shapes}</link>"
+        )
+
+    def hinge(name: str, child: str, y: float, axis: str, extra: str = "") -> str:
+        return (
+            f'<joint name="{name}" type="revolute"><parent link="palm"/>'
+            f'<child link="{child}"/><origin xyz="0 {y:g} 0.075"/>'
+            f'<axis xyz="{axis}"/><limit lower="-0.1745" upper="0.5236" '
+            f'effort="0.8" velocity="2"/>{extra}</joint>'
+        )
+
+    return (
+        '<?xml version="1.0"?><robot name="angular_gripper">'
+        '<link name="palm"><inertial><mass value="0.3"/>'
+        '<inertia ixx="3e-4" iyy="3e-4" izz="3e-4" ixy="0" ixz="0" iyz="0"/>'
+        '</inertial><collision><origin xyz="0 0 0.035"/><geometry>'
+        '<box size="0.03 0.06 0.07"/></geometry></collision></link>'
+        + jaw("left_jaw", 1.0)
+        + jaw("right_jaw", -1.0)
+        + hinge("left_hinge", "left_jaw", -0.024, "1 0 0")
+        + hinge(
+            "right_hinge",
+            "right_jaw",
+            0.024,
+            "-1 0 0",
+            '<mimic joint="left_hinge" multiplier="1" offset="0"/>',
+        )  # fmt: skip
+        + transmissions(["left_hinge"])
+        + "</robot>"
     )
 
 
