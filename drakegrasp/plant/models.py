@@ -121,6 +121,11 @@ def drake_reading(read, *args, **kwargs):
     Here the reason (what was logged at WARNING and above) is kept instead and
     raised as ``RuntimeError(reason)``, for the caller to name its file; what
     the reader logs without refusing reaches the logger's handlers afterwards.
+    A reader that refuses has its INFO records dropped: they say what it was
+    doing ("PackageMap: Downloading https://..."), which the refusal says
+    again with its outcome, and they were a line on stderr before the CLI's
+    one-line error.  What it logged at WARNING and above still reaches the
+    handlers after a ``RuntimeError``.
 
     Raises
     ------
@@ -133,8 +138,11 @@ def drake_reading(read, *args, **kwargs):
     propagate = logger.propagate
     logger.addHandler(collected)
     logger.propagate = False
+    refused = True
     try:
-        return read(*args, **kwargs)
+        result = read(*args, **kwargs)
+        refused = False
+        return result
     except SystemExit as e:
         said = [
             r.getMessage() for r in collected.records if r.levelno >= logging.WARNING
@@ -145,7 +153,8 @@ def drake_reading(read, *args, **kwargs):
         logger.removeHandler(collected)
         logger.propagate = propagate
         for record in collected.records:
-            logger.handle(record)
+            if not refused or record.levelno >= logging.WARNING:
+                logger.handle(record)
 
 
 def load_models(where: str, read, *args, **kwargs):

@@ -108,6 +108,31 @@ def test_what_drake_logs_without_refusing_reaches_its_logger(caplog):
     assert [r.getMessage() for r in caplog.records] == ["a mesh has no normals"]
 
 
+def test_a_refusal_drops_what_the_reader_said_it_was_doing(caplog):
+    # offline, Drake logs "Downloading <url>" at INFO and then refuses with an
+    # error naming that url: the INFO line came before the CLI's one line
+    drake = logging.getLogger("drake")
+
+    def downloads():
+        drake.info("PackageMap: Downloading https://example.invalid/models.tar.gz")
+        drake.warning("a mesh has no normals")
+        raise RuntimeError("when downloading 'drake_models' ... failed")
+
+    with caplog.at_level(logging.INFO, logger="drake"):
+        with pytest.raises(RuntimeError, match="downloading 'drake_models'"):
+            drake_reading(downloads)
+    assert [r.getMessage() for r in caplog.records] == ["a mesh has no normals"]
+    caplog.clear()
+
+    def reads():  # the same lines from a reader that does not refuse: kept
+        drake.info("PackageMap: Downloading https://example.invalid/models.tar.gz")
+        return 3
+
+    with caplog.at_level(logging.INFO, logger="drake"):
+        assert drake_reading(reads) == 3
+    assert [r.levelno for r in caplog.records] == [logging.INFO]
+
+
 def test_a_refusal_keeps_its_reason():
     def demands():
         logging.getLogger("drake").error("directive: Specify one of")
