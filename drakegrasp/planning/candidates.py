@@ -195,13 +195,16 @@ class GraspCandidate:
         ``torque_needed`` is NaN), and ``"N·m"`` for a candidate built or
         pickled without it.
     motors : tuple of str
-        The joints of ``joint_names`` that carry a motor, which
+        The hand's joints that carry an actuator's motor, which
         ``torque_needed`` is per (:func:`~drakegrasp.planning.motors.motor_names`:
         a ``<mimic>`` follower turns with its leader's, so a
-        Robotiq-2F-85-like hand's six closing joints have one); set by the
-        planner for every candidate on a plant, () for one built or pickled
-        without them (and when the plant's constraints are unknown to
-        drakegrasp).  ``num_motors`` counts them.
+        Robotiq-2F-85-like hand's six closing joints have one; a jaw's
+        hidden drive is one); set by the planner for every candidate on a
+        plant.  () when none is known: a model that gives the hand no
+        actuator (``torque_needed`` then takes one motor at each joint but
+        a hidden drive), a plant whose constraints drakegrasp was not told
+        of, or a candidate built or pickled without them.  Distinct str,
+        else ``InvalidGraspError``.  ``num_motors`` counts them.
 
     Notes
     -----
@@ -243,6 +246,9 @@ class GraspCandidate:
     held_joints: tuple[tuple[str, float], ...] = ()
     torque_unit: str = "N·m"
     motors: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "motors", _checked_motors(self.motors))
 
     def __getstate__(self) -> dict:
         # ``grasp`` (a cached_property, in __dict__ once read) is rebuilt from
@@ -479,24 +485,27 @@ def _held_values(k: int, candidate: GraspCandidate) -> dict[str, float]:
     return values
 
 
-def _motor_count(k: int, candidate: GraspCandidate) -> int:
-    """Candidate ``k``'s ``num_motors``, for the table.
+def _checked_motors(motors) -> tuple[str, ...]:
+    """``GraspCandidate.motors`` as a tuple of distinct joint names.
 
     Raises
     ------
     InvalidGraspError
-        ``motors`` is not a tuple or list of joint names (one edited by hand:
-        a string would count its letters).
+        Not a tuple or list of str (a string would count its letters), or a
+        name twice.
     """
-    motors = candidate.motors
     if not isinstance(motors, tuple | list) or not all(
         isinstance(name, str) for name in motors
     ):
         raise InvalidGraspError(
-            f"candidate {k}'s motors must be a tuple of joint names, got "
+            "the candidate's motors must be a tuple of joint names, got "
             f"{reprlib.repr(motors)}"
         )
-    return len(motors)
+    if len(set(motors)) != len(motors):
+        raise InvalidGraspError(
+            f"the candidate's motors name a joint twice: {reprlib.repr(motors)}"
+        )
+    return tuple(motors)
 
 
 def _finite_number(value) -> bool:
@@ -672,15 +681,14 @@ class GraspCandidates(Sequence):
         table has a full one's schema; none if ``settings`` names none.
 
         ``num_motors`` (int64), after ``torque_unit``, counts each row's
-        ``motors``, the motors its ``torque_needed`` is per (0: not recorded).
+        ``motors`` (0: none known).
 
         Raises
         ------
         InvalidGraspError
             A candidate's ``held_joints`` is not (joint name, real number)
-            pairs, or its ``motors`` not joint names (one edited by hand); the
-            message names the candidate's index in the result, the joint and
-            the value.
+            pairs (one edited by hand); the message names the candidate's
+            index in the result, the joint and the value.
         """
         rows = self.candidates
         n = len(rows)
@@ -697,9 +705,7 @@ class GraspCandidates(Sequence):
             "torque_needed": column(lambda c: c.torque_needed),
             "torque_capacity": column(lambda c: c.torque_capacity),
             "torque_unit": column(lambda c: c.torque_unit, object),
-            "num_motors": np.array(
-                [_motor_count(k, c) for k, c in enumerate(rows)], dtype=np.int64
-            ),
+            "num_motors": column(lambda c: c.num_motors, np.int64),
             "epsilon": column(lambda c: c.epsilon),
             "robustness": column(lambda c: c.robustness),
             "is_closure": column(lambda c: c.is_closure, bool),

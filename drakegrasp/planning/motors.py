@@ -308,10 +308,12 @@ def _motor_map(plant, candidate: GraspCandidate):
     each coordinate's generalized force ``(J C)ᵀ f`` may carry per N·m allowed
     at every actuator: ``|C|ᵀ a``, ``a_k`` 1 for a joint with an actuator and
     0 for one without (a follower's torque comes through its coupling; an
-    unactuated, uncoupled joint is passive).  A plant without any actuator
-    says nothing of its motors: each joint counts as one, but a hidden drive
-    (its followers count in its stead, as in its twin whose motor sits on a
-    finger).  None when every joint is its own motor (``C = I``, ``w = 1``).
+    unactuated, uncoupled joint is passive).  A hand without any actuator on
+    its joints (or on a leader of theirs) says nothing of its motors: each
+    joint counts as one, but a hidden drive (its followers count in its
+    stead, as in its twin whose motor sits on a finger), whatever actuators
+    the plant's other models have (:func:`_motor_flags`).  None when every
+    joint is its own motor (``C = I``, ``w = 1``).
     """
     joints = [find_joint(plant, name) for name in candidate.joint_names]
     columns = np.array([j.velocity_start() for j in joints], dtype=int)
@@ -324,32 +326,55 @@ def _motor_map(plant, candidate: GraspCandidate):
 
 
 def _motor_flags(plant, joint_names, couplings=None) -> np.ndarray:
-    """(n,) bool: which of ``joint_names`` is a motor (see :func:`motor_names`).
+    """(n,) bool: which of ``joint_names`` the torque LP takes as a motor.
 
-    ``couplings``: the plant's (:func:`~drakegrasp.plant.couplings.plant_couplings`),
-    read here when None and needed (a plant without actuators).
+    A hand with an actuator on one of ``joint_names`` or on a joint that
+    leads one of them (a jaw's hidden drive): the joints with one.  A hand
+    without any says nothing of its motors (whatever the plant's other
+    models have): each joint counts as one, but a hidden drive, whose
+    followers count in its stead.  ``couplings``: the plant's
+    (:func:`~drakegrasp.plant.couplings.plant_couplings`), read when None.
     """
-    if plant.num_actuators():
-        return np.array(
-            [bool(_actuators(plant, find_joint(plant, n))) for n in joint_names],
-            dtype=bool,
-        )
     if couplings is None:
         couplings = plant_couplings(plant)
+    names = tuple(joint_names)
+    own = _actuated(plant, names)
+    if own.any() or _actuated(plant, _outside_leaders(names, couplings)).any():
+        return own
     drives = hidden_drives(plant, couplings)  # a hidden drive touches nothing
-    return np.array([n not in drives for n in joint_names], dtype=bool)
+    return np.array([n not in drives for n in names], dtype=bool)
+
+
+def _actuated(plant, names) -> np.ndarray:
+    """(n,) bool: which of the joints ``names`` has an actuator."""
+    return np.array(
+        [bool(_actuators(plant, find_joint(plant, n))) for n in names], dtype=bool
+    )
+
+
+def _outside_leaders(names: tuple[str, ...], couplings) -> tuple[str, ...]:
+    """The joints not in ``names`` that lead one of them, once each, in order."""
+    inside = set(names)
+    return tuple(
+        dict.fromkeys(
+            leader
+            for follower, leader, _, _ in couplings
+            if follower in inside and leader not in inside
+        )
+    )
 
 
 def motor_names(plant, joint_names) -> tuple[str, ...]:
-    """The joints of ``joint_names`` that carry a motor, in their order.
+    """The motors of the hand whose closing joints are ``joint_names``.
 
     ``torque_needed`` and ``torque_limit`` are per motor: a joint with an
     actuator of ``plant``.  A ``<mimic>`` follower without an actuator of its
     own turns with its leader's motor and is not one (the Robotiq-2F-85's
-    six closing joints have one motor).  A plant without any actuator says
-    nothing of its motors: each joint counts as one, but a hidden drive,
-    whose followers count in its stead (as :func:`torque_capacity` takes
-    them).
+    six closing joints have one motor); a leader outside ``joint_names``
+    with an actuator is one (a jaw whose fingers follow a hidden drive).
+    A hand none of whose joints has an actuator has no motor known: ()
+    (its ``torque_needed`` then takes one at each joint but a hidden drive,
+    :func:`torque_capacity`).
 
     Parameters
     ----------
@@ -362,18 +387,20 @@ def motor_names(plant, joint_names) -> tuple[str, ...]:
     Returns
     -------
     tuple of str
-        The motors' scoped names, a subsequence of ``joint_names``.
+        The motors' scoped names: the leaders outside ``joint_names`` first,
+        then those of ``joint_names``, in its order.
 
     Raises
     ------
     InvalidOptionError
-        A name that is not a joint of ``plant``; for a plant without
-        actuators, constraints drakegrasp was not told of
-        (:func:`~drakegrasp.plant.couplings.plant_couplings`).
+        A name that is not a joint of ``plant``, or constraints drakegrasp
+        was not told of (:func:`~drakegrasp.plant.couplings.plant_couplings`).
     """
     names = tuple(joint_names)
-    flags = _motor_flags(plant, names)
-    return tuple(n for n, motor in zip(names, flags, strict=True) if motor)
+    every = (*_outside_leaders(names, plant_couplings(plant)), *names)
+    return tuple(
+        n for n, motor in zip(every, _actuated(plant, every), strict=True) if motor
+    )
 
 
 def _torque_lp(GS, TS, u, *, idle=None, row=None, bound=None) -> np.ndarray:

@@ -15,10 +15,17 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-from coupled_hands import one_motor_pinch_urdf, plan_on_box, spread_hand_urdf
+from coupled_hands import (
+    coupled_jaw_urdf,
+    one_motor_pinch_urdf,
+    plan_on_box,
+    spread_hand_urdf,
+)
 
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError
 from drakegrasp.planning.motors import motor_names
+
+BOX = "package://drakegrasp/objects/box.sdf"
 
 
 def _transmitted(urdf: str) -> set[str]:
@@ -97,15 +104,89 @@ def test_the_table_json_and_pickle_carry_the_motors(spread):
     assert empty.table()["num_motors"].shape == (0,)
 
 
-@pytest.mark.parametrize("motors", ["abc", None, (1, 2), ("a", 3.0)])
-def test_an_edited_motors_is_refused_by_the_table(spread, motors):
+@pytest.mark.parametrize("motors", ["abc", None, 5, (1, 2), ("a", 3.0), ("a", "a")])
+def test_an_edited_motors_is_refused(spread, motors):
     _, _, result = spread
-    edited = dataclasses.replace(
-        result,
-        candidates=(result[0], dataclasses.replace(result[1], motors=motors)),
-    )
-    with pytest.raises(InvalidGraspError, match="candidate 1's motors"):
-        edited.table()
+    with pytest.raises(InvalidGraspError, match="the candidate's motors"):
+        dataclasses.replace(result[1], motors=motors)
+    listed = dataclasses.replace(result[1], motors=list(result[1].motors))
+    assert listed.motors == result[1].motors  # a list is taken as its tuple
+
+
+def test_a_hand_without_actuators_has_no_motor_known_in_any_plant(tmp_path):
+    # its joints' torque is taken one per joint; an actuator of another model
+    # of the plant (a slider welded beside it) left the hand with no motor in
+    # the torque LP too: torque_needed inf, and nothing said
+    from drakegrasp.planning import plan_grasps, planning_scene
+    from drakegrasp.planning.scenes import scene_from_models
+    from drakegrasp.plant.couplings import add_models
+
+    bare = spread_hand_urdf().split("<transmission")[0] + "</robot>"
+    slider = (
+        '<?xml version="1.0"?><robot name="slider"><link name="base"/>'
+        '<link name="cart"><inertial><mass value="0.1"/><inertia ixx="1e-5" '
+        'iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        '<joint name="weld" type="fixed"><parent link="world"/><child link="base"/>'
+        '<origin xyz="5 5 5"/></joint><joint name="slide" type="prismatic">'
+        '<parent link="base"/><child link="cart"/><axis xyz="1 0 0"/>'
+        '<limit lower="0" upper="1" effort="1" velocity="1"/></joint>'
+        '<transmission name="t"><type>transmission_interface/SimpleTransmission'
+        '</type><joint name="slide"/><actuator name="m"/></transmission></robot>'
+    )  # fmt: skip
+    (tmp_path / "bare.urdf").write_text(bare)
+    (tmp_path / "slider.urdf").write_text(slider)
+    alone = planning_scene(BOX, hand_url=str(tmp_path / "bare.urdf"))
+
+    def with_slider(plant, parser):
+        hand, name = alone.add_models(plant, parser)
+        add_models(parser, str(tmp_path / "slider.urdf"))
+        return hand, name
+
+    beside = scene_from_models(with_slider)
+    assert (alone.plant.num_actuators(), beside.plant.num_actuators()) == (0, 1)
+    plans = [
+        plan_grasps(
+            s.plant,
+            s.context,
+            s.object_body,
+            hand=s.hand,
+            num_candidates=40,
+            mu=0.5,
+            seed=0,
+            robustness_samples=4,
+            object_mass=0.2,
+        )  # fmt: skip
+        for s in (alone, beside)
+    ]
+    a, b = plans
+    assert len(a) == len(b) > 3
+    for x, y in zip(a, b, strict=True):
+        assert x.motors == y.motors == ()
+        assert x.sample == y.sample
+        assert x.torque_needed == pytest.approx(y.torque_needed, rel=1e-9, nan_ok=True)
+    assert any(np.isfinite(x.torque_needed) for x in b)
+
+
+def test_a_jaws_hidden_drive_is_its_motor(tmp_path):
+    # the jaw's slides follow a drive that is not among its closing joints;
+    # its twin has the motor on the left slide
+    from drakegrasp.planning import plan_grasps, planning_scene
+
+    motors = {}
+    for hidden in (False, True):
+        path = tmp_path / f"jaw_{hidden}.urdf"
+        path.write_text(coupled_jaw_urdf(hidden_drive=hidden))
+        s = planning_scene(BOX, hand_url=str(path))
+        result = plan_grasps(
+            s.plant, s.context, s.object_body, hand=s.hand, num_candidates=20,
+            mu=0.5, seed=0, robustness_samples=4,
+        )  # fmt: skip
+        assert len(result)
+        motors[hidden] = {c.motors for c in result}
+    assert motors == {
+        False: {("coupled_jaw::left_slide",)},
+        True: {("coupled_jaw::drive",)},
+    }
 
 
 def test_motor_names_refuses_a_joint_the_plant_lacks(spread):

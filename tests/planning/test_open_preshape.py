@@ -76,14 +76,15 @@ def _pad_gap(scene, q: float) -> float:
 
 def test_the_shut_model_collides_and_is_told_to_open(gripper):
     result = _plan(_scene(gripper))
-    assert len(result) <= 2
+    assert len(result) == 0
     assert (
         result.rejections["hand collides with the object"]
         >= 0.9 * PLAN["num_candidates"]
     )
-    if not len(result):
-        assert result.reason.endswith(OPEN_HAND_HINT)
-    assert "preshape='open'" in OPEN_HAND_HINT
+    assert result.reason.endswith(OPEN_HAND_HINT)
+    assert result.reason.endswith(
+        "open it (preshape='open', or joint values) or move the palm back (standoff=)"
+    )
 
 
 def test_open_turns_each_jaw_to_the_limit_that_parts_them(opened, gripper):
@@ -159,3 +160,48 @@ def test_a_barrett_like_hand_opens_from_straight_fingers(tmp_path):
         assert q[f"spread_hand::f{k}_distal_joint"] == pytest.approx(-0.25)
     assert q["spread_hand::f1_spread"] > 0.1
     assert len(opened) >= len(shut) > 0
+
+
+def test_jaws_without_limits_open_as_far_as_that_parts_them(tmp_path):
+    # continuous hinges: no limit to stop at; the opening went 0.2 rad (its
+    # step budget came from the joints' ranges) and stopped
+    urdf = angular_gripper_urdf().replace('type="revolute"', 'type="continuous"')
+    urdf = urdf.replace('lower="-0.1745" upper="0.5236" ', "")
+    path = tmp_path / "continuous.urdf"
+    path.write_text(urdf)
+    scene = _scene(path)
+    assert np.isinf(scene.plant.GetJointByName("left_hinge").position_upper_limits())
+    result = _plan(scene, preshape=OPEN, num_candidates=4)
+    q = result.settings["hand"]["preshape"][0]
+    # a second route: the jaws' geometry centres, by Drake's FK on a grid, are
+    # farthest apart within a sixteenth of the opening's 0.1 rad step of q
+    plant = scene.plant
+    ctx = plant.CreateDefaultContext()
+    inspector = (
+        scene.plant.get_geometry_query_input_port()
+        .Eval(plant.GetMyContextFromRoot(scene.context))
+        .inspector()
+    )
+
+    def spread(angle: float) -> float:
+        for name in ("left_hinge", "right_hinge"):
+            plant.GetJointByName(name).set_angle(ctx, angle)
+        centres = []
+        for jaw in ("left_jaw", "right_jaw"):
+            body = plant.GetBodyByName(jaw)
+            X_WB = plant.EvalBodyPoseInWorld(ctx, body)
+            centres.append(
+                np.mean(
+                    [
+                        X_WB.multiply(inspector.GetPoseInFrame(g).translation())
+                        for g in plant.GetCollisionGeometriesForBody(body)
+                    ],
+                    axis=0,
+                )
+            )
+        return float(np.linalg.norm(centres[0] - centres[1]))
+
+    grid = np.linspace(0.0, np.pi, 2001)
+    best = grid[int(np.argmax([spread(a) for a in grid]))]
+    assert q == pytest.approx(best, abs=0.1 / 16)
+    assert q > 1.4
