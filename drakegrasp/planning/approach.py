@@ -301,29 +301,51 @@ def _curl(tips, q0, structure, moves, steps=_CURL_STEPS) -> np.ndarray:
     drive curls as its twin with the motor on a finger does.
     """
     lower, upper = structure.lower, structure.upper
-    own = np.array([_CURL_STEP[j.type_name() == "prismatic"] for j in structure.joints])
-    cap = structure.coupling.leader_steps(own, moves)
+    cap = _steps_of(structure, moves)
     q = q0.copy()
-    h = 1e-4
     for _ in range(steps):
-        t = tips(q)
-        grad = np.zeros_like(q)
-        for j in range(len(q)):
-            e = np.zeros_like(q)
-            e[j] = h
-            tp, tm = (
-                tips(np.clip(q + e, lower, upper)),
-                tips(np.clip(q - e, lower, upper)),
-            )
-            spread_p = np.sum((tp - t.mean(axis=0)) ** 2)
-            spread_m = np.sum((tm - t.mean(axis=0)) ** 2)
-            grad[j] = (spread_p - spread_m) / (2 * h)
-        grad = structure.coupling.pull_back(grad)
+        grad = _spread_gradient(tips, q, structure)
         scale = np.max(np.abs(grad), initial=0.0)
         if scale <= 1e-12:
             break
         q = np.clip(q - cap * grad / scale, lower, upper)
     return q
+
+
+def _steps_of(structure, moves) -> np.ndarray:
+    """Each closing joint's largest move a step of the curl or the opening.
+
+    :data:`_CURL_STEP` by the joint's kind, a leader's within its followers'
+    caps over their ratios, a hidden drive's (``moves`` False) within those
+    alone (:meth:`Coupling.leader_steps
+    <drakegrasp.plant.fingers.Coupling.leader_steps>`).
+    """
+    own = np.array([_CURL_STEP[j.type_name() == "prismatic"] for j in structure.joints])
+    return structure.coupling.leader_steps(own, moves)
+
+
+def _spread_gradient(tips, q, structure, h: float = 1e-4) -> np.ndarray:
+    """∂/∂q of the fingertips' spread ``Σ_f |t_f(q) − t̄(q)|²`` at ``q``.
+
+    Central differences of ``h`` (clipped to the limits) about the mean
+    ``t̄`` at ``q`` (the same derivative there), pulled back onto the
+    leaders (:meth:`Coupling.pull_back
+    <drakegrasp.plant.fingers.Coupling.pull_back>`).
+    """
+    lower, upper = structure.lower, structure.upper
+    t = tips(q)
+    grad = np.zeros_like(q)
+    for j in range(len(q)):
+        e = np.zeros_like(q)
+        e[j] = h
+        tp, tm = (
+            tips(np.clip(q + e, lower, upper)),
+            tips(np.clip(q - e, lower, upper)),
+        )
+        spread_p = np.sum((tp - t.mean(axis=0)) ** 2)
+        spread_m = np.sum((tm - t.mean(axis=0)) ** 2)
+        grad[j] = (spread_p - spread_m) / (2 * h)
+    return structure.coupling.pull_back(grad)
 
 
 def _opened(tips, q0, structure, moves) -> np.ndarray:
@@ -342,38 +364,23 @@ def _opened(tips, q0, structure, moves) -> np.ndarray:
     local: a finger curled shut past the others' tips spreads them further
     by curling on, and stays.
     """
-    own = np.array([_CURL_STEP[j.type_name() == "prismatic"] for j in structure.joints])
-    cap = structure.coupling.leader_steps(own, moves)
+    cap = _steps_of(structure, moves)
     span = (structure.upper - structure.lower)[cap > 0]
     if np.all(np.isfinite(span)):
         crossings = int(np.ceil(np.max(span / cap[cap > 0], initial=0.0)))
         steps = min(2 * crossings + 2, _OPEN_MAX_STEPS)
     else:  # a joint without limits turns as far as that parts the fingertips
         steps = _OPEN_MAX_STEPS
+    lower, upper = structure.lower, structure.upper
 
-    def spread(q):
+    def spread(q) -> float:
         t = tips(q)
         return float(np.sum((t - t.mean(axis=0)) ** 2))
 
-    return _ascend(spread, structure, cap, steps, q0)
-
-
-def _ascend(spread, structure, cap, steps: int, q0) -> np.ndarray:
-    """:func:`_opened`'s ascent of ``spread`` from ``q0``, at most ``steps`` steps."""
-    lower, upper = structure.lower, structure.upper
     q = structure.coupling.apply(np.clip(q0, lower, upper))
-    h = 1e-4
     current = spread(q)
     for _ in range(steps):
-        grad = np.zeros_like(q)
-        for j in range(len(q)):
-            e = np.zeros_like(q)
-            e[j] = h
-            grad[j] = (
-                spread(np.clip(q + e, lower, upper))
-                - spread(np.clip(q - e, lower, upper))
-            ) / (2 * h)
-        grad = structure.coupling.pull_back(grad)
+        grad = _spread_gradient(tips, q, structure)
         pinned = ((grad > 0) & (q >= upper)) | ((grad < 0) & (q <= lower))
         grad = np.where(pinned, 0.0, grad)
         scale = np.max(np.abs(grad), initial=0.0)
