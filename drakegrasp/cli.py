@@ -1750,7 +1750,8 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
         "m, within its limits; repeatable; 'model::joint' where names repeat); "
         "default the model's, and for --hand allegro the thumb opposed "
         "(joint_12=1.0); 'open': from there, each joint turned the way that "
-        "parts the fingertips, to its limit (an angular gripper shut at zero)",
+        "parts the fingertips, to its limit or as far as that parts them (an "
+        "angular gripper shut at zero)",
     )
     plan.add_argument(
         "--shake",

@@ -394,8 +394,9 @@ def plan_grasps(
         (:func:`~drakegrasp.planning.approach.multi_finger_hand`): the
         pre-shape over the closing joints (default the context's open hand;
         ``"open"``: the hand opened from there, each joint turned the way
-        that parts the fingertips, to its limit: an angular gripper whose
-        model's zero is nearly shut), a synergy direction and the range of
+        that parts the fingertips, to its limit or as far as that parts
+        them: an angular gripper whose model's zero is nearly shut), a
+        synergy direction and the range of
         its amount drawn per pose, the approach in the base frame H, the
         palm stand-off range (m).
     tilt : float, optional
@@ -645,9 +646,9 @@ def _finished(
     the scoped names of the hand's closing joints (each candidate's
     ``joint_names``, whose kinds set each one's ``torque_unit``, a jaw's
     too, and its ``motors``).  A joint that a coupling ties to a closing
-    joint moved with it: it is not held.  The names of the joints held with ``closing``
-    go to ``settings["held_joints"]``, so that a result without candidates
-    still knows its table's held-joint columns.
+    joint moved with it: it is not held.  The names of the joints held with
+    ``closing`` go to ``settings["held_joints"]``, so that a result without
+    candidates still knows its table's held-joint columns.
     """
     bodies = {int(b.index()) for b in hand_bodies(plant, anchor, hand)}
     joints = [plant.get_joint(j) for j in plant.GetJointIndices()]
