@@ -283,7 +283,7 @@ class GraspCandidate:
 
     @property
     def num_motors(self) -> int:
-        """Number of ``motors`` (0: not recorded)."""
+        """Number of ``motors`` (0: none known)."""
         return len(self.motors)
 
     def apply(self, plant, context, *, object_body=None) -> None:

@@ -353,7 +353,14 @@ def _actuated(plant, names) -> np.ndarray:
 
 
 def _outside_leaders(names: tuple[str, ...], couplings) -> tuple[str, ...]:
-    """The joints not in ``names`` that lead one of them, once each, in order."""
+    """The joints not in ``names`` that lead one of them, once each, in order.
+
+    Any leader, one with geometry too, where :func:`motor_limit` reads the
+    motors of a hidden drive alone: a candidate cut down to followers whose
+    leaders' motors lie outside it is a hand with motors, its followers
+    passive (``tests/planning/test_coupled_hand.py``), not a hand without
+    actuators whose every joint counts as a motor.
+    """
     inside = set(names)
     return tuple(
         dict.fromkeys(
