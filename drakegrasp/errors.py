@@ -30,6 +30,16 @@ class InvalidOptionError(GraspError, ValueError):
     """Options passed to a function conflict or are out of range."""
 
 
+class InvalidArgumentError(GraspError, TypeError):
+    """A call does not fit the function's signature.
+
+    Raised, where Python would raise a bare :class:`TypeError`, for an unknown
+    or misspelled keyword (the message names the closest one the function
+    takes), more positional arguments than the function takes (the message
+    names the keyword-only ones), and a missing or twice-given argument.
+    """
+
+
 class BatchFileError(InvalidOptionError):
     """A batch input or output file cannot be read or written as asked.
 

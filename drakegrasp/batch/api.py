@@ -30,6 +30,7 @@ from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_chunk, force_task, form_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import (
@@ -54,6 +55,7 @@ __all__ = [
 ]
 
 
+@checked_call
 @dataclass(frozen=True)
 class BatchClosureResult:
     """Closure verdicts of ``K`` grasps, as arrays.
@@ -304,6 +306,7 @@ def form_chunks(
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
 @takes_batch_options
+@checked_call
 def stream_force_closure(
     positions,
     normals,
@@ -390,6 +393,7 @@ def stream_force_closure(
 
 
 @takes_batch_options
+@checked_call
 def stream_form_closure(
     positions,
     normals,
@@ -446,6 +450,7 @@ def stream_form_closure(
 @keyword_only("mu", after=2)
 @accepts_ragged(merge_results, check=metric_moment_arms)
 @takes_batch_options
+@checked_call
 def batch_force_closure(
     positions: np.ndarray,
     normals: np.ndarray,
@@ -567,6 +572,7 @@ def batch_force_closure(
 
 @accepts_ragged(merge_results, check=metric_moment_arms)
 @takes_batch_options
+@checked_call
 def batch_form_closure(
     positions: np.ndarray,
     normals: np.ndarray,
@@ -626,6 +632,7 @@ def batch_form_closure(
     return collect(K, d, "form", options["tol"], options["metrics"], chunks)
 
 
+@checked_call
 def iter_batch_closure(
     chunks: Iterable[Mapping[str, np.ndarray] | tuple],
     *,

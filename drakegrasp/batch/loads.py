@@ -18,6 +18,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from drakegrasp.closure.load_forces import GraspForceResult, grasp_forces
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
@@ -77,6 +78,7 @@ def _per_grasp(name: str, value, K: int) -> list:
     return items
 
 
+@checked_call
 def batch_grasp_forces(
     grasps: Sequence[Grasp],
     wrenches: np.ndarray,

@@ -31,6 +31,7 @@ from drakegrasp.batch.inputs import (
 )
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE
 from drakegrasp.batch.run.workers import check_workers
+from drakegrasp.core.calls import checked_fields
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import (
@@ -38,7 +39,7 @@ from drakegrasp.core.tolerances import (
     DEFAULT_RANK_TOL,
     DEFAULT_TOL,
 )
-from drakegrasp.core.validation import check_flag, check_num_generators, checked_fields
+from drakegrasp.core.validation import check_flag, check_num_generators
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -114,13 +115,12 @@ class BatchOptions:
             object.__setattr__(self, name, value)
 
     def replace(self, **changes: Any) -> BatchOptions:
-        """A copy with ``changes`` (checked again); unknown names are refused."""
-        # model= (deprecated) reaches the constructor, which warns and renames it
-        unknown = sorted(set(changes) - set(OPTION_NAMES) - {"model"})
-        if unknown:
-            raise InvalidOptionError(
-                f"unknown batch option(s) {unknown}; valid: {list(OPTION_NAMES)}"
-            )
+        """A copy with ``changes`` (checked again); unknown names are refused.
+
+        The constructor refuses them (``checked_fields``), naming the closest
+        option; ``model=`` (deprecated) reaches it too, which warns and
+        renames it.
+        """
         return dataclasses.replace(self, **changes)
 
     def keywords(self) -> dict[str, Any]:

@@ -245,10 +245,23 @@ def accepts_ragged(
 
     def decorate(fn):
         @functools.wraps(fn)
-        def batch(positions, normals, **options):
-            if not is_ragged(positions):
-                return fn(positions, normals, **options)
-            return merge(*run_groups(fn, positions, normals, check, **options))
+        def batch(*args, **options):
+            # positions and normals by position or by name; a call that does
+            # not fit goes to ``fn`` as it is, whose check (checked_call)
+            # names what is wrong, as for any other call
+            if len(args) > 2:
+                return fn(*args, **options)
+            given = dict(zip(("positions", "normals")[: len(args)], args, strict=True))
+            named = {k: options[k] for k in ("positions", "normals") if k in options}
+            if given.keys() & named.keys():
+                return fn(*args, **options)
+            arrays = given | named
+            if len(arrays) < 2 or not is_ragged(arrays["positions"]):
+                return fn(*args, **options)
+            rest = {k: v for k, v in options.items() if k not in named}
+            return merge(
+                *run_groups(fn, arrays["positions"], arrays["normals"], check, **rest)
+            )
 
         return batch
 

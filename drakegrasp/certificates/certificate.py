@@ -68,6 +68,7 @@ from drakegrasp.certificates.kinds import (
     check_kind_and_cones,
 )
 from drakegrasp.certificates.text import describe_certificate
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.friction_cone import ConeLayout, cone_support, support_of
 from drakegrasp.core.grasp import (
@@ -103,6 +104,7 @@ and 1e-9 is their round-off.
 """
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class Certificate:
     """A witness of a closure verdict, in the grasp frame about ``p``.

@@ -15,6 +15,7 @@ from typing import Protocol
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import InvalidOptionError
 
@@ -46,6 +47,7 @@ Violations are scaled to 1 before they are compared with it.
 """
 
 
+@checked_call
 @dataclass(frozen=True)
 class CertificateCheck:
     """How well a certificate holds on a grasp, evaluated without a solver.

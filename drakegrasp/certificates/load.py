@@ -52,6 +52,7 @@ from drakegrasp.certificates.kinds import (
     CertificateCheck,
     check_kind_and_cones,
 )
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.friction_cone import ConeLayout, support_of
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.core.serialize import jsonable
@@ -76,6 +77,7 @@ _KINDS = (LOAD_NOT_HELD, PAYLOAD_BOUND)
 _CONES = ("polyhedral", "exact")
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class LoadCertificate:
     """A dual direction proving that no admissible contact forces hold a load.

@@ -49,6 +49,7 @@ from drakegrasp.closure.load_problem import (
     load_problem,
     saturating_joints,
 )
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp, grasp_matrix
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
@@ -74,6 +75,7 @@ force variables on the most sensitive joint), so the slack never depends on the
 size of the load or of the limits."""
 
 
+@checked_call
 @dataclass(frozen=True)
 class GraspForceVariables:
     """Decision variables of :func:`build_grasp_forces_program`.
@@ -110,6 +112,7 @@ class GraspForceVariables:
     margin: object = None
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class GraspForceResult:
     r"""Contact forces and joint torques that hold a load, or why none exist.
@@ -229,6 +232,7 @@ def _torque_weights(P: LoadProblem) -> tuple[np.ndarray, np.ndarray]:
     return use, lim[use]
 
 
+@checked_call
 def build_grasp_forces_program(
     grasp: Grasp,
     wrench: np.ndarray,
@@ -498,6 +502,7 @@ def _infeasible(P, w, objective, prog, result, F0) -> GraspForceResult:
     )
 
 
+@checked_call
 def grasp_forces(
     grasp: Grasp,
     wrench: np.ndarray,

@@ -39,6 +39,7 @@ from drakegrasp.closure.load_problem import (
     load_problem,
     saturating_joints,
 )
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
@@ -54,6 +55,7 @@ _AGREE = 1e-6
 """Relative gap allowed between the rescaled ``α*`` and its dual bound."""
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class MaxLoadResult:
     """The largest multiple of a load direction that the grasp holds.
@@ -125,6 +127,7 @@ class MaxLoadResult:
         return "\n".join(lines)
 
 
+@checked_call
 def build_max_load_program(
     grasp: Grasp,
     direction: np.ndarray,
@@ -327,6 +330,7 @@ def _held_without_limits(P: LoadProblem, d: np.ndarray) -> bool:
     return False
 
 
+@checked_call
 def max_load(
     grasp: Grasp,
     direction: np.ndarray,

@@ -41,6 +41,7 @@ from drakegrasp.closure.constraints import (
     add_linear_constraint,
     add_linear_equality_constraint,
 )
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import (
@@ -87,6 +88,7 @@ moves that error to about 1e-10 without changing the optimum.
 _FORMULATIONS = ("facets", "generators")
 
 
+@checked_call
 @dataclass(frozen=True)
 class ProgramVariables:
     """Decision variables of a closure program.
@@ -358,6 +360,7 @@ def _shared_balance_rows(grasp: Grasp, layout: ConeLayout, rank_tol: float):
     return per_grasp(grasp, ("balance rows", rank_tol, *_layout_key(layout)), compute)
 
 
+@checked_call
 def build_form_closure_program(
     grasp: Grasp,
     *,
@@ -392,6 +395,7 @@ def build_form_closure_program(
     return prog, ProgramVariables(d, f, np.arange(N))
 
 
+@checked_call
 def build_force_closure_program(
     grasp: Grasp,
     *,
@@ -445,6 +449,7 @@ def build_force_closure_program(
     return prog, ProgramVariables(d, forces, layout.columns, weights=lam, generators=S)
 
 
+@checked_call
 def build_exact_force_closure_program(
     grasp: Grasp,
     *,
@@ -488,6 +493,7 @@ def lp3_is_conic(grasp: Grasp) -> bool:
     return any(c.components in EXACT_CONE_COMPONENTS for c in layout.cones)
 
 
+@checked_call
 def build_internal_force_program(
     grasp: Grasp,
     hand_jacobian: np.ndarray,

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deferred import deferrable
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import ZERO_FRACTION, near_threshold
@@ -18,6 +19,7 @@ if TYPE_CHECKING:
 __all__ = ["ClosureResult", "InternalForceResult"]
 
 
+@checked_call
 @dataclass(frozen=True)
 class InternalForceResult:
     """LP3: an internal force with positive normals in ``N(G) ∩ N(Jᵀ)``, if any.
@@ -167,6 +169,7 @@ class InternalForceResult:
         return [lp3, null]
 
 
+@checked_call
 @dataclass(frozen=True)
 class ClosureResult:
     """Verdict of a form- or force-closure program.

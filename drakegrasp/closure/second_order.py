@@ -46,6 +46,7 @@ from drakegrasp.closure.constraints import (
 from drakegrasp.closure.programs import add_balance
 from drakegrasp.closure.results import ClosureResult
 from drakegrasp.closure.verdicts import form_closure
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.curvature import ContactCurvature, _skew, contact_hessians
 from drakegrasp.core.grasp import Grasp, normal_grasp_matrix
 from drakegrasp.core.linalg import left_null_space
@@ -245,6 +246,7 @@ def build_second_order_program(
     return prog, SecondOrderVariables(lam, t, S, B, T, A, H, lmi)
 
 
+@checked_call
 @dataclass(frozen=True)
 class SecondOrderResult:
     """Verdict of second-order form closure.
@@ -418,6 +420,7 @@ def _check_first_order(first_order, grasp: Grasp) -> None:
         )
 
 
+@checked_call
 def second_order_form_closure(
     grasp: Grasp,
     curvatures: Sequence[ContactCurvature],

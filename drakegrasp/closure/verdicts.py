@@ -33,6 +33,7 @@ from drakegrasp.closure.programs import (
     per_grasp,
 )
 from drakegrasp.closure.results import ClosureResult, InternalForceResult
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deferred import defer, parts, replace, resolve
 from drakegrasp.core.grasp import (
     Grasp,
@@ -89,6 +90,7 @@ def _split_forces(
     return tuple(full[s].copy() for s in grasp.component_slices())
 
 
+@checked_call
 def form_closure(
     grasp: Grasp,
     *,
@@ -168,6 +170,7 @@ def _form_closure_solution(grasp: Grasp, tol: float, rank_tol: float) -> tuple:
     return d_star, relative_margin(d_star, tol), forces, solver, status
 
 
+@checked_call
 def internal_forces(
     grasp: Grasp,
     hand_jacobian: np.ndarray,
@@ -397,6 +400,7 @@ def _normal_force_certificate(
     return relative_margin(d_star, tol), _split_forces(grasp, normals, f_n)
 
 
+@checked_call
 def force_closure(
     grasp: Grasp,
     *,
@@ -463,6 +467,7 @@ def force_closure(
     )
 
 
+@checked_call
 def force_closure_exact(
     grasp: Grasp,
     *,

@@ -16,6 +16,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
@@ -28,6 +29,7 @@ DEFAULT_ANGLE_TOL = 1e-9
 """Angles may exceed ``atan μ`` by this much (rad) and still count as inside."""
 
 
+@checked_call
 @dataclass(frozen=True)
 class AntipodalResult:
     """Antipodal check of a two-contact grasp.
@@ -143,6 +145,7 @@ def _angle(u: np.ndarray, v: np.ndarray) -> float:
     return float(np.arctan2(np.linalg.norm(cross), np.dot(u, v)))
 
 
+@checked_call
 def is_antipodal(
     grasp_or_contacts: Grasp | Sequence[Contact],
     *,

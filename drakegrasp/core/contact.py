@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call, checked_fields
 from drakegrasp.core.deprecation import renamed_keyword, warn_deprecated
 from drakegrasp.core.tolerances import UNIT_NORMAL_TOL
 from drakegrasp.core.validation import (
@@ -78,6 +79,7 @@ def missing_torsional_friction(error: type = InvalidContactError) -> Exception:
     )
 
 
+@checked_call
 def contact_frames(normals: np.ndarray) -> np.ndarray:
     """Contact frames ``R = [n, t1, t2]`` (or ``[n, t]``) for many unit normals.
 
@@ -139,6 +141,7 @@ def contact_frames(normals: np.ndarray) -> np.ndarray:
     return np.stack([n, t1, t2], axis=-1)
 
 
+@checked_call
 def contact_frame(normal: np.ndarray) -> np.ndarray:
     """Contact frame ``R_i`` of one unit normal; see :func:`contact_frames`.
 
@@ -176,6 +179,7 @@ def _frozen(a: np.ndarray) -> np.ndarray:
 
 
 @renamed_keyword("model", "contact_model")
+@checked_fields("keyword")  # an option error, as for the options objects
 @dataclass(frozen=True, eq=False)
 class Contact:
     """One contact between a finger and the object.
@@ -231,12 +235,7 @@ class Contact:
         mu: float = 0.0,
         contact_model: ContactModel | str = ContactModel.HARD_FINGER,
         torsional_friction: float | None = None,
-        **unknown,
     ) -> None:
-        if unknown:  # an option error, as checked_fields gives the options objects
-            raise InvalidOptionError(
-                f"Contact() got unexpected keyword(s) {sorted(unknown)}"
-            )
         p = check_positions("contact position", position)
         if p.ndim > 1 and p.size in (2, 3):
             p = p.reshape(-1)

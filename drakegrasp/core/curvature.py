@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.validation import real_array, real_scalar, unit_vectors
 from drakegrasp.errors import InvalidContactError
@@ -82,6 +83,7 @@ def _skew(x: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
 
 
+@checked_call
 @dataclass(frozen=True)
 class SurfaceCurvature:
     """Principal curvatures of one surface at a contact point.
@@ -260,6 +262,7 @@ def _radius(radius: float) -> float:
     return r
 
 
+@checked_call
 @dataclass(frozen=True)
 class ContactCurvature:
     """The object's and the finger's curvature at one contact.

@@ -24,15 +24,15 @@ __all__ = ["keyword_only", "outside_stacklevel", "renamed_keyword", "warn_deprec
 F = TypeVar("F", bound=Callable)
 
 
-def warn_deprecated(message: str, *, stacklevel: int | None = 3) -> None:
+def warn_deprecated(message: str, *, stacklevel: int | None = None) -> None:
     """Warn with a :class:`DeprecationWarning` attributed to the user's line.
 
-    ``stacklevel`` counts as ``warnings.warn`` does, from this function
-    (3: the caller of the function that calls this one).  ``None`` (used by the
-    decorators here) attributes the warning to the first frame outside
-    drakegrasp and ``dataclasses``, however many wrappers are stacked (a
-    ``dataclasses.replace`` or an internal call that passes the user's keyword
-    on is not where the old spelling was written).
+    ``stacklevel`` counts as ``warnings.warn`` does, from this function (3:
+    the caller of the function that calls this one).  ``None``, the default,
+    attributes the warning to the first frame outside drakegrasp and
+    ``dataclasses``, however many wrappers are stacked (the check of a public
+    call's arguments, a ``dataclasses.replace``, an internal call that passes
+    the user's keyword on: none is where the old spelling was written).
     """
     if stacklevel is None:
         stacklevel = outside_stacklevel()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.grasp import Grasp
@@ -21,6 +22,7 @@ __all__ = [
 ]
 
 
+@checked_call
 def planar_two_finger_square(
     mu: float, *, half_width: float = 1.0, offset: float = 0.5
 ) -> Grasp:
@@ -54,6 +56,7 @@ def planar_two_finger_square(
     )
 
 
+@checked_call
 def planar_square_four_contacts(half_width: float = 1.0) -> Grasp:
     """Four frictionless contacts in first-order form closure on a square.
 
@@ -93,6 +96,7 @@ _CUBE_CONTACTS = (  # (position on the cube [-1, 1]^3, inward normal)
 )
 
 
+@checked_call
 def cube_seven_contacts(half_width: float = 1.0) -> Grasp:
     """Seven frictionless contacts in first-order form closure on a cube.
 
@@ -122,6 +126,7 @@ def cube_seven_contacts(half_width: float = 1.0) -> Grasp:
 
 
 @renamed_keyword("model", "contact_model")
+@checked_call
 def equator_fingers(
     mu: float,
     *,
@@ -168,6 +173,7 @@ def equator_fingers(
 
 
 @renamed_keyword("model", "contact_model")
+@checked_call
 def spatial_two_fingers(
     mu: float,
     *,

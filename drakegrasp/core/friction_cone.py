@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp, grasp_matrix
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
@@ -242,6 +243,7 @@ def _cone(comps: tuple[int, ...], mu: float, n_g: int, torsion: float) -> Effect
     return EffectiveCone(comps, S, F)
 
 
+@checked_call
 def friction_cone_generators(
     contact: Contact,
     num_generators: int = DEFAULT_NUM_GENERATORS,
@@ -276,6 +278,7 @@ def friction_cone_generators(
     return S
 
 
+@checked_call
 def friction_cone_facets(
     contact: Contact,
     num_generators: int = DEFAULT_NUM_GENERATORS,

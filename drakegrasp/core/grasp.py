@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deprecation import renamed_keyword, warn_deprecated
 from drakegrasp.core.validation import (
@@ -42,6 +43,7 @@ __all__ = [
 ]
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class Grasp:
     """Contacts on one object, all expressed in one frame.
@@ -296,6 +298,7 @@ def _contact_block(contact: Contact, p: np.ndarray) -> np.ndarray:
     return block
 
 
+@checked_call
 def grasp_matrix(grasp: Grasp) -> np.ndarray:
     r"""Grasp matrix ``G`` mapping contact forces to the object wrench.
 
@@ -333,6 +336,7 @@ def grasp_matrix(grasp: Grasp) -> np.ndarray:
     return _require_grasp(grasp)._grasp_matrix.copy()
 
 
+@checked_call
 def normal_grasp_matrix(grasp: Grasp) -> np.ndarray:
     """Grasp matrix ``G_n`` of the normal components only.
 
@@ -349,6 +353,7 @@ def normal_grasp_matrix(grasp: Grasp) -> np.ndarray:
     return _require_grasp(grasp)._grasp_matrix[:, grasp.normal_indices()]
 
 
+@checked_call
 def invariant_grasp_matrix(grasp: Grasp) -> np.ndarray:
     r"""``G`` made invariant to units and to the reference point, for rank tests.
 
@@ -383,6 +388,7 @@ def invariant_grasp_matrix(grasp: Grasp) -> np.ndarray:
     return _require_grasp(grasp)._invariant_grasp_matrix.copy()
 
 
+@checked_call
 def normalised_grasp_matrix(grasp: Grasp) -> np.ndarray:
     """Deprecated name of :func:`invariant_grasp_matrix` (``T G``).
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.tolerances import DEFAULT_RANK_TOL
 from drakegrasp.core.validation import check_rank_tol, real_array, safe_norm
 from drakegrasp.errors import InvalidOptionError
@@ -42,6 +43,7 @@ against 0.14 ms at 768) and a full ``V`` of a 6 x 30,000 matrix is 7.2 GB.
 """
 
 
+@checked_call
 def matrix_rank(A: np.ndarray, *, rank_tol: float = DEFAULT_RANK_TOL) -> int:
     """Numerical rank: singular values above ``rank_tol * σ_max``.
 

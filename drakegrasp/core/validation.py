@@ -47,8 +47,6 @@ object arrays.
 
 from __future__ import annotations
 
-import dataclasses
-import functools
 import numbers
 import operator
 import sys
@@ -86,7 +84,6 @@ __all__ = [
     "check_positions",
     "check_rank_tol",
     "check_tol",
-    "checked_fields",
     "describe",
     "integer_or_none",
     "outside_moment_arms",
@@ -522,46 +519,3 @@ def check_distance_tolerance(value) -> float:
             "count as touching; the unit is metres (the default 0.1 mm is 1e-4)"
         )
     return tol
-
-
-def checked_fields(what: str):
-    """Class decorator: a dataclass's constructor refuses unknown arguments.
-
-    Parameters
-    ----------
-    what : str
-        What the class holds, for the message ("analysis option").
-
-    Returns
-    -------
-    decorator
-        Wraps the dataclass's ``__init__`` so that an unknown keyword or too many
-        positional arguments raise :class:`~drakegrasp.InvalidOptionError`
-        naming them and the valid fields, not Python's ``TypeError``.
-    """
-
-    def decorate(cls):
-        names = [f.name for f in dataclasses.fields(cls) if f.init]
-        init = cls.__init__
-
-        @functools.wraps(init)
-        def __init__(self, /, *args, **kwargs):  # self=1 is an unknown field
-            unknown = sorted(set(kwargs) - set(names))
-            if unknown:
-                raise InvalidOptionError(f"unknown {what}(s) {unknown}; valid: {names}")
-            if len(args) > len(names):
-                raise InvalidOptionError(
-                    f"{cls.__name__} takes at most {len(names)} {what}s, "
-                    f"got {len(args)} by position"
-                )
-            given_twice = sorted(set(names[: len(args)]) & set(kwargs))
-            if given_twice:
-                raise InvalidOptionError(
-                    f"{cls.__name__} got {given_twice} both by position and by name"
-                )
-            init(self, *args, **kwargs)
-
-        cls.__init__ = __init__
-        return cls
-
-    return decorate

@@ -23,9 +23,11 @@ the Parquet shards).  See ``docs/distributed.md`` for pointing it at a cluster.
 
 from __future__ import annotations
 
+import inspect
 import os
 import re
 import uuid
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +49,7 @@ from drakegrasp.batch.options import (
 )
 from drakegrasp.batch.run.chunk import check_form_metrics
 from drakegrasp.batch.run.stream import chunk_size_for
+from drakegrasp.core.calls import checked_call, unknown_names
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
@@ -61,7 +64,12 @@ from drakegrasp.distributed.dataset import (
     shard_path,
     write_shard,
 )
-from drakegrasp.errors import GraspError, InvalidContactError, InvalidOptionError
+from drakegrasp.errors import (
+    GraspError,
+    InvalidArgumentError,
+    InvalidContactError,
+    InvalidOptionError,
+)
 
 __all__ = [
     "evaluate_on_cluster",
@@ -139,6 +147,7 @@ def _partition(
 
 
 @keyword_only("mu", after=3)
+@checked_call
 def evaluate_on_cluster(
     client,
     positions,
@@ -209,6 +218,7 @@ def evaluate_on_cluster(
     """
     if kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
+    _refuse_unknown(keywords, kind, evaluate_on_cluster)
     options, chunk_size = _engine_options(options, keywords, kind, chunk_size)
     if "metrics" in options:  # read once: an iterator would reach no partition
         options["metrics"] = check_metrics(options["metrics"])
@@ -296,6 +306,29 @@ def evaluate_on_cluster(
     return collect(K, d, kind, tol, names, chunks)
 
 
+def _refuse_unknown(keywords: dict, kind: str, caller: Callable) -> None:
+    """Refuse keywords that neither ``caller`` nor the engine takes, at once.
+
+    The partitions would refuse them, each on its worker, after the cluster
+    was reached; this names them (with the closest accepted one) first.
+    """
+    run = stream_force_closure if kind == "force" else stream_form_closure
+    named = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    accepted = [
+        name
+        for function in (caller, run)
+        for name, p in inspect.signature(function).parameters.items()
+        if p.kind in named and name not in ("positions", "normals")
+    ]
+    accepted = list(dict.fromkeys(accepted))
+    # model=: the engine's old spelling of contact_model=, renamed (with its
+    # warning) where the engine runs
+    unknown = [name for name in keywords if name not in (*accepted, "model")]
+    if unknown:
+        where = f"{caller.__qualname__}()"
+        raise InvalidArgumentError(f"{where}: " + unknown_names(unknown, accepted))
+
+
 def _engine_options(
     options: BatchOptions | None, keywords: dict, kind: str, chunk_size
 ) -> tuple[dict, int | None]:
@@ -327,6 +360,7 @@ def _engine_options(
     return merged, chunk_size
 
 
+@checked_call
 def stream_file_on_cluster(
     input_path, output_path, *, scheduler: str, fmt: str | None = None,
     workers=None, progress: bool = False, kind: str = "force", mu=None,
@@ -349,6 +383,7 @@ def stream_file_on_cluster(
     from drakegrasp.batch.files.writer import BatchSummary
 
     del workers, progress, fmt  # the cluster decides; output is always a dataset
+    _refuse_unknown(options, kind, stream_file_on_cluster)
     source = as_path("input", input_path)
     data = read_grasps(source)
     extra = engine_options(

@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import BatchFileError, InvalidOptionError
@@ -329,6 +330,7 @@ def shard_is_done(shard: Path, job: str, rows: int) -> bool:
     return shard.exists() and _shard_problem(shard, job, rows) is None
 
 
+@checked_call
 def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
     """The arrays of a dataset of :func:`evaluate_on_cluster`, shards in order.
 

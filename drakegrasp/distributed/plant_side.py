@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.validation import integer_or_none
 from drakegrasp.distributed.client import connected
 from drakegrasp.errors import GraspError, InvalidOptionError
@@ -28,6 +29,7 @@ def _scene(name: str):
     return _SCENES[name]
 
 
+@checked_call
 def cached_scenes() -> list[str]:
     """Names of the scenes this process has loaded (run on a worker to inspect)."""
     return sorted(_SCENES)
@@ -72,6 +74,7 @@ def _analyze_block(
     return out
 
 
+@checked_call
 def analyze_poses(
     client,
     scene: str,

@@ -65,6 +65,7 @@ import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import RigidBody
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.centring import chain_sides
 from drakegrasp.planning.gripper import free_base
@@ -113,6 +114,7 @@ _OPEN_SHARES = (1.0, 0.5, 0.25, 0.125, 0.0625)
 first, before it stops: it ends within 1/16 of a step of the most spread."""
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class MultiFingerHand:
     """A multi-finger hand as the planner sees it, in its base frame H.
@@ -398,6 +400,7 @@ def _opened(tips, q0, structure, moves) -> np.ndarray:
     return q
 
 
+@checked_call
 def multi_finger_hand(
     plant,
     plant_context,

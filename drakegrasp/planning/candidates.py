@@ -24,6 +24,7 @@ from pydrake.math import RigidTransform
 
 from drakegrasp.batch.run.stream import progress_bar
 from drakegrasp.closure.results import ClosureResult
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
@@ -68,6 +69,7 @@ def pose_dict(X: RigidTransform) -> dict:
     }
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class GraspCandidate:
     """One planned grasp.
@@ -573,6 +575,7 @@ def check_candidate(candidate: GraspCandidate) -> np.ndarray:
     return values["q_hand"]
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class GraspCandidates(Sequence):
     """Ranked planned grasps, best first, and why the other samples were dropped.

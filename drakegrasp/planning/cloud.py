@@ -348,7 +348,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
                     "(Drake fills a new field with NaN: never set?); estimating "
                     "the normals from the points, as for a cloud without one",
                     PointCloudWarning,
-                    stacklevel=3,
+                    stacklevel=outside_stacklevel(),
                 )
                 normals = None
     else:
@@ -493,7 +493,7 @@ def _warn_of(points: np.ndarray, total: int) -> None:
             "finite (NaN marks missing depth; with cloud_normals, a point whose "
             f"normal is not finite too); planning on the other {len(points)}",
             PointCloudWarning,
-            stacklevel=4,
+            stacklevel=outside_stacklevel(),
         )
     extent = float(np.max(np.ptp(points, axis=0)))
     if extent > CLOUD_UNITS_EXTENT:
@@ -502,7 +502,7 @@ def _warn_of(points: np.ndarray, total: int) -> None:
             f"more than {CLOUD_UNITS_EXTENT:g} m: a cloud is in metres; if this "
             f"one is in millimetres, divide it by 1000 ({extent / 1000:.4g} m)",
             PointCloudWarning,
-            stacklevel=4,
+            stacklevel=outside_stacklevel(),
         )
     if extent < CLOUD_SMALL_EXTENT:
         warnings.warn(
@@ -511,7 +511,7 @@ def _warn_of(points: np.ndarray, total: int) -> None:
             "than what a hand grasps: a cloud is in metres; if this one was "
             f"divided by 1000 twice, multiply it by 1000 ({extent * 1e3:.4g} m)",
             PointCloudWarning,
-            stacklevel=4,
+            stacklevel=outside_stacklevel(),
         )
 
 

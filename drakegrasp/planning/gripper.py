@@ -38,6 +38,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, Joint, RigidBody
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import ModelError
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.attachment import chain_to_world, free_carrier, how_held
@@ -54,6 +55,7 @@ _LATERAL_MIN = 1e-3
 """The pads' centre must lie this far (m) from the palm's across the axis."""
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class ParallelJaw:
     """Geometry of a two-finger prismatic gripper, in its base frame H.
@@ -265,6 +267,7 @@ def _finger_supports(plant, ctx, inspector, finger, base, a_H, sign):
     return ids, np.array(supports), np.array(centres)
 
 
+@checked_call
 def parallel_jaw(
     plant: MultibodyPlant, plant_context, object_body: RigidBody, hand: HandSpec
 ) -> ParallelJaw:

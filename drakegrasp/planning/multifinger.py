@@ -51,6 +51,7 @@ from collections import Counter
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.errors import (
     InvalidOptionError,
@@ -116,6 +117,7 @@ REASONS = {
 """Every rejection reason of the multi-finger route, with what it means."""
 
 
+@checked_call
 def hand_is_parallel_jaw(plant, plant_context, object_body, hand) -> bool:
     """Whether ``hand`` is two fingers of one prismatic joint each (in the plant)."""
     bodies = hand_bodies(plant, object_body, hand)

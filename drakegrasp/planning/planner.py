@@ -39,6 +39,7 @@ import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import RigidBody
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import (
@@ -170,6 +171,7 @@ def _mass_of(ctx, body, object_mass) -> float:
     return mass if mass > 0 else float("nan")
 
 
+@checked_call
 def object_surface(plant, plant_context, object_body) -> ObjectSurface:
     """The object's collision geometry as convex pieces in its body frame O."""
     ctx = plant_context_of(plant, plant_context)
@@ -217,6 +219,7 @@ def _check_positive(name: str, value, unit: str) -> float:
     return value
 
 
+@checked_call
 def plan_grasps(
     plant,
     plant_context,

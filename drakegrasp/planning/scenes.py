@@ -18,6 +18,7 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import add_models as add_coupled_models
 from drakegrasp.plant.models import (
@@ -35,6 +36,7 @@ WSG_URL = "package://drake_models/wsg_50_description/sdf/schunk_wsg_50_with_tip.
 """Drake's Schunk WSG-50 with its four tip spheres per finger."""
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class PlanningScene:
     """A built planning scene.
@@ -59,6 +61,7 @@ class PlanningScene:
     add_models: Any
 
 
+@checked_call
 def planning_scene(
     object_url: str | None = None,
     *,
@@ -160,6 +163,7 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
     return pairs
 
 
+@checked_call
 def scene_from_models(add_models) -> PlanningScene:
     """A planning scene built by a recipe of one's own (time step 0).
 

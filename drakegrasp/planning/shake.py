@@ -63,6 +63,8 @@ from pydrake.multibody.tree import PdControllerGains, SpatialInertia, UnitInerti
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
+from drakegrasp.core.calls import checked_call
+from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.validation import unit_vectors
 from drakegrasp.errors import (
     GraspError,
@@ -185,7 +187,7 @@ def _warn_friction(plant, ctx, body, hand, candidate: GraspCandidate) -> None:
         "at that friction (plan with the models' friction, or set their "
         "coulomb_friction to the plan's, to plan and shake alike)",
         FrictionMismatchWarning,
-        stacklevel=3,
+        stacklevel=outside_stacklevel(),
     )
 
 
@@ -717,10 +719,11 @@ def _warn_at_stops(stopped: list[str]) -> None:
             "joint needs it to close further than the model allows: choose a "
             "candidate that leaves it room (or give the model its true range)",
             SqueezeLostWarning,
-            stacklevel=3,
+            stacklevel=outside_stacklevel(),
         )
 
 
+@checked_call
 def shake_test(
     add_models: Callable,
     candidate: GraspCandidate,
@@ -923,7 +926,7 @@ def shake_test(
             "hydroelastic_modulus= (1e6 Pa, rubber) for fingers that press "
             "over patches",
             SoftFingerShakeWarning,
-            stacklevel=2,
+            stacklevel=outside_stacklevel(),
         )
     t0 = time.perf_counter()
     builder = DiagramBuilder()
@@ -1157,7 +1160,7 @@ def shake_test(
             f"closed on (pads that give, a finger that touched nothing); lower "
             f"the stiffness (or raise the squeeze) for the squeeze to hold",
             SqueezeLostWarning,
-            stacklevel=2,
+            stacklevel=outside_stacklevel(),
         )
     stopped = (
         _at_stops(plant, ctx, squeezing, targets, efforts, effort_units)

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call, unknown_names
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import (
     InvalidGraspError,
@@ -120,6 +121,7 @@ class ShakenCandidate:
         )
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class ShakenCandidates(Sequence):
     """Shaken candidates: those that held first, each group in the planner's order.
@@ -298,8 +300,7 @@ def check_settings(top, held_from, options: dict) -> dict:
     unknown = sorted(set(options) - set(_OPTIONS))
     if unknown:
         raise InvalidOptionError(
-            f"shake_test takes no option {', '.join(unknown)} (it takes "
-            f"{', '.join(sorted(_OPTIONS))})"
+            "shake_test(): " + unknown_names(unknown, sorted(_OPTIONS), noun="option")
         )
     settings = {**_OPTIONS, **options}
     check_shake_options(
@@ -310,6 +311,7 @@ def check_settings(top, held_from, options: dict) -> dict:
     return settings
 
 
+@checked_call
 def shake_candidates(
     add_models: Callable,
     candidates: GraspCandidates | Sequence[GraspCandidate],

@@ -13,6 +13,7 @@ import numpy as np
 from pydrake.math import RigidTransform
 
 from drakegrasp.closure.load_problem import effort_unit_of
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
@@ -20,6 +21,7 @@ from drakegrasp.errors import InvalidOptionError
 __all__ = ["ShakeResult", "motion_text", "squeeze_unit_of"]
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class ShakeResult:
     """What the shake test saw.

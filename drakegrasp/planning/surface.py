@@ -47,6 +47,7 @@ from pydrake.geometry import (
 )
 from pydrake.math import RigidTransform
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import ModelError
 from drakegrasp.plant.mesh_convexity import NON_CONVEX_SHARE as NON_CONVEX_SHARE
 from drakegrasp.plant.mesh_convexity import NonConvexMeshWarning as NonConvexMeshWarning
@@ -425,6 +426,7 @@ def piece_of_shape(shape: Shape, X_OG: RigidTransform, name: str = "") -> Piece:
     return Piece(kind, X_OG, name, axes, empty, np.zeros(0), np.zeros((0, 3, 3)))
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class ObjectSurface:
     """The union of an object's convex collision pieces, in its body frame O.

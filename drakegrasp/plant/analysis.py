@@ -31,6 +31,7 @@ from drakegrasp.closure.verdicts import (
     with_internal_forces,
 )
 from drakegrasp.core.antipodal import AntipodalResult, is_antipodal
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deferred import defer, deferrable
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
@@ -86,6 +87,7 @@ PLANE_NORMAL_TOL = 1e-6
 """A planar analysis needs every normal's out-of-plane component below this."""
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class GraspFromPlant:
     """A grasp read from a plant, with its Jacobians.
@@ -211,6 +213,7 @@ def _core_contact(
     )
 
 
+@checked_call
 def grasp_from_plant(
     plant: MultibodyPlant,
     plant_context: Context,
@@ -465,6 +468,7 @@ def _pose_of(
     return found
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class GraspReport:
     """Everything drakegrasp says about the grasp in a plant's configuration.
@@ -626,6 +630,7 @@ class GraspReport:
         return "\n".join(lines)
 
 
+@checked_call
 def analyze_grasp(
     plant: MultibodyPlant,
     plant_context: Context,

@@ -72,6 +72,7 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import check_distance_tolerance
 from drakegrasp.errors import (
@@ -115,6 +116,7 @@ DEFAULT_MAX_ITERATIONS = 100
 """Default bound on the steps of each finger."""
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class FingerClosure:
     """Where one finger stopped.
@@ -155,6 +157,7 @@ class FingerClosure:
         return dict(vars(self))
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class HandClosure:
     """The result of :func:`close_hand`.
@@ -285,6 +288,7 @@ class HandClosure:
         return "\n".join(lines)
 
 
+@checked_call
 def close_hand(
     plant: MultibodyPlant,
     plant_context: Context,

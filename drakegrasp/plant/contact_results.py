@@ -28,6 +28,7 @@ from pydrake.geometry import ContactSurface, GeometryId, QueryObject
 from pydrake.multibody.plant import ContactResults, MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.validation import real_array, unit_vectors
 from drakegrasp.errors import (
     InvalidContactError,
@@ -125,6 +126,7 @@ def _surface_points_and_normal(
     return vertices, np.asarray(normal, dtype=float)
 
 
+@checked_call
 def contacts_from_results(
     plant: MultibodyPlant,
     plant_context: Context,

@@ -59,6 +59,7 @@ from pydrake.multibody.tree import (
 )
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import (
     check_distance_tolerance,
@@ -110,6 +111,7 @@ __all__ = [
 _scoped_name = scoped_name  # the name other modules of the plant layer import
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class PlantContact:
     """One contact between a finger geometry and the object.
@@ -391,6 +393,7 @@ def _label(body: str, name: str, index: int | None) -> str:
     return where if index is None else f"{where}#{index}"
 
 
+@checked_call
 def find_contacts(
     plant: MultibodyPlant,
     plant_context: Context,

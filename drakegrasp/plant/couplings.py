@@ -53,6 +53,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import coupling_entries, coupling_entry, joint_name
@@ -81,6 +82,7 @@ __all__ = [
 _DRAKE_NS = "{http://drake.mit.edu}"
 
 
+@checked_call
 class JointCoupling(NamedTuple):
     """``q_follower = gear_ratio * q_leader + offset`` (Drake's coupler constraint).
 
@@ -345,6 +347,7 @@ def record_model_couplings(
             )
 
 
+@checked_call
 def add_models(
     parser: Parser,
     file_name: str | Path | None = None,
@@ -526,6 +529,7 @@ def _limit_value(text: str | None, missing: float, kind: str) -> float | None:
     return float(number.group(1)) if number else None
 
 
+@checked_call
 def add_coupler_constraint(
     plant: MultibodyPlant,
     joint_0: Joint,
@@ -552,6 +556,7 @@ def add_coupler_constraint(
     return cid
 
 
+@checked_call
 def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
     """The couplings to use: ``couplings`` when given, else those of the plant.
 

@@ -42,6 +42,7 @@ from pydrake.geometry import (
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.curvature import ContactCurvature, SurfaceCurvature
 from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import flat_faces, surface_pieces
@@ -241,6 +242,7 @@ def _in_plane(k: SurfaceCurvature, n_O: np.ndarray, axes) -> SurfaceCurvature:
     return SurfaceCurvature((total,))
 
 
+@checked_call
 def contact_curvatures(
     plant: MultibodyPlant,
     plant_context: Context,

@@ -37,6 +37,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, JointIndex
 
 from drakegrasp.core.antipodal import AntipodalResult, is_antipodal
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.plant.validation import scoped_name
@@ -190,6 +191,7 @@ def _best_on_arcs(V, n1, m2) -> np.ndarray:
     return best[1]
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class FingerAntipodal:
     """The antipodal test of a two-finger hand, one patch per finger.

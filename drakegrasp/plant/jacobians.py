@@ -28,6 +28,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable, JointIndex, RigidBody
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.validation import check_grasp
@@ -52,6 +53,7 @@ __all__ = [
 ]
 
 
+@checked_call
 def hand_velocity_indices(
     plant: MultibodyPlant, bodies: Iterable[RigidBody]
 ) -> np.ndarray:
@@ -119,6 +121,7 @@ def _finger_jacobians(plant, context, contacts, frame_O):
     return out
 
 
+@checked_call
 def signed_distance_jacobian(
     plant: MultibodyPlant,
     plant_context: Context,
@@ -167,6 +170,7 @@ def signed_distance_jacobian(
     return np.array(rows).reshape(len(contacts), plant.num_velocities())
 
 
+@checked_call
 def hand_jacobian(
     plant: MultibodyPlant,
     plant_context: Context,

@@ -38,6 +38,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import PrismaticJoint
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.plant.couplings import JointCoupling
 from drakegrasp.plant.fingers import HandStructure
 from drakegrasp.plant.validation import scoped_name
@@ -54,6 +55,7 @@ PARALLEL_AXIS_TOL = np.deg2rad(1.0)
 """Largest angle (radians) between two jaws' axes of a parallel gripper."""
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class ParallelJaws:
     """The two jaws of a parallel gripper (see the module docstring).
@@ -117,6 +119,7 @@ def _jaw_pairs(plant, hand: HandStructure, position: int) -> tuple:
     )
 
 
+@checked_call
 def parallel_jaws(
     plant: MultibodyPlant, plant_context: Context, hand: HandStructure, query
 ) -> ParallelJaws | None:
@@ -176,6 +179,7 @@ def parallel_jaws(
     )
 
 
+@checked_call
 @dataclass(frozen=True)
 class JawContact:
     """How far one jaw of a parallel gripper is from the object.

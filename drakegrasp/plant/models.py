@@ -19,6 +19,7 @@ from pathlib import Path
 from pydrake.multibody.parsing import PackageMap, Parser
 from pydrake.multibody.plant import MultibodyPlant
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import GraspError, InvalidOptionError, ModelError
 
 __all__ = [
@@ -186,6 +187,7 @@ def load_models(where: str, read, *args, **kwargs):
 
 
 @functools.cache
+@checked_call
 def models_dir() -> Path:
     """Absolute path of the directory that holds ``package.xml`` and the models.
 
@@ -215,6 +217,7 @@ def models_dir() -> Path:
     )
 
 
+@checked_call
 def register_models(parser_or_package_map: Parser | PackageMap) -> PackageMap:
     """Make ``package://drakegrasp/...`` resolve in a Drake parser or package map.
 
@@ -246,6 +249,7 @@ def register_models(parser_or_package_map: Parser | PackageMap) -> PackageMap:
     return package_map
 
 
+@checked_call
 def use_local_drake_models(
     parser_or_package_map: Parser | PackageMap, path: str | os.PathLike | None = None
 ) -> PackageMap:

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_fields
 from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.serialize import jsonable
@@ -33,7 +34,6 @@ from drakegrasp.core.validation import (
     check_length,
     check_num_generators,
     check_tol,
-    checked_fields,
     describe,
     real_array,
     real_scalar,
@@ -245,14 +245,12 @@ class AnalysisOptions:
                 )
 
     def replace(self, **changes: Any) -> AnalysisOptions:
-        """A copy with ``changes`` (validated again); unknown names are refused."""
-        # model= (deprecated) reaches the constructor, which warns and renames it
-        unknown = sorted(set(changes) - {f.name for f in fields(self)} - {"model"})
-        if unknown:
-            raise InvalidOptionError(
-                f"unknown analysis option(s) {unknown}; valid: "
-                f"{[f.name for f in fields(self)]}"
-            )
+        """A copy with ``changes`` (validated again); unknown names are refused.
+
+        The constructor refuses them (``checked_fields``), naming the closest
+        option; ``model=`` (deprecated) reaches it too, which warns and
+        renames it.
+        """
         return dataclasses.replace(self, **changes)
 
     def require_friction(self) -> AnalysisOptions:

@@ -24,6 +24,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JointIndex, RigidBody
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import (
     CouplingError,
     InvalidPoseError,
@@ -113,6 +114,7 @@ JOINT_LIMIT_REMEDY = "pass check_pose=False to analyse it anyway"
 """The remedy of a :class:`JointLimitError` raised by a pose check (Python)."""
 
 
+@checked_call
 @dataclass(frozen=True)
 class PoseCheck:
     """What :func:`check_pose` found.

@@ -21,6 +21,7 @@ import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import ModelError
 from drakegrasp.plant._shapes import bounding_sphere
 from drakegrasp.plant.validation import (
@@ -36,6 +37,7 @@ SCALE_NAME = "the radius about O's origin that bounds the object's collision geo
 """What the length of :func:`object_radius` is, in words for a report."""
 
 
+@checked_call
 def object_radius(plant: MultibodyPlant, plant_context: Context, object_body) -> float:
     """Radius of a sphere about the object's origin that holds its geometry.
 

@@ -157,6 +157,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.validation import check_coefficient, check_flag, describe
@@ -207,6 +208,7 @@ DEFAULT_SCENE = "parallel_jaw_box"
 """Name of the scene that ``drakegrasp analyze`` uses without an argument."""
 
 
+@checked_call
 @dataclass(frozen=True)
 class SceneInfo:
     """The ``drakegrasp:`` section of a scene file.
@@ -274,6 +276,7 @@ class SceneInfo:
     object_mass: float | None = None
 
 
+@checked_call
 @dataclass(frozen=True)
 class Scene:
     """A loaded scene: the diagram, its plant and the context the file sets.
@@ -359,6 +362,7 @@ def scenes_dir() -> Path:
     return models_dir() / "scenes"
 
 
+@checked_call
 def list_scenes() -> list[SceneInfo]:
     """The shipped scenes, sorted by name (the default scene included)."""
     return [read_scene_info(p) for p in sorted(scenes_dir().glob("*.yaml"))]
@@ -683,6 +687,7 @@ def _infer_hand(path: Path, plant: MultibodyPlant, object_body: RigidBody) -> st
     )
 
 
+@checked_call
 def load_scene(
     path_or_name: str | Path | None = None,
     *,

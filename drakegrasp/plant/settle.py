@@ -66,6 +66,7 @@ from pydrake.solvers import MathematicalProgram, SolutionResult
 from pydrake.systems.framework import Context
 
 from drakegrasp._solvers import require_solution, solve
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant._shapes import bounding_sphere
@@ -90,6 +91,7 @@ _START_RADIUS = 2e-3  # metres: the first trust region
 _LEVER = 0.05  # metres per radian: a revolute joint's trust region is r / _LEVER
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class SettleResult:
     """How the object moved to seat the fingers.
@@ -285,6 +287,7 @@ def build_settle_step(
     return prog, x
 
 
+@checked_call
 def settle_object(
     plant: MultibodyPlant,
     plant_context: Context,

@@ -27,6 +27,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, JointIndex, ModelInstanceIndex, RigidBody
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.core.tolerances import QUERY_POSE_TOL
 from drakegrasp.core.validation import describe, integer_or_none
@@ -714,6 +715,7 @@ def _welded_to_world(plant: MultibodyPlant) -> frozenset[int]:
     )
 
 
+@checked_call
 def hand_bodies(
     plant: MultibodyPlant, object_body: RigidBody, hand: HandSpec = None
 ) -> list[RigidBody]:

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, L1_MAX_POINTS
@@ -46,6 +47,7 @@ LINF_MAX_CANDIDATES = 2_000_000
 _NORMS = ("L1", "Linf")
 
 
+@checked_call
 def primitive_wrenches(
     grasp: Grasp,
     *,
@@ -610,6 +612,7 @@ def _linf_radius(wrenches: Sequence[np.ndarray], A: np.ndarray | None = None) ->
     return best
 
 
+@checked_call
 def ferrari_canny(
     grasp: Grasp,
     *,

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian
 from drakegrasp.quality._common import (
     RANK_TOL,
@@ -29,6 +30,7 @@ __all__ = [
 ]
 
 
+@checked_call
 def grasp_singular_values(
     grasp: Grasp, *, torque_scale: float | None = None
 ) -> np.ndarray:
@@ -73,6 +75,7 @@ def grasp_singular_values(
     return _padded_singular_values(_metric_grasp_matrix(grasp, b))
 
 
+@checked_call
 def min_singular_value(grasp: Grasp, *, torque_scale: float | None = None) -> float:
     """Smallest singular value ``σ_min(Ĝ)``: the worst-direction wrench gain.
 
@@ -83,6 +86,7 @@ def min_singular_value(grasp: Grasp, *, torque_scale: float | None = None) -> fl
     return float(grasp_singular_values(grasp, torque_scale=torque_scale)[-1])
 
 
+@checked_call
 def isotropy(grasp: Grasp, *, torque_scale: float | None = None) -> float:
     """Grasp isotropy index ``σ_min(Ĝ) / σ_max(Ĝ)`` in ``[0, 1]``.
 
@@ -94,6 +98,7 @@ def isotropy(grasp: Grasp, *, torque_scale: float | None = None) -> float:
     return float(s[-1] / s[0]) if s[0] > 0 else 0.0
 
 
+@checked_call
 def wrench_ellipsoid_volume(
     grasp: Grasp, *, torque_scale: float | None = None
 ) -> float:
@@ -110,6 +115,7 @@ def wrench_ellipsoid_volume(
     return float(np.prod(grasp_singular_values(grasp, torque_scale=torque_scale)))
 
 
+@checked_call
 def hand_object_matrix(
     grasp: Grasp,
     hand_jacobian: np.ndarray,
@@ -167,6 +173,7 @@ def hand_object_matrix(
     return G_pinv.T @ J
 
 
+@checked_call
 def hand_object_singular_values(
     grasp: Grasp, hand_jacobian: np.ndarray, *, torque_scale: float | None = None
 ) -> np.ndarray:
@@ -180,6 +187,7 @@ def hand_object_singular_values(
     )
 
 
+@checked_call
 def distance_to_singularity(
     grasp: Grasp, hand_jacobian: np.ndarray, *, torque_scale: float | None = None
 ) -> float:
@@ -193,6 +201,7 @@ def distance_to_singularity(
     return float(s[-1])
 
 
+@checked_call
 def uniformity_of_transformation(
     grasp: Grasp, hand_jacobian: np.ndarray, *, torque_scale: float | None = None
 ) -> float:
@@ -205,6 +214,7 @@ def uniformity_of_transformation(
     return float(s[0] / s[-1]) if s[-1] > 0 else math.inf
 
 
+@checked_call
 def manipulability_volume(
     grasp: Grasp, hand_jacobian: np.ndarray, *, torque_scale: float | None = None
 ) -> float:

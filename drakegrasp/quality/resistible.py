@@ -10,6 +10,7 @@ from pydrake.solvers import MathematicalProgram
 
 from drakegrasp._solvers import require_solution, solve
 from drakegrasp.closure.load_problem import check_direction
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.friction_cone import ConeLayout
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
@@ -26,6 +27,7 @@ __all__ = [
 ]
 
 
+@checked_call
 @dataclass(frozen=True)
 class MaxWrenchVariables:
     """Decision variables of :func:`build_max_resistible_wrench_program`.
@@ -49,6 +51,7 @@ class MaxWrenchVariables:
     normal_positions: np.ndarray
 
 
+@checked_call
 @dataclass(frozen=True)
 class MaxWrenchResult:
     """Largest multiple of an external wrench that a grasp resists.
@@ -131,6 +134,7 @@ def _norm(d: np.ndarray) -> float:
     return float(safe_norm(d))
 
 
+@checked_call
 def build_max_resistible_wrench_program(
     grasp: Grasp,
     direction: np.ndarray,
@@ -196,6 +200,7 @@ def build_max_resistible_wrench_program(
     return prog, MaxWrenchVariables(alpha, f, columns, normals)
 
 
+@checked_call
 def max_resistible_wrench(
     grasp: Grasp,
     direction: np.ndarray,

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deprecation import warn_deprecated
 from drakegrasp.core.grasp import Grasp, check_hand_jacobian
 from drakegrasp.core.serialize import jsonable
@@ -22,6 +23,7 @@ from drakegrasp.quality.indices import (
 __all__ = ["GraspQuality", "grasp_quality", "lp2_d_star", "lp2_margin"]
 
 
+@checked_call
 def lp2_d_star(
     grasp: Grasp,
     *,
@@ -65,6 +67,7 @@ def lp2_d_star(
     return d if math.isfinite(d) else 0.0
 
 
+@checked_call
 def lp2_margin(
     grasp: Grasp,
     *,
@@ -82,6 +85,7 @@ def lp2_margin(
     return lp2_d_star(grasp, num_generators=num_generators, tol=tol)
 
 
+@checked_call
 @dataclass(frozen=True)
 class GraspQuality:
     """All quality metrics of one grasp (see the functions named in each field).
@@ -165,6 +169,7 @@ class GraspQuality:
         return "\n".join(lines)
 
 
+@checked_call
 def grasp_quality(
     grasp: Grasp,
     *,

@@ -18,7 +18,9 @@ from pydrake.multibody.plant import ContactResults, MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import Context, EventStatus, LeafSystem, State
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import ContactModel
+from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.tolerances import (
     DEFAULT_DISTANCE_TOLERANCE,
     DEFAULT_NUM_GENERATORS,
@@ -124,6 +126,7 @@ def _monitor_couplings(plant: MultibodyPlant, couplings, bodies) -> tuple:
     return resolved
 
 
+@checked_call
 class GraspMonitor(LeafSystem):
     """Analyse the grasp of a simulated plant every ``period`` seconds.
 
@@ -534,7 +537,7 @@ class GraspMonitor(LeafSystem):
             warnings.warn(
                 f"GraspMonitor {self.get_name()!r}: {message}",
                 FrictionMismatchWarning,
-                stacklevel=3,
+                stacklevel=outside_stacklevel(),
             )
 
     def _analyse(self, context, query):

@@ -75,6 +75,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_scalar
 from drakegrasp.errors import InvalidOptionError
@@ -104,6 +105,7 @@ _GRIPPED = ("holding", "at risk", "slipping")
 _STICKY = ("touching", *_GRIPPED, "dropped")
 
 
+@checked_call
 @dataclass(frozen=True)
 class HoldingThresholds:
     """When a grip is at risk, slips, or has left the hand; and the hysteresis.

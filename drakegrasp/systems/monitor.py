@@ -176,6 +176,7 @@ from pydrake.geometry import SceneGraph
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import DiagramBuilder
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.systems.grasp_monitor import GraspMonitor
 from drakegrasp.systems.monitor_options import MIN_PERIOD
@@ -200,6 +201,7 @@ def _unique_name(builder: DiagramBuilder, base: str) -> str:
     return f"{base}_{k}"
 
 
+@checked_call
 def add_grasp_monitor(
     builder: DiagramBuilder,
     plant: MultibodyPlant,

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import check_flag, describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
@@ -32,6 +33,7 @@ MIN_PERIOD = 1e-6
 """Shortest sample period (s) accepted: a plant steps at ~1e-3 s."""
 
 
+@checked_call
 @dataclass(frozen=True)
 class MonitorSettings:
     """A grasp monitor's validated options.

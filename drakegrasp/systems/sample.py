@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.systems.finger_loads import FingerLoad
 from drakegrasp.systems.holding import HoldingMemory, holding_code
@@ -90,6 +91,7 @@ def grip_verdicts(
     return np.array(head + tail, dtype=float)
 
 
+@checked_call
 @dataclass(frozen=True, eq=False)
 class GraspSample:
     """One evaluation of the monitor.

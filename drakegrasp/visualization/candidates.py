@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.geometry import Meshcat, Rgba, Role
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import describe, real_array, real_scalar
 from drakegrasp.errors import InvalidOptionError
@@ -58,6 +59,7 @@ _STOPS = np.array(
 )  # red, yellow, green
 
 
+@checked_call
 def score_colors(scores, *, alpha: float = 0.4) -> np.ndarray:
     """(K, 4) RGBA colours of scores: red (lowest) → yellow → green (highest).
 
@@ -101,6 +103,7 @@ def score_colors(scores, *, alpha: float = 0.4) -> np.ndarray:
     return np.column_stack([rgb, np.full(len(s), a)])
 
 
+@checked_call
 @dataclass(frozen=True)
 class CandidateDrawing:
     """What :func:`draw_candidates` drew.
@@ -185,6 +188,7 @@ def _hand_bodies(plant, candidate, k: int):
     ]
 
 
+@checked_call
 def draw_candidates(
     meshcat: Meshcat,
     plant,
@@ -330,6 +334,7 @@ def _bin_edges(scores: np.ndarray, bins: int) -> np.ndarray:
     return edges
 
 
+@checked_call
 def plot_score_distribution(candidates, *, ax=None, bins: int = 30, top: int = 10):
     """Histogram of the candidates' scores (matplotlib).
 

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp
@@ -168,6 +169,7 @@ def check_sign(value: Any) -> float:
     return x
 
 
+@checked_call
 def contact_pose_3d(contact: Contact) -> tuple[np.ndarray, np.ndarray]:
     """Contact frame and position of a contact, lifted to 3-D.
 
@@ -194,6 +196,7 @@ def contact_pose_3d(contact: Contact) -> tuple[np.ndarray, np.ndarray]:
     return R.copy(), c.copy()
 
 
+@checked_call
 def normalize_contact_forces(grasp: Grasp, forces: Any) -> list[np.ndarray] | None:
     """Per-contact force arrays from a closure result or a sequence of arrays.
 
@@ -259,6 +262,7 @@ def normalize_contact_forces(grasp: Grasp, forces: Any) -> list[np.ndarray] | No
     return out
 
 
+@checked_call
 def contact_forces_in_grasp_frame(
     grasp: Grasp, forces: Sequence[np.ndarray]
 ) -> np.ndarray:
@@ -288,6 +292,7 @@ def contact_forces_in_grasp_frame(
     return np.array(rows, dtype=float).reshape(grasp.num_contacts, grasp.dim)
 
 
+@checked_call
 def cone_edge_directions(contact: Contact) -> np.ndarray:
     """Unit edge rays of a planar contact's (exact) friction cone.
 
@@ -312,6 +317,7 @@ def cone_edge_directions(contact: Contact) -> np.ndarray:
     return local @ np.asarray(contact.frame, dtype=float).T
 
 
+@checked_call
 def exact_cone_mesh(
     mu: float, height: float, *, num_segments: int = 32, sign: float = 1.0
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -386,6 +392,7 @@ def pyramid_generators(
     return S[:, keep]
 
 
+@checked_call
 def pyramid_mesh(
     generators: np.ndarray, height: float, *, sign: float = 1.0
 ) -> tuple[np.ndarray, np.ndarray]:

@@ -32,6 +32,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import check_flag, check_num_generators, safe_norm
@@ -85,6 +86,7 @@ MESHCAT_COLORS: dict[str, tuple[float, float, float, float]] = {
 _CONE_CHOICES = ("exact", "pyramid", "both", None)
 
 
+@checked_call
 @dataclass(frozen=True)
 class GraspDrawing:
     """What :func:`draw_grasp` put in the scene.
@@ -140,6 +142,7 @@ def _draw_on_top(meshcat: Meshcat, path: str) -> None:
     meshcat.SetProperty(f"{path}/<object>", "renderOrder", ON_TOP_RENDER_ORDER)
 
 
+@checked_call
 def draw_grasp(
     meshcat: Meshcat,
     grasp: Grasp,
@@ -475,6 +478,7 @@ def _draw_cone(
     return drawn
 
 
+@checked_call
 def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
     """Delete a drawing made by :func:`draw_grasp` (everything under ``prefix``)."""
     _check_meshcat(meshcat)

@@ -22,6 +22,7 @@ from drakegrasp.certificates.certificate import (
     UNRESISTED_WRENCH,
     Certificate,
 )
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.validation import check_length, safe_norm
 from drakegrasp.errors import InvalidOptionError
@@ -73,6 +74,7 @@ def import_pyplot():
     return plt
 
 
+@checked_call
 @dataclass(frozen=True)
 class PlanarGraspPlot:
     """Artists of :func:`plot_planar_grasp`, for inspection or restyling.
@@ -165,6 +167,7 @@ def _arrows(ax, tails, vectors, color, width: float, *, zorder: int):
     )
 
 
+@checked_call
 def plot_planar_grasp(
     grasp: Grasp,
     *,

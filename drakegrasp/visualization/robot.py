@@ -13,6 +13,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pydrake.geometry import Meshcat, Role, SceneGraph
 from pydrake.multibody.tree import ModelInstanceIndex
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.validation import describe, integer_or_none, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.validation import check_plant, model_instance
@@ -21,6 +22,7 @@ from drakegrasp.visualization.primitives import check_meshcat, check_path
 __all__ = ["set_translucent", "visualizer_paths"]
 
 
+@checked_call
 def visualizer_paths(
     plant, scene_graph, model_instances, *, prefix: str = "visualizer"
 ) -> list[str]:
@@ -139,6 +141,7 @@ def translucent_arguments(paths, opacity) -> tuple[list[str], float]:
     return [str(p) for p in listed], x
 
 
+@checked_call
 def set_translucent(
     meshcat: Meshcat, paths: str | Sequence[str], opacity: float = 0.3
 ) -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from pydrake.geometry import Meshcat, Rgba, Role, SceneGraph
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.validation import describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.primitives import check_meshcat, check_path
@@ -22,6 +23,7 @@ _ROLES = {"illustration": Role.kIllustration, "proximity": Role.kProximity}
 _GREY = Rgba(0.7, 0.7, 0.7, 1.0)
 
 
+@checked_call
 def draw_scene_geometry(
     meshcat: Meshcat,
     scene_graph: SceneGraph,

@@ -31,6 +31,7 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.validation import describe, real_array, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.validation import plant_context_of, resolve_object_body
@@ -64,6 +65,7 @@ about 1e31 m and every square computed below 1e63, so the view is finite (points
 at ±1e300 once put the camera at ``inf``)."""
 
 
+@checked_call
 @dataclass(frozen=True)
 class CameraView:
     """Where :func:`frame_points` put the camera.
@@ -127,6 +129,7 @@ def camera_view(points_W, *, pad: float = 0.0) -> CameraView:
     return CameraView(position_W=position, target_W=target, radius=radius)
 
 
+@checked_call
 def frame_points(meshcat: Meshcat, points_W, *, pad: float = 0.0) -> CameraView:
     """Aim Meshcat's camera so that every point (and ``pad`` around it) is seen.
 
@@ -159,6 +162,7 @@ def frame_points(meshcat: Meshcat, points_W, *, pad: float = 0.0) -> CameraView:
     return view
 
 
+@checked_call
 def grasp_pose(
     X_WG: RigidTransform | None = None,
     plant: MultibodyPlant | None = None,

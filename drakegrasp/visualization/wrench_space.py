@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp, wrench_columns
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
@@ -65,6 +66,7 @@ ORIGIN_CLEARANCE_TOL = 1e-9
 primitive wrenches' hull must clear the origin for it to count as inside."""
 
 
+@checked_call
 def wrench_space_points(
     grasp: Grasp,
     *,
@@ -147,6 +149,7 @@ def _most_hull_columns(m: int) -> int:
     return low
 
 
+@checked_call
 @dataclass(frozen=True)
 class WrenchHull:
     """Convex hull of a set of wrenches and where the origin lies.
@@ -171,6 +174,7 @@ class WrenchHull:
     rank: int
 
 
+@checked_call
 def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHull:
     """Convex hull of the columns of ``W`` and whether it contains the origin.
 
@@ -241,6 +245,7 @@ def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHu
     return WrenchHull(hull, margin > tol, margin, rank)
 
 
+@checked_call
 @dataclass(frozen=True)
 class WrenchSpacePlot:
     """Artists and data of :func:`plot_wrench_space`.
@@ -283,6 +288,7 @@ class WrenchSpacePlot:
         return self.hull.origin_inside
 
 
+@checked_call
 def plot_wrench_space(
     grasp: Grasp,
     *,

@@ -374,3 +374,48 @@ def test_a_jacobian_without_torque_limits_gets_a_certificate():
     assert r.certificate.check(g, hand_jacobian=J).holds
     f = dg.grasp_forces(g, w, hand_jacobian=J, max_squeeze=1.0)
     assert not f.feasible and f.certificate.check(g, hand_jacobian=J).holds
+
+
+_CALLABLES = {
+    "grasp_matrix": dg.grasp_matrix,
+    "force_closure": dg.force_closure,
+    "form_closure": dg.form_closure,
+    "grasp_quality": dg.grasp_quality,
+    "batch_force_closure": dg.batch_force_closure,
+    "batch_form_closure": dg.batch_form_closure,
+    "Contact": dg.Contact,
+    "Grasp": dg.Grasp,
+    "AnalysisOptions": dg.AnalysisOptions,
+    "BatchOptions": dg.BatchOptions,
+}
+
+
+@SETTINGS
+@given(
+    name=st.sampled_from(sorted(_CALLABLES)),
+    num_args=st.integers(0, 6),
+    keywords=st.lists(
+        st.one_of(
+            st.from_regex(r"[A-Za-z_][A-Za-z0-9_]{0,12}", fullmatch=True),
+            st.sampled_from(["mu", "tol", "Tol", "mu_", "contact_modle", "grasp"]),
+        ),
+        max_size=3,
+        unique=True,
+    ),
+    value=st.one_of(hostile_floats, st.sampled_from([None, "abc", 1j, True])),
+)
+def test_a_call_of_any_shape_is_answered_or_refused_clearly(
+    name, num_args, keywords, value
+):
+    # Any number of positional arguments and any keywords, known or not, with
+    # hostile values: a clear GraspError naming the function, or an answer.
+    fn = _CALLABLES[name]
+    g = fuzz_cases._valid_grasp()
+    args = [g, *[value] * (num_args - 1)] if num_args else []
+    kwargs = dict.fromkeys(keywords, value)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        outcome, detail = fuzz_cases.run_case(
+            fuzz_cases.Case("calls", "", lambda: fn(*args, **kwargs), "either", None)
+        )
+    assert outcome in ("clear GraspError", "plausible verdict"), f"{outcome}: {detail}"

@@ -153,7 +153,7 @@ def test_a_candidate_drake_cannot_simulate_is_recorded_and_the_rest_are_shaken()
         (dict(held_from=np.array(["seat"])), "held_from must be"),
         (dict(squeeze=10**400), "squeeze must be"),
         (dict(hydroelastic_modulus=1e20), "hydroelastic_modulus must be"),
-        (dict(stifness=10.0), "no option stifness"),
+        (dict(stifness=10.0), "unknown option stifness="),
         (dict(squeeze=-1.0), "squeeze must be"),
         (dict(directions=[(0, 0, 0)]), "directions must be"),
         (dict(X_WO=np.eye(4)), "X_WO"),

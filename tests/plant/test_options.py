@@ -8,12 +8,10 @@ import drakegrasp as dg
 
 @pytest.mark.parametrize("cls", [dg.AnalysisOptions, dg.BatchOptions])
 def test_an_unknown_or_extra_argument_is_an_option_error_naming_it(cls):
-    with pytest.raises(
-        dg.InvalidOptionError, match=r"unknown .* option\(s\) \['bogus'\]"
-    ):
+    with pytest.raises(dg.InvalidOptionError, match=r"unknown \w+ option bogus="):
         cls(bogus=1)
     too_many = len(cls.__dataclass_fields__) + 1
-    with pytest.raises(dg.InvalidOptionError, match="by position"):
+    with pytest.raises(dg.InvalidOptionError, match=r"positional arguments .* but"):
         cls(*([None] * too_many))
     first = next(iter(cls.__dataclass_fields__))
     with pytest.raises(dg.InvalidOptionError, match="both by position and by name"):

@@ -44,6 +44,7 @@ from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.ragged import accepts_ragged
 from drakegrasp.batch.run.chunk import force_task
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE, stream
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import (
@@ -80,6 +81,7 @@ def _merge_epsilon(K: int, _dim: int, parts) -> np.ndarray:
 @keyword_only("mu", after=2)
 @accepts_ragged(_merge_epsilon, check=moment_arms_in_input_order)
 @takes_batch_options
+@checked_call
 def batch_epsilon_l1(
     positions: np.ndarray,
     normals: np.ndarray,

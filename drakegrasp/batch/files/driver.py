@@ -37,6 +37,7 @@ from drakegrasp.batch.files.writer import (
 from drakegrasp.batch.inputs import shape_of
 from drakegrasp.batch.options import takes_batch_options
 from drakegrasp.batch.run.stream import DEFAULT_CHUNK_SIZE
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.tolerances import (
@@ -89,6 +90,7 @@ def _file_run(
 
 @renamed_keyword("model", "contact_model")
 @takes_batch_options
+@checked_call
 def evaluate_file(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
@@ -154,6 +156,7 @@ def evaluate_file(
 
 @renamed_keyword("model", "contact_model")
 @takes_batch_options
+@checked_call
 def stream_file(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
@@ -208,6 +211,7 @@ def stream_file(
     return summary
 
 
+@checked_call
 def write_result(
     result: BatchClosureResult,
     path: str | os.PathLike,

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import not_a_file
 from drakegrasp.errors import BatchFileError, GraspError, InvalidOptionError
 
@@ -33,6 +34,7 @@ __all__ = ["as_path", "engine_options", "input_files", "read_grasps"]
 _OPTIONAL = ("mu", "torsional_friction", "reference_points", "characteristic_lengths")
 
 
+@checked_call
 def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
     """Read grasps from a ``.npz`` archive or a directory of ``.npy`` files.
 

@@ -40,6 +40,7 @@ import numpy as np
 from drakegrasp.batch.columns import result_arrays
 from drakegrasp.batch.files.npz import NpzWriter
 from drakegrasp.batch.files.parquet import ParquetWriter
+from drakegrasp.core.calls import checked_call
 from drakegrasp.errors import BatchFileError, InvalidOptionError
 
 __all__ = [
@@ -55,6 +56,7 @@ __all__ = [
 FORMATS = ("npz", "parquet")
 
 
+@checked_call
 @dataclass
 class BatchSummary:
     """Running totals of a streamed batch (what a summary line needs).
@@ -271,6 +273,7 @@ def placed(path: Path, *, overwrite: bool) -> Iterator[str]:
             os.unlink(tmp)
 
 
+@checked_call
 def write_chunks(
     chunks: Iterable[tuple[slice, dict[str, np.ndarray]]],
     path: str | os.PathLike,
