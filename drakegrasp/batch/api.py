@@ -303,10 +303,10 @@ def form_chunks(
     return options, chunks
 
 
+@checked_call
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
 @takes_batch_options
-@checked_call
 def stream_force_closure(
     positions,
     normals,
@@ -392,8 +392,8 @@ def stream_force_closure(
     return chunks
 
 
-@takes_batch_options
 @checked_call
+@takes_batch_options
 def stream_form_closure(
     positions,
     normals,
@@ -446,11 +446,11 @@ def stream_form_closure(
     return chunks
 
 
+@checked_call
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
 @accepts_ragged(merge_results, check=metric_moment_arms)
 @takes_batch_options
-@checked_call
 def batch_force_closure(
     positions: np.ndarray,
     normals: np.ndarray,
@@ -570,9 +570,9 @@ def batch_force_closure(
     return collect(K, d, "force", options["tol"], options["metrics"], chunks)
 
 
+@checked_call
 @accepts_ragged(merge_results, check=metric_moment_arms)
 @takes_batch_options
-@checked_call
 def batch_form_closure(
     positions: np.ndarray,
     normals: np.ndarray,

@@ -48,10 +48,12 @@ def checked_call(target: T) -> T:
         A public function, or a class: its own ``__init__`` (a named tuple:
         ``__new__``) and every public method it defines (instance, class and
         static methods; not properties) are wrapped.  For a dataclass, apply
-        this above ``@dataclass``.  Applied below any
-        :func:`~drakegrasp.core.deprecation.renamed_keyword` or
-        :func:`~drakegrasp.core.deprecation.keyword_only`, so that an old
-        spelling has become the new one before the call is checked.
+        this above ``@dataclass``; for a function, above its other decorators
+        (the signature checked is the one they show: ``options=`` of
+        ``takes_batch_options``), whose old spellings
+        (:func:`~drakegrasp.core.deprecation.renamed_keyword`,
+        :func:`~drakegrasp.core.deprecation.keyword_only`) are read as the new
+        ones.
 
     Returns
     -------
@@ -139,6 +141,10 @@ def _checked(
         try:
             return function(*args, **kwargs)
         except TypeError:
+            if method and not args:  # a method read off its class, no instance
+                raise error(
+                    f"{where}: called without an object to call it on"
+                ) from None
             given = args[1:] if method else args
             problem = call_problem(function, given, kwargs, method=method, noun=noun)
             if problem is None:  # the arguments fit: the body's own TypeError
@@ -146,6 +152,27 @@ def _checked(
             raise error(f"{where}: {problem}") from None
 
     return wrapper
+
+
+def _new_spellings(
+    function: Callable, args: tuple, kwargs: dict[str, Any]
+) -> tuple[tuple, dict[str, Any]]:
+    """The call in today's spellings, as ``function``'s deprecation wrappers see it.
+
+    :func:`~drakegrasp.core.deprecation.renamed_keyword` and
+    :func:`~drakegrasp.core.deprecation.keyword_only` record on their wrapper
+    the old keywords (``_old_keywords``: old to new) and the positional
+    places that are now keywords (``_old_positionals``: their first place and
+    names); a call in those spellings is judged as the wrapper passes it on.
+    """
+    renamed = getattr(function, "_old_keywords", {})
+    if renamed:
+        kwargs = {renamed.get(name, name): value for name, value in kwargs.items()}
+    after, names = getattr(function, "_old_positionals", (None, ()))
+    if after is not None and after < len(args) <= after + len(names):
+        kwargs = {**kwargs, **dict(zip(names, args[after:], strict=False))}
+        args = args[:after]
+    return args, kwargs
 
 
 @functools.cache
@@ -192,6 +219,7 @@ def call_problem(
         keyword-only ones; an argument given both by position and by name;
         or every required argument that is missing.
     """
+    args, kwargs = _new_spellings(function, args, kwargs)
     signature = _signature(function, method)
     parameters = list(signature.parameters.values())
     kinds = {p.kind for p in parameters}
@@ -219,7 +247,7 @@ def call_problem(
         message = (
             f"takes {len(positional)} positional argument"
             f"{'' if len(positional) == 1 else 's'}{named} but {len(args)} "
-            "were given"
+            f"{'was' if len(args) == 1 else 'were'} given"
         )
         if only:
             message += "; by keyword only: " + ", ".join(f"{n}=" for n in only)

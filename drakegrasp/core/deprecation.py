@@ -140,6 +140,10 @@ def _renamed(
             kwargs[new] = kwargs.pop(old)
         return function(*args, **kwargs)
 
+    # Read by drakegrasp.core.calls, which names what is wrong with a call:
+    # ``old=`` is a keyword of this function (it does not import this module,
+    # which would put the core one level deeper).
+    wrapper._old_keywords = {**getattr(function, "_old_keywords", {}), old: new}
     return wrapper  # type: ignore[return-value]
 
 
@@ -215,6 +219,9 @@ def keyword_only(*names: str, after: int) -> Callable[[F], F]:
                 args = args[:after]
             return function(*args, **kwargs)
 
+        # Read by drakegrasp.core.calls (see _renamed): positional arguments
+        # from place ``after`` on are these keywords.
+        wrapper._old_positionals = (after, names)
         return wrapper  # type: ignore[return-value]
 
     return decorate

@@ -12,6 +12,8 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.grasp import Grasp
+from drakegrasp.core.validation import check_length, integer_or_none, real_scalar
+from drakegrasp.errors import InvalidGraspError
 
 __all__ = [
     "cube_seven_contacts",
@@ -47,7 +49,10 @@ def planar_two_finger_square(
     Grasp
         Planar, reference point at the square's centre.
     """
-    h = half_width
+    h = check_length("half_width", half_width)
+    offset = real_scalar("offset", offset, error=InvalidGraspError)
+    if not np.isfinite(offset):
+        raise InvalidGraspError(f"offset must be finite (metres), got {offset!r}")
     return Grasp(
         [
             Contact([-h, -offset], [1.0, 0.0], mu=mu),
@@ -74,7 +79,7 @@ def planar_square_four_contacts(half_width: float = 1.0) -> Grasp:
     Grasp
         Planar, frictionless, reference point at the centre.
     """
-    h = half_width
+    h = check_length("half_width", half_width)
     return Grasp(
         [
             Contact([h, h / 2], [-1, 0], contact_model=ContactModel.FRICTIONLESS),
@@ -115,6 +120,7 @@ def cube_seven_contacts(half_width: float = 1.0) -> Grasp:
     Grasp
         Spatial, frictionless, reference point at the centre.
     """
+    half_width = check_length("half_width", half_width)
     return Grasp(
         [
             Contact(
@@ -125,8 +131,11 @@ def cube_seven_contacts(half_width: float = 1.0) -> Grasp:
     )
 
 
-@renamed_keyword("model", "contact_model")
+_MAX_FINGERS = 1000  # fingers on the equator: a picture, not a stress test
+
+
 @checked_call
+@renamed_keyword("model", "contact_model")
 def equator_fingers(
     mu: float,
     *,
@@ -146,6 +155,7 @@ def equator_fingers(
     ----------
     mu : float
     num_fingers : int, optional
+        How many, in [1, 1000].
     radius : float, optional
         Sphere radius, metres.
     contact_model : ContactModel or str, optional
@@ -156,7 +166,14 @@ def equator_fingers(
     Grasp
         Spatial, reference point at the sphere's centre.
     """
-    angles = 2.0 * np.pi * np.arange(num_fingers) / num_fingers
+    count = integer_or_none(num_fingers)
+    if count is None or not 1 <= count <= _MAX_FINGERS:
+        raise InvalidGraspError(
+            f"num_fingers must be an integer in [1, {_MAX_FINGERS}], "
+            f"got {num_fingers!r}"
+        )
+    radius = check_length("radius", radius)
+    angles = 2.0 * np.pi * np.arange(count) / count
     contacts = []
     for a in angles:
         outward = np.array([np.cos(a), np.sin(a), 0.0])
@@ -172,8 +189,8 @@ def equator_fingers(
     return Grasp(contacts)
 
 
-@renamed_keyword("model", "contact_model")
 @checked_call
+@renamed_keyword("model", "contact_model")
 def spatial_two_fingers(
     mu: float,
     *,
@@ -199,6 +216,7 @@ def spatial_two_fingers(
     -------
     Grasp
     """
+    half_width = check_length("half_width", half_width)
     return Grasp(
         [
             Contact(

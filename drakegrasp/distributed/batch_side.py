@@ -146,8 +146,8 @@ def _partition(
     return write_shard(Path(shard), out, job)
 
 
-@keyword_only("mu", after=3)
 @checked_call
+@keyword_only("mu", after=3)
 def evaluate_on_cluster(
     client,
     positions,
@@ -307,23 +307,26 @@ def evaluate_on_cluster(
 
 
 def _refuse_unknown(keywords: dict, kind: str, caller: Callable) -> None:
-    """Refuse keywords that neither ``caller`` nor the engine takes, at once.
+    """Refuse keywords that no function of a cluster run takes, at once.
 
-    The partitions would refuse them, each on its worker, after the cluster
-    was reached; this names them (with the closest accepted one) first.
+    ``caller`` passes ``keywords`` on to :func:`evaluate_on_cluster` (or is
+    it), which passes them on to the engine of ``kind``; the partitions would
+    refuse an unknown one, each on its worker, after the cluster was reached.
+    This names them (with the closest accepted one) first.
     """
     run = stream_force_closure if kind == "force" else stream_form_closure
     named = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
     accepted = [
         name
-        for function in (caller, run)
+        for function in dict.fromkeys((caller, evaluate_on_cluster, run))
         for name, p in inspect.signature(function).parameters.items()
         if p.kind in named and name not in ("positions", "normals")
     ]
     accepted = list(dict.fromkeys(accepted))
     # model=: the engine's old spelling of contact_model=, renamed (with its
     # warning) where the engine runs
-    unknown = [name for name in keywords if name not in (*accepted, "model")]
+    old = ("model",) if "contact_model" in accepted else ()
+    unknown = [name for name in keywords if name not in (*accepted, *old)]
     if unknown:
         where = f"{caller.__qualname__}()"
         raise InvalidArgumentError(f"{where}: " + unknown_names(unknown, accepted))

@@ -28,7 +28,7 @@ from drakegrasp.plant.models import (
     use_local_drake_models,
 )
 from drakegrasp.plant.scene_refs import add_named_package
-from drakegrasp.plant.validation import check_rigid_transform
+from drakegrasp.plant.validation import check_rigid_transform, resolve_body
 
 __all__ = ["WSG_URL", "PlanningScene", "planning_scene", "scene_from_models"]
 
@@ -181,16 +181,29 @@ def scene_from_models(add_models) -> PlanningScene:
     PlanningScene
         The finalized plant in its diagram, a default context and the recipe.
     """
+    if not callable(add_models):
+        raise InvalidOptionError(
+            "add_models must be a function add_models(plant, parser) -> (hand, "
+            f"object body name), got {type(add_models).__name__}"
+        )
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    hand, name = add_models(plant, new_parser(plant, "the planning scene"))
+    returned = add_models(plant, new_parser(plant, "the planning scene"))
+    if not (isinstance(returned, tuple) and len(returned) == 2):
+        raise InvalidOptionError(
+            "add_models must return (hand model instance, object body name "
+            f"'model::body' or None), got {returned!r}"
+        )
+    hand, name = returned
+    if name is not None and not isinstance(name, str):
+        raise InvalidOptionError(
+            "add_models must return the object body's scoped name 'model::body' "
+            f"(or None), got {name!r}"
+        )
     plant.Finalize()
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
-    object_body = None
-    if name is not None:
-        model, _, body = name.rpartition("::")
-        object_body = plant.GetBodyByName(body, plant.GetModelInstanceByName(model))
+    object_body = None if name is None else resolve_body(plant, name)
     return PlanningScene(diagram, plant, context, hand, object_body, add_models)
 
 

@@ -299,8 +299,10 @@ def check_settings(top, held_from, options: dict) -> dict:
         )
     unknown = sorted(set(options) - set(_OPTIONS))
     if unknown:
+        # shake_candidates' own keywords, then shake_test's options
+        accepted = ["top", "held_from", *sorted(_OPTIONS)]
         raise InvalidOptionError(
-            "shake_test(): " + unknown_names(unknown, sorted(_OPTIONS), noun="option")
+            "shake_candidates(): " + unknown_names(unknown, accepted, noun="option")
         )
     settings = {**_OPTIONS, **options}
     check_shake_options(

@@ -58,6 +58,7 @@ from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import coupling_entries, coupling_entry, joint_name
 from drakegrasp.plant.models import load_models
+from drakegrasp.plant.validation import check_plant
 
 __all__ = [
     "COUPLING_TOL",
@@ -580,6 +581,7 @@ def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
     """
     if couplings is not None:
         return coupling_entries(couplings)
+    check_plant(plant, finalized=False)
     known = tuple(_RECORDED.get(plant, ()))
     if plant.num_constraints() > len(known):
         raise InvalidOptionError(

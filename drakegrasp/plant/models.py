@@ -186,8 +186,8 @@ def load_models(where: str, read, *args, **kwargs):
         raise ModelError(f"{where}: cannot load the models: {msg}") from None
 
 
-@functools.cache
 @checked_call
+@functools.cache
 def models_dir() -> Path:
     """Absolute path of the directory that holds ``package.xml`` and the models.
 

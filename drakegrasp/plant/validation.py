@@ -91,19 +91,20 @@ def _per_plant(plant: MultibodyPlant, key: tuple, compute):
     return _TOPOLOGY.value(plant, key, compute)
 
 
-def check_plant(plant) -> MultibodyPlant:
-    """``plant`` itself, once it is known to be a finalized ``MultibodyPlant``.
+def check_plant(plant, *, finalized: bool = True) -> MultibodyPlant:
+    """``plant`` itself, once it is known to be a (finalized) ``MultibodyPlant``.
 
     Raises
     ------
     ModelError
-        If ``plant`` is not a ``MultibodyPlant`` or is not finalized.
+        If ``plant`` is not a ``MultibodyPlant``, or (``finalized``) is not
+        finalized.
     """
     if not isinstance(plant, MultibodyPlant):
         raise ModelError(
             f"plant must be a pydrake MultibodyPlant, got {type(plant).__name__}"
         )
-    if not plant.is_finalized():
+    if finalized and not plant.is_finalized():
         raise ModelError(
             "the plant is not finalized; call plant.Finalize() before analysing it"
         )
@@ -743,6 +744,8 @@ def hand_bodies(
         For an unknown instance or body, or a hand left with no body that can
         move (for instance a list of bodies all welded to the world).
     """
+    check_plant(plant, finalized=False)  # a plant being built is read too
+    object_body = resolve_object_body(plant, object_body)
     if isinstance(hand, str | ModelInstanceIndex) or hand is None:
         obj = (int(object_body.index()), int(object_body.model_instance()))
         spec = ("index", int(hand)) if isinstance(hand, ModelInstanceIndex) else hand

@@ -171,7 +171,7 @@ def test_forwarded_keywords_are_named_too():
         "batch_form_closure()": lambda: next(
             db.iter_batch_closure([(P, N)], kind="form", **{BOGUS: 1})
         ),
-        "shake_test()": lambda: dg.shake_candidates(print, [], **{BOGUS: 1}),
+        "shake_candidates()": lambda: dg.shake_candidates(print, [], **{BOGUS: 1}),
         # before the file is read
         "stream_file_on_cluster()": lambda: dd.stream_file_on_cluster(
             "missing.npz", "out", scheduler="tcp://host:8786", **{BOGUS: 1}
@@ -364,3 +364,69 @@ def test_call_problem_agrees_with_python_on_any_keywords(names):
             assert f"{name} is positional only" in problem
         elif name not in ("c", "d", "e"):
             assert f"unknown keyword {name}=" in problem
+
+
+# What a review of the first version found (each failed on it).
+
+
+def test_a_cluster_run_from_a_file_takes_evaluate_on_clusters_keywords():
+    import drakegrasp.distributed as dd
+
+    with pytest.raises(dg.BatchFileError, match="does not exist"):  # past the check
+        dd.stream_file_on_cluster(
+            "/nonexistent.npz", "out", scheduler="tcp://x:1", partition_chunks=2
+        )
+
+
+def test_a_form_closure_cluster_run_refuses_the_old_spelling_of_a_friction_option():
+    import drakegrasp.distributed as dd
+
+    P = np.zeros((2, 3, 3))
+    with pytest.raises(dg.InvalidArgumentError, match="unknown keyword model="):
+        dd.evaluate_on_cluster(None, P, P, kind="form", model="hard_finger")
+
+
+def test_an_old_spelling_is_read_as_the_new_one_when_the_call_is_judged():
+    grasp = dg.examples.planar_square_four_contacts()
+    with (
+        pytest.warns(DeprecationWarning),
+        pytest.raises(dg.InvalidArgumentError) as caught,
+    ):
+        grasp.with_friction(0.5, 1, model="hard_finger")  # one positional too many
+    assert "takes 1 positional argument (mu) but 2 were given" in str(caught.value)
+    assert " model=" not in str(caught.value)
+    with (
+        pytest.warns(DeprecationWarning),
+        pytest.raises(dg.InvalidArgumentError) as caught,
+    ):
+        grasp.with_friction(model="hard_finger", mu_=1)
+    assert str(caught.value) == (
+        "Grasp.with_friction(): unknown keyword mu_= (did you mean mu=?)"
+    )
+    P = np.zeros((2, 3, 3))
+    with pytest.warns(DeprecationWarning), pytest.raises(dg.InvalidArgumentError) as c:
+        dg.batch_force_closure(P, P, 0.5, bogus=1)  # mu by position: the old way
+    assert "unknown keyword bogus=" in str(c.value) and "mu" not in str(c.value)[:60]
+
+
+def test_the_batch_functions_name_their_options_keyword():
+    P = np.zeros((2, 3, 3))
+    with pytest.raises(dg.InvalidArgumentError, match="did you mean options=?"):
+        dg.batch_form_closure(P, P, optoins=dg.BatchOptions())
+    with pytest.raises(dg.InvalidArgumentError, match="did you mean options=?"):
+        dg.evaluate_file("x.npz", optoins=dg.BatchOptions())
+
+
+def test_shake_candidates_names_its_own_keywords():
+    with pytest.raises(dg.InvalidOptionError) as caught:
+        dg.shake_candidates(print, [], held_frm="seat")
+    assert str(caught.value) == (
+        "shake_candidates(): unknown option held_frm= (did you mean held_from=?)"
+    )
+
+
+def test_one_argument_was_given_and_a_method_needs_its_object():
+    with pytest.raises(dg.InvalidArgumentError, match="but 1 was given$"):
+        dg.plant.models_dir([])  # the check is above functools.cache
+    with pytest.raises(dg.InvalidArgumentError, match="called without an object"):
+        dg.Grasp.with_friction(mu=0.5)

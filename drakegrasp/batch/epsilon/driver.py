@@ -77,11 +77,11 @@ def _merge_epsilon(K: int, _dim: int, parts) -> np.ndarray:
     return out
 
 
+@checked_call
 @renamed_keyword("model", "contact_model")
 @keyword_only("mu", after=2)
 @accepts_ragged(_merge_epsilon, check=moment_arms_in_input_order)
 @takes_batch_options
-@checked_call
 def batch_epsilon_l1(
     positions: np.ndarray,
     normals: np.ndarray,

@@ -88,9 +88,9 @@ def _file_run(
     return output, K, d, options, chunks
 
 
+@checked_call
 @renamed_keyword("model", "contact_model")
 @takes_batch_options
-@checked_call
 def evaluate_file(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
@@ -154,9 +154,9 @@ def evaluate_file(
     return result
 
 
+@checked_call
 @renamed_keyword("model", "contact_model")
 @takes_batch_options
-@checked_call
 def stream_file(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
