@@ -10,9 +10,10 @@ a :class:`TypeError` (caught as before).  Its message names the function,
 every keyword it does not take with the closest one it does, and which
 parameters are keyword-only.
 
-An options dataclass (:class:`~drakegrasp.AnalysisOptions`) is wrapped by
-:func:`checked_fields` instead: an unknown field is an unknown option, an
-:class:`~drakegrasp.InvalidOptionError`.
+The options objects (:class:`~drakegrasp.AnalysisOptions`,
+:class:`~drakegrasp.BatchOptions`) are wrapped by :func:`checked_fields`
+instead: an unknown field is an unknown option, an
+:class:`~drakegrasp.InvalidOptionError`, as it always was.
 
 The check costs nothing on a call that fits: the signature is read only after
 Python has refused the call, and a :class:`TypeError` raised by the function's

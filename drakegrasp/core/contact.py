@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drakegrasp.core.calls import checked_call, checked_fields
+from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deprecation import renamed_keyword, warn_deprecated
 from drakegrasp.core.tolerances import UNIT_NORMAL_TOL
 from drakegrasp.core.validation import (
@@ -179,7 +179,7 @@ def _frozen(a: np.ndarray) -> np.ndarray:
 
 
 @renamed_keyword("model", "contact_model")
-@checked_fields("keyword")  # an option error, as for the options objects
+@checked_call
 @dataclass(frozen=True, eq=False)
 class Contact:
     """One contact between a finger and the object.

@@ -1,7 +1,7 @@
 """A call that does not fit a public signature raises a named GraspError.
 
 Every public function and constructor is wrapped by ``checked_call`` (or, for
-the options objects and ``Contact``, ``checked_fields``).  These tests read
+the options objects, ``checked_fields``).  These tests read
 every public name of every package's table, so a new public function without
 the wrapper fails here.
 """

@@ -43,7 +43,7 @@ def test_both_spellings_at_once_are_refused():
         dg.batch_force_closure(
             P, N, mu=0.5, model="hard_finger", contact_model="hard_finger"
         )
-    with pytest.raises(dg.InvalidOptionError, match="unknown keyword modle="):
+    with pytest.raises(dg.InvalidArgumentError, match="unknown keyword modle="):
         dg.Contact([0, 0, 0], [1, 0, 0], modle="frictionless")
 
 
