@@ -125,19 +125,28 @@ def contact_frames(normals: np.ndarray) -> np.ndarray:
                 f"{float(off[idx]):.3g} (more than {UNIT_NORMAL_TOL:g}; normalise "
                 "them, or build each frame with contact_frame, which does)"
             )
-    if n.shape[-1] == 2:
-        t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
-        return np.stack([n, t], axis=-1)
-    if n.shape[-1] != 3:
+    if n.shape[-1] not in (2, 3):
         raise InvalidContactError(
             f"normals must have 2 or 3 components, got shape {n.shape}"
         )
+    return _frames_of(n)
+
+
+def _frames_of(n: np.ndarray) -> np.ndarray:
+    """:func:`contact_frames` of unit normals already checked, float64 (..., d)."""
+    if n.shape[-1] == 2:
+        t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
+        return np.stack([n, t], axis=-1)
     axis = np.argmin(np.abs(n), axis=-1)
-    e = np.zeros_like(n)
-    np.put_along_axis(e, axis[..., None], 1.0, axis=-1)
-    t1 = e - np.sum(e * n, axis=-1, keepdims=True) * n
+    e = (np.arange(3) == axis[..., None]).astype(float)
+    # e·n is n's component along that axis: the other two terms are ±0
+    along = np.take_along_axis(n, axis[..., None], axis=-1)
+    t1 = e - along * n
     t1 /= np.linalg.norm(t1, axis=-1, keepdims=True)
-    t2 = np.cross(n, t1)
+    t2 = np.empty_like(n)  # n × t1, as np.cross computes it
+    t2[..., 0] = n[..., 1] * t1[..., 2] - n[..., 2] * t1[..., 1]
+    t2[..., 1] = n[..., 2] * t1[..., 0] - n[..., 0] * t1[..., 2]
+    t2[..., 2] = n[..., 0] * t1[..., 1] - n[..., 1] * t1[..., 0]
     return np.stack([n, t1, t2], axis=-1)
 
 
@@ -268,7 +277,7 @@ class Contact:
         object.__setattr__(self, "mu", mu_value)
         object.__setattr__(self, "contact_model", contact_model)
         object.__setattr__(self, "torsional_friction", nu_value)
-        object.__setattr__(self, "_frame", _frozen(contact_frames(n)))
+        object.__setattr__(self, "_frame", _frozen(_frames_of(n)))
 
     @property
     def dim(self) -> int:

@@ -126,3 +126,40 @@ def test_contact_frames_refuses_normals_that_are_not_unit():
     np.testing.assert_allclose(
         dg.contact_frame([2.0, 0.0, 0.0]), dg.contact_frames([1.0, 0.0, 0.0])
     )
+
+
+def _frames_by_cross(n):
+    """The frames as numpy's own routines build them (the route before 43)."""
+    axis = np.argmin(np.abs(n), axis=-1)
+    e = np.zeros_like(n)
+    np.put_along_axis(e, axis[..., None], 1.0, axis=-1)
+    t1 = e - np.sum(e * n, axis=-1, keepdims=True) * n
+    t1 /= np.linalg.norm(t1, axis=-1, keepdims=True)
+    return np.stack([n, t1, np.cross(n, t1)], axis=-1)
+
+
+def _hostile_unit_normals(rng, count):
+    """Unit normals with ties, zeros of either sign, and scales 1e-300 to 1e300."""
+    from drakegrasp.core.validation import unit_vectors
+
+    raw = rng.normal(size=(count, 3)) * 10.0 ** rng.integers(-300, 300, (count, 1))
+    raw[: count // 4] = rng.choice([-1.0, -0.0, 0.0, 1.0, 2.0], (count // 4, 3))
+    raw[count // 4 : count // 2, 1] = raw[count // 4 : count // 2, 0]  # ties
+    raw = raw[np.any(raw != 0.0, axis=1)]
+    return unit_vectors("normals", raw)
+
+
+def test_frames_are_bitwise_those_of_numpys_cross(rng):
+    # The frames compute e·n as n's component and n × t1 component by
+    # component: the same floating-point operations as np.sum and np.cross,
+    # so every bit, signs of zero included, is theirs (d* downstream too).
+    from drakegrasp.core.contact import _frames_of
+
+    n = _hostile_unit_normals(rng, 40_000)
+    ours, theirs = _frames_of(n), _frames_by_cross(n)
+    assert ours.tobytes() == theirs.tobytes()
+    assert dg.contact_frames(n).tobytes() == theirs.tobytes()
+    for k in range(0, len(n), 997):  # one at a time, as a Contact builds its own
+        contact = dg.Contact([0.0, 0.0, 0.0], n[k])  # normalises n[k] again
+        expected = _frames_by_cross(contact.normal[None])[0]
+        assert contact.frame.tobytes() == expected.tobytes()
