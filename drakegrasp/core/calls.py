@@ -15,9 +15,10 @@ The options objects (:class:`~drakegrasp.AnalysisOptions`,
 instead: an unknown field is an unknown option, an
 :class:`~drakegrasp.InvalidOptionError`, as it always was.
 
-The check costs nothing on a call that fits: the signature is read only after
-Python has refused the call, and a :class:`TypeError` raised by the function's
-own body (the arguments fit) passes through unchanged.
+A call that fits pays one more Python frame (about 0.2 µs,
+``benchmarks/bench_call_check.py``): the signature is read only after Python
+has refused the call, and a :class:`TypeError` raised by the function's own
+work (the arguments fit) passes through unchanged.
 """
 
 from __future__ import annotations

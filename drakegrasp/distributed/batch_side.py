@@ -306,13 +306,16 @@ def evaluate_on_cluster(
     return collect(K, d, kind, tol, names, chunks)
 
 
-def _refuse_unknown(keywords: dict, kind: str, caller: Callable) -> None:
+def _refuse_unknown(
+    keywords: dict, kind: str, caller: Callable, *, passed: tuple[str, ...] = ()
+) -> None:
     """Refuse keywords that no function of a cluster run takes, at once.
 
     ``caller`` passes ``keywords`` on to :func:`evaluate_on_cluster` (or is
     it), which passes them on to the engine of ``kind``; the partitions would
     refuse an unknown one, each on its worker, after the cluster was reached.
-    This names them (with the closest accepted one) first.
+    This names them (with the closest accepted one) first.  ``passed``: the
+    arguments of ``evaluate_on_cluster`` that ``caller`` sets itself.
     """
     run = stream_force_closure if kind == "force" else stream_form_closure
     named = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
@@ -320,7 +323,7 @@ def _refuse_unknown(keywords: dict, kind: str, caller: Callable) -> None:
         name
         for function in dict.fromkeys((caller, evaluate_on_cluster, run))
         for name, p in inspect.signature(function).parameters.items()
-        if p.kind in named and name not in ("positions", "normals")
+        if p.kind in named and name not in ("positions", "normals", *passed)
     ]
     accepted = list(dict.fromkeys(accepted))
     # model=: the engine's old spelling of contact_model=, renamed (with its
@@ -386,7 +389,9 @@ def stream_file_on_cluster(
     from drakegrasp.batch.files.writer import BatchSummary
 
     del workers, progress, fmt  # the cluster decides; output is always a dataset
-    _refuse_unknown(options, kind, stream_file_on_cluster)
+    _refuse_unknown(
+        options, kind, stream_file_on_cluster, passed=("client", "output_dir")
+    )
     source = as_path("input", input_path)
     data = read_grasps(source)
     extra = engine_options(

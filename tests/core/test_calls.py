@@ -376,6 +376,13 @@ def test_a_cluster_run_from_a_file_takes_evaluate_on_clusters_keywords():
         dd.stream_file_on_cluster(
             "/nonexistent.npz", "out", scheduler="tcp://x:1", partition_chunks=2
         )
+    # what it sets itself on evaluate_on_cluster is not among them
+    with pytest.raises(dg.InvalidArgumentError, match="did you mean output_path="):
+        dd.stream_file_on_cluster(
+            "/nonexistent.npz", "out", scheduler="tcp://x:1", output_dir="x"
+        )
+    with pytest.raises(dg.InvalidArgumentError, match="unknown keyword client="):
+        dd.stream_file_on_cluster("/nonexistent.npz", "out", scheduler="x", client=1)
 
 
 def test_a_form_closure_cluster_run_refuses_the_old_spelling_of_a_friction_option():
