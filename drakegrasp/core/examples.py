@@ -131,7 +131,7 @@ def cube_seven_contacts(half_width: float = 1.0) -> Grasp:
     )
 
 
-_MAX_FINGERS = 1000  # fingers on the equator: a picture, not a stress test
+_MAX_FINGERS = 10_000  # a picture, not a stress test: 10**9 would take hours
 
 
 @checked_call
@@ -155,7 +155,7 @@ def equator_fingers(
     ----------
     mu : float
     num_fingers : int, optional
-        How many, in [1, 1000].
+        How many, in [1, 10000] (an integral float such as ``3.0`` counts).
     radius : float, optional
         Sphere radius, metres.
     contact_model : ContactModel or str, optional
@@ -166,7 +166,7 @@ def equator_fingers(
     Grasp
         Spatial, reference point at the sphere's centre.
     """
-    count = integer_or_none(num_fingers)
+    count = integer_or_none(num_fingers, integral_floats=True)
     if count is None or not 1 <= count <= _MAX_FINGERS:
         raise InvalidGraspError(
             f"num_fingers must be an integer in [1, {_MAX_FINGERS}], "

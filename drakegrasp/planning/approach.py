@@ -80,7 +80,12 @@ from drakegrasp.plant.fingers import (
     tip_bodies,
 )
 from drakegrasp.plant.pose import JOINT_LIMIT_TOL
-from drakegrasp.plant.validation import HandSpec, hand_bodies
+from drakegrasp.plant.validation import (
+    HandSpec,
+    hand_bodies,
+    plant_context_of,
+    resolve_object_body,
+)
 
 __all__ = [
     "OPEN",
@@ -453,7 +458,9 @@ def multi_finger_hand(
     InvalidOptionError
         A malformed pre-shape, synergy, approach or stand-off.
     """
+    plant_context = plant_context_of(plant, plant_context)  # the diagram's too
     bodies = hand_bodies(plant, object_body, hand)
+    object_body = resolve_object_body(plant, object_body)
     base = free_base(plant, bodies, hand=hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     structure = hand_structure(

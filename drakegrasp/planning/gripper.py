@@ -44,7 +44,13 @@ from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.attachment import chain_to_world, free_carrier, how_held
 from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import finger_chains, hand_structure
-from drakegrasp.plant.validation import HandSpec, hand_bodies, scoped_name
+from drakegrasp.plant.validation import (
+    HandSpec,
+    hand_bodies,
+    plant_context_of,
+    resolve_object_body,
+    scoped_name,
+)
 
 __all__ = ["PAD_DEPTH", "ParallelJaw", "free_base", "parallel_jaw"]
 
@@ -290,6 +296,7 @@ def parallel_jaw(
         A hand without a free base, without two prismatic fingers with parallel
         axes and finite limits, or whose pads cannot be told from its palm.
     """
+    plant_context = plant_context_of(plant, plant_context)  # the diagram's too
     base, fingers, joints, coupling, (lower, upper) = _two_prismatic_fingers(
         plant, plant_context, object_body, hand
     )
@@ -363,6 +370,7 @@ def _two_prismatic_fingers(plant, plant_context, object_body, hand):
     couplings let them reach (:func:`_coupled_limits`).
     """
     bodies = hand_bodies(plant, object_body, hand)
+    object_body = resolve_object_body(plant, object_body)
     base = free_base(plant, bodies, hand=hand)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     structure = hand_structure(

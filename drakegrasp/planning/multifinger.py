@@ -73,7 +73,12 @@ from drakegrasp.plant.closing import close_checked_hand
 from drakegrasp.plant.contacts import find_contacts
 from drakegrasp.plant.couplings import plant_couplings
 from drakegrasp.plant.fingers import finger_chains, hand_structure, passive_joints
-from drakegrasp.plant.validation import hand_bodies, scoped_name
+from drakegrasp.plant.validation import (
+    hand_bodies,
+    plant_context_of,
+    resolve_object_body,
+    scoped_name,
+)
 
 __all__ = [
     "DEFAULT_TILT",
@@ -120,7 +125,9 @@ REASONS = {
 @checked_call
 def hand_is_parallel_jaw(plant, plant_context, object_body, hand) -> bool:
     """Whether ``hand`` is two fingers of one prismatic joint each (in the plant)."""
+    plant_context = plant_context_of(plant, plant_context)  # the diagram's too
     bodies = hand_bodies(plant, object_body, hand)
+    object_body = resolve_object_body(plant, object_body)
     inspector = plant.get_geometry_query_input_port().Eval(plant_context).inspector()
     try:
         structure = hand_structure(

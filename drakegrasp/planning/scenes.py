@@ -189,7 +189,7 @@ def scene_from_models(add_models) -> PlanningScene:
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     returned = add_models(plant, new_parser(plant, "the planning scene"))
-    if not (isinstance(returned, tuple) and len(returned) == 2):
+    if not (isinstance(returned, tuple | list) and len(returned) == 2):
         raise InvalidOptionError(
             "add_models must return (hand model instance, object body name "
             f"'model::body' or None), got {returned!r}"

@@ -15,6 +15,7 @@ import drakegrasp.core.examples as examples
 import drakegrasp.plant as dp
 from drakegrasp.planning import scene_from_models
 
+BOX = "package://drake_models/ycb/003_cracker_box.sdf"
 HOSTILE = [None, "1", -1.0, float("nan"), 1e400, [1, 2], 0.0, 1j, True, 10**9]
 
 
@@ -43,9 +44,20 @@ def test_the_example_grasps_refuse_or_answer(name, parameter, value):
         assert isinstance(grasp, dg.Grasp)
 
 
-def test_a_thousand_and_one_fingers_are_refused_not_built():
-    with pytest.raises(dg.InvalidGraspError, match=r"num_fingers .* \[1, 1000\]"):
+def test_a_billion_fingers_are_refused_not_built():
+    with pytest.raises(dg.InvalidGraspError, match=r"num_fingers .* \[1, 10000\]"):
         examples.equator_fingers(0.5, num_fingers=10**9)
+    # an integral float counts, as for num_generators
+    assert len(examples.equator_fingers(0.5, num_fingers=4.0).contacts) == 4
+
+
+@pytest.mark.parametrize("half_width", [0.0, -1.0])
+def test_an_example_of_no_size_or_turned_inside_out_is_refused(half_width):
+    # -1 put every contact on the far face with its normal pointing out
+    with pytest.raises(
+        dg.InvalidGraspError, match="half_width must be a finite length"
+    ):
+        examples.cube_seven_contacts(half_width)
 
 
 @pytest.mark.parametrize("plant", [None, [], "plant"])
@@ -77,3 +89,34 @@ def test_hand_bodies_refuses_what_is_not_a_body():
 def test_a_scene_recipe_that_returns_the_wrong_thing_is_named(recipe, message):
     with pytest.raises(dg.GraspError, match=message):
         scene_from_models(recipe)
+
+
+def test_a_scene_recipe_may_return_a_list_as_the_shake_reads_it(drake_models_dir):
+    from drakegrasp.planning import planning_scene
+
+    built = planning_scene(BOX, models_dir=drake_models_dir)
+    as_list = scene_from_models(
+        lambda plant, parser: list(built.add_models(plant, parser))
+    )
+    assert as_list.object_body.name() == built.object_body.name()
+
+
+def test_hand_helpers_take_a_body_name_and_the_diagrams_context(drake_models_dir):
+    # hand_bodies resolves the object body; the helpers that call it must use
+    # that body too, and read the plant's context inside the diagram's.
+    import json
+
+    from drakegrasp.planning import multi_finger_hand, parallel_jaw
+    from drakegrasp.planning.multifinger import hand_is_parallel_jaw
+
+    scene = dg.planning_scene(BOX, models_dir=drake_models_dir)
+    name = "003_cracker_box::base_link_cracker"
+    plant_context = scene.plant.GetMyContextFromRoot(scene.context)
+    assert hand_is_parallel_jaw(scene.plant, scene.context, name, scene.hand)
+    by_name = parallel_jaw(scene.plant, scene.context, name, scene.hand).to_dict()
+    by_body = parallel_jaw(
+        scene.plant, plant_context, scene.object_body, scene.hand
+    ).to_dict()
+    same = json.dumps(by_name, sort_keys=True, default=str)
+    assert same == json.dumps(by_body, sort_keys=True, default=str)
+    assert multi_finger_hand(scene.plant, scene.context, name, scene.hand)
