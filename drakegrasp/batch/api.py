@@ -664,7 +664,7 @@ def iter_batch_closure(
         The result of each chunk, in order.  Error messages index grasps within
         their chunk.
     """
-    if kind not in ("force", "form"):
+    if not isinstance(kind, str) or kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
     for item in chunks:
         if isinstance(item, Mapping):

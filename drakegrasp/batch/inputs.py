@@ -226,7 +226,7 @@ def check_metrics(metrics: Sequence[str]) -> tuple[str, ...]:
             f"{metrics!r}"
         ) from None
     for name in names:
-        if name not in METRICS:
+        if not isinstance(name, str) or name not in METRICS:
             raise InvalidOptionError(
                 f"unknown metric {name!r}; valid metrics are {', '.join(METRICS)}"
             )
@@ -255,7 +255,7 @@ KERNELS = ("auto", "numba", "numpy")
 
 def check_kernel(kernel: str) -> str:
     """``kernel`` if it is one of :data:`KERNELS` (not resolved)."""
-    if kernel not in KERNELS:
+    if not isinstance(kernel, str) or kernel not in KERNELS:
         raise InvalidOptionError(
             f"kernel must be 'auto', 'numba' or 'numpy', got {kernel!r}"
         )

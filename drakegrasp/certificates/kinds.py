@@ -117,9 +117,9 @@ def check_kind_and_cones(
     kind: str, cones: str, kinds: tuple[str, ...], cone_kinds: tuple[str, ...]
 ) -> None:
     """Raise :class:`~drakegrasp.InvalidOptionError` unless both are known."""
-    if kind not in kinds:
+    if not isinstance(kind, str) or kind not in kinds:
         raise InvalidOptionError(f"kind must be one of {kinds}, got {kind!r}")
-    if cones not in cone_kinds:
+    if not isinstance(cones, str) or cones not in cone_kinds:
         raise InvalidOptionError(f"cones must be one of {cone_kinds}, got {cones!r}")
 
 

@@ -216,7 +216,7 @@ def evaluate_on_cluster(
         (:func:`~drakegrasp.batch.metrics.check_moment_arms_of_batch`), before
         connecting; other faults of the input come from the partitions.
     """
-    if kind not in ("force", "form"):
+    if not isinstance(kind, str) or kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
     _refuse_unknown(keywords, kind, evaluate_on_cluster)
     options, chunk_size = _engine_options(options, keywords, kind, chunk_size)

@@ -462,7 +462,7 @@ def find_contacts(
     """
     plant_context = plant_context_of(plant, plant_context)
     tol = check_distance_tolerance(distance_tolerance)
-    if patches not in ("vertices", "witness"):
+    if not isinstance(patches, str) or patches not in ("vertices", "witness"):
         raise InvalidOptionError(
             f"patches must be 'vertices' or 'witness', got {patches!r}"
         )

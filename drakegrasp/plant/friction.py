@@ -120,7 +120,7 @@ def pair_friction(
 
 
 def _check_rule(rule) -> str:
-    if rule not in ("static", "dynamic"):
+    if not isinstance(rule, str) or rule not in ("static", "dynamic"):
         raise InvalidOptionError(
             f"rule must be 'static', 'dynamic' or None, got {rule!r}"
         )

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import inspect
 
+import numpy as np
 import pytest
 
 import drakegrasp as dg
@@ -120,3 +121,28 @@ def test_hand_helpers_take_a_body_name_and_the_diagrams_context(drake_models_dir
     same = json.dumps(by_name, sort_keys=True, default=str)
     assert same == json.dumps(by_body, sort_keys=True, default=str)
     assert multi_finger_hand(scene.plant, scene.context, name, scene.hand)
+
+
+ARRAYS = [np.array([1, 2, 3], dtype=object), np.zeros((0, 3)), np.array(["a", "b"])]
+
+
+@pytest.mark.parametrize("value", ARRAYS, ids=["objects", "empty", "strings"])
+def test_a_choice_given_as_an_array_is_refused_by_name(value):
+    # `value not in ("auto", ...)` compared an array element by element and
+    # numpy refused to call the answer true or false (a bare ValueError).
+    import drakegrasp.batch as db
+    from drakegrasp.batch.files.writer import format_of
+
+    P = np.zeros((2, 3, 3))
+    N = np.tile([0.0, 0.0, 1.0], (2, 3, 1))
+    calls = {
+        "kernel": lambda: dg.BatchOptions(kernel=value),
+        "unknown metric": lambda: dg.BatchOptions(
+            metrics=np.ones((2, 2)) + 0 * value.size
+        ),
+        "kind": lambda: next(db.iter_batch_closure([(P, N)], kind=value)),
+        "format": lambda: format_of("out.npz", value),  # stream_file's --format
+    }
+    for name, call in calls.items():
+        with pytest.raises(dg.GraspError, match=name):
+            call()

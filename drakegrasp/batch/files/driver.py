@@ -61,7 +61,7 @@ def _file_run(
     Returns ``(output, K, d, options, chunks)``, ``options`` the validated
     engine options (``tol``, ``metrics``, ...).
     """
-    if kind not in ("force", "form"):
+    if not isinstance(kind, str) or kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
     overwrite = check_flag("overwrite", overwrite)
     source = as_path("input", input_path)

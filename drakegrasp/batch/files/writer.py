@@ -120,7 +120,7 @@ def format_of(path: str | os.PathLike, fmt: str | None = None) -> str:
     """
     suffix = Path(path).suffix.lower().lstrip(".")
     if fmt is not None:
-        if fmt not in FORMATS:
+        if not isinstance(fmt, str) or fmt not in FORMATS:
             raise InvalidOptionError(
                 f"format must be one of {', '.join(FORMATS)}, got {fmt!r}"
             )
