@@ -218,6 +218,10 @@ class WeakMemo(weakref.WeakKeyDictionary):
         store = self.get(owner)
         if store is None:
             store = self[owner] = {}
-        if key not in store:
+        try:
+            known = key in store
+        except TypeError:  # an unhashable argument: compute() judges it, uncached
+            return compute()
+        if not known:
             store[key] = compute()
         return store[key]

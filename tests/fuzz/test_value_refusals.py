@@ -146,3 +146,17 @@ def test_a_choice_given_as_an_array_is_refused_by_name(value):
     for name, call in calls.items():
         with pytest.raises(dg.GraspError, match=name):
             call()
+
+
+@pytest.mark.parametrize("value", [[[1, 2], [3]], [8], np.array([1.0, 1.0, 1.0])])
+def test_an_unhashable_option_is_judged_not_memoised(value):
+    # The per-grasp memo keyed its results on the options, and a list is not
+    # a key: a bare TypeError ('unhashable type') before the option's check.
+    grasp = dg.examples.spatial_two_fingers(0.5)
+    planar = dg.examples.planar_two_finger_square(0.6)
+    for call in (
+        lambda: dg.force_closure(grasp, num_generators=value),
+        lambda: dg.grasp_quality(planar, num_generators=value),
+    ):
+        with pytest.raises(dg.InvalidOptionError, match="num_generators must be"):
+            call()
