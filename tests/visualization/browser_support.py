@@ -76,9 +76,26 @@ def read_png(path: Path) -> np.ndarray:
 
 
 def screenshot(
-    url: str, path: Path, profile: Path, budget_ms: int = 4000
+    url: str, path: Path, profile: Path, budget_ms: int = 4000, attempts: int = 3
 ) -> np.ndarray:
-    """Open ``url`` in headless Chromium and return its screenshot as RGB."""
+    """Open ``url`` in headless Chromium and return its screenshot as RGB.
+
+    A page that had not drawn its 3-D scene when the virtual-time budget ran
+    out is a flat image (a standard deviation under 5 grey levels; every
+    Meshcat scene, even an empty one, has its grid and shading).  On a loaded
+    machine that happened in CI once (89 % of pixels off the empty scene's);
+    such a shot is taken again, up to ``attempts`` times, with twice the
+    budget each time.  What a rendered scene shows is never retried.
+    """
+    for attempt in range(attempts):
+        img = _screenshot(url, path, profile, budget_ms * 2**attempt)
+        if img.std() > 5.0:
+            break
+    return img
+
+
+def _screenshot(url: str, path: Path, profile: Path, budget_ms: int) -> np.ndarray:
+    """One headless Chromium screenshot of ``url``, as RGB."""
     cmd = [
         str(CHROMIUM),
         "--headless",
