@@ -231,28 +231,28 @@ def call_problem(
         if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
     ]
     if inspect.Parameter.VAR_KEYWORD not in kinds:
-        only = {p.name for p in parameters if p.kind is p.POSITIONAL_ONLY}
+        by_position = {p.name for p in parameters if p.kind is p.POSITIONAL_ONLY}
         wrong = [
             f"{name} is positional only: give it by position"
             for name in kwargs
-            if name in only
+            if name in by_position
         ]
-        unknown = [name for name in kwargs if name not in keywords and name not in only]
+        unknown = [n for n in kwargs if n not in keywords and n not in by_position]
         if unknown:
             wrong.append(unknown_names(unknown, keywords, noun=noun))
         if wrong:
             return "; ".join(wrong)
     positional = [p.name for p in parameters if p.kind in _POSITIONAL]
     if inspect.Parameter.VAR_POSITIONAL not in kinds and len(args) > len(positional):
-        only = [p.name for p in parameters if p.kind is p.KEYWORD_ONLY]
+        by_keyword = [p.name for p in parameters if p.kind is p.KEYWORD_ONLY]
         named = f" ({', '.join(positional)})" if positional else ""
         message = (
             f"takes {len(positional)} positional argument"
             f"{'' if len(positional) == 1 else 's'}{named} but {len(args)} "
             f"{'was' if len(args) == 1 else 'were'} given"
         )
-        if only:
-            message += "; by keyword only: " + ", ".join(f"{n}=" for n in only)
+        if by_keyword:
+            message += "; by keyword only: " + ", ".join(f"{n}=" for n in by_keyword)
         return message
     twice = [
         p.name
