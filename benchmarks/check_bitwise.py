@@ -7,6 +7,7 @@ Usage::
     PYTHONPATH=TREE python benchmarks/check_bitwise.py single OUT.npz [--grasps 150]
     python benchmarks/check_bitwise.py compare A.npz B.npz
     PYTHONPATH=TREE python benchmarks/check_bitwise.py plan [--num 1500] [--seed 0]
+    PYTHONPATH=TREE python benchmarks/check_bitwise.py plan-cloud [--num 150] [--seed 0]
 
 ``record`` runs, in this process, ``batch_force_closure`` (d*, rank, verdict,
 margin, converged, normal certificate) and ``batch_epsilon_l1`` (ε) on
@@ -28,6 +29,12 @@ object, a SHA-256 of the ranked candidates (in rank order: sample, ``X_WH``,
 ``q_hand``, verdict, rank, d*, ε, robustness, weight capacity α, squeeze
 needed and score, each as its exact bytes), the candidate count and the
 rejections by reason; two trees agree bit for bit when the hashes do.
+
+``plan-cloud`` does the same for the multi-finger cloud route: the Allegro
+hand (thumb opposed) on the full and the one-sided cloud of the soup can
+(3,000 points, seed 0, as ``bench_cloud_hold.py`` samples them), planned with
+the can's mass; its hash adds each candidate's torque needed and contacts
+(positions and normals) and prints the seconds each plan took.
 """
 
 from __future__ import annotations
@@ -185,6 +192,45 @@ def plan_hashes(num: int, seed: int) -> None:
         print(f"{name:<20} {h.hexdigest()[:16]} {len(result):5d} candidates; {reasons}")
 
 
+def _hash_candidate(h, c) -> None:
+    h.update(np.int64(c.sample).tobytes())
+    h.update(c.X_WH.GetAsMatrix34().tobytes())
+    h.update(np.asarray(c.q_hand, float).tobytes())
+    h.update(np.array([c.is_closure, c.rank], np.int64).tobytes())
+    torque = np.nan if c.torque_needed is None else c.torque_needed
+    values = (c.d_star, c.epsilon, c.robustness, c.score, torque)
+    h.update(np.array(values, float).tobytes())
+    for contact in c.grasp.contacts:
+        h.update(np.asarray(contact.position, float).tobytes())
+        h.update(np.asarray(contact.normal, float).tobytes())
+
+
+def plan_cloud_hashes(num: int, seed: int) -> None:
+    import hashlib
+
+    from bench_cloud_hold import CAN, VIEW, allegro_scene, plan_cloud, sample_cloud
+    from bench_plan import drake_models
+
+    models = drake_models()
+    if models is None:
+        raise SystemExit("drake_models not found (set DRAKEGRASP_DRAKE_MODELS)")
+    full, hand = allegro_scene(models, CAN), allegro_scene(models)
+    mass = full.object_body.get_mass(full.plant.GetMyContextFromRoot(full.context))
+    for name, view in (("full", None), ("one-sided", VIEW)):
+        points, normals = sample_cloud(full, 3000, 0, view)
+        result, seconds = plan_cloud(
+            hand, points, normals, view, num=num, seed=seed, mass=mass
+        )
+        h = hashlib.sha256()
+        for c in result:
+            _hash_candidate(h, c)
+        reasons = ", ".join(f"{k} {v}" for k, v in sorted(result.rejections.items()))
+        print(
+            f"{name:<10} {h.hexdigest()[:16]} {len(result):4d} candidates "
+            f"in {seconds:5.1f} s; {reasons}"
+        )
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="cmd", required=True)
@@ -200,7 +246,13 @@ def main() -> int:
     pl = sub.add_parser("plan")
     pl.add_argument("--num", type=int, default=1500)
     pl.add_argument("--seed", type=int, default=0)
+    pc = sub.add_parser("plan-cloud")
+    pc.add_argument("--num", type=int, default=150)
+    pc.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
+    if args.cmd == "plan-cloud":
+        plan_cloud_hashes(args.num, args.seed)
+        return 0
     if args.cmd == "plan":
         plan_hashes(args.num, args.seed)
         return 0

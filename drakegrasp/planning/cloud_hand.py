@@ -193,6 +193,12 @@ held them)."""
 _FD = 1e-7
 """Step (m) of the central differences of a signed distance's gradient."""
 
+_PROBES = np.vstack([_FD * np.eye(3), -_FD * np.eye(3)])
+"""(6, 3) float: the central differences' steps (m), +x, +y, +z, then −x, −y, −z."""
+
+_PROBES_AT = np.vstack([np.zeros(3), _PROBES])
+"""(7, 3) float: the point itself, then ``_PROBES`` (m)."""
+
 _EXACT_WITHIN = 5e-3
 """Distances (m) of finger geometries are exact below this, lower bounds
 above it (enough to bound a closing step), so only the cloud points near a
@@ -469,8 +475,7 @@ class CloudHand(CentredCloser):
         differences of the closed form), None where the gradient vanishes.
         """
         R, p = self._pose(g)
-        probe = np.vstack([np.zeros(3), _FD * np.eye(3), -_FD * np.eye(3)])
-        sd = self._signed(g, R, p, x_W + probe @ R.T)
+        sd = self._signed(g, R, p, x_W + _PROBES_AT @ R.T)
         grad = (sd[1:4] - sd[4:7]) / (2 * _FD)
         norm = np.linalg.norm(grad)
         if not norm > 0:
@@ -803,8 +808,7 @@ class CloudHand(CentredCloser):
         not the object's, fixes the contact normal.
         """
         R, p = self._pose(g)
-        probe = np.vstack([_FD * np.eye(3), -_FD * np.eye(3)])
-        sd = self._signed(g, R, p, x_W + probe)
+        sd = self._signed(g, R, p, x_W + _PROBES)
         grad = (sd[:3] - sd[3:]) / (2 * _FD)
         return -grad / np.linalg.norm(grad)
 
