@@ -19,7 +19,7 @@ command load only the layers they use: ``drakegrasp analyze`` imports no batch
 engine, quality metrics, pictures or grasp monitor.
 """
 
-from drakegrasp._lazy import lazy_exports
+from drakegrasp._lazy import forward_moved_modules, lazy_exports
 
 # Where each public name lives (the imports an eager package would run).
 _SOURCES = {
@@ -195,6 +195,52 @@ _SUBMODULES = {
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(), _SOURCES, submodules=_SUBMODULES
 )
+
+# Modules that moved into the layer folders (docs/changes.md, "the house"):
+# their old paths import the new modules and warn.  ``drakegrasp.examples``
+# stays public, without a warning.
+_MOVED = {
+    f"drakegrasp.{old}": f"drakegrasp.{new}"
+    for old, new in {
+        "antipodal": "core.antipodal",
+        "contact": "core.contact",
+        "curvature": "core.curvature",
+        "examples": "core.examples",
+        "friction_cone": "core.friction_cone",
+        "cone_support": "core.friction_cone",
+        "grasp": "core.grasp",
+        "validation": "core.validation",
+        "certificate_check": "certificates.certificate",
+        "certificate_kinds": "certificates.kinds",
+        "certificate_text": "certificates.text",
+        "witness": "certificates.witness",
+        "results": "closure.results",
+        "second_order": "closure.second_order",
+        "batch.engine": "batch.api",
+        "batch.chunks": "batch.run.chunk",
+        "batch.parallel": "batch.run.workers",
+        "batch.shared_arrays": "batch.run.shared_arrays",
+        "batch.construction": "batch.build.construction",
+        "batch.construction_kernel": "batch.build.construction_kernel",
+        "batch.rowspace": "batch.build.rowspace",
+        "batch.wrenches": "batch.build.wrenches",
+        "batch.margin": "batch.lp.dstar",
+        "batch.fused_kernel": "batch.lp.fused_kernel",
+        "batch.active_set": "batch.lp.active_set",
+        "batch.block_kernel": "batch.lp.block_kernel",
+        "batch.block_ops": "batch.lp.block_ops",
+        "batch.block_ipm": "batch.lp.block_ipm",
+        "batch.householder": "batch.lp.householder",
+        "batch.ipm": "batch.lp.ipm",
+        "batch.epsilon_kernel": "batch.epsilon.kernel",
+        "batch.polytope": "batch.epsilon.polytope",
+        "batch.certificates": "batch.witnesses",
+        "batch.io": "batch.files.reader",
+        "batch.writers": "batch.files.writer",
+        "visualization.certificates": "visualization.meshcat_certificates",
+    }.items()
+}
+forward_moved_modules(_MOVED, aliases=("drakegrasp.examples",))
 
 __version__ = "0.1.0"
 

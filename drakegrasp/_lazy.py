@@ -9,15 +9,23 @@ name lives; :func:`lazy_exports` gives it a module-level ``__getattr__`` (PEP
 value in the package, so later reads are plain attribute reads.
 ``from drakegrasp import X``, ``drakegrasp.X`` and ``from drakegrasp import *``
 all resolve exactly as with eager imports.
+
+Modules that moved keep their old paths: :func:`forward_moved_modules` lets
+``import drakegrasp.grasp`` give ``drakegrasp.core.grasp`` (the same module
+object, with a ``DeprecationWarning`` naming the new path).
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.machinery
+import sys
+import warnings
 from collections.abc import Callable, Iterable, Mapping
+from types import ModuleType
 from typing import Any
 
-__all__ = ["lazy_exports"]
+__all__ = ["forward_moved_modules", "lazy_exports"]
 
 
 def lazy_exports(
@@ -69,3 +77,65 @@ def lazy_exports(
         return sorted(set(namespace) | set(where) | set(children))
 
     return __getattr__, __dir__
+
+
+class _MovedModules:
+    """Finds a moved module's old path and loads it as the module it became.
+
+    A meta path finder and its loader (the import system's protocols).
+    """
+
+    def __init__(self, moved: Mapping[str, tuple[str, bool]]):
+        self.moved = dict(moved)
+
+    def find_spec(self, fullname, path=None, target=None):  # noqa: ARG002
+        """A spec for an old path (None for any other name)."""
+        if fullname not in self.moved:
+            return None
+        return importlib.machinery.ModuleSpec(fullname, self)
+
+    def create_module(self, spec) -> ModuleType:
+        new, deprecated = self.moved[spec.name]
+        module = importlib.import_module(new)
+        if deprecated:
+            # stacklevel 2 skips the import system's own frames: the warning
+            # points at the user's import statement
+            warnings.warn(
+                f"the module {spec.name} moved to {new}; import it from there "
+                "(the old path will be removed)",
+                DeprecationWarning,
+                stacklevel=2,
+            )
+        return module
+
+    def exec_module(self, module: ModuleType) -> None:
+        """Nothing to run: the module is the one its new path imported."""
+
+
+def forward_moved_modules(
+    moved: Mapping[str, str], aliases: Iterable[str] = ()
+) -> None:
+    """Let old module paths import the modules they became.
+
+    ``import old`` (and ``from old import name``, and a pickle that names
+    ``old``) gives the very module ``new`` is, whose attributes the old path's
+    users read; ``old`` is kept in ``sys.modules``.  Each old path warns once
+    per process (``DeprecationWarning``), unless it is one of ``aliases``:
+    paths that stay public (``drakegrasp.examples``).
+
+    Parameters
+    ----------
+    moved : mapping of str to str
+        ``{old module path: new module path}``, full dotted names.  An old
+        path's last part must not be a public name of its package, which the
+        import would replace by the module.
+    aliases : iterable of str, optional
+        Old paths that import without a warning.
+    """
+    aliases = set(aliases)
+    table = {old: (new, old not in aliases) for old, new in moved.items()}
+    for finder in sys.meta_path:
+        if isinstance(finder, _MovedModules):  # the package was imported again
+            finder.moved.update(table)
+            return
+    sys.meta_path.append(_MovedModules(table))

@@ -335,7 +335,9 @@ def test_package_inits_import_nothing_but_the_lazy_table():
         tree = ast.parse(MODULES[name].read_text())
         targets = {t for node in ast.walk(tree) for t in _import_targets(node)}
         inner = {t for t in targets if t.split(".")[0] == "drakegrasp"}
-        assert inner <= {"drakegrasp._lazy", "drakegrasp._lazy.lazy_exports"}, (
+        lazy = {"drakegrasp._lazy", "drakegrasp._lazy.lazy_exports"}
+        lazy.add("drakegrasp._lazy.forward_moved_modules")  # strings, not imports
+        assert inner <= lazy, (
             name,
             sorted(inner),
         )
@@ -438,7 +440,7 @@ def test_every_import_by_name_is_accounted_for():
     # A new importlib.import_module call is a dependency no statement shows:
     # add its edges to DYNAMIC_IMPORTS, or name why it is none.
     known = {
-        "drakegrasp._lazy": 2,  # a public name's module, a child module
+        "drakegrasp._lazy": 3,  # a public name's module, a child module, a moved one
         "drakegrasp.batch.compiled": 1,  # a kernel unpickled by reference
         "drakegrasp.batch.aot": 1,  # the compiled extension
         "drakegrasp.batch.aot_build": 1,  # the kernel modules: DYNAMIC_IMPORTS

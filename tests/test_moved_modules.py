@@ -1,0 +1,95 @@
+"""Old module paths still import: each gives the module it became, and warns.
+
+The imports run in a child process: importing an old path puts it in
+``sys.modules`` and on its package, which the other tests of a worker must not
+see.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import drakegrasp
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "drakegrasp"
+
+_CHILD = r"""
+import importlib, json, pickle, sys, warnings
+import drakegrasp
+out = {}
+for old, new in sorted(drakegrasp._MOVED.items()):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        exec(f"import {old}")  # an import statement, as a user writes it
+    out[old] = {
+        "same": sys.modules[old] is sys.modules[new],
+        "name": sys.modules[old].__name__,
+        "warnings": [
+            [w.category.__name__, str(w.message), w.filename] for w in caught
+        ],
+    }
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    from drakegrasp.grasp import Grasp
+    from drakegrasp.results import ClosureResult
+out["from"] = Grasp is drakegrasp.Grasp and ClosureResult is drakegrasp.ClosureResult
+# a pickle made before the move names the old module
+out["pickle"] = pickle.loads(b"cdrakegrasp.contact\nContact\n.") is drakegrasp.Contact
+try:
+    importlib.import_module("drakegrasp.no_such_module")
+    out["unknown"] = "imported"
+except ModuleNotFoundError as error:
+    out["unknown"] = str(error)
+print(json.dumps(out))
+"""
+
+
+def _child() -> dict:
+    done = subprocess.run(
+        [sys.executable, "-c", _CHILD],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+        check=True,
+    )
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def test_each_old_path_is_its_new_module_and_warns_at_the_import():
+    out = _child()
+    for old, new in drakegrasp._MOVED.items():
+        got = out[old]
+        assert got["same"] and got["name"] == new, (old, got)
+        if old == "drakegrasp.examples":  # public: dg.examples
+            assert got["warnings"] == [], got
+            continue
+        assert len(got["warnings"]) == 1, (old, got)
+        category, message, filename = got["warnings"][0]
+        assert category == "DeprecationWarning"
+        assert f"{old} moved to {new}" in message
+        assert filename == "<string>", filename  # the import statement's line
+    assert out["from"] and out["pickle"]
+    assert out["unknown"] == "No module named 'drakegrasp.no_such_module'"
+
+
+def test_the_table_maps_gone_paths_to_modules_that_exist():
+    """An old path is not a file (it would shadow nothing but itself), its new
+    path is one, and its last part is no public name of its package, which
+    the import would replace by the module."""
+    for old, new in drakegrasp._MOVED.items():
+        rel_old = Path(*old.split(".")[1:])
+        assert not (PACKAGE / rel_old).with_suffix(".py").exists(), old
+        assert not (PACKAGE / rel_old).is_dir(), old
+        assert (PACKAGE / Path(*new.split(".")[1:])).with_suffix(".py").is_file(), new
+        parent, _, child = old.rpartition(".")
+        package = importlib.import_module(parent)
+        public = {
+            n for names in vars(package).get("_SOURCES", {}).values() for n in names
+        }
+        assert child not in public, old
