@@ -561,6 +561,13 @@ def add_coupler_constraint(
 def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
     """The couplings to use: ``couplings`` when given, else those of the plant.
 
+    A chain of couplings (a joint following a joint that follows another, as
+    Drake's coupler constraints allow) is resolved to its root: each follower
+    of a chain is coupled to the chain's first leader, ``q_2 = ρ_a q_1 + Δ_a``
+    and ``q_1 = ρ_b q_0 + Δ_b`` giving ``q_2 = ρ_a ρ_b q_0 + ρ_a Δ_b + Δ_a``,
+    the same set of positions, so every follower follows a joint that follows
+    none.
+
     Parameters
     ----------
     plant : MultibodyPlant
@@ -570,17 +577,20 @@ def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
     Returns
     -------
     tuple
-        ``couplings`` as given, or the recorded :class:`JointCoupling` s.
+        ``couplings`` as given, or the recorded :class:`JointCoupling` s; where
+        they hold a chain, :class:`JointCoupling` s of scoped names, each
+        follower's to the root of its chain.
 
     Raises
     ------
     InvalidOptionError
         When ``couplings`` is None and the plant has constraints that were not
         recorded as couplings (a ``<mimic>`` parsed by a bare ``Parser``, a
-        constraint added in code): names the ways to tell drakegrasp.
+        constraint added in code): names the ways to tell drakegrasp.  For
+        couplings that close a loop, or a joint that follows two joints.
     """
     if couplings is not None:
-        return coupling_entries(couplings)
+        return _resolved_chains(plant, coupling_entries(couplings))
     check_plant(plant, finalized=False)
     known = tuple(_RECORDED.get(plant, ()))
     if plant.num_constraints() > len(known):
@@ -593,7 +603,46 @@ def plant_couplings(plant: MultibodyPlant, couplings=None) -> tuple:
             "drakegrasp.plant.add_coupler_constraint, or pass couplings=[(joint_0, "
             "joint_1, gear_ratio, offset)] (couplings=() to ignore them)"
         )
-    return known
+    return _resolved_chains(plant, known)
+
+
+def _resolved_chains(plant: MultibodyPlant, entries: tuple) -> tuple:
+    """``entries`` with each chain resolved to its root (:func:`plant_couplings`).
+
+    Entries without a chain are returned as they are (the same objects).
+    """
+    if len(entries) < 2:
+        return entries
+    named = {}
+    for entry in entries:
+        j0, j1, rho, offset = coupling_entry(plant, entry)
+        follower, leader = joint_name(plant, j0), joint_name(plant, j1)
+        if named.get(follower, (leader, rho, offset)) == (leader, rho, offset):
+            named[follower] = (leader, rho, offset)  # a repeated coupling is one
+            continue
+        if follower in named:
+            raise InvalidOptionError(
+                f"joint {follower} follows two joints ({named[follower][0]} and "
+                f"{leader}); a joint follows at most one"
+            )
+    if not any(leader in named for leader, _, _ in named.values()):
+        return entries
+    resolved = []
+    for follower, (leader, rho, offset) in named.items():
+        path = [follower]
+        while leader in named:
+            if leader in path:
+                loop = " -> ".join([*path[path.index(leader) :], leader])
+                raise InvalidOptionError(
+                    f"the couplings close a loop ({loop}, each following the "
+                    "next): a chain of couplings must end at a joint that follows "
+                    "none"
+                )
+            path.append(leader)
+            leader, rho_b, offset_b = named[leader]
+            rho, offset = rho * rho_b, rho * offset_b + offset
+        resolved.append(JointCoupling(follower, leader, rho, offset))
+    return tuple(resolved)
 
 
 def coupling_map(

@@ -13,21 +13,32 @@ MODEL = "coupled_hand"
 RATIO = 1.0  # the followers' multiplier
 
 
-def coupled_hand_sdf(*, follower_effort: float = 2.0, ratio: float = RATIO) -> str:
+def coupled_hand_sdf(
+    *,
+    follower_effort: float = 2.0,
+    ratio: float = RATIO,
+    tip_ratio: float | None = None,
+) -> str:
     """The hand as SDFormat text.
 
     Three two-link fingers 120° apart around the palm's z axis, capsule links,
     joints about ``-y`` of each finger (positive closes), limits [-0.6, 1.5]
     rad.  Drake adds an actuator to a joint whose ``<effort>`` is not zero: the
     proximal joints get 2 N·m; ``follower_effort=0`` leaves the distal joints
-    without one, as a real linkage's follower has no motor.
+    without one, as a real linkage's follower has no motor.  ``tip_ratio``
+    adds a third link to each finger, its joint a follower of the distal one
+    at that multiplier (a chain of couplings: tip → distal → proximal), the
+    distal and proximal links then 0.04 and 0.035 m long.
     """
     links, joints = [], []
+    parts = (("prox", 0.0, 0.05), ("dist", 0.05, 0.04))
+    if tip_ratio is not None:
+        parts = (("prox", 0.0, 0.04), ("dist", 0.04, 0.035), ("tip", 0.075, 0.03))
     for k in range(3):
         a = 2 * np.pi * k / 3
         c, s = np.cos(a), np.sin(a)
         x, y = 0.045 * c, 0.045 * s
-        for part, z, length in (("prox", 0.0, 0.05), ("dist", 0.05, 0.04)):
+        for part, z, length in parts:
             links.append(
                 f"<link name='f{k}_{part}'><pose>{x} {y} {z} 0 0 {a}</pose>"
                 "<inertial><mass>0.03</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy>"
@@ -39,10 +50,17 @@ def coupled_hand_sdf(*, follower_effort: float = 2.0, ratio: float = RATIO) -> s
         mimic = (
             f"<drake:mimic joint='f{k}_prox_joint' multiplier='{ratio:g}' offset='0'/>"
         )
-        for part, parent, extra, effort in (
+        chain = [
             ("prox", "palm", "", 2.0),
             ("dist", f"f{k}_prox", mimic, follower_effort),
-        ):
+        ]
+        if tip_ratio is not None:
+            tip = (
+                f"<drake:mimic joint='f{k}_dist_joint' multiplier='{tip_ratio:g}' "
+                "offset='0'/>"
+            )
+            chain.append(("tip", f"f{k}_dist", tip, follower_effort))
+        for part, parent, extra, effort in chain:
             joints.append(
                 f"<joint name='f{k}_{part}_joint' type='revolute'>"
                 f"<parent>{parent}</parent><child>f{k}_{part}</child>"

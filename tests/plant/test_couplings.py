@@ -313,7 +313,7 @@ def test_a_drake_prefix_the_file_does_not_declare_is_read_as_drake_reads_it():
     assert couplings_in_model(bare, "sdf")[0][0][2:] == (2.0, -0.01)
 
 
-def _chain_plant(ratios=(1.0, 0.5)):
+def _chain_plant(ratios=(1.0, 0.5), offsets=(0.0, 0.0)):
     """Three hinges on a palm, ``b`` following ``a`` and ``c`` following ``b``."""
     from pydrake.multibody.parsing import Parser
     from pydrake.multibody.plant import MultibodyPlant
@@ -329,13 +329,13 @@ def _chain_plant(ratios=(1.0, 0.5)):
         '<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
         "{1}</joint>"
     )
-    mimic = '<mimic joint="{0}" multiplier="{1}" offset="0"/>'
+    mimic = '<mimic joint="{0}" multiplier="{1}" offset="{2}"/>'
     urdf = (
         '<?xml version="1.0"?><robot name="chain">'
         + "".join(link.format(n) for n in ("palm", "la", "lb", "lc"))
         + hinge.format("a", "")
-        + hinge.format("b", mimic.format("a", ratios[0]))
-        + hinge.format("c", mimic.format("b", ratios[1]))
+        + hinge.format("b", mimic.format("a", ratios[0], offsets[0]))
+        + hinge.format("c", mimic.format("b", ratios[1], offsets[1]))
         + "</robot>"
     )
     plant = MultibodyPlant(0.0)
@@ -344,16 +344,52 @@ def _chain_plant(ratios=(1.0, 0.5)):
     return plant
 
 
-def test_a_chain_of_couplings_is_refused_naming_the_joint_in_the_middle():
-    # "a joint may not both lead and follow a coupling": which one, it did not say
-    from drakegrasp.plant.couplings import coupling_map
+def test_a_chain_of_couplings_is_resolved_to_its_root():
+    # A joint following a follower was refused ("may not both lead and
+    # follow"), though Drake's coupler constraints take chains.  Resolved, c
+    # follows a: checked against the recorded chain applied link by link.
+    from drakegrasp.plant.couplings import coupling_map, recorded_couplings
 
-    plant = _chain_plant()
+    plant = _chain_plant(ratios=(2.0, -0.5), offsets=(0.1, 0.03))
+    raw = recorded_couplings(plant)
+    resolved = plant_couplings(plant)
+    assert {c.follower: c.leader for c in resolved} == {
+        "chain::b": "chain::a",
+        "chain::c": "chain::a",
+    }
+    rho = {c.follower: (c.gear_ratio, c.offset) for c in resolved}
+    for q_a in (-0.7, 0.0, 0.4):
+        q = {"chain::a": q_a}
+        for follower, leader, ratio, offset in raw:  # b before c, as recorded
+            q[follower] = ratio * q[leader] + offset
+        for follower, (ratio, offset) in rho.items():
+            assert ratio * q_a + offset == pytest.approx(q[follower], abs=1e-15)
+    # given couplings resolve alike, in any order, and a chain-free list is
+    # returned as it was given (the same objects)
+    assert set(plant_couplings(plant, couplings=raw[::-1])) == set(resolved)
+    assert plant_couplings(plant, couplings=raw[:1]) == raw[:1]
+    # the velocity map: v_b = 2 v_a, v_c = -0.5 v_b = -v_a
     columns = [plant.GetJointByName(n).velocity_start() for n in "abc"]
+    C, independent = coupling_map(plant, columns, resolved)
+    np.testing.assert_array_equal(C, [[1.0], [2.0], [-1.0]])
+    assert list(independent) == columns[:1]
+    # the map itself still takes one level: a raw chain is named, not misread
     with pytest.raises(
         InvalidOptionError, match="joint chain::b may not both lead and follow"
     ):
-        coupling_map(plant, columns, plant_couplings(plant))
+        coupling_map(plant, columns, raw)
+
+
+def test_couplings_that_loop_or_a_joint_with_two_leaders_are_refused():
+    plant = _chain_plant()
+    loop = [("chain::b", "chain::a", 1.0, 0.0), ("chain::a", "chain::b", 1.0, 0.0)]
+    with pytest.raises(InvalidOptionError, match=r"close a loop \(chain::b -> "):
+        plant_couplings(plant, couplings=loop)
+    two = [("chain::c", "chain::a", 1.0, 0.0), ("chain::c", "chain::b", 2.0, 0.0)]
+    with pytest.raises(InvalidOptionError, match="chain::c follows two joints"):
+        plant_couplings(plant, couplings=two)
+    same = [("chain::c", "chain::a", 1.0, 0.0)] * 2  # a repeated coupling is one
+    assert plant_couplings(plant, couplings=same) == tuple(same)
 
 
 def test_a_zero_ratio_names_the_joints_it_couples():

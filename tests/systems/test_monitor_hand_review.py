@@ -270,12 +270,12 @@ def test_an_unrecorded_mimic_is_refused_when_the_monitor_is_built():
             **OPTIONS,
         )
     # given couplings every sample's analysis would refuse are refused when
-    # the monitor is built, as given (a joint that leads and follows)
+    # the monitor is built, as given (two joints each following the other)
     both_ways = [
         (COUPLING[0], COUPLING[1], 1.0, 0.0),
         (COUPLING[1], COUPLING[0], 1.0, 0.0),
     ]
-    with pytest.raises(InvalidOptionError, match="lead and follow") as caught:
+    with pytest.raises(InvalidOptionError, match="close a loop") as caught:
         dg.GraspMonitor(
             scene.plant, object_body=scene.ball, hand=scene.gripper,
             couplings=both_ways, **OPTIONS,
