@@ -24,8 +24,13 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp, grasp_matrix
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import check_grasp, check_length, check_num_generators
-from drakegrasp.errors import InvalidContactError, InvalidOptionError
+from drakegrasp.core.validation import (
+    check_contact,
+    check_grasp,
+    check_length,
+    check_num_generators,
+)
+from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
     "DEFAULT_NUM_GENERATORS",
@@ -204,10 +209,7 @@ def effective_cone(
     -------
     EffectiveCone
     """
-    if not isinstance(contact, Contact):
-        raise InvalidContactError(
-            f"contact must be a drakegrasp.Contact, got {type(contact).__name__}"
-        )
+    check_contact(contact)
     n_g = _check_num_generators(num_generators)
     comps = contact.effective_components()
     torsion = 0.0

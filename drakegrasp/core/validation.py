@@ -76,6 +76,7 @@ __all__ = [
     "check_angle_tol",
     "check_coefficient",
     "check_coefficient_array",
+    "check_contact",
     "check_distance_tolerance",
     "check_flag",
     "check_grasp",
@@ -474,6 +475,19 @@ def check_grasp(value, name: str = "grasp"):
     if grasp_module is None or not isinstance(value, grasp_module.Grasp):
         raise InvalidGraspError(
             f"{name} must be a drakegrasp.Grasp, got {describe(value)} "
+            f"({type(value).__name__})"
+        )
+    return value
+
+
+def check_contact(value, name: str = "contact"):
+    """``value`` if it is a :class:`~drakegrasp.Contact`, else InvalidContactError."""
+    # Looked up where it lives, as in check_grasp (drakegrasp.core.contact
+    # imports this module).
+    contact_module = sys.modules.get("drakegrasp.core.contact")
+    if contact_module is None or not isinstance(value, contact_module.Contact):
+        raise InvalidContactError(
+            f"{name} must be a drakegrasp.Contact, got {describe(value)} "
             f"({type(value).__name__})"
         )
     return value

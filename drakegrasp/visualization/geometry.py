@@ -38,6 +38,8 @@ from drakegrasp.core.validation import (
     LENGTH_BOUND,
     LENGTH_MIN,
     check_coefficient,
+    check_contact,
+    check_grasp,
     describe,
     integer_or_none,
     real_array,
@@ -187,6 +189,7 @@ def contact_pose_3d(contact: Contact) -> tuple[np.ndarray, np.ndarray]:
     p_GC : (3,) float
         Contact point, metres, in G (``z = 0`` for a planar contact).
     """
+    check_contact(contact)
     R = np.asarray(contact.frame, dtype=float)
     c = np.asarray(contact.position, dtype=float)
     if contact.planar:
@@ -224,6 +227,7 @@ def normalize_contact_forces(grasp: Grasp, forces: Any) -> list[np.ndarray] | No
         If the number of arrays differs from the number of contacts, or an
         array has too many components or non-finite entries.
     """
+    check_grasp(grasp)
     if forces is None:
         return None
     if hasattr(forces, "contact_forces"):
@@ -272,7 +276,8 @@ def contact_forces_in_grasp_frame(
     ----------
     grasp : Grasp
     forces : sequence of ndarray
-        As returned by :func:`normalize_contact_forces`.
+        As returned by :func:`normalize_contact_forces` (also what it takes:
+        each array is checked by it).
 
     Returns
     -------
@@ -280,7 +285,20 @@ def contact_forces_in_grasp_frame(
         ``R_i [f_n, f_t…]`` for each contact (the soft-finger moment ``m_n`` is
         not a force and is left out), newtons, in the grasp frame; ``d`` is 2 for
         a planar grasp and 3 otherwise.
+
+    Raises
+    ------
+    InvalidOptionError
+        If ``forces`` is not one array of at most ``num_components`` finite
+        real numbers per contact.
     """
+    given = forces
+    forces = normalize_contact_forces(grasp, forces)
+    if forces is None:
+        raise InvalidOptionError(
+            "forces must be one array of force components per contact, got "
+            f"{describe(given)}"
+        )
     rows = []
     for contact, f in zip(grasp.contacts, forces, strict=True):
         R = np.asarray(contact.frame, dtype=float)
@@ -307,6 +325,7 @@ def cone_edge_directions(contact: Contact) -> np.ndarray:
         Rows are the unit vectors along ``R [1, +μ]`` and ``R [1, -μ]`` in the
         grasp frame (both equal ``n`` for a frictionless contact or ``μ = 0``).
     """
+    check_contact(contact)
     if not contact.planar:
         raise InvalidOptionError(
             "cone_edge_directions is for planar contacts; got a spatial contact "

@@ -24,7 +24,7 @@ from drakegrasp.certificates.certificate import (
 )
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.validation import check_length, safe_norm
+from drakegrasp.core.validation import check_flag, check_length, real_array, safe_norm
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.certificate_plots import (
     check_axes,
@@ -128,14 +128,16 @@ def _outline_patch(outline: Any, colors: Mapping[str, Any]):
                 "a circle outline is a mapping with keys 'center' and 'radius', "
                 f"got keys {sorted(outline)}"
             )
-        center = np.asarray(outline["center"], dtype=float).reshape(-1)
+        center = real_array(
+            "circle center", outline["center"], error=InvalidOptionError
+        ).reshape(-1)
         radius = positive_length("outline radius", outline["radius"])
         if center.shape != (2,) or not np.all(np.isfinite(center)):
             raise InvalidOptionError(
                 f"circle center must be a finite 2-vector, got {outline['center']!r}"
             )
         return Circle(tuple(center), radius, **style)
-    pts = np.asarray(outline, dtype=float)
+    pts = real_array("outline", outline, error=InvalidOptionError)
     if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 3:
         raise InvalidOptionError(
             "outline must be an (M, 2) polygon with M >= 3, a mapping "
@@ -234,6 +236,8 @@ def plot_planar_grasp(
             f"plot_planar_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
     _check_plot_options(colors, outline, force_scale)
+    show_normals = check_flag("show_normals", show_normals)
+    show_labels = check_flag("show_labels", show_labels)
     if not grasp.planar:
         raise InvalidOptionError(
             "plot_planar_grasp draws planar grasps; this grasp is spatial "

@@ -25,7 +25,13 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp, wrench_columns
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import check_flag, describe, real_array, real_scalar
+from drakegrasp.core.validation import (
+    check_flag,
+    check_grasp,
+    describe,
+    real_array,
+    real_scalar,
+)
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.plots import import_pyplot
 
@@ -101,6 +107,8 @@ def wrench_space_points(
     Only force generators enter: a soft finger's moment generators
     ``[1, 0, 0, ±bν]`` add the wrench ``[n; (c - p) × n ± bν n]``.
     """
+    check_grasp(grasp)
+    scale_moments = check_flag("scale_moments", scale_moments)
     b = grasp.characteristic_length
     p = grasp.reference_point
     cols, owner = [], []

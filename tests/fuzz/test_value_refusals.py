@@ -160,3 +160,92 @@ def test_an_unhashable_option_is_judged_not_memoised(value):
     ):
         with pytest.raises(dg.InvalidOptionError, match="num_generators must be"):
             call()
+
+
+def _planar():
+    return dg.examples.planar_two_finger_square(0.5)
+
+
+def _spatial():
+    return dg.examples.spatial_two_fingers(0.5)
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "message"),
+    [
+        (lambda v: v.contact_pose_3d(b"x"), dg.InvalidContactError, "contact must"),
+        (
+            lambda v: v.cone_edge_directions(_planar()),
+            dg.InvalidContactError,
+            "contact must be a drakegrasp.Contact, got Grasp",
+        ),
+        (
+            lambda v: v.normalize_contact_forces(3, [1.0]),
+            dg.InvalidGraspError,
+            "grasp must",
+        ),
+        (
+            lambda v: v.contact_forces_in_grasp_frame("x", [1.0]),
+            dg.InvalidGraspError,
+            "grasp must",
+        ),
+        (
+            lambda v: v.contact_forces_in_grasp_frame(_spatial(), object()),
+            dg.InvalidOptionError,
+            "forces must be",
+        ),
+        (
+            lambda v: v.contact_forces_in_grasp_frame(_spatial(), np.zeros((0, 3))),
+            dg.InvalidOptionError,
+            "forces must be",
+        ),
+        (
+            lambda v: v.contact_forces_in_grasp_frame(_spatial(), np.zeros((2, 0))),
+            dg.InvalidOptionError,
+            "contact 0 .* has 3 force components",
+        ),
+        (
+            lambda v: v.wrench_space_points([1]),
+            dg.InvalidGraspError,
+            "grasp must",
+        ),
+        (
+            lambda v: v.wrench_space_points(_planar(), scale_moments=np.ones(3)),
+            dg.InvalidOptionError,
+            "scale_moments must be True or False",
+        ),
+        (
+            lambda v: v.plot_planar_grasp(_planar(), outline=[1, "a"]),
+            dg.InvalidOptionError,
+            "outline must be an array of real numbers",
+        ),
+        (
+            lambda v: v.plot_planar_grasp(
+                _planar(), outline={"center": "ab", "radius": 1}
+            ),
+            dg.InvalidOptionError,
+            "circle center must be",
+        ),
+        (
+            lambda v: v.plot_planar_grasp(_planar(), show_labels=np.zeros(3)),
+            dg.InvalidOptionError,
+            "show_labels must be True or False",
+        ),
+    ],
+)
+def test_a_drawing_helper_names_a_value_of_the_wrong_kind(call, error, message):
+    # Each reached an attribute, a zip or an `if` of an array: a bare
+    # AttributeError, ValueError or IndexError instead of the value's name.
+    import drakegrasp.visualization as v
+
+    with pytest.raises(error, match=message):
+        call(v)
+
+
+def test_contact_forces_in_grasp_frame_takes_what_normalize_gives():
+    import drakegrasp.visualization as v
+
+    grasp = _spatial()
+    forces = v.normalize_contact_forces(grasp, [[1.0], [1.0, 0.1, 0.0]])
+    f_G = v.contact_forces_in_grasp_frame(grasp, forces)
+    np.testing.assert_array_equal(f_G, [[1.0, 0.0, 0.0], [-1.0, 0.1, 0.0]])
