@@ -16,7 +16,7 @@ matrices exist at any moment, and inputs may be memory-mapped arrays.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence, Sized
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -666,10 +666,25 @@ def iter_batch_closure(
     """
     if not isinstance(kind, str) or kind not in ("force", "form"):
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
-    for item in chunks:
+    try:
+        items = iter(chunks)
+    except TypeError:
+        raise InvalidOptionError(
+            "chunks must be an iterable of (positions, normals[, mu]) tuples or "
+            f"mappings, got {type(chunks).__name__}"
+        ) from None
+    for c, item in enumerate(items):
         if isinstance(item, Mapping):
             arrays = dict(item)
         else:
+            count = len(item) if isinstance(item, Sized) else None
+            if count is None or count > 3:
+                raise InvalidOptionError(
+                    f"chunk {c} must be a tuple (positions, normals) or (positions, "
+                    f"normals, mu), or a mapping with those keys; got "
+                    + type(item).__name__
+                    + ("" if count is None else f" of length {count}")
+                )
             names = ("positions", "normals", "mu")[: len(item)]
             arrays = dict(zip(names, item, strict=True))
         try:

@@ -59,15 +59,23 @@ def _check_tol(name: str, value) -> float:
     return check_rank_tol(value) if name == "rank_tol" else check_tol(value, name)
 
 
+def _shape(name: str, value, must: str, *, error: type) -> tuple[int, ...]:
+    """``np.shape(value)``, or ``error`` saying what ``name`` must be if ragged."""
+    try:
+        return np.shape(value)
+    except (ValueError, TypeError):  # inhomogeneous nested sequences
+        raise error(
+            f"{name} must be {must}; got a nested sequence of uneven shape"
+        ) from None
+
+
 def shape_of(name: str, a) -> tuple[int, int, int]:
     """``(K, N, d)`` of a stacked input, or a clear error naming ``name``."""
-    try:
-        shape = np.shape(a) if a is not None else ()
-    except (ValueError, TypeError):  # inhomogeneous nested sequences
-        raise InvalidContactError(
-            f"{name} must be a (K, N, 2) or (K, N, 3) array, or a list of per-grasp "
-            "(N_k, d) arrays; got a nested sequence of uneven shape"
-        ) from None
+    shape = () if a is None else _shape(
+        name, a,
+        "a (K, N, 2) or (K, N, 3) array, or a list of per-grasp (N_k, d) arrays",
+        error=InvalidContactError,
+    )  # fmt: skip
     if len(shape) != 3 or shape[2] not in (2, 3) or shape[1] < 1:
         raise InvalidContactError(
             f"{name} must have shape (K, N, 2) or (K, N, 3) with N >= 1, got {shape}"
@@ -78,7 +86,12 @@ def shape_of(name: str, a) -> tuple[int, int, int]:
 def per_contact_getter(name: str, value, K: int, N: int, *, error=InvalidContactError):
     """A per-contact coefficient as a function of a chunk slice -> (k, N) array."""
     a = value
-    shape = tuple(a.shape) if hasattr(a, "shape") else np.shape(a)
+    shape = (
+        tuple(a.shape)
+        if hasattr(a, "shape")
+        else _shape(name, a, "a scalar or a (K,), (K, 1), (1, N) or (K, N) array",
+                    error=error)
+    )  # fmt: skip
     if value is None or shape == ():
         x = check_coefficient(name, value, error=error)
         return lambda sl: np.full((sl.stop - sl.start, N), x)
@@ -149,7 +162,10 @@ def _refuse_grasp(
 def _reference_points(value, K: int, d: int):
     if value is None:
         return lambda sl: np.zeros((sl.stop - sl.start, d))
-    shape = np.shape(value)
+    shape = _shape(
+        "reference_points", value, f"a ({d},) or (K, {d}) array",
+        error=InvalidGraspError,
+    )  # fmt: skip
     if shape == (d,):
         p = check_positions("reference_points", value, error=InvalidGraspError)
         return lambda sl: np.broadcast_to(p, (sl.stop - sl.start, d))
@@ -174,7 +190,12 @@ def _reference_points(value, K: int, d: int):
 def _characteristic_lengths(value, K: int):
     if value is None:
         return None
-    shape = np.shape(value)
+    shape = _shape(
+        "characteristic_lengths",
+        value,
+        "a scalar or a (K,) array",
+        error=InvalidGraspError,
+    )
     if shape not in ((), (K,)):
         raise InvalidGraspError(
             f"characteristic_lengths must be a scalar or shape (K,) = ({K},), "

@@ -126,6 +126,14 @@ def batch_grasp_forces(
         raise InvalidOptionError(
             f"wrenches must have shape (D,) or ({K}, D), got {np.shape(wrenches)}"
         )
+    if hand_jacobians is not None and (
+        isinstance(hand_jacobians, (str, bytes))
+        or not hasattr(hand_jacobians, "__iter__")
+    ):
+        raise InvalidOptionError(
+            "hand_jacobians must be a sequence of one (M_k, n_v) Jacobian per "
+            f"grasp, got {type(hand_jacobians).__name__}"
+        )
     Js = [None] * K if hand_jacobians is None else list(hand_jacobians)
     if len(Js) != K:
         raise InvalidOptionError(

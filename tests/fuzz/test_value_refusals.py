@@ -249,3 +249,82 @@ def test_contact_forces_in_grasp_frame_takes_what_normalize_gives():
     forces = v.normalize_contact_forces(grasp, [[1.0], [1.0, 0.1, 0.0]])
     f_G = v.contact_forces_in_grasp_frame(grasp, forces)
     np.testing.assert_array_equal(f_G, [[1.0, 0.0, 0.0], [-1.0, 0.1, 0.0]])
+
+
+RAGGED = [[1.0, 2.0], [3.0]]
+
+
+@pytest.mark.parametrize(
+    ("keywords", "error", "name"),
+    [
+        ({"mu": RAGGED}, dg.InvalidContactError, "mu"),
+        (
+            {"mu": 0.5, "torsional_friction": RAGGED},
+            dg.InvalidContactError,
+            "torsional",
+        ),
+        ({"mu": 0.5, "reference_points": RAGGED}, dg.InvalidGraspError, "reference"),
+        ({"mu": 0.5, "characteristic_lengths": RAGGED}, dg.InvalidGraspError, "char"),
+    ],
+)
+def test_a_ragged_nested_per_grasp_value_is_named(keywords, error, name):
+    # np.shape of [[1, 2], [3]] raised numpy's bare "inhomogeneous shape".
+    P = np.zeros((2, 3, 3))
+    N = np.tile([0.0, 0.0, 1.0], (2, 3, 1))
+    with pytest.raises(error, match=rf"^{name}.* must be .*uneven shape"):
+        dg.batch_force_closure(P, N, **keywords)
+
+
+@pytest.mark.parametrize(
+    ("chunks", "message"),
+    [
+        (None, "chunks must be an iterable"),
+        ([None], "chunk 0 must be a tuple"),
+        ([(1, 2, 3, 4)], "chunk 0 must be a tuple .* length 4"),
+    ],
+)
+def test_iter_batch_closure_names_a_chunk_of_the_wrong_kind(chunks, message):
+    import drakegrasp.batch as db
+
+    with pytest.raises(dg.InvalidOptionError, match=message):
+        next(db.iter_batch_closure(chunks))
+
+
+@pytest.mark.parametrize(
+    ("change", "error", "message"),
+    [
+        ({"path": b"out.npz"}, dg.BatchFileError, "path must be a file path"),
+        ({"path": 3.0}, dg.BatchFileError, "path must be a file path"),
+        ({"path": "missing/out.npz"}, dg.BatchFileError, "cannot write"),
+        ({"K": "x"}, dg.InvalidOptionError, "K must be an integer"),
+        ({"kind": float("nan")}, dg.InvalidOptionError, "kind must be"),
+        ({"tol": object()}, dg.InvalidOptionError, "tol must be a real number"),
+        ({"required_rank": None}, dg.InvalidOptionError, "required_rank must be"),
+        ({"chunks": None}, dg.InvalidOptionError, "chunks must be an iterable"),
+        ({"chunks": [1]}, dg.InvalidOptionError, "each chunk must be a pair"),
+        ({"K": 3}, dg.InvalidOptionError, "covered 0 of 3 grasps"),
+    ],
+)
+def test_write_chunks_names_what_it_cannot_write(tmp_path, change, error, message):
+    # Path(), tempfile and the loop over chunks raised bare TypeError,
+    # FileNotFoundError, AttributeError and ValueError.
+    from drakegrasp.batch import write_chunks
+
+    arguments = {"chunks": [], "path": "out.npz", "K": 0, "kind": "form"}
+    arguments.update({"tol": 1e-6, "required_rank": 6}, **change)
+    arguments["path"] = (
+        tmp_path / arguments["path"]
+        if isinstance(arguments["path"], str)
+        else arguments["path"]
+    )
+    with pytest.raises(error, match=message):
+        write_chunks(arguments.pop("chunks"), arguments.pop("path"), **arguments)
+    assert [p.name for p in tmp_path.iterdir()] == []  # nothing left behind
+
+
+def test_batch_grasp_forces_names_hand_jacobians_that_are_no_sequence():
+    from drakegrasp.batch import batch_grasp_forces
+
+    grasp = _spatial()
+    with pytest.raises(dg.InvalidOptionError, match="hand_jacobians must be"):
+        batch_grasp_forces([grasp], np.zeros(6), hand_jacobians=float)

@@ -31,7 +31,7 @@ import contextlib
 import os
 import secrets
 import tempfile
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,7 +40,9 @@ import numpy as np
 from drakegrasp.batch.columns import result_arrays
 from drakegrasp.batch.files.npz import NpzWriter
 from drakegrasp.batch.files.parquet import ParquetWriter
+from drakegrasp.batch.files.reader import as_path
 from drakegrasp.core.calls import checked_call
+from drakegrasp.core.validation import describe, integer_or_none, real_scalar
 from drakegrasp.errors import BatchFileError, InvalidOptionError
 
 __all__ = [
@@ -309,24 +311,49 @@ def write_chunks(
     Returns
     -------
     BatchSummary
+
+    Raises
+    ------
+    BatchFileError
+        For a ``path`` that is not a file path or cannot be written.
+    InvalidOptionError
+        For a ``K``, ``kind``, ``tol`` or ``required_rank`` of the wrong kind,
+        or chunks that are not ``(slice, arrays)`` pairs covering ``0 … K`` in
+        order.
     """
-    path = Path(path)
+    path = as_path("path", path)
     fmt = format_of(path, fmt)
+    _check_meta(K, kind, tol, required_rank)
+    try:
+        items = iter(chunks)
+    except TypeError:
+        raise InvalidOptionError(
+            "chunks must be an iterable of (slice, arrays) pairs, got "
+            + type(chunks).__name__
+        ) from None
     meta = {"kind": kind, "tol": tol, "required_rank": required_rank}
-    writer = (NpzWriter if fmt == "npz" else ParquetWriter)(path, K, meta)
+    try:
+        writer = (NpzWriter if fmt == "npz" else ParquetWriter)(path, K, meta)
+    except OSError as err:
+        raise BatchFileError(
+            f"cannot write {str(path)!r}: {err.strerror or err}"
+        ) from None
     summary = BatchSummary(kind=kind, tol=tol)
     expected = 0
     written = False
     try:
-        for sl, arrays in chunks:
+        for item in items:
+            sl, arrays = _chunk(item)
             if sl.start != expected:
-                raise ValueError(f"chunk {sl} out of order (expected {expected})")
+                raise InvalidOptionError(
+                    f"chunk {sl} out of order (expected {expected})"
+                )
             expected = sl.stop
             writer.write(arrays)
             summary.add(arrays)
             written = True
         if expected != K:
-            raise ValueError(f"the chunks covered {expected} of {K} grasps")
+            raise InvalidOptionError(f"the chunks covered {expected} of {K} grasps")
         if not written:  # no grasps: the columns of any K, with no rows
             out, out_metrics = result_arrays(0, kind, metrics)
             writer.write({**out, **out_metrics})
@@ -335,3 +362,34 @@ def write_chunks(
         writer.abort()
         raise
     return summary
+
+
+def _check_meta(K, kind, tol, required_rank) -> None:
+    """Refuse what :func:`write_chunks` would store wrongly beside the arrays."""
+    n = integer_or_none(K)
+    if n is None or n < 0:
+        raise InvalidOptionError(f"K must be an integer >= 0, got {describe(K)}")
+    if not isinstance(kind, str) or kind not in ("force", "form"):
+        raise InvalidOptionError(
+            f"kind must be 'force' or 'form', got {describe(kind)}"
+        )
+    real_scalar("tol", tol)
+    if integer_or_none(required_rank) is None:
+        raise InvalidOptionError(
+            f"required_rank must be an integer, got {describe(required_rank)}"
+        )
+
+
+def _chunk(item) -> tuple[slice, dict]:
+    """One ``(slice, arrays)`` item of :func:`write_chunks`'s stream, checked."""
+    if (
+        not isinstance(item, tuple | list)
+        or len(item) != 2
+        or not isinstance(item[0], slice)
+        or not isinstance(item[1], Mapping)
+    ):
+        raise InvalidOptionError(
+            "each chunk must be a pair (slice, dict of result arrays), as "
+            f"stream_force_closure yields them; got {describe(item)}"
+        )
+    return item
