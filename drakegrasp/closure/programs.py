@@ -57,6 +57,7 @@ from drakegrasp.core.linalg import (
 )
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_RANK_TOL
 from drakegrasp.core.validation import (
+    check_flag,
     check_grasp,
     check_rank_tol,
 )
@@ -539,6 +540,7 @@ def build_internal_force_program(
     """
     rank_tol = check_program_options(grasp, rank_tol)
     J = check_hand_jacobian(grasp, hand_jacobian)
+    within_friction = check_flag("within_friction", within_friction)
     layout = cone_layout(grasp, DEFAULT_NUM_GENERATORS)
     N = grasp.num_contacts
     prog, f, d = _margin_program(len(layout.columns))

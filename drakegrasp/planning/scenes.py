@@ -9,6 +9,7 @@ writes the same kind of function and builds the plant themselves.
 
 from __future__ import annotations
 
+import inspect
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +20,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.core.calls import checked_call
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import add_models as add_coupled_models
 from drakegrasp.plant.models import (
@@ -181,11 +183,22 @@ def scene_from_models(add_models) -> PlanningScene:
     PlanningScene
         The finalized plant in its diagram, a default context and the recipe.
     """
-    if not callable(add_models):
+    # A class is callable but no recipe: float(plant, parser) raised a bare
+    # TypeError from the call below.
+    if not callable(add_models) or inspect.isclass(add_models):
         raise InvalidOptionError(
             "add_models must be a function add_models(plant, parser) -> (hand, "
-            f"object body name), got {type(add_models).__name__}"
+            f"object body name), got {describe(add_models)}"
         )
+    try:
+        inspect.signature(add_models).bind(None, None)
+    except TypeError:
+        raise InvalidOptionError(
+            "add_models must take two arguments, add_models(plant, parser); "
+            f"{describe(add_models)} takes {inspect.signature(add_models)}"
+        ) from None
+    except ValueError:  # a builtin without a signature to read
+        pass
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     returned = add_models(plant, new_parser(plant, "the planning scene"))

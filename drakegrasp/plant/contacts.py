@@ -63,6 +63,7 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import (
     check_distance_tolerance,
+    check_flag,
     describe,
     integer_or_none,
 )
@@ -462,6 +463,7 @@ def find_contacts(
     """
     plant_context = plant_context_of(plant, plant_context)
     tol = check_distance_tolerance(distance_tolerance)
+    allow_penetration = check_flag("allow_penetration", allow_penetration)
     if not isinstance(patches, str) or patches not in ("vertices", "witness"):
         raise InvalidOptionError(
             f"patches must be 'vertices' or 'witness', got {patches!r}"

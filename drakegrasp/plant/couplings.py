@@ -40,6 +40,7 @@ that image is again a box, ``|u_i| <= Σ_k |C_ki| τ_max,k``
 from __future__ import annotations
 
 import math
+import os
 import re
 import weakref
 import xml.etree.ElementTree as ET
@@ -55,6 +56,7 @@ from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import coupling_entries, coupling_entry, joint_name
 from drakegrasp.plant.models import load_models
@@ -379,14 +381,31 @@ def add_models(
     Raises
     ------
     InvalidOptionError
-        Unless exactly one of ``file_name``, ``url`` and ``text`` is given.
+        Unless exactly one of ``file_name``, ``url`` and ``text`` is given,
+        as a string (``file_name`` also a path); for a ``parser`` that is not
+        a pydrake ``Parser``.
     ModelError
         Drake cannot load the models (a missing or unreadable file, an unknown
         package, text that is not a model), as :func:`drakegrasp.load_scene`.
     """
+    if not isinstance(parser, Parser):
+        raise InvalidOptionError(
+            f"parser must be a pydrake Parser, got {describe(parser)} "
+            f"({type(parser).__name__})"
+        )
     given = [x is not None for x in (file_name, url, text)]
     if sum(given) != 1:
         raise InvalidOptionError("give exactly one of file_name, url and text")
+    for name, value, kinds in (
+        ("file_name", file_name, (str, os.PathLike)),
+        ("url", url, str),
+        ("text", text, str),
+    ):
+        if value is not None and not isinstance(value, kinds):
+            raise InvalidOptionError(
+                f"{name} must be a string{' or a path' if name == 'file_name' else ''}"
+                f", got {describe(value)} ({type(value).__name__})"
+            )
     plant = parser.plant()
     if text is not None:
         if kind not in ("urdf", "sdf"):
@@ -541,7 +560,26 @@ def add_coupler_constraint(
     """``plant.AddCouplerConstraint`` that drakegrasp can read back.
 
     ``q_0 = gear_ratio * q_1 + offset``; returns Drake's constraint id.
+
+    Raises
+    ------
+    ModelError
+        For what is not a ``MultibodyPlant``, or one already finalized.
+    InvalidOptionError
+        For what is not a joint of the plant, a joint coupled to itself, a
+        gear ratio that is not a finite non-zero real number or an offset that
+        is not a finite real number (Drake would take a NaN, or another
+        plant's joint for the one of that index).
     """
+    check_plant(plant, finalized=False)
+    if plant.is_finalized():
+        raise ModelError(
+            "add_coupler_constraint adds a constraint to the plant before "
+            "plant.Finalize(); this plant is finalized"
+        )
+    joint_0, joint_1, gear_ratio, offset = coupling_entry(
+        plant, (joint_0, joint_1, gear_ratio, offset)
+    )
     cid = plant.AddCouplerConstraint(joint_0, joint_1, gear_ratio, offset)
     _record(
         plant,

@@ -53,7 +53,11 @@ from drakegrasp.plant.contacts import (
 )
 from drakegrasp.plant.handles import local_geometry_id
 from drakegrasp.plant.options import PLANES, check_plane
-from drakegrasp.plant.validation import plant_context_of, query_object_of
+from drakegrasp.plant.validation import (
+    checked_query_object,
+    plant_context_of,
+    query_object_of,
+)
 
 __all__ = [
     "EDGE_TILT_TOL",
@@ -285,7 +289,8 @@ def contact_curvatures(
         (its geometries are :class:`~drakegrasp.plant.handles.ForeignGeometryId`),
         or an item of ``contacts`` that is not a ``PlantContact``.
     InvalidOptionError
-        An unknown ``plane``.
+        An unknown ``plane``, or a ``query_object`` that is not a
+        ``QueryObject`` of the plant's scene graph.
     """
     plant_context = plant_context_of(plant, plant_context)
     body = resolve_object_body(plant, object_body)
@@ -294,7 +299,9 @@ def contact_curvatures(
     query = query_object
     if query is None:
         query = query_object_of(plant, plant_context)
-    inspector = query.inspector()
+        inspector = query.inspector()
+    else:
+        inspector = checked_query_object(plant, query)
     X_OW = plant.EvalBodyPoseInWorld(plant_context, body).inverse()
     out = []
     for k, pc in enumerate(contacts):

@@ -230,6 +230,16 @@ class HandStructure:
     coupling: Coupling
 
 
+def check_hand_structure(hand) -> HandStructure:
+    """``hand`` itself, once it is a :class:`HandStructure` (InvalidOptionError)."""
+    if not isinstance(hand, HandStructure):
+        raise InvalidOptionError(
+            "hand must be a HandStructure (from hand_structure), got "
+            f"{type(hand).__name__}"
+        )
+    return hand
+
+
 def joint_name(plant: MultibodyPlant, joint: Joint) -> str:
     """``model::joint`` of a joint."""
     return f"{plant.GetModelInstanceName(joint.model_instance())}::{joint.name()}"

@@ -40,8 +40,12 @@ from pydrake.systems.framework import Context
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.plant.couplings import JointCoupling
-from drakegrasp.plant.fingers import HandStructure
-from drakegrasp.plant.validation import scoped_name
+from drakegrasp.plant.fingers import HandStructure, check_hand_structure
+from drakegrasp.plant.validation import (
+    checked_query_object,
+    plant_context_of,
+    scoped_name,
+)
 
 __all__ = [
     "PARALLEL_AXIS_TOL",
@@ -141,7 +145,18 @@ def parallel_jaws(
         None unless the closing joints are two prismatic joints with parallel
         axes whose jaws (each with a geometry that can touch the object)
         face each other.
+
+    Raises
+    ------
+    ModelError, InvalidContextError
+        For what is not a finalized plant, or a context of another system.
+    InvalidOptionError
+        For a ``hand`` that is not a ``HandStructure``, or a ``query`` that is
+        not a ``QueryObject`` of the plant's scene graph.
     """
+    plant_context = plant_context_of(plant, plant_context)
+    check_hand_structure(hand)
+    checked_query_object(plant, query)
     if len(hand.joints) != 2 or not all(
         isinstance(j, PrismaticJoint) for j in hand.joints
     ):

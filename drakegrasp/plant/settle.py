@@ -68,10 +68,22 @@ from pydrake.systems.framework import Context
 from drakegrasp._solvers import require_solution, solve
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import (
+    check_distance_tolerance,
+    describe,
+    integer_or_none,
+    real_array,
+)
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant._shapes import bounding_sphere
-from drakegrasp.plant.fingers import HandStructure
-from drakegrasp.plant.validation import query_object_of, scoped_name
+from drakegrasp.plant.fingers import HandStructure, check_hand_structure
+from drakegrasp.plant.validation import (
+    check_bodies,
+    plant_context_of,
+    query_object_of,
+    resolve_object_body,
+    scoped_name,
+)
 
 __all__ = [
     "DEFAULT_SETTLE_ITERATIONS",
@@ -330,21 +342,34 @@ def settle_object(
     Raises
     ------
     InvalidOptionError
-        For an object that is not a free body or a ``pushing`` of the wrong
-        shape.
+        For an object that is not a free body, a ``hand`` that is not a
+        ``HandStructure``, a ``pushing`` of the wrong shape, ``bodies`` that
+        are not the plant's, or a bad ``distance_tolerance`` or
+        ``max_iterations``.
+    ModelError, InvalidContextError
+        For what is not a finalized plant, or a context of another system.
     """
+    plant_context = plant_context_of(plant, plant_context)
+    object_body = resolve_object_body(plant, object_body)
+    check_hand_structure(hand)
+    bodies = check_bodies(plant, bodies)
+    n = integer_or_none(max_iterations)
+    if n is None or n < 1:
+        raise InvalidOptionError(
+            f"max_iterations must be an integer >= 1, got {describe(max_iterations)}"
+        )
     if not object_body.is_floating_base_body():
         raise InvalidOptionError(
             f"settling moves the object: {scoped_name(plant, object_body)!r} is "
             "not a free body"
         )
     n_h = len(hand.joints)
-    tau = np.asarray(pushing, dtype=float)
+    tau = real_array("pushing", pushing, error=InvalidOptionError)
     if tau.shape != (n_h,) or not np.all(np.isfinite(tau)):
         raise InvalidOptionError(
             f"pushing must be {n_h} finite numbers, got {pushing!r}"
         )
-    tol = float(distance_tolerance)
+    tol = check_distance_tolerance(distance_tolerance)
     inspector = query_object_of(plant, plant_context).inspector()
     pairs = _Pairs.of(plant, inspector, object_body, bodies)
     L = _object_radius(plant, inspector, object_body)

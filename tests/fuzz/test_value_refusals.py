@@ -328,3 +328,116 @@ def test_batch_grasp_forces_names_hand_jacobians_that_are_no_sequence():
     grasp = _spatial()
     with pytest.raises(dg.InvalidOptionError, match="hand_jacobians must be"):
         batch_grasp_forces([grasp], np.zeros(6), hand_jacobians=float)
+
+
+def test_build_internal_force_program_names_a_flag_that_is_an_array():
+    grasp = _spatial()
+    with pytest.raises(dg.InvalidOptionError, match="within_friction must be True"):
+        dg.build_internal_force_program(
+            grasp, np.ones((6, 2)), within_friction=np.zeros((0, 3))
+        )
+
+
+@pytest.mark.parametrize(
+    ("recipe", "message"),
+    [
+        (float, "add_models must be a function"),
+        (type, "add_models must be a function"),
+        (lambda plant: None, r"must take two arguments.* takes \(plant\)"),
+    ],
+)
+def test_a_scene_recipe_that_is_a_class_or_takes_other_arguments_is_named(
+    recipe, message
+):
+    # float(plant, parser) raised the bare TypeError of the call.
+    with pytest.raises(dg.InvalidOptionError, match=message):
+        scene_from_models(recipe)
+
+
+@pytest.fixture(scope="module")
+def box_scene(drake_models_dir):
+    """The cracker box, the Schunk gripper and what the plant helpers take."""
+    from drakegrasp.planning import planning_scene
+    from drakegrasp.plant.fingers import hand_structure
+    from drakegrasp.plant.validation import hand_bodies, query_object_of
+
+    scene = planning_scene(BOX, models_dir=drake_models_dir)
+    plant, body = scene.plant, scene.object_body
+    context = plant.GetMyContextFromRoot(scene.context)
+    query = query_object_of(plant, context)
+    hand = hand_structure(
+        plant, body, hand_bodies(plant, body, scene.hand), inspector=query.inspector()
+    )
+    return plant, context, body, hand, query
+
+
+def _settle(box, **change):
+    from drakegrasp.plant.settle import settle_object
+
+    plant, context, body, hand, _ = box
+    arguments = {"plant": plant, "plant_context": context, "object_body": body}
+    arguments.update(hand=hand, pushing=np.zeros(len(hand.joints)), bodies=[])
+    arguments["distance_tolerance"] = 1e-4
+    arguments.update(change)
+    return settle_object(**arguments)
+
+
+@pytest.mark.parametrize(
+    ("change", "error", "message"),
+    [
+        ({"plant": {"a": 1}}, dg.ModelError, "plant must be a pydrake"),
+        ({"object_body": 1.5}, dg.InvalidOptionError, "object_body must be"),
+        ({"hand": 1e308}, dg.InvalidOptionError, "hand must be a HandStructure"),
+        ({"pushing": b"x"}, dg.InvalidOptionError, "pushing must be an array"),
+        ({"bodies": np.ones(3)}, dg.InvalidOptionError, r"bodies\[0\] must be"),
+        ({"distance_tolerance": "x"}, dg.InvalidOptionError, "distance_tolerance"),
+        ({"max_iterations": 0}, dg.InvalidOptionError, "max_iterations must be"),
+    ],
+)
+def test_settle_object_names_an_argument_of_the_wrong_kind(
+    box_scene, change, error, message
+):
+    # It called methods of whatever it got: a bare AttributeError.
+    with pytest.raises(error, match=message):
+        _settle(box_scene, **change)
+
+
+def test_plant_helpers_name_a_hand_query_or_flag_of_the_wrong_kind(box_scene):
+    from drakegrasp.plant.jaws import parallel_jaws
+
+    plant, context, body, hand, query = box_scene
+    with pytest.raises(dg.ModelError, match="plant must be a pydrake"):
+        parallel_jaws(set(), context, hand, query)
+    with pytest.raises(dg.InvalidOptionError, match="hand must be a HandStructure"):
+        parallel_jaws(plant, context, np.ones(3), query)
+    with pytest.raises(dg.InvalidOptionError, match="query_object must be"):
+        parallel_jaws(plant, context, hand, None)
+    assert parallel_jaws(plant, context, hand, query) is not None  # the Schunk's
+    with pytest.raises(dg.InvalidOptionError, match="query_object must be"):
+        dp.contact_curvatures(
+            plant, context, [], object_body=body, query_object=np.zeros(3)
+        )
+    with pytest.raises(dg.InvalidOptionError, match="allow_penetration must be"):
+        dp.find_contacts(
+            plant, context, body, allow_penetration=np.ma.masked_array([1, 2, 3])
+        )
+
+
+def test_coupling_and_model_helpers_name_an_argument_of_the_wrong_kind(box_scene):
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    finalized = box_scene[0]
+    with pytest.raises(dg.ModelError, match="plant must be a pydrake"):
+        dp.add_coupler_constraint(0, None, None, 1.0)
+    with pytest.raises(dg.ModelError, match="before plant.Finalize"):
+        dp.add_coupler_constraint(finalized, None, None, 1.0)
+    fresh = MultibodyPlant(0.0)
+    with pytest.raises(dg.InvalidOptionError, match="coupling joint None is not"):
+        dp.add_coupler_constraint(fresh, None, None, 1.0)
+    with pytest.raises(dg.InvalidOptionError, match="parser must be a pydrake Parser"):
+        dp.add_models(0, "hand.urdf")
+    with pytest.raises(dg.InvalidOptionError, match="file_name must be a string"):
+        dp.add_models(Parser(fresh), np.float16(2.0))
+    with pytest.raises(dg.InvalidOptionError, match="url must be a string"):
+        dp.add_models(Parser(fresh), url={"a": 1})
