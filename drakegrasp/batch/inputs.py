@@ -59,7 +59,7 @@ def _check_tol(name: str, value) -> float:
     return check_rank_tol(value) if name == "rank_tol" else check_tol(value, name)
 
 
-def _shape(name: str, value, must: str, *, error: type) -> tuple[int, ...]:
+def read_shape(name: str, value, must: str, *, error: type) -> tuple[int, ...]:
     """``np.shape(value)``, or ``error`` saying what ``name`` must be if ragged."""
     try:
         return np.shape(value)
@@ -71,7 +71,7 @@ def _shape(name: str, value, must: str, *, error: type) -> tuple[int, ...]:
 
 def shape_of(name: str, a) -> tuple[int, int, int]:
     """``(K, N, d)`` of a stacked input, or a clear error naming ``name``."""
-    shape = () if a is None else _shape(
+    shape = () if a is None else read_shape(
         name, a,
         "a (K, N, 2) or (K, N, 3) array, or a list of per-grasp (N_k, d) arrays",
         error=InvalidContactError,
@@ -86,12 +86,12 @@ def shape_of(name: str, a) -> tuple[int, int, int]:
 def per_contact_getter(name: str, value, K: int, N: int, *, error=InvalidContactError):
     """A per-contact coefficient as a function of a chunk slice -> (k, N) array."""
     a = value
+    must = "a scalar or a (K,), (K, 1), (1, N) or (K, N) array"
     shape = (
         tuple(a.shape)
         if hasattr(a, "shape")
-        else _shape(name, a, "a scalar or a (K,), (K, 1), (1, N) or (K, N) array",
-                    error=error)
-    )  # fmt: skip
+        else read_shape(name, a, must, error=error)
+    )
     if value is None or shape == ():
         x = check_coefficient(name, value, error=error)
         return lambda sl: np.full((sl.stop - sl.start, N), x)
@@ -162,7 +162,7 @@ def _refuse_grasp(
 def _reference_points(value, K: int, d: int):
     if value is None:
         return lambda sl: np.zeros((sl.stop - sl.start, d))
-    shape = _shape(
+    shape = read_shape(
         "reference_points", value, f"a ({d},) or (K, {d}) array",
         error=InvalidGraspError,
     )  # fmt: skip
@@ -190,7 +190,7 @@ def _reference_points(value, K: int, d: int):
 def _characteristic_lengths(value, K: int):
     if value is None:
         return None
-    shape = _shape(
+    shape = read_shape(
         "characteristic_lengths",
         value,
         "a scalar or a (K,) array",

@@ -268,12 +268,14 @@ RAGGED = [[1.0, 2.0], [3.0]]
         ),
         ({"mu": 0.5, "reference_points": RAGGED}, dg.InvalidGraspError, "reference"),
         ({"mu": 0.5, "characteristic_lengths": RAGGED}, dg.InvalidGraspError, "char"),
+        ({"mu": 0.5, "normals": RAGGED}, dg.InvalidContactError, "normals"),
     ],
 )
 def test_a_ragged_nested_per_grasp_value_is_named(keywords, error, name):
     # np.shape of [[1, 2], [3]] raised numpy's bare "inhomogeneous shape".
+    keywords = dict(keywords)
     P = np.zeros((2, 3, 3))
-    N = np.tile([0.0, 0.0, 1.0], (2, 3, 1))
+    N = keywords.pop("normals", np.tile([0.0, 0.0, 1.0], (2, 3, 1)))
     with pytest.raises(error, match=rf"^{name}.* must be .*uneven shape"):
         dg.batch_force_closure(P, N, **keywords)
 

@@ -17,6 +17,7 @@ from drakegrasp.batch.inputs import (
     check_chunk_positions,
     chunk_unit_normals,
     positive_int,
+    read_shape,
     shape_of,
 )
 from drakegrasp.batch.run.workers import map_ordered, resolve_workers
@@ -167,10 +168,13 @@ def stream(
 ) -> Iterator[tuple[slice, dict[str, np.ndarray]]]:
     """Validated chunks through ``task`` (which builds one chunk's work), in order."""
     K, N, d = shape_of("positions", positions)
-    if np.shape(normals) != (K, N, d):
+    normal_shape = read_shape(
+        "normals", normals, "an array of the shape of positions",
+        error=InvalidContactError,
+    )  # fmt: skip
+    if normal_shape != (K, N, d):
         raise InvalidContactError(
-            f"normals must have the shape of positions {(K, N, d)}, got "
-            f"{np.shape(normals)}"
+            f"normals must have the shape of positions {(K, N, d)}, got {normal_shape}"
         )
     size = chunk_size_for(N, d, chunk_size, n_g, K)
     n_workers = resolve_workers(workers)
