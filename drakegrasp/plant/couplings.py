@@ -668,6 +668,7 @@ def _resolved_chains(plant: MultibodyPlant, entries: tuple) -> tuple:
     resolved = []
     for follower, (leader, rho, offset) in named.items():
         path = [follower]
+        links = [JointCoupling(follower, leader, rho, offset)]
         while leader in named:
             if leader in path:
                 loop = " -> ".join([*path[path.index(leader) :], leader])
@@ -677,10 +678,24 @@ def _resolved_chains(plant: MultibodyPlant, entries: tuple) -> tuple:
                     "none"
                 )
             path.append(leader)
+            links.append(JointCoupling(leader, *named[leader]))
             leader, rho_b, offset_b = named[leader]
             rho, offset = rho * rho_b, rho * offset_b + offset
-        resolved.append(JointCoupling(follower, leader, rho, offset))
+        coupling = _ChainCoupling(follower, leader, rho, offset)
+        coupling.links = tuple(links)
+        resolved.append(coupling)
     return tuple(resolved)
+
+
+class _ChainCoupling(JointCoupling):
+    """A :class:`JointCoupling` resolved to its chain's root.
+
+    Equal to the plain tuple; ``links`` holds the chain as recorded, follower
+    first, for :func:`coupling_map`, which keeps the part of a chain inside
+    the hand when its root lies outside.
+    """
+
+    links: tuple = ()
 
 
 def coupling_map(
@@ -695,27 +710,34 @@ def coupling_map(
         The hand's velocities (plant indices).
     couplings : sequence of (joint_0, joint_1, gear_ratio, offset)
         Couplings whose joints are not both among the hand's velocities are
-        left out.
+        left out.  A chain (as recorded, or as :func:`plant_couplings`
+        resolves it) is followed to its last joint among them: with ``c → b →
+        a`` and ``a`` outside, ``c`` follows ``b``.
 
     Returns
     -------
     C : (n_h, n_u) float
-        Identity on the independent velocities, ``gear_ratio`` at (follower,
-        leader).
+        Identity on the independent velocities, at (follower, leader) the
+        product of the gear ratios along the chain.
     independent : (n_u,) int
         Plant velocity indices of the independent velocities, in order.
 
     Raises
     ------
     InvalidOptionError
-        For an unknown joint, a joint that is not one-dof, or a joint that
-        both leads and follows.
+        For an unknown joint, a joint that is not one-dof, or couplings that
+        close a loop.
     """
     v = [int(i) for i in velocity_indices]
     row = {vi: k for k, vi in enumerate(v)}
     follows: dict[int, tuple[int, float]] = {}
     by_velocity: dict[int, Joint] = {}
-    for entry in coupling_entries(couplings):
+    links = [
+        link
+        for entry in coupling_entries(couplings)
+        for link in getattr(entry, "links", None) or (entry,)
+    ]
+    for entry in links:
         j0, j1, rho, _ = coupling_entry(plant, entry)
         for j in (j0, j1):
             if j.num_velocities() != 1:
@@ -727,13 +749,21 @@ def coupling_map(
         if f in row and lead in row:
             follows[f] = (lead, rho)
             by_velocity[f] = j0
-    both = set(follows) & {lead for lead, _ in follows.values()}
-    if both:
-        raise InvalidOptionError(
-            f"joint {joint_name(plant, by_velocity[min(both)])} may not both "
-            "lead and follow a coupling; a coupling map takes one level (each joint "
-            "following a joint that follows none)"
-        )
+    for f in list(follows):  # each follower on its chain's last joint here
+        lead, rho = follows[f]
+        seen = [f]
+        while lead in follows:
+            if lead in seen:
+                loop = " -> ".join(
+                    joint_name(plant, by_velocity[x]) for x in (*seen, lead)
+                )
+                raise InvalidOptionError(
+                    f"the couplings close a loop ({loop}, each following the next)"
+                )
+            seen.append(lead)
+            lead, rho_b = follows[lead]
+            rho *= rho_b
+        follows[f] = (lead, rho)
     independent = [vi for vi in v if vi not in follows]
     col = {vi: k for k, vi in enumerate(independent)}
     C = np.zeros((len(v), len(independent)))

@@ -373,11 +373,30 @@ def test_a_chain_of_couplings_is_resolved_to_its_root():
     C, independent = coupling_map(plant, columns, resolved)
     np.testing.assert_array_equal(C, [[1.0], [2.0], [-1.0]])
     assert list(independent) == columns[:1]
-    # the map itself still takes one level: a raw chain is named, not misread
-    with pytest.raises(
-        InvalidOptionError, match="joint chain::b may not both lead and follow"
-    ):
-        coupling_map(plant, columns, raw)
+    # the chain as recorded maps alike
+    C_raw, independent_raw = coupling_map(plant, columns, raw)
+    np.testing.assert_array_equal(C_raw, C)
+    assert list(independent_raw) == list(independent)
+
+
+def test_a_chain_whose_root_is_outside_the_hand_keeps_its_followers_tied():
+    # hand= bodies that leave the chain's root out (c -> b -> a, a outside):
+    # c still follows b, as before chains were resolved; resolved to the root,
+    # both couplings named a joint outside the map and were left out, and
+    # J C gained a motion the coupler constraints do not allow (a reviewer's
+    # finding).
+    from drakegrasp.plant.couplings import coupling_map, recorded_couplings
+
+    plant = _chain_plant(ratios=(2.0, -0.5))
+    columns = [plant.GetJointByName(n).velocity_start() for n in "bc"]
+    for couplings in (plant_couplings(plant), recorded_couplings(plant)):
+        C, independent = coupling_map(plant, columns, couplings)
+        np.testing.assert_array_equal(C, [[1.0], [-0.5]])  # v_c = -0.5 v_b
+        assert list(independent) == columns[:1]
+    # a loop given to the map directly is named
+    b_c = [("chain::b", "chain::c", 1.0, 0.0), ("chain::c", "chain::b", 1.0, 0.0)]
+    with pytest.raises(InvalidOptionError, match="close a loop"):
+        coupling_map(plant, columns, b_c)
 
 
 def test_couplings_that_loop_or_a_joint_with_two_leaders_are_refused():
