@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.machinery
+import os
 import sys
 import warnings
 from collections.abc import Callable, Iterable, Mapping
@@ -87,6 +88,7 @@ class _MovedModules:
 
     def __init__(self, moved: Mapping[str, tuple[str, bool]]):
         self.moved = dict(moved)
+        self._specs: dict[str, importlib.machinery.ModuleSpec] = {}
 
     def find_spec(self, fullname, path=None, target=None):  # noqa: ARG002
         """A spec for an old path (None for any other name)."""
@@ -98,18 +100,53 @@ class _MovedModules:
         new, deprecated = self.moved[spec.name]
         module = importlib.import_module(new)
         if deprecated:
-            # stacklevel 2 skips the import system's own frames: the warning
-            # points at the user's import statement
             warnings.warn(
                 f"the module {spec.name} moved to {new}; import it from there "
                 "(the old path will be removed)",
                 DeprecationWarning,
-                stacklevel=2,
+                stacklevel=_importer_level(),
             )
+        # the import system now sets module.__spec__ to the old path's spec;
+        # exec_module puts the module's own back
+        self._specs[spec.name] = module.__spec__
         return module
 
     def exec_module(self, module: ModuleType) -> None:
-        """Nothing to run: the module is the one its new path imported."""
+        """Nothing to run: the module is the one its new path imported.
+
+        Its own ``__spec__`` is restored: with the old path's (this loader),
+        ``importlib.reload`` of the module would run nothing and rename it
+        to the old path.
+        """
+        spec = self._specs.pop(getattr(module.__spec__, "name", None), None)
+        if spec is not None:
+            module.__spec__ = spec
+
+    def get_code(self, fullname):
+        """``python -m old``: refused, naming the new path (no code here)."""
+        new, _ = self.moved[fullname]
+        raise ImportError(f"the module {fullname} moved to {new}; run that one")
+
+
+def _importer_level() -> int:
+    """``stacklevel`` of :meth:`_MovedModules.create_module`'s warning.
+
+    ``warnings`` steps over the import system's ``_bootstrap`` frames itself;
+    ``importlib.import_module`` (and ``reload``), in ``importlib/__init__.py``,
+    are stepped over here, so the warning names the line that asked for the
+    old path (in ``__main__``, where the default filters show it).
+    """
+    level, frame = 2, sys._getframe(2)  # the frame that called create_module
+    while frame is not None:
+        name = frame.f_code.co_filename
+        if "importlib" in name and "_bootstrap" in name:
+            frame = frame.f_back  # not counted: warnings skips it too
+            continue
+        if not name.endswith(os.path.join("importlib", "__init__.py")):
+            return level
+        level += 1
+        frame = frame.f_back
+    return 2
 
 
 def forward_moved_modules(

@@ -93,3 +93,71 @@ def test_the_table_maps_gone_paths_to_modules_that_exist():
             n for names in vars(package).get("_SOURCES", {}).values() for n in names
         }
         assert child not in public, old
+
+
+def _run(code: str, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, *args, "-c", code] if code else [sys.executable, *args],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+    )
+
+
+_RELOAD = r"""
+import importlib, json, sys, warnings
+warnings.simplefilter("ignore")
+import drakegrasp.grasp
+new = sys.modules["drakegrasp.core.grasp"]
+out = {"spec": new.__spec__.name,
+       "find_spec": importlib.util.find_spec("drakegrasp.core.grasp").name}
+new.grasp_matrix = None  # a reload runs the module again and restores it
+importlib.reload(new)
+out.update(name=new.__name__, package=new.__package__,
+           rerun=new.grasp_matrix is not None)
+print(json.dumps(out))
+"""
+
+
+def test_importing_an_old_path_leaves_the_new_modules_spec_and_reload_alone():
+    # The import system gives the module a loader returns the old path's spec:
+    # the new module's __spec__ was the old path's, importlib.reload (IPython's
+    # autoreload) then ran nothing and renamed the module (__name__
+    # "drakegrasp.grasp", __package__ "drakegrasp").
+    done = _run(_RELOAD)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout.strip().splitlines()[-1])
+    assert out == {
+        "spec": "drakegrasp.core.grasp",
+        "find_spec": "drakegrasp.core.grasp",
+        "name": "drakegrasp.core.grasp",
+        "package": "drakegrasp.core",
+        "rerun": True,
+    }, out
+
+
+def test_running_an_old_path_as_a_script_names_the_new_one():
+    # python -m drakegrasp.grasp ended in an AttributeError traceback of
+    # runpy ('_MovedModules' object has no attribute 'get_code').
+    done = _run("", "-m", "drakegrasp.grasp")
+    assert done.returncode == 1
+    assert "Traceback" not in done.stderr, done.stderr
+    assert "drakegrasp.core.grasp" in done.stderr, done.stderr
+
+
+_IMPORT_MODULE = r"""
+import importlib, json, warnings
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    exec('importlib.import_module("drakegrasp.results")')
+print(json.dumps([w.filename for w in caught]))
+"""
+
+
+def test_import_module_of_an_old_path_warns_at_the_callers_line():
+    # importlib.import_module(old) warned at importlib/__init__.py, which the
+    # default filters hide (DeprecationWarning shows in __main__ only).
+    done = _run(_IMPORT_MODULE)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout.strip().splitlines()[-1]) == ["<string>"]
