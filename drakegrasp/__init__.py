@@ -240,7 +240,15 @@ _MOVED = {
         "visualization.certificates": "visualization.meshcat_certificates",
     }.items()
 }
-forward_moved_modules(_MOVED, aliases=("drakegrasp.examples",))
+# Old modules that were split: the names of their ``__all__`` that went to
+# another module than the one in _MOVED (renamed names are not forwarded).
+_DRIVER = "drakegrasp.batch.files.driver"
+_MOVED_NAMES = {
+    "drakegrasp.batch.io": {"evaluate_file": _DRIVER, "write_result": _DRIVER},
+    "drakegrasp.batch.writers": {"stream_file": _DRIVER},
+    "drakegrasp.results": {"AntipodalResult": "drakegrasp.core.antipodal"},
+}
+forward_moved_modules(_MOVED, aliases=("drakegrasp.examples",), names=_MOVED_NAMES)
 
 __version__ = "0.1.0"
 

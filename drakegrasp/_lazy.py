@@ -86,8 +86,13 @@ class _MovedModules:
     A meta path finder and its loader (the import system's protocols).
     """
 
-    def __init__(self, moved: Mapping[str, tuple[str, bool]]):
+    def __init__(
+        self,
+        moved: Mapping[str, tuple[str, bool]],
+        names: Mapping[str, Mapping[str, str]],
+    ):
         self.moved = dict(moved)
+        self.names = dict(names)
         self._specs: dict[str, importlib.machinery.ModuleSpec] = {}
 
     def find_spec(self, fullname, path=None, target=None):  # noqa: ARG002
@@ -106,6 +111,9 @@ class _MovedModules:
                 DeprecationWarning,
                 stacklevel=_importer_level(),
             )
+        extra = self.names.get(spec.name)
+        if extra:  # the old module was split: its names from each part
+            return _split_module(spec.name, module, extra)
         # the import system now sets module.__spec__ to the old path's spec;
         # exec_module puts the module's own back
         self._specs[spec.name] = module.__spec__
@@ -126,6 +134,31 @@ class _MovedModules:
         """``python -m old``: refused, naming the new path (no code here)."""
         new, _ = self.moved[fullname]
         raise ImportError(f"the module {fullname} moved to {new}; run that one")
+
+
+def _split_module(name: str, first: ModuleType, extra: Mapping[str, str]):
+    """The old module ``name``: ``first``'s names, and ``extra``'s from theirs.
+
+    ``extra`` is ``{name: module path}`` for the names of the old module that
+    went to other modules than ``first`` (each imported on first read).
+    """
+    module = ModuleType(name, first.__doc__)
+
+    def __getattr__(attr: str):
+        if attr in extra:
+            return getattr(importlib.import_module(extra[attr]), attr)
+        try:
+            return getattr(first, attr)
+        except AttributeError:
+            raise AttributeError(f"module {name!r} has no attribute {attr!r}") from None
+
+    def __dir__():
+        return sorted(set(dir(first)) | set(extra))
+
+    module.__getattr__ = __getattr__
+    module.__dir__ = __dir__
+    module.__all__ = [*getattr(first, "__all__", ()), *extra]
+    return module
 
 
 def _importer_level() -> int:
@@ -150,7 +183,9 @@ def _importer_level() -> int:
 
 
 def forward_moved_modules(
-    moved: Mapping[str, str], aliases: Iterable[str] = ()
+    moved: Mapping[str, str],
+    aliases: Iterable[str] = (),
+    names: Mapping[str, Mapping[str, str]] | None = None,
 ) -> None:
     """Let old module paths import the modules they became.
 
@@ -168,11 +203,18 @@ def forward_moved_modules(
         import would replace by the module.
     aliases : iterable of str, optional
         Old paths that import without a warning.
+    names : mapping of str to mapping of str to str, optional
+        ``{old module path: {name: module path}}`` for an old module that was
+        split: the names it held that ``moved[old]`` does not, and where each
+        went.  Its old path then imports a module of its own whose attributes
+        are the new module's and these (not the very module ``new`` is).
     """
     aliases = set(aliases)
     table = {old: (new, old not in aliases) for old, new in moved.items()}
+    names = dict(names or {})
     for finder in sys.meta_path:
         if isinstance(finder, _MovedModules):  # the package was imported again
             finder.moved.update(table)
+            finder.names.update(names)
             return
-    sys.meta_path.append(_MovedModules(table))
+    sys.meta_path.append(_MovedModules(table, names))
