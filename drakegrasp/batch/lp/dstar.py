@@ -13,9 +13,14 @@ the whole budget spent, and ``d* = 0`` otherwise.  Let ``c = e - Q Qᵀ e`` (the
 projection of ``e`` on ``N(G)``).  Corner cases: no null space or ``c = 0``
 (no balanced force pushes) give ``d* = 0``; a one-dimensional null space is
 spanned by ``c``, so ``t* = min F c / ‖c‖²``.  Everything else goes to the
-block interior-point method :func:`drakegrasp.batch.lp.block_ipm.solve_block_lp`,
-started at ``f = c / ‖c‖²``; the rare LPs that reach its iteration cap are solved
-again one by one with HiGHS.
+block interior-point method, started at ``f = c / ‖c‖²``: compiled
+(:mod:`drakegrasp.batch.lp.block_kernel`) or in numpy
+(:func:`drakegrasp.batch.lp.block_ipm.solve_block_lp`); the rare LPs that
+reach its iteration cap are solved again one by one with HiGHS.  With numba,
+the grasps whose full rank a QR certifies are first solved in one compiled
+pass (:mod:`drakegrasp.batch.lp.fused_kernel`: null space and LP together, by
+the active-set method of :mod:`drakegrasp.batch.lp.active_set` where the null
+space is small); only those it does not finish take the path above.
 """
 
 from __future__ import annotations
