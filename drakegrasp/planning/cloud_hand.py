@@ -254,7 +254,6 @@ class _Geometry:
         centre, self.radius = bounding_sphere(self.shape)
         self.centre_G = np.asarray(centre, float)
         self.centre_B = self.R_BG @ self.centre_G + self.p_BG
-        self.is_sphere = isinstance(self.shape, Sphere)
         piece = piece_of_shape(self.shape, self.X_BG, inspector.GetName(gid))
         self.probes_G = piece.sample(SHADOW_PROBES, rng)[0] if piece.area > 0 else None
 
