@@ -368,7 +368,9 @@ def stream_force_closure(
         Metrics to add to each chunk's arrays, as in
         :func:`batch_force_closure`.
     workers : int, optional
-        Worker processes; default (None) every available core.
+        Worker processes; default (None) every available core, but a batch
+        of fewer than :data:`~drakegrasp.batch.run.stream.PARALLEL_MIN_WORK`
+        contacts (``K N``) then runs in this process.
     kernel : {"auto", "numba", "numpy"}, optional
         The LP and ε kernels (default ``"auto"``: numba when installed).
     options : BatchOptions, optional
@@ -528,7 +530,9 @@ def batch_force_closure(
         computed as :func:`~drakegrasp.batch.batch_epsilon_l1` does (a compiled
         kernel; Qhull per grasp with ``kernel="numpy"`` or without numba).
     workers : int, optional
-        Worker processes; default (None) every available core.  Results are
+        Worker processes; default (None) every available core, but a batch
+        of fewer than :data:`~drakegrasp.batch.run.stream.PARALLEL_MIN_WORK`
+        contacts (``K N``) then runs in this process.  Results are
         bitwise the same for any number (:mod:`drakegrasp.batch.run.workers`).
     kernel : {"auto", "numba", "numpy"}, optional
         Interior-point implementation: the compiled one (needs numba) or the

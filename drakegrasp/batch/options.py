@@ -77,7 +77,9 @@ class BatchOptions:
     chunk_size : int, optional
         Grasps per chunk; default (None) sized by the engine's memory budget.
     workers : int, optional
-        Worker processes; default (None) every available core.
+        Worker processes; default (None) every available core, but a batch
+        of fewer than :data:`~drakegrasp.batch.run.stream.PARALLEL_MIN_WORK`
+        contacts (``K N``) then runs in this process.
     progress : bool, optional
         Show a tqdm progress bar.
 
