@@ -321,7 +321,28 @@ def result_certificate(grasp: Grasp, result: Any) -> Certificate | None:
 def draw_result_certificate(
     meshcat: Meshcat, grasp: Grasp, result: Any, prefix: str
 ) -> tuple[str, ...]:
-    """The hook of ``draw_grasp``: draw ``result.certificate`` if it has one."""
+    """Draw the certificate a result carries, if it carries one.
+
+    What ``draw_grasp(..., result=)`` draws beside the grasp, for a caller
+    that draws the grasp itself: :func:`result_certificate` then
+    :func:`draw_certificate`.
+
+    Parameters
+    ----------
+    meshcat : pydrake.geometry.Meshcat
+    grasp : Grasp
+        The grasp the result judged (object frame O, metres).
+    result : object
+        A result of a closure decision (its ``certificate`` is read), as
+        :func:`result_certificate` takes it.
+    prefix : str
+        Meshcat path under which the certificate is drawn.
+
+    Returns
+    -------
+    tuple of str
+        The Meshcat paths drawn (empty when the result carries none).
+    """
     cert = result_certificate(grasp, result)
     if cert is None:
         return ()
