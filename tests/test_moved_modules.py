@@ -49,20 +49,26 @@ print(json.dumps(out))
 """
 
 
-def _child() -> dict:
-    done = subprocess.run(
-        [sys.executable, "-c", _CHILD],
+def _run(code: str, *args: str) -> subprocess.CompletedProcess:
+    """``python [args] -c code`` in a fresh process (``code`` empty: no ``-c``)."""
+    return subprocess.run(
+        [sys.executable, *args, "-c", code] if code else [sys.executable, *args],
         capture_output=True,
         text=True,
         cwd=ROOT,
         timeout=300,
-        check=True,
     )
+
+
+def _printed(code: str):
+    """The JSON that ``code`` prints last, run in a fresh process."""
+    done = _run(code)
+    assert done.returncode == 0, done.stderr
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 def test_each_old_path_is_its_new_module_and_warns_at_the_import():
-    out = _child()
+    out = _printed(_CHILD)
     for old, new in drakegrasp._MOVED.items():
         got = out[old]
         if old in drakegrasp._MOVED_NAMES:  # split: a module of its own
@@ -98,16 +104,6 @@ def test_the_table_maps_gone_paths_to_modules_that_exist():
         assert child not in public, old
 
 
-def _run(code: str, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, *args, "-c", code] if code else [sys.executable, *args],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=300,
-    )
-
-
 _RELOAD = r"""
 import importlib, json, sys, warnings
 warnings.simplefilter("ignore")
@@ -128,9 +124,7 @@ def test_importing_an_old_path_leaves_the_new_modules_spec_and_reload_alone():
     # the new module's __spec__ was the old path's, importlib.reload (IPython's
     # autoreload) then ran nothing and renamed the module (__name__
     # "drakegrasp.grasp", __package__ "drakegrasp").
-    done = _run(_RELOAD)
-    assert done.returncode == 0, done.stderr
-    out = json.loads(done.stdout.strip().splitlines()[-1])
+    out = _printed(_RELOAD)
     assert out == {
         "spec": "drakegrasp.core.grasp",
         "find_spec": "drakegrasp.core.grasp",
@@ -161,9 +155,7 @@ print(json.dumps([w.filename for w in caught]))
 def test_import_module_of_an_old_path_warns_at_the_callers_line():
     # importlib.import_module(old) warned at importlib/__init__.py, which the
     # default filters hide (DeprecationWarning shows in __main__ only).
-    done = _run(_IMPORT_MODULE)
-    assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout.strip().splitlines()[-1]) == ["<string>"]
+    assert _printed(_IMPORT_MODULE) == ["<string>"]
 
 
 _SPLIT = r"""
@@ -195,9 +187,7 @@ def test_old_modules_that_were_split_keep_every_name_of_their_all():
     # old path gave only the first, so names of the old __all__ (evaluate_file,
     # write_result, stream_file, AntipodalResult) were an ImportError, and a
     # pickled AntipodalResult did not load.
-    done = _run(_SPLIT)
-    assert done.returncode == 0, done.stderr
-    out = json.loads(done.stdout.strip().splitlines()[-1])
+    out = _printed(_SPLIT)
     assert out == {
         "io": True,
         "writers": True,

@@ -467,30 +467,31 @@ def check_length(name: str, value, *, error: type = InvalidGraspError) -> float:
     return x
 
 
-def check_grasp(value, name: str = "grasp"):
-    """``value`` if it is a :class:`~drakegrasp.Grasp`, else InvalidGraspError."""
-    # No import of drakegrasp.core.grasp (it imports this module: a cycle): a Grasp
-    # can only exist once that module is loaded, so look it up there.
-    grasp_module = sys.modules.get("drakegrasp.core.grasp")
-    if grasp_module is None or not isinstance(value, grasp_module.Grasp):
-        raise InvalidGraspError(
-            f"{name} must be a drakegrasp.Grasp, got {describe(value)} "
+def _instance(value, module: str, cls: str, name: str, error: type):
+    """``value`` if it is a ``module.cls``, else ``error`` naming ``name``.
+
+    No import of ``module`` (it imports this one: a cycle): an instance can
+    only exist once that module is loaded, so the class is looked up there.
+    """
+    loaded = sys.modules.get(module)
+    if loaded is None or not isinstance(value, getattr(loaded, cls)):
+        raise error(
+            f"{name} must be a drakegrasp.{cls}, got {describe(value)} "
             f"({type(value).__name__})"
         )
     return value
+
+
+def check_grasp(value, name: str = "grasp"):
+    """``value`` if it is a :class:`~drakegrasp.Grasp`, else InvalidGraspError."""
+    return _instance(value, "drakegrasp.core.grasp", "Grasp", name, InvalidGraspError)
 
 
 def check_contact(value, name: str = "contact"):
     """``value`` if it is a :class:`~drakegrasp.Contact`, else InvalidContactError."""
-    # Looked up where it lives, as in check_grasp (drakegrasp.core.contact
-    # imports this module).
-    contact_module = sys.modules.get("drakegrasp.core.contact")
-    if contact_module is None or not isinstance(value, contact_module.Contact):
-        raise InvalidContactError(
-            f"{name} must be a drakegrasp.Contact, got {describe(value)} "
-            f"({type(value).__name__})"
-        )
-    return value
+    return _instance(
+        value, "drakegrasp.core.contact", "Contact", name, InvalidContactError
+    )
 
 
 def check_flag(name: str, value) -> bool:
