@@ -653,8 +653,11 @@ def _resolved_chains(plant: MultibodyPlant, entries: tuple) -> tuple:
         return entries
     named = {}
     for entry in entries:
-        j0, j1, rho, offset = coupling_entry(plant, entry)
-        follower, leader = joint_name(plant, j0), joint_name(plant, j1)
+        if type(entry) is JointCoupling:  # recorded: scoped names, checked then
+            follower, leader, rho, offset = entry
+        else:
+            j0, j1, rho, offset = coupling_entry(plant, entry)
+            follower, leader = joint_name(plant, j0), joint_name(plant, j1)
         if named.get(follower, (leader, rho, offset)) == (leader, rho, offset):
             named[follower] = (leader, rho, offset)  # a repeated coupling is one
             continue
