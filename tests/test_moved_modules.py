@@ -105,7 +105,7 @@ def test_the_table_maps_gone_paths_to_modules_that_exist():
 
 
 _RELOAD = r"""
-import importlib, json, sys, warnings
+import importlib, importlib.util, json, sys, warnings
 warnings.simplefilter("ignore")
 import drakegrasp.grasp
 new = sys.modules["drakegrasp.core.grasp"]
