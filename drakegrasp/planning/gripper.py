@@ -43,7 +43,7 @@ from drakegrasp.errors import ModelError
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.attachment import chain_to_world, free_carrier, how_held
 from drakegrasp.plant.couplings import plant_couplings
-from drakegrasp.plant.fingers import finger_chains, hand_structure
+from drakegrasp.plant.fingers import chain_root, finger_chains, hand_structure
 from drakegrasp.plant.validation import (
     HandSpec,
     hand_bodies,
@@ -438,7 +438,7 @@ def _coupled_limits(joints, follows, fingers: list) -> list[tuple[float, float]]
 
     roots: dict[int, list] = {}
     for i in fingers:
-        k, a, c = _chain_root(follows, i)
+        k, a, c, _ = chain_root(follows, i)
         roots.setdefault(k, []).append((i, a, c))
     out = {}
     for k, members in roots.items():
@@ -458,26 +458,14 @@ def _jaw_coupling(follows, i0: int, i1: int) -> tuple[float, float] | None:
 
     ``follows``: :class:`~drakegrasp.plant.fingers.Coupling`'s follower ->
     ``(leader, ρ, Δq)``.  Each joint is written as ``a q_root + c`` of the
-    joint at the end of its chain of leaders (:func:`_chain_root`).
+    joint at the end of its chain of leaders
+    (:func:`~drakegrasp.plant.fingers.chain_root`).
     """
-    (r0, a0, c0), (r1, a1, c1) = _chain_root(follows, i0), _chain_root(follows, i1)
+    r0, a0, c0, _ = chain_root(follows, i0)
+    r1, a1, c1, _ = chain_root(follows, i1)
     if r0 != r1:
         return None
     return float(a1 / a0), float(c1 - a1 / a0 * c0)
-
-
-def _chain_root(follows, i: int) -> tuple[int, float, float]:
-    """``(root, a, c)`` with ``q_i = a q_root + c``, up ``i``'s chain of leaders.
-
-    ``follows``: follower -> ``(leader, ρ, Δq)``, ``q_f = ρ q_l + Δq``; a
-    joint that follows none is its own root (``a = 1``, ``c = 0``).
-    """
-    a, c, seen = 1.0, 0.0, set()
-    while i in follows and i not in seen:
-        seen.add(i)
-        i, rho, off = follows[i]
-        a, c = a * rho, a * off + c
-    return i, a, c
 
 
 def _grasp_axis(finger_origins, lower, upper) -> np.ndarray:

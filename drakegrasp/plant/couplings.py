@@ -58,7 +58,12 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError, ModelError
-from drakegrasp.plant.fingers import coupling_entries, coupling_entry, joint_name
+from drakegrasp.plant.fingers import (
+    chain_root,
+    coupling_entries,
+    coupling_entry,
+    joint_name,
+)
 from drakegrasp.plant.models import load_models
 from drakegrasp.plant.validation import check_plant
 
@@ -669,23 +674,10 @@ def _resolved_chains(plant: MultibodyPlant, entries: tuple) -> tuple:
     if not any(leader in named for leader, _, _ in named.values()):
         return entries
     resolved = []
-    for follower, (leader, rho, offset) in named.items():
-        path = [follower]
-        links = [JointCoupling(follower, leader, rho, offset)]
-        while leader in named:
-            if leader in path:
-                loop = " -> ".join([*path[path.index(leader) :], leader])
-                raise InvalidOptionError(
-                    f"the couplings close a loop ({loop}, each following the "
-                    "next): a chain of couplings must end at a joint that follows "
-                    "none"
-                )
-            path.append(leader)
-            links.append(JointCoupling(leader, *named[leader]))
-            leader, rho_b, offset_b = named[leader]
-            rho, offset = rho * rho_b, rho * offset_b + offset
-        coupling = _ChainCoupling(follower, leader, rho, offset)
-        coupling.links = tuple(links)
+    for follower in named:
+        root, rho, offset, path = chain_root(named, follower)
+        coupling = _ChainCoupling(follower, root, rho, offset)
+        coupling.links = tuple(JointCoupling(f, *named[f]) for f in path[:-1])
         resolved.append(coupling)
     return tuple(resolved)
 
@@ -733,7 +725,7 @@ def coupling_map(
     """
     v = [int(i) for i in velocity_indices]
     row = {vi: k for k, vi in enumerate(v)}
-    follows: dict[int, tuple[int, float]] = {}
+    follows: dict[int, tuple[int, float, float]] = {}
     by_velocity: dict[int, Joint] = {}
     links = [
         link
@@ -750,23 +742,12 @@ def coupling_map(
                 )
         f, lead = j0.velocity_start(), j1.velocity_start()
         if f in row and lead in row:
-            follows[f] = (lead, rho)
+            follows[f] = (lead, rho, 0.0)  # velocities: no offset
             by_velocity[f] = j0
-    for f in list(follows):  # each follower on its chain's last joint here
-        lead, rho = follows[f]
-        seen = [f]
-        while lead in follows:
-            if lead in seen:
-                loop = " -> ".join(
-                    joint_name(plant, by_velocity[x]) for x in (*seen, lead)
-                )
-                raise InvalidOptionError(
-                    f"the couplings close a loop ({loop}, each following the next)"
-                )
-            seen.append(lead)
-            lead, rho_b = follows[lead]
-            rho *= rho_b
-        follows[f] = (lead, rho)
+    follows = {  # each follower on its chain's last joint here
+        f: chain_root(follows, f, lambda x: joint_name(plant, by_velocity[x]))[:2]
+        for f in follows
+    }
     independent = [vi for vi in v if vi not in follows]
     col = {vi: k for k, vi in enumerate(independent)}
     C = np.zeros((len(v), len(independent)))

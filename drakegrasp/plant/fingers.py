@@ -34,7 +34,7 @@ from __future__ import annotations
 import copy
 import numbers
 import weakref
-from collections.abc import Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -261,6 +261,57 @@ def find_joint(plant: MultibodyPlant, spec) -> Joint:
         f"coupling joint {spec!r} is not a joint of the plant (give a Joint or "
         "a 'model::joint' name)"
     )
+
+
+def chain_root(
+    follows: Mapping[Hashable, tuple[Hashable, float, float]],
+    joint: Hashable,
+    name: Callable[[Hashable], str] = str,
+) -> tuple[Hashable, float, float, list]:
+    """Where ``joint``'s chain of couplings ends: ``(root, ρ, Δ, path)``.
+
+    ``q_joint = ρ q_root + Δ``, composed link by link from ``joint`` up:
+    ``(ρ, Δ) ← (ρ ρ_l, ρ Δ_l + Δ)`` for each link ``q_f = ρ_l q_l + Δ_l``.  A
+    joint that follows none is its own root (``ρ = 1``, ``Δ = 0``).
+
+    Parameters
+    ----------
+    follows : mapping
+        Follower -> ``(leader, ρ_l, Δ_l)``, one link each (joints by any
+        hashable key: index, velocity index, scoped name).
+    joint : hashable
+        A key of ``follows`` or any other joint.
+    name : callable, optional
+        A key's name in the error message.
+
+    Returns
+    -------
+    root : hashable
+        The chain's last leader, which follows none.
+    rho : float
+        The product of the gear ratios along the chain.
+    offset : float
+        Position offset (m or rad, the follower's unit).
+    path : list
+        ``joint``, then each leader up to ``root``.
+
+    Raises
+    ------
+    InvalidOptionError
+        For a chain that closes a loop, named.
+    """
+    rho, offset, path = 1.0, 0.0, [joint]
+    while joint in follows:
+        joint, rho_l, offset_l = follows[joint]
+        if joint in path:
+            loop = " -> ".join(name(k) for k in (*path[path.index(joint) :], joint))
+            raise InvalidOptionError(
+                f"the couplings close a loop ({loop}, each following the next): "
+                "a chain of couplings must end at a joint that follows none"
+            )
+        path.append(joint)
+        rho, offset = rho * rho_l, rho * offset_l + offset
+    return joint, rho, offset, path
 
 
 def coupling_entries(couplings) -> tuple:
