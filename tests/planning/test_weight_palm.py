@@ -232,6 +232,10 @@ def test_a_finger_pressing_towards_the_palm_lets_it_push_back():
 # two palm normals 1 mrad apart, one face whose row was whichever came first:
 # a permutation moved a capacity by 4e-4 (found by hypothesis in CI)
 @example(seed=41550, mu=0.3)
+# a capacity of 0 on a degenerate LP: 2.5e-13 in a batch of three, 2.1e-6 after
+# a permutation, where Clp (the fallback, and solver="drake" alike) stops
+# (found by hypothesis in CI)
+@example(seed=32385, mu=0.3)
 def test_never_raises_a_capacity_and_follows_order_and_rigid_motion(seed, mu):
     rng = np.random.default_rng(seed)
     P, N, F = _jaw_over_palm(rng, 3)
@@ -242,7 +246,8 @@ def test_never_raises_a_capacity_and_follows_order_and_rigid_motion(seed, mu):
     assert np.all(new <= old + 1e-7)
     perm = rng.permutation(6)
     shuffled = weight_capacity(P[:, perm], N[:, perm], F[:, perm], **kw, palm=2)
-    assert shuffled == pytest.approx(new, rel=1e-6, abs=1e-7)
+    # abs: Clp's accuracy on a degenerate capacity LP (2.1e-6 where 0 is exact)
+    assert shuffled == pytest.approx(new, rel=1e-6, abs=1e-5)
     q = rng.normal(size=4)
     q /= np.linalg.norm(q)
     w, x, y, z = q
