@@ -13,6 +13,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import drakegrasp
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -195,3 +197,27 @@ def test_old_modules_that_were_split_keep_every_name_of_their_all():
         "pickle": True,
         "all": ["AntipodalResult", "ClosureResult", "InternalForceResult"],
     }, out
+
+
+def test_names_that_left_the_cloud_module_still_read_there_and_warn():
+    # estimate_normals, the spacing constants and sphere_entry moved out of
+    # planning.cloud into modules of their own; code that read them there
+    # gets the same objects, with a warning that names the new module.
+    import warnings
+
+    from drakegrasp.planning import cloud, cloud_normals, cloud_spacing, cloud_tips
+
+    modules = (cloud_normals, cloud_spacing, cloud_tips)
+    moved = {name: module for module in modules for name in module.__all__}
+    assert {"estimate_normals", "TWIN_JUMP", "sphere_entry"} <= set(moved)
+    for name, module in moved.items():
+        assert name not in cloud.__all__
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            value = getattr(cloud, name)
+        assert value is getattr(module, name)
+        assert [w.category for w in caught] == [DeprecationWarning], name
+        assert f"{module.__name__}.{name}" in str(caught[0].message)
+        assert caught[0].filename == __file__
+    with pytest.raises(AttributeError, match="no_such_name"):
+        cloud.no_such_name  # noqa: B018

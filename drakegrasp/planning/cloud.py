@@ -3,7 +3,7 @@ r"""Planning on a point cloud: the object is points with normals, not a body.
 The perception route: the plant holds the gripper and the surroundings, and
 the object is a cloud, a pydrake ``PointCloud`` or an ``(M, 3)`` array in the
 world frame, with normals given or estimated from the flattest nearby patch
-(:func:`estimate_normals`) and turned outwards (away from the cloud's
+(:func:`.estimate_normals`) and turned outwards (away from the cloud's
 centroid, or towards a ``viewpoint``: the camera, for a one-sided cloud).
 Points that are not finite (Drake marks missing depth with NaN) are dropped,
 with a :class:`PointCloudWarning` that counts them (the result's
@@ -29,7 +29,7 @@ finger closes along the grasp axis by the smallest travel at which one of its
 shapes reaches a cloud point (a point moving against the closing direction
 enters a convex piece at its chord's entry; a spherical fingertip, often smaller
 than the cloud's spacing, meets a quadric fitted to the points of the face
-around its line: :func:`sphere_entry`), and its contacts are the points its
+around its line: :func:`.sphere_entry`), and its contacts are the points its
 shapes touch within ``band``: the point nearest the line for a sphere (a
 fingertip), the corners of the touched set's convex hull across the axis for
 a flat pad.  The contact normals are the cloud's.
@@ -44,60 +44,41 @@ body, meeting a quadric fitted at each point (:class:`FittedCloud`).
 
 from __future__ import annotations
 
-import hashlib
-import threading
 import warnings
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, cKDTree
 
 from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import real_array, unit_vectors
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.planning import cloud_normals, cloud_spacing, cloud_tips
+from drakegrasp.planning.cloud_normals import _estimate_normals
+from drakegrasp.planning.cloud_spacing import (
+    _areas,
+    _distinct,
+    _gather,
+    _Spots,
+    _spots,
+)
+from drakegrasp.planning.cloud_tips import _basis_across
 from drakegrasp.planning.gripper import ParallelJaw
 from drakegrasp.planning.surface import piece_of_shape
 from drakegrasp.plant.validation import scoped_name
 
 __all__ = [
-    "AREA_EDGE_OFFSET",
-    "AREA_FACE_ANGLE",
-    "AREA_NEIGHBOURS",
-    "AREA_SMOOTHING",
     "CLOUD_SMALL_EXTENT",
     "CLOUD_STRAY_RATIO",
     "CLOUD_UNITS_EXTENT",
     "MAX_COORDINATE",
     "CONTACT_BAND",
-    "DISTINCT",
     "EDGE_LINES",
     "FACING_NEIGHBOURS",
-    "FIT_FACE_COS",
-    "FIT_MIN_POINTS",
     "FIT_NEIGHBOURS",
-    "FIT_RADIUS_LINES",
     "LINE_RADIUS_SPACINGS",
-    "NORMAL_ANGLE_TARGET",
-    "NORMAL_CURVED_F",
-    "NORMAL_MAX_NEIGHBOURS",
-    "NORMAL_NEIGHBOURS",
-    "NORMAL_OWN_FACTOR",
     "PAD_CONTACT_BAND",
-    "SPACING_DENSITY_FLOOR",
-    "SPACING_NEIGHBOURS",
-    "SPACING_REACH",
-    "SPOT_LINKS",
-    "SPOT_NEIGHBOURS",
-    "TWIN_JUMP",
-    "TWIN_MIN_POINTS",
-    "TWIN_MIN_SPOTS",
-    "TWIN_RADIUS",
-    "TWIN_SHARE",
-    "TWIN_TIGHT",
     "UNSEEN_DEPTH_ANGLE",
     "UNSEEN_WEAK",
     "VOXEL_SPACINGS",
@@ -107,12 +88,31 @@ __all__ = [
     "FittedCloud",
     "PointCloudWarning",
     "cloud_surface",
-    "sphere_entry",
     "complete_unseen",
-    "estimate_normals",
     "read_cloud",
     "read_cloud_fit",
 ]
+
+_MOVED_OUT = {
+    name: module
+    for module in (cloud_normals, cloud_spacing, cloud_tips)
+    for name in module.__all__
+}
+"""Public names that moved to :mod:`.cloud_normals`, :mod:`.cloud_spacing` and
+:mod:`.cloud_tips`: still read here, with a ``DeprecationWarning``."""
+
+
+def __getattr__(name: str):
+    module = _MOVED_OUT.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    warnings.warn(
+        f"drakegrasp.planning.cloud.{name} moved to {module.__name__}.{name}",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return getattr(module, name)
+
 
 CONTACT_BAND = 1e-3
 """A finger shape touches the cloud points within this travel (m) of its first."""
@@ -124,51 +124,13 @@ route counts contacts.
 
 A rigid pad stops where it first touches; another of its tip shapes presses
 only if the surface lies within the contacts' give.  Fingertips meet the
-cloud's fitted surface (:func:`sphere_entry`, within 20 µm on a sampled can),
+cloud's fitted surface (:func:`.sphere_entry`, within 20 µm on a sampled can),
 so the band can be the body route's: with 0.25 mm the ten best of six clouds
 of the YCB soup can (whole, side and oblique views, seeds 0 and 1) held 41
 of 60 times at the predicted squeeze, with 0.1 mm 45 (before re-closing on
 the cloud, :class:`FittedCloud`, which brought it to 59;
 ``benchmarks/bench_cloud_jaw.py``)."""
 
-NORMAL_NEIGHBOURS = 20
-"""Points of each neighbourhood whose plane gives an estimated normal (more on
-a noisy cloud: :data:`NORMAL_ANGLE_TARGET`)."""
-
-NORMAL_ANGLE_TARGET = np.radians(0.1)
-"""Standard error (radians) of an estimated normal that a noisy cloud's
-neighbourhoods grow to reach, up to :data:`NORMAL_MAX_NEIGHBOURS` points.
-
-The error of a plane fitted to ``k`` points with in-plane variances ``λ₁, λ₂``
-and noise ``σ`` across it is ``σ √((1/λ₁ + 1/λ₂)/k)``, about ``1/k`` as the
-patch grows with ``k``.  A parallel jaw closes along a point's normal, and a
-pad a fraction of a degree off a face touches it along an edge: on the YCB
-cracker box's cloud (3,000 points, depth noise σ = 0.25 mm) the normals of
-20 points were 0.3° off and 4 of the ten best grasps fell even at five times
-the box's weight, with closing axes 0.3-0.6° off the faces; with 60 points
-(0.1°) the axes were within 0.14° and all ten held.  A noise-free cloud
-(residuals of its quadric fits near zero) keeps :data:`NORMAL_NEIGHBOURS`."""
-
-NORMAL_MAX_NEIGHBOURS = 100
-"""Most points of a neighbourhood grown for noise (:data:`NORMAL_ANGLE_TARGET`):
-a patch must still fit on one face to be flat (100 points of a 3,000-point
-cloud of the YCB cracker box span about 70 mm; its narrowest face is 66 mm
-wide)."""
-
-NORMAL_OWN_FACTOR = 1.5
-"""A point keeps its own neighbourhood's plane unless that plane's surface
-variation is more than this times the flattest plane that passes through it."""
-
-NORMAL_CURVED_F = 5.6
-"""A neighbourhood is fitted with a quadric, and a point takes the quadric's
-normal at itself, where the quadric explains the points better than the plane
-beyond chance: the F statistic of the three added terms exceeds this (the 1 %
-point of F(3, 14), 20 points less six coefficients).  A cloud of fewer than
-:data:`NORMAL_NEIGHBOURS` points has fewer residual degrees of freedom, and
-its test the 1 % point of F(3, k - 6) instead, when that is higher."""
-
-_NORMAL_CHUNK = 50_000
-"""Points whose neighbourhoods are fitted at once (memory: chunk × 20 × 3)."""
 
 LINE_RADIUS_SPACINGS = 2.5
 """Default line radius in median nearest-neighbour spacings: a disc of that
@@ -273,7 +235,7 @@ class PointCloudWarning(UserWarning):
     Points left out (not finite: a depth camera's missing depth), or an
     extent too large for metres (:data:`CLOUD_UNITS_EXTENT`) or too small
     for an object a hand grasps (:data:`CLOUD_SMALL_EXTENT`), or points in
-    near twins (scans merged without downsampling: see :data:`TWIN_JUMP`).
+    near twins (scans merged without downsampling: see :data:`.TWIN_JUMP`).
     Silence it
     with ``warnings.simplefilter("ignore", PointCloudWarning)``.
     """
@@ -296,7 +258,7 @@ def read_cloud(point_cloud, normals=None, *, viewpoint=None):
     Returns
     -------
     points, normals : (M', 3) float
-        For scans merged as they were (near twins, :data:`TWIN_JUMP`), each
+        For scans merged as they were (near twins, :data:`.TWIN_JUMP`), each
         spot's mean point, and its points' normals summed.
     dropped : int
         Points left out (not finite, or no normal could be estimated); a
@@ -332,7 +294,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
         patch), ``noise`` (metres: the RMS residual of the patches' quadric
         fits, the cloud's noise across its surface) and ``error_deg`` (the
         normals' expected standard error, degrees); see
-        :func:`estimate_normals`.
+        :func:`.estimate_normals`.
     """
     from pydrake.perception import PointCloud
 
@@ -465,7 +427,7 @@ def _refuse_strays(points: np.ndarray) -> None:
     InvalidOptionError
         The farthest point from the median point is more than
         :data:`CLOUD_STRAY_RATIO` times the median point's distance (of the
-        distinct points, :data:`DISTINCT` apart: a spot repeated many times
+        distinct points, :data:`.DISTINCT` apart: a spot repeated many times
         counts once).
     """
     distinct = _distinct(points)  # a spot seen many times counts once
@@ -515,262 +477,6 @@ def _warn_of(points: np.ndarray, total: int) -> None:
         )
 
 
-def estimate_normals(points: np.ndarray) -> np.ndarray:
-    """Unit normals of a cloud's points, unoriented, from the flattest nearby patch.
-
-    Each point's :data:`NORMAL_NEIGHBOURS` nearest points are fitted with a
-    plane (principal components; the surface variation ``λ₀ / Σλ`` measures
-    how badly).  Near an edge, a point's own neighbourhood straddles two
-    faces and its plane is tilted between them (Drake's
-    ``PointCloud.EstimateNormals`` tilted normals up to 66° at the soup can's
-    rim, and planning on one-sided clouds with them held 0 of the ten best
-    grasps of the can and of the cracker box at the predicted squeeze).  So a
-    point takes, among the planes of its neighbours' neighbourhoods that pass
-    within a quarter spacing of it (plus their own scatter), the flattest
-    (of equally flat ones, the nearest), and keeps its own unless that is
-    more than :data:`NORMAL_OWN_FACTOR` times as curved.  The neighbourhoods
-    shift off the edge, so faces keep sharp normals: on a sampled box, 2-3 %
-    of the points end more than 10° off (those within about a spacing of an
-    edge, which may take the other face's normal) against Drake's 28 %.
-
-    On a curved face the patch taken is off-centre (always so at a one-sided
-    cloud's silhouette), and its plane's normal is that of the patch's
-    centre, not the point's: 4-5° off on average on the soup can, up to 14°
-    at the silhouette of its side view.  So the patch is also fitted with a
-    quadric ``w = a u² + b uv + c v² + d u + e v + f`` in its principal
-    frame, and where the quadric is the better model beyond chance (F test of
-    its three added terms, :data:`NORMAL_CURVED_F`) the point takes the
-    quadric's normal at itself: 0.02° on average on the can's side view
-    (0.3° at most), while a box's flat faces keep their planes.
-
-    On a noisy cloud the patches grow (to at most
-    :data:`NORMAL_MAX_NEIGHBOURS` points) until the normals' expected error,
-    from the quadrics' residuals, falls to :data:`NORMAL_ANGLE_TARGET`.
-
-    Parameters
-    ----------
-    points : (M, 3) float
-        Finite points, metres.
-
-    Returns
-    -------
-    normals : (M, 3) float
-        Unit normals (either sign); NaN where a neighbourhood spans no plane
-        (fewer than 3 distinct points, or all on a line).  A point given
-        twice counts once, and both copies get its normal; so do points
-        closer than single precision resolves at the cloud's extent.
-    """
-    return _estimate_normals(points)[0]
-
-
-def _estimate_normals(points: np.ndarray) -> tuple[np.ndarray, dict]:
-    """:func:`estimate_normals`, and the fit :func:`read_cloud_fit` reports."""
-    same = _same_point(points)
-    if same is not None:  # repeated points (fused frames) count once
-        first, inverse = np.unique(same, return_index=True, return_inverse=True)[1:]
-        normals, fit = _estimate_normals(points[first])
-        return normals[inverse.reshape(-1)], fit
-    M = len(points)
-    k = min(NORMAL_NEIGHBOURS, M)
-    normals, error, noise = _patch_normals(points, k)
-    # error ~ 1/k: the patch's in-plane variances grow with its size
-    wanted = np.nan_to_num(k * error / NORMAL_ANGLE_TARGET, nan=0.0, posinf=M)
-    grown = min(M, NORMAL_MAX_NEIGHBOURS, int(np.ceil(wanted)))
-    if grown > k:
-        k = grown
-        normals, error, noise = _patch_normals(points, k)
-    fit = {"neighbours": k, "noise": noise, "error_deg": float(np.degrees(error))}
-    return normals, fit
-
-
-def _patch_normals(points: np.ndarray, k: int) -> tuple[np.ndarray, float, float]:
-    """:func:`estimate_normals` with ``k`` points a patch, and its typical error.
-
-    Returns
-    -------
-    normals : (M, 3) float
-        As :func:`estimate_normals` returns them.
-    error : float
-        Median over the points of the standard error (radians) of their
-        chosen plane's normal, with the noise taken as the median residual
-        of the patches' quadric fits (0 when ``k <= 6``).
-    noise : float
-        That residual, metres (RMS about the quadric; 0 when ``k <= 6``).
-    """
-    M = len(points)
-    tree = cKDTree(points)
-    dist, idx = tree.query(points, k=k)
-    dist, idx = dist.reshape(M, k), idx.reshape(M, k)
-    centre = np.empty((M, 3))
-    frame = np.empty((M, 3, 3))  # columns: the plane's normal, then its axes
-    eig = np.empty((M, 3))
-    chunk = max(1, _NORMAL_CHUNK * NORMAL_NEIGHBOURS // k)
-    for start in range(0, M, chunk):
-        rows = slice(start, start + chunk)
-        Q = points[idx[rows]]
-        centre[rows] = Q.mean(axis=1)
-        X = Q - centre[rows][:, None, :]
-        w, frame[rows] = np.linalg.eigh(np.einsum("lki,lkj->lij", X, X) / k)
-        eig[rows] = np.maximum(w, 0.0)
-    plane = frame[:, :, 0]
-    total = eig.sum(axis=1)
-    flat = eig[:, 1] > 1e-12 * eig[:, 2]  # spans a plane, not a line or a point
-    variation = np.where(flat, eig[:, 0] / np.where(total > 0, total, 1.0), np.inf)
-    spacing = float(np.median(dist[:, 1])) if k > 1 else 0.0
-    best = np.empty(M, dtype=int)
-    for start in range(0, M, chunk):
-        rows = slice(start, start + chunk)
-        near_idx = idx[rows]
-        off = np.abs(
-            np.einsum(
-                "lki,lki->lk",
-                points[rows, None, :] - centre[near_idx],
-                plane[near_idx],
-            )
-        )
-        # within a quarter spacing, plus three times the plane's own scatter
-        near = off <= 0.25 * spacing + 3.0 * np.sqrt(eig[near_idx, 0])
-        # flattest first; among equally flat planes (two faces at an edge)
-        # the one the point lies on
-        closeness = (off / spacing) ** 2 if spacing > 0 else np.zeros_like(off)
-        score = np.where(near, variation[near_idx] + 1e-3 * closeness, np.inf)
-        j = np.argmin(score, axis=1)
-        best[rows] = near_idx[np.arange(len(j)), j]
-    own = variation <= NORMAL_OWN_FACTOR * variation[best] + 1e-4
-    chosen = np.where(own, np.arange(M), best)
-    normals = plane[chosen]
-    noise = np.full(M, np.nan)  # residual variance of each chosen quadric, m²
-    if k > 6:
-        for start in range(0, M, chunk):
-            rows = slice(start, start + chunk)
-            c = chosen[rows]
-            normals[rows], noise[rows] = _quadric_normals(
-                points[rows], points[idx[c]], centre[c], frame[c], eig[c, 0], spacing
-            )
-    bad = ~np.isfinite(variation[chosen])
-    normals[bad] = np.nan
-    error = spread = 0.0
-    fitted = ~bad & np.isfinite(noise)
-    if fitted.any():
-        lam = eig[chosen[fitted]][:, 1:]  # in-plane variances (> 0: flat), m²
-        spread = float(np.median(noise[fitted]))
-        ratio = spread / lam  # dimensionless: no overflow
-        error = float(np.median(np.sqrt(np.sum(ratio, axis=1) / k)))
-    return normals, error, float(np.sqrt(spread))
-
-
-def _same_point(points: np.ndarray):
-    """Which points are one point given more than once, or None if none are.
-
-    Points closer than a single-precision float resolves at the cloud's
-    extent (or than a few units of round-off of its coordinates) are one
-    point: fused frames repeat points with such jitter, and twenty copies of
-    a point 1e-12 m apart once filled its neighbourhood with the jitter, whose
-    "plane" is any direction (normals 55-60 deg off on a flat grid).
-
-    Returns
-    -------
-    labels : (M,) int or None
-        Equal for points that are one; None when every point is apart.
-    """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    extent = float(np.max(np.ptp(points, axis=0)))
-    size = float(np.max(np.abs(points)))
-    tol = max(np.finfo(np.float32).eps * extent, 8 * np.finfo(float).eps * size)
-    if tol == 0.0:  # one point, or none
-        return np.zeros(len(points), int) if len(points) > 1 else None
-    # cells of side tol first (a cluster of 10^5 copies is one cell, not 10^10
-    # pairs), then cells whose points are within tol across a cell boundary
-    cell = np.floor((points - points.min(axis=0)) / tol)
-    _, first, label = np.unique(cell, axis=0, return_index=True, return_inverse=True)
-    label = label.reshape(-1)
-    pairs = cKDTree(points[first]).query_pairs(tol, output_type="ndarray")
-    if len(pairs):
-        n = len(first)
-        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), (n, n))
-        label = connected_components(graph, directed=False)[1][label]
-    return label if len(np.unique(label)) < len(points) else None
-
-
-def _curved_threshold(k: int) -> float:
-    """The F statistic a patch of ``k`` points must exceed to take its quadric.
-
-    :data:`NORMAL_CURVED_F` is the 1 % point for 20 points; a smaller patch
-    (a cloud of 7-19 points) leaves the quadric fewer residual degrees of
-    freedom, ``k - 6``, and chance alone gives far larger F: the 1 % point of
-    F(3, 1) is 5403.  With 5.6 there, seven points on a noisy plane took a
-    quadric fitted to the noise, normals up to 18° off.
-    """
-    if k >= NORMAL_NEIGHBOURS:  # the constant's own case (scipy.stats is slow to load)
-        return NORMAL_CURVED_F
-    from scipy.stats import f as f_distribution
-
-    return max(NORMAL_CURVED_F, float(f_distribution.ppf(0.99, 3, k - 6)))
-
-
-def _quadric_normals(p, Q, centre, frame, plane_var, spacing):
-    """Normals at ``p`` of quadrics fitted to patches, or the patches' planes.
-
-    Parameters
-    ----------
-    p : (L, 3) float
-        The points, metres.
-    Q : (L, k, 3) float
-        Each point's patch, metres.
-    centre : (L, 3) float
-        The patches' centroids.
-    frame : (L, 3, 3) float
-        Their principal axes as columns, the plane's normal first.
-    plane_var : (L,) float
-        Mean squared distance of a patch's points to its plane, m².
-    spacing : float
-        The cloud's median point spacing, metres (sets a floor on the residual
-        an exactly sampled surface leaves).
-
-    Returns
-    -------
-    normals : (L, 3) float
-        Unit normals: the quadric's at ``p`` where the F statistic exceeds
-        :func:`_curved_threshold` of the patch size (:data:`NORMAL_CURVED_F`
-        for 20 points), the plane's elsewhere and where the patch's points
-        leave the quadric undetermined (all on one conic of the plane).
-    noise : (L,) float
-        Residual variance of each quadric fit, ``RSS / (k − 6)``, m² (NaN
-        where it is undetermined): the cloud's noise across its surface.
-    """
-    L, k, _ = Q.shape
-    local = np.einsum("lki,lij->lkj", Q - centre[:, None, :], frame)
-    w, u, v = local[..., 0], local[..., 1], local[..., 2]
-    scale = np.sqrt(np.mean(u * u + v * v, axis=1))  # patch radius: conditioning
-    scale = np.where(scale > 0, scale, 1.0)[:, None]
-    u, v = u / scale, v / scale
-    A = np.stack([u * u, u * v, v * v, u, v, np.ones_like(u)], axis=-1)
-    AtA = np.einsum("lki,lkj->lij", A, A)
-    spread = np.linalg.eigvalsh(AtA)
-    # patches whose points lie on a conic (two scan lines, a ring) leave the
-    # quadric undetermined: those keep their planes
-    posed = spread[:, 0] > 1e-8 * spread[:, -1]
-    AtA[~posed] += np.eye(6)
-    coef = np.linalg.solve(AtA, np.einsum("lki,lk->li", A, w)[..., None])[..., 0]
-    quadric_rss = np.sum((np.einsum("lki,li->lk", A, coef) - w) ** 2, axis=1)
-    plane_rss = k * plane_var
-    floor = (1e-6 * spacing) ** 2  # round-off on an exact plane
-    F = ((plane_rss - quadric_rss) / 3.0) / np.maximum(quadric_rss / (k - 6), floor)
-    at = np.einsum("li,lij->lj", p - centre, frame)
-    u0, v0 = at[:, 1] / scale[:, 0], at[:, 2] / scale[:, 0]
-    a, b, c, d, e = coef[:, :5].T
-    du = (2 * a * u0 + b * v0 + d) / scale[:, 0]
-    dv = (b * u0 + 2 * c * v0 + e) / scale[:, 0]
-    local_n = np.stack([np.ones(L), -du, -dv], axis=1)
-    local_n /= np.linalg.norm(local_n, axis=1, keepdims=True)
-    curved = np.einsum("lij,lj->li", frame, local_n)
-    better = posed & (F > _curved_threshold(k))
-    noise = np.where(posed, quadric_rss / (k - 6), np.nan)
-    return np.where(better[:, None], curved, frame[:, :, 0]), noise
-
-
 def complete_unseen(points, normals, viewpoint):
     r"""The unseen side of a one-sided cloud, by point symmetry: an assumption.
 
@@ -779,7 +485,7 @@ def complete_unseen(points, normals, viewpoint):
     box, a bottle's body, a ball), so its unseen surface is the seen one
     reflected through ``c``: points ``2c − p`` with normals ``−n``.  ``c`` is
     the point nearest, in least squares, to every normal line ``p + t n``,
-    each point weighted by its share ``a_i`` of the surface (:data:`AREA_NEIGHBOURS`):
+    each point weighted by its share ``a_i`` of the surface (:data:`.AREA_NEIGHBOURS`):
 
     .. math::
 
@@ -852,111 +558,6 @@ def complete_unseen(points, normals, viewpoint):
     return mirrored[keep], -normals[keep], info
 
 
-AREA_NEIGHBOURS = 8
-"""A point's raw share of the surface is the square of the distance to this
-neighbour on its own face (:func:`complete_unseen` weighs each point by its
-share)."""
-
-AREA_SMOOTHING = 16
-"""A point's share of the surface is the median of the raw shares of the
-nearest points of its face, this many with itself: a raw share (one distance
-squared) scatters by tens of per cent from point to point."""
-
-AREA_FACE_ANGLE = np.radians(30.0)
-"""Neighbours whose normals turn more than this from a point's lie on another
-face (across a box's edge): they do not count in its share."""
-
-AREA_EDGE_OFFSET = 0.25
-"""A point whose :data:`AREA_SMOOTHING` nearest points of its face lie, on
-average, more than this many times the farthest one's distance off it is on
-the edge of what was seen of that face (half a disc of neighbours: 0.42; a
-whole one of 16 random points: 0.16 on average).  Half its neighbourhood is
-missing, so its raw share is about double: it is left out of the medians."""
-
-_AREA_CANDIDATES = 48
-"""Nearest points searched for a point's neighbours on its own face."""
-
-_AREA_CHUNK = 20_000
-"""Points whose neighbourhoods are measured at once (memory: chunk × 48 × 3)."""
-
-
-def _areas(points: np.ndarray, normals: np.ndarray, spots=None) -> np.ndarray:
-    """(M,) each point's share of the surface, up to a common factor.
-
-    Where a camera's points crowd (a face seen near or head-on) each stands
-    for less of the surface.  The points are first gathered into spots:
-    repeats (:data:`DISTINCT`) and, for scans merged as they were, near twins
-    (:data:`TWIN_JUMP`, :data:`SPOT_LINKS`); each spot's share is
-    split among its points.  A spot's raw share is ``r_k²``, with ``r_k`` the
-    distance to the :data:`AREA_NEIGHBOURS`-th spot of its own face (normals
-    within :data:`AREA_FACE_ANGLE`), and its share the median of the raw
-    shares of its :data:`AREA_SMOOTHING` nearest spots of the face (itself
-    included) that are not on the edge of the view
-    (:data:`AREA_EDGE_OFFSET`), or of all of them where every one is.
-    Fewer than ``AREA_NEIGHBOURS + 1`` spots: equal shares.
-
-    Parameters
-    ----------
-    points, normals : (M, 3) float
-        Any frame and unit of length; unit normals.
-    spots : optional
-        The spots of ``points`` (see :data:`TWIN_JUMP`), if already at hand.
-    """
-    M = len(points)
-    first, spot = _gathered(points, _spots(points) if spots is None else spots, normals)
-    if len(first) <= AREA_NEIGHBOURS:
-        return np.ones(M)
-    share = _spot_areas(points[first], normals[first])
-    return share[spot] / np.bincount(spot)[spot]
-
-
-def _spot_areas(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """:func:`_areas` of distinct spots, in chunks of rows (memory ~ 50 per row)."""
-    M = len(points)
-    K = min(_AREA_CANDIDATES, M - 1)
-    tree = cKDTree(points)
-    raw, reach, face_near = np.empty(M), np.empty(M), []
-    inner = np.empty(M, dtype=bool)
-    for lo in range(0, M, _AREA_CHUNK):
-        rows = slice(lo, min(lo + _AREA_CHUNK, M))
-        d, near = tree.query(points[rows], k=K + 1)
-        cos = np.einsum("ij,ikj->ik", normals[rows], normals[near])
-        same = cos >= np.cos(AREA_FACE_ANGLE)
-        same[:, 0] = True  # the point itself (d = 0, first)
-        rank = np.cumsum(same, axis=1) - 1  # each neighbour's place on the face
-
-        def distance_to(k, same=same, rank=rank, d=d):
-            at = same & (rank == k)
-            where = np.argmax(at, axis=1)
-            return np.where(at.any(axis=1), d[np.arange(len(d)), where], np.nan)
-
-        raw[rows] = distance_to(AREA_NEIGHBOURS)
-        reach[rows] = distance_to(AREA_SMOOTHING - 1)
-        face = same & (rank < AREA_SMOOTHING)
-        centroid = (
-            np.einsum("ik,ikj->ij", face, points[near]) / face.sum(axis=1)[:, None]
-        )
-        offset = np.linalg.norm(centroid - points[rows], axis=1)
-        inner[rows] = offset <= AREA_EDGE_OFFSET * reach[rows]  # False if NaN
-        face_near.append(np.where(face, near, -1).astype(np.int32))
-    face_near = np.concatenate(face_near)
-    scale = np.nanmedian(raw) if np.any(np.isfinite(raw)) else 1.0
-    raw = (raw / (scale or 1.0)) ** 2  # in units of the cloud: no underflow
-    share = np.empty(M)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
-        for lo in range(0, M, _AREA_CHUNK):
-            member = face_near[lo : lo + _AREA_CHUNK] >= 0
-            at = np.where(member, face_near[lo : lo + _AREA_CHUNK], 0)
-            mine = np.nanmedian(np.where(member & inner[at], raw[at], np.nan), 1)
-            every = np.nanmedian(np.where(member, raw[at], np.nan), axis=1)
-            share[lo : lo + _AREA_CHUNK] = np.where(np.isnan(mine), every, mine)
-        if np.all(np.isnan(share)):  # too few points on any face
-            return np.ones(M)
-        share = np.where(np.isnan(share), np.nanmedian(share), share)
-    return np.maximum(share, np.finfo(float).tiny)
-
-
 def cloud_surface(points, normals, viewpoint=None, complete: bool = True):
     """The surface a hand is planned on: the cloud, completed when it can be.
 
@@ -994,302 +595,11 @@ def cloud_surface(points, normals, viewpoint=None, complete: bool = True):
     return surface, completion
 
 
-DISTINCT = 1e-9
-"""Points closer than this (m) are one point repeated, for the spacing."""
-
-TWIN_JUMP = 3.0
-"""How many times farther the next spot lies than a spot's own points.
-
-Scans merged without downsampling see each spot of the surface several
-times, a registration error apart.  The distances from a point to its
-nearest ones then jump, past its own spot's twins, by the ratio of the
-spots' spacing to the error: 4-125 for 2-100 scans 0.01-0.1 mm apart on a
-2 mm cloud.  Each point's jump is its own, so spots of different counts
-(scans that overlap in part, or of different densities) are told alike.  A
-single scan's points show such a jump now and then (a point whose nearest
-happens to be near): the cloud has *sharp twins* when most of its points
-do (:data:`TWIN_SHARE`).  Scans blurred by a larger error (a standard
-deviation near a tenth of their spacing) show none, and are told by their
-density instead (:data:`SPACING_DENSITY_FLOOR`)."""
-
-TWIN_SHARE = 0.5
-"""Share of the points whose neighbour distances jump by :data:`TWIN_JUMP`
-for a cloud to have sharp twins (a single scan at random: about 0.1)."""
-
-TWIN_MIN_SPOTS = 256
-"""Fewest spots a cloud of sharp twins has: a spot holds at most this
-fraction of its points (clusters of points far apart are not twins of one
-surface: 200 cubes of 20 points each are not; 300 are)."""
-
-SPOT_NEIGHBOURS = 1024
-"""Neighbours looked through for a point's jump: the most scans merged whose
-sharp twins are told."""
-
-SPACING_NEIGHBOURS = 64
-"""Neighbours whose farthest sets a point's density spacing (see
-:data:`SPACING_DENSITY_FLOOR`)."""
-
-SPACING_DENSITY_FLOOR = 0.4
-"""The spacing of scans merged as they were, blurred, in spot spacings.
-
-A point's density spacing, ``sqrt(pi / k) r_k`` with ``r_k`` the distance to
-its ``k``-th neighbour (``k`` = :data:`SPACING_NEIGHBOURS`), is the side of
-the square it has on the surface; the cloud's is the median.  On a randomly
-sampled surface the median nearest-neighbour distance is 0.46-0.52 of it (on
-a grid, 1).
-
-Scans merged with a registration error too large for a jump
-(:data:`TWIN_JUMP`) but below their spacing still see each spot several
-times: the nearest-neighbour median is the error.  The points within
-:data:`TWIN_RADIUS` density spacings of a point are one spot; with ``m`` the
-median count, a spot has ``m`` times a point's square, ``sqrt(m)`` times its
-side, and such a cloud's spacing is this fraction of a spot's side (about 0.8
-of one scan's nearest-neighbour median).  Other clouds keep that median."""
-
-SPACING_REACH = 20.0
-"""The density spacing is a surface's when a point's
-:data:`SPACING_NEIGHBOURS`-th neighbour lies at most this many times farther
-than its quarter of them (on a surface about 2; up to 10 for blurred twins): not
-in another piece of the cloud (70 cubes of 30 points 0.5 m apart read as
-twins of 30, a line radius of 0.6 m)."""
-
-TWIN_RADIUS = 0.25
-"""Points this many density spacings apart are one spot seen twice (a
-randomly sampled surface has another point that near one point in five)."""
-
-TWIN_TIGHT = 0.75
-"""Blurred twins lie this close: a point's nearest (the median) within this
-fraction of :data:`TWIN_RADIUS`.  Scans merged 0.01-0.1 mm apart put it at
-0.05-0.5 of it; a single scan with a dense patch that happens to put a second
-point in the radius, at 0.8-1."""
-
-TWIN_MIN_POINTS = 4 * SPACING_NEIGHBOURS
-"""Fewest distinct points for blurred twins to be told: in a smaller cloud
-the :data:`SPACING_NEIGHBOURS`-th neighbour lies across the object, and its
-spots are no spots (a 58-point face read as twins of three)."""
-
 VOXEL_SPACINGS = 2.0
 """The voxel a twin warning suggests, in spot spacings: few spots are split
 across voxels' sides (at 1.5 spacings, 50 scans 0.1 mm apart still came in
 twins), at the price of a coarser cloud (on the sugar box, 2,000-2,750
 points of 3,000 spots, their spacing 1.0-1.5 times theirs)."""
-
-_SPOT_QUERIES = 512
-"""Points, evenly spread over the cloud, whose own jumps are measured."""
-
-_SPOT_SPACING_QUERIES = 16384
-"""Points, evenly strided, whose distance past their twins is the spacing
-(the median of 512 can be 10 % off all of them; of 16,384, 1 %); fewer where
-a spot holds hundreds (4 million distances at most)."""
-
-_SPACING_QUERIES = 4096
-"""Points, evenly strided, whose density spacing and blurred spot are
-measured (the median of 4,096 is within a few per cent of all of them)."""
-
-
-class _Spots(NamedTuple):
-    """A cloud's spacing and the spots its points gather in (:func:`_spots`)."""
-
-    nearest: float
-    """The median distance (m) from a point to its nearest distinct one."""
-    spacing: float
-    """The gap (m) between neighbouring spots: ``nearest`` unless ``seen > 1``."""
-    seen: int
-    """Points per spot (the median): 1 unless scans were merged as they were."""
-    radius: float
-    """Points this close (m) are one spot: :data:`DISTINCT` unless ``seen > 1``."""
-    sharp: bool = False
-    """Twins told by their jump (:data:`TWIN_JUMP`): each spot can be
-    gathered into its mean.  Blurred twins (told by their density) are not."""
-
-
-def _cells(points: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarray]:
-    """The cells of a grid of ``size`` (m) that hold ``points``.
-
-    Returns each cell's first point (index) and each point's cell, (M,).
-    """
-    _, first, cell = np.unique(
-        np.round(points / size), axis=0, return_index=True, return_inverse=True
-    )
-    return first, cell.reshape(-1)
-
-
-def _distinct(points: np.ndarray) -> np.ndarray:
-    """``points`` taken once each, on a grid of :data:`DISTINCT`, in their order."""
-    return points[np.sort(_cells(points, DISTINCT)[0])]
-
-
-SPOT_LINKS = 16
-"""Twins a point is linked to when scans merged as they were are gathered
-into spots (each spot one share of the surface in the completion's centre):
-a spot of up to a hundred points is one connected piece."""
-
-
-def _gathered(
-    points: np.ndarray, spots: _Spots, normals: np.ndarray | None = None
-) -> tuple[np.ndarray, np.ndarray]:
-    """The spots ``points`` gather in, as :func:`_cells` gives cells.
-
-    Repeats (:data:`DISTINCT`) are one spot.  For near twins (``seen > 1``) a
-    spot is a connected piece of the graph linking each distinct point to its
-    :data:`SPOT_LINKS` nearest within ``spots.radius``, wherever it lies (a
-    grid of cells would split a spot across a cell's side and count it
-    twice), and, given oriented unit ``normals``, only where they agree
-    (:data:`FIT_FACE_COS`: the two faces of a plate thinner than the radius
-    stay apart).  Repeats are taken once first: a point's nearest would
-    otherwise be its own copies, and its twins left unlinked.
-    """
-    first, cell = _cells(points, DISTINCT)
-    if spots.seen == 1:
-        return first, cell
-    distinct = points[first]
-    M = len(distinct)
-    k = min(SPOT_LINKS, M - 1) + 1  # within the radius: a spot of more links too
-    tree = cKDTree(distinct)
-    rows, cols = [], []
-    for lo in range(0, M, _AREA_CHUNK):  # memory ~ 16 k bytes per point
-        d, j = tree.query(
-            distinct[lo : lo + _AREA_CHUNK], k=k, distance_upper_bound=spots.radius
-        )
-        linked = np.isfinite(d)
-        r, c = np.nonzero(linked)[0] + lo, j[linked]
-        if normals is not None:
-            n = normals[first]
-            agree = np.einsum("ij,ij->i", n[r], n[c]) >= FIT_FACE_COS
-            r, c = r[agree], c[agree]
-        rows.append(r.astype(np.int32))
-        cols.append(c.astype(np.int32))
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.ones(len(rows), bool), (rows, cols)), shape=(M, M))
-    _, piece = connected_components(graph, directed=False)
-    spot = piece[cell]
-    _, first = np.unique(spot, return_index=True)
-    return first, spot
-
-
-_SPOTS_KEPT = 2
-"""Clouds whose spots are kept: a plan reads its cloud, then completes it."""
-
-_spots_lock = threading.Lock()
-_spots_kept: dict[tuple, _Spots] = {}
-
-
-def _spots(points: np.ndarray) -> _Spots:
-    """:func:`_measured_spots`, kept for the last clouds by their contents.
-
-    A one-sided cloud's plan measures its spots when it reads the cloud
-    (:func:`read_cloud_fit`) and again when it completes it
-    (:func:`complete_unseen`, public and callable alone), on the same
-    points: 2.1 s at 10⁶ points.  The key is the points' bytes (a 16-byte
-    BLAKE2 digest with the shape and dtype), so a cloud changed in place or
-    equal to another one is never confused.
-    """
-    points = np.ascontiguousarray(points)
-    key = (
-        points.shape,
-        points.dtype.str,
-        hashlib.blake2b(points.tobytes(), digest_size=16).digest(),
-    )
-    with _spots_lock:
-        spots = _spots_kept.pop(key, None)
-        if spots is not None:  # the last used is the last evicted
-            _spots_kept[key] = spots
-    if spots is None:
-        spots = _measured_spots(points)
-        with _spots_lock:
-            _spots_kept[key] = spots
-            while len(_spots_kept) > _SPOTS_KEPT:
-                del _spots_kept[next(iter(_spots_kept))]
-    return spots
-
-
-def _measured_spots(points: np.ndarray) -> _Spots:
-    """A cloud's spacing, telling scans merged as they were (near twins).
-
-    The points are taken once each (on a grid of :data:`DISTINCT`: merged
-    camera frames repeat the points they share).  The spacing is the median
-    distance from a point to its nearest, unless
-
-    - most points' distances to their nearest ones jump by :data:`TWIN_JUMP`
-      (:data:`TWIN_SHARE`), in a cloud of at least :data:`TWIN_MIN_SPOTS`
-      spots: *sharp twins*.  ``seen`` is the median count of a point's spot
-      (itself and the neighbours before its jump), the spacing the median
-      distance past each point's own jump (its nearest point of another
-      spot; a point without a jump counts its nearest), and the spot radius
-      halfway (geometrically) between a spot's farthest twin and that;
-    - else, the points come in blurred twins (:func:`_blurred`): the spacing
-      is :data:`SPACING_DENSITY_FLOOR` of a spot's side.
-    """
-    distinct = _distinct(points)
-    if len(distinct) < 2:
-        return _Spots(0.0, 0.0, 1, DISTINCT)
-    tree = cKDTree(distinct)
-    nearest = float(np.median(tree.query(distinct, k=2)[0][:, 1]))
-    if len(distinct) >= 2 * TWIN_MIN_SPOTS:
-        K = min(SPOT_NEIGHBOURS, len(distinct) // TWIN_MIN_SPOTS)
-        at = np.linspace(0, len(distinct) - 1, _SPOT_QUERIES).astype(int)
-        own = _own_spots(tree.query(distinct[at], k=K + 1)[0][:, 1:])
-        seen = int(np.ceil(np.median(own)))
-        if np.mean(own > 1) >= TWIN_SHARE and seen >= 2:
-            # the distances past each point's jump, of every point strided
-            K = min(K, 2 * int(np.max(own)) + 2)
-            count = max(1024, min(_SPOT_SPACING_QUERIES, 4_000_000 // K))
-            many = distinct[:: max(1, len(distinct) // count)]
-            d = tree.query(many, k=K + 1)[0][:, 1:]
-            mine = _own_spots(d)
-            rows = np.arange(len(d))
-            past = d[rows, np.minimum(mine - 1, K - 1)]
-            farthest = d[rows, np.maximum(mine - 2, 0)]
-            twinned = mine > 1
-            spacing = float(np.median(past))
-            spread = np.median(farthest[twinned]) if twinned.any() else 0.0
-            radius = float(np.sqrt(spread * spacing)) or spacing / TWIN_JUMP
-            return _Spots(nearest, spacing, seen, radius, sharp=True)
-    blurred = _blurred(tree, distinct, nearest)
-    return blurred or _Spots(nearest, nearest, 1, DISTINCT)
-
-
-def _own_spots(d: np.ndarray) -> np.ndarray:
-    """Each point's spot count: 1 + the neighbours before its jump.
-
-    ``d`` (n, K) are the sorted distances to its ``K`` nearest others; the
-    jump is the first step of :data:`TWIN_JUMP` or more (none: 1).
-    """
-    with np.errstate(divide="ignore", invalid="ignore"):
-        step = d[:, 1:] / d[:, :-1]
-    jump = np.isfinite(step) & (step >= TWIN_JUMP)
-    has = jump.any(axis=1)
-    return np.where(has, np.argmax(jump, axis=1) + 2, 1)
-
-
-def _blurred(tree, distinct: np.ndarray, nearest: float) -> _Spots | None:
-    """Scans merged as they were whose twins show no jump, told by density.
-
-    The median number ``m`` of distinct points within :data:`TWIN_RADIUS`
-    density spacings of a point (its spot) is 2 or more (the density a
-    surface's, :data:`SPACING_REACH`), a point's nearest
-    lies well inside that (:data:`TWIN_TIGHT`), and the nearest-neighbour
-    median is below :data:`SPACING_DENSITY_FLOOR` of a spot's side (the
-    density spacing times ``sqrt(m)``); at least :data:`TWIN_MIN_POINTS`
-    distinct points.  None otherwise.
-    """
-    if len(distinct) < TWIN_MIN_POINTS:  # k reaches across the object: no spots
-        return None
-    k = min(SPACING_NEIGHBOURS, len(distinct) - 1)
-    queries = distinct[:: max(1, len(distinct) // _SPACING_QUERIES)]
-    reach = np.median(tree.query(queries, k=k + 1)[0], axis=0)
-    if reach[k] > SPACING_REACH * reach[k // 4]:  # across to other pieces
-        return None
-    density = float(np.sqrt(np.pi / k) * reach[k])
-    near = tree.query_ball_point(queries, TWIN_RADIUS * density, return_length=True)
-    seen = max(1, int(np.median(near)))
-    side = density * np.sqrt(seen)
-    radius = TWIN_RADIUS * density
-    if seen < 2 or nearest > TWIN_TIGHT * radius:
-        return None
-    if not nearest < SPACING_DENSITY_FLOOR * side:
-        return None
-    return _Spots(nearest, SPACING_DENSITY_FLOOR * side, seen, radius)
 
 
 def _warn_of_twins(spots: _Spots, gathered: tuple[int, int] | None = None) -> None:
@@ -1317,28 +627,6 @@ def _warn_of_twins(spots: _Spots, gathered: tuple[int, int] | None = None) -> No
     )
 
 
-def _gather(points: np.ndarray, normals, spots: _Spots):
-    """Each spot of ``points`` (:func:`_gathered`) as its mean point, in order.
-
-    ``normals`` (or None): oriented unit normals, which link only twins that
-    agree; each spot's is the sum of its points'.
-    """
-    first, spot = _gathered(points, spots, normals)
-    order = np.argsort(first, kind="stable")  # spots in their first point's order
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    spot = rank[spot]
-    count = np.bincount(spot).astype(float)
-
-    def summed(values: np.ndarray) -> np.ndarray:
-        return np.stack(
-            [np.bincount(spot, weights=values[:, i]) for i in range(3)], axis=1
-        )
-
-    means = summed(points) / count[:, None]
-    return means, None if normals is None else summed(normals)
-
-
 class CloudSurface:
     """A cloud in its frame O (at its centroid or a given origin), sampled and cut.
 
@@ -1354,8 +642,8 @@ class CloudSurface:
         :data:`LINE_RADIUS_SPACINGS` times the cloud's spacing (the median
         distance from a point to its nearest distinct neighbour; for near
         twins, as scans merged as they were give, to the nearest point of
-        another spot, :data:`TWIN_JUMP`, or for blurred ones
-        :data:`SPACING_DENSITY_FLOOR` of a spot's side), at least 1 mm.
+        another spot, :data:`.TWIN_JUMP`, or for blurred ones
+        :data:`.SPACING_DENSITY_FLOOR` of a spot's side), at least 1 mm.
     viewpoint : (3,) float, optional
         The camera, world frame (a one-sided cloud).
     origin : (3,) float, optional
@@ -1370,12 +658,12 @@ class CloudSurface:
         The gap between neighbouring points on the surface, metres: the
         median distance from a point to its nearest distinct one, or for
         scans merged as they were to the nearest point of another spot
-        (:data:`TWIN_JUMP`; blurred: :data:`SPACING_DENSITY_FLOOR` of a
+        (:data:`.TWIN_JUMP`; blurred: :data:`.SPACING_DENSITY_FLOOR` of a
         spot's side).
     seen : int
         Points per spot: 1, or for scans merged as they were the median
         count of a spot's near twins; point-count thresholds
-        (:data:`FIT_MIN_POINTS`, :data:`FIT_NEIGHBOURS`) are multiplied by it.
+        (:data:`.FIT_MIN_POINTS`, :data:`FIT_NEIGHBOURS`) are multiplied by it.
     centroid : (3,) float
         The points' mean, world frame.
     origin : (3,) float
@@ -1686,10 +974,10 @@ class CloudFingers:
 
         A chord enters the piece only within its bounding radius ``r`` of
         the line; a fingertip sphere also fits the points of its face within
-        :data:`FIT_RADIUS_LINES` line radii of it (:func:`sphere_entry`).
+        :data:`.FIT_RADIUS_LINES` line radii of it (:func:`.sphere_entry`).
         """
         if piece.kind == "ellipsoid" and np.ptp(piece.semi_axes) == 0:
-            return r + max(FIT_RADIUS_LINES, 1.0) * self.surface.line_radius
+            return r + max(cloud_tips.FIT_RADIUS_LINES, 1.0) * self.surface.line_radius
         return r
 
     def _in_sweep(self, idx, p, c_W, lateral: float) -> np.ndarray:
@@ -1716,14 +1004,14 @@ class CloudFingers:
         """Travel at which each point, moving along ``u_G``, meets the piece.
 
         A sphere (a fingertip, often smaller than the cloud's spacing) meets
-        the surface that runs between the points: see :func:`sphere_entry`.
+        the surface that runs between the points: see :func:`.sphere_entry`.
         Other shapes meet a point where it enters them (the chord's entry).
         """
         if piece.kind == "ellipsoid" and np.ptp(piece.semi_axes) == 0:
             n_G = self.surface.normals[idx] @ R  # the points' normals, frame G
-            return sphere_entry(
+            return cloud_tips.sphere_entry(
                 piece.semi_axes[0], q_G, u_G, n_G, self.surface.line_radius,
-                FIT_MIN_POINTS * self.surface.seen,
+                cloud_tips.FIT_MIN_POINTS * self.surface.seen,
             )  # fmt: skip
         return piece.chord(q_G, np.tile(u_G, (len(q_G), 1)))[0]
 
@@ -1759,9 +1047,6 @@ class CloudFingers:
         return out
 
 
-FIT_MIN_POINTS = 8
-"""Fewest points of one face near a fingertip's line for a quadric fit."""
-
 FACING_NEIGHBOURS = 8
 """A re-closing probe meets the quadric of the nearest of this many points whose
 normal faces it (:class:`FittedCloud`)."""
@@ -1780,114 +1065,6 @@ _FIT_CHUNK = 1 << 20
 """Neighbours fitted at once, over all rows (the 300 scans of a 3,000-point
 cloud fitted in one batch asked for 4.8 GiB)."""
 
-FIT_RADIUS_LINES = 2.0
-"""Quadrics fit the points within this many line radii: of a fingertip's line
-(plus its radius, :func:`sphere_entry`) or of a point (:class:`FittedCloud`);
-about 20 points of a random sample."""
-
-FIT_FACE_COS = np.cos(np.radians(45.0))
-"""Points whose normals lie within this angle of the first-met point's are
-fitted as its face; the others (an edge's other face) are met point by point."""
-
-_DISC = np.array(
-    [
-        (rho * np.cos(a), rho * np.sin(a), np.sqrt(max(1.0 - rho * rho, 0.0)))
-        for rho in (0.0, 0.25, 0.5, 0.7, 0.85, 0.95, 1.0)
-        for a in np.linspace(0.0, 2 * np.pi, 1 if rho == 0 else 24, endpoint=False)
-    ]
-)
-"""Unit-disc points ``(x, y, sqrt(1 − x² − y²))`` on which a sphere's first
-touch of a fitted surface is sought."""
-
-
-def sphere_entry(
-    r: float,
-    q_G: np.ndarray,
-    u_G: np.ndarray,
-    n_G: np.ndarray,
-    line_radius: float,
-    min_points: int = FIT_MIN_POINTS,
-) -> np.ndarray:
-    """Travel at which a sphere first meets the surface that points sample.
-
-    Parameters
-    ----------
-    r : float
-        The sphere's radius, metres; its centre is G's origin.
-    q_G : (M, 3) float
-        Cloud points, frame G, metres; they move along ``u_G`` (unit).
-    n_G : (M, 3) float
-        Their outward unit normals, frame G.
-    line_radius : float
-        Points within ``r + line_radius`` of the centre's line count.
-    min_points : int, optional
-        Fewest points of the face for the fit: :data:`FIT_MIN_POINTS`, times
-        the points a spot holds in scans merged as they were
-        (``CloudSurface.seen``), whose twins would let two spots pass for
-        eight points.
-
-    Returns
-    -------
-    (M,) float
-        Per point, the travel at which the sphere meets the surface there, NaN
-        for a point that does not stand for the first touch.  A sphere (often
-        smaller than the spacing) falls between sampled points: each point
-        alone would let it sink up to ``r`` where the points are sparse.  The
-        points of the face it meets first (their normals within 45° of the
-        first-met point's, within ``ρ = r +`` :data:`FIT_RADIUS_LINES` line
-        radii of the line and ``ρ`` of the first along it) are fitted by a
-        quadric ``s(x, y)`` (travel over the plane across the line); the
-        sphere meets it at the smallest ``s(x, y) − sqrt(r² − x² − y²)`` over
-        its disc, reported at the fitted point nearest the line.
-        The first face is that of the first point met among those not
-        already behind the centre by more than ``r``.  Points of another face
-        (an edge's, the far side's, one passed) keep their own travel
-        ``s − sqrt(max(r² − δ², 0))`` (``δ`` their distance from the line), as
-        do faces with fewer than ``min_points`` points.
-    """
-    s = -(q_G @ u_G)  # travel to the centre's closest approach
-    lateral = q_G + s[:, None] * u_G
-    delta = np.linalg.norm(lateral, axis=1)
-    reach = delta <= r + line_radius
-    t = np.where(reach, s - np.sqrt(np.maximum(r * r - delta * delta, 0.0)), np.nan)
-    ahead = np.where(s >= -r, t, np.nan)  # not a point the sphere has passed
-    if not np.any(np.isfinite(ahead)):
-        return t
-    first = int(np.nanargmin(ahead))
-    fit = r + FIT_RADIUS_LINES * line_radius
-    face = (
-        (delta <= fit)
-        & (n_G @ n_G[first] >= FIT_FACE_COS)
-        & (np.abs(s - s[first]) <= fit)  # the same sheet: slopes up to 45°
-    )
-    if np.count_nonzero(face) < min_points:
-        return t
-    e1, e2 = _basis_across(u_G[None, :])
-    x, y = lateral[face] @ e1[0], lateral[face] @ e2[0]
-    xs, ys = x / fit, y / fit  # in units of the neighbourhood: conditioning
-    A = np.column_stack([np.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys])
-    coef, _, rank, _ = np.linalg.lstsq(A, s[face], rcond=None)
-    if rank < 6:
-        return t
-    dx, dy = _DISC[:, 0] * r / fit, _DISC[:, 1] * r / fit
-    surface = (
-        coef[0] + coef[1] * dx + coef[2] * dy
-        + coef[3] * dx * dx + coef[4] * dx * dy + coef[5] * dy * dy
-    )  # fmt: skip
-    meet = float(np.min(surface - _DISC[:, 2] * r))
-    out = np.where(face, np.nan, t)
-    nearest = np.flatnonzero(face)[int(np.argmin(delta[face]))]
-    out[nearest] = meet
-    return out
-
-
-def _basis_across(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(L, 3) unit ``e1, e2`` with ``(e1, e2, d)`` right-handed, for unit ``d``."""
-    helper = np.eye(3)[np.argmin(np.abs(d), axis=1)]
-    e1 = np.cross(d, helper)
-    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
-    return e1, np.cross(d, e1)
-
 
 class FittedCloud:
     """A cloud's surface as the jaws re-close on it: a quadric at every point.
@@ -1900,9 +1077,9 @@ class FittedCloud:
     points give (between points 1.5 mm apart the can's side sags 0.3 mm).  So
     each point carries a quadric ``h(u, v)`` along its normal, fitted to the
     points of its face (normals within 45°) within ``ρ =``
-    :data:`FIT_RADIUS_LINES` line radii, and a probe meets the quadric of the
+    :data:`.FIT_RADIUS_LINES` line radii, and a probe meets the quadric of the
     facing point nearest it, then of the point nearest that meeting (where a
-    face has fewer than :data:`FIT_MIN_POINTS` points, times the points a
+    face has fewer than :data:`.FIT_MIN_POINTS` points, times the points a
     spot holds, ``CloudSurface.seen``, its tangent plane).
     A point's quadric is fitted when a probe first meets it (a cloud of
     200,000 points fits only those near the grasps), on at most
@@ -1916,7 +1093,7 @@ class FittedCloud:
     def __init__(self, surface: CloudSurface):
         self.surface = surface
         self.tree = cKDTree(surface.points)
-        self.fit = FIT_RADIUS_LINES * surface.line_radius
+        self.fit = cloud_tips.FIT_RADIUS_LINES * surface.line_radius
         M = len(surface.points)
         self.coef = np.zeros((M, 6))  # too few points: the tangent plane h = 0
         self._done = np.zeros(M, bool)  # fitted when first met (big clouds)
@@ -1951,13 +1128,15 @@ class FittedCloud:
         u = np.einsum("lwi,li->lw", v, a) / fit  # in units of ρ
         w = np.einsum("lwi,li->lw", v, b) / fit
         z = np.einsum("lwi,li->lw", v, n)
-        face = valid & (np.einsum("lwi,li->lw", normals[idx], n) >= FIT_FACE_COS)
+        face = valid & (
+            np.einsum("lwi,li->lw", normals[idx], n) >= cloud_tips.FIT_FACE_COS
+        )
         A = np.stack([np.ones_like(u), u, w, u * u, u * w, w * w], axis=2)
         weight = face.astype(float)
         AtA = np.einsum("lw,lwi,lwj->lij", weight, A, A)
         Atb = np.einsum("lw,lwi,lw->li", weight, A, z)
         eig = np.linalg.eigvalsh(AtA)
-        ok = (face.sum(axis=1) >= FIT_MIN_POINTS * seen) & (
+        ok = (face.sum(axis=1) >= cloud_tips.FIT_MIN_POINTS * seen) & (
             eig[:, 0] > 1e-9 * np.maximum(eig[:, -1], 1e-300)
         )
         coef = np.zeros((L, 6))
@@ -2023,7 +1202,7 @@ class FittedCloud:
             :data:`EDGE_LINES` line radii from every point (the probe slid
             past the cloud's edge), or where its meeting with the quadric of
             the facing point nearest that is farther from that point than
-            the radius the quadric was fitted in (:data:`FIT_RADIUS_LINES`
+            the radius the quadric was fitted in (:data:`.FIT_RADIUS_LINES`
             line radii: the line grazed it).
         n_out : (L, 3) float
             Outward unit normal there, frame O.

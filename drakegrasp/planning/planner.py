@@ -337,11 +337,11 @@ def plan_grasps(
         3,000-20,000 points.  So can scans merged as they are: each spot is
         then seen several times, and the cloud is planned on each spot's
         mean point, with a ``PointCloudWarning``
-        (:data:`~drakegrasp.planning.cloud.TWIN_JUMP`).
+        (:data:`~drakegrasp.planning.cloud_spacing.TWIN_JUMP`).
     cloud_normals : (M, 3) float, optional
         Outward normals of the cloud's points; default the cloud's own, else
         estimated from the flattest nearby patch, plane or quadric, grown with
-        the cloud's noise (:func:`~drakegrasp.planning.cloud.estimate_normals`;
+        the cloud's noise (:func:`~drakegrasp.planning.cloud_normals.estimate_normals`;
         the result's ``settings["cloud_normals"]`` says how: points a patch,
         the noise read, the normals' expected error; None when given).
     viewpoint : (3,) float, optional

@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.planning.cloud import _areas, complete_unseen
+from drakegrasp.planning.cloud import complete_unseen
+from drakegrasp.planning.cloud_spacing import _areas
 
 HALF = np.array([0.08, 0.105, 0.033])  # the cracker box's half sides (m)
 
@@ -244,17 +245,17 @@ def test_a_one_sided_plan_measures_its_clouds_spots_once(monkeypatch):
     points) is measured on its own.  A cloud changed in place is measured
     again: the kept spots are keyed by the points' contents.
     """
-    from drakegrasp.planning import cloud
+    from drakegrasp.planning import cloud, cloud_spacing
 
     measured = []
-    real = cloud._measured_spots
+    real = cloud_spacing._measured_spots
 
     def counted(points):
         measured.append(len(points))
         return real(points)
 
-    monkeypatch.setattr(cloud, "_measured_spots", counted)
-    monkeypatch.setattr(cloud, "_spots_kept", {})
+    monkeypatch.setattr(cloud_spacing, "_measured_spots", counted)
+    monkeypatch.setattr(cloud_spacing, "_spots_kept", {})
     rng = np.random.default_rng(3)
     u = rng.normal(size=(4000, 3))
     u /= np.linalg.norm(u, axis=1)[:, None]
@@ -265,8 +266,8 @@ def test_a_one_sided_plan_measures_its_clouds_spots_once(monkeypatch):
     surface, completion = cloud.cloud_surface(p, n, viewpoint, True)
     assert completion["skipped"] is None
     assert measured == [len(p), len(surface.points)]
-    kept = cloud._spots(p.copy())  # another array, the same points: kept
+    kept = cloud_spacing._spots(p.copy())  # another array, the same points: kept
     assert len(measured) == 2
     p[0] += 0.01  # the same array, moved in place: its spots are measured again
-    assert cloud._spots(p) is not kept
+    assert cloud_spacing._spots(p) is not kept
     assert len(measured) == 3

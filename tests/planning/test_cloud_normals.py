@@ -7,7 +7,8 @@ import pytest
 from pydrake.perception import BaseField, Fields, PointCloud
 
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.planning.cloud import estimate_normals, read_cloud
+from drakegrasp.planning.cloud import read_cloud
+from drakegrasp.planning.cloud_normals import estimate_normals
 
 HALF = np.array([0.04, 0.03, 0.08])  # a 80 x 60 x 160 mm box
 
@@ -115,14 +116,14 @@ def _cylinder_side(n: int, seed: int = 0):
 
 def _flattest_plane_only(points):
     """The estimate without its quadric step: each point's chosen patch plane."""
-    from drakegrasp.planning import cloud
+    from drakegrasp.planning import cloud_normals
 
-    saved = cloud.NORMAL_CURVED_F
-    cloud.NORMAL_CURVED_F = np.inf
+    saved = cloud_normals.NORMAL_CURVED_F
+    cloud_normals.NORMAL_CURVED_F = np.inf
     try:
         return estimate_normals(points)
     finally:
-        cloud.NORMAL_CURVED_F = saved
+        cloud_normals.NORMAL_CURVED_F = saved
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -253,37 +254,45 @@ def test_noisy_cloud_grows_its_neighbourhoods_to_the_target_error():
     # 20-point planes are 0.3 deg off, and a parallel jaw closing along such
     # a normal touches a face along its pad's edge.  The patches grow until
     # the expected error is NORMAL_ANGLE_TARGET (0.1 deg).
-    from drakegrasp.planning import cloud
+    from drakegrasp.planning import cloud_normals
 
     points, true = _noisy_box(3000, 1e-4)
     inner = _inner(points, true)
-    fixed, fixed_error, _ = cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)
+    fixed, fixed_error, _ = cloud_normals._patch_normals(
+        points, cloud_normals.NORMAL_NEIGHBOURS
+    )
     before = _angles(fixed[inner], true[inner])
     after = _angles(estimate_normals(points)[inner], true[inner])
     # the error estimated from the quadrics' residuals is the measured one
     assert np.degrees(fixed_error) == pytest.approx(np.median(before), rel=0.3)
     assert np.median(before) > 0.25
-    assert np.median(after) < np.degrees(cloud.NORMAL_ANGLE_TARGET)
+    assert np.median(after) < np.degrees(cloud_normals.NORMAL_ANGLE_TARGET)
     assert np.percentile(after, 90) < 0.5 * np.percentile(before, 90)
 
 
 def test_noise_free_cloud_keeps_twenty_point_patches():
-    from drakegrasp.planning import cloud
+    from drakegrasp.planning import cloud_normals
 
     points, _ = _box_surface(3000, seed=3)
-    fixed, error, _ = cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)
+    fixed, error, _ = cloud_normals._patch_normals(
+        points, cloud_normals.NORMAL_NEIGHBOURS
+    )
     assert np.degrees(error) < 1e-3
     np.testing.assert_array_equal(estimate_normals(points), fixed)
 
 
 def test_noise_estimate_scales_with_the_noise_not_the_units():
-    from drakegrasp.planning import cloud
+    from drakegrasp.planning import cloud_normals
 
     errors = []
     for sigma in (1e-4, 2e-4, 4e-4):
         points, _ = _noisy_box(3000, sigma, seed=4)
-        errors.append(cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)[1])
-        millimetres = cloud._patch_normals(1e3 * points, cloud.NORMAL_NEIGHBOURS)[1]
+        errors.append(
+            cloud_normals._patch_normals(points, cloud_normals.NORMAL_NEIGHBOURS)[1]
+        )
+        millimetres = cloud_normals._patch_normals(
+            1e3 * points, cloud_normals.NORMAL_NEIGHBOURS
+        )[1]
         assert millimetres == pytest.approx(errors[-1], rel=1e-6)  # radians
     ratios = np.array(errors[1:]) / np.array(errors[:-1])
     np.testing.assert_allclose(ratios, 2.0, rtol=0.15)
@@ -294,14 +303,17 @@ def test_noisy_cloud_at_any_scale_grows_the_same_patches(scale):
     # The error estimate is a ratio of squares (noise over in-plane spread):
     # at 1e-150 m their products would underflow and ask for no growth, or
     # overflow into an inf that no neighbourhood size can hold.
-    from drakegrasp.planning import cloud
+    from drakegrasp.planning import cloud_normals
 
     points, _ = _noisy_box(1500, 2e-4, seed=5)
     base = estimate_normals(points)
     err = _angles(estimate_normals(points * scale), base)
-    error = cloud._patch_normals(points * scale, cloud.NORMAL_NEIGHBOURS)[1]
+    error = cloud_normals._patch_normals(
+        points * scale, cloud_normals.NORMAL_NEIGHBOURS
+    )[1]
     assert error == pytest.approx(
-        cloud._patch_normals(points, cloud.NORMAL_NEIGHBOURS)[1], rel=1e-6
+        cloud_normals._patch_normals(points, cloud_normals.NORMAL_NEIGHBOURS)[1],
+        rel=1e-6,
     )
     assert np.all(np.isfinite(base)) and np.percentile(err, 99) < 1e-3
 

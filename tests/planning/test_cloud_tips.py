@@ -11,11 +11,10 @@ import pytest
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from drakegrasp.planning.cloud import (
+from drakegrasp.planning.cloud import CloudSurface, FittedCloud
+from drakegrasp.planning.cloud_tips import (
     FIT_MIN_POINTS,
     FIT_RADIUS_LINES,
-    CloudSurface,
-    FittedCloud,
     sphere_entry,
 )
 
