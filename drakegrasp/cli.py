@@ -2018,6 +2018,7 @@ def _terminable():
     try:
         yield
     finally:
+        _FINISHED.append(True)  # a signal from here on finds the work done
         for sig, handler in previous.items():
             signal.signal(sig, handler)
 
@@ -2098,12 +2099,48 @@ def run() -> None:
     program (and a ``| tee`` reading its output).  Such a worker ends by itself
     once it sees its parent gone.
     """
+    _FINISHED.clear()
+    main_thread = threading.current_thread() is threading.main_thread()
+    if main_thread:
+        for sig in _TERMINATING:
+            signal.signal(sig, _outside_the_command)
     code = main()
     if _SIGNALLED:
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(code)
+    if main_thread:
+        signal.signal(signal.SIGINT, _noted_late)
+    _stop_workers()  # here, not in the interpreter's exit
     sys.exit(code)
+
+
+_FINISHED: list[bool] = []  # the command's body has ended (:func:`_terminable`)
+
+
+def _noted_late(signum: int, _frame) -> None:
+    """A signal once the command has finished: taken; a second one ends it."""
+    signal.signal(signum, signal.SIG_DFL)
+
+
+def _outside_the_command(signum: int, frame) -> None:
+    """SIGTERM or SIGHUP while :func:`run` is not inside the command's body.
+
+    Before the body (the arguments being read) nothing is under way: the
+    process ends at once, with the line and status of a signalled run.  After
+    it, the command has written its files, but the interpreter's exit still
+    stops the kept worker pool and tears the modules down; with the default
+    handler a signal then killed the process (status -15, the output
+    complete, at times a fragment of a traceback on stderr).  Now the first
+    such signal is taken and the exit goes on with the command's own status;
+    a second ends the process at once, as the default does.
+    """
+    if _in_forked_child(signum):
+        return
+    if not _FINISHED:
+        _say(f"drakegrasp: terminated by {signal.Signals(signum).name}")
+        os._exit(128 + signum)
+    _noted_late(signum, frame)
 
 
 if __name__ == "__main__":

@@ -397,3 +397,76 @@ def test_file_names_with_terminal_escapes_are_printed_safely(tmp_path, capsys):
     assert main(["analyze", str(bad)]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "\x1b" not in err
+
+
+_LATE = """
+import atexit, os, signal, sys, time
+from drakegrasp.cli import run
+
+times, sig = int(sys.argv[1]), getattr(signal, sys.argv[2])
+
+def signalled_while_exiting():  # the interpreter's exit, after the command
+    for _ in range(times):
+        os.kill(os.getpid(), sig)
+        time.sleep(0.2)
+    print("exited", flush=True)
+
+atexit.register(signalled_while_exiting)
+sys.argv = ["drakegrasp", "scenes"]
+run()
+"""
+
+
+@linux_only
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP", "SIGINT"])
+def test_a_signal_as_the_finished_command_exits_breaks_nothing(sig):
+    # The command had finished and written its output, but the interpreter's
+    # exit (the worker pool's stop, the modules' teardown) still ran with the
+    # default handlers: SIGTERM killed it (status -15, a fragment of a
+    # traceback on stderr at times), Ctrl-C printed a traceback.  The first
+    # signal then is taken, and the exit ends with the command's status.
+    once = subprocess.run(
+        [sys.executable, "-c", _LATE, "1", sig],
+        capture_output=True, text=True, env=_env(), timeout=60,
+    )  # fmt: skip
+    assert (once.returncode, once.stdout.split()[-1:]) == (0, ["exited"]), once
+    assert once.stderr == ""
+    # a second one ends the process at once, as the default does
+    twice = subprocess.run(
+        [sys.executable, "-c", _LATE, "2", sig],
+        capture_output=True, text=True, env=_env(), timeout=60,
+    )  # fmt: skip
+    assert twice.returncode == -getattr(signal, sig), twice
+    assert "exited" not in twice.stdout
+
+
+_EARLY = """
+import os, signal, sys, time
+from drakegrasp import cli
+
+real = cli.build_parser
+
+def signalled_while_reading_arguments():
+    os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(0.5)
+    print("went on", flush=True)
+    return real()
+
+cli.build_parser = signalled_while_reading_arguments
+sys.argv = ["drakegrasp", "scenes"]
+cli.run()
+"""
+
+
+@linux_only
+def test_a_signal_before_the_command_runs_ends_it_in_one_line():
+    # Before the command's handlers (its arguments being read) SIGTERM killed
+    # the program silently, status -15; nothing is under way yet, so it ends
+    # at once, as a signalled run does.
+    proc = subprocess.run(
+        [sys.executable, "-c", _EARLY],
+        capture_output=True, text=True, env=_env(), timeout=60,
+    )  # fmt: skip
+    assert proc.returncode == 128 + signal.SIGTERM, proc
+    assert proc.stderr == "drakegrasp: terminated by SIGTERM\n"
+    assert "went on" not in proc.stdout
