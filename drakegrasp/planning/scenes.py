@@ -76,13 +76,15 @@ def planning_scene(
 
     Parameters
     ----------
-    object_url : str or None, optional
+    object_url : str, path or None, optional
         ``package://`` URL or file path of the object's model (one body with
-        collision geometry is the object: the model's first body); None
+        collision geometry is the object: the model's first such body, that
+        of a nested ``<model>`` after those of the model holding it); None
         (default) for a scene with the hand only (planning on a point cloud).
-    hand_url : str, optional
+    hand_url : str or path, optional
         The gripper's model (default Drake's WSG-50 with tip spheres); its
-        base is left free.
+        base is left free.  Of nested ``<model>`` elements, the hand is the first
+        model instance that holds a body.
     X_WO : RigidTransform, optional
         The object's pose (default the identity): a finite translation and a
         proper rotation.
@@ -129,15 +131,17 @@ def planning_scene(
         for name, folder in packages:  # drake_models too: the user's folder wins
             add_named_package(parser.package_map(), name, folder)
         try:
-            hand = _add(parser, hand_url)
-            obj = None if object_url is None else _add(parser, object_url)
+            hands = _add(parser, hand_url)
+            objs = None if object_url is None else _add(parser, object_url)
         except RuntimeError as exc:  # Drake's parser errors
             raise ModelError(f"could not load a model: {exc}") from exc
-        if obj is None:
+        hand = _hand_instance(plant, hands, hand_url)
+        if objs is None:
             return hand, None
-        body = plant.get_body(plant.GetBodyIndices(obj)[0])
+        body = _object_body(plant, objs, object_url)
         plant.SetDefaultFloatingBaseBodyPose(body, X_WO)
-        return hand, f"{plant.GetModelInstanceName(obj)}::{body.name()}"
+        model = plant.GetModelInstanceName(body.model_instance())
+        return hand, f"{model}::{body.name()}"
 
     return scene_from_models(add_models)
 
@@ -220,12 +224,50 @@ def scene_from_models(add_models) -> PlanningScene:
     return PlanningScene(diagram, plant, context, hand, object_body, add_models)
 
 
-def _add(parser, url: str):
+def _add(parser, url: str) -> list:
+    """Every model instance that the file at ``url`` adds, in the parser's order.
+
+    A file of nested SDFormat models adds one instance per ``<model>``, the
+    outer ones first and possibly without a body of their own.
+    """
     # Through drakegrasp's loader, which records a <mimic>'s coupling on the
     # plant: a bare Parser leaves a coupled hand's constraints unreadable, and
     # the planner refuses such a plant.
     if "://" in url:
-        return add_coupled_models(parser, url=url)[0]
+        return list(add_coupled_models(parser, url=url))
     if str(url).lower().endswith(".obj"):
         check_obj_vertices(url)
-    return add_coupled_models(parser, str(url))[0]
+    return list(add_coupled_models(parser, str(url)))
+
+
+def _hand_instance(plant, instances: list, url) -> Any:
+    """The hand's model instance: the first of ``instances`` that holds a body.
+
+    An SDFormat file whose hand is a nested ``<model>`` (``robot`` holding
+    ``robot::hand``) adds the empty outer instance first; planning on it
+    found no bodies, and the command line has no way to name the inner one.
+    """
+    for instance in instances:
+        if plant.GetBodyIndices(instance):
+            return instance
+    raise ModelError(f"the hand's model {str(url)!r} has no bodies")
+
+
+def _object_body(plant, instances: list, url) -> Any:
+    """The object: the first body with collision geometry of ``instances``.
+
+    In the order the file adds its models (a nested ``<model>`` after the one
+    holding it) and their bodies; the first body at all where none has
+    collision geometry (which the planner then refuses, naming it).
+    """
+    bodies = [
+        plant.get_body(index)
+        for instance in instances
+        for index in plant.GetBodyIndices(instance)
+    ]
+    if not bodies:
+        raise ModelError(f"the object's model {str(url)!r} has no bodies")
+    for body in bodies:
+        if plant.GetCollisionGeometriesForBody(body):
+            return body
+    return bodies[0]
