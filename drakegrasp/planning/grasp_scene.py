@@ -110,8 +110,10 @@ def grasp_scene_text(
     ------
     ModelError
         The hand's base or the object is not a body of the plant, the hand
-        spans several model instances, or the object shares its model
-        instance with the hand or is not free.
+        spans several model instances, the hand or the object is a
+        ``<model>`` nested in another (Drake's directives cannot set its
+        joints or pose), or the object shares its model instance with the
+        hand or is not free.
     InvalidOptionError
         A file that is not a string or path.
     """
@@ -131,8 +133,18 @@ def grasp_scene_text(
             f"the object {body.name()!r} is not a free body: its scene file would "
             "place it with a weld of its own, which this writer does not know"
         )
+    for what, instance in (("hand", hand), ("object", body.model_instance())):
+        name = plant.GetModelInstanceName(instance)
+        if "::" in name:  # Drake's directives set no joint of a nested model
+            raise ModelError(
+                f"the {what}'s model instance {name!r} is a <model> nested in "
+                f"{name.rpartition('::')[0]!r}: a scene file's add_model sets "
+                "the joint positions and free-body poses of the model it adds, "
+                "not of its nested ones, so no scene file holds this grasp; "
+                "load the nested model's own file instead"
+            )
     names = {plant.GetModelInstanceName(hand)}
-    names |= {n.split("::")[0] for n in candidate.joint_names}
+    names |= {n.rpartition("::")[0] for n in candidate.joint_names}
     if len(names) != 1:
         raise ModelError(
             f"the hand spans the model instances {sorted(names)}: a scene file of "

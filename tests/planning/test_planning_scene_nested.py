@@ -10,7 +10,10 @@ on the command line to name the inner one.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from drakegrasp.errors import ModelError
+from drakegrasp.planning.grasp_scene import grasp_scene_text
 from drakegrasp.planning.planner import plan_grasps
 from drakegrasp.planning.scenes import planning_scene
 
@@ -52,3 +55,16 @@ def test_nested_models_plan_as_the_bare_ones(tmp_path):
     np.testing.assert_allclose(
         [c.score for c in got], [c.score for c in want], rtol=1e-9, atol=1e-12
     )
+
+
+def test_a_nested_hand_scene_file_is_refused_for_what_it_is(tmp_path):
+    # Drake's directives cannot set a nested model's joints: the writer said
+    # the hand "spans the model instances ['robot', 'robot::parallel_jaw']".
+    scene = planning_scene(BOX, hand_url=_nested(tmp_path, "robot", JAW))
+    best = _plan(scene)[0]
+    with pytest.raises(ModelError, match="'robot::parallel_jaw' is a <model> nested"):
+        grasp_scene_text(
+            scene.plant, scene.context, best, object_body=scene.object_body,
+            hand_file=tmp_path / "robot.sdf", object_file=BOX, mu=0.5,
+            folder=tmp_path,
+        )  # fmt: skip
