@@ -224,7 +224,7 @@ def scene_from_models(add_models) -> PlanningScene:
     return PlanningScene(diagram, plant, context, hand, object_body, add_models)
 
 
-def _add(parser, url: str) -> list:
+def _add(parser, url: str | os.PathLike) -> list:
     """Every model instance that the file at ``url`` adds, in the parser's order.
 
     A file of nested SDFormat models adds one instance per ``<model>``, the
@@ -233,11 +233,12 @@ def _add(parser, url: str) -> list:
     # Through drakegrasp's loader, which records a <mimic>'s coupling on the
     # plant: a bare Parser leaves a coupled hand's constraints unreadable, and
     # the planner refuses such a plant.
+    url = os.fspath(url)  # a pathlib.Path too, as the docstring allows
     if "://" in url:
         return list(add_coupled_models(parser, url=url))
-    if str(url).lower().endswith(".obj"):
+    if url.lower().endswith(".obj"):
         check_obj_vertices(url)
-    return list(add_coupled_models(parser, str(url)))
+    return list(add_coupled_models(parser, url))
 
 
 def _hand_instance(plant, instances: list, url) -> Any:

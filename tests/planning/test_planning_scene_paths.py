@@ -10,6 +10,7 @@ import pytest
 
 from drakegrasp.errors import ModelError
 from drakegrasp.planning.scenes import planning_scene
+from drakegrasp.plant.models import models_dir
 
 JAW = "package://drakegrasp/hands/parallel_jaw.sdf"
 
@@ -32,3 +33,12 @@ def test_a_directory_is_named_as_one(tmp_path):
 def test_files_and_urls_still_load(tmp_path):
     scene = planning_scene("package://drakegrasp/objects/box.sdf", hand_url=JAW)
     assert scene.object_body is not None
+
+
+def test_a_pathlib_path_loads_as_its_string(tmp_path):
+    # The check let a Path through, then `"://" in url` raised a bare TypeError.
+    box = models_dir() / "objects" / "box.sdf"
+    jaw = models_dir() / "hands" / "parallel_jaw.sdf"
+    scene = planning_scene(box, hand_url=jaw)
+    assert scene.object_body.name() == "box"
+    assert scene.plant.GetModelInstanceName(scene.hand) == "parallel_jaw"
