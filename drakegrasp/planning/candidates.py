@@ -159,8 +159,13 @@ class GraspCandidate:
         known: planned on a body, or on a point cloud with ``object_mass``;
         ``m g / torque_capacity``; inf: none does, or, with a
         ``torque_capacity`` > 0, more than the largest float; NaN: not
-        computed.  Compare it with the actuators' effort limits, or use it as
-        ``shake_test``'s squeeze.
+        computed.  Compare it with the actuators' effort limits.  As
+        ``shake_test``'s squeeze it is per joint, not per motor: the shake
+        presses every joint a motor drives with the squeeze, so a motor with
+        ``<mimic>`` followers applies it once per joint it closes (a
+        one-motor jaw: twice, ``ShakeResult.efforts``).  Give a hand whose
+        every closing joint is a motor ``torque_needed``, and a coupled one
+        ``torque_needed`` over the number of joints its motor closes.
     torque_scale : float
         The length (m) the planner divided moments by and bounded a soft
         finger's torsion with (``GraspCandidates.torque_scale``), and so the
