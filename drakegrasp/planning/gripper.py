@@ -52,7 +52,7 @@ from drakegrasp.plant.validation import (
     scoped_name,
 )
 
-__all__ = ["PAD_DEPTH", "ParallelJaw", "free_base", "parallel_jaw"]
+__all__ = ["PAD_DEPTH", "ParallelJaw", "free_base", "palm_geometries", "parallel_jaw"]
 
 PAD_DEPTH = 5e-4
 """Geometries this close (m) to a finger's innermost support make its pad."""
@@ -495,12 +495,52 @@ def _pads(supports, a_H):
     return tuple(pad_ids), 0.5 * (lateral[0] + lateral[1])
 
 
+def palm_geometries(plant: MultibodyPlant, inspector, base: RigidBody) -> list:
+    """The palm's collision geometries, each posed in the base frame H.
+
+    The base's own; a base without any (a bare mount: many URDFs root a hand
+    at a link without geometry, fixed to the palm link elsewhere and turned)
+    takes those of the bodies welded to it.  Read from the base alone, such
+    a palm was the mount's origin, and a pivoting jaw under a turned mount
+    approached the object from there (1 candidate of 150 samples, 61 without
+    the mount).  A base with geometry keeps its own: a finger's knuckle
+    welded to the palm is no palm.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized.
+    inspector : SceneGraphInspector
+    base : RigidBody
+        The hand's base (frame H).
+
+    Returns
+    -------
+    list of (GeometryId, RigidTransform)
+        ``(g, X_HG)``: the base's geometries, else those of the bodies welded
+        to it in body order (empty: none has any).
+    """
+    own = plant.GetCollisionGeometriesForBody(base)
+    if own:
+        return [(g, inspector.GetPoseInFrame(g)) for g in own]
+    ctx = plant.CreateDefaultContext()  # welds: the same in every state
+    welded = sorted(
+        (b for b in plant.GetBodiesWeldedTo(base) if b.index() != base.index()),
+        key=lambda b: int(b.index()),
+    )
+    out = []
+    for body in welded:
+        X_HB = plant.CalcRelativeTransform(ctx, base.body_frame(), body.body_frame())
+        out.extend(
+            (g, X_HB @ inspector.GetPoseInFrame(g))
+            for g in plant.GetCollisionGeometriesForBody(body)
+        )
+    return out
+
+
 def _approach(plant, inspector, base, pad_lateral, a_H) -> np.ndarray:
     """Unit direction in H from the palm's collision geometry to the pads."""
-    palm = [
-        inspector.GetPoseInFrame(g).translation()
-        for g in plant.GetCollisionGeometriesForBody(base)
-    ]
+    palm = [X_HG.translation() for _, X_HG in palm_geometries(plant, inspector, base)]
     palm_centre = np.mean(palm, axis=0) if palm else np.zeros(3)
     palm_lateral = palm_centre - (palm_centre @ a_H) * a_H
     approach = pad_lateral - palm_lateral

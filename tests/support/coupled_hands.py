@@ -396,3 +396,70 @@ def plan_on_box(path, urdf: str, **plan):
         **{**options, **plan},
     )  # fmt: skip
     return scene, result
+
+
+_PIVOT_INERTIA = '<inertia ixx="2e-5" iyy="2e-5" izz="2e-6" ixy="0" ixz="0" iyz="0"/>'
+
+
+def _pivot_jaw(name: str, side: float) -> str:
+    shapes = "".join(
+        f'<collision><origin xyz="{x:g} {-0.002 * side:g} 0.075"/>'
+        '<geometry><sphere radius="0.006"/></geometry></collision>'
+        for x in (-0.008, 0.008)
+    )
+    return (
+        f'<link name="{name}"><inertial><origin xyz="0 0 0.04"/>'
+        f'<mass value="0.05"/>{_PIVOT_INERTIA}</inertial><collision><origin '
+        f'xyz="0 {0.004 * side:g} 0.045"/><geometry><box size="0.015 0.008 0.07"/>'
+        f"</geometry></collision>{shapes}</link>"
+    )
+
+
+def _pivot_hinge(name: str, child: str, side: float, extra: str = "") -> str:
+    return (
+        f'<joint name="{name}" type="revolute"><parent link="palm"/>'
+        f'<child link="{child}"/><origin xyz="0 {0.05 * side:g} 0"/>'
+        f'<axis xyz="{side:g} 0 0"/><limit lower="-0.2" upper="0.9" effort="3" '
+        f'velocity="2"/>{extra}</joint>'
+    )
+
+
+def pivot_jaw_urdf(*, mount: tuple[str, str] | None = None) -> str:
+    """A pivoting jaw on one motor: two jaws hinged about x at y = ±50 mm.
+
+    Each jaw carries two 6 mm tip spheres 16 mm apart, 75 mm above its
+    hinge; the right hinge is a ``<mimic>`` of the left, which alone has a
+    ``<transmission>`` (3 N·m).  ``mount``: ``(xyz, rpy)`` of the palm under
+    a root link ``mount`` (no geometry, a fixed joint), so that the hand's
+    base frame lies there and is turned so.
+    """
+    mounted = ""
+    if mount is not None:
+        mounted = (
+            '<link name="mount"><inertial><mass value="0.1"/><inertia ixx="1e-4" '
+            'iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+            '<joint name="mount_weld" type="fixed"><parent link="mount"/>'
+            f'<child link="palm"/><origin xyz="{mount[0]}" rpy="{mount[1]}"/>'
+            "</joint>"
+        )
+    return (
+        '<?xml version="1.0"?><robot name="pivot_jaw">'
+        + mounted
+        + '<link name="palm"><inertial><origin xyz="0 0 -0.02"/><mass value="0.5"/>'
+        '<inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/>'
+        '</inertial><collision><origin xyz="0 0 -0.02"/><geometry>'
+        '<box size="0.04 0.12 0.04"/></geometry></collision></link>'
+        + _pivot_jaw("left", 1.0)
+        + _pivot_jaw("right", -1.0)
+        + _pivot_hinge("left_pivot", "left", 1.0)
+        + _pivot_hinge(
+            "right_pivot",
+            "right",
+            -1.0,
+            '<mimic joint="left_pivot" multiplier="1" offset="0"/>',
+        )
+        + '<transmission name="t"><type>transmission_interface/SimpleTransmission'
+        '</type><joint name="left_pivot"><hardwareInterface>EffortJointInterface'
+        '</hardwareInterface></joint><actuator name="m"><mechanicalReduction>1'
+        "</mechanicalReduction></actuator></transmission></robot>"
+    )
