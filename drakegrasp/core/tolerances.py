@@ -10,13 +10,16 @@ from __future__ import annotations
 import math
 
 __all__ = [
+    "COUPLING_TOL",
     "L1_MAX_POINTS",
     "MOMENT_ARMS",
     "DEFAULT_DISTANCE_TOLERANCE",
     "DEFAULT_NUM_GENERATORS",
     "DEFAULT_RANK_TOL",
     "DEFAULT_TOL",
+    "MAX_COUPLING_TOL",
     "MAX_DISTANCE_TOLERANCE",
+    "MONITOR_COUPLING_TOL",
     "QUERY_POSE_TOL",
     "UNIT_NORMAL_TOL",
     "ZERO_FRACTION",
@@ -48,6 +51,23 @@ metres; the widest tolerance drakegrasp uses itself, in its tests, tutorials
 and benchmarks, is 2 mm (a point cloud's spacing), most 1 mm or the default
 0.1 mm.
 """
+
+COUPLING_TOL = 1e-6
+"""A configuration breaks ``q_0 = ρ q_1 + Δq`` by more than this (m or rad),
+as :func:`~drakegrasp.close_hand` refuses a pre-shape; an analysis's default
+``coupling_tolerance``."""
+
+MONITOR_COUPLING_TOL = 1e-3
+"""A :class:`~drakegrasp.GraspMonitor`'s default ``coupling_tolerance`` (m or
+rad): a simulation's coupler constraints give under load, as its contacts
+penetrate.  Drake's SAP held a three-finger hand's ``<mimic>`` distal joints
+7 µrad off their leaders at 0.5 N·m, and every sample of that grip was
+"invalid" at :data:`COUPLING_TOL`; 1 mrad moves a fingertip 0.1 m from its
+joint by the default distance tolerance."""
+
+MAX_COUPLING_TOL = 0.1
+"""Largest ``coupling_tolerance`` accepted (m or rad): beyond it the hand the
+analysis assumes (its joints on their couplings) is not the plant's."""
 
 UNIT_NORMAL_TOL = 1e-6
 """How far from 1 the length of a normal given to ``contact_frames`` may be.

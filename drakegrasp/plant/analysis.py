@@ -49,6 +49,7 @@ from drakegrasp.plant.contacts import (
     resolve_object_body,
 )
 from drakegrasp.plant.couplings import (
+    COUPLING_TOL,
     coupling_map,
     coupling_violations,
     plant_couplings,
@@ -347,6 +348,7 @@ def grasp_from_plant(
             allow_penetration=allow_penetration,
             query_object=query_object,
             couplings=couplings,
+            coupling_tolerance=opts.coupling_tolerance,
         )
         if contacts is None:
             try:
@@ -436,6 +438,7 @@ def _pose_of(
     allow_penetration,
     query_object=None,
     couplings=(),
+    coupling_tolerance=COUPLING_TOL,
 ) -> PoseCheck:
     """Check the pose; raise unless the caller opted out.
 
@@ -458,6 +461,7 @@ def _pose_of(
         plant_context,
         (*couplings, *recorded_couplings(plant)),
         model_instances={b.model_instance() for b in hand_bodies},
+        tol=coupling_tolerance,
     )
     found = PoseCheck(found.penetrations, found.joint_limit_violations, refuse, broken)
     if refuse:

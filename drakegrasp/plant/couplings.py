@@ -56,6 +56,7 @@ from pydrake.multibody.tree import Joint, ModelInstanceIndex
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
+from drakegrasp.core.tolerances import COUPLING_TOL
 from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import (
@@ -928,11 +929,6 @@ def split_coupled_torque(
     return tau
 
 
-COUPLING_TOL = 1e-6
-"""A configuration breaks ``q_0 = ρ q_1 + Δq`` by more than this (m or rad),
-as :func:`~drakegrasp.close_hand` refuses a pre-shape."""
-
-
 @dataclass(frozen=True)
 class CouplingViolation:
     """A configuration that breaks a coupling ``q_0 = ρ q_1 + Δq``.
@@ -988,7 +984,7 @@ def coupling_violations(
         Only couplings with a joint in one of these (the hand's) are checked.
     tol : float, optional
         ``|q_0 - (ρ q_1 + Δq)| > tol`` breaks it (default
-        :data:`COUPLING_TOL`, close_hand's).
+        :data:`~drakegrasp.core.tolerances.COUPLING_TOL`, close_hand's).
 
     Returns
     -------

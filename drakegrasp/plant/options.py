@@ -23,9 +23,11 @@ from drakegrasp.core.contact import ContactModel, missing_torsional_friction
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import (
+    COUPLING_TOL,
     DEFAULT_DISTANCE_TOLERANCE,
     DEFAULT_NUM_GENERATORS,
     DEFAULT_TOL,
+    MAX_COUPLING_TOL,
 )
 from drakegrasp.core.validation import (
     check_coefficient,
@@ -97,6 +99,8 @@ OPTION_HELP = {
     "found within the tolerance)",
     "patches": "how a flat contact patch is reported: vertices or witness",
     "check_pose": "refuse an impossible pose (penetration, joints beyond limits)",
+    "coupling_tolerance": "largest break of a joint coupling (m or rad) that "
+    "the pose check accepts",
     "load": "an external wrench on the object (frame O about its origin), or "
     "'gravity' (its weight): adds the load section",
     "object_mass": "the object's mass (kg, > 0) that load 'gravity' weighs, "
@@ -146,6 +150,14 @@ class AnalysisOptions:
         How a flat contact patch is reported.
     check_pose : bool
         Refuse an impossible pose (penetration, joints beyond their limits).
+    coupling_tolerance : float
+        The largest ``|q_0 - (ρ q_1 + Δq)|`` (m or rad) of a coupling that the
+        pose check accepts; finite, ``> 0`` and at most
+        :data:`~drakegrasp.core.tolerances.MAX_COUPLING_TOL`.  Default
+        :data:`~drakegrasp.core.tolerances.COUPLING_TOL`; a
+        :class:`~drakegrasp.GraspMonitor`'s
+        :data:`~drakegrasp.core.tolerances.MONITOR_COUPLING_TOL`, since a
+        simulation's coupler constraints give under load.
     load : None, "gravity" or tuple of float
         An external wrench on the object, (6,) or planar (3,), in frame O about
         its origin, or the object's weight: the report then has a load section.
@@ -175,6 +187,7 @@ class AnalysisOptions:
     allow_penetration: bool = False
     patches: str = "vertices"
     check_pose: bool = True
+    coupling_tolerance: float = COUPLING_TOL
     load: str | tuple[float, ...] | None = None
     object_mass: float | None = None
     torque_limits: str | tuple[float, ...] | None = None
@@ -220,6 +233,7 @@ class AnalysisOptions:
             "allow_penetration", check_flag("allow_penetration", self.allow_penetration)
         )
         put("check_pose", check_flag("check_pose", self.check_pose))
+        put("coupling_tolerance", _coupling_tolerance(self.coupling_tolerance))
         if not isinstance(self.patches, str) or self.patches not in PATCH_MODES:
             raise InvalidOptionError(
                 f"patches must be one of {list(PATCH_MODES)}, got {self.patches!r}"
@@ -330,6 +344,21 @@ def checked_options(options: Any) -> AnalysisOptions:
             f"options must be an AnalysisOptions, got {type(options).__name__}"
         )
     return options
+
+
+def _coupling_tolerance(value: Any) -> float:
+    """``coupling_tolerance`` as a float in ``(0, MAX_COUPLING_TOL]``."""
+    message = (
+        f"coupling_tolerance must be finite and > 0, at most {MAX_COUPLING_TOL:g} "
+        f"(m or rad), got {value!r}"
+    )
+    try:
+        tol = real_scalar("coupling_tolerance", value)
+    except InvalidOptionError:
+        raise InvalidOptionError(message) from None
+    if not 0.0 < tol <= MAX_COUPLING_TOL:
+        raise InvalidOptionError(message)
+    return tol
 
 
 def resolve_options(

@@ -180,6 +180,14 @@ class GraspMonitor(LeafSystem):
         (a joint off its limits; penetration deeper than
         ``distance_tolerance`` by any hand body where ``allow_penetration`` is
         False) gives an ``"invalid"`` sample, not an exception.
+    coupling_tolerance : float, optional
+        The largest break of a joint coupling (m or rad) a sample's pose may
+        have (:class:`~drakegrasp.AnalysisOptions`); default (None)
+        :data:`~drakegrasp.core.tolerances.MONITOR_COUPLING_TOL` (1 mrad):
+        Drake's coupler constraints give under load (SAP held a three-finger
+        hand's ``<mimic>`` distal joints 7 µrad off at 0.5 N·m, and at an
+        analysis's 1e-6 every sample of that grip was ``"invalid"``).  Given
+        ``options=``, its ``coupling_tolerance`` is used.
     allow_penetration : bool, optional
         As in :func:`drakegrasp.analyze_grasp`; default (None) True: the
         simulator's contacts penetrate to make their force (the WSG-50
@@ -259,6 +267,7 @@ class GraspMonitor(LeafSystem):
         allow_penetration: bool | None = None,
         patches: str = "vertices",
         check_pose: bool = True,
+        coupling_tolerance: float | None = None,
         load: str | Sequence[float] | None = None,
         torque_limits: str | Sequence[float] | None = None,
         contacts: str = "geometry",
@@ -296,6 +305,7 @@ class GraspMonitor(LeafSystem):
             allow_penetration=allow_penetration,
             patches=patches,
             check_pose=check_pose,
+            coupling_tolerance=coupling_tolerance,
             load=load,
             torque_limits=torque_limits,
         )

@@ -19,6 +19,7 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.tolerances import COUPLING_TOL, MONITOR_COUPLING_TOL
 from drakegrasp.core.validation import check_flag, describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.options import AnalysisOptions, resolve_options
@@ -156,6 +157,11 @@ def monitor_settings(
     penetrate = options is None and analysis_keywords.get("allow_penetration") is None
     if analysis_keywords.get("allow_penetration") is None:
         analysis_keywords["allow_penetration"] = False  # AnalysisOptions' default
+    # and its coupler constraints give under load, as its contacts penetrate
+    if analysis_keywords.get("coupling_tolerance") is None:
+        analysis_keywords["coupling_tolerance"] = (
+            COUPLING_TOL if options is not None else MONITOR_COUPLING_TOL
+        )
     analysis = resolve_options(options, **analysis_keywords)
     if penetrate:
         analysis = analysis.replace(allow_penetration=True)

@@ -15,6 +15,7 @@ import pytest
 from pick_support import build_pick
 
 import drakegrasp as dg
+from drakegrasp.core.tolerances import MONITOR_COUPLING_TOL
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.friction import (
     FrictionMismatchWarning,
@@ -67,10 +68,14 @@ def test_options_object_and_keywords_give_the_same_samples(gripped):
     keywords = GraspMonitor(
         gripped.plant, object_body=BOX, mu=1.0, distance_tolerance=1e-3
     )
-    # a monitor allows penetration unless told otherwise; an options object
-    # says it itself (AnalysisOptions' default is an analysis's: False)
+    # a monitor allows penetration and a simulation's coupler give unless
+    # told otherwise; an options object says it itself (AnalysisOptions'
+    # defaults are an analysis's: False, COUPLING_TOL)
     options = dg.AnalysisOptions(
-        mu=1.0, distance_tolerance=1e-3, allow_penetration=True
+        mu=1.0,
+        distance_tolerance=1e-3,
+        allow_penetration=True,
+        coupling_tolerance=MONITOR_COUPLING_TOL,
     )
     given = GraspMonitor(gripped.plant, object_body=BOX, options=options)
     assert given.settings.analysis == options == keywords.settings.analysis
