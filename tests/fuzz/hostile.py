@@ -173,3 +173,119 @@ BAD_COUNTS = (0, -1, 1.5, "2", None, True, NAN, 1j, 10**30, [2])
 def pick(rng: np.random.Generator, pool):
     """One element of ``pool``, chosen by ``rng``."""
     return pool[int(rng.integers(len(pool)))]
+
+
+# ------------------------------------------------------- hostile objects
+
+
+class HostileError(Exception):
+    """What a hostile object's dunder raises: no library code expects it."""
+
+
+def _boom(*_args, **_kwargs):
+    raise HostileError("a hostile dunder")
+
+
+class LenRaises(list):
+    """A list of three floats whose ``len()`` raises."""
+
+    __len__ = _boom
+
+
+class IterRaises:
+    """A sequence that claims 3 items and raises when iterated or indexed."""
+
+    def __len__(self):
+        return 3
+
+    __iter__ = _boom
+    __getitem__ = _boom
+
+
+class LyingLength:
+    """``len()`` says 3; iteration and indexing give 2 floats."""
+
+    def __len__(self):
+        return 3
+
+    def __iter__(self):
+        return iter([0.5, 0.5])
+
+    def __getitem__(self, i):
+        return [0.5, 0.5][i]
+
+
+class ArrayRaises:
+    """An array-like whose ``__array__`` raises."""
+
+    __array__ = _boom
+
+
+class FloatRaises:
+    """A registered :class:`numbers.Real` whose ``float()`` raises."""
+
+    __float__ = _boom
+    __index__ = _boom
+
+
+class FloatSubclassRaises(float):
+    """A float (0.5) whose ``__float__`` raises."""
+
+    __float__ = _boom
+
+
+class BoolRaises:
+    """An object whose truth value raises."""
+
+    __bool__ = _boom
+
+
+class EqHashRaises:
+    """An object that cannot be compared or hashed."""
+
+    __eq__ = _boom
+    __hash__ = _boom
+
+
+class ArraySubclass(np.ndarray):
+    """A numpy subclass (what a library's own array type is)."""
+
+
+def _register():
+    import numbers
+
+    numbers.Real.register(FloatRaises)
+
+
+_register()
+
+
+def objects() -> list:
+    """Hostile objects, fresh: dunders that raise or lie, odd numpy kinds.
+
+    For the in-process fuzz of the public calls (``report_public.py``): they
+    cannot cross the JSON sandbox.  The generator is consumed by its first
+    use, as a caller's would be.
+    """
+    import decimal
+    import fractions
+
+    selfish: list = []
+    selfish.append(selfish)
+    return [
+        LenRaises([0.5, 0.5, 0.5]), IterRaises(), LyingLength(), ArrayRaises(),
+        FloatRaises(), FloatSubclassRaises(0.5), BoolRaises(), EqHashRaises(),
+        selfish, (x for x in (0.5, 0.5, 0.5)), np.ones(3).view(ArraySubclass),
+        np.ma.masked_array([0.5, 0.5, 0.5], [0, 1, 0]), np.array(0.5),
+        np.array(True), np.bool_(False), np.float32(0.5), np.int64(8),
+        np.ones(3, dtype=np.float16), np.ones(3, dtype=np.longdouble),
+        np.ones(3, dtype=complex), np.array([0.5, FloatRaises()], dtype=object),
+        fractions.Fraction(1, 2), decimal.Decimal("0.5"), decimal.Decimal("sNaN"),
+        np.broadcast_to(0.5, (10**9, 3)), np.ones((4, 3))[::2],
+        _readonly(np.ones((2, 3))), [[0.5, 0.5, 0.5], LyingLength()],
+    ]  # fmt: skip
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a

@@ -5,13 +5,16 @@
 For ``--budget`` seconds (default 150) it picks a public callable at random
 (one of ``PUBLIC`` of ``tests/core/test_calls.py``: every name of every
 package's table, and the example grasps), fills its parameters with values
-drawn from :data:`HOSTILE` and the scene's objects (for a parameter that
-:func:`scene_values` knows, often a valid value instead, so that the call
-gets past its first check), calls it and draws a few items of what it
-yields.  A :class:`~drakegrasp.GraspError` is the refusal the library
-promises.  Anything else is a *raw kind*, keyed by the callable, the
-exception's type and the ``file:line`` that raised it; a call still running
-after ``--limit`` seconds (default 4) is the kind ``TIMEOUT``.
+drawn from :data:`HOSTILE`, the hostile objects of ``hostile.objects``
+(dunders that raise or lie, masked arrays, odd dtypes, huge broadcast
+shapes) and the scene's objects (for a parameter that :func:`scene_values`
+knows, often a valid value instead, so that the call gets past its first
+check), calls it and draws a few items of what it yields.  A
+:class:`~drakegrasp.GraspError` is the refusal the library promises.
+Anything else is a *raw kind*, keyed by the callable, the exception's type
+and the ``file:line`` that raised it (the innermost frame inside drakegrasp,
+so a hostile object's own dunder is not the key); a call still running after
+``--limit`` seconds (default 4) is the kind ``TIMEOUT``.
 
 It prints the number of calls, then one line per raw kind: how many calls
 met it, its key, and the first such call (arguments and message).  The
@@ -44,6 +47,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import hostile as hostile_objects  # noqa: E402
 
 import drakegrasp as dg  # noqa: E402
 from drakegrasp.planning.scenes import planning_scene  # noqa: E402
@@ -106,6 +112,20 @@ HOSTILE = [
 scene's objects, :func:`scene_values`, they are what a parameter is given)."""
 
 
+MEMORY = 3 << 30
+"""Bytes of data a call may add (the huge broadcast shapes of the hostile pool
+would otherwise take the machine's memory): beyond it, ``MemoryError``."""
+
+
+def _cap_memory(extra: int) -> None:
+    """Limit the process's data segment to what it holds now plus ``extra``."""
+    import resource
+
+    with open("/proc/self/status") as status:
+        held = next(int(line.split()[1]) << 10 for line in status if "VmData" in line)
+    resource.setrlimit(resource.RLIMIT_DATA, (held + extra, resource.RLIM_INFINITY))
+
+
 class _Timeout(BaseException):
     """Raised by SIGALRM: a BaseException, so no ``except Exception`` eats it."""
 
@@ -160,7 +180,9 @@ def _call(function, args, keywords, limit: float) -> BaseException | None:
 def _kind(name: str, error: BaseException) -> tuple[str, str, str]:
     if isinstance(error, _Timeout):
         return name, "TIMEOUT", ""
-    frame = traceback.extract_tb(error.__traceback__)[-1]
+    frames = traceback.extract_tb(error.__traceback__)
+    ours = [f for f in frames if f"{os.sep}drakegrasp{os.sep}" in f.filename]
+    frame = (ours or frames)[-1]  # where the library let it through
     return name, type(error).__name__, f"{Path(frame.filename).name}:{frame.lineno}"
 
 
@@ -169,12 +191,13 @@ def run(seed: int, budget: float, limit: float):
     from test_calls import PUBLIC
 
     good, misplaced = scene_values(os.environ.get("DRAKEGRASP_DRAKE_MODELS"))
-    hostile = HOSTILE + misplaced
+    hostile = HOSTILE + hostile_objects.objects() + misplaced
     targets = [
         (name, getattr(importlib.import_module(package), name))
         for package, name in PUBLIC
         if name not in SKIP
     ]
+    _cap_memory(MEMORY)
     rng = random.Random(seed)
     kinds: dict = {}
     counts = collections.Counter()
