@@ -134,8 +134,15 @@ JACOBIAN_BOUND = 1e100
 
 
 def describe(value) -> str:
-    """``repr(value)`` on one line, cut to 120 characters, for a message."""
-    text = " ".join(repr(value).split())
+    """``repr(value)`` on one line, cut to 120 characters, for a message.
+
+    A ``repr`` that raises is no reason to lose the message: the value is then
+    named by its type.
+    """
+    try:
+        text = " ".join(repr(value).split())
+    except Exception as err:  # noqa: BLE001 - a hostile __repr__
+        text = f"<{type(value).__name__} whose repr() raised {type(err).__name__}>"
     return text if len(text) <= 120 else text[:117] + "..."
 
 
@@ -172,8 +179,12 @@ def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
         )
     try:
         return float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise error(f"{name} must be a real number, got {describe(value)}") from None
+    except Exception as err:  # noqa: BLE001 - whatever a hostile __float__ raises
+        raise error(
+            f"{name} must be a real number, got {describe(value)} "
+            f"({type(value).__name__}), whose float() raised "
+            f"{type(err).__name__}: {err}"
+        ) from None
 
 
 def real_array(name: str, value, *, error: type = InvalidContactError) -> np.ndarray:
@@ -194,16 +205,28 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
     """
     if value is None or isinstance(value, (str, bytes)):
         raise error(f"{name} must be an array of real numbers, got {describe(value)}")
+    if np.ma.isMaskedArray(value) and np.ma.is_masked(value):
+        raise error(
+            f"{name} must be an array of real numbers, got a masked array with "
+            f"{int(np.ma.count_masked(value))} masked entries (their hidden values "
+            "would be read as data); fill them (.filled()) or drop them first"
+        )
     try:
         a = np.asarray(value)
     except (TypeError, ValueError) as err:  # ragged nested sequences
         raise error(
             f"{name} must be a rectangular array of real numbers ({err})"
         ) from None
+    except Exception as err:  # noqa: BLE001 - a hostile __len__, __iter__, __array__
+        raise error(
+            f"{name} must be an array of real numbers, got {describe(value)} "
+            f"({type(value).__name__}), which raised {type(err).__name__}: {err} "
+            "when read as an array"
+        ) from None
     if a.dtype.kind == "O":
         try:
             a = np.asarray(a.tolist(), dtype=float)
-        except (TypeError, ValueError, OverflowError):
+        except Exception:  # noqa: BLE001 - None, strings, a hostile __float__
             raise error(
                 f"{name} must be an array of real numbers, got {describe(value)}"
             ) from None
@@ -426,11 +449,15 @@ def integer_or_none(value, *, integral_floats: bool = False) -> int | None:
         return None
     try:
         return int(operator.index(value))
-    except TypeError:
+    except Exception:  # noqa: BLE001 - not an integer, or a hostile __index__
         pass
     if integral_floats and isinstance(value, (float, np.floating)):
-        if float(value).is_integer():
-            return int(value)
+        try:
+            x = float(value)
+        except Exception:  # noqa: BLE001 - a float subclass's hostile __float__
+            return None
+        if x.is_integer():
+            return int(x)
     return None
 
 

@@ -1,0 +1,100 @@
+"""Hostile objects at the shared checks: dunders that raise, masks, 0-d flags.
+
+An object whose ``__float__``, ``__array__``, ``__iter__``, ``__index__`` or
+``__repr__`` raises passed that exception out of ``real_scalar``,
+``real_array``, ``integer_or_none`` and the messages as it was (a
+``RuntimeError`` from deep inside numpy's conversion).  A masked array lost
+its mask: the hidden values were read as data.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+import pytest
+
+import drakegrasp as dg
+from drakegrasp.core import validation as v
+from drakegrasp.errors import InvalidContactError, InvalidOptionError
+
+
+class Hostile(RuntimeError):
+    pass
+
+
+def _raise(*_args, **_kwargs):
+    raise Hostile("a hostile dunder")
+
+
+class FloatRaises:
+    __float__ = _raise
+    __index__ = _raise
+
+
+numbers.Real.register(FloatRaises)
+
+
+class FloatSubclassRaises(float):
+    __float__ = _raise
+
+
+class ArrayRaises:
+    __array__ = _raise
+
+
+class IterRaises:
+    def __len__(self):
+        return 3
+
+    __iter__ = _raise
+    __getitem__ = _raise
+
+
+class ReprRaises:
+    __repr__ = _raise
+
+
+@pytest.mark.parametrize("value", [FloatRaises(), FloatSubclassRaises(0.5)])
+def test_a_float_that_raises_is_named(value):
+    with pytest.raises(InvalidOptionError, match=r"^x must be a real number.*float"):
+        v.real_scalar("x", value)
+    with pytest.raises(InvalidOptionError, match="num_generators must be an integer"):
+        v.check_num_generators(value)
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        ArrayRaises(),
+        IterRaises(),
+        [IterRaises(), IterRaises()],
+        np.array([0.5, FloatRaises()], dtype=object),
+    ],
+    ids=["array", "iter", "nested", "object-dtype"],
+)
+def test_an_array_like_that_raises_is_named(value):
+    with pytest.raises(InvalidContactError, match=r"^p must be an array of real"):
+        v.check_positions("p", value)
+
+
+def test_a_masked_array_with_masked_entries_is_refused_not_unmasked():
+    masked = np.ma.masked_array([[0.0, 0.0, 1.0]], mask=[[0, 1, 0]])
+    with pytest.raises(InvalidContactError, match="1 masked entries"):
+        v.real_array("normals", masked)
+    with pytest.raises(dg.GraspError, match="masked"):
+        dg.Contact(np.ma.masked_array([0.0, 9.0, 0.0], [0, 1, 0]), [1, 0, 0])
+    # nothing masked: its data, as numpy reads it
+    clear = np.ma.masked_array([0.5, 1.0], mask=False)
+    np.testing.assert_array_equal(v.real_array("x", clear), [0.5, 1.0])
+
+
+def test_a_message_survives_a_repr_that_raises():
+    assert "ReprRaises whose repr() raised Hostile" in v.describe(ReprRaises())
+    with pytest.raises(InvalidOptionError, match="flag must be True or False"):
+        v.check_flag("flag", ReprRaises())
+
+
+@pytest.mark.parametrize("value", [np.float32(0.5), np.array(0.5), np.int64(8)])
+def test_numpy_scalars_pass_where_a_number_is_wanted(value):
+    assert v.real_scalar("x", value) == float(value)
