@@ -522,8 +522,25 @@ def check_contact(value, name: str = "contact"):
 
 
 def check_flag(name: str, value) -> bool:
-    """A boolean option: ``True``/``False`` (numpy booleans too), nothing else."""
+    """A boolean option: ``True``/``False``, nothing else.
+
+    Parameters
+    ----------
+    name : str
+        Name of the option, for the message.
+    value : bool
+        Also a numpy boolean (``np.bool_``) or a 0-d boolean array
+        (``np.array(True)``, what ``np.asarray`` of a flag gives), as
+        :func:`real_scalar` takes a 0-d real array.  Not ``1``, ``None``, a
+        string or an array of any other shape or dtype.
+
+    Returns
+    -------
+    bool
+    """
     if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, np.ndarray) and value.shape == () and value.dtype == bool:
         return bool(value)
     raise InvalidOptionError(f"{name} must be True or False, got {describe(value)}")
 

@@ -34,7 +34,8 @@ import numpy as np
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.errors import BatchFileError, InvalidOptionError
+from drakegrasp.core.validation import check_flag
+from drakegrasp.errors import BatchFileError
 
 __all__ = [
     "MANIFEST",
@@ -217,8 +218,7 @@ def prepare_dataset(
     BatchFileError
         The directory is a file, or holds another job without ``overwrite``.
     """
-    if not isinstance(overwrite, bool):
-        raise InvalidOptionError(f"overwrite must be True or False, got {overwrite!r}")
+    overwrite = check_flag("overwrite", overwrite)
     output_dir = Path(output_dir)
     if output_dir.exists() and not output_dir.is_dir():
         raise BatchFileError(

@@ -74,7 +74,7 @@ from pydrake.systems.framework import Context
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
-from drakegrasp.core.validation import check_distance_tolerance
+from drakegrasp.core.validation import check_distance_tolerance, check_flag
 from drakegrasp.errors import (
     InvalidOptionError,
     JointLimitError,
@@ -415,8 +415,8 @@ def close_hand(
     q_all = plant.GetPositions(plant_context)
     q0 = q_all[hand_.position_indices].copy()
     jaws = parallel_jaws(plant, plant_context, hand_, query)
-    _check_flag("symmetric", symmetric)
-    _check_flag("settle", settle)
+    check_flag("symmetric", symmetric)
+    check_flag("settle", settle)
     if symmetric:
         hand_ = _couple_jaws(plant, body, bodies, couplings, hand_, jaws, q0, inspector)
     if settle and not body.is_floating_base_body():
@@ -553,11 +553,6 @@ def _close(
             closure=closure,
         )
     return closure
-
-
-def _check_flag(name: str, value) -> None:
-    if not isinstance(value, bool | np.bool_):
-        raise InvalidOptionError(f"{name} must be True or False, got {value!r}")
 
 
 def _refuse_branching_fingers(plant, hand: HandStructure) -> None:

@@ -4,7 +4,9 @@ An object whose ``__float__``, ``__array__``, ``__iter__``, ``__index__`` or
 ``__repr__`` raises passed that exception out of ``real_scalar``,
 ``real_array``, ``integer_or_none`` and the messages as it was (a
 ``RuntimeError`` from deep inside numpy's conversion).  A masked array lost
-its mask: the hidden values were read as data.
+its mask: the hidden values were read as data.  ``check_flag`` took
+``np.bool_`` but refused ``np.array(True)``, and ``prepare_dataset`` refused
+``np.bool_`` too: one rule for a flag now, in ``check_flag``.
 """
 
 from __future__ import annotations
@@ -95,6 +97,31 @@ def test_a_message_survives_a_repr_that_raises():
         v.check_flag("flag", ReprRaises())
 
 
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [(True, True), (np.bool_(False), False), (np.array(True), True)],
+)
+def test_a_flag_may_be_a_numpy_boolean_or_a_0d_boolean_array(value, expected):
+    assert v.check_flag("flag", value) is expected
+
+
+@pytest.mark.parametrize(
+    "value", [np.array([True]), np.array(1), np.array(1.0), 1, None, "yes"]
+)
+def test_a_flag_of_another_shape_or_dtype_is_refused(value):
+    with pytest.raises(InvalidOptionError, match="flag must be True or False"):
+        v.check_flag("flag", value)
+
+
 @pytest.mark.parametrize("value", [np.float32(0.5), np.array(0.5), np.int64(8)])
 def test_numpy_scalars_pass_where_a_number_is_wanted(value):
     assert v.real_scalar("x", value) == float(value)
+
+
+def test_prepare_dataset_takes_a_flag_as_check_flag_does(tmp_path):
+    from drakegrasp.distributed.dataset import prepare_dataset
+
+    for flag in (np.bool_(False), np.array(True)):
+        assert prepare_dataset(tmp_path / "out", {}, overwrite=flag, create=False)
+    with pytest.raises(InvalidOptionError, match="overwrite must be True or False"):
+        prepare_dataset(tmp_path / "out", {}, overwrite=np.array([True]))
