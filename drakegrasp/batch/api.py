@@ -672,7 +672,7 @@ def iter_batch_closure(
         raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
     try:
         items = iter(chunks)
-    except TypeError:
+    except Exception:  # noqa: BLE001 - not iterable, or a hostile __iter__
         raise InvalidOptionError(
             "chunks must be an iterable of (positions, normals[, mu]) tuples or "
             f"mappings, got {type(chunks).__name__}"

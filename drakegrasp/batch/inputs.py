@@ -25,7 +25,9 @@ from drakegrasp.core.validation import (
     check_positions,
     check_rank_tol,
     check_tol,
+    describe,
     integer_or_none,
+    items_of,
     real_array,
     unit_vectors,
 )
@@ -66,6 +68,11 @@ def read_shape(name: str, value, must: str, *, error: type) -> tuple[int, ...]:
     except (ValueError, TypeError):  # inhomogeneous nested sequences
         raise error(
             f"{name} must be {must}; got a nested sequence of uneven shape"
+        ) from None
+    except Exception as err:  # noqa: BLE001 - a hostile __len__, __iter__, __array__
+        raise error(
+            f"{name} must be {must}; got {describe(value)} ({type(value).__name__}), "
+            f"which raised {type(err).__name__}: {err} when its shape was read"
         ) from None
 
 
@@ -233,19 +240,19 @@ def check_metrics(metrics: Sequence[str]) -> tuple[str, ...]:
     if isinstance(metrics, str):
         metrics = (metrics,)
     if isinstance(metrics, Iterator):
-        metrics = tuple(itertools.islice(metrics, MAX_METRIC_NAMES + 1))
+        metrics = items_of(
+            "metrics",
+            itertools.islice(metrics, MAX_METRIC_NAMES + 1),
+            f"a sequence of names from {', '.join(METRICS)}",
+        )
         if len(metrics) > MAX_METRIC_NAMES:
             raise InvalidOptionError(
                 f"metrics yields more than {MAX_METRIC_NAMES} names; give a "
                 f"sequence of names from {', '.join(METRICS)}"
             )
-    try:
-        names = tuple(metrics)
-    except TypeError:
-        raise InvalidOptionError(
-            f"metrics must be a sequence of names from {', '.join(METRICS)}, got "
-            f"{metrics!r}"
-        ) from None
+    names = tuple(
+        items_of("metrics", metrics, f"a sequence of names from {', '.join(METRICS)}")
+    )
     for name in names:
         if not isinstance(name, str) or name not in METRICS:
             raise InvalidOptionError(

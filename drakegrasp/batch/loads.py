@@ -22,7 +22,7 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import check_grasp, real_array
+from drakegrasp.core.validation import check_grasp, items_of, real_array
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["BatchGraspForceResult", "batch_grasp_forces"]
@@ -117,6 +117,7 @@ def batch_grasp_forces(
             f"grasps must be a sequence of drakegrasp.Grasp, got "
             f"{type(grasps).__name__}"
         )
+    grasps = items_of("grasps", grasps, "a sequence of drakegrasp.Grasp")
     grasps = [check_grasp(g, f"grasps[{k}]") for k, g in enumerate(grasps)]
     K = len(grasps)
     W = real_array("wrenches", wrenches, error=InvalidOptionError)

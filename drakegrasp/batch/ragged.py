@@ -77,7 +77,7 @@ def _shape(value) -> tuple[int, ...] | None:
     """``np.shape`` of a homogeneous array-like; None for a ragged one."""
     try:
         return np.shape(value)
-    except (ValueError, TypeError):  # inhomogeneous nested sequences
+    except Exception:  # noqa: BLE001 - ragged, or a hostile __len__ or __iter__
         return None
 
 

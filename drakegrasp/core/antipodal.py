@@ -120,7 +120,7 @@ def _two_contacts(grasp_or_contacts: Grasp | Sequence[Contact]) -> tuple[Contact
     else:
         try:
             contacts = tuple(grasp_or_contacts)
-        except TypeError:
+        except Exception:  # noqa: BLE001 - not iterable, or a hostile __iter__
             raise InvalidGraspError(
                 "the antipodal check takes a Grasp or a pair of Contact, got "
                 f"{type(grasp_or_contacts).__name__}"

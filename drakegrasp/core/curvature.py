@@ -36,7 +36,12 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.validation import real_array, real_scalar, unit_vectors
+from drakegrasp.core.validation import (
+    items_of,
+    real_array,
+    real_scalar,
+    unit_vectors,
+)
 from drakegrasp.errors import InvalidContactError
 
 __all__ = [
@@ -469,7 +474,14 @@ def contact_hessians(
             "curvatures must be a sequence of ContactCurvature (one per contact), "
             f"got a {type(curvatures).__name__}"
         )
-    curvatures = tuple(curvatures)
+    curvatures = tuple(
+        items_of(
+            "curvatures",
+            curvatures,
+            "a sequence of ContactCurvature (one per contact)",
+            error=InvalidContactError,
+        )
+    )
     if len(curvatures) != grasp.num_contacts:
         raise InvalidContactError(
             f"curvatures has {len(curvatures)} entries but the grasp has "

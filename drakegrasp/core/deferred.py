@@ -220,7 +220,8 @@ class WeakMemo(weakref.WeakKeyDictionary):
             store = self[owner] = {}
         try:
             known = key in store
-        except TypeError:  # an unhashable argument: compute() judges it, uncached
+        except Exception:  # noqa: BLE001 - unhashable, or a hostile __hash__/__eq__
+            # compute() judges the argument, uncached
             return compute()
         if not known:
             store[key] = compute()

@@ -89,7 +89,7 @@ class Grasp:
             contacts = (contacts,)
         try:
             contacts = tuple(contacts)
-        except TypeError:
+        except Exception:  # noqa: BLE001 - not iterable, or a hostile __iter__
             raise InvalidGraspError(
                 "contacts must be an iterable of drakegrasp.Contact, got "
                 f"{type(contacts).__name__}"

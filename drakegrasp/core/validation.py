@@ -87,6 +87,7 @@ __all__ = [
     "check_tol",
     "describe",
     "integer_or_none",
+    "items_of",
     "outside_moment_arms",
     "real_array",
     "real_scalar",
@@ -247,6 +248,46 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
             f"{describe(value)}"
         )
     return a.astype(float, copy=False)
+
+
+def items_of(name: str, value, must: str, *, error: type = InvalidOptionError) -> list:
+    """The items of a caller's iterable, read once into a list.
+
+    Parameters
+    ----------
+    name : str
+        Name of the input, for the message.
+    value : iterable
+        Read once (a generator is consumed).
+    must : str
+        What ``name`` must be, for the message ("a sequence of drakegrasp.Grasp").
+    error : type, optional
+        The :class:`~drakegrasp.GraspError` subclass to raise.
+
+    Returns
+    -------
+    list
+
+    Raises
+    ------
+    GraspError
+        ``error`` for a string, bytes, a 0-d array (numpy's "iteration over a
+        0-d array") or anything else not iterable, and for an iterable whose
+        ``__iter__``, ``__len__`` or items raise: the message names ``name``,
+        the type and what was raised.
+    """
+    if isinstance(value, (str, bytes)) or (
+        isinstance(value, np.ndarray) and value.ndim == 0
+    ):
+        raise error(f"{name} must be {must}, got {describe(value)}")
+    try:
+        return list(value)
+    except Exception as err:  # noqa: BLE001 - not iterable, or a hostile __iter__
+        raise error(
+            f"{name} must be {must}, got {describe(value)} "
+            f"({type(value).__name__}), which raised {type(err).__name__}: {err} "
+            "when its items were read"
+        ) from None
 
 
 def _holds_bool(value) -> bool:

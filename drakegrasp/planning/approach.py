@@ -274,7 +274,7 @@ def _check_preshape_couplings(given: np.ndarray, q: np.ndarray, structure) -> No
 def _vector(name, value, n) -> np.ndarray:
     try:
         v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except Exception:  # noqa: BLE001 - not numbers, or a hostile __array__
         v = np.full(0, np.nan)
     if v.shape != (n,) or not np.all(np.isfinite(v)):
         raise InvalidOptionError(f"{name} must be {n} finite numbers, got {value!r}")

@@ -66,6 +66,7 @@ from drakegrasp.core.validation import (
     check_flag,
     describe,
     integer_or_none,
+    items_of,
 )
 from drakegrasp.errors import (
     InvalidContactError,
@@ -311,7 +312,12 @@ def check_plant_contacts(
             "contacts must be a sequence of PlantContact (from find_contacts), "
             f"got {describe(contacts)}"
         )
-    contacts = list(contacts)
+    contacts = items_of(
+        "contacts",
+        contacts,
+        "a sequence of PlantContact (from find_contacts)",
+        error=InvalidContactError,
+    )
     owners = _collision_owners(plant)
     for k, c in enumerate(contacts):
         if not isinstance(c, PlantContact):

@@ -42,6 +42,7 @@ from pydrake.geometry import Role
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, Joint, JointIndex, RigidBody
 
+from drakegrasp.core.validation import items_of
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.validation import scoped_name
 
@@ -323,7 +324,13 @@ def coupling_entries(couplings) -> tuple:
             "couplings must be a sequence of (joint_0, joint_1, gear_ratio, offset) "
             f"entries (() for none), got {couplings!r}"
         )
-    return tuple(couplings)
+    return tuple(
+        items_of(
+            "couplings",
+            couplings,
+            "a sequence of (joint_0, joint_1, gear_ratio, offset) entries",
+        )
+    )
 
 
 def coupling_entry(plant: MultibodyPlant, entry) -> tuple[Joint, Joint, float, float]:

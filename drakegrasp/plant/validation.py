@@ -30,7 +30,7 @@ from pydrake.systems.framework import Context
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.core.tolerances import QUERY_POSE_TOL
-from drakegrasp.core.validation import describe, integer_or_none
+from drakegrasp.core.validation import describe, integer_or_none, items_of
 from drakegrasp.errors import (
     GraspError,
     InvalidContextError,
@@ -607,6 +607,7 @@ def check_bodies(
             f"got {describe(bodies)}"
         )
     out = []
+    bodies = items_of(argument, bodies, "an iterable of the plant's RigidBody objects")
     for k, body in enumerate(bodies):
         if not isinstance(body, RigidBody):
             raise InvalidOptionError(
@@ -768,7 +769,12 @@ def _listed(hand) -> Iterable:
             "hand must be a model instance (ModelInstanceIndex or name), an "
             f"iterable of bodies or scoped body names, or None; got {hand!r}"
         )
-    return hand
+    return items_of(
+        "hand",
+        hand,
+        "a model instance (ModelInstanceIndex or name), an iterable of bodies "
+        "or scoped body names, or None",
+    )
 
 
 def _hand_repr(plant: MultibodyPlant, hand) -> str:

@@ -42,6 +42,7 @@ from drakegrasp.core.validation import (
     check_grasp,
     describe,
     integer_or_none,
+    items_of,
     real_array,
     real_scalar,
 )
@@ -239,7 +240,11 @@ def normalize_contact_forces(grasp: Grasp, forces: Any) -> list[np.ndarray] | No
             "forces must be a ClosureResult or one array of force components per "
             f"contact, got {describe(forces)} ({type(forces).__name__})"
         )
-    forces = list(forces)
+    forces = items_of(
+        "forces",
+        forces,
+        "a ClosureResult or one array of force components per contact",
+    )
     if not forces:
         return None
     if len(forces) != grasp.num_contacts:

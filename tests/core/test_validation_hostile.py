@@ -125,3 +125,11 @@ def test_prepare_dataset_takes_a_flag_as_check_flag_does(tmp_path):
         assert prepare_dataset(tmp_path / "out", {}, overwrite=flag, create=False)
     with pytest.raises(InvalidOptionError, match="overwrite must be True or False"):
         prepare_dataset(tmp_path / "out", {}, overwrite=np.array([True]))
+
+
+def test_items_of_reads_a_generator_once_and_names_what_raises():
+    assert v.items_of("xs", (x for x in (1, 2)), "numbers") == [1, 2]
+    with pytest.raises(InvalidOptionError, match=r"^xs must be numbers.*Hostile"):
+        v.items_of("xs", IterRaises(), "numbers")
+    with pytest.raises(InvalidOptionError, match=r"^xs must be numbers, got array"):
+        v.items_of("xs", np.array(1.0), "numbers")

@@ -446,3 +446,50 @@ def test_coupling_and_model_helpers_name_an_argument_of_the_wrong_kind(box_scene
         dp.add_models(Parser(fresh), np.float16(2.0))
     with pytest.raises(dg.InvalidOptionError, match="url must be a string"):
         dp.add_models(Parser(fresh), url={"a": 1})
+
+
+class _IterRaises:
+    """Claims three items; iterating or indexing raises."""
+
+    def __len__(self):
+        return 3
+
+    def __iter__(self):
+        raise RuntimeError("a hostile __iter__")
+
+    __getitem__ = __iter__
+
+
+class _HashRaises:
+    def __hash__(self):
+        raise RuntimeError("a hostile __hash__")
+
+    __eq__ = __hash__
+
+
+def _hostile_sequence_calls():
+    import drakegrasp.batch as db
+    import drakegrasp.visualization as v
+
+    grasp, planar = _spatial(), _planar()
+    P, N = np.zeros((2, 3, 3)), np.tile([0.0, 0.0, 1.0], (2, 3, 1))
+    return {
+        "grasps": lambda x: db.batch_grasp_forces(x, np.zeros(6)),
+        "forces": lambda x: v.contact_forces_in_grasp_frame(planar, x),
+        "curvatures": lambda x: dg.second_order_form_closure(planar, curvatures=x),
+        "metrics": lambda x: dg.batch_force_closure(P, N, mu=0.5, metrics=x),
+        "positions": lambda x: dg.batch_force_closure(x, N, mu=0.5),
+        "contacts": lambda x: dg.Grasp(x),
+        "chunks": lambda x: next(db.iter_batch_closure(x)),
+        "antipodal": lambda x: dg.is_antipodal(x),
+        "num_generators": lambda x: dg.lp2_d_star(grasp, num_generators=x),
+    }
+
+
+@pytest.mark.parametrize("value", [_IterRaises(), np.array(True), _HashRaises()])
+@pytest.mark.parametrize("name", sorted(_hostile_sequence_calls()))
+def test_a_sequence_that_raises_or_is_0d_is_named(name, value):
+    # list()/tuple()/np.shape of it, or the memo's `key in store`, raised the
+    # object's own RuntimeError or numpy's "iteration over a 0-d array".
+    with pytest.raises(dg.GraspError):
+        _hostile_sequence_calls()[name](value)
