@@ -17,6 +17,7 @@ __all__ = [
     "DEFAULT_NUM_GENERATORS",
     "DEFAULT_RANK_TOL",
     "DEFAULT_TOL",
+    "MAX_ARRAY_ENTRIES",
     "MAX_COUPLING_TOL",
     "MAX_DISTANCE_TOLERANCE",
     "MONITOR_COUPLING_TOL",
@@ -90,6 +91,15 @@ DEFAULT_NUM_GENERATORS = 8
 
 ZERO_FRACTION = 1e-3
 """``d*`` below ``ZERO_FRACTION * tol`` is the solver's zero, not a near miss."""
+
+
+MAX_ARRAY_ENTRIES = 2**30
+"""Most entries of one array argument read in memory (8 GiB as float64).
+
+A broadcast array (``np.broadcast_to(0.0, (10**9, 3))``) costs nothing to make
+and took 22 GiB to read as floats, or minutes to check; beyond this it is
+refused before it is read.  A larger batch streams from a file chunk by chunk
+(``drakegrasp.batch.stream_file``), whose chunks are far below it."""
 
 
 L1_MAX_POINTS = 2_000

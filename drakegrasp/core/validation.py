@@ -42,7 +42,9 @@ hand Jacobian entries       real, finite, ``|J_ij| <=`` :data:`JACOBIAN_BOUND`.
 
 Arrays must have a real numeric dtype: complex arrays are refused (numpy would
 silently drop the imaginary part), as are strings, ``None``, booleans and
-object arrays.
+object arrays; so are masked arrays with masked entries (the mask would be
+dropped) and arrays of more than
+:data:`~drakegrasp.core.tolerances.MAX_ARRAY_ENTRIES` entries.
 """
 
 from __future__ import annotations
@@ -53,7 +55,11 @@ import sys
 
 import numpy as np
 
-from drakegrasp.core.tolerances import MAX_DISTANCE_TOLERANCE, MOMENT_ARMS
+from drakegrasp.core.tolerances import (
+    MAX_ARRAY_ENTRIES,
+    MAX_DISTANCE_TOLERANCE,
+    MOMENT_ARMS,
+)
 from drakegrasp.errors import (
     InvalidContactError,
     InvalidGraspError,
@@ -203,6 +209,14 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
     ndarray of float64
         A new array (or a read-only view of a float64 input); may hold
         non-finite values, which the caller checks.
+
+    Raises
+    ------
+    GraspError
+        ``error`` for what is not an array of real numbers (also a masked
+        array with masked entries, or an object whose conversion raises), and
+        for more than :data:`~drakegrasp.core.tolerances.MAX_ARRAY_ENTRIES`
+        entries (a broadcast array of 10**9 rows), before it is read.
     """
     if value is None or isinstance(value, (str, bytes)):
         raise error(f"{name} must be an array of real numbers, got {describe(value)}")
@@ -224,6 +238,13 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
             f"({type(value).__name__}), which raised {type(err).__name__}: {err} "
             "when read as an array"
         ) from None
+    if a.size > MAX_ARRAY_ENTRIES:
+        raise error(
+            f"{name} has shape {a.shape}: {a.size} entries, more than the "
+            f"{MAX_ARRAY_ENTRIES} drakegrasp reads in memory "
+            "(drakegrasp.core.tolerances.MAX_ARRAY_ENTRIES); stream a batch "
+            "that large from a file"
+        )
     if a.dtype.kind == "O":
         try:
             a = np.asarray(a.tolist(), dtype=float)

@@ -133,3 +133,17 @@ def test_items_of_reads_a_generator_once_and_names_what_raises():
         v.items_of("xs", IterRaises(), "numbers")
     with pytest.raises(InvalidOptionError, match=r"^xs must be numbers, got array"):
         v.items_of("xs", np.array(1.0), "numbers")
+
+
+def test_a_huge_broadcast_array_is_refused_before_it_is_read():
+    # np.broadcast_to costs nothing; reading it as floats took 22 GiB (and
+    # the fuzz's check of it minutes), so it is refused by its size first.
+    huge = np.broadcast_to(0.5, (10**9, 3))
+    with pytest.raises(InvalidContactError, match=r"^p has shape \(1000000000, 3\)"):
+        v.check_positions("p", huge)
+    with pytest.raises(dg.GraspError, match="MAX_ARRAY_ENTRIES"):
+        dg.Contact(huge, [0.0, 0.0, 1.0])
+    with pytest.raises(dg.GraspError, match="MAX_ARRAY_ENTRIES"):
+        dg.max_resistible_wrench(
+            dg.examples.spatial_two_fingers(0.5), huge, max_normal_force=1.0
+        )
