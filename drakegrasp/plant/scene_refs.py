@@ -58,6 +58,7 @@ from drakegrasp.plant.scene_file import check_poses
 
 __all__ = [
     "MAX_INCLUDED_FILES",
+    "MAX_URL_LENGTH",
     "PackagesSpec",
     "add_named_package",
     "add_packages",
@@ -67,6 +68,11 @@ __all__ = [
 
 MAX_INCLUDED_FILES = 32
 """Most directive files (the scene and what it includes) checked per scene."""
+
+MAX_URL_LENGTH = 4096
+"""Most characters of a ``file:`` of a directive: ``PATH_MAX``, the longest path
+the system opens.  Drake's ``PackageMap.ResolveUrl`` crashed the process
+(a segmentation fault) on a URL of 100,000 characters."""
 
 ROS_PACKAGE_PATH = "ROS_PACKAGE_PATH"
 
@@ -394,6 +400,12 @@ def check_references(
         if current is path:
             anchor_relative_files(parsed, path)
         for kind, url in _entries(parsed):
+            if len(url) > MAX_URL_LENGTH:
+                raise SceneError(
+                    f"scene {str(current)!r}: {kind}.file {url[:60]!r}... has "
+                    f"{len(url)} characters, more than any path can have "
+                    f"({MAX_URL_LENGTH}, drakegrasp.plant.scene_refs.MAX_URL_LENGTH)"
+                )
             try:
                 if not allow_any_file:
                     _check_url(url, scene_dir=scene_dir, package_map=package_map)

@@ -206,6 +206,18 @@ def test_hostile_scenes_one_line_each(tmp_path, case):
     assert line.startswith("drakegrasp: error:") and cause in line, line
 
 
+@pytest.mark.parametrize("flag", [(), ("--allow-any-file",)])
+def test_a_model_file_name_longer_than_any_path_is_one_line(tmp_path, flag):
+    # Drake's PackageMap.ResolveUrl crashed the process (SIGSEGV, no line at
+    # all) on a file: of 100,000 characters.
+    long_name = "package://drakegrasp/objects/box.sdf"
+    text = edited_shipped("parallel_jaw_box", (long_name, "x" * 100_000))
+    scene = tmp_path / "long.yaml"
+    scene.write_text(text)
+    line = _one_line_error(_run("analyze", str(scene), *flag))
+    assert "characters, more than any path can have" in line, line
+
+
 def test_upper_case_suffix_overwrite_and_the_deprecated_alias(tmp_path):
     good = _grasps(tmp_path / "good.npz", 5)
     out = tmp_path / "OUT.NPZ"
