@@ -135,7 +135,20 @@ def batch_grasp_forces(
             "hand_jacobians must be a sequence of one (M_k, n_v) Jacobian per "
             f"grasp, got {type(hand_jacobians).__name__}"
         )
-    Js = [None] * K if hand_jacobians is None else list(hand_jacobians)
+    if (
+        isinstance(hand_jacobians, np.ndarray)
+        and hand_jacobians.ndim
+        and len(hand_jacobians) != K
+    ):
+        Js = hand_jacobians  # refused by its length, before a view per row
+    elif hand_jacobians is None:
+        Js = [None] * K
+    else:
+        Js = items_of(
+            "hand_jacobians",
+            hand_jacobians,
+            "a sequence of one (M_k, n_v) Jacobian per grasp",
+        )
     if len(Js) != K:
         raise InvalidOptionError(
             f"hand_jacobians must hold {K} Jacobians (one per grasp), got {len(Js)}"

@@ -87,7 +87,12 @@ def is_ragged(positions) -> bool:
     A sequence of equally long grasps is stacked as before (it is a ``(K, N,
     d)`` array-like); an ``ndarray`` is never ragged.
     """
-    if not isinstance(positions, (list, tuple)) or not positions:
+    if not isinstance(positions, (list, tuple)):
+        return False
+    try:
+        if not positions:
+            return False
+    except Exception:  # noqa: BLE001 - a list whose __len__ raises: real_array names it
         return False
     return _shape(positions) is None
 

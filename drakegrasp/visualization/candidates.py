@@ -289,7 +289,7 @@ def _candidate_rows(candidates) -> list:
     try:
         # An endless iterator is cut at one past the bound, not listed forever.
         rows = list(itertools.islice(candidates, MAX_CANDIDATES + 1))
-    except TypeError:
+    except Exception:  # noqa: BLE001 - not iterable, or a hostile __iter__
         rows = None
     if rows is None or isinstance(candidates, str | bytes):
         raise InvalidOptionError(

@@ -493,3 +493,28 @@ def test_a_sequence_that_raises_or_is_0d_is_named(name, value):
     # object's own RuntimeError or numpy's "iteration over a 0-d array".
     with pytest.raises(dg.GraspError):
         _hostile_sequence_calls()[name](value)
+
+
+class _LenRaises(list):
+    def __len__(self):
+        raise RuntimeError("a hostile __len__")
+
+
+def test_the_last_hostile_sequences_of_the_fuzz_are_named():
+    # is_ragged asked `not positions` of a list whose __len__ raised;
+    # batch_grasp_forces listed a 10**9-row hand_jacobians (a view per row:
+    # MemoryError) before comparing its length; plot_score_distribution
+    # caught only TypeError from iterating the candidates.
+    import drakegrasp.batch as db
+    import drakegrasp.visualization as v
+
+    N = np.tile([0.0, 0.0, 1.0], (2, 3, 1))
+    with pytest.raises(dg.InvalidContactError, match="positions must"):
+        dg.batch_force_closure(_LenRaises([[0.0] * 3] * 3), N, mu=0.5)
+    huge = np.broadcast_to(0.5, (10**9, 6, 2))
+    with pytest.raises(dg.InvalidOptionError, match="must hold 1 Jacobians"):
+        db.batch_grasp_forces([_spatial()], np.zeros(6), hand_jacobians=huge)
+    with pytest.raises(dg.InvalidOptionError, match="hand_jacobians must be"):
+        db.batch_grasp_forces([_spatial()], np.zeros(6), hand_jacobians=np.array(1))
+    with pytest.raises(dg.InvalidOptionError, match="candidates must be"):
+        v.plot_score_distribution(_IterRaises())
