@@ -6,7 +6,9 @@ must answer or refuse quickly and within memory proportional to the file:
 - files larger than :data:`MAX_SCENE_BYTES` are refused before parsing;
 - YAML **anchors and aliases** (``&a`` / ``*a``) are refused: eight nested
   aliases in 1.3 KB expand to gigabytes ("billion laughs"), and no scene needs
-  them; so is nesting deeper than :data:`MAX_DEPTH`;
+  them; so is nesting deeper than :data:`MAX_DEPTH`, and a file of more than
+  :data:`MAX_NODES` values (a list of 200,000 numbers fits in 1 MiB and took
+  a minute to read, three times over);
 - a key given twice in one mapping is refused (PyYAML keeps the last, other
   readers the first: the two readings of the file would differ);
 - plain scalars are read with the YAML 1.2 core schema, as Drake reads them:
@@ -50,6 +52,7 @@ __all__ = [
     "LOADER_NU_REMEDY",
     "MAX_ANGLE_DEG",
     "MAX_DEPTH",
+    "MAX_NODES",
     "MAX_SCENE_BYTES",
     "TOP_LEVEL_KEYS",
     "check_directives",
@@ -64,6 +67,11 @@ MAX_SCENE_BYTES = 1 << 20
 
 MAX_DEPTH = 64
 """Deepest nesting of YAML collections accepted."""
+
+MAX_NODES = 10_000
+"""Most YAML values (scalars, lists, mappings) of one file: the shipped and
+tested scenes hold at most about 120, and PyYAML composes some 10,000 a
+second on each of the three readings of a scene."""
 
 MAX_ANGLE_DEG = 1e8
 """Largest magnitude of a pose's angle, degrees.
@@ -128,6 +136,14 @@ class _SceneLoader(yaml.SafeLoader):
                 "(they can expand without bound); write the values out"
             )
         self._depth = getattr(self, "_depth", 0) + 1
+        self._nodes = getattr(self, "_nodes", 0) + 1
+        if self._nodes > MAX_NODES:
+            self._depth -= 1
+            raise SceneError(
+                f"YAML holds more than {MAX_NODES} values (lists, mappings and "
+                f"scalars; drakegrasp.plant.scene_file.MAX_NODES) by line "
+                f"{event.start_mark.line + 1}; a scene needs a few hundred"
+            )
         try:
             if self._depth > MAX_DEPTH:
                 raise SceneError(

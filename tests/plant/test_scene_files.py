@@ -18,7 +18,7 @@ from drakegrasp.cli import main
 from drakegrasp.errors import SceneError
 from drakegrasp.plant.models import models_dir
 from drakegrasp.plant.scene import DEFAULT_SCENE, read_scene_info, scene_path
-from drakegrasp.plant.scene_file import MAX_DEPTH, MAX_SCENE_BYTES
+from drakegrasp.plant.scene_file import MAX_DEPTH, MAX_NODES, MAX_SCENE_BYTES
 
 DEFAULT = scene_path(DEFAULT_SCENE).read_text()
 
@@ -57,6 +57,20 @@ def test_deep_nesting_and_size_limits(tmp_path):
     big = DEFAULT + "#" + "x" * MAX_SCENE_BYTES + "\n"
     with pytest.raises(SceneError, match="the limit is"):
         read_scene_info(_write(tmp_path, big, "big.yaml"))
+
+
+def test_a_file_of_too_many_values_is_refused_fast(tmp_path):
+    # 200,000 numbers fit in 1 MiB; the three readings of the file composed
+    # them for about a minute before torque_limits refused their count.
+    many = "[" + ", ".join(["1.0"] * 200_000) + "]"
+    text = DEFAULT.replace(
+        "  mu: 0.5", f"  mu: 0.5\n  load: gravity\n  torque_limits: {many}"
+    )
+    path = _write(tmp_path, text)
+    start = time.perf_counter()
+    with pytest.raises(SceneError, match=f"more than {MAX_NODES} values"):
+        load_scene(path)
+    assert time.perf_counter() - start < 5.0
 
 
 @pytest.mark.parametrize(
