@@ -49,6 +49,7 @@ dropped) and arrays of more than
 
 from __future__ import annotations
 
+import decimal
 import numbers
 import operator
 import sys
@@ -161,7 +162,9 @@ def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
     name : str
         Name of the input, for the message.
     value : int or float
-        Also a numpy real scalar or a 0-d real array.
+        Also a numpy real scalar, a 0-d real array, a
+        ``fractions.Fraction`` or a ``decimal.Decimal`` (as an
+        array of them is read).
     error : type, optional
         The :class:`~drakegrasp.GraspError` subclass to raise.
 
@@ -179,7 +182,7 @@ def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
                 f"{value.shape} and dtype {value.dtype}"
             )
         return float(value)
-    if not isinstance(value, numbers.Real):
+    if not isinstance(value, numbers.Real | decimal.Decimal):
         raise error(
             f"{name} must be a real number, got {describe(value)} "
             f"({type(value).__name__})"

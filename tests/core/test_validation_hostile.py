@@ -147,3 +147,16 @@ def test_a_huge_broadcast_array_is_refused_before_it_is_read():
         dg.max_resistible_wrench(
             dg.examples.spatial_two_fingers(0.5), huge, max_normal_force=1.0
         )
+
+
+def test_a_decimal_is_a_number_as_it_is_in_an_array():
+    # [Decimal("0.5")] was read as an array of 0.5 while Decimal("0.5") alone
+    # was refused as no real number.
+    import decimal
+
+    assert v.real_scalar("x", decimal.Decimal("0.5")) == 0.5
+    assert v.check_coefficient("mu", decimal.Decimal("0.5")) == 0.5
+    with pytest.raises(InvalidOptionError, match="x must be a real number"):
+        v.real_scalar("x", decimal.Decimal("sNaN"))
+    with pytest.raises(InvalidContactError, match="mu must be finite"):
+        v.check_coefficient("mu", decimal.Decimal("NaN"))
