@@ -164,3 +164,16 @@ def test_every_entry_point_shows_options_in_its_signature():
         p = inspect.signature(f).parameters["options"]
         assert p.kind is inspect.Parameter.KEYWORD_ONLY and p.default is None
     assert dg.BatchOptions is BatchOptions
+
+
+def test_a_fork_bomb_of_workers_is_refused_before_any_fork():
+    # The pool forks every worker at once: workers=100000 with chunk_size=1
+    # forked one process per chunk, each a copy of the caller.
+    from drakegrasp.batch.run.workers import MAX_WORKERS
+
+    with pytest.raises(InvalidOptionError, match=r"workers must be at most \d+"):
+        BatchOptions(workers=100_000)
+    P, N = np.zeros((2, 3, 3)), np.tile([0.0, 0.0, 1.0], (2, 3, 1))
+    with pytest.raises(InvalidOptionError, match="workers must be at most"):
+        dg.batch_force_closure(P, N, mu=0.5, chunk_size=1, workers=10**9)
+    assert BatchOptions(workers=MAX_WORKERS).workers == MAX_WORKERS

@@ -47,12 +47,19 @@ from drakegrasp.core.validation import integer_or_none
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
+    "MAX_WORKERS",
     "available_cores",
     "check_workers",
     "map_ordered",
     "resolve_workers",
     "shutdown_pool",
 ]
+
+MAX_WORKERS = 256
+"""Most worker processes a call may ask for, unless the machine has more cores.
+
+The pool forks every worker at once: ``workers=100000`` with many chunks
+forked as many processes as chunks, each a copy of the caller."""
 
 PARENT_WATCH_PERIOD = 0.2
 """Seconds between a worker's checks that its parent is alive."""
@@ -69,13 +76,24 @@ def available_cores() -> int:
 
 
 def check_workers(workers) -> int | None:
-    """``workers`` checked: None (every core) or an int >= 1 (not resolved)."""
+    """``workers`` checked: None (every core) or an int >= 1 (not resolved).
+
+    At most :data:`MAX_WORKERS`, or the cores this process may run on where
+    that is more (``None`` asks for every core).
+    """
     if workers is None:
         return None
     n = integer_or_none(workers)  # bools are not counts (True was one worker)
     if n is None or n < 1:
         raise InvalidOptionError(
             f"workers must be None (every core) or an integer >= 1, got {workers!r}"
+        )
+    most = max(MAX_WORKERS, available_cores())
+    if n > most:
+        raise InvalidOptionError(
+            f"workers must be at most {most} (drakegrasp.batch.run.workers."
+            f"MAX_WORKERS, or every core), got {n}: each is a process forked at "
+            "once; None runs one per core"
         )
     return n
 
