@@ -20,7 +20,11 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import check_angle_tol, check_coefficient
+from drakegrasp.core.validation import (
+    check_angle_tol,
+    check_coefficient,
+    items_of,
+)
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError
 
 __all__ = ["DEFAULT_ANGLE_TOL", "AntipodalResult", "is_antipodal"]
@@ -118,13 +122,14 @@ def _two_contacts(grasp_or_contacts: Grasp | Sequence[Contact]) -> tuple[Contact
     if isinstance(grasp_or_contacts, Grasp):
         contacts = grasp_or_contacts.contacts
     else:
-        try:
-            contacts = tuple(grasp_or_contacts)
-        except Exception:  # noqa: BLE001 - not iterable, or a hostile __iter__
-            raise InvalidGraspError(
-                "the antipodal check takes a Grasp or a pair of Contact, got "
-                f"{type(grasp_or_contacts).__name__}"
-            ) from None
+        contacts = tuple(
+            items_of(
+                "grasp_or_contacts",
+                grasp_or_contacts,
+                "a Grasp or a pair of Contact (the antipodal check)",
+                error=InvalidGraspError,
+            )
+        )
     if len(contacts) != 2 or not all(isinstance(c, Contact) for c in contacts):
         raise InvalidGraspError(
             "the antipodal check takes exactly two contacts (a Grasp or a pair of "

@@ -26,6 +26,7 @@ from drakegrasp.core.validation import (
     LENGTH_MIN,
     check_length,
     check_positions,
+    items_of,
     real_array,
     safe_norm,
 )
@@ -87,13 +88,14 @@ class Grasp:
     ) -> None:
         if isinstance(contacts, Contact):
             contacts = (contacts,)
-        try:
-            contacts = tuple(contacts)
-        except Exception:  # noqa: BLE001 - not iterable, or a hostile __iter__
-            raise InvalidGraspError(
-                "contacts must be an iterable of drakegrasp.Contact, got "
-                f"{type(contacts).__name__}"
-            ) from None
+        contacts = tuple(
+            items_of(
+                "contacts",
+                contacts,
+                "an iterable of drakegrasp.Contact",
+                error=InvalidGraspError,
+            )
+        )
         if not contacts:
             raise InvalidGraspError("a grasp needs at least one contact, got none")
         for i, c in enumerate(contacts):

@@ -20,6 +20,7 @@ __all__ = [
     "MAX_ARRAY_ENTRIES",
     "MAX_COUPLING_TOL",
     "MAX_DISTANCE_TOLERANCE",
+    "MAX_ITEMS",
     "MONITOR_COUPLING_TOL",
     "QUERY_POSE_TOL",
     "UNIT_NORMAL_TOL",
@@ -100,6 +101,13 @@ A broadcast array (``np.broadcast_to(0.0, (10**9, 3))``) costs nothing to make
 and took 22 GiB to read as floats, or minutes to check; beyond this it is
 refused before it is read.  A larger batch streams from a file chunk by chunk
 (``drakegrasp.batch.stream_file``), whose chunks are far below it."""
+
+
+MAX_ITEMS = 10**7
+"""Most items of one sequence argument read into a list (contacts, grasps,
+forces, bodies...).  ``list()`` of a 10**9-row array made a view per row
+(about 100 GB), and of an endless generator never returned; more items than
+this are refused as they are counted.  A larger batch is given as arrays."""
 
 
 L1_MAX_POINTS = 2_000

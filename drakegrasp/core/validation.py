@@ -50,6 +50,7 @@ dropped) and arrays of more than
 from __future__ import annotations
 
 import decimal
+import itertools
 import numbers
 import operator
 import sys
@@ -59,6 +60,7 @@ import numpy as np
 from drakegrasp.core.tolerances import (
     MAX_ARRAY_ENTRIES,
     MAX_DISTANCE_TOLERANCE,
+    MAX_ITEMS,
     MOMENT_ARMS,
 )
 from drakegrasp.errors import (
@@ -296,22 +298,34 @@ def items_of(name: str, value, must: str, *, error: type = InvalidOptionError) -
     ------
     GraspError
         ``error`` for a string, bytes, a 0-d array (numpy's "iteration over a
-        0-d array") or anything else not iterable, and for an iterable whose
-        ``__iter__``, ``__len__`` or items raise: the message names ``name``,
-        the type and what was raised.
+        0-d array") or anything else not iterable, for an iterable whose
+        ``__iter__``, ``__len__`` or items raise (the message names ``name``,
+        the type and what was raised), and for more than
+        :data:`~drakegrasp.core.tolerances.MAX_ITEMS` items (an array by its
+        length, before a view per row is made; an endless generator as it is
+        read).
     """
     if isinstance(value, (str, bytes)) or (
         isinstance(value, np.ndarray) and value.ndim == 0
     ):
         raise error(f"{name} must be {must}, got {describe(value)}")
+    too_many = error(
+        f"{name} must be {must}; got more than {MAX_ITEMS} items "
+        "(drakegrasp.core.tolerances.MAX_ITEMS; a larger batch is given as arrays)"
+    )
+    if isinstance(value, np.ndarray) and len(value) > MAX_ITEMS:
+        raise too_many
     try:
-        return list(value)
+        items = list(itertools.islice(value, MAX_ITEMS + 1))
     except Exception as err:  # noqa: BLE001 - not iterable, or a hostile __iter__
         raise error(
             f"{name} must be {must}, got {describe(value)} "
             f"({type(value).__name__}), which raised {type(err).__name__}: {err} "
             "when its items were read"
         ) from None
+    if len(items) > MAX_ITEMS:
+        raise too_many
+    return items
 
 
 def _holds_bool(value) -> bool:

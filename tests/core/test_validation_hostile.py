@@ -160,3 +160,18 @@ def test_a_decimal_is_a_number_as_it_is_in_an_array():
         v.real_scalar("x", decimal.Decimal("sNaN"))
     with pytest.raises(InvalidContactError, match="mu must be finite"):
         v.check_coefficient("mu", decimal.Decimal("NaN"))
+
+
+def test_a_sequence_of_more_items_than_max_items_is_refused_as_it_is_counted():
+    # tuple() of a 10**9-row array made a view per row (about 100 GB) and of
+    # an endless generator never returned.
+    import itertools
+
+    from drakegrasp.core.tolerances import MAX_ITEMS
+
+    contact = dg.examples.spatial_two_fingers(0.5).contacts[0]
+    for endless in (np.broadcast_to(0.5, (10**9, 3)), itertools.repeat(contact)):
+        with pytest.raises(dg.InvalidGraspError, match=f"more than {MAX_ITEMS}"):
+            dg.Grasp(endless)
+    with pytest.raises(InvalidOptionError, match="more than"):
+        v.items_of("xs", itertools.repeat(0.5), "numbers")

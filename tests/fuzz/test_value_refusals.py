@@ -518,3 +518,27 @@ def test_the_last_hostile_sequences_of_the_fuzz_are_named():
         db.batch_grasp_forces([_spatial()], np.zeros(6), hand_jacobians=np.array(1))
     with pytest.raises(dg.InvalidOptionError, match="candidates must be"):
         v.plot_score_distribution(_IterRaises())
+
+
+def test_the_shared_checks_answer_every_hostile_object_of_the_fuzz():
+    # report_public.py draws these objects for every public callable; the
+    # checks every entry point shares must accept or name each of them.
+    import hostile
+
+    from drakegrasp.core import validation as v
+
+    checks = [
+        lambda x: v.real_scalar("x", x),
+        lambda x: v.check_positions("x", x),
+        lambda x: v.unit_vectors("x", x),
+        lambda x: v.check_flag("x", x),
+        lambda x: v.check_num_generators(x),
+        lambda x: v.items_of("x", x, "a sequence"),
+        lambda x: v.describe(x),
+    ]
+    for value in hostile.objects():
+        for check in checks:
+            try:
+                check(value)
+            except dg.GraspError:
+                pass
