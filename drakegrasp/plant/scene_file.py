@@ -171,9 +171,16 @@ class _SceneLoader(yaml.SafeLoader):
     def construct_yaml_int(self, node):
         text = self.construct_scalar(node)
         sign, digits = (-1, text[1:]) if text[:1] == "-" else (1, text.lstrip("+"))
-        if digits[:2] in ("0o", "0x"):
-            return sign * int(digits[2:], 8 if digits[1] == "o" else 16)
-        return sign * int(digits, 10)
+        try:
+            if digits[:2] in ("0o", "0x"):
+                return sign * int(digits[2:], 8 if digits[1] == "o" else 16)
+            return sign * int(digits, 10)
+        except ValueError:  # more digits than Python converts (4300)
+            mark = node.start_mark
+            raise SceneError(
+                f"integer of {len(digits)} digits at line {mark.line + 1}, column "
+                f"{mark.column + 1}: more digits than any value of a scene needs"
+            ) from None
 
 
 # YAML 1.2 core schema (https://yaml.org/spec/1.2.2/#1032-tag-resolution), the

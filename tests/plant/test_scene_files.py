@@ -73,6 +73,14 @@ def test_a_file_of_too_many_values_is_refused_fast(tmp_path):
     assert time.perf_counter() - start < 5.0
 
 
+def test_an_integer_of_too_many_digits_names_its_line(tmp_path):
+    # Python's int() refuses over 4300 digits; the message said "not valid
+    # YAML: ... use sys.set_int_max_str_digits()", advice for a programmer.
+    path = _write(tmp_path, DEFAULT.replace("  mu: 0.5", "  mu: " + "1" * 5000))
+    with pytest.raises(SceneError, match=r"integer of 5000 digits at line \d+"):
+        load_scene(path)
+
+
 @pytest.mark.parametrize(
     "old, new, fragment",
     [
