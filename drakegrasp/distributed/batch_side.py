@@ -54,7 +54,7 @@ from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
 from drakegrasp.core.validation import check_num_generators
-from drakegrasp.distributed.client import connected
+from drakegrasp.distributed.client import connected, results_or_cancel
 from drakegrasp.distributed.dataset import (
     job_manifest,
     prepare_dataset,
@@ -295,7 +295,11 @@ def evaluate_on_cluster(
                 _partition, kind, P, Nrm, part, options, shard, size, job, start,
                 key=f"drakegrasp-partition-{j}-{run}", pure=False,
             )))  # fmt: skip
-        results = {j: f.result() for j, _, f in futures}
+        # A block computed on the cluster is held by its partition alone, so
+        # it is released with it (a failed run's error holds this frame).
+        P = Nrm = None
+        done = results_or_cancel(client, [f for _, _, f in futures])
+        results = {j: r for (j, _, _), r in zip(futures, done, strict=True)}
     if output_dir is not None:
         results.update(done_paths)
         # every shard is complete: a worker killed mid-write left a temporary

@@ -10,11 +10,11 @@ import math
 import numbers
 import threading
 import traceback
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 
 from drakegrasp.errors import InvalidOptionError
 
-__all__ = ["HANDSHAKE_GRACE", "client_for", "connected"]
+__all__ = ["HANDSHAKE_GRACE", "client_for", "connected", "results_or_cancel"]
 
 HANDSHAKE_GRACE = 2.0
 """Seconds the handshake may take beyond the connection timeout.
@@ -127,6 +127,38 @@ def connected(client_or_address, *, timeout: float | None = None) -> Iterator:
     finally:
         if client is not client_or_address:
             client.close()
+
+
+def results_or_cancel(client, futures: Sequence) -> list:
+    """The results of ``futures`` in order; on any failure, every one cancelled.
+
+    A task that raised re-raises here (its error, as the worker raised it),
+    and so does an interruption (``KeyboardInterrupt``).  Dask keeps a failed
+    future's error, and that error's traceback holds the frame that waited on
+    it, hence every other future of the call: without the cancel they were
+    never released, so the tasks still queued went on computing and the
+    finished ones held their results in the workers' memory until the client
+    closed (a notebook's client: until the kernel stopped).
+
+    Parameters
+    ----------
+    client : distributed.Client
+        The client that submitted ``futures``.
+    futures : sequence of distributed.Future
+
+    Returns
+    -------
+    list
+        ``[f.result() for f in futures]``: waited for in order, so of
+        several failures the first future's is raised, whichever failed
+        first.
+    """
+    try:
+        return [f.result() for f in futures]
+    except BaseException:
+        with contextlib.suppress(Exception):  # a closed client has none left
+            client.cancel(list(futures))
+        raise
 
 
 def _connect_timeout(timeout) -> float:

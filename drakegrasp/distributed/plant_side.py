@@ -11,7 +11,7 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.validation import integer_or_none
-from drakegrasp.distributed.client import connected
+from drakegrasp.distributed.client import connected, results_or_cancel
 from drakegrasp.errors import GraspError, InvalidOptionError
 from drakegrasp.plant.options import AnalysisOptions, checked_options
 
@@ -135,7 +135,7 @@ def analyze_poses(
         futs = [client.submit(_analyze_block, scene, q[s:s + block], options,
                               overrides, pure=False)
                 for s in range(0, len(q), block)]  # fmt: skip
-        parts = client.gather(futs)
+        parts = results_or_cancel(client, futs)
     names = {"is_force_closure": bool, "d_star": float, "num_contacts": int,
              "error": str}  # fmt: skip
     return {

@@ -284,3 +284,58 @@ def test_form_closure_on_a_cluster_refuses_epsilon_before_the_lengths(grasps):
             "tcp://127.0.0.1:1", P[:20], Nrm[:20], kind="form",
             characteristic_lengths=1e-15, metrics=["epsilon_l1"],
         )  # fmt: skip
+
+
+def _keys(dask_scheduler) -> list[str]:
+    return [str(k) for k in dask_scheduler.tasks]
+
+
+def _tasks_left(client, before: set) -> set:
+    """The scheduler's tasks not in ``before``, once they settle.
+
+    A released task leaves the scheduler shortly after its client lets it go:
+    the keys are read until no new one is left or 30 s have passed.
+    """
+    deadline = time.monotonic() + 30.0
+    left = set(client.run_on_scheduler(_keys)) - before
+    while left and time.monotonic() < deadline:
+        time.sleep(0.1)
+        left = set(client.run_on_scheduler(_keys)) - before
+    return left
+
+
+@pytest.mark.parametrize("source", ["numpy", "dask"])
+def test_a_failed_partition_leaves_no_task_on_the_cluster(client, source):
+    """One bad grasp in the first partition of 80: the error came back at
+    once, but the failed future's error (kept by Dask, and held here by
+    ``pytest.raises`` as a notebook holds its last error) held the call's
+    frame and so every other future: the queued partitions went on computing
+    and the finished ones kept their results on the workers, never released
+    until the client closed; so did the last block of a Dask array input.
+    Every partition is cancelled with the error."""
+    import drakegrasp as dg
+
+    rng = np.random.default_rng(9200)
+    P, Nrm = random_grasps(rng, 20000, 8, 3)
+    P[3, 0, 0] = np.nan
+    if source == "dask":
+        da = pytest.importorskip("dask.array")
+        P, Nrm = (da.from_array(a, chunks=(250, -1, -1)) for a in (P, Nrm))
+    before = set(client.run_on_scheduler(_keys))
+    with pytest.raises(dg.InvalidContactError, match="grasp 3, contact 0") as info:
+        evaluate_on_cluster(client, P, Nrm, mu=0.5, chunk_size=250,
+                            partition_chunks=1)  # fmt: skip
+    assert not _tasks_left(client, before)
+    del info
+
+
+def test_a_failed_block_of_poses_leaves_no_task_on_the_cluster(client):
+    """As above for ``analyze_poses``: a scene the workers cannot load fails
+    every block, and none is left on the cluster."""
+    import drakegrasp as dg
+
+    before = set(client.run_on_scheduler(_keys))
+    with pytest.raises(dg.GraspError) as info:
+        analyze_poses(client, "no_such_scene_anywhere", np.zeros((40, 3)), block=1)
+    assert not _tasks_left(client, before)
+    del info
