@@ -81,3 +81,56 @@ def test_format_is_checked():
         format_of("x.csv")
     with pytest.raises(InvalidOptionError, match="format must be one of"):
         format_of("x.npz", "csv")
+
+
+@pytest.mark.parametrize("fmt", ["npz", "parquet"])
+def test_a_stream_that_fails_leaves_the_earlier_file_and_nothing_else(
+    npy_dir, tmp_path, fmt
+):
+    """``write_chunks`` of a stream that raises at its fourth chunk (a grasp
+    the engine refuses).  The Parquet writer wrote row groups straight into
+    the output: the earlier file was gone at the first chunk, and the failed
+    run left a valid file of the first 600 grasps, which a reader takes for
+    the whole run.  Both formats now reach the output's name only complete,
+    as the ``.npz`` writer's archive did."""
+    if fmt == "parquet":
+        pytest.importorskip("pyarrow", reason="pyarrow is an optional extra")
+    from drakegrasp.batch import stream_force_closure, write_chunks
+    from drakegrasp.errors import InvalidContactError
+
+    _, P, Nrm, mu = npy_dir
+    P = np.array(P)
+    P[700, 1] = np.nan
+    out = tmp_path / f"out.{fmt}"
+    out.write_bytes(b"the old results")
+    chunks = stream_force_closure(P, Nrm, mu=mu, chunk_size=200, workers=1)
+    with pytest.raises(InvalidContactError, match="grasp 700"):
+        write_chunks(chunks, out, K=len(P), kind="force", tol=1e-6, required_rank=6)
+    assert out.read_bytes() == b"the old results"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["grasps", f"out.{fmt}"]
+
+
+def test_an_archive_that_cannot_be_finished_leaves_the_earlier_file(
+    npy_dir, tmp_path, monkeypatch
+):
+    """The ``.npz`` archive was made at the output's name: a disk that filled
+    while the arrays were copied into it left a truncated archive there, in
+    place of the earlier file."""
+    import errno
+    import os
+    import zipfile
+
+    from drakegrasp.batch import stream_force_closure, write_chunks
+
+    def full(self, *args, **kwargs):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    _, P, Nrm, mu = npy_dir
+    out = tmp_path / "out.npz"
+    out.write_bytes(b"the old results")
+    monkeypatch.setattr(zipfile.ZipFile, "write", full)
+    chunks = stream_force_closure(P, Nrm, mu=mu, chunk_size=500, workers=1)
+    with pytest.raises(OSError, match="No space left"):
+        write_chunks(chunks, out, K=len(P), kind="force", tol=1e-6, required_rank=6)
+    assert out.read_bytes() == b"the old results"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["grasps", "out.npz"]

@@ -4,13 +4,15 @@ Each result array is appended, chunk by chunk, to its own ``.npy`` file in a
 scratch directory beside the output (the header is written first, since ``K``
 is known); the files are then copied block by block into an uncompressed zip
 archive that ``numpy.load`` reads like ``numpy.savez``'s, with the 0-d arrays
-``kind``, ``tol`` and ``required_rank``.  The scratch directory is removed on
+``kind``, ``tol`` and ``required_rank``, made in the scratch directory too and
+moved to the output's name once complete.  The scratch directory is removed on
 success and on failure.
 """
 
 from __future__ import annotations
 
 import contextlib
+import os
 import shutil
 import tempfile
 import zipfile
@@ -46,13 +48,15 @@ class NpzWriter:
         """Finish the archive at ``path`` and remove the scratch directory."""
         for f in self.files.values():
             f.close()
-        with zipfile.ZipFile(self.path, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
+        archive = self.scratch / "results.npz"  # at path only once complete
+        with zipfile.ZipFile(archive, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
             for key, value in self.meta.items():
                 tmp = self.scratch / f"{key}.npy"
                 np.save(tmp, np.array(value))
                 z.write(tmp, f"{key}.npy")
             for name in self.names:
                 z.write(self.scratch / f"{name}.npy", f"{name}.npy")
+        os.replace(archive, self.path)
         shutil.rmtree(self.scratch, ignore_errors=True)
 
     def abort(self) -> None:
