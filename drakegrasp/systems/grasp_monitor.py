@@ -351,6 +351,7 @@ class GraspMonitor(LeafSystem):
         empty = self._sample(
             0.0, "not sampled", "", None, 0.0, np.zeros(nx), 0.0, grip=None
         )
+        self._unsampled = empty  # what a run starts from
         self._verdict_index = self.DeclareDiscreteState(len(self.verdict_names))
         self._report_index = self.DeclareAbstractState(AbstractValue.Make(empty))
         self.DeclareStateOutputPort("verdicts", self._verdict_index)
@@ -640,6 +641,12 @@ class GraspMonitor(LeafSystem):
         ``HoldingThresholds.max_penetration`` gives an ``"invalid"`` sample
         too, where penetration is allowed.
 
+        A sample earlier than the one held (a simulator restarted at time 0,
+        its context's time set back) starts a new run: it continues from
+        nothing ("no contact", no anchors), not from the last run's grip,
+        which a restart would otherwise keep (a box dropped in one run was
+        "dropped" through the next run's approach, untouched).
+
         Raises
         ------
         InvalidOptionError
@@ -650,6 +657,8 @@ class GraspMonitor(LeafSystem):
         self._validate(context)
         previous = context.get_abstract_state(self._report_index).get_value()
         t = context.get_time()
+        if t < previous.time:  # the clock went back: a new run, not a continuation
+            previous = self._unsampled
         x = np.array(self._state_port.Eval(context), dtype=float)
         # An invalid sample keeps the grip before it: it is no evidence.
         kept = (previous.memory, previous.loads, (np.nan, 0.0), previous.anchors)

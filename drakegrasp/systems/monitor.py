@@ -128,6 +128,9 @@ any Drake discrete update, a logger publishing at a sample time ``t_k`` sees
 the value held *before* the update at ``t_k``: the verdict logged at
 ``t_{k+1}`` is the analysis of the plant state logged at ``t_k``
 (``GraspSample.time`` and ``GraspSample.state`` say exactly which).
+A sample at a time earlier than the one held (a simulator restarted with its
+context's time set back) starts a new run, from ``no contact``: the holding
+state of the run before is no evidence about this one.
 A discrete plant's contact results are those of its last step; they exist in
 the simulator's context, not in a fresh context where only ``q`` and ``v``
 were set.

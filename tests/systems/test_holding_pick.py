@@ -97,3 +97,39 @@ def test_a_firm_grip_in_contact_results_is_holding_at_the_default_tolerance(clos
     assert line.displacement[line.times >= LIFT_START].max() < 2e-3
     held = [s for s, up in zip(line.states, airborne, strict=True) if up]
     assert set(held) == {"holding"}, held
+
+
+def test_a_restarted_simulation_does_not_inherit_the_last_runs_drop():
+    """A simulator run again from time 0 (the plant's state set back, then
+    ``Initialize``, as Drake asks after a change of context) continued the
+    holding state of the run before: the box dropped in the first run was
+    "dropped" through the second run's approach, resting untouched on the
+    ground between the open fingers."""
+    from pydrake.math import RigidTransform
+
+    pick = build_pick(
+        mu=0.5, distance_tolerance=1e-3, period=0.01, closed=0.022,
+        **CASES["point, geometry"],
+    )  # fmt: skip
+    pick.run(1.6)
+    root = pick.simulator.get_mutable_context()
+    monitor_context = pick.monitor.GetMyContextFromRoot(root)
+    report = pick.monitor.get_report_output_port()
+    assert report.Eval(monitor_context).holding == "dropped"
+    plant, plant_context = pick.plant, pick.plant.GetMyMutableContextFromRoot(root)
+    root.SetTime(0.0)
+    for name in ("left_finger_joint", "right_finger_joint"):
+        plant.GetJointByName(name, pick.gripper).set_translation(plant_context, OPEN)
+    plant.GetJointByName("lift", pick.gripper).set_translation(plant_context, 0.0)
+    plant.SetVelocities(plant_context, np.zeros(plant.num_velocities()))
+    box = plant.GetBodyByName("box", pick.box)
+    plant.SetFreeBodyPose(plant_context, box, RigidTransform([0, 0, 0.05]))
+    pick.simulator.Initialize()
+    seen = []
+    for t in np.arange(0.0, 0.3, 0.01):  # the fingers are open until 0.3 s
+        pick.simulator.AdvanceTo(t)
+        sample = report.Eval(monitor_context)
+        # the box is where it was put, away from the fingers
+        assert plant.EvalBodyPoseInWorld(plant_context, box).translation()[2] < 0.0505
+        seen.append((sample.time, sample.status, sample.holding))
+    assert {h for _, _, h in seen} == {"no contact"}, seen
