@@ -9,6 +9,7 @@ Usage::
                        [--num-generators NG] [--tol TOL] [--patches MODE]
                        [--close | --no-close] [--allow-penetration]
                        [--check-pose | --no-check-pose]
+                       [--coupling-tolerance C]
                        [--load gravity|FX,FY,FZ,MX,MY,MZ] [--object-mass KG]
                        [--torque-limits plant|T1,T2,...]
                        [--package NAME=DIR ...] [--allow-any-file] [--json]
@@ -769,6 +770,7 @@ _ANALYSIS_FLAGS = (
     "allow_penetration",
     "patches",
     "check_pose",
+    "coupling_tolerance",
     "load",
     "object_mass",
     "torque_limits",
@@ -790,6 +792,7 @@ def _add_analysis_options(parser: argparse.ArgumentParser) -> None:
         "num_generators": {"type": int},
         "tol": {"type": _positive_float},
         "patches": {"choices": list(PATCH_MODES)},
+        "coupling_tolerance": {"type": _positive_float},
         "load": {
             "type": _named_or_numbers("gravity"),
             "metavar": "gravity|FX,FY,FZ,MX,MY,MZ",

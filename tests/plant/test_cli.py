@@ -151,3 +151,27 @@ def test_module_and_console_script_run_from_another_directory(tmp_path):
     assert result.returncode == 1
     assert result.stderr.startswith("drakegrasp: error:")
     assert "Traceback" not in result.stderr
+
+
+def test_every_analysis_option_is_a_flag_of_analyze_with_its_help():
+    # AnalysisOptions gained coupling_tolerance without a flag: the command
+    # line is to reach every option the library has, helped by its own words.
+    from dataclasses import fields
+
+    from drakegrasp.plant.options import OPTION_HELP, AnalysisOptions
+
+    _, sub = build_parser()
+    flags = {a.dest: a for a in sub.choices["analyze"]._actions}
+    missing = [f.name for f in fields(AnalysisOptions) if f.name not in flags]
+    assert missing == []
+    for f in fields(AnalysisOptions):
+        assert OPTION_HELP[f.name] in flags[f.name].help, f.name
+
+
+def test_the_coupling_tolerance_flag_reaches_the_analysis(capsys):
+    code, out, _ = run(capsys, "analyze", "--coupling-tolerance", "0.001", "--json")
+    assert code == 0
+    assert json.loads(out)["options"]["coupling_tolerance"] == 0.001
+    code, out, err = run(capsys, "analyze", "--coupling-tolerance", "0.5")
+    assert (code, out) == (1, "")
+    assert "--coupling-tolerance" in err and err.count("\n") == 1
