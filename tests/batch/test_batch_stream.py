@@ -110,27 +110,51 @@ def test_a_stream_that_fails_leaves_the_earlier_file_and_nothing_else(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["grasps", f"out.{fmt}"]
 
 
-def test_an_archive_that_cannot_be_finished_leaves_the_earlier_file(
-    npy_dir, tmp_path, monkeypatch
+@pytest.mark.parametrize("fmt", ["npz", "parquet"])
+def test_a_file_that_cannot_be_finished_leaves_the_earlier_file(
+    npy_dir, tmp_path, monkeypatch, fmt
 ):
     """The ``.npz`` archive was made at the output's name: a disk that filled
     while the arrays were copied into it left a truncated archive there, in
-    place of the earlier file."""
+    place of the earlier file.  The disk's error was a bare ``OSError``; it is
+    now the output's ``BatchFileError``, naming the file."""
     import errno
     import os
     import zipfile
 
     from drakegrasp.batch import stream_force_closure, write_chunks
+    from drakegrasp.errors import BatchFileError
 
     def full(self, *args, **kwargs):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
+    if fmt == "parquet":
+        pq = pytest.importorskip("pyarrow.parquet", reason="pyarrow is optional")
+        monkeypatch.setattr(pq.ParquetWriter, "write_table", full)
+    else:
+        monkeypatch.setattr(zipfile.ZipFile, "write", full)
     _, P, Nrm, mu = npy_dir
-    out = tmp_path / "out.npz"
+    out = tmp_path / f"out.{fmt}"
     out.write_bytes(b"the old results")
-    monkeypatch.setattr(zipfile.ZipFile, "write", full)
     chunks = stream_force_closure(P, Nrm, mu=mu, chunk_size=500, workers=1)
-    with pytest.raises(OSError, match="No space left"):
+    with pytest.raises(BatchFileError, match=r"cannot write .*out\.\w+.*No space left"):
         write_chunks(chunks, out, K=len(P), kind="force", tol=1e-6, required_rank=6)
     assert out.read_bytes() == b"the old results"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["grasps", "out.npz"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["grasps", f"out.{fmt}"]
+
+
+def test_an_input_that_fails_as_it_streams_is_not_named_as_the_output(tmp_path):
+    """Only the writer's own steps are the output's errors: a chunk stream
+    that raises ``OSError`` (an input read as it streams) passes as it is."""
+    from drakegrasp.batch import write_chunks
+    from drakegrasp.errors import BatchFileError
+
+    def chunks():
+        raise FileNotFoundError(2, "No such file or directory", "in.npz")
+        yield
+
+    with pytest.raises(FileNotFoundError) as info:
+        write_chunks(chunks(), tmp_path / "out.npz", K=1, kind="force", tol=1e-6,
+                     required_rank=6)  # fmt: skip
+    assert not isinstance(info.value, BatchFileError)
+    assert list(tmp_path.iterdir()) == []

@@ -315,7 +315,8 @@ def write_chunks(
     Raises
     ------
     BatchFileError
-        For a ``path`` that is not a file path or cannot be written.
+        For a ``path`` that is not a file path or cannot be written, also
+        part-way (a full disk): the file there before is left as it was.
     InvalidOptionError
         For a ``K``, ``kind``, ``tol`` or ``required_rank`` of the wrong kind,
         or chunks that are not ``(slice, arrays)`` pairs covering ``0 … K`` in
@@ -332,12 +333,7 @@ def write_chunks(
             + type(chunks).__name__
         ) from None
     meta = {"kind": kind, "tol": tol, "required_rank": required_rank}
-    try:
-        writer = (NpzWriter if fmt == "npz" else ParquetWriter)(path, K, meta)
-    except OSError as err:
-        raise BatchFileError(
-            f"cannot write {str(path)!r}: {err.strerror or err}"
-        ) from None
+    writer = _on_disk(path, NpzWriter if fmt == "npz" else ParquetWriter, path, K, meta)
     summary = BatchSummary(kind=kind, tol=tol)
     expected = 0
     written = False
@@ -349,19 +345,33 @@ def write_chunks(
                     f"chunk {sl} out of order (expected {expected})"
                 )
             expected = sl.stop
-            writer.write(arrays)
+            _on_disk(path, writer.write, arrays)
             summary.add(arrays)
             written = True
         if expected != K:
             raise InvalidOptionError(f"the chunks covered {expected} of {K} grasps")
         if not written:  # no grasps: the columns of any K, with no rows
             out, out_metrics = result_arrays(0, kind, metrics)
-            writer.write({**out, **out_metrics})
-        writer.close()
+            _on_disk(path, writer.write, {**out, **out_metrics})
+        _on_disk(path, writer.close)
     except BaseException:
         writer.abort()
         raise
     return summary
+
+
+def _on_disk(path: Path, call, *args):
+    """``call(*args)``, a file system error named as the output's.
+
+    The writer's own steps only: an ``OSError`` raised by the chunks (an
+    input read as it streams) is the input's, and passes as it is.
+    """
+    try:
+        return call(*args)
+    except OSError as err:
+        raise BatchFileError(
+            f"cannot write {str(path)!r}: {err.strerror or err}"
+        ) from None
 
 
 def _check_meta(K, kind, tol, required_rank) -> None:
