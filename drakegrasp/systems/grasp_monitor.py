@@ -7,6 +7,8 @@ itself: its ports, its state and one sample (:meth:`GraspMonitor.evaluate`).
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import time as _time
 import warnings
 from collections.abc import Sequence
@@ -204,7 +206,10 @@ class GraspMonitor(LeafSystem):
         :mod:`drakegrasp.systems.monitor` for what each can see.
     period : float, optional
         Seconds between samples (default 0.05, at least
-        :data:`~drakegrasp.systems.monitor_options.MIN_PERIOD`).
+        :data:`~drakegrasp.systems.monitor_options.MIN_PERIOD`).  A sample
+        that finds a discrete plant not stepped since the one before (a
+        period shorter than its time step) repeats that sample: the
+        hysteresis counts plant states.
     offset : float, optional
         Time of the first periodic sample (default 0); a sample is also taken
         at initialization.
@@ -641,6 +646,16 @@ class GraspMonitor(LeafSystem):
         ``HoldingThresholds.max_penetration`` gives an ``"invalid"`` sample
         too, where penetration is allowed.
 
+        A sample that finds a discrete plant not stepped since the sample
+        held (no update time of the plant between the two, and the same
+        state: a period shorter than the plant's time step, or the periodic
+        sample at the time of the initialization one) is that sample again,
+        at its own time: the same evidence is judged once, so the hysteresis
+        counts plant states, not samples (a period of 0.7 ms on a 1 ms plant
+        judged 512 of 1712 states twice, and a single step's evidence turned
+        "at risk" into "touching").  A plant that stepped and came to the
+        very same state, at rest, is judged again: its rest is evidence.
+
         A sample earlier than the one held (a simulator restarted at time 0,
         its context's time set back) starts a new run: it continues from
         nothing ("no contact", no anchors), not from the last run's grip,
@@ -662,6 +677,15 @@ class GraspMonitor(LeafSystem):
         x = np.array(self._state_port.Eval(context), dtype=float)
         # An invalid sample keeps the grip before it: it is no evidence.
         kept = (previous.memory, previous.loads, (np.nan, 0.0), previous.anchors)
+        if (
+            previous.status != "not sampled"
+            and t >= previous.time
+            and _plant_steps(self._plant, t) == _plant_steps(self._plant, previous.time)
+            and np.array_equal(x, previous.state, equal_nan=True)
+        ):  # the plant has not stepped since: the same evidence, judged once
+            return dataclasses.replace(
+                previous, time=float(t), seconds=_time.perf_counter() - start
+            )
         if not np.all(np.isfinite(x)):
             bad = np.flatnonzero(~np.isfinite(x))
             message = (
@@ -758,3 +782,16 @@ class GraspMonitor(LeafSystem):
         state.get_mutable_discrete_state(self._verdict_index).set_value(sample.verdicts)
         state.get_mutable_abstract_state(self._report_index).set_value(sample)
         return EventStatus.Succeeded()
+
+
+def _plant_steps(plant, t: float) -> float:
+    """How many of a discrete plant's updates a sample at ``t`` sees (s).
+
+    A discrete plant updates at ``0, h, 2h, ...``; a sample at ``t`` sees the
+    state before the update at ``t`` itself (Drake's discrete updates at one
+    time all read the state before them), so those at times below ``t``:
+    ``ceil(t / h)``.  A continuous plant (``h = 0``) changes at every time:
+    ``t`` itself, so that two samples never count as one.
+    """
+    h = plant.time_step()
+    return math.ceil(t / h - 1e-9) if h > 0 else t

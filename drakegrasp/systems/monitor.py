@@ -128,6 +128,10 @@ any Drake discrete update, a logger publishing at a sample time ``t_k`` sees
 the value held *before* the update at ``t_k``: the verdict logged at
 ``t_{k+1}`` is the analysis of the plant state logged at ``t_k``
 (``GraspSample.time`` and ``GraspSample.state`` say exactly which).
+A sample that finds a discrete plant not stepped since the sample held (no
+update time of the plant between them, and the same state: a period shorter
+than the plant's time step) repeats that sample at its own time, so the
+hysteresis of the holding state counts plant states, not samples.
 A sample at a time earlier than the one held (a simulator restarted with its
 context's time set back) starts a new run, from ``no contact``: the holding
 state of the run before is no evidence about this one.

@@ -133,3 +133,65 @@ def test_a_restarted_simulation_does_not_inherit_the_last_runs_drop():
         assert plant.EvalBodyPoseInWorld(plant_context, box).translation()[2] < 0.0505
         seen.append((sample.time, sample.status, sample.holding))
     assert {h for _, _, h in seen} == {"no contact"}, seen
+
+
+def test_samples_faster_than_the_plant_judge_each_plant_state_once():
+    """A period of 0.7 ms on the pick's 1 ms plant: about one sample in three
+    finds the plant state of the sample before, and judged that same evidence
+    again, counting it twice towards the hysteresis: the state moved ("at
+    risk" to "touching") between two samples of one plant state, on a single
+    step's evidence.  Two samples of one plant state are now one judgement."""
+    pick = build_pick(
+        distance_tolerance=1e-3, period=7e-4, contacts="contact_results",
+        **POINT,
+    )  # fmt: skip
+    root = pick.simulator.get_mutable_context()
+    monitor_context = pick.monitor.GetMyContextFromRoot(root)
+    report = pick.monitor.get_report_output_port()
+    samples = []
+    for t in np.arange(7e-4, 1.2, 7e-4):
+        pick.simulator.AdvanceTo(t)
+        sample = report.Eval(monitor_context)
+        if not samples or sample.time != samples[-1].time:
+            samples.append(sample)
+    repeated = [
+        (a, b)
+        for a, b in zip(samples, samples[1:], strict=False)
+        if np.array_equal(a.state, b.state)
+    ]
+    assert len(repeated) > 100  # the plant steps less often than the samples
+    for a, b in repeated:
+        assert b.holding == a.holding and b.memory == a.memory, (a.time, b.time)
+        assert np.array_equal(a.verdicts, b.verdicts, equal_nan=True)
+    # the grip is still seen
+    assert "holding" in {s.holding for s in samples}
+
+
+def test_a_sample_at_each_plant_step_is_judged(monkeypatch):
+    """Only a sample that no plant update separates from the one before is a
+    repeat: with a period equal to the plant's step every sample is judged,
+    once at time 0 (the initialization's sample and the first periodic one
+    see one state), so an object at rest, whose state may repeat bit for bit
+    from step to step, still counts towards the hysteresis."""
+    from drakegrasp.systems.grasp_monitor import GraspMonitor, _plant_steps
+
+    pick = build_pick(
+        distance_tolerance=1e-3, period=1e-3, contacts="contact_results", **POINT
+    )
+    h = pick.plant.time_step()
+    assert h == pytest.approx(1e-3)
+    # the update at t itself is not yet seen at t
+    steps = [_plant_steps(pick.plant, t) for t in (0.0, 7e-4, 1e-3, 1.4e-3, 2e-3)]
+    assert steps == [0, 1, 1, 2, 2]
+    judged = []
+    real = GraspMonitor._analyse
+
+    def counted(self, context, query):
+        judged.append(context.get_time())
+        return real(self, context, query)
+
+    monkeypatch.setattr(GraspMonitor, "_analyse", counted)
+    pick.simulator.AdvanceTo(0.0105)
+    # time 0 was judged once, by the initialization (before the count): the
+    # periodic sample at 0 repeated it; then one judgement per plant step
+    np.testing.assert_allclose(judged, np.arange(1, 11) * h, atol=1e-12)
