@@ -37,7 +37,7 @@ from drakegrasp.batch.inputs import (
     check_metrics,
     chunk_unit_normals,
 )
-from drakegrasp.core.validation import real_array
+from drakegrasp.core.validation import items_of, real_array
 from drakegrasp.errors import InvalidContactError
 
 __all__ = [
@@ -132,6 +132,10 @@ def ragged_groups(positions, normals) -> tuple[int, int, list[RaggedGroup]]:
         Naming the grasp whose positions or normals are ill-shaped, or whose
         dimension differs from the first grasp's.
     """
+    must = "a list of per-grasp (N_k, d) arrays"
+    positions = items_of("positions", positions, must, error=InvalidContactError)
+    if isinstance(normals, (list, tuple)):
+        normals = items_of("normals", normals, must, error=InvalidContactError)
     if not isinstance(normals, (list, tuple)) or len(normals) != len(positions):
         raise InvalidContactError(
             f"with ragged positions ({len(positions)} per-grasp arrays), normals "

@@ -166,3 +166,27 @@ def test_an_uneven_nested_list_is_refused_clearly_where_only_stacks_go():
     uneven = [[[0.0, 0.0, 1.0]], [[1.0, 2.0]]]
     with pytest.raises(dg.InvalidContactError, match="uneven shape"):
         next(stream_form_closure(uneven, uneven))
+
+
+class _LenRaises(list):
+    def __len__(self):
+        raise RuntimeError("no length")
+
+
+class _IterRaises(list):
+    def __iter__(self):
+        raise RuntimeError("no items")
+
+
+def test_ragged_normals_whose_length_or_items_raise_are_named():
+    # The fuzz's last raw kind: len() of a list whose __len__ raises, on the
+    # ragged route's normals.  They are read as every caller's sequence is.
+    P = [np.zeros((1, 3)), np.array([[0.1, 0, 0], [0, 0.1, 0]])]
+    n = [np.array([[0, 0, 1.0]]), np.array([[0, 0, 1.0], [0, 0, -1.0]])]
+    expected = dg.batch_force_closure(P, n, mu=0.5)
+    got = dg.batch_force_closure(P, _LenRaises(n), mu=0.5)  # read by its items
+    np.testing.assert_array_equal(got.d_star, expected.d_star)
+    with pytest.raises(dg.InvalidContactError, match="as many per-grasp arrays"):
+        dg.batch_force_closure(P, _LenRaises(n[:1]), mu=0.5)
+    with pytest.raises(dg.InvalidContactError, match="normals.*RuntimeError: no items"):
+        dg.batch_force_closure(P, _IterRaises(n), mu=0.5)
