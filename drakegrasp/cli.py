@@ -102,7 +102,9 @@ Exit status: 0 on success, 1 on an error (one line on stderr, never a
 traceback), 2 for a bad command line (argparse), 130 on Ctrl-C (SIGINT) with
 one line ``drakegrasp: interrupted``, 143 on SIGTERM and 129 on SIGHUP with one
 line ``drakegrasp: terminated by SIGTERM`` (the run unwinds as on Ctrl-C: no
-partial file, scratch folder or worker process is left).  ``batch`` and
+partial file, scratch folder or worker process is left; a first signal that
+arrives once the command has finished and written its output lets the exit
+finish, with the command's status).  ``batch`` and
 ``plan --out`` / ``--scene-out`` refuse an output that exists unless
 ``--overwrite`` (``batch``
 also one that is its input), checked before any work; both write atomically
@@ -2101,6 +2103,12 @@ def run() -> None:
     was being started as the others died, and waiting for it would hang the
     program (and a ``| tee`` reading its output).  Such a worker ends by itself
     once it sees its parent gone.
+
+    Outside the command's body the program handles signals too: before it (the
+    arguments being read) a SIGTERM or SIGHUP ends the program at once, with
+    the same line and status; after it (the output written), the first such
+    signal or Ctrl-C lets the exit finish with the command's own status, and a
+    second one ends the process at once.
     """
     _FINISHED.clear()
     main_thread = threading.current_thread() is threading.main_thread()
