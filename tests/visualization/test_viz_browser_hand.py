@@ -80,8 +80,16 @@ def _look(meshcat, report, X_WO, camera, target):
     }
 
 
-def _force_pixels(meshcat, tmp_path, name):
-    img = screenshot(meshcat.web_url(), tmp_path / f"{name}.png", tmp_path / "prof")
+def _force_pixels(meshcat, tmp_path, name, *, expected=False):
+    """The screenshot and its force-coloured pixels; ``expected``: the arrows
+    are to be seen (a shot without any is taken again, as one taken before
+    the arrows reached the page)."""
+    img = screenshot(
+        meshcat.web_url(),
+        tmp_path / f"{name}.png",
+        tmp_path / "prof",
+        drawn=(lambda img: colour_mask(img, FORCE).any()) if expected else None,
+    )
     return img, colour_mask(img, FORCE)
 
 
@@ -106,7 +114,7 @@ def _hidden_then_on_top(
     dg.draw_grasp(meshcat, report.grasp, **options)
     _, plain = _force_pixels(meshcat, tmp_path, f"{name}_plain")
     drawing = dg.draw_grasp(meshcat, report.grasp, on_top=True, **options)
-    _, on_top = _force_pixels(meshcat, tmp_path, f"{name}_on_top")
+    _, on_top = _force_pixels(meshcat, tmp_path, f"{name}_on_top", expected=True)
     print(f"{name} force pixels: hidden {plain.sum()}, on top {on_top.sum()}")
     assert on_top.sum() > 2 * plain.sum() + 50
     segments = _arrow_segments(drawing, report, X_WO, camera, target)
@@ -140,7 +148,7 @@ def test_shipped_hand_on_top_and_translucent(meshcat, tmp_path):
     assert paths and all(meshcat.HasPath(p) for p in paths)
     dg.draw_grasp(meshcat, report.grasp, **options)
     set_translucent(meshcat, paths, 0.25)
-    _, seen_through = _force_pixels(meshcat, tmp_path, "translucent")
+    _, seen_through = _force_pixels(meshcat, tmp_path, "translucent", expected=True)
     print(f"force pixels through a translucent hand: {seen_through.sum()}")
     assert seen_through.sum() > plain.sum() + 50
     set_translucent(meshcat, paths, 1.0)
