@@ -191,6 +191,17 @@ def test_a_sample_at_each_plant_step_is_judged(monkeypatch):
         return real(self, context, query)
 
     monkeypatch.setattr(GraspMonitor, "_analyse", counted)
+    # The state as the initialization judged it, bit for bit: at its own time
+    # a repeat, two plant steps later a new judgement (an object at rest).
+    root = pick.simulator.get_mutable_context()
+    monitor_context = pick.monitor.GetMyContextFromRoot(root)
+    pick.monitor.evaluate(monitor_context)
+    assert judged == []
+    root.SetTime(2 * h)
+    pick.monitor.evaluate(monitor_context)
+    assert judged == [pytest.approx(2 * h)]
+    judged.clear()
+    root.SetTime(0.0)
     pick.simulator.AdvanceTo(0.0105)
     # time 0 was judged once, by the initialization (before the count): the
     # periodic sample at 0 repeated it; then one judgement per plant step
