@@ -444,11 +444,52 @@ def _new_plant(path: Path, package_map: PackagesSpec, ros_package_path: bool):
 def _load_models(path: Path, directives, plant: MultibodyPlant, parser) -> None:
     """Process the (checked) directives into ``plant`` and finalize it."""
     _check_joint_limits(path, directives, parser)
-    added = load_models(
-        f"scene {str(path)!r}", ProcessModelDirectives, directives, plant, parser
-    )
+    try:
+        added = load_models(
+            f"scene {str(path)!r}", ProcessModelDirectives, directives, plant, parser
+        )
+    except ModelError as e:
+        if _DRAKE_NESTED_WELD in str(e):
+            _refuse_nested_weld(path, directives, plant)
+        raise
     record_model_couplings(plant, added, parser.package_map())
     plant.Finalize()
+
+
+_DRAKE_NESTED_WELD = "AddWeld(): condition 'found' failed"
+"""Drake's words when an ``add_weld`` child lies in a model nested in the one
+an ``add_model`` added (its directives record welds by added model only)."""
+
+
+def _refuse_nested_weld(path: Path, directives, plant: MultibodyPlant) -> None:
+    """Name the ``add_weld`` whose child is in a nested model, and the way out.
+
+    A model instance is nested when a proper prefix of its scoped name
+    (``rig`` of ``rig::gripper::jaw``) is a model instance of the plant too;
+    an ``add_directives`` namespace (``left::gripper``) is no model instance,
+    so its models are not taken for nested ones.  Returns when no weld fits
+    (the caller re-raises Drake's words).
+    """
+    for d in directives.directives:
+        weld = d.add_weld
+        if weld is None:
+            continue
+        instance = _instance_of(weld.child)
+        parts = instance.split("::")
+        outer = [
+            "::".join(parts[:n])
+            for n in range(1, len(parts))
+            if plant.HasModelInstanceNamed("::".join(parts[:n]))
+        ]
+        if outer and plant.HasModelInstanceNamed(instance):
+            raise SceneError(
+                f"scene {str(path)!r}: add_weld child {weld.child!r} is a frame of "
+                f"the model {instance!r}, nested in {outer[0]!r}, and Drake's model "
+                "directives weld only frames of the models an add_model adds: weld "
+                f"a link of {outer[0]!r} itself (fixed to the nested model by a joint "
+                "in the model file), or add the nested model with an add_model of "
+                "its own"
+            )
 
 
 _UNKNOWN_KEY = re.compile(

@@ -123,3 +123,65 @@ def test_an_unscoped_body_name_is_refused_with_the_scoped_names(
         fixed = DEFAULT.replace(old, new.replace("[left", "[gripper::left"))
         scene = dg.load_scene(_write(tmp_path, fixed, "fixed.yaml"))
         assert [b.name() for b in scene.hand] == ["left_finger", "right_finger"]
+
+
+_NESTED_MOUNT = """<?xml version="1.0"?>
+<sdf version="1.9">
+<model name="mount">
+  {base}
+  <model name="gripper">
+    <include><uri>package://drakegrasp/hands/parallel_jaw.sdf</uri><name>jaw</name>
+    </include>
+  </model>
+  {joint}
+</model>
+</sdf>
+"""
+
+_NESTED_SCENE = """directives:
+- add_model:
+    name: rig
+    file: file://{sdf}
+- add_weld:
+    parent: world
+    child: {child}
+- add_model:
+    name: box
+    file: package://drakegrasp/objects/box.sdf
+    default_free_body_pose:
+      box:
+        translation: [0.0, 0.0, 0.065]
+drakegrasp:
+  object_body: box::box
+  hand: rig
+  mu: 0.5
+"""
+
+
+def test_a_weld_of_a_nested_model_is_refused_with_the_way_out(tmp_path, capsys):
+    # Drake's directives record a weld by the model an add_model added and
+    # demand to find it: a nested model's frame read "AddWeld(): condition
+    # 'found' failed", naming neither the weld nor what to do instead.
+    sdf = _write(tmp_path, _NESTED_MOUNT.format(base="", joint=""), "mount.sdf")
+    scene = _write(
+        tmp_path, _NESTED_SCENE.format(sdf=sdf, child="rig::gripper::jaw::palm")
+    )
+    with pytest.raises(SceneError) as e:
+        dg.load_scene(scene)
+    said = str(e.value)
+    assert "'rig::gripper::jaw::palm'" in said and "nested in 'rig'" in said
+    assert "condition 'found'" not in said
+    assert "add_model of its own" in said
+    assert "nested in 'rig'" in _cli_error(capsys, "analyze", str(scene))
+
+    # The way out the message gives loads: a link of the outer model itself,
+    # fixed to the nested one in the model file, welded to the world.
+    fixed = _NESTED_MOUNT.format(
+        base='<link name="base"><inertial><mass>1</mass></inertial></link>',
+        joint='<joint name="fix" type="fixed"><parent>base</parent>'
+        "<child>gripper::jaw::palm</child></joint>",
+    )
+    _write(tmp_path, fixed, "mount.sdf")
+    _write(tmp_path, _NESTED_SCENE.format(sdf=sdf, child="rig::base"))
+    loaded = dg.load_scene(scene)
+    assert loaded.plant.HasModelInstanceNamed("rig::gripper::jaw")
