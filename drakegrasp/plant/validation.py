@@ -545,8 +545,13 @@ def resolve_body(plant: MultibodyPlant, name: str) -> RigidBody:
     raise ModelError(f"no body named {name!r} in the plant; bodies are {bodies}")
 
 
-def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
+def resolve_object_body(
+    plant: MultibodyPlant, object_body, *, what: str = "object_body"
+) -> RigidBody:
     """A body given as a ``RigidBody`` (of this plant), a ``BodyIndex`` or a name.
+
+    ``what`` names the argument in the messages (``"hand[1]"`` for an item of
+    a hand given as bodies).
 
     Raises
     ------
@@ -557,7 +562,7 @@ def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
         For any other type.
     """
     if isinstance(object_body, RigidBody):
-        return _own_body(plant, object_body, "body")
+        return _own_body(plant, object_body, "body" if what == "object_body" else what)
     if isinstance(object_body, BodyIndex):
         n = plant.num_bodies()
         if not object_body.is_valid() or not 0 <= int(object_body) < n:
@@ -569,7 +574,7 @@ def resolve_object_body(plant: MultibodyPlant, object_body) -> RigidBody:
     if isinstance(object_body, str):
         return resolve_body(plant, object_body)
     raise InvalidOptionError(
-        "object_body must be a RigidBody, a BodyIndex or a 'model::body' name, "
+        f"{what} must be a RigidBody, a BodyIndex or a 'model::body' name, "
         f"got {type(object_body).__name__}"
     )
 
@@ -777,6 +782,18 @@ def _listed(hand) -> Iterable:
     )
 
 
+def _listed_bodies(plant: MultibodyPlant, hand) -> list[RigidBody]:
+    """A hand given as bodies, each resolved, read once (a generator is spent).
+
+    A wrong item is named by its place, ``hand[i]``; the messages that show
+    the hand afterwards show this list, not the spent iterable.
+    """
+    return [
+        resolve_object_body(plant, b, what=f"hand[{i}]")
+        for i, b in enumerate(_listed(hand))
+    ]
+
+
 def _hand_repr(plant: MultibodyPlant, hand) -> str:
     """``hand`` as a message shows it: an instance by name, bodies by scoped name."""
     if isinstance(hand, ModelInstanceIndex):
@@ -835,7 +852,7 @@ def _hand_bodies(plant, object_body, hand) -> list[RigidBody]:
             b for b in bodies if b.model_instance() != object_body.model_instance()
         ]
     else:
-        listed = [resolve_object_body(plant, b) for b in _listed(hand)]
+        listed = hand = _listed_bodies(plant, hand)
         _check_apart(plant, object_body, hand, listed)
         bodies = [b for b in listed if int(b.index()) not in welded]
         if listed and not bodies:
@@ -950,7 +967,7 @@ def hand_contact_bodies(
     if isinstance(hand, str | ModelInstanceIndex):
         bodies = _instance_bodies(plant, hand)
     else:
-        bodies = [resolve_object_body(plant, b) for b in _listed(hand)]
+        bodies = hand = _listed_bodies(plant, hand)
     _check_apart(plant, object_body, hand, bodies)
     bodies = [b for b in bodies if int(b.index()) not in (0, obj)]
     if not bodies:

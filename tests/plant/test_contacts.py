@@ -312,6 +312,16 @@ def test_bad_options_and_bodies():
         rig.contacts(hand=[rig.object])
     with pytest.raises(ModelError, match="hand has no bodies"):
         rig.contacts(hand=[])
+    # A wrong item of a hand given as bodies is named as the hand's item, not
+    # as the object_body (which was right); a generator is read once, so the
+    # message shows the bodies it gave, not the spent generator's nothing.
+    for hand in ([rig.fingers[0], 3], (b for b in [rig.fingers[0], None])):
+        with pytest.raises(InvalidOptionError) as e:
+            rig.contacts(hand=hand)
+        assert str(e.value).startswith("hand[1] must be a RigidBody")
+    with pytest.raises(InvalidOptionError) as e:
+        rig.contacts(hand=(b for b in [rig.fingers[0], rig.object]))
+    assert "(hand=['hand::finger0', 'object::object'])" in str(e.value)
     # The diagram's root context resolves to the plant's; object_body positional.
     from_root = find_contacts(rig.plant, rig.root, rig.object)
     assert [c.psi for c in from_root] == [c.psi for c in rig.contacts()]
