@@ -237,6 +237,12 @@ class GraspMonitor(LeafSystem):
     :class:`~drakegrasp.systems.sample.GraspSample`).  Both are state: they
     change only at samples.
 
+    The monitor is a Python system that holds the plant it analyses, and has
+    no scalar conversion: ``Clone()`` and ``ToAutoDiffXd()`` of it, or of a
+    diagram that contains it, raise Drake's ``RuntimeError`` ("does not
+    support Cloning").  Build the diagram again for each copy (one per
+    process in a parallel sweep); a context can be cloned as usual.
+
     Raises
     ------
     InvalidOptionError

@@ -350,3 +350,24 @@ def test_an_invalid_analysis_keeps_the_last_valid_grip(resting):
     # The very loads of that sample, not this one's sensing.
     assert len(sample.loads) == len(before.loads) == 3
     assert all(a is b for a, b in zip(sample.loads, before.loads, strict=True))
+
+
+def test_a_diagram_with_the_monitor_does_not_clone_as_its_docstring_says():
+    # The docstring tells a user building parallel sweeps to build a diagram
+    # per copy; when Drake (or the monitor) learns to clone it, this fails
+    # and the docstring must change.  A context still clones, and the clone
+    # gives the same sample.
+    scene = Scene()
+    for convert in (scene.diagram.Clone, scene.monitor.Clone):
+        with pytest.raises(RuntimeError, match="does not support Cloning"):
+            convert()
+    with pytest.raises(RuntimeError, match="GraspMonitor"):
+        scene.diagram.ToAutoDiffXd()
+    assert "does not support Cloning" in dg.GraspMonitor.__doc__.replace("\n    ", " ")
+    scene.run(0.1)
+    copy = scene.context.Clone()
+    port = scene.monitor.GetOutputPort("verdicts")
+    np.testing.assert_array_equal(
+        port.Eval(scene.monitor.GetMyContextFromRoot(copy)),
+        port.Eval(scene.monitor.GetMyContextFromRoot(scene.context)),
+    )
