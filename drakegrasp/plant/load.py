@@ -478,10 +478,7 @@ class LoadReport:
                 tau = _named(self.joint_names, f.joint_torques, self.torque_units)
                 lines.append(f"  joint torques: {tau}")
             if self.actuator_torques is not None:
-                tau = _named(
-                    self.actuator_names, self.actuator_torques, self.actuator_units
-                )
-                lines.append(f"  actuator efforts (coupled, shared by limit): {tau}")
+                lines.append(self._actuator_line())
         elif f.certificate is not None:
             lines.append(f"  why not: {f.certificate}")
         alpha = math.nan if self.payload is None else self.payload.alpha
@@ -516,6 +513,31 @@ class LoadReport:
         )
         lines += [f"  WARNING: {w}" for w in self.warnings]
         return lines
+
+    def _actuator_line(self) -> str:
+        """The coupled hand's efforts, of the joints that have an actuator.
+
+        A follower without one (limit 0: a linkage's driven joint) makes no
+        effort by :func:`~drakegrasp.plant.couplings.split_coupled_torque`;
+        it is named apart, not listed as an actuator at 0.
+        """
+        limits = self.actuator_torque_limits
+        driven = [
+            i
+            for i in range(len(self.actuator_names))
+            if limits is None or limits[i] != 0.0
+        ]
+        units = self.actuator_units or ("",) * len(self.actuator_names)
+        tau = _named(
+            [self.actuator_names[i] for i in driven],
+            [self.actuator_torques[i] for i in driven],
+            [units[i] for i in driven],
+        )
+        line = f"  actuator efforts (coupled, shared by limit): {tau or 'none'}"
+        passive = [n for i, n in enumerate(self.actuator_names) if i not in driven]
+        if passive:
+            line += f" (no actuator, moved by their leaders: {', '.join(passive)})"
+        return line
 
     def __str__(self) -> str:
         return "\n".join(self.report_lines())
@@ -561,7 +583,7 @@ def _named(names, values, units, *, signed: bool = True) -> str:
     units = units or ("",) * len(names)
     form = "+.3g" if signed else ".4g"
     return ", ".join(
-        f"{n} {t:{form}}" + (f" {u}" if u else "")
+        f"{n} {t + 0.0:{form}}" + (f" {u}" if u else "")  # -0.0 reads 0
         for n, t, u in zip(names, values, units, strict=True)
     )
 

@@ -109,6 +109,28 @@ def test_a_coupled_actuator_adds_its_effort_to_its_leaders(franka_sugar):
     json.dumps(coupled.to_dict())
 
 
+def test_a_follower_without_an_actuator_is_not_listed_among_the_actuators(
+    franka_sugar,
+):
+    # A linkage's follower has no motor (limit 0): the report listed it among
+    # the "actuator efforts" at "-0 N".  The leader's motor now carries the
+    # coordinate alone, and the follower is named apart.
+    report = _analyze(
+        franka_sugar, couplings=[(J2, J1, -1.0, 0.0)], torque_limits=[20.0, 0.0]
+    )
+    load = report.load
+    np.testing.assert_array_equal(load.torque_limits, [20.0])
+    np.testing.assert_array_equal(load.actuator_torques[1], 0.0)
+    (line,) = [x for x in str(load).splitlines() if "actuator efforts" in x]
+    assert "panda_finger_joint2 " not in line.split("(no actuator")[0]
+    assert line.endswith("(no actuator, moved by their leaders: panda_finger_joint2)")
+    assert "-0 N" not in str(load)
+    # The joint torque the follower's share carried is its leader's now.
+    assert load.actuator_torques[0] == pytest.approx(
+        load.forces.joint_torques[0], rel=1e-9
+    )
+
+
 def test_given_limits_per_actuator_or_per_coordinate(franka_sugar):
     s = franka_sugar
     per_actuator = _analyze(
