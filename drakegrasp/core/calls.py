@@ -142,6 +142,8 @@ def _checked(
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
             return function(*args, **kwargs)
+        except GraspError:  # ours already (a TypeError too, some): it stands
+            raise
         except TypeError:
             if method and not args:  # a method read off its class, no instance
                 raise error(

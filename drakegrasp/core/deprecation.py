@@ -17,7 +17,7 @@ import warnings
 from collections.abc import Callable
 from typing import TypeVar
 
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import InvalidArgumentError, InvalidOptionError
 
 __all__ = ["keyword_only", "outside_stacklevel", "renamed_keyword", "warn_deprecated"]
 
@@ -159,6 +159,17 @@ def _replaced_object(frame):
     return frame.f_locals.get("obj", frame.f_locals.get("self"))
 
 
+class _PositionalError(InvalidArgumentError, InvalidOptionError):
+    """A call that gives keyword-only options by position, one too many or twice.
+
+    Python raises ``TypeError`` for such a call, as drakegrasp does for every
+    other call that does not fit a signature; these refusals were an
+    :class:`~drakegrasp.InvalidOptionError` (a ``ValueError``) when ``mu``
+    became keyword-only, and stay one, as numpy's ``AxisError`` is both a
+    ``ValueError`` and an ``IndexError``.
+    """
+
+
 def keyword_only(*names: str, after: int) -> Callable[[F], F]:
     """Accept ``names`` positionally (deprecated) where they are now keyword-only.
 
@@ -176,7 +187,10 @@ def keyword_only(*names: str, after: int) -> Callable[[F], F]:
         Wraps a function so that positional arguments from place ``after`` on
         warn and are passed as ``names[0]=``, ``names[1]=``, ...; more
         positional arguments than that, or a value given both ways, raise
-        :class:`~drakegrasp.InvalidOptionError`.
+        :class:`~drakegrasp.InvalidArgumentError` (a ``TypeError``, as Python
+        raises for such a call, and as :func:`~drakegrasp.core.calls.checked_call`
+        raises for the other calls that do not fit a signature) that is still
+        the :class:`~drakegrasp.InvalidOptionError` (a ``ValueError``) it was.
     """
     if not names:
         raise TypeError("keyword_only needs at least one parameter name")
@@ -200,14 +214,14 @@ def keyword_only(*names: str, after: int) -> Callable[[F], F]:
             if len(args) > after:
                 extra = args[after:]
                 if len(extra) > len(names):
-                    raise InvalidOptionError(
+                    raise _PositionalError(
                         f"{where} takes {after} positional arguments and "
                         f"{spelled} by keyword; got {len(args)} positional"
                     )
                 moved = names[: len(extra)]
                 for name in moved:
                     if name in kwargs:
-                        raise InvalidOptionError(
+                        raise _PositionalError(
                             f"{where} got {name} both by position and as {name}="
                         )
                 warn_deprecated(

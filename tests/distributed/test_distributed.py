@@ -55,14 +55,14 @@ def test_results_are_bitwise_the_local_engine(client, grasps):
 
 def test_positional_mu_warns_and_means_the_same(client, grasps):
     """``mu`` is keyword-only after the arrays, as in the batch functions."""
-    from drakegrasp import InvalidOptionError
+    from drakegrasp import InvalidArgumentError
 
     P, Nrm, mu = (a[:200] for a in grasps)
     new = evaluate_on_cluster(client, P, Nrm, mu=mu, chunk_size=100)
     with pytest.warns(DeprecationWarning, match="mu="):
         old = evaluate_on_cluster(client, P, Nrm, mu, chunk_size=100)
     assert old.d_star.tobytes() == new.d_star.tobytes()
-    with pytest.raises(InvalidOptionError, match="both by position"):
+    with pytest.raises(InvalidArgumentError, match="both by position"):
         evaluate_on_cluster(client, P, Nrm, mu, mu=mu)
 
 
