@@ -26,12 +26,15 @@ candidate or is counted under one rejection reason.
    reads on the applied candidate), and both fingers must touch.
 4. **Ranking**: verdicts, ε and robustness in the batch engine
    (:mod:`drakegrasp.planning.ranking`), weight capacity in one LP per grasp
-   (:mod:`drakegrasp.planning.weight`).
+   (:mod:`drakegrasp.planning.weight`); the squeeze (or torque) that holds
+   the weight ``m |g|``, ``|g|`` the magnitude of the plant's own gravity
+   field, as :func:`~drakegrasp.analyze_grasp` weighs the object.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from dataclasses import replace
 
@@ -99,7 +102,7 @@ from drakegrasp.planning.ranking import (
     rank_multifinger,
 )
 from drakegrasp.planning.surface import ObjectSurface, piece_of_shape
-from drakegrasp.planning.turned_gravity import GRAVITY
+from drakegrasp.planning.turned_gravity import plant_gravity
 from drakegrasp.planning.weight import centre_of_mass
 from drakegrasp.plant.attachment import free_carrier, how_held
 from drakegrasp.plant.couplings import plant_couplings
@@ -169,6 +172,28 @@ def _mass_of(ctx, body, object_mass) -> float:
         return float(object_mass)
     mass = body.get_mass(ctx)
     return mass if mass > 0 else float("nan")
+
+
+def _weight(mass: float, g: float) -> float:
+    """The weight planned for, ``m |g|`` (N); NaN for an unknown mass (NaN).
+
+    ``g``: the magnitude of the plant's gravity field
+    (:func:`~drakegrasp.planning.turned_gravity.plant_gravity`); 0 in a plant
+    without gravity, whose weight is then 0 (nothing to hold).
+
+    Raises
+    ------
+    ModelError
+        The body's own mass weighs more than a float holds in the plant's
+        gravity (a given ``object_mass`` is refused so before any work).
+    """
+    weight = mass * g
+    if math.isinf(weight):
+        raise ModelError(
+            f"the object's mass, {mass:g} kg, weighs more than a float holds in "
+            f"the plant's gravity, {g:g} m/s² (m g = inf N)"
+        )
+    return weight
 
 
 @checked_call
@@ -267,6 +292,18 @@ def plan_grasps(
     plant : MultibodyPlant
         Finalized, registered with a ``SceneGraph``; holds the hand (its base a
         free body), the object and anything else (a table, other objects).
+        The magnitude ``|g|`` of its gravity field
+        (``plant.gravity_field().gravity_vector()``, read once per call:
+        :func:`~drakegrasp.planning.turned_gravity.plant_gravity`) weighs the
+        object: ``squeeze_needed`` and ``torque_needed`` hold ``m |g|``, the
+        weight :func:`~drakegrasp.analyze_grasp` (``load="gravity"``) puts on
+        the same plant.  Its direction plays no part (the weight is held in
+        every direction of
+        :data:`~drakegrasp.planning.weight.WEIGHT_DIRECTIONS`).  A plant
+        without gravity weighs nothing: every candidate's ``squeeze_needed``
+        and ``torque_needed`` are 0 (no weight needs no effort), so none is
+        ranked behind the others for needing more than the motors give; the
+        scores (per newton of weight) are those of any other gravity.
     plant_context : Context
         The plant's context or its diagram's root.  The object's pose (and the
         scene's) is read from it; the hand's configuration is used as scratch
@@ -366,7 +403,8 @@ def plan_grasps(
         ``torque_needed`` and the ranking by it; default the body's mass (a
         cloud has none, nor has a massless body: NaN, and neither is
         computed).  Finite and > 0, with
-        a finite weight ``m g``, else ``InvalidOptionError``.  A figure it
+        a finite weight ``m |g|`` in the plant's gravity, else
+        ``InvalidOptionError``.  A figure it
         makes that exceeds the largest float (``--mass 1.7e307``: 1.67e308 N
         over a capacity below 1) is ``inf`` beside a capacity > 0, and said
         "beyond float range" (:mod:`~drakegrasp.planning.needed`).
@@ -425,7 +463,9 @@ def plan_grasps(
         another body, its base not among ``hand``'s bodies, or bodies of
         several free bodies) or without fingers; an object without graspable
         collision geometry, one that is not free to move (welded or jointed
-        to the world: it cannot be lifted), or one attached to the hand.
+        to the world: it cannot be lifted), or one attached to the hand; a
+        plant whose gravity is not finite, or in which the body's own mass
+        weighs more than a float holds.
     """
     t0 = time.perf_counter()
     n = _check_count(num_candidates)
@@ -453,11 +493,6 @@ def plan_grasps(
         raise InvalidOptionError(f"tilt must be in [0, pi/2] radians, got {tilt!r}")
     if object_mass is not None:
         object_mass = _check_positive("object_mass", object_mass, "kg")
-        if not np.isfinite(object_mass * GRAVITY):  # every figure would be inf
-            raise InvalidOptionError(
-                f"object_mass = {object_mass:g} kg weighs more than a float "
-                f"holds (m g = inf N)"
-            )
     if squeeze_limit is not None:
         squeeze_limit = check_squeeze_limit(squeeze_limit)
     if torque_limit is not None:
@@ -482,6 +517,12 @@ def plan_grasps(
     if contact_model == ContactModel.SOFT_FINGER.value and torsional_friction is None:
         raise missing_torsional_friction(InvalidOptionError)
     ctx = plant_context_of(plant, plant_context)
+    g = plant_gravity(plant)  # |g|, m/s²: the weight per kg, as analyze_grasp's
+    if object_mass is not None and not math.isfinite(object_mass * g):
+        raise InvalidOptionError(  # every figure would be inf
+            f"object_mass = {object_mass:g} kg weighs more than a float holds "
+            f"(m g = inf N at the plant's gravity, {g:g} m/s²)"
+        )
     q_planned = plant.GetPositions(ctx).copy()  # the joints not closed stay here
     if (object_body is None) == (point_cloud is None):
         raise InvalidOptionError(
@@ -520,7 +561,7 @@ def plan_grasps(
                 rng=np.random.default_rng(seed),
                 surface=object_surface(plant, ctx, body), settings=settings, t0=t0,
                 name=scoped_name(plant, body), certify=certify, workers=workers,
-                progress=progress, weight=mass * GRAVITY, **multi,
+                progress=progress, weight=_weight(mass, g), **multi,
             )  # fmt: skip
             closing = result.settings["hand"]["joints"]
             return _finished(mass, result, plant, q_planned, body, hand, closing)
@@ -531,6 +572,7 @@ def plan_grasps(
         reference = centre_of_mass(ctx, body, surface)
         name = scoped_name(plant, body)
         mass = _mass_of(ctx, body, object_mass)
+        weight = _weight(mass, g)
     else:
         body = None
         # a hand that cannot be placed is refused before the cloud is read
@@ -547,7 +589,7 @@ def plan_grasps(
                 plant, ctx, hand=hand, points=points, normals=normals,
                 viewpoint=viewpoint, n=n, mu=mu, rng=np.random.default_rng(seed),
                 settings=settings, t0=t0, certify=certify, workers=workers,
-                progress=progress, weight=mass * GRAVITY, complete=complete_unseen,
+                progress=progress, weight=_weight(mass, g), complete=complete_unseen,
                 **multi,
             )  # fmt: skip
             closing = result.settings["hand"]["joints"]
@@ -560,6 +602,7 @@ def plan_grasps(
         reference = np.zeros(3)  # the cloud's centre, the assumed centre of mass
         name = "point cloud"
         mass = np.nan if object_mass is None else float(object_mass)
+        weight = _weight(mass, g)
         settings.update(
             cloud_points=len(points),
             cloud_dropped=dropped,
@@ -614,7 +657,7 @@ def plan_grasps(
         kept, finger_names=closer.finger_names, gripper=gripper, plant=plant, mu=mu,
         contact_model=contact_model, nu=torsional_friction, torque_scale=torque_scale,
         samples=robustness_samples, noise=noise, rng=rng, certify=certify,
-        workers=workers, X_WO=X_WO, weight=mass * GRAVITY, weight_check=weight_check,
+        workers=workers, X_WO=X_WO, weight=weight, weight_check=weight_check,
         surface=FittedCloud(surface) if body is None else surface, tol=tol,
         reference=reference,
     )  # fmt: skip

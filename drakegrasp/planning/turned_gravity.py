@@ -1,6 +1,7 @@
 """Gravity turned around a grasped object: the shake test's load schedule.
 
-Gravity (``m g``, on the object only, at its centre of mass) is zero while the
+Gravity (``m g``, on the object only, at its centre of mass; ``g`` the
+magnitude of the plant's own gravity field, :func:`plant_gravity`) is zero while the
 fingers seat, held along the world's −z while the grasp settles, then turned
 through a sequence of directions, each held for a phase; between two
 directions it turns along the great circle through them at a constant rate,
@@ -11,17 +12,64 @@ to the plant as an externally applied spatial force.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce
 from pydrake.systems.framework import LeafSystem
 
-__all__ = ["DEFAULT_DIRECTIONS", "GRAVITY"]
+from drakegrasp.errors import ModelError
+
+__all__ = ["DEFAULT_DIRECTIONS", "GRAVITY", "plant_gravity"]
 
 GRAVITY = 9.81
-"""Standard gravity, m/s²: the turned gravity's magnitude, and the planner's for
-the weight that ``squeeze_needed`` and ``torque_needed`` hold."""
+"""Standard gravity, m/s²: the strength of Drake's default gravity field.
+
+No longer the weight's magnitude: the planner (``squeeze_needed``,
+``torque_needed``) and the shake test weigh the object with the plant's own
+field (:func:`plant_gravity`), as ``analyze_grasp(load="gravity")`` does.  It
+bounds the checks made before any plant is built (an ``object_mass`` whose
+weight at standard gravity is no float is refused before a shake test
+simulates anything) and stays importable for the callers that used it."""
+
+
+def plant_gravity(plant) -> float:
+    """The magnitude ``|g|`` (m/s²) of the plant's gravity field: N per kg of weight.
+
+    ``plant.gravity_field().gravity_vector()`` in the world frame, as
+    :func:`~drakegrasp.plant.load.gravity_wrench` reads it; only its length
+    is used (the planner holds the weight in every direction, the shake test
+    turns it around).  9.81 exactly for Drake's default field; 0 for a plant
+    whose gravity was set to zero.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized or not: the field is read as it stands.
+
+    Returns
+    -------
+    float
+        ``|g| >= 0``, finite.
+
+    Raises
+    ------
+    ModelError
+        A field that is not finite (Drake takes ``inf`` and NaN), or whose
+        length is no float (components near 1e308), named with its vector.
+    """
+    g_W = np.asarray(plant.gravity_field().gravity_vector(), dtype=float)
+    g = math.hypot(*g_W)  # |(0, 0, -9.81)| is 9.81 to the bit; no overflow inside
+    if not math.isfinite(g):
+        raise ModelError(
+            f"the plant's gravity field {g_W.tolist()} m/s² has no finite "
+            "magnitude: set a finite one (plant.mutable_gravity_field()"
+            ".set_gravity_vector) to weigh the object with"
+        )
+    return g
+
 
 DEFAULT_DIRECTIONS = (
     (1.0, 0.0, 0.0),

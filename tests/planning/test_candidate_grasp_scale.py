@@ -17,7 +17,7 @@ import pytest
 
 import drakegrasp as dg
 from drakegrasp.planning import plan_grasps, planning_scene
-from drakegrasp.planning.planner import GRAVITY
+from drakegrasp.planning.turned_gravity import plant_gravity
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS
 
 ROUNDED = "package://drakegrasp/hands/parallel_jaw.sdf"
@@ -32,7 +32,7 @@ def soft_plan():
         contact_model="soft_finger", torsional_friction=0.05,
     )  # fmt: skip
     ctx = scene.plant.GetMyContextFromRoot(scene.context)
-    return result, scene.object_body.get_mass(ctx) * GRAVITY
+    return result, scene.object_body.get_mass(ctx) * plant_gravity(scene.plant)
 
 
 def test_the_grasp_carries_the_runs_torque_scale(soft_plan):
