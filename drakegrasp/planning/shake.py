@@ -23,9 +23,16 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
   stopped.  (Aimed from the planned joint values instead, a finger planned
   0.5 mm inside the object would press ``0.5 mm · k`` harder: 2 N more at
   the WSG-50's default gains);
-- the object is free; gravity (``9.81 m/s²``, the plant's own gravity field is
-  set to zero) acts on the object only, as an external force at its centre of
-  mass, zero while the fingers seat, whose direction is then held for
+- the object is free; gravity acts on the object only, as an external force
+  ``m |g|`` at its centre of mass, where ``|g|`` is the magnitude of the
+  gravity field of the plant ``add_models`` built (9.81 m/s² by Drake's
+  default; read once, before that field is set to zero, so that the hand
+  feels none): the weight that
+  :func:`~drakegrasp.planning.planner.plan_grasps` and
+  :func:`~drakegrasp.analyze_grasp` put on the object in that plant.  A
+  plant without gravity is refused (``ModelError``): an object that weighs
+  nothing is held by every grasp, so the test would say nothing.  The force
+  is zero while the fingers seat; its direction is then held for
   ``settle`` seconds along the world's ``−z`` and then turned through
   ``directions`` (each held for ``phase`` seconds; over the first ``blend``
   seconds of a phase gravity turns from the previous direction to the next
@@ -81,6 +88,7 @@ from drakegrasp.planning.turned_gravity import (
     GRAVITY,
     _schedule,
     _TurnedGravity,
+    plant_gravity,
 )
 from drakegrasp.plant.couplings import motor_shares, plant_couplings
 from drakegrasp.plant.fingers import (
@@ -375,8 +383,43 @@ contact solver stopped on objects of 1e-12 kg against a gripper's gains (the
 fuzz suite); no hand grasps anything that light."""
 
 
+def _weightless(plant) -> str:
+    """Why a plant without gravity is not shaken, and what to do."""
+    g_W = np.asarray(plant.gravity_field().gravity_vector(), dtype=float)
+    return (
+        f"the plant that add_models built has gravity {g_W.tolist()} m/s²: "
+        "the shake test turns the object's weight around the grasp, and an "
+        "object that weighs nothing is held by every grasp, so the test would "
+        "say nothing; give that plant the gravity to shake under in add_models "
+        "(plant.mutable_gravity_field().set_gravity_vector([0, 0, -9.81]), or "
+        "the acceleration the grasp must bear)"
+    )
+
+
+def _checked_weight(mass: float, g: float) -> float:
+    """``m |g|`` (N), the turned gravity's magnitude, refused unless finite > 0.
+
+    ``mass`` (kg) is checked at standard gravity before the plant is built
+    (:func:`_check_mass`); in a plant of stronger gravity its weight may
+    still be no float, and in one of subnormal gravity it may be 0.
+    """
+    weight = mass * g
+    if not 0.0 < weight < math.inf:
+        raise ModelError(
+            f"the object's {mass:g} kg in the plant's gravity, {g:g} m/s², "
+            f"weighs {weight:g} N: the shake test needs a finite weight > 0 "
+            "(give the plant that add_models builds another gravity)"
+        )
+    return weight
+
+
 def _check_mass(name: str, mass: float) -> None:
-    """Refuse a mass (kg) the shake cannot simulate, naming ``name``."""
+    """Refuse a mass (kg) the shake cannot simulate, naming ``name``.
+
+    Its weight is taken at standard gravity (:data:`GRAVITY`): the plant's
+    own is not known before ``add_models`` builds it, where
+    :func:`_checked_weight` checks the weight again.
+    """
     if not math.isfinite(mass * GRAVITY):
         raise InvalidOptionError(
             f"{name} = {mass:g} kg weighs more than a float holds (its weight "
@@ -753,6 +796,11 @@ def shake_test(
         base not welded) and the object to a fresh plant, as for planning;
         ``hand`` a model instance, ``object_body`` a body or its scoped name.
         Leave out supports such as a table: the test turns gravity around.
+        The magnitude of the gravity field it leaves the plant with is the
+        turned gravity's (``ShakeResult.gravity``; Drake's default 9.81 m/s²):
+        set it here (``plant.mutable_gravity_field().set_gravity_vector``) to
+        shake under the gravity the grasp was planned in, a moon's or a
+        scaled scene's.  A field of zero is refused.
     candidate : GraspCandidate
         From :func:`~drakegrasp.planning.planner.plan_grasps`.
     squeeze : float or None, optional
@@ -868,7 +916,9 @@ def shake_test(
         ``add_models`` did not add the candidate's hand base or closing joints
         or welded the base itself, its object has no mass and no
         ``object_mass`` is given (gravity would pull on nothing and every grasp
-        would hold), or Drake refused to
+        would hold), its plant has no gravity (the same: set the gravity to
+        shake under in ``add_models``), a gravity that is not finite or in
+        which the object's weight is no float, or Drake refused to
         advance the model for another reason (its first sentence is in the
         message).
     InvalidGraspError
@@ -941,6 +991,9 @@ def shake_test(
     hand, obj = made
     if object_body is not None:
         obj = object_body
+    g = plant_gravity(plant)  # |g| as add_models left it, before it is zeroed
+    if g == 0.0:
+        raise ModelError(_weightless(plant))
     base = resolve_body(plant, candidate.hand_base)
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
     by_name = {_scoped(plant, a.joint()): a for a in actuators}
@@ -1036,8 +1089,9 @@ def shake_test(
     if object_mass is None:
         object_mass = _planned_mass(planned, body)
     mass, com, inertia = _object_inertia(body, object_mass, candidate)
+    weight = _checked_weight(mass, g)
     schedule = _schedule(seat, settle, phase, blend, dirs)
-    gravity = builder.AddSystem(_TurnedGravity(body.index(), mass, com, schedule))
+    gravity = builder.AddSystem(_TurnedGravity(body.index(), weight, com, schedule))
     builder.Connect(
         gravity.get_output_port(), plant.get_applied_spatial_force_input_port()
     )
@@ -1206,4 +1260,5 @@ def shake_test(
         X_WH=candidate.X_WH.GetAsMatrix4(),
         gains=used,
         object_mass=mass,
+        gravity=g,
     )

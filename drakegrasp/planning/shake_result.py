@@ -130,6 +130,11 @@ class ShakeResult:
         The object's mass (kg) that gravity pulled on and the simulation
         moved: the model's, or ``shake_test``'s ``object_mass``.  NaN in a
         record made before it existed.
+    gravity : float
+        The magnitude (m/s²) of the turned gravity: that of the gravity field
+        of the plant ``add_models`` built, so the object weighed
+        ``object_mass × gravity`` newtons.  NaN in a record made before it
+        existed (those shook with 9.81).
     """
 
     held: bool
@@ -158,6 +163,7 @@ class ShakeResult:
     gains: tuple[tuple[float, float], ...] = ()
     object_mass: float = float("nan")
     squeeze_at_contacts: bool = False
+    gravity: float = float("nan")
 
     def seated(self, candidate):
         """``candidate`` with the hand's joints and the object where seating left them.

@@ -84,11 +84,16 @@ consecutive pair orthogonal: every blend turns gravity by 90°)."""
 
 
 class _TurnedGravity(LeafSystem):
-    """Outputs ``m g(t)`` on one body at its centre of mass (world frame)."""
+    """Outputs ``m g(t)`` on one body at its centre of mass (world frame).
 
-    def __init__(self, body_index, mass, p_BoBcm_B, schedule):
+    ``weight``: ``m |g|`` (N), the force's magnitude while gravity acts;
+    ``schedule(t)``: its unit direction, or zero (:func:`_schedule`).
+    """
+
+    def __init__(self, body_index, weight: float, p_BoBcm_B, schedule):
         super().__init__()
-        self._body, self._mass, self._com = body_index, mass, np.asarray(p_BoBcm_B)
+        self._body, self._weight = body_index, float(weight)
+        self._com = np.asarray(p_BoBcm_B)
         self._schedule = schedule
         self.DeclareAbstractOutputPort(
             "spatial_forces",
@@ -101,7 +106,7 @@ class _TurnedGravity(LeafSystem):
         force.body_index = self._body
         force.p_BoBq_B = self._com
         g = self._schedule(context.get_time())
-        force.F_Bq_W = SpatialForce(np.zeros(3), self._mass * GRAVITY * g)
+        force.F_Bq_W = SpatialForce(np.zeros(3), self._weight * g)
         output.set_value([force])
 
 
