@@ -149,10 +149,13 @@ diagram.ForcedPublish(root)
 # `dg.shake_test` welds the hand at `X_WH`, holds the fingers with Drake's
 # PD-controlled actuators pressing with a set squeeze, lets the object free and
 # turns gravity through six directions.  A light squeeze, 1.5 times the box's
-# weight per finger, separates well-placed grasps from the others.
+# weight per finger, separates well-placed grasps from the others.  The weight
+# is the mass times the strength of the plant's gravity field, as the planner
+# and the shake weigh it.
 
 # %%
-weight = scene.object_body.default_mass() * 9.81
+g = np.linalg.norm(scene.plant.gravity_field().gravity_vector())  # 9.81 m/s²
+weight = scene.object_body.default_mass() * g
 squeeze = 1.5 * weight
 kw = dict(settle=0.2, phase=0.3) if TEST_MODE else {}
 print("best:", dg.shake_test(scene.add_models, best, squeeze=squeeze, **kw))
