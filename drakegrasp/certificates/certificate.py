@@ -61,6 +61,7 @@ from drakegrasp.certificates.kinds import (
     BALANCE,
     DEFAULT_CHECK_TOL,
     ESCAPE_TWIST,
+    INTERIOR_SLACK,
     UNCONTROLLABLE,
     UNRESISTED_WRENCH,
     CertificateCheck,
@@ -275,16 +276,20 @@ def check_certificate(
     else:
         assert read.kind == BALANCE
         violation, slack, detail = _check_balance(read, grasp)
-        if math.isfinite(violation) and not slack > 0.0:
+        if math.isfinite(violation) and not slack > INTERIOR_SLACK:
             # "Strictly inside every cone": a force on a cone's boundary (or
             # outside it by less than tol) proves no force closure; it held for
-            # the boundary grasp whose "no" witness held too.
+            # the boundary grasp whose "no" witness held too.  On the boundary
+            # the slack is roundoff of either sign, hence the floor.
             return CertificateCheck(
                 holds=False,
                 violation=float(max(violation, -slack)),
                 slack=float(slack),
                 tol=float(tol),
-                detail=f"{detail}; not strictly inside every cone (slack <= 0)",
+                detail=(
+                    f"{detail}; not strictly inside every cone (slack "
+                    f"{slack:.2g} <= {INTERIOR_SLACK:.2g}, roundoff of the boundary)"
+                ),
             )
     return CertificateCheck.evaluated(violation, slack, tol, detail)
 

@@ -22,6 +22,7 @@ from drakegrasp.errors import InvalidOptionError
 __all__ = [
     "BALANCE",
     "DEFAULT_CHECK_TOL",
+    "INTERIOR_SLACK",
     "ESCAPE_TWIST",
     "UNCONTROLLABLE",
     "UNRESISTED_WRENCH",
@@ -44,6 +45,17 @@ DEFAULT_CHECK_TOL = 1e-7
 """Relative tolerance of :meth:`drakegrasp.certificates.certificate.Certificate.check`.
 
 Violations are scaled to 1 before they are compared with it.
+"""
+
+INTERIOR_SLACK = 64 * 2.0**-52
+"""How far inside every cone (relative to ``Σ f_n``) a balancing internal force
+must lie to be strictly inside, ≈ 1.4e-14.
+
+A force on a cone's boundary computes within a few roundings of 0, of either
+sign: the planar square's boundary witness read ``-1e-17`` with one numpy
+build and ``+2.8e-17`` with another (numpy 2.4), and held there.  A witness
+this close to a boundary proves nothing either way; one strictly inside by
+more than roundoff (``1e-7`` at ``μ = 0.5000001``) still holds.
 """
 
 

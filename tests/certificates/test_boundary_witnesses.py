@@ -26,8 +26,10 @@ def yes():
 
 @pytest.mark.parametrize("mu", [0.5, 0.4999999, 0.4])
 def test_a_balancing_force_on_or_past_the_boundary_proves_nothing(yes, mu):
+    from drakegrasp.certificates.kinds import INTERIOR_SLACK
+
     got = yes.check(ex.planar_two_finger_square(mu))
-    assert not got.holds and got.slack <= 0.0
+    assert not got.holds and got.slack <= INTERIOR_SLACK
     assert "not strictly inside every cone" in got.detail
 
 
@@ -102,3 +104,20 @@ def test_an_axis_nearly_in_the_null_space_is_taken_as_the_span_holds_it(tilt):
     assert not result.is_closure
     assert result.certificate.null_basis.shape[1] == 6 - result.rank
     assert result.certificate.check(grasp).holds
+
+
+@pytest.mark.parametrize(
+    ("delta", "holds"), [(0.0, False), (1e-15, False), (1e-12, True)]
+)
+def test_a_force_inside_by_roundoff_is_on_the_boundary(yes, delta, holds):
+    # On the boundary the slack is roundoff of either sign: one numpy build
+    # computed -1e-17 at mu = 0.5, numpy 2.4 computed +2.8e-17, and the "yes"
+    # held beside the grasp's own "no".  A force inside by less than
+    # INTERIOR_SLACK (64 eps of sum f_n) proves nothing; inside by 1e-12 holds.
+    from drakegrasp.certificates.kinds import INTERIOR_SLACK
+
+    got = yes.check(ex.planar_two_finger_square(0.5 + delta))
+    assert got.holds is holds
+    assert (got.slack > INTERIOR_SLACK) is holds
+    if not holds:
+        assert "roundoff of the boundary" in got.detail
