@@ -251,6 +251,142 @@ class ArraySubclass(np.ndarray):
     """A numpy subclass (what a library's own array type is)."""
 
 
+class ReprRaises:
+    """An object whose ``repr()`` raises (a message that names it must not)."""
+
+    __repr__ = _boom
+
+
+class ReprNotStr:
+    """An object whose ``__repr__`` returns an int: ``repr()`` raises TypeError."""
+
+    def __repr__(self):
+        return 42
+
+
+HUGE = 10**7
+"""Characters of a huge ``repr``: a message must not carry them all."""
+
+
+class ReprHuge:
+    """An object whose ``repr()`` is 10**7 characters long."""
+
+    def __repr__(self):
+        return "x" * HUGE
+
+
+class StrRaises:
+    """An object whose ``str()`` raises (its ``repr`` is fine)."""
+
+    __str__ = _boom
+
+    def __repr__(self):
+        return "StrRaises()"
+
+
+class FormatRaises:
+    """An object whose ``format()`` raises, so ``f"{x}"`` and ``f"{x:g}"`` do."""
+
+    __format__ = _boom
+
+    def __repr__(self):
+        return "FormatRaises()"
+
+
+class FloatReprRaises(float):
+    """A float (0.5) that passes ``isinstance(x, float)``; repr, str, format raise."""
+
+    __repr__ = _boom
+    __str__ = _boom
+    __format__ = _boom
+
+
+class FloatReprHuge(float):
+    """A float (0.5) whose ``repr()`` and ``str()`` are 10**7 characters long."""
+
+    def __repr__(self):
+        return "5" * HUGE
+
+    __str__ = __repr__
+
+
+class IntReprRaises(int):
+    """An int (2) whose repr, str and format raise."""
+
+    __repr__ = _boom
+    __str__ = _boom
+    __format__ = _boom
+
+
+class StrReprRaises(str):
+    """A str whose ``repr()`` raises (its ``str()`` and format are a str's)."""
+
+    __repr__ = _boom
+
+
+class StrFormatRaises(str):
+    """A str whose ``str()`` and ``format()`` raise (its ``repr`` is fine)."""
+
+    __str__ = _boom
+    __format__ = _boom
+
+
+class ArrayReprRaises(np.ndarray):
+    """A numpy array subclass whose repr, str and format raise."""
+
+    __repr__ = _boom
+    __str__ = _boom
+    __format__ = _boom
+
+
+class ListReprRaises(list):
+    """A list whose repr, str and format raise."""
+
+    __repr__ = _boom
+    __str__ = _boom
+    __format__ = _boom
+
+
+class TupleReprRaises(tuple):
+    """A tuple whose repr, str and format raise."""
+
+    __repr__ = _boom
+    __str__ = _boom
+    __format__ = _boom
+
+
+class DictReprRaises(dict):
+    """A dict whose repr, str and format raise."""
+
+    __repr__ = _boom
+    __str__ = _boom
+    __format__ = _boom
+
+
+def repr_hostile() -> list:
+    """Fresh objects whose repr, str or format raise, lie or are huge.
+
+    Some are plain objects; the others also pass for what a parameter wants
+    (a float, an int, a str, an array, a list, a tuple, a dict), so a check
+    can let them through and a message built later still meets their repr.
+    """
+    objects = [
+        ReprRaises(), ReprNotStr(), ReprHuge(), StrRaises(), FormatRaises(),
+        FloatReprRaises(0.5), FloatReprRaises("nan"), FloatReprHuge(0.5),
+        FloatReprHuge(-1.0), IntReprRaises(2), IntReprRaises(-1),
+        StrReprRaises("x"), StrReprRaises("hard_finger"),
+        StrReprRaises("package://nope/x.sdf"), StrFormatRaises("x"),
+        np.ones(3).view(ArrayReprRaises), np.ones((2, 3, 3)).view(ArrayReprRaises),
+        np.array(0.5).view(ArrayReprRaises), np.zeros((0, 3)).view(ArrayReprRaises),
+        ListReprRaises([0.5, 0.5, 0.5]), ListReprRaises([ReprRaises()]),
+        TupleReprRaises((0.5, 0.5, 0.5)), DictReprRaises(), DictReprRaises(a=1),
+        [ReprRaises(), 0.5, 0.5], {"x": ReprRaises()}, {ReprRaises(): 1},
+        np.array([ReprRaises(), 0.5, 0.5], dtype=object),
+        np.array([ReprHuge()], dtype=object),
+    ]  # fmt: skip
+    return objects
+
+
 def _register():
     import numbers
 
@@ -283,6 +419,7 @@ def objects() -> list:
         fractions.Fraction(1, 2), decimal.Decimal("0.5"), decimal.Decimal("sNaN"),
         np.broadcast_to(0.5, (10**9, 3)), np.ones((4, 3))[::2],
         _readonly(np.ones((2, 3))), [[0.5, 0.5, 0.5], LyingLength()],
+        *repr_hostile(),
     ]  # fmt: skip
 
 

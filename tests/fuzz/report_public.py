@@ -14,7 +14,9 @@ check), calls it and draws a few items of what it yields.  A
 Anything else is a *raw kind*, keyed by the callable, the exception's type
 and the ``file:line`` that raised it (the innermost frame inside drakegrasp,
 so a hostile object's own dunder is not the key); a call still running after
-``--limit`` seconds (default 4) is the kind ``TIMEOUT``.
+``--limit`` seconds (default 4) is the kind ``TIMEOUT``, and a GraspError
+whose message is longer than :data:`LONG` characters (a huge ``repr`` carried
+into it whole) is the kind ``LONG_MESSAGE``.
 
 It prints the number of calls, then one line per raw kind: how many calls
 met it, its key, and the first such call (arguments and message).  The
@@ -126,6 +128,28 @@ def _cap_memory(extra: int) -> None:
     resource.setrlimit(resource.RLIMIT_DATA, (held + extra, resource.RLIM_INFINITY))
 
 
+LONG = 10_000
+"""Characters beyond which a GraspError's message counts as a raw kind."""
+
+
+def _shown(value, width: int = 120) -> str:
+    """``repr(value)`` cut to ``width``, or its type if the repr raises or lies.
+
+    The report's own printing must survive the hostile objects it passes.
+    """
+    try:
+        text = repr(value)
+        if type(text) is not str:
+            raise TypeError("not a str")  # noqa: TRY301
+    except Exception:  # noqa: BLE001 - a hostile __repr__
+        return f"<{type(value).__name__}: repr raised>"
+    return text[:width]
+
+
+class LONG_MESSAGE(Exception):  # noqa: N801 - the kind's name in the report
+    """A GraspError whose message is longer than :data:`LONG` characters."""
+
+
 class _Timeout(BaseException):
     """Raised by SIGALRM: a BaseException, so no ``except Exception`` eats it."""
 
@@ -168,7 +192,10 @@ def _call(function, args, keywords, limit: float) -> BaseException | None:
         if inspect.isgenerator(result) or hasattr(result, "__next__"):
             for _ in zip(range(3), result, strict=False):
                 pass
-    except dg.GraspError:
+    except dg.GraspError as error:
+        if len(str(error)) > LONG:
+            long = LONG_MESSAGE(f"{len(str(error))} characters: {str(error)[:100]}")
+            return long.with_traceback(error.__traceback__)
         return None
     except BaseException as error:  # noqa: BLE001 - what the report counts
         return error
@@ -215,7 +242,15 @@ def run(seed: int, budget: float, limit: float):
             if error is not None:
                 key = _kind(name, error)
                 counts[key] += 1
-                kinds.setdefault(key, (*arguments, str(error)[:200]))
+                args, keywords = arguments
+                kinds.setdefault(
+                    key,
+                    (
+                        [_shown(a) for a in args],
+                        {k: _shown(v) for k, v in keywords.items()},
+                        str(error)[:200],
+                    ),
+                )
     finally:
         signal.signal(signal.SIGALRM, old)
     return calls, {key: (counts[key], first) for key, first in kinds.items()}
