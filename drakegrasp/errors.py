@@ -8,9 +8,30 @@ from __future__ import annotations
 
 from typing import Any
 
+MAX_MESSAGE = 10_000
+"""Characters of a message beyond which :class:`GraspError` cuts it.
+
+Messages name the offending value; a value whose ``repr`` is megabytes long
+(a user's own type) must not make a megabyte message, in a log or on a
+terminal.  Messages cut a value themselves, to about 120 characters
+(:func:`~drakegrasp.core.validation.describe`); this bound is the last guard.
+"""
+
 
 class GraspError(Exception):
-    """Base class of every error raised by drakegrasp."""
+    """Base class of every error raised by drakegrasp.
+
+    A message longer than :data:`MAX_MESSAGE` characters is cut to at most that
+    length, saying how much was cut.
+    """
+
+    def __init__(self, *args: Any):
+        if args and isinstance(args[0], str) and len(args[0]) > MAX_MESSAGE:
+            message = str.__str__(args[0])
+            kept = MAX_MESSAGE - 50  # room for the note: a cut message stays whole
+            note = f"... ({len(message) - kept} characters cut)"
+            args = (message[:kept] + note, *args[1:])
+        super().__init__(*args)
 
 
 class InvalidContactError(GraspError, ValueError):

@@ -143,17 +143,36 @@ JACOBIAN_BOUND = 1e100
 """Largest absolute entry of a hand Jacobian."""
 
 
+DESCRIBE_WIDTH = 120
+"""Characters of a value's ``repr`` that :func:`describe` keeps."""
+
+
 def describe(value) -> str:
     """``repr(value)`` on one line, cut to 120 characters, for a message.
 
-    A ``repr`` that raises is no reason to lose the message: the value is then
-    named by its type.
+    A ``repr`` that raises, returns something other than a ``str`` or is
+    huge is no reason to lose the message or to make it huge: the value is
+    then named by its type, and a long ``repr`` is cut before it is read
+    (a user's ``float`` or ``str`` subclass may carry any of these, even
+    after an ``isinstance`` check).
     """
     try:
-        text = " ".join(repr(value).split())
+        text = repr(value)
+        # A str subclass passes repr(); read it as a plain str, whose
+        # methods its own cannot override.
+        text = str.__getitem__(text, slice(0, 4 * DESCRIBE_WIDTH))
     except Exception as err:  # noqa: BLE001 - a hostile __repr__
-        text = f"<{type(value).__name__} whose repr() raised {type(err).__name__}>"
-    return text if len(text) <= 120 else text[:117] + "..."
+        return f"<{_type_name(value)} whose repr() raised {_type_name(err)}>"
+    text = " ".join(text.split())
+    if len(text) <= DESCRIBE_WIDTH:
+        return text
+    return text[: DESCRIBE_WIDTH - 3] + "..."
+
+
+def _type_name(value) -> str:
+    """The name of ``value``'s type, or ``"object"`` if even that misbehaves."""
+    name = getattr(type(value), "__name__", None)
+    return str.__str__(name) if isinstance(name, str) else "object"
 
 
 def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
