@@ -39,6 +39,7 @@ from drakegrasp.core.tolerances import (
     DEFAULT_TOL,
     ZERO_FRACTION,
 )
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -669,7 +670,9 @@ def iter_batch_closure(
         their chunk.
     """
     if not isinstance(kind, str) or kind not in ("force", "form"):
-        raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
+        raise InvalidOptionError(
+            f"kind must be 'force' or 'form', got {describe(kind)}"
+        )
     try:
         items = iter(chunks)
     except Exception:  # noqa: BLE001 - not iterable, or a hostile __iter__

@@ -52,7 +52,7 @@ def positive_int(name: str, value, minimum: int) -> int:
     n = integer_or_none(value)
     if n is None or n < minimum:
         raise InvalidOptionError(
-            f"{name} must be an integer >= {minimum}, got {value!r}"
+            f"{name} must be an integer >= {minimum}, got {describe(value)}"
         )
     return int(n)
 
@@ -256,7 +256,8 @@ def check_metrics(metrics: Sequence[str]) -> tuple[str, ...]:
     for name in names:
         if not isinstance(name, str) or name not in METRICS:
             raise InvalidOptionError(
-                f"unknown metric {name!r}; valid metrics are {', '.join(METRICS)}"
+                f"unknown metric {describe(name)}; valid metrics are "
+                f"{', '.join(METRICS)}"
             )
     return names
 
@@ -285,7 +286,7 @@ def check_kernel(kernel: str) -> str:
     """``kernel`` if it is one of :data:`KERNELS` (not resolved)."""
     if not isinstance(kernel, str) or kernel not in KERNELS:
         raise InvalidOptionError(
-            f"kernel must be 'auto', 'numba' or 'numpy', got {kernel!r}"
+            f"kernel must be 'auto', 'numba' or 'numpy', got {describe(kernel)}"
         )
     return kernel
 

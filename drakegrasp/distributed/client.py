@@ -12,6 +12,7 @@ import threading
 import traceback
 from collections.abc import Iterator, Sequence
 
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["HANDSHAKE_GRACE", "client_for", "connected", "results_or_cancel"]
@@ -77,7 +78,7 @@ def client_for(client_or_address, *, timeout: float | None = None):
         port = client_or_address.rpartition(":")[2]
         if port.isdigit() and not 0 < int(port) < 65536:  # Dask waited 30 s
             raise InvalidOptionError(
-                f"the scheduler address {client_or_address!r} has port {port}; "
+                f"the scheduler address {describe(client_or_address)} has port {port}; "
                 "a port is in 1..65535"
             )
         seconds = _connect_timeout(timeout)
@@ -102,13 +103,14 @@ def client_for(client_or_address, *, timeout: float | None = None):
             _clear_frames(error)
             gc.collect()
         raise InvalidOptionError(
-            f"could not connect to the Dask scheduler at {client_or_address!r}: "
+            "could not connect to the Dask scheduler at "
+            f"{describe(client_or_address)}: "
             f"{_failure(error, seconds, shook_hands, reply)}"
         ) from error
     if not isinstance(client_or_address, Client):
         raise InvalidOptionError(
             "client must be a distributed.Client or a scheduler address such as "
-            f"'tcp://host:8786', got {client_or_address!r}"
+            f"'tcp://host:8786', got {describe(client_or_address)}"
         )
     return client_or_address
 
@@ -178,7 +180,7 @@ def _connect_timeout(timeout) -> float:
         or not 0 < timeout < math.inf
     ):
         raise InvalidOptionError(
-            f"{name} must be a positive number of seconds, got {timeout!r}"
+            f"{name} must be a positive number of seconds, got {describe(timeout)}"
         )
     return float(timeout)
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.validation import integer_or_none
+from drakegrasp.core.validation import describe, integer_or_none
 from drakegrasp.distributed.client import connected, results_or_cancel
 from drakegrasp.errors import GraspError, InvalidOptionError
 from drakegrasp.plant.options import AnalysisOptions, checked_options
@@ -127,7 +127,8 @@ def analyze_poses(
     n = integer_or_none(block)
     if n is None or n < 1:
         raise InvalidOptionError(
-            f"block (configurations per task) must be an integer >= 1, got {block!r}"
+            "block (configurations per task) must be an integer >= 1, got "
+            f"{describe(block)}"
         )
     block = n
     q = _configurations(positions)

@@ -45,7 +45,7 @@ from drakegrasp.core.tolerances import (
     DEFAULT_RANK_TOL,
     DEFAULT_TOL,
 )
-from drakegrasp.core.validation import check_flag
+from drakegrasp.core.validation import check_flag, describe
 from drakegrasp.errors import BatchFileError, InvalidOptionError
 
 __all__ = ["evaluate_file", "stream_file", "write_result"]
@@ -62,7 +62,9 @@ def _file_run(
     engine options (``tol``, ``metrics``, ...).
     """
     if not isinstance(kind, str) or kind not in ("force", "form"):
-        raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
+        raise InvalidOptionError(
+            f"kind must be 'force' or 'form', got {describe(kind)}"
+        )
     overwrite = check_flag("overwrite", overwrite)
     source = as_path("input", input_path)
     output = as_path("output", output_path)

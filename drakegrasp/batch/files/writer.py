@@ -124,8 +124,9 @@ def format_of(path: str | os.PathLike, fmt: str | None = None) -> str:
     if fmt is not None:
         if not isinstance(fmt, str) or fmt not in FORMATS:
             raise InvalidOptionError(
-                f"format must be one of {', '.join(FORMATS)}, got {fmt!r}"
+                f"format must be one of {', '.join(FORMATS)}, got {describe(fmt)}"
             )
+        fmt = str.__str__(fmt)  # a plain str: a subclass's repr or format may raise
         if suffix in FORMATS and suffix != fmt:
             raise InvalidOptionError(
                 f"output file {str(path)!r} ends in .{suffix} but the format is "

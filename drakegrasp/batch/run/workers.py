@@ -43,7 +43,7 @@ from drakegrasp.batch.run.shared_arrays import (
     resolve,
     store_result,
 )
-from drakegrasp.core.validation import integer_or_none
+from drakegrasp.core.validation import describe, integer_or_none
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -86,7 +86,8 @@ def check_workers(workers) -> int | None:
     n = integer_or_none(workers)  # bools are not counts (True was one worker)
     if n is None or n < 1:
         raise InvalidOptionError(
-            f"workers must be None (every core) or an integer >= 1, got {workers!r}"
+            "workers must be None (every core) or an integer >= 1, got "
+            f"{describe(workers)}"
         )
     most = max(MAX_WORKERS, available_cores())
     if n > most:
