@@ -27,6 +27,7 @@ from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.validation import (
     check_grasp,
     check_num_generators,
+    describe,
     real_array,
     real_scalar,
 )
@@ -76,7 +77,7 @@ def check_tolerance(value) -> float:
     x = real_scalar("tol", value)
     if not (0.0 < x < 1.0) or not math.isfinite(x):
         raise InvalidOptionError(
-            f"tol must be a real number in (0, 1), got {value!r}: the check's "
+            f"tol must be a real number in (0, 1), got {describe(value)}: the check's "
             "violations are relative, and a tolerance of 1 or more passes any "
             "witness"
         )
@@ -120,7 +121,7 @@ def _forces(cert: Witness, grasp: Grasp) -> tuple[np.ndarray, ...]:
     if forces is None or isinstance(forces, (str, bytes)):
         raise InvalidOptionError(
             f"a {cert.kind!r} certificate needs its contact_forces (one array per "
-            f"contact), got {forces!r}"
+            f"contact), got {describe(forces)}"
         )
     try:
         forces = list(forces)

@@ -81,6 +81,7 @@ from drakegrasp.core.grasp import (
 from drakegrasp.core.linalg import equilibrated
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_RANK_TOL
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -169,7 +170,7 @@ class Certificate:
             raise TypeError(
                 "a Certificate is a witness, not a string: compare "
                 'ClosureResult.decided_by ("d*", "rank", "normal forces", '
-                f'"LP3") with {other!r} instead'
+                f'"LP3") with {describe(other)} instead'
             )
         return self is other
 

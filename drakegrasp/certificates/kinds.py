@@ -17,6 +17,7 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -130,9 +131,11 @@ def check_kind_and_cones(
 ) -> None:
     """Raise :class:`~drakegrasp.InvalidOptionError` unless both are known."""
     if not isinstance(kind, str) or kind not in kinds:
-        raise InvalidOptionError(f"kind must be one of {kinds}, got {kind!r}")
+        raise InvalidOptionError(f"kind must be one of {kinds}, got {describe(kind)}")
     if not isinstance(cones, str) or cones not in cone_kinds:
-        raise InvalidOptionError(f"cones must be one of {cone_kinds}, got {cones!r}")
+        raise InvalidOptionError(
+            f"cones must be one of {cone_kinds}, got {describe(cones)}"
+        )
 
 
 class Witness(Protocol):

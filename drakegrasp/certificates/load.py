@@ -59,6 +59,7 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import (
     check_grasp,
     check_num_generators,
+    describe,
     real_array,
     real_scalar,
 )
@@ -401,7 +402,8 @@ def _impossible(cert: LoadCertificate) -> str | None:
         return "a limit it relies on is negative or NaN (no force meets it)"
     if not (math.isfinite(cert.bound) and cert.bound >= 0.0):
         return (
-            f"its claimed bound {cert.bound!r} is not a finite number >= 0 (the "
+            f"its claimed bound {describe(cert.bound)} is not a finite number >= 0 "
+            "(the "
             "grasp always holds α = 0 with no force)"
         )
     return None

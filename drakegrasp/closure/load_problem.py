@@ -57,7 +57,12 @@ from drakegrasp.core.grasp import Grasp, check_hand_jacobian, grasp_matrix
 from drakegrasp.core.linalg import FULL_SVD_MAX_COLUMNS
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import check_grasp as _check_grasp
-from drakegrasp.core.validation import check_num_generators, real_array, safe_norm
+from drakegrasp.core.validation import (
+    check_num_generators,
+    describe,
+    real_array,
+    safe_norm,
+)
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -495,7 +500,7 @@ def check_direction(grasp: Grasp, direction, name: str = "direction") -> np.ndar
 
 def _check_cones(cones) -> str:
     if not isinstance(cones, str) or cones not in CONES:
-        raise InvalidOptionError(f"cones must be one of {CONES}, got {cones!r}")
+        raise InvalidOptionError(f"cones must be one of {CONES}, got {describe(cones)}")
     return cones
 
 

@@ -60,6 +60,7 @@ from drakegrasp.core.validation import (
     check_flag,
     check_grasp,
     check_rank_tol,
+    describe,
 )
 from drakegrasp.errors import InvalidOptionError
 
@@ -131,7 +132,7 @@ def check_program_options(grasp: Grasp, rank_tol: float) -> float:
 def check_formulation(formulation: str) -> str:
     if not isinstance(formulation, str) or formulation not in _FORMULATIONS:
         raise InvalidOptionError(
-            f"formulation must be one of {_FORMULATIONS}, got {formulation!r}"
+            f"formulation must be one of {_FORMULATIONS}, got {describe(formulation)}"
         )
     return formulation
 

@@ -57,6 +57,7 @@ from drakegrasp.core.validation import (
     TOL_MIN,
     check_grasp,
     check_rank_tol,
+    describe,
     real_scalar,
 )
 from drakegrasp.errors import (
@@ -373,7 +374,7 @@ def _check_tol(tol: float) -> float:
         raise InvalidOptionError(
             f"tol must be finite and > 0, a real number in [{TOL_MIN:g}, "
             f"{TOL_MAX:g}] (a numerical zero for the dimensionless t*, as for d*), "
-            f"got {tol!r}"
+            f"got {describe(tol)}"
         )
     return t
 

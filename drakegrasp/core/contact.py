@@ -19,6 +19,7 @@ from drakegrasp.core.tolerances import UNIT_NORMAL_TOL
 from drakegrasp.core.validation import (
     check_coefficient,
     check_positions,
+    describe,
     real_array,
     unit_vectors,
 )
@@ -52,12 +53,13 @@ class ContactModel(str, enum.Enum):
         """Return the model named by ``value`` (an enum member or its string)."""
         if isinstance(value, cls):
             return value
-        try:
-            return cls(str(value).strip().lower().replace("-", "_"))
-        except ValueError:
+        try:  # a str subclass is read as a plain str: its own __str__ may raise
+            text = str.__str__(value) if isinstance(value, str) else str(value)
+            return cls(str.strip(text).lower().replace("-", "_"))
+        except Exception:  # noqa: BLE001 - no model's name, or a hostile __str__
             valid = ", ".join(repr(m.value) for m in cls)
             raise InvalidContactError(
-                f"unknown contact model {value!r} (contact_model=); valid "
+                f"unknown contact model {describe(value)} (contact_model=); valid "
                 f"models are {valid}"
             ) from None
 

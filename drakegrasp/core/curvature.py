@@ -37,6 +37,7 @@ import numpy as np
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.validation import (
+    describe,
     items_of,
     real_array,
     real_scalar,
@@ -262,7 +263,7 @@ def _radius(radius: float) -> float:
     if not math.isfinite(r) or not r >= 1.0 / CURVATURE_BOUND:
         raise InvalidContactError(
             f"a radius must be finite and >= {1.0 / CURVATURE_BOUND:g} m "
-            f"(1 / CURVATURE_BOUND), got {radius!r}"
+            f"(1 / CURVATURE_BOUND), got {describe(radius)}"
         )
     return r
 

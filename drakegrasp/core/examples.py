@@ -12,7 +12,12 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.deprecation import renamed_keyword
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.validation import check_length, integer_or_none, real_scalar
+from drakegrasp.core.validation import (
+    check_length,
+    describe,
+    integer_or_none,
+    real_scalar,
+)
 from drakegrasp.errors import InvalidGraspError
 
 __all__ = [
@@ -52,7 +57,9 @@ def planar_two_finger_square(
     h = check_length("half_width", half_width)
     offset = real_scalar("offset", offset, error=InvalidGraspError)
     if not np.isfinite(offset):
-        raise InvalidGraspError(f"offset must be finite (metres), got {offset!r}")
+        raise InvalidGraspError(
+            f"offset must be finite (metres), got {describe(offset)}"
+        )
     return Grasp(
         [
             Contact([-h, -offset], [1.0, 0.0], mu=mu),
@@ -170,7 +177,7 @@ def equator_fingers(
     if count is None or not 1 <= count <= _MAX_FINGERS:
         raise InvalidGraspError(
             f"num_fingers must be an integer in [1, {_MAX_FINGERS}], "
-            f"got {num_fingers!r}"
+            f"got {describe(num_fingers)}"
         )
     radius = check_length("radius", radius)
     angles = 2.0 * np.pi * np.arange(count) / count

@@ -658,7 +658,7 @@ def check_distance_tolerance(value) -> float:
     """
     message = (
         f"distance_tolerance must be finite and > 0, at most "
-        f"{MAX_DISTANCE_TOLERANCE:g} m (metres), got {value!r}"
+        f"{MAX_DISTANCE_TOLERANCE:g} m (metres), got {describe(value)}"
     )
     try:  # a real number only: float() would also read "1e-4" and True
         tol = real_scalar("distance_tolerance", value)

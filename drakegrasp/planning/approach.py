@@ -68,6 +68,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import RigidBody
 
 from drakegrasp.core.calls import checked_call
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.centring import chain_sides
 from drakegrasp.planning.gripper import free_base, palm_geometries
@@ -277,7 +278,9 @@ def _vector(name, value, n) -> np.ndarray:
     except Exception:  # noqa: BLE001 - not numbers, or a hostile __array__
         v = np.full(0, np.nan)
     if v.shape != (n,) or not np.all(np.isfinite(v)):
-        raise InvalidOptionError(f"{name} must be {n} finite numbers, got {value!r}")
+        raise InvalidOptionError(
+            f"{name} must be {n} finite numbers, got {describe(value)}"
+        )
     return v
 
 
@@ -285,7 +288,7 @@ def _range(name, value) -> np.ndarray:
     r = _vector(name, value, 2)
     if not r[0] <= r[1]:
         raise InvalidOptionError(
-            f"{name} must be (low, high) with low <= high, got {value!r}"
+            f"{name} must be (low, high) with low <= high, got {describe(value)}"
         )
     return r
 
@@ -491,7 +494,7 @@ def multi_finger_hand(
     opened = isinstance(preshape, str)
     if opened and preshape != OPEN:
         raise InvalidOptionError(
-            f"preshape must be n_h = {n} numbers or {OPEN!r}, got {preshape!r}"
+            f"preshape must be n_h = {n} numbers or {OPEN!r}, got {describe(preshape)}"
         )
     if preshape is None or opened:
         q0 = plant.GetPositions(plant_context)[structure.position_indices]
@@ -505,7 +508,7 @@ def multi_finger_hand(
     curl_synergy = isinstance(synergy, str)
     if curl_synergy and synergy != "curl":
         raise InvalidOptionError(
-            f"synergy must be n_h = {n} numbers or 'curl', got {synergy!r}"
+            f"synergy must be n_h = {n} numbers or 'curl', got {describe(synergy)}"
         )
     syn = (
         None
@@ -579,7 +582,9 @@ def multi_finger_hand(
         depth = max(depth, (X_HG.translation() - origin) @ u + piece.support(u_G))
     span = np.array([0.0, reach]) if standoff is None else _range("standoff", standoff)
     if span[0] < 0:
-        raise InvalidOptionError(f"standoff must be >= 0 metres, got {standoff!r}")
+        raise InvalidOptionError(
+            f"standoff must be >= 0 metres, got {describe(standoff)}"
+        )
     q_all = plant.GetPositions(ctx)
     q_all[structure.position_indices] = structure.coupling.apply(q0)
     plant.SetPositions(ctx, q_all)  # the pre-shape, where the pinch is learnt

@@ -39,7 +39,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from pydrake.math import RigidTransform
 
-from drakegrasp.core.validation import real_array
+from drakegrasp.core.validation import describe, real_array
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -343,7 +343,9 @@ def _checked(psi, lines, tol, groups):
         or not math.isfinite(tol)
         or tol <= 0
     ):
-        raise InvalidOptionError(f"tol must be a finite number > 0 (m), got {tol!r}")
+        raise InvalidOptionError(
+            f"tol must be a finite number > 0 (m), got {describe(tol)}"
+        )
     if groups is None:
         return psi, lines, np.zeros(len(psi), int)
     return psi, lines, _integers("groups", groups, len(psi))

@@ -52,7 +52,7 @@ from scipy.spatial import ConvexHull, cKDTree
 
 from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
-from drakegrasp.core.validation import real_array, unit_vectors
+from drakegrasp.core.validation import describe, real_array, unit_vectors
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning import cloud_normals, cloud_spacing, cloud_tips
 from drakegrasp.planning.cloud_normals import _estimate_normals
@@ -325,7 +325,7 @@ def read_cloud_fit(point_cloud, normals=None, *, viewpoint=None):
         if viewpoint.shape != (3,) or not np.all(np.abs(viewpoint) < MAX_COORDINATE):
             raise InvalidOptionError(
                 f"viewpoint must be a point (3,) in metres, each coordinate "
-                f"finite and within {MAX_COORDINATE:g} m, got {viewpoint!r}"
+                f"finite and within {MAX_COORDINATE:g} m, got {describe(viewpoint)}"
             )
     if normals is not None:
         normals = real_array("cloud_normals", normals, error=InvalidOptionError)

@@ -89,7 +89,7 @@ from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import grasp_matrix
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import real_scalar
+from drakegrasp.core.validation import describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.checks import checked_directions
@@ -478,7 +478,9 @@ def _torque_figures(
     if math.isnan(weight):
         return math.nan, math.nan
     if not math.isfinite(weight) or weight < 0:
-        raise InvalidOptionError(f"weight must be finite and >= 0 (N), got {weight!r}")
+        raise InvalidOptionError(
+            f"weight must be finite and >= 0 (N), got {describe(weight)}"
+        )
     beta = float(np.min(torque_capacity(plant, plant_context, candidate, object_body)))
     return beta, needed_for(weight, beta)
 
@@ -723,7 +725,7 @@ def _positive_limit(name: str, value, unit: str) -> float:
     number = real_scalar(name, value)
     if not 0 < number < math.inf:
         raise InvalidOptionError(
-            f"{name} must be a finite number > 0 ({unit}), got {value!r}"
+            f"{name} must be a finite number > 0 ({unit}), got {describe(value)}"
         )
     return number
 

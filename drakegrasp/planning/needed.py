@@ -28,6 +28,7 @@ import sys
 import numpy as np
 
 from drakegrasp.core.deprecation import warn_deprecated
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -96,7 +97,7 @@ def _figure(name: str, value, *, negative_is_none: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(
         value, int | float | np.integer | np.floating
     ):
-        raise InvalidOptionError(f"{name} must be a real number, got {value!r}")
+        raise InvalidOptionError(f"{name} must be a real number, got {describe(value)}")
     value = float(value)
     if value < 0.0 and not negative_is_none:
         raise InvalidOptionError(f"{name} must be >= 0, got {value:g}")
@@ -140,7 +141,9 @@ def needed_text(needed: float, capacity: float, unit: str, spec: str = ".3g") ->
     if isinstance(needed, bool) or not isinstance(
         needed, int | float | np.integer | np.floating
     ):
-        raise InvalidOptionError(f"needed must be a real number, got {needed!r}")
+        raise InvalidOptionError(
+            f"needed must be a real number, got {describe(needed)}"
+        )
     needed = float(needed)
     if beyond_float_range(needed, capacity):
         return f"more than {FLOAT_MAX:.2g} {unit}, beyond float range"
@@ -150,7 +153,7 @@ def needed_text(needed: float, capacity: float, unit: str, spec: str = ".3g") ->
         return f"{needed:{spec}} {unit}"
     except (TypeError, ValueError):
         raise InvalidOptionError(
-            f"spec must be a float format such as '.3g', got {spec!r}"
+            f"spec must be a float format such as '.3g', got {describe(spec)}"
         ) from None
 
 

@@ -105,6 +105,10 @@ def planning_scene(
         A URL that is not a string or path, or an ``X_WO`` that is not a
         finite rigid pose.
     """
+    # A str subclass is read as a plain str: its own __str__ or repr may raise.
+    object_url, hand_url = (
+        str.__str__(u) if isinstance(u, str) else u for u in (object_url, hand_url)
+    )
     for name, url in (("object_url", object_url), ("hand_url", hand_url)):
         if not (
             isinstance(url, (str, os.PathLike))
@@ -112,7 +116,7 @@ def planning_scene(
         ):
             raise InvalidOptionError(
                 f"{name} must be a package:// URL or a file path, got "
-                f"{type(url).__name__} {url!r}"
+                f"{type(url).__name__} {describe(url)}"
             )
         if url is not None and "://" not in str(url) and not Path(url).is_file():
             # Checked before the hand loads: a wrong object name was reported
@@ -158,13 +162,17 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
     pairs = []
     for name, folder in package_map.items():
         if not isinstance(name, str) or not name or "/" in name:
-            raise InvalidOptionError(f"package name must be a word, got {name!r}")
+            raise InvalidOptionError(
+                f"package name must be a word, got {describe(name)}"
+            )
         if name in ("drake", "drakegrasp"):  # (refused again where it is added)
             raise InvalidOptionError(
-                f"package {name!r} is built in and cannot be replaced"
+                f"package {describe(name)} is built in and cannot be replaced"
             )
         if not isinstance(folder, (str, os.PathLike)) or not Path(folder).is_dir():
-            raise InvalidOptionError(f"package {name!r}: {folder!r} is not a folder")
+            raise InvalidOptionError(
+                f"package {describe(name)}: {describe(folder)} is not a folder"
+            )
         pairs.append((name, str(Path(folder).resolve())))
     return pairs
 
@@ -209,13 +217,13 @@ def scene_from_models(add_models) -> PlanningScene:
     if not (isinstance(returned, tuple | list) and len(returned) == 2):
         raise InvalidOptionError(
             "add_models must return (hand model instance, object body name "
-            f"'model::body' or None), got {returned!r}"
+            f"'model::body' or None), got {describe(returned)}"
         )
     hand, name = returned
     if name is not None and not isinstance(name, str):
         raise InvalidOptionError(
             "add_models must return the object body's scoped name 'model::body' "
-            f"(or None), got {name!r}"
+            f"(or None), got {describe(name)}"
         )
     plant.Finalize()
     diagram = builder.Build()

@@ -30,6 +30,7 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call, unknown_names
 from drakegrasp.core.serialize import jsonable
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import (
     InvalidGraspError,
     InvalidOptionError,
@@ -218,7 +219,8 @@ def _checked_top(top) -> int:
         or not 0 < int(top) <= 10_000
     ):
         raise InvalidOptionError(
-            f"top must be a whole number of candidates from 1 to 10000, got {top!r}"
+            "top must be a whole number of candidates from 1 to 10000, got "
+            f"{describe(top)}"
         )
     return int(top)
 
@@ -295,7 +297,8 @@ def check_settings(top, held_from, options: dict) -> dict:
     _checked_top(top)
     if not isinstance(held_from, str) or held_from not in HELD_FROM:
         raise InvalidOptionError(
-            f"held_from must be one of {', '.join(HELD_FROM)}, got {held_from!r}"
+            f"held_from must be one of {', '.join(HELD_FROM)}, got "
+            f"{describe(held_from)}"
         )
     unknown = sorted(set(options) - set(_OPTIONS))
     if unknown:

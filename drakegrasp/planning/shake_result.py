@@ -15,7 +15,7 @@ from pydrake.math import RigidTransform
 from drakegrasp.closure.load_problem import effort_unit_of
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import real_scalar
+from drakegrasp.core.validation import describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = ["ShakeResult", "motion_text", "squeeze_unit_of"]
@@ -368,7 +368,7 @@ def _pose(name: str, X) -> np.ndarray:
         )
     if not ok:
         raise InvalidOptionError(
-            f"{name} must be a finite (4, 4) rigid transform, got {X!r}"[:200]
+            f"{name} must be a finite (4, 4) rigid transform, got {describe(X)}"[:200]
         )
     return M
 

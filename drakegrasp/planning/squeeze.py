@@ -48,6 +48,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import DiagramBuilder
 
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import coupling_map
 from drakegrasp.plant.fingers import find_joint
@@ -195,7 +196,7 @@ def contact_levers(
         ):
             raise InvalidOptionError(
                 f"the sign that closes joint {name!r} must be 1, -1 or 0 (closing "
-                f"leaves it still), got {sign!r}"
+                f"leaves it still), got {describe(sign)}"
             )
     contacts = checked_contacts(candidate)
     X_WO = candidate.X_WO if X_WO is None else check_rigid_transform("X_WO", X_WO)

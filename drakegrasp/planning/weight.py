@@ -85,7 +85,12 @@ from drakegrasp.batch.lp.ipm import solve_max_last, solve_max_last_active
 from drakegrasp.batch.run.workers import check_workers, map_ordered, resolve_workers
 from drakegrasp.core.deprecation import keyword_only, renamed_keyword
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import check_num_generators, real_array, unit_vectors
+from drakegrasp.core.validation import (
+    check_num_generators,
+    describe,
+    real_array,
+    unit_vectors,
+)
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 from drakegrasp.planning.checks import (
     checked_contacts,
@@ -473,7 +478,9 @@ def weight_capacity(
     directions = checked_directions("directions", directions)
     num_generators = check_num_generators(num_generators)
     if not isinstance(solver, str) or solver not in ("batch", "drake"):
-        raise InvalidOptionError(f"solver must be 'batch' or 'drake', got {solver!r}")
+        raise InvalidOptionError(
+            f"solver must be 'batch' or 'drake', got {describe(solver)}"
+        )
     check_workers(workers)
     palm = checked_palm(palm)
     if K == 0:

@@ -74,7 +74,7 @@ from pydrake.systems.framework import Context
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
-from drakegrasp.core.validation import check_distance_tolerance, check_flag
+from drakegrasp.core.validation import check_distance_tolerance, check_flag, describe
 from drakegrasp.errors import (
     InvalidOptionError,
     JointLimitError,
@@ -389,7 +389,9 @@ def close_hand(
             or not isinstance(value, int | np.integer)
             or value < 1
         ):
-            raise InvalidOptionError(f"{name} must be an integer >= 1, got {value!r}")
+            raise InvalidOptionError(
+                f"{name} must be an integer >= 1, got {describe(value)}"
+            )
     body = resolve_object_body(plant, object_body)
     bodies = hand_bodies(plant, body, hand)
     couplings = plant_couplings(plant, couplings)
@@ -660,7 +662,8 @@ def _user_direction(direction, n: int, hand: HandStructure) -> np.ndarray | None
     if d.shape != (n,) or not np.all(np.isfinite(d)):
         raise InvalidOptionError(
             f"direction must be {n} finite numbers (one per closing joint, in "
-            f"the order of HandClosure.joints {list(hand.names)}), got {direction!r}"
+            f"the order of HandClosure.joints {list(hand.names)}), got "
+            f"{describe(direction)}"
         )
     scale = np.max(np.abs(d), initial=0.0)
     if scale > 0.0:  # a positive multiple closes alike (1e-13 was read as zero)

@@ -472,7 +472,7 @@ def find_contacts(
     allow_penetration = check_flag("allow_penetration", allow_penetration)
     if not isinstance(patches, str) or patches not in ("vertices", "witness"):
         raise InvalidOptionError(
-            f"patches must be 'vertices' or 'witness', got {patches!r}"
+            f"patches must be 'vertices' or 'witness', got {describe(patches)}"
         )
     body = resolve_object_body(plant, object_body)
     fingers = hand_contact_bodies(plant, body, hand)

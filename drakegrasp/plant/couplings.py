@@ -424,7 +424,7 @@ def add_models(
         _record_text(plant, text, kind, instances, resolve)
         return instances
     if url is not None:
-        where = f"model URL {url!r}"
+        where = f"model URL {describe(url)}"
         path = load_models(where, parser.package_map().ResolveUrl, url)
     else:
         where = f"model file {str(file_name)!r}"

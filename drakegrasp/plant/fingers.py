@@ -42,7 +42,7 @@ from pydrake.geometry import Role
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, Joint, JointIndex, RigidBody
 
-from drakegrasp.core.validation import items_of
+from drakegrasp.core.validation import describe, items_of
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.validation import scoped_name
 
@@ -259,7 +259,7 @@ def find_joint(plant: MultibodyPlant, spec) -> Joint:
             ):
                 return j
     raise InvalidOptionError(
-        f"coupling joint {spec!r} is not a joint of the plant (give a Joint or "
+        f"coupling joint {describe(spec)} is not a joint of the plant (give a Joint or "
         "a 'model::joint' name)"
     )
 
@@ -322,7 +322,7 @@ def coupling_entries(couplings) -> tuple:
     ):
         raise InvalidOptionError(
             "couplings must be a sequence of (joint_0, joint_1, gear_ratio, offset) "
-            f"entries (() for none), got {couplings!r}"
+            f"entries (() for none), got {describe(couplings)}"
         )
     return tuple(
         items_of(
@@ -353,12 +353,13 @@ def coupling_entry(plant: MultibodyPlant, entry) -> tuple[Joint, Joint, float, f
     ):
         raise InvalidOptionError(
             "each coupling is (joint_0, joint_1, gear_ratio, offset) with "
-            f"q_0 = gear_ratio * q_1 + offset, got {entry!r}"
+            f"q_0 = gear_ratio * q_1 + offset, got {describe(entry)}"
         )
     j0, j1 = find_joint(plant, entry[0]), find_joint(plant, entry[1])
     if j0.index() == j1.index():
         raise InvalidOptionError(
-            f"coupling {entry!r} couples joint {joint_name(plant, j0)} to itself; "
+            f"coupling {describe(entry)} couples joint {joint_name(plant, j0)} to "
+            "itself; "
             "a coupling joins two different joints"
         )
     values = []
@@ -371,7 +372,7 @@ def coupling_entry(plant: MultibodyPlant, entry) -> tuple[Joint, Joint, float, f
         raise InvalidOptionError(
             f"coupling of {joint_name(plant, j0)} to {joint_name(plant, j1)}: "
             "gear_ratio must be a finite non-zero real number and offset a finite "
-            f"real number, got {entry[2]!r}, {entry[3]!r}"
+            f"real number, got {describe(entry[2])}, {describe(entry[3])}"
         )
     return j0, j1, rho, off
 
@@ -846,7 +847,7 @@ def _touching_bodies(plant, finger: Finger, touching) -> set[int]:
         bodies = list(touching)
     except TypeError:
         raise InvalidOptionError(
-            f"touching must be a list of the finger's bodies, got {touching!r}"
+            f"touching must be a list of the finger's bodies, got {describe(touching)}"
         ) from None
     if not bodies:
         raise InvalidOptionError(

@@ -30,6 +30,7 @@ from pydrake.multibody.plant import (
     MultibodyPlant,
 )
 
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.handles import local_geometry_id
 from drakegrasp.plant.validation import (
@@ -122,7 +123,7 @@ def pair_friction(
 def _check_rule(rule) -> str:
     if not isinstance(rule, str) or rule not in ("static", "dynamic"):
         raise InvalidOptionError(
-            f"rule must be 'static', 'dynamic' or None, got {rule!r}"
+            f"rule must be 'static', 'dynamic' or None, got {describe(rule)}"
         )
     return rule
 

@@ -38,7 +38,7 @@ from pydrake.geometry import (
 from pydrake.multibody.plant import ContactModel
 from pydrake.multibody.tree import RigidBody
 
-from drakegrasp.core.validation import real_scalar
+from drakegrasp.core.validation import describe, real_scalar
 from drakegrasp.errors import InvalidOptionError, ModelError
 
 __all__ = ["MODULI", "check_hydroelastic_modulus", "use_hydroelastic_contact"]
@@ -83,7 +83,7 @@ def check_hydroelastic_modulus(value, name: str = "hydroelastic_modulus"):
         raise InvalidOptionError(
             f"{name} must be None (the models' own contact) or a number of "
             f"pascals in [{MODULI[0]:g}, {MODULI[1]:g}] (rubber pads: about "
-            f"1e6), got {value!r}"
+            f"1e6), got {describe(value)}"
         )
     return x
 

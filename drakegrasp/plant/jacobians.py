@@ -31,7 +31,7 @@ from pydrake.systems.framework import Context
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact, ContactModel
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.validation import check_grasp
+from drakegrasp.core.validation import check_grasp, describe
 from drakegrasp.errors import InvalidGraspError
 from drakegrasp.plant.contacts import PlantContact, check_plant_contacts
 from drakegrasp.plant.options import PLANES, check_plane
@@ -233,7 +233,7 @@ def hand_jacobian(
         )
     if grasp.planar != (plane is not None):
         raise InvalidGraspError(
-            f"plane={plane!r} for a spatial grasp: give no plane"
+            f"plane={describe(plane)} for a spatial grasp: give no plane"
             if plane is not None
             else "a planar grasp needs plane= (the object-frame plane of its "
             f"contacts, one of {sorted(PLANES)})"

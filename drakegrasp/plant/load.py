@@ -53,7 +53,7 @@ from drakegrasp.closure.payload import MaxLoadResult, max_load
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import grasp_matrix
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import check_distance_tolerance, real_array
+from drakegrasp.core.validation import check_distance_tolerance, describe, real_array
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import coupled_torque_limits, split_coupled_torque
 from drakegrasp.plant.fingers import effort_unit, limit_towards
@@ -126,7 +126,8 @@ def gravity_wrench(
     own = float(body.get_mass(ctx))
     if mass is not None and not own > 0.0:
         raise InvalidOptionError(
-            f"object_mass = {mass!r} kg: the model gives {body.name()!r} no mass, "
+            f"object_mass = {describe(mass)} kg: the model gives {body.name()!r} no "
+            "mass, "
             "so no centre of mass to weigh it at; give the load as a wrench "
             "[f; m] in frame O about its origin"
         )
@@ -593,7 +594,7 @@ def _load_wrench(plant, plant_context, data, load, object_mass=None):
         if load != "gravity":
             raise InvalidOptionError(
                 f"load must be None, 'gravity' or a wrench [f; m] in frame O, got "
-                f"{load!r}"
+                f"{describe(load)}"
             )
         return gravity_wrench(
             plant,
@@ -648,7 +649,7 @@ def _torque_limits(plant, data, torque_limits):
         if torque_limits != "plant":
             raise InvalidOptionError(
                 "torque_limits must be None, 'plant' or one limit per hand "
-                f"velocity, got {torque_limits!r}"
+                f"velocity, got {describe(torque_limits)}"
             )
         if coupling is None:
             return plant_torque_limits(plant, data.hand_velocity_indices), "plant", None
@@ -927,7 +928,7 @@ def load_section(
         The load section when ``load`` is given.
     """
     if isinstance(mu, str) and mu != "plant":
-        raise InvalidOptionError(f"mu must be a number or 'plant', got {mu!r}")
+        raise InvalidOptionError(f"mu must be a number or 'plant', got {describe(mu)}")
     if load is None and not (isinstance(mu, str)):
         if torque_limits is not None:
             raise InvalidOptionError(

@@ -199,7 +199,7 @@ class AnalysisOptions:
         if isinstance(self.mu, str):
             if self.mu != "plant":
                 raise InvalidOptionError(
-                    f"mu must be a number or 'plant', got {self.mu!r}"
+                    f"mu must be a number or 'plant', got {describe(self.mu)}"
                 )
             put("mu", "plant")  # a plain str, whatever str subclass came in
         elif self.mu is not None:
@@ -236,7 +236,8 @@ class AnalysisOptions:
         put("coupling_tolerance", _coupling_tolerance(self.coupling_tolerance))
         if not isinstance(self.patches, str) or self.patches not in PATCH_MODES:
             raise InvalidOptionError(
-                f"patches must be one of {list(PATCH_MODES)}, got {self.patches!r}"
+                f"patches must be one of {list(PATCH_MODES)}, got "
+                f"{describe(self.patches)}"
             )
         put("load", _named_or_values("load", self.load, "gravity"))
         dim = 6 if self.plane is None else 3
@@ -293,7 +294,7 @@ def check_object_mass(value: Any) -> float:
     m = real_scalar("object_mass", value, error=InvalidOptionError)
     if not (0.0 < m < np.inf):
         raise InvalidOptionError(
-            f"object_mass must be a finite mass > 0 (kg), got {value!r}"
+            f"object_mass must be a finite mass > 0 (kg), got {describe(value)}"
         )
     return m
 
@@ -309,13 +310,13 @@ def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
         return None if value is None else word  # a plain str
     if isinstance(value, str):
         raise InvalidOptionError(
-            f"{name} must be {word!r}, numbers or None, got {value!r}"
+            f"{name} must be {word!r}, numbers or None, got {describe(value)}"
         )
     try:  # real numbers only: not "1.0" or True read as numbers
         values = real_array(name, value, error=InvalidOptionError)
     except InvalidOptionError:
         raise InvalidOptionError(
-            f"{name} must be {word!r}, numbers or None, got {value!r}"
+            f"{name} must be {word!r}, numbers or None, got {describe(value)}"
         ) from None
     if limits:  # a motor's limit is a magnitude: >= 0, inf for none
         if values.ndim == 0:  # one number: every actuator's limit, as [x] is
@@ -328,11 +329,11 @@ def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
             raise InvalidOptionError(
                 f"{name} must be {word!r}, one number >= 0 for every actuator or "
                 "a 1-D sequence of one or more numbers >= 0 (inf: no limit), got "
-                f"{value!r}"
+                f"{describe(value)}"
             )
         raise InvalidOptionError(
             f"{name} must be a 1-D sequence of one or more finite numbers, got "
-            f"{value!r}"
+            f"{describe(value)}"
         )
     return tuple(float(x) for x in values)
 
@@ -350,7 +351,7 @@ def _coupling_tolerance(value: Any) -> float:
     """``coupling_tolerance`` as a float in ``(0, MAX_COUPLING_TOL]``."""
     message = (
         f"coupling_tolerance must be finite and > 0, at most {MAX_COUPLING_TOL:g} "
-        f"(m or rad), got {value!r}"
+        f"(m or rad), got {describe(value)}"
     )
     try:
         tol = real_scalar("coupling_tolerance", value)

@@ -373,7 +373,7 @@ def _path_argument(path) -> Path:
     if not isinstance(path, str | os.PathLike) or isinstance(os.fspath(path), bytes):
         raise InvalidOptionError(
             "a scene is a file path or a shipped scene's name (str or "
-            f"pathlib.Path), got {type(path).__name__} {path!r}"
+            f"pathlib.Path), got {type(path).__name__} {describe(path)}"
         )
     return Path(path)
 

@@ -46,6 +46,7 @@ from pathlib import Path
 
 from pydrake.multibody.parsing import LoadModelDirectives, PackageMap, Parser
 
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.models import (
     check_obj_vertices,
@@ -127,7 +128,7 @@ def add_packages(
         if not isinstance(packages, Iterable) or isinstance(packages, bytes):
             raise SceneError(
                 "packages must be a PackageMap, a mapping {name: directory} or "
-                f"directories, got {type(packages).__name__} {packages!r}"
+                f"directories, got {type(packages).__name__} {describe(packages)}"
             )
         for folder in packages:
             _add_package_xml(package_map, folder)
@@ -151,15 +152,19 @@ def add_named_package(package_map: PackageMap, name, folder) -> None:
     """
     if not isinstance(name, str) or not name or "/" in name:
         raise SceneError(
-            f"package name must be a non-empty string without '/', got {name!r}"
+            f"package name must be a non-empty string without '/', got {describe(name)}"
         )
-    path = _folder(f"package {name!r}", folder)
+    path = _folder(f"package {describe(name)}", folder)
     if not path.is_dir():
-        raise SceneError(f"package {name!r}: {str(folder)!r} is not a directory")
+        raise SceneError(
+            f"package {describe(name)}: {str(folder)!r} is not a directory"
+        )
     path = str(path.resolve())
     if package_map.Contains(name):
         if name in ("drake", "drakegrasp"):
-            raise SceneError(f"package {name!r} is built in and cannot be replaced")
+            raise SceneError(
+                f"package {describe(name)} is built in and cannot be replaced"
+            )
         package_map.Remove(name)
     package_map.Add(name, path)
 
@@ -171,7 +176,7 @@ def _folder(what: str, folder) -> Path:
     ):
         raise SceneError(
             f"{what}: a directory is a str or a pathlib.Path, got "
-            f"{type(folder).__name__} {folder!r}"
+            f"{type(folder).__name__} {describe(folder)}"
         )
     return Path(folder).expanduser()
 

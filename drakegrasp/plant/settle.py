@@ -367,7 +367,7 @@ def settle_object(
     tau = real_array("pushing", pushing, error=InvalidOptionError)
     if tau.shape != (n_h,) or not np.all(np.isfinite(tau)):
         raise InvalidOptionError(
-            f"pushing must be {n_h} finite numbers, got {pushing!r}"
+            f"pushing must be {n_h} finite numbers, got {describe(pushing)}"
         )
     tol = check_distance_tolerance(distance_tolerance)
     inspector = query_object_of(plant, plant_context).inspector()

@@ -479,7 +479,7 @@ def model_instance(
     if isinstance(spec, str):
         if not plant.HasModelInstanceNamed(spec):
             raise error(
-                f"no model instance named {spec!r}; instances are "
+                f"no model instance named {describe(spec)}; instances are "
                 f"{_instance_names(plant)}" + _body_hint(plant, spec)
             )
         return plant.GetModelInstanceByName(spec)
@@ -506,8 +506,8 @@ def _body_hint(plant: MultibodyPlant, name: str) -> str:
     if not plant.HasBodyNamed(body, plant.GetModelInstanceByName(model)):
         return ""
     return (
-        f" ({name!r} is a body: a hand of bodies is a list of them, "
-        f"[{name!r}, ...], and its model instance is {model!r})"
+        f" ({describe(name)} is a body: a hand of bodies is a list of them, "
+        f"[{describe(name)}, ...], and its model instance is {model!r})"
     )
 
 
@@ -537,12 +537,14 @@ def resolve_body(plant: MultibodyPlant, name: str) -> RigidBody:
         elif plant.HasBodyNamed(name):
             return plant.GetBodyByName(name)
     except RuntimeError as e:  # the name is used by several model instances
-        raise ModelError(f"body name {name!r} is ambiguous: {e}") from None
+        raise ModelError(f"body name {describe(name)} is ambiguous: {e}") from None
     bodies = [
         scoped_name(plant, plant.get_body(BodyIndex(i)))
         for i in range(1, plant.num_bodies())
     ]
-    raise ModelError(f"no body named {name!r} in the plant; bodies are {bodies}")
+    raise ModelError(
+        f"no body named {describe(name)} in the plant; bodies are {bodies}"
+    )
 
 
 def resolve_object_body(
@@ -772,7 +774,7 @@ def _listed(hand) -> Iterable:
     if isinstance(hand, bytes | dict) or not isinstance(hand, Iterable):
         raise InvalidOptionError(
             "hand must be a model instance (ModelInstanceIndex or name), an "
-            f"iterable of bodies or scoped body names, or None; got {hand!r}"
+            f"iterable of bodies or scoped body names, or None; got {describe(hand)}"
         )
     return items_of(
         "hand",

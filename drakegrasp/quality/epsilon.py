@@ -17,7 +17,7 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, L1_MAX_POINTS
-from drakegrasp.core.validation import check_num_generators
+from drakegrasp.core.validation import check_num_generators, describe
 from drakegrasp.errors import InvalidOptionError, SolverError
 from drakegrasp.quality._common import (
     RANK_TOL,
@@ -706,7 +706,7 @@ def ferrari_canny(
         :func:`primitive_wrenches`), or a grasp past the limits above.
     """
     if not isinstance(norm, str) or norm not in _NORMS:
-        raise InvalidOptionError(f"norm must be one of {_NORMS}, got {norm!r}")
+        raise InvalidOptionError(f"norm must be one of {_NORMS}, got {describe(norm)}")
     eps_1, eps_inf = _epsilons(
         grasp,
         num_generators=num_generators,

@@ -28,6 +28,7 @@ from drakegrasp.core.tolerances import (
     DEFAULT_NUM_GENERATORS,
     DEFAULT_TOL,
 )
+from drakegrasp.core.validation import describe
 from drakegrasp.errors import (
     GraspError,
     InvalidOptionError,
@@ -290,7 +291,8 @@ class GraspMonitor(LeafSystem):
         super().__init__()
         if not isinstance(plant, MultibodyPlant) or not plant.is_finalized():
             raise InvalidOptionError(
-                f"GraspMonitor needs a finalized pydrake MultibodyPlant, got {plant!r}"
+                "GraspMonitor needs a finalized pydrake MultibodyPlant, got "
+                f"{describe(plant)}"
             )
         if not plant.geometry_source_is_registered():
             raise ModelError(

@@ -77,7 +77,7 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import real_scalar
+from drakegrasp.core.validation import describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -168,7 +168,9 @@ class HoldingThresholds:
             raise InvalidOptionError(f"risk must be in (0, 1], got {self.risk}")
         h = self.hold_samples
         if isinstance(h, bool) or not isinstance(h, int | np.integer) or h < 0:
-            raise InvalidOptionError(f"hold_samples must be an int >= 0, got {h!r}")
+            raise InvalidOptionError(
+                f"hold_samples must be an int >= 0, got {describe(h)}"
+            )
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""

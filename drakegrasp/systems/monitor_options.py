@@ -100,7 +100,7 @@ def seconds(name: str, value: Any, *, least: float) -> float:
         ) from None
     if not np.isfinite(value) or value < least:
         raise InvalidOptionError(
-            f"{name} must be finite and >= {least:g} s, got {value!r}"
+            f"{name} must be finite and >= {least:g} s, got {describe(value)}"
         )
     return value
 
@@ -145,7 +145,7 @@ def monitor_settings(
     """
     if not isinstance(contacts, str) or contacts not in CONTACT_SOURCES:
         raise InvalidOptionError(
-            f"contacts must be one of {CONTACT_SOURCES}, got {contacts!r}"
+            f"contacts must be one of {CONTACT_SOURCES}, got {describe(contacts)}"
         )
     holding = HoldingThresholds() if holding is None else holding
     if not isinstance(holding, HoldingThresholds):

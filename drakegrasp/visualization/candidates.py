@@ -247,7 +247,7 @@ def draw_candidates(
     check_meshcat(meshcat)
     check_path("prefix", prefix)
     if isinstance(top, bool) or not isinstance(top, int | np.integer) or top < 0:
-        raise InvalidOptionError(f"top must be an integer >= 0, got {top!r}")
+        raise InvalidOptionError(f"top must be an integer >= 0, got {describe(top)}")
     ctx = plant_context_of(plant, plant_context)
     inspector = plant.get_geometry_query_input_port().Eval(ctx).inspector()
     scratch = plant.CreateDefaultContext()  # a copy of the user's configuration
@@ -377,7 +377,7 @@ def plot_score_distribution(candidates, *, ax=None, bins: int = 30, top: int = 1
             f"(drakegrasp.visualization.candidates.MAX_BINS), got {describe(bins)}"
         )
     if isinstance(top, bool) or not isinstance(top, int | np.integer) or top < 0:
-        raise InvalidOptionError(f"top must be an integer >= 0, got {top!r}")
+        raise InvalidOptionError(f"top must be an integer >= 0, got {describe(top)}")
     rows = _candidate_rows(candidates)
     scores = np.array([float(c.score) for c in rows])
     if not np.all(np.isfinite(scores)):

@@ -348,7 +348,7 @@ def _unpack(scene_or_plant, result, plant_context, object_body, plane):
         report_plane = getattr(data, "plane", None)
         if plane is not None and report_plane is not None and plane != report_plane:
             raise InvalidOptionError(
-                f"plane={plane!r}, but the report was analysed in the "
+                f"plane={describe(plane)}, but the report was analysed in the "
                 f"{report_plane!r} plane"
             )
         plane = plane or report_plane
@@ -452,7 +452,7 @@ def animate_escape(
     if not (MIN_DURATION <= duration <= MAX_DURATION):
         raise InvalidOptionError(
             f"duration must be a real number of seconds in [{MIN_DURATION:g}, "
-            f"{MAX_DURATION:g}], got {duration!r}"
+            f"{MAX_DURATION:g}], got {describe(duration)}"
         )
     amount = check_amount(amount)
     plant, context, body, (x, p_cert, b, two_sided), plane = _unpack(

@@ -35,7 +35,12 @@ from pydrake.systems.framework import Context
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import check_flag, check_num_generators, safe_norm
+from drakegrasp.core.validation import (
+    check_flag,
+    check_num_generators,
+    describe,
+    safe_norm,
+)
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.geometry import (
     DRAW_LENGTH_MAX,
@@ -123,7 +128,9 @@ def _rgba(colors: Mapping[str, Any], key: str) -> Rgba:
     if len(v) == 3:
         v.append(1.0)
     if len(v) != 4:
-        raise InvalidOptionError(f"colour {key!r} must be RGB or RGBA, got {value!r}")
+        raise InvalidOptionError(
+            f"colour {describe(key)} must be RGB or RGBA, got {describe(value)}"
+        )
     return Rgba(*v)
 
 
@@ -286,7 +293,7 @@ def draw_grasp(
     _check_rgba_colors(colors)
     if not isinstance(cone, (str, type(None))) or cone not in _CONE_CHOICES:
         raise InvalidOptionError(
-            f"cone must be 'exact', 'pyramid', 'both' or None, got {cone!r}"
+            f"cone must be 'exact', 'pyramid', 'both' or None, got {describe(cone)}"
         )
     check_path("prefix", prefix)
     sign = side_sign(side)
@@ -495,7 +502,8 @@ def _check_rgba_colors(colors) -> None:
         return
     if not isinstance(colors, Mapping):
         raise InvalidOptionError(
-            f"colors must be a mapping of names to RGB(A) colours, got {colors!r}"
+            "colors must be a mapping of names to RGB(A) colours, got "
+            f"{describe(colors)}"
         )
     for key, value in colors.items():
         if isinstance(value, Rgba):
@@ -510,6 +518,6 @@ def _check_rgba_colors(colors) -> None:
             or not np.all((v >= 0.0) & (v <= 1.0))
         ):
             raise InvalidOptionError(
-                f"colour {key!r} must be an Rgba or 3 or 4 numbers in [0, 1], got "
-                f"{value!r}"
+                f"colour {describe(key)} must be an Rgba or 3 or 4 numbers in "
+                f"[0, 1], got {describe(value)}"
             )

@@ -24,7 +24,13 @@ from drakegrasp.certificates.certificate import (
 )
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp
-from drakegrasp.core.validation import check_flag, check_length, real_array, safe_norm
+from drakegrasp.core.validation import (
+    check_flag,
+    check_length,
+    describe,
+    real_array,
+    safe_norm,
+)
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.certificate_plots import (
     check_axes,
@@ -134,7 +140,8 @@ def _outline_patch(outline: Any, colors: Mapping[str, Any]):
         radius = positive_length("outline radius", outline["radius"])
         if center.shape != (2,) or not np.all(np.isfinite(center)):
             raise InvalidOptionError(
-                f"circle center must be a finite 2-vector, got {outline['center']!r}"
+                "circle center must be a finite 2-vector, got "
+                f"{describe(outline['center'])}"
             )
         return Circle(tuple(center), radius, **style)
     pts = real_array("outline", outline, error=InvalidOptionError)
@@ -385,20 +392,20 @@ def _check_plot_options(colors, outline, force_scale) -> None:
     if colors is not None:
         if not isinstance(colors, Mapping):
             raise InvalidOptionError(
-                f"colors must be a mapping of names to colours, got {colors!r}"
+                f"colors must be a mapping of names to colours, got {describe(colors)}"
             )
         from matplotlib.colors import is_color_like
 
         bad = {k: v for k, v in colors.items() if not is_color_like(v)}
         if bad:
             raise InvalidOptionError(
-                f"colors {bad} are not matplotlib colours (names such as 'red', "
-                "'#1f77b4', or RGB(A) tuples in [0, 1])"
+                f"colors {describe(bad)} are not matplotlib colours (names such as "
+                "'red', '#1f77b4', or RGB(A) tuples in [0, 1])"
             )
     if isinstance(outline, (str, bytes)):
         raise InvalidOptionError(
             "outline must be polygon vertices (M, 2), {'center': ..., 'radius': "
-            f"...}} or a matplotlib patch, got {outline!r}"
+            f"...}} or a matplotlib patch, got {describe(outline)}"
         )
     if force_scale is not None:
         check_length("force_scale", force_scale, error=InvalidOptionError)

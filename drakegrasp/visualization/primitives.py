@@ -9,7 +9,7 @@ import numpy as np
 from pydrake.geometry import Cylinder, Meshcat, Rgba
 from pydrake.math import RigidTransform, RotationMatrix
 
-from drakegrasp.core.validation import safe_norm
+from drakegrasp.core.validation import describe, safe_norm
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.geometry import exact_cone_mesh
 
@@ -34,7 +34,9 @@ def check_meshcat(meshcat) -> None:
 def check_path(name: str, value) -> str:
     """A Meshcat path: a string with something besides slashes."""
     if not isinstance(value, str) or not value.strip("/"):
-        raise InvalidOptionError(f"{name} must be a non-empty path, got {value!r}")
+        raise InvalidOptionError(
+            f"{name} must be a non-empty path, got {describe(value)}"
+        )
     return value
 
 

@@ -137,7 +137,9 @@ def translucent_arguments(paths, opacity) -> tuple[list[str], float]:
         )
     for path in listed:
         if not isinstance(path, str) or not path.strip("/"):
-            raise InvalidOptionError(f"paths must be non-empty strings, got {path!r}")
+            raise InvalidOptionError(
+                f"paths must be non-empty strings, got {describe(path)}"
+            )
     return [str(p) for p in listed], x
 
 

@@ -238,7 +238,9 @@ def wrench_hull(W: np.ndarray, *, tol: float = ORIGIN_CLEARANCE_TOL) -> WrenchHu
         )  # fmt: skip
     tol = real_scalar("tol", tol)
     if not (0.0 <= tol < np.inf):
-        raise InvalidOptionError(f"tol must be a finite real number >= 0, got {tol!r}")
+        raise InvalidOptionError(
+            f"tol must be a finite real number >= 0, got {describe(tol)}"
+        )
     rank = int(np.linalg.matrix_rank(W)) if K else 0
     # The hull has an interior only if the points' affine hull is m-dimensional.
     affine_rank = int(np.linalg.matrix_rank(W[:, 1:] - W[:, :1])) if K > 1 else 0
@@ -353,7 +355,9 @@ def plot_wrench_space(
         )
     tol = real_scalar("tol", tol)
     if not (0.0 < tol < 1.0):
-        raise InvalidOptionError(f"tol must be a real number in (0, 1), got {tol!r}")
+        raise InvalidOptionError(
+            f"tol must be a real number in (0, 1), got {describe(tol)}"
+        )
     if not grasp.planar:
         raise InvalidOptionError(
             "plot_wrench_space draws planar grasps, whose wrench space is 3-D; "
