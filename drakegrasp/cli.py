@@ -140,6 +140,7 @@ from drakegrasp.errors import (
     InvalidOptionError,
     InvalidPoseError,
     ModelError,
+    cut_message,
 )
 
 __all__ = ["Terminated", "build_parser", "main", "printable", "run"]
@@ -533,9 +534,9 @@ def _parsed(text: str, convert, noun: str, ok, must: str):
     try:
         x = convert(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not {noun}: {text!r}") from None
+        raise argparse.ArgumentTypeError(f"not {noun}: {describe(text)}") from None
     if not ok(x):
-        raise argparse.ArgumentTypeError(f"must be {must}, got {text!r}")
+        raise argparse.ArgumentTypeError(f"must be {must}, got {describe(text)}")
     return x
 
 
@@ -563,7 +564,7 @@ def _modulus(text: str) -> float | str:
         return _strictly_positive(text)
     except argparse.ArgumentTypeError:
         raise argparse.ArgumentTypeError(
-            f"expected a modulus in Pa (finite, > 0) or none, got {text!r}"
+            f"expected a modulus in Pa (finite, > 0) or none, got {describe(text)}"
         ) from None
 
 
@@ -575,7 +576,8 @@ def _package(text: str) -> tuple[str, str]:
     name, sep, folder = text.partition("=")
     if not sep or not name or not folder or "/" in name:
         raise argparse.ArgumentTypeError(
-            f"expected NAME=DIR (a package name, '=', its directory), got {text!r}"
+            "expected NAME=DIR (a package name, '=', its directory), got "
+            f"{describe(text)}"
         )
     return name, folder
 
@@ -672,6 +674,7 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str):
         if message.startswith("argument --metrics: invalid choice"):
             message += f"; {_METRICS_HINT}"
+        message = cut_message(message)  # argparse names a bad argument whole
         self.exit(2, f"{self.prog}: error: {message} (see: {self.prog} --help)\n")
 
 
@@ -850,7 +853,7 @@ def _named_or_numbers(name: str):
             return tuple(float(v) for v in text.split(","))
         except ValueError:
             raise argparse.ArgumentTypeError(
-                f"expected {name!r} or comma-separated numbers, got {text!r}"
+                f"expected {name!r} or comma-separated numbers, got {describe(text)}"
             ) from None
 
     return parse
@@ -1314,7 +1317,7 @@ def _joint_value(text: str) -> tuple[str, float] | str:
     if not sep or not name or not math.isfinite(number):
         raise argparse.ArgumentTypeError(
             f"expected JOINT=VALUE (a joint's name, '=', a finite position in "
-            f"rad or m) or {OPEN!r}, got {text!r}"
+            f"rad or m) or {OPEN!r}, got {describe(text)}"
         )
     return name, number
 
@@ -2085,7 +2088,7 @@ def printable(text: str) -> str:
 
 def _error(message: str) -> int:
     """Print one line on stderr; return the error status."""
-    text = printable(" ".join(str(message).split()))
+    text = printable(" ".join(cut_message(str(message)).split()))
     print(f"drakegrasp: error: {text}", file=sys.stderr)
     return EXIT_ERROR
 

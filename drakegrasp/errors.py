@@ -18,6 +18,18 @@ terminal.  Messages cut a value themselves, to about 120 characters
 """
 
 
+def cut_message(text: str, limit: int = MAX_MESSAGE) -> str:
+    """``text`` as a plain str of at most ``limit`` characters, saying what it cut.
+
+    A cut text fits ``limit`` with its note, so cutting it again changes nothing.
+    """
+    text = str.__str__(text)
+    if len(text) <= limit:
+        return text
+    kept = max(limit - 50, 0)  # room for the note
+    return f"{text[:kept]}... ({len(text) - kept} characters cut)"
+
+
 class GraspError(Exception):
     """Base class of every error raised by drakegrasp.
 
@@ -26,11 +38,8 @@ class GraspError(Exception):
     """
 
     def __init__(self, *args: Any):
-        if args and isinstance(args[0], str) and len(args[0]) > MAX_MESSAGE:
-            message = str.__str__(args[0])
-            kept = MAX_MESSAGE - 50  # room for the note: a cut message stays whole
-            note = f"... ({len(message) - kept} characters cut)"
-            args = (message[:kept] + note, *args[1:])
+        if args and isinstance(args[0], str):
+            args = (cut_message(args[0]), *args[1:])
         super().__init__(*args)
 
 
