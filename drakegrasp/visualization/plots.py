@@ -387,6 +387,18 @@ def _draw_certificate(ax, grasp: Grasp, cert: Any, patch: Any):
     return plot_unresisted_wrench(ax, grasp, cert)
 
 
+def _colour(is_color_like, value) -> bool:
+    """Whether matplotlib can draw ``value``; not if reading it raises.
+
+    matplotlib names a value it cannot read with its ``repr``, so a value whose
+    ``repr`` raises made ``is_color_like`` raise instead of answering.
+    """
+    try:
+        return bool(is_color_like(value))
+    except Exception:  # noqa: BLE001 - a hostile repr or __array__
+        return False
+
+
 def _check_plot_options(colors, outline, force_scale) -> None:
     """Refuse colours matplotlib cannot draw, a text outline, a bad force scale."""
     if colors is not None:
@@ -396,7 +408,7 @@ def _check_plot_options(colors, outline, force_scale) -> None:
             )
         from matplotlib.colors import is_color_like
 
-        bad = {k: v for k, v in colors.items() if not is_color_like(v)}
+        bad = {k: v for k, v in colors.items() if not _colour(is_color_like, v)}
         if bad:
             raise InvalidOptionError(
                 f"colors {describe(bad)} are not matplotlib colours (names such as "

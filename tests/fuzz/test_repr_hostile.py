@@ -186,3 +186,12 @@ def test_a_valid_float_subclass_is_taken_whatever_its_repr(options):
     # A float subclass whose repr raises is a valid tolerance: its message,
     # built before the check, raised the repr's error for a valid value.
     assert options(hostile.FloatReprRaises(5e-4)) == 5e-4
+
+
+@pytest.mark.parametrize("value", HOSTILE, ids=IDS)
+def test_plot_colours_with_a_hostile_repr_are_refused_by_name(value):
+    # matplotlib's is_color_like formats a value it cannot read with its repr.
+    import drakegrasp.visualization as viz
+
+    grasp = dg.core.examples.planar_two_finger_square(0.5)
+    _refuses_briefly(lambda v: viz.plot_planar_grasp(grasp, colors={"x": v}), value)
