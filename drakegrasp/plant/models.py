@@ -288,6 +288,8 @@ def use_local_drake_models(
             f"path must be a folder name (str or os.PathLike), got a "
             f"{type(path).__name__}"
         )
+    if isinstance(path, str):  # a plain str: a subclass's own __str__ may raise
+        path = str.__str__(path)
     folder = Path(path).expanduser().resolve()
     if not folder.is_dir():
         if from_env:

@@ -195,3 +195,12 @@ def test_plot_colours_with_a_hostile_repr_are_refused_by_name(value):
 
     grasp = dg.core.examples.planar_two_finger_square(0.5)
     _refuses_briefly(lambda v: viz.plot_planar_grasp(grasp, colors={"x": v}), value)
+
+
+def test_a_models_folder_that_is_a_hostile_str_subclass_is_read_as_its_text():
+    # pathlib calls str() on a str subclass, whose own __str__ may raise.
+    from drakegrasp.planning.scenes import planning_scene
+
+    box = "package://drake_models/ycb/003_cracker_box.sdf"
+    with pytest.raises(dg.ModelError, match="drake_models folder 'x'"):
+        planning_scene(box, models_dir=hostile.StrFormatRaises("x"))
