@@ -304,6 +304,7 @@ def plan_grasps(
         and ``torque_needed`` are 0 (no weight needs no effort), so none is
         ranked behind the others for needing more than the motors give; the
         scores (per newton of weight) are those of any other gravity.
+        ``result.settings["gravity"]`` records it (m/s²).
     plant_context : Context
         The plant's context or its diagram's root.  The object's pose (and the
         scene's) is read from it; the hand's configuration is used as scratch
@@ -539,6 +540,7 @@ def plan_grasps(
         "distance_tolerance": tol,
         "robustness_samples": robustness_samples,
         "noise": noise,
+        "gravity": g,  # |g| (m/s²) the weight was taken at, for the shake to match
     }
     if object_mass is not None:
         settings["object_mass"] = object_mass  # the weight planned for, to shake

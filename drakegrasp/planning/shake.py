@@ -114,14 +114,19 @@ from drakegrasp.plant.validation import (
 )
 
 __all__ = [
+    "CONTACT_PERIOD_STEPS",
     "DAMPING_TIME",
+    "DEFAULT_TIME_STEP",
     "MIN_SHAKEN_MASS",
+    "PASSED_DEPTH",
     "PRISMATIC_STIFFNESS",
     "REVOLUTE_AIM",
     "SEAT_TOLERANCE",
+    "CoarseStepWarning",
     "SoftFingerShakeWarning",
     "SqueezeLostWarning",
     "check_shake_options",
+    "contact_period",
     "recorded_mass",
     "shake_test",
 ]
@@ -323,13 +328,14 @@ def check_shake_options(
     ]
     mass = [] if object_mass is None else [("object_mass", object_mass, 0.0, "kg")]
     squeezes = []  # None: newtons at the contacts (shake_test)
+    steps = [] if time_step is None else [("time_step", time_step, 0.0, "s")]
     if squeeze is not None:
         squeezes = [("squeeze", squeeze, 0.0, "N, or N·m for revolute joints")]
     for name, value, low, unit in (
         *gains,
         *mass,
         *squeezes,
-        ("time_step", time_step, 0.0, "s"),
+        *steps,
         ("phase", phase, 0.0, "s"),
         ("settle", settle, None, "s"),
         ("blend", blend, None, "s"),
@@ -350,7 +356,7 @@ def check_shake_options(
             )
     if object_mass is not None:
         _check_mass("object_mass", float(object_mass))
-    if time_step > phase / 10:
+    if time_step is not None and time_step > phase / 10:
         raise InvalidOptionError(
             f"time_step must be at most a tenth of a phase ({phase / 10:g} s) to "
             f"resolve the shake, got {time_step!r}"
@@ -381,6 +387,124 @@ MIN_SHAKEN_MASS = 1e-6
 """The lightest object (kg) the shake test simulates: a milligram.  Drake's
 contact solver stopped on objects of 1e-12 kg against a gripper's gains (the
 fuzz suite); no hand grasps anything that light."""
+
+
+DEFAULT_TIME_STEP = 1e-3
+"""The shake's time step (s) where the object's contacts do not ask for a
+finer one (:data:`CONTACT_PERIOD_STEPS`)."""
+
+CONTACT_PERIOD_STEPS = 1.25
+"""Steps per period of the object's stiffest contact mode that the shake
+takes at the least (``time_step=None`` picks the step so; a coarser given
+step is warned of, :class:`CoarseStepWarning`).
+
+Drake's SAP solver treats a contact whose period ``T = 2π / ω`` is below the
+step as near-rigid and regularises it, letting the object creep in stiction
+at a rate that grows with the step.  Measured with Drake 1.51's default point
+contact (1e6 N/m per geometry, so 5e5 N/m a pair) at the default squeeze of
+20 N, 2.8 s of shaking: a 1 cm cube held by a three-finger hand at its three
+planned contacts, 4 g (``T`` 0.39 ms by :func:`contact_period`), dropped and
+left the hand at 1 ms (T/h 0.39), turned 17.6° at 0.5 ms (0.78: dropped),
+9.7° at 0.2 ms (1.9), 6.2° at 0.1 ms and 3.9° at 0.05 ms (held); at 16 g
+(T 0.78 ms) 17.0° at 1 ms (0.78: dropped), 8.9° at 0.5 ms and 5.3° at 0.2 ms
+(held); the WSG-50's tip spheres on a 5 g cube (T 0.53 ms) threw it 5 m out
+of the hand at 1 ms and 2 m at 0.5 ms (T/h 0.53 and 1.06), and kept it
+within 7.8 mm at 0.2 ms and 0.1 ms (turning 179° about the line between its
+two point contacts, which resist no torque about it: a drop that point
+contact makes, at every step).  The shipped objects' periods are 2.6 ms and
+longer (the WSG-50 on the 50 mm box: 4.8 ms), so their default step stays
+1 ms."""
+
+
+def _resolving_step(period: float) -> float:
+    """The step (s) that takes :data:`CONTACT_PERIOD_STEPS` per ``period``.
+
+    Rounded down to two significant digits (0.26 ms for a period of 0.53
+    ms); ``inf`` for an infinite period.
+    """
+    if not math.isfinite(period):
+        return math.inf
+    h = period / CONTACT_PERIOD_STEPS
+    unit = 10.0 ** (math.floor(math.log10(h)) - 1)
+    return math.floor(h / unit) * unit
+
+
+class CoarseStepWarning(UserWarning):
+    """The given ``time_step`` does not resolve the object's contacts.
+
+    The object's stiffest contact mode has a period under
+    :data:`CONTACT_PERIOD_STEPS` steps: Drake's contact solver regularises
+    it, and the object creeps or is thrown out of the hand by the
+    simulation, not by the grasp.  The message names the step that resolves
+    it (``time_step=None`` picks it).
+    """
+
+
+def contact_period(plant, inspector, body, candidate, mass: float) -> float:
+    r"""The period (s) of the object's stiffest translation on the planned contacts.
+
+    Each planned contact ``i`` (normal ``n_i`` in the object's frame O) is a
+    spring of Drake's point-contact stiffness ``k_i`` (N/m), that of the
+    finger body's and the object's geometries in series, as Drake combines
+    them (``material/point_contact_stiffness``; the stiffest geometry of each
+    body), between rigid fingers (position-controlled, and far heavier than
+    a light object) and the object's mass ``m`` (kg):
+
+    .. math::
+
+        T = 2\pi \sqrt{m / \lambda_{max}\left(\sum_i k_i \, n_i n_i^T\right)}.
+
+    Parameters
+    ----------
+    plant : MultibodyPlant
+        Finalized, registered with a ``SceneGraph``; holds the object and the
+        candidate's finger bodies.
+    inspector : SceneGraphInspector
+        The inspector of a context's geometry query (it holds the
+        ``SceneGraphConfig``'s default proximity properties).
+    body : RigidBody
+        The object.
+    candidate : GraspCandidate
+        Its ``contacts`` (frame O) name their finger bodies.
+    mass : float
+        The object's mass, kg.
+
+    Returns
+    -------
+    float
+        Seconds; ``inf`` where it cannot be told (no contacts, or a geometry
+        without a point-contact stiffness: Drake's own estimate then).  A
+        hydroelastic pair presses with its patch's stiffness, not this one:
+        :func:`shake_test` does not ask with ``hydroelastic_modulus``.
+    """
+
+    def stiffness(of) -> float:
+        values = [
+            inspector.GetProximityProperties(g).GetPropertyOrDefault(
+                "material", "point_contact_stiffness", math.nan
+            )
+            for g in plant.GetCollisionGeometriesForBody(of)
+        ]
+        if not values or not all(map(_finite, values)):
+            return math.nan
+        return float(max(values))
+
+    k_object = stiffness(body)
+    contacts = [c for c in candidate.contacts if getattr(c, "finger_body", None)]
+    if not contacts or not k_object > 0:
+        return math.inf
+    K = np.zeros((3, 3))
+    for c in contacts:
+        try:
+            k_finger = stiffness(resolve_body(plant, c.finger_body))
+        except GraspError:
+            return math.inf
+        if not k_finger > 0:
+            return math.inf
+        n = np.asarray(c.nhat_O, dtype=float)
+        K += (k_finger * k_object / (k_finger + k_object)) * np.outer(n, n)
+    lam = float(np.max(np.linalg.eigvalsh(K)))
+    return 2 * math.pi * math.sqrt(mass / lam) if lam > 0 else math.inf
 
 
 def _weightless(plant) -> str:
@@ -726,6 +850,108 @@ def _check_finger_gaps(plant, ctx, body, planned: list) -> None:
             )
 
 
+PASSED_DEPTH = 1e-4
+"""How deep (m) a finger's collision geometry may overlap the object at the
+seat while pressing it with no force, before the shake refuses the run as one
+whose fingers passed into the object (:func:`_check_seated`).  Pressing, an
+overlap is the contact's own compliance (0.04 mm at 20 N in Drake's default
+point contact; 1-4 mm for compliant pads); pressing nothing, it is a finger
+Drake no longer sees: the WSG-50's 1 mm tip spheres made hydroelastic at 1e6
+Pa carry about ``E π r²`` = 3 N, and under a 20 N squeeze they closed 2.5 mm
+into a 10 mm cube, wholly inside it, where a compliant geometry in a rigid one
+has no contact surface: the cube fell 8 m, "dropped" by no grasp's fault."""
+
+
+def _check_seated(plant, ctx, body, candidate, modulus, squeeze) -> None:
+    """Refuse a run whose fingers went into the object while seating.
+
+    Each finger body that touched the object in the plan (the candidate's
+    contacts name it) must, at the end of seating, press the object (a
+    contact force in Drake's ``ContactResults``) or not overlap it deeper
+    than :data:`PASSED_DEPTH`: one that overlaps it pressing nothing passed
+    into it (or through it), and what the test would see next is the
+    simulation's failure, not a drop.  A candidate planned on a point cloud
+    names no fingers on a body and is let be.
+
+    Raises
+    ------
+    SolverError
+        A finger passed into the object; the message names it, its depth and
+        the remedies.
+    """
+    fingers = sorted(
+        {
+            c.finger_body
+            for c in candidate.contacts
+            if getattr(c, "object_geometry_name", None)
+            and getattr(c, "finger_body", None)
+        }
+    )
+    if not fingers:
+        return
+    results = plant.get_contact_results_output_port().Eval(ctx)
+    query = plant.get_geometry_query_input_port().Eval(ctx)
+    inspector = query.inspector()
+    pressing = set()  # bodies that press the object
+    for i in range(results.num_point_pair_contacts()):
+        info = results.point_pair_contact_info(i)
+        pair = {info.bodyA_index(), info.bodyB_index()}
+        if body.index() in pair and np.linalg.norm(info.contact_force()) > 0:
+            pressing |= pair
+    for i in range(results.num_hydroelastic_contacts()):
+        info = results.hydroelastic_contact_info(i)
+        surface = info.contact_surface()
+        pair = {
+            plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index()
+            for g in (surface.id_M(), surface.id_N())
+        }
+        if body.index() in pair and np.linalg.norm(info.F_Ac_W().translational()) > 0:
+            pressing |= pair
+    objects = plant.GetCollisionGeometriesForBody(body)
+    passed = []
+    for name in fingers:
+        finger = resolve_body(plant, name)
+        if finger.index() in pressing:
+            continue
+        depths = []
+        for gf in plant.GetCollisionGeometriesForBody(finger):
+            for go in objects:
+                if inspector.CollisionFiltered(go, gf):
+                    continue
+                try:
+                    pair = query.ComputeSignedDistancePairClosestPoints(go, gf)
+                except RuntimeError:  # a pair Drake does not measure: let be
+                    continue
+                depths.append(-float(pair.distance))
+        if depths and max(depths) > PASSED_DEPTH:
+            passed.append(f"{name} {max(depths) * 1e3:.3g} mm")
+    if not passed:
+        return
+    if modulus is not None:
+        cause = (
+            f"its hydroelastic geometry ({modulus:g} Pa) gave way under the "
+            f"squeeze ({squeeze:g}) until it lay inside the rigid object, where "
+            "a compliant geometry has no contact surface (a compliant ball of "
+            "radius r carries about modulus × π r² before it does)"
+        )
+        remedy = (
+            "give a stiffer hydroelastic_modulus, a smaller squeeze, or point "
+            "contact (hydroelastic_modulus=None)"
+        )
+    else:
+        cause = "it closed past the object's surface faster than contact stopped it"
+        remedy = (
+            "give a smaller time_step, stiffer contact (the geometries' "
+            "point_contact_stiffness) or a smaller squeeze"
+        )
+    raise SolverError(
+        "the shake test's simulation lost the grasp while seating, which is no "
+        f"drop: the finger{'' if len(passed) == 1 else 's'} "
+        f"{', '.join(passed)} inside {_scoped(plant, body)}, pressing it with "
+        f"no force (deeper than {PASSED_DEPTH * 1e3:g} mm): {cause}; {remedy}"
+    )
+
+
 def _at_stops(plant, ctx, squeezing, targets, efforts, units) -> list[str]:
     """The squeezing joints that stand at their limit, aimed past it, in words.
 
@@ -779,7 +1005,7 @@ def shake_test(
     phase: float = 0.4,
     seat: float = 0.1,
     blend: float = 0.1,
-    time_step: float = 1e-3,
+    time_step: float | None = None,
     max_displacement: float = 0.01,
     max_rotation: float = np.radians(10.0),
     object_body=None,
@@ -952,6 +1178,7 @@ def shake_test(
             "candidate must be a GraspCandidate from plan_grasps, got "
             f"{type(candidate).__name__}"
         )
+    given = (candidate, X_WO, object_mass)  # as called: for a finer step's run
     planned_X_WO = candidate.X_WO
     if X_WO is not None:
         candidate = replace(candidate, X_WO=check_rigid_transform("X_WO", X_WO))
@@ -965,24 +1192,10 @@ def shake_test(
         object_mass=object_mass,
     )  # fmt: skip
     modulus = check_hydroelastic_modulus(hydroelastic_modulus)
-    if modulus is None and candidate.contact_options.get("contact_model") == (
-        "soft_finger"
-    ):
-        warnings.warn(
-            "the candidate was planned with soft fingers (torsional_friction "
-            f"{candidate.contact_options.get('torsional_friction')!r}), which "
-            "resist a torque about each contact normal; Drake's point contact "
-            "resists none, so this shake may drop a grasp the plan holds: give "
-            "hydroelastic_modulus= (1e6 Pa, rubber) for fingers that press "
-            "over patches",
-            SoftFingerShakeWarning,
-            stacklevel=outside_stacklevel(),
-        )
     t0 = time.perf_counter()
+    step = DEFAULT_TIME_STEP if time_step is None else float(time_step)
     builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(
-        builder, time_step=float(time_step)
-    )
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=step)
     made = add_models(plant, new_parser(plant, "the shake test's plant"))
     if not (isinstance(made, tuple | list) and len(made) == 2):
         raise ModelError(
@@ -1101,6 +1314,45 @@ def shake_test(
     ctx = plant.GetMyContextFromRoot(root)
     if inertia is not None:
         body.SetSpatialInertiaInBodyFrame(ctx, inertia)
+    period = math.inf  # a compliant patch's stiffness is not a point's
+    query = plant.get_geometry_query_input_port().Eval(ctx)  # the config's too
+    if modulus is None:
+        period = contact_period(plant, query.inspector(), body, candidate, mass)
+    resolving = _resolving_step(period)
+    if time_step is None and resolving < step:  # built again at that step
+        result = shake_test(
+            add_models, given[0], squeeze=None if default else squeeze,
+            stiffness=stiffness, damping=damping, directions=directions,
+            settle=settle, phase=phase, seat=seat, blend=blend,
+            time_step=resolving, max_displacement=max_displacement,
+            max_rotation=max_rotation, object_body=object_body, X_WO=given[1],
+            hydroelastic_modulus=hydroelastic_modulus, object_mass=given[2],
+        )  # fmt: skip
+        return replace(result, wall_time=time.perf_counter() - t0)
+    if step > resolving:
+        warnings.warn(
+            f"time_step = {step:g} s does not resolve the object's contacts: "
+            f"their stiffest mode has a period of {period:.3g} s "
+            f"({mass:g} kg on point contacts), under {CONTACT_PERIOD_STEPS:g} "
+            "steps, so Drake's contact solver regularises them and the object "
+            "may creep or be thrown out of the hand by the simulation; give "
+            f"time_step <= {resolving:.2g} s (or None, which picks it)",
+            CoarseStepWarning,
+            stacklevel=outside_stacklevel(),
+        )
+    if modulus is None and candidate.contact_options.get("contact_model") == (
+        "soft_finger"
+    ):
+        warnings.warn(
+            "the candidate was planned with soft fingers (torsional_friction "
+            f"{candidate.contact_options.get('torsional_friction')!r}), which "
+            "resist a torque about each contact normal; Drake's point contact "
+            "resists none, so this shake may drop a grasp the plan holds: give "
+            "hydroelastic_modulus= (1e6 Pa, rubber) for fingers that press "
+            "over patches",
+            SoftFingerShakeWarning,
+            stacklevel=outside_stacklevel(),
+        )
     candidate.apply(plant, ctx, object_body=body)
     _check_planned_object(plant, ctx, body, candidate, planned_X_WO)
     _warn_friction(plant, ctx, body, hand, candidate)
@@ -1181,6 +1433,7 @@ def shake_test(
              for name in candidate.joint_names],
         )  # fmt: skip
         seated_X_WO = plant.EvalBodyPoseInWorld(ctx, body).GetAsMatrix4()
+        _check_seated(plant, ctx, body, candidate, modulus, squeeze)
     else:
         advance(settle)  # efforts are read once something has been simulated
     u = plant.get_net_actuation_output_port().Eval(ctx)
@@ -1240,7 +1493,7 @@ def shake_test(
         phases=tuple(phases),
         squeeze=float(squeeze),
         efforts=efforts,
-        time_step=float(time_step),
+        time_step=step,
         duration=duration,
         wall_time=time.perf_counter() - t0,
         bounds=(float(max_displacement), float(max_rotation)),
@@ -1261,4 +1514,5 @@ def shake_test(
         gains=used,
         object_mass=mass,
         gravity=g,
+        contact_period=period,
     )

@@ -17,6 +17,7 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.planning.turned_gravity import GRAVITY
 
 __all__ = ["ShakeResult", "motion_text", "squeeze_unit_of"]
 
@@ -135,6 +136,14 @@ class ShakeResult:
         of the plant ``add_models`` built, so the object weighed
         ``object_mass × gravity`` newtons.  NaN in a record made before it
         existed (those shook with 9.81).
+    contact_period : float
+        The period (s) of the object's stiffest mode on the planned contacts'
+        point-contact stiffness
+        (:func:`~drakegrasp.planning.shake.contact_period`), which
+        ``time_step=None`` takes at least
+        :data:`~drakegrasp.planning.shake.CONTACT_PERIOD_STEPS` steps per;
+        ``inf`` where not told (hydroelastic fingers, a stiffness the models
+        do not state), NaN in a record made before it existed.
     """
 
     held: bool
@@ -164,6 +173,7 @@ class ShakeResult:
     object_mass: float = float("nan")
     squeeze_at_contacts: bool = False
     gravity: float = float("nan")
+    contact_period: float = float("nan")
 
     def seated(self, candidate):
         """``candidate`` with the hand's joints and the object where seating left them.
@@ -259,6 +269,9 @@ class ShakeResult:
     def __str__(self) -> str:
         """One line, led by ``held_from_seat`` ("held from the seat").
 
+        The gravity is named when it is not the standard 9.81 m/s² (a moon's,
+        a scaled scene's).
+
         With seating, the motion from the seat comes first and the motion from
         the plan's pose after it (``held``, which ``shake_candidates(
         held_from="plan")`` ranks by, counts from there).
@@ -312,6 +325,11 @@ class ShakeResult:
                     if self.hydroelastic_refused
                     else ")"
                 )
+            )
+            + (
+                f", gravity {self.gravity:g} m/s²"
+                if np.isfinite(self.gravity) and self.gravity != GRAVITY
+                else ""
             )
             + f"{tail}; {self.wall_time:.2f} s wall"
         )

@@ -1,0 +1,127 @@
+"""The shake test tells a simulation's failure from a drop.
+
+A 10 mm, 5 g cube held by the WSG-50's 1 mm tip spheres (``cube.sdf`` below,
+planned with soft fingers as the reports that found these did): with
+hydroelastic tips of 1e6 Pa the fingers closed through it while seating and it
+fell 8 m, "dropped"; in point contact at a 1 ms step it was thrown 5 m out of
+the hand, where 0.2 ms and 0.1 ms keep it within 7.8 mm (turning about the
+line between its two point contacts, which point contact lets it).
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+
+import pytest
+
+from drakegrasp.errors import SolverError
+from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning.shake import (
+    CONTACT_PERIOD_STEPS,
+    CoarseStepWarning,
+    SoftFingerShakeWarning,
+)
+from drakegrasp.plant.friction import FrictionMismatchWarning
+
+CUBE = """<?xml version="1.0"?>
+<sdf version="1.9">
+<model name="cube">
+  <link name="cube">
+    <inertial><mass>0.005</mass><inertia><ixx>8.3e-8</ixx><iyy>8.3e-8</iyy>
+      <izz>8.3e-8</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
+    <collision name="c"><geometry><box><size>0.01 0.01 0.01</size></box></geometry>
+    </collision>
+  </link>
+</model>
+</sdf>
+"""
+
+
+@pytest.fixture(scope="module")
+def cube(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cube") / "cube.sdf"
+    path.write_text(CUBE)
+    scene = planning_scene(f"file://{path}")
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=60, mu=0.5, seed=0, contact_model="soft_finger",
+        torsional_friction=0.1,
+    )  # fmt: skip
+    return scene, next(c for c in result if c.is_closure)
+
+
+def _quiet():
+    ctx = warnings.catch_warnings()
+    ctx.__enter__()
+    for category in (SoftFingerShakeWarning, FrictionMismatchWarning):
+        warnings.simplefilter("ignore", category)
+    return ctx
+
+
+def test_fingers_that_closed_through_the_object_are_no_drop(cube):
+    # before: held=False, max_displacement 8.15 m, seated_q_hand (0, 0)
+    scene, candidate = cube
+    ctx = _quiet()
+    try:
+        with pytest.raises(SolverError) as caught:
+            shake_test(scene.add_models, candidate, hydroelastic_modulus=1e6)
+    finally:
+        ctx.__exit__(None, None, None)
+    message = str(caught.value)
+    assert "which is no drop" in message
+    depths = re.findall(r"_finger (\d+\.?\d*) mm", message)
+    assert len(depths) == 2 and all(float(d) > 2.0 for d in depths), message
+    assert "stiffer hydroelastic_modulus" in message
+    assert "point contact (hydroelastic_modulus=None)" in message
+
+
+def test_a_step_coarser_than_the_contacts_is_warned_of_and_none_resolves_it(cube):
+    scene, candidate = cube
+    ctx = _quiet()
+    try:
+        with pytest.warns(CoarseStepWarning, match=r"give time_step <= 0\.00035 s"):
+            coarse = shake_test(scene.add_models, candidate, time_step=1e-3)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", CoarseStepWarning)
+            chosen = shake_test(scene.add_models, candidate)
+    finally:
+        ctx.__exit__(None, None, None)
+    # 5 g on two 5e5 N/m contacts: T = 2 pi sqrt(0.005 / 1e6) = 0.444 ms
+    assert chosen.contact_period == pytest.approx(4.443e-4, rel=1e-3)
+    assert chosen.time_step <= chosen.contact_period / CONTACT_PERIOD_STEPS
+    assert chosen.time_step == pytest.approx(3.5e-4)
+    # thrown out of the hand at 1 ms; kept in it, as at 0.1 ms (7.8 mm), now
+    assert coarse.max_displacement > 1.0
+    assert chosen.max_displacement < 0.012
+    assert not chosen.held  # it turns about its two point contacts: physics
+    assert "out of the hand" not in str(chosen)
+
+
+def test_the_shipped_box_keeps_the_default_step():
+    scene = planning_scene("package://drakegrasp/objects/box.sdf")
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=30, mu=1.0, seed=0,
+    )  # fmt: skip
+    shaken = shake_test(scene.add_models, result[0], directions=[[1.0, 0, 0]])
+    assert shaken.time_step == 1e-3
+    assert shaken.contact_period > 1.25e-3
+    assert "m/s²" not in str(shaken)  # standard gravity goes unsaid
+
+
+def test_the_plan_records_its_gravity_and_the_shake_names_another():
+    scene = planning_scene("package://drakegrasp/objects/box.sdf")
+    result = plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=30, mu=1.0, seed=0,
+    )  # fmt: skip
+    assert result.settings["gravity"] == 9.81
+
+    def moon(plant, parser):
+        made = scene.add_models(plant, parser)
+        plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -1.62])
+        return made
+
+    shaken = shake_test(moon, result[0], directions=[[1.0, 0, 0]], settle=0.1)
+    assert ", gravity 1.62 m/s²" in str(shaken)
