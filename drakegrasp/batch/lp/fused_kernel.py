@@ -128,11 +128,15 @@ def _full_rank_stack(G, normal, rank_tol, F, shared, kap, coff, ncomp, foff, nro
     wr, wm, we, WT, Hs, S = work_arrays(R, M, e, N)
     Cf = np.empty(R)
     nz = M - w
-    ZT = np.empty((max(nz, 1), M))
-    AT = np.empty((max(nz, 1), R))
-    ct = np.empty(max(nz, 1))
     reduced = active_set and nz >= 2 and worth_it(nz, R)
-    aswork = active_set_work(max(nz, 1), R)
+    # The null-space basis and the active set's work arrays hold O(nz M),
+    # O(nz R) and O(nz²) numbers: only for the small null spaces they serve
+    # (nz <= 7), never O(N²) for a grasp of many contacts.
+    nr = nz if reduced else 1
+    ZT = np.empty((nr, M))
+    AT = np.empty((nr, R))
+    ct = np.empty(nr)
+    aswork = active_set_work(nr, R)
     for k in range(K):
         for i in range(w):
             for m in range(M):
