@@ -6,11 +6,15 @@ a grasp too large for any chunk is refused before anything is allocated.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
+from scipy import sparse
 
-from drakegrasp.batch import batch_force_closure
+from drakegrasp.batch import batch_force_closure, batch_form_closure
 from drakegrasp.batch.lp import block_kernel
+from drakegrasp.batch.lp.dstar import _facet_block
 
 
 def _ellipsoid(N, K=1, seed=3):
@@ -38,3 +42,38 @@ def test_one_grasp_of_twenty_thousand_contacts_is_solved():
     P, Nrm = _ellipsoid(20_000)
     res = batch_force_closure(P, Nrm, mu=0.5, kernel="numba")
     assert res.is_closure.all() and res.converged.all()
+
+
+@needs_numba
+def test_a_huge_lp_past_the_ipm_cap_is_not_handed_to_highs():
+    # LP1 of 20,000 frictionless contacts reaches the IPM's cap; HiGHS took
+    # a dense (20,000 x 20,000) block (3 GiB, 10 GB at its peak) and then
+    # more than 10 minutes.  The IPM's iterate stands, marked not converged.
+    P, Nrm = _ellipsoid(20_000)
+    start = time.perf_counter()
+    form = batch_form_closure(P, Nrm, kernel="numba")
+    assert time.perf_counter() - start < 60
+    assert form.is_closure.all() and 0.9 < form.d_star[0] < 1.0
+
+
+def test_highs_gets_the_dense_facet_block_as_sparse():
+    rng = np.random.default_rng(5)
+    mu = 0.4
+    planar = np.array([[mu, 1.0], [mu, -1.0]]) / np.hypot(1.0, mu)
+    hard = rng.normal(size=(8, 3))
+    hard[0, 1] = 0.0
+    facets = [planar, np.ones((1, 1)), hard, planar]
+    widths = [F.shape[1] for F in facets]
+    starts = np.concatenate([[0], np.cumsum(widths)[:-1]])
+    slices = [slice(a, a + b) for a, b in zip(starts, widths, strict=True)]
+    M = sum(widths)
+    dense = np.zeros((sum(F.shape[0] for F in facets), M))
+    row = 0
+    for F, s in zip(facets, slices, strict=True):
+        dense[row : row + F.shape[0], s] = F
+        row += F.shape[0]
+    want = sparse.csc_array(np.hstack([-dense, np.ones((row, 1))]))
+    got = _facet_block(facets, slices, M)
+    np.testing.assert_array_equal(got.indptr, want.indptr)
+    np.testing.assert_array_equal(got.indices, want.indices)
+    np.testing.assert_array_equal(got.data, want.data)

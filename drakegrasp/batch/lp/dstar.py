@@ -16,7 +16,9 @@ spanned by ``c``, so ``t* = min F c / ‖c‖²``.  Everything else goes to the
 block interior-point method, started at ``f = c / ‖c‖²``: compiled
 (:mod:`drakegrasp.batch.lp.block_kernel`) or in numpy
 (:func:`drakegrasp.batch.lp.block_ipm.solve_block_lp`); the rare LPs that
-reach its iteration cap are solved again one by one with HiGHS.  With numba,
+reach its iteration cap are solved again one by one with HiGHS (those of at
+most ``HIGHS_MAX_COLUMNS`` force components; a larger one keeps the
+interior-point method's answer, reported as not converged).  With numba,
 the grasps whose full rank a QR certifies are first solved in one compiled
 pass (:mod:`drakegrasp.batch.lp.fused_kernel`: null space and LP together, by
 the active-set method of :mod:`drakegrasp.batch.lp.active_set` where the null
@@ -32,7 +34,12 @@ import numpy as np
 from drakegrasp.batch.build.rowspace import row_spaces
 from drakegrasp.batch.inputs import compiled_route
 from drakegrasp.batch.lp.block_ipm import ContactGroup, solve_block_lp
-from drakegrasp.batch.lp.tolerances import IPM_MAX_ITER, IPM_TOL, PUSH_TOL
+from drakegrasp.batch.lp.tolerances import (
+    HIGHS_MAX_COLUMNS,
+    IPM_MAX_ITER,
+    IPM_TOL,
+    PUSH_TOL,
+)
 
 __all__ = ["solve_dstar_blocks"]
 
@@ -81,29 +88,54 @@ def _stack_facets(facets, members, sel, everyone):
     return np.ascontiguousarray(np.transpose(stacked[:, sel], (2, 3, 0, 1)))
 
 
+def _facet_block(facets, slices, M):
+    """``-F`` (every contact's facet rows on its columns) and ``1``: sparse (R, M+1).
+
+    ``O(R c)`` entries, never the dense (R, M) block (36 GiB for one grasp of
+    20,000 hard contacts).  Exact zeros are dropped and indices sorted, so
+    HiGHS receives the very matrix ``csc_array`` makes of the dense block.
+    """
+    from scipy import sparse
+
+    rows, cols, vals = [], [], []
+    row = 0
+    for F, s in zip(facets, slices, strict=True):
+        r, c = F.shape
+        rows.append(np.repeat(np.arange(row, row + r), c))
+        cols.append(np.tile(np.arange(s.start, s.start + c), r))
+        vals.append(-F.reshape(-1))
+        row += r
+    rows.append(np.arange(row))
+    cols.append(np.full(row, M))
+    vals.append(np.ones(row))
+    block = sparse.csc_array(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(row, M + 1),
+    )
+    block.eliminate_zeros()
+    block.sort_indices()
+    return block
+
+
 def _highs(Q, facets, slices, normal_columns, fallback):
     """``t*`` of one LP with HiGHS (``scipy.optimize.linprog``): (value, ok)."""
+    from scipy import sparse
     from scipy.optimize import linprog
 
     M = Q.shape[0]
-    Fblock = np.zeros((sum(F.shape[0] for F in facets), M))
-    row = 0
-    for F, s in zip(facets, slices, strict=True):
-        Fblock[row : row + F.shape[0], s] = F
-        row += F.shape[0]
     e = np.zeros(M)
     e[normal_columns] = 1.0
     A_eq = np.hstack([np.vstack([Q.T, e]), np.zeros((Q.shape[1] + 1, 1))])
     b_eq = np.zeros(Q.shape[1] + 1)
     b_eq[-1] = 1.0
-    A_ub = np.hstack([-Fblock, np.ones((Fblock.shape[0], 1))])
+    A_ub = _facet_block(facets, slices, M)
     cost = np.zeros(M + 1)
     cost[-1] = -1.0
     res = linprog(
         cost,
         A_ub=A_ub,
         b_ub=np.zeros(A_ub.shape[0]),
-        A_eq=A_eq,
+        A_eq=sparse.csc_array(A_eq),
         b_eq=b_eq,
         bounds=[(None, None)] * (M + 1),
         method="highs",
@@ -284,7 +316,7 @@ def solve_dstar_blocks(
                 groups, tol=tol_t, max_iter=ipm_max_iter, stop_below=0.0
             )
             t, ok = sol.value, sol.converged
-        if not ok.all():
+        if not ok.all() and M <= HIGHS_MAX_COLUMNS:  # else: converged False
             t, ok = t.copy(), ok.copy()
             for j in np.flatnonzero(~ok):
                 k = sel[j]

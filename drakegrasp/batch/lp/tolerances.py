@@ -9,7 +9,7 @@ not user thresholds: those (``tol``, ``rank_tol``) are in
 
 from __future__ import annotations
 
-__all__ = ["BLOCK_TOL", "IPM_MAX_ITER", "IPM_TOL", "PUSH_TOL"]
+__all__ = ["BLOCK_TOL", "HIGHS_MAX_COLUMNS", "IPM_MAX_ITER", "IPM_TOL", "PUSH_TOL"]
 
 IPM_TOL = 1e-10
 """The interior-point iteration stops when its scaled residuals and duality gap
@@ -25,3 +25,12 @@ PUSH_TOL = 1e-10
 BLOCK_TOL = 1e-9
 """A facet blocks a step when its rate along the step, relative to the norms
 involved, is below ``-BLOCK_TOL`` (active set) or above it (vertex walk)."""
+
+HIGHS_MAX_COLUMNS = 2048
+"""Most force components ``M`` of an LP that HiGHS solves again after the
+interior-point method reached its cap.  HiGHS's time grows about as ``M³``
+on these LPs (one grasp of frictionless contacts on an ellipsoid: 0.07 s at
+``M = 1000``, 0.38 s at 2000, 3.2 s at 4000, more than 10 minutes at 20,000);
+a larger LP keeps the interior-point method's last iterate, reported with
+``converged = False``, rather than hang.  The LPs of hands (``M <= 4 * 32``)
+are far below it."""
