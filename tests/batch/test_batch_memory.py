@@ -15,6 +15,8 @@ from scipy import sparse
 from drakegrasp.batch import batch_force_closure, batch_form_closure
 from drakegrasp.batch.lp import block_kernel
 from drakegrasp.batch.lp.dstar import _facet_block
+from drakegrasp.batch.run.stream import GRASP_BYTES_MAX, chunk_size_for, grasp_bytes
+from drakegrasp.errors import InvalidContactError
 
 
 def _ellipsoid(N, K=1, seed=3):
@@ -77,3 +79,30 @@ def test_highs_gets_the_dense_facet_block_as_sparse():
     np.testing.assert_array_equal(got.indptr, want.indptr)
     np.testing.assert_array_equal(got.indices, want.indices)
     np.testing.assert_array_equal(got.data, want.data)
+
+
+@pytest.mark.parametrize("kind", ["force", "form"])
+def test_a_grasp_too_large_for_any_chunk_is_refused_at_once(kind):
+    # 10**7 contacts: about 30 GB of working memory (more with the facets);
+    # refused before a chunk is read, not after gigabytes were allocated.
+    P = np.broadcast_to(np.array([1.0, 0.0, 0.0]), (1, 10**7, 3))
+    Nrm = np.broadcast_to(np.array([-1.0, 0.0, 0.0]), (1, 10**7, 3))
+    start = time.perf_counter()
+    with pytest.raises(InvalidContactError) as err:
+        if kind == "force":
+            batch_force_closure(P, Nrm, mu=0.5, num_generators=8)
+        else:
+            batch_form_closure(P, Nrm)
+    assert time.perf_counter() - start < 1.0
+    text = str(err.value)
+    assert "one grasp of 10000000 contacts" in text
+    assert str(grasp_bytes(10**7, 8 if kind == "force" else 1)) in text
+    assert ("num_generators=8" in text) == (kind == "force")
+
+
+def test_the_largest_grasp_admitted_fits_the_bound():
+    most = GRASP_BYTES_MAX // grasp_bytes(1, 8)
+    assert grasp_bytes(most, 8) <= GRASP_BYTES_MAX < grasp_bytes(most + 1, 8)
+    assert chunk_size_for(most, 3, None, 8, 10) == 1
+    with pytest.raises(InvalidContactError, match=f"at most {most} contacts"):
+        chunk_size_for(most + 1, 3, None, 8, 10)

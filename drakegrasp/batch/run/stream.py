@@ -26,11 +26,13 @@ from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
 __all__ = [
     "CHUNK_BYTES",
+    "GRASP_BYTES_MAX",
     "DEFAULT_CHUNK_SIZE",
     "MIN_CHUNK_CONTACTS",
     "PARALLEL_MIN_WORK",
     "TARGET_CHUNKS",
     "chunk_size_for",
+    "grasp_bytes",
     "progress_bar",
     "stream",
 ]
@@ -59,6 +61,30 @@ MIN_CHUNK_CONTACTS = 6144
 """Contacts below which a chunk is not cut further: each chunk costs about
 0.5 ms besides its grasps (measured: 3 contacts per grasp, 170k grasps/s in
 chunks of 256 grasps, 255k in 1024, 265k in 2048)."""
+
+
+GRASP_BYTES_MAX = 2**32
+"""Most working memory one grasp may need (:func:`grasp_bytes`): 4 GiB.
+
+A chunk holds at least one grasp, so a grasp past this is refused before
+anything is read or allocated, naming its contacts, generators and bytes:
+unchecked, one grasp of 10**7 contacts went on to ask for about 30 GB.  It
+admits about 780,000 hard contacts with 8 generators (a grasp of 100,000
+runs in about 5 s and 400 MB)."""
+
+
+def grasp_bytes(N: int, n_g: int) -> int:
+    """Bytes one grasp of ``N`` contacts needs at the peak of its LP (an upper bound).
+
+    ``8 N (256 + 48 (n_g + 1))``: the grasp matrix, its QR and row space, the
+    facet rows (at most ``2 n_g + 2`` a contact, a soft finger's) with the
+    interior-point method's slacks, multipliers and work.  Measured as the
+    peak virtual memory of one grasp of 50,000 contacts with 8 generators:
+    2,763 bytes a contact (spatial hard fingers; ``1419 + 168 n_g`` for
+    ``n_g`` 4–16), 5,285 (soft fingers), 1,146 (planar), 878 (frictionless);
+    this bound is 5,504.
+    """
+    return 8 * max(1, int(N)) * (256 + 48 * (max(1, int(n_g)) + 1))
 
 
 def _bounded_chunk_size(chunk_size: int, N: int, n_g: int) -> int:
@@ -120,7 +146,22 @@ def chunk_size_for(
     ``TARGET_CHUNKS`` such chunks is cut into ``TARGET_CHUNKS`` (chunks of at
     least ``MIN_CHUNK_CONTACTS`` contacts).  The size depends on the inputs
     only, never on the number of workers.
+
+    Raises
+    ------
+    InvalidContactError
+        One grasp needs more than ``GRASP_BYTES_MAX`` (:func:`grasp_bytes`).
     """
+    need = grasp_bytes(N, n_g)
+    if need > GRASP_BYTES_MAX:
+        raise InvalidContactError(
+            f"one grasp of {N} contacts with num_generators={n_g} needs about "
+            f"{need / 2**30:.3g} GiB of working memory ({need} bytes), above the "
+            f"{GRASP_BYTES_MAX / 2**30:.3g} GiB a grasp may take "
+            "(drakegrasp.batch.run.stream.GRASP_BYTES_MAX); give grasps of at "
+            f"most {_most_contacts(n_g)} contacts"
+            + (", or fewer generators" if n_g > 1 else "")
+        )
     if chunk_size is not None:
         size = positive_int("chunk_size", chunk_size, 1)
     else:
@@ -131,6 +172,11 @@ def chunk_size_for(
             floor = -(-MIN_CHUNK_CONTACTS // max(1, N))
             size = min(size, max(floor, -(-int(K) // TARGET_CHUNKS)))
     return _bounded_chunk_size(size, N, n_g)
+
+
+def _most_contacts(n_g: int) -> int:
+    """The most contacts a grasp with ``n_g`` generators may have."""
+    return GRASP_BYTES_MAX // grasp_bytes(1, n_g)
 
 
 def _release_pages(a, stop: int) -> None:
