@@ -29,6 +29,7 @@ from drakegrasp.core.validation import (
     integer_or_none,
     items_of,
     real_array,
+    refuse_structured,
     unit_vectors,
 )
 from drakegrasp.errors import InvalidContactError, InvalidGraspError, InvalidOptionError
@@ -78,6 +79,7 @@ def read_shape(name: str, value, must: str, *, error: type) -> tuple[int, ...]:
 
 def shape_of(name: str, a) -> tuple[int, int, int]:
     """``(K, N, d)`` of a stacked input, or a clear error naming ``name``."""
+    refuse_structured(name, a)
     shape = () if a is None else read_shape(
         name, a,
         "a (K, N, 2) or (K, N, 3) array, or a list of per-grasp (N_k, d) arrays",

@@ -37,7 +37,7 @@ from drakegrasp.batch.inputs import (
     check_metrics,
     chunk_unit_normals,
 )
-from drakegrasp.core.validation import items_of, real_array
+from drakegrasp.core.validation import items_of, real_array, refuse_structured
 from drakegrasp.errors import InvalidContactError
 
 __all__ = [
@@ -98,6 +98,7 @@ def is_ragged(positions) -> bool:
 
 
 def _grasp_array(name: str, value, k: int) -> np.ndarray:
+    refuse_structured(f"{name}[{k}]", value)
     shape = _shape(value)
     if shape is None or len(shape) != 2 or shape[1] not in (2, 3) or shape[0] < 1:
         raise InvalidContactError(

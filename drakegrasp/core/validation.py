@@ -99,6 +99,7 @@ __all__ = [
     "items_of",
     "outside_moment_arms",
     "real_array",
+    "refuse_structured",
     "real_scalar",
     "safe_norm",
     "unit_vectors",
@@ -218,6 +219,37 @@ def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:
         ) from None
 
 
+def refuse_structured(name: str, value, *, error: type = InvalidContactError) -> None:
+    """Refuse a NumPy structured (record) array, or a sequence of them, as ``name``.
+
+    Its fields would be read as one more axis, or not at all (``np.asarray``
+    keeps the record dtype), so the caller's shape or dtype message would
+    point at the wrong fault.  A plain array, or anything without a dtype,
+    passes.
+
+    Raises
+    ------
+    GraspError
+        ``error`` naming ``name``, the fields and the conversion to use.
+    """
+    item = value
+    try:
+        if isinstance(value, (list, tuple)) and len(value) > 0:
+            item = value[0]  # a sequence of per-grasp arrays
+        dtype = getattr(item, "dtype", None)
+        fields = dtype.names if isinstance(dtype, np.dtype) else None
+    except Exception:  # noqa: BLE001 - a hostile __len__ or dtype: named later
+        return
+    if fields is None:
+        return
+    raise error(
+        f"{name} must be a plain float array, not a structured (record) array "
+        f"with fields ({', '.join(fields)}) of dtype {dtype}: convert it first, "
+        "e.g. numpy.lib.recfunctions.structured_to_unstructured(a, dtype=float) "
+        "when its fields are the coordinates"
+    )
+
+
 def real_array(name: str, value, *, error: type = InvalidContactError) -> np.ndarray:
     """``value`` as a float64 array, refusing complex, string and object data.
 
@@ -281,6 +313,7 @@ def real_array(name: str, value, *, error: type = InvalidContactError) -> np.nda
             f"{name} must be real; got a complex array (its imaginary part would "
             "be dropped silently)"
         )
+    refuse_structured(name, a, error=error)
     if a.dtype.kind not in "iuf":
         raise error(
             f"{name} must be an array of real numbers, got dtype {a.dtype} "

@@ -281,3 +281,46 @@ def test_workers_must_be_a_count(grasps, workers):
     P, Nrm = grasps
     with pytest.raises(InvalidOptionError, match="workers"):
         batch_force_closure(P, Nrm, mu=0.5, workers=workers)
+
+
+def _structured_cases(P):
+    """(what, structured value) pairs of the grasps' points ``P`` (K, N, 3)."""
+    K, N, _ = P.shape
+    xyz = np.zeros((K, N), dtype=[("x", float), ("y", float), ("z", float)])
+    xyz["x"], xyz["y"], xyz["z"] = P[..., 0], P[..., 1], P[..., 2]
+    one = np.zeros(P.shape, dtype=[("x", float)])
+    one["x"] = P
+    return [
+        ("fields x, y, z", xyz),
+        ("one field", one),
+        ("record array", xyz.view(np.recarray)),
+        ("np.rec", np.rec.fromarrays([P[..., 0], P[..., 1], P[..., 2]], names="x,y,z")),
+        ("list of grasps", list(xyz)),
+        ("ragged list", [xyz[0], xyz[1, :2]]),
+    ]
+
+
+@pytest.mark.parametrize("arg", ["positions", "normals"])
+@pytest.mark.parametrize("call", ["force", "form", "epsilon"])
+def test_a_structured_array_is_named_and_refused(grasps, arg, call):
+    from drakegrasp.batch import batch_epsilon_l1
+
+    P, Nrm = grasps
+    for what, bad in _structured_cases(P if arg == "positions" else Nrm):
+        ragged = what == "ragged list"
+        good = P if arg == "normals" else Nrm
+        if ragged:
+            good = [good[0], good[1, :2]]
+        elif what == "list of grasps":
+            good = list(good)
+        args = (bad, good) if arg == "positions" else (good, bad)
+        with pytest.raises(InvalidContactError) as err:
+            if call == "force":
+                batch_force_closure(*args, mu=0.5)
+            elif call == "form":
+                batch_form_closure(*args)
+            else:
+                batch_epsilon_l1(*args, mu=0.5)
+        text = str(err.value)
+        assert text.startswith(arg), (what, text)
+        assert "must be a plain float array, not a structured" in text, (what, text)

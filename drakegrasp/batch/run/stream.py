@@ -21,7 +21,7 @@ from drakegrasp.batch.inputs import (
     shape_of,
 )
 from drakegrasp.batch.run.workers import map_ordered, resolve_workers
-from drakegrasp.core.validation import check_flag, real_array
+from drakegrasp.core.validation import check_flag, real_array, refuse_structured
 from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
 __all__ = [
@@ -214,6 +214,7 @@ def stream(
 ) -> Iterator[tuple[slice, dict[str, np.ndarray]]]:
     """Validated chunks through ``task`` (which builds one chunk's work), in order."""
     K, N, d = shape_of("positions", positions)
+    refuse_structured("normals", normals)
     normal_shape = read_shape(
         "normals", normals, "an array of the shape of positions",
         error=InvalidContactError,
