@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from drakegrasp.batch.api import collect, stream_force_closure, stream_form_closure
+from drakegrasp.batch.columns import result_arrays
 from drakegrasp.batch.inputs import (
     check_metrics,
     per_contact_getter,
@@ -139,8 +140,11 @@ def _partition(
         if start == 0:  # already named by its place in the input
             raise
         raise _in_the_input(e, start) from e
-    names = parts[0].keys() if parts else ()
-    out = {n: np.concatenate([p[n] for p in parts]) for n in names}
+    if parts:
+        out = {n: np.concatenate([p[n] for p in parts]) for n in parts[0]}
+    else:  # the one partition of an empty job: every column, no rows
+        arrays, metrics = result_arrays(0, kind, options.get("metrics", ()))
+        out = {**arrays, **metrics}
     if shard is None:
         return out
     return write_shard(Path(shard), out, job)
@@ -260,7 +264,9 @@ def evaluate_on_cluster(
             positions, arrays.get("reference_points"),
             arrays.get("characteristic_lengths"),
         )  # fmt: skip
-    starts = list(range(0, K, step))
+    # An empty job still writes one shard, of no rows: its dataset has the
+    # columns of any other (as a local file of no grasps has).
+    starts = list(range(0, K, step)) or ([0] if output_dir is not None else [])
     job = None
     if output_dir is not None:
         manifest = job_manifest(
