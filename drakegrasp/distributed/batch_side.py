@@ -399,6 +399,9 @@ def stream_file_on_cluster(
     from drakegrasp.batch.files.writer import BatchSummary
 
     del workers, progress, fmt  # the cluster decides; output is always a dataset
+    if kind == "form":  # as stream_file: form closure ignores the cone options
+        for name in FRICTION_OPTIONS:
+            options.pop(name, None)
     _refuse_unknown(
         options, kind, stream_file_on_cluster, passed=("client", "output_dir")
     )

@@ -14,6 +14,7 @@ pq = pytest.importorskip("pyarrow.parquet", reason="pyarrow is an optional extra
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "batch"))
 from batch_support import random_grasps  # noqa: E402
 
+from drakegrasp.batch import batch_force_closure, batch_form_closure  # noqa: E402
 from drakegrasp.cli import main  # noqa: E402
 from drakegrasp.distributed import evaluate_on_cluster, read_dataset  # noqa: E402
 
@@ -33,7 +34,7 @@ def _columns(arrays: dict) -> list[tuple[str, str]]:
     return [(name, str(a.dtype)) for name, a in arrays.items()]
 
 
-@pytest.mark.parametrize("kind", ["force"])
+@pytest.mark.parametrize("kind", ["force", "form"])
 def test_an_empty_file_on_a_cluster_has_the_columns_of_a_full_one(
     small_client, tmp_path, kind
 ):
@@ -54,6 +55,15 @@ def test_an_empty_file_on_a_cluster_has_the_columns_of_a_full_one(
     assert [name for name, _ in _columns(got)] == want.column_names
     assert _columns(got) == _columns(read_dataset(tmp_path / "full"))
     assert all(a.shape == (0,) for a in got.values())
+    # the full job's verdicts are the local engine's (form: the cone flags the
+    # CLI always passes are ignored, as without --scheduler)
+    local = (
+        batch_force_closure(P, Nrm, mu=0.5, workers=1)
+        if kind == "force"
+        else batch_form_closure(P, Nrm, workers=1)
+    )
+    for name, a in local.to_arrays().items():
+        assert read_dataset(tmp_path / "full")[name].tobytes() == a.tobytes()
 
 
 def test_an_empty_job_with_metrics_writes_them_and_resumes(small_client, tmp_path):
