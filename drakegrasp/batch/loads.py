@@ -67,9 +67,13 @@ def _per_grasp(name: str, value, K: int) -> list:
     if isinstance(value, np.ndarray) and value.ndim >= 1 and value.dtype != object:
         return [value] * K  # one array for every grasp
     try:
-        items = list(value)
+        iter(value)
     except TypeError:
-        return [value] * K
+        return [value] * K  # a scalar: every grasp's (grasp_forces checks it)
+    except Exception:  # noqa: BLE001, S110 - a hostile __iter__: items_of names it
+        pass
+    must = f"one value for all grasps or a sequence of {K} (one per grasp)"
+    items = items_of(name, value, must, error=InvalidOptionError)
     if len(items) != K:
         raise InvalidOptionError(
             f"{name} must be one value for all grasps or a sequence of {K} (one "

@@ -60,3 +60,40 @@ def test_batch_broadcasts_one_load_and_refuses_wrong_lengths():
         dg.batch_grasp_forces(grasps, w, max_squeeze=[1.0, 2.0])
     with pytest.raises(dg.InvalidOptionError, match="wrenches"):
         dg.batch_grasp_forces(grasps, np.zeros((2, 6)))
+
+
+class _Hostile(Exception):
+    pass
+
+
+def _boom(*_args):
+    raise _Hostile("a hostile dunder")
+
+
+class _LenRaises(list):
+    __len__ = _boom
+
+
+class _IterRaises:
+    def __len__(self):
+        return 2
+
+    __iter__ = _boom
+    __getitem__ = _boom
+
+
+@pytest.mark.parametrize("name", ["torque_limits", "max_normal_force", "max_squeeze"])
+def test_a_per_grasp_option_whose_items_cannot_be_read_is_named(name):
+    # list(value) let the hostile dunder's exception through (fuzz seed 5).
+    grasps = _grasps(np.random.default_rng(3), 2)
+    W = np.zeros((2, 6))
+    with pytest.raises(dg.InvalidOptionError, match=f"^{name} must be"):
+        dg.batch_grasp_forces(grasps, W, **{name: _IterRaises()})
+
+
+def test_a_per_grasp_list_is_read_without_its_length():
+    grasps = _grasps(np.random.default_rng(3), 2)
+    W = np.zeros((2, 6))
+    want = dg.batch_grasp_forces(grasps, W, max_squeeze=[2.0, 3.0])
+    got = dg.batch_grasp_forces(grasps, W, max_squeeze=_LenRaises([2.0, 3.0]))
+    np.testing.assert_array_equal(got.squeeze, want.squeeze)
