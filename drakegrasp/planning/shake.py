@@ -853,7 +853,7 @@ def _check_finger_gaps(plant, ctx, body, planned: list) -> None:
 PASSED_DEPTH = 1e-4
 """How deep (m) a finger's collision geometry may overlap the object at the
 seat while pressing it with no force, before the shake refuses the run as one
-whose fingers passed into the object (:func:`_check_seated`).  Pressing, an
+whose fingers passed into the object (``_check_seated``).  Pressing, an
 overlap is the contact's own compliance (0.04 mm at 20 N in Drake's default
 point contact; 1-4 mm for compliant pads); pressing nothing, it is a finger
 Drake no longer sees: the WSG-50's 1 mm tip spheres made hydroelastic at 1e6
