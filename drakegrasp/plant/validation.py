@@ -655,9 +655,27 @@ def check_velocity_indices(
         given more than once; the message names the entries and their places.
     """
     nv = plant.num_velocities()
+    must = (
+        f"a one-dimensional sequence of plant velocity indices (integers in "
+        f"0..{nv - 1})"
+    )
+    if isinstance(indices, np.ndarray) and indices.ndim == 1 and indices.size > nv:
+        # read as objects, 10**9 broadcast rows would be 8 GB: no sequence of
+        # distinct indices is longer than the plant's velocities
+        raise InvalidOptionError(
+            f"{argument} must be {must}, each once; got {indices.size} of them "
+            f"for a plant of {nv} velocities"
+        )
     try:
-        items = np.asarray(indices, dtype=object)
-    except (TypeError, ValueError):  # a ragged nest
+        if isinstance(indices, np.ndarray) and indices.ndim != 1:
+            items = None  # refused by its shape, never read
+        else:
+            read = items_of(argument, indices, must)
+            items = np.empty(len(read), dtype=object)
+            items[:] = read
+            if any(_nested(x) for x in read):
+                items = None
+    except (TypeError, ValueError):
         items = None
     if isinstance(indices, str | bytes | dict) or items is None or items.ndim != 1:
         raise InvalidOptionError(
@@ -782,6 +800,11 @@ def _listed(hand) -> Iterable:
         "a model instance (ModelInstanceIndex or name), an iterable of bodies "
         "or scoped body names, or None",
     )
+
+
+def _nested(x) -> bool:
+    """Whether ``x`` is a sequence (an item of a nest), asked without reading it."""
+    return isinstance(x, list | tuple) or (isinstance(x, np.ndarray) and x.ndim > 0)
 
 
 def _listed_bodies(plant: MultibodyPlant, hand) -> list[RigidBody]:

@@ -353,3 +353,26 @@ def test_every_add_models_call_reaches_drake():
         del scene
     gc.collect()
     assert not any(r() is not None for r in refs)
+
+
+def test_velocity_indices_of_a_billion_rows_are_refused_unread(jaw, jaw_found):
+    # The broad fuzz: np.asarray(indices, dtype=object) of a broadcast
+    # (10**9, 3) array asked for 24 GB (a raw MemoryError); a 1-D one of 10**9
+    # entries cannot be distinct indices of a plant's few velocities.
+    g, contacts = jaw_found
+    for indices, words in (
+        (np.broadcast_to(0.5, (10**9, 3)), "one-dimensional"),
+        (np.broadcast_to(1, (10**9,)), "1000000000 of them"),
+    ):
+        with pytest.raises(dg.InvalidOptionError, match="velocity_indices") as e:
+            dg.hand_jacobian(
+                jaw.plant, jaw.plant_context, contacts, g.grasp, jaw.object_body,
+                velocity_indices=indices,
+            )  # fmt: skip
+        assert words in str(e.value)
+    # A generator of indices is read once, as a sequence of them.
+    J = dg.hand_jacobian(
+        jaw.plant, jaw.plant_context, contacts, g.grasp, jaw.object_body,
+        velocity_indices=(i for i in g.hand_velocity_indices),
+    )  # fmt: skip
+    assert J.shape[1] == len(g.hand_velocity_indices)
