@@ -817,26 +817,36 @@ def _check_planned_object(
             plant.SetFreeBodyPose(ctx, body, placed)
 
 
+def _distances(plant, query, finger, objects) -> list[float]:
+    """Signed distances (m) between ``finger``'s geometries and ``objects``.
+
+    Each pair that is not collision-filtered, as ``query`` measures it now; a
+    pair Drake does not measure (its ``RuntimeError``) is left out.
+    """
+    inspector = query.inspector()
+    out = []
+    for gf in plant.GetCollisionGeometriesForBody(finger):
+        for go in objects:
+            if inspector.CollisionFiltered(go, gf):
+                continue
+            try:
+                pair = query.ComputeSignedDistancePairClosestPoints(go, gf)
+            except RuntimeError:  # a pair Drake does not measure: let be
+                continue
+            out.append(float(pair.distance))
+    return out
+
+
 def _check_finger_gaps(plant, ctx, body, planned: list) -> None:
     """:func:`_check_planned_object` at the poses ``ctx`` holds."""
     query = plant.get_geometry_query_input_port().Eval(ctx)
-    inspector = query.inspector()
     objects = plant.GetCollisionGeometriesForBody(body)
     for name in sorted({c.finger_body for c in planned}):
         finger = resolve_body(plant, name)
         bound = SEAT_TOLERANCE + max(
             abs(c.psi) for c in planned if c.finger_body == name
         )
-        gaps = []
-        for gf in plant.GetCollisionGeometriesForBody(finger):
-            for go in objects:
-                if inspector.CollisionFiltered(go, gf):
-                    continue
-                try:
-                    pair = query.ComputeSignedDistancePairClosestPoints(go, gf)
-                except RuntimeError:  # a pair Drake does not measure: let be
-                    continue
-                gaps.append(float(pair.distance))
+        gaps = _distances(plant, query, finger, objects)
         if gaps and abs(min(gaps)) > bound:
             gap = min(gaps)
             where = (
@@ -913,16 +923,7 @@ def _check_seated(plant, ctx, body, candidate, modulus, squeeze) -> None:
         finger = resolve_body(plant, name)
         if finger.index() in pressing:
             continue
-        depths = []
-        for gf in plant.GetCollisionGeometriesForBody(finger):
-            for go in objects:
-                if inspector.CollisionFiltered(go, gf):
-                    continue
-                try:
-                    pair = query.ComputeSignedDistancePairClosestPoints(go, gf)
-                except RuntimeError:  # a pair Drake does not measure: let be
-                    continue
-                depths.append(-float(pair.distance))
+        depths = [-d for d in _distances(plant, query, finger, objects)]
         if depths and max(depths) > PASSED_DEPTH:
             passed.append(f"{name} {max(depths) * 1e3:.3g} mm")
     if not passed:
