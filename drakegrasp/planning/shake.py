@@ -391,7 +391,8 @@ fuzz suite); no hand grasps anything that light."""
 
 DEFAULT_TIME_STEP = 1e-3
 """The shake's time step (s) where the object's contacts do not ask for a
-finer one (:data:`CONTACT_PERIOD_STEPS`)."""
+finer one (:data:`CONTACT_PERIOD_STEPS`) and a phase is at least ten of it
+(``time_step=None`` takes a tenth of a shorter phase, as a given step must)."""
 
 CONTACT_PERIOD_STEPS = 1.25
 """Steps per period of the object's stiffest contact mode that the shake
@@ -1091,8 +1092,13 @@ def shake_test(
         where it stopped, so that it presses with
         ``squeeze`` whether the plan left it short of the surface or inside
         it.  0: aimed from the candidate's joint values.
-    time_step : float, optional
-        The discrete plant's step, seconds.
+    time_step : float or None, optional
+        The discrete plant's step, seconds: at most a tenth of ``phase``.
+        None (default) picks it: :data:`DEFAULT_TIME_STEP`, or a tenth of
+        ``phase`` where that is shorter, or shorter still where the object's
+        point contacts ask for it (:data:`CONTACT_PERIOD_STEPS`,
+        ``ShakeResult.contact_period``).  A given step that does not resolve
+        the contacts is warned of (:class:`CoarseStepWarning`).
     max_displacement, max_rotation : float, optional
         Bounds on the object's motion in the hand frame: metres, radians.
     object_body : optional
@@ -1194,7 +1200,9 @@ def shake_test(
     )  # fmt: skip
     modulus = check_hydroelastic_modulus(hydroelastic_modulus)
     t0 = time.perf_counter()
-    step = DEFAULT_TIME_STEP if time_step is None else float(time_step)
+    # None: the default step, within a tenth of a phase as a given one must be
+    step = min(DEFAULT_TIME_STEP, phase / 10) if time_step is None else time_step
+    step = float(step)
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=step)
     made = add_models(plant, new_parser(plant, "the shake test's plant"))
