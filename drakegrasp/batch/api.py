@@ -284,6 +284,7 @@ def force_chunks(
     chunks = stream(
         positions, normals, kind="force", task=task, chunk_size=chunk_size,
         progress=progress, workers=workers, n_g=options["num_generators"],
+        contact_model=options["contact_model"],
     )  # fmt: skip
     return options, chunks
 

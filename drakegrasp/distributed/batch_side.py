@@ -242,12 +242,17 @@ def evaluate_on_cluster(
             f"{np.shape(normals)}"
         )
     # the local engine's chunks (same n_g and K), so partitions align with them
-    n_g = 1
+    n_g, model = 1, None
     if kind == "force":
         n_g = check_num_generators(
             options.get("num_generators", DEFAULT_NUM_GENERATORS)
         )
-    size = chunk_size_for(N, d, chunk_size, n_g, K)
+        try:  # as the engine reads it; a bad one is refused by the partitions
+            model = ContactModel.parse(options.get("contact_model", "hard_finger"))
+            model = model.value
+        except GraspError:
+            model = None
+    size = chunk_size_for(N, d, chunk_size, n_g, K, contact_model=model)
     step = size * per_partition
     arrays = {k: options.pop(k) for k in _ARRAY_OPTIONS if k in options}
     if kind == "force":

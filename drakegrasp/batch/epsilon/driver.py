@@ -157,6 +157,7 @@ def batch_epsilon_l1(
     chunks = stream(
         positions, normals, kind="epsilon", task=eps_task, chunk_size=chunk_size,
         progress=progress, workers=workers, n_g=options["num_generators"],
+        contact_model=options["contact_model"],
     )  # fmt: skip
     for sl, arrays in chunks:
         out[sl] = arrays["epsilon_l1"]

@@ -536,6 +536,7 @@ def force_verdicts(
         positions, normals, kind="force", task=verdict_task,
         chunk_size=DEFAULT_CHUNK_SIZE,
         progress=False, workers=workers, n_g=options["num_generators"],
+        contact_model=options["contact_model"],
     ):  # fmt: skip
         out[sl] = arrays["is_closure"]
     return out

@@ -32,6 +32,7 @@ __all__ = [
     "PARALLEL_MIN_WORK",
     "TARGET_CHUNKS",
     "chunk_size_for",
+    "cone_generators",
     "grasp_bytes",
     "progress_bar",
     "stream",
@@ -134,8 +135,29 @@ def _chunks(K: int, chunk_size: int, progress: bool, desc: str) -> Iterator[slic
             bar.close()
 
 
+def cone_generators(n_g: int, d: int, contact_model: str | None = None) -> int:
+    """The generators a contact's cone has, for :func:`grasp_bytes`.
+
+    ``num_generators`` shapes only a spatial cone with friction: a planar
+    cone has its 2 edges, a frictionless contact its normal alone (1).  A
+    ``contact_model`` of None (not known: form closure, or not yet read) is
+    taken as friction.
+    """
+    if contact_model == "frictionless":
+        return 1
+    if d == 2:
+        return min(2, max(1, int(n_g)))
+    return n_g
+
+
 def chunk_size_for(
-    N: int, d: int, chunk_size: int | None, n_g: int = 8, K: int | None = None
+    N: int,
+    d: int,
+    chunk_size: int | None,
+    n_g: int = 8,
+    K: int | None = None,
+    *,
+    contact_model: str | None = None,
 ) -> int:
     """Grasps per chunk: ``chunk_size``, or as many as fit in ``CHUNK_BYTES``.
 
@@ -147,20 +169,28 @@ def chunk_size_for(
     least ``MIN_CHUNK_CONTACTS`` contacts).  The size depends on the inputs
     only, never on the number of workers.
 
+    ``contact_model`` (``"frictionless"``, ...; None: one with friction) and
+    ``d`` say which cones ``n_g`` shapes (:func:`cone_generators`), for the
+    bound on one grasp's memory only: the chunk size does not depend on it.
+
     Raises
     ------
     InvalidContactError
-        One grasp needs more than ``GRASP_BYTES_MAX`` (:func:`grasp_bytes`).
+        One grasp needs more than ``GRASP_BYTES_MAX`` (:func:`grasp_bytes` of
+        its cones' generators).
     """
-    need = grasp_bytes(N, n_g)
+    cone = cone_generators(n_g, d, contact_model)
+    need = grasp_bytes(N, cone)
     if need > GRASP_BYTES_MAX:
+        many = cone == n_g and n_g > 1  # num_generators shapes these cones
         raise InvalidContactError(
-            f"one grasp of {N} contacts with num_generators={n_g} needs about "
-            f"{need / 2**30:.3g} GiB of working memory ({need} bytes), above the "
-            f"{GRASP_BYTES_MAX / 2**30:.3g} GiB a grasp may take "
-            "(drakegrasp.batch.run.stream.GRASP_BYTES_MAX); give grasps of at "
-            f"most {_most_contacts(n_g)} contacts"
-            + (", or fewer generators" if n_g > 1 else "")
+            f"one grasp of {N} contacts"
+            + (f" with num_generators={n_g}" if many else "")
+            + f" needs about {need / 2**30:.3g} GiB of working memory ({need} "
+            f"bytes), above the {GRASP_BYTES_MAX / 2**30:.3g} GiB a grasp may "
+            "take (drakegrasp.batch.run.stream.GRASP_BYTES_MAX); give grasps of "
+            f"at most {_most_contacts(cone)} contacts"
+            + (", or fewer generators" if many else "")
         )
     if chunk_size is not None:
         size = positive_int("chunk_size", chunk_size, 1)
@@ -211,8 +241,13 @@ def stream(
     progress: bool,
     workers,
     n_g: int = 1,
+    contact_model: str | None = None,
 ) -> Iterator[tuple[slice, dict[str, np.ndarray]]]:
-    """Validated chunks through ``task`` (which builds one chunk's work), in order."""
+    """Validated chunks through ``task`` (which builds one chunk's work), in order.
+
+    ``n_g`` and ``contact_model`` (the checked option's value) size the
+    chunks and bound one grasp's memory (:func:`chunk_size_for`).
+    """
     K, N, d = shape_of("positions", positions)
     refuse_structured("normals", normals)
     normal_shape = read_shape(
@@ -223,7 +258,7 @@ def stream(
         raise InvalidContactError(
             f"normals must have the shape of positions {(K, N, d)}, got {normal_shape}"
         )
-    size = chunk_size_for(N, d, chunk_size, n_g, K)
+    size = chunk_size_for(N, d, chunk_size, n_g, K, contact_model=contact_model)
     n_workers = resolve_workers(workers)
     if workers is None and K * N < PARALLEL_MIN_WORK:
         n_workers = 1  # starting processes would cost more than they save
