@@ -54,7 +54,7 @@ from drakegrasp.core.calls import checked_call, unknown_names
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
-from drakegrasp.core.validation import check_num_generators
+from drakegrasp.core.validation import check_num_generators, describe
 from drakegrasp.distributed.client import connected, results_or_cancel
 from drakegrasp.distributed.dataset import (
     job_manifest,
@@ -221,7 +221,9 @@ def evaluate_on_cluster(
         connecting; other faults of the input come from the partitions.
     """
     if not isinstance(kind, str) or kind not in ("force", "form"):
-        raise InvalidOptionError(f"kind must be 'force' or 'form', got {kind!r}")
+        raise InvalidOptionError(
+            f"kind must be 'force' or 'form', got {describe(kind)}"
+        )
     _refuse_unknown(keywords, kind, evaluate_on_cluster)
     options, chunk_size = _engine_options(options, keywords, kind, chunk_size)
     if "metrics" in options:  # read once: an iterator would reach no partition
