@@ -470,11 +470,14 @@ def _refuse_nested_weld(path: Path, directives, plant: MultibodyPlant) -> None:
     so its models are not taken for nested ones.  Returns when no weld fits
     (the caller re-raises Drake's words).
     """
+    added = {d.add_model.name for d in directives.directives if d.add_model}
     for d in directives.directives:
         weld = d.add_weld
         if weld is None:
             continue
         instance = _instance_of(weld.child)
+        if instance in added:  # an add_model's own (its name may hold "::")
+            continue
         parts = instance.split("::")
         outer = [
             "::".join(parts[:n])

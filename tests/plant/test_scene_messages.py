@@ -174,6 +174,18 @@ def test_a_weld_of_a_nested_model_is_refused_with_the_way_out(tmp_path, capsys):
     assert "add_model of its own" in said
     assert "nested in 'rig'" in _cli_error(capsys, "analyze", str(scene))
 
+    # An add_model whose own name is scoped under the outer model's
+    # ("rig::extra") is no nested model: its weld is not the one named.
+    extra = _NESTED_SCENE.format(sdf=sdf, child="rig::gripper::jaw::palm").replace(
+        "- add_weld:",
+        "- add_model:\n    name: rig::extra\n    file: "
+        "package://drakegrasp/hands/parallel_jaw.sdf\n- add_weld:\n    parent: "
+        "world\n    child: rig::extra::palm\n- add_weld:",
+        1,
+    )
+    with pytest.raises(SceneError, match="'rig::gripper::jaw::palm' is a frame"):
+        dg.load_scene(_write(tmp_path, extra, "extra.yaml"))
+
     # The way out the message gives loads: a link of the outer model itself,
     # fixed to the nested one in the model file, welded to the world.
     fixed = _NESTED_MOUNT.format(
