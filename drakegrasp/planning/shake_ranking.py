@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import inspect
 import itertools
+import math
 import time
+import warnings
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
@@ -50,6 +52,7 @@ from drakegrasp.plant.validation import check_rigid_transform
 
 __all__ = [
     "HELD_FROM",
+    "GravityMismatchWarning",
     "ShakenCandidate",
     "ShakenCandidates",
     "check_settings",
@@ -58,6 +61,35 @@ __all__ = [
 
 HELD_FROM = ("seat", "plan")
 """What "held" counts from: where seating left the object, or the planned pose."""
+
+
+class GravityMismatchWarning(UserWarning):
+    """The shake's plant has another gravity than the one the plan was made in.
+
+    :func:`~drakegrasp.planning.planner.plan_grasps` records the magnitude it
+    weighed the object with (``settings["gravity"]``); the shake turns the
+    weight of the plant ``add_models`` builds (``ShakeResult.gravity``).  A
+    plan made in a plant whose gravity was set outside ``add_models`` (a moon
+    scene built by hand) is then shaken with another weight.
+    """
+
+
+def _check_gravity(candidates, result: ShakeResult) -> None:
+    """Warn when ``result`` shook at another |g| than ``candidates`` were planned at."""
+    settings = getattr(candidates, "settings", None)
+    planned = settings.get("gravity") if isinstance(settings, dict) else None
+    shaken = result.gravity
+    if not isinstance(planned, float) or math.isclose(planned, shaken, rel_tol=1e-9):
+        return
+    warnings.warn(
+        f"the candidates were planned in a plant of gravity {planned:g} m/s², "
+        f"but the plant add_models builds has {shaken:g} m/s²: the shake weighs "
+        "the object with the latter; set the planning plant's gravity in "
+        "add_models to shake the plan's weight",
+        GravityMismatchWarning,
+        stacklevel=3,
+    )
+
 
 _OPTIONS = {
     name: p.default
@@ -384,6 +416,13 @@ def shake_candidates(
         As :func:`~drakegrasp.planning.shake.shake_test` raises it for the
         first candidate: a model that does not match the candidates (the
         others would share it).
+
+    Warns
+    -----
+    GravityMismatchWarning
+        ``candidates`` from :func:`~drakegrasp.planning.planner.plan_grasps`
+        planned at another ``|g|`` (their ``settings["gravity"]``) than the
+        plant ``add_models`` builds has: the shake turns that plant's weight.
     """
     if not callable(add_models):
         raise InvalidOptionError(
@@ -406,6 +445,8 @@ def shake_candidates(
             # none of its contacts: recorded, the rest still run
             shaken.append(ShakenCandidate(c, k, None, False, str(e)))
             continue
+        if not any(s.result is not None for s in shaken):
+            _check_gravity(candidates, result)  # one plant for all: once
         held = result.held_from_seat if held_from == "seat" else result.held
         shaken.append(ShakenCandidate(c, k, result, bool(held)))
 

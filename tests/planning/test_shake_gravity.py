@@ -164,3 +164,23 @@ def test_a_weight_that_rounds_to_zero_is_refused(scenes):
     tiny = _with_gravity(earth_scene.add_models, (0.0, 0.0, -5e-324))
     with pytest.raises(ModelError, match="weighs 0 N: the shake test needs"):
         shake_test(tiny, earth[0], object_mass=1e-6, **SHAKE)
+
+
+def test_a_plan_shaken_in_another_gravity_is_warned_of(scenes):
+    # The review: settings["gravity"] was recorded for the shake to match,
+    # and nothing read it.  The moon plan shaken with Earth's add_models
+    # weighs six times what was planned; with the moon's, nothing is said.
+    import warnings
+
+    from drakegrasp.planning.shake_ranking import GravityMismatchWarning
+
+    earth, _, moon, moon_plan = scenes
+    assert moon_plan.settings["gravity"] == pytest.approx(1.62, rel=1e-15)
+    short = {**SHAKE, "settle": 0.05, "phase": 0.05, "seat": 0.05, "blend": 0.02}
+    with pytest.warns(GravityMismatchWarning, match="1.62 m/s²") as seen:
+        shake_candidates(earth.add_models, moon_plan, top=2, **short)
+    assert len([w for w in seen if w.category is GravityMismatchWarning]) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GravityMismatchWarning)
+        shaken = shake_candidates(moon.add_models, moon_plan, top=1, **short)
+    assert shaken.shaken[0].result.gravity == pytest.approx(1.62, rel=1e-15)
