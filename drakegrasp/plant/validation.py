@@ -813,10 +813,15 @@ def _listed_bodies(plant: MultibodyPlant, hand) -> list[RigidBody]:
     A wrong item is named by its place, ``hand[i]``; the messages that show
     the hand afterwards show this list, not the spent iterable.
     """
-    return [
-        resolve_object_body(plant, b, what=f"hand[{i}]")
-        for i, b in enumerate(_listed(hand))
-    ]
+    bodies = []
+    for i, b in enumerate(_listed(hand)):
+        try:
+            bodies.append(resolve_object_body(plant, b, what=f"hand[{i}]"))
+        except ModelError as e:  # an unknown name or index: which item it was
+            if str(e).startswith(f"hand[{i}]"):
+                raise
+            raise ModelError(f"hand[{i}]: {e}") from None
+    return bodies
 
 
 def _hand_repr(plant: MultibodyPlant, hand) -> str:

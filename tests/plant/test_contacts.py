@@ -18,7 +18,7 @@ from pydrake.geometry import (
 )
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.multibody.tree import SpatialInertia
+from pydrake.multibody.tree import BodyIndex, SpatialInertia
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp import ModelError, NoContactsError, PenetrationError
@@ -322,6 +322,11 @@ def test_bad_options_and_bodies():
     with pytest.raises(InvalidOptionError) as e:
         rig.contacts(hand=(b for b in [rig.fingers[0], rig.object]))
     assert "(hand=['hand::finger0', 'object::object'])" in str(e.value)
+    # An unknown name or index among them is named by its place too.
+    for item in ("hand::nope", BodyIndex(99)):
+        with pytest.raises(ModelError) as e:
+            rig.contacts(hand=[rig.fingers[0], item])
+        assert str(e.value).startswith("hand[1]: ")
     # The diagram's root context resolves to the plant's; object_body positional.
     from_root = find_contacts(rig.plant, rig.root, rig.object)
     assert [c.psi for c in from_root] == [c.psi for c in rig.contacts()]
