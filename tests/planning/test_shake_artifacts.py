@@ -39,7 +39,7 @@ CUBE = """<?xml version="1.0"?>
 
 
 @pytest.fixture(scope="module")
-def cube(tmp_path_factory):
+def cube(tmp_path_factory, drake_models_dir):  # the WSG-50: skips without it
     path = tmp_path_factory.mktemp("cube") / "cube.sdf"
     path.write_text(CUBE)
     scene = planning_scene(f"file://{path}")
@@ -98,7 +98,7 @@ def test_a_step_coarser_than_the_contacts_is_warned_of_and_none_resolves_it(cube
     assert "out of the hand" not in str(chosen)
 
 
-def test_the_shipped_box_keeps_the_default_step():
+def test_the_shipped_box_keeps_the_default_step(drake_models_dir):
     scene = planning_scene("package://drakegrasp/objects/box.sdf")
     result = plan_grasps(
         scene.plant, scene.context, scene.object_body, hand=scene.hand,
@@ -110,7 +110,9 @@ def test_the_shipped_box_keeps_the_default_step():
     assert "m/s²" not in str(shaken)  # standard gravity goes unsaid
 
 
-def test_the_plan_records_its_gravity_and_the_shake_names_another():
+def test_the_plan_records_its_gravity_and_the_shake_names_another(
+    drake_models_dir,
+):
     scene = planning_scene("package://drakegrasp/objects/box.sdf")
     result = plan_grasps(
         scene.plant, scene.context, scene.object_body, hand=scene.hand,
