@@ -33,7 +33,8 @@ where the candidate put them, and simulates with Drake's ``Simulator``:
   plant without gravity is refused (``ModelError``): an object that weighs
   nothing is held by every grasp, so the test would say nothing.  The force
   is zero while the fingers seat; its direction is then held for
-  ``settle`` seconds along the world's ``−z`` and then turned through
+  ``settle`` seconds along the plant's gravity (the world's ``−z`` by
+  Drake's default) and then turned through
   ``directions`` (each held for ``phase`` seconds; over the first ``blend``
   seconds of a phase gravity turns from the previous direction to the next
   at a constant rate along the great circle through them, about an axis
@@ -1080,13 +1081,15 @@ def shake_test(
         every joint (``plan --shake`` gives the Allegro hand 0.7 N·m,
         stiffness 10, damping 0.1).
     directions : sequence of (3,) float, optional
-        World gravity directions after the settling phase along −z (any
-        finite, non-zero length: only the direction counts; consecutive ones
-        may be opposite).
+        World gravity directions after the settling phase (any finite,
+        non-zero length: only the direction counts; consecutive ones may be
+        opposite).  The grasp settles under the plant's own gravity
+        direction: the world's −z by Drake's default.
     settle, phase, blend : float, optional
-        Seconds: settling under −z gravity, each direction's hold, the blend
-        between directions (gravity turns along the great circle from one
-        direction to the next, its magnitude constant).
+        Seconds: settling under the plant's gravity direction, each
+        direction's hold, the blend between directions (gravity turns along
+        the great circle from one direction to the next, its magnitude
+        constant).
     seat : float, optional
         Seconds without gravity, before settling, in which the fingers close
         on the object: each is aimed ``squeeze / k`` past where it stands
@@ -1218,6 +1221,7 @@ def shake_test(
     g = plant_gravity(plant)  # |g| as add_models left it, before it is zeroed
     if g == 0.0:
         raise ModelError(_weightless(plant))
+    down = np.asarray(plant.gravity_field().gravity_vector(), dtype=float) / g
     base = resolve_body(plant, candidate.hand_base)
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
     by_name = {_scoped(plant, a.joint()): a for a in actuators}
@@ -1314,7 +1318,7 @@ def shake_test(
         object_mass = _planned_mass(planned, body)
     mass, com, inertia = _object_inertia(body, object_mass, candidate)
     weight = _checked_weight(mass, g)
-    schedule = _schedule(seat, settle, phase, blend, dirs)
+    schedule = _schedule(seat, settle, phase, blend, dirs, down=down)
     gravity = builder.AddSystem(_TurnedGravity(body.index(), weight, com, schedule))
     builder.Connect(
         gravity.get_output_port(), plant.get_applied_spatial_force_input_port()

@@ -1,8 +1,9 @@
 """Gravity turned around a grasped object: the shake test's load schedule.
 
 Gravity (``m g``, on the object only, at its centre of mass; ``g`` the
-magnitude of the plant's own gravity field, :func:`plant_gravity`) is zero while the
-fingers seat, held along the world's −z while the grasp settles, then turned
+magnitude of the plant's own gravity field, :func:`plant_gravity`) is zero while
+the fingers seat, held along the plant's gravity (the world's −z by Drake's
+default) while the grasp settles, then turned
 through a sequence of directions, each held for a phase; between two
 directions it turns along the great circle through them at a constant rate,
 so its magnitude stays ``m g`` (``_turned``), opposite directions
@@ -79,7 +80,7 @@ DEFAULT_DIRECTIONS = (
     (0.0, 1.0, 0.0),
     (0.0, 0.0, -1.0),
 )
-"""World directions gravity turns through after settling along −z (each
+"""World directions gravity turns through after settling (each
 consecutive pair orthogonal: every blend turns gravity by 90°)."""
 
 
@@ -138,14 +139,16 @@ def _turned(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _schedule(seat, settle, phase, blend, directions):
+def _schedule(seat, settle, phase, blend, directions, down=(0.0, 0.0, -1.0)):
     """Gravity's unit direction at time t (zero while the fingers seat).
 
+    ``down`` (a unit vector, world frame) is the settling direction: the
+    plant's own gravity's (the world's −z by Drake's default).
     ``directions`` are unit vectors; from each to the next, gravity turns over
     ``blend`` seconds along the great circle (:func:`_turned`), so its
     magnitude stays ``m g`` throughout.
     """
-    dirs = [np.array([0.0, 0.0, -1.0]), *np.asarray(directions, float)]
+    dirs = [np.asarray(down, dtype=float), *np.asarray(directions, float)]
 
     def g(t: float) -> np.ndarray:
         if t < seat:

@@ -184,3 +184,32 @@ def test_a_plan_shaken_in_another_gravity_is_warned_of(scenes):
         warnings.simplefilter("error", GravityMismatchWarning)
         shaken = shake_candidates(moon.add_models, moon_plan, top=1, **short)
     assert shaken.shaken[0].result.gravity == pytest.approx(1.62, rel=1e-15)
+
+
+def test_the_grasp_settles_under_the_plants_own_gravity_direction(scenes, monkeypatch):
+    # The review: the shake settled along the world's -z whatever the plant's
+    # gravity; a scene whose gravity points along -y (a model turned on its
+    # side) settled under a weight across the planned one.  The first forces
+    # after the seat now point along the plant's gravity, at its magnitude.
+    earth, earth_plan, _, _ = scenes
+    forces: list[tuple[float, np.ndarray]] = []
+
+    class Recording(_TurnedGravity):
+        def _calc(self, context, output):
+            super()._calc(context, output)
+            f = np.array(output.get_value()[0].F_Bq_W.translational())
+            forces.append((context.get_time(), f))
+
+    monkeypatch.setattr(shake_module, "_TurnedGravity", Recording)
+    sideways = _with_gravity(earth.add_models, (0.0, -9.81, 0.0))
+    result = shake_test(
+        sideways, earth_plan[0], squeeze=60.0, seat=0.05, settle=0.05,
+        phase=0.05, blend=0.02, directions=[[1.0, 0.0, 0.0]], **{
+            k: v for k, v in SHAKE.items() if k != "directions"
+        },
+    )  # fmt: skip
+    assert result.gravity == 9.81
+    settling = [f for t, f in forces if 0.05 < t < 0.1]
+    assert settling
+    for f in settling:
+        np.testing.assert_allclose(f, [0.0, -MASS * 9.81, 0.0], rtol=1e-12)
