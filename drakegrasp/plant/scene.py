@@ -485,6 +485,10 @@ def _refuse_nested_weld(path: Path, directives, plant: MultibodyPlant) -> None:
             if plant.HasModelInstanceNamed("::".join(parts[:n]))
         ]
         if outer and plant.HasModelInstanceNamed(instance):
+            # the add_model it sits in: the longest such prefix (rig::extra
+            # beside rig holds rig::extra::gripper::jaw, not rig)
+            by_added = [o for o in outer if o in added]
+            outer = by_added[-1:] or outer
             raise SceneError(
                 f"scene {str(path)!r}: add_weld child {weld.child!r} is a frame of "
                 f"the model {instance!r}, nested in {outer[0]!r}, and Drake's model "

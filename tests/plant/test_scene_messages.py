@@ -197,3 +197,20 @@ def test_a_weld_of_a_nested_model_is_refused_with_the_way_out(tmp_path, capsys):
     _write(tmp_path, _NESTED_SCENE.format(sdf=sdf, child="rig::base"))
     loaded = dg.load_scene(scene)
     assert loaded.plant.HasModelInstanceNamed("rig::gripper::jaw")
+
+
+def test_a_nested_weld_in_a_scoped_add_model_names_that_model(tmp_path):
+    # An add_model named rig::extra beside rig, whose own file nests the jaw:
+    # its weld of rig::extra::gripper::jaw::palm is nested in rig::extra (the
+    # model the directives weld by), not in rig, whose links it cannot reach.
+    sdf = _write(tmp_path, _NESTED_MOUNT.format(base="", joint=""), "mount.sdf")
+    scene = _NESTED_SCENE.format(sdf=sdf, child="rig::palm_of_nothing").replace(
+        "- add_weld:\n    parent: world\n    child: rig::palm_of_nothing\n",
+        f"- add_model:\n    name: rig::extra\n    file: file://{sdf}\n"
+        "- add_weld:\n    parent: world\n    child: rig::extra::gripper::jaw::palm\n",
+    )
+    with pytest.raises(SceneError) as e:
+        dg.load_scene(_write(tmp_path, scene, "scoped.yaml"))
+    said = str(e.value)
+    assert "nested in 'rig::extra'" in said, said
+    assert "a link of 'rig::extra' itself" in said, said
