@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drakegrasp.core.calls import checked_call, unknown_names
+from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import describe
 from drakegrasp.errors import (
@@ -87,7 +88,7 @@ def _check_gravity(candidates, result: ShakeResult) -> None:
         "the object with the latter; set the planning plant's gravity in "
         "add_models to shake the plan's weight",
         GravityMismatchWarning,
-        stacklevel=3,
+        stacklevel=outside_stacklevel(),  # checked_call wraps shake_candidates
     )
 
 

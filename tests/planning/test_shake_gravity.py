@@ -213,3 +213,17 @@ def test_the_grasp_settles_under_the_plants_own_gravity_direction(scenes, monkey
     assert settling
     for f in settling:
         np.testing.assert_allclose(f, [0.0, -MASS * 9.81, 0.0], rtol=1e-12)
+
+
+def test_the_gravity_mismatch_warning_points_at_the_callers_line(scenes):
+    # shake_candidates is wrapped by checked_call: a fixed stacklevel=3 named
+    # drakegrasp/core/calls.py, not the line that called it.
+    from drakegrasp.planning.shake_ranking import GravityMismatchWarning
+
+    earth, _, _, moon_plan = scenes
+    short = {**SHAKE, "settle": 0.05, "phase": 0.05, "seat": 0.05, "blend": 0.02}
+    with pytest.warns(GravityMismatchWarning) as seen:
+        shake_candidates(earth.add_models, moon_plan, top=1, **short)
+    assert [w.filename for w in seen if w.category is GravityMismatchWarning] == [
+        __file__
+    ]
