@@ -396,7 +396,7 @@ finer one (:data:`CONTACT_PERIOD_STEPS`) and a phase is at least ten of it
 (``time_step=None`` takes a tenth of a shorter phase, as a given step must)."""
 
 CONTACT_PERIOD_STEPS = 1.25
-"""Steps per period of the object's stiffest sliding mode on its contacts
+"""Steps per period of the object's stiffest translation on its contacts
 that the shake takes at the least (``time_step=None`` picks the step so; a
 coarser given step is warned of, :class:`CoarseStepWarning`).  Turning modes
 are not counted (:func:`contact_period`): with them the WSG-50's period on
@@ -436,7 +436,7 @@ def _resolving_step(period: float) -> float:
 class CoarseStepWarning(UserWarning):
     """The given ``time_step`` does not resolve the object's contacts.
 
-    The object's stiffest sliding (translational) contact mode has a period
+    The object's stiffest translational contact mode has a period
     under :data:`CONTACT_PERIOD_STEPS` steps: Drake's contact solver regularises
     it, and the object creeps or is thrown out of the hand by the
     simulation, not by the grasp.  The message names the step that resolves
@@ -1347,7 +1347,7 @@ def shake_test(
     if step > resolving:
         warnings.warn(
             f"time_step = {step:g} s does not resolve the object's contacts: "
-            f"their stiffest sliding mode has a period of {period:.3g} s "
+            f"their stiffest translation has a period of {period:.3g} s "
             f"({mass:g} kg on point contacts), under {CONTACT_PERIOD_STEPS:g} "
             "steps, so Drake's contact solver regularises them and the object "
             "may creep or be thrown out of the hand by the simulation; give "

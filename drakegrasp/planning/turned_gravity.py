@@ -81,7 +81,8 @@ DEFAULT_DIRECTIONS = (
     (0.0, 0.0, -1.0),
 )
 """World directions gravity turns through after settling (each
-consecutive pair orthogonal: every blend turns gravity by 90°)."""
+consecutive pair orthogonal: every blend turns gravity by 90°, the first too
+where the plant's gravity is Drake's default −z)."""
 
 
 class _TurnedGravity(LeafSystem):
