@@ -675,6 +675,8 @@ def check_velocity_indices(
             items[:] = read
             if any(_nested(x) for x in read):
                 items = None
+    except GraspError:  # items_of's own words: too many, or what reading raised
+        raise
     except (TypeError, ValueError):
         items = None
     if isinstance(indices, str | bytes | dict) or items is None or items.ndim != 1:

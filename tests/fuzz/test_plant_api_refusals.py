@@ -365,6 +365,16 @@ def test_velocity_indices_of_a_billion_rows_are_refused_unread(jaw, jaw_found):
         (np.broadcast_to(1, (10**9,)), "1000000000 of them"),
     ):
         test_hand_jacobian_refuses_bad_velocity_indices(jaw, jaw_found, indices, words)
+
+    # An iterable that raises as it is read is named with what it raised
+    # (items_of's words), not as a sequence of the wrong shape.
+    def broken():
+        yield 0
+        raise RuntimeError("sensor unplugged")
+
+    test_hand_jacobian_refuses_bad_velocity_indices(
+        jaw, jaw_found, broken(), "sensor unplugged"
+    )
     # A generator of indices is read once, as a sequence of them.
     J = dg.hand_jacobian(
         jaw.plant, jaw.plant_context, contacts, g.grasp, jaw.object_body,
