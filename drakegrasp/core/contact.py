@@ -20,6 +20,7 @@ from drakegrasp.core.validation import (
     check_coefficient,
     check_positions,
     describe,
+    plain_str,
     real_array,
     unit_vectors,
 )
@@ -54,7 +55,7 @@ class ContactModel(str, enum.Enum):
         if isinstance(value, cls):
             return value
         try:  # a str subclass is read as a plain str: its own __str__ may raise
-            text = str.__str__(value) if isinstance(value, str) else str(value)
+            text = str(plain_str(value))
             return cls(str.strip(text).lower().replace("-", "_"))
         except Exception:  # noqa: BLE001 - no model's name, or a hostile __str__
             valid = ", ".join(repr(m.value) for m in cls)

@@ -98,6 +98,7 @@ __all__ = [
     "integer_or_none",
     "items_of",
     "outside_moment_arms",
+    "plain_str",
     "real_array",
     "refuse_structured",
     "real_scalar",
@@ -168,6 +169,17 @@ def describe(value) -> str:
     if len(text) <= DESCRIBE_WIDTH:
         return text
     return text[: DESCRIBE_WIDTH - 3] + "..."
+
+
+def plain_str(value):
+    """``value``, a ``str`` subclass as the plain ``str`` it holds.
+
+    A user's ``str`` subclass passes an ``isinstance`` check, but its own
+    ``__str__``, ``__format__`` or ``__fspath__`` may raise or lie where
+    pathlib, a message or Drake read it; ``str.__str__`` reads the characters
+    alone.  Anything that is not a ``str`` is returned unchanged.
+    """
+    return str.__str__(value) if isinstance(value, str) else value
 
 
 def _type_name(value) -> str:

@@ -34,7 +34,7 @@ import numpy as np
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import check_flag, describe
+from drakegrasp.core.validation import check_flag, describe, plain_str
 from drakegrasp.errors import BatchFileError
 
 __all__ = [
@@ -358,9 +358,7 @@ def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
         raise BatchFileError(
             f"the dataset directory must be a path, got {describe(output_dir)}"
         )
-    output_dir = Path(
-        str.__str__(output_dir) if isinstance(output_dir, str) else output_dir
-    )
+    output_dir = Path(plain_str(output_dir))
     if not output_dir.is_dir():
         what = "is not a directory" if output_dir.exists() else "does not exist"
         raise BatchFileError(f"dataset directory {str(output_dir)!r} {what}")

@@ -20,7 +20,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, plain_str
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import add_models as add_coupled_models
 from drakegrasp.plant.models import (
@@ -105,10 +105,7 @@ def planning_scene(
         A URL that is not a string or path, or an ``X_WO`` that is not a
         finite rigid pose.
     """
-    # A str subclass is read as a plain str: its own __str__ or repr may raise.
-    object_url, hand_url = (
-        str.__str__(u) if isinstance(u, str) else u for u in (object_url, hand_url)
-    )
+    object_url, hand_url = plain_str(object_url), plain_str(hand_url)
     for name, url in (("object_url", object_url), ("hand_url", hand_url)):
         if not (
             isinstance(url, (str, os.PathLike))

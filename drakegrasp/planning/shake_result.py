@@ -137,8 +137,8 @@ class ShakeResult:
         ``object_mass × gravity`` newtons.  NaN in a record made before it
         existed (those shook with 9.81).
     contact_period : float
-        The period (s) of the object's stiffest mode on the planned contacts'
-        point-contact stiffness
+        The period (s) of the object's stiffest translation on the planned
+        contacts' point-contact stiffness
         (:func:`~drakegrasp.planning.shake.contact_period`), which
         ``time_step=None`` takes at least
         :data:`~drakegrasp.planning.shake.CONTACT_PERIOD_STEPS` steps per;

@@ -20,6 +20,7 @@ from pydrake.multibody.parsing import PackageMap, Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 from drakegrasp.core.calls import checked_call
+from drakegrasp.core.validation import plain_str
 from drakegrasp.errors import GraspError, InvalidOptionError, ModelError
 
 __all__ = [
@@ -288,8 +289,7 @@ def use_local_drake_models(
             f"path must be a folder name (str or os.PathLike), got a "
             f"{type(path).__name__}"
         )
-    if isinstance(path, str):  # a plain str: a subclass's own __str__ may raise
-        path = str.__str__(path)
+    path = plain_str(path)  # its own __str__ or format may raise
     folder = Path(path).expanduser().resolve()
     if not folder.is_dir():
         if from_env:

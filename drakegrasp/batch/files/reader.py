@@ -27,7 +27,7 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import not_a_file
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, plain_str
 from drakegrasp.errors import BatchFileError, GraspError, InvalidOptionError
 
 __all__ = ["as_path", "engine_options", "input_files", "read_grasps"]
@@ -97,7 +97,7 @@ def as_path(what: str, path) -> Path:
     """``path`` as a ``Path``; a clear error for anything but a non-empty path."""
     if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
         raise BatchFileError(f"{what} must be a file path, got {describe(path)}")
-    return Path(str.__str__(path) if isinstance(path, str) else path)
+    return Path(plain_str(path))
 
 
 def _check_regular(what: str, path: Path) -> None:

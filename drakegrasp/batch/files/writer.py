@@ -42,7 +42,12 @@ from drakegrasp.batch.files.npz import NpzWriter
 from drakegrasp.batch.files.parquet import ParquetWriter
 from drakegrasp.batch.files.reader import as_path
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.validation import describe, integer_or_none, real_scalar
+from drakegrasp.core.validation import (
+    describe,
+    integer_or_none,
+    plain_str,
+    real_scalar,
+)
 from drakegrasp.errors import BatchFileError, InvalidOptionError
 
 __all__ = [
@@ -126,7 +131,7 @@ def format_of(path: str | os.PathLike, fmt: str | None = None) -> str:
             raise InvalidOptionError(
                 f"format must be one of {', '.join(FORMATS)}, got {describe(fmt)}"
             )
-        fmt = str.__str__(fmt)  # a plain str: a subclass's repr or format may raise
+        fmt = plain_str(fmt)
         if suffix in FORMATS and suffix != fmt:
             raise InvalidOptionError(
                 f"output file {str(path)!r} ends in .{suffix} but the format is "
