@@ -13,8 +13,13 @@ import pytest
 from scipy import sparse
 
 from drakegrasp.batch import batch_force_closure, batch_form_closure
-from drakegrasp.batch.lp import block_kernel
+from drakegrasp.batch.lp import block_kernel, dstar
 from drakegrasp.batch.lp.dstar import _facet_block
+from drakegrasp.batch.lp.tolerances import (
+    HIGHS_MAX_COLUMNS,
+    IPM_MAX_ITER,
+    IPM_MAX_ITER_LARGE,
+)
 from drakegrasp.batch.run.stream import (
     GRASP_BYTES_MAX,
     chunk_size_for,
@@ -52,15 +57,49 @@ def test_one_grasp_of_twenty_thousand_contacts_is_solved():
 
 
 @needs_numba
-def test_a_huge_lp_past_the_ipm_cap_is_not_handed_to_highs():
-    # LP1 of 20,000 frictionless contacts reaches the IPM's cap; HiGHS took
-    # a dense (20,000 x 20,000) block (3 GiB, 10 GB at its peak) and then
-    # more than 10 minutes.  The IPM's iterate stands, marked not converged.
+def test_a_huge_lp_past_highs_is_solved_with_the_longer_cap():
+    # LP1 of 20,000 frictionless contacts needs more than IPM_MAX_ITER
+    # iterations.  HiGHS took a dense (20,000 x 20,000) block (3 GiB, 10 GB at
+    # its peak) and then more than 10 minutes, so an LP past
+    # HIGHS_MAX_COLUMNS is never handed to it; it gets IPM_MAX_ITER_LARGE
+    # iterations instead (at IPM_MAX_ITER it ended unconverged, d* off by 6e-4).
     P, Nrm = _ellipsoid(20_000)
     start = time.perf_counter()
     form = batch_form_closure(P, Nrm, kernel="numba")
     assert time.perf_counter() - start < 60
-    assert form.is_closure.all() and 0.9 < form.d_star[0] < 1.0
+    assert form.is_closure.all() and form.converged.all()
+    assert 0.9 < form.d_star[0] < 1.0
+
+
+@needs_numba
+def test_the_longer_cap_converges_to_the_reference_and_highs():
+    # 8,000 contacts: the compiled IPM needed 158 iterations.  The numpy
+    # reference IPM is a second implementation; HiGHS, on the textbook LP
+    # max N min_i f_i s.t. G f = 0, sum f = 1 (dense G, no normalisation),
+    # gave 0.979115676030914 in 138 s, too slow to run here.
+    P, Nrm = _ellipsoid(8_000)
+    fast = batch_form_closure(P, Nrm, kernel="numba")
+    reference = batch_form_closure(P, Nrm, kernel="numpy")
+    assert fast.converged.all() and reference.converged.all()
+    assert abs(fast.d_star[0] - reference.d_star[0]) < 1e-8
+    assert abs(fast.d_star[0] - 0.979115676030914) < 1e-8
+
+
+def test_lps_within_highs_reach_keep_the_short_cap(monkeypatch):
+    # Below HIGHS_MAX_COLUMNS the cap stays IPM_MAX_ITER (HiGHS follows it),
+    # so the answers there are unchanged; past it the cap is the longer one.
+    seen = []
+    real = dstar.solve_block_lp
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs["max_iter"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(dstar, "solve_block_lp", spy)
+    for n in (200, HIGHS_MAX_COLUMNS + 1):
+        P, Nrm = _ellipsoid(n, seed=5)
+        batch_form_closure(P, Nrm, kernel="numpy")
+    assert seen == [IPM_MAX_ITER, IPM_MAX_ITER_LARGE]
 
 
 def test_highs_gets_the_dense_facet_block_as_sparse():

@@ -17,8 +17,9 @@ block interior-point method, started at ``f = c / ‖c‖²``: compiled
 (:mod:`drakegrasp.batch.lp.block_kernel`) or in numpy
 (:func:`drakegrasp.batch.lp.block_ipm.solve_block_lp`); the rare LPs that
 reach its iteration cap are solved again one by one with HiGHS (those of at
-most ``HIGHS_MAX_COLUMNS`` force components; a larger one keeps the
-interior-point method's answer, reported as not converged).  With numba,
+most ``HIGHS_MAX_COLUMNS`` force components; a larger one is given the
+longer cap ``IPM_MAX_ITER_LARGE`` instead, and if it reaches that too keeps
+the interior-point method's answer, reported as not converged).  With numba,
 the grasps whose full rank a QR certifies are first solved in one compiled
 pass (:mod:`drakegrasp.batch.lp.fused_kernel`: null space and LP together, by
 the active-set method of :mod:`drakegrasp.batch.lp.active_set` where the null
@@ -37,6 +38,7 @@ from drakegrasp.batch.lp.block_ipm import ContactGroup, solve_block_lp
 from drakegrasp.batch.lp.tolerances import (
     HIGHS_MAX_COLUMNS,
     IPM_MAX_ITER,
+    IPM_MAX_ITER_LARGE,
     IPM_TOL,
     PUSH_TOL,
 )
@@ -171,7 +173,7 @@ def solve_dstar_blocks(
     *,
     rank_tol: float,
     ipm_tol: float = IPM_TOL,
-    ipm_max_iter: int = IPM_MAX_ITER,
+    ipm_max_iter: int | None = None,
     kernel: str = "auto",
     verdict_tol: float | None = None,
 ) -> DStarSolution:
@@ -193,7 +195,9 @@ def solve_dstar_blocks(
     rank_tol : float
         Singular values ``<= rank_tol * σ_max`` count as zero.
     ipm_tol, ipm_max_iter : optional
-        Tolerance and iteration cap of the interior-point method.
+        Tolerance and iteration cap of the interior-point method.  None
+        (default cap): ``IPM_MAX_ITER``, or ``IPM_MAX_ITER_LARGE`` for LPs of
+        more than ``HIGHS_MAX_COLUMNS`` force components (no HiGHS after them).
     kernel : {"auto", "numba", "numpy", "unfused"}, optional
         The compiled interior-point method (:mod:`~drakegrasp.batch.lp.block_kernel`,
         with the full-rank grasps prepared in the compiled loop too,
@@ -220,6 +224,8 @@ def solve_dstar_blocks(
     # d* = N t: tighten the tolerance on t beyond 4 contacts so that d* keeps
     # about 4 ipm_tol absolute accuracy at any N.
     tol_t = ipm_tol * min(1.0, 4.0 / N)
+    if ipm_max_iter is None:
+        ipm_max_iter = IPM_MAX_ITER if M <= HIGHS_MAX_COLUMNS else IPM_MAX_ITER_LARGE
     band = None if verdict_tol is None else _verdict_band(verdict_tol, N)
     compiled = compiled_route(kernel)  # "unfused" too: the loops, not the fused pass
     use_numba = compiled and kernel != "unfused"
