@@ -134,7 +134,7 @@ from pathlib import Path
 
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, path_text
 from drakegrasp.errors import (
     GraspError,
     InvalidOptionError,
@@ -520,7 +520,9 @@ def _cli_words(message: str, command: str | None) -> str:
         # the folder is blamed only when it lacks the model's whole directory
         # (wsg_50_description/), not for a file name misspelt in the URL
         first = re.search(r"package://drake_models/([^/\s'\"]+)/", message)
-        if folder and first and not (Path(folder) / first.group(1)).is_dir():
+        # os.path's isdir: pathlib's raised for a name too long, inside this
+        # handler of another error
+        if folder and first and not os.path.isdir(os.path.join(folder, first[1])):
             message += (
                 f" ({DRAKE_MODELS_ENV} is set to {folder!r}, which does not hold "
                 "this model: point it at a local copy of the drake_models "
@@ -1097,6 +1099,7 @@ body, the mesh its collision geometry, with the mass of water filling it."""
 
 def _model_file(spec: str, what: str) -> str:
     """``spec`` as it is: a URL, or a model file that exists."""
+    spec = path_text(what, spec)
     if "://" not in spec and not os.path.isfile(spec):
         raise InvalidOptionError(f"{what} file {spec!r} not found")
     return spec
@@ -1393,7 +1396,10 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         _check_pyarrow()  # (it was found missing after the whole plan)
         # before planning: refuse an existing file unless --overwrite, as batch
         check_output(
-            Path(args.out), (), overwrite=args.overwrite, remedy="pass --overwrite"
+            Path(path_text("--out", args.out)),
+            (),
+            overwrite=args.overwrite,
+            remedy="pass --overwrite",
         )
     if args.scene_out is not None:
         _check_scene_out(args)
@@ -1490,7 +1496,7 @@ def _check_scene_out(args: argparse.Namespace) -> None:
             "own file places its hand: apply a candidate to it in Python "
             "(candidate.apply, then analyze_grasp)"
         )
-    path = Path(args.scene_out)
+    path = Path(path_text("--scene-out", args.scene_out))
     if path.is_dir():
         raise InvalidOptionError(f"--scene-out {str(path)!r} is a directory")
     if path.exists() and not args.overwrite:

@@ -77,6 +77,8 @@ __all__ = [
     "LENGTH_MIN",
     "MAX_ANGLE_TOL",
     "MAX_NUM_GENERATORS",
+    "NAME_MAX",
+    "PATH_MAX",
     "POSITION_BOUND",
     "RANK_TOL_MAX",
     "RANK_TOL_MIN",
@@ -98,6 +100,7 @@ __all__ = [
     "integer_or_none",
     "items_of",
     "outside_moment_arms",
+    "path_text",
     "plain_str",
     "real_array",
     "refuse_structured",
@@ -179,7 +182,103 @@ def plain_str(value):
     pathlib, a message or Drake read it; ``str.__str__`` reads the characters
     alone.  Anything that is not a ``str`` is returned unchanged.
     """
-    return str.__str__(value) if isinstance(value, str) else value
+    # type(), not isinstance(): a __class__ property can claim str, and
+    # str.__str__ would then raise on what is no str at all.
+    return str.__str__(value) if issubclass(type(value), str) else value
+
+
+PATH_MAX = 4096
+"""Bytes in a path that :func:`path_text` takes (Linux's ``PATH_MAX``)."""
+
+NAME_MAX = 255
+"""Bytes in one name of a path (ext4, APFS, NTFS): a longer one names no file."""
+
+
+def path_text(
+    name: str,
+    value,
+    *,
+    error: type = InvalidOptionError,
+    must: str = "a file path (a str or an os.PathLike)",
+    empty: bool = False,
+) -> str:
+    """The plain ``str`` of a path given as ``value``, or a refusal naming ``name``.
+
+    The one reader of a user's file, folder or model path (or ``package://``
+    URL): every entry point asks it before pathlib, ``open`` or Drake see the
+    value.  A ``str`` subclass is read by ``str.__str__`` (its own
+    ``__str__``, ``__format__`` or ``__fspath__`` may raise or lie); an
+    ``os.PathLike`` by its ``__fspath__``, whose exception or answer of the
+    wrong type is refused by name.  What then reaches the file system cannot
+    raise anything but an ``OSError`` of the file itself: a NUL character, a
+    character the file system cannot encode (a lone surrogate), a path
+    longer than :data:`PATH_MAX` bytes or a name in it longer than
+    :data:`NAME_MAX` bytes are refused here (pathlib raised a bare
+    ``ValueError``, ``UnicodeEncodeError`` or ``OSError`` for them, from
+    ``is_file()`` too).
+
+    Parameters
+    ----------
+    name : str
+        The parameter, for the message.
+    value : str or os.PathLike
+    error : type, optional
+        The :class:`~drakegrasp.GraspError` subclass to raise (default
+        :class:`~drakegrasp.InvalidOptionError`).
+    must : str, optional
+        What ``value`` must be, for the message.
+    empty : bool, optional
+        Take ``""`` (default: refuse it; pathlib reads it as the current
+        folder).
+
+    Returns
+    -------
+    str
+        The path's characters, a plain ``str``.
+    """
+    kind = type(value)
+    if issubclass(kind, str):
+        text = str.__str__(value)
+    elif hasattr(kind, "__fspath__") and not issubclass(kind, bytes):
+        try:
+            text = kind.__fspath__(value)
+        except Exception as err:  # noqa: BLE001 - a user's __fspath__
+            raise error(
+                f"{name} must be {must}: its __fspath__() raised {_type_name(err)}"
+            ) from None
+        if not issubclass(type(text), str):
+            raise error(
+                f"{name} must be {must}: its __fspath__() returned a "
+                f"{_type_name(text)}, not a str"
+            )
+        text = str.__str__(text)
+    else:
+        raise error(f"{name} must be {must}, got {_type_name(value)} {describe(value)}")
+    if not text and not empty:
+        raise error(f"{name} is empty; it must be {must}")
+    problem = _path_problem(text)
+    if problem:
+        raise error(f"{name} {describe(text)} {problem}")
+    return text
+
+
+def _path_problem(text: str) -> str:
+    """Why the file system cannot take ``text`` as a path, or ""."""
+    if "\0" in text:
+        return "holds a NUL character, which no path can hold"
+    try:
+        encoded = text.encode(sys.getfilesystemencoding(), "surrogateescape")
+    except UnicodeError:
+        return "holds a character the file system cannot encode (a lone surrogate?)"
+    if len(encoded) > PATH_MAX:
+        return f"is {len(encoded)} bytes long; a path holds at most {PATH_MAX}"
+    longest = max(len(part) for part in encoded.split(b"/"))
+    if longest > NAME_MAX:
+        return (
+            f"holds a name of {longest} bytes; a file or folder name holds at "
+            f"most {NAME_MAX}"
+        )
+    return ""
 
 
 def _type_name(value) -> str:

@@ -54,7 +54,7 @@ from drakegrasp.core.calls import checked_call, unknown_names
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
-from drakegrasp.core.validation import check_num_generators, describe
+from drakegrasp.core.validation import check_num_generators, describe, path_text
 from drakegrasp.distributed.client import connected, results_or_cancel
 from drakegrasp.distributed.dataset import (
     job_manifest,
@@ -66,6 +66,7 @@ from drakegrasp.distributed.dataset import (
     write_shard,
 )
 from drakegrasp.errors import (
+    BatchFileError,
     GraspError,
     InvalidArgumentError,
     InvalidContactError,
@@ -224,6 +225,11 @@ def evaluate_on_cluster(
         raise InvalidOptionError(
             f"kind must be 'force' or 'form', got {describe(kind)}"
         )
+    if output_dir is not None:
+        output_dir = Path(
+            path_text("output_dir", output_dir, error=BatchFileError,
+                      must="a directory path (a str or an os.PathLike)")
+        )  # fmt: skip
     _refuse_unknown(keywords, kind, evaluate_on_cluster)
     options, chunk_size = _engine_options(options, keywords, kind, chunk_size)
     if "metrics" in options:  # read once: an iterator would reach no partition
@@ -413,6 +419,7 @@ def stream_file_on_cluster(
         options, kind, stream_file_on_cluster, passed=("client", "output_dir")
     )
     source = as_path("input", input_path)
+    output = as_path("output", output_path)
     data = read_grasps(source)
     extra = engine_options(
         data, source, kind=kind, mu=mu, torsional_friction=torsional_friction
@@ -421,9 +428,9 @@ def stream_file_on_cluster(
     options.update({k: v for k, v in extra.items() if v is not None})
     options = {k: v for k, v in options.items() if v is not None}
     evaluate_on_cluster(scheduler, data["positions"], data["normals"], mu=mu,
-                        kind=kind, output_dir=as_path("output", output_path),
+                        kind=kind, output_dir=output,
                         overwrite=overwrite, **options)  # fmt: skip
-    arrays = read_dataset(output_path)
+    arrays = read_dataset(output)
     summary = BatchSummary(kind=kind, tol=float(options.get("tol", DEFAULT_TOL)))
     if arrays:
         summary.add(arrays)

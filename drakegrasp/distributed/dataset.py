@@ -34,7 +34,7 @@ import numpy as np
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import check_flag, describe, plain_str
+from drakegrasp.core.validation import check_flag, path_text
 from drakegrasp.errors import BatchFileError
 
 __all__ = [
@@ -219,7 +219,7 @@ def prepare_dataset(
         The directory is a file, or holds another job without ``overwrite``.
     """
     overwrite = check_flag("overwrite", overwrite)
-    output_dir = Path(output_dir)
+    output_dir = Path(path_text("output_dir", output_dir, error=BatchFileError))
     if output_dir.exists() and not output_dir.is_dir():
         raise BatchFileError(
             f"output {str(output_dir)!r} is a file; a cluster run writes a "
@@ -354,11 +354,10 @@ def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
     """
     import pyarrow.parquet as pq
 
-    if not isinstance(output_dir, str | os.PathLike) or not os.fspath(output_dir):
-        raise BatchFileError(
-            f"the dataset directory must be a path, got {describe(output_dir)}"
-        )
-    output_dir = Path(plain_str(output_dir))
+    output_dir = Path(
+        path_text("output_dir", output_dir, error=BatchFileError,
+                  must="a dataset directory's path (a str or an os.PathLike)")
+    )  # fmt: skip
     if not output_dir.is_dir():
         what = "is not a directory" if output_dir.exists() else "does not exist"
         raise BatchFileError(f"dataset directory {str(output_dir)!r} {what}")

@@ -33,7 +33,7 @@ from pydrake.multibody.parsing import (
 )
 from pydrake.multibody.tree import JointIndex
 
-from drakegrasp.core.validation import check_length
+from drakegrasp.core.validation import check_length, describe, path_text
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.candidates import GraspCandidate
 from drakegrasp.plant.validation import (
@@ -117,8 +117,17 @@ def grasp_scene_text(
     InvalidOptionError
         A file that is not a string or path.
     """
+    must = "a model file's path or URL (a str or an os.PathLike)"
+    hand_file = path_text("hand_file", hand_file, must=must)
+    object_file = path_text("object_file", object_file, must=must)
+    folder = path_text("folder", folder, must="a folder (a str or an os.PathLike)")
+    planned = plant_context_of(plant, plant_context)  # (checks the plant first)
+    if not isinstance(candidate, GraspCandidate):
+        raise InvalidOptionError(
+            f"candidate must be a GraspCandidate, got {describe(candidate)}"
+        )
     ctx = plant.CreateDefaultContext()  # a copy: the caller's stays as it is
-    ctx.SetTimeStateAndParametersFrom(plant_context_of(plant, plant_context))
+    ctx.SetTimeStateAndParametersFrom(planned)
     body = resolve_object_body(plant, object_body)
     base = resolve_body(plant, candidate.hand_base)
     candidate.apply(plant, ctx, object_body=body)
@@ -166,7 +175,7 @@ def grasp_scene_text(
         directives=[
             ModelDirective(
                 add_model=AddModel(
-                    file=_reference(hand_file, folder, "hand_file"),
+                    file=_reference(hand_file, folder),
                     name=hand_name,
                     default_joint_positions=positions,
                 )
@@ -180,7 +189,7 @@ def grasp_scene_text(
             ),
             ModelDirective(
                 add_model=AddModel(
-                    file=_reference(object_file, folder, "object_file"),
+                    file=_reference(object_file, folder),
                     name=object_name,
                     default_free_body_pose={body.name(): Transform(X_WO)},
                 )
@@ -227,16 +236,11 @@ def grasp_scene_text(
     return yaml_dump_typed(directives) + drakegrasp
 
 
-def _reference(file, folder, name: str) -> str:
+def _reference(file: str, folder: str) -> str:
     """A model file as the scene refers to it: a URL as it is, else a path."""
-    if not isinstance(file, str | os.PathLike):
-        raise InvalidOptionError(
-            f"{name} must be a model file's path or URL, got {type(file).__name__}"
-        )
-    text = os.fspath(file)
-    if "://" in text:
-        return text
-    path = Path(text).resolve()
+    if "://" in file:
+        return file
+    path = Path(file).resolve()
     try:
         return Path(os.path.relpath(path, Path(folder).resolve())).as_posix()
     except ValueError:  # another drive (Windows): no relative path

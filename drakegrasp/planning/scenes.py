@@ -20,7 +20,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.validation import describe, plain_str
+from drakegrasp.core.validation import describe, path_text
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import add_models as add_coupled_models
 from drakegrasp.plant.models import (
@@ -105,22 +105,21 @@ def planning_scene(
         A URL that is not a string or path, or an ``X_WO`` that is not a
         finite rigid pose.
     """
-    object_url, hand_url = plain_str(object_url), plain_str(hand_url)
+    must = "a package:// URL or a file path (a str or an os.PathLike)"
+    if object_url is not None:
+        object_url = path_text("object_url", object_url, must=must)
+    hand_url = path_text("hand_url", hand_url, must=must)
+    if models_dir is not None:
+        models_dir = path_text(
+            "models_dir", models_dir, must="a folder name (a str or an os.PathLike)"
+        )
     for name, url in (("object_url", object_url), ("hand_url", hand_url)):
-        if not (
-            isinstance(url, (str, os.PathLike))
-            or (url is None and name == "object_url")
-        ):
-            raise InvalidOptionError(
-                f"{name} must be a package:// URL or a file path, got "
-                f"{type(url).__name__} {describe(url)}"
-            )
-        if url is not None and "://" not in str(url) and not Path(url).is_file():
+        if url is not None and "://" not in url and not os.path.isfile(url):
             # Checked before the hand loads: a wrong object name was reported
             # as the hand's failure to download drake_models, offline.
-            what = "a directory" if Path(url).is_dir() else "not a file"
+            what = "a directory" if os.path.isdir(url) else "not a file"
             raise ModelError(
-                f"{name} {str(url)!r} is {what}: give a model file (.sdf, .urdf, "
+                f"{name} {url!r} is {what}: give a model file (.sdf, .urdf, "
                 ".obj, ...) or a package:// URL"
             )
     X_WO = RigidTransform() if X_WO is None else check_rigid_transform("X_WO", X_WO)
@@ -158,7 +157,9 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
         )
     pairs = []
     for name, folder in package_map.items():
-        if not isinstance(name, str) or not name or "/" in name:
+        # read as a path is: the name is one folder of a package:// URL
+        name = path_text("package name", name, must="a word")
+        if "/" in name:
             raise InvalidOptionError(
                 f"package name must be a word, got {describe(name)}"
             )
@@ -166,10 +167,10 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
             raise InvalidOptionError(
                 f"package {describe(name)} is built in and cannot be replaced"
             )
-        if not isinstance(folder, (str, os.PathLike)) or not Path(folder).is_dir():
-            raise InvalidOptionError(
-                f"package {describe(name)}: {describe(folder)} is not a folder"
-            )
+        where = f"package {describe(name)}"
+        folder = path_text(where, folder, must="a folder (a str or an os.PathLike)")
+        if not os.path.isdir(folder):
+            raise InvalidOptionError(f"{where}: {describe(folder)} is not a folder")
         pairs.append((name, str(Path(folder).resolve())))
     return pairs
 
@@ -229,7 +230,7 @@ def scene_from_models(add_models) -> PlanningScene:
     return PlanningScene(diagram, plant, context, hand, object_body, add_models)
 
 
-def _add(parser, url: str | os.PathLike) -> list:
+def _add(parser, url: str) -> list:
     """Every model instance that the file at ``url`` adds, in the parser's order.
 
     A file of nested SDFormat models adds one instance per ``<model>``, the
@@ -238,8 +239,7 @@ def _add(parser, url: str | os.PathLike) -> list:
     # Through drakegrasp's loader, which records a <mimic>'s coupling on the
     # plant: a bare Parser leaves a coupled hand's constraints unreadable, and
     # the planner refuses such a plant.
-    url = os.fspath(url)  # a pathlib.Path too, as the docstring allows
-    if "://" in url:
+    if "://" in url:  # (a plain str: read by planning_scene's path_text)
         return list(add_coupled_models(parser, url=url))
     if url.lower().endswith(".obj"):
         check_obj_vertices(url)

@@ -40,7 +40,6 @@ that image is again a box, ``|u_i| <= Σ_k |C_ki| τ_max,k``
 from __future__ import annotations
 
 import math
-import os
 import re
 import weakref
 import xml.etree.ElementTree as ET
@@ -57,7 +56,7 @@ from pydrake.multibody.tree import Joint, ModelInstanceIndex
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.tolerances import COUPLING_TOL
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, path_text, plain_str
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.fingers import (
     chain_root,
@@ -402,20 +401,28 @@ def add_models(
     given = [x is not None for x in (file_name, url, text)]
     if sum(given) != 1:
         raise InvalidOptionError("give exactly one of file_name, url and text")
-    for name, value, kinds in (
-        ("file_name", file_name, (str, os.PathLike)),
-        ("url", url, str),
-        ("text", text, str),
-    ):
-        if value is not None and not isinstance(value, kinds):
+    if file_name is not None:
+        file_name = path_text(
+            "file_name", file_name, must="a string or a path (an os.PathLike)"
+        )
+    if url is not None:
+        if not isinstance(url, str):  # no path: a URL
             raise InvalidOptionError(
-                f"{name} must be a string{' or a path' if name == 'file_name' else ''}"
-                f", got {describe(value)} ({type(value).__name__})"
+                f"url must be a string, got {describe(url)} ({type(url).__name__})"
             )
+        url = path_text("url", url, must="a string")
+    if text is not None and not isinstance(text, str):
+        raise InvalidOptionError(
+            f"text must be a string, got {describe(text)} ({type(text).__name__})"
+        )
+    text = plain_str(text)
     plant = parser.plant()
     if text is not None:
-        if kind not in ("urdf", "sdf"):
-            raise InvalidOptionError(f"text needs kind='urdf' or 'sdf', got {kind!r}")
+        if not isinstance(kind, str) or kind not in ("urdf", "sdf"):
+            raise InvalidOptionError(
+                f"text needs kind='urdf' or 'sdf', got {describe(kind)}"
+            )
+        kind = plain_str(kind)
         resolve = model_resolver(parser.package_map(), Path.cwd())
         check_joint_limits(text, kind, "the model text", resolve=resolve)
         instances = load_models(
@@ -427,14 +434,14 @@ def add_models(
         where = f"model URL {describe(url)}"
         path = load_models(where, parser.package_map().ResolveUrl, url)
     else:
-        where = f"model file {str(file_name)!r}"
-        path = str(file_name)
+        where = f"model file {file_name!r}"
+        path = file_name
     why = not_a_file(path, "a model file")
     if why and why != MISSING:  # a pipe would block Drake's parser for good
         raise ModelError(f"{where} {why}")
     kind = _kind_of(path)
     document = None
-    if kind and Path(path).is_file():
+    if kind and not why:
         try:
             document = Path(path).read_text()
         except (OSError, UnicodeDecodeError) as e:
@@ -447,7 +454,7 @@ def add_models(
     if url is not None:
         instances = load_models(where, parser.AddModels, url=url)
     else:
-        instances = load_models(where, parser.AddModels, str(file_name))
+        instances = load_models(where, parser.AddModels, file_name)
     if document is not None:
         _record_text(plant, document, kind, instances, resolve)
     return instances

@@ -20,7 +20,7 @@ from pydrake.multibody.parsing import PackageMap, Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.validation import plain_str
+from drakegrasp.core.validation import path_text
 from drakegrasp.errors import GraspError, InvalidOptionError, ModelError
 
 __all__ = [
@@ -280,18 +280,17 @@ def use_local_drake_models(
     """
     package_map = _package_map_of(parser_or_package_map, "use_local_drake_models")
     from_env = path is None
+    must = "a folder name (a str or an os.PathLike)"
     if path is None:
         path = os.environ.get(DRAKE_MODELS_ENV)
         if not path:
             return package_map
-    if not isinstance(path, (str, os.PathLike)):
-        raise InvalidOptionError(
-            f"path must be a folder name (str or os.PathLike), got a "
-            f"{type(path).__name__}"
-        )
-    path = plain_str(path)  # its own __str__ or format may raise
-    folder = Path(path).expanduser().resolve()
-    if not folder.is_dir():
+        path = path_text(DRAKE_MODELS_ENV, path, error=ModelError, must=must)
+    else:
+        path = path_text("path", path, must=must)
+    # os.path's expanduser: pathlib's raises RuntimeError for "~nobody"
+    folder = Path(os.path.expanduser(path)).resolve()
+    if not os.path.isdir(folder):
         if from_env:
             raise ModelError(
                 f"{DRAKE_MODELS_ENV} is set to {str(path)!r}, which is not a "

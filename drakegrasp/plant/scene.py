@@ -142,7 +142,6 @@ tips touch.)
 
 from __future__ import annotations
 
-import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -160,7 +159,12 @@ from pydrake.systems.framework import Context, Diagram, DiagramBuilder
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.files import MISSING, not_a_file
-from drakegrasp.core.validation import check_coefficient, check_flag, describe
+from drakegrasp.core.validation import (
+    check_coefficient,
+    check_flag,
+    describe,
+    path_text,
+)
 from drakegrasp.errors import InvalidOptionError, ModelError, SceneError
 from drakegrasp.plant.couplings import (
     check_joint_limits,
@@ -368,14 +372,12 @@ def list_scenes() -> list[SceneInfo]:
     return [read_scene_info(p) for p in sorted(scenes_dir().glob("*.yaml"))]
 
 
-def _path_argument(path) -> Path:
-    """``path`` (a ``str`` or an ``os.PathLike`` of one) as a Path."""
-    if not isinstance(path, str | os.PathLike) or isinstance(os.fspath(path), bytes):
-        raise InvalidOptionError(
-            "a scene is a file path or a shipped scene's name (str or "
-            f"pathlib.Path), got {type(path).__name__} {describe(path)}"
-        )
-    return Path(path)
+_SCENE_MUST = "a scene file's path or a shipped scene's name (a str or a pathlib.Path)"
+
+
+def _path_argument(name: str, path, *, empty: bool = False) -> str:
+    """``path`` (a ``str`` or an ``os.PathLike`` of one) as a plain str."""
+    return path_text(name, path, must=_SCENE_MUST, empty=empty)
 
 
 def scene_path(path_or_name: str | Path) -> Path:
@@ -390,11 +392,11 @@ def scene_path(path_or_name: str | Path) -> Path:
         directory, a named pipe or a device is named as one, by ``stat``: a
         pipe is never opened).
     """
-    candidate = _path_argument(path_or_name)
-    why = not_a_file(candidate, "a scene file")
+    name = _path_argument("path_or_name", path_or_name, empty=True)
+    candidate = Path(name)
+    why = not_a_file(candidate, "a scene file") if name else MISSING
     if not why:
         return candidate
-    name = str(path_or_name)
     names = ", ".join(p.stem for p in sorted(scenes_dir().glob("*.yaml")))
     if not name.strip():
         raise ModelError(f"the scene's name is empty (shipped scenes: {names})")
@@ -426,7 +428,7 @@ def read_scene_info(
     InvalidOptionError
         If ``path`` is not a ``str`` or an ``os.PathLike`` of one.
     """
-    path = _path_argument(path)
+    path = Path(_path_argument("path", path))
     _, data = read_yaml(path)
     section = check_section(path, data, torsional_friction=torsional_friction)
     return SceneInfo(name=path.stem, path=path.resolve(), **section)

@@ -46,7 +46,7 @@ from pathlib import Path
 
 from pydrake.multibody.parsing import LoadModelDirectives, PackageMap, Parser
 
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, path_text
 from drakegrasp.errors import ModelError, SceneError
 from drakegrasp.plant.models import (
     check_obj_vertices,
@@ -150,15 +150,15 @@ def add_named_package(package_map: PackageMap, name, folder) -> None:
         A name that is not a word, a folder that is not a directory, or a
         built-in package.
     """
-    if not isinstance(name, str) or not name or "/" in name:
-        raise SceneError(
-            f"package name must be a non-empty string without '/', got {describe(name)}"
-        )
+    must = "a non-empty string without '/'"
+    # read as a path is (a str subclass's own methods, a character Drake
+    # cannot encode): the name is one folder of a package:// URL
+    name = path_text("package name", name, error=SceneError, must=must)
+    if "/" in name:
+        raise SceneError(f"package name must be {must}, got {describe(name)}")
     path = _folder(f"package {describe(name)}", folder)
-    if not path.is_dir():
-        raise SceneError(
-            f"package {describe(name)}: {str(folder)!r} is not a directory"
-        )
+    if not os.path.isdir(path):  # (pathlib's raises for a path too long)
+        raise SceneError(f"package {describe(name)}: {str(path)!r} is not a directory")
     path = str(path.resolve())
     if package_map.Contains(name):
         if name in ("drake", "drakegrasp"):
@@ -171,22 +171,22 @@ def add_named_package(package_map: PackageMap, name, folder) -> None:
 
 def _folder(what: str, folder) -> Path:
     """``folder`` as a path; anything but a str or an os.PathLike is refused."""
-    if not isinstance(folder, str | os.PathLike) or isinstance(
-        os.fspath(folder), bytes
-    ):
-        raise SceneError(
-            f"{what}: a directory is a str or a pathlib.Path, got "
-            f"{type(folder).__name__} {describe(folder)}"
-        )
-    return Path(folder).expanduser()
+    text = path_text(
+        f"{what}: the directory",
+        folder,
+        error=SceneError,
+        must="a str or a pathlib.Path",
+    )
+    # os.path's: pathlib's raises RuntimeError for "~nobody" (no such user)
+    return Path(os.path.expanduser(text))
 
 
 def _add_package_xml(package_map: PackageMap, folder) -> None:
     path = _folder("package", folder)
     xml = path if path.name == "package.xml" else path / "package.xml"
-    if not xml.is_file():
+    if not os.path.isfile(xml):
         raise SceneError(
-            f"{str(folder)!r} holds no package.xml; pass {{name: directory}} to "
+            f"{str(path)!r} holds no package.xml; pass {{name: directory}} to "
             "name a package without one"
         )
     try:

@@ -109,5 +109,5 @@ def test_a_dataset_that_is_a_file_is_not_called_missing(tmp_path):
 @pytest.mark.parametrize("given", [None, 5, b"out", ""])
 def test_a_dataset_directory_that_is_no_path_is_refused(given):
     # read_dataset(None) raised Python's TypeError (fuzzer)
-    with pytest.raises(BatchFileError, match="the dataset directory must be a path"):
+    with pytest.raises(BatchFileError, match="must be a dataset directory.s path"):
         read_dataset(given)

@@ -387,6 +387,72 @@ def repr_hostile() -> list:
     return objects
 
 
+class FspathRaises:
+    """An ``os.PathLike`` whose ``__fspath__`` raises."""
+
+    __fspath__ = _boom
+
+    def __repr__(self):
+        return "FspathRaises()"
+
+
+class FspathReturns:
+    """An ``os.PathLike`` whose ``__fspath__`` returns ``value`` (any type)."""
+
+    def __init__(self, value):
+        self.value = value
+
+    def __fspath__(self):
+        return self.value
+
+    def __repr__(self):
+        return f"FspathReturns({type(self.value).__name__})"
+
+
+class PathReprRaises:
+    """An ``os.PathLike`` of a file that is not there; its repr, str, format raise."""
+
+    def __fspath__(self):
+        return "/nonexistent/drakegrasp-hostile.npz"
+
+    __repr__ = _boom
+    __str__ = _boom
+    __format__ = _boom
+
+
+class StrFspathRaises(str):
+    """A str whose ``__fspath__``, ``__str__`` and ``__format__`` raise."""
+
+    __fspath__ = _boom
+    __str__ = _boom
+    __format__ = _boom
+
+
+def path_hostile() -> list:
+    """Fresh paths, file names and URLs that no check may let escape raw.
+
+    ``os.PathLike`` objects whose ``__fspath__`` raises or returns no str
+    (an int, bytes, a hostile str subclass, 10**7 characters); ``str``
+    subclasses whose ``__str__``, ``__format__``, ``__fspath__`` or ``repr``
+    raise, of an existing and of a missing file; and plain
+    strings that pathlib, ``os.stat`` or Drake refuse with a bare exception:
+    huge (10**7 characters), longer than ``PATH_MAX``, a name longer than
+    ``NAME_MAX``, a NUL character, a lone surrogate, ``~nobody`` (pathlib's
+    ``expanduser`` raised ``RuntimeError``), empty, and bytes.
+    """
+    return [
+        FspathRaises(), FspathReturns(42), FspathReturns(None),
+        FspathReturns(b"/tmp"), FspathReturns(StrFormatRaises("x")),
+        FspathReturns("x" * HUGE), FspathReturns("\0"), PathReprRaises(),
+        StrFspathRaises("/nonexistent/x.npz"), StrFspathRaises("."),
+        StrFormatRaises("/nonexistent/x.sdf"), StrFormatRaises("/tmp"),
+        StrReprRaises("/nonexistent/x.yaml"), StrFormatRaises("package://x/y.sdf"),
+        "x" * HUGE, "/" + "d/" * 2100, "y" * 300, "/tmp/" + "z" * 300 + ".npz",
+        "a\0b", "\ud800", "/tmp/\udfff.npz", "~drakegrasp-nobody/x",
+        "", b"/tmp", bytearray(b"/tmp"),
+    ]  # fmt: skip
+
+
 def _register():
     import numbers
 
@@ -419,7 +485,7 @@ def objects() -> list:
         fractions.Fraction(1, 2), decimal.Decimal("0.5"), decimal.Decimal("sNaN"),
         np.broadcast_to(0.5, (10**9, 3)), np.ones((4, 3))[::2],
         _readonly(np.ones((2, 3))), [[0.5, 0.5, 0.5], LyingLength()],
-        *repr_hostile(),
+        *repr_hostile(), *path_hostile(),
     ]  # fmt: skip
 
 

@@ -72,7 +72,7 @@ def _file_run(
     data = read_grasps(source)
     positions, normals = data["positions"], data["normals"]
     extra = engine_options(
-        data, input_path, kind=kind, mu=mu, torsional_friction=torsional_friction
+        data, source, kind=kind, mu=mu, torsional_friction=torsional_friction
     )
     K, _, d = shape_of("positions", positions)
     p, b = extra["reference_points"], extra["characteristic_lengths"]

@@ -27,7 +27,7 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import not_a_file
-from drakegrasp.core.validation import describe, plain_str
+from drakegrasp.core.validation import path_text
 from drakegrasp.errors import BatchFileError, GraspError, InvalidOptionError
 
 __all__ = ["as_path", "engine_options", "input_files", "read_grasps"]
@@ -94,10 +94,11 @@ _NPY_MAGIC = b"\x93NUMPY"
 
 
 def as_path(what: str, path) -> Path:
-    """``path`` as a ``Path``; a clear error for anything but a non-empty path."""
-    if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
-        raise BatchFileError(f"{what} must be a file path, got {describe(path)}")
-    return Path(plain_str(path))
+    """``path`` as a ``Path``; a clear error for anything but a non-empty path.
+
+    Read by :func:`~drakegrasp.core.validation.path_text`, as every path is.
+    """
+    return Path(path_text(what, path, error=BatchFileError))
 
 
 def _check_regular(what: str, path: Path) -> None:

@@ -125,7 +125,8 @@ def format_of(path: str | os.PathLike, fmt: str | None = None) -> str:
     A ``fmt`` that contradicts the suffix is refused, not obeyed: a Parquet
     file called ``.npz`` would fool every reader that trusts the name.
     """
-    suffix = Path(path).suffix.lower().lstrip(".")
+    path = as_path("path", path)
+    suffix = path.suffix.lower().lstrip(".")
     if fmt is not None:
         if not isinstance(fmt, str) or fmt not in FORMATS:
             raise InvalidOptionError(
