@@ -245,7 +245,7 @@ def draw_candidates(
         was.
     """
     check_meshcat(meshcat)
-    check_path("prefix", prefix)
+    prefix = check_path("prefix", prefix)
     if isinstance(top, bool) or not isinstance(top, int | np.integer) or top < 0:
         raise InvalidOptionError(f"top must be an integer >= 0, got {describe(top)}")
     ctx = plant_context_of(plant, plant_context)

@@ -440,7 +440,7 @@ def animate_escape(
         For a ``plant_context`` of another system.
     """
     check_meshcat(meshcat)
-    check_path("prefix", prefix)
+    prefix = check_path("prefix", prefix)
     frames_n = integer_or_none(frames)
     if frames_n is None or not (2 <= frames_n <= MAX_FRAMES):
         raise InvalidOptionError(

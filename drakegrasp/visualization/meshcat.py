@@ -295,7 +295,7 @@ def draw_grasp(
         raise InvalidOptionError(
             f"cone must be 'exact', 'pyramid', 'both' or None, got {describe(cone)}"
         )
-    check_path("prefix", prefix)
+    prefix = check_path("prefix", prefix)
     sign = side_sign(side)
     palette = merge_palette(MESHCAT_COLORS, colors)
     # Given lengths are checked; the defaults are fractions of b (or of size),
@@ -489,7 +489,7 @@ def _draw_cone(
 def clear_grasp(meshcat: Meshcat, prefix: str = DEFAULT_PREFIX) -> None:
     """Delete a drawing made by :func:`draw_grasp` (everything under ``prefix``)."""
     _check_meshcat(meshcat)
-    check_path("prefix", prefix)
+    prefix = check_path("prefix", prefix)
     meshcat.Delete(prefix)
 
 

@@ -218,7 +218,7 @@ def draw_certificate(
         drawn then.
     """
     check_meshcat(meshcat)
-    check_path("prefix", prefix)
+    prefix = check_path("prefix", prefix)
     direction, p = checked_certificate(grasp, certificate)
     b = grasp.characteristic_length
     L = 0.8 * b if length is None else positive_length("length", length)

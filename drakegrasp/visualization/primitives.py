@@ -32,12 +32,26 @@ def check_meshcat(meshcat) -> None:
 
 
 def check_path(name: str, value) -> str:
-    """A Meshcat path: a string with something besides slashes."""
-    if not isinstance(value, str) or not value.strip("/"):
+    """A Meshcat path: a string with something besides slashes, as a plain str.
+
+    A ``str`` subclass is read by ``str``'s own methods (its ``__format__``
+    may raise where the path is joined); a character that UTF-8 cannot
+    encode (a lone surrogate) is refused here, not by pydrake's bare
+    ``UnicodeEncodeError`` when Meshcat is called.
+    """
+    if not isinstance(value, str) or not str.strip(value, "/"):
         raise InvalidOptionError(
             f"{name} must be a non-empty path, got {describe(value)}"
         )
-    return value
+    text = str.__str__(value)
+    try:
+        text.encode("utf-8")
+    except UnicodeError:
+        raise InvalidOptionError(
+            f"{name} {describe(text)} holds a character UTF-8 cannot encode "
+            "(a lone surrogate?)"
+        ) from None
+    return text
 
 
 def _set_mesh(meshcat: Meshcat, path: str, vertices, faces, rgba: Rgba, **kw) -> None:

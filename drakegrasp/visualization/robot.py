@@ -68,7 +68,7 @@ def visualizer_paths(
             "scene_graph must be the pydrake SceneGraph the plant is registered "
             f"with, got {type(scene_graph).__name__}"
         )
-    check_path("prefix", prefix)
+    prefix = check_path("prefix", prefix)
     instances = [
         _model_instance(plant, spec) for spec in _instance_list(model_instances)
     ]
@@ -135,12 +135,7 @@ def translucent_arguments(paths, opacity) -> tuple[list[str], float]:
             "paths must be a Meshcat path or a sequence of them (non-empty "
             f"strings), got {describe(paths)}"
         )
-    for path in listed:
-        if not isinstance(path, str) or not path.strip("/"):
-            raise InvalidOptionError(
-                f"paths must be non-empty strings, got {describe(path)}"
-            )
-    return [str(p) for p in listed], x
+    return [check_path("paths", path) for path in listed], x
 
 
 @checked_call

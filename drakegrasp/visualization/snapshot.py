@@ -77,7 +77,7 @@ def draw_scene_geometry(
             "scene_graph must be a pydrake SceneGraph (diagram.GetSubsystemByName"
             f"('scene_graph')), got {type(scene_graph).__name__}"
         )
-    check_path("prefix", prefix)
+    prefix = check_path("prefix", prefix)
     if not isinstance(role, str) or role not in _ROLES:
         raise InvalidOptionError(
             f"role must be one of {sorted(_ROLES)}, got {describe(role)}"

@@ -61,6 +61,13 @@ def _keyed(value, folder) -> dict:
     return {value: str(folder)}
 
 
+class _Meshcat:
+    """Takes every Meshcat call and does nothing (no server, no port)."""
+
+    def __getattr__(self, name):
+        return lambda *args, **kwargs: None
+
+
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     """A grasp file, a batch result and a free folder to write in."""
@@ -138,6 +145,13 @@ def _calls(files):
             )
 
         yield f"grasp_scene_text({key})", scene_text
+    yield "set_translucent", lambda v: dg.visualization.set_translucent(_Meshcat(), v)
+    yield (
+        "draw_grasp(prefix)",
+        lambda v: dg.visualization.draw_grasp(
+            _Meshcat(), dg.core.examples.spatial_two_fingers(0.5), prefix=v
+        ),
+    )
 
 
 def _refuses_briefly(call, value) -> None:
