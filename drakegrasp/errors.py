@@ -22,24 +22,41 @@ def cut_message(text: str, limit: int = MAX_MESSAGE) -> str:
     """``text`` as a plain str of at most ``limit`` characters, saying what it cut.
 
     A cut text fits ``limit`` with its note, so cutting it again changes nothing.
+    A ``str`` subclass is read by ``str.__str__`` (its own ``__str__`` may
+    raise or lie); any other value by ``str()``, or as its type's name when
+    that raises or returns no str: an error's text never fails to be made.
     """
-    text = str.__str__(text)
+    text = _plain_text(text)
     if len(text) <= limit:
         return text
     kept = max(limit - 50, 0)  # room for the note
     return f"{text[:kept]}... ({len(text) - kept} characters cut)"
 
 
+def _plain_text(value) -> str:
+    """``value`` as a plain str (see :func:`cut_message`)."""
+    if issubclass(type(value), str):
+        return str.__str__(value)
+    try:
+        shown = str(value)
+    except Exception:  # noqa: BLE001 - a value's own __str__
+        shown = None
+    if issubclass(type(shown), str):
+        return str.__str__(shown)
+    name = getattr(type(value), "__name__", None)
+    return f"<{str.__str__(name) if issubclass(type(name), str) else 'object'}>"
+
+
 class GraspError(Exception):
     """Base class of every error raised by drakegrasp.
 
     A message longer than :data:`MAX_MESSAGE` characters is cut to at most that
-    length, saying how much was cut.
+    length, saying how much was cut; so is every other ``str`` argument (the
+    text of an error of several arguments shows them all), each a plain str.
     """
 
     def __init__(self, *args: Any):
-        if args and isinstance(args[0], str):
-            args = (cut_message(args[0]), *args[1:])
+        args = tuple(cut_message(a) if issubclass(type(a), str) else a for a in args)
         super().__init__(*args)
 
 
@@ -100,9 +117,12 @@ class InvalidPoseError(GraspError):
     Attributes
     ----------
     problem, remedy : str
+        Plain strings cut to :data:`MAX_MESSAGE` characters, as the message is
+        (they may name a user's bodies and joints, of any length).
     """
 
     def __init__(self, problem: str, *, remedy: str = ""):
+        problem, remedy = cut_message(problem), cut_message(remedy)
         super().__init__(f"{problem} ({remedy})" if remedy else problem)
         self.problem = problem
         self.remedy = remedy

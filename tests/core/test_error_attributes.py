@@ -1,0 +1,110 @@
+"""An error's text attributes are cut and plain, as its message is.
+
+``GraspError`` cuts a message longer than ``MAX_MESSAGE`` and reads a ``str``
+subclass as the plain str it holds; ``InvalidPoseError.problem`` and
+``.remedy`` kept what they were given, whole (a pose check of a thousand
+joints, or of a model whose names are megabytes long, carried it all), and a
+second ``str`` argument of any error was not cut at all.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+import drakegrasp as dg
+from drakegrasp.errors import MAX_MESSAGE, cut_message
+from drakegrasp.plant.pose import JointLimitViolation, PoseCheck
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "fuzz"))
+import hostile  # noqa: E402
+
+HUGE = "j" * 1_000_000
+
+POSE_ERRORS = [
+    dg.InvalidPoseError,
+    dg.PenetrationError,
+    dg.JointLimitError,
+    dg.CouplingError,
+]
+
+
+def _bounded_plain(text) -> None:
+    assert type(text) is str
+    assert len(text) <= MAX_MESSAGE
+
+
+@pytest.mark.parametrize("cls", POSE_ERRORS)
+def test_a_pose_error_cuts_its_problem_and_remedy(cls):
+    error = cls(HUGE, remedy=HUGE)
+    _bounded_plain(error.problem)
+    _bounded_plain(error.remedy)
+    _bounded_plain(str(error))
+    assert error.problem.startswith("jjj") and "characters cut" in error.problem
+    again = error.with_remedy("add --no-check-pose")
+    assert type(again) is cls
+    assert again.problem == error.problem
+    assert again.remedy == "add --no-check-pose"
+    _bounded_plain(str(again))
+
+
+@pytest.mark.parametrize(
+    "value",
+    [hostile.StrFormatRaises("hand::finger"), hostile.StrReprRaises("hand::finger")],
+    ids=["str-raises", "repr-raises"],
+)
+def test_a_pose_error_holds_a_str_subclass_as_plain_text(value):
+    error = dg.JointLimitError(value, remedy=value)
+    assert type(error.problem) is str and error.problem == "hand::finger"
+    assert type(error.remedy) is str and error.remedy == "hand::finger"
+    assert str(error) == "hand::finger (hand::finger)"
+
+
+def test_a_pose_check_of_a_huge_joint_name_raises_a_bounded_problem():
+    # The raise site: every violation joined, each naming its joint whole.
+    check = PoseCheck(
+        joint_limit_violations=tuple(
+            JointLimitViolation(f"hand::{'j' * 50_000}_{k}", 2.0, -1.0, 1.0)
+            for k in range(3)
+        )
+    )
+    with pytest.raises(dg.JointLimitError) as refused:
+        check.raise_if_invalid()
+    _bounded_plain(refused.value.problem)
+    _bounded_plain(str(refused.value))
+    assert refused.value.problem.startswith("impossible pose: hand::jjj")
+
+
+def test_every_str_argument_of_an_error_is_cut():
+    error = dg.ModelError("short", HUGE, 3)
+    assert error.args[0] == "short"
+    _bounded_plain(error.args[1])
+    assert error.args[2] == 3
+    assert len(str(error)) <= 3 * MAX_MESSAGE
+
+
+@pytest.mark.parametrize(
+    ("value", "text"),
+    [
+        (hostile.StrFormatRaises("x"), "x"),
+        (3, "3"),
+        (hostile.StrRaises(), "<StrRaises>"),
+        (hostile.ReprNotStr(), "<ReprNotStr>"),
+    ],
+    ids=["str-subclass", "int", "str-raises", "str-not-str"],
+)
+def test_cut_message_gives_plain_text_of_any_value(value, text):
+    out = cut_message(value)
+    assert type(out) is str
+    assert out == text
+
+
+class _StrNotStr:
+    def __str__(self):
+        return 42
+
+
+def test_cut_message_names_a_value_whose_str_is_no_str():
+    assert cut_message(_StrNotStr()) == "<_StrNotStr>"
