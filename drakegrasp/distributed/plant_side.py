@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.validation import describe, integer_or_none
+from drakegrasp.core.validation import describe, integer_or_none, path_text
 from drakegrasp.distributed.client import connected, results_or_cancel
 from drakegrasp.errors import GraspError, InvalidOptionError
 from drakegrasp.plant.options import AnalysisOptions, checked_options
@@ -131,6 +131,13 @@ def analyze_poses(
             f"{describe(block)}"
         )
     block = n
+    # read here, not on each worker: a str subclass or os.PathLike of the
+    # user's own would travel pickled and fail remotely, once per task
+    scene = path_text(
+        "scene",
+        scene,
+        must="a shipped scene's name or a scene file's path (a str or an os.PathLike)",
+    )
     q = _configurations(positions)
     with connected(client) as client:
         futs = [client.submit(_analyze_block, scene, q[s:s + block], options,

@@ -198,6 +198,10 @@ def test_a_cluster_run_refuses_a_hostile_path_before_it_connects(files, value):
         with pytest.raises(dg.BatchFileError) as refused:
             call(value)
         assert len(str(refused.value)) <= SHORT
+    # read here, not pickled to every worker to fail there once per task
+    with pytest.raises(dg.InvalidOptionError, match="^scene ") as refused:
+        dg.distributed.analyze_poses(None, value, np.zeros((1, 3)))
+    assert len(str(refused.value)) <= SHORT
 
 
 @pytest.mark.parametrize(
