@@ -271,12 +271,12 @@ def _path_problem(text: str) -> str:
     except UnicodeError:
         return "holds a character the file system cannot encode (a lone surrogate?)"
     if len(encoded) > PATH_MAX:
-        return f"is {len(encoded)} bytes long; a path holds at most {PATH_MAX}"
+        return f"is too long: {len(encoded)} bytes, where a path holds {PATH_MAX}"
     longest = max(len(part) for part in encoded.split(b"/"))
     if longest > NAME_MAX:
         return (
-            f"holds a name of {longest} bytes; a file or folder name holds at "
-            f"most {NAME_MAX}"
+            f"holds a name too long: {longest} bytes, where a file or folder "
+            f"name holds {NAME_MAX}"
         )
     return ""
 
