@@ -30,7 +30,12 @@ from pydrake.systems.framework import Context
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deferred import WeakMemo
 from drakegrasp.core.tolerances import QUERY_POSE_TOL
-from drakegrasp.core.validation import describe, integer_or_none, items_of
+from drakegrasp.core.validation import (
+    describe,
+    integer_or_none,
+    items_of,
+    plain_str,
+)
 from drakegrasp.errors import (
     GraspError,
     InvalidContextError,
@@ -477,7 +482,8 @@ def model_instance(
         For a ``spec`` that is neither an index nor a name.
     """
     if isinstance(spec, str):
-        if not plant.HasModelInstanceNamed(spec):
+        spec = plain_str(spec)
+        if not _drake_name(spec) or not plant.HasModelInstanceNamed(spec):
             raise error(
                 f"no model instance named {describe(spec)}; instances are "
                 f"{_instance_names(plant)}" + _body_hint(plant, spec)
@@ -498,8 +504,23 @@ def model_instance(
     )
 
 
+def _drake_name(name: str) -> bool:
+    """Whether pybind11 can pass ``name`` to Drake (UTF-8 can encode it).
+
+    A lone surrogate (U+D800 alone) cannot be: Drake's name lookups raised a
+    bare TypeError for it.  No body, joint or model instance has such a name.
+    """
+    try:
+        name.encode("utf-8")
+    except UnicodeError:
+        return False
+    return True
+
+
 def _body_hint(plant: MultibodyPlant, name: str) -> str:
     """A hint when a model-instance name is a body's scoped name instead."""
+    if not _drake_name(name):
+        return ""
     model, _, body = name.rpartition("::")
     if not (model and plant.HasModelInstanceNamed(model)):
         return ""
@@ -527,8 +548,11 @@ def resolve_body(plant: MultibodyPlant, name: str) -> RigidBody:
             "a body name must be a string such as 'model::body', got a "
             f"{type(name).__name__}"
         )
+    name = plain_str(name)
     try:
-        if "::" in name:
+        if not _drake_name(name):
+            pass  # no body has it: refused below with the plant's bodies
+        elif "::" in name:
             model, body = name.rsplit("::", 1)
             if plant.HasModelInstanceNamed(model):
                 instance = plant.GetModelInstanceByName(model)

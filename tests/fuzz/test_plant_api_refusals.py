@@ -381,3 +381,23 @@ def test_velocity_indices_of_a_billion_rows_are_refused_unread(jaw, jaw_found):
         velocity_indices=(i for i in g.hand_velocity_indices),
     )  # fmt: skip
     assert J.shape[1] == len(g.hand_velocity_indices)
+
+
+# -- names that Drake cannot read ------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["\ud800", "hand::\udfff", "\udfff::base_link"],
+    ids=["lone", "scoped-lone", "lone-model"],
+)
+def test_a_name_drake_cannot_read_is_no_body_and_no_model_instance(jaw, name):
+    # pybind11 cannot pass a lone surrogate: Drake's HasBodyNamed and
+    # HasModelInstanceNamed raised a bare TypeError for it (report_public).
+    plant = jaw.plant
+    with pytest.raises(dg.ModelError, match="no body named"):
+        dg.object_radius(plant, jaw.plant_context, name)
+    with pytest.raises(dg.ModelError, match="no body named"):
+        dg.plant.hand_bodies(plant, name)
+    with pytest.raises(dg.ModelError, match="no model instance named"):
+        dg.plant.hand_bodies(plant, jaw.object_body, hand=name)
