@@ -132,7 +132,7 @@ def _outline_patch(outline: Any, colors: Mapping[str, Any]):
         if set(outline) != {"center", "radius"}:
             raise InvalidOptionError(
                 "a circle outline is a mapping with keys 'center' and 'radius', "
-                f"got keys {sorted(outline)}"
+                f"got keys {describe(list(outline))}"
             )
         center = real_array(
             "circle center", outline["center"], error=InvalidOptionError

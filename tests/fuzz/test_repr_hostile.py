@@ -204,3 +204,18 @@ def test_a_models_folder_that_is_a_hostile_str_subclass_is_read_as_its_text():
     box = "package://drake_models/ycb/003_cracker_box.sdf"
     with pytest.raises(dg.ModelError, match="drake_models folder 'x'"):
         planning_scene(box, models_dir=hostile.StrFormatRaises("x"))
+
+
+@pytest.mark.parametrize(
+    "outline",
+    [{hostile.ReprRaises(): 1}, {1: 2, "a": 3}, hostile.DictReprRaises(a=1)],
+    ids=["key-repr-raises", "unsortable-keys", "dict-repr-raises"],
+)
+def test_a_circle_outline_of_odd_keys_is_refused_by_name(outline):
+    # The message listed sorted(outline): a key's repr raised, and keys of
+    # several types could not be sorted (a bare TypeError).
+    import drakegrasp.visualization as viz
+
+    grasp = dg.core.examples.planar_two_finger_square(0.5)
+    with pytest.raises(dg.InvalidOptionError, match="keys 'center' and 'radius'"):
+        viz.plot_planar_grasp(grasp, outline=outline)
