@@ -133,8 +133,29 @@ def add_packages(
         for folder in packages:
             _add_package_xml(package_map, folder)
     if ros_package_path and os.environ.get(ROS_PACKAGE_PATH):
-        package_map.PopulateFromRosPackagePath()
+        _populate_from_ros_package_path(package_map)
     return package_map
+
+
+def _populate_from_ros_package_path(package_map: PackageMap) -> None:
+    """Drake's crawl of ``$ROS_PACKAGE_PATH``, its folders read as paths first.
+
+    Drake raised a bare ``RuntimeError`` ("filesystem error: ... File name
+    too long") for a folder whose name is too long.
+    """
+    for folder in os.environ[ROS_PACKAGE_PATH].split(os.pathsep):
+        if folder:
+            path_text(
+                f"{ROS_PACKAGE_PATH} folder", folder, error=SceneError,
+                must="a folder name",
+            )  # fmt: skip
+    try:
+        package_map.PopulateFromRosPackagePath()
+    except RuntimeError as e:
+        raise SceneError(
+            f"cannot read the packages of {ROS_PACKAGE_PATH}: "
+            + " ".join(str(e).split())
+        ) from None
 
 
 def add_named_package(package_map: PackageMap, name, folder) -> None:

@@ -307,3 +307,17 @@ def test_the_command_names_a_drake_models_variable_of_a_long_name(capsys, monkey
     assert err.count("\n") == 1, err[:300]
     assert DRAKE_MODELS_ENV in err
     assert os.environ[DRAKE_MODELS_ENV].startswith("/tmp/w")
+
+
+@pytest.mark.parametrize(
+    "value",
+    ["/tmp/" + "r" * 300, "s" * 5000, "/nonexistent:/tmp/" + "t" * 300],
+    ids=["long-name", "too-long", "second-entry"],
+)
+def test_a_hostile_ros_package_path_is_a_scene_error(value, monkeypatch):
+    # Drake's PopulateFromRosPackagePath raised a bare RuntimeError
+    # ("filesystem error: ... File name too long").
+    monkeypatch.setenv("ROS_PACKAGE_PATH", value)
+    with pytest.raises(dg.SceneError, match="ROS_PACKAGE_PATH") as refused:
+        dg.load_scene("parallel_jaw_box")
+    assert len(str(refused.value)) <= SHORT
