@@ -6,17 +6,18 @@ For ``--budget`` seconds (default 150) it picks a public callable at random
 (one of ``PUBLIC`` of ``tests/core/test_calls.py``: every name of every
 package's table, and the example grasps), fills its parameters with values
 drawn from :data:`HOSTILE`, the hostile objects of ``hostile.objects``
-(dunders that raise or lie, masked arrays, odd dtypes, huge broadcast
-shapes) and the scene's objects (for a parameter that :func:`scene_values`
-knows, often a valid value instead, so that the call gets past its first
-check), calls it and draws a few items of what it yields.  A
-:class:`~drakegrasp.GraspError` is the refusal the library promises.
-Anything else is a *raw kind*, keyed by the callable, the exception's type
-and the ``file:line`` that raised it (the innermost frame inside drakegrasp,
-so a hostile object's own dunder is not the key); a call still running after
-``--limit`` seconds (default 4) is the kind ``TIMEOUT``, and a GraspError
-whose message is longer than :data:`LONG` characters (a huge ``repr`` carried
-into it whole) is the kind ``LONG_MESSAGE``.
+(dunders that raise or lie, masked arrays, odd dtypes, huge broadcast shapes,
+and ``hostile.path_hostile``'s paths: path-likes whose ``__fspath__`` raises
+or lies, a NUL, a lone surrogate, names too long) and the scene's objects (for
+a parameter that :func:`scene_values` knows, often a valid value instead, so
+that the call gets past its first check), calls it and draws a few items of
+what it yields.  A :class:`~drakegrasp.GraspError` is the refusal the library
+promises.  Anything else is a *raw kind*, keyed by the callable, the
+exception's type and the ``file:line`` that raised it (the innermost frame
+inside drakegrasp, so a hostile object's own dunder is not the key); a call
+still running after ``--limit`` seconds (default 4) is the kind ``TIMEOUT``,
+and a GraspError whose message is longer than :data:`LONG` characters (a huge
+``repr`` carried into it whole) is the kind ``LONG_MESSAGE``.
 
 It prints the number of calls, then one line per raw kind: how many calls
 met it, its key, and the first such call (arguments and message).  The
