@@ -11,7 +11,7 @@ rejects colliding poses and closes the fingers with Drake's distance queries
 (:mod:`~drakegrasp.planning.cloud`; multi-finger hands,
 :mod:`~drakegrasp.planning.cloud_hand`), and ranks the grasps
 (:mod:`~drakegrasp.planning.ranking`, :mod:`~drakegrasp.planning.weight`,
-:mod:`~drakegrasp.planning.motors`);
+:mod:`~drakegrasp.planning.motors`, :mod:`~drakegrasp.planning.opposition`);
 the results are :mod:`~drakegrasp.planning.candidates`, and
 :mod:`~drakegrasp.planning.shake` checks them in a Drake simulation
 (:mod:`~drakegrasp.planning.shake_ranking`: the best ones, those that held
@@ -54,6 +54,7 @@ _SUBMODULES = (
     "motors",
     "multifinger",
     "needed",
+    "opposition",
     "placement",
     "planner",
     "ranking",
