@@ -31,6 +31,7 @@ from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import real_array, real_scalar
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.planning.needed import needed_text, per_motor
+from drakegrasp.planning.opposition import push_text
 from drakegrasp.plant.contacts import PlantContact
 from drakegrasp.plant.couplings import coupled_positions, recorded_couplings
 from drakegrasp.plant.fingers import find_joint
@@ -212,6 +213,25 @@ class GraspCandidate:
         a hidden drive), a plant whose constraints drakegrasp was not told
         of, or a candidate built or pickled without them.  Distinct str,
         else ``InvalidGraspError``.  ``num_motors`` counts them.
+    torque_limit : float
+        The torque per motor (in ``torque_unit``) that the ranking held
+        ``torque_needed`` against: the smallest effort limit of the
+        candidate's motors, or ``plan_grasps``' ``torque_limit`` where that
+        is smaller (:func:`~drakegrasp.planning.motors.with_torques_needed`);
+        NaN where no finite limit is known or ``torque_needed`` was not
+        computed.  ``torque_needed > torque_limit`` is one of the
+        ``concerns``.
+    squeeze_push : float
+        How one way the hand's closing motions push the object, in ``[0,
+        1]``: 0 where they oppose one another (a jaw, a thumb against
+        fingers), towards 1 where every contact's closing motion leans one
+        way and the squeeze may push the object out of the hand
+        (:mod:`~drakegrasp.planning.opposition`); for a multi-finger hand's
+        best force-closure candidates
+        (:func:`~drakegrasp.planning.motors.with_squeeze_push`, which ranks
+        those above :data:`~drakegrasp.planning.opposition.SQUEEZE_PUSH_MAX`
+        after the other force-closure candidates), NaN where not computed
+        (a parallel jaw's, whose fingers close towards each other).
 
     Notes
     -----
@@ -253,6 +273,8 @@ class GraspCandidate:
     held_joints: tuple[tuple[str, float], ...] = ()
     torque_unit: str = "N·m"
     motors: tuple[str, ...] = ()
+    torque_limit: float = float("nan")
+    squeeze_push: float = float("nan")
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "motors", _checked_motors(self.motors))
@@ -292,6 +314,36 @@ class GraspCandidate:
     def num_motors(self) -> int:
         """Number of ``motors`` (0: none known)."""
         return len(self.motors)
+
+    @property
+    def concerns(self) -> tuple[str, ...]:
+        """What the plan itself says against this candidate holding, in words.
+
+        Empty when the plan knows nothing against it.  Otherwise one sentence
+        each, in this order: not force closure; a ``torque_needed`` above
+        ``torque_limit`` (the motors apply less than the weight needs, by
+        the plan's own lower bound); a ``squeeze_push`` above
+        :data:`~drakegrasp.planning.opposition.SQUEEZE_PUSH_MAX` (the
+        squeeze may push the object out of the hand).  A figure not computed
+        (NaN) raises no concern.  ``shake_candidates`` names them beside a
+        dropped candidate.
+        """
+        out = []
+        if not self.is_closure:
+            out.append(
+                "not force closure: some wrench on the object meets no contact force"
+            )
+        if self.torque_needed > self.torque_limit:  # False where either is NaN
+            unit = per_motor(str(self.torque_unit))
+            needed = needed_text(self.torque_needed, self.torque_capacity, unit)
+            out.append(
+                f"it needs {needed} (torque_needed), more than the "
+                f"{self.torque_limit:.3g} its motors apply (torque_limit)"
+            )
+        push = push_text(float(self.squeeze_push))
+        if push:
+            out.append(push)
+        return tuple(out)
 
     def apply(self, plant, context, *, object_body=None) -> None:
         """Put the candidate's hand pose (and the planned object pose) in a context.
@@ -391,6 +443,9 @@ class GraspCandidate:
             "held_joints": {name: float(q) for name, q in self.held_joints},
             "torque_unit": self.torque_unit,
             "motors": list(self.motors),
+            "torque_limit": jsonable(self.torque_limit),
+            "squeeze_push": jsonable(self.squeeze_push),
+            "concerns": list(self.concerns),
         }
 
     def __str__(self) -> str:
@@ -423,7 +478,7 @@ class GraspCandidate:
             f", {self.num_contacts} contacts, eps = {self.epsilon:.4f}, robustness "
             f"{self.robustness:.2f}, {holds}, score {self.score:.4f}; {shape}, "
             f"p_WH = ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
-        )
+        ) + "".join(f"; {c}" for c in self.concerns[0 if self.is_closure else 1 :])
 
 
 def _counted(n: int, noun: str) -> str:
@@ -592,7 +647,12 @@ class GraspCandidates(Sequence):
         sample index); for a multi-finger hand with a known weight, the
         candidates whose ``torque_needed`` is within the hand's smallest
         effort limit come first, in that order
-        (:func:`~drakegrasp.planning.motors.with_torques_needed`).
+        (:func:`~drakegrasp.planning.motors.with_torques_needed`); and for a
+        multi-finger hand, the force-closure candidates whose closing motions
+        all push the object one way (``squeeze_push`` above
+        :data:`~drakegrasp.planning.opposition.SQUEEZE_PUSH_MAX`, checked for
+        the best of them) come after the other force-closure ones
+        (:func:`~drakegrasp.planning.motors.with_squeeze_push`).
     rejections : dict of str to int
         Sampled poses dropped, by reason.
     num_sampled : int
@@ -689,7 +749,8 @@ class GraspCandidates(Sequence):
         table has a full one's schema; none if ``settings`` names none.
 
         ``num_motors`` (int64), after ``torque_unit``, counts each row's
-        ``motors`` (0: none known).
+        ``motors`` (0: none known); ``torque_limit`` and ``squeeze_push``
+        follow it (NaN where not computed).
 
         Raises
         ------
@@ -714,6 +775,8 @@ class GraspCandidates(Sequence):
             "torque_capacity": column(lambda c: c.torque_capacity),
             "torque_unit": column(lambda c: c.torque_unit, object),
             "num_motors": column(lambda c: c.num_motors, np.int64),
+            "torque_limit": column(lambda c: c.torque_limit),
+            "squeeze_push": column(lambda c: c.squeeze_push),
             "epsilon": column(lambda c: c.epsilon),
             "robustness": column(lambda c: c.robustness),
             "is_closure": column(lambda c: c.is_closure, bool),
@@ -771,6 +834,14 @@ class GraspCandidates(Sequence):
                 f"  ranked first: the {first['held']} with {first['needed']} <= "
                 f"{first['limit']:g} {first['unit']} ({first['source']}){rest} in "
                 "score order"
+            )
+        last = self.settings.get("pushed_last")
+        if last and last["count"] and self:
+            lines.append(
+                f"  ranked after the other force-closure candidates: the "
+                f"{last['count']} of the {last['checked']} checked whose closing "
+                "motions push the object one way (squeeze_push > "
+                f"{last['bound']:g}), in the order above"
             )
         if self.reason:
             lines.append(f"  {self.reason}" if self else f"  empty: {self.reason}")

@@ -59,7 +59,13 @@ When the weight is known (an object body's mass, or ``object_mass=``),
 candidates and ranks those the hand's actuators hold (``torque_needed`` at
 most the smallest effort limit of the candidate's joints) ahead of the rest;
 ``plan_grasps(..., torque_limit=)`` puts the torque the user will apply (N·m,
-capped by the effort limit) in the limit's place.
+capped by the effort limit) in the limit's place, and each checked candidate
+records the limit its figure was held to (``torque_limit``).
+:func:`with_squeeze_push` then gives the same head :func:`squeeze_push`, how
+one way the hand's closing motions push the object
+(:mod:`~drakegrasp.planning.opposition`), and ranks those that push one way
+after every other force-closure candidate: the squeeze carries such a grasp
+out of the hand before any load, whatever its torque.
 
 **A parallel jaw** presses each finger with at most its actuator's effort
 limit (N), so :func:`with_squeeze_limit` ranks the candidates whose
@@ -99,6 +105,11 @@ from drakegrasp.planning.needed import (
     needed_text,
     per_motor,
 )
+from drakegrasp.planning.opposition import (
+    SQUEEZE_PUSH_MAX,
+    closing_directions,
+    squeeze_push_of,
+)
 from drakegrasp.planning.weight import WEIGHT_DIRECTIONS, palm_faces, palm_rows
 from drakegrasp.plant.couplings import coupling_map, motor_shares, plant_couplings
 from drakegrasp.plant.fingers import effort_unit, find_joint, hidden_drives
@@ -127,9 +138,11 @@ __all__ = [
     "finger_jacobian",
     "motor_limit",
     "motor_names",
+    "squeeze_push",
     "torque_capacity",
     "torque_needed",
     "with_squeeze_limit",
+    "with_squeeze_push",
     "with_torques_needed",
 ]
 
@@ -539,7 +552,8 @@ def with_torques_needed(
     -------
     GraspCandidates
         With ``reason`` saying so when no checked candidate is held by the
-        actuators.
+        actuators; each checked candidate records the limit its figure was
+        held to (``torque_limit``, where a finite one is known).
     """
     if torque_limit is not None:
         torque_limit = check_torque_limit(torque_limit)
@@ -561,6 +575,13 @@ def with_torques_needed(
     if applied:
         limit = torque_limit
     unit = _unit_of_joints(plant, ranked[0].joint_names) if ranked else "N·m"
+    if math.isfinite(limit):  # what each checked candidate's figure was held to
+        ranked = [
+            c if math.isnan(c.torque_needed) else dataclasses.replace(
+                c, torque_limit=float(limit)
+            )
+            for c in ranked
+        ]  # fmt: skip
     reason = (
         result.reason
         or _too_weak(head, limit, applied, unit)
@@ -606,6 +627,136 @@ def _with_held_first(settings, ranked, needed, limit, unit, applied, given) -> d
     entry = dict(needed=needed, limit=float(limit), unit=unit, source=source,
                  held=held)  # fmt: skip
     return {**settings, "held_first": entry}
+
+
+def squeeze_push(plant, plant_context, candidate: GraspCandidate, object_body) -> float:
+    """How one way a candidate's closing motions push the object, in ``[0, 1]``.
+
+    :func:`~drakegrasp.planning.opposition.squeeze_push_of` of the directions
+    in which closing moves each contact's finger point
+    (:func:`~drakegrasp.planning.opposition.closing_directions` of the hand
+    Jacobian :func:`finger_jacobian` at the candidate's pose, each joint
+    closing the way ``closing_signs`` says; a contact closing does not move
+    pushes back along its normal).  0: the motions oppose one another; 1:
+    all push one way, and the squeeze may push the object out of the hand.
+
+    Parameters
+    ----------
+    plant, plant_context, candidate, object_body
+        As for :func:`finger_jacobian` (``object_body`` None on a point
+        cloud); the context is left as it was.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    InvalidOptionError
+        ``candidate`` is not a :class:`GraspCandidate`, or a planar one.
+    """
+    J = finger_jacobian(plant, plant_context, candidate, object_body)
+    contacts = candidate.grasp.contacts
+    frames = np.array([c.frame for c in contacts])
+    counts = [c.num_components for c in contacts]
+    return squeeze_push_of(
+        closing_directions(J, frames, counts, candidate.closing_signs)
+    )
+
+
+def with_squeeze_push(
+    result: GraspCandidates,
+    plant,
+    plant_context,
+    object_body,
+    *,
+    top: int,
+    started: float,
+    check: int = TORQUE_CHECK,
+    push_last: bool = True,
+) -> GraspCandidates:
+    """A multi-finger ``result`` with :func:`squeeze_push` on its best candidates.
+
+    The force-closure candidates among the first ``max(top, check)`` (those
+    :func:`with_torques_needed` checks) get ``squeeze_push``.  With
+    ``push_last``, those above
+    :data:`~drakegrasp.planning.opposition.SQUEEZE_PUSH_MAX` move after every
+    other force-closure candidate, ahead of those that are not force
+    closure, each group keeping its order (the motors-first order of
+    :func:`with_torques_needed`, then the score): in Drake the squeeze
+    pushed such grasps out of the hand while seating, before any load, at
+    any torque (:mod:`~drakegrasp.planning.opposition`).  A candidate past
+    the head is not checked, and stays in its group.
+
+    Parameters
+    ----------
+    result : GraspCandidates
+        A multi-finger hand's candidates, ranked.
+    plant, plant_context, object_body
+        As for :func:`finger_jacobian` (``object_body`` None on a point cloud).
+    top : int
+        The ``certify`` of the run: the first ``top`` candidates after the
+        re-ranking carry the single-grasp verdict (``closure``).
+    started : float
+        The run's ``time.perf_counter()`` at its start (``result.time``
+        counts this stage).
+    check : int, optional
+        How deep the head goes (default :data:`TORQUE_CHECK`).
+    push_last : bool, optional
+        Move the candidates that push one way after the rest of the head
+        (default); False records the figure only.
+
+    Returns
+    -------
+    GraspCandidates
+        ``settings["pushed_last"]`` records ``bound``, ``checked`` (candidates
+        given the figure) and ``count`` (above the bound); ``reason`` says so
+        when every checked candidate pushes one way (and no other reason is
+        given).
+    """
+    n = max(int(top), int(check))
+    head = [
+        dataclasses.replace(
+            c, squeeze_push=squeeze_push(plant, plant_context, c, object_body)
+        )
+        if c.is_closure
+        else c
+        for c in result.candidates[:n]
+    ]
+    ranked = [*head, *result.candidates[n:]]
+    checked = [c for c in head if not math.isnan(c.squeeze_push)]
+    pushing = [c for c in checked if c.squeeze_push > SQUEEZE_PUSH_MAX]
+    if push_last and pushing:
+        ranked = sorted(
+            ranked,
+            key=lambda c: (not c.is_closure, c.squeeze_push > SQUEEZE_PUSH_MAX),
+        )
+    ranked = _certified(ranked, top)
+    reason = result.reason
+    if not reason and checked and len(pushing) == len(checked):
+        least = min(c.squeeze_push for c in pushing)
+        reason = (
+            f"the closing motions of every one of the {len(checked)} best "
+            "force-closure candidates push the object one way (squeeze_push > "
+            f"{SQUEEZE_PUSH_MAX:g}, at least {least:.2f}): "
+            "the squeeze may push it out of the hand; try a pre-shape that "
+            "opposes a finger to the others (a thumb), or more samples"
+        )
+    settings = result.settings
+    if push_last:
+        settings = {
+            **settings,
+            "pushed_last": dict(
+                bound=SQUEEZE_PUSH_MAX, checked=len(checked), count=len(pushing)
+            ),
+        }
+    return dataclasses.replace(
+        result,
+        candidates=tuple(ranked),
+        reason=reason,
+        settings=settings,
+        time=time.perf_counter() - started,
+    )
 
 
 def with_squeeze_limit(
@@ -685,6 +836,12 @@ def _held_first(ranked: list, needed: str, limit: float, top: int) -> list:
     if not math.isfinite(limit):
         return ranked
     ranked = sorted(ranked, key=lambda c: not getattr(c, needed) <= limit)
+    return _certified(ranked, top)
+
+
+def _certified(ranked: list, top: int) -> list:
+    """``ranked`` with its first ``top`` carrying the single-grasp verdict."""
+    ranked = list(ranked)
     ranked[:top] = [
         c if c.closure is not None else dataclasses.replace(
             c, closure=force_closure(c.grasp)

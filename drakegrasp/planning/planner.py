@@ -28,7 +28,9 @@ candidate or is counted under one rejection reason.
    (:mod:`drakegrasp.planning.ranking`), weight capacity in one LP per grasp
    (:mod:`drakegrasp.planning.weight`); the squeeze (or torque) that holds
    the weight ``m |g|``, ``|g|`` the magnitude of the plant's own gravity
-   field, as :func:`~drakegrasp.analyze_grasp` weighs the object.
+   field, as :func:`~drakegrasp.analyze_grasp` weighs the object; for a
+   multi-finger hand, whether its closing motions push the object one way
+   (:mod:`drakegrasp.planning.opposition`).
 """
 
 from __future__ import annotations
@@ -80,6 +82,7 @@ from drakegrasp.planning.motors import (
     check_torque_limit,
     motor_names,
     with_squeeze_limit,
+    with_squeeze_push,
     with_torques_needed,
 )
 from drakegrasp.planning.multifinger import (
@@ -451,7 +454,13 @@ def plan_grasps(
     -------
     GraspCandidates
         Ranked best first; ``rejections`` counts the other samples by reason
-        (:data:`REASONS`); ``reason`` says why when it is empty.
+        (:data:`REASONS`); ``reason`` says why when it is empty.  A
+        multi-finger hand's best force-closure candidates also carry
+        ``squeeze_push``, and those whose closing motions all push the object
+        one way come after the other checked ones
+        (:func:`~drakegrasp.planning.motors.with_squeeze_push`); each
+        candidate's ``concerns`` say what the plan expects to keep it from
+        holding.
 
     Raises
     ------
@@ -991,10 +1000,11 @@ def plan_multifinger(
         workers=workers, X_WO=X_WO, weight=weight, rejections=rejections,
         num_sampled=n, object_body=name, started=t0, reference=reference,
     )  # fmt: skip
-    return with_torques_needed(
+    result = with_torques_needed(
         result, plant, ctx, body, weight=weight, top=certify, started=t0,
         torque_limit=torque_limit,
     )  # fmt: skip
+    return with_squeeze_push(result, plant, ctx, body, top=certify, started=t0)
 
 
 def plan_multifinger_cloud(
@@ -1052,7 +1062,8 @@ def plan_multifinger_cloud(
         reference=np.zeros(3),
     )  # fmt: skip
     # no object body: each contact's finger point is its cloud point
-    return with_torques_needed(
+    result = with_torques_needed(
         result, plant, ctx, None, weight=weight, top=certify, started=t0,
         torque_limit=torque_limit,
     )  # fmt: skip
+    return with_squeeze_push(result, plant, ctx, None, top=certify, started=t0)

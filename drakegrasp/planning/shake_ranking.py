@@ -1,11 +1,13 @@
 r"""Ranking by physics: the planner's best candidates shaken, those that held first.
 
 The planner ranks from the planned contacts (closure, ε, robustness, the
-weight held per newton of squeeze).  What it does not see is what a hand's
-closing motion does to the object once the fingers meet it: the Allegro
-hand's thumbless grasps of the YCB sugar box are force closure and rank high,
-and the squeeze alone pushes the box out of the hand (the planning guide,
-"What the ranking does not see").  :func:`shake_candidates` runs
+weight held per newton of squeeze, the torque the motors need, and which way
+the closing motions push: :mod:`~drakegrasp.planning.opposition`).  What it
+does not see is how the object moves once the fingers meet it: it seats a
+few millimetres off the plan, touches links the plan did not list, and a
+grasp whose torque figures say it holds may still slip (the Allegro hand's
+soup-can grasps within its 0.7 N·m held about two times in three in the
+planning guide's runs).  :func:`shake_candidates` runs
 :func:`~drakegrasp.planning.shake.shake_test` on the first ``top`` candidates
 and re-orders them: those that held, in the planner's order, then those that
 dropped, then those Drake could not simulate, each with its
@@ -136,6 +138,7 @@ class ShakenCandidate:
         }
 
     def __str__(self) -> str:
+        """One line; a drop the plan expected names the candidate's ``concerns``."""
         if self.result is None:
             return f"plan #{self.planned_rank}: not simulated ({self.error})"
         r = self.result
@@ -148,10 +151,14 @@ class ShakenCandidate:
                 + motion_text(r.max_displacement_from_seat, r.max_rotation_from_seat, 1)
             )
         )
+        said = self.candidate.concerns
+        expected = (
+            f"; as the plan said: {'; '.join(said)}" if said and not self.held else ""
+        )
         return (
             f"plan #{self.planned_rank}: {'held' if self.held else 'dropped'} "
             f"(at most {motion_text(r.max_displacement, r.max_rotation, 1)} "
-            f"from the plan{seated})"
+            f"from the plan{seated}){expected}"
         )
 
 

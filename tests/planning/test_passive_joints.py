@@ -143,8 +143,8 @@ def test_a_candidate_records_the_joints_the_plan_held(bent):
 
 COLUMNS = [
     "rank_in_result", "sample", "score", "weight_capacity", "squeeze_needed",
-    "torque_needed", "torque_capacity", "torque_unit", "num_motors", "epsilon",
-    "robustness",
+    "torque_needed", "torque_capacity", "torque_unit", "num_motors",
+    "torque_limit", "squeeze_push", "epsilon", "robustness",
     "is_closure", "d_star", "num_contacts", "opening", "p_WH", "R_WH", "q_hand",
 ]  # fmt: skip
 """``GraspCandidates.table()``'s columns for candidates that held no joint."""

@@ -1,19 +1,31 @@
-"""The squeeze push: whether a candidate's closing motions oppose each other
-(``drakegrasp.planning.opposition``)."""
+"""The squeeze push: whether a candidate's closing motions oppose each other,
+and the ranking that puts the grasps whose squeeze pushes the object out of
+the hand after the others (``drakegrasp.planning.opposition``,
+``motors.with_squeeze_push``), and a candidate's ``concerns``."""
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 import pytest
+from allegro_support import allegro_scene, has_thumb
 
+import drakegrasp as dg
+import drakegrasp.planning.motors as motors
 from drakegrasp.core.contact import contact_frame
 from drakegrasp.core.linalg import rotations_about
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.opposition import (
     PASSIVE_SPEED,
+    SQUEEZE_PUSH_MAX,
     closing_directions,
     squeeze_push_of,
 )
+
+THREE = "package://drakegrasp/hands/three_finger_hand.sdf"
+THREE_OPEN = [-0.4, 0.0, 0.0] * 3
 
 
 def _cone(theta: float, k: int = 3, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -125,3 +137,170 @@ def test_closing_directions_refuse_what_does_not_fit():
         closing_directions(np.zeros((2, 1)), R, [2], [1.0])  # no such contact
     with pytest.raises(InvalidOptionError, match="finite"):
         closing_directions(np.full((3, 1), np.nan), R, [3], [1.0])
+
+
+# --- the ranking: pushers after the other force-closure candidates -----------
+
+
+@pytest.fixture(scope="module")
+def three_on_box():
+    scene = dg.planning_scene("package://drakegrasp/objects/box.sdf", hand_url=THREE)
+    result = dg.plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=40, mu=1.0, seed=3, robustness_samples=8, preshape=THREE_OPEN,
+    )  # fmt: skip
+    return scene, result
+
+
+def test_a_three_finger_hands_grasps_oppose(three_on_box):
+    # its fingers close on the object from three sides: nothing moves
+    _, result = three_on_box
+    pushes = [c.squeeze_push for c in result if c.is_closure]
+    assert pushes and max(pushes) < 0.5
+    assert all(math.isnan(c.squeeze_push) for c in result if not c.is_closure)
+    assert result.settings["pushed_last"] == dict(
+        bound=SQUEEZE_PUSH_MAX, checked=len(pushes), count=0
+    )
+    assert "push the object one way" not in str(result)
+
+
+def _uncertified(result):
+    return dataclasses.replace(
+        result,
+        candidates=tuple(
+            dataclasses.replace(c, closure=None, squeeze_push=math.nan) for c in result
+        ),
+    )
+
+
+def test_a_candidate_whose_squeeze_pushes_it_out_is_not_ranked_above_one_that_opposes(
+    three_on_box, monkeypatch
+):
+    """with_squeeze_push, given pushes (the hand's own oppose, so they are
+    stood in for): the force-closure candidates above SQUEEZE_PUSH_MAX come
+    after every other force-closure candidate and before those that are not
+    force closure, each group in the order it came; the new head is
+    certified; the result says how many moved."""
+    scene, result = three_on_box
+    closed = [c for c in result if c.is_closure]
+    assert len(closed) >= 6 and not result[len(closed)].is_closure
+    pushes = {
+        c.sample: 0.95 if k in (0, 2, 3) else 0.1 * (k % 5)
+        for k, c in enumerate(closed)
+    }
+
+    def push(plant, context, candidate, object_body):
+        return pushes[candidate.sample]
+
+    monkeypatch.setattr(motors, "squeeze_push", push)
+    given = _uncertified(result)
+    ranked = motors.with_squeeze_push(
+        given, scene.plant, scene.context, scene.object_body, top=4, started=0.0
+    )
+    samples = [c.sample for c in ranked]
+    opposed = [c.sample for c in closed if pushes[c.sample] <= SQUEEZE_PUSH_MAX]
+    pushing = [closed[0].sample, closed[2].sample, closed[3].sample]
+    others = [c.sample for c in result if not c.is_closure]
+    assert samples == [*opposed, *pushing, *others]
+    # no pusher above an opposed candidate, whatever the score said
+    k = samples.index(pushing[0])
+    assert all(c.squeeze_push <= SQUEEZE_PUSH_MAX for c in ranked[:k])
+    assert all(c.closure is not None for c in ranked[:4])
+    assert ranked.settings["pushed_last"] == dict(
+        bound=SQUEEZE_PUSH_MAX, checked=len(closed), count=3
+    )
+    assert "the 3 of the" in str(ranked) and ranked.reason == ""
+    assert all(any("push the object one way" in w for w in c.concerns)
+               for c in ranked if c.sample in pushing)  # fmt: skip
+    kept = motors.with_squeeze_push(
+        given, scene.plant, scene.context, scene.object_body, top=4, started=0.0,
+        push_last=False,
+    )  # fmt: skip
+    assert [c.sample for c in kept] == [c.sample for c in result]
+
+
+def test_when_every_candidate_pushes_the_reason_says_so(three_on_box, monkeypatch):
+    scene, result = three_on_box
+    monkeypatch.setattr(motors, "squeeze_push", lambda *a: 0.9)
+    ranked = motors.with_squeeze_push(
+        _uncertified(result), scene.plant, scene.context, scene.object_body, top=4,
+        started=0.0,
+    )  # fmt: skip
+    assert "push the object one way" in ranked.reason
+    assert [c.sample for c in ranked] == [c.sample for c in result]
+
+
+# --- a candidate's concerns ---------------------------------------------------
+
+
+def test_concerns_name_what_the_plan_says_against_holding(three_on_box):
+    _, result = three_on_box
+    c = next(c for c in result if c.is_closure)
+    quiet = dataclasses.replace(
+        c, torque_needed=0.5, torque_capacity=2.0, torque_limit=0.7, squeeze_push=0.2
+    )
+    assert quiet.concerns == ()
+    heavy = dataclasses.replace(quiet, torque_needed=1.25, torque_capacity=0.8)
+    (concern,) = heavy.concerns
+    assert "1.25 N·m per motor (torque_needed)" in concern and "0.7" in concern
+    assert str(heavy).endswith(concern)
+    pushed = dataclasses.replace(heavy, squeeze_push=0.9)
+    assert len(pushed.concerns) == 2 and "squeeze_push 0.90 > 0.7" in pushed.concerns[1]
+    unknown = dataclasses.replace(c, torque_needed=9.0, torque_limit=math.nan)
+    assert unknown.concerns == ()  # no limit known: nothing to hold it to
+    not_closed = next(c for c in result if not c.is_closure)
+    assert not_closed.concerns[0].startswith("not force closure")
+    assert "not force closure" not in str(not_closed)  # it says "no closure"
+    assert pushed.to_dict()["concerns"] == list(pushed.concerns)
+    assert pushed.to_dict()["squeeze_push"] == 0.9
+
+
+# --- Drake's Allegro hand ---------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def allegro_on_sugar(drake_models_dir):
+    """The YCB sugar box as if 0.25 kg, so that the hand's 0.7 N·m holds some."""
+    scene = allegro_scene("004_sugar_box", drake_models_dir)
+    result = dg.plan_grasps(
+        scene.plant, scene.context, scene.object_body, hand=scene.hand,
+        num_candidates=150, mu=1.0, seed=0, object_mass=0.25,
+    )  # fmt: skip
+    return scene, result
+
+
+def test_the_allegro_hands_thumbless_grasps_push_one_way(allegro_on_sugar):
+    # its index, middle and ring curl the same way; with the thumb they oppose
+    _, result = allegro_on_sugar
+    closed = [c for c in result if not math.isnan(c.squeeze_push)]
+    assert len(closed) >= 8
+    for c in closed:
+        assert (c.squeeze_push > SQUEEZE_PUSH_MAX) == (not has_thumb(c)), c
+    first = next(k for k, c in enumerate(result) if c.squeeze_push > SQUEEZE_PUSH_MAX)
+    assert all(c.is_closure and has_thumb(c) for c in result[:first])
+    assert all(c.torque_limit == pytest.approx(0.7) for c in closed)
+
+
+def test_the_allegro_hands_first_grasps_hold_and_those_it_put_last_are_pushed_out(
+    allegro_on_sugar,
+):
+    """In Drake, at the shake's default squeeze (20 N at the contacts, each
+    joint within its 0.7 N·m): the planner's first two grasps of the light
+    sugar box hold, and the two thumbless ones that the torque figures alone
+    ranked third and fourth (both within the 0.7 N·m) are pushed out of the
+    hand while seating, before any load (measured 0.49 and 0.70 m/s).
+    About 3 s."""
+    scene, result = allegro_on_sugar
+    pushers = [c for c in result if c.squeeze_push > SQUEEZE_PUSH_MAX]
+    within = [c for c in pushers if c.torque_needed <= c.torque_limit][:2]
+    assert len(within) == 2  # the motors hold them, by the torque figures
+    first = dg.shake_candidates(scene.add_models, result, top=2)
+    last = dg.shake_candidates(scene.add_models, within, top=2)
+    assert len(first.held) == 2
+    assert not last.held
+    assert all(s.result.seat_speed > 0.1 for s in last)  # pushed, not dropped
+    # each drop is named with what the plan said of it
+    assert all(
+        "; as the plan said: " in str(s) and "squeeze_push" in str(s) for s in last
+    )
+    assert all("as the plan said" not in str(s) for s in first)
