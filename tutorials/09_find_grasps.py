@@ -245,7 +245,11 @@ print(
 # direction in the hand is learnt from the plant: from the palm towards where
 # the fingertips meet when the hand curls on nothing.  The candidates are
 # ranked as the WSG's: force closure, ε, robustness and the weight capacity
-# with one squeeze bound per finger.
+# with one squeeze bound per finger; then those whose `torque_needed` the
+# motors' 0.7 N·m cover come first, and those whose closing motions all push
+# the can one way (`squeeze_push`, the index, middle and ring without the
+# thumb) after every other force-closure candidate.  Each candidate's
+# `concerns` say what the plan has against it.
 
 # %%
 ALLEGRO = (
