@@ -53,6 +53,7 @@ import decimal
 import itertools
 import numbers
 import operator
+import os
 import sys
 
 import numpy as np
@@ -187,8 +188,19 @@ def plain_str(value):
     return str.__str__(value) if issubclass(type(value), str) else value
 
 
-PATH_MAX = 4096
-"""Bytes in a path that :func:`path_text` takes (Linux's ``PATH_MAX``)."""
+def _system_limit(name: str, default: int) -> int:
+    """``os.pathconf("/", name)``, or ``default`` where the system does not say."""
+    try:
+        value = os.pathconf("/", name)
+    except (AttributeError, OSError, ValueError):  # no pathconf, or no such name
+        return default
+    return value if value > 0 else default  # -1: no limit given
+
+
+PATH_MAX = _system_limit("PC_PATH_MAX", 4096)
+"""The system's ``PATH_MAX`` (4096 on Linux, 1024 on macOS): bytes in a path,
+the NUL that ends it counted, so :func:`path_text` takes at most
+``PATH_MAX - 1``; the system refuses a longer one (``ENAMETOOLONG``)."""
 
 NAME_MAX = 255
 """Bytes in one name of a path (ext4, APFS, NTFS): a longer one names no file."""
@@ -211,8 +223,8 @@ def path_text(
     ``os.PathLike`` by its ``__fspath__``, whose exception or answer of the
     wrong type is refused by name.  What then reaches the file system cannot
     raise anything but an ``OSError`` of the file itself: a NUL character, a
-    character the file system cannot encode (a lone surrogate), a path
-    longer than :data:`PATH_MAX` bytes or a name in it longer than
+    character the file system cannot encode (a lone surrogate), a path of
+    :data:`PATH_MAX` bytes or more or a name in it longer than
     :data:`NAME_MAX` bytes are refused here (pathlib raised a bare
     ``ValueError``, ``UnicodeEncodeError`` or ``OSError`` for them, from
     ``is_file()`` too).
@@ -270,8 +282,11 @@ def _path_problem(text: str) -> str:
         encoded = text.encode(sys.getfilesystemencoding(), "surrogateescape")
     except UnicodeError:
         return "holds a character the file system cannot encode (a lone surrogate?)"
-    if len(encoded) > PATH_MAX:
-        return f"is too long: {len(encoded)} bytes, where a path holds {PATH_MAX}"
+    if len(encoded) >= PATH_MAX:  # PATH_MAX counts the NUL that ends the path
+        return (
+            f"is too long: {len(encoded)} bytes, where a path holds at most "
+            f"{PATH_MAX - 1}"
+        )
     longest = max(len(part) for part in encoded.split(b"/"))
     if longest > NAME_MAX:
         return (

@@ -232,7 +232,33 @@ def test_the_reader_returns_the_plain_text_of_a_str_subclass_or_a_path_like():
     assert type(text) is str and text == "b"
     assert path_text("p", Path("/tmp/c")) == "/tmp/c"
     assert path_text("p", "", empty=True) == ""
-    assert path_text("p", "/" + "d/" * 2000) == "/" + "d/" * 2000  # 4001 bytes
+    many = "/" + "d/" * ((PATH_MAX - 2) // 2)  # PATH_MAX - 1 or - 2 bytes
+    assert path_text("p", many) == many
+
+
+def _path_of_bytes(n: int) -> str:
+    """An absolute path of ``n`` bytes, each name within ``NAME_MAX``."""
+    names = "/".join(["p" * 200] * (n // 201 + 1))
+    return ("/" + names)[:n]
+
+
+def test_a_path_of_path_max_bytes_is_refused_as_too_long():
+    # PATH_MAX counts the NUL that ends a path: the kernel refuses a path of
+    # PATH_MAX bytes (ENAMETOOLONG), and pathlib's is_file() raised it.
+    assert path_text("p", _path_of_bytes(PATH_MAX - 1)) == _path_of_bytes(PATH_MAX - 1)
+    with pytest.raises(dg.InvalidOptionError, match="^p ") as refused:
+        path_text("p", _path_of_bytes(PATH_MAX))
+    assert f"too long: {PATH_MAX} bytes" in str(refused.value)
+    with pytest.raises(dg.BatchFileError, match="too long"):
+        dg.batch.read_grasps(_path_of_bytes(PATH_MAX))
+
+
+def test_path_max_is_the_systems():
+    # 4096 on Linux, 1024 on macOS: a path of 1024 to 4095 bytes passed the
+    # reader there and met pathlib's bare OSError.
+    if not hasattr(os, "pathconf"):
+        pytest.skip("no os.pathconf on this platform")
+    assert PATH_MAX == os.pathconf("/", "PC_PATH_MAX")
 
 
 def test_the_reader_raises_the_error_it_is_given():
