@@ -120,7 +120,10 @@ def grasp_scene_text(
     must = "a model file's path or URL (a str or an os.PathLike)"
     hand_file = path_text("hand_file", hand_file, must=must)
     object_file = path_text("object_file", object_file, must=must)
-    folder = path_text("folder", folder, must="a folder (a str or an os.PathLike)")
+    # "" is the current folder (os.path.dirname of a bare file name)
+    folder = path_text(
+        "folder", folder, must="a folder (a str or an os.PathLike)", empty=True
+    )
     planned = plant_context_of(plant, plant_context)  # (checks the plant first)
     if not isinstance(candidate, GraspCandidate):
         raise InvalidOptionError(

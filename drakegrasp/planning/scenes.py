@@ -168,7 +168,9 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
                 f"package {describe(name)} is built in and cannot be replaced"
             )
         where = f"package {describe(name)}"
-        folder = path_text(where, folder, must="a folder (a str or an os.PathLike)")
+        must = "a folder (a str or an os.PathLike)"
+        # "" is the current folder, as pathlib reads it (os.path.dirname's)
+        folder = path_text(where, folder, must=must, empty=True) or "."
         if not os.path.isdir(folder):
             raise InvalidOptionError(f"{where}: {describe(folder)} is not a folder")
         pairs.append((name, str(Path(folder).resolve())))

@@ -197,6 +197,7 @@ def _folder(what: str, folder) -> Path:
         folder,
         error=SceneError,
         must="a str or a pathlib.Path",
+        empty=True,  # the current folder, as pathlib reads "" (os.path.dirname's)
     )
     # os.path's: pathlib's raises RuntimeError for "~nobody" (no such user)
     return Path(os.path.expanduser(text))

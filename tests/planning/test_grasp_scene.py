@@ -10,6 +10,7 @@ own contacts and verdict.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -93,6 +94,33 @@ def test_files_by_path_are_written_relative_to_the_scene(tmp_path):
     )  # fmt: skip
     assert "file: jaw.urdf" in text
     _as_planned(tmp_path, moved, result, hand, BOX)
+
+
+def test_an_empty_folder_is_the_current_one(tmp_path, monkeypatch):
+    # os.path.dirname("grasp.yaml") is "": the scene's folder is the current
+    # one, as it was before every path went through one reader (which refused
+    # "" for files and folders alike); a package's folder likewise.
+    box = tmp_path / "box.sdf"
+    box.write_text((models_dir() / "objects" / "box.sdf").read_text())
+    monkeypatch.chdir(tmp_path)
+    scene = planning_scene("package://mine/box.sdf", hand_url=FLAT,
+                           package_map={"mine": ""})  # fmt: skip
+    result = _plan(scene, n=10)
+    texts = [
+        grasp_scene_text(
+            scene.plant,
+            scene.context,
+            result[0],
+            object_body=scene.object_body,
+            hand_file=FLAT,
+            object_file="box.sdf",
+            mu=result.mu,
+            folder=folder,
+        )  # fmt: skip
+        for folder in (os.path.dirname("grasp.yaml"), tmp_path)
+    ]
+    assert texts[0] == texts[1]
+    assert "file: box.sdf" in texts[0]
 
 
 def test_the_allegro_hand_on_the_soup_can(tmp_path, drake_models_dir):

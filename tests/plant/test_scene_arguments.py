@@ -48,6 +48,26 @@ def test_packages_that_are_no_directories_are_refused(packages, said):
         dg.load_scene(DEFAULT_SCENE, package_map=packages)
 
 
+def test_an_empty_package_folder_is_the_current_one(tmp_path, monkeypatch):
+    # As pathlib reads "" and os.path.dirname gives it for a bare file name
+    # (os.path.dirname("package.xml")); the one path reader refused it.
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    from drakegrasp.plant.scene_refs import add_packages
+
+    (tmp_path / "package.xml").write_text(
+        '<package format="2"><name>here</name></package>'
+    )
+    monkeypatch.chdir(tmp_path)
+    plant = MultibodyPlant(0.0)
+    packages = add_packages(Parser(plant), {"mine": ""}, ros_package_path=False)
+    assert packages.GetPath("mine") == str(tmp_path.resolve())
+    plant = MultibodyPlant(0.0)
+    packages = add_packages(Parser(plant), [""], ros_package_path=False)
+    assert packages.GetPath("here") == str(tmp_path.resolve())
+
+
 @pytest.mark.parametrize("flag", ["no", 1, None])
 def test_ros_package_path_is_a_flag(flag):
     with pytest.raises(InvalidOptionError, match="ros_package_path"):
