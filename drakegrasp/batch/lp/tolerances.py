@@ -24,7 +24,9 @@ are below this (the gap bounds the error of ``d*`` once the residuals vanish).""
 
 IPM_MAX_ITER = 60
 """Most interior-point iterations per problem; one that has not converged by
-then is reported with ``converged = False``."""
+then is reported with ``converged = False``.  (A ``d*`` LP of at most
+``HIGHS_MAX_COLUMNS`` force components is then solved again by HiGHS; a
+larger one gets ``IPM_MAX_ITER_LARGE`` instead.)"""
 
 PUSH_TOL = 1e-10
 """``‖c‖`` below this: no balanced force has a normal component (``d* = 0``)."""
@@ -38,8 +40,9 @@ HIGHS_MAX_COLUMNS = 2048
 interior-point method reached its cap.  HiGHS's time grows about as ``M³``
 on these LPs (one grasp of frictionless contacts on an ellipsoid: 0.07 s at
 ``M = 1000``, 0.38 s at 2000, 3.2 s at 4000, more than 10 minutes at 20,000);
-a larger LP keeps the interior-point method's last iterate, reported with
-``converged = False``, rather than hang.  The LPs of hands (``M <= 4 * 32``)
+a larger LP gets ``IPM_MAX_ITER_LARGE`` iterations instead and then keeps
+the interior-point method's last iterate, reported with ``converged = False``,
+rather than hang.  The LPs of hands (``M <= 4 * 32``)
 are far below it."""
 
 IPM_MAX_ITER_LARGE = 300
