@@ -43,6 +43,7 @@ from drakegrasp.batch.files.parquet import ParquetWriter
 from drakegrasp.batch.files.reader import as_path
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.validation import (
+    NAME_MAX,
     describe,
     integer_or_none,
     plain_str,
@@ -219,10 +220,6 @@ def _link_or_rename(tmp: str, path: Path) -> None:
     os.unlink(tmp)
 
 
-_NAME_MAX = 255
-"""Bytes in a file name on the usual file systems (ext4, APFS, NTFS)."""
-
-
 def _new_sibling(path: Path) -> str:
     """Create an empty ``.NAME.XXXX.partial`` beside ``path``; return its name.
 
@@ -233,9 +230,7 @@ def _new_sibling(path: Path) -> str:
     # The name is cut so the temporary one fits where the output's does: a
     # name of 234-255 bytes (the usual limit) gained 22 and could not be made.
     name = path.name
-    while (
-        name and len(os.fsencode(name)) > _NAME_MAX - len(".0123456789ab.partial") - 1
-    ):
+    while name and len(os.fsencode(name)) > NAME_MAX - len(".0123456789ab.partial") - 1:
         name = name[:-1]
     for _ in range(100):
         tmp = path.parent / f".{name}.{secrets.token_hex(6)}.partial"
