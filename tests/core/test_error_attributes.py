@@ -108,3 +108,31 @@ class _StrNotStr:
 
 def test_cut_message_names_a_value_whose_str_is_no_str():
     assert cut_message(_StrNotStr()) == "<_StrNotStr>"
+
+
+@pytest.mark.parametrize(
+    "error",
+    [
+        dg.GraspError(HUGE),
+        dg.ModelError("short", HUGE, 3),
+        dg.SceneError(hostile.StrFormatRaises("scene")),
+        dg.InvalidPoseError(HUGE, remedy=HUGE),
+        dg.PenetrationError("fingers inside", remedy="pass check_pose=False"),
+        dg.JointLimitError(HUGE),
+        dg.SolverError(HUGE, program=None, result=None),
+        dg.UnreachableError(HUGE, closure=None),
+    ],
+    ids=lambda e: type(e).__name__,
+)
+def test_a_cut_error_pickles_to_the_same_class_and_text(error):
+    # A Dask or multiprocessing worker sends its error back pickled: the
+    # class is rebuilt from args (one message, already cut: cut again, the
+    # same), then the attributes (problem, remedy) from its __dict__.
+    import pickle
+
+    back = pickle.loads(pickle.dumps(error))
+    assert type(back) is type(error)
+    assert back.args == error.args and str(back) == str(error)
+    assert back.__dict__ == error.__dict__
+    if isinstance(error, dg.InvalidPoseError):
+        assert back.with_remedy("x").problem == error.problem
