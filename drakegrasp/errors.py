@@ -112,7 +112,8 @@ class InvalidPoseError(GraspError):
         What is wrong with the pose.
     remedy : str, optional
         How to analyse it anyway, in the caller's words (a Python argument,
-        a command-line flag); the message is ``"problem (remedy)"``.
+        a command-line flag); the message is ``"problem (remedy)"``.  ``""``
+        or None: no remedy.
 
     Attributes
     ----------
@@ -121,8 +122,9 @@ class InvalidPoseError(GraspError):
         (they may name a user's bodies and joints, of any length).
     """
 
-    def __init__(self, problem: str, *, remedy: str = ""):
-        problem, remedy = cut_message(problem), cut_message(remedy)
+    def __init__(self, problem: str, *, remedy: str | None = ""):
+        problem = cut_message(problem)
+        remedy = "" if remedy is None else cut_message(remedy)
         super().__init__(f"{problem} ({remedy})" if remedy else problem)
         self.problem = problem
         self.remedy = remedy

@@ -136,3 +136,11 @@ def test_a_cut_error_pickles_to_the_same_class_and_text(error):
     assert back.__dict__ == error.__dict__
     if isinstance(error, dg.InvalidPoseError):
         assert back.with_remedy("x").problem == error.problem
+
+
+@pytest.mark.parametrize("remedy", ["", None])
+def test_a_pose_error_without_a_remedy_is_its_problem_alone(remedy):
+    # None read as the text "None": the message was "p (None)".
+    error = dg.PenetrationError("fingers inside", remedy=remedy)
+    assert str(error) == "fingers inside" and error.remedy == ""
+    assert error.with_remedy(None).args == error.args
