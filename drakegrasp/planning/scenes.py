@@ -12,7 +12,6 @@ from __future__ import annotations
 import inspect
 import os
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from pydrake.math import RigidTransform
@@ -29,7 +28,7 @@ from drakegrasp.plant.models import (
     register_models,
     use_local_drake_models,
 )
-from drakegrasp.plant.scene_refs import add_named_package
+from drakegrasp.plant.scene_refs import add_named_package, package_folder
 from drakegrasp.plant.validation import check_rigid_transform, resolve_body
 
 __all__ = ["WSG_URL", "PlanningScene", "planning_scene", "scene_from_models"]
@@ -168,12 +167,13 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
                 f"package {describe(name)} is built in and cannot be replaced"
             )
         where = f"package {describe(name)}"
-        must = "a folder (a str or an os.PathLike)"
-        # "" is the current folder, as pathlib reads it (os.path.dirname's)
-        folder = path_text(where, folder, must=must, empty=True) or "."
+        # as a scene file's packages are read: "" the current folder, ~ expanded
+        folder = package_folder(where, folder, error=InvalidOptionError)
         if not os.path.isdir(folder):
-            raise InvalidOptionError(f"{where}: {describe(folder)} is not a folder")
-        pairs.append((name, str(Path(folder).resolve())))
+            raise InvalidOptionError(
+                f"{where}: {describe(str(folder))} is not a folder"
+            )
+        pairs.append((name, str(folder.resolve())))
     return pairs
 
 

@@ -65,6 +65,7 @@ __all__ = [
     "add_packages",
     "anchor_relative_files",
     "check_references",
+    "package_folder",
 ]
 
 MAX_INCLUDED_FILES = 32
@@ -177,7 +178,7 @@ def add_named_package(package_map: PackageMap, name, folder) -> None:
     name = path_text("package name", name, error=SceneError, must=must)
     if "/" in name:
         raise SceneError(f"package name must be {must}, got {describe(name)}")
-    path = _folder(f"package {describe(name)}", folder)
+    path = package_folder(f"package {describe(name)}", folder)
     if not os.path.isdir(path):  # (pathlib's raises for a path too long)
         raise SceneError(f"package {describe(name)}: {str(path)!r} is not a directory")
     path = str(path.resolve())
@@ -190,13 +191,19 @@ def add_named_package(package_map: PackageMap, name, folder) -> None:
     package_map.Add(name, path)
 
 
-def _folder(what: str, folder) -> Path:
-    """``folder`` as a path; anything but a str or an os.PathLike is refused."""
+def package_folder(what: str, folder, *, error: type = SceneError) -> Path:
+    """A package's ``folder`` as a path, ``~`` expanded; not yet checked to exist.
+
+    The one reading of a package folder, for scene files and for
+    ``planning_scene(package_map=)``: ``""`` is the current folder (as
+    pathlib reads it, and ``os.path.dirname`` returns it), and anything but a
+    str or an os.PathLike is refused with ``error`` naming ``what``.
+    """
     text = path_text(
         f"{what}: the directory",
         folder,
-        error=SceneError,
-        must="a str or a pathlib.Path",
+        error=error,
+        must="a str or an os.PathLike",
         empty=True,  # the current folder, as pathlib reads "" (os.path.dirname's)
     )
     # os.path's: pathlib's raises RuntimeError for "~nobody" (no such user)
@@ -204,7 +211,7 @@ def _folder(what: str, folder) -> Path:
 
 
 def _add_package_xml(package_map: PackageMap, folder) -> None:
-    path = _folder("package", folder)
+    path = package_folder("package", folder)
     xml = path if path.name == "package.xml" else path / "package.xml"
     if not os.path.isfile(xml):
         raise SceneError(

@@ -320,3 +320,18 @@ def test_plan_reads_its_own_packages(tmp_path, capsys):
     assert "force closure: YES" in capsys.readouterr().out
     with pytest.raises(dg.InvalidOptionError, match="is not a folder"):
         planning_scene(BOX, package_map={"mypkg": tmp_path / "none"})
+
+
+def test_a_package_folder_under_home_is_read_as_a_scene_files_is(tmp_path, monkeypatch):
+    # load_scene expanded "~" in a package's folder and planning_scene did
+    # not: "~/mine" was "not a folder" there.  One reader does both now.
+    (tmp_path / "mine").mkdir()
+    box = tmp_path / "mine" / "box.sdf"
+    box.write_text((models_dir() / "objects" / "box.sdf").read_text())
+    monkeypatch.setenv("HOME", str(tmp_path))
+    scene = planning_scene(
+        "package://mine/box.sdf", hand_url=FLAT, package_map={"mine": "~/mine"}
+    )
+    assert scene.object_body.name() == "box"
+    with pytest.raises(dg.InvalidOptionError, match="is not a folder"):
+        planning_scene(BOX, hand_url=FLAT, package_map={"mine": "~/none"})
