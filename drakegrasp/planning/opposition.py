@@ -51,10 +51,16 @@ import math
 
 import numpy as np
 
-from drakegrasp.core.validation import real_array
+from drakegrasp.core.validation import (
+    describe,
+    integer_or_none,
+    real_array,
+    real_scalar,
+)
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
+    "FRAME_TOL",
     "PASSIVE_SPEED",
     "SQUEEZE_PUSH_MAX",
     "closing_directions",
@@ -75,6 +81,10 @@ PASSIVE_SPEED = 1e-9
 closing joints) when the hand closes is passive: it pushes back along its
 inward normal (the palm; a finger that closing left still)."""
 
+FRAME_TOL = 1e-6
+"""How far (largest entry of ``RᵀR - I``) a contact frame given to
+:func:`closing_directions` may be from orthonormal."""
+
 
 def closing_directions(
     J: np.ndarray, frames: np.ndarray, components, signs
@@ -90,12 +100,12 @@ def closing_directions(
         frictionless contact); m/s per unit joint velocity.
     frames : (N, 3, 3) float
         Each contact's frame ``[n, t1, t2]`` (columns, frame O; ``n`` into the
-        object).
+        object): orthonormal, within :data:`FRAME_TOL`.
     components : sequence of int
         Each contact's number of rows in ``J`` (1, 3 or 4), summing to ``M``.
     signs : (n_j,) float
         The sign with which each joint closed (``closing_signs``; 0: closing
-        left it still).
+        left it still); finite.
 
     Returns
     -------
@@ -108,12 +118,14 @@ def closing_directions(
     Raises
     ------
     InvalidOptionError
-        Shapes that do not match, or values that are not finite.
+        Shapes that do not match, values that are not finite, frames that are
+        not orthonormal, component counts that are not integers, or a motion
+        too large for a float.
     """
     J = real_array("J", J, error=InvalidOptionError)
     frames = real_array("frames", frames, error=InvalidOptionError)
     signs = real_array("signs", signs, error=InvalidOptionError)
-    components = [int(k) for k in components]
+    components = _counts(components)
     if (
         J.ndim != 2
         or frames.ndim != 3
@@ -129,20 +141,58 @@ def closing_directions(
             f"{J.shape}, frames {frames.shape}, {len(components)} counts "
             f"summing to {sum(components)}, signs {signs.shape}"
         )
-    if not (np.all(np.isfinite(J)) and np.all(np.isfinite(frames))):
-        raise InvalidOptionError("closing_directions needs finite J and frames")
+    if not (
+        np.all(np.isfinite(J))
+        and np.all(np.isfinite(frames))
+        and np.all(np.isfinite(signs))
+    ):
+        raise InvalidOptionError("closing_directions needs finite J, frames and signs")
+    # a NaN sign left every contact "passive"; a zero frame gave a zero "unit"
+    # direction, read as opposing every other one
+    off = np.abs(frames.transpose(0, 2, 1) @ frames - np.eye(3)).max(axis=(1, 2))
+    if np.any(off > FRAME_TOL):
+        i = int(np.argmax(off))
+        raise InvalidOptionError(
+            f"closing_directions needs orthonormal contact frames; frames[{i}] "
+            f"is {off[i]:.3g} from it (|RᵀR - I|)"
+        )
     out = np.empty((len(frames), 3))
     rows = np.cumsum([0, *components])
     for i, (R, k) in enumerate(zip(frames, components, strict=True)):
         m = min(k, 3)  # a soft finger's torsion row is no translation
-        v = R[:, :m] @ (J[rows[i] : rows[i] + m] @ signs)
-        speed = float(np.linalg.norm(v))
+        with np.errstate(over="ignore", invalid="ignore"):
+            v = R[:, :m] @ (J[rows[i] : rows[i] + m] @ signs)
+        if not np.all(np.isfinite(v)):
+            raise InvalidOptionError(
+                f"closing_directions: contact {i}'s closing motion overflows a "
+                "float (J and signs too large)"
+            )
+        big = float(np.max(np.abs(v)))
+        speed = big * float(np.linalg.norm(v / big)) if big > 0.0 else 0.0
         out[i] = v / speed if speed > PASSIVE_SPEED else R[:, 0]
     return out
 
 
+def _counts(components) -> list[int]:
+    """``components`` as a list of ints, or InvalidOptionError naming them."""
+    try:
+        values = list(components)
+    except Exception:  # noqa: BLE001 - not iterable, or a hostile __iter__
+        raise InvalidOptionError(
+            f"components must be a sequence of integers (1, 3 or 4), got "
+            f"{describe(components)}"
+        ) from None
+    counts = [integer_or_none(k, integral_floats=True) for k in values]
+    if any(k is None for k in counts):
+        bad = next(v for v, k in zip(values, counts, strict=True) if k is None)
+        raise InvalidOptionError(
+            f"components must be integers (1, 3 or 4), got {describe(bad)}"
+        )
+    return counts
+
+
 def squeeze_push_of(directions) -> float:
-    """The squeeze push ``r`` of unit push directions (module docstring).
+    """The squeeze push ``r`` of push directions (module docstring).
 
     The hull's point nearest the origin comes from Lawson-Hanson NNLS; ``r``
     is then ``min_i d_i·y/‖y‖`` for that point ``y``, a value that some unit
@@ -152,7 +202,9 @@ def squeeze_push_of(directions) -> float:
     Parameters
     ----------
     directions : (N, 3) float
-        Unit vectors, ``N >= 1`` (:func:`closing_directions`).
+        Push directions, ``N >= 1`` (:func:`closing_directions`); each row is
+        read as its unit vector, so their lengths do not matter, but a zero
+        row has no direction and is refused.
 
     Returns
     -------
@@ -163,14 +215,26 @@ def squeeze_push_of(directions) -> float:
     Raises
     ------
     InvalidOptionError
-        Not an ``(N, 3)`` array of finite numbers with ``N >= 1``.
+        Not an ``(N, 3)`` array of finite numbers with ``N >= 1``, or a row
+        of zeros.
     """
     D = real_array("directions", directions, error=InvalidOptionError)
-    if D.ndim != 2 or D.shape[1] != 3 or len(D) == 0 or not np.all(np.isfinite(D)):
+    if D.ndim != 2 or D.shape[1] != 3 or len(D) == 0:
         raise InvalidOptionError(
-            f"directions must be (N, 3) finite unit vectors, N >= 1; got shape "
-            f"{D.shape}"
+            f"directions must be (N, 3) finite vectors, N >= 1; got shape {D.shape}"
         )
+    if not np.all(np.isfinite(D)):
+        raise InvalidOptionError("directions must be finite; got NaN or inf")
+    # a row of length 10 was read as reaching 10 times as far (push 1 for two
+    # orthogonal rows, whose push is 0.71), a zero row as opposing every other
+    big = np.max(np.abs(D), axis=1)
+    if not np.all(big > 0.0):
+        i = int(np.argmin(big))
+        raise InvalidOptionError(
+            f"directions[{i}] is zero: a push direction needs a length"
+        )
+    D = D / big[:, None]
+    D = D / np.linalg.norm(D, axis=1)[:, None]
     from scipy.optimize import nnls  # here: scipy.optimize is slow to import
 
     # min ‖Dᵀλ‖² + (1ᵀλ - 1)², λ >= 0: y = Dᵀλ / 1ᵀλ lies in the hull
@@ -189,11 +253,30 @@ def squeeze_push_of(directions) -> float:
     return float(min(1.0, max(0.0, np.min(D @ y) / norm)))
 
 
-def push_text(push: float) -> str:
-    """``push`` in words, for a candidate's concerns: "" at or below the bound."""
-    if not (isinstance(push, float) and math.isfinite(push)) or push <= (
-        SQUEEZE_PUSH_MAX
-    ):
+def push_text(push) -> str:
+    """``push`` in words, for a candidate's concerns: "" at or below the bound.
+
+    Parameters
+    ----------
+    push : float
+        A squeeze push, in ``[0, 1]``; NaN (not computed) says nothing.
+
+    Returns
+    -------
+    str
+        A sentence when ``push`` exceeds :data:`SQUEEZE_PUSH_MAX`, else "".
+
+    Raises
+    ------
+    InvalidOptionError
+        ``push`` is not a real number, or outside ``[0, 1]``.
+    """
+    push = real_scalar("squeeze_push", push)
+    if math.isnan(push):
+        return ""
+    if not 0.0 <= push <= 1.0:
+        raise InvalidOptionError(f"squeeze_push must be in [0, 1] or NaN, got {push!r}")
+    if push <= SQUEEZE_PUSH_MAX:
         return ""
     return (
         f"its closing motions all push the object one way (squeeze_push "

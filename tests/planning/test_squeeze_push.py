@@ -21,6 +21,7 @@ from drakegrasp.planning.opposition import (
     PASSIVE_SPEED,
     SQUEEZE_PUSH_MAX,
     closing_directions,
+    push_text,
     squeeze_push_of,
 )
 
@@ -102,6 +103,26 @@ def test_what_is_not_directions_is_refused(bad):
         squeeze_push_of(bad)
 
 
+def test_the_push_reads_directions_of_any_length_as_their_unit_vectors():
+    # two orthogonal rows of length 10 read 1 (clipped), of length 0.1 read
+    # 0.07: the hull of the rows, not of their directions
+    rng = np.random.default_rng(11)
+    D = rng.standard_normal((5, 3)) + [0.0, 2.0, 0.0]
+    unit = D / np.linalg.norm(D, axis=1, keepdims=True)
+    lengths = 10.0 ** rng.uniform(-200, 200, (5, 1))
+    assert squeeze_push_of(D * lengths) == pytest.approx(
+        squeeze_push_of(unit), abs=1e-12
+    )
+    for scale in (10.0, 0.1):
+        assert squeeze_push_of(np.eye(3)[:2] * scale) == pytest.approx(0.5**0.5)
+
+
+def test_a_zero_direction_is_refused_not_read_as_opposing():
+    # it put the origin in the hull: push 0, "the motions oppose"
+    with pytest.raises(InvalidOptionError, match=r"directions\[1\] is zero"):
+        squeeze_push_of([[1.0, 0, 0], [0, 0, 0], [0.9, 0.1, 0]])
+
+
 # --- which way each contact is pushed ----------------------------------------
 
 
@@ -137,6 +158,36 @@ def test_closing_directions_refuse_what_does_not_fit():
         closing_directions(np.zeros((2, 1)), R, [2], [1.0])  # no such contact
     with pytest.raises(InvalidOptionError, match="finite"):
         closing_directions(np.full((3, 1), np.nan), R, [3], [1.0])
+
+
+def test_closing_directions_are_unit_however_large_the_motion():
+    # |v| overflowed to inf below the float range's top: a zero "unit" direction
+    out = closing_directions(np.eye(3), np.eye(3)[None], [3], [1e308, 1e308, 1.0])
+    assert out[0] == pytest.approx([0.5**0.5, 0.5**0.5, 0.0])
+    with pytest.raises(InvalidOptionError, match="overflows"):
+        closing_directions(np.ones((3, 3)), np.eye(3)[None], [3], [1e308, 1e308, 1])
+
+
+def test_closing_directions_refuse_a_nan_sign_and_a_frame_that_is_no_rotation():
+    # a NaN sign made the contact "passive" (its normal), a zero frame gave the
+    # zero vector as its direction, which squeeze_push_of read as opposing
+    R = np.eye(3)[None]
+    with pytest.raises(InvalidOptionError, match="finite"):
+        closing_directions(np.eye(3), R, [3], [np.nan, 1.0, 1.0])
+    with pytest.raises(InvalidOptionError, match="orthonormal"):
+        closing_directions(np.eye(3), R * 0.0, [3], [0.0, 0.0, 0.0])
+    with pytest.raises(InvalidOptionError, match="components"):
+        closing_directions(np.eye(3), R, [3.5], [1.0, 1.0, 1.0])
+
+
+def test_push_text_reads_any_real_number_and_refuses_the_rest():
+    # push_text(1) and a float32 0.9 said nothing: only a Python float was read
+    assert "squeeze_push 1.00" in push_text(1)
+    assert "squeeze_push 0.90" in push_text(np.float32(0.9))
+    assert push_text(SQUEEZE_PUSH_MAX) == "" and push_text(math.nan) == ""
+    for bad in ("0.9", None, 1.5, -0.2):
+        with pytest.raises(InvalidOptionError, match="squeeze_push"):
+            push_text(bad)
 
 
 # --- the ranking: pushers after the other force-closure candidates -----------
