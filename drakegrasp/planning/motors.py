@@ -98,7 +98,7 @@ from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
-from drakegrasp.planning.checks import checked_directions
+from drakegrasp.planning.checks import checked_count, checked_directions
 from drakegrasp.planning.needed import (
     beyond_float_range,
     needed_for,
@@ -713,8 +713,23 @@ def with_squeeze_push(
         given the figure) and ``count`` (above the bound); ``reason`` says so
         when every checked candidate pushes one way (and no other reason is
         given).
+
+    Raises
+    ------
+    InvalidOptionError
+        ``result`` is not a :class:`GraspCandidates`, ``top`` or ``check`` not
+        an integer >= 0, ``started`` not a real number, or ``push_last`` not
+        a bool.
     """
-    n = max(int(top), int(check))
+    if not isinstance(result, GraspCandidates):
+        raise InvalidOptionError(
+            f"result must be the GraspCandidates of plan_grasps, got {describe(result)}"
+        )
+    top, check = checked_count("top", top), checked_count("check", check)
+    started = real_scalar("started", started)
+    if not isinstance(push_last, (bool, np.bool_)):
+        raise InvalidOptionError(f"push_last must be a bool, got {describe(push_last)}")
+    n = max(top, check)
     head = [
         dataclasses.replace(
             c, squeeze_push=squeeze_push(plant, plant_context, c, object_body)

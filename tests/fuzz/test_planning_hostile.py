@@ -25,7 +25,15 @@ from pydrake.geometry import Box
 from pydrake.math import RigidTransform
 
 import drakegrasp as dg
-from drakegrasp.planning import checks, planner, ranking, reclose, weight
+from drakegrasp.planning import (
+    checks,
+    motors,
+    opposition,
+    planner,
+    ranking,
+    reclose,
+    weight,
+)
 from drakegrasp.planning.gripper import ParallelJaw
 from drakegrasp.planning.placement import sample_poses
 from drakegrasp.planning.planner import plan_grasps
@@ -627,3 +635,72 @@ def test_plan_grasps_names_a_bad_option_before_reading_the_plant(
         plan_grasps, _plan_args, name, value, monkeypatch,
         (planner, "plant_context_of"),
     )  # fmt: skip
+
+
+# ---------------------------------------------------------- the squeeze push
+
+
+def _opposition_cases():
+    """``(call, bad argument)``: every bad value must be named, never answered."""
+    J, F = np.eye(3), np.eye(3)[None]
+    calls = {
+        "closing_directions": lambda **k: opposition.closing_directions(
+            **{"J": J, "frames": F, "components": [3], "signs": [1.0, 1.0, 1.0], **k}
+        ),
+        "squeeze_push_of": lambda directions: opposition.squeeze_push_of(directions),
+        "push_text": lambda push: opposition.push_text(push),
+    }
+    bad = {
+        ("closing_directions", "J"): [J * np.nan, "J", None, J[0], J * 1j],
+        ("closing_directions", "frames"): [F * 0.0, F * 2.0, F * np.nan, F[0], "O"],
+        ("closing_directions", "components"): [["a"], None, 3, [3.7], [True], [2]],
+        ("closing_directions", "signs"): [
+            [np.nan, 1, 1],
+            [np.inf, 1, 1],
+            "abc",
+            [[1, 1, 1]],
+        ],
+        ("squeeze_push_of", "directions"): [
+            [[1, 0, 0], [0, 0, 0]],
+            [[np.nan, 0, 0]],
+            np.zeros((0, 3)),
+            None,
+            "x",
+            [1, 0, 0],
+            [[True, False, False]],
+            np.ones((2, 3, 1)),
+        ],
+        ("push_text", "push"): [-0.1, 1.5, np.inf, "0.9", None, True, [0.9]],
+    }
+    for (call, name), values in bad.items():
+        for i, v in enumerate(values):
+            label = " ".join(repr(v).split())[:30]
+            yield pytest.param(calls[call], name, v, id=f"{call}-{name}{i}={label}")
+
+
+@pytest.mark.parametrize(("call", "name", "value"), list(_opposition_cases()))
+def test_the_squeeze_push_functions_refuse_what_they_cannot_read(call, name, value):
+    # a NaN sign or a zero frame made every contact "passive" or gave a zero
+    # "unit" direction; a zero direction was read as opposing the others;
+    # push_text(1) (an int) said nothing, push_text("0.9") too; a component
+    # count "a" raised a raw ValueError
+    with np.errstate(all="ignore"), pytest.raises(dg.GraspError):
+        call(**{name: value})
+
+
+def test_with_squeeze_push_names_what_is_not_a_run():
+    with pytest.raises(dg.GraspError, match="result"):
+        motors.with_squeeze_push(None, None, None, None, top=1, started=0.0)
+    empty = dg.GraspCandidates(
+        candidates=(), rejections={}, num_sampled=0, object_body="box", mu=0.5,
+        torque_scale=0.05,
+    )  # fmt: skip
+    for bad in ({"top": -1}, {"top": "3"}, {"check": 2.5}, {"started": "now"}):
+        with pytest.raises(dg.GraspError, match=next(iter(bad))):
+            motors.with_squeeze_push(
+                empty, None, None, None, **{"top": 1, "started": 0.0, **bad}
+            )
+    with pytest.raises(dg.GraspError, match="push_last"):
+        motors.with_squeeze_push(
+            empty, None, None, None, top=1, started=0.0, push_last="no"
+        )
