@@ -73,7 +73,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deprecation import outside_stacklevel
-from drakegrasp.core.validation import unit_vectors
+from drakegrasp.core.validation import describe, unit_vectors
 from drakegrasp.errors import (
     GraspError,
     InvalidGraspError,
@@ -396,34 +396,41 @@ finer one (:data:`CONTACT_PERIOD_STEPS`) and a phase is at least ten of it
 (``time_step=None`` takes a tenth of a shorter phase, as a given step must)."""
 
 CONTACT_PERIOD_STEPS = 1.25
-"""Steps per period of the object's stiffest translation on its contacts
-that the shake takes at the least (``time_step=None`` picks the step so; a
-coarser given step is warned of, :class:`CoarseStepWarning`).  Turning modes
-are not counted (:func:`contact_period`): with them the WSG-50's period on
-the 50 mm box read 0.67 ms, where 1 ms shakes it as finer steps do.
+"""Steps per period of the object's stiffest mode on its contacts that the
+shake takes at the least (``time_step=None`` picks the step so; a coarser
+given step is warned of, :class:`CoarseStepWarning`).  The mode is the rigid
+body's, translations and rotations about its centre of mass together
+(:func:`contact_period`).
 
 Drake's SAP solver treats a contact whose period ``T = 2π / ω`` is below the
-step as near-rigid and regularises it, letting the object creep in stiction
-at a rate that grows with the step.  Measured with Drake 1.51's default point
-contact (1e6 N/m per geometry, so 5e5 N/m a pair) at the default squeeze of
-20 N, 2.8 s of shaking: a 1 cm cube held by a three-finger hand at its three
-planned contacts, 4 g (``T`` 0.39 ms by :func:`contact_period`), dropped and
-left the hand at 1 ms (T/h 0.39), turned 17.6° at 0.5 ms (0.78: dropped),
-9.7° at 0.2 ms (1.9), 6.2° at 0.1 ms and 3.9° at 0.05 ms (held); at 16 g
-(T 0.78 ms) 17.0° at 1 ms (0.78: dropped), 8.9° at 0.5 ms and 5.3° at 0.2 ms
-(held); the WSG-50's tip spheres on a 5 g cube (T 0.53 ms) threw it 5 m out
-of the hand at 1 ms and 2 m at 0.5 ms (T/h 0.53 and 1.06), and kept it
-within 7.8 mm at 0.2 ms and 0.1 ms (turning 179° about the line between its
-two point contacts, which resist no torque about it: a drop that point
-contact makes, at every step).  The shipped objects' periods are 2.6 ms and
-longer (the WSG-50 on the 50 mm box: 4.8 ms), so their default step stays
-1 ms."""
+step as near-rigid and regularises it.  Measured with Drake 1.51's default
+point contact (1e6 N/m per geometry, so 5e5 N/m a pair) at the default
+squeeze of 20 N, 2.8 s of shaking: a 1 cm cube held by a three-finger hand at
+its three planned contacts, 4 g (``T`` 0.30 ms), dropped and left the hand at
+1 ms (T/h 0.30), turned 17.6° at 0.5 ms (0.60: dropped), 9.7° at 0.2 ms
+(1.5), 6.2° at 0.1 ms and 3.9° at 0.05 ms (held); at 16 g (T 0.60 ms) 17.0°
+at 1 ms (0.60: dropped), 8.9° at 0.5 ms and 5.3° at 0.2 ms (held).  The
+WSG-50's tip spheres on a 5 g, 1 cm cube, 3.6 mm off its centre (T 0.33 ms;
+its translation alone, the period counted once, 0.44 ms) threw it 5 m out of
+the hand at 1 ms, 2.2 m at 0.5 ms and 0.26 m at 0.4 ms, and kept it within 9 mm at 0.45
+ms and from 0.35 ms down (turning 179° about the line between its two point
+contacts, which resist no torque about it: a drop that point contact makes,
+at every step).  With a dense core (a tenth of that inertia, T 0.15 ms) it
+was thrown 1.3-6 m at 0.25, 0.3 and 0.4-0.5 ms, steps its translation
+resolves, and kept within 9.2 mm from 0.2 ms down; over inertias of 0.1 to
+1.6 times the cube's (T 0.15-0.36 ms, 40 runs at 0.07-0.5 ms) the 11 throws
+came at T/h of 0.91 or less, none at 0.93 or more.  Grasps that hold only
+creep more at a coarser step: 32 grasps of light rods, plates and boxes (5
+and 20 g, the turning mode up to 14 times faster than the translation) held
+at the translation's step, at this one and at a quarter of it, the box with
+a dense core creeping 0.45 mm and 0.60° at the first, 0.04 mm and 0.04° at
+the second."""
 
 
 def _resolving_step(period: float) -> float:
     """The step (s) that takes :data:`CONTACT_PERIOD_STEPS` per ``period``.
 
-    Rounded down to two significant digits (0.26 ms for a period of 0.53
+    Rounded down to two significant digits (0.26 ms for a period of 0.33
     ms); ``inf`` for an infinite period.
     """
     if not math.isfinite(period):
@@ -436,33 +443,122 @@ def _resolving_step(period: float) -> float:
 class CoarseStepWarning(UserWarning):
     """The given ``time_step`` does not resolve the object's contacts.
 
-    The object's stiffest translational contact mode has a period
-    under :data:`CONTACT_PERIOD_STEPS` steps: Drake's contact solver regularises
-    it, and the object creeps or is thrown out of the hand by the
+    The object's stiffest mode on its contacts (a translation, a rotation
+    about its centre of mass, or both: :func:`contact_period`) has a period
+    under :data:`CONTACT_PERIOD_STEPS` steps: Drake's contact solver
+    regularises it, and the object creeps or is thrown out of the hand by the
     simulation, not by the grasp.  The message names the step that resolves
     it (``time_step=None`` picks it).
     """
 
 
-def contact_period(plant, inspector, body, candidate, mass: float) -> float:
-    r"""The period (s) of the object's stiffest translation on the planned contacts.
+_NO_INERTIA = 1e-12
+"""A principal moment of inertia about the centre of mass at most this share
+of the largest (or not finite) counts as none (:func:`contact_period`)."""
 
-    Each planned contact ``i`` (normal ``n_i`` in the object's frame O) is a
-    spring of Drake's point-contact stiffness ``k_i`` (N/m), that of the
-    finger body's and the object's geometries in series, as Drake combines
-    them (``material/point_contact_stiffness``; the stiffest geometry of each
-    body), between rigid fingers (position-controlled, and far heavier than
-    a light object) and the object's mass ``m`` (kg):
+
+def _mode_period(
+    k: np.ndarray,
+    p_OC: np.ndarray,
+    nhat_O: np.ndarray,
+    mass: float,
+    p_OBcm: np.ndarray,
+    I_Bcm_O: np.ndarray,
+) -> float:
+    r"""The period (s) of the stiffest mode of a rigid body on point springs.
+
+    Parameters
+    ----------
+    k : (N,) float
+        Each spring's stiffness along its normal, N/m (> 0).
+    p_OC : (N, 3) float
+        Where each acts, metres, in the body's frame O.
+    nhat_O : (N, 3) float
+        Its unit normal, in frame O.
+    mass : float
+        The body's mass, kg (> 0).
+    p_OBcm : (3,) float
+        Its centre of mass, metres, in frame O.
+    I_Bcm_O : (3, 3) float
+        Its rotational inertia about the centre of mass, kg·m², in frame O.
+
+    Returns
+    -------
+    float
+        ``2π / ω``, seconds, of the largest root of :math:`K v = \omega^2 M v`
+        in the body's twist ``v = [ω_O; v_Bcm_O]`` (rotation about the centre
+        of mass, then its translation, frame O):
+
+        .. math::
+
+            K = \sum_i k_i w_i w_i^T, \quad
+            w_i = \begin{bmatrix} r_i \times n_i \\ n_i \end{bmatrix}, \quad
+            M = \begin{bmatrix} I_{Bcm} & 0 \\ 0 & m \mathbb{1} \end{bmatrix},
+
+        ``r_i = p_OC_i − p_OBcm`` (``w_iᵀ v`` is how fast spring ``i``
+        compresses).  ``inf`` where no spring resists any motion.  A rotation
+        about a principal axis of no inertia (a moment at most
+        ``_NO_INERTIA`` of the largest: a point mass, a thin rod's own
+        axis) has no period, as no step resolves it (Drake refuses to
+        simulate a free body without rotational inertia): it is held still,
+        and the period is that of the other modes; a point mass's is that of
+        its translations, :math:`2\pi \sqrt{m / \lambda_{max}(\sum_i k_i n_i
+        n_i^T)}`.
+    """
+    r = p_OC - p_OBcm
+    rows = np.hstack([np.cross(r, nhat_O), nhat_O])  # (N, 6): w_iᵀ
+    if np.all(np.isfinite(I_Bcm_O)):
+        moments, axes = np.linalg.eigh((I_Bcm_O + I_Bcm_O.T) / 2)
+        turns = moments > _NO_INERTIA * max(float(moments[-1]), 0.0)
+    else:
+        moments, axes, turns = np.ones(3), np.eye(3), np.zeros(3, bool)
+    # in coordinates M^(1/2) v (principal axes), M is the identity
+    scaled = np.hstack(
+        [
+            (rows[:, :3] @ axes[:, turns]) / np.sqrt(moments[turns]),
+            rows[:, 3:] / math.sqrt(mass),
+        ]
+    )
+    K = scaled.T @ (k[:, None] * scaled)
+    omega2 = float(np.max(np.linalg.eigvalsh(K)))
+    return 2 * math.pi / math.sqrt(omega2) if omega2 > 0 else math.inf
+
+
+def contact_period(
+    plant, inspector, body, candidate, mass: float, *, M_BBo_B=None
+) -> float:
+    r"""The period (s) of the object's stiffest mode on the planned contacts.
+
+    Each planned contact ``i`` (point ``p_OC``, normal ``n_i``, in the
+    object's frame O) is a spring of Drake's point-contact stiffness ``k_i``
+    (N/m), that of the finger body's and the object's geometries in series,
+    as Drake combines them (``material/point_contact_stiffness``; the
+    stiffest geometry of each body), between rigid fingers
+    (position-controlled, and far heavier than a light object) and the
+    object, a rigid body of mass ``m`` (kg) and rotational inertia
+    ``I_Bcm`` about its centre of mass.  The period is that of the stiffest
+    of its six modes, translations and rotations about its centre of mass
+    together (:math:`K v = \omega^2 M v`, ``K = Σ k_i w_i w_iᵀ``, ``w_i =
+    [r_i × n_i; n_i]``, ``r_i`` from the centre of mass, ``M =
+    blockdiag(I_Bcm, m 1)``, all in frame O):
 
     .. math::
 
-        T = 2\pi \sqrt{m / \lambda_{max}\left(\sum_i k_i \, n_i n_i^T\right)}.
+        T = 2\pi / \omega_{max}.
+
+    A grasp whose contacts lie off the centre of mass, or spread over a pad
+    wider than the object's radius of gyration, turns faster than it slides:
+    the WSG-50's tip spheres 3.6 mm off the centre of a 5 g, 1 cm cube, 0.33
+    ms against its translation's 0.44 ms (0.15 ms with a dense core, a tenth
+    of the inertia).  Where every contact's line passes through the centre
+    of mass it is the period of the stiffest translation,
+    :math:`2\pi \sqrt{m / \lambda_{max}(\sum_i k_i n_i n_i^T)}`.
 
     Parameters
     ----------
     plant : MultibodyPlant
-        Finalized, registered with a ``SceneGraph``; holds the object and the
-        candidate's finger bodies.
+        Registered with a ``SceneGraph``; holds the object and the
+        candidate's finger bodies (finalized or not).
     inspector : SceneGraphInspector
         The inspector of a context's geometry query (it holds the
         ``SceneGraphConfig``'s default proximity properties).
@@ -471,7 +567,16 @@ def contact_period(plant, inspector, body, candidate, mass: float) -> float:
     candidate : GraspCandidate
         Its ``contacts`` (frame O) name their finger bodies.
     mass : float
-        The object's mass, kg.
+        The object's mass, kg (finite, > 0).
+    M_BBo_B : SpatialInertia, optional
+        Where its centre of mass and the shape of its inertia (unit inertia)
+        are read: about the body's origin Bo, in its frame B = O (the shake's
+        object inertia).  None (default): the body's default spatial inertia.
+        Its rotational inertia is taken at ``mass``.  A body of no
+        rotational inertia (a massless model's, a point mass) turns without
+        a period of its own: its rotations are held, and the period is that
+        of its translations; an axis without inertia (a thin rod's own) is
+        held alike, and the other modes count.
 
     Returns
     -------
@@ -480,7 +585,16 @@ def contact_period(plant, inspector, body, candidate, mass: float) -> float:
         without a point-contact stiffness: Drake's own estimate then).  A
         hydroelastic pair presses with its patch's stiffness, not this one:
         :func:`shake_test` does not ask with ``hydroelastic_modulus``.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``mass`` is not a finite number > 0.
     """
+    if not (_finite(mass) and mass > 0):
+        raise InvalidOptionError(
+            f"mass must be a finite number > 0 (kg), got {describe(mass)}"
+        )
 
     def stiffness(of) -> float:
         values = [
@@ -497,7 +611,7 @@ def contact_period(plant, inspector, body, candidate, mass: float) -> float:
     contacts = [c for c in candidate.contacts if getattr(c, "finger_body", None)]
     if not contacts or not k_object > 0:
         return math.inf
-    K = np.zeros((3, 3))
+    k = []
     for c in contacts:
         try:
             k_finger = stiffness(resolve_body(plant, c.finger_body))
@@ -505,10 +619,18 @@ def contact_period(plant, inspector, body, candidate, mass: float) -> float:
             return math.inf
         if not k_finger > 0:
             return math.inf
-        n = np.asarray(c.nhat_O, dtype=float)
-        K += (k_finger * k_object / (k_finger + k_object)) * np.outer(n, n)
-    lam = float(np.max(np.linalg.eigvalsh(K)))
-    return 2 * math.pi * math.sqrt(mass / lam) if lam > 0 else math.inf
+        k.append(k_finger * k_object / (k_finger + k_object))
+    M = body.default_spatial_inertia() if M_BBo_B is None else M_BBo_B
+    p_OBcm = np.asarray(M.get_com(), dtype=float)
+    G_Bcm = M.get_unit_inertia().ShiftToCenterOfMass(p_OBcm).CopyToFullMatrix3()
+    return _mode_period(
+        np.asarray(k, dtype=float),
+        np.array([c.p_OC for c in contacts], dtype=float),
+        np.array([c.nhat_O for c in contacts], dtype=float),
+        float(mass),
+        p_OBcm,
+        float(mass) * G_Bcm,
+    )
 
 
 def _weightless(plant) -> str:
@@ -1101,9 +1223,11 @@ def shake_test(
         The discrete plant's step, seconds: at most a tenth of ``phase``.
         None (default) picks it: :data:`DEFAULT_TIME_STEP`, or a tenth of
         ``phase`` where that is shorter, or shorter still where the object's
-        point contacts ask for it (:data:`CONTACT_PERIOD_STEPS`,
-        ``ShakeResult.contact_period``).  A given step that does not resolve
-        the contacts is warned of (:class:`CoarseStepWarning`).
+        point contacts ask for it: :data:`CONTACT_PERIOD_STEPS` steps per
+        period of its stiffest mode, translations and rotations about its
+        centre of mass (``ShakeResult.contact_period``,
+        :func:`contact_period`).  A given step that does not resolve the
+        contacts is warned of (:class:`CoarseStepWarning`).
     max_displacement, max_rotation : float, optional
         Bounds on the object's motion in the hand frame: metres, radians.
     object_body : optional
@@ -1332,7 +1456,9 @@ def shake_test(
     period = math.inf  # a compliant patch's stiffness is not a point's
     query = plant.get_geometry_query_input_port().Eval(ctx)  # the config's too
     if modulus is None:
-        period = contact_period(plant, query.inspector(), body, candidate, mass)
+        period = contact_period(
+            plant, query.inspector(), body, candidate, mass, M_BBo_B=inertia
+        )
     resolving = _resolving_step(period)
     if time_step is None and resolving < step:  # built again at that step
         result = shake_test(
@@ -1347,7 +1473,7 @@ def shake_test(
     if step > resolving:
         warnings.warn(
             f"time_step = {step:g} s does not resolve the object's contacts: "
-            f"their stiffest translation has a period of {period:.3g} s "
+            f"their stiffest mode has a period of {period:.3g} s "
             f"({mass:g} kg on point contacts), under {CONTACT_PERIOD_STEPS:g} "
             "steps, so Drake's contact solver regularises them and the object "
             "may creep or be thrown out of the hand by the simulation; give "

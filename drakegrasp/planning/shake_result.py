@@ -137,7 +137,8 @@ class ShakeResult:
         ``object_mass × gravity`` newtons.  NaN in a record made before it
         existed (those shook with 9.81).
     contact_period : float
-        The period (s) of the object's stiffest translation on the planned
+        The period (s) of the object's stiffest mode (translations and
+        rotations about its centre of mass together) on the planned
         contacts' point-contact stiffness
         (:func:`~drakegrasp.planning.shake.contact_period`), which
         ``time_step=None`` takes at least

@@ -10,9 +10,11 @@ line between its two point contacts, which point contact lets it).
 
 from __future__ import annotations
 
+import math
 import re
 import warnings
 
+import numpy as np
 import pytest
 
 from drakegrasp.errors import SolverError
@@ -76,26 +78,75 @@ def test_fingers_that_closed_through_the_object_are_no_drop(cube):
     assert "point contact (hydroelastic_modulus=None)" in message
 
 
+def _turning_period(candidate, mass, inertia) -> float:
+    """By hand: two antipodal 5e5 N/m contacts along x at (∓a, y, z) from the
+    centre of mass, ``w_2 = -w_1 = [0, -z, y, -1, 0, 0]``: one mode, sliding
+    along x while turning, ``ω² = 2k (1/m + (y² + z²)/I)`` (I isotropic).
+
+    The planned contacts are antipodal to about 1e-7 of their lever arm.
+    """
+    left, right = (np.asarray(c.p_OC) for c in candidate.contacts)
+    assert np.allclose(left[1:], right[1:]) and np.allclose(
+        [abs(c.nhat_O[0]) for c in candidate.contacts], 1.0
+    )
+    arm2 = float(left[1] ** 2 + left[2] ** 2)
+    return 2 * math.pi / math.sqrt(2 * 5e5 * (1 / mass + arm2 / inertia))
+
+
 def test_a_step_coarser_than_the_contacts_is_warned_of_and_none_resolves_it(cube):
     scene, candidate = cube
     ctx = _quiet()
     try:
-        with pytest.warns(CoarseStepWarning, match=r"give time_step <= 0\.00035 s"):
+        with pytest.warns(CoarseStepWarning, match=r"give time_step <= 0\.00026 s"):
             coarse = shake_test(scene.add_models, candidate, time_step=1e-3)
         with warnings.catch_warnings():
             warnings.simplefilter("error", CoarseStepWarning)
             chosen = shake_test(scene.add_models, candidate)
     finally:
         ctx.__exit__(None, None, None)
-    # 5 g on two 5e5 N/m contacts: T = 2 pi sqrt(0.005 / 1e6) = 0.444 ms
-    assert chosen.contact_period == pytest.approx(4.443e-4, rel=1e-3)
+    # 5 g on two 5e5 N/m contacts 3.6 mm off its centre of mass: T = 0.332
+    # ms, where its translation alone has 2 pi sqrt(0.005 / 1e6) = 0.444 ms
+    assert chosen.contact_period == pytest.approx(
+        _turning_period(candidate, 0.005, 8.3e-8), rel=1e-6
+    )
+    assert chosen.contact_period == pytest.approx(3.321e-4, rel=1e-3)
     assert chosen.time_step <= chosen.contact_period / CONTACT_PERIOD_STEPS
-    assert chosen.time_step == pytest.approx(3.5e-4)
+    assert chosen.time_step == pytest.approx(2.6e-4)
     # thrown out of the hand at 1 ms; kept in it, as at 0.1 ms (7.8 mm), now
     assert coarse.max_displacement > 1.0
     assert chosen.max_displacement < 0.012
     assert not chosen.held  # it turns about its two point contacts: physics
     assert "out of the hand" not in str(chosen)
+
+
+def test_a_cube_that_turns_faster_than_it_slides_is_shaken_at_its_turning_step(
+    cube, tmp_path
+):
+    # the cube with a dense core (a tenth of its uniform inertia): its
+    # translation's period is 0.444 ms, its turn on the contacts' 3.6 mm
+    # lever 0.149 ms.  At 0.3 ms a step (1.5 a translation's period) Drake
+    # threw it 1.9 m; at 0.25 ms 1.3 m, at 0.4-0.5 ms 5.5-6 m; from 0.2 ms
+    # down it stays within 9.2 mm (turning about its contact line, a drop
+    # point contact makes at every step), as at 0.11 ms, the step its turn asks
+    scene, candidate = cube
+    path = tmp_path / "dense_cube.sdf"
+    path.write_text(CUBE.replace("8.3e-8", "8.3e-9"))
+    dense = planning_scene(f"file://{path}")
+    ctx = _quiet()
+    try:
+        with pytest.warns(CoarseStepWarning, match=r"give time_step <= 0\.00011 s"):
+            slid = shake_test(dense.add_models, candidate, time_step=3e-4)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", CoarseStepWarning)
+            chosen = shake_test(dense.add_models, candidate)
+    finally:
+        ctx.__exit__(None, None, None)
+    assert chosen.contact_period == pytest.approx(
+        _turning_period(candidate, 0.005, 8.3e-9), rel=1e-6
+    )
+    assert chosen.time_step == pytest.approx(1.1e-4)
+    assert slid.max_displacement > 1.0  # out of the hand: the simulation's
+    assert chosen.max_displacement < 0.012
 
 
 def test_the_shipped_box_keeps_the_default_step(drake_models_dir):
