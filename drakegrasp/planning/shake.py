@@ -1119,6 +1119,51 @@ def _warn_at_stops(stopped: list[str]) -> None:
         )
 
 
+def _shake_plant(add_models, step: float, object_body):
+    """``add_models`` read into a new discrete plant of time step ``step`` (s).
+
+    Returns ``(builder, plant, scene_graph, hand, object, g)``: the object
+    ``object_body`` where given, and ``g`` the magnitude (m/s²) of the
+    gravity field ``add_models`` left the plant with (read before the shake
+    sets it to zero, so that the hand feels none).
+
+    Raises
+    ------
+    ModelError
+        ``add_models`` returned no ``(hand, object_body)`` pair, or left the
+        plant without gravity or with one that is not finite.
+    """
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=step)
+    made = add_models(plant, new_parser(plant, "the shake test's plant"))
+    if not (isinstance(made, tuple | list) and len(made) == 2):
+        raise ModelError(
+            f"add_models must return (hand, object_body), got {type(made).__name__}"
+        )
+    hand, obj = made
+    if object_body is not None:
+        obj = object_body
+    g = plant_gravity(plant)
+    if g == 0.0:
+        raise ModelError(_weightless(plant))
+    return builder, plant, scene_graph, hand, obj, g
+
+
+def _period_before_finalize(plant, scene_graph, body, candidate, mass, M_BBo_B):
+    """:func:`contact_period` on a plant not yet finalized (s).
+
+    Read through a context of ``scene_graph`` alone, whose inspector holds
+    its ``SceneGraphConfig``'s default proximity properties as the
+    simulation's will: a step finer than the plant's is known before
+    anything is built on the plant, which is then dropped unfinalized (Drake
+    fixes a plant's step when it is made, and the step depends on the models
+    ``add_models`` reads).
+    """
+    context = scene_graph.CreateDefaultContext()
+    inspector = scene_graph.get_query_output_port().Eval(context).inspector()
+    return contact_period(plant, inspector, body, candidate, mass, M_BBo_B=M_BBo_B)
+
+
 @checked_call
 def shake_test(
     add_models: Callable,
@@ -1280,9 +1325,8 @@ def shake_test(
         ``object_mass`` is given (gravity would pull on nothing and every grasp
         would hold), its plant has no gravity (the same: set the gravity to
         shake under in ``add_models``), a gravity that is not finite or in
-        which the object's weight is no float, or Drake refused to
-        advance the model for another reason (its first sentence is in the
-        message).
+        which the object's weight is no float, or Drake refused to advance
+        the model for another reason (its first sentence is in the message).
     InvalidGraspError
         The candidate's joint values or poses are not finite or do not match
         its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`),
@@ -1314,7 +1358,6 @@ def shake_test(
             "candidate must be a GraspCandidate from plan_grasps, got "
             f"{type(candidate).__name__}"
         )
-    given = (candidate, X_WO, object_mass)  # as called: for a finer step's run
     planned_X_WO = candidate.X_WO
     if X_WO is not None:
         candidate = replace(candidate, X_WO=check_rigid_transform("X_WO", X_WO))
@@ -1332,19 +1375,25 @@ def shake_test(
     # None: the default step, within a tenth of a phase as a given one must be
     step = min(DEFAULT_TIME_STEP, phase / 10) if time_step is None else time_step
     step = float(step)
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=step)
-    made = add_models(plant, new_parser(plant, "the shake test's plant"))
-    if not (isinstance(made, tuple | list) and len(made) == 2):
-        raise ModelError(
-            f"add_models must return (hand, object_body), got {type(made).__name__}"
+    builder, plant, scene_graph, hand, obj, g = _shake_plant(
+        add_models, step, object_body
+    )
+    body = resolve_object_body(plant, obj)
+    if object_mass is None:
+        object_mass = _planned_mass(planned, body)
+    mass, com, inertia = _object_inertia(body, object_mass, candidate)
+    period = math.inf  # a compliant patch's stiffness is not a point's
+    if modulus is None:
+        period = _period_before_finalize(
+            plant, scene_graph, body, candidate, mass, inertia
         )
-    hand, obj = made
-    if object_body is not None:
-        obj = object_body
-    g = plant_gravity(plant)  # |g| as add_models left it, before it is zeroed
-    if g == 0.0:
-        raise ModelError(_weightless(plant))
+    resolving = _resolving_step(period)
+    if time_step is None and resolving < step:  # the models read again at that step
+        step = resolving
+        builder, plant, scene_graph, hand, obj, g = _shake_plant(
+            add_models, step, object_body
+        )
+        body = resolve_object_body(plant, obj)
     down = np.asarray(plant.gravity_field().gravity_vector(), dtype=float) / g
     base = resolve_body(plant, candidate.hand_base)
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
@@ -1419,7 +1468,6 @@ def shake_test(
             f"shake welds it at the candidate's X_WH); Drake: {str(e)[:160]}"
         ) from None
     plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
-    body = resolve_object_body(plant, obj)
     refused = 0
     if modulus is not None:
         # the hand: its base's model instance and those of its closing joints
@@ -1438,9 +1486,6 @@ def shake_test(
             plant, scene_graph, hand_bodies, [body], modulus=modulus
         )
     plant.Finalize()
-    if object_mass is None:
-        object_mass = _planned_mass(planned, body)
-    mass, com, inertia = _object_inertia(body, object_mass, candidate)
     weight = _checked_weight(mass, g)
     schedule = _schedule(seat, settle, phase, blend, dirs, down=down)
     gravity = builder.AddSystem(_TurnedGravity(body.index(), weight, com, schedule))
@@ -1453,23 +1498,6 @@ def shake_test(
     ctx = plant.GetMyContextFromRoot(root)
     if inertia is not None:
         body.SetSpatialInertiaInBodyFrame(ctx, inertia)
-    period = math.inf  # a compliant patch's stiffness is not a point's
-    query = plant.get_geometry_query_input_port().Eval(ctx)  # the config's too
-    if modulus is None:
-        period = contact_period(
-            plant, query.inspector(), body, candidate, mass, M_BBo_B=inertia
-        )
-    resolving = _resolving_step(period)
-    if time_step is None and resolving < step:  # built again at that step
-        result = shake_test(
-            add_models, given[0], squeeze=None if default else squeeze,
-            stiffness=stiffness, damping=damping, directions=directions,
-            settle=settle, phase=phase, seat=seat, blend=blend,
-            time_step=resolving, max_displacement=max_displacement,
-            max_rotation=max_rotation, object_body=object_body, X_WO=given[1],
-            hydroelastic_modulus=hydroelastic_modulus, object_mass=given[2],
-        )  # fmt: skip
-        return replace(result, wall_time=time.perf_counter() - t0)
     if step > resolving:
         warnings.warn(
             f"time_step = {step:g} s does not resolve the object's contacts: "

@@ -16,6 +16,7 @@ import warnings
 
 import numpy as np
 import pytest
+from allegro_support import allegro_scene
 
 from drakegrasp.errors import SolverError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
@@ -147,6 +148,42 @@ def test_a_cube_that_turns_faster_than_it_slides_is_shaken_at_its_turning_step(
     assert chosen.time_step == pytest.approx(1.1e-4)
     assert slid.max_displacement > 1.0  # out of the hand: the simulation's
     assert chosen.max_displacement < 0.012
+
+
+@pytest.mark.parametrize("hand", ["wsg", "allegro"])
+def test_a_finer_step_finalizes_one_plant(cube, drake_models_dir, hand):
+    # the period is read on the first plant before Finalize; a finer step
+    # reads the models into a plant of that step (Drake fixes a plant's step
+    # when it is made) and builds on that one alone.  Before, the first plant
+    # was finalized and simulated-to-be, and the whole test ran again: the
+    # Allegro hand's default squeeze built its lever plant twice
+    if hand == "wsg":
+        scene, candidate = cube
+    else:
+        scene = allegro_scene("004_sugar_box", drake_models_dir)
+        candidate = plan_grasps(
+            scene.plant, scene.context, scene.object_body, hand=scene.hand,
+            num_candidates=20, mu=1.0, seed=0, robustness_samples=2,
+            object_mass=0.02,
+        )[0]  # fmt: skip
+    plants = []
+
+    def kept(plant, parser):
+        plants.append(plant)
+        return scene.add_models(plant, parser)
+
+    ctx = _quiet()
+    try:
+        shaken = shake_test(
+            kept, candidate, seat=0.02, settle=0.02, phase=0.02, blend=0.005,
+            directions=[[1.0, 0, 0]],
+        )  # fmt: skip
+    finally:
+        ctx.__exit__(None, None, None)
+    assert shaken.time_step < 1e-3
+    read = [(p.time_step(), p.is_finalized()) for p in plants]
+    levers = [(0.0, True)] if hand == "allegro" else []  # the default squeeze's
+    assert read == [(1e-3, False), (shaken.time_step, True), *levers]
 
 
 def test_the_shipped_box_keeps_the_default_step(drake_models_dir):
