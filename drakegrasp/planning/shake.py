@@ -119,6 +119,7 @@ __all__ = [
     "DAMPING_TIME",
     "DEFAULT_TIME_STEP",
     "MIN_SHAKEN_MASS",
+    "MIN_TIME_STEP",
     "PASSED_DEPTH",
     "PRISMATIC_STIFFNESS",
     "REVOLUTE_AIM",
@@ -387,7 +388,9 @@ def check_shake_options(
 MIN_SHAKEN_MASS = 1e-6
 """The lightest object (kg) the shake test simulates: a milligram.  Drake's
 contact solver stopped on objects of 1e-12 kg against a gripper's gains (the
-fuzz suite); no hand grasps anything that light."""
+fuzz suite); no hand grasps anything that light.  On stiff point contacts an
+object this light also asks for a step under :data:`MIN_TIME_STEP`, which
+``time_step=None`` refuses: it is simulated at a ``time_step`` given."""
 
 
 DEFAULT_TIME_STEP = 1e-3
@@ -397,10 +400,10 @@ finer one (:data:`CONTACT_PERIOD_STEPS`) and a phase is at least ten of it
 
 CONTACT_PERIOD_STEPS = 1.25
 """Steps per period of the object's stiffest mode on its contacts that the
-shake takes at the least (``time_step=None`` picks the step so; a coarser
-given step is warned of, :class:`CoarseStepWarning`).  The mode is the rigid
-body's, translations and rotations about its centre of mass together
-(:func:`contact_period`).
+shake takes at the least (``time_step=None`` picks the step so, down to
+:data:`MIN_TIME_STEP`; a coarser given step is warned of,
+:class:`CoarseStepWarning`).  The mode is the rigid body's, translations and
+rotations about its centre of mass together (:func:`contact_period`).
 
 Drake's SAP solver treats a contact whose period ``T = 2π / ω`` is below the
 step as near-rigid and regularises it.  Measured with Drake 1.51's default
@@ -425,6 +428,18 @@ and 20 g, the turning mode up to 14 times faster than the translation) held
 at the translation's step, at this one and at a quarter of it, the box with
 a dense core creeping 0.45 mm and 0.60° at the first, 0.04 mm and 0.04° at
 the second."""
+
+MIN_TIME_STEP = 1e-5
+"""The finest step (s) ``time_step=None`` picks.  Where the object's
+contacts ask for a finer one (:data:`CONTACT_PERIOD_STEPS`) the shake refuses
+up front (``ModelError``) rather than run for many minutes or hours: the
+default 2.8 s shake is 280,000 steps at this one, measured at 48 s with the
+WSG-50 (0.17 ms a step) and about 3 minutes with the Allegro hand (0.66 ms a
+step), on one core.  On Drake's default point contact (5e5 N/m a pair) an
+object of 4 mg held at two contacts in line with its centre of mass asks for
+it (a period of 12.5 µs); a milligram on the WSG-50's contacts asks for 3.7
+µs on a 1 cm cube and about 2.4 µs on the shipped box, where its eight tips
+touch.  A ``time_step`` given below it is the caller's choice, and is run."""
 
 
 def _resolving_step(period: float) -> float:
@@ -1164,6 +1179,27 @@ def _period_before_finalize(plant, scene_graph, body, candidate, mass, M_BBo_B):
     return contact_period(plant, inspector, body, candidate, mass, M_BBo_B=M_BBo_B)
 
 
+def _too_fine(plant, body, mass, period, resolving, duration) -> str:
+    """Why ``time_step=None`` refuses an object, and what the caller can do.
+
+    Its contacts ask for a step under :data:`MIN_TIME_STEP`: ``resolving``
+    (s) for a period ``period`` (s), over ``duration`` seconds of shaking.
+    """
+    steps = math.ceil(duration / resolving)
+    return (
+        f"the object {_scoped(plant, body)} ({mass:g} kg) on its planned point "
+        f"contacts has a stiffest mode of period {period:.3g} s, which takes "
+        f"time_step <= {resolving:.2g} s to resolve ({CONTACT_PERIOD_STEPS:g} "
+        f"steps a period): under the shake's floor of {MIN_TIME_STEP:g} s "
+        f"(MIN_TIME_STEP), {steps:,} steps for {duration:g} s of shaking, so "
+        "time_step=None does not run it; give time_step= (the step you "
+        "accept: smaller runs longer, larger lets Drake's contact solver "
+        "regularise the contacts), a heavier object_mass, or softer contact "
+        "(a lower point_contact_stiffness in the models' proximity "
+        "properties, or hydroelastic_modulus= for compliant fingers)"
+    )
+
+
 @checked_call
 def shake_test(
     add_models: Callable,
@@ -1271,8 +1307,12 @@ def shake_test(
         point contacts ask for it: :data:`CONTACT_PERIOD_STEPS` steps per
         period of its stiffest mode, translations and rotations about its
         centre of mass (``ShakeResult.contact_period``,
-        :func:`contact_period`).  A given step that does not resolve the
-        contacts is warned of (:class:`CoarseStepWarning`).
+        :func:`contact_period`), down to :data:`MIN_TIME_STEP` (10 µs): an
+        object whose contacts ask for a finer step (a few milligrams on
+        Drake's default point contact) is refused before anything is
+        simulated (``ModelError``), and runs with a ``time_step`` given.  A
+        given step that does not resolve the contacts is warned of
+        (:class:`CoarseStepWarning`); one below :data:`MIN_TIME_STEP` is run.
     max_displacement, max_rotation : float, optional
         Bounds on the object's motion in the hand frame: metres, radians.
     object_body : optional
@@ -1325,8 +1365,11 @@ def shake_test(
         ``object_mass`` is given (gravity would pull on nothing and every grasp
         would hold), its plant has no gravity (the same: set the gravity to
         shake under in ``add_models``), a gravity that is not finite or in
-        which the object's weight is no float, or Drake refused to advance
-        the model for another reason (its first sentence is in the message).
+        which the object's weight is no float, an object whose point
+        contacts ask ``time_step=None`` for a step under
+        :data:`MIN_TIME_STEP` (the message names it, its mass, the period and
+        the remedies), or Drake refused to advance the model for another
+        reason (its first sentence is in the message).
     InvalidGraspError
         The candidate's joint values or poses are not finite or do not match
         its closing joints (:func:`~drakegrasp.planning.candidates.check_candidate`),
@@ -1389,6 +1432,9 @@ def shake_test(
         )
     resolving = _resolving_step(period)
     if time_step is None and resolving < step:  # the models read again at that step
+        if resolving < MIN_TIME_STEP:
+            duration = seat + settle + len(dirs) * phase
+            raise ModelError(_too_fine(plant, body, mass, period, resolving, duration))
         step = resolving
         builder, plant, scene_graph, hand, obj, g = _shake_plant(
             add_models, step, object_body
@@ -1505,7 +1551,12 @@ def shake_test(
             f"({mass:g} kg on point contacts), under {CONTACT_PERIOD_STEPS:g} "
             "steps, so Drake's contact solver regularises them and the object "
             "may creep or be thrown out of the hand by the simulation; give "
-            f"time_step <= {resolving:.2g} s (or None, which picks it)",
+            f"time_step <= {resolving:.2g} s "
+            + (
+                "(or None, which picks it)"
+                if resolving >= MIN_TIME_STEP
+                else f"(under MIN_TIME_STEP, {MIN_TIME_STEP:g} s, which None refuses)"
+            ),
             CoarseStepWarning,
             stacklevel=outside_stacklevel(),
         )

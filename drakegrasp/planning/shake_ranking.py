@@ -423,7 +423,10 @@ def shake_candidates(
     ModelError
         As :func:`~drakegrasp.planning.shake.shake_test` raises it for the
         first candidate: a model that does not match the candidates (the
-        others would share it).
+        others would share it), or, with ``time_step`` None, an object whose
+        contacts ask for a step under
+        :data:`~drakegrasp.planning.shake.MIN_TIME_STEP` (a later candidate's
+        such refusal is recorded, and the rest still run).
 
     Warns
     -----

@@ -77,7 +77,9 @@ Per hand, each call in a sandboxed worker (a hang or crash is an outcome):
     URDF box link without ``<inertial>``), planned with or without
     ``object_mass``, then ``shake_test`` with hostile ``object_mass``
     values (0, negative, NaN, inf, 1e308 whose weight overflows, booleans,
-    strings, numpy scalars, 1e-300, 1e300, 1e4 kg) or ``shake_candidates``
+    strings, numpy scalars, 1e-300, a milligram whose contacts ask for a step
+    under ``MIN_TIME_STEP``, refused at the first candidate shaken, 1e300, 1e4
+    kg) or ``shake_candidates``
     on the plan, a slice of it, or a list, with or without ``object_mass``.
     A massless model's shake also gets a candidate whose ``torque_scale``
     or ``reference_point`` (the ball its inertia is taken from) is hostile.
@@ -1106,8 +1108,9 @@ def _q(rng, hand: dict, most: float = 1.0) -> dict:
 
 MASSES = {  # shake_test's object_mass: what a right outcome is
     "refuse": (0.0, -1.0, math.nan, math.inf, -math.inf, 1e308, True, False, "0.3",
-               [0.3], 1j, np.float64(-2.0), 1e-12, 1e-300),  # below a milligram
-    "answer": (0.2, 3.0, 1e-6, 1e300, HEAVY, 1e6, 2,
+               [0.3], 1j, np.float64(-2.0), 1e-12, 1e-300,  # below a milligram
+               1e-6),  # a milligram: its contacts ask for a step under 10 µs
+    "answer": (0.2, 3.0, 1e-3, 1e300, HEAVY, 1e6, 2,
                np.float32(0.5), np.int64(3), np.float64(0.7)),
 }  # fmt: skip
 

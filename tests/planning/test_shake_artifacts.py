@@ -18,10 +18,11 @@ import numpy as np
 import pytest
 from allegro_support import allegro_scene
 
-from drakegrasp.errors import SolverError
+from drakegrasp.errors import ModelError, SolverError
 from drakegrasp.planning import plan_grasps, planning_scene, shake_test
 from drakegrasp.planning.shake import (
     CONTACT_PERIOD_STEPS,
+    MIN_TIME_STEP,
     CoarseStepWarning,
     SoftFingerShakeWarning,
 )
@@ -148,6 +149,46 @@ def test_a_cube_that_turns_faster_than_it_slides_is_shaken_at_its_turning_step(
     assert chosen.time_step == pytest.approx(1.1e-4)
     assert slid.max_displacement > 1.0  # out of the hand: the simulation's
     assert chosen.max_displacement < 0.012
+
+
+def test_contacts_that_ask_for_microseconds_are_refused_up_front(cube):
+    # a milligram on the cube's contacts: T = 0.332 ms × sqrt(1e-6 / 0.005) =
+    # 4.7 µs, a step of 3.7 µs: 757,000 steps, minutes on the WSG-50 and more
+    # on a hand of many joints, where a step given below the floor is run
+    scene, candidate = cube
+    reads = []
+
+    def counted(plant, parser):
+        reads.append(plant.time_step())
+        return scene.add_models(plant, parser)
+
+    with pytest.raises(ModelError) as caught:
+        shake_test(counted, candidate, object_mass=1e-6)
+    assert reads == [1e-3]  # refused before the models are read at its step
+    message = str(caught.value)
+    for words in (
+        "the object cube::cube (1e-06 kg)", "period 4.7e-06 s",
+        "time_step <= 3.7e-06 s", f"floor of {MIN_TIME_STEP:g} s (MIN_TIME_STEP)",
+        "756,757 steps for 2.8 s", "give time_step=", "a heavier object_mass",
+        "point_contact_stiffness", "hydroelastic_modulus=",
+    ):  # fmt: skip
+        assert words in message, message
+    short = dict(
+        object_mass=1e-6, seat=0.002, settle=0.002, phase=0.002, blend=5e-4,
+        directions=[[1.0, 0, 0]],
+    )  # fmt: skip
+    ctx = _quiet()
+    try:
+        with pytest.warns(CoarseStepWarning, match=r"3\.7e-06 s \(under MIN_TIME_"):
+            shake_test(counted, candidate, time_step=4e-6, **short)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", CoarseStepWarning)
+            given = shake_test(counted, candidate, time_step=3.5e-6, **short)
+    finally:
+        ctx.__exit__(None, None, None)
+    assert reads[1:] == [4e-6, 3.5e-6]  # the caller's steps: run
+    assert given.time_step == 3.5e-6
+    assert given.object_mass == 1e-6 and math.isfinite(given.max_displacement)
 
 
 @pytest.mark.parametrize("hand", ["wsg", "allegro"])
