@@ -596,8 +596,9 @@ def contact_period(
     Returns
     -------
     float
-        Seconds; ``inf`` where it cannot be told (no contacts, or a geometry
-        without a point-contact stiffness: Drake's own estimate then).  A
+        Seconds; ``inf`` where it cannot be told (no contacts, a contact that
+        is not a finite point and normal, or a geometry without a
+        point-contact stiffness: Drake's own estimate then).  A
         hydroelastic pair presses with its patch's stiffness, not this one:
         :func:`shake_test` does not ask with ``hydroelastic_modulus``.
 
@@ -624,7 +625,18 @@ def contact_period(
 
     k_object = stiffness(body)
     contacts = [c for c in candidate.contacts if getattr(c, "finger_body", None)]
-    if not contacts or not k_object > 0:
+    try:
+        p_OC = np.array([np.asarray(c.p_OC, dtype=float) for c in contacts])
+        nhat_O = np.array([np.asarray(c.nhat_O, dtype=float) for c in contacts])
+    except (TypeError, ValueError):  # ragged, or not numbers
+        return math.inf
+    if not (
+        contacts
+        and p_OC.shape == nhat_O.shape == (len(contacts), 3)
+        and np.all(np.isfinite(p_OC))
+        and np.all(np.isfinite(nhat_O))
+        and k_object > 0
+    ):
         return math.inf
     k = []
     for c in contacts:
@@ -640,8 +652,8 @@ def contact_period(
     G_Bcm = M.get_unit_inertia().ShiftToCenterOfMass(p_OBcm).CopyToFullMatrix3()
     return _mode_period(
         np.asarray(k, dtype=float),
-        np.array([c.p_OC for c in contacts], dtype=float),
-        np.array([c.nhat_O for c in contacts], dtype=float),
+        p_OC,
+        nhat_O,
         float(mass),
         p_OBcm,
         float(mass) * G_Bcm,

@@ -214,3 +214,21 @@ def test_a_mass_that_is_no_finite_positive_number_is_refused(box_plant, mass):
     plant, inspector, body, candidate = box_plant
     with pytest.raises(InvalidOptionError, match="mass must be a finite number > 0"):
         contact_period(plant, inspector, body, candidate, mass)
+
+
+@pytest.mark.parametrize(
+    "edit",
+    [
+        {"nhat_O": np.full(3, np.nan)},
+        {"p_OC": np.array([np.inf, 0.0, 0.0])},
+        {"p_OC": np.zeros(2)},
+    ],
+)
+def test_a_contact_that_is_no_finite_point_and_normal_has_no_period(box_plant, edit):
+    # was numpy's LinAlgError ("Eigenvalues did not converge") out of
+    # shake_test for a parallel jaw; the shake refuses such a contact where
+    # it presses with it (the default squeeze of a turning finger)
+    plant, inspector, body, candidate = box_plant
+    first = dataclasses.replace(candidate.contacts[0], **edit)
+    bad = dataclasses.replace(candidate, contacts=(first, *candidate.contacts[1:]))
+    assert contact_period(plant, inspector, body, bad, BOX[0]) == math.inf
