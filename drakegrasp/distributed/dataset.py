@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.files import MISSING, not_a_file
+from drakegrasp.core.files import MISSING, not_a_file, unexaminable, unlistable
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import check_flag, path_text
 from drakegrasp.errors import BatchFileError
@@ -201,6 +201,20 @@ def _check_creatable(output_dir: Path) -> None:
         )
 
 
+def _check_examinable(output_dir: Path) -> None:
+    """Refuse a dataset directory whose existence or names cannot be read.
+
+    Inside a folder this process may not search, pathlib's ``exists()`` and
+    ``is_dir()`` raised a bare ``PermissionError``, and ``iterdir`` in one it
+    may not read.
+    """
+    why = unexaminable(output_dir)
+    if not why and output_dir.is_dir():
+        why = unlistable(output_dir)  # iterdir raised PermissionError
+    if why:
+        raise BatchFileError(f"dataset directory {str(output_dir)!r} {why}")
+
+
 def prepare_dataset(
     output_dir, manifest: dict, *, overwrite: bool, create: bool = True
 ) -> Path:
@@ -220,6 +234,7 @@ def prepare_dataset(
     """
     overwrite = check_flag("overwrite", overwrite)
     output_dir = Path(path_text("output_dir", output_dir, error=BatchFileError))
+    _check_examinable(output_dir)
     if output_dir.exists() and not output_dir.is_dir():
         raise BatchFileError(
             f"output {str(output_dir)!r} is a file; a cluster run writes a "
@@ -358,6 +373,7 @@ def read_dataset(output_dir: str | os.PathLike) -> dict[str, np.ndarray]:
         path_text("output_dir", output_dir, error=BatchFileError,
                   must="a dataset directory's path (a str or an os.PathLike)")
     )  # fmt: skip
+    _check_examinable(output_dir)
     if not output_dir.is_dir():
         what = "is not a directory" if output_dir.exists() else "does not exist"
         raise BatchFileError(f"dataset directory {str(output_dir)!r} {what}")

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.files import not_a_file
+from drakegrasp.core.files import not_a_file, unexaminable, unlistable
 from drakegrasp.core.validation import path_text
 from drakegrasp.errors import BatchFileError, GraspError, InvalidOptionError
 
@@ -51,6 +51,7 @@ def read_grasps(path: str | os.PathLike) -> dict[str, np.ndarray]:
         The arrays present, by name (memory-mapped for a directory).
     """
     path = as_path("input", path)
+    _check_examinable(path)
     if path.is_dir():
         return _read_npy_directory(path)
     if path.suffix.lower() != ".npz":
@@ -217,7 +218,21 @@ def _read_npy_directory(path: Path) -> dict[str, np.ndarray]:
 
 def input_files(source: Path) -> list[Path]:
     """``source`` and, for a directory, the ``.npy`` files it holds."""
+    _check_examinable(source)
     return [source, *(sorted(source.glob("*.npy")) if source.is_dir() else [])]
+
+
+def _check_examinable(path: Path) -> None:
+    """Refuse an input whose kind, or a directory's names, cannot be read.
+
+    In a folder this process may not search, pathlib's ``is_dir()`` raised
+    ``PermissionError``; a directory it may not read globbed as empty.
+    """
+    why = unexaminable(path)
+    if not why and path.is_dir():
+        why = unlistable(path)
+    if why:
+        raise BatchFileError(f"input {str(path)!r} {why}")
 
 
 def engine_options(

@@ -42,6 +42,7 @@ from drakegrasp.batch.files.npz import NpzWriter
 from drakegrasp.batch.files.parquet import ParquetWriter
 from drakegrasp.batch.files.reader import as_path
 from drakegrasp.core.calls import checked_call
+from drakegrasp.core.files import unexaminable
 from drakegrasp.core.validation import (
     NAME_MAX,
     describe,
@@ -165,6 +166,12 @@ def check_output(
         raise BatchFileError(
             f"output file {str(output)!r} must end in .npz (or .parquet with pyarrow)"
         )
+    # pathlib's exists() and is_dir() raise PermissionError inside a folder
+    # this process may not search: such a path is refused by name first
+    for what, path in (("output file", output), *(("input", p) for p in inputs)):
+        why = unexaminable(path)
+        if why:
+            raise BatchFileError(f"{what} {str(path)!r} {why}")
     for source in inputs:
         same = output.resolve() == source.resolve()
         if not same and output.exists() and source.exists():
