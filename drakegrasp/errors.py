@@ -60,6 +60,21 @@ class GraspError(Exception):
         super().__init__(*args)
 
 
+class GraspWarning(UserWarning):
+    """Base class of every warning drakegrasp issues (but deprecations).
+
+    ``warnings.simplefilter("ignore", drakegrasp.GraspWarning)`` silences them
+    all, and ``"error"`` makes each an exception.  Its text is cut as a
+    :class:`GraspError`'s is: a warning may name a user's bodies or values,
+    of any length.  Deprecations are :class:`DeprecationWarning`, as Python's
+    tools expect.
+    """
+
+    def __init__(self, *args: Any):
+        args = tuple(cut_message(a) if issubclass(type(a), str) else a for a in args)
+        super().__init__(*args)
+
+
 class InvalidContactError(GraspError, ValueError):
     """A contact, or a set of contacts, is not well formed.
 

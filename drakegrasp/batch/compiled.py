@@ -41,6 +41,7 @@ import time
 import warnings
 
 from drakegrasp.batch import aot
+from drakegrasp.errors import GraspWarning
 
 __all__ = [
     "FASTMATH",
@@ -70,7 +71,7 @@ AVAILABLE = importlib.util.find_spec("numba") is not None
 """Whether numba is installed: the kernels are compiled, else the numpy route runs."""
 
 
-class NumbaMissingWarning(UserWarning):
+class NumbaMissingWarning(GraspWarning):
     """numba is not installed: the batch engine runs its (slower) numpy route."""
 
 

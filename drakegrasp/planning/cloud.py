@@ -53,7 +53,7 @@ from scipy.spatial import ConvexHull, cKDTree
 from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.tolerances import DEFAULT_DISTANCE_TOLERANCE
 from drakegrasp.core.validation import describe, real_array, unit_vectors
-from drakegrasp.errors import InvalidOptionError
+from drakegrasp.errors import GraspWarning, InvalidOptionError
 from drakegrasp.planning import cloud_normals, cloud_spacing, cloud_tips
 from drakegrasp.planning.cloud_normals import _estimate_normals
 from drakegrasp.planning.cloud_spacing import (
@@ -229,7 +229,7 @@ which named an argument of the batch engine.  A rod, a plate or a one-sided
 view stays within a few times its median."""
 
 
-class PointCloudWarning(UserWarning):
+class PointCloudWarning(GraspWarning):
     """Planning went on with a point cloud that may not be what was meant.
 
     Points left out (not finite: a depth camera's missing depth), or an

@@ -54,6 +54,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.errors import (
+    GraspWarning,
     InvalidOptionError,
     ModelError,
     NoContactsError,
@@ -91,7 +92,7 @@ __all__ = [
 ]
 
 
-class PassiveJointWarning(UserWarning):
+class PassiveJointWarning(GraspWarning):
     """A hand has joints no motor moves, which the planner treats as driven.
 
     A one-dof joint without an actuator that follows no driven joint (no

@@ -76,6 +76,7 @@ from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.validation import describe, unit_vectors
 from drakegrasp.errors import (
     GraspError,
+    GraspWarning,
     InvalidGraspError,
     InvalidOptionError,
     ModelError,
@@ -134,7 +135,7 @@ __all__ = [
 ]
 
 
-class SqueezeLostWarning(UserWarning):
+class SqueezeLostWarning(GraspWarning):
     """The seated fingers press with a small share of the squeeze, the object at rest.
 
     (An object still moving at the seat is being pushed out: a drop the test
@@ -173,7 +174,7 @@ grasps: 0.17-0.53 m/s, against 0.012-0.045 for grasps that hold), a drop the
 test is right to report."""
 
 
-class SoftFingerShakeWarning(UserWarning):
+class SoftFingerShakeWarning(GraspWarning):
     """A candidate planned with soft fingers is shaken in point contact.
 
     The plan counted on each contact resisting a torque about its normal (up
@@ -455,7 +456,7 @@ def _resolving_step(period: float) -> float:
     return math.floor(h / unit) * unit
 
 
-class CoarseStepWarning(UserWarning):
+class CoarseStepWarning(GraspWarning):
     """The given ``time_step`` does not resolve the object's contacts.
 
     The object's stiffest mode on its contacts (a translation, a rotation

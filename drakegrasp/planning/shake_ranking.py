@@ -37,6 +37,7 @@ from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.validation import describe
 from drakegrasp.errors import (
+    GraspWarning,
     InvalidGraspError,
     InvalidOptionError,
     ModelError,
@@ -66,7 +67,7 @@ HELD_FROM = ("seat", "plan")
 """What "held" counts from: where seating left the object, or the planned pose."""
 
 
-class GravityMismatchWarning(UserWarning):
+class GravityMismatchWarning(GraspWarning):
     """The shake's plant has another gravity than the one the plan was made in.
 
     :func:`~drakegrasp.planning.planner.plan_grasps` records the magnitude it

@@ -31,7 +31,7 @@ from pydrake.multibody.plant import (
 )
 
 from drakegrasp.core.validation import describe
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import GraspWarning, InvalidOptionError, ModelError
 from drakegrasp.plant.handles import local_geometry_id
 from drakegrasp.plant.validation import (
     checked_query_object,
@@ -52,7 +52,7 @@ __all__ = [
 ]
 
 
-class FrictionMismatchWarning(UserWarning):
+class FrictionMismatchWarning(GraspWarning):
     """A given friction coefficient is not the one the plant simulates."""
 
 

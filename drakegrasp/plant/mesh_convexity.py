@@ -19,6 +19,8 @@ import warnings
 import numpy as np
 from pydrake.geometry import CalcVolume, Mesh, ReadObjToTriangleSurfaceMesh, Shape
 
+from drakegrasp.errors import GraspWarning
+
 __all__ = [
     "NON_CONVEX_SHARE",
     "NonConvexMeshWarning",
@@ -28,7 +30,7 @@ __all__ = [
 ]
 
 
-class NonConvexMeshWarning(UserWarning):
+class NonConvexMeshWarning(GraspWarning):
     """A collision ``Mesh`` is not convex: Drake, and drakegrasp, use its hull.
 
     The planner, like Drake's point-contact queries, treats a ``Mesh`` as its

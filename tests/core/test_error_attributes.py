@@ -144,3 +144,52 @@ def test_a_pose_error_without_a_remedy_is_its_problem_alone(remedy):
     error = dg.PenetrationError("fingers inside", remedy=remedy)
     assert str(error) == "fingers inside" and error.remedy == ""
     assert error.with_remedy(None).args == error.args
+
+
+def _warning_classes():
+    """Every warning class drakegrasp defines, by importing its modules."""
+    import importlib
+    import pkgutil
+
+    import drakegrasp
+
+    found = set()
+    for info in pkgutil.walk_packages(drakegrasp.__path__, "drakegrasp."):
+        if info.name.endswith("__main__") or ".batch._aot" in info.name:
+            continue
+        try:
+            module = importlib.import_module(info.name)
+        except ImportError:  # an optional extra (dask, pyarrow, meshcat)
+            continue
+        for value in vars(module).values():
+            if (
+                isinstance(value, type)
+                and issubclass(value, Warning)
+                and value.__module__.startswith("drakegrasp")
+            ):
+                found.add(value)
+    return sorted(found, key=lambda c: c.__name__)
+
+
+def test_every_drakegrasp_warning_is_a_grasp_warning():
+    # One filter silences or raises them all, as except GraspError catches
+    # every error; the nine warnings were UserWarnings of their own.
+    classes = _warning_classes()
+    assert len(classes) >= 10, classes  # GraspWarning and its nine
+    assert all(issubclass(c, dg.GraspWarning) for c in classes), classes
+    assert all(issubclass(c, UserWarning) for c in classes)
+
+
+def test_a_grasp_warning_is_cut_as_an_error_is():
+    import warnings
+
+    from drakegrasp.planning.shake import CoarseStepWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        warnings.warn(HUGE, CoarseStepWarning, stacklevel=1)
+    _bounded_plain(str(caught[0].message))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", dg.GraspWarning)
+        with pytest.raises(CoarseStepWarning, match="characters cut"):
+            warnings.warn(HUGE, CoarseStepWarning, stacklevel=1)
