@@ -43,8 +43,18 @@ def _plain_text(value) -> str:
         shown = None
     if issubclass(type(shown), str):
         return str.__str__(shown)
+    return f"<{type_name(value)}>"
+
+
+def type_name(value) -> str:
+    """The name of ``value``'s type, or ``"object"`` if even that misbehaves."""
     name = getattr(type(value), "__name__", None)
-    return f"<{str.__str__(name) if issubclass(type(name), str) else 'object'}>"
+    return str.__str__(name) if issubclass(type(name), str) else "object"
+
+
+def _cut_args(args: tuple) -> tuple:
+    """An exception's or warning's arguments, each ``str`` one cut and plain."""
+    return tuple(cut_message(a) if issubclass(type(a), str) else a for a in args)
 
 
 class GraspError(Exception):
@@ -56,8 +66,7 @@ class GraspError(Exception):
     """
 
     def __init__(self, *args: Any):
-        args = tuple(cut_message(a) if issubclass(type(a), str) else a for a in args)
-        super().__init__(*args)
+        super().__init__(*_cut_args(args))
 
 
 class GraspWarning(UserWarning):
@@ -71,8 +80,7 @@ class GraspWarning(UserWarning):
     """
 
     def __init__(self, *args: Any):
-        args = tuple(cut_message(a) if issubclass(type(a), str) else a for a in args)
-        super().__init__(*args)
+        super().__init__(*_cut_args(args))
 
 
 class InvalidContactError(GraspError, ValueError):

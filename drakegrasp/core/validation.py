@@ -68,6 +68,7 @@ from drakegrasp.errors import (
     InvalidContactError,
     InvalidGraspError,
     InvalidOptionError,
+    type_name,
 )
 
 __all__ = [
@@ -104,8 +105,8 @@ __all__ = [
     "path_text",
     "plain_str",
     "real_array",
-    "refuse_structured",
     "real_scalar",
+    "refuse_structured",
     "safe_norm",
     "unit_vectors",
 ]
@@ -168,7 +169,7 @@ def describe(value) -> str:
         # methods its own cannot override.
         text = str.__getitem__(text, slice(0, 4 * DESCRIBE_WIDTH))
     except Exception as err:  # noqa: BLE001 - a hostile __repr__
-        return f"<{_type_name(value)} whose repr() raised {_type_name(err)}>"
+        return f"<{type_name(value)} whose repr() raised {type_name(err)}>"
     text = " ".join(text.split())
     if len(text) <= DESCRIBE_WIDTH:
         return text
@@ -256,16 +257,16 @@ def path_text(
             text = kind.__fspath__(value)
         except Exception as err:  # noqa: BLE001 - a user's __fspath__
             raise error(
-                f"{name} must be {must}: its __fspath__() raised {_type_name(err)}"
+                f"{name} must be {must}: its __fspath__() raised {type_name(err)}"
             ) from None
         if not issubclass(type(text), str):
             raise error(
                 f"{name} must be {must}: its __fspath__() returned a "
-                f"{_type_name(text)}, not a str"
+                f"{type_name(text)}, not a str"
             )
         text = str.__str__(text)
     else:
-        raise error(f"{name} must be {must}, got {_type_name(value)} {describe(value)}")
+        raise error(f"{name} must be {must}, got {type_name(value)} {describe(value)}")
     if not text and not empty:
         raise error(f"{name} is empty; it must be {must}")
     problem = _path_problem(text)
@@ -294,12 +295,6 @@ def _path_problem(text: str) -> str:
             f"name holds {NAME_MAX}"
         )
     return ""
-
-
-def _type_name(value) -> str:
-    """The name of ``value``'s type, or ``"object"`` if even that misbehaves."""
-    name = getattr(type(value), "__name__", None)
-    return str.__str__(name) if isinstance(name, str) else "object"
 
 
 def real_scalar(name: str, value, *, error: type = InvalidOptionError) -> float:

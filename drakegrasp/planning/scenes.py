@@ -28,7 +28,11 @@ from drakegrasp.plant.models import (
     register_models,
     use_local_drake_models,
 )
-from drakegrasp.plant.scene_refs import add_named_package, package_folder
+from drakegrasp.plant.scene_refs import (
+    add_named_package,
+    package_folder,
+    package_name,
+)
 from drakegrasp.plant.validation import check_rigid_transform, resolve_body
 
 __all__ = ["WSG_URL", "PlanningScene", "planning_scene", "scene_from_models"]
@@ -156,12 +160,7 @@ def _checked_packages(package_map) -> list[tuple[str, str]]:
         )
     pairs = []
     for name, folder in package_map.items():
-        # read as a path is: the name is one folder of a package:// URL
-        name = path_text("package name", name, must="a word")
-        if "/" in name:
-            raise InvalidOptionError(
-                f"package name must be a word, got {describe(name)}"
-            )
+        name = package_name(name, error=InvalidOptionError)
         if name in ("drake", "drakegrasp"):  # (refused again where it is added)
             raise InvalidOptionError(
                 f"package {describe(name)} is built in and cannot be replaced"

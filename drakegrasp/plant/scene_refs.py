@@ -66,6 +66,7 @@ __all__ = [
     "anchor_relative_files",
     "check_references",
     "package_folder",
+    "package_name",
 ]
 
 MAX_INCLUDED_FILES = 32
@@ -172,12 +173,7 @@ def add_named_package(package_map: PackageMap, name, folder) -> None:
         A name that is not a word, a folder that is not a directory, or a
         built-in package.
     """
-    must = "a non-empty string without '/'"
-    # read as a path is (a str subclass's own methods, a character Drake
-    # cannot encode): the name is one folder of a package:// URL
-    name = path_text("package name", name, error=SceneError, must=must)
-    if "/" in name:
-        raise SceneError(f"package name must be {must}, got {describe(name)}")
+    name = package_name(name)
     path = package_folder(f"package {describe(name)}", folder)
     if not os.path.isdir(path):  # (pathlib's raises for a path too long)
         raise SceneError(f"package {describe(name)}: {str(path)!r} is not a directory")
@@ -189,6 +185,20 @@ def add_named_package(package_map: PackageMap, name, folder) -> None:
             )
         package_map.Remove(name)
     package_map.Add(name, path)
+
+
+def package_name(name, *, error: type = SceneError) -> str:
+    """A package's ``name`` as a plain str: one folder of a ``package://`` URL.
+
+    Read as a path is (a str subclass's own methods, a character Drake cannot
+    encode), and refused with ``error`` when empty or holding ``/``; for
+    scene files and for ``planning_scene(package_map=)`` alike.
+    """
+    must = "a non-empty string without '/'"
+    name = path_text("package name", name, error=error, must=must)
+    if "/" in name:
+        raise error(f"package name must be {must}, got {describe(name)}")
+    return name
 
 
 def package_folder(what: str, folder, *, error: type = SceneError) -> Path:

@@ -26,8 +26,8 @@ from drakegrasp.errors import InvalidContactError, InvalidOptionError
 
 __all__ = [
     "CHUNK_BYTES",
-    "GRASP_BYTES_MAX",
     "DEFAULT_CHUNK_SIZE",
+    "GRASP_BYTES_MAX",
     "MIN_CHUNK_CONTACTS",
     "PARALLEL_MIN_WORK",
     "TARGET_CHUNKS",
