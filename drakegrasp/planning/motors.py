@@ -95,7 +95,7 @@ from drakegrasp.closure.verdicts import force_closure
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import grasp_matrix
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import describe, real_scalar
+from drakegrasp.core.validation import check_flag, describe, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.planning.candidates import GraspCandidate, GraspCandidates
 from drakegrasp.planning.checks import checked_count, checked_directions
@@ -727,8 +727,7 @@ def with_squeeze_push(
         )
     top, check = checked_count("top", top), checked_count("check", check)
     started = real_scalar("started", started)
-    if not isinstance(push_last, (bool, np.bool_)):
-        raise InvalidOptionError(f"push_last must be a bool, got {describe(push_last)}")
+    push_last = check_flag("push_last", push_last)
     n = max(top, check)
     head = [
         dataclasses.replace(
