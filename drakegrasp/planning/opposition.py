@@ -56,6 +56,7 @@ from drakegrasp.core.validation import (
     integer_or_none,
     real_array,
     real_scalar,
+    safe_norm,
 )
 from drakegrasp.errors import InvalidOptionError
 
@@ -167,8 +168,7 @@ def closing_directions(
                 f"closing_directions: contact {i}'s closing motion overflows a "
                 "float (J and signs too large)"
             )
-        big = float(np.max(np.abs(v)))
-        speed = big * float(np.linalg.norm(v / big)) if big > 0.0 else 0.0
+        speed = float(safe_norm(v))
         out[i] = v / speed if speed > PASSIVE_SPEED else R[:, 0]
     return out
 
