@@ -215,9 +215,11 @@ class GraspCandidate:
         else ``InvalidGraspError``.  ``num_motors`` counts them.
     torque_limit : float
         The torque per motor (in ``torque_unit``) that the ranking held
-        ``torque_needed`` against: the smallest effort limit of the
-        candidate's motors, or ``plan_grasps``' ``torque_limit`` where that
-        is smaller (:func:`~drakegrasp.planning.motors.with_torques_needed`);
+        ``torque_needed`` against, one for the whole plan: the smallest
+        effort limit of the first-ranked candidate's motors (each candidate's
+        own where the hand's motors share one limit, as the Allegro hand's
+        do), or ``plan_grasps``' ``torque_limit`` where that is smaller
+        (:func:`~drakegrasp.planning.motors.with_torques_needed`);
         NaN where no finite limit is known or ``torque_needed`` was not
         computed.  ``torque_needed > torque_limit`` is one of the
         ``concerns``.

@@ -59,6 +59,7 @@ from drakegrasp.core.validation import (
     safe_norm,
 )
 from drakegrasp.errors import InvalidOptionError
+from drakegrasp.quality.epsilon import hull_point_nearest_origin
 
 __all__ = [
     "FRAME_TOL",
@@ -235,18 +236,9 @@ def squeeze_push_of(directions) -> float:
         )
     D = D / big[:, None]
     D = D / np.linalg.norm(D, axis=1)[:, None]
-    from scipy.optimize import nnls  # here: scipy.optimize is slow to import
-
-    # min ‖Dᵀλ‖² + (1ᵀλ - 1)², λ >= 0: y = Dᵀλ / 1ᵀλ lies in the hull
-    A = np.vstack([D.T, np.ones((1, len(D)))])
-    try:
-        lam = nnls(A, np.array([0.0, 0.0, 0.0, 1.0]))[0]
-    except RuntimeError:  # the iteration limit: no point, no push claimed
+    y = hull_point_nearest_origin(D)  # a point of the hull
+    if y is None:  # the iteration limit: no point, no push claimed
         return 0.0
-    total = float(np.sum(lam))
-    if not total > 0.0:
-        return 0.0
-    y = D.T @ lam / total
     norm = float(np.linalg.norm(y))
     if not norm > 1e-12:
         return 0.0

@@ -35,6 +35,7 @@ __all__ = [
     "L1_MAX_POINTS",
     "LINF_MAX_CANDIDATES",
     "ferrari_canny",
+    "hull_point_nearest_origin",
     "primitive_wrenches",
 ]
 
@@ -190,6 +191,45 @@ def _below_every_facet(points: np.ndarray, eq: np.ndarray, tol: float) -> bool:
     return True
 
 
+def hull_point_nearest_origin(
+    points: np.ndarray, rho: float = 1.0
+) -> np.ndarray | None:
+    r"""The point of ``conv(points)`` nearest the origin, as NNLS proposes it.
+
+    Lawson–Hanson NNLS on ``min ‖Pᵀλ‖² + ρ²(1ᵀλ - 1)²``, ``λ >= 0`` (tens of
+    microseconds for a few hundred points) gives ``y = Pᵀλ / 1ᵀλ``.  Not
+    certified: scipy 1.15's ``nnls`` stops short of the optimum on some
+    inputs, so a caller trusts ``y`` only through a check of its own (a
+    separating plane, a bound that errs on the safe side).
+
+    Parameters
+    ----------
+    points : (K, n) float
+        The points, one a row (trusted: finite, ``K >= 1``).
+    rho : float, optional
+        Weight of the constraint ``1ᵀλ = 1`` (the points' scale).
+
+    Returns
+    -------
+    (n,) float or None
+        ``y``; None where NNLS reached its iteration limit or gave ``λ = 0``.
+    """
+    A = np.vstack([points.T, np.full((1, points.shape[0]), rho)])
+    rhs = np.zeros(points.shape[1] + 1)
+    rhs[-1] = rho
+    try:
+        # Imported here: scipy.optimize alone doubles `import drakegrasp`'s time.
+        from scipy.optimize import nnls
+
+        lam = nnls(A, rhs)[0]
+    except RuntimeError:  # the iteration limit
+        return None
+    total = float(np.sum(lam))
+    if not total > 0.0:
+        return None
+    return points.T @ lam / total
+
+
 def _separated_from_origin(points: np.ndarray, scale: float) -> bool:
     r"""Whether a checked hyperplane separates the origin from ``conv(points)``.
 
@@ -203,20 +243,9 @@ def _separated_from_origin(points: np.ndarray, scale: float) -> bool:
     the last release for Python 3.10 —, or its iteration limit) Qhull decides.
     """
     rho = max(scale, 1e-300)
-    A = np.vstack([points.T, np.full((1, points.shape[0]), rho)])
-    rhs = np.zeros(points.shape[1] + 1)
-    rhs[-1] = rho
-    try:
-        # Imported here: scipy.optimize alone doubles `import drakegrasp`'s time.
-        from scipy.optimize import nnls
-
-        lam = nnls(A, rhs)[0]
-    except RuntimeError:  # iteration limit: let Qhull decide
+    y = hull_point_nearest_origin(points, rho)
+    if y is None:  # iteration limit: let Qhull decide
         return False
-    total = float(np.sum(lam))
-    if not total > 0.0:
-        return False
-    y = points.T @ lam / total
     norm = float(np.linalg.norm(y))
     return bool(norm > 0.0 and np.min(points @ y) > HULL_TOL * rho * norm)
 
