@@ -9,7 +9,7 @@ import numpy as np
 from pydrake.geometry import Cylinder, Meshcat, Rgba
 from pydrake.math import RigidTransform, RotationMatrix
 
-from drakegrasp.core.validation import describe, safe_norm
+from drakegrasp.core.validation import describe, plain_str, safe_norm
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.geometry import exact_cone_mesh
 
@@ -34,16 +34,19 @@ def check_meshcat(meshcat) -> None:
 def check_path(name: str, value) -> str:
     """A Meshcat path: a string with something besides slashes, as a plain str.
 
-    A ``str`` subclass is read by ``str``'s own methods (its ``__format__``
-    may raise where the path is joined); a character that UTF-8 cannot
-    encode (a lone surrogate) is refused here, not by pydrake's bare
-    ``UnicodeEncodeError`` when Meshcat is called.
+    A ``str`` subclass is read once as the plain ``str`` it holds (its own
+    ``strip``, ``encode`` or ``__format__`` may raise or lie), and an object
+    whose ``__class__`` merely claims ``str`` is refused; a character that
+    UTF-8 cannot encode (a lone surrogate) is refused here, not by pydrake's
+    bare ``UnicodeEncodeError`` when Meshcat is called.
     """
-    if not isinstance(value, str) or not str.strip(value, "/"):
+    # type(), not isinstance(): an object whose __class__ claims str passes
+    # isinstance, and str's own methods then raise a bare TypeError on it.
+    text = plain_str(value)
+    if type(text) is not str or not text.strip("/"):
         raise InvalidOptionError(
             f"{name} must be a non-empty path, got {describe(value)}"
         )
-    text = str.__str__(value)
     try:
         text.encode("utf-8")
     except UnicodeError:

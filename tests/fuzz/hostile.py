@@ -428,6 +428,110 @@ class StrFspathRaises(str):
     __format__ = _boom
 
 
+class ClaimsStr:
+    """No str, though ``isinstance(x, str)`` says so: its ``__class__`` claims str.
+
+    ``str``'s own methods refuse it (``str.strip(x)`` raises a bare
+    TypeError); only ``type(x)`` tells the truth.
+    """
+
+    __class__ = property(lambda self: str)  # noqa: PLE0237 - the lie under test
+
+    def __repr__(self):
+        return "ClaimsStr()"
+
+
+_STR_METHODS = (
+    "strip", "lstrip", "rstrip", "split", "rsplit", "partition", "rpartition",
+    "startswith", "endswith", "replace", "lower", "upper", "casefold", "find",
+    "rfind", "index", "join", "encode", "expandtabs", "format", "isidentifier",
+    "__contains__", "__getitem__", "__iter__", "__add__", "__radd__", "__mod__",
+    "__mul__", "__lt__", "__le__", "__gt__", "__ge__",
+)  # fmt: skip
+
+
+class StrMethodsRaise(str):
+    """A str whose every method a reader may call raises (its repr is a str's)."""
+
+    __fspath__ = _boom
+
+
+for _name in _STR_METHODS:
+    setattr(StrMethodsRaise, _name, _boom)
+
+
+class StrEqRaises(str):
+    """A str that cannot be compared: ``==``, ``!=`` raise (it hashes as a str)."""
+
+    __eq__ = _boom
+    __ne__ = _boom
+    __hash__ = str.__hash__
+
+
+class StrHashRaises(str):
+    """A str that cannot be hashed (a dict key, a set member)."""
+
+    __hash__ = _boom
+
+
+class StrLenRaises(str):
+    """A str whose ``len()`` and truth value raise."""
+
+    __len__ = _boom
+    __bool__ = _boom
+
+
+class StrEncodeRaises(str):
+    """A str whose ``encode`` raises (a UTF-8 check would meet it)."""
+
+    encode = _boom
+
+
+class StrLies(str):
+    """A str whose methods lie: equal to everything, empty, stripped to a name.
+
+    A check that asks it (``x == "open"``, ``x.strip()``, ``len(x)``, its
+    ``__fspath__``) would take it for something it does not hold.
+    """
+
+    def __eq__(self, other):
+        return True
+
+    def __ne__(self, other):
+        return False
+
+    __hash__ = str.__hash__
+
+    def __len__(self):
+        return 0
+
+    def strip(self, *args):
+        return "box"
+
+    lstrip = rstrip = strip
+
+    def encode(self, *args, **kwargs):
+        return b"box"
+
+    def __fspath__(self):
+        return "/nonexistent/lie.npz"
+
+    def __str__(self):
+        return "box"
+
+
+def str_hostile(text: str) -> list:
+    """Fresh ``str`` subclasses of ``text`` whose methods raise or lie, and a fake.
+
+    Each holds ``text`` (but :class:`ClaimsStr`, which holds nothing): a
+    reader that reads it as a plain ``str`` once (``str.__str__``) sees
+    ``text``; one that calls its methods meets a raise or a lie.
+    """
+    kinds = (StrMethodsRaise, StrEqRaises, StrHashRaises, StrLenRaises,
+             StrEncodeRaises, StrLies, StrFspathRaises, StrFormatRaises)  # fmt: skip
+    return [kind(text) for kind in kinds] + [ClaimsStr()]
+
+
 def path_hostile() -> list:
     """Fresh paths, file names and URLs that no check may let escape raw.
 
@@ -438,7 +542,10 @@ def path_hostile() -> list:
     strings that pathlib, ``os.stat`` or Drake refuse with a bare exception:
     huge (10**7 characters), longer than ``PATH_MAX``, a name longer than
     ``NAME_MAX``, a NUL character, a lone surrogate, ``~nobody`` (pathlib's
-    ``expanduser`` raised ``RuntimeError``), empty, and bytes.
+    ``expanduser`` raised ``RuntimeError``), empty, and bytes; and
+    :func:`str_hostile`'s subclasses (methods that raise or lie, and an
+    object whose ``__class__`` claims str) of a missing file, a folder, a
+    lone surrogate and a NUL.
     """
     return [
         FspathRaises(), FspathReturns(42), FspathReturns(None),
@@ -450,6 +557,8 @@ def path_hostile() -> list:
         "x" * HUGE, "/" + "d/" * 2100, "y" * 300, "/tmp/" + "z" * 300 + ".npz",
         "a\0b", "\ud800", "/tmp/\udfff.npz", "~drakegrasp-nobody/x",
         "", b"/tmp", bytearray(b"/tmp"),
+        *str_hostile("/nonexistent/x.npz"), *str_hostile("/tmp"),
+        *str_hostile("\ud800"), *str_hostile("a\0b"),
     ]  # fmt: skip
 
 

@@ -8,7 +8,9 @@ package's table, and the example grasps), fills its parameters with values
 drawn from :data:`HOSTILE`, the hostile objects of ``hostile.objects``
 (dunders that raise or lie, masked arrays, odd dtypes, huge broadcast shapes,
 and ``hostile.path_hostile``'s paths: path-likes whose ``__fspath__`` raises
-or lies, a NUL, a lone surrogate, names too long) and the scene's objects (for
+or lies, a NUL, a lone surrogate, names too long, ``str`` subclasses whose
+``==``, ``__hash__``, ``strip`` or ``encode`` raise or lie, and an object
+whose ``__class__`` claims ``str``) and the scene's objects (for
 a parameter that :func:`scene_values` knows, often a valid value instead, so
 that the call gets past its first check), calls it and draws a few items of
 what it yields.  A :class:`~drakegrasp.GraspError` is the refusal the library

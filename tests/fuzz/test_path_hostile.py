@@ -53,10 +53,11 @@ REFUSED_IDS = [IDS[i] for i, v in enumerate(PATHS) if _refused_by_the_reader(v)]
 
 
 def _keyed(value, folder) -> dict:
-    """``{value: folder}``, or no such dict (a bytearray is no key)."""
+    """``{value: folder}``, or no such dict (a bytearray is no key, nor a str
+    whose ``__hash__`` raises)."""
     try:
         hash(value)
-    except TypeError:
+    except Exception:  # noqa: BLE001 - TypeError, or a hostile __hash__
         return {}
     return {value: str(folder)}
 
