@@ -39,7 +39,7 @@ from drakegrasp.core.tolerances import (
     DEFAULT_TOL,
     ZERO_FRACTION,
 )
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, plain_str
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -670,7 +670,8 @@ def iter_batch_closure(
         The result of each chunk, in order.  Error messages index grasps within
         their chunk.
     """
-    if not isinstance(kind, str) or kind not in ("force", "form"):
+    kind = plain_str(kind)
+    if type(kind) is not str or kind not in ("force", "form"):
         raise InvalidOptionError(
             f"kind must be 'force' or 'form', got {describe(kind)}"
         )

@@ -28,6 +28,7 @@ from drakegrasp.core.validation import (
     describe,
     integer_or_none,
     items_of,
+    plain_str,
     real_array,
     refuse_structured,
     unit_vectors,
@@ -252,11 +253,14 @@ def check_metrics(metrics: Sequence[str]) -> tuple[str, ...]:
                 f"metrics yields more than {MAX_METRIC_NAMES} names; give a "
                 f"sequence of names from {', '.join(METRICS)}"
             )
-    names = tuple(
-        items_of("metrics", metrics, f"a sequence of names from {', '.join(METRICS)}")
+    names = tuple(  # each read as the plain str it holds (its == may lie)
+        plain_str(name)
+        for name in items_of(
+            "metrics", metrics, f"a sequence of names from {', '.join(METRICS)}"
+        )
     )
     for name in names:
-        if not isinstance(name, str) or name not in METRICS:
+        if type(name) is not str or name not in METRICS:
             raise InvalidOptionError(
                 f"unknown metric {describe(name)}; valid metrics are "
                 f"{', '.join(METRICS)}"
@@ -286,7 +290,8 @@ KERNELS = ("auto", "numba", "numpy")
 
 def check_kernel(kernel: str) -> str:
     """``kernel`` if it is one of :data:`KERNELS` (not resolved)."""
-    if not isinstance(kernel, str) or kernel not in KERNELS:
+    kernel = plain_str(kernel)
+    if type(kernel) is not str or kernel not in KERNELS:
         raise InvalidOptionError(
             f"kernel must be 'auto', 'numba' or 'numpy', got {describe(kernel)}"
         )

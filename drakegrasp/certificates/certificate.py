@@ -177,7 +177,9 @@ class Certificate:
     __hash__ = object.__hash__
 
     def __post_init__(self):
-        check_kind_and_cones(self.kind, self.cones, _KINDS, _CONES)
+        kind, cones = check_kind_and_cones(self.kind, self.cones, _KINDS, _CONES)
+        object.__setattr__(self, "kind", kind)
+        object.__setattr__(self, "cones", cones)
 
     @property
     def two_sided(self) -> bool:

@@ -17,7 +17,7 @@ import numpy as np
 
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, plain_str
 from drakegrasp.errors import InvalidOptionError
 
 __all__ = [
@@ -128,14 +128,24 @@ class CertificateCheck:
 
 def check_kind_and_cones(
     kind: str, cones: str, kinds: tuple[str, ...], cone_kinds: tuple[str, ...]
-) -> None:
-    """Raise :class:`~drakegrasp.InvalidOptionError` unless both are known."""
-    if not isinstance(kind, str) or kind not in kinds:
+) -> tuple[str, str]:
+    """``(kind, cones)`` as plain strs, once both are known.
+
+    Raises
+    ------
+    InvalidOptionError
+        Unless both are known (a ``str`` subclass is read as the plain ``str``
+        it holds: its own ``==`` may raise or lie).
+    """
+    kind = plain_str(kind)
+    if type(kind) is not str or kind not in kinds:
         raise InvalidOptionError(f"kind must be one of {kinds}, got {describe(kind)}")
-    if not isinstance(cones, str) or cones not in cone_kinds:
+    cones = plain_str(cones)
+    if type(cones) is not str or cones not in cone_kinds:
         raise InvalidOptionError(
             f"cones must be one of {cone_kinds}, got {describe(cones)}"
         )
+    return kind, cones
 
 
 class Witness(Protocol):

@@ -131,7 +131,9 @@ class LoadCertificate:
     bound: float
 
     def __post_init__(self):
-        check_kind_and_cones(self.kind, self.cones, _KINDS, _CONES)
+        kind, cones = check_kind_and_cones(self.kind, self.cones, _KINDS, _CONES)
+        object.__setattr__(self, "kind", kind)
+        object.__setattr__(self, "cones", cones)
 
     def power_budget(self) -> float:
         """``B``: the most power the motors and force bounds absorb along ``y`` (W)."""

@@ -53,7 +53,7 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.grasp import Grasp, grasp_matrix
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
-from drakegrasp.core.validation import describe, safe_norm
+from drakegrasp.core.validation import describe, plain_str, safe_norm
 from drakegrasp.errors import InvalidOptionError, SolverError
 
 __all__ = [
@@ -215,7 +215,8 @@ class GraspForceResult:
 
 
 def _check_objective(objective) -> str:
-    if not isinstance(objective, str) or objective not in OBJECTIVES:
+    objective = plain_str(objective)
+    if type(objective) is not str or objective not in OBJECTIVES:
         raise InvalidOptionError(
             f"objective must be one of {OBJECTIVES}, got {describe(objective)}"
         )

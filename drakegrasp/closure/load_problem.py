@@ -60,6 +60,7 @@ from drakegrasp.core.validation import check_grasp as _check_grasp
 from drakegrasp.core.validation import (
     check_num_generators,
     describe,
+    plain_str,
     real_array,
     safe_norm,
 )
@@ -499,7 +500,8 @@ def check_direction(grasp: Grasp, direction, name: str = "direction") -> np.ndar
 
 
 def _check_cones(cones) -> str:
-    if not isinstance(cones, str) or cones not in CONES:
+    cones = plain_str(cones)
+    if type(cones) is not str or cones not in CONES:
         raise InvalidOptionError(f"cones must be one of {CONES}, got {describe(cones)}")
     return cones
 

@@ -61,6 +61,7 @@ from drakegrasp.core.validation import (
     check_grasp,
     check_rank_tol,
     describe,
+    plain_str,
 )
 from drakegrasp.errors import InvalidOptionError
 
@@ -130,7 +131,8 @@ def check_program_options(grasp: Grasp, rank_tol: float) -> float:
 
 
 def check_formulation(formulation: str) -> str:
-    if not isinstance(formulation, str) or formulation not in _FORMULATIONS:
+    formulation = plain_str(formulation)
+    if type(formulation) is not str or formulation not in _FORMULATIONS:
         raise InvalidOptionError(
             f"formulation must be one of {_FORMULATIONS}, got {describe(formulation)}"
         )

@@ -181,8 +181,13 @@ def plain_str(value):
 
     A user's ``str`` subclass passes an ``isinstance`` check, but its own
     ``__str__``, ``__format__`` or ``__fspath__`` may raise or lie where
-    pathlib, a message or Drake read it; ``str.__str__`` reads the characters
-    alone.  Anything that is not a ``str`` is returned unchanged.
+    pathlib, a message or Drake read it, and its ``==``, ``__hash__``,
+    ``strip`` or ``encode`` may raise or lie where a word or a name is
+    compared; ``str.__str__`` reads the characters alone.  Anything that is
+    not a ``str`` is returned unchanged, so ``type(x) is str`` afterwards
+    tells a string from an object whose ``__class__`` merely claims ``str``
+    (``isinstance`` believes the claim).  Read a user's word or name through
+    it once, where it enters, and use what it returns.
     """
     # type(), not isinstance(): a __class__ property can claim str, and
     # str.__str__ would then raise on what is no str at all.

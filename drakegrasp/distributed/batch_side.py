@@ -54,7 +54,12 @@ from drakegrasp.core.calls import checked_call, unknown_names
 from drakegrasp.core.contact import ContactModel
 from drakegrasp.core.deprecation import keyword_only
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, DEFAULT_TOL
-from drakegrasp.core.validation import check_num_generators, describe, path_text
+from drakegrasp.core.validation import (
+    check_num_generators,
+    describe,
+    path_text,
+    plain_str,
+)
 from drakegrasp.distributed.client import connected, results_or_cancel
 from drakegrasp.distributed.dataset import (
     job_manifest,
@@ -221,7 +226,8 @@ def evaluate_on_cluster(
         (:func:`~drakegrasp.batch.metrics.check_moment_arms_of_batch`), before
         connecting; other faults of the input come from the partitions.
     """
-    if not isinstance(kind, str) or kind not in ("force", "form"):
+    kind = plain_str(kind)
+    if type(kind) is not str or kind not in ("force", "form"):
         raise InvalidOptionError(
             f"kind must be 'force' or 'form', got {describe(kind)}"
         )

@@ -35,7 +35,7 @@ import numpy as np
 from drakegrasp.core.calls import checked_call, unknown_names
 from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, plain_str
 from drakegrasp.errors import (
     GraspWarning,
     InvalidGraspError,
@@ -336,7 +336,8 @@ def check_settings(top, held_from, options: dict) -> dict:
         As :func:`shake_candidates` raises it for its settings.
     """
     _checked_top(top)
-    if not isinstance(held_from, str) or held_from not in HELD_FROM:
+    held_from = plain_str(held_from)
+    if type(held_from) is not str or held_from not in HELD_FROM:
         raise InvalidOptionError(
             f"held_from must be one of {', '.join(HELD_FROM)}, got "
             f"{describe(held_from)}"
@@ -441,6 +442,7 @@ def shake_candidates(
             "add_models must be a function add_models(plant, parser) -> (hand, "
             f"object_body), got {type(add_models).__name__}"
         )
+    held_from = plain_str(held_from)  # compared below: its own == may lie
     settings = check_settings(top, held_from, options)
     chosen = _first_candidates(
         candidates, int(top), at_contacts=settings["squeeze"] is None

@@ -88,6 +88,7 @@ from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS
 from drakegrasp.core.validation import (
     check_num_generators,
     describe,
+    plain_str,
     real_array,
     unit_vectors,
 )
@@ -477,7 +478,8 @@ def weight_capacity(
     torque_scale = checked_torque_scale(torque_scale, positions)
     directions = checked_directions("directions", directions)
     num_generators = check_num_generators(num_generators)
-    if not isinstance(solver, str) or solver not in ("batch", "drake"):
+    solver = plain_str(solver)
+    if type(solver) is not str or solver not in ("batch", "drake"):
         raise InvalidOptionError(
             f"solver must be 'batch' or 'drake', got {describe(solver)}"
         )

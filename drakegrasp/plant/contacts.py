@@ -67,6 +67,7 @@ from drakegrasp.core.validation import (
     describe,
     integer_or_none,
     items_of,
+    plain_str,
 )
 from drakegrasp.errors import (
     InvalidContactError,
@@ -470,7 +471,8 @@ def find_contacts(
     plant_context = plant_context_of(plant, plant_context)
     tol = check_distance_tolerance(distance_tolerance)
     allow_penetration = check_flag("allow_penetration", allow_penetration)
-    if not isinstance(patches, str) or patches not in ("vertices", "witness"):
+    patches = plain_str(patches)
+    if type(patches) is not str or patches not in ("vertices", "witness"):
         raise InvalidOptionError(
             f"patches must be 'vertices' or 'witness', got {describe(patches)}"
         )

@@ -57,7 +57,7 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.files import MISSING, not_a_file
 from drakegrasp.core.tolerances import COUPLING_TOL
 from drakegrasp.core.validation import describe, path_text, plain_str
-from drakegrasp.errors import InvalidOptionError, ModelError
+from drakegrasp.errors import InvalidOptionError, ModelError, type_name
 from drakegrasp.plant.fingers import (
     chain_root,
     coupling_entries,
@@ -406,23 +406,23 @@ def add_models(
             "file_name", file_name, must="a string or a path (an os.PathLike)"
         )
     if url is not None:
-        if not isinstance(url, str):  # no path: a URL
+        if not issubclass(type(url), str):  # no path: a URL
             raise InvalidOptionError(
                 f"url must be a string, got {describe(url)} ({type(url).__name__})"
             )
         url = path_text("url", url, must="a string")
-    if text is not None and not isinstance(text, str):
-        raise InvalidOptionError(
-            f"text must be a string, got {describe(text)} ({type(text).__name__})"
-        )
     text = plain_str(text)
+    if text is not None and type(text) is not str:
+        raise InvalidOptionError(
+            f"text must be a string, got {describe(text)} ({type_name(text)})"
+        )
     plant = parser.plant()
     if text is not None:
-        if not isinstance(kind, str) or kind not in ("urdf", "sdf"):
+        kind = plain_str(kind)
+        if type(kind) is not str or kind not in ("urdf", "sdf"):
             raise InvalidOptionError(
                 f"text needs kind='urdf' or 'sdf', got {describe(kind)}"
             )
-        kind = plain_str(kind)
         resolve = model_resolver(parser.package_map(), Path.cwd())
         check_joint_limits(text, kind, "the model text", resolve=resolve)
         instances = load_models(

@@ -30,7 +30,7 @@ from pydrake.multibody.plant import (
     MultibodyPlant,
 )
 
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, plain_str
 from drakegrasp.errors import GraspWarning, InvalidOptionError, ModelError
 from drakegrasp.plant.handles import local_geometry_id
 from drakegrasp.plant.validation import (
@@ -121,7 +121,8 @@ def pair_friction(
 
 
 def _check_rule(rule) -> str:
-    if not isinstance(rule, str) or rule not in ("static", "dynamic"):
+    rule = plain_str(rule)
+    if type(rule) is not str or rule not in ("static", "dynamic"):
         raise InvalidOptionError(
             f"rule must be 'static', 'dynamic' or None, got {describe(rule)}"
         )

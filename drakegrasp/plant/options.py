@@ -37,6 +37,7 @@ from drakegrasp.core.validation import (
     check_num_generators,
     check_tol,
     describe,
+    plain_str,
     real_array,
     real_scalar,
 )
@@ -71,7 +72,8 @@ def check_plane(plane: Any) -> str | None:
     """
     if plane is None:
         return None
-    if not isinstance(plane, str) or plane not in PLANES:
+    plane = plain_str(plane)
+    if type(plane) is not str or plane not in PLANES:
         raise InvalidOptionError(
             f"plane must be one of {sorted(PLANES)} (object-frame axes) or "
             f"None, got {describe(plane)}"
@@ -196,8 +198,8 @@ class AnalysisOptions:
         def put(name: str, value: Any) -> None:
             object.__setattr__(self, name, value)
 
-        if isinstance(self.mu, str):
-            if self.mu != "plant":
+        if isinstance(self.mu, str):  # read as the plain str it holds, if any
+            if plain_str(self.mu) != "plant":
                 raise InvalidOptionError(
                     f"mu must be a number or 'plant', got {describe(self.mu)}"
                 )
@@ -234,7 +236,8 @@ class AnalysisOptions:
         )
         put("check_pose", check_flag("check_pose", self.check_pose))
         put("coupling_tolerance", _coupling_tolerance(self.coupling_tolerance))
-        if not isinstance(self.patches, str) or self.patches not in PATCH_MODES:
+        put("patches", plain_str(self.patches))
+        if type(self.patches) is not str or self.patches not in PATCH_MODES:
             raise InvalidOptionError(
                 f"patches must be one of {list(PATCH_MODES)}, got "
                 f"{describe(self.patches)}"
@@ -306,7 +309,8 @@ def _named_or_values(name: str, value: Any, word: str, *, limits: bool = False):
     real number is one limit for every actuator: ``x`` gives ``(x,)``, as
     ``[x]`` does.
     """
-    if value is None or (isinstance(value, str) and value == word):
+    value = plain_str(value)  # a str subclass's own __eq__ may raise or lie
+    if value is None or (type(value) is str and value == word):
         return None if value is None else word  # a plain str
     if isinstance(value, str):
         raise InvalidOptionError(

@@ -17,7 +17,7 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.friction_cone import friction_cone_generators
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.tolerances import DEFAULT_NUM_GENERATORS, L1_MAX_POINTS
-from drakegrasp.core.validation import check_num_generators, describe
+from drakegrasp.core.validation import check_num_generators, describe, plain_str
 from drakegrasp.errors import InvalidOptionError, SolverError
 from drakegrasp.quality._common import (
     RANK_TOL,
@@ -734,7 +734,8 @@ def ferrari_canny(
         Bad ``norm``, ``num_generators`` or ``torque_scale`` (see
         :func:`primitive_wrenches`), or a grasp past the limits above.
     """
-    if not isinstance(norm, str) or norm not in _NORMS:
+    norm = plain_str(norm)
+    if type(norm) is not str or norm not in _NORMS:
         raise InvalidOptionError(f"norm must be one of {_NORMS}, got {describe(norm)}")
     eps_1, eps_inf = _epsilons(
         grasp,

@@ -20,7 +20,7 @@ import numpy as np
 from drakegrasp.core.calls import checked_call
 from drakegrasp.core.serialize import jsonable
 from drakegrasp.core.tolerances import COUPLING_TOL, MONITOR_COUPLING_TOL
-from drakegrasp.core.validation import check_flag, describe, real_scalar
+from drakegrasp.core.validation import check_flag, describe, plain_str, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.plant.options import AnalysisOptions, resolve_options
 from drakegrasp.systems.holding import HoldingThresholds
@@ -143,7 +143,8 @@ def monitor_settings(
         ``release_distance`` or ``max_penetration`` at or below
         ``distance_tolerance``.
     """
-    if not isinstance(contacts, str) or contacts not in CONTACT_SOURCES:
+    contacts = plain_str(contacts)
+    if type(contacts) is not str or contacts not in CONTACT_SOURCES:
         raise InvalidOptionError(
             f"contacts must be one of {CONTACT_SOURCES}, got {describe(contacts)}"
         )

@@ -35,6 +35,7 @@ from drakegrasp.core.validation import (
     check_positions,
     describe,
     integer_or_none,
+    plain_str,
     real_array,
     real_scalar,
 )
@@ -237,7 +238,8 @@ def _twist_3d(
 ) -> tuple[np.ndarray, np.ndarray]:
     if x.size == 6:
         return x, p
-    if not isinstance(plane, str) or plane not in PLANES:
+    plane = plain_str(plane)
+    if type(plane) is not str or plane not in PLANES:
         raise InvalidOptionError(
             f"a planar escape twist needs its plane, one of {sorted(PLANES)}; "
             f"got {describe(plane)}"

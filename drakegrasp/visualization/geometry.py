@@ -43,6 +43,7 @@ from drakegrasp.core.validation import (
     describe,
     integer_or_none,
     items_of,
+    plain_str,
     real_array,
     real_scalar,
 )
@@ -120,7 +121,8 @@ def side_sign(side: str) -> float:
     InvalidOptionError
         If ``side`` is neither.
     """
-    if not isinstance(side, str) or side not in SIDES:
+    side = plain_str(side)
+    if type(side) is not str or side not in SIDES:
         raise InvalidOptionError(
             f"side must be 'outside' or 'inside', got {describe(side)}"
         )

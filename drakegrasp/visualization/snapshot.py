@@ -13,7 +13,7 @@ from __future__ import annotations
 from pydrake.geometry import Meshcat, Rgba, Role, SceneGraph
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.validation import describe, real_scalar
+from drakegrasp.core.validation import describe, plain_str, real_scalar
 from drakegrasp.errors import InvalidOptionError
 from drakegrasp.visualization.primitives import check_meshcat, check_path
 
@@ -78,7 +78,8 @@ def draw_scene_geometry(
             f"('scene_graph')), got {type(scene_graph).__name__}"
         )
     prefix = check_path("prefix", prefix)
-    if not isinstance(role, str) or role not in _ROLES:
+    role = plain_str(role)
+    if type(role) is not str or role not in _ROLES:
         raise InvalidOptionError(
             f"role must be one of {sorted(_ROLES)}, got {describe(role)}"
         )

@@ -45,7 +45,7 @@ from drakegrasp.core.tolerances import (
     DEFAULT_RANK_TOL,
     DEFAULT_TOL,
 )
-from drakegrasp.core.validation import check_flag, describe
+from drakegrasp.core.validation import check_flag, describe, plain_str
 from drakegrasp.errors import BatchFileError, InvalidOptionError
 
 __all__ = ["evaluate_file", "stream_file", "write_result"]
@@ -61,7 +61,8 @@ def _file_run(
     Returns ``(output, K, d, options, chunks)``, ``options`` the validated
     engine options (``tol``, ``metrics``, ...).
     """
-    if not isinstance(kind, str) or kind not in ("force", "form"):
+    kind = plain_str(kind)
+    if type(kind) is not str or kind not in ("force", "form"):
         raise InvalidOptionError(
             f"kind must be 'force' or 'form', got {describe(kind)}"
         )

@@ -130,11 +130,11 @@ def format_of(path: str | os.PathLike, fmt: str | None = None) -> str:
     path = as_path("path", path)
     suffix = path.suffix.lower().lstrip(".")
     if fmt is not None:
-        if not isinstance(fmt, str) or fmt not in FORMATS:
+        fmt = plain_str(fmt)
+        if type(fmt) is not str or fmt not in FORMATS:
             raise InvalidOptionError(
                 f"format must be one of {', '.join(FORMATS)}, got {describe(fmt)}"
             )
-        fmt = plain_str(fmt)
         if suffix in FORMATS and suffix != fmt:
             raise InvalidOptionError(
                 f"output file {str(path)!r} ends in .{suffix} but the format is "
@@ -333,7 +333,7 @@ def write_chunks(
     """
     path = as_path("path", path)
     fmt = format_of(path, fmt)
-    _check_meta(K, kind, tol, required_rank)
+    kind = _check_meta(K, kind, tol, required_rank)
     try:
         items = iter(chunks)
     except TypeError:
@@ -383,12 +383,16 @@ def _on_disk(path: Path, call, *args):
         ) from None
 
 
-def _check_meta(K, kind, tol, required_rank) -> None:
-    """Refuse what :func:`write_chunks` would store wrongly beside the arrays."""
+def _check_meta(K, kind, tol, required_rank) -> str:
+    """Refuse what :func:`write_chunks` would store wrongly beside the arrays.
+
+    Returns ``kind`` as the plain ``str`` it holds.
+    """
     n = integer_or_none(K)
     if n is None or n < 0:
         raise InvalidOptionError(f"K must be an integer >= 0, got {describe(K)}")
-    if not isinstance(kind, str) or kind not in ("force", "form"):
+    kind = plain_str(kind)
+    if type(kind) is not str or kind not in ("force", "form"):
         raise InvalidOptionError(
             f"kind must be 'force' or 'form', got {describe(kind)}"
         )
@@ -397,6 +401,7 @@ def _check_meta(K, kind, tol, required_rank) -> None:
         raise InvalidOptionError(
             f"required_rank must be an integer, got {describe(required_rank)}"
         )
+    return kind
 
 
 def _chunk(item) -> tuple[slice, dict]:
