@@ -68,7 +68,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import RigidBody
 
 from drakegrasp.core.calls import checked_call
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, plain_str
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.planning.centring import chain_sides
 from drakegrasp.planning.gripper import free_base, palm_geometries
@@ -491,7 +491,9 @@ def multi_finger_hand(
     # a finger is a kinematic chain, though a <mimic> closes two as one
     chains = finger_chains(plant, structure)
     n = len(structure.names)
-    opened = isinstance(preshape, str)
+    # each read once as the plain str it holds: a subclass's == may raise or lie
+    preshape, synergy = plain_str(preshape), plain_str(synergy)
+    opened = type(preshape) is str
     if opened and preshape != OPEN:
         raise InvalidOptionError(
             f"preshape must be n_h = {n} numbers or {OPEN!r}, got {describe(preshape)}"
@@ -505,7 +507,7 @@ def multi_finger_hand(
         q0 = structure.coupling.apply(given)
         _check_preshape_couplings(given, q0, structure)
     q0 = structure.coupling.apply(np.clip(q0, structure.lower, structure.upper))
-    curl_synergy = isinstance(synergy, str)
+    curl_synergy = type(synergy) is str
     if curl_synergy and synergy != "curl":
         raise InvalidOptionError(
             f"synergy must be n_h = {n} numbers or 'curl', got {describe(synergy)}"

@@ -28,7 +28,7 @@ from drakegrasp.core.calls import checked_call
 from drakegrasp.core.contact import Contact
 from drakegrasp.core.grasp import Grasp
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import real_array, real_scalar
+from drakegrasp.core.validation import describe, plain_str, real_array, real_scalar
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.planning.needed import needed_text, per_motor
 from drakegrasp.planning.opposition import push_text
@@ -280,6 +280,12 @@ class GraspCandidate:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "motors", _checked_motors(self.motors))
+        # joint names, each read once as the plain str it holds: they are
+        # hashed and compared, where a subclass's own methods may raise or lie
+        object.__setattr__(self, "joint_names", _plain_names(self.joint_names))
+        object.__setattr__(
+            self, "held_joints", _plain_names(self.held_joints, pairs=True)
+        )
 
     def __getstate__(self) -> dict:
         # ``grasp`` (a cached_property, in __dict__ once read) is rebuilt from
@@ -504,14 +510,37 @@ def _held_joints(plant, held_joints) -> list:
             joint = None
         if joint is None or joint.num_positions() != 1:
             raise ModelError(
-                f"the candidate's held joint {name!r} is not a one-dof joint of "
-                "this plant (held_joints records the hand's other joints as "
+                f"the candidate's held joint {describe(name)} is not a one-dof joint "
+                "of this plant (held_joints records the hand's other joints as "
                 "planned): apply the candidate to the hand it was planned with, "
                 "or leave them as this plant has them: "
                 "dataclasses.replace(candidate, held_joints=())"
             )
         out.append((joint, float(q)))
     return out
+
+
+def _plain_names(items, *, pairs: bool = False):
+    """``items`` (a tuple or list) with its names read as plain ``str`` s.
+
+    Each item, or with ``pairs`` the first of each ``(name, value)`` pair, is
+    read as the plain ``str`` it holds when it is a ``str``.  Anything else is
+    returned as it is, for the checks that refuse it.
+    """
+    if not isinstance(items, tuple | list):
+        return items
+    try:
+        if pairs:
+            plain = [
+                (plain_str(p[0]), p[1]) if type(p) in (tuple, list) and len(p) == 2
+                else p
+                for p in items
+            ]  # fmt: skip
+        else:
+            plain = [plain_str(item) for item in items]
+    except Exception:  # noqa: BLE001 - a hostile sequence: its checks refuse it
+        return items
+    return tuple(plain) if isinstance(items, tuple) else plain
 
 
 def _named_pairs(held) -> bool:
@@ -543,7 +572,7 @@ def _held_values(k: int, candidate: GraspCandidate) -> dict[str, float]:
             values[name] = real_scalar(name, value, error=InvalidGraspError)
         except InvalidGraspError:
             raise InvalidGraspError(
-                f"candidate {k}'s held joint {name!r} has the value "
+                f"candidate {k}'s held joint {describe(name)} has the value "
                 f"{reprlib.repr(value)}, not a real number (metres or radians)"
             ) from None
     return values
@@ -558,18 +587,19 @@ def _checked_motors(motors) -> tuple[str, ...]:
         Not a tuple or list of str (a string would count its letters), or a
         name twice.
     """
-    if not isinstance(motors, tuple | list) or not all(
-        isinstance(name, str) for name in motors
+    names = _plain_names(motors)  # hashed below: a subclass's __hash__ may raise
+    if not isinstance(names, tuple | list) or not all(
+        type(name) is str for name in names
     ):
         raise InvalidGraspError(
             "the candidate's motors must be a tuple of joint names, got "
             f"{reprlib.repr(motors)}"
         )
-    if len(set(motors)) != len(motors):
+    if len(set(names)) != len(names):
         raise InvalidGraspError(
-            f"the candidate's motors name a joint twice: {reprlib.repr(motors)}"
+            f"the candidate's motors name a joint twice: {reprlib.repr(names)}"
         )
-    return tuple(motors)
+    return tuple(names)
 
 
 def _finite_number(value) -> bool:

@@ -868,7 +868,7 @@ def _is_default(value, default) -> bool:
         return value is default
     try:
         return bool(np.array_equal(np.asarray(value, float), np.asarray(default)))
-    except (TypeError, ValueError):
+    except Exception:  # noqa: BLE001 - unreadable (a raising dunder): not the default
         return False
 
 

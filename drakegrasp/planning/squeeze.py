@@ -48,7 +48,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import DiagramBuilder
 
-from drakegrasp.core.validation import describe
+from drakegrasp.core.validation import describe, plain_str
 from drakegrasp.errors import InvalidGraspError, InvalidOptionError, ModelError
 from drakegrasp.plant.couplings import coupling_map
 from drakegrasp.plant.fingers import find_joint
@@ -280,13 +280,13 @@ def checked_contacts(candidate) -> list[tuple[str, np.ndarray, np.ndarray]]:
     out = []
     for k, pc in enumerate(contacts):
         try:
-            name = pc.finger_body
+            name = plain_str(pc.finger_body)  # a key: its own __hash__ may lie
             p = np.asarray(pc.p_OC, dtype=float)
             n = np.asarray(pc.nhat_O, dtype=float)
         except (AttributeError, TypeError, ValueError):
             name, p, n = None, np.zeros(0), np.zeros(0)
         if not (
-            isinstance(name, str)
+            type(name) is str
             and p.shape == n.shape == (3,)
             and np.all(np.isfinite(p))
             and np.all(np.isfinite(n))

@@ -42,7 +42,7 @@ from pydrake.geometry import Role
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, Joint, JointIndex, RigidBody
 
-from drakegrasp.core.validation import describe, items_of
+from drakegrasp.core.validation import describe, items_of, plain_str
 from drakegrasp.errors import InvalidOptionError, ModelError
 from drakegrasp.plant.validation import scoped_name
 
@@ -250,8 +250,9 @@ def find_joint(plant: MultibodyPlant, spec) -> Joint:
     """The joint ``spec`` names: a Joint of ``plant``, or ``"model::joint"``."""
     if isinstance(spec, Joint) and spec.GetParentPlant() is plant:
         return spec
-    if isinstance(spec, str):
-        model, _, name = spec.rpartition("::")
+    text = plain_str(spec)  # compared in Python: a subclass's methods may lie
+    if type(text) is str:
+        model, _, name = text.rpartition("::")
         for i in range(plant.num_joints()):
             j = plant.get_joint(JointIndex(i))
             if j.name() == name and (

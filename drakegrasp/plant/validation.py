@@ -42,6 +42,7 @@ from drakegrasp.errors import (
     InvalidOptionError,
     InvalidPoseError,
     ModelError,
+    type_name,
 )
 from drakegrasp.plant.attachment import joined
 
@@ -481,7 +482,7 @@ def model_instance(
     InvalidOptionError
         For a ``spec`` that is neither an index nor a name.
     """
-    if isinstance(spec, str):
+    if issubclass(type(spec), str):  # not isinstance: __class__ may claim str
         spec = plain_str(spec)
         if not _drake_name(spec) or not plant.HasModelInstanceNamed(spec):
             raise error(
@@ -543,12 +544,12 @@ def resolve_body(plant: MultibodyPlant, name: str) -> RigidBody:
     InvalidOptionError
         If ``name`` is not a string.
     """
-    if not isinstance(name, str):
+    name = plain_str(name)
+    if type(name) is not str:
         raise InvalidOptionError(
             "a body name must be a string such as 'model::body', got a "
-            f"{type(name).__name__}"
+            f"{type_name(name)}"
         )
-    name = plain_str(name)
     try:
         if not _drake_name(name):
             pass  # no body has it: refused below with the plant's bodies
@@ -798,7 +799,8 @@ def hand_bodies(
     """
     check_plant(plant, finalized=False)  # a plant being built is read too
     object_body = resolve_object_body(plant, object_body)
-    if isinstance(hand, str | ModelInstanceIndex) or hand is None:
+    hand = plain_str(hand)  # a key of the memo: its own __hash__ may raise or lie
+    if type(hand) is str or isinstance(hand, ModelInstanceIndex) or hand is None:
         obj = (int(object_body.index()), int(object_body.model_instance()))
         spec = ("index", int(hand)) if isinstance(hand, ModelInstanceIndex) else hand
         key = ("hand bodies", obj, spec)
@@ -855,7 +857,7 @@ def _hand_repr(plant: MultibodyPlant, hand) -> str:
     if isinstance(hand, ModelInstanceIndex):
         return repr(plant.GetModelInstanceName(hand))
     if isinstance(hand, str) or hand is None:
-        return repr(hand)
+        return describe(hand)
     return repr(
         [scoped_name(plant, b) if isinstance(b, RigidBody) else b for b in hand]
     )
@@ -1017,6 +1019,7 @@ def hand_contact_bodies(
         For an unknown instance or body, or a hand with no body at all.
     """
     obj = int(object_body.index())
+    hand = plain_str(hand)  # its own methods may raise or lie
     if hand is None:
         movable = hand_bodies(plant, object_body, None)
         return hand_model_instances(plant, movable, object_body)
