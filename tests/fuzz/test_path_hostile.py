@@ -324,6 +324,89 @@ def test_the_command_refuses_a_path_of_a_long_name_on_one_line(
     assert len(err) <= SHORT, f"a {len(err)}-character refusal"
 
 
+UNDECODABLE = os.fsdecode(b"\xff\xfe")
+"""Bytes no UTF-8 decodes, as Python hands them to ``main`` in ``sys.argv``
+(``surrogateescape``: lone surrogates U+DCFF U+DCFE)."""
+
+
+@pytest.fixture(scope="module")
+def gripper(tmp_path_factory):
+    """A multi-finger hand's model file (two hinged jaws): --preshape reads it."""
+    from coupled_hands import angular_gripper_urdf
+
+    path = tmp_path_factory.mktemp("hand") / "angular_gripper.urdf"
+    path.write_text(angular_gripper_urdf())
+    return str(path)
+
+
+def _undecodable_argvs(gripper: str) -> dict:
+    b = UNDECODABLE
+    plan = ["plan", "box", "--num", "2"]
+    return {
+        "batch-in": ["batch", f"{b}.npz", "out.npz", "--mu", "0.5"],
+        "batch-out-folder": ["batch", "in.npz", f"{b}/out.npz", "--mu", "0.5"],
+        "analyze-scene": ["analyze", f"{b}.yaml"],
+        "analyze-name": ["analyze", b],
+        "analyze-package": ["analyze", "--package", f"mine=/tmp/{b}"],
+        "plan-object": ["plan", f"{b}.sdf", "--num", "2"],
+        "plan-object-name": ["plan", b, "--num", "2"],
+        "plan-hand-file": [*plan, "--hand", f"{b}.urdf"],
+        "plan-hand-name": [*plan, "--hand", b],
+        "plan-preshape-joint": [*plan, "--hand", gripper, "--preshape", f"{b}=0.1"],
+        "plan-preshape-surrogate": [
+            *plan, "--hand", gripper, "--preshape", "\ud800=0.1"
+        ],
+        "plan-preshape-word": [*plan, "--hand", gripper, "--preshape", b],
+        "plan-scene-out": [*plan, "--scene-out", f"{b}/x.yaml"],
+    }  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        "batch-in", "batch-out-folder", "analyze-scene", "analyze-name",
+        "analyze-package", "plan-object", "plan-object-name", "plan-hand-file",
+        "plan-hand-name", "plan-preshape-joint", "plan-preshape-surrogate",
+        "plan-preshape-word", "plan-scene-out",
+    ],
+)  # fmt: skip
+def test_the_command_refuses_undecodable_bytes_on_one_line(
+    case, gripper, capsys, files, monkeypatch
+):
+    # These gave a one-line refusal when probed by hand; now they are fuzzed.
+    monkeypatch.chdir(files[0])
+    argv = _undecodable_argvs(gripper)[case]
+    try:
+        status = cli.main(argv)
+    except SystemExit as exit_:  # argparse's own refusals
+        status = exit_.code
+    err = capsys.readouterr().err
+    assert status != 0
+    assert err.count("\n") == 1, err[:300]
+    assert err.startswith("drakegrasp") and "unexpected" not in err, err[:300]
+    assert len(err) <= SHORT, f"a {len(err)}-character refusal"
+
+
+def test_a_batch_output_of_undecodable_bytes_is_written_under_that_name(
+    files, tmp_path
+):
+    # Not an error: the bytes are a file name the file system takes.  Run as a
+    # user runs it, argv given as bytes, stdout and stderr pipes.
+    import subprocess
+
+    name = os.fsencode(tmp_path) + b"/\xff\xfe.npz"
+    done = subprocess.run(
+        [sys.executable, "-m", "drakegrasp", "batch", str(files[1]), name],
+        capture_output=True, timeout=300,
+        env={**os.environ, "PYTHONPATH": str(Path(cli.__file__).parents[1])},
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-500:]
+    assert b"Traceback" not in done.stderr
+    assert [p.name for p in tmp_path.iterdir()] == [os.fsdecode(b"\xff\xfe.npz")]
+    with np.load(os.fsdecode(name)) as written:
+        assert written["is_closure"].tolist() == [True]
+
+
 def test_the_command_names_a_drake_models_variable_of_a_long_name(capsys, monkeypatch):
     # _cli_words asked pathlib whether the folder holds the model, inside the
     # handler of the first error: a name too long raised OSError there.
