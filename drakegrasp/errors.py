@@ -83,6 +83,16 @@ class GraspWarning(UserWarning):
         super().__init__(*_cut_args(args))
 
 
+class KernelsVariableWarning(GraspWarning):
+    """``DRAKEGRASP_KERNELS`` holds neither ``auto`` nor ``jit`` (a misspelling).
+
+    The batch kernels then run through numba's JIT, which may compile for tens
+    of seconds where the ahead-of-time kernels would have loaded at once
+    (:mod:`drakegrasp.batch.aot`).  Said once per process, when a batch
+    kernel first looks for its ahead-of-time entry.
+    """
+
+
 class InvalidContactError(GraspError, ValueError):
     """A contact, or a set of contacts, is not well formed.
 

@@ -35,7 +35,6 @@ import importlib.util
 import json
 import os
 import threading
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -51,6 +50,7 @@ __all__ = [
     "export_name",
     "host_cpu",
     "lookup",
+    "misspelt",
     "parse_signature",
     "source_digest",
     "status",
@@ -198,14 +198,17 @@ _state: dict = {}
 
 
 def _load() -> tuple[object | None, str]:
-    """The extension module if usable, and a sentence saying which route runs."""
+    """The extension module if usable, and a sentence saying which route runs.
+
+    A misspelt :data:`ENV` is recorded (:func:`misspelt`), not warned about
+    here: this module imports nothing of drakegrasp, so
+    :mod:`drakegrasp.batch.compiled` says it, once per process, as a
+    :class:`~drakegrasp.KernelsVariableWarning`.
+    """
     choice = os.environ.get(ENV, "auto").strip().lower() or "auto"
     if choice not in ("auto", "jit"):
-        status = f"{ENV}={choice!r} is not 'auto' or 'jit'; numba's JIT runs"
-        # said once per process: a misspelt value would otherwise cost the
-        # compile (tens of seconds) without a word
-        warnings.warn(status, RuntimeWarning, stacklevel=4)
-        return None, status
+        _state["misspelt"] = True
+        return None, f"{ENV}={choice!r} is not 'auto' or 'jit'; numba's JIT runs"
     if choice == "jit":
         return None, f"{ENV}=jit: numba's JIT runs"
     try:
@@ -244,6 +247,15 @@ def status() -> str:
     """Which route the batch kernels take in this process, and why."""
     _module()
     return _state["status"]
+
+
+def misspelt() -> bool:
+    """Whether :data:`ENV` held neither ``auto`` nor ``jit`` when it was read.
+
+    It is read once per process (with the route, :func:`status`).
+    """
+    _module()
+    return _state.get("misspelt", False)
 
 
 def _reset() -> None:

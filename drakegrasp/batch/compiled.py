@@ -41,7 +41,7 @@ import time
 import warnings
 
 from drakegrasp.batch import aot
-from drakegrasp.errors import GraspWarning
+from drakegrasp.errors import GraspWarning, KernelsVariableWarning
 
 __all__ = [
     "FASTMATH",
@@ -50,6 +50,7 @@ __all__ = [
     "Kernel",
     "NumbaMissingWarning",
     "announce_numpy_route",
+    "announce_misspelt_kernels",
     "compile_count",
     "kernels",
     "njit",
@@ -98,6 +99,30 @@ def announce_numpy_route() -> None:
         NumbaMissingWarning,
         stacklevel=3,
     )
+
+
+_misspelling_said = False
+
+
+def announce_misspelt_kernels() -> None:
+    """Warn, once per process, that ``DRAKEGRASP_KERNELS`` is misspelt.
+
+    :mod:`drakegrasp.batch.aot` records the misspelling where it reads the
+    variable (it imports nothing of drakegrasp); this says it as a
+    :class:`~drakegrasp.KernelsVariableWarning` with aot's status sentence.
+    Called where a kernel first looks for its ahead-of-time entry; later
+    calls return at once.
+    """
+    global _misspelling_said
+    if _misspelling_said or not aot.misspelt():
+        return
+    with _announce_lock:
+        if _misspelling_said:
+            return
+        _misspelling_said = True
+    # a misspelt value would otherwise cost the compile (tens of seconds)
+    # without a word
+    warnings.warn(aot.status(), KernelsVariableWarning, stacklevel=4)
 
 
 class _CompileNotice:
@@ -284,6 +309,7 @@ class Kernel:
         """The ahead-of-time compiled function, or None (the JIT runs)."""
         if self._aot is _MISSING:
             self._aot = aot.lookup(self.key)
+            announce_misspelt_kernels()
         return self._aot
 
     def __call__(self, *args):

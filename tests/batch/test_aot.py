@@ -13,6 +13,7 @@ import os
 import shutil
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -161,14 +162,73 @@ def test_jit_is_forced_by_the_environment(monkeypatch):
     aot._reset()
     try:
         assert aot.lookup("drakegrasp.batch.epsilon.kernel._stack") is None
-        assert "JIT" in aot.status()
+        assert "JIT" in aot.status() and not aot.misspelt()
         monkeypatch.setenv(aot.ENV, "fast")
         aot._reset()
-        with pytest.warns(RuntimeWarning, match="'fast' is not 'auto' or 'jit'"):
-            assert "not 'auto' or 'jit'" in aot.status()
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # aot records it; compiled says it
+            assert "'fast' is not 'auto' or 'jit'" in aot.status()
+        assert aot.misspelt()
     finally:
         monkeypatch.delenv(aot.ENV)
         aot._reset()
+
+
+def test_a_misspelt_variable_is_a_grasp_warning_said_once(monkeypatch):
+    monkeypatch.setenv(aot.ENV, "fast")
+    monkeypatch.setattr(compiled, "_misspelling_said", False)
+    aot._reset()
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for _ in range(3):
+                compiled.announce_misspelt_kernels()
+    finally:
+        monkeypatch.delenv(aot.ENV)
+        aot._reset()
+    assert [w.category for w in caught] == [dg.KernelsVariableWarning]
+    assert issubclass(dg.KernelsVariableWarning, dg.GraspWarning)
+    assert str(caught[0].message) == (
+        "DRAKEGRASP_KERNELS='fast' is not 'auto' or 'jit'; numba's JIT runs"
+    )
+
+
+_MISSPELT = r"""
+import json, warnings
+import numpy as np
+import drakegrasp as dg
+from drakegrasp.batch import batch_force_closure
+rng = np.random.default_rng(3)
+p = rng.normal(size=(40, 3, 3)); n = -p + 0.3 * rng.normal(size=(40, 3, 3))
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    a = batch_force_closure(p, n, 0.5, workers=1)
+    b = batch_force_closure(p, n, 0.5, workers=1)
+said = [w for w in caught if issubclass(w.category, dg.GraspWarning)]
+print(json.dumps({
+    "said": [(w.category.__name__, str(w.message)) for w in said],
+    "same": a.is_closure.tolist() == b.is_closure.tolist(),
+}))
+"""
+
+
+def test_a_misspelt_variable_is_said_once_in_a_process_that_runs_kernels(
+    checkout_env,
+):
+    # aot imports nothing of drakegrasp; the engine's kernels say it for it
+    env = dict(checkout_env, **{aot.ENV: "fast"})
+    out = subprocess.run(
+        [sys.executable, "-c", _MISSPELT],
+        env=env, capture_output=True, text=True, timeout=600, check=True,
+    )  # fmt: skip
+    said = json.loads(out.stdout)
+    assert said["same"]
+    assert said["said"] == [
+        [
+            "KernelsVariableWarning",
+            "DRAKEGRASP_KERNELS='fast' is not 'auto' or 'jit'; numba's JIT runs",
+        ]
+    ]
 
 
 # -- a real build ------------------------------------------------------------------
