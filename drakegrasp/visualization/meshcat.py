@@ -39,6 +39,7 @@ from drakegrasp.core.validation import (
     check_flag,
     check_num_generators,
     describe,
+    plain_str,
     safe_norm,
 )
 from drakegrasp.errors import InvalidOptionError
@@ -291,7 +292,8 @@ def draw_grasp(
             f"draw_grasp needs a drakegrasp.Grasp, got {type(grasp).__name__}"
         )
     _check_rgba_colors(colors)
-    if not isinstance(cone, (str, type(None))) or cone not in _CONE_CHOICES:
+    cone = plain_str(cone)  # compared below: a subclass's own == may raise or lie
+    if not (cone is None or type(cone) is str) or cone not in _CONE_CHOICES:
         raise InvalidOptionError(
             f"cone must be 'exact', 'pyramid', 'both' or None, got {describe(cone)}"
         )

@@ -61,6 +61,13 @@ def _grasp():
     return dg.core.examples.equator_fingers(0.5)
 
 
+class _Meshcat:
+    """Takes every Meshcat call and does nothing (no server, no port)."""
+
+    def __getattr__(self, name):
+        return lambda *args, **kwargs: None
+
+
 def _batch_kind(kind):
     g = _grasp()
     chunk = (g.positions[None], g.normals[None])
@@ -86,6 +93,12 @@ WORDS = [
         lambda v: check_kind_and_cones(v, "exact", ("force", "form"), ("exact",)),
         "form",
         "force",
+    ),
+    (
+        "cone",
+        lambda v: dg.visualization.draw_grasp(_Meshcat(), _grasp(), cone=v).paths,
+        "pyramid",
+        "exact",
     ),
 ]
 WORD_IDS = [f"{name}-{i}" for i, (name, *_) in enumerate(WORDS)]
