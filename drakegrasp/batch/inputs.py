@@ -300,7 +300,7 @@ def check_kernel(kernel: str) -> str:
 
 def resolve_kernel(kernel: str) -> str:
     """``kernel`` checked, and ``"auto"`` resolved to ``"numba"`` or ``"numpy"``."""
-    check_kernel(kernel)
+    kernel = check_kernel(kernel)  # the plain str: a subclass's == may lie
     if kernel == "numba":
         if not numba_available():
             raise InvalidOptionError(

@@ -131,6 +131,15 @@ def check_program_options(grasp: Grasp, rank_tol: float) -> float:
 
 
 def check_formulation(formulation: str) -> str:
+    """``formulation`` as the plain ``str`` it holds, if it is a known one.
+
+    Callers use what it returns: a ``str`` subclass's own ``==`` may lie.
+
+    Raises
+    ------
+    InvalidOptionError
+        Unless ``formulation`` holds one of ``"facets"``, ``"generators"``.
+    """
     formulation = plain_str(formulation)
     if type(formulation) is not str or formulation not in _FORMULATIONS:
         raise InvalidOptionError(
@@ -431,7 +440,7 @@ def build_force_closure_program(
         ``forces`` cover the components the cones allow (see ``columns``).
     """
     rank_tol = check_program_options(grasp, rank_tol)
-    check_formulation(formulation)
+    formulation = check_formulation(formulation)  # the plain str it holds
     layout = cone_layout(grasp, num_generators)
     N = grasp.num_contacts
     if formulation == "facets":

@@ -443,7 +443,7 @@ def force_closure(
     """
     rank_tol = check_program_options(grasp, rank_tol)
     tol = check_tol(tol)
-    check_formulation(formulation)
+    formulation = check_formulation(formulation)  # the plain str it holds
 
     def build():
         prog, variables = build_force_closure_program(

@@ -27,10 +27,11 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 import drakegrasp as dg
-from drakegrasp.batch.api import iter_batch_closure
+from drakegrasp.batch.api import batch_force_closure, iter_batch_closure
 from drakegrasp.batch.files.writer import format_of
+from drakegrasp.batch.inputs import resolve_kernel
 from drakegrasp.certificates.kinds import check_kind_and_cones
-from drakegrasp.closure.programs import check_formulation
+from drakegrasp.closure.programs import build_force_closure_program, check_formulation
 from drakegrasp.planning import plan_grasps, planning_scene
 from drakegrasp.planning.approach import OPEN
 from drakegrasp.planning.candidates import GraspCandidate
@@ -68,6 +69,13 @@ class _Meshcat:
         return lambda *args, **kwargs: None
 
 
+def _batch_kernel(kernel):
+    g = _grasp()
+    return batch_force_closure(
+        g.positions[None], g.normals[None], mu=0.5, kernel=kernel
+    ).is_closure.tolist()
+
+
 def _batch_kind(kind):
     g = _grasp()
     chunk = (g.positions[None], g.normals[None])
@@ -88,6 +96,21 @@ WORDS = [
     ("norm", lambda v: dg.ferrari_canny(_grasp(), norm=v), "Linf", "L1"),
     ("kind", _batch_kind, "form", None),  # "force" takes mu, "form" refuses it
     ("formulation", check_formulation, "generators", "facets"),
+    # the callers of the checks above: each must use what its check returns
+    (
+        "formulation",
+        lambda v: dg.force_closure(_grasp(), formulation=v).formulation,
+        "generators",
+        "facets",
+    ),
+    (
+        "formulation",
+        lambda v: build_force_closure_program(_grasp(), formulation=v)[0].num_vars(),
+        "generators",
+        "facets",
+    ),
+    ("kernel", resolve_kernel, "numpy", "auto"),
+    ("kernel", _batch_kernel, "numpy", None),
     (
         "kind",
         lambda v: check_kind_and_cones(v, "exact", ("force", "form"), ("exact",)),
