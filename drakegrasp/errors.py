@@ -88,8 +88,9 @@ class KernelsVariableWarning(GraspWarning):
 
     The batch kernels then run through numba's JIT, which may compile for tens
     of seconds where the ahead-of-time kernels would have loaded at once
-    (:mod:`drakegrasp.batch.aot`).  Said once per process, when a batch
-    kernel first looks for its ahead-of-time entry.
+    (:mod:`drakegrasp.batch.aot`).  Said once per process, at the caller's
+    line, when a batch call first chooses numba's route (before any worker
+    process runs) or a kernel first looks for its ahead-of-time entry.
     """
 
 

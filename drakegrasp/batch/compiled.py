@@ -110,8 +110,11 @@ def announce_misspelt_kernels() -> None:
     :mod:`drakegrasp.batch.aot` records the misspelling where it reads the
     variable (it imports nothing of drakegrasp); this says it as a
     :class:`~drakegrasp.KernelsVariableWarning` with aot's status sentence.
-    Called where a kernel first looks for its ahead-of-time entry; later
-    calls return at once.
+    Called where the batch engine resolves its kernel (in the caller's
+    process and thread, before any worker runs a chunk: a worker's warning
+    would never reach the caller's filters) and where a kernel first looks
+    for its ahead-of-time entry; later calls return at once.  The warning
+    points at the caller's own line, the first frame outside drakegrasp.
     """
     global _misspelling_said
     if _misspelling_said or not aot.misspelt():
@@ -122,7 +125,22 @@ def announce_misspelt_kernels() -> None:
         _misspelling_said = True
     # a misspelt value would otherwise cost the compile (tens of seconds)
     # without a word
-    warnings.warn(aot.status(), KernelsVariableWarning, stacklevel=4)
+    warnings.warn(aot.status(), KernelsVariableWarning, stacklevel=_outside_level())
+
+
+def _outside_level() -> int:
+    """``warnings.warn``'s ``stacklevel`` for the first frame outside drakegrasp.
+
+    Counted from the caller of this function, as
+    :func:`drakegrasp.core.deprecation.outside_stacklevel` counts; not imported
+    from there, which would lengthen the package's longest import chain.
+    """
+    level, frame = 1, sys._getframe(1)
+    while frame is not None and (
+        frame.f_globals.get("__name__", "").split(".")[0] == "drakegrasp"
+    ):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 class _CompileNotice:

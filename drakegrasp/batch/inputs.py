@@ -299,19 +299,26 @@ def check_kernel(kernel: str) -> str:
 
 
 def resolve_kernel(kernel: str) -> str:
-    """``kernel`` checked, and ``"auto"`` resolved to ``"numba"`` or ``"numpy"``."""
+    """``kernel`` checked, and ``"auto"`` resolved to ``"numba"`` or ``"numpy"``.
+
+    A misspelt ``DRAKEGRASP_KERNELS`` is said here, where the numba route is
+    chosen in the caller's process, not where a worker process first runs a
+    kernel (:func:`~drakegrasp.batch.compiled.announce_misspelt_kernels`).
+    """
     kernel = check_kernel(kernel)  # the plain str: a subclass's == may lie
-    if kernel == "numba":
-        if not numba_available():
-            raise InvalidOptionError(
-                "kernel='numba' needs numba, a dependency of drakegrasp that "
-                "is not installed here (pip install numba); use kernel='numpy'"
-            )
-    if kernel == "auto":
-        if numba_available():
-            return "numba"
+    if kernel == "numba" and not numba_available():
+        raise InvalidOptionError(
+            "kernel='numba' needs numba, a dependency of drakegrasp that "
+            "is not installed here (pip install numba); use kernel='numpy'"
+        )
+    if kernel == "auto" and not numba_available():
         from drakegrasp.batch.compiled import announce_numpy_route
 
         announce_numpy_route()  # once per process
         return "numpy"
-    return kernel
+    if kernel == "numpy":
+        return kernel
+    from drakegrasp.batch.compiled import announce_misspelt_kernels
+
+    announce_misspelt_kernels()  # once per process
+    return "numba"

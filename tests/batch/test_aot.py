@@ -183,6 +183,12 @@ def test_a_misspelt_variable_is_a_grasp_warning_said_once(monkeypatch):
             warnings.simplefilter("always")
             for _ in range(3):
                 compiled.announce_misspelt_kernels()
+        monkeypatch.setattr(compiled, "_misspelling_said", False)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", dg.GraspWarning)
+            with pytest.raises(dg.KernelsVariableWarning, match="'fast'"):
+                compiled.announce_misspelt_kernels()
+            compiled.announce_misspelt_kernels()  # said (raised) once
     finally:
         monkeypatch.delenv(aot.ENV)
         aot._reset()
@@ -194,31 +200,39 @@ def test_a_misspelt_variable_is_a_grasp_warning_said_once(monkeypatch):
 
 
 _MISSPELT = r"""
-import json, warnings
+import json, sys, warnings
 import numpy as np
 import drakegrasp as dg
 from drakegrasp.batch import batch_force_closure
+workers = int(sys.argv[1])
 rng = np.random.default_rng(3)
 p = rng.normal(size=(40, 3, 3)); n = -p + 0.3 * rng.normal(size=(40, 3, 3))
 with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
-    a = batch_force_closure(p, n, 0.5, workers=1)
-    b = batch_force_closure(p, n, 0.5, workers=1)
+    a = batch_force_closure(p, n, mu=0.5, workers=workers, chunk_size=8)
+    b = batch_force_closure(p, n, mu=0.5, workers=workers, chunk_size=8)
 said = [w for w in caught if issubclass(w.category, dg.GraspWarning)]
+with warnings.catch_warnings():
+    warnings.simplefilter("error", dg.GraspWarning)
+    c = batch_force_closure(p, n, mu=0.5, workers=workers, chunk_size=8)
 print(json.dumps({
-    "said": [(w.category.__name__, str(w.message)) for w in said],
-    "same": a.is_closure.tolist() == b.is_closure.tolist(),
+    "said": [(w.category.__name__, str(w.message), w.filename) for w in said],
+    "same": a.is_closure.tolist() == b.is_closure.tolist() == c.is_closure.tolist(),
 }))
 """
 
 
+@pytest.mark.parametrize("workers", [1, 2])
 def test_a_misspelt_variable_is_said_once_in_a_process_that_runs_kernels(
-    checkout_env,
+    checkout_env, workers
 ):
-    # aot imports nothing of drakegrasp; the engine's kernels say it for it
+    # aot imports nothing of drakegrasp: the engine says it for it, in the
+    # caller's process before any worker runs (workers=2 ran every chunk in
+    # worker processes, and the caller heard nothing), at the caller's line
+    # (it pointed into drakegrasp/batch/build/construction_kernel.py)
     env = dict(checkout_env, **{aot.ENV: "fast"})
     out = subprocess.run(
-        [sys.executable, "-c", _MISSPELT],
+        [sys.executable, "-c", _MISSPELT, str(workers)],
         env=env, capture_output=True, text=True, timeout=600, check=True,
     )  # fmt: skip
     said = json.loads(out.stdout)
@@ -227,6 +241,7 @@ def test_a_misspelt_variable_is_said_once_in_a_process_that_runs_kernels(
         [
             "KernelsVariableWarning",
             "DRAKEGRASP_KERNELS='fast' is not 'auto' or 'jit'; numba's JIT runs",
+            "<string>",
         ]
     ]
 
