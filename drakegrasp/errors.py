@@ -6,6 +6,7 @@ all of them.  Messages name the offending value and what would be valid.
 
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 MAX_MESSAGE = 10_000
@@ -16,6 +17,29 @@ Messages name the offending value; a value whose ``repr`` is megabytes long
 terminal.  Messages cut a value themselves, to about 120 characters
 (:func:`~drakegrasp.core.validation.describe`); this bound is the last guard.
 """
+
+
+def outside_stacklevel() -> int:
+    """``warnings.warn``'s ``stacklevel`` for the user's line, from the caller.
+
+    Called by the function that calls ``warnings.warn``: the level of the
+    first frame outside drakegrasp and ``dataclasses``, however deep in the
+    library the warning was raised (a ``plan_grasps`` call and a direct
+    call of the class that warns point at the user's own line alike).  It
+    lives beside :class:`GraspWarning` so that every module may use it,
+    those that import nothing else of drakegrasp's too.
+    """
+    stacklevel = 1
+    frame = sys._getframe(1)
+    while frame is not None and _inside(frame.f_globals.get("__name__", "")):
+        frame = frame.f_back
+        stacklevel += 1
+    return stacklevel
+
+
+def _inside(module: str) -> bool:
+    """Whether a frame of ``module`` is drakegrasp's or dataclasses' own."""
+    return module == "dataclasses" or module.split(".")[0] == "drakegrasp"
 
 
 def cut_message(text: str, limit: int = MAX_MESSAGE) -> str:

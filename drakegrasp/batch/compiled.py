@@ -41,7 +41,11 @@ import time
 import warnings
 
 from drakegrasp.batch import aot
-from drakegrasp.errors import GraspWarning, KernelsVariableWarning
+from drakegrasp.errors import (
+    GraspWarning,
+    KernelsVariableWarning,
+    outside_stacklevel,
+)
 
 __all__ = [
     "FASTMATH",
@@ -97,7 +101,7 @@ def announce_numpy_route() -> None:
         "dependency of drakegrasp; install it with `pip install numba` "
         "(this is said once per process)",
         NumbaMissingWarning,
-        stacklevel=3,
+        stacklevel=outside_stacklevel(),
     )
 
 
@@ -125,22 +129,7 @@ def announce_misspelt_kernels() -> None:
         _misspelling_said = True
     # a misspelt value would otherwise cost the compile (tens of seconds)
     # without a word
-    warnings.warn(aot.status(), KernelsVariableWarning, stacklevel=_outside_level())
-
-
-def _outside_level() -> int:
-    """``warnings.warn``'s ``stacklevel`` for the first frame outside drakegrasp.
-
-    Counted from the caller of this function, as
-    :func:`drakegrasp.core.deprecation.outside_stacklevel` counts; not imported
-    from there, which would lengthen the package's longest import chain.
-    """
-    level, frame = 1, sys._getframe(1)
-    while frame is not None and (
-        frame.f_globals.get("__name__", "").split(".")[0] == "drakegrasp"
-    ):
-        frame, level = frame.f_back, level + 1
-    return level
+    warnings.warn(aot.status(), KernelsVariableWarning, stacklevel=outside_stacklevel())
 
 
 class _CompileNotice:

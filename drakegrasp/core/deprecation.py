@@ -17,7 +17,11 @@ import warnings
 from collections.abc import Callable
 from typing import TypeVar
 
-from drakegrasp.errors import InvalidArgumentError, InvalidOptionError
+from drakegrasp.errors import (
+    InvalidArgumentError,
+    InvalidOptionError,
+    outside_stacklevel,
+)
 
 __all__ = ["keyword_only", "outside_stacklevel", "renamed_keyword", "warn_deprecated"]
 
@@ -37,27 +41,6 @@ def warn_deprecated(message: str, *, stacklevel: int | None = None) -> None:
     if stacklevel is None:
         stacklevel = outside_stacklevel()
     warnings.warn(message, DeprecationWarning, stacklevel=stacklevel)
-
-
-def outside_stacklevel() -> int:
-    """``warnings.warn``'s ``stacklevel`` for the user's line, from the caller.
-
-    Called by the function that calls ``warnings.warn``: the level of the
-    first frame outside drakegrasp and ``dataclasses``, however deep in the
-    library the warning was raised (a ``plan_grasps`` call and a direct
-    call of the class that warns point at the user's own line alike).
-    """
-    stacklevel = 1
-    frame = sys._getframe(1)
-    while frame is not None and _inside(frame.f_globals.get("__name__", "")):
-        frame = frame.f_back
-        stacklevel += 1
-    return stacklevel
-
-
-def _inside(module: str) -> bool:
-    """Whether a frame of ``module`` is drakegrasp's or dataclasses' own."""
-    return module == "dataclasses" or module.split(".")[0] == "drakegrasp"
 
 
 def renamed_keyword(old: str, new: str) -> Callable[[F], F]:

@@ -161,6 +161,23 @@ def test_the_numpy_route_is_announced_once(monkeypatch):
     assert "numba is not installed" in str(ours[0].message)
 
 
+def test_the_numpy_route_is_announced_at_the_users_line(monkeypatch):
+    import drakegrasp.batch.inputs as inputs
+    from drakegrasp.batch import batch_force_closure
+
+    monkeypatch.setattr(inputs, "numba_available", lambda: False)
+    monkeypatch.setattr(compiled, "_announced", False)
+    rng = np.random.default_rng(3)
+    p = rng.normal(size=(4, 3, 3))
+    n = -p + 0.3 * rng.normal(size=(4, 3, 3))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        batch_force_closure(p, n, mu=0.5, workers=1)
+    ours = [w for w in caught if issubclass(w.category, compiled.NumbaMissingWarning)]
+    # deep in the batch engine, the warning still points at this line
+    assert [w.filename for w in ours] == [__file__]
+
+
 _NO_NUMBA = r"""
 import sys, json
 sys.modules["numba"] = None  # as if numba could not be installed
