@@ -88,9 +88,9 @@ from drakegrasp.planning.squeeze import DEFAULT_SQUEEZE, HOLD_LEVER, contact_lev
 from drakegrasp.planning.turned_gravity import (
     DEFAULT_DIRECTIONS,
     GRAVITY,
+    _gravity_field,
     _schedule,
     _TurnedGravity,
-    plant_gravity,
 )
 from drakegrasp.plant.couplings import motor_shares, plant_couplings
 from drakegrasp.plant.fingers import (
@@ -1165,10 +1165,11 @@ def _warn_at_stops(stopped: list[str]) -> None:
 def _shake_plant(add_models, step: float, object_body):
     """``add_models`` read into a new discrete plant of time step ``step`` (s).
 
-    Returns ``(builder, plant, scene_graph, hand, object, g)``: the object
-    ``object_body`` where given, and ``g`` the magnitude (m/s²) of the
-    gravity field ``add_models`` left the plant with (read before the shake
-    sets it to zero, so that the hand feels none).
+    Returns ``(builder, plant, scene_graph, hand, object, g, down)``: the
+    object ``object_body`` where given, ``g`` the magnitude (m/s²) of the
+    gravity field ``add_models`` left the plant with and ``down`` its unit
+    direction (3,) in the world frame, both from one read of the field made
+    before the shake sets it to zero (so that the hand feels none).
 
     Raises
     ------
@@ -1186,10 +1187,10 @@ def _shake_plant(add_models, step: float, object_body):
     hand, obj = made
     if object_body is not None:
         obj = object_body
-    g = plant_gravity(plant)
+    g, g_W = _gravity_field(plant)
     if g == 0.0:
         raise ModelError(_weightless(plant))
-    return builder, plant, scene_graph, hand, obj, g
+    return builder, plant, scene_graph, hand, obj, g, g_W / g
 
 
 def _period_before_finalize(plant, scene_graph, body, candidate, mass, M_BBo_B):
@@ -1442,11 +1443,13 @@ def shake_test(
         object_mass=object_mass,
     )  # fmt: skip
     modulus = check_hydroelastic_modulus(hydroelastic_modulus)
+    ends = [seat + settle + (k + 1) * phase for k in range(len(dirs))]
+    duration = ends[-1]  # simulated seconds, once
     t0 = time.perf_counter()
     # None: the default step, within a tenth of a phase as a given one must be
     step = min(DEFAULT_TIME_STEP, phase / 10) if time_step is None else time_step
     step = float(step)
-    builder, plant, scene_graph, hand, obj, g = _shake_plant(
+    builder, plant, scene_graph, hand, obj, g, down = _shake_plant(
         add_models, step, object_body
     )
     body = resolve_object_body(plant, obj)
@@ -1461,14 +1464,12 @@ def shake_test(
     resolving = _resolving_step(period)
     if time_step is None and resolving < step:  # the models read again at that step
         if resolving < MIN_TIME_STEP:
-            duration = seat + settle + len(dirs) * phase
             raise ModelError(_too_fine(plant, body, mass, period, resolving, duration))
         step = resolving
-        builder, plant, scene_graph, hand, obj, g = _shake_plant(
+        builder, plant, scene_graph, hand, obj, g, down = _shake_plant(
             add_models, step, object_body
         )
         body = resolve_object_body(plant, obj)
-    down = np.asarray(plant.gravity_field().gravity_vector(), dtype=float) / g
     base = resolve_body(plant, candidate.hand_base)
     actuators = [plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices()]
     by_name = {_scoped(plant, a.joint()): a for a in actuators}
@@ -1628,8 +1629,6 @@ def shake_test(
     plant.get_actuation_input_port().FixValue(ctx, np.zeros(plant.num_actuated_dofs()))
     H = base.body_frame()
     X_HO0 = plant.CalcRelativeTransform(ctx, H, body.body_frame())
-    ends = [seat + settle + (k + 1) * phase for k in range(len(dirs))]
-    duration = ends[-1]
     max_d = max_r = 0.0
     phases = []
     t, dt_check = 0.0, 0.01

@@ -61,6 +61,22 @@ def plant_gravity(plant) -> float:
         A field that is not finite (Drake takes ``inf`` and NaN), or whose
         length is no float (components near 1e308), named with its vector.
     """
+    return _gravity_field(plant)[0]
+
+
+def _gravity_field(plant) -> tuple[float, np.ndarray]:
+    """The plant's gravity field, read once: ``(|g|, g_W)``.
+
+    ``|g|`` as :func:`plant_gravity` returns it (m/s², finite, >= 0) and
+    ``g_W`` the field's vector (3,) in the world frame, m/s², from the same
+    read, so that a caller who needs the direction too (the shake settles
+    along ``g_W / |g|``) does not ask the plant twice.
+
+    Raises
+    ------
+    ModelError
+        As :func:`plant_gravity`.
+    """
     g_W = np.asarray(plant.gravity_field().gravity_vector(), dtype=float)
     g = math.hypot(*g_W)  # |(0, 0, -9.81)| is 9.81 to the bit; no overflow inside
     if not math.isfinite(g):
@@ -69,7 +85,7 @@ def plant_gravity(plant) -> float:
             "magnitude: set a finite one (plant.mutable_gravity_field()"
             ".set_gravity_vector) to weigh the object with"
         )
-    return g
+    return g, g_W
 
 
 DEFAULT_DIRECTIONS = (
