@@ -35,7 +35,7 @@ import numpy as np
 from drakegrasp.core.calls import checked_call, unknown_names
 from drakegrasp.core.deprecation import outside_stacklevel
 from drakegrasp.core.serialize import jsonable
-from drakegrasp.core.validation import describe, plain_str
+from drakegrasp.core.validation import describe, plain_str, real_scalar
 from drakegrasp.errors import (
     GraspWarning,
     InvalidGraspError,
@@ -79,11 +79,20 @@ class GravityMismatchWarning(GraspWarning):
 
 
 def _check_gravity(candidates, result: ShakeResult) -> None:
-    """Warn when ``result`` shook at another |g| than ``candidates`` were planned at."""
+    """Warn when ``result`` shook at another |g| than ``candidates`` were planned at.
+
+    The recorded gravity is any real scalar (a float, a numpy float64, an
+    int from JSON: ``settings["gravity"]`` of a plan read back); none, or one
+    that is not a finite real number, is not compared.
+    """
     settings = getattr(candidates, "settings", None)
-    planned = settings.get("gravity") if isinstance(settings, dict) else None
+    recorded = settings.get("gravity") if isinstance(settings, dict) else None
+    try:
+        planned = real_scalar('settings["gravity"]', recorded)
+    except InvalidOptionError:  # none recorded (a list of candidates), or no number
+        return
     shaken = result.gravity
-    if not isinstance(planned, float) or math.isclose(planned, shaken, rel_tol=1e-9):
+    if not math.isfinite(planned) or math.isclose(planned, shaken, rel_tol=1e-9):
         return
     warnings.warn(
         f"the candidates were planned in a plant of gravity {planned:g} m/s², "

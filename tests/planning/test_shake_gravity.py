@@ -227,3 +227,50 @@ def test_the_gravity_mismatch_warning_points_at_the_callers_line(scenes):
     assert [w.filename for w in seen if w.category is GravityMismatchWarning] == [
         __file__
     ]
+
+
+@pytest.mark.parametrize(
+    "planned",
+    [1.62, np.float64(1.62), np.float32(1.62), 2, np.int64(2), np.array(1.62)],
+)
+def test_a_recorded_gravity_of_any_real_type_is_compared(planned):
+    # The review: a plan's settings["gravity"] read back from JSON (an int) or
+    # computed in numpy (float64) was skipped, since only a float was compared
+    import types
+    import warnings
+
+    from drakegrasp.planning.shake_ranking import GravityMismatchWarning, _check_gravity
+    from drakegrasp.planning.shake_result import ShakeResult
+
+    def shaken(g: float) -> ShakeResult:
+        return ShakeResult(
+            held=True, max_displacement=0.0, max_rotation=0.0, phases=(),
+            squeeze=1.0, efforts=(), time_step=1e-3, duration=1.0, wall_time=0.1,
+            bounds=(0.01, 0.1), gravity=g,
+        )  # fmt: skip
+
+    plan = types.SimpleNamespace(settings={"gravity": planned})
+    with pytest.warns(GravityMismatchWarning, match=f"{float(planned):g} m/s²"):
+        _check_gravity(plan, shaken(9.81))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GravityMismatchWarning)
+        _check_gravity(plan, shaken(float(planned)))  # the same: nothing said
+
+
+@pytest.mark.parametrize("recorded", [None, "1.62", True, float("nan"), [1.62]])
+def test_no_recorded_gravity_is_compared_with_nothing_said(recorded):
+    import types
+    import warnings
+
+    from drakegrasp.planning.shake_ranking import GravityMismatchWarning, _check_gravity
+    from drakegrasp.planning.shake_result import ShakeResult
+
+    result = ShakeResult(
+        held=True, max_displacement=0.0, max_rotation=0.0, phases=(), squeeze=1.0,
+        efforts=(), time_step=1e-3, duration=1.0, wall_time=0.1, bounds=(0.01, 0.1),
+        gravity=9.81,
+    )  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GravityMismatchWarning)
+        _check_gravity(types.SimpleNamespace(settings={"gravity": recorded}), result)
+        _check_gravity([], result)  # a list of candidates records none
