@@ -68,6 +68,7 @@ from scipy.optimize import linprog
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+from bench_allegro_squeeze import ALLEGRO, FINGERS  # noqa: E402  (the same hand)
 from bench_plan import drake_models  # noqa: E402
 from pydrake.math import RigidTransform  # noqa: E402
 
@@ -77,16 +78,6 @@ from drakegrasp.core.grasp import grasp_matrix  # noqa: E402
 from drakegrasp.planning.motors import finger_jacobian  # noqa: E402
 from drakegrasp.planning.opposition import closing_directions  # noqa: E402
 
-ALLEGRO = (
-    "package://drake_models/allegro_hand_description/sdf/"
-    "allegro_hand_description_right.sdf"
-)
-FINGERS = {  # the Allegro right hand's links, by finger
-    "I": ("link_0", "link_1", "link_2", "link_3"),
-    "M": ("link_4", "link_5", "link_6", "link_7"),
-    "R": ("link_8", "link_9", "link_10", "link_11"),
-    "T": ("link_12", "link_13", "link_14", "link_15"),
-}
 TIPS = ("link_3", "link_7", "link_11", "link_15")
 OBJECTS = [
     "005_tomato_soup_can", "004_sugar_box", "003_cracker_box",

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import pytest
-
-from drakegrasp import cli
+from cli_runs import run_cli
 
 HUGE = "x" * 200_000
 
@@ -21,11 +20,7 @@ HUGE = "x" * 200_000
     ids=["mu", "contact-model", "modulus", "hand", "package"],
 )
 def test_a_huge_argument_is_refused_on_one_short_line(argv, capsys):
-    try:
-        status = cli.main(argv)
-    except SystemExit as exit_:  # argparse's own refusals
-        status = exit_.code
-    err = capsys.readouterr().err
+    status, err = run_cli(argv, capsys)
     assert status != 0
     assert err.count("\n") == 1, err[:300]
     assert len(err) <= 10_300, f"a {len(err)}-character refusal"

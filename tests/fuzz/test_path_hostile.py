@@ -29,6 +29,7 @@ from drakegrasp.plant.models import DRAKE_MODELS_ENV
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import hostile  # noqa: E402
+from cli_runs import run_cli  # noqa: E402
 
 SHORT = 2_000
 """Characters a refusal's message may take, whatever the path."""
@@ -313,11 +314,7 @@ def test_the_command_refuses_a_path_of_a_long_name_on_one_line(
     argv, capsys, files, monkeypatch
 ):
     monkeypatch.chdir(files[0])
-    try:
-        status = cli.main(argv)
-    except SystemExit as exit_:  # argparse's own refusals
-        status = exit_.code
-    err = capsys.readouterr().err
+    status, err = run_cli(argv, capsys)
     assert status != 0
     assert err.count("\n") == 1, err[:300]
     assert "unexpected" not in err, err[:300]  # the CLI's last net: a bug
@@ -376,11 +373,7 @@ def test_the_command_refuses_undecodable_bytes_on_one_line(
     # These gave a one-line refusal when probed by hand; now they are fuzzed.
     monkeypatch.chdir(files[0])
     argv = _undecodable_argvs(gripper)[case]
-    try:
-        status = cli.main(argv)
-    except SystemExit as exit_:  # argparse's own refusals
-        status = exit_.code
-    err = capsys.readouterr().err
+    status, err = run_cli(argv, capsys)
     assert status != 0
     assert err.count("\n") == 1, err[:300]
     assert err.startswith("drakegrasp") and "unexpected" not in err, err[:300]

@@ -18,7 +18,6 @@ as the plain ``str`` it holds (``str.__str__``), or refuses it by name:
 from __future__ import annotations
 
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +31,7 @@ from drakegrasp.batch.files.writer import format_of
 from drakegrasp.batch.inputs import resolve_kernel
 from drakegrasp.certificates.kinds import check_kind_and_cones
 from drakegrasp.closure.programs import build_force_closure_program, check_formulation
-from drakegrasp.planning import plan_grasps, planning_scene
+from drakegrasp.planning import planning_scene
 from drakegrasp.planning.approach import OPEN
 from drakegrasp.planning.candidates import GraspCandidate
 from drakegrasp.plant.couplings import (
@@ -51,6 +50,7 @@ from drakegrasp.visualization.geometry import side_sign
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import hostile  # noqa: E402
+from quiet_plans import plan_quietly  # noqa: E402
 
 SHORT = 2_000
 """Characters a refusal's message may take, whatever the value."""
@@ -288,12 +288,7 @@ PLAN = dict(num_candidates=4, mu=0.5, seed=0, robustness_samples=2)
 
 
 def _plan(scene, **options):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # friction mismatches and the like
-        return plan_grasps(
-            scene.plant, scene.context, scene.object_body, hand=scene.hand,
-            **{**PLAN, **options},
-        )  # fmt: skip
+    return plan_quietly(scene, **{**PLAN, **options})
 
 
 @pytest.mark.parametrize("option", ["preshape", "synergy"])

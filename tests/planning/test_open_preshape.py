@@ -10,14 +10,13 @@ holds in Drake's simulation.
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 from coupled_hands import angular_gripper_urdf, coupled_jaw_urdf, spread_hand_urdf
+from quiet_plans import plan_quietly
 
 from drakegrasp.errors import InvalidOptionError
-from drakegrasp.planning import plan_grasps, planning_scene, shake_test
+from drakegrasp.planning import planning_scene, shake_test
 from drakegrasp.planning.approach import OPEN
 from drakegrasp.planning.planner import OPEN_HAND_HINT
 
@@ -43,12 +42,7 @@ def _scene(path, left=None):
 
 
 def _plan(scene, **options):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # friction mismatches and the like
-        return plan_grasps(
-            scene.plant, scene.context, scene.object_body, hand=scene.hand,
-            **{**PLAN, **options},
-        )  # fmt: skip
+    return plan_quietly(scene, **{**PLAN, **options})
 
 
 @pytest.fixture(scope="module")
