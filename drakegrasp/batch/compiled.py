@@ -80,8 +80,23 @@ class NumbaMissingWarning(GraspWarning):
     """numba is not installed: the batch engine runs its (slower) numpy route."""
 
 
-_announced = False
-_announce_lock = threading.Lock()
+_said: set[type] = set()
+"""The warnings said in this process (:func:`_first_time`)."""
+_said_lock = threading.Lock()
+
+
+def _first_time(category: type[GraspWarning]) -> bool:
+    """Whether ``category`` is said for the first time in this process.
+
+    Marks it said: each warning of the batch engine is said once per
+    process.  The caller warns with it (a literal class, which the test of
+    every ``warnings.warn`` call reads).
+    """
+    with _said_lock:
+        if category in _said:
+            return False
+        _said.add(category)
+        return True
 
 
 def announce_numpy_route() -> None:
@@ -90,22 +105,15 @@ def announce_numpy_route() -> None:
     Called where ``kernel="auto"`` resolves to the numpy route; later calls
     return at once.
     """
-    global _announced
-    with _announce_lock:
-        if _announced:
-            return
-        _announced = True
-    warnings.warn(
-        "numba is not installed, so drakegrasp's batch engine runs its numpy "
-        "route: the same verdicts, about 5-10 times slower. numba is a "
-        "dependency of drakegrasp; install it with `pip install numba` "
-        "(this is said once per process)",
-        NumbaMissingWarning,
-        stacklevel=outside_stacklevel(),
-    )
-
-
-_misspelling_said = False
+    if _first_time(NumbaMissingWarning):
+        warnings.warn(
+            "numba is not installed, so drakegrasp's batch engine runs its "
+            "numpy route: the same verdicts, about 5-10 times slower. numba is "
+            "a dependency of drakegrasp; install it with `pip install numba` "
+            "(this is said once per process)",
+            NumbaMissingWarning,
+            stacklevel=outside_stacklevel(),
+        )
 
 
 def announce_misspelt_kernels() -> None:
@@ -120,16 +128,13 @@ def announce_misspelt_kernels() -> None:
     for its ahead-of-time entry; later calls return at once.  The warning
     points at the caller's own line, the first frame outside drakegrasp.
     """
-    global _misspelling_said
-    if _misspelling_said or not aot.misspelt():
-        return
-    with _announce_lock:
-        if _misspelling_said:
-            return
-        _misspelling_said = True
     # a misspelt value would otherwise cost the compile (tens of seconds)
     # without a word
-    warnings.warn(aot.status(), KernelsVariableWarning, stacklevel=outside_stacklevel())
+    if KernelsVariableWarning not in _said and aot.misspelt():
+        if _first_time(KernelsVariableWarning):
+            warnings.warn(
+                aot.status(), KernelsVariableWarning, stacklevel=outside_stacklevel()
+            )
 
 
 class _CompileNotice:

@@ -176,14 +176,14 @@ def test_jit_is_forced_by_the_environment(monkeypatch):
 
 def test_a_misspelt_variable_is_a_grasp_warning_said_once(monkeypatch):
     monkeypatch.setenv(aot.ENV, "fast")
-    monkeypatch.setattr(compiled, "_misspelling_said", False)
+    monkeypatch.setattr(compiled, "_said", set())
     aot._reset()
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             for _ in range(3):
                 compiled.announce_misspelt_kernels()
-        monkeypatch.setattr(compiled, "_misspelling_said", False)
+        monkeypatch.setattr(compiled, "_said", set())
         with warnings.catch_warnings():
             warnings.simplefilter("error", dg.GraspWarning)
             with pytest.raises(dg.KernelsVariableWarning, match="'fast'"):

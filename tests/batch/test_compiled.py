@@ -150,7 +150,7 @@ def test_the_numpy_route_is_announced_once(monkeypatch):
     import drakegrasp.batch.inputs as inputs
 
     monkeypatch.setattr(inputs, "numba_available", lambda: False)
-    monkeypatch.setattr(compiled, "_announced", False)
+    monkeypatch.setattr(compiled, "_said", set())
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         assert [resolve_kernel("auto") for _ in range(3)] == ["numpy"] * 3
@@ -166,7 +166,7 @@ def test_the_numpy_route_is_announced_at_the_users_line(monkeypatch):
     from drakegrasp.batch import batch_force_closure
 
     monkeypatch.setattr(inputs, "numba_available", lambda: False)
-    monkeypatch.setattr(compiled, "_announced", False)
+    monkeypatch.setattr(compiled, "_said", set())
     rng = np.random.default_rng(3)
     p = rng.normal(size=(4, 3, 3))
     n = -p + 0.3 * rng.normal(size=(4, 3, 3))

@@ -95,17 +95,26 @@ def _turning_period(candidate, mass, inertia) -> float:
     return 2 * math.pi / math.sqrt(2 * 5e5 * (1 / mass + arm2 / inertia))
 
 
-def test_a_step_coarser_than_the_contacts_is_warned_of_and_none_resolves_it(cube):
-    scene, candidate = cube
+def _coarse_and_chosen(add_models, candidate, step: float, match: str):
+    """The shake at the coarse ``step`` (its warning matching ``match``), and
+    the shake at the step it picks itself (which must warn of nothing)."""
     ctx = _quiet()
     try:
-        with pytest.warns(CoarseStepWarning, match=r"give time_step <= 0\.00026 s"):
-            coarse = shake_test(scene.add_models, candidate, time_step=1e-3)
+        with pytest.warns(CoarseStepWarning, match=match):
+            coarse = shake_test(add_models, candidate, time_step=step)
         with warnings.catch_warnings():
             warnings.simplefilter("error", CoarseStepWarning)
-            chosen = shake_test(scene.add_models, candidate)
+            chosen = shake_test(add_models, candidate)
     finally:
         ctx.__exit__(None, None, None)
+    return coarse, chosen
+
+
+def test_a_step_coarser_than_the_contacts_is_warned_of_and_none_resolves_it(cube):
+    scene, candidate = cube
+    coarse, chosen = _coarse_and_chosen(
+        scene.add_models, candidate, 1e-3, r"give time_step <= 0\.00026 s"
+    )
     # 5 g on two 5e5 N/m contacts 3.6 mm off its centre of mass: T = 0.332
     # ms, where its translation alone has 2 pi sqrt(0.005 / 1e6) = 0.444 ms
     assert chosen.contact_period == pytest.approx(
@@ -134,15 +143,9 @@ def test_a_cube_that_turns_faster_than_it_slides_is_shaken_at_its_turning_step(
     path = tmp_path / "dense_cube.sdf"
     path.write_text(CUBE.replace("8.3e-8", "8.3e-9"))
     dense = planning_scene(f"file://{path}")
-    ctx = _quiet()
-    try:
-        with pytest.warns(CoarseStepWarning, match=r"give time_step <= 0\.00011 s"):
-            slid = shake_test(dense.add_models, candidate, time_step=3e-4)
-        with warnings.catch_warnings():
-            warnings.simplefilter("error", CoarseStepWarning)
-            chosen = shake_test(dense.add_models, candidate)
-    finally:
-        ctx.__exit__(None, None, None)
+    slid, chosen = _coarse_and_chosen(
+        dense.add_models, candidate, 3e-4, r"give time_step <= 0\.00011 s"
+    )
     assert chosen.contact_period == pytest.approx(
         _turning_period(candidate, 0.005, 8.3e-9), rel=1e-6
     )
